@@ -1,0 +1,45 @@
+# The two entry points of the README: `make demo` and `make test`. Both set everything up.
+VENV   ?= .venv
+PY     := $(VENV)/bin/python
+PIP    := $(PY) -m pip
+STAMP  := $(VENV)/.deps-stamp
+PYSRC  := python tests benches
+
+.PHONY: demo test develop rust-test rust-lint py-lint pytest bench clean
+
+$(STAMP): pyproject.toml
+	python3 -m venv $(VENV)
+	$(PIP) install -q --upgrade pip
+	$(PIP) install -q "maturin>=1.9,<2" "numpy>=1.24" "scipy>=1.10" "matplotlib>=3.7" \
+		"pytest>=8" "hypothesis>=6.100" "ruff>=0.6" "npTDMS>=1.9" "h5py>=3.9" "pyarrow>=14"
+	touch $(STAMP)
+
+# Build the Rust extension (release) and install the package into the venv.
+develop: $(STAMP)
+	VIRTUAL_ENV=$(abspath $(VENV)) $(VENV)/bin/maturin develop --release --locked -q
+
+demo: develop
+	$(VENV)/bin/contactlab demo --out demo-output
+
+rust-test:
+	cargo test -p contactlab-core --locked -q
+
+rust-lint:
+	cargo fmt --all --check
+	cargo clippy --workspace --all-targets --locked -q -- -D warnings
+
+py-lint: $(STAMP)
+	$(VENV)/bin/ruff check $(PYSRC)
+	$(VENV)/bin/ruff format --check $(PYSRC)
+
+pytest: develop
+	$(PY) -m pytest -q -p no:cacheprovider
+
+test: rust-lint rust-test py-lint pytest
+
+bench: develop
+	cargo bench -p contactlab-core --locked --bench masing
+	$(PY) benches/bench_masing.py
+
+clean:
+	rm -rf $(VENV) target demo-output

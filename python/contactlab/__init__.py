@@ -1,0 +1,25 @@
+"""contactlab: hysteresis of contact joints in machine structures.
+
+Tangential contact (Masing friction hysteresis), normal contact (Konowalski's loops and
+models), fitting, reports and model-discrepancy diagnosis. See README.md.
+"""
+
+from __future__ import annotations
+
+from .errors import ContactLabError, ContactLabWarning, ConvergenceError, InputError
+from .masing import CycleTable, Masing, MasingOperator, cycle_energies, loop_area
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "ContactLabError",
+    "ContactLabWarning",
+    "ConvergenceError",
+    "CycleTable",
+    "InputError",
+    "Masing",
+    "MasingOperator",
+    "__version__",
+    "cycle_energies",
+    "loop_area",
+]

@@ -1,0 +1,60 @@
+"""Array conversion at the package boundary: float64, contiguous, 1-D, finite, named errors."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .errors import InputError
+
+
+def as_1d(x: Any, name: str, *, allow_empty: bool = False, finite: bool = True) -> np.ndarray:
+    """Return `x` as a contiguous 1-D float64 array or raise :class:`InputError`.
+
+    int and float32 input is converted; NaN/inf is rejected with the index named.
+    """
+    try:
+        a = np.ascontiguousarray(x, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} cannot be converted to a float array: {exc}") from None
+    if a.ndim != 1:
+        raise InputError(f"{name} must be 1-D, got an array of shape {a.shape}")
+    if a.size == 0 and not allow_empty:
+        raise InputError(f"{name} is empty")
+    if finite:
+        bad = ~np.isfinite(a)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise InputError(f"{name}[{i}] is not finite ({a[i]})")
+    return a
+
+
+def scalar_or_array(x: Any, name: str) -> tuple[np.ndarray, bool]:
+    """Flatten a scalar or array for a vectorised kernel; tell whether it was a scalar."""
+    try:
+        a = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} cannot be converted to a float array: {exc}") from None
+    flat = np.ascontiguousarray(a.reshape(-1))
+    bad = ~np.isfinite(flat)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise InputError(f"{name}[{i}] is not finite ({flat[i]})")
+    return flat, a.ndim == 0
+
+
+def restore(flat: np.ndarray, like: Any, was_scalar: bool) -> Any:
+    if was_scalar:
+        return float(flat[0])
+    return flat.reshape(np.shape(like))
+
+
+def positive(value: Any, name: str) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a number, got {value!r}") from None
+    if not np.isfinite(v) or v <= 0:
+        raise InputError(f"{name} must be finite and > 0, got {v}")
+    return v

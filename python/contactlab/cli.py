@@ -1,0 +1,60 @@
+"""Command-line interface: ``contactlab <verb> ...``.
+
+Each verb lives in its own module and registers itself through ``add_parser(subparsers)``;
+its handler returns an exit code. Errors derived from ``ContactLabError`` print one clear line
+and exit non-zero; Ctrl-C exits 130 without leaving partial outputs (writers are atomic).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from .errors import ContactLabError
+
+# Modules providing `add_parser(subparsers)`; each sets `handler` via set_defaults.
+_VERB_MODULES = [
+    "contactlab.demo",
+]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="contactlab",
+        description="Hysteresis of contact joints: fit, measure and diagnose contact models.",
+    )
+    from . import __version__
+
+    p.add_argument("--version", action="version", version=f"contactlab {__version__}")
+    sub = p.add_subparsers(dest="verb", metavar="VERB")
+    for name in _VERB_MODULES:
+        try:
+            mod = importlib.import_module(name)
+        except ModuleNotFoundError as exc:  # a verb whose optional module is absent
+            if exc.name != name:
+                raise
+            continue
+        mod.add_parser(sub)
+    return p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "handler", None):
+        parser.print_help()
+        return 2
+    try:
+        return int(args.handler(args) or 0)
+    except ContactLabError as exc:
+        print(f"contactlab {args.verb}: error: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print(f"contactlab {args.verb}: interrupted; no partial outputs written", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,362 @@
+//! Virgin (initial loading) curves for the Masing operator.
+//!
+//! A curve is an odd, non-decreasing function `f` with `f(0) = 0`. The operator only calls
+//! [`Backbone::eval`]; the energy and stiffness helpers use the rest of the trait. Adding a
+//! curve means implementing this trait; the operator does not change.
+
+use crate::error::{check_finite, check_positive, CoreError};
+
+/// An odd, monotone non-decreasing virgin curve with `f(0) = 0`.
+pub trait Backbone {
+    /// `f(u)`, odd in `u`.
+    fn eval(&self, u: f64) -> f64;
+    /// `f'(u)`, even in `u`.
+    fn slope(&self, u: f64) -> f64;
+    /// `∫_0^u f(s) ds` for `u >= 0`.
+    fn integral(&self, u: f64) -> f64;
+    /// Area between the curve and its chord on `[0, u]`, `u >= 0`:
+    /// `∫_0^u f - u f(u) / 2`. A closed Masing loop of range `R` with branch scale `λ`
+    /// dissipates `2 λ² B(R/λ)` (PHYSICS.md §1). Override where the default cancels badly.
+    fn chord_area(&self, u: f64) -> f64 {
+        let u = u.abs();
+        self.integral(u) - 0.5 * u * self.eval(u)
+    }
+}
+
+/// `1 - exp(-z)` for `z >= 0`, accurate for small `z` (Sterbenz: above ln 2 the subtraction is
+/// exact and `exp` is cheaper than `expm1`).
+#[inline(always)]
+pub fn one_minus_exp_neg(z: f64) -> f64 {
+    if z < std::f64::consts::LN_2 {
+        -(-z).exp_m1()
+    } else {
+        1.0 - (-z).exp()
+    }
+}
+
+/// The paper's exponential virgin curve `f(u) = h0 (1 - exp(-ac u))`, odd-extended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Exponential {
+    /// Saturation force h0 (break-away friction force).
+    pub h0: f64,
+    /// Curvature ac (1/length).
+    pub ac: f64,
+}
+
+impl Exponential {
+    pub fn new(h0: f64, ac: f64) -> Result<Self, CoreError> {
+        check_positive("h0", h0)?;
+        check_positive("ac", ac)?;
+        Ok(Self { h0, ac })
+    }
+
+    /// Energy dissipated by a symmetric Masing cycle (λ = 2) of amplitude `a` (PHYSICS.md §1).
+    pub fn loop_energy(&self, a: f64) -> f64 {
+        8.0 * self.chord_area(a)
+    }
+}
+
+/// `z - (1 - e^-z) - z (1 - e^-z) / 2`, the chord area of `1 - e^-u` on `[0, z]`,
+/// computed without cancellation for small `z` (series `Σ (-1)^m z^m (2 - m) / (2 m!)`).
+fn exp_chord_area_unit(z: f64) -> f64 {
+    if z < 2.0 {
+        // Terms from m = 3; the m = 2 term vanishes.
+        let mut term = z * z * z / 6.0; // z^m / m! at m = 3
+        let mut sum = 0.0;
+        let mut m = 3.0_f64;
+        loop {
+            let t = term * (m - 2.0) * 0.5;
+            let signed = if (m as i64) % 2 == 0 { t } else { -t };
+            sum -= signed;
+            if t < 1e-18 * sum.abs() || m > 60.0 {
+                break;
+            }
+            m += 1.0;
+            term *= z / m;
+        }
+        sum
+    } else {
+        let g = one_minus_exp_neg(z);
+        z - g - 0.5 * z * g
+    }
+}
+
+impl Backbone for Exponential {
+    #[inline(always)]
+    fn eval(&self, u: f64) -> f64 {
+        (self.h0 * one_minus_exp_neg(self.ac * u.abs())).copysign(u)
+    }
+    fn slope(&self, u: f64) -> f64 {
+        self.h0 * self.ac * (-self.ac * u.abs()).exp()
+    }
+    fn integral(&self, u: f64) -> f64 {
+        let u = u.abs();
+        self.h0 * (u - one_minus_exp_neg(self.ac * u) / self.ac)
+    }
+    fn chord_area(&self, u: f64) -> f64 {
+        self.h0 / self.ac * exp_chord_area_unit(self.ac * u.abs())
+    }
+}
+
+/// A measured backbone: points `(u_i, f_i)` with `u_0 = 0`, `f_0 = 0`, `u` strictly increasing
+/// and `f` non-decreasing, interpolated by a monotone piecewise cubic (Fritsch–Carlson / PCHIP),
+/// odd-extended, and continued linearly with the end slope beyond the last point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tabulated {
+    u: Vec<f64>,
+    f: Vec<f64>,
+    d: Vec<f64>,
+    /// Cumulative integral at each knot.
+    cum: Vec<f64>,
+}
+
+impl Tabulated {
+    pub fn new(u: &[f64], f: &[f64]) -> Result<Self, CoreError> {
+        crate::error::check_same_len("x_points", u.len(), "f_points", f.len())?;
+        if u.len() < 2 {
+            return Err(CoreError::InvalidBackbone {
+                index: u.len(),
+                reason: "need at least two points (the origin and one more)",
+            });
+        }
+        check_finite("x_points", u)?;
+        check_finite("f_points", f)?;
+        if u[0] != 0.0 || f[0] != 0.0 {
+            return Err(CoreError::InvalidBackbone {
+                index: 0,
+                reason: "the backbone must start at the origin (x = 0, f = 0)",
+            });
+        }
+        for i in 1..u.len() {
+            if u[i] <= u[i - 1] {
+                return Err(CoreError::InvalidBackbone {
+                    index: i,
+                    reason: "x_points must be strictly increasing",
+                });
+            }
+            if f[i] < f[i - 1] {
+                return Err(CoreError::InvalidBackbone {
+                    index: i,
+                    reason: "f_points must be non-decreasing (monotone backbone)",
+                });
+            }
+        }
+        if f[f.len() - 1] <= 0.0 {
+            return Err(CoreError::InvalidBackbone {
+                index: f.len() - 1,
+                reason: "the backbone must rise above zero",
+            });
+        }
+        let d = pchip_slopes(u, f);
+        let mut cum = vec![0.0; u.len()];
+        for i in 1..u.len() {
+            let h = u[i] - u[i - 1];
+            // Exact integral of the Hermite cubic over one interval.
+            cum[i] = cum[i - 1] + h * (f[i - 1] + f[i]) / 2.0 + h * h * (d[i - 1] - d[i]) / 12.0;
+        }
+        Ok(Self {
+            u: u.to_vec(),
+            f: f.to_vec(),
+            d,
+            cum,
+        })
+    }
+
+    /// The knots `(u, f)`.
+    pub fn points(&self) -> (&[f64], &[f64]) {
+        (&self.u, &self.f)
+    }
+
+    /// Interval index `i` with `u[i] <= s < u[i+1]`, or `None` beyond the last knot.
+    #[inline]
+    fn interval(&self, s: f64) -> Option<usize> {
+        let n = self.u.len();
+        if s >= self.u[n - 1] {
+            return None;
+        }
+        // partition_point: first index with u > s; s >= 0 = u[0] so it is >= 1.
+        Some(self.u.partition_point(|&v| v <= s) - 1)
+    }
+
+    fn eval_pos(&self, s: f64) -> f64 {
+        let n = self.u.len();
+        match self.interval(s) {
+            None => self.f[n - 1] + self.d[n - 1] * (s - self.u[n - 1]),
+            Some(i) => {
+                let h = self.u[i + 1] - self.u[i];
+                let t = (s - self.u[i]) / h;
+                let (t2, t3) = (t * t, t * t * t);
+                let h00 = 2.0 * t3 - 3.0 * t2 + 1.0;
+                let h10 = t3 - 2.0 * t2 + t;
+                let h01 = -2.0 * t3 + 3.0 * t2;
+                let h11 = t3 - t2;
+                h00 * self.f[i] + h10 * h * self.d[i] + h01 * self.f[i + 1] + h11 * h * self.d[i + 1]
+            }
+        }
+    }
+}
+
+/// Fritsch–Carlson monotone slopes (the scheme of scipy's `PchipInterpolator`).
+fn pchip_slopes(x: &[f64], y: &[f64]) -> Vec<f64> {
+    let n = x.len();
+    let h: Vec<f64> = x.windows(2).map(|w| w[1] - w[0]).collect();
+    let delta: Vec<f64> = (0..n - 1).map(|i| (y[i + 1] - y[i]) / h[i]).collect();
+    let mut d = vec![0.0; n];
+    if n == 2 {
+        d[0] = delta[0];
+        d[1] = delta[0];
+        return d;
+    }
+    for k in 1..n - 1 {
+        if delta[k - 1] * delta[k] <= 0.0 {
+            d[k] = 0.0;
+        } else {
+            let w1 = 2.0 * h[k] + h[k - 1];
+            let w2 = h[k] + 2.0 * h[k - 1];
+            d[k] = (w1 + w2) / (w1 / delta[k - 1] + w2 / delta[k]);
+        }
+    }
+    d[0] = pchip_end(h[0], h[1], delta[0], delta[1]);
+    d[n - 1] = pchip_end(h[n - 2], h[n - 3], delta[n - 2], delta[n - 3]);
+    d
+}
+
+fn pchip_end(h0: f64, h1: f64, m0: f64, m1: f64) -> f64 {
+    let d = ((2.0 * h0 + h1) * m0 - h0 * m1) / (h0 + h1);
+    if d.signum() != m0.signum() || m0 == 0.0 {
+        0.0
+    } else if m0.signum() != m1.signum() && d.abs() > 3.0 * m0.abs() {
+        3.0 * m0
+    } else {
+        d
+    }
+}
+
+impl Backbone for Tabulated {
+    #[inline]
+    fn eval(&self, u: f64) -> f64 {
+        self.eval_pos(u.abs()).copysign(u)
+    }
+    fn slope(&self, u: f64) -> f64 {
+        let s = u.abs();
+        let n = self.u.len();
+        match self.interval(s) {
+            None => self.d[n - 1],
+            Some(i) => {
+                let h = self.u[i + 1] - self.u[i];
+                let t = (s - self.u[i]) / h;
+                let t2 = t * t;
+                let dh00 = (6.0 * t2 - 6.0 * t) / h;
+                let dh10 = 3.0 * t2 - 4.0 * t + 1.0;
+                let dh01 = (-6.0 * t2 + 6.0 * t) / h;
+                let dh11 = 3.0 * t2 - 2.0 * t;
+                dh00 * self.f[i] + dh10 * self.d[i] + dh01 * self.f[i + 1] + dh11 * self.d[i + 1]
+            }
+        }
+    }
+    fn integral(&self, u: f64) -> f64 {
+        let s = u.abs();
+        let n = self.u.len();
+        match self.interval(s) {
+            None => {
+                let r = s - self.u[n - 1];
+                self.cum[n - 1] + self.f[n - 1] * r + 0.5 * self.d[n - 1] * r * r
+            }
+            Some(i) => {
+                let h = self.u[i + 1] - self.u[i];
+                let t = (s - self.u[i]) / h;
+                let (t2, t3, t4) = (t * t, t * t * t, t * t * t * t);
+                // Antiderivatives of the Hermite basis functions on [0, t].
+                let i00 = t4 / 2.0 - t3 + t;
+                let i10 = t4 / 4.0 - 2.0 * t3 / 3.0 + t2 / 2.0;
+                let i01 = -t4 / 2.0 + t3;
+                let i11 = t4 / 4.0 - t3 / 3.0;
+                self.cum[i]
+                    + h * (i00 * self.f[i]
+                        + i10 * h * self.d[i]
+                        + i01 * self.f[i + 1]
+                        + i11 * h * self.d[i + 1])
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn simpson(f: impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
+        let h = (b - a) / n as f64;
+        let mut s = f(a) + f(b);
+        for i in 1..n {
+            let w = if i % 2 == 1 { 4.0 } else { 2.0 };
+            s += w * f(a + h * i as f64);
+        }
+        s * h / 3.0
+    }
+
+    #[test]
+    fn exponential_energy_matches_physics_formula_and_limits() {
+        let c = Exponential::new(3.0, 2.0).unwrap();
+        for &a in &[0.05, 0.3, 1.0, 2.5, 10.0] {
+            let hm = c.eval(a);
+            let printed = 8.0 * (c.h0 * (a - (1.0 - (-c.ac * a).exp()) / c.ac) - a * hm / 2.0);
+            let e = c.loop_energy(a);
+            assert!((e - printed).abs() <= 1e-9 * printed.abs(), "{a}: {e} vs {printed}");
+        }
+        // Small amplitude: cubic law (2/3) h0 ac^2 A^3.
+        let a = 1e-6;
+        let cubic = 2.0 / 3.0 * c.h0 * c.ac * c.ac * a * a * a;
+        assert!((c.loop_energy(a) / cubic - 1.0).abs() < 1e-5);
+        // Large amplitude: 4 h0 A - 8 h0 / ac.
+        let a = 50.0;
+        let big = 4.0 * c.h0 * a - 8.0 * c.h0 / c.ac;
+        assert!((c.loop_energy(a) / big - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn chord_area_series_and_direct_agree_at_switch() {
+        let below = exp_chord_area_unit(2.0 - 1e-12);
+        let g = one_minus_exp_neg(2.0);
+        let direct = 2.0 - g - g;
+        assert!((below - direct).abs() < 1e-12);
+    }
+
+    #[test]
+    fn tabulated_integral_matches_quadrature_and_is_monotone() {
+        let u = [0.0, 0.1, 0.3, 0.7, 1.5];
+        let f = [0.0, 0.8, 1.5, 1.9, 2.0];
+        let t = Tabulated::new(&u, &f).unwrap();
+        for &s in &[0.05, 0.3, 0.55, 1.2, 1.5, 2.0] {
+            let q = simpson(|v| t.eval(v), 0.0, s, 20_000);
+            assert!((t.integral(s) - q).abs() < 1e-9, "{s}");
+        }
+        let mut prev = t.eval(0.0);
+        for i in 1..2000 {
+            let v = t.eval(i as f64 * 1e-3);
+            assert!(v >= prev);
+            prev = v;
+        }
+        for (i, &ui) in u.iter().enumerate() {
+            assert!((t.eval(ui) - f[i]).abs() < 1e-15);
+            assert!((t.eval(-ui) + f[i]).abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn tabulated_rejects_bad_tables() {
+        assert!(matches!(
+            Tabulated::new(&[0.1, 0.2], &[0.0, 1.0]),
+            Err(CoreError::InvalidBackbone { index: 0, .. })
+        ));
+        assert!(matches!(
+            Tabulated::new(&[0.0, 0.2, 0.1], &[0.0, 1.0, 2.0]),
+            Err(CoreError::InvalidBackbone { index: 2, .. })
+        ));
+        assert!(matches!(
+            Tabulated::new(&[0.0, 0.1, 0.2], &[0.0, 1.0, 0.5]),
+            Err(CoreError::InvalidBackbone { index: 2, .. })
+        ));
+        assert!(Tabulated::new(&[0.0, f64::NAN], &[0.0, 1.0]).is_err());
+    }
+}

@@ -1,0 +1,101 @@
+//! One error type for the whole core. Every variant carries the data a user needs to find the
+//! problem (which argument, which index); the Python binding maps variants to
+//! `contactlab.InputError` / `contactlab.ConvergenceError`.
+
+/// Errors returned by core kernels. The core never panics on user input.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CoreError {
+    /// A sample is NaN or infinite.
+    #[error("{name}[{index}] is not finite ({value})")]
+    NonFinite {
+        name: &'static str,
+        index: usize,
+        value: f64,
+    },
+    /// An input array has no samples.
+    #[error("{name} is empty")]
+    Empty { name: &'static str },
+    /// Two arrays that must be sample-aligned differ in length.
+    #[error("{name_a} has {len_a} samples but {name_b} has {len_b}")]
+    LengthMismatch {
+        name_a: &'static str,
+        len_a: usize,
+        name_b: &'static str,
+        len_b: usize,
+    },
+    /// A scalar parameter is outside its valid range.
+    #[error("parameter {name} = {value} is invalid: {reason}")]
+    InvalidParameter {
+        name: &'static str,
+        value: f64,
+        reason: &'static str,
+    },
+    /// An array that must be strictly increasing is not.
+    #[error("{name} must be strictly increasing, but {name}[{index}] = {value} does not exceed {name}[{prev_index}] = {prev}", prev_index = index.saturating_sub(1))]
+    NotIncreasing {
+        name: &'static str,
+        index: usize,
+        value: f64,
+        prev: f64,
+    },
+    /// A backbone (virgin curve) table violates a requirement.
+    #[error("backbone is invalid at point {index}: {reason}")]
+    InvalidBackbone { index: usize, reason: &'static str },
+    /// An exported operator state cannot be restored.
+    #[error("operator state is invalid: {reason}")]
+    InvalidState { reason: &'static str },
+    /// An ODE integrator could not keep its error below tolerance.
+    #[error("step size became too small ({step:e}) at t = {time}")]
+    StepSizeTooSmall { time: f64, step: f64 },
+    /// A stiffness function is not positive where it is evaluated.
+    #[error("stiffness is not positive ({value}) at {name} = {at}")]
+    NonPositiveStiffness {
+        name: &'static str,
+        at: f64,
+        value: f64,
+    },
+}
+
+/// Return `Err(NonFinite)` naming the first non-finite sample of `data`.
+pub fn check_finite(name: &'static str, data: &[f64]) -> Result<(), CoreError> {
+    match data.iter().position(|v| !v.is_finite()) {
+        Some(index) => Err(CoreError::NonFinite {
+            name,
+            index,
+            value: data[index],
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Return `Err(InvalidParameter)` unless `value` is finite and strictly positive.
+pub fn check_positive(name: &'static str, value: f64) -> Result<(), CoreError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(CoreError::InvalidParameter {
+            name,
+            value,
+            reason: "must be finite and > 0",
+        })
+    }
+}
+
+/// Return `Err(LengthMismatch)` unless the two lengths agree.
+pub fn check_same_len(
+    name_a: &'static str,
+    len_a: usize,
+    name_b: &'static str,
+    len_b: usize,
+) -> Result<(), CoreError> {
+    if len_a == len_b {
+        Ok(())
+    } else {
+        Err(CoreError::LengthMismatch {
+            name_a,
+            len_a,
+            name_b,
+            len_b,
+        })
+    }
+}

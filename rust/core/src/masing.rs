@@ -1,0 +1,364 @@
+//! Masing hysteresis operator with non-local memory (Masing's rules plus the Madelung
+//! "wiping-out" rules), PHYSICS.md §1.
+//!
+//! Branch from a reversal point `(x_r, h_r)`: `h = h_r + λ f((x - x_r) / λ)`; `λ = 2` is Masing's
+//! rule, other values give the generalized (non-Masing) operator. A branch that reaches the
+//! reversal at which the interrupted branch began closes the inner loop: both reversals are
+//! forgotten and the older branch continues. A branch that leaves the virgin curve and reaches
+//! the mirrored largest excursion rejoins the virgin curve. With `λ ≠ 2` that rejoin is a jump
+//! (the branch does not meet the virgin curve there); inner loops close exactly for every `λ`.
+
+use crate::curve::Backbone;
+use crate::error::{check_positive, CoreError};
+
+/// A remembered reversal point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reversal {
+    pub x: f64,
+    pub h: f64,
+    /// Global sample index at which the reversal happened (sample before the direction change).
+    pub index: u64,
+}
+
+/// Operator memory. `Default` is the origin: no history, on the virgin curve at (0, 0).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct MasingState {
+    /// Last input and output.
+    pub x: f64,
+    pub h: f64,
+    /// Direction of the current branch: +1, -1, or 0 before the first move.
+    pub dir: i8,
+    /// Samples processed so far (global index of the next sample).
+    pub count: u64,
+    /// Active reversal points, oldest first. Empty: on the virgin curve.
+    pub stack: Vec<Reversal>,
+}
+
+impl MasingState {
+    /// Flatten to `[x, h, dir, count, x_1, h_1, i_1, x_2, h_2, i_2, ...]` (for pickling).
+    pub fn to_vec(&self) -> Vec<f64> {
+        let mut v = Vec::with_capacity(4 + 3 * self.stack.len());
+        v.extend([self.x, self.h, f64::from(self.dir), self.count as f64]);
+        for r in &self.stack {
+            v.extend([r.x, r.h, r.index as f64]);
+        }
+        v
+    }
+
+    /// Inverse of [`MasingState::to_vec`], validating what it reads.
+    pub fn from_slice(v: &[f64]) -> Result<Self, CoreError> {
+        let bad = |reason| Err(CoreError::InvalidState { reason });
+        if v.len() < 4 || (v.len() - 4) % 3 != 0 {
+            return bad("length must be 4 + 3 * (number of reversals)");
+        }
+        if v.iter().any(|a| !a.is_finite()) {
+            return bad("contains a non-finite value");
+        }
+        let dir = v[2];
+        if dir != -1.0 && dir != 0.0 && dir != 1.0 {
+            return bad("direction must be -1, 0 or 1");
+        }
+        if v[3] < 0.0 || v[3].fract() != 0.0 {
+            return bad("sample count must be a non-negative integer");
+        }
+        let stack: Vec<Reversal> = v[4..]
+            .chunks_exact(3)
+            .map(|c| Reversal {
+                x: c[0],
+                h: c[1],
+                index: c[2].max(0.0) as u64,
+            })
+            .collect();
+        if dir == 0.0 && !stack.is_empty() {
+            return bad("reversals recorded before the first move");
+        }
+        // Reversals must alternate and nest: each new one lies strictly inside the previous
+        // range, on the side opposite to the current direction.
+        let mut lo = f64::NEG_INFINITY;
+        let mut hi = f64::INFINITY;
+        for (k, r) in stack.iter().enumerate() {
+            // Counting back from the top (the reversal the current branch started at, which is
+            // opposite to the current direction), maxima and minima alternate.
+            let from_top = stack.len() - 1 - k;
+            let is_max = (dir > 0.0) == (from_top % 2 == 1);
+            if k == 0 {
+                // The first reversal left the virgin curve, which runs outward from 0; the
+                // branch from it rejoins the virgin curve at the mirror point.
+                if (is_max && r.x <= 0.0) || (!is_max && r.x >= 0.0) {
+                    return bad("first reversal is on the wrong side of the origin");
+                }
+                lo = -r.x.abs();
+                hi = r.x.abs();
+                continue;
+            }
+            if !(r.x > lo && r.x < hi) {
+                return bad("reversal points are not nested");
+            }
+            if is_max {
+                hi = r.x;
+            } else {
+                lo = r.x;
+            }
+        }
+        let x = v[0];
+        if !stack.is_empty() && !(x >= lo && x <= hi) {
+            return bad("current input lies outside the remembered reversals");
+        }
+        Ok(Self {
+            x,
+            h: v[1],
+            dir: dir as i8,
+            count: v[3] as u64,
+            stack,
+        })
+    }
+}
+
+/// What a loop closure looked like; reported to an [`Observer`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Closure {
+    /// An inner loop between reversals `older` and `newer` closed at sample `index`.
+    Inner {
+        older: Reversal,
+        newer: Reversal,
+        index: u64,
+    },
+    /// A branch that left the virgin curve at `from` rejoined it at `-from.x`.
+    Virgin { from: Reversal, index: u64 },
+}
+
+/// Receives loop closures as the operator runs (rainflow-style cycle counting).
+pub trait Observer {
+    fn closed(&mut self, closure: Closure);
+}
+
+/// The observer that ignores everything; the force kernel uses it (and compiles it away).
+pub struct NoObserver;
+impl Observer for NoObserver {
+    #[inline(always)]
+    fn closed(&mut self, _: Closure) {}
+}
+
+impl<F: FnMut(Closure)> Observer for F {
+    fn closed(&mut self, closure: Closure) {
+        self(closure);
+    }
+}
+
+/// The current branch anchor `(x_a, h_a, scale)` and its closure target.
+#[derive(Clone, Copy)]
+struct Branch {
+    xa: f64,
+    ha: f64,
+    scale: f64,
+    /// Input value at which this branch closes (±inf: never).
+    target: f64,
+}
+
+#[inline]
+fn branch_of(state: &MasingState, scale: f64) -> Branch {
+    let n = state.stack.len();
+    let dir_inf = if state.dir >= 0 {
+        f64::INFINITY
+    } else {
+        f64::NEG_INFINITY
+    };
+    match n {
+        0 => Branch {
+            xa: 0.0,
+            ha: 0.0,
+            scale: 1.0,
+            target: dir_inf,
+        },
+        1 => Branch {
+            xa: state.stack[0].x,
+            ha: state.stack[0].h,
+            scale,
+            target: -state.stack[0].x,
+        },
+        _ => Branch {
+            xa: state.stack[n - 1].x,
+            ha: state.stack[n - 1].h,
+            scale,
+            target: state.stack[n - 2].x,
+        },
+    }
+}
+
+/// Run the operator over `x`, writing forces to `out` (when given) and reporting closures.
+///
+/// The history continues from `state`, which is updated; processing a signal in chunks with
+/// the state carried over gives bit-identical results to one pass.
+pub fn run<C: Backbone, O: Observer>(
+    curve: &C,
+    scale: f64,
+    x: &[f64],
+    mut out: Option<&mut [f64]>,
+    state: &mut MasingState,
+    observer: &mut O,
+) -> Result<(), CoreError> {
+    check_positive("scale", scale)?;
+    if let Some(o) = out.as_deref() {
+        crate::error::check_same_len("x", x.len(), "out", o.len())?;
+    }
+    // Validate before touching the state so that an error leaves it unchanged.
+    crate::error::check_finite("x", x)?;
+
+    let mut br = branch_of(state, scale);
+    let mut xp = state.x;
+    let mut hp = state.h;
+    let mut dir = state.dir;
+    let base = state.count;
+
+    for (i, &xi) in x.iter().enumerate() {
+        let dx = xi - xp;
+        if dx != 0.0 {
+            let s: i8 = if dx > 0.0 { 1 } else { -1 };
+            if s != dir {
+                if dir != 0 {
+                    state.stack.push(Reversal {
+                        x: xp,
+                        h: hp,
+                        index: base + i as u64 - 1,
+                    });
+                }
+                dir = s;
+                state.dir = dir;
+                br = branch_of(state, scale);
+            }
+            // Closure uses >= so that exactly repeated extremes close the loop.
+            while if dir > 0 {
+                xi >= br.target
+            } else {
+                xi <= br.target
+            } {
+                let idx = base + i as u64;
+                let n = state.stack.len();
+                if n == 1 {
+                    let from = state.stack[0];
+                    state.stack.clear();
+                    observer.closed(Closure::Virgin { from, index: idx });
+                } else {
+                    let newer = state.stack[n - 1];
+                    let older = state.stack[n - 2];
+                    state.stack.truncate(n - 2);
+                    observer.closed(Closure::Inner {
+                        older,
+                        newer,
+                        index: idx,
+                    });
+                }
+                br = branch_of(state, scale);
+            }
+            hp = br.ha + br.scale * curve.eval((xi - br.xa) / br.scale);
+            xp = xi;
+        }
+        if let Some(o) = out.as_deref_mut() {
+            o[i] = hp;
+        }
+    }
+    state.x = xp;
+    state.h = hp;
+    state.dir = dir;
+    state.count = base + x.len() as u64;
+    Ok(())
+}
+
+/// Forces for `x`, continuing from `state` (the origin when `MasingState::default()`).
+pub fn masing_force<C: Backbone>(
+    curve: &C,
+    scale: f64,
+    x: &[f64],
+    out: &mut [f64],
+    state: &mut MasingState,
+) -> Result<(), CoreError> {
+    run(curve, scale, x, Some(out), state, &mut NoObserver)
+}
+
+/// One closed cycle found by [`cycle_energies`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cycle {
+    /// Peak-to-peak input range of the loop.
+    pub range: f64,
+    /// Mean input of the loop (midpoint of its reversals).
+    pub mean: f64,
+    /// Global sample index where the loop started (the older reversal).
+    pub start: u64,
+    /// Global sample index where the loop closed.
+    pub end: u64,
+    /// 1 for a closed inner loop; 0.5 for a half cycle that rejoined the virgin curve.
+    pub count: f64,
+    /// Energy dissipated: `count · 2 λ² B(range / λ)`.
+    pub energy: f64,
+}
+
+/// Every closed cycle of `x`, counted by the operator's own memory (equivalent to rainflow
+/// counting): each inner-loop closure is a full cycle; each virgin rejoin is a half cycle.
+/// The energies sum to `∮ F dx` over a stretch that returns the operator to its start state.
+pub fn cycle_energies<C: Backbone>(
+    curve: &C,
+    scale: f64,
+    x: &[f64],
+    state: &mut MasingState,
+) -> Result<Vec<Cycle>, CoreError> {
+    let mut cycles = Vec::new();
+    let loop_energy = |range: f64| 2.0 * scale * scale * curve.chord_area(range / scale);
+    let mut obs = |c: Closure| match c {
+        Closure::Inner {
+            older,
+            newer,
+            index,
+        } => {
+            let range = (older.x - newer.x).abs();
+            cycles.push(Cycle {
+                range,
+                mean: 0.5 * (older.x + newer.x),
+                start: older.index,
+                end: index,
+                count: 1.0,
+                energy: loop_energy(range),
+            });
+        }
+        Closure::Virgin { from, index } => {
+            let range = 2.0 * from.x.abs();
+            cycles.push(Cycle {
+                range,
+                mean: 0.0,
+                start: from.index,
+                end: index,
+                count: 0.5,
+                energy: 0.5 * loop_energy(range),
+            });
+        }
+    };
+    run(curve, scale, x, None, state, &mut obs)?;
+    Ok(cycles)
+}
+
+/// `∮ F dx` of the closed polygon through `(x_i, F_i)` (last point joined to the first):
+/// positive for a clockwise (dissipative) loop. Uses the trapezoid form with the mean force
+/// removed and compensated summation, so large offsets in `x` or `F` cost no accuracy.
+pub fn loop_area(x: &[f64], f: &[f64]) -> Result<f64, CoreError> {
+    crate::error::check_same_len("x", x.len(), "F", f.len())?;
+    if x.is_empty() {
+        return Err(CoreError::Empty { name: "x" });
+    }
+    crate::error::check_finite("x", x)?;
+    crate::error::check_finite("F", f)?;
+    let n = x.len();
+    let fm = f.iter().sum::<f64>() / n as f64;
+    let (mut sum, mut comp) = (0.0_f64, 0.0_f64);
+    for i in 0..n {
+        let j = if i + 1 == n { 0 } else { i + 1 };
+        let term = 0.5 * ((f[i] - fm) + (f[j] - fm)) * (x[j] - x[i]);
+        // Neumaier summation.
+        let t = sum + term;
+        if sum.abs() >= term.abs() {
+            comp += (sum - t) + term;
+        } else {
+            comp += (term - t) + sum;
+        }
+        sum = t;
+    }
+    Ok(sum + comp)
+}

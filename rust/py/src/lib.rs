@@ -1,0 +1,274 @@
+//! `contactlab._core`: converts numpy arrays and errors, releases the GIL, and nothing else.
+//! All physics lives in `contactlab-core`.
+
+use contactlab_core::{
+    curve::{Backbone, Exponential, Tabulated},
+    masing, CoreError, MasingState,
+};
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::PyDict;
+
+mod errors;
+use errors::{internal, to_pyerr};
+
+/// Run `f` without the GIL, turning a panic (a bug, never expected) into `ContactLabError`.
+pub(crate) fn detach_guarded<T: Send, F: FnOnce() -> Result<T, CoreError> + Send>(
+    py: Python<'_>,
+    f: F,
+) -> PyResult<T> {
+    let r = py.detach(|| std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)));
+    match r {
+        Ok(Ok(v)) => Ok(v),
+        Ok(Err(e)) => Err(to_pyerr(py, &e)),
+        Err(_) => Err(internal(py, "internal error in contactlab core (panic caught)")),
+    }
+}
+
+/// A virgin curve: the exponential curve or a tabulated backbone.
+#[derive(Clone)]
+enum Curve {
+    Exp(Exponential),
+    Tab(Tabulated),
+}
+
+macro_rules! with_curve {
+    ($curve:expr, $c:ident => $body:expr) => {
+        match $curve {
+            Curve::Exp($c) => $body,
+            Curve::Tab($c) => $body,
+        }
+    };
+}
+
+/// Masing operator with non-local memory and a carried state (one instance per recording).
+#[pyclass(module = "contactlab._core")]
+struct MasingCore {
+    curve: Curve,
+    scale: f64,
+    state: MasingState,
+}
+
+fn slice<'a>(a: &'a PyReadonlyArray1<'_, f64>, name: &'static str) -> PyResult<&'a [f64]> {
+    a.as_slice()
+        .map_err(|_| PyErr::new::<pyo3::exceptions::PyValueError, _>(format!("{name} must be contiguous")))
+}
+
+#[pymethods]
+impl MasingCore {
+    /// Exponential virgin curve `h0 (1 - exp(-ac u))`.
+    #[staticmethod]
+    fn exponential(py: Python<'_>, h0: f64, ac: f64, scale: f64) -> PyResult<Self> {
+        let curve = Exponential::new(h0, ac).map_err(|e| to_pyerr(py, &e))?;
+        check_scale(py, scale)?;
+        Ok(Self {
+            curve: Curve::Exp(curve),
+            scale,
+            state: MasingState::default(),
+        })
+    }
+
+    /// Tabulated monotone backbone through `(x_points, f_points)`.
+    #[staticmethod]
+    fn tabulated(
+        py: Python<'_>,
+        x_points: PyReadonlyArray1<'_, f64>,
+        f_points: PyReadonlyArray1<'_, f64>,
+        scale: f64,
+    ) -> PyResult<Self> {
+        let u = slice(&x_points, "x_points")?;
+        let f = slice(&f_points, "f_points")?;
+        let curve = Tabulated::new(u, f).map_err(|e| to_pyerr(py, &e))?;
+        check_scale(py, scale)?;
+        Ok(Self {
+            curve: Curve::Tab(curve),
+            scale,
+            state: MasingState::default(),
+        })
+    }
+
+    /// A copy with the same curve and scale, state reset to the origin.
+    fn fresh(&self) -> Self {
+        Self {
+            curve: self.curve.clone(),
+            scale: self.scale,
+            state: MasingState::default(),
+        }
+    }
+
+    /// Forces for the chunk `x`, continuing the carried history.
+    fn push<'py>(
+        &mut self,
+        py: Python<'py>,
+        x: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let xs = slice(&x, "x")?;
+        let mut out = vec![0.0; xs.len()];
+        let mut st = self.state.clone();
+        let (curve, scale) = (&self.curve, self.scale);
+        let st = detach_guarded(py, || {
+            with_curve!(curve, c => masing::masing_force(c, scale, xs, &mut out, &mut st))?;
+            Ok(st)
+        })?;
+        self.state = st;
+        Ok(out.into_pyarray(py))
+    }
+
+    /// Closed cycles of `x` (continuing the carried history, which is advanced):
+    /// dict of arrays `range, mean, start, end, count, energy`.
+    fn cycles<'py>(
+        &mut self,
+        py: Python<'py>,
+        x: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let xs = slice(&x, "x")?;
+        let mut st = self.state.clone();
+        let (curve, scale) = (&self.curve, self.scale);
+        let (cycles, st) = detach_guarded(py, || {
+            let c = with_curve!(curve, c => masing::cycle_energies(c, scale, xs, &mut st))?;
+            Ok((c, st))
+        })?;
+        self.state = st;
+        let d = PyDict::new(py);
+        let col = |f: &dyn Fn(&masing::Cycle) -> f64| -> Vec<f64> { cycles.iter().map(f).collect() };
+        d.set_item("range", col(&|c| c.range).into_pyarray(py))?;
+        d.set_item("mean", col(&|c| c.mean).into_pyarray(py))?;
+        let idx = |f: &dyn Fn(&masing::Cycle) -> u64| -> Vec<i64> {
+            cycles.iter().map(|c| f(c) as i64).collect()
+        };
+        d.set_item("start", idx(&|c| c.start).into_pyarray(py))?;
+        d.set_item("end", idx(&|c| c.end).into_pyarray(py))?;
+        d.set_item("count", col(&|c| c.count).into_pyarray(py))?;
+        d.set_item("energy", col(&|c| c.energy).into_pyarray(py))?;
+        Ok(d)
+    }
+
+    fn reset(&mut self) {
+        self.state = MasingState::default();
+    }
+
+    /// The carried state as a flat float array (see `MasingState::to_vec`).
+    fn get_state<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.state.to_vec().into_pyarray(py)
+    }
+
+    fn set_state(&mut self, py: Python<'_>, state: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
+        let v = slice(&state, "state")?;
+        self.state = MasingState::from_slice(v).map_err(|e| to_pyerr(py, &e))?;
+        Ok(())
+    }
+
+    /// Virgin curve `f(u)` (no history).
+    fn backbone<'py>(
+        &self,
+        py: Python<'py>,
+        u: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        self.map(py, &u, |c, v| c.eval(v))
+    }
+
+    /// Tangent stiffness of the virgin curve `f'(u)`.
+    fn slope<'py>(
+        &self,
+        py: Python<'py>,
+        u: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        self.map(py, &u, |c, v| c.slope(v))
+    }
+
+    /// Area between the virgin curve and its chord on `[0, |u|]`.
+    fn chord_area<'py>(
+        &self,
+        py: Python<'py>,
+        u: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        self.map(py, &u, |c, v| c.chord_area(v))
+    }
+
+    #[getter]
+    fn scale(&self) -> f64 {
+        self.scale
+    }
+
+    /// Run the kernel on `x` `repeat` times from the origin and return the best wall time in
+    /// seconds measured inside Rust (benchmarks compare it with the Python call).
+    fn time_kernel(&self, py: Python<'_>, x: PyReadonlyArray1<'_, f64>, repeat: usize) -> PyResult<f64> {
+        let xs = slice(&x, "x")?;
+        let (curve, scale) = (&self.curve, self.scale);
+        detach_guarded(py, || {
+            let mut out = vec![0.0; xs.len()];
+            let mut best = f64::INFINITY;
+            for _ in 0..repeat.max(1) {
+                let mut st = MasingState::default();
+                let t0 = std::time::Instant::now();
+                with_curve!(curve, c => masing::masing_force(c, scale, xs, &mut out, &mut st))?;
+                best = best.min(t0.elapsed().as_secs_f64());
+                std::hint::black_box(&out);
+            }
+            Ok(best)
+        })
+    }
+}
+
+impl MasingCore {
+    fn map<'py>(
+        &self,
+        py: Python<'py>,
+        u: &PyReadonlyArray1<'py, f64>,
+        f: impl Fn(&dyn Backbone, f64) -> f64 + Send + Sync,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let us = slice(u, "x")?;
+        let curve = &self.curve;
+        let out = detach_guarded(py, || {
+            contactlab_core::error::check_finite("x", us)?;
+            let c: &dyn Backbone = match curve {
+                Curve::Exp(c) => c,
+                Curve::Tab(c) => c,
+            };
+            Ok(us.iter().map(|&v| f(c, v)).collect::<Vec<f64>>())
+        })?;
+        Ok(out.into_pyarray(py))
+    }
+}
+
+fn check_scale(py: Python<'_>, scale: f64) -> PyResult<()> {
+    contactlab_core::error::check_positive("scale", scale).map_err(|e| to_pyerr(py, &e))
+}
+
+/// `∮ F dx` of the closed polygon through the samples (positive for a dissipative loop).
+#[pyfunction]
+#[pyo3(name = "loop_area")]
+fn loop_area_py(py: Python<'_>, x: PyReadonlyArray1<'_, f64>, f: PyReadonlyArray1<'_, f64>) -> PyResult<f64> {
+    let (xs, fs) = (slice(&x, "x")?, slice(&f, "F")?);
+    detach_guarded(py, || masing::loop_area(xs, fs))
+}
+
+/// Analytic loop energy `E(A)` of the exponential curve (λ = 2), vectorised over `a`.
+#[pyfunction]
+fn exp_loop_energy<'py>(
+    py: Python<'py>,
+    h0: f64,
+    ac: f64,
+    a: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let c = Exponential::new(h0, ac).map_err(|e| to_pyerr(py, &e))?;
+    let av = slice(&a, "A")?;
+    let out = detach_guarded(py, || {
+        contactlab_core::error::check_finite("A", av)?;
+        Ok(av.iter().map(|&v| c.loop_energy(v)).collect::<Vec<f64>>())
+    })?;
+    Ok(out.into_pyarray(py))
+}
+
+static VERSION: PyOnceLock<String> = PyOnceLock::new();
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("__version__", VERSION.get_or_init(py, || env!("CARGO_PKG_VERSION").to_string()))?;
+    m.add_class::<MasingCore>()?;
+    m.add_function(wrap_pyfunction!(loop_area_py, m)?)?;
+    m.add_function(wrap_pyfunction!(exp_loop_energy, m)?)?;
+    Ok(())
+}
