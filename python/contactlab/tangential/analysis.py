@@ -357,10 +357,22 @@ def analyze_tangential(
     params = [
         Parameter("k0", h0_init * ac_init, min=1e-9 * h0_init * ac_init, unit="N/m"),
         Parameter("ac", ac_init, min=1e-9 * ac_init, unit="1/m"),
-        Parameter("offset", off0 if fit_offset else 0.0, vary=fit_offset, unit="N"),
+        Parameter(
+            "offset", off0 if fit_offset else 0.0, vary=fit_offset, unit="N", scale=max(hm0, 1e-300)
+        ),
     ]
     if steady:
-        params.append(Parameter("x0", centre0, vary=fit_x0, unit="m"))
+        params.append(
+            Parameter(
+                "x0",
+                centre0,
+                vary=fit_x0,
+                min=centre0 - amplitude0,
+                max=centre0 + amplitude0,
+                unit="m",
+                scale=amplitude0,
+            )
+        )
         params.append(
             Parameter(
                 "amplitude",
@@ -372,7 +384,9 @@ def analyze_tangential(
             )
         )
     else:
-        params.append(Parameter("x0", float(xa[0]), vary=fit_x0, unit="m"))
+        params.append(
+            Parameter("x0", float(xa[0]), vary=fit_x0, unit="m", scale=max(amplitude0, 1e-300))
+        )
 
     sl = slice(start, None)
     peaks, valleys, first_is_peak = rev.peaks, rev.valleys, rev.first_is_peak
