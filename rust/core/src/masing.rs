@@ -101,7 +101,7 @@ impl MasingState {
             }
         }
         let x = v[0];
-        if !stack.is_empty() && !(x >= lo && x <= hi) {
+        if !(stack.is_empty() || (lo..=hi).contains(&x)) {
             return bad("current input lies outside the remembered reversals");
         }
         Ok(Self {

@@ -22,7 +22,10 @@ pub(crate) fn detach_guarded<T: Send, F: FnOnce() -> Result<T, CoreError> + Send
     match r {
         Ok(Ok(v)) => Ok(v),
         Ok(Err(e)) => Err(to_pyerr(py, &e)),
-        Err(_) => Err(internal(py, "internal error in contactlab core (panic caught)")),
+        Err(_) => Err(internal(
+            py,
+            "internal error in contactlab core (panic caught)",
+        )),
     }
 }
 
@@ -51,8 +54,9 @@ struct MasingCore {
 }
 
 fn slice<'a>(a: &'a PyReadonlyArray1<'_, f64>, name: &'static str) -> PyResult<&'a [f64]> {
-    a.as_slice()
-        .map_err(|_| PyErr::new::<pyo3::exceptions::PyValueError, _>(format!("{name} must be contiguous")))
+    a.as_slice().map_err(|_| {
+        PyErr::new::<pyo3::exceptions::PyValueError, _>(format!("{name} must be contiguous"))
+    })
 }
 
 #[pymethods]
@@ -131,7 +135,8 @@ impl MasingCore {
         })?;
         self.state = st;
         let d = PyDict::new(py);
-        let col = |f: &dyn Fn(&masing::Cycle) -> f64| -> Vec<f64> { cycles.iter().map(f).collect() };
+        let col =
+            |f: &dyn Fn(&masing::Cycle) -> f64| -> Vec<f64> { cycles.iter().map(f).collect() };
         d.set_item("range", col(&|c| c.range).into_pyarray(py))?;
         d.set_item("mean", col(&|c| c.mean).into_pyarray(py))?;
         let idx = |f: &dyn Fn(&masing::Cycle) -> u64| -> Vec<i64> {
@@ -193,7 +198,12 @@ impl MasingCore {
 
     /// Run the kernel on `x` `repeat` times from the origin and return the best wall time in
     /// seconds measured inside Rust (benchmarks compare it with the Python call).
-    fn time_kernel(&self, py: Python<'_>, x: PyReadonlyArray1<'_, f64>, repeat: usize) -> PyResult<f64> {
+    fn time_kernel(
+        &self,
+        py: Python<'_>,
+        x: PyReadonlyArray1<'_, f64>,
+        repeat: usize,
+    ) -> PyResult<f64> {
         let xs = slice(&x, "x")?;
         let (curve, scale) = (&self.curve, self.scale);
         detach_guarded(py, || {
@@ -239,7 +249,11 @@ fn check_scale(py: Python<'_>, scale: f64) -> PyResult<()> {
 /// `∮ F dx` of the closed polygon through the samples (positive for a dissipative loop).
 #[pyfunction]
 #[pyo3(name = "loop_area")]
-fn loop_area_py(py: Python<'_>, x: PyReadonlyArray1<'_, f64>, f: PyReadonlyArray1<'_, f64>) -> PyResult<f64> {
+fn loop_area_py(
+    py: Python<'_>,
+    x: PyReadonlyArray1<'_, f64>,
+    f: PyReadonlyArray1<'_, f64>,
+) -> PyResult<f64> {
     let (xs, fs) = (slice(&x, "x")?, slice(&f, "F")?);
     detach_guarded(py, || masing::loop_area(xs, fs))
 }
@@ -266,7 +280,10 @@ static VERSION: PyOnceLock<String> = PyOnceLock::new();
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
-    m.add("__version__", VERSION.get_or_init(py, || env!("CARGO_PKG_VERSION").to_string()))?;
+    m.add(
+        "__version__",
+        VERSION.get_or_init(py, || env!("CARGO_PKG_VERSION").to_string()),
+    )?;
     m.add_class::<MasingCore>()?;
     m.add_function(wrap_pyfunction!(loop_area_py, m)?)?;
     m.add_function(wrap_pyfunction!(exp_loop_energy, m)?)?;
