@@ -1,6 +1,9 @@
 //! `contactlab._core`: converts numpy arrays and errors, releases the GIL, and nothing else.
 //! All physics lives in `contactlab-core`.
 
+// PyO3 extracts arguments by value; borrowing them is not an option in signatures.
+#![allow(clippy::needless_pass_by_value)]
+
 use contactlab_core::{
     curve::{Backbone, Exponential, Tabulated},
     masing, CoreError, MasingState,
