@@ -2,9 +2,9 @@
 
 Lines starting with ``#`` before the header are kept as comments in ``meta``. The delimiter
 (comma, semicolon, tab or whitespace) is detected from the header, and a decimal comma
-(``1,5`` as European locales write it, with ``;`` or tab delimiters) from the first data line. Only the needed columns are
-parsed (``numpy.loadtxt`` with ``usecols``); when that fails, the file is scanned once more to
-name the first bad cell by line and column.
+(``1,5`` as European locales write it, with ``;`` or tab delimiters) from the first data line.
+Only the needed columns are parsed (``numpy.loadtxt`` with ``usecols``); when that fails, the
+file is scanned once more to name the first bad cell by line and column.
 """
 
 from __future__ import annotations

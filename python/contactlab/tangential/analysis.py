@@ -49,6 +49,7 @@ UNITS = {
     "h0_lower_bound": "N",
     "ac_upper_bound": "1/m",
     "peak_force": "N",
+    "force_drift": "N/s",
 }
 
 #: ``ac·A`` above which the loop is taken to have reached gross sliding (branch slope at the
@@ -240,6 +241,7 @@ def analyze_tangential(
     min_cycles: int = 2,
     max_rel_stderr: float = 1.0 / 3.0,
     fit_amplitude: bool = True,
+    detrend: bool = True,
     initial: dict[str, float] | None = None,
     warn: bool = True,
 ) -> TangentialAnalysis:
@@ -263,6 +265,9 @@ def analyze_tangential(
     fit_amplitude : bool, default True
         On a steady loop, fit the turning points' half distance ``A`` instead of taking the
         extremes of noisy data (which overestimate it and bias ``h0``, ``ac``).
+    detrend : bool, default True
+        Remove a linear force drift estimated from the per-cycle mean force (needs 3 complete
+        cycles; reported as ``force_drift``, N/s).
     n_points : int, optional
         Phase bins of the averaged loop (default: samples per cycle, 16..400).
     rel_threshold : float
@@ -310,6 +315,22 @@ def analyze_tangential(
     except InputError:
         if on == "averaged":
             raise
+    drift = (0.0, 0.0)
+    if detrend and loop is not None and loop.n_cycles >= 3:
+        # A load cell's slow drift shows as a trend in the per-cycle mean force (a steady loop
+        # has the same mean every cycle). Remove it and average again.
+        ct, cm = loop.scatter.time, loop.scatter.mean_force
+        tm = float(np.mean(ct))
+        sxx = float(np.sum((ct - tm) ** 2))
+        slope = float(np.sum((ct - tm) * (cm - cm.mean())) / sxx)
+        res_ = cm - cm.mean() - slope * (ct - tm)
+        se = math.sqrt(float(res_ @ res_) / (ct.size - 2) / sxx) if ct.size > 2 else math.nan
+        drift = (slope, se)
+        tt = ta if ta is not None else np.arange(xa.size, dtype=float)
+        Fa = Fa - slope * (tt - tm)
+        loop = average_loop(
+            xa, Fa, ta, n_points=n_points, rel_threshold=rel_threshold, min_cycles=min_cycles
+        )
     scatter = loop.scatter if loop is not None else None
 
     # -- data the fit sees --------------------------------------------------------------
@@ -498,6 +519,7 @@ def analyze_tangential(
     derived["energy_per_cycle_numeric"] = (float(e_num), e_sem)
     a2 = math.pi * amplitude**2
     derived["equivalent_damping_numeric"] = (float(e_num / a2), e_sem / a2)
+    derived["force_drift"] = drift
     if not identifiable:
         derived["h0_lower_bound"] = (float(h0_lo), math.nan)
         derived["ac_upper_bound"] = (float(ac_up), math.nan)

@@ -173,6 +173,8 @@ class CycleScatter:
     force_range: np.ndarray  # half the F range of the cycle's loop, N
     energy: np.ndarray  # loop area of the cycle, J
     period: np.ndarray  # s
+    mean_force: np.ndarray  # mean force over the cycle (mean of its bin means), N
+    time: np.ndarray  # middle of the cycle (mean of its two peak instants), s
 
     @property
     def n_cycles(self) -> int:
@@ -181,7 +183,7 @@ class CycleScatter:
     def summary(self) -> dict[str, dict[str, float]]:
         """Mean, standard deviation and standard error of the mean of each quantity."""
         out = {}
-        for k in ("amplitude", "force_range", "energy", "period"):
+        for k in ("amplitude", "force_range", "energy", "period", "mean_force"):
             v = getattr(self, k)
             sd = float(np.std(v, ddof=1)) if v.size > 1 else float("nan")
             out[k] = {"mean": float(np.mean(v)), "std": sd, "sem": sd / np.sqrt(v.size)}
@@ -349,6 +351,8 @@ def average_loop(
         force_range=np.asarray(franges),
         energy=np.asarray(energies),
         period=np.diff(rev.peak_times),
+        mean_force=np.nanmean(cF, axis=1),
+        time=0.5 * (rev.peak_times[:-1] + rev.peak_times[1:]),
     )
     phase = (np.arange(n_points) + 0.5) / n_points
     return AveragedLoop(phase, xm, Fm, count, x_std, F_std, scatter, rev, start, end)
