@@ -336,3 +336,11 @@ def test_csv_units_property(tmp_path_factory, xunit, funit, tunit, values, delim
     np.testing.assert_allclose(rec.t, t * tunit[1], rtol=1e-15)
     np.testing.assert_allclose(rec["x"], np.array(values) * xunit[1], rtol=1e-15)
     np.testing.assert_allclose(rec["F"], -np.array(values) * funit[1], rtol=1e-15)
+
+
+def test_csv_rows_count_blank_and_comment_lines(tmp_path):
+    p = tmp_path / "gaps.csv"
+    p.write_text("t [s],x [m],F [N]\n0,0,0\n\n# pause\n1,1,1\n1,2,2\n")
+    with pytest.raises(RecordingError, match="duplicated") as info:
+        read_recording(p)
+    assert info.value.row == 6  # the 6th line of the file

@@ -63,6 +63,22 @@ def _decimal_comma(path: Path, delim: str | None, first_data_line: int) -> bool:
     return False
 
 
+def _line_of_sample(path: Path, first_data_line: int, index: int) -> int:
+    """1-based line of the file holding data row ``index`` (blank and ``#`` lines skipped).
+
+    Called only to word an error, so the extra pass over the file costs nothing normally.
+    """
+    k = -1
+    with open(path, encoding="utf-8-sig", errors="replace") as fh:
+        for lineno, line in enumerate(fh):
+            if lineno < first_data_line or not line.strip() or line.lstrip().startswith("#"):
+                continue
+            k += 1
+            if k == index:
+                return lineno + 1
+    return first_data_line + index + 1
+
+
 def _locate_bad_cell(
     path: Path,
     delim: str | None,
@@ -141,7 +157,6 @@ def read_csv(
         raise RecordingError("header but no data rows", file=file)
     raw = {c: np.ascontiguousarray(block[:, j]) for j, c in enumerate(canon)}
     units = {c: split_name(mapping[c])[1] for c in canon}
-    # Rows of sample i: blank and comment lines are rare after the header; assume none.
     return finish(
         raw,
         mapping,
@@ -149,7 +164,7 @@ def read_csv(
         kind=kind,
         file=file,
         fs=fs,
-        row_offset=first_data + 1,
+        row_of=lambda i: _line_of_sample(path, first_data, i),
         meta={
             "format": "csv",
             "comments": comments,
