@@ -402,3 +402,14 @@ def test_force_drift_is_removed():
     # left in, the drift opens the averaged loop: worse fit, h0 off by 3σ
     assert raw.fit.chisqr > 1.2 * res.fit.chisqr
     assert abs(_z(raw, "h0", H0)) > 2.5
+
+
+def test_inverted_force_sign_is_detected():
+    rec = synthetic_recording(H0, AC, A, n_cycles=4, fs=300, noise=0.01, seed=2)
+    flipped = Recording(rec.t, {"x": rec["x"], "F": -rec["F"]}, {"x": "m", "F": "N"})
+    with pytest.warns(ContactLabWarning, match="analysed -F"):
+        res = analyze_tangential(flipped)
+    assert res.meta["invert_force"] is True
+    assert abs(_z(res, "h0", H0)) < 4
+    straight = analyze_tangential(rec)
+    assert res.fit.params["h0"].value == pytest.approx(straight.fit.params["h0"].value, rel=1e-6)

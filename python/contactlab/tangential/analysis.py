@@ -106,6 +106,7 @@ def analyze_tangential(
     max_rel_stderr: float = 1.0 / 3.0,
     fit_amplitude: bool = True,
     detrend: bool = True,
+    invert_force: bool | None = None,
     initial: dict[str, float] | None = None,
     warn: bool = True,
 ) -> TangentialAnalysis:
@@ -132,6 +133,9 @@ def analyze_tangential(
     detrend : bool, default True
         Remove a linear force drift estimated from the per-cycle mean force (needs 3 complete
         cycles; reported as ``force_drift``, N/s).
+    invert_force : bool, optional
+        Analyse ``-F``. By default this is done (with a warning) when the force falls as the
+        displacement rises, i.e. the load cell counts the other way.
     n_points : int, optional
         Phase bins of the averaged loop (default: samples per cycle, 16..400).
     rel_threshold : float
@@ -167,6 +171,18 @@ def analyze_tangential(
     if on == "averaged" and history == "virgin":
         raise InputError("history='virgin' applies to on='signal'; an averaged loop is steady")
     steady = history == "steady"
+    pre_warns: list[str] = []
+    xc = xa - xa.mean()
+    inverted = float(xc @ (Fa - Fa.mean())) < 0
+    if invert_force is None:
+        invert_force = inverted
+        if inverted:
+            pre_warns.append(
+                "the force falls as the displacement rises (sensor sign convention): "
+                "analysed -F; pass invert_force=False to keep the sign"
+            )
+    if invert_force:
+        Fa = -Fa
     if fit_x0 is None:
         fit_x0 = True
     if n_points is not None and (n_points < 8 or n_points % 2):
@@ -389,7 +405,7 @@ def analyze_tangential(
         derived["ac_upper_bound"] = (float(ac_up), math.nan)
 
     # -- warnings -------------------------------------------------------------------------
-    warns: list[str] = list(raw.notes)
+    warns: list[str] = pre_warns + list(raw.notes)
     hm_data = 0.5 * float(np.ptp(loop.F if loop is not None else Fa))
     ratio = e_num / (4 * amplitude * hm_data) if hm_data > 0 else 0.0
     if (identifiable and z > GROSS_SLIDING_Z) or ratio > GROSS_SLIDING_AREA_RATIO:
@@ -434,7 +450,7 @@ def analyze_tangential(
         weights=w,
         t=td,
         source=source,
-        meta={"fit_start": start},
+        meta={"fit_start": start, "invert_force": bool(invert_force)},
     )
 
 
