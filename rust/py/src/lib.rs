@@ -11,6 +11,7 @@ use pyo3::sync::PyOnceLock;
 use pyo3::types::PyDict;
 
 mod errors;
+mod normal;
 use errors::{internal, to_pyerr};
 
 /// Run `f` without the GIL, turning a panic (a bug, never expected) into `ContactLabError`.
@@ -270,5 +271,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<MasingCore>()?;
     m.add_function(wrap_pyfunction!(loop_area_py, m)?)?;
     m.add_function(wrap_pyfunction!(exp_loop_energy, m)?)?;
+    normal::register(m)?;
     Ok(())
 }
