@@ -6,6 +6,7 @@ models), fitting, reports and model-discrepancy diagnosis. See README.md.
 
 from __future__ import annotations
 
+from . import normal
 from .errors import ContactLabError, ContactLabWarning, ConvergenceError, InputError
 from .masing import CycleTable, Masing, MasingOperator, cycle_energies, loop_area
 
@@ -22,4 +23,5 @@ __all__ = [
     "__version__",
     "cycle_energies",
     "loop_area",
+    "normal",
 ]

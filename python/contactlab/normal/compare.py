@@ -24,8 +24,13 @@ from ..errors import InputError
 
 
 def measured_velocity(
-    t: np.ndarray, delta: np.ndarray, *, method: str = "savgol", window: int | None = None,
-    omega: float | None = None, harmonics: int = 20
+    t: np.ndarray,
+    delta: np.ndarray,
+    *,
+    method: str = "savgol",
+    window: int | None = None,
+    omega: float | None = None,
+    harmonics: int = 20,
 ) -> np.ndarray:
     """Noise-robust dδ/dt of a uniformly sampled displacement.
 
@@ -92,7 +97,10 @@ class Comparison:
         }
 
     def table(self) -> str:
-        head = f"{'model':<12}{'RMS δ [µm]':>12}{'peak δ':>10}{'RMS δ′ [µm/s]':>15}{'peak δ′':>10}{'ΔE_d':>9}"
+        head = (
+            f"{'model':<12}{'RMS δ [µm]':>12}{'peak δ':>10}{'RMS δ′ [µm/s]':>15}"
+            f"{'peak δ′':>10}{'ΔE_d':>9}"
+        )
         rows = [head]
         for name, m in self.metrics.items():
             rows.append(
@@ -169,9 +177,7 @@ def compare(
     period = 2 * np.pi / omega
     span = tv[-1] - tv[0]
     if span < 2 * period * (1 - 1e-9):
-        raise InputError(
-            f"the recording spans {span / period:.3g} cycles; at least two are needed"
-        )
+        raise InputError(f"the recording spans {span / period:.3g} cycles; at least two are needed")
     if int(discard_cycles) != discard_cycles or discard_cycles < 0:
         raise InputError(f"discard_cycles must be a whole number >= 0, got {discard_cycles!r}")
     t_start = tv[0] + int(discard_cycles) * period

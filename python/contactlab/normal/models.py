@@ -353,12 +353,15 @@ class NonlinearContact(_ContactModel):
                 kmin, at = _core.poly_min_on(self._coeffs, lo, hi)
                 if kmin <= 0:
                     raise InputError(
-                        f"k_s(δ) is not positive over delta_range: {kmin:.4g} Pa/m at δ = {at:.4g} m"
+                        "k_s(δ) is not positive over delta_range: "
+                        f"{kmin:.4g} Pa/m at δ = {at:.4g} m"
                     )
 
     def __repr__(self) -> str:
-        law = f"k_s_delta={self.k_s_delta.tolist()}" if self.k_s_delta is not None else (
-            f"b={self.b.tolist() if self.b is not None else None}"
+        law = (
+            f"k_s_delta={self.k_s_delta.tolist()}"
+            if self.k_s_delta is not None
+            else (f"b={self.b.tolist() if self.b is not None else None}")
         )
         return f"NonlinearContact({law}, psi={self.psi:.6g}, omega={self.omega:.6g})"
 

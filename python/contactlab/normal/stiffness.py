@@ -61,7 +61,9 @@ class PressureStiffnessFit:
             )
         return np.array([np.interp(p0, self.p0, self.b[:, j]) for j in range(self.b.shape[1])])
 
-    def model(self, p0: float, psi: float | None = None, omega: float | None = None) -> NonlinearContact:
+    def model(
+        self, p0: float, psi: float | None = None, omega: float | None = None
+    ) -> NonlinearContact:
         """Eq. 17 with k_s(p) at ``p0``; ψ and ω default to the interpolated test values."""
         ps = float(np.interp(p0, self.p0, self.psi)) if psi is None else psi
         om = float(np.interp(p0, self.p0, self.omega)) if omega is None else omega
@@ -88,7 +90,7 @@ class PressureStiffnessFit:
     def table(self) -> str:
         """b1..b4 against p0 in the paper's units."""
         rows = [f"{'p0 [MPa]':>9} {'b1':>11} {'b2':>11} {'b3':>11} {'b4':>11}"]
-        for p0, bd in zip(self.p0, self.b_display()):
+        for p0, bd in zip(self.p0, self.b_display(), strict=True):
             rows.append(f"{p0 / 1e6:9.3f} " + " ".join(f"{v:11.5f}" for v in bd))
         return "\n".join(rows)
 
@@ -100,7 +102,9 @@ def _as_result(item: Any, kwargs: Mapping[str, Any]) -> LoopResult:
         try:
             t, p, d = item["t"], item["p"], item["delta"]
         except KeyError as exc:
-            raise InputError(f"a test given as a dict needs keys t, p, delta: missing {exc}") from None
+            raise InputError(
+                f"a test given as a dict needs keys t, p, delta: missing {exc}"
+            ) from None
         kw = dict(kwargs)
         if "p0" in item:
             kw["p0"] = item["p0"]

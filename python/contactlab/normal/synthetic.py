@@ -4,7 +4,8 @@ The pressure is ``p(t) = p0 + pa sin(ω t)`` (Pa), the displacement δ(t) (m, ze
 static state under p0) is either
 
 - ``model="nonlinear"`` (default): Konowalski's eq. 17 with ``k_s(δ)`` from the centre curve
-  of Table 2 and ψ computed from the Table 2 loop by eq. 7;
+  of Table 2 and ψ computed from the Table 2 loop by eq. 7 (see :func:`table2_model` for
+  other p0);
 - ``model="linear"``: Kelvin-Voigt with the paper's linear-model inputs (k = 1.206 MPa/µm,
   ψ = 0.0887);
 - ``model="table2"``: the quasi-static loop of Table 2 itself — δ on the loading curve while
@@ -39,9 +40,17 @@ def table2_psi() -> float:
 
 
 def table2_model(p0: float | None = _paper.TABLE2_P0) -> NonlinearContact:
-    """Eq. 17 with k_s(δ) from the Table 2 centre curve and ψ from the Table 2 loop (eq. 7)."""
+    """Eq. 17 with k_s(δ) from the Table 2 centre curve and ψ from the Table 2 loop (eq. 7).
+
+    Table 2 holds for p0 = 0.5 MPa. For another p0 the stiffness is scaled by
+    ``sqrt(p0 / 0.5 MPa)`` — an illustrative trend (joints stiffen with mean pressure, as the
+    paper's Fig. 8 shows), not a fit to the paper's data.
+    """
     c = _paper.loop_poly_to_si(_paper.TABLE2_MPA_UM["centre"])
-    return NonlinearContact(k_s_delta=c[1:], psi=table2_psi(), omega=_paper.TABLE2_OMEGA, p0=p0)
+    scale = 1.0 if p0 is None else float(np.sqrt(positive(p0, "p0") / _paper.TABLE2_P0))
+    return NonlinearContact(
+        k_s_delta=scale * c[1:], psi=table2_psi(), omega=_paper.TABLE2_OMEGA, p0=p0
+    )
 
 
 def _monotone_bracket(c: np.ndarray, span: float = 5e-6) -> tuple[float, float]:
@@ -70,11 +79,10 @@ def _invert_branch(c: np.ndarray, target: np.ndarray) -> np.ndarray:
         a = np.where(f < 0, m, a)
         b = np.where(f < 0, b, m)
     x = 0.5 * (a + b)
+    pv = np.polynomial.polynomial.polyval
     dc = np.polynomial.polynomial.polyder(c)
     for _ in range(3):
-        x = x - (np.polynomial.polynomial.polyval(x, c) - target) / np.polynomial.polynomial.polyval(
-            x, dc
-        )
+        x = x - (pv(x, c) - target) / pv(x, dc)
     return x
 
 
@@ -190,7 +198,8 @@ def synthetic_recording(
                 mdl = KelvinVoigt(_paper.PAPER_K_TAN, _paper.PAPER_PSI, omega, p0=p0)
             else:
                 raise InputError(
-                    f"model must be 'nonlinear', 'linear', 'table2' or a model object, got {model!r}"
+                    "model must be 'nonlinear', 'linear', 'table2' or a model object, "
+                    f"got {model!r}"
                 )
         else:
             if not hasattr(model, "simulate"):
