@@ -6,12 +6,12 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pytest  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
 
-import contactlab  # noqa: E402
-from contactlab.normal import (  # noqa: E402
+import contactlab
+from contactlab.normal import (
     KelvinVoigt,
     NonlinearContact,
     analyze_loop,
@@ -24,7 +24,7 @@ from contactlab.normal import (  # noqa: E402
     plot_velocity,
     synthetic_recording,
 )
-from contactlab.normal.compare import measured_velocity  # noqa: E402
+from contactlab.normal.compare import measured_velocity
 
 
 @pytest.fixture(scope="module")
@@ -162,14 +162,14 @@ def test_synthetic_recording_properties():
     t, p, d = synthetic_recording(n_cycles=8, seed=1)
     assert t.size == p.size == d.size == 8 * 256
     assert np.mean(p) == pytest.approx(0.5e6, rel=1e-3)
-    t2, p2, d2 = synthetic_recording(n_cycles=8, seed=1)
+    _t2, _p2, d2 = synthetic_recording(n_cycles=8, seed=1)
     np.testing.assert_array_equal(d, d2)
     _, _, clean = synthetic_recording(n_cycles=8, noise=None)
     noise = d - clean
     assert 1e-9 < np.std(noise) < 4e-9
     _, _, lin = synthetic_recording(n_cycles=4, model="linear", noise=None)
     assert np.max(lin) == pytest.approx(-np.min(lin), rel=1e-3)  # symmetric ellipse
-    _, pr, dr = synthetic_recording(n_cycles=4, noise={"p": 100.0, "delta": 1e-9}, seed=2)
+    _, _pr, dr = synthetic_recording(n_cycles=4, noise={"p": 100.0, "delta": 1e-9}, seed=2)
     assert np.all(np.isfinite(dr))
     _, _, dx = synthetic_recording(n_cycles=4, noise=0.01, seed=2)
     assert np.all(np.isfinite(dx))

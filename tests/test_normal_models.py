@@ -45,7 +45,7 @@ def test_kelvin_voigt_converges_to_the_analytic_steady_state(w):
 def test_stable_and_accurate_at_256_samples_per_period():
     # The paper's sampling: 256 per period, ψ = 0.0887 (time constant 0.014 s vs Δt = 0.025 s).
     m = NonlinearContact(k_s_delta=A_T2, psi=0.0887, omega=1.0)
-    t, p, dp = sine(16, 256)
+    t, p, _dp = sine(16, 256)
     ref = m.simulate(t, p, rtol=1e-13, atol=1e-22)
     for rtol in (1e-6, 1e-8):
         res = m.simulate(t, p, rtol=rtol)
