@@ -13,10 +13,11 @@ are parameters (the paper's branch shift ``x0``), not the extremes of the noisy 
 overestimate the amplitude, and the loop is most sensitive exactly there. The displacement
 channel's own measurement of the turning points (a regression of the bins next to each turn)
 enters the fit as two extra residuals, so both channels locate them. Over many noise seeds
-about 95 % of the 2σ intervals of ``h0``, ``ac``, ``E`` and ``A`` hold the truth (tests). When the relative standard errors
-of ``h0`` or ``ac`` exceed ``max_rel_stderr`` (the paper's steel case: amplitude ≪ 1/ac, the
-loop is nearly a straight line) the analysis reports them as not identifiable and gives
-``h0·ac`` with its error, plus a one-sided bound on each.
+about 95 % of the 2σ intervals of ``h0``, ``ac``, ``E`` and ``A`` hold the truth (tests).
+
+When the relative standard errors of ``h0`` or ``ac`` exceed ``max_rel_stderr`` (the paper's
+steel case: amplitude ≪ 1/ac, the loop is nearly a straight line) the analysis reports them
+as not identifiable and gives ``h0·ac`` with its error, plus a one-sided bound on each.
 """
 
 from __future__ import annotations
