@@ -437,3 +437,21 @@ def test_triangle_wave_with_sharp_turns():
         res = analyze_tangential(rec, on=on)
         assert abs(_z(res, "h0", H0)) < 3 and abs(_z(res, "ac", AC)) < 3, on
         assert abs(res.amplitude - A) < 3 * res.amplitude_stderr
+
+
+def test_synthetic_sensor_imperfections():
+    base = dict(h0=H0, ac=AC, amplitude=A, n_cycles=2, fs=1000, noise=0.0, x_noise=0.0, seed=1)
+    clean = synthetic_recording(**base)
+    np.testing.assert_array_equal(clean["F"], Masing(H0, AC).force(clean["x"]))
+    q = synthetic_recording(**base, adc_bits=8)
+    assert np.unique(q["F"]).size <= 2**8
+    hum = synthetic_recording(**base, hum=0.5)
+    spec = np.abs(np.fft.rfft(hum["F"] - clean["F"]))
+    freqs = np.fft.rfftfreq(hum.t.size, 1 / 1000)
+    assert freqs[np.argmax(spec)] == pytest.approx(50.0)
+    drift = synthetic_recording(**base, drift=0.1, offset=1.0)
+    np.testing.assert_allclose(drift["F"] - clean["F"], 1.0 + 0.1 * clean.t)
+    assert synthetic_recording(**{**base, "seed": 7})["F"].tolist() == clean["F"].tolist()
+    noisy1 = synthetic_recording(**{**base, "noise": 0.01, "seed": 3})
+    noisy2 = synthetic_recording(**{**base, "noise": 0.01, "seed": 3})
+    np.testing.assert_array_equal(noisy1["F"], noisy2["F"])
