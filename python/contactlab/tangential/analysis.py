@@ -427,12 +427,11 @@ def analyze_tangential(
     derived["k_global"] = _propagate(lambda v, A: float(_model(v).global_stiffness(A)))
     derived["peak_force"] = _propagate(lambda v, A: float(_model(v).virgin(A)))
     if loop is not None:
-        e_num = loop_area(loop.x, loop.F)
-        e_sem = (
-            float(np.std(scatter.energy, ddof=1) / math.sqrt(scatter.n_cycles))
-            if scatter is not None and scatter.n_cycles > 1
-            else math.nan
-        )
+        e_num, e_sem = _numeric_energy(loop, xa, Fa)
+        if drift[1] > 0 and scatter is not None:
+            # a drift error δs opens every cycle's polygon by δs·T·A
+            period = float(np.mean(scatter.period))
+            e_sem = math.hypot(e_sem, drift[1] * period * amplitude)
     else:
         e_num = loop_area(xa[start:], Fa[start:])
         e_sem = math.nan
@@ -492,6 +491,41 @@ def analyze_tangential(
         source=source,
         meta={"fit_start": start, "invert_force": bool(invert_force)},
     )
+
+
+def _numeric_energy(loop: AveragedLoop, x: np.ndarray, F: np.ndarray) -> tuple[float, float]:
+    """Energy per cycle as the mean area ``∮ F dx`` of the complete cycles' own samples, and
+    its standard error.
+
+    Each cycle's shoelace area is linear in each sample's ``F`` (and ``x``), with coefficients
+    half the neighbours' difference in ``x`` (in ``F``), and sensor noise is independent from
+    sample to sample, so the error follows from the per-sample noise variances, pooled over all
+    phase bins from the cycle-to-cycle spread (many degrees of freedom, unlike the spread of a
+    handful of per-cycle areas). Areas of raw samples, not of bin means, which would cut the
+    corners at the turns.
+    """
+    e = loop.scatter.energy
+    if loop.cycle_bounds is None or not np.any(np.isfinite(e)):
+        return float(loop_area(loop.x, loop.F)), math.nan
+    n = loop.n_cycles
+    if n < 2:
+        return float(np.nanmean(e)), math.nan
+    per_cycle = loop.count / n
+    s2F = float(np.nanmean(loop.F_std**2 * per_cycle))
+    s2x = float(np.nanmean(loop.x_std**2 * per_cycle))
+    var = 0.0
+    for k in range(n):
+        a, b = int(loop.cycle_bounds[k]), int(loop.cycle_bounds[k + 1])
+        xs, Fs = x[a:b], F[a:b]
+        dA_dF = 0.5 * (np.roll(xs, 1) - np.roll(xs, -1))
+        dA_dx = 0.5 * (np.roll(Fs, -1) - np.roll(Fs, 1))
+        var += float(np.sum(dA_dF**2) * s2F + np.sum(dA_dx**2) * s2x)
+    err = math.sqrt(var) / n
+    # Sampling also moves each cycle's polygon across the turns differently; when the areas
+    # scatter more than the noise explains, their own spread is the better error.
+    emp = float(np.nanstd(e, ddof=1)) / math.sqrt(n)
+    err = max(err, emp) if math.isfinite(emp) else err
+    return float(np.nanmean(e)), err if math.isfinite(err) else math.nan
 
 
 def _tip(loop: AveragedLoop, first: int, k: int) -> tuple[float, float] | None:
