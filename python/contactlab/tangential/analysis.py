@@ -39,9 +39,10 @@ from .model import (
     steady_loop_force,
     steady_signal_force,
     turn_nodes,
+    turn_values,
     virgin_signal_force,
 )
-from .preprocess import AveragedLoop, average_loop, find_reversals, monotone_path
+from .preprocess import AveragedLoop, Reversals, average_loop, find_reversals, monotone_path
 from .result import TangentialAnalysis
 
 #: ``ac·A`` above which the loop is taken to have reached gross sliding (branch slope at the
@@ -310,6 +311,7 @@ def analyze_tangential(
     sl = slice(start, None)
     first_is_peak = rev.first_is_peak
     nodes = turn_nodes(xpath, rev.peaks, rev.valleys) if on == "signal" and steady else None
+    vnodes = _virgin_nodes(xa, ta, xpath, rev) if on == "signal" and not steady else None
 
     def predict(v: dict[str, float]) -> np.ndarray:
         m = _model(v)
@@ -318,7 +320,7 @@ def analyze_tangential(
         elif steady:
             Fm = steady_signal_force(m, xpath, v["x0"], v["amplitude"], nodes, first_is_peak)
         else:
-            Fm = virgin_signal_force(m, xpath, v["x0"])
+            Fm = virgin_signal_force(m, xpath, v["x0"], vnodes)
         return Fm + v["offset"]
 
     def residual(v: dict[str, float]) -> np.ndarray:
@@ -491,6 +493,38 @@ def analyze_tangential(
         source=source,
         meta={"fit_start": start, "invert_force": bool(invert_force)},
     )
+
+
+def _virgin_nodes(
+    x: np.ndarray, t: np.ndarray | None, xpath: np.ndarray, rev: Reversals
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """Measured turning points for a virgin-history fit, inserted between samples (where
+    the turn lies), with the projected path clipped so that no sample passes its turn."""
+    tt = np.arange(x.size, dtype=float) if t is None else t
+    times = np.r_[rev.peak_times, rev.valley_times]
+    if times.size == 0:
+        return None
+    is_peak = np.r_[np.ones(rev.peaks.size, bool), np.zeros(rev.valleys.size, bool)]
+    idx = np.r_[rev.peaks, rev.valleys].astype(np.int64)
+    gaps = np.diff(np.sort(times))
+    half = 0.1 * float(np.median(gaps)) if gaps.size else 0.05 * float(tt[-1] - tt[0])
+    vals = turn_values(tt, x, times, half)
+    pos, val = [], []
+    for i, p_, v in zip(idx, is_peak, vals, strict=True):
+        if not np.isfinite(v):
+            continue
+        sign = 1.0 if p_ else -1.0
+        left = sign * xpath[i - 1] if i > 0 else -np.inf
+        right = sign * xpath[i + 1] if i + 1 < x.size else -np.inf
+        pos.append(i + 1 if right >= left else i)
+        val.append(v)
+        # no sample beyond its turn (noise would make the operator turn twice)
+        near = np.abs(tt - tt[i]) <= half
+        xpath[near] = np.minimum(xpath[near], v) if p_ else np.maximum(xpath[near], v)
+    if not pos:
+        return None
+    order = np.argsort(pos, kind="stable")
+    return np.asarray(pos, dtype=np.int64)[order], np.asarray(val, dtype=float)[order]
 
 
 def _numeric_energy(loop: AveragedLoop, x: np.ndarray, F: np.ndarray) -> tuple[float, float]:
