@@ -361,3 +361,12 @@ def test_failed_write_leaves_nothing_behind(tmp_path, monkeypatch, fmt):
         write_recording(p, _rec(50))
     monkeypatch.setattr(atomic.os, "replace", real)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_mat_v4_is_read(tmp_path):
+    import scipy.io
+
+    p = tmp_path / "v4.mat"
+    scipy.io.savemat(p, {"t": np.arange(3.0), "x": np.ones(3), "F": np.zeros(3)}, format="4")
+    rec = read_recording(p)
+    np.testing.assert_array_equal(rec["x"], np.ones(3))

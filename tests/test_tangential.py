@@ -180,7 +180,9 @@ def test_fit_recovers_parameters_with_offsets(on):
 
 
 def test_virgin_history_fit_finds_the_rest_position():
-    rec = synthetic_recording(H0, AC, A, n_cycles=3, fs=500, noise=0.01, seed=5, x_offset=2e-6)
+    rec = synthetic_recording(
+        H0, AC, A, n_cycles=3, fs=500, noise=0.01, x_noise=0.003, seed=5, x_offset=2e-6
+    )
     res = analyze_tangential(rec, on="signal", history="virgin")
     assert abs(_z(res, "x0", 2e-6)) < 4
     assert abs(_z(res, "h0", H0)) < 4
