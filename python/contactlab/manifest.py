@@ -112,7 +112,7 @@ def tags_from_filename(name: str | os.PathLike[str]) -> dict[str, Any]:
     >>> tags_from_filename("C45_p0-0.5MPa_pa-0.4MPa.mat")["p0"]
     500000.0
     """
-    stem = Path(name).name.split(".")[0]
+    stem = Path(name).stem
     tokens = [t for t in stem.split("_") if t]
     tags: dict[str, Any] = {}
     for i, tok in enumerate(tokens):
