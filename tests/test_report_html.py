@@ -11,10 +11,10 @@ import matplotlib
 import pytest
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
-from contactlab import InputError  # noqa: E402
-from contactlab.report import Column, Report, commit_outputs, format_value, slugify  # noqa: E402
+from contactlab import InputError
+from contactlab.report import Column, Report, commit_outputs, format_value, slugify
 
 
 class _Refs(HTMLParser):

@@ -13,12 +13,12 @@ import numpy as np
 import pytest
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
-from contactlab.manifest import StudyEntry  # noqa: E402
-from contactlab.masing import Masing  # noqa: E402
-from contactlab.study import RecordingResult, StudyResult, _flatten  # noqa: E402
-from contactlab.study_plots import (  # noqa: E402
+from contactlab.manifest import StudyEntry
+from contactlab.masing import Masing
+from contactlab.study import RecordingResult, StudyResult, _flatten
+from contactlab.study_plots import (
     display_unit,
     normal_study_figures,
     plot_study,
@@ -149,8 +149,8 @@ def test_study_figures_per_material_and_normal():
     rows = _tangential_rows()
     figs = tangential_study_figures(rows, {"h0": "N"})
     names = [n for n, _, _ in figs]
-    assert names == [f"study-{m}-{q}" for m in ("Al/Al", "PVC/steel")
-                     for q in ("energy_per_cycle", "equivalent_damping", "k_local0", "k_global")]  # fmt: skip
+    qs = ("energy_per_cycle", "equivalent_damping", "k_local0", "k_global")
+    assert names == [f"study-{m}-{q}" for m in ("Al/Al", "PVC/steel") for q in qs]
     # stiffness falls with amplitude for every load (the paper's trend; here exact Masing)
     fig = figs[3][1]
     for line in fig.axes[1].get_lines():
