@@ -62,6 +62,8 @@ def test_read_manifest(tmp_path):
         "operator": "Ann",
     }
     assert es[0].columns == {"x": "disp", "F": "force"}
+    assert es[0].units == {"normal_load": "N", "amplitude_nominal": "m"}
+    assert es[2].units == {"p0": "Pa"}
     assert es[1].tags["material"] == "Al/Al"  # from the file name
     assert es[1].tags["normal_load"] == 50.0
     assert es[2].tags["p0"] == pytest.approx(5e5)

@@ -37,17 +37,17 @@ from typing import Any
 
 from .errors import InputError
 
-# Unit → factor to SI. Micro written u, µ (micro sign) or μ (Greek mu).
-_UNITS: dict[str, float] = {
-    "": 1.0, "-": 1.0, "1": 1.0,
-    "s": 1.0, "ms": 1e-3, "us": 1e-6,
-    "m": 1.0, "mm": 1e-3, "um": 1e-6, "nm": 1e-9,
-    "N": 1.0, "kN": 1e3, "mN": 1e-3,
-    "Pa": 1.0, "kPa": 1e3, "MPa": 1e6, "GPa": 1e9,
-    "Hz": 1.0, "1/s": 1.0, "rad/s": 1.0,
-    "1/m": 1.0, "1/mm": 1e3, "1/um": 1e6,
-    "J": 1.0, "mJ": 1e-3, "uJ": 1e-6,
-    "N/m": 1.0, "N/mm": 1e3, "N/um": 1e6,
+# Unit → (factor to SI, SI unit). Micro written u, µ (micro sign) or μ (Greek mu).
+_UNITS: dict[str, tuple[float, str]] = {
+    "": (1.0, ""), "-": (1.0, ""), "1": (1.0, ""),
+    "s": (1.0, "s"), "ms": (1e-3, "s"), "us": (1e-6, "s"),
+    "m": (1.0, "m"), "mm": (1e-3, "m"), "um": (1e-6, "m"), "nm": (1e-9, "m"),
+    "N": (1.0, "N"), "kN": (1e3, "N"), "mN": (1e-3, "N"),
+    "Pa": (1.0, "Pa"), "kPa": (1e3, "Pa"), "MPa": (1e6, "Pa"), "GPa": (1e9, "Pa"),
+    "Hz": (1.0, "Hz"), "1/s": (1.0, "1/s"), "rad/s": (1.0, "rad/s"),
+    "1/m": (1.0, "1/m"), "1/mm": (1e3, "1/m"), "1/um": (1e6, "1/m"),
+    "J": (1.0, "J"), "mJ": (1e-3, "J"), "uJ": (1e-6, "J"),
+    "N/m": (1.0, "N/m"), "N/mm": (1e3, "N/m"), "N/um": (1e6, "N/m"),
 }  # fmt: skip
 
 # Canonical tag → its SI unit (for the study table's units map).
@@ -73,13 +73,22 @@ _KNOWN = {"file", "kind", "material", "columns", *TAG_UNITS}
 _KINDS = ("tangential", "normal")
 
 
-def unit_factor(unit: str, where: str) -> float:
-    """Factor converting a value in ``unit`` to SI; unknown units raise naming ``where``."""
+def _unit(unit: str, where: str) -> tuple[float, str]:
     u = unit.strip().replace("µ", "u").replace("μ", "u")
     if u not in _UNITS:
         known = ", ".join(k for k in _UNITS if k not in ("", "-", "1"))
         raise InputError(f"{where}: unknown unit {unit!r} (known: {known})")
     return _UNITS[u]
+
+
+def unit_factor(unit: str, where: str) -> float:
+    """Factor converting a value in ``unit`` to SI; unknown units raise naming ``where``."""
+    return _unit(unit, where)[0]
+
+
+def si_unit(unit: str, where: str = "unit") -> str:
+    """The SI unit a value in ``unit`` is converted to (``"um"`` → ``"m"``)."""
+    return _unit(unit, where)[1]
 
 
 @dataclass
@@ -89,6 +98,7 @@ class StudyEntry:
     path: Path
     kind: str
     tags: dict[str, Any] = field(default_factory=dict)
+    units: dict[str, str] = field(default_factory=dict)  # SI units of numeric tags
     columns: dict[str, str] | None = None
     fs: float | None = None
     source: str = ""  # "manifest.csv row 3" or the file name, for error messages
@@ -160,7 +170,8 @@ def entry_from_file(path: str | os.PathLike[str], **overrides: Any) -> StudyEntr
     tags.pop("kind", None)
     if kind not in _KINDS:
         raise InputError(f"{p}: kind {kind!r} must be 'tangential' or 'normal'")
-    return StudyEntry(path=p, kind=kind, tags=tags, source=p.name)
+    units = {k: u for k, u in TAG_UNITS.items() if k in tags}
+    return StudyEntry(path=p, kind=kind, tags=tags, units=units, source=p.name)
 
 
 def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
@@ -185,6 +196,7 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
     header_row, header = lines[0][0], rows[0]
     keys: list[str] = []
     factors: list[float | None] = []
+    si: dict[str, str] = {}
     for j, cell in enumerate(header):
         m = _HEADER.match(cell)
         name, unit = (m.group(1), m.group(2)) if m else (cell.strip(), None)
@@ -195,7 +207,11 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
         if key in keys:
             raise InputError(f"{where}: duplicated column {key!r}")
         keys.append(key)
-        factors.append(unit_factor(unit, where) if unit is not None else None)
+        if unit is not None:
+            f, si[key] = _unit(unit, where)
+            factors.append(f)
+        else:
+            factors.append(None)
     if "file" not in keys:
         raise InputError(f"manifest {mpath}, row {header_row}: no 'file' column in {header}")
 
@@ -239,12 +255,20 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
             raise InputError(f"{where}, column 'kind': {kind!r} must be 'tangential' or 'normal'")
         fs = tags.pop("fs", None)
         entries.append(
-            StudyEntry(path=fpath, kind=kind, tags=tags, columns=columns, fs=fs, source=f"{where}")
+            StudyEntry(
+                path=fpath,
+                kind=kind,
+                tags=tags,
+                units={k: u for k, u in {**TAG_UNITS, **si}.items() if k in tags and u},
+                columns=columns,
+                fs=fs,
+                source=where,
+            )
         )
     if not entries:
         raise InputError(f"manifest {mpath} lists no recordings")
     return entries
 
 
-__all__ = ["TAG_UNITS", "StudyEntry", "entry_from_file", "read_manifest", "tags_from_filename",
-           "unit_factor"]  # fmt: skip
+__all__ = ["TAG_UNITS", "StudyEntry", "entry_from_file", "read_manifest", "si_unit",
+           "tags_from_filename", "unit_factor"]  # fmt: skip

@@ -111,6 +111,7 @@ def analyze_entry(
     rec = read_recording(entry.path, columns=entry.columns, kind=entry.kind, fs=entry.fs)
     base = {"file": entry.path.name, "kind": entry.kind, **entry.tags}
     units = {k: TAG_UNITS[k] for k in entry.tags if k in TAG_UNITS}
+    units.update(entry.units)
     if entry.kind == "tangential":
         from .tangential import analyze_tangential
 
