@@ -11,7 +11,9 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
+from ..errors import InputError
 from ..manifest import entry_from_file
 from ..study import run_study
 from ._common import (
@@ -47,6 +49,8 @@ def _handler(args: argparse.Namespace) -> int:
     columns = parse_columns(args.columns)
     entries = []
     for f in args.files:
+        if not Path(f).is_file():
+            raise InputError(f"{f}: no such file")
         e = entry_from_file(f, kind=args.model)
         e.columns, e.fs = columns, args.fs
         entries.append(e)
