@@ -7,6 +7,8 @@ models), fitting, reports and model-discrepancy diagnosis. See README.md.
 from __future__ import annotations
 
 from .errors import ContactLabError, ContactLabWarning, ConvergenceError, InputError
+from .fitting import FitResult, Parameter, least_squares_fit
+from .io import Recording, RecordingError, read_recording, write_recording
 from .masing import CycleTable, Masing, MasingOperator, cycle_energies, loop_area
 
 __version__ = "0.1.0"
@@ -16,10 +18,17 @@ __all__ = [
     "ContactLabWarning",
     "ConvergenceError",
     "CycleTable",
+    "FitResult",
     "InputError",
     "Masing",
     "MasingOperator",
+    "Parameter",
+    "Recording",
+    "RecordingError",
     "__version__",
     "cycle_energies",
+    "least_squares_fit",
     "loop_area",
+    "read_recording",
+    "write_recording",
 ]
