@@ -86,6 +86,9 @@ def test_commit_outputs_writes_all(tmp_path):
     paths = commit_outputs(tmp_path / "new" / "dir", {"a.txt": b"1", "s/b.txt": b"2"})
     assert [p.read_bytes() for p in paths] == [b"1", b"2"]
     assert sorted(os.listdir(tmp_path / "new" / "dir")) == ["a.txt", "s"]
+    mask = os.umask(0o022)
+    os.umask(mask)
+    assert paths[0].stat().st_mode & 0o777 == 0o666 & ~mask  # not mkstemp's 0600
 
 
 def test_commit_outputs_all_or_nothing_on_interrupt(tmp_path, monkeypatch):

@@ -95,7 +95,7 @@ def tangential_signal(
     f_true = Masing(h0, ac).force(x_true)
     duration = t[-1]
     # displacement sensor: zero offset, thermal drift (a few % of A over the record), noise
-    x_off = rng.uniform(-0.5, 0.5) * amplitude
+    x_off = rng.uniform(-0.3, 0.3) * amplitude
     x_drift = rng.uniform(-0.02, 0.02) * amplitude / duration
     x = x_true + x_off + x_drift * t + rng.normal(0.0, pair.x_noise, n)
     x = np.round(x / 1e-9) * 1e-9  # stored at 1 nm resolution
@@ -211,6 +211,8 @@ def generate(out: Path, *, normal: bool = True) -> list[Path]:
     w.writerow(MANIFEST_HEADER)
     w.writerows(rows)
     written.append(write_text(out / "manifest.csv", buf.getvalue()))
+    for path in written:  # atomic writers create 0600 files; data files are for everyone
+        path.chmod(0o644)
     return written
 
 

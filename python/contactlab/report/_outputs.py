@@ -24,6 +24,13 @@ def _check_relative(name: str) -> PurePosixPath:
     return rel
 
 
+def _default_mode() -> int:
+    """Permissions a plain ``open(..., "w")`` would give (mkstemp makes files 0600)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
 def commit_outputs(directory: str | os.PathLike[str], files: Mapping[str, bytes]) -> list[Path]:
     """Write ``files`` (relative name → content) under ``directory``, all or nothing.
 
@@ -48,6 +55,7 @@ def commit_outputs(directory: str | os.PathLike[str], files: Mapping[str, bytes]
     """
     root = Path(directory)
     targets = [(root / _check_relative(name), data) for name, data in files.items()]
+    mode = _default_mode()
     created_dirs: list[Path] = []
     staged: list[tuple[Path, Path]] = []
     try:
@@ -64,6 +72,7 @@ def commit_outputs(directory: str | os.PathLike[str], files: Mapping[str, bytes]
             staged.append((Path(tmp), final))
             with os.fdopen(fd, "wb") as fh:
                 fh.write(data)
+            os.chmod(staged[-1][0], mode)
         # Every temporary is complete: move them into place (fast, no more I/O of content).
         for tmp, final in staged:
             os.replace(tmp, final)
