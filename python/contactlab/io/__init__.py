@@ -1,8 +1,10 @@
 """Reading and writing recordings: CSV/text, NI TDMS, HDF5 and MATLAB .mat, SI inside.
 
->>> from contactlab.io import read_recording            # doctest: +SKIP
->>> rec = read_recording("run_109N.csv")                 # columns "t [ms], x [um], F [N]"
->>> rec["x"], rec.units["x"]                             # metres, "m"
+Typical use (a file with columns ``t [ms], x [um], F [N]``)::
+
+    from contactlab.io import read_recording
+    rec = read_recording("run_109N.csv")
+    rec["x"], rec.units["x"]            # metres, "m"
 
 The format comes from the extension and is checked against the content. Channel names are
 guessed (``x``/``disp``, ``F``/``force``, ``p``/``pressure``, ``delta``, ``t``/``time``) or given
