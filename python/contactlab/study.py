@@ -99,6 +99,31 @@ def _with_source(exc: BaseException, entry: StudyEntry) -> str:
     return msg if entry.path.name in msg else f"{entry.path}: {msg}"
 
 
+_FIT_STATS = ("chisqr", "redchi", "aic", "bic", "success", "nfev", "ndata", "nvarys")
+
+
+def tangential_row(d: Mapping[str, Any]) -> dict[str, Any]:
+    """Table row of a tangential analysis' ``to_dict()``: identifiability as a flag plus the
+    evidence, fit statistics (not the covariance matrix), warnings joined into one text."""
+    out = {k: v for k, v in d.items() if k not in ("identifiable", "fit", "warnings", "source")}
+    ident = d.get("identifiable")
+    if isinstance(ident, Mapping):
+        out["identifiable"] = bool(ident.get("h0")) and bool(ident.get("ac"))
+        for k in ("ac_times_amplitude", "correlation_h0_ac", "rel_stderr_h0_ac"):
+            if k in ident:
+                out[k] = ident[k]
+        out["identifiability"] = ident.get("message", "")
+    elif ident is not None:
+        out["identifiable"] = bool(ident)
+    fit = d.get("fit")
+    if isinstance(fit, Mapping):
+        for k in _FIT_STATS:
+            if k in fit:
+                out[f"fit_{k}"] = fit[k]
+    out["warnings"] = " | ".join(str(w) for w in d.get("warnings", []) or [])
+    return out
+
+
 def analyze_entry(
     entry: StudyEntry,
     *,
@@ -115,8 +140,9 @@ def analyze_entry(
     if entry.kind == "tangential":
         from .tangential import analyze_tangential
 
-        analysis = analyze_tangential(rec, **dict(tangential_options or {}))
-        d = analysis.to_dict()
+        opts = {"warn": False, **dict(tangential_options or {})}  # warnings go in the table
+        analysis = analyze_tangential(rec, **opts)
+        d = tangential_row(analysis.to_dict())
         row, u = _flatten(d, d.get("units", {}) or {})
         extra: dict[str, Any] = {}
     else:

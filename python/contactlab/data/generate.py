@@ -71,7 +71,7 @@ MATERIALS = (
     MaterialPair("PVC-steel", "PVC/steel", 0.30, 2.5e4, 60.0, (30.0, 60.0, 90.0),
                  (10e-6, 20e-6, 40e-6), ("tdms",), 10e-9, 0.03, 100.0),
     MaterialPair("steel-steel", "steel/steel", 0.18, 5.0e4, 75.0, (75.0, 150.0, 225.0),
-                 (0.25e-6, 0.5e-6, 1.0e-6), ("h5", "mat"), 2e-9, 0.004, 20.0),
+                 (0.25e-6, 0.5e-6, 1.0e-6), ("h5", "mat"), 5e-9, 0.02, 50.0),
 )  # fmt: skip
 
 NORMAL_P0 = (0.5e6, 1.0e6, 1.5e6, 2.0e6, 2.5e6)  # Pa

@@ -32,6 +32,8 @@ TANGENTIAL_COLUMNS = [
     Column("equivalent_damping", "c_e·ω", "N/µm", 1e-6, stderr="equivalent_damping_stderr"),
     Column("k_local0", "k_l(0)", "N/µm", 1e-6, stderr="k_local0_stderr"),
     Column("k_global", "k_g(A)", "N/µm", 1e-6, stderr="k_global_stderr"),
+    Column("true_h0", "h0 true", "N"),
+    Column("true_ac", "ac true", "1/mm", 1e-3),
     Column("identifiable", "h0, ac separable"),
 ]
 NORMAL_COLUMNS = [
@@ -85,9 +87,10 @@ def _tangential_detail(rep: Report, r: RecordingResult, dpi: int) -> None:
     plot_residuals(r.analysis, ax=a2)
     fig.suptitle(_label(r), fontsize=9)
     rep.figure(fig, f"loop-{r.entry.path.stem}", f"{_label(r)}: loop with fit, residuals", dpi=dpi)
-    fit = getattr(r.analysis, "fit", None)
-    if fit is not None and hasattr(fit, "report"):
-        rep.preformatted(fit.report())
+    for w in getattr(r.analysis, "warnings", None) or []:
+        rep.text(w, note=True)
+    if hasattr(r.analysis, "report"):
+        rep.preformatted(r.analysis.report())
 
 
 def poly_eval(coeffs: Sequence[float], x: np.ndarray) -> np.ndarray:
@@ -152,10 +155,10 @@ def build_report(
         rep.section(f"{kind.capitalize()} recordings: summary")
         rep.table(rows, cols, caption="Fitted parameters (± 1 standard error); full table "
                   f"with every column in SI: study_{kind}.csv / .parquet")  # fmt: skip
-        for r in result.of_kind(kind):
-            if r.ok and r.row.get("identifiable") is False:
-                rep.text(f"{r.entry.name}: the loop is too small to separate h0 and ac; only "
-                         "h0·ac (the initial stiffness) is identified.", note=True)  # fmt: skip
+        warned = [r.entry.name for r in result.of_kind(kind) if r.ok and r.row.get("warnings")]
+        if warned:
+            rep.text(f"{len(warned)} recording(s) with warnings (see their sections below): "
+                     + ", ".join(warned), note=True)  # fmt: skip
         if study_plots and len(rows) > 1:
             figs = (tangential_study_figures if kind == "tangential" else normal_study_figures)(
                 rows, units
