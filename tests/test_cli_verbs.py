@@ -95,7 +95,8 @@ def test_analyze_normal_json(normal_file, tmp_path):
 def test_analyze_several_files(tangential_file, tmp_path):
     other = tmp_path / "Al-Al_W50N_A20um.csv"
     code = main(["simulate", "tangential", str(other), "--h0", "20", "--ac", "5e4",
-                 "--amplitude", "20um", "--cycles", "4", "--fs", "400", "--seed", "4"])  # fmt: skip
+                 "--amplitude", "20um", "--cycles", "4", "--fs", "400", "--seed", "4",
+                 "--offset", "0.3N", "--x-offset", "1um", "--adc-bits", "16"])  # fmt: skip
     assert code == 0
     out = tmp_path / "all.json"
     assert main(["analyze", str(tangential_file), str(other), "--model", "tangential",

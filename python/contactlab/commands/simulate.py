@@ -29,6 +29,10 @@ def _handler(args: argparse.Namespace) -> int:
             fs=args.fs,
             noise=args.noise,
             seed=args.seed,
+            offset=args.offset,
+            x_offset=args.x_offset,
+            drift=args.drift,
+            adc_bits=args.adc_bits,
         )
     else:
         from ..normal import synthetic_recording as normal_synthetic
@@ -66,6 +70,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="displacement amplitude (m; e.g. 20um)")  # fmt: skip
     g.add_argument("--frequency", type=quantity("Hz"), default=1.0, help="Hz")
     g.add_argument("--fs", type=quantity("Hz"), default=500.0, help="sampling rate (Hz)")
+    g.add_argument("--offset", type=quantity("N"), default=0.0, help="load-cell zero offset (N)")
+    g.add_argument("--x-offset", type=quantity("m"), default=0.0,
+                   help="displacement-sensor zero offset (m)")  # fmt: skip
+    g.add_argument("--drift", type=float, default=0.0, help="force drift (N/s)")
+    g.add_argument("--adc-bits", type=int, default=None, help="quantise to this many bits")
     n = p.add_argument_group("normal")
     n.add_argument("--p0", type=quantity("Pa"), default=0.5e6, help="static pressure (Pa)")
     n.add_argument("--pa", type=quantity("Pa"), default=0.4e6, help="pressure amplitude (Pa)")
@@ -73,7 +82,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     n.add_argument("--samples-per-cycle", type=int, default=400)
     n.add_argument("--normal-model", default=None, help="model of the normal contact")
     p.add_argument("--cycles", type=int, default=5, help="number of cycles")
-    p.add_argument("--noise", type=float, default=0.0,
-                   help="relative noise level (see synthetic_recording)")  # fmt: skip
+    p.add_argument("--noise", type=float, default=0.01,
+                   help="noise level: tangential, force noise as a fraction of the peak force; "
+                   "normal, as the normal module's synthetic_recording defines it")  # fmt: skip
     p.add_argument("--seed", type=int, default=0)
     p.set_defaults(handler=_handler)
