@@ -158,7 +158,13 @@ def test_study_figures_per_material_and_normal():
         if len(y) == 3:
             assert np.all(np.diff(y) < 0)
     nrows = [
-        {"p0": p0, "pa": 4e5, "psi": 0.1 + 0.01 * i, "k_tan": 1.2e12 + 1e11 * i, "b1": 0.1 * i}
+        {
+            "p0": p0,
+            "pa": 4e5,
+            "psi": 0.1 + 0.01 * i,
+            "k_tan": 1.2e12 + 1e11 * i,
+            "b1_paper": 0.1 * i,
+        }
         for i, p0 in enumerate((5e5, 1e6, 1.5e6))
     ]
     nf = normal_study_figures(nrows)

@@ -18,6 +18,8 @@ from typing import Any
 
 import numpy as np
 
+from .normal_study import B_PAPER_UNITS
+
 # key, label, SI unit; an optional second key drawn beside it (numeric loop area).
 TANGENTIAL_QUANTITIES: list[tuple[str, str, str, str | None]] = [
     ("energy_per_cycle", "energy per cycle E", "J", "energy_per_cycle_numeric"),
@@ -192,7 +194,8 @@ def normal_study_figures(
     units = {"p0": "Pa", "pa": "Pa", **(units or {})}
     quantities = [(k, lab, u) for k, lab, u in NORMAL_QUANTITIES
                   if any(math.isfinite(_num(r, k)) for r in rows)]  # fmt: skip
-    bs = [f"b{i}" for i in range(1, 5) if any(math.isfinite(_num(r, f"b{i}")) for r in rows)]
+    bs = [f"b{i}_paper" for i in range(1, 5)
+          if any(math.isfinite(_num(r, f"b{i}_paper")) for r in rows)]  # fmt: skip
     out = []
     if quantities:
         n = len(quantities)
@@ -211,11 +214,11 @@ def normal_study_figures(
         fig, axs = plt.subplots(1, len(bs), figsize=(3.4 * len(bs), 3.2),
                                 constrained_layout=True, squeeze=False)  # fmt: skip
         for ax, key in zip(axs.flat, bs, strict=False):
-            plot_study(
-                rows, key, "p0", "pa", unit=units.get(key, ""), label=key, units=units, ax=ax
-            )
-        fig.suptitle("k_s(p) = b1 p³ + b2 p² + b3 p + b4 (eq. 16): coefficients against p0",
-                     fontsize=10)  # fmt: skip
+            name = key.split("_")[0]
+            plot_study(rows, key, "p0", "pa", label=f"{name} [{B_PAPER_UNITS[name]}]",
+                       units=units, ax=ax)  # fmt: skip
+        fig.suptitle("k_s(p) = b1 p³ + b2 p² + b3 p + b4 (eq. 16; k_s in MPa/µm, p in MPa) "
+                     "against p0", fontsize=10)  # fmt: skip
         out.append(("study-normal-b-coefficients", fig, "b1..b4 of eq. 16 against p0"))
     return out
 

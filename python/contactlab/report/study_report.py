@@ -50,10 +50,10 @@ NORMAL_COLUMNS = [
     Column("k_sec", "k_sec", "MPa/µm", 1e-12),
     Column("delta_min", "δ_min", "µm", 1e6),
     Column("delta_max", "δ_max", "µm", 1e6),
-    Column("b1", "b1"),
-    Column("b2", "b2"),
-    Column("b3", "b3"),
-    Column("b4", "b4"),
+    Column("b1_paper", "b1 (MPa, µm)"),
+    Column("b2_paper", "b2 (MPa, µm)"),
+    Column("b3_paper", "b3 (MPa, µm)"),
+    Column("b4_paper", "b4 [MPa/µm]"),
 ]
 
 
@@ -99,16 +99,21 @@ def poly_eval(coeffs: Sequence[float], x: np.ndarray) -> np.ndarray:
 
 
 def plot_normal_loop(r: RecordingResult, ax: Any = None) -> Any:
-    """Measured p(δ) of a normal recording with the fitted eq.-1 polynomials (MPa, µm)."""
+    """Measured p(δ) of a normal recording, its averaged cycle and the fitted eq.-1
+    polynomials (loading, centre, unloading), in the paper's units (MPa, µm)."""
     import matplotlib.pyplot as plt
 
     if ax is None:
         _, ax = plt.subplots(figsize=(5.0, 3.6), constrained_layout=True)
-    rec, row = r.recording, r.row
-    p = np.asarray(rec.data["p"], dtype=float)
-    d = np.asarray(rec.data["delta"], dtype=float)
-    p0 = float(row.get("p0", r.entry.tags.get("p0", 0.0)) or 0.0)
-    ax.plot(d * 1e6, (p - p0) * 1e-6, color="0.6", lw=0.6, label="measured")
+    rec, row, res = r.recording, r.row, r.analysis
+    p0 = float(row.get("p0", 0.0) or 0.0)
+    shift = float(row.get("delta_offset", 0.0) or 0.0)
+    p = np.asarray(rec["p"], dtype=float)
+    d = np.asarray(rec["delta"], dtype=float)
+    ax.plot((d - shift) * 1e6, (p - p0) * 1e-6, color="0.75", lw=0.5, label="recorded")
+    if res is not None and hasattr(res, "cycle_delta"):
+        ax.plot(np.asarray(res.cycle_delta) * 1e6, np.asarray(res.cycle_p) * 1e-6, ".",
+                color="0.2", ms=2, label="averaged cycle")  # fmt: skip
     lo, hi = row.get("delta_min"), row.get("delta_max")
     if isinstance(lo, float) and isinstance(hi, float) and math.isfinite(lo + hi):
         dm = np.linspace(lo, hi, 200)  # SI: the polynomials take δ in m and give p in Pa
@@ -117,7 +122,7 @@ def plot_normal_loop(r: RecordingResult, ax: Any = None) -> Any:
             if all(isinstance(c, float) for c in coeffs):
                 ax.plot(dm * 1e6, poly_eval(coeffs, dm) * 1e-6, style, lw=1.2,
                         label=name.replace("poly_", ""))  # fmt: skip
-    ax.set_xlabel("normal displacement δ [µm]")
+    ax.set_xlabel("normal contact displacement δ [µm]")
     ax.set_ylabel("dynamic pressure p − p0 [MPa]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
