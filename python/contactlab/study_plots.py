@@ -166,16 +166,17 @@ def tangential_study_figures(
     materials = sorted({str(r.get("material", "unknown")) for r in rows})
     for mat in materials:
         mrows = [r for r in rows if str(r.get("material", "unknown")) == mat]
-        amp_group = (
-            "amplitude_nominal" if any("amplitude_nominal" in r for r in mrows) else "amplitude"
-        )
+        # The paper plots against the commanded amplitude; the measured one (in the table)
+        # is used when no nominal amplitude is tagged.
+        nominal = all(math.isfinite(_num(r, "amplitude_nominal")) for r in mrows)
+        amp_group = amp_x = "amplitude_nominal" if nominal else "amplitude"
         for key, label, unit, secondary in TANGENTIAL_QUANTITIES:
             if not any(math.isfinite(_num(r, key)) for r in mrows):
                 continue
             fig, (a1, a2) = plt.subplots(1, 2, figsize=(9.0, 3.6), constrained_layout=True)
             plot_study(mrows, key, "normal_load", amp_group, unit=unit, label=label,
                        secondary=secondary, units=units, ax=a1)  # fmt: skip
-            plot_study(mrows, key, "amplitude", "normal_load", unit=unit, label=label,
+            plot_study(mrows, key, amp_x, "normal_load", unit=unit, label=label,
                        secondary=secondary, units=units, ax=a2)  # fmt: skip
             fig.suptitle(f"{mat}: {label}", fontsize=10)
             cap = f"{mat}: {label} against normal load and amplitude (± 1 standard error)"
