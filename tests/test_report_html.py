@@ -9,6 +9,8 @@ from html.parser import HTMLParser
 
 import matplotlib
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
@@ -122,3 +124,48 @@ def test_commit_outputs_rejects_escaping_names(tmp_path, name):
 def test_report_file_name_must_be_html(tmp_path):
     with pytest.raises(InputError, match=r"\.html"):
         Report("x").write(tmp_path, html_name="report.txt")
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    names=st.lists(
+        st.sampled_from(["a.txt", "b.png", "s/c.csv", "s/t/d.bin", "e.html"]),
+        min_size=1,
+        max_size=5,
+        unique=True,
+    ),
+    fail_at=st.integers(0, 6),
+    data=st.binary(max_size=64),
+)
+def test_commit_outputs_is_all_or_nothing(tmp_path_factory, names, fail_at, data):
+    """Whatever file fails, the folder is either fully updated or exactly as before."""
+    out = tmp_path_factory.mktemp("o")
+    (out / "a.txt").write_bytes(b"old")
+    before = sorted((str(p.relative_to(out)), p.read_bytes() if p.is_file() else None)
+                    for p in out.rglob("*"))  # fmt: skip
+    real = os.fdopen
+    calls = {"n": 0}
+
+    def flaky(fd, mode):
+        if calls["n"] == fail_at:
+            os.close(fd)
+            raise OSError("disk full")
+        calls["n"] += 1
+        return real(fd, mode)
+
+    os.fdopen = flaky
+    try:
+        commit_outputs(out, dict.fromkeys(names, data))
+        ok = True
+    except OSError:
+        ok = False
+    finally:
+        os.fdopen = real
+    after = sorted((str(p.relative_to(out)), p.read_bytes() if p.is_file() else None)
+                   for p in out.rglob("*"))  # fmt: skip
+    if ok:
+        assert fail_at >= len(names)
+        for n in names:
+            assert (out / n).read_bytes() == data
+    else:
+        assert after == before

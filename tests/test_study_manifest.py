@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from contactlab import InputError
 from contactlab.manifest import entry_from_file, read_manifest, tags_from_filename, unit_factor
@@ -96,3 +98,19 @@ def test_manifest_missing_or_binary(tmp_path):
     (tmp_path / "bin.csv").write_bytes(b"\xff\xfe\x00\x81garbage")
     with pytest.raises(InputError, match="not a UTF-8"):
         read_manifest(tmp_path / "bin.csv")
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    material=st.from_regex(r"[A-Za-z][A-Za-z0-9]{0,6}(-[A-Za-z0-9]{1,6})?", fullmatch=True),
+    load=st.floats(0.01, 1e4, allow_nan=False),
+    amp_um=st.floats(1e-3, 1e3, allow_nan=False),
+    p0_mpa=st.floats(0.01, 10, allow_nan=False),
+)
+def test_filename_tags_round_trip(material, load, amp_um, p0_mpa):
+    name = f"{material}_W{load:.6g}N_A{amp_um:.6g}um_p0-{p0_mpa:.6g}MPa.csv"
+    t = tags_from_filename(name)
+    assert t["material"] == material.replace("-", "/")
+    assert t["normal_load"] == pytest.approx(float(f"{load:.6g}"), rel=1e-12)
+    assert t["amplitude_nominal"] == pytest.approx(float(f"{amp_um:.6g}") * 1e-6, rel=1e-12)
+    assert t["p0"] == pytest.approx(float(f"{p0_mpa:.6g}") * 1e6, rel=1e-12)
