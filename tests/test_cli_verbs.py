@@ -166,3 +166,11 @@ def test_demo_quick_end_to_end(tmp_path, capsys):
     html = (out / "report.html").read_text(encoding="utf-8")
     for mat in ("Al/Al", "PVC/steel", "steel/steel"):
         assert mat in html
+
+
+def test_progress_bar_on_request(tangential_file, capsys):
+    assert main(["analyze", str(tangential_file), "--model", "tangential", "--progress"]) == 0
+    err = capsys.readouterr().err
+    assert "analysing" in err and "1/1" in err
+    assert main(["analyze", str(tangential_file), "--model", "tangential", "--no-progress"]) == 0
+    assert "analysing" not in capsys.readouterr().err
