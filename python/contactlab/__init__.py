@@ -6,6 +6,7 @@ models), fitting, reports and model-discrepancy diagnosis. See README.md.
 
 from __future__ import annotations
 
+from . import normal
 from .errors import ContactLabError, ContactLabWarning, ConvergenceError, InputError
 from .fitting import FitResult, Parameter, least_squares_fit
 from .io import Recording, RecordingError, read_recording, write_recording
@@ -29,6 +30,7 @@ __all__ = [
     "cycle_energies",
     "least_squares_fit",
     "loop_area",
+    "normal",
     "read_recording",
     "write_recording",
 ]
