@@ -20,7 +20,8 @@ as a tag (numbers converted to SI when a unit is given).
 
 File names: when a tag is not given, it is looked for in the file name, split at ``_``:
 the first token is the material (``-`` standing for ``/``), and tokens ``W50N``, ``A10um``,
-``f1Hz``, ``p0-0.5MPa``, ``pa-0.4MPa`` give load, amplitude, frequency, p0 and pa. A file with a
+``f1Hz``, ``p0-0.5MPa``, ``pa-0.4MPa`` (number and unit, both required) give load, amplitude,
+frequency, p0 and pa. A file with a
 ``p0`` tag is a normal-contact recording unless ``kind`` says otherwise.
 """
 
@@ -61,7 +62,7 @@ TAG_UNITS: dict[str, str] = {
 }
 
 _HEADER = re.compile(r"^\s*([^\[\]]*?)\s*(?:\[\s*([^\]]*?)\s*\])?\s*$")
-_TOKEN = re.compile(r"^(W|A|f|p0|pa)[-=]?(\d+(?:\.\d+)?(?:[eE][-+]?\d+)?)([A-Za-zµμ/]*)$")
+_TOKEN = re.compile(r"^(W|A|f|p0|pa)[-=]?(\d+(?:\.\d+)?)([A-Za-zµμ/]*)$")
 _TOKEN_TAG = {
     "W": "normal_load",
     "A": "amplitude_nominal",
@@ -126,8 +127,8 @@ def tags_from_filename(name: str | os.PathLike[str]) -> dict[str, Any]:
     tokens = [t for t in stem.split("_") if t]
     tags: dict[str, Any] = {}
     for i, tok in enumerate(tokens):
-        m = _TOKEN.match(tok)
-        if m:
+        m = _TOKEN.match(tok) if i > 0 else None  # the first token is always the material
+        if m and m.group(3):  # a tag needs its unit: "A10um", not "A10"
             key, num, unit = m.groups()
             try:
                 factor = unit_factor(unit, f"file name {Path(name).name!r}, token {tok!r}")

@@ -22,9 +22,10 @@ resolution. Formats as rigs write them: CSV with units in the headers (``time [m
 and MATLAB .mat.
 
 Normal (Konowalski 2009; PHYSICS.md §2). Dynamic pressure ``p = pa sin(ω t)`` about the static
-pressure p0 = 0.5 ... 2.5 MPa, pa = 0.4 MPa, ω = 1 1/s; the displacement comes from
-:func:`contactlab.normal.synthetic_recording` (the nonlinear model, eq. 17, with a stiffness
-that grows with p0), plus sensor noise (inductive probe, 5 nm) and pressure noise.
+pressure p0 = 0.5 ... 2.5 MPa, pa = 0.4 MPa, ω = 1 1/s, 256 samples per cycle as the paper's
+rig; the displacement comes from :func:`contactlab.normal.synthetic_recording` (the nonlinear
+model, eq. 17, with a stiffness that grows with p0) with its sensor noise and quantisation,
+plus an imperfect zeroing of the displacement probe.
 
 The manifest lists each file with its tags and the true parameters (``true_h0``, ``true_ac``),
 so a study can be checked against the truth.
@@ -78,6 +79,7 @@ NORMAL_P0 = (0.5e6, 1.0e6, 1.5e6, 2.0e6, 2.5e6)  # Pa
 NORMAL_PA = 0.4e6  # Pa
 NORMAL_OMEGA = 1.0  # 1/s (Konowalski's ω)
 NORMAL_FORMATS = ("csv", "mat")
+NORMAL_CYCLES = 6  # the paper recorded 128 cycles of 256 samples; 6 keep the files small
 
 
 def truth(pair: MaterialPair, load: float) -> tuple[float, float]:
@@ -159,16 +161,21 @@ def write_normal(path: Path, t: np.ndarray, p: np.ndarray, delta: np.ndarray) ->
 
 
 def normal_signal(p0: float, rng: np.random.Generator) -> tuple[np.ndarray, ...]:
-    """Time (s), dynamic pressure p − p0 (Pa) and displacement δ (m) of one normal test."""
+    """Time (s), total pressure p0 + pa sin ωt (Pa) and displacement δ (m) of one test.
+
+    :func:`contactlab.normal.synthetic_recording` gives the steady-state response of the
+    nonlinear model (eq. 17) with its "realistic" sensor noise (0.2 % of pa on p, 2 nm on δ,
+    16-bit quantisation); the displacement probe's zeroing under p0 is left imperfect here
+    (a residual offset of up to ±20 nm).
+    """
     from ..normal import synthetic_recording
 
     seed = int(rng.integers(2**31))
     t, p, delta = synthetic_recording(
-        p0, NORMAL_PA, NORMAL_OMEGA, n_cycles=3, samples_per_cycle=400, seed=seed
+        p0, NORMAL_PA, NORMAL_OMEGA, n_cycles=NORMAL_CYCLES, samples_per_cycle=256, seed=seed
     )
     t, p, delta = (np.asarray(a, dtype=float) for a in (t, p, delta))
-    p = p + rng.normal(0.0, 2e-3 * NORMAL_PA, p.size)
-    delta = delta + rng.normal(0.0, 5e-9, delta.size)
+    delta = delta + rng.uniform(-20e-9, 20e-9)
     return t, p, delta
 
 
@@ -202,7 +209,7 @@ def generate(out: Path, *, normal: bool = True) -> list[Path]:
             t, p, delta = normal_signal(p0, rng)
             written.append(write_normal(out / name, t, p, delta))
             freq = NORMAL_OMEGA / (2.0 * np.pi)
-            rows.append([name, "normal", "C45/C45", "", "", f"{freq:.6g}",
+            rows.append([name, "normal", "C45/C45", "", "", f"{freq:.12g}",
                          f"{p0 * 1e-6:g}", f"{NORMAL_PA * 1e-6:g}", "", ""])  # fmt: skip
     buf = io.StringIO()
     buf.write("# Example study made by contactlab.data.generate (seeded; see its docstring).\n")
