@@ -7,30 +7,61 @@ import numpy as np
 import pytest
 
 from contactlab.data import data_dir, manifest_path
-from contactlab.data.generate import MATERIALS, generate, truth
+from contactlab.data.generate import MATERIALS, NORMAL_P0, generate, truth
 from contactlab.io import read_recording
 from contactlab.manifest import read_manifest
+from contactlab.study import run_study
 
 
 @pytest.fixture(scope="module")
 def regenerated(tmp_path_factory):
     out = tmp_path_factory.mktemp("regen")
-    generate(out, normal=False)
+    generate(out)
     return out
 
 
-def test_bundled_tangential_files_equal_a_fresh_run_of_the_script(regenerated):
-    shipped = sorted((data_dir() / "tangential").iterdir())
-    fresh = sorted((regenerated / "tangential").iterdir())
+@pytest.mark.parametrize(("kind", "channels"), [("tangential", "xF"), ("normal", ("p", "delta"))])
+def test_bundled_files_equal_a_fresh_run_of_the_script(regenerated, kind, channels):
+    shipped = sorted((data_dir() / kind).iterdir())
+    fresh = sorted((regenerated / kind).iterdir())
     assert [p.name for p in shipped] == [p.name for p in fresh]
-    assert len(shipped) == sum(len(m.loads) * len(m.amplitudes) for m in MATERIALS)
+    if kind == "tangential":
+        assert len(shipped) == sum(len(m.loads) * len(m.amplitudes) for m in MATERIALS)
+    else:
+        assert len(shipped) == len(NORMAL_P0)
     for a, b in zip(shipped, fresh, strict=True):
         if a.suffix == ".csv":
             assert a.read_bytes() == b.read_bytes(), a.name
-        ra, rb = read_recording(a, kind="tangential"), read_recording(b, kind="tangential")
+        ra, rb = read_recording(a, kind=kind), read_recording(b, kind=kind)
         np.testing.assert_array_equal(ra.t, rb.t)
-        np.testing.assert_array_equal(ra["x"], rb["x"])
-        np.testing.assert_array_equal(ra["F"], rb["F"])
+        for c in channels:
+            np.testing.assert_array_equal(ra[c], rb[c])
+    assert (data_dir() / "manifest.csv").read_bytes() == (regenerated / "manifest.csv").read_bytes()
+
+
+def test_study_of_the_bundle_recovers_the_truth():
+    """End to end on the shipped files: readers, fits and identifiability as documented."""
+    res = run_study(manifest_path(), progress=False)
+    assert not res.failures
+    rows = res.table("tangential")
+    for r in rows:
+        k_true = r["true_h0"] * r["true_ac"]
+        # the initial stiffness h0·ac is always identified (to 0.1-3 %), and within 5 σ
+        assert r["h0_ac"] == pytest.approx(k_true, rel=0.05)
+        assert abs(r["h0_ac"] - k_true) < 5 * r["h0_ac_stderr"] + 1e-9 * k_true
+        if r["identifiable"]:
+            assert abs(r["h0"] - r["true_h0"]) < 5 * r["h0_stderr"]
+            assert abs(r["ac"] - r["true_ac"]) < 5 * r["ac_stderr"]
+        else:
+            assert r["h0"] is None and r["ac"] is None  # not arbitrary numbers
+    by_mat = {m: [r for r in rows if r["material"] == m] for m in ("Al/Al", "PVC/steel")}
+    assert all(r["identifiable"] for m in by_mat.values() for r in m)
+    steel = [r for r in rows if r["material"] == "steel/steel"]
+    assert sum(not r["identifiable"] for r in steel) >= len(steel) // 2
+    normal = res.table("normal")
+    assert [r["p0"] for r in normal] == pytest.approx(NORMAL_P0, rel=1e-3)
+    k = [r["k_tan"] for r in sorted(normal, key=lambda r: r["p0"])]
+    assert np.all(np.diff(k) > 0)  # the joint stiffens with the static pressure
 
 
 def test_bundle_is_small_and_mixed_format():
