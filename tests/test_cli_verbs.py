@@ -90,6 +90,11 @@ def test_analyze_normal_json(normal_file, tmp_path):
     assert d["units"]["delta_max"] == "m"
     assert 0 < d["psi"] < 1
     assert d["k_tan"] > 1e11  # Pa/m (≈ 1 MPa/µm = 1e12 Pa/m)
+    # eq. 16 for this test: k_s at p = 0 (b4) is the tangent stiffness at equilibrium
+    assert d["b4"] == pytest.approx(d["k_tan"], rel=0.02)
+    assert d["b4_paper"] == pytest.approx(d["k_tan"] * 1e-12, rel=0.02)
+    assert d["units"]["b4"] == "Pa/m" and d["units"]["k_tan"] == "Pa/m"
+    assert 0 < d["E_d_stderr"] < 0.1 * d["E_d"]
 
 
 def test_analyze_several_files(tangential_file, tmp_path):

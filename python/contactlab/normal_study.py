@@ -51,13 +51,22 @@ def analyze_normal_recording(
         units[name] = B_UNITS[name]
     d["k_s_p_rms"] = float(stiff.rms[0])
     units["k_s_p_rms"] = "Pa/m"
+    # standard error of the mean dissipated energy from its cycle-to-cycle scatter
+    n = int(d.get("n_cycles") or 0)
+    e_std = d.get("E_d_cycle_std")
+    if n > 1 and isinstance(e_std, float) and math.isfinite(e_std):
+        d["E_d_stderr"] = e_std / math.sqrt(n)
+        units["E_d_stderr"] = units.get("E_d", "J/m^2")
     d["units"] = units
     msgs = [str(w.message) for w in caught if issubclass(w.category, ContactLabWarning)]
     for w in caught:  # anything else (a numpy RuntimeWarning) goes on as raised
         if not issubclass(w.category, ContactLabWarning):
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     d["warnings"] = " | ".join(msgs)
-    extra = {"warnings": msgs}
+    added = ("b1", "b2", "b3", "b4", "b1_paper", "b2_paper", "b3_paper", "b4_paper",
+             "k_s_p_rms", "E_d_stderr")  # fmt: skip
+    extra = {k: d[k] for k in added if k in d}
+    extra["warnings"] = msgs
     return result, d, extra
 
 

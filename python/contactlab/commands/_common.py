@@ -74,10 +74,12 @@ def recording_json(r: RecordingResult) -> dict[str, Any]:
     d = dict(r.analysis.to_dict()) if r.analysis is not None else {}
     if r.extra:
         d.update(r.extra)
-    units = dict(d.get("units", {}) or {})
-    units.update(r.units)  # tags' units, flattened keys
-    d["units"] = units
     d = {"file": str(r.entry.path), "model": r.entry.kind, **r.entry.tags, **d}
+    units = dict(d.get("units", {}) or {})
+    for k, u in r.units.items():  # tags' and added keys' units (not the flattened vectors)
+        if k in d:
+            units.setdefault(k, u)
+    d["units"] = units
     return jsonable(d)
 
 
