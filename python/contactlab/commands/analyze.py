@@ -26,7 +26,8 @@ from ._common import (
 )
 
 _SUMMARY = {
-    "tangential": [("h0", "N", 1.0), ("ac", "1/m", 1.0), ("amplitude", "um", 1e6),
+    "tangential": [("h0", "N", 1.0), ("ac", "1/m", 1.0), ("h0_ac", "N/m", 1.0),
+                   ("amplitude", "um", 1e6),
                    ("energy_per_cycle", "J", 1.0), ("equivalent_damping", "N/m", 1.0),
                    ("k_local0", "N/m", 1.0), ("k_global", "N/m", 1.0)],
     "normal": [("E_d", "J/m^2", 1.0), ("psi", "", 1.0), ("psi_kv", "", 1.0),
@@ -58,6 +59,9 @@ def _handler(args: argparse.Namespace) -> int:
     for r in result.results:
         if r.ok:
             print(f"{r.entry.path}: {_summary_line(r.row, r.entry.kind)}")
+            if r.row.get("warnings"):
+                for w in str(r.row["warnings"]).split(" | "):
+                    print(f"  warning: {w}", file=sys.stderr)
             if args.verbose and hasattr(getattr(r.analysis, "fit", None), "report"):
                 print(r.analysis.fit.report())
         else:
