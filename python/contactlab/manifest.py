@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import csv
 import io
+import math
 import os
 import re
 from collections.abc import Mapping
@@ -80,6 +81,17 @@ def _unit(unit: str, where: str) -> tuple[float, str]:
         known = ", ".join(k for k in _UNITS if k not in ("", "-", "1"))
         raise InputError(f"{where}: unknown unit {unit!r} (known: {known})")
     return _UNITS[u]
+
+
+def scaled(number: str, factor: float) -> float:
+    """``float(number) * factor``, exact to the last digit when ``factor`` is a power of ten
+    (``"10"`` µm → ``1e-05`` m, not ``9.999999999999999e-06``)."""
+    value = float(number)
+    if factor > 0 and math.isfinite(value) and "e" not in repr(value):
+        exp = round(math.log10(factor))
+        if 10.0**exp == factor:
+            return float(f"{value!r}e{exp}")
+    return value * factor
 
 
 def unit_factor(unit: str, where: str) -> float:
@@ -134,7 +146,7 @@ def tags_from_filename(name: str | os.PathLike[str]) -> dict[str, Any]:
                 factor = unit_factor(unit, f"file name {Path(name).name!r}, token {tok!r}")
             except InputError:
                 continue  # not a tag after all (e.g. "A4paper"); leave it
-            tags[_TOKEN_TAG[key]] = float(num) * factor
+            tags[_TOKEN_TAG[key]] = scaled(num, factor)
         elif i == 0:
             tags["material"] = tok.replace("-", "/")
         elif tok.lower() in _KINDS:
@@ -244,10 +256,9 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
                 continue
             if key in TAG_UNITS or factor is not None:
                 try:
-                    value = float(cell)
+                    tags[key] = scaled(cell, factor if factor is not None else 1.0)
                 except ValueError:
                     raise InputError(f"{where}, column {key!r}: {cell!r} is not a number") from None
-                tags[key] = value * (factor if factor is not None else 1.0)
             else:
                 tags[key] = cell
         kind = _infer_kind(tags)

@@ -253,7 +253,12 @@ def collect_entries(source: str | os.PathLike[str] | Sequence[Any]) -> list[Stud
         p = Path(source)
         if p.is_dir():
             files = sorted(
-                f for f in p.rglob("*") if f.is_file() and f.suffix.lower() in SUPPORTED_EXTENSIONS
+                f
+                for f in p.rglob("*")
+                if f.is_file()
+                and f.suffix.lower() in SUPPORTED_EXTENSIONS
+                and f.name.lower() != "manifest.csv"  # a manifest is not a recording
+                and not f.name.startswith(".")  # hidden files, our own temporaries
             )
             if not files:
                 raise InputError(f"folder {p} holds no recordings ({SUPPORTED_EXTENSIONS})")
@@ -276,7 +281,8 @@ def run_study(
     Parameters
     ----------
     source : path or sequence
-        A manifest CSV, a folder of recordings tagged by their names, or a list of
+        A manifest CSV, a folder of recordings tagged by their names (searched recursively;
+        files named ``manifest.csv`` and hidden files are skipped), or a list of
         :class:`~contactlab.manifest.StudyEntry` / file paths.
     progress : bool or None
         Show a progress bar (``tqdm.auto``: a widget in notebooks); None shows it on a terminal.
