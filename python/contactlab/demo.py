@@ -119,7 +119,7 @@ def run_demo(out: Path, *, quick: bool = False, progress: bool | None = None) ->
         "noise, offsets, quantisation and drift; see contactlab.data.generate). The table's "
         "true_h0 / true_ac columns are the values the recordings were made with."
     )
-    rep = build_report(result, "contactlab demo: example study", intro=intro)
+    rep = build_report(result, "contactlab demo: example study", intro=intro, progress=progress)
     files.update(rep.files())
     files.update(result.table_files())
     return commit_outputs(out, files)

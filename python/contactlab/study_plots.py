@@ -157,7 +157,8 @@ def tangential_study_figures(
 ) -> list[tuple[str, Any, str]]:
     """One figure per material and quantity: against load (left) and amplitude (right).
 
-    Returns ``(name, figure, caption)`` triples; the caller owns (and closes) the figures.
+    Materials with fewer than two recordings are left out. Returns ``(name, figure,
+    caption)`` triples; the caller owns (and closes) the figures.
     """
     import matplotlib.pyplot as plt
 
@@ -166,6 +167,8 @@ def tangential_study_figures(
     materials = sorted({str(r.get("material", "unknown")) for r in rows})
     for mat in materials:
         mrows = [r for r in rows if str(r.get("material", "unknown")) == mat]
+        if len(mrows) < 2:
+            continue  # one recording is no load/amplitude study
         # The paper plots against the commanded amplitude; the measured one (in the table)
         # is used when no nominal amplitude is tagged.
         nominal = all(math.isfinite(_num(r, "amplitude_nominal")) for r in mrows)

@@ -112,6 +112,7 @@ def write_report(
     *,
     study_plots: bool,
     extra: Mapping[str, bytes] | None = None,
+    progress: bool | None = None,
 ) -> list[Path]:
     """Render the report and tables in memory, then write them all or nothing."""
     import matplotlib
@@ -119,7 +120,7 @@ def write_report(
     matplotlib.use("Agg")
     from ..report.study_report import build_report
 
-    rep = build_report(result, title, study_plots=study_plots)
+    rep = build_report(result, title, study_plots=study_plots, progress=progress)
     files = rep.files()
     files.update(result.table_files())
     if extra:

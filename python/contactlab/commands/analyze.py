@@ -68,7 +68,9 @@ def _handler(args: argparse.Namespace) -> int:
             print(f"{r.entry.path}: FAILED: {r.error}", file=sys.stderr)
     if args.report:
         title = f"contactlab analyze ({args.model}, {len(entries)} recording(s))"
-        for p in write_report(args.report, result, title, study_plots=len(entries) > 1):
+        for p in write_report(
+            args.report, result, title, study_plots=len(entries) > 1, progress=args.progress
+        ):
             if p.suffix == ".html":
                 print(f"wrote {p}")
     if args.json:

@@ -21,7 +21,7 @@ def _handler(args: argparse.Namespace) -> int:
         print(f"FAILED: {r.error}", file=sys.stderr)
     n_ok = sum(r.ok for r in result.results)
     print(f"analysed {n_ok} of {len(result.results)} recordings")
-    paths = write_report(args.report, result, args.title, study_plots=True)
+    paths = write_report(args.report, result, args.title, study_plots=True, progress=args.progress)
     for p in paths:
         if p.suffix in (".html", ".csv", ".parquet"):
             print(f"wrote {p}")

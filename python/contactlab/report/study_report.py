@@ -148,8 +148,15 @@ def build_report(
     details: bool = True,
     dpi: int = 90,
     intro: str | None = None,
+    progress: bool | None = False,
 ) -> Report:
-    """Assemble the report of analysed recordings (and the study plots when asked)."""
+    """Assemble the report of analysed recordings (and the study plots when asked).
+
+    Rendering the figures is the slow part of a large study; ``progress`` shows a bar for it
+    (``tqdm.auto``; None: only on a terminal).
+    """
+    from tqdm.auto import tqdm
+
     rep = Report(title, intro)
     for kind in ("tangential", "normal"):
         rows = result.table(kind)
@@ -174,9 +181,10 @@ def build_report(
                     rep.figure(fig, name, cap, dpi=dpi)
         if details:
             rep.section(f"{kind.capitalize()} recordings: loops, fits and residuals")
-            for r in result.of_kind(kind):
-                if not r.ok:
-                    continue
+            todo = [r for r in result.of_kind(kind) if r.ok]
+            bar = tqdm(todo, desc=f"report ({kind})", unit="fig",
+                       disable=None if progress is None else not progress)  # fmt: skip
+            for r in bar:
                 rep.subheading(_label(r))
                 (_tangential_detail if kind == "tangential" else _normal_detail)(rep, r, dpi)
     if result.failures:
