@@ -30,12 +30,12 @@ def measured_velocity(
     method: str = "savgol",
     window: int | None = None,
     omega: float | None = None,
-    harmonics: int = 20,
+    harmonics: int = 10,
 ) -> np.ndarray:
     """Noise-robust dδ/dt of a uniformly sampled displacement.
 
     ``method="savgol"``: Savitzky-Golay (cubic) derivative over ``window`` samples (default:
-    about 1/16 of a period when ``omega`` is known, else 15). ``method="spectral"``: FFT
+    about 1/8 of a period when ``omega`` is known, else 15). ``method="spectral"``: FFT
     derivative keeping the first ``harmonics`` harmonics of ``omega``.
     """
     from scipy.signal import savgol_filter
@@ -45,7 +45,7 @@ def measured_velocity(
     if method == "savgol":
         if window is None:
             spc = 2 * np.pi / (omega * dt) if omega else 240.0
-            window = max(7, int(spc / 16) | 1)
+            window = max(7, int(spc / 8) | 1)
         window = int(window)
         if window % 2 == 0:
             window += 1
@@ -65,7 +65,8 @@ def measured_velocity(
 
 
 def _loop_area_per_cycle(p: np.ndarray, d: np.ndarray, n_cycles: float) -> float:
-    return float(np.sum(0.5 * (p[1:] + p[:-1]) * np.diff(d)) / n_cycles)
+    """∮ p dδ per cycle over whole cycles of samples (closed polygon: last joins first)."""
+    return float(np.sum(0.5 * (p + np.roll(p, -1)) * (np.roll(d, -1) - d)) / n_cycles)
 
 
 @dataclass
@@ -176,15 +177,18 @@ def compare(
     omega = float(first.omega)
     period = 2 * np.pi / omega
     span = tv[-1] - tv[0]
-    if span < 2 * period * (1 - 1e-9):
+    if span + float(np.median(np.diff(tv))) < 2 * period * (1 - 1e-6):
         raise InputError(f"the recording spans {span / period:.3g} cycles; at least two are needed")
     if int(discard_cycles) != discard_cycles or discard_cycles < 0:
         raise InputError(f"discard_cycles must be a whole number >= 0, got {discard_cycles!r}")
+    dt = float(np.median(np.diff(tv)))
     t_start = tv[0] + int(discard_cycles) * period
-    n_cyc = int(np.floor((tv[-1] - t_start) / period + 1e-9))
+    # A cycle of samples ends one sample before the next cycle starts.
+    n_cyc = int(np.floor((tv[-1] + dt - t_start) / period + 1e-6))
     if n_cyc < 1:
         raise InputError("no whole cycle is left after discard_cycles")
-    win = (tv >= t_start - 1e-12 * period) & (tv <= t_start + n_cyc * period + 1e-12 * period)
+    eps = 1e-6 * dt
+    win = (tv >= t_start - eps) & (tv < t_start + n_cyc * period - eps)
     v_meas = measured_velocity(tv, dv, method=velocity, window=window, omega=omega)
 
     sims: dict[str, dict[str, np.ndarray]] = {}

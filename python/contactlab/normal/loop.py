@@ -207,12 +207,14 @@ def _estimate_omega(x: np.ndarray, dt: float) -> float:
         if den < 0:
             kf = k + 0.5 * (a - c) / den
     w = 2 * np.pi * kf / (n * dt)
-    # Refine with the phase drift of the fundamental between the two halves.
+    # Refine with the phase drift of the fundamental between the two halves (Hann-windowed
+    # sums, so the image at -ω leaks little into the phase).
     h = n // 2
     tt = np.arange(n) * dt
+    win = np.hanning(h)
     for _ in range(3):
-        za = np.sum(y[:h] * np.exp(-1j * w * tt[:h]))
-        zb = np.sum(y[h : 2 * h] * np.exp(-1j * w * tt[h : 2 * h]))
+        za = np.sum(win * y[:h] * np.exp(-1j * w * tt[:h]))
+        zb = np.sum(win * y[h : 2 * h] * np.exp(-1j * w * tt[h : 2 * h]))
         if za == 0 or zb == 0:
             break
         dphi = float(np.angle(zb / za))

@@ -190,8 +190,14 @@ class _ContactModel:
             n_steps=int(r["n_accepted"]),
             n_rejected=int(r["n_rejected"]),
         )
+        if not res.success:
+            res.message += self._failure_hint(res.delta)
         self._check_solution(res.delta)
         return res
+
+    def _failure_hint(self, delta: np.ndarray) -> str:
+        """Extra explanation appended to a failed solve's message (override)."""
+        return ""
 
 
 class KelvinVoigt(_ContactModel):
@@ -410,6 +416,20 @@ class NonlinearContact(_ContactModel):
             raise InputError(
                 f"k_s(p) is not positive at sample {i} (p = {pd[i]:.6g} Pa, k_s = {k[i]:.4g} Pa/m)"
             )
+
+    def _failure_hint(self, delta: np.ndarray) -> str:
+        if self._law != "delta" or delta.size == 0:
+            return ""
+        span = 4 * float(np.max(np.abs(delta)))
+        roots = np.asarray(_core.poly_roots_in(self._coeffs, -span, span)) if span > 0 else []
+        if len(roots) == 0:
+            return ""
+        d = float(roots[np.argmin(np.abs(roots - delta[-1]))])
+        return (
+            f" k_s(δ) vanishes at δ = {d:.4g} m next to the response (last δ = "
+            f"{delta[-1]:.4g} m): the stiffness polynomial is not positive over the "
+            "response's range, so δ runs away."
+        )
 
     def _check_solution(self, delta: np.ndarray) -> None:
         if self.delta_range is None or delta.size == 0:
