@@ -91,6 +91,16 @@ def test_parquet_round_trip_with_units():
     assert set(files) == {"study_tangential.csv", "study_tangential.parquet"}
 
 
+def test_notebook_repr():
+    res = _result(_tangential_rows()[:2])
+    res.results.append(
+        RecordingResult(StudyEntry(Path("b.csv"), "tangential", {}), {}, {}, error="b.csv: <x>")
+    )
+    text = res._repr_html_()
+    assert text.count("<tr>") == 3 and "h0 [N]" in text and "b.csv: &lt;x&gt;" in text
+    assert repr(res) == "StudyResult(2 tangential, 0 normal, 1 failed)"
+
+
 def test_failures_are_kept_out_of_the_table():
     rows = _tangential_rows()[:2]
     res = _result(rows)

@@ -14,6 +14,7 @@ draws the paper's plots from it.
 from __future__ import annotations
 
 import csv
+import html
 import io
 import json
 import math
@@ -221,6 +222,26 @@ class StudyResult:
         buf = io.BytesIO()
         pq.write_table(table, buf)
         return buf.getvalue()
+
+    def _repr_html_(self) -> str:
+        """Summary tables in notebooks (the full report: ``report.study_report``)."""
+        from .report.html import table_html
+        from .report.study_report import NORMAL_COLUMNS, TANGENTIAL_COLUMNS
+
+        parts = []
+        for kind, cols in (("tangential", TANGENTIAL_COLUMNS), ("normal", NORMAL_COLUMNS)):
+            rows = self.table(kind)
+            if rows:
+                present = [c for c in cols if any(c.key in r for r in rows)]
+                parts.append(table_html(rows, present, f"{kind}: {len(rows)} recording(s)"))
+        for r in self.failures:
+            parts.append(f"<p>failed: {html.escape(str(r.error))}</p>")
+        return "".join(parts) or "<p>empty study</p>"
+
+    def __repr__(self) -> str:
+        n = {k: len(self.table(k)) for k in KINDS}
+        return (f"StudyResult({n['tangential']} tangential, {n['normal']} normal, "
+                f"{len(self.failures)} failed)")  # fmt: skip
 
     def table_files(self, stem: str = "study") -> dict[str, bytes]:
         """``<stem>_<kind>.csv`` and ``.parquet`` for each kind present."""

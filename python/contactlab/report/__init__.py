@@ -7,6 +7,14 @@ set of files all or nothing, so a failed or interrupted run leaves the output fo
 from __future__ import annotations
 
 from ._outputs import commit_outputs
-from .html import Column, Report, figure_png, format_value, slugify
+from .html import Column, Report, figure_png, format_value, slugify, table_html
 
-__all__ = ["Column", "Report", "commit_outputs", "figure_png", "format_value", "slugify"]
+__all__ = [
+    "Column",
+    "Report",
+    "commit_outputs",
+    "figure_png",
+    "format_value",
+    "slugify",
+    "table_html",
+]

@@ -96,6 +96,26 @@ class Column:
         return text, numeric
 
 
+def table_html(
+    rows: Sequence[Mapping[str, Any]], columns: Sequence[Column], caption: str = ""
+) -> str:
+    """An HTML table of ``rows`` (also what notebooks show for a study result)."""
+    esc = html.escape
+    out = ['<div class="tablewrap"><table>']
+    if caption:
+        out.append(f"<caption>{esc(caption)}</caption>")
+    out.append("<tr>" + "".join(f"<th>{esc(c.header())}</th>" for c in columns) + "</tr>")
+    for r in rows:
+        cells = []
+        for c in columns:
+            text, numeric = c.cell(r)
+            cls = "" if numeric else ' class="s"'
+            cells.append(f"<td{cls}>{esc(text)}</td>")
+        out.append("<tr>" + "".join(cells) + "</tr>")
+    out.append("</table></div>")
+    return "".join(out)
+
+
 @dataclass
 class _Figure:
     name: str
@@ -220,19 +240,7 @@ class Report:
             return f'<figure><img alt="{alt}" src="data:image/png;base64,{b64}">{cap}</figure>'
         if kind == "table":
             rows, cols, caption = payload
-            out = ['<div class="tablewrap"><table>']
-            if caption:
-                out.append(f"<caption>{esc(caption)}</caption>")
-            out.append("<tr>" + "".join(f"<th>{esc(c.header())}</th>" for c in cols) + "</tr>")
-            for r in rows:
-                cells = []
-                for c in cols:
-                    text, numeric = c.cell(r)
-                    cls = "" if numeric else ' class="s"'
-                    cells.append(f"<td{cls}>{esc(text)}</td>")
-                out.append("<tr>" + "".join(cells) + "</tr>")
-            out.append("</table></div>")
-            return "".join(out)
+            return table_html(rows, cols, caption)
         raise AssertionError(kind)  # pragma: no cover
 
     def render_html(self) -> str:
