@@ -4,6 +4,8 @@ Runs ``contactlab.cli.main([...])`` in temporary folders on small synthetic reco
 
 from __future__ import annotations
 
+import csv
+import io
 import json
 import math
 from html.parser import HTMLParser
@@ -179,3 +181,34 @@ def test_progress_bar_on_request(tangential_file, capsys):
     assert "analysing" in err and "1/1" in err
     assert main(["analyze", str(tangential_file), "--model", "tangential", "--no-progress"]) == 0
     assert "analysing" not in capsys.readouterr().err
+
+
+def test_unidentifiable_loop_json_says_so(tmp_path):
+    """The paper's steel case: a tiny loop; h0 and ac are null, h0·ac is given with its error."""
+    from contactlab.data import data_dir
+
+    f = data_dir() / "tangential" / "steel-steel_W225N_A0.25um.h5"
+    out = tmp_path / "s.json"
+    assert main(["analyze", str(f), "--model", "tangential", "--json", str(out)]) == 0
+    text = out.read_text()
+    assert "NaN" not in text and "Infinity" not in text  # strict JSON
+    d = json.loads(text)
+    assert d["h0"] is None and d["ac"] is None
+    assert d["identifiable"]["h0"] is False and "NOT separately identifiable" in d["warnings"][0]
+    assert d["h0_ac"] == pytest.approx(40.5 * 34668.1, rel=0.03)  # the truth in the manifest
+    assert 0 < d["h0_ac_stderr"] < 0.02 * d["h0_ac"] and d["units"]["h0_ac"] == "N/m"
+
+
+def test_study_json_and_tables_agree(tmp_path):
+    from contactlab.data import data_dir
+
+    files = sorted((data_dir() / "tangential").glob("PVC-steel_W30N_*"))
+    m = tmp_path / "m.csv"
+    m.write_text("file\n" + "".join(f"{f}\n" for f in files))
+    rep, js = tmp_path / "r", tmp_path / "r.json"
+    assert main(["study", str(m), "--report", str(rep), "--json", str(js), "--no-progress"]) == 0
+    d = json.loads(js.read_text())
+    assert [r["amplitude_nominal"] for r in d["recordings"]] == pytest.approx([1e-5, 2e-5, 4e-5])
+    rows = list(csv.reader(io.StringIO((rep / "study_tangential.csv").read_text())))
+    col = rows[0].index("h0 [N]")
+    assert [float(r[col]) for r in rows[1:]] == [r["h0"] for r in d["recordings"]]

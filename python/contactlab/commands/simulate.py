@@ -27,7 +27,7 @@ def _handler(args: argparse.Namespace) -> int:
             frequency=args.frequency,
             n_cycles=args.cycles,
             fs=args.fs,
-            noise=args.noise,
+            noise=0.01 if args.noise is None else args.noise,
             seed=args.seed,
             offset=args.offset,
             x_offset=args.x_offset,
@@ -37,7 +37,7 @@ def _handler(args: argparse.Namespace) -> int:
     else:
         from ..normal import synthetic_recording as normal_synthetic
 
-        kwargs = {"noise": args.noise, "seed": args.seed}
+        kwargs = {"noise": "realistic" if args.noise is None else args.noise, "seed": args.seed}
         if args.normal_model:
             kwargs["model"] = args.normal_model
         t, p, delta = normal_synthetic(
@@ -82,8 +82,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     n.add_argument("--samples-per-cycle", type=int, default=400)
     n.add_argument("--normal-model", default=None, help="model of the normal contact")
     p.add_argument("--cycles", type=int, default=5, help="number of cycles")
-    p.add_argument("--noise", type=float, default=0.01,
-                   help="noise level: tangential, force noise as a fraction of the peak force; "
-                   "normal, as the normal module's synthetic_recording defines it")  # fmt: skip
+    p.add_argument("--noise", type=float, default=None,
+                   help="tangential: force noise as a fraction of the peak force (default "
+                   "0.01); normal: relative to each channel's peak-to-peak value (default: "
+                   "realistic sensor noise and 16-bit quantisation); 0 = exact")  # fmt: skip
     p.add_argument("--seed", type=int, default=0)
     p.set_defaults(handler=_handler)
