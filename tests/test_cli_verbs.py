@@ -212,3 +212,11 @@ def test_study_json_and_tables_agree(tmp_path):
     rows = list(csv.reader(io.StringIO((rep / "study_tangential.csv").read_text())))
     col = rows[0].index("h0 [N]")
     assert [float(r[col]) for r in rows[1:]] == [r["h0"] for r in d["recordings"]]
+
+
+def test_json_to_stdout_is_pure_json(tangential_file, capsys):
+    assert main(["analyze", str(tangential_file), "--model", "tangential", "--json", "-"]) == 0
+    out = capsys.readouterr()
+    d = json.loads(out.out)  # nothing but the JSON on stdout
+    assert d["h0"] == pytest.approx(40.0, rel=0.05)
+    assert "h0 = " in out.err  # the summary went to stderr

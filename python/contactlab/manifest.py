@@ -19,7 +19,8 @@ mapping for the reader, ``x=disp;F=force``). Any other column is carried into th
 as a tag (numbers converted to SI when a unit is given).
 
 File names: when a tag is not given, it is looked for in the file name, split at ``_``:
-the first token is the material (``-`` standing for ``/``), and tokens ``W50N``, ``A10um``,
+the first token is the material (``-`` standing for ``/``; only when the name carries some
+other tag, so ``run3.csv`` names no material), and tokens ``W50N``, ``A10um``,
 ``f1Hz``, ``p0-0.5MPa``, ``pa-0.4MPa`` (number and unit, both required) give load, amplitude,
 frequency, p0 and pa. A file with a
 ``p0`` tag is a normal-contact recording unless ``kind`` says otherwise.
@@ -134,6 +135,8 @@ def tags_from_filename(name: str | os.PathLike[str]) -> dict[str, Any]:
     {'material': 'Al/Al', 'normal_load': 50.0, 'amplitude_nominal': 1e-05}
     >>> tags_from_filename("C45_p0-0.5MPa_pa-0.4MPa.mat")["p0"]
     500000.0
+    >>> tags_from_filename("run3.csv")  # no tags, so no material either
+    {}
     """
     stem = Path(name).stem
     tokens = [t for t in stem.split("_") if t]
@@ -151,6 +154,8 @@ def tags_from_filename(name: str | os.PathLike[str]) -> dict[str, Any]:
             tags["material"] = tok.replace("-", "/")
         elif tok.lower() in _KINDS:
             tags["kind"] = tok.lower()
+    if set(tags) <= {"material", "kind"}:
+        tags.pop("material", None)  # "run3.csv" names no material: nothing else was tagged
     return tags
 
 

@@ -56,14 +56,16 @@ def _handler(args: argparse.Namespace) -> int:
         e.columns, e.fs = columns, args.fs
         entries.append(e)
     result = run_study(entries, progress=args.progress, keep_going=args.keep_going)
+    # With --json -, stdout carries the JSON alone; everything else goes to stderr.
+    say = sys.stderr if args.json == "-" else sys.stdout
     for r in result.results:
         if r.ok:
-            print(f"{r.entry.path}: {_summary_line(r.row, r.entry.kind)}")
+            print(f"{r.entry.path}: {_summary_line(r.row, r.entry.kind)}", file=say)
             if r.row.get("warnings"):
                 for w in str(r.row["warnings"]).split(" | "):
                     print(f"  warning: {w}", file=sys.stderr)
-            if args.verbose and hasattr(getattr(r.analysis, "fit", None), "report"):
-                print(r.analysis.fit.report())
+            if args.verbose and hasattr(r.analysis, "report"):
+                print(r.analysis.report(), file=say)
         else:
             print(f"{r.entry.path}: FAILED: {r.error}", file=sys.stderr)
     if args.report:
@@ -72,11 +74,11 @@ def _handler(args: argparse.Namespace) -> int:
             args.report, result, title, study_plots=len(entries) > 1, progress=args.progress
         ):
             if p.suffix == ".html":
-                print(f"wrote {p}")
+                print(f"wrote {p}", file=say)
     if args.json:
         p = write_json(args.json, json_document(result))
         if str(p) != "-":
-            print(f"wrote {p}")
+            print(f"wrote {p}", file=say)
     return 1 if result.failures else 0
 
 
