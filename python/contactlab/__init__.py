@@ -6,6 +6,9 @@ models), fitting, reports and model-discrepancy diagnosis. See README.md.
 
 from __future__ import annotations
 
+# `contactlab.diagnose` is the subpackage, made callable: `contactlab.diagnose(recording,
+# model=...)` runs the workflow while `contactlab.diagnose.<module>` imports keep working.
+from . import diagnose
 from .errors import ContactLabError, ContactLabWarning, ConvergenceError, InputError
 from .masing import CycleTable, Masing, MasingOperator, cycle_energies, loop_area
 
@@ -21,5 +24,6 @@ __all__ = [
     "MasingOperator",
     "__version__",
     "cycle_energies",
+    "diagnose",
     "loop_area",
 ]

@@ -17,6 +17,7 @@ from .errors import ContactLabError
 # Modules providing `add_parser(subparsers)`; each sets `handler` via set_defaults.
 _VERB_MODULES = [
     "contactlab.demo",
+    "contactlab.diagnose.cli",
 ]
 
 

@@ -10,6 +10,10 @@ missing, and how much the gap shrinks once it is added (issue 5).
 
 from __future__ import annotations
 
+import sys
+import types
+from typing import Any
+
 from .generator import HiddenEffectRecording, hidden_effect_recording
 from .model import ExtendedModel
 from .workflow import DiagnosisReport, Effect, Step, diagnose
@@ -23,3 +27,13 @@ __all__ = [
     "diagnose",
     "hidden_effect_recording",
 ]
+
+
+class _CallableModule(types.ModuleType):
+    """``contactlab.diagnose(...)`` calls :func:`diagnose`; attributes are the subpackage's."""
+
+    def __call__(self, *args: Any, **kwargs: Any) -> DiagnosisReport:
+        return diagnose(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule

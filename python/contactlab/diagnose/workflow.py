@@ -165,6 +165,12 @@ class DiagnosisReport:
 
         return plot_location(self, ax=ax)
 
+    def write_html(self, directory: Any) -> Any:
+        """Write a self-contained ``diagnose.html`` (figures and JSON) into ``directory``."""
+        from ._html import write_html
+
+        return write_html(self, directory)
+
     def plot_gap(self, ax: Any = None) -> Any:
         """Held-out RMS (in units of the noise level) after each step."""
         from .plots import plot_gap
