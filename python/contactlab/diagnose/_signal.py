@@ -123,7 +123,7 @@ def find_cycles(u: np.ndarray, period_samples: float | None = None) -> Cycles:
             continue
         seg = us[a:b]
         i = a + int(np.argmax(seg) if s > 0 else np.argmin(seg))
-        if ismax and ismax[-1] == (s > 0):
+        if i == 0 or i == n - 1 or (ismax and ismax[-1] == (s > 0)):  # interior extrema only
             continue
         rev.append(i)
         ismax.append(s > 0)
