@@ -97,10 +97,11 @@ class Masing:
     # -- history-dependent response --------------------------------------------------------
     def force(self, x: Any, state: Any = None) -> np.ndarray:
         """Force for the displacement history ``x`` (starting at the origin unless ``state``)."""
+        xa = as_1d(x, "x", finite=False)  # the core names a non-finite sample's index
         op = self.operator()
         if state is not None:
             op.state = state
-        return op.push(x)
+        return op.push(xa)
 
     def operator(self) -> MasingOperator:
         """A stateful operator for streaming a recording chunk by chunk."""

@@ -190,7 +190,10 @@ impl Tabulated {
                 let h10 = t3 - 2.0 * t2 + t;
                 let h01 = -2.0 * t3 + 3.0 * t2;
                 let h11 = t3 - t2;
-                h00 * self.f[i] + h10 * h * self.d[i] + h01 * self.f[i + 1] + h11 * h * self.d[i + 1]
+                h00 * self.f[i]
+                    + h10 * h * self.d[i]
+                    + h01 * self.f[i + 1]
+                    + h11 * h * self.d[i + 1]
             }
         }
     }
@@ -302,7 +305,10 @@ mod tests {
             let hm = c.eval(a);
             let printed = 8.0 * (c.h0 * (a - (1.0 - (-c.ac * a).exp()) / c.ac) - a * hm / 2.0);
             let e = c.loop_energy(a);
-            assert!((e - printed).abs() <= 1e-9 * printed.abs(), "{a}: {e} vs {printed}");
+            assert!(
+                (e - printed).abs() <= 1e-9 * printed.abs(),
+                "{a}: {e} vs {printed}"
+            );
         }
         // Small amplitude: cubic law (2/3) h0 ac^2 A^3.
         let a = 1e-6;

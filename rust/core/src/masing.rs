@@ -101,7 +101,7 @@ impl MasingState {
             }
         }
         let x = v[0];
-        if !stack.is_empty() && !(x >= lo && x <= hi) {
+        if !(stack.is_empty() || (lo..=hi).contains(&x)) {
             return bad("current input lies outside the remembered reversals");
         }
         Ok(Self {
@@ -145,55 +145,142 @@ impl<F: FnMut(Closure)> Observer for F {
     }
 }
 
-/// The current branch anchor `(x_a, h_a, scale)` and its closure target.
+/// The current branch anchor `(x_a, h_a)`, its scale and its closure target.
 #[derive(Clone, Copy)]
 struct Branch {
     xa: f64,
     ha: f64,
     scale: f64,
+    inv_scale: f64,
     /// Input value at which this branch closes (±inf: never).
     target: f64,
 }
 
 #[inline]
-fn branch_of(state: &MasingState, scale: f64) -> Branch {
-    let n = state.stack.len();
-    let dir_inf = if state.dir >= 0 {
-        f64::INFINITY
-    } else {
-        f64::NEG_INFINITY
+fn branch_of(stack: &[Reversal], dir: f64, scale: f64, inv_scale: f64) -> Branch {
+    let n = stack.len();
+    let (anchor, target) = match n {
+        0 => {
+            let never = if dir >= 0.0 {
+                f64::INFINITY
+            } else {
+                f64::NEG_INFINITY
+            };
+            return Branch {
+                xa: 0.0,
+                ha: 0.0,
+                scale: 1.0,
+                inv_scale: 1.0,
+                target: never,
+            };
+        }
+        1 => (stack[0], -stack[0].x),
+        _ => (stack[n - 1], stack[n - 2].x),
     };
-    match n {
-        0 => Branch {
-            xa: 0.0,
-            ha: 0.0,
-            scale: 1.0,
-            target: dir_inf,
-        },
-        1 => Branch {
-            xa: state.stack[0].x,
-            ha: state.stack[0].h,
+    Branch {
+        xa: anchor.x,
+        ha: anchor.h,
+        scale,
+        inv_scale,
+        target,
+    }
+}
+
+/// One step of the operator: stepping separate from driving, so the force kernel and the
+/// cycle counter share the rules. The fast path (same direction, no closure) is inlined; the
+/// rare events are not.
+struct Stepper<'a, C: Backbone> {
+    curve: &'a C,
+    scale: f64,
+    inv_scale: f64,
+    xp: f64,
+    hp: f64,
+    /// +1, -1, or 0 before the first move.
+    dir: f64,
+    br: Branch,
+    stack: &'a mut Vec<Reversal>,
+}
+
+impl<'a, C: Backbone> Stepper<'a, C> {
+    fn new(curve: &'a C, scale: f64, state: &'a mut MasingState) -> Self {
+        let dir = f64::from(state.dir);
+        let inv_scale = 1.0 / scale;
+        let br = branch_of(&state.stack, dir, scale, inv_scale);
+        Self {
+            curve,
             scale,
-            target: -state.stack[0].x,
-        },
-        _ => Branch {
-            xa: state.stack[n - 1].x,
-            ha: state.stack[n - 1].h,
-            scale,
-            target: state.stack[n - 2].x,
-        },
+            inv_scale,
+            xp: state.x,
+            hp: state.h,
+            dir,
+            br,
+            stack: &mut state.stack,
+        }
+    }
+
+    #[inline(always)]
+    fn step<O: Observer>(&mut self, xi: f64, index: u64, observer: &mut O) -> f64 {
+        let dx = xi - self.xp;
+        // Fast path: moving on along the branch without reaching its closure point
+        // (closure uses >= so that exactly repeated extremes close the loop).
+        if !(dx * self.dir > 0.0 && (xi - self.br.target) * self.dir < 0.0) {
+            if dx == 0.0 {
+                return self.hp; // zero-length steps change nothing
+            }
+            self.event(xi, dx, index, observer);
+        }
+        let br = &self.br;
+        self.hp = br.ha + br.scale * self.curve.eval((xi - br.xa) * br.inv_scale);
+        self.xp = xi;
+        self.hp
+    }
+
+    /// A reversal and/or one or more loop closures at sample `index`.
+    #[inline(never)]
+    fn event<O: Observer>(&mut self, xi: f64, dx: f64, index: u64, observer: &mut O) {
+        let s = if dx > 0.0 { 1.0 } else { -1.0 };
+        if s != self.dir {
+            if self.dir != 0.0 {
+                self.stack.push(Reversal {
+                    x: self.xp,
+                    h: self.hp,
+                    index: index.saturating_sub(1),
+                });
+            }
+            self.dir = s;
+            self.br = branch_of(self.stack, s, self.scale, self.inv_scale);
+        }
+        while (xi - self.br.target) * s >= 0.0 {
+            let n = self.stack.len();
+            if n == 1 {
+                let from = self.stack[0];
+                self.stack.clear();
+                observer.closed(Closure::Virgin { from, index });
+            } else {
+                let newer = self.stack[n - 1];
+                let older = self.stack[n - 2];
+                self.stack.truncate(n - 2);
+                observer.closed(Closure::Inner {
+                    older,
+                    newer,
+                    index,
+                });
+            }
+            self.br = branch_of(self.stack, s, self.scale, self.inv_scale);
+        }
     }
 }
 
 /// Run the operator over `x`, writing forces to `out` (when given) and reporting closures.
 ///
 /// The history continues from `state`, which is updated; processing a signal in chunks with
-/// the state carried over gives bit-identical results to one pass.
+/// the state carried over gives bit-identical results to one pass. On error the state is
+/// unchanged.
 pub fn run<C: Backbone, O: Observer>(
     curve: &C,
     scale: f64,
     x: &[f64],
-    mut out: Option<&mut [f64]>,
+    out: Option<&mut [f64]>,
     state: &mut MasingState,
     observer: &mut O,
 ) -> Result<(), CoreError> {
@@ -201,65 +288,25 @@ pub fn run<C: Backbone, O: Observer>(
     if let Some(o) = out.as_deref() {
         crate::error::check_same_len("x", x.len(), "out", o.len())?;
     }
-    // Validate before touching the state so that an error leaves it unchanged.
     crate::error::check_finite("x", x)?;
-
-    let mut br = branch_of(state, scale);
-    let mut xp = state.x;
-    let mut hp = state.h;
-    let mut dir = state.dir;
     let base = state.count;
-
-    for (i, &xi) in x.iter().enumerate() {
-        let dx = xi - xp;
-        if dx != 0.0 {
-            let s: i8 = if dx > 0.0 { 1 } else { -1 };
-            if s != dir {
-                if dir != 0 {
-                    state.stack.push(Reversal {
-                        x: xp,
-                        h: hp,
-                        index: base + i as u64 - 1,
-                    });
-                }
-                dir = s;
-                state.dir = dir;
-                br = branch_of(state, scale);
+    let mut st = Stepper::new(curve, scale, state);
+    match out {
+        Some(out) => {
+            for ((i, &xi), o) in x.iter().enumerate().zip(out.iter_mut()) {
+                *o = st.step(xi, base + i as u64, observer);
             }
-            // Closure uses >= so that exactly repeated extremes close the loop.
-            while if dir > 0 {
-                xi >= br.target
-            } else {
-                xi <= br.target
-            } {
-                let idx = base + i as u64;
-                let n = state.stack.len();
-                if n == 1 {
-                    let from = state.stack[0];
-                    state.stack.clear();
-                    observer.closed(Closure::Virgin { from, index: idx });
-                } else {
-                    let newer = state.stack[n - 1];
-                    let older = state.stack[n - 2];
-                    state.stack.truncate(n - 2);
-                    observer.closed(Closure::Inner {
-                        older,
-                        newer,
-                        index: idx,
-                    });
-                }
-                br = branch_of(state, scale);
-            }
-            hp = br.ha + br.scale * curve.eval((xi - br.xa) / br.scale);
-            xp = xi;
         }
-        if let Some(o) = out.as_deref_mut() {
-            o[i] = hp;
+        None => {
+            for (i, &xi) in x.iter().enumerate() {
+                st.step(xi, base + i as u64, observer);
+            }
         }
     }
+    let (xp, hp, dir) = (st.xp, st.hp, st.dir);
     state.x = xp;
     state.h = hp;
-    state.dir = dir;
+    state.dir = dir as i8;
     state.count = base + x.len() as u64;
     Ok(())
 }

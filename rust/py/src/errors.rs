@@ -12,8 +12,14 @@ fn classes(py: Python<'_>) -> Option<&(Py<PyType>, Py<PyType>, Py<PyType>)> {
     ERRORS
         .get_or_try_init(py, || -> PyResult<_> {
             let m = py.import("contactlab.errors")?;
-            let get = |n: &str| -> PyResult<Py<PyType>> { Ok(m.getattr(n)?.cast_into::<PyType>()?.unbind()) };
-            Ok((get("ContactLabError")?, get("InputError")?, get("ConvergenceError")?))
+            let get = |n: &str| -> PyResult<Py<PyType>> {
+                Ok(m.getattr(n)?.cast_into::<PyType>()?.unbind())
+            };
+            Ok((
+                get("ContactLabError")?,
+                get("InputError")?,
+                get("ConvergenceError")?,
+            ))
         })
         .ok()
 }
