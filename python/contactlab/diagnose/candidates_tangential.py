@@ -129,6 +129,14 @@ class TangentialFamily:
     def prepare(self, d: Prepared) -> None:
         """Nothing to precompute beyond :class:`Prepared` (memory is cached lazily)."""
 
+    def context(self, d: Prepared) -> dict[str, float]:
+        """Nothing beyond the parameters is needed to simulate a fitted model."""
+        return {}
+
+    def check(self, effects: tuple[str, ...]) -> bool:
+        """All tangential effects combine (in the order of the module docstring)."""
+        return True
+
     def scales(self, d: Prepared) -> dict[str, float]:
         rms = lambda a: float(np.sqrt(np.mean(a * a))) or 1.0  # noqa: E731
         Fs, xs = rms(d.y - np.mean(d.y)), rms(d.u - np.mean(d.u))
@@ -213,7 +221,7 @@ class TangentialFamily:
             }
         return {}, {}
 
-    def base_model(self, p: dict[str, float]) -> Any:
+    def base_model(self, p: dict[str, float], context: dict[str, float]) -> Any:
         return Masing(p["h0"], p["ac"])
 
     @staticmethod

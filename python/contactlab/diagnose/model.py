@@ -35,8 +35,10 @@ class ExtendedModel:
         effects: tuple[str, ...],
         params: dict[str, float],
         stderr: dict[str, float] | None = None,
+        context: dict[str, float] | None = None,
     ) -> None:
         self.family = family
+        self.context = dict(context or {})
         self.effects = tuple(effects)
         self.params = dict(params)
         self.stderr = dict(stderr or {})
@@ -48,7 +50,7 @@ class ExtendedModel:
     @property
     def base(self) -> Any:
         """The base model with the fitted base parameters (effects not included)."""
-        return self.family.base_model(self.params)
+        return self.family.base_model(self.params, self.context)
 
     def __repr__(self) -> str:
         eff = " + ".join(self.effects) if self.effects else "no effects"
@@ -63,6 +65,7 @@ class ExtendedModel:
         if ta.size != ua.size:
             raise InputError(f"t has {ta.size} samples but {self.family.input_name} has {ua.size}")
         d = Prepared.build(ta, ua)
+        d.extra.update(self.context)
         self.family.prepare(d)
         return self.family.predict(self.params, self.effects, d)
 
@@ -73,11 +76,12 @@ class ExtendedModel:
 
         t, u, y = _arrays(recording, self.family)
         d = Prepared.build(t, u, y)
+        d.extra.update(self.context)
         self.family.prepare(d)
         res = fit(
             self.family, self.effects, d, np.ones(y.size, bool), self.params, self.family.scales(d)
         )
-        out = ExtendedModel(self.family, self.effects, res.params, res.stderr)
+        out = ExtendedModel(self.family, self.effects, res.params, res.stderr, self.context)
         out.fit_result_ = res  # type: ignore[attr-defined]
         return out
 
@@ -86,6 +90,7 @@ class ExtendedModel:
             "model": self.kind,
             "effects": list(self.effects),
             "parameters": dict(self.params),
+            "context": dict(self.context),
             "stderr": {k: (v if np.isfinite(v) else None) for k, v in self.stderr.items()},
         }
 

@@ -70,6 +70,7 @@ def fit(
     names = [s.name for s in specs]
     sc = np.array([scales[s.name] if s.name in scales else scales[s.scale] for s in specs])
     x0 = np.array([start.get(s.name, s.null) for s in specs], dtype=float)
+    x0 = np.where(np.isfinite(x0), x0, 0.3 * sc)  # no "absent" value (e.g. a time constant)
     lo = np.array([s.lower for s in specs]) / sc
     hi = np.array([s.upper for s in specs]) / sc
     z0 = np.clip(x0 / sc, lo, hi)

@@ -178,19 +178,19 @@ class DiagnosisReport:
         return plot_gap(self, ax=ax)
 
 
-def _family(model: Any) -> tuple[Family, dict[str, float]]:
-    """The model family and optional starting parameters from a name or model object."""
+def _family(model: Any) -> tuple[Family, dict[str, float], dict[str, float]]:
+    """Model family, starting parameters and context from a name or a model object."""
     from ..masing import Masing
 
     if isinstance(model, str):
         if model == "tangential":
             from .candidates_tangential import TangentialFamily
 
-            return TangentialFamily(), {}
+            return TangentialFamily(), {}, {}
         if model == "normal":
             from .candidates_normal import NormalFamily
 
-            return NormalFamily(), {}
+            return NormalFamily(), {}, {}
         raise InputError(
             f"model must be 'tangential' or 'normal' (or a model object), got {model!r}"
         )
@@ -199,14 +199,15 @@ def _family(model: Any) -> tuple[Family, dict[str, float]]:
 
         if not model.is_exponential:
             raise InputError("diagnose needs the exponential Masing model (h0, ac)")
-        return TangentialFamily(), {"h0": model.h0, "ac": model.ac}
+        return TangentialFamily(), {"h0": model.h0, "ac": model.ac}, {}
     if isinstance(model, ExtendedModel):
-        return model.family, dict(model.params)
+        return model.family, dict(model.params), dict(model.context)
     from .candidates_normal import NormalFamily, start_from_model
 
     start = start_from_model(model)
     if start is not None:
-        return NormalFamily(), start
+        ctx = {"omega": float(model.omega)} if hasattr(model, "omega") else {}
+        return NormalFamily(), start, ctx
     raise InputError(f"cannot diagnose a model of type {type(model).__name__}")
 
 
@@ -287,7 +288,7 @@ def diagnose(
     >>> report.effect_names
     ['force_offset']
     """
-    family, start = _family(model)
+    family, start, context = _family(model)
     t, u, y = _arrays(recording, family)
     if folds < 2:
         raise InputError(f"folds must be >= 2, got {folds}")
@@ -298,6 +299,7 @@ def diagnose(
                 f"unknown {family.kind} candidate {n!r}; choose from {', '.join(family.candidates)}"
             )
     d = Prepared.build(t, u, y)
+    d.extra.update(context)
     family.prepare(d)
     scales = family.scales(d)
     effects: tuple[str, ...] = tuple(model.effects) if isinstance(model, ExtendedModel) else ()
@@ -314,7 +316,7 @@ def diagnose(
     while len(added) < max_effects:
         verdicts, best = [], None
         for name in names:
-            if name in effects:
+            if name in effects or not family.check((*effects, name)):
                 continue
             cand = evaluate(family, (*effects, name), d, current.full.params, scales, folds)
             v = judge(name, current, cand, sigma, z, min_gain)
@@ -342,7 +344,7 @@ def diagnose(
         ss = {s.name: se[s.name] for s in family.candidates[name].params}
         dp, ds = family.derived(p, se, name)
         out_effects.append(Effect(name, {**ps, **dp}, {**ss, **ds}))
-    final = ExtendedModel(family, effects, p, se)
+    final = ExtendedModel(family, effects, p, se, family.context(d))
     return DiagnosisReport(
         family.kind, out_effects, steps, where, sigma, final, location, d, trials
     )
