@@ -10,6 +10,8 @@ from __future__ import annotations
 # model=...)` runs the workflow while `contactlab.diagnose.<module>` imports keep working.
 from . import diagnose
 from .errors import ContactLabError, ContactLabWarning, ConvergenceError, InputError
+from .fitting import FitResult, Parameter, least_squares_fit
+from .io import Recording, RecordingError, read_recording, write_recording
 from .masing import CycleTable, Masing, MasingOperator, cycle_energies, loop_area
 
 __version__ = "0.1.0"
@@ -19,11 +21,18 @@ __all__ = [
     "ContactLabWarning",
     "ConvergenceError",
     "CycleTable",
+    "FitResult",
     "InputError",
     "Masing",
     "MasingOperator",
+    "Parameter",
+    "Recording",
+    "RecordingError",
     "__version__",
     "cycle_energies",
     "diagnose",
+    "least_squares_fit",
     "loop_area",
+    "read_recording",
+    "write_recording",
 ]

@@ -91,7 +91,7 @@ def hidden_effect_recording_normal(
         np.array([0.3, 0.6, 0.9]) * p0, np.array([1.0, 1.7, 0.6]) * f0, cycles_per_block
     )
     fs = samples_per_cycle * f0
-    t = np.arange(int(round(T * fs)) + 1) / fs
+    t = np.arange(round(T * fs) + 1) / fs
     omega = 2.0 * np.pi * f0
     d0 = _displacement({}, t, pfun, k, psi, omega, 1.0)
     dr = _rms(d0)

@@ -1,0 +1,500 @@
+"""Least-squares fits with lmfit-style results: parameters with standard errors, correlations,
+χ², AIC/BIC and an honest account of what the data identify.
+
+Built on :func:`scipy.optimize.least_squares`. The covariance is ``(JᵀJ)⁻¹`` from a central
+difference Jacobian at the optimum, scaled by the reduced χ² (``scale_covar=True``, the lmfit
+default, right when the residuals are unweighted or their scale is unknown). ``(JᵀJ)⁻¹`` is
+taken by SVD: a direction of parameter space the data do not constrain (singular value below
+``rcond`` times the largest) is reported, and the parameters along it are flagged not
+identifiable, instead of being given a meaningless tiny or huge error.
+
+AIC and BIC follow lmfit: ``n ln(χ²/n) + 2k`` and ``n ln(χ²/n) + k ln n``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from .errors import ConvergenceError, InputError
+
+
+@dataclass
+class Parameter:
+    """A fit parameter.
+
+    Parameters
+    ----------
+    name : str
+    value : float
+        Initial value before the fit, best-fit value after it.
+    stderr : float or None
+        Standard error (None when fixed or when the data do not determine it).
+    vary : bool
+        Fitted (True) or held fixed (False).
+    min, max : float
+        Bounds for the fit.
+    identifiable : bool or None
+        Whether the data determine the parameter (None before a fit or when fixed).
+    note : str
+        A human-readable remark (why it is not identifiable, what is identified instead).
+    unit : str
+        SI unit, for reports.
+    """
+
+    name: str
+    value: float
+    stderr: float | None = None
+    vary: bool = True
+    min: float = -math.inf
+    max: float = math.inf
+    identifiable: bool | None = None
+    note: str = ""
+    unit: str = ""
+    init_value: float | None = None
+
+    @property
+    def fixed(self) -> bool:
+        return not self.vary
+
+    @property
+    def rel_stderr(self) -> float | None:
+        """``stderr / |value|`` (None when unknown or the value is 0)."""
+        if self.stderr is None or self.value == 0:
+            return None
+        return abs(self.stderr / self.value)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "name": self.name,
+            "value": _num(self.value),
+            "stderr": _num(self.stderr),
+            "vary": self.vary,
+            "min": _num(self.min),
+            "max": _num(self.max),
+            "identifiable": self.identifiable,
+            "note": self.note,
+            "unit": self.unit,
+            "init_value": _num(self.init_value),
+        }
+
+
+def _num(v: Any) -> Any:
+    """JSON-safe number: NaN and ±inf become None."""
+    if v is None:
+        return None
+    v = float(v)
+    return v if math.isfinite(v) else None
+
+
+@dataclass
+class FitResult:
+    """Outcome of a least-squares fit, in the manner of lmfit's ``MinimizerResult``.
+
+    ``covar`` and ``correl`` are square arrays over ``var_names`` (the varied parameters, in
+    order); ``correl_dict()`` gives them by name. ``residual`` is the residual vector at the
+    optimum as returned by the residual function.
+    """
+
+    params: dict[str, Parameter]
+    var_names: list[str]
+    covar: np.ndarray | None
+    correl: np.ndarray | None
+    chisqr: float
+    redchi: float
+    aic: float
+    bic: float
+    ndata: int
+    nvarys: int
+    success: bool
+    status: int
+    message: str
+    nfev: int
+    residual: np.ndarray
+    jac: np.ndarray | None = None
+    singular_values: np.ndarray | None = None
+    condition: float = math.nan
+    scale_covar: bool = True
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def nfree(self) -> int:
+        return self.ndata - self.nvarys
+
+    @property
+    def values(self) -> dict[str, float]:
+        return {k: p.value for k, p in self.params.items()}
+
+    def correl_dict(self) -> dict[str, dict[str, float]]:
+        """Correlations ``{a: {b: r}}`` between varied parameters (a ≠ b)."""
+        if self.correl is None:
+            return {}
+        out: dict[str, dict[str, float]] = {}
+        for i, a in enumerate(self.var_names):
+            out[a] = {b: float(self.correl[i, j]) for j, b in enumerate(self.var_names) if j != i}
+        return out
+
+    def propagate(
+        self, fn: Callable[[dict[str, float]], Any], *, rel_step: float = 1e-6
+    ) -> tuple[Any, Any]:
+        """Value and standard error of a derived quantity ``fn(values)`` (first order).
+
+        ``fn`` takes the dict of all parameter values and returns a float or an array; its
+        gradient with respect to the varied parameters is taken by central differences and
+        ``stderr = sqrt(g C gᵀ)``. Returns ``(value, stderr)``; the error is NaN when there is
+        no covariance.
+        """
+        base = self.values
+        val = np.asarray(fn(base), dtype=float)
+        if self.covar is None or not self.var_names:
+            return _scalar(val), _scalar(np.full_like(val, np.nan))
+        grads = []
+        for name in self.var_names:
+            v = base[name]
+            h = rel_step * (abs(v) if v != 0 else 1.0)
+            up = dict(base, **{name: v + h})
+            dn = dict(base, **{name: v - h})
+            grads.append((np.asarray(fn(up), float) - np.asarray(fn(dn), float)) / (2 * h))
+        g = np.stack([np.reshape(x, -1) for x in grads], axis=1)  # (m, k)
+        var = np.einsum("mi,ij,mj->m", g, self.covar, g)
+        err = np.sqrt(np.clip(var, 0.0, None)).reshape(val.shape)
+        return _scalar(val), _scalar(err)
+
+    def report(self, *, min_correl: float = 0.1) -> str:
+        """A text report like lmfit's ``fit_report``."""
+        lines = [
+            "[[Fit Statistics]]",
+            f"    success            = {self.success}",
+            f"    message            = {self.message}",
+            f"    # function evals   = {self.nfev}",
+            f"    # data points      = {self.ndata}",
+            f"    # variables        = {self.nvarys}",
+            f"    chi-square         = {self.chisqr:.6g}",
+            f"    reduced chi-square = {self.redchi:.6g}",
+            f"    Akaike info crit   = {self.aic:.6g}",
+            f"    Bayesian info crit = {self.bic:.6g}",
+            f"    Jacobian condition = {self.condition:.3g}",
+            "[[Variables]]",
+        ]
+        for p in self.params.values():
+            unit = f" {p.unit}" if p.unit else ""
+            if not p.vary:
+                lines.append(f"    {p.name}: {p.value:.8g}{unit} (fixed)")
+                continue
+            if p.stderr is None:
+                err = "+/- (not determined)"
+            else:
+                rel = p.rel_stderr
+                err = f"+/- {p.stderr:.4g}" + (f" ({100 * rel:.2f}%)" if rel is not None else "")
+            flag = "" if p.identifiable is not False else "  [NOT IDENTIFIABLE]"
+            init = f" (init = {p.init_value:.6g})" if p.init_value is not None else ""
+            lines.append(f"    {p.name}: {p.value:.8g} {err}{unit}{init}{flag}")
+            if p.note:
+                lines.append(f"        note: {p.note}")
+        if self.correl is not None and len(self.var_names) > 1:
+            pairs = []
+            for i, a in enumerate(self.var_names):
+                for j in range(i + 1, len(self.var_names)):
+                    r = float(self.correl[i, j])
+                    if abs(r) >= min_correl:
+                        pairs.append((abs(r), f"    C({a}, {self.var_names[j]}) = {r:+.4f}"))
+            if pairs:
+                lines.append(f"[[Correlations]] (unreported correlations are < {min_correl})")
+                lines += [s for _, s in sorted(pairs, reverse=True)]
+        if self.notes:
+            lines.append("[[Notes]]")
+            lines += [f"    {n}" for n in self.notes]
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-safe dict (NaN/inf become None)."""
+        return {
+            "params": {k: p.to_dict() for k, p in self.params.items()},
+            "var_names": list(self.var_names),
+            "covar": None if self.covar is None else _nested(self.covar),
+            "correl": self.correl_dict() or None,
+            "chisqr": _num(self.chisqr),
+            "redchi": _num(self.redchi),
+            "aic": _num(self.aic),
+            "bic": _num(self.bic),
+            "ndata": self.ndata,
+            "nvarys": self.nvarys,
+            "success": bool(self.success),
+            "status": int(self.status),
+            "message": self.message,
+            "nfev": int(self.nfev),
+            "condition": _num(self.condition),
+            "scale_covar": self.scale_covar,
+            "notes": list(self.notes),
+        }
+
+
+def _nested(a: np.ndarray) -> list[list[Any]]:
+    return [[_num(v) for v in row] for row in a]
+
+
+def _scalar(a: np.ndarray) -> Any:
+    return float(a) if a.ndim == 0 else a
+
+
+def _as_params(params: Any) -> dict[str, Parameter]:
+    if isinstance(params, Mapping):
+        out = {}
+        for k, v in params.items():
+            if isinstance(v, Parameter):
+                if v.name != k:
+                    raise InputError(f"parameter stored under {k!r} is named {v.name!r}")
+                out[k] = replace(v)
+            else:
+                out[k] = Parameter(k, float(v))
+        return out
+    if isinstance(params, Iterable):
+        out = {}
+        for p in params:
+            if not isinstance(p, Parameter):
+                raise InputError(f"expected Parameter objects, got {type(p).__name__}")
+            out[p.name] = replace(p)
+        return out
+    raise InputError(f"params must be a dict or a list of Parameter, got {type(params).__name__}")
+
+
+def least_squares_fit(
+    residual_fn: Callable[[dict[str, float]], Any],
+    params: Mapping[str, Parameter | float] | Iterable[Parameter],
+    *,
+    scale_covar: bool = True,
+    rcond: float = 1e-8,
+    max_rel_stderr: float | None = None,
+    loss: str = "linear",
+    max_nfev: int | None = None,
+    ftol: float = 1e-10,
+    xtol: float = 1e-10,
+    gtol: float = 1e-10,
+    jac_rel_step: float = 1e-6,
+) -> FitResult:
+    """Minimise ``sum(residual_fn(values)**2)`` over the varied parameters.
+
+    Parameters
+    ----------
+    residual_fn : callable
+        ``residual_fn({name: value, ...}) -> 1-D array`` of (weighted) residuals. It receives
+        every parameter, fixed ones included.
+    params : dict or list of Parameter (or dict name -> initial value)
+        Initial values, bounds and which to vary. Not modified.
+    scale_covar : bool, default True
+        Scale the covariance by the reduced χ² (residuals of unknown scale). Use False when
+        the residuals are already divided by their true standard deviations.
+    rcond : float
+        Relative singular-value cut-off of the Jacobian: directions below it are not
+        identifiable.
+    max_rel_stderr : float, optional
+        Flag a parameter not identifiable when its relative standard error exceeds this.
+    loss, max_nfev, ftol, xtol, gtol
+        Passed to :func:`scipy.optimize.least_squares`.
+    jac_rel_step : float
+        Relative step of the central-difference Jacobian used for the covariance.
+
+    Returns
+    -------
+    FitResult
+        ``success=False`` with the solver's message when it did not converge; malformed input
+        (non-finite residuals at the start, bad bounds) raises :class:`InputError`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.linspace(0, 1, 50)
+    >>> y = 2.0 * x + 1.0 + 0.01 * np.sin(37 * x)
+    >>> res = least_squares_fit(lambda p: p["a"] * x + p["b"] - y, {"a": 1.0, "b": 0.0})
+    >>> round(res.params["a"].value, 2), res.success
+    (2.0, True)
+    """
+    ps = _as_params(params)
+    names = [k for k, p in ps.items() if p.vary]
+    for p in ps.values():
+        if not math.isfinite(p.value):
+            raise InputError(f"parameter {p.name!r} has a non-finite initial value {p.value}")
+        if p.vary and not (p.min <= p.value <= p.max):
+            raise InputError(
+                f"parameter {p.name!r}: initial value {p.value} outside [{p.min}, {p.max}]"
+            )
+        p.init_value = p.value if p.vary else None
+    # Fit in scaled variables (value / |initial value|) so parameters that differ by orders of
+    # magnitude (h0 ~ 10 N, ac ~ 1e5 1/m) are equally well conditioned.
+    scale = np.array([abs(ps[n].value) if ps[n].value != 0 else 1.0 for n in names])
+    lo = np.array([ps[n].min for n in names]) / scale
+    hi = np.array([ps[n].max for n in names]) / scale
+    fixed = {k: p.value for k, p in ps.items() if not p.vary}
+    nfev = 0
+
+    def values_of(z: np.ndarray) -> dict[str, float]:
+        v = dict(fixed)
+        v.update({n: float(zi * s) for n, zi, s in zip(names, z, scale, strict=True)})
+        return {k: v[k] for k in ps}
+
+    def fun(z: np.ndarray) -> np.ndarray:
+        nonlocal nfev
+        nfev += 1
+        r = np.asarray(residual_fn(values_of(z)), dtype=np.float64).reshape(-1)
+        return r
+
+    z0 = np.ones(len(names))
+    r0 = fun(z0)
+    if not np.all(np.isfinite(r0)):
+        i = int(np.argmax(~np.isfinite(r0)))
+        raise InputError(f"residual[{i}] is not finite at the initial parameter values")
+    ndata = int(r0.size)
+    if not names:
+        chisqr = float(r0 @ r0)
+        return _finish(ps, [], None, r0, chisqr, ndata, True, 0, "no varied parameters", nfev)
+    if ndata < len(names):
+        raise InputError(f"{ndata} residuals cannot determine {len(names)} parameters")
+    try:
+        sol = least_squares(
+            fun,
+            z0,
+            bounds=(lo, hi),
+            method="trf",
+            x_scale=1.0,
+            loss=loss,
+            ftol=ftol,
+            xtol=xtol,
+            gtol=gtol,
+            max_nfev=max_nfev,
+        )
+    except InputError as exc:
+        raise ConvergenceError(
+            f"the model rejected the parameters the solver tried ({exc}); tighten the bounds"
+        ) from exc
+    z = sol.x
+    r = np.asarray(sol.fun, dtype=np.float64)
+    chisqr = float(r @ r)
+    # Central-difference Jacobian at the optimum, in the scaled variables (bounds respected
+    # by one-sided steps).
+    J = np.empty((ndata, len(names)))
+    for j in range(len(names)):
+        h = jac_rel_step * max(abs(z[j]), 1e-3)
+        up, dn = z.copy(), z.copy()
+        up[j] = min(z[j] + h, hi[j])
+        dn[j] = max(z[j] - h, lo[j])
+        J[:, j] = (fun(up) - fun(dn)) / (up[j] - dn[j])
+    res = _finish(
+        ps,
+        names,
+        (J, scale),
+        r,
+        chisqr,
+        ndata,
+        bool(sol.success),
+        int(sol.status),
+        str(sol.message),
+        nfev,
+        values=values_of(z),
+        scale_covar=scale_covar,
+        rcond=rcond,
+        max_rel_stderr=max_rel_stderr,
+    )
+    return res
+
+
+def _finish(
+    ps: dict[str, Parameter],
+    names: list[str],
+    jac: tuple[np.ndarray, np.ndarray] | None,
+    r: np.ndarray,
+    chisqr: float,
+    ndata: int,
+    success: bool,
+    status: int,
+    message: str,
+    nfev: int,
+    *,
+    values: dict[str, float] | None = None,
+    scale_covar: bool = True,
+    rcond: float = 1e-8,
+    max_rel_stderr: float | None = None,
+) -> FitResult:
+    k = len(names)
+    nfree = ndata - k
+    redchi = chisqr / nfree if nfree > 0 else math.nan
+    tiny = np.finfo(float).tiny
+    n2ll = ndata * math.log(max(chisqr / ndata, tiny))
+    aic = n2ll + 2 * k
+    bic = n2ll + math.log(ndata) * k
+    if values is not None:
+        for n, v in values.items():
+            ps[n].value = v
+    covar = correl = sv = None
+    cond = math.nan
+    notes: list[str] = []
+    Jfull = None
+    if jac is not None:
+        Js, scale = jac
+        Jfull = Js / scale  # d r / d value
+        _U, s, Vt = np.linalg.svd(Js, full_matrices=False)
+        sv = s
+        cond = float(s[0] / s[-1]) if s[-1] > 0 else math.inf
+        keep = s > rcond * s[0] if s[0] > 0 else np.zeros_like(s, bool)
+        if not keep.all():
+            for idx in np.flatnonzero(~keep):
+                v = Vt[idx]
+                involved = [names[i] for i in np.flatnonzero(np.abs(v) > 0.1)]
+                notes.append(
+                    "the data do not constrain the combination of "
+                    + ", ".join(involved)
+                    + f" (singular value {s[idx]:.3g} vs {s[0]:.3g})"
+                )
+                for n in involved:
+                    ps[n].identifiable = False
+        inv = (Vt[keep].T / s[keep] ** 2) @ Vt[keep]
+        cov_s = inv * (redchi if scale_covar and nfree > 0 else 1.0)
+        covar = cov_s * np.outer(scale, scale)
+        d = np.sqrt(np.clip(np.diag(covar), 0.0, None))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            correl = covar / np.outer(d, d)
+        correl[~np.isfinite(correl)] = 0.0
+        np.fill_diagonal(correl, 1.0)
+        for i, n in enumerate(names):
+            p = ps[n]
+            if p.identifiable is False:
+                p.stderr = None
+                continue
+            p.stderr = float(d[i])
+            p.identifiable = True
+            if max_rel_stderr is not None and p.rel_stderr is not None:
+                if p.rel_stderr > max_rel_stderr:
+                    p.identifiable = False
+                    p.note = p.note or (
+                        f"relative standard error {100 * p.rel_stderr:.0f}% exceeds "
+                        f"{100 * max_rel_stderr:.0f}%"
+                    )
+            at_bound = (p.value <= p.min) or (p.value >= p.max)
+            if at_bound:
+                notes.append(f"{n} ended at a bound ({p.value}); its error is not reliable")
+    return FitResult(
+        params=ps,
+        var_names=list(names),
+        covar=covar,
+        correl=correl,
+        chisqr=chisqr,
+        redchi=redchi,
+        aic=aic,
+        bic=bic,
+        ndata=ndata,
+        nvarys=k,
+        success=success,
+        status=status,
+        message=message,
+        nfev=nfev,
+        residual=r,
+        jac=Jfull,
+        singular_values=sv,
+        condition=cond,
+        scale_covar=scale_covar,
+        notes=notes,
+    )

@@ -1,0 +1,136 @@
+"""CSV / text recordings: one header row with column names (units in brackets), then numbers.
+
+Lines starting with ``#`` before the header are kept as comments in ``meta``. The delimiter
+(comma, semicolon, tab or whitespace) is detected from the header. Only the needed columns are
+parsed (``numpy.loadtxt`` with ``usecols``); when that fails, the file is scanned once more to
+name the first bad cell by line and column.
+"""
+
+from __future__ import annotations
+
+import csv as _csv
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .._io_atomic import atomic_path
+from .recording import Recording, RecordingError, finish, resolve_columns
+from .units import split_name
+
+
+def _header(path: Path) -> tuple[list[str], str | None, int, list[str]]:
+    """Column names, delimiter (None = whitespace), 0-based header line, comment lines."""
+    comments: list[str] = []
+    with open(path, encoding="utf-8-sig", errors="replace") as fh:
+        for lineno, line in enumerate(fh):
+            s = line.strip()
+            if not s:
+                continue
+            if s.startswith("#"):
+                comments.append(s[1:].strip())
+                continue
+            for delim in ("\t", ";", ","):
+                if delim in s:
+                    names = [c.strip().strip('"') for c in next(_csv.reader([s], delimiter=delim))]
+                    return names, delim, lineno, comments
+            toks: list[str] = []
+            for tok in s.split():  # "x [um]" split by whitespace: rejoin the unit
+                if toks and tok[:1] in "[(":
+                    toks[-1] += " " + tok
+                else:
+                    toks.append(tok)
+            return toks, None, lineno, comments
+    raise RecordingError("no header row (the file is empty)", file=str(path))
+
+
+def _locate_bad_cell(
+    path: Path, delim: str | None, first_data_line: int, cols: list[int], names: list[str]
+) -> RecordingError:
+    """Scan the file to find the first cell that is not a number."""
+    with open(path, encoding="utf-8-sig", errors="replace") as fh:
+        for lineno, line in enumerate(fh):
+            if lineno < first_data_line or not line.strip() or line.lstrip().startswith("#"):
+                continue
+            cells = line.rstrip("\r\n").split(delim) if delim else line.split()
+            for c in cols:
+                if c >= len(cells):
+                    return RecordingError(
+                        f"line has {len(cells)} fields, column {names[c]!r} is field {c + 1}",
+                        file=str(path),
+                        column=names[c],
+                        row=lineno + 1,
+                    )
+                cell = cells[c].strip().strip('"')
+                try:
+                    float(cell)
+                except ValueError:
+                    return RecordingError(
+                        f"cell {cell!r} is not a number",
+                        file=str(path),
+                        column=names[c],
+                        row=lineno + 1,
+                    )
+    return RecordingError("cannot be parsed as numbers", file=str(path))
+
+
+def read_csv(
+    path: str | Path,
+    *,
+    columns: dict[str, str] | None = None,
+    kind: str | None = None,
+    fs: float | None = None,
+) -> Recording:
+    """Read a CSV/text recording; see :func:`contactlab.io.read_recording`.
+
+    Rows reported in errors are 1-based lines of the file (the header is a line too).
+    """
+    path = Path(path)
+    file = str(path)
+    names, delim, header_line, comments = _header(path)
+    if len(set(names)) != len(names):
+        dup = next(n for n in names if names.count(n) > 1)
+        raise RecordingError("column name appears twice in the header", file=file, column=dup)
+    kind, mapping = resolve_columns(names, columns=columns, kind=kind, file=file)
+    canon = list(mapping)
+    idx = [names.index(mapping[c]) for c in canon]
+    first_data = header_line + 1
+    try:
+        block = np.loadtxt(
+            path,
+            delimiter=delim,
+            skiprows=first_data,
+            usecols=idx,
+            ndmin=2,
+            comments="#",
+            dtype=np.float64,
+            encoding="utf-8-sig",
+            quotechar='"',
+        )
+    except ValueError:
+        raise _locate_bad_cell(path, delim, first_data, idx, names) from None
+    if block.shape[0] == 0:
+        raise RecordingError("header but no data rows", file=file)
+    raw = {c: np.ascontiguousarray(block[:, j]) for j, c in enumerate(canon)}
+    units = {c: split_name(mapping[c])[1] for c in canon}
+    # Rows of sample i: blank and comment lines are rare after the header; assume none.
+    return finish(
+        raw,
+        mapping,
+        units,
+        kind=kind,
+        file=file,
+        fs=fs,
+        row_offset=first_data + 1,
+        meta={"format": "csv", "comments": comments, "delimiter": delim or "whitespace"},
+    )
+
+
+def write_csv(path: str | Path, rec: Recording, **_: Any) -> Path:
+    """Write ``rec`` as CSV with SI units in the header (``t [s],x [m],F [N]``), atomically."""
+    cols = [("t", "s", rec.t)] + [(k, rec.units[k], v) for k, v in rec.data.items()]
+    header = ",".join(f"{k} [{u}]" if u else k for k, u, _ in cols)
+    block = np.column_stack([v for _, _, v in cols])
+    with atomic_path(path) as tmp:
+        np.savetxt(tmp, block, delimiter=",", header=header, comments="", fmt="%.17g")
+    return Path(path)

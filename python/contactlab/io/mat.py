@@ -1,0 +1,171 @@
+"""MATLAB .mat recordings: v4-v7 through ``scipy.io``, v7.3 (HDF5 inside) through h5py.
+
+Each channel is a vector variable. Units, in order of preference: a struct variable ``units``
+with one text field per channel, a text variable ``<name>_unit``, or the name itself
+(``x_um``; see :func:`contactlab.io.units.split_name`). Only the needed variables are read
+(``variable_names=`` for scipy, lazy datasets for v7.3).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import scipy.io
+
+from .._io_atomic import atomic_path
+from .hdf5 import _h5py, _text, vector
+from .recording import Recording, RecordingError, finish, resolve_columns
+from .sniff import content_format
+from .units import split_name
+
+
+def _mat_text(v: Any) -> str | None:
+    a = np.asarray(v)
+    if a.dtype.kind in "US":
+        s = "".join(str(c) for c in a.reshape(-1)).strip()
+        return s or None
+    if a.dtype == object and a.size == 1:
+        return _mat_text(a.reshape(-1)[0])
+    return None
+
+
+def _read_v5(path: Path, file: str, columns: Any, kind: Any) -> tuple[Any, ...]:
+    try:
+        info = scipy.io.whosmat(path)
+    except Exception as exc:
+        raise RecordingError(f"not a readable MATLAB file ({exc})", file=file) from None
+    numeric = [n for n, _shape, cls in info if cls in ("double", "single") or "int" in cls]
+    kind, mapping = resolve_columns(numeric, columns=columns, kind=kind, file=file)
+    names = set(mapping.values())
+    extra = [n for n, _s, _c in info if n == "units" or n in {f"{m}_unit" for m in names}]
+    extra += [n for n, _s, _c in info if n in ("dt", "fs")]
+    d = scipy.io.loadmat(path, variable_names=[*names, *extra], squeeze_me=True)
+    raw = {}
+    for c, n in mapping.items():
+        a = np.asarray(d[n], dtype=np.float64)
+        if a.ndim > 1:
+            raise RecordingError(
+                f"variable has shape {a.shape}; a channel must be a vector", file=file, column=n
+            )
+        raw[c] = a.reshape(-1)
+    units: dict[str, str | None] = {}
+    ustruct = d.get("units")
+    for c, n in mapping.items():
+        u = None
+        if ustruct is not None and getattr(ustruct, "dtype", None) is not None:
+            if ustruct.dtype.names and n in ustruct.dtype.names:
+                u = _mat_text(ustruct[n])
+        if u is None and f"{n}_unit" in d:
+            u = _mat_text(d[f"{n}_unit"])
+        if u is None:
+            u = split_name(n)[1]
+        units[c] = u
+    dt = None
+    if "dt" in d:
+        dt = float(np.asarray(d["dt"]).reshape(-1)[0])
+    elif "fs" in d:
+        dt = 1.0 / float(np.asarray(d["fs"]).reshape(-1)[0])
+    return kind, mapping, raw, units, dt
+
+
+def _read_v73(path: Path, file: str, columns: Any, kind: Any) -> tuple[Any, ...]:
+    h5py = _h5py()
+    with h5py.File(path, "r") as f:
+        numeric = [
+            n
+            for n, obj in f.items()
+            if isinstance(obj, h5py.Dataset)
+            and _text(obj.attrs.get("MATLAB_class", b"double")) in ("double", "single")
+        ]
+        kind, mapping = resolve_columns(numeric, columns=columns, kind=kind, file=file)
+        raw = {c: vector(f[n], file=file, column=n) for c, n in mapping.items()}
+        units: dict[str, str | None] = {}
+        for c, n in mapping.items():
+            u = None
+            if "units" in f and isinstance(f["units"], h5py.Group) and n in f["units"]:
+                u = _text(f["units"][n][()]).strip() or None
+            if u is None and f"{n}_unit" in f:
+                u = _text(f[f"{n}_unit"][()]).strip() or None
+            if u is None:
+                u = split_name(n)[1]
+            units[c] = u
+        dt = None
+        if "dt" in f:
+            dt = float(np.asarray(f["dt"][()]).reshape(-1)[0])
+        elif "fs" in f:
+            dt = 1.0 / float(np.asarray(f["fs"][()]).reshape(-1)[0])
+    return kind, mapping, raw, units, dt
+
+
+def read_mat(
+    path: str | Path,
+    *,
+    columns: dict[str, str] | None = None,
+    kind: str | None = None,
+    fs: float | None = None,
+) -> Recording:
+    """Read a MATLAB recording (v4-v7 or v7.3); see :func:`contactlab.io.read_recording`.
+
+    Rows in errors are 0-based sample indices.
+    """
+    path = Path(path)
+    file = str(path)
+    v73 = content_format(path) == "mat73"
+    reader = _read_v73 if v73 else _read_v5
+    kind, mapping, raw, units, dt = reader(path, file, columns, kind)
+    lengths = {mapping[c]: v.size for c, v in raw.items()}
+    if len(set(lengths.values())) > 1:
+        raise RecordingError(f"variables differ in length: {lengths}", file=file)
+    t_fallback = None
+    if "t" not in raw and fs is None and dt is not None:
+        if not np.isfinite(dt) or dt <= 0:
+            raise RecordingError(f"sampling interval dt = {dt} is not > 0", file=file)
+        t_fallback = dt * np.arange(next(iter(raw.values())).size, dtype=np.float64)
+    return finish(
+        raw,
+        mapping,
+        units,
+        kind=kind,
+        file=file,
+        fs=fs,
+        t_fallback=t_fallback,
+        meta={"format": "mat73" if v73 else "mat"},
+    )
+
+
+_MAT73_HEADER = b"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created by: contactlab HDF5 schema 1.00 ."
+
+
+def write_mat(path: str | Path, rec: Recording, *, version: str = "5", **_: Any) -> Path:
+    """Write ``rec`` as a MATLAB file: column vectors ``t`` and one per channel, plus a struct
+    ``units``. ``version="5"`` (scipy, default) or ``"7.3"`` (HDF5 with the MATLAB header and
+    ``MATLAB_class`` attributes, as MATLAB writes it)."""
+    if version not in ("5", "7.3"):
+        raise RecordingError(f"MAT version must be '5' or '7.3', got {version!r}", file=str(path))
+    units = {"t": "s", **rec.units}
+    with atomic_path(path) as tmp:
+        if version == "5":
+            d: dict[str, Any] = {"t": rec.t.reshape(-1, 1)}
+            d.update({k: v.reshape(-1, 1) for k, v in rec.data.items()})
+            d["units"] = {k: u for k, u in units.items()}
+            with open(tmp, "wb") as fh:
+                scipy.io.savemat(fh, d, format="5", oned_as="column")
+        else:
+            h5py = _h5py()
+            with h5py.File(tmp, "w", userblock_size=512) as f:
+                for k, v in {"t": rec.t, **rec.data}.items():
+                    ds = f.create_dataset(k, data=v.reshape(1, -1))
+                    ds.attrs["MATLAB_class"] = np.bytes_("double")
+                g = f.create_group("units")
+                g.attrs["MATLAB_class"] = np.bytes_("struct")
+                for k, u in units.items():
+                    ds = g.create_dataset(k, data=np.array([[ord(c)] for c in u], np.uint16))
+                    ds.attrs["MATLAB_class"] = np.bytes_("char")
+            with open(tmp, "r+b") as fh:
+                fh.write(_MAT73_HEADER.ljust(116, b" ")[:116])
+                fh.write(b"\x00" * 8)  # subsystem data offset
+                fh.write(b"\x00\x02")  # version 0x0200
+                fh.write(b"IM")  # endian indicator
+    return Path(path)

@@ -1,0 +1,344 @@
+"""The :class:`Recording` container, its error type and the checks every reader shares.
+
+A recording holds SI data only: readers convert on the way in (see :mod:`.units`), so the
+analysis code never sees µm or MPa. Canonical channel names: tangential ``x`` (m) and ``F``
+(N); normal ``p`` (Pa) and ``delta`` (m); time ``t`` (s).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from .units import SI_UNITS, UnknownUnitError, split_name, to_si
+
+#: canonical channel -> physical dimension
+DIMENSIONS = {"t": "time", "x": "length", "F": "force", "p": "pressure", "delta": "length"}
+#: the channels each kind of recording needs
+KIND_CHANNELS = {"tangential": ("x", "F"), "normal": ("p", "delta")}
+#: names recognised (case-insensitive, unit stripped) for each canonical channel, best first
+ALIASES: dict[str, tuple[str, ...]] = {
+    "t": ("t", "time", "zeit", "timestamp", "time_s", "times"),
+    "x": ("x", "disp", "displacement", "u", "x_t", "tangential displacement", "s", "ux"),
+    "F": ("f", "force", "ft", "f_t", "friction", "friction force", "h", "tangential force"),
+    "p": ("p", "pressure", "contact pressure", "sigma", "p_n"),
+    "delta": ("delta", "δ", "d", "normal displacement", "disp", "displacement", "dn"),
+}
+
+
+class RecordingError(InputError):
+    """A recording that cannot be read as asked; the message names file, column and row.
+
+    Attributes ``file``, ``column`` and ``row`` (1-based line of the file for text formats,
+    0-based sample index otherwise) are set when known.
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        file: str | None = None,
+        column: str | None = None,
+        row: int | None = None,
+    ) -> None:
+        self.file = file
+        self.column = column
+        self.row = row
+        parts = []
+        if file is not None:
+            parts.append(str(file))
+        if column is not None:
+            parts.append(f"column {column!r}")
+        if row is not None:
+            parts.append(f"row {row}")
+        prefix = ", ".join(parts)
+        super().__init__(f"{prefix}: {message}" if prefix else message)
+
+
+class RecordingUnitError(RecordingError, UnknownUnitError):
+    """A column's unit is unknown (catchable as either parent)."""
+
+
+@dataclass
+class Recording:
+    """A measured (or simulated) recording in SI units.
+
+    Parameters
+    ----------
+    t : ndarray
+        Time stamps, s, strictly increasing.
+    data : dict of str to ndarray
+        Channels, SI, each as long as ``t``. Canonical names: ``x``, ``F``, ``p``, ``delta``.
+    units : dict of str to str
+        SI unit of each channel (``"m"``, ``"N"``, ``"Pa"``, ...).
+    source : str
+        Where it came from (a path or ``"synthetic"``).
+    meta : dict
+        Anything else (original units and column names, sampling rate, kind, ...).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> rec = Recording(np.arange(3) * 1e-3, {"x": np.zeros(3), "F": np.ones(3)},
+    ...                 {"x": "m", "F": "N"})
+    >>> rec["F"].tolist(), rec.fs
+    ([1.0, 1.0, 1.0], 1000.0)
+    """
+
+    t: np.ndarray
+    data: dict[str, np.ndarray]
+    units: dict[str, str]
+    source: str = "<memory>"
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        self.t = np.ascontiguousarray(self.t, dtype=np.float64)
+        if self.t.ndim != 1:
+            raise InputError(f"{self.source}: t must be 1-D, got shape {self.t.shape}")
+        for k, v in list(self.data.items()):
+            a = np.ascontiguousarray(v, dtype=np.float64)
+            if a.shape != self.t.shape:
+                raise InputError(
+                    f"{self.source}: channel {k!r} has {a.size} samples but t has {self.t.size}"
+                )
+            self.data[k] = a
+        missing = [k for k in self.data if k not in self.units]
+        if missing:
+            raise InputError(f"{self.source}: no unit given for channel(s) {missing}")
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name == "t":
+            return self.t
+        try:
+            return self.data[name]
+        except KeyError:
+            raise KeyError(
+                f"{self.source} has no channel {name!r}; channels: {sorted(self.data)}"
+            ) from None
+
+    def __contains__(self, name: object) -> bool:
+        return name == "t" or name in self.data
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    @property
+    def channels(self) -> list[str]:
+        return list(self.data)
+
+    @property
+    def fs(self) -> float:
+        """Mean sampling rate, Hz."""
+        if self.t.size < 2:
+            return float("nan")
+        return float((self.t.size - 1) / (self.t[-1] - self.t[0]))
+
+    @property
+    def kind(self) -> str | None:
+        """``"tangential"``, ``"normal"`` or None, from the channels present."""
+        for kind, chans in KIND_CHANNELS.items():
+            if all(c in self.data for c in chans):
+                return kind
+        return None
+
+
+def resolve_columns(
+    available: list[str],
+    *,
+    columns: dict[str, str] | None,
+    kind: str | None,
+    file: str,
+) -> tuple[str | None, dict[str, str]]:
+    """Map canonical channel names to names in the file.
+
+    Returns ``(kind, {canonical: file_name})``; ``"t"`` is included when a time column exists.
+    Explicit ``columns`` entries match the full name or the name without its unit.
+    """
+    if kind not in (None, "tangential", "normal"):
+        raise InputError(f"kind must be 'tangential', 'normal' or None, got {kind!r}")
+    columns = dict(columns or {})
+    bases = {c: split_name(c)[0].strip().lower() for c in available}
+    mapping: dict[str, str] = {}
+
+    def find(name: str) -> str | None:
+        for c in available:
+            if c == name:
+                return c
+        low = name.strip().lower()
+        for c in available:
+            if c.strip().lower() == low or bases[c] == low:
+                return c
+        return None
+
+    for canon, name in columns.items():
+        hit = find(name)
+        if hit is None:
+            raise RecordingError(
+                f"column {name!r} (asked for {canon!r}) not found; columns are {available}",
+                file=file,
+                column=name,
+            )
+        mapping[canon] = hit
+
+    def guess(canon: str) -> str | None:
+        used = set(mapping.values())
+        for alias in ALIASES[canon]:
+            for c in available:
+                if c not in used and bases[c] == alias:
+                    return c
+        return None
+
+    if kind is None:
+        for k, chans in KIND_CHANNELS.items():
+            if all(c in mapping for c in chans):
+                kind = k
+                break
+    if kind is None:
+        # Guess: the force column decides tangential, a pressure column normal.
+        if "F" in mapping or guess("F") is not None:
+            kind = "tangential"
+        elif "p" in mapping or guess("p") is not None:
+            kind = "normal"
+    if kind is None:
+        raise RecordingError(
+            f"cannot tell a tangential (x, F) from a normal (p, delta) recording; columns are "
+            f"{available}; pass kind= and columns={{'x': ..., 'F': ...}}",
+            file=file,
+        )
+    for canon in (*KIND_CHANNELS[kind], "t"):
+        if canon in mapping:
+            continue
+        hit = guess(canon)
+        if hit is not None:
+            mapping[canon] = hit
+        elif canon != "t":
+            raise RecordingError(
+                f"no column for {canon!r} ({DIMENSIONS[canon]}) of a {kind} recording; columns "
+                f"are {available}; name it e.g. {ALIASES[canon][0]!r} or pass columns="
+                f"{{{canon!r}: 'your column'}}",
+                file=file,
+                column=canon,
+            )
+    return kind, mapping
+
+
+def unit_factor(
+    canon: str, column: str, unit: str | None, *, file: str, assumed: list[str]
+) -> tuple[float, str]:
+    """Factor to SI of a column, checking the unit's dimension against the channel's."""
+    dim = DIMENSIONS.get(canon)
+    if unit is None or unit == "":
+        assumed.append(column)
+        return 1.0, SI_UNITS[dim] if dim else ""
+    try:
+        factor, udim = to_si(unit)
+    except UnknownUnitError as exc:
+        raise RecordingUnitError(str(exc), file=file, column=column) from None
+    if dim is not None and udim != dim:
+        raise RecordingError(
+            f"unit {unit!r} is a {udim} unit but {canon!r} is a {dim}", file=file, column=column
+        )
+    return factor, SI_UNITS[udim]
+
+
+def check_time(t: np.ndarray, *, file: str, column: str, row_offset: int = 0) -> None:
+    """Time stamps finite, strictly increasing, without gaps (> 1.5 median step).
+
+    ``row_offset`` converts a sample index into the row reported (e.g. header lines).
+    """
+    if t.size < 2:
+        raise RecordingError(f"only {t.size} sample(s)", file=file, column=column)
+    d = np.diff(t)
+    bad = np.flatnonzero(d <= 0)
+    if bad.size:
+        i = int(bad[0]) + 1
+        what = "duplicated" if d[bad[0]] == 0 else "unsorted (goes back in time)"
+        raise RecordingError(
+            f"time stamp {t[i]!r} is {what}; previous is {t[i - 1]!r}",
+            file=file,
+            column=column,
+            row=i + row_offset,
+        )
+    med = float(np.median(d))
+    gaps = np.flatnonzero(d > 1.5 * med)
+    if gaps.size:
+        i = int(gaps[0]) + 1
+        raise RecordingError(
+            f"gap in time: {d[gaps[0]]:.6g} s between samples where the step is {med:.6g} s "
+            f"({gaps.size} gap(s) in all)",
+            file=file,
+            column=column,
+            row=i + row_offset,
+        )
+
+
+def time_from_fs(n: int, fs: float | None, *, file: str, t0: float = 0.0) -> np.ndarray:
+    if fs is None:
+        raise RecordingError(
+            "no time column and no sampling rate: pass fs= (Hz) or columns={'t': ...}", file=file
+        )
+    fs = float(fs)
+    if not np.isfinite(fs) or fs <= 0:
+        raise InputError(f"fs must be finite and > 0, got {fs}")
+    return t0 + np.arange(n, dtype=np.float64) / fs
+
+
+def check_finite(a: np.ndarray, *, file: str, column: str, row_offset: int = 0) -> None:
+    bad = ~np.isfinite(a)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise RecordingError(
+            f"value {a[i]!r} is not a finite number", file=file, column=column, row=i + row_offset
+        )
+
+
+def finish(
+    raw: dict[str, np.ndarray],
+    names: dict[str, str],
+    file_units: dict[str, str | None],
+    *,
+    kind: str | None,
+    file: str,
+    fs: float | None,
+    row_offset: int = 0,
+    t_fallback: np.ndarray | None = None,
+    meta: dict[str, Any] | None = None,
+) -> Recording:
+    """Convert raw columns to SI, build ``t`` and check everything; shared by all readers.
+
+    ``raw`` maps canonical name to values in file units; ``names`` to the file's names.
+    """
+    assumed: list[str] = []
+    data: dict[str, np.ndarray] = {}
+    units: dict[str, str] = {}
+    t = None
+    for canon, values in raw.items():
+        col = names[canon]
+        check_finite(values, file=file, column=col, row_offset=row_offset)
+        factor, si = unit_factor(canon, col, file_units.get(canon), file=file, assumed=assumed)
+        v = np.ascontiguousarray(values, dtype=np.float64) * factor
+        if canon == "t":
+            t = v
+        else:
+            data[canon] = v
+            units[canon] = si
+    n = next(iter(data.values())).size if data else 0
+    if t is None:
+        if t_fallback is not None:
+            t = t_fallback
+        else:
+            t = time_from_fs(n, fs, file=file)
+        tcol = "t"
+    else:
+        tcol = names["t"]
+    check_time(t, file=file, column=tcol, row_offset=row_offset)
+    m = dict(meta or {})
+    m.setdefault("kind", kind)
+    m["columns"] = dict(names)
+    m["file_units"] = dict(file_units)
+    if assumed:
+        m["units_assumed_si"] = assumed
+    return Recording(t=t, data=data, units=units, source=file, meta=m)

@@ -1,0 +1,80 @@
+"""Tell a file's format from its first bytes, so a file that is not what its extension says
+is reported as such instead of failing somewhere deep inside a parser."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .recording import RecordingError
+
+HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+EXTENSIONS = {
+    ".csv": "csv",
+    ".txt": "csv",
+    ".tsv": "csv",
+    ".dat": "csv",
+    ".tdms": "tdms",
+    ".h5": "hdf5",
+    ".hdf5": "hdf5",
+    ".hdf": "hdf5",
+    ".mat": "mat",
+}
+NAMES = {"csv": "a text (CSV)", "tdms": "a TDMS", "hdf5": "an HDF5", "mat": "a MATLAB .mat"}
+
+
+def content_format(path: Path) -> str:
+    """``"tdms"``, ``"hdf5"``, ``"mat"`` (v4-v7), ``"mat73"`` (HDF5 based), ``"csv"`` or
+    ``"binary"`` (unknown binary), from the content alone."""
+    with open(path, "rb") as fh:
+        head = fh.read(1024)
+    if head.startswith(b"TDSm"):
+        return "tdms"
+    if head.startswith(HDF5_SIGNATURE):
+        return "hdf5"
+    if head.startswith(b"MATLAB 7.3 MAT-file") and head[512:520] == HDF5_SIGNATURE:
+        return "mat73"
+    if head.startswith(b"MATLAB 5.0 MAT-file"):
+        return "mat"
+    if b"\x00" in head:
+        return "binary"
+    try:
+        head.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        # A cut multi-byte character at the end of the block is fine.
+        if exc.start < len(head) - 4:
+            try:
+                head.decode("latin-1")
+            except UnicodeDecodeError:  # pragma: no cover - latin-1 decodes any byte
+                return "binary"
+    return "csv"
+
+
+def format_of(path: Path, fmt: str | None = None) -> str:
+    """The format to read ``path`` with: from its extension (or ``fmt``), verified by content."""
+    if not path.exists():
+        raise RecordingError("no such file", file=str(path))
+    if path.is_dir():
+        raise RecordingError("is a directory, not a recording file", file=str(path))
+    if fmt is None:
+        fmt = EXTENSIONS.get(path.suffix.lower())
+        if fmt is None:
+            raise RecordingError(
+                f"unknown extension {path.suffix!r}; supported: {sorted(EXTENSIONS)}",
+                file=str(path),
+            )
+    content = content_format(path)
+    ok = {
+        "csv": ("csv",),
+        "tdms": ("tdms",),
+        "hdf5": ("hdf5", "mat73"),
+        "mat": ("mat", "mat73"),
+    }[fmt]
+    if content not in ok:
+        found = {"mat73": "a MATLAB v7.3 (HDF5)", "binary": "an unknown binary"}.get(
+            content, NAMES.get(content, content)
+        )
+        raise RecordingError(
+            f"the extension says {NAMES[fmt]} file but the content is {found} file",
+            file=str(path),
+        )
+    return fmt

@@ -1,0 +1,119 @@
+"""Physical units of recorded channels and their conversion to SI.
+
+Column names may carry their unit, as test rigs write them: ``x [um]``, ``F (N)``, ``p [MPa]``,
+``t_ms``. :func:`split_name` separates name and unit; :func:`to_si` gives the factor to SI and
+the dimension, so a channel in the wrong kind of unit (a force in mm) is caught.
+"""
+
+from __future__ import annotations
+
+import re
+
+from ..errors import InputError
+
+# dimension -> SI unit
+SI_UNITS = {"time": "s", "length": "m", "force": "N", "pressure": "Pa"}
+
+_MU = ("u", "µ", "μ")  # ASCII u, micro sign U+00B5, Greek mu U+03BC
+
+_TABLE: dict[str, tuple[float, str]] = {}
+
+
+def _add(dim: str, names: tuple[str, ...], factor: float) -> None:
+    for n in names:
+        _TABLE[n] = (factor, dim)
+
+
+_add("time", ("s", "sec", "second", "seconds"), 1.0)
+_add("time", ("ms", "msec", "millisecond", "milliseconds"), 1e-3)
+_add("time", (*tuple(m + "s" for m in _MU), "usec", "microsecond", "microseconds"), 1e-6)
+_add("time", ("ns",), 1e-9)
+_add("time", ("min",), 60.0)
+_add("length", ("m", "meter", "metre"), 1.0)
+_add("length", ("mm", "millimeter", "millimetre"), 1e-3)
+_add("length", (*tuple(m + "m" for m in _MU), "micron", "microns", "micrometer"), 1e-6)
+_add("length", ("nm", "nanometer", "nanometre"), 1e-9)
+_add("force", ("n", "newton", "newtons"), 1.0)
+_add("force", ("mn",), 1e-3)
+_add("force", ("kn", "kilonewton"), 1e3)
+_add("pressure", ("pa", "n/m2", "n/m^2", "n/m²"), 1.0)
+_add("pressure", ("kpa",), 1e3)
+_add("pressure", ("mpa", "n/mm2", "n/mm^2", "n/mm²"), 1e6)
+_add("pressure", ("gpa",), 1e9)
+_add("pressure", ("bar",), 1e5)
+
+# Case matters only where it changes the meaning: "mN" (millinewton) vs "MN" is not supported,
+# "Pa"/"pa" are the same; "m" is metre (minute is "min").
+
+
+class UnknownUnitError(InputError):
+    """A unit string that contactlab does not know."""
+
+
+def known_units() -> list[str]:
+    """Every unit string accepted (case-insensitive)."""
+    return sorted(_TABLE)
+
+
+def normalize(unit: str) -> str:
+    return unit.strip().replace(" ", "").lower()
+
+
+def lookup(unit: str) -> tuple[float, str] | None:
+    """``(factor to SI, dimension)`` of ``unit``, or None when it is not known."""
+    return _TABLE.get(normalize(unit))
+
+
+def to_si(unit: str, *, where: str = "") -> tuple[float, str]:
+    """Factor that converts values in ``unit`` to SI, and the unit's dimension.
+
+    Raises
+    ------
+    UnknownUnitError
+        Naming the unit and ``where`` it was found.
+
+    Examples
+    --------
+    >>> to_si("um")
+    (1e-06, 'length')
+    >>> to_si("MPa")
+    (1000000.0, 'pressure')
+    """
+    hit = lookup(unit)
+    if hit is None:
+        loc = f" in {where}" if where else ""
+        raise UnknownUnitError(
+            f"unknown unit {unit!r}{loc}; known units: s, ms, us, m, mm, um, nm, N, mN, kN, "
+            "Pa, kPa, MPa, GPa, bar, N/mm2"
+        )
+    return hit
+
+
+_BRACKET = re.compile(r"^\s*(?P<name>.*?)\s*[\[(](?P<unit>[^\])]*)[\])]\s*$")
+_SLASH = re.compile(r"^\s*(?P<name>[^/]+?)\s*/\s*(?P<unit>[A-Za-zµμ][A-Za-z0-9µμ/^²]*)\s*$")
+_SUFFIX = re.compile(r"^(?P<name>.+?)_(?P<unit>[A-Za-zµμ]+)$")
+
+
+def split_name(column: str) -> tuple[str, str | None]:
+    """Split ``"x [um]"``, ``"x (um)"``, ``"x / um"`` or ``"x_um"`` into ``("x", "um")``.
+
+    A bracketed unit is returned even when unknown (so that it can be reported); the slash and
+    underscore forms are recognised only with a known unit (``"F_tan"`` stays a plain name).
+
+    Examples
+    --------
+    >>> split_name("t [ms]")
+    ('t', 'ms')
+    >>> split_name("force")
+    ('force', None)
+    >>> split_name("x_um")
+    ('x', 'um')
+    """
+    m = _BRACKET.match(column)
+    if m and m.group("name"):
+        return m.group("name"), m.group("unit").strip()
+    for rx in (_SLASH, _SUFFIX):
+        m = rx.match(column)
+        if m and lookup(m.group("unit")) is not None:
+            return m.group("name").strip(), m.group("unit")
+    return column.strip(), None

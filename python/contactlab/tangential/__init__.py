@@ -1,0 +1,27 @@
+"""Tangential contact recordings ``(t, x, F)``: reversal detection, period averaging,
+Masing fits with honest uncertainty and identifiability, derived quantities and plots.
+
+Implements the analysis of *Experimental investigation of tangential contact stiffness and
+equivalent damping* with the corrected formulas of PHYSICS.md §1.
+"""
+
+from __future__ import annotations
+
+from .analysis import UNITS, TangentialAnalysis, analyze_tangential
+from .plots import plot_loop, plot_residuals
+from .preprocess import AveragedLoop, CycleScatter, Reversals, average_loop, find_reversals
+from .synthetic import synthetic_recording
+
+__all__ = [
+    "UNITS",
+    "AveragedLoop",
+    "CycleScatter",
+    "Reversals",
+    "TangentialAnalysis",
+    "analyze_tangential",
+    "average_loop",
+    "find_reversals",
+    "plot_loop",
+    "plot_residuals",
+    "synthetic_recording",
+]

@@ -1,0 +1,590 @@
+"""Analysis of a tangential recording: average, fit ``h0, ac`` through the Rust Masing operator,
+derive energy, damping and stiffness with propagated uncertainty, and say what is identified.
+
+Implements the procedure of *Experimental investigation of tangential contact stiffness and
+equivalent damping* (loops averaged over periods, eq. 1/6 fitted), with PHYSICS.md §1's
+corrected energy ``E(A)``, equivalent damping ``c_e·ω = E / (π A²)`` (eq. 17), local stiffness
+``f'(x)`` (eq. 18) and global stiffness ``f(A)/A`` (eq. 19).
+
+Fitting is done in the parameters ``(k0 = h0·ac, ac, offset[, x0])``: ``k0``, the initial
+stiffness, is what a small loop determines; ``ac`` is determined only by the loop's curvature.
+The covariance is transformed to ``(h0, ac)`` for reporting. When the relative standard errors
+of ``h0`` or ``ac`` exceed ``max_rel_stderr`` (the paper's steel case: amplitude ≪ 1/ac, the
+loop is nearly a straight line) the analysis reports them as not identifiable and gives
+``h0·ac`` with its error, plus a one-sided bound on each.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from .._arrays import as_1d
+from ..errors import ContactLabWarning, InputError
+from ..fitting import FitResult, Parameter, _num, least_squares_fit
+from ..io import Recording
+from ..masing import Masing, loop_area
+from .model import initial_guess, steady_loop_force, steady_signal_force, virgin_signal_force
+from .preprocess import AveragedLoop, CycleScatter, average_loop, find_reversals, monotone_path
+
+#: SI units of every reported quantity
+UNITS = {
+    "h0": "N",
+    "ac": "1/m",
+    "h0_ac": "N/m",
+    "offset": "N",
+    "x0": "m",
+    "amplitude": "m",
+    "energy_per_cycle": "J",
+    "energy_per_cycle_numeric": "J",
+    "equivalent_damping": "N/m",
+    "equivalent_damping_numeric": "N/m",
+    "k_local0": "N/m",
+    "k_local_amplitude": "N/m",
+    "k_global": "N/m",
+    "h0_lower_bound": "N",
+    "ac_upper_bound": "1/m",
+    "peak_force": "N",
+}
+
+#: ``ac·A`` above which the loop is taken to have reached gross sliding (branch slope at the
+#: turn below e^-3 = 5 % of the initial stiffness: the force has plateaued near ±h0)
+GROSS_SLIDING_Z = 3.0
+#: loop area / (4 A × half force range) above which a loop counts as nearly rectangular
+GROSS_SLIDING_AREA_RATIO = 0.6
+
+
+@dataclass
+class TangentialAnalysis:
+    """Result of :func:`analyze_tangential`.
+
+    Attributes
+    ----------
+    fit : FitResult
+        Parameters ``h0``, ``ac``, ``offset`` (and ``x0`` when fitted) with standard errors,
+        covariance and correlations, χ², AIC/BIC.
+    model : Masing
+        The best-fit model (when ``identifiable`` is False it reproduces the loop at this
+        amplitude but its ``h0`` and ``ac`` are not individually meaningful).
+    amplitude, amplitude_stderr : float
+        Displacement amplitude (half the averaged loop's x range) and its error from the
+        cycle-to-cycle scatter.
+    loop : AveragedLoop or None
+        The period-averaged loop (None when the recording has fewer than 2 cycles and the fit
+        was on the signal).
+    scatter : CycleScatter or None
+        Per-cycle amplitude, force range, energy and period.
+    identifiable : bool
+        Whether ``h0`` and ``ac`` are separately determined.
+    identifiability : dict
+        The evidence: relative errors, correlation, ``ac·A``, Jacobian condition, message.
+    derived : dict
+        ``name -> (value, stderr)`` for the derived quantities (see :data:`UNITS`).
+    warnings : list of str
+        Everything a user should know (also issued as :class:`ContactLabWarning`).
+    x, F, F_model, weights : ndarray
+        The data the fit saw (averaged bins or the signal's samples), the model at the optimum
+        and the residual weights.
+    """
+
+    fit: FitResult
+    model: Masing
+    amplitude: float
+    amplitude_stderr: float
+    loop: AveragedLoop | None
+    scatter: CycleScatter | None
+    identifiable: bool
+    identifiability: dict[str, Any]
+    derived: dict[str, tuple[float, float]]
+    warnings: list[str]
+    on: str
+    history: str
+    x: np.ndarray
+    F: np.ndarray
+    F_model: np.ndarray
+    weights: np.ndarray
+    t: np.ndarray | None = None
+    source: str = "<arrays>"
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def residual(self) -> np.ndarray:
+        """Data minus model (N), unweighted."""
+        return self.F - self.F_model
+
+    def value(self, name: str) -> float:
+        return self.to_dict()[name]
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-safe summary: SI values, ``*_stderr``, a ``units`` map and the fit.
+
+        When ``h0`` and ``ac`` are not identifiable their values are None (not arbitrary
+        numbers); ``h0_ac`` (always present) carries what the data determine.
+        """
+        p = self.fit.params
+        ident = self.identifiable
+        out: dict[str, Any] = {
+            "source": self.source,
+            "on": self.on,
+            "history": self.history,
+            "h0": _num(p["h0"].value) if ident else None,
+            "h0_stderr": _num(p["h0"].stderr) if ident else None,
+            "ac": _num(p["ac"].value) if ident else None,
+            "ac_stderr": _num(p["ac"].stderr) if ident else None,
+            "offset": _num(p["offset"].value),
+            "offset_stderr": _num(p["offset"].stderr),
+        }
+        if "x0" in p:
+            out["x0"] = _num(p["x0"].value)
+            out["x0_stderr"] = _num(p["x0"].stderr)
+        out["amplitude"] = _num(self.amplitude)
+        out["amplitude_stderr"] = _num(self.amplitude_stderr)
+        for k, (v, e) in self.derived.items():
+            out[k] = _num(v)
+            out[f"{k}_stderr"] = _num(e)
+        out["identifiable"] = {
+            k: (_num(v) if isinstance(v, float) else v) for k, v in self.identifiability.items()
+        }
+        out["n_cycles"] = None if self.scatter is None else self.scatter.n_cycles
+        out["warnings"] = list(self.warnings)
+        out["fit"] = self.fit.to_dict()
+        out["units"] = {k: u for k, u in UNITS.items() if k in out}
+        for k in list(out["units"]):
+            if f"{k}_stderr" in out:
+                out["units"][f"{k}_stderr"] = UNITS[k]
+        return out
+
+    def report(self) -> str:
+        """Human-readable summary: fit report, identifiability and derived quantities."""
+        lines = [f"Tangential analysis of {self.source} (fit on {self.on}, {self.history})"]
+        lines.append(self.fit.report())
+        lines.append("[[Identifiability]]")
+        lines.append(f"    {self.identifiability['message']}")
+        lines.append("[[Derived quantities]]")
+        lines.append(f"    amplitude = {self.amplitude:.6g} +/- {self.amplitude_stderr:.3g} m")
+        for k, (v, e) in self.derived.items():
+            lines.append(f"    {k} = {v:.6g} +/- {e:.3g} {UNITS.get(k, '')}")
+        if self.warnings:
+            lines.append("[[Warnings]]")
+            lines += [f"    {w}" for w in self.warnings]
+        return "\n".join(lines)
+
+
+def _inputs(
+    recording: Recording | None, t: Any, x: Any, F: Any
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, str]:
+    if recording is not None:
+        if any(v is not None for v in (t, x, F)):
+            raise InputError("give either a recording or t/x/F arrays, not both")
+        if not isinstance(recording, Recording):
+            raise InputError(f"expected a contactlab.io.Recording, got {type(recording).__name__}")
+        for ch in ("x", "F"):
+            if ch not in recording.data:
+                raise InputError(
+                    f"{recording.source}: no {ch!r} channel; a tangential recording needs x "
+                    f"and F (channels: {sorted(recording.data)})"
+                )
+        return recording["x"], recording["F"], recording.t, recording.source
+    if x is None or F is None:
+        raise InputError("give a recording, or the arrays x (m) and F (N)")
+    xa = as_1d(x, "x")
+    Fa = as_1d(F, "F")
+    if xa.size != Fa.size:
+        raise InputError(f"x has {xa.size} samples but F has {Fa.size}")
+    ta = None
+    if t is not None:
+        ta = as_1d(t, "t")
+        if ta.size != xa.size:
+            raise InputError(f"t has {ta.size} samples but x has {xa.size}")
+        if np.any(np.diff(ta) <= 0):
+            i = int(np.argmax(np.diff(ta) <= 0)) + 1
+            raise InputError(f"t[{i}] = {ta[i]} does not increase")
+    return xa, Fa, ta, "<arrays>"
+
+
+def _propagate_fit(
+    fit: FitResult,
+    fn: Any,
+    amplitude: float,
+    amplitude_stderr: float,
+) -> tuple[float, float]:
+    """Value and error of ``fn(values, A)``: fit covariance plus the amplitude's error."""
+    val, err = fit.propagate(lambda v: fn(v, amplitude))
+    if amplitude_stderr > 0 and np.isfinite(amplitude_stderr):
+        h = 1e-6 * amplitude
+        d = (fn(fit.values, amplitude + h) - fn(fit.values, amplitude - h)) / (2 * h)
+        err = math.sqrt(err**2 + (d * amplitude_stderr) ** 2)
+    return float(val), float(err)
+
+
+def _model(v: dict[str, float]) -> Masing:
+    return Masing(v["k0"] / v["ac"], v["ac"])
+
+
+def analyze_tangential(
+    recording: Recording | None = None,
+    *,
+    t: Any = None,
+    x: Any = None,
+    F: Any = None,
+    on: str = "averaged",
+    history: str = "steady",
+    fit_offset: bool = True,
+    fit_x0: bool | None = None,
+    n_points: int | None = None,
+    rel_threshold: float = 0.5,
+    min_cycles: int = 2,
+    max_rel_stderr: float = 1.0 / 3.0,
+    fit_amplitude: bool = True,
+    initial: dict[str, float] | None = None,
+    warn: bool = True,
+) -> TangentialAnalysis:
+    """Fit the Masing model to a tangential recording and derive the paper's quantities.
+
+    Parameters
+    ----------
+    recording : Recording, optional
+        With channels ``x`` (m) and ``F`` (N); or pass ``x``, ``F`` (and ``t``) directly.
+    on : {"averaged", "signal"}
+        Fit the period-averaged loop (the paper's way; noise averaged out, one cycle of
+        bins) or every sample of the signal.
+    history : {"steady", "virgin"}
+        For ``on="signal"``: the recording is in the steady state of its outer loop (the fit
+        then starts at the first reversal), or it starts at rest on the virgin curve.
+    fit_offset : bool
+        Fit a force offset (load-cell zero / loop centre). Otherwise it is 0.
+    fit_x0 : bool, optional (default True)
+        Fit the branch shift ``x0`` (the paper's eq. 1): on a steady loop the centre of the
+        turning points ``x0 ± A``, for ``history="virgin"`` the displacement at rest.
+    fit_amplitude : bool, default True
+        On a steady loop, fit the turning points' half distance ``A`` instead of taking the
+        extremes of noisy data (which overestimate it and bias ``h0``, ``ac``).
+    n_points : int, optional
+        Phase bins of the averaged loop (default: samples per cycle, 16..400).
+    rel_threshold : float
+        Reversal band as a fraction of the amplitude (see ``find_reversals``).
+    min_cycles : int
+        Minimum number of complete cycles for averaging.
+    max_rel_stderr : float, default 1/3
+        ``h0`` and ``ac`` count as identified only when both relative standard errors are
+        below this (3σ from zero).
+    initial : dict, optional
+        Starting values ``{"h0": ..., "ac": ...}`` (default: from the loop's size and area).
+    warn : bool
+        Issue :class:`ContactLabWarning` for each warning (they are kept in ``.warnings``
+        either way).
+
+    Returns
+    -------
+    TangentialAnalysis
+
+    Examples
+    --------
+    >>> from contactlab.tangential import synthetic_recording
+    >>> rec = synthetic_recording(h0=20.0, ac=1e5, amplitude=10e-6, n_cycles=5, seed=0)
+    >>> res = analyze_tangential(rec)
+    >>> res.identifiable, abs(res.fit.params["h0"].value - 20) < 3 * res.fit.params["h0"].stderr
+    (True, True)
+    """
+    xa, Fa, ta, source = _inputs(recording, t, x, F)
+    if on not in ("averaged", "signal"):
+        raise InputError(f"on must be 'averaged' or 'signal', got {on!r}")
+    if history not in ("steady", "virgin"):
+        raise InputError(f"history must be 'steady' or 'virgin', got {history!r}")
+    if on == "averaged" and history == "virgin":
+        raise InputError("history='virgin' applies to on='signal'; an averaged loop is steady")
+    steady = history == "steady"
+    if fit_x0 is None:
+        fit_x0 = True
+    if n_points is not None and (n_points < 8 or n_points % 2):
+        raise InputError(f"n_points must be even and >= 8, got {n_points}")
+    loop: AveragedLoop | None = None
+    try:
+        loop = average_loop(
+            xa, Fa, ta, n_points=n_points, rel_threshold=rel_threshold, min_cycles=min_cycles
+        )
+    except InputError:
+        if on == "averaged":
+            raise
+    scatter = loop.scatter if loop is not None else None
+
+    # -- data the fit sees --------------------------------------------------------------
+    if on == "averaged":
+        assert loop is not None
+        xd, Fd, w = loop.x, loop.F, np.sqrt(loop.count)
+        td = None
+        start = 0
+        h = xd.size // 2
+        xpath = monotone_path(xd, np.array([h]))
+        rev = loop.reversals
+    else:
+        rev = (
+            loop.reversals
+            if loop is not None
+            else find_reversals(xa, ta, rel_threshold=rel_threshold)
+        )
+        if rev.peaks.size + rev.valleys.size == 0:
+            raise InputError("no reversal found in x: the recording holds no loop")
+        start = rev.first if steady else 0
+        xd, Fd, td = xa, Fa, ta
+        w = np.ones(xa.size)
+        xpath = monotone_path(xa, rev.turns)
+    lo_x, hi_x = float(np.min(xpath[start:])), float(np.max(xpath[start:]))
+    amplitude0 = 0.5 * (hi_x - lo_x)
+    centre0 = 0.5 * (hi_x + lo_x)
+    if not amplitude0 > 0:
+        raise InputError("the displacement does not move: amplitude is 0")
+
+    # -- starting values ------------------------------------------------------------------
+    if loop is not None:
+        hm0 = 0.5 * float(loop.F.max() - loop.F.min())
+        e0 = loop_area(loop.x, loop.F)
+        off0 = 0.5 * float(loop.F.max() + loop.F.min())
+    else:
+        hm0 = 0.5 * float(np.ptp(Fa))
+        e0 = 0.0
+        off0 = float(np.mean(Fa))
+    h0_init, ac_init = initial_guess(amplitude0, hm0, e0)
+    if initial:
+        h0_init = float(initial.get("h0", h0_init))
+        ac_init = float(initial.get("ac", ac_init))
+    if not (h0_init > 0 and ac_init > 0):
+        raise InputError(f"initial h0, ac must be > 0, got {h0_init}, {ac_init}")
+    params = [
+        Parameter("k0", h0_init * ac_init, min=1e-9 * h0_init * ac_init, unit="N/m"),
+        Parameter("ac", ac_init, min=1e-9 * ac_init, unit="1/m"),
+        Parameter("offset", off0 if fit_offset else 0.0, vary=fit_offset, unit="N"),
+    ]
+    if steady:
+        params.append(Parameter("x0", centre0, vary=fit_x0, unit="m"))
+        params.append(
+            Parameter(
+                "amplitude",
+                amplitude0,
+                vary=fit_amplitude,
+                min=0.5 * amplitude0,
+                max=1.5 * amplitude0,
+                unit="m",
+            )
+        )
+    else:
+        params.append(Parameter("x0", float(xa[0]), vary=fit_x0, unit="m"))
+
+    sl = slice(start, None)
+    peaks, valleys, first_is_peak = rev.peaks, rev.valleys, rev.first_is_peak
+
+    def predict(v: dict[str, float]) -> np.ndarray:
+        m = _model(v)
+        if on == "averaged":
+            Fm = steady_loop_force(m, xpath, v["x0"], v["amplitude"])
+        elif steady:
+            Fm = steady_signal_force(
+                m, xpath, v["x0"], v["amplitude"], peaks, valleys, first_is_peak
+            )
+        else:
+            Fm = virgin_signal_force(m, xpath, v["x0"])
+        return Fm + v["offset"]
+
+    def residual(v: dict[str, float]) -> np.ndarray:
+        return (predict(v)[sl] - Fd[sl]) * w[sl]
+
+    raw = least_squares_fit(residual, params)
+    fit = _reparametrize(raw)
+    vals = raw.values
+    model = _model(vals)
+    F_model = predict(vals)
+    if steady and fit_amplitude:
+        amplitude = float(vals["amplitude"])
+        amplitude_stderr = float(raw.params["amplitude"].stderr or math.nan)
+        a_extra = 0.0  # its error is in the covariance already
+    else:
+        amplitude = float(vals["amplitude"]) if steady else amplitude0
+        if scatter is not None and scatter.n_cycles > 1:
+            amplitude_stderr = float(
+                np.std(scatter.amplitude, ddof=1) / math.sqrt(scatter.n_cycles)
+            )
+        else:
+            amplitude_stderr = 0.0
+        a_extra = amplitude_stderr
+
+    # -- identifiability ------------------------------------------------------------------
+    ph0, pac = fit.params["h0"], fit.params["ac"]
+    rel_h0 = ph0.rel_stderr if ph0.stderr is not None else math.inf
+    rel_ac = pac.rel_stderr if pac.stderr is not None else math.inf
+    k0 = raw.params["k0"]
+    rel_k0 = k0.rel_stderr if k0.stderr is not None else math.inf
+    corr = _correl(fit, "h0", "ac")
+    z = pac.value * amplitude
+    at_bound = pac.value <= raw.params["ac"].min * 1.0001
+    identifiable = bool(rel_h0 < max_rel_stderr and rel_ac < max_rel_stderr and not at_bound)
+    ac_up = pac.value + 2 * pac.stderr if pac.stderr is not None else math.inf
+    h0_lo = k0.value / ac_up if math.isfinite(ac_up) and ac_up > 0 else 0.0
+    if identifiable:
+        msg = (
+            f"h0 and ac are identified (relative errors {100 * rel_h0:.1f}% and "
+            f"{100 * rel_ac:.1f}%, correlation {corr:+.3f}, ac·A = {z:.3g})"
+        )
+    else:
+        msg = (
+            f"h0 and ac are NOT separately identifiable from this loop: ac·A = {z:.3g} "
+            f"(the loop is {'nearly linear, a pure stiffness' if z < 0.5 else 'too noisy'}); "
+            f"relative errors h0 {100 * rel_h0:.0f}%, ac {100 * rel_ac:.0f}%, correlation "
+            f"{corr:+.3f}. Identified: h0·ac = {k0.value:.6g} ± {k0.stderr or math.nan:.3g} N/m"
+            f" ({100 * rel_k0:.2f}%); ac < {ac_up:.3g} 1/m and h0 > {h0_lo:.3g} N (2σ)."
+        )
+        for p in (ph0, pac):
+            p.identifiable = False
+            p.note = "not separately identifiable: only h0·ac is (see identifiability)"
+    identifiability = {
+        "h0": identifiable,
+        "ac": identifiable,
+        "h0_ac": bool(rel_k0 < max_rel_stderr),
+        "rel_stderr_h0": float(rel_h0),
+        "rel_stderr_ac": float(rel_ac),
+        "rel_stderr_h0_ac": float(rel_k0),
+        "correlation_h0_ac": float(corr),
+        "ac_times_amplitude": float(z),
+        "condition": float(raw.condition),
+        "max_rel_stderr": float(max_rel_stderr),
+        "message": msg,
+    }
+
+    # -- derived quantities ---------------------------------------------------------------
+    def energy(v: dict[str, float], A: float) -> float:
+        return float(_model(v).loop_energy(A))
+
+    def _propagate(fn: Any) -> tuple[float, float]:
+        # the amplitude comes from the fit (with its covariance) when it was fitted
+        if steady and fit_amplitude:
+            return _propagate_fit(raw, lambda v, _A: fn(v, v["amplitude"]), amplitude, 0.0)
+        return _propagate_fit(raw, fn, amplitude, a_extra)
+
+    derived: dict[str, tuple[float, float]] = {}
+    derived["h0_ac"] = (float(k0.value), float(k0.stderr) if k0.stderr is not None else math.nan)
+    derived["energy_per_cycle"] = _propagate(energy)
+    derived["equivalent_damping"] = _propagate(lambda v, A: energy(v, A) / (math.pi * A * A))
+    derived["k_local0"] = derived["h0_ac"]
+    derived["k_local_amplitude"] = _propagate(lambda v, A: float(_model(v).local_stiffness(A)))
+    derived["k_global"] = _propagate(lambda v, A: float(_model(v).global_stiffness(A)))
+    derived["peak_force"] = _propagate(lambda v, A: float(_model(v).virgin(A)))
+    if loop is not None:
+        e_num = loop_area(loop.x, loop.F)
+        e_sem = (
+            float(np.std(scatter.energy, ddof=1) / math.sqrt(scatter.n_cycles))
+            if scatter is not None and scatter.n_cycles > 1
+            else math.nan
+        )
+    else:
+        e_num = loop_area(xa[start:], Fa[start:])
+        e_sem = math.nan
+    derived["energy_per_cycle_numeric"] = (float(e_num), e_sem)
+    a2 = math.pi * amplitude**2
+    derived["equivalent_damping_numeric"] = (float(e_num / a2), e_sem / a2)
+    if not identifiable:
+        derived["h0_lower_bound"] = (float(h0_lo), math.nan)
+        derived["ac_upper_bound"] = (float(ac_up), math.nan)
+
+    # -- warnings -------------------------------------------------------------------------
+    warns: list[str] = list(raw.notes)
+    hm_data = 0.5 * float(np.ptp(loop.F if loop is not None else Fa))
+    ratio = e_num / (4 * amplitude * hm_data) if hm_data > 0 else 0.0
+    if (identifiable and z > GROSS_SLIDING_Z) or ratio > GROSS_SLIDING_AREA_RATIO:
+        warns.append(
+            f"amplitude {amplitude:.3g} m leaves the pre-sliding regime (gross sliding): "
+            f"ac·A = {z:.3g}, loop area is {100 * ratio:.0f}% of the rectangle 4·A·h_m, the "
+            f"force plateaus near ±h0; the pre-sliding model and its ac describe the loop poorly"
+        )
+    if not identifiable:
+        warns.append(msg)
+    if not raw.success:
+        warns.append(f"the fit did not converge: {raw.message}")
+    if loop is not None and on == "averaged" and loop.n_cycles > 2:
+        # Is the misfit larger than the cycle-to-cycle noise explains?
+        per_cycle = loop.count / loop.n_cycles
+        noise_var = float(np.nanmean(loop.F_std**2 * per_cycle))
+        if noise_var > 0 and raw.redchi > 4.0 * noise_var:
+            warns.append(
+                f"the residuals are {math.sqrt(raw.redchi / noise_var):.1f}× the cycle-to-cycle "
+                "noise: the exponential Masing model misses systematic features of this loop"
+            )
+    if warn:
+        for wtxt in warns:
+            warnings.warn(wtxt, ContactLabWarning, stacklevel=2)
+
+    return TangentialAnalysis(
+        fit=fit,
+        model=model,
+        amplitude=float(amplitude),
+        amplitude_stderr=amplitude_stderr,
+        loop=loop,
+        scatter=scatter,
+        identifiable=identifiable,
+        identifiability=identifiability,
+        derived=derived,
+        warnings=warns,
+        on=on,
+        history=history,
+        x=np.asarray(xd),
+        F=np.asarray(Fd),
+        F_model=F_model,
+        weights=w,
+        t=td,
+        source=source,
+        meta={"fit_start": start},
+    )
+
+
+def _correl(fit: FitResult, a: str, b: str) -> float:
+    if fit.correl is None or a not in fit.var_names or b not in fit.var_names:
+        return math.nan
+    return float(fit.correl[fit.var_names.index(a), fit.var_names.index(b)])
+
+
+def _reparametrize(raw: FitResult) -> FitResult:
+    """``(k0, ac, ...)`` → ``(h0, ac, ...)`` with the covariance transformed to first order."""
+    k0, ac = raw.params["k0"].value, raw.params["ac"].value
+    h0 = k0 / ac
+    params: dict[str, Parameter] = {}
+    pk = raw.params["k0"]
+    params["h0"] = Parameter(
+        "h0",
+        h0,
+        vary=True,
+        min=0.0,
+        unit="N",
+        init_value=(pk.init_value / raw.params["ac"].init_value)
+        if pk.init_value and raw.params["ac"].init_value
+        else None,
+    )
+    for name, p in raw.params.items():
+        if name != "k0":
+            params[name] = replace(p)
+    names = ["h0" if n == "k0" else n for n in raw.var_names]
+    covar = correl = None
+    if raw.covar is not None:
+        T = np.eye(len(names))
+        i_k, i_a = raw.var_names.index("k0"), raw.var_names.index("ac")
+        # h0 = k0 / ac
+        T[i_k, i_k] = 1.0 / ac
+        T[i_k, i_a] = -k0 / ac**2
+        covar = T @ raw.covar @ T.T
+        d = np.sqrt(np.clip(np.diag(covar), 0.0, None))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            correl = covar / np.outer(d, d)
+        correl[~np.isfinite(correl)] = 0.0
+        np.fill_diagonal(correl, 1.0)
+        for i, n in enumerate(names):
+            src = raw.params["k0" if n == "h0" else n]
+            if src.stderr is None and src.identifiable is False:
+                params[n].stderr = None
+                params[n].identifiable = False
+            else:
+                params[n].stderr = float(d[i])
+                params[n].identifiable = True
+    out = replace(raw, params=params, var_names=names, covar=covar, correl=correl, jac=None)
+    out.notes = [n.replace("k0", "h0·ac") for n in raw.notes]
+    return out

@@ -1,0 +1,282 @@
+"""contactlab.io: readers and writers for CSV, TDMS, HDF5 and MAT, units and bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from contactlab import InputError
+from contactlab.io import (
+    Recording,
+    RecordingError,
+    UnknownUnitError,
+    read_recording,
+    split_name,
+    to_si,
+    write_recording,
+)
+
+FORMATS = ["csv", "txt", "tdms", "h5", "hdf5", "mat", "mat73"]
+
+
+def _rec(n=500, fs=1000.0):
+    t = np.arange(n) / fs
+    x = 5e-6 * np.sin(2 * np.pi * 3 * t)
+    F = 2.0 * np.cos(2 * np.pi * 3 * t) + 0.1
+    return Recording(t, {"x": x, "F": F}, {"x": "m", "F": "N"}, source="test")
+
+
+def _path(tmp_path, fmt):
+    return tmp_path / ("r.mat" if fmt == "mat73" else f"r.{fmt}")
+
+
+def _write(tmp_path, fmt, rec):
+    p = _path(tmp_path, fmt)
+    write_recording(p, rec, **({"version": "7.3"} if fmt == "mat73" else {}))
+    return p
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_round_trip_every_format(tmp_path, fmt):
+    rec = _rec()
+    p = _write(tmp_path, fmt, rec)
+    back = read_recording(p)
+    assert back.kind == "tangential"
+    np.testing.assert_allclose(back.t, rec.t, rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(back["x"], rec["x"])
+    np.testing.assert_array_equal(back["F"], rec["F"])
+    assert back.units == {"x": "m", "F": "N"}
+    assert back.source == str(p)
+    assert not list(tmp_path.glob("*.part"))
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_normal_recording_round_trip(tmp_path, fmt):
+    t = np.arange(200) / 100.0
+    rec = Recording(
+        t,
+        {"p": 5e5 + 4e5 * np.sin(t), "delta": 1e-6 * np.sin(t - 0.1)},
+        {"p": "Pa", "delta": "m"},
+    )
+    back = read_recording(_write(tmp_path, fmt, rec))
+    assert back.kind == "normal"
+    np.testing.assert_array_equal(back["p"], rec["p"])
+    np.testing.assert_array_equal(back["delta"], rec["delta"])
+
+
+def test_csv_units_in_brackets_are_converted(tmp_path):
+    p = tmp_path / "run.csv"
+    p.write_text("# rig 3, W = 109 N\nt [ms];x [um];F [kN]\n0;1.5;0.002\n1;2.5;0.003\n2;3;0.001\n")
+    rec = read_recording(p)
+    np.testing.assert_allclose(rec.t, [0, 1e-3, 2e-3])
+    np.testing.assert_allclose(rec["x"], [1.5e-6, 2.5e-6, 3e-6])
+    np.testing.assert_allclose(rec["F"], [2.0, 3.0, 1.0])
+    assert rec.meta["comments"] == ["rig 3, W = 109 N"]
+    assert rec.meta["file_units"] == {"t": "ms", "x": "um", "F": "kN"}
+
+
+def test_csv_whitespace_and_pressure_units(tmp_path):
+    p = tmp_path / "normal.txt"
+    p.write_text("time [s]\tp [MPa]\tdelta [µm]\n0\t0.5\t0\n0.01\t0.6\t0.1\n0.02\t0.7\t0.2\n")
+    rec = read_recording(p)
+    assert rec.kind == "normal"
+    np.testing.assert_allclose(rec["p"], [5e5, 6e5, 7e5])
+    np.testing.assert_allclose(rec["delta"], [0, 1e-7, 2e-7])
+    p2 = tmp_path / "ws.dat"
+    p2.write_text("t [ms]   disp [mm]   force [N]\n0 1 2\n1 2 3\n")
+    rec2 = read_recording(p2)
+    np.testing.assert_allclose(rec2["x"], [1e-3, 2e-3])
+
+
+def test_column_mapping_and_sampling_rate(tmp_path):
+    p = tmp_path / "m.csv"
+    p.write_text("LVDT1 [um],load cell [N],other\n1,2,3\n2,3,4\n3,4,5\n")
+    with pytest.raises(RecordingError, match="cannot tell"):
+        read_recording(p)
+    with pytest.raises(RecordingError, match="fs="):
+        read_recording(p, columns={"x": "LVDT1", "F": "load cell [N]"})
+    rec = read_recording(p, columns={"x": "LVDT1", "F": "load cell [N]"}, fs=100.0)
+    np.testing.assert_allclose(rec.t, [0, 0.01, 0.02])
+    np.testing.assert_allclose(rec["x"], [1e-6, 2e-6, 3e-6])
+    assert rec.meta["columns"] == {"x": "LVDT1 [um]", "F": "load cell [N]"}
+
+
+def test_units_assumed_si_are_recorded(tmp_path):
+    p = tmp_path / "plain.csv"
+    p.write_text("t,x,F\n0,1e-6,1\n0.001,2e-6,2\n")
+    rec = read_recording(p)
+    assert sorted(rec.meta["units_assumed_si"]) == ["F", "t", "x"]
+
+
+def test_csv_reads_only_needed_columns(tmp_path):
+    # a junk text column that is not asked for does not break the read
+    p = tmp_path / "extra.csv"
+    p.write_text("t [s],note,x [m],F [N]\n0,start,0,0\n1,mid,1e-6,1\n2,end,2e-6,2\n")
+    rec = read_recording(p)
+    assert set(rec.data) == {"x", "F"}
+
+
+@pytest.mark.parametrize(
+    ("text", "match", "column", "row"),
+    [
+        ("t [s],x [m],F [N]\n0,0,0\n1,abc,1\n2,0,0\n", "'abc' is not a number", "x [m]", 3),
+        ("t [s],x [m],F [N]\n0,0,0\n1,,1\n2,0,0\n", "'' is not a number", "x [m]", 3),
+        ("t [s],x [furlong],F [N]\n0,0,0\n1,1,1\n", "unknown unit 'furlong'", "x [furlong]", None),
+        ("t [s],x [N],F [N]\n0,0,0\n1,1,1\n", "is a force unit", "x [N]", None),
+        ("t [s],x [m],F [N]\n0,0,0\n2,1,1\n1,1,1\n", "unsorted", "t [s]", 4),
+        ("t [s],x [m],F [N]\n0,0,0\n1,1,1\n1,1,1\n", "duplicated", "t [s]", 4),
+        ("t [s],x [m],F [N]\n0,0,0\n1,1,1\n2,1,1\n5,1,1\n6,0,0\n", "gap in time", "t [s]", 5),
+        ("t [s],x [m],Fz [N]\n0,0,0\n1,1,1\n", "no column for 'F'", "F", None),
+        ("t [s],x [m],F [N]\n0,0,0\n1,nan,1\n", "not a finite number", "x [m]", 3),
+    ],
+)
+def test_csv_errors_name_file_column_and_row(tmp_path, text, match, column, row):
+    p = tmp_path / "bad.csv"
+    p.write_text(text)
+    with pytest.raises(RecordingError, match=match) as info:
+        read_recording(p, kind="tangential")
+    err = info.value
+    assert str(p) in str(err)
+    assert err.file == str(p)
+    assert err.column == column
+    assert err.row == row
+    if row is not None:
+        assert f"row {row}" in str(err)
+    assert isinstance(err, InputError)
+
+
+def test_missing_explicit_column_is_named(tmp_path):
+    p = tmp_path / "r.csv"
+    write_recording(p, _rec(20))
+    with pytest.raises(RecordingError, match="'Fx'") as info:
+        read_recording(p, columns={"F": "Fx"})
+    assert info.value.column == "Fx"
+
+
+@pytest.mark.parametrize(
+    ("real", "claimed"),
+    [("h5", "csv"), ("csv", "tdms"), ("tdms", "h5"), ("csv", "mat"), ("mat", "h5")],
+)
+def test_wrong_content_for_extension(tmp_path, real, claimed):
+    src = tmp_path / f"a.{real}"
+    write_recording(src, _rec(20))
+    dst = tmp_path / f"b.{claimed}"
+    dst.write_bytes(src.read_bytes())
+    with pytest.raises(RecordingError, match="content is") as info:
+        read_recording(dst)
+    assert str(dst) in str(info.value)
+
+
+def test_missing_file_and_unknown_extension(tmp_path):
+    with pytest.raises(RecordingError, match="no such file"):
+        read_recording(tmp_path / "nope.csv")
+    p = tmp_path / "r.xyz"
+    p.write_text("t,x,F\n")
+    with pytest.raises(RecordingError, match="unknown extension"):
+        read_recording(p)
+    with pytest.raises(RecordingError, match="unknown extension"):
+        write_recording(tmp_path / "out.xyz", _rec(10))
+
+
+def test_tdms_unit_and_increment_from_properties(tmp_path):
+    nptdms = pytest.importorskip("nptdms")
+    p = tmp_path / "rig.tdms"
+    with nptdms.TdmsWriter(p) as w:
+        w.write_segment(
+            [
+                nptdms.GroupObject("Rig"),
+                nptdms.ChannelObject(
+                    "Rig",
+                    "displacement",
+                    np.array([1.0, 2.0, 3.0]),
+                    properties={"unit_string": "um", "wf_increment": 0.5e-3},
+                ),
+                nptdms.ChannelObject(
+                    "Rig", "force", np.array([0.1, 0.2, 0.3]), properties={"unit_string": "kN"}
+                ),
+            ]
+        )
+    rec = read_recording(p)
+    np.testing.assert_allclose(rec.t, [0, 5e-4, 1e-3])
+    np.testing.assert_allclose(rec["x"], [1e-6, 2e-6, 3e-6])
+    np.testing.assert_allclose(rec["F"], [100, 200, 300])
+    rec2 = read_recording(p, columns={"x": "Rig/displacement"}, fs=10.0)
+    np.testing.assert_allclose(rec2.t, [0, 0.1, 0.2])
+
+
+def test_hdf5_attributes_and_nested_datasets(tmp_path):
+    h5py = pytest.importorskip("h5py")
+    p = tmp_path / "rig.h5"
+    with h5py.File(p, "w") as f:
+        g = f.create_group("run1")
+        g.create_dataset("x", data=[1.0, 2.0, 4.0]).attrs["units"] = b"mm"
+        g.create_dataset("F", data=[1.0, 2.0, 3.0]).attrs["unit"] = "N"
+        f.attrs["fs"] = 2.0
+    rec = read_recording(p)
+    np.testing.assert_allclose(rec.t, [0, 0.5, 1.0])
+    np.testing.assert_allclose(rec["x"], [1e-3, 2e-3, 4e-3])
+    with h5py.File(p, "a") as f:
+        f["run1/x"].attrs["units"] = "parsec"
+    with pytest.raises(UnknownUnitError, match="parsec"):
+        read_recording(p)
+
+
+def test_mat_name_suffix_units_and_dt(tmp_path):
+    import scipy.io
+
+    p = tmp_path / "m.mat"
+    scipy.io.savemat(p, {"x_um": np.array([1.0, 2.0]), "F_N": np.array([3.0, 4.0]), "dt": 0.01})
+    rec = read_recording(p)
+    np.testing.assert_allclose(rec["x"], [1e-6, 2e-6])
+    np.testing.assert_allclose(rec.t, [0, 0.01])
+
+
+def test_recording_validation():
+    with pytest.raises(InputError, match="samples"):
+        Recording(np.arange(3.0), {"x": np.zeros(2)}, {"x": "m"})
+    with pytest.raises(InputError, match="no unit"):
+        Recording(np.arange(3.0), {"x": np.zeros(3)}, {})
+    rec = _rec(10)
+    with pytest.raises(KeyError, match="channels"):
+        rec["p"]
+    assert "x" in rec and "t" in rec and len(rec) == 10
+
+
+@pytest.mark.parametrize(
+    ("unit", "factor", "dim"),
+    [
+        ("s", 1, "time"),
+        ("ms", 1e-3, "time"),
+        ("us", 1e-6, "time"),
+        ("µs", 1e-6, "time"),
+        ("m", 1, "length"),
+        ("mm", 1e-3, "length"),
+        ("um", 1e-6, "length"),
+        ("μm", 1e-6, "length"),
+        ("N", 1, "force"),
+        ("kN", 1e3, "force"),
+        ("Pa", 1, "pressure"),
+        ("kPa", 1e3, "pressure"),
+        ("MPa", 1e6, "pressure"),
+        ("N/mm2", 1e6, "pressure"),
+    ],
+)
+def test_unit_table(unit, factor, dim):
+    assert to_si(unit) == (factor, dim)
+
+
+def test_unknown_unit_raises():
+    with pytest.raises(UnknownUnitError, match="furlong"):
+        to_si("furlong")
+
+
+@settings(max_examples=50, deadline=None)
+@given(
+    name=st.text(st.characters(whitelist_categories=("L",)), min_size=1, max_size=8),
+    unit=st.sampled_from(["s", "ms", "um", "mm", "N", "kN", "MPa", "Pa"]),
+    style=st.sampled_from(["{} [{}]", "{} ({})", "{}[{}]"]),
+)
+def test_split_name_property(name, unit, style):
+    assert split_name(style.format(name, unit)) == (name, unit)
