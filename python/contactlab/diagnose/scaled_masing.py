@@ -109,23 +109,30 @@ def scaled_force(virgin: Callable[[np.ndarray], np.ndarray], lam: float, mem: Me
     if not (np.isfinite(lam) and lam > 0):
         raise InputError(f"branch scale lam must be finite and > 0, got {lam}")
     x = mem.x
-    h = np.empty_like(x)
-    bounds = np.r_[mem.runs, x.size]
-    for a, b in itertools.pairwise(bounds):
-        r, tg = int(mem.anchor[a]), int(mem.target[a])
-        seg = x[a:b]
+    n = x.size
+    anchor, target = mem.anchor, mem.target
+    on_branch = anchor >= 0
+    # The virgin curve is evaluated in three vectorised calls; only the end points of each
+    # branch need the sequential pass below.
+    xa = x[np.where(on_branch, anchor, 0)]
+    mirror = target < 0
+    xt = np.where(mirror, -x[np.clip(-1 - target, 0, n - 1)], x[np.clip(target, 0, n - 1)])
+    f = virgin(np.concatenate([np.where(on_branch, (x - xa) / lam, x), (xt - xa) / lam, xt]))
+    g, den, f_xt = f[:n], f[n : 2 * n], f[2 * n :]
+    h = np.where(on_branch, 0.0, g)  # virgin-curve samples are final already
+    starts = mem.runs
+    ends = np.r_[starts[1:], n]
+    hl = h  # local alias; the loop writes branch runs in time order
+    for a, b in zip(starts.tolist(), ends.tolist(), strict=True):
+        r = int(anchor[a])
         if r < 0:
-            h[a:b] = virgin(seg)
             continue
-        xr, hr = x[r], h[r]
-        if tg >= 0:
-            xt, ht = x[tg], h[tg]
+        tg = int(target[a])
+        hr = hl[r]
+        ht = f_xt[a] if tg < 0 else hl[tg]
+        dn = den[a]
+        if dn == 0.0:
+            hl[a:b] = hr
         else:
-            xt = -x[-1 - tg]
-            ht = float(virgin(np.array([xt]))[0])
-        den = float(virgin(np.array([(xt - xr) / lam]))[0])
-        if den == 0.0:
-            h[a:b] = hr
-        else:
-            h[a:b] = hr + (ht - hr) * virgin((seg - xr) / lam) / den
+            hl[a:b] = hr + (ht - hr) / dn * g[a:b]
     return h

@@ -22,9 +22,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.optimize import least_squares
 
-from ..errors import ConvergenceError, InputError
+from ..errors import InputError
+from ..fitting import Parameter, least_squares_fit
 from ._family import Family, ParamSpec, Prepared
 
 
@@ -63,51 +63,50 @@ def fit(
 ) -> FitOut:
     """Least-squares fit of the base and effect parameters on the samples in ``mask``.
 
-    Variables are normalised by typical magnitudes; parameters of the model that ``start``
-    lacks begin at their "absent" value.
+    Runs :func:`contactlab.fitting.least_squares_fit`. Each parameter is passed as
+    ``w = (value - start) / typical + 1`` — centred at 1 and of order 1 per typical change —
+    because that function scales each variable by its initial value, which would be
+    meaningless for an effect starting at its "absent" value 0. Parameters ``start`` lacks
+    begin at their absent value; standard errors are mapped back (``inf`` where the fitting
+    layer reports a parameter as not identifiable).
     """
     specs = specs_for(family, effects)
     names = [s.name for s in specs]
-    sc = np.array([scales[s.name] if s.name in scales else scales[s.scale] for s in specs])
-    x0 = np.array([start.get(s.name, s.null) for s in specs], dtype=float)
-    x0 = np.where(np.isfinite(x0), x0, 0.3 * sc)  # no "absent" value (e.g. a time constant)
-    lo = np.array([s.lower for s in specs]) / sc
-    hi = np.array([s.upper for s in specs]) / sc
-    z0 = np.clip(x0 / sc, lo, hi)
-    # strictly inside the bounds, so a start at "absent" (often a bound) can move
-    span = np.where(np.isfinite(hi - lo), hi - lo, 1.0)
-    z0 = np.clip(z0, lo + 1e-6 * span, hi - 1e-6 * span)
+    sc = {s.name: scales[s.name] if s.name in scales else scales[s.scale] for s in specs}
+    x0: dict[str, float] = {}
+    for s in specs:
+        v = float(start.get(s.name, s.null))
+        if not np.isfinite(v):  # no "absent" value (e.g. a time constant): a typical one
+            v = 0.3 * sc[s.name]
+        span = s.upper - s.lower if np.isfinite(s.upper - s.lower) else sc[s.name]
+        # strictly inside the bounds, so a start at "absent" (often a bound) can move
+        x0[s.name] = float(np.clip(v, s.lower + 1e-6 * span, s.upper - 1e-6 * span))
+    params = [
+        Parameter(
+            s.name,
+            1.0,
+            min=(s.lower - x0[s.name]) / sc[s.name] + 1.0,
+            max=(s.upper - x0[s.name]) / sc[s.name] + 1.0,
+            unit=s.unit,
+        )
+        for s in specs
+    ]
     y = d.y[mask]
 
-    def resid(z: np.ndarray) -> np.ndarray:
-        p = dict(zip(names, z * sc, strict=True))
-        return family.predict(p, effects, d)[mask] - y
+    def value(w: dict[str, float]) -> dict[str, float]:
+        return {n: x0[n] + (w[n] - 1.0) * sc[n] for n in names}
 
-    try:
-        res = least_squares(resid, z0, bounds=(lo, hi), method="trf", x_scale=1.0, max_nfev=400)
-    except InputError as exc:
-        raise ConvergenceError(f"fit of {family.kind} + {effects} failed: {exc}") from None
-    n, k = int(mask.sum()), len(specs)
-    rss = float(2.0 * res.cost)
-    J = res.jac
-    s2 = rss / max(n - k, 1)
-    try:
-        cov = np.linalg.inv(J.T @ J) * s2
-        se = np.sqrt(np.clip(np.diag(cov), 0.0, None)) * sc
-        if not np.all(np.isfinite(se)):
-            raise np.linalg.LinAlgError
-    except np.linalg.LinAlgError:
-        se = np.full(k, np.inf)
-    params = dict(zip(names, (res.x * sc).tolist(), strict=True))
+    def resid(w: dict[str, float]) -> np.ndarray:
+        return family.predict(value(w), effects, d)[mask] - y
+
+    res = least_squares_fit(resid, params, ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=400)
+    w = {n: res.params[n].value for n in names}
+    se = {
+        n: (res.params[n].stderr * sc[n] if res.params[n].stderr is not None else np.inf)
+        for n in names
+    }
     return FitOut(
-        params,
-        dict(zip(names, se.tolist(), strict=True)),
-        rss,
-        n,
-        k,
-        bool(res.success),
-        str(res.message),
-        int(res.nfev),
+        value(w), se, float(res.chisqr), res.ndata, res.nvarys, res.success, res.message, res.nfev
     )
 
 
