@@ -160,3 +160,26 @@ def test_bad_input_is_named():
     n = 260  # two cycles only: nothing to hold out
     with pytest.raises(InputError, match="complete excitation cycles"):
         contactlab.diagnose((t[:n], rec.data["x"][:n], rec.data["F"][:n]))
+
+
+def test_cli_diagnose_writes_json_and_report(tmp_path, capsys):
+    from contactlab.cli import main
+    from contactlab.io import write_recording
+
+    rec = hidden_effect_recording(["asymmetry"], magnitude=0.05, noise=0.01, seed=SEED + 8)
+    path = write_recording(tmp_path / "run.csv", rec)
+    out, rep = tmp_path / "result.json", tmp_path / "report"
+    code = main(
+        ["diagnose", str(path), "--model", "tangential", "--json", str(out), "--report", str(rep)]
+    )
+    assert code == 0
+    d = json.loads(out.read_text(encoding="utf-8"))
+    _check_layout(d)
+    assert [e["name"] for e in d["effects"]] == ["asymmetry"]
+    assert (rep / "diagnose.html").is_file()
+    text = capsys.readouterr().out
+    assert "asymmetry" in text and "held-out RMS" in text
+    # a file without the channels the model needs: one clear error line, exit code 1
+    code = main(["diagnose", str(path), "--model", "normal"])
+    assert code == 1
+    assert "diagnose: error:" in capsys.readouterr().err

@@ -31,7 +31,7 @@ def run(args: argparse.Namespace) -> int:
     from ..io import read_recording
     from .workflow import diagnose
 
-    rec = read_recording(args.file)
+    rec = read_recording(args.file, kind=args.model)
     report = diagnose(rec, model=args.model, max_effects=args.max_effects)
     print(report.summary())
     if args.json:

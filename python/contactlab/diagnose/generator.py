@@ -33,6 +33,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..errors import InputError
+from ..io import Recording
 from ..masing import Masing
 from .scaled_masing import memory, scaled_force
 
@@ -50,12 +51,11 @@ TANGENTIAL_EFFECTS = (
 
 
 @dataclass
-class HiddenEffectRecording:
-    """A generated recording: ``t`` and ``data`` like :class:`contactlab.io.Recording`,
-    plus the ``truth`` (base parameters, active effects and their parameters)."""
+class HiddenEffectRecording(Recording):
+    """A generated :class:`contactlab.io.Recording` (SI units; write it with
+    :func:`contactlab.io.write_recording`) that also carries the ``truth``: base parameters,
+    active effects with their parameters, magnitudes and noise levels."""
 
-    t: np.ndarray
-    data: dict[str, np.ndarray]
     truth: dict[str, Any] = field(default_factory=dict)
     model: str = "tangential"
 
@@ -271,7 +271,15 @@ def hidden_effect_recording(
         "magnitudes": dict(sizes),
         "noise_rms": {"x": x_noise, "F": F_noise},
     }
-    return HiddenEffectRecording(t, {"x": xm, "F": Fm}, truth, "tangential")
+    return HiddenEffectRecording(
+        t,
+        {"x": xm, "F": Fm},
+        {"x": "m", "F": "N"},
+        source="hidden_effect_recording",
+        meta={"kind": "tangential"},
+        truth=truth,
+        model="tangential",
+    )
 
 
 def _sizes(

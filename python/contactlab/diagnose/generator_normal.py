@@ -134,4 +134,12 @@ def hidden_effect_recording_normal(
         truth["effects"]["creep_drift"]["tau_c"] = 0.25 * float(t[-1])
     pm = p + rng.normal(0.0, p_noise, p.size)
     dm = delta + rng.normal(0.0, d_noise, delta.size)
-    return HiddenEffectRecording(t, {"p": pm, "delta": dm}, truth, "normal")
+    return HiddenEffectRecording(
+        t,
+        {"p": pm, "delta": dm},
+        {"p": "Pa", "delta": "m"},
+        source="hidden_effect_recording",
+        meta={"kind": "normal"},
+        truth=truth,
+        model="normal",
+    )
