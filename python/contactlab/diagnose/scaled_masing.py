@@ -20,7 +20,6 @@ the displacement history, so it is computed once per signal.
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Callable
 from dataclasses import dataclass
 
