@@ -13,6 +13,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Mapping
 
 import numpy as np
+from scipy.optimize import brentq
 
 from ..errors import InputError
 from .candidates_normal import frequency_domain, kelvin_voigt, nonlinear
@@ -109,9 +110,8 @@ def hidden_effect_recording_normal(
             "hysteretic_damping": 1.0,
             "creep_drift": 3.0 * dr,
             "channel_delay": 0.25 / (fmax * 1.0),
-            "asymmetric_branches": 0.8,
+            "asymmetric_branches": 0.4,
         }[name]
-        from scipy.optimize import brentq
 
         def g(s: float, name: str = name, target: float = target, sign: float = sign) -> float:
             return size(name, sign * s) - target
