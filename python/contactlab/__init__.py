@@ -8,7 +8,7 @@ from __future__ import annotations
 
 # `contactlab.diagnose` is the subpackage, made callable: `contactlab.diagnose(recording,
 # model=...)` runs the workflow while `contactlab.diagnose.<module>` imports keep working.
-from . import diagnose
+from . import diagnose, normal
 from .errors import ContactLabError, ContactLabWarning, ConvergenceError, InputError
 from .fitting import FitResult, Parameter, least_squares_fit
 from .io import Recording, RecordingError, read_recording, write_recording
@@ -33,6 +33,7 @@ __all__ = [
     "diagnose",
     "least_squares_fit",
     "loop_area",
+    "normal",
     "read_recording",
     "write_recording",
 ]

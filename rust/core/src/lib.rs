@@ -9,6 +9,7 @@
 pub mod curve;
 pub mod error;
 pub mod masing;
+pub mod normal;
 
 pub use curve::{Backbone, Exponential, Tabulated};
 pub use error::CoreError;

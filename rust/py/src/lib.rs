@@ -14,6 +14,7 @@ use pyo3::sync::PyOnceLock;
 use pyo3::types::PyDict;
 
 mod errors;
+mod normal;
 use errors::{internal, to_pyerr};
 
 /// Run `f` without the GIL, turning a panic (a bug, never expected) into `ContactLabError`.
@@ -292,5 +293,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<MasingCore>()?;
     m.add_function(wrap_pyfunction!(loop_area_py, m)?)?;
     m.add_function(wrap_pyfunction!(exp_loop_energy, m)?)?;
+    normal::register(m)?;
     Ok(())
 }

@@ -1,0 +1,533 @@
+"""Hysteresis-loop analysis of a normal-contact recording (Konowalski 2009, eqs. 1-7).
+
+From sampled dynamic pressure p(t) and normal contact displacement δ(t):
+
+1. estimate the excitation frequency (windowed FFT peak, refined by the phase drift of the
+   fundamental between the two halves of the record), cut the record into whole cycles that
+   start where the fundamental of p crosses its mean upwards, drop the start-up cycles and
+   average the rest on a common phase grid (cycle-to-cycle scatter reported);
+2. split loading (dp/dt > 0) from unloading with a Savitzky-Golay derivative of the averaged
+   cycle and fit each branch with a polynomial p(δ) (degree 4 by default, eq. 1); the centre
+   curve is their mean (Table 2 satisfies this to the printed digits);
+3. shift δ so the centre curve passes through the origin (δ = 0 at p = 0, the static
+   equilibrium under p0) and compute E_d (loop area, ∮ p dδ from the samples), E_pu / E_pd
+   (strain energy under the centre curve to the extreme displacement on the loading / relief
+   side), ψ by eq. 3 (E_d / E_pu) and eq. 7 (2 E_d / (E_pd + E_pu)), k_tan (eq. 4, slope of the
+   centre curve at p = 0), k_sec (eq. 5, 2 pa / Δδ) and k_s(δ) (eq. 6).
+
+All quantities are SI (Pa, m, J/m², Pa/m); :meth:`LoopResult.table2` shows the paper's units.
+PHYSICS.md §2 warns that the paper's printed ψ = 0.0887 and k_tan = 1.206 MPa/µm do not
+follow from its Table 2 loop; nothing here assumes them.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .. import _core
+from .._arrays import as_1d, positive
+from ..errors import ContactLabWarning, InputError
+from . import _paper
+
+_UNITS = {
+    "E_d": "J/m^2",
+    "E_d_poly": "J/m^2",
+    "E_pu": "J/m^2",
+    "E_pd": "J/m^2",
+    "psi": "1",
+    "psi_kv": "1",
+    "k_tan": "Pa/m",
+    "k_sec": "Pa/m",
+    "k_s_delta": "Pa/m; ascending powers of delta in m (a1, a2, a3, a4)",
+    "poly_load": "Pa; ascending powers of delta in m",
+    "poly_unload": "Pa; ascending powers of delta in m",
+    "poly_centre": "Pa; ascending powers of delta in m",
+    "delta_max": "m",
+    "delta_min": "m",
+    "delta_offset": "m",
+    "cycle_scatter": "m",
+    "cycle_scatter_rel": "1",
+    "E_d_cycle_std": "J/m^2",
+    "p0": "Pa",
+    "pa": "Pa",
+    "omega": "rad/s",
+    "frequency": "Hz",
+}
+
+
+@dataclass
+class LoopResult:
+    """Result of :func:`analyze_loop`. SI units throughout (see :attr:`units`)."""
+
+    E_d: float
+    E_d_poly: float
+    E_pu: float
+    E_pd: float
+    psi: float
+    psi_kv: float
+    k_tan: float
+    k_sec: float
+    k_s_delta: list[float]
+    poly_load: list[float]
+    poly_unload: list[float]
+    poly_centre: list[float]
+    delta_max: float
+    delta_min: float
+    delta_offset: float
+    p0: float
+    pa: float
+    omega: float
+    frequency: float
+    n_cycles: int
+    n_discarded: int
+    samples_per_cycle: float
+    cycle_scatter: float
+    cycle_scatter_rel: float
+    E_d_cycle_std: float
+    degree: int
+    resampled: bool
+    #: Averaged cycle: phase time (s from the cycle start), dynamic pressure, displacement
+    #: (shifted by ``delta_offset``), its cycle-to-cycle standard deviation, loading mask.
+    cycle_t: np.ndarray = field(repr=False)
+    cycle_p: np.ndarray = field(repr=False)
+    cycle_delta: np.ndarray = field(repr=False)
+    cycle_delta_std: np.ndarray = field(repr=False)
+    loading: np.ndarray = field(repr=False)
+    units: dict[str, str] = field(default_factory=lambda: dict(_UNITS), repr=False)
+
+    _SCALARS = (
+        "E_d",
+        "E_d_poly",
+        "E_pu",
+        "E_pd",
+        "psi",
+        "psi_kv",
+        "k_tan",
+        "k_sec",
+        "delta_max",
+        "delta_min",
+        "delta_offset",
+        "p0",
+        "pa",
+        "omega",
+        "frequency",
+        "samples_per_cycle",
+        "cycle_scatter",
+        "cycle_scatter_rel",
+        "E_d_cycle_std",
+    )
+
+    def to_dict(self, arrays: bool = False) -> dict[str, Any]:
+        """JSON-ready dict of the results (SI); ``arrays=True`` adds the averaged cycle."""
+        d: dict[str, Any] = {k: float(getattr(self, k)) for k in self._SCALARS}
+        for k in ("k_s_delta", "poly_load", "poly_unload", "poly_centre"):
+            d[k] = [float(v) for v in getattr(self, k)]
+        d["n_cycles"] = int(self.n_cycles)
+        d["n_discarded"] = int(self.n_discarded)
+        d["degree"] = int(self.degree)
+        d["resampled"] = bool(self.resampled)
+        d["units"] = dict(self.units)
+        if arrays:
+            for k in ("cycle_t", "cycle_p", "cycle_delta", "cycle_delta_std"):
+                d[k] = getattr(self, k).tolist()
+            d["loading"] = self.loading.astype(bool).tolist()
+        return d
+
+    def table2(self) -> dict[str, list[float]]:
+        """Loop polynomials in the paper's units (p in MPa, δ in µm), like its Table 2."""
+        return {
+            "load": _paper.loop_poly_to_display(self.poly_load).tolist(),
+            "centre": _paper.loop_poly_to_display(self.poly_centre).tolist(),
+            "unload": _paper.loop_poly_to_display(self.poly_unload).tolist(),
+        }
+
+    def report(self) -> str:
+        """Human-readable summary in the paper's units."""
+        t2 = self.table2()
+        head = "".join(f"{'a' + str(i):>11}" for i in range(self.degree + 1))
+        lines = [
+            f"Loop analysis: p0 = {self.p0 / 1e6:.4g} MPa, pa = {self.pa / 1e6:.4g} MPa, "
+            f"ω = {self.omega:.6g} rad/s ({self.frequency:.6g} Hz)",
+            f"cycles averaged: {self.n_cycles} (discarded {self.n_discarded}), "
+            f"{self.samples_per_cycle:.6g} samples/cycle, scatter of δ "
+            f"{self.cycle_scatter * 1e6:.3g} µm ({100 * self.cycle_scatter_rel:.2g} % of Δδ)",
+            f"{'curve':<8}{head}",
+        ]
+        for name in ("load", "centre", "unload"):
+            lines.append(f"{name:<8}" + "".join(f"{v:11.5f}" for v in t2[name]))
+        lines += [
+            f"E_d = {self.E_d:.5g} J/m² (from the curves: {self.E_d_poly:.5g}), "
+            f"E_pu = {self.E_pu:.5g}, E_pd = {self.E_pd:.5g} J/m²",
+            f"ψ (eq. 7) = {self.psi:.5g}, ψ_KV (eq. 3) = {self.psi_kv:.5g}",
+            f"k_tan = {self.k_tan / 1e12:.5g} MPa/µm, k_sec = {self.k_sec / 1e12:.5g} MPa/µm",
+            f"δ_max = {self.delta_max * 1e6:.5g} µm, δ_min = {self.delta_min * 1e6:.5g} µm",
+        ]
+        return "\n".join(lines)
+
+
+# --- helpers -------------------------------------------------------------------------------
+
+
+def _time_vector(t: Any, n: int) -> np.ndarray:
+    if np.ndim(t) == 0:
+        fs = positive(t, "sampling rate")
+        return np.arange(n) / fs
+    tv = as_1d(t, "t")
+    if tv.size != n:
+        raise InputError(f"t has {tv.size} samples but p has {n}")
+    d = np.diff(tv)
+    if np.any(d <= 0):
+        i = int(np.argmax(d <= 0)) + 1
+        raise InputError(
+            f"t must be strictly increasing, but t[{i}] = {tv[i]} does not exceed "
+            f"t[{i - 1}] = {tv[i - 1]}"
+        )
+    return tv
+
+
+def _estimate_omega(x: np.ndarray, dt: float) -> float:
+    """Angular frequency of the dominant sinusoid in ``x`` (uniform sampling ``dt``)."""
+    n = x.size
+    y = x - x.mean()
+    if not np.any(y):
+        raise InputError("p is constant: no periodic excitation to analyse")
+    spec = np.abs(np.fft.rfft(y * np.hanning(n)))
+    spec[0] = 0.0
+    k = int(np.argmax(spec))
+    if k == 0 or spec[k] <= 0:
+        raise InputError("p shows no periodic excitation")
+    kf = float(k)
+    if 1 <= k < spec.size - 1:
+        a, b, c = np.log(spec[k - 1 : k + 2] + 1e-300)
+        den = a - 2 * b + c
+        if den < 0:
+            kf = k + 0.5 * (a - c) / den
+    w = 2 * np.pi * kf / (n * dt)
+    # Refine with the phase drift of the fundamental between the two halves (Hann-windowed
+    # sums, so the image at -ω leaks little into the phase).
+    h = n // 2
+    tt = np.arange(n) * dt
+    win = np.hanning(h)
+    for _ in range(3):
+        za = np.sum(win * y[:h] * np.exp(-1j * w * tt[:h]))
+        zb = np.sum(win * y[h : 2 * h] * np.exp(-1j * w * tt[h : 2 * h]))
+        if za == 0 or zb == 0:
+            break
+        dphi = float(np.angle(zb / za))
+        w_new = w + dphi / (h * dt)
+        if not np.isfinite(w_new) or w_new <= 0:
+            break
+        w = w_new
+    return float(w)
+
+
+def _periodic_extreme(y: np.ndarray, largest: bool) -> float:
+    """Extreme of a periodic sampled curve, refined by a parabola through three samples."""
+    i = int(np.argmax(y) if largest else np.argmin(y))
+    n = y.size
+    a, b, c = y[(i - 1) % n], y[i], y[(i + 1) % n]
+    den = a - 2 * b + c
+    if den == 0 or (largest and den > 0) or (not largest and den < 0):
+        return float(b)
+    off = 0.5 * (a - c) / den
+    if abs(off) > 1:
+        return float(b)
+    return float(b - 0.25 * (a - c) * off)
+
+
+def _loop_energy(p: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """∮ p dδ over one period of each row (periodic samples), by Parseval: exact for the
+    trigonometric interpolants of the samples (no polygon error)."""
+    n = p.shape[-1]
+    P = np.fft.rfft(p, axis=-1) / n
+    D = np.fft.rfft(d, axis=-1) / n
+    kmax = (n - 1) // 2  # drop the Nyquist term of even n (no defined derivative)
+    k = np.arange(1, kmax + 1)
+    prod = np.conj(P[..., 1 : kmax + 1]) * D[..., 1 : kmax + 1]
+    return -4 * np.pi * np.sum(k * prod.imag, axis=-1)
+
+
+def _poly_shift(c: np.ndarray, s: float) -> np.ndarray:
+    """Coefficients of ``q(x) = c(x + s)`` (ascending)."""
+    out = np.zeros_like(c)
+    # Horner with the polynomial (x + s).
+    for a in c[::-1]:
+        out = np.concatenate(([0.0], out[:-1])) + s * out
+        out[0] += a
+    return out
+
+
+def _polyval(c: Any, x: Any) -> Any:
+    return np.polynomial.polynomial.polyval(x, np.asarray(c, dtype=float))
+
+
+def _savgol_derivative_periodic(x: np.ndarray) -> np.ndarray:
+    """Savitzky-Golay first derivative (quadratic fit, window ~n/32) of a periodic signal,
+    in samples⁻¹: ``Σ k x[i+k] / Σ k²``. Antisymmetric, so for a sampled sine its sign is
+    that of the cosine at every sample."""
+    n = x.size
+    half = max(2, n // 64)
+    ks = np.arange(1, half + 1)
+    out = np.zeros_like(x)
+    for k in ks:
+        out += k * (np.roll(x, -k) - np.roll(x, k))
+    return out / (2 * np.sum(ks.astype(float) ** 2))
+
+
+# --- main entry point ----------------------------------------------------------------------
+
+
+def analyze_loop(
+    t: Any,
+    p: Any,
+    delta: Any,
+    *,
+    degree: int = 4,
+    omega: float | None = None,
+    discard_cycles: int | None = None,
+    p0: float | None = None,
+    zero_delta: bool = True,
+    n_bins: int | None = None,
+) -> LoopResult:
+    """Analyse the hysteresis loop of a normal-contact recording (Konowalski 2009, eqs. 1-7).
+
+    Parameters
+    ----------
+    t : array_like or float
+        Sample times in s (strictly increasing), or the sampling rate in Hz.
+    p : array_like
+        Contact pressure in Pa: the total pressure p0 + p_dyn(t) (then ``p0`` defaults to its
+        mean) or the dynamic part only (then pass ``p0``). Only p minus its cycle mean enters
+        the loop.
+    delta : array_like
+        Normal contact displacement in m (zeroed at the static state under p0).
+    degree : int, default 4
+        Degree of the loading/unloading/centre polynomials p(δ) (eq. 1 uses 4).
+    omega : float, optional
+        Angular excitation frequency in rad/s; estimated from ``p`` when omitted.
+    discard_cycles : int, optional
+        Whole cycles dropped at the start (start-up transient). Default: 1 when the record
+        holds at least 3 whole cycles, else 0.
+    p0 : float, optional
+        Mean (static) pressure in Pa; default: the mean of ``p`` over the analysed cycles.
+    zero_delta : bool, default True
+        Shift δ so the centre curve passes through the origin (δ = 0 at p = 0); the shift is
+        reported as ``delta_offset``.
+    n_bins : int, optional
+        Phase points per averaged cycle (default: samples per period, rounded).
+
+    Returns
+    -------
+    LoopResult
+
+    Raises
+    ------
+    InputError
+        Mismatched lengths, NaN/inf (index named), non-increasing time, fewer than two whole
+        cycles, pa > p0 (the joint would separate), a branch too short for ``degree``.
+
+    Examples
+    --------
+    >>> from contactlab.normal import analyze_loop, synthetic_recording
+    >>> t, p, d = synthetic_recording(model="table2", n_cycles=4, noise=None)
+    >>> res = analyze_loop(t, p, d)
+    >>> [round(a, 3) for a in res.table2()["unload"]]
+    [-0.015, 1.32, 1.705, 3.562, 4.176]
+    """
+    pv = as_1d(p, "p")
+    dv = as_1d(delta, "delta")
+    if dv.size != pv.size:
+        raise InputError(f"p has {pv.size} samples but delta has {dv.size}")
+    n = pv.size
+    if n < 8:
+        raise InputError(f"a recording of {n} samples is too short to hold two cycles")
+    tv = _time_vector(t, n)
+    if isinstance(degree, bool) or not isinstance(degree, (int, np.integer)) or degree < 1:
+        raise InputError(f"degree must be an integer >= 1, got {degree!r}")
+    degree = int(degree)
+
+    dts = np.diff(tv)
+    dt = float(np.median(dts))
+    resampled = bool(np.max(np.abs(dts - dt)) > 1e-6 * dt)
+    if resampled:
+        tu = tv[0] + dt * np.arange(int(np.floor((tv[-1] - tv[0]) / dt)) + 1)
+        pv = np.interp(tu, tv, pv)
+        dv = np.interp(tu, tv, dv)
+        tv, n = tu, tu.size
+
+    w = _estimate_omega(pv, dt) if omega is None else positive(omega, "omega")
+    period = 2 * np.pi / (w * dt)  # samples per cycle
+    if period < 8:
+        raise InputError(
+            f"only {period:.3g} samples per cycle at ω = {w:.6g} rad/s; at least 8 are needed"
+        )
+    # Phase of the fundamental: p ≈ mean + A sin(ω t + θ); cycles start where ω t + θ ≡ 0.
+    z = np.sum((pv - pv.mean()) * np.exp(-1j * w * (tv - tv[0])))
+    theta = float(np.angle(z)) + np.pi / 2
+    s0 = ((-theta) % (2 * np.pi)) / (2 * np.pi) * period  # samples from the first sample
+    bins = round(period) if n_bins is None else int(n_bins)
+    if bins < 8:
+        raise InputError(f"n_bins must be >= 8, got {bins}")
+    step = period / bins
+    n_whole = int(np.floor((n - 1 - s0 + step) / period + 1e-9))
+    if n_whole < 2:
+        # The start may sit late in the first cycle; try one cycle earlier being partial.
+        raise InputError(
+            f"the recording holds fewer than two whole cycles ({max(n_whole, 0)} at "
+            f"ω = {w:.6g} rad/s, {period:.4g} samples per cycle)"
+        )
+    # Snap to the sample grid when the period is an integer number of samples, so that
+    # folding needs no interpolation.
+    if n_bins is None and abs(period - round(period)) * n_whole < 0.05:
+        period = float(round(period))
+        s0 = float(round(s0)) % period
+        step = period / bins
+        n_whole = int(np.floor((n - 1 - s0 + step) / period + 1e-9))
+    if discard_cycles is None:
+        discard = 1 if n_whole >= 3 else 0
+    else:
+        if isinstance(discard_cycles, bool) or int(discard_cycles) != discard_cycles:
+            raise InputError(f"discard_cycles must be a whole number, got {discard_cycles!r}")
+        discard = int(discard_cycles)
+        if discard < 0:
+            raise InputError(f"discard_cycles must be >= 0, got {discard}")
+    n_used = n_whole - discard
+    if n_used < 1:
+        raise InputError(f"discarding {discard} of {n_whole} whole cycles leaves none to analyse")
+    start = s0 + discard * period
+    P = np.asarray(_core.fold_cycles(pv, start, period, n_used, bins)).reshape(n_used, bins)
+    D = np.asarray(_core.fold_cycles(dv, start, period, n_used, bins)).reshape(n_used, bins)
+
+    pm = P.mean(axis=0)
+    dm = D.mean(axis=0)
+    p_mean = float(pm.mean())
+    pdyn = pm - p_mean
+    p0_val = p_mean if p0 is None else float(p0)
+    if not np.isfinite(p0_val):
+        raise InputError(f"p0 must be finite, got {p0}")
+    pa = 0.5 * (_periodic_extreme(pdyn, True) - _periodic_extreme(pdyn, False))
+    if pa <= 0:
+        raise InputError("the dynamic pressure has no amplitude")
+    if pa > p0_val:
+        raise InputError(
+            f"pa = {pa:.6g} Pa exceeds p0 = {p0_val:.6g} Pa: the joint would separate "
+            "(if p holds only the dynamic pressure, pass p0=)"
+        )
+    if n_used > 1:
+        dstd = D.std(axis=0, ddof=1)
+        e_cycles = _loop_energy(P - P.mean(axis=1, keepdims=True), D)
+        e_std = float(np.std(e_cycles, ddof=1))
+    else:
+        dstd = np.zeros(bins)
+        e_std = 0.0
+
+    # Branches (dp/dt > 0 loading) and polynomial fits on δ centred by its cycle mean.
+    dp = _savgol_derivative_periodic(pdyn)
+    load = dp >= 0
+    unload = dp <= 0
+    if load.sum() < degree + 1 or unload.sum() < degree + 1:
+        raise InputError(
+            f"a branch of the loop has fewer than degree + 1 = {degree + 1} points; "
+            "lower degree or sample more densely"
+        )
+    m = float(dm.mean())
+    u = dm - m
+    c_load = np.asarray(_core.poly_fit(u[load], pdyn[load], degree))
+    c_unload = np.asarray(_core.poly_fit(u[unload], pdyn[unload], degree))
+    c_centre = 0.5 * (c_load + c_unload)
+    shift = m
+    u_lo, u_hi = float(u.min()), float(u.max())
+    if zero_delta:
+        roots = np.asarray(_core.poly_roots_in(c_centre, u_lo, u_hi))
+        if roots.size == 0:
+            warnings.warn(
+                "the centre curve does not cross p = 0 inside the loop; δ is left as recorded",
+                ContactLabWarning,
+                stacklevel=2,
+            )
+            r = -m  # undo the centring: keep δ as recorded
+        else:
+            r = float(roots[np.argmin(np.abs(roots))])
+    else:
+        r = -m
+    c_load = _poly_shift(c_load, r)
+    c_unload = _poly_shift(c_unload, r)
+    c_centre = 0.5 * (c_load + c_unload)
+    shift = m + r
+    dz = dm - shift
+
+    d_max = _periodic_extreme(dz, True)
+    d_min = _periodic_extreme(dz, False)
+    E_d = float(_loop_energy(pdyn, dz))
+    ic = np.polynomial.polynomial.polyint(c_centre)
+    E_pu = float(_polyval(ic, d_max) - _polyval(ic, 0.0))
+    E_pd = float(_polyval(ic, d_min) - _polyval(ic, 0.0))
+    diff_int = np.polynomial.polynomial.polyint(c_load - c_unload)
+    E_d_poly = float(_polyval(diff_int, d_max) - _polyval(diff_int, d_min))
+    if E_pu <= 0 or E_pd <= 0:
+        raise InputError(
+            "the centre curve does not store positive strain energy on both sides of the "
+            "equilibrium; is delta's sign consistent with p (compression positive)?"
+        )
+    if E_d <= 0:
+        warnings.warn(
+            f"the loop area is not positive (E_d = {E_d:.3g} J/m²): loading and unloading "
+            "may be swapped or the loop is dominated by noise",
+            ContactLabWarning,
+            stacklevel=2,
+        )
+    # k_tan: slope of the centre curve where p = 0 (δ = 0 after zeroing).
+    p_zero_at = 0.0
+    if not zero_delta:
+        rr = np.asarray(_core.poly_roots_in(c_centre, float(dz.min()), float(dz.max())))
+        if rr.size:
+            p_zero_at = float(rr[np.argmin(np.abs(rr))])
+    k_tan = float(_polyval(np.polynomial.polynomial.polyder(c_centre), p_zero_at))
+    k_sec = 2 * pa / (d_max - d_min)
+    k_s = c_centre[1:].copy()
+    kmin, kat = _core.poly_min_on(np.ascontiguousarray(k_s), d_min, d_max)
+    if kmin <= 0:
+        warnings.warn(
+            f"k_s(δ) is not positive over the loop's range (k_s = {kmin:.3g} Pa/m at "
+            f"δ = {kat:.3g} m); a nonlinear model built on it is invalid there",
+            ContactLabWarning,
+            stacklevel=2,
+        )
+    return LoopResult(
+        E_d=E_d,
+        E_d_poly=E_d_poly,
+        E_pu=E_pu,
+        E_pd=E_pd,
+        psi=2 * E_d / (E_pd + E_pu),
+        psi_kv=E_d / E_pu,
+        k_tan=k_tan,
+        k_sec=k_sec,
+        k_s_delta=k_s.tolist(),
+        poly_load=c_load.tolist(),
+        poly_unload=c_unload.tolist(),
+        poly_centre=c_centre.tolist(),
+        delta_max=d_max,
+        delta_min=d_min,
+        delta_offset=float(shift),
+        p0=p0_val,
+        pa=pa,
+        omega=w,
+        frequency=w / (2 * np.pi),
+        n_cycles=n_used,
+        n_discarded=discard,
+        samples_per_cycle=float(period),
+        cycle_scatter=float(np.sqrt(np.mean(dstd**2))),
+        cycle_scatter_rel=float(np.sqrt(np.mean(dstd**2)) / (d_max - d_min)),
+        E_d_cycle_std=e_std,
+        degree=degree,
+        resampled=resampled,
+        cycle_t=np.arange(bins) * (2 * np.pi / w / bins),
+        cycle_p=pdyn,
+        cycle_delta=dz,
+        cycle_delta_std=dstd,
+        loading=dp > 0,
+    )

@@ -1,0 +1,251 @@
+//! Bindings of `contactlab_core::normal`: array/error conversion and GIL release only.
+
+use contactlab_core::normal::{
+    cycles, ode, poly, ContactModel, Forcing, Interp, KelvinVoigt, Stiffness,
+};
+use contactlab_core::CoreError;
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::detach_guarded;
+use crate::errors::to_pyerr;
+
+fn sl<'a>(a: &'a PyReadonlyArray1<'_, f64>, name: &'static str) -> PyResult<&'a [f64]> {
+    a.as_slice().map_err(|_| {
+        PyErr::new::<pyo3::exceptions::PyValueError, _>(format!("{name} must be contiguous"))
+    })
+}
+
+fn bad(name: &'static str, reason: &'static str) -> CoreError {
+    CoreError::InvalidParameter {
+        name,
+        value: f64::NAN,
+        reason,
+    }
+}
+
+fn build_model(law: &str, coeffs: &[f64], psi: f64, omega: f64) -> Result<ContactModel, CoreError> {
+    let st = match law {
+        "constant" => match coeffs {
+            [k] => Stiffness::Constant(*k),
+            _ => {
+                return Err(bad(
+                    "coeffs",
+                    "law 'constant' takes exactly one coefficient (k)",
+                ))
+            }
+        },
+        "delta" => Stiffness::Delta(coeffs.to_vec()),
+        "pressure" => Stiffness::Pressure(coeffs.to_vec()),
+        _ => return Err(bad("law", "must be 'constant', 'delta' or 'pressure'")),
+    };
+    ContactModel::new(st, psi, omega)
+}
+
+/// Integrate the contact ODE over sampled `(t, p)`; returns a dict of arrays and counters.
+#[pyfunction]
+#[pyo3(signature = (t, p, law, coeffs, psi, omega, delta0, rtol, atol, interp="cubic", dpdt=None, first_step=None, max_steps=0))]
+fn normal_simulate<'py>(
+    py: Python<'py>,
+    t: PyReadonlyArray1<'py, f64>,
+    p: PyReadonlyArray1<'py, f64>,
+    law: &str,
+    coeffs: PyReadonlyArray1<'py, f64>,
+    psi: f64,
+    omega: f64,
+    delta0: f64,
+    rtol: f64,
+    atol: f64,
+    interp: &str,
+    dpdt: Option<PyReadonlyArray1<'py, f64>>,
+    first_step: Option<f64>,
+    max_steps: u64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let ts = sl(&t, "t")?;
+    let ps = sl(&p, "p")?;
+    let cs = sl(&coeffs, "coeffs")?;
+    let ds = match &dpdt {
+        Some(d) => Some(sl(d, "dpdt")?),
+        None => None,
+    };
+    let law = law.to_owned();
+    let interp = match interp {
+        "cubic" => Interp::Cubic,
+        "linear" => Interp::Linear,
+        _ => return Err(to_pyerr(py, &bad("interp", "must be 'cubic' or 'linear'"))),
+    };
+    let opts = ode::Options {
+        rtol,
+        atol,
+        first_step,
+        max_steps,
+    };
+    let (mut delta, mut vel, out) = detach_guarded(py, move || {
+        let model = build_model(&law, cs, psi, omega)?;
+        let forcing = Forcing::new(ts, ps, ds, interp)?;
+        let n = forcing.len();
+        let mut delta = vec![0.0; n];
+        let mut vel = vec![0.0; n];
+        let out = ode::simulate(&model, &forcing, delta0, &opts, &mut delta, &mut vel)?;
+        Ok((delta, vel, out))
+    })?;
+    delta.truncate(out.n_out);
+    vel.truncate(out.n_out);
+    let d = PyDict::new(py);
+    d.set_item("delta", delta.into_pyarray(py))?;
+    d.set_item("velocity", vel.into_pyarray(py))?;
+    d.set_item("n_out", out.n_out)?;
+    d.set_item("status", out.status.code())?;
+    d.set_item("message", out.status.message())?;
+    d.set_item("nfev", out.stats.nfev)?;
+    d.set_item("njev", out.stats.njev)?;
+    d.set_item("nlu", out.stats.nlu)?;
+    d.set_item("n_accepted", out.stats.n_accepted)?;
+    d.set_item("n_rejected", out.stats.n_rejected)?;
+    Ok(d)
+}
+
+/// Equilibrium displacement `k_s δ = p` of a model under constant pressure `p`.
+#[pyfunction]
+fn normal_equilibrium(
+    py: Python<'_>,
+    law: &str,
+    coeffs: PyReadonlyArray1<'_, f64>,
+    psi: f64,
+    omega: f64,
+    p: f64,
+) -> PyResult<f64> {
+    let cs = sl(&coeffs, "coeffs")?;
+    let model = build_model(law, cs, psi, omega).map_err(|e| to_pyerr(py, &e))?;
+    if !p.is_finite() {
+        return Err(to_pyerr(py, &bad("p", "must be finite")));
+    }
+    model.equilibrium(p).map_err(|e| to_pyerr(py, &e))
+}
+
+/// Kelvin-Voigt analytic quantities `(h, K, phi, E_d)` for amplitude `pa` (eqs. 13-15).
+#[pyfunction]
+fn kv_analytic(
+    py: Python<'_>,
+    k: f64,
+    psi: f64,
+    omega: f64,
+    pa: f64,
+) -> PyResult<(f64, f64, f64, f64)> {
+    let kv = KelvinVoigt::new(k, psi, omega).map_err(|e| to_pyerr(py, &e))?;
+    if !pa.is_finite() {
+        return Err(to_pyerr(py, &bad("pa", "must be finite")));
+    }
+    Ok((
+        kv.damping(),
+        kv.amplitude(pa),
+        kv.phase(),
+        kv.loop_energy(pa),
+    ))
+}
+
+/// Kelvin-Voigt steady state `(δ, δ')` at times `t` under `pa sin ω t`.
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn kv_steady_state<'py>(
+    py: Python<'py>,
+    k: f64,
+    psi: f64,
+    omega: f64,
+    pa: f64,
+    t: PyReadonlyArray1<'py, f64>,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    let kv = KelvinVoigt::new(k, psi, omega).map_err(|e| to_pyerr(py, &e))?;
+    let ts = sl(&t, "t")?;
+    let (d, v) = detach_guarded(py, || {
+        let mut d = vec![0.0; ts.len()];
+        let mut v = vec![0.0; ts.len()];
+        kv.steady_state(pa, ts, &mut d, &mut v)?;
+        Ok((d, v))
+    })?;
+    Ok((d.into_pyarray(py), v.into_pyarray(py)))
+}
+
+/// Least-squares polynomial (ascending coefficients) through `(x, y)`.
+#[pyfunction]
+#[pyo3(signature = (x, y, degree, weights=None))]
+fn poly_fit<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray1<'py, f64>,
+    y: PyReadonlyArray1<'py, f64>,
+    degree: usize,
+    weights: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let xs = sl(&x, "x")?;
+    let ys = sl(&y, "y")?;
+    let ws = match &weights {
+        Some(w) => Some(sl(w, "weights")?),
+        None => None,
+    };
+    let c = detach_guarded(py, || poly::fit(xs, ys, degree, ws))?;
+    Ok(c.into_pyarray(py))
+}
+
+/// Real roots of a polynomial (ascending coefficients) in `[lo, hi]`.
+#[pyfunction]
+fn poly_roots_in<'py>(
+    py: Python<'py>,
+    c: PyReadonlyArray1<'py, f64>,
+    lo: f64,
+    hi: f64,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let cs = sl(&c, "c")?;
+    contactlab_core::error::check_finite("c", cs).map_err(|e| to_pyerr(py, &e))?;
+    Ok(poly::roots_in(cs, lo, hi, 0).into_pyarray(py))
+}
+
+/// `(minimum value, where)` of a polynomial over `[lo, hi]`.
+#[pyfunction]
+fn poly_min_on(
+    py: Python<'_>,
+    c: PyReadonlyArray1<'_, f64>,
+    lo: f64,
+    hi: f64,
+) -> PyResult<(f64, f64)> {
+    let cs = sl(&c, "c")?;
+    contactlab_core::error::check_finite("c", cs).map_err(|e| to_pyerr(py, &e))?;
+    if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+        return Err(to_pyerr(py, &bad("lo, hi", "must be finite with lo <= hi")));
+    }
+    Ok(poly::min_on(cs, lo, hi))
+}
+
+/// Fold `x` into `n_cycles * n_bins` values (row-major) on a common phase grid.
+#[pyfunction]
+fn fold_cycles<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray1<'py, f64>,
+    start: f64,
+    period: f64,
+    n_cycles: usize,
+    n_bins: usize,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let xs = sl(&x, "x")?;
+    let out = detach_guarded(py, || {
+        let len = n_cycles
+            .checked_mul(n_bins)
+            .ok_or_else(|| bad("n_cycles", "n_cycles * n_bins overflows"))?;
+        let mut out = vec![0.0; len];
+        cycles::fold_cycles(xs, start, period, n_cycles, n_bins, &mut out)?;
+        Ok(out)
+    })?;
+    Ok(out.into_pyarray(py))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(normal_simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(normal_equilibrium, m)?)?;
+    m.add_function(wrap_pyfunction!(kv_analytic, m)?)?;
+    m.add_function(wrap_pyfunction!(kv_steady_state, m)?)?;
+    m.add_function(wrap_pyfunction!(poly_fit, m)?)?;
+    m.add_function(wrap_pyfunction!(poly_roots_in, m)?)?;
+    m.add_function(wrap_pyfunction!(poly_min_on, m)?)?;
+    m.add_function(wrap_pyfunction!(fold_cycles, m)?)?;
+    Ok(())
+}
