@@ -50,7 +50,14 @@ class Effect:
 
 @dataclass(frozen=True)
 class Step:
-    """Held-out errors of the model after one step (``added`` is None for the base fit)."""
+    """Held-out errors of the model after one step (``added`` is None for the base fit).
+
+    ``heldout_rms`` and ``heldout_peak``: RMS and largest absolute error of the output over
+    the held-out cycles (each cycle predicted by the fit that did not see it);
+    ``energy_error``: ``Σ |E_model - E_measured| / Σ |E_measured|`` over the held-out cycles,
+    ``E`` the loop area of one cycle; ``candidates``: the verdict on each candidate tried
+    after this step.
+    """
 
     added: str | None
     heldout_rms: float
