@@ -1,4 +1,10 @@
-"""The discrepancy workflow on normal-contact recordings (Kelvin-Voigt base, issue 5)."""
+"""The discrepancy workflow on normal-contact recordings (Kelvin-Voigt base, issue 5).
+
+Recordings here are 18 cycles at 80 samples per cycle and effects of 10 % of the output RMS
+(one magnitude for all): at 5 % a channel delay is absorbed by the Kelvin-Voigt damping,
+whose relaxation time ``h/k`` delays ``δ`` by the same first-order phase ``ω τ`` at every
+frequency (benches/eval_diagnose.py --model normal gives the rates by magnitude).
+"""
 
 from __future__ import annotations
 
@@ -12,16 +18,24 @@ from contactlab.diagnose.candidates_normal import NormalFamily, frequency_domain
 from contactlab.diagnose.generator_normal import NORMAL_EFFECTS
 
 SEED = 4242
+SMALL = {"samples_per_cycle": 80, "magnitude": 0.1}
 
 
 def test_frequency_domain_solution_matches_kelvin_voigt_integration():
-    # eta = 0: the FFT solution from rest equals the package's ODE integration
+    # eta = 0: the FFT solution equals the package's ODE integration (which starts in
+    # equilibrium), also for a record that starts and ends away from zero pressure
+    from contactlab.normal import KelvinVoigt
+
     t = np.arange(3000) * 2e-3
-    p = 4e5 * np.sin(2 * np.pi * 2.0 * t) * np.clip(t / 0.5, 0, 1) ** 2
+    p = 4e5 * np.sin(2 * np.pi * 2.0 * t + 0.7) * (1 + 0.3 * np.sin(0.5 * t))
     k, psi, om = 1.3e12, 0.0887, 2 * np.pi * 2.0
     a = frequency_domain(t, p, k, psi, om, 0.0)
-    b = kelvin_voigt(t, p, k, psi, om)
-    assert np.max(np.abs(a - b)) < 1e-4 * np.max(np.abs(b))
+    b = KelvinVoigt(k, psi, om).simulate(t, p, rtol=1e-10).delta
+    # the integrator continues p between samples by cubic Hermite with finite-difference
+    # slopes, the FFT by band-limited interpolation: they agree to ~(ω dt)² / 6
+    assert np.max(np.abs(a - b)) < 1e-3 * np.max(np.abs(b))
+    mid = slice(100, -100)
+    assert np.max(np.abs(a - b)[mid]) < 3e-4 * np.max(np.abs(b))
 
 
 def test_hysteretic_loss_is_rate_independent():
@@ -47,8 +61,7 @@ def test_candidate_reproduces_generator(effect):
     d.extra.update({"omega": 2 * np.pi * rec.truth["base"]["f0"]})
     d.extra["delta_r"] = rec.truth["base"]["delta_r"]
     fam.prepare(d)
-    d.extra["p0"] = rec.truth["base"]["p0"]
-    params = {"k": rec.truth["base"]["k"], "psi": rec.truth["base"]["psi"]}
+    params = {k: rec.truth["base"][k] for k in ("k", "psi", "p0")}
     for vals in rec.truth["effects"].values():
         params.update(vals)
     pred = fam.predict(params, (effect,), d)
@@ -58,20 +71,20 @@ def test_candidate_reproduces_generator(effect):
 
 @pytest.mark.parametrize("effect", NORMAL_EFFECTS)
 def test_each_normal_effect_is_named_alone(effect):
-    rec = hidden_effect_recording([effect], model="normal", magnitude=0.05, seed=SEED)
+    rec = hidden_effect_recording([effect], model="normal", seed=SEED, **SMALL)
     rep = contactlab.diagnose(rec, model="normal")
     assert rep.effect_names == [effect]
     assert rep.steps[-1].heldout_rms <= 1.5 * rep.noise_rms
 
 
 def test_clean_normal_data_names_nothing_and_two_effects_are_found():
-    rec = hidden_effect_recording([], model="normal", seed=SEED + 1)
+    rec = hidden_effect_recording([], model="normal", seed=SEED + 1, **SMALL)
     rep = contactlab.diagnose(rec, model="normal")
     assert rep.effects == []
     assert rep.final_model.params["k"] == pytest.approx(1.3e12, rel=0.01)
     assert isinstance(rep.final_model.base, contactlab.normal.KelvinVoigt)
     pair = ["channel_delay", "stiffness_nonlinearity"]
-    rec = hidden_effect_recording(pair, model="normal", magnitude=0.05, seed=SEED + 2)
+    rec = hidden_effect_recording(pair, model="normal", seed=SEED + 2, **SMALL)
     rep = contactlab.diagnose(rec, model="normal")
     assert sorted(rep.effect_names) == sorted(pair)
     assert rep.steps[-1].heldout_rms <= 1.5 * rep.noise_rms

@@ -1,9 +1,11 @@
 """Normal contact: the linear Kelvin-Voigt base model and its candidate extensions.
 
 Base model (PHYSICS.md §2, Konowalski 2009 eqs. 8-15): ``p = k δ + h δ'`` with
-``h = ψ k / (2π ω)``, driven by the measured dynamic pressure ``p(t) - p0`` (``p0`` the mean
-pressure of the recording, ``ω`` the excitation's angular frequency estimated from the
-recording), predicting the measured displacement ``δ(t)``. Simulated with
+``h = ψ k / (2π ω)``, driven by the measured dynamic pressure ``p(t) - p0`` and predicting
+the measured displacement ``δ(t)``. ``p0``, the static pressure at which ``δ`` was zeroed,
+is fitted with ``k`` and ``ψ`` (the mean of a recording of whole cycles is only close to
+it); ``ω``, the angular frequency at which ψ holds, is the excitation's, estimated from the
+recording. Simulated with
 :class:`contactlab.normal.KelvinVoigt` (the package's integrator; none is written here).
 
 Candidates (name: model, parameters):
@@ -22,9 +24,9 @@ Candidates (name: model, parameters):
 the paper's eq. 6 coefficients follow as ``a1 = k``, ``a2 = k a / δ_r``, ``a3 = k κ / δ_r²``.
 Both stiffness candidates run through :class:`contactlab.normal.NonlinearContact` (eq. 17,
 where the damping ``ψ k_s / (2π ω)`` follows the stiffness as in the paper). The hysteretic
-model is linear and solved by FFT with zero padding (its ideal form is non-causal, so it
-has no time-domain integrator); for ``η = 0`` it reproduces the Kelvin-Voigt response from
-rest. Hysteretic damping combined with a stiffness nonlinearity is not offered.
+model is linear and solved by FFT on a smooth periodic continuation of the record (its ideal
+form is non-causal, so it has no time-domain integrator); for ``η = 0`` it reproduces the
+Kelvin-Voigt integration. Hysteretic damping combined with a stiffness nonlinearity is not offered.
 """
 
 from __future__ import annotations
@@ -77,11 +79,12 @@ CANDIDATES: dict[str, Candidate] = {
 BASE_PARAMS = (
     ParamSpec("k", "Pa/m", _INF, 0.0, _INF, "k"),
     ParamSpec("psi", "-", _INF, 1e-6, 10.0, "psi"),
+    ParamSpec("p0", "Pa", _INF, -_INF, _INF, "p"),
 )
 
 
 #: Relative tolerance of the ODE solves: far below any sensor noise, and cheap.
-RTOL = 1e-7
+RTOL = 1e-6
 
 
 def _delta(res: Any, n: int) -> np.ndarray:
@@ -121,13 +124,21 @@ def nonlinear(
 def frequency_domain(
     t: np.ndarray, pd: np.ndarray, k: float, psi: float, omega: float, eta: float
 ) -> np.ndarray:
-    """``δ̂ = p̂ / (k + i ω h + i η k sgn ω)`` with zero padding (response from rest)."""
+    """``δ̂ = p̂ / (k + i ω h + i η k sgn ω)`` on a periodic continuation of the record.
+
+    The record is continued by a raised-cosine blend from its last value back to its first
+    (at least as long as the record and ten Kelvin-Voigt time constants), so the continuation
+    is smooth, the record starts in equilibrium with ``p(t0)`` (as the time-domain models do)
+    and the non-local hysteretic kernel sees no artificial jump.
+    """
     n = pd.size
     dt = float(t[1] - t[0])
     tau_kv = psi / (2.0 * np.pi * omega)
     pad = int(min(max(n, 10 * tau_kv / dt), 50 * n))
     m = fft.next_fast_len(n + pad, real=True)
-    P = fft.rfft(pd, m)
+    s = np.linspace(0.0, 1.0, m - n + 2)[1:-1]
+    blend = pd[-1] + (pd[0] - pd[-1]) * 0.5 * (1.0 - np.cos(np.pi * s))
+    P = fft.rfft(np.concatenate([pd, blend]))
     w = 2.0 * np.pi * fft.rfftfreq(m, dt)
     h = psi * k / (2.0 * np.pi * omega)
     sgn = np.sign(w)
@@ -147,9 +158,8 @@ class NormalFamily:
         """Mean pressure, excitation angular frequency and displacement scale.
 
         Values already in ``d.extra`` (from a fitted model's context) are kept: ``omega`` and
-        ``delta_r`` belong to the model's parameters, ``p0`` to the recording.
+        ``delta_r`` belong to the model's parameters.
         """
-        d.extra["p0"] = float(np.mean(d.u))
         d.extra.setdefault("omega", 2.0 * np.pi / (d.cycles.period_samples * d.dt))
         if "delta_r" not in d.extra:
             if not np.isfinite(d.y).all():
@@ -161,10 +171,12 @@ class NormalFamily:
         return {"omega": d.extra["omega"], "delta_r": d.extra["delta_r"]}
 
     def scales(self, d: Prepared) -> dict[str, float]:
-        pd = d.u - d.extra["p0"]
+        pd = d.u - np.mean(d.u)
         dr = d.extra["delta_r"]
+        pr = float(np.sqrt(np.mean(pd * pd)))
         return {
-            "k": float(np.sqrt(np.mean(pd * pd))) / dr,
+            "k": pr / dr,
+            "p": 0.1 * pr,
             "psi": 0.1,
             "one": 1.0,
             "delta": dr,
@@ -173,9 +185,10 @@ class NormalFamily:
         }
 
     def initial_base(self, d: Prepared) -> dict[str, float]:
-        pd = d.u - d.extra["p0"]
+        p0 = float(np.mean(d.u))
+        pd = d.u - p0
         k = float(pd @ pd) / float(pd @ d.y) if float(pd @ d.y) > 0 else self.scales(d)["k"]
-        return {"k": abs(k), "psi": 0.1}
+        return {"k": abs(k), "psi": 0.1, "p0": p0}
 
     def check(self, effects: tuple[str, ...]) -> bool:
         """Whether these effects can be combined."""
@@ -186,7 +199,7 @@ class NormalFamily:
         """Measured displacement predicted for the measured pressure ``d.u``."""
         if not self.check(effects):
             raise InputError("hysteretic damping cannot be combined with a stiffness nonlinearity")
-        pd = d.u - d.extra["p0"]
+        pd = d.u - p["p0"]
         om = d.extra["omega"]
         k, psi = p["k"], p["psi"]
         if "hysteretic_damping" in effects:
@@ -213,7 +226,7 @@ class NormalFamily:
     def base_model(self, p: dict[str, float], context: dict[str, float]) -> Any:
         from ..normal import KelvinVoigt
 
-        return KelvinVoigt(p["k"], p["psi"], context["omega"])
+        return KelvinVoigt(p["k"], p["psi"], context["omega"], p0=p["p0"])
 
     @staticmethod
     def loop_energy(u: np.ndarray, y: np.ndarray) -> float:

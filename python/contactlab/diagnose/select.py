@@ -8,9 +8,11 @@ only if all three hold:
 
 1. its held-out mean-square error is lower by at least ``min_gain · σ²``, where σ is the
    noise level estimated from the data (:func:`contactlab.diagnose._signal.noise_rms`);
-2. that improvement is significant across held-out cycles: the paired per-cycle MSE
-   differences have ``mean / standard error > z`` (cycles, not samples, are the independent
-   units, so slowly varying residuals do not inflate the evidence);
+2. that improvement is consistent across held-out cycles: the per-cycle log ratios
+   ``ln(MSE_current / MSE_candidate)`` have ``mean / standard error > z`` (cycles, not
+   samples, are the independent units, so slowly varying residuals do not inflate the
+   evidence; ratios, not differences, so that cycles of large amplitude or rate — where
+   rate-dependent effects are largest — do not swamp the others);
 3. the Bayesian information criterion of the fit to all data decreases.
 
 The accepted candidate with the largest held-out gain wins.
@@ -92,12 +94,15 @@ def fit(
         for s in specs
     ]
     y = d.y[mask]
+    # residuals in units of the output's RMS: the solver's gradient tolerance is absolute,
+    # and a displacement residual in metres (1e-9) would stop it at the first step
+    ys = float(np.sqrt(np.mean(y * y))) or 1.0
 
     def value(w: dict[str, float]) -> dict[str, float]:
         return {n: x0[n] + (w[n] - 1.0) * sc[n] for n in names}
 
     def resid(w: dict[str, float]) -> np.ndarray:
-        return family.predict(value(w), effects, d)[mask] - y
+        return (family.predict(value(w), effects, d)[mask] - y) / ys
 
     res = least_squares_fit(resid, params, ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=400)
     w = {n: res.params[n].value for n in names}
@@ -106,7 +111,14 @@ def fit(
         for n in names
     }
     return FitOut(
-        value(w), se, float(res.chisqr), res.ndata, res.nvarys, res.success, res.message, res.nfev
+        value(w),
+        se,
+        float(res.chisqr) * ys * ys,
+        res.ndata,
+        res.nvarys,
+        res.success,
+        res.message,
+        res.nfev,
     )
 
 
@@ -217,10 +229,10 @@ def judge(
     name: str, current: Trial, cand: Trial, sigma: float, z: float, min_gain: float
 ) -> Verdict:
     """Apply the three acceptance rules of the module docstring."""
-    diff = current.cycle_mse - cand.cycle_mse
+    ratio = np.log(current.cycle_mse / cand.cycle_mse)
     gain = float(current.heldout_mse - cand.heldout_mse) / sigma**2
-    sd = float(np.std(diff, ddof=1)) if diff.size > 1 else np.inf
-    t = float(np.mean(diff) / (sd / np.sqrt(diff.size))) if sd > 0 else np.inf
+    sd = float(np.std(ratio, ddof=1)) if ratio.size > 1 else np.inf
+    t = float(np.mean(ratio) / (sd / np.sqrt(ratio.size))) if sd > 0 else np.inf
     dbic = cand.full.bic - current.full.bic
     if gain < min_gain:
         reason = f"held-out gain {gain:.3g} σ² below {min_gain:g} σ²"

@@ -213,6 +213,8 @@ def _family(model: Any) -> tuple[Family, dict[str, float], dict[str, float]]:
 
     start = start_from_model(model)
     if start is not None:
+        if getattr(model, "p0", None) is not None:
+            start["p0"] = float(model.p0)
         ctx = {"omega": float(model.omega)} if hasattr(model, "omega") else {}
         return NormalFamily(), start, ctx
     raise InputError(f"cannot diagnose a model of type {type(model).__name__}")
