@@ -78,7 +78,8 @@ def main() -> None:
         if eff is None and mag != mags[0]:
             continue  # clean data has no magnitude
         cases.append(run_case(args.model, () if eff is None else (eff,), mag, noise, seed))
-    pairs = list(itertools.combinations(effs, 2))
+    family = contactlab.diagnose.workflow._family(args.model)[0]
+    pairs = [pr for pr in itertools.combinations(effs, 2) if family.check(pr)]
     rng = np.random.default_rng(7)
     two = [pairs[i] for i in rng.choice(len(pairs), size=min(8, len(pairs)), replace=False)]
     two_cases = [

@@ -14,7 +14,7 @@ import pytest
 import contactlab
 from contactlab.diagnose import hidden_effect_recording
 from contactlab.diagnose._family import Prepared
-from contactlab.diagnose.candidates_normal import NormalFamily, frequency_domain, kelvin_voigt
+from contactlab.diagnose.candidates_normal import NormalFamily, frequency_domain
 from contactlab.diagnose.generator_normal import NORMAL_EFFECTS
 
 SEED = 4242
