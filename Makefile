@@ -22,7 +22,7 @@ demo: develop
 	$(VENV)/bin/contactlab demo --out demo-output
 
 rust-test:
-	cargo test -p contactlab-core --locked -q
+	cargo test --workspace --locked -q
 
 rust-lint:
 	cargo fmt --all --check

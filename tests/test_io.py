@@ -280,3 +280,67 @@ def test_unknown_unit_raises():
 )
 def test_split_name_property(name, unit, style):
     assert split_name(style.format(name, unit)) == (name, unit)
+
+
+def test_csv_decimal_comma(tmp_path):
+    p = tmp_path / "eu.csv"
+    p.write_text("Zeit [ms];Weg [µm];Kraft [N]\n0;1,5;-0,25\n1;2,5;1e-1\n2;3;0,5\n")
+    rec = read_recording(p, columns={"t": "Zeit", "x": "Weg", "F": "Kraft"})
+    np.testing.assert_allclose(rec["x"], [1.5e-6, 2.5e-6, 3e-6])
+    np.testing.assert_allclose(rec["F"], [-0.25, 0.1, 0.5])
+    assert rec.meta["decimal"] == ","
+    p.write_text("Zeit [ms];Weg [µm];Kraft [N]\n0;1,5;-0,25\n1;2,x5;1e-1\n")
+    with pytest.raises(RecordingError, match="'2,x5'") as info:
+        read_recording(p, columns={"t": "Zeit", "x": "Weg", "F": "Kraft"})
+    assert info.value.row == 3
+
+
+@pytest.mark.parametrize("fmt", ["h5", "mat", "tdms"])
+def test_binary_formats_name_the_bad_sample(tmp_path, fmt):
+    rec = _rec(50)
+    rec.data["F"][17] = np.inf
+    p = tmp_path / f"r.{fmt}"
+    write_recording(p, rec)
+    with pytest.raises(RecordingError, match="not a finite number") as info:
+        read_recording(p)
+    assert info.value.row == 17
+    assert info.value.column == "F"
+
+
+@pytest.mark.parametrize("fmt", ["h5", "mat", "tdms"])
+def test_binary_formats_missing_channel(tmp_path, fmt):
+    rec = Recording(np.arange(5.0), {"x": np.zeros(5)}, {"x": "m"})
+    p = tmp_path / f"r.{fmt}"
+    write_recording(p, rec)
+    with pytest.raises(RecordingError, match="no column for 'F'") as info:
+        read_recording(p, kind="tangential")
+    assert str(p) in str(info.value)
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    xunit=st.sampled_from([("m", 1.0), ("mm", 1e-3), ("um", 1e-6), ("nm", 1e-9)]),
+    funit=st.sampled_from([("N", 1.0), ("kN", 1e3), ("mN", 1e-3)]),
+    tunit=st.sampled_from([("s", 1.0), ("ms", 1e-3), ("us", 1e-6)]),
+    values=st.lists(st.floats(-1e6, 1e6, allow_nan=False), min_size=2, max_size=20),
+    delim=st.sampled_from([",", ";", "\t"]),
+)
+def test_csv_units_property(tmp_path_factory, xunit, funit, tunit, values, delim):
+    n = len(values)
+    t = np.arange(n) * 3.0
+    header = delim.join([f"t [{tunit[0]}]", f"x [{xunit[0]}]", f"F [{funit[0]}]"])
+    rows = [delim.join(repr(float(v)) for v in (t[i], values[i], -values[i])) for i in range(n)]
+    p = tmp_path_factory.mktemp("u") / "r.csv"
+    p.write_text(header + "\n" + "\n".join(rows) + "\n")
+    rec = read_recording(p)
+    np.testing.assert_allclose(rec.t, t * tunit[1], rtol=1e-15)
+    np.testing.assert_allclose(rec["x"], np.array(values) * xunit[1], rtol=1e-15)
+    np.testing.assert_allclose(rec["F"], -np.array(values) * funit[1], rtol=1e-15)
+
+
+def test_csv_rows_count_blank_and_comment_lines(tmp_path):
+    p = tmp_path / "gaps.csv"
+    p.write_text("t [s],x [m],F [N]\n0,0,0\n\n# pause\n1,1,1\n1,2,2\n")
+    with pytest.raises(RecordingError, match="duplicated") as info:
+        read_recording(p)
+    assert info.value.row == 6  # the 6th line of the file

@@ -13,6 +13,7 @@ from .errors import ContactLabError, ContactLabWarning, ConvergenceError, InputE
 from .fitting import FitResult, Parameter, least_squares_fit
 from .io import Recording, RecordingError, read_recording, write_recording
 from .masing import CycleTable, Masing, MasingOperator, cycle_energies, loop_area
+from .tangential import TangentialAnalysis, analyze_tangential
 
 __version__ = "0.1.0"
 
@@ -28,7 +29,9 @@ __all__ = [
     "Parameter",
     "Recording",
     "RecordingError",
+    "TangentialAnalysis",
     "__version__",
+    "analyze_tangential",
     "cycle_energies",
     "diagnose",
     "least_squares_fit",

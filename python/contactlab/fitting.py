@@ -45,6 +45,11 @@ class Parameter:
         A human-readable remark (why it is not identifiable, what is identified instead).
     unit : str
         SI unit, for reports.
+    init_value : float, optional
+        Set by the fit: the starting value.
+    scale : float, optional
+        Typical size of the parameter's changes (default ``|value|``, or 1 when the value is
+        0). Give it for a parameter that starts at 0 but lives on a tiny or huge scale.
     """
 
     name: str
@@ -57,6 +62,7 @@ class Parameter:
     note: str = ""
     unit: str = ""
     init_value: float | None = None
+    scale: float | None = None
 
     @property
     def fixed(self) -> bool:
@@ -242,6 +248,14 @@ def _scalar(a: np.ndarray) -> Any:
     return float(a) if a.ndim == 0 else a
 
 
+def _scale_of(p: Parameter) -> float:
+    if p.scale is not None:
+        if not (math.isfinite(p.scale) and p.scale > 0):
+            raise InputError(f"parameter {p.name!r}: scale must be finite and > 0, got {p.scale}")
+        return float(p.scale)
+    return abs(p.value) if p.value != 0 else 1.0
+
+
 def _as_params(params: Any) -> dict[str, Parameter]:
     if isinstance(params, Mapping):
         out = {}
@@ -324,9 +338,10 @@ def least_squares_fit(
                 f"parameter {p.name!r}: initial value {p.value} outside [{p.min}, {p.max}]"
             )
         p.init_value = p.value if p.vary else None
-    # Fit in scaled variables (value / |initial value|) so parameters that differ by orders of
-    # magnitude (h0 ~ 10 N, ac ~ 1e5 1/m) are equally well conditioned.
-    scale = np.array([abs(ps[n].value) if ps[n].value != 0 else 1.0 for n in names])
+    # Fit in scaled variables (value / scale, scale = |initial value| unless given) so that
+    # parameters that differ by orders of magnitude (h0 ~ 10 N, ac ~ 1e5 1/m) are equally
+    # well conditioned.
+    scale = np.array([_scale_of(ps[n]) for n in names])
     lo = np.array([ps[n].min for n in names]) / scale
     hi = np.array([ps[n].max for n in names]) / scale
     fixed = {k: p.value for k, p in ps.items() if not p.vary}
@@ -343,7 +358,7 @@ def least_squares_fit(
         r = np.asarray(residual_fn(values_of(z)), dtype=np.float64).reshape(-1)
         return r
 
-    z0 = np.ones(len(names))
+    z0 = np.array([ps[n].value for n in names]) / scale
     r0 = fun(z0)
     if not np.all(np.isfinite(r0)):
         i = int(np.argmax(~np.isfinite(r0)))
@@ -378,7 +393,7 @@ def least_squares_fit(
     # by one-sided steps).
     J = np.empty((ndata, len(names)))
     for j in range(len(names)):
-        h = jac_rel_step * max(abs(z[j]), 1e-3)
+        h = jac_rel_step * max(abs(z[j]), 1.0)
         up, dn = z.copy(), z.copy()
         up[j] = min(z[j] + h, hi[j])
         dn[j] = max(z[j] - h, lo[j])

@@ -100,10 +100,9 @@ def read_recording(
 
     Examples
     --------
-    >>> import numpy as np, tempfile, os
-    >>> d = tempfile.mkdtemp()
-    >>> p = os.path.join(d, "run.csv")
-    >>> _ = open(p, "w").write("t [ms],x [um],F [N]\\n0,0,0\\n1,2,0.5\\n2,4,0.9\\n")
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "run.csv"
+    >>> _ = p.write_text("t [ms],x [um],F [N]\\n0,0,0\\n1,2,0.5\\n2,4,0.9\\n")
     >>> rec = read_recording(p)
     >>> rec.t.tolist(), rec["x"].tolist(), rec.units["x"]
     ([0.0, 0.001, 0.002], [0.0, 2e-06, 4e-06], 'm')

@@ -1,14 +1,16 @@
 """CSV / text recordings: one header row with column names (units in brackets), then numbers.
 
 Lines starting with ``#`` before the header are kept as comments in ``meta``. The delimiter
-(comma, semicolon, tab or whitespace) is detected from the header. Only the needed columns are
-parsed (``numpy.loadtxt`` with ``usecols``); when that fails, the file is scanned once more to
-name the first bad cell by line and column.
+(comma, semicolon, tab or whitespace) is detected from the header, and a decimal comma
+(``1,5`` as European locales write it, with ``;`` or tab delimiters) from the first data line.
+Only the needed columns are parsed (``numpy.loadtxt`` with ``usecols``); when that fails, the
+file is scanned once more to name the first bad cell by line and column.
 """
 
 from __future__ import annotations
 
 import csv as _csv
+import re
 from pathlib import Path
 from typing import Any
 
@@ -44,8 +46,46 @@ def _header(path: Path) -> tuple[list[str], str | None, int, list[str]]:
     raise RecordingError("no header row (the file is empty)", file=str(path))
 
 
+_DECIMAL_COMMA = re.compile(r"^\s*[+-]?\d+,\d*(?:[eE][+-]?\d+)?\s*$")
+
+
+def _decimal_comma(path: Path, delim: str | None, first_data_line: int) -> bool:
+    """Whether numbers are written with a decimal comma (``1,5``; European locales), judged
+    from the first data line. Only possible when the delimiter is not a comma."""
+    if delim == ",":
+        return False
+    with open(path, encoding="utf-8-sig", errors="replace") as fh:
+        for lineno, line in enumerate(fh):
+            if lineno < first_data_line or not line.strip() or line.lstrip().startswith("#"):
+                continue
+            cells = line.rstrip("\r\n").split(delim) if delim else line.split()
+            return any(_DECIMAL_COMMA.match(c) for c in cells)
+    return False
+
+
+def _line_of_sample(path: Path, first_data_line: int, index: int) -> int:
+    """1-based line of the file holding data row ``index`` (blank and ``#`` lines skipped).
+
+    Called only to word an error, so the extra pass over the file costs nothing normally.
+    """
+    k = -1
+    with open(path, encoding="utf-8-sig", errors="replace") as fh:
+        for lineno, line in enumerate(fh):
+            if lineno < first_data_line or not line.strip() or line.lstrip().startswith("#"):
+                continue
+            k += 1
+            if k == index:
+                return lineno + 1
+    return first_data_line + index + 1
+
+
 def _locate_bad_cell(
-    path: Path, delim: str | None, first_data_line: int, cols: list[int], names: list[str]
+    path: Path,
+    delim: str | None,
+    first_data_line: int,
+    cols: list[int],
+    names: list[str],
+    comma: bool = False,
 ) -> RecordingError:
     """Scan the file to find the first cell that is not a number."""
     with open(path, encoding="utf-8-sig", errors="replace") as fh:
@@ -63,10 +103,12 @@ def _locate_bad_cell(
                     )
                 cell = cells[c].strip().strip('"')
                 try:
+                    if comma:
+                        cell = cell.replace(",", ".")
                     float(cell)
                 except ValueError:
                     return RecordingError(
-                        f"cell {cell!r} is not a number",
+                        f"cell {cells[c].strip()!r} is not a number",
                         file=str(path),
                         column=names[c],
                         row=lineno + 1,
@@ -95,6 +137,7 @@ def read_csv(
     canon = list(mapping)
     idx = [names.index(mapping[c]) for c in canon]
     first_data = header_line + 1
+    comma = _decimal_comma(path, delim, first_data)
     try:
         block = np.loadtxt(
             path,
@@ -106,14 +149,14 @@ def read_csv(
             dtype=np.float64,
             encoding="utf-8-sig",
             quotechar='"',
+            converters=(lambda v: float(v.replace(",", "."))) if comma else None,
         )
     except ValueError:
-        raise _locate_bad_cell(path, delim, first_data, idx, names) from None
+        raise _locate_bad_cell(path, delim, first_data, idx, names, comma) from None
     if block.shape[0] == 0:
         raise RecordingError("header but no data rows", file=file)
     raw = {c: np.ascontiguousarray(block[:, j]) for j, c in enumerate(canon)}
     units = {c: split_name(mapping[c])[1] for c in canon}
-    # Rows of sample i: blank and comment lines are rare after the header; assume none.
     return finish(
         raw,
         mapping,
@@ -121,8 +164,13 @@ def read_csv(
         kind=kind,
         file=file,
         fs=fs,
-        row_offset=first_data + 1,
-        meta={"format": "csv", "comments": comments, "delimiter": delim or "whitespace"},
+        row_of=lambda i: _line_of_sample(path, first_data, i),
+        meta={
+            "format": "csv",
+            "comments": comments,
+            "delimiter": delim or "whitespace",
+            "decimal": "," if comma else ".",
+        },
     )
 
 

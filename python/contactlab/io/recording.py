@@ -7,6 +7,7 @@ analysis code never sees µm or MPa. Canonical channel names: tangential ``x`` (
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -244,10 +245,17 @@ def unit_factor(
     return factor, SI_UNITS[udim]
 
 
-def check_time(t: np.ndarray, *, file: str, column: str, row_offset: int = 0) -> None:
+RowOf = Callable[[int], int]
+
+
+def _plain(i: int) -> int:
+    return i
+
+
+def check_time(t: np.ndarray, *, file: str, column: str, row_of: RowOf = _plain) -> None:
     """Time stamps finite, strictly increasing, without gaps (> 1.5 median step).
 
-    ``row_offset`` converts a sample index into the row reported (e.g. header lines).
+    ``row_of`` converts a sample index into the row reported (e.g. a line of a text file).
     """
     if t.size < 2:
         raise RecordingError(f"only {t.size} sample(s)", file=file, column=column)
@@ -260,7 +268,7 @@ def check_time(t: np.ndarray, *, file: str, column: str, row_offset: int = 0) ->
             f"time stamp {t[i]!r} is {what}; previous is {t[i - 1]!r}",
             file=file,
             column=column,
-            row=i + row_offset,
+            row=row_of(i),
         )
     med = float(np.median(d))
     gaps = np.flatnonzero(d > 1.5 * med)
@@ -271,7 +279,7 @@ def check_time(t: np.ndarray, *, file: str, column: str, row_offset: int = 0) ->
             f"({gaps.size} gap(s) in all)",
             file=file,
             column=column,
-            row=i + row_offset,
+            row=row_of(i),
         )
 
 
@@ -286,12 +294,12 @@ def time_from_fs(n: int, fs: float | None, *, file: str, t0: float = 0.0) -> np.
     return t0 + np.arange(n, dtype=np.float64) / fs
 
 
-def check_finite(a: np.ndarray, *, file: str, column: str, row_offset: int = 0) -> None:
+def check_finite(a: np.ndarray, *, file: str, column: str, row_of: RowOf = _plain) -> None:
     bad = ~np.isfinite(a)
     if bad.any():
         i = int(np.argmax(bad))
         raise RecordingError(
-            f"value {a[i]!r} is not a finite number", file=file, column=column, row=i + row_offset
+            f"value {a[i]!r} is not a finite number", file=file, column=column, row=row_of(i)
         )
 
 
@@ -303,13 +311,14 @@ def finish(
     kind: str | None,
     file: str,
     fs: float | None,
-    row_offset: int = 0,
+    row_of: RowOf = _plain,
     t_fallback: np.ndarray | None = None,
     meta: dict[str, Any] | None = None,
 ) -> Recording:
     """Convert raw columns to SI, build ``t`` and check everything; shared by all readers.
 
-    ``raw`` maps canonical name to values in file units; ``names`` to the file's names.
+    ``raw`` maps canonical name to values in file units; ``names`` to the file's names;
+    ``row_of`` turns a sample index into the row an error names (identity: 0-based index).
     """
     assumed: list[str] = []
     data: dict[str, np.ndarray] = {}
@@ -317,7 +326,7 @@ def finish(
     t = None
     for canon, values in raw.items():
         col = names[canon]
-        check_finite(values, file=file, column=col, row_offset=row_offset)
+        check_finite(values, file=file, column=col, row_of=row_of)
         factor, si = unit_factor(canon, col, file_units.get(canon), file=file, assumed=assumed)
         v = np.ascontiguousarray(values, dtype=np.float64) * factor
         if canon == "t":
@@ -334,7 +343,7 @@ def finish(
         tcol = "t"
     else:
         tcol = names["t"]
-    check_time(t, file=file, column=tcol, row_offset=row_offset)
+    check_time(t, file=file, column=tcol, row_of=row_of)
     m = dict(meta or {})
     m.setdefault("kind", kind)
     m["columns"] = dict(names)

@@ -7,9 +7,10 @@ equivalent damping* with the corrected formulas of PHYSICS.md §1.
 
 from __future__ import annotations
 
-from .analysis import UNITS, TangentialAnalysis, analyze_tangential
+from .analysis import analyze_tangential
 from .plots import plot_loop, plot_residuals
 from .preprocess import AveragedLoop, CycleScatter, Reversals, average_loop, find_reversals
+from .result import UNITS, TangentialAnalysis
 from .synthetic import synthetic_recording
 
 __all__ = [

@@ -18,160 +18,25 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from .._arrays import as_1d
 from ..errors import ContactLabWarning, InputError
-from ..fitting import FitResult, Parameter, _num, least_squares_fit
+from ..fitting import FitResult, Parameter, least_squares_fit
 from ..io import Recording
 from ..masing import Masing, loop_area
 from .model import initial_guess, steady_loop_force, steady_signal_force, virgin_signal_force
-from .preprocess import AveragedLoop, CycleScatter, average_loop, find_reversals, monotone_path
-
-#: SI units of every reported quantity
-UNITS = {
-    "h0": "N",
-    "ac": "1/m",
-    "h0_ac": "N/m",
-    "offset": "N",
-    "x0": "m",
-    "amplitude": "m",
-    "energy_per_cycle": "J",
-    "energy_per_cycle_numeric": "J",
-    "equivalent_damping": "N/m",
-    "equivalent_damping_numeric": "N/m",
-    "k_local0": "N/m",
-    "k_local_amplitude": "N/m",
-    "k_global": "N/m",
-    "h0_lower_bound": "N",
-    "ac_upper_bound": "1/m",
-    "peak_force": "N",
-}
+from .preprocess import AveragedLoop, average_loop, find_reversals, monotone_path
+from .result import TangentialAnalysis
 
 #: ``ac·A`` above which the loop is taken to have reached gross sliding (branch slope at the
 #: turn below e^-3 = 5 % of the initial stiffness: the force has plateaued near ±h0)
 GROSS_SLIDING_Z = 3.0
 #: loop area / (4 A × half force range) above which a loop counts as nearly rectangular
 GROSS_SLIDING_AREA_RATIO = 0.6
-
-
-@dataclass
-class TangentialAnalysis:
-    """Result of :func:`analyze_tangential`.
-
-    Attributes
-    ----------
-    fit : FitResult
-        Parameters ``h0``, ``ac``, ``offset`` (and ``x0`` when fitted) with standard errors,
-        covariance and correlations, χ², AIC/BIC.
-    model : Masing
-        The best-fit model (when ``identifiable`` is False it reproduces the loop at this
-        amplitude but its ``h0`` and ``ac`` are not individually meaningful).
-    amplitude, amplitude_stderr : float
-        Displacement amplitude (half the averaged loop's x range) and its error from the
-        cycle-to-cycle scatter.
-    loop : AveragedLoop or None
-        The period-averaged loop (None when the recording has fewer than 2 cycles and the fit
-        was on the signal).
-    scatter : CycleScatter or None
-        Per-cycle amplitude, force range, energy and period.
-    identifiable : bool
-        Whether ``h0`` and ``ac`` are separately determined.
-    identifiability : dict
-        The evidence: relative errors, correlation, ``ac·A``, Jacobian condition, message.
-    derived : dict
-        ``name -> (value, stderr)`` for the derived quantities (see :data:`UNITS`).
-    warnings : list of str
-        Everything a user should know (also issued as :class:`ContactLabWarning`).
-    x, F, F_model, weights : ndarray
-        The data the fit saw (averaged bins or the signal's samples), the model at the optimum
-        and the residual weights.
-    """
-
-    fit: FitResult
-    model: Masing
-    amplitude: float
-    amplitude_stderr: float
-    loop: AveragedLoop | None
-    scatter: CycleScatter | None
-    identifiable: bool
-    identifiability: dict[str, Any]
-    derived: dict[str, tuple[float, float]]
-    warnings: list[str]
-    on: str
-    history: str
-    x: np.ndarray
-    F: np.ndarray
-    F_model: np.ndarray
-    weights: np.ndarray
-    t: np.ndarray | None = None
-    source: str = "<arrays>"
-    meta: dict[str, Any] = field(default_factory=dict)
-
-    @property
-    def residual(self) -> np.ndarray:
-        """Data minus model (N), unweighted."""
-        return self.F - self.F_model
-
-    def value(self, name: str) -> float:
-        return self.to_dict()[name]
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-safe summary: SI values, ``*_stderr``, a ``units`` map and the fit.
-
-        When ``h0`` and ``ac`` are not identifiable their values are None (not arbitrary
-        numbers); ``h0_ac`` (always present) carries what the data determine.
-        """
-        p = self.fit.params
-        ident = self.identifiable
-        out: dict[str, Any] = {
-            "source": self.source,
-            "on": self.on,
-            "history": self.history,
-            "h0": _num(p["h0"].value) if ident else None,
-            "h0_stderr": _num(p["h0"].stderr) if ident else None,
-            "ac": _num(p["ac"].value) if ident else None,
-            "ac_stderr": _num(p["ac"].stderr) if ident else None,
-            "offset": _num(p["offset"].value),
-            "offset_stderr": _num(p["offset"].stderr),
-        }
-        if "x0" in p:
-            out["x0"] = _num(p["x0"].value)
-            out["x0_stderr"] = _num(p["x0"].stderr)
-        out["amplitude"] = _num(self.amplitude)
-        out["amplitude_stderr"] = _num(self.amplitude_stderr)
-        for k, (v, e) in self.derived.items():
-            out[k] = _num(v)
-            out[f"{k}_stderr"] = _num(e)
-        out["identifiable"] = {
-            k: (_num(v) if isinstance(v, float) else v) for k, v in self.identifiability.items()
-        }
-        out["n_cycles"] = None if self.scatter is None else self.scatter.n_cycles
-        out["warnings"] = list(self.warnings)
-        out["fit"] = self.fit.to_dict()
-        out["units"] = {k: u for k, u in UNITS.items() if k in out}
-        for k in list(out["units"]):
-            if f"{k}_stderr" in out:
-                out["units"][f"{k}_stderr"] = UNITS[k]
-        return out
-
-    def report(self) -> str:
-        """Human-readable summary: fit report, identifiability and derived quantities."""
-        lines = [f"Tangential analysis of {self.source} (fit on {self.on}, {self.history})"]
-        lines.append(self.fit.report())
-        lines.append("[[Identifiability]]")
-        lines.append(f"    {self.identifiability['message']}")
-        lines.append("[[Derived quantities]]")
-        lines.append(f"    amplitude = {self.amplitude:.6g} +/- {self.amplitude_stderr:.3g} m")
-        for k, (v, e) in self.derived.items():
-            lines.append(f"    {k} = {v:.6g} +/- {e:.3g} {UNITS.get(k, '')}")
-        if self.warnings:
-            lines.append("[[Warnings]]")
-            lines += [f"    {w}" for w in self.warnings]
-        return "\n".join(lines)
 
 
 def _inputs(
@@ -240,6 +105,8 @@ def analyze_tangential(
     min_cycles: int = 2,
     max_rel_stderr: float = 1.0 / 3.0,
     fit_amplitude: bool = True,
+    detrend: bool = True,
+    invert_force: bool | None = None,
     initial: dict[str, float] | None = None,
     warn: bool = True,
 ) -> TangentialAnalysis:
@@ -263,6 +130,12 @@ def analyze_tangential(
     fit_amplitude : bool, default True
         On a steady loop, fit the turning points' half distance ``A`` instead of taking the
         extremes of noisy data (which overestimate it and bias ``h0``, ``ac``).
+    detrend : bool, default True
+        Remove a linear force drift estimated from the per-cycle mean force (needs 3 complete
+        cycles; reported as ``force_drift``, N/s).
+    invert_force : bool, optional
+        Analyse ``-F``. By default this is done (with a warning) when the force falls as the
+        displacement rises, i.e. the load cell counts the other way.
     n_points : int, optional
         Phase bins of the averaged loop (default: samples per cycle, 16..400).
     rel_threshold : float
@@ -298,6 +171,18 @@ def analyze_tangential(
     if on == "averaged" and history == "virgin":
         raise InputError("history='virgin' applies to on='signal'; an averaged loop is steady")
     steady = history == "steady"
+    pre_warns: list[str] = []
+    xc = xa - xa.mean()
+    inverted = float(xc @ (Fa - Fa.mean())) < 0
+    if invert_force is None:
+        invert_force = inverted
+        if inverted:
+            pre_warns.append(
+                "the force falls as the displacement rises (sensor sign convention): "
+                "analysed -F; pass invert_force=False to keep the sign"
+            )
+    if invert_force:
+        Fa = -Fa
     if fit_x0 is None:
         fit_x0 = True
     if n_points is not None and (n_points < 8 or n_points % 2):
@@ -310,6 +195,22 @@ def analyze_tangential(
     except InputError:
         if on == "averaged":
             raise
+    drift = (0.0, 0.0)
+    if detrend and loop is not None and loop.n_cycles >= 3:
+        # A load cell's slow drift shows as a trend in the per-cycle mean force (a steady loop
+        # has the same mean every cycle). Remove it and average again.
+        ct, cm = loop.scatter.time, loop.scatter.mean_force
+        tm = float(np.mean(ct))
+        sxx = float(np.sum((ct - tm) ** 2))
+        slope = float(np.sum((ct - tm) * (cm - cm.mean())) / sxx)
+        res_ = cm - cm.mean() - slope * (ct - tm)
+        se = math.sqrt(float(res_ @ res_) / (ct.size - 2) / sxx) if ct.size > 2 else math.nan
+        drift = (slope, se)
+        tt = ta if ta is not None else np.arange(xa.size, dtype=float)
+        Fa = Fa - slope * (tt - tm)
+        loop = average_loop(
+            xa, Fa, ta, n_points=n_points, rel_threshold=rel_threshold, min_cycles=min_cycles
+        )
     scatter = loop.scatter if loop is not None else None
 
     # -- data the fit sees --------------------------------------------------------------
@@ -357,10 +258,22 @@ def analyze_tangential(
     params = [
         Parameter("k0", h0_init * ac_init, min=1e-9 * h0_init * ac_init, unit="N/m"),
         Parameter("ac", ac_init, min=1e-9 * ac_init, unit="1/m"),
-        Parameter("offset", off0 if fit_offset else 0.0, vary=fit_offset, unit="N"),
+        Parameter(
+            "offset", off0 if fit_offset else 0.0, vary=fit_offset, unit="N", scale=max(hm0, 1e-300)
+        ),
     ]
     if steady:
-        params.append(Parameter("x0", centre0, vary=fit_x0, unit="m"))
+        params.append(
+            Parameter(
+                "x0",
+                centre0,
+                vary=fit_x0,
+                min=centre0 - amplitude0,
+                max=centre0 + amplitude0,
+                unit="m",
+                scale=amplitude0,
+            )
+        )
         params.append(
             Parameter(
                 "amplitude",
@@ -372,7 +285,9 @@ def analyze_tangential(
             )
         )
     else:
-        params.append(Parameter("x0", float(xa[0]), vary=fit_x0, unit="m"))
+        params.append(
+            Parameter("x0", float(xa[0]), vary=fit_x0, unit="m", scale=max(amplitude0, 1e-300))
+        )
 
     sl = slice(start, None)
     peaks, valleys, first_is_peak = rev.peaks, rev.valleys, rev.first_is_peak
@@ -484,12 +399,13 @@ def analyze_tangential(
     derived["energy_per_cycle_numeric"] = (float(e_num), e_sem)
     a2 = math.pi * amplitude**2
     derived["equivalent_damping_numeric"] = (float(e_num / a2), e_sem / a2)
+    derived["force_drift"] = drift
     if not identifiable:
         derived["h0_lower_bound"] = (float(h0_lo), math.nan)
         derived["ac_upper_bound"] = (float(ac_up), math.nan)
 
     # -- warnings -------------------------------------------------------------------------
-    warns: list[str] = list(raw.notes)
+    warns: list[str] = pre_warns + list(raw.notes)
     hm_data = 0.5 * float(np.ptp(loop.F if loop is not None else Fa))
     ratio = e_num / (4 * amplitude * hm_data) if hm_data > 0 else 0.0
     if (identifiable and z > GROSS_SLIDING_Z) or ratio > GROSS_SLIDING_AREA_RATIO:
@@ -534,7 +450,7 @@ def analyze_tangential(
         weights=w,
         t=td,
         source=source,
-        meta={"fit_start": start},
+        meta={"fit_start": start, "invert_force": bool(invert_force)},
     )
 
 

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from .analysis import TangentialAnalysis
+from .result import TangentialAnalysis
 
 
 def _axes(ax: Any) -> Any:

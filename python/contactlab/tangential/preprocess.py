@@ -18,6 +18,7 @@ The paper (*Experimental investigation of tangential contact stiffness and equiv
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -172,6 +173,8 @@ class CycleScatter:
     force_range: np.ndarray  # half the F range of the cycle's loop, N
     energy: np.ndarray  # loop area of the cycle, J
     period: np.ndarray  # s
+    mean_force: np.ndarray  # mean force over the cycle (mean of its bin means), N
+    time: np.ndarray  # middle of the cycle (mean of its two peak instants), s
 
     @property
     def n_cycles(self) -> int:
@@ -180,7 +183,7 @@ class CycleScatter:
     def summary(self) -> dict[str, dict[str, float]]:
         """Mean, standard deviation and standard error of the mean of each quantity."""
         out = {}
-        for k in ("amplitude", "force_range", "energy", "period"):
+        for k in ("amplitude", "force_range", "energy", "period", "mean_force"):
             v = getattr(self, k)
             sd = float(np.std(v, ddof=1)) if v.size > 1 else float("nan")
             out[k] = {"mean": float(np.mean(v)), "std": sd, "sem": sd / np.sqrt(v.size)}
@@ -240,6 +243,22 @@ def phase_of(t: np.ndarray, rev: Reversals) -> tuple[np.ndarray, int, int]:
     return ph, start, end
 
 
+def _dphase(v: np.ndarray, n: int) -> np.ndarray:
+    """Derivative of bin values along phase (periodic central difference)."""
+    return (np.roll(v, -1) - np.roll(v, 1)) * (n / 2.0)
+
+
+def _spread(a: np.ndarray) -> np.ndarray:
+    """Standard deviation over axis 0 ignoring NaN; NaN where fewer than 2 values."""
+    ok = np.isfinite(a)
+    k = ok.sum(axis=0)
+    z = np.where(ok, a, 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = z.sum(axis=0) / k
+        var = (np.where(ok, a - mean, 0.0) ** 2).sum(axis=0) / (k - 1)
+    return np.where(k >= 2, np.sqrt(var), np.nan)
+
+
 def average_loop(
     x: np.ndarray,
     F: np.ndarray,
@@ -292,7 +311,8 @@ def average_loop(
     cyc = np.floor(ph).astype(np.int64)
     frac = ph - cyc
     if n_points is None:
-        n_points = 2 * int(np.clip(np.median(np.diff(rev.peaks)), 16, 400) // 2)
+        # about two samples of every cycle per bin, so no bin is left empty by jitter
+        n_points = 2 * int(np.clip(np.median(np.diff(rev.peaks)) / 2, 16, 400) // 2)
     if n_points < 8:
         raise InputError(f"n_points must be >= 8, got {n_points}")
     b = np.minimum((frac * n_points).astype(np.int64), n_points - 1)
@@ -312,8 +332,14 @@ def average_loop(
     with np.errstate(invalid="ignore", divide="ignore"):
         cx = np.bincount(flat, xs, size).reshape(n_cyc, n_points) / cc
         cF = np.bincount(flat, Fs, size).reshape(n_cyc, n_points) / cc
-    x_std = np.nanstd(cx, axis=0, ddof=1) if n_cyc > 1 else np.full(n_points, np.nan)
-    F_std = np.nanstd(cF, axis=0, ddof=1) if n_cyc > 1 else np.full(n_points, np.nan)
+        cphi = np.bincount(flat, frac, size).reshape(n_cyc, n_points) / cc
+    # Where the samples of a cycle sit inside a bin differs from cycle to cycle; on a steep
+    # branch that alone spreads the per-cycle means. Remove it to first order (gradient along
+    # phase, periodic) so the spread measures noise and real cycle-to-cycle change.
+    phim = np.bincount(b, frac, n_points) / count
+    dphi = cphi - phim
+    x_std = _spread(cx - _dphase(xm, n_points) * dphi)
+    F_std = _spread(cF - _dphase(Fm, n_points) * dphi)
     amps, franges, energies = [], [], []
     for k in range(n_cyc):
         ok = np.isfinite(cx[k]) & np.isfinite(cF[k])
@@ -325,6 +351,8 @@ def average_loop(
         force_range=np.asarray(franges),
         energy=np.asarray(energies),
         period=np.diff(rev.peak_times),
+        mean_force=np.nanmean(cF, axis=1),
+        time=0.5 * (rev.peak_times[:-1] + rev.peak_times[1:]),
     )
     phase = (np.arange(n_points) + 0.5) / n_points
     return AveragedLoop(phase, xm, Fm, count, x_std, F_std, scatter, rev, start, end)
@@ -348,7 +376,7 @@ def monotone_path(x: np.ndarray, turns: np.ndarray) -> np.ndarray:
     xa = np.asarray(x, dtype=float)
     out = xa.copy()
     edges = np.unique(np.r_[0, np.asarray(turns, dtype=np.int64), xa.size])
-    for a, b in zip(edges[:-1], edges[1:], strict=True):
+    for a, b in itertools.pairwise(edges):
         seg = xa[a:b]
         if seg.size < 2:
             continue

@@ -89,7 +89,7 @@ def synthetic_recording(
     n_cycles = positive(n_cycles, "n_cycles")
     if noise < 0 or (x_noise is not None and x_noise < 0):
         raise InputError("noise levels must be >= 0")
-    n = int(round(n_cycles * fs / f))
+    n = round(n_cycles * fs / f)
     if n < 4:
         raise InputError(f"{n} samples is too short a recording")
     rng = np.random.default_rng(seed)

@@ -1,0 +1,153 @@
+"""The result of a tangential analysis (:class:`TangentialAnalysis`): the fit, the derived
+quantities of *Experimental investigation of tangential contact stiffness and equivalent
+damping* (energy per cycle, eq. 17 damping, eqs. 18-19 stiffness) with their errors, the
+identifiability verdict, and its JSON form (SI values plus a ``units`` map).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..fitting import FitResult, _num
+from ..masing import Masing
+from .preprocess import AveragedLoop, CycleScatter
+
+#: SI units of every reported quantity
+UNITS = {
+    "h0": "N",
+    "ac": "1/m",
+    "h0_ac": "N/m",
+    "offset": "N",
+    "x0": "m",
+    "amplitude": "m",
+    "energy_per_cycle": "J",
+    "energy_per_cycle_numeric": "J",
+    "equivalent_damping": "N/m",
+    "equivalent_damping_numeric": "N/m",
+    "k_local0": "N/m",
+    "k_local_amplitude": "N/m",
+    "k_global": "N/m",
+    "h0_lower_bound": "N",
+    "ac_upper_bound": "1/m",
+    "peak_force": "N",
+    "force_drift": "N/s",
+}
+
+
+@dataclass
+class TangentialAnalysis:
+    """Result of :func:`analyze_tangential`.
+
+    Attributes
+    ----------
+    fit : FitResult
+        Parameters ``h0``, ``ac``, ``offset`` (and ``x0`` when fitted) with standard errors,
+        covariance and correlations, χ², AIC/BIC.
+    model : Masing
+        The best-fit model (when ``identifiable`` is False it reproduces the loop at this
+        amplitude but its ``h0`` and ``ac`` are not individually meaningful).
+    amplitude, amplitude_stderr : float
+        Displacement amplitude (half the averaged loop's x range) and its error from the
+        cycle-to-cycle scatter.
+    loop : AveragedLoop or None
+        The period-averaged loop (None when the recording has fewer than 2 cycles and the fit
+        was on the signal).
+    scatter : CycleScatter or None
+        Per-cycle amplitude, force range, energy and period.
+    identifiable : bool
+        Whether ``h0`` and ``ac`` are separately determined.
+    identifiability : dict
+        The evidence: relative errors, correlation, ``ac·A``, Jacobian condition, message.
+    derived : dict
+        ``name -> (value, stderr)`` for the derived quantities (see :data:`UNITS`).
+    warnings : list of str
+        Everything a user should know (also issued as :class:`ContactLabWarning`).
+    x, F, F_model, weights : ndarray
+        The data the fit saw (averaged bins or the signal's samples), the model at the optimum
+        and the residual weights.
+    """
+
+    fit: FitResult
+    model: Masing
+    amplitude: float
+    amplitude_stderr: float
+    loop: AveragedLoop | None
+    scatter: CycleScatter | None
+    identifiable: bool
+    identifiability: dict[str, Any]
+    derived: dict[str, tuple[float, float]]
+    warnings: list[str]
+    on: str
+    history: str
+    x: np.ndarray
+    F: np.ndarray
+    F_model: np.ndarray
+    weights: np.ndarray
+    t: np.ndarray | None = None
+    source: str = "<arrays>"
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def residual(self) -> np.ndarray:
+        """Data minus model (N), unweighted."""
+        return self.F - self.F_model
+
+    def value(self, name: str) -> float:
+        return self.to_dict()[name]
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-safe summary: SI values, ``*_stderr``, a ``units`` map and the fit.
+
+        When ``h0`` and ``ac`` are not identifiable their values are None (not arbitrary
+        numbers); ``h0_ac`` (always present) carries what the data determine.
+        """
+        p = self.fit.params
+        ident = self.identifiable
+        out: dict[str, Any] = {
+            "source": self.source,
+            "on": self.on,
+            "history": self.history,
+            "h0": _num(p["h0"].value) if ident else None,
+            "h0_stderr": _num(p["h0"].stderr) if ident else None,
+            "ac": _num(p["ac"].value) if ident else None,
+            "ac_stderr": _num(p["ac"].stderr) if ident else None,
+            "offset": _num(p["offset"].value),
+            "offset_stderr": _num(p["offset"].stderr),
+        }
+        if "x0" in p:
+            out["x0"] = _num(p["x0"].value)
+            out["x0_stderr"] = _num(p["x0"].stderr)
+        out["amplitude"] = _num(self.amplitude)
+        out["amplitude_stderr"] = _num(self.amplitude_stderr)
+        for k, (v, e) in self.derived.items():
+            out[k] = _num(v)
+            out[f"{k}_stderr"] = _num(e)
+        out["identifiable"] = {
+            k: (_num(v) if isinstance(v, float) else v) for k, v in self.identifiability.items()
+        }
+        out["n_cycles"] = None if self.scatter is None else self.scatter.n_cycles
+        out["warnings"] = list(self.warnings)
+        out["fit"] = self.fit.to_dict()
+        out["units"] = {k: u for k, u in UNITS.items() if k in out}
+        for k in list(out["units"]):
+            if f"{k}_stderr" in out:
+                out["units"][f"{k}_stderr"] = UNITS[k]
+        return out
+
+    def report(self) -> str:
+        """Human-readable summary: fit report, identifiability and derived quantities."""
+        lines = [f"Tangential analysis of {self.source} (fit on {self.on}, {self.history})"]
+        lines.append(self.fit.report())
+        lines.append("[[Identifiability]]")
+        lines.append(f"    {self.identifiability['message']}")
+        lines.append("[[Derived quantities]]")
+        lines.append(f"    amplitude = {self.amplitude:.6g} +/- {self.amplitude_stderr:.3g} m")
+        for k, (v, e) in self.derived.items():
+            lines.append(f"    {k} = {v:.6g} +/- {e:.3g} {UNITS.get(k, '')}")
+        if self.warnings:
+            lines.append("[[Warnings]]")
+            lines += [f"    {w}" for w in self.warnings]
+        return "\n".join(lines)
