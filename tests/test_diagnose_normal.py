@@ -8,6 +8,7 @@ frequency (benches/eval_diagnose.py --model normal gives the rates by magnitude)
 
 from __future__ import annotations
 
+import matplotlib
 import numpy as np
 import pytest
 
@@ -16,6 +17,8 @@ from contactlab.diagnose import hidden_effect_recording
 from contactlab.diagnose._family import Prepared
 from contactlab.diagnose.candidates_normal import NormalFamily, frequency_domain
 from contactlab.diagnose.generator_normal import NORMAL_EFFECTS
+
+matplotlib.use("Agg")
 
 SEED = 4242
 SMALL = {"samples_per_cycle": 80, "magnitude": 0.1}
@@ -83,6 +86,11 @@ def test_clean_normal_data_names_nothing_and_two_effects_are_found():
     assert rep.effects == []
     assert rep.final_model.params["k"] == pytest.approx(1.3e12, rel=0.01)
     assert isinstance(rep.final_model.base, contactlab.normal.KelvinVoigt)
+    from matplotlib.figure import Figure
+
+    for fn in (rep.plot_overlay, rep.plot_residual, rep.plot_location, rep.plot_gap):
+        ax = Figure().add_subplot()
+        assert fn(ax=ax) is ax
     pair = ["channel_delay", "stiffness_nonlinearity"]
     rec = hidden_effect_recording(pair, model="normal", seed=SEED + 2, **SMALL)
     rep = contactlab.diagnose(rec, model="normal")

@@ -156,3 +156,40 @@ def test_prepared_rejects_bad_time():
     t[60:] += 5e-4
     with pytest.raises(InputError, match="uniformly"):
         Prepared.build(t, np.sin(t), np.sin(t))
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.floats(-1.0, 1.0), st.floats(-1.0, 1.0), st.floats(-1.0, 1.0), st.integers(1, 7))
+def test_harmonic_shares_split_known_components(c0, c1, c2, n):
+    from contactlab.diagnose.locate import harmonic_shares
+
+    phase = np.linspace(0.0, 40 * np.pi, 8000, endpoint=False)
+    e = c0 + c1 * np.cos(phase) + c2 * np.sin(n * phase)
+    h = harmonic_shares(phase, e)
+    tot = np.sum(e * e)
+    if tot < 1e-9:
+        return
+    assert h["mean"] == pytest.approx(c0 * c0 * phase.size / tot, abs=1e-6)
+    expect = np.zeros(7)
+    expect[0] += c1 * c1 / 2
+    expect[n - 1] += c2 * c2 / 2
+    np.testing.assert_allclose(h["per_harmonic"], expect * phase.size / tot, atol=1e-6)
+    assert h["odd"] + h["even"] + h["mean"] == pytest.approx(1.0, abs=1e-6)
+
+
+def test_locate_statements_carry_numbers():
+    from contactlab.diagnose.locate import locate
+
+    rec = hidden_effect_recording([], noise=0.01, seed=8)
+    t, x, F = rec.arrays()
+    d = Prepared.build(t, x, F)
+    # a residual that lives right after reversals: 100 % of its power there
+    e = np.where(d.cycles.phase_in_branch < 0.05, 1.0, 0.0)
+    statements, nums = locate(d, -e, FAM)
+    assert nums["after_reversal"][0] == pytest.approx(1.0)
+    assert statements[0].startswith("100 % of the residual power is in the")
+    assert all(any(ch.isdigit() for ch in s) for s in statements)
+    # a residual growing over the recording
+    statements, nums = locate(d, -(t / t[-1]), FAM)
+    r = nums["time_thirds_rms"]
+    assert r[0] < r[1] < r[2]
