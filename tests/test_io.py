@@ -361,3 +361,23 @@ def test_failed_write_leaves_nothing_behind(tmp_path, monkeypatch, fmt):
         write_recording(p, _rec(50))
     monkeypatch.setattr(atomic.os, "replace", real)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_mat_v4_is_read(tmp_path):
+    import scipy.io
+
+    p = tmp_path / "v4.mat"
+    scipy.io.savemat(p, {"t": np.arange(3.0), "x": np.ones(3), "F": np.zeros(3)}, format="4")
+    rec = read_recording(p)
+    np.testing.assert_array_equal(rec["x"], np.ones(3))
+
+
+def test_recording_window():
+    rec = _rec(100, fs=100.0)
+    w = rec.window(0.2, 0.5)
+    np.testing.assert_allclose(w.t, rec.t[20:50])
+    np.testing.assert_array_equal(w["F"], rec["F"][20:50])
+    assert w.meta["window"] == (0.2, 0.5) and w.units == rec.units
+    assert len(rec.window(t0=0.9)) == 10 and len(rec.window(t1=0.1)) == 10
+    with pytest.raises(InputError, match="holds 0 samples"):
+        rec.window(5.0, 6.0)

@@ -137,6 +137,19 @@ class Recording:
             return float("nan")
         return float((self.t.size - 1) / (self.t[-1] - self.t[0]))
 
+    def window(self, t0: float | None = None, t1: float | None = None) -> Recording:
+        """The samples with ``t0 <= t < t1`` (either end open when None), as a new recording
+        (e.g. to drop a run-in before the loops settle)."""
+        a = 0 if t0 is None else int(np.searchsorted(self.t, t0, side="left"))
+        b = self.t.size if t1 is None else int(np.searchsorted(self.t, t1, side="left"))
+        if b - a < 2:
+            raise InputError(
+                f"{self.source}: the window [{t0}, {t1}) holds {max(b - a, 0)} samples"
+            )
+        meta = dict(self.meta, window=(t0, t1))
+        data = {k: v[a:b].copy() for k, v in self.data.items()}
+        return Recording(self.t[a:b].copy(), data, dict(self.units), self.source, meta)
+
     @property
     def kind(self) -> str | None:
         """``"tangential"``, ``"normal"`` or None, from the channels present."""

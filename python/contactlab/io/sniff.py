@@ -49,6 +49,16 @@ def content_format(path: Path) -> str:
     return "csv"
 
 
+def _is_mat4(path: Path) -> bool:
+    """MATLAB v4 files have no text header; ask scipy whether it can list the variables."""
+    import scipy.io
+
+    try:
+        return bool(scipy.io.whosmat(path))
+    except Exception:  # any parse failure means: not a v4 file
+        return False
+
+
 def format_of(path: Path, fmt: str | None = None) -> str:
     """The format to read ``path`` with: from its extension (or ``fmt``), verified by content."""
     if not path.exists():
@@ -63,6 +73,8 @@ def format_of(path: Path, fmt: str | None = None) -> str:
                 file=str(path),
             )
     content = content_format(path)
+    if fmt == "mat" and content == "binary" and _is_mat4(path):
+        return fmt
     ok = {
         "csv": ("csv",),
         "tdms": ("tdms",),

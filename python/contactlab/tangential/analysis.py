@@ -39,9 +39,10 @@ from .model import (
     steady_loop_force,
     steady_signal_force,
     turn_nodes,
+    turn_values,
     virgin_signal_force,
 )
-from .preprocess import AveragedLoop, average_loop, find_reversals, monotone_path
+from .preprocess import AveragedLoop, Reversals, average_loop, find_reversals, monotone_path
 from .result import TangentialAnalysis
 
 #: ``ac·A`` above which the loop is taken to have reached gross sliding (branch slope at the
@@ -310,6 +311,7 @@ def analyze_tangential(
     sl = slice(start, None)
     first_is_peak = rev.first_is_peak
     nodes = turn_nodes(xpath, rev.peaks, rev.valleys) if on == "signal" and steady else None
+    vnodes = _virgin_nodes(xa, ta, xpath, rev) if on == "signal" and not steady else None
 
     def predict(v: dict[str, float]) -> np.ndarray:
         m = _model(v)
@@ -318,7 +320,7 @@ def analyze_tangential(
         elif steady:
             Fm = steady_signal_force(m, xpath, v["x0"], v["amplitude"], nodes, first_is_peak)
         else:
-            Fm = virgin_signal_force(m, xpath, v["x0"])
+            Fm = virgin_signal_force(m, xpath, v["x0"], vnodes)
         return Fm + v["offset"]
 
     def residual(v: dict[str, float]) -> np.ndarray:
@@ -427,12 +429,11 @@ def analyze_tangential(
     derived["k_global"] = _propagate(lambda v, A: float(_model(v).global_stiffness(A)))
     derived["peak_force"] = _propagate(lambda v, A: float(_model(v).virgin(A)))
     if loop is not None:
-        e_num = loop_area(loop.x, loop.F)
-        e_sem = (
-            float(np.std(scatter.energy, ddof=1) / math.sqrt(scatter.n_cycles))
-            if scatter is not None and scatter.n_cycles > 1
-            else math.nan
-        )
+        e_num, e_sem = _numeric_energy(loop, xa, Fa)
+        if drift[1] > 0 and scatter is not None:
+            # a drift error δs opens every cycle's polygon by δs·T·A
+            period = float(np.mean(scatter.period))
+            e_sem = math.hypot(e_sem, drift[1] * period * amplitude)
     else:
         e_num = loop_area(xa[start:], Fa[start:])
         e_sem = math.nan
@@ -492,6 +493,73 @@ def analyze_tangential(
         source=source,
         meta={"fit_start": start, "invert_force": bool(invert_force)},
     )
+
+
+def _virgin_nodes(
+    x: np.ndarray, t: np.ndarray | None, xpath: np.ndarray, rev: Reversals
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """Measured turning points for a virgin-history fit, inserted between samples (where
+    the turn lies), with the projected path clipped so that no sample passes its turn."""
+    tt = np.arange(x.size, dtype=float) if t is None else t
+    times = np.r_[rev.peak_times, rev.valley_times]
+    if times.size == 0:
+        return None
+    is_peak = np.r_[np.ones(rev.peaks.size, bool), np.zeros(rev.valleys.size, bool)]
+    idx = np.r_[rev.peaks, rev.valleys].astype(np.int64)
+    gaps = np.diff(np.sort(times))
+    half = 0.1 * float(np.median(gaps)) if gaps.size else 0.05 * float(tt[-1] - tt[0])
+    vals = turn_values(tt, x, times, half)
+    pos, val = [], []
+    for i, p_, v in zip(idx, is_peak, vals, strict=True):
+        if not np.isfinite(v):
+            continue
+        sign = 1.0 if p_ else -1.0
+        left = sign * xpath[i - 1] if i > 0 else -np.inf
+        right = sign * xpath[i + 1] if i + 1 < x.size else -np.inf
+        pos.append(i + 1 if right >= left else i)
+        val.append(v)
+        # no sample beyond its turn (noise would make the operator turn twice)
+        near = np.abs(tt - tt[i]) <= half
+        xpath[near] = np.minimum(xpath[near], v) if p_ else np.maximum(xpath[near], v)
+    if not pos:
+        return None
+    order = np.argsort(pos, kind="stable")
+    return np.asarray(pos, dtype=np.int64)[order], np.asarray(val, dtype=float)[order]
+
+
+def _numeric_energy(loop: AveragedLoop, x: np.ndarray, F: np.ndarray) -> tuple[float, float]:
+    """Energy per cycle as the mean area ``∮ F dx`` of the complete cycles' own samples, and
+    its standard error.
+
+    Each cycle's shoelace area is linear in each sample's ``F`` (and ``x``), with coefficients
+    half the neighbours' difference in ``x`` (in ``F``), and sensor noise is independent from
+    sample to sample, so the error follows from the per-sample noise variances, pooled over all
+    phase bins from the cycle-to-cycle spread (many degrees of freedom, unlike the spread of a
+    handful of per-cycle areas). Areas of raw samples, not of bin means, which would cut the
+    corners at the turns.
+    """
+    e = loop.scatter.energy
+    if loop.cycle_bounds is None or not np.any(np.isfinite(e)):
+        return float(loop_area(loop.x, loop.F)), math.nan
+    n = loop.n_cycles
+    if n < 2:
+        return float(np.nanmean(e)), math.nan
+    per_cycle = loop.count / n
+    s2F = float(np.nanmean(loop.F_std**2 * per_cycle))
+    s2x = float(np.nanmean(loop.x_std**2 * per_cycle))
+    var = 0.0
+    for k in range(n):
+        a, b = int(loop.cycle_bounds[k]), int(loop.cycle_bounds[k + 1])
+        xs, Fs = x[a:b], F[a:b]
+        dA_dF = 0.5 * (np.roll(xs, 1) - np.roll(xs, -1))
+        dA_dx = 0.5 * (np.roll(Fs, -1) - np.roll(Fs, 1))
+        var += float(np.sum(dA_dF**2) * s2F + np.sum(dA_dx**2) * s2x)
+    err = math.sqrt(var) / n
+    # Sampling also moves each cycle's polygon across the turns differently; when the areas
+    # scatter more than the noise explains, their own spread is the better error.
+    emp = float(np.nanstd(e, ddof=1)) / math.sqrt(n)
+    err = max(err, emp) if math.isfinite(emp) else err
+    return float(np.nanmean(e)), err if math.isfinite(err) else math.nan
 
 
 def _tip(loop: AveragedLoop, first: int, k: int) -> tuple[float, float] | None:

@@ -91,9 +91,43 @@ def steady_signal_force(
     return model.force(np.concatenate([prime, path]))[3:][keep]
 
 
-def virgin_signal_force(model: Masing, x: np.ndarray, x0: float) -> np.ndarray:
-    """Force along a recording that starts at rest at displacement ``x0``."""
-    return model.force(np.concatenate([[0.0], x - x0]))[1:]
+def virgin_signal_force(
+    model: Masing,
+    x: np.ndarray,
+    x0: float,
+    nodes: tuple[np.ndarray, ...] | None = None,
+) -> np.ndarray:
+    """Force along a recording that starts at rest at displacement ``x0``.
+
+    ``nodes = (positions, values)`` inserts measured turning points into the path (see
+    :func:`turn_values`); the model is returned at the samples only.
+    """
+    if nodes is None:
+        return model.force(np.concatenate([[0.0], x - x0]))[1:]
+    pos, val = nodes
+    path = np.insert(x, pos, val)
+    keep = np.ones(path.size, dtype=bool)
+    keep[pos + np.arange(pos.size)] = False
+    return model.force(np.concatenate([[0.0], path - x0]))[1:][keep]
+
+
+def turn_values(
+    t: np.ndarray, x: np.ndarray, centres: np.ndarray, half_window: float
+) -> np.ndarray:
+    """Displacement at each turn, by regressing the samples within ``half_window`` of the
+    turn instant on ``|Δt|`` and ``Δt²`` (unbiased for rounded and sharp turns alike; the
+    largest noisy sample would overestimate the excursion)."""
+    out = np.empty(centres.size)
+    for k, tc in enumerate(centres):
+        sel = np.abs(t - tc) <= half_window
+        dt = t[sel] - tc
+        if dt.size < 4:
+            out[k] = np.nan
+            continue
+        X = np.column_stack([np.ones(dt.size), np.abs(dt), dt * dt])
+        coef, *_ = np.linalg.lstsq(X, x[sel], rcond=None)
+        out[k] = coef[0]
+    return out
 
 
 def area_ratio(z: float) -> float:

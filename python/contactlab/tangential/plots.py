@@ -33,12 +33,13 @@ def plot_loop(analysis: TangentialAnalysis, ax: Any = None, *, show_scatter: boo
         loop = a.loop
         order = np.r_[np.arange(loop.x.size), 0]
         if show_scatter and loop.n_cycles > 1:
-            ax.fill_between(
-                loop.x[order] * um,
-                (loop.F - loop.F_std)[order],
-                (loop.F + loop.F_std)[order],
-                color="0.8",
-                label=f"±1σ over {loop.n_cycles} cycles",
+            ax.vlines(
+                loop.x * um,
+                loop.F - loop.F_std,
+                loop.F + loop.F_std,
+                color="0.75",
+                lw=1.0,
+                label=f"±1σ cycle to cycle ({loop.n_cycles} cycles)",
             )
         ax.plot(loop.x * um, loop.F, ".", ms=3, color="C0", label="averaged loop")
         ax.plot(a.x[order] * um, a.F_model[order], "-", color="C3", lw=1.5, label="Masing fit")

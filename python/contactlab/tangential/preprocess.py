@@ -171,7 +171,7 @@ class CycleScatter:
 
     amplitude: np.ndarray  # half the x range of the cycle's bin-averaged loop, m
     force_range: np.ndarray  # half the F range of the cycle's loop, N
-    energy: np.ndarray  # loop area of the cycle, J
+    energy: np.ndarray  # area of the cycle's own samples (closed polygon), J
     period: np.ndarray  # s
     mean_force: np.ndarray  # mean force over the cycle (mean of its bin means), N
     time: np.ndarray  # middle of the cycle (mean of its two peak instants), s
@@ -210,6 +210,7 @@ class AveragedLoop:
     cycle_end: int
     phase_mean: np.ndarray | None = None  # mean phase (within the cycle) of each bin's samples
     phase_sq: np.ndarray | None = None  # mean squared phase of each bin's samples
+    cycle_bounds: np.ndarray | None = None  # first sample of each cycle, and the end
 
     @property
     def n_cycles(self) -> int:
@@ -243,6 +244,15 @@ def phase_of(t: np.ndarray, rev: Reversals) -> tuple[np.ndarray, int, int]:
     end = int(np.searchsorted(t, kt[-1], side="left"))
     ph = np.interp(t[start:end], kt, kp)
     return ph, start, end
+
+
+def _period_means(t: np.ndarray, v: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """Time average of ``v`` between consecutive ``edges`` (trapezoid rule, interpolated at
+    the edges). For a periodic signal this does not depend on where the period starts, so
+    the jitter of the turn instants does not leak into it (as sample-counting would)."""
+    c = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))])
+    ce = np.interp(edges, t, c)
+    return np.diff(ce) / np.diff(edges)
 
 
 def _dphase(v: np.ndarray, n: int) -> np.ndarray:
@@ -342,24 +352,27 @@ def average_loop(
     dphi = cphi - phim
     x_std = _spread(cx - _dphase(xm, n_points) * dphi)
     F_std = _spread(cF - _dphase(Fm, n_points) * dphi)
+    # sample index where each cycle starts (and where the last one ends)
+    bounds = start + np.searchsorted(cyc, np.arange(n_cyc + 1))
     amps, franges, energies = [], [], []
     for k in range(n_cyc):
-        ok = np.isfinite(cx[k]) & np.isfinite(cF[k])
         amps.append(0.5 * (np.nanmax(cx[k]) - np.nanmin(cx[k])))
         franges.append(0.5 * (np.nanmax(cF[k]) - np.nanmin(cF[k])))
-        energies.append(loop_area(cx[k][ok], cF[k][ok]) if ok.sum() >= 3 else np.nan)
+        # the area of the cycle's own samples: bin means would cut the corners at the turns
+        a, b2 = int(bounds[k]), int(bounds[k + 1])
+        energies.append(loop_area(xa[a:b2], Fa[a:b2]) if b2 - a >= 3 else np.nan)
     scatter = CycleScatter(
         amplitude=np.asarray(amps),
         force_range=np.asarray(franges),
         energy=np.asarray(energies),
         period=np.diff(rev.peak_times),
-        mean_force=np.nanmean(cF, axis=1),
+        mean_force=_period_means(ta, Fa, rev.peak_times),
         time=0.5 * (rev.peak_times[:-1] + rev.peak_times[1:]),
     )
     phase = (np.arange(n_points) + 0.5) / n_points
     phase_sq = np.bincount(b, frac * frac, n_points) / count
     return AveragedLoop(
-        phase, xm, Fm, count, x_std, F_std, scatter, rev, start, end, phim, phase_sq
+        phase, xm, Fm, count, x_std, F_std, scatter, rev, start, end, phim, phase_sq, bounds
     )
 
 
