@@ -6,7 +6,9 @@ models), fitting, reports and model-discrepancy diagnosis. See README.md.
 
 from __future__ import annotations
 
-from . import normal
+# `contactlab.diagnose` is the subpackage, made callable: `contactlab.diagnose(recording,
+# model=...)` runs the workflow while `contactlab.diagnose.<module>` imports keep working.
+from . import diagnose, normal
 from .errors import ContactLabError, ContactLabWarning, ConvergenceError, InputError
 from .fitting import FitResult, Parameter, least_squares_fit
 from .io import Recording, RecordingError, read_recording, write_recording
@@ -31,6 +33,7 @@ __all__ = [
     "__version__",
     "analyze_tangential",
     "cycle_energies",
+    "diagnose",
     "least_squares_fit",
     "loop_area",
     "normal",

@@ -20,6 +20,7 @@ _VERB_MODULES = [
     "contactlab.commands.study",
     "contactlab.commands.simulate",
     "contactlab.demo",
+    "contactlab.diagnose.cli",
 ]
 
 

@@ -1,0 +1,39 @@
+"""Model-discrepancy workflow: where model and measurement disagree, which effect is
+missing, and how much the gap shrinks once it is added (issue 5).
+
+>>> import contactlab
+>>> from contactlab.diagnose import hidden_effect_recording
+>>> report = contactlab.diagnose(hidden_effect_recording(["channel_delay"], seed=0))
+>>> report.effect_names
+['channel_delay']
+"""
+
+from __future__ import annotations
+
+import sys
+import types
+from typing import Any
+
+from .generator import HiddenEffectRecording, hidden_effect_recording
+from .model import ExtendedModel
+from .workflow import DiagnosisReport, Effect, Step, diagnose
+
+__all__ = [
+    "DiagnosisReport",
+    "Effect",
+    "ExtendedModel",
+    "HiddenEffectRecording",
+    "Step",
+    "diagnose",
+    "hidden_effect_recording",
+]
+
+
+class _CallableModule(types.ModuleType):
+    """``contactlab.diagnose(...)`` calls :func:`diagnose`; attributes are the subpackage's."""
+
+    def __call__(self, *args: Any, **kwargs: Any) -> DiagnosisReport:
+        return diagnose(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule

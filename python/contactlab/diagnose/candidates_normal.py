@@ -1,0 +1,244 @@
+"""Normal contact: the linear Kelvin-Voigt base model and its candidate extensions.
+
+Base model (PHYSICS.md §2, Konowalski 2009 eqs. 8-15): ``p = k δ + h δ'`` with
+``h = ψ k / (2π ω)``, driven by the measured dynamic pressure ``p(t) - p0`` and predicting
+the measured displacement ``δ(t)``. ``p0``, the static pressure at which ``δ`` was zeroed,
+is fitted with ``k`` and ``ψ`` (the mean of a recording of whole cycles is only close to
+it); ``ω``, the angular frequency at which ψ holds, is the excitation's, estimated from the
+recording. Simulated with
+:class:`contactlab.normal.KelvinVoigt` (the package's integrator; none is written here).
+
+Candidates (name: model, parameters):
+
+- ``stiffness_nonlinearity``: ``k_s(δ) = k (1 + κ (δ/δ_r)²)`` in eq. 17 — symmetric
+  hardening, the paper's own step from the linear to the nonlinear model; ``kappa``.
+- ``asymmetric_branches``: ``k_s(δ) = k (1 + a δ/δ_r)`` — the compression (δ > 0) and relief
+  (δ < 0) branches of the loop have different stiffness; ``a``.
+- ``hysteretic_damping``: a rate-independent loss ``η k`` besides the viscous one, in the
+  frequency domain ``δ̂ = p̂ / (k + i ω h + i η k sgn ω)``; ``eta``.
+- ``creep_drift``: ``δ += D (1 - exp(-t/τ_c))``, the joint settling over the cycles;
+  ``D`` (m), ``tau_c`` (s).
+- ``channel_delay``: ``δ(t) = δ_model(t - τ)``, the displacement channel lags; ``tau`` (s).
+
+``δ_r`` is the RMS of the measured displacement, so ``kappa`` and ``a`` are dimensionless;
+the paper's eq. 6 coefficients follow as ``a1 = k``, ``a2 = k a / δ_r``, ``a3 = k κ / δ_r²``.
+Both stiffness candidates run through :class:`contactlab.normal.NonlinearContact` (eq. 17,
+where the damping ``ψ k_s / (2π ω)`` follows the stiffness as in the paper). The hysteretic
+model is linear and solved by FFT on a smooth periodic continuation of the record (its ideal
+form is non-causal, so it has no time-domain integrator); for ``η = 0`` it reproduces the
+Kelvin-Voigt integration. Hysteretic damping combined with a stiffness nonlinearity is not offered.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from scipy import fft
+
+from ..errors import InputError
+from ._family import Candidate, ParamSpec, Prepared
+from ._signal import shift
+
+_INF = np.inf
+
+CANDIDATES: dict[str, Candidate] = {
+    c.name: c
+    for c in (
+        Candidate(
+            "stiffness_nonlinearity",
+            (ParamSpec("kappa", "-", 0.0, -0.15, 10.0, "one"),),
+            "stiffness growing with displacement, k_s(δ) = k (1 + κ (δ/δ_r)²) (eq. 17)",
+        ),
+        Candidate(
+            "hysteretic_damping",
+            (ParamSpec("eta", "-", 0.0, 0.0, 2.0, "psi"),),
+            "rate-independent loss factor η (energy per cycle independent of frequency)",
+        ),
+        Candidate(
+            "creep_drift",
+            (
+                ParamSpec("D", "m", 0.0, -_INF, _INF, "delta"),
+                ParamSpec("tau_c", "s", np.nan, 0.0, _INF, "T"),
+            ),
+            "displacement creeping over the cycles, D (1 - exp(-t/τ_c))",
+        ),
+        Candidate(
+            "channel_delay",
+            (ParamSpec("tau", "s", 0.0, -_INF, _INF, "tau"),),
+            "displacement channel lags the pressure channel by tau",
+        ),
+        Candidate(
+            "asymmetric_branches",
+            (ParamSpec("a", "-", 0.0, -0.4, 0.4, "one"),),
+            "different stiffness on the compression and relief sides, k (1 + a δ/δ_r)",
+        ),
+    )
+}
+
+BASE_PARAMS = (
+    ParamSpec("k", "Pa/m", _INF, 0.0, _INF, "k"),
+    ParamSpec("psi", "-", _INF, 1e-6, 10.0, "psi"),
+    ParamSpec("p0", "Pa", _INF, -_INF, _INF, "p"),
+)
+
+
+#: Relative tolerance of the ODE solves: far below any sensor noise, and cheap.
+RTOL = 1e-6
+
+
+def _delta(res: Any, n: int) -> np.ndarray:
+    """Displacement from an :class:`~contactlab.normal.OdeResult`.
+
+    A solve that stopped early (``success`` False, e.g. a trial stiffness that is not
+    positive) gives the samples reached, then holds the last value: a finite, large residual
+    that steers the optimiser away instead of aborting the fit.
+    """
+    d = np.asarray(res.delta, dtype=float)
+    if res.success and d.size == n:
+        return d
+    out = np.empty(n)
+    m = d.size
+    out[:m] = d
+    out[m:] = d[-1] if m else 0.0
+    return out
+
+
+def kelvin_voigt(t: np.ndarray, pd: np.ndarray, k: float, psi: float, omega: float) -> np.ndarray:
+    """Linear Kelvin-Voigt response via :class:`contactlab.normal.KelvinVoigt`."""
+    from ..normal import KelvinVoigt
+
+    return _delta(KelvinVoigt(k, psi, omega).simulate(t, pd, rtol=RTOL), pd.size)
+
+
+def nonlinear(
+    t: np.ndarray, pd: np.ndarray, coeffs: tuple[float, ...], psi: float, omega: float
+) -> np.ndarray:
+    """Eq. 17 with ``k_s(δ) = Σ coeffs[i] δ^i``, via :class:`contactlab.normal.NonlinearContact`."""
+    from ..normal import NonlinearContact
+
+    model = NonlinearContact(k_s_delta=list(coeffs), psi=psi, omega=omega)
+    return _delta(model.simulate(t, pd, rtol=RTOL), pd.size)
+
+
+def frequency_domain(
+    t: np.ndarray, pd: np.ndarray, k: float, psi: float, omega: float, eta: float
+) -> np.ndarray:
+    """``δ̂ = p̂ / (k + i ω h + i η k sgn ω)`` on a periodic continuation of the record.
+
+    The record is continued by a raised-cosine blend from its last value back to its first
+    (at least as long as the record and ten Kelvin-Voigt time constants), so the continuation
+    is smooth, the record starts in equilibrium with ``p(t0)`` (as the time-domain models do)
+    and the non-local hysteretic kernel sees no artificial jump.
+    """
+    n = pd.size
+    dt = float(t[1] - t[0])
+    tau_kv = psi / (2.0 * np.pi * omega)
+    pad = int(min(max(n, 10 * tau_kv / dt), 50 * n))
+    m = fft.next_fast_len(n + pad, real=True)
+    s = np.linspace(0.0, 1.0, m - n + 2)[1:-1]
+    blend = pd[-1] + (pd[0] - pd[-1]) * 0.5 * (1.0 - np.cos(np.pi * s))
+    P = fft.rfft(np.concatenate([pd, blend]))
+    w = 2.0 * np.pi * fft.rfftfreq(m, dt)
+    h = psi * k / (2.0 * np.pi * omega)
+    sgn = np.sign(w)
+    return fft.irfft(P / (k + 1j * w * h + 1j * eta * k * sgn), m)[:n]
+
+
+class NormalFamily:
+    """Kelvin-Voigt base model with the normal-contact candidate library."""
+
+    kind = "normal"
+    base_params = BASE_PARAMS
+    candidates = CANDIDATES
+    input_name = "p"
+    output_name = "delta"
+
+    def prepare(self, d: Prepared) -> None:
+        """Mean pressure, excitation angular frequency and displacement scale.
+
+        Values already in ``d.extra`` (from a fitted model's context) are kept: ``omega`` and
+        ``delta_r`` belong to the model's parameters.
+        """
+        d.extra.setdefault("omega", 2.0 * np.pi / (d.cycles.period_samples * d.dt))
+        if "delta_r" not in d.extra:
+            if not np.isfinite(d.y).all():
+                raise InputError("delta_r is needed to simulate a fitted normal model")
+            d.extra["delta_r"] = float(np.sqrt(np.mean(d.y * d.y))) or 1.0
+
+    def context(self, d: Prepared) -> dict[str, float]:
+        """What a fitted model needs to be simulated on another excitation."""
+        return {"omega": d.extra["omega"], "delta_r": d.extra["delta_r"]}
+
+    def scales(self, d: Prepared) -> dict[str, float]:
+        pd = d.u - np.mean(d.u)
+        dr = d.extra["delta_r"]
+        pr = float(np.sqrt(np.mean(pd * pd)))
+        return {
+            "k": pr / dr,
+            "p": 0.1 * pr,
+            "psi": 0.1,
+            "one": 1.0,
+            "delta": dr,
+            "T": d.duration,
+            "tau": d.cycles.period_samples * d.dt / 100.0,
+        }
+
+    def initial_base(self, d: Prepared) -> dict[str, float]:
+        p0 = float(np.mean(d.u))
+        pd = d.u - p0
+        k = float(pd @ pd) / float(pd @ d.y) if float(pd @ d.y) > 0 else self.scales(d)["k"]
+        return {"k": abs(k), "psi": 0.1, "p0": p0}
+
+    def check(self, effects: tuple[str, ...]) -> bool:
+        """Whether these effects can be combined."""
+        stiff = {"stiffness_nonlinearity", "asymmetric_branches"} & set(effects)
+        return not (stiff and "hysteretic_damping" in effects)
+
+    def predict(self, p: dict[str, float], effects: tuple[str, ...], d: Prepared) -> np.ndarray:
+        """Measured displacement predicted for the measured pressure ``d.u``."""
+        if not self.check(effects):
+            raise InputError("hysteretic damping cannot be combined with a stiffness nonlinearity")
+        pd = d.u - p["p0"]
+        om = d.extra["omega"]
+        k, psi = p["k"], p["psi"]
+        if "hysteretic_damping" in effects:
+            delta = frequency_domain(d.t, pd, k, psi, om, p["eta"])
+        elif "stiffness_nonlinearity" in effects or "asymmetric_branches" in effects:
+            dr = d.extra["delta_r"]
+            a = p.get("a", 0.0) if "asymmetric_branches" in effects else 0.0
+            kap = p.get("kappa", 0.0) if "stiffness_nonlinearity" in effects else 0.0
+            delta = nonlinear(d.t, pd, (k, k * a / dr, k * kap / dr**2), psi, om)
+        else:
+            delta = kelvin_voigt(d.t, pd, k, psi, om)
+        if "creep_drift" in effects:
+            tc = max(p["tau_c"], 1e-6 * d.duration)
+            delta = delta + p["D"] * -np.expm1(-(d.t - d.t[0]) / tc)
+        if "channel_delay" in effects:
+            delta = shift(delta, d.t, p["tau"])
+        return delta
+
+    def derived(
+        self, p: dict[str, float], se: dict[str, float], effect: str
+    ) -> tuple[dict[str, float], dict[str, float]]:
+        return {}, {}
+
+    def base_model(self, p: dict[str, float], context: dict[str, float]) -> Any:
+        from ..normal import KelvinVoigt
+
+        return KelvinVoigt(p["k"], p["psi"], context["omega"], p0=p["p0"])
+
+    @staticmethod
+    def loop_energy(u: np.ndarray, y: np.ndarray) -> float:
+        """Energy dissipated per cycle per unit area, ``∮ p dδ``."""
+        from ..masing import loop_area
+
+        return loop_area(y, u)
+
+
+def start_from_model(model: Any) -> dict[str, float] | None:
+    """Starting parameters from a normal-contact model object, or None if not one."""
+    k, psi = getattr(model, "k", None), getattr(model, "psi", None)
+    if isinstance(k, float | int) and isinstance(psi, float | int):
+        return {"k": float(k), "psi": float(psi)}
+    return None

@@ -1,0 +1,230 @@
+"""Tangential contact: the Masing base model and its library of candidate extensions.
+
+Base model (PHYSICS.md §1): Masing hysteresis with the exponential virgin curve
+``f(u) = h0 (1 - exp(-ac u))`` and branch scale 2, force ``h = M(x)`` for the measured
+displacement history ``x``. Candidate effects, each with its own fitted parameters:
+
+========================  =========================================================  =========
+name                      measured force ``F`` (or measured ``x``)                   params
+========================  =========================================================  =========
+``viscous_damping``       ``F = h + c ẋ``                                             c  [N s/m]
+``inertia``               ``F = h + m ẍ``  (mass between sensor and contact)          m  [kg]
+``parallel_stiffness``    ``F = h + k_p x`` (rig flexures in parallel)                k_p [N/m]
+``series_compliance``     ``x = x_c + C_s h`` (rig compliance in series)              C_s [m/N]
+``force_offset``          ``F = h + F0`` (sensor bias)                                F0 [N]
+``channel_delay``         ``F(t) = h(t - τ)`` (force channel lags displacement)       tau [s]
+``asymmetry``             ``F = h + α |h|``: saturation ``h0(1 ± α)`` per direction   alpha [-]
+``non_masing_scaling``    branch scale ``λ`` instead of 2, loops kept closed           lam [-]
+``parameter_drift``       ``h0(t) = h0 (1 + β t/T)``, i.e. ``F = h (1 + β t/T)``      beta [-]
+========================  =========================================================  =========
+
+Notes on exactness. The exponential Masing force is linear in ``h0`` at fixed ``ac`` along a
+history, so the drift factor is exact. A linear spring in series with a Masing element is
+again a Masing element whose virgin curve is ``x(u) = u + C_s f(u)`` against ``f(u)`` (the
+branch rule ``x - x_r = λ g⁻¹((F - F_r)/λ)`` holds for the sum because both parts obey it),
+so the series compliance is solved exactly by reparametrising the virgin curve and using
+:meth:`contactlab.Masing.from_backbone`. The branch scale uses
+:mod:`contactlab.diagnose.scaled_masing` (λ-scaled branch shape anchored at both ends),
+because ``Masing(..., scale=λ)`` jumps where the memory rules end a branch and so cannot
+be fitted to noisy data. ``ẋ`` and ``ẍ`` are Savitzky-Golay derivatives of the
+measured displacement; the delay is a fractional-sample shift by linear interpolation.
+When several effects are active they compose in this order: series compliance and branch
+scale inside the Masing element; asymmetry and drift on its force; the additive terms
+(parallel stiffness, viscous, inertia, offset); the delay on the total measured force.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..masing import Masing, loop_area
+from ._family import Candidate, ParamSpec, Prepared
+from ._signal import shift
+from .scaled_masing import memory, scaled_force
+
+_INF = np.inf
+
+CANDIDATES: dict[str, Candidate] = {
+    c.name: c
+    for c in (
+        Candidate(
+            "viscous_damping",
+            (ParamSpec("c", "N s/m", 0.0, 0.0, _INF, "c"),),
+            "viscous force c·ẋ in parallel with the contact",
+        ),
+        Candidate(
+            "inertia",
+            (ParamSpec("m", "kg", 0.0, 0.0, _INF, "m"),),
+            "inertial force m·ẍ of the mass between force sensor and contact",
+        ),
+        Candidate(
+            "parallel_stiffness",
+            (ParamSpec("k_p", "N/m", 0.0, 0.0, _INF, "k"),),
+            "linear spring k_p·x in parallel (rig flexures, guides)",
+        ),
+        Candidate(
+            "series_compliance",
+            (ParamSpec("C_s", "m/N", 0.0, 0.0, _INF, "C"),),
+            "measured displacement includes rig compliance C_s·F",
+        ),
+        Candidate(
+            "force_offset",
+            (ParamSpec("F0", "N", 0.0, -_INF, _INF, "F"),),
+            "constant force-sensor bias F0",
+        ),
+        Candidate(
+            "channel_delay",
+            (ParamSpec("tau", "s", 0.0, -_INF, _INF, "tau"),),
+            "force channel lags the displacement channel by tau",
+        ),
+        Candidate(
+            "asymmetry",
+            (ParamSpec("alpha", "-", 0.0, -0.95, 0.95, "one"),),
+            "saturation force h0(1+alpha) in the positive, h0(1-alpha) in the negative direction",
+        ),
+        Candidate(
+            "non_masing_scaling",
+            (ParamSpec("lam", "-", 2.0, 0.2, 20.0, "one"),),
+            "branch scale lam instead of Masing's 2 (generalised Masing rule)",
+        ),
+        Candidate(
+            "parameter_drift",
+            (ParamSpec("beta", "-", 0.0, -0.95, 5.0, "one"),),
+            "saturation force drifting over the recording: h0(t) = h0 (1 + beta t/T)",
+        ),
+    )
+}
+
+BASE_PARAMS = (
+    ParamSpec("h0", "N", _INF, 0.0, _INF, "F"),
+    ParamSpec("ac", "1/m", _INF, 0.0, _INF, "ac"),
+)
+
+_SERIES_POINTS = 400
+
+
+def series_backbone(h0: float, ac: float, C_s: float, x_max: float) -> tuple[np.ndarray, ...]:
+    """Virgin curve of a Masing element in series with compliance ``C_s``, as points.
+
+    ``x(u) = u + C_s f(u)`` against ``f(u)``, ``u`` from 0 to ``3 x_max`` on a grid that is
+    dense where the curve bends.
+    """
+    s = np.linspace(0.0, 1.0, _SERIES_POINTS)
+    u = 3.0 * x_max * s * s
+    f = h0 * -np.expm1(-ac * u)
+    return u + C_s * f, f
+
+
+class TangentialFamily:
+    """Masing base model with the tangential candidate library (see module docstring)."""
+
+    kind = "tangential"
+    base_params = BASE_PARAMS
+    candidates = CANDIDATES
+    input_name = "x"
+    output_name = "F"
+
+    def prepare(self, d: Prepared) -> None:
+        """Nothing to precompute beyond :class:`Prepared` (memory is cached lazily)."""
+
+    def context(self, d: Prepared) -> dict[str, float]:
+        """Nothing beyond the parameters is needed to simulate a fitted model."""
+        return {}
+
+    def check(self, effects: tuple[str, ...]) -> bool:
+        """All tangential effects combine (in the order of the module docstring)."""
+        return True
+
+    def scales(self, d: Prepared) -> dict[str, float]:
+        rms = lambda a: float(np.sqrt(np.mean(a * a))) or 1.0  # noqa: E731
+        Fs, xs = rms(d.y - np.mean(d.y)), rms(d.u - np.mean(d.u))
+        return {
+            "F": Fs,
+            "ac": 1.0 / xs,
+            "c": Fs / rms(d.ud),
+            "m": Fs / rms(d.udd),
+            "k": Fs / xs,
+            "C": xs / Fs,
+            "tau": d.cycles.period_samples * d.dt / 100.0,
+            "one": 1.0,
+        }
+
+    def initial_base(self, d: Prepared) -> dict[str, float]:
+        """Grid over ``ac·max|x|`` with ``h0`` by linear least squares (F is linear in h0)."""
+        xmax = float(np.max(np.abs(d.u)))
+        best = (np.inf, 1.0, 1.0)
+        for q in np.geomspace(0.2, 50.0, 13):
+            ac = q / xmax
+            g = Masing(1.0, ac).force(d.u)
+            gg = float(g @ g)
+            if gg == 0.0:
+                continue
+            h0 = max(float(g @ d.y) / gg, 1e-12)
+            r = float(np.sum((h0 * g - d.y) ** 2))
+            if r < best[0]:
+                best = (r, h0, ac)
+        return {"h0": best[1], "ac": best[2]}
+
+    def predict(self, p: dict[str, float], effects: tuple[str, ...], d: Prepared) -> np.ndarray:
+        """Measured force predicted for the measured displacement ``d.u``."""
+        x = d.u
+        if "series_compliance" in effects:
+            xmax = float(np.max(np.abs(x))) or 1.0
+            bx, bf = series_backbone(p["h0"], p["ac"], max(p["C_s"], 0.0), xmax)
+            core = Masing.from_backbone(bx, bf)
+        else:
+            core = Masing(p["h0"], p["ac"])
+        if "non_masing_scaling" in effects:
+            mem = d.extra.get("memory")
+            if mem is None:
+                mem = d.extra["memory"] = memory(x)
+            h = scaled_force(core.virgin, p["lam"], mem)
+        else:
+            h = core.force(x)
+        if "asymmetry" in effects:
+            h = h + p["alpha"] * np.abs(h)
+        if "parameter_drift" in effects:
+            h = h * (1.0 + p["beta"] * (d.t - d.t[0]) / d.duration)
+        F = h
+        if "parallel_stiffness" in effects:
+            F = F + p["k_p"] * x
+        if "viscous_damping" in effects:
+            F = F + p["c"] * d.ud
+        if "inertia" in effects:
+            F = F + p["m"] * d.udd
+        if "force_offset" in effects:
+            F = F + p["F0"]
+        if "channel_delay" in effects:
+            F = shift(F, d.t, p["tau"])
+        return F
+
+    def derived(
+        self, p: dict[str, float], se: dict[str, float], effect: str
+    ) -> tuple[dict[str, float], dict[str, float]]:
+        """Extra reported quantities of an effect (with delta-method standard errors)."""
+        if effect == "series_compliance" and p["C_s"] > 0:
+            return {"k_s": 1.0 / p["C_s"]}, {"k_s": se["C_s"] / p["C_s"] ** 2}
+        if effect == "asymmetry":
+            h0, a = p["h0"], p["alpha"]
+            s = float(np.hypot(se["h0"] * (1 + a), h0 * se["alpha"]))
+            s2 = float(np.hypot(se["h0"] * (1 - a), h0 * se["alpha"]))
+            return {"h0_plus": h0 * (1 + a), "h0_minus": h0 * (1 - a)}, {
+                "h0_plus": s,
+                "h0_minus": s2,
+            }
+        if effect == "parameter_drift":
+            h0, b = p["h0"], p["beta"]
+            return {"h0_end": h0 * (1 + b)}, {
+                "h0_end": float(np.hypot(se["h0"] * (1 + b), h0 * se["beta"]))
+            }
+        return {}, {}
+
+    def base_model(self, p: dict[str, float], context: dict[str, float]) -> Any:
+        return Masing(p["h0"], p["ac"])
+
+    @staticmethod
+    def loop_energy(u: np.ndarray, y: np.ndarray) -> float:
+        """Energy dissipated around one cycle, ``∮ F dx``."""
+        return loop_area(u, y)

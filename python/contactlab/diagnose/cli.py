@@ -1,0 +1,47 @@
+"""``contactlab diagnose FILE --model tangential|normal [--json OUT] [--report DIR]``.
+
+Reads the recording (any format :func:`contactlab.io.read_recording` knows), runs
+:func:`contactlab.diagnose`, prints the findings and the gap-shrink table, and optionally
+writes the JSON result and a self-contained HTML report. Outputs are written atomically.
+"""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from .._io_atomic import write_text
+
+
+def add_parser(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "diagnose",
+        help="find where model and measurement disagree and which effect is missing",
+        description=__doc__.split("\n\n")[1] if __doc__ else None,
+    )
+    p.add_argument("file", metavar="FILE", help="recording (CSV, TDMS, HDF5, MAT)")
+    p.add_argument("--model", choices=["tangential", "normal"], required=True)
+    p.add_argument("--json", metavar="OUT", help="write the result as JSON to OUT")
+    p.add_argument("--report", metavar="DIR", help="write DIR/diagnose.html")
+    p.add_argument("--max-effects", type=int, default=3, help="stop after this many additions")
+    p.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..io import read_recording
+    from .workflow import diagnose
+
+    rec = read_recording(args.file, kind=args.model)
+    report = diagnose(rec, model=args.model, max_effects=args.max_effects)
+    print(report.summary())
+    if args.json:
+        write_text(args.json, report.to_json() + "\n")
+    if args.report:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from ._html import write_html
+
+        path = write_html(report, args.report)
+        print(f"report: {path}")
+    return 0

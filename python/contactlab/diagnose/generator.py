@@ -1,0 +1,327 @@
+"""Recordings with hidden effects: the experiment behind the discrepancy workflow's tests.
+
+:func:`hidden_effect_recording` simulates a test-rig recording of a contact joint with zero,
+one or several effects of the candidate library switched on, adds sensor noise, and returns
+the recording together with the truth (which the workflow is never shown). Users can run
+the same experiment on their own rig parameters to see what the workflow can and cannot
+tell apart at their noise level.
+
+Excitation. A sine whose amplitude and frequency step smoothly through three blocks
+(amplitudes ``(0.6, 1.5, 3.0) / ac``, frequencies ``(1, 1.7, 0.6) · f0`` for the tangential
+joint), as on a rig tested at several amplitudes and rates. Several rates are needed to tell
+rate-dependent effects (viscous damping, inertia) from rate-independent ones, and several
+amplitudes to separate the virgin-curve parameters. Transitions use a cubic smooth-step, so
+the displacement is twice differentiable and known in closed form at any time.
+
+Magnitude. The size of an effect is the RMS change of the measured output it causes (all
+else equal, before any fit), relative to the RMS of the output. The physical parameter is
+solved for that size; its sign is drawn from the seed where both signs are physical.
+
+Every effect is simulated by its own route where one exists: the delay by evaluating the
+excitation at ``t - τ`` in closed form, viscous and inertial forces from the exact
+derivatives of the excitation, series compliance by adding ``F/k_s`` to the contact
+displacement, so agreement with the workflow's models is a real check.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ..errors import InputError
+from ..io import Recording
+from ..masing import Masing
+from .scaled_masing import memory, scaled_force
+
+TANGENTIAL_EFFECTS = (
+    "viscous_damping",
+    "inertia",
+    "parallel_stiffness",
+    "series_compliance",
+    "force_offset",
+    "channel_delay",
+    "asymmetry",
+    "non_masing_scaling",
+    "parameter_drift",
+)
+
+
+@dataclass
+class HiddenEffectRecording(Recording):
+    """A generated :class:`contactlab.io.Recording` (SI units; write it with
+    :func:`contactlab.io.write_recording`) that also carries the ``truth``: base parameters,
+    active effects with their parameters, magnitudes and noise levels."""
+
+    truth: dict[str, Any] = field(default_factory=dict)
+    model: str = "tangential"
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        keys = ("x", "F") if self.model == "tangential" else ("p", "delta")
+        return self.t, self.data[keys[0]], self.data[keys[1]]
+
+
+class Profile:
+    """A piecewise-constant level smoothed by cubic steps of width ``w``, with its integral."""
+
+    def __init__(self, levels: Iterable[float], starts: Iterable[float], w: float) -> None:
+        self.levels = np.asarray(list(levels), float)
+        self.starts = np.asarray(list(starts), float)
+        self.w = float(w)
+
+    def __call__(self, t: np.ndarray) -> np.ndarray:
+        out = np.full_like(t, self.levels[0], dtype=float)
+        for lv_prev, lv, ts in zip(self.levels[:-1], self.levels[1:], self.starts, strict=True):
+            u = np.clip((t - ts) / self.w, 0.0, 1.0)
+            out += (lv - lv_prev) * u * u * (3.0 - 2.0 * u)
+        return out
+
+    def integral(self, t: np.ndarray) -> np.ndarray:
+        out = self.levels[0] * t
+        for lv_prev, lv, ts in zip(self.levels[:-1], self.levels[1:], self.starts, strict=True):
+            u = (t - ts) / self.w
+            uc = np.clip(u, 0.0, 1.0)
+            part = np.where(u > 1.0, 0.5 + (u - 1.0), uc**3 - uc**4 / 2.0)
+            out += (lv - lv_prev) * self.w * np.where(u < 0.0, 0.0, part)
+        return out
+
+
+def block_excitation(
+    amplitudes: Iterable[float], freqs: Iterable[float], cycles_per_block: int
+) -> tuple[Callable[[np.ndarray], np.ndarray], float, float]:
+    """Closed-form excitation ``x(t)`` (zero for ``t < 0``), its duration and max frequency."""
+    A = list(amplitudes)
+    f = list(freqs)
+    durations = [cycles_per_block / fi for fi in f]
+    starts = np.cumsum(durations)[:-1]
+    w = 1.0 / min(f)
+    # amplitude ramps in from zero over the first cycle, so x(t) = 0 for t < 0 joins smoothly
+    amp = Profile([0.0, *A], [0.0, *(starts - w / 2)], w)
+    fr = Profile(f, starts - w / 2, w)
+    total = float(np.sum(durations))
+
+    def x(t: np.ndarray) -> np.ndarray:
+        tt = np.asarray(t, float)
+        val = amp(tt) * np.sin(2.0 * np.pi * fr.integral(tt))
+        return np.where(tt < 0.0, 0.0, val)
+
+    return x, total, max(f)
+
+
+def _derivs(fun: Callable[[np.ndarray], np.ndarray], t: np.ndarray, T: float):
+    h = 1e-4 * T
+    d1 = (fun(t + h) - fun(t - h)) / (2 * h)
+    d2 = (fun(t + h) - 2 * fun(t) + fun(t - h)) / (h * h)
+    return d1, d2
+
+
+def _rms(a: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(a * a)))
+
+
+def _tangential_force(
+    effects: Mapping[str, float],
+    t: np.ndarray,
+    xfun: Callable[[np.ndarray], np.ndarray],
+    h0: float,
+    ac: float,
+    period: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Noise-free measured ``(x, F)`` with the given effect parameters (by effect name)."""
+    tau = effects.get("channel_delay", 0.0)
+    xc = xfun(t - tau)  # the contact moves as x(t - τ) when the force channel lags by τ
+    if "non_masing_scaling" in effects:
+        h = scaled_force(Masing(h0, ac).virgin, effects["non_masing_scaling"], memory(xc))
+    else:
+        h = Masing(h0, ac).force(xc)
+    if "asymmetry" in effects:
+        h = h + effects["asymmetry"] * np.abs(h)
+    if "parameter_drift" in effects:
+        h = h * (1.0 + effects["parameter_drift"] * (t - t[0]) / (t[-1] - t[0]))
+    x_meas = xfun(t)
+    if "series_compliance" in effects:
+        x_meas = x_meas + h * effects["series_compliance"]
+    F = h
+    v, a = _derivs(xfun, t - tau, period)
+    if "parallel_stiffness" in effects:
+        F = F + effects["parallel_stiffness"] * xc
+    if "viscous_damping" in effects:
+        F = F + effects["viscous_damping"] * v
+    if "inertia" in effects:
+        F = F + effects["inertia"] * a
+    if "force_offset" in effects:
+        F = F + effects["force_offset"]
+    return x_meas, F
+
+
+_PARAM_NAME = {
+    "viscous_damping": "c",
+    "inertia": "m",
+    "parallel_stiffness": "k_p",
+    "series_compliance": "C_s",
+    "force_offset": "F0",
+    "channel_delay": "tau",
+    "asymmetry": "alpha",
+    "non_masing_scaling": "lam",
+    "parameter_drift": "beta",
+}
+
+
+def hidden_effect_recording(
+    effects: Iterable[str] | Mapping[str, float] = (),
+    *,
+    model: str = "tangential",
+    magnitude: float = 0.05,
+    noise: float = 0.01,
+    seed: int = 0,
+    cycles_per_block: int = 6,
+    samples_per_cycle: int = 120,
+    **base: float,
+) -> HiddenEffectRecording:
+    """Simulate a recording with hidden effects and sensor noise.
+
+    Parameters
+    ----------
+    effects : iterable of str or mapping
+        Effect names from the candidate library, or ``{name: magnitude}`` to give each its
+        own size. Empty: the base model only (clean data).
+    model : {"tangential", "normal"}
+        Which joint and candidate library.
+    magnitude : float
+        Size of each effect: RMS change of the measured output it causes, relative to the
+        output's RMS (0.05 = 5 %).
+    noise : float
+        Output sensor noise RMS relative to the output's RMS; the input channel gets a
+        fifth of that (relative to its own RMS). White, Gaussian.
+    seed : int
+        Random seed (noise and the sign of effects that may have either sign).
+    cycles_per_block, samples_per_cycle : int
+        Excitation cycles per amplitude block (three blocks) and samples per cycle at the
+        reference frequency.
+    **base
+        Base-model parameters: tangential ``h0`` (N, default 50), ``ac`` (1/m, default 5e4),
+        ``f0`` (Hz, default 5).
+
+    Returns
+    -------
+    HiddenEffectRecording
+        ``t``, ``data`` (``x``, ``F`` in SI units) and ``truth``.
+
+    Examples
+    --------
+    >>> from contactlab.diagnose import hidden_effect_recording
+    >>> rec = hidden_effect_recording(["channel_delay"], magnitude=0.05, seed=1)
+    >>> sorted(rec.data), rec.truth["effects"]["channel_delay"]["tau"] > 0
+    (['F', 'x'], True)
+    """
+    if model == "normal":
+        from .generator_normal import hidden_effect_recording_normal
+
+        return hidden_effect_recording_normal(
+            effects,
+            magnitude=magnitude,
+            noise=noise,
+            seed=seed,
+            cycles_per_block=cycles_per_block,
+            samples_per_cycle=samples_per_cycle,
+            **base,
+        )
+    if model != "tangential":
+        raise InputError(f"model must be 'tangential' or 'normal', got {model!r}")
+    sizes = _sizes(effects, magnitude, TANGENTIAL_EFFECTS)
+    h0 = float(base.pop("h0", 50.0))
+    ac = float(base.pop("ac", 5e4))
+    f0 = float(base.pop("f0", 5.0))
+    if base:
+        raise InputError(f"unknown base parameter(s) {sorted(base)} for the tangential model")
+    rng = np.random.default_rng(seed)
+    xfun, T, fmax = block_excitation(
+        np.array([0.6, 1.5, 3.0]) / ac, np.array([1.0, 1.7, 0.6]) * f0, cycles_per_block
+    )
+    fs = samples_per_cycle * f0
+    t = np.arange(round(T * fs) + 1) / fs
+    period = 1.0 / fmax
+    _x0, F0 = _tangential_force({}, t, xfun, h0, ac, period)
+    Fr = _rms(F0)
+
+    def size(name: str, value: float) -> float:
+        x1, F1 = _tangential_force({name: value}, t, xfun, h0, ac, period)
+        # measured output change, on the measured displacement (what a base fit would see)
+        F_on_x1 = Masing(h0, ac).force(x1)
+        return _rms(F1 - F_on_x1) / Fr
+
+    params: dict[str, float] = {}
+    for name, target in sizes.items():
+        sign = 1.0
+        if name in ("force_offset", "asymmetry", "parameter_drift", "non_masing_scaling"):
+            sign = 1.0 if rng.random() < 0.5 else -1.0
+        params[name] = _solve_size(name, target, sign, size, h0, ac, Fr, period)
+    x, F = _tangential_force(params, t, xfun, h0, ac, period)
+    x_noise = 0.2 * noise * _rms(x)
+    F_noise = noise * _rms(F)
+    xm = x + rng.normal(0.0, x_noise, x.size)
+    Fm = F + rng.normal(0.0, F_noise, F.size)
+    truth = {
+        "model": "tangential",
+        "base": {"h0": h0, "ac": ac, "f0": f0},
+        "effects": {n: {_PARAM_NAME[n]: v} for n, v in params.items()},
+        "magnitudes": dict(sizes),
+        "noise_rms": {"x": x_noise, "F": F_noise},
+    }
+    return HiddenEffectRecording(
+        t,
+        {"x": xm, "F": Fm},
+        {"x": "m", "F": "N"},
+        source="hidden_effect_recording",
+        meta={"kind": "tangential"},
+        truth=truth,
+        model="tangential",
+    )
+
+
+def _sizes(
+    effects: Iterable[str] | Mapping[str, float], magnitude: float, known: tuple[str, ...]
+) -> dict[str, float]:
+    sizes = dict(effects) if isinstance(effects, Mapping) else dict.fromkeys(effects, magnitude)
+    for n, m in sizes.items():
+        if n not in known:
+            raise InputError(f"unknown effect {n!r}; choose from {', '.join(known)}")
+        if not (0.0 < float(m) < 1.0):
+            raise InputError(f"magnitude of {n} must be in (0, 1), got {m}")
+    return {n: float(m) for n, m in sizes.items()}
+
+
+def _solve_size(
+    name: str,
+    target: float,
+    sign: float,
+    size: Callable[[str, float], float],
+    h0: float,
+    ac: float,
+    Fr: float,
+    period: float,
+) -> float:
+    """Physical parameter value whose output change has the requested relative RMS."""
+    null = 2.0 if name == "non_masing_scaling" else 0.0
+    hi = {
+        "viscous_damping": 10.0 * Fr * period * ac,
+        "inertia": 10.0 * Fr * period**2 * ac,
+        "parallel_stiffness": 10.0 * h0 * ac,
+        "series_compliance": 10.0 / (h0 * ac),
+        "force_offset": 2.0 * Fr,
+        "channel_delay": 0.25 * period,
+        "asymmetry": 0.9,
+        "non_masing_scaling": 1.5 if sign > 0 else 0.9,
+        "parameter_drift": 0.9,
+    }[name]
+
+    def g(s: float) -> float:
+        return size(name, null + sign * s) - target
+
+    if g(hi) < 0:
+        raise InputError(f"magnitude {target:g} is out of reach for {name}")
+    s = brentq(g, 0.0, hi, xtol=1e-12 * hi, rtol=1e-6)
+    return null + sign * s

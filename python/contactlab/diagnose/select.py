@@ -1,0 +1,245 @@
+"""Fitting candidate models and choosing among them.
+
+Every candidate model (the current model plus one more effect) is fitted with the recording
+split into folds of whole excitation cycles (cycle k goes to fold k mod K; a cycle is held
+out from the fit that predicts it, while the model is still simulated over the full history,
+as hysteresis needs). The held-out error is what ranks candidates. A candidate is accepted
+only if all three hold:
+
+1. its held-out mean-square error is lower by at least ``min_gain · σ²``, where σ is the
+   noise level estimated from the data (:func:`contactlab.diagnose._signal.noise_rms`);
+2. that improvement is consistent across held-out cycles: the per-cycle log ratios
+   ``ln(MSE_current / MSE_candidate)`` have ``mean / standard error > z`` (cycles, not
+   samples, are the independent units, so slowly varying residuals do not inflate the
+   evidence; ratios, not differences, so that cycles of large amplitude or rate — where
+   rate-dependent effects are largest — do not swamp the others);
+3. the Bayesian information criterion of the fit to all data decreases.
+
+The accepted candidate with the largest held-out gain wins.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from ..fitting import Parameter, least_squares_fit
+from ._family import Family, ParamSpec, Prepared
+
+
+@dataclass
+class FitOut:
+    """Parameters fitted on a subset of samples, with standard errors from the Jacobian."""
+
+    params: dict[str, float]
+    stderr: dict[str, float]
+    rss: float
+    n: int
+    nfree: int
+    success: bool
+    message: str
+    nfev: int
+
+    @property
+    def bic(self) -> float:
+        return float(self.n * np.log(max(self.rss, 1e-300) / self.n) + self.nfree * np.log(self.n))
+
+
+def specs_for(family: Family, effects: tuple[str, ...]) -> list[ParamSpec]:
+    out = list(family.base_params)
+    for e in effects:
+        out.extend(family.candidates[e].params)
+    return out
+
+
+def fit(
+    family: Family,
+    effects: tuple[str, ...],
+    d: Prepared,
+    mask: np.ndarray,
+    start: dict[str, float],
+    scales: dict[str, float],
+) -> FitOut:
+    """Least-squares fit of the base and effect parameters on the samples in ``mask``.
+
+    Runs :func:`contactlab.fitting.least_squares_fit`. Each parameter is passed as
+    ``w = (value - start) / typical + 1`` — centred at 1 and of order 1 per typical change —
+    because that function scales each variable by its initial value, which would be
+    meaningless for an effect starting at its "absent" value 0. Parameters ``start`` lacks
+    begin at their absent value; standard errors are mapped back (``inf`` where the fitting
+    layer reports a parameter as not identifiable).
+    """
+    specs = specs_for(family, effects)
+    names = [s.name for s in specs]
+    sc = {s.name: scales[s.name] if s.name in scales else scales[s.scale] for s in specs}
+    x0: dict[str, float] = {}
+    for s in specs:
+        v = float(start.get(s.name, s.null))
+        if not np.isfinite(v):  # no "absent" value (e.g. a time constant): a typical one
+            v = 0.3 * sc[s.name]
+        span = s.upper - s.lower if np.isfinite(s.upper - s.lower) else sc[s.name]
+        # strictly inside the bounds, so a start at "absent" (often a bound) can move
+        x0[s.name] = float(np.clip(v, s.lower + 1e-6 * span, s.upper - 1e-6 * span))
+    params = [
+        Parameter(
+            s.name,
+            1.0,
+            min=(s.lower - x0[s.name]) / sc[s.name] + 1.0,
+            max=(s.upper - x0[s.name]) / sc[s.name] + 1.0,
+            unit=s.unit,
+        )
+        for s in specs
+    ]
+    y = d.y[mask]
+    # residuals in units of the output's RMS: the solver's gradient tolerance is absolute,
+    # and a displacement residual in metres (1e-9) would stop it at the first step
+    ys = float(np.sqrt(np.mean(y * y))) or 1.0
+
+    def value(w: dict[str, float]) -> dict[str, float]:
+        return {n: x0[n] + (w[n] - 1.0) * sc[n] for n in names}
+
+    def resid(w: dict[str, float]) -> np.ndarray:
+        return (family.predict(value(w), effects, d)[mask] - y) / ys
+
+    res = least_squares_fit(resid, params, ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=400)
+    w = {n: res.params[n].value for n in names}
+    se = {
+        n: (res.params[n].stderr * sc[n] if res.params[n].stderr is not None else np.inf)
+        for n in names
+    }
+    return FitOut(
+        value(w),
+        se,
+        float(res.chisqr) * ys * ys,
+        res.ndata,
+        res.nvarys,
+        res.success,
+        res.message,
+        res.nfev,
+    )
+
+
+@dataclass
+class Trial:
+    """A candidate model evaluated by cross-validation over cycles, then fitted to all data."""
+
+    effects: tuple[str, ...]
+    full: FitOut
+    prediction: np.ndarray  # held-out prediction for held-out samples, full fit elsewhere
+    heldout: np.ndarray  # boolean mask of samples that were held out
+    cycle_mse: np.ndarray  # held-out MSE per cycle
+    heldout_rms: float
+    heldout_peak: float
+    energy_error: float
+    fitted: np.ndarray  # prediction of the fit to all data
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    def full_residual(self, d: Prepared) -> np.ndarray:
+        """Residual (model minus measurement) of the fit to all data."""
+        return self.fitted - d.y
+
+    @property
+    def heldout_mse(self) -> float:
+        return self.heldout_rms**2
+
+
+def fold_masks(d: Prepared, folds: int) -> list[np.ndarray]:
+    """Test masks: cycle k (from one maximum of the input to the next) in fold k mod folds."""
+    cyc = d.cycles.cycle
+    if d.cycles.n_cycles < 2 * folds:
+        raise InputError(
+            f"the recording has {d.cycles.n_cycles} complete excitation cycles; the "
+            f"discrepancy workflow needs at least {2 * folds} to hold cycles out"
+        )
+    return [(cyc >= 0) & (cyc % folds == k) for k in range(folds)]
+
+
+def evaluate(
+    family: Family,
+    effects: tuple[str, ...],
+    d: Prepared,
+    start: dict[str, float],
+    scales: dict[str, float],
+    folds: int = 2,
+) -> Trial:
+    """Cross-validated held-out errors and the fit to all data of one model."""
+    masks = fold_masks(d, folds)
+    full = fit(family, effects, d, np.ones(d.y.size, bool), start, scales)
+    fitted = family.predict(full.params, effects, d)
+    pred = fitted.copy()
+    heldout = np.zeros(d.y.size, bool)
+    for test in masks:
+        f = fit(family, effects, d, ~test, full.params, scales)
+        pred[test] = family.predict(f.params, effects, d)[test]
+        heldout |= test
+    err = pred - d.y
+    cyc = d.cycles.cycle
+    ids = np.unique(cyc[heldout])
+    cycle_mse = np.array([np.mean(err[cyc == k] ** 2) for k in ids])
+    e_meas, e_mod = [], []
+    for k in ids:
+        sel = cyc == k
+        e_meas.append(family.loop_energy(d.u[sel], d.y[sel]))
+        e_mod.append(family.loop_energy(d.u[sel], pred[sel]))
+    e_meas_a, e_mod_a = np.array(e_meas), np.array(e_mod)
+    denom = float(np.sum(np.abs(e_meas_a)))
+    energy_error = float(np.sum(np.abs(e_mod_a - e_meas_a)) / denom) if denom > 0 else np.nan
+    eh = err[heldout]
+    return Trial(
+        effects,
+        full,
+        pred,
+        heldout,
+        cycle_mse,
+        float(np.sqrt(np.mean(eh * eh))),
+        float(np.max(np.abs(eh))),
+        energy_error,
+        fitted,
+    )
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Comparison of a candidate with the current model."""
+
+    name: str
+    heldout_rms: float
+    gain: float  # held-out MSE reduction in units of the noise variance
+    t_stat: float
+    delta_bic: float
+    accepted: bool
+    reason: str
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "name": self.name,
+            "heldout_rms": self.heldout_rms,
+            "gain_over_noise_var": self.gain,
+            "t_stat": self.t_stat,
+            "delta_bic": self.delta_bic,
+            "accepted": self.accepted,
+            "reason": self.reason,
+        }
+
+
+def judge(
+    name: str, current: Trial, cand: Trial, sigma: float, z: float, min_gain: float
+) -> Verdict:
+    """Apply the three acceptance rules of the module docstring."""
+    ratio = np.log(current.cycle_mse / cand.cycle_mse)
+    gain = float(current.heldout_mse - cand.heldout_mse) / sigma**2
+    sd = float(np.std(ratio, ddof=1)) if ratio.size > 1 else np.inf
+    t = float(np.mean(ratio) / (sd / np.sqrt(ratio.size))) if sd > 0 else np.inf
+    dbic = cand.full.bic - current.full.bic
+    if gain < min_gain:
+        reason = f"held-out gain {gain:.3g} σ² below {min_gain:g} σ²"
+    elif not t > z:
+        reason = f"gain not significant across held-out cycles (t = {t:.2f} <= {z:g})"
+    elif not dbic < 0:
+        reason = f"BIC does not decrease (ΔBIC = {dbic:+.1f})"
+    else:
+        reason = "accepted"
+    return Verdict(name, cand.heldout_rms, gain, t, dbic, reason == "accepted", reason)

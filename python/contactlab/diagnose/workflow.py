@@ -1,0 +1,359 @@
+"""The discrepancy workflow: fit the base model, locate the residual, name the missing
+effect from the candidate library, add it, repeat, and show the gap shrink.
+
+Steps (issue 5): (1) fit the base model — Masing with exponential virgin curve for a
+tangential joint, linear Kelvin-Voigt for a normal joint (PHYSICS.md §1, §2); (2) describe
+where the residual lives (:mod:`.locate`); (3) fit every candidate extension of the current
+model, rank by the error on held-out cycles and accept the best only if it passes the rules
+of :mod:`.select` against the noise level estimated from the data; (4) repeat until no
+candidate helps; (5) report held-out RMS, peak error and loop-energy error after each step.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .._arrays import as_1d
+from ..errors import InputError
+from ._family import Family, Prepared
+from ._signal import noise_rms
+from .locate import locate
+from .model import ExtendedModel
+from .select import Trial, Verdict, evaluate, judge
+
+__all__ = ["DiagnosisReport", "Effect", "Step", "diagnose"]
+
+
+@dataclass(frozen=True)
+class Effect:
+    """An effect added to the model, with fitted parameters and standard errors.
+
+    A standard error of ``inf`` means the parameter is not identifiable from this record.
+    """
+
+    name: str
+    parameters: dict[str, float]
+    stderr: dict[str, float]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "name": self.name,
+            "parameters": dict(self.parameters),
+            "stderr": {k: _finite_or_none(v) for k, v in self.stderr.items()},
+        }
+
+
+@dataclass(frozen=True)
+class Step:
+    """Held-out errors of the model after one step (``added`` is None for the base fit).
+
+    ``heldout_rms`` and ``heldout_peak``: RMS and largest absolute error of the output over
+    the held-out cycles (each cycle predicted by the fit that did not see it);
+    ``energy_error``: ``Σ |E_model - E_measured| / Σ |E_measured|`` over the held-out cycles,
+    ``E`` the loop area of one cycle; ``candidates``: the verdict on each candidate tried
+    after this step.
+    """
+
+    added: str | None
+    heldout_rms: float
+    heldout_peak: float
+    energy_error: float
+    candidates: tuple[Verdict, ...] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "added": self.added,
+            "heldout_rms": self.heldout_rms,
+            "heldout_peak": self.heldout_peak,
+            "energy_error": _finite_or_none(self.energy_error),
+        }
+
+
+def _finite_or_none(v: float) -> float | None:
+    return float(v) if np.isfinite(v) else None
+
+
+@dataclass
+class DiagnosisReport:
+    """What :func:`diagnose` found. ``to_dict()`` gives the JSON layout of issue 5.
+
+    Attributes
+    ----------
+    model : str
+        ``"tangential"`` or ``"normal"``.
+    effects : list of Effect
+        Effects added, in the order added (empty when the base model suffices).
+    steps : list of Step
+        Held-out RMS / peak / loop-energy error of the base model and after each addition,
+        with the verdict on every candidate tried at that step.
+    where : list of str
+        Where the base model's residual lives, as statements with numbers.
+    noise_rms : float
+        Output noise RMS estimated from the data (units of the output).
+    final_model : ExtendedModel
+        The base model plus the effects, ready to simulate or refit.
+    """
+
+    model: str
+    effects: list[Effect]
+    steps: list[Step]
+    where: list[str]
+    noise_rms: float
+    final_model: ExtendedModel
+    location: dict[str, Any] = field(repr=False, default_factory=dict)
+    _data: Prepared | None = field(repr=False, default=None)
+    _trials: list[Trial] = field(repr=False, default_factory=list)
+
+    @property
+    def effect_names(self) -> list[str]:
+        return [e.name for e in self.effects]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "model": self.model,
+            "effects": [e.to_dict() for e in self.effects],
+            "steps": [s.to_dict() for s in self.steps],
+            "where": list(self.where),
+            "noise_rms": self.noise_rms,
+        }
+
+    def to_json(self, indent: int = 2) -> str:
+        return json.dumps(self.to_dict(), indent=indent, allow_nan=False)
+
+    def table(self) -> str:
+        """The gap-shrink table as text."""
+        lines = [
+            f"{'step':<24}{'held-out RMS':>14}{'/ noise':>9}{'peak':>12}{'energy err':>12}",
+        ]
+        for s in self.steps:
+            name = "base model" if s.added is None else f"+ {s.added}"
+            lines.append(
+                f"{name:<24}{s.heldout_rms:>14.4g}{s.heldout_rms / self.noise_rms:>9.2f}"
+                f"{s.heldout_peak:>12.4g}{100 * s.energy_error:>11.2f}%"
+            )
+        return "\n".join(lines)
+
+    def summary(self) -> str:
+        """Findings, effects with parameters, and the gap-shrink table, as text."""
+        out = [f"contactlab diagnose — {self.model} model", ""]
+        out += ["Where the base model disagrees:"] + [f"  - {w}" for w in self.where]
+        out.append("")
+        if not self.effects:
+            out.append("No missing effect: no candidate improves the held-out error significantly.")
+        for e in self.effects:
+            ps = ", ".join(
+                f"{k} = {v:.4g} ± {e.stderr.get(k, np.nan):.2g}" for k, v in e.parameters.items()
+            )
+            out.append(f"Added {e.name}: {ps}")
+        out += ["", self.table(), f"noise RMS (estimated): {self.noise_rms:.4g}"]
+        return "\n".join(out)
+
+    # -- figures ------------------------------------------------------------------------------
+    def plot_overlay(self, step: int | None = None, ax: Any = None) -> Any:
+        """Measured and modelled loops (output against input), base model and final model."""
+        from .plots import plot_overlay
+
+        return plot_overlay(self, step=step, ax=ax)
+
+    def plot_residual(self, ax: Any = None) -> Any:
+        """Held-out residual over time, before (base) and after (final model)."""
+        from .plots import plot_residual
+
+        return plot_residual(self, ax=ax)
+
+    def plot_location(self, ax: Any = None) -> Any:
+        """Where the base residual lives: residual power by position in the branch."""
+        from .plots import plot_location
+
+        return plot_location(self, ax=ax)
+
+    def write_html(self, directory: Any) -> Any:
+        """Write a self-contained ``diagnose.html`` (figures and JSON) into ``directory``."""
+        from ._html import write_html
+
+        return write_html(self, directory)
+
+    def plot_gap(self, ax: Any = None) -> Any:
+        """Held-out RMS (in units of the noise level) after each step."""
+        from .plots import plot_gap
+
+        return plot_gap(self, ax=ax)
+
+
+def _family(model: Any) -> tuple[Family, dict[str, float], dict[str, float]]:
+    """Model family, starting parameters and context from a name or a model object."""
+    from ..masing import Masing
+
+    if isinstance(model, str):
+        if model == "tangential":
+            from .candidates_tangential import TangentialFamily
+
+            return TangentialFamily(), {}, {}
+        if model == "normal":
+            from .candidates_normal import NormalFamily
+
+            return NormalFamily(), {}, {}
+        raise InputError(
+            f"model must be 'tangential' or 'normal' (or a model object), got {model!r}"
+        )
+    if isinstance(model, Masing):
+        from .candidates_tangential import TangentialFamily
+
+        if not model.is_exponential:
+            raise InputError("diagnose needs the exponential Masing model (h0, ac)")
+        return TangentialFamily(), {"h0": model.h0, "ac": model.ac}, {}
+    if isinstance(model, ExtendedModel):
+        return model.family, dict(model.params), dict(model.context)
+    from .candidates_normal import NormalFamily, start_from_model
+
+    start = start_from_model(model)
+    if start is not None:
+        if getattr(model, "p0", None) is not None:
+            start["p0"] = float(model.p0)
+        ctx = {"omega": float(model.omega)} if hasattr(model, "omega") else {}
+        return NormalFamily(), start, ctx
+    raise InputError(f"cannot diagnose a model of type {type(model).__name__}")
+
+
+def _arrays(recording: Any, family: Family) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(t, input, output)`` from a Recording-like object, a dict or a tuple of arrays."""
+    uname, yname = family.input_name, family.output_name
+    if hasattr(recording, "t") and hasattr(recording, "data"):
+        data, t = recording.data, recording.t
+    elif isinstance(recording, dict):
+        data, t = recording, recording.get("t")
+    elif isinstance(recording, Sequence) and len(recording) == 3:
+        t, u, y = recording
+        data = {uname: u, yname: y}
+    else:
+        raise InputError(
+            "recording must be a contactlab.io.Recording, a dict with 't', "
+            f"'{uname}', '{yname}', or a tuple (t, {uname}, {yname})"
+        )
+    for k in (uname, yname):
+        if k not in data:
+            raise InputError(
+                f"the {family.kind} workflow needs channels '{uname}' and '{yname}'; "
+                f"the recording has {sorted(data)}"
+            )
+    if t is None:
+        raise InputError("the recording has no time vector 't'")
+    ta = as_1d(t, "t")
+    u = as_1d(data[uname], uname)
+    y = as_1d(data[yname], yname)
+    if not (ta.size == u.size == y.size):
+        raise InputError(f"t, {uname}, {yname} have {ta.size}, {u.size}, {y.size} samples")
+    return ta, u, y
+
+
+def diagnose(
+    recording: Any,
+    model: Any = "tangential",
+    *,
+    candidates: Sequence[str] | None = None,
+    max_effects: int = 3,
+    folds: int = 2,
+    z: float = 3.0,
+    min_gain: float = 0.05,
+) -> DiagnosisReport:
+    """Find where a model and a measurement disagree, name the missing effect, add it.
+
+    Parameters
+    ----------
+    recording : contactlab.io.Recording, dict or tuple
+        The measurement: a Recording with channels ``x``, ``F`` (tangential) or ``p``,
+        ``delta`` (normal) in SI units, a dict with ``t`` and those keys, or a tuple
+        ``(t, x, F)`` / ``(t, p, delta)``. Uniform sampling; several excitation cycles.
+    model : {"tangential", "normal"} or model object
+        Base model family, or a model whose parameters start the fit
+        (:class:`contactlab.Masing`, a normal-contact model, or an :class:`ExtendedModel`
+        from an earlier diagnosis, whose effects are kept).
+    candidates : sequence of str, optional
+        Restrict the candidate library to these names (default: all of the family).
+    max_effects : int
+        Stop after this many additions.
+    folds : int
+        Cycles are split into this many interleaved folds for the held-out error.
+    z : float
+        Significance threshold (t statistic across held-out cycles).
+    min_gain : float
+        Minimum held-out MSE reduction, in units of the estimated noise variance.
+
+    Returns
+    -------
+    DiagnosisReport
+
+    Examples
+    --------
+    >>> import contactlab
+    >>> from contactlab.diagnose import hidden_effect_recording
+    >>> rec = hidden_effect_recording(["force_offset"], magnitude=0.05, seed=2)
+    >>> report = contactlab.diagnose(rec, model="tangential")
+    >>> report.effect_names
+    ['force_offset']
+    """
+    family, start, context = _family(model)
+    t, u, y = _arrays(recording, family)
+    if folds < 2:
+        raise InputError(f"folds must be >= 2, got {folds}")
+    names = list(family.candidates) if candidates is None else list(candidates)
+    for n in names:
+        if n not in family.candidates:
+            raise InputError(
+                f"unknown {family.kind} candidate {n!r}; choose from {', '.join(family.candidates)}"
+            )
+    d = Prepared.build(t, u, y)
+    d.extra.update(context)
+    family.prepare(d)
+    scales = family.scales(d)
+    effects: tuple[str, ...] = tuple(model.effects) if isinstance(model, ExtendedModel) else ()
+    if not start:
+        start = family.initial_base(d)
+    current = evaluate(family, effects, d, start, scales, folds)
+    sigma = noise_rms(current.full_residual(d))
+    if sigma <= 0:
+        raise InputError("the output channel has no noise at all; cannot judge significance")
+    where, location = locate(d, current.full_residual(d), family)
+    trials = [current]
+    steps = [Step(None, current.heldout_rms, current.heldout_peak, current.energy_error)]
+    added: list[str] = []
+    while len(added) < max_effects:
+        verdicts, best = [], None
+        for name in names:
+            if name in effects or not family.check((*effects, name)):
+                continue
+            cand = evaluate(family, (*effects, name), d, current.full.params, scales, folds)
+            v = judge(name, current, cand, sigma, z, min_gain)
+            verdicts.append(v)
+            if v.accepted and (best is None or v.gain > best[0].gain):
+                best = (v, cand)
+        steps[-1] = Step(
+            steps[-1].added,
+            steps[-1].heldout_rms,
+            steps[-1].heldout_peak,
+            steps[-1].energy_error,
+            tuple(sorted(verdicts, key=lambda v: v.heldout_rms)),
+        )
+        if best is None:
+            break
+        v, current = best
+        effects = current.effects
+        added.append(v.name)
+        trials.append(current)
+        steps.append(Step(v.name, current.heldout_rms, current.heldout_peak, current.energy_error))
+    p, se = current.full.params, current.full.stderr
+    out_effects = []
+    for name in added:
+        ps = {s.name: p[s.name] for s in family.candidates[name].params}
+        ss = {s.name: se[s.name] for s in family.candidates[name].params}
+        dp, ds = family.derived(p, se, name)
+        out_effects.append(Effect(name, {**ps, **dp}, {**ss, **ds}))
+    final = ExtendedModel(family, effects, p, se, family.context(d))
+    return DiagnosisReport(
+        family.kind, out_effects, steps, where, sigma, final, location, d, trials
+    )

@@ -1,0 +1,185 @@
+"""The discrepancy workflow on recordings with hidden effects (issue 5).
+
+The workflow sees only the recording. Each effect must be named alone, clean data must give
+nothing, two effects must both be named, and the held-out RMS must come down to within 1.5×
+the noise level estimated from the data. Seeds are arbitrary (not chosen to pass); the
+confusion matrix over many seeds, magnitudes and noise levels is benches/eval_diagnose.py.
+"""
+
+from __future__ import annotations
+
+import json
+
+import matplotlib
+import numpy as np
+import pytest
+
+import contactlab
+from contactlab import InputError
+from contactlab.diagnose import ExtendedModel, hidden_effect_recording
+from contactlab.diagnose.generator import TANGENTIAL_EFFECTS
+
+matplotlib.use("Agg")
+
+SEED = 20261123
+
+
+def _check_layout(d: dict) -> None:
+    assert set(d) == {"model", "effects", "steps", "where", "noise_rms"}
+    assert isinstance(d["model"], str) and isinstance(d["noise_rms"], float)
+    for e in d["effects"]:
+        assert set(e) == {"name", "parameters", "stderr"}
+        assert all(isinstance(v, float) for v in e["parameters"].values())
+    for s in d["steps"]:
+        assert set(s) == {"added", "heldout_rms", "heldout_peak", "energy_error"}
+    assert [s["added"] for s in d["steps"]] == [None] + [e["name"] for e in d["effects"]]
+    assert all(isinstance(w, str) for w in d["where"])
+    json.loads(json.dumps(d, allow_nan=False))
+
+
+@pytest.mark.parametrize("effect", TANGENTIAL_EFFECTS)
+def test_each_effect_is_named_alone(effect):
+    rec = hidden_effect_recording([effect], magnitude=0.05, noise=0.01, seed=SEED)
+    rep = contactlab.diagnose(rec, model="tangential")
+    assert rep.effect_names == [effect]
+    assert rep.steps[-1].heldout_rms <= 1.5 * rep.noise_rms
+    assert rep.steps[-1].heldout_rms < rep.steps[0].heldout_rms
+    _check_layout(rep.to_dict())
+
+
+def test_clean_data_names_nothing():
+    rec = hidden_effect_recording([], noise=0.01, seed=SEED)
+    rep = contactlab.diagnose(rec, model="tangential")
+    assert rep.effects == []
+    d = rep.to_dict()
+    _check_layout(d)
+    assert d["effects"] == [] and len(d["steps"]) == 1
+    assert rep.steps[0].heldout_rms <= 1.5 * rep.noise_rms
+    # every candidate was tried and refused, with a reason
+    assert len(rep.steps[0].candidates) == len(TANGENTIAL_EFFECTS)
+    assert all(not v.accepted for v in rep.steps[0].candidates)
+
+
+@pytest.mark.parametrize(
+    "pair",
+    [("channel_delay", "force_offset"), ("parameter_drift", "viscous_damping")],
+)
+def test_two_effects_are_both_named(pair):
+    rec = hidden_effect_recording(list(pair), magnitude=0.05, noise=0.01, seed=SEED + 1)
+    rep = contactlab.diagnose(rec, model="tangential")
+    assert sorted(rep.effect_names) == sorted(pair)
+    assert rep.steps[-1].heldout_rms <= 1.5 * rep.noise_rms
+    assert rep.steps[0].heldout_rms > rep.steps[1].heldout_rms > rep.steps[2].heldout_rms
+
+
+def test_parameters_recovered_within_their_errors():
+    rec = hidden_effect_recording(["channel_delay"], magnitude=0.05, noise=0.01, seed=SEED + 2)
+    rep = contactlab.diagnose(rec, model="tangential")
+    tau_true = rec.truth["effects"]["channel_delay"]["tau"]
+    (eff,) = rep.effects
+    assert abs(eff.parameters["tau"] - tau_true) < 5 * eff.stderr["tau"]
+    assert eff.stderr["tau"] < 0.05 * tau_true
+    p = rep.final_model.params
+    assert p["h0"] == pytest.approx(50.0, rel=0.01)
+    assert p["ac"] == pytest.approx(5e4, rel=0.02)
+    # the noise level estimated from the data includes the displacement noise seen through
+    # the contact stiffness, so it is a little above the force-sensor noise alone
+    assert 0.9 < rep.noise_rms / rec.truth["noise_rms"]["F"] < 1.3
+
+
+def test_final_model_is_an_ordinary_model():
+    rec = hidden_effect_recording(["force_offset"], magnitude=0.05, noise=0.01, seed=SEED + 3)
+    rep = contactlab.diagnose(rec)
+    m = rep.final_model
+    assert isinstance(m, ExtendedModel) and m.effects == ("force_offset",)
+    assert isinstance(m.base, contactlab.Masing)
+    F = m.simulate(rec.t, rec.data["x"])
+    assert np.sqrt(np.mean((F - rec.data["F"]) ** 2)) < 1.2 * rep.noise_rms
+    refit = m.fit(rec)
+    assert refit.params["F0"] == pytest.approx(m.params["F0"], rel=1e-3)
+    assert "F0" in m.report() and m.to_dict()["effects"] == ["force_offset"]
+    # a diagnosis can start from the model found before: nothing more to add
+    again = contactlab.diagnose(rec, model=m)
+    assert again.effects == [] and again.final_model.effects == ("force_offset",)
+
+
+def test_where_statements_point_at_the_effect():
+    rec = hidden_effect_recording(["force_offset"], magnitude=0.08, noise=0.01, seed=SEED + 4)
+    rep = contactlab.diagnose(rec)
+    assert rep.location["harmonics"]["mean"] > 0.5  # an offset is a constant residual
+    assert any("constant offset" in w for w in rep.where)
+    assert any("right after a reversal" in w for w in rep.where)
+    rec = hidden_effect_recording(["asymmetry"], magnitude=0.08, noise=0.01, seed=SEED + 4)
+    rep = contactlab.diagnose(rec)
+    h = rep.location["harmonics"]
+    assert h["even"] + h["mean"] > h["odd"]  # α|h| is even in the excitation phase
+
+
+def test_callable_package_attribute_and_plain_arrays():
+    import contactlab.diagnose.generator as gen  # the subpackage stays importable
+
+    rec = gen.hidden_effect_recording(["force_offset"], seed=SEED + 5)
+    a = contactlab.diagnose(rec.arrays(), model="tangential")
+    b = contactlab.diagnose.diagnose({"t": rec.t, **rec.data})
+    assert a.effect_names == b.effect_names == ["force_offset"]
+    assert a.to_dict() == b.to_dict()
+
+
+def test_plots_and_html(tmp_path):
+    rec = hidden_effect_recording(["viscous_damping"], magnitude=0.05, seed=SEED + 6)
+    rep = contactlab.diagnose(rec)
+    from matplotlib.figure import Figure
+
+    for fn in (rep.plot_overlay, rep.plot_residual, rep.plot_location, rep.plot_gap):
+        ax = Figure().add_subplot()
+        assert fn(ax=ax) is ax
+        assert ax.has_data()
+    path = rep.write_html(tmp_path / "out")
+    text = path.read_text(encoding="utf-8")
+    assert text.count("data:image/png;base64,") == 4
+    assert "&quot;viscous_damping&quot;" in text and "Gap shrink" in text
+    assert [p.name for p in (tmp_path / "out").iterdir()] == ["diagnose.html"]
+    assert "viscous_damping" in rep.summary() and "base model" in rep.table()
+
+
+def test_bad_input_is_named():
+    rec = hidden_effect_recording([], seed=SEED + 7)
+    t, x, F = rec.arrays()
+    bad = F.copy()
+    bad[123] = np.nan
+    with pytest.raises(InputError, match=r"F\[123\]"):
+        contactlab.diagnose((t, x, bad))
+    with pytest.raises(InputError, match="samples"):
+        contactlab.diagnose((t, x, F[:-5]))
+    with pytest.raises(InputError, match="model must be"):
+        contactlab.diagnose(rec, model="rotational")
+    with pytest.raises(InputError, match="unknown tangential candidate"):
+        contactlab.diagnose(rec, candidates=["wear"])
+    with pytest.raises(InputError, match="channels 'x' and 'F'"):
+        contactlab.diagnose({"t": t, "x": x, "force": F})
+    n = 260  # two cycles only: nothing to hold out
+    with pytest.raises(InputError, match="complete excitation cycles"):
+        contactlab.diagnose((t[:n], rec.data["x"][:n], rec.data["F"][:n]))
+
+
+def test_cli_diagnose_writes_json_and_report(tmp_path, capsys):
+    from contactlab.cli import main
+    from contactlab.io import write_recording
+
+    rec = hidden_effect_recording(["asymmetry"], magnitude=0.05, noise=0.01, seed=SEED + 8)
+    path = write_recording(tmp_path / "run.csv", rec)
+    out, rep = tmp_path / "result.json", tmp_path / "report"
+    code = main(
+        ["diagnose", str(path), "--model", "tangential", "--json", str(out), "--report", str(rep)]
+    )
+    assert code == 0
+    d = json.loads(out.read_text(encoding="utf-8"))
+    _check_layout(d)
+    assert [e["name"] for e in d["effects"]] == ["asymmetry"]
+    assert (rep / "diagnose.html").is_file()
+    text = capsys.readouterr().out
+    assert "asymmetry" in text and "held-out RMS" in text
+    # a file without the channels the model needs: one clear error line, exit code 1
+    code = main(["diagnose", str(path), "--model", "normal"])
+    assert code == 1
+    assert "diagnose: error:" in capsys.readouterr().err

@@ -1,0 +1,100 @@
+"""The discrepancy workflow on normal-contact recordings (Kelvin-Voigt base, issue 5).
+
+Recordings here are 18 cycles at 80 samples per cycle and effects of 10 % of the output RMS
+(one magnitude for all): at 5 % a channel delay is absorbed by the Kelvin-Voigt damping,
+whose relaxation time ``h/k`` delays ``δ`` by the same first-order phase ``ω τ`` at every
+frequency (benches/eval_diagnose.py --model normal gives the rates by magnitude).
+"""
+
+from __future__ import annotations
+
+import matplotlib
+import numpy as np
+import pytest
+
+import contactlab
+from contactlab.diagnose import hidden_effect_recording
+from contactlab.diagnose._family import Prepared
+from contactlab.diagnose.candidates_normal import NormalFamily, frequency_domain
+from contactlab.diagnose.generator_normal import NORMAL_EFFECTS
+
+matplotlib.use("Agg")
+
+SEED = 4242
+SMALL = {"samples_per_cycle": 80, "magnitude": 0.1}
+
+
+def test_frequency_domain_solution_matches_kelvin_voigt_integration():
+    # eta = 0: the FFT solution equals the package's ODE integration (which starts in
+    # equilibrium), also for a record that starts and ends away from zero pressure
+    from contactlab.normal import KelvinVoigt
+
+    t = np.arange(3000) * 2e-3
+    p = 4e5 * np.sin(2 * np.pi * 2.0 * t + 0.7) * (1 + 0.3 * np.sin(0.5 * t))
+    k, psi, om = 1.3e12, 0.0887, 2 * np.pi * 2.0
+    a = frequency_domain(t, p, k, psi, om, 0.0)
+    b = KelvinVoigt(k, psi, om).simulate(t, p, rtol=1e-10).delta
+    # the integrator continues p between samples by cubic Hermite with finite-difference
+    # slopes, the FFT by band-limited interpolation: they agree to ~(ω dt)² / 6
+    assert np.max(np.abs(a - b)) < 1e-3 * np.max(np.abs(b))
+    mid = slice(100, -100)
+    assert np.max(np.abs(a - b)[mid]) < 3e-4 * np.max(np.abs(b))
+
+
+def test_hysteretic_loss_is_rate_independent():
+    # energy per cycle of the hysteretic part: π η k A² at any frequency (steady state)
+    k, eta, A = 1e12, 0.05, 0.3e-6
+    for f in (0.5, 3.0):
+        t = np.arange(40 * 256) / (256 * f)
+        d = A * np.sin(2 * np.pi * f * t)
+        # invert: the pressure that produces this δ is k(1 + iη) in the frequency domain;
+        # check the forward solve returns δ for p = k δ + η k H[δ]
+        p = k * d + eta * k * A * np.cos(2 * np.pi * f * t)  # H[sin] = -cos; sign per sgn ω
+        out = frequency_domain(t, p, k, 1e-9, 2 * np.pi * f, eta)
+        mid = slice(10 * 256, 30 * 256)
+        assert np.max(np.abs(out[mid] - d[mid])) < 2e-3 * A
+
+
+@pytest.mark.parametrize("effect", NORMAL_EFFECTS)
+def test_candidate_reproduces_generator(effect):
+    rec = hidden_effect_recording([effect], model="normal", noise=1e-12, seed=SEED)
+    t, p, delta = rec.arrays()
+    fam = NormalFamily()
+    d = Prepared.build(t, p, delta)
+    d.extra.update({"omega": 2 * np.pi * rec.truth["base"]["f0"]})
+    d.extra["delta_r"] = rec.truth["base"]["delta_r"]
+    fam.prepare(d)
+    params = {k: rec.truth["base"][k] for k in ("k", "psi", "p0")}
+    for vals in rec.truth["effects"].values():
+        params.update(vals)
+    pred = fam.predict(params, (effect,), d)
+    rel = np.sqrt(np.mean((pred - delta) ** 2)) / np.sqrt(np.mean(delta**2))
+    assert rel < 2e-3
+
+
+@pytest.mark.parametrize("effect", NORMAL_EFFECTS)
+def test_each_normal_effect_is_named_alone(effect):
+    rec = hidden_effect_recording([effect], model="normal", seed=SEED, **SMALL)
+    rep = contactlab.diagnose(rec, model="normal")
+    assert rep.effect_names == [effect]
+    assert rep.steps[-1].heldout_rms <= 1.5 * rep.noise_rms
+
+
+def test_clean_normal_data_names_nothing_and_two_effects_are_found():
+    rec = hidden_effect_recording([], model="normal", seed=SEED + 1, **SMALL)
+    rep = contactlab.diagnose(rec, model="normal")
+    assert rep.effects == []
+    assert rep.final_model.params["k"] == pytest.approx(1.3e12, rel=0.01)
+    assert isinstance(rep.final_model.base, contactlab.normal.KelvinVoigt)
+    from matplotlib.figure import Figure
+
+    for fn in (rep.plot_overlay, rep.plot_residual, rep.plot_location, rep.plot_gap):
+        ax = Figure().add_subplot()
+        assert fn(ax=ax) is ax
+    pair = ["channel_delay", "stiffness_nonlinearity"]
+    rec = hidden_effect_recording(pair, model="normal", seed=SEED + 2, **SMALL)
+    rep = contactlab.diagnose(rec, model="normal")
+    assert sorted(rep.effect_names) == sorted(pair)
+    assert rep.steps[-1].heldout_rms <= 1.5 * rep.noise_rms
+    sim = rep.final_model.simulate(rec.t, rec.data["p"])
+    assert np.sqrt(np.mean((sim - rec.data["delta"]) ** 2)) < 1.5 * rep.noise_rms
