@@ -147,6 +147,9 @@ def test_study_manifest(tangential_file, normal_file, tmp_path):
     assert main(["study", str(m), "--report", str(rep), "--no-progress"]) == 0
     t = (rep / "study_tangential.csv").read_text().splitlines()
     assert len(t) == 2 and "h0 [N]" in t[0].split(",")
+    row = dict(zip(t[0].split(","), next(csv.reader([t[1]])), strict=True))
+    assert float(row["fs [Hz]"]) == pytest.approx(400.0) and row["n_samples"] == "1600"
+    assert row["format"] == "csv" and row["units_assumed_si"] == ""
     n = (rep / "study_normal.csv").read_text().splitlines()
     assert len(n) == 2 and "p0 [Pa]" in n[0].split(",")
     assert (rep / "report.html").stat().st_size > 10_000

@@ -140,6 +140,26 @@ def _normal_detail(rep: Report, r: RecordingResult, dpi: int) -> None:
     )
 
 
+def _provenance(rep: Report, result: StudyResult) -> None:
+    rows = [r.row for r in result.results if r.ok]
+    if not rows:
+        return
+    rep.section("Data read")
+    cols = [
+        Column("file"),
+        Column("kind"),
+        Column("format"),
+        Column("n_samples", "samples"),
+        Column("fs", "fs", "Hz"),
+        Column("units_assumed_si", "columns without units (SI assumed)"),
+    ]
+    rep.table(rows, cols)
+    assumed = [r["file"] for r in rows if r.get("units_assumed_si")]
+    if assumed:
+        rep.text(f"{len(assumed)} file(s) have columns without units, read as SI: "
+                 + ", ".join(assumed), note=True)  # fmt: skip
+
+
 def build_report(
     result: StudyResult,
     title: str = "contactlab report",
@@ -187,6 +207,7 @@ def build_report(
             for r in bar:
                 rep.subheading(_label(r))
                 (_tangential_detail if kind == "tangential" else _normal_detail)(rep, r, dpi)
+    _provenance(rep, result)
     if result.failures:
         rep.section("Recordings that could not be analysed")
         for r in result.failures:
