@@ -20,6 +20,15 @@ from ..study import RecordingResult, StudyResult
 _QTY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-zµμ/]*)\s*$")
 
 
+def describe(doc: str | None) -> str | None:
+    """The second paragraph of a module docstring as plain text for ``--help``."""
+    if not doc or "\n\n" not in doc:
+        return doc
+    text = doc.split("\n\n")[1]
+    text = re.sub(r":\w+:`~?([^`]+)`", r"\1", text)  # :mod:`x` -> x
+    return text.replace("``", "")
+
+
 def quantity(default_unit: str):
     """argparse ``type=``: a number with an optional unit (``20um``, ``0.5MPa``) → SI float."""
 

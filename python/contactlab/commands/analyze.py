@@ -18,6 +18,7 @@ from ..manifest import entry_from_file
 from ..study import run_study
 from ._common import (
     add_progress_flags,
+    describe,
     json_document,
     parse_columns,
     quantity,
@@ -86,7 +87,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "analyze",
         help="analyse recordings (tangential Masing fit or normal-contact loop)",
-        description=__doc__.split("\n\n")[1] if __doc__ else None,
+        description=describe(__doc__),
     )
     p.add_argument("files", nargs="+", metavar="FILE", help="recordings (.csv .tdms .h5 .mat)")
     p.add_argument("--model", required=True, choices=("tangential", "normal"))

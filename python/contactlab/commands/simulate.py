@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import argparse
 
-from ._common import quantity
+from ._common import describe, quantity
 
 
 def _handler(args: argparse.Namespace) -> int:
@@ -59,7 +59,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "simulate",
         help="write a synthetic recording (tangential Masing or normal contact)",
-        description=__doc__.split("\n\n")[1] if __doc__ else None,
+        description=describe(__doc__),
     )
     p.add_argument("model", choices=("tangential", "normal"))
     p.add_argument("out", metavar="OUT", help="output file (.csv .tdms .h5 .mat)")

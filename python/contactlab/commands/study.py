@@ -12,7 +12,7 @@ import argparse
 import sys
 
 from ..study import run_study
-from ._common import add_progress_flags, json_document, write_json, write_report
+from ._common import add_progress_flags, describe, json_document, write_json, write_report
 
 
 def _handler(args: argparse.Namespace) -> int:
@@ -34,7 +34,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "study",
         help="analyse a set of tagged recordings: table, study plots and report",
-        description=__doc__.split("\n\n")[1] if __doc__ else None,
+        description=describe(__doc__),
     )
     p.add_argument("manifest", metavar="MANIFEST", help="manifest CSV, or a folder of recordings")
     p.add_argument("--report", metavar="DIR", required=True, help="output folder")
