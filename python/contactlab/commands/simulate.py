@@ -80,7 +80,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     n.add_argument("--pa", type=quantity("Pa"), default=0.4e6, help="pressure amplitude (Pa)")
     n.add_argument("--omega", type=quantity("1/s"), default=1.0, help="angular frequency (1/s)")
     n.add_argument("--samples-per-cycle", type=int, default=400)
-    n.add_argument("--normal-model", default=None, help="model of the normal contact")
+    n.add_argument("--normal-model", default=None, choices=("nonlinear", "linear", "table2"),
+                   help="eq. 17 (default), Kelvin-Voigt, or the Table 2 loop itself")  # fmt: skip
     p.add_argument("--cycles", type=int, default=5, help="number of cycles")
     p.add_argument("--noise", type=float, default=None,
                    help="tangential: force noise as a fraction of the peak force (default "
