@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from ..study import RecordingResult, StudyResult
-from ..study_plots import display_unit, normal_study_figures, tangential_study_figures
+from ..study_plots import display_unit, normal_study_figures, tangential_study_figures, trends
 from .html import Column, Report
 
 TANGENTIAL_COLUMNS = [
@@ -197,6 +197,11 @@ def build_report(
             )
             if figs:
                 rep.section(f"{kind.capitalize()} study plots")
+                if kind == "tangential":
+                    rep.table(trends(rows), ["material", "quantity", Column("with_load",
+                              "against normal load"), Column("with_amplitude",
+                              "against amplitude")], caption="Trends (a series counts when "
+                              "every step moves the same way)")  # fmt: skip
                 for name, fig, cap in figs:
                     rep.figure(fig, name, cap, dpi=dpi)
         if details:
