@@ -140,6 +140,12 @@ def _normal_detail(rep: Report, r: RecordingResult, dpi: int) -> None:
     )
 
 
+_TRENDS_CAPTION = (
+    "Trends: a series (one amplitude, or one load) counts as rising or falling only when every "
+    "step does; others are not counted"
+)
+
+
 def _provenance(rep: Report, result: StudyResult) -> None:
     rows = [r.row for r in result.results if r.ok]
     if not rows:
@@ -198,10 +204,13 @@ def build_report(
             if figs:
                 rep.section(f"{kind.capitalize()} study plots")
                 if kind == "tangential":
-                    rep.table(trends(rows), ["material", "quantity", Column("with_load",
-                              "against normal load"), Column("with_amplitude",
-                              "against amplitude")], caption="Trends (a series counts when "
-                              "every step moves the same way)")  # fmt: skip
+                    cols_t = [
+                        "material",
+                        "quantity",
+                        Column("with_load", "against normal load"),
+                        Column("with_amplitude", "against amplitude"),
+                    ]
+                    rep.table(trends(rows), cols_t, caption=_TRENDS_CAPTION)
                 for name, fig, cap in figs:
                     rep.figure(fig, name, cap, dpi=dpi)
         if details:
