@@ -208,3 +208,18 @@ def test_trends_match_exact_masing():
     t = {e["quantity"]: e for e in trends(across, ["equivalent_damping"])}
     assert t["equivalent_damping"]["with_amplitude"] == "not monotone at any of 2 loads"
     assert t["equivalent_damping"]["with_load"] == "rises at 3 of 3 amplitudes"
+
+
+def test_report_of_a_study_has_plots_trends_and_provenance():
+    from contactlab.report.study_report import build_report
+
+    rows = _tangential_rows()
+    for r in rows:
+        r.update(format="csv", n_samples=1200, fs=200.0, units_assumed_si="")
+    rows[0]["units_assumed_si"] = "x"
+    rep = build_report(_result(rows), "t", details=False)
+    html = rep.render_html()
+    assert "against normal load" in html and "rises at 3 of 3 amplitudes" in html
+    assert len(rep.figures) == 8  # 2 materials × 4 quantities
+    assert "1 file(s) have columns without units, read as SI" in html
+    plt.close("all")
