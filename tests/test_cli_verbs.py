@@ -153,6 +153,7 @@ def test_study_manifest(tangential_file, normal_file, tmp_path):
     n = (rep / "study_normal.csv").read_text().splitlines()
     assert len(n) == 2 and "p0 [Pa]" in n[0].split(",")
     assert (rep / "report.html").stat().st_size > 10_000
+    assert f"Made by: contactlab study {m} --report {rep}" in (rep / "report.html").read_text()
 
 
 def test_simulate_bad_extension(tmp_path, capsys):

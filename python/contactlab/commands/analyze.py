@@ -18,6 +18,7 @@ from ..manifest import entry_from_file
 from ..study import run_study
 from ._common import (
     add_progress_flags,
+    command_line,
     describe,
     json_document,
     parse_columns,
@@ -71,9 +72,12 @@ def _handler(args: argparse.Namespace) -> int:
             print(f"{r.entry.path}: FAILED: {r.error}", file=sys.stderr)
     if args.report:
         title = f"contactlab analyze ({args.model}, {len(entries)} recording(s))"
-        for p in write_report(
-            args.report, result, title, study_plots=len(entries) > 1, progress=args.progress
-        ):
+        cmd = command_line("analyze", *args.files, "--model", args.model,
+                           *(["--columns", args.columns] if args.columns else []),
+                           "--report", args.report)  # fmt: skip
+        paths = write_report(args.report, result, title, study_plots=len(entries) > 1,
+                             progress=args.progress, command=cmd)  # fmt: skip
+        for p in paths:
             if p.suffix == ".html":
                 print(f"wrote {p}", file=say)
     if args.json:

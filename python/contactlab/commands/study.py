@@ -12,7 +12,14 @@ import argparse
 import sys
 
 from ..study import run_study
-from ._common import add_progress_flags, describe, json_document, write_json, write_report
+from ._common import (
+    add_progress_flags,
+    command_line,
+    describe,
+    json_document,
+    write_json,
+    write_report,
+)
 
 
 def _handler(args: argparse.Namespace) -> int:
@@ -21,7 +28,10 @@ def _handler(args: argparse.Namespace) -> int:
         print(f"FAILED: {r.error}", file=sys.stderr)
     n_ok = sum(r.ok for r in result.results)
     print(f"analysed {n_ok} of {len(result.results)} recordings")
-    paths = write_report(args.report, result, args.title, study_plots=True, progress=args.progress)
+    cmd = command_line("study", args.manifest, "--report", args.report)
+    paths = write_report(
+        args.report, result, args.title, study_plots=True, progress=args.progress, command=cmd
+    )
     for p in paths:
         if p.suffix in (".html", ".csv", ".parquet"):
             print(f"wrote {p}")
