@@ -136,8 +136,15 @@ def analyze_entry(
 
     rec = read_recording(entry.path, columns=entry.columns, kind=entry.kind, fs=entry.fs)
     base = {"file": entry.path.name, "kind": entry.kind, **entry.tags}
+    # provenance: what was read (a units-assumed-SI note matters when a file has no units)
+    base["format"] = entry.path.suffix.lower().lstrip(".")
+    base["n_samples"] = len(rec.t)
+    base["fs"] = float(rec.fs)
+    assumed = (rec.meta or {}).get("units_assumed_si")
+    base["units_assumed_si"] = ", ".join(map(str, assumed)) if assumed else ""
     units = {k: TAG_UNITS[k] for k in entry.tags if k in TAG_UNITS}
     units.update(entry.units)
+    units["fs"] = "Hz"
     if entry.kind == "tangential":
         from .tangential import analyze_tangential
 
