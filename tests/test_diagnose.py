@@ -183,3 +183,26 @@ def test_cli_diagnose_writes_json_and_report(tmp_path, capsys):
     code = main(["diagnose", str(path), "--model", "normal"])
     assert code == 1
     assert "diagnose: error:" in capsys.readouterr().err
+
+
+def test_unexplained_gap_is_reported_not_hidden():
+    # the delay is hidden, but only the offset candidate is offered: nothing is named and the
+    # report says the remaining discrepancy is outside the library
+    rec = hidden_effect_recording(["channel_delay"], magnitude=0.05, seed=SEED + 9)
+    rep = contactlab.diagnose(rec, candidates=["force_offset"])
+    assert rep.effects == []
+    assert rep.steps[-1].heldout_rms > 2 * rep.noise_rms
+    assert "not explained by any candidate" in rep.where[-1]
+
+
+def test_independent_synthetic_recordings():
+    # recordings from contactlab.tangential's own simulator (another route to the data)
+    from contactlab.tangential.synthetic import synthetic_recording
+
+    kw = {"frequency": 5.0, "n_cycles": 16, "fs": 600.0, "noise": 0.01, "seed": SEED % 1000}
+    clean = synthetic_recording(50.0, 5e4, 4e-5, **kw)
+    assert contactlab.diagnose(clean).effects == []
+    drift = synthetic_recording(50.0, 5e4, 4e-5, drift=2.0, **kw)
+    (eff,) = contactlab.diagnose(drift).effects
+    assert eff.name == "force_drift"
+    assert eff.parameters["F1"] == pytest.approx(2.0 * 16 / 5.0, rel=0.05)  # N/s × duration
