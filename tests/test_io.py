@@ -18,7 +18,7 @@ from contactlab.io import (
     write_recording,
 )
 
-FORMATS = ["csv", "txt", "tdms", "h5", "hdf5", "mat", "mat73"]
+FORMATS = ["csv", "txt", "tsv", "tdms", "h5", "hdf5", "mat", "mat73"]
 
 
 def _rec(n=500, fs=1000.0):
@@ -344,3 +344,20 @@ def test_csv_rows_count_blank_and_comment_lines(tmp_path):
     with pytest.raises(RecordingError, match="duplicated") as info:
         read_recording(p)
     assert info.value.row == 6  # the 6th line of the file
+
+
+@pytest.mark.parametrize("fmt", ["csv", "h5", "mat", "tdms"])
+def test_failed_write_leaves_nothing_behind(tmp_path, monkeypatch, fmt):
+    import contactlab._io_atomic as atomic
+
+    real = atomic.os.replace
+
+    def boom(src, dst):  # fail at the very end, after the data went to the temporary file
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(atomic.os, "replace", boom)
+    p = tmp_path / f"out.{fmt}"
+    with pytest.raises(KeyboardInterrupt):
+        write_recording(p, _rec(50))
+    monkeypatch.setattr(atomic.os, "replace", real)
+    assert list(tmp_path.iterdir()) == []

@@ -27,6 +27,8 @@ def test_kelvin_voigt_analytic_quantities_by_hand():
     assert kv.phase == pytest.approx(np.arctan(kv.h / 1.206e12), rel=1e-14)
     e_pu = 0.5 * 1.206e12 * kv.amplitude(0.4e6) ** 2
     assert kv.loop_energy(0.4e6) / e_pu == pytest.approx(0.0887, rel=1e-13)
+    a = kv.analytic(0.4e6)
+    assert a["K"] == kv.amplitude(0.4e6) and a["phi"] == kv.phase and a["h"] == kv.h
 
 
 @pytest.mark.parametrize("w", [1.0, 2 * np.pi * 10])

@@ -16,6 +16,9 @@ from .errors import ContactLabError
 
 # Modules providing `add_parser(subparsers)`; each sets `handler` via set_defaults.
 _VERB_MODULES = [
+    "contactlab.commands.analyze",
+    "contactlab.commands.study",
+    "contactlab.commands.simulate",
     "contactlab.demo",
     "contactlab.diagnose.cli",
 ]

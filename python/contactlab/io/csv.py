@@ -174,11 +174,17 @@ def read_csv(
     )
 
 
-def write_csv(path: str | Path, rec: Recording, **_: Any) -> Path:
-    """Write ``rec`` as CSV with SI units in the header (``t [s],x [m],F [N]``), atomically."""
+def write_csv(path: str | Path, rec: Recording, *, delimiter: str | None = None, **_: Any) -> Path:
+    """Write ``rec`` as CSV with SI units in the header (``t [s],x [m],F [N]``), atomically.
+
+    The delimiter is a tab for ``.tsv`` files and a comma otherwise, unless given. Values are
+    written with 17 significant digits, so they read back bit for bit.
+    """
+    if delimiter is None:
+        delimiter = "\t" if Path(path).suffix.lower() == ".tsv" else ","
     cols = [("t", "s", rec.t)] + [(k, rec.units[k], v) for k, v in rec.data.items()]
-    header = ",".join(f"{k} [{u}]" if u else k for k, u, _ in cols)
+    header = delimiter.join(f"{k} [{u}]" if u else k for k, u, _ in cols)
     block = np.column_stack([v for _, _, v in cols])
     with atomic_path(path) as tmp:
-        np.savetxt(tmp, block, delimiter=",", header=header, comments="", fmt="%.17g")
+        np.savetxt(tmp, block, delimiter=delimiter, header=header, comments="", fmt="%.17g")
     return Path(path)

@@ -98,14 +98,16 @@ class Comparison:
         }
 
     def table(self) -> str:
+        """Error metrics per model (µm, µm/s, % of the measured loop area)."""
+        w = max(12, *(len(n) + 2 for n in self.metrics))
         head = (
-            f"{'model':<12}{'RMS δ [µm]':>12}{'peak δ':>10}{'RMS δ′ [µm/s]':>15}"
+            f"{'model':<{w}}{'RMS δ [µm]':>12}{'peak δ':>10}{'RMS δ′ [µm/s]':>15}"
             f"{'peak δ′':>10}{'ΔE_d':>9}"
         )
         rows = [head]
         for name, m in self.metrics.items():
             rows.append(
-                f"{name:<12}{m['rms_delta'] * 1e6:12.4g}{m['peak_delta'] * 1e6:10.4g}"
+                f"{name:<{w}}{m['rms_delta'] * 1e6:12.4g}{m['peak_delta'] * 1e6:10.4g}"
                 f"{m['rms_velocity'] * 1e6:15.4g}{m['peak_velocity'] * 1e6:10.4g}"
                 f"{100 * m['loop_area_error']:8.3g}%"
             )

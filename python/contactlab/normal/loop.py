@@ -390,9 +390,13 @@ def analyze_loop(
     if discard_cycles is None:
         discard = 1 if n_whole >= 3 else 0
     else:
-        if isinstance(discard_cycles, bool) or int(discard_cycles) != discard_cycles:
+        try:
+            discard = int(discard_cycles)
+            whole = not isinstance(discard_cycles, bool) and discard == discard_cycles
+        except (TypeError, ValueError, OverflowError):
+            whole = False
+        if not whole:
             raise InputError(f"discard_cycles must be a whole number, got {discard_cycles!r}")
-        discard = int(discard_cycles)
         if discard < 0:
             raise InputError(f"discard_cycles must be >= 0, got {discard}")
     n_used = n_whole - discard

@@ -48,27 +48,47 @@ def steady_loop_force(model: Masing, x: np.ndarray, x0: float, amplitude: float)
     return np.concatenate([second[1 : h + 1], second[h + 2 :]])
 
 
+def turn_nodes(x: np.ndarray, peaks: np.ndarray, valleys: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Where to insert the turning points into a sampled path: between each extreme sample
+    and its larger (peaks) or smaller (valleys) neighbour, where the true turn lies.
+
+    Returns ``(positions, is_peak)`` for :func:`steady_signal_force`, sorted; computed once
+    from the data so the model stays a smooth function of the fit parameters.
+    """
+    n = x.size
+    pos, top = [], []
+    for idx, sign in ((peaks, 1.0), (valleys, -1.0)):
+        for i in np.asarray(idx, dtype=np.int64):
+            left = sign * x[i - 1] if i > 0 else -np.inf
+            right = sign * x[i + 1] if i + 1 < n else -np.inf
+            pos.append(i + 1 if right >= left else i)
+            top.append(sign > 0)
+    order = np.argsort(pos, kind="stable")
+    return np.asarray(pos, dtype=np.int64)[order], np.asarray(top, dtype=bool)[order]
+
+
 def steady_signal_force(
     model: Masing,
     x: np.ndarray,
     x0: float,
     amplitude: float,
-    peaks: np.ndarray,
-    valleys: np.ndarray,
+    nodes: tuple[np.ndarray, ...],
     first_is_peak: bool,
 ) -> np.ndarray:
     """Force along a recording in the steady state of its outer loop ``x0 ± amplitude``.
 
-    ``x`` is the (monotone-projected) path; the samples at ``peaks``/``valleys`` are set to the
-    turning points and the rest clipped into the loop. Primed to ``(top, bottom)`` or
-    ``(bottom, top)`` depending on the direction of the first turn.
+    ``x`` is the (monotone-projected) path, clipped into the loop; the turning points are
+    inserted as extra path nodes at ``nodes`` (from :func:`turn_nodes`), so no sample is
+    moved. Primed to ``(top, bottom)`` or ``(bottom, top)`` by the direction of the first turn.
     """
     top, bot = amplitude, -amplitude
     u = np.clip(x - x0, bot, top)
-    u[peaks] = top
-    u[valleys] = bot
+    pos, is_top = nodes
+    path = np.insert(u, pos, np.where(is_top, top, bot))
+    keep = np.ones(path.size, dtype=bool)
+    keep[pos + np.arange(pos.size)] = False
     prime = [0.0, top, bot] if first_is_peak else [0.0, bot, top]
-    return model.force(np.concatenate([prime, u]))[3:]
+    return model.force(np.concatenate([prime, path]))[3:][keep]
 
 
 def virgin_signal_force(model: Masing, x: np.ndarray, x0: float) -> np.ndarray:

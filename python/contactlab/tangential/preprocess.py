@@ -208,6 +208,8 @@ class AveragedLoop:
     reversals: Reversals
     cycle_start: int  # first and last sample index of the averaged stretch
     cycle_end: int
+    phase_mean: np.ndarray | None = None  # mean phase (within the cycle) of each bin's samples
+    phase_sq: np.ndarray | None = None  # mean squared phase of each bin's samples
 
     @property
     def n_cycles(self) -> int:
@@ -355,7 +357,10 @@ def average_loop(
         time=0.5 * (rev.peak_times[:-1] + rev.peak_times[1:]),
     )
     phase = (np.arange(n_points) + 0.5) / n_points
-    return AveragedLoop(phase, xm, Fm, count, x_std, F_std, scatter, rev, start, end)
+    phase_sq = np.bincount(b, frac * frac, n_points) / count
+    return AveragedLoop(
+        phase, xm, Fm, count, x_std, F_std, scatter, rev, start, end, phim, phase_sq
+    )
 
 
 def monotone_path(x: np.ndarray, turns: np.ndarray) -> np.ndarray:

@@ -1,5 +1,8 @@
 //! Bindings of `contactlab_core::normal`: array/error conversion and GIL release only.
 
+// PyO3 hands arguments over by value (readonly array borrows); nothing to consume.
+#![allow(clippy::needless_pass_by_value)]
+
 use contactlab_core::normal::{
     cycles, ode, poly, ContactModel, Forcing, Interp, KelvinVoigt, Stiffness,
 };

@@ -23,6 +23,8 @@ pub enum Interp {
 pub struct Segment {
     pub t0: f64,
     pub h: f64,
+    /// `1 / h` (multiplying is cheaper than dividing in the integrator's inner loop).
+    pub inv_h: f64,
     pub c: [f64; 4],
 }
 
@@ -30,16 +32,16 @@ impl Segment {
     /// `p(t)`.
     #[inline]
     pub fn value(&self, t: f64) -> f64 {
-        let s = (t - self.t0) / self.h;
+        let s = (t - self.t0) * self.inv_h;
         self.c[0] + s * (self.c[1] + s * (self.c[2] + s * self.c[3]))
     }
 
     /// `p(t)` and `dp/dt`.
     #[inline]
     pub fn value_deriv(&self, t: f64) -> (f64, f64) {
-        let s = (t - self.t0) / self.h;
+        let s = (t - self.t0) * self.inv_h;
         let p = self.c[0] + s * (self.c[1] + s * (self.c[2] + s * self.c[3]));
-        let d = (self.c[1] + s * (2.0 * self.c[2] + s * 3.0 * self.c[3])) / self.h;
+        let d = (self.c[1] + s * (2.0 * self.c[2] + s * 3.0 * self.c[3])) * self.inv_h;
         (p, d)
     }
 }
@@ -160,7 +162,12 @@ impl<'a> Forcing<'a> {
                 ]
             }
         };
-        Segment { t0, h, c }
+        Segment {
+            t0,
+            h,
+            inv_h: 1.0 / h,
+            c,
+        }
     }
 
     /// `dp/dt` at sample `i` as the interpolant sees it (right-sided at the last sample).

@@ -317,7 +317,7 @@ pub fn simulate(
                         stats.n_accepted += 1;
                         y = y_new;
                         tc = if lands { t_end } else { tc + h };
-                        let mut fac = (0.9 * err.max(1e-10).powf(-0.25)).clamp(0.2, 6.0);
+                        let mut fac = (0.9 / err.max(1e-10).sqrt().sqrt()).clamp(0.2, 6.0);
                         if last_rejected {
                             fac = fac.min(1.0);
                         }
@@ -329,7 +329,7 @@ pub fn simulate(
                     Some((_, err)) => {
                         stats.n_rejected += 1;
                         last_rejected = true;
-                        h_prop = h * (0.9 * err.powf(-0.25)).clamp(0.1, 0.9);
+                        h_prop = h * (0.9 / err.sqrt().sqrt()).clamp(0.1, 0.9);
                     }
                     None => {
                         stats.n_rejected += 1;

@@ -246,4 +246,34 @@ mod tests {
         let (v, at) = min_on(&[1.0, 0.0, 1.0], -1.0, 2.0);
         assert!((v - 1.0).abs() < 1e-15 && at.abs() < 1e-12);
     }
+
+    proptest::proptest! {
+        #[test]
+        fn fit_round_trips_exact_samples(
+            c in proptest::collection::vec(-3.0_f64..3.0, 1..6),
+            xscale in 1e-8_f64..1e2,
+            n in 12_usize..80,
+        ) {
+            let x: Vec<f64> = (0..n).map(|k| xscale * (-1.0 + 2.0 * k as f64 / (n - 1) as f64)).collect();
+            // Coefficients scaled so every term is O(1) on the interval.
+            let cs: Vec<f64> = c.iter().enumerate().map(|(i, a)| a / xscale.powi(i as i32)).collect();
+            let y: Vec<f64> = x.iter().map(|&v| eval(&cs, v)).collect();
+            let got = fit(&x, &y, cs.len() - 1, None).unwrap();
+            for (i, (g, e)) in got.iter().zip(&cs).enumerate() {
+                let tol = 1e-9 / xscale.powi(i as i32);
+                proptest::prop_assert!((g - e).abs() <= tol, "coef {}: {} vs {}", i, g, e);
+            }
+        }
+
+        #[test]
+        fn roots_found_are_roots(
+            r1 in -1.0_f64..1.0, r2 in -1.0_f64..1.0, r3 in -1.0_f64..1.0,
+        ) {
+            // (x - r1)(x - r2)(x - r3)
+            let c = [-r1 * r2 * r3, r1 * r2 + r1 * r3 + r2 * r3, -(r1 + r2 + r3), 1.0];
+            for r in roots_in(&c, -1.5, 1.5, 0) {
+                proptest::prop_assert!(eval(&c, r).abs() < 1e-9);
+            }
+        }
+    }
 }

@@ -1,0 +1,136 @@
+"""Helpers shared by the CLI verbs: quantities with units, JSON output, report writing."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .._io_atomic import write_text
+from ..errors import InputError
+from ..manifest import unit_factor
+from ..report import commit_outputs
+from ..study import RecordingResult, StudyResult
+
+_QTY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-zµμ/]*)\s*$")
+
+
+def quantity(default_unit: str):
+    """argparse ``type=``: a number with an optional unit (``20um``, ``0.5MPa``) → SI float."""
+
+    def parse(text: str) -> float:
+        m = _QTY.match(text)
+        if not m:
+            raise ValueError(text)
+        unit = m.group(2) or default_unit
+        try:
+            return float(m.group(1)) * unit_factor(unit, "value")
+        except InputError as exc:
+            raise ValueError(str(exc)) from None
+
+    parse.__name__ = f"quantity in {default_unit or 'SI'}"
+    return parse
+
+
+def parse_columns(text: str | None) -> dict[str, str] | None:
+    """``x=disp,F=force`` (or ``;``-separated) → mapping for the readers."""
+    if not text:
+        return None
+    out = {}
+    for part in re.split(r"[;,]", text):
+        if not part.strip():
+            continue
+        if "=" not in part:
+            raise InputError(f"--columns: {part!r} must look like 'x=disp'")
+        k, v = part.split("=", 1)
+        out[k.strip()] = v.strip()
+    return out
+
+
+def jsonable(value: Any) -> Any:
+    """Plain JSON types; NaN/inf become null (JSON has no NaN)."""
+    if isinstance(value, Mapping):
+        return {str(k): jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [jsonable(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return jsonable(value.tolist())
+    if isinstance(value, (np.floating, np.integer, np.bool_)):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, Path):
+        return str(value)
+    return value
+
+
+def recording_json(r: RecordingResult) -> dict[str, Any]:
+    """One recording's JSON object: the analysis' ``to_dict()`` (SI, with ``units``) + tags."""
+    d = dict(r.analysis.to_dict()) if r.analysis is not None else {}
+    if r.extra:
+        d.update(r.extra)
+    d = {"file": str(r.entry.path), "model": r.entry.kind, **r.entry.tags, **d}
+    units = dict(d.get("units", {}) or {})
+    for k, u in r.units.items():  # tags' and added keys' units (not the flattened vectors)
+        if k in d:
+            units.setdefault(k, u)
+    d["units"] = units
+    return jsonable(d)
+
+
+def json_document(result: StudyResult) -> dict[str, Any]:
+    """A single recording's object at top level; several as ``{"recordings": [...]}``."""
+    recs = [recording_json(r) for r in result.results if r.ok]
+    from .. import __version__
+
+    if len(recs) == 1 and not result.failures:
+        return {**recs[0], "contactlab_version": __version__}
+    return {
+        "contactlab_version": __version__,
+        "recordings": recs,
+        "failures": [{"file": str(r.entry.path), "error": r.error} for r in result.failures],
+    }
+
+
+def write_json(path: str, doc: Mapping[str, Any]) -> Path:
+    text = json.dumps(jsonable(doc), indent=2, allow_nan=False) + "\n"
+    if path == "-":
+        print(text, end="")
+        return Path("-")
+    return write_text(path, text)
+
+
+def write_report(
+    directory: str,
+    result: StudyResult,
+    title: str,
+    *,
+    study_plots: bool,
+    extra: Mapping[str, bytes] | None = None,
+    progress: bool | None = None,
+) -> list[Path]:
+    """Render the report and tables in memory, then write them all or nothing."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from ..report.study_report import build_report
+
+    rep = build_report(result, title, study_plots=study_plots, progress=progress)
+    files = rep.files()
+    files.update(result.table_files())
+    if extra:
+        files.update(extra)
+    return commit_outputs(directory, files)
+
+
+def add_progress_flags(p: Any) -> None:
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--progress", dest="progress", action="store_true", default=None,
+                   help="always show a progress bar (default: only on a terminal)")  # fmt: skip
+    g.add_argument("--no-progress", dest="progress", action="store_false",
+                   help="never show a progress bar")  # fmt: skip

@@ -1,0 +1,101 @@
+"""``contactlab analyze FILE... --model tangential|normal [--json OUT] [--report DIR]``.
+
+Reads each recording (CSV/TDMS/HDF5/MAT, SI inside), runs the tangential analysis (Masing fit,
+energy analytic and numeric, c_e·ω, stiffness; the tangential paper's eqs. 1-19) or the normal
+one (Konowalski's eqs. 1-7 and 16), prints a summary, and optionally writes JSON (SI values and
+a ``units`` map) and an HTML report. Tags (material, load, amplitude, p0, pa) are read from
+the file names as in :mod:`contactlab.manifest`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from ..errors import InputError
+from ..manifest import entry_from_file
+from ..study import run_study
+from ._common import (
+    add_progress_flags,
+    json_document,
+    parse_columns,
+    quantity,
+    write_json,
+    write_report,
+)
+
+_SUMMARY = {
+    "tangential": [("h0", "N", 1.0), ("ac", "1/m", 1.0), ("h0_ac", "N/m", 1.0),
+                   ("amplitude", "um", 1e6),
+                   ("energy_per_cycle", "J", 1.0), ("equivalent_damping", "N/m", 1.0),
+                   ("k_local0", "N/m", 1.0), ("k_global", "N/m", 1.0)],
+    "normal": [("E_d", "J/m^2", 1.0), ("psi", "", 1.0), ("psi_kv", "", 1.0),
+               ("k_tan", "Pa/m", 1.0), ("k_sec", "Pa/m", 1.0)],
+}  # fmt: skip
+
+
+def _summary_line(row: dict, kind: str) -> str:
+    parts = []
+    for key, unit, f in _SUMMARY[kind]:
+        v = row.get(key)
+        if isinstance(v, float):
+            s = row.get(f"{key}_stderr")
+            pm = f" ± {abs(s) * f:.2g}" if isinstance(s, float) else ""
+            parts.append(f"{key} = {v * f:.5g}{pm} {unit}".rstrip())
+    return "; ".join(parts)
+
+
+def _handler(args: argparse.Namespace) -> int:
+    columns = parse_columns(args.columns)
+    entries = []
+    for f in args.files:
+        if not Path(f).is_file():
+            raise InputError(f"{f}: no such file")
+        e = entry_from_file(f, kind=args.model)
+        e.columns, e.fs = columns, args.fs
+        entries.append(e)
+    result = run_study(entries, progress=args.progress, keep_going=args.keep_going)
+    # With --json -, stdout carries the JSON alone; everything else goes to stderr.
+    say = sys.stderr if args.json == "-" else sys.stdout
+    for r in result.results:
+        if r.ok:
+            print(f"{r.entry.path}: {_summary_line(r.row, r.entry.kind)}", file=say)
+            if r.row.get("warnings"):
+                for w in str(r.row["warnings"]).split(" | "):
+                    print(f"  warning: {w}", file=sys.stderr)
+            if args.verbose and hasattr(r.analysis, "report"):
+                print(r.analysis.report(), file=say)
+        else:
+            print(f"{r.entry.path}: FAILED: {r.error}", file=sys.stderr)
+    if args.report:
+        title = f"contactlab analyze ({args.model}, {len(entries)} recording(s))"
+        for p in write_report(
+            args.report, result, title, study_plots=len(entries) > 1, progress=args.progress
+        ):
+            if p.suffix == ".html":
+                print(f"wrote {p}", file=say)
+    if args.json:
+        p = write_json(args.json, json_document(result))
+        if str(p) != "-":
+            print(f"wrote {p}", file=say)
+    return 1 if result.failures else 0
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "analyze",
+        help="analyse recordings (tangential Masing fit or normal-contact loop)",
+        description=__doc__.split("\n\n")[1] if __doc__ else None,
+    )
+    p.add_argument("files", nargs="+", metavar="FILE", help="recordings (.csv .tdms .h5 .mat)")
+    p.add_argument("--model", required=True, choices=("tangential", "normal"))
+    p.add_argument("--json", metavar="OUT", help="write results as JSON (SI; '-' = stdout)")
+    p.add_argument("--report", metavar="DIR", help="write report.html, figures and tables here")
+    p.add_argument("--columns", help="column mapping, e.g. 'x=disp,F=force' (default: by name)")
+    p.add_argument("--fs", type=quantity("Hz"), help="sampling rate when a file has no time")
+    p.add_argument("--keep-going", action="store_true",
+                   help="skip recordings that fail (exit code 1) instead of stopping")  # fmt: skip
+    p.add_argument("-v", "--verbose", action="store_true", help="print each fit report")
+    add_progress_flags(p)
+    p.set_defaults(handler=_handler)

@@ -1,0 +1,46 @@
+"""``contactlab study MANIFEST|FOLDER --report DIR``: a load/amplitude (or p0) study.
+
+Analyses every recording a manifest lists (or every recording in a folder, tagged by file
+name; see :mod:`contactlab.manifest`) and writes one table (``study_tangential.csv`` /
+``.parquet``, ``study_normal.*``; SI, uncertainties as ``*_stderr``), the paper's plots
+against load and amplitude per material (and against p0), and the HTML report.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ..study import run_study
+from ._common import add_progress_flags, json_document, write_json, write_report
+
+
+def _handler(args: argparse.Namespace) -> int:
+    result = run_study(args.manifest, progress=args.progress, keep_going=args.keep_going)
+    for r in result.failures:
+        print(f"FAILED: {r.error}", file=sys.stderr)
+    n_ok = sum(r.ok for r in result.results)
+    print(f"analysed {n_ok} of {len(result.results)} recordings")
+    paths = write_report(args.report, result, args.title, study_plots=True, progress=args.progress)
+    for p in paths:
+        if p.suffix in (".html", ".csv", ".parquet"):
+            print(f"wrote {p}")
+    if args.json:
+        write_json(args.json, json_document(result))
+    return 1 if result.failures else 0
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "study",
+        help="analyse a set of tagged recordings: table, study plots and report",
+        description=__doc__.split("\n\n")[1] if __doc__ else None,
+    )
+    p.add_argument("manifest", metavar="MANIFEST", help="manifest CSV, or a folder of recordings")
+    p.add_argument("--report", metavar="DIR", required=True, help="output folder")
+    p.add_argument("--json", metavar="OUT", help="also write every result as JSON (SI)")
+    p.add_argument("--title", default="contactlab study", help="report title")
+    p.add_argument("--keep-going", action="store_true",
+                   help="skip recordings that fail (exit code 1) instead of stopping")  # fmt: skip
+    add_progress_flags(p)
+    p.set_defaults(handler=_handler)

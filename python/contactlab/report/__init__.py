@@ -1,0 +1,20 @@
+"""Reports: one self-contained HTML file with embedded figures, plus the figures as PNG.
+
+``Report`` assembles headings, text, tables and matplotlib figures; ``commit_outputs`` writes a
+set of files all or nothing, so a failed or interrupted run leaves the output folder as it was.
+"""
+
+from __future__ import annotations
+
+from ._outputs import commit_outputs
+from .html import Column, Report, figure_png, format_value, slugify, table_html
+
+__all__ = [
+    "Column",
+    "Report",
+    "commit_outputs",
+    "figure_png",
+    "format_value",
+    "slugify",
+    "table_html",
+]

@@ -1,0 +1,198 @@
+"""The report of an analysis or a study: summary tables, each recording's loop, fit and
+residuals, and the study plots (:mod:`contactlab.study_plots`).
+
+Tangential sections show the averaged measured loop with the fitted Masing loop and the
+residuals (via :func:`contactlab.tangential.plot_loop` / ``plot_residuals``) and the lmfit-style
+fit report; normal sections show the measured loop p(δ) with the fitted loading, unloading and
+centre polynomials of Konowalski's eq. 1.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from ..study import RecordingResult, StudyResult
+from ..study_plots import display_unit, normal_study_figures, tangential_study_figures
+from .html import Column, Report
+
+TANGENTIAL_COLUMNS = [
+    Column("file"),
+    Column("material"),
+    Column("normal_load", "W", "N"),
+    Column("amplitude", "A", "µm", 1e6),
+    Column("h0", "h0", "N", stderr="h0_stderr"),
+    Column("ac", "ac", "1/mm", 1e-3, stderr="ac_stderr"),
+    Column("h0_ac", "h0·ac", "N/µm", 1e-6, stderr="h0_ac_stderr"),
+    Column("energy_per_cycle", "E", "µJ", 1e6, stderr="energy_per_cycle_stderr"),
+    Column("energy_per_cycle_numeric", "E numeric", "µJ", 1e6),
+    Column("equivalent_damping", "c_e·ω", "N/µm", 1e-6, stderr="equivalent_damping_stderr"),
+    Column("k_local0", "k_l(0)", "N/µm", 1e-6, stderr="k_local0_stderr"),
+    Column("k_global", "k_g(A)", "N/µm", 1e-6, stderr="k_global_stderr"),
+    Column("true_h0", "h0 true", "N"),
+    Column("true_ac", "ac true", "1/mm", 1e-3),
+    Column("identifiable", "h0, ac separable"),
+]
+NORMAL_COLUMNS = [
+    Column("file"),
+    Column("material"),
+    Column("p0", "p0", "MPa", 1e-6),
+    Column("pa", "pa", "MPa", 1e-6),
+    Column("E_d", "E_d", "MPa·µm"),
+    Column("E_pu", "E_pu", "MPa·µm"),
+    Column("E_pd", "E_pd", "MPa·µm"),
+    Column("psi", "ψ (eq. 7)"),
+    Column("psi_kv", "ψ KV (eq. 3)"),
+    Column("k_tan", "k_tan", "MPa/µm", 1e-12),
+    Column("k_sec", "k_sec", "MPa/µm", 1e-12),
+    Column("delta_min", "δ_min", "µm", 1e6),
+    Column("delta_max", "δ_max", "µm", 1e6),
+    Column("b1_paper", "b1 (MPa, µm)"),
+    Column("b2_paper", "b2 (MPa, µm)"),
+    Column("b3_paper", "b3 (MPa, µm)"),
+    Column("b4_paper", "b4 [MPa/µm]"),
+]
+
+
+def _present(columns: Sequence[Column], rows: Sequence[dict]) -> list[Column]:
+    return [c for c in columns if any(c.key in r for r in rows)]
+
+
+def _label(r: RecordingResult) -> str:
+    t = r.entry.tags
+    parts = [r.entry.name]
+    if "material" in t:
+        parts.append(str(t["material"]))
+    if "normal_load" in t:
+        parts.append(f"W = {t['normal_load']:.4g} N")
+    if "amplitude_nominal" in t:
+        parts.append(f"A = {t['amplitude_nominal'] * 1e6:.4g} µm")
+    if "p0" in t:
+        parts.append(f"p0 = {t['p0'] * 1e-6:.4g} MPa")
+    if "pa" in t:
+        parts.append(f"pa = {t['pa'] * 1e-6:.4g} MPa")
+    return ", ".join(parts)
+
+
+def _tangential_detail(rep: Report, r: RecordingResult, dpi: int) -> None:
+    import matplotlib.pyplot as plt
+
+    from ..tangential import plot_loop, plot_residuals
+
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(9.0, 3.4), constrained_layout=True)
+    plot_loop(r.analysis, ax=a1)
+    plot_residuals(r.analysis, ax=a2)
+    fig.suptitle(_label(r), fontsize=9)
+    rep.figure(fig, f"loop-{r.entry.path.stem}", f"{_label(r)}: loop with fit, residuals", dpi=dpi)
+    for w in getattr(r.analysis, "warnings", None) or []:
+        rep.text(w, note=True)
+    if hasattr(r.analysis, "report"):
+        rep.preformatted(r.analysis.report())
+
+
+def poly_eval(coeffs: Sequence[float], x: np.ndarray) -> np.ndarray:
+    """Evaluate a polynomial with ascending coefficients."""
+    return np.polynomial.polynomial.polyval(x, np.asarray(coeffs, dtype=float))
+
+
+def plot_normal_loop(r: RecordingResult, ax: Any = None) -> Any:
+    """Measured p(δ) of a normal recording, its averaged cycle and the fitted eq.-1
+    polynomials (loading, centre, unloading), in the paper's units (MPa, µm)."""
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        _, ax = plt.subplots(figsize=(5.0, 3.6), constrained_layout=True)
+    rec, row, res = r.recording, r.row, r.analysis
+    p0 = float(row.get("p0", 0.0) or 0.0)
+    shift = float(row.get("delta_offset", 0.0) or 0.0)
+    p = np.asarray(rec["p"], dtype=float)
+    d = np.asarray(rec["delta"], dtype=float)
+    ax.plot((d - shift) * 1e6, (p - p0) * 1e-6, color="0.75", lw=0.5, label="recorded")
+    if res is not None and hasattr(res, "cycle_delta"):
+        ax.plot(np.asarray(res.cycle_delta) * 1e6, np.asarray(res.cycle_p) * 1e-6, ".",
+                color="0.2", ms=2, label="averaged cycle")  # fmt: skip
+    lo, hi = row.get("delta_min"), row.get("delta_max")
+    if isinstance(lo, float) and isinstance(hi, float) and math.isfinite(lo + hi):
+        dm = np.linspace(lo, hi, 200)  # SI: the polynomials take δ in m and give p in Pa
+        for name, style in (("poly_load", "C3-"), ("poly_centre", "k--"), ("poly_unload", "C0-")):
+            coeffs = [row.get(f"{name}_{i}") for i in range(5)]
+            if all(isinstance(c, float) for c in coeffs):
+                ax.plot(dm * 1e6, poly_eval(coeffs, dm) * 1e-6, style, lw=1.2,
+                        label=name.replace("poly_", ""))  # fmt: skip
+    ax.set_xlabel("normal contact displacement δ [µm]")
+    ax.set_ylabel("dynamic pressure p − p0 [MPa]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    return ax
+
+
+def _normal_detail(rep: Report, r: RecordingResult, dpi: int) -> None:
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5.2, 3.6), constrained_layout=True)
+    plot_normal_loop(r, ax=ax)
+    ax.set_title(_label(r), fontsize=8)
+    rep.figure(
+        fig, f"loop-{r.entry.path.stem}", f"{_label(r)}: loop and eq.-1 polynomials", dpi=dpi
+    )
+
+
+def build_report(
+    result: StudyResult,
+    title: str = "contactlab report",
+    *,
+    study_plots: bool = True,
+    details: bool = True,
+    dpi: int = 90,
+    intro: str | None = None,
+    progress: bool | None = False,
+) -> Report:
+    """Assemble the report of analysed recordings (and the study plots when asked).
+
+    Rendering the figures is the slow part of a large study; ``progress`` shows a bar for it
+    (``tqdm.auto``; None: only on a terminal).
+    """
+    from tqdm.auto import tqdm
+
+    rep = Report(title, intro)
+    for kind in ("tangential", "normal"):
+        rows = result.table(kind)
+        if not rows:
+            continue
+        units = result.units(kind)
+        cols = _present(TANGENTIAL_COLUMNS if kind == "tangential" else NORMAL_COLUMNS, rows)
+        rep.section(f"{kind.capitalize()} recordings: summary")
+        rep.table(rows, cols, caption="Fitted parameters (± 1 standard error); full table "
+                  f"with every column in SI: study_{kind}.csv / .parquet")  # fmt: skip
+        warned = [r.entry.name for r in result.of_kind(kind) if r.ok and r.row.get("warnings")]
+        if warned:
+            rep.text(f"{len(warned)} recording(s) with warnings (see their sections below): "
+                     + ", ".join(warned), note=True)  # fmt: skip
+        if study_plots and len(rows) > 1:
+            figs = (tangential_study_figures if kind == "tangential" else normal_study_figures)(
+                rows, units
+            )
+            if figs:
+                rep.section(f"{kind.capitalize()} study plots")
+                for name, fig, cap in figs:
+                    rep.figure(fig, name, cap, dpi=dpi)
+        if details:
+            rep.section(f"{kind.capitalize()} recordings: loops, fits and residuals")
+            todo = [r for r in result.of_kind(kind) if r.ok]
+            bar = tqdm(todo, desc=f"report ({kind})", unit="fig",
+                       disable=None if progress is None else not progress)  # fmt: skip
+            for r in bar:
+                rep.subheading(_label(r))
+                (_tangential_detail if kind == "tangential" else _normal_detail)(rep, r, dpi)
+    if result.failures:
+        rep.section("Recordings that could not be analysed")
+        for r in result.failures:
+            rep.text(str(r.error), note=True)
+    return rep
+
+
+__all__ = ["NORMAL_COLUMNS", "TANGENTIAL_COLUMNS", "build_report", "display_unit",
+           "plot_normal_loop", "poly_eval"]  # fmt: skip

@@ -1,0 +1,90 @@
+"""CLI bad input and interruption: non-zero exit, a message naming what is wrong, and no
+partial outputs (the output folder is left exactly as it was)."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+import contactlab.study as study_mod
+from contactlab.cli import main
+
+
+def _snapshot(d):
+    return sorted(
+        (str(p.relative_to(d)), p.read_bytes() if p.is_file() else None) for p in d.rglob("*")
+    )
+
+
+@pytest.fixture
+def outdir(tmp_path):
+    d = tmp_path / "out"
+    d.mkdir()
+    (d / "keep.txt").write_text("user file")
+    (d / "report.html").write_text("previous report")
+    return d
+
+
+def test_no_verb_prints_help(capsys):
+    assert main([]) == 2
+    assert "analyze" in capsys.readouterr().out
+
+
+def test_analyze_missing_file(tmp_path, outdir, capsys):
+    before = _snapshot(outdir)
+    code = main(["analyze", str(tmp_path / "nope.csv"), "--model", "tangential",
+                 "--report", str(outdir), "--json", str(outdir / "r.json")])  # fmt: skip
+    assert code == 1
+    err = capsys.readouterr().err
+    assert "contactlab analyze: error:" in err and "nope.csv" in err
+    assert _snapshot(outdir) == before
+
+
+def test_analyze_bad_model_is_usage_error(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["analyze", "x.csv", "--model", "sideways"])
+    assert exc.value.code == 2
+    assert "invalid choice" in capsys.readouterr().err
+
+
+def test_study_bad_manifest_names_row_and_column(tmp_path, outdir, capsys):
+    (tmp_path / "a.csv").write_text("t,x,F\n")
+    m = tmp_path / "m.csv"
+    m.write_text("file,normal_load [N]\na.csv,50\na.csv,fifty\n")
+    before = _snapshot(outdir)
+    assert main(["study", str(m), "--report", str(outdir)]) == 1
+    err = capsys.readouterr().err
+    assert "row 3" in err and "normal_load" in err and "'fifty' is not a number" in err
+    assert _snapshot(outdir) == before
+
+
+def test_study_missing_manifest(tmp_path, outdir, capsys):
+    assert main(["study", str(tmp_path / "none.csv"), "--report", str(outdir)]) == 1
+    assert "does not exist" in capsys.readouterr().err
+
+
+def test_study_ctrl_c_leaves_report_dir_as_it_was(tmp_path, outdir, monkeypatch, capsys):
+    for n in ("Al-Al_W50N_A10um.csv", "Al-Al_W100N_A10um.csv"):
+        (tmp_path / n).write_text("t,x,F\n")
+    calls = []
+
+    def interrupted(entry, **_):
+        calls.append(entry.name)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(study_mod, "analyze_entry", interrupted)
+    before = _snapshot(outdir)
+    code = main(["study", str(tmp_path), "--report", str(outdir), "--no-progress"])
+    assert code == 130
+    assert "interrupted" in capsys.readouterr().err
+    assert calls == ["Al-Al_W100N_A10um.csv"]  # sorted: stopped at the first
+    assert _snapshot(outdir) == before
+    assert not any(n.endswith(".part") for n in os.listdir(outdir))
+
+
+def test_study_folder_without_recordings(tmp_path, outdir, capsys):
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    assert main(["study", str(empty), "--report", str(outdir)]) == 1
+    assert "holds no recordings" in capsys.readouterr().err
