@@ -138,7 +138,16 @@ def test_plots_and_html(tmp_path):
     text = path.read_text(encoding="utf-8")
     assert text.count("data:image/png;base64,") == 4
     assert "&quot;viscous_damping&quot;" in text and "Gap shrink" in text
-    assert [p.name for p in (tmp_path / "out").iterdir()] == ["diagnose.html"]
+    files = sorted(p.relative_to(tmp_path / "out").as_posix() for p in path.parent.rglob("*.*"))
+    assert files == [
+        "diagnose.html",
+        "diagnose.json",
+        "figures/gap.png",
+        "figures/location.png",
+        "figures/loops.png",
+        "figures/residual.png",
+    ]
+    assert json.loads((path.parent / "diagnose.json").read_text()) == rep.to_dict()
     assert "viscous_damping" in rep.summary() and "base model" in rep.table()
 
 

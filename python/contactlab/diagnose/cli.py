@@ -31,7 +31,9 @@ def add_parser(subparsers: Any) -> None:
         help="tangential: x, F (Masing base); normal: p, delta (Kelvin-Voigt base)",
     )
     p.add_argument("--json", metavar="OUT", help="write the result as JSON to OUT")
-    p.add_argument("--report", metavar="DIR", help="write DIR/diagnose.html")
+    p.add_argument(
+        "--report", metavar="DIR", help="write DIR/diagnose.html (+ figures/, diagnose.json)"
+    )
     p.add_argument("--max-effects", type=int, default=3, help="stop after this many additions")
     p.set_defaults(handler=run)
 

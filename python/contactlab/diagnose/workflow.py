@@ -173,7 +173,8 @@ class DiagnosisReport:
         return plot_location(self, ax=ax)
 
     def write_html(self, directory: Any) -> Any:
-        """Write a self-contained ``diagnose.html`` (figures and JSON) into ``directory``."""
+        """Write a self-contained ``diagnose.html`` (figures embedded, also as PNGs under
+        ``figures/``) and ``diagnose.json`` into ``directory``; returns the HTML's path."""
         from ._html import write_html
 
         return write_html(self, directory)
