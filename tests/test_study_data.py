@@ -112,11 +112,6 @@ def test_recordings_carry_sensor_imperfections():
     assert abs(np.mean(rec["x"])) > 1e-8  # a zero offset, not a perfectly centred signal
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="tangential fit: steel-steel_W75N_A0.25um is flagged identifiable with h0 = 2.1 ± 0.6 N "
-    "against a true 13.5 N (the linearised error of a nearly linear loop; reported to the lead)",
-)
 def test_steel_loops_identified_only_when_right(bundle_study):
     for r in bundle_study.table("tangential"):
         if r["material"] == "steel/steel":

@@ -492,3 +492,13 @@ def test_every_regime_is_reported_honestly(h0, z, amp, noise, seed):
         pa = res.fit.params["ac"]
         if pa.stderr is not None:
             assert ac < pa.value + 5 * pa.stderr
+
+
+def test_displacement_drift_is_removed():
+    rate = 0.03 * A  # m/s: the sensor's zero wanders 30 % of A over 10 s
+    rec = synthetic_recording(H0, AC, A, n_cycles=10.25, fs=200, noise=0.02, x_drift=rate, seed=9)
+    res = analyze_tangential(rec)
+    d, dd = res.derived["displacement_drift"]
+    assert abs(d - rate) < 4 * dd
+    assert abs(_z(res, "h0", H0)) < 3 and abs(_z(res, "ac", AC)) < 3
+    assert res.to_dict()["units"]["displacement_drift"] == "m/s"

@@ -175,6 +175,7 @@ class CycleScatter:
     period: np.ndarray  # s
     mean_force: np.ndarray  # mean force over the cycle (mean of its bin means), N
     time: np.ndarray  # middle of the cycle (mean of its two peak instants), s
+    mean_x: np.ndarray | None = None  # mean displacement over the cycle, m
 
     @property
     def n_cycles(self) -> int:
@@ -367,6 +368,7 @@ def average_loop(
         energy=np.asarray(energies),
         period=np.diff(rev.peak_times),
         mean_force=_period_means(ta, Fa, rev.peak_times),
+        mean_x=_period_means(ta, xa, rev.peak_times),
         time=0.5 * (rev.peak_times[:-1] + rev.peak_times[1:]),
     )
     phase = (np.arange(n_points) + 0.5) / n_points

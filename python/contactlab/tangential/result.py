@@ -34,6 +34,7 @@ UNITS = {
     "ac_upper_bound": "1/m",
     "peak_force": "N",
     "force_drift": "N/s",
+    "displacement_drift": "m/s",
 }
 
 

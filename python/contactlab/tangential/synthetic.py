@@ -31,6 +31,7 @@ def synthetic_recording(
     x_noise: float | None = None,
     x_offset: float = 0.0,
     drift: float = 0.0,
+    x_drift: float = 0.0,
     hum: float = 0.0,
     hum_frequency: float = 50.0,
     adc_bits: int | None = None,
@@ -64,6 +65,8 @@ def synthetic_recording(
         Zero offset of the displacement sensor, m.
     drift : float
         Linear force drift, N/s.
+    x_drift : float
+        Linear drift of the displacement sensor, m/s.
     hum, hum_frequency : float
         Amplitude (N) and frequency (Hz) of mains hum on the force.
     adc_bits : int, optional
@@ -101,7 +104,7 @@ def synthetic_recording(
     if hum:
         F = F + hum * np.sin(2 * np.pi * hum_frequency * t + rng.uniform(0, 2 * np.pi))
     xn = noise / 10 if x_noise is None else x_noise
-    x = x_true + x_offset + xn * A * rng.standard_normal(n)
+    x = x_true + x_offset + x_drift * t + xn * A * rng.standard_normal(n)
     if adc_bits is not None:
         if not 4 <= int(adc_bits) <= 32:
             raise InputError(f"adc_bits must be in 4..32, got {adc_bits}")
@@ -115,6 +118,8 @@ def synthetic_recording(
         "frequency": f,
         "offset": float(offset),
         "x_offset": float(x_offset),
+        "drift": float(drift),
+        "x_drift": float(x_drift),
         "noise_F": noise * hm,
         "noise_x": xn * A,
         "scale": float(scale),
