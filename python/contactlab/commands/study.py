@@ -28,6 +28,10 @@ def _handler(args: argparse.Namespace) -> int:
         print(f"FAILED: {r.error}", file=sys.stderr)
     n_ok = sum(r.ok for r in result.results)
     print(f"analysed {n_ok} of {len(result.results)} recordings")
+    warned = [r.entry.name for r in result.results if r.ok and r.row.get("warnings")]
+    if warned:
+        print(f"{len(warned)} with warnings (listed in the report): {', '.join(warned)}",
+              file=sys.stderr)  # fmt: skip
     cmd = command_line("study", args.manifest, "--report", args.report)
     paths = write_report(
         args.report, result, args.title, study_plots=True, progress=args.progress, command=cmd
