@@ -37,9 +37,13 @@ pytest: develop
 
 test: rust-lint rust-test py-lint pytest
 
+# Benchmarks (not part of `make test`): criterion for the Rust core, then the Python-level
+# scripts. LSODA over 1e7 samples takes ~20 min; bench_normal's --scipy-n shortens it.
 bench: develop
-	cargo bench -p contactlab-core --locked --bench masing
+	cargo bench -p contactlab-core --locked --bench masing --bench normal
 	$(PY) benches/bench_masing.py
+	$(PY) benches/bench_normal.py --scipy-n 1e6
+	$(PY) benches/bench_study.py
 
 clean:
 	rm -rf $(VENV) target demo-output

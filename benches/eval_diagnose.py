@@ -78,6 +78,12 @@ def main() -> None:
         if eff is None and mag != mags[0]:
             continue  # clean data has no magnitude
         cases.append(run_case(args.model, () if eff is None else (eff,), mag, noise, seed))
+        c = cases[-1]
+        print(
+            f"  {len(cases):4d} {eff or 'none':<24} mag {mag:<5g} noise {noise:<6g} seed {seed}"
+            f" -> {c['named']}",
+            flush=True,
+        )
     family = contactlab.diagnose.workflow._family(args.model)[0]
     pairs = [pr for pr in itertools.combinations(effs, 2) if family.check(pr)]
     rng = np.random.default_rng(7)

@@ -88,3 +88,19 @@ def test_study_folder_without_recordings(tmp_path, outdir, capsys):
     empty.mkdir()
     assert main(["study", str(empty), "--report", str(outdir)]) == 1
     assert "holds no recordings" in capsys.readouterr().err
+
+
+def test_keep_going_survives_an_unexpected_error(tmp_path, monkeypatch):
+    for n in ("Al-Al_W50N_A10um.csv", "Al-Al_W100N_A10um.csv"):
+        (tmp_path / n).write_text("t,x,F\n")
+
+    def broken(entry, **_):
+        raise ZeroDivisionError("boom")
+
+    monkeypatch.setattr(study_mod, "analyze_entry", broken)
+    res = study_mod.run_study(tmp_path, progress=False, keep_going=True)
+    assert [r.error.split(": ", 1)[1] for r in res.failures] == [
+        "unexpected ZeroDivisionError: boom"
+    ] * 2
+    with pytest.raises(ZeroDivisionError):  # without keep_going a bug stays a bug
+        study_mod.run_study(tmp_path, progress=False)

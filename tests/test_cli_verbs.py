@@ -147,9 +147,13 @@ def test_study_manifest(tangential_file, normal_file, tmp_path):
     assert main(["study", str(m), "--report", str(rep), "--no-progress"]) == 0
     t = (rep / "study_tangential.csv").read_text().splitlines()
     assert len(t) == 2 and "h0 [N]" in t[0].split(",")
+    row = dict(zip(t[0].split(","), next(csv.reader([t[1]])), strict=True))
+    assert float(row["fs [Hz]"]) == pytest.approx(400.0) and row["n_samples"] == "1600"
+    assert row["format"] == "csv" and row["units_assumed_si"] == ""
     n = (rep / "study_normal.csv").read_text().splitlines()
     assert len(n) == 2 and "p0 [Pa]" in n[0].split(",")
     assert (rep / "report.html").stat().st_size > 10_000
+    assert f"Made by: contactlab study {m} --report {rep}" in (rep / "report.html").read_text()
 
 
 def test_simulate_bad_extension(tmp_path, capsys):
@@ -220,3 +224,32 @@ def test_json_to_stdout_is_pure_json(tangential_file, capsys):
     d = json.loads(out.out)  # nothing but the JSON on stdout
     assert d["h0"] == pytest.approx(40.0, rel=0.05)
     assert "h0 = " in out.err  # the summary went to stderr
+
+
+@pytest.mark.parametrize("ext", ["csv", "tdms", "h5", "mat"])
+def test_simulate_analyze_round_trip_every_format(tmp_path, ext):
+    """simulate → file → analyze recovers the parameters within 3 reported standard errors."""
+    f = tmp_path / f"rt.{ext}"
+    assert main(["simulate", "tangential", str(f), "--h0", "25", "--ac", "6e4", "--amplitude",
+                 "15um", "--cycles", "5", "--fs", "300", "--noise", "0.01", "--offset", "0.4",
+                 "--x-offset", "2um", "--seed", "11"]) == 0  # fmt: skip
+    js = tmp_path / "rt.json"
+    assert main(["analyze", str(f), "--model", "tangential", "--json", str(js)]) == 0
+    d = json.loads(js.read_text())
+    assert abs(d["h0"] - 25.0) < 3 * d["h0_stderr"]
+    assert abs(d["ac"] - 6e4) < 3 * d["ac_stderr"]
+    assert abs(d["amplitude"] - 15e-6) < 3 * d["amplitude_stderr"] + 1e-9
+
+
+@pytest.mark.parametrize("model", ["nonlinear", "linear"])
+def test_simulate_normal_models(tmp_path, model):
+    f = tmp_path / f"n_{model}.h5"
+    assert main(["simulate", "normal", str(f), "--cycles", "4", "--normal-model", model]) == 0
+    js = tmp_path / "n.json"
+    assert main(["analyze", str(f), "--model", "normal", "--json", str(js)]) == 0
+    d = json.loads(js.read_text())
+    if model == "linear":  # Kelvin-Voigt with the paper's inputs: k = 1.206 MPa/µm, ψ = 0.0887
+        assert d["k_tan"] == pytest.approx(1.206e12, rel=0.03)
+        assert d["psi"] == pytest.approx(0.0887, rel=0.1)
+    else:
+        assert d["k_tan"] > d["k_sec"] * 0.9

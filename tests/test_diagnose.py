@@ -138,7 +138,16 @@ def test_plots_and_html(tmp_path):
     text = path.read_text(encoding="utf-8")
     assert text.count("data:image/png;base64,") == 4
     assert "&quot;viscous_damping&quot;" in text and "Gap shrink" in text
-    assert [p.name for p in (tmp_path / "out").iterdir()] == ["diagnose.html"]
+    files = sorted(p.relative_to(tmp_path / "out").as_posix() for p in path.parent.rglob("*.*"))
+    assert files == [
+        "diagnose.html",
+        "diagnose.json",
+        "figures/gap.png",
+        "figures/location.png",
+        "figures/loops.png",
+        "figures/residual.png",
+    ]
+    assert json.loads((path.parent / "diagnose.json").read_text()) == rep.to_dict()
     assert "viscous_damping" in rep.summary() and "base model" in rep.table()
 
 
@@ -183,3 +192,26 @@ def test_cli_diagnose_writes_json_and_report(tmp_path, capsys):
     code = main(["diagnose", str(path), "--model", "normal"])
     assert code == 1
     assert "diagnose: error:" in capsys.readouterr().err
+
+
+def test_unexplained_gap_is_reported_not_hidden():
+    # the delay is hidden, but only the offset candidate is offered: nothing is named and the
+    # report says the remaining discrepancy is outside the library
+    rec = hidden_effect_recording(["channel_delay"], magnitude=0.05, seed=SEED + 9)
+    rep = contactlab.diagnose(rec, candidates=["force_offset"])
+    assert rep.effects == []
+    assert rep.steps[-1].heldout_rms > 2 * rep.noise_rms
+    assert "not explained by any candidate" in rep.where[-1]
+
+
+def test_independent_synthetic_recordings():
+    # recordings from contactlab.tangential's own simulator (another route to the data)
+    from contactlab.tangential.synthetic import synthetic_recording
+
+    kw = {"frequency": 5.0, "n_cycles": 16, "fs": 600.0, "noise": 0.01, "seed": SEED % 1000}
+    clean = synthetic_recording(50.0, 5e4, 4e-5, **kw)
+    assert contactlab.diagnose(clean).effects == []
+    drift = synthetic_recording(50.0, 5e4, 4e-5, drift=2.0, **kw)
+    (eff,) = contactlab.diagnose(drift).effects
+    assert eff.name == "force_drift"
+    assert eff.parameters["F1"] == pytest.approx(2.0 * 16 / 5.0, rel=0.05)  # N/s × duration

@@ -91,6 +91,11 @@ def test_clean_normal_data_names_nothing_and_two_effects_are_found():
     for fn in (rep.plot_overlay, rep.plot_residual, rep.plot_location, rep.plot_gap):
         ax = Figure().add_subplot()
         assert fn(ax=ax) is ax
+    # a model object starts the fit and fixes the frequency at which ψ holds
+    kv = contactlab.normal.KelvinVoigt(1.0e12, 0.2, 2 * np.pi * rec.truth["base"]["f0"])
+    again = contactlab.diagnose(rec, model=kv)
+    assert again.effects == []
+    assert again.final_model.params["psi"] == pytest.approx(0.0887, rel=0.1)
     pair = ["channel_delay", "stiffness_nonlinearity"]
     rec = hidden_effect_recording(pair, model="normal", seed=SEED + 2, **SMALL)
     rep = contactlab.diagnose(rec, model="normal")

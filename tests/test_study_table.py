@@ -23,6 +23,7 @@ from contactlab.study_plots import (
     normal_study_figures,
     plot_study,
     tangential_study_figures,
+    trends,
 )
 
 
@@ -183,3 +184,42 @@ def test_study_figures_per_material_and_normal():
     np.testing.assert_allclose(ax.get_lines()[0].get_xdata(), [0.5, 1.0, 1.5])
     plt.close("all")
     assert not math.isnan(rows[0]["h0"])
+
+
+def test_trends_match_exact_masing():
+    """E grows with load and amplitude; k_g grows with load and falls with amplitude; c_e·ω
+    rises with A below its peak at ac·A ≈ 2.69 and falls above it."""
+    rows = [r for r in _tangential_rows() if r["material"] == "Al/Al"]  # ac·A = 0.6 .. 2.4
+    t = {e["quantity"]: e for e in trends(rows)}
+    assert t["energy_per_cycle"]["with_load"] == "rises at 3 of 3 amplitudes"
+    assert t["energy_per_cycle"]["with_amplitude"] == "rises at 3 of 3 loads"
+    assert t["k_global"]["with_load"] == "rises at 3 of 3 amplitudes"
+    assert t["k_global"]["with_amplitude"] == "falls at 3 of 3 loads"
+    assert t["equivalent_damping"]["with_amplitude"] == "rises at 3 of 3 loads"
+    assert t["k_local0"]["with_amplitude"] == "not monotone at any of 3 loads"  # constant
+    z = np.linspace(0.05, 10, 4000)
+    assert z[np.argmax(Masing(1.0, 1.0).equivalent_damping(z))] == pytest.approx(2.69, abs=0.01)
+    across = []
+    for W in (50.0, 100.0):
+        m = Masing(0.4 * W, 1e5)  # ac·A = 1, 2.69, 7: across the peak of c_e·ω
+        for A in (10e-6, 26.9e-6, 70e-6):
+            across.append({"material": "x", "normal_load": W, "amplitude_nominal": A,
+                           "equivalent_damping": float(m.equivalent_damping(A))})  # fmt: skip
+    t = {e["quantity"]: e for e in trends(across, ["equivalent_damping"])}
+    assert t["equivalent_damping"]["with_amplitude"] == "not monotone at any of 2 loads"
+    assert t["equivalent_damping"]["with_load"] == "rises at 3 of 3 amplitudes"
+
+
+def test_report_of_a_study_has_plots_trends_and_provenance():
+    from contactlab.report.study_report import build_report
+
+    rows = _tangential_rows()
+    for r in rows:
+        r.update(format="csv", n_samples=1200, fs=200.0, units_assumed_si="")
+    rows[0]["units_assumed_si"] = "x"
+    rep = build_report(_result(rows), "t", details=False)
+    html = rep.render_html()
+    assert "against normal load" in html and "rises at 3 of 3 amplitudes" in html
+    assert len(rep.figures) == 8  # 2 materials × 4 quantities
+    assert "1 file(s) have columns without units, read as SI" in html
+    plt.close("all")

@@ -136,8 +136,15 @@ def analyze_entry(
 
     rec = read_recording(entry.path, columns=entry.columns, kind=entry.kind, fs=entry.fs)
     base = {"file": entry.path.name, "kind": entry.kind, **entry.tags}
+    # provenance: what was read (a units-assumed-SI note matters when a file has no units)
+    base["format"] = entry.path.suffix.lower().lstrip(".")
+    base["n_samples"] = len(rec.t)
+    base["fs"] = float(rec.fs)
+    assumed = (rec.meta or {}).get("units_assumed_si")
+    base["units_assumed_si"] = ", ".join(map(str, assumed)) if assumed else ""
     units = {k: TAG_UNITS[k] for k in entry.tags if k in TAG_UNITS}
     units.update(entry.units)
+    units["fs"] = "Hz"
     if entry.kind == "tangential":
         from .tangential import analyze_tangential
 
@@ -309,7 +316,8 @@ def run_study(
         Show a progress bar (``tqdm.auto``: a widget in notebooks); None shows it on a terminal.
     keep_going : bool
         If False (default) the first recording that cannot be read or analysed stops the study
-        with its error (naming the file). If True it is recorded in ``failures`` and skipped.
+        with its error (naming the file). If True it is recorded in ``failures`` and skipped
+        (unexpected errors too, with their type, so one odd file does not cost a long study).
     tangential_options, normal_options : mapping, optional
         Keyword arguments for the per-recording analyses.
     callback : callable, optional
@@ -343,6 +351,12 @@ def run_study(
                     raise
                 raise new from exc
             r = RecordingResult(entry, {}, {}, error=_with_source(exc, entry))
+        except Exception as exc:  # not a known bad input: a bug, or something unforeseen
+            if not keep_going:
+                raise
+            # The user asked to go on: keep the rest of the study, name what happened.
+            msg = f"{entry.path}: unexpected {type(exc).__name__}: {exc}"
+            r = RecordingResult(entry, {}, {}, error=msg)
         results.append(r)
         if callback is not None:
             callback(r)

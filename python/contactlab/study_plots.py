@@ -189,6 +189,61 @@ def tangential_study_figures(
     return out
 
 
+def _direction(xs: Sequence[float], ys: Sequence[float]) -> int:
+    """+1 when y rises strictly with x over every step, -1 when it falls, 0 otherwise."""
+    pts = sorted((x, y) for x, y in zip(xs, ys, strict=True) if math.isfinite(x + y))
+    if len(pts) < 2:
+        return 0
+    d = np.diff([y for _, y in pts])
+    return 1 if np.all(d > 0) else -1 if np.all(d < 0) else 0
+
+
+def trends(
+    rows: Sequence[Mapping[str, Any]], quantities: Sequence[str] | None = None
+) -> list[dict[str, Any]]:
+    """How each quantity moves with load (at fixed nominal amplitude) and with amplitude (at
+    fixed load), per material — the trends the tangential paper reports (E and c_e·ω grow with
+    load; stiffness grows with load and falls with amplitude).
+
+    Returns rows ``{material, quantity, with_load, with_amplitude}`` where each entry reads
+    like ``"rises at 3 of 3 amplitudes"``: a series counts as rising (falling) only when every
+    step rises (falls); series with fewer than two points are not counted.
+    """
+    keys = list(quantities or [q for q, *_ in TANGENTIAL_QUANTITIES])
+    out = []
+    for mat in sorted({str(r.get("material", "unknown")) for r in rows}):
+        mrows = [r for r in rows if str(r.get("material", "unknown")) == mat]
+        for key in keys:
+            if not any(math.isfinite(_num(r, key)) for r in mrows):
+                continue
+            entry: dict[str, Any] = {"material": mat, "quantity": key}
+            nominal = all(math.isfinite(_num(r, "amplitude_nominal")) for r in mrows)
+            amp = "amplitude_nominal" if nominal else "amplitude"
+            for label, along, fixed, what in (
+                ("with_load", "normal_load", amp, "amplitudes"),
+                ("with_amplitude", amp, "normal_load", "loads"),
+            ):
+                groups: dict[float, list[Mapping[str, Any]]] = {}
+                for r in mrows:
+                    groups.setdefault(_group_key(r, fixed), []).append(r)
+                dirs = [
+                    _direction([_num(r, along) for r in g], [_num(r, key) for r in g])
+                    for g in groups.values()
+                    if sum(math.isfinite(_num(r, key)) for r in g) >= 2
+                ]
+                up, down, n = dirs.count(1), dirs.count(-1), len(dirs)
+                if n == 0:
+                    entry[label] = "—"
+                elif up == down == 0:
+                    entry[label] = f"not monotone at any of {n} {what}"
+                elif up >= down:
+                    entry[label] = f"rises at {up} of {n} {what}"
+                else:
+                    entry[label] = f"falls at {down} of {n} {what}"
+            out.append(entry)
+    return out
+
+
 def normal_study_figures(
     rows: Sequence[Mapping[str, Any]], units: Mapping[str, str] | None = None
 ) -> list[tuple[str, Any, str]]:
@@ -228,4 +283,4 @@ def normal_study_figures(
 
 
 __all__ = ["NORMAL_QUANTITIES", "TANGENTIAL_QUANTITIES", "display_unit", "normal_study_figures",
-           "plot_study", "tangential_study_figures"]  # fmt: skip
+           "plot_study", "tangential_study_figures", "trends"]  # fmt: skip

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import shlex
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -18,6 +19,15 @@ from ..report import commit_outputs
 from ..study import RecordingResult, StudyResult
 
 _QTY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-zµμ/]*)\s*$")
+
+
+def describe(doc: str | None) -> str | None:
+    """The second paragraph of a module docstring as plain text for ``--help``."""
+    if not doc or "\n\n" not in doc:
+        return doc
+    text = doc.split("\n\n")[1]
+    text = re.sub(r":\w+:`~?([^`]+)`", r"\1", text)  # :mod:`x` -> x
+    return text.replace("``", "")
 
 
 def quantity(default_unit: str):
@@ -113,19 +123,31 @@ def write_report(
     study_plots: bool,
     extra: Mapping[str, bytes] | None = None,
     progress: bool | None = None,
+    command: str | None = None,
 ) -> list[Path]:
-    """Render the report and tables in memory, then write them all or nothing."""
+    """Render the report and tables in memory, then write them all or nothing.
+
+    ``command`` (the command line that made it) is quoted at the top of the report.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
     from ..report.study_report import build_report
 
-    rep = build_report(result, title, study_plots=study_plots, progress=progress)
+    intro = f"Made by: {command}" if command else None
+    rep = build_report(result, title, study_plots=study_plots, progress=progress, intro=intro)
     files = rep.files()
     files.update(result.table_files())
     if extra:
         files.update(extra)
     return commit_outputs(directory, files)
+
+
+def command_line(verb: str, *parts: Any) -> str:
+    """A shell-quoted ``contactlab VERB ...`` line for the report's provenance."""
+    words = ["contactlab", verb]
+    words += [str(p) for p in parts if p is not None and p is not False and p != ""]
+    return " ".join(shlex.quote(w) for w in words)
 
 
 def add_progress_flags(p: Any) -> None:

@@ -18,6 +18,8 @@ from ..manifest import entry_from_file
 from ..study import run_study
 from ._common import (
     add_progress_flags,
+    command_line,
+    describe,
     json_document,
     parse_columns,
     quantity,
@@ -70,9 +72,12 @@ def _handler(args: argparse.Namespace) -> int:
             print(f"{r.entry.path}: FAILED: {r.error}", file=sys.stderr)
     if args.report:
         title = f"contactlab analyze ({args.model}, {len(entries)} recording(s))"
-        for p in write_report(
-            args.report, result, title, study_plots=len(entries) > 1, progress=args.progress
-        ):
+        cmd = command_line("analyze", *args.files, "--model", args.model,
+                           *(["--columns", args.columns] if args.columns else []),
+                           "--report", args.report)  # fmt: skip
+        paths = write_report(args.report, result, title, study_plots=len(entries) > 1,
+                             progress=args.progress, command=cmd)  # fmt: skip
+        for p in paths:
             if p.suffix == ".html":
                 print(f"wrote {p}", file=say)
     if args.json:
@@ -86,7 +91,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "analyze",
         help="analyse recordings (tangential Masing fit or normal-contact loop)",
-        description=__doc__.split("\n\n")[1] if __doc__ else None,
+        description=describe(__doc__),
     )
     p.add_argument("files", nargs="+", metavar="FILE", help="recordings (.csv .tdms .h5 .mat)")
     p.add_argument("--model", required=True, choices=("tangential", "normal"))

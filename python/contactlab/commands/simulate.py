@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import argparse
 
-from ._common import quantity
+from ._common import describe, quantity
 
 
 def _handler(args: argparse.Namespace) -> int:
@@ -59,7 +59,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "simulate",
         help="write a synthetic recording (tangential Masing or normal contact)",
-        description=__doc__.split("\n\n")[1] if __doc__ else None,
+        description=describe(__doc__),
     )
     p.add_argument("model", choices=("tangential", "normal"))
     p.add_argument("out", metavar="OUT", help="output file (.csv .tdms .h5 .mat)")
@@ -80,7 +80,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     n.add_argument("--pa", type=quantity("Pa"), default=0.4e6, help="pressure amplitude (Pa)")
     n.add_argument("--omega", type=quantity("1/s"), default=1.0, help="angular frequency (1/s)")
     n.add_argument("--samples-per-cycle", type=int, default=400)
-    n.add_argument("--normal-model", default=None, help="model of the normal contact")
+    n.add_argument("--normal-model", default=None, choices=("nonlinear", "linear", "table2"),
+                   help="eq. 17 (default), Kelvin-Voigt, or the Table 2 loop itself")  # fmt: skip
     p.add_argument("--cycles", type=int, default=5, help="number of cycles")
     p.add_argument("--noise", type=float, default=None,
                    help="tangential: force noise as a fraction of the peak force (default "

@@ -12,7 +12,14 @@ import argparse
 import sys
 
 from ..study import run_study
-from ._common import add_progress_flags, json_document, write_json, write_report
+from ._common import (
+    add_progress_flags,
+    command_line,
+    describe,
+    json_document,
+    write_json,
+    write_report,
+)
 
 
 def _handler(args: argparse.Namespace) -> int:
@@ -21,7 +28,14 @@ def _handler(args: argparse.Namespace) -> int:
         print(f"FAILED: {r.error}", file=sys.stderr)
     n_ok = sum(r.ok for r in result.results)
     print(f"analysed {n_ok} of {len(result.results)} recordings")
-    paths = write_report(args.report, result, args.title, study_plots=True, progress=args.progress)
+    warned = [r.entry.name for r in result.results if r.ok and r.row.get("warnings")]
+    if warned:
+        print(f"{len(warned)} with warnings (listed in the report): {', '.join(warned)}",
+              file=sys.stderr)  # fmt: skip
+    cmd = command_line("study", args.manifest, "--report", args.report)
+    paths = write_report(
+        args.report, result, args.title, study_plots=True, progress=args.progress, command=cmd
+    )
     for p in paths:
         if p.suffix in (".html", ".csv", ".parquet"):
             print(f"wrote {p}")
@@ -34,7 +48,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "study",
         help="analyse a set of tagged recordings: table, study plots and report",
-        description=__doc__.split("\n\n")[1] if __doc__ else None,
+        description=describe(__doc__),
     )
     p.add_argument("manifest", metavar="MANIFEST", help="manifest CSV, or a folder of recordings")
     p.add_argument("--report", metavar="DIR", required=True, help="output folder")

@@ -1,96 +1,93 @@
-"""Self-contained HTML page of a diagnosis: findings, gap table, figures (embedded PNG) and
-the JSON result. Written atomically."""
+"""HTML report of a diagnosis, built with :class:`contactlab.report.Report`: findings,
+effects with their parameters, the gap-shrink table, before/after figures, the verdict on
+every candidate and the JSON result. Written all or nothing (HTML, PNGs and the JSON)."""
 
 from __future__ import annotations
 
-import base64
-import html
-import io
 from pathlib import Path
 from typing import Any
 
-from .._io_atomic import write_text
+from ..report import Column, Report
+
+FIGURES = (
+    ("loops", "Loops: measurement, base model and final model", "plot_overlay"),
+    ("residual", "Held-out residual before and after (dashed: ± noise RMS)", "plot_residual"),
+    ("location", "Where the base model's residual lives within the branches", "plot_location"),
+    ("gap", "Gap shrink: held-out RMS over the noise level after each step", "plot_gap"),
+)
 
 
-def _png(fig: Any) -> str:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
-    return base64.b64encode(buf.getvalue()).decode("ascii")
-
-
-def render(report: Any) -> str:
-    """The HTML text of ``report`` (figures drawn with the Agg backend)."""
+def build(report: Any) -> Report:
+    """The :class:`~contactlab.report.Report` of ``report`` (figures drawn off-screen)."""
     from matplotlib.figure import Figure
 
-    figs = []
-    for title, fn in (
-        ("Loops before and after", report.plot_overlay),
-        ("Held-out residual before and after", report.plot_residual),
-        ("Where the residual lives", report.plot_location),
-        ("Gap shrink", report.plot_gap),
-    ):
-        fig = Figure(figsize=(7.0, 4.4), layout="constrained")
-        fn(ax=fig.add_subplot())
-        figs.append((title, _png(fig)))
-    e = html.escape
-    rows = "".join(
-        f"<tr><td>{e(s.added or 'base model')}</td><td>{s.heldout_rms:.4g}</td>"
-        f"<td>{s.heldout_rms / report.noise_rms:.2f}</td><td>{s.heldout_peak:.4g}</td>"
-        f"<td>{100 * s.energy_error:.2f} %</td></tr>"
+    r = Report(
+        f"Model discrepancy: {report.model} contact",
+        "Where the base model and the measurement disagree, which candidate effects explain "
+        "it (chosen by their error on held-out cycles) and how much the gap shrinks.",
+    )
+    r.section("Where the base model disagrees")
+    for w in report.where:
+        r.text(w, note=w.startswith("after "))
+    r.section("Effects added")
+    if report.effects:
+        rows = [
+            {"effect": e.name, "parameter": k, "value": v, "stderr": e.stderr.get(k)}
+            for e in report.effects
+            for k, v in e.parameters.items()
+        ]
+        r.table(rows, ["effect", "parameter", Column("value", stderr="stderr")])
+    else:
+        r.text("None: no candidate improves the held-out error significantly.")
+    r.section("Gap shrink (held-out cycles)")
+    rows = [
+        {
+            "step": s.added or "base model",
+            "heldout_rms": s.heldout_rms,
+            "over_noise": s.heldout_rms / report.noise_rms,
+            "heldout_peak": s.heldout_peak,
+            "energy_error": 100 * s.energy_error,
+        }
         for s in report.steps
+    ]
+    r.table(
+        rows,
+        [
+            "step",
+            Column("heldout_rms", "held-out RMS"),
+            Column("over_noise", "/ noise RMS"),
+            Column("heldout_peak", "peak error"),
+            Column("energy_error", "loop-energy error", unit="%"),
+        ],
     )
-    cand = ""
+    r.text(f"Noise RMS estimated from the data: {report.noise_rms:.4g}")
+    for name, caption, method in FIGURES:
+        fig = Figure(figsize=(7.0, 4.4), layout="constrained")
+        getattr(report, method)(ax=fig.add_subplot())
+        r.figure(fig, name, caption, dpi=110)
+    r.section("Candidates tried")
     for i, s in enumerate(report.steps):
-        if not s.candidates:
-            continue
-        cand += f"<h3>Candidates tried after step {i} ({e(s.added or 'base model')})</h3><table>"
-        cand += "<tr><th>candidate</th><th>held-out RMS</th><th>gain / σ²</th><th>t</th>"
-        cand += "<th>ΔBIC</th><th>verdict</th></tr>"
-        for v in s.candidates:
-            cand += (
-                f"<tr><td>{e(v.name)}</td><td>{v.heldout_rms:.4g}</td><td>{v.gain:.3g}</td>"
-                f"<td>{v.t_stat:.2f}</td><td>{v.delta_bic:+.1f}</td><td>{e(v.reason)}</td></tr>"
+        if s.candidates:
+            r.subheading(f"after step {i} ({s.added or 'base model'})")
+            r.table(
+                [v.to_dict() for v in s.candidates],
+                [
+                    "name",
+                    Column("heldout_rms", "held-out RMS"),
+                    Column("gain_over_noise_var", "gain / σ²"),
+                    Column("t_stat", "t"),
+                    Column("delta_bic", "ΔBIC"),
+                    "reason",
+                ],
             )
-        cand += "</table>"
-    effects = (
-        "".join(
-            f"<li><b>{e(x.name)}</b>: "
-            + ", ".join(
-                f"{e(k)} = {v:.5g} ± {x.stderr.get(k, float('nan')):.2g}"
-                for k, v in x.parameters.items()
-            )
-            + "</li>"
-            for x in report.effects
-        )
-        or "<li>none — no candidate improves the held-out error significantly</li>"
-    )
-    imgs = "".join(
-        f'<figure><img alt="{e(t)}" src="data:image/png;base64,{b}"><figcaption>{e(t)}'
-        "</figcaption></figure>"
-        for t, b in figs
-    )
-    where = "".join(f"<li>{e(w)}</li>" for w in report.where)
-    return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>contactlab diagnose</title>
-<style>body{{font-family:sans-serif;max-width:60em;margin:2em auto}}
-table{{border-collapse:collapse}}td,th{{border:1px solid #bbb;padding:2px 8px}}
-img{{max-width:100%}}pre{{background:#f4f4f4;padding:1em;overflow:auto}}</style></head><body>
-<h1>Model discrepancy: {e(report.model)} contact</h1>
-<h2>Where the base model disagrees</h2><ul>{where}</ul>
-<h2>Effects added</h2><ul>{effects}</ul>
-<h2>Gap shrink (held-out cycles)</h2>
-<table><tr><th>step</th><th>held-out RMS</th><th>/ noise</th><th>peak error</th>
-<th>loop-energy error</th></tr>{rows}</table>
-<p>Noise RMS estimated from the data: {report.noise_rms:.4g}</p>
-{imgs}
-{cand}
-<h2>Result (JSON)</h2><pre>{e(report.to_json())}</pre>
-</body></html>
-"""
+    r.section("Result (JSON)")
+    r.preformatted(report.to_json())
+    return r
 
 
 def write_html(report: Any, directory: str | Path) -> Path:
-    """Write ``diagnose.html`` into ``directory`` (created if needed); return its path."""
-    path = Path(directory) / "diagnose.html"
-    write_text(path, render(report))
-    return path
+    """Write ``diagnose.html``, its figures and ``diagnose.json`` into ``directory``."""
+    r = build(report)
+    extra = {"diagnose.json": (report.to_json() + "\n").encode("utf-8")}
+    paths = r.write(directory, extra=extra, html_name="diagnose.html")
+    return paths[0]

@@ -12,6 +12,8 @@ name                      measured force ``F`` (or measured ``x``)              
 ``parallel_stiffness``    ``F = h + k_p x`` (rig flexures in parallel)                k_p [N/m]
 ``series_compliance``     ``x = x_c + C_s h`` (rig compliance in series)              C_s [m/N]
 ``force_offset``          ``F = h + F0`` (sensor bias)                                F0 [N]
+``force_drift``           ``F = h + F1 (t - t0)/T`` (load-cell zero drifting)        F1 [N]
+``displacement_offset``   ``h = M(x - x0)`` (displacement sensor zero off the origin)  x0 [m]
 ``channel_delay``         ``F(t) = h(t - τ)`` (force channel lags displacement)       tau [s]
 ``asymmetry``             ``F = h + α |h|``: saturation ``h0(1 ± α)`` per direction   alpha [-]
 ``non_masing_scaling``    branch scale ``λ`` instead of 2, loops kept closed           lam [-]
@@ -28,9 +30,12 @@ so the series compliance is solved exactly by reparametrising the virgin curve a
 because ``Masing(..., scale=λ)`` jumps where the memory rules end a branch and so cannot
 be fitted to noisy data. ``ẋ`` and ``ẍ`` are Savitzky-Golay derivatives of the
 measured displacement; the delay is a fractional-sample shift by linear interpolation.
-When several effects are active they compose in this order: series compliance and branch
+Beyond the issue's list, ``force_drift`` and ``displacement_offset`` cover two common sensor
+faults that no other candidate can stand in for. When several effects are active they
+compose in this order: displacement offset on the input; series compliance and branch
 scale inside the Masing element; asymmetry and drift on its force; the additive terms
-(parallel stiffness, viscous, inertia, offset); the delay on the total measured force.
+(parallel stiffness, viscous, inertia, offset, force drift); the delay on the total
+measured force.
 """
 
 from __future__ import annotations
@@ -73,6 +78,16 @@ CANDIDATES: dict[str, Candidate] = {
             "force_offset",
             (ParamSpec("F0", "N", 0.0, -_INF, _INF, "F"),),
             "constant force-sensor bias F0",
+        ),
+        Candidate(
+            "force_drift",
+            (ParamSpec("F1", "N", 0.0, -_INF, _INF, "F"),),
+            "force-sensor zero drifting linearly, by F1 over the recording",
+        ),
+        Candidate(
+            "displacement_offset",
+            (ParamSpec("x0", "m", 0.0, -_INF, _INF, "x"),),
+            "displacement-sensor zero: the contact sees x - x0",
         ),
         Candidate(
             "channel_delay",
@@ -147,6 +162,7 @@ class TangentialFamily:
             "m": Fs / rms(d.udd),
             "k": Fs / xs,
             "C": xs / Fs,
+            "x": 0.05 * xs,
             "tau": d.cycles.period_samples * d.dt / 100.0,
             "one": 1.0,
         }
@@ -170,6 +186,8 @@ class TangentialFamily:
     def predict(self, p: dict[str, float], effects: tuple[str, ...], d: Prepared) -> np.ndarray:
         """Measured force predicted for the measured displacement ``d.u``."""
         x = d.u
+        if "displacement_offset" in effects:
+            x = x - p["x0"]
         if "series_compliance" in effects:
             xmax = float(np.max(np.abs(x))) or 1.0
             bx, bf = series_backbone(p["h0"], p["ac"], max(p["C_s"], 0.0), xmax)
@@ -196,6 +214,8 @@ class TangentialFamily:
             F = F + p["m"] * d.udd
         if "force_offset" in effects:
             F = F + p["F0"]
+        if "force_drift" in effects:
+            F = F + p["F1"] * (d.t - d.t[0]) / d.duration
         if "channel_delay" in effects:
             F = shift(F, d.t, p["tau"])
         return F

@@ -17,12 +17,23 @@ def add_parser(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "diagnose",
         help="find where model and measurement disagree and which effect is missing",
-        description=__doc__.split("\n\n")[1] if __doc__ else None,
+        description=(
+            "Fit the base model to the recording, report where the residual lives, name the "
+            "missing effect(s) from the candidate library by their error on held-out cycles, "
+            "and show the gap shrink. Prints the findings and the gap-shrink table."
+        ),
     )
     p.add_argument("file", metavar="FILE", help="recording (CSV, TDMS, HDF5, MAT)")
-    p.add_argument("--model", choices=["tangential", "normal"], required=True)
+    p.add_argument(
+        "--model",
+        choices=["tangential", "normal"],
+        required=True,
+        help="tangential: x, F (Masing base); normal: p, delta (Kelvin-Voigt base)",
+    )
     p.add_argument("--json", metavar="OUT", help="write the result as JSON to OUT")
-    p.add_argument("--report", metavar="DIR", help="write DIR/diagnose.html")
+    p.add_argument(
+        "--report", metavar="DIR", help="write DIR/diagnose.html (+ figures/, diagnose.json)"
+    )
     p.add_argument("--max-effects", type=int, default=3, help="stop after this many additions")
     p.set_defaults(handler=run)
 

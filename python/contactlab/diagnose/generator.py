@@ -43,6 +43,8 @@ TANGENTIAL_EFFECTS = (
     "parallel_stiffness",
     "series_compliance",
     "force_offset",
+    "force_drift",
+    "displacement_offset",
     "channel_delay",
     "asymmetry",
     "non_masing_scaling",
@@ -142,6 +144,8 @@ def _tangential_force(
     if "parameter_drift" in effects:
         h = h * (1.0 + effects["parameter_drift"] * (t - t[0]) / (t[-1] - t[0]))
     x_meas = xfun(t)
+    if "displacement_offset" in effects:
+        x_meas = x_meas + effects["displacement_offset"]
     if "series_compliance" in effects:
         x_meas = x_meas + h * effects["series_compliance"]
     F = h
@@ -154,6 +158,8 @@ def _tangential_force(
         F = F + effects["inertia"] * a
     if "force_offset" in effects:
         F = F + effects["force_offset"]
+    if "force_drift" in effects:
+        F = F + effects["force_drift"] * (t - t[0]) / (t[-1] - t[0])
     return x_meas, F
 
 
@@ -163,6 +169,8 @@ _PARAM_NAME = {
     "parallel_stiffness": "k_p",
     "series_compliance": "C_s",
     "force_offset": "F0",
+    "force_drift": "F1",
+    "displacement_offset": "x0",
     "channel_delay": "tau",
     "asymmetry": "alpha",
     "non_masing_scaling": "lam",
@@ -256,7 +264,14 @@ def hidden_effect_recording(
     params: dict[str, float] = {}
     for name, target in sizes.items():
         sign = 1.0
-        if name in ("force_offset", "asymmetry", "parameter_drift", "non_masing_scaling"):
+        if name in (
+            "force_offset",
+            "force_drift",
+            "displacement_offset",
+            "asymmetry",
+            "parameter_drift",
+            "non_masing_scaling",
+        ):
             sign = 1.0 if rng.random() < 0.5 else -1.0
         params[name] = _solve_size(name, target, sign, size, h0, ac, Fr, period)
     x, F = _tangential_force(params, t, xfun, h0, ac, period)
@@ -312,6 +327,8 @@ def _solve_size(
         "parallel_stiffness": 10.0 * h0 * ac,
         "series_compliance": 10.0 / (h0 * ac),
         "force_offset": 2.0 * Fr,
+        "force_drift": 6.0 * Fr,
+        "displacement_offset": 2.0 / ac,
         "channel_delay": 0.25 * period,
         "asymmetry": 0.9,
         "non_masing_scaling": 1.5 if sign > 0 else 0.9,

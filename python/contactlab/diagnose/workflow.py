@@ -144,7 +144,7 @@ class DiagnosisReport:
         out += ["Where the base model disagrees:"] + [f"  - {w}" for w in self.where]
         out.append("")
         if not self.effects:
-            out.append("No missing effect: no candidate improves the held-out error significantly.")
+            out.append("No candidate improves the held-out error significantly.")
         for e in self.effects:
             ps = ", ".join(
                 f"{k} = {v:.4g} ± {e.stderr.get(k, np.nan):.2g}" for k, v in e.parameters.items()
@@ -173,7 +173,8 @@ class DiagnosisReport:
         return plot_location(self, ax=ax)
 
     def write_html(self, directory: Any) -> Any:
-        """Write a self-contained ``diagnose.html`` (figures and JSON) into ``directory``."""
+        """Write a self-contained ``diagnose.html`` (figures embedded, also as PNGs under
+        ``figures/``) and ``diagnose.json`` into ``directory``; returns the HTML's path."""
         from ._html import write_html
 
         return write_html(self, directory)
@@ -354,6 +355,13 @@ def diagnose(
         dp, ds = family.derived(p, se, name)
         out_effects.append(Effect(name, {**ps, **dp}, {**ss, **ds}))
     final = ExtendedModel(family, effects, p, se, family.context(d))
+    gap = current.heldout_rms / sigma
+    if gap > 1.5:
+        where.append(
+            f"after {'the additions' if added else 'the base fit'} the held-out RMS is still "
+            f"{gap:.1f}× the noise level: the remaining discrepancy is not explained by any "
+            "candidate of the library"
+        )
     return DiagnosisReport(
         family.kind, out_effects, steps, where, sigma, final, location, d, trials
     )

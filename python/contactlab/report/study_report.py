@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from ..study import RecordingResult, StudyResult
-from ..study_plots import display_unit, normal_study_figures, tangential_study_figures
+from ..study_plots import display_unit, normal_study_figures, tangential_study_figures, trends
 from .html import Column, Report
 
 TANGENTIAL_COLUMNS = [
@@ -140,6 +140,32 @@ def _normal_detail(rep: Report, r: RecordingResult, dpi: int) -> None:
     )
 
 
+_TRENDS_CAPTION = (
+    "Trends: a series (one amplitude, or one load) counts as rising or falling only when every "
+    "step does; others are not counted"
+)
+
+
+def _provenance(rep: Report, result: StudyResult) -> None:
+    rows = [r.row for r in result.results if r.ok]
+    if not rows:
+        return
+    rep.section("Data read")
+    cols = [
+        Column("file"),
+        Column("kind"),
+        Column("format"),
+        Column("n_samples", "samples"),
+        Column("fs", "fs", "Hz"),
+        Column("units_assumed_si", "columns without units (SI assumed)"),
+    ]
+    rep.table(rows, cols)
+    assumed = [r["file"] for r in rows if r.get("units_assumed_si")]
+    if assumed:
+        rep.text(f"{len(assumed)} file(s) have columns without units, read as SI: "
+                 + ", ".join(assumed), note=True)  # fmt: skip
+
+
 def build_report(
     result: StudyResult,
     title: str = "contactlab report",
@@ -177,6 +203,14 @@ def build_report(
             )
             if figs:
                 rep.section(f"{kind.capitalize()} study plots")
+                if kind == "tangential":
+                    cols_t = [
+                        "material",
+                        "quantity",
+                        Column("with_load", "against normal load"),
+                        Column("with_amplitude", "against amplitude"),
+                    ]
+                    rep.table(trends(rows), cols_t, caption=_TRENDS_CAPTION)
                 for name, fig, cap in figs:
                     rep.figure(fig, name, cap, dpi=dpi)
         if details:
@@ -187,6 +221,7 @@ def build_report(
             for r in bar:
                 rep.subheading(_label(r))
                 (_tangential_detail if kind == "tangential" else _normal_detail)(rep, r, dpi)
+    _provenance(rep, result)
     if result.failures:
         rep.section("Recordings that could not be analysed")
         for r in result.failures:
