@@ -513,3 +513,42 @@ def _finish(
         scale_covar=scale_covar,
         notes=notes,
     )
+
+
+def add_covariance(fit: FitResult, extra: np.ndarray, *, note: str | None = None) -> FitResult:
+    """A copy of ``fit`` whose covariance includes ``extra`` (over ``fit.var_names``).
+
+    For error sources the residuals do not show: an input the fit took as exact but that was
+    estimated beforehand with its own error ``Σ_u`` (a drift removed from the data, a
+    calibration). With ``G = ∂θ/∂u`` (the fitted parameters' response to the input), that
+    error adds ``G Σ_u Gᵀ`` to the covariance. Standard errors and correlations are updated;
+    a parameter flagged not identifiable stays so.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.linspace(0, 1, 20)
+    >>> y = 2 * x + 1 + 0.01 * np.cos(40 * x)
+    >>> fit = least_squares_fit(lambda p: p["a"] * x + p["b"] - y, {"a": 1.0, "b": 0.0})
+    >>> out = add_covariance(fit, np.diag([0.0, 1e-4]))
+    >>> round(out.params["b"].stderr, 4) >= 0.01
+    True
+    """
+    if fit.covar is None:
+        return fit
+    extra = np.asarray(extra, dtype=float)
+    k = len(fit.var_names)
+    if extra.shape != (k, k) or not np.all(np.isfinite(extra)):
+        raise InputError(f"extra covariance must be a finite {k}x{k} array, got {extra.shape}")
+    covar = fit.covar + 0.5 * (extra + extra.T)
+    d = np.sqrt(np.clip(np.diag(covar), 0.0, None))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        correl = covar / np.outer(d, d)
+    correl[~np.isfinite(correl)] = 0.0
+    np.fill_diagonal(correl, 1.0)
+    params = {n: replace(p) for n, p in fit.params.items()}
+    for i, n in enumerate(fit.var_names):
+        if params[n].stderr is not None:
+            params[n].stderr = float(d[i])
+    notes = list(fit.notes) + ([note] if note else [])
+    return replace(fit, params=params, covar=covar, correl=correl, notes=notes)

@@ -31,7 +31,7 @@ import numpy as np
 
 from .._arrays import as_1d
 from ..errors import ContactLabWarning, InputError
-from ..fitting import FitResult, Parameter, least_squares_fit
+from ..fitting import FitResult, Parameter, add_covariance, least_squares_fit
 from ..io import Recording
 from ..masing import Masing, loop_area
 from .model import (
@@ -213,6 +213,7 @@ def analyze_tangential(
             raise
     drift = (0.0, 0.0)
     x_drift = (0.0, 0.0)
+    drift_ref: tuple[np.ndarray, float] | None = None
     if detrend and loop is not None and loop.n_cycles >= 3:
         # Slow sensor drift shows as a trend in the per-cycle means (a steady loop has the
         # same mean force and displacement every cycle). Remove both and average again.
@@ -220,6 +221,7 @@ def analyze_tangential(
         tt = ta if ta is not None else np.arange(xa.size, dtype=float)
         tm = float(np.mean(sc.time))
         drift = _trend(sc.time, sc.mean_force)
+        drift_ref = (tt, tm)
         Fa = Fa - drift[0] * (tt - tm)
         if sc.mean_x is not None:
             x_drift = _trend(sc.time, sc.mean_x)
@@ -321,43 +323,96 @@ def analyze_tangential(
     nodes = turn_nodes(xpath, rev.peaks, rev.valleys) if on == "signal" and steady else None
     vnodes = _virgin_nodes(xa, ta, xpath, rev) if on == "signal" and not steady else None
 
-    def predict(v: dict[str, float]) -> np.ndarray:
+    def predict(v: dict[str, float], xp: np.ndarray | None = None, vn: Any = None) -> np.ndarray:
         m = _model(v)
+        xp = xpath if xp is None else xp
         if on == "averaged":
-            Fm = steady_loop_force(m, xpath, v["x0"], v["amplitude"], bin_var)
+            Fm = steady_loop_force(m, xp, v["x0"], v["amplitude"], bin_var)
         elif steady:
-            Fm = steady_signal_force(m, xpath, v["x0"], v["amplitude"], nodes, first_is_peak)
+            Fm = steady_signal_force(m, xp, v["x0"], v["amplitude"], nodes, first_is_peak)
         else:
-            Fm = virgin_signal_force(m, xpath, v["x0"], vnodes)
+            Fm = virgin_signal_force(m, xp, v["x0"], vnodes if vn is None else vn)
         return Fm + v["offset"]
 
-    def residual(v: dict[str, float]) -> np.ndarray:
-        return (predict(v)[sl] - Fd[sl]) * w[sl]
+    def residual(
+        v: dict[str, float],
+        xp: np.ndarray | None = None,
+        vn: Any = None,
+        dF: np.ndarray | None = None,
+    ) -> np.ndarray:
+        Fdat = Fd if dF is None else Fd + dF
+        return (predict(v, xp, vn)[sl] - Fdat[sl]) * w[sl]
 
     raw = least_squares_fit(residual, params)
     prior = _turning_point_prior(loop) if (steady and loop is not None) else None
+    extra: list[tuple[str, float]] = []
+    s_f = 1.0
+
+    def full_residual(
+        v: dict[str, float],
+        xp: np.ndarray | None = None,
+        vn: Any = None,
+        dF: np.ndarray | None = None,
+        tips: tuple[float, float, float] | None = None,
+    ) -> np.ndarray:
+        r = residual(v, xp, vn, dF)
+        if not extra:
+            return r
+        tp = prior if tips is None else tips
+        assert tp is not None
+        meas = {"x0": tp[0], "amplitude": tp[1]}
+        pr = [(v[k] - meas[k]) / prior[2] * s_f for k, _ in extra]  # type: ignore[index]
+        return np.concatenate([r, pr])
+
     if prior is not None and (fit_amplitude or fit_x0):
         # The displacement channel measures the turning points too. Add that measurement as
         # two more residuals, in the force residuals' units (their scale from the first fit),
         # and refit from the first solution.
         s_f = math.sqrt(raw.redchi) if raw.redchi > 0 else 1.0
-        x0_d, a_d, sig = prior
-        extra = []
+        x0_d, a_d, _sig = prior
         if fit_x0:
             extra.append(("x0", x0_d))
         if fit_amplitude:
             extra.append(("amplitude", a_d))
 
-        def residual_with_prior(v: dict[str, float]) -> np.ndarray:
-            pr = [(v[k] - d) / sig * s_f for k, d in extra]
-            return np.concatenate([residual(v), pr])
-
         start_params = [replace(p, value=raw.params[p.name].value) for p in params]
         for p in start_params:
             p.value = min(max(p.value, p.min), p.max)
-        raw = least_squares_fit(residual_with_prior, start_params)
+        raw = least_squares_fit(full_residual, start_params)
         for p, p0 in zip(raw.params.values(), params, strict=True):
             p.init_value = p0.value if p0.vary else None
+
+    if drift_ref is not None and raw.jac is not None and raw.covar is not None:
+        # The drifts were estimated (from per-cycle means) and removed before the fit, which
+        # then took the data as exact. Carry their errors into the covariance:
+        # G = ∂θ/∂s = -(JᵀJ)⁻¹Jᵀ ∂r/∂s (the residuals are linear in the removed trend),
+        # cov += G diag(σ_s²) Gᵀ; the two slopes come from independent channels.
+        tt, tm = drift_ref
+        assert loop is not None  # drifts are estimated from its cycles
+        # each bin's mean of (t - tm): what a unit slope removed from that bin
+        T_bin = average_loop(
+            xa, tt - tm, ta, n_points=loop.x.size, rel_threshold=rel_threshold,
+            min_cycles=min_cycles,
+        ).F  # fmt: skip
+        T = T_bin if on == "averaged" else tt - tm
+        vals0 = raw.values
+        base = full_residual(vals0)
+        cols = []
+        if drift[1] > 0 and math.isfinite(drift[1]):
+            cols.append(full_residual(vals0, dF=-drift[1] * T) - base)
+        if x_drift[1] > 0 and math.isfinite(x_drift[1]):
+            dx = x_drift[1] * T
+            vn = None
+            if vnodes is not None:
+                at = tt[np.minimum(vnodes[0], tt.size - 1)] - tm
+                vn = (vnodes[0], vnodes[1] - x_drift[1] * at)
+            tips = None
+            if extra and loop is not None:
+                tips = _turning_point_prior(replace(loop, x=loop.x - x_drift[1] * T_bin))
+            cols.append(full_residual(vals0, xp=xpath - dx, vn=vn, tips=tips) - base)
+        if cols:
+            G = -np.linalg.lstsq(raw.jac, np.column_stack(cols), rcond=None)[0]
+            raw = add_covariance(raw, G @ G.T)
     fit = _reparametrize(raw)
     vals = raw.values
     model = _model(vals)
