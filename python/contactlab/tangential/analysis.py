@@ -39,11 +39,11 @@ from .model import (
     steady_loop_force,
     steady_signal_force,
     turn_nodes,
-    turn_values,
     virgin_signal_force,
 )
-from .preprocess import AveragedLoop, Reversals, average_loop, find_reversals, monotone_path
+from .preprocess import AveragedLoop, average_loop, find_reversals, monotone_path
 from .result import TangentialAnalysis
+from .turns import turning_point_prior, virgin_amplitude, virgin_nodes
 
 #: ``ac·A`` above which the loop is taken to have reached gross sliding (branch slope at the
 #: turn below e^-3 = 5 % of the initial stiffness: the force has plateaued near ±h0)
@@ -89,13 +89,30 @@ def _propagate_fit(
     fn: Any,
     amplitude: float,
     amplitude_stderr: float,
+    g_amp: np.ndarray | None = None,
 ) -> tuple[float, float]:
-    """Value and error of ``fn(values, A)``: fit covariance plus the amplitude's error."""
+    """Value and error of ``fn(values, A)``: fit covariance plus the amplitude's error.
+
+    ``g_amp = ∂θ/∂A`` (over ``fit.var_names``) when the fit held ``A`` fixed at a measured
+    value: the fitted parameters then move with ``A``, and the covariance term
+    ``2 (∇θ fn · g_amp) ∂fn/∂A σ_A²`` is included (``fit.covar`` already holds
+    ``g_amp σ_A² g_ampᵀ``).
+    """
     val, err = fit.propagate(lambda v: fn(v, amplitude))
     if amplitude_stderr > 0 and np.isfinite(amplitude_stderr):
         h = 1e-6 * amplitude
         d = (fn(fit.values, amplitude + h) - fn(fit.values, amplitude - h)) / (2 * h)
-        err = math.sqrt(err**2 + (d * amplitude_stderr) ** 2)
+        var = err**2 + (d * amplitude_stderr) ** 2
+        if g_amp is not None and fit.var_names:
+            base = fit.values
+            grad = []
+            for name in fit.var_names:
+                hv = 1e-6 * (abs(base[name]) or 1.0)
+                up = fn(dict(base, **{name: base[name] + hv}), amplitude)
+                dn = fn(dict(base, **{name: base[name] - hv}), amplitude)
+                grad.append((up - dn) / (2 * hv))
+            var += 2.0 * float(np.dot(grad, g_amp)) * d * amplitude_stderr**2
+        err = math.sqrt(max(var, 0.0))
     return float(val), float(err)
 
 
@@ -284,6 +301,10 @@ def analyze_tangential(
         ac_init = float(initial.get("ac", ac_init))
     if not (h0_init > 0 and ac_init > 0):
         raise InputError(f"initial h0, ac must be > 0, got {h0_init}, {ac_init}")
+    prior = turning_point_prior(loop) if (steady and loop is not None) else None
+    # a fixed amplitude comes from the displacement channel's turn regression (the range of
+    # bin means or samples is biased: bins cut the tips, noise widens the extremes)
+    a_fixed = prior[1] if (prior is not None and not fit_amplitude) else amplitude0
     params = [
         Parameter("k0", h0_init * ac_init, min=1e-9 * h0_init * ac_init, unit="N/m"),
         Parameter("ac", ac_init, min=1e-9 * ac_init, unit="1/m"),
@@ -306,7 +327,7 @@ def analyze_tangential(
         params.append(
             Parameter(
                 "amplitude",
-                amplitude0,
+                amplitude0 if fit_amplitude else a_fixed,
                 vary=fit_amplitude,
                 min=0.5 * amplitude0,
                 max=1.5 * amplitude0,
@@ -321,7 +342,7 @@ def analyze_tangential(
     sl = slice(start, None)
     first_is_peak = rev.first_is_peak
     nodes = turn_nodes(xpath, rev.peaks, rev.valleys) if on == "signal" and steady else None
-    vnodes = _virgin_nodes(xa, ta, xpath, rev) if on == "signal" and not steady else None
+    vnodes = virgin_nodes(xa, ta, xpath, rev) if on == "signal" and not steady else None
 
     def predict(v: dict[str, float], xp: np.ndarray | None = None, vn: Any = None) -> np.ndarray:
         m = _model(v)
@@ -344,7 +365,6 @@ def analyze_tangential(
         return (predict(v, xp, vn)[sl] - Fdat[sl]) * w[sl]
 
     raw = least_squares_fit(residual, params)
-    prior = _turning_point_prior(loop) if (steady and loop is not None) else None
     extra: list[tuple[str, float]] = []
     s_f = 1.0
 
@@ -408,11 +428,19 @@ def analyze_tangential(
                 vn = (vnodes[0], vnodes[1] - x_drift[1] * at)
             tips = None
             if extra and loop is not None:
-                tips = _turning_point_prior(replace(loop, x=loop.x - x_drift[1] * T_bin))
+                tips = turning_point_prior(replace(loop, x=loop.x - x_drift[1] * T_bin))
             cols.append(full_residual(vals0, xp=xpath - dx, vn=vn, tips=tips) - base)
         if cols:
             G = -np.linalg.lstsq(raw.jac, np.column_stack(cols), rcond=None)[0]
             raw = add_covariance(raw, G @ G.T)
+    g_amp: np.ndarray | None = None  # ∂θ/∂A when the amplitude was fixed from the x channel
+    if steady and not fit_amplitude and prior is not None and raw.jac is not None:
+        vals0 = raw.values
+        col = full_residual(dict(vals0, amplitude=vals0["amplitude"] + prior[2]))
+        g_amp = -np.linalg.lstsq(raw.jac, col - full_residual(vals0), rcond=None)[0]
+        if raw.covar is not None:
+            raw = add_covariance(raw, np.outer(g_amp, g_amp))
+        g_amp = g_amp / prior[2]
     fit = _reparametrize(raw)
     vals = raw.values
     model = _model(vals)
@@ -429,6 +457,12 @@ def analyze_tangential(
             )
         else:
             amplitude_stderr = 0.0
+        if steady and prior is not None:
+            amplitude_stderr = prior[2]
+        elif not steady:
+            va, va_se = virgin_amplitude(xa, ta, rev)
+            if math.isfinite(va) and math.isfinite(va_se):
+                amplitude, amplitude_stderr = va, va_se
         a_extra = amplitude_stderr
 
     # -- identifiability ------------------------------------------------------------------
@@ -481,7 +515,7 @@ def analyze_tangential(
         # the amplitude comes from the fit (with its covariance) when it was fitted
         if steady and fit_amplitude:
             return _propagate_fit(raw, lambda v, _A: fn(v, v["amplitude"]), amplitude, 0.0)
-        return _propagate_fit(raw, fn, amplitude, a_extra)
+        return _propagate_fit(raw, fn, amplitude, a_extra, g_amp)
 
     derived: dict[str, tuple[float, float]] = {}
     derived["h0_ac"] = (float(k0.value), float(k0.stderr) if k0.stderr is not None else math.nan)
@@ -569,38 +603,6 @@ def _trend(t: np.ndarray, v: np.ndarray) -> tuple[float, float]:
     return slope, se
 
 
-def _virgin_nodes(
-    x: np.ndarray, t: np.ndarray | None, xpath: np.ndarray, rev: Reversals
-) -> tuple[np.ndarray, np.ndarray] | None:
-    """Measured turning points for a virgin-history fit, inserted between samples (where
-    the turn lies), with the projected path clipped so that no sample passes its turn."""
-    tt = np.arange(x.size, dtype=float) if t is None else t
-    times = np.r_[rev.peak_times, rev.valley_times]
-    if times.size == 0:
-        return None
-    is_peak = np.r_[np.ones(rev.peaks.size, bool), np.zeros(rev.valleys.size, bool)]
-    idx = np.r_[rev.peaks, rev.valleys].astype(np.int64)
-    gaps = np.diff(np.sort(times))
-    half = 0.1 * float(np.median(gaps)) if gaps.size else 0.05 * float(tt[-1] - tt[0])
-    vals = turn_values(tt, x, times, half)
-    pos, val = [], []
-    for i, p_, v in zip(idx, is_peak, vals, strict=True):
-        if not np.isfinite(v):
-            continue
-        sign = 1.0 if p_ else -1.0
-        left = sign * xpath[i - 1] if i > 0 else -np.inf
-        right = sign * xpath[i + 1] if i + 1 < x.size else -np.inf
-        pos.append(i + 1 if right >= left else i)
-        val.append(v)
-        # no sample beyond its turn (noise would make the operator turn twice)
-        near = np.abs(tt - tt[i]) <= half
-        xpath[near] = np.minimum(xpath[near], v) if p_ else np.maximum(xpath[near], v)
-    if not pos:
-        return None
-    order = np.argsort(pos, kind="stable")
-    return np.asarray(pos, dtype=np.int64)[order], np.asarray(val, dtype=float)[order]
-
-
 def _numeric_energy(loop: AveragedLoop, x: np.ndarray, F: np.ndarray) -> tuple[float, float]:
     """Energy per cycle as the mean area ``∮ F dx`` of the complete cycles' own samples, and
     its standard error.
@@ -634,57 +636,6 @@ def _numeric_energy(loop: AveragedLoop, x: np.ndarray, F: np.ndarray) -> tuple[f
     emp = float(np.nanstd(e, ddof=1)) / math.sqrt(n)
     err = max(err, emp) if math.isfinite(emp) else err
     return float(np.nanmean(e)), err if math.isfinite(err) else math.nan
-
-
-def _tip(loop: AveragedLoop, first: int, k: int) -> tuple[float, float] | None:
-    """Displacement at a turn and its standard error, from the ``k`` bins on either side.
-
-    The turn lies on the boundary before bin ``first``. Bin means are regressed on the mean
-    ``|φ|`` and ``φ²`` of each bin's samples (φ: phase from the turn), so the estimate is
-    unbiased for a rounded (sine) turn and for a sharp (triangle) one alike, and not pulled
-    by noise as the largest sample or bin would be.
-    """
-    n = loop.x.size
-    idx = np.r_[np.arange(first - k, first), np.arange(first, first + k)] % n
-    turn = first / n  # phase of the turn: 0 (peak) or 1/2 (valley)
-    pm, p2 = loop.phase_mean[idx], loop.phase_sq[idx]
-    before = np.r_[np.ones(k, bool), np.zeros(k, bool)]
-    ref = np.where(before & (turn == 0.0), 1.0, turn)  # bins before the peak sit just below 1
-    m1 = np.abs(pm - ref)
-    m2 = p2 - 2.0 * ref * pm + ref * ref
-    X = np.column_stack([np.ones(2 * k), m1, m2])
-    y = loop.x[idx]
-    coef, *_ = np.linalg.lstsq(X, y, rcond=None)
-    resid = y - X @ coef
-    dof = 2 * k - 3
-    s2_fit = float(resid @ resid) / dof if dof > 0 else 0.0
-    sb = loop.x_std[idx] / math.sqrt(loop.n_cycles)
-    s2_bins = float(np.nanmean(sb**2)) if np.any(np.isfinite(sb)) else 0.0
-    s2 = max(s2_fit, s2_bins)
-    var0 = s2 * float(np.linalg.inv(X.T @ X)[0, 0])
-    if not np.isfinite(var0):
-        return None
-    return float(coef[0]), math.sqrt(var0)
-
-
-def _turning_point_prior(loop: AveragedLoop) -> tuple[float, float, float] | None:
-    """Turning points measured by the displacement channel: ``(x0, A, σ)``.
-
-    ``x0 = (top + bottom) / 2`` and ``A = (top - bottom) / 2`` from :func:`_tip`; with equal
-    weights both have ``σ = sqrt(σ_top² + σ_bot²) / 2`` and no correlation.
-    """
-    n = loop.x.size
-    k = 4
-    if loop.n_cycles < 2 or n < 4 * k or loop.phase_mean is None or loop.phase_sq is None:
-        return None
-    top = _tip(loop, 0, k)
-    bot = _tip(loop, n // 2, k)
-    if top is None or bot is None:
-        return None
-    sig = 0.5 * math.hypot(top[1], bot[1])
-    if not (sig > 0 and math.isfinite(sig)):
-        return None
-    return 0.5 * (top[0] + bot[0]), 0.5 * (top[0] - bot[0]), sig
 
 
 def _correl(fit: FitResult, a: str, b: str) -> float:
