@@ -339,7 +339,17 @@ def analyze_tangential(
             Parameter("x0", float(xa[0]), vary=fit_x0, unit="m", scale=max(amplitude0, 1e-300))
         )
 
-    sl = slice(start, None)
+    stop = None
+    if on == "signal" and not steady:
+        # An unconfirmed last extreme (no centre crossing after it) has no measured turn: the
+        # projected path's extreme there is the most outlying noisy sample, and every sample
+        # after it would follow a branch started from that outlier. The operator is causal,
+        # so dropping those samples leaves the rest of the fit exact.
+        confirmed = np.r_[rev.peaks, rev.valleys]
+        late = rev.edges[rev.edges > (confirmed.max() if confirmed.size else 0)]
+        if late.size:
+            stop = int(late[-1])
+    sl = slice(start, stop)
     first_is_peak = rev.first_is_peak
     nodes = turn_nodes(xpath, rev.peaks, rev.valleys) if on == "signal" and steady else None
     vnodes = virgin_nodes(xa, ta, xpath, rev) if on == "signal" and not steady else None
@@ -352,7 +362,8 @@ def analyze_tangential(
         elif steady:
             Fm = steady_signal_force(m, xp, v["x0"], v["amplitude"], nodes, first_is_peak)
         else:
-            Fm = virgin_signal_force(m, xp, v["x0"], vnodes if vn is None else vn)
+            nd = vnodes if vn is None else vn
+            Fm = virgin_signal_force(m, xp, v["x0"], None if nd is None else nd[:2])
         return Fm + v["offset"]
 
     def residual(
@@ -425,7 +436,7 @@ def analyze_tangential(
             vn = None
             if vnodes is not None:
                 at = tt[np.minimum(vnodes[0], tt.size - 1)] - tm
-                vn = (vnodes[0], vnodes[1] - x_drift[1] * at)
+                vn = (vnodes[0], vnodes[1] - x_drift[1] * at, vnodes[2])
             tips = None
             if extra and loop is not None:
                 tips = turning_point_prior(replace(loop, x=loop.x - x_drift[1] * T_bin))
@@ -433,6 +444,18 @@ def analyze_tangential(
         if cols:
             G = -np.linalg.lstsq(raw.jac, np.column_stack(cols), rcond=None)[0]
             raw = add_covariance(raw, G @ G.T)
+    if vnodes is not None and raw.jac is not None and raw.covar is not None:
+        # The measured turning points are held fixed in a virgin-history fit; each has its
+        # regression error (independent turns): cov += Σ_j g_j g_jᵀ, g_j = ∂θ/∂v_j σ_j.
+        vals0 = raw.values
+        base = full_residual(vals0)
+        cols = []
+        for j in range(vnodes[1].size):
+            moved = vnodes[1].copy()
+            moved[j] += vnodes[2][j]
+            cols.append(full_residual(vals0, vn=(vnodes[0], moved, vnodes[2])) - base)
+        G = -np.linalg.lstsq(raw.jac, np.column_stack(cols), rcond=None)[0]
+        raw = add_covariance(raw, G @ G.T)
     g_amp: np.ndarray | None = None  # ∂θ/∂A when the amplitude was fixed from the x channel
     if steady and not fit_amplitude and prior is not None and raw.jac is not None:
         vals0 = raw.values

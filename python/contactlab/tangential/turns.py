@@ -162,9 +162,12 @@ def virgin_amplitude(x: np.ndarray, t: np.ndarray | None, rev: Reversals) -> tup
 
 def virgin_nodes(
     x: np.ndarray, t: np.ndarray | None, xpath: np.ndarray, rev: Reversals
-) -> tuple[np.ndarray, np.ndarray] | None:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     """Measured turning points for a virgin-history fit, inserted between samples (where
-    the turn lies), with the projected path clipped so that no sample passes its turn."""
+    the turn lies), with the projected path near each turn replaced by the regression that
+    measured it (so no sample passes its turn). Returns ``(positions, values, stderrs)``,
+    sorted by position; the fit holds the values fixed, and the analysis carries their
+    errors into its covariance."""
     tt = np.arange(x.size, dtype=float) if t is None else t
     times = np.r_[rev.peak_times, rev.valley_times]
     if times.size == 0:
@@ -173,19 +176,31 @@ def virgin_nodes(
     idx = np.r_[rev.peaks, rev.valleys].astype(np.int64)
     half = _half_window(tt, rev)
     vals = turn_values(tt, x, times, half)
-    pos, val = [], []
-    for i, p_, v in zip(idx, is_peak, vals, strict=True):
-        if not np.isfinite(v):
+    pos, val, err = [], [], []
+    for i, p_, v, tc in zip(idx, is_peak, vals, times, strict=True):
+        e2 = _turn_fit(tt, x, tc, half)[1]
+        if not (np.isfinite(v) and np.isfinite(e2)):
             continue
+        err.append(math.sqrt(e2))
         sign = 1.0 if p_ else -1.0
         left = sign * xpath[i - 1] if i > 0 else -np.inf
         right = sign * xpath[i + 1] if i + 1 < x.size else -np.inf
         pos.append(i + 1 if right >= left else i)
         val.append(v)
-        # no sample beyond its turn (noise would make the operator turn twice)
-        near = np.abs(tt - tt[i]) <= half
-        xpath[near] = np.minimum(xpath[near], v) if p_ else np.maximum(xpath[near], v)
+        # Near the turn the samples are replaced by the regression that measured it (a
+        # denoised path; clipping noisy samples at the turn would pull them inward, as only
+        # those beyond it move), so no sample passes its turn.
+        near = np.abs(tt - tc) <= half
+        dt = tt[near] - tc
+        X = np.column_stack([np.ones(dt.size), np.abs(dt), dt * dt])
+        coef, *_ = np.linalg.lstsq(X, x[near], rcond=None)
+        smooth = X @ coef
+        xpath[near] = np.minimum(smooth, v) if p_ else np.maximum(smooth, v)
     if not pos:
         return None
     order = np.argsort(pos, kind="stable")
-    return np.asarray(pos, dtype=np.int64)[order], np.asarray(val, dtype=float)[order]
+    return (
+        np.asarray(pos, dtype=np.int64)[order],
+        np.asarray(val, dtype=float)[order],
+        np.asarray(err, dtype=float)[order],
+    )
