@@ -376,6 +376,27 @@ def analyze_tangential(
         return (predict(v, xp, vn)[sl] - Fdat[sl]) * w[sl]
 
     raw = least_squares_fit(residual, params)
+    x_noise = math.nan
+    if on == "signal":
+        # Errors in variables: the displacement noise σx moves every sample along its branch,
+        # a force error k·σx with the local stiffness k (h0·ac just after a turn, much less
+        # further on), heteroscedastic and largest exactly where the loop's shape is decided.
+        # Weight each residual by its effective variance σF² + (k σx)² (σx from the data,
+        # σF from the unweighted fit's residuals) and refit.
+        s2x = _x_noise_var(xa, loop)
+        x_noise = math.sqrt(s2x)
+        if s2x > 0:
+            v1 = raw.values
+            Fm = predict(v1)
+            k2 = _path_slope(Fm, xpath, v1["k0"])[sl] ** 2 * s2x
+            r2 = float(np.mean((Fm - Fd)[sl] ** 2))
+            s2F = max(r2 - float(np.mean(k2)), 0.05 * r2)
+            w = np.ones(Fd.size)
+            w[sl] = np.sqrt(s2F / (s2F + k2))
+            start_w = [replace(p, value=min(max(v1[p.name], p.min), p.max)) for p in params]
+            raw = least_squares_fit(residual, start_w)
+            for p, p0 in zip(raw.params.values(), params, strict=True):
+                p.init_value = p0.value if p0.vary else None
     extra: list[tuple[str, float]] = []
     s_f = 1.0
 
@@ -612,8 +633,32 @@ def analyze_tangential(
         weights=w,
         t=td,
         source=source,
-        meta={"fit_start": start, "invert_force": bool(invert_force)},
+        meta={"fit_start": start, "invert_force": bool(invert_force), "x_noise": x_noise},
     )
+
+
+def _x_noise_var(x: np.ndarray, loop: AveragedLoop | None) -> float:
+    """Variance of the displacement sensor's noise: from the cycle-to-cycle spread of the
+    averaged loop's bins when there is one, else from the second differences of ``x``
+    (``var(Δ²x) = 6 σx²`` for white noise; robust scale, the smooth drive adds little)."""
+    if loop is not None and loop.n_cycles > 1 and np.any(np.isfinite(loop.x_std)):
+        return float(np.nanmean(loop.x_std**2 * loop.count / loop.n_cycles))
+    d2 = np.diff(x, 2)
+    if d2.size < 10:
+        return 0.0
+    mad = float(np.median(np.abs(d2 - np.median(d2))))
+    return (1.4826 * mad) ** 2 / 6.0
+
+
+def _path_slope(F: np.ndarray, x: np.ndarray, k_max: float) -> np.ndarray:
+    """``|dF/dx|`` along a path (central differences), within ``[0, k_max]``; where the path
+    barely moves (a turn, a pooled stretch) the initial stiffness ``k_max`` is taken."""
+    dF = np.gradient(F)
+    dx = np.gradient(x)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k = np.abs(dF / dx)
+    k[~np.isfinite(k)] = k_max
+    return np.clip(k, 0.0, k_max)
 
 
 def _trend(t: np.ndarray, v: np.ndarray) -> tuple[float, float]:
