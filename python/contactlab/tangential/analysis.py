@@ -351,8 +351,8 @@ def analyze_tangential(
         elif steady:
             Fm = steady_signal_force(m, xp, v["x0"], v["amplitude"], nodes, first_is_peak)
         else:
-            nd = vnodes if vn is None else vn
-            Fm = virgin_signal_force(m, xp, v["x0"], None if nd is None else nd[:2])
+            nd = (None if vnodes is None else vnodes.nodes) if vn is None else vn
+            Fm = virgin_signal_force(m, xp, v["x0"], nd)
         return Fm + v["offset"]
 
     def residual(
@@ -445,8 +445,8 @@ def analyze_tangential(
             dx = x_drift[1] * T
             vn = None
             if vnodes is not None:
-                at = tt[np.minimum(vnodes[0], tt.size - 1)] - tm
-                vn = (vnodes[0], vnodes[1] - x_drift[1] * at, vnodes[2])
+                at = tt[np.minimum(vnodes.positions, tt.size - 1)] - tm
+                vn = (vnodes.positions, vnodes.values - x_drift[1] * at)
             tips = None
             if extra and loop is not None:
                 tips = turning_point_prior(replace(loop, x=loop.x - x_drift[1] * T_bin))
@@ -454,18 +454,30 @@ def analyze_tangential(
         if cols:
             G = -np.linalg.lstsq(raw.jac, np.column_stack(cols), rcond=None)[0]
             raw = add_covariance(raw, G @ G.T)
+    c_theta_amp: np.ndarray | None = None
     if vnodes is not None and raw.jac is not None and raw.covar is not None:
-        # The measured turning points are held fixed in a virgin-history fit; each has its
-        # regression error (independent turns): cov += Σ_j g_j g_jᵀ, g_j = ∂θ/∂v_j σ_j.
+        # The measured turning points are held fixed in a virgin-history fit, and the path
+        # around each is its local regression: carry each regression's error (three
+        # independent 1σ modes per turn, the turns independent) into the covariance,
+        # cov += Σ g gᵀ with g = -(JᵀJ)⁻¹Jᵀ ∂r for each mode.
         vals0 = raw.values
         base = full_residual(vals0)
         cols = []
-        for j in range(vnodes[1].size):
-            moved = vnodes[1].copy()
-            moved[j] += vnodes[2][j]
-            cols.append(full_residual(vals0, vn=(vnodes[0], moved, vnodes[2])) - base)
+        d_amp = []  # the same modes move the amplitude (half the peak-valley distance)
+        n_pk = max(int(vnodes.is_peak.sum()), 1)
+        n_vl = max(int((~vnodes.is_peak).sum()), 1)
+        for j, (lo, hi, dpath, dval) in enumerate(vnodes.modes):
+            share = 0.5 / n_pk if vnodes.is_peak[j] else -0.5 / n_vl
+            for m_ in range(dval.size):
+                d_amp.append(share * dval[m_])
+                moved = vnodes.values.copy()
+                moved[j] += dval[m_]
+                xp_j = xpath.copy()
+                xp_j[lo:hi] += dpath[:, m_]
+                cols.append(full_residual(vals0, xp=xp_j, vn=(vnodes.positions, moved)) - base)
         G = -np.linalg.lstsq(raw.jac, np.column_stack(cols), rcond=None)[0]
         raw = add_covariance(raw, G @ G.T)
+        c_theta_amp = G @ np.asarray(d_amp)  # Cov(θ, A) through the shared turns
     g_amp: np.ndarray | None = None  # ∂θ/∂A when the amplitude was fixed from the x channel
     if steady and not fit_amplitude and prior is not None and raw.jac is not None:
         vals0 = raw.values
@@ -496,6 +508,8 @@ def analyze_tangential(
             va, va_se = virgin_amplitude(xa, ta, rev)
             if math.isfinite(va) and math.isfinite(va_se):
                 amplitude, amplitude_stderr = va, va_se
+                if c_theta_amp is not None and va_se > 0:
+                    g_amp = c_theta_amp / va_se**2  # so that Cov(θ, A) = g_amp σ_A²
         a_extra = amplitude_stderr
 
     # -- identifiability ------------------------------------------------------------------

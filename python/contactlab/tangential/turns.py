@@ -23,10 +23,10 @@ difference over that variance is added to the variance.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
-from .model import turn_values
 from .preprocess import AveragedLoop, Reversals
 
 #: bins either side of a turn in the regression of an averaged loop's turning point
@@ -160,14 +160,38 @@ def virgin_amplitude(x: np.ndarray, t: np.ndarray | None, rev: Reversals) -> tup
     return 0.5 * (means[0] - means[1]), 0.5 * math.sqrt(variances[0] + variances[1])
 
 
+@dataclass(frozen=True)
+class VirginTurns:
+    """Measured turning points of a recording that starts at rest (see :func:`virgin_nodes`).
+
+    ``positions`` (where each turn is inserted into the path) and ``values`` (m), sorted by
+    position, with each value's standard error ``stderr``. ``modes[j] = (lo, hi, dpath,
+    dvalue)``: the error of turn ``j``'s local regression as three independent 1σ modes
+    (columns), each moving the denoised path ``lo:hi`` by ``dpath[:, m]`` and the turn by
+    ``dvalue[m]``. ``is_peak``: peak (True) or valley.
+    """
+
+    positions: np.ndarray
+    values: np.ndarray
+    stderr: np.ndarray
+    modes: list[tuple[int, int, np.ndarray, np.ndarray]]
+    is_peak: np.ndarray
+
+    @property
+    def nodes(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(positions, values)`` for :func:`~contactlab.tangential.model.virgin_signal_force`."""
+        return self.positions, self.values
+
+
 def virgin_nodes(
     x: np.ndarray, t: np.ndarray | None, xpath: np.ndarray, rev: Reversals
-) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-    """Measured turning points for a virgin-history fit, inserted between samples (where
-    the turn lies), with the projected path near each turn replaced by the regression that
-    measured it (so no sample passes its turn). Returns ``(positions, values, stderrs)``,
-    sorted by position; the fit holds the values fixed, and the analysis carries their
-    errors into its covariance."""
+) -> VirginTurns | None:
+    """Measured turning points for a virgin-history fit, inserted between samples (where the
+    turn lies), with the projected path near each turn replaced by the regression that
+    measured it: a denoised path (clipping the noisy samples at the turn instead would pull
+    them inward, as only those beyond it move), and no sample passes its turn. ``xpath`` is
+    changed in place. The fit holds the turns fixed; the analysis carries their regressions'
+    errors (``modes``) into its covariance."""
     tt = np.arange(x.size, dtype=float) if t is None else t
     times = np.r_[rev.peak_times, rev.valley_times]
     if times.size == 0:
@@ -175,32 +199,39 @@ def virgin_nodes(
     is_peak = np.r_[np.ones(rev.peaks.size, bool), np.zeros(rev.valleys.size, bool)]
     idx = np.r_[rev.peaks, rev.valleys].astype(np.int64)
     half = _half_window(tt, rev)
-    vals = turn_values(tt, x, times, half)
-    pos, val, err = [], [], []
-    for i, p_, v, tc in zip(idx, is_peak, vals, times, strict=True):
-        e2 = _turn_fit(tt, x, tc, half)[1]
-        if not (np.isfinite(v) and np.isfinite(e2)):
+    pos, val, err, modes, peak = [], [], [], [], []
+    for i, p_, tc in zip(idx, is_peak, times, strict=True):
+        near = np.abs(tt - tc) <= half
+        dt = tt[near] - tc
+        if dt.size < 5:
             continue
-        err.append(math.sqrt(e2))
+        X = np.column_stack([np.ones(dt.size), np.abs(dt), dt * dt])
+        coef, *_ = np.linalg.lstsq(X, x[near], rcond=None)
+        smooth = X @ coef
+        r = x[near] - smooth
+        cov = float(r @ r) / (dt.size - 3) * np.linalg.inv(X.T @ X)
+        lam, vec = np.linalg.eigh(0.5 * (cov + cov.T))
+        L = vec * np.sqrt(np.clip(lam, 0.0, None))  # 1σ modes as columns
+        v = float(coef[0])
+        if not (np.isfinite(v) and np.all(np.isfinite(L))):
+            continue
         sign = 1.0 if p_ else -1.0
         left = sign * xpath[i - 1] if i > 0 else -np.inf
         right = sign * xpath[i + 1] if i + 1 < x.size else -np.inf
         pos.append(i + 1 if right >= left else i)
         val.append(v)
-        # Near the turn the samples are replaced by the regression that measured it (a
-        # denoised path; clipping noisy samples at the turn would pull them inward, as only
-        # those beyond it move), so no sample passes its turn.
-        near = np.abs(tt - tc) <= half
-        dt = tt[near] - tc
-        X = np.column_stack([np.ones(dt.size), np.abs(dt), dt * dt])
-        coef, *_ = np.linalg.lstsq(X, x[near], rcond=None)
-        smooth = X @ coef
+        peak.append(bool(p_))
+        err.append(math.sqrt(max(cov[0, 0], 0.0)))
+        where = np.flatnonzero(near)
+        modes.append((int(where[0]), int(where[-1]) + 1, X @ L, L[0].copy()))
         xpath[near] = np.minimum(smooth, v) if p_ else np.maximum(smooth, v)
     if not pos:
         return None
     order = np.argsort(pos, kind="stable")
-    return (
+    return VirginTurns(
         np.asarray(pos, dtype=np.int64)[order],
         np.asarray(val, dtype=float)[order],
         np.asarray(err, dtype=float)[order],
+        [modes[k] for k in order],
+        np.asarray(peak, dtype=bool)[order],
     )
