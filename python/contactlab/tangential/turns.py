@@ -14,10 +14,11 @@ Errors. A regression intercept has a noise error (from the residuals, or from th
 cycle-to-cycle spread, whichever is larger) and a truncation error: the quadratic only
 approximates the turn's shape over the window. The truncation error does not average out
 over cycles, and with a noise-free displacement channel it is all there is, so it is
-estimated from the data: the intercepts of two nested windows differ by the truncation error
-of the wider (the narrower one's is ``(k'/k)^4`` ≈ 3 times smaller for a sine) plus noise of
-known variance ``var(narrow) - var(wide)`` (nested least squares); the excess of the squared
-difference over that variance is added to the variance.
+estimated from the data: the intercepts of two nested windows differ by ``1 - ρ⁴`` of the
+wider window's truncation error (ρ: width ratio; the first neglected term of a rounded turn
+is of fourth order, Richardson) plus noise of known variance ``var(narrow) - var(wide)``
+(nested least squares); the excess of the squared difference over that variance, scaled by
+``1 / (1 - ρ⁴)²``, is added to the variance.
 """
 
 from __future__ import annotations
@@ -33,10 +34,17 @@ from .preprocess import AveragedLoop, Reversals
 TIP_BINS = 4
 
 
-def _truncation_var(c_wide: float, v_wide: float, c_narrow: float, v_narrow: float) -> float:
-    """Variance to add for the wide window's truncation error (see the module docstring)."""
-    d2 = (c_wide - c_narrow) ** 2
-    return max(d2 - max(v_narrow - v_wide, 0.0), 0.0)
+def _truncation_var(
+    c_wide: float, v_wide: float, c_narrow: float, v_narrow: float, ratio: float
+) -> float:
+    """Variance to add for the wide window's truncation error (see the module docstring).
+
+    ``ratio``: narrow / wide window. The first neglected term of a rounded turn is of fourth
+    order, so the narrow window keeps ``ratio⁴`` of the wide one's error and the difference
+    is ``1 - ratio⁴`` of it (Richardson).
+    """
+    d2 = max((c_wide - c_narrow) ** 2 - max(v_narrow - v_wide, 0.0), 0.0)
+    return d2 / (1.0 - ratio**4) ** 2
 
 
 def _tip_fit(loop: AveragedLoop, first: int, k: int) -> tuple[float, float] | None:
@@ -78,7 +86,7 @@ def tip(loop: AveragedLoop, first: int, k: int = TIP_BINS) -> tuple[float, float
     if k >= 3:
         narrow = _tip_fit(loop, first, k - 1)
         if narrow is not None:
-            var += _truncation_var(wide[0], wide[1], narrow[0], narrow[1])
+            var += _truncation_var(wide[0], wide[1], narrow[0], narrow[1], (k - 1) / k)
     return wide[0], math.sqrt(var)
 
 
@@ -154,6 +162,7 @@ def virgin_amplitude(x: np.ndarray, t: np.ndarray | None, rev: Reversals) -> tup
                 float(np.mean(vw[both])) / int(both.sum()),
                 float(np.mean(cn[both])),
                 float(np.mean(vn[both])) / int(both.sum()),
+                0.7,
             )
         means.append(float(np.mean(cw[ok])))
         variances.append(var)

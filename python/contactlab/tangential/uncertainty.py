@@ -58,16 +58,22 @@ def propagate_fit(
 
 
 def x_noise_var(x: np.ndarray, loop: AveragedLoop | None) -> float:
-    """Variance of the displacement sensor's noise: from the cycle-to-cycle spread of the
-    averaged loop's bins when there is one, else from the second differences of ``x``
-    (``var(Δ²x) = 6 σx²`` for white noise; robust scale, the smooth drive adds little)."""
-    if loop is not None and loop.n_cycles > 1 and np.any(np.isfinite(loop.x_std)):
-        return float(np.nanmean(loop.x_std**2 * loop.count / loop.n_cycles))
+    """Variance of the displacement sensor's noise.
+
+    Two estimates, each biased only upwards: the second differences of ``x``
+    (``var(Δ²x) = 6 σx²`` for white noise, robust scale; the smooth drive adds its own
+    curvature) and, when there is an averaged loop, the cycle-to-cycle spread of its bins
+    (which also holds real cycle-to-cycle change and where samples fall in a bin). The
+    smaller is taken.
+    """
+    est = []
     d2 = np.diff(x, 2)
-    if d2.size < 10:
-        return 0.0
-    mad = float(np.median(np.abs(d2 - np.median(d2))))
-    return (1.4826 * mad) ** 2 / 6.0
+    if d2.size >= 10:
+        mad = float(np.median(np.abs(d2 - np.median(d2))))
+        est.append((1.4826 * mad) ** 2 / 6.0)
+    if loop is not None and loop.n_cycles > 1 and np.any(np.isfinite(loop.x_std)):
+        est.append(float(np.nanmean(loop.x_std**2 * loop.count / loop.n_cycles)))
+    return min(est) if est else 0.0
 
 
 def path_slope(F: np.ndarray, x: np.ndarray, k_max: float) -> np.ndarray:
