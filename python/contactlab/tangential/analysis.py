@@ -12,8 +12,28 @@ The covariance is transformed to ``(h0, ac)`` for reporting. The turning points 
 are parameters (the paper's branch shift ``x0``), not the extremes of the noisy samples: those
 overestimate the amplitude, and the loop is most sensitive exactly there. The displacement
 channel's own measurement of the turning points (a regression of the bins next to each turn)
-enters the fit as two extra residuals, so both channels locate them. Over many noise seeds
-about 95 % of the 2σ intervals of ``h0``, ``ac``, ``E`` and ``A`` hold the truth (tests).
+enters the fit as two extra residuals, so both channels locate them.
+
+Inputs the fit takes as exact carry their own errors into the covariance, each through the
+fit's linear response ``G = -(JᵀJ)⁻¹Jᵀ ∂r/∂u`` to the input ``u`` (``cov += G Σ_u Gᵀ``,
+:func:`contactlab.fitting.add_covariance`):
+
+- the linear force and displacement drifts removed before the fit (estimated from the
+  per-cycle means, with their standard errors);
+- a fixed amplitude (``fit_amplitude=False``: the displacement channel's turn regression,
+  with ``Cov(θ, A)`` kept for the derived quantities);
+- the measured turning points of a recording that starts at rest (``history="virgin"``: each
+  turn's local regression, which also forms the denoised path around it).
+
+Whole-signal fits are errors-in-variables problems: displacement noise ``σx`` moves each
+sample along its branch, a force error ``k σx`` that is largest just after each turn (``k =
+h0·ac``). Each residual is weighted by its effective variance ``σF² + (k σx)²``, with ``σx``
+estimated from the data (``meta["x_noise"]``). A recording starting at rest is fitted only up
+to its last confirmed turn. The turning points' errors include the truncation of their
+regressions (:mod:`contactlab.tangential.turns`), which matters with a clean displacement
+channel. Over many noise seeds about 95 % of the 2σ intervals of ``h0``, ``ac``, ``h0·ac``,
+``E`` and ``A`` hold the truth (tests/test_tangential*.py; a whole-signal fit at 1 %
+displacement noise: 94-95 %).
 
 When the relative standard errors of ``h0`` or ``ac`` exceed ``max_rel_stderr`` (the paper's
 steel case: amplitude ≪ 1/ac, the loop is nearly a straight line) the analysis reports them

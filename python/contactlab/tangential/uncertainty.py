@@ -1,7 +1,7 @@
 """Uncertainty helpers of the tangential analysis: what the fit's covariance does not hold
 by itself, and the transformations of it that the report needs.
 
-- :func:`propagate_with_amplitude`: first-order error of a derived quantity ``fn(θ, A)``
+- :func:`propagate_fit`: first-order error of a derived quantity ``fn(θ, A)``
   (energy ``E(A)``, damping ``E / (π A²)``, stiffness; PHYSICS.md §1 eqs. 17-19) from the
   fit covariance and a separately measured amplitude, with their correlation when the fit
   held ``A`` fixed;
@@ -34,10 +34,10 @@ def propagate_fit(
 ) -> tuple[float, float]:
     """Value and error of ``fn(values, A)``: fit covariance plus the amplitude's error.
 
-    ``g_amp = ∂θ/∂A`` (over ``fit.var_names``) when the fit held ``A`` fixed at a measured
-    value: the fitted parameters then move with ``A``, and the covariance term
-    ``2 (∇θ fn · g_amp) ∂fn/∂A σ_A²`` is included (``fit.covar`` already holds
-    ``g_amp σ_A² g_ampᵀ``).
+    ``g_amp`` (over ``fit.var_names``) gives the covariance of the fitted parameters with the
+    amplitude, ``Cov(θ, A) = g_amp σ_A²`` (``∂θ/∂A`` when the fit held ``A`` fixed at a
+    measured value; from the shared turning points of a virgin-history fit); the term
+    ``2 (∇θ fn · g_amp) ∂fn/∂A σ_A²`` is then included.
     """
     val, err = fit.propagate(lambda v: fn(v, amplitude))
     if amplitude_stderr > 0 and np.isfinite(amplitude_stderr):
