@@ -8,6 +8,7 @@ confusion matrix over many seeds, magnitudes and noise levels is benches/eval_di
 
 from __future__ import annotations
 
+import functools
 import json
 
 import matplotlib
@@ -22,6 +23,8 @@ from contactlab.diagnose.generator import TANGENTIAL_EFFECTS
 matplotlib.use("Agg")
 
 SEED = 20261123
+# recordings of 18 cycles at 80 samples per cycle keep the suite quick; the bench uses 120
+hidden_effect_recording = functools.partial(hidden_effect_recording, samples_per_cycle=80)
 
 
 def _check_layout(d: dict) -> None:
