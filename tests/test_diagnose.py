@@ -165,6 +165,10 @@ def test_bad_input_is_named():
         contactlab.diagnose((t, x, F[:-5]))
     with pytest.raises(InputError, match="model must be"):
         contactlab.diagnose(rec, model="rotational")
+    with pytest.raises(InputError, match="max_effects"):
+        contactlab.diagnose(rec, max_effects=-1)
+    with pytest.raises(InputError, match="folds"):
+        contactlab.diagnose(rec, folds=1)
     with pytest.raises(InputError, match="unknown tangential candidate"):
         contactlab.diagnose(rec, candidates=["wear"])
     with pytest.raises(InputError, match="channels 'x' and 'F'"):
