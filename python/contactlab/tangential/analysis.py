@@ -237,6 +237,11 @@ def analyze_tangential(
         start = 0
         h = xd.size // 2
         xpath = monotone_path(xd, np.array([h]))
+        bin_var = None
+        if loop.x_var is not None and loop.n_cycles > 1:
+            # spread of the true x inside a bin: the samples' spread less the sensor noise
+            s2x = float(np.nanmean(loop.x_std**2 * loop.count / loop.n_cycles))
+            bin_var = np.clip(loop.x_var - s2x, 0.0, None)
         rev = loop.reversals
     else:
         rev = (
@@ -319,7 +324,7 @@ def analyze_tangential(
     def predict(v: dict[str, float]) -> np.ndarray:
         m = _model(v)
         if on == "averaged":
-            Fm = steady_loop_force(m, xpath, v["x0"], v["amplitude"])
+            Fm = steady_loop_force(m, xpath, v["x0"], v["amplitude"], bin_var)
         elif steady:
             Fm = steady_signal_force(m, xpath, v["x0"], v["amplitude"], nodes, first_is_peak)
         else:

@@ -29,7 +29,13 @@ from scipy.optimize import brentq
 from ..masing import Masing
 
 
-def steady_loop_force(model: Masing, x: np.ndarray, x0: float, amplitude: float) -> np.ndarray:
+def steady_loop_force(
+    model: Masing,
+    x: np.ndarray,
+    x0: float,
+    amplitude: float,
+    x_var: np.ndarray | None = None,
+) -> np.ndarray:
     """Steady-state force along one averaged cycle.
 
     ``x`` holds ``n`` (even) phase bins with the peak between the last and the first bin and
@@ -37,6 +43,11 @@ def steady_loop_force(model: Masing, x: np.ndarray, x0: float, amplitude: float)
     points are ``x0 ± amplitude`` (fit parameters: the measured extremes are biased by noise);
     bins beyond them are clipped. The operator is primed to the top on the virgin curve and the
     cycle pushed twice; the second pass is returned.
+
+    ``x_var`` (the spread of the true displacement inside each bin) adds the second-order
+    term of a bin mean, ``½ h''(x̄) var(x)``: a bin's mean force is not the force at its mean
+    displacement where the branch curves (``h'' = ±½ h0 ac² exp(-ac u)`` on the branches of the
+    exponential curve, ``u`` half the distance from the branch's turn).
     """
     n = x.size
     h = n // 2
@@ -45,7 +56,13 @@ def steady_loop_force(model: Masing, x: np.ndarray, x0: float, amplitude: float)
     one = np.concatenate([[top], u[:h], [bot], u[h:]])
     out = model.force(np.concatenate([[0.0, top], one, one]))
     second = out[2 + one.size :]
-    return np.concatenate([second[1 : h + 1], second[h + 2 :]])
+    F = np.concatenate([second[1 : h + 1], second[h + 2 :]])
+    if x_var is not None and model.is_exponential:
+        dist = np.r_[top - u[:h], u[h:] - bot]  # from the turn that starts each branch
+        curv = 0.5 * model.h0 * model.ac**2 * np.exp(-0.5 * model.ac * dist)
+        curv[h:] *= -1.0  # descending branches curve up, ascending ones down
+        F = F + 0.5 * curv * x_var
+    return F
 
 
 def turn_nodes(x: np.ndarray, peaks: np.ndarray, valleys: np.ndarray) -> tuple[np.ndarray, ...]:

@@ -212,6 +212,7 @@ class AveragedLoop:
     phase_mean: np.ndarray | None = None  # mean phase (within the cycle) of each bin's samples
     phase_sq: np.ndarray | None = None  # mean squared phase of each bin's samples
     cycle_bounds: np.ndarray | None = None  # first sample of each cycle, and the end
+    x_var: np.ndarray | None = None  # variance of the samples' x inside each bin (all cycles)
 
     @property
     def n_cycles(self) -> int:
@@ -373,8 +374,22 @@ def average_loop(
     )
     phase = (np.arange(n_points) + 0.5) / n_points
     phase_sq = np.bincount(b, frac * frac, n_points) / count
+    x_var = np.clip(np.bincount(b, xs * xs, n_points) / count - xm * xm, 0.0, None)
     return AveragedLoop(
-        phase, xm, Fm, count, x_std, F_std, scatter, rev, start, end, phim, phase_sq, bounds
+        phase,
+        xm,
+        Fm,
+        count,
+        x_std,
+        F_std,
+        scatter,
+        rev,
+        start,
+        end,
+        phim,
+        phase_sq,
+        bounds,
+        x_var,
     )
 
 
