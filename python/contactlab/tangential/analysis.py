@@ -360,8 +360,12 @@ def analyze_tangential(
             stop = int(late[-1])
     sl = slice(start, stop)
     first_is_peak = rev.first_is_peak
+    # measured turns: the path around each is replaced by its local regression (denoised;
+    # their errors are carried into the covariance below); a virgin-history fit also holds
+    # the turns' values, a steady one fits x0 ± A instead
+    measured = virgin_nodes(xa, ta, xpath, rev) if on == "signal" else None
     nodes = turn_nodes(xpath, rev.peaks, rev.valleys) if on == "signal" and steady else None
-    vnodes = virgin_nodes(xa, ta, xpath, rev) if on == "signal" and not steady else None
+    vnodes = measured if not steady else None
 
     def predict(v: dict[str, float], xp: np.ndarray | None = None, vn: Any = None) -> np.ndarray:
         m = _model(v)
@@ -475,29 +479,31 @@ def analyze_tangential(
             G = -np.linalg.lstsq(raw.jac, np.column_stack(cols), rcond=None)[0]
             raw = add_covariance(raw, G @ G.T)
     c_theta_amp: np.ndarray | None = None
-    if vnodes is not None and raw.jac is not None and raw.covar is not None:
-        # The measured turning points are held fixed in a virgin-history fit, and the path
-        # around each is its local regression: carry each regression's error (three
+    if measured is not None and raw.jac is not None and raw.covar is not None:
+        # The path around each measured turn is its local regression, and a virgin-history
+        # fit holds the turn values fixed: carry each regression's error (three
         # independent 1σ modes per turn, the turns independent) into the covariance,
         # cov += Σ g gᵀ with g = -(JᵀJ)⁻¹Jᵀ ∂r for each mode.
         vals0 = raw.values
         base = full_residual(vals0)
         cols = []
         d_amp = []  # the same modes move the amplitude (half the peak-valley distance)
-        n_pk = max(int(vnodes.is_peak.sum()), 1)
-        n_vl = max(int((~vnodes.is_peak).sum()), 1)
-        for j, (lo, hi, dpath, dval) in enumerate(vnodes.modes):
-            share = 0.5 / n_pk if vnodes.is_peak[j] else -0.5 / n_vl
+        n_pk = max(int(measured.is_peak.sum()), 1)
+        n_vl = max(int((~measured.is_peak).sum()), 1)
+        for j, (lo, hi, dpath, dval) in enumerate(measured.modes):
+            share = 0.5 / n_pk if measured.is_peak[j] else -0.5 / n_vl
             for m_ in range(dval.size):
                 d_amp.append(share * dval[m_])
-                moved = vnodes.values.copy()
+                moved = measured.values.copy()
                 moved[j] += dval[m_]
                 xp_j = xpath.copy()
                 xp_j[lo:hi] += dpath[:, m_]
-                cols.append(full_residual(vals0, xp=xp_j, vn=(vnodes.positions, moved)) - base)
+                vn_j = None if steady else (measured.positions, moved)
+                cols.append(full_residual(vals0, xp=xp_j, vn=vn_j) - base)
         G = -np.linalg.lstsq(raw.jac, np.column_stack(cols), rcond=None)[0]
         raw = add_covariance(raw, G @ G.T)
-        c_theta_amp = G @ np.asarray(d_amp)  # Cov(θ, A) through the shared turns
+        if not steady:
+            c_theta_amp = G @ np.asarray(d_amp)  # Cov(θ, A) through the shared turns
     g_amp: np.ndarray | None = None  # ∂θ/∂A when the amplitude was fixed from the x channel
     if steady and not fit_amplitude and prior is not None and raw.jac is not None:
         vals0 = raw.values
