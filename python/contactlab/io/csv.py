@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import csv as _csv
 import re
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -139,18 +140,22 @@ def read_csv(
     first_data = header_line + 1
     comma = _decimal_comma(path, delim, first_data)
     try:
-        block = np.loadtxt(
-            path,
-            delimiter=delim,
-            skiprows=first_data,
-            usecols=idx,
-            ndmin=2,
-            comments="#",
-            dtype=np.float64,
-            encoding="utf-8-sig",
-            quotechar='"',
-            converters=(lambda v: float(v.replace(",", "."))) if comma else None,
-        )
+        with warnings.catch_warnings():
+            # A header without data rows is reported below as an error of its own; numpy's
+            # "input contained no data" UserWarning would only add noise before it.
+            warnings.filterwarnings("ignore", message="loadtxt: input contained no data")
+            block = np.loadtxt(
+                path,
+                delimiter=delim,
+                skiprows=first_data,
+                usecols=idx,
+                ndmin=2,
+                comments="#",
+                dtype=np.float64,
+                encoding="utf-8-sig",
+                quotechar='"',
+                converters=(lambda v: float(v.replace(",", "."))) if comma else None,
+            )
     except ValueError:
         raise _locate_bad_cell(path, delim, first_data, idx, names, comma) from None
     if block.shape[0] == 0:

@@ -278,7 +278,7 @@ def check_time(t: np.ndarray, *, file: str, column: str, row_of: RowOf = _plain)
         i = int(bad[0]) + 1
         what = "duplicated" if d[bad[0]] == 0 else "unsorted (goes back in time)"
         raise RecordingError(
-            f"time stamp {t[i]!r} is {what}; previous is {t[i - 1]!r}",
+            f"time stamp {float(t[i]):.9g} s is {what}; previous is {float(t[i - 1]):.9g} s",
             file=file,
             column=column,
             row=row_of(i),
@@ -312,7 +312,7 @@ def check_finite(a: np.ndarray, *, file: str, column: str, row_of: RowOf = _plai
     if bad.any():
         i = int(np.argmax(bad))
         raise RecordingError(
-            f"value {a[i]!r} is not a finite number", file=file, column=column, row=row_of(i)
+            f"value {float(a[i])} is not a finite number", file=file, column=column, row=row_of(i)
         )
 
 
