@@ -55,6 +55,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except ContactLabError as exc:
         print(f"contactlab {args.verb}: error: {exc}", file=sys.stderr)
         return 1
+    except OSError as exc:  # the file system said no (permissions, full disk, a file in the way)
+        where = f": {exc.filename}" if exc.filename else ""
+        print(f"contactlab {args.verb}: error: {exc.strerror or exc}{where}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print(f"contactlab {args.verb}: interrupted; no partial outputs written", file=sys.stderr)
         return 130

@@ -107,8 +107,43 @@ def json_document(result: StudyResult) -> dict[str, Any]:
     }
 
 
-def write_json(path: str, doc: Mapping[str, Any]) -> Path:
-    text = json.dumps(jsonable(doc), indent=2, allow_nan=False) + "\n"
+def json_text(doc: Mapping[str, Any]) -> str:
+    """The JSON document as text (rendered before anything is written, so that a document that
+    cannot be serialised fails the run before the report lands on disk)."""
+    return json.dumps(jsonable(doc), indent=2, allow_nan=False) + "\n"
+
+
+def _first_existing(path: Path) -> Path:
+    p = path.absolute()
+    while not p.exists() and p != p.parent:
+        p = p.parent
+    return p
+
+
+def check_output_targets(*, json_out: str | None = None, report: str | None = None) -> None:
+    """Refuse output paths that cannot be written *before* a long analysis runs.
+
+    ``--report`` must be a folder (or not exist yet) below a folder; ``--json`` must not be a
+    folder. Raises :class:`~contactlab.InputError` naming the option and the path.
+    """
+    if report:
+        r = Path(report)
+        if r.exists() and not r.is_dir():
+            raise InputError(f"--report {report}: exists and is not a folder")
+        anc = _first_existing(r)
+        if not anc.is_dir():
+            raise InputError(f"--report {report}: {anc} is a file, not a folder")
+    if json_out and json_out != "-":
+        j = Path(json_out)
+        if j.is_dir():
+            raise InputError(f"--json {json_out}: is a folder; give a file name (or '-')")
+        anc = _first_existing(j.parent)
+        if not anc.is_dir():
+            raise InputError(f"--json {json_out}: {anc} is a file, not a folder")
+
+
+def write_json(path: str, doc: Mapping[str, Any] | str) -> Path:
+    text = doc if isinstance(doc, str) else json_text(doc)
     if path == "-":
         print(text, end="")
         return Path("-")

@@ -18,9 +18,11 @@ from ..manifest import entry_from_file
 from ..study import run_study
 from ._common import (
     add_progress_flags,
+    check_output_targets,
     command_line,
     describe,
     json_document,
+    json_text,
     parse_columns,
     quantity,
     write_json,
@@ -50,8 +52,11 @@ def _summary_line(row: dict, kind: str) -> str:
 
 def _handler(args: argparse.Namespace) -> int:
     columns = parse_columns(args.columns)
+    check_output_targets(json_out=args.json, report=args.report)
     entries = []
     for f in args.files:
+        if Path(f).is_dir():
+            raise InputError(f"{f}: is a folder, not a recording file (use `contactlab study`)")
         if not Path(f).is_file():
             raise InputError(f"{f}: no such file")
         e = entry_from_file(f, kind=args.model)
@@ -70,6 +75,7 @@ def _handler(args: argparse.Namespace) -> int:
                 print(r.analysis.report(), file=say)
         else:
             print(f"{r.entry.path}: FAILED: {r.error}", file=sys.stderr)
+    doc = json_text(json_document(result)) if args.json else None
     if args.report:
         title = f"contactlab analyze ({args.model}, {len(entries)} recording(s))"
         cmd = command_line("analyze", *args.files, "--model", args.model,
@@ -81,7 +87,7 @@ def _handler(args: argparse.Namespace) -> int:
             if p.suffix == ".html":
                 print(f"wrote {p}", file=say)
     if args.json:
-        p = write_json(args.json, json_document(result))
+        p = write_json(args.json, doc)
         if str(p) != "-":
             print(f"wrote {p}", file=say)
     return 1 if result.failures else 0
