@@ -1,0 +1,224 @@
+"""Regressions for defects a demanding user hit end to end (CLI, readers, outputs, report).
+
+Each test here failed before its fix; the docstring says what the user saw.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import stat
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import contactlab
+from contactlab import cli
+from contactlab._io_atomic import write_text
+from contactlab.data import data_dir
+from contactlab.io import Recording, RecordingError, read_recording, write_recording
+from contactlab.report import Column, table_html
+
+TANG = data_dir() / "tangential" / "Al-Al_W109N_A10um.csv"
+
+
+def _mode(p: Path) -> int:
+    return stat.S_IMODE(p.stat().st_mode)
+
+
+def default_mode() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
+def _short_csv(path: Path, rows: list[str], header: str = "t [ms],x [um],F [N]") -> Path:
+    path.write_text(header + "\n" + "\n".join(rows) + ("\n" if rows else ""))
+    return path
+
+
+# --- outputs: permissions ---------------------------------------------------------------------
+
+
+def test_atomic_outputs_get_ordinary_permissions(tmp_path):
+    """JSON and recordings written by contactlab were 0600 (mkstemp's mode), unreadable for
+    anyone else sharing the results folder."""
+    p = write_text(tmp_path / "a.json", "{}\n")
+    assert _mode(p) == default_mode()
+    rec = Recording(np.arange(4) * 1e-3, {"x": np.zeros(4), "F": np.ones(4)}, {"x": "m", "F": "N"})
+    q = write_recording(tmp_path / "r.csv", rec)
+    assert _mode(q) == default_mode()
+
+
+def test_atomic_outputs_keep_the_mode_of_the_file_they_replace(tmp_path):
+    p = tmp_path / "a.json"
+    p.write_text("old")
+    os.chmod(p, 0o640)
+    write_text(p, "new")
+    assert p.read_text() == "new" and _mode(p) == 0o640
+
+
+# --- readers: messages ------------------------------------------------------------------------
+
+
+def test_unsorted_time_message_has_plain_numbers_with_unit(tmp_path):
+    """The message read 'time stamp np.float64(0.002) is unsorted'."""
+    f = _short_csv(tmp_path / "u.csv", ["0,0,0", "1,1,1", "3,2,2", "2,3,3", "4,4,4"])
+    with pytest.raises(RecordingError) as ei:
+        read_recording(f)
+    msg = str(ei.value)
+    assert "np.float64" not in msg
+    assert "0.002 s is unsorted" in msg and "previous is 0.003 s" in msg
+    assert "row 5" in msg and "'t [ms]'" in msg
+
+
+def test_nan_cell_message_has_plain_numbers(tmp_path):
+    f = _short_csv(tmp_path / "n.csv", ["0,0,0", "1,nan,1", "2,2,2"])
+    with pytest.raises(RecordingError, match=r"'x \[um\]', row 3: value nan is not") as ei:
+        read_recording(f)
+    assert "np.float64" not in str(ei.value)
+
+
+def test_header_only_csv_is_an_error_not_a_numpy_warning(tmp_path):
+    """numpy's 'input contained no data' UserWarning escaped before the error (and under
+    ``-W error`` replaced it)."""
+    f = _short_csv(tmp_path / "h.csv", [])
+    with pytest.raises(RecordingError, match="header but no data rows"):
+        read_recording(f)
+
+
+# --- Python API: complex input ----------------------------------------------------------------
+
+
+@pytest.mark.parametrize("x", [np.array([0.0, 1e-6j]), [0.0, 1e-6 + 0j], 1e-6j])
+def test_complex_input_is_rejected_not_truncated(x):
+    """Complex arrays were cast to their real part with only a ComplexWarning."""
+    m = contactlab.Masing(40.0, 4e4)
+    with pytest.raises(contactlab.InputError, match="complex"):
+        m.force(x)
+    with pytest.raises(contactlab.InputError, match="complex"):
+        m.local_stiffness(x)
+
+
+# --- CLI: output targets and folders ----------------------------------------------------------
+
+
+def _run(capsys, *argv):
+    rc = cli.main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def test_analyze_a_folder_says_folder(tmp_path, capsys):
+    """A folder given to ``analyze`` was reported as 'no such file'."""
+    d = tmp_path / "recordings"
+    d.mkdir()
+    rc, _, err = _run(capsys, "analyze", d, "--model", "tangential")
+    assert rc == 1 and "is a folder" in err and "Traceback" not in err
+
+
+def test_report_target_that_is_a_file_fails_cleanly_before_analysis(tmp_path, capsys):
+    """``--report FILE`` ended in a NotADirectoryError traceback naming a temporary file,
+    after the whole analysis had run."""
+    rep = tmp_path / "out"
+    rep.write_text("keep me")
+    js = tmp_path / "fit.json"
+    rc, _, err = _run(capsys, "analyze", TANG, "--model", "tangential", "--json", js,
+                      "--report", rep, "--no-progress")  # fmt: skip
+    assert rc == 1
+    assert "--report" in err and "not a folder" in err and "Traceback" not in err
+    assert rep.read_text() == "keep me" and not js.exists()
+    assert "h0 =" not in err  # refused before the analysis ran
+
+
+def test_json_target_that_is_a_folder_leaves_no_report(tmp_path, capsys):
+    """``--json DIR`` failed only after report.html had been written: a partial output."""
+    js = tmp_path / "j"
+    js.mkdir()
+    rep = tmp_path / "rep"
+    rc, _, err = _run(capsys, "study", data_dir() / "normal", "--json", js, "--report", rep,
+                      "--no-progress")  # fmt: skip
+    assert rc == 1 and "--json" in err and "is a folder" in err
+    assert not rep.exists() and list(js.iterdir()) == []
+
+
+def test_os_errors_are_one_line_not_a_traceback(tmp_path, capsys, monkeypatch):
+    """Any OSError from the file system (permissions, full disk) gave a traceback."""
+    from contactlab.commands import analyze
+
+    def boom(*_a, **_k):
+        raise PermissionError(13, "Permission denied", str(tmp_path / "fit.json"))
+
+    monkeypatch.setattr(analyze, "write_json", boom)
+    rc, _, err = _run(capsys, "analyze", TANG, "--model", "tangential", "--json",
+                      tmp_path / "fit.json", "--no-progress")  # fmt: skip
+    assert rc == 1
+    assert "error: Permission denied: " in err and "fit.json" in err
+    assert "Traceback" not in err
+
+
+# --- report: value ± uncertainty --------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "v, s, text",
+    [
+        (5.764e-14, 0.00068, "0.00000 ± 0.00068"),  # was '5.764e-14 ± 0.00068'
+        (-1e-9, 0.0012, "0.0000 ± 0.0012"),  # no '-0.0000'
+        (2.66912, 0.00084, "2.66912 ± 0.00084"),  # was '2.669 ± 0.00084'
+        (45.7789, 0.0463, "45.779 ± 0.046"),
+        (40.0, 0.25, "40.00 ± 0.25"),
+        (1588123.0, 840.0, "(1.58812 ± 0.00084)e+06"),
+        (1.0e-12, 3.0e-14, "(1.000 ± 0.030)e-12"),
+        (3.0, 0.0, "3 ± 0"),
+    ],
+)
+def test_format_measurement(v, s, text):
+    from contactlab.report import format_measurement
+
+    assert format_measurement(v, s) == text
+
+
+def test_table_cells_round_value_to_its_uncertainty():
+    html = table_html([{"E": 5.764e-20, "E_se": 6.8e-10}], [Column("E", "E", "µJ", 1e6, "E_se")])
+    assert "0.00000 ± 0.00068" in html and "e-14" not in html
+
+
+# --- README -----------------------------------------------------------------------------------
+
+
+def _readme_blocks() -> list[str]:
+    text = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    blocks, cur = [], None
+    for line in text.splitlines():
+        if cur is None and line.strip() == "```python":
+            cur = []
+        elif cur is not None and line.strip() == "```":
+            blocks.append("\n".join(cur))
+            cur = None
+        elif cur is not None:
+            cur.append(line)
+    return blocks
+
+
+def test_readme_python_examples_run(tmp_path, monkeypatch):
+    """The README's first example used ``xp, fp`` without defining them (NameError)."""
+    blocks = _readme_blocks()
+    assert len(blocks) == 2
+    monkeypatch.chdir(tmp_path)
+    ns: dict = {}
+    exec(compile(blocks[0], "README.md[python 1]", "exec"), ns)
+    # The second example reads ./manifest.csv: a two-recording study of the bundled data.
+    src = data_dir()
+    for sub, name in (("tangential", TANG.name), ("normal", "C45-C45_p0-1MPa_pa-0.4MPa.mat")):
+        (tmp_path / sub).mkdir()
+        shutil.copy(src / sub / name, tmp_path / sub / name)
+    (tmp_path / "manifest.csv").write_text(
+        "file,kind,material,normal_load [N],amplitude [um],p0 [MPa],pa [MPa]\n"
+        f"tangential/{TANG.name},tangential,Al/Al,109,10,,\n"
+        "normal/C45-C45_p0-1MPa_pa-0.4MPa.mat,normal,C45/C45,,,1,0.4\n"
+    )
+    ns2: dict = {}
+    exec(compile(blocks[1], "README.md[python 2]", "exec"), ns2)
+    assert (tmp_path / "study-out" / "report.html").is_file()
