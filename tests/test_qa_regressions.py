@@ -222,3 +222,38 @@ def test_readme_python_examples_run(tmp_path, monkeypatch):
     ns2: dict = {}
     exec(compile(blocks[1], "README.md[python 2]", "exec"), ns2)
     assert (tmp_path / "study-out" / "report.html").is_file()
+
+
+# --- readers: complex channels, corrupt TDMS ---------------------------------------------------
+
+
+def test_complex_channels_are_rejected_by_the_binary_readers(tmp_path):
+    """A complex .mat variable or TDMS channel lost its imaginary part with a ComplexWarning."""
+    import scipy.io
+    from nptdms import ChannelObject, TdmsWriter
+
+    t = np.arange(50) * 1e-3
+    scipy.io.savemat(tmp_path / "c.mat", {"t": t, "x": t + 1j, "F": t})
+    with pytest.raises(RecordingError, match=r"c\.mat, column 'x': complex values"):
+        read_recording(tmp_path / "c.mat")
+    props = {"wf_increment": 1e-3}
+    with TdmsWriter(tmp_path / "c.tdms") as w:
+        w.write_segment([ChannelObject("g", "x", t + 1j, properties=props),
+                         ChannelObject("g", "F", t, properties=props)])  # fmt: skip
+    with pytest.raises(RecordingError, match=r"c\.tdms, column 'x': complex values"):
+        read_recording(tmp_path / "c.tdms")
+
+
+def test_corrupt_tdms_leaves_no_open_file(tmp_path, caplog):
+    """npTDMS leaked its file handle on a corrupt file (ResourceWarning at garbage collection)."""
+    import gc
+    import warnings
+
+    p = tmp_path / "bad.tdms"
+    p.write_bytes(b"TDSm" + b"\x00" * 60)
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        with pytest.raises(RecordingError, match="not a readable TDMS file"):
+            read_recording(p)
+        gc.collect()
+    assert not [w for w in seen if issubclass(w.category, ResourceWarning)]

@@ -261,6 +261,18 @@ def unit_factor(
 RowOf = Callable[[int], int]
 
 
+def real_values(values: Any, *, file: str, column: str) -> np.ndarray:
+    """A channel's values as float64; complex or non-numeric data is a :class:`RecordingError`
+    (numpy would drop an imaginary part with only a ``ComplexWarning``)."""
+    a = np.asarray(values)
+    if np.iscomplexobj(a):
+        raise RecordingError("complex values; a channel must be real", file=file, column=column)
+    try:
+        return np.asarray(a, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise RecordingError(f"values are not numeric ({exc})", file=file, column=column) from None
+
+
 def _plain(i: int) -> int:
     return i
 
