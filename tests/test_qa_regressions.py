@@ -257,3 +257,17 @@ def test_corrupt_tdms_leaves_no_open_file(tmp_path, caplog):
             read_recording(p)
         gc.collect()
     assert not [w for w in seen if issubclass(w.category, ResourceWarning)]
+
+
+def test_normal_json_gives_units_of_the_paper_b_coefficients(tmp_path, capsys):
+    """``b1_paper`` .. ``b4_paper`` (MPa/µm units) were in the JSON without a unit, beside
+    ``b1`` .. ``b4`` in SI: nothing told a reader that they differ by powers of 10⁶."""
+    import json
+
+    js = tmp_path / "n.json"
+    f = data_dir() / "normal" / "C45-C45_p0-1MPa_pa-0.4MPa.mat"
+    rc, _, _ = _run(capsys, "analyze", f, "--model", "normal", "--json", js, "--no-progress")
+    assert rc == 0
+    units = json.loads(js.read_text())["units"]
+    assert units["b1_paper"] == "µm⁻¹·MPa⁻²" and units["b4_paper"] == "MPa/µm"
+    assert units["b1"] == "1/(m·Pa^2)"

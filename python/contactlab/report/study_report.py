@@ -50,10 +50,10 @@ NORMAL_COLUMNS = [
     Column("k_sec", "k_sec", "MPa/µm", 1e-12),
     Column("delta_min", "δ_min", "µm", 1e6),
     Column("delta_max", "δ_max", "µm", 1e6),
-    Column("b1_paper", "b1 (MPa, µm)"),
-    Column("b2_paper", "b2 (MPa, µm)"),
-    Column("b3_paper", "b3 (MPa, µm)"),
-    Column("b4_paper", "b4 [MPa/µm]"),
+    Column("b1_paper", "b1", "µm⁻¹·MPa⁻²"),
+    Column("b2_paper", "b2", "µm⁻¹·MPa⁻¹"),
+    Column("b3_paper", "b3", "µm⁻¹"),
+    Column("b4_paper", "b4", "MPa/µm"),
 ]
 
 
