@@ -271,3 +271,28 @@ def test_normal_json_gives_units_of_the_paper_b_coefficients(tmp_path, capsys):
     units = json.loads(js.read_text())["units"]
     assert units["b1_paper"] == "µm⁻¹·MPa⁻²" and units["b4_paper"] == "MPa/µm"
     assert units["b1"] == "1/(m·Pa^2)"
+
+
+# --- CLI: quantities with units ---------------------------------------------------------------
+
+
+def test_cli_quantities_check_sign_and_dimension(capsys):
+    """``--fs -5`` was accepted silently, ``--amplitude 5N`` became 5 m, ``--fs 10kHz`` was an
+    unknown unit, and argparse replaced every reason with 'invalid quantity in Hz value'."""
+    from contactlab.commands._common import quantity
+
+    assert quantity("m")("20um") == 2e-05  # exact, not 1.9999999999999998e-05
+    assert quantity("Hz", positive=True)("10kHz") == 1e4
+    assert quantity("1/m")("40/mm") == 4e4
+    assert quantity("1/s")("2rad/s") == 2.0
+    for argv, reason in [
+        (["analyze", "x.csv", "--model", "tangential", "--fs", "-5"], "'-5': must be > 0"),
+        (["analyze", "x.csv", "--model", "tangential", "--fs", "5N"], "N is not a unit"),
+        (["simulate", "tangential", "x.csv", "--amplitude", "5N"], "N is not a unit"),
+        (["simulate", "normal", "x.csv", "--omega", "1Hz"], "Hz is not a unit"),  # 2π
+        (["simulate", "tangential", "x.csv", "--h0", "40lbs"], "unknown unit 'lbs'"),
+    ]:
+        with pytest.raises(SystemExit) as ei:
+            cli.main(argv)
+        assert ei.value.code == 2
+        assert reason in capsys.readouterr().err

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import re
@@ -14,7 +15,7 @@ import numpy as np
 
 from .._io_atomic import write_text
 from ..errors import InputError
-from ..manifest import unit_factor
+from ..manifest import scaled, si_unit, unit_factor
 from ..report import commit_outputs
 from ..study import RecordingResult, StudyResult
 
@@ -30,18 +31,40 @@ def describe(doc: str | None) -> str | None:
     return text.replace("``", "")
 
 
-def quantity(default_unit: str):
-    """argparse ``type=``: a number with an optional unit (``20um``, ``0.5MPa``) → SI float."""
+def quantity(default_unit: str, *, positive: bool = False):
+    """argparse ``type=``: a number with an optional unit (``20um``, ``0.5MPa``) → SI float.
+
+    ``positive=True`` refuses zero and negative values (a sampling rate, a frequency).
+    """
+
+    compatible = {si_unit(default_unit)} if default_unit else {""}
+    # a rate in 1/s may be written rad/s, a frequency in Hz as 1/s (not the other way round:
+    # 1 Hz is 2π rad/s)
+    compatible |= {"1/s": {"rad/s"}, "Hz": {"1/s"}}.get(next(iter(compatible)), set())
 
     def parse(text: str) -> float:
+        # ArgumentTypeError: argparse shows its message (a ValueError's is replaced).
         m = _QTY.match(text)
         if not m:
-            raise ValueError(text)
+            raise argparse.ArgumentTypeError(
+                f"{text!r} is not a number with an optional unit (e.g. 20um, 0.5MPa)"
+            )
         unit = m.group(2) or default_unit
+        if unit.startswith("/"):  # 40/mm means 40 1/mm
+            unit = "1" + unit
         try:
-            return float(m.group(1)) * unit_factor(unit, "value")
+            value = scaled(m.group(1), unit_factor(unit, "value"))  # 20um -> 2e-05 exactly
+            si = si_unit(unit)
         except InputError as exc:
-            raise ValueError(str(exc)) from None
+            raise argparse.ArgumentTypeError(f"{text!r}: {exc}") from None
+        if si not in compatible:
+            raise argparse.ArgumentTypeError(
+                f"{text!r}: {unit} is not a unit of this option (give {default_unit}, or "
+                f"a multiple of it)"
+            )
+        if positive and not value > 0:
+            raise argparse.ArgumentTypeError(f"{text!r}: must be > 0")
+        return value
 
     parse.__name__ = f"quantity in {default_unit or 'SI'}"
     return parse

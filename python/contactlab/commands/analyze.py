@@ -104,7 +104,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", metavar="OUT", help="write results as JSON (SI; '-' = stdout)")
     p.add_argument("--report", metavar="DIR", help="write report.html, figures and tables here")
     p.add_argument("--columns", help="column mapping, e.g. 'x=disp,F=force' (default: by name)")
-    p.add_argument("--fs", type=quantity("Hz"), help="sampling rate when a file has no time")
+    p.add_argument(
+        "--fs", type=quantity("Hz", positive=True), help="sampling rate when a file has no time"
+    )
     p.add_argument("--keep-going", action="store_true",
                    help="skip recordings that fail (exit code 1) instead of stopping")  # fmt: skip
     p.add_argument("-v", "--verbose", action="store_true", help="print each fit report")
