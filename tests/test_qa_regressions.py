@@ -296,3 +296,17 @@ def test_cli_quantities_check_sign_and_dimension(capsys):
             cli.main(argv)
         assert ei.value.code == 2
         assert reason in capsys.readouterr().err
+
+
+def test_columns_without_units_are_warned_about(tmp_path, capsys):
+    """A header ``t,x,F`` with x written in µm gave 'amplitude = 1e+07 um' and no warning."""
+    import json
+
+    lines = TANG.read_text().splitlines()
+    rows = [f"{float(r.split(',')[0]) / 1e3!r},{r.split(',', 1)[1]}" for r in lines[1:]]
+    f = _short_csv(tmp_path / "nounits.csv", rows, header="t,x,F")
+    js = tmp_path / "fit.json"
+    rc, _, err = _run(capsys, "analyze", f, "--model", "tangential", "--json", js, "--no-progress")
+    assert rc == 0
+    assert "warning: no unit in the file for x, F, t: taken as SI (t in s, x in m, F in N)" in err
+    assert json.loads(js.read_text())["warnings"][0].startswith("no unit in the file for x, F")

@@ -160,6 +160,17 @@ def analyze_entry(
         row, u = _flatten(d, d.get("units", {}) or {})
     units.update(u)
     base.update(row)
+    if assumed:
+        # A header without units is the commonest way to get metres where µm were meant:
+        # say so beside the results (terminal, JSON, report), not only in a provenance column.
+        si = ", ".join(["t in s"] + [f"{k} in {v}" for k, v in rec.units.items()])
+        note = (
+            f"no unit in the file for {', '.join(map(str, assumed))}: taken as SI ({si}); "
+            "if that is wrong, put the unit in the name, e.g. 'x [um]'"
+        )
+        ws = [note, *(w for w in str(base.get("warnings") or "").split(" | ") if w)]
+        base["warnings"] = " | ".join(ws)
+        extra = {**extra, "warnings": ws}
     return RecordingResult(entry, base, units, analysis=analysis, recording=rec, extra=extra)
 
 
