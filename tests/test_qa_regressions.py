@@ -310,3 +310,13 @@ def test_columns_without_units_are_warned_about(tmp_path, capsys):
     assert rc == 0
     assert "warning: no unit in the file for x, F, t: taken as SI (t in s, x in m, F in N)" in err
     assert json.loads(js.read_text())["warnings"][0].startswith("no unit in the file for x, F")
+
+
+def test_report_shows_the_uncertainty_of_the_numeric_loop_energy():
+    """'E numeric' showed -0.0003019 µJ bare for a tiny steel loop: a negative energy with
+    nothing to say it is (-0.3 ± 1.3) nJ, i.e. zero within its uncertainty."""
+    from contactlab.report.study_report import TANGENTIAL_COLUMNS
+
+    row = {"energy_per_cycle_numeric": -3.0188e-10, "energy_per_cycle_numeric_stderr": 1.27e-9}
+    html = table_html([row], [c for c in TANGENTIAL_COLUMNS if "numeric" in c.key])
+    assert "-0.0003 ± 0.0013" in html
