@@ -320,3 +320,13 @@ def test_report_shows_the_uncertainty_of_the_numeric_loop_energy():
     row = {"energy_per_cycle_numeric": -3.0188e-10, "energy_per_cycle_numeric_stderr": 1.27e-9}
     html = table_html([row], [c for c in TANGENTIAL_COLUMNS if "numeric" in c.key])
     assert "-0.0003 ± 0.0013" in html
+
+
+def test_os_error_names_the_output_not_its_temporary():
+    """'Is a directory: /tmp/.fit.json.h3a5bx85.part' named a file the user never asked for."""
+    from contactlab.cli import _os_error_text
+
+    e = IsADirectoryError(21, "Is a directory", "/d/.fit.json.h3a5bx85.part", "/d/fit.json")
+    assert _os_error_text(e) == "Is a directory: /d/fit.json"
+    e = NotADirectoryError(20, "Not a directory", "/d/afile/.report.html.k2_j4x9.part")
+    assert _os_error_text(e) == "Not a directory: /d/afile/report.html"
