@@ -330,3 +330,20 @@ def test_os_error_names_the_output_not_its_temporary():
     assert _os_error_text(e) == "Is a directory: /d/fit.json"
     e = NotADirectoryError(20, "Not a directory", "/d/afile/.report.html.k2_j4x9.part")
     assert _os_error_text(e) == "Not a directory: /d/afile/report.html"
+
+
+def test_polynomial_coefficients_get_their_own_units_in_the_table():
+    """Every column poly_load_0..4 of study_normal.csv was headed
+    '[Pa; ascending powers of delta in m]' and k_s_delta_0..3 '[Pa/m; ...]', a description
+    rather than a unit, and wrong for all but one coefficient."""
+    from contactlab.manifest import entry_from_file
+    from contactlab.study import analyze_entry
+
+    f = data_dir() / "normal" / "C45-C45_p0-1MPa_pa-0.4MPa.mat"
+    r = analyze_entry(entry_from_file(f, kind="normal"))
+    assert [r.units[f"poly_load_{i}"] for i in range(5)] == [
+        "Pa", "Pa/m", "Pa/m^2", "Pa/m^3", "Pa/m^4"]  # fmt: skip
+    assert [r.units[f"k_s_delta_{i}"] for i in range(4)] == [
+        "Pa/m", "Pa/m^2", "Pa/m^3", "Pa/m^4"]  # fmt: skip
+    header = r.units["poly_centre_1"]
+    assert ";" not in header
