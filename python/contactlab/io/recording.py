@@ -23,10 +23,11 @@ KIND_CHANNELS = {"tangential": ("x", "F"), "normal": ("p", "delta")}
 #: names recognised (case-insensitive, unit stripped) for each canonical channel, best first
 ALIASES: dict[str, tuple[str, ...]] = {
     "t": ("t", "time", "zeit", "timestamp", "time_s", "times"),
-    "x": ("x", "disp", "displacement", "u", "x_t", "tangential displacement", "s", "ux"),
-    "F": ("f", "force", "ft", "f_t", "friction", "friction force", "h", "tangential force"),
-    "p": ("p", "pressure", "contact pressure", "sigma", "p_n"),
-    "delta": ("delta", "δ", "d", "normal displacement", "disp", "displacement", "dn"),
+    "x": ("x", "disp", "displacement", "u", "x_t", "tangential displacement", "s", "ux", "weg"),
+    "F": ("f", "force", "ft", "f_t", "friction", "friction force", "h", "tangential force",
+          "kraft"),  # fmt: skip
+    "p": ("p", "pressure", "contact pressure", "sigma", "p_n", "druck"),
+    "delta": ("delta", "δ", "d", "normal displacement", "disp", "displacement", "dn", "weg"),
 }
 
 
