@@ -347,3 +347,14 @@ def test_polynomial_coefficients_get_their_own_units_in_the_table():
         "Pa/m", "Pa/m^2", "Pa/m^3", "Pa/m^4"]  # fmt: skip
     header = r.units["poly_centre_1"]
     assert ";" not in header
+
+
+def test_latin1_csv_from_windows_acquisition_software(tmp_path):
+    """A header ``Zeit [ms],Weg [µm],Kraft [N]`` or a comment ``# Prüfstand 2`` written in a
+    Windows code page failed with 'cannot be parsed as numbers'."""
+    body = "\n".join(f"{i},{i % 7 - 3},{0.5 * (i % 7)}" for i in range(30))
+    f = tmp_path / "messung.csv"
+    f.write_bytes(("# Prüfstand 2\nZeit [ms],Weg [µm],Kraft [N]\n" + body + "\n").encode("cp1252"))
+    rec = read_recording(f)
+    assert rec.meta["encoding"] == "latin-1" and rec.meta["comments"] == ["Prüfstand 2"]
+    assert rec["x"][0] == -3e-6 and rec.t[1] == 1e-3 and rec.kind == "tangential"

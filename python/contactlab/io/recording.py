@@ -24,8 +24,17 @@ KIND_CHANNELS = {"tangential": ("x", "F"), "normal": ("p", "delta")}
 ALIASES: dict[str, tuple[str, ...]] = {
     "t": ("t", "time", "zeit", "timestamp", "time_s", "times"),
     "x": ("x", "disp", "displacement", "u", "x_t", "tangential displacement", "s", "ux", "weg"),
-    "F": ("f", "force", "ft", "f_t", "friction", "friction force", "h", "tangential force",
-          "kraft"),  # fmt: skip
+    "F": (
+        "f",
+        "force",
+        "ft",
+        "f_t",
+        "friction",
+        "friction force",
+        "h",
+        "tangential force",
+        "kraft",
+    ),
     "p": ("p", "pressure", "contact pressure", "sigma", "p_n", "druck"),
     "delta": ("delta", "δ", "d", "normal displacement", "disp", "displacement", "dn", "weg"),
 }
