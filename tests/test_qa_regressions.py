@@ -358,3 +358,12 @@ def test_latin1_csv_from_windows_acquisition_software(tmp_path):
     rec = read_recording(f)
     assert rec.meta["encoding"] == "latin-1" and rec.meta["comments"] == ["Prüfstand 2"]
     assert rec["x"][0] == -3e-6 and rec.t[1] == 1e-3 and rec.kind == "tangential"
+
+
+def test_normal_analysis_of_a_dead_displacement_sensor():
+    """A constant delta gave 'parameter x = 0 is invalid: all abscissae are zero'."""
+    from contactlab.normal import analyze_loop
+
+    t = np.linspace(0.0, 20 * np.pi, 2561)
+    with pytest.raises(contactlab.InputError, match=r"delta is constant \(0 m\)"):
+        analyze_loop(t, 1e6 + 4e5 * np.sin(t), np.zeros_like(t))
