@@ -8,6 +8,7 @@ confusion matrix over many seeds, magnitudes and noise levels is benches/eval_di
 
 from __future__ import annotations
 
+import functools
 import json
 
 import matplotlib
@@ -22,6 +23,8 @@ from contactlab.diagnose.generator import TANGENTIAL_EFFECTS
 matplotlib.use("Agg")
 
 SEED = 20261123
+# recordings of 18 cycles at 80 samples per cycle keep the suite quick; the bench uses 120
+hidden_effect_recording = functools.partial(hidden_effect_recording, samples_per_cycle=80)
 
 
 def _check_layout(d: dict) -> None:
@@ -162,6 +165,10 @@ def test_bad_input_is_named():
         contactlab.diagnose((t, x, F[:-5]))
     with pytest.raises(InputError, match="model must be"):
         contactlab.diagnose(rec, model="rotational")
+    with pytest.raises(InputError, match="max_effects"):
+        contactlab.diagnose(rec, max_effects=-1)
+    with pytest.raises(InputError, match="folds"):
+        contactlab.diagnose(rec, folds=1)
     with pytest.raises(InputError, match="unknown tangential candidate"):
         contactlab.diagnose(rec, candidates=["wear"])
     with pytest.raises(InputError, match="channels 'x' and 'F'"):

@@ -6,7 +6,6 @@ Each test here failed before its fix; the docstring says what the user saw.
 from __future__ import annotations
 
 import os
-import shutil
 import stat
 from pathlib import Path
 
@@ -183,45 +182,6 @@ def test_format_measurement(v, s, text):
 def test_table_cells_round_value_to_its_uncertainty():
     html = table_html([{"E": 5.764e-20, "E_se": 6.8e-10}], [Column("E", "E", "µJ", 1e6, "E_se")])
     assert "0.00000 ± 0.00068" in html and "e-14" not in html
-
-
-# --- README -----------------------------------------------------------------------------------
-
-
-def _readme_blocks() -> list[str]:
-    text = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
-    blocks, cur = [], None
-    for line in text.splitlines():
-        if cur is None and line.strip() == "```python":
-            cur = []
-        elif cur is not None and line.strip() == "```":
-            blocks.append("\n".join(cur))
-            cur = None
-        elif cur is not None:
-            cur.append(line)
-    return blocks
-
-
-def test_readme_python_examples_run(tmp_path, monkeypatch):
-    """The README's first example used ``xp, fp`` without defining them (NameError)."""
-    blocks = _readme_blocks()
-    assert len(blocks) == 2
-    monkeypatch.chdir(tmp_path)
-    ns: dict = {}
-    exec(compile(blocks[0], "README.md[python 1]", "exec"), ns)
-    # The second example reads ./manifest.csv: a two-recording study of the bundled data.
-    src = data_dir()
-    for sub, name in (("tangential", TANG.name), ("normal", "C45-C45_p0-1MPa_pa-0.4MPa.mat")):
-        (tmp_path / sub).mkdir()
-        shutil.copy(src / sub / name, tmp_path / sub / name)
-    (tmp_path / "manifest.csv").write_text(
-        "file,kind,material,normal_load [N],amplitude [um],p0 [MPa],pa [MPa]\n"
-        f"tangential/{TANG.name},tangential,Al/Al,109,10,,\n"
-        "normal/C45-C45_p0-1MPa_pa-0.4MPa.mat,normal,C45/C45,,,1,0.4\n"
-    )
-    ns2: dict = {}
-    exec(compile(blocks[1], "README.md[python 2]", "exec"), ns2)
-    assert (tmp_path / "study-out" / "report.html").is_file()
 
 
 # --- readers: complex channels, corrupt TDMS ---------------------------------------------------

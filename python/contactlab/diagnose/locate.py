@@ -56,7 +56,11 @@ def locate(
     """Statements (with numbers) on where the residual lives, and the numbers themselves."""
     e = -residual_model_minus_meas  # measured minus model
     p = e * e
-    unit = "N" if family.kind == "tangential" else "m"
+    # display units: tangential F in N, x in µm; normal δ in nm, p in MPa
+    if family.kind == "tangential":
+        unit, ys, uunit, us = "N", 1.0, "µm", 1e6
+    else:
+        unit, ys, uunit, us = "nm", 1e9, "MPa", 1e-6
     uname = family.input_name
     rms = float(np.sqrt(p.mean()))
     ph = d.cycles.phase_in_branch
@@ -81,8 +85,8 @@ def locate(
     nums["rising_share"] = _share(rising, p)
     out.append(
         f"{100 * nums['rising_share']:.0f} % of the residual power is on branches with "
-        f"{uname} rising; mean residual {m_up:+.3g} {unit} while {uname} rises, "
-        f"{m_dn:+.3g} {unit} while it falls"
+        f"{uname} rising; mean residual {m_up * ys:+.3g} {unit} while {uname} rises, "
+        f"{m_dn * ys:+.3g} {unit} while it falls"
     )
 
     speed = np.abs(d.ud)
@@ -91,7 +95,8 @@ def locate(
     nums["slow_quarter"] = _share(speed <= q25, p)
     out.append(
         f"{100 * nums['fast_quarter']:.0f} % of the residual power is in the fastest quarter "
-        f"of samples (|d{uname}/dt| >= {q75:.3g}), {100 * nums['slow_quarter']:.0f} % in the "
+        f"of samples (|d{uname}/dt| >= {q75 * us:.3g} {uunit}/s), "
+        f"{100 * nums['slow_quarter']:.0f} % in the "
         "slowest quarter"
     )
 
@@ -102,8 +107,9 @@ def locate(
     nums["time_thirds_rms"] = tr
     nums["time_thirds_mean"] = tm
     out.append(
-        f"residual RMS {tr[0]:.3g} / {tr[1]:.3g} / {tr[2]:.3g} {unit} in the first / middle / "
-        f"last third of the recording (mean {tm[0]:+.3g} / {tm[1]:+.3g} / {tm[2]:+.3g} {unit})"
+        f"residual RMS {tr[0] * ys:.3g} / {tr[1] * ys:.3g} / {tr[2] * ys:.3g} {unit} in the "
+        f"first / middle / last third of the recording (mean {tm[0] * ys:+.3g} / "
+        f"{tm[1] * ys:+.3g} / {tm[2] * ys:+.3g} {unit})"
     )
 
     cyc = d.cycles.cycle
@@ -119,7 +125,8 @@ def locate(
         out.append(
             "residual RMS by cycle amplitude: "
             + ", ".join(
-                f"{r:.3g} {unit} at {uname} ≈ {a:.3g}" for a, r in zip(g_amp, g_rms, strict=True)
+                f"{r * ys:.3g} {unit} at {uname} amplitude {a * us:.3g} {uunit}"
+                for a, r in zip(g_amp, g_rms, strict=True)
             )
         )
 

@@ -302,6 +302,10 @@ def diagnose(
     t, u, y = _arrays(recording, family)
     if folds < 2:
         raise InputError(f"folds must be >= 2, got {folds}")
+    if max_effects < 0:
+        raise InputError(f"max_effects must be >= 0, got {max_effects}")
+    if not (z > 0 and min_gain >= 0):
+        raise InputError(f"z must be > 0 and min_gain >= 0, got z={z}, min_gain={min_gain}")
     names = list(family.candidates) if candidates is None else list(candidates)
     for n in names:
         if n not in family.candidates:
