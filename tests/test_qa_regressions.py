@@ -327,3 +327,34 @@ def test_normal_analysis_of_a_dead_displacement_sensor():
     t = np.linspace(0.0, 20 * np.pi, 2561)
     with pytest.raises(contactlab.InputError, match=r"delta is constant \(0 m\)"):
         analyze_loop(t, 1e6 + 4e5 * np.sin(t), np.zeros_like(t))
+
+
+# --- study manifests --------------------------------------------------------------------------
+
+
+def _manifest(tmp_path: Path, text: str) -> Path:
+    src = data_dir() / "normal" / "C45-C45_p0-1MPa_pa-0.4MPa.mat"
+    (tmp_path / "n.mat").write_bytes(src.read_bytes())
+    m = tmp_path / "manifest.csv"
+    m.write_text(text, encoding="utf-8")
+    return m
+
+
+def test_manifest_saved_by_a_european_spreadsheet(tmp_path):
+    """A ';'-separated manifest with decimal commas (Excel in de/fr/it/... locales) failed
+    with "no 'file' column in ['file;kind;...']"."""
+    from contactlab.manifest import read_manifest
+
+    m = _manifest(tmp_path, "file;kind;p0 [MPa];pa [MPa]\nn.mat;normal;1,5;0,4\n")
+    (e,) = read_manifest(m)
+    assert e.kind == "normal" and e.tags["p0"] == 1.5e6 and e.tags["pa"] == 4e5
+
+
+def test_manifest_listing_a_file_twice_is_refused(tmp_path):
+    """A duplicated row was analysed twice: counted twice in every trend, one figure lost."""
+    from contactlab.manifest import read_manifest
+
+    m = _manifest(tmp_path, "file,kind\nn.mat,normal\n./n.mat,normal\n")
+    with pytest.raises(contactlab.InputError, match=r"row 3, column 'file': ./n.mat is listed "
+                       r"already in row 2"):  # fmt: skip
+        read_manifest(m)

@@ -210,7 +210,12 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
     lines = [(i, ln) for i, ln in lines if not ln.lstrip().startswith("#")]
     if not lines:
         raise InputError(f"manifest {mpath} is empty (a header row with 'file' is needed)")
-    rows = list(csv.reader(io.StringIO("\n".join(ln for _, ln in lines))))
+    # Spreadsheets in many European locales save "CSV" with ';' (and a decimal comma).
+    head = lines[0][1]
+    delim = ","
+    if "," not in head:
+        delim = ";" if ";" in head else "\t" if "\t" in head else ","
+    rows = list(csv.reader(io.StringIO("\n".join(ln for _, ln in lines)), delimiter=delim))
     header_row, header = lines[0][0], rows[0]
     keys: list[str] = []
     factors: list[float | None] = []
@@ -234,6 +239,7 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
         raise InputError(f"manifest {mpath}, row {header_row}: no 'file' column in {header}")
 
     entries: list[StudyEntry] = []
+    seen: dict[Path, int] = {}
     for (lineno, _), cells in zip(lines[1:], rows[1:], strict=True):
         if len(cells) > len(keys):
             raise InputError(
@@ -250,6 +256,10 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
             fpath = mpath.parent / fpath
         if not fpath.exists():
             raise InputError(f"{where}, column 'file': {fpath} does not exist")
+        first = seen.setdefault(fpath.resolve(), lineno)
+        if first != lineno:
+            # analysed twice, it would count twice in every trend and overwrite its figure
+            raise InputError(f"{where}, column 'file': {fname} is listed already in row {first}")
         tags = tags_from_filename(fpath)
         columns = None
         for key, factor, cell in zip(keys, factors, cells, strict=True):
@@ -260,6 +270,8 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
                 columns = _parse_columns(cell, f"{where}, column 'columns'")
                 continue
             if key in TAG_UNITS or factor is not None:
+                if delim != ",":
+                    cell = cell.replace(",", ".")  # decimal comma
                 try:
                     tags[key] = scaled(cell, factor if factor is not None else 1.0)
                 except ValueError:
