@@ -358,3 +358,17 @@ def test_manifest_listing_a_file_twice_is_refused(tmp_path):
     with pytest.raises(contactlab.InputError, match=r"row 3, column 'file': ./n.mat is listed "
                        r"already in row 2"):  # fmt: skip
         read_manifest(m)
+
+
+# --- Masing: the linear limit -----------------------------------------------------------------
+
+
+@pytest.mark.parametrize("h0", [1e8, 1e150, 1e160, 1e250])
+def test_loop_energy_in_the_linear_limit_is_not_nan(h0):
+    """With h0·ac fixed and ac → 0 (where fits of nearly linear loops go), loop_energy gave
+    0.0 near h0 = 1e150 and NaN from h0 = 1e155 on: h0/ac overflowed while (ac·A)³ underflowed."""
+    k0, A = 1e6, 2.5e-7
+    m = contactlab.Masing(h0, k0 / h0)
+    want = 2.0 / 3.0 * k0 * (m.ac * A) * A * A  # cubic law, exact to O(ac·A)
+    assert m.loop_energy(A) == pytest.approx(want, rel=1e-9)
+    assert m.equivalent_damping(A) == pytest.approx(want / (np.pi * A * A), rel=1e-9)
