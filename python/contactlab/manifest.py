@@ -256,10 +256,6 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
             fpath = mpath.parent / fpath
         if not fpath.exists():
             raise InputError(f"{where}, column 'file': {fpath} does not exist")
-        first = seen.setdefault(fpath.resolve(), lineno)
-        if first != lineno:
-            # analysed twice, it would count twice in every trend and overwrite its figure
-            raise InputError(f"{where}, column 'file': {fname} is listed already in row {first}")
         tags = tags_from_filename(fpath)
         columns = None
         for key, factor, cell in zip(keys, factors, cells, strict=True):
@@ -283,6 +279,10 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
         if kind not in _KINDS:
             raise InputError(f"{where}, column 'kind': {kind!r} must be 'tangential' or 'normal'")
         fs = tags.pop("fs", None)
+        first = seen.setdefault(fpath.resolve(), lineno)
+        if first != lineno:
+            # analysed twice, it would count twice in every trend and overwrite its figure
+            raise InputError(f"{where}, column 'file': {fname} is listed already in row {first}")
         entries.append(
             StudyEntry(
                 path=fpath,
