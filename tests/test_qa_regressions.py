@@ -372,3 +372,9 @@ def test_loop_energy_in_the_linear_limit_is_not_nan(h0):
     want = 2.0 / 3.0 * k0 * (m.ac * A) * A * A  # cubic law, exact to O(ac·A)
     assert m.loop_energy(A) == pytest.approx(want, rel=1e-9)
     assert m.equivalent_damping(A) == pytest.approx(want / (np.pi * A * A), rel=1e-9)
+
+
+def test_analyze_the_same_file_twice_is_refused(capsys):
+    """``analyze a.csv a.csv`` (a shell glob overlap) analysed and reported it twice."""
+    rc, _, err = _run(capsys, "analyze", TANG, str(TANG), "--model", "tangential")
+    assert rc == 1 and "given twice" in err

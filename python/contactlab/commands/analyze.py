@@ -59,6 +59,8 @@ def _handler(args: argparse.Namespace) -> int:
             raise InputError(f"{f}: is a folder, not a recording file (use `contactlab study`)")
         if not Path(f).is_file():
             raise InputError(f"{f}: no such file")
+        if any(Path(f).resolve() == e.path.resolve() for e in entries):
+            raise InputError(f"{f}: given twice (it would be analysed and counted twice)")
         e = entry_from_file(f, kind=args.model)
         e.columns, e.fs = columns, args.fs
         entries.append(e)
