@@ -378,3 +378,13 @@ def test_analyze_the_same_file_twice_is_refused(capsys):
     """``analyze a.csv a.csv`` (a shell glob overlap) analysed and reported it twice."""
     rc, _, err = _run(capsys, "analyze", TANG, str(TANG), "--model", "tangential")
     assert rc == 1 and "given twice" in err
+
+
+def test_python_dash_m_contactlab():
+    """``python -m contactlab`` failed: 'No module named contactlab.__main__'."""
+    import subprocess
+    import sys
+
+    r = subprocess.run([sys.executable, "-m", "contactlab", "--version"], capture_output=True,
+                       text=True, timeout=60)  # fmt: skip
+    assert r.returncode == 0 and r.stdout.startswith("contactlab ")
