@@ -9,15 +9,28 @@ import numpy as np
 from .errors import InputError
 
 
+def _float_array(x: Any, name: str) -> np.ndarray:
+    """``x`` as a float64 array; complex input is an error (numpy would drop the imaginary
+    part with only a warning)."""
+    try:
+        a = np.asarray(x)
+        complex_ = np.iscomplexobj(a)
+        if not complex_:
+            a = np.ascontiguousarray(a, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} cannot be converted to a float array: {exc}") from None
+    if complex_:
+        raise InputError(f"{name} is complex; pass a real array (e.g. its .real part)")
+    return a
+
+
 def as_1d(x: Any, name: str, *, allow_empty: bool = False, finite: bool = True) -> np.ndarray:
     """Return `x` as a contiguous 1-D float64 array or raise :class:`InputError`.
 
-    int and float32 input is converted; NaN/inf is rejected with the index named.
+    int and float32 input is converted; NaN/inf is rejected with the index named; complex
+    input is rejected (numpy would silently drop the imaginary part).
     """
-    try:
-        a = np.ascontiguousarray(x, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{name} cannot be converted to a float array: {exc}") from None
+    a = _float_array(x, name)
     if a.ndim != 1:
         raise InputError(f"{name} must be 1-D, got an array of shape {a.shape}")
     if a.size == 0 and not allow_empty:
@@ -32,10 +45,7 @@ def as_1d(x: Any, name: str, *, allow_empty: bool = False, finite: bool = True) 
 
 def scalar_or_array(x: Any, name: str) -> tuple[np.ndarray, bool]:
     """Flatten a scalar or array for a vectorised kernel; tell whether it was a scalar."""
-    try:
-        a = np.asarray(x, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{name} cannot be converted to a float array: {exc}") from None
+    a = _float_array(x, name)
     flat = np.ascontiguousarray(a.reshape(-1))
     bad = ~np.isfinite(flat)
     if bad.any():

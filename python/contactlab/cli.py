@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import re
 import sys
 from collections.abc import Sequence
 
@@ -22,6 +23,19 @@ _VERB_MODULES = [
     "contactlab.demo",
     "contactlab.diagnose.cli",
 ]
+
+
+# Temporaries of the atomic writers: ".report.html.k2j4x9.part" beside "report.html".
+_TEMP = re.compile(r"(^|[/\\])\.([^/\\]+)\.[A-Za-z0-9_]+\.part$")
+
+
+def _os_error_text(exc: OSError) -> str:
+    """``strerror: path``, naming the output the user asked for rather than its temporary."""
+    name = exc.filename2 or exc.filename  # os.replace(tmp, final): final is filename2
+    if name is None:
+        return str(exc)
+    name = _TEMP.sub(r"\1\2", str(name))
+    return f"{exc.strerror or exc}: {name}"
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -54,6 +68,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return int(args.handler(args) or 0)
     except ContactLabError as exc:
         print(f"contactlab {args.verb}: error: {exc}", file=sys.stderr)
+        return 1
+    except OSError as exc:  # the file system said no (permissions, full disk, a file in the way)
+        print(f"contactlab {args.verb}: error: {_os_error_text(exc)}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print(f"contactlab {args.verb}: interrupted; no partial outputs written", file=sys.stderr)

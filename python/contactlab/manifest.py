@@ -47,7 +47,7 @@ _UNITS: dict[str, tuple[float, str]] = {
     "m": (1.0, "m"), "mm": (1e-3, "m"), "um": (1e-6, "m"), "nm": (1e-9, "m"),
     "N": (1.0, "N"), "kN": (1e3, "N"), "mN": (1e-3, "N"),
     "Pa": (1.0, "Pa"), "kPa": (1e3, "Pa"), "MPa": (1e6, "Pa"), "GPa": (1e9, "Pa"),
-    "Hz": (1.0, "Hz"), "1/s": (1.0, "1/s"), "rad/s": (1.0, "rad/s"),
+    "Hz": (1.0, "Hz"), "kHz": (1e3, "Hz"), "1/s": (1.0, "1/s"), "rad/s": (1.0, "rad/s"),
     "1/m": (1.0, "1/m"), "1/mm": (1e3, "1/m"), "1/um": (1e6, "1/m"),
     "J": (1.0, "J"), "mJ": (1e-3, "J"), "uJ": (1e-6, "J"),
     "N/m": (1.0, "N/m"), "N/mm": (1e3, "N/m"), "N/um": (1e6, "N/m"),
@@ -210,7 +210,12 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
     lines = [(i, ln) for i, ln in lines if not ln.lstrip().startswith("#")]
     if not lines:
         raise InputError(f"manifest {mpath} is empty (a header row with 'file' is needed)")
-    rows = list(csv.reader(io.StringIO("\n".join(ln for _, ln in lines))))
+    # Spreadsheets in many European locales save "CSV" with ';' (and a decimal comma).
+    head = lines[0][1]
+    delim = ","
+    if "," not in head:
+        delim = ";" if ";" in head else "\t" if "\t" in head else ","
+    rows = list(csv.reader(io.StringIO("\n".join(ln for _, ln in lines)), delimiter=delim))
     header_row, header = lines[0][0], rows[0]
     keys: list[str] = []
     factors: list[float | None] = []
@@ -234,6 +239,7 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
         raise InputError(f"manifest {mpath}, row {header_row}: no 'file' column in {header}")
 
     entries: list[StudyEntry] = []
+    seen: dict[Path, int] = {}
     for (lineno, _), cells in zip(lines[1:], rows[1:], strict=True):
         if len(cells) > len(keys):
             raise InputError(
@@ -260,6 +266,8 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
                 columns = _parse_columns(cell, f"{where}, column 'columns'")
                 continue
             if key in TAG_UNITS or factor is not None:
+                if delim != ",":
+                    cell = cell.replace(",", ".")  # decimal comma
                 try:
                     tags[key] = scaled(cell, factor if factor is not None else 1.0)
                 except ValueError:
@@ -271,6 +279,10 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
         if kind not in _KINDS:
             raise InputError(f"{where}, column 'kind': {kind!r} must be 'tangential' or 'normal'")
         fs = tags.pop("fs", None)
+        first = seen.setdefault(fpath.resolve(), lineno)
+        if first != lineno:
+            # analysed twice, it would count twice in every trend and overwrite its figure
+            raise InputError(f"{where}, column 'file': {fname} is listed already in row {first}")
         entries.append(
             StudyEntry(
                 path=fpath,

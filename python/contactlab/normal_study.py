@@ -49,6 +49,7 @@ def analyze_normal_recording(
         d[name] = b[i]
         d[f"{name}_paper"] = bp[i]
         units[name] = B_UNITS[name]
+        units[f"{name}_paper"] = B_PAPER_UNITS[name]
     d["k_s_p_rms"] = float(stiff.rms[0])
     units["k_s_p_rms"] = "Pa/m"
     # standard error of the mean dissipated energy from its cycle-to-cycle scatter

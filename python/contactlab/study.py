@@ -19,6 +19,7 @@ import io
 import json
 import math
 import os
+import re
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -50,6 +51,24 @@ class RecordingResult:
         return self.error is None
 
 
+# "Pa; ascending powers of delta in m" (a polynomial's coefficients, described in one string)
+_POWERS = re.compile(
+    r"^\s*([A-Za-z]+)(/([A-Za-z]+)(?:\^(\d+))?)?\s*; ascending powers of \S+ in (\w+)"
+)
+
+
+def _coefficient_unit(unit: str, i: int) -> str:
+    """Unit of coefficient ``i`` of a polynomial whose unit map says ``"Pa; ascending powers of
+    delta in m"``: ``Pa``, ``Pa/m``, ``Pa/m^2``, ... (``"Pa/m; ..."`` starts at ``Pa/m``).
+    Other strings are returned as they are."""
+    m = _POWERS.match(unit)
+    if m is None or (m.group(2) and m.group(3) != m.group(5)):
+        return unit
+    n = i + (int(m.group(4) or 1) if m.group(2) else 0)
+    var = m.group(5)
+    return m.group(1) if n == 0 else f"{m.group(1)}/{var}" if n == 1 else f"{m.group(1)}/{var}^{n}"
+
+
 def _flatten(d: Mapping[str, Any], units: Mapping[str, str]) -> tuple[dict, dict]:
     """Scalars as they are, short vectors as ``key_0, key_1, ...``; nested dicts dotted."""
     row: dict[str, Any] = {}
@@ -73,7 +92,7 @@ def _flatten(d: Mapping[str, Any], units: Mapping[str, str]) -> tuple[dict, dict
                     if isinstance(unit, (list, tuple)) and i < len(unit):
                         out_units[f"{key}_{i}"] = str(unit[i])
                     elif isinstance(unit, str) and unit:
-                        out_units[f"{key}_{i}"] = unit
+                        out_units[f"{key}_{i}"] = _coefficient_unit(unit, i)
             continue
         if isinstance(value, (np.floating, np.integer, np.bool_)):
             value = value.item()
@@ -160,6 +179,17 @@ def analyze_entry(
         row, u = _flatten(d, d.get("units", {}) or {})
     units.update(u)
     base.update(row)
+    if assumed:
+        # A header without units is the commonest way to get metres where µm were meant:
+        # say so beside the results (terminal, JSON, report), not only in a provenance column.
+        si = ", ".join(["t in s"] + [f"{k} in {v}" for k, v in rec.units.items()])
+        note = (
+            f"no unit in the file for {', '.join(map(str, assumed))}: taken as SI ({si}); "
+            "if that is wrong, put the unit in the name, e.g. 'x [um]'"
+        )
+        ws = [note, *(w for w in str(base.get("warnings") or "").split(" | ") if w)]
+        base["warnings"] = " | ".join(ws)
+        extra = {**extra, "warnings": ws}
     return RecordingResult(entry, base, units, analysis=analysis, recording=rec, extra=extra)
 
 

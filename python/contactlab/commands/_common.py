@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import re
@@ -14,7 +15,7 @@ import numpy as np
 
 from .._io_atomic import write_text
 from ..errors import InputError
-from ..manifest import unit_factor
+from ..manifest import scaled, si_unit, unit_factor
 from ..report import commit_outputs
 from ..study import RecordingResult, StudyResult
 
@@ -30,18 +31,40 @@ def describe(doc: str | None) -> str | None:
     return text.replace("``", "")
 
 
-def quantity(default_unit: str):
-    """argparse ``type=``: a number with an optional unit (``20um``, ``0.5MPa``) → SI float."""
+def quantity(default_unit: str, *, positive: bool = False):
+    """argparse ``type=``: a number with an optional unit (``20um``, ``0.5MPa``) → SI float.
+
+    ``positive=True`` refuses zero and negative values (a sampling rate, a frequency).
+    """
+
+    compatible = {si_unit(default_unit)} if default_unit else {""}
+    # a rate in 1/s may be written rad/s, a frequency in Hz as 1/s (not the other way round:
+    # 1 Hz is 2π rad/s)
+    compatible |= {"1/s": {"rad/s"}, "Hz": {"1/s"}}.get(next(iter(compatible)), set())
 
     def parse(text: str) -> float:
+        # ArgumentTypeError: argparse shows its message (a ValueError's is replaced).
         m = _QTY.match(text)
         if not m:
-            raise ValueError(text)
+            raise argparse.ArgumentTypeError(
+                f"{text!r} is not a number with an optional unit (e.g. 20um, 0.5MPa)"
+            )
         unit = m.group(2) or default_unit
+        if unit.startswith("/"):  # 40/mm means 40 1/mm
+            unit = "1" + unit
         try:
-            return float(m.group(1)) * unit_factor(unit, "value")
+            value = scaled(m.group(1), unit_factor(unit, "value"))  # 20um -> 2e-05 exactly
+            si = si_unit(unit)
         except InputError as exc:
-            raise ValueError(str(exc)) from None
+            raise argparse.ArgumentTypeError(f"{text!r}: {exc}") from None
+        if si not in compatible:
+            raise argparse.ArgumentTypeError(
+                f"{text!r}: {unit} is not a unit of this option (give {default_unit}, or "
+                f"a multiple of it)"
+            )
+        if positive and not value > 0:
+            raise argparse.ArgumentTypeError(f"{text!r}: must be > 0")
+        return value
 
     parse.__name__ = f"quantity in {default_unit or 'SI'}"
     return parse
@@ -107,8 +130,43 @@ def json_document(result: StudyResult) -> dict[str, Any]:
     }
 
 
-def write_json(path: str, doc: Mapping[str, Any]) -> Path:
-    text = json.dumps(jsonable(doc), indent=2, allow_nan=False) + "\n"
+def json_text(doc: Mapping[str, Any]) -> str:
+    """The JSON document as text (rendered before anything is written, so that a document that
+    cannot be serialised fails the run before the report lands on disk)."""
+    return json.dumps(jsonable(doc), indent=2, allow_nan=False) + "\n"
+
+
+def _first_existing(path: Path) -> Path:
+    p = path.absolute()
+    while not p.exists() and p != p.parent:
+        p = p.parent
+    return p
+
+
+def check_output_targets(*, json_out: str | None = None, report: str | None = None) -> None:
+    """Refuse output paths that cannot be written *before* a long analysis runs.
+
+    ``--report`` must be a folder (or not exist yet) below a folder; ``--json`` must not be a
+    folder. Raises :class:`~contactlab.InputError` naming the option and the path.
+    """
+    if report:
+        r = Path(report)
+        if r.exists() and not r.is_dir():
+            raise InputError(f"--report {report}: exists and is not a folder")
+        anc = _first_existing(r)
+        if not anc.is_dir():
+            raise InputError(f"--report {report}: {anc} is a file, not a folder")
+    if json_out and json_out != "-":
+        j = Path(json_out)
+        if j.is_dir():
+            raise InputError(f"--json {json_out}: is a folder; give a file name (or '-')")
+        anc = _first_existing(j.parent)
+        if not anc.is_dir():
+            raise InputError(f"--json {json_out}: {anc} is a file, not a folder")
+
+
+def write_json(path: str, doc: Mapping[str, Any] | str) -> Path:
+    text = doc if isinstance(doc, str) else json_text(doc)
     if path == "-":
         print(text, end="")
         return Path("-")

@@ -18,9 +18,11 @@ from ..manifest import entry_from_file
 from ..study import run_study
 from ._common import (
     add_progress_flags,
+    check_output_targets,
     command_line,
     describe,
     json_document,
+    json_text,
     parse_columns,
     quantity,
     write_json,
@@ -50,10 +52,15 @@ def _summary_line(row: dict, kind: str) -> str:
 
 def _handler(args: argparse.Namespace) -> int:
     columns = parse_columns(args.columns)
+    check_output_targets(json_out=args.json, report=args.report)
     entries = []
     for f in args.files:
+        if Path(f).is_dir():
+            raise InputError(f"{f}: is a folder, not a recording file (use `contactlab study`)")
         if not Path(f).is_file():
             raise InputError(f"{f}: no such file")
+        if any(Path(f).resolve() == e.path.resolve() for e in entries):
+            raise InputError(f"{f}: given twice (it would be analysed and counted twice)")
         e = entry_from_file(f, kind=args.model)
         e.columns, e.fs = columns, args.fs
         entries.append(e)
@@ -70,6 +77,7 @@ def _handler(args: argparse.Namespace) -> int:
                 print(r.analysis.report(), file=say)
         else:
             print(f"{r.entry.path}: FAILED: {r.error}", file=sys.stderr)
+    doc = json_text(json_document(result)) if args.json else None
     if args.report:
         title = f"contactlab analyze ({args.model}, {len(entries)} recording(s))"
         cmd = command_line("analyze", *args.files, "--model", args.model,
@@ -81,7 +89,7 @@ def _handler(args: argparse.Namespace) -> int:
             if p.suffix == ".html":
                 print(f"wrote {p}", file=say)
     if args.json:
-        p = write_json(args.json, json_document(result))
+        p = write_json(args.json, doc)
         if str(p) != "-":
             print(f"wrote {p}", file=say)
     return 1 if result.failures else 0
@@ -98,7 +106,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", metavar="OUT", help="write results as JSON (SI; '-' = stdout)")
     p.add_argument("--report", metavar="DIR", help="write report.html, figures and tables here")
     p.add_argument("--columns", help="column mapping, e.g. 'x=disp,F=force' (default: by name)")
-    p.add_argument("--fs", type=quantity("Hz"), help="sampling rate when a file has no time")
+    p.add_argument(
+        "--fs", type=quantity("Hz", positive=True), help="sampling rate when a file has no time"
+    )
     p.add_argument("--keep-going", action="store_true",
                    help="skip recordings that fail (exit code 1) instead of stopping")  # fmt: skip
     p.add_argument("-v", "--verbose", action="store_true", help="print each fit report")

@@ -68,8 +68,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     g.add_argument("--ac", type=quantity("1/m"), default=4e4, help="curvature (1/m)")
     g.add_argument("--amplitude", type=quantity("m"), default=20e-6,
                    help="displacement amplitude (m; e.g. 20um)")  # fmt: skip
-    g.add_argument("--frequency", type=quantity("Hz"), default=1.0, help="Hz")
-    g.add_argument("--fs", type=quantity("Hz"), default=500.0, help="sampling rate (Hz)")
+    g.add_argument("--frequency", type=quantity("Hz", positive=True), default=1.0, help="Hz")
+    g.add_argument(
+        "--fs", type=quantity("Hz", positive=True), default=500.0, help="sampling rate (Hz)"
+    )
     g.add_argument("--offset", type=quantity("N"), default=0.0, help="load-cell zero offset (N)")
     g.add_argument("--x-offset", type=quantity("m"), default=0.0,
                    help="displacement-sensor zero offset (m)")  # fmt: skip

@@ -14,15 +14,18 @@ import sys
 from ..study import run_study
 from ._common import (
     add_progress_flags,
+    check_output_targets,
     command_line,
     describe,
     json_document,
+    json_text,
     write_json,
     write_report,
 )
 
 
 def _handler(args: argparse.Namespace) -> int:
+    check_output_targets(json_out=args.json, report=args.report)
     result = run_study(args.manifest, progress=args.progress, keep_going=args.keep_going)
     for r in result.failures:
         print(f"FAILED: {r.error}", file=sys.stderr)
@@ -32,6 +35,7 @@ def _handler(args: argparse.Namespace) -> int:
     if warned:
         print(f"{len(warned)} with warnings (listed in the report): {', '.join(warned)}",
               file=sys.stderr)  # fmt: skip
+    doc = json_text(json_document(result)) if args.json else None
     cmd = command_line("study", args.manifest, "--report", args.report)
     paths = write_report(
         args.report, result, args.title, study_plots=True, progress=args.progress, command=cmd
@@ -40,7 +44,7 @@ def _handler(args: argparse.Namespace) -> int:
         if p.suffix in (".html", ".csv", ".parquet"):
             print(f"wrote {p}")
     if args.json:
-        write_json(args.json, json_document(result))
+        write_json(args.json, doc)
     return 1 if result.failures else 0
 
 

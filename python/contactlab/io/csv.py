@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import csv as _csv
 import re
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -21,10 +22,27 @@ from .recording import Recording, RecordingError, finish, resolve_columns
 from .units import split_name
 
 
-def _header(path: Path) -> tuple[list[str], str | None, int, list[str]]:
+def _encoding(path: Path) -> str:
+    """``"utf-8-sig"`` when the file's start decodes as UTF-8, else ``"latin-1"``.
+
+    Acquisition software on Windows writes headers and comments such as ``Weg [µm]`` or
+    ``# Prüfstand 2`` in a legacy 8-bit code page; read as UTF-8 those files failed with
+    'cannot be parsed as numbers'. Latin-1 decodes any byte, and its µ (0xB5) is cp1252's.
+    """
+    with open(path, "rb") as fh:
+        head = fh.read(1 << 20)
+    try:
+        head.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        if exc.start < len(head) - 4:  # not merely a character cut at the end of the block
+            return "latin-1"
+    return "utf-8-sig"
+
+
+def _header(path: Path, enc: str = "utf-8-sig") -> tuple[list[str], str | None, int, list[str]]:
     """Column names, delimiter (None = whitespace), 0-based header line, comment lines."""
     comments: list[str] = []
-    with open(path, encoding="utf-8-sig", errors="replace") as fh:
+    with open(path, encoding=enc, errors="replace") as fh:
         for lineno, line in enumerate(fh):
             s = line.strip()
             if not s:
@@ -49,12 +67,14 @@ def _header(path: Path) -> tuple[list[str], str | None, int, list[str]]:
 _DECIMAL_COMMA = re.compile(r"^\s*[+-]?\d+,\d*(?:[eE][+-]?\d+)?\s*$")
 
 
-def _decimal_comma(path: Path, delim: str | None, first_data_line: int) -> bool:
+def _decimal_comma(
+    path: Path, delim: str | None, first_data_line: int, enc: str = "utf-8-sig"
+) -> bool:
     """Whether numbers are written with a decimal comma (``1,5``; European locales), judged
     from the first data line. Only possible when the delimiter is not a comma."""
     if delim == ",":
         return False
-    with open(path, encoding="utf-8-sig", errors="replace") as fh:
+    with open(path, encoding=enc, errors="replace") as fh:
         for lineno, line in enumerate(fh):
             if lineno < first_data_line or not line.strip() or line.lstrip().startswith("#"):
                 continue
@@ -63,13 +83,13 @@ def _decimal_comma(path: Path, delim: str | None, first_data_line: int) -> bool:
     return False
 
 
-def _line_of_sample(path: Path, first_data_line: int, index: int) -> int:
+def _line_of_sample(path: Path, first_data_line: int, index: int, enc: str = "utf-8-sig") -> int:
     """1-based line of the file holding data row ``index`` (blank and ``#`` lines skipped).
 
     Called only to word an error, so the extra pass over the file costs nothing normally.
     """
     k = -1
-    with open(path, encoding="utf-8-sig", errors="replace") as fh:
+    with open(path, encoding=enc, errors="replace") as fh:
         for lineno, line in enumerate(fh):
             if lineno < first_data_line or not line.strip() or line.lstrip().startswith("#"):
                 continue
@@ -86,9 +106,10 @@ def _locate_bad_cell(
     cols: list[int],
     names: list[str],
     comma: bool = False,
+    enc: str = "utf-8-sig",
 ) -> RecordingError:
     """Scan the file to find the first cell that is not a number."""
-    with open(path, encoding="utf-8-sig", errors="replace") as fh:
+    with open(path, encoding=enc, errors="replace") as fh:
         for lineno, line in enumerate(fh):
             if lineno < first_data_line or not line.strip() or line.lstrip().startswith("#"):
                 continue
@@ -129,7 +150,8 @@ def read_csv(
     """
     path = Path(path)
     file = str(path)
-    names, delim, header_line, comments = _header(path)
+    enc = _encoding(path)
+    names, delim, header_line, comments = _header(path, enc)
     if len(set(names)) != len(names):
         dup = next(n for n in names if names.count(n) > 1)
         raise RecordingError("column name appears twice in the header", file=file, column=dup)
@@ -137,22 +159,32 @@ def read_csv(
     canon = list(mapping)
     idx = [names.index(mapping[c]) for c in canon]
     first_data = header_line + 1
-    comma = _decimal_comma(path, delim, first_data)
+    comma = _decimal_comma(path, delim, first_data, enc)
     try:
-        block = np.loadtxt(
-            path,
-            delimiter=delim,
-            skiprows=first_data,
-            usecols=idx,
-            ndmin=2,
-            comments="#",
-            dtype=np.float64,
-            encoding="utf-8-sig",
-            quotechar='"',
-            converters=(lambda v: float(v.replace(",", "."))) if comma else None,
-        )
+        with warnings.catch_warnings():
+            # A header without data rows is reported below as an error of its own; numpy's
+            # "input contained no data" UserWarning would only add noise before it.
+            warnings.filterwarnings("ignore", message="loadtxt: input contained no data")
+            block = np.loadtxt(
+                path,
+                delimiter=delim,
+                skiprows=first_data,
+                usecols=idx,
+                ndmin=2,
+                comments="#",
+                dtype=np.float64,
+                encoding=enc,
+                quotechar='"',
+                converters=(lambda v: float(v.replace(",", "."))) if comma else None,
+            )
+    except UnicodeDecodeError as exc:  # a non-UTF-8 byte after the block _encoding looked at
+        raise RecordingError(
+            f"byte {exc.object[exc.start : exc.start + 1]!r} is not {enc} text; save the file "
+            "as UTF-8",
+            file=file,
+        ) from None
     except ValueError:
-        raise _locate_bad_cell(path, delim, first_data, idx, names, comma) from None
+        raise _locate_bad_cell(path, delim, first_data, idx, names, comma, enc) from None
     if block.shape[0] == 0:
         raise RecordingError("header but no data rows", file=file)
     raw = {c: np.ascontiguousarray(block[:, j]) for j, c in enumerate(canon)}
@@ -164,12 +196,13 @@ def read_csv(
         kind=kind,
         file=file,
         fs=fs,
-        row_of=lambda i: _line_of_sample(path, first_data, i),
+        row_of=lambda i: _line_of_sample(path, first_data, i, enc),
         meta={
             "format": "csv",
             "comments": comments,
             "delimiter": delim or "whitespace",
             "decimal": "," if comma else ".",
+            "encoding": enc,
         },
     )
 

@@ -16,7 +16,7 @@ import numpy as np
 
 from .._io_atomic import atomic_path
 from ..errors import InputError
-from .recording import Recording, RecordingError, finish, resolve_columns
+from .recording import Recording, RecordingError, finish, real_values, resolve_columns
 
 
 def _h5py() -> Any:
@@ -61,7 +61,7 @@ def vector(ds: Any, *, file: str, column: str) -> np.ndarray:
         raise RecordingError(
             f"dataset has shape {shape}; a channel must be a vector", file=file, column=column
         )
-    return np.asarray(ds[()], dtype=np.float64).reshape(-1)
+    return real_values(ds[()], file=file, column=column).reshape(-1)
 
 
 def unit_attr(ds: Any) -> str | None:

@@ -16,7 +16,7 @@ import scipy.io
 
 from .._io_atomic import atomic_path
 from .hdf5 import _h5py, _text, vector
-from .recording import Recording, RecordingError, finish, resolve_columns
+from .recording import Recording, RecordingError, finish, real_values, resolve_columns
 from .sniff import content_format
 from .units import split_name
 
@@ -44,7 +44,7 @@ def _read_v5(path: Path, file: str, columns: Any, kind: Any) -> tuple[Any, ...]:
     d = scipy.io.loadmat(path, variable_names=[*names, *extra], squeeze_me=True)
     raw = {}
     for c, n in mapping.items():
-        a = np.asarray(d[n], dtype=np.float64)
+        a = real_values(d[n], file=file, column=n)
         if a.ndim > 1:
             raise RecordingError(
                 f"variable has shape {a.shape}; a channel must be a vector", file=file, column=n

@@ -23,10 +23,20 @@ KIND_CHANNELS = {"tangential": ("x", "F"), "normal": ("p", "delta")}
 #: names recognised (case-insensitive, unit stripped) for each canonical channel, best first
 ALIASES: dict[str, tuple[str, ...]] = {
     "t": ("t", "time", "zeit", "timestamp", "time_s", "times"),
-    "x": ("x", "disp", "displacement", "u", "x_t", "tangential displacement", "s", "ux"),
-    "F": ("f", "force", "ft", "f_t", "friction", "friction force", "h", "tangential force"),
-    "p": ("p", "pressure", "contact pressure", "sigma", "p_n"),
-    "delta": ("delta", "δ", "d", "normal displacement", "disp", "displacement", "dn"),
+    "x": ("x", "disp", "displacement", "u", "x_t", "tangential displacement", "s", "ux", "weg"),
+    "F": (
+        "f",
+        "force",
+        "ft",
+        "f_t",
+        "friction",
+        "friction force",
+        "h",
+        "tangential force",
+        "kraft",
+    ),
+    "p": ("p", "pressure", "contact pressure", "sigma", "p_n", "druck"),
+    "delta": ("delta", "δ", "d", "normal displacement", "disp", "displacement", "dn", "weg"),
 }
 
 
@@ -261,6 +271,18 @@ def unit_factor(
 RowOf = Callable[[int], int]
 
 
+def real_values(values: Any, *, file: str, column: str) -> np.ndarray:
+    """A channel's values as float64; complex or non-numeric data is a :class:`RecordingError`
+    (numpy would drop an imaginary part with only a ``ComplexWarning``)."""
+    a = np.asarray(values)
+    if np.iscomplexobj(a):
+        raise RecordingError("complex values; a channel must be real", file=file, column=column)
+    try:
+        return np.asarray(a, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise RecordingError(f"values are not numeric ({exc})", file=file, column=column) from None
+
+
 def _plain(i: int) -> int:
     return i
 
@@ -278,7 +300,7 @@ def check_time(t: np.ndarray, *, file: str, column: str, row_of: RowOf = _plain)
         i = int(bad[0]) + 1
         what = "duplicated" if d[bad[0]] == 0 else "unsorted (goes back in time)"
         raise RecordingError(
-            f"time stamp {t[i]!r} is {what}; previous is {t[i - 1]!r}",
+            f"time stamp {float(t[i]):.9g} s is {what}; previous is {float(t[i - 1]):.9g} s",
             file=file,
             column=column,
             row=row_of(i),
@@ -312,7 +334,7 @@ def check_finite(a: np.ndarray, *, file: str, column: str, row_of: RowOf = _plai
     if bad.any():
         i = int(np.argmax(bad))
         raise RecordingError(
-            f"value {a[i]!r} is not a finite number", file=file, column=column, row=row_of(i)
+            f"value {float(a[i])} is not a finite number", file=file, column=column, row=row_of(i)
         )
 
 

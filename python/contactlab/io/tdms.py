@@ -15,7 +15,7 @@ import numpy as np
 
 from .._io_atomic import atomic_path
 from ..errors import InputError
-from .recording import Recording, RecordingError, finish, resolve_columns
+from .recording import Recording, RecordingError, finish, real_values, resolve_columns
 
 
 def _nptdms() -> Any:
@@ -41,11 +41,14 @@ def read_tdms(
     nptdms = _nptdms()
     path = Path(path)
     file = str(path)
+    # Our own handle: npTDMS leaks the one it opens when parsing fails (ResourceWarning).
+    fh = open(path, "rb")
     try:
-        tf = nptdms.TdmsFile.open(path)
+        tf = nptdms.TdmsFile.open(fh)
     except Exception as exc:  # npTDMS raises plain ValueError/KeyError on corrupt files
+        fh.close()
         raise RecordingError(f"not a readable TDMS file ({exc})", file=file) from None
-    with tf:
+    with tf, fh:
         chans: dict[str, Any] = {}
         for g in tf.groups():
             for ch in g.channels():
@@ -56,13 +59,7 @@ def read_tdms(
         units: dict[str, str | None] = {}
         for canon, name in mapping.items():
             ch = chans[name]
-            try:
-                values = np.asarray(ch[:], dtype=np.float64)
-            except (TypeError, ValueError) as exc:
-                raise RecordingError(
-                    f"channel is not numeric ({exc})", file=file, column=name
-                ) from None
-            raw[canon] = values
+            raw[canon] = real_values(ch[:], file=file, column=name)
             u = ch.properties.get("unit_string")
             units[canon] = str(u) if u not in (None, "") else None
         lengths = {mapping[c]: v.size for c, v in raw.items()}

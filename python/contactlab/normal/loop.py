@@ -349,6 +349,11 @@ def analyze_loop(
     if isinstance(degree, bool) or not isinstance(degree, (int, np.integer)) or degree < 1:
         raise InputError(f"degree must be an integer >= 1, got {degree!r}")
     degree = int(degree)
+    if not np.ptp(dv) > 0:
+        raise InputError(
+            f"delta is constant ({float(dv[0]):g} m): the displacement sensor recorded no motion, "
+            "so there is no loop to analyse"
+        )
 
     dts = np.diff(tv)
     dt = float(np.median(dts))

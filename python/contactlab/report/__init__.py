@@ -7,13 +7,22 @@ set of files all or nothing, so a failed or interrupted run leaves the output fo
 from __future__ import annotations
 
 from ._outputs import commit_outputs
-from .html import Column, Report, figure_png, format_value, slugify, table_html
+from .html import (
+    Column,
+    Report,
+    figure_png,
+    format_measurement,
+    format_value,
+    slugify,
+    table_html,
+)
 
 __all__ = [
     "Column",
     "Report",
     "commit_outputs",
     "figure_png",
+    "format_measurement",
     "format_value",
     "slugify",
     "table_html",

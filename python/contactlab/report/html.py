@@ -66,6 +66,43 @@ def format_value(value: Any, digits: int = 4) -> str:
     return str(value)
 
 
+def format_measurement(value: float, stderr: float, digits: int = 2) -> str:
+    """``value ± stderr`` with the uncertainty to ``digits`` significant digits and the value
+    rounded to the same decimal place, as measurements are written.
+
+    Printing the value to a fixed number of significant digits instead gives cells such as
+    ``5.764e-14 ± 0.00068``, which claims 14 decimals for a value known to 4, or
+    ``2.669 ± 0.00084``, which hides the digits the fit did determine.
+
+    Examples
+    --------
+    >>> format_measurement(5.764e-14, 0.00068)
+    '0.00000 ± 0.00068'
+    >>> format_measurement(2.66912, 0.00084)
+    '2.66912 ± 0.00084'
+    >>> format_measurement(75.512, 0.38)
+    '75.51 ± 0.38'
+    >>> format_measurement(1588123.0, 840.0)
+    '(1.58812 ± 0.00084)e+06'
+    """
+    v, s = float(value), abs(float(stderr))
+    if not math.isfinite(v):
+        return format_value(v)
+    if not math.isfinite(s) or s == 0.0:
+        return f"{format_value(v)} ± {format_value(s, digits)}"
+    last = math.floor(math.log10(s)) - (digits - 1)  # decimal exponent of the last digit shown
+    big = max(abs(v), s)
+    if -8 <= last <= 0 and big < 1e6:
+        d = -last
+        if round(v, d) == 0.0:
+            v = 0.0  # no "-0.00000"
+        return f"{v:.{d}f} ± {s:.{d}f}"
+    # Very large or very small: one common power of ten.
+    e = math.floor(math.log10(big))
+    d = max(e - last, 0)
+    return f"({v / 10.0**e:.{d}f} ± {s / 10.0**e:.{d}f})e{e:+03d}"
+
+
 @dataclass
 class Column:
     """One table column: ``key`` in the rows, header ``label``, display ``scale`` and ``unit``.
@@ -92,7 +129,7 @@ class Column:
         if self.stderr is not None and numeric:
             s = row.get(self.stderr)
             if isinstance(s, (int, float)) and not isinstance(s, bool):
-                text += " ± " + format_value(abs(float(s)) * self.scale, 2)
+                text = format_measurement(float(v), float(s) * self.scale)
         return text, numeric
 
 

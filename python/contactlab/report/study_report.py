@@ -28,7 +28,9 @@ TANGENTIAL_COLUMNS = [
     Column("ac", "ac", "1/mm", 1e-3, stderr="ac_stderr"),
     Column("h0_ac", "h0·ac", "N/µm", 1e-6, stderr="h0_ac_stderr"),
     Column("energy_per_cycle", "E", "µJ", 1e6, stderr="energy_per_cycle_stderr"),
-    Column("energy_per_cycle_numeric", "E numeric", "µJ", 1e6),
+    Column(
+        "energy_per_cycle_numeric", "E numeric", "µJ", 1e6, stderr="energy_per_cycle_numeric_stderr"
+    ),
     Column("equivalent_damping", "c_e·ω", "N/µm", 1e-6, stderr="equivalent_damping_stderr"),
     Column("k_local0", "k_l(0)", "N/µm", 1e-6, stderr="k_local0_stderr"),
     Column("k_global", "k_g(A)", "N/µm", 1e-6, stderr="k_global_stderr"),
@@ -50,10 +52,10 @@ NORMAL_COLUMNS = [
     Column("k_sec", "k_sec", "MPa/µm", 1e-12),
     Column("delta_min", "δ_min", "µm", 1e6),
     Column("delta_max", "δ_max", "µm", 1e6),
-    Column("b1_paper", "b1 (MPa, µm)"),
-    Column("b2_paper", "b2 (MPa, µm)"),
-    Column("b3_paper", "b3 (MPa, µm)"),
-    Column("b4_paper", "b4 [MPa/µm]"),
+    Column("b1_paper", "b1", "µm⁻¹·MPa⁻²"),
+    Column("b2_paper", "b2", "µm⁻¹·MPa⁻¹"),
+    Column("b3_paper", "b3", "µm⁻¹"),
+    Column("b4_paper", "b4", "MPa/µm"),
 ]
 
 

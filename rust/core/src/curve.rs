@@ -56,29 +56,27 @@ impl Exponential {
     }
 }
 
-/// `z - (1 - e^-z) - z (1 - e^-z) / 2`, the chord area of `1 - e^-u` on `[0, z]`,
-/// computed without cancellation for small `z` (series `Σ (-1)^m z^m (2 - m) / (2 m!)`).
-fn exp_chord_area_unit(z: f64) -> f64 {
-    if z < 2.0 {
-        // Terms from m = 3; the m = 2 term vanishes.
-        let mut term = z * z * z / 6.0; // z^m / m! at m = 3
-        let mut sum = 0.0;
-        let mut m = 3.0_f64;
-        loop {
-            let t = term * (m - 2.0) * 0.5;
-            let signed = if (m as i64) % 2 == 0 { t } else { -t };
-            sum -= signed;
-            if t < 1e-18 * sum.abs() || m > 60.0 {
-                break;
-            }
-            m += 1.0;
-            term *= z / m;
+/// `S(z) = [z - (1 - e^-z) - z (1 - e^-z) / 2] / z³` for `0 <= z < 2`: the chord area of
+/// `1 - e^-u` on `[0, z]` divided by `z³`, by its series `Σ_{m>=3} (-1)^{m+1} (m - 2) z^(m-3) /
+/// (2 m!)` (no cancellation; `S(0) = 1/12`). Dividing out `z³` keeps the chord area finite
+/// when `z` is so small that `z³` underflows (ac → 0 with h0·ac fixed, where fits of nearly
+/// linear loops go).
+fn exp_chord_area_unit_over_z3(z: f64) -> f64 {
+    debug_assert!((0.0..2.0).contains(&z));
+    let mut term = 1.0 / 6.0; // z^(m-3) / m! at m = 3
+    let mut sum = 0.0;
+    let mut m = 3.0_f64;
+    loop {
+        let t = term * (m - 2.0) * 0.5;
+        let signed = if (m as i64) % 2 == 0 { t } else { -t };
+        sum -= signed;
+        if t < 1e-18 * sum.abs() || m > 60.0 {
+            break;
         }
-        sum
-    } else {
-        let g = one_minus_exp_neg(z);
-        z - g - 0.5 * z * g
+        m += 1.0;
+        term *= z / m;
     }
+    sum
 }
 
 impl Backbone for Exponential {
@@ -94,7 +92,16 @@ impl Backbone for Exponential {
         self.h0 * (u - one_minus_exp_neg(self.ac * u) / self.ac)
     }
     fn chord_area(&self, u: f64) -> f64 {
-        self.h0 / self.ac * exp_chord_area_unit(self.ac * u.abs())
+        let u = u.abs();
+        let z = self.ac * u;
+        if z < 2.0 {
+            // (h0/ac) z³ S(z) written as (h0 ac) z u² S(z): h0/ac and z³ over/underflow when
+            // ac is tiny and h0 huge (h0 ac finite), which gave NaN or 0 instead of E.
+            (self.h0 * self.ac) * z * u * u * exp_chord_area_unit_over_z3(z)
+        } else {
+            let g = one_minus_exp_neg(z);
+            self.h0 / self.ac * (z - g - 0.5 * z * g)
+        }
     }
 }
 
@@ -322,10 +329,31 @@ mod tests {
 
     #[test]
     fn chord_area_series_and_direct_agree_at_switch() {
-        let below = exp_chord_area_unit(2.0 - 1e-12);
+        let z = 2.0 - 1e-12;
+        let below = z * z * z * exp_chord_area_unit_over_z3(z);
         let g = one_minus_exp_neg(2.0);
         let direct = 2.0 - g - g;
         assert!((below - direct).abs() < 1e-12);
+        let c = Exponential::new(3.0, 5.0).unwrap();
+        let (lo, hi) = (c.chord_area(0.4 - 1e-13), c.chord_area(0.4 + 1e-13));
+        assert!((lo / hi - 1.0).abs() < 1e-11);
+    }
+
+    #[test]
+    fn loop_energy_stays_finite_when_ac_is_tiny_and_h0_huge() {
+        // h0 ac = 1e6 N/m fixed while ac -> 0: E -> (2/3) h0 ac² A³ = (2/3) (h0 ac) (ac A) A².
+        // h0/ac and (ac A)³ over/underflowed here (NaN for h0 >= 1e155, 0 near 1e150).
+        let a = 2.5e-7;
+        for e in [0, 50, 100, 150, 160, 200, 250, 300] {
+            let ac = 10f64.powi(-e) * 1.0;
+            let c = Exponential::new(1e6 / ac, ac).unwrap();
+            let want = 2.0 / 3.0 * (c.h0 * c.ac) * (c.ac * a) * a * a;
+            let got = c.loop_energy(a);
+            assert!(
+                got.is_finite() && (got / want - 1.0).abs() < 1e-6,
+                "{e}: {got} vs {want}"
+            );
+        }
     }
 
     #[test]
