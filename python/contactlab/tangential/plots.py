@@ -85,6 +85,8 @@ def plot_residuals(analysis: TangentialAnalysis, ax: Any = None) -> Any:
         ax.set_xlabel("time (s)" if a.t is not None else "sample")
     ax.axhline(0.0, color="k", lw=0.8)
     ax.set_ylabel("residual F − fit (N)")
-    ax.set_title(f"χ²_red = {a.fit.redchi:.3g}, {a.fit.ndata} points", fontsize=9)
+    # redchi is the unweighted residual variance (N²); show its root, in newtons.
+    s_res = np.sqrt(a.fit.redchi) if np.isfinite(a.fit.redchi) else np.nan
+    ax.set_title(f"residual RMS s = {s_res:.3g} N, {a.fit.ndata} points", fontsize=9)
     ax.grid(True, alpha=0.3)
     return ax
