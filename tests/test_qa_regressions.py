@@ -388,3 +388,18 @@ def test_python_dash_m_contactlab():
     r = subprocess.run([sys.executable, "-m", "contactlab", "--version"], capture_output=True,
                        text=True, timeout=60)  # fmt: skip
     assert r.returncode == 0 and r.stdout.startswith("contactlab ")
+
+
+def test_diagnose_cli_names_the_file_when_the_recording_is_too_short(tmp_path, capsys):
+    from contactlab.cli import main
+    from contactlab.io import write_recording
+    from contactlab.tangential import synthetic_recording
+
+    rec = synthetic_recording(h0=40.0, ac=4e4, amplitude=20e-6, n_cycles=2, fs=400.0, seed=2)
+    path = tmp_path / "short_run.csv"
+    write_recording(path, rec)
+    out = tmp_path / "out.json"
+    assert main(["diagnose", str(path), "--model", "tangential", "--json", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "short_run.csv" in err and "cycles" in err
+    assert not out.exists()

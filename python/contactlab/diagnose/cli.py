@@ -39,11 +39,15 @@ def add_parser(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..errors import InputError
     from ..io import read_recording
     from .workflow import diagnose
 
     rec = read_recording(args.file, kind=args.model)
-    report = diagnose(rec, model=args.model, max_effects=args.max_effects)
+    try:
+        report = diagnose(rec, model=args.model, max_effects=args.max_effects)
+    except InputError as exc:  # name the file: the workflow only sees arrays
+        raise InputError(f"{args.file}: {exc}") from exc
     print(report.summary())
     if args.json:
         write_text(args.json, report.to_json() + "\n")

@@ -319,7 +319,8 @@ def average_loop(
     if n_cyc < min_cycles:
         raise InputError(
             f"only {n_cyc} complete cycle(s) (peak to peak) found with a reversal band of "
-            f"±{rev.threshold:.3g} around {rev.centre:.3g}; at least {min_cycles} are needed"
+            f"±{rev.threshold:.3g} m around x = {rev.centre:.3g} m; "
+            f"at least {min_cycles} are needed"
         )
     ph, start, end = phase_of(ta, rev)
     cyc = np.floor(ph).astype(np.int64)
