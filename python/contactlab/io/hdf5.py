@@ -16,7 +16,15 @@ import numpy as np
 
 from .._io_atomic import atomic_path
 from ..errors import InputError
-from .recording import Recording, RecordingError, finish, real_values, resolve_columns
+from .recording import (
+    Recording,
+    RecordingError,
+    check_equal_lengths,
+    finish,
+    real_values,
+    resolve_columns,
+    time_from_interval,
+)
 
 
 def _h5py() -> Any:
@@ -107,16 +115,13 @@ def read_hdf5(
         kind, mapping = resolve_columns(names, columns=columns, kind=kind, file=file)
         raw = {c: vector(dsets[n], file=file, column=n) for c, n in mapping.items()}
         units = {c: unit_attr(dsets[n]) for c, n in mapping.items()}
-        lengths = {mapping[c]: v.size for c, v in raw.items()}
-        if len(set(lengths.values())) > 1:
-            raise RecordingError(f"channels differ in length: {lengths}", file=file)
+        check_equal_lengths(raw, mapping, file=file)
         t_fallback = None
         if "t" not in raw and fs is None:
             dt = _dt_attr([dsets[n] for c, n in mapping.items()] + [f])
             if dt is not None:
-                if not np.isfinite(dt) or dt <= 0:
-                    raise RecordingError(f"sampling interval {dt} is not > 0", file=file)
-                t_fallback = dt * np.arange(next(iter(raw.values())).size, dtype=np.float64)
+                n = next(iter(raw.values())).size
+                t_fallback = time_from_interval(dt, n, file=file)
         return finish(
             raw,
             mapping,

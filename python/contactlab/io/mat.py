@@ -16,7 +16,15 @@ import scipy.io
 
 from .._io_atomic import atomic_path
 from .hdf5 import _h5py, _text, vector
-from .recording import Recording, RecordingError, finish, real_values, resolve_columns
+from .recording import (
+    Recording,
+    RecordingError,
+    check_equal_lengths,
+    finish,
+    real_values,
+    resolve_columns,
+    time_from_interval,
+)
 from .sniff import content_format
 from .units import split_name
 
@@ -115,14 +123,11 @@ def read_mat(
     v73 = content_format(path) == "mat73"
     reader = _read_v73 if v73 else _read_v5
     kind, mapping, raw, units, dt = reader(path, file, columns, kind)
-    lengths = {mapping[c]: v.size for c, v in raw.items()}
-    if len(set(lengths.values())) > 1:
-        raise RecordingError(f"variables differ in length: {lengths}", file=file)
+    check_equal_lengths(raw, mapping, file=file, what="variables")
     t_fallback = None
     if "t" not in raw and fs is None and dt is not None:
-        if not np.isfinite(dt) or dt <= 0:
-            raise RecordingError(f"sampling interval dt = {dt} is not > 0", file=file)
-        t_fallback = dt * np.arange(next(iter(raw.values())).size, dtype=np.float64)
+        n = next(iter(raw.values())).size
+        t_fallback = time_from_interval(dt, n, file=file, name="sampling interval dt =")
     return finish(
         raw,
         mapping,

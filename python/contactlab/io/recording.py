@@ -338,6 +338,30 @@ def check_finite(a: np.ndarray, *, file: str, column: str, row_of: RowOf = _plai
         )
 
 
+def check_equal_lengths(
+    raw: dict[str, np.ndarray], names: dict[str, str], *, file: str, what: str = "channels"
+) -> None:
+    """Raise naming each channel's length unless all channels of ``raw`` have the same."""
+    lengths = {names[c]: v.size for c, v in raw.items()}
+    if len(set(lengths.values())) > 1:
+        raise RecordingError(f"{what} differ in length: {lengths}", file=file)
+
+
+def time_from_interval(
+    dt: float,
+    n: int,
+    *,
+    file: str,
+    t0: float = 0.0,
+    name: str = "sampling interval",
+    column: str | None = None,
+) -> np.ndarray:
+    """``t0 + dt·[0, n)`` for a file that stores a sampling interval instead of a time column."""
+    if not np.isfinite(dt) or dt <= 0:
+        raise RecordingError(f"{name} {dt} is not a positive time step", file=file, column=column)
+    return t0 + dt * np.arange(n, dtype=np.float64)
+
+
 def finish(
     raw: dict[str, np.ndarray],
     names: dict[str, str],

@@ -15,7 +15,15 @@ import numpy as np
 
 from .._io_atomic import atomic_path
 from ..errors import InputError
-from .recording import Recording, RecordingError, finish, real_values, resolve_columns
+from .recording import (
+    Recording,
+    RecordingError,
+    check_equal_lengths,
+    finish,
+    real_values,
+    resolve_columns,
+    time_from_interval,
+)
 
 
 def _nptdms() -> Any:
@@ -62,24 +70,17 @@ def read_tdms(
             raw[canon] = real_values(ch[:], file=file, column=name)
             u = ch.properties.get("unit_string")
             units[canon] = str(u) if u not in (None, "") else None
-        lengths = {mapping[c]: v.size for c, v in raw.items()}
-        if len(set(lengths.values())) > 1:
-            raise RecordingError(f"channels differ in length: {lengths}", file=file)
+        check_equal_lengths(raw, mapping, file=file)
         t_fallback = None
         if "t" not in raw:
             ref = chans[mapping[next(c for c in mapping if c != "t")]]
             inc = ref.properties.get("wf_increment")
             if inc is not None and fs is None:
-                inc = float(inc)
-                if not np.isfinite(inc) or inc <= 0:
-                    raise RecordingError(
-                        f"wf_increment {inc} is not a positive time step",
-                        file=file,
-                        column=ref.name,
-                    )
                 t0 = float(ref.properties.get("wf_start_offset", 0.0) or 0.0)
                 n = next(iter(raw.values())).size
-                t_fallback = t0 + inc * np.arange(n, dtype=np.float64)
+                t_fallback = time_from_interval(
+                    float(inc), n, file=file, t0=t0, name="wf_increment", column=ref.name
+                )
         return finish(
             raw,
             mapping,
