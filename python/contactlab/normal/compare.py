@@ -256,32 +256,29 @@ def _window(c: Comparison, cycles: float) -> np.ndarray:
 _STYLE = ["-", "--", "-.", ":"]
 
 
-def plot_displacement(c: Comparison, ax: Any = None, cycles: float = 2.0) -> Any:
-    """Displacement time runs, measured and modelled (Fig. 9)."""
+def _time_run(c: Comparison, ax: Any, cycles: float, key: str, ylabel: str) -> Any:
+    """Measured and modelled time runs of ``key`` (``delta`` or ``velocity``), in µm units."""
     fig, ax = _axes(ax)
     w = _window(c, cycles)
-    ax.plot(c.t[w], c.delta[w] * 1e6, color="0.3", lw=1.0, label="measurement")
+    measured = c.delta if key == "delta" else c.velocity
+    ax.plot(c.t[w], measured[w] * 1e6, color="0.3", lw=1.0, label="measurement")
     for i, (name, s) in enumerate(c.models.items()):
-        ax.plot(c.t[w], s["delta"][w] * 1e6, _STYLE[i % 4], lw=1.4, label=name)
+        ax.plot(c.t[w], s[key][w] * 1e6, _STYLE[i % 4], lw=1.4, label=name)
     ax.set_xlabel("t [s]")
-    ax.set_ylabel("δ [µm]")
+    ax.set_ylabel(ylabel)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     return fig
+
+
+def plot_displacement(c: Comparison, ax: Any = None, cycles: float = 2.0) -> Any:
+    """Displacement time runs, measured and modelled (Fig. 9)."""
+    return _time_run(c, ax, cycles, "delta", "δ [µm]")
 
 
 def plot_velocity(c: Comparison, ax: Any = None, cycles: float = 2.0) -> Any:
     """Velocity time runs (Fig. 10)."""
-    fig, ax = _axes(ax)
-    w = _window(c, cycles)
-    ax.plot(c.t[w], c.velocity[w] * 1e6, color="0.3", lw=1.0, label="measurement")
-    for i, (name, s) in enumerate(c.models.items()):
-        ax.plot(c.t[w], s["velocity"][w] * 1e6, _STYLE[i % 4], lw=1.4, label=name)
-    ax.set_xlabel("t [s]")
-    ax.set_ylabel("v = dδ/dt [µm/s]")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    return fig
+    return _time_run(c, ax, cycles, "velocity", "v = dδ/dt [µm/s]")
 
 
 def plot_phase_portrait(c: Comparison, ax: Any = None, cycles: float = 1.0) -> Any:
