@@ -276,23 +276,6 @@ fn loop_area_py(
     detach_guarded(py, || masing::loop_area(xs, fs))
 }
 
-/// Analytic loop energy `E(A)` of the exponential curve (λ = 2), vectorised over `a`.
-#[pyfunction]
-fn exp_loop_energy<'py>(
-    py: Python<'py>,
-    h0: f64,
-    ac: f64,
-    a: PyReadonlyArray1<'py, f64>,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let c = Exponential::new(h0, ac).map_err(|e| to_pyerr(py, &e))?;
-    let av = slice(&a, "A")?;
-    let out = detach_guarded(py, || {
-        contactlab_core::error::check_finite("A", av)?;
-        Ok(av.iter().map(|&v| c.loop_energy(v)).collect::<Vec<f64>>())
-    })?;
-    Ok(out.into_pyarray(py))
-}
-
 static VERSION: PyOnceLock<String> = PyOnceLock::new();
 
 #[pymodule]
@@ -304,7 +287,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     m.add_class::<MasingCore>()?;
     m.add_function(wrap_pyfunction!(loop_area_py, m)?)?;
-    m.add_function(wrap_pyfunction!(exp_loop_energy, m)?)?;
     normal::register(m)?;
     Ok(())
 }
