@@ -20,8 +20,8 @@ _VERB_MODULES = [
     "contactlab.commands.analyze",
     "contactlab.commands.study",
     "contactlab.commands.simulate",
-    "contactlab.demo",
-    "contactlab.diagnose.cli",
+    "contactlab.commands.demo",
+    "contactlab.commands.diagnose",
 ]
 
 
