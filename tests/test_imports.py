@@ -61,3 +61,23 @@ def test_version_has_one_home_matching_pyproject():
     version = re.search(r'^version = "([^"]+)"', pyproject.read_text(), re.MULTILINE)
     assert version is not None
     assert contactlab.__version__ == __version__ == version.group(1)
+
+
+def test_data_generator_command_still_runs_from_the_data_package():
+    done = subprocess.run(
+        [sys.executable, "-m", "contactlab.data.generate", "--help"],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
+    assert "usage: python -m contactlab.data.generate" in done.stdout
+    assert "--no-normal" in done.stdout
+    from contactlab import _datagen
+    from contactlab.data import generate
+
+    assert generate.generate is _datagen.generate
+
+
+def test_importing_the_data_package_loads_no_model():
+    loaded = _modules_after("import contactlab.data")
+    assert not {"contactlab.masing", "contactlab.normal", "contactlab.io", "numpy"} & loaded
