@@ -11,13 +11,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..study import RecordingResult, StudyResult
 from ..study_plots import display_unit, normal_study_figures, tangential_study_figures, trends
 from .html import Column, Report
+
+if TYPE_CHECKING:  # annotations only: the study imports this module's columns at run time
+    from ..study import RecordingResult, StudyResult
 
 TANGENTIAL_COLUMNS = [
     Column("file"),
