@@ -1,8 +1,8 @@
 """Studies over many recordings: one table of fitted parameters against load and amplitude.
 
 Issue 4 ("Studies over many recordings"). Each recording of a study (tagged by a manifest or by
-its file name, see :mod:`contactlab.studies.manifest`) is read, analysed — tangential recordings with
-:func:`contactlab.tangential.analyze_tangential` (h0, ac, E per cycle analytic and numeric,
+its file name, see :mod:`contactlab.studies.manifest`) is read, analysed — tangential recordings
+with :func:`contactlab.tangential.analyze_tangential` (h0, ac, E per cycle analytic and numeric,
 c_e·ω = E/(πA²), local and global stiffness, eqs. 8-19 of the tangential paper), normal ones
 with :func:`contactlab.normal.analyze_loop` (E_d, ψ eqs. 3 and 7, k_tan eq. 4, k_sec eq. 5) and
 the pressure-dependent stiffness of eq. 16 (b1..b4) — and becomes one row of a table in SI
