@@ -13,6 +13,7 @@ from .errors import ContactLabError, ContactLabWarning, ConvergenceError, InputE
 from .fitting import FitResult, Parameter, least_squares_fit
 from .io import Recording, RecordingError, read_recording, write_recording
 from .masing import CycleTable, Masing, MasingOperator, cycle_energies, loop_area
+from .studies.track import TrackResult, track
 from .tangential import TangentialAnalysis, analyze_tangential
 
 __version__ = "0.1.0"
@@ -30,6 +31,7 @@ __all__ = [
     "Recording",
     "RecordingError",
     "TangentialAnalysis",
+    "TrackResult",
     "__version__",
     "analyze_tangential",
     "cycle_energies",
@@ -38,5 +40,6 @@ __all__ = [
     "loop_area",
     "normal",
     "read_recording",
+    "track",
     "write_recording",
 ]

@@ -19,16 +19,20 @@ from .study import (
     collect_entries,
     run_study,
 )
+from .track import TrackResult, parse_every, track
 
 __all__ = [
     "KINDS",
     "RecordingResult",
     "StudyEntry",
     "StudyResult",
+    "TrackResult",
     "analyze_entry",
     "collect_entries",
     "entry_from_file",
+    "parse_every",
     "read_manifest",
     "run_study",
     "tags_from_filename",
+    "track",
 ]
