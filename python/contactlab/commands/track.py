@@ -86,8 +86,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         description=describe(__doc__),
     )
     p.add_argument("file", metavar="FILE", help="recording (.csv .tdms .h5 .mat)")
-    p.add_argument("--every", default="100cycles",
-                   help="window length: '100cycles' or a time, '10s' (default 100cycles)")  # fmt: skip
+    p.add_argument(
+        "--every",
+        default="100cycles",
+        help="window length: '100cycles' or a time, '10s' (default 100cycles)",
+    )
     p.add_argument("--model", choices=("tangential", "normal"), help="default: from the columns")
     p.add_argument("--json", metavar="OUT", help="write windows, pooled result and per-cycle "
                    "energies as JSON (SI; '-' = stdout)")  # fmt: skip

@@ -42,15 +42,21 @@ def build_track_report(
         f"(read in chunks of {result.meta.get('chunk_size')} samples)."
     )
     comb = result.combined()
-    rep.table([comb], _columns(result, with_time=False),
-              "all windows pooled (inverse-variance mean; error widened by the Birge ratio)")  # fmt: skip
+    rep.table(
+        [comb],
+        _columns(result, with_time=False),
+        "all windows pooled (inverse-variance mean; error widened by the Birge ratio)",
+    )
     failed = [r["error"] for r in result.rows if r.get("error")]
     for msg in failed:
         rep.text(msg, note=True)
     rep.section(f"Quantities against {against}")
     for name, fig in track_figures(result, against=against):
-        cap = (f"{LABELS.get(name, name)} per window, ±1 standard error" if name != "cycle_energy"
-               else f"loop energy of every cycle [{CYCLE_UNITS[result.kind]['energy']}]")  # fmt: skip
+        cap = (
+            f"{LABELS.get(name, name)} per window, ±1 standard error"
+            if name != "cycle_energy"
+            else f"loop energy of every cycle [{CYCLE_UNITS[result.kind]['energy']}]"
+        )
         rep.figure(fig, name, cap)
     rep.section("Windows")
     rep.table(result.rows, _columns(result), "one row per window (SI values in the CSV/JSON)")
