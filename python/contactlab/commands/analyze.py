@@ -4,7 +4,7 @@ Reads each recording (CSV/TDMS/HDF5/MAT, SI inside), runs the tangential analysi
 energy analytic and numeric, c_e·ω, stiffness; the tangential paper's eqs. 1-19) or the normal
 one (Konowalski's eqs. 1-7 and 16), prints a summary, and optionally writes JSON (SI values and
 a ``units`` map) and an HTML report. Tags (material, load, amplitude, p0, pa) are read from
-the file names as in :mod:`contactlab.manifest`.
+the file names as in :mod:`contactlab.studies.manifest`.
 """
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ import sys
 from pathlib import Path
 
 from ..errors import InputError
-from ..manifest import entry_from_file
-from ..study import run_study
+from ..studies.manifest import entry_from_file
+from ..studies.study import run_study
 from ._common import (
     add_progress_flags,
     check_output_targets,
