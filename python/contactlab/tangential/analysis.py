@@ -54,6 +54,7 @@ from ..fitting import FitResult
 from ..io import Recording
 from ..masing import loop_area
 from . import steps
+from .orientation import orient
 from .result import TangentialAnalysis
 from .uncertainty import correl, numeric_energy, reparametrize
 
@@ -105,20 +106,6 @@ def _check_options(on: str, history: str, n_points: int | None) -> None:
         raise InputError("history='virgin' applies to on='signal'; an averaged loop is steady")
     if n_points is not None and (n_points < 8 or n_points % 2):
         raise InputError(f"n_points must be even and >= 8, got {n_points}")
-
-
-def orientation(x: np.ndarray, F: np.ndarray, invert_force: bool | None) -> tuple[bool, list[str]]:
-    """Whether to analyse ``-F``, and the warnings that decision deserves."""
-    xc = x - x.mean()
-    inverted = float(xc @ (F - F.mean())) < 0
-    if invert_force is not None:
-        return bool(invert_force), []
-    if not inverted:
-        return False, []
-    return True, [
-        "the force falls as the displacement rises (sensor sign convention): "
-        "analysed -F; pass invert_force=False to keep the sign"
-    ]
 
 
 def identifiability(
@@ -266,6 +253,7 @@ def analyze_tangential(
     fit_amplitude: bool = True,
     detrend: bool = True,
     invert_force: bool | None = None,
+    force_sign: int | str = "auto",
     initial: dict[str, float] | None = None,
     warn: bool = True,
 ) -> TangentialAnalysis:
@@ -293,9 +281,14 @@ def analyze_tangential(
         Remove linear force and displacement drifts (load cell, thermal drift of the
         displacement sensor) estimated from the per-cycle means (needs 3 complete cycles;
         reported as ``force_drift``, N/s, and ``displacement_drift``, m/s).
+    force_sign : {"auto", +1, -1}, default "auto"
+        Analyse ``force_sign·F``. ``"auto"`` decides from physics: a passive joint
+        dissipates, so the signed loop area ``∮ F dx`` over the complete cycles must be
+        positive; when it is within its noise, the sign of the stiffness (F rising with x)
+        decides (:func:`contactlab.tangential.orientation.orient`). Reported as
+        ``force_sign`` and ``orientation_reason``; an automatic inversion is also a warning.
     invert_force : bool, optional
-        Analyse ``-F``. By default this is done (with a warning) when the force falls as the
-        displacement rises, i.e. the load cell counts the other way.
+        Older spelling: True is ``force_sign=-1``, False is ``force_sign=+1``.
     n_points : int, optional
         Phase bins of the averaged loop (default: samples per cycle, 16..400).
     rel_threshold : float
@@ -328,8 +321,11 @@ def analyze_tangential(
     xa, Fa, ta, source = _inputs(recording, t, x, F)
     _check_options(on, history, n_points)
     steady = history == "steady"
-    invert_force, pre_warns = orientation(xa, Fa, invert_force)
-    if invert_force:
+    if invert_force is not None:
+        force_sign = -1 if invert_force else 1
+    ori = orient(xa, Fa, ta, force_sign=force_sign)
+    pre_warns = [f"analysed -F: {ori.reason}"] if (ori.sign < 0 and ori.by != "user") else []
+    if ori.sign < 0:
         Fa = -Fa
     fit_x0 = True if fit_x0 is None else fit_x0
     det = steps.detrend(
@@ -402,5 +398,13 @@ def analyze_tangential(
         weights=res.w,
         t=data.td,
         source=source,
-        meta={"fit_start": data.start, "invert_force": bool(invert_force), "x_noise": x_noise},
+        meta={
+            "fit_start": data.start,
+            "invert_force": ori.sign < 0,
+            "x_noise": x_noise,
+            "force_sign": ori.sign,
+            "orientation_reason": ori.reason,
+            "orientation_by": ori.by,
+            "loop_area_recorded": (ori.loop_area, ori.loop_area_stderr),
+        },
     )

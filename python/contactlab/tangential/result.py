@@ -35,6 +35,7 @@ UNITS = {
     "peak_force": "N",
     "force_drift": "N/s",
     "displacement_drift": "m/s",
+    "loop_area_recorded": "J",
 }
 
 
@@ -121,6 +122,12 @@ class TangentialAnalysis:
         if "x0" in p:
             out["x0"] = _num(p["x0"].value)
             out["x0_stderr"] = _num(p["x0"].stderr)
+        out["force_sign"] = int(self.meta.get("force_sign", 1))
+        out["orientation_reason"] = str(self.meta.get("orientation_reason", ""))
+        la = self.meta.get("loop_area_recorded")
+        if la is not None:
+            out["loop_area_recorded"] = _num(la[0])
+            out["loop_area_recorded_stderr"] = _num(la[1])
         out["amplitude"] = _num(self.amplitude)
         out["amplitude_stderr"] = _num(self.amplitude_stderr)
         for k, (v, e) in self.derived.items():
