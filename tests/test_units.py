@@ -7,7 +7,7 @@ import pytest
 from contactlab.errors import InputError
 from contactlab.io import UnknownUnitError, known_units, to_si
 from contactlab.io.units import SI_UNITS
-from contactlab.manifest import read_manifest, si_unit, unit_factor
+from contactlab.studies.manifest import read_manifest, si_unit, unit_factor
 
 
 @pytest.mark.parametrize("unit", known_units())

@@ -20,6 +20,7 @@ from .errors import ContactLabError
 _VERB_MODULES = [
     "contactlab.commands.analyze",
     "contactlab.commands.study",
+    "contactlab.commands.track",
     "contactlab.commands.simulate",
     "contactlab.commands.demo",
     "contactlab.commands.diagnose",

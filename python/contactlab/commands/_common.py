@@ -16,9 +16,9 @@ import numpy as np
 from .._io_atomic import write_text
 from .._version import __version__
 from ..errors import InputError
-from ..manifest import scaled, si_unit, unit_factor
 from ..report import commit_outputs
-from ..study import RecordingResult, StudyResult
+from ..studies.manifest import scaled, si_unit, unit_factor
+from ..studies.study import RecordingResult, StudyResult
 
 _QTY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-zµμ/]*)\s*$")
 

@@ -4,7 +4,7 @@
    amplitude (PHYSICS.md §1): ``loops.png`` and ``amplitude_table.csv``.
 2. The bundled example recordings (:mod:`contactlab.data`: three material pairs over loads
    and amplitudes, normal-contact tests over p0; CSV/TDMS/HDF5/MAT) go through the study
-   (:func:`contactlab.study.run_study`): ``report.html`` (self-contained), ``figures/*.png``,
+   (:func:`contactlab.studies.run_study`): ``report.html`` (self-contained), ``figures/*.png``,
    ``study_tangential.csv``/``.parquet`` and ``study_normal.*``.
 
 All outputs are rendered first and written all or nothing into the output folder.
@@ -86,7 +86,7 @@ def masing_outputs() -> dict[str, bytes]:
 def demo_entries(quick: bool = False) -> list:
     """Entries of the bundled study; ``quick`` keeps one recording per material and kind."""
     from ..data import manifest_path
-    from ..manifest import read_manifest
+    from ..studies.manifest import read_manifest
 
     entries = read_manifest(manifest_path())
     if not quick:
@@ -110,7 +110,7 @@ def run_demo(out: Path, *, quick: bool = False, progress: bool | None = None) ->
     matplotlib.use("Agg")
     from ..report import commit_outputs
     from ..report.study_report import build_report
-    from ..study import run_study
+    from ..studies import run_study
 
     files = masing_outputs()
     result = run_study(demo_entries(quick), progress=progress)

@@ -93,6 +93,21 @@ def _dt_attr(objs: list[Any]) -> float | None:
     return None
 
 
+def hdf5_layout(
+    f: Any, *, columns: dict[str, str] | None, kind: str | None, file: str
+) -> tuple[str | None, dict[str, str], dict[str, Any], dict[str, str | None], float | None]:
+    """What a reader needs before touching the data: ``(kind, mapping, datasets, units, dt)``;
+    ``dt`` is the sampling interval from the attributes (None when absent or a ``t`` exists)."""
+    dsets = datasets(f)
+    names = [n for n in dsets if not n.startswith("#")]
+    kind, mapping = resolve_columns(names, columns=columns, kind=kind, file=file)
+    units = {c: unit_attr(dsets[n]) for c, n in mapping.items()}
+    dt = None
+    if "t" not in mapping:
+        dt = _dt_attr([dsets[n] for n in mapping.values()] + [f])
+    return kind, mapping, dsets, units, dt
+
+
 def read_hdf5(
     path: str | Path,
     *,
@@ -112,18 +127,13 @@ def read_hdf5(
     except OSError as exc:
         raise RecordingError(f"not a readable HDF5 file ({exc})", file=file) from None
     with f:
-        dsets = datasets(f)
-        names = [n for n in dsets if not n.startswith("#")]
-        kind, mapping = resolve_columns(names, columns=columns, kind=kind, file=file)
+        kind, mapping, dsets, units, dt = hdf5_layout(f, columns=columns, kind=kind, file=file)
         raw = {c: vector(dsets[n], file=file, column=n) for c, n in mapping.items()}
-        units = {c: unit_attr(dsets[n]) for c, n in mapping.items()}
         check_equal_lengths(raw, mapping, file=file)
         t_fallback = None
-        if "t" not in raw and fs is None:
-            dt = _dt_attr([dsets[n] for c, n in mapping.items()] + [f])
-            if dt is not None:
-                n = next(iter(raw.values())).size
-                t_fallback = time_from_interval(dt, n, file=file)
+        if "t" not in raw and fs is None and dt is not None:
+            n = next(iter(raw.values())).size
+            t_fallback = time_from_interval(dt, n, file=file)
         return finish(
             raw,
             mapping,
