@@ -35,10 +35,13 @@ from typing import Any
 
 import numpy as np
 
+from .._json import jsonable
 from ..errors import ContactLabError, ContactLabWarning, InputError
 from ..io import DEFAULT_CHUNK, Recording, read_chunks
 from ..io.units import UnknownUnitError, to_si
 from ._cycles import MIN_BLOCK, CycleState, block_cycles
+from .columns import CYCLE_UNITS
+from .study import coefficient_unit
 
 #: tangential quantities tracked per window (each with ``*_stderr``)
 TANGENTIAL_QUANTITIES = ("h0", "ac", "h0_ac", "energy_per_cycle", "energy_per_cycle_numeric",
@@ -47,11 +50,6 @@ TANGENTIAL_QUANTITIES = ("h0", "ac", "h0_ac", "energy_per_cycle", "energy_per_cy
 #: normal quantities tracked per window (``E_d`` with ``E_d_stderr``)
 NORMAL_QUANTITIES = ("E_d", "psi", "psi_kv", "k_tan", "k_sec", "delta_max", "delta_min",
                      "p0", "pa")  # fmt: skip
-#: SI units of the per-cycle quantities
-CYCLE_UNITS = {
-    "tangential": {"start": "s", "end": "s", "energy": "J", "amplitude": "m", "offset": "N"},
-    "normal": {"start": "s", "end": "s", "energy": "J/m^2", "amplitude": "m", "offset": "Pa"},
-}
 #: default upper bound on a window's samples (one window is held in memory)
 MAX_WINDOW = 2_000_000
 
@@ -274,12 +272,10 @@ def _normal_window(rec: Recording, options: Mapping[str, Any]) -> tuple[dict, di
     n, e_std = int(d.get("n_cycles") or 0), d.get("E_d_cycle_std")
     row["E_d_stderr"] = e_std / math.sqrt(n) if n > 1 and _finite(e_std) else None
     units["E_d_stderr"] = du.get("E_d", "J/m^2")
-    from .study import _coefficient_unit
-
     for key in ("poly_load", "poly_unload", "poly_centre"):
         for i, c in enumerate(d.get(key) or []):
             row[f"{key}_{i}"] = float(c)
-            units[f"{key}_{i}"] = _coefficient_unit(du.get(key, ""), i)
+            units[f"{key}_{i}"] = coefficient_unit(du.get(key, ""), i)
     row["n_cycles"] = n
     row["warnings"] = " | ".join(str(w.message) for w in caught
                                  if issubclass(w.category, ContactLabWarning))  # fmt: skip
@@ -490,8 +486,6 @@ def track(
 
 def track_json(result: TrackResult, *, cycles: bool = True) -> str:
     """The result as JSON text (NaN → null)."""
-    from ..commands._common import jsonable
-
     return json.dumps(jsonable(result.to_dict(cycles=cycles)), indent=1, allow_nan=False) + "\n"
 
 
