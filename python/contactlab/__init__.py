@@ -13,7 +13,7 @@ from .errors import ContactLabError, ContactLabWarning, ConvergenceError, InputE
 from .fitting import FitResult, Parameter, least_squares_fit
 from .io import Recording, RecordingError, read_recording, write_recording
 from .masing import CycleTable, Masing, MasingOperator, cycle_energies, loop_area
-from .studies.track import TrackResult, track
+from .studies.tracking import TrackResult, track
 from .tangential import TangentialAnalysis, analyze_tangential
 
 __version__ = "0.1.0"

@@ -19,7 +19,7 @@ from .study import (
     collect_entries,
     run_study,
 )
-from .track import TrackResult, parse_every, track
+from .tracking import TrackResult, parse_every, track
 
 __all__ = [
     "KINDS",

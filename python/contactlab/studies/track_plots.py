@@ -1,4 +1,4 @@
-"""Plots of a :class:`~contactlab.studies.track.TrackResult`: every tracked quantity against
+"""Plots of a :class:`~contactlab.studies.tracking.TrackResult`: every tracked quantity against
 time or cycle count with its standard error as error bars, and the per-cycle energies."""
 
 from __future__ import annotations
@@ -11,13 +11,26 @@ from .plots import display_unit
 
 #: axis labels of the tracked quantities
 LABELS = {
-    "h0": "h0", "ac": "ac", "h0_ac": "h0·ac", "energy_per_cycle": "E per cycle (analytic)",
-    "energy_per_cycle_numeric": "E per cycle (loop area)", "equivalent_damping": "c_e·ω",
-    "k_local0": "k_local(0)", "k_global": "k_global(A)", "amplitude": "amplitude A",
-    "offset": "force offset", "E_d": "E_d", "psi": "ψ (eq. 7)", "psi_kv": "ψ_KV (eq. 3)",
-    "k_tan": "k_tan", "k_sec": "k_sec", "delta_max": "δ_max", "delta_min": "δ_min",
-    "p0": "p0", "pa": "pa",
-}  # fmt: skip
+    "h0": "h0",
+    "ac": "ac",
+    "h0_ac": "h0·ac",
+    "energy_per_cycle": "E per cycle (analytic)",
+    "energy_per_cycle_numeric": "E per cycle (loop area)",
+    "equivalent_damping": "c_e·ω",
+    "k_local0": "k_local(0)",
+    "k_global": "k_global(A)",
+    "amplitude": "amplitude A",
+    "offset": "force offset",
+    "E_d": "E_d",
+    "psi": "ψ (eq. 7)",
+    "psi_kv": "ψ_KV (eq. 3)",
+    "k_tan": "k_tan",
+    "k_sec": "k_sec",
+    "delta_max": "δ_max",
+    "delta_min": "δ_min",
+    "p0": "p0",
+    "pa": "pa",
+}
 
 
 def _axes(ax: Any) -> Any:
@@ -47,8 +60,15 @@ def plot_quantity(result: Any, name: str, *, against: str = "time", ax: Any = No
         xv = 0.5 * (result.column("cycle_start") + result.column("cycle_end"))
         xl = "cycle"
     has_err = np.isfinite(e).any()
-    ax.errorbar(xv, y, yerr=np.where(np.isfinite(e), e, 0.0) if has_err else None,
-                fmt="o-", ms=3, lw=1, capsize=2)  # fmt: skip
+    ax.errorbar(
+        xv,
+        y,
+        yerr=np.where(np.isfinite(e), e, 0.0) if has_err else None,
+        fmt="o-",
+        ms=3,
+        lw=1,
+        capsize=2,
+    )
     label = LABELS.get(name, name)
     ax.set_ylabel(f"{label} [{shown}]" if shown else label)
     ax.set_xlabel(xl)
@@ -58,7 +78,7 @@ def plot_quantity(result: Any, name: str, *, against: str = "time", ax: Any = No
 
 def plot_cycles(result: Any, name: str = "energy", ax: Any = None) -> Any:
     """A per-cycle quantity against the cycle number (every cycle of the record)."""
-    from .track import CYCLE_UNITS
+    from .tracking import CYCLE_UNITS
 
     ax = _axes(ax)
     v = result.cycles[name]

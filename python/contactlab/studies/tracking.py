@@ -41,12 +41,20 @@ from ..io.units import UnknownUnitError, to_si
 from ._cycles import MIN_BLOCK, CycleState, block_cycles
 
 #: tangential quantities tracked per window (each with ``*_stderr``)
-TANGENTIAL_QUANTITIES = ("h0", "ac", "h0_ac", "energy_per_cycle", "energy_per_cycle_numeric",
-                         "equivalent_damping", "k_local0", "k_global", "amplitude",
-                         "offset")  # fmt: skip
+TANGENTIAL_QUANTITIES = (
+    "h0",
+    "ac",
+    "h0_ac",
+    "energy_per_cycle",
+    "energy_per_cycle_numeric",
+    "equivalent_damping",
+    "k_local0",
+    "k_global",
+    "amplitude",
+    "offset",
+)
 #: normal quantities tracked per window (``E_d`` with ``E_d_stderr``)
-NORMAL_QUANTITIES = ("E_d", "psi", "psi_kv", "k_tan", "k_sec", "delta_max", "delta_min",
-                     "p0", "pa")  # fmt: skip
+NORMAL_QUANTITIES = ("E_d", "psi", "psi_kv", "k_tan", "k_sec", "delta_max", "delta_min", "p0", "pa")
 #: SI units of the per-cycle quantities
 CYCLE_UNITS = {
     "tangential": {"start": "s", "end": "s", "energy": "J", "amplitude": "m", "offset": "N"},
@@ -148,13 +156,25 @@ class TrackResult:
         Each quantity with a standard error is the inverse-variance weighted mean over the
         windows that determine it; its ``*_stderr`` is ``1/sqrt(Σ w)`` times the Birge ratio
         ``sqrt(χ²/(n-1))`` when that exceeds 1 (windows scattering beyond their errors: the
-        joint changed, or the errors are optimistic). ``*_birge`` gives the ratio.
+        joint changed, or the errors are optimistic). ``*_birge`` gives the ratio. A quantity
+        the window analysis gives no error for (ψ, k_tan, ... of normal loops) is the plain
+        mean over the windows with the standard error of that mean.
         """
         out: dict[str, Any] = {"n_windows": len(self.rows)}
         for q in self.quantities:
             v, s = self.column(q), self.column(f"{q}_stderr")
             ok = np.isfinite(v) & np.isfinite(s) & (s > 0)
             if not ok.any():
+                # no standard error per window: the mean of the windows and its error from
+                # their scatter
+                fin = v[np.isfinite(v)]
+                if fin.size:
+                    out[q] = float(np.mean(fin))
+                    out[f"{q}_stderr"] = (
+                        float(np.std(fin, ddof=1) / math.sqrt(fin.size))
+                        if fin.size > 1
+                        else float("nan")
+                    )
                 continue
             w = 1.0 / s[ok] ** 2
             mean = float(np.sum(w * v[ok]) / np.sum(w))
@@ -203,8 +223,12 @@ class TrackResult:
         w = csv.writer(buf, lineterminator="\n")
         w.writerow([f"{c} [{self.units[c]}]" if self.units.get(c) else c for c in cols])
         for r in self.rows:
-            w.writerow(["" if r.get(c) is None else repr(r[c]) if isinstance(r[c], float)
-                        else str(r[c]) for c in cols])  # fmt: skip
+            w.writerow(
+                [
+                    "" if r.get(c) is None else repr(r[c]) if isinstance(r[c], float) else str(r[c])
+                    for c in cols
+                ]
+            )
         return buf.getvalue()
 
     def cycles_csv(self) -> str:
@@ -227,8 +251,10 @@ class TrackResult:
         return plot_quantity(self, name, against=against, ax=ax)
 
     def __repr__(self) -> str:
-        return (f"TrackResult({self.source!r}, {self.kind}, every={self.every!r}, "
-                f"{len(self.rows)} windows, {self.cycles['energy'].size} cycles)")  # fmt: skip
+        return (
+            f"TrackResult({self.source!r}, {self.kind}, every={self.every!r}, "
+            f"{len(self.rows)} windows, {self.cycles['energy'].size} cycles)"
+        )
 
 
 def _finite(v: Any) -> bool:
@@ -281,8 +307,9 @@ def _normal_window(rec: Recording, options: Mapping[str, Any]) -> tuple[dict, di
             row[f"{key}_{i}"] = float(c)
             units[f"{key}_{i}"] = _coefficient_unit(du.get(key, ""), i)
     row["n_cycles"] = n
-    row["warnings"] = " | ".join(str(w.message) for w in caught
-                                 if issubclass(w.category, ContactLabWarning))  # fmt: skip
+    row["warnings"] = " | ".join(
+        str(w.message) for w in caught if issubclass(w.category, ContactLabWarning)
+    )
     return row, units
 
 
@@ -304,10 +331,20 @@ class _Windows:
         t = np.concatenate([p.t for p in self.pieces])
         data = {c: np.concatenate([p.data[c] for p in self.pieces]) for c in self.pieces[0].data}
         first = self.pieces[0]
-        rec = Recording(t[:k], {c: v[:k] for c, v in data.items()}, dict(first.units),
-                        first.source, dict(first.meta, offset=self.start))  # fmt: skip
-        rest = Recording(t[k:], {c: v[k:] for c, v in data.items()}, dict(first.units),
-                         first.source, dict(first.meta, offset=stop))  # fmt: skip
+        rec = Recording(
+            t[:k],
+            {c: v[:k] for c, v in data.items()},
+            dict(first.units),
+            first.source,
+            dict(first.meta, offset=self.start),
+        )
+        rest = Recording(
+            t[k:],
+            {c: v[k:] for c, v in data.items()},
+            dict(first.units),
+            first.source,
+            dict(first.meta, offset=stop),
+        )
         self.pieces = [rest] if len(rest) else []
         self.n -= k
         self.start = stop
@@ -404,8 +441,9 @@ def track(
     opts = dict(options or {})
 
     state = CycleState()
-    cyc: dict[str, list[np.ndarray]] = {k: [] for k in ("start", "end", "energy", "amplitude",
-                                                        "offset")}  # fmt: skip
+    cyc: dict[str, list[np.ndarray]] = {
+        k: [] for k in ("start", "end", "energy", "amplitude", "offset")
+    }
     rows: list[dict[str, Any]] = []
     units: dict[str, str] = {"t_start": "s", "t_end": "s", "t_mid": "s"}
     buf = _Windows()
@@ -483,8 +521,14 @@ def track(
             f"tracking needs windows of at least 2 cycles"
         )
     cycles = {k: (np.concatenate(v) if v else np.empty(0)) for k, v in cyc.items()}
-    meta = {"n_samples": n_total, "n_windows": len(rows), "tail_samples_left_out": tail,
-            "chunk_size": chunk_size, "every_mode": mode, "every_value": size}  # fmt: skip
+    meta = {
+        "n_samples": n_total,
+        "n_windows": len(rows),
+        "tail_samples_left_out": tail,
+        "chunk_size": chunk_size,
+        "every_mode": mode,
+        "every_value": size,
+    }
     return TrackResult(cr.source, kind_, every_text, rows, units, cycles, meta)
 
 
@@ -495,5 +539,13 @@ def track_json(result: TrackResult, *, cycles: bool = True) -> str:
     return json.dumps(jsonable(result.to_dict(cycles=cycles)), indent=1, allow_nan=False) + "\n"
 
 
-__all__ = ["CYCLE_UNITS", "MAX_WINDOW", "NORMAL_QUANTITIES", "TANGENTIAL_QUANTITIES",
-           "TrackResult", "parse_every", "track", "track_json"]  # fmt: skip
+__all__ = [
+    "CYCLE_UNITS",
+    "MAX_WINDOW",
+    "NORMAL_QUANTITIES",
+    "TANGENTIAL_QUANTITIES",
+    "TrackResult",
+    "parse_every",
+    "track",
+    "track_json",
+]
