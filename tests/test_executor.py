@@ -85,3 +85,15 @@ def test_dask_local_cluster_equals_serial(files, serial):
     for a, b in zip(got, want, strict=True):
         assert a.rows == b.rows
         np.testing.assert_array_equal(a.cycles["energy"], b.cycles["energy"])
+
+
+@pytest.mark.parametrize("pool", [ThreadPoolExecutor, ProcessPoolExecutor])
+def test_track_windows_in_parallel_equal_serial(pool):
+    from contactlab.studies import track
+
+    rec = _tracks()[0]
+    want = track(rec, "3cycles")
+    with pool(2) as ex:
+        got = track(rec, "3cycles", executor=ex)
+    assert got.rows == want.rows and len(got.rows) == 2
+    np.testing.assert_array_equal(got.cycles["energy"], want.cycles["energy"])

@@ -218,3 +218,12 @@ def test_real_friction_frame_data():
         inside = (a.cycles["start"] >= r["t_start"]) & (a.cycles["end"] <= r["t_end"] + 0.01)
         e = abs(r["energy_per_cycle_numeric"])
         assert abs(np.mean(a.cycles["energy"][inside]) - e) < 0.05 * e
+
+
+def test_auto_windows_hold_whole_cycles(long_rec, monkeypatch):
+    import contactlab.studies.tracking as tr
+
+    monkeypatch.setattr(tr, "AUTO_WINDOW", 6 * 750)  # 1500 Hz / 2 Hz = 750 samples a cycle
+    r = track(long_rec, every="auto")
+    assert r.meta["every_mode"] == "cycles" and r.meta["every_value"] == 6
+    assert [row["cycle_end"] - row["cycle_start"] for row in r.rows][:-1] == [6] * (len(r.rows) - 1)

@@ -29,6 +29,7 @@ import io
 import json
 import math
 import re
+from collections import deque
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -63,13 +64,18 @@ CYCLE_UNITS = {
 }
 #: default upper bound on a window's samples (one window is held in memory)
 MAX_WINDOW = 2_000_000
+#: samples per window for ``every="auto"`` (the analysis' samples/s is best near this size)
+AUTO_WINDOW = 1 << 19
 
 _EVERY = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?\d+)?)\s*([A-Za-zµμ]*)\s*$")
 
 
 def parse_every(every: str | float | int) -> tuple[str, float]:
     """``"100cycles"`` → ``("cycles", 100)``, ``"10s"``/``"2min"``/``"500 ms"`` →
-    ``("time", seconds)``. A bare number counts cycles."""
+    ``("time", seconds)``, ``"auto"`` → ``("auto", 0)`` (whole cycles, about
+    :data:`AUTO_WINDOW` samples per window). A bare number counts cycles."""
+    if isinstance(every, str) and every.strip().lower() == "auto":
+        return "auto", 0.0
     if isinstance(every, (int, float)) and not isinstance(every, bool):
         text = f"{every}cycles"
     elif isinstance(every, str):
@@ -387,6 +393,7 @@ def track(
     options: Mapping[str, Any] | None = None,
     keep_going: bool = True,
     callback: Callable[[dict[str, Any]], None] | None = None,
+    executor: Any = None,
 ) -> TrackResult:
     """Fitted quantities of a long recording window by window, in bounded memory.
 
@@ -396,7 +403,8 @@ def track(
         A recording file (CSV/TDMS/HDF5/MAT, read in chunks) or a :class:`Recording`.
     every : str or number
         Window length: ``"100cycles"`` (a bare number counts cycles), or a time such as
-        ``"10s"``, ``"500ms"``, ``"2min"``. Windows are cut at upward crossings of the drive
+        ``"10s"``, ``"500ms"``, ``"2min"``, or ``"auto"`` (whole cycles, about
+        :data:`AUTO_WINDOW` samples). Windows are cut at upward crossings of the drive
         (``x`` or ``p``), so they hold whole cycles; the first also holds the lead-in before
         the first crossing, and a last, shorter window is analysed when it has >= 2 cycles.
     kind, columns, fs
@@ -413,6 +421,10 @@ def track(
         stopping the run. Errors of the file itself always stop it.
     callback : callable, optional
         Called with each window's row as it completes (progress).
+    executor : optional
+        Analyse windows in parallel on a ``concurrent.futures`` executor or a Dask
+        ``distributed.Client`` while the file is read on; at most two windows per worker are
+        held. The rows equal those of a serial run.
 
     Returns
     -------
@@ -451,9 +463,28 @@ def track(
     n_cross = 0  # crossings so far
     cycles_at_start = 0  # complete cycles before the current window
     next_cross_target = int(size) if mode == "cycles" else None
+    first_crossings: list[int] = []
     window_t0: float | None = None
     crossings_in_window = 0
     n_total = 0
+
+    from .executor import n_workers
+
+    in_flight: deque[tuple[dict[str, Any], Any]] = deque()
+    limit = 2 * n_workers(executor)
+    dask = executor is not None and type(executor).__module__.split(".")[0] == "distributed"
+
+    def collect(row: dict[str, Any], job: Any) -> None:
+        try:
+            values, u = job() if executor is None else job.result()
+        except ContactLabError as exc:
+            if not keep_going:
+                raise
+            values, u = {"error": f"window {row['window']}: {exc}"}, {}
+        row.update(values)
+        units.update(u)
+        if callback is not None:
+            callback(row)
 
     def emit(stop: int, n_cycles_before_stop: int) -> None:
         nonlocal cycles_at_start
@@ -467,55 +498,70 @@ def track(
             "cycle_end": n_cycles_before_stop,
             "n_samples": len(rec),
         }
-        try:
-            values, u = analyse(rec, opts)
-        except ContactLabError as exc:
-            if not keep_going:
-                raise
-            values, u = {"error": f"window {row['window']}: {exc}"}, {}
-        row.update(values)
-        units.update(u)
         rows.append(row)
         cycles_at_start = n_cycles_before_stop
-        if callback is not None:
-            callback(row)
+        if executor is None:
+            collect(row, functools.partial(analyse, rec, opts))
+            return
+        fut = (
+            executor.submit(analyse, rec, opts, pure=False)
+            if dask
+            else executor.submit(analyse, rec, opts)
+        )
+        in_flight.append((row, fut))
+        while len(in_flight) >= limit:
+            collect(*in_flight.popleft())
 
-    for block in _blocks(iter(cr), MIN_BLOCK):
-        off = int(block.meta.get("offset", n_total))
-        buf.add(block)
-        n_total = off + len(block)
-        got = block_cycles(block.t, block[loop_x], block[loop_F], block[drive], off, state)
-        for k in cyc:
-            cyc[k].append(np.asarray(getattr(got, k), dtype=float))
-        if window_t0 is None:
-            window_t0 = float(block.t[0])
-        for g in got.crossings.tolist():
-            n_cross += 1
-            crossings_in_window += 1
-            # complete cycles before crossing g: crossings so far minus the first one
-            done = n_cross - 1
-            if mode == "cycles":
-                assert next_cross_target is not None
-                cut = n_cross == next_cross_target + 1
+    try:
+        for block in _blocks(iter(cr), MIN_BLOCK):
+            off = int(block.meta.get("offset", n_total))
+            buf.add(block)
+            n_total = off + len(block)
+            got = block_cycles(block.t, block[loop_x], block[loop_F], block[drive], off, state)
+            for k in cyc:
+                cyc[k].append(np.asarray(getattr(got, k), dtype=float))
+            if window_t0 is None:
+                window_t0 = float(block.t[0])
+            if mode == "auto":
+                first_crossings.extend(got.crossings[:64].tolist())
+                if len(first_crossings) >= 3:
+                    per_cycle = float(np.median(np.diff(first_crossings)))
+                    size = float(max(4, round(AUTO_WINDOW / per_cycle)))
+                    mode, next_cross_target = "cycles", int(size)
+            for g in got.crossings.tolist():
+                n_cross += 1
+                crossings_in_window += 1
+                # complete cycles before crossing g: crossings so far minus the first one
+                done = n_cross - 1
+                if mode == "auto":
+                    cut = False
+                elif mode == "cycles":
+                    assert next_cross_target is not None
+                    cut = n_cross == next_cross_target + 1
+                    if cut:
+                        next_cross_target += int(size)
+                else:
+                    t_g = float(block.t[g - off])
+                    cut = t_g - window_t0 >= size and crossings_in_window >= 3
                 if cut:
-                    next_cross_target += int(size)
-            else:
-                t_g = float(block.t[g - off])
-                cut = t_g - window_t0 >= size and crossings_in_window >= 3
-            if cut:
-                emit(g, done)
-                window_t0 = float(block.t[g - off])
-                crossings_in_window = 1
-        if buf.n > max_window:
-            raise InputError(
-                f"{cr.source}: a window of every={every_text!r} holds more than "
-                f"{max_window} samples; choose a shorter window (or raise max_window)"
-            )
-    # the tail: analysed when it holds at least 2 complete cycles
-    tail = buf.n
-    if tail and crossings_in_window >= 3:
-        emit(n_total, max(n_cross - 1, 0))
-        tail = 0
+                    emit(g, done)
+                    window_t0 = float(block.t[g - off])
+                    crossings_in_window = 1
+            if buf.n > max_window:
+                raise InputError(
+                    f"{cr.source}: a window of every={every_text!r} holds more than "
+                    f"{max_window} samples; choose a shorter window (or raise max_window)"
+                )
+        # the tail: analysed when it holds at least 2 complete cycles
+        tail = buf.n
+        if tail and crossings_in_window >= 3:
+            emit(n_total, max(n_cross - 1, 0))
+            tail = 0
+        while in_flight:
+            collect(*in_flight.popleft())
+    finally:
+        for _row, fut in in_flight:
+            fut.cancel()
     if not rows:
         raise InputError(
             f"{cr.source}: found {max(n_cross - 1, 0)} complete cycle(s) in {n_total} samples; "
@@ -572,6 +618,7 @@ def track_json(result: TrackResult, *, cycles: bool = True) -> str:
 
 
 __all__ = [
+    "AUTO_WINDOW",
     "CYCLE_UNITS",
     "MAX_WINDOW",
     "NORMAL_QUANTITIES",
