@@ -144,3 +144,16 @@ def test_track_real_sigint_exits_130_without_output(tmp_path):
     assert proc.returncode == 130, err
     assert "interrupted" in err
     assert not out.exists()
+
+
+def test_analyze_stream_agrees_with_whole_file(rec_file, tmp_path):
+    whole, streamed = tmp_path / "w.json", tmp_path / "s.json"
+    assert main(["analyze", str(rec_file), "--model", "tangential", "--json", str(whole),
+                 "--no-progress"]) == 0  # fmt: skip
+    assert main(["analyze", str(rec_file), "--model", "tangential", "--stream", "--every",
+                 "5cycles", "--json", str(streamed), "--no-progress"]) == 0  # fmt: skip
+    w, s = json.loads(whole.read_text()), json.loads(streamed.read_text())
+    assert s["streamed"] is True and s["n_windows"] == 3 and s["units"]["h0"] == "N"
+    for q in ("h0", "ac", "energy_per_cycle", "energy_per_cycle_numeric", "k_global"):
+        err = (w[f"{q}_stderr"] ** 2 + s[f"{q}_stderr"] ** 2) ** 0.5
+        assert abs(w[q] - s[q]) < 3 * err, q

@@ -16,10 +16,12 @@ import sys
 
 from ._common import (
     add_progress_flags,
+    add_workers_flag,
     check_output_targets,
     command_line,
     describe,
     parse_columns,
+    process_pool,
     quantity,
     write_json,
 )
@@ -49,15 +51,17 @@ def _handler(args: argparse.Namespace) -> int:
         bar = tqdm(desc="windows", unit="win", file=sys.stderr)
     print(f"tracking {args.file} every {args.every}", file=say, flush=True)
     try:
-        res = track(
-            args.file,
-            args.every,
-            kind=args.model,
-            columns=parse_columns(args.columns),
-            fs=args.fs,
-            chunk_size=args.chunk_size,
-            callback=(lambda _row: bar.update(1)) if bar is not None else None,
-        )
+        with process_pool(args.workers) as ex:
+            res = track(
+                args.file,
+                args.every,
+                kind=args.model,
+                columns=parse_columns(args.columns),
+                fs=args.fs,
+                chunk_size=args.chunk_size,
+                executor=ex,
+                callback=(lambda _row: bar.update(1)) if bar is not None else None,
+            )
     finally:
         if bar is not None:
             bar.close()
@@ -132,5 +136,6 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         metavar="N",
         help="samples read at a time (default 1048576)",
     )
+    add_workers_flag(p, "windows")
     add_progress_flags(p)
     p.set_defaults(handler=_handler)
