@@ -208,9 +208,9 @@ def _vector_length(ds: Any, *, file: str, column: str) -> int:
 def _h5_chunks(
     path: Path, fmt: str, *, columns: Any, kind: Any, fs: Any, chunk: int
 ) -> ChunkedRecording:
-    from .hdf5 import _h5py, hdf5_layout
+    from .hdf5 import hdf5_layout, import_h5py
 
-    h5py = _h5py()
+    h5py = import_h5py()
     file = str(path)
 
     def layout(f: Any) -> tuple[Any, ...]:
@@ -258,9 +258,9 @@ def _h5_chunks(
 
 
 def _tdms_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> ChunkedRecording:
-    from .tdms import _nptdms
+    from .tdms import import_nptdms
 
-    nptdms = _nptdms()
+    nptdms = import_nptdms()
     file = str(path)
 
     def open_tdms() -> tuple[Any, Any, dict[str, Any]]:
@@ -322,12 +322,18 @@ def _tdms_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) ->
 
 
 def _csv_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> ChunkedRecording:
-    from .csv import _decimal_comma, _encoding, _header, _line_of_sample, _locate_bad_cell
+    from .csv import (
+        detect_encoding,
+        has_decimal_comma,
+        line_of_sample,
+        locate_bad_cell,
+        read_header,
+    )
     from .units import split_name
 
     file = str(path)
-    enc = _encoding(path)
-    names, delim, header_line, comments = _header(path, enc)
+    enc = detect_encoding(path)
+    names, delim, header_line, comments = read_header(path, enc)
     if len(set(names)) != len(names):
         dup = next(n for n in names if names.count(n) > 1)
         raise RecordingError("column name appears twice in the header", file=file, column=dup)
@@ -335,7 +341,7 @@ def _csv_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> 
     canon = list(mapping)
     idx = [names.index(mapping[c]) for c in canon]
     first_data = header_line + 1
-    comma = _decimal_comma(path, delim, first_data, enc)
+    comma = has_decimal_comma(path, delim, first_data, enc)
     units = {c: split_name(mapping[c])[1] for c in canon}
     meta = {
         "format": "csv",
@@ -346,7 +352,7 @@ def _csv_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> 
     }
 
     def row_of(i: int) -> int:
-        return _line_of_sample(path, first_data, i, enc)
+        return line_of_sample(path, first_data, i, enc)
 
     fin0 = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, row_of=row_of, meta=meta)
 
@@ -377,7 +383,7 @@ def _csv_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> 
                                 else None,
                             )
                     except ValueError:
-                        raise _locate_bad_cell(
+                        raise locate_bad_cell(
                             path, delim, first_data, idx, names, comma, enc
                         ) from None
                     if block.shape[0] == 0:

@@ -27,7 +27,8 @@ from .recording import (
 )
 
 
-def _h5py() -> Any:
+def import_h5py() -> Any:
+    """The h5py module (an optional dependency; HDF5 and MATLAB v7.3 readers need it)."""
     try:
         import h5py
     except ImportError:  # pragma: no cover - depends on the installation
@@ -35,12 +36,13 @@ def _h5py() -> Any:
     return h5py
 
 
-def _text(v: Any) -> str:
+def text_value(v: Any) -> str:
+    """An HDF5 attribute or dataset as text: bytes, one-element string arrays, MATLAB chars."""
     if isinstance(v, bytes):
         return v.decode("utf-8", "replace")
     if isinstance(v, np.ndarray):
         if v.dtype.kind in "SO" and v.size == 1:
-            return _text(v.reshape(-1)[0])
+            return text_value(v.reshape(-1)[0])
         if v.dtype.kind in "ui":  # MATLAB char arrays: uint16 code points
             return "".join(chr(int(c)) for c in v.reshape(-1))
     return str(v)
@@ -48,7 +50,7 @@ def _text(v: Any) -> str:
 
 def datasets(f: Any) -> dict[str, Any]:
     """Every numeric dataset: by full path (no leading slash) and by its last name."""
-    h5py = _h5py()
+    h5py = import_h5py()
     out: dict[str, Any] = {}
 
     def visit(name: str, obj: Any) -> None:
@@ -75,7 +77,7 @@ def vector(ds: Any, *, file: str, column: str) -> np.ndarray:
 def unit_attr(ds: Any) -> str | None:
     for key in ("unit", "units", "unit_string", "Unit"):
         if key in ds.attrs:
-            u = _text(ds.attrs[key]).strip()
+            u = text_value(ds.attrs[key]).strip()
             return u or None
     return None
 
@@ -117,7 +119,7 @@ def read_hdf5(
 
     Rows in errors are 0-based sample indices.
     """
-    h5py = _h5py()
+    h5py = import_h5py()
     path = Path(path)
     file = str(path)
     try:
@@ -147,7 +149,7 @@ def read_hdf5(
 def write_hdf5(path: str | Path, rec: Recording, **_: Any) -> Path:
     """Write ``rec`` as HDF5: datasets ``t`` and one per channel, each with a ``unit``
     attribute; the recording's ``source`` and ``kind`` as file attributes."""
-    h5py = _h5py()
+    h5py = import_h5py()
     with atomic_path(path) as tmp:
         with h5py.File(tmp, "w") as f:
             f.create_dataset("t", data=rec.t).attrs["unit"] = "s"

@@ -39,19 +39,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import InputError
-
-# Unit → (factor to SI, SI unit). Micro written u, µ (micro sign) or μ (Greek mu).
-_UNITS: dict[str, tuple[float, str]] = {
-    "": (1.0, ""), "-": (1.0, ""), "1": (1.0, ""),
-    "s": (1.0, "s"), "ms": (1e-3, "s"), "us": (1e-6, "s"),
-    "m": (1.0, "m"), "mm": (1e-3, "m"), "um": (1e-6, "m"), "nm": (1e-9, "m"),
-    "N": (1.0, "N"), "kN": (1e3, "N"), "mN": (1e-3, "N"),
-    "Pa": (1.0, "Pa"), "kPa": (1e3, "Pa"), "MPa": (1e6, "Pa"), "GPa": (1e9, "Pa"),
-    "Hz": (1.0, "Hz"), "kHz": (1e3, "Hz"), "1/s": (1.0, "1/s"), "rad/s": (1.0, "rad/s"),
-    "1/m": (1.0, "1/m"), "1/mm": (1e3, "1/m"), "1/um": (1e6, "1/m"),
-    "J": (1.0, "J"), "mJ": (1e-3, "J"), "uJ": (1e-6, "J"),
-    "N/m": (1.0, "N/m"), "N/mm": (1e3, "N/m"), "N/um": (1e6, "N/m"),
-}  # fmt: skip
+from ..io import units
 
 # Canonical tag → its SI unit (for the study table's units map).
 TAG_UNITS: dict[str, str] = {
@@ -77,11 +65,18 @@ _KINDS = ("tangential", "normal")
 
 
 def _unit(unit: str, where: str) -> tuple[float, str]:
-    u = unit.strip().replace("µ", "u").replace("μ", "u")
-    if u not in _UNITS:
-        known = ", ".join(k for k in _UNITS if k not in ("", "-", "1"))
-        raise InputError(f"{where}: unknown unit {unit!r} (known: {known})")
-    return _UNITS[u]
+    """``(factor to SI, SI unit)`` from the package's unit table (:mod:`contactlab.io.units`)."""
+    hit = units.lookup(unit)
+    if hit is None:
+        raise InputError(f"{where}: unknown unit {unit!r} (known: {_KNOWN_UNITS})")
+    factor, dim = hit
+    return factor, units.SI_UNITS[dim]
+
+
+_KNOWN_UNITS = (
+    "s, ms, us, m, mm, um, nm, N, kN, mN, Pa, kPa, MPa, GPa, bar, Hz, kHz, 1/s, rad/s, 1/m, "
+    "1/mm, 1/um, J, mJ, uJ, N/m, N/mm, N/um"
+)
 
 
 def scaled(number: str, factor: float) -> float:

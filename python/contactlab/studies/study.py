@@ -58,7 +58,7 @@ _POWERS = re.compile(
 )
 
 
-def _coefficient_unit(unit: str, i: int) -> str:
+def coefficient_unit(unit: str, i: int) -> str:
     """Unit of coefficient ``i`` of a polynomial whose unit map says ``"Pa; ascending powers of
     delta in m"``: ``Pa``, ``Pa/m``, ``Pa/m^2``, ... (``"Pa/m; ..."`` starts at ``Pa/m``).
     Other strings are returned as they are."""
@@ -93,7 +93,7 @@ def _flatten(d: Mapping[str, Any], units: Mapping[str, str]) -> tuple[dict, dict
                     if isinstance(unit, (list, tuple)) and i < len(unit):
                         out_units[f"{key}_{i}"] = str(unit[i])
                     elif isinstance(unit, str) and unit:
-                        out_units[f"{key}_{i}"] = _coefficient_unit(unit, i)
+                        out_units[f"{key}_{i}"] = coefficient_unit(unit, i)
             continue
         if isinstance(value, (np.floating, np.integer, np.bool_)):
             value = value.item()

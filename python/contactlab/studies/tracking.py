@@ -307,12 +307,12 @@ def _normal_window(rec: Recording, options: Mapping[str, Any]) -> tuple[dict, di
     n, e_std = int(d.get("n_cycles") or 0), d.get("E_d_cycle_std")
     row["E_d_stderr"] = e_std / math.sqrt(n) if n > 1 and _finite(e_std) else None
     units["E_d_stderr"] = du.get("E_d", "J/m^2")
-    from .study import _coefficient_unit
+    from .study import coefficient_unit
 
     for key in ("poly_load", "poly_unload", "poly_centre"):
         for i, c in enumerate(d.get(key) or []):
             row[f"{key}_{i}"] = float(c)
-            units[f"{key}_{i}"] = _coefficient_unit(du.get(key, ""), i)
+            units[f"{key}_{i}"] = coefficient_unit(du.get(key, ""), i)
     row["n_cycles"] = n
     row["warnings"] = " | ".join(
         str(w.message) for w in caught if issubclass(w.category, ContactLabWarning)
