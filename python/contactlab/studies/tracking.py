@@ -333,29 +333,35 @@ class _Windows:
         self.n += len(rec)
 
     def take(self, stop: int) -> Recording:
-        """Samples ``[start, stop)`` as one recording; they are dropped from the buffer."""
-        k = stop - self.start
-        t = np.concatenate([p.t for p in self.pieces])
-        data = {c: np.concatenate([p.data[c] for p in self.pieces]) for c in self.pieces[0].data}
-        first = self.pieces[0]
-        rec = Recording(
-            t[:k],
-            {c: v[:k] for c, v in data.items()},
-            dict(first.units),
-            first.source,
-            dict(first.meta, offset=self.start),
-        )
-        rest = Recording(
-            t[k:],
-            {c: v[k:] for c, v in data.items()},
-            dict(first.units),
-            first.source,
-            dict(first.meta, offset=stop),
-        )
-        self.pieces = [rest] if len(rest) else []
-        self.n -= k
+        """Samples ``[start, stop)`` as one recording; they are dropped from the buffer.
+
+        Only the window's pieces are copied (joined); the rest of a split piece stays a view,
+        so cutting many short windows out of one long block costs no more than the block.
+        """
+        need = stop - self.start
+        parts: list[Recording] = []
+        while need > 0:
+            p = self.pieces[0]
+            if len(p) <= need:
+                parts.append(self.pieces.pop(0))
+                need -= len(p)
+            else:
+                parts.append(_part(p, 0, need))
+                self.pieces[0] = _part(p, need, len(p))
+                need = 0
+        rec = _join(parts)
+        self.n -= stop - self.start
         self.start = stop
-        return rec
+        return Recording(
+            rec.t, rec.data, rec.units, rec.source, dict(rec.meta, offset=stop - len(rec))
+        )
+
+
+def _part(rec: Recording, a: int, b: int) -> Recording:
+    """Samples ``a:b`` of ``rec`` as views (no copy)."""
+    off = int(rec.meta.get("offset", 0))
+    data = {c: v[a:b] for c, v in rec.data.items()}
+    return Recording(rec.t[a:b], data, rec.units, rec.source, dict(rec.meta, offset=off + a))
 
 
 def _blocks(chunks: Iterator[Recording], min_block: int) -> Iterator[Recording]:
