@@ -553,7 +553,7 @@ def track(
                     emit(g, done)
                     window_t0 = float(block.t[g - off])
                     crossings_in_window = 1
-            if buf.n > max_window:
+            if buf.n > max_window:  # the open window (cut windows have left the buffer)
                 raise InputError(
                     f"{cr.source}: a window of every={every_text!r} holds more than "
                     f"{max_window} samples; choose a shorter window (or raise max_window)"
