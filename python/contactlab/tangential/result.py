@@ -35,6 +35,7 @@ UNITS = {
     "peak_force": "N",
     "force_drift": "N/s",
     "displacement_drift": "m/s",
+    "loop_area_recorded": "J",
 }
 
 
@@ -121,6 +122,12 @@ class TangentialAnalysis:
         if "x0" in p:
             out["x0"] = json_number(p["x0"].value)
             out["x0_stderr"] = json_number(p["x0"].stderr)
+        out["force_sign"] = int(self.meta.get("force_sign", 1))
+        out["orientation_reason"] = str(self.meta.get("orientation_reason", ""))
+        la = self.meta.get("loop_area_recorded")
+        if la is not None:
+            out["loop_area_recorded"] = json_number(la[0])
+            out["loop_area_recorded_stderr"] = json_number(la[1])
         out["amplitude"] = json_number(self.amplitude)
         out["amplitude_stderr"] = json_number(self.amplitude_stderr)
         for k, (v, e) in self.derived.items():
