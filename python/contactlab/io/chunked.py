@@ -135,9 +135,31 @@ class _Finisher:
             m["units_assumed_si"] = assumed
         self.meta = m
 
+    def _check_time(self, t: np.ndarray, row_of: Callable[[int], int]) -> None:
+        """The whole-file reader's time checks, judged against the first chunk's median step
+        and across the boundary with the previous chunk."""
+        col = self.tcol
+        if self.prev_t is None:
+            if t.size >= 2:
+                self.step = float(np.median(np.diff(t)))
+            check_time(t, file=self.file, column=col, row_of=row_of, step=self.step)
+            return
+        if t.size:  # the boundary: the previous chunk's last stamp, then this one's first
+            check_time(
+                np.array([self.prev_t, t[0]]),
+                file=self.file,
+                column=col,
+                row_of=lambda i: row_of(i - 1),
+                step=self.step,
+            )
+        if t.size >= 2:
+            check_time(t, file=self.file, column=col, row_of=row_of, step=self.step)
+
     def __call__(self, raw: dict[str, np.ndarray], offset: int) -> Recording:
         check_equal_lengths(raw, self.mapping, file=self.file)
         n = next(iter(raw.values())).size
+        if self.prev_t is None and n < 2:  # as the whole-file check of the time says
+            raise RecordingError(f"only {n} sample(s)", file=self.file, column=self.tcol)
 
         def row_of(i: int) -> int:
             return self.row_of(offset + i)
@@ -155,20 +177,12 @@ class _Finisher:
             else:
                 data[canon] = v
         if t is None:
+            # a time axis made from the sampling interval is increasing and gap-free by
+            # construction: nothing to check
             assert self.dt is not None
             t = self.t0 + self.dt * np.arange(offset, offset + n, dtype=np.float64)
-        if self.prev_t is None:
-            check_time(t, file=self.file, column=self.tcol, row_of=row_of)
-            self.step = float(np.median(np.diff(t)))
-        elif n:
-            # judge the boundary too: the previous chunk's last stamp leads this one
-            check_time(
-                np.r_[self.prev_t, t],
-                file=self.file,
-                column=self.tcol,
-                row_of=lambda i: row_of(i - 1),
-                step=self.step,
-            )
+        else:
+            self._check_time(t, row_of)
         if n:
             self.prev_t = float(t[-1])
         meta = dict(self.meta, offset=offset)
