@@ -73,9 +73,10 @@ def _handler(args: argparse.Namespace) -> int:
     )
     for key, unit, f in _SHOW[res.kind]:
         if key in comb:
+            birge = comb.get(f"{key}_birge")
+            how = f"pooled; Birge ratio {birge:.2g}" if birge is not None else "mean of the windows"
             print(
-                f"  {key} = {comb[key] * f:.5g} ± {comb[f'{key}_stderr'] * f:.2g} {unit} "
-                f"(pooled; Birge ratio {comb[f'{key}_birge']:.2g})",
+                f"  {key} = {comb[key] * f:.5g} ± {comb[f'{key}_stderr'] * f:.2g} {unit} ({how})",
                 file=say,
             )
     for r in res.rows:

@@ -3,6 +3,7 @@ time or cycle count with its standard error as error bars, and the per-cycle ene
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -92,22 +93,21 @@ def plot_cycles(result: Any, name: str = "energy", ax: Any = None) -> Any:
     return ax
 
 
-def track_figures(result: Any, *, against: str = "time") -> list[tuple[str, Any]]:
-    """``(name, figure)`` for every tracked quantity, then the per-cycle energy."""
+def track_figures(result: Any, *, against: str = "time") -> Iterator[tuple[str, Any]]:
+    """``(name, figure)`` for every tracked quantity, then the per-cycle energy: a generator,
+    so that a caller who closes each figure holds one at a time."""
     import matplotlib.pyplot as plt
 
-    out = []
     for q in result.quantities:
         fig, ax = plt.subplots(figsize=(6.0, 3.2))
         plot_quantity(result, q, against=against, ax=ax)
         fig.tight_layout()
-        out.append((q, fig))
+        yield q, fig
     if result.cycles["energy"].size:
         fig, ax = plt.subplots(figsize=(6.0, 3.2))
         plot_cycles(result, "energy", ax=ax)
         fig.tight_layout()
-        out.append(("cycle_energy", fig))
-    return out
+        yield "cycle_energy", fig
 
 
 __all__ = ["LABELS", "plot_cycles", "plot_quantity", "track_figures"]
