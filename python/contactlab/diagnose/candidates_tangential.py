@@ -195,8 +195,11 @@ class TangentialFamily:
         else:
             core = Masing(p["h0"], p["ac"])
         if "non_masing_scaling" in effects:
+            # the reversal bookkeeping depends on x (through x0 too: the start at the origin
+            # and the mirrored targets on the virgin curve), so a cached one is reused only
+            # for the very same displacement (issue 13)
             mem = d.extra.get("memory")
-            if mem is None:
+            if mem is None or not np.array_equal(mem.x, x):
                 mem = d.extra["memory"] = memory(x)
             h = scaled_force(core.virgin, p["lam"], mem)
         else:

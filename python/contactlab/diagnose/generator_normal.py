@@ -16,8 +16,8 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..errors import InputError
+from ._gen_common import HiddenEffectRecording, _rms, _sizes, block_excitation
 from .candidates_normal import frequency_domain, kelvin_voigt, nonlinear
-from .generator import HiddenEffectRecording, _rms, _sizes, block_excitation
 
 NORMAL_EFFECTS = (
     "stiffness_nonlinearity",

@@ -18,9 +18,9 @@ from typing import Any
 
 import numpy as np
 
-from .._arrays import as_1d
 from ..errors import InputError
 from ._family import Family, Prepared
+from ._inputs import arrays as _arrays
 from ._signal import noise_rms
 from .locate import locate
 from .model import ExtendedModel
@@ -219,37 +219,6 @@ def _family(model: Any) -> tuple[Family, dict[str, float], dict[str, float]]:
         ctx = {"omega": float(model.omega)} if hasattr(model, "omega") else {}
         return NormalFamily(), start, ctx
     raise InputError(f"cannot diagnose a model of type {type(model).__name__}")
-
-
-def _arrays(recording: Any, family: Family) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(t, input, output)`` from a Recording-like object, a dict or a tuple of arrays."""
-    uname, yname = family.input_name, family.output_name
-    if hasattr(recording, "t") and hasattr(recording, "data"):
-        data, t = recording.data, recording.t
-    elif isinstance(recording, dict):
-        data, t = recording, recording.get("t")
-    elif isinstance(recording, Sequence) and len(recording) == 3:
-        t, u, y = recording
-        data = {uname: u, yname: y}
-    else:
-        raise InputError(
-            "recording must be a contactlab.io.Recording, a dict with 't', "
-            f"'{uname}', '{yname}', or a tuple (t, {uname}, {yname})"
-        )
-    for k in (uname, yname):
-        if k not in data:
-            raise InputError(
-                f"the {family.kind} workflow needs channels '{uname}' and '{yname}'; "
-                f"the recording has {sorted(data)}"
-            )
-    if t is None:
-        raise InputError("the recording has no time vector 't'")
-    ta = as_1d(t, "t")
-    u = as_1d(data[uname], uname)
-    y = as_1d(data[yname], yname)
-    if not (ta.size == u.size == y.size):
-        raise InputError(f"t, {uname}, {yname} have {ta.size}, {u.size}, {y.size} samples")
-    return ta, u, y
 
 
 def diagnose(
