@@ -20,6 +20,7 @@ from scipy.signal import savgol_filter
 from ..errors import InputError
 
 _MAD_TO_SIGMA = 1.0 / 0.6744897501960817
+INPUT_FILTER_FRACTION = 0.04
 
 
 def check_uniform(t: np.ndarray) -> float:
@@ -52,9 +53,9 @@ def dominant_period_samples(u: np.ndarray) -> float:
     return n / k
 
 
-def smooth_window(period_samples: float, fraction: float = 0.08) -> int:
-    """Odd Savitzky-Golay window covering ``fraction`` of a period (at least 7 samples)."""
-    w = max(7, round(fraction * period_samples))
+def smooth_window(period_samples: float, fraction: float = 0.08, least: int = 7) -> int:
+    """Odd Savitzky-Golay window covering ``fraction`` of a period (at least ``least``)."""
+    w = max(least, round(fraction * period_samples))
     return w if w % 2 == 1 else w + 1
 
 
@@ -64,6 +65,37 @@ def derivatives(u: np.ndarray, dt: float, window: int) -> tuple[np.ndarray, np.n
     d1 = savgol_filter(u, w, 3, deriv=1, delta=dt, mode="interp")
     d2 = savgol_filter(u, w, 3, deriv=2, delta=dt, mode="interp")
     return d1, d2
+
+
+def input_noise(u: np.ndarray) -> float:
+    """Sensor-noise RMS of an input channel, estimated from the data.
+
+    The smaller of two estimates that a smooth drive can only bias upwards: the tangential
+    analysis's second-difference estimator
+    (:func:`contactlab.tangential.uncertainty.x_noise_var`) and the third-difference one of
+    :func:`noise_rms`, which a sine at few samples per period disturbs less.
+    """
+    from ..tangential.uncertainty import x_noise_var
+
+    return float(min(np.sqrt(x_noise_var(u, None)), noise_rms(u)))
+
+
+def filter_input(u: np.ndarray, period_samples: float, sigma: float) -> tuple[np.ndarray, int]:
+    """The input every candidate sees: zero-phase Savitzky-Golay smoothing (cubic) over
+    :data:`INPUT_FILTER_FRACTION` of a period when the input carries noise, else ``u``.
+
+    A cubic over 4 % of a period changes a sine by about 3e-5 of its amplitude (far below
+    any sensor's noise) and divides white noise by ``√(w/2.25)``, leaving what remains
+    correlated over the window: a fractional delay can no longer average it away.
+    Returns the input and the window (0: not filtered).
+    """
+    if not sigma > 0.0:
+        return u, 0
+    w = smooth_window(period_samples, INPUT_FILTER_FRACTION, 5)
+    w = min(w, u.size - (1 - u.size % 2))
+    if w < 5:
+        return u, 0
+    return savgol_filter(u, w, 3, mode="interp"), w
 
 
 def noise_rms(residual: np.ndarray) -> float:

@@ -43,9 +43,10 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from scipy.signal import savgol_filter
 
 from ..masing import Masing, loop_area
-from ._family import Candidate, ParamSpec, Prepared
+from ._family import Candidate, ParamSpec, Prepared, implausible_common
 from ._signal import shift
 from .scaled_masing import memory, scaled_force
 
@@ -171,7 +172,7 @@ class TangentialFamily:
         """Grid over ``ac·max|x|`` with ``h0`` by linear least squares (F is linear in h0)."""
         xmax = float(np.max(np.abs(d.u)))
         best = (np.inf, 1.0, 1.0)
-        for q in np.geomspace(0.2, 50.0, 13):
+        for q in np.geomspace(0.2, 5000.0, 23):  # pre-sliding to gross sliding
             ac = q / xmax
             g = Masing(1.0, ac).force(d.u)
             gg = float(g @ g)
@@ -246,6 +247,52 @@ class TangentialFamily:
 
     def base_model(self, p: dict[str, float], context: dict[str, float]) -> Any:
         return Masing(p["h0"], p["ac"])
+
+    def slope(self, p: dict[str, float], d: Prepared) -> np.ndarray:
+        """Local slope ``|dF/dx|`` where the input noise turns into force error: the larger of
+        the base Masing element's slope along the (filtered) displacement and the measured
+        path's (``|dF/dt| / |dx/dt|``, Savitzky-Golay derivatives), within ``[0, h0·ac]`` —
+        the steepest slope of the exponential element, at a reversal. The measured path is
+        what marks a sticking phase (the force changes while the displacement does not),
+        which a steep element crosses in a fraction of a micrometre."""
+        h = Masing(p["h0"], p["ac"]).force(d.u)
+        kmax = p["h0"] * p["ac"]
+        w = min(d.window, d.y.size - (1 - d.y.size % 2))
+        yd = savgol_filter(d.y, w, 3, deriv=1, mode="interp")
+        ud = savgol_filter(d.u, w, 3, deriv=1, mode="interp")
+        with np.errstate(divide="ignore", invalid="ignore"):
+            km = np.abs(np.gradient(h) / np.gradient(d.u))
+            kd = np.abs(yd / ud)
+        k = np.fmax(np.where(np.isfinite(km), km, kmax), np.where(np.isfinite(kd), kd, kmax))
+        return np.clip(k, 0.0, kmax)
+
+    def implausible(self, name: str, p: dict[str, float], d: Prepared) -> str | None:
+        """Why a fitted effect cannot be physical on this rig, or None."""
+        why = implausible_common(self.candidates[name], p, d)
+        if why:
+            return why
+        if name == "non_masing_scaling" and not 0.5 <= p["lam"] <= 8.0:
+            return f"branch scale lam = {p['lam']:.3g} is outside 0.5..8 (no known joint)"
+        if name == "displacement_offset":
+            amp = 0.5 * float(np.ptp(d.u))
+            if abs(p["x0"]) > 0.5 * amp:
+                return f"a displacement offset of {p['x0']:.3g} m is over half the amplitude"
+        return None
+
+    def regime(self, p: dict[str, float], d: Prepared) -> str:
+        """Pre-sliding, transition or gross sliding, from ``ac·A`` of the base fit."""
+        amp = 0.5 * float(np.ptp(d.u))
+        q = p["ac"] * amp
+        if q < 1.0:
+            kind = "pre-sliding (ac·A < 1: only h0·ac, the initial stiffness, is well fixed)"
+        elif q < 10.0:
+            kind = "transition from pre-sliding to sliding (h0 and ac both fixed)"
+        else:
+            kind = (
+                "gross sliding (ac·A > 10: near-rectangular loops; h0 is the plateau force, "
+                "ac only bounded from below)"
+            )
+        return f"base model regime: {kind}; h0 = {p['h0']:.4g} N, ac·A = {q:.3g}"
 
     @staticmethod
     def loop_energy(u: np.ndarray, y: np.ndarray) -> float:

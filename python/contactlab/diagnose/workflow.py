@@ -11,12 +11,14 @@ candidate helps; (5) report held-out RMS, peak error and loop-energy error after
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from scipy.signal import savgol_coeffs
 
 from ..errors import InputError
 from ._family import Family, Prepared
@@ -221,6 +223,31 @@ def _family(model: Any) -> tuple[Family, dict[str, float], dict[str, float]]:
     raise InputError(f"cannot diagnose a model of type {type(model).__name__}")
 
 
+def eiv_weight(
+    family: Family, params: dict[str, float], d: Prepared, sigma: float
+) -> tuple[np.ndarray, float] | None:
+    """Errors-in-variables weights of the samples and the sub-sample delay's gain budget.
+
+    ``w = σy² / (σy² + (s σu')²)`` with ``s`` the base model's local slope ``|dy/du|``
+    (:meth:`Family.slope`) and ``σu'`` the noise left in the input the candidates see (the
+    estimated input noise times the filter's noise gain). The budget, in units of ``σy²``, is
+    the mean of ``(s σu')² w``: the most that smoothing the input could lower the weighted
+    error, which a delay shorter than a sample must beat. None when the family has no slope
+    or the input carries no measurable noise.
+    """
+    su = float(d.extra.get("u_noise", 0.0))
+    if not su > 0.0:
+        return None
+    s = family.slope(params, d)
+    if s is None:
+        return None
+    wlen = int(d.extra.get("u_filter", 0))
+    gain = float(np.sum(savgol_coeffs(wlen, 3) ** 2)) if wlen else 1.0
+    var = (s * su) ** 2 * gain
+    w = sigma**2 / (sigma**2 + var)
+    return w, float(np.mean(var * w)) / sigma**2
+
+
 def diagnose(
     recording: Any,
     model: Any = "tangential",
@@ -292,7 +319,23 @@ def diagnose(
     sigma = noise_rms(current.full_residual(d))
     if sigma <= 0:
         raise InputError("the output channel has no noise at all; cannot judge significance")
+    budget = 0.0
+    w = eiv_weight(family, current.full.params, d, sigma)
+    if w is not None:  # errors in variables: refit the base with the likelihood's weights
+        d.extra["weight"], budget = w
+        current = evaluate(family, effects, d, current.full.params, scales, folds)
+        sigma = noise_rms(current.full_residual(d))
     where, location = locate(d, current.full_residual(d), family)
+    where.insert(0, family.regime(current.full.params, d))
+    if w is not None:
+        low = float(np.mean(d.extra["weight"] < 0.5))
+        location["low_weight_fraction"] = low
+        if low > 0.01:
+            where.append(
+                f"{100 * low:.0f} % of the samples count less than half (input noise "
+                f"{d.extra['u_noise']:.3g} seen through a steep local slope, e.g. sticking "
+                "phases after reversals): what the model does there is barely tested"
+            )
     trials = [current]
     steps = [Step(None, current.heldout_rms, current.heldout_peak, current.energy_error)]
     added: list[str] = []
@@ -302,7 +345,14 @@ def diagnose(
             if name in effects or not family.check((*effects, name)):
                 continue
             cand = evaluate(family, (*effects, name), d, current.full.params, scales, folds)
-            v = judge(name, current, cand, sigma, z, min_gain)
+            p = cand.full.params
+            extra = 0.0
+            if name == "channel_delay" and abs(p["tau"]) < d.dt:
+                extra = budget  # a sub-sample shift must beat what smoothing the input buys
+            v = judge(name, current, cand, sigma, z, min_gain + extra)
+            why = family.implausible(name, p, d)
+            if v.accepted and why:
+                v = dataclasses.replace(v, accepted=False, reason=f"implausible: {why}")
             verdicts.append(v)
             if v.accepted and (best is None or v.gain > best[0].gain):
                 best = (v, cand)
