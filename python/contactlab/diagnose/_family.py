@@ -134,6 +134,8 @@ class Family(Protocol):
 
     input_name: str
     output_name: str
+    input_unit: str
+    output_unit: str
 
     def prepare(self, d: Prepared) -> None: ...
 

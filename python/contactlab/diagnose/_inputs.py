@@ -41,3 +41,38 @@ def arrays(recording: Any, family: Family) -> tuple[np.ndarray, np.ndarray, np.n
     if not (ta.size == u.size == y.size):
         raise InputError(f"t, {uname}, {yname} have {ta.size}, {u.size}, {y.size} samples")
     return ta, u, y
+
+
+#: channels beyond these magnitudes (in SI units) are not measurements: a unit or scaling
+#: error, and squares of them overflow
+_MAX_ABS = 1e100
+_MIN_RMS = 1e-100
+
+
+def check_channels(t: np.ndarray, named: dict[str, tuple[np.ndarray, str]]) -> None:
+    """Sentences about the data for channels no model can be fitted to: a time axis or
+    values too large to be SI measurements, a constant or vanishing output."""
+    if float(np.max(np.abs(t))) > _MAX_ABS:
+        raise InputError(
+            f"the time axis reaches {float(np.max(np.abs(t))):.3g} s; that is not a time in "
+            "seconds — check the time column's unit"
+        )
+    for name, (v, unit) in named.items():
+        big = float(np.max(np.abs(v)))
+        if big > _MAX_ABS:
+            i = int(np.argmax(np.abs(v)))
+            raise InputError(
+                f"channel {name!r} holds {v[i]:.3g} {unit} at sample {i}; that is not a "
+                f"measurement in {unit} — check the channel's unit or scaling"
+            )
+        if float(np.ptp(v)) == 0.0:
+            raise InputError(
+                f"channel {name!r} is constant ({v[0] + 0.0:.6g} {unit} at every sample): there is "
+                "no loop to diagnose — is the sensor connected?"
+            )
+        rms = float(np.sqrt(np.mean((v / big) ** 2))) * big
+        if rms < _MIN_RMS:
+            raise InputError(
+                f"channel {name!r} has an RMS of {rms:.3g} {unit}: no measurable signal — "
+                f"check the channel's unit or scaling"
+            )

@@ -159,6 +159,8 @@ class NormalFamily:
     candidates = CANDIDATES
     input_name = "p"
     output_name = "delta"
+    input_unit = "Pa"
+    output_unit = "m"
 
     def prepare(self, d: Prepared) -> None:
         """Mean pressure, excitation angular frequency and displacement scale.

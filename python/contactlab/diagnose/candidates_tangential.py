@@ -45,6 +45,7 @@ from typing import Any
 import numpy as np
 from scipy.signal import savgol_filter
 
+from ..errors import InputError
 from ..masing import Masing, loop_area
 from ._family import Candidate, ParamSpec, Prepared, implausible_common
 from ._signal import shift
@@ -133,6 +134,23 @@ def series_backbone(h0: float, ac: float, C_s: float, x_max: float) -> tuple[np.
     return u + C_s * f, f
 
 
+def _grid(x: np.ndarray, F: np.ndarray) -> tuple[float, float, float]:
+    """Best ``(rss, h0, ac)`` over ``ac·max|x|`` from pre-sliding to gross sliding."""
+    xmax = float(np.max(np.abs(x)))
+    best = (np.inf, 1.0, 1.0)
+    for q in np.geomspace(0.2, 5000.0, 23):
+        ac = q / xmax
+        g = Masing(1.0, ac).force(x)
+        gg = float(g @ g)
+        if gg == 0.0:
+            continue
+        h0 = max(float(g @ F) / gg, 1e-12)
+        r = float(np.sum((h0 * g - F) ** 2))
+        if r < best[0]:
+            best = (r, h0, ac)
+    return best
+
+
 class TangentialFamily:
     """Masing base model with the tangential candidate library (see module docstring)."""
 
@@ -141,6 +159,8 @@ class TangentialFamily:
     candidates = CANDIDATES
     input_name = "x"
     output_name = "F"
+    input_unit = "m"
+    output_unit = "N"
 
     def prepare(self, d: Prepared) -> None:
         """Nothing to precompute beyond :class:`Prepared` (memory is cached lazily)."""
@@ -169,20 +189,26 @@ class TangentialFamily:
         }
 
     def initial_base(self, d: Prepared) -> dict[str, float]:
-        """Grid over ``ac·max|x|`` with ``h0`` by linear least squares (F is linear in h0)."""
-        xmax = float(np.max(np.abs(d.u)))
-        best = (np.inf, 1.0, 1.0)
-        for q in np.geomspace(0.2, 5000.0, 23):  # pre-sliding to gross sliding
-            ac = q / xmax
-            g = Masing(1.0, ac).force(d.u)
-            gg = float(g @ g)
-            if gg == 0.0:
-                continue
-            h0 = max(float(g @ d.y) / gg, 1e-12)
-            r = float(np.sum((h0 * g - d.y) ** 2))
-            if r < best[0]:
-                best = (r, h0, ac)
-        return {"h0": best[1], "ac": best[2]}
+        """Grid over ``ac·max|x|`` with ``h0`` by linear least squares (F is linear in h0).
+
+        Refuses, with a sentence about the data, a force that no Masing curve follows and a
+        loop that runs the wrong way (∮F dx < 0: the force recorded with the opposite sign).
+        """
+        rss, h0, ac = _grid(d.u, d.y)
+        var = float(np.sum((d.y - d.y.mean()) ** 2))
+        if not rss < 0.9 * var:
+            if _grid(d.u, -d.y)[0] < 0.5 * var:
+                raise InputError(
+                    f"the loop runs the wrong way: ∮F dx = {loop_area(d.u, d.y):.3g} J over the "
+                    "recording, but a passive joint dissipates (∮F dx > 0); the force channel "
+                    "is recorded with the opposite sign — negate F"
+                )
+            raise InputError(
+                f"the force does not follow the displacement: the best Masing curve explains "
+                f"{100 * max(0.0, 1 - rss / var):.0f} % of the force variance — no friction "
+                "loop in this recording (unrelated or swapped channels?)"
+            )
+        return {"h0": h0, "ac": ac}
 
     def predict(self, p: dict[str, float], effects: tuple[str, ...], d: Prepared) -> np.ndarray:
         """Measured force predicted for the measured displacement ``d.u``."""

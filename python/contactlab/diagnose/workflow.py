@@ -18,15 +18,16 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.signal import savgol_coeffs
+from scipy.signal import decimate, savgol_coeffs
 
 from ..errors import InputError
 from ._family import Family, Prepared
 from ._inputs import arrays as _arrays
-from ._signal import noise_rms
+from ._inputs import check_channels
+from ._signal import check_uniform, dominant_period_samples, noise_rms
 from .locate import locate
 from .model import ExtendedModel
-from .select import Trial, Verdict, evaluate, judge
+from .select import Trial, Verdict, evaluate, fit, judge
 
 __all__ = ["DiagnosisReport", "Effect", "Step", "diagnose"]
 
@@ -223,6 +224,44 @@ def _family(model: Any) -> tuple[Family, dict[str, float], dict[str, float]]:
     raise InputError(f"cannot diagnose a model of type {type(model).__name__}")
 
 
+#: longest record diagnosed sample by sample; longer ones are decimated (anti-aliased, zero
+#: phase) to no fewer than MIN_SAMPLES_PER_CYCLE per excitation period and, if still longer,
+#: diagnosed on their first MAX_SAMPLES samples (said so in the report)
+MAX_SAMPLES = 24_000
+MIN_SAMPLES_PER_CYCLE = 64
+
+
+def reduce_long(
+    t: np.ndarray, u: np.ndarray, y: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
+    """A long record brought to at most :data:`MAX_SAMPLES` samples, and a sentence saying
+    how (empty when the record is used as it is).
+
+    Both channels go through the same zero-phase FIR anti-alias filter before every q-th
+    sample is kept, so neither channel is delayed against the other and the noise of both
+    is reduced alike (the noise level is then estimated on the decimated record).
+    """
+    n = t.size
+    if n <= MAX_SAMPLES:
+        return t, u, y, ""
+    check_uniform(t)
+    per = dominant_period_samples(u)
+    q = int(min(per // MIN_SAMPLES_PER_CYCLE, -(-n // MAX_SAMPLES)))
+    how = []
+    if q > 1:
+        u = decimate(u, q, ftype="fir", zero_phase=True)
+        y = decimate(y, q, ftype="fir", zero_phase=True)
+        t = t[::q][: u.size]
+        how.append(f"decimated by {q} (zero-phase anti-alias filter on both channels)")
+    if t.size > MAX_SAMPLES:
+        cycles = t.size * q / per
+        t, u, y = t[:MAX_SAMPLES], u[:MAX_SAMPLES], y[:MAX_SAMPLES]
+        how.append(
+            f"diagnosed on its first {MAX_SAMPLES * q / per:.0f} of {cycles:.0f} excitation cycles"
+        )
+    return t, u, y, f"the record of {n} samples was " + " and ".join(how)
+
+
 def eiv_weight(
     family: Family, params: dict[str, float], d: Prepared, sigma: float
 ) -> tuple[np.ndarray, float] | None:
@@ -296,6 +335,9 @@ def diagnose(
     """
     family, start, context = _family(model)
     t, u, y = _arrays(recording, family)
+    check_channels(
+        t, {family.input_name: (u, family.input_unit), family.output_name: (y, family.output_unit)}
+    )
     if folds < 2:
         raise InputError(f"folds must be >= 2, got {folds}")
     if max_effects < 0:
@@ -308,6 +350,8 @@ def diagnose(
             raise InputError(
                 f"unknown {family.kind} candidate {n!r}; choose from {', '.join(family.candidates)}"
             )
+    n_in = t.size
+    t, u, y, reduced = reduce_long(t, u, y)
     d = Prepared.build(t, u, y)
     d.extra.update(context)
     family.prepare(d)
@@ -327,6 +371,9 @@ def diagnose(
         sigma = noise_rms(current.full_residual(d))
     where, location = locate(d, current.full_residual(d), family)
     where.insert(0, family.regime(current.full.params, d))
+    if reduced:
+        where.insert(1, reduced)
+    location["samples"] = {"recording": n_in, "diagnosed": int(t.size)}
     if w is not None:
         low = float(np.mean(d.extra["weight"] < 0.5))
         location["low_weight_fraction"] = low
@@ -339,12 +386,31 @@ def diagnose(
     trials = [current]
     steps = [Step(None, current.heldout_rms, current.heldout_peak, current.energy_error)]
     added: list[str] = []
+    all_samples = np.ones(d.y.size, bool)
     while len(added) < max_effects:
         verdicts, best = [], None
         for name in names:
             if name in effects or not family.check((*effects, name)):
                 continue
-            cand = evaluate(family, (*effects, name), d, current.full.params, scales, folds)
+            trial_effects = (*effects, name)
+            # screening: a candidate whose fit to all data lowers the error by less than
+            # min_gain σ² cannot do better on held-out cycles; no cross-validation for it
+            full = fit(family, trial_effects, d, all_samples, current.full.params, scales)
+            in_gain = (current.full.mse - full.mse) / sigma**2
+            if in_gain < min_gain:
+                verdicts.append(
+                    Verdict(
+                        name,
+                        np.nan,
+                        float(in_gain),
+                        np.nan,
+                        np.nan,
+                        False,
+                        f"in-sample gain {in_gain:.3g} σ² below {min_gain:g} σ²",
+                    )
+                )
+                continue
+            cand = evaluate(family, trial_effects, d, current.full.params, scales, folds, full)
             p = cand.full.params
             extra = 0.0
             if name == "channel_delay" and abs(p["tau"]) < d.dt:
