@@ -88,3 +88,64 @@ def _sizes(
         if not (0.0 < float(m) < 1.0):
             raise InputError(f"magnitude of {n} must be in (0, 1), got {m}")
     return {n: float(m) for n, m in sizes.items()}
+
+
+ANTI_ALIAS_ORDER = 4
+
+
+def measure(
+    t: np.ndarray,
+    u: np.ndarray,
+    y: np.ndarray,
+    rng: np.random.Generator,
+    *,
+    u_noise: float,
+    y_noise: float,
+    anti_alias: tuple[float, float] | None,
+    bits: int | None,
+    f_ref: float,
+) -> tuple[np.ndarray, np.ndarray, dict[str, Any]]:
+    """What a rig's two channels record of the true input ``u`` and output ``y``.
+
+    Each channel passes its own causal anti-alias filter (Butterworth of order
+    :data:`ANTI_ALIAS_ORDER`, cut-offs ``anti_alias = (input, output)`` as fractions of the
+    Nyquist frequency; started at rest at the first value), gets white sensor noise of RMS
+    ``u_noise`` / ``y_noise`` (absolute) and is quantised to ``bits`` over ±1.25 × its peak.
+    Different cut-offs delay one channel against the other: ``info["filter_skew"]`` is the
+    output's group delay minus the input's at ``f_ref`` (seconds; positive: the output lags).
+    """
+    from scipy.signal import butter, group_delay, lfilter, lfilter_zi
+
+    dt = float(t[1] - t[0])
+    info: dict[str, Any] = {"filter_skew": 0.0}
+    chans = []
+    delays = []
+    for k, (v, sd) in enumerate(((u, u_noise), (y, y_noise))):
+        out = np.asarray(v, float)
+        if anti_alias is not None:
+            fc = float(anti_alias[k])
+            if not 0.0 < fc < 1.0:
+                raise InputError(f"anti-alias cut-offs are fractions of Nyquist, got {fc}")
+            b, a = butter(ANTI_ALIAS_ORDER, fc)
+            out, _ = lfilter(b, a, out, zi=lfilter_zi(b, a) * out[0])
+            _, gd = group_delay((b, a), w=[2.0 * np.pi * f_ref * dt])
+            delays.append(float(gd[0]) * dt)
+        if sd > 0:
+            out = out + rng.normal(0.0, sd, out.size)
+        if bits is not None:
+            lsb = 2.5 * float(np.max(np.abs(out))) / 2.0**bits
+            out = np.round(out / lsb) * lsb
+        chans.append(out)
+    if delays:
+        info["filter_skew"] = delays[1] - delays[0]
+    return chans[0], chans[1], info
+
+
+def _start_index(start: str, t: np.ndarray, f0: float, f_min: float) -> int:
+    """First sample kept: 0 from rest; after the amplitude ramp (one period of the slowest
+    block) and 1.5 reference cycles more for a steady start."""
+    if start == "rest":
+        return 0
+    if start != "steady":
+        raise InputError(f"start must be 'rest' or 'steady', got {start!r}")
+    return int(np.searchsorted(t, 1.0 / f_min + 1.5 / f0))

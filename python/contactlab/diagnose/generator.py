@@ -32,7 +32,14 @@ from scipy.optimize import brentq
 
 from ..errors import InputError
 from ..masing import Masing
-from ._gen_common import HiddenEffectRecording, _rms, _sizes, block_excitation
+from ._gen_common import (
+    HiddenEffectRecording,
+    _rms,
+    _sizes,
+    _start_index,
+    block_excitation,
+    measure,
+)
 from .generator_normal import hidden_effect_recording_normal
 from .scaled_masing import memory, scaled_force
 
@@ -121,6 +128,10 @@ def hidden_effect_recording(
     seed: int = 0,
     cycles_per_block: int = 6,
     samples_per_cycle: int = 120,
+    input_noise: float | None = None,
+    anti_alias: tuple[float, float] | None = None,
+    bits: int | None = None,
+    start: str = "rest",
     **base: float,
 ) -> HiddenEffectRecording:
     """Simulate a recording with hidden effects and sensor noise.
@@ -143,6 +154,19 @@ def hidden_effect_recording(
     cycles_per_block, samples_per_cycle : int
         Excitation cycles per amplitude block (three blocks) and samples per cycle at the
         reference frequency.
+    input_noise : float, optional
+        Input sensor noise RMS relative to the input's amplitude (``max |x|``; 0.002 =
+        0.2 %), instead of the default fifth of ``noise`` relative to its RMS.
+    anti_alias : (float, float), optional
+        Cut-offs of causal 4th-order Butterworth anti-alias filters on the input and output
+        channels, as fractions of the Nyquist frequency; different cut-offs skew the
+        channels (``truth["filter_skew"]``, s).
+    bits : int, optional
+        ADC resolution: each channel quantised to ``bits`` over ±1.25 × its peak.
+    start : {"rest", "steady"}
+        ``"rest"``: the record starts with the joint at rest on its virgin curve;
+        ``"steady"``: the first 1.5 reference cycles after the amplitude ramp are cut, so
+        the record starts in the middle of a loop with its history unseen.
     **base
         Base-model parameters: tangential ``h0`` (N, default 50), ``ac`` (1/m, default 5e4),
         ``f0`` (Hz, default 5).
@@ -167,6 +191,10 @@ def hidden_effect_recording(
             seed=seed,
             cycles_per_block=cycles_per_block,
             samples_per_cycle=samples_per_cycle,
+            input_noise=input_noise,
+            anti_alias=anti_alias,
+            bits=bits,
+            start=start,
             **base,
         )
     if model != "tangential":
@@ -207,16 +235,30 @@ def hidden_effect_recording(
             sign = 1.0 if rng.random() < 0.5 else -1.0
         params[name] = _solve_size(name, target, sign, size, h0, ac, Fr, period)
     x, F = _tangential_force(params, t, xfun, h0, ac, period)
-    x_noise = 0.2 * noise * _rms(x)
+    keep = _start_index(start, t, f0, 0.6 * f0)
+    t, x, F = t[keep:] - t[keep], x[keep:], F[keep:]
+    x_noise = (
+        0.2 * noise * _rms(x) if input_noise is None else input_noise * float(np.max(np.abs(x)))
+    )
     F_noise = noise * _rms(F)
-    xm = x + rng.normal(0.0, x_noise, x.size)
-    Fm = F + rng.normal(0.0, F_noise, F.size)
+    xm, Fm, info = measure(
+        t,
+        x,
+        F,
+        rng,
+        u_noise=x_noise,
+        y_noise=F_noise,
+        anti_alias=anti_alias,
+        bits=bits,
+        f_ref=f0,
+    )
     truth = {
         "model": "tangential",
         "base": {"h0": h0, "ac": ac, "f0": f0},
         "effects": {n: {_PARAM_NAME[n]: v} for n, v in params.items()},
         "magnitudes": dict(sizes),
         "noise_rms": {"x": x_noise, "F": F_noise},
+        "sensors": {"anti_alias": anti_alias, "bits": bits, "start": start, **info},
     }
     return HiddenEffectRecording(
         t,
