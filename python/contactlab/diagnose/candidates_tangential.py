@@ -111,6 +111,40 @@ CANDIDATES: dict[str, Candidate] = {
             (ParamSpec("beta", "-", 0.0, -0.95, 5.0, "one"),),
             "saturation force drifting over the recording: h0(t) = h0 (1 + beta t/T)",
         ),
+        Candidate(
+            "stribeck",
+            (
+                ParamSpec("s", "-", 0.0, -0.9, 3.0, "one"),
+                ParamSpec("v_s", "m/s", np.nan, 0.0, _INF, "v"),
+            ),
+            "velocity-dependent friction: F = h (1 + s exp(-|ẋ|/v_s)) (Stribeck, s > 0: "
+            "friction weakening with sliding speed)",
+        ),
+        Candidate(
+            "position_friction",
+            tuple(ParamSpec(n, "-", 0.0, -0.9, 0.9, "one") for n in ("a1", "b1", "a2", "b2")),
+            "friction varying along the track (wavy plateaus): F = h (1 + Σ a_k cos(kπ ξ) + "
+            "b_k sin(kπ ξ)), ξ the position scaled to -1..1 over the stroke, k = 1, 2",
+        ),
+        Candidate(
+            "stick_slip",
+            (
+                ParamSpec("s_b", "-", 0.0, 0.0, 3.0, "one"),
+                ParamSpec("ell", "m", np.nan, 0.0, _INF, "x"),
+            ),
+            "breakaway after each reversal: the branch rises s_b above Masing's and falls back "
+            "over a slip distance ell (static friction above kinetic)",
+        ),
+        Candidate(
+            "normal_load",
+            (
+                ParamSpec("eps_c", "-", 0.0, -0.5, 0.5, "one"),
+                ParamSpec("eps_s", "-", 0.0, -0.5, 0.5, "one"),
+                ParamSpec("f_n", "Hz", np.nan, 0.0, _INF, "fq"),
+            ),
+            "normal load fluctuating at its own frequency f_n: F = h (1 + eps_c cos 2π f_n t "
+            "+ eps_s sin 2π f_n t)",
+        ),
     )
 }
 
@@ -132,6 +166,31 @@ def series_backbone(h0: float, ac: float, C_s: float, x_max: float) -> tuple[np.
     u = 3.0 * x_max * s * s
     f = h0 * -np.expm1(-ac * u)
     return u + C_s * f, f
+
+
+def breakaway(
+    h: np.ndarray, x: np.ndarray, reversals: np.ndarray, s_b: float, ell: float
+) -> np.ndarray:
+    """Branches with a breakaway peak: after each reversal ``r`` the rise ``h - h_r`` is
+    scaled by ``1 + s_b exp(-|x - x_r| / ell)`` — equal to Masing's at the reversal (no
+    jump) and far from it, above it in between (static friction above kinetic). Before the
+    first reversal the virgin curve from the origin is treated the same way."""
+    if s_b == 0.0:
+        return h
+    idx = np.searchsorted(reversals, np.arange(h.size), side="right") - 1
+    has = idx >= 0
+    r = reversals[np.where(has, idx, 0)] if reversals.size else np.zeros(h.size, int)
+    xr = np.where(has, x[r], 0.0)
+    hr = np.where(has, h[r], 0.0)
+    return hr + (h - hr) * (1.0 + s_b * np.exp(-np.abs(x - xr) / max(ell, 1e-300)))
+
+
+def breakaway_force(h0: float, ac: float, s_b: float, ell: float) -> float:
+    """Peak force of a full branch from ``-h0`` with the breakaway of :func:`breakaway`
+    (the static friction force; ``h0`` without breakaway)."""
+    u = np.linspace(0.0, 20.0 / ac + 20.0 * ell, 4001)
+    rise = 2.0 * h0 * -np.expm1(-ac * u / 2.0)
+    return float(np.max(-h0 + rise * (1.0 + s_b * np.exp(-u / max(ell, 1e-300)))))
 
 
 def _grid(x: np.ndarray, F: np.ndarray) -> tuple[float, float, float]:
@@ -163,11 +222,44 @@ class TangentialFamily:
     output_unit = "N"
 
     def prepare(self, d: Prepared) -> None:
-        """Nothing to precompute beyond :class:`Prepared` (memory is cached lazily)."""
+        """The stroke (centre and half-range of x) that scales the position of
+        ``position_friction``; kept when given by a fitted model's context."""
+        if "x_mid" not in d.extra:
+            lo, hi = float(np.min(d.u)), float(np.max(d.u))
+            d.extra["x_mid"], d.extra["x_half"] = 0.5 * (lo + hi), 0.5 * (hi - lo) or 1.0
 
     def context(self, d: Prepared) -> dict[str, float]:
-        """Nothing beyond the parameters is needed to simulate a fitted model."""
-        return {}
+        """The stroke scaling of ``position_friction`` (the rest are parameters)."""
+        return {"x_mid": d.extra["x_mid"], "x_half": d.extra["x_half"]}
+
+    def start_effect(
+        self, name: str, p: dict[str, float], d: Prepared, residual: np.ndarray
+    ) -> dict[str, float]:
+        """Starting values of an effect's nonlinear parameters from the current residual.
+
+        ``normal_load``: the frequency whose ``h cos, h sin`` pair explains most of the
+        residual (measured minus model), scanned from 0.05 to 3 excitation frequencies at a
+        quarter of the record's frequency resolution; ``stick_slip``: a slip distance of
+        ``1/ac``; ``stribeck``: ``v_s`` of the RMS speed.
+        """
+        if name == "stick_slip":
+            return {"ell": 1.0 / p["ac"]}
+        if name == "stribeck":
+            return {"v_s": float(np.sqrt(np.mean(d.ud**2)))}
+        if name != "normal_load":
+            return {}
+        h = self.predict(p, (), d)
+        tt = d.t - d.t[0]
+        f_exc = 1.0 / (d.cycles.period_samples * d.dt)
+        freqs = np.arange(0.05 * f_exc, 3.0 * f_exc, 0.25 / d.duration)
+        best, fbest = -1.0, f_exc
+        for f in freqs:
+            A = np.column_stack((h * np.cos(2 * np.pi * f * tt), h * np.sin(2 * np.pi * f * tt)))
+            coef = np.linalg.lstsq(A, residual, rcond=None)[0]
+            gain = float(np.sum((A @ coef) ** 2))
+            if gain > best:
+                best, fbest = gain, float(f)
+        return {"f_n": fbest}
 
     def check(self, effects: tuple[str, ...]) -> bool:
         """All tangential effects combine (in the order of the module docstring)."""
@@ -186,6 +278,8 @@ class TangentialFamily:
             "x": 0.05 * xs,
             "tau": d.cycles.period_samples * d.dt / 100.0,
             "one": 1.0,
+            "v": rms(d.ud),
+            "fq": 1.0 / d.duration,
         }
 
     def initial_base(self, d: Prepared) -> dict[str, float]:
@@ -235,6 +329,22 @@ class TangentialFamily:
             h = h + p["alpha"] * np.abs(h)
         if "parameter_drift" in effects:
             h = h * (1.0 + p["beta"] * (d.t - d.t[0]) / d.duration)
+        if "stick_slip" in effects:
+            h = breakaway(h, x, d.cycles.reversals, p["s_b"], p["ell"])
+        if "stribeck" in effects:
+            h = h * (1.0 + p["s"] * np.exp(-np.abs(d.ud) / max(p["v_s"], 1e-300)))
+        if "position_friction" in effects:
+            xi = np.pi * (x - d.extra["x_mid"]) / d.extra["x_half"]
+            h = h * (
+                1.0
+                + p["a1"] * np.cos(xi)
+                + p["b1"] * np.sin(xi)
+                + p["a2"] * np.cos(2 * xi)
+                + p["b2"] * np.sin(2 * xi)
+            )
+        if "normal_load" in effects:
+            ph = 2.0 * np.pi * p["f_n"] * (d.t - d.t[0])
+            h = h * (1.0 + p["eps_c"] * np.cos(ph) + p["eps_s"] * np.sin(ph))
         F = h
         if "parallel_stiffness" in effects:
             F = F + p["k_p"] * x
@@ -264,6 +374,16 @@ class TangentialFamily:
                 "h0_plus": s,
                 "h0_minus": s2,
             }
+        if effect == "stick_slip":
+            keys = ("h0", "ac", "s_b", "ell")
+            val = breakaway_force(*(p[k] for k in keys))
+            var = 0.0
+            for i, k in enumerate(keys):
+                step = 1e-4 * abs(p[k]) or 1e-12
+                q = [p[j] for j in keys]
+                q[i] += step
+                var += ((breakaway_force(*q) - val) / step * se.get(k, np.inf)) ** 2
+            return {"breakaway_force": val}, {"breakaway_force": float(np.sqrt(var))}
         if effect == "parameter_drift":
             h0, b = p["h0"], p["beta"]
             return {"h0_end": h0 * (1 + b)}, {

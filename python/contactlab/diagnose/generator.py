@@ -40,6 +40,7 @@ from ._gen_common import (
     block_excitation,
     measure,
 )
+from .candidates_tangential import breakaway
 from .generator_normal import hidden_effect_recording_normal
 from .scaled_masing import memory, scaled_force
 
@@ -55,7 +56,21 @@ TANGENTIAL_EFFECTS = (
     "asymmetry",
     "non_masing_scaling",
     "parameter_drift",
+    "stribeck",
+    "position_friction",
+    "stick_slip",
+    "normal_load",
 )
+
+#: fixed shapes of the real-friction effects (the size parameter is solved for): Stribeck
+#: speed as a fraction of the RMS sliding speed, slip distance of the breakaway in units of
+#: 1/ac, the wave of friction along the track (one wave over the stroke, phase), and the
+#: normal-load fluctuation's frequency (in units of the fastest block's, no harmonic of
+#: any block's drive) and phase
+STRIBECK_SPEED = 0.5
+BREAKAWAY_DISTANCE = 1.0
+TRACK_WAVES, TRACK_PHASE = 1.0, 0.7
+LOAD_FREQUENCY, LOAD_PHASE = 0.23, 0.3
 
 
 def _derivs(fun: Callable[[np.ndarray], np.ndarray], t: np.ndarray, T: float):
@@ -84,13 +99,29 @@ def _tangential_force(
         h = h + effects["asymmetry"] * np.abs(h)
     if "parameter_drift" in effects:
         h = h * (1.0 + effects["parameter_drift"] * (t - t[0]) / (t[-1] - t[0]))
+    v, a = _derivs(xfun, t - tau, period)
+    if "stick_slip" in effects:
+        # reversals of the contact's own motion (sign changes of its exact velocity)
+        rev = np.flatnonzero(np.diff(np.sign(v)) != 0)
+        rev = rev[np.abs(xc[rev]) > 0.05 * np.max(np.abs(xc))]
+        h = breakaway(h, xc, rev, effects["stick_slip"], BREAKAWAY_DISTANCE / ac)
+    if "stribeck" in effects:
+        vs = STRIBECK_SPEED * _rms(v)
+        h = h * (1.0 + effects["stribeck"] * np.exp(-np.abs(v) / vs))
+    if "position_friction" in effects:
+        xi = xc / np.max(np.abs(xc))
+        h = h * (
+            1.0 + effects["position_friction"] * np.sin(TRACK_WAVES * 2 * np.pi * xi + TRACK_PHASE)
+        )
+    if "normal_load" in effects:
+        ph = 2 * np.pi * LOAD_FREQUENCY / period * (t - t[0]) + LOAD_PHASE
+        h = h * (1.0 + effects["normal_load"] * np.sin(ph))
     x_meas = xfun(t)
     if "displacement_offset" in effects:
         x_meas = x_meas + effects["displacement_offset"]
     if "series_compliance" in effects:
         x_meas = x_meas + h * effects["series_compliance"]
     F = h
-    v, a = _derivs(xfun, t - tau, period)
     if "parallel_stiffness" in effects:
         F = F + effects["parallel_stiffness"] * xc
     if "viscous_damping" in effects:
@@ -116,6 +147,10 @@ _PARAM_NAME = {
     "asymmetry": "alpha",
     "non_masing_scaling": "lam",
     "parameter_drift": "beta",
+    "stribeck": "s",
+    "position_friction": "eps",
+    "stick_slip": "s_b",
+    "normal_load": "eps",
 }
 
 
@@ -231,6 +266,8 @@ def hidden_effect_recording(
             "asymmetry",
             "parameter_drift",
             "non_masing_scaling",
+            "position_friction",
+            "normal_load",
         ):
             sign = 1.0 if rng.random() < 0.5 else -1.0
         params[name] = _solve_size(name, target, sign, size, h0, ac, Fr, period)
@@ -255,7 +292,7 @@ def hidden_effect_recording(
     truth = {
         "model": "tangential",
         "base": {"h0": h0, "ac": ac, "f0": f0},
-        "effects": {n: {_PARAM_NAME[n]: v} for n, v in params.items()},
+        "effects": {n: {_PARAM_NAME[n]: v, **_fixed(n, ac, period)} for n, v in params.items()},
         "magnitudes": dict(sizes),
         "noise_rms": {"x": x_noise, "F": F_noise},
         "sensors": {"anti_alias": anti_alias, "bits": bits, "start": start, **info},
@@ -269,6 +306,19 @@ def hidden_effect_recording(
         truth=truth,
         model="tangential",
     )
+
+
+def _fixed(name: str, ac: float, period: float) -> dict[str, float]:
+    """The fixed shape parameters of a real-friction effect, for the truth."""
+    if name == "stick_slip":
+        return {"ell": BREAKAWAY_DISTANCE / ac}
+    if name == "stribeck":
+        return {"v_s_over_rms_speed": STRIBECK_SPEED}
+    if name == "position_friction":
+        return {"waves_over_stroke": TRACK_WAVES, "phase": TRACK_PHASE}
+    if name == "normal_load":
+        return {"f_n": LOAD_FREQUENCY / period, "phase": LOAD_PHASE}
+    return {}
 
 
 def _solve_size(
@@ -292,6 +342,10 @@ def _solve_size(
         "force_drift": 6.0 * Fr,
         "displacement_offset": 2.0 / ac,
         "channel_delay": 0.25 * period,
+        "stribeck": 3.0,
+        "position_friction": 0.9,
+        "stick_slip": 3.0,
+        "normal_load": 0.5,
         "asymmetry": 0.9,
         "non_masing_scaling": 1.5 if sign > 0 else 0.9,
         "parameter_drift": 0.9,

@@ -393,9 +393,12 @@ def diagnose(
             if name in effects or not family.check((*effects, name)):
                 continue
             trial_effects = (*effects, name)
+            start_c = dict(current.full.params)
+            if hasattr(family, "start_effect"):
+                start_c.update(family.start_effect(name, start_c, d, -current.full_residual(d)))
             # screening: a candidate whose fit to all data lowers the error by less than
             # min_gain σ² cannot do better on held-out cycles; no cross-validation for it
-            full = fit(family, trial_effects, d, all_samples, current.full.params, scales)
+            full = fit(family, trial_effects, d, all_samples, start_c, scales)
             in_gain = (current.full.mse - full.mse) / sigma**2
             if in_gain < min_gain:
                 verdicts.append(
@@ -410,7 +413,7 @@ def diagnose(
                     )
                 )
                 continue
-            cand = evaluate(family, trial_effects, d, current.full.params, scales, folds, full)
+            cand = evaluate(family, trial_effects, d, start_c, scales, folds, full)
             p = cand.full.params
             extra = 0.0
             if name == "channel_delay" and abs(p["tau"]) < d.dt:
