@@ -22,6 +22,7 @@ _VERB_MODULES = [
     "contactlab.commands.simulate",
     "contactlab.demo",
     "contactlab.diagnose.cli",
+    "contactlab.commands.export",
 ]
 
 
