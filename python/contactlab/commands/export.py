@@ -22,7 +22,7 @@ EXIT_NOT_IDENTIFIABLE = 3
 
 _AREA = re.compile(
     r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(m2|m\^2|cm2|cm\^2|mm2|mm\^2)?\s*$"
-)  # noqa: E501
+)
 _AREA_F = {None: 1.0, "m2": 1.0, "m^2": 1.0, "cm2": 1e-4, "cm^2": 1e-4, "mm2": 1e-6, "mm^2": 1e-6}
 
 
@@ -87,9 +87,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--normal-load", type=quantity("N", positive=True),
                    help="normal load W (tangential; default from the tags, e.g. W50N)")  # fmt: skip
     p.add_argument("--amplitude", type=quantity("m", positive=True),
-                   help="amplitude for the joint spring/dashpot (tangential; e.g. 20um)")  # fmt: skip
+                   help="amplitude of the joint spring/dashpot (tangential; 20um)")  # fmt: skip
     p.add_argument("--frequency", type=quantity("Hz", positive=True),
-                   help="frequency of the viscous coefficients (Hz; normal: default the test's)")  # fmt: skip
+                   help="frequency of the viscous values (normal: default the test's)")  # fmt: skip
     p.add_argument("--points", type=int, default=25,
                    help="rows of the pressure–overclosure table (default 25)")  # fmt: skip
     p.set_defaults(handler=_handler)

@@ -95,7 +95,9 @@ def load_result(path: str | Path, recording: str | None = None) -> dict[str, Any
     try:
         doc = json.loads(p.read_text(encoding="utf-8"))
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise InputError(f"{path}: not a JSON file written by `contactlab analyze --json` ({exc})")
+        raise InputError(
+            f"{path}: not a JSON file written by `contactlab analyze --json` ({exc})"
+        ) from None
     if not isinstance(doc, dict):
         raise InputError(f"{path}: expected a JSON object from `contactlab analyze --json`")
     if "recordings" in doc:
@@ -187,10 +189,10 @@ def _normal(
     n = max(int(points), 3)
     dd = np.linspace(max(dmin, d_at_zero), dmax, n)
     pp = p0 + _poly(load, dd)
-    table = np.column_stack([pp, dd - d_at_zero])
-    if table[0, 0] > 0:
-        table = np.vstack([[0.0, 0.0], table])
-    else:
+    if p_abs[0] > 0:
+        table = np.vstack([[0.0, 0.0], np.column_stack([pp, dd - d_at_zero])])
+    else:  # the branch itself reaches zero pressure: its first row is the origin
+        table = np.column_stack([pp, dd - d_at_zero])
         table[0] = (0.0, 0.0)
     if not (np.all(np.diff(table[:, 0]) > 0) and np.all(np.diff(table[:, 1]) > 0)):
         raise NotIdentifiableError(f"{where}: the pressure–overclosure table is not monotone")

@@ -172,12 +172,13 @@ def check_tangential(
     area: float,
     normal_load: float,
     amplitudes: tuple[float, ...] | None = None,
-    increment: float = 0.025,
+    increment: float = 0.1,
 ) -> TangentialCheck:
     """Cyclic shear of the two-block model with the exported ``*FRICTION`` (SI arguments).
 
     ``area`` (m²) sets the blocks' footprint; ``amplitudes`` (m) default to 2 and 4 times the
-    elastic slip F_s/k = 1/ac.
+    elastic slip F_s/k = 1/ac; ``increment`` is the largest solver step as a fraction of a
+    quarter cycle (0.1: the loop energy is within 0.1 % of the 0.025 result).
     """
     jc = joint_characteristics(result, area=area, normal_load=normal_load)
     text = render(jc, "calculix", _MM)

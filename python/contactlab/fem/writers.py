@@ -68,7 +68,8 @@ def _keywords(jc: JointCharacteristics, u: UnitSystem, abaqus: bool) -> list[str
     if jc.kind == "normal":
         out += ["*SURFACE INTERACTION, NAME=JOINT",
                 "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=TABULAR",
-                f"** pressure [{u.label('pressure')}], overclosure [{u.label('length')}]"]  # fmt: skip
+                f"** pressure [{u.label('pressure')}], "
+                f"overclosure [{u.label('length')}]"]  # fmt: skip
         out += [f"{_g(p)}, {_g(d)}" for p, d in _table(jc, u)]
         c = jc.get("c_contact")
         if c is not None:
