@@ -235,6 +235,11 @@ _DAT = """
 
         28  1.499999E-01  0.000000E+00  0.000000E+00
 
+ stresses (elem, integ.pnt.,sxx,syy,szz,sxy,sxz,syz) for set EB and time  0.1000000E+01
+
+         9   1 -1.0E-02  2.0E-03 -1.500000E-01  0.0E+00  0.0E+00  0.0E+00
+         9   2 -1.0E-02  2.0E-03 -1.500000E-01  0.0E+00  0.0E+00  0.0E+00
+
  total force (fx,fy,fz) for set NB and time  0.1025000E+01
 
         1.984817E+00 -3.924976E-08 -5.000000E+01
@@ -258,6 +263,8 @@ def test_parse_dat() -> None:
     assert c[0][0, 1] == pytest.approx(0.15, rel=1e-5)
     t, f = dat.series("total force", "nb")
     assert t[0] == 1.025 and f[0].shape == (1, 3)
+    _, s = dat.series("stresses", "EB")  # *EL PRINT
+    assert s[0].shape == (2, 8) and s[0][1, 4] == -0.15
     assert dat.eigen.shape == (2, 5) and dat.eigen[1, 3] == pytest.approx(765.9908)
 
 
@@ -285,3 +292,14 @@ def test_loop_energy_of_a_bilinear_loop() -> None:
     x = np.array([A, A - 2 * fs / k, -A, -A + 2 * fs / k])
     f = np.array([fs, -fs, -fs, fs])
     assert _loop_energy(x, f) == pytest.approx(4 * fs * (A - fs / k))
+
+
+def test_check_without_ccx_names_the_package(tmp_path, capsys, monkeypatch, normal) -> None:
+    import contactlab.fem.ccx as ccx
+
+    monkeypatch.setattr(ccx, "find_ccx", lambda: None)
+    res = tmp_path / "fit.json"
+    res.write_text(json.dumps(normal))
+    out = tmp_path / "joint.inp"
+    assert main(["export", str(res), "--format", "calculix", "-o", str(out), "--check"]) == 1
+    assert "calculix-ccx" in capsys.readouterr().err and not out.exists()

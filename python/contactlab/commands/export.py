@@ -4,7 +4,8 @@ Turns what ``contactlab analyze --json`` wrote into joint characteristics for a 
 model (:mod:`contactlab.fem`): from a normal analysis a pressure–overclosure table with contact
 stiffness and damping per unit area; from a tangential one the friction coefficient and stick
 slope, and with --amplitude/--frequency a joint spring and dashpot. Values whose parameters
-the fit did not identify are refused (exit code 3, nothing written).
+the fit did not identify are refused (exit code 3, nothing written). --check first runs the
+CalculiX checks of contactlab.fem.checks on the values and prints their reports.
 """
 
 from __future__ import annotations
@@ -59,6 +60,8 @@ def _handler(args: argparse.Namespace) -> int:
     except NotIdentifiableError as exc:
         print(f"contactlab export: refused: {exc}; nothing written", file=sys.stderr)
         return EXIT_NOT_IDENTIFIABLE
+    if args.check:
+        _check(doc, jc.kind, args)
     cmd = command_line("export", args.result, "--format", args.format, "--units", args.units,
                        "-o", args.output)  # fmt: skip
     path = write(jc, out, args.format, units, command=cmd)
@@ -66,6 +69,21 @@ def _handler(args: argparse.Namespace) -> int:
     for n in jc.notes:
         print(f"  note: {n}", file=sys.stderr)
     return 0
+
+
+def _check(doc: dict, kind: str, args: argparse.Namespace) -> None:
+    """Run the CalculiX checks on what is about to be exported; print their reports."""
+    from ..fem.checks import check_dynamics, check_normal, check_tangential
+
+    if kind == "normal":
+        print(check_normal(doc, points=args.points).report())
+        return
+    load = args.normal_load if args.normal_load is not None else doc.get("normal_load")
+    area_ = args.area if args.area is not None else doc.get("contact_area", doc.get("area"))
+    print(check_tangential(doc, area=area_, normal_load=load).report())
+    if args.amplitude is not None and args.frequency is not None:
+        print(check_dynamics(doc, area=area_, normal_load=load, amplitude=args.amplitude,
+                             frequency=args.frequency).report())  # fmt: skip
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -92,4 +110,6 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="frequency of the viscous values (normal: default the test's)")  # fmt: skip
     p.add_argument("--points", type=int, default=25,
                    help="rows of the pressure–overclosure table (default 25)")  # fmt: skip
+    p.add_argument("--check", action="store_true",
+                   help="first run the CalculiX checks on these values (needs ccx)")  # fmt: skip
     p.set_defaults(handler=_handler)

@@ -17,6 +17,7 @@ from .characteristics import (
     joint_characteristics,
     load_result,
 )
+from .ccx import SolverError
 from .units import SYSTEMS, UnitSystem, unit_system
 from .writers import FORMATS, render, write
 
@@ -25,6 +26,7 @@ __all__ = [
     "SYSTEMS",
     "JointCharacteristics",
     "NotIdentifiableError",
+    "SolverError",
     "UnitSystem",
     "Value",
     "joint_characteristics",

@@ -54,6 +54,9 @@ def _header(jc: JointCharacteristics, u: UnitSystem, fmt: str, c: str, command: 
     lines.append("exported values:")
     lines += [f"  {_value_line(v, u)}" for v in jc.values]
     lines += [f"note: {n}" for n in jc.notes]
+    if fmt == "calculix" and jc.kind == "normal":
+        lines.append("note: CalculiX 2.20 converges with this table in TYPE=NODE TO SURFACE "
+                     "contact pairs (checked); with SURFACE TO SURFACE it did not")  # fmt: skip
     return [f"{c} {line}".rstrip() for line in lines]
 
 
