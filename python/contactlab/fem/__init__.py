@@ -10,6 +10,7 @@ stick slope (elastic Coulomb), and amplitude-dependent spring/dashpot values for
 
 from __future__ import annotations
 
+from .ccx import SolverError
 from .characteristics import (
     JointCharacteristics,
     NotIdentifiableError,
@@ -17,7 +18,6 @@ from .characteristics import (
     joint_characteristics,
     load_result,
 )
-from .ccx import SolverError
 from .units import SYSTEMS, UnitSystem, unit_system
 from .writers import FORMATS, render, write
 
