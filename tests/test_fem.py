@@ -103,6 +103,7 @@ def test_ansys_and_neutral_forms(tangential: dict, normal: dict) -> None:
     assert pu[0].tolist() == [0.0, 0.0] and np.all(np.diff(pu, axis=0) > 0)
     names = {v["quantity"]: v for v in doc["values"]}
     assert names["c_contact"]["unit"] == "Pa·s/m" and names["psi"]["value"] > 0
+    assert len(doc["ks_pressure"]) == 25 and "table_pressure" not in names
     csv_text = render(joint_characteristics(normal), "csv", unit_system("mm-N-s"))
     assert "table_pressure,0,0.0,,MPa,zero pressure" in csv_text
 
@@ -121,6 +122,12 @@ def test_normal_table_matches_the_loading_branch(normal: dict) -> None:
         u[1] + d_star, np.polynomial.polynomial.polyder(normal["poly_load"])
     )
     assert p[1] / u[1] == pytest.approx(slope, rel=1e-9)
+    # k_s(p), eq. 6: at p0 (δ = 0) it is the centre curve's slope k_tan (eq. 4)
+    ks = jc.ks_table
+    assert np.interp(normal["p0"], ks[:, 0], ks[:, 1]) == pytest.approx(normal["k_tan"], rel=0.02)
+    i = len(ks) // 3
+    d_i = np.linspace(normal["delta_min"], normal["delta_max"], len(ks))[i]
+    assert ks[i, 1] * d_i == pytest.approx(ks[i, 0] - normal["p0"], rel=1e-6)
     c = jc.get("c_contact").value
     assert c == pytest.approx(normal["psi"] * normal["k_tan"] / (2 * math.pi * normal["omega"]))
     c10 = joint_characteristics(normal, frequency=10.0).get("c_contact").value

@@ -72,6 +72,8 @@ class JointCharacteristics:
     table: np.ndarray | None = None
     extrapolated_below: float = 0.0
     notes: list[str] = field(default_factory=list)
+    #: normal only: (absolute pressure, secant stiffness k_s) rows, eq. 6 along the centre curve
+    ks_table: np.ndarray | None = None
 
     def get(self, name: str) -> Value | None:
         for v in self.values:
@@ -236,6 +238,7 @@ def _normal(
                 f"eq. 13: ψ·k_tan/(2π ω) at ω = {omega:.6g} rad/s ({omega / 2 / math.pi:.6g} Hz)",
             )
         )
+    ks = _ks_table(d, where, dmin, dmax, n)
     prov = [
         ("source", str(d.get("file", where))),
         ("analysis", f"normal-contact loop, {src}"),
@@ -244,7 +247,19 @@ def _normal(
         ("E_d", _pm(_num(d, "E_d", where), _se(d, "E_d"), "J/m^2")),
         ("cycle scatter", f"{100 * float(d.get('cycle_scatter_rel', math.nan)):.3g}% of Δδ"),
     ]
-    return JointCharacteristics("normal", str(d.get("file", where)), values, prov, table, lo, notes)
+    return JointCharacteristics("normal", str(d.get("file", where)), values, prov, table, lo,
+                                notes, ks)  # fmt: skip
+
+
+def _ks_table(d: dict[str, Any], where: str, dmin: float, dmax: float, n: int) -> np.ndarray:
+    """k_s(p): eq. 6, ``k_s = p_centre(δ)/δ``, tabulated against p = p0 + p_centre(δ)."""
+    centre = d.get("poly_centre")
+    if not isinstance(centre, list) or len(centre) < 2:
+        raise InputError(f"{where}: key 'poly_centre' (centre-curve polynomial) is missing")
+    c = np.asarray(centre, float)
+    dd = np.linspace(dmin, dmax, n)
+    ks = np.polynomial.polynomial.polyval(dd, c[1:])  # (p_centre(δ) - a0)/δ, a0 ≈ 0 by eq. 1
+    return np.column_stack([float(d["p0"]) + _poly(list(c), dd), ks])
 
 
 # --- tangential contact ----------------------------------------------------------------------

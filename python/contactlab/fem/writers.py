@@ -66,6 +66,16 @@ def _table(jc: JointCharacteristics, u: UnitSystem) -> list[tuple[float, float]]
     return [(float(p) * fp, float(d) * fl) for p, d in jc.table]
 
 
+def _ks_comment(jc: JointCharacteristics, u: UnitSystem, c: str) -> list[str]:
+    if jc.ks_table is None:
+        return []
+    fp, fk = u.factor("pressure"), u.factor("stiffness_per_area")
+    out = [f"{c} contact stiffness k_s(p) (eq. 6, secant along the centre curve): "
+           f"pressure [{u.label('pressure')}], k_s [{u.label('stiffness_per_area')}]"]  # fmt: skip
+    out += [f"{c}   {_g(p * fp)}, {_g(k * fk)}" for p, k in jc.ks_table]
+    return out
+
+
 def _keywords(jc: JointCharacteristics, u: UnitSystem, abaqus: bool) -> list[str]:
     out: list[str] = []
     if jc.kind == "normal":
@@ -74,6 +84,7 @@ def _keywords(jc: JointCharacteristics, u: UnitSystem, abaqus: bool) -> list[str
                 f"** pressure [{u.label('pressure')}], "
                 f"overclosure [{u.label('length')}]"]  # fmt: skip
         out += [f"{_g(p)}, {_g(d)}" for p, d in _table(jc, u)]
+        out += _ks_comment(jc, u, "**")
         c = jc.get("c_contact")
         if c is not None:
             val, _, lab = c.converted(u)
@@ -121,6 +132,7 @@ def _ansys(jc: JointCharacteristics, u: UnitSystem) -> list[str]:
         for i, (p, d) in enumerate(rows, 1):
             out.append(f"JOINT_PU({i},1)={_g(p)}")
             out.append(f"JOINT_PU({i},2)={_g(d)}")
+        out += _ks_comment(jc, u, "!")
         c = jc.get("c_contact")
         if c is not None:
             cv, _, cl = c.converted(u)
@@ -158,6 +170,14 @@ def _rows(jc: JointCharacteristics, u: UnitSystem) -> list[dict[str, object]]:
                          "unit": u.label("pressure"), "source": src})  # fmt: skip
             rows.append({"quantity": "table_overclosure", "index": i, "value": d,
                          "stderr": None, "unit": u.label("length"), "source": src})  # fmt: skip
+    if jc.ks_table is not None:
+        src = "eq. 6: p_centre(δ)/δ along the centre curve"
+        for i, (p, k) in enumerate(jc.ks_table):
+            rows.append({"quantity": "ks_pressure", "index": i, "value": p * u.factor("pressure"),
+                         "stderr": None, "unit": u.label("pressure"), "source": src})  # fmt: skip
+            rows.append({"quantity": "ks", "index": i,
+                         "value": k * u.factor("stiffness_per_area"), "stderr": None,
+                         "unit": u.label("stiffness_per_area"), "source": src})  # fmt: skip
     return rows
 
 
@@ -183,10 +203,13 @@ def render(jc: JointCharacteristics, fmt: str, units: UnitSystem, command: str =
             "header": [line[2:] for line in _header(jc, units, fmt, "#", command)],
             "provenance": dict(jc.provenance),
             "notes": jc.notes,
-            "values": [r for r in _rows(jc, units) if not r["quantity"].startswith("table_")],
+            "values": [r for r in _rows(jc, units) if r["index"] == ""],
         }
         if jc.table is not None:
             doc["pressure_overclosure"] = [list(r) for r in _table(jc, units)]
+        if jc.ks_table is not None:
+            fp, fk = units.factor("pressure"), units.factor("stiffness_per_area")
+            doc["ks_pressure"] = [[float(p) * fp, float(k) * fk] for p, k in jc.ks_table]
         return json.dumps(doc, indent=2, allow_nan=False) + "\n"
     else:
         raise InputError(f"unknown format {fmt!r}; choose one of {', '.join(FORMATS)}")
