@@ -156,6 +156,7 @@ def test_table_is_monotone_from_zero(
         "delta_min": -0.1e-6,
         "delta_max": 0.3e-6,
         "poly_load": coeffs,
+        "poly_centre": coeffs,
         "k_tan": coeffs[1],
         "psi": 0.1,
         "omega": 1.0,
