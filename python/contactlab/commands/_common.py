@@ -14,10 +14,11 @@ from typing import Any
 import numpy as np
 
 from .._io_atomic import write_text
+from .._version import __version__
 from ..errors import InputError
-from ..manifest import scaled, si_unit, unit_factor
 from ..report import commit_outputs
-from ..study import RecordingResult, StudyResult
+from ..studies.manifest import scaled, si_unit, unit_factor
+from ..studies.study import RecordingResult, StudyResult
 
 _QTY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-zµμ/]*)\s*$")
 
@@ -119,8 +120,6 @@ def recording_json(r: RecordingResult) -> dict[str, Any]:
 def json_document(result: StudyResult) -> dict[str, Any]:
     """A single recording's object at top level; several as ``{"recordings": [...]}``."""
     recs = [recording_json(r) for r in result.results if r.ok]
-    from .. import __version__
-
     if len(recs) == 1 and not result.failures:
         return {**recs[0], "contactlab_version": __version__}
     return {

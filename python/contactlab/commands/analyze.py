@@ -4,7 +4,7 @@ Reads each recording (CSV/TDMS/HDF5/MAT, SI inside), runs the tangential analysi
 energy analytic and numeric, c_e·ω, stiffness; the tangential paper's eqs. 1-19) or the normal
 one (Konowalski's eqs. 1-7 and 16), prints a summary, and optionally writes JSON (SI values and
 a ``units`` map) and an HTML report. Tags (material, load, amplitude, p0, pa) are read from
-the file names as in :mod:`contactlab.manifest`.
+the file names as in :mod:`contactlab.studies.manifest`.
 """
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ import sys
 from pathlib import Path
 
 from ..errors import InputError
-from ..manifest import entry_from_file
-from ..study import run_study
+from ..studies.manifest import entry_from_file
+from ..studies.study import run_study
 from ._common import (
     add_progress_flags,
     check_output_targets,
@@ -47,6 +47,8 @@ def _summary_line(row: dict, kind: str) -> str:
             s = row.get(f"{key}_stderr")
             pm = f" ± {abs(s) * f:.2g}" if isinstance(s, float) else ""
             parts.append(f"{key} = {v * f:.5g}{pm} {unit}".rstrip())
+    if kind == "tangential" and row.get("force_sign") in (1, -1):
+        parts.append(f"force sign {row['force_sign']:+d}")
     return "; ".join(parts)
 
 
@@ -64,7 +66,9 @@ def _handler(args: argparse.Namespace) -> int:
         e = entry_from_file(f, kind=args.model)
         e.columns, e.fs = columns, args.fs
         entries.append(e)
-    result = run_study(entries, progress=args.progress, keep_going=args.keep_going)
+    topts = {"force_sign": args.force_sign}
+    result = run_study(entries, progress=args.progress, keep_going=args.keep_going,
+                       tangential_options=topts)  # fmt: skip
     # With --json -, stdout carries the JSON alone; everything else goes to stderr.
     say = sys.stderr if args.json == "-" else sys.stdout
     for r in result.results:
@@ -108,6 +112,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--columns", help="column mapping, e.g. 'x=disp,F=force' (default: by name)")
     p.add_argument(
         "--fs", type=quantity("Hz", positive=True), help="sampling rate when a file has no time"
+    )
+    p.add_argument(
+        "--force-sign",
+        choices=("auto", "+1", "-1", "1"),
+        default="auto",
+        help="tangential: analyse F (+1) or -F (-1); auto (default): the sign that makes the "
+        "loop area ∮F dx positive (a passive joint dissipates)",
     )
     p.add_argument("--keep-going", action="store_true",
                    help="skip recordings that fail (exit code 1) instead of stopping")  # fmt: skip

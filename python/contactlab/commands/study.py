@@ -1,7 +1,7 @@
 """``contactlab study MANIFEST|FOLDER --report DIR``: a load/amplitude (or p0) study.
 
 Analyses every recording a manifest lists (or every recording in a folder, tagged by file
-name; see :mod:`contactlab.manifest`) and writes one table (``study_tangential.csv`` /
+name; see :mod:`contactlab.studies.manifest`) and writes one table (``study_tangential.csv`` /
 ``.parquet``, ``study_normal.*``; SI, uncertainties as ``*_stderr``), the paper's plots
 against load and amplitude per material (and against p0), and the HTML report.
 """
@@ -11,7 +11,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ..study import run_study
+from ..studies.study import run_study
 from ._common import (
     add_progress_flags,
     check_output_targets,

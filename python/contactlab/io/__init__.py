@@ -20,17 +20,21 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from .chunked import DEFAULT_CHUNK, ChunkedRecording, read_chunks
 from .recording import DIMENSIONS, KIND_CHANNELS, Recording, RecordingError
 from .sniff import EXTENSIONS, format_of
 from .units import UnknownUnitError, known_units, split_name, to_si
 
 __all__ = [
+    "DEFAULT_CHUNK",
     "DIMENSIONS",
     "KIND_CHANNELS",
+    "ChunkedRecording",
     "Recording",
     "RecordingError",
     "UnknownUnitError",
     "known_units",
+    "read_chunks",
     "read_recording",
     "split_name",
     "supported_extensions",

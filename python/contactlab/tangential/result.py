@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from ..fitting import FitResult, _num
+from ..fitting import FitResult, json_number
 from ..masing import Masing
 from .preprocess import AveragedLoop, CycleScatter
 
@@ -35,6 +35,7 @@ UNITS = {
     "peak_force": "N",
     "force_drift": "N/s",
     "displacement_drift": "m/s",
+    "loop_area_recorded": "J",
 }
 
 
@@ -111,23 +112,30 @@ class TangentialAnalysis:
             "source": self.source,
             "on": self.on,
             "history": self.history,
-            "h0": _num(p["h0"].value) if ident else None,
-            "h0_stderr": _num(p["h0"].stderr) if ident else None,
-            "ac": _num(p["ac"].value) if ident else None,
-            "ac_stderr": _num(p["ac"].stderr) if ident else None,
-            "offset": _num(p["offset"].value),
-            "offset_stderr": _num(p["offset"].stderr),
+            "h0": json_number(p["h0"].value) if ident else None,
+            "h0_stderr": json_number(p["h0"].stderr) if ident else None,
+            "ac": json_number(p["ac"].value) if ident else None,
+            "ac_stderr": json_number(p["ac"].stderr) if ident else None,
+            "offset": json_number(p["offset"].value),
+            "offset_stderr": json_number(p["offset"].stderr),
         }
         if "x0" in p:
-            out["x0"] = _num(p["x0"].value)
-            out["x0_stderr"] = _num(p["x0"].stderr)
-        out["amplitude"] = _num(self.amplitude)
-        out["amplitude_stderr"] = _num(self.amplitude_stderr)
+            out["x0"] = json_number(p["x0"].value)
+            out["x0_stderr"] = json_number(p["x0"].stderr)
+        out["force_sign"] = int(self.meta.get("force_sign", 1))
+        out["orientation_reason"] = str(self.meta.get("orientation_reason", ""))
+        la = self.meta.get("loop_area_recorded")
+        if la is not None:
+            out["loop_area_recorded"] = json_number(la[0])
+            out["loop_area_recorded_stderr"] = json_number(la[1])
+        out["amplitude"] = json_number(self.amplitude)
+        out["amplitude_stderr"] = json_number(self.amplitude_stderr)
         for k, (v, e) in self.derived.items():
-            out[k] = _num(v)
-            out[f"{k}_stderr"] = _num(e)
+            out[k] = json_number(v)
+            out[f"{k}_stderr"] = json_number(e)
         out["identifiable"] = {
-            k: (_num(v) if isinstance(v, float) else v) for k, v in self.identifiability.items()
+            k: (json_number(v) if isinstance(v, float) else v)
+            for k, v in self.identifiability.items()
         }
         out["n_cycles"] = None if self.scatter is None else self.scatter.n_cycles
         out["warnings"] = list(self.warnings)
