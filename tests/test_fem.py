@@ -176,6 +176,11 @@ def test_refusals(tangential: dict, tangential_small: dict, normal: dict) -> Non
         joint_characteristics(tangential, normal_load=50.0)
     with pytest.raises(InputError, match="--normal-load"):
         joint_characteristics({**tangential, "normal_load": None}, area=1e-3)
+    with pytest.raises(InputError, match="contact_area = 'big'"):
+        joint_characteristics({**tangential, "contact_area": "big"})
+    # a manifest column without a unit arrives as text (SI)
+    jc = joint_characteristics({**tangential, "contact_area": "0.005"})
+    assert jc.get("stick_slope").value == pytest.approx(tangential["h0_ac"] / 0.005)
     with pytest.raises(InputError, match="--frequency"):
         joint_characteristics(tangential, area=1e-3, normal_load=50.0, amplitude=1e-5)
     bent = {**normal, "poly_load": [0.0, 1e12, -5e19]}  # turns over inside the loop

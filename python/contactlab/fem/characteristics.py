@@ -273,6 +273,19 @@ def _dyn_grad(h0: float, ac: float, fn: Any) -> tuple[float, np.ndarray]:
     return v, g
 
 
+def _tag(d: dict[str, Any], keys: tuple[str, ...], where: str) -> float | None:
+    """A numeric tag (a manifest column without a unit arrives as text, already SI)."""
+    for k in keys:
+        v = d.get(k)
+        if v is None or v == "" or isinstance(v, bool):
+            continue
+        try:
+            return float(v)
+        except (TypeError, ValueError):
+            raise InputError(f"{where}: tag {k} = {v!r} is not a number") from None
+    return None
+
+
 def _tangential(
     d: dict[str, Any],
     where: str,
@@ -285,14 +298,9 @@ def _tangential(
     ident = d.get("identifiable") if isinstance(d.get("identifiable"), dict) else {}
     reason = str(ident.get("message", "the analysis did not state its identifiability"))
     if normal_load is None:
-        nl = d.get("normal_load")
-        normal_load = (
-            float(nl) if isinstance(nl, (int, float)) and not isinstance(nl, bool) else None
-        )
+        normal_load = _tag(d, ("normal_load",), where)
     if area is None:
-        for k in ("contact_area", "area"):
-            if isinstance(d.get(k), (int, float)) and d[k] > 0:
-                area = float(d[k])
+        area = _tag(d, ("contact_area", "area"), where)
     if normal_load is None or not normal_load > 0:
         raise InputError(
             f"{where}: no normal load: give --normal-load (e.g. 50N) or tag the recording "
