@@ -316,3 +316,26 @@ def test_check_without_ccx_names_the_package(tmp_path, capsys, monkeypatch, norm
     out = tmp_path / "joint.inp"
     assert main(["export", str(res), "--format", "calculix", "-o", str(out), "--check"]) == 1
     assert "calculix-ccx" in capsys.readouterr().err and not out.exists()
+
+
+def test_real_macro_slip_frame_is_refused() -> None:
+    """Measured macro-slip loops (friction frame) do not resolve pre-sliding: the stick slope
+    is not identified, and the export must refuse it with the analysis' reason."""
+    from pathlib import Path
+
+    from contactlab import Recording
+
+    data = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "friction_frame"
+    if not data.is_dir():
+        pytest.skip("friction_frame data: ../shared/data absent")
+    d = np.genfromtxt(data / "frame_disc450g.csv", delimiter=",", names=True)
+    t, x, y = d["t_s"], d["x_top_plate_disp_mm"] * 1e-3, d["y_base_disp_mm"] * 1e-3
+    dt = float(t[1] - t[0])
+    xd, yd = np.gradient(x, dt), np.gradient(y, dt)
+    # the authors' model: F_f = K (y − x) + C (y' − x') − M x''  (README of the data)
+    f = 1191.0 * (y - x) + 0.6690 * (yd - xd) - 3.0799 * np.gradient(xd, dt)
+    rec = Recording(t, {"x": x, "F": f}, {"x": "m", "F": "N"}, source="frame_disc450g.csv")
+    with pytest.warns(Warning):
+        res = {**analyze_tangential(rec).to_dict(), "model": "tangential", "file": rec.source}
+    with pytest.raises(NotIdentifiableError, match="stick slope h0·ac is not identified"):
+        joint_characteristics(res, area=1e-4, normal_load=0.45 * 9.81)
