@@ -43,6 +43,7 @@ def test_normal_table_and_compliance(seed: int, p0: float, pa: float) -> None:
     assert chk.table_pressure_error <= 0.01
     assert chk.poly_error <= 0.01  # the table follows the fitted branch it came from
     assert chk.compliance_error <= 0.01
+    assert 0.4 < chk.block_share < 0.6  # both terms of the series matter
     # the reported pairs span the table (the ramp reached its top)
     assert chk.pressure.max() == pytest.approx(0.98 * (p0 + pa) * 1e-6, rel=0.03)
 
