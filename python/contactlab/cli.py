@@ -24,6 +24,7 @@ _VERB_MODULES = [
     "contactlab.commands.simulate",
     "contactlab.commands.demo",
     "contactlab.commands.diagnose",
+    "contactlab.commands.export",
 ]
 
 

@@ -188,6 +188,24 @@ def command_line(verb: str, *parts: Any) -> str:
     return " ".join(shlex.quote(w) for w in words)
 
 
+def add_workers_flag(p: Any, what: str) -> None:
+    p.add_argument("--workers", type=int, default=None, metavar="N",
+                   help=f"analyse {what} in N processes (default: serially)")  # fmt: skip
+
+
+def process_pool(workers: int | None) -> Any:
+    """A ``ProcessPoolExecutor`` for ``--workers N`` (a null context for None)."""
+    import contextlib
+
+    if workers is None:
+        return contextlib.nullcontext(None)
+    if workers < 1:
+        raise InputError(f"--workers must be >= 1, got {workers}")
+    from concurrent.futures import ProcessPoolExecutor
+
+    return ProcessPoolExecutor(workers)
+
+
 def add_progress_flags(p: Any) -> None:
     g = p.add_mutually_exclusive_group()
     g.add_argument("--progress", dest="progress", action="store_true", default=None,

@@ -15,6 +15,7 @@ use pyo3::types::PyDict;
 
 mod errors;
 mod normal;
+mod structure;
 use errors::{internal, slice, to_pyerr};
 
 /// Run `f` without the GIL, turning a panic (a bug, never expected) into `ContactLabError`.
@@ -282,5 +283,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<MasingCore>()?;
     m.add_function(wrap_pyfunction!(loop_area_py, m)?)?;
     normal::register(m)?;
+    structure::register(m)?;
     Ok(())
 }
