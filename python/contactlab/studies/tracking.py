@@ -37,6 +37,7 @@ from typing import Any
 
 import numpy as np
 
+from .._json import jsonable
 from ..errors import ContactLabError, ContactLabWarning, InputError
 from ..io import DEFAULT_CHUNK, Recording, read_chunks
 from ..io.units import UnknownUnitError, to_si
@@ -619,8 +620,6 @@ def track_many(
 
 def track_json(result: TrackResult, *, cycles: bool = True) -> str:
     """The result as JSON text (NaN → null)."""
-    from ..commands._common import jsonable
-
     return json.dumps(jsonable(result.to_dict(cycles=cycles)), indent=1, allow_nan=False) + "\n"
 
 
