@@ -117,6 +117,9 @@ pub struct Tabulated {
     cum: Vec<f64>,
 }
 
+// Knot-table index arithmetic: a table holds n >= 2 knots (checked in `Tabulated::new`) and
+// every index stays in 0..n, so nothing over- or underflows.
+#[allow(clippy::arithmetic_side_effects)]
 impl Tabulated {
     pub fn new(u: &[f64], f: &[f64]) -> Result<Self, CoreError> {
         crate::error::check_same_len("x_points", u.len(), "f_points", f.len())?;
@@ -207,6 +210,8 @@ impl Tabulated {
 }
 
 /// Fritsch–Carlson monotone slopes (the scheme of scipy's `PchipInterpolator`).
+// Index arithmetic on n = x.len() >= 2 knots (n >= 3 past the early return).
+#[allow(clippy::arithmetic_side_effects)]
 fn pchip_slopes(x: &[f64], y: &[f64]) -> Vec<f64> {
     let n = x.len();
     let h: Vec<f64> = x.windows(2).map(|w| w[1] - w[0]).collect();
@@ -242,6 +247,9 @@ fn pchip_end(h0: f64, h1: f64, m0: f64, m1: f64) -> f64 {
     }
 }
 
+// Knot-table index arithmetic: a table holds n >= 2 knots (checked in `Tabulated::new`) and
+// every index stays in 0..n, so nothing over- or underflows.
+#[allow(clippy::arithmetic_side_effects)]
 impl Backbone for Tabulated {
     #[inline]
     fn eval(&self, u: f64) -> f64 {

@@ -6,6 +6,17 @@
 //!
 //! Every kernel validates its input and returns [`CoreError`]; none panics on user data.
 
+// Library code never unwraps and never lets an integer operation overflow or divide by zero:
+// counts and sizes come from the caller. Unit tests (cfg(test)) may.
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::arithmetic_side_effects
+    )
+)]
+
 pub mod curve;
 pub mod error;
 pub mod masing;

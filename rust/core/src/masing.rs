@@ -40,7 +40,7 @@ pub struct MasingState {
 impl MasingState {
     /// Flatten to `[x, h, dir, count, x_1, h_1, i_1, x_2, h_2, i_2, ...]` (for pickling).
     pub fn to_vec(&self) -> Vec<f64> {
-        let mut v = Vec::with_capacity(4 + 3 * self.stack.len());
+        let mut v = Vec::with_capacity(self.stack.len().saturating_mul(3).saturating_add(4));
         v.extend([self.x, self.h, f64::from(self.dir), self.count as f64]);
         for r in &self.stack {
             v.extend([r.x, r.h, r.index as f64]);
@@ -51,7 +51,7 @@ impl MasingState {
     /// Inverse of [`MasingState::to_vec`], validating what it reads.
     pub fn from_slice(v: &[f64]) -> Result<Self, CoreError> {
         let bad = |reason| Err(CoreError::InvalidState { reason });
-        if v.len() < 4 || (v.len() - 4) % 3 != 0 {
+        if v.len().checked_sub(4).is_none_or(|r| r % 3 != 0) {
             return bad("length must be 4 + 3 * (number of reversals)");
         }
         if v.iter().any(|a| !a.is_finite()) {
@@ -83,7 +83,7 @@ impl MasingState {
         for (k, r) in stack.iter().enumerate() {
             // Counting back from the top (the reversal the current branch started at, which is
             // opposite to the current direction), maxima and minima alternate.
-            let from_top = stack.len() - 1 - k;
+            let from_top = stack.len().saturating_sub(k).saturating_sub(1); // k < len
             let is_max = (dir > 0.0) == (from_top % 2 == 1);
             if k == 0 {
                 // The first reversal left the virgin curve, which runs outward from 0; the
@@ -161,6 +161,8 @@ struct Branch {
 }
 
 #[inline]
+// `n - 1`, `n - 2` only in the arm where n >= 2.
+#[allow(clippy::arithmetic_side_effects)]
 fn branch_of(stack: &[Reversal], dir: f64, scale: f64, inv_scale: f64) -> Branch {
     let n = stack.len();
     let (anchor, target) = match n {
@@ -241,6 +243,8 @@ impl<'a, C: Backbone> Stepper<'a, C> {
 
     /// A reversal and/or one or more loop closures at sample `index`.
     #[inline(never)]
+    // `n - 1`, `n - 2` only where the stack holds n >= 2 reversals.
+    #[allow(clippy::arithmetic_side_effects)]
     fn event<O: Observer>(&mut self, xi: f64, dx: f64, index: u64, observer: &mut O) {
         let s = if dx > 0.0 { 1.0 } else { -1.0 };
         if s != self.dir {
@@ -304,13 +308,14 @@ pub fn run<C: Backbone, O: Observer>(
     let mut st = Stepper::new(curve, scale, state);
     match out {
         Some(out) => {
-            for ((i, &xi), o) in x.iter().enumerate().zip(out.iter_mut()) {
-                *o = st.step(xi, base + i as u64, observer);
+            // The slices come first: the index range is never advanced past the last sample.
+            for ((&xi, o), index) in x.iter().zip(out.iter_mut()).zip(base..) {
+                *o = st.step(xi, index, observer);
             }
         }
         None => {
-            for (i, &xi) in x.iter().enumerate() {
-                st.step(xi, base + i as u64, observer);
+            for (&xi, index) in x.iter().zip(base..) {
+                st.step(xi, index, observer);
             }
         }
     }
@@ -406,8 +411,8 @@ pub fn loop_area(x: &[f64], f: &[f64]) -> Result<f64, CoreError> {
     let n = x.len();
     let fm = f.iter().sum::<f64>() / n as f64;
     let (mut sum, mut comp) = (0.0_f64, 0.0_f64);
-    for i in 0..n {
-        let j = if i + 1 == n { 0 } else { i + 1 };
+    // Point i joined to the next, the last to the first.
+    for (i, j) in (0..n).zip((1..n).chain(std::iter::once(0))) {
         let term = 0.5 * ((f[i] - fm) + (f[j] - fm)) * (x[j] - x[i]);
         // Neumaier summation.
         let t = sum + term;

@@ -13,6 +13,9 @@ pub struct Lu {
     piv: Vec<usize>,
 }
 
+// Row-major n × n index arithmetic with r, c, k < n; `Lu` is crate-internal and only built
+// for a `Structure`, whose n * n was checked in `Structure::new`.
+#[allow(clippy::arithmetic_side_effects)]
 impl Lu {
     pub fn new(n: usize) -> Self {
         Self {

@@ -198,6 +198,9 @@ pub struct Trial {
 
 /// Masing force and tangent at `x` from `state`, without changing the state (the branch logic
 /// of [`crate::masing`]: a reversal pushes the current point, reaching a closure target pops).
+// Stack-depth arithmetic: `len` counts the reversals walked (<= stack length + 1) and only
+// `len - 1`, `len - 2` where len >= 1, 2.
+#[allow(clippy::arithmetic_side_effects)]
 fn masing_trial<C: Backbone>(curve: &C, scale: f64, st: &MasingState, x: f64) -> (f64, f64) {
     let dx = x - st.x;
     let dir = f64::from(st.dir);

@@ -7,7 +7,7 @@
 //! - [`newmark`]: the integrator, sample-exact outputs, energy bookkeeping.
 //! - [`dense`]: allocation-free LU for the Newton systems.
 
-pub mod dense;
+pub(crate) mod dense;
 pub mod joint;
 pub mod newmark;
 

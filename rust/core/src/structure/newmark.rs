@@ -194,6 +194,9 @@ fn rel(j: &Joint, x: &[f64]) -> f64 {
 }
 
 /// Total external load at fraction `tau` of interval `i → i+1` (linear interpolation).
+// Row-major index arithmetic: indices < n (dofs), nj (joints) or the sample count, into
+// buffers whose sizes n*n, nt*n and nt*nj were checked in `Structure::new` and `simulate`.
+#[allow(clippy::arithmetic_side_effects)]
 fn load(s: &Structure, inp: &Inputs<'_>, i: usize, tau: f64, out: &mut [f64]) {
     let n = s.n;
     out.fill(0.0);
@@ -215,6 +218,9 @@ fn load(s: &Structure, inp: &Inputs<'_>, i: usize, tau: f64, out: &mut [f64]) {
     }
 }
 
+// Row-major index arithmetic: indices < n (dofs), nj (joints) or the sample count, into
+// buffers whose sizes n*n, nt*n and nt*nj were checked in `Structure::new` and `simulate`.
+#[allow(clippy::arithmetic_side_effects)]
 fn matvec(a: &[f64], x: &[f64], n: usize, out: &mut [f64]) {
     for (r, o) in out.iter_mut().enumerate().take(n) {
         *o = a[r * n..(r + 1) * n]
@@ -242,6 +248,9 @@ struct Scratch {
 /// One Newmark step of length `h` from `w` to load `f1` (in `sc.f1`); on success the new
 /// state is in `sc.x1/v1/a1/trials` (not yet committed). Returns the Newton iterations used,
 /// or `None` if Newton failed.
+// Row-major index arithmetic: indices < n (dofs), nj (joints) or the sample count, into
+// buffers whose sizes n*n, nt*n and nt*nj were checked in `Structure::new` and `simulate`.
+#[allow(clippy::arithmetic_side_effects)]
 fn newton_step(s: &Structure, w: &Work, h: f64, sc: &mut Scratch, opts: &Options) -> Option<u64> {
     let n = s.n;
     let (b, g) = (0.25 * h * h, 0.5 * h);
@@ -396,7 +405,7 @@ pub fn simulate(
         f1: vec![0.0; n],
         r: vec![0.0; n],
         tmp: vec![0.0; n],
-        jac: vec![0.0; n * n],
+        jac: vec![0.0; n.saturating_mul(n)], // n * n checked in Structure::new
         trials: vec![Trial::default(); nj],
         lu: Lu::new(n),
     };
@@ -445,8 +454,8 @@ pub fn simulate(
     };
     record(s, &w, &mut out, 0);
     out.n_out = 1;
-    for i in 0..nt - 1 {
-        let big_h = inp.t[i + 1] - inp.t[i];
+    for (i, pair) in inp.t.windows(2).enumerate() {
+        let big_h = pair[1] - pair[0];
         let mut tau = 0.0_f64;
         let mut halvings = 0usize;
         let mut events = 0usize;
@@ -458,7 +467,7 @@ pub fn simulate(
             load(s, inp, i, tau1, &mut sc.f1);
             match newton_step(s, &w, h, &mut sc, opts) {
                 None => {
-                    halvings += 1;
+                    halvings = halvings.saturating_add(1);
                     if halvings > opts.max_halvings {
                         out.status = Status::NoConvergence {
                             time: inp.t[i] + tau * big_h,
@@ -469,7 +478,7 @@ pub fn simulate(
                     frac = 0.5 * step;
                     continue;
                 }
-                Some(it) => out.n_iter += it,
+                Some(it) => out.n_iter = out.n_iter.saturating_add(it),
             }
             // Split the step at the earliest joint event strictly inside it.
             if events < opts.max_events {
@@ -483,13 +492,13 @@ pub fn simulate(
                 }
                 let min_piece = 1e-3 / step;
                 if theta > min_piece && theta < 1.0 - min_piece {
-                    events += 1;
+                    events = events.saturating_add(1);
                     frac = step * theta;
                     continue;
                 }
             }
             accept(s, &mut w, &mut sc)?;
-            out.n_steps += 1;
+            out.n_steps = out.n_steps.saturating_add(1);
             tau = tau1;
             frac = (1.0 - tau).max(0.0);
             if w.x.iter().chain(&w.v).any(|v| !v.is_finite()) {
@@ -499,13 +508,17 @@ pub fn simulate(
                 return Ok(out);
             }
         }
-        record(s, &w, &mut out, i + 1);
-        out.n_out = i + 2;
+        let next = i.saturating_add(1); // < nt
+        record(s, &w, &mut out, next);
+        out.n_out = next.saturating_add(1);
     }
     Ok(out)
 }
 
 /// Commit the converged step in `sc` to `w`, with the energy bookkeeping.
+// Row-major index arithmetic: indices < n (dofs), nj (joints) or the sample count, into
+// buffers whose sizes n*n, nt*n and nt*nj were checked in `Structure::new` and `simulate`.
+#[allow(clippy::arithmetic_side_effects)]
 fn accept(s: &Structure, w: &mut Work, sc: &mut Scratch) -> Result<(), CoreError> {
     let n = s.n;
     // Δxᵀ f̄ and Δxᵀ C v̄ (Δx = h v̄ for Newmark average acceleration).
@@ -542,6 +555,9 @@ fn accept(s: &Structure, w: &mut Work, sc: &mut Scratch) -> Result<(), CoreError
     Ok(())
 }
 
+// Row-major index arithmetic: indices < n (dofs), nj (joints) or the sample count, into
+// buffers whose sizes n*n, nt*n and nt*nj were checked in `Structure::new` and `simulate`.
+#[allow(clippy::arithmetic_side_effects)]
 fn record(s: &Structure, w: &Work, out: &mut Response, i: usize) {
     let n = s.n;
     let nj = s.joints.len();
