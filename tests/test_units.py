@@ -31,13 +31,21 @@ def test_manifest_units_kept_their_meaning(unit, factor, si):
     assert si_unit(unit) == si
 
 
-@pytest.mark.parametrize("unit", ["MN", "Ms", "MM", "MJ"])
+@pytest.mark.parametrize("unit", ["MN", "MJ", " MN "])
 def test_mega_is_not_read_as_milli(unit):
     """Case-folding "MN" gave millinewton in recordings: 10^9 too small, silently."""
     with pytest.raises(UnknownUnitError, match=repr(unit)):
         to_si(unit)
     with pytest.raises(InputError, match=rf"col 2: unknown unit {unit!r}"):
         unit_factor(unit, "col 2")
+
+
+@pytest.mark.parametrize(
+    ("unit", "factor"), [("MM", 1e-3), ("MS", 1e-3), ("KN", 1e3), ("MPA", 1e6)]
+)
+def test_all_caps_headers_keep_their_meaning(unit, factor):
+    assert to_si(unit)[0] == factor
+    assert unit_factor(unit, "here") == factor
 
 
 def test_manifest_header_in_a_recording_unit_spelling(tmp_path):

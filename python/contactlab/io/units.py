@@ -73,10 +73,11 @@ _add("stiffness", ("N/m",), 1.0)
 _add("stiffness", ("N/mm",), 1e3)
 _add("stiffness", ("N/um",), 1e6)
 
-# Case is ignored ("Pa", "pa", "MPA" are the same; "m" is metre, minute is "min") except where it
-# changes the meaning: these milli units need their lower-case m, so "MN" or "Ms" (mega, which
-# is not supported) is unknown rather than read 10^9 times too small.
-_MILLI = {"ms", "msec", "mm", "mn", "mj"}
+# Case is ignored ("Pa", "pa", "MPA" are the same; all-caps headers such as "MM" or "MS" mean
+# mm and ms; "m" is metre, minute is "min") except where the capital could be a real mega
+# unit: "MN" (meganewton) and "MJ" (megajoule) are unknown rather than read as mN and mJ,
+# 10^9 times too small.
+_MILLI = {"mn", "mj"}
 
 
 class UnknownUnitError(InputError):
