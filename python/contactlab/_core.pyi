@@ -1,5 +1,7 @@
 """Type stubs for the Rust extension ``contactlab._core`` (hand-written)."""
 
+from typing import final
+
 import numpy as np
 import numpy.typing as npt
 
@@ -7,6 +9,7 @@ __version__: str
 
 _F = npt.NDArray[np.float64]
 
+@final
 class MasingCore:
     @staticmethod
     def exponential(h0: float, ac: float, scale: float) -> MasingCore: ...

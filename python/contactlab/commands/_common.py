@@ -4,16 +4,14 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import re
 import shlex
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from .._io_atomic import write_text
+from .._json import jsonable
 from .._version import __version__
 from ..errors import InputError
 from ..report import commit_outputs
@@ -84,23 +82,6 @@ def parse_columns(text: str | None) -> dict[str, str] | None:
         k, v = part.split("=", 1)
         out[k.strip()] = v.strip()
     return out
-
-
-def jsonable(value: Any) -> Any:
-    """Plain JSON types; NaN/inf become null (JSON has no NaN)."""
-    if isinstance(value, Mapping):
-        return {str(k): jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [jsonable(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return jsonable(value.tolist())
-    if isinstance(value, (np.floating, np.integer, np.bool_)):
-        value = value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, Path):
-        return str(value)
-    return value
 
 
 def recording_json(r: RecordingResult) -> dict[str, Any]:

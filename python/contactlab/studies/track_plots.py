@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from .columns import CYCLE_UNITS
 from .plots import display_unit
 
 #: axis labels of the tracked quantities
@@ -79,8 +80,6 @@ def plot_quantity(result: Any, name: str, *, against: str = "time", ax: Any = No
 
 def plot_cycles(result: Any, name: str = "energy", ax: Any = None) -> Any:
     """A per-cycle quantity against the cycle number (every cycle of the record)."""
-    from .tracking import CYCLE_UNITS
-
     ax = _axes(ax)
     v = result.cycles[name]
     unit = CYCLE_UNITS[result.kind][name]

@@ -37,10 +37,13 @@ from typing import Any
 
 import numpy as np
 
+from .._json import jsonable
 from ..errors import ContactLabError, ContactLabWarning, InputError
 from ..io import DEFAULT_CHUNK, Recording, read_chunks
 from ..io.units import UnknownUnitError, to_si
 from ._cycles import MIN_BLOCK, CycleState, block_cycles
+from .columns import CYCLE_UNITS
+from .study import coefficient_unit
 
 #: tangential quantities tracked per window (each with ``*_stderr``)
 TANGENTIAL_QUANTITIES = (
@@ -57,11 +60,6 @@ TANGENTIAL_QUANTITIES = (
 )
 #: normal quantities tracked per window (``E_d`` with ``E_d_stderr``)
 NORMAL_QUANTITIES = ("E_d", "psi", "psi_kv", "k_tan", "k_sec", "delta_max", "delta_min", "p0", "pa")
-#: SI units of the per-cycle quantities
-CYCLE_UNITS = {
-    "tangential": {"start": "s", "end": "s", "energy": "J", "amplitude": "m", "offset": "N"},
-    "normal": {"start": "s", "end": "s", "energy": "J/m^2", "amplitude": "m", "offset": "Pa"},
-}
 #: fewest cycles in a window: N crossing-to-crossing cycles hold N - 1 complete peak-to-peak
 #: cycles, and the window analyses average at least 2 of those
 MIN_CYCLES = 3
@@ -312,8 +310,6 @@ def _normal_window(rec: Recording, options: Mapping[str, Any]) -> tuple[dict, di
     n, e_std = int(d.get("n_cycles") or 0), d.get("E_d_cycle_std")
     row["E_d_stderr"] = e_std / math.sqrt(n) if n > 1 and _finite(e_std) else None
     units["E_d_stderr"] = du.get("E_d", "J/m^2")
-    from .study import coefficient_unit
-
     for key in ("poly_load", "poly_unload", "poly_centre"):
         for i, c in enumerate(d.get(key) or []):
             row[f"{key}_{i}"] = float(c)
@@ -623,8 +619,6 @@ def track_many(
 
 def track_json(result: TrackResult, *, cycles: bool = True) -> str:
     """The result as JSON text (NaN → null)."""
-    from ..commands._common import jsonable
-
     return json.dumps(jsonable(result.to_dict(cycles=cycles)), indent=1, allow_nan=False) + "\n"
 
 

@@ -15,7 +15,7 @@ use pyo3::types::PyDict;
 
 mod errors;
 mod normal;
-use errors::{internal, to_pyerr};
+use errors::{internal, slice, to_pyerr};
 
 /// Run `f` without the GIL, turning a panic (a bug, never expected) into `ContactLabError`.
 pub(crate) fn detach_guarded<T: Send, F: FnOnce() -> Result<T, CoreError> + Send>(
@@ -55,12 +55,6 @@ struct MasingCore {
     curve: Curve,
     scale: f64,
     state: MasingState,
-}
-
-fn slice<'a>(a: &'a PyReadonlyArray1<'_, f64>, name: &'static str) -> PyResult<&'a [f64]> {
-    a.as_slice().map_err(|_| {
-        PyErr::new::<pyo3::exceptions::PyValueError, _>(format!("{name} must be contiguous"))
-    })
 }
 
 #[pymethods]
