@@ -208,6 +208,56 @@ def command_line(verb: str, *parts: Any) -> str:
     return " ".join(shlex.quote(w) for w in words)
 
 
+def add_pressure_flags(p: Any) -> None:
+    """``--p0`` and ``--pa`` (normal contact): quantities in Pa (``0.5MPa``)."""
+    p.add_argument(
+        "--p0",
+        type=quantity("Pa", positive=True),
+        help="normal: static pressure, e.g. 0.5MPa (needed when the pressure channel holds "
+        "only the dynamic part; default: the file-name tag p0-..., the manifest, or the "
+        "channel's mean)",
+    )
+    p.add_argument(
+        "--pa",
+        type=quantity("Pa", positive=True),
+        help="normal: nominal dynamic amplitude, e.g. 0.4MPa (checked against the measured "
+        "one; default: the file-name tag pa-... or the manifest)",
+    )
+
+
+def with_static_pressure(rec: Any, file: str, p0: float | None, pa: float | None) -> Any:
+    """A normal recording whose pressure channel holds only the dynamic part, with the static
+    pressure added (from ``--p0``, else the file-name tag ``p0-...``); unchanged otherwise.
+    A nominal ``pa`` (``--pa`` or tag) that the pressure's half range misses by more than
+    10 % is reported on stderr, naming both."""
+    import sys
+
+    from ..io import Recording
+    from ..manifest import tags_from_filename
+    from ..normal.loop import dynamic_only
+
+    tags = tags_from_filename(file)
+    p0 = p0 if p0 is not None else tags.get("p0")
+    pa = pa if pa is not None else tags.get("pa")
+    p = np.asarray(rec["p"], dtype=float)
+    if pa is not None:
+        measured = 0.5 * float(np.ptp(p))
+        if abs(measured - pa) > 0.1 * pa:
+            print(f"warning: {file}: the pressure's half range {measured:.4g} Pa differs "
+                  f"from the nominal pa = {pa:.4g} Pa", file=sys.stderr)  # fmt: skip
+    if not dynamic_only(p):
+        return rec
+    if p0 is None:
+        raise InputError(
+            f"{file}: the pressure channel holds only the dynamic pressure (mean "
+            f"{float(np.mean(p)):.3g} Pa): give the static pressure with --p0 (e.g. 0.5MPa) "
+            "or a file-name tag such as p0-0.5MPa"
+        )
+    data = dict(rec.data)
+    data["p"] = p + p0
+    return Recording(rec.t, data, dict(rec.units), rec.source, dict(rec.meta or {}))
+
+
 def add_progress_flags(p: Any) -> None:
     g = p.add_mutually_exclusive_group()
     g.add_argument("--progress", dest="progress", action="store_true", default=None,

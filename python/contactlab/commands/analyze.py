@@ -17,6 +17,7 @@ from ..errors import InputError
 from ..manifest import entry_from_file
 from ..study import run_study
 from ._common import (
+    add_pressure_flags,
     add_progress_flags,
     check_output_targets,
     command_line,
@@ -67,8 +68,9 @@ def _handler(args: argparse.Namespace) -> int:
         e.columns, e.fs = columns, args.fs
         entries.append(e)
     topts = {"force_sign": args.force_sign}
+    nopts = {"p0": args.p0, "pa": args.pa}
     result = run_study(entries, progress=args.progress, keep_going=args.keep_going,
-                       tangential_options=topts)  # fmt: skip
+                       tangential_options=topts, normal_options=nopts)  # fmt: skip
     # With --json -, stdout carries the JSON alone; everything else goes to stderr.
     say = sys.stderr if args.json == "-" else sys.stdout
     for r in result.results:
@@ -120,6 +122,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="tangential: analyse F (+1) or -F (-1); auto (default): the sign that makes the "
         "loop area ∮F dx positive (a passive joint dissipates)",
     )
+    add_pressure_flags(p)
     p.add_argument("--keep-going", action="store_true",
                    help="skip recordings that fail (exit code 1) instead of stopping")  # fmt: skip
     p.add_argument("-v", "--verbose", action="store_true", help="print each fit report")
