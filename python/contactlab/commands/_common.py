@@ -7,6 +7,7 @@ import json
 import math
 import re
 import shlex
+import sys
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -195,10 +196,44 @@ def write_report(
     intro = f"Made by: {command}" if command else None
     rep = build_report(result, title, study_plots=study_plots, progress=progress, intro=intro)
     files = rep.files()
-    files.update(result.table_files())
+    tables, skipped = table_files(result)
+    files.update(tables)
+    for name, why in skipped.items():
+        print(f"note: skipped {name}: {why}", file=sys.stderr)
     if extra:
         files.update(extra)
     return commit_outputs(directory, files)
+
+
+def parquet_available() -> str | None:
+    """None when Parquet can be written, else why not and what to install."""
+    try:
+        import pyarrow
+        import pyarrow.parquet  # noqa: F401
+    except ImportError:
+        return "writing Parquet needs pyarrow, which is not installed: pip install 'contactlab[io]'"
+    return None
+
+
+def table_files(
+    result: StudyResult, stem: str = "study"
+) -> tuple[dict[str, bytes], dict[str, str]]:
+    """The study tables as files (``<stem>_<kind>.csv`` always, ``.parquet`` when pyarrow is
+    installed) and, for each table left out, why (a bare install has no ``io`` extra)."""
+    from ..study import KINDS
+
+    files: dict[str, bytes] = {}
+    skipped: dict[str, str] = {}
+    why = parquet_available()
+    for kind in KINDS:
+        if not result.table(kind):
+            continue
+        files[f"{stem}_{kind}.csv"] = result.to_csv(kind).encode("utf-8")
+        if why is None:
+            files[f"{stem}_{kind}.parquet"] = result.to_parquet(kind)
+        else:
+            skipped[f"{stem}_{kind}.parquet"] = why
+    return files, skipped
 
 
 def command_line(verb: str, *parts: Any) -> str:
@@ -230,7 +265,6 @@ def with_static_pressure(rec: Any, file: str, p0: float | None, pa: float | None
     pressure added (from ``--p0``, else the file-name tag ``p0-...``); unchanged otherwise.
     A nominal ``pa`` (``--pa`` or tag) that the pressure's half range misses by more than
     10 % is reported on stderr, naming both."""
-    import sys
 
     from ..io import Recording
     from ..manifest import tags_from_filename
