@@ -49,6 +49,7 @@ from typing import Any
 import numpy as np
 
 from .._arrays import as_1d
+from .._physical import check_channel
 from ..errors import ContactLabWarning, InputError
 from ..fitting import FitResult
 from ..io import Recording
@@ -138,6 +139,11 @@ def identifiability(
             f"{corr:+.3f}. Identified: h0·ac = {k0.value:.6g} ± {k0.stderr or math.nan:.3g} N/m"
             f" ({100 * rel_k0:.2f}%); ac < {ac_up:.3g} 1/m and h0 > {h0_lo:.3g} N (2σ)."
         )
+        if not rel_k0 < max_rel_stderr:
+            msg += (
+                " Not even h0·ac is determined: the force hardly follows the displacement "
+                "(a noise-only or disconnected force channel?)."
+            )
         for p in (ph0, pac):
             p.identifiable = False
             p.note = "not separately identifiable: only h0·ac is (see identifiability)"
@@ -388,6 +394,8 @@ def analyze_tangential(
     """
     xa, Fa, ta, source = _inputs(recording, t, x, F)
     _check_options(on, history, n_points)
+    check_channel("x", xa, "m", "displacement")
+    check_channel("F", Fa, "N", "force")
     steady = history == "steady"
     if invert_force is not None:
         force_sign = -1 if invert_force else 1
