@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from ..fitting import FitResult, _num
+from ..fitting import FitResult, json_number
 from ..masing import Masing
 from .preprocess import AveragedLoop, CycleScatter
 
@@ -129,35 +129,36 @@ class TangentialAnalysis:
             "source": self.source,
             "on": self.on,
             "history": self.history,
-            "h0": _num(h0) if ih0 else None,
-            "h0_stderr": _num(h0_se) if ih0 else None,
-            "ac": _num(p["ac"].value) if iac else None,
-            "ac_stderr": _num(p["ac"].stderr) if iac else None,
-            "offset": _num(p["offset"].value),
-            "offset_stderr": _num(p["offset"].stderr),
+            "h0": json_number(h0) if ih0 else None,
+            "h0_stderr": json_number(h0_se) if ih0 else None,
+            "ac": json_number(p["ac"].value) if iac else None,
+            "ac_stderr": json_number(p["ac"].stderr) if iac else None,
+            "offset": json_number(p["offset"].value),
+            "offset_stderr": json_number(p["offset"].stderr),
         }
         if "x0" in p:
-            out["x0"] = _num(p["x0"].value)
-            out["x0_stderr"] = _num(p["x0"].stderr)
+            out["x0"] = json_number(p["x0"].value)
+            out["x0_stderr"] = json_number(p["x0"].stderr)
         out["force_sign"] = int(self.meta.get("force_sign", 1))
         out["orientation_reason"] = str(self.meta.get("orientation_reason", ""))
         la = self.meta.get("loop_area_recorded")
         if la is not None:
-            out["loop_area_recorded"] = _num(la[0])
-            out["loop_area_recorded_stderr"] = _num(la[1])
-        out["amplitude"] = _num(self.amplitude)
-        out["amplitude_stderr"] = _num(self.amplitude_stderr)
+            out["loop_area_recorded"] = json_number(la[0])
+            out["loop_area_recorded_stderr"] = json_number(la[1])
+        out["amplitude"] = json_number(self.amplitude)
+        out["amplitude_stderr"] = json_number(self.amplitude_stderr)
         for k, (v, e) in self.derived.items():
-            out[k] = _num(v)
-            out[f"{k}_stderr"] = _num(e)
+            out[k] = json_number(v)
+            out[f"{k}_stderr"] = json_number(e)
         out["identifiable"] = {
-            k: (_num(v) if isinstance(v, float) else v) for k, v in self.identifiability.items()
+            k: (json_number(v) if isinstance(v, float) else v)
+            for k, v in self.identifiability.items()
         }
         for k, v in self.regime.items():
             if k == "stick_slip":
-                out[k] = dict({kk: _num(vv) for kk, vv in v.items()}, units=_STICK_UNITS)
+                out[k] = dict({kk: json_number(vv) for kk, vv in v.items()}, units=_STICK_UNITS)
             else:
-                out[k] = v if isinstance(v, str) else _num(v)
+                out[k] = v if isinstance(v, str) else json_number(v)
         out["n_cycles"] = None if self.scatter is None else self.scatter.n_cycles
         out["warnings"] = list(self.warnings)
         out["fit"] = self.fit.to_dict()
