@@ -249,8 +249,8 @@ def with_static_pressure(rec: Any, file: str, p0: float | None, pa: float | None
     import numpy as np
 
     from ..io import Recording
-    from ..manifest import tags_from_filename
     from ..normal.loop import dynamic_only
+    from ..studies.manifest import tags_from_filename
 
     tags = tags_from_filename(file)
     p0 = p0 if p0 is not None else tags.get("p0")
