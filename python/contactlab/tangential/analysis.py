@@ -279,7 +279,9 @@ def collect_warnings(
 ) -> list[str]:
     """Everything the user should know about the fit: regime, identifiability, convergence,
     and a misfit beyond the cycle-to-cycle noise."""
-    warns: list[str] = pre + list(raw.notes)
+    # on a plateau the Masing fit is superseded: its numerical notes would only confuse
+    plateau = evidence.get("h0_source") == "plateau"
+    warns: list[str] = pre + ([] if plateau else list(raw.notes))
     loop = data.loop
     z = evidence["ac_times_amplitude"]
     ratio = regime.area_ratio
@@ -290,14 +292,13 @@ def collect_warnings(
         )
     if not identifiable:
         warns.append(evidence["message"])
-    if not raw.success:
-        why = (
-            "; in gross sliding the loop is nearly rectangular and the fit's ac runs off "
-            "towards infinity, which is why h0 comes from the plateau"
-            if evidence.get("h0_source") == "plateau"
-            else ""
+    if not raw.success and plateau:
+        warns.append(
+            "the exponential Masing fit cannot follow this nearly rectangular loop (its ac "
+            "runs off towards infinity), which is why h0 comes from the plateau"
         )
-        warns.append(f"the Masing fit did not converge ({raw.message}){why}")
+    elif not raw.success:
+        warns.append(f"the Masing fit did not converge ({raw.message})")
     if loop is not None and data.on == "averaged" and loop.n_cycles > 2:
         # Is the misfit larger than the cycle-to-cycle noise explains?
         per_cycle = loop.count / loop.n_cycles
