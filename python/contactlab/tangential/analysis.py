@@ -452,6 +452,7 @@ def analyze_tangential(
         F=det.F,
         t=ta,
         rev=data.rev,
+        x_raw=xa,
     )
     apply_regime(regime, amp, fit, identifiable, evidence, derived, max_rel_stderr)
     warns = collect_warnings(pre_warns, raw, data, amp.value, identifiable, evidence, regime)
