@@ -339,3 +339,28 @@ def test_real_macro_slip_frame_is_refused() -> None:
         res = {**analyze_tangential(rec).to_dict(), "model": "tangential", "file": rec.source}
     with pytest.raises(NotIdentifiableError, match="stick slope h0·ac is not identified"):
         joint_characteristics(res, area=1e-4, normal_load=0.45 * 9.81)
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    h0=st.floats(1.0, 500.0),
+    ac=st.floats(1e3, 1e6),
+    area=st.floats(1e-6, 1e-1),
+    load=st.floats(1.0, 1e4),
+    system=st.sampled_from(["mm-N-s", "mm-t-s"]),
+)
+def test_units_scale_consistently(h0: float, ac: float, area: float, load: float,
+                                  system: str) -> None:  # fmt: skip
+    d = {"model": "tangential", "h0": h0, "h0_stderr": 0.01 * h0, "ac": ac,
+         "ac_stderr": 0.01 * ac, "h0_ac": h0 * ac, "h0_ac_stderr": 0.01 * h0 * ac,
+         "identifiable": {"h0": True, "ac": True, "h0_ac": True, "message": "ok"}}  # fmt: skip
+    jc = joint_characteristics(d, area=area, normal_load=load, amplitude=2 / ac, frequency=50.0)
+    u = unit_system(system)
+    exps = {"length": 1, "stiffness_per_area": -3, "stiffness": -1, "damping": -1,
+            "force": 0, "1": 0, "energy": 1}  # fmt: skip
+    for v in jc.values:
+        val = v.converted(u)[0]
+        assert val == pytest.approx(v.value * 1e3 ** exps[v.dim], rel=1e-12)
+    # the friction card in mm: λ·A_c·(1/ac) = μ·W (slip starts at the elastic slip 1/ac)
+    lam = jc.get("stick_slope").converted(u)[0]
+    assert lam * area * 1e6 / (ac * 1e-3) == pytest.approx(jc.get("mu").value * load, rel=1e-9)
