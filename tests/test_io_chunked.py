@@ -123,3 +123,16 @@ def test_resolution_errors_are_immediate(tmp_path, files: dict) -> None:
     p.write_bytes(b"not hdf5 at all")
     with pytest.raises(RecordingError, match=r"junk\.h5"):
         read_chunks(p)
+
+
+@pytest.mark.parametrize(("ext", "opts"), [("tdms", {}), ("mat", {"version": "7.3"}), ("h5", {})])
+def test_nan_named_alike_in_every_binary_format(tmp_path, ext, opts) -> None:
+    rec = _rec(n=300)
+    rec.data["F"][211] = np.nan
+    p = tmp_path / f"bad.{ext}"
+    write_recording(p, rec, **opts)
+    with pytest.raises(RecordingError) as whole:
+        read_recording(p)
+    with pytest.raises(RecordingError) as chunked:
+        list(read_chunks(p, chunk_size=50))
+    assert str(chunked.value) == str(whole.value) and chunked.value.row == 211

@@ -17,7 +17,7 @@ if TYPE_CHECKING:
     from .fitting import FitResult, Parameter, least_squares_fit
     from .io import Recording, RecordingError, read_recording, write_recording
     from .masing import CycleTable, Masing, MasingOperator, cycle_energies, loop_area
-    from .studies.track import TrackResult, track
+    from .studies.tracking import TrackResult, track
     from .tangential import TangentialAnalysis, analyze_tangential
 
 # Everything but the errors loads on first use (PEP 562): `import contactlab` stays cheap, and
@@ -40,8 +40,8 @@ _LAZY = {
     "loop_area": "masing",
     "TangentialAnalysis": "tangential",
     "analyze_tangential": "tangential",
-    "TrackResult": "studies.track",
-    "track": "studies.track",
+    "TrackResult": "studies.tracking",
+    "track": "studies.tracking",
 }
 
 

@@ -4,16 +4,14 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import re
 import shlex
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from .._io_atomic import write_text
+from .._json import jsonable
 from .._version import __version__
 from ..errors import InputError
 from ..report import commit_outputs
@@ -84,23 +82,6 @@ def parse_columns(text: str | None) -> dict[str, str] | None:
         k, v = part.split("=", 1)
         out[k.strip()] = v.strip()
     return out
-
-
-def jsonable(value: Any) -> Any:
-    """Plain JSON types; NaN/inf become null (JSON has no NaN)."""
-    if isinstance(value, Mapping):
-        return {str(k): jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [jsonable(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return jsonable(value.tolist())
-    if isinstance(value, (np.floating, np.integer, np.bool_)):
-        value = value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, Path):
-        return str(value)
-    return value
 
 
 def recording_json(r: RecordingResult) -> dict[str, Any]:
@@ -205,6 +186,24 @@ def command_line(verb: str, *parts: Any) -> str:
     words = ["contactlab", verb]
     words += [str(p) for p in parts if p is not None and p is not False and p != ""]
     return " ".join(shlex.quote(w) for w in words)
+
+
+def add_workers_flag(p: Any, what: str) -> None:
+    p.add_argument("--workers", type=int, default=None, metavar="N",
+                   help=f"analyse {what} in N processes (default: serially)")  # fmt: skip
+
+
+def process_pool(workers: int | None) -> Any:
+    """A ``ProcessPoolExecutor`` for ``--workers N`` (a null context for None)."""
+    import contextlib
+
+    if workers is None:
+        return contextlib.nullcontext(None)
+    if workers < 1:
+        raise InputError(f"--workers must be >= 1, got {workers}")
+    from concurrent.futures import ProcessPoolExecutor
+
+    return ProcessPoolExecutor(workers)
 
 
 def add_progress_flags(p: Any) -> None:

@@ -114,8 +114,9 @@ class _Finisher:
                 self.dt = 1.0 / fs
             elif dt is not None:
                 if not np.isfinite(dt) or dt <= 0:
-                    raise RecordingError(f"sampling interval {dt} is not a positive time step",
-                                         file=file)  # fmt: skip
+                    raise RecordingError(
+                        f"sampling interval {dt} is not a positive time step", file=file
+                    )
                 self.dt = float(dt)
             else:
                 raise RecordingError(
@@ -134,9 +135,31 @@ class _Finisher:
             m["units_assumed_si"] = assumed
         self.meta = m
 
+    def _check_time(self, t: np.ndarray, row_of: Callable[[int], int]) -> None:
+        """The whole-file reader's time checks, judged against the first chunk's median step
+        and across the boundary with the previous chunk."""
+        col = self.tcol
+        if self.prev_t is None:
+            if t.size >= 2:
+                self.step = float(np.median(np.diff(t)))
+            check_time(t, file=self.file, column=col, row_of=row_of, step=self.step)
+            return
+        if t.size:  # the boundary: the previous chunk's last stamp, then this one's first
+            check_time(
+                np.array([self.prev_t, t[0]]),
+                file=self.file,
+                column=col,
+                row_of=lambda i: row_of(i - 1),
+                step=self.step,
+            )
+        if t.size >= 2:
+            check_time(t, file=self.file, column=col, row_of=row_of, step=self.step)
+
     def __call__(self, raw: dict[str, np.ndarray], offset: int) -> Recording:
         check_equal_lengths(raw, self.mapping, file=self.file)
         n = next(iter(raw.values())).size
+        if self.prev_t is None and n < 2:  # as the whole-file check of the time says
+            raise RecordingError(f"only {n} sample(s)", file=self.file, column=self.tcol)
 
         def row_of(i: int) -> int:
             return self.row_of(offset + i)
@@ -154,15 +177,12 @@ class _Finisher:
             else:
                 data[canon] = v
         if t is None:
+            # a time axis made from the sampling interval is increasing and gap-free by
+            # construction: nothing to check
             assert self.dt is not None
             t = self.t0 + self.dt * np.arange(offset, offset + n, dtype=np.float64)
-        if self.prev_t is None:
-            check_time(t, file=self.file, column=self.tcol, row_of=row_of)
-            self.step = float(np.median(np.diff(t)))
-        elif n:
-            # judge the boundary too: the previous chunk's last stamp leads this one
-            check_time(np.r_[self.prev_t, t], file=self.file, column=self.tcol,
-                       row_of=lambda i: row_of(i - 1), step=self.step)  # fmt: skip
+        else:
+            self._check_time(t, row_of)
         if n:
             self.prev_t = float(t[-1])
         meta = dict(self.meta, offset=offset)
@@ -227,12 +247,10 @@ def _h5_chunks(
         raise RecordingError(f"not a readable HDF5 file ({exc})", file=file) from None
     with f:
         kind_, mapping, _d, units, dt, n = layout(f)
-    fin0 = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt,
-                     meta={"format": fmt})  # fmt: skip
+    fin0 = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, meta={"format": fmt})
 
     def gen() -> Iterator[Recording]:
-        fin = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt,
-                        meta={"format": fmt})  # fmt: skip
+        fin = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, meta={"format": fmt})
         with h5py.File(path, "r") as f:
             dsets = {n_: f[n_] for n_ in mapping.values()} if fmt == "mat73" else None
             if dsets is None:
@@ -241,8 +259,9 @@ def _h5_chunks(
                 alld = datasets(f)
                 dsets = {n_: alld[n_] for n_ in mapping.values()}
             if n < 2:
-                yield fin({c: _slice(dsets[m], 0, n, file=file, column=m)
-                           for c, m in mapping.items()}, 0)  # fmt: skip
+                yield fin(
+                    {c: _slice(dsets[m], 0, n, file=file, column=m) for c, m in mapping.items()}, 0
+                )
                 return
             for a in range(0, n, chunk):
                 b = min(a + chunk, n)
@@ -253,9 +272,9 @@ def _h5_chunks(
 
 
 def _tdms_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> ChunkedRecording:
-    from .tdms import _nptdms
+    from .tdms import import_nptdms
 
-    nptdms = _nptdms()
+    nptdms = import_nptdms()
     file = str(path)
 
     def open_tdms() -> tuple[Any, Any, dict[str, Any]]:
@@ -292,32 +311,43 @@ def _tdms_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) ->
                 dt = float(inc)
                 t0 = float(ref.properties.get("wf_start_offset", 0.0) or 0.0)
                 if not np.isfinite(dt) or dt <= 0:
-                    raise RecordingError(f"wf_increment {dt} is not a positive time step",
-                                         file=file, column=ref.name)  # fmt: skip
-    fin0 = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, t0=t0,
-                     meta={"format": "tdms"})  # fmt: skip
+                    raise RecordingError(
+                        f"wf_increment {dt} is not a positive time step", file=file, column=ref.name
+                    )
+    fin0 = _Finisher(
+        mapping, units, kind=kind_, file=file, fs=fs, dt=dt, t0=t0, meta={"format": "tdms"}
+    )
 
     def gen() -> Iterator[Recording]:
-        fin = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, t0=t0,
-                        meta={"format": "tdms"})  # fmt: skip
+        fin = _Finisher(
+            mapping, units, kind=kind_, file=file, fs=fs, dt=dt, t0=t0, meta={"format": "tdms"}
+        )
         fh, tf, chans = open_tdms()
         with tf, fh:
             for a in range(0, max(n, 1), chunk):
                 length = min(chunk, n - a)
-                raw = {c: real_values(chans[m].read_data(a, length), file=file, column=m)
-                       for c, m in mapping.items()}  # fmt: skip
+                raw = {
+                    c: real_values(chans[m].read_data(a, length), file=file, column=m)
+                    for c, m in mapping.items()
+                }
                 yield fin(raw, a)
 
     return ChunkedRecording(file, kind_, fin0.units, mapping, n, fin0.meta, gen)
 
 
 def _csv_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> ChunkedRecording:
-    from .csv import _decimal_comma, _encoding, _header, _line_of_sample, _locate_bad_cell
+    from .csv import (
+        detect_encoding,
+        has_decimal_comma,
+        line_of_sample,
+        locate_bad_cell,
+        read_header,
+    )
     from .units import split_name
 
     file = str(path)
-    enc = _encoding(path)
-    names, delim, header_line, comments = _header(path, enc)
+    enc = detect_encoding(path)
+    names, delim, header_line, comments = read_header(path, enc)
     if len(set(names)) != len(names):
         dup = next(n for n in names if names.count(n) > 1)
         raise RecordingError("column name appears twice in the header", file=file, column=dup)
@@ -325,13 +355,18 @@ def _csv_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> 
     canon = list(mapping)
     idx = [names.index(mapping[c]) for c in canon]
     first_data = header_line + 1
-    comma = _decimal_comma(path, delim, first_data, enc)
+    comma = has_decimal_comma(path, delim, first_data, enc)
     units = {c: split_name(mapping[c])[1] for c in canon}
-    meta = {"format": "csv", "comments": comments, "delimiter": delim or "whitespace",
-            "decimal": "," if comma else ".", "encoding": enc}  # fmt: skip
+    meta = {
+        "format": "csv",
+        "comments": comments,
+        "delimiter": delim or "whitespace",
+        "decimal": "," if comma else ".",
+        "encoding": enc,
+    }
 
     def row_of(i: int) -> int:
-        return _line_of_sample(path, first_data, i, enc)
+        return line_of_sample(path, first_data, i, enc)
 
     fin0 = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, row_of=row_of, meta=meta)
 
@@ -350,14 +385,21 @@ def _csv_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> 
                         with warnings.catch_warnings():
                             warnings.filterwarnings("ignore", message="loadtxt: input contained")
                             block = np.loadtxt(
-                                lines, delimiter=delim, usecols=idx, ndmin=2, comments="#",
-                                dtype=np.float64, quotechar='"',
-                                converters=(lambda v: float(v.replace(",", "."))) if comma
+                                lines,
+                                delimiter=delim,
+                                usecols=idx,
+                                ndmin=2,
+                                comments="#",
+                                dtype=np.float64,
+                                quotechar='"',
+                                converters=(lambda v: float(v.replace(",", ".")))
+                                if comma
                                 else None,
-                            )  # fmt: skip
+                            )
                     except ValueError:
-                        raise _locate_bad_cell(path, delim, first_data, idx, names, comma,
-                                               enc) from None  # fmt: skip
+                        raise locate_bad_cell(
+                            path, delim, first_data, idx, names, comma, enc
+                        ) from None
                     if block.shape[0] == 0:
                         continue
                     raw = {c: np.ascontiguousarray(block[:, j]) for j, c in enumerate(canon)}
@@ -382,11 +424,17 @@ def _whole_chunks(rec: Recording, chunk: int) -> ChunkedRecording:
         for a in range(0, n, chunk):
             b = min(a + chunk, n)
             data = {k: v[a:b] for k, v in rec.data.items()}
-            yield Recording(rec.t[a:b], data, dict(rec.units), rec.source,
-                            dict(rec.meta, offset=a))  # fmt: skip
+            yield Recording(rec.t[a:b], data, dict(rec.units), rec.source, dict(rec.meta, offset=a))
 
-    return ChunkedRecording(rec.source, rec.kind, dict(rec.units),
-                            dict(rec.meta.get("columns", {})), n, dict(rec.meta), gen)  # fmt: skip
+    return ChunkedRecording(
+        rec.source,
+        rec.kind,
+        dict(rec.units),
+        dict(rec.meta.get("columns", {})),
+        n,
+        dict(rec.meta),
+        gen,
+    )
 
 
 def read_chunks(

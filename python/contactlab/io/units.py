@@ -27,8 +27,8 @@ SI_UNITS = {
 }
 
 # The one unit table of the package (channel units of recordings here, tag units of study
-# manifests in contactlab.manifest): normalised spelling -> (factor to SI, dimension). Micro is
-# written u, µ (micro sign U+00B5) or μ (Greek mu U+03BC); normalize() maps both to u.
+# manifests in contactlab.studies.manifest): normalised spelling -> (factor to SI, dimension).
+# Micro is written u, µ (micro sign U+00B5) or μ (Greek mu U+03BC); normalize() maps both to u.
 _TABLE: dict[str, tuple[float, str]] = {}
 
 

@@ -72,9 +72,10 @@ def plot_normal_loop(r: RecordingResult, ax: Any = None) -> Any:
     rec, row, res = r.recording, r.row, r.analysis
     p0 = float(row.get("p0", 0.0) or 0.0)
     shift = float(row.get("delta_offset", 0.0) or 0.0)
-    p = np.asarray(rec["p"], dtype=float)
-    d = np.asarray(rec["delta"], dtype=float)
-    ax.plot((d - shift) * 1e6, (p - p0) * 1e-6, color="0.75", lw=0.5, label="recorded")
+    if rec is not None:  # None: a study run with keep_recordings=False holds no samples
+        p = np.asarray(rec["p"], dtype=float)
+        d = np.asarray(rec["delta"], dtype=float)
+        ax.plot((d - shift) * 1e6, (p - p0) * 1e-6, color="0.75", lw=0.5, label="recorded")
     if res is not None and hasattr(res, "cycle_delta"):
         ax.plot(np.asarray(res.cycle_delta) * 1e6, np.asarray(res.cycle_p) * 1e-6, ".",
                 color="0.2", ms=2, label="averaged cycle")  # fmt: skip

@@ -6,15 +6,21 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..studies.track import CYCLE_UNITS, TrackResult
 from ..studies.track_plots import LABELS, track_figures
+from ..studies.tracking import CYCLE_UNITS, TrackResult
 from .html import Column, Report
 
 #: display (label, unit, scale) of the tracked quantities' SI units
 _DISPLAY = {
-    "N": ("N", 1.0), "1/m": ("1/mm", 1e-3), "N/m": ("N/µm", 1e-6), "J": ("µJ", 1e6),
-    "m": ("µm", 1e6), "J/m^2": ("J/m²", 1.0), "Pa/m": ("MPa/µm", 1e-12), "Pa": ("MPa", 1e-6),
-}  # fmt: skip
+    "N": ("N", 1.0),
+    "1/m": ("1/mm", 1e-3),
+    "N/m": ("N/µm", 1e-6),
+    "J": ("µJ", 1e6),
+    "m": ("µm", 1e6),
+    "J/m^2": ("J/m²", 1.0),
+    "Pa/m": ("MPa/µm", 1e-12),
+    "Pa": ("MPa", 1e-6),
+}
 
 
 def _columns(result: TrackResult, with_time: bool = True) -> list[Column]:
@@ -24,8 +30,9 @@ def _columns(result: TrackResult, with_time: bool = True) -> list[Column]:
     for q in result.quantities:
         unit, scale = _DISPLAY.get(result.units.get(q, ""), (result.units.get(q, ""), 1.0))
         has_err = any(r.get(f"{q}_stderr") is not None for r in result.rows)
-        cols.append(Column(q, LABELS.get(q, q), unit, scale,
-                           stderr=f"{q}_stderr" if has_err else None))  # fmt: skip
+        cols.append(
+            Column(q, LABELS.get(q, q), unit, scale, stderr=f"{q}_stderr" if has_err else None)
+        )
     return cols
 
 

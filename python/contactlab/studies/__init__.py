@@ -10,6 +10,7 @@
 
 from __future__ import annotations
 
+from .executor import ordered_map
 from .manifest import StudyEntry, entry_from_file, read_manifest, tags_from_filename
 from .study import (
     KINDS,
@@ -19,7 +20,7 @@ from .study import (
     collect_entries,
     run_study,
 )
-from .track import TrackResult, parse_every, track
+from .tracking import TrackResult, parse_every, track, track_many
 
 __all__ = [
     "KINDS",
@@ -30,9 +31,11 @@ __all__ = [
     "analyze_entry",
     "collect_entries",
     "entry_from_file",
+    "ordered_map",
     "parse_every",
     "read_manifest",
     "run_study",
     "tags_from_filename",
     "track",
+    "track_many",
 ]

@@ -64,28 +64,41 @@ def _segment_extrema(v: np.ndarray, starts: np.ndarray) -> tuple[np.ndarray, np.
 
 
 def block_cycles(
-    t: np.ndarray, x: np.ndarray, F: np.ndarray, drive: np.ndarray, offset: int, s: CycleState
+    t: np.ndarray,
+    x: np.ndarray,
+    F: np.ndarray,
+    drive: np.ndarray,
+    offset: int,
+    s: CycleState,
+    levels: tuple[float, float] | None = None,
 ) -> Cycles:
     """Crossings of ``drive`` and the cycles they complete in one block; updates ``s``.
 
     ``x``/``F`` are the loop's abscissa and ordinate (``x, F`` or ``delta, p``), ``drive`` the
     channel whose crossings mark the cycles, ``offset`` the global index of the block's first
-    sample.
+    sample. ``levels = (low, high)`` fixes the trigger band (default: from the block's range).
     """
     n = x.size
-    lo_d, hi_d = float(drive.min()), float(drive.max())
-    centre, half = 0.5 * (hi_d + lo_d), 0.5 * (hi_d - lo_d) * BAND
+    if levels is None:
+        lo_d, hi_d = (float(drive.min()), float(drive.max())) if n else (0.0, 0.0)
+        centre, half = 0.5 * (hi_d + lo_d), 0.5 * (hi_d - lo_d) * BAND
+        low, high = centre - half, centre + half
+    else:
+        low, high = float(levels[0]), float(levels[1])
+        half = 0.5 * (high - low)
     mark = np.zeros(n, dtype=np.int8)
-    mark[drive >= centre + half] = 1
-    mark[drive <= centre - half] = -1
+    mark[drive >= high] = 1
+    mark[drive <= low] = -1
     idx = np.where(mark != 0, np.arange(n), -1)
     np.maximum.accumulate(idx, out=idx)
+    if n == 0:
+        return Cycles(crossings=np.empty(0, dtype=np.int64))
     filled = np.where(idx >= 0, mark[np.maximum(idx, 0)], np.int8(s.level))
     before = np.empty(n, dtype=np.int8)
     before[0] = s.level
     before[1:] = filled[:-1]
     ups = np.flatnonzero((filled == 1) & (before == -1))
-    if half == 0.0:  # a constant block has no crossing
+    if not half > 0.0:  # a constant block has no crossing
         ups = ups[:0]
     s.level = int(filled[-1]) if n else s.level
 
@@ -108,8 +121,12 @@ def block_cycles(
         xmax, xmin = _segment_extrema(x, starts)
         fmax, fmin = _segment_extrema(F, starts)
         if ups[0] > 0:
-            first = (max(s.x_max, xmax[0]), min(s.x_min, xmin[0]),
-                     max(s.F_max, fmax[0]), min(s.F_min, fmin[0]))  # fmt: skip
+            first = (
+                max(s.x_max, xmax[0]),
+                min(s.x_min, xmin[0]),
+                max(s.F_max, fmax[0]),
+                min(s.F_min, fmin[0]),
+            )
             xmax, xmin, fmax, fmin = xmax[1:], xmin[1:], fmax[1:], fmin[1:]
         else:
             first = (s.x_max, s.x_min, s.F_max, s.F_min)
@@ -127,8 +144,12 @@ def block_cycles(
         last = int(ups[-1])
         s.x_cross, s.F_cross, s.t_cross = float(x[last]), float(F[last]), float(t[last])
         s.acc = float(cum[-1] - c_at[-1])
-        s.x_max, s.x_min, s.F_max, s.F_min = (float(xmax[-1]), float(xmin[-1]),
-                                              float(fmax[-1]), float(fmin[-1]))  # fmt: skip
+        s.x_max, s.x_min, s.F_max, s.F_min = (
+            float(xmax[-1]),
+            float(xmin[-1]),
+            float(fmax[-1]),
+            float(fmin[-1]),
+        )
     elif n:
         s.acc = float(cum[-1])
         s.x_max, s.x_min = max(s.x_max, float(x.max())), min(s.x_min, float(x.min()))

@@ -14,6 +14,7 @@ draws the paper's plots from it.
 from __future__ import annotations
 
 import csv
+import functools
 import html
 import io
 import json
@@ -57,7 +58,7 @@ _POWERS = re.compile(
 )
 
 
-def _coefficient_unit(unit: str, i: int) -> str:
+def coefficient_unit(unit: str, i: int) -> str:
     """Unit of coefficient ``i`` of a polynomial whose unit map says ``"Pa; ascending powers of
     delta in m"``: ``Pa``, ``Pa/m``, ``Pa/m^2``, ... (``"Pa/m; ..."`` starts at ``Pa/m``).
     Other strings are returned as they are."""
@@ -92,7 +93,7 @@ def _flatten(d: Mapping[str, Any], units: Mapping[str, str]) -> tuple[dict, dict
                     if isinstance(unit, (list, tuple)) and i < len(unit):
                         out_units[f"{key}_{i}"] = str(unit[i])
                     elif isinstance(unit, str) and unit:
-                        out_units[f"{key}_{i}"] = _coefficient_unit(unit, i)
+                        out_units[f"{key}_{i}"] = coefficient_unit(unit, i)
             continue
         if isinstance(value, (np.floating, np.integer, np.bool_)):
             value = value.item()
@@ -298,11 +299,19 @@ def _csv_cell(v: Any) -> str:
     return str(v)
 
 
-def _progress(iterable: Sequence[Any], progress: bool | None, desc: str) -> Iterable[Any]:
+def _progress(
+    iterable: Iterable[Any], progress: bool | None, desc: str, total: int | None = None
+) -> Iterable[Any]:
     """tqdm.auto bar (a widget in notebooks, text in terminals); None = only on a terminal."""
     from tqdm.auto import tqdm
 
-    return tqdm(iterable, desc=desc, unit="rec", disable=None if progress is None else not progress)
+    return tqdm(
+        iterable,
+        desc=desc,
+        unit="rec",
+        total=total,
+        disable=None if progress is None else not progress,
+    )
 
 
 def collect_entries(source: str | os.PathLike[str] | Sequence[Any]) -> list[StudyEntry]:
@@ -325,6 +334,34 @@ def collect_entries(source: str | os.PathLike[str] | Sequence[Any]) -> list[Stud
     return [e if isinstance(e, StudyEntry) else entry_from_file(e) for e in source]
 
 
+def _study_task(
+    entry: StudyEntry,
+    *,
+    tangential_options: Mapping[str, Any] | None,
+    normal_options: Mapping[str, Any] | None,
+    keep_going: bool,
+    keep_recording: bool,
+) -> RecordingResult:
+    """One recording of a study, as run on a worker (module level: it must pickle)."""
+    try:
+        r = analyze_entry(
+            entry, tangential_options=tangential_options, normal_options=normal_options
+        )
+    except ContactLabError as exc:
+        if not keep_going:
+            raise
+        return RecordingResult(entry, {}, {}, error=_with_source(exc, entry))
+    except Exception as exc:  # not a known bad input: a bug, or something unforeseen
+        if not keep_going:
+            raise
+        # The user asked to go on: keep the rest of the study, name what happened.
+        msg = f"{entry.path}: unexpected {type(exc).__name__}: {exc}"
+        return RecordingResult(entry, {}, {}, error=msg)
+    if not keep_recording:
+        r.recording = None
+    return r
+
+
 def run_study(
     source: str | os.PathLike[str] | Sequence[Any],
     *,
@@ -333,6 +370,8 @@ def run_study(
     tangential_options: Mapping[str, Any] | None = None,
     normal_options: Mapping[str, Any] | None = None,
     callback: Callable[[RecordingResult], None] | None = None,
+    executor: Any = None,
+    keep_recordings: bool | None = None,
 ) -> StudyResult:
     """Analyse every recording of a study.
 
@@ -352,6 +391,15 @@ def run_study(
         Keyword arguments for the per-recording analyses.
     callback : callable, optional
         Called with each :class:`RecordingResult` as it completes.
+    executor : optional
+        Run the recordings in parallel: a ``concurrent.futures`` executor (threads or
+        processes) or a Dask ``distributed.Client`` (see :mod:`contactlab.studies.executor`).
+        Results come in the order of the study and equal the serial run's; a few recordings
+        are in flight at a time.
+    keep_recordings : bool, optional
+        Keep each recording's samples in its result (``RecordingResult.recording``, drawn
+        behind the normal loops of the report). Default: yes for a serial run, no with an
+        executor, so that a study of thousands of files holds only the results.
 
     Returns
     -------
@@ -367,29 +415,29 @@ def run_study(
     >>> row["material"], row["normal_load"], round(row["h0"], 1)  # SI: N, N
     ('Al/Al', 50.0, 21.0)
     """
+    from .executor import ordered_map
+
     entries = collect_entries(source)
-    results = []
-    for entry in _progress(entries, progress, "analysing"):
-        try:
-            r = analyze_entry(
-                entry, tangential_options=tangential_options, normal_options=normal_options
-            )
-        except ContactLabError as exc:
-            if not keep_going:
-                new = _renamed(exc, entry)
-                if new is exc:
-                    raise
-                raise new from exc
-            r = RecordingResult(entry, {}, {}, error=_with_source(exc, entry))
-        except Exception as exc:  # not a known bad input: a bug, or something unforeseen
-            if not keep_going:
-                raise
-            # The user asked to go on: keep the rest of the study, name what happened.
-            msg = f"{entry.path}: unexpected {type(exc).__name__}: {exc}"
-            r = RecordingResult(entry, {}, {}, error=msg)
-        results.append(r)
-        if callback is not None:
-            callback(r)
+    keep = executor is None if keep_recordings is None else bool(keep_recordings)
+    task = functools.partial(
+        _study_task,
+        tangential_options=tangential_options,
+        normal_options=normal_options,
+        keep_going=keep_going,
+        keep_recording=keep,
+    )
+    results: list[RecordingResult] = []
+    done = ordered_map(task, entries, executor)
+    try:
+        for r in _progress(done, progress, "analysing", total=len(entries)):
+            results.append(r)
+            if callback is not None:
+                callback(r)
+    except ContactLabError as exc:
+        new = _renamed(exc, entries[len(results)])
+        if new is exc:
+            raise
+        raise new from exc
     return StudyResult(results)
 
 

@@ -1,8 +1,9 @@
-"""Plots of a :class:`~contactlab.studies.track.TrackResult`: every tracked quantity against
+"""Plots of a :class:`~contactlab.studies.tracking.TrackResult`: every tracked quantity against
 time or cycle count with its standard error as error bars, and the per-cycle energies."""
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -11,13 +12,26 @@ from .plots import display_unit
 
 #: axis labels of the tracked quantities
 LABELS = {
-    "h0": "h0", "ac": "ac", "h0_ac": "h0·ac", "energy_per_cycle": "E per cycle (analytic)",
-    "energy_per_cycle_numeric": "E per cycle (loop area)", "equivalent_damping": "c_e·ω",
-    "k_local0": "k_local(0)", "k_global": "k_global(A)", "amplitude": "amplitude A",
-    "offset": "force offset", "E_d": "E_d", "psi": "ψ (eq. 7)", "psi_kv": "ψ_KV (eq. 3)",
-    "k_tan": "k_tan", "k_sec": "k_sec", "delta_max": "δ_max", "delta_min": "δ_min",
-    "p0": "p0", "pa": "pa",
-}  # fmt: skip
+    "h0": "h0",
+    "ac": "ac",
+    "h0_ac": "h0·ac",
+    "energy_per_cycle": "E per cycle (analytic)",
+    "energy_per_cycle_numeric": "E per cycle (loop area)",
+    "equivalent_damping": "c_e·ω",
+    "k_local0": "k_local(0)",
+    "k_global": "k_global(A)",
+    "amplitude": "amplitude A",
+    "offset": "force offset",
+    "E_d": "E_d",
+    "psi": "ψ (eq. 7)",
+    "psi_kv": "ψ_KV (eq. 3)",
+    "k_tan": "k_tan",
+    "k_sec": "k_sec",
+    "delta_max": "δ_max",
+    "delta_min": "δ_min",
+    "p0": "p0",
+    "pa": "pa",
+}
 
 
 def _axes(ax: Any) -> Any:
@@ -47,8 +61,15 @@ def plot_quantity(result: Any, name: str, *, against: str = "time", ax: Any = No
         xv = 0.5 * (result.column("cycle_start") + result.column("cycle_end"))
         xl = "cycle"
     has_err = np.isfinite(e).any()
-    ax.errorbar(xv, y, yerr=np.where(np.isfinite(e), e, 0.0) if has_err else None,
-                fmt="o-", ms=3, lw=1, capsize=2)  # fmt: skip
+    ax.errorbar(
+        xv,
+        y,
+        yerr=np.where(np.isfinite(e), e, 0.0) if has_err else None,
+        fmt="o-",
+        ms=3,
+        lw=1,
+        capsize=2,
+    )
     label = LABELS.get(name, name)
     ax.set_ylabel(f"{label} [{shown}]" if shown else label)
     ax.set_xlabel(xl)
@@ -58,7 +79,7 @@ def plot_quantity(result: Any, name: str, *, against: str = "time", ax: Any = No
 
 def plot_cycles(result: Any, name: str = "energy", ax: Any = None) -> Any:
     """A per-cycle quantity against the cycle number (every cycle of the record)."""
-    from .track import CYCLE_UNITS
+    from .tracking import CYCLE_UNITS
 
     ax = _axes(ax)
     v = result.cycles[name]
@@ -72,22 +93,21 @@ def plot_cycles(result: Any, name: str = "energy", ax: Any = None) -> Any:
     return ax
 
 
-def track_figures(result: Any, *, against: str = "time") -> list[tuple[str, Any]]:
-    """``(name, figure)`` for every tracked quantity, then the per-cycle energy."""
+def track_figures(result: Any, *, against: str = "time") -> Iterator[tuple[str, Any]]:
+    """``(name, figure)`` for every tracked quantity, then the per-cycle energy: a generator,
+    so that a caller who closes each figure holds one at a time."""
     import matplotlib.pyplot as plt
 
-    out = []
     for q in result.quantities:
         fig, ax = plt.subplots(figsize=(6.0, 3.2))
         plot_quantity(result, q, against=against, ax=ax)
         fig.tight_layout()
-        out.append((q, fig))
+        yield q, fig
     if result.cycles["energy"].size:
         fig, ax = plt.subplots(figsize=(6.0, 3.2))
         plot_cycles(result, "energy", ax=ax)
         fig.tight_layout()
-        out.append(("cycle_energy", fig))
-    return out
+        yield "cycle_energy", fig
 
 
 __all__ = ["LABELS", "plot_cycles", "plot_quantity", "track_figures"]
