@@ -20,6 +20,7 @@ _VERB_MODULES = [
     "contactlab.commands.analyze",
     "contactlab.commands.study",
     "contactlab.commands.simulate",
+    "contactlab.commands.structure",
     "contactlab.demo",
     "contactlab.diagnose.cli",
 ]
