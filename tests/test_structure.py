@@ -46,7 +46,7 @@ def test_linear_sdof_forced_steady_state_matches_closed_form():
 
 @pytest.mark.parametrize("fs,kj", [(1.0, 2e4), (0.3, 5e3)])
 def test_jenkins_quasi_static_loop_energy(fs, kj):
-    s, r = _quasi_static("jenkins", 4 * fs / kj, k=kj, fs=fs)
+    _s, r = _quasi_static("jenkins", 4 * fs / kj, k=kj, fs=fs)
     n = 2000  # one cycle per 2000 samples; use the last (steady) cycle
     x, e = r.x[-n - 1 :], r.joint_energy[-n - 1 :, 0]
     A = 0.5 * (x.max() - x.min())
@@ -58,7 +58,7 @@ def test_jenkins_quasi_static_loop_energy(fs, kj):
 @settings(max_examples=8, deadline=None)
 def test_masing_joint_matches_masing_force(h0, ac, scale):
     amp = 2.0 / ac
-    s, r = _quasi_static("masing", amp, h0=h0, ac=ac, scale=scale)
+    _s, r = _quasi_static("masing", amp, h0=h0, ac=ac, scale=scale)
     ref = contactlab.Masing(h0, ac, scale=scale).force(r.x)
     # the integrator also visits the reversal points between samples; at the sampled
     # turning points that shifts the remembered reversal by at most O(h²) in x
@@ -172,3 +172,23 @@ def test_failed_integration_returns_partial_result():
     assert not r.success and r.status == -1 and "t =" in r.message
     assert 1 <= r.t.size < t.size and r.x.shape == r.t.shape
     assert np.all(np.isfinite(r.x))
+
+
+def test_amplitude_dependence_jenkins_closed_form():
+    from contactlab.structure.amplitude import amplitude_dependence, plot_amplitude_dependence
+
+    m, c, k, kj, fs = 1.0, 0.5, 1000.0, 1000.0, 1.0
+    s = Structure(m, c, k)
+    s.add_joint("jenkins", 0, k=kj, fs=fs)
+    ad = amplitude_dependence(s, [5e-4, 3e-3, 1e-1])
+    A = ad.amplitude
+    # stuck below fs/kj: linear with k + kj; slipping: loop energy 4 fs (A − fs/kj)
+    assert ad.frequency_hz[0] == pytest.approx(np.sqrt((k + kj) / m) / (2 * np.pi), rel=1e-6)
+    np.testing.assert_allclose(ad.energy[1:], 4 * fs * (A[1:] - fs / kj), rtol=1e-4)
+    # first-harmonic stiffness of the Jenkins element (Caughey): with φ = arccos(1 − 2 fs/(kj A))
+    phi = np.arccos(1 - 2 * fs / (kj * A[1:]))
+    keq = kj / np.pi * (phi - 0.5 * np.sin(2 * phi))
+    np.testing.assert_allclose(ad.k_eq[1:], keq, rtol=1e-3)
+    assert ad.frequency_hz[-1] < ad.frequency_hz[1] < ad.frequency_hz[0]
+    ax = plot_amplitude_dependence(ad)
+    assert len(ax) == 2

@@ -99,6 +99,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--input", help="CSV with the input column and a time column (else --fs)")
     s.add_argument("--u", help="input column name")
     s.add_argument("--base", action="store_true", help="the input is base displacement")
-    s.add_argument("--periodic", action="store_true",
-                   help="periodic steady state (input repeated until the response repeats)")
+    s.add_argument(
+        "--periodic",
+        action="store_true",
+        help="periodic steady state (input repeated until the response repeats)",
+    )
     p.set_defaults(handler=_handler)

@@ -31,7 +31,7 @@ def identify_record(
 
     if not (0.0 <= holdout < 0.9):
         raise InputError(f"--holdout must be in [0, 0.9), got {holdout}")
-    n_train = int(round(t.size * (1.0 - holdout)))
+    n_train = round(t.size * (1.0 - holdout))
     if n_train < 20:
         raise InputError("too few training samples after the hold-out")
     model = identify(

@@ -203,9 +203,7 @@ def _num(v: float) -> float | None:
 
 
 # ------------------------------------------------------------------ building models
-def build_structure(
-    joint: str, v: dict[str, float], excitation: str
-) -> Structure:
+def build_structure(joint: str, v: dict[str, float], excitation: str) -> Structure:
     """The SDOF structure of parameter values ``v`` (names as in the fit)."""
     s = Structure(v["m"], v["c"], v["k"])
     if joint == "bouc_wen":
@@ -260,7 +258,7 @@ def equation_error(
             cols = [xd, y]
         A = np.stack(cols, axis=1)
         coef, *_ = np.linalg.lstsq(A, rhs, rcond=None)
-        m, c, k = (coef if mass is None else (mass, coef[0], coef[1]))
+        m, c, k = coef if mass is None else (mass, coef[0], coef[1])
         jf = u - m * xdd - c * xd - k * y
     else:
         if mass is None:
@@ -467,8 +465,15 @@ def identify(
             if cost < best_cost:
                 best_cost = cost
                 best_ps = [
-                    Parameter(p.name, fr.params[p.name].value, vary=p.vary, min=p.min,
-                              max=p.max, unit=p.unit, scale=p.scale)  # fmt: skip
+                    Parameter(
+                        p.name,
+                        fr.params[p.name].value,
+                        vary=p.vary,
+                        min=p.min,
+                        max=p.max,
+                        unit=p.unit,
+                        scale=p.scale,
+                    )
                     for p in ps
                 ]
     fit = least_squares_fit(residual_on(t.size), best_ps, max_nfev=max_nfev, ftol=1e-7,

@@ -85,9 +85,7 @@ def modes(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> Modes:
     phi = phi * np.sign(phi[big, np.arange(n)])
     zeta = np.einsum("ij,ik,kj->j", phi, C, phi) / (2.0 * w)
     # State-space eigenvalues, matched to the undamped modes by nearest |λ|.
-    A = np.block(
-        [[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]]
-    )
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
     lam = np.linalg.eigvals(A)
     osc = lam[lam.imag > 0]
     fd = np.full(n, np.nan)

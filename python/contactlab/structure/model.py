@@ -461,7 +461,7 @@ def _refine(
             fine_n = nt * k
             out = np.fft.irfft(spec, n=fine_n, axis=0) * k
             out = np.concatenate([out[: (nt - 1) * k + 1]], axis=0)
-        return out.reshape((tf.size,) + arr.shape[1:])
+        return out.reshape((tf.size, *arr.shape[1:]))
 
     fv = fine(force, "force")
     yv = fine(base, "base")

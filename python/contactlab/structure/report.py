@@ -48,8 +48,14 @@ def build_structure_report(
     rep.table(rows, [Column("quantity"), Column("value")])
     rep.table(
         [
-            {"parameter": n, "value": p.value, "stderr": p.stderr, "unit": p.unit,
-             "identifiable": p.identifiable, "vary": p.vary}  # fmt: skip
+            {
+                "parameter": n,
+                "value": p.value,
+                "stderr": p.stderr,
+                "unit": p.unit,
+                "identifiable": p.identifiable,
+                "vary": p.vary,
+            }
             for n, p in model.fit.params.items()
         ],
         ["parameter", "value", "stderr", "unit", "identifiable", "vary"],
@@ -87,7 +93,7 @@ def build_structure_report(
         ax.plot(d_meas, recon, ".", ms=1.5, alpha=0.4, color="0.5",
                 label="reconstructed from the equation of motion")  # fmt: skip
         summary["equation_error_linear"] = {k: ee[k] for k in ("m", "c", "k")}
-    except Exception:  # noqa: BLE001 - the reconstruction is an extra, never a failure
+    except Exception:
         pass
     if sim.joint_force.shape[1]:
         ax.plot(x[: sim.x.size], sim.joint_force.sum(axis=1), lw=0.6, label="identified joint")
@@ -105,7 +111,7 @@ def build_structure_report(
             fig, ax2 = plt.subplots(1, 2, figsize=(9, 3.5))
             plot_amplitude_dependence(ad, ax2)
             rep.figure(fig, "amplitude", "Equivalent-linear natural frequency and damping.")
-        except Exception:  # noqa: BLE001 - optional figure
+        except Exception:
             pass
     rep.section("Fit report")
     rep.preformatted(model.report())

@@ -272,7 +272,8 @@ fn bw_rate(alpha: f64, beta: f64, gamma: f64, delta: f64, nu: f64, z: f64, s: f6
 }
 
 /// `z` after a monotone displacement increment `dd` from `z0` (classical RK4 in `d`, with
-/// enough sub-steps that `|dd| · |∂rate/∂z| ≤ 0.05` per sub-step).
+/// enough sub-steps that `|dd| · |∂rate/∂z| ≤ 0.2` per sub-step: local error ~1e-6
+/// relative, below the Newmark step's own error).
 fn bw_advance(p: (f64, f64, f64, f64, f64), z0: f64, dd: f64) -> f64 {
     let (alpha, beta, gamma, delta, nu) = p;
     if dd == 0.0 {
@@ -281,7 +282,7 @@ fn bw_advance(p: (f64, f64, f64, f64, f64), z0: f64, dd: f64) -> f64 {
     let s = dd.signum();
     let zr = (z0.abs() + alpha * dd.abs()).max(f64::MIN_POSITIVE);
     let lip = beta * (gamma.abs() + delta.abs()) * nu * zr.powf(nu - 1.0).min(1e300);
-    let m = ((dd.abs() * lip / 0.05).ceil()).clamp(1.0, 1000.0) as usize;
+    let m = ((dd.abs() * lip / 0.2).ceil()).clamp(1.0, 1000.0) as usize;
     let h = dd / m as f64;
     let g = |z: f64| bw_rate(alpha, beta, gamma, delta, nu, z, s);
     let mut z = z0;
@@ -561,7 +562,7 @@ mod tests {
         for &d in &[1e-5, 1e-4, 1e-3] {
             let z = bw_advance((alpha, beta, gamma, delta, 1.0), 0.0, d);
             let exact = alpha / b * (1.0 - (-b * d).exp());
-            assert!((z - exact).abs() < 1e-9 * exact.abs(), "{z} vs {exact}");
+            assert!((z - exact).abs() < 1e-6 * exact.abs(), "{z} vs {exact}");
         }
     }
 
