@@ -16,10 +16,12 @@ and MAT v7.3 need the optional extra ``contactlab[io]`` (npTDMS, h5py).
 
 from __future__ import annotations
 
+import struct
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from ..errors import ContactLabError
 from .recording import DIMENSIONS, KIND_CHANNELS, Recording, RecordingError
 from .sniff import EXTENSIONS, format_of
 from .units import UnknownUnitError, known_units, split_name, to_si
@@ -37,6 +39,22 @@ __all__ = [
     "to_si",
     "write_recording",
 ]
+
+
+_FORMAT_NAMES = {"tdms": "TDMS", "hdf5": "HDF5", "mat": "MATLAB"}
+_LIBRARY_ERRORS = (
+    OSError,
+    RuntimeError,
+    KeyError,
+    IndexError,
+    ValueError,
+    TypeError,
+    OverflowError,
+    MemoryError,
+    EOFError,
+    struct.error,
+    UnicodeError,
+)
 
 
 def supported_extensions() -> list[str]:
@@ -109,7 +127,19 @@ def read_recording(
     """
     p = Path(path)
     fmt = format_of(p, format)
-    return _reader(fmt)(p, columns=columns, kind=kind, fs=fs)
+    if fmt == "csv":
+        return _reader(fmt)(p, columns=columns, kind=kind, fs=fs)
+    try:
+        return _reader(fmt)(p, columns=columns, kind=kind, fs=fs)
+    except ContactLabError:
+        raise
+    except _LIBRARY_ERRORS as exc:
+        # h5py, scipy.io and npTDMS raise all of these (and KeyError for a missing object) on
+        # damaged files, from deep inside; found by fuzzing (fuzz/read_{hdf5,mat,tdms}.py)
+        raise RecordingError(
+            f"not a readable {_FORMAT_NAMES[fmt]} file (damaged? {type(exc).__name__}: {exc})",
+            file=str(p),
+        ) from None
 
 
 def write_recording(path: str | Path, rec: Recording, **options: Any) -> Path:

@@ -84,7 +84,8 @@ def _read_v73(path: Path, file: str, columns: Any, kind: Any) -> tuple[Any, ...]
         numeric = [
             n
             for n, obj in f.items()
-            if isinstance(obj, h5py.Dataset)
+            if isinstance(n, str)  # a damaged name table can yield bytes
+            and isinstance(obj, h5py.Dataset)
             and _text(obj.attrs.get("MATLAB_class", b"double")) in ("double", "single")
         ]
         kind, mapping = resolve_columns(numeric, columns=columns, kind=kind, file=file)
