@@ -44,7 +44,9 @@ def check(fn: Callable[[], Any], *, expected: type[BaseException] | None = None)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         warnings.simplefilter("ignore", ContactLabWarning)
-        with np.errstate(all="raise"):
+        # numpy's defaults warn on overflow, 0/0 and x/0 (underflow is silent): those are
+        # defects here, raised at their source
+        with np.errstate(over="raise", divide="raise", invalid="raise", under="ignore"):
             try:
                 return fn()
             except KeyboardInterrupt:
@@ -203,7 +205,8 @@ def _signature(exc: BaseException) -> str:
     where = f"{Path(frames[-1].filename).name}:{frames[-1].lineno}" if frames else "?"
     import re
 
-    msg = re.sub(r"\d+", "N", " ".join(str(exc).split()))[:100]  # indices, values: one defect
+    msg = re.sub(r"\d+", "N", " ".join(str(exc).split()))
+    msg = msg.split(": ")[0][:100]  # the head names the defect; the tail has data in it
     return f"{type(exc).__name__} at {where}: {msg}"
 
 

@@ -25,15 +25,15 @@ def build(b: Bytes) -> tuple[str, str]:
     from contactlab.masing import Masing
 
     kind = b.choice(("tangential", "normal"))
-    fs = b.choice((200.0, 1000.0, 5000.0, b.positive(1000.0, 2.0)))
-    f = b.choice((1.0, 5.0, b.positive(5.0, 1.0)))
+    fs = b.choice((200.0, 1000.0, 5000.0, _pos(b, 1000.0, 2.0)))
+    f = b.choice((1.0, 5.0, _pos(b, 5.0, 1.0)))
     cycles = b.choice((0.5, 2, 4, 6, b.int(1, 10)))
     n = int(min(4000, max(2, cycles * fs / f)))
     t = np.arange(n) / fs
     with np.errstate(all="ignore"):
         if kind == "tangential":
-            A = b.positive(2e-5, 3.0)
-            h0, ac = b.positive(40.0, 6.0), b.positive(2.0, 1.0) / A
+            A = _pos(b, 2e-5, 3.0)
+            h0, ac = _pos(b, 40.0, 6.0), _pos(b, 2.0, 1.0) / A
             x = A * np.sin(2 * np.pi * f * t)
             try:
                 F = Masing(h0, ac).force(x)
@@ -41,8 +41,8 @@ def build(b: Bytes) -> tuple[str, str]:
                 F = h0 * np.tanh(x / A)
             a, c = x, F
         else:
-            p0, pa = b.positive(0.5e6, 3.0), b.positive(0.4e6, 3.0)
-            k = b.positive(1e11, 3.0)
+            p0, pa = _pos(b, 0.5e6, 3.0), _pos(b, 0.4e6, 3.0)
+            k = _pos(b, 1e11, 3.0)
             lag = b.float(0.0, 0.5)
             p = p0 + pa * np.sin(2 * np.pi * f * t)
             d = (p0 + pa * np.sin(2 * np.pi * f * t - lag)) / k
@@ -79,6 +79,12 @@ def build(b: Bytes) -> tuple[str, str]:
         for row in zip(t, a, c, strict=True):
             buf.write(",".join(repr(float(v)) for v in row) + "\n")
     return kind, buf.getvalue()
+
+
+def _pos(b: Bytes, typical: float, decades: float) -> float:
+    """A positive rate: ``b.positive`` without its special values (those belong to data)."""
+    v = b.positive(typical, decades)
+    return v if math.isfinite(v) and v > 0 else typical
 
 
 def _noise(b: Bytes, n: int) -> np.ndarray:

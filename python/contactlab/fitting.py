@@ -431,7 +431,8 @@ def least_squares_fit(
         z, rs, J, success, status, message = _polish(fun, jacobian, z, rs, J, lo, hi, names)
     with np.errstate(over="ignore"):
         r = rs * rscale
-    chisqr = _sumsq(rs) * rscale**2 if math.isfinite(_sumsq(rs)) else math.inf
+    with np.errstate(over="ignore"):
+        chisqr = float(np.float64(_sumsq(rs)) * np.float64(rscale) ** 2)
     notes = []
     if not np.all(np.isfinite(J)):
         success, status = False, -3

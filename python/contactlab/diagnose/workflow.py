@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from .._arrays import as_1d
+from .._range import check_channel
 from ..errors import InputError
 from ._family import Family, Prepared
 from ._signal import noise_rms
@@ -249,6 +250,9 @@ def _arrays(recording: Any, family: Family) -> tuple[np.ndarray, np.ndarray, np.
     y = as_1d(data[yname], yname)
     if not (ta.size == u.size == y.size):
         raise InputError(f"t, {uname}, {yname} have {ta.size}, {u.size}, {y.size} samples")
+    units = getattr(recording, "units", None) or {}
+    for a, k in ((u, uname), (y, yname)):
+        check_channel(a, k, units.get(k, "(SI)"))
     return ta, u, y
 
 

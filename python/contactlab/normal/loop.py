@@ -30,6 +30,7 @@ import numpy as np
 
 from .. import _core
 from .._arrays import as_1d, positive
+from .._range import check_channel
 from ..errors import ContactLabWarning, InputError
 from . import _paper
 
@@ -342,6 +343,8 @@ def analyze_loop(
     dv = as_1d(delta, "delta")
     if dv.size != pv.size:
         raise InputError(f"p has {pv.size} samples but delta has {dv.size}")
+    check_channel(pv, "p", "Pa")
+    check_channel(dv, "delta", "m")
     n = pv.size
     if n < 8:
         raise InputError(f"a recording of {n} samples is too short to hold two cycles")
