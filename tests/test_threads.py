@@ -92,3 +92,32 @@ def test_fits_and_normal_loops_in_threads_equal_serial():
         serial = [fn(s) for s in seeds]
         with ThreadPoolExecutor(WORKERS) as ex:
             assert list(ex.map(fn, seeds)) == serial
+
+
+def test_a_shared_operator_is_refused_with_a_contactlab_error():
+    """Two threads pushing into one operator: the second is told to use its own (a clear
+    ContactLabError, not PyO3's bare RuntimeError); what completes is still correct."""
+    import threading
+
+    from contactlab import ContactLabError
+
+    m = Masing(h0=40.0, ac=4e4)
+    op = m.operator()
+    x = 20e-6 * np.sin(np.linspace(0, 400 * np.pi, 1_000_000))
+    errors: list[BaseException] = []
+    done: list[np.ndarray] = []
+
+    def push():
+        try:
+            done.append(op.push(x))
+        except BaseException as exc:
+            errors.append(exc)
+
+    threads = [threading.Thread(target=push) for _ in range(3)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert all(isinstance(e, ContactLabError) for e in errors), errors
+    assert "one operator per thread" in str(errors[0]) if errors else True
+    assert len(done) + len(errors) == 3
