@@ -19,7 +19,7 @@ import numpy as np
 from contactlab.data import manifest_path
 from contactlab.report import figure_png
 from contactlab.report.study_report import build_report
-from contactlab.study import run_study
+from contactlab.studies import run_study
 
 
 def best_of(f, repeat: int) -> tuple[float, object]:

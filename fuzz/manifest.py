@@ -1,4 +1,4 @@
-"""Fuzz target: the study manifest (``contactlab.manifest.read_manifest``).
+"""Fuzz target: the study manifest (``contactlab.studies.manifest.read_manifest``).
 
 The input is the manifest's bytes; the folder beside it holds ``tangential.csv`` and
 ``normal.mat`` so rows can name real files. Invariant: a list of entries (each naming an
@@ -15,7 +15,7 @@ from _harness import InvariantViolation, check, instrumented, main
 
 with instrumented(("contactlab",)):
     from contactlab.io import Recording, write_recording
-    from contactlab.manifest import read_manifest
+    from contactlab.studies.manifest import read_manifest
 
 TARGET = "manifest"
 _DIR = Path(tempfile.mkdtemp(prefix="contactlab-fuzz-manifest-"))

@@ -7,7 +7,7 @@ import os
 
 import pytest
 
-import contactlab.study as study_mod
+import contactlab.studies.study as study_mod
 from contactlab.cli import main
 
 

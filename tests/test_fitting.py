@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from contactlab import ConvergenceError, InputError
-from contactlab.fitting import FitResult, Parameter, least_squares_fit
+from contactlab.fitting import Parameter, least_squares_fit
 
 
 def _linear_reference(x, y):
@@ -124,8 +124,15 @@ def test_to_dict_is_json_safe():
     res = least_squares_fit(lambda p: p["a"] * x - 2 * x, {"a": 1.0})  # perfect fit: redchi 0
     d = res.to_dict()
     text = json.dumps(d, allow_nan=False)
-    assert json.loads(text)["params"]["a"]["value"] == pytest.approx(2.0)
-    assert isinstance(res, FitResult)
+    back = json.loads(text)
+    assert back["params"]["a"]["value"] == pytest.approx(2.0)
+    assert back["chisqr"] == pytest.approx(0.0, abs=1e-20)
+    assert back["success"] is True and back["nfev"] == res.nfev
+    assert back["params"]["a"]["min"] is None  # -inf bound
+    # No degrees of freedom: redchi is NaN, which JSON cannot hold; it becomes null.
+    one = least_squares_fit(lambda p: np.array([p["a"] - 2.0]), {"a": 1.0})
+    assert math.isnan(one.redchi)
+    assert json.loads(json.dumps(one.to_dict(), allow_nan=False))["redchi"] is None
 
 
 def test_bad_input_raises_input_error():

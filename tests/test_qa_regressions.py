@@ -296,8 +296,8 @@ def test_polynomial_coefficients_get_their_own_units_in_the_table():
     """Every column poly_load_0..4 of study_normal.csv was headed
     '[Pa; ascending powers of delta in m]' and k_s_delta_0..3 '[Pa/m; ...]', a description
     rather than a unit, and wrong for all but one coefficient."""
-    from contactlab.manifest import entry_from_file
-    from contactlab.study import analyze_entry
+    from contactlab.studies.manifest import entry_from_file
+    from contactlab.studies.study import analyze_entry
 
     f = data_dir() / "normal" / "C45-C45_p0-1MPa_pa-0.4MPa.mat"
     r = analyze_entry(entry_from_file(f, kind="normal"))
@@ -343,7 +343,7 @@ def _manifest(tmp_path: Path, text: str) -> Path:
 def test_manifest_saved_by_a_european_spreadsheet(tmp_path):
     """A ';'-separated manifest with decimal commas (Excel in de/fr/it/... locales) failed
     with "no 'file' column in ['file;kind;...']"."""
-    from contactlab.manifest import read_manifest
+    from contactlab.studies.manifest import read_manifest
 
     m = _manifest(tmp_path, "file;kind;p0 [MPa];pa [MPa]\nn.mat;normal;1,5;0,4\n")
     (e,) = read_manifest(m)
@@ -352,7 +352,7 @@ def test_manifest_saved_by_a_european_spreadsheet(tmp_path):
 
 def test_manifest_listing_a_file_twice_is_refused(tmp_path):
     """A duplicated row was analysed twice: counted twice in every trend, one figure lost."""
-    from contactlab.manifest import read_manifest
+    from contactlab.studies.manifest import read_manifest
 
     m = _manifest(tmp_path, "file,kind\nn.mat,normal\n./n.mat,normal\n")
     with pytest.raises(contactlab.InputError, match=r"row 3, column 'file': ./n.mat is listed "

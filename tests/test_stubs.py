@@ -1,10 +1,15 @@
 """The hand-written stub `_core.pyi` must describe the compiled module: every public name in
-the extension is declared in the stub and vice versa (classes down to their methods)."""
+the extension is declared in the stub and vice versa (classes down to their methods), with the
+same signatures (``mypy.stubtest``)."""
 
 from __future__ import annotations
 
 import ast
+import subprocess
+import sys
 from pathlib import Path
+
+import pytest
 
 import contactlab
 from contactlab import _core
@@ -41,3 +46,15 @@ def test_stub_matches_extension():
         cls = getattr(_core, name)
         have = {m for m in dir(cls) if not m.startswith("_")}
         assert methods == have, f"{name}: stub {sorted(methods ^ have)} differ"
+
+
+def test_stub_signatures_match_extension():
+    """Parameter names, defaults and kinds as the extension reports them (PyO3 text signatures)."""
+    pytest.importorskip("mypy.stubtest", reason="mypy (the dev extra; `make test` installs it)")
+    allowlist = Path(__file__).with_name("stubtest_allowlist.txt")
+    done = subprocess.run(
+        [sys.executable, "-m", "mypy.stubtest", "contactlab._core", "--concise",
+         "--ignore-disjoint-bases", "--allowlist", str(allowlist)],
+        capture_output=True, text=True, check=False,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stdout + done.stderr

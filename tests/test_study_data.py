@@ -6,11 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from contactlab._datagen import MATERIALS, NORMAL_P0, generate, truth
 from contactlab.data import data_dir, manifest_path
-from contactlab.data.generate import MATERIALS, NORMAL_P0, generate, truth
 from contactlab.io import read_recording
-from contactlab.manifest import read_manifest
-from contactlab.study import run_study
+from contactlab.studies.manifest import read_manifest
+from contactlab.studies.study import run_study
 
 
 @pytest.fixture(scope="module")
@@ -61,6 +61,7 @@ def test_study_of_the_bundle_recovers_the_truth(bundle_study):
     res = bundle_study
     assert not res.failures
     rows = res.table("tangential")
+    assert _counts(rows) == _expected_counts()  # every recording is in the table
     for r in rows:
         if r["material"] != "steel/steel":
             assert r["identifiable"], r["file"]
@@ -113,6 +114,18 @@ def test_recordings_carry_sensor_imperfections():
 
 
 def test_steel_loops_identified_only_when_right(bundle_study):
-    for r in bundle_study.table("tangential"):
-        if r["material"] == "steel/steel":
-            _check_truth(r)
+    steel = [r for r in bundle_study.table("tangential") if r["material"] == "steel/steel"]
+    assert len(steel) == _expected_counts()["steel/steel"] > 0
+    for r in steel:
+        _check_truth(r)
+
+
+def _counts(rows):
+    out: dict[str, int] = {}
+    for r in rows:
+        out[r["material"]] = out.get(r["material"], 0) + 1
+    return out
+
+
+def _expected_counts():
+    return {m.material: len(m.loads) * len(m.amplitudes) for m in MATERIALS}

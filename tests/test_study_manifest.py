@@ -1,4 +1,4 @@
-"""Manifest parsing and file-name tagging (contactlab.manifest)."""
+"""Manifest parsing and file-name tagging (contactlab.studies.manifest)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from contactlab import InputError
-from contactlab.manifest import entry_from_file, read_manifest, tags_from_filename, unit_factor
+from contactlab.studies.manifest import (
+    entry_from_file,
+    read_manifest,
+    tags_from_filename,
+    unit_factor,
+)
 
 
 @pytest.mark.parametrize(

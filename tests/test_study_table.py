@@ -15,16 +15,16 @@ import pytest
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-from contactlab.manifest import StudyEntry
 from contactlab.masing import Masing
-from contactlab.study import RecordingResult, StudyResult, _flatten
-from contactlab.study_plots import (
+from contactlab.studies.manifest import StudyEntry
+from contactlab.studies.plots import (
     display_unit,
     normal_study_figures,
     plot_study,
     tangential_study_figures,
     trends,
 )
+from contactlab.studies.study import RecordingResult, StudyResult, _flatten
 
 
 def _tangential_rows():

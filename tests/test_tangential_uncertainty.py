@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from contactlab import Masing
-from contactlab.data import generate as gen
+from contactlab import _datagen as gen
 from contactlab.tangential import analyze_tangential, average_loop, synthetic_recording
 
 H0, AC, A = 20.0, 1e5, 10e-6

@@ -13,15 +13,18 @@ import re
 import sys
 from collections.abc import Sequence
 
+from ._version import __version__
 from .errors import ContactLabError
 
 # Modules providing `add_parser(subparsers)`; each sets `handler` via set_defaults.
 _VERB_MODULES = [
     "contactlab.commands.analyze",
     "contactlab.commands.study",
+    "contactlab.commands.track",
     "contactlab.commands.simulate",
-    "contactlab.demo",
-    "contactlab.diagnose.cli",
+    "contactlab.commands.demo",
+    "contactlab.commands.diagnose",
+    "contactlab.commands.export",
 ]
 
 
@@ -43,8 +46,6 @@ def build_parser() -> argparse.ArgumentParser:
         prog="contactlab",
         description="Hysteresis of contact joints: fit, measure and diagnose contact models.",
     )
-    from . import __version__
-
     p.add_argument("--version", action="version", version=f"contactlab {__version__}")
     sub = p.add_subparsers(dest="verb", metavar="VERB")
     for name in _VERB_MODULES:

@@ -78,19 +78,19 @@ class Parameter:
     def to_dict(self) -> dict[str, Any]:
         return {
             "name": self.name,
-            "value": _num(self.value),
-            "stderr": _num(self.stderr),
+            "value": json_number(self.value),
+            "stderr": json_number(self.stderr),
             "vary": self.vary,
-            "min": _num(self.min),
-            "max": _num(self.max),
+            "min": json_number(self.min),
+            "max": json_number(self.max),
             "identifiable": self.identifiable,
             "note": self.note,
             "unit": self.unit,
-            "init_value": _num(self.init_value),
+            "init_value": json_number(self.init_value),
         }
 
 
-def _num(v: Any) -> Any:
+def json_number(v: Any) -> Any:
     """JSON-safe number: NaN and ±inf become None."""
     if v is None:
         return None
@@ -224,24 +224,24 @@ class FitResult:
             "var_names": list(self.var_names),
             "covar": None if self.covar is None else _nested(self.covar),
             "correl": self.correl_dict() or None,
-            "chisqr": _num(self.chisqr),
-            "redchi": _num(self.redchi),
-            "aic": _num(self.aic),
-            "bic": _num(self.bic),
+            "chisqr": json_number(self.chisqr),
+            "redchi": json_number(self.redchi),
+            "aic": json_number(self.aic),
+            "bic": json_number(self.bic),
             "ndata": self.ndata,
             "nvarys": self.nvarys,
             "success": bool(self.success),
             "status": int(self.status),
             "message": self.message,
             "nfev": int(self.nfev),
-            "condition": _num(self.condition),
+            "condition": json_number(self.condition),
             "scale_covar": self.scale_covar,
             "notes": list(self.notes),
         }
 
 
 def _nested(a: np.ndarray) -> list[list[Any]]:
-    return [[_num(v) for v in row] for row in a]
+    return [[json_number(v) for v in row] for row in a]
 
 
 def _scalar(a: np.ndarray) -> Any:

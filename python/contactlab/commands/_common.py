@@ -4,20 +4,19 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import re
 import shlex
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from .._io_atomic import write_text
+from .._json import jsonable
+from .._version import __version__
 from ..errors import InputError
-from ..manifest import scaled, si_unit, unit_factor
 from ..report import commit_outputs
-from ..study import RecordingResult, StudyResult
+from ..studies.manifest import scaled, si_unit, unit_factor
+from ..studies.study import RecordingResult, StudyResult
 
 _QTY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-zµμ/]*)\s*$")
 
@@ -85,23 +84,6 @@ def parse_columns(text: str | None) -> dict[str, str] | None:
     return out
 
 
-def jsonable(value: Any) -> Any:
-    """Plain JSON types; NaN/inf become null (JSON has no NaN)."""
-    if isinstance(value, Mapping):
-        return {str(k): jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [jsonable(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return jsonable(value.tolist())
-    if isinstance(value, (np.floating, np.integer, np.bool_)):
-        value = value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, Path):
-        return str(value)
-    return value
-
-
 def recording_json(r: RecordingResult) -> dict[str, Any]:
     """One recording's JSON object: the analysis' ``to_dict()`` (SI, with ``units``) + tags."""
     d = dict(r.analysis.to_dict()) if r.analysis is not None else {}
@@ -119,8 +101,6 @@ def recording_json(r: RecordingResult) -> dict[str, Any]:
 def json_document(result: StudyResult) -> dict[str, Any]:
     """A single recording's object at top level; several as ``{"recordings": [...]}``."""
     recs = [recording_json(r) for r in result.results if r.ok]
-    from .. import __version__
-
     if len(recs) == 1 and not result.failures:
         return {**recs[0], "contactlab_version": __version__}
     return {
@@ -206,6 +186,24 @@ def command_line(verb: str, *parts: Any) -> str:
     words = ["contactlab", verb]
     words += [str(p) for p in parts if p is not None and p is not False and p != ""]
     return " ".join(shlex.quote(w) for w in words)
+
+
+def add_workers_flag(p: Any, what: str) -> None:
+    p.add_argument("--workers", type=int, default=None, metavar="N",
+                   help=f"analyse {what} in N processes (default: serially)")  # fmt: skip
+
+
+def process_pool(workers: int | None) -> Any:
+    """A ``ProcessPoolExecutor`` for ``--workers N`` (a null context for None)."""
+    import contextlib
+
+    if workers is None:
+        return contextlib.nullcontext(None)
+    if workers < 1:
+        raise InputError(f"--workers must be >= 1, got {workers}")
+    from concurrent.futures import ProcessPoolExecutor
+
+    return ProcessPoolExecutor(workers)
 
 
 def add_progress_flags(p: Any) -> None:

@@ -4,7 +4,7 @@ Reads each recording (CSV/TDMS/HDF5/MAT, SI inside), runs the tangential analysi
 energy analytic and numeric, c_e·ω, stiffness; the tangential paper's eqs. 1-19) or the normal
 one (Konowalski's eqs. 1-7 and 16), prints a summary, and optionally writes JSON (SI values and
 a ``units`` map) and an HTML report. Tags (material, load, amplitude, p0, pa) are read from
-the file names as in :mod:`contactlab.manifest`.
+the file names as in :mod:`contactlab.studies.manifest`.
 """
 
 from __future__ import annotations
@@ -14,16 +14,18 @@ import sys
 from pathlib import Path
 
 from ..errors import InputError
-from ..manifest import entry_from_file
-from ..study import run_study
+from ..studies.manifest import entry_from_file
+from ..studies.study import run_study
 from ._common import (
     add_progress_flags,
+    add_workers_flag,
     check_output_targets,
     command_line,
     describe,
     json_document,
     json_text,
     parse_columns,
+    process_pool,
     quantity,
     write_json,
     write_report,
@@ -47,7 +49,98 @@ def _summary_line(row: dict, kind: str) -> str:
             s = row.get(f"{key}_stderr")
             pm = f" ± {abs(s) * f:.2g}" if isinstance(s, float) else ""
             parts.append(f"{key} = {v * f:.5g}{pm} {unit}".rstrip())
+    if kind == "tangential" and row.get("force_sign") in (1, -1):
+        parts.append(f"force sign {row['force_sign']:+d}")
     return "; ".join(parts)
+
+
+def _streamed(args: argparse.Namespace, entries: list, columns: dict | None, topts: dict) -> int:
+    """``--stream``: each file read in chunks, analysed window by window and pooled
+    (:func:`contactlab.studies.track`); memory bounded whatever the length."""
+    from .. import __version__
+    from ..errors import ContactLabError
+    from ..studies.tracking import parse_every, track
+
+    parse_every(args.every)
+    if args.report and len(entries) > 1:
+        raise InputError("--stream --report takes one file (or use `contactlab track` per file)")
+    say = sys.stderr if args.json == "-" else sys.stdout
+    docs, failures, last = [], [], None
+    with process_pool(args.workers) as ex:
+        for e in entries:
+            try:
+                res = track(
+                    e.path,
+                    args.every,
+                    kind=args.model,
+                    columns=columns,
+                    fs=args.fs,
+                    executor=ex,
+                    options=topts if args.model == "tangential" else None,
+                )
+            except ContactLabError as exc:
+                if not args.keep_going:
+                    raise
+                failures.append({"file": str(e.path), "error": str(exc)})
+                print(f"{e.path}: FAILED: {exc}", file=sys.stderr)
+                continue
+            last = res
+            full = res.to_dict(cycles=False)
+            comb = full["combined"]
+            print(
+                f"{e.path}: {_summary_line(comb, args.model)} (streamed: {len(res.rows)} "
+                f"windows, {comb.get('n_cycles', 0)} cycles)",
+                file=say,
+            )
+            units = {k: u for k, u in full["units"].items() if k in comb}
+            docs.append(
+                {
+                    "file": str(e.path),
+                    "model": args.model,
+                    **e.tags,
+                    "streamed": True,
+                    "every": res.every,
+                    "n_samples": res.meta["n_samples"],
+                    "n_windows": len(res.rows),
+                    **comb,
+                    "units": units,
+                }
+            )
+    doc: dict = (
+        {**docs[0], "contactlab_version": __version__}
+        if len(docs) == 1 and not failures
+        else {"contactlab_version": __version__, "recordings": docs, "failures": failures}
+    )
+    text = json_text(doc) if args.json else None
+    if args.report and last is not None:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from ..report import commit_outputs
+        from ..report.track_report import build_track_report, track_files
+
+        cmd = command_line(
+            "analyze",
+            *args.files,
+            "--model",
+            args.model,
+            "--stream",
+            "--every",
+            args.every,
+            "--report",
+            args.report,
+        )
+        rep = build_track_report(
+            last, f"contactlab analyze --stream: {last.source}", intro=f"Made by: {cmd}"
+        )
+        for p in commit_outputs(args.report, track_files(last, rep)):
+            if p.suffix == ".html":
+                print(f"wrote {p}", file=say)
+    if args.json:
+        p = write_json(args.json, text)
+        if str(p) != "-":
+            print(f"wrote {p}", file=say)
+    return 1 if failures else 0
 
 
 def _handler(args: argparse.Namespace) -> int:
@@ -64,7 +157,11 @@ def _handler(args: argparse.Namespace) -> int:
         e = entry_from_file(f, kind=args.model)
         e.columns, e.fs = columns, args.fs
         entries.append(e)
-    result = run_study(entries, progress=args.progress, keep_going=args.keep_going)
+    topts = {"force_sign": args.force_sign}
+    if args.stream:
+        return _streamed(args, entries, columns, topts)
+    result = run_study(entries, progress=args.progress, keep_going=args.keep_going,
+                       tangential_options=topts)  # fmt: skip
     # With --json -, stdout carries the JSON alone; everything else goes to stderr.
     say = sys.stderr if args.json == "-" else sys.stdout
     for r in result.results:
@@ -80,11 +177,23 @@ def _handler(args: argparse.Namespace) -> int:
     doc = json_text(json_document(result)) if args.json else None
     if args.report:
         title = f"contactlab analyze ({args.model}, {len(entries)} recording(s))"
-        cmd = command_line("analyze", *args.files, "--model", args.model,
-                           *(["--columns", args.columns] if args.columns else []),
-                           "--report", args.report)  # fmt: skip
-        paths = write_report(args.report, result, title, study_plots=len(entries) > 1,
-                             progress=args.progress, command=cmd)  # fmt: skip
+        cmd = command_line(
+            "analyze",
+            *args.files,
+            "--model",
+            args.model,
+            *(["--columns", args.columns] if args.columns else []),
+            "--report",
+            args.report,
+        )
+        paths = write_report(
+            args.report,
+            result,
+            title,
+            study_plots=len(entries) > 1,
+            progress=args.progress,
+            command=cmd,
+        )
         for p in paths:
             if p.suffix == ".html":
                 print(f"wrote {p}", file=say)
@@ -109,8 +218,25 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--fs", type=quantity("Hz", positive=True), help="sampling rate when a file has no time"
     )
+    p.add_argument(
+        "--force-sign",
+        choices=("auto", "+1", "-1", "1"),
+        default="auto",
+        help="tangential: analyse F (+1) or -F (-1); auto (default): the sign that makes the "
+        "loop area ∮F dx positive (a passive joint dissipates)",
+    )
     p.add_argument("--keep-going", action="store_true",
                    help="skip recordings that fail (exit code 1) instead of stopping")  # fmt: skip
     p.add_argument("-v", "--verbose", action="store_true", help="print each fit report")
+    p.add_argument(
+        "--stream",
+        action="store_true",
+        help="long files: read in chunks, analyse windows (--every) and pool them; "
+        "memory stays bounded whatever the length",
+    )
+    p.add_argument(
+        "--every", default="auto", help="window of --stream: 'auto' (default), '200cycles' or '10s'"
+    )
+    add_workers_flag(p, "the windows of --stream")
     add_progress_flags(p)
     p.set_defaults(handler=_handler)

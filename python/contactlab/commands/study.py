@@ -1,7 +1,7 @@
 """``contactlab study MANIFEST|FOLDER --report DIR``: a load/amplitude (or p0) study.
 
 Analyses every recording a manifest lists (or every recording in a folder, tagged by file
-name; see :mod:`contactlab.manifest`) and writes one table (``study_tangential.csv`` /
+name; see :mod:`contactlab.studies.manifest`) and writes one table (``study_tangential.csv`` /
 ``.parquet``, ``study_normal.*``; SI, uncertainties as ``*_stderr``), the paper's plots
 against load and amplitude per material (and against p0), and the HTML report.
 """
@@ -11,14 +11,16 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ..study import run_study
+from ..studies.study import run_study
 from ._common import (
     add_progress_flags,
+    add_workers_flag,
     check_output_targets,
     command_line,
     describe,
     json_document,
     json_text,
+    process_pool,
     write_json,
     write_report,
 )
@@ -26,7 +28,14 @@ from ._common import (
 
 def _handler(args: argparse.Namespace) -> int:
     check_output_targets(json_out=args.json, report=args.report)
-    result = run_study(args.manifest, progress=args.progress, keep_going=args.keep_going)
+    with process_pool(args.workers) as ex:
+        result = run_study(
+            args.manifest,
+            progress=args.progress,
+            keep_going=args.keep_going,
+            executor=ex,
+            keep_recordings=True,  # the report draws them
+        )
     for r in result.failures:
         print(f"FAILED: {r.error}", file=sys.stderr)
     n_ok = sum(r.ok for r in result.results)
@@ -60,5 +69,6 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--title", default="contactlab study", help="report title")
     p.add_argument("--keep-going", action="store_true",
                    help="skip recordings that fail (exit code 1) instead of stopping")  # fmt: skip
+    add_workers_flag(p, "recordings")
     add_progress_flags(p)
     p.set_defaults(handler=_handler)

@@ -12,6 +12,9 @@ with ``columns={"x": "LVDT 1", "F": "load cell"}``. Units come from the column n
 (``x [um]``) or the format's unit metadata (TDMS ``unit_string``, HDF5 ``unit`` attribute);
 a channel without a unit is taken as SI and listed in ``meta["units_assumed_si"]``. TDMS, HDF5
 and MAT v7.3 need the optional extra ``contactlab[io]`` (npTDMS, h5py).
+
+Long files: :func:`read_chunks` yields the same recording as consecutive chunks of bounded
+size, with the same checks and messages (see :mod:`.chunked`).
 """
 
 from __future__ import annotations
@@ -22,17 +25,21 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ContactLabError
+from .chunked import DEFAULT_CHUNK, ChunkedRecording, read_chunks
 from .recording import DIMENSIONS, KIND_CHANNELS, Recording, RecordingError
 from .sniff import EXTENSIONS, format_of
 from .units import UnknownUnitError, known_units, split_name, to_si
 
 __all__ = [
+    "DEFAULT_CHUNK",
     "DIMENSIONS",
     "KIND_CHANNELS",
+    "ChunkedRecording",
     "Recording",
     "RecordingError",
     "UnknownUnitError",
     "known_units",
+    "read_chunks",
     "read_recording",
     "split_name",
     "supported_extensions",

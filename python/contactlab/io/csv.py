@@ -22,7 +22,7 @@ from .recording import Recording, RecordingError, finish, resolve_columns
 from .units import split_name
 
 
-def _encoding(path: Path) -> str:
+def detect_encoding(path: Path) -> str:
     """``"utf-8-sig"`` when the file's start decodes as UTF-8, else ``"latin-1"``.
 
     Acquisition software on Windows writes headers and comments such as ``Weg [µm]`` or
@@ -39,7 +39,7 @@ def _encoding(path: Path) -> str:
     return "utf-8-sig"
 
 
-def _header(path: Path, enc: str = "utf-8-sig") -> tuple[list[str], str | None, int, list[str]]:
+def read_header(path: Path, enc: str = "utf-8-sig") -> tuple[list[str], str | None, int, list[str]]:
     """Column names, delimiter (None = whitespace), 0-based header line, comment lines."""
     comments: list[str] = []
     with open(path, encoding=enc, errors="replace") as fh:
@@ -67,7 +67,7 @@ def _header(path: Path, enc: str = "utf-8-sig") -> tuple[list[str], str | None, 
 _DECIMAL_COMMA = re.compile(r"^\s*[+-]?\d+,\d*(?:[eE][+-]?\d+)?\s*$")
 
 
-def _decimal_comma(
+def has_decimal_comma(
     path: Path, delim: str | None, first_data_line: int, enc: str = "utf-8-sig"
 ) -> bool:
     """Whether numbers are written with a decimal comma (``1,5``; European locales), judged
@@ -83,7 +83,7 @@ def _decimal_comma(
     return False
 
 
-def _line_of_sample(path: Path, first_data_line: int, index: int, enc: str = "utf-8-sig") -> int:
+def line_of_sample(path: Path, first_data_line: int, index: int, enc: str = "utf-8-sig") -> int:
     """1-based line of the file holding data row ``index`` (blank and ``#`` lines skipped).
 
     Called only to word an error, so the extra pass over the file costs nothing normally.
@@ -99,7 +99,7 @@ def _line_of_sample(path: Path, first_data_line: int, index: int, enc: str = "ut
     return first_data_line + index + 1
 
 
-def _locate_bad_cell(
+def locate_bad_cell(
     path: Path,
     delim: str | None,
     first_data_line: int,
@@ -150,8 +150,8 @@ def read_csv(
     """
     path = Path(path)
     file = str(path)
-    enc = _encoding(path)
-    names, delim, header_line, comments = _header(path, enc)
+    enc = detect_encoding(path)
+    names, delim, header_line, comments = read_header(path, enc)
     if len(set(names)) != len(names):
         dup = next(n for n in names if names.count(n) > 1)
         raise RecordingError("column name appears twice in the header", file=file, column=dup)
@@ -159,7 +159,7 @@ def read_csv(
     canon = list(mapping)
     idx = [names.index(mapping[c]) for c in canon]
     first_data = header_line + 1
-    comma = _decimal_comma(path, delim, first_data, enc)
+    comma = has_decimal_comma(path, delim, first_data, enc)
     try:
         with warnings.catch_warnings():
             # A header without data rows is reported below as an error of its own; numpy's
@@ -177,14 +177,14 @@ def read_csv(
                 quotechar='"',
                 converters=(lambda v: float(v.replace(",", "."))) if comma else None,
             )
-    except UnicodeDecodeError as exc:  # a non-UTF-8 byte after the block _encoding looked at
+    except UnicodeDecodeError as exc:  # a non-UTF-8 byte after the block detect_encoding looked at
         raise RecordingError(
             f"byte {exc.object[exc.start : exc.start + 1]!r} is not {enc} text; save the file "
             "as UTF-8",
             file=file,
         ) from None
     except ValueError:
-        raise _locate_bad_cell(path, delim, first_data, idx, names, comma, enc) from None
+        raise locate_bad_cell(path, delim, first_data, idx, names, comma, enc) from None
     if block.shape[0] == 0:
         raise RecordingError("header but no data rows", file=file)
     raw = {c: np.ascontiguousarray(block[:, j]) for j, c in enumerate(canon)}
@@ -196,7 +196,7 @@ def read_csv(
         kind=kind,
         file=file,
         fs=fs,
-        row_of=lambda i: _line_of_sample(path, first_data, i, enc),
+        row_of=lambda i: line_of_sample(path, first_data, i, enc),
         meta={
             "format": "csv",
             "comments": comments,

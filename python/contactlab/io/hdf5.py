@@ -27,7 +27,8 @@ from .recording import (
 )
 
 
-def _h5py() -> Any:
+def import_h5py() -> Any:
+    """The h5py module (an optional dependency; HDF5 and MATLAB v7.3 readers need it)."""
     try:
         import h5py
     except ImportError:  # pragma: no cover - depends on the installation
@@ -35,12 +36,13 @@ def _h5py() -> Any:
     return h5py
 
 
-def _text(v: Any) -> str:
+def text_value(v: Any) -> str:
+    """An HDF5 attribute or dataset as text: bytes, one-element string arrays, MATLAB chars."""
     if isinstance(v, bytes):
         return v.decode("utf-8", "replace")
     if isinstance(v, np.ndarray):
         if v.dtype.kind in "SO" and v.size == 1:
-            return _text(v.reshape(-1)[0])
+            return text_value(v.reshape(-1)[0])
         if v.dtype.kind in "ui":  # MATLAB char arrays: uint16 code points
             return "".join(chr(int(c)) for c in v.reshape(-1))
     return str(v)
@@ -48,7 +50,7 @@ def _text(v: Any) -> str:
 
 def datasets(f: Any) -> dict[str, Any]:
     """Every numeric dataset: by full path (no leading slash) and by its last name."""
-    h5py = _h5py()
+    h5py = import_h5py()
     out: dict[str, Any] = {}
 
     def visit(name: str, obj: Any) -> None:
@@ -75,7 +77,7 @@ def vector(ds: Any, *, file: str, column: str) -> np.ndarray:
 def unit_attr(ds: Any) -> str | None:
     for key in ("unit", "units", "unit_string", "Unit"):
         if key in ds.attrs:
-            u = _text(ds.attrs[key]).strip()
+            u = text_value(ds.attrs[key]).strip()
             return u or None
     return None
 
@@ -91,6 +93,21 @@ def _dt_attr(objs: list[Any]) -> float | None:
     return None
 
 
+def hdf5_layout(
+    f: Any, *, columns: dict[str, str] | None, kind: str | None, file: str
+) -> tuple[str | None, dict[str, str], dict[str, Any], dict[str, str | None], float | None]:
+    """What a reader needs before touching the data: ``(kind, mapping, datasets, units, dt)``;
+    ``dt`` is the sampling interval from the attributes (None when absent or a ``t`` exists)."""
+    dsets = datasets(f)
+    names = [n for n in dsets if not n.startswith("#")]
+    kind, mapping = resolve_columns(names, columns=columns, kind=kind, file=file)
+    units = {c: unit_attr(dsets[n]) for c, n in mapping.items()}
+    dt = None
+    if "t" not in mapping:
+        dt = _dt_attr([dsets[n] for n in mapping.values()] + [f])
+    return kind, mapping, dsets, units, dt
+
+
 def read_hdf5(
     path: str | Path,
     *,
@@ -102,7 +119,7 @@ def read_hdf5(
 
     Rows in errors are 0-based sample indices.
     """
-    h5py = _h5py()
+    h5py = import_h5py()
     path = Path(path)
     file = str(path)
     try:
@@ -110,18 +127,13 @@ def read_hdf5(
     except OSError as exc:
         raise RecordingError(f"not a readable HDF5 file ({exc})", file=file) from None
     with f:
-        dsets = datasets(f)
-        names = [n for n in dsets if not n.startswith("#")]
-        kind, mapping = resolve_columns(names, columns=columns, kind=kind, file=file)
+        kind, mapping, dsets, units, dt = hdf5_layout(f, columns=columns, kind=kind, file=file)
         raw = {c: vector(dsets[n], file=file, column=n) for c, n in mapping.items()}
-        units = {c: unit_attr(dsets[n]) for c, n in mapping.items()}
         check_equal_lengths(raw, mapping, file=file)
         t_fallback = None
-        if "t" not in raw and fs is None:
-            dt = _dt_attr([dsets[n] for c, n in mapping.items()] + [f])
-            if dt is not None:
-                n = next(iter(raw.values())).size
-                t_fallback = time_from_interval(dt, n, file=file)
+        if "t" not in raw and fs is None and dt is not None:
+            n = next(iter(raw.values())).size
+            t_fallback = time_from_interval(dt, n, file=file)
         return finish(
             raw,
             mapping,
@@ -137,7 +149,7 @@ def read_hdf5(
 def write_hdf5(path: str | Path, rec: Recording, **_: Any) -> Path:
     """Write ``rec`` as HDF5: datasets ``t`` and one per channel, each with a ``unit``
     attribute; the recording's ``source`` and ``kind`` as file attributes."""
-    h5py = _h5py()
+    h5py = import_h5py()
     with atomic_path(path) as tmp:
         with h5py.File(tmp, "w") as f:
             f.create_dataset("t", data=rec.t).attrs["unit"] = "s"

@@ -15,7 +15,7 @@ import numpy as np
 import scipy.io
 
 from .._io_atomic import atomic_path
-from .hdf5 import _h5py, _text, vector
+from .hdf5 import import_h5py, text_value, vector
 from .recording import (
     Recording,
     RecordingError,
@@ -78,33 +78,42 @@ def _read_v5(path: Path, file: str, columns: Any, kind: Any) -> tuple[Any, ...]:
     return kind, mapping, raw, units, dt
 
 
+def v73_layout(
+    f: Any, *, columns: Any, kind: Any, file: str
+) -> tuple[str | None, dict[str, str], dict[str, str | None], float | None]:
+    """``(kind, mapping, units, dt)`` of an open MAT v7.3 file, without reading the data."""
+    h5py = import_h5py()
+    numeric = [
+        n
+        for n, obj in f.items()
+        if isinstance(n, str)  # a damaged name table can yield bytes (found by fuzzing)
+        and isinstance(obj, h5py.Dataset)
+        and text_value(obj.attrs.get("MATLAB_class", b"double")) in ("double", "single")
+    ]
+    kind, mapping = resolve_columns(numeric, columns=columns, kind=kind, file=file)
+    units: dict[str, str | None] = {}
+    for c, n in mapping.items():
+        u = None
+        if "units" in f and isinstance(f["units"], h5py.Group) and n in f["units"]:
+            u = text_value(f["units"][n][()]).strip() or None
+        if u is None and f"{n}_unit" in f:
+            u = text_value(f[f"{n}_unit"][()]).strip() or None
+        if u is None:
+            u = split_name(n)[1]
+        units[c] = u
+    dt = None
+    if "dt" in f:
+        dt = float(np.asarray(f["dt"][()]).reshape(-1)[0])
+    elif "fs" in f:
+        dt = 1.0 / float(np.asarray(f["fs"][()]).reshape(-1)[0])
+    return kind, mapping, units, dt
+
+
 def _read_v73(path: Path, file: str, columns: Any, kind: Any) -> tuple[Any, ...]:
-    h5py = _h5py()
+    h5py = import_h5py()
     with h5py.File(path, "r") as f:
-        numeric = [
-            n
-            for n, obj in f.items()
-            if isinstance(n, str)  # a damaged name table can yield bytes
-            and isinstance(obj, h5py.Dataset)
-            and _text(obj.attrs.get("MATLAB_class", b"double")) in ("double", "single")
-        ]
-        kind, mapping = resolve_columns(numeric, columns=columns, kind=kind, file=file)
+        kind, mapping, units, dt = v73_layout(f, columns=columns, kind=kind, file=file)
         raw = {c: vector(f[n], file=file, column=n) for c, n in mapping.items()}
-        units: dict[str, str | None] = {}
-        for c, n in mapping.items():
-            u = None
-            if "units" in f and isinstance(f["units"], h5py.Group) and n in f["units"]:
-                u = _text(f["units"][n][()]).strip() or None
-            if u is None and f"{n}_unit" in f:
-                u = _text(f[f"{n}_unit"][()]).strip() or None
-            if u is None:
-                u = split_name(n)[1]
-            units[c] = u
-        dt = None
-        if "dt" in f:
-            dt = float(np.asarray(f["dt"][()]).reshape(-1)[0])
-        elif "fs" in f:
-            dt = 1.0 / float(np.asarray(f["fs"][()]).reshape(-1)[0])
     return kind, mapping, raw, units, dt
 
 
@@ -159,7 +168,7 @@ def write_mat(path: str | Path, rec: Recording, *, version: str = "5", **_: Any)
             with open(tmp, "wb") as fh:
                 scipy.io.savemat(fh, d, format="5", oned_as="column")
         else:
-            h5py = _h5py()
+            h5py = import_h5py()
             with h5py.File(tmp, "w", userblock_size=512) as f:
                 for k, v in {"t": rec.t, **rec.data}.items():
                     ds = f.create_dataset(k, data=v.reshape(1, -1))

@@ -290,10 +290,13 @@ def _plain(i: int) -> int:
     return i
 
 
-def check_time(t: np.ndarray, *, file: str, column: str, row_of: RowOf = _plain) -> None:
+def check_time(
+    t: np.ndarray, *, file: str, column: str, row_of: RowOf = _plain, step: float | None = None
+) -> None:
     """Time stamps finite, strictly increasing, without gaps (> 1.5 median step).
 
-    ``row_of`` converts a sample index into the row reported (e.g. a line of a text file).
+    ``row_of`` converts a sample index into the row reported (e.g. a line of a text file);
+    ``step`` replaces the median step as the reference (a chunk judged by the first one's).
     """
     if t.size < 2:
         raise RecordingError(f"only {t.size} sample(s)", file=file, column=column)
@@ -308,7 +311,7 @@ def check_time(t: np.ndarray, *, file: str, column: str, row_of: RowOf = _plain)
             column=column,
             row=row_of(i),
         )
-    med = float(np.median(d))
+    med = float(np.median(d)) if step is None else float(step)
     gaps = np.flatnonzero(d > 1.5 * med)
     if gaps.size:
         i = int(gaps[0]) + 1

@@ -26,7 +26,7 @@ from .recording import (
 )
 
 
-def _nptdms() -> Any:
+def import_nptdms() -> Any:
     try:
         import nptdms
     except ImportError:  # pragma: no cover - depends on the installation
@@ -46,7 +46,7 @@ def read_tdms(
     A channel may be named ``"name"`` or ``"group/name"`` in ``columns``. Rows in errors are
     0-based sample indices.
     """
-    nptdms = _nptdms()
+    nptdms = import_nptdms()
     path = Path(path)
     file = str(path)
     # Our own handle: npTDMS leaks the one it opens when parsing fails (ResourceWarning).
@@ -96,7 +96,7 @@ def read_tdms(
 def write_tdms(path: str | Path, rec: Recording, *, group: str = "recording", **_: Any) -> Path:
     """Write ``rec`` as TDMS, one channel per signal with ``unit_string``; a uniformly sampled
     time axis goes into ``wf_increment``/``wf_start_offset``, otherwise a ``t`` channel."""
-    nptdms = _nptdms()
+    nptdms = import_nptdms()
     d = np.diff(rec.t)
     uniform = d.size > 0 and np.allclose(d, d.mean(), rtol=1e-9, atol=0.0)
     objs = [nptdms.GroupObject(group)]

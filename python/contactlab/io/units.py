@@ -12,26 +12,43 @@ import re
 from ..errors import InputError
 
 # dimension -> SI unit
-SI_UNITS = {"time": "s", "length": "m", "force": "N", "pressure": "Pa"}
+SI_UNITS = {
+    "time": "s",
+    "length": "m",
+    "force": "N",
+    "pressure": "Pa",
+    "dimensionless": "",
+    "frequency": "Hz",
+    "rate": "1/s",
+    "angular frequency": "rad/s",
+    "inverse length": "1/m",
+    "energy": "J",
+    "stiffness": "N/m",
+}
 
-_MU = ("u", "µ", "μ")  # ASCII u, micro sign U+00B5, Greek mu U+03BC
-
+# The one unit table of the package (channel units of recordings here, tag units of study
+# manifests in contactlab.studies.manifest): normalised spelling -> (factor to SI, dimension).
+# Micro is written u, µ (micro sign U+00B5) or μ (Greek mu U+03BC); normalize() maps both to u.
 _TABLE: dict[str, tuple[float, str]] = {}
 
 
 def _add(dim: str, names: tuple[str, ...], factor: float) -> None:
     for n in names:
-        _TABLE[n] = (factor, dim)
+        _TABLE[normalize(n)] = (factor, dim)
+
+
+def normalize(unit: str) -> str:
+    return unit.strip().replace(" ", "").replace("µ", "u").replace("μ", "u").lower()
 
 
 _add("time", ("s", "sec", "second", "seconds"), 1.0)
 _add("time", ("ms", "msec", "millisecond", "milliseconds"), 1e-3)
-_add("time", (*tuple(m + "s" for m in _MU), "usec", "microsecond", "microseconds"), 1e-6)
+_add("time", ("us", "usec", "microsecond", "microseconds"), 1e-6)
 _add("time", ("ns",), 1e-9)
 _add("time", ("min",), 60.0)
 _add("length", ("m", "meter", "metre"), 1.0)
 _add("length", ("mm", "millimeter", "millimetre"), 1e-3)
-_add("length", (*tuple(m + "m" for m in _MU), "micron", "microns", "micrometer"), 1e-6)
+_add("length", ("um", "micron", "microns", "micrometer"), 1e-6)
 _add("length", ("nm", "nanometer", "nanometre"), 1e-9)
 _add("force", ("n", "newton", "newtons"), 1.0)
 _add("force", ("mn",), 1e-3)
@@ -41,9 +58,25 @@ _add("pressure", ("kpa",), 1e3)
 _add("pressure", ("mpa", "n/mm2", "n/mm^2", "n/mm²"), 1e6)
 _add("pressure", ("gpa",), 1e9)
 _add("pressure", ("bar",), 1e5)
+_add("dimensionless", ("", "-", "1"), 1.0)
+_add("frequency", ("Hz",), 1.0)
+_add("frequency", ("kHz",), 1e3)
+_add("rate", ("1/s",), 1.0)
+_add("angular frequency", ("rad/s",), 1.0)
+_add("inverse length", ("1/m",), 1.0)
+_add("inverse length", ("1/mm",), 1e3)
+_add("inverse length", ("1/um",), 1e6)
+_add("energy", ("J",), 1.0)
+_add("energy", ("mJ",), 1e-3)
+_add("energy", ("uJ",), 1e-6)
+_add("stiffness", ("N/m",), 1.0)
+_add("stiffness", ("N/mm",), 1e3)
+_add("stiffness", ("N/um",), 1e6)
 
-# Case matters only where it changes the meaning: "mN" (millinewton) vs "MN" is not supported,
-# "Pa"/"pa" are the same; "m" is metre (minute is "min").
+# Case is ignored ("Pa", "pa", "MPA" are the same; "m" is metre, minute is "min") except where it
+# changes the meaning: these milli units need their lower-case m, so "MN" or "Ms" (mega, which
+# is not supported) is unknown rather than read 10^9 times too small.
+_MILLI = {"ms", "msec", "mm", "mn", "mj"}
 
 
 class UnknownUnitError(InputError):
@@ -55,13 +88,12 @@ def known_units() -> list[str]:
     return sorted(_TABLE)
 
 
-def normalize(unit: str) -> str:
-    return unit.strip().replace(" ", "").lower()
-
-
 def lookup(unit: str) -> tuple[float, str] | None:
     """``(factor to SI, dimension)`` of ``unit``, or None when it is not known."""
-    return _TABLE.get(normalize(unit))
+    key = normalize(unit)
+    if key in _MILLI and not unit.strip().startswith("m"):
+        return None
+    return _TABLE.get(key)
 
 
 def to_si(unit: str, *, where: str = "") -> tuple[float, str]:

@@ -279,6 +279,235 @@ def _savgol_derivative_periodic(x: np.ndarray) -> np.ndarray:
     return out / (2 * np.sum(ks.astype(float) ** 2))
 
 
+# --- the steps of analyze_loop ---------------------------------------------------------------
+
+
+def _check_inputs(t: Any, p: Any, delta: Any, degree: Any) -> tuple[np.ndarray, ...]:
+    """Step 1: arrays, time vector and degree checked; returns ``(t, p, delta)``."""
+    pv = as_1d(p, "p")
+    dv = as_1d(delta, "delta")
+    if dv.size != pv.size:
+        raise InputError(f"p has {pv.size} samples but delta has {dv.size}")
+    n = pv.size
+    if n < 8:
+        raise InputError(f"a recording of {n} samples is too short to hold two cycles")
+    tv = _time_vector(t, n)
+    if isinstance(degree, bool) or not isinstance(degree, (int, np.integer)) or degree < 1:
+        raise InputError(f"degree must be an integer >= 1, got {degree!r}")
+    if not np.ptp(dv) > 0:
+        raise InputError(
+            f"delta is constant ({float(dv[0]):g} m): the displacement sensor recorded no motion, "
+            "so there is no loop to analyse"
+        )
+    return tv, pv, dv
+
+
+def _uniform(
+    tv: np.ndarray, pv: np.ndarray, dv: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, bool]:
+    """Step 2: resample onto a uniform grid (median step) when the sampling is not uniform."""
+    dts = np.diff(tv)
+    dt = float(np.median(dts))
+    resampled = bool(np.max(np.abs(dts - dt)) > 1e-6 * dt)
+    if resampled:
+        tu = tv[0] + dt * np.arange(int(np.floor((tv[-1] - tv[0]) / dt)) + 1)
+        pv = np.interp(tu, tv, pv)
+        dv = np.interp(tu, tv, dv)
+        tv = tu
+    return tv, pv, dv, dt, resampled
+
+
+@dataclass(frozen=True)
+class _Cycles:
+    """Where the whole cycles are: ω, samples per period, first cycle start (samples), bins,
+    cycles analysed and discarded."""
+
+    omega: float
+    period: float
+    start: float
+    bins: int
+    n_used: int
+    discard: int
+
+
+def _discard_count(discard_cycles: Any, n_whole: int) -> int:
+    if discard_cycles is None:
+        return 1 if n_whole >= 3 else 0
+    try:
+        discard = int(discard_cycles)
+        whole = not isinstance(discard_cycles, bool) and discard == discard_cycles
+    except (TypeError, ValueError, OverflowError):
+        whole = False
+    if not whole:
+        raise InputError(f"discard_cycles must be a whole number, got {discard_cycles!r}")
+    if discard < 0:
+        raise InputError(f"discard_cycles must be >= 0, got {discard}")
+    return discard
+
+
+def _cycles(
+    tv: np.ndarray,
+    pv: np.ndarray,
+    dt: float,
+    omega: float | None,
+    n_bins: int | None,
+    discard_cycles: Any,
+) -> _Cycles:
+    """Step 3: the excitation frequency and the whole cycles, starting where the fundamental
+    of p crosses its mean upwards (the start-up cycles dropped)."""
+    n = pv.size
+    w = _estimate_omega(pv, dt) if omega is None else positive(omega, "omega")
+    period = 2 * np.pi / (w * dt)  # samples per cycle
+    if period < 8:
+        raise InputError(
+            f"only {period:.3g} samples per cycle at ω = {w:.6g} rad/s; at least 8 are needed"
+        )
+    # Phase of the fundamental: p ≈ mean + A sin(ω t + θ); cycles start where ω t + θ ≡ 0.
+    z = np.sum((pv - pv.mean()) * np.exp(-1j * w * (tv - tv[0])))
+    theta = float(np.angle(z)) + np.pi / 2
+    s0 = ((-theta) % (2 * np.pi)) / (2 * np.pi) * period  # samples from the first sample
+    bins = round(period) if n_bins is None else int(n_bins)
+    if bins < 8:
+        raise InputError(f"n_bins must be >= 8, got {bins}")
+    step = period / bins
+    n_whole = int(np.floor((n - 1 - s0 + step) / period + 1e-9))
+    if n_whole < 2:
+        raise InputError(
+            f"the recording holds fewer than two whole cycles ({max(n_whole, 0)} at "
+            f"ω = {w:.6g} rad/s, {period:.4g} samples per cycle)"
+        )
+    # Snap to the sample grid when the period is an integer number of samples, so that
+    # folding needs no interpolation.
+    if n_bins is None and abs(period - round(period)) * n_whole < 0.05:
+        period = float(round(period))
+        s0 = float(round(s0)) % period
+        step = period / bins
+        n_whole = int(np.floor((n - 1 - s0 + step) / period + 1e-9))
+    discard = _discard_count(discard_cycles, n_whole)
+    n_used = n_whole - discard
+    if n_used < 1:
+        raise InputError(f"discarding {discard} of {n_whole} whole cycles leaves none to analyse")
+    return _Cycles(float(w), float(period), s0 + discard * period, bins, n_used, discard)
+
+
+def _pressure_levels(pdyn: np.ndarray, p_mean: float, p0: float | None) -> tuple[float, float]:
+    """Step 5: ``(p0, pa)``; the joint must stay closed (pa ≤ p0)."""
+    p0_val = p_mean if p0 is None else float(p0)
+    if not np.isfinite(p0_val):
+        raise InputError(f"p0 must be finite, got {p0}")
+    pa = 0.5 * (_periodic_extreme(pdyn, True) - _periodic_extreme(pdyn, False))
+    if pa <= 0:
+        raise InputError("the dynamic pressure has no amplitude")
+    if pa > p0_val:
+        raise InputError(
+            f"pa = {pa:.6g} Pa exceeds p0 = {p0_val:.6g} Pa: the joint would separate "
+            "(if p holds only the dynamic pressure, pass p0=)"
+        )
+    return p0_val, pa
+
+
+@dataclass(frozen=True)
+class _Branches:
+    load: np.ndarray  # ascending coefficients of p(δ), δ zeroed
+    unload: np.ndarray
+    centre: np.ndarray
+    shift: float  # δ offset removed
+    loading: np.ndarray  # mask of the averaged cycle's loading samples (dp/dt > 0)
+
+
+def _branches(pdyn: np.ndarray, dm: np.ndarray, degree: int, zero_delta: bool) -> _Branches:
+    """Step 6: loading (dp/dt > 0) and unloading polynomials p(δ) of eq. 1, the centre curve
+    their mean, and δ shifted so the centre curve passes through the origin."""
+    dp = _savgol_derivative_periodic(pdyn)
+    load = dp >= 0
+    unload = dp <= 0
+    if load.sum() < degree + 1 or unload.sum() < degree + 1:
+        raise InputError(
+            f"a branch of the loop has fewer than degree + 1 = {degree + 1} points; "
+            "lower degree or sample more densely"
+        )
+    m = float(dm.mean())
+    u = dm - m
+    c_load = np.asarray(_core.poly_fit(u[load], pdyn[load], degree))
+    c_unload = np.asarray(_core.poly_fit(u[unload], pdyn[unload], degree))
+    c_centre = 0.5 * (c_load + c_unload)
+    u_lo, u_hi = float(u.min()), float(u.max())
+    r = -m  # undo the centring: keep δ as recorded
+    if zero_delta:
+        roots = np.asarray(_core.poly_roots_in(c_centre, u_lo, u_hi))
+        if roots.size == 0:
+            warnings.warn(
+                "the centre curve does not cross p = 0 inside the loop; δ is left as recorded",
+                ContactLabWarning,
+                stacklevel=3,
+            )
+        else:
+            r = float(roots[np.argmin(np.abs(roots))])
+    c_load = _poly_shift(c_load, r)
+    c_unload = _poly_shift(c_unload, r)
+    return _Branches(c_load, c_unload, 0.5 * (c_load + c_unload), m + r, dp > 0)
+
+
+@dataclass(frozen=True)
+class _Energies:
+    E_d: float
+    E_d_poly: float
+    E_pu: float
+    E_pd: float
+    d_max: float
+    d_min: float
+
+
+def _energies(pdyn: np.ndarray, dz: np.ndarray, br: _Branches) -> _Energies:
+    """Step 7: E_d (loop area from the samples), E_d from the curves, E_pu / E_pd (strain
+    energy under the centre curve to the extremes)."""
+    d_max = _periodic_extreme(dz, True)
+    d_min = _periodic_extreme(dz, False)
+    E_d = float(_loop_energy(pdyn, dz))
+    ic = np.polynomial.polynomial.polyint(br.centre)
+    E_pu = float(_polyval(ic, d_max) - _polyval(ic, 0.0))
+    E_pd = float(_polyval(ic, d_min) - _polyval(ic, 0.0))
+    diff_int = np.polynomial.polynomial.polyint(br.load - br.unload)
+    E_d_poly = float(_polyval(diff_int, d_max) - _polyval(diff_int, d_min))
+    if E_pu <= 0 or E_pd <= 0:
+        raise InputError(
+            "the centre curve does not store positive strain energy on both sides of the "
+            "equilibrium; is delta's sign consistent with p (compression positive)?"
+        )
+    if E_d <= 0:
+        warnings.warn(
+            f"the loop area is not positive (E_d = {E_d:.3g} J/m²): loading and unloading "
+            "may be swapped or the loop is dominated by noise",
+            ContactLabWarning,
+            stacklevel=3,
+        )
+    return _Energies(E_d, E_d_poly, E_pu, E_pd, d_max, d_min)
+
+
+def _stiffness(
+    br: _Branches, dz: np.ndarray, en: _Energies, pa: float, zero_delta: bool
+) -> tuple[float, float, np.ndarray]:
+    """Step 8: k_tan (eq. 4, slope of the centre curve at p = 0), k_sec (eq. 5) and the
+    coefficients of k_s(δ) (eq. 6), warning when k_s is not positive over the loop."""
+    p_zero_at = 0.0
+    if not zero_delta:
+        rr = np.asarray(_core.poly_roots_in(br.centre, float(dz.min()), float(dz.max())))
+        if rr.size:
+            p_zero_at = float(rr[np.argmin(np.abs(rr))])
+    k_tan = float(_polyval(np.polynomial.polynomial.polyder(br.centre), p_zero_at))
+    k_sec = 2 * pa / (en.d_max - en.d_min)
+    k_s = br.centre[1:].copy()
+    kmin, kat = _core.poly_min_on(np.ascontiguousarray(k_s), en.d_min, en.d_max)
+    if kmin <= 0:
+        warnings.warn(
+            f"k_s(δ) is not positive over the loop's range (k_s = {kmin:.3g} Pa/m at "
+            f"δ = {kat:.3g} m); a nonlinear model built on it is invalid there",
+            ContactLabWarning,
+            stacklevel=3,
+        )
+    return k_tan, k_sec, k_s
+
+
 # --- main entry point ----------------------------------------------------------------------
 
 
@@ -339,201 +568,58 @@ def analyze_loop(
     >>> [round(a, 3) for a in res.table2()["unload"]]
     [-0.015, 1.32, 1.705, 3.562, 4.176]
     """
-    pv = as_1d(p, "p")
-    dv = as_1d(delta, "delta")
-    if dv.size != pv.size:
-        raise InputError(f"p has {pv.size} samples but delta has {dv.size}")
+    tv, pv, dv = _check_inputs(t, p, delta, degree)
     check_channel(pv, "p", "Pa")
     check_channel(dv, "delta", "m")
-    n = pv.size
-    if n < 8:
-        raise InputError(f"a recording of {n} samples is too short to hold two cycles")
-    tv = _time_vector(t, n)
-    if isinstance(degree, bool) or not isinstance(degree, (int, np.integer)) or degree < 1:
-        raise InputError(f"degree must be an integer >= 1, got {degree!r}")
     degree = int(degree)
-    if not np.ptp(dv) > 0:
-        raise InputError(
-            f"delta is constant ({float(dv[0]):g} m): the displacement sensor recorded no motion, "
-            "so there is no loop to analyse"
-        )
-
-    dts = np.diff(tv)
-    dt = float(np.median(dts))
-    resampled = bool(np.max(np.abs(dts - dt)) > 1e-6 * dt)
-    if resampled:
-        tu = tv[0] + dt * np.arange(int(np.floor((tv[-1] - tv[0]) / dt)) + 1)
-        pv = np.interp(tu, tv, pv)
-        dv = np.interp(tu, tv, dv)
-        tv, n = tu, tu.size
-
-    w = _estimate_omega(pv, dt) if omega is None else positive(omega, "omega")
-    period = 2 * np.pi / (w * dt)  # samples per cycle
-    if period < 8:
-        raise InputError(
-            f"only {period:.3g} samples per cycle at ω = {w:.6g} rad/s; at least 8 are needed"
-        )
-    # Phase of the fundamental: p ≈ mean + A sin(ω t + θ); cycles start where ω t + θ ≡ 0.
-    z = np.sum((pv - pv.mean()) * np.exp(-1j * w * (tv - tv[0])))
-    theta = float(np.angle(z)) + np.pi / 2
-    s0 = ((-theta) % (2 * np.pi)) / (2 * np.pi) * period  # samples from the first sample
-    bins = round(period) if n_bins is None else int(n_bins)
-    if bins < 8:
-        raise InputError(f"n_bins must be >= 8, got {bins}")
-    step = period / bins
-    n_whole = int(np.floor((n - 1 - s0 + step) / period + 1e-9))
-    if n_whole < 2:
-        # The start may sit late in the first cycle; try one cycle earlier being partial.
-        raise InputError(
-            f"the recording holds fewer than two whole cycles ({max(n_whole, 0)} at "
-            f"ω = {w:.6g} rad/s, {period:.4g} samples per cycle)"
-        )
-    # Snap to the sample grid when the period is an integer number of samples, so that
-    # folding needs no interpolation.
-    if n_bins is None and abs(period - round(period)) * n_whole < 0.05:
-        period = float(round(period))
-        s0 = float(round(s0)) % period
-        step = period / bins
-        n_whole = int(np.floor((n - 1 - s0 + step) / period + 1e-9))
-    if discard_cycles is None:
-        discard = 1 if n_whole >= 3 else 0
-    else:
-        try:
-            discard = int(discard_cycles)
-            whole = not isinstance(discard_cycles, bool) and discard == discard_cycles
-        except (TypeError, ValueError, OverflowError):
-            whole = False
-        if not whole:
-            raise InputError(f"discard_cycles must be a whole number, got {discard_cycles!r}")
-        if discard < 0:
-            raise InputError(f"discard_cycles must be >= 0, got {discard}")
-    n_used = n_whole - discard
-    if n_used < 1:
-        raise InputError(f"discarding {discard} of {n_whole} whole cycles leaves none to analyse")
-    start = s0 + discard * period
-    P = np.asarray(_core.fold_cycles(pv, start, period, n_used, bins)).reshape(n_used, bins)
-    D = np.asarray(_core.fold_cycles(dv, start, period, n_used, bins)).reshape(n_used, bins)
-
+    tv, pv, dv, dt, resampled = _uniform(tv, pv, dv)
+    cyc = _cycles(tv, pv, dt, omega, n_bins, discard_cycles)
+    # step 4: fold the whole cycles onto the phase grid and average them
+    n_used, bins = cyc.n_used, cyc.bins
+    P = np.asarray(_core.fold_cycles(pv, cyc.start, cyc.period, n_used, bins)).reshape(n_used, bins)
+    D = np.asarray(_core.fold_cycles(dv, cyc.start, cyc.period, n_used, bins)).reshape(n_used, bins)
     pm = P.mean(axis=0)
     dm = D.mean(axis=0)
     p_mean = float(pm.mean())
     pdyn = pm - p_mean
-    p0_val = p_mean if p0 is None else float(p0)
-    if not np.isfinite(p0_val):
-        raise InputError(f"p0 must be finite, got {p0}")
-    pa = 0.5 * (_periodic_extreme(pdyn, True) - _periodic_extreme(pdyn, False))
-    if pa <= 0:
-        raise InputError("the dynamic pressure has no amplitude")
-    if pa > p0_val:
-        raise InputError(
-            f"pa = {pa:.6g} Pa exceeds p0 = {p0_val:.6g} Pa: the joint would separate "
-            "(if p holds only the dynamic pressure, pass p0=)"
-        )
+    p0_val, pa = _pressure_levels(pdyn, p_mean, p0)
     if n_used > 1:
         dstd = D.std(axis=0, ddof=1)
-        e_cycles = _loop_energy(P - P.mean(axis=1, keepdims=True), D)
-        e_std = float(np.std(e_cycles, ddof=1))
+        e_std = float(np.std(_loop_energy(P - P.mean(axis=1, keepdims=True), D), ddof=1))
     else:
         dstd = np.zeros(bins)
         e_std = 0.0
-
-    # Branches (dp/dt > 0 loading) and polynomial fits on δ centred by its cycle mean.
-    dp = _savgol_derivative_periodic(pdyn)
-    load = dp >= 0
-    unload = dp <= 0
-    if load.sum() < degree + 1 or unload.sum() < degree + 1:
-        raise InputError(
-            f"a branch of the loop has fewer than degree + 1 = {degree + 1} points; "
-            "lower degree or sample more densely"
-        )
-    m = float(dm.mean())
-    u = dm - m
-    c_load = np.asarray(_core.poly_fit(u[load], pdyn[load], degree))
-    c_unload = np.asarray(_core.poly_fit(u[unload], pdyn[unload], degree))
-    c_centre = 0.5 * (c_load + c_unload)
-    shift = m
-    u_lo, u_hi = float(u.min()), float(u.max())
-    if zero_delta:
-        roots = np.asarray(_core.poly_roots_in(c_centre, u_lo, u_hi))
-        if roots.size == 0:
-            warnings.warn(
-                "the centre curve does not cross p = 0 inside the loop; δ is left as recorded",
-                ContactLabWarning,
-                stacklevel=2,
-            )
-            r = -m  # undo the centring: keep δ as recorded
-        else:
-            r = float(roots[np.argmin(np.abs(roots))])
-    else:
-        r = -m
-    c_load = _poly_shift(c_load, r)
-    c_unload = _poly_shift(c_unload, r)
-    c_centre = 0.5 * (c_load + c_unload)
-    shift = m + r
-    dz = dm - shift
-
-    d_max = _periodic_extreme(dz, True)
-    d_min = _periodic_extreme(dz, False)
-    E_d = float(_loop_energy(pdyn, dz))
-    ic = np.polynomial.polynomial.polyint(c_centre)
-    E_pu = float(_polyval(ic, d_max) - _polyval(ic, 0.0))
-    E_pd = float(_polyval(ic, d_min) - _polyval(ic, 0.0))
-    diff_int = np.polynomial.polynomial.polyint(c_load - c_unload)
-    E_d_poly = float(_polyval(diff_int, d_max) - _polyval(diff_int, d_min))
-    if E_pu <= 0 or E_pd <= 0:
-        raise InputError(
-            "the centre curve does not store positive strain energy on both sides of the "
-            "equilibrium; is delta's sign consistent with p (compression positive)?"
-        )
-    if E_d <= 0:
-        warnings.warn(
-            f"the loop area is not positive (E_d = {E_d:.3g} J/m²): loading and unloading "
-            "may be swapped or the loop is dominated by noise",
-            ContactLabWarning,
-            stacklevel=2,
-        )
-    # k_tan: slope of the centre curve where p = 0 (δ = 0 after zeroing).
-    p_zero_at = 0.0
-    if not zero_delta:
-        rr = np.asarray(_core.poly_roots_in(c_centre, float(dz.min()), float(dz.max())))
-        if rr.size:
-            p_zero_at = float(rr[np.argmin(np.abs(rr))])
-    k_tan = float(_polyval(np.polynomial.polynomial.polyder(c_centre), p_zero_at))
-    k_sec = 2 * pa / (d_max - d_min)
-    k_s = c_centre[1:].copy()
-    kmin, kat = _core.poly_min_on(np.ascontiguousarray(k_s), d_min, d_max)
-    if kmin <= 0:
-        warnings.warn(
-            f"k_s(δ) is not positive over the loop's range (k_s = {kmin:.3g} Pa/m at "
-            f"δ = {kat:.3g} m); a nonlinear model built on it is invalid there",
-            ContactLabWarning,
-            stacklevel=2,
-        )
+    br = _branches(pdyn, dm, degree, zero_delta)
+    dz = dm - br.shift
+    en = _energies(pdyn, dz, br)
+    k_tan, k_sec, k_s = _stiffness(br, dz, en, pa, zero_delta)
+    w = cyc.omega
+    scatter = float(np.sqrt(np.mean(dstd**2)))
     return LoopResult(
-        E_d=E_d,
-        E_d_poly=E_d_poly,
-        E_pu=E_pu,
-        E_pd=E_pd,
-        psi=2 * E_d / (E_pd + E_pu),
-        psi_kv=E_d / E_pu,
+        E_d=en.E_d,
+        E_d_poly=en.E_d_poly,
+        E_pu=en.E_pu,
+        E_pd=en.E_pd,
+        psi=2 * en.E_d / (en.E_pd + en.E_pu),
+        psi_kv=en.E_d / en.E_pu,
         k_tan=k_tan,
         k_sec=k_sec,
         k_s_delta=k_s.tolist(),
-        poly_load=c_load.tolist(),
-        poly_unload=c_unload.tolist(),
-        poly_centre=c_centre.tolist(),
-        delta_max=d_max,
-        delta_min=d_min,
-        delta_offset=float(shift),
+        poly_load=br.load.tolist(),
+        poly_unload=br.unload.tolist(),
+        poly_centre=br.centre.tolist(),
+        delta_max=en.d_max,
+        delta_min=en.d_min,
+        delta_offset=float(br.shift),
         p0=p0_val,
         pa=pa,
         omega=w,
         frequency=w / (2 * np.pi),
         n_cycles=n_used,
-        n_discarded=discard,
-        samples_per_cycle=float(period),
-        cycle_scatter=float(np.sqrt(np.mean(dstd**2))),
-        cycle_scatter_rel=float(np.sqrt(np.mean(dstd**2)) / (d_max - d_min)),
+        n_discarded=cyc.discard,
+        samples_per_cycle=float(cyc.period),
+        cycle_scatter=scatter,
+        cycle_scatter_rel=float(scatter / (en.d_max - en.d_min)),
         E_d_cycle_std=e_std,
         degree=degree,
         resampled=resampled,
@@ -541,5 +627,5 @@ def analyze_loop(
         cycle_p=pdyn,
         cycle_delta=dz,
         cycle_delta_std=dstd,
-        loading=dp > 0,
+        loading=br.loading,
     )

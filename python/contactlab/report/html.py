@@ -19,6 +19,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
+from .._version import __version__
 from ..errors import InputError
 from ._outputs import commit_outputs
 
@@ -283,8 +284,6 @@ class Report:
     def render_html(self) -> str:
         """The whole report as one HTML string."""
         esc = html.escape
-        from .. import __version__
-
         stamp = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
         parts = [
             "<!DOCTYPE html>",

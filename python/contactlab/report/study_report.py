@@ -1,5 +1,5 @@
 """The report of an analysis or a study: summary tables, each recording's loop, fit and
-residuals, and the study plots (:mod:`contactlab.study_plots`).
+residuals, and the study plots (:mod:`contactlab.studies.plots`).
 
 Tangential sections show the averaged measured loop with the fitted Masing loop and the
 residuals (via :func:`contactlab.tangential.plot_loop` / ``plot_residuals``) and the lmfit-style
@@ -15,48 +15,10 @@ from typing import Any
 
 import numpy as np
 
-from ..study import RecordingResult, StudyResult
-from ..study_plots import display_unit, normal_study_figures, tangential_study_figures, trends
+from ..studies.columns import NORMAL_COLUMNS, TANGENTIAL_COLUMNS
+from ..studies.plots import display_unit, normal_study_figures, tangential_study_figures, trends
+from ..studies.study import RecordingResult, StudyResult
 from .html import Column, Report
-
-TANGENTIAL_COLUMNS = [
-    Column("file"),
-    Column("material"),
-    Column("normal_load", "W", "N"),
-    Column("amplitude", "A", "µm", 1e6),
-    Column("h0", "h0", "N", stderr="h0_stderr"),
-    Column("ac", "ac", "1/mm", 1e-3, stderr="ac_stderr"),
-    Column("h0_ac", "h0·ac", "N/µm", 1e-6, stderr="h0_ac_stderr"),
-    Column("energy_per_cycle", "E", "µJ", 1e6, stderr="energy_per_cycle_stderr"),
-    Column(
-        "energy_per_cycle_numeric", "E numeric", "µJ", 1e6, stderr="energy_per_cycle_numeric_stderr"
-    ),
-    Column("equivalent_damping", "c_e·ω", "N/µm", 1e-6, stderr="equivalent_damping_stderr"),
-    Column("k_local0", "k_l(0)", "N/µm", 1e-6, stderr="k_local0_stderr"),
-    Column("k_global", "k_g(A)", "N/µm", 1e-6, stderr="k_global_stderr"),
-    Column("true_h0", "h0 true", "N"),
-    Column("true_ac", "ac true", "1/mm", 1e-3),
-    Column("identifiable", "h0, ac separable"),
-]
-NORMAL_COLUMNS = [
-    Column("file"),
-    Column("material"),
-    Column("p0", "p0", "MPa", 1e-6),
-    Column("pa", "pa", "MPa", 1e-6),
-    Column("E_d", "E_d", "MPa·µm"),
-    Column("E_pu", "E_pu", "MPa·µm"),
-    Column("E_pd", "E_pd", "MPa·µm"),
-    Column("psi", "ψ (eq. 7)"),
-    Column("psi_kv", "ψ KV (eq. 3)"),
-    Column("k_tan", "k_tan", "MPa/µm", 1e-12),
-    Column("k_sec", "k_sec", "MPa/µm", 1e-12),
-    Column("delta_min", "δ_min", "µm", 1e6),
-    Column("delta_max", "δ_max", "µm", 1e6),
-    Column("b1_paper", "b1", "µm⁻¹·MPa⁻²"),
-    Column("b2_paper", "b2", "µm⁻¹·MPa⁻¹"),
-    Column("b3_paper", "b3", "µm⁻¹"),
-    Column("b4_paper", "b4", "MPa/µm"),
-]
 
 
 def _present(columns: Sequence[Column], rows: Sequence[dict]) -> list[Column]:
@@ -110,9 +72,10 @@ def plot_normal_loop(r: RecordingResult, ax: Any = None) -> Any:
     rec, row, res = r.recording, r.row, r.analysis
     p0 = float(row.get("p0", 0.0) or 0.0)
     shift = float(row.get("delta_offset", 0.0) or 0.0)
-    p = np.asarray(rec["p"], dtype=float)
-    d = np.asarray(rec["delta"], dtype=float)
-    ax.plot((d - shift) * 1e6, (p - p0) * 1e-6, color="0.75", lw=0.5, label="recorded")
+    if rec is not None:  # None: a study run with keep_recordings=False holds no samples
+        p = np.asarray(rec["p"], dtype=float)
+        d = np.asarray(rec["delta"], dtype=float)
+        ax.plot((d - shift) * 1e6, (p - p0) * 1e-6, color="0.75", lw=0.5, label="recorded")
     if res is not None and hasattr(res, "cycle_delta"):
         ax.plot(np.asarray(res.cycle_delta) * 1e6, np.asarray(res.cycle_p) * 1e-6, ".",
                 color="0.2", ms=2, label="averaged cycle")  # fmt: skip

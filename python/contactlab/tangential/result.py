@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from ..fitting import FitResult, _num
+from ..fitting import FitResult, json_number
 from ..masing import Masing
 from .preprocess import AveragedLoop, CycleScatter
 
@@ -35,6 +35,17 @@ UNITS = {
     "peak_force": "N",
     "force_drift": "N/s",
     "displacement_drift": "m/s",
+    "loop_area_recorded": "J",
+    "h0_plateau": "N",
+    "ac_lower_bound": "1/m",
+    "k_local0_lower_bound": "N/m",
+}
+_STICK_UNITS = {
+    "stick_duration": "s",
+    "breakaway_force": "N",
+    "breakaway_force_stderr": "N",
+    "velocity_threshold": "m/s",
+    "smooth_turn_dwell": "s",
 }
 
 
@@ -90,6 +101,7 @@ class TangentialAnalysis:
     t: np.ndarray | None = None
     source: str = "<arrays>"
     meta: dict[str, Any] = field(default_factory=dict)
+    regime: dict[str, Any] = field(default_factory=dict)
 
     @property
     def residual(self) -> np.ndarray:
@@ -107,28 +119,46 @@ class TangentialAnalysis:
         """
         p = self.fit.params
         ident = self.identifiable
+        ev = self.identifiability
+        h0, h0_se = p["h0"].value, p["h0"].stderr
+        if ev.get("h0_source") == "plateau" and "h0_plateau" in self.derived:
+            h0, h0_se = self.derived["h0_plateau"]
+        ih0 = bool(ev.get("h0", ident))
+        iac = bool(ev.get("ac", ident))
         out: dict[str, Any] = {
             "source": self.source,
             "on": self.on,
             "history": self.history,
-            "h0": _num(p["h0"].value) if ident else None,
-            "h0_stderr": _num(p["h0"].stderr) if ident else None,
-            "ac": _num(p["ac"].value) if ident else None,
-            "ac_stderr": _num(p["ac"].stderr) if ident else None,
-            "offset": _num(p["offset"].value),
-            "offset_stderr": _num(p["offset"].stderr),
+            "h0": json_number(h0) if ih0 else None,
+            "h0_stderr": json_number(h0_se) if ih0 else None,
+            "ac": json_number(p["ac"].value) if iac else None,
+            "ac_stderr": json_number(p["ac"].stderr) if iac else None,
+            "offset": json_number(p["offset"].value),
+            "offset_stderr": json_number(p["offset"].stderr),
         }
         if "x0" in p:
-            out["x0"] = _num(p["x0"].value)
-            out["x0_stderr"] = _num(p["x0"].stderr)
-        out["amplitude"] = _num(self.amplitude)
-        out["amplitude_stderr"] = _num(self.amplitude_stderr)
+            out["x0"] = json_number(p["x0"].value)
+            out["x0_stderr"] = json_number(p["x0"].stderr)
+        out["force_sign"] = int(self.meta.get("force_sign", 1))
+        out["orientation_reason"] = str(self.meta.get("orientation_reason", ""))
+        la = self.meta.get("loop_area_recorded")
+        if la is not None:
+            out["loop_area_recorded"] = json_number(la[0])
+            out["loop_area_recorded_stderr"] = json_number(la[1])
+        out["amplitude"] = json_number(self.amplitude)
+        out["amplitude_stderr"] = json_number(self.amplitude_stderr)
         for k, (v, e) in self.derived.items():
-            out[k] = _num(v)
-            out[f"{k}_stderr"] = _num(e)
+            out[k] = json_number(v)
+            out[f"{k}_stderr"] = json_number(e)
         out["identifiable"] = {
-            k: (_num(v) if isinstance(v, float) else v) for k, v in self.identifiability.items()
+            k: (json_number(v) if isinstance(v, float) else v)
+            for k, v in self.identifiability.items()
         }
+        for k, v in self.regime.items():
+            if k == "stick_slip":
+                out[k] = dict({kk: json_number(vv) for kk, vv in v.items()}, units=_STICK_UNITS)
+            else:
+                out[k] = v if isinstance(v, str) else json_number(v)
         out["n_cycles"] = None if self.scatter is None else self.scatter.n_cycles
         out["warnings"] = list(self.warnings)
         out["fit"] = self.fit.to_dict()
@@ -144,6 +174,9 @@ class TangentialAnalysis:
         lines.append(self.fit.report())
         lines.append("[[Identifiability]]")
         lines.append(f"    {self.identifiability['message']}")
+        if self.regime:
+            lines.append("[[Regime]]")
+            lines.append(f"    {self.regime.get('regime_reason', '')}")
         lines.append("[[Derived quantities]]")
         lines.append(f"    amplitude = {self.amplitude:.6g} +/- {self.amplitude_stderr:.3g} m")
         for k, (v, e) in self.derived.items():

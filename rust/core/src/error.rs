@@ -1,6 +1,7 @@
 //! One error type for the whole core. Every variant carries the data a user needs to find the
-//! problem (which argument, which index); the Python binding maps variants to
-//! `contactlab.InputError` / `contactlab.ConvergenceError`.
+//! problem (which argument, which index); the Python binding maps them to
+//! `contactlab.InputError`. A solver that does not converge is not an error: it returns its
+//! partial result with a failure status (see `normal::ode::Status`).
 
 /// Errors returned by core kernels. The core never panics on user input.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -44,9 +45,6 @@ pub enum CoreError {
     /// An exported operator state cannot be restored.
     #[error("operator state is invalid: {reason}")]
     InvalidState { reason: &'static str },
-    /// An ODE integrator could not keep its error below tolerance.
-    #[error("step size became too small ({step:e}) at t = {time}")]
-    StepSizeTooSmall { time: f64, step: f64 },
     /// A result does not fit in double precision although every input did (overflow, or an
     /// underflow that became 0·∞): the input's magnitudes are too extreme in its units.
     #[error("{what}[{index}] is out of the double-precision range ({value}) although the inputs are finite: their magnitudes are too extreme in these units; rescale the data (other units)")]

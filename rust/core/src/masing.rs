@@ -20,6 +20,9 @@ pub struct Reversal {
     pub index: u64,
 }
 
+/// Largest sample count a state exports exactly (`to_vec` stores it as f64).
+const MAX_EXACT_COUNT: f64 = 9_007_199_254_740_992.0; // 2^53
+
 /// Operator memory. `Default` is the origin: no history, on the virgin curve at (0, 0).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct MasingState {
@@ -58,8 +61,9 @@ impl MasingState {
         if dir != -1.0 && dir != 0.0 && dir != 1.0 {
             return bad("direction must be -1, 0 or 1");
         }
-        if v[3] < 0.0 || v[3].fract() != 0.0 {
-            return bad("sample count must be a non-negative integer");
+        // Counts are exported as f64: above 2^53 they were never exact (nor reachable).
+        if v[3] < 0.0 || v[3].fract() != 0.0 || v[3] > MAX_EXACT_COUNT {
+            return bad("sample count must be a non-negative integer no larger than 2^53");
         }
         let stack: Vec<Reversal> = v[4..]
             .chunks_exact(3)
@@ -292,6 +296,13 @@ pub fn run<C: Backbone, O: Observer>(
     let base = state.count;
     let saved = state.clone(); // restored when the forces overflow
     let mut range = Ok(());
+    // `state` has public fields: a count near u64::MAX must not wrap the sample indices.
+    let end = u64::try_from(x.len())
+        .ok()
+        .and_then(|n| base.checked_add(n))
+        .ok_or(CoreError::InvalidState {
+            reason: "sample count overflows",
+        })?;
     let mut st = Stepper::new(curve, scale, state);
     match out {
         Some(out) => {
@@ -314,7 +325,7 @@ pub fn run<C: Backbone, O: Observer>(
     state.x = xp;
     state.h = hp;
     state.dir = dir as i8;
-    state.count = base + x.len() as u64;
+    state.count = end;
     Ok(())
 }
 

@@ -15,7 +15,8 @@ use pyo3::types::PyDict;
 
 mod errors;
 mod normal;
-use errors::{internal, to_pyerr};
+mod structure;
+use errors::{internal, slice, to_pyerr};
 
 /// Run `f` without the GIL, turning a panic (a bug, never expected) into `ContactLabError`.
 pub(crate) fn detach_guarded<T: Send, F: FnOnce() -> Result<T, CoreError> + Send>(
@@ -55,12 +56,6 @@ struct MasingCore {
     curve: Curve,
     scale: f64,
     state: MasingState,
-}
-
-fn slice<'a>(a: &'a PyReadonlyArray1<'_, f64>, name: &'static str) -> PyResult<&'a [f64]> {
-    a.as_slice().map_err(|_| {
-        PyErr::new::<pyo3::exceptions::PyValueError, _>(format!("{name} must be contiguous"))
-    })
 }
 
 #[pymethods]
@@ -290,5 +285,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<MasingCore>()?;
     m.add_function(wrap_pyfunction!(loop_area_py, m)?)?;
     normal::register(m)?;
+    structure::register(m)?;
     Ok(())
 }

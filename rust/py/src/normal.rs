@@ -12,13 +12,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::detach_guarded;
-use crate::errors::to_pyerr;
-
-fn sl<'a>(a: &'a PyReadonlyArray1<'_, f64>, name: &'static str) -> PyResult<&'a [f64]> {
-    a.as_slice().map_err(|_| {
-        PyErr::new::<pyo3::exceptions::PyValueError, _>(format!("{name} must be contiguous"))
-    })
-}
+use crate::errors::{slice, to_pyerr};
 
 fn bad(name: &'static str, reason: &'static str) -> CoreError {
     CoreError::InvalidParameter {
@@ -65,11 +59,11 @@ fn normal_simulate<'py>(
     first_step: Option<f64>,
     max_steps: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let ts = sl(&t, "t")?;
-    let ps = sl(&p, "p")?;
-    let cs = sl(&coeffs, "coeffs")?;
+    let ts = slice(&t, "t")?;
+    let ps = slice(&p, "p")?;
+    let cs = slice(&coeffs, "coeffs")?;
     let ds = match &dpdt {
-        Some(d) => Some(sl(d, "dpdt")?),
+        Some(d) => Some(slice(d, "dpdt")?),
         None => None,
     };
     let law = law.to_owned();
@@ -119,7 +113,7 @@ fn normal_equilibrium(
     omega: f64,
     p: f64,
 ) -> PyResult<f64> {
-    let cs = sl(&coeffs, "coeffs")?;
+    let cs = slice(&coeffs, "coeffs")?;
     let model = build_model(law, cs, psi, omega).map_err(|e| to_pyerr(py, &e))?;
     if !p.is_finite() {
         return Err(to_pyerr(py, &bad("p", "must be finite")));
@@ -160,7 +154,7 @@ fn kv_steady_state<'py>(
     t: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
     let kv = KelvinVoigt::new(k, psi, omega).map_err(|e| to_pyerr(py, &e))?;
-    let ts = sl(&t, "t")?;
+    let ts = slice(&t, "t")?;
     let (d, v) = detach_guarded(py, || {
         let mut d = vec![0.0; ts.len()];
         let mut v = vec![0.0; ts.len()];
@@ -180,10 +174,10 @@ fn poly_fit<'py>(
     degree: usize,
     weights: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let xs = sl(&x, "x")?;
-    let ys = sl(&y, "y")?;
+    let xs = slice(&x, "x")?;
+    let ys = slice(&y, "y")?;
     let ws = match &weights {
-        Some(w) => Some(sl(w, "weights")?),
+        Some(w) => Some(slice(w, "weights")?),
         None => None,
     };
     let c = detach_guarded(py, || poly::fit(xs, ys, degree, ws))?;
@@ -198,7 +192,7 @@ fn poly_roots_in<'py>(
     lo: f64,
     hi: f64,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let cs = sl(&c, "c")?;
+    let cs = slice(&c, "c")?;
     contactlab_core::error::check_finite("c", cs).map_err(|e| to_pyerr(py, &e))?;
     Ok(poly::roots_in(cs, lo, hi, 0).into_pyarray(py))
 }
@@ -211,7 +205,7 @@ fn poly_min_on(
     lo: f64,
     hi: f64,
 ) -> PyResult<(f64, f64)> {
-    let cs = sl(&c, "c")?;
+    let cs = slice(&c, "c")?;
     contactlab_core::error::check_finite("c", cs).map_err(|e| to_pyerr(py, &e))?;
     if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
         return Err(to_pyerr(py, &bad("lo, hi", "must be finite with lo <= hi")));
@@ -229,7 +223,7 @@ fn fold_cycles<'py>(
     n_cycles: usize,
     n_bins: usize,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let xs = sl(&x, "x")?;
+    let xs = slice(&x, "x")?;
     let out = detach_guarded(py, || {
         let len = n_cycles
             .checked_mul(n_bins)

@@ -22,9 +22,27 @@ fn slope(x: &[f64], i: usize) -> f64 {
     }
 }
 
-/// Value of the sampled signal at fractional index `pos` (`0 <= pos <= len - 1`).
+/// Value of the sampled signal at fractional index `pos` (clamped to `[0, len - 1]`).
+pub fn sample_at(x: &[f64], pos: f64) -> Result<f64, CoreError> {
+    if x.is_empty() {
+        return Err(CoreError::Empty { name: "x" });
+    }
+    if pos.is_nan() {
+        return Err(CoreError::InvalidParameter {
+            name: "pos",
+            value: pos,
+            reason: "must not be NaN",
+        });
+    }
+    if x.len() == 1 {
+        return Ok(x[0]);
+    }
+    Ok(interpolate(x, pos))
+}
+
+/// [`sample_at`] for `x.len() >= 2` and a number `pos`.
 #[inline]
-pub fn sample_at(x: &[f64], pos: f64) -> f64 {
+fn interpolate(x: &[f64], pos: f64) -> f64 {
     let n = x.len();
     let i = (pos.floor() as usize).min(n - 1);
     let s = pos - i as f64;
@@ -70,7 +88,14 @@ pub fn fold_cycles(
             reason: "need n_bins >= 2 and n_cycles >= 1",
         });
     }
-    crate::error::check_same_len("n_cycles * n_bins", n_cycles * n_bins, "out", out.len())?;
+    let len = n_cycles
+        .checked_mul(n_bins)
+        .ok_or(CoreError::InvalidParameter {
+            name: "n_cycles",
+            value: n_cycles as f64,
+            reason: "n_cycles * n_bins overflows",
+        })?;
+    crate::error::check_same_len("n_cycles * n_bins", len, "out", out.len())?;
     let last = start + (n_cycles as f64) * period - period / n_bins as f64;
     if last > (x.len() - 1) as f64 + 1e-9 {
         return Err(CoreError::InvalidParameter {
@@ -81,11 +106,11 @@ pub fn fold_cycles(
     }
     let step = period / n_bins as f64;
     let max_pos = (x.len() - 1) as f64;
-    for c in 0..n_cycles {
+    for (c, row) in out.chunks_exact_mut(n_bins).enumerate() {
         let base = start + c as f64 * period;
-        for j in 0..n_bins {
+        for (j, o) in row.iter_mut().enumerate() {
             let pos = (base + j as f64 * step).min(max_pos);
-            out[c * n_bins + j] = sample_at(x, pos);
+            *o = interpolate(x, pos);
         }
     }
     Ok(())
@@ -110,8 +135,32 @@ mod tests {
     #[test]
     fn fractional_positions_interpolate_smooth_signals() {
         let x: Vec<f64> = (0..400).map(|k| (0.05 * f64::from(k)).sin()).collect();
-        let v = sample_at(&x, 100.37);
+        let v = sample_at(&x, 100.37).unwrap();
         assert!((v - (0.05 * 100.37_f64).sin()).abs() < 1e-6);
+    }
+
+    #[test]
+    fn sample_at_empty_or_nan_is_an_error() {
+        assert_eq!(sample_at(&[], 0.0), Err(CoreError::Empty { name: "x" }));
+        assert!(sample_at(&[1.0, 2.0], f64::NAN).is_err());
+        assert_eq!(sample_at(&[4.0], 0.7), Ok(4.0));
+        assert_eq!(sample_at(&[1.0, 2.0, 3.0], -5.0), Ok(1.0));
+        assert_eq!(sample_at(&[1.0, 2.0, 3.0], 9.0), Ok(3.0));
+        assert_eq!(sample_at(&[1.0, 2.0, 3.0], f64::INFINITY), Ok(3.0));
+    }
+
+    #[test]
+    fn huge_cycle_counts_are_an_error_not_an_overflow() {
+        let x = vec![0.0; 30];
+        let mut out = vec![0.0; 4];
+        let r = fold_cycles(&x, 0.0, 10.0, usize::MAX / 2, 4, &mut out);
+        assert!(matches!(
+            r,
+            Err(CoreError::InvalidParameter {
+                reason: "n_cycles * n_bins overflows",
+                ..
+            })
+        ));
     }
 
     #[test]

@@ -59,6 +59,13 @@ impl KelvinVoigt {
         delta: &mut [f64],
         velocity: &mut [f64],
     ) -> Result<(), CoreError> {
+        if !pa.is_finite() {
+            return Err(CoreError::InvalidParameter {
+                name: "pa",
+                value: pa,
+                reason: "must be finite",
+            });
+        }
         check_finite("t", t)?;
         crate::error::check_same_len("t", t.len(), "delta (output)", delta.len())?;
         crate::error::check_same_len("t", t.len(), "velocity (output)", velocity.len())?;
@@ -95,6 +102,21 @@ mod tests {
         let k11 = pa / (kv.k * kv.k + (h * kv.omega).powi(2)).sqrt();
         assert!((k11 - k_amp).abs() < 1e-15 * k_amp.abs().max(1e-300) * 1e3);
         assert!((kv.phase() - (h * kv.omega / kv.k).atan()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn steady_state_rejects_non_finite_amplitude() {
+        let kv = KelvinVoigt::new(1.0, 0.1, 1.0).unwrap();
+        let t = [0.0, 0.5, 1.0];
+        let (mut d, mut v) = ([0.0; 3], [0.0; 3]);
+        for pa in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let r = kv.steady_state(pa, &t, &mut d, &mut v);
+            assert!(matches!(
+                r,
+                Err(CoreError::InvalidParameter { name: "pa", .. })
+            ));
+        }
+        assert!(kv.steady_state(0.4, &t, &mut d, &mut v).is_ok());
     }
 
     #[test]

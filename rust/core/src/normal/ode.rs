@@ -151,6 +151,14 @@ pub enum Status {
     StepSizeTooSmall { time: f64, step: f64 },
     /// `max_steps` attempts were used up.
     MaxSteps { time: f64 },
+    /// The solution reached a state where the stiffness `k_s` is not positive (the model is
+    /// undefined there), at `name = at` (δ or p) with `k_s = value`.
+    NonPositiveStiffness {
+        time: f64,
+        name: &'static str,
+        at: f64,
+        value: f64,
+    },
 }
 
 impl Status {
@@ -171,6 +179,15 @@ impl Status {
                 format!("Required step size is less than spacing between numbers (step {step:e} at t = {time}).")
             }
             Status::MaxSteps { time } => format!("Maximum number of steps reached at t = {time}."),
+            Status::NonPositiveStiffness {
+                time,
+                name,
+                at,
+                value,
+            } => format!(
+                "The solution left the model's domain at t = {time:.6}: the stiffness is not \
+                 positive (k_s = {value:.4e}) at {name} = {at:.4e}."
+            ),
         }
     }
 }
@@ -239,9 +256,9 @@ fn rodas4_step(
 /// Integrate `model` driven by `forcing` from `delta0` at the first sample, writing δ and δ'
 /// at every sample time into `delta` and `velocity` (each `forcing.len()` long).
 ///
-/// Malformed input is an `Err`; a solve that cannot meet the tolerance returns
-/// `Ok(Outcome)` with a failure status and `n_out` samples written. A state where
-/// `k_s ≤ 0` is `Err(NonPositiveStiffness)`.
+/// Malformed input is an `Err` (a starting state `delta0` where `k_s ≤ 0` among it); a solve
+/// that cannot meet the tolerance, or whose solution reaches a state where `k_s ≤ 0`, returns
+/// `Ok(Outcome)` with a failure status and the `n_out` samples computed up to there.
 pub fn simulate(
     model: &ContactModel,
     forcing: &Forcing<'_>,
@@ -274,7 +291,11 @@ pub fn simulate(
         let mut tc = t[i];
         // Output at the start of the interval: δ and δ' = f(t_i, δ_i).
         let (p_i, dp_i) = seg.value_deriv(tc);
-        let e = model.eval(p_i, dp_i, y)?;
+        let e = match model.eval(p_i, dp_i, y) {
+            Ok(e) => e,
+            Err(e) if i > 0 => return stopped(e, tc, i, stats),
+            Err(e) => return Err(e), // delta0 itself is outside the model's domain
+        };
         stats.nfev += 1;
         delta[i] = y;
         velocity[i] = e.f;
@@ -283,7 +304,10 @@ pub fn simulate(
         while tc < t_end {
             if !first {
                 let (p, dp) = seg.value_deriv(tc);
-                let e = model.eval(p, dp, y)?;
+                let e = match model.eval(p, dp, y) {
+                    Ok(e) => e,
+                    Err(e) => return stopped(e, tc, i + 1, stats),
+                };
                 stats.nfev += 1;
                 (f0, jac, dfdt) = (e.f, e.jac, e.dfdt);
             }
@@ -342,7 +366,10 @@ pub fn simulate(
     }
     let last = n - 1;
     let p = forcing.values()[last];
-    let e = model.eval(p, forcing.sample_deriv(last), y)?;
+    let e = match model.eval(p, forcing.sample_deriv(last), y) {
+        Ok(e) => e,
+        Err(e) => return stopped(e, t[last], last, stats),
+    };
     stats.nfev += 1;
     delta[last] = y;
     velocity[last] = e.f;
@@ -351,6 +378,24 @@ pub fn simulate(
         n_out: n,
         stats,
     })
+}
+
+/// An accepted step left `y` where the model is undefined (`k_s ≤ 0`): the solve ends there
+/// with the samples already written, as a failure status rather than an error.
+fn stopped(e: CoreError, time: f64, n_out: usize, stats: Stats) -> Result<Outcome, CoreError> {
+    match e {
+        CoreError::NonPositiveStiffness { name, at, value } => Ok(Outcome {
+            status: Status::NonPositiveStiffness {
+                time,
+                name,
+                at,
+                value,
+            },
+            n_out,
+            stats,
+        }),
+        other => Err(other),
+    }
 }
 
 #[cfg(test)]
@@ -452,6 +497,53 @@ mod tests {
         for i in 64..t.len() {
             assert!((y[i] - p[i] / 2.0).abs() < 1e-6);
         }
+    }
+
+    #[test]
+    fn leaving_the_domain_returns_the_partial_solution() {
+        // k_s(δ) = 1 + 5e6 δ vanishes at δ = -0.2e-6 inside the response; a loose tolerance
+        // lets an accepted step land beyond it.
+        let m = ContactModel::new(Stiffness::Delta(vec![1e12, 5e18]), 0.1, 1.0).unwrap();
+        let w = 1.0;
+        let per = 16;
+        let n = 2 * per + 1;
+        let dt = 2.0 * PI / w / per as f64;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
+        let p: Vec<f64> = t.iter().map(|&v| 0.4e6 * (w * v).sin()).collect();
+        let fo = Forcing::new(&t, &p, None, Interp::Linear).unwrap();
+        let mut y = vec![f64::NAN; n];
+        let mut v = vec![f64::NAN; n];
+        let o = Options {
+            rtol: 0.1,
+            atol: 1e-8,
+            ..Options::default()
+        };
+        let out = simulate(&m, &fo, 0.0, &o, &mut y, &mut v).unwrap();
+        let Status::NonPositiveStiffness {
+            name, at, value, ..
+        } = out.status
+        else {
+            panic!("expected NonPositiveStiffness, got {:?}", out.status);
+        };
+        assert_eq!(name, "delta");
+        assert!(at < -0.2e-6 && value <= 0.0);
+        assert_eq!(out.status.code(), -1);
+        assert!(out.status.message().contains("not positive"));
+        assert!(out.n_out > 1 && out.n_out < n);
+        // Everything reported lies inside the domain and was computed.
+        for &d in &y[..out.n_out] {
+            assert!(d.is_finite() && 1e12 + 5e18 * d > 0.0);
+        }
+    }
+
+    #[test]
+    fn starting_outside_the_domain_is_an_error() {
+        let m = ContactModel::new(Stiffness::Delta(vec![1e12, 5e18]), 0.1, 1.0).unwrap();
+        let (t, p, _) = sine(33, 16, 1.0);
+        let fo = Forcing::new(&t, &p, None, Interp::Linear).unwrap();
+        let (mut y, mut v) = (vec![0.0; t.len()], vec![0.0; t.len()]);
+        let r = simulate(&m, &fo, -1e-6, &Options::default(), &mut y, &mut v);
+        assert!(matches!(r, Err(CoreError::NonPositiveStiffness { .. })));
     }
 
     #[test]

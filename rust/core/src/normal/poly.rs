@@ -68,14 +68,17 @@ pub fn fit(
         }
     }
     let n = x.len();
-    let m = degree + 1;
-    if n < m {
-        return Err(CoreError::InvalidParameter {
-            name: "degree",
-            value: degree as f64,
-            reason: "needs at least degree + 1 points",
-        });
-    }
+    // degree < n, so degree + 1 cannot overflow (degree = usize::MAX is just too high).
+    let m = match degree.checked_add(1) {
+        Some(m) if m <= n => m,
+        _ => {
+            return Err(CoreError::InvalidParameter {
+                name: "degree",
+                value: degree as f64,
+                reason: "needs at least degree + 1 points",
+            })
+        }
+    };
     let xs = x.iter().fold(0.0_f64, |a, &v| a.max(v.abs()));
     let ys = y.iter().fold(0.0_f64, |a, &v| a.max(v.abs()));
     if xs == 0.0 {
@@ -236,6 +239,17 @@ mod tests {
         assert!(fit(&[1.0, 2.0], &[1.0, 2.0], 2, None).is_err());
         assert!(fit(&[0.0, 1.0, f64::NAN], &[1.0, 2.0, 3.0], 1, None).is_err());
         assert!(fit(&[0.0, 1.0], &[1.0, 2.0, 3.0], 1, None).is_err());
+    }
+
+    #[test]
+    fn fit_with_the_largest_degree_is_an_error_not_an_overflow() {
+        for degree in [usize::MAX, usize::MAX - 1, 3] {
+            let r = fit(&[0.0, 1.0, 2.0], &[1.0, 2.0, 3.0], degree, None);
+            assert!(matches!(
+                r,
+                Err(CoreError::InvalidParameter { name: "degree", .. })
+            ));
+        }
     }
 
     #[test]

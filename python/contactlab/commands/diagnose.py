@@ -39,9 +39,9 @@ def add_parser(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..diagnose import diagnose
     from ..errors import InputError
     from ..io import read_recording
-    from .workflow import diagnose
 
     rec = read_recording(args.file, kind=args.model)
     try:
@@ -55,8 +55,6 @@ def run(args: argparse.Namespace) -> int:
         import matplotlib
 
         matplotlib.use("Agg")
-        from ._html import write_html
-
-        path = write_html(report, args.report)
+        path = report.write_html(args.report)
         print(f"report: {path}")
     return 0

@@ -4,7 +4,7 @@
    amplitude (PHYSICS.md §1): ``loops.png`` and ``amplitude_table.csv``.
 2. The bundled example recordings (:mod:`contactlab.data`: three material pairs over loads
    and amplitudes, normal-contact tests over p0; CSV/TDMS/HDF5/MAT) go through the study
-   (:func:`contactlab.study.run_study`): ``report.html`` (self-contained), ``figures/*.png``,
+   (:func:`contactlab.studies.run_study`): ``report.html`` (self-contained), ``figures/*.png``,
    ``study_tangential.csv``/``.parquet`` and ``study_normal.*``.
 
 All outputs are rendered first and written all or nothing into the output folder.
@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .masing import Masing, loop_area
+from ..masing import Masing, loop_area
 
 # Illustrative aluminium-on-aluminium values of the order the paper reports.
 DEMO_H0 = 40.0  # N
@@ -53,7 +53,7 @@ def masing_outputs() -> dict[str, bytes]:
     """``loops.png`` and ``amplitude_table.csv`` of the illustrative Masing model."""
     import matplotlib.pyplot as plt
 
-    from .report import figure_png
+    from ..report import figure_png
 
     model = Masing(DEMO_H0, DEMO_AC)
     amps = np.asarray(DEMO_AMPLITUDES)
@@ -85,8 +85,8 @@ def masing_outputs() -> dict[str, bytes]:
 
 def demo_entries(quick: bool = False) -> list:
     """Entries of the bundled study; ``quick`` keeps one recording per material and kind."""
-    from .data import manifest_path
-    from .manifest import read_manifest
+    from ..data import manifest_path
+    from ..studies.manifest import read_manifest
 
     entries = read_manifest(manifest_path())
     if not quick:
@@ -108,9 +108,9 @@ def run_demo(out: Path, *, quick: bool = False, progress: bool | None = None) ->
     import matplotlib
 
     matplotlib.use("Agg")
-    from .report import commit_outputs
-    from .report.study_report import build_report
-    from .study import run_study
+    from ..report import commit_outputs
+    from ..report.study_report import build_report
+    from ..studies import run_study
 
     files = masing_outputs()
     result = run_study(demo_entries(quick), progress=progress)

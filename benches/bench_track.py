@@ -1,0 +1,263 @@
+"""Long recordings end to end: throughput and peak memory of chunked reading, per-cycle
+energies, ``track``/``analyze --stream`` and whole-file ``analyze``, against the Masing kernel
+alone on the same samples in the same run (issue 9).
+
+Writes a tangential HDF5 recording of ``--samples`` samples (default 1e8: x and F as float64
+with a sampling interval attribute, 1.6 GB) into a temporary folder, deletes it afterwards,
+and runs each stage in a child process so that its peak RSS is its own (``os.wait4``).
+
+Stages (``samples/s`` = recording samples per second of wall time):
+
+- ``masing``: ``MasingOperator.push`` over the same displacement, chunk by chunk — the
+  reference every ratio is taken against (measured while writing the file);
+- ``read``: :func:`contactlab.io.read_chunks` alone (HDF5 slices, unit conversion, checks);
+- ``cycles``: read + the per-cycle kernel (crossings, ∮F dx, amplitude, offset per cycle);
+- ``track``: :func:`contactlab.track` with ``every="auto"`` (= ``analyze --stream``), serial
+  and with ``--workers`` processes;
+- ``whole``: ``contactlab analyze`` of a ``--whole-samples`` file (default 1e7) read whole
+  (the issue's "before"), and ``analyze --stream`` of the same file (its "after");
+- ``study``: ``--study-files`` recordings analysed serially and on a process pool.
+
+Run: ``nice .venv/bin/python benches/bench_track.py [--samples 1e8] [--workers 2]``
+(tens of minutes at 1e8 on 2 cores; ``--samples 2e6`` for a quick look).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+FS, FREQ, AMP, H0, AC = 10_000.0, 10.0, 20e-6, 40.0, 4e4
+CHUNK = 1 << 20
+
+
+def _signal(a: int, b: int) -> np.ndarray:
+    t = np.arange(a, b, dtype=np.float64) / FS
+    return AMP * np.sin(2 * np.pi * FREQ * t)
+
+
+def write_file(path: Path, n: int, seed: int = 12) -> dict:
+    """x (0.1 % sensor noise), F (Masing of the true x, 1 % noise) in chunks; returns the
+    Masing kernel's time on them. (Noise on the true x would be real jitter: the force would
+    run minor loops around every jitter, dissipating more than the smooth loop.)"""
+    import h5py
+
+    import contactlab
+
+    rng = np.random.default_rng(seed)
+    op = contactlab.Masing(h0=H0, ac=AC).operator()
+    t_kernel = 0.0
+    t0 = time.perf_counter()
+    with h5py.File(path, "w") as f:
+        dx = f.create_dataset("x", shape=(n,), dtype="f8", chunks=(1 << 16,))
+        dF = f.create_dataset("F", shape=(n,), dtype="f8", chunks=(1 << 16,))
+        for ds, unit in ((dx, "m"), (dF, "N")):
+            ds.attrs["unit"] = unit
+            ds.attrs["dt"] = 1.0 / FS
+        for a in range(0, n, CHUNK):
+            b = min(a + CHUNK, n)
+            x = _signal(a, b)
+            k0 = time.perf_counter()
+            F = op.push(x)
+            t_kernel += time.perf_counter() - k0
+            dx[a:b] = x + 2e-8 * rng.standard_normal(b - a)
+            dF[a:b] = F + 0.4 * rng.standard_normal(b - a)
+    return {"write_s": time.perf_counter() - t0, "masing_s": t_kernel, "bytes": path.stat().st_size}
+
+
+def stage(name: str, path: str, workers: int) -> dict:
+    """Run in the child: one stage on ``path``; returns its wall time and a check value."""
+    import h5py  # noqa: F401  (imported before the clock starts)
+
+    from contactlab.io import read_chunks
+
+    t0 = time.perf_counter()
+    out: dict = {}
+    if name == "read":
+        n = sum(len(c) for c in read_chunks(path, chunk_size=CHUNK))
+        out["n"] = n
+    elif name == "cycles":
+        from contactlab.studies._cycles import CycleState, block_cycles
+
+        s, n_cyc = CycleState(), 0
+        for c in read_chunks(path, chunk_size=CHUNK):
+            n_cyc += block_cycles(c.t, c["x"], c["F"], c["x"], c.meta["offset"], s).energy.size
+        out["cycles"] = n_cyc
+    elif name.startswith("track"):
+        from concurrent.futures import ProcessPoolExecutor
+
+        import contactlab
+
+        if workers > 1:
+            with ProcessPoolExecutor(workers) as ex:
+                r = contactlab.track(path, every="auto", executor=ex)
+        else:
+            r = contactlab.track(path, every="auto")
+        comb = r.combined()
+        out.update(
+            windows=len(r.rows),
+            cycles=comb.get("n_cycles"),
+            h0=comb.get("h0"),
+            h0_stderr=comb.get("h0_stderr"),
+        )
+    else:
+        raise SystemExit(f"unknown stage {name}")
+    out["wall_s"] = time.perf_counter() - t0
+    return out
+
+
+def child(cmd: list[str]) -> tuple[float, float, str]:
+    """Wall time (s), peak RSS (MB) of a child process and its stdout."""
+    t0 = time.perf_counter()
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, text=True)
+    assert p.stdout is not None
+    text = p.stdout.read()
+    _, status, usage = os.wait4(p.pid, 0)
+    p.returncode = os.waitstatus_to_exitcode(status)
+    wall = time.perf_counter() - t0
+    if p.returncode != 0:
+        raise SystemExit(f"{cmd} failed with {p.returncode}")
+    # ru_maxrss of the waited child (KiB on Linux); pool workers are its children, so their
+    # peaks are not in it: see the track stage's note
+    return wall, usage.ru_maxrss / 1024.0, text
+
+
+def run_stage(name: str, path: Path, workers: int) -> dict:
+    cmd = [
+        sys.executable,
+        __file__,
+        "--stage",
+        name,
+        "--file",
+        str(path),
+        "--workers",
+        str(workers),
+    ]
+    wall, rss, text = child(cmd)
+    d = json.loads(text.strip().splitlines()[-1])
+    d.update(proc_wall_s=wall, peak_rss_mb=rss)
+    return d
+
+
+def many_recordings(tmp: Path, n_files: int, workers: int) -> dict:
+    from concurrent.futures import ProcessPoolExecutor
+
+    from contactlab.io import write_recording
+    from contactlab.studies import run_study
+    from contactlab.tangential import synthetic_recording
+
+    files = []
+    for i in range(n_files):
+        rec = synthetic_recording(
+            h0=H0,
+            ac=AC,
+            amplitude=AMP,
+            n_cycles=40,
+            fs=2000.0,
+            frequency=2.0,
+            noise=0.01,
+            seed=500 + i,
+        )
+        p = tmp / f"Al-Al_W50N_A20um_{i:03d}.h5"
+        write_recording(p, rec)
+        files.append(p)
+    t0 = time.perf_counter()
+    a = run_study(files, progress=False, keep_recordings=False)
+    t_serial = time.perf_counter() - t0
+    with ProcessPoolExecutor(workers) as ex:
+        list(ex.map(abs, range(workers)))  # start the workers before timing
+        t0 = time.perf_counter()
+        b = run_study(files, progress=False, executor=ex)
+        t_pool = time.perf_counter() - t0
+    same = a.to_csv("tangential") == b.to_csv("tangential")
+    return {"files": n_files, "serial_s": t_serial, "pool_s": t_pool, "identical": same}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--samples", type=float, default=1e8)
+    ap.add_argument("--whole-samples", type=float, default=1e7)
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--study-files", type=int, default=12)
+    ap.add_argument("--skip", default="", help="comma-separated stages to skip")
+    ap.add_argument("--stage", help=argparse.SUPPRESS)
+    ap.add_argument("--file", help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.stage:
+        print(json.dumps(stage(args.stage, args.file, args.workers)))
+        return
+    skip = set(filter(None, args.skip.split(",")))
+    n = int(args.samples)
+    tmp = Path(tempfile.mkdtemp(prefix="contactlab-bench-track-"))
+    try:
+        print(f"cores: {os.cpu_count()}, load average {os.getloadavg()[0]:.1f}")
+        big = tmp / "long.h5"
+        w = write_file(big, n)
+        m_rate = n / w["masing_s"]
+        print(f"wrote {n:.3g} samples, {w['bytes'] / 1e9:.2f} GB in {w['write_s']:.1f} s")
+        print(
+            f"reference  Masing kernel alone (push, chunks of {CHUNK}): "
+            f"{m_rate / 1e6:8.1f} M samples/s"
+        )
+        stages = [("read", 1), ("cycles", 1), ("track", 1), ("track", args.workers)]
+        for name, wk in stages:
+            if name in skip:
+                continue
+            d = run_stage(name, big, wk)
+            rate = n / d["wall_s"]
+            label = f"{name} ({wk} proc)" if name == "track" else name
+            extra = {
+                k: v for k, v in d.items() if k not in ("wall_s", "proc_wall_s", "peak_rss_mb", "n")
+            }
+            print(
+                f"{label:<16} {d['wall_s']:8.1f} s {rate / 1e6:8.2f} M samples/s  "
+                f"ratio to Masing {rate / m_rate:6.3f}  peak RSS {d['peak_rss_mb']:6.0f} MB"
+                f"{'' if wk == 1 else ' (parent only)'}  {extra}"
+            )
+        big.unlink()
+        if "whole" not in skip:
+            nw = int(args.whole_samples)
+            wf = tmp / "whole.h5"
+            write_file(wf, nw, seed=13)
+            for label, extra in (("analyze (whole file)", []), ("analyze --stream", ["--stream"])):
+                cmd = [
+                    sys.executable,
+                    "-m",
+                    "contactlab",
+                    "analyze",
+                    str(wf),
+                    "--model",
+                    "tangential",
+                    "--no-progress",
+                    "--json",
+                    str(tmp / "o.json"),
+                    *extra,
+                ]
+                wall, rss, _ = child(cmd)
+                print(
+                    f"{label:<22} {nw:.0e} samples: {wall:6.1f} s "
+                    f"{nw / wall / 1e6:6.2f} M samples/s, peak RSS {rss:6.0f} MB"
+                )
+            wf.unlink()
+        if "study" not in skip:
+            s = many_recordings(tmp, args.study_files, args.workers)
+            print(
+                f"study of {s['files']} recordings: serial {s['serial_s']:.1f} s, "
+                f"{args.workers} processes {s['pool_s']:.1f} s "
+                f"(x{s['serial_s'] / s['pool_s']:.2f}), identical: {s['identical']}"
+            )
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,142 @@
+"""``contactlab track FILE --every 100cycles [--json OUT] [--report DIR]``: a long recording
+window by window.
+
+Reads the recording in chunks (memory bounded by one chunk and one window, whatever its
+length), analyses every window of N cycles or T seconds as ``analyze`` does (tangential: h0,
+ac or h0·ac, energy analytic and numeric, c_e·ω, k_local, k_global, amplitude, offset, with
+standard errors; normal: E_d, ψ, k_tan, k_sec, polynomials) and the loop energy of every
+cycle; writes them as JSON and as a report with each quantity plotted against time or cycle
+count.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ._common import (
+    add_progress_flags,
+    add_workers_flag,
+    check_output_targets,
+    command_line,
+    describe,
+    parse_columns,
+    process_pool,
+    quantity,
+    write_json,
+)
+
+_SHOW = {
+    "tangential": [
+        ("h0", "N", 1.0),
+        ("ac", "1/m", 1.0),
+        ("h0_ac", "N/m", 1.0),
+        ("energy_per_cycle", "J", 1.0),
+        ("amplitude", "um", 1e6),
+    ],
+    "normal": [("E_d", "J/m^2", 1.0), ("psi", "", 1.0), ("k_tan", "Pa/m", 1.0)],
+}
+
+
+def _handler(args: argparse.Namespace) -> int:
+    from ..studies.tracking import parse_every, track, track_json
+
+    check_output_targets(json_out=args.json, report=args.report)
+    parse_every(args.every)  # a bad --every fails before the file is opened
+    say = sys.stderr if args.json == "-" else sys.stdout
+    bar = None
+    if args.progress or (args.progress is None and sys.stderr.isatty()):
+        from tqdm.auto import tqdm
+
+        bar = tqdm(desc="windows", unit="win", file=sys.stderr)
+    print(f"tracking {args.file} every {args.every}", file=say, flush=True)
+    try:
+        with process_pool(args.workers) as ex:
+            res = track(
+                args.file,
+                args.every,
+                kind=args.model,
+                columns=parse_columns(args.columns),
+                fs=args.fs,
+                chunk_size=args.chunk_size,
+                executor=ex,
+                callback=(lambda _row: bar.update(1)) if bar is not None else None,
+            )
+    finally:
+        if bar is not None:
+            bar.close()
+    comb = res.combined()
+    print(
+        f"{res.source}: {len(res.rows)} windows, {comb.get('n_cycles', 0)} cycles, "
+        f"{res.meta['n_samples']} samples",
+        file=say,
+    )
+    for key, unit, f in _SHOW[res.kind]:
+        if key in comb:
+            birge = comb.get(f"{key}_birge")
+            how = f"pooled; Birge ratio {birge:.2g}" if birge is not None else "mean of the windows"
+            print(
+                f"  {key} = {comb[key] * f:.5g} ± {comb[f'{key}_stderr'] * f:.2g} {unit} ({how})",
+                file=say,
+            )
+    for r in res.rows:
+        if r.get("error"):
+            print(f"  warning: {r['error']}", file=sys.stderr)
+    doc = track_json(res) if args.json else None  # rendered before anything is written
+    if args.report:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from ..report import commit_outputs
+        from ..report.track_report import build_track_report, track_files
+
+        cmd = command_line("track", args.file, "--every", args.every, "--report", args.report)
+        rep = build_track_report(
+            res, f"contactlab track: {args.file}", against=args.against, intro=f"Made by: {cmd}"
+        )
+        for p in commit_outputs(args.report, track_files(res, rep)):
+            if p.suffix == ".html":
+                print(f"wrote {p}", file=say)
+    if args.json:
+        p = write_json(args.json, doc)
+        if str(p) != "-":
+            print(f"wrote {p}", file=say)
+    return 0
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "track",
+        help="fitted quantities window by window along a long recording (bounded memory)",
+        description=describe(__doc__),
+    )
+    p.add_argument("file", metavar="FILE", help="recording (.csv .tdms .h5 .mat)")
+    p.add_argument(
+        "--every",
+        default="100cycles",
+        help="window length: '100cycles' or a time, '10s' (default 100cycles)",
+    )
+    p.add_argument("--model", choices=("tangential", "normal"), help="default: from the columns")
+    p.add_argument(
+        "--json",
+        metavar="OUT",
+        help="write windows, pooled result and per-cycle energies as JSON (SI; '-' = stdout)",
+    )
+    p.add_argument("--report", metavar="DIR", help="write report.html, figures and tables here")
+    p.add_argument(
+        "--against", choices=("time", "cycle"), default="time", help="x axis of the plots"
+    )
+    p.add_argument("--columns", help="column mapping, e.g. 'x=disp,F=force' (default: by name)")
+    p.add_argument(
+        "--fs", type=quantity("Hz", positive=True), help="sampling rate when a file has no time"
+    )
+    p.add_argument(
+        "--chunk-size",
+        type=int,
+        default=1 << 20,
+        metavar="N",
+        help="samples read at a time (default 1048576)",
+    )
+    add_workers_flag(p, "windows")
+    add_progress_flags(p)
+    p.set_defaults(handler=_handler)

@@ -1,0 +1,486 @@
+"""Reading a long recording chunk by chunk, in bounded memory.
+
+:func:`read_chunks` opens a recording like :func:`contactlab.io.read_recording` (same column
+guessing, units, ``kind``, ``fs``) and yields it as consecutive :class:`Recording` chunks of at
+most ``chunk_size`` samples, SI inside, each with ``meta["offset"]`` (index of its first
+sample). Only one chunk of the needed channels is in memory at a time:
+
+- HDF5 and MAT v7.3: datasets read by slices (h5py);
+- TDMS: channels read by ``offset``/``length`` (npTDMS streaming mode: only the segments
+  holding the slice are touched);
+- CSV/text: blocks of lines parsed with ``numpy.loadtxt``;
+- MAT v4-v7 (scipy) has no partial reads: the file is read whole, then handed out in chunks.
+
+Every chunk is checked as the whole-file readers check a file, and errors carry the same
+messages (file, column, row: the 1-based line for text, the 0-based sample index otherwise):
+non-finite values, time going back or repeating (also across chunk boundaries) and gaps
+(steps above 1.5 times the first chunk's median step).
+"""
+
+from __future__ import annotations
+
+import itertools
+import warnings
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from .recording import (
+    Recording,
+    RecordingError,
+    check_equal_lengths,
+    check_finite,
+    check_time,
+    real_values,
+    resolve_columns,
+    unit_factor,
+)
+from .sniff import content_format, format_of
+
+#: default samples per chunk (8 MiB per channel)
+DEFAULT_CHUNK = 1 << 20
+
+
+@dataclass
+class ChunkedRecording:
+    """A recording read chunk by chunk; iterate it for :class:`Recording` chunks.
+
+    Attributes
+    ----------
+    source : str
+        The file.
+    kind : str or None
+        ``"tangential"`` or ``"normal"``.
+    units : dict
+        SI unit of each channel.
+    columns : dict
+        Canonical channel name to the name in the file.
+    n_samples : int or None
+        Number of samples when the format tells without reading (None for text files).
+    meta : dict
+        Format, file units, channels whose unit was assumed SI.
+    """
+
+    source: str
+    kind: str | None
+    units: dict[str, str]
+    columns: dict[str, str]
+    n_samples: int | None
+    meta: dict[str, Any]
+    _open: Callable[[], Iterator[Recording]] = field(repr=False)
+
+    def __iter__(self) -> Iterator[Recording]:
+        return self._open()
+
+
+class _Finisher:
+    """Unit conversion and the checks of :func:`~contactlab.io.recording.finish`, applied
+    chunk by chunk with the state they need across boundaries (the last time stamp, the
+    reference step)."""
+
+    def __init__(
+        self,
+        mapping: dict[str, str],
+        file_units: dict[str, str | None],
+        *,
+        kind: str | None,
+        file: str,
+        fs: float | None,
+        dt: float | None = None,
+        t0: float = 0.0,
+        row_of: Callable[[int], int] | None = None,
+        meta: dict[str, Any] | None = None,
+    ) -> None:
+        self.mapping, self.kind, self.file = mapping, kind, file
+        self.row_of = row_of or (lambda i: i)
+        assumed: list[str] = []
+        self.factors: dict[str, float] = {}
+        self.units: dict[str, str] = {}
+        for canon, col in mapping.items():
+            f, si = unit_factor(canon, col, file_units.get(canon), file=file, assumed=assumed)
+            self.factors[canon] = f
+            if canon != "t":
+                self.units[canon] = si
+        self.dt = None
+        if "t" not in mapping:
+            if fs is not None:
+                fs = float(fs)
+                if not np.isfinite(fs) or fs <= 0:
+                    raise InputError(f"fs must be finite and > 0, got {fs}")
+                self.dt = 1.0 / fs
+            elif dt is not None:
+                if not np.isfinite(dt) or dt <= 0:
+                    raise RecordingError(
+                        f"sampling interval {dt} is not a positive time step", file=file
+                    )
+                self.dt = float(dt)
+            else:
+                raise RecordingError(
+                    "no time column and no sampling rate: pass fs= (Hz) or columns={'t': ...}",
+                    file=file,
+                )
+        self.t0 = t0
+        self.tcol = mapping.get("t", "t")
+        self.prev_t: float | None = None
+        self.step: float | None = None
+        m = dict(meta or {})
+        m.setdefault("kind", kind)
+        m["columns"] = dict(mapping)
+        m["file_units"] = dict(file_units)
+        if assumed:
+            m["units_assumed_si"] = assumed
+        self.meta = m
+
+    def _check_time(self, t: np.ndarray, row_of: Callable[[int], int]) -> None:
+        """The whole-file reader's time checks, judged against the first chunk's median step
+        and across the boundary with the previous chunk."""
+        col = self.tcol
+        if self.prev_t is None:
+            if t.size >= 2:
+                self.step = float(np.median(np.diff(t)))
+            check_time(t, file=self.file, column=col, row_of=row_of, step=self.step)
+            return
+        if t.size:  # the boundary: the previous chunk's last stamp, then this one's first
+            check_time(
+                np.array([self.prev_t, t[0]]),
+                file=self.file,
+                column=col,
+                row_of=lambda i: row_of(i - 1),
+                step=self.step,
+            )
+        if t.size >= 2:
+            check_time(t, file=self.file, column=col, row_of=row_of, step=self.step)
+
+    def __call__(self, raw: dict[str, np.ndarray], offset: int) -> Recording:
+        check_equal_lengths(raw, self.mapping, file=self.file)
+        n = next(iter(raw.values())).size
+        if self.prev_t is None and n < 2:  # as the whole-file check of the time says
+            raise RecordingError(f"only {n} sample(s)", file=self.file, column=self.tcol)
+
+        def row_of(i: int) -> int:
+            return self.row_of(offset + i)
+
+        data: dict[str, np.ndarray] = {}
+        t = None
+        for canon, values in raw.items():
+            col = self.mapping[canon]
+            check_finite(values, file=self.file, column=col, row_of=row_of)
+            v = np.ascontiguousarray(values, dtype=np.float64)
+            if self.factors[canon] != 1.0:
+                v = v * self.factors[canon]
+            if canon == "t":
+                t = v
+            else:
+                data[canon] = v
+        if t is None:
+            # a time axis made from the sampling interval is increasing and gap-free by
+            # construction: nothing to check
+            assert self.dt is not None
+            t = self.t0 + self.dt * np.arange(offset, offset + n, dtype=np.float64)
+        else:
+            self._check_time(t, row_of)
+        if n:
+            self.prev_t = float(t[-1])
+        meta = dict(self.meta, offset=offset)
+        return Recording(t, data, dict(self.units), self.file, meta)
+
+
+def _check_chunk_size(chunk_size: int) -> int:
+    try:
+        c = int(chunk_size)
+    except (TypeError, ValueError):
+        raise InputError(f"chunk_size must be an integer, got {chunk_size!r}") from None
+    if c < 2 or c != chunk_size:
+        raise InputError(f"chunk_size must be an integer >= 2, got {chunk_size!r}")
+    return c
+
+
+def _slice(ds: Any, a: int, b: int, *, file: str, column: str) -> np.ndarray:
+    """Samples ``a:b`` of a vector dataset (MATLAB stores vectors as 1×N or N×1)."""
+    if ds.ndim <= 1:
+        part = ds[a:b]
+    else:
+        axis = next((i for i, s in enumerate(ds.shape) if s != 1), 0)
+        idx: list[Any] = [0] * ds.ndim
+        idx[axis] = slice(a, b)
+        part = ds[tuple(idx)]
+    return real_values(part, file=file, column=column).reshape(-1)
+
+
+def _vector_length(ds: Any, *, file: str, column: str) -> int:
+    if len([s for s in ds.shape if s != 1]) > 1:
+        raise RecordingError(
+            f"dataset has shape {ds.shape}; a channel must be a vector", file=file, column=column
+        )
+    return int(np.prod(ds.shape, dtype=np.int64))
+
+
+def _h5_chunks(
+    path: Path, fmt: str, *, columns: Any, kind: Any, fs: Any, chunk: int
+) -> ChunkedRecording:
+    from .hdf5 import hdf5_layout, import_h5py
+
+    h5py = import_h5py()
+    file = str(path)
+
+    def layout(f: Any) -> tuple[Any, ...]:
+        if fmt == "mat73":
+            from .mat import v73_layout
+
+            kind_, mapping, units, dt = v73_layout(f, columns=columns, kind=kind, file=file)
+            dsets = {n: f[n] for n in mapping.values()}
+        else:
+            kind_, mapping, dsets, units, dt = hdf5_layout(f, columns=columns, kind=kind, file=file)
+        sizes = {n: _vector_length(dsets[n], file=file, column=n) for n in mapping.values()}
+        if len(set(sizes.values())) > 1:
+            what = "variables" if fmt == "mat73" else "channels"
+            raise RecordingError(f"{what} differ in length: {sizes}", file=file)
+        return kind_, mapping, dsets, units, dt, next(iter(sizes.values()))
+
+    try:
+        f = h5py.File(path, "r")
+    except OSError as exc:
+        raise RecordingError(f"not a readable HDF5 file ({exc})", file=file) from None
+    with f:
+        kind_, mapping, _d, units, dt, n = layout(f)
+    fin0 = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, meta={"format": fmt})
+
+    def gen() -> Iterator[Recording]:
+        fin = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, meta={"format": fmt})
+        with h5py.File(path, "r") as f:
+            dsets = {n_: f[n_] for n_ in mapping.values()} if fmt == "mat73" else None
+            if dsets is None:
+                from .hdf5 import datasets
+
+                alld = datasets(f)
+                dsets = {n_: alld[n_] for n_ in mapping.values()}
+            if n < 2:
+                yield fin(
+                    {c: _slice(dsets[m], 0, n, file=file, column=m) for c, m in mapping.items()}, 0
+                )
+                return
+            for a in range(0, n, chunk):
+                b = min(a + chunk, n)
+                raw = {c: _slice(dsets[m], a, b, file=file, column=m) for c, m in mapping.items()}
+                yield fin(raw, a)
+
+    return ChunkedRecording(file, kind_, fin0.units, mapping, n, fin0.meta, gen)
+
+
+def _tdms_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> ChunkedRecording:
+    from .tdms import import_nptdms
+
+    nptdms = import_nptdms()
+    file = str(path)
+
+    def open_tdms() -> tuple[Any, Any, dict[str, Any]]:
+        fh = open(path, "rb")
+        try:
+            tf = nptdms.TdmsFile.open(fh)
+        except Exception as exc:  # npTDMS raises plain ValueError/KeyError on corrupt files
+            fh.close()
+            raise RecordingError(f"not a readable TDMS file ({exc})", file=file) from None
+        chans: dict[str, Any] = {}
+        for g in tf.groups():
+            for ch in g.channels():
+                chans.setdefault(ch.name, ch)
+                chans[f"{g.name}/{ch.name}"] = ch
+        return fh, tf, chans
+
+    fh, tf, chans = open_tdms()
+    with tf, fh:
+        kind_, mapping = resolve_columns(list(chans), columns=columns, kind=kind, file=file)
+        units: dict[str, str | None] = {}
+        sizes = {}
+        for canon, name in mapping.items():
+            u = chans[name].properties.get("unit_string")
+            units[canon] = str(u) if u not in (None, "") else None
+            sizes[name] = len(chans[name])
+        if len(set(sizes.values())) > 1:
+            raise RecordingError(f"channels differ in length: {sizes}", file=file)
+        n = next(iter(sizes.values()))
+        dt, t0 = None, 0.0
+        if "t" not in mapping and fs is None:
+            ref = chans[mapping[next(c for c in mapping if c != "t")]]
+            inc = ref.properties.get("wf_increment")
+            if inc is not None:
+                dt = float(inc)
+                t0 = float(ref.properties.get("wf_start_offset", 0.0) or 0.0)
+                if not np.isfinite(dt) or dt <= 0:
+                    raise RecordingError(
+                        f"wf_increment {dt} is not a positive time step", file=file, column=ref.name
+                    )
+    fin0 = _Finisher(
+        mapping, units, kind=kind_, file=file, fs=fs, dt=dt, t0=t0, meta={"format": "tdms"}
+    )
+
+    def gen() -> Iterator[Recording]:
+        fin = _Finisher(
+            mapping, units, kind=kind_, file=file, fs=fs, dt=dt, t0=t0, meta={"format": "tdms"}
+        )
+        fh, tf, chans = open_tdms()
+        with tf, fh:
+            for a in range(0, max(n, 1), chunk):
+                length = min(chunk, n - a)
+                raw = {
+                    c: real_values(chans[m].read_data(a, length), file=file, column=m)
+                    for c, m in mapping.items()
+                }
+                yield fin(raw, a)
+
+    return ChunkedRecording(file, kind_, fin0.units, mapping, n, fin0.meta, gen)
+
+
+def _csv_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> ChunkedRecording:
+    from .csv import (
+        detect_encoding,
+        has_decimal_comma,
+        line_of_sample,
+        locate_bad_cell,
+        read_header,
+    )
+    from .units import split_name
+
+    file = str(path)
+    enc = detect_encoding(path)
+    names, delim, header_line, comments = read_header(path, enc)
+    if len(set(names)) != len(names):
+        dup = next(n for n in names if names.count(n) > 1)
+        raise RecordingError("column name appears twice in the header", file=file, column=dup)
+    kind_, mapping = resolve_columns(names, columns=columns, kind=kind, file=file)
+    canon = list(mapping)
+    idx = [names.index(mapping[c]) for c in canon]
+    first_data = header_line + 1
+    comma = has_decimal_comma(path, delim, first_data, enc)
+    units = {c: split_name(mapping[c])[1] for c in canon}
+    meta = {
+        "format": "csv",
+        "comments": comments,
+        "delimiter": delim or "whitespace",
+        "decimal": "," if comma else ".",
+        "encoding": enc,
+    }
+
+    def row_of(i: int) -> int:
+        return line_of_sample(path, first_data, i, enc)
+
+    fin0 = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, row_of=row_of, meta=meta)
+
+    def gen() -> Iterator[Recording]:
+        fin = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, row_of=row_of, meta=meta)
+        offset = 0
+        with open(path, encoding=enc, errors="strict", newline="") as fh:
+            try:
+                for _ in itertools.islice(fh, first_data):
+                    pass
+                while True:
+                    lines = list(itertools.islice(fh, chunk))
+                    if not lines:
+                        break
+                    try:
+                        with warnings.catch_warnings():
+                            warnings.filterwarnings("ignore", message="loadtxt: input contained")
+                            block = np.loadtxt(
+                                lines,
+                                delimiter=delim,
+                                usecols=idx,
+                                ndmin=2,
+                                comments="#",
+                                dtype=np.float64,
+                                quotechar='"',
+                                converters=(lambda v: float(v.replace(",", ".")))
+                                if comma
+                                else None,
+                            )
+                    except ValueError:
+                        raise locate_bad_cell(
+                            path, delim, first_data, idx, names, comma, enc
+                        ) from None
+                    if block.shape[0] == 0:
+                        continue
+                    raw = {c: np.ascontiguousarray(block[:, j]) for j, c in enumerate(canon)}
+                    yield fin(raw, offset)
+                    offset += block.shape[0]
+            except UnicodeDecodeError as exc:
+                raise RecordingError(
+                    f"byte {exc.object[exc.start : exc.start + 1]!r} is not {enc} text; save "
+                    "the file as UTF-8",
+                    file=file,
+                ) from None
+        if offset == 0:
+            raise RecordingError("header but no data rows", file=file)
+
+    return ChunkedRecording(file, kind_, fin0.units, mapping, None, fin0.meta, gen)
+
+
+def _whole_chunks(rec: Recording, chunk: int) -> ChunkedRecording:
+    n = len(rec)
+
+    def gen() -> Iterator[Recording]:
+        for a in range(0, n, chunk):
+            b = min(a + chunk, n)
+            data = {k: v[a:b] for k, v in rec.data.items()}
+            yield Recording(rec.t[a:b], data, dict(rec.units), rec.source, dict(rec.meta, offset=a))
+
+    return ChunkedRecording(
+        rec.source,
+        rec.kind,
+        dict(rec.units),
+        dict(rec.meta.get("columns", {})),
+        n,
+        dict(rec.meta),
+        gen,
+    )
+
+
+def read_chunks(
+    path: str | Path | Recording,
+    *,
+    chunk_size: int = DEFAULT_CHUNK,
+    columns: dict[str, str] | None = None,
+    kind: str | None = None,
+    fs: float | None = None,
+    format: str | None = None,
+) -> ChunkedRecording:
+    """Open a recording for reading in chunks of at most ``chunk_size`` samples.
+
+    Parameters are those of :func:`contactlab.io.read_recording`; a :class:`Recording` (already
+    in memory) is handed out in chunks too. Column resolution and units are checked at once,
+    the data as the chunks are read.
+
+    Returns
+    -------
+    ChunkedRecording
+        Iterable (again and again) of :class:`Recording` chunks with ``meta["offset"]``.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "run.csv"
+    >>> _ = p.write_text("t [ms],x [um],F [N]\\n" + "".join(f"{i},{i},0\\n" for i in range(5)))
+    >>> [len(c) for c in read_chunks(p, chunk_size=2)]
+    [2, 2, 1]
+    """
+    chunk = _check_chunk_size(chunk_size)
+    if isinstance(path, Recording):
+        return _whole_chunks(path, chunk)
+    p = Path(path)
+    fmt = format_of(p, format)
+    if fmt == "csv":
+        return _csv_chunks(p, columns=columns, kind=kind, fs=fs, chunk=chunk)
+    if fmt == "tdms":
+        return _tdms_chunks(p, columns=columns, kind=kind, fs=fs, chunk=chunk)
+    if fmt == "hdf5":
+        return _h5_chunks(p, "hdf5", columns=columns, kind=kind, fs=fs, chunk=chunk)
+    if content_format(p) == "mat73":
+        return _h5_chunks(p, "mat73", columns=columns, kind=kind, fs=fs, chunk=chunk)
+    from .mat import read_mat
+
+    return _whole_chunks(read_mat(p, columns=columns, kind=kind, fs=fs), chunk)
+
+
+__all__ = ["DEFAULT_CHUNK", "ChunkedRecording", "read_chunks"]

@@ -1,0 +1,639 @@
+"""Tracking a joint over a long recording: the fitted quantities window by window.
+
+An endurance, fretting or wear test runs for 10⁴..10⁶ cycles, and the question is how the
+joint changes. :func:`track` reads the recording in chunks (:func:`contactlab.io.read_chunks`)
+and cuts it into windows of N cycles or T seconds (cut at upward crossings of the drive, so
+every window holds whole cycles), analyses each window as the whole-recording analyses do and
+keeps only the results:
+
+- tangential windows: :func:`contactlab.tangential.analyze_tangential` — h0, ac (None where
+  the analysis finds them not separately identifiable; ``h0_ac`` always), energy per cycle
+  analytic and numeric, c_e·ω (eq. 17), k_local0 (eq. 18), k_global (eq. 19), amplitude and
+  force offset, each with its standard error;
+- normal windows: :func:`contactlab.normal.analyze_loop` — E_d (with its standard error from
+  the cycle-to-cycle scatter), ψ (eq. 7), ψ_KV (eq. 3), k_tan (eq. 4), k_sec (eq. 5) and the
+  loading, unloading and centre polynomials of eq. 1;
+- every cycle of the record (:mod:`._cycles`): loop energy ∮F dx, amplitude, offset.
+
+Memory holds one chunk and one window, whatever the length of the record.
+:meth:`TrackResult.combined` pools the windows (inverse-variance weights, widened by the
+Birge ratio when the windows scatter more than their errors say): the whole-record result of a
+streamed analysis.
+"""
+
+from __future__ import annotations
+
+import csv
+import functools
+import io
+import json
+import math
+import re
+from collections import deque
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import ContactLabError, ContactLabWarning, InputError
+from ..io import DEFAULT_CHUNK, Recording, read_chunks
+from ..io.units import UnknownUnitError, to_si
+from ._cycles import MIN_BLOCK, CycleState, block_cycles
+from .columns import CYCLE_UNITS
+
+#: tangential quantities tracked per window (each with ``*_stderr``)
+TANGENTIAL_QUANTITIES = (
+    "h0",
+    "ac",
+    "h0_ac",
+    "energy_per_cycle",
+    "energy_per_cycle_numeric",
+    "equivalent_damping",
+    "k_local0",
+    "k_global",
+    "amplitude",
+    "offset",
+)
+#: normal quantities tracked per window (``E_d`` with ``E_d_stderr``)
+NORMAL_QUANTITIES = ("E_d", "psi", "psi_kv", "k_tan", "k_sec", "delta_max", "delta_min", "p0", "pa")
+#: fewest cycles in a window: N crossing-to-crossing cycles hold N - 1 complete peak-to-peak
+#: cycles, and the window analyses average at least 2 of those
+MIN_CYCLES = 3
+#: default upper bound on a window's samples (one window is held in memory)
+MAX_WINDOW = 2_000_000
+#: samples per window for ``every="auto"`` (the analysis' samples/s is best near this size)
+AUTO_WINDOW = 1 << 19
+
+_EVERY = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?\d+)?)\s*([A-Za-zµμ]*)\s*$")
+
+
+def parse_every(every: str | float | int) -> tuple[str, float]:
+    """``"100cycles"`` → ``("cycles", 100)``, ``"10s"``/``"2min"``/``"500 ms"`` →
+    ``("time", seconds)``, ``"auto"`` → ``("auto", 0)`` (whole cycles, about
+    :data:`AUTO_WINDOW` samples per window). A bare number counts cycles."""
+    if isinstance(every, str) and every.strip().lower() == "auto":
+        return "auto", 0.0
+    if isinstance(every, (int, float)) and not isinstance(every, bool):
+        text = f"{every}cycles"
+    elif isinstance(every, str):
+        text = every
+    else:
+        raise InputError(f"every must be e.g. '100cycles' or '10s', got {every!r}")
+    m = _EVERY.match(text)
+    if not m:
+        raise InputError(f"every={every!r}: give a number and a unit, e.g. '100cycles' or '10s'")
+    value, unit = float(m.group(1)), m.group(2).lower()
+    if unit in ("", "cycle", "cycles", "cyc", "c"):
+        if value < MIN_CYCLES or value != int(value):
+            raise InputError(
+                f"every={every!r}: a window needs a whole number >= {MIN_CYCLES} of cycles"
+            )
+        return "cycles", float(int(value))
+    factors = {"min": 60.0, "h": 3600.0}
+    if unit in factors:
+        seconds = value * factors[unit]
+    else:
+        try:
+            factor, dim = to_si(unit)
+        except UnknownUnitError:
+            dim, factor = "", 0.0
+        if dim != "time":
+            raise InputError(f"every={every!r}: {unit!r} is neither 'cycles' nor a time unit")
+        seconds = value * factor
+    if not seconds > 0:
+        raise InputError(f"every={every!r}: a window must last > 0 s")
+    return "time", seconds
+
+
+@dataclass
+class TrackResult:
+    """Quantities per window of a long recording, and per cycle over the whole record.
+
+    Attributes
+    ----------
+    source : str
+        The recording.
+    kind : str
+        ``"tangential"`` or ``"normal"``.
+    every : str
+        The window length asked for.
+    rows : list of dict
+        One per window: ``window``, ``t_start``, ``t_end``, ``t_mid`` (s), ``cycle_start``,
+        ``cycle_end`` (complete cycles before the window's ends), ``n_samples``, then the
+        analysis' quantities in SI with ``*_stderr``; ``error`` when a window could not be
+        analysed.
+    units : dict
+        SI unit of every column.
+    cycles : dict of str to ndarray
+        Per cycle: ``start``, ``end`` (s), ``energy`` (J, or J/m² for normal),
+        ``amplitude`` (m), ``offset`` (N or Pa).
+    meta : dict
+        Samples read, windows analysed, tail left out.
+    """
+
+    source: str
+    kind: str
+    every: str
+    rows: list[dict[str, Any]]
+    units: dict[str, str]
+    cycles: dict[str, np.ndarray]
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def quantities(self) -> list[str]:
+        """The tracked quantities present (those with a value in some window)."""
+        names = TANGENTIAL_QUANTITIES if self.kind == "tangential" else NORMAL_QUANTITIES
+        extra = [c for c in self.columns() if c.startswith("poly_") and "stderr" not in c]
+        return [q for q in (*names, *extra) if any(_finite(r.get(q)) for r in self.rows)]
+
+    def column(self, name: str) -> np.ndarray:
+        """One column over the windows as floats (None → NaN)."""
+        return np.array([_as_float(r.get(name)) for r in self.rows], dtype=float)
+
+    def columns(self) -> list[str]:
+        cols: list[str] = []
+        for r in self.rows:
+            cols.extend(k for k in r if k not in cols)
+        return cols
+
+    def combined(self) -> dict[str, Any]:
+        """The windows pooled into one whole-record result.
+
+        Each quantity with a standard error is the inverse-variance weighted mean over the
+        windows that determine it; its ``*_stderr`` is ``1/sqrt(Σ w)`` times the Birge ratio
+        ``sqrt(χ²/(n-1))`` when that exceeds 1 (windows scattering beyond their errors: the
+        joint changed, or the errors are optimistic). ``*_birge`` gives the ratio. A quantity
+        the window analysis gives no error for (ψ, k_tan, ... of normal loops) is the plain
+        mean over the windows with the standard error of that mean.
+        """
+        out: dict[str, Any] = {"n_windows": len(self.rows)}
+        for q in self.quantities:
+            v, s = self.column(q), self.column(f"{q}_stderr")
+            ok = np.isfinite(v) & np.isfinite(s) & (s > 0)
+            if not ok.any():
+                # no standard error per window: the mean of the windows and its error from
+                # their scatter
+                fin = v[np.isfinite(v)]
+                if fin.size:
+                    out[q] = float(np.mean(fin))
+                    out[f"{q}_stderr"] = (
+                        float(np.std(fin, ddof=1) / math.sqrt(fin.size))
+                        if fin.size > 1
+                        else float("nan")
+                    )
+                continue
+            w = 1.0 / s[ok] ** 2
+            mean = float(np.sum(w * v[ok]) / np.sum(w))
+            err = float(1.0 / math.sqrt(np.sum(w)))
+            birge = 1.0
+            if ok.sum() > 1:
+                chi2 = float(np.sum(w * (v[ok] - mean) ** 2))
+                birge = math.sqrt(chi2 / (ok.sum() - 1))
+            out[q] = mean
+            out[f"{q}_stderr"] = err * max(birge, 1.0)
+            out[f"{q}_birge"] = birge
+        e = self.cycles.get("energy")
+        if e is not None and e.size:
+            out["n_cycles"] = int(e.size)
+            out["cycle_energy_mean"] = float(np.mean(e))
+            out["cycle_energy_std"] = float(np.std(e, ddof=1)) if e.size > 1 else float("nan")
+        return out
+
+    def to_dict(self, *, cycles: bool = True) -> dict[str, Any]:
+        """JSON-ready: ``windows`` (rows), ``combined``, ``cycles`` (arrays), ``units``."""
+        cu = CYCLE_UNITS[self.kind]
+        comb = self.combined()
+        units = dict(self.units)
+        for k in list(comb):
+            base = k.removesuffix("_stderr")
+            if base in self.units:
+                units.setdefault(k, self.units[base])
+        d: dict[str, Any] = {
+            "source": self.source,
+            "kind": self.kind,
+            "every": self.every,
+            "windows": self.rows,
+            "combined": comb,
+            "units": units,
+            "cycle_units": dict(cu),
+            "meta": self.meta,
+        }
+        if cycles:
+            d["cycles"] = {k: v.tolist() for k, v in self.cycles.items()}
+        return d
+
+    def to_csv(self) -> str:
+        """The window table as CSV; header cells carry SI units (``h0 [N]``)."""
+        cols = self.columns()
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow([f"{c} [{self.units[c]}]" if self.units.get(c) else c for c in cols])
+        for r in self.rows:
+            w.writerow(
+                [
+                    "" if r.get(c) is None else repr(r[c]) if isinstance(r[c], float) else str(r[c])
+                    for c in cols
+                ]
+            )
+        return buf.getvalue()
+
+    def cycles_csv(self) -> str:
+        """The per-cycle table as CSV (``cycle, start [s], end [s], energy [J], ...``)."""
+        cu = CYCLE_UNITS[self.kind]
+        names = list(self.cycles)
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(["cycle", *(f"{k} [{cu[k]}]" for k in names)])
+        cols = [self.cycles[k] for k in names]
+        for i in range(cols[0].size if cols else 0):
+            w.writerow([i + 1, *(repr(float(c[i])) for c in cols)])
+        return buf.getvalue()
+
+    def plot(self, name: str, *, against: str = "time", ax: Any = None) -> Any:
+        """``name`` (with error bars when it has a standard error) against window mid time
+        (``against="time"``) or cycle count (``"cycle"``); returns the axes."""
+        from .track_plots import plot_quantity
+
+        return plot_quantity(self, name, against=against, ax=ax)
+
+    def __repr__(self) -> str:
+        return (
+            f"TrackResult({self.source!r}, {self.kind}, every={self.every!r}, "
+            f"{len(self.rows)} windows, {self.cycles['energy'].size} cycles)"
+        )
+
+
+def _finite(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _as_float(v: Any) -> float:
+    return float(v) if _finite(v) else float("nan")
+
+
+def _tangential_window(rec: Recording, options: Mapping[str, Any]) -> tuple[dict, dict]:
+    from ..tangential import analyze_tangential
+
+    res = analyze_tangential(rec, **{"warn": False, **dict(options)})
+    d = res.to_dict()
+    row: dict[str, Any] = {}
+    for q in TANGENTIAL_QUANTITIES:
+        row[q] = d.get(q)
+        row[f"{q}_stderr"] = d.get(f"{q}_stderr")
+    row["identifiable"] = bool(res.identifiable)
+    row["n_cycles"] = d.get("n_cycles")
+    row["warnings"] = " | ".join(res.warnings)
+    units = {k: v for k, v in d.get("units", {}).items() if k in row}
+    return row, units
+
+
+def _normal_window(rec: Recording, options: Mapping[str, Any]) -> tuple[dict, dict]:
+    import warnings
+
+    from ..normal import analyze_loop
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ContactLabWarning)
+        res = analyze_loop(rec.t, rec["p"], rec["delta"], **dict(options))
+    d = res.to_dict()
+    du = d.get("units", {})
+    row: dict[str, Any] = {}
+    units: dict[str, str] = {}
+    for q in NORMAL_QUANTITIES:
+        row[q] = d.get(q)
+        if q in du:
+            units[q] = du[q]
+    n, e_std = int(d.get("n_cycles") or 0), d.get("E_d_cycle_std")
+    row["E_d_stderr"] = e_std / math.sqrt(n) if n > 1 and _finite(e_std) else None
+    units["E_d_stderr"] = du.get("E_d", "J/m^2")
+    from .study import coefficient_unit
+
+    for key in ("poly_load", "poly_unload", "poly_centre"):
+        for i, c in enumerate(d.get(key) or []):
+            row[f"{key}_{i}"] = float(c)
+            units[f"{key}_{i}"] = coefficient_unit(du.get(key, ""), i)
+    row["n_cycles"] = n
+    row["warnings"] = " | ".join(
+        str(w.message) for w in caught if issubclass(w.category, ContactLabWarning)
+    )
+    return row, units
+
+
+class _Windows:
+    """Pieces of the stream not yet handed to a window, by global sample index."""
+
+    def __init__(self) -> None:
+        self.pieces: list[Recording] = []
+        self.start = 0  # global index of the first sample kept
+        self.n = 0
+
+    def add(self, rec: Recording) -> None:
+        self.pieces.append(rec)
+        self.n += len(rec)
+
+    def take(self, stop: int) -> Recording:
+        """Samples ``[start, stop)`` as one recording; they are dropped from the buffer.
+
+        Only the window's pieces are copied (joined); the rest of a split piece stays a view,
+        so cutting many short windows out of one long block costs no more than the block.
+        """
+        need = stop - self.start
+        parts: list[Recording] = []
+        while need > 0:
+            p = self.pieces[0]
+            if len(p) <= need:
+                parts.append(self.pieces.pop(0))
+                need -= len(p)
+            else:
+                parts.append(_part(p, 0, need))
+                self.pieces[0] = _part(p, need, len(p))
+                need = 0
+        rec = _join(parts)
+        self.n -= stop - self.start
+        self.start = stop
+        return Recording(
+            rec.t, rec.data, rec.units, rec.source, dict(rec.meta, offset=stop - len(rec))
+        )
+
+
+def _part(rec: Recording, a: int, b: int) -> Recording:
+    """Samples ``a:b`` of ``rec`` as views (no copy)."""
+    off = int(rec.meta.get("offset", 0))
+    data = {c: v[a:b] for c, v in rec.data.items()}
+    return Recording(rec.t[a:b], data, rec.units, rec.source, dict(rec.meta, offset=off + a))
+
+
+def _blocks(chunks: Iterator[Recording], min_block: int) -> Iterator[Recording]:
+    """Chunks joined until each holds at least ``min_block`` samples (the last may be short)."""
+    buf: list[Recording] = []
+    size = 0
+    for c in chunks:
+        buf.append(c)
+        size += len(c)
+        if size >= min_block:
+            yield _join(buf)
+            buf, size = [], 0
+    if buf:
+        yield _join(buf)
+
+
+def _join(parts: list[Recording]) -> Recording:
+    if len(parts) == 1:
+        return parts[0]
+    first = parts[0]
+    t = np.concatenate([p.t for p in parts])
+    data = {c: np.concatenate([p.data[c] for p in parts]) for c in first.data}
+    return Recording(t, data, dict(first.units), first.source, dict(first.meta))
+
+
+def track(
+    source: str | Path | Recording,
+    every: str | float = "100cycles",
+    *,
+    kind: str | None = None,
+    columns: dict[str, str] | None = None,
+    fs: float | None = None,
+    chunk_size: int = DEFAULT_CHUNK,
+    max_window: int = MAX_WINDOW,
+    options: Mapping[str, Any] | None = None,
+    keep_going: bool = True,
+    callback: Callable[[dict[str, Any]], None] | None = None,
+    executor: Any = None,
+) -> TrackResult:
+    """Fitted quantities of a long recording window by window, in bounded memory.
+
+    Parameters
+    ----------
+    source : path or Recording
+        A recording file (CSV/TDMS/HDF5/MAT, read in chunks) or a :class:`Recording`.
+    every : str or number
+        Window length: ``"100cycles"`` (a bare number counts cycles), or a time such as
+        ``"10s"``, ``"500ms"``, ``"2min"``, or ``"auto"`` (whole cycles, about
+        :data:`AUTO_WINDOW` samples). Windows are cut at upward crossings of the drive
+        (``x`` or ``p``), so they hold whole cycles; the first also holds the lead-in before
+        the first crossing, and a last, shorter window is analysed when it has >= 3 cycles.
+    kind, columns, fs
+        As for :func:`contactlab.io.read_recording`.
+    chunk_size : int
+        Samples read at a time.
+    max_window : int
+        Refuse windows longer than this many samples (one window is held in memory).
+    options : mapping, optional
+        Keyword arguments of the per-window analysis (``analyze_tangential`` or
+        ``normal.analyze_loop``).
+    keep_going : bool
+        A window the analysis cannot fit gets a row with ``error`` (default) instead of
+        stopping the run. Errors of the file itself always stop it.
+    callback : callable, optional
+        Called with each window's row as it completes (progress).
+    executor : optional
+        Analyse windows in parallel on a ``concurrent.futures`` executor or a Dask
+        ``distributed.Client`` while the file is read on; at most two windows per worker are
+        held. The rows equal those of a serial run.
+
+    Returns
+    -------
+    TrackResult
+
+    Examples
+    --------
+    >>> from contactlab.tangential import synthetic_recording
+    >>> rec = synthetic_recording(h0=40.0, ac=4e4, amplitude=20e-6, n_cycles=12, fs=2000.0,
+    ...                           noise=0.01, seed=2)
+    >>> res = track(rec, every="4cycles")  # 10 complete cycles: 4 + 4, and a 2-cycle tail
+    >>> len(res.rows), res.cycles["energy"].size, res.rows[-1]["cycle_end"]
+    (2, 10, 8)
+    >>> bool(abs(res.combined()["h0"] - 40.0) < 4 * res.combined()["h0_stderr"])
+    True
+    """
+    mode, size = parse_every(every)
+    every_text = every if isinstance(every, str) else f"{every}cycles"
+    if not (isinstance(max_window, int) and max_window >= 16):
+        raise InputError(f"max_window must be an integer >= 16, got {max_window!r}")
+    cr = read_chunks(source, chunk_size=chunk_size, columns=columns, kind=kind, fs=fs)
+    kind_ = cr.kind
+    if kind_ not in ("tangential", "normal"):
+        raise InputError(f"{cr.source}: cannot tell the kind of recording; pass kind=")
+    loop_x, loop_F, drive = ("x", "F", "x") if kind_ == "tangential" else ("delta", "p", "p")
+    analyse = _tangential_window if kind_ == "tangential" else _normal_window
+    opts = dict(options or {})
+
+    state = CycleState()
+    cyc: dict[str, list[np.ndarray]] = {
+        k: [] for k in ("start", "end", "energy", "amplitude", "offset")
+    }
+    rows: list[dict[str, Any]] = []
+    units: dict[str, str] = {"t_start": "s", "t_end": "s", "t_mid": "s"}
+    buf = _Windows()
+    n_cross = 0  # crossings so far
+    cycles_at_start = 0  # complete cycles before the current window
+    next_cross_target = int(size) if mode == "cycles" else None
+    first_crossings: list[int] = []
+    window_t0: float | None = None
+    crossings_in_window = 0
+    n_total = 0
+
+    from .executor import n_workers
+
+    in_flight: deque[tuple[dict[str, Any], Any]] = deque()
+    limit = 2 * n_workers(executor)
+    dask = executor is not None and type(executor).__module__.split(".")[0] == "distributed"
+
+    def collect(row: dict[str, Any], job: Any) -> None:
+        try:
+            values, u = job() if executor is None else job.result()
+        except ContactLabError as exc:
+            if not keep_going:
+                raise
+            values, u = {"error": f"window {row['window']}: {exc}"}, {}
+        row.update(values)
+        units.update(u)
+        if callback is not None:
+            callback(row)
+
+    def emit(stop: int, n_cycles_before_stop: int) -> None:
+        nonlocal cycles_at_start
+        rec = buf.take(stop)
+        row: dict[str, Any] = {
+            "window": len(rows) + 1,
+            "t_start": float(rec.t[0]),
+            "t_end": float(rec.t[-1]),
+            "t_mid": 0.5 * float(rec.t[0] + rec.t[-1]),
+            "cycle_start": cycles_at_start,
+            "cycle_end": n_cycles_before_stop,
+            "n_samples": len(rec),
+        }
+        rows.append(row)
+        cycles_at_start = n_cycles_before_stop
+        if executor is None:
+            collect(row, functools.partial(analyse, rec, opts))
+            return
+        fut = (
+            executor.submit(analyse, rec, opts, pure=False)
+            if dask
+            else executor.submit(analyse, rec, opts)
+        )
+        in_flight.append((row, fut))
+        while len(in_flight) >= limit:
+            collect(*in_flight.popleft())
+
+    try:
+        for block in _blocks(iter(cr), MIN_BLOCK):
+            off = int(block.meta.get("offset", n_total))
+            buf.add(block)
+            n_total = off + len(block)
+            got = block_cycles(block.t, block[loop_x], block[loop_F], block[drive], off, state)
+            for k in cyc:
+                cyc[k].append(np.asarray(getattr(got, k), dtype=float))
+            if window_t0 is None:
+                window_t0 = float(block.t[0])
+            if mode == "auto":
+                first_crossings.extend(got.crossings[:64].tolist())
+                if len(first_crossings) >= 3:
+                    per_cycle = float(np.median(np.diff(first_crossings)))
+                    size = float(max(MIN_CYCLES + 1, round(AUTO_WINDOW / per_cycle)))
+                    mode, next_cross_target = "cycles", int(size)
+            for g in got.crossings.tolist():
+                n_cross += 1
+                crossings_in_window += 1
+                # complete cycles before crossing g: crossings so far minus the first one
+                done = n_cross - 1
+                if mode == "auto":
+                    cut = False
+                elif mode == "cycles":
+                    assert next_cross_target is not None
+                    cut = n_cross == next_cross_target + 1
+                    if cut:
+                        next_cross_target += int(size)
+                else:
+                    t_g = float(block.t[g - off])
+                    cut = t_g - window_t0 >= size and crossings_in_window > MIN_CYCLES
+                if cut:
+                    emit(g, done)
+                    window_t0 = float(block.t[g - off])
+                    crossings_in_window = 1
+            if buf.n > max_window:  # the open window (cut windows have left the buffer)
+                raise InputError(
+                    f"{cr.source}: a window of every={every_text!r} holds more than "
+                    f"{max_window} samples; choose a shorter window (or raise max_window)"
+                )
+        # the tail: analysed when it holds MIN_CYCLES complete cycles
+        tail = buf.n
+        if tail and crossings_in_window > MIN_CYCLES:
+            emit(n_total, max(n_cross - 1, 0))
+            tail = 0
+        while in_flight:
+            collect(*in_flight.popleft())
+    finally:
+        for _row, fut in in_flight:
+            fut.cancel()
+    if not rows:
+        raise InputError(
+            f"{cr.source}: found {max(n_cross - 1, 0)} complete cycle(s) in {n_total} samples; "
+            f"tracking needs windows of at least {MIN_CYCLES} cycles"
+        )
+    cycles = {k: (np.concatenate(v) if v else np.empty(0)) for k, v in cyc.items()}
+    meta = {
+        "n_samples": n_total,
+        "n_windows": len(rows),
+        "tail_samples_left_out": tail,
+        "chunk_size": chunk_size,
+        "every_mode": mode,
+        "every_value": size,
+    }
+    return TrackResult(cr.source, kind_, every_text, rows, units, cycles, meta)
+
+
+def track_many(
+    sources: Sequence[str | Path | Recording],
+    every: str | float = "100cycles",
+    *,
+    executor: Any = None,
+    **options: Any,
+) -> Iterator[TrackResult]:
+    """:func:`track` over many recordings, in order, optionally on ``executor`` (a
+    ``concurrent.futures`` executor or a Dask ``distributed.Client``; see
+    :mod:`contactlab.studies.executor`). A generator: each result can be saved and dropped
+    before the next arrives, so thousands of long recordings fit in memory.
+
+    ``options`` go to :func:`track`. Results equal those of a serial run.
+
+    Examples
+    --------
+    >>> from concurrent.futures import ThreadPoolExecutor
+    >>> from contactlab.tangential import synthetic_recording
+    >>> recs = [synthetic_recording(h0=40.0, ac=4e4, amplitude=20e-6, n_cycles=8, fs=1000.0,
+    ...                             noise=0.01, seed=s) for s in (1, 2)]
+    >>> with ThreadPoolExecutor(2) as ex:
+    ...     [len(r.rows) for r in track_many(recs, "3cycles", executor=ex)]
+    [2, 2]
+    """
+    from .executor import ordered_map
+
+    parse_every(every)  # a bad window length fails before anything is submitted
+    task = functools.partial(track, every=every, **options)
+    yield from ordered_map(task, list(sources), executor)
+
+
+def track_json(result: TrackResult, *, cycles: bool = True) -> str:
+    """The result as JSON text (NaN → null)."""
+    from ..commands._common import jsonable
+
+    return json.dumps(jsonable(result.to_dict(cycles=cycles)), indent=1, allow_nan=False) + "\n"
+
+
+__all__ = [
+    "AUTO_WINDOW",
+    "CYCLE_UNITS",
+    "MAX_WINDOW",
+    "MIN_CYCLES",
+    "NORMAL_QUANTITIES",
+    "TANGENTIAL_QUANTITIES",
+    "TrackResult",
+    "parse_every",
+    "track",
+    "track_json",
+    "track_many",
+]

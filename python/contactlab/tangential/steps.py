@@ -1,0 +1,617 @@
+"""The named steps of :func:`contactlab.tangential.analyze_tangential`, each testable alone.
+
+The analysis (*Experimental investigation of tangential contact stiffness and equivalent
+damping*: averaged loops, eq. 1/6 fitted; PHYSICS.md §1) runs
+
+1. :func:`detrend` — period averaging and removal of linear force/displacement drifts;
+2. :func:`fit_data` — what the fit sees (averaged bins or samples, monotone path, turns);
+3. :func:`start_values` — starting parameters from the loop's size and area;
+4. :class:`Residuals` + :func:`fit` — the weighted residuals (errors in variables, the
+   displacement channel's own measurement of the turning points) and the fits;
+5. :func:`drift_covariance`, :func:`turn_covariance`, :func:`fixed_amplitude_covariance` —
+   the errors of inputs the fit took as exact, carried into the covariance through the fit's
+   linear response ``G = -(JᵀJ)⁻¹Jᵀ ∂r/∂u`` (``cov += G Σ_u Gᵀ``);
+6. :func:`amplitude_estimate` — the amplitude and its error.
+
+Identifiability, derived quantities and warnings are in :mod:`.regime` and :mod:`.analysis`.
+Perturbations of the inputs (for the covariance terms) are explicit keyword arguments of
+:meth:`Residuals.residual`, never hidden state.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from ..fitting import FitResult, Parameter, add_covariance, least_squares_fit
+from ..masing import Masing, loop_area
+from .model import (
+    initial_guess,
+    steady_loop_force,
+    steady_signal_force,
+    turn_nodes,
+    virgin_signal_force,
+)
+from .preprocess import AveragedLoop, Reversals, average_loop, find_reversals, monotone_path
+from .turns import VirginTurns, turning_point_prior, virgin_amplitude, virgin_nodes
+from .uncertainty import path_slope, trend, x_noise_var
+
+
+def model_of(v: dict[str, float]) -> Masing:
+    """The Masing model of a parameter set in the fit's parametrisation ``(k0, ac)``."""
+    return Masing(v["k0"] / v["ac"], v["ac"])
+
+
+# -- 1. averaging and drift --------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Drift:
+    """Linear drifts removed before the fit (``(slope, stderr)`` per channel) and the time
+    axis they were removed on (``t - t_mid``)."""
+
+    force: tuple[float, float]
+    displacement: tuple[float, float]
+    tt: np.ndarray
+    t_mid: float
+
+
+@dataclass(frozen=True)
+class Detrended:
+    x: np.ndarray
+    F: np.ndarray
+    loop: AveragedLoop | None
+    drift: Drift | None
+
+    @property
+    def force_drift(self) -> tuple[float, float]:
+        return self.drift.force if self.drift is not None else (0.0, 0.0)
+
+    @property
+    def displacement_drift(self) -> tuple[float, float]:
+        return self.drift.displacement if self.drift is not None else (0.0, 0.0)
+
+
+def detrend(
+    x: np.ndarray,
+    F: np.ndarray,
+    t: np.ndarray | None,
+    *,
+    on: str,
+    enabled: bool,
+    n_points: int | None,
+    rel_threshold: float,
+    min_cycles: int,
+) -> Detrended:
+    """Average the loop; with ``enabled`` and ≥ 3 cycles remove the linear force and
+    displacement drifts seen in the per-cycle means and average again.
+
+    A whole-signal fit (``on="signal"``) goes on without an averaged loop when there are too
+    few cycles; an averaged fit then raises :class:`InputError`.
+    """
+    loop: AveragedLoop | None = None
+    try:
+        loop = average_loop(
+            x, F, t, n_points=n_points, rel_threshold=rel_threshold, min_cycles=min_cycles
+        )
+    except InputError:
+        if on == "averaged":
+            raise
+    if not (enabled and loop is not None and loop.n_cycles >= 3):
+        return Detrended(x, F, loop, None)
+    # Slow sensor drift shows as a trend in the per-cycle means (a steady loop has the same
+    # mean force and displacement every cycle). Remove both and average again.
+    sc = loop.scatter
+    tt = t if t is not None else np.arange(x.size, dtype=float)
+    tm = float(np.mean(sc.time))
+    f_drift = trend(sc.time, sc.mean_force)
+    F = F - f_drift[0] * (tt - tm)
+    x_drift = (0.0, 0.0)
+    if sc.mean_x is not None:
+        x_drift = trend(sc.time, sc.mean_x)
+        x = x - x_drift[0] * (tt - tm)
+    loop = average_loop(
+        x, F, t, n_points=n_points, rel_threshold=rel_threshold, min_cycles=min_cycles
+    )
+    return Detrended(x, F, loop, Drift(f_drift, x_drift, tt, tm))
+
+
+# -- 2. the data the fit sees ------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class FitData:
+    """Data of the fit: ``xd, Fd`` (averaged bins or samples) with base weights ``w``, the
+    noise-free monotone path ``xpath`` fed to the operator, the fitted stretch ``start:stop``
+    and what the model needs about the turns."""
+
+    on: str
+    steady: bool
+    x: np.ndarray  # the whole (detrended) displacement signal
+    F: np.ndarray
+    t: np.ndarray | None
+    loop: AveragedLoop | None
+    xd: np.ndarray
+    Fd: np.ndarray
+    w: np.ndarray
+    td: np.ndarray | None
+    xpath: np.ndarray
+    rev: Reversals
+    start: int
+    stop: int | None
+    bin_var: np.ndarray | None
+    nodes: tuple[np.ndarray, ...] | None
+    measured: VirginTurns | None
+    amplitude0: float
+    centre0: float
+
+    @property
+    def sl(self) -> slice:
+        return slice(self.start, self.stop)
+
+    @property
+    def vnodes(self) -> VirginTurns | None:
+        """Turn values a virgin-history fit holds fixed."""
+        return None if self.steady else self.measured
+
+
+def _bin_var(loop: AveragedLoop) -> np.ndarray | None:
+    if loop.x_var is None or loop.n_cycles <= 1:
+        return None
+    # spread of the true x inside a bin: the samples' spread less the sensor noise
+    s2x = float(np.nanmean(loop.x_std**2 * loop.count / loop.n_cycles))
+    return np.clip(loop.x_var - s2x, 0.0, None)
+
+
+def _virgin_stop(rev: Reversals) -> int | None:
+    # An unconfirmed last extreme (no centre crossing after it) has no measured turn: the
+    # projected path's extreme there is the most outlying noisy sample, and every sample
+    # after it would follow a branch started from that outlier. The operator is causal, so
+    # dropping those samples leaves the rest of the fit exact.
+    confirmed = np.r_[rev.peaks, rev.valleys]
+    late = rev.edges[rev.edges > (confirmed.max() if confirmed.size else 0)]
+    return int(late[-1]) if late.size else None
+
+
+def fit_data(
+    det: Detrended, t: np.ndarray | None, *, on: str, steady: bool, rel_threshold: float
+) -> FitData:
+    """Step 2: the averaged loop's bins (``on="averaged"``) or every sample, the monotone
+    path between the turns, and the fitted stretch (a steady fit starts at the first turn,
+    a virgin-history fit stops at its last confirmed one)."""
+    xa, Fa, loop = det.x, det.F, det.loop
+    bin_var = None
+    if on == "averaged":
+        if loop is None:
+            raise InputError("an averaged fit needs an averaged loop (at least 2 cycles)")
+        xd, Fd, w, td = loop.x, loop.F, np.sqrt(loop.count), None
+        start = 0
+        xpath = monotone_path(xd, np.array([xd.size // 2]))
+        bin_var = _bin_var(loop)
+        rev = loop.reversals
+    else:
+        rev = (
+            loop.reversals
+            if loop is not None
+            else find_reversals(xa, t, rel_threshold=rel_threshold)
+        )
+        if rev.peaks.size + rev.valleys.size == 0:
+            raise InputError("no reversal found in x: the recording holds no loop")
+        start = rev.first if steady else 0
+        xd, Fd, td = xa, Fa, t
+        w = np.ones(xa.size)
+        xpath = monotone_path(xa, rev.turns)
+    lo_x, hi_x = float(np.min(xpath[start:])), float(np.max(xpath[start:]))
+    amplitude0 = 0.5 * (hi_x - lo_x)
+    if not amplitude0 > 0:
+        raise InputError("the displacement does not move: amplitude is 0")
+    stop = _virgin_stop(rev) if (on == "signal" and not steady) else None
+    # measured turns: the path around each is replaced by its local regression (denoised;
+    # their errors are carried into the covariance); a virgin-history fit also holds the
+    # turns' values, a steady one fits x0 ± A instead
+    measured = virgin_nodes(xa, t, xpath, rev) if on == "signal" else None
+    nodes = turn_nodes(xpath, rev.peaks, rev.valleys) if on == "signal" and steady else None
+    return FitData(
+        on=on,
+        steady=steady,
+        x=xa,
+        F=Fa,
+        t=t,
+        loop=loop,
+        xd=xd,
+        Fd=Fd,
+        w=w,
+        td=td,
+        xpath=xpath,
+        rev=rev,
+        start=start,
+        stop=stop,
+        bin_var=bin_var,
+        nodes=nodes,
+        measured=measured,
+        amplitude0=amplitude0,
+        centre0=0.5 * (hi_x + lo_x),
+    )
+
+
+# -- 3. starting values ------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class StartValues:
+    params: list[Parameter]
+    prior: tuple[float, float, float] | None  # turn regression: (x0, A, σ)
+    half_force_range: float
+
+
+def start_values(
+    data: FitData,
+    *,
+    rel_threshold: float,
+    fit_offset: bool,
+    fit_x0: bool,
+    fit_amplitude: bool,
+    initial: dict[str, float] | None,
+) -> StartValues:
+    """Step 3: ``(k0, ac, offset, x0, A)`` from the loop's half force range and area
+    (:func:`~contactlab.tangential.model.initial_guess`), the turning-point prior of a
+    steady loop, bounds and scales."""
+    xa, Fa, t, loop = data.x, data.F, data.t, data.loop
+    guide = loop
+    if guide is None:  # signal fit of a short recording: one cycle still guides the start
+        try:
+            guide = average_loop(xa, Fa, t, rel_threshold=rel_threshold, min_cycles=1)
+        except InputError:
+            guide = None
+    if guide is not None:
+        hm0 = 0.5 * float(guide.F.max() - guide.F.min())
+        e0 = loop_area(guide.x, guide.F)
+        off0 = 0.5 * float(guide.F.max() + guide.F.min())
+    else:
+        hm0 = 0.5 * float(np.ptp(Fa))
+        e0 = 0.0
+        off0 = float(np.mean(Fa))
+    a0, c0 = data.amplitude0, data.centre0
+    h0_init, ac_init = initial_guess(a0, hm0, e0)
+    if initial:
+        h0_init = float(initial.get("h0", h0_init))
+        ac_init = float(initial.get("ac", ac_init))
+    if not (h0_init > 0 and ac_init > 0):
+        raise InputError(f"initial h0, ac must be > 0, got {h0_init}, {ac_init}")
+    prior = turning_point_prior(loop) if (data.steady and loop is not None) else None
+    # a fixed amplitude comes from the displacement channel's turn regression (the range of
+    # bin means or samples is biased: bins cut the tips, noise widens the extremes)
+    a_fixed = prior[1] if (prior is not None and not fit_amplitude) else a0
+    k0 = h0_init * ac_init
+    params = [
+        Parameter("k0", k0, min=1e-9 * k0, unit="N/m"),
+        Parameter("ac", ac_init, min=1e-9 * ac_init, unit="1/m"),
+        Parameter(
+            "offset", off0 if fit_offset else 0.0, vary=fit_offset, unit="N", scale=max(hm0, 1e-300)
+        ),
+    ]
+    if data.steady:
+        params.append(
+            Parameter("x0", c0, vary=fit_x0, min=c0 - a0, max=c0 + a0, unit="m", scale=a0)
+        )
+        params.append(
+            Parameter(
+                "amplitude",
+                a0 if fit_amplitude else a_fixed,
+                vary=fit_amplitude,
+                min=0.5 * a0,
+                max=1.5 * a0,
+                unit="m",
+            )
+        )
+    else:
+        params.append(Parameter("x0", float(xa[0]), vary=fit_x0, unit="m", scale=max(a0, 1e-300)))
+    return StartValues(params, prior, hm0)
+
+
+# -- 4. residuals and fit ----------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class PriorRows:
+    """The displacement channel's measurement of the turning points as extra residual rows,
+    in the force residuals' units (``scale`` = the first fit's residual scale)."""
+
+    names: tuple[str, ...]
+    x0: float
+    amplitude: float
+    sigma: float
+    scale: float
+
+
+@dataclass(frozen=True)
+class Residuals:
+    """Weighted residuals ``(model - data) · w`` of a parameter set, plus the prior rows.
+
+    The keyword arguments of :meth:`predict` and :meth:`residual` perturb one input (path,
+    fixed turn values, force data, measured turning points): the covariance steps take
+    finite differences with them.
+    """
+
+    data: FitData
+    w: np.ndarray
+    prior: PriorRows | None = None
+
+    def predict(
+        self,
+        v: dict[str, float],
+        *,
+        xp: np.ndarray | None = None,
+        vn: tuple[np.ndarray, np.ndarray] | None = None,
+    ) -> np.ndarray:
+        d = self.data
+        m = model_of(v)
+        xp = d.xpath if xp is None else xp
+        if d.on == "averaged":
+            Fm = steady_loop_force(m, xp, v["x0"], v["amplitude"], d.bin_var)
+        elif d.steady:
+            Fm = steady_signal_force(m, xp, v["x0"], v["amplitude"], d.nodes, d.rev.first_is_peak)
+        else:
+            nd = vn if vn is not None else (None if d.vnodes is None else d.vnodes.nodes)
+            Fm = virgin_signal_force(m, xp, v["x0"], nd)
+        return Fm + v["offset"]
+
+    def residual(
+        self,
+        v: dict[str, float],
+        *,
+        xp: np.ndarray | None = None,
+        vn: tuple[np.ndarray, np.ndarray] | None = None,
+        dF: np.ndarray | None = None,
+        tips: tuple[float, float, float] | None = None,
+    ) -> np.ndarray:
+        d = self.data
+        sl = d.sl
+        Fdat = d.Fd if dF is None else d.Fd + dF
+        r = (self.predict(v, xp=xp, vn=vn)[sl] - Fdat[sl]) * self.w[sl]
+        pr = self.prior
+        if pr is None:
+            return r
+        meas = {"x0": pr.x0, "amplitude": pr.amplitude}
+        if tips is not None:
+            meas = {"x0": tips[0], "amplitude": tips[1]}
+        rows = [(v[k] - meas[k]) / pr.sigma * pr.scale for k in pr.names]
+        return np.concatenate([r, rows])
+
+    def __call__(self, v: dict[str, float]) -> np.ndarray:
+        return self.residual(v)
+
+
+def _restart(params: list[Parameter], raw: FitResult) -> list[Parameter]:
+    """``params`` started from a fit's solution (clipped into their bounds)."""
+    return [replace(p, value=min(max(raw.params[p.name].value, p.min), p.max)) for p in params]
+
+
+def _keep_init(raw: FitResult, params: list[Parameter]) -> None:
+    for p, p0 in zip(raw.params.values(), params, strict=True):
+        p.init_value = p0.value if p0.vary else None
+
+
+def eiv_weights(res: Residuals, raw: FitResult, s2x: float) -> np.ndarray:
+    """Errors-in-variables weights ``sqrt(σF² / (σF² + (k σx)²))`` on the fitted stretch.
+
+    The displacement noise σx moves every sample along its branch, a force error k·σx with
+    the local stiffness k (h0·ac just after a turn, much less further on), heteroscedastic
+    and largest exactly where the loop's shape is decided. σF comes from the unweighted
+    fit's residuals less the part the x noise explains (at least 5 % of them).
+    """
+    d = res.data
+    v1 = raw.values
+    Fm = res.predict(v1)
+    k2 = path_slope(Fm, d.xpath, v1["k0"])[d.sl] ** 2 * s2x
+    r2 = float(np.mean((Fm - d.Fd)[d.sl] ** 2))
+    s2F = max(r2 - float(np.mean(k2)), 0.05 * r2)
+    w = np.ones(d.Fd.size)
+    w[d.sl] = np.sqrt(s2F / (s2F + k2))
+    return w
+
+
+def fit(
+    res: Residuals, start: StartValues, *, fit_x0: bool, fit_amplitude: bool
+) -> tuple[FitResult, Residuals, float]:
+    """Step 4: least squares; a whole-signal fit is refitted with errors-in-variables weights
+    (σx estimated from the data), then the turning-point prior rows are added and the fit
+    repeated from the solution. Returns ``(fit, final residuals, σx)``."""
+    params = start.params
+    raw = least_squares_fit(res, params)
+    x_noise = math.nan
+    d = res.data
+    if d.on == "signal":
+        s2x = x_noise_var(d.x, d.loop)
+        x_noise = math.sqrt(s2x)
+        if s2x > 0:
+            res = replace(res, w=eiv_weights(res, raw, s2x))
+            raw = least_squares_fit(res, _restart(params, raw))
+            _keep_init(raw, params)
+    if start.prior is not None and (fit_amplitude or fit_x0):
+        names = tuple(n for n, on in (("x0", fit_x0), ("amplitude", fit_amplitude)) if on)
+        s_f = math.sqrt(raw.redchi) if raw.redchi > 0 else 1.0
+        x0_d, a_d, sig = start.prior
+        res = replace(res, prior=PriorRows(names, x0_d, a_d, sig, s_f))
+        raw = least_squares_fit(res, _restart(params, raw))
+        _keep_init(raw, params)
+    return raw, res, x_noise
+
+
+# -- 5. covariance of inputs taken as exact ----------------------------------------------
+
+
+def _response(raw: FitResult, cols: list[np.ndarray]) -> np.ndarray:
+    """``G = -(JᵀJ)⁻¹Jᵀ [∂r]``: the fit's linear response to input perturbations."""
+    return -np.linalg.lstsq(raw.jac, np.column_stack(cols), rcond=None)[0]
+
+
+def drift_covariance(
+    raw: FitResult,
+    res: Residuals,
+    drift: Drift | None,
+    *,
+    rel_threshold: float,
+    min_cycles: int,
+) -> FitResult:
+    """The drifts were estimated (from per-cycle means) and removed before the fit, which
+    then took the data as exact. Carry their errors into the covariance: the residuals are
+    linear in the removed trend, ``cov += G diag(σ_s²) Gᵀ`` (independent channels)."""
+    d = res.data
+    if drift is None or d.loop is None or raw.jac is None or raw.covar is None:
+        return raw
+    tt, tm = drift.tt, drift.t_mid
+    # each bin's mean of (t - tm): what a unit slope removed from that bin
+    T_bin = average_loop(
+        d.x,
+        tt - tm,
+        d.t,
+        n_points=d.loop.x.size,
+        rel_threshold=rel_threshold,
+        min_cycles=min_cycles,
+    ).F
+    T = T_bin if d.on == "averaged" else tt - tm
+    vals0 = raw.values
+    base = res.residual(vals0)
+    cols = []
+    s_f, s_x = drift.force[1], drift.displacement[1]
+    if s_f > 0 and math.isfinite(s_f):
+        cols.append(res.residual(vals0, dF=-s_f * T) - base)
+    if s_x > 0 and math.isfinite(s_x):
+        vn = None
+        if d.vnodes is not None:
+            at = tt[np.minimum(d.vnodes.positions, tt.size - 1)] - tm
+            vn = (d.vnodes.positions, d.vnodes.values - s_x * at)
+        tips = None
+        if res.prior is not None:
+            tips = turning_point_prior(replace(d.loop, x=d.loop.x - s_x * T_bin))
+        cols.append(res.residual(vals0, xp=d.xpath - s_x * T, vn=vn, tips=tips) - base)
+    if not cols:
+        return raw
+    G = _response(raw, cols)
+    return add_covariance(raw, G @ G.T)
+
+
+def turn_covariance(raw: FitResult, res: Residuals) -> tuple[FitResult, np.ndarray | None]:
+    """The path around each measured turn is its local regression, and a virgin-history fit
+    holds the turn values fixed: carry each regression's error (three independent 1σ modes
+    per turn, the turns independent) into the covariance, ``cov += Σ g gᵀ``.
+
+    Returns the fit and, for a virgin-history fit, ``Cov(θ, A)`` through the shared turns.
+    """
+    d = res.data
+    measured = d.measured
+    if measured is None or raw.jac is None or raw.covar is None:
+        return raw, None
+    vals0 = raw.values
+    base = res.residual(vals0)
+    cols = []
+    d_amp = []  # the same modes move the amplitude (half the peak-valley distance)
+    n_pk = max(int(measured.is_peak.sum()), 1)
+    n_vl = max(int((~measured.is_peak).sum()), 1)
+    for j, (lo, hi, dpath, dval) in enumerate(measured.modes):
+        share = 0.5 / n_pk if measured.is_peak[j] else -0.5 / n_vl
+        for m_ in range(dval.size):
+            d_amp.append(share * dval[m_])
+            moved = measured.values.copy()
+            moved[j] += dval[m_]
+            xp_j = d.xpath.copy()
+            xp_j[lo:hi] += dpath[:, m_]
+            vn_j = None if d.steady else (measured.positions, moved)
+            cols.append(res.residual(vals0, xp=xp_j, vn=vn_j) - base)
+    G = _response(raw, cols)
+    raw = add_covariance(raw, G @ G.T)
+    return raw, (None if d.steady else G @ np.asarray(d_amp))
+
+
+def fixed_amplitude_covariance(
+    raw: FitResult, res: Residuals, prior: tuple[float, float, float] | None, fit_amplitude: bool
+) -> tuple[FitResult, np.ndarray | None]:
+    """A steady fit that held the amplitude at the displacement channel's measurement:
+    ``cov += g gᵀ σ_A²`` with ``g = ∂θ/∂A``; returns the fit and ``g`` (per metre)."""
+    if not res.data.steady or fit_amplitude or prior is None or raw.jac is None:
+        return raw, None
+    vals0 = raw.values
+    col = res.residual(dict(vals0, amplitude=vals0["amplitude"] + prior[2]))
+    g_amp = _response(raw, [col - res.residual(vals0)])[:, 0]
+    if raw.covar is not None:
+        raw = add_covariance(raw, np.outer(g_amp, g_amp))
+    return raw, g_amp / prior[2]
+
+
+# -- 6. amplitude ------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Amplitude:
+    value: float
+    stderr: float
+    extra: float  # error to propagate beside the fit covariance (0 when fitted)
+    g_amp: np.ndarray | None  # Cov(θ, A) = g_amp σ_A²
+    fitted: bool
+
+
+def amplitude_estimate(
+    raw: FitResult,
+    data: FitData,
+    prior: tuple[float, float, float] | None,
+    *,
+    fit_amplitude: bool,
+    g_amp: np.ndarray | None,
+    c_theta_amp: np.ndarray | None,
+) -> Amplitude:
+    """The amplitude: fitted (its error in the covariance), held at the turn regression, or
+    for a virgin-history fit the turns' local regressions (:func:`virgin_amplitude`)."""
+    vals = raw.values
+    if data.steady and fit_amplitude:
+        se = raw.params["amplitude"].stderr
+        return Amplitude(float(vals["amplitude"]), float(se or math.nan), 0.0, None, True)
+    amplitude = float(vals["amplitude"]) if data.steady else data.amplitude0
+    sc = data.loop.scatter if data.loop is not None else None
+    se = 0.0
+    if sc is not None and sc.n_cycles > 1:
+        se = float(np.std(sc.amplitude, ddof=1) / math.sqrt(sc.n_cycles))
+    if data.steady and prior is not None:
+        se = prior[2]
+    elif not data.steady:
+        va, va_se = virgin_amplitude(data.x, data.t, data.rev)
+        if math.isfinite(va) and math.isfinite(va_se):
+            amplitude, se = va, va_se
+            if c_theta_amp is not None and va_se > 0:
+                g_amp = c_theta_amp / va_se**2  # so that Cov(θ, A) = g_amp σ_A²
+    return Amplitude(amplitude, se, se, g_amp, False)
+
+
+def propagate(raw: FitResult, amp: Amplitude, fn: Any) -> tuple[float, float]:
+    """Value and error of ``fn(values, A)`` from the fit covariance and the amplitude."""
+    from .uncertainty import propagate_fit
+
+    if amp.fitted:
+        return propagate_fit(raw, lambda v, _A: fn(v, v["amplitude"]), amp.value, 0.0)
+    return propagate_fit(raw, fn, amp.value, amp.extra, amp.g_amp)
+
+
+__all__ = [
+    "Amplitude",
+    "Detrended",
+    "Drift",
+    "FitData",
+    "PriorRows",
+    "Residuals",
+    "StartValues",
+    "amplitude_estimate",
+    "detrend",
+    "drift_covariance",
+    "eiv_weights",
+    "fit",
+    "fit_data",
+    "fixed_amplitude_covariance",
+    "model_of",
+    "propagate",
+    "start_values",
+    "turn_covariance",
+]

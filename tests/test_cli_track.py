@@ -1,0 +1,194 @@
+"""``contactlab track``: JSON keys, report contents, bad input, Ctrl-C (exit 130, nothing
+written) both simulated and with a real SIGINT."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+import contactlab.studies.tracking as track_mod
+from contactlab.cli import main
+from contactlab.io import write_recording
+from contactlab.tangential import synthetic_recording
+
+
+@pytest.fixture(scope="module")
+def rec_file(tmp_path_factory):
+    rec = synthetic_recording(
+        h0=30.0, ac=5e4, amplitude=12e-6, n_cycles=16, fs=1000.0, noise=0.01, seed=7321
+    )
+    p = tmp_path_factory.mktemp("trk") / "endurance.h5"
+    write_recording(p, rec)
+    return p
+
+
+def test_track_json_and_report(rec_file, tmp_path, capsys):
+    out, rep = tmp_path / "o.json", tmp_path / "rep"
+    code = main(
+        [
+            "track",
+            str(rec_file),
+            "--every",
+            "5cycles",
+            "--json",
+            str(out),
+            "--report",
+            str(rep),
+            "--no-progress",
+        ]
+    )
+    assert code == 0
+    text = capsys.readouterr().out
+    assert "h0 = " in text and "pooled" in text
+    doc = json.loads(out.read_text())
+    assert {"windows", "combined", "cycles", "units", "cycle_units", "kind", "every"} <= set(doc)
+    w = doc["windows"][0]
+    for k in (
+        "t_start",
+        "t_end",
+        "t_mid",
+        "cycle_start",
+        "cycle_end",
+        "h0",
+        "h0_stderr",
+        "ac",
+        "h0_ac",
+        "energy_per_cycle",
+        "energy_per_cycle_numeric",
+        "equivalent_damping",
+        "k_local0",
+        "k_global",
+        "amplitude",
+        "offset",
+        "offset_stderr",
+    ):
+        assert k in w, k
+    assert doc["units"]["h0_stderr"] == "N" and doc["units"]["equivalent_damping"] == "N/m"
+    assert len(doc["cycles"]["energy"]) == doc["windows"][-1]["cycle_end"]
+    assert doc["cycle_units"]["energy"] == "J"
+    html = (rep / "report.html").read_text()
+    assert "Quantities against time" in html and html.count("<img") >= 11
+    assert (rep / "figures" / "h0.png").exists() and (rep / "track_cycles.csv").exists()
+    assert (rep / "track_windows.csv").read_text().startswith("window,t_start [s]")
+
+
+def test_track_bad_input(tmp_path, capsys):
+    p = tmp_path / "run.csv"
+    p.write_text("t [s],x [um],F [N]\n0,1,2\n0.001,oops,3\n")
+    assert main(["track", str(p), "--every", "5cycles"]) == 1
+    err = capsys.readouterr().err
+    assert "run.csv" in err and "column 'x [um]'" in err and "row 3" in err
+    assert main(["track", str(p), "--every", "soon"]) == 1
+    assert "every='soon'" in capsys.readouterr().err
+
+
+def test_track_ctrl_c_writes_nothing(rec_file, tmp_path, monkeypatch, capsys):
+    def interrupted(*_a, **_k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(track_mod, "_tangential_window", interrupted)
+    out, rep = tmp_path / "o.json", tmp_path / "rep"
+    code = main(
+        [
+            "track",
+            str(rec_file),
+            "--every",
+            "5cycles",
+            "--json",
+            str(out),
+            "--report",
+            str(rep),
+            "--no-progress",
+        ]
+    )
+    assert code == 130
+    assert "interrupted" in capsys.readouterr().err
+    assert os.listdir(tmp_path) == []
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_track_real_sigint_exits_130_without_output(tmp_path):
+    rec = synthetic_recording(
+        h0=30.0, ac=5e4, amplitude=12e-6, n_cycles=400, fs=1000.0, noise=0.01, seed=7322
+    )
+    f = tmp_path / "long.h5"
+    write_recording(f, rec)
+    out = tmp_path / "out"
+    cmd = [
+        sys.executable,
+        "-m",
+        "contactlab",
+        "track",
+        str(f),
+        "--every",
+        "3cycles",
+        "--json",
+        str(out / "o.json"),
+        "--report",
+        str(out / "rep"),
+        "--no-progress",
+    ]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert proc.stdout is not None
+    first = proc.stdout.readline()  # printed when tracking starts
+    assert first.startswith("tracking")
+    time.sleep(0.5)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    # 130, or killed by SIGINT (a shell shows that as 130 too): CPython re-raises SIGINT at
+    # exit when the interrupt landed inside an import the CLI does lazily, even though the
+    # CLI caught it and returned 130
+    assert proc.returncode in (130, -signal.SIGINT), err
+    assert "interrupted" in err
+    assert not out.exists()
+
+
+def test_analyze_stream_agrees_with_whole_file(rec_file, tmp_path):
+    whole, streamed = tmp_path / "w.json", tmp_path / "s.json"
+    assert main(["analyze", str(rec_file), "--model", "tangential", "--json", str(whole),
+                 "--no-progress"]) == 0  # fmt: skip
+    assert main(["analyze", str(rec_file), "--model", "tangential", "--stream", "--every",
+                 "5cycles", "--json", str(streamed), "--no-progress"]) == 0  # fmt: skip
+    w, s = json.loads(whole.read_text()), json.loads(streamed.read_text())
+    assert s["streamed"] is True and s["n_windows"] == 3 and s["units"]["h0"] == "N"
+    for q in ("h0", "ac", "energy_per_cycle", "energy_per_cycle_numeric", "k_global"):
+        err = (w[f"{q}_stderr"] ** 2 + s[f"{q}_stderr"] ** 2) ** 0.5
+        assert abs(w[q] - s[q]) < 3 * err, q
+
+
+def test_track_normal_recording_cli(tmp_path, capsys):
+    import contactlab.normal as cn
+    from contactlab.io import Recording
+
+    t, p, d = cn.synthetic_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=16, seed=5022)
+    f = tmp_path / "C45_p0-0.5MPa_pa-0.4MPa.csv"
+    write_recording(f, Recording(t, {"p": p, "delta": d}, {"p": "Pa", "delta": "m"}))
+    rep, out = tmp_path / "rep", tmp_path / "o.json"
+    code = main(
+        [
+            "track",
+            str(f),
+            "--every",
+            "4cycles",
+            "--report",
+            str(rep),
+            "--json",
+            str(out),
+            "--against",
+            "cycle",
+            "--no-progress",
+        ]
+    )
+    assert code == 0
+    text = capsys.readouterr().out
+    assert "E_d = " in text and "psi = " in text and "mean of the windows" in text
+    doc = json.loads(out.read_text())
+    assert doc["kind"] == "normal" and doc["cycle_units"]["energy"] == "J/m^2"
+    assert {"E_d", "E_d_stderr", "psi", "k_tan", "k_sec", "poly_load_0"} <= set(doc["windows"][0])
+    assert (rep / "figures" / "psi.png").exists() and (rep / "figures" / "poly-load-0.png").exists()

@@ -1,0 +1,138 @@
+"""Chunked readers (contactlab.io.read_chunks): same data, same checks, same messages as the
+whole-file readers, whatever the chunk size."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from contactlab import InputError
+from contactlab.io import Recording, RecordingError, read_chunks, read_recording, write_recording
+
+FORMATS = [("csv", {}), ("tdms", {}), ("h5", {}), ("mat", {}), ("mat", {"version": "7.3"})]
+
+
+def _rec(n: int = 400, seed: int = 0) -> Recording:
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) * 1e-3
+    x = 20e-6 * np.sin(2 * np.pi * 5 * t) + 1e-7 * rng.standard_normal(n)
+    F = 30 * np.tanh(x / 10e-6) + 0.1 * rng.standard_normal(n)
+    return Recording(t, {"x": x, "F": F}, {"x": "m", "F": "N"}, "synthetic")
+
+
+def _joined(chunks: list[Recording]) -> dict[str, np.ndarray]:
+    return {k: np.concatenate([c[k] for c in chunks]) for k in ("t", "x", "F")}
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory: pytest.TempPathFactory) -> dict[str, object]:
+    d = tmp_path_factory.mktemp("chunks")
+    rec = _rec()
+    out = {}
+    for ext, opts in FORMATS:
+        p = d / f"run{'73' if opts else ''}.{ext}"
+        write_recording(p, rec, **opts)
+        out[p.name] = p
+    return out
+
+
+@pytest.mark.parametrize("name", ["run.csv", "run.tdms", "run.h5", "run.mat", "run73.mat"])
+def test_chunks_equal_whole_file(files: dict, name: str) -> None:
+    p = files[name]
+    whole = read_recording(p)
+    cr = read_chunks(p, chunk_size=37)
+    chunks = list(cr)
+    assert all(len(c) <= 37 for c in chunks)
+    assert [c.meta["offset"] for c in chunks] == list(range(0, len(whole), 37))
+    j = _joined(chunks)
+    for k in ("t", "x", "F"):
+        np.testing.assert_array_equal(j[k], whole[k])
+    assert cr.kind == "tangential" and cr.units == {"x": "m", "F": "N"}
+    assert cr.n_samples in (None, len(whole))
+    assert len(list(cr)) == len(chunks)  # iterable again
+
+
+@settings(max_examples=15, deadline=None)
+@given(size=st.integers(2, 500))
+def test_any_chunk_size_reassembles(size: int) -> None:
+    rec = _rec(n=301, seed=size)
+    j = _joined(list(read_chunks(rec, chunk_size=size)))
+    np.testing.assert_array_equal(j["x"], rec["x"])
+    np.testing.assert_array_equal(j["t"], rec.t)
+
+
+def _bad_csv(tmp_path, body_fn) -> object:
+    rec = _rec(n=200)
+    p = tmp_path / "bad.csv"
+    write_recording(p, rec)
+    lines = p.read_text().splitlines()
+    body_fn(lines)
+    p.write_text("\n".join(lines) + "\n")
+    return p
+
+
+@pytest.mark.parametrize(
+    "edit",
+    [
+        lambda ls: ls.__setitem__(150, ls[150].replace(ls[150].split(",")[1], "nan", 1)),
+        lambda ls: ls.__setitem__(150, ls[150].replace(ls[150].split(",")[2], "abc", 1)),
+        lambda ls: ls.__setitem__(101, ls[99]),  # time goes back, across a 50-sample boundary
+        lambda ls: ls.__delitem__(slice(120, 125)),  # gap
+    ],
+    ids=["nan", "text", "unsorted", "gap"],
+)
+def test_csv_errors_match_whole_reader(tmp_path, edit) -> None:
+    p = _bad_csv(tmp_path, edit)
+    with pytest.raises(RecordingError) as whole:
+        read_recording(p)
+    with pytest.raises(RecordingError) as chunked:
+        list(read_chunks(p, chunk_size=50))
+    assert str(chunked.value) == str(whole.value)
+    assert chunked.value.row == whole.value.row and chunked.value.column == whole.value.column
+
+
+@pytest.mark.parametrize("where", ["nan", "back"])
+def test_hdf5_errors_match_whole_reader(tmp_path, where: str) -> None:
+    rec = _rec(n=200)
+    if where == "nan":
+        rec.data["F"][133] = np.nan
+    else:
+        rec.t[100] = rec.t[98]
+    p = tmp_path / "bad.h5"
+    import h5py
+
+    with h5py.File(p, "w") as f:  # write_recording would refuse nothing, but be explicit
+        f["t"] = rec.t
+        f["x"] = rec["x"]
+        f["F"] = rec["F"]
+    with pytest.raises(RecordingError) as whole:
+        read_recording(p)
+    with pytest.raises(RecordingError) as chunked:
+        list(read_chunks(p, chunk_size=64))
+    assert str(chunked.value) == str(whole.value)
+
+
+def test_resolution_errors_are_immediate(tmp_path, files: dict) -> None:
+    with pytest.raises(RecordingError, match="column 'nope'"):
+        read_chunks(files["run.h5"], columns={"x": "nope"})
+    with pytest.raises(InputError, match="chunk_size"):
+        read_chunks(files["run.h5"], chunk_size=1)
+    p = tmp_path / "junk.h5"
+    p.write_bytes(b"not hdf5 at all")
+    with pytest.raises(RecordingError, match=r"junk\.h5"):
+        read_chunks(p)
+
+
+@pytest.mark.parametrize(("ext", "opts"), [("tdms", {}), ("mat", {"version": "7.3"}), ("h5", {})])
+def test_nan_named_alike_in_every_binary_format(tmp_path, ext, opts) -> None:
+    rec = _rec(n=300)
+    rec.data["F"][211] = np.nan
+    p = tmp_path / f"bad.{ext}"
+    write_recording(p, rec, **opts)
+    with pytest.raises(RecordingError) as whole:
+        read_recording(p)
+    with pytest.raises(RecordingError) as chunked:
+        list(read_chunks(p, chunk_size=50))
+    assert str(chunked.value) == str(whole.value) and chunked.value.row == 211
