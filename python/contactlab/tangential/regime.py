@@ -291,14 +291,17 @@ def classify(
     F: np.ndarray,
     t: np.ndarray | None,
     rev: Reversals,
+    x_raw: np.ndarray | None = None,
 ) -> Regime:
     """Decide the regime from ``z`` (the fit's when identified, else the area ratio's), the
-    plateau and the sticks."""
+    plateau and the sticks. ``x_raw``: the displacement before drift removal, for the
+    velocity (a removed drift would make a stuck plate creep at the drift's rate)."""
     if z_fit is not None and math.isfinite(z_fit):
         z, src = float(z_fit), "fit"
     else:
         z, src = z_from_area_ratio(ratio), "loop area"
-    v, thr, window = velocity(t, x) if x.size >= 20 else (np.zeros(x.size), 0.0, 5)
+    xv = x if x_raw is None else x_raw
+    v, thr, window = velocity(t, xv) if xv.size >= 20 else (np.zeros(xv.size), 0.0, 5)
     pl = plateau(loop, x, F, v, thr) if (loop is not None and z >= GROSS_SLIDING_Z) else None
     st = stick_slip(t, x, F, rev, v, thr, window, pl.offset if pl is not None else 0.0)
     zt = f"ac·A = {z:.3g} (from the {src}; loop area {100 * ratio:.0f}% of the rectangle 4·A·h_m)"

@@ -119,13 +119,15 @@ pub fn fit(
             reason: "least-squares solve failed",
         })?;
     let mut scale = ys;
-    Ok((0..m)
+    let c: Vec<f64> = (0..m)
         .map(|j| {
             let c = sol[j] * scale;
             scale /= xs;
             c
         })
-        .collect())
+        .collect();
+    crate::error::check_output("polynomial coefficient", &c)?;
+    Ok(c)
 }
 
 /// Real roots of `c` in `[lo, hi]`, found by bracketing on a fine grid and bisection.
