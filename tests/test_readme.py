@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import re
 import shlex
+import sys
 from pathlib import Path
 
 import pytest
@@ -79,10 +80,14 @@ def test_readme_has_examples():
 def test_readme_block_runs(code, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     ns = {"__name__": "__readme__"}
-    exec(compile(code, str(README), "exec"), ns)
-    for key, check in CLAIMS.items():
-        if key in code:
-            check(ns)
+    try:
+        exec(compile(code, str(README), "exec"), ns)
+        for key, check in CLAIMS.items():
+            if key in code:
+                check(ns)
+    finally:  # a block that plots (as a user would) leaves its figure open: not for later tests
+        if "matplotlib.pyplot" in sys.modules:
+            sys.modules["matplotlib.pyplot"].close("all")
 
 
 @pytest.mark.parametrize("line", COMMANDS)
