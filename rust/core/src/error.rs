@@ -44,6 +44,9 @@ pub enum CoreError {
     /// An exported operator state cannot be restored.
     #[error("operator state is invalid: {reason}")]
     InvalidState { reason: &'static str },
+    /// A signal is too long for the sample counter (global indices must fit in 63 bits).
+    #[error("a chunk of {len} samples would overflow the operator's sample counter")]
+    TooLong { len: usize },
     /// An ODE integrator could not keep its error below tolerance.
     #[error("step size became too small ({step:e}) at t = {time}")]
     StepSizeTooSmall { time: f64, step: f64 },
