@@ -12,7 +12,7 @@ from . import diagnose, normal
 from .errors import ContactLabError, ContactLabWarning, ConvergenceError, InputError
 from .fitting import FitResult, Parameter, least_squares_fit
 from .io import Recording, RecordingError, read_recording, write_recording
-from .masing import CycleTable, Masing, MasingOperator, cycle_energies, loop_area
+from .masing import CycleTable, Masing, MasingOperator, cycle_energies, force_many, loop_area
 from .tangential import TangentialAnalysis, analyze_tangential
 
 __version__ = "0.1.0"
@@ -34,6 +34,7 @@ __all__ = [
     "analyze_tangential",
     "cycle_energies",
     "diagnose",
+    "force_many",
     "least_squares_fit",
     "loop_area",
     "normal",

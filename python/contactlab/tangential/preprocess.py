@@ -26,6 +26,7 @@ import numpy as np
 from .._arrays import as_1d
 from ..errors import InputError
 from ..masing import loop_area
+from ..reversals import excursions
 
 
 @dataclass(frozen=True)
@@ -64,15 +65,16 @@ class Reversals:
         return int(min(cand)) if cand else 0
 
 
-def _crossing_time(t: np.ndarray, x: np.ndarray, i: int, level: float) -> float:
-    """Time at which ``x`` crosses ``level`` between samples ``i-1`` and ``i`` (linear)."""
-    if i <= 0:
-        return float(t[0])
-    x0, x1 = x[i - 1], x[i]
-    if x1 == x0:
-        return float(t[i])
-    a = (level - x0) / (x1 - x0)
-    return float(t[i - 1] + min(max(a, 0.0), 1.0) * (t[i] - t[i - 1]))
+def _crossing_times(t: np.ndarray, x: np.ndarray, i: np.ndarray, level: np.ndarray) -> np.ndarray:
+    """Times at which ``x`` crosses ``level`` between samples ``i-1`` and ``i`` (linear; the
+    time of sample ``i`` where the two samples are equal, ``t[0]`` for ``i = 0``)."""
+    i = np.asarray(i, dtype=np.int64)
+    ip = np.maximum(i - 1, 0)
+    x0, x1 = x[ip], x[i]
+    flat = x1 == x0
+    a = (level - x0) / np.where(flat, 1.0, x1 - x0)
+    tc = t[ip] + np.clip(a, 0.0, 1.0) * (t[i] - t[ip])
+    return np.where(i <= 0, t[0], np.where(flat, t[i], tc))
 
 
 def find_reversals(
@@ -117,51 +119,31 @@ def find_reversals(
         threshold = rel_threshold * amp
     if not threshold > 0:
         raise InputError(f"the displacement does not move (amplitude {amp:g}); no reversals")
-    hi_level = centre + threshold
-    lo_level = centre - threshold
-    state = np.where(xa > hi_level, 1, np.where(xa < lo_level, -1, 0))
-    nz = np.flatnonzero(state)
+    # Excursions beyond the band (Rust detector): +1 = above it since the last time below.
+    ex = excursions(xa, centre, float(threshold))
     empty = np.empty(0, dtype=np.int64)
-    if nz.size == 0:
+    if len(ex) == 0:
         return Reversals(empty, empty, np.empty(0), np.empty(0), float(threshold), centre)
-    # Segments of constant (forward-filled) state: +1 = above the band since the last time
-    # below it.
-    s = state[nz]
-    change = np.flatnonzero(np.diff(s) != 0) + 1
-    seg_start = np.r_[nz[0], nz[change]]
-    seg_state = s[np.r_[0, change]]
-    seg_end = np.r_[nz[change], xa.size]  # exclusive: next segment's first sample
-    peaks, valleys, ptimes, vtimes, edges = [], [], [], [], []
-    last = len(seg_start) - 1
-    for k, (a, b, st) in enumerate(zip(seg_start, seg_end, seg_state, strict=True)):
-        # An extreme is confirmed only when the signal has left it through the band; the
-        # last segment's turn is unconfirmed and the first may be cut by the recording start.
-        seg = xa[a:b]
-        level = hi_level if st > 0 else lo_level
-        inside = seg > level if st > 0 else seg < level
-        idx_in = np.flatnonzero(inside)
-        i_ext = a + int(np.argmax(seg) if st > 0 else np.argmin(seg))
-        if (k == 0 and a == 0) or (k == last and not np.any((xa[i_ext:] - centre) * st < 0)):
-            # cut by the recording's start, or not confirmed by a centre crossing before its end
-            edges.append(i_ext)
-            continue
-        t_in = _crossing_time(ta, xa, a, level)
-        j = a + int(idx_in[-1]) + 1  # first sample back inside the band
-        t_out = _crossing_time(ta, xa, min(j, xa.size - 1), level)
-        if st > 0:
-            peaks.append(i_ext)
-            ptimes.append(0.5 * (t_in + t_out))
-        else:
-            valleys.append(i_ext)
-            vtimes.append(0.5 * (t_in + t_out))
+    # An extreme is confirmed only when the signal has left it through the band; the last
+    # excursion's turn is unconfirmed unless it crossed the centre before the end, and the
+    # first may be cut by the recording's start.
+    edge = np.zeros(len(ex), dtype=bool)
+    edge[0] = ex.start[0] == 0
+    edge[-1] |= not bool(ex.returned[-1])
+    up = ex.sign > 0
+    level = np.where(up, centre + threshold, centre - threshold)
+    t_in = _crossing_times(ta, xa, ex.start, level)
+    j = np.minimum(ex.last_beyond + 1, xa.size - 1)  # first sample back inside the band
+    t_mid = 0.5 * (t_in + _crossing_times(ta, xa, j, level))
+    peak, valley = ~edge & up, ~edge & ~up
     return Reversals(
-        np.asarray(peaks, dtype=np.int64),
-        np.asarray(valleys, dtype=np.int64),
-        np.asarray(ptimes, dtype=float),
-        np.asarray(vtimes, dtype=float),
+        ex.extreme[peak].astype(np.int64),
+        ex.extreme[valley].astype(np.int64),
+        t_mid[peak],
+        t_mid[valley],
         float(threshold),
         float(centre),
-        np.asarray(edges, dtype=np.int64),
+        ex.extreme[edge].astype(np.int64),
     )
 
 

@@ -54,3 +54,8 @@ pub fn to_pyerr(py: Python<'_>, e: &CoreError) -> PyErr {
 pub fn internal(py: Python<'_>, msg: &str) -> PyErr {
     make(py, 0, msg.to_string())
 }
+
+/// `InputError` with a message (bad arguments the binding itself detects).
+pub fn input(py: Python<'_>, msg: &str) -> PyErr {
+    make(py, 1, msg.to_string())
+}
