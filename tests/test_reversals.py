@@ -122,3 +122,35 @@ def test_force_many_and_out_buffers_equal_force():
         contactlab.force_many(models[:2], xs)
     with pytest.raises(InputError, match="threads"):
         contactlab.force_many(models[0], xs, threads=0)
+
+
+def test_phase_fold_equals_numpy_bincount_and_streams():
+    from contactlab import _core
+    from contactlab.tangential.preprocess import _phase_knots, find_reversals, phase_of
+
+    rng = np.random.default_rng(8)
+    n = 20_000
+    t = np.arange(n) * 1e-3
+    x = np.sin(2 * np.pi * 3.3 * t) + rng.normal(0, 0.05, n)
+    F = np.cos(2 * np.pi * 3.3 * t) + rng.normal(0, 0.05, n)
+    rev = find_reversals(x, t)
+    n_cyc, nb = rev.peaks.size - 1, 40
+    ph, start, end = phase_of(t, rev)
+    cyc = np.floor(ph).astype(np.int64)
+    frac = ph - cyc
+    b = np.minimum((frac * nb).astype(np.int64), nb - 1)
+    kt, kp = _phase_knots(rev)
+    fold = _core.PhaseFold(nb, n_cyc)
+    for a in range(0, n, 3001):  # chunk by chunk
+        fold.push(t[a : a + 3001], x[a : a + 3001], F[a : a + 3001], a, kt, kp)
+    s = fold.sums()
+    assert np.array_equal(s["count"], np.bincount(b, minlength=nb))
+    assert np.array_equal(s["sum_x"], np.bincount(b, x[start:end], nb))
+    assert np.array_equal(s["sum_phase2"], np.bincount(b, frac * frac, nb))
+    flat = cyc * nb + b
+    cf = np.bincount(flat, F[start:end], n_cyc * nb).reshape(n_cyc, nb)
+    assert np.array_equal(s["cycle_F"], cf)
+    assert s["first"][0] == start
+    assert np.array_equal(s["first"], start + np.searchsorted(cyc, np.arange(n_cyc)))
+    with pytest.raises(InputError, match="knot_t"):
+        fold.push(t, x, F, 0, kt[::-1].copy(), kp)

@@ -23,9 +23,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import _core
 from .._arrays import as_1d
 from ..errors import InputError
-from ..masing import loop_area
 from ..reversals import excursions
 
 
@@ -210,9 +210,8 @@ class AveragedLoop:
         return self.phase < 0.5
 
 
-def phase_of(t: np.ndarray, rev: Reversals) -> tuple[np.ndarray, int, int]:
-    """Phase of each sample of the complete cycles; returns ``(phase, start, end)`` where
-    samples ``start:end`` are covered (phase ``k + φ`` for cycle ``k``, φ in [0, 1))."""
+def _phase_knots(rev: Reversals) -> tuple[np.ndarray, np.ndarray]:
+    """Knots ``(time, phase)``: peak k at phase k, the valley after it at k + 1/2."""
     pt, vt = rev.peak_times, rev.valley_times
     knots_t, knots_p = [], []
     for k, tp in enumerate(pt):
@@ -222,8 +221,13 @@ def phase_of(t: np.ndarray, rev: Reversals) -> tuple[np.ndarray, int, int]:
         if k + 1 < pt.size and later.size and later[0] < pt[k + 1]:
             knots_t.append(later[0])
             knots_p.append(k + 0.5)
-    kt = np.asarray(knots_t)
-    kp = np.asarray(knots_p)
+    return np.asarray(knots_t), np.asarray(knots_p)
+
+
+def phase_of(t: np.ndarray, rev: Reversals) -> tuple[np.ndarray, int, int]:
+    """Phase of each sample of the complete cycles; returns ``(phase, start, end)`` where
+    samples ``start:end`` are covered (phase ``k + φ`` for cycle ``k``, φ in [0, 1))."""
+    kt, kp = _phase_knots(rev)
     start = int(np.searchsorted(t, kt[0], side="left"))
     end = int(np.searchsorted(t, kt[-1], side="left"))
     ph = np.interp(t[start:end], kt, kp)
@@ -304,60 +308,61 @@ def average_loop(
             f"±{rev.threshold:.3g} m around x = {rev.centre:.3g} m; "
             f"at least {min_cycles} are needed"
         )
-    ph, start, end = phase_of(ta, rev)
-    cyc = np.floor(ph).astype(np.int64)
-    frac = ph - cyc
+    kt, kp = _phase_knots(rev)
+    start = int(np.searchsorted(ta, kt[0], side="left"))
+    end = int(np.searchsorted(ta, kt[-1], side="left"))
     if n_points is None:
         # about two samples of every cycle per bin, so no bin is left empty by jitter
         n_points = 2 * int(np.clip(np.median(np.diff(rev.peaks)) / 2, 16, 400) // 2)
     if n_points < 8:
         raise InputError(f"n_points must be >= 8, got {n_points}")
-    b = np.minimum((frac * n_points).astype(np.int64), n_points - 1)
-    xs, Fs = xa[start:end], Fa[start:end]
-    count = np.bincount(b, minlength=n_points).astype(float)
+    # One pass in Rust: phase by interpolating the knots, bin sums overall and per cycle (no
+    # per-sample temporaries; the bins are numpy.interp's).
+    fold = _core.PhaseFold(int(n_points), n_cyc)
+    fold.push(ta, xa, Fa, 0, kt, kp)
+    sums = fold.sums()
+    count = sums["count"]
     if np.any(count == 0):
         raise InputError(
             f"{int(np.sum(count == 0))} of {n_points} phase bins are empty: the recording has "
             f"too few samples per cycle for n_points={n_points}; lower n_points"
         )
-    xm = np.bincount(b, xs, n_points) / count
-    Fm = np.bincount(b, Fs, n_points) / count
+    xm = sums["sum_x"] / count
+    Fm = sums["sum_F"] / count
     # per-cycle bin means (cycles x bins); a bin a cycle missed is NaN
-    flat = cyc * n_points + b
-    size = n_cyc * n_points
-    cc = np.bincount(flat, minlength=size).reshape(n_cyc, n_points)
+    cc = sums["cycle_count"]
     with np.errstate(invalid="ignore", divide="ignore"):
-        cx = np.bincount(flat, xs, size).reshape(n_cyc, n_points) / cc
-        cF = np.bincount(flat, Fs, size).reshape(n_cyc, n_points) / cc
-        cphi = np.bincount(flat, frac, size).reshape(n_cyc, n_points) / cc
+        cx = sums["cycle_x"] / cc
+        cF = sums["cycle_F"] / cc
+        cphi = sums["cycle_phase"] / cc
     # Where the samples of a cycle sit inside a bin differs from cycle to cycle; on a steep
     # branch that alone spreads the per-cycle means. Remove it to first order (gradient along
     # phase, periodic) so the spread measures noise and real cycle-to-cycle change.
-    phim = np.bincount(b, frac, n_points) / count
+    phim = sums["sum_phase"] / count
     dphi = cphi - phim
     x_std = _spread(cx - _dphase(xm, n_points) * dphi)
     F_std = _spread(cF - _dphase(Fm, n_points) * dphi)
-    # sample index where each cycle starts (and where the last one ends)
-    bounds = start + np.searchsorted(cyc, np.arange(n_cyc + 1))
-    amps, franges, energies = [], [], []
-    for k in range(n_cyc):
-        amps.append(0.5 * (np.nanmax(cx[k]) - np.nanmin(cx[k])))
-        franges.append(0.5 * (np.nanmax(cF[k]) - np.nanmin(cF[k])))
-        # the area of the cycle's own samples: bin means would cut the corners at the turns
-        a, b2 = int(bounds[k]), int(bounds[k + 1])
-        energies.append(loop_area(xa[a:b2], Fa[a:b2]) if b2 - a >= 3 else np.nan)
+    # sample index where each cycle starts (a cycle without samples starts where the next
+    # does), and where the last one ends
+    first = np.r_[sums["first"], end]
+    first = np.minimum.accumulate(np.where(first < 0, end, first)[::-1])[::-1]
+    bounds = first.astype(np.int64)
+    amps = 0.5 * (np.nanmax(cx, axis=1) - np.nanmin(cx, axis=1))
+    franges = 0.5 * (np.nanmax(cF, axis=1) - np.nanmin(cF, axis=1))
+    # the area of the cycle's own samples: bin means would cut the corners at the turns
+    energies = _core.loop_areas(xa, Fa, bounds.tolist())
     scatter = CycleScatter(
-        amplitude=np.asarray(amps),
-        force_range=np.asarray(franges),
-        energy=np.asarray(energies),
+        amplitude=amps,
+        force_range=franges,
+        energy=energies,
         period=np.diff(rev.peak_times),
         mean_force=_period_means(ta, Fa, rev.peak_times),
         mean_x=_period_means(ta, xa, rev.peak_times),
         time=0.5 * (rev.peak_times[:-1] + rev.peak_times[1:]),
     )
     phase = (np.arange(n_points) + 0.5) / n_points
-    phase_sq = np.bincount(b, frac * frac, n_points) / count
-    x_var = np.clip(np.bincount(b, xs * xs, n_points) / count - xm * xm, 0.0, None)
+    phase_sq = sums["sum_phase2"] / count
+    x_var = np.clip(sums["sum_xx"] / count - xm * xm, 0.0, None)
     return AveragedLoop(
         phase,
         xm,

@@ -131,6 +131,176 @@ impl Schmitt {
     }
 }
 
+/// Sums of a phase-bin fold (the cycle averaging of a periodic recording), accumulated over
+/// any number of chunks: per bin (`n_bins`) and per cycle and bin (`n_cycles × n_bins`,
+/// row-major by cycle). Means are sums over counts; the caller divides.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FoldSums {
+    pub n_bins: usize,
+    pub n_cycles: usize,
+    /// Per bin: samples, Σx, ΣF, Σφ, Σφ², Σx² (φ: phase within the cycle, in [0, 1)).
+    pub count: Vec<f64>,
+    pub sum_x: Vec<f64>,
+    pub sum_f: Vec<f64>,
+    pub sum_phase: Vec<f64>,
+    pub sum_phase2: Vec<f64>,
+    pub sum_xx: Vec<f64>,
+    /// Per cycle and bin: samples, Σx, ΣF, Σφ.
+    pub cycle_count: Vec<f64>,
+    pub cycle_x: Vec<f64>,
+    pub cycle_f: Vec<f64>,
+    pub cycle_phase: Vec<f64>,
+    /// Global index of each cycle's first sample (-1: none yet).
+    pub first: Vec<i64>,
+}
+
+impl FoldSums {
+    pub fn new(n_bins: usize, n_cycles: usize) -> Result<Self, CoreError> {
+        if n_bins == 0 {
+            return Err(CoreError::InvalidParameter {
+                name: "n_bins",
+                value: 0.0,
+                reason: "must be >= 1",
+            });
+        }
+        let cells = n_bins
+            .checked_mul(n_cycles)
+            .filter(|&c| c <= (1 << 40))
+            .ok_or(CoreError::InvalidParameter {
+                name: "n_cycles",
+                value: n_cycles as f64,
+                reason: "n_cycles × n_bins is too large",
+            })?;
+        let z = |k| vec![0.0; k];
+        Ok(Self {
+            n_bins,
+            n_cycles,
+            count: z(n_bins),
+            sum_x: z(n_bins),
+            sum_f: z(n_bins),
+            sum_phase: z(n_bins),
+            sum_phase2: z(n_bins),
+            sum_xx: z(n_bins),
+            cycle_count: z(cells),
+            cycle_x: z(cells),
+            cycle_f: z(cells),
+            cycle_phase: z(cells),
+            first: vec![-1; n_cycles],
+        })
+    }
+}
+
+/// Fold the samples `(t, x, F)` (a chunk starting at global index `offset`) into phase bins.
+///
+/// The phase of a sample is the piecewise-linear interpolation of the knots `(kt, kp)` at its
+/// time (as `numpy.interp`, so the bins are those numpy gives); samples outside
+/// `[kt[0], kt[last])` are skipped. Cycle `k = floor(phase)`, bin `floor(frac · n_bins)`.
+/// Knots must be strictly increasing in time and non-decreasing in phase, with phases below
+/// `n_cycles`. Streaming: call per chunk with the same `sums` (knots covering the chunk).
+pub fn fold_phase(
+    t: &[f64],
+    x: &[f64],
+    f: &[f64],
+    offset: u64,
+    kt: &[f64],
+    kp: &[f64],
+    sums: &mut FoldSums,
+) -> Result<(), CoreError> {
+    check_same_len("t", t.len(), "x", x.len())?;
+    check_same_len("t", t.len(), "F", f.len())?;
+    check_same_len("knot_t", kt.len(), "knot_phase", kp.len())?;
+    check_finite("t", t)?;
+    check_finite("knot_t", kt)?;
+    check_finite("knot_phase", kp)?;
+    if kt.len() < 2 {
+        return Err(CoreError::Empty { name: "knot_t" });
+    }
+    for i in 1..kt.len() {
+        if kt[i] <= kt[i - 1] {
+            return Err(CoreError::NotIncreasing {
+                name: "knot_t",
+                index: i,
+                value: kt[i],
+                prev: kt[i - 1],
+            });
+        }
+    }
+    let top = kp[kp.len() - 1];
+    if kp[0] < 0.0 || top > sums.n_cycles as f64 || kp.windows(2).any(|w| w[1] < w[0]) {
+        return Err(CoreError::InvalidParameter {
+            name: "knot_phase",
+            value: top,
+            reason: "knot phases must be non-decreasing, in [0, n_cycles]",
+        });
+    }
+    let nb = sums.n_bins;
+    let (t0, t1) = (kt[0], kt[kt.len() - 1]);
+    let mut j = 0_usize;
+    for (i, ((&ti, &xi), &fi)) in t.iter().zip(x).zip(f).enumerate() {
+        if !(ti >= t0 && ti < t1) {
+            continue;
+        }
+        if ti < kt[j] {
+            j = 0; // time went back (a new chunk of another stretch): search from the start
+        }
+        while kt[j + 1] <= ti {
+            j += 1;
+        }
+        // numpy.interp's arithmetic: the knot's value on the knot, else slope·(t - t_j) + p_j.
+        let ph = if ti == kt[j] {
+            kp[j]
+        } else {
+            let slope = (kp[j + 1] - kp[j]) / (kt[j + 1] - kt[j]);
+            slope * (ti - kt[j]) + kp[j]
+        };
+        let cf = ph.floor();
+        let frac = ph - cf;
+        let c = cf as usize; // 0 <= ph < n_cycles checked through the knots
+        if c >= sums.n_cycles {
+            continue; // only ph == n_cycles exactly, which interp never gives below t1
+        }
+        let b = ((frac * nb as f64) as usize).min(nb - 1);
+        sums.count[b] += 1.0;
+        sums.sum_x[b] += xi;
+        sums.sum_f[b] += fi;
+        sums.sum_phase[b] += frac;
+        sums.sum_phase2[b] += frac * frac;
+        sums.sum_xx[b] += xi * xi;
+        let k = c * nb + b;
+        sums.cycle_count[k] += 1.0;
+        sums.cycle_x[k] += xi;
+        sums.cycle_f[k] += fi;
+        sums.cycle_phase[k] += frac;
+        if sums.first[c] < 0 {
+            sums.first[c] = i64::try_from(offset.saturating_add(i as u64)).unwrap_or(i64::MAX);
+        }
+    }
+    Ok(())
+}
+
+/// `∮ F dx` of each cycle `x[bounds[k]..bounds[k+1]]` (as [`crate::masing::loop_area`]; NaN
+/// for a cycle of fewer than 3 samples).
+pub fn loop_areas(x: &[f64], f: &[f64], bounds: &[usize]) -> Result<Vec<f64>, CoreError> {
+    check_same_len("x", x.len(), "F", f.len())?;
+    let mut out = Vec::with_capacity(bounds.len().saturating_sub(1));
+    for w in bounds.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if b > x.len() || a > b {
+            return Err(CoreError::InvalidParameter {
+                name: "bounds",
+                value: b as f64,
+                reason: "cycle bounds must be non-decreasing and within the signal",
+            });
+        }
+        out.push(if b - a >= 3 {
+            crate::masing::loop_area(&x[a..b], &f[a..b])?
+        } else {
+            f64::NAN
+        });
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -2,7 +2,7 @@
 //! of the Masing rules, and the multi-channel force kernel (Rust threads).
 
 use contactlab_core::masing::{branch_memory, MasingState};
-use contactlab_core::signal::{Excursion, Schmitt};
+use contactlab_core::signal::{fold_phase, loop_areas, Excursion, FoldSums, Schmitt};
 use contactlab_core::CoreError;
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadwriteArray1};
 use pyo3::prelude::*;
@@ -184,7 +184,87 @@ fn run_many(
     results.into_iter().collect()
 }
 
+/// Phase-bin fold of a periodic recording, accumulated chunk by chunk (see
+/// `contactlab_core::signal::fold_phase`).
+#[pyclass(module = "contactlab._core")]
+struct PhaseFold {
+    sums: FoldSums,
+}
+
+#[pymethods]
+impl PhaseFold {
+    #[new]
+    fn new(py: Python<'_>, n_bins: usize, n_cycles: usize) -> PyResult<Self> {
+        let sums = FoldSums::new(n_bins, n_cycles).map_err(|e| to_pyerr(py, &e))?;
+        Ok(Self { sums })
+    }
+
+    /// Fold the chunk `(t, x, F)` starting at global sample `offset`, phases from the knots.
+    fn push(
+        &mut self,
+        py: Python<'_>,
+        t: PyReadonlyArray1<'_, f64>,
+        x: PyReadonlyArray1<'_, f64>,
+        f: PyReadonlyArray1<'_, f64>,
+        offset: u64,
+        knot_t: PyReadonlyArray1<'_, f64>,
+        knot_phase: PyReadonlyArray1<'_, f64>,
+    ) -> PyResult<()> {
+        let (ts, xs, fs) = (slice(&t, "t")?, slice(&x, "x")?, slice(&f, "F")?);
+        let (kt, kp) = (slice(&knot_t, "knot_t")?, slice(&knot_phase, "knot_phase")?);
+        let mut sums = self.sums.clone();
+        self.sums = detach_guarded(py, || {
+            fold_phase(ts, xs, fs, offset, kt, kp, &mut sums)?;
+            Ok(sums)
+        })?;
+        Ok(())
+    }
+
+    /// The sums so far: dict of arrays (per bin, and per cycle × bin as 2-D arrays).
+    fn sums<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = &self.sums;
+        let d = PyDict::new(py);
+        for (k, v) in [
+            ("count", &s.count),
+            ("sum_x", &s.sum_x),
+            ("sum_F", &s.sum_f),
+            ("sum_phase", &s.sum_phase),
+            ("sum_phase2", &s.sum_phase2),
+            ("sum_xx", &s.sum_xx),
+        ] {
+            d.set_item(k, v.clone().into_pyarray(py))?;
+        }
+        for (k, v) in [
+            ("cycle_count", &s.cycle_count),
+            ("cycle_x", &s.cycle_x),
+            ("cycle_F", &s.cycle_f),
+            ("cycle_phase", &s.cycle_phase),
+        ] {
+            let a = v.clone().into_pyarray(py);
+            d.set_item(k, a.reshape([s.n_cycles, s.n_bins])?)?;
+        }
+        d.set_item("first", s.first.clone().into_pyarray(py))?;
+        Ok(d)
+    }
+}
+
+/// `∮ F dx` of each cycle between consecutive `bounds` (NaN below 3 samples).
+#[pyfunction]
+#[pyo3(name = "loop_areas")]
+fn loop_areas_py<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray1<'py, f64>,
+    f: PyReadonlyArray1<'py, f64>,
+    bounds: Vec<usize>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let (xs, fs) = (slice(&x, "x")?, slice(&f, "F")?);
+    let a = detach_guarded(py, || loop_areas(xs, fs, &bounds))?;
+    Ok(a.into_pyarray(py))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PhaseFold>()?;
+    m.add_function(wrap_pyfunction!(loop_areas_py, m)?)?;
     m.add_class::<ReversalDetector>()?;
     m.add_function(wrap_pyfunction!(branch_memory_py, m)?)?;
     m.add_function(wrap_pyfunction!(force_many, m)?)?;
