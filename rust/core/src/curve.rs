@@ -52,8 +52,8 @@ const EXPM1_COEFFS: [f64; 12] = [
 pub fn one_minus_exp_neg(z: f64) -> f64 {
     const LOG2E: f64 = std::f64::consts::LOG2_E;
     // ln 2 split so that k · LN2_HI is exact for |k| < 2^20.
-    const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-1;
-    const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10;
+    const LN2_HI: f64 = f64::from_bits(0x3FE6_2E42_FEE0_0000); // fdlibm's ln2_hi
+    const LN2_LO: f64 = f64::from_bits(0x3DEA_39EF_3579_3C76); // fdlibm's ln2_lo
     const SHIFTER: f64 = 6_755_399_441_055_744.0; // 1.5 · 2^52
                                                   // Beyond 708 exp(-z) < 2^-1021: 1 - exp(-z) rounds to 1, and 2^k stays a normal number.
     let z = if z < 708.0 { z } else { 708.0 };

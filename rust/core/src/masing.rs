@@ -615,10 +615,9 @@ pub fn branch_memory(
         return Err(CoreError::TooLong { len: x.len() });
     }
     let mut st = Stepper::new(&NoCurve, BranchRule::Scaled(2.0), false, false, state);
-    let mut index = base;
-    for ((&xi, a), t) in x.iter().zip(anchor.iter_mut()).zip(target.iter_mut()) {
+    let samples = x.iter().zip(anchor.iter_mut()).zip(target.iter_mut());
+    for (index, ((&xi, a), t)) in (base..).zip(samples) {
         st.advance(xi, index, &mut NoObserver);
-        index += 1;
         let s = &st.stack;
         // Indices fit in i64: checked against `end` above.
         (*a, *t) = match s.len() {

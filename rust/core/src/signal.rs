@@ -79,8 +79,7 @@ impl Schmitt {
         let lo = self.centre - self.threshold;
         let centre = self.centre;
         let mut open = self.open;
-        let mut index = self.count;
-        for (&u, &v) in trigger.iter().zip(value) {
+        for (index, (&u, &v)) in (self.count..).zip(trigger.iter().zip(value)) {
             let s: i8 = if u > hi {
                 1
             } else if u < lo {
@@ -123,7 +122,6 @@ impl Schmitt {
                     });
                 }
             }
-            index += 1;
         }
         self.open = open;
         self.count = end;

@@ -93,6 +93,8 @@ impl ReversalDetector {
     }
 }
 
+type IndexPair<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>);
+
 /// Per-sample branch bookkeeping of the Masing memory rules from the origin:
 /// `(anchor, target)` sample-index arrays (see `contactlab_core::masing::branch_memory`).
 #[pyfunction]
@@ -100,7 +102,7 @@ impl ReversalDetector {
 fn branch_memory_py<'py>(
     py: Python<'py>,
     x: PyReadonlyArray1<'py, f64>,
-) -> PyResult<(Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>)> {
+) -> PyResult<IndexPair<'py>> {
     let xs = slice(&x, "x")?;
     let (a, t) = detach_guarded(py, || {
         let mut a = vec![0_i64; xs.len()];
@@ -135,7 +137,8 @@ fn force_many<'py>(
         .iter()
         .map(|x| PyArray1::<f64>::zeros(py, x.len(), false))
         .collect();
-    let mut rws: Vec<PyReadwriteArray1<'py, f64>> = outs.iter().map(|a| a.readwrite()).collect();
+    let mut rws: Vec<PyReadwriteArray1<'py, f64>> =
+        outs.iter().map(PyArrayMethods::readwrite).collect();
     let mut slices: Vec<&mut [f64]> = Vec::with_capacity(rws.len());
     for rw in &mut rws {
         slices.push(
