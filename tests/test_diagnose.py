@@ -222,3 +222,28 @@ def test_independent_synthetic_recordings():
     (eff,) = contactlab.diagnose(drift).effects
     assert eff.name == "force_drift"
     assert eff.parameters["F1"] == pytest.approx(2.0 * 16 / 5.0, rel=0.05)  # N/s × duration
+
+
+@pytest.mark.parametrize(
+    ("make", "match"),
+    [
+        (lambda t, x, F: (t, x, 0.0 * F), r"channel 'F' is constant \(0 N"),
+        (lambda t, x, F: (t, x, 0.0 * F + 3.0), r"channel 'F' is constant \(3 N"),
+        (lambda t, x, F: (t, x, F * 1e300), r"channel 'F' holds .*e\+30\d N at sample \d+"),
+        (lambda t, x, F: (t, x * 1e300, F), r"channel 'x' holds .* m at sample"),
+        (lambda t, x, F: (t, x, F * 1e-300), "no measurable signal"),
+        (lambda t, x, F: (t * 1e300, x, F), "not a time in seconds"),
+        (lambda t, x, F: (t, x, -F), r"wrong way: ∮F dx = -"),
+        (
+            lambda t, x, F: (t, x, np.random.default_rng(1).normal(0.0, 1.0, F.size)),
+            "force does not follow the displacement",
+        ),
+    ],
+)
+def test_bad_data_gets_a_sentence_about_the_data(make, match):
+    # issue 8: no "initial value 1.0 outside [nan, nan]", "h0 must be finite and > 0, got
+    # -2.9e-17", overflow warning or traceback reaches the user (warnings are errors here)
+    rec = hidden_effect_recording([], seed=SEED + 10)
+    with pytest.raises(InputError, match=match) as exc:
+        contactlab.diagnose(make(*rec.arrays()), max_effects=1)
+    assert "initial value" not in str(exc.value) and "must be finite" not in str(exc.value)

@@ -60,7 +60,7 @@ def test_candidate_reproduces_generator(effect):
     rec = hidden_effect_recording([effect], model="normal", noise=1e-12, seed=SEED)
     t, p, delta = rec.arrays()
     fam = NormalFamily()
-    d = Prepared.build(t, p, delta)
+    d = Prepared.build(t, p, delta, errors_in_input=False)
     d.extra.update({"omega": 2 * np.pi * rec.truth["base"]["f0"]})
     d.extra["delta_r"] = rec.truth["base"]["delta_r"]
     fam.prepare(d)

@@ -193,3 +193,18 @@ def test_locate_statements_carry_numbers():
     statements, nums = locate(d, -(t / t[-1]), FAM)
     r = nums["time_thirds_rms"]
     assert r[0] < r[1] < r[2]
+
+
+def test_branch_scale_follows_a_changing_displacement_offset():
+    # issue 13: the λ-scaled element must see x - x0 for the x0 of each evaluation, not the
+    # displacement of the first evaluation (a fit changes x0 between calls)
+    rec = hidden_effect_recording([], noise=1e-12, seed=4)
+    t, x, F = rec.arrays()
+    d = Prepared.build(t, x, F)
+    eff = ("displacement_offset", "non_masing_scaling")
+    p = {"h0": 50.0, "ac": 5e4, "x0": 0.0, "lam": 1.6}
+    FAM.predict(p, eff, d)  # first call fills any cache with x0 = 0
+    p["x0"] = 4e-6
+    got = FAM.predict(p, eff, d)
+    want = scaled_force(Masing(50.0, 5e4).virgin, 1.6, memory(x - 4e-6))
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * 50.0)

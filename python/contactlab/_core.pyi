@@ -55,3 +55,22 @@ def poly_fit(x: _F, y: _F, degree: int, weights: _F | None = None) -> _F: ...
 def poly_roots_in(c: _F, lo: float, hi: float) -> _F: ...
 def poly_min_on(c: _F, lo: float, hi: float) -> tuple[float, float]: ...
 def fold_cycles(x: _F, start: float, period: float, n_cycles: int, n_bins: int) -> _F: ...
+
+# --- structures with joints (contactlab.structure) ---
+def structure_simulate(
+    n: int,
+    m: _F,
+    c: _F,
+    k: _F,
+    joints: list[tuple[str, int, int, _F, _F, _F]],
+    t: _F,
+    x0: _F,
+    v0: _F,
+    force: _F | None = None,
+    base: _F | None = None,
+    base_velocity: _F | None = None,
+    kr: _F | None = None,
+    cr: _F | None = None,
+    rtol: float = 1e-10,
+    max_iter: int = 30,
+) -> dict[str, object]: ...

@@ -24,6 +24,8 @@ _VERB_MODULES = [
     "contactlab.commands.simulate",
     "contactlab.commands.demo",
     "contactlab.commands.diagnose",
+    "contactlab.commands.export",
+    "contactlab.commands.structure",
 ]
 
 

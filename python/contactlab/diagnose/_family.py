@@ -13,7 +13,9 @@ from ._signal import (
     check_uniform,
     derivatives,
     dominant_period_samples,
+    filter_input,
     find_cycles,
+    input_noise,
     smooth_window,
 )
 
@@ -63,14 +65,64 @@ class Prepared:
         return float(self.t[-1] - self.t[0])
 
     @classmethod
-    def build(cls, t: np.ndarray, u: np.ndarray, y: np.ndarray | None = None) -> Prepared:
+    def build(
+        cls,
+        t: np.ndarray,
+        u: np.ndarray,
+        y: np.ndarray | None = None,
+        *,
+        errors_in_input: bool = True,
+    ) -> Prepared:
+        """Checks, derivatives and cycles of a recording.
+
+        Errors in variables: with ``errors_in_input`` the input's sensor noise ``σu`` is
+        estimated from the data (:func:`input_noise`) and every candidate sees the same
+        zero-phase filtered input (:func:`filter_input`), so that no candidate can lower the
+        error by smoothing the input itself (a fractional delay interpolates between
+        samples and would). ``extra`` records ``u_noise`` (σu), ``u_filter`` (the
+        window, samples; 0 when the input is used as measured) and ``u_raw``.
+        """
         dt = check_uniform(t)
         per = dominant_period_samples(u)
         window = smooth_window(per)
         ud, udd = derivatives(u, dt, window)
         cyc = find_cycles(u, per)
         yy = np.full_like(u, np.nan) if y is None else y
-        return cls(t, u, yy, dt, window, ud, udd, cyc)
+        extra: dict[str, Any] = {"u_raw": u, "u_noise": 0.0, "u_filter": 0}
+        uf = u
+        if errors_in_input:
+            sig = input_noise(u)
+            extra["u_noise"] = sig
+            uf, extra["u_filter"] = filter_input(u, per, sig)
+        return cls(t, uf, yy, dt, window, ud, udd, cyc, extra)
+
+
+#: largest plausible channel delay, as a fraction of the excitation period: anti-alias
+#: filters and converters of a test rig skew channels by a few samples, which at any sensible
+#: sampling rate is well below 2 % of a period (7°); a larger "delay" is a model error.
+MAX_DELAY_FRACTION = 0.02
+
+
+def implausible_common(cand: Candidate, p: dict[str, float], d: Prepared) -> str | None:
+    """Reason a fitted effect is physically implausible, or None (checks shared by families):
+    a parameter at the edge of its physical range, a delay of a large fraction of a period."""
+    for s in cand.params:
+        v = p[s.name]
+        if not np.isfinite(v):
+            return f"{s.name} is not finite"
+        span = s.upper - s.lower if np.isfinite(s.upper - s.lower) else None
+        for bound in (s.lower, s.upper):
+            if np.isfinite(bound) and span and abs(v - bound) <= 1e-3 * span and bound != s.null:
+                return f"{s.name} = {v:.4g} {s.unit} sits at the limit of its physical range"
+    if "tau" in p and cand.name == "channel_delay":
+        period = d.cycles.period_samples * d.dt
+        if abs(p["tau"]) > MAX_DELAY_FRACTION * period:
+            return (
+                f"a delay of {p['tau']:.3g} s is {100 * abs(p['tau']) / period:.1f} % of the "
+                f"excitation period (plausible: below {100 * MAX_DELAY_FRACTION:g} %): the base "
+                "model, not the sensors, is off"
+            )
+    return None
 
 
 class Family(Protocol):
@@ -82,6 +134,8 @@ class Family(Protocol):
 
     input_name: str
     output_name: str
+    input_unit: str
+    output_unit: str
 
     def prepare(self, d: Prepared) -> None: ...
 
@@ -102,3 +156,9 @@ class Family(Protocol):
     ) -> tuple[dict[str, float], dict[str, float]]: ...
 
     def base_model(self, p: dict[str, float], context: dict[str, float]) -> Any: ...
+
+    def slope(self, p: dict[str, float], d: Prepared) -> np.ndarray | None: ...
+
+    def implausible(self, name: str, p: dict[str, float], d: Prepared) -> str | None: ...
+
+    def regime(self, p: dict[str, float], d: Prepared) -> str | None: ...

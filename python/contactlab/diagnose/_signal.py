@@ -15,11 +15,13 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.ndimage import uniform_filter1d
-from scipy.signal import savgol_filter
+from scipy.signal import savgol_coeffs, savgol_filter
 
 from ..errors import InputError
 
 _MAD_TO_SIGMA = 1.0 / 0.6744897501960817
+INPUT_FILTER_FRACTION = 0.04
+INPUT_NOISE_FLOOR = 1e-5
 
 
 def check_uniform(t: np.ndarray) -> float:
@@ -52,9 +54,9 @@ def dominant_period_samples(u: np.ndarray) -> float:
     return n / k
 
 
-def smooth_window(period_samples: float, fraction: float = 0.08) -> int:
-    """Odd Savitzky-Golay window covering ``fraction`` of a period (at least 7 samples)."""
-    w = max(7, round(fraction * period_samples))
+def smooth_window(period_samples: float, fraction: float = 0.08, least: int = 7) -> int:
+    """Odd Savitzky-Golay window covering ``fraction`` of a period (at least ``least``)."""
+    w = max(least, round(fraction * period_samples))
     return w if w % 2 == 1 else w + 1
 
 
@@ -64,6 +66,47 @@ def derivatives(u: np.ndarray, dt: float, window: int) -> tuple[np.ndarray, np.n
     d1 = savgol_filter(u, w, 3, deriv=1, delta=dt, mode="interp")
     d2 = savgol_filter(u, w, 3, deriv=2, delta=dt, mode="interp")
     return d1, d2
+
+
+def input_noise(u: np.ndarray) -> float:
+    """Sensor-noise RMS of an input channel, estimated from the data.
+
+    The smaller of two estimates that a smooth drive can only bias upwards: the tangential
+    analysis's second-difference estimator
+    (:func:`contactlab.tangential.uncertainty.x_noise_var`) and the robust scale of what a
+    local cubic over 7 samples leaves (``var = σ² (1 - c0)``, ``c0`` the filter's centre
+    coefficient), which a sine at 50 samples per period biases by about 3e-5 of its
+    amplitude only. Zero when that is below :data:`INPUT_NOISE_FLOOR` of the input's RMS
+    (a simulated or noise-free input: nothing to filter).
+    """
+    from ..tangential.uncertainty import x_noise_var
+
+    if u.size < 16:
+        return 0.0
+    r = u - savgol_filter(u, 7, 3, mode="interp")
+    c0 = float(savgol_coeffs(7, 3)[3])
+    mad = float(np.median(np.abs(r - np.median(r))))
+    est = min(float(np.sqrt(x_noise_var(u, None))), mad * _MAD_TO_SIGMA / np.sqrt(1.0 - c0))
+    ref = float(np.sqrt(np.mean((u - u.mean()) ** 2)))
+    return est if est > INPUT_NOISE_FLOOR * ref else 0.0
+
+
+def filter_input(u: np.ndarray, period_samples: float, sigma: float) -> tuple[np.ndarray, int]:
+    """The input every candidate sees: zero-phase Savitzky-Golay smoothing (cubic) over
+    :data:`INPUT_FILTER_FRACTION` of a period when the input carries noise, else ``u``.
+
+    A cubic over 4 % of a period changes a sine by about 3e-5 of its amplitude (far below
+    any sensor's noise) and divides white noise by ``√(w/2.25)``, leaving what remains
+    correlated over the window: a fractional delay can no longer average it away.
+    Returns the input and the window (0: not filtered).
+    """
+    if not sigma > 0.0:
+        return u, 0
+    w = smooth_window(period_samples, INPUT_FILTER_FRACTION, 5)
+    w = min(w, u.size - (1 - u.size % 2))
+    if w < 5:
+        return u, 0
+    return savgol_filter(u, w, 3, mode="interp"), w
 
 
 def noise_rms(residual: np.ndarray) -> float:

@@ -43,7 +43,7 @@ import numpy as np
 from scipy import fft
 
 from ..errors import InputError
-from ._family import Candidate, ParamSpec, Prepared
+from ._family import Candidate, ParamSpec, Prepared, implausible_common
 from ._signal import shift
 
 _INF = np.inf
@@ -159,6 +159,8 @@ class NormalFamily:
     candidates = CANDIDATES
     input_name = "p"
     output_name = "delta"
+    input_unit = "Pa"
+    output_unit = "m"
 
     def prepare(self, d: Prepared) -> None:
         """Mean pressure, excitation angular frequency and displacement scale.
@@ -233,6 +235,20 @@ class NormalFamily:
         from ..normal import KelvinVoigt
 
         return KelvinVoigt(p["k"], p["psi"], context["omega"], p0=p["p0"])
+
+    def slope(self, p: dict[str, float], d: Prepared) -> None:
+        """The linear base has one compliance ``1/k`` everywhere: pressure noise adds the same
+        output error at every sample, so no sample is weighted differently."""
+        return None
+
+    def implausible(self, name: str, p: dict[str, float], d: Prepared) -> str | None:
+        """Why a fitted effect cannot be physical on this rig, or None."""
+        return implausible_common(self.candidates[name], p, d)
+
+    def regime(self, p: dict[str, float], d: Prepared) -> str:
+        psi = p["psi"]
+        kind = "viscoelastic (Kelvin-Voigt)" if 0.0 < psi < 1.0 else "outside 0 < ψ < 1"
+        return f"base model regime: {kind}; k = {p['k']:.4g} Pa/m, ψ = {psi:.3g}"
 
     @staticmethod
     def loop_energy(u: np.ndarray, y: np.ndarray) -> float:

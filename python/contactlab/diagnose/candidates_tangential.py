@@ -43,14 +43,22 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from scipy.signal import savgol_filter
 
+from ..errors import InputError
 from ..masing import Masing, loop_area
-from ._family import Candidate, ParamSpec, Prepared
+from ._family import Candidate, ParamSpec, Prepared, implausible_common
 from ._signal import shift
 from .scaled_masing import memory, scaled_force
 
 _INF = np.inf
 
+# Physical ranges of the real-friction effects (a fit at their edge is refused as
+# implausible): static over kinetic friction of dry metal pairs is at most about 2 (a full
+# branch peaks near h0 (1 + 2 s_b) when the slip distance is long against 1/ac: s_b <= 0.5);
+# Stribeck's low-speed excess within -0.5..1 of the sliding force; friction along a track
+# varies by tens of per cent, not by its own size (each Fourier coefficient within ±0.3);
+# the friction force of the two directions differs by less than a factor 3 (|alpha| <= 0.5).
 CANDIDATES: dict[str, Candidate] = {
     c.name: c
     for c in (
@@ -96,7 +104,7 @@ CANDIDATES: dict[str, Candidate] = {
         ),
         Candidate(
             "asymmetry",
-            (ParamSpec("alpha", "-", 0.0, -0.95, 0.95, "one"),),
+            (ParamSpec("alpha", "-", 0.0, -0.5, 0.5, "one"),),
             "saturation force h0(1+alpha) in the positive, h0(1-alpha) in the negative direction",
         ),
         Candidate(
@@ -108,6 +116,40 @@ CANDIDATES: dict[str, Candidate] = {
             "parameter_drift",
             (ParamSpec("beta", "-", 0.0, -0.95, 5.0, "one"),),
             "saturation force drifting over the recording: h0(t) = h0 (1 + beta t/T)",
+        ),
+        Candidate(
+            "stribeck",
+            (
+                ParamSpec("s", "-", 0.0, -0.5, 1.0, "one"),
+                ParamSpec("v_s", "m/s", np.nan, 0.0, _INF, "v"),
+            ),
+            "velocity-dependent friction: F = h (1 + s exp(-|ẋ|/v_s)) (Stribeck, s > 0: "
+            "friction weakening with sliding speed)",
+        ),
+        Candidate(
+            "position_friction",
+            tuple(ParamSpec(n, "-", 0.0, -0.3, 0.3, "one") for n in ("a1", "b1", "a2", "b2")),
+            "friction varying along the track (wavy plateaus): F = h (1 + Σ a_k cos(kπ ξ) + "
+            "b_k sin(kπ ξ)), ξ the position scaled to -1..1 over the stroke, k = 1, 2",
+        ),
+        Candidate(
+            "stick_slip",
+            (
+                ParamSpec("s_b", "-", 0.0, 0.0, 0.5, "one"),
+                ParamSpec("ell", "m", np.nan, 0.0, _INF, "x"),
+            ),
+            "breakaway after each reversal: the branch rises s_b above Masing's and falls back "
+            "over a slip distance ell (static friction above kinetic)",
+        ),
+        Candidate(
+            "normal_load",
+            (
+                ParamSpec("eps_c", "-", 0.0, -0.5, 0.5, "one"),
+                ParamSpec("eps_s", "-", 0.0, -0.5, 0.5, "one"),
+                ParamSpec("f_n", "Hz", np.nan, 0.0, _INF, "fq"),
+            ),
+            "normal load fluctuating at its own frequency f_n: F = h (1 + eps_c cos 2π f_n t "
+            "+ eps_s sin 2π f_n t)",
         ),
     )
 }
@@ -132,6 +174,48 @@ def series_backbone(h0: float, ac: float, C_s: float, x_max: float) -> tuple[np.
     return u + C_s * f, f
 
 
+def breakaway(
+    h: np.ndarray, x: np.ndarray, reversals: np.ndarray, s_b: float, ell: float
+) -> np.ndarray:
+    """Branches with a breakaway peak: after each reversal ``r`` the rise ``h - h_r`` is
+    scaled by ``1 + s_b exp(-|x - x_r| / ell)`` — equal to Masing's at the reversal (no
+    jump) and far from it, above it in between (static friction above kinetic). Before the
+    first reversal the virgin curve from the origin is treated the same way."""
+    if s_b == 0.0:
+        return h
+    idx = np.searchsorted(reversals, np.arange(h.size), side="right") - 1
+    has = idx >= 0
+    r = reversals[np.where(has, idx, 0)] if reversals.size else np.zeros(h.size, int)
+    xr = np.where(has, x[r], 0.0)
+    hr = np.where(has, h[r], 0.0)
+    return hr + (h - hr) * (1.0 + s_b * np.exp(-np.abs(x - xr) / max(ell, 1e-300)))
+
+
+def breakaway_force(h0: float, ac: float, s_b: float, ell: float) -> float:
+    """Peak force of a full branch from ``-h0`` with the breakaway of :func:`breakaway`
+    (the static friction force; ``h0`` without breakaway)."""
+    u = np.linspace(0.0, 20.0 / ac + 20.0 * ell, 4001)
+    rise = 2.0 * h0 * -np.expm1(-ac * u / 2.0)
+    return float(np.max(-h0 + rise * (1.0 + s_b * np.exp(-u / max(ell, 1e-300)))))
+
+
+def _grid(x: np.ndarray, F: np.ndarray) -> tuple[float, float, float]:
+    """Best ``(rss, h0, ac)`` over ``ac·max|x|`` from pre-sliding to gross sliding."""
+    xmax = float(np.max(np.abs(x)))
+    best = (np.inf, 1.0, 1.0)
+    for q in np.geomspace(0.2, 5000.0, 23):
+        ac = q / xmax
+        g = Masing(1.0, ac).force(x)
+        gg = float(g @ g)
+        if gg == 0.0:
+            continue
+        h0 = max(float(g @ F) / gg, 1e-12)
+        r = float(np.sum((h0 * g - F) ** 2))
+        if r < best[0]:
+            best = (r, h0, ac)
+    return best
+
+
 class TangentialFamily:
     """Masing base model with the tangential candidate library (see module docstring)."""
 
@@ -140,13 +224,51 @@ class TangentialFamily:
     candidates = CANDIDATES
     input_name = "x"
     output_name = "F"
+    input_unit = "m"
+    output_unit = "N"
 
     def prepare(self, d: Prepared) -> None:
-        """Nothing to precompute beyond :class:`Prepared` (memory is cached lazily)."""
+        """The stroke (centre and half-range of x) that scales the position of
+        ``position_friction``; kept when given by a fitted model's context."""
+        if "x_mid" not in d.extra:
+            lo, hi = float(np.min(d.u)), float(np.max(d.u))
+            d.extra["x_mid"], d.extra["x_half"] = 0.5 * (lo + hi), 0.5 * (hi - lo) or 1.0
 
     def context(self, d: Prepared) -> dict[str, float]:
-        """Nothing beyond the parameters is needed to simulate a fitted model."""
-        return {}
+        """The stroke scaling of ``position_friction`` (the rest are parameters)."""
+        return {"x_mid": d.extra["x_mid"], "x_half": d.extra["x_half"]}
+
+    def start_effect(
+        self, name: str, p: dict[str, float], d: Prepared, residual: np.ndarray
+    ) -> dict[str, float]:
+        """Starting values of an effect's nonlinear parameters from the current residual.
+
+        ``normal_load``: the frequency whose ``h cos, h sin`` pair explains most of the
+        residual (measured minus model), scanned from 0.05 to 3 excitation frequencies at a
+        quarter of the record's frequency resolution; ``stick_slip``: a slip distance of
+        ``1/ac``; ``stribeck``: ``v_s`` of the RMS speed.
+        """
+        if name == "stick_slip":
+            return {"ell": 1.0 / p["ac"]}
+        if name == "stribeck":
+            return {"v_s": float(np.sqrt(np.mean(d.ud**2)))}
+        if name != "normal_load":
+            return {}
+        h = self.predict(p, (), d)
+        tt = d.t - d.t[0]
+        f_exc = 1.0 / (d.cycles.period_samples * d.dt)
+        freqs = np.arange(0.05 * f_exc, 3.0 * f_exc, 0.25 / d.duration)
+        # a fluctuation locked to the drive is position_friction's: skip the harmonics
+        k = np.round(freqs / f_exc)
+        freqs = freqs[(k < 1) | (np.abs(freqs - k * f_exc) >= 1.0 / d.duration)]
+        best, fbest = -1.0, f_exc
+        for f in freqs:
+            A = np.column_stack((h * np.cos(2 * np.pi * f * tt), h * np.sin(2 * np.pi * f * tt)))
+            coef = np.linalg.lstsq(A, residual, rcond=None)[0]
+            gain = float(np.sum((A @ coef) ** 2))
+            if gain > best:
+                best, fbest = gain, float(f)
+        return {"f_n": fbest}
 
     def check(self, effects: tuple[str, ...]) -> bool:
         """All tangential effects combine (in the order of the module docstring)."""
@@ -165,23 +287,31 @@ class TangentialFamily:
             "x": 0.05 * xs,
             "tau": d.cycles.period_samples * d.dt / 100.0,
             "one": 1.0,
+            "v": rms(d.ud),
+            "fq": 1.0 / d.duration,
         }
 
     def initial_base(self, d: Prepared) -> dict[str, float]:
-        """Grid over ``ac·max|x|`` with ``h0`` by linear least squares (F is linear in h0)."""
-        xmax = float(np.max(np.abs(d.u)))
-        best = (np.inf, 1.0, 1.0)
-        for q in np.geomspace(0.2, 50.0, 13):
-            ac = q / xmax
-            g = Masing(1.0, ac).force(d.u)
-            gg = float(g @ g)
-            if gg == 0.0:
-                continue
-            h0 = max(float(g @ d.y) / gg, 1e-12)
-            r = float(np.sum((h0 * g - d.y) ** 2))
-            if r < best[0]:
-                best = (r, h0, ac)
-        return {"h0": best[1], "ac": best[2]}
+        """Grid over ``ac·max|x|`` with ``h0`` by linear least squares (F is linear in h0).
+
+        Refuses, with a sentence about the data, a force that no Masing curve follows and a
+        loop that runs the wrong way (∮F dx < 0: the force recorded with the opposite sign).
+        """
+        rss, h0, ac = _grid(d.u, d.y)
+        var = float(np.sum((d.y - d.y.mean()) ** 2))
+        if not rss < 0.9 * var:
+            if _grid(d.u, -d.y)[0] < 0.5 * var:
+                raise InputError(
+                    f"the loop runs the wrong way: ∮F dx = {loop_area(d.u, d.y):.3g} J over the "
+                    "recording, but a passive joint dissipates (∮F dx > 0); the force channel "
+                    "is recorded with the opposite sign — negate F"
+                )
+            raise InputError(
+                f"the force does not follow the displacement: the best Masing curve explains "
+                f"{100 * max(0.0, 1 - rss / var):.0f} % of the force variance — no friction "
+                "loop in this recording (unrelated or swapped channels?)"
+            )
+        return {"h0": h0, "ac": ac}
 
     def predict(self, p: dict[str, float], effects: tuple[str, ...], d: Prepared) -> np.ndarray:
         """Measured force predicted for the measured displacement ``d.u``."""
@@ -195,8 +325,11 @@ class TangentialFamily:
         else:
             core = Masing(p["h0"], p["ac"])
         if "non_masing_scaling" in effects:
+            # the reversal bookkeeping depends on x (through x0 too: the start at the origin
+            # and the mirrored targets on the virgin curve), so a cached one is reused only
+            # for the very same displacement (issue 13)
             mem = d.extra.get("memory")
-            if mem is None:
+            if mem is None or not np.array_equal(mem.x, x):
                 mem = d.extra["memory"] = memory(x)
             h = scaled_force(core.virgin, p["lam"], mem)
         else:
@@ -205,6 +338,22 @@ class TangentialFamily:
             h = h + p["alpha"] * np.abs(h)
         if "parameter_drift" in effects:
             h = h * (1.0 + p["beta"] * (d.t - d.t[0]) / d.duration)
+        if "stick_slip" in effects:
+            h = breakaway(h, x, d.cycles.reversals, p["s_b"], p["ell"])
+        if "stribeck" in effects:
+            h = h * (1.0 + p["s"] * np.exp(-np.abs(d.ud) / max(p["v_s"], 1e-300)))
+        if "position_friction" in effects:
+            xi = np.pi * (x - d.extra["x_mid"]) / d.extra["x_half"]
+            h = h * (
+                1.0
+                + p["a1"] * np.cos(xi)
+                + p["b1"] * np.sin(xi)
+                + p["a2"] * np.cos(2 * xi)
+                + p["b2"] * np.sin(2 * xi)
+            )
+        if "normal_load" in effects:
+            ph = 2.0 * np.pi * p["f_n"] * (d.t - d.t[0])
+            h = h * (1.0 + p["eps_c"] * np.cos(ph) + p["eps_s"] * np.sin(ph))
         F = h
         if "parallel_stiffness" in effects:
             F = F + p["k_p"] * x
@@ -234,6 +383,16 @@ class TangentialFamily:
                 "h0_plus": s,
                 "h0_minus": s2,
             }
+        if effect == "stick_slip":
+            keys = ("h0", "ac", "s_b", "ell")
+            val = breakaway_force(*(p[k] for k in keys))
+            var = 0.0
+            for i, k in enumerate(keys):
+                step = 1e-4 * abs(p[k]) or 1e-12
+                q = [p[j] for j in keys]
+                q[i] += step
+                var += ((breakaway_force(*q) - val) / step * se.get(k, np.inf)) ** 2
+            return {"breakaway_force": val}, {"breakaway_force": float(np.sqrt(var))}
         if effect == "parameter_drift":
             h0, b = p["h0"], p["beta"]
             return {"h0_end": h0 * (1 + b)}, {
@@ -243,6 +402,61 @@ class TangentialFamily:
 
     def base_model(self, p: dict[str, float], context: dict[str, float]) -> Any:
         return Masing(p["h0"], p["ac"])
+
+    def slope(self, p: dict[str, float], d: Prepared) -> np.ndarray:
+        """Local slope ``|dF/dx|`` where the input noise turns into force error: the larger of
+        the base Masing element's slope along the (filtered) displacement and the measured
+        path's (``|dF/dt| / |dx/dt|``, Savitzky-Golay derivatives), within ``[0, h0·ac]`` —
+        the steepest slope of the exponential element, at a reversal. The measured path is
+        what marks a sticking phase (the force changes while the displacement does not),
+        which a steep element crosses in a fraction of a micrometre."""
+        h = Masing(p["h0"], p["ac"]).force(d.u)
+        kmax = p["h0"] * p["ac"]
+        w = min(d.window, d.y.size - (1 - d.y.size % 2))
+        yd = savgol_filter(d.y, w, 3, deriv=1, mode="interp")
+        ud = savgol_filter(d.u, w, 3, deriv=1, mode="interp")
+        with np.errstate(divide="ignore", invalid="ignore"):
+            km = np.abs(np.gradient(h) / np.gradient(d.u))
+            kd = np.abs(yd / ud)
+        k = np.fmax(np.where(np.isfinite(km), km, kmax), np.where(np.isfinite(kd), kd, kmax))
+        return np.clip(k, 0.0, kmax)
+
+    def implausible(self, name: str, p: dict[str, float], d: Prepared) -> str | None:
+        """Why a fitted effect cannot be physical on this rig, or None."""
+        why = implausible_common(self.candidates[name], p, d)
+        if why:
+            return why
+        if name == "non_masing_scaling" and not 0.5 <= p["lam"] <= 8.0:
+            return f"branch scale lam = {p['lam']:.3g} is outside 0.5..8 (no known joint)"
+        if name == "normal_load":
+            f_exc = 1.0 / (d.cycles.period_samples * d.dt)
+            k = round(p["f_n"] / f_exc)
+            if k >= 1 and abs(p["f_n"] - k * f_exc) < 1.0 / d.duration:
+                return (
+                    f"a load fluctuation at {p['f_n']:.4g} Hz, harmonic {k} of the excitation, "
+                    "cannot be told from friction that varies along the track "
+                    "(position_friction)"
+                )
+        if name == "displacement_offset":
+            amp = 0.5 * float(np.ptp(d.u))
+            if abs(p["x0"]) > 0.5 * amp:
+                return f"a displacement offset of {p['x0']:.3g} m is over half the amplitude"
+        return None
+
+    def regime(self, p: dict[str, float], d: Prepared) -> str:
+        """Pre-sliding, transition or gross sliding, from ``ac·A`` of the base fit."""
+        amp = 0.5 * float(np.ptp(d.u))
+        q = p["ac"] * amp
+        if q < 1.0:
+            kind = "pre-sliding (ac·A < 1: only h0·ac, the initial stiffness, is well fixed)"
+        elif q < 10.0:
+            kind = "transition from pre-sliding to sliding (h0 and ac both fixed)"
+        else:
+            kind = (
+                "gross sliding (ac·A > 10: near-rectangular loops; h0 is the plateau force, "
+                "ac only bounded from below)"
+            )
+        return f"base model regime: {kind}; h0 = {p['h0']:.4g} N, ac·A = {q:.3g}"
 
     @staticmethod
     def loop_energy(u: np.ndarray, y: np.ndarray) -> float:

@@ -26,15 +26,22 @@ displacement, so agreement with the workflow's models is a real check.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 from scipy.optimize import brentq
 
 from ..errors import InputError
-from ..io import Recording
 from ..masing import Masing
+from ._gen_common import (
+    HiddenEffectRecording,
+    block_excitation,
+    effect_sizes,
+    measure,
+    rms_of,
+    start_index,
+)
+from .candidates_tangential import breakaway
+from .generator_normal import hidden_effect_recording_normal
 from .scaled_masing import memory, scaled_force
 
 TANGENTIAL_EFFECTS = (
@@ -49,68 +56,21 @@ TANGENTIAL_EFFECTS = (
     "asymmetry",
     "non_masing_scaling",
     "parameter_drift",
+    "stribeck",
+    "position_friction",
+    "stick_slip",
+    "normal_load",
 )
 
-
-@dataclass
-class HiddenEffectRecording(Recording):
-    """A generated :class:`contactlab.io.Recording` (SI units; write it with
-    :func:`contactlab.io.write_recording`) that also carries the ``truth``: base parameters,
-    active effects with their parameters, magnitudes and noise levels."""
-
-    truth: dict[str, Any] = field(default_factory=dict)
-    model: str = "tangential"
-
-    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        keys = ("x", "F") if self.model == "tangential" else ("p", "delta")
-        return self.t, self.data[keys[0]], self.data[keys[1]]
-
-
-class Profile:
-    """A piecewise-constant level smoothed by cubic steps of width ``w``, with its integral."""
-
-    def __init__(self, levels: Iterable[float], starts: Iterable[float], w: float) -> None:
-        self.levels = np.asarray(list(levels), float)
-        self.starts = np.asarray(list(starts), float)
-        self.w = float(w)
-
-    def __call__(self, t: np.ndarray) -> np.ndarray:
-        out = np.full_like(t, self.levels[0], dtype=float)
-        for lv_prev, lv, ts in zip(self.levels[:-1], self.levels[1:], self.starts, strict=True):
-            u = np.clip((t - ts) / self.w, 0.0, 1.0)
-            out += (lv - lv_prev) * u * u * (3.0 - 2.0 * u)
-        return out
-
-    def integral(self, t: np.ndarray) -> np.ndarray:
-        out = self.levels[0] * t
-        for lv_prev, lv, ts in zip(self.levels[:-1], self.levels[1:], self.starts, strict=True):
-            u = (t - ts) / self.w
-            uc = np.clip(u, 0.0, 1.0)
-            part = np.where(u > 1.0, 0.5 + (u - 1.0), uc**3 - uc**4 / 2.0)
-            out += (lv - lv_prev) * self.w * np.where(u < 0.0, 0.0, part)
-        return out
-
-
-def block_excitation(
-    amplitudes: Iterable[float], freqs: Iterable[float], cycles_per_block: int
-) -> tuple[Callable[[np.ndarray], np.ndarray], float, float]:
-    """Closed-form excitation ``x(t)`` (zero for ``t < 0``), its duration and max frequency."""
-    A = list(amplitudes)
-    f = list(freqs)
-    durations = [cycles_per_block / fi for fi in f]
-    starts = np.cumsum(durations)[:-1]
-    w = 1.0 / min(f)
-    # amplitude ramps in from zero over the first cycle, so x(t) = 0 for t < 0 joins smoothly
-    amp = Profile([0.0, *A], [0.0, *(starts - w / 2)], w)
-    fr = Profile(f, starts - w / 2, w)
-    total = float(np.sum(durations))
-
-    def x(t: np.ndarray) -> np.ndarray:
-        tt = np.asarray(t, float)
-        val = amp(tt) * np.sin(2.0 * np.pi * fr.integral(tt))
-        return np.where(tt < 0.0, 0.0, val)
-
-    return x, total, max(f)
+#: fixed shapes of the real-friction effects (the size parameter is solved for): Stribeck
+#: speed as a fraction of the RMS sliding speed, slip distance of the breakaway in units of
+#: 1/ac, the wave of friction along the track (one wave over the stroke, phase), and the
+#: normal-load fluctuation's frequency (in units of the fastest block's, no harmonic of
+#: any block's drive) and phase
+STRIBECK_SPEED = 0.5
+BREAKAWAY_DISTANCE = 1.0
+TRACK_WAVES, TRACK_PHASE = 1.0, 0.7
+LOAD_FREQUENCY, LOAD_PHASE = 0.23, 0.3
 
 
 def _derivs(fun: Callable[[np.ndarray], np.ndarray], t: np.ndarray, T: float):
@@ -118,10 +78,6 @@ def _derivs(fun: Callable[[np.ndarray], np.ndarray], t: np.ndarray, T: float):
     d1 = (fun(t + h) - fun(t - h)) / (2 * h)
     d2 = (fun(t + h) - 2 * fun(t) + fun(t - h)) / (h * h)
     return d1, d2
-
-
-def _rms(a: np.ndarray) -> float:
-    return float(np.sqrt(np.mean(a * a)))
 
 
 def _tangential_force(
@@ -143,13 +99,29 @@ def _tangential_force(
         h = h + effects["asymmetry"] * np.abs(h)
     if "parameter_drift" in effects:
         h = h * (1.0 + effects["parameter_drift"] * (t - t[0]) / (t[-1] - t[0]))
+    v, a = _derivs(xfun, t - tau, period)
+    if "stick_slip" in effects:
+        # reversals of the contact's own motion (sign changes of its exact velocity)
+        rev = np.flatnonzero(np.diff(np.sign(v)) != 0)
+        rev = rev[np.abs(xc[rev]) > 0.05 * np.max(np.abs(xc))]
+        h = breakaway(h, xc, rev, effects["stick_slip"], BREAKAWAY_DISTANCE / ac)
+    if "stribeck" in effects:
+        vs = STRIBECK_SPEED * rms_of(v)
+        h = h * (1.0 + effects["stribeck"] * np.exp(-np.abs(v) / vs))
+    if "position_friction" in effects:
+        xi = xc / np.max(np.abs(xc))
+        h = h * (
+            1.0 + effects["position_friction"] * np.sin(TRACK_WAVES * 2 * np.pi * xi + TRACK_PHASE)
+        )
+    if "normal_load" in effects:
+        ph = 2 * np.pi * LOAD_FREQUENCY / period * (t - t[0]) + LOAD_PHASE
+        h = h * (1.0 + effects["normal_load"] * np.sin(ph))
     x_meas = xfun(t)
     if "displacement_offset" in effects:
         x_meas = x_meas + effects["displacement_offset"]
     if "series_compliance" in effects:
         x_meas = x_meas + h * effects["series_compliance"]
     F = h
-    v, a = _derivs(xfun, t - tau, period)
     if "parallel_stiffness" in effects:
         F = F + effects["parallel_stiffness"] * xc
     if "viscous_damping" in effects:
@@ -175,6 +147,10 @@ _PARAM_NAME = {
     "asymmetry": "alpha",
     "non_masing_scaling": "lam",
     "parameter_drift": "beta",
+    "stribeck": "s",
+    "position_friction": "eps",
+    "stick_slip": "s_b",
+    "normal_load": "eps",
 }
 
 
@@ -187,6 +163,10 @@ def hidden_effect_recording(
     seed: int = 0,
     cycles_per_block: int = 6,
     samples_per_cycle: int = 120,
+    input_noise: float | None = None,
+    anti_alias: tuple[float, float] | None = None,
+    bits: int | None = None,
+    start: str = "rest",
     **base: float,
 ) -> HiddenEffectRecording:
     """Simulate a recording with hidden effects and sensor noise.
@@ -209,6 +189,19 @@ def hidden_effect_recording(
     cycles_per_block, samples_per_cycle : int
         Excitation cycles per amplitude block (three blocks) and samples per cycle at the
         reference frequency.
+    input_noise : float, optional
+        Input sensor noise RMS relative to the input's amplitude (``max |x|``; 0.002 =
+        0.2 %), instead of the default fifth of ``noise`` relative to its RMS.
+    anti_alias : (float, float), optional
+        Cut-offs of causal 4th-order Butterworth anti-alias filters on the input and output
+        channels, as fractions of the Nyquist frequency; different cut-offs skew the
+        channels (``truth["filter_skew"]``, s).
+    bits : int, optional
+        ADC resolution: each channel quantised to ``bits`` over ±1.25 × its peak.
+    start : {"rest", "steady"}
+        ``"rest"``: the record starts with the joint at rest on its virgin curve;
+        ``"steady"``: the first 1.5 reference cycles after the amplitude ramp are cut, so
+        the record starts in the middle of a loop with its history unseen.
     **base
         Base-model parameters: tangential ``h0`` (N, default 50), ``ac`` (1/m, default 5e4),
         ``f0`` (Hz, default 5).
@@ -226,8 +219,6 @@ def hidden_effect_recording(
     (['F', 'x'], True)
     """
     if model == "normal":
-        from .generator_normal import hidden_effect_recording_normal
-
         return hidden_effect_recording_normal(
             effects,
             magnitude=magnitude,
@@ -235,11 +226,15 @@ def hidden_effect_recording(
             seed=seed,
             cycles_per_block=cycles_per_block,
             samples_per_cycle=samples_per_cycle,
+            input_noise=input_noise,
+            anti_alias=anti_alias,
+            bits=bits,
+            start=start,
             **base,
         )
     if model != "tangential":
         raise InputError(f"model must be 'tangential' or 'normal', got {model!r}")
-    sizes = _sizes(effects, magnitude, TANGENTIAL_EFFECTS)
+    sizes = effect_sizes(effects, magnitude, TANGENTIAL_EFFECTS)
     h0 = float(base.pop("h0", 50.0))
     ac = float(base.pop("ac", 5e4))
     f0 = float(base.pop("f0", 5.0))
@@ -253,13 +248,13 @@ def hidden_effect_recording(
     t = np.arange(round(T * fs) + 1) / fs
     period = 1.0 / fmax
     _x0, F0 = _tangential_force({}, t, xfun, h0, ac, period)
-    Fr = _rms(F0)
+    Fr = rms_of(F0)
 
     def size(name: str, value: float) -> float:
         x1, F1 = _tangential_force({name: value}, t, xfun, h0, ac, period)
         # measured output change, on the measured displacement (what a base fit would see)
         F_on_x1 = Masing(h0, ac).force(x1)
-        return _rms(F1 - F_on_x1) / Fr
+        return rms_of(F1 - F_on_x1) / Fr
 
     params: dict[str, float] = {}
     for name, target in sizes.items():
@@ -271,20 +266,36 @@ def hidden_effect_recording(
             "asymmetry",
             "parameter_drift",
             "non_masing_scaling",
+            "position_friction",
+            "normal_load",
         ):
             sign = 1.0 if rng.random() < 0.5 else -1.0
         params[name] = _solve_size(name, target, sign, size, h0, ac, Fr, period)
     x, F = _tangential_force(params, t, xfun, h0, ac, period)
-    x_noise = 0.2 * noise * _rms(x)
-    F_noise = noise * _rms(F)
-    xm = x + rng.normal(0.0, x_noise, x.size)
-    Fm = F + rng.normal(0.0, F_noise, F.size)
+    keep = start_index(start, t, f0, 0.6 * f0)
+    t, x, F = t[keep:] - t[keep], x[keep:], F[keep:]
+    x_noise = (
+        0.2 * noise * rms_of(x) if input_noise is None else input_noise * float(np.max(np.abs(x)))
+    )
+    F_noise = noise * rms_of(F)
+    xm, Fm, info = measure(
+        t,
+        x,
+        F,
+        rng,
+        u_noise=x_noise,
+        y_noise=F_noise,
+        anti_alias=anti_alias,
+        bits=bits,
+        f_ref=f0,
+    )
     truth = {
         "model": "tangential",
         "base": {"h0": h0, "ac": ac, "f0": f0},
-        "effects": {n: {_PARAM_NAME[n]: v} for n, v in params.items()},
+        "effects": {n: {_PARAM_NAME[n]: v, **_fixed(n, ac, period)} for n, v in params.items()},
         "magnitudes": dict(sizes),
         "noise_rms": {"x": x_noise, "F": F_noise},
+        "sensors": {"anti_alias": anti_alias, "bits": bits, "start": start, **info},
     }
     return HiddenEffectRecording(
         t,
@@ -297,16 +308,17 @@ def hidden_effect_recording(
     )
 
 
-def _sizes(
-    effects: Iterable[str] | Mapping[str, float], magnitude: float, known: tuple[str, ...]
-) -> dict[str, float]:
-    sizes = dict(effects) if isinstance(effects, Mapping) else dict.fromkeys(effects, magnitude)
-    for n, m in sizes.items():
-        if n not in known:
-            raise InputError(f"unknown effect {n!r}; choose from {', '.join(known)}")
-        if not (0.0 < float(m) < 1.0):
-            raise InputError(f"magnitude of {n} must be in (0, 1), got {m}")
-    return {n: float(m) for n, m in sizes.items()}
+def _fixed(name: str, ac: float, period: float) -> dict[str, float]:
+    """The fixed shape parameters of a real-friction effect, for the truth."""
+    if name == "stick_slip":
+        return {"ell": BREAKAWAY_DISTANCE / ac}
+    if name == "stribeck":
+        return {"v_s_over_rms_speed": STRIBECK_SPEED}
+    if name == "position_friction":
+        return {"waves_over_stroke": TRACK_WAVES, "phase": TRACK_PHASE}
+    if name == "normal_load":
+        return {"f_n": LOAD_FREQUENCY / period, "phase": LOAD_PHASE}
+    return {}
 
 
 def _solve_size(
@@ -330,6 +342,10 @@ def _solve_size(
         "force_drift": 6.0 * Fr,
         "displacement_offset": 2.0 / ac,
         "channel_delay": 0.25 * period,
+        "stribeck": 3.0,
+        "position_friction": 0.9,
+        "stick_slip": 3.0,
+        "normal_load": 0.5,
         "asymmetry": 0.9,
         "non_masing_scaling": 1.5 if sign > 0 else 0.9,
         "parameter_drift": 0.9,

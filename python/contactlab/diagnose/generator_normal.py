@@ -16,8 +16,15 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..errors import InputError
+from ._gen_common import (
+    HiddenEffectRecording,
+    block_excitation,
+    effect_sizes,
+    measure,
+    rms_of,
+    start_index,
+)
 from .candidates_normal import frequency_domain, kelvin_voigt, nonlinear
-from .generator import HiddenEffectRecording, _rms, _sizes, block_excitation
 
 NORMAL_EFFECTS = (
     "stiffness_nonlinearity",
@@ -68,6 +75,10 @@ def hidden_effect_recording_normal(
     seed: int = 0,
     cycles_per_block: int = 6,
     samples_per_cycle: int = 120,
+    input_noise: float | None = None,
+    anti_alias: tuple[float, float] | None = None,
+    bits: int | None = None,
+    start: str = "rest",
     **base: float,
 ) -> HiddenEffectRecording:
     """Normal-contact recording (``p`` in Pa, ``delta`` in m) with hidden effects.
@@ -76,7 +87,7 @@ def hidden_effect_recording_normal(
     default 5e5), ``f0`` (Hz, default 1). Other arguments as
     :func:`contactlab.diagnose.hidden_effect_recording`.
     """
-    sizes = _sizes(effects, magnitude, NORMAL_EFFECTS)
+    sizes = effect_sizes(effects, magnitude, NORMAL_EFFECTS)
     if {"stiffness_nonlinearity", "asymmetric_branches"} & set(sizes) and (
         "hysteretic_damping" in sizes
     ):
@@ -95,10 +106,10 @@ def hidden_effect_recording_normal(
     t = np.arange(round(T * fs) + 1) / fs
     omega = 2.0 * np.pi * f0
     d0 = _displacement({}, t, pfun, k, psi, omega, 1.0)
-    dr = _rms(d0)
+    dr = rms_of(d0)
 
     def size(name: str, value: float) -> float:
-        return _rms(_displacement({name: value}, t, pfun, k, psi, omega, dr) - d0) / dr
+        return rms_of(_displacement({name: value}, t, pfun, k, psi, omega, dr) - d0) / dr
 
     params: dict[str, float] = {}
     for name, target in sizes.items():
@@ -121,19 +132,33 @@ def hidden_effect_recording_normal(
         params[name] = sign * brentq(g, 0.0, hi, xtol=1e-12 * hi, rtol=1e-6)
     delta = _displacement(params, t, pfun, k, psi, omega, dr)
     p = p0 + pfun(t)
-    p_noise = 0.2 * noise * _rms(p - p0)
-    d_noise = noise * _rms(delta)
+    keep = start_index(start, t, f0, 0.6 * f0)
+    tau_c = 0.25 * float(t[-1])
+    t, p, delta = t[keep:] - t[keep], p[keep:], delta[keep:]
+    pd_amp = float(np.max(np.abs(p - p0)))
+    p_noise = 0.2 * noise * rms_of(p - p0) if input_noise is None else input_noise * pd_amp
+    d_noise = noise * rms_of(delta)
+    pm, dm, info = measure(
+        t,
+        p,
+        delta,
+        rng,
+        u_noise=p_noise,
+        y_noise=d_noise,
+        anti_alias=anti_alias,
+        bits=bits,
+        f_ref=f0,
+    )
     truth = {
         "model": "normal",
         "base": {"k": k, "psi": psi, "p0": p0, "f0": f0, "delta_r": dr},
         "effects": {n: {_PARAM_NAME[n]: v} for n, v in params.items()},
         "magnitudes": dict(sizes),
         "noise_rms": {"p": p_noise, "delta": d_noise},
+        "sensors": {"anti_alias": anti_alias, "bits": bits, "start": start, **info},
     }
     if "creep_drift" in params:
-        truth["effects"]["creep_drift"]["tau_c"] = 0.25 * float(t[-1])
-    pm = p + rng.normal(0.0, p_noise, p.size)
-    dm = delta + rng.normal(0.0, d_noise, delta.size)
+        truth["effects"]["creep_drift"]["tau_c"] = tau_c
     return HiddenEffectRecording(
         t,
         {"p": pm, "delta": dm},

@@ -14,6 +14,8 @@ import numpy as np
 from .._arrays import as_1d
 from ..errors import InputError
 from ._family import Family, Prepared
+from ._inputs import arrays as _arrays
+from .select import fit
 
 
 class ExtendedModel:
@@ -71,9 +73,6 @@ class ExtendedModel:
 
     def fit(self, recording: Any) -> ExtendedModel:
         """Refit all parameters (same effects) to ``recording``; returns a new model."""
-        from .select import fit
-        from .workflow import _arrays
-
         t, u, y = _arrays(recording, self.family)
         d = Prepared.build(t, u, y)
         d.extra.update(self.context)

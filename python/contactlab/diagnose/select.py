@@ -37,6 +37,7 @@ class FitOut:
     params: dict[str, float]
     stderr: dict[str, float]
     rss: float
+    mse: float  # weighted mean square: rss over the sum of the weights
     n: int
     nfree: int
     success: bool
@@ -46,6 +47,23 @@ class FitOut:
     @property
     def bic(self) -> float:
         return float(self.n * np.log(max(self.rss, 1e-300) / self.n) + self.nfree * np.log(self.n))
+
+
+#: residuals a single fit works on at most (longer masks are strided)
+FIT_SAMPLES = 5000
+
+
+def sample_weight(d: Prepared) -> np.ndarray:
+    """Likelihood weight of each sample (errors in variables), 1 when none is set.
+
+    ``w = σy² / (σy² + (s σu)²)``: the output noise ``σy`` against the input noise ``σu`` seen
+    through the local slope ``s = |dy/du|`` of the base model (set by the workflow after the
+    base fit, :func:`contactlab.diagnose.workflow.eiv_weight`). Where a steep branch turns
+    the input noise into output error (right after a reversal, a sticking phase of a
+    rectangular loop) a sample counts less, the same for every candidate.
+    """
+    w = d.extra.get("weight")
+    return np.ones(d.y.size) if w is None else w
 
 
 def specs_for(family: Family, effects: tuple[str, ...]) -> list[ParamSpec]:
@@ -93,27 +111,42 @@ def fit(
         )
         for s in specs
     ]
+    # long records: the fit sees every stride-th sample of the mask (the solver's work grows
+    # with the number of residuals); held-out errors are still taken on every sample, and
+    # the standard errors are scaled to the full count
+    n_all = int(np.count_nonzero(mask))
+    stride = -(-n_all // FIT_SAMPLES)
+    if stride > 1:
+        mask = mask & (np.arange(mask.size) % stride == 0)
     y = d.y[mask]
     # residuals in units of the output's RMS: the solver's gradient tolerance is absolute,
     # and a displacement residual in metres (1e-9) would stop it at the first step
     ys = float(np.sqrt(np.mean(y * y))) or 1.0
+    sw = np.sqrt(sample_weight(d)[mask]) / ys  # errors in variables (see sample_weight)
+
+    lo = {s.name: s.lower for s in specs}
+    hi = {s.name: s.upper for s in specs}
 
     def value(w: dict[str, float]) -> dict[str, float]:
-        return {n: x0[n] + (w[n] - 1.0) * sc[n] for n in names}
+        # clipped: the affine map back can step a rounding error past a bound (h0 = -3e-17)
+        return {n: float(np.clip(x0[n] + (w[n] - 1.0) * sc[n], lo[n], hi[n])) for n in names}
 
     def resid(w: dict[str, float]) -> np.ndarray:
-        return (family.predict(value(w), effects, d)[mask] - y) / ys
+        return (family.predict(value(w), effects, d)[mask] - y) * sw
 
     res = least_squares_fit(resid, params, ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=400)
     w = {n: res.params[n].value for n in names}
+    shrink = float(np.sqrt(y.size / n_all))
     se = {
-        n: (res.params[n].stderr * sc[n] if res.params[n].stderr is not None else np.inf)
+        n: (res.params[n].stderr * sc[n] * shrink if res.params[n].stderr is not None else np.inf)
         for n in names
     }
+    wsum = float(np.sum(sw * sw)) * ys * ys
     return FitOut(
         value(w),
         se,
         float(res.chisqr) * ys * ys,
+        float(res.chisqr) * ys * ys / wsum,
         res.ndata,
         res.nvarys,
         res.success,
@@ -164,10 +197,13 @@ def evaluate(
     start: dict[str, float],
     scales: dict[str, float],
     folds: int = 2,
+    full: FitOut | None = None,
 ) -> Trial:
-    """Cross-validated held-out errors and the fit to all data of one model."""
+    """Cross-validated held-out errors and the fit to all data of one model (``full``, when
+    that fit is at hand already)."""
     masks = fold_masks(d, folds)
-    full = fit(family, effects, d, np.ones(d.y.size, bool), start, scales)
+    if full is None:
+        full = fit(family, effects, d, np.ones(d.y.size, bool), start, scales)
     fitted = family.predict(full.params, effects, d)
     pred = fitted.copy()
     heldout = np.zeros(d.y.size, bool)
@@ -176,9 +212,12 @@ def evaluate(
         pred[test] = family.predict(f.params, effects, d)[test]
         heldout |= test
     err = pred - d.y
+    wt = sample_weight(d)
     cyc = d.cycles.cycle
     ids = np.unique(cyc[heldout])
-    cycle_mse = np.array([np.mean(err[cyc == k] ** 2) for k in ids])
+    cycle_mse = np.array(
+        [np.sum(wt[sel] * err[sel] ** 2) / np.sum(wt[sel]) for sel in (cyc == k for k in ids)]
+    )
     e_meas, e_mod = [], []
     for k in ids:
         sel = cyc == k
@@ -187,14 +226,14 @@ def evaluate(
     e_meas_a, e_mod_a = np.array(e_meas), np.array(e_mod)
     denom = float(np.sum(np.abs(e_meas_a)))
     energy_error = float(np.sum(np.abs(e_mod_a - e_meas_a)) / denom) if denom > 0 else np.nan
-    eh = err[heldout]
+    eh, wh = err[heldout], wt[heldout]
     return Trial(
         effects,
         full,
         pred,
         heldout,
         cycle_mse,
-        float(np.sqrt(np.mean(eh * eh))),
+        float(np.sqrt(np.sum(wh * eh * eh) / np.sum(wh))),
         float(np.max(np.abs(eh))),
         energy_error,
         fitted,

@@ -11,20 +11,23 @@ candidate helps; (5) report held-out RMS, peak error and loop-energy error after
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from scipy.signal import decimate, savgol_coeffs
 
-from .._arrays import as_1d
 from ..errors import InputError
 from ._family import Family, Prepared
-from ._signal import noise_rms
+from ._inputs import arrays as _arrays
+from ._inputs import check_channels
+from ._signal import check_uniform, dominant_period_samples, noise_rms
 from .locate import locate
 from .model import ExtendedModel
-from .select import Trial, Verdict, evaluate, judge
+from .select import Trial, Verdict, evaluate, fit, judge
 
 __all__ = ["DiagnosisReport", "Effect", "Step", "diagnose"]
 
@@ -221,35 +224,85 @@ def _family(model: Any) -> tuple[Family, dict[str, float], dict[str, float]]:
     raise InputError(f"cannot diagnose a model of type {type(model).__name__}")
 
 
-def _arrays(recording: Any, family: Family) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(t, input, output)`` from a Recording-like object, a dict or a tuple of arrays."""
-    uname, yname = family.input_name, family.output_name
-    if hasattr(recording, "t") and hasattr(recording, "data"):
-        data, t = recording.data, recording.t
-    elif isinstance(recording, dict):
-        data, t = recording, recording.get("t")
-    elif isinstance(recording, Sequence) and len(recording) == 3:
-        t, u, y = recording
-        data = {uname: u, yname: y}
-    else:
-        raise InputError(
-            "recording must be a contactlab.io.Recording, a dict with 't', "
-            f"'{uname}', '{yname}', or a tuple (t, {uname}, {yname})"
-        )
-    for k in (uname, yname):
-        if k not in data:
-            raise InputError(
-                f"the {family.kind} workflow needs channels '{uname}' and '{yname}'; "
-                f"the recording has {sorted(data)}"
+#: longest record diagnosed sample by sample; longer ones are decimated (anti-aliased, zero
+#: phase) to no fewer than MIN_SAMPLES_PER_CYCLE per excitation period and, if still longer,
+#: diagnosed on their first MAX_SAMPLES samples (said so in the report)
+MAX_SAMPLES = 24_000
+MIN_SAMPLES_PER_CYCLE = 64
+
+
+#: an effect may refine the base model, not replace it: the base parameters that carry the
+#: joint's physics (tangential h0, the friction force; normal k, the contact stiffness) may
+#: move by at most this fraction from the base fit when an effect is added
+MAX_BASE_SHIFT = 0.3
+_ANCHORS = {"tangential": ("h0",), "normal": ("k",)}
+
+
+def _takes_over(family: Family, base: dict[str, float], p: dict[str, float]) -> str | None:
+    for name in _ANCHORS.get(family.kind, ()):
+        b, v = base[name], p[name]
+        if b > 0 and abs(v / b - 1.0) > MAX_BASE_SHIFT:
+            return (
+                f"it takes over the base model ({name} from {b:.4g} to {v:.4g}): the base "
+                "is in the wrong regime or the effect is not what the data show"
             )
-    if t is None:
-        raise InputError("the recording has no time vector 't'")
-    ta = as_1d(t, "t")
-    u = as_1d(data[uname], uname)
-    y = as_1d(data[yname], yname)
-    if not (ta.size == u.size == y.size):
-        raise InputError(f"t, {uname}, {yname} have {ta.size}, {u.size}, {y.size} samples")
-    return ta, u, y
+    return None
+
+
+def reduce_long(
+    t: np.ndarray, u: np.ndarray, y: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
+    """A long record brought to at most :data:`MAX_SAMPLES` samples, and a sentence saying
+    how (empty when the record is used as it is).
+
+    Both channels go through the same zero-phase FIR anti-alias filter before every q-th
+    sample is kept, so neither channel is delayed against the other and the noise of both
+    is reduced alike (the noise level is then estimated on the decimated record).
+    """
+    n = t.size
+    if n <= MAX_SAMPLES:
+        return t, u, y, ""
+    check_uniform(t)
+    per = dominant_period_samples(u)
+    q = int(min(per // MIN_SAMPLES_PER_CYCLE, -(-n // MAX_SAMPLES)))
+    how = []
+    if q > 1:
+        u = decimate(u, q, ftype="fir", zero_phase=True)
+        y = decimate(y, q, ftype="fir", zero_phase=True)
+        t = t[::q][: u.size]
+        how.append(f"decimated by {q} (zero-phase anti-alias filter on both channels)")
+    if t.size > MAX_SAMPLES:
+        cycles = t.size * q / per
+        t, u, y = t[:MAX_SAMPLES], u[:MAX_SAMPLES], y[:MAX_SAMPLES]
+        how.append(
+            f"diagnosed on its first {MAX_SAMPLES * q / per:.0f} of {cycles:.0f} excitation cycles"
+        )
+    return t, u, y, f"the record of {n} samples was " + " and ".join(how)
+
+
+def eiv_weight(
+    family: Family, params: dict[str, float], d: Prepared, sigma: float
+) -> tuple[np.ndarray, float] | None:
+    """Errors-in-variables weights of the samples and the sub-sample delay's gain budget.
+
+    ``w = σy² / (σy² + (s σu')²)`` with ``s`` the base model's local slope ``|dy/du|``
+    (:meth:`Family.slope`) and ``σu'`` the noise left in the input the candidates see (the
+    estimated input noise times the filter's noise gain). The budget, in units of ``σy²``, is
+    the mean of ``(s σu')² w``: the most that smoothing the input could lower the weighted
+    error, which a delay shorter than a sample must beat. None when the family has no slope
+    or the input carries no measurable noise.
+    """
+    su = float(d.extra.get("u_noise", 0.0))
+    if not su > 0.0:
+        return None
+    s = family.slope(params, d)
+    if s is None:
+        return None
+    wlen = int(d.extra.get("u_filter", 0))
+    gain = float(np.sum(savgol_coeffs(wlen, 3) ** 2)) if wlen else 1.0
+    var = (s * su) ** 2 * gain
+    w = sigma**2 / (sigma**2 + var)
+    return w, float(np.mean(var * w)) / sigma**2
 
 
 def diagnose(
@@ -300,6 +353,9 @@ def diagnose(
     """
     family, start, context = _family(model)
     t, u, y = _arrays(recording, family)
+    check_channels(
+        t, {family.input_name: (u, family.input_unit), family.output_name: (y, family.output_unit)}
+    )
     if folds < 2:
         raise InputError(f"folds must be >= 2, got {folds}")
     if max_effects < 0:
@@ -312,6 +368,8 @@ def diagnose(
             raise InputError(
                 f"unknown {family.kind} candidate {n!r}; choose from {', '.join(family.candidates)}"
             )
+    n_in = t.size
+    t, u, y, reduced = reduce_long(t, u, y)
     d = Prepared.build(t, u, y)
     d.extra.update(context)
     family.prepare(d)
@@ -323,17 +381,70 @@ def diagnose(
     sigma = noise_rms(current.full_residual(d))
     if sigma <= 0:
         raise InputError("the output channel has no noise at all; cannot judge significance")
+    budget = 0.0
+    w = eiv_weight(family, current.full.params, d, sigma)
+    if w is not None:  # errors in variables: refit the base with the likelihood's weights
+        d.extra["weight"], budget = w
+        current = evaluate(family, effects, d, current.full.params, scales, folds)
+        sigma = noise_rms(current.full_residual(d))
     where, location = locate(d, current.full_residual(d), family)
+    where.insert(0, family.regime(current.full.params, d))
+    if reduced:
+        where.insert(1, reduced)
+    location["samples"] = {"recording": n_in, "diagnosed": int(t.size)}
+    if w is not None:
+        low = float(np.mean(d.extra["weight"] < 0.5))
+        location["low_weight_fraction"] = low
+        if low > 0.01:
+            where.append(
+                f"{100 * low:.0f} % of the samples count less than half (input noise "
+                f"{d.extra['u_noise']:.3g} seen through a steep local slope, e.g. sticking "
+                "phases after reversals): what the model does there is barely tested"
+            )
     trials = [current]
     steps = [Step(None, current.heldout_rms, current.heldout_peak, current.energy_error)]
     added: list[str] = []
+    base_fit = dict(current.full.params)
+    all_samples = np.ones(d.y.size, bool)
     while len(added) < max_effects:
         verdicts, best = [], None
         for name in names:
             if name in effects or not family.check((*effects, name)):
                 continue
-            cand = evaluate(family, (*effects, name), d, current.full.params, scales, folds)
-            v = judge(name, current, cand, sigma, z, min_gain)
+            trial_effects = (*effects, name)
+            start_c = dict(current.full.params)
+            if hasattr(family, "start_effect"):
+                start_c.update(family.start_effect(name, start_c, d, -current.full_residual(d)))
+            # screening: a candidate whose fit to all data lowers the error by less than
+            # min_gain σ² cannot do better on held-out cycles; no cross-validation for it
+            full = fit(family, trial_effects, d, all_samples, start_c, scales)
+            in_gain = (current.full.mse - full.mse) / sigma**2
+            if in_gain < min_gain:
+                verdicts.append(
+                    Verdict(
+                        name,
+                        np.nan,
+                        float(in_gain),
+                        np.nan,
+                        np.nan,
+                        False,
+                        f"in-sample gain {in_gain:.3g} σ² below {min_gain:g} σ²",
+                    )
+                )
+                continue
+            cand = evaluate(family, trial_effects, d, start_c, scales, folds, full)
+            p = cand.full.params
+            extra = 0.0
+            if name == "channel_delay" and abs(p["tau"]) < d.dt:
+                extra = budget  # a sub-sample shift must beat what smoothing the input buys
+            v = judge(name, current, cand, sigma, z, min_gain + extra)
+            # every effect of the candidate model, not only the new one: a refit can push an
+            # effect added before to the edge of its physical range
+            why = next(
+                (w for e in trial_effects if (w := family.implausible(e, p, d))), None
+            ) or _takes_over(family, base_fit, p)
+            if v.accepted and why:
+                v = dataclasses.replace(v, accepted=False, reason=f"implausible: {why}")
             verdicts.append(v)
             if v.accepted and (best is None or v.gain > best[0].gain):
                 best = (v, cand)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from ..report.html import Column
 
-#: SI units of the per-cycle quantities of :func:`contactlab.studies.track.track`
+#: SI units of the per-cycle quantities of :func:`contactlab.studies.tracking.track`
 CYCLE_UNITS = {
     "tangential": {"start": "s", "end": "s", "energy": "J", "amplitude": "m", "offset": "N"},
     "normal": {"start": "s", "end": "s", "energy": "J/m^2", "amplitude": "m", "offset": "Pa"},

@@ -8,6 +8,7 @@ equivalent damping* with the corrected formulas of PHYSICS.md §1.
 from __future__ import annotations
 
 from .analysis import analyze_tangential
+from .frame import FrameForce, frame_friction_force
 from .plots import plot_loop, plot_residuals
 from .preprocess import AveragedLoop, CycleScatter, Reversals, average_loop, find_reversals
 from .result import UNITS, TangentialAnalysis
@@ -17,11 +18,13 @@ __all__ = [
     "UNITS",
     "AveragedLoop",
     "CycleScatter",
+    "FrameForce",
     "Reversals",
     "TangentialAnalysis",
     "analyze_tangential",
     "average_loop",
     "find_reversals",
+    "frame_friction_force",
     "plot_loop",
     "plot_residuals",
     "synthetic_recording",

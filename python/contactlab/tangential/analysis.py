@@ -49,12 +49,15 @@ from typing import Any
 import numpy as np
 
 from .._arrays import as_1d
+from .._physical import check_channel
+from .._range import check_channel as check_range
 from ..errors import ContactLabWarning, InputError
 from ..fitting import FitResult
 from ..io import Recording
 from ..masing import loop_area
 from . import steps
 from .orientation import orient
+from .regime import Regime, classify
 from .result import TangentialAnalysis
 from .uncertainty import correl, numeric_energy, reparametrize
 
@@ -79,6 +82,8 @@ def _inputs(
                     f"{recording.source}: no {ch!r} channel; a tangential recording needs x "
                     f"and F (channels: {sorted(recording.data)})"
                 )
+        for ch, unit in (("x", "m"), ("F", "N")):
+            check_range(recording[ch], ch, unit, recording.source)
         return recording["x"], recording["F"], recording.t, recording.source
     if x is None or F is None:
         raise InputError("give a recording, or the arrays x (m) and F (N)")
@@ -94,6 +99,8 @@ def _inputs(
         if np.any(np.diff(ta) <= 0):
             i = int(np.argmax(np.diff(ta) <= 0)) + 1
             raise InputError(f"t[{i}] = {ta[i]} does not increase")
+    check_range(xa, "x", "m")
+    check_range(Fa, "F", "N")
     return xa, Fa, ta, "<arrays>"
 
 
@@ -137,6 +144,11 @@ def identifiability(
             f"{corr:+.3f}. Identified: h0·ac = {k0.value:.6g} ± {k0.stderr or math.nan:.3g} N/m"
             f" ({100 * rel_k0:.2f}%); ac < {ac_up:.3g} 1/m and h0 > {h0_lo:.3g} N (2σ)."
         )
+        if not rel_k0 < max_rel_stderr:
+            msg += (
+                " Not even h0·ac is determined: the force hardly follows the displacement "
+                "(a noise-only or disconnected force channel?)."
+            )
         for p in (ph0, pac):
             p.identifiable = False
             p.note = "not separately identifiable: only h0·ac is (see identifiability)"
@@ -198,6 +210,69 @@ def derived_quantities(
     return derived
 
 
+def loop_area_ratio(data: steps.FitData, amplitude: float, e_num: float) -> float:
+    """``E / (4 A h_m)``: 0 for a line, 1 for the Coulomb rectangle (h_m from the data)."""
+    hm = 0.5 * float(np.ptp(data.loop.F if data.loop is not None else data.F))
+    return e_num / (4 * amplitude * hm) if hm > 0 and amplitude > 0 else 0.0
+
+
+def apply_regime(
+    regime: Regime,
+    amp: steps.Amplitude,
+    fit: FitResult,
+    identifiable: bool,
+    evidence: dict[str, Any],
+    derived: dict[str, tuple[float, float]],
+    max_rel_stderr: float,
+) -> None:
+    """What the regime identifies: in gross sliding (and stick-slip) ``h0`` from the plateau
+    (when the fit does not identify it) and only a lower bound on ``ac``. Updates
+    ``evidence`` (per-parameter flags, ``h0_source``, message) and ``derived`` in place."""
+    evidence["h0_source"] = "fit"
+    pl = regime.plateau
+    if not regime.sliding or pl is None:
+        return
+    derived["h0_plateau"] = (pl.h0, pl.h0_stderr)
+    if identifiable:
+        return
+    rel = pl.h0_stderr / pl.h0 if pl.h0 > 0 else math.inf
+    evidence["h0"] = bool(rel < max_rel_stderr)
+    evidence["ac"] = False
+    evidence["h0_source"] = "plateau"
+    for k in ("h0_lower_bound", "ac_upper_bound"):  # the small-loop bounds do not apply
+        derived.pop(k, None)
+    derived["ac_lower_bound"] = (pl.ac_lower_bound, math.nan)
+    # The Masing fit's h0·ac and curve are meaningless on a rectangle: the quantities that
+    # follow from the plateau are E = 4 h0 A - 8 h0 / ac (ac ≥ its bound: the bound's range
+    # enters the error), c_e·ω = E / (π A²), the peak force h0 and k_g = h0 / A; the initial
+    # stiffness is only bounded below.
+    A, sA = amp.value, amp.stderr if math.isfinite(amp.stderr) else 0.0
+    h, sh = pl.h0, pl.h0_stderr
+    half_gap = 4.0 * h / pl.ac_lower_bound
+    e = 4.0 * h * A - half_gap
+    se = math.sqrt((4 * A * sh) ** 2 + (4 * h * sA) ** 2 + half_gap**2)
+    derived["energy_per_cycle"] = (e, se)
+    derived["equivalent_damping"] = (e / (math.pi * A * A), se / (math.pi * A * A))
+    derived["peak_force"] = (h, sh)
+    derived["k_global"] = (h / A, math.hypot(sh / A, h * sA / A**2))
+    for k in ("h0_ac", "k_local0", "k_local_amplitude"):
+        derived.pop(k, None)
+    derived["k_local0_lower_bound"] = (h * pl.ac_lower_bound, math.nan)
+    evidence["h0_ac"] = False
+    evidence["message"] = (
+        f"{regime.name}: the loop reaches its plateau, so h0 = {pl.h0:.4g} ± "
+        f"{pl.h0_stderr:.2g} N is identified from the plateau ({pl.n_up} + {pl.n_down} "
+        f"strokes); ac is NOT identifiable here, only bounded below: ac ≥ "
+        f"{pl.ac_lower_bound:.3g} 1/m (each branch covers 95% of its swing within "
+        f"{pl.dx95:.3g} m)"
+    )
+    ph0, pac = fit.params["h0"], fit.params["ac"]
+    ph0.identifiable = False
+    ph0.note = f"Masing-fit value; the plateau gives h0 = {pl.h0:.4g} ± {pl.h0_stderr:.2g} N"
+    pac.identifiable = False
+    pac.note = f"not identifiable in {regime.name}: only ac >= {pl.ac_lower_bound:.3g} 1/m"
+
+
 def collect_warnings(
     pre: list[str],
     raw: FitResult,
@@ -205,25 +280,30 @@ def collect_warnings(
     amplitude: float,
     identifiable: bool,
     evidence: dict[str, Any],
-    e_num: float,
+    regime: Regime,
 ) -> list[str]:
     """Everything the user should know about the fit: regime, identifiability, convergence,
     and a misfit beyond the cycle-to-cycle noise."""
-    warns: list[str] = pre + list(raw.notes)
+    # on a plateau the Masing fit is superseded: its numerical notes would only confuse
+    plateau = evidence.get("h0_source") == "plateau"
+    warns: list[str] = pre + ([] if plateau else list(raw.notes))
     loop = data.loop
     z = evidence["ac_times_amplitude"]
-    hm_data = 0.5 * float(np.ptp(loop.F if loop is not None else data.F))
-    ratio = e_num / (4 * amplitude * hm_data) if hm_data > 0 else 0.0
-    if (identifiable and z > GROSS_SLIDING_Z) or ratio > GROSS_SLIDING_AREA_RATIO:
+    ratio = regime.area_ratio
+    if regime.sliding or (identifiable and z > GROSS_SLIDING_Z) or ratio > GROSS_SLIDING_AREA_RATIO:
         warns.append(
             f"amplitude {amplitude:.3g} m leaves the pre-sliding regime (gross sliding): "
-            f"ac·A = {z:.3g}, loop area is {100 * ratio:.0f}% of the rectangle 4·A·h_m, the "
-            f"force plateaus near ±h0; the pre-sliding model and its ac describe the loop poorly"
+            f"{regime.reason}; the pre-sliding model and its ac describe the loop poorly"
         )
     if not identifiable:
         warns.append(evidence["message"])
-    if not raw.success:
-        warns.append(f"the fit did not converge: {raw.message}")
+    if not raw.success and plateau:
+        warns.append(
+            "the exponential Masing fit cannot follow this nearly rectangular loop (its ac "
+            "runs off towards infinity), which is why h0 comes from the plateau"
+        )
+    elif not raw.success:
+        warns.append(f"the Masing fit did not converge ({raw.message})")
     if loop is not None and data.on == "averaged" and loop.n_cycles > 2:
         # Is the misfit larger than the cycle-to-cycle noise explains?
         per_cycle = loop.count / loop.n_cycles
@@ -320,6 +400,8 @@ def analyze_tangential(
     """
     xa, Fa, ta, source = _inputs(recording, t, x, F)
     _check_options(on, history, n_points)
+    check_channel("x", xa, "m", "displacement")
+    check_channel("F", Fa, "N", "force")
     steady = history == "steady"
     if invert_force is not None:
         force_sign = -1 if invert_force else 1
@@ -366,15 +448,19 @@ def analyze_tangential(
     if not identifiable:
         derived["h0_lower_bound"] = (h0_lo, math.nan)
         derived["ac_upper_bound"] = (ac_up, math.nan)
-    warns = collect_warnings(
-        pre_warns,
-        raw,
-        data,
-        amp.value,
-        identifiable,
-        evidence,
-        derived["energy_per_cycle_numeric"][0],
+    ratio = loop_area_ratio(data, amp.value, derived["energy_per_cycle_numeric"][0])
+    regime = classify(
+        z_fit=evidence["ac_times_amplitude"] if identifiable else None,
+        ratio=ratio,
+        loop=det.loop,
+        x=det.x,
+        F=det.F,
+        t=ta,
+        rev=data.rev,
+        x_raw=xa,
     )
+    apply_regime(regime, amp, fit, identifiable, evidence, derived, max_rel_stderr)
+    warns = collect_warnings(pre_warns, raw, data, amp.value, identifiable, evidence, regime)
     if warn:
         for wtxt in warns:
             warnings.warn(wtxt, ContactLabWarning, stacklevel=2)
@@ -389,6 +475,7 @@ def analyze_tangential(
         identifiable=identifiable,
         identifiability=evidence,
         derived=derived,
+        regime=regime.to_dict(),
         warnings=warns,
         on=on,
         history=history,

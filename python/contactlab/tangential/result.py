@@ -36,6 +36,16 @@ UNITS = {
     "force_drift": "N/s",
     "displacement_drift": "m/s",
     "loop_area_recorded": "J",
+    "h0_plateau": "N",
+    "ac_lower_bound": "1/m",
+    "k_local0_lower_bound": "N/m",
+}
+_STICK_UNITS = {
+    "stick_duration": "s",
+    "breakaway_force": "N",
+    "breakaway_force_stderr": "N",
+    "velocity_threshold": "m/s",
+    "smooth_turn_dwell": "s",
 }
 
 
@@ -91,6 +101,7 @@ class TangentialAnalysis:
     t: np.ndarray | None = None
     source: str = "<arrays>"
     meta: dict[str, Any] = field(default_factory=dict)
+    regime: dict[str, Any] = field(default_factory=dict)
 
     @property
     def residual(self) -> np.ndarray:
@@ -108,14 +119,20 @@ class TangentialAnalysis:
         """
         p = self.fit.params
         ident = self.identifiable
+        ev = self.identifiability
+        h0, h0_se = p["h0"].value, p["h0"].stderr
+        if ev.get("h0_source") == "plateau" and "h0_plateau" in self.derived:
+            h0, h0_se = self.derived["h0_plateau"]
+        ih0 = bool(ev.get("h0", ident))
+        iac = bool(ev.get("ac", ident))
         out: dict[str, Any] = {
             "source": self.source,
             "on": self.on,
             "history": self.history,
-            "h0": json_number(p["h0"].value) if ident else None,
-            "h0_stderr": json_number(p["h0"].stderr) if ident else None,
-            "ac": json_number(p["ac"].value) if ident else None,
-            "ac_stderr": json_number(p["ac"].stderr) if ident else None,
+            "h0": json_number(h0) if ih0 else None,
+            "h0_stderr": json_number(h0_se) if ih0 else None,
+            "ac": json_number(p["ac"].value) if iac else None,
+            "ac_stderr": json_number(p["ac"].stderr) if iac else None,
             "offset": json_number(p["offset"].value),
             "offset_stderr": json_number(p["offset"].stderr),
         }
@@ -137,6 +154,11 @@ class TangentialAnalysis:
             k: (json_number(v) if isinstance(v, float) else v)
             for k, v in self.identifiability.items()
         }
+        for k, v in self.regime.items():
+            if k == "stick_slip":
+                out[k] = dict({kk: json_number(vv) for kk, vv in v.items()}, units=_STICK_UNITS)
+            else:
+                out[k] = v if isinstance(v, str) else json_number(v)
         out["n_cycles"] = None if self.scatter is None else self.scatter.n_cycles
         out["warnings"] = list(self.warnings)
         out["fit"] = self.fit.to_dict()
@@ -152,6 +174,9 @@ class TangentialAnalysis:
         lines.append(self.fit.report())
         lines.append("[[Identifiability]]")
         lines.append(f"    {self.identifiability['message']}")
+        if self.regime:
+            lines.append("[[Regime]]")
+            lines.append(f"    {self.regime.get('regime_reason', '')}")
         lines.append("[[Derived quantities]]")
         lines.append(f"    amplitude = {self.amplitude:.6g} +/- {self.amplitude_stderr:.3g} m")
         for k, (v, e) in self.derived.items():

@@ -10,6 +10,7 @@ pub mod curve;
 pub mod error;
 pub mod masing;
 pub mod normal;
+pub mod structure;
 
 pub use curve::{Backbone, Exponential, Tabulated};
 pub use error::CoreError;

@@ -15,6 +15,7 @@ use pyo3::types::PyDict;
 
 mod errors;
 mod normal;
+mod structure;
 use errors::{internal, slice, to_pyerr};
 
 /// Run `f` without the GIL, turning a panic (a bug, never expected) into `ContactLabError`.
@@ -248,7 +249,9 @@ impl MasingCore {
                 Curve::Exp(c) => c,
                 Curve::Tab(c) => c,
             };
-            Ok(us.iter().map(|&v| f(c, v)).collect::<Vec<f64>>())
+            let v = us.iter().map(|&v| f(c, v)).collect::<Vec<f64>>();
+            contactlab_core::error::check_output("curve value", &v)?;
+            Ok(v)
         })?;
         Ok(out.into_pyarray(py))
     }
@@ -282,5 +285,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<MasingCore>()?;
     m.add_function(wrap_pyfunction!(loop_area_py, m)?)?;
     normal::register(m)?;
+    structure::register(m)?;
     Ok(())
 }

@@ -1,0 +1,576 @@
+//! Joint elements acting on a relative displacement `d` (PHYSICS.md §1 for Masing): the force
+//! `F(d, ḋ, history)`, its tangents `∂F/∂d`, `∂F/∂ḋ` for Newton's method, the state update once
+//! a step is accepted, the stored (recoverable) energy, and where inside a step the law
+//! changes character (a reversal, a stick-slip transition) so the integrator can sub-step.
+//!
+//! Every hysteretic law here is rate-independent: a step from `d_n` to `d_{n+1}` is taken as a
+//! monotone path, which is why steps are split at velocity reversals.
+
+use crate::curve::{Backbone, Exponential, Tabulated};
+use crate::error::{check_finite, check_positive, CoreError};
+use crate::masing::{MasingState, Reversal};
+use crate::normal::poly;
+
+/// The virgin curve of a Masing joint.
+#[derive(Debug, Clone, PartialEq)]
+pub enum MasingCurve {
+    Exp(Exponential),
+    Tab(Tabulated),
+}
+
+impl Backbone for MasingCurve {
+    #[inline]
+    fn eval(&self, u: f64) -> f64 {
+        match self {
+            Self::Exp(c) => c.eval(u),
+            Self::Tab(c) => c.eval(u),
+        }
+    }
+    #[inline]
+    fn slope(&self, u: f64) -> f64 {
+        match self {
+            Self::Exp(c) => c.slope(u),
+            Self::Tab(c) => c.slope(u),
+        }
+    }
+    fn integral(&self, u: f64) -> f64 {
+        match self {
+            Self::Exp(c) => c.integral(u),
+            Self::Tab(c) => c.integral(u),
+        }
+    }
+}
+
+impl MasingCurve {
+    /// `(f(u), f'(u))` with one transcendental call for the exponential curve.
+    #[inline]
+    fn eval_slope(&self, u: f64) -> (f64, f64) {
+        match self {
+            Self::Exp(c) => {
+                let em1 = (-c.ac * u.abs()).exp_m1(); // e^{-z} − 1
+                ((-c.h0 * em1).copysign(u), c.h0 * c.ac * (1.0 + em1))
+            }
+            Self::Tab(c) => (c.eval(u), c.slope(u)),
+        }
+    }
+}
+
+/// A joint's constitutive law.
+#[derive(Debug, Clone, PartialEq)]
+pub enum JointLaw {
+    /// Masing operator with non-local memory, branch scale λ.
+    Masing { curve: MasingCurve, scale: f64 },
+    /// Elastic-Coulomb (Jenkins): stiffness `k` in series with a slider of slip force `fs`.
+    Jenkins { k: f64, fs: f64 },
+    /// Parallel Jenkins elements (a discretised Iwan model).
+    Iwan { k: Vec<f64>, fs: Vec<f64> },
+    /// `F = z`, `dz/dd = α − β (γ s |z|^(ν−1) z + δ |z|^ν)`, `s = sign(ḋ)` (Bouc-Wen in the
+    /// form of the hysteretic benchmark).
+    BoucWen {
+        alpha: f64,
+        beta: f64,
+        gamma: f64,
+        delta: f64,
+        nu: f64,
+    },
+    /// `F = k d + c ḋ`.
+    KelvinVoigt { k: f64, c: f64 },
+    /// `F = k_s(d) d`, `k_s` a polynomial with ascending coefficients (normal contact, eq. 6);
+    /// stored as the coefficients of `F(d)` itself.
+    Normal {
+        force: Vec<f64>,
+        slope: Vec<f64>,
+        energy: Vec<f64>,
+    },
+}
+
+impl JointLaw {
+    pub fn jenkins(k: f64, fs: f64) -> Result<Self, CoreError> {
+        check_positive("k", k)?;
+        check_positive("fs", fs)?;
+        Ok(Self::Jenkins { k, fs })
+    }
+
+    pub fn iwan(k: &[f64], fs: &[f64]) -> Result<Self, CoreError> {
+        crate::error::check_same_len("iwan k", k.len(), "iwan fs", fs.len())?;
+        if k.is_empty() {
+            return Err(CoreError::Empty { name: "iwan k" });
+        }
+        for (&ki, &fi) in k.iter().zip(fs) {
+            check_positive("iwan k", ki)?;
+            check_positive("iwan fs", fi)?;
+        }
+        Ok(Self::Iwan {
+            k: k.to_vec(),
+            fs: fs.to_vec(),
+        })
+    }
+
+    pub fn masing(curve: MasingCurve, scale: f64) -> Result<Self, CoreError> {
+        check_positive("scale", scale)?;
+        Ok(Self::Masing { curve, scale })
+    }
+
+    pub fn bouc_wen(
+        alpha: f64,
+        beta: f64,
+        gamma: f64,
+        delta: f64,
+        nu: f64,
+    ) -> Result<Self, CoreError> {
+        check_positive("alpha", alpha)?;
+        check_positive("nu", nu)?;
+        check_finite("gamma", &[gamma])?;
+        check_finite("delta", &[delta])?;
+        if !(beta.is_finite() && beta >= 0.0) {
+            return Err(CoreError::InvalidParameter {
+                name: "beta",
+                value: beta,
+                reason: "must be finite and >= 0",
+            });
+        }
+        Ok(Self::BoucWen {
+            alpha,
+            beta,
+            gamma,
+            delta,
+            nu,
+        })
+    }
+
+    pub fn kelvin_voigt(k: f64, c: f64) -> Result<Self, CoreError> {
+        for (name, v) in [("k", k), ("c", c)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(CoreError::InvalidParameter {
+                    name,
+                    value: v,
+                    reason: "must be finite and >= 0",
+                });
+            }
+        }
+        Ok(Self::KelvinVoigt { k, c })
+    }
+
+    /// `k_s(d) = coeffs[0] + coeffs[1] d + …`, `F = k_s(d) d`.
+    pub fn normal(coeffs: &[f64]) -> Result<Self, CoreError> {
+        if coeffs.is_empty() {
+            return Err(CoreError::Empty {
+                name: "normal coeffs",
+            });
+        }
+        check_finite("normal coeffs", coeffs)?;
+        let force: Vec<f64> = std::iter::once(0.0).chain(coeffs.iter().copied()).collect();
+        Ok(Self::Normal {
+            slope: poly::deriv(&force),
+            energy: poly::integral(&force),
+            force,
+        })
+    }
+
+    /// Tangent stiffness in the virgin state (d = 0, no history).
+    pub fn initial_stiffness(&self) -> f64 {
+        match self {
+            Self::Masing { curve, .. } => curve.slope(0.0),
+            Self::Jenkins { k, .. } | Self::KelvinVoigt { k, .. } => *k,
+            Self::Iwan { k, .. } => k.iter().sum(),
+            Self::BoucWen { alpha, .. } => *alpha,
+            Self::Normal { slope, .. } => poly::eval(slope, 0.0),
+        }
+    }
+
+    /// The virgin state (d = 0, F = 0).
+    pub fn fresh_state(&self) -> JointState {
+        match self {
+            Self::Masing { .. } => JointState::Masing(MasingState::default()),
+            Self::Jenkins { .. } | Self::BoucWen { .. } => JointState::Slider(0.0),
+            Self::Iwan { k, .. } => JointState::Sliders(vec![0.0; k.len()]),
+            Self::KelvinVoigt { .. } | Self::Normal { .. } => JointState::Elastic,
+        }
+    }
+}
+
+/// History of a joint.
+#[derive(Debug, Clone, PartialEq)]
+pub enum JointState {
+    Masing(MasingState),
+    /// Jenkins: the force; Bouc-Wen: `z`.
+    Slider(f64),
+    /// Iwan: each element's force.
+    Sliders(Vec<f64>),
+    Elastic,
+}
+
+/// Force and tangents at a trial displacement.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Trial {
+    pub f: f64,
+    /// `∂F/∂d`.
+    pub kt: f64,
+    /// `∂F/∂ḋ`.
+    pub ct: f64,
+    /// Masing: `2 × (reversals kept) + (1 if the trial point pushed a reversal)`, so that
+    /// committing applies the same memory update without walking the branches again.
+    pub aux: usize,
+}
+
+/// Masing force and tangent at `x` from `state`, without changing the state (the branch logic
+/// of [`crate::masing`]: a reversal pushes the current point, reaching a closure target pops).
+/// Returns `(f, slope, aux)` with `aux` as in [`Trial::aux`].
+fn masing_trial(curve: &MasingCurve, scale: f64, st: &MasingState, x: f64) -> (f64, f64, usize) {
+    let dx = x - st.x;
+    let dir = f64::from(st.dir);
+    let s = if dx > 0.0 {
+        1.0
+    } else if dx < 0.0 {
+        -1.0
+    } else {
+        dir
+    };
+    let pushed = s != dir && st.dir != 0 && dx != 0.0;
+    let n = st.stack.len();
+    let get = |k: usize| -> (f64, f64) {
+        if k < n {
+            (st.stack[k].x, st.stack[k].h)
+        } else {
+            (st.x, st.h)
+        }
+    };
+    let mut len = n + usize::from(pushed);
+    loop {
+        let (xa, ha, target) = match len {
+            0 => {
+                let (f, k) = curve.eval_slope(x);
+                return (f, k, usize::from(pushed));
+            }
+            1 => {
+                let a = get(0);
+                (a.0, a.1, -a.0)
+            }
+            _ => {
+                let a = get(len - 1);
+                (a.0, a.1, get(len - 2).0)
+            }
+        };
+        if dx != 0.0 && (x - target) * s >= 0.0 {
+            len -= if len == 1 { 1 } else { 2 };
+            continue;
+        }
+        let (f, k) = curve.eval_slope((x - xa) / scale);
+        return (ha + scale * f, k, 2 * len + usize::from(pushed));
+    }
+}
+
+/// `dz/dd` of the Bouc-Wen law for motion in direction `s`.
+#[inline]
+fn bw_rate(alpha: f64, beta: f64, gamma: f64, delta: f64, nu: f64, z: f64, s: f64) -> f64 {
+    if nu == 1.0 {
+        alpha - beta * (gamma * s * z + delta * z.abs())
+    } else {
+        let a = z.abs().powf(nu);
+        alpha - beta * (gamma * s * a.copysign(z) + delta * a)
+    }
+}
+
+/// `z` after a monotone displacement increment `dd` from `z0` (classical RK4 in `d`, with
+/// enough sub-steps that `|dd| · |∂rate/∂z| ≤ 0.2` per sub-step: local error ~1e-6
+/// relative, below the Newmark step's own error).
+fn bw_advance(p: (f64, f64, f64, f64, f64), z0: f64, dd: f64) -> f64 {
+    let (alpha, beta, gamma, delta, nu) = p;
+    if dd == 0.0 {
+        return z0;
+    }
+    let s = dd.signum();
+    let zr = (z0.abs() + alpha * dd.abs()).max(f64::MIN_POSITIVE);
+    let lip = beta * (gamma.abs() + delta.abs()) * nu * zr.powf(nu - 1.0).min(1e300);
+    let m = ((dd.abs() * lip / 0.2).ceil()).clamp(1.0, 1000.0) as usize;
+    let h = dd / m as f64;
+    let g = |z: f64| bw_rate(alpha, beta, gamma, delta, nu, z, s);
+    let mut z = z0;
+    for _ in 0..m {
+        let k1 = g(z);
+        let k2 = g(z + 0.5 * h * k1);
+        let k3 = g(z + 0.5 * h * k2);
+        let k4 = g(z + h * k3);
+        z += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+    }
+    z
+}
+
+impl JointLaw {
+    /// Force and tangents at `d_new` (velocity `v_new`), having been at `d_old` in `state`.
+    pub fn trial(&self, state: &JointState, d_old: f64, d_new: f64, v_new: f64) -> Trial {
+        let dd = d_new - d_old;
+        match (self, state) {
+            (Self::Masing { curve, scale }, JointState::Masing(st)) => {
+                let (f, kt, aux) = masing_trial(curve, *scale, st, d_new);
+                Trial {
+                    f,
+                    kt,
+                    ct: 0.0,
+                    aux,
+                }
+            }
+            (Self::Jenkins { k, fs }, JointState::Slider(f0)) => {
+                let ft = f0 + k * dd;
+                if ft.abs() > *fs {
+                    Trial {
+                        f: fs.copysign(ft),
+                        ..Trial::default()
+                    }
+                } else {
+                    Trial {
+                        f: ft,
+                        kt: *k,
+                        ..Trial::default()
+                    }
+                }
+            }
+            (Self::Iwan { k, fs }, JointState::Sliders(f0)) => {
+                let mut out = Trial::default();
+                for ((&ki, &fi), &f0i) in k.iter().zip(fs).zip(f0) {
+                    let ft = f0i + ki * dd;
+                    if ft.abs() > fi {
+                        out.f += fi.copysign(ft);
+                    } else {
+                        out.f += ft;
+                        out.kt += ki;
+                    }
+                }
+                out
+            }
+            (
+                Self::BoucWen {
+                    alpha,
+                    beta,
+                    gamma,
+                    delta,
+                    nu,
+                },
+                JointState::Slider(z0),
+            ) => {
+                let p = (*alpha, *beta, *gamma, *delta, *nu);
+                let z = bw_advance(p, *z0, dd);
+                let s = if dd == 0.0 { 1.0 } else { dd.signum() };
+                let kt = bw_rate(*alpha, *beta, *gamma, *delta, *nu, z, s);
+                Trial {
+                    f: z,
+                    kt: kt.max(0.0),
+                    ..Trial::default()
+                }
+            }
+            (Self::KelvinVoigt { k, c }, _) => Trial {
+                f: k * d_new + c * v_new,
+                kt: *k,
+                ct: *c,
+                aux: 0,
+            },
+            (Self::Normal { force, slope, .. }, _) => Trial {
+                f: poly::eval(force, d_new),
+                kt: poly::eval(slope, d_new),
+                ..Trial::default()
+            },
+            // A state of another law never reaches here (states are made by `fresh_state`).
+            _ => Trial::default(),
+        }
+    }
+
+    /// Accept the step to `d_new`: update the history.
+    pub fn commit(
+        &self,
+        state: &mut JointState,
+        d_old: f64,
+        d_new: f64,
+        trial: &Trial,
+    ) -> Result<(), CoreError> {
+        let dd = d_new - d_old;
+        match (self, state) {
+            (Self::Masing { .. }, JointState::Masing(st)) => {
+                // The memory update the trial found (same rules as `masing::run`).
+                let dx = d_new - st.x;
+                if dx != 0.0 {
+                    if trial.aux & 1 == 1 {
+                        st.stack.push(Reversal {
+                            x: st.x,
+                            h: st.h,
+                            index: st.count.saturating_sub(1),
+                        });
+                    }
+                    st.stack.truncate(trial.aux / 2);
+                    st.dir = if dx > 0.0 { 1 } else { -1 };
+                    st.x = d_new;
+                    st.h = trial.f;
+                }
+                st.count = st.count.saturating_add(1);
+                Ok(())
+            }
+            (Self::Jenkins { .. } | Self::BoucWen { .. }, JointState::Slider(f)) => {
+                *f = trial.f;
+                Ok(())
+            }
+            (Self::Iwan { k, fs }, JointState::Sliders(f0)) => {
+                for ((&ki, &fi), f) in k.iter().zip(fs).zip(f0.iter_mut()) {
+                    let ft = *f + ki * dd;
+                    *f = if ft.abs() > fi { fi.copysign(ft) } else { ft };
+                }
+                Ok(())
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Recoverable energy held by the joint in `state` at `d` (the dissipated energy is the
+    /// work done on the joint minus this). Jenkins/Iwan: `Σ F_i² / (2 k_i)`; Bouc-Wen:
+    /// `z² / (2 α)`; Masing: `F² / (2 k_0)` with the initial stiffness `k_0` (exact for every
+    /// closed cycle, where F returns to its start); Kelvin-Voigt: `k d² / 2`; normal contact:
+    /// `∫_0^d F`.
+    pub fn stored_energy(&self, state: &JointState, d: f64) -> f64 {
+        match (self, state) {
+            (Self::Masing { curve, .. }, JointState::Masing(st)) => {
+                let k0 = curve.slope(0.0);
+                if k0 > 0.0 {
+                    0.5 * st.h * st.h / k0
+                } else {
+                    0.0
+                }
+            }
+            (Self::Jenkins { k, .. }, JointState::Slider(f)) => 0.5 * f * f / k,
+            (Self::BoucWen { alpha, .. }, JointState::Slider(z)) => 0.5 * z * z / alpha,
+            (Self::Iwan { k, .. }, JointState::Sliders(f)) => {
+                k.iter().zip(f).map(|(ki, fi)| 0.5 * fi * fi / ki).sum()
+            }
+            (Self::KelvinVoigt { k, .. }, _) => 0.5 * k * d * d,
+            (Self::Normal { energy, .. }, _) => poly::eval(energy, d),
+            _ => 0.0,
+        }
+    }
+
+    /// Fraction `θ ∈ (0, 1)` of the step `d_old → d_new` (velocities `v_old → v_new`) at which
+    /// the law changes character: a velocity reversal (every hysteretic law) or a stick-slip
+    /// transition of a Jenkins/Iwan element (linear in `d` while stuck). `None`: no event.
+    pub fn event(
+        &self,
+        state: &JointState,
+        d_old: f64,
+        d_new: f64,
+        v_old: f64,
+        v_new: f64,
+    ) -> Option<f64> {
+        let mut theta: Option<f64> = None;
+        let mut take = |t: f64| {
+            if t > 0.0 && t < 1.0 {
+                theta = Some(theta.map_or(t, |a: f64| a.min(t)));
+            }
+        };
+        let hysteretic = !matches!(self, Self::KelvinVoigt { .. } | Self::Normal { .. });
+        if hysteretic && v_old * v_new < 0.0 {
+            take(v_old / (v_old - v_new));
+        }
+        let dd = d_new - d_old;
+        if dd != 0.0 {
+            let mut stick_slip = |k: f64, fs: f64, f0: f64| {
+                let ft = f0 + k * dd;
+                if f0.abs() < fs && ft.abs() > fs {
+                    take((fs.copysign(ft) - f0) / (k * dd));
+                }
+            };
+            match (self, state) {
+                (Self::Jenkins { k, fs }, JointState::Slider(f0)) => stick_slip(*k, *fs, *f0),
+                (Self::Iwan { k, fs }, JointState::Sliders(f0)) => {
+                    for ((&ki, &fi), &f0i) in k.iter().zip(fs).zip(f0) {
+                        stick_slip(ki, fi, f0i);
+                    }
+                }
+                _ => {}
+            }
+        }
+        theta
+    }
+}
+
+/// A joint between `dof` and `dof2` (`None`: the fixed ground); `d = x[dof] − x[dof2]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Joint {
+    pub law: JointLaw,
+    pub dof: usize,
+    pub dof2: Option<usize>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::masing;
+
+    fn exp_curve() -> MasingCurve {
+        MasingCurve::Exp(Exponential { h0: 40.0, ac: 4e4 })
+    }
+
+    #[test]
+    fn masing_trial_matches_the_operator_on_a_random_walk() -> Result<(), CoreError> {
+        let curve = exp_curve();
+        let law = JointLaw::masing(curve.clone(), 2.0)?;
+        let mut st = law.fresh_state();
+        let mut ref_state = MasingState::default();
+        let mut x = 0.0_f64;
+        let mut seed = 12345_u64;
+        for _ in 0..2000 {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            let r = ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5;
+            let xn = x + 4e-5 * r;
+            let tr = law.trial(&st, x, xn, 0.0);
+            let mut out = [0.0];
+            masing::masing_force(&curve, 2.0, &[xn], &mut out, &mut ref_state)?;
+            assert!(
+                (tr.f - out[0]).abs() <= 1e-12 * 40.0,
+                "{} vs {}",
+                tr.f,
+                out[0]
+            );
+            law.commit(&mut st, x, xn, &tr)?;
+            if let JointState::Masing(ms) = &st {
+                assert_eq!(ms.stack.len(), ref_state.stack.len());
+                assert_eq!(ms.dir, ref_state.dir);
+            }
+            x = xn;
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn masing_tangent_is_the_derivative() {
+        let curve = exp_curve();
+        let law = JointLaw::Masing { curve, scale: 2.0 };
+        let mut st = law.fresh_state();
+        let path = [3e-5, -1e-5, 2e-5];
+        let mut x = 0.0;
+        for &xn in &path {
+            let tr = law.trial(&st, x, xn, 0.0);
+            assert!(law.commit(&mut st, x, xn, &tr).is_ok());
+            x = xn;
+        }
+        // moving down from 2e-5: numerical derivative on the descending branch
+        let h = 1e-9;
+        let a = law.trial(&st, x, x - 5e-6, 0.0);
+        let b = law.trial(&st, x, x - 5e-6 - h, 0.0);
+        assert!(((a.f - b.f) / h - a.kt).abs() < 1e-4 * a.kt);
+    }
+
+    #[test]
+    fn bouc_wen_rk4_matches_the_exact_solution_for_nu_one() {
+        // ν = 1, z ≥ 0, s = +1: dz/dd = α − β(γ + δ) z → z = α/b (1 − e^{−b d}).
+        let (alpha, beta, gamma, delta) = (5e4, 1e3, 0.8, -0.5);
+        let b = beta * (gamma + delta);
+        for &d in &[1e-5, 1e-4, 1e-3] {
+            let z = bw_advance((alpha, beta, gamma, delta, 1.0), 0.0, d);
+            let exact = alpha / b * (1.0 - (-b * d).exp());
+            assert!((z - exact).abs() < 1e-6 * exact.abs(), "{z} vs {exact}");
+        }
+    }
+
+    #[test]
+    fn jenkins_event_is_at_the_slip_force() {
+        let law = JointLaw::Jenkins { k: 100.0, fs: 1.0 };
+        let st = JointState::Slider(0.5);
+        let th = law.event(&st, 0.0, 0.01, 1.0, 1.0);
+        assert_eq!(th, Some(0.5));
+    }
+}

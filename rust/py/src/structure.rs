@@ -1,0 +1,150 @@
+//! Bindings of `contactlab_core::structure`: array/error conversion and GIL release only.
+
+// PyO3 hands arguments over by value (readonly array borrows); nothing to consume.
+#![allow(clippy::needless_pass_by_value)]
+
+use contactlab_core::curve::{Exponential, Tabulated};
+use contactlab_core::structure::{
+    simulate, Inputs, Joint, JointLaw, MasingCurve, Options, Structure,
+};
+use contactlab_core::CoreError;
+use numpy::{IntoPyArray, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::detach_guarded;
+use crate::errors::slice as sl;
+
+fn bad(name: &'static str, reason: &'static str) -> CoreError {
+    CoreError::InvalidParameter {
+        name,
+        value: f64::NAN,
+        reason,
+    }
+}
+
+/// `(kind, dof, dof2 or -1, params, array_a, array_b)` as `contactlab.structure.joints` sends it.
+type JointSpec = (String, usize, i64, Vec<f64>, Vec<f64>, Vec<f64>);
+
+fn build_joint(spec: &JointSpec) -> Result<Joint, CoreError> {
+    let (kind, dof, dof2, p, a, b) = spec;
+    let want = |k: usize| {
+        if p.len() == k {
+            Ok(())
+        } else {
+            Err(bad("joint params", "wrong number of joint parameters"))
+        }
+    };
+    let law = match kind.as_str() {
+        "masing" => {
+            want(3)?;
+            JointLaw::masing(MasingCurve::Exp(Exponential::new(p[0], p[1])?), p[2])?
+        }
+        "masing_tabulated" => {
+            want(1)?;
+            JointLaw::masing(MasingCurve::Tab(Tabulated::new(a, b)?), p[0])?
+        }
+        "jenkins" => {
+            want(2)?;
+            JointLaw::jenkins(p[0], p[1])?
+        }
+        "iwan" => JointLaw::iwan(a, b)?,
+        "bouc_wen" => {
+            want(5)?;
+            JointLaw::bouc_wen(p[0], p[1], p[2], p[3], p[4])?
+        }
+        "kelvin_voigt" => {
+            want(2)?;
+            JointLaw::kelvin_voigt(p[0], p[1])?
+        }
+        "normal" => JointLaw::normal(a)?,
+        _ => return Err(bad("joint kind", "unknown joint kind")),
+    };
+    Ok(Joint {
+        law,
+        dof: *dof,
+        dof2: usize::try_from(*dof2).ok(),
+    })
+}
+
+/// Newmark simulation of a structure with joints; returns a dict of flat arrays and status.
+#[pyfunction]
+#[pyo3(signature = (n, m, c, k, joints, t, x0, v0, force=None, base=None, base_velocity=None, kr=None, cr=None, rtol=1e-10, max_iter=30))]
+fn structure_simulate<'py>(
+    py: Python<'py>,
+    n: usize,
+    m: PyReadonlyArray1<'py, f64>,
+    c: PyReadonlyArray1<'py, f64>,
+    k: PyReadonlyArray1<'py, f64>,
+    joints: Vec<JointSpec>,
+    t: PyReadonlyArray1<'py, f64>,
+    x0: PyReadonlyArray1<'py, f64>,
+    v0: PyReadonlyArray1<'py, f64>,
+    force: Option<PyReadonlyArray1<'py, f64>>,
+    base: Option<PyReadonlyArray1<'py, f64>>,
+    base_velocity: Option<PyReadonlyArray1<'py, f64>>,
+    kr: Option<PyReadonlyArray1<'py, f64>>,
+    cr: Option<PyReadonlyArray1<'py, f64>>,
+    rtol: f64,
+    max_iter: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (ms, cs, ks) = (sl(&m, "M")?, sl(&c, "C")?, sl(&k, "K")?);
+    let (ts, x0s, v0s) = (sl(&t, "t")?, sl(&x0, "x0")?, sl(&v0, "v0")?);
+    let fs = match &force {
+        Some(f) => Some(sl(f, "force")?),
+        None => None,
+    };
+    let base = match (&base, &base_velocity, &kr, &cr) {
+        (Some(y), Some(yd), Some(kr), Some(cr)) => Some((
+            sl(y, "base")?,
+            sl(yd, "base_velocity")?,
+            sl(kr, "K r")?,
+            sl(cr, "C r")?,
+        )),
+        (None, None, None, None) => None,
+        _ => {
+            return Err(crate::errors::to_pyerr(
+                py,
+                &bad("base", "base, base_velocity, kr and cr go together"),
+            ))
+        }
+    };
+    let opts = Options {
+        rtol,
+        max_iter,
+        ..Options::default()
+    };
+    let r = detach_guarded(py, move || {
+        let js = joints
+            .iter()
+            .map(build_joint)
+            .collect::<Result<Vec<_>, _>>()?;
+        let s = Structure::new(n, ms, cs, ks, js)?;
+        let inp = Inputs {
+            t: ts,
+            force: fs,
+            base,
+        };
+        simulate(&s, &inp, x0s, v0s, &opts)
+    })?;
+    let d = PyDict::new(py);
+    d.set_item("x", r.x.into_pyarray(py))?;
+    d.set_item("v", r.v.into_pyarray(py))?;
+    d.set_item("a", r.a.into_pyarray(py))?;
+    d.set_item("joint_force", r.joint_force.into_pyarray(py))?;
+    d.set_item("joint_work", r.joint_work.into_pyarray(py))?;
+    d.set_item("joint_dissipated", r.joint_dissipated.into_pyarray(py))?;
+    d.set_item("input_work", r.input_work.into_pyarray(py))?;
+    d.set_item("damping_work", r.damping_work.into_pyarray(py))?;
+    d.set_item("n_out", r.n_out)?;
+    d.set_item("status", r.status.code())?;
+    d.set_item("message", r.status.message())?;
+    d.set_item("n_steps", r.n_steps)?;
+    d.set_item("n_iter", r.n_iter)?;
+    Ok(d)
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(structure_simulate, m)?)?;
+    Ok(())
+}
