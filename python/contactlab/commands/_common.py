@@ -279,6 +279,14 @@ def add_workers_flag(p: Any, what: str) -> None:
                    help=f"analyse {what} in N processes (default: serially)")  # fmt: skip
 
 
+def _ignore_sigint() -> None:
+    """Pool workers leave Ctrl-C to the parent, which cancels what is queued and exits 130
+    (otherwise every worker prints its own KeyboardInterrupt traceback)."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def process_pool(workers: int | None) -> Any:
     """A ``ProcessPoolExecutor`` for ``--workers N`` (a null context for None)."""
     import contextlib
@@ -289,7 +297,7 @@ def process_pool(workers: int | None) -> Any:
         raise InputError(f"--workers must be >= 1, got {workers}")
     from concurrent.futures import ProcessPoolExecutor
 
-    return ProcessPoolExecutor(workers)
+    return ProcessPoolExecutor(workers, initializer=_ignore_sigint)
 
 
 def add_progress_flags(p: Any) -> None:

@@ -83,9 +83,9 @@ def savgol_derivative(v: np.ndarray, window: int, deriv: int, dt: float) -> np.n
     return savgol_filter(v, window, POLYORDER, deriv=deriv, delta=dt, mode="interp")
 
 
-def savgol_weights(window: int, deriv: int, dt: float) -> np.ndarray:
-    """The weights of :func:`savgol_derivative` (``estimate = weights · samples``): white
-    noise σ on the samples gives the estimate a noise ``σ ‖weights‖``."""
+def savgol_coefficients(window: int, deriv: int, dt: float) -> np.ndarray:
+    """Savitzky-Golay weights of the ``deriv``-th derivative (dot with a centred window):
+    white noise σ on the samples gives the estimate a noise ``σ ‖weights‖``."""
     from scipy.signal import savgol_coeffs
 
     return savgol_coeffs(window, POLYORDER, deriv=deriv, delta=dt, use="dot")
@@ -106,9 +106,9 @@ def lepski_window(x: np.ndarray, dt: float, sigma: float, *, kappa: float = LEPS
     chosen = cands[0]
     for i, w in enumerate(cands[1:], start=1):
         ok = True
-        cw = savgol_weights(w, 2, dt)
+        cw = savgol_coefficients(w, 2, dt)
         for wp in cands[:i]:
-            cp = np.pad(savgol_weights(wp, 2, dt), (w - wp) // 2)
+            cp = np.pad(savgol_coefficients(wp, 2, dt), (w - wp) // 2)
             sd = sigma * float(np.linalg.norm(cw - cp))
             inner = slice(w // 2, n - w // 2)
             rms = float(np.sqrt(np.mean((ests[w][inner] - ests[wp][inner]) ** 2)))
@@ -209,7 +209,7 @@ def frame_friction_force(
     F = K * (ya - xa) + C * (yd - xd) - M * xdd
     # noise of F: K (y - x) direct, C and M through the filters' coefficients (x's terms
     # combine into one filter of x: -K δ - C c1 - M c2)
-    c1, c2 = savgol_weights(window, 1, dt), savgol_weights(window, 2, dt)
+    c1, c2 = savgol_coefficients(window, 1, dt), savgol_coefficients(window, 2, dt)
     fx = -C * c1 - M * c2
     fx[window // 2] -= K
     fy = C * c1
@@ -223,6 +223,6 @@ __all__ = [
     "difference_noise",
     "frame_friction_force",
     "lepski_window",
+    "savgol_coefficients",
     "savgol_derivative",
-    "savgol_weights",
 ]

@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from .frame import difference_noise, lepski_window, savgol_derivative, savgol_weights
+from .frame import difference_noise, lepski_window, savgol_coefficients, savgol_derivative
 from .model import area_ratio
 from .preprocess import AveragedLoop, Reversals
 
@@ -89,7 +89,7 @@ def velocity(t: np.ndarray | None, x: np.ndarray) -> tuple[np.ndarray, float, in
     sx = difference_noise(x)
     window = min(lepski_window(x, dt, sx), max(5, (x.size // 2) * 2 - 1))
     v = savgol_derivative(x, window, 1, dt)
-    thr = VELOCITY_SIGMAS * sx * float(np.linalg.norm(savgol_weights(window, 1, dt)))
+    thr = VELOCITY_SIGMAS * sx * float(np.linalg.norm(savgol_coefficients(window, 1, dt)))
     if not thr > 0:  # no measurable noise: a smooth turn crosses zero within a sample
         thr = 1e-9 * float(np.max(np.abs(v)))
     return v, thr, window
