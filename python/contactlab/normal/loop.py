@@ -30,7 +30,6 @@ import numpy as np
 
 from .. import _core
 from .._arrays import as_1d, positive
-from .._physical import check_channel
 from .._range import check_channel as check_range
 from ..errors import ContactLabWarning, InputError
 from . import _paper
@@ -303,13 +302,11 @@ def _check_inputs(t: Any, p: Any, delta: Any, degree: Any) -> tuple[np.ndarray, 
     tv = _time_vector(t, n)
     if isinstance(degree, bool) or not isinstance(degree, (int, np.integer)) or degree < 1:
         raise InputError(f"degree must be an integer >= 1, got {degree!r}")
-    check_channel("p", pv, "Pa", "pressure")
     if not np.ptp(dv) > 0:
         raise InputError(
             f"delta is constant ({float(dv[0]):g} m): the displacement sensor recorded no motion, "
             "so there is no loop to analyse"
         )
-    check_channel("delta", dv, "m", "displacement")
     return tv, pv, dv
 
 

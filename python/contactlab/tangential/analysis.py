@@ -49,7 +49,6 @@ from typing import Any
 import numpy as np
 
 from .._arrays import as_1d
-from .._physical import check_channel
 from .._range import check_channel as check_range
 from ..errors import ContactLabWarning, InputError
 from ..fitting import FitResult
@@ -400,8 +399,6 @@ def analyze_tangential(
     """
     xa, Fa, ta, source = _inputs(recording, t, x, F)
     _check_options(on, history, n_points)
-    check_channel("x", xa, "m", "displacement")
-    check_channel("F", Fa, "N", "force")
     steady = history == "steady"
     if invert_force is not None:
         force_sign = -1 if invert_force else 1
