@@ -25,19 +25,19 @@ def _write(path, header, a, b):
 
 
 TANGENTIAL = {
-    "constant_force": (X, np.full(T.size, 3.0), "'F' is constant (3 N"),
-    "zero_force": (X, np.zeros(T.size), "'F' is constant (0 N"),
-    "zero_displacement": (np.zeros(T.size), F, "'x' is constant (0 m"),
-    "huge_force": (X, F * 1e299, "force channel 'F' reaches"),
-    "huge_displacement": (X * 1e300, F, "displacement channel 'x' reaches"),
-    "tiny_force": (X, F * 1e-300, "'F' varies by only"),
+    "constant_force": (X, np.full(T.size, 3.0), "F does not vary (3 N"),
+    "zero_force": (X, np.zeros(T.size), "F is zero in all"),
+    "zero_displacement": (np.zeros(T.size), F, "x is zero in all"),
+    "huge_force": (X, F * 1e299, "beyond any physical force"),
+    "huge_displacement": (X * 1e300, F, "beyond any physical displacement"),
+    "tiny_force": (X, F * 1e-300, "F is zero in all"),
 }
 NORMAL = {
-    "constant_pressure": (np.full(T.size, 0.5e6), D, "'p' is constant (500000 Pa"),
-    "zero_pressure": (np.zeros(T.size), D, "'p' is constant (0 Pa"),
+    "constant_pressure": (np.full(T.size, 0.5e6), D, "p does not vary"),
+    "zero_pressure": (np.zeros(T.size), D, "p is zero in all"),
     "zero_displacement": (P, np.zeros(T.size), "delta is"),
-    "huge_pressure": (P * 1e299, D, "pressure channel 'p' reaches"),
-    "huge_displacement": (P, D * 1e300, "'delta' reaches"),
+    "huge_pressure": (P * 1e299, D, "beyond any physical pressure"),
+    "huge_displacement": (P, D * 1e300, "beyond any physical displacement"),
 }
 INTERNAL = ("Traceback", "outside [nan", "must be finite and > 0", "RuntimeWarning", "singular")
 

@@ -30,7 +30,7 @@ import numpy as np
 
 from .. import _core
 from .._arrays import as_1d, positive
-from .._range import check_channel as check_range
+from .._physical import check_channel
 from ..errors import ContactLabWarning, InputError
 from . import _paper
 
@@ -302,11 +302,13 @@ def _check_inputs(t: Any, p: Any, delta: Any, degree: Any) -> tuple[np.ndarray, 
     tv = _time_vector(t, n)
     if isinstance(degree, bool) or not isinstance(degree, (int, np.integer)) or degree < 1:
         raise InputError(f"degree must be an integer >= 1, got {degree!r}")
+    check_channel("p", pv, "Pa", "pressure")
     if not np.ptp(dv) > 0:
         raise InputError(
             f"delta is constant ({float(dv[0]):g} m): the displacement sensor recorded no motion, "
             "so there is no loop to analyse"
         )
+    check_channel("delta", dv, "m", "displacement")
     return tv, pv, dv
 
 
@@ -606,8 +608,6 @@ def analyze_loop(
     [-0.015, 1.32, 1.705, 3.562, 4.176]
     """
     tv, pv, dv = _check_inputs(t, p, delta, degree)
-    check_range(pv, "p", "Pa")
-    check_range(dv, "delta", "m")
     degree = int(degree)
     tv, pv, dv, dt, resampled = _uniform(tv, pv, dv)
     cyc = _cycles(tv, pv, dt, omega, n_bins, discard_cycles)

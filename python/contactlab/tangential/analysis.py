@@ -49,7 +49,7 @@ from typing import Any
 import numpy as np
 
 from .._arrays import as_1d
-from .._range import check_channel as check_range
+from .._physical import check_channel
 from ..errors import ContactLabWarning, InputError
 from ..fitting import FitResult
 from ..io import Recording
@@ -81,8 +81,6 @@ def _inputs(
                     f"{recording.source}: no {ch!r} channel; a tangential recording needs x "
                     f"and F (channels: {sorted(recording.data)})"
                 )
-        for ch, unit in (("x", "m"), ("F", "N")):
-            check_range(recording[ch], ch, unit, recording.source)
         return recording["x"], recording["F"], recording.t, recording.source
     if x is None or F is None:
         raise InputError("give a recording, or the arrays x (m) and F (N)")
@@ -98,8 +96,6 @@ def _inputs(
         if np.any(np.diff(ta) <= 0):
             i = int(np.argmax(np.diff(ta) <= 0)) + 1
             raise InputError(f"t[{i}] = {ta[i]} does not increase")
-    check_range(xa, "x", "m")
-    check_range(Fa, "F", "N")
     return xa, Fa, ta, "<arrays>"
 
 
@@ -399,6 +395,8 @@ def analyze_tangential(
     """
     xa, Fa, ta, source = _inputs(recording, t, x, F)
     _check_options(on, history, n_points)
+    check_channel("x", xa, "m", "displacement")
+    check_channel("F", Fa, "N", "force")
     steady = history == "steady"
     if invert_force is not None:
         force_sign = -1 if invert_force else 1
