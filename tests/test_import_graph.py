@@ -32,6 +32,7 @@ PREFIXES = {
     "contactlab._json": "base",
     "contactlab.data": "base",  # bundled files only (the generator is contactlab._datagen)
     "contactlab.masing": "masing/fitting/io",
+    "contactlab.reversals": "masing/fitting/io",
     "contactlab.fitting": "masing/fitting/io",
     "contactlab.io": "masing/fitting/io",
     "contactlab.report": "masing/fitting/io",  # the generic HTML report writer
