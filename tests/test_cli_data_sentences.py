@@ -25,7 +25,7 @@ def _write(path, header, a, b):
 
 
 TANGENTIAL = {
-    "constant_force": (X, np.full(T.size, 3.0), "F does not vary (3 N"),
+    "constant_force": (X, np.full(T.size, 3.0), "F is constant (3 N"),
     "zero_force": (X, np.zeros(T.size), "F is zero in all"),
     "zero_displacement": (np.zeros(T.size), F, "x is zero in all"),
     "huge_force": (X, F * 1e299, "beyond any physical force"),
@@ -33,7 +33,7 @@ TANGENTIAL = {
     "tiny_force": (X, F * 1e-300, "F is zero in all"),
 }
 NORMAL = {
-    "constant_pressure": (np.full(T.size, 0.5e6), D, "p does not vary"),
+    "constant_pressure": (np.full(T.size, 0.5e6), D, "p is constant"),
     "zero_pressure": (np.zeros(T.size), D, "p is zero in all"),
     "zero_displacement": (P, np.zeros(T.size), "delta is"),
     "huge_pressure": (P * 1e299, D, "beyond any physical pressure"),

@@ -28,7 +28,7 @@ def check_channel(name: str, v: np.ndarray, unit: str, what: str) -> None:
     >>> check_channel("F", np.full(5, 3.0), "N", "force")
     Traceback (most recent call last):
     ...
-    contactlab.errors.InputError: F does not vary (3 N in all 5 samples): ...
+    contactlab.errors.InputError: F is constant (3 N in all 5 samples): ...
     """
     a = np.abs(v)
     i = int(np.argmax(a))
@@ -46,7 +46,7 @@ def check_channel(name: str, v: np.ndarray, unit: str, what: str) -> None:
     spread = float(np.ptp(v))
     if spread <= 1e-12 * big:
         raise InputError(
-            f"{name} does not vary ({float(v[0]):.6g} {unit} in all {v.size} samples): the "
+            f"{name} is constant ({float(v[0]):.6g} {unit} in all {v.size} samples): the "
             f"{what} sensor recorded no change, so there is no loop to analyse"
         )
 
