@@ -20,8 +20,8 @@ failures one per line, and whether the bars of issue 8 are met. ``--figures DIR`
 confusion matrices and the per-level rates as PNG.
 
 Run: ``.venv/bin/python benches/eval_diagnose.py [--model both] [--seeds 2] [--jobs 2]``
-(about 15-25 minutes on 2 cores with the defaults; ``--quick`` keeps the reference condition
-and two factor levels: a few minutes). Not part of the test suite.
+(about an hour on 2 cores with the defaults; ``--quick`` keeps one or two levels per factor
+besides the reference: 15-30 minutes). Not part of the test suite.
 """
 
 from __future__ import annotations
@@ -54,7 +54,14 @@ FACTORS: dict[str, list[Any]] = {
     "bits": [None, 16, 12],
     "magnitude": [0.03, 0.05, 0.1],
 }
-QUICK = {"input_noise": [0.002, 0.01], "anti_alias": [(0.5, 0.5), (0.3, 0.6)]}
+#: a smaller design for a bounded run (about 150 tangential and 60 normal diagnoses)
+QUICK = {
+    "input_noise": [0.0, 0.01],
+    "samples_per_cycle": [50, 500],
+    "start": ["steady"],
+    "anti_alias": [None, (0.3, 0.6)],
+    "bits": [12],
+}
 
 
 def effects_of(model: str) -> tuple[str, ...]:
@@ -208,7 +215,14 @@ def evaluate_model(model: str, args: argparse.Namespace, pool: ProcessPoolExecut
         for p, s in itertools.product(chosen, seeds)
     ]
     t0 = time.perf_counter()
-    cases = list(pool.map(run_case, jobs, chunksize=1))
+    cases = []
+    for c in pool.map(run_case, jobs, chunksize=1):
+        cases.append(c)
+        print(
+            f"  {len(cases):4d}/{len(jobs)} [{c['level']}] {c['effects'] or 'none'} -> "
+            f"{c['named']} {'ok' if c['right'] else '--'} ({c['seconds']:.1f} s)",
+            flush=True,
+        )
     wall = time.perf_counter() - t0
     single = [c for c in cases if c["level"] != "pairs"]
     two = [c for c in cases if c["level"] == "pairs"]
