@@ -192,15 +192,18 @@ def save_figures(directory: str, model: str, conf: dict, effs: tuple, levels: di
 def evaluate_model(model: str, args: argparse.Namespace, pool: ProcessPoolExecutor) -> dict:
     effs = effects_of(model)
     factors = QUICK if args.quick else FACTORS
+    if args.factors:
+        factors = {k: v for k, v in factors.items() if k in args.factors.split(",")}
     conds: list[tuple[str, dict[str, Any]]] = [("reference", dict(REFERENCE))]
     for f, levels in factors.items():
         for lv in levels:
             if lv != REFERENCE[f]:
                 conds.append((f"{f}={_label(lv)}", {**REFERENCE, f: lv}))
     seeds = range(args.seed0, args.seed0 + args.seeds)
+    chosen_effs = [x for x in effs if not args.effects or x in args.effects.split(",")]
     jobs = [
         {"model": model, "effects": e, "cond": c, "level": name, "seed": s}
-        for (name, c), e, s in itertools.product(conds, [(), *((x,) for x in effs)], seeds)
+        for (name, c), e, s in itertools.product(conds, [(), *((x,) for x in chosen_effs)], seeds)
     ]
     from contactlab.diagnose.workflow import _family
 
@@ -292,6 +295,8 @@ def main() -> None:
     ap.add_argument("--pairs", type=int, default=10, help="pairs of effects drawn")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--factors", help="comma-separated subset of the factors to vary")
+    ap.add_argument("--effects", help="comma-separated subset of the single effects")
     ap.add_argument("--figures", help="save confusion matrices and factor plots here")
     ap.add_argument("--json", help="write all cases to this file")
     args = ap.parse_args()
