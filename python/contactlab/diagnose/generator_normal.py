@@ -127,7 +127,15 @@ def hidden_effect_recording_normal(
         def g(s: float, name: str = name, target: float = target, sign: float = sign) -> float:
             return size(name, sign * s) - target
 
-        if g(hi) < 0:
+        for _ in range(8):  # the bracket's end must keep the joint's stiffness positive
+            try:
+                g_hi = g(hi)
+                break
+            except InputError:
+                hi *= 0.5
+        else:
+            raise InputError(f"magnitude {target:g} is out of reach for {name}")
+        if g_hi < 0:
             raise InputError(f"magnitude {target:g} is out of reach for {name}")
         params[name] = sign * brentq(g, 0.0, hi, xtol=1e-12 * hi, rtol=1e-6)
     delta = _displacement(params, t, pfun, k, psi, omega, dr)
