@@ -20,8 +20,8 @@ failures one per line, and whether the bars of issue 8 are met. ``--figures DIR`
 confusion matrices and the per-level rates as PNG.
 
 Run: ``.venv/bin/python benches/eval_diagnose.py [--model both] [--seeds 2] [--jobs 2]``
-(about 15-25 minutes on 2 cores with the defaults; ``--quick`` keeps the reference condition
-and two factor levels: a few minutes). Not part of the test suite.
+(about an hour on 2 cores with the defaults; ``--quick`` keeps one or two levels per factor
+besides the reference: 15-30 minutes). Not part of the test suite.
 """
 
 from __future__ import annotations
@@ -54,7 +54,14 @@ FACTORS: dict[str, list[Any]] = {
     "bits": [None, 16, 12],
     "magnitude": [0.03, 0.05, 0.1],
 }
-QUICK = {"input_noise": [0.002, 0.01], "anti_alias": [(0.5, 0.5), (0.3, 0.6)]}
+#: a smaller design for a bounded run (about 150 tangential and 60 normal diagnoses)
+QUICK = {
+    "input_noise": [0.0, 0.01],
+    "samples_per_cycle": [50, 500],
+    "start": ["steady"],
+    "anti_alias": [None, (0.3, 0.6)],
+    "bits": [12],
+}
 
 
 def effects_of(model: str) -> tuple[str, ...]:
@@ -185,15 +192,18 @@ def save_figures(directory: str, model: str, conf: dict, effs: tuple, levels: di
 def evaluate_model(model: str, args: argparse.Namespace, pool: ProcessPoolExecutor) -> dict:
     effs = effects_of(model)
     factors = QUICK if args.quick else FACTORS
+    if args.factors:
+        factors = {k: v for k, v in factors.items() if k in args.factors.split(",")}
     conds: list[tuple[str, dict[str, Any]]] = [("reference", dict(REFERENCE))]
     for f, levels in factors.items():
         for lv in levels:
             if lv != REFERENCE[f]:
                 conds.append((f"{f}={_label(lv)}", {**REFERENCE, f: lv}))
     seeds = range(args.seed0, args.seed0 + args.seeds)
+    chosen_effs = [x for x in effs if not args.effects or x in args.effects.split(",")]
     jobs = [
         {"model": model, "effects": e, "cond": c, "level": name, "seed": s}
-        for (name, c), e, s in itertools.product(conds, [(), *((x,) for x in effs)], seeds)
+        for (name, c), e, s in itertools.product(conds, [(), *((x,) for x in chosen_effs)], seeds)
     ]
     from contactlab.diagnose.workflow import _family
 
@@ -208,7 +218,14 @@ def evaluate_model(model: str, args: argparse.Namespace, pool: ProcessPoolExecut
         for p, s in itertools.product(chosen, seeds)
     ]
     t0 = time.perf_counter()
-    cases = list(pool.map(run_case, jobs, chunksize=1))
+    cases = []
+    for c in pool.map(run_case, jobs, chunksize=1):
+        cases.append(c)
+        print(
+            f"  {len(cases):4d}/{len(jobs)} [{c['level']}] {c['effects'] or 'none'} -> "
+            f"{c['named']} {'ok' if c['right'] else '--'} ({c['seconds']:.1f} s)",
+            flush=True,
+        )
     wall = time.perf_counter() - t0
     single = [c for c in cases if c["level"] != "pairs"]
     two = [c for c in cases if c["level"] == "pairs"]
@@ -278,6 +295,8 @@ def main() -> None:
     ap.add_argument("--pairs", type=int, default=10, help="pairs of effects drawn")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--factors", help="comma-separated subset of the factors to vary")
+    ap.add_argument("--effects", help="comma-separated subset of the single effects")
     ap.add_argument("--figures", help="save confusion matrices and factor plots here")
     ap.add_argument("--json", help="write all cases to this file")
     args = ap.parse_args()

@@ -247,3 +247,24 @@ def test_bad_data_gets_a_sentence_about_the_data(make, match):
     with pytest.raises(InputError, match=match) as exc:
         contactlab.diagnose(make(*rec.arrays()), max_effects=1)
     assert "initial value" not in str(exc.value) and "must be finite" not in str(exc.value)
+
+
+def test_input_noise_does_not_buy_a_sub_sample_delay():
+    # issue 8 item 3, an independent route to the data: Masing from rest, ac·A = 2, 500
+    # samples per cycle, 20 cycles, F noise 0.5 % of h0 and x noise 0.2 % of the amplitude.
+    # Before errors in variables the clean record got channel_delay (τ ≈ 0.45 sample) named,
+    # and so did each single-effect record beside its effect.
+    h0, ac = 40.0, 4e4
+    amp = 2.0 / ac
+    t = np.arange(20 * 500 + 1) / 2500.0
+    x = amp * np.sin(2 * np.pi * 5.0 * t)
+    rng = np.random.default_rng(SEED + 11)
+    xm = x + rng.normal(0.0, 0.002 * amp, x.size)
+    F = contactlab.Masing(h0, ac).force(x) + rng.normal(0.0, 0.005 * h0, x.size)
+    rep = contactlab.diagnose((t, xm, F))
+    assert rep.effects == []
+    assert rep.final_model.params["h0"] == pytest.approx(h0, rel=0.02)
+    # the displacement noise is found from the data
+    assert rep._data.extra["u_noise"] == pytest.approx(0.002 * amp, rel=0.2)
+    rep = contactlab.diagnose((t, xm, F + 0.02 * h0))
+    assert rep.effect_names == ["force_offset"]

@@ -74,8 +74,7 @@ def block_excitation(
     return x, total, max(f)
 
 
-def rms_of(a: np.ndarray) -> float:
-    """Root mean square of ``a``."""
+def rms(a: np.ndarray) -> float:
     return float(np.sqrt(np.mean(a * a)))
 
 

@@ -160,6 +160,8 @@ BASE_PARAMS = (
 )
 
 _SERIES_POINTS = 400
+#: a normal-load fluctuation must make this many periods in the record; slower, it is a drift
+MIN_LOAD_PERIODS = 2.0
 
 
 def series_backbone(h0: float, ac: float, C_s: float, x_max: float) -> tuple[np.ndarray, ...]:
@@ -244,9 +246,9 @@ class TangentialFamily:
         """Starting values of an effect's nonlinear parameters from the current residual.
 
         ``normal_load``: the frequency whose ``h cos, h sin`` pair explains most of the
-        residual (measured minus model), scanned from 0.05 to 3 excitation frequencies at a
-        quarter of the record's frequency resolution; ``stick_slip``: a slip distance of
-        ``1/ac``; ``stribeck``: ``v_s`` of the RMS speed.
+        residual (measured minus model), scanned from 0.05 excitation frequencies (at least
+        two periods in the record) to 3, at a quarter of the record's frequency resolution;
+        ``stick_slip``: a slip distance of ``1/ac``; ``stribeck``: ``v_s`` of the RMS speed.
         """
         if name == "stick_slip":
             return {"ell": 1.0 / p["ac"]}
@@ -257,7 +259,8 @@ class TangentialFamily:
         h = self.predict(p, (), d)
         tt = d.t - d.t[0]
         f_exc = 1.0 / (d.cycles.period_samples * d.dt)
-        freqs = np.arange(0.05 * f_exc, 3.0 * f_exc, 0.25 / d.duration)
+        f_lo = max(0.05 * f_exc, MIN_LOAD_PERIODS / d.duration)
+        freqs = np.arange(f_lo, 3.0 * f_exc, 0.25 / d.duration)
         # a fluctuation locked to the drive is position_friction's: skip the harmonics
         k = np.round(freqs / f_exc)
         freqs = freqs[(k < 1) | (np.abs(freqs - k * f_exc) >= 1.0 / d.duration)]
@@ -429,6 +432,11 @@ class TangentialFamily:
         if name == "non_masing_scaling" and not 0.5 <= p["lam"] <= 8.0:
             return f"branch scale lam = {p['lam']:.3g} is outside 0.5..8 (no known joint)"
         if name == "normal_load":
+            if p["f_n"] < MIN_LOAD_PERIODS / d.duration:
+                return (
+                    f"a load fluctuation of {p['f_n']:.3g} Hz makes fewer than "
+                    f"{MIN_LOAD_PERIODS:g} periods in the record: a drift (parameter_drift)"
+                )
             f_exc = 1.0 / (d.cycles.period_samples * d.dt)
             k = round(p["f_n"] / f_exc)
             if k >= 1 and abs(p["f_n"] - k * f_exc) < 1.0 / d.duration:

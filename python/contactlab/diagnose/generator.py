@@ -37,7 +37,7 @@ from ._gen_common import (
     block_excitation,
     effect_sizes,
     measure,
-    rms_of,
+    rms,
     start_index,
 )
 from .candidates_tangential import breakaway
@@ -106,7 +106,7 @@ def _tangential_force(
         rev = rev[np.abs(xc[rev]) > 0.05 * np.max(np.abs(xc))]
         h = breakaway(h, xc, rev, effects["stick_slip"], BREAKAWAY_DISTANCE / ac)
     if "stribeck" in effects:
-        vs = STRIBECK_SPEED * rms_of(v)
+        vs = STRIBECK_SPEED * rms(v)
         h = h * (1.0 + effects["stribeck"] * np.exp(-np.abs(v) / vs))
     if "position_friction" in effects:
         xi = xc / np.max(np.abs(xc))
@@ -248,13 +248,13 @@ def hidden_effect_recording(
     t = np.arange(round(T * fs) + 1) / fs
     period = 1.0 / fmax
     _x0, F0 = _tangential_force({}, t, xfun, h0, ac, period)
-    Fr = rms_of(F0)
+    Fr = rms(F0)
 
     def size(name: str, value: float) -> float:
         x1, F1 = _tangential_force({name: value}, t, xfun, h0, ac, period)
         # measured output change, on the measured displacement (what a base fit would see)
         F_on_x1 = Masing(h0, ac).force(x1)
-        return rms_of(F1 - F_on_x1) / Fr
+        return rms(F1 - F_on_x1) / Fr
 
     params: dict[str, float] = {}
     for name, target in sizes.items():
@@ -275,9 +275,9 @@ def hidden_effect_recording(
     keep = start_index(start, t, f0, 0.6 * f0)
     t, x, F = t[keep:] - t[keep], x[keep:], F[keep:]
     x_noise = (
-        0.2 * noise * rms_of(x) if input_noise is None else input_noise * float(np.max(np.abs(x)))
+        0.2 * noise * rms(x) if input_noise is None else input_noise * float(np.max(np.abs(x)))
     )
-    F_noise = noise * rms_of(F)
+    F_noise = noise * rms(F)
     xm, Fm, info = measure(
         t,
         x,

@@ -21,7 +21,7 @@ from ._gen_common import (
     block_excitation,
     effect_sizes,
     measure,
-    rms_of,
+    rms,
     start_index,
 )
 from .candidates_normal import frequency_domain, kelvin_voigt, nonlinear
@@ -106,10 +106,10 @@ def hidden_effect_recording_normal(
     t = np.arange(round(T * fs) + 1) / fs
     omega = 2.0 * np.pi * f0
     d0 = _displacement({}, t, pfun, k, psi, omega, 1.0)
-    dr = rms_of(d0)
+    dr = rms(d0)
 
     def size(name: str, value: float) -> float:
-        return rms_of(_displacement({name: value}, t, pfun, k, psi, omega, dr) - d0) / dr
+        return rms(_displacement({name: value}, t, pfun, k, psi, omega, dr) - d0) / dr
 
     params: dict[str, float] = {}
     for name, target in sizes.items():
@@ -127,7 +127,15 @@ def hidden_effect_recording_normal(
         def g(s: float, name: str = name, target: float = target, sign: float = sign) -> float:
             return size(name, sign * s) - target
 
-        if g(hi) < 0:
+        for _ in range(8):  # the bracket's end must keep the joint's stiffness positive
+            try:
+                g_hi = g(hi)
+                break
+            except InputError:
+                hi *= 0.5
+        else:
+            raise InputError(f"magnitude {target:g} is out of reach for {name}")
+        if g_hi < 0:
             raise InputError(f"magnitude {target:g} is out of reach for {name}")
         params[name] = sign * brentq(g, 0.0, hi, xtol=1e-12 * hi, rtol=1e-6)
     delta = _displacement(params, t, pfun, k, psi, omega, dr)
@@ -136,8 +144,8 @@ def hidden_effect_recording_normal(
     tau_c = 0.25 * float(t[-1])
     t, p, delta = t[keep:] - t[keep], p[keep:], delta[keep:]
     pd_amp = float(np.max(np.abs(p - p0)))
-    p_noise = 0.2 * noise * rms_of(p - p0) if input_noise is None else input_noise * pd_amp
-    d_noise = noise * rms_of(delta)
+    p_noise = 0.2 * noise * rms(p - p0) if input_noise is None else input_noise * pd_amp
+    d_noise = noise * rms(delta)
     pm, dm, info = measure(
         t,
         p,
