@@ -44,7 +44,7 @@ def _value_line(v: Value, u: UnitSystem) -> str:
 
 
 def _header(jc: JointCharacteristics, u: UnitSystem, fmt: str, c: str, command: str) -> list[str]:
-    from .. import __version__
+    from .._version import __version__
 
     lines = [f"contactlab {__version__} joint characteristics ({jc.kind}), format {fmt}"]
     if command:
