@@ -3,7 +3,7 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 PIP    := $(PY) -m pip
 STAMP  := $(VENV)/.deps-stamp
-PYSRC  := python tests benches
+PYSRC  := python tests benches fuzz
 
 .PHONY: demo test develop rust-test rust-lint py-lint pytest bench clean
 

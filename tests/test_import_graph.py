@@ -52,19 +52,6 @@ PREFIXES = {
 }
 
 
-# Being removed on branch `diag` (issue 13: the diagnose-internal cycles and the private names
-# behind them). Only these may remain; delete the two sets once that work is merged.
-PENDING_CYCLES = [
-    ["contactlab.diagnose.generator", "contactlab.diagnose.generator_normal"],
-    ["contactlab.diagnose.model", "contactlab.diagnose.workflow"],
-]
-PENDING_PRIVATE = {
-    "contactlab.diagnose.model imports _arrays from contactlab.diagnose.workflow",
-    "contactlab.diagnose.generator_normal imports _rms from contactlab.diagnose.generator",
-    "contactlab.diagnose.generator_normal imports _sizes from contactlab.diagnose.generator",
-}
-
-
 def module_name(path: Path) -> str:
     parts = list(path.relative_to(PACKAGE.parent).with_suffix("").parts)
     if parts[-1] == "__init__":
@@ -194,8 +181,7 @@ def test_every_module_has_a_layer():
 
 def test_import_graph_has_no_cycles():
     graph, _ = import_graph()
-    found = [c for c in cycles(graph) if c not in PENDING_CYCLES]
-    assert found == [], format_graph(graph)
+    assert cycles(graph) == [], format_graph(graph)
 
 
 def test_imports_run_one_way():
@@ -211,8 +197,7 @@ def test_imports_run_one_way():
 
 def test_no_private_names_imported_across_modules():
     _, private = import_graph()
-    found = sorted(set(private) - PENDING_PRIVATE)
-    assert not found, "\n".join(found)
+    assert not private, "\n".join(private)
 
 
 def test_the_checker_sees_cycles_and_upward_imports():

@@ -332,7 +332,22 @@ def least_squares_fit(
     names = [k for k, p in ps.items() if p.vary]
     for p in ps.values():
         if not math.isfinite(p.value):
-            raise InputError(f"parameter {p.name!r} has a non-finite initial value {p.value}")
+            raise InputError(
+                f"parameter {p.name!r} has a non-finite initial value {p.value}: the data or "
+                "the start estimate derived from them are not usable (a constant channel, an "
+                "overflow?)"
+            )
+        for side, bound in (("lower", p.min), ("upper", p.max)):
+            if math.isnan(bound):
+                raise InputError(
+                    f"parameter {p.name!r}: the {side} bound is NaN (bounds derived from "
+                    "data that have none, e.g. a constant or empty channel?); give a number, "
+                    "or ±inf for no bound"
+                )
+        if p.vary and p.min >= p.max:
+            raise InputError(
+                f"parameter {p.name!r}: empty range [{p.min}, {p.max}] (min must be < max)"
+            )
         if p.vary and not (p.min <= p.value <= p.max):
             raise InputError(
                 f"parameter {p.name!r}: initial value {p.value} outside [{p.min}, {p.max}]"
@@ -352,20 +367,30 @@ def least_squares_fit(
         v.update({n: float(zi * s) for n, zi, s in zip(names, z, scale, strict=True)})
         return {k: v[k] for k in ps}
 
-    def fun(z: np.ndarray) -> np.ndarray:
+    def raw_fun(z: np.ndarray) -> np.ndarray:
         nonlocal nfev
         nfev += 1
-        r = np.asarray(residual_fn(values_of(z)), dtype=np.float64).reshape(-1)
-        return r
+        with np.errstate(all="ignore"):  # an overflowing trial step is refused below
+            return np.asarray(residual_fn(values_of(z)), dtype=np.float64).reshape(-1)
 
     z0 = np.array([ps[n].value for n in names]) / scale
-    r0 = fun(z0)
+    r0 = raw_fun(z0)
     if not np.all(np.isfinite(r0)):
         i = int(np.argmax(~np.isfinite(r0)))
         raise InputError(f"residual[{i}] is not finite at the initial parameter values")
     ndata = int(r0.size)
+    # Residuals are scaled too (by their size at the start), so that the solver's tolerances
+    # and χ² neither overflow nor underflow and a fit gives the same relative result in any
+    # units (nN/nm to kN/mm): least_squares' gtol is absolute in the cost's units.
+    rscale = _rms(r0)
+    if not (rscale > 0 and math.isfinite(rscale)):
+        rscale = 1.0
+
+    def fun(z: np.ndarray) -> np.ndarray:
+        return raw_fun(z) / rscale
+
     if not names:
-        chisqr = float(r0 @ r0)
+        chisqr = _sumsq(r0)
         return _finish(ps, [], None, r0, chisqr, ndata, True, 0, "no varied parameters", nfev)
     if ndata < len(names):
         raise InputError(f"{ndata} residuals cannot determine {len(names)} parameters")
@@ -386,41 +411,156 @@ def least_squares_fit(
         raise ConvergenceError(
             f"the model rejected the parameters the solver tried ({exc}); tighten the bounds"
         ) from exc
+
+    def jacobian(z: np.ndarray) -> np.ndarray:
+        # central differences in the scaled variables (bounds respected by one-sided steps)
+        J = np.empty((ndata, len(names)))
+        for j in range(len(names)):
+            h = jac_rel_step * max(abs(z[j]), 1.0)
+            up, dn = z.copy(), z.copy()
+            up[j] = min(z[j] + h, hi[j])
+            dn[j] = max(z[j] - h, lo[j])
+            J[:, j] = (fun(up) - fun(dn)) / (up[j] - dn[j])
+        return J
+
     z = sol.x
-    r = np.asarray(sol.fun, dtype=np.float64)
-    chisqr = float(r @ r)
-    # Central-difference Jacobian at the optimum, in the scaled variables (bounds respected
-    # by one-sided steps).
-    J = np.empty((ndata, len(names)))
-    for j in range(len(names)):
-        h = jac_rel_step * max(abs(z[j]), 1.0)
-        up, dn = z.copy(), z.copy()
-        up[j] = min(z[j] + h, hi[j])
-        dn[j] = max(z[j] - h, lo[j])
-        J[:, j] = (fun(up) - fun(dn)) / (up[j] - dn[j])
+    rs = np.asarray(sol.fun, dtype=np.float64)
+    success, status, message = bool(sol.success), int(sol.status), str(sol.message)
+    J = jacobian(z)
+    if success and loss == "linear":
+        z, rs, J, success, status, message = _polish(fun, jacobian, z, rs, J, lo, hi, names)
+    with np.errstate(over="ignore"):
+        r = rs * rscale
+    with np.errstate(over="ignore"):
+        chisqr = float(np.float64(_sumsq(rs)) * np.float64(rscale) ** 2)
+    notes = []
+    if not np.all(np.isfinite(J)):
+        success, status = False, -3
+        message = "the model is not finite next to the end point (its Jacobian overflows)"
+    elif _rms(rs) < 1e5 * np.finfo(float).eps * _rms(J @ z):
+        # residuals at the rounding level of the model's values: the parameters are exact
+        # to rounding, but χ² and so the standard errors are rounding noise (NIST Lanczos1)
+        notes.append(
+            "the residuals are at the floating-point rounding level of the model (an exact "
+            "fit): standard errors are not determined"
+        )
     res = _finish(
         ps,
         names,
-        (J, scale),
+        (J, scale, rscale) if np.all(np.isfinite(J)) else None,
         r,
         chisqr,
         ndata,
-        bool(sol.success),
-        int(sol.status),
-        str(sol.message),
+        success,
+        status,
+        message,
         nfev,
         values=values_of(z),
         scale_covar=scale_covar,
         rcond=rcond,
         max_rel_stderr=max_rel_stderr,
     )
+    if notes:
+        for n in names:
+            res.params[n].stderr = None
+        res.notes.extend(notes)
     return res
+
+
+def _rms(r: np.ndarray) -> float:
+    """Root mean square without overflow or underflow of the squares."""
+    m = float(np.max(np.abs(r))) if r.size else 0.0
+    if not (m > 0 and math.isfinite(m)):
+        return m
+    return m * float(np.sqrt(np.mean((r / m) ** 2)))
+
+
+def _sumsq(r: np.ndarray) -> float:
+    """``r @ r`` (inf when it exceeds the float range, rather than a warning)."""
+    with np.errstate(over="ignore"):
+        return r.size * _rms(r) ** 2 if r.size else 0.0
+
+
+def _polish(
+    fun: Callable[[np.ndarray], np.ndarray],
+    jacobian: Callable[[np.ndarray], np.ndarray],
+    z: np.ndarray,
+    r: np.ndarray,
+    J: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    names: list[str],
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool, int, str]:
+    """Gauss-Newton steps from the solver's end point until they stop paying, then the trust
+    check: the step still possible must be a negligible fraction of each parameter's standard
+    error, or the fit is reported ``success=False`` naming the parameter.
+
+    The trust-region solver stops on *relative* changes, which can leave a slow, ill-
+    conditioned fit (NIST's ENSO, Lanczos, MGH17) several digits short of its minimum while
+    reporting success. Parameters at a bound are held there.
+    """
+    cost = float(r @ r)
+    for _ in range(30):
+        step = _gn_step(J, r, z, lo, hi)
+        if step is None or not np.any(step):
+            break
+        z_new = np.clip(z + step, lo, hi)
+        r_new = fun(z_new)
+        if not np.all(np.isfinite(r_new)):
+            break
+        cost_new = float(r_new @ r_new)
+        if cost_new > cost:
+            break
+        moved = np.max(np.abs(z_new - z) / np.maximum(np.abs(z), 1e-300))
+        z, r, cost = z_new, r_new, cost_new
+        J = jacobian(z)
+        if moved < 1e-14:
+            break
+    # trust: one more step from here, measured in standard errors
+    step = _gn_step(J, r, z, lo, hi)
+    nfree = r.size - len(names)
+    if step is not None and nfree > 0 and np.all(np.isfinite(J)):
+        try:
+            cov = np.linalg.pinv(J.T @ J, rcond=1e-13) * (cost / nfree)
+        except np.linalg.LinAlgError:
+            cov = None
+        if cov is not None:
+            sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+            with np.errstate(divide="ignore", invalid="ignore"):
+                ratio = np.where(sd > 0, np.abs(step) / sd, 0.0)
+            # a step below 1e-10 of the value is rounding noise whatever the error says
+            # (an exact fit's standard errors are themselves rounding noise)
+            ratio[np.abs(step) <= 1e-10 * np.abs(z)] = 0.0
+            worst = int(np.argmax(ratio))
+            if ratio[worst] > 1e-3:
+                return (z, r, J, False, -2,
+                        f"not converged: a further Gauss-Newton step would move {names[worst]} "
+                        f"by {ratio[worst]:.2g} standard errors (the minimum is not reached; "
+                        "try other starting values or bounds)")  # fmt: skip
+    return z, r, J, True, 1, "converged (Gauss-Newton step below 1e-3 standard errors)"
+
+
+def _gn_step(
+    J: np.ndarray, r: np.ndarray, z: np.ndarray, lo: np.ndarray, hi: np.ndarray
+) -> np.ndarray | None:
+    """The Gauss-Newton step ``-J⁺ r``, parameters at a bound held fixed (None if J is not
+    finite)."""
+    if not (np.all(np.isfinite(J)) and np.all(np.isfinite(r))):
+        return None
+    tol = 1e-12 * np.maximum(np.abs(z), 1.0)
+    free = ~(((z - lo) <= tol) | ((hi - z) <= tol))
+    step = np.zeros_like(z)
+    if not free.any():
+        return step
+    sol, *_ = np.linalg.lstsq(J[:, free], -r, rcond=1e-13)
+    step[free] = sol
+    return step
 
 
 def _finish(
     ps: dict[str, Parameter],
     names: list[str],
-    jac: tuple[np.ndarray, np.ndarray] | None,
+    jac: tuple[np.ndarray, np.ndarray, float] | None,
     r: np.ndarray,
     chisqr: float,
     ndata: int,
@@ -449,8 +589,9 @@ def _finish(
     notes: list[str] = []
     Jfull = None
     if jac is not None:
-        Js, scale = jac
-        Jfull = Js / scale  # d r / d value
+        Js, scale, rscale = jac  # d(r / rscale) / d(value / scale)
+        with np.errstate(over="ignore"):
+            Jfull = Js * rscale / scale  # d r / d value
         _U, s, Vt = np.linalg.svd(Js, full_matrices=False)
         sv = s
         cond = float(s[0] / s[-1]) if s[-1] > 0 else math.inf
@@ -467,7 +608,13 @@ def _finish(
                 for n in involved:
                     ps[n].identifiable = False
         inv = (Vt[keep].T / s[keep] ** 2) @ Vt[keep]
-        cov_s = inv * (redchi if scale_covar and nfree > 0 else 1.0)
+        # in the scaled residuals rscale cancels from (JᵀJ)⁻¹·χ²/ν; unscaled (weights given
+        # as 1/σ) the covariance is (JᵀJ)⁻¹ of the original residuals
+        if scale_covar and nfree > 0:
+            factor = _sumsq(r / rscale) / nfree
+        else:
+            factor = 1.0 / rscale**2
+        cov_s = inv * factor
         covar = cov_s * np.outer(scale, scale)
         d = np.sqrt(np.clip(np.diag(covar), 0.0, None))
         with np.errstate(divide="ignore", invalid="ignore"):

@@ -15,6 +15,8 @@ The history-dependent work runs in the Rust core with the GIL released.
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,7 +24,7 @@ import numpy as np
 
 from . import _core
 from ._arrays import as_1d, positive, restore, scalar_or_array
-from .errors import InputError
+from .errors import ContactLabError, InputError
 
 
 class Masing:
@@ -147,6 +149,22 @@ class Masing:
         return restore(np.ascontiguousarray(k), x, sc)
 
 
+@contextlib.contextmanager
+def _one_thread() -> Iterator[None]:
+    """An operator is stateful: a second thread pushing while the first one is (the kernel
+    runs without the GIL) finds it borrowed. Say so as a ContactLabError, not PyO3's bare
+    ``RuntimeError: Already borrowed``."""
+    try:
+        yield
+    except RuntimeError as exc:
+        if "borrowed" not in str(exc):
+            raise
+        raise ContactLabError(
+            "this MasingOperator is in use by another thread; it carries the loop memory "
+            "of one recording: create one operator per thread with model.operator()"
+        ) from None
+
+
 class MasingOperator:
     """Stateful Masing operator: ``push`` chunks of a recording, the memory carries over.
 
@@ -161,12 +179,14 @@ class MasingOperator:
     def push(self, chunk: Any) -> np.ndarray:
         """Forces for the next chunk of displacement samples."""
         x = as_1d(chunk, "x", allow_empty=True, finite=False)
-        return self._core.push(x)
+        with _one_thread():
+            return self._core.push(x)
 
     def cycles(self, chunk: Any) -> CycleTable:
         """Closed cycles in the next chunk (advances the state like ``push``)."""
         x = as_1d(chunk, "x", allow_empty=True, finite=False)
-        return CycleTable(**self._core.cycles(x))
+        with _one_thread():
+            return CycleTable(**self._core.cycles(x))
 
     def reset(self) -> None:
         """Forget the history: back to the origin on the virgin curve."""

@@ -19,10 +19,12 @@ size, with the same checks and messages (see :mod:`.chunked`).
 
 from __future__ import annotations
 
+import struct
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from ..errors import ContactLabError
 from .chunked import DEFAULT_CHUNK, ChunkedRecording, read_chunks
 from .recording import DIMENSIONS, KIND_CHANNELS, Recording, RecordingError
 from .sniff import EXTENSIONS, format_of
@@ -44,6 +46,22 @@ __all__ = [
     "to_si",
     "write_recording",
 ]
+
+
+_FORMAT_NAMES = {"tdms": "TDMS", "hdf5": "HDF5", "mat": "MATLAB"}
+_LIBRARY_ERRORS = (
+    OSError,
+    RuntimeError,
+    KeyError,
+    IndexError,
+    ValueError,
+    TypeError,
+    OverflowError,
+    MemoryError,
+    EOFError,
+    struct.error,
+    UnicodeError,
+)
 
 
 def supported_extensions() -> list[str]:
@@ -116,7 +134,19 @@ def read_recording(
     """
     p = Path(path)
     fmt = format_of(p, format)
-    return _reader(fmt)(p, columns=columns, kind=kind, fs=fs)
+    if fmt == "csv":
+        return _reader(fmt)(p, columns=columns, kind=kind, fs=fs)
+    try:
+        return _reader(fmt)(p, columns=columns, kind=kind, fs=fs)
+    except ContactLabError:
+        raise
+    except _LIBRARY_ERRORS as exc:
+        # h5py, scipy.io and npTDMS raise all of these (and KeyError for a missing object) on
+        # damaged files, from deep inside; found by fuzzing (fuzz/read_{hdf5,mat,tdms}.py)
+        raise RecordingError(
+            f"not a readable {_FORMAT_NAMES[fmt]} file (damaged? {type(exc).__name__}: {exc})",
+            file=str(p),
+        ) from None
 
 
 def write_recording(path: str | Path, rec: Recording, **options: Any) -> Path:

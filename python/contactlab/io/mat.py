@@ -86,7 +86,8 @@ def v73_layout(
     numeric = [
         n
         for n, obj in f.items()
-        if isinstance(obj, h5py.Dataset)
+        if isinstance(n, str)  # a damaged name table can yield bytes (found by fuzzing)
+        and isinstance(obj, h5py.Dataset)
         and text_value(obj.attrs.get("MATLAB_class", b"double")) in ("double", "single")
     ]
     kind, mapping = resolve_columns(numeric, columns=columns, kind=kind, file=file)

@@ -278,7 +278,10 @@ def real_values(values: Any, *, file: str, column: str) -> np.ndarray:
     if np.iscomplexobj(a):
         raise RecordingError("complex values; a channel must be real", file=file, column=column)
     try:
-        return np.asarray(a, dtype=np.float64)
+        # a float128 or huge integer beyond float64 becomes inf (refused with its row by the
+        # finiteness check), not a numpy overflow warning
+        with np.errstate(over="ignore", invalid="ignore"):
+            return np.asarray(a, dtype=np.float64)
     except (TypeError, ValueError) as exc:
         raise RecordingError(f"values are not numeric ({exc})", file=file, column=column) from None
 
@@ -362,7 +365,19 @@ def time_from_interval(
     """``t0 + dt·[0, n)`` for a file that stores a sampling interval instead of a time column."""
     if not np.isfinite(dt) or dt <= 0:
         raise RecordingError(f"{name} {dt} is not a positive time step", file=file, column=column)
-    return t0 + dt * np.arange(n, dtype=np.float64)
+    if not np.isfinite(t0):
+        raise RecordingError(f"start time {t0} is not a finite number", file=file, column=column)
+    with np.errstate(over="ignore", invalid="ignore"):
+        t = t0 + dt * np.arange(n, dtype=np.float64)
+    # found by fuzzing: a huge step overflows, a tiny one vanishes against a large start time
+    if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+        raise RecordingError(
+            f"{name} {dt} from start time {t0} gives no increasing, finite time axis for "
+            f"{n} samples",
+            file=file,
+            column=column,
+        )
+    return t
 
 
 def finish(

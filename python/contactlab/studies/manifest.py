@@ -29,7 +29,6 @@ frequency, p0 and pa. A file with a
 from __future__ import annotations
 
 import csv
-import io
 import math
 import os
 import re
@@ -210,7 +209,9 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
     delim = ","
     if "," not in head:
         delim = ";" if ";" in head else "\t" if "\t" in head else ","
-    rows = list(csv.reader(io.StringIO("\n".join(ln for _, ln in lines)), delimiter=delim))
+    # one csv row per line (a quote left open must not swallow the following lines, which
+    # misaligned rows and their line numbers: found by fuzzing)
+    rows = [next(csv.reader([ln], delimiter=delim), []) for _, ln in lines]
     header_row, header = lines[0][0], rows[0]
     keys: list[str] = []
     factors: list[float | None] = []
@@ -251,6 +252,8 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
             fpath = mpath.parent / fpath
         if not fpath.exists():
             raise InputError(f"{where}, column 'file': {fpath} does not exist")
+        if not fpath.is_file():
+            raise InputError(f"{where}, column 'file': {fpath} is a folder, not a recording file")
         tags = tags_from_filename(fpath)
         columns = None
         for key, factor, cell in zip(keys, factors, cells, strict=True):

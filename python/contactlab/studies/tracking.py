@@ -37,11 +37,13 @@ from typing import Any
 
 import numpy as np
 
+from .._json import jsonable
 from ..errors import ContactLabError, ContactLabWarning, InputError
 from ..io import DEFAULT_CHUNK, Recording, read_chunks
 from ..io.units import UnknownUnitError, to_si
 from ._cycles import MIN_BLOCK, CycleState, block_cycles
 from .columns import CYCLE_UNITS
+from .study import coefficient_unit
 
 #: tangential quantities tracked per window (each with ``*_stderr``)
 TANGENTIAL_QUANTITIES = (
@@ -308,8 +310,6 @@ def _normal_window(rec: Recording, options: Mapping[str, Any]) -> tuple[dict, di
     n, e_std = int(d.get("n_cycles") or 0), d.get("E_d_cycle_std")
     row["E_d_stderr"] = e_std / math.sqrt(n) if n > 1 and _finite(e_std) else None
     units["E_d_stderr"] = du.get("E_d", "J/m^2")
-    from .study import coefficient_unit
-
     for key in ("poly_load", "poly_unload", "poly_centre"):
         for i, c in enumerate(d.get(key) or []):
             row[f"{key}_{i}"] = float(c)
@@ -619,8 +619,6 @@ def track_many(
 
 def track_json(result: TrackResult, *, cycles: bool = True) -> str:
     """The result as JSON text (NaN → null)."""
-    from ..commands._common import jsonable
-
     return json.dumps(jsonable(result.to_dict(cycles=cycles)), indent=1, allow_nan=False) + "\n"
 
 

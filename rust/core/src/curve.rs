@@ -47,6 +47,8 @@ impl Exponential {
     pub fn new(h0: f64, ac: f64) -> Result<Self, CoreError> {
         check_positive("h0", h0)?;
         check_positive("ac", ac)?;
+        // the initial stiffness h0·ac must be a number too (fuzzing: 4e201 · 4e204 = inf)
+        crate::error::check_output("h0*ac", &[h0 * ac])?;
         Ok(Self { h0, ac })
     }
 
@@ -161,6 +163,8 @@ impl Tabulated {
             // Exact integral of the Hermite cubic over one interval.
             cum[i] = cum[i - 1] + h * (f[i - 1] + f[i]) / 2.0 + h * h * (d[i - 1] - d[i]) / 12.0;
         }
+        crate::error::check_output("backbone slope", &d)?;
+        crate::error::check_output("backbone integral", &cum)?;
         Ok(Self {
             u: u.to_vec(),
             f: f.to_vec(),

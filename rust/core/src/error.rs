@@ -45,6 +45,14 @@ pub enum CoreError {
     /// An exported operator state cannot be restored.
     #[error("operator state is invalid: {reason}")]
     InvalidState { reason: &'static str },
+    /// A result does not fit in double precision although every input did (overflow, or an
+    /// underflow that became 0·∞): the input's magnitudes are too extreme in its units.
+    #[error("{what}[{index}] is out of the double-precision range ({value}) although the inputs are finite: their magnitudes are too extreme in these units; rescale the data (other units)")]
+    OutOfRange {
+        what: &'static str,
+        index: usize,
+        value: f64,
+    },
     /// A stiffness function is not positive where it is evaluated.
     #[error("stiffness is not positive ({value}) at {name} = {at}")]
     NonPositiveStiffness {
@@ -59,6 +67,19 @@ pub fn check_finite(name: &'static str, data: &[f64]) -> Result<(), CoreError> {
     match data.iter().position(|v| !v.is_finite()) {
         Some(index) => Err(CoreError::NonFinite {
             name,
+            index,
+            value: data[index],
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Return `Err(OutOfRange)` naming the first non-finite value of a kernel's result (inputs
+/// already checked finite: a NaN or ±inf here is an overflow, never a success).
+pub fn check_output(what: &'static str, data: &[f64]) -> Result<(), CoreError> {
+    match data.iter().position(|v| !v.is_finite()) {
+        Some(index) => Err(CoreError::OutOfRange {
+            what,
             index,
             value: data[index],
         }),

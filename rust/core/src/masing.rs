@@ -294,6 +294,8 @@ pub fn run<C: Backbone, O: Observer>(
     }
     crate::error::check_finite("x", x)?;
     let base = state.count;
+    let saved = state.clone(); // restored when the forces overflow
+    let mut range = Ok(());
     // `state` has public fields: a count near u64::MAX must not wrap the sample indices.
     let end = u64::try_from(x.len())
         .ok()
@@ -307,6 +309,7 @@ pub fn run<C: Backbone, O: Observer>(
             for ((i, &xi), o) in x.iter().enumerate().zip(out.iter_mut()) {
                 *o = st.step(xi, base + i as u64, observer);
             }
+            range = crate::error::check_output("force", out);
         }
         None => {
             for (i, &xi) in x.iter().enumerate() {
@@ -315,6 +318,10 @@ pub fn run<C: Backbone, O: Observer>(
         }
     }
     let (xp, hp, dir) = (st.xp, st.hp, st.dir);
+    if let Err(e) = range {
+        *state = saved;
+        return Err(e);
+    }
     state.x = xp;
     state.h = hp;
     state.dir = dir as i8;
@@ -390,6 +397,8 @@ pub fn cycle_energies<C: Backbone>(
         }
     };
     run(curve, scale, x, None, state, &mut obs)?;
+    let energies: Vec<f64> = cycles.iter().map(|c| c.energy).collect();
+    crate::error::check_output("cycle energy", &energies)?;
     Ok(cycles)
 }
 
@@ -404,11 +413,19 @@ pub fn loop_area(x: &[f64], f: &[f64]) -> Result<f64, CoreError> {
     crate::error::check_finite("x", x)?;
     crate::error::check_finite("F", f)?;
     let n = x.len();
-    let fm = f.iter().sum::<f64>() / n as f64;
+    // Work in units of the largest |x| and |F| so that sums and products of 1e±300 data
+    // neither overflow nor underflow (found by fuzzing); the scales multiply the result.
+    let sx = x.iter().fold(0.0_f64, |a, &v| a.max(v.abs()));
+    let sf = f.iter().fold(0.0_f64, |a, &v| a.max(v.abs()));
+    if sx == 0.0 || sf == 0.0 {
+        return Ok(0.0);
+    }
+    let fm = f.iter().map(|&v| v / sf).sum::<f64>() / n as f64;
     let (mut sum, mut comp) = (0.0_f64, 0.0_f64);
     for i in 0..n {
         let j = if i + 1 == n { 0 } else { i + 1 };
-        let term = 0.5 * ((f[i] - fm) + (f[j] - fm)) * (x[j] - x[i]);
+        let (fi, fj) = (f[i] / sf - fm, f[j] / sf - fm);
+        let term = 0.5 * (fi + fj) * (x[j] / sx - x[i] / sx);
         // Neumaier summation.
         let t = sum + term;
         if sum.abs() >= term.abs() {
@@ -418,5 +435,52 @@ pub fn loop_area(x: &[f64], f: &[f64]) -> Result<f64, CoreError> {
         }
         sum = t;
     }
-    Ok(sum + comp)
+    let area = (sum + comp) * sx * sf;
+    crate::error::check_output("loop area", &[area])?;
+    Ok(area)
+}
+
+#[cfg(test)]
+mod range_tests {
+    //! Extreme but finite inputs found by fuzzing (fuzz/afl, fuzz/kernels.py): a result
+    //! or a clear `OutOfRange`, never a NaN reported as success.
+    use super::*;
+    use crate::curve::{Exponential, Tabulated};
+
+    #[test]
+    fn loop_area_of_1e274_data_is_scaled_not_nan() {
+        let x = [1e274, -1e274, -1e274, 1e274];
+        let f = [1e30, 1e30, -1e30, -1e30];
+        // 4e304 fits although every product of differences overflowed before
+        let a = loop_area(&x, &f).unwrap_or(f64::NAN);
+        assert!((a.abs() / 4e304 - 1.0).abs() < 1e-12, "{a}");
+        let big = [1e40, 1e40, -1e40, -1e40];
+        assert!(matches!(loop_area(&x, &big), Err(CoreError::OutOfRange { .. })));
+        // same shape at ordinary magnitudes: the area scales exactly
+        let xs: Vec<f64> = x.iter().map(|v| v * 1e-270).collect();
+        let fs: Vec<f64> = f.iter().map(|v| v * 1e-30).collect();
+        let small = loop_area(&xs, &fs).unwrap_or(f64::NAN);
+        let tiny: Vec<f64> = xs.iter().map(|v| v * 1e-300).collect();
+        let t = loop_area(&tiny, &fs).unwrap_or(f64::NAN);
+        assert!((t / small / 1e-300 - 1.0).abs() < 1e-12, "{t} vs {small}");
+    }
+
+    #[test]
+    fn exponential_with_overflowing_stiffness_is_refused() {
+        assert!(matches!(
+            Exponential::new(4e201, 4e204),
+            Err(CoreError::OutOfRange { .. })
+        ));
+    }
+
+    #[test]
+    fn overflowing_force_is_an_error_and_leaves_the_state() {
+        let c = Tabulated::new(&[0.0, 1.0], &[0.0, 1.7e308]).unwrap_or_else(|_| unreachable!());
+        let mut st = MasingState::default();
+        let x = [1.0, -0.99]; // the branch 2·f(-0.995) overflows before it is added
+        let mut out = [0.0; 2];
+        let r = masing_force(&c, 2.0, &x, &mut out, &mut st);
+        assert!(matches!(r, Err(CoreError::OutOfRange { .. })), "{r:?}");
+        assert_eq!(st, MasingState::default());
+    }
 }

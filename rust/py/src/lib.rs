@@ -249,7 +249,9 @@ impl MasingCore {
                 Curve::Exp(c) => c,
                 Curve::Tab(c) => c,
             };
-            Ok(us.iter().map(|&v| f(c, v)).collect::<Vec<f64>>())
+            let v = us.iter().map(|&v| f(c, v)).collect::<Vec<f64>>();
+            contactlab_core::error::check_output("curve value", &v)?;
+            Ok(v)
         })?;
         Ok(out.into_pyarray(py))
     }

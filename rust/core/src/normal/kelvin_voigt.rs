@@ -24,7 +24,10 @@ impl KelvinVoigt {
         check_positive("k", k)?;
         check_positive("psi", psi)?;
         check_positive("omega", omega)?;
-        Ok(Self { k, psi, omega })
+        let kv = Self { k, psi, omega };
+        let g = psi / (2.0 * PI);
+        crate::error::check_output("damping, (psi/2pi)^2", &[kv.damping(), g * g])?;
+        Ok(kv)
     }
 
     /// Damping coefficient `h = ψ k / (2π ω)` (eq. 13).
@@ -72,6 +75,8 @@ impl KelvinVoigt {
             *d = a * x.sin();
             *v = a * w * x.cos();
         }
+        crate::error::check_output("delta", delta)?;
+        crate::error::check_output("velocity", velocity)?;
         Ok(())
     }
 

@@ -39,7 +39,7 @@ pub fn deriv(c: &[f64]) -> Vec<f64> {
 /// Coefficients of the antiderivative that vanishes at 0.
 pub fn integral(c: &[f64]) -> Vec<f64> {
     std::iter::once(0.0)
-        .chain(c.iter().enumerate().map(|(i, &a)| a / (i + 1) as f64))
+        .chain(c.iter().enumerate().map(|(i, &a)| a / (i as f64 + 1.0)))
         .collect()
 }
 
@@ -119,13 +119,15 @@ pub fn fit(
             reason: "least-squares solve failed",
         })?;
     let mut scale = ys;
-    Ok((0..m)
+    let c: Vec<f64> = (0..m)
         .map(|j| {
             let c = sol[j] * scale;
             scale /= xs;
             c
         })
-        .collect())
+        .collect();
+    crate::error::check_output("polynomial coefficient", &c)?;
+    Ok(c)
 }
 
 /// Real roots of `c` in `[lo, hi]`, found by bracketing on a fine grid and bisection.
