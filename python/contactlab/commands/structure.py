@@ -21,7 +21,7 @@ _UNIT = re.compile(r"(?:\[([^\]]+)\]|_([A-Za-z]+))\s*$")
 
 def read_table(path: str) -> dict[str, np.ndarray]:
     """Columns of a CSV (header line, optional ``#``), converted to SI from unit suffixes."""
-    from ..manifest import unit_factor
+    from ..studies.manifest import unit_factor
 
     p = Path(path)
     try:

@@ -31,7 +31,6 @@ import numpy as np
 from .. import _core
 from .._arrays import as_1d, positive
 from .._physical import check_channel
-from .._range import check_channel as check_range
 from ..errors import ContactLabWarning, InputError
 from . import _paper
 
@@ -609,8 +608,6 @@ def analyze_loop(
     [-0.015, 1.32, 1.705, 3.562, 4.176]
     """
     tv, pv, dv = _check_inputs(t, p, delta, degree)
-    check_range(pv, "p", "Pa")
-    check_range(dv, "delta", "m")
     degree = int(degree)
     tv, pv, dv, dt, resampled = _uniform(tv, pv, dv)
     cyc = _cycles(tv, pv, dt, omega, n_bins, discard_cycles)

@@ -50,7 +50,6 @@ import numpy as np
 
 from .._arrays import as_1d
 from .._physical import check_channel
-from .._range import check_channel as check_range
 from ..errors import ContactLabWarning, InputError
 from ..fitting import FitResult
 from ..io import Recording
@@ -82,8 +81,6 @@ def _inputs(
                     f"{recording.source}: no {ch!r} channel; a tangential recording needs x "
                     f"and F (channels: {sorted(recording.data)})"
                 )
-        for ch, unit in (("x", "m"), ("F", "N")):
-            check_range(recording[ch], ch, unit, recording.source)
         return recording["x"], recording["F"], recording.t, recording.source
     if x is None or F is None:
         raise InputError("give a recording, or the arrays x (m) and F (N)")
@@ -99,8 +96,6 @@ def _inputs(
         if np.any(np.diff(ta) <= 0):
             i = int(np.argmax(np.diff(ta) <= 0)) + 1
             raise InputError(f"t[{i}] = {ta[i]} does not increase")
-    check_range(xa, "x", "m")
-    check_range(Fa, "F", "N")
     return xa, Fa, ta, "<arrays>"
 
 
