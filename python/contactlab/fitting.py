@@ -491,31 +491,41 @@ def _polish(
     hi: np.ndarray,
     names: list[str],
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool, int, str]:
-    """Gauss-Newton steps from the solver's end point until they stop paying, then the trust
-    check: the step still possible must be a negligible fraction of each parameter's standard
-    error, or the fit is reported ``success=False`` naming the parameter.
+    """Gauss-Newton steps (halved until they lower χ²) from the solver's end point until
+    they stop paying. Should they still be paying after 30 steps, the trust check: the step
+    still possible must be a negligible fraction of each parameter's standard error, or the
+    fit is reported ``success=False`` naming the parameter.
 
     The trust-region solver stops on *relative* changes, which can leave a slow, ill-
     conditioned fit (NIST's ENSO, Lanczos, MGH17) several digits short of its minimum while
     reporting success. Parameters at a bound are held there.
     """
     cost = float(r @ r)
+    stalled = False  # no Gauss-Newton step (nor a fraction of one) lowers χ²: a minimum
     for _ in range(30):
         step = _gn_step(J, r, z, lo, hi)
         if step is None or not np.any(step):
+            stalled = True
             break
-        z_new = np.clip(z + step, lo, hi)
-        r_new = fun(z_new)
-        if not np.all(np.isfinite(r_new)):
+        for _halving in range(8):
+            z_new = np.clip(z + step, lo, hi)
+            r_new = fun(z_new)
+            if np.all(np.isfinite(r_new)) and float(r_new @ r_new) <= cost:
+                break
+            step = step / 2
+        else:
+            stalled = True
             break
         cost_new = float(r_new @ r_new)
-        if cost_new > cost:
-            break
         moved = np.max(np.abs(z_new - z) / np.maximum(np.abs(z), 1e-300))
+        gain = cost - cost_new
         z, r, cost = z_new, r_new, cost_new
         J = jacobian(z)
-        if moved < 1e-14:
+        if moved < 1e-14 or gain <= 1e-15 * cost:
+            stalled = True
             break
+    if stalled:
+        return z, r, J, True, 1, "converged (no Gauss-Newton step lowers the residuals further)"
     # trust: one more step from here, measured in standard errors
     step = _gn_step(J, r, z, lo, hi)
     nfree = r.size - len(names)
