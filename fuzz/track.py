@@ -16,8 +16,9 @@ from pathlib import Path
 from _harness import Bytes, InvariantViolation, instrumented, main
 
 with instrumented(("contactlab",)):
-    import contactlab.cli  # noqa: F401
     from _signals import build, run_cli
+
+    import contactlab.cli  # noqa: F401
 
 TARGET = "track"
 _DIR = Path(tempfile.mkdtemp(prefix="contactlab-fuzz-track-"))

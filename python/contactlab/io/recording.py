@@ -410,8 +410,7 @@ def finish(
         if not np.all(np.isfinite(v)):  # found by fuzzing: 1e306 kN overflows in N
             i = int(np.argmax(~np.isfinite(v)))
             raise RecordingError(
-                f"value {float(values[i])} overflows double precision when converted to SI "
-                f"({si})",
+                f"value {float(values[i])} overflows double precision when converted to SI ({si})",
                 file=file,
                 column=col,
                 row=row_of(i),
