@@ -23,6 +23,19 @@ MIN_SPAN = 1e-100
 _WHAT = {"x": "displacement", "F": "force", "p": "pressure", "delta": "normal displacement"}
 
 
+def check_magnitude(a: np.ndarray, name: str, unit: str, source: str = "") -> None:
+    """Raise :class:`InputError` when a channel's values exceed ``MAX_ABS`` (part of
+    :func:`check_channel`, for pieces of a recording that may well be constant)."""
+    if a.size and float(np.max(np.abs(a))) > MAX_ABS:
+        where = f"{source}: " if source else ""
+        what = f"{_WHAT.get(name, 'channel')} channel {name!r}"
+        raise InputError(
+            f"{where}the {what} reaches {float(np.max(np.abs(a))):.3g} {unit}, beyond the "
+            f"range the analysis can handle (|value| ≤ {MAX_ABS:g} {unit}); is the unit in "
+            "the file right?"
+        )
+
+
 def check_channel(a: np.ndarray, name: str, unit: str, source: str = "") -> None:
     """Raise :class:`InputError` naming the channel when it is constant, too small or too
     large for the analyses (``a`` finite, 1-D)."""
@@ -30,12 +43,7 @@ def check_channel(a: np.ndarray, name: str, unit: str, source: str = "") -> None
     what = f"{_WHAT.get(name, 'channel')} channel {name!r}"
     if a.size == 0:
         raise InputError(f"{where}the {what} is empty")
-    top = float(np.max(np.abs(a)))
-    if top > MAX_ABS:
-        raise InputError(
-            f"{where}the {what} reaches {top:.3g} {unit}, beyond the range the analysis can "
-            f"handle (|value| ≤ {MAX_ABS:g} {unit}); is the unit in the file right?"
-        )
+    check_magnitude(a, name, unit, source)
     span = float(np.max(a) - np.min(a))
     if span == 0.0:
         raise InputError(

@@ -37,6 +37,7 @@ from typing import Any
 
 import numpy as np
 
+from .._range import check_magnitude
 from ..errors import ContactLabError, ContactLabWarning, InputError
 from ..io import DEFAULT_CHUNK, Recording, read_chunks
 from ..io.units import UnknownUnitError, to_si
@@ -370,6 +371,8 @@ def _blocks(chunks: Iterator[Recording], min_block: int) -> Iterator[Recording]:
     buf: list[Recording] = []
     size = 0
     for c in chunks:
+        for name, v in c.data.items():  # found by fuzzing: 1e300 data overflowed windows
+            check_magnitude(v, name, c.units.get(name, ""), c.source)
         buf.append(c)
         size += len(c)
         if size >= min_block:
