@@ -455,7 +455,10 @@ mod range_tests {
         let a = loop_area(&x, &f).unwrap_or(f64::NAN);
         assert!((a.abs() / 4e304 - 1.0).abs() < 1e-12, "{a}");
         let big = [1e40, 1e40, -1e40, -1e40];
-        assert!(matches!(loop_area(&x, &big), Err(CoreError::OutOfRange { .. })));
+        assert!(matches!(
+            loop_area(&x, &big),
+            Err(CoreError::OutOfRange { .. })
+        ));
         // same shape at ordinary magnitudes: the area scales exactly
         let xs: Vec<f64> = x.iter().map(|v| v * 1e-270).collect();
         let fs: Vec<f64> = f.iter().map(|v| v * 1e-30).collect();
