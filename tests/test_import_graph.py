@@ -27,6 +27,7 @@ PREFIXES = {
     "contactlab.errors": "base",
     "contactlab._version": "base",
     "contactlab._arrays": "base",
+    "contactlab._range": "base",
     "contactlab._io_atomic": "base",
     "contactlab._json": "base",
     "contactlab.data": "base",  # bundled files only (the generator is contactlab._datagen)

@@ -428,7 +428,7 @@ def least_squares_fit(
     success, status, message = bool(sol.success), int(sol.status), str(sol.message)
     J = jacobian(z)
     if success and loss == "linear":
-        z, rs, J, success, status, message = _polish(fun, jacobian, z, rs, J, lo, hi, names)
+        z, rs, J, success, status, message = _polish(fun, jacobian, z, rs, J, lo, hi, names, rcond)
     with np.errstate(over="ignore"):
         r = rs * rscale
     with np.errstate(over="ignore"):
@@ -490,6 +490,7 @@ def _polish(
     lo: np.ndarray,
     hi: np.ndarray,
     names: list[str],
+    rcond: float,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool, int, str]:
     """Gauss-Newton steps (halved until they lower χ²) from the solver's end point until
     they stop paying. Should they still be paying after 30 steps, the trust check: the step
@@ -503,13 +504,16 @@ def _polish(
     cost = float(r @ r)
     stalled = False  # no Gauss-Newton step (nor a fraction of one) lowers χ²: a minimum
     for _ in range(30):
-        step = _gn_step(J, r, z, lo, hi)
+        step = _gn_step(J, r, z, lo, hi, rcond)
         if step is None or not np.any(step):
             stalled = True
             break
         for _halving in range(8):
             z_new = np.clip(z + step, lo, hi)
-            r_new = fun(z_new)
+            try:
+                r_new = fun(z_new)
+            except InputError:  # the model refuses the trial point (a bound reached): shorter
+                r_new = np.full_like(r, np.nan)
             if np.all(np.isfinite(r_new)) and float(r_new @ r_new) <= cost:
                 break
             step = step / 2
@@ -519,15 +523,19 @@ def _polish(
         cost_new = float(r_new @ r_new)
         moved = np.max(np.abs(z_new - z) / np.maximum(np.abs(z), 1e-300))
         gain = cost - cost_new
-        z, r, cost = z_new, r_new, cost_new
-        J = jacobian(z)
+        try:
+            J_new = jacobian(z_new)
+        except InputError:  # no Jacobian there (a step onto a bound the model refuses)
+            stalled = True
+            break
+        z, r, cost, J = z_new, r_new, cost_new, J_new
         if moved < 1e-14 or gain <= 1e-15 * cost:
             stalled = True
             break
     if stalled:
         return z, r, J, True, 1, "converged (no Gauss-Newton step lowers the residuals further)"
     # trust: one more step from here, measured in standard errors
-    step = _gn_step(J, r, z, lo, hi)
+    step = _gn_step(J, r, z, lo, hi, rcond)
     nfree = r.size - len(names)
     if step is not None and nfree > 0 and np.all(np.isfinite(J)):
         try:
@@ -551,7 +559,7 @@ def _polish(
 
 
 def _gn_step(
-    J: np.ndarray, r: np.ndarray, z: np.ndarray, lo: np.ndarray, hi: np.ndarray
+    J: np.ndarray, r: np.ndarray, z: np.ndarray, lo: np.ndarray, hi: np.ndarray, rcond: float
 ) -> np.ndarray | None:
     """The Gauss-Newton step ``-J⁺ r``, parameters at a bound held fixed (None if J is not
     finite)."""
@@ -562,7 +570,9 @@ def _gn_step(
     step = np.zeros_like(z)
     if not free.any():
         return step
-    sol, *_ = np.linalg.lstsq(J[:, free], -r, rcond=1e-13)
+    # directions the data do not constrain (singular value below rcond, the fit's own
+    # identifiability cut-off) are left alone: a step along them is arbitrary
+    sol, *_ = np.linalg.lstsq(J[:, free], -r, rcond=rcond)
     step[free] = sol
     return step
 
