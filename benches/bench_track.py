@@ -98,8 +98,14 @@ def stage(name: str, path: str, workers: int) -> dict:
         import contactlab
 
         if workers > 1:
+            import resource
+
             with ProcessPoolExecutor(workers) as ex:
                 r = contactlab.track(path, every="auto", executor=ex)
+            # the workers have been waited for: the largest of their peaks
+            out["worker_peak_rss_mb"] = (
+                resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
+            )
         else:
             r = contactlab.track(path, every="auto")
         comb = r.combined()

@@ -111,7 +111,7 @@ def test_normal_steps_cycles_levels_branches():
     pdyn = np.sin(np.linspace(0, 2 * np.pi, 64, endpoint=False))
     p0, pa = nloop._pressure_levels(pdyn, 2.0, None)
     assert p0 == 2.0 and pa == pytest.approx(1.0, abs=1e-3)
-    with pytest.raises(InputError, match="pass p0"):
+    with pytest.raises(InputError, match="give the static pressure p0"):
         nloop._pressure_levels(pdyn, 0.0, None)
     with pytest.raises(InputError, match="whole number"):
         nloop._discard_count(1.5, 4)

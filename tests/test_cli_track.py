@@ -145,7 +145,7 @@ def test_track_real_sigint_exits_130_without_output(tmp_path):
     # exit when the interrupt landed inside an import the CLI does lazily, even though the
     # CLI caught it and returned 130
     assert proc.returncode in (130, -signal.SIGINT), err
-    assert "interrupted" in err
+    assert "interrupted" in err and "Traceback" not in err
     assert not out.exists()
 
 
@@ -166,7 +166,7 @@ def test_track_normal_recording_cli(tmp_path, capsys):
     import contactlab.normal as cn
     from contactlab.io import Recording
 
-    t, p, d = cn.synthetic_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=16, seed=5022)
+    t, p, d = cn.synthetic_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=13, seed=5022)
     f = tmp_path / "C45_p0-0.5MPa_pa-0.4MPa.csv"
     write_recording(f, Recording(t, {"p": p, "delta": d}, {"p": "Pa", "delta": "m"}))
     rep, out = tmp_path / "rep", tmp_path / "o.json"
@@ -191,4 +191,4 @@ def test_track_normal_recording_cli(tmp_path, capsys):
     doc = json.loads(out.read_text())
     assert doc["kind"] == "normal" and doc["cycle_units"]["energy"] == "J/m^2"
     assert {"E_d", "E_d_stderr", "psi", "k_tan", "k_sec", "poly_load_0"} <= set(doc["windows"][0])
-    assert (rep / "figures" / "psi.png").exists() and (rep / "figures" / "poly-load-0.png").exists()
+    assert (rep / "figures" / "psi.png").exists() and (rep / "figures" / "poly-load.png").exists()

@@ -318,9 +318,11 @@ def test_check_without_ccx_names_the_package(tmp_path, capsys, monkeypatch, norm
     assert "calculix-ccx" in capsys.readouterr().err and not out.exists()
 
 
-def test_real_macro_slip_frame_is_refused() -> None:
-    """Measured macro-slip loops (friction frame) do not resolve pre-sliding: the stick slope
-    is not identified, and the export must refuse it with the analysis' reason."""
+def test_real_macro_slip_frame() -> None:
+    """Measured macro-slip loops (friction frame, two normal loads) give μ from the plateau
+    but do not resolve pre-sliding: the stick slope is refused with the analysis' reason
+    (CalculiX's *FRICTION needs it, so that format is refused; Abaqus/ANSYS/CSV get μ alone).
+    Coulomb: μ must not depend on the load."""
     from pathlib import Path
 
     from contactlab import Recording
@@ -328,14 +330,74 @@ def test_real_macro_slip_frame_is_refused() -> None:
     data = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "friction_frame"
     if not data.is_dir():
         pytest.skip("friction_frame data: ../shared/data absent")
-    d = np.genfromtxt(data / "frame_disc450g.csv", delimiter=",", names=True)
-    t, x, y = d["t_s"], d["x_top_plate_disp_mm"] * 1e-3, d["y_base_disp_mm"] * 1e-3
-    dt = float(t[1] - t[0])
-    xd, yd = np.gradient(x, dt), np.gradient(y, dt)
-    # the authors' model: F_f = K (y − x) + C (y' − x') − M x''  (README of the data)
-    f = 1191.0 * (y - x) + 0.6690 * (yd - xd) - 3.0799 * np.gradient(xd, dt)
-    rec = Recording(t, {"x": x, "F": f}, {"x": "m", "F": "N"}, source="frame_disc450g.csv")
-    with pytest.warns(Warning):
-        res = {**analyze_tangential(rec).to_dict(), "model": "tangential", "file": rec.source}
-    with pytest.raises(NotIdentifiableError, match="stick slope h0·ac is not identified"):
-        joint_characteristics(res, area=1e-4, normal_load=0.45 * 9.81)
+    mus = []
+    for grams in (250, 450):
+        d = np.genfromtxt(data / f"frame_disc{grams}g.csv", delimiter=",", names=True)
+        t, x, y = d["t_s"], d["x_top_plate_disp_mm"] * 1e-3, d["y_base_disp_mm"] * 1e-3
+        dt = float(t[1] - t[0])
+        xd, yd = np.gradient(x, dt), np.gradient(y, dt)
+        # the authors' model: F_f = K (y − x) + C (y' − x') − M x''  (README of the data)
+        f = 1191.0 * (y - x) + 0.6690 * (yd - xd) - 3.0799 * np.gradient(xd, dt)
+        rec = Recording(t, {"x": x, "F": f}, {"x": "m", "F": "N"}, source=f"frame_{grams}g")
+        with pytest.warns(Warning):
+            res = {**analyze_tangential(rec).to_dict(), "model": "tangential"}
+        w = grams * 1e-3 * 9.81
+        jc = joint_characteristics(res, area=1e-4, normal_load=w)
+        assert jc.get("stick_slope") is None and jc.get("elastic_slip") is None
+        assert any("no stick slope: h0·ac is not identified" in n for n in jc.notes)
+        mu = jc.get("mu")
+        assert mu.stderr < 0.05 * mu.value
+        # the plateau lies below the force's 95th percentile (stick-slip peaks, noise)
+        assert mu.value * w < float(np.percentile(np.abs(f), 95))
+        mus.append(mu.value)
+        with pytest.raises(NotIdentifiableError, match="needs a stick slope"):
+            render(jc, "calculix", unit_system("SI"))
+        aba = render(jc, "abaqus", unit_system("SI")).splitlines()
+        assert aba[-2] == "*FRICTION" and float(aba[-1]) == pytest.approx(mu.value)
+        assert "RMODIF" not in render(jc, "ansys", unit_system("SI"))
+        with pytest.raises(NotIdentifiableError, match="ac is not identified"):
+            joint_characteristics(res, area=1e-4, normal_load=w, amplitude=1e-3, frequency=1.0)
+    assert mus[0] == pytest.approx(mus[1], rel=0.1)
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    h0=st.floats(1.0, 500.0),
+    ac=st.floats(1e3, 1e6),
+    area=st.floats(1e-6, 1e-1),
+    load=st.floats(1.0, 1e4),
+    system=st.sampled_from(["mm-N-s", "mm-t-s"]),
+)
+def test_units_scale_consistently(h0: float, ac: float, area: float, load: float,
+                                  system: str) -> None:  # fmt: skip
+    d = {"model": "tangential", "h0": h0, "h0_stderr": 0.01 * h0, "ac": ac,
+         "ac_stderr": 0.01 * ac, "h0_ac": h0 * ac, "h0_ac_stderr": 0.01 * h0 * ac,
+         "identifiable": {"h0": True, "ac": True, "h0_ac": True, "message": "ok"}}  # fmt: skip
+    jc = joint_characteristics(d, area=area, normal_load=load, amplitude=2 / ac, frequency=50.0)
+    u = unit_system(system)
+    exps = {"length": 1, "stiffness_per_area": -3, "stiffness": -1, "damping": -1,
+            "force": 0, "1": 0, "energy": 1}  # fmt: skip
+    for v in jc.values:
+        val = v.converted(u)[0]
+        assert val == pytest.approx(v.value * 1e3 ** exps[v.dim], rel=1e-12)
+    # the friction card in mm: λ·A_c·(1/ac) = μ·W (slip starts at the elastic slip 1/ac)
+    lam = jc.get("stick_slope").converted(u)[0]
+    assert lam * area * 1e6 / (ac * 1e-3) == pytest.approx(jc.get("mu").value * load, rel=1e-9)
+
+
+def test_cli_mu_only(tmp_path, capsys) -> None:
+    """Gross sliding: h0 from the plateau, no stick slope. CalculiX is refused (exit 3, no
+    file); Abaqus gets μ alone."""
+    d = {"model": "tangential", "file": "gs.csv", "regime": "gross sliding", "h0": 20.0,
+         "h0_stderr": 0.2, "ac": None, "h0_ac": None, "ac_lower_bound": 5e5, "normal_load": 50.0,
+         "identifiable": {"h0": True, "ac": False, "h0_ac": False,
+                          "message": "plateau"}}  # fmt: skip
+    res = tmp_path / "gs.json"
+    res.write_text(json.dumps(d))
+    out = tmp_path / "f.inp"
+    args = ["export", str(res), "-o", str(out), "--area", "1cm2", "--format"]
+    assert main([*args, "calculix"]) == 3 and not out.exists()
+    err = capsys.readouterr().err
+    assert "needs a stick slope" in err and "elastic slip ≤ 2e-06 m" in err
+    assert main([*args, "abaqus"]) == 0
+    assert out.read_text().rstrip().endswith("*FRICTION\n0.4")

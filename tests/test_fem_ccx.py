@@ -69,4 +69,8 @@ def test_beam_frequency_on_joint_spring(tangential: dict) -> None:
                          frequency=50.0)  # fmt: skip
     print(chk.report())
     assert chk.error <= 0.005
+    assert chk.reference.startswith("contactlab.structure")
+    # the two references agree with each other (Hermite elements vs the closed form)
+    assert chk.frequency_reference == pytest.approx(chk.frequency_closed_form, rel=1e-4)
+    assert 0 < chk.damping_ratio < 1
     assert math.isfinite(chk.frequency_fe) and chk.frequency_fe > 0

@@ -105,16 +105,18 @@ def _butter(v, fs, fc):
 
 
 @pytest.mark.parametrize(
-    ("seed", "fs", "Fs", "filt"),
-    [(301, 250.0, 0.8, None), (302, 500.0, 1.0, (60.0, 60.0))],
-)
-def test_simulated_stick_slip_frame(seed, fs, Fs, filt):
-    """From rest, noise on both channels, optionally anti-alias filtered (both at 60 Hz):
+    ("seed", "fs", "Fs", "filt", "sigma"),
+    [(301, 250.0, 0.8, None, 5e-7), (302, 500.0, 1.0, (60.0, 60.0), 5e-7),
+     (303, 1000.0, 1.0, None, 0.0)],
+)  # fmt: skip
+def test_simulated_stick_slip_frame(seed, fs, Fs, filt, sigma):
+    """From rest, noise on both channels (or none), optionally anti-alias filtered (both at
+    60 Hz):
     the plateau gives the kinetic friction, the sticks the static one."""
     t, x, y, F = simulate_frame(Fk=0.8, Fs=Fs, fs=fs)
     rng = np.random.default_rng(seed)
-    xm = x + rng.normal(0, 5e-7, x.size)
-    ym = y + rng.normal(0, 5e-7, y.size)
+    xm = x + rng.normal(0, sigma, x.size)
+    ym = y + rng.normal(0, sigma, y.size)
     if filt is not None:
         xm, ym = _butter(xm, fs, filt[0]), _butter(ym, fs, filt[1])
     r = frame_friction_force(t, xm, ym, M=3.08, C=0.669, K=1191.0)

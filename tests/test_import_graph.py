@@ -27,11 +27,12 @@ PREFIXES = {
     "contactlab.errors": "base",
     "contactlab._version": "base",
     "contactlab._arrays": "base",
-    "contactlab._range": "base",
+    "contactlab._physical": "base",
     "contactlab._io_atomic": "base",
     "contactlab._json": "base",
     "contactlab.data": "base",  # bundled files only (the generator is contactlab._datagen)
     "contactlab.masing": "masing/fitting/io",
+    "contactlab.reversals": "masing/fitting/io",
     "contactlab.fitting": "masing/fitting/io",
     "contactlab.io": "masing/fitting/io",
     "contactlab.report": "masing/fitting/io",  # the generic HTML report writer
@@ -50,19 +51,6 @@ PREFIXES = {
     "contactlab.cli": "commands",
     "contactlab.__main__": "commands",
     "contactlab": "commands",  # the package root re-exports everything (lazily)
-}
-
-
-# Being removed on branch `diag` (issue 13: the diagnose-internal cycles and the private names
-# behind them). Only these may remain; delete the two sets once that work is merged.
-PENDING_CYCLES = [
-    ["contactlab.diagnose.generator", "contactlab.diagnose.generator_normal"],
-    ["contactlab.diagnose.model", "contactlab.diagnose.workflow"],
-]
-PENDING_PRIVATE = {
-    "contactlab.diagnose.model imports _arrays from contactlab.diagnose.workflow",
-    "contactlab.diagnose.generator_normal imports _rms from contactlab.diagnose.generator",
-    "contactlab.diagnose.generator_normal imports _sizes from contactlab.diagnose.generator",
 }
 
 
@@ -195,8 +183,7 @@ def test_every_module_has_a_layer():
 
 def test_import_graph_has_no_cycles():
     graph, _ = import_graph()
-    found = [c for c in cycles(graph) if c not in PENDING_CYCLES]
-    assert found == [], format_graph(graph)
+    assert cycles(graph) == [], format_graph(graph)
 
 
 def test_imports_run_one_way():
@@ -212,8 +199,7 @@ def test_imports_run_one_way():
 
 def test_no_private_names_imported_across_modules():
     _, private = import_graph()
-    found = sorted(set(private) - PENDING_PRIVATE)
-    assert not found, "\n".join(found)
+    assert not private, "\n".join(private)
 
 
 def test_the_checker_sees_cycles_and_upward_imports():

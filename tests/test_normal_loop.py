@@ -157,7 +157,7 @@ def test_noisy_nonlinear_recording():
 
 def test_dynamic_pressure_needs_p0(table2_loop):
     t, p, d = table2_loop
-    with pytest.raises(contactlab.InputError, match="pass p0"):
+    with pytest.raises(contactlab.InputError, match="give the static pressure p0"):
         analyze_loop(t, p - 0.5e6, d)
     r = analyze_loop(t, p - 0.5e6, d, p0=0.5e6)
     assert r.p0 == 0.5e6

@@ -17,7 +17,8 @@ BLOCKS = re.findall(r"```python\n(.*?)```", TEXT, re.S)
 COMMANDS = [
     line.split(" #")[0].strip()
     for block in re.findall(r"```bash\n(.*?)```", TEXT, re.S)
-    for line in block.splitlines()
+    # a line ending in a backslash continues on the next (comments stripped first)
+    for line in re.sub(r"\\[ \t]*\n", " ", re.sub(r"[ \t]+#[^\n]*", "", block)).splitlines()
     if line.strip().startswith("contactlab ")
 ]
 
@@ -51,6 +52,12 @@ def _study(ns):
     assert (Path("study-out") / "report.html").is_file()
 
 
+def _frame(ns):
+    d = ns["d"]  # a Coulomb-like loop through the frame reconstruction: sign and plateau kept
+    assert d["regime"] in ("gross sliding", "stick-slip") and d["force_sign"] == 1
+    assert abs(d["h0"] - 0.8) < 0.03 * 0.8
+
+
 # What each block claims, keyed by a line that identifies the block.
 CLAIMS = {
     "m = contactlab.Masing(h0=40.0, ac=4e4)": _masing,
@@ -58,6 +65,7 @@ CLAIMS = {
     "run = nl.simulate(t, p - loop.p0)": _normal,
     'hidden_effect_recording(["channel_delay"]': _diagnose,
     "res = run_study(files)": _study,
+    "fr = frame_friction_force(": _frame,
 }
 
 

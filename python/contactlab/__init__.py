@@ -16,7 +16,7 @@ if TYPE_CHECKING:
     from . import diagnose, normal
     from .fitting import FitResult, Parameter, least_squares_fit
     from .io import Recording, RecordingError, read_recording, write_recording
-    from .masing import CycleTable, Masing, MasingOperator, cycle_energies, loop_area
+    from .masing import CycleTable, Masing, MasingOperator, cycle_energies, force_many, loop_area
     from .studies.tracking import TrackResult, track
     from .tangential import TangentialAnalysis, analyze_tangential
 
@@ -38,6 +38,7 @@ _LAZY = {
     "MasingOperator": "masing",
     "cycle_energies": "masing",
     "loop_area": "masing",
+    "force_many": "masing",
     "TangentialAnalysis": "tangential",
     "analyze_tangential": "tangential",
     "TrackResult": "studies.tracking",
@@ -77,6 +78,7 @@ __all__ = [
     "analyze_tangential",
     "cycle_energies",
     "diagnose",
+    "force_many",
     "least_squares_fit",
     "loop_area",
     "normal",

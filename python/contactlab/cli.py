@@ -25,6 +25,7 @@ _VERB_MODULES = [
     "contactlab.commands.demo",
     "contactlab.commands.diagnose",
     "contactlab.commands.export",
+    "contactlab.commands.structure",
 ]
 
 

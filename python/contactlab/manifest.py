@@ -10,6 +10,8 @@ _NEW = "contactlab.studies.manifest"
 
 
 def __getattr__(name: str) -> Any:
+    if name.startswith("__"):  # import machinery probing (__path__ …), not a user
+        raise AttributeError(name)
     warnings.warn(
         f"contactlab.manifest is deprecated; import {name} from {_NEW}",
         DeprecationWarning,

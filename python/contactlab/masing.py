@@ -97,13 +97,17 @@ class Masing:
         return self._backbone is None
 
     # -- history-dependent response --------------------------------------------------------
-    def force(self, x: Any, state: Any = None) -> np.ndarray:
-        """Force for the displacement history ``x`` (starting at the origin unless ``state``)."""
+    def force(self, x: Any, state: Any = None, out: np.ndarray | None = None) -> np.ndarray:
+        """Force for the displacement history ``x`` (starting at the origin unless ``state``).
+
+        ``out``: a float64 array of the same length to write into (reused between calls, as a
+        fit's model evaluations do); returned.
+        """
         xa = as_1d(x, "x", finite=False)  # the core names a non-finite sample's index
         op = self.operator()
         if state is not None:
             op.state = state
-        return op.push(xa)
+        return op.push(xa, out=out)
 
     def operator(self) -> MasingOperator:
         """A stateful operator for streaming a recording chunk by chunk."""
@@ -176,11 +180,11 @@ class MasingOperator:
         self.model = model
         self._core = model._core.fresh()
 
-    def push(self, chunk: Any) -> np.ndarray:
-        """Forces for the next chunk of displacement samples."""
+    def push(self, chunk: Any, out: np.ndarray | None = None) -> np.ndarray:
+        """Forces for the next chunk of displacement samples (into ``out`` when given)."""
         x = as_1d(chunk, "x", allow_empty=True, finite=False)
         with _one_thread():
-            return self._core.push(x)
+            return self._core.push(x, _out_buffer(out, x.size))
 
     def cycles(self, chunk: Any) -> CycleTable:
         """Closed cycles in the next chunk (advances the state like ``push``)."""
@@ -220,6 +224,56 @@ class MasingOperator:
 
     def global_stiffness(self, x: Any) -> Any:
         return self.model.global_stiffness(x)
+
+
+def _out_buffer(out: Any, n: int) -> np.ndarray | None:
+    """Validate a caller's output buffer: float64, 1-D, C-contiguous, writeable, length n."""
+    if out is None:
+        return None
+    if not (
+        isinstance(out, np.ndarray)
+        and out.dtype == np.float64
+        and out.ndim == 1
+        and out.flags.c_contiguous
+        and out.flags.writeable
+    ):
+        raise InputError("out must be a writeable, contiguous 1-D float64 numpy array")
+    if out.size != n:
+        raise InputError(f"out has {out.size} samples but x has {n}")
+    return out
+
+
+def force_many(models: Any, signals: Any, threads: int | None = None) -> list[np.ndarray]:
+    """Forces of several channels or recordings at once, on all cores.
+
+    Each signal starts at the origin with its own model (one :class:`Masing` for all, or a
+    sequence with one per signal). The work runs on ``threads`` Rust threads inside one call
+    with the GIL released (default: the number of CPUs), handing out one channel at a time.
+
+    Examples
+    --------
+    >>> import numpy as np, contactlab
+    >>> x = [1e-5 * np.sin(np.linspace(0, 9, 500)) * k for k in (1, 2, 3)]
+    >>> F = contactlab.force_many(contactlab.Masing(10.0, 2e5), x, threads=2)
+    >>> bool(np.array_equal(F[1], contactlab.Masing(10.0, 2e5).force(x[1])))
+    True
+    """
+    import os
+
+    sigs = [
+        as_1d(x, f"signals[{i}]", allow_empty=True, finite=False) for i, x in enumerate(signals)
+    ]
+    ms = [models] * len(sigs) if isinstance(models, Masing) else list(models)
+    if len(ms) != len(sigs):
+        raise InputError(f"{len(ms)} models but {len(sigs)} signals")
+    for i, m in enumerate(ms):
+        if not isinstance(m, Masing):
+            raise InputError(f"models[{i}] must be a contactlab.Masing, got {type(m).__name__}")
+    if threads is None:
+        threads = os.cpu_count() or 1
+    if not (isinstance(threads, int | np.integer) and threads >= 1):
+        raise InputError(f"threads must be an integer >= 1, got {threads!r}")
+    return _core.force_many([m._core for m in ms], sigs, int(threads))
 
 
 @dataclass(frozen=True)

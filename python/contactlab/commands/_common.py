@@ -6,6 +6,7 @@ import argparse
 import json
 import re
 import shlex
+import sys
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -175,10 +176,44 @@ def write_report(
     intro = f"Made by: {command}" if command else None
     rep = build_report(result, title, study_plots=study_plots, progress=progress, intro=intro)
     files = rep.files()
-    files.update(result.table_files())
+    tables, skipped = table_files(result)
+    files.update(tables)
+    for name, why in skipped.items():
+        print(f"note: skipped {name}: {why}", file=sys.stderr)
     if extra:
         files.update(extra)
     return commit_outputs(directory, files)
+
+
+def parquet_available() -> str | None:
+    """None when Parquet can be written, else why not and what to install."""
+    try:
+        import pyarrow
+        import pyarrow.parquet  # noqa: F401
+    except ImportError:
+        return "writing Parquet needs pyarrow, which is not installed: pip install 'contactlab[io]'"
+    return None
+
+
+def table_files(
+    result: StudyResult, stem: str = "study"
+) -> tuple[dict[str, bytes], dict[str, str]]:
+    """The study tables as files (``<stem>_<kind>.csv`` always, ``.parquet`` when pyarrow is
+    installed) and, for each table left out, why (a bare install has no ``io`` extra)."""
+    from ..studies.study import KINDS
+
+    files: dict[str, bytes] = {}
+    skipped: dict[str, str] = {}
+    why = parquet_available()
+    for kind in KINDS:
+        if not result.table(kind):
+            continue
+        files[f"{stem}_{kind}.csv"] = result.to_csv(kind).encode("utf-8")
+        if why is None:
+            files[f"{stem}_{kind}.parquet"] = result.to_parquet(kind)
+        else:
+            skipped[f"{stem}_{kind}.parquet"] = why
+    return files, skipped
 
 
 def command_line(verb: str, *parts: Any) -> str:
@@ -188,9 +223,68 @@ def command_line(verb: str, *parts: Any) -> str:
     return " ".join(shlex.quote(w) for w in words)
 
 
+def add_pressure_flags(p: Any) -> None:
+    """``--p0`` and ``--pa`` (normal contact): quantities in Pa (``0.5MPa``)."""
+    p.add_argument(
+        "--p0",
+        type=quantity("Pa", positive=True),
+        help="normal: static pressure, e.g. 0.5MPa (needed when the pressure channel holds "
+        "only the dynamic part; default: the file-name tag p0-..., the manifest, or the "
+        "channel's mean)",
+    )
+    p.add_argument(
+        "--pa",
+        type=quantity("Pa", positive=True),
+        help="normal: nominal dynamic amplitude, e.g. 0.4MPa (checked against the measured "
+        "one; default: the file-name tag pa-... or the manifest)",
+    )
+
+
+def with_static_pressure(rec: Any, file: str, p0: float | None, pa: float | None) -> Any:
+    """A normal recording whose pressure channel holds only the dynamic part, with the static
+    pressure added (from ``--p0``, else the file-name tag ``p0-...``); unchanged otherwise.
+    A nominal ``pa`` (``--pa`` or tag) that the pressure's half range misses by more than
+    10 % is reported on stderr, naming both."""
+
+    import numpy as np
+
+    from ..io import Recording
+    from ..normal.loop import dynamic_only
+    from ..studies.manifest import tags_from_filename
+
+    tags = tags_from_filename(file)
+    p0 = p0 if p0 is not None else tags.get("p0")
+    pa = pa if pa is not None else tags.get("pa")
+    p = np.asarray(rec["p"], dtype=float)
+    if pa is not None:
+        measured = 0.5 * float(np.ptp(p))
+        if abs(measured - pa) > 0.1 * pa:
+            print(f"warning: {file}: the pressure's half range {measured:.4g} Pa differs "
+                  f"from the nominal pa = {pa:.4g} Pa", file=sys.stderr)  # fmt: skip
+    if not dynamic_only(p):
+        return rec
+    if p0 is None:
+        raise InputError(
+            f"{file}: the pressure channel holds only the dynamic pressure (mean "
+            f"{float(np.mean(p)):.3g} Pa): give the static pressure with --p0 (e.g. 0.5MPa) "
+            "or a file-name tag such as p0-0.5MPa"
+        )
+    data = dict(rec.data)
+    data["p"] = p + p0
+    return Recording(rec.t, data, dict(rec.units), rec.source, dict(rec.meta or {}))
+
+
 def add_workers_flag(p: Any, what: str) -> None:
     p.add_argument("--workers", type=int, default=None, metavar="N",
                    help=f"analyse {what} in N processes (default: serially)")  # fmt: skip
+
+
+def _ignore_sigint() -> None:
+    """Pool workers leave Ctrl-C to the parent, which cancels what is queued and exits 130
+    (otherwise every worker prints its own KeyboardInterrupt traceback)."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def process_pool(workers: int | None) -> Any:
@@ -203,7 +297,7 @@ def process_pool(workers: int | None) -> Any:
         raise InputError(f"--workers must be >= 1, got {workers}")
     from concurrent.futures import ProcessPoolExecutor
 
-    return ProcessPoolExecutor(workers)
+    return ProcessPoolExecutor(workers, initializer=_ignore_sigint)
 
 
 def add_progress_flags(p: Any) -> None:

@@ -17,6 +17,7 @@ from ..errors import InputError
 from ..studies.manifest import entry_from_file
 from ..studies.study import run_study
 from ._common import (
+    add_pressure_flags,
     add_progress_flags,
     add_workers_flag,
     check_output_targets,
@@ -158,10 +159,11 @@ def _handler(args: argparse.Namespace) -> int:
         e.columns, e.fs = columns, args.fs
         entries.append(e)
     topts = {"force_sign": args.force_sign}
+    nopts = {"p0": args.p0, "pa": args.pa}
     if args.stream:
         return _streamed(args, entries, columns, topts)
     result = run_study(entries, progress=args.progress, keep_going=args.keep_going,
-                       tangential_options=topts)  # fmt: skip
+                       tangential_options=topts, normal_options=nopts)  # fmt: skip
     # With --json -, stdout carries the JSON alone; everything else goes to stderr.
     say = sys.stderr if args.json == "-" else sys.stdout
     for r in result.results:
@@ -225,6 +227,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="tangential: analyse F (+1) or -F (-1); auto (default): the sign that makes the "
         "loop area ∮F dx positive (a passive joint dissipates)",
     )
+    add_pressure_flags(p)
     p.add_argument("--keep-going", action="store_true",
                    help="skip recordings that fail (exit code 1) instead of stopping")  # fmt: skip
     p.add_argument("-v", "--verbose", action="store_true", help="print each fit report")

@@ -35,6 +35,9 @@ def add_parser(subparsers: Any) -> None:
         "--report", metavar="DIR", help="write DIR/diagnose.html (+ figures/, diagnose.json)"
     )
     p.add_argument("--max-effects", type=int, default=3, help="stop after this many additions")
+    from ..commands._common import add_pressure_flags
+
+    add_pressure_flags(p)
     p.set_defaults(handler=run)
 
 
@@ -44,6 +47,11 @@ def run(args: argparse.Namespace) -> int:
     from ..io import read_recording
 
     rec = read_recording(args.file, kind=args.model)
+    if args.model == "normal":
+        from ..commands._common import with_static_pressure
+
+        rec = with_static_pressure(rec, args.file, getattr(args, "p0", None),
+                                   getattr(args, "pa", None))  # fmt: skip
     try:
         report = diagnose(rec, model=args.model, max_effects=args.max_effects)
     except InputError as exc:  # name the file: the workflow only sees arrays

@@ -39,8 +39,9 @@ def area(text: str) -> float:
 
 
 def _handler(args: argparse.Namespace) -> int:
+    from .._io_atomic import write_text
     from ..fem import NotIdentifiableError, joint_characteristics, load_result, unit_system
-    from ..fem.writers import write
+    from ..fem.writers import render
 
     units = unit_system(args.units)
     out = Path(args.output)
@@ -60,11 +61,16 @@ def _handler(args: argparse.Namespace) -> int:
     except NotIdentifiableError as exc:
         print(f"contactlab export: refused: {exc}; nothing written", file=sys.stderr)
         return EXIT_NOT_IDENTIFIABLE
-    if args.check:
-        _check(doc, jc.kind, args)
     cmd = command_line("export", args.result, "--format", args.format, "--units", args.units,
                        "-o", args.output)  # fmt: skip
-    path = write(jc, out, args.format, units, command=cmd)
+    try:
+        text = render(jc, args.format, units, command=cmd)  # refuses what a format cannot hold
+    except NotIdentifiableError as exc:
+        print(f"contactlab export: refused: {exc}; nothing written", file=sys.stderr)
+        return EXIT_NOT_IDENTIFIABLE
+    if args.check:
+        _check(doc, jc.kind, args)
+    path = write_text(out, text)
     print(f"wrote {path} ({jc.kind} joint, {args.format}, {units.name})")
     for n in jc.notes:
         print(f"  note: {n}", file=sys.stderr)

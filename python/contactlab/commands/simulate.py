@@ -17,6 +17,10 @@ from ._common import describe, quantity
 def _handler(args: argparse.Namespace) -> int:
     from ..io import Recording, write_recording
 
+    if args.model == "structure":
+        from .structure import simulate_structure
+
+        return simulate_structure(args)
     if args.model == "tangential":
         from ..tangential import synthetic_recording
 
@@ -61,7 +65,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="write a synthetic recording (tangential Masing or normal contact)",
         description=describe(__doc__),
     )
-    p.add_argument("model", choices=("tangential", "normal"))
+    p.add_argument("model", choices=("tangential", "normal", "structure"))
     p.add_argument("out", metavar="OUT", help="output file (.csv .tdms .h5 .mat)")
     g = p.add_argument_group("tangential")
     g.add_argument("--h0", type=quantity("N"), default=40.0, help="saturation force (N)")
@@ -90,4 +94,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    "0.01); normal: relative to each channel's peak-to-peak value (default: "
                    "realistic sensor noise and 16-bit quantisation); 0 = exact")  # fmt: skip
     p.add_argument("--seed", type=int, default=0)
+    s = p.add_argument_group("structure (a model from `contactlab identify --json`)")
+    s.add_argument("--structure", help="model JSON (identified model or Structure.save)")
+    s.add_argument("--input", help="CSV with the input column and a time column (else --fs)")
+    s.add_argument("--u", help="input column name")
+    s.add_argument("--base", action="store_true", help="the input is base displacement")
+    s.add_argument(
+        "--periodic",
+        action="store_true",
+        help="periodic steady state (input repeated until the response repeats)",
+    )
     p.set_defaults(handler=_handler)

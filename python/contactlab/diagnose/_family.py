@@ -112,7 +112,7 @@ def implausible_common(cand: Candidate, p: dict[str, float], d: Prepared) -> str
             return f"{s.name} is not finite"
         span = s.upper - s.lower if np.isfinite(s.upper - s.lower) else None
         for bound in (s.lower, s.upper):
-            if np.isfinite(bound) and span and abs(v - bound) <= 1e-4 * span and bound != s.null:
+            if np.isfinite(bound) and span and abs(v - bound) <= 1e-3 * span and bound != s.null:
                 return f"{s.name} = {v:.4g} {s.unit} sits at the limit of its physical range"
     if "tau" in p and cand.name == "channel_delay":
         period = d.cycles.period_samples * d.dt

@@ -74,11 +74,12 @@ def block_excitation(
     return x, total, max(f)
 
 
-def _rms(a: np.ndarray) -> float:
+def rms_of(a: np.ndarray) -> float:
+    """Root mean square of ``a``."""
     return float(np.sqrt(np.mean(a * a)))
 
 
-def _sizes(
+def effect_sizes(
     effects: Iterable[str] | Mapping[str, float], magnitude: float, known: tuple[str, ...]
 ) -> dict[str, float]:
     sizes = dict(effects) if isinstance(effects, Mapping) else dict.fromkeys(effects, magnitude)
@@ -141,7 +142,7 @@ def measure(
     return chans[0], chans[1], info
 
 
-def _start_index(start: str, t: np.ndarray, f0: float, f_min: float) -> int:
+def start_index(start: str, t: np.ndarray, f0: float, f_min: float) -> int:
     """First sample kept: 0 from rest; after the amplitude ramp (one period of the slowest
     block) and 1.5 reference cycles more for a steady start."""
     if start == "rest":

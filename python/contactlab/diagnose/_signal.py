@@ -18,6 +18,7 @@ from scipy.ndimage import uniform_filter1d
 from scipy.signal import savgol_coeffs, savgol_filter
 
 from ..errors import InputError
+from ..reversals import excursions
 
 _MAD_TO_SIGMA = 1.0 / 0.6744897501960817
 INPUT_FILTER_FRACTION = 0.04
@@ -146,30 +147,23 @@ def find_cycles(u: np.ndarray, period_samples: float | None = None) -> Cycles:
     us = savgol_filter(u, min(w, n - (1 - n % 2)), 3, mode="interp") if n > 7 else u.copy()
     win = max(3, round(period_samples))
     uc = us - uniform_filter1d(us, win, mode="nearest")
-    # Half-waves between sign changes of the centred signal, with hysteresis so that noise
-    # around zero does not split a half-wave.
+    # Hysteresis so that noise around zero does not split a half-wave.
     thr = 0.2 * float(np.sqrt(np.mean(uc * uc)))
-    sign = np.zeros(n, dtype=int)
-    cur = 0
-    for i in range(n):
-        if uc[i] > thr:
-            cur = 1
-        elif uc[i] < -thr:
-            cur = -1
-        sign[i] = cur
-    change = np.flatnonzero(np.diff(sign) != 0) + 1
-    bounds = np.r_[0, change, n]
+    # Half-waves = excursions of uc beyond ±thr (the package's Rust detector); the extreme of
+    # each is located on the smoothed signal us.
+    ex = excursions(uc, 0.0, thr, value=us) if thr > 0 else None
     rev, ismax = [], []
-    for a, b in itertools.pairwise(bounds):
-        s = sign[a]
-        if s == 0 or b - a < 2:
-            continue
-        seg = us[a:b]
-        i = a + int(np.argmax(seg) if s > 0 else np.argmin(seg))
-        if i == 0 or i == n - 1 or (ismax and ismax[-1] == (s > 0)):  # interior extrema only
-            continue
-        rev.append(i)
-        ismax.append(s > 0)
+    if ex is not None and len(ex):
+        ends = np.r_[ex.start[1:], n]
+        for a, b, s, i in zip(
+            ex.start.tolist(), ends.tolist(), ex.sign.tolist(), ex.extreme.tolist(), strict=True
+        ):
+            if b - a < 2:
+                continue
+            if i == 0 or i == n - 1 or (ismax and ismax[-1] == (s > 0)):  # interior extrema only
+                continue
+            rev.append(i)
+            ismax.append(s > 0)
     reversals = np.asarray(rev, dtype=int)
     is_max = np.asarray(ismax, dtype=bool)
     cycle = np.full(n, -1, dtype=int)

@@ -53,6 +53,12 @@ from .scaled_masing import memory, scaled_force
 
 _INF = np.inf
 
+# Physical ranges of the real-friction effects (a fit at their edge is refused as
+# implausible): static over kinetic friction of dry metal pairs is at most about 2 (a full
+# branch peaks near h0 (1 + 2 s_b) when the slip distance is long against 1/ac: s_b <= 0.5);
+# Stribeck's low-speed excess within -0.5..1 of the sliding force; friction along a track
+# varies by tens of per cent, not by its own size (each Fourier coefficient within ±0.3);
+# the friction force of the two directions differs by less than a factor 3 (|alpha| <= 0.5).
 CANDIDATES: dict[str, Candidate] = {
     c.name: c
     for c in (
@@ -98,7 +104,7 @@ CANDIDATES: dict[str, Candidate] = {
         ),
         Candidate(
             "asymmetry",
-            (ParamSpec("alpha", "-", 0.0, -0.95, 0.95, "one"),),
+            (ParamSpec("alpha", "-", 0.0, -0.5, 0.5, "one"),),
             "saturation force h0(1+alpha) in the positive, h0(1-alpha) in the negative direction",
         ),
         Candidate(
@@ -114,7 +120,7 @@ CANDIDATES: dict[str, Candidate] = {
         Candidate(
             "stribeck",
             (
-                ParamSpec("s", "-", 0.0, -0.9, 3.0, "one"),
+                ParamSpec("s", "-", 0.0, -0.5, 1.0, "one"),
                 ParamSpec("v_s", "m/s", np.nan, 0.0, _INF, "v"),
             ),
             "velocity-dependent friction: F = h (1 + s exp(-|ẋ|/v_s)) (Stribeck, s > 0: "
@@ -122,14 +128,14 @@ CANDIDATES: dict[str, Candidate] = {
         ),
         Candidate(
             "position_friction",
-            tuple(ParamSpec(n, "-", 0.0, -0.9, 0.9, "one") for n in ("a1", "b1", "a2", "b2")),
+            tuple(ParamSpec(n, "-", 0.0, -0.3, 0.3, "one") for n in ("a1", "b1", "a2", "b2")),
             "friction varying along the track (wavy plateaus): F = h (1 + Σ a_k cos(kπ ξ) + "
             "b_k sin(kπ ξ)), ξ the position scaled to -1..1 over the stroke, k = 1, 2",
         ),
         Candidate(
             "stick_slip",
             (
-                ParamSpec("s_b", "-", 0.0, 0.0, 3.0, "one"),
+                ParamSpec("s_b", "-", 0.0, 0.0, 0.5, "one"),
                 ParamSpec("ell", "m", np.nan, 0.0, _INF, "x"),
             ),
             "breakaway after each reversal: the branch rises s_b above Masing's and falls back "
@@ -252,6 +258,9 @@ class TangentialFamily:
         tt = d.t - d.t[0]
         f_exc = 1.0 / (d.cycles.period_samples * d.dt)
         freqs = np.arange(0.05 * f_exc, 3.0 * f_exc, 0.25 / d.duration)
+        # a fluctuation locked to the drive is position_friction's: skip the harmonics
+        k = np.round(freqs / f_exc)
+        freqs = freqs[(k < 1) | (np.abs(freqs - k * f_exc) >= 1.0 / d.duration)]
         best, fbest = -1.0, f_exc
         for f in freqs:
             A = np.column_stack((h * np.cos(2 * np.pi * f * tt), h * np.sin(2 * np.pi * f * tt)))
@@ -419,6 +428,15 @@ class TangentialFamily:
             return why
         if name == "non_masing_scaling" and not 0.5 <= p["lam"] <= 8.0:
             return f"branch scale lam = {p['lam']:.3g} is outside 0.5..8 (no known joint)"
+        if name == "normal_load":
+            f_exc = 1.0 / (d.cycles.period_samples * d.dt)
+            k = round(p["f_n"] / f_exc)
+            if k >= 1 and abs(p["f_n"] - k * f_exc) < 1.0 / d.duration:
+                return (
+                    f"a load fluctuation at {p['f_n']:.4g} Hz, harmonic {k} of the excitation, "
+                    "cannot be told from friction that varies along the track "
+                    "(position_friction)"
+                )
         if name == "displacement_offset":
             amp = 0.5 * float(np.ptp(d.u))
             if abs(p["x0"]) > 0.5 * amp:

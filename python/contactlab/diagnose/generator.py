@@ -34,11 +34,11 @@ from ..errors import InputError
 from ..masing import Masing
 from ._gen_common import (
     HiddenEffectRecording,
-    _rms,
-    _sizes,
-    _start_index,
     block_excitation,
+    effect_sizes,
     measure,
+    rms_of,
+    start_index,
 )
 from .candidates_tangential import breakaway
 from .generator_normal import hidden_effect_recording_normal
@@ -106,7 +106,7 @@ def _tangential_force(
         rev = rev[np.abs(xc[rev]) > 0.05 * np.max(np.abs(xc))]
         h = breakaway(h, xc, rev, effects["stick_slip"], BREAKAWAY_DISTANCE / ac)
     if "stribeck" in effects:
-        vs = STRIBECK_SPEED * _rms(v)
+        vs = STRIBECK_SPEED * rms_of(v)
         h = h * (1.0 + effects["stribeck"] * np.exp(-np.abs(v) / vs))
     if "position_friction" in effects:
         xi = xc / np.max(np.abs(xc))
@@ -234,7 +234,7 @@ def hidden_effect_recording(
         )
     if model != "tangential":
         raise InputError(f"model must be 'tangential' or 'normal', got {model!r}")
-    sizes = _sizes(effects, magnitude, TANGENTIAL_EFFECTS)
+    sizes = effect_sizes(effects, magnitude, TANGENTIAL_EFFECTS)
     h0 = float(base.pop("h0", 50.0))
     ac = float(base.pop("ac", 5e4))
     f0 = float(base.pop("f0", 5.0))
@@ -248,13 +248,13 @@ def hidden_effect_recording(
     t = np.arange(round(T * fs) + 1) / fs
     period = 1.0 / fmax
     _x0, F0 = _tangential_force({}, t, xfun, h0, ac, period)
-    Fr = _rms(F0)
+    Fr = rms_of(F0)
 
     def size(name: str, value: float) -> float:
         x1, F1 = _tangential_force({name: value}, t, xfun, h0, ac, period)
         # measured output change, on the measured displacement (what a base fit would see)
         F_on_x1 = Masing(h0, ac).force(x1)
-        return _rms(F1 - F_on_x1) / Fr
+        return rms_of(F1 - F_on_x1) / Fr
 
     params: dict[str, float] = {}
     for name, target in sizes.items():
@@ -272,12 +272,12 @@ def hidden_effect_recording(
             sign = 1.0 if rng.random() < 0.5 else -1.0
         params[name] = _solve_size(name, target, sign, size, h0, ac, Fr, period)
     x, F = _tangential_force(params, t, xfun, h0, ac, period)
-    keep = _start_index(start, t, f0, 0.6 * f0)
+    keep = start_index(start, t, f0, 0.6 * f0)
     t, x, F = t[keep:] - t[keep], x[keep:], F[keep:]
     x_noise = (
-        0.2 * noise * _rms(x) if input_noise is None else input_noise * float(np.max(np.abs(x)))
+        0.2 * noise * rms_of(x) if input_noise is None else input_noise * float(np.max(np.abs(x)))
     )
-    F_noise = noise * _rms(F)
+    F_noise = noise * rms_of(F)
     xm, Fm, info = measure(
         t,
         x,

@@ -18,11 +18,11 @@ from scipy.optimize import brentq
 from ..errors import InputError
 from ._gen_common import (
     HiddenEffectRecording,
-    _rms,
-    _sizes,
-    _start_index,
     block_excitation,
+    effect_sizes,
     measure,
+    rms_of,
+    start_index,
 )
 from .candidates_normal import frequency_domain, kelvin_voigt, nonlinear
 
@@ -87,7 +87,7 @@ def hidden_effect_recording_normal(
     default 5e5), ``f0`` (Hz, default 1). Other arguments as
     :func:`contactlab.diagnose.hidden_effect_recording`.
     """
-    sizes = _sizes(effects, magnitude, NORMAL_EFFECTS)
+    sizes = effect_sizes(effects, magnitude, NORMAL_EFFECTS)
     if {"stiffness_nonlinearity", "asymmetric_branches"} & set(sizes) and (
         "hysteretic_damping" in sizes
     ):
@@ -106,10 +106,10 @@ def hidden_effect_recording_normal(
     t = np.arange(round(T * fs) + 1) / fs
     omega = 2.0 * np.pi * f0
     d0 = _displacement({}, t, pfun, k, psi, omega, 1.0)
-    dr = _rms(d0)
+    dr = rms_of(d0)
 
     def size(name: str, value: float) -> float:
-        return _rms(_displacement({name: value}, t, pfun, k, psi, omega, dr) - d0) / dr
+        return rms_of(_displacement({name: value}, t, pfun, k, psi, omega, dr) - d0) / dr
 
     params: dict[str, float] = {}
     for name, target in sizes.items():
@@ -132,12 +132,12 @@ def hidden_effect_recording_normal(
         params[name] = sign * brentq(g, 0.0, hi, xtol=1e-12 * hi, rtol=1e-6)
     delta = _displacement(params, t, pfun, k, psi, omega, dr)
     p = p0 + pfun(t)
-    keep = _start_index(start, t, f0, 0.6 * f0)
+    keep = start_index(start, t, f0, 0.6 * f0)
     tau_c = 0.25 * float(t[-1])
     t, p, delta = t[keep:] - t[keep], p[keep:], delta[keep:]
     pd_amp = float(np.max(np.abs(p - p0)))
-    p_noise = 0.2 * noise * _rms(p - p0) if input_noise is None else input_noise * pd_amp
-    d_noise = noise * _rms(delta)
+    p_noise = 0.2 * noise * rms_of(p - p0) if input_noise is None else input_noise * pd_amp
+    d_noise = noise * rms_of(delta)
     pm, dm, info = measure(
         t,
         p,

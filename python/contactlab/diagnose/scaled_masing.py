@@ -26,6 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
+from ..masing import Masing
+from ..reversals import branch_memory
 
 
 @dataclass(frozen=True)
@@ -47,39 +49,11 @@ class Memory:
 def memory(x: np.ndarray) -> Memory:
     """Reversal stack of Masing's rules with wiping out, sample by sample.
 
-    The same rules, tie-breaking and start at the origin as :class:`contactlab.Masing`.
+    The same rules, tie-breaking and start at the origin as :class:`contactlab.Masing`: the
+    bookkeeping comes from the core operator itself (:func:`contactlab.reversals.branch_memory`).
     """
-    n = x.size
-    anchor = np.full(n, -1, dtype=np.int64)
-    target = np.full(n, -1, dtype=np.int64)
-    stack: list[int] = []  # sample indices of remembered reversals, oldest first
-    direction = 0
-    xs = x.tolist()
-    prev = 0.0  # the history starts at the origin, on the virgin curve
-    for i in range(n):
-        step = xs[i] - prev
-        if step != 0.0:
-            d = 1 if step > 0 else -1
-            if direction != 0 and d != direction:
-                stack.append(i - 1)
-            direction = d
-            prev = xs[i]
-        # wiping out: the branch passed the point it was heading for
-        while stack:
-            if len(stack) >= 2:
-                xt = xs[stack[-2]]
-                if direction * (xs[i] - xt) >= 0.0:
-                    del stack[-2:]
-                    continue
-            else:
-                xt = -xs[stack[0]]
-                if direction * (xs[i] - xt) >= 0.0:
-                    stack.clear()
-                    continue
-            break
-        if stack:
-            anchor[i] = stack[-1]
-            target[i] = stack[-2] if len(stack) >= 2 else -1 - stack[0]
+    x = np.ascontiguousarray(x, dtype=float)
+    anchor, target = branch_memory(x)
     change = np.flatnonzero((np.diff(anchor) != 0) | (np.diff(target) != 0)) + 1
     return Memory(x, anchor, target, np.r_[0, change])
 
@@ -107,6 +81,28 @@ def scaled_force(virgin: Callable[[np.ndarray], np.ndarray], lam: float, mem: Me
     """
     if not (np.isfinite(lam) and lam > 0):
         raise InputError(f"branch scale lam must be finite and > 0, got {lam}")
+    model = getattr(virgin, "__self__", None)
+    if isinstance(model, Masing) and getattr(virgin, "__func__", None) is Masing.virgin:
+        # The core operator with branches anchored at both ends (BranchRule::Anchored): one
+        # pass in Rust, the same memory rules as ``mem`` (which only depends on ``mem.x``).
+        return _anchored(model, float(lam)).force(mem.x)
+    return _scaled_force_python(virgin, float(lam), mem)
+
+
+def _anchored(model: Masing, lam: float) -> Masing:
+    """``model``'s virgin curve with branch scale ``lam`` and the anchored branch rule."""
+    if model.is_exponential:
+        m = Masing(model.h0, model.ac, scale=lam)
+    else:
+        m = Masing.from_backbone(*model._backbone, scale=lam)  # type: ignore[misc]
+    m._core = m._core.fresh(anchored=True)
+    return m
+
+
+def _scaled_force_python(
+    virgin: Callable[[np.ndarray], np.ndarray], lam: float, mem: Memory
+) -> np.ndarray:
+    """:func:`scaled_force` for any vectorised virgin curve (numpy, one loop step per branch)."""
     x = mem.x
     n = x.size
     anchor, target = mem.anchor, mem.target

@@ -231,6 +231,24 @@ MAX_SAMPLES = 24_000
 MIN_SAMPLES_PER_CYCLE = 64
 
 
+#: an effect may refine the base model, not replace it: the base parameters that carry the
+#: joint's physics (tangential h0, the friction force; normal k, the contact stiffness) may
+#: move by at most this fraction from the base fit when an effect is added
+MAX_BASE_SHIFT = 0.3
+_ANCHORS = {"tangential": ("h0",), "normal": ("k",)}
+
+
+def _takes_over(family: Family, base: dict[str, float], p: dict[str, float]) -> str | None:
+    for name in _ANCHORS.get(family.kind, ()):
+        b, v = base[name], p[name]
+        if b > 0 and abs(v / b - 1.0) > MAX_BASE_SHIFT:
+            return (
+                f"it takes over the base model ({name} from {b:.4g} to {v:.4g}): the base "
+                "is in the wrong regime or the effect is not what the data show"
+            )
+    return None
+
+
 def reduce_long(
     t: np.ndarray, u: np.ndarray, y: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
@@ -386,6 +404,7 @@ def diagnose(
     trials = [current]
     steps = [Step(None, current.heldout_rms, current.heldout_peak, current.energy_error)]
     added: list[str] = []
+    base_fit = dict(current.full.params)
     all_samples = np.ones(d.y.size, bool)
     while len(added) < max_effects:
         verdicts, best = [], None
@@ -419,7 +438,11 @@ def diagnose(
             if name == "channel_delay" and abs(p["tau"]) < d.dt:
                 extra = budget  # a sub-sample shift must beat what smoothing the input buys
             v = judge(name, current, cand, sigma, z, min_gain + extra)
-            why = family.implausible(name, p, d)
+            # every effect of the candidate model, not only the new one: a refit can push an
+            # effect added before to the edge of its physical range
+            why = next(
+                (w for e in trial_effects if (w := family.implausible(e, p, d))), None
+            ) or _takes_over(family, base_fit, p)
             if v.accepted and why:
                 v = dataclasses.replace(v, accepted=False, reason=f"implausible: {why}")
             verdicts.append(v)

@@ -308,26 +308,38 @@ def _tangential(
         )
     if area is None or not area > 0:
         raise InputError(f"{where}: no contact area: give --area (e.g. 50cm2 or 5e-3m2)")
-    if not ident.get("h0_ac", False):
-        raise NotIdentifiableError(f"{where}: the stick slope h0·ac is not identified: {reason}")
-    k0, k0_se = _num(d, "h0_ac", where, positive=True), _se(d, "h0_ac")
-    values = [
-        Value("stick_slope", k0 / area, k0_se / area, "stiffness_per_area", "h0·ac / A_c (eq. 18)")
-    ]
-    notes: list[str] = []
     if not (ident.get("h0", False) and d.get("h0") is not None):
         raise NotIdentifiableError(
             f"{where}: the friction coefficient needs h0, which is not identified: {reason}"
         )
+    notes: list[str] = []
     h0, h0_se = _num(d, "h0", where, positive=True), _se(d, "h0")
-    ac, ac_se = _num(d, "ac", where, positive=True), _se(d, "ac")
-    values.append(Value("mu", h0 / normal_load, h0_se / normal_load, "1", "h0 / W"))
-    values.append(Value("elastic_slip", 1 / ac, ac_se / ac**2, "length", "μp/λ = 1/ac"))
-    values.append(Value("slip_force", h0, h0_se, "force", "μ·W = h0 (Jenkins F_s)"))
-    values.append(Value("k_stick", k0, k0_se, "stiffness", "h0·ac (Jenkins k)"))
+    values = [Value("mu", h0 / normal_load, h0_se / normal_load, "1", "h0 / W"),
+              Value("slip_force", h0, h0_se, "force", "μ·W = h0 (Jenkins F_s)")]  # fmt: skip
+    if ident.get("h0_ac", False) and d.get("h0_ac") is not None:
+        k0, k0_se = _num(d, "h0_ac", where, positive=True), _se(d, "h0_ac")
+        values += [
+            Value("stick_slope", k0 / area, k0_se / area, "stiffness_per_area",
+                  "h0·ac / A_c (eq. 18)"),
+            Value("elastic_slip", h0 / k0, h0 / k0 * math.hypot(h0_se / h0, k0_se / k0),
+                  "length", "μp/λ = h0/(h0·ac) = 1/ac"),
+            Value("k_stick", k0, k0_se, "stiffness", "h0·ac (Jenkins k)"),
+        ]  # fmt: skip
+    else:
+        k0, k0_se = math.nan, math.nan
+        lb = d.get("ac_lower_bound")
+        bound = (f"; the data only bound it: ac ≥ {lb:.3g} 1/m, i.e. an elastic slip ≤ "
+                 f"{1 / lb:.3g} m" if isinstance(lb, (int, float)) and lb > 0 else "")  # fmt: skip
+        notes.append(f"no stick slope: h0·ac is not identified{bound} ({reason})")
+    ac_ok = bool(ident.get("ac", False)) and d.get("ac") is not None
+    ac, ac_se = (_num(d, "ac", where, positive=True), _se(d, "ac")) if ac_ok else (math.nan,) * 2
     if amplitude is not None:
         if frequency is None:
             raise InputError(f"{where}: --amplitude needs --frequency (for the dashpot c_e)")
+        if not ac_ok:
+            raise NotIdentifiableError(
+                f"{where}: k_global(A) and c_e(A) need h0 and ac; ac is not identified: {reason}"
+            )
         m = Masing(h0, ac)
         omega = 2 * math.pi * frequency
         rho = float(ident.get("correlation_h0_ac", 0.0) or 0.0)
@@ -359,10 +371,14 @@ def _tangential(
         )  # fmt: skip
     prov = [
         ("source", str(d.get("file", where))),
-        ("analysis", f"tangential Masing fit ({d.get('on', '?')}, {d.get('history', '?')})"),
+        (
+            "analysis",
+            f"tangential Masing fit ({d.get('on', '?')}, {d.get('history', '?')}"
+            f"{', regime ' + str(d['regime']) if d.get('regime') else ''})",
+        ),
         ("h0", _pm(h0, h0_se, "N")),
-        ("ac", _pm(ac, ac_se, "1/m")),
-        ("h0·ac", _pm(k0, k0_se, "N/m")),
+        ("ac", _pm(ac, ac_se, "1/m") if ac_ok else "not identified"),
+        ("h0·ac", _pm(k0, k0_se, "N/m") if math.isfinite(k0) else "not identified"),
         ("identifiability", reason),
         ("normal load W", f"{normal_load:.6g} N"),
         ("contact area A_c", f"{area:.6g} m^2"),

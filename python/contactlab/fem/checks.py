@@ -10,7 +10,9 @@
   fitted Masing energy at the same amplitude beside it — the FE friction law is not the
   fitted contact, and the user must see by how much.
 - :func:`check_dynamics`: first natural frequency of a pinned beam whose tip rests on the
-  exported joint spring, CalculiX ``*FREQUENCY`` against the Euler–Bernoulli closed form
+  exported joint spring, CalculiX ``*FREQUENCY`` against ``contactlab.structure``'s
+  ``Structure(M, C, K).modes()`` of the same beam (Hermite elements, the joint spring and
+  dashpot as a Kelvin–Voigt joint) and the Euler–Bernoulli closed form
   ``EI β³ (sin βL coth βL − cos βL) = 2 k sin βL`` (ω = β² √(EI/m)).
 
 All models are built in mm-N-s (mm, N, s, t; MPa) from the file text the exporter writes.
@@ -229,12 +231,17 @@ def check_tangential(
 
 @dataclass
 class DynamicsCheck:
+    """Result of :func:`check_dynamics`: CalculiX's first frequency against the reference
+    (``contactlab.structure`` when installed, else the closed form), both references kept."""
+
     frequency_fe: float  # Hz
     frequency_reference: float  # Hz
     reference: str
     spring: float  # N/m
     beam: Beam
     seconds: float
+    frequency_closed_form: float = math.nan  # Hz
+    damping_ratio: float = math.nan  # structure's modal ζ of mode 1 with the joint dashpot
 
     @property
     def error(self) -> float:
@@ -246,12 +253,56 @@ class DynamicsCheck:
         return (f"dynamics check (CalculiX *FREQUENCY, {self.seconds:.2f} s): beam "
                 f"{b.length:.4g} mm × {b.side:.3g} mm square, joint spring {self.spring:.5g} N/m "
                 f"(kL³/EI = {ratio:.3g}): f1 = {self.frequency_fe:.6g} Hz vs {self.reference} "
-                f"{self.frequency_reference:.6g} Hz, error {100 * self.error:.3g}%")  # fmt: skip
+                f"{self.frequency_reference:.6g} Hz, error {100 * self.error:.3g}% (closed form "
+                f"{self.frequency_closed_form:.6g} Hz; modal damping ratio with the joint "
+                f"dashpot {self.damping_ratio:.3g})")  # fmt: skip
 
     def to_dict(self) -> dict[str, Any]:
         return {"frequency_fe": self.frequency_fe, "frequency_reference":
                 self.frequency_reference, "reference": self.reference, "error": self.error,
-                "spring": self.spring, "seconds": self.seconds}  # fmt: skip
+                "frequency_closed_form": self.frequency_closed_form,
+                "damping_ratio": self.damping_ratio, "spring": self.spring,
+                "seconds": self.seconds}  # fmt: skip
+
+
+def structure_beam_modes(beam: Beam, k: float, c: float, n: int = 40) -> Any:
+    """Modes of the same beam from :class:`contactlab.structure.Structure` (SI).
+
+    Euler–Bernoulli Hermite elements (consistent mass), deflection held at x = 0, the joint as
+    a Kelvin–Voigt joint (``k`` N/m, ``c`` N·s/m) from the tip deflection to ground. Raises
+    ImportError when ``contactlab.structure`` is not installed.
+    """
+    from ..structure import Structure
+
+    L, EI = beam.length * 1e-3, beam.EI * 1e-6  # mm → m, N·mm² → N·m²
+    m = beam.mass_per_length * 1e6  # t/mm → kg/m
+    h = L / n
+    ke = (
+        EI
+        / h**3
+        * np.array(
+            [
+                [12, 6 * h, -12, 6 * h],
+                [6 * h, 4 * h * h, -6 * h, 2 * h * h],
+                [-12, -6 * h, 12, -6 * h],
+                [6 * h, 2 * h * h, -6 * h, 4 * h * h],
+            ]
+        )
+    )
+    q = h * h
+    me = m * h / 420 * np.array([[156, 22 * h, 54, -13 * h], [22 * h, 4 * q, 13 * h, -3 * q],
+                                 [54, 13 * h, 156, -22 * h],
+                                 [-13 * h, -3 * q, -22 * h, 4 * q]])  # fmt: skip
+    size = 2 * (n + 1)
+    K, M = np.zeros((size, size)), np.zeros((size, size))
+    for e in range(n):
+        s = slice(2 * e, 2 * e + 4)
+        K[s, s] += ke
+        M[s, s] += me
+    keep = np.arange(1, size)  # deflection at x = 0 held
+    st = Structure(M[np.ix_(keep, keep)], np.zeros((size - 1, size - 1)), K[np.ix_(keep, keep)])
+    st.add_joint("kelvin_voigt", 2 * n - 1, k=k, c=c)  # tip deflection (index 2n before cut)
+    return st.modes()
 
 
 def pinned_spring_beam_frequency(beam: Beam, k: float) -> float:
@@ -292,5 +343,13 @@ def check_dynamics(
     if run.dat.eigen is None or run.dat.eigen.size == 0:
         raise InputError("CalculiX printed no eigenvalues")
     f_fe = float(run.dat.eigen[0, 3])
-    f_ref = pinned_spring_beam_frequency(beam, k)
-    return DynamicsCheck(f_fe, f_ref, "Euler–Bernoulli closed form", k * 1e3, beam, run.seconds)
+    f_closed = pinned_spring_beam_frequency(beam, k)
+    c = float(joint[joint.index("*DASHPOT, ELSET=JOINT_DASHPOT") + 2])  # N·s/mm as written
+    try:
+        md = structure_beam_modes(beam, k * 1e3, c * 1e3, n=n)
+    except ImportError:
+        return DynamicsCheck(f_fe, f_closed, "Euler–Bernoulli closed form", k * 1e3, beam,
+                             run.seconds, f_closed)  # fmt: skip
+    return DynamicsCheck(f_fe, float(md.frequency_hz[0]), "contactlab.structure modes()",
+                         k * 1e3, beam, run.seconds, f_closed,
+                         float(md.damping_ratio[0]))  # fmt: skip

@@ -27,7 +27,7 @@ from pathlib import Path
 
 from .._io_atomic import write_text
 from ..errors import InputError
-from .characteristics import JointCharacteristics, Value
+from .characteristics import JointCharacteristics, NotIdentifiableError, Value
 from .units import UnitSystem
 
 FORMATS = ("calculix", "abaqus", "ansys", "csv", "json")
@@ -94,15 +94,25 @@ def _keywords(jc: JointCharacteristics, u: UnitSystem, abaqus: bool) -> list[str
             out.append(_g(val))
     else:
         mu, lam = jc.get("mu"), jc.get("stick_slope")
-        assert mu is not None and lam is not None
+        assert mu is not None
         out.append("** place under your *SURFACE INTERACTION (it also needs a *SURFACE BEHAVIOR)")
-        if abaqus:
+        if lam is None and not abaqus:
+            why = next((n for n in jc.notes if n.startswith("no stick slope")), "")
+            raise NotIdentifiableError(
+                f"CalculiX's *FRICTION needs a stick slope: {why}. The friction coefficient "
+                f"alone (μ = {mu.value:.4g}) goes out with --format abaqus, ansys, csv or json"
+            )
+        if abaqus and lam is None:
+            out += ["** friction coefficient [1]; stick slope not identified: Abaqus' default "
+                    "penalty (SLIP TOLERANCE) applies", "*FRICTION", _g(mu.value)]  # fmt: skip
+        elif abaqus:
             slip = jc.get("elastic_slip")
             assert slip is not None
             s, _, lab = slip.converted(u)
             out += [f"** elastic slip [{lab}] = μp/λ = 1/ac", f"*FRICTION, ELASTIC SLIP={_g(s)}",
                     _g(mu.value)]  # fmt: skip
         else:
+            assert lam is not None
             lv, _, lab = lam.converted(u)
             out += [f"** friction coefficient [1], stick slope [{lab}]", "*FRICTION",
                     f"{_g(mu.value)}, {_g(lv)}"]  # fmt: skip
@@ -140,11 +150,14 @@ def _ansys(jc: JointCharacteristics, u: UnitSystem) -> list[str]:
                     f"JOINT_C={_g(cv)}"]  # fmt: skip
     else:
         mu, lam = jc.get("mu"), jc.get("stick_slope")
-        assert mu is not None and lam is not None
-        lv, _, ll = lam.converted(u)
-        out += ["! friction coefficient [1] (h0 / W)", f"MP,MU,1,{_g(mu.value)}",
-                f"! FKT < 0: absolute tangential (stick) stiffness [{ll}] (h0·ac / A_c)",
-                "R,1", f"RMODIF,1,12,{_g(-lv)}"]  # fmt: skip
+        assert mu is not None
+        out += ["! friction coefficient [1] (h0 / W)", f"MP,MU,1,{_g(mu.value)}"]
+        if lam is None:
+            out.append("! stick slope not identified: FKT left at the program default")
+        else:
+            lv, _, ll = lam.converted(u)
+            out += [f"! FKT < 0: absolute tangential (stick) stiffness [{ll}] (h0·ac / A_c)",
+                    "R,1", f"RMODIF,1,12,{_g(-lv)}"]  # fmt: skip
     k, c = jc.get("k_global"), jc.get("c_e")
     if k is not None and c is not None:
         kv, _, kl = k.converted(u)

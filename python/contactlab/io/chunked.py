@@ -345,17 +345,11 @@ def _tdms_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) ->
 
 
 def _csv_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> ChunkedRecording:
-    from .csv import (
-        detect_encoding,
-        has_decimal_comma,
-        line_of_sample,
-        locate_bad_cell,
-        read_header,
-    )
+    from .csv import decimal_comma, line_of_sample, locate_bad_cell, read_header, sniff_encoding
     from .units import split_name
 
     file = str(path)
-    enc = detect_encoding(path)
+    enc = sniff_encoding(path)
     names, delim, header_line, comments = read_header(path, enc)
     if len(set(names)) != len(names):
         dup = next(n for n in names if names.count(n) > 1)
@@ -364,7 +358,7 @@ def _csv_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> 
     canon = list(mapping)
     idx = [names.index(mapping[c]) for c in canon]
     first_data = header_line + 1
-    comma = has_decimal_comma(path, delim, first_data, enc)
+    comma = decimal_comma(path, delim, first_data, enc)
     units = {c: split_name(mapping[c])[1] for c in canon}
     meta = {
         "format": "csv",
@@ -406,9 +400,8 @@ def _csv_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> 
                                 else None,
                             )
                     except ValueError:
-                        raise locate_bad_cell(
-                            path, delim, first_data, idx, names, comma, enc
-                        ) from None
+                        raise locate_bad_cell(path, delim, first_data, idx, names, comma,
+                                               enc) from None  # fmt: skip
                     if block.shape[0] == 0:
                         continue
                     raw = {c: np.ascontiguousarray(block[:, j]) for j, c in enumerate(canon)}

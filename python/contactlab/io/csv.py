@@ -22,7 +22,7 @@ from .recording import Recording, RecordingError, finish, resolve_columns
 from .units import split_name
 
 
-def detect_encoding(path: Path) -> str:
+def sniff_encoding(path: Path) -> str:
     """``"utf-8-sig"`` when the file's start decodes as UTF-8, else ``"latin-1"``.
 
     Acquisition software on Windows writes headers and comments such as ``Weg [µm]`` or
@@ -67,7 +67,7 @@ def read_header(path: Path, enc: str = "utf-8-sig") -> tuple[list[str], str | No
 _DECIMAL_COMMA = re.compile(r"^\s*[+-]?\d+,\d*(?:[eE][+-]?\d+)?\s*$")
 
 
-def has_decimal_comma(
+def decimal_comma(
     path: Path, delim: str | None, first_data_line: int, enc: str = "utf-8-sig"
 ) -> bool:
     """Whether numbers are written with a decimal comma (``1,5``; European locales), judged
@@ -150,7 +150,7 @@ def read_csv(
     """
     path = Path(path)
     file = str(path)
-    enc = detect_encoding(path)
+    enc = sniff_encoding(path)
     names, delim, header_line, comments = read_header(path, enc)
     if len(set(names)) != len(names):
         dup = next(n for n in names if names.count(n) > 1)
@@ -159,7 +159,7 @@ def read_csv(
     canon = list(mapping)
     idx = [names.index(mapping[c]) for c in canon]
     first_data = header_line + 1
-    comma = has_decimal_comma(path, delim, first_data, enc)
+    comma = decimal_comma(path, delim, first_data, enc)
     try:
         with warnings.catch_warnings():
             # A header without data rows is reported below as an error of its own; numpy's
@@ -177,7 +177,7 @@ def read_csv(
                 quotechar='"',
                 converters=(lambda v: float(v.replace(",", "."))) if comma else None,
             )
-    except UnicodeDecodeError as exc:  # a non-UTF-8 byte after the block detect_encoding looked at
+    except UnicodeDecodeError as exc:  # a non-UTF-8 byte after the block sniff_encoding looked at
         raise RecordingError(
             f"byte {exc.object[exc.start : exc.start + 1]!r} is not {enc} text; save the file "
             "as UTF-8",

@@ -30,7 +30,7 @@ import numpy as np
 
 from .. import _core
 from .._arrays import as_1d, positive
-from .._range import check_channel
+from .._physical import check_channel
 from ..errors import ContactLabWarning, InputError
 from . import _paper
 
@@ -55,6 +55,7 @@ _UNITS = {
     "E_d_cycle_std": "J/m^2",
     "p0": "Pa",
     "pa": "Pa",
+    "pa_nominal": "Pa",
     "omega": "rad/s",
     "frequency": "Hz",
 }
@@ -99,6 +100,10 @@ class LoopResult:
     cycle_delta_std: np.ndarray = field(repr=False)
     loading: np.ndarray = field(repr=False)
     units: dict[str, str] = field(default_factory=lambda: dict(_UNITS), repr=False)
+    #: where p0 came from: "given" (argument, CLI, file-name tag or manifest) or "mean of p"
+    p0_source: str = "mean of p"
+    #: the nominal dynamic amplitude given (NaN when none); ``pa`` is always measured
+    pa_nominal: float = float("nan")
 
     _SCALARS = (
         "E_d",
@@ -131,6 +136,9 @@ class LoopResult:
         d["n_discarded"] = int(self.n_discarded)
         d["degree"] = int(self.degree)
         d["resampled"] = bool(self.resampled)
+        d["p0_source"] = self.p0_source
+        if np.isfinite(self.pa_nominal):
+            d["pa_nominal"] = float(self.pa_nominal)
         d["units"] = dict(self.units)
         if arrays:
             for k in ("cycle_t", "cycle_p", "cycle_delta", "cycle_delta_std"):
@@ -294,11 +302,13 @@ def _check_inputs(t: Any, p: Any, delta: Any, degree: Any) -> tuple[np.ndarray, 
     tv = _time_vector(t, n)
     if isinstance(degree, bool) or not isinstance(degree, (int, np.integer)) or degree < 1:
         raise InputError(f"degree must be an integer >= 1, got {degree!r}")
+    check_channel("p", pv, "Pa", "pressure")
     if not np.ptp(dv) > 0:
         raise InputError(
             f"delta is constant ({float(dv[0]):g} m): the displacement sensor recorded no motion, "
             "so there is no loop to analyse"
         )
+    check_channel("delta", dv, "m", "displacement")
     return tv, pv, dv
 
 
@@ -390,18 +400,42 @@ def _cycles(
     return _Cycles(float(w), float(period), s0 + discard * period, bins, n_used, discard)
 
 
-def _pressure_levels(pdyn: np.ndarray, p_mean: float, p0: float | None) -> tuple[float, float]:
-    """Step 5: ``(p0, pa)``; the joint must stay closed (pa ≤ p0)."""
+def dynamic_only(p: np.ndarray) -> bool:
+    """True when a pressure channel holds only the dynamic part (piezo sensors: its mean is
+    within half the dynamic amplitude of zero), so the static pressure p0 must be given."""
+    half_range = 0.5 * float(np.ptp(p))
+    return bool(abs(float(np.mean(p))) < 0.5 * half_range)
+
+
+def _pressure_levels(
+    pdyn: np.ndarray, p_mean: float, p0: float | None, pa_nominal: float | None = None
+) -> tuple[float, float]:
+    """Step 5: ``(p0, pa)``; the joint must stay closed (pa ≤ p0). A given nominal ``pa``
+    is compared with the measured amplitude (a warning beyond 10 %)."""
+    if p0 is None and abs(p_mean) < 0.5 * 0.5 * float(np.ptp(pdyn)):
+        raise InputError(
+            f"the pressure channel holds only the dynamic pressure (mean {p_mean:.3g} Pa, "
+            f"amplitude {0.5 * float(np.ptp(pdyn)):.3g} Pa): give the static pressure p0 "
+            "(analyze_loop(p0=...), --p0 0.5MPa, a file-name tag such as p0-0.5MPa, or the "
+            "manifest's p0 column)"
+        )
     p0_val = p_mean if p0 is None else float(p0)
     if not np.isfinite(p0_val):
         raise InputError(f"p0 must be finite, got {p0}")
     pa = 0.5 * (_periodic_extreme(pdyn, True) - _periodic_extreme(pdyn, False))
-    if pa <= 0:
-        raise InputError("the dynamic pressure has no amplitude")
+    if not pa > 0:
+        raise InputError("the dynamic pressure has no amplitude: p is constant over every cycle")
     if pa > p0_val:
         raise InputError(
             f"pa = {pa:.6g} Pa exceeds p0 = {p0_val:.6g} Pa: the joint would separate "
-            "(if p holds only the dynamic pressure, pass p0=)"
+            "(if p holds only the dynamic pressure, give p0: analyze_loop(p0=...) or --p0)"
+        )
+    if pa_nominal is not None and abs(pa - pa_nominal) > 0.1 * abs(pa_nominal):
+        warnings.warn(
+            f"the measured dynamic amplitude pa = {pa:.4g} Pa differs from the nominal "
+            f"{pa_nominal:.4g} Pa by {100 * (pa / pa_nominal - 1):+.0f}%",
+            ContactLabWarning,
+            stacklevel=3,
         )
     return p0_val, pa
 
@@ -520,6 +554,7 @@ def analyze_loop(
     omega: float | None = None,
     discard_cycles: int | None = None,
     p0: float | None = None,
+    pa: float | None = None,
     zero_delta: bool = True,
     n_bins: int | None = None,
 ) -> LoopResult:
@@ -544,6 +579,10 @@ def analyze_loop(
         holds at least 3 whole cycles, else 0.
     p0 : float, optional
         Mean (static) pressure in Pa; default: the mean of ``p`` over the analysed cycles.
+        Required when ``p`` holds only the dynamic pressure (piezo sensors: mean ≈ 0).
+    pa : float, optional
+        Nominal dynamic amplitude in Pa: reported as ``pa_nominal`` and compared with the
+        measured ``pa`` (a warning when they differ by more than 10 %).
     zero_delta : bool, default True
         Shift δ so the centre curve passes through the origin (δ = 0 at p = 0); the shift is
         reported as ``delta_offset``.
@@ -569,8 +608,6 @@ def analyze_loop(
     [-0.015, 1.32, 1.705, 3.562, 4.176]
     """
     tv, pv, dv = _check_inputs(t, p, delta, degree)
-    check_channel(pv, "p", "Pa")
-    check_channel(dv, "delta", "m")
     degree = int(degree)
     tv, pv, dv, dt, resampled = _uniform(tv, pv, dv)
     cyc = _cycles(tv, pv, dt, omega, n_bins, discard_cycles)
@@ -582,7 +619,9 @@ def analyze_loop(
     dm = D.mean(axis=0)
     p_mean = float(pm.mean())
     pdyn = pm - p_mean
-    p0_val, pa = _pressure_levels(pdyn, p_mean, p0)
+    if pa is not None and not (np.isfinite(pa) and pa > 0):
+        raise InputError(f"pa must be a finite pressure > 0, got {pa!r}")
+    p0_val, pa_meas = _pressure_levels(pdyn, p_mean, p0, pa)
     if n_used > 1:
         dstd = D.std(axis=0, ddof=1)
         e_std = float(np.std(_loop_energy(P - P.mean(axis=1, keepdims=True), D), ddof=1))
@@ -592,7 +631,7 @@ def analyze_loop(
     br = _branches(pdyn, dm, degree, zero_delta)
     dz = dm - br.shift
     en = _energies(pdyn, dz, br)
-    k_tan, k_sec, k_s = _stiffness(br, dz, en, pa, zero_delta)
+    k_tan, k_sec, k_s = _stiffness(br, dz, en, pa_meas, zero_delta)
     w = cyc.omega
     scatter = float(np.sqrt(np.mean(dstd**2)))
     return LoopResult(
@@ -612,7 +651,7 @@ def analyze_loop(
         delta_min=en.d_min,
         delta_offset=float(br.shift),
         p0=p0_val,
-        pa=pa,
+        pa=pa_meas,
         omega=w,
         frequency=w / (2 * np.pi),
         n_cycles=n_used,
@@ -628,4 +667,6 @@ def analyze_loop(
         cycle_delta=dz,
         cycle_delta_std=dstd,
         loading=br.loading,
+        p0_source="mean of p" if p0 is None else "given",
+        pa_nominal=float("nan") if pa is None else float(pa),
     )

@@ -9,15 +9,18 @@ identify joints from input/response records (issue 10).
 
 from __future__ import annotations
 
+from .identify import IdentifiedModel, identify
 from .joints import Joint, iwan_uniform, make_joint
 from .modal import Modes, modes
 from .model import SimulationResult, Structure
 
 __all__ = [
+    "IdentifiedModel",
     "Joint",
     "Modes",
     "SimulationResult",
     "Structure",
+    "identify",
     "iwan_uniform",
     "make_joint",
     "modes",

@@ -231,6 +231,8 @@ class Structure:
         max_periods: int = 50,
         periodic_tol: float = 1e-6,
         rtol: float = 1e-10,
+        substeps: int = 1,
+        interpolation: str = "linear",
     ) -> SimulationResult:
         """Response to a force input and/or base motion sampled at ``t``.
 
@@ -252,6 +254,12 @@ class Structure:
             ``max_periods`` periods) and return the last period.
         influence : array_like (n,), optional
             Influence vector ``r`` of the base motion (default ones).
+        substeps : int
+            Integration steps per sample interval (the response is returned at ``t`` only).
+        interpolation : {"linear", "fourier"}
+            How inputs are continued between samples when ``substeps > 1``: linear, or
+            band-limited (FFT zero padding, for a uniformly sampled periodic input such as a
+            multisine record of whole periods).
 
         Returns
         -------
@@ -269,6 +277,19 @@ class Structure:
         for name, a in (("x0", x0a), ("v0", v0a)):
             if a.size != n:
                 raise InputError(f"{name} has {a.size} entries, expected {n}")
+        substeps = int(substeps)
+        if substeps < 1:
+            raise InputError(f"substeps must be >= 1, got {substeps}")
+        if substeps > 1:
+            tf, force, base, base_velocity = _refine(
+                t, substeps, interpolation, force, base, base_velocity
+            )
+            r = self.simulate(
+                tf, force, base, x0a, v0a, periodic=periodic, base_velocity=base_velocity,
+                influence=influence, max_periods=max_periods, periodic_tol=periodic_tol,
+                rtol=rtol,
+            )  # fmt: skip
+            return _slice(r, slice(None, None, substeps), t[: (r.t.size - 1) // substeps + 1])
         kw = self._inputs(t, force, base, base_velocity, influence)
         if not periodic:
             return self._run(t, kw, x0a, v0a, rtol)
@@ -393,6 +414,7 @@ class Structure:
 def _slice(r: SimulationResult, s: slice, t: np.ndarray) -> SimulationResult:
     return SimulationResult(
         t=t.copy(),
+        extra=dict(r.extra),
         x=r.x[s],
         v=r.v[s],
         a=r.a[s],
@@ -407,3 +429,41 @@ def _slice(r: SimulationResult, s: slice, t: np.ndarray) -> SimulationResult:
         n_steps=r.n_steps,
         n_iter=r.n_iter,
     )
+
+
+def _refine(
+    t: np.ndarray, k: int, how: str, force: Any, base: Any, base_velocity: Any
+) -> tuple[np.ndarray, Any, Any, Any]:
+    """``k`` sub-samples per interval: the fine time grid and the inputs on it."""
+    nt = t.size
+    frac = np.arange(k) / k
+    tf = np.concatenate([(t[:-1, None] + np.diff(t)[:, None] * frac).reshape(-1), t[-1:]])
+    if how not in ("linear", "fourier"):
+        raise InputError(f"interpolation must be 'linear' or 'fourier', got {how!r}")
+    if how == "fourier":
+        dt = np.diff(t)
+        if np.ptp(dt) > 1e-9 * dt.mean():
+            raise InputError("interpolation='fourier' needs uniformly sampled t")
+
+    def fine(a: Any, name: str) -> Any:
+        if a is None:
+            return None
+        arr = np.asarray(a, dtype=float)
+        if arr.shape[0] != nt:
+            raise InputError(f"{name} has {arr.shape[0]} samples but t has {nt}")
+        if how == "linear":
+            cols = arr.reshape(nt, -1)
+            out = np.stack([np.interp(tf, t, c) for c in cols.T], axis=1)
+        else:
+            # Periodic band-limited interpolation of the whole record (nt samples = one
+            # period), evaluated on the k-times finer grid; the last point wraps around.
+            spec = np.fft.rfft(arr.reshape(nt, -1), axis=0)
+            fine_n = nt * k
+            out = np.fft.irfft(spec, n=fine_n, axis=0) * k
+            out = np.concatenate([out[: (nt - 1) * k + 1]], axis=0)
+        return out.reshape((tf.size, *arr.shape[1:]))
+
+    fv = fine(force, "force")
+    yv = fine(base, "base")
+    ydv = fine(base_velocity, "base_velocity")
+    return tf, fv, yv, ydv

@@ -32,8 +32,17 @@ def analyze_normal_recording(
     the row's ``warnings`` (and the report) rather than raised.
     """
     from ..normal import analyze_loop, fit_pressure_stiffness
+    from ..normal.loop import dynamic_only
 
     opts = dict(options)
+    for key in ("p0", "pa"):  # the file-name tags and manifest columns, unless given
+        tag = entry.tags.get(key)
+        if opts.get(key) is None and isinstance(tag, float) and math.isfinite(tag):
+            opts[key] = tag
+    if opts.get("p0") is not None and not dynamic_only(rec["p"]):
+        # a total-pressure channel measures p0 itself (its mean); a given value is the check
+        opts["p0"] = None
+    opts = {k: v for k, v in opts.items() if v is not None or k not in ("p0", "pa")}
     freq = entry.tags.get("frequency")
     if "omega" not in opts and isinstance(freq, float) and math.isfinite(freq) and freq > 0:
         opts["omega"] = 2.0 * math.pi * freq

@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from .columns import CYCLE_UNITS
 from .plots import display_unit
 
 #: axis labels of the tracked quantities
@@ -32,6 +33,9 @@ LABELS = {
     "p0": "p0",
     "pa": "pa",
 }
+
+
+_MARGINS = {"left": 0.16, "right": 0.97, "bottom": 0.17, "top": 0.93}
 
 
 def _axes(ax: Any) -> Any:
@@ -79,8 +83,6 @@ def plot_quantity(result: Any, name: str, *, against: str = "time", ax: Any = No
 
 def plot_cycles(result: Any, name: str = "energy", ax: Any = None) -> Any:
     """A per-cycle quantity against the cycle number (every cycle of the record)."""
-    from .tracking import CYCLE_UNITS
-
     ax = _axes(ax)
     v = result.cycles[name]
     unit = CYCLE_UNITS[result.kind][name]
@@ -94,19 +96,37 @@ def plot_cycles(result: Any, name: str = "energy", ax: Any = None) -> Any:
 
 
 def track_figures(result: Any, *, against: str = "time") -> Iterator[tuple[str, Any]]:
-    """``(name, figure)`` for every tracked quantity, then the per-cycle energy: a generator,
-    so that a caller who closes each figure holds one at a time."""
+    """``(name, figure)`` for every tracked quantity (a polynomial's coefficients share one
+    figure, one panel each), then the per-cycle energy: a generator, so that a caller who
+    closes each figure holds one at a time."""
     import matplotlib.pyplot as plt
 
+    polys: dict[str, list[str]] = {}
     for q in result.quantities:
+        head, _, tail = q.rpartition("_")
+        if q.startswith("poly_") and tail.isdigit():
+            polys.setdefault(head, []).append(q)
+            continue
         fig, ax = plt.subplots(figsize=(6.0, 3.2))
         plot_quantity(result, q, against=against, ax=ax)
-        fig.tight_layout()
+        fig.subplots_adjust(**_MARGINS)  # fixed margins: tight_layout costs 0.5 s a figure
         yield q, fig
+    for head, names in polys.items():
+        fig, axes = plt.subplots(
+            len(names), 1, figsize=(6.0, 1.6 * len(names) + 0.6), sharex=True, squeeze=False
+        )
+        for ax, q in zip(axes[:, 0], names, strict=True):
+            plot_quantity(result, q, against=against, ax=ax)
+            ax.set_ylabel(f"a{q.rpartition('_')[2]} [{ax.get_ylabel().rpartition('[')[2]}")
+            ax.set_xlabel("")
+        axes[-1, 0].set_xlabel("time [s]" if against == "time" else "cycle")
+        axes[0, 0].set_title(f"{head} coefficients (ascending powers)")
+        fig.subplots_adjust(**{**_MARGINS, "bottom": 0.6 / (1.6 * len(names) + 0.6)})
+        yield head, fig
     if result.cycles["energy"].size:
         fig, ax = plt.subplots(figsize=(6.0, 3.2))
         plot_cycles(result, "energy", ax=ax)
-        fig.tight_layout()
+        fig.subplots_adjust(**_MARGINS)
         yield "cycle_energy", fig
 
 

@@ -37,12 +37,14 @@ from typing import Any
 
 import numpy as np
 
-from .._range import check_magnitude
+from .._json import jsonable
+from .._physical import MAX_MAGNITUDE
 from ..errors import ContactLabError, ContactLabWarning, InputError
 from ..io import DEFAULT_CHUNK, Recording, read_chunks
 from ..io.units import UnknownUnitError, to_si
 from ._cycles import MIN_BLOCK, CycleState, block_cycles
 from .columns import CYCLE_UNITS
+from .study import coefficient_unit
 
 #: tangential quantities tracked per window (each with ``*_stderr``)
 TANGENTIAL_QUANTITIES = (
@@ -309,8 +311,6 @@ def _normal_window(rec: Recording, options: Mapping[str, Any]) -> tuple[dict, di
     n, e_std = int(d.get("n_cycles") or 0), d.get("E_d_cycle_std")
     row["E_d_stderr"] = e_std / math.sqrt(n) if n > 1 and _finite(e_std) else None
     units["E_d_stderr"] = du.get("E_d", "J/m^2")
-    from .study import coefficient_unit
-
     for key in ("poly_load", "poly_unload", "poly_centre"):
         for i, c in enumerate(d.get(key) or []):
             row[f"{key}_{i}"] = float(c)
@@ -372,7 +372,13 @@ def _blocks(chunks: Iterator[Recording], min_block: int) -> Iterator[Recording]:
     size = 0
     for c in chunks:
         for name, v in c.data.items():  # found by fuzzing: 1e300 data overflowed windows
-            check_magnitude(v, name, c.units.get(name, ""), c.source)
+            if v.size and float(np.max(np.abs(v))) > MAX_MAGNITUDE:
+                i = int(np.argmax(np.abs(v)))
+                raise InputError(
+                    f"{c.source}: {name} reaches {float(v[i]):.3g} {c.units.get(name, '')} "
+                    f"at sample {i + int(c.meta.get('offset', 0))}: beyond any physical value; "
+                    "a unit mix-up or a corrupt file?"
+                )
         buf.append(c)
         size += len(c)
         if size >= min_block:
@@ -622,8 +628,6 @@ def track_many(
 
 def track_json(result: TrackResult, *, cycles: bool = True) -> str:
     """The result as JSON text (NaN → null)."""
-    from ..commands._common import jsonable
-
     return json.dumps(jsonable(result.to_dict(cycles=cycles)), indent=1, allow_nan=False) + "\n"
 
 

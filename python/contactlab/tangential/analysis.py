@@ -49,7 +49,7 @@ from typing import Any
 import numpy as np
 
 from .._arrays import as_1d
-from .._range import check_channel
+from .._physical import check_channel
 from ..errors import ContactLabWarning, InputError
 from ..fitting import FitResult
 from ..io import Recording
@@ -81,8 +81,6 @@ def _inputs(
                     f"{recording.source}: no {ch!r} channel; a tangential recording needs x "
                     f"and F (channels: {sorted(recording.data)})"
                 )
-        for ch, unit in (("x", "m"), ("F", "N")):
-            check_channel(recording[ch], ch, unit, recording.source)
         return recording["x"], recording["F"], recording.t, recording.source
     if x is None or F is None:
         raise InputError("give a recording, or the arrays x (m) and F (N)")
@@ -98,8 +96,6 @@ def _inputs(
         if np.any(np.diff(ta) <= 0):
             i = int(np.argmax(np.diff(ta) <= 0)) + 1
             raise InputError(f"t[{i}] = {ta[i]} does not increase")
-    check_channel(xa, "x", "m")
-    check_channel(Fa, "F", "N")
     return xa, Fa, ta, "<arrays>"
 
 
@@ -143,6 +139,11 @@ def identifiability(
             f"{corr:+.3f}. Identified: h0·ac = {k0.value:.6g} ± {k0.stderr or math.nan:.3g} N/m"
             f" ({100 * rel_k0:.2f}%); ac < {ac_up:.3g} 1/m and h0 > {h0_lo:.3g} N (2σ)."
         )
+        if not rel_k0 < max_rel_stderr:
+            msg += (
+                " Not even h0·ac is determined: the force hardly follows the displacement "
+                "(a noise-only or disconnected force channel?)."
+            )
         for p in (ph0, pac):
             p.identifiable = False
             p.note = "not separately identifiable: only h0·ac is (see identifiability)"
@@ -278,7 +279,9 @@ def collect_warnings(
 ) -> list[str]:
     """Everything the user should know about the fit: regime, identifiability, convergence,
     and a misfit beyond the cycle-to-cycle noise."""
-    warns: list[str] = pre + list(raw.notes)
+    # on a plateau the Masing fit is superseded: its numerical notes would only confuse
+    plateau = evidence.get("h0_source") == "plateau"
+    warns: list[str] = pre + ([] if plateau else list(raw.notes))
     loop = data.loop
     z = evidence["ac_times_amplitude"]
     ratio = regime.area_ratio
@@ -289,14 +292,13 @@ def collect_warnings(
         )
     if not identifiable:
         warns.append(evidence["message"])
-    if not raw.success:
-        why = (
-            "; in gross sliding the loop is nearly rectangular and the fit's ac runs off "
-            "towards infinity, which is why h0 comes from the plateau"
-            if evidence.get("h0_source") == "plateau"
-            else ""
+    if not raw.success and plateau:
+        warns.append(
+            "the exponential Masing fit cannot follow this nearly rectangular loop (its ac "
+            "runs off towards infinity), which is why h0 comes from the plateau"
         )
-        warns.append(f"the Masing fit did not converge ({raw.message}){why}")
+    elif not raw.success:
+        warns.append(f"the Masing fit did not converge ({raw.message})")
     if loop is not None and data.on == "averaged" and loop.n_cycles > 2:
         # Is the misfit larger than the cycle-to-cycle noise explains?
         v = loop.F_std**2 * (loop.count / loop.n_cycles)
@@ -394,6 +396,8 @@ def analyze_tangential(
     """
     xa, Fa, ta, source = _inputs(recording, t, x, F)
     _check_options(on, history, n_points)
+    check_channel("x", xa, "m", "displacement")
+    check_channel("F", Fa, "N", "force")
     steady = history == "steady"
     if invert_force is not None:
         force_sign = -1 if invert_force else 1
@@ -449,6 +453,7 @@ def analyze_tangential(
         F=det.F,
         t=ta,
         rev=data.rev,
+        x_raw=xa,
     )
     apply_regime(regime, amp, fit, identifiable, evidence, derived, max_rel_stderr)
     warns = collect_warnings(pre_warns, raw, data, amp.value, identifiable, evidence, regime)

@@ -75,13 +75,15 @@ def difference_noise(v: np.ndarray, order: int = 4) -> float:
     return float(est[k + 1] if ratios[k] < 4.0 else est[0])
 
 
-def _savgol(v: np.ndarray, window: int, deriv: int, dt: float) -> np.ndarray:
+def savgol_derivative(v: np.ndarray, window: int, deriv: int, dt: float) -> np.ndarray:
+    """``deriv``-th derivative of ``v`` (sample interval ``dt``) by a Savitzky-Golay filter."""
     from scipy.signal import savgol_filter
 
     return savgol_filter(v, window, POLYORDER, deriv=deriv, delta=dt, mode="interp")
 
 
-def _coeffs(window: int, deriv: int, dt: float) -> np.ndarray:
+def savgol_coefficients(window: int, deriv: int, dt: float) -> np.ndarray:
+    """Savitzky-Golay weights of the ``deriv``-th derivative (dot with a centred window)."""
     from scipy.signal import savgol_coeffs
 
     return savgol_coeffs(window, POLYORDER, deriv=deriv, delta=dt, use="dot")
@@ -98,13 +100,13 @@ def lepski_window(x: np.ndarray, dt: float, sigma: float, *, kappa: float = LEPS
     cands = sorted({w | 1 for w in np.geomspace(7, top, 16).astype(int) if w >= 7})
     if sigma <= 0 or len(cands) < 2:
         return cands[0]
-    ests = {w: _savgol(x, w, 2, dt) for w in cands}
+    ests = {w: savgol_derivative(x, w, 2, dt) for w in cands}
     chosen = cands[0]
     for i, w in enumerate(cands[1:], start=1):
         ok = True
-        cw = _coeffs(w, 2, dt)
+        cw = savgol_coefficients(w, 2, dt)
         for wp in cands[:i]:
-            cp = np.pad(_coeffs(wp, 2, dt), (w - wp) // 2)
+            cp = np.pad(savgol_coefficients(wp, 2, dt), (w - wp) // 2)
             sd = sigma * float(np.linalg.norm(cw - cp))
             inner = slice(w // 2, n - w // 2)
             rms = float(np.sqrt(np.mean((ests[w][inner] - ests[wp][inner]) ** 2)))
@@ -199,13 +201,13 @@ def frame_friction_force(
         raise InputError(f"window must be an odd number of samples >= 5, got {window!r}")
     if window > xa.size:
         raise InputError(f"window of {window} samples is longer than the record ({xa.size})")
-    xd = _savgol(xa, window, 1, dt)
-    xdd = _savgol(xa, window, 2, dt)
-    yd = _savgol(ya, window, 1, dt)
+    xd = savgol_derivative(xa, window, 1, dt)
+    xdd = savgol_derivative(xa, window, 2, dt)
+    yd = savgol_derivative(ya, window, 1, dt)
     F = K * (ya - xa) + C * (yd - xd) - M * xdd
     # noise of F: K (y - x) direct, C and M through the filters' coefficients (x's terms
     # combine into one filter of x: -K δ - C c1 - M c2)
-    c1, c2 = _coeffs(window, 1, dt), _coeffs(window, 2, dt)
+    c1, c2 = savgol_coefficients(window, 1, dt), savgol_coefficients(window, 2, dt)
     fx = -C * c1 - M * c2
     fx[window // 2] -= K
     fy = C * c1

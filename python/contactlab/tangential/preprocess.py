@@ -23,9 +23,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import _core
 from .._arrays import as_1d
 from ..errors import InputError
-from ..masing import loop_area
+from ..reversals import excursions
 
 
 @dataclass(frozen=True)
@@ -64,15 +65,16 @@ class Reversals:
         return int(min(cand)) if cand else 0
 
 
-def _crossing_time(t: np.ndarray, x: np.ndarray, i: int, level: float) -> float:
-    """Time at which ``x`` crosses ``level`` between samples ``i-1`` and ``i`` (linear)."""
-    if i <= 0:
-        return float(t[0])
-    x0, x1 = x[i - 1], x[i]
-    if x1 == x0:
-        return float(t[i])
-    a = (level - x0) / (x1 - x0)
-    return float(t[i - 1] + min(max(a, 0.0), 1.0) * (t[i] - t[i - 1]))
+def _crossing_times(t: np.ndarray, x: np.ndarray, i: np.ndarray, level: np.ndarray) -> np.ndarray:
+    """Times at which ``x`` crosses ``level`` between samples ``i-1`` and ``i`` (linear; the
+    time of sample ``i`` where the two samples are equal, ``t[0]`` for ``i = 0``)."""
+    i = np.asarray(i, dtype=np.int64)
+    ip = np.maximum(i - 1, 0)
+    x0, x1 = x[ip], x[i]
+    flat = x1 == x0
+    a = (level - x0) / np.where(flat, 1.0, x1 - x0)
+    tc = t[ip] + np.clip(a, 0.0, 1.0) * (t[i] - t[ip])
+    return np.where(i <= 0, t[0], np.where(flat, t[i], tc))
 
 
 def find_reversals(
@@ -117,51 +119,31 @@ def find_reversals(
         threshold = rel_threshold * amp
     if not threshold > 0:
         raise InputError(f"the displacement does not move (amplitude {amp:g}); no reversals")
-    hi_level = centre + threshold
-    lo_level = centre - threshold
-    state = np.where(xa > hi_level, 1, np.where(xa < lo_level, -1, 0))
-    nz = np.flatnonzero(state)
+    # Excursions beyond the band (Rust detector): +1 = above it since the last time below.
+    ex = excursions(xa, centre, float(threshold))
     empty = np.empty(0, dtype=np.int64)
-    if nz.size == 0:
+    if len(ex) == 0:
         return Reversals(empty, empty, np.empty(0), np.empty(0), float(threshold), centre)
-    # Segments of constant (forward-filled) state: +1 = above the band since the last time
-    # below it.
-    s = state[nz]
-    change = np.flatnonzero(np.diff(s) != 0) + 1
-    seg_start = np.r_[nz[0], nz[change]]
-    seg_state = s[np.r_[0, change]]
-    seg_end = np.r_[nz[change], xa.size]  # exclusive: next segment's first sample
-    peaks, valleys, ptimes, vtimes, edges = [], [], [], [], []
-    last = len(seg_start) - 1
-    for k, (a, b, st) in enumerate(zip(seg_start, seg_end, seg_state, strict=True)):
-        # An extreme is confirmed only when the signal has left it through the band; the
-        # last segment's turn is unconfirmed and the first may be cut by the recording start.
-        seg = xa[a:b]
-        level = hi_level if st > 0 else lo_level
-        inside = seg > level if st > 0 else seg < level
-        idx_in = np.flatnonzero(inside)
-        i_ext = a + int(np.argmax(seg) if st > 0 else np.argmin(seg))
-        if (k == 0 and a == 0) or (k == last and not np.any((xa[i_ext:] - centre) * st < 0)):
-            # cut by the recording's start, or not confirmed by a centre crossing before its end
-            edges.append(i_ext)
-            continue
-        t_in = _crossing_time(ta, xa, a, level)
-        j = a + int(idx_in[-1]) + 1  # first sample back inside the band
-        t_out = _crossing_time(ta, xa, min(j, xa.size - 1), level)
-        if st > 0:
-            peaks.append(i_ext)
-            ptimes.append(0.5 * (t_in + t_out))
-        else:
-            valleys.append(i_ext)
-            vtimes.append(0.5 * (t_in + t_out))
+    # An extreme is confirmed only when the signal has left it through the band; the last
+    # excursion's turn is unconfirmed unless it crossed the centre before the end, and the
+    # first may be cut by the recording's start.
+    edge = np.zeros(len(ex), dtype=bool)
+    edge[0] = ex.start[0] == 0
+    edge[-1] |= not bool(ex.returned[-1])
+    up = ex.sign > 0
+    level = np.where(up, centre + threshold, centre - threshold)
+    t_in = _crossing_times(ta, xa, ex.start, level)
+    j = np.minimum(ex.last_beyond + 1, xa.size - 1)  # first sample back inside the band
+    t_mid = 0.5 * (t_in + _crossing_times(ta, xa, j, level))
+    peak, valley = ~edge & up, ~edge & ~up
     return Reversals(
-        np.asarray(peaks, dtype=np.int64),
-        np.asarray(valleys, dtype=np.int64),
-        np.asarray(ptimes, dtype=float),
-        np.asarray(vtimes, dtype=float),
+        ex.extreme[peak].astype(np.int64),
+        ex.extreme[valley].astype(np.int64),
+        t_mid[peak],
+        t_mid[valley],
         float(threshold),
         float(centre),
-        np.asarray(edges, dtype=np.int64),
+        ex.extreme[edge].astype(np.int64),
     )
 
 
@@ -228,9 +210,8 @@ class AveragedLoop:
         return self.phase < 0.5
 
 
-def phase_of(t: np.ndarray, rev: Reversals) -> tuple[np.ndarray, int, int]:
-    """Phase of each sample of the complete cycles; returns ``(phase, start, end)`` where
-    samples ``start:end`` are covered (phase ``k + φ`` for cycle ``k``, φ in [0, 1))."""
+def _phase_knots(rev: Reversals) -> tuple[np.ndarray, np.ndarray]:
+    """Knots ``(time, phase)``: peak k at phase k, the valley after it at k + 1/2."""
     pt, vt = rev.peak_times, rev.valley_times
     knots_t, knots_p = [], []
     for k, tp in enumerate(pt):
@@ -240,8 +221,13 @@ def phase_of(t: np.ndarray, rev: Reversals) -> tuple[np.ndarray, int, int]:
         if k + 1 < pt.size and later.size and later[0] < pt[k + 1]:
             knots_t.append(later[0])
             knots_p.append(k + 0.5)
-    kt = np.asarray(knots_t)
-    kp = np.asarray(knots_p)
+    return np.asarray(knots_t), np.asarray(knots_p)
+
+
+def phase_of(t: np.ndarray, rev: Reversals) -> tuple[np.ndarray, int, int]:
+    """Phase of each sample of the complete cycles; returns ``(phase, start, end)`` where
+    samples ``start:end`` are covered (phase ``k + φ`` for cycle ``k``, φ in [0, 1))."""
+    kt, kp = _phase_knots(rev)
     start = int(np.searchsorted(t, kt[0], side="left"))
     end = int(np.searchsorted(t, kt[-1], side="left"))
     ph = np.interp(t[start:end], kt, kp)
@@ -322,60 +308,61 @@ def average_loop(
             f"±{rev.threshold:.3g} m around x = {rev.centre:.3g} m; "
             f"at least {min_cycles} are needed"
         )
-    ph, start, end = phase_of(ta, rev)
-    cyc = np.floor(ph).astype(np.int64)
-    frac = ph - cyc
+    kt, kp = _phase_knots(rev)
+    start = int(np.searchsorted(ta, kt[0], side="left"))
+    end = int(np.searchsorted(ta, kt[-1], side="left"))
     if n_points is None:
         # about two samples of every cycle per bin, so no bin is left empty by jitter
         n_points = 2 * int(np.clip(np.median(np.diff(rev.peaks)) / 2, 16, 400) // 2)
     if n_points < 8:
         raise InputError(f"n_points must be >= 8, got {n_points}")
-    b = np.minimum((frac * n_points).astype(np.int64), n_points - 1)
-    xs, Fs = xa[start:end], Fa[start:end]
-    count = np.bincount(b, minlength=n_points).astype(float)
+    # One pass in Rust: phase by interpolating the knots, bin sums overall and per cycle (no
+    # per-sample temporaries; the bins are numpy.interp's).
+    fold = _core.PhaseFold(int(n_points), n_cyc)
+    fold.push(ta, xa, Fa, 0, kt, kp)
+    sums = fold.sums()
+    count = sums["count"]
     if np.any(count == 0):
         raise InputError(
             f"{int(np.sum(count == 0))} of {n_points} phase bins are empty: the recording has "
             f"too few samples per cycle for n_points={n_points}; lower n_points"
         )
-    xm = np.bincount(b, xs, n_points) / count
-    Fm = np.bincount(b, Fs, n_points) / count
+    xm = sums["sum_x"] / count
+    Fm = sums["sum_F"] / count
     # per-cycle bin means (cycles x bins); a bin a cycle missed is NaN
-    flat = cyc * n_points + b
-    size = n_cyc * n_points
-    cc = np.bincount(flat, minlength=size).reshape(n_cyc, n_points)
+    cc = sums["cycle_count"]
     with np.errstate(invalid="ignore", divide="ignore"):
-        cx = np.bincount(flat, xs, size).reshape(n_cyc, n_points) / cc
-        cF = np.bincount(flat, Fs, size).reshape(n_cyc, n_points) / cc
-        cphi = np.bincount(flat, frac, size).reshape(n_cyc, n_points) / cc
+        cx = sums["cycle_x"] / cc
+        cF = sums["cycle_F"] / cc
+        cphi = sums["cycle_phase"] / cc
     # Where the samples of a cycle sit inside a bin differs from cycle to cycle; on a steep
     # branch that alone spreads the per-cycle means. Remove it to first order (gradient along
     # phase, periodic) so the spread measures noise and real cycle-to-cycle change.
-    phim = np.bincount(b, frac, n_points) / count
+    phim = sums["sum_phase"] / count
     dphi = cphi - phim
     x_std = _spread(cx - _dphase(xm, n_points) * dphi)
     F_std = _spread(cF - _dphase(Fm, n_points) * dphi)
-    # sample index where each cycle starts (and where the last one ends)
-    bounds = start + np.searchsorted(cyc, np.arange(n_cyc + 1))
-    amps, franges, energies = [], [], []
-    for k in range(n_cyc):
-        amps.append(0.5 * (np.nanmax(cx[k]) - np.nanmin(cx[k])))
-        franges.append(0.5 * (np.nanmax(cF[k]) - np.nanmin(cF[k])))
-        # the area of the cycle's own samples: bin means would cut the corners at the turns
-        a, b2 = int(bounds[k]), int(bounds[k + 1])
-        energies.append(loop_area(xa[a:b2], Fa[a:b2]) if b2 - a >= 3 else np.nan)
+    # sample index where each cycle starts (a cycle without samples starts where the next
+    # does), and where the last one ends
+    first = np.r_[sums["first"], end]
+    first = np.minimum.accumulate(np.where(first < 0, end, first)[::-1])[::-1]
+    bounds = first.astype(np.int64)
+    amps = 0.5 * (np.nanmax(cx, axis=1) - np.nanmin(cx, axis=1))
+    franges = 0.5 * (np.nanmax(cF, axis=1) - np.nanmin(cF, axis=1))
+    # the area of the cycle's own samples: bin means would cut the corners at the turns
+    energies = _core.loop_areas(xa, Fa, bounds.tolist())
     scatter = CycleScatter(
-        amplitude=np.asarray(amps),
-        force_range=np.asarray(franges),
-        energy=np.asarray(energies),
+        amplitude=amps,
+        force_range=franges,
+        energy=energies,
         period=np.diff(rev.peak_times),
         mean_force=_period_means(ta, Fa, rev.peak_times),
         mean_x=_period_means(ta, xa, rev.peak_times),
         time=0.5 * (rev.peak_times[:-1] + rev.peak_times[1:]),
     )
     phase = (np.arange(n_points) + 0.5) / n_points
-    phase_sq = np.bincount(b, frac * frac, n_points) / count
-    x_var = np.clip(np.bincount(b, xs * xs, n_points) / count - xm * xm, 0.0, None)
+    phase_sq = sums["sum_phase2"] / count
+    x_var = np.clip(sums["sum_xx"] / count - xm * xm, 0.0, None)
     return AveragedLoop(
         phase,
         xm,

@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from .frame import _coeffs, _savgol, difference_noise, lepski_window
+from .frame import difference_noise, lepski_window, savgol_coefficients, savgol_derivative
 from .model import area_ratio
 from .preprocess import AveragedLoop, Reversals
 
@@ -88,8 +88,8 @@ def velocity(t: np.ndarray | None, x: np.ndarray) -> tuple[np.ndarray, float, in
     dt = float(np.median(np.diff(tt)))
     sx = difference_noise(x)
     window = min(lepski_window(x, dt, sx), max(5, (x.size // 2) * 2 - 1))
-    v = _savgol(x, window, 1, dt)
-    thr = VELOCITY_SIGMAS * sx * float(np.linalg.norm(_coeffs(window, 1, dt)))
+    v = savgol_derivative(x, window, 1, dt)
+    thr = VELOCITY_SIGMAS * sx * float(np.linalg.norm(savgol_coefficients(window, 1, dt)))
     if not thr > 0:  # no measurable noise: a smooth turn crosses zero within a sample
         thr = 1e-9 * float(np.max(np.abs(v)))
     return v, thr, window
@@ -291,14 +291,17 @@ def classify(
     F: np.ndarray,
     t: np.ndarray | None,
     rev: Reversals,
+    x_raw: np.ndarray | None = None,
 ) -> Regime:
     """Decide the regime from ``z`` (the fit's when identified, else the area ratio's), the
-    plateau and the sticks."""
+    plateau and the sticks. ``x_raw``: the displacement before drift removal, for the
+    velocity (a removed drift would make a stuck plate creep at the drift's rate)."""
     if z_fit is not None and math.isfinite(z_fit):
         z, src = float(z_fit), "fit"
     else:
         z, src = z_from_area_ratio(ratio), "loop area"
-    v, thr, window = velocity(t, x) if x.size >= 20 else (np.zeros(x.size), 0.0, 5)
+    xv = x if x_raw is None else x_raw
+    v, thr, window = velocity(t, xv) if xv.size >= 20 else (np.zeros(xv.size), 0.0, 5)
     pl = plateau(loop, x, F, v, thr) if (loop is not None and z >= GROSS_SLIDING_Z) else None
     st = stick_slip(t, x, F, rev, v, thr, window, pl.offset if pl is not None else 0.0)
     zt = f"ac·A = {z:.3g} (from the {src}; loop area {100 * ratio:.0f}% of the rectangle 4·A·h_m)"

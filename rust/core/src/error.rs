@@ -53,6 +53,9 @@ pub enum CoreError {
         index: usize,
         value: f64,
     },
+    /// A signal is too long for the sample counter (global indices must fit in 63 bits).
+    #[error("a chunk of {len} samples would overflow the operator's sample counter")]
+    TooLong { len: usize },
     /// A stiffness function is not positive where it is evaluated.
     #[error("stiffness is not positive ({value}) at {name} = {at}")]
     NonPositiveStiffness {

@@ -133,12 +133,16 @@ pub enum Closure {
 
 /// Receives loop closures as the operator runs (rainflow-style cycle counting).
 pub trait Observer {
+    /// True when closures are ignored: the force kernel may then defer the forces of new
+    /// reversals (closures would report them as NaN).
+    const IGNORES: bool = false;
     fn closed(&mut self, closure: Closure);
 }
 
 /// The observer that ignores everything; the force kernel uses it (and compiles it away).
 pub struct NoObserver;
 impl Observer for NoObserver {
+    const IGNORES: bool = true;
     #[inline(always)]
     fn closed(&mut self, _: Closure) {}
 }
@@ -149,94 +153,205 @@ impl<F: FnMut(Closure)> Observer for F {
     }
 }
 
-/// The current branch anchor `(x_a, h_a)`, its scale and its closure target.
+/// How a branch is drawn from its anchor reversal `(x_a, h_a)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BranchRule {
+    /// `h = h_a + λ f((x - x_a) / λ)`: Masing's rule for `λ = 2`, the generalised (non-Masing)
+    /// operator otherwise, which jumps where a branch rejoins the virgin curve.
+    Scaled(f64),
+    /// `h = h_a + (h_t - h_a) f((x - x_a)/λ) / f((x_t - x_a)/λ)`: the λ-scaled branch shape
+    /// anchored at both ends, the reversal `(x_a, h_a)` and the target `(x_t, h_t)` the memory
+    /// rules say it ends at (the older reversal, or the mirrored first reversal on the virgin
+    /// curve). Loops close for every `λ`; `λ = 2` is Masing's branch (PHYSICS.md §1).
+    Anchored(f64),
+}
+
+impl BranchRule {
+    fn lambda(self) -> f64 {
+        match self {
+            Self::Scaled(l) | Self::Anchored(l) => l,
+        }
+    }
+}
+
+/// No pending sample: the value is known.
+const KNOWN: u32 = u32::MAX;
+
+/// The current branch: `h = base + mul · f((x - xa) · inv)` with `base` the anchor's force
+/// `ha`, or, while that force is still deferred, the output of in-block sample `src`.
 #[derive(Clone, Copy)]
 struct Branch {
     xa: f64,
     ha: f64,
-    scale: f64,
-    inv_scale: f64,
+    src: u32,
+    mul: f64,
+    inv: f64,
     /// Input value at which this branch closes (±inf: never).
     target: f64,
 }
 
-#[inline]
-fn branch_of(stack: &[Reversal], dir: f64, scale: f64, inv_scale: f64) -> Branch {
-    let n = stack.len();
-    let (anchor, target) = match n {
-        0 => {
-            let never = if dir >= 0.0 {
-                f64::INFINITY
-            } else {
-                f64::NEG_INFINITY
-            };
-            return Branch {
-                xa: 0.0,
-                ha: 0.0,
-                scale: 1.0,
-                inv_scale: 1.0,
-                target: never,
-            };
-        }
-        1 => (stack[0], -stack[0].x),
-        _ => (stack[n - 1], stack[n - 2].x),
-    };
-    Branch {
-        xa: anchor.x,
-        ha: anchor.h,
-        scale,
-        inv_scale,
-        target,
-    }
+/// A stretch of a block on one branch: its samples have `h = base + mul · f(u)` (`base` as
+/// in [`Branch`]).
+#[derive(Clone, Copy)]
+struct Run {
+    ha: f64,
+    src: u32,
+    mul: f64,
 }
 
-/// One step of the operator: stepping separate from driving, so the force kernel and the
-/// cycle counter share the rules. The fast path (same direction, no closure) is inlined; the
-/// rare events are not.
+/// Samples per block of the force kernel: the curve arguments of one block and its run table
+/// stay in L1 between the sequential pass and the vectorised curve pass.
+const BLOCK: usize = 512;
+
+/// One step of the operator: stepping separate from driving, so the force kernel, the cycle
+/// counter and the branch-memory export share the rules. The fast path (same direction, no
+/// closure) is inlined; the rare events are not.
+///
+/// In lazy mode (the force kernel with Masing's scaled rule) a new reversal's force is not
+/// evaluated when it is found: it is the output of the previous sample, which the block's
+/// curve pass computes anyway; the reversal refers to that sample (`srcs`) until the block
+/// ends. Otherwise (cycle counting, the anchored rule whose branch factor needs the forces at
+/// once) it is evaluated on the spot with the same expression, so both agree bit for bit.
 struct Stepper<'a, C: Backbone> {
     curve: &'a C,
-    scale: f64,
-    inv_scale: f64,
+    rule: BranchRule,
+    inv_lambda: f64,
+    /// Record runs of samples on one branch (the force kernel).
+    track: bool,
+    /// Defer reversal forces to the block's curve pass (Masing's scaled rule, no observer).
+    defer: bool,
     xp: f64,
-    hp: f64,
     /// +1, -1, or 0 before the first move.
     dir: f64,
     br: Branch,
+    /// Curve argument of the last sample (on branch `br`).
+    u: f64,
+    /// Force of the sample before the current block (known).
+    h_before: f64,
+    /// Position of the current sample in its block.
+    pos: u32,
+    /// Index in `runs` of the current run.
+    run: u16,
     stack: &'a mut Vec<Reversal>,
+    /// Per stack entry: in-block sample whose output is its force, or `KNOWN`.
+    srcs: Vec<u32>,
+    runs: Vec<Run>,
 }
 
 impl<'a, C: Backbone> Stepper<'a, C> {
-    fn new(curve: &'a C, scale: f64, state: &'a mut MasingState) -> Self {
+    fn new(
+        curve: &'a C,
+        rule: BranchRule,
+        track: bool,
+        defer: bool,
+        state: &'a mut MasingState,
+    ) -> Self {
         let dir = f64::from(state.dir);
-        let inv_scale = 1.0 / scale;
-        let br = branch_of(&state.stack, dir, scale, inv_scale);
-        Self {
+        let inv_lambda = 1.0 / rule.lambda();
+        let srcs = vec![KNOWN; state.stack.len()];
+        let mut st = Self {
             curve,
-            scale,
-            inv_scale,
+            rule,
+            inv_lambda,
+            track,
+            defer: track && defer && matches!(rule, BranchRule::Scaled(_)),
             xp: state.x,
-            hp: state.h,
             dir,
-            br,
+            br: Branch {
+                xa: 0.0,
+                ha: 0.0,
+                src: KNOWN,
+                mul: 1.0,
+                inv: 1.0,
+                target: f64::INFINITY,
+            },
+            u: 0.0,
+            h_before: state.h,
+            pos: 0,
+            run: 0,
             stack: &mut state.stack,
+            srcs,
+            runs: Vec::with_capacity(if track { BLOCK + 1 } else { 0 }),
+        };
+        st.br = st.branch(dir);
+        // The state's force is the last output of the branch its stack defines (bit for bit
+        // when the state came from this kernel); continuing from the branch keeps chunked
+        // and one-pass runs identical.
+        st.u = (st.xp - st.br.xa) * st.br.inv;
+        st
+    }
+
+    /// Force of the last sample, evaluated now (only valid when it is not deferred).
+    #[inline]
+    fn last_value(&self) -> f64 {
+        self.br.ha + self.br.mul * self.curve.eval(self.u)
+    }
+
+    /// The branch the stack defines when moving in direction `dir`.
+    #[inline]
+    fn branch(&self, dir: f64) -> Branch {
+        let stack = &self.stack;
+        let n = stack.len();
+        let (k, target) = match n {
+            0 => {
+                let never = if dir >= 0.0 {
+                    f64::INFINITY
+                } else {
+                    f64::NEG_INFINITY
+                };
+                return Branch {
+                    xa: 0.0,
+                    ha: 0.0,
+                    src: KNOWN,
+                    mul: 1.0,
+                    inv: 1.0,
+                    target: never,
+                };
+            }
+            1 => (0, -stack[0].x),
+            _ => (n - 1, stack[n - 2].x),
+        };
+        let anchor = stack[k];
+        let mul = match self.rule {
+            BranchRule::Scaled(l) => l,
+            BranchRule::Anchored(_) => {
+                let ht = if n == 1 {
+                    self.curve.eval(target)
+                } else {
+                    stack[n - 2].h
+                };
+                let den = self.curve.eval((target - anchor.x) * self.inv_lambda);
+                if den == 0.0 {
+                    0.0
+                } else {
+                    (ht - anchor.h) / den
+                }
+            }
+        };
+        Branch {
+            xa: anchor.x,
+            ha: anchor.h,
+            src: self.srcs[k],
+            mul,
+            inv: self.inv_lambda,
+            target,
         }
     }
 
+    /// Advance to input `xi` (global sample `index`); the curve argument is left in `self.u`.
     #[inline(always)]
-    fn step<O: Observer>(&mut self, xi: f64, index: u64, observer: &mut O) -> f64 {
+    fn advance<O: Observer>(&mut self, xi: f64, index: u64, observer: &mut O) {
         let dx = xi - self.xp;
         // Fast path: moving on along the branch without reaching its closure point
         // (closure uses >= so that exactly repeated extremes close the loop).
         if !(dx * self.dir > 0.0 && (xi - self.br.target) * self.dir < 0.0) {
             if dx == 0.0 {
-                return self.hp; // zero-length steps change nothing
+                return; // zero-length steps change nothing
             }
             self.event(xi, dx, index, observer);
         }
-        let br = &self.br;
-        self.hp = br.ha + br.scale * self.curve.eval((xi - br.xa) * br.inv_scale);
+        self.u = (xi - self.br.xa) * self.br.inv;
         self.xp = xi;
-        self.hp
     }
 
     /// A reversal and/or one or more loop closures at sample `index`.
@@ -245,41 +360,122 @@ impl<'a, C: Backbone> Stepper<'a, C> {
         let s = if dx > 0.0 { 1.0 } else { -1.0 };
         if s != self.dir {
             if self.dir != 0.0 {
+                // The reversal is the previous sample; its force is deferred when it lies in
+                // this block and the kernel evaluates the block later.
+                let (h, src) = if !self.defer {
+                    (self.last_value(), KNOWN)
+                } else if self.pos == 0 {
+                    (self.h_before, KNOWN)
+                } else {
+                    (f64::NAN, self.pos - 1)
+                };
                 self.stack.push(Reversal {
                     x: self.xp,
-                    h: self.hp,
+                    h,
                     index: index.saturating_sub(1),
                 });
+                self.srcs.push(src);
             }
             self.dir = s;
-            self.br = branch_of(self.stack, s, self.scale, self.inv_scale);
         }
-        while (xi - self.br.target) * s >= 0.0 {
+        // Wipe out every loop this step closes; the branch is rebuilt once, at the end.
+        loop {
             let n = self.stack.len();
+            let target = match n {
+                0 => break,
+                1 => -self.stack[0].x,
+                _ => self.stack[n - 2].x,
+            };
+            if (xi - target) * s < 0.0 {
+                break;
+            }
             if n == 1 {
                 let from = self.stack[0];
                 self.stack.clear();
+                self.srcs.clear();
                 observer.closed(Closure::Virgin { from, index });
             } else {
                 let newer = self.stack[n - 1];
                 let older = self.stack[n - 2];
                 self.stack.truncate(n - 2);
+                self.srcs.truncate(n - 2);
                 observer.closed(Closure::Inner {
                     older,
                     newer,
                     index,
                 });
             }
-            self.br = branch_of(self.stack, s, self.scale, self.inv_scale);
+        }
+        self.br = self.branch(s);
+        if self.track {
+            self.runs.push(Run {
+                ha: self.br.ha,
+                src: self.br.src,
+                mul: self.br.mul,
+            });
+            // At most one run per sample plus the block's first: BLOCK + 1 < 2^16.
+            self.run = (self.runs.len() - 1) as u16;
+        }
+    }
+
+    /// Start a block: its first run is the current branch.
+    fn begin_block(&mut self) {
+        self.pos = 0;
+        self.run = 0;
+        self.runs.clear();
+        self.runs.push(Run {
+            ha: self.br.ha,
+            src: self.br.src,
+            mul: self.br.mul,
+        });
+    }
+
+    /// End a block whose outputs are `out`: resolve the deferred forces it refers to.
+    fn end_block(&mut self, out: &[f64]) {
+        for (r, src) in self.stack.iter_mut().zip(self.srcs.iter_mut()).rev() {
+            if *src == KNOWN {
+                break; // deferred entries are the newest ones
+            }
+            r.h = out[*src as usize];
+            *src = KNOWN;
+        }
+        if self.br.src != KNOWN {
+            self.br.ha = out[self.br.src as usize];
+            self.br.src = KNOWN;
+        }
+        if let Some(&h) = out.last() {
+            self.h_before = h;
         }
     }
 }
 
-/// Run the operator over `x`, writing forces to `out` (when given) and reporting closures.
-///
-/// The history continues from `state`, which is updated; processing a signal in chunks with
-/// the state carried over gives bit-identical results to one pass. On error the state is
-/// unchanged.
+/// Curve pass of one block, free of data-dependent branches however short the branches of
+/// the signal are: `out[i] = f(u[i])` over the whole block (auto-vectorised for the
+/// exponential curve); then each run's base is resolved in order (a deferred base is the
+/// output of an earlier sample, itself `base + mul · f(u)` of an earlier run); then
+/// `out[i] = base + mul · out[i]` with the run of sample `i` looked up in `rid`.
+#[inline(always)]
+fn eval_block<C: Backbone>(curve: &C, runs: &mut [Run], u: &[f64], rid: &[u16], out: &mut [f64]) {
+    for (o, &v) in out.iter_mut().zip(u) {
+        *o = curve.eval(v);
+    }
+    for k in 0..runs.len() {
+        let r = runs[k];
+        if r.src != KNOWN {
+            let s = r.src as usize;
+            let from = runs[rid[s] as usize];
+            runs[k].ha = from.ha + from.mul * out[s];
+            runs[k].src = KNOWN;
+        }
+    }
+    for (o, &k) in out.iter_mut().zip(rid) {
+        let r = &runs[k as usize];
+        *o = r.ha + r.mul * *o;
+    }
+}
+
+/// Run the operator over `x` with Masing's branch rule of scale `scale`, writing forces to
+/// `out` (when given) and reporting closures. See [`run_rule`].
 pub fn run<C: Backbone, O: Observer>(
     curve: &C,
     scale: f64,
@@ -288,36 +484,76 @@ pub fn run<C: Backbone, O: Observer>(
     state: &mut MasingState,
     observer: &mut O,
 ) -> Result<(), CoreError> {
-    check_positive("scale", scale)?;
+    run_rule(curve, BranchRule::Scaled(scale), x, out, state, observer)
+}
+
+fn checked_end(state: &MasingState, len: usize) -> Result<u64, CoreError> {
+    u64::try_from(len)
+        .ok()
+        .and_then(|n| state.count.checked_add(n))
+        .filter(|&e| i64::try_from(e).is_ok())
+        .ok_or(CoreError::TooLong { len })
+}
+
+/// Run the operator over `x` with branch rule `rule`, writing forces to `out` (when given) and
+/// reporting closures.
+///
+/// The history continues from `state`, which is updated; processing a signal in chunks with
+/// the state carried over gives bit-identical results to one pass. On error the state is
+/// unchanged.
+///
+/// With `out`, the kernel runs in two passes per block of samples: a sequential pass applies
+/// the memory rules and records each sample's curve argument and the runs of samples on one
+/// branch; then one loop per run evaluates the curve (auto-vectorised for the exponential
+/// curve, whose `1 - e^{-z}` is branch-free and needs no library call). Closures report
+/// reversal forces evaluated on the spot.
+pub fn run_rule<C: Backbone, O: Observer>(
+    curve: &C,
+    rule: BranchRule,
+    x: &[f64],
+    out: Option<&mut [f64]>,
+    state: &mut MasingState,
+    observer: &mut O,
+) -> Result<(), CoreError> {
+    check_positive("scale", rule.lambda())?;
     if let Some(o) = out.as_deref() {
         crate::error::check_same_len("x", x.len(), "out", o.len())?;
     }
     crate::error::check_finite("x", x)?;
-    let base = state.count;
     let saved = state.clone(); // restored when the forces overflow
     let mut range = Ok(());
-    // `state` has public fields: a count near u64::MAX must not wrap the sample indices.
-    let end = u64::try_from(x.len())
-        .ok()
-        .and_then(|n| base.checked_add(n))
-        .ok_or(CoreError::InvalidState {
-            reason: "sample count overflows",
-        })?;
-    let mut st = Stepper::new(curve, scale, state);
+    let end = checked_end(state, x.len())?;
+    let mut index = state.count;
+    let track = out.is_some();
+    let mut st = Stepper::new(curve, rule, track, O::IGNORES, state);
     match out {
         Some(out) => {
-            for ((i, &xi), o) in x.iter().enumerate().zip(out.iter_mut()) {
-                *o = st.step(xi, base + i as u64, observer);
+            let mut ub = [0.0_f64; BLOCK];
+            let mut rid = [0_u16; BLOCK];
+            for (xc, oc) in x.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
+                st.begin_block();
+                for ((&xi, u), r) in xc.iter().zip(ub.iter_mut()).zip(rid.iter_mut()) {
+                    st.advance(xi, index, observer);
+                    *u = st.u;
+                    *r = st.run;
+                    index += 1;
+                    st.pos += 1;
+                }
+                let m = xc.len();
+                eval_block(curve, &mut st.runs, &ub[..m], &rid[..m], oc);
+                st.end_block(oc);
             }
             range = crate::error::check_output("force", out);
         }
         None => {
-            for (i, &xi) in x.iter().enumerate() {
-                st.step(xi, base + i as u64, observer);
+            for &xi in x {
+                st.advance(xi, index, observer);
+                index += 1;
             }
         }
     }
-    let (xp, hp, dir) = (st.xp, st.hp, st.dir);
+    let (xp, dir) = (st.xp, st.dir);
+    let hp = st.last_value();
     if let Err(e) = range {
         *state = saved;
         return Err(e);
@@ -338,6 +574,75 @@ pub fn masing_force<C: Backbone>(
     state: &mut MasingState,
 ) -> Result<(), CoreError> {
     run(curve, scale, x, Some(out), state, &mut NoObserver)
+}
+
+/// Forces for `x` under branch rule `rule`, continuing from `state`.
+pub fn masing_force_rule<C: Backbone>(
+    curve: &C,
+    rule: BranchRule,
+    x: &[f64],
+    out: &mut [f64],
+    state: &mut MasingState,
+) -> Result<(), CoreError> {
+    run_rule(curve, rule, x, Some(out), state, &mut NoObserver)
+}
+
+/// A curve that is zero everywhere: drives the memory rules when only the reversal bookkeeping
+/// is wanted.
+struct NoCurve;
+impl Backbone for NoCurve {
+    #[inline(always)]
+    fn eval(&self, _: f64) -> f64 {
+        0.0
+    }
+    fn slope(&self, _: f64) -> f64 {
+        0.0
+    }
+    fn integral(&self, _: f64) -> f64 {
+        0.0
+    }
+}
+
+/// Per-sample branch bookkeeping of the memory rules (the same rules, tie-breaking and state
+/// as the force kernel): `anchor[i]` is the global sample index of the reversal the branch at
+/// sample `i` starts from (`-1` on the virgin curve); `target[i]` the index of the reversal it
+/// heads for, or `-1 - j` when it heads for the mirror `-x[j]` of the first reversal `j`.
+/// Streaming: `state` carries the memory across chunks (its forces are not computed).
+pub fn branch_memory(
+    x: &[f64],
+    anchor: &mut [i64],
+    target: &mut [i64],
+    state: &mut MasingState,
+) -> Result<(), CoreError> {
+    crate::error::check_same_len("x", x.len(), "anchor", anchor.len())?;
+    crate::error::check_same_len("x", x.len(), "target", target.len())?;
+    crate::error::check_finite("x", x)?;
+    let base = state.count;
+    let n = u64::try_from(x.len()).map_err(|_| CoreError::TooLong { len: x.len() })?;
+    let end = base
+        .checked_add(n)
+        .ok_or(CoreError::TooLong { len: x.len() })?;
+    if i64::try_from(end).is_err() {
+        return Err(CoreError::TooLong { len: x.len() });
+    }
+    let mut st = Stepper::new(&NoCurve, BranchRule::Scaled(2.0), false, false, state);
+    let samples = x.iter().zip(anchor.iter_mut()).zip(target.iter_mut());
+    for (index, ((&xi, a), t)) in (base..).zip(samples) {
+        st.advance(xi, index, &mut NoObserver);
+        let s = &st.stack;
+        // Indices fit in i64: checked against `end` above.
+        (*a, *t) = match s.len() {
+            0 => (-1, -1),
+            1 => (s[0].index as i64, -1 - s[0].index as i64),
+            k => (s[k - 1].index as i64, s[k - 2].index as i64),
+        };
+    }
+    let (xp, dir) = (st.xp, st.dir);
+    state.x = xp;
+    state.h = 0.0;
+    state.dir = dir as i8;
+    state.count = end;
+    Ok(())
 }
 
 /// One closed cycle found by [`cycle_energies`].

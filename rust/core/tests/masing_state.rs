@@ -28,18 +28,14 @@ fn a_count_that_would_wrap_is_an_error_and_leaves_the_state() {
     };
     let before = st.clone();
     let r = masing_force(&c, 2.0, &[0.1, 0.2, 0.1], &mut out, &mut st);
-    assert_eq!(
-        r,
-        Err(CoreError::InvalidState {
-            reason: "sample count overflows"
-        })
-    );
+    assert_eq!(r, Err(CoreError::TooLong { len: 3 }));
     assert_eq!(st, before);
-    // Up to the last representable index it still runs.
+    // Global sample indices must fit in 63 bits: up to i64::MAX it still runs.
+    let last = u64::try_from(i64::MAX).unwrap();
     let mut st = MasingState {
-        count: u64::MAX - 3,
+        count: last - 3,
         ..MasingState::default()
     };
     masing_force(&c, 2.0, &[0.1, 0.2, 0.1], &mut out, &mut st).unwrap();
-    assert_eq!(st.count, u64::MAX);
+    assert_eq!(st.count, last);
 }

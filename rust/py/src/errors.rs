@@ -55,3 +55,8 @@ pub fn slice<'a>(a: &'a PyReadonlyArray1<'_, f64>, name: &'static str) -> PyResu
 pub fn internal(py: Python<'_>, msg: &str) -> PyErr {
     make(py, 0, msg.to_string())
 }
+
+/// `InputError` with a message (bad arguments the binding itself detects).
+pub fn input(py: Python<'_>, msg: &str) -> PyErr {
+    make(py, 1, msg.to_string())
+}

@@ -6,7 +6,7 @@
 
 use contactlab_core::{
     curve::{Backbone, Exponential, Tabulated},
-    masing, CoreError, MasingState,
+    masing, BranchRule, CoreError, MasingState,
 };
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -15,6 +15,7 @@ use pyo3::types::PyDict;
 
 mod errors;
 mod normal;
+mod signal;
 mod structure;
 use errors::{internal, slice, to_pyerr};
 
@@ -36,7 +37,7 @@ pub(crate) fn detach_guarded<T: Send, F: FnOnce() -> Result<T, CoreError> + Send
 
 /// A virgin curve: the exponential curve or a tabulated backbone.
 #[derive(Clone)]
-enum Curve {
+pub(crate) enum Curve {
     Exp(Exponential),
     Tab(Tabulated),
 }
@@ -52,10 +53,22 @@ macro_rules! with_curve {
 
 /// Masing operator with non-local memory and a carried state (one instance per recording).
 #[pyclass(module = "contactlab._core")]
-struct MasingCore {
+pub(crate) struct MasingCore {
     curve: Curve,
     scale: f64,
+    /// Branches anchored at both ends (`BranchRule::Anchored`) instead of Masing's scaled rule.
+    anchored: bool,
     state: MasingState,
+}
+
+impl MasingCore {
+    pub(crate) fn rule(&self) -> BranchRule {
+        if self.anchored {
+            BranchRule::Anchored(self.scale)
+        } else {
+            BranchRule::Scaled(self.scale)
+        }
+    }
 }
 
 #[pymethods]
@@ -68,6 +81,7 @@ impl MasingCore {
         Ok(Self {
             curve: Curve::Exp(curve),
             scale,
+            anchored: false,
             state: MasingState::default(),
         })
     }
@@ -87,39 +101,51 @@ impl MasingCore {
         Ok(Self {
             curve: Curve::Tab(curve),
             scale,
+            anchored: false,
             state: MasingState::default(),
         })
     }
 
-    /// A copy with the same curve and scale, state reset to the origin.
-    fn fresh(&self) -> Self {
+    /// A copy with the same curve and scale, state reset to the origin; `anchored` selects
+    /// the branch rule (default: keep this one's).
+    #[pyo3(signature = (anchored=None))]
+    fn fresh(&self, anchored: Option<bool>) -> Self {
         Self {
             curve: self.curve.clone(),
             scale: self.scale,
+            anchored: anchored.unwrap_or(self.anchored),
             state: MasingState::default(),
         }
     }
 
-    /// Forces for the chunk `x`, continuing the carried history.
+    /// Forces for the chunk `x`, continuing the carried history; into `out` when given
+    /// (same length, contiguous float64), else into a new array.
+    #[pyo3(signature = (x, out=None))]
     fn push<'py>(
         &mut self,
         py: Python<'py>,
         x: PyReadonlyArray1<'py, f64>,
+        out: Option<Bound<'py, PyArray1<f64>>>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let xs = slice(&x, "x")?;
-        // The output is allocated by numpy, which asks the OS for transparent huge pages on
+        // A new output is allocated by numpy, which asks the OS for transparent huge pages on
         // large arrays: on this kind of machine, first-touch page faults and TLB misses on a
         // fresh 80 MB Vec cost as much as the kernel itself.
-        let arr = PyArray1::<f64>::zeros(py, xs.len(), false);
+        let arr = match out {
+            Some(a) => a,
+            None => PyArray1::<f64>::zeros(py, xs.len(), false),
+        };
         let mut st = self.state.clone();
-        let (curve, scale) = (&self.curve, self.scale);
+        let (curve, rule) = (&self.curve, self.rule());
         {
-            let mut rw = arr.readwrite();
+            let mut rw = arr.try_readwrite().map_err(|_| {
+                errors::input(py, "out must be a writeable array not shared with x")
+            })?;
             let out = rw
                 .as_slice_mut()
-                .map_err(|_| internal(py, "fresh output not contiguous"))?;
+                .map_err(|_| errors::input(py, "out must be contiguous"))?;
             st = detach_guarded(py, || {
-                with_curve!(curve, c => masing::masing_force(c, scale, xs, out, &mut st))?;
+                with_curve!(curve, c => masing::masing_force_rule(c, rule, xs, out, &mut st))?;
                 Ok(st)
             })?;
         }
@@ -135,6 +161,12 @@ impl MasingCore {
         x: PyReadonlyArray1<'py, f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let xs = slice(&x, "x")?;
+        if self.anchored {
+            return Err(errors::input(
+                py,
+                "cycle energies are defined for Masing's scaled branches, not anchored ones",
+            ));
+        }
         let mut st = self.state.clone();
         let (curve, scale) = (&self.curve, self.scale);
         let (cycles, st) = detach_guarded(py, || {
@@ -203,38 +235,16 @@ impl MasingCore {
     fn scale(&self) -> f64 {
         self.scale
     }
-
-    /// Run the kernel on `x` `repeat` times from the origin, each time into a fresh
-    /// numpy-allocated output as `push` does, and return the best wall time in seconds measured
-    /// inside Rust. Benchmarks compare it with the whole Python call: the difference is what
-    /// calling from Python adds.
-    fn time_kernel(
-        &self,
-        py: Python<'_>,
-        x: PyReadonlyArray1<'_, f64>,
-        repeat: usize,
-    ) -> PyResult<f64> {
-        let xs = slice(&x, "x")?;
-        let (curve, scale) = (&self.curve, self.scale);
-        let mut best = f64::INFINITY;
-        for _ in 0..repeat.max(1) {
-            let t0 = std::time::Instant::now();
-            let arr = PyArray1::<f64>::zeros(py, xs.len(), false);
-            let mut rw = arr.readwrite();
-            let out = rw
-                .as_slice_mut()
-                .map_err(|_| internal(py, "fresh output not contiguous"))?;
-            detach_guarded(py, || {
-                let mut st = MasingState::default();
-                with_curve!(curve, c => masing::masing_force(c, scale, xs, out, &mut st))
-            })?;
-            best = best.min(t0.elapsed().as_secs_f64());
-        }
-        Ok(best)
-    }
 }
 
 impl MasingCore {
+    /// Forces of `x` from the origin (no carried state): one channel of `force_many`.
+    pub(crate) fn force_from_origin(&self, x: &[f64], out: &mut [f64]) -> Result<(), CoreError> {
+        let mut st = MasingState::default();
+        let rule = self.rule();
+        with_curve!(&self.curve, c => masing::masing_force_rule(c, rule, x, out, &mut st))
+    }
+
     fn map<'py>(
         &self,
         py: Python<'py>,
@@ -286,5 +296,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(loop_area_py, m)?)?;
     normal::register(m)?;
     structure::register(m)?;
+    signal::register(m)?;
     Ok(())
 }

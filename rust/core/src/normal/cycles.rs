@@ -9,6 +9,9 @@
 use crate::error::{check_finite, check_positive, CoreError};
 
 #[inline]
+// Index arithmetic only: `i < x.len()` and `x.len() >= 2` (checked by `sample_at` and
+// `fold_cycles`, the only callers), so no index over- or underflows.
+#[allow(clippy::arithmetic_side_effects)]
 fn slope(x: &[f64], i: usize) -> f64 {
     let n = x.len();
     if n == 2 {
@@ -42,6 +45,9 @@ pub fn sample_at(x: &[f64], pos: f64) -> Result<f64, CoreError> {
 
 /// [`sample_at`] for `x.len() >= 2` and a number `pos`.
 #[inline]
+// Index arithmetic only: `i < x.len()` and `x.len() >= 2` (checked by `sample_at` and
+// `fold_cycles`, the only callers), so no index over- or underflows.
+#[allow(clippy::arithmetic_side_effects)]
 fn interpolate(x: &[f64], pos: f64) -> f64 {
     let n = x.len();
     let i = (pos.floor() as usize).min(n - 1);
@@ -97,7 +103,8 @@ pub fn fold_cycles(
         })?;
     crate::error::check_same_len("n_cycles * n_bins", len, "out", out.len())?;
     let last = start + (n_cycles as f64) * period - period / n_bins as f64;
-    if last > (x.len() - 1) as f64 + 1e-9 {
+    let max_pos = x.len().saturating_sub(1) as f64; // len >= 2 here
+    if last > max_pos + 1e-9 {
         return Err(CoreError::InvalidParameter {
             name: "n_cycles",
             value: n_cycles as f64,
@@ -105,7 +112,6 @@ pub fn fold_cycles(
         });
     }
     let step = period / n_bins as f64;
-    let max_pos = (x.len() - 1) as f64;
     for (c, row) in out.chunks_exact_mut(n_bins).enumerate() {
         let base = start + c as f64 * period;
         for (j, o) in row.iter_mut().enumerate() {

@@ -58,13 +58,13 @@ pub struct Forcing<'a> {
 /// Check that `t` is finite and strictly increasing.
 pub fn check_time(t: &[f64]) -> Result<(), CoreError> {
     check_finite("t", t)?;
-    for i in 1..t.len() {
-        if t[i] <= t[i - 1] {
+    for (index, w) in (1..).zip(t.windows(2)) {
+        if w[1] <= w[0] {
             return Err(CoreError::NotIncreasing {
                 name: "t",
-                index: i,
-                value: t[i],
-                prev: t[i - 1],
+                index,
+                value: w[1],
+                prev: w[0],
             });
         }
     }
@@ -115,8 +115,11 @@ impl<'a> Forcing<'a> {
         self.p
     }
 
-    /// Slope at sample `i` (given, or `numpy.gradient(..., edge_order=2)`).
-    pub fn slope(&self, i: usize) -> f64 {
+    /// Slope at sample `i < len` (given, or `numpy.gradient(..., edge_order=2)`).
+    // Index arithmetic only: `i < len` (checked by the caller) and `len >= 2` (checked by
+    // `Forcing::new`), so no index over- or underflows.
+    #[allow(clippy::arithmetic_side_effects)]
+    pub(crate) fn slope(&self, i: usize) -> f64 {
         if let Some(d) = self.dpdt {
             return d[i];
         }
@@ -146,7 +149,10 @@ impl<'a> Forcing<'a> {
     }
 
     /// The interpolant on `[t_i, t_{i+1}]`, `i < len - 1`.
-    pub fn segment(&self, i: usize) -> Segment {
+    // Index arithmetic only: `i < len` (checked by the caller) and `len >= 2` (checked by
+    // `Forcing::new`), so no index over- or underflows.
+    #[allow(clippy::arithmetic_side_effects)]
+    pub(crate) fn segment(&self, i: usize) -> Segment {
         let (t0, t1) = (self.t[i], self.t[i + 1]);
         let (p0, p1) = (self.p[i], self.p[i + 1]);
         let h = t1 - t0;
@@ -170,8 +176,11 @@ impl<'a> Forcing<'a> {
         }
     }
 
-    /// `dp/dt` at sample `i` as the interpolant sees it (right-sided at the last sample).
-    pub fn sample_deriv(&self, i: usize) -> f64 {
+    /// `dp/dt` at sample `i < len` as the interpolant sees it (right-sided at the last sample).
+    // Index arithmetic only: `i < len` (checked by the caller) and `len >= 2` (checked by
+    // `Forcing::new`), so no index over- or underflows.
+    #[allow(clippy::arithmetic_side_effects)]
+    pub(crate) fn sample_deriv(&self, i: usize) -> f64 {
         match self.interp {
             Interp::Cubic => self.slope(i),
             Interp::Linear => {

@@ -217,8 +217,8 @@ fn rodas4_step(
     stats: &mut Stats,
 ) -> Option<(f64, f64)> {
     use rodas4::{A, ALPHA, C, GAMMA, GAMMA_I};
-    stats.njev += 1;
-    stats.nlu += 1;
+    stats.njev = stats.njev.saturating_add(1);
+    stats.nlu = stats.nlu.saturating_add(1);
     let g = 1.0 / (h * GAMMA) - jac;
     if !(g.is_finite() && g != 0.0) {
         return None;
@@ -235,7 +235,7 @@ fn rodas4_step(
             ci += C[i][j] * k[j];
         }
         let p = seg.value(t + ALPHA[i] * h);
-        stats.nfev += 1;
+        stats.nfev = stats.nfev.saturating_add(1);
         let fi = model.f(p, yi)?;
         k[i] = (fi + ci * hinv + h * GAMMA_I[i] * dfdt) * ginv;
     }
@@ -285,9 +285,9 @@ pub fn simulate(
     let mut attempts: u64 = 0;
     let mut last_rejected = false;
 
-    for i in 0..n - 1 {
+    // Interval i runs from t[i] to t_end = t[i + 1].
+    for (i, &t_end) in t[1..].iter().enumerate() {
         let seg = forcing.segment(i);
-        let t_end = t[i + 1];
         let mut tc = t[i];
         // Output at the start of the interval: δ and δ' = f(t_i, δ_i).
         let (p_i, dp_i) = seg.value_deriv(tc);
@@ -296,7 +296,7 @@ pub fn simulate(
             Err(e) if i > 0 => return stopped(e, tc, i, stats),
             Err(e) => return Err(e), // delta0 itself is outside the model's domain
         };
-        stats.nfev += 1;
+        stats.nfev = stats.nfev.saturating_add(1);
         delta[i] = y;
         velocity[i] = e.f;
         let (mut f0, mut jac, mut dfdt) = (e.f, e.jac, e.dfdt);
@@ -306,18 +306,18 @@ pub fn simulate(
                 let (p, dp) = seg.value_deriv(tc);
                 let e = match model.eval(p, dp, y) {
                     Ok(e) => e,
-                    Err(e) => return stopped(e, tc, i + 1, stats),
+                    Err(e) => return stopped(e, tc, i.saturating_add(1), stats),
                 };
-                stats.nfev += 1;
+                stats.nfev = stats.nfev.saturating_add(1);
                 (f0, jac, dfdt) = (e.f, e.jac, e.dfdt);
             }
             first = false;
             loop {
-                attempts += 1;
+                attempts = attempts.saturating_add(1);
                 if opts.max_steps > 0 && attempts > opts.max_steps {
                     return Ok(Outcome {
                         status: Status::MaxSteps { time: tc },
-                        n_out: i + 1,
+                        n_out: i.saturating_add(1),
                         stats,
                     });
                 }
@@ -332,13 +332,13 @@ pub fn simulate(
                 if h <= 4.0 * f64::EPSILON * tc.abs().max(remaining) {
                     return Ok(Outcome {
                         status: Status::StepSizeTooSmall { time: tc, step: h },
-                        n_out: i + 1,
+                        n_out: i.saturating_add(1),
                         stats,
                     });
                 }
                 match rodas4_step(model, &seg, tc, y, f0, jac, dfdt, h, opts, &mut stats) {
                     Some((y_new, err)) if err <= 1.0 => {
-                        stats.n_accepted += 1;
+                        stats.n_accepted = stats.n_accepted.saturating_add(1);
                         y = y_new;
                         tc = if lands { t_end } else { tc + h };
                         let mut fac = (0.9 / err.max(1e-10).sqrt().sqrt()).clamp(0.2, 6.0);
@@ -351,12 +351,12 @@ pub fn simulate(
                         break;
                     }
                     Some((_, err)) => {
-                        stats.n_rejected += 1;
+                        stats.n_rejected = stats.n_rejected.saturating_add(1);
                         last_rejected = true;
                         h_prop = h * (0.9 / err.sqrt().sqrt()).clamp(0.1, 0.9);
                     }
                     None => {
-                        stats.n_rejected += 1;
+                        stats.n_rejected = stats.n_rejected.saturating_add(1);
                         last_rejected = true;
                         h_prop = h * 0.25;
                     }
@@ -364,13 +364,13 @@ pub fn simulate(
             }
         }
     }
-    let last = n - 1;
+    let last = n.saturating_sub(1); // n >= 2 (Forcing::new)
     let p = forcing.values()[last];
     let e = match model.eval(p, forcing.sample_deriv(last), y) {
         Ok(e) => e,
         Err(e) => return stopped(e, t[last], last, stats),
     };
-    stats.nfev += 1;
+    stats.nfev = stats.nfev.saturating_add(1);
     delta[last] = y;
     velocity[last] = e.f;
     Ok(Outcome {

@@ -39,7 +39,7 @@ pub fn deriv(c: &[f64]) -> Vec<f64> {
 /// Coefficients of the antiderivative that vanishes at 0.
 pub fn integral(c: &[f64]) -> Vec<f64> {
     std::iter::once(0.0)
-        .chain(c.iter().enumerate().map(|(i, &a)| a / (i + 1) as f64))
+        .chain(c.iter().enumerate().map(|(i, &a)| a / (i as f64 + 1.0)))
         .collect()
 }
 

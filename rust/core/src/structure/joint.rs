@@ -8,7 +8,7 @@
 
 use crate::curve::{Backbone, Exponential, Tabulated};
 use crate::error::{check_finite, check_positive, CoreError};
-use crate::masing::{self, MasingState, NoObserver, Reversal};
+use crate::masing::{MasingState, Reversal};
 use crate::normal::poly;
 
 /// The virgin curve of a Masing joint.
@@ -37,6 +37,20 @@ impl Backbone for MasingCurve {
         match self {
             Self::Exp(c) => c.integral(u),
             Self::Tab(c) => c.integral(u),
+        }
+    }
+}
+
+impl MasingCurve {
+    /// `(f(u), f'(u))` with one transcendental call for the exponential curve.
+    #[inline]
+    fn eval_slope(&self, u: f64) -> (f64, f64) {
+        match self {
+            Self::Exp(c) => {
+                let em1 = (-c.ac * u.abs()).exp_m1(); // e^{-z} − 1
+                ((-c.h0 * em1).copysign(u), c.h0 * c.ac * (1.0 + em1))
+            }
+            Self::Tab(c) => (c.eval(u), c.slope(u)),
         }
     }
 }
@@ -194,11 +208,15 @@ pub struct Trial {
     pub kt: f64,
     /// `∂F/∂ḋ`.
     pub ct: f64,
+    /// Masing: `2 × (reversals kept) + (1 if the trial point pushed a reversal)`, so that
+    /// committing applies the same memory update without walking the branches again.
+    pub aux: usize,
 }
 
 /// Masing force and tangent at `x` from `state`, without changing the state (the branch logic
 /// of [`crate::masing`]: a reversal pushes the current point, reaching a closure target pops).
-fn masing_trial<C: Backbone>(curve: &C, scale: f64, st: &MasingState, x: f64) -> (f64, f64) {
+/// Returns `(f, slope, aux)` with `aux` as in [`Trial::aux`].
+fn masing_trial(curve: &MasingCurve, scale: f64, st: &MasingState, x: f64) -> (f64, f64, usize) {
     let dx = x - st.x;
     let dir = f64::from(st.dir);
     let s = if dx > 0.0 {
@@ -208,49 +226,37 @@ fn masing_trial<C: Backbone>(curve: &C, scale: f64, st: &MasingState, x: f64) ->
     } else {
         dir
     };
-    let extra = if s != dir && st.dir != 0 && dx != 0.0 {
-        Some(Reversal {
-            x: st.x,
-            h: st.h,
-            index: 0,
-        })
-    } else {
-        None
-    };
+    let pushed = s != dir && st.dir != 0 && dx != 0.0;
     let n = st.stack.len();
-    let get = |k: usize| -> Reversal {
+    let get = |k: usize| -> (f64, f64) {
         if k < n {
-            st.stack[k]
+            (st.stack[k].x, st.stack[k].h)
         } else {
-            extra.unwrap_or(Reversal {
-                x: st.x,
-                h: st.h,
-                index: 0,
-            })
+            (st.x, st.h)
         }
     };
-    let mut len = n + usize::from(extra.is_some());
+    let mut len = n + usize::from(pushed);
     loop {
-        let (xa, ha, sc, target) = match len {
+        let (xa, ha, target) = match len {
             0 => {
-                let f = curve.eval(x);
-                return (f, curve.slope(x));
+                let (f, k) = curve.eval_slope(x);
+                return (f, k, usize::from(pushed));
             }
             1 => {
                 let a = get(0);
-                (a.x, a.h, scale, -a.x)
+                (a.0, a.1, -a.0)
             }
             _ => {
                 let a = get(len - 1);
-                (a.x, a.h, scale, get(len - 2).x)
+                (a.0, a.1, get(len - 2).0)
             }
         };
-        if s != 0.0 && (x - target) * s >= 0.0 && dx != 0.0 {
+        if dx != 0.0 && (x - target) * s >= 0.0 {
             len -= if len == 1 { 1 } else { 2 };
             continue;
         }
-        let u = (x - xa) / sc;
-        return (ha + sc * curve.eval(u), curve.slope(u));
+        let (f, k) = curve.eval_slope((x - xa) / scale);
+        return (ha + scale * f, k, 2 * len + usize::from(pushed));
     }
 }
 
@@ -266,7 +272,8 @@ fn bw_rate(alpha: f64, beta: f64, gamma: f64, delta: f64, nu: f64, z: f64, s: f6
 }
 
 /// `z` after a monotone displacement increment `dd` from `z0` (classical RK4 in `d`, with
-/// enough sub-steps that `|dd| · |∂rate/∂z| ≤ 0.05` per sub-step).
+/// enough sub-steps that `|dd| · |∂rate/∂z| ≤ 0.2` per sub-step: local error ~1e-6
+/// relative, below the Newmark step's own error).
 fn bw_advance(p: (f64, f64, f64, f64, f64), z0: f64, dd: f64) -> f64 {
     let (alpha, beta, gamma, delta, nu) = p;
     if dd == 0.0 {
@@ -275,7 +282,7 @@ fn bw_advance(p: (f64, f64, f64, f64, f64), z0: f64, dd: f64) -> f64 {
     let s = dd.signum();
     let zr = (z0.abs() + alpha * dd.abs()).max(f64::MIN_POSITIVE);
     let lip = beta * (gamma.abs() + delta.abs()) * nu * zr.powf(nu - 1.0).min(1e300);
-    let m = ((dd.abs() * lip / 0.05).ceil()).clamp(1.0, 1000.0) as usize;
+    let m = ((dd.abs() * lip / 0.2).ceil()).clamp(1.0, 1000.0) as usize;
     let h = dd / m as f64;
     let g = |z: f64| bw_rate(alpha, beta, gamma, delta, nu, z, s);
     let mut z = z0;
@@ -295,22 +302,26 @@ impl JointLaw {
         let dd = d_new - d_old;
         match (self, state) {
             (Self::Masing { curve, scale }, JointState::Masing(st)) => {
-                let (f, kt) = masing_trial(curve, *scale, st, d_new);
-                Trial { f, kt, ct: 0.0 }
+                let (f, kt, aux) = masing_trial(curve, *scale, st, d_new);
+                Trial {
+                    f,
+                    kt,
+                    ct: 0.0,
+                    aux,
+                }
             }
             (Self::Jenkins { k, fs }, JointState::Slider(f0)) => {
                 let ft = f0 + k * dd;
                 if ft.abs() > *fs {
                     Trial {
                         f: fs.copysign(ft),
-                        kt: 0.0,
-                        ct: 0.0,
+                        ..Trial::default()
                     }
                 } else {
                     Trial {
                         f: ft,
                         kt: *k,
-                        ct: 0.0,
+                        ..Trial::default()
                     }
                 }
             }
@@ -344,18 +355,19 @@ impl JointLaw {
                 Trial {
                     f: z,
                     kt: kt.max(0.0),
-                    ct: 0.0,
+                    ..Trial::default()
                 }
             }
             (Self::KelvinVoigt { k, c }, _) => Trial {
                 f: k * d_new + c * v_new,
                 kt: *k,
                 ct: *c,
+                aux: 0,
             },
             (Self::Normal { force, slope, .. }, _) => Trial {
                 f: poly::eval(force, d_new),
                 kt: poly::eval(slope, d_new),
-                ct: 0.0,
+                ..Trial::default()
             },
             // A state of another law never reaches here (states are made by `fresh_state`).
             _ => Trial::default(),
@@ -372,9 +384,24 @@ impl JointLaw {
     ) -> Result<(), CoreError> {
         let dd = d_new - d_old;
         match (self, state) {
-            (Self::Masing { curve, scale }, JointState::Masing(st)) => {
-                let mut out = [0.0];
-                masing::run(curve, *scale, &[d_new], Some(&mut out), st, &mut NoObserver)
+            (Self::Masing { .. }, JointState::Masing(st)) => {
+                // The memory update the trial found (same rules as `masing::run`).
+                let dx = d_new - st.x;
+                if dx != 0.0 {
+                    if trial.aux & 1 == 1 {
+                        st.stack.push(Reversal {
+                            x: st.x,
+                            h: st.h,
+                            index: st.count.saturating_sub(1),
+                        });
+                    }
+                    st.stack.truncate(trial.aux / 2);
+                    st.dir = if dx > 0.0 { 1 } else { -1 };
+                    st.x = d_new;
+                    st.h = trial.f;
+                }
+                st.count = st.count.saturating_add(1);
+                Ok(())
             }
             (Self::Jenkins { .. } | Self::BoucWen { .. }, JointState::Slider(f)) => {
                 *f = trial.f;
@@ -471,6 +498,7 @@ pub struct Joint {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::masing;
 
     fn exp_curve() -> MasingCurve {
         MasingCurve::Exp(Exponential { h0: 40.0, ac: 4e4 })
@@ -498,6 +526,10 @@ mod tests {
                 out[0]
             );
             law.commit(&mut st, x, xn, &tr)?;
+            if let JointState::Masing(ms) = &st {
+                assert_eq!(ms.stack.len(), ref_state.stack.len());
+                assert_eq!(ms.dir, ref_state.dir);
+            }
             x = xn;
         }
         Ok(())
@@ -530,7 +562,7 @@ mod tests {
         for &d in &[1e-5, 1e-4, 1e-3] {
             let z = bw_advance((alpha, beta, gamma, delta, 1.0), 0.0, d);
             let exact = alpha / b * (1.0 - (-b * d).exp());
-            assert!((z - exact).abs() < 1e-9 * exact.abs(), "{z} vs {exact}");
+            assert!((z - exact).abs() < 1e-6 * exact.abs(), "{z} vs {exact}");
         }
     }
 

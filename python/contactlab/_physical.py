@@ -1,0 +1,54 @@
+"""Plausibility of a measured channel before any fit sees it.
+
+A fit given a constant channel, a channel of zeros or values near the float64 limits fails
+deep inside (singular Jacobians, overflowing squares, NaN bounds) with messages about its
+internals. These checks say what is wrong with the data instead, naming the channel, the
+value and the sample. ``1e100`` is far beyond any force (N), pressure (Pa) or displacement
+(m) a contact measurement records, yet leaves squares and products of two channels finite
+(float64 overflows near 1e308, so squares near 1e154).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import InputError
+
+MAX_MAGNITUDE = 1e100
+MIN_MAGNITUDE = 1e-100
+
+
+def check_channel(name: str, v: np.ndarray, unit: str, what: str) -> None:
+    """Refuse a channel that is out of any physical scale, zero throughout, or constant.
+
+    ``what`` names the sensor in the sentence (e.g. "force").
+
+    Examples
+    --------
+    >>> check_channel("F", np.full(5, 3.0), "N", "force")
+    Traceback (most recent call last):
+    ...
+    contactlab.errors.InputError: F does not vary (3 N in all 5 samples): ...
+    """
+    a = np.abs(v)
+    i = int(np.argmax(a))
+    big = float(a[i])
+    if big > MAX_MAGNITUDE:
+        raise InputError(
+            f"{name} reaches {float(v[i]):.3g} {unit} at sample {i}: beyond any physical "
+            f"{what}; a unit mix-up or a corrupt file?"
+        )
+    if big < MIN_MAGNITUDE:
+        raise InputError(
+            f"{name} is zero in all {v.size} samples: the {what} sensor recorded nothing, so "
+            "there is no loop to analyse"
+        )
+    spread = float(np.ptp(v))
+    if spread <= 1e-12 * big:
+        raise InputError(
+            f"{name} does not vary ({float(v[0]):.6g} {unit} in all {v.size} samples): the "
+            f"{what} sensor recorded no change, so there is no loop to analyse"
+        )
+
+
+__all__ = ["MAX_MAGNITUDE", "MIN_MAGNITUDE", "check_channel"]

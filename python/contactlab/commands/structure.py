@@ -1,0 +1,180 @@
+"""``contactlab identify FILE``: identify a structure with a joint from input and response;
+``contactlab simulate structure OUT --structure MODEL.json --input FILE``: predict.
+
+The record is a CSV whose first line names the columns (a leading ``#`` is allowed); units
+come from the column names (``x_mm``, ``u_force_N``, ``y [um]``) or default to SI.
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ._common import check_output_targets, command_line, describe, write_json
+
+_UNIT = re.compile(r"(?:\[([^\]]+)\]|_([A-Za-z]+))\s*$")
+
+
+def read_table(path: str) -> dict[str, np.ndarray]:
+    """Columns of a CSV (header line, optional ``#``), converted to SI from unit suffixes."""
+    from ..studies.manifest import unit_factor
+
+    p = Path(path)
+    try:
+        with p.open(encoding="utf-8", errors="replace") as fh:
+            header = fh.readline().lstrip("#").strip()
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read ({exc.strerror})") from None
+    names = [h.strip() for h in header.split(",")]
+    if len(names) < 2:
+        raise InputError(f"{path}: the first line must name the comma-separated columns")
+    try:
+        data = np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2)
+    except ValueError as exc:
+        raise InputError(f"{path}: not a numeric table: {exc}") from None
+    if data.shape[1] != len(names):
+        raise InputError(f"{path}: {len(names)} column names but {data.shape[1]} columns")
+    out = {}
+    for i, name in enumerate(names):
+        col = data[:, i]
+        bad = ~np.isfinite(col)
+        if bad.any():
+            raise InputError(f"{path}: column {name!r} row {int(np.argmax(bad)) + 2} not finite")
+        m = _UNIT.search(name)
+        factor = 1.0
+        if m:
+            unit = m.group(1) or m.group(2)
+            try:
+                factor = unit_factor(unit, f"{path}: column {name!r}")
+            except InputError:
+                factor = 1.0  # a word, not a unit (e.g. "_force")
+        out[name] = col * factor
+    return out
+
+
+def _pick(cols: dict[str, np.ndarray], want: str | None, guesses: tuple[str, ...], what: str,
+          path: str) -> str:  # fmt: skip
+    if want:
+        if want not in cols:
+            raise InputError(f"{path}: no column {want!r} (columns: {', '.join(cols)})")
+        return want
+    for g in guesses:
+        for name in cols:
+            low = name.lower()
+            if low.startswith(g) and not low.startswith(("t_", "time")) and low != "t":
+                return name
+    raise InputError(f"{path}: cannot tell which column is {what}; name it with --{what}")
+
+
+def _time(cols: dict[str, np.ndarray], args: argparse.Namespace, n: int, path: str) -> np.ndarray:
+    for name in cols:
+        if name.lower() in ("t", "time") or name.lower().startswith(("t_", "t [", "time")):
+            return cols[name]
+    if args.fs:
+        return np.arange(n) / args.fs
+    raise InputError(f"{path}: no time column (t, t_s, time); give the sampling rate --fs")
+
+
+def _identify(args: argparse.Namespace) -> int:
+    from ..report import commit_outputs
+    from .structure_verbs import identify_record
+
+    check_output_targets(json_out=args.json, report=args.report)
+    cols = read_table(args.file)
+    exc = args.excitation
+    ucol = _pick(cols, args.u, ("u", "f", "y_base", "base") if exc == "force" else
+                 ("y_base", "base", "y"), "u", args.file)  # fmt: skip
+    ycol = _pick(cols, args.y, ("y_disp", "y", "x") if exc == "force" else ("x", "y_disp"),
+                 "y", args.file)  # fmt: skip
+    if ucol == ycol:
+        raise InputError(f"{args.file}: input and response are the same column {ucol!r}")
+    u, y = cols[ucol], cols[ycol]
+    t = _time(cols, args, u.size, args.file)
+    cmd = command_line("identify", args.file, "--joint", args.joint, "--excitation", exc)
+    model, rep, summary = identify_record(
+        t, u, y, joint=args.joint, excitation=exc, mass=args.mass, holdout=args.holdout,
+        substeps=args.substeps, periodic=args.periodic, title=f"{Path(args.file).name}: "
+        f"{args.joint} joint", intro=f"Made by: {cmd}",
+    )  # fmt: skip
+    doc = model.to_dict()
+    doc["summary"] = summary
+    doc["columns"] = {"u": ucol, "y": ycol}
+    if args.json:
+        write_json(args.json, doc)
+    if args.report:
+        commit_outputs(args.report, rep.files())
+    if args.json != "-":
+        hold = summary.get("rms_holdout")
+        print(f"{args.joint}: RMS output error {summary['rms_train']:.4g} m (training)"
+              + (f", {hold:.4g} m (hold-out)" if hold is not None else "")
+              + f"; identified in {model.elapsed:.1f} s")  # fmt: skip
+    return 0
+
+
+def simulate_structure(args: argparse.Namespace) -> int:
+    """Handler of ``contactlab simulate structure OUT --structure MODEL --input FILE``."""
+    from .._io_atomic import write_text
+    from ..structure import IdentifiedModel, Structure
+
+    if not args.structure or not args.input:
+        raise InputError("simulate structure needs --structure MODEL.json and --input FILE")
+    doc_path = Path(args.structure)
+    try:
+        model: IdentifiedModel | None = IdentifiedModel.load(doc_path)
+    except InputError:
+        model = None
+    cols = read_table(args.input)
+    exc = model.excitation if model else ("base" if args.base else "force")
+    ucol = _pick(cols, args.u, ("u", "f") if exc == "force" else ("y_base", "base", "y"), "u",
+                 args.input)  # fmt: skip
+    u = cols[ucol]
+    t = _time(cols, args, u.size, args.input)
+    kw = {"force": u} if exc == "force" else {"base": u}
+    if model is not None:
+        r = model.simulate(t, periodic=args.periodic, **kw)
+    else:
+        s = Structure.load(doc_path)
+        r = s.simulate(t, periodic=args.periodic, **kw)
+    x = r.x.reshape(r.t.size, -1)
+    header = ["t [s]", f"u [{'N' if exc == 'force' else 'm'}]"]
+    header += [f"x{i} [m]" if x.shape[1] > 1 else "x [m]" for i in range(x.shape[1])]
+    header += [f"F_joint{j} [N]" for j in range(r.joint_force.shape[1])]
+    uu = u if not args.periodic else u[: r.t.size]
+    table = np.column_stack([r.t, uu[: r.t.size], x, r.joint_force])
+    lines = [",".join(header)] + [",".join(f"{v:.10g}" for v in row) for row in table]
+    path = write_text(args.out, "\n".join(lines) + "\n")
+    if not r.success:
+        raise InputError(f"simulation stopped early ({r.message}); wrote {r.t.size} samples")
+    print(f"wrote {path} ({r.t.size} samples)")
+    return 0
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "identify",
+        help="identify a structure with a joint (M, C, K and joint parameters) from a record",
+        description=describe(__doc__),
+    )
+    p.add_argument("file", metavar="FILE", help="CSV record (input and response columns)")
+    p.add_argument("--joint", default="bouc_wen",
+                   choices=("masing", "jenkins", "iwan", "bouc_wen", "kelvin_voigt", "normal",
+                            "linear"))  # fmt: skip
+    p.add_argument("--excitation", default="force", choices=("force", "base"))
+    p.add_argument("--u", help="input column (force, or base displacement)")
+    p.add_argument("--y", help="response column (displacement of the mass)")
+    p.add_argument("--fs", type=float, help="sampling rate (Hz) when there is no time column")
+    p.add_argument("--mass", type=float, help="known mass (kg), held fixed; needed for base")
+    p.add_argument("--holdout", type=float, default=0.0,
+                   help="fraction of the record (at its end) kept out of the fit and "
+                   "reported as hold-out error")  # fmt: skip
+    p.add_argument("--substeps", type=int, default=4, help="integration steps per sample")
+    p.add_argument("--periodic", action="store_true",
+                   help="the record holds whole periods of a periodic input (band-limited "
+                   "interpolation between samples)")  # fmt: skip
+    p.add_argument("--json", help="write the model (and summary) as JSON ('-': stdout)")
+    p.add_argument("--report", help="write report.html and figures/ into this folder")
+    p.set_defaults(handler=_identify)

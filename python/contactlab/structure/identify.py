@@ -1,0 +1,533 @@
+"""Identification of a single-DOF structure with a joint from its input and response.
+
+Output-error least squares (:func:`contactlab.fitting.least_squares_fit`): the model
+``m x'' + c x' + k x + F_joint = u`` (``excitation="force"``) or
+``m x'' + c (x' − y') + k (x − y) + F_joint = 0`` with the measured base motion ``y``
+(``excitation="base"``) is simulated by the Rust core and its displacement compared with the
+measured one. Fitted: ``m`` (unless given), ``c``, ``k``, the joint's parameters and the
+initial state ``x0``, ``v0``; standard errors, correlations and identifiability come from the
+fit. The output-error surface of a hysteretic joint has local minima (e.g. Bouc-Wen's γ, δ
+signs, a slip force above or below the excitation's reach), so several starts are fitted on a
+short stretch of the record and the best is refined on the whole of it.
+
+Starting values come from an equation-error fit of the linear model to the record
+(derivatives by finite differences), which also gives the force the joint must supply
+(``u − m x'' − c x' − k x``), the route that reconstructs the joint force from the equation
+of motion.
+
+Bouc-Wen: only the products ``β γ`` and ``β δ`` enter the law, so ``β`` is held at 1 and
+``γ``, ``δ`` carry the products (units 1/m^ν).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .._arrays import as_1d
+from .._io_atomic import write_text
+from ..errors import ContactLabError, InputError
+from ..fitting import FitResult, Parameter, least_squares_fit
+from .joints import iwan_uniform
+from .model import SimulationResult, Structure
+
+JOINTS = ("masing", "jenkins", "iwan", "bouc_wen", "kelvin_voigt", "normal", "linear")
+IWAN_ELEMENTS = 20
+
+
+@dataclass
+class IdentifiedModel:
+    """An identified SDOF structure with a joint; simulate it for new inputs.
+
+    Attributes
+    ----------
+    structure : Structure
+        The fitted structure (``M``, ``C``, ``K`` and the joint, dof 0 to ground).
+    joint : str
+    excitation : {"force", "base"}
+    fit : FitResult
+        Parameters with standard errors, correlations, identifiability.
+    x0, v0 : float
+        Estimated initial displacement and velocity of the record.
+    substeps : int
+        Integration steps per sample used in the fit (and by :meth:`simulate`).
+    interpolation : str
+        Input interpolation between samples used in the fit.
+    rms : float
+        RMS output error on the fitted record [m].
+    starts : list of dict
+        Each start's initial values and training cost (multi-start).
+    elapsed : float
+        Wall time of the identification [s].
+    """
+
+    structure: Structure
+    joint: str
+    excitation: str
+    fit: FitResult
+    x0: float = 0.0
+    v0: float = 0.0
+    substeps: int = 4
+    interpolation: str = "linear"
+    rms: float = math.nan
+    starts: list[dict[str, Any]] = field(default_factory=list)
+    elapsed: float = math.nan
+
+    def simulate(
+        self,
+        t: Any,
+        force: Any = None,
+        base: Any = None,
+        *,
+        periodic: bool = False,
+        x0: Any = None,
+        v0: Any = None,
+        interpolation: str | None = None,
+    ) -> SimulationResult:
+        """Response of the identified model to a new input (from rest unless ``x0``/``v0``).
+
+        ``force`` for a force-excited model, ``base`` (displacement) for a base-excited one.
+        Returns a :class:`SimulationResult` whose ``.x`` is the displacement at ``t``.
+        """
+        if self.excitation == "force" and force is None:
+            raise InputError("this model is force-excited: pass force=")
+        if self.excitation == "base" and base is None:
+            raise InputError("this model is base-excited: pass base=")
+        return self.structure.simulate(
+            t,
+            force=force,
+            base=base,
+            x0=x0,
+            v0=v0,
+            periodic=periodic,
+            substeps=self.substeps,
+            interpolation=interpolation or self.interpolation,
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "kind": "contactlab.structure.IdentifiedModel",
+            "joint": self.joint,
+            "excitation": self.excitation,
+            "structure": self.structure.to_dict(),
+            "x0": self.x0,
+            "v0": self.v0,
+            "substeps": self.substeps,
+            "interpolation": self.interpolation,
+            "rms": _num(self.rms),
+            "elapsed": _num(self.elapsed),
+            "fit": self.fit.to_dict(),
+            "starts": self.starts,
+            "units": {"x0": "m", "v0": "m/s", "rms": "m", "elapsed": "s"},
+        }
+
+    def save(self, path: str | Path) -> None:
+        """Write the model as JSON (atomically); :meth:`load` reads it back."""
+        write_text(path, json.dumps(self.to_dict(), indent=2))
+
+    @classmethod
+    def load(cls, path: str | Path) -> IdentifiedModel:
+        try:
+            d = json.loads(Path(path).read_text())
+        except (OSError, json.JSONDecodeError) as exc:
+            raise InputError(f"cannot read model JSON {path}: {exc}") from None
+        return cls.from_dict(d)
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> IdentifiedModel:
+        try:
+            s = Structure.from_dict(d["structure"])
+            fd = d["fit"]
+            params = {
+                p["name"]: Parameter(
+                    name=p["name"],
+                    value=float(p["value"]),
+                    stderr=p.get("stderr"),
+                    vary=bool(p.get("vary", True)),
+                    identifiable=p.get("identifiable"),
+                    note=p.get("note", ""),
+                    unit=p.get("unit", ""),
+                )
+                for p in fd["params"].values()
+            } if isinstance(fd.get("params"), dict) else {}  # fmt: skip
+            fit = FitResult(
+                params=params,
+                var_names=list(fd.get("var_names", [])),
+                covar=None,
+                correl=None,
+                chisqr=float(fd.get("chisqr") or math.nan),
+                redchi=float(fd.get("redchi") or math.nan),
+                aic=float(fd.get("aic") or math.nan),
+                bic=float(fd.get("bic") or math.nan),
+                ndata=int(fd.get("ndata", 0)),
+                nvarys=int(fd.get("nvarys", 0)),
+                success=bool(fd.get("success", True)),
+                status=int(fd.get("status", 0)),
+                message=str(fd.get("message", "")),
+                nfev=int(fd.get("nfev", 0)),
+                residual=np.zeros(0),
+            )
+            return cls(
+                structure=s,
+                joint=str(d["joint"]),
+                excitation=str(d["excitation"]),
+                fit=fit,
+                x0=float(d.get("x0", 0.0)),
+                v0=float(d.get("v0", 0.0)),
+                substeps=int(d.get("substeps", 1)),
+                interpolation=str(d.get("interpolation", "linear")),
+                rms=float(d.get("rms") or math.nan),
+                starts=list(d.get("starts", [])),
+                elapsed=float(d.get("elapsed") or math.nan),
+            )
+        except (KeyError, TypeError, ValueError) as exc:
+            raise InputError(f"not an identified-structure model: {exc}") from None
+
+    def report(self) -> str:
+        lines = [
+            f"joint: {self.joint}   excitation: {self.excitation}   "
+            f"RMS output error: {self.rms:.4g} m   time: {self.elapsed:.1f} s",
+            self.fit.report(),
+        ]
+        return "\n".join(lines)
+
+
+def _num(v: float) -> float | None:
+    return float(v) if v is not None and math.isfinite(v) else None
+
+
+# ------------------------------------------------------------------ building models
+def build_structure(joint: str, v: dict[str, float], excitation: str) -> Structure:
+    """The SDOF structure of parameter values ``v`` (names as in the fit)."""
+    s = Structure(v["m"], v["c"], v["k"])
+    if joint == "bouc_wen":
+        s.add_joint("bouc_wen", 0, alpha=v["alpha"], beta=1.0, gamma=v["gamma"],
+                    delta=v["delta"], nu=v["nu"])  # fmt: skip
+    elif joint == "masing":
+        s.add_joint("masing", 0, h0=v["h0"], ac=v["ac"], scale=v.get("scale", 2.0))
+    elif joint == "jenkins":
+        s.add_joint("jenkins", 0, k=v["kj"], fs=v["fs"])
+    elif joint == "iwan":
+        s.add_joint("iwan", 0, **iwan_uniform(v["kj"], v["fs"], IWAN_ELEMENTS))
+    elif joint == "kelvin_voigt":
+        s.add_joint("kelvin_voigt", 0, k=v["kj"], c=v["cj"])
+    elif joint == "normal":
+        s.add_joint("normal", 0, coeffs=[v["a1"], v["a2"], v["a3"]])
+    return s
+
+
+def _derivatives(t: np.ndarray, y: np.ndarray, periodic: bool) -> tuple[np.ndarray, np.ndarray]:
+    if periodic:
+        n = y.size
+        dt = float(t[1] - t[0])
+        w = 2j * np.pi * np.fft.rfftfreq(n, dt)
+        Y = np.fft.rfft(y)
+        return np.fft.irfft(w * Y, n), np.fft.irfft(w * w * Y, n)
+    dt = np.diff(t)
+    win = 15
+    if y.size > 2 * win and np.ptp(dt) <= 1e-6 * dt.mean():
+        # Savitzky-Golay (cubic, 15 samples): second differences of raw samples amplify the
+        # measurement noise by 1/dt², which biases the regression towards zero stiffness.
+        from scipy.signal import savgol_filter
+
+        h = float(dt.mean())
+        return (
+            savgol_filter(y, win, 3, deriv=1, delta=h),
+            savgol_filter(y, win, 3, deriv=2, delta=h),
+        )
+    v = np.gradient(y, t, edge_order=2)
+    return v, np.gradient(v, t, edge_order=2)
+
+
+def equation_error(
+    t: np.ndarray,
+    u: np.ndarray,
+    y: np.ndarray,
+    excitation: str = "force",
+    mass: float | None = None,
+    *,
+    periodic: bool = False,
+) -> dict[str, Any]:
+    """Linear equation-error fit and the reconstructed joint force.
+
+    ``force``: ``u ≈ m x'' + c x' + k x``; ``base`` (``u`` = base displacement, ``y`` = mass
+    displacement): ``−m x'' ≈ c (x' − u') + k (x − u)``, ``m`` required. Returns ``m``, ``c``,
+    ``k`` and ``joint_force = rhs − m x'' − c x' − k x`` (what the joint must supply if the
+    linear part were exactly this).
+    """
+    xd, xdd = _derivatives(t, y, periodic)
+    if excitation == "force":
+        cols = [xdd, xd, y]
+        rhs = u.copy()
+        if mass is not None:
+            rhs = rhs - mass * xdd
+            cols = [xd, y]
+        A = np.stack(cols, axis=1)
+        coef, *_ = np.linalg.lstsq(A, rhs, rcond=None)
+        m, c, k = coef if mass is None else (mass, coef[0], coef[1])
+        jf = u - m * xdd - c * xd - k * y
+    else:
+        if mass is None:
+            raise InputError("base excitation needs the mass (mass=...) for the equation error")
+        ud, _ = _derivatives(t, u, periodic)
+        A = np.stack([xd - ud, y - u], axis=1)
+        coef, *_ = np.linalg.lstsq(A, -mass * xdd, rcond=None)
+        m, (c, k) = mass, coef
+        jf = -m * xdd - c * (xd - ud) - k * (y - u)
+    # The same with a Coulomb term fs·sign(x') (joint to ground): starting values for the
+    # friction joints (a linear fit lets the stiffness absorb the friction force).
+    sgn = np.sign(xd)
+    if excitation == "force":
+        rhs_c, cols_c = u - m * xdd, [xd, y, sgn]
+    else:
+        ud, _ = _derivatives(t, u, periodic)
+        rhs_c, cols_c = -m * xdd, [xd - ud, y - u, sgn]
+    cc, *_ = np.linalg.lstsq(np.stack(cols_c, axis=1), rhs_c, rcond=None)
+    return {
+        "m": float(m),
+        "c": float(c),
+        "k": float(k),
+        "joint_force": jf,
+        "coulomb": {"c": float(cc[0]), "k": float(cc[1]), "fs": float(cc[2])},
+    }
+
+
+def _params(
+    joint: str, lin: dict[str, Any], y: np.ndarray, mass: float | None, start: dict[str, float]
+) -> list[Parameter]:
+    m, c, k = lin["m"], max(lin["c"], 1e-9 * abs(lin["k"]) + 1e-12), abs(lin["k"])
+    yr = max(float(np.std(y)), 1e-300)
+    ftyp = max(k * yr, 1e-300)
+    frac = start.get("k_frac", 0.5)
+    ps = [
+        Parameter("m", m if mass is None else mass, vary=mass is None, min=0.0, unit="kg"),
+        Parameter("c", c, min=0.0, unit="N s/m", scale=max(c, 1e-3 * k * yr)),
+    ]
+    kl = Parameter("k", k * (1 - frac), min=0.0, unit="N/m", scale=k)
+    if joint in ("linear",):
+        kl.value = k
+        ps.append(kl)
+    elif joint == "kelvin_voigt":
+        # the joint is the linear spring-damper: the structure's own k, c would duplicate it
+        ps[1] = Parameter("c", 0.0, vary=False, unit="N s/m")
+        ps += [
+            Parameter("k", 0.0, vary=False, unit="N/m"),
+            Parameter("kj", k, min=0.0, unit="N/m"),
+            Parameter("cj", c, min=0.0, unit="N s/m"),
+        ]
+    elif joint == "normal":
+        ps.append(Parameter("k", 0.0, vary=False, unit="N/m"))
+        ps += [
+            Parameter("a1", k, min=0.0, unit="N/m"),
+            Parameter("a2", start.get("a2", 0.0), unit="N/m^2", scale=k / yr),
+            Parameter("a3", start.get("a3", 0.0), unit="N/m^3", scale=k / yr**2),
+        ]
+    else:
+        ps.append(kl)
+        kj = k * frac
+        if joint == "bouc_wen":
+            ps += [
+                Parameter("alpha", kj, min=1e-9 * kj, unit="N/m"),
+                Parameter("gamma", start["gamma"] / yr, unit="1/m", scale=1 / yr),
+                Parameter("delta", start["delta"] / yr, unit="1/m", scale=1 / yr),
+                Parameter("nu", 1.0, min=0.25, max=4.0, vary=start.get("fit_nu", True), unit=""),
+            ]
+        elif joint in ("masing", "jenkins", "iwan"):
+            cf = lin["coulomb"]
+            fsc = start["f_frac"] * ftyp
+            if start.get("coulomb") and cf["fs"] > 0 and cf["k"] > 0:
+                # k and c from the Coulomb-augmented regression, joint stiffer than k
+                kl.value = cf["k"]
+                ps[1].value = max(cf["c"], ps[1].value * 1e-3)
+                kj, fsc = start["kj_frac"] * cf["k"], start["f_frac"] * cf["fs"]
+            if joint == "masing":
+                ps += [
+                    Parameter("h0", fsc, min=0.0, unit="N"),
+                    Parameter("ac", kj / fsc, min=0.0, unit="1/m"),
+                ]
+            else:
+                ps += [
+                    Parameter("kj", kj, min=0.0, unit="N/m"),
+                    Parameter("fs", fsc, min=0.0, unit="N"),
+                ]
+    ps += [
+        Parameter("x0", 0.0, unit="m", scale=yr),
+        Parameter("v0", 0.0, unit="m/s", scale=yr * 2 * np.pi * 10),
+    ]
+    return ps
+
+
+def _starts(joint: str) -> list[dict[str, float]]:
+    if joint == "bouc_wen":
+        return [
+            {"gamma": g, "delta": d, "k_frac": f}
+            for (g, d) in ((0.5, -0.5), (0.5, 0.5), (-0.25, 0.5))
+            for f in (0.5,)
+        ]
+    if joint in ("masing", "jenkins", "iwan"):
+        return [{"f_frac": f, "k_frac": kf} for f in (0.1, 0.3, 1.0) for kf in (0.3, 0.7)] + [
+            {"coulomb": 1.0, "f_frac": f, "kj_frac": kf, "k_frac": 0.5}
+            for f in (0.7, 1.4)
+            for kf in (3.0, 30.0)
+        ]
+    if joint == "normal":
+        return [{"a2": 0.0, "a3": 0.0}]
+    return [{}]
+
+
+def identify(
+    t: Any,
+    u: Any,
+    y: Any,
+    joint: str = "bouc_wen",
+    excitation: str = "force",
+    *,
+    mass: float | None = None,
+    substeps: int = 4,
+    interpolation: str = "auto",
+    periodic: bool | None = None,
+    multistart: bool = True,
+    start_samples: int = 4096,
+    max_nfev: int = 200,
+    estimate_initial_state: bool = True,
+) -> IdentifiedModel:
+    """Identify ``m``, ``c``, ``k`` and a joint from input ``u`` and response ``y``.
+
+    Parameters
+    ----------
+    t : array_like
+        Sample times [s] (uniform for ``interpolation="fourier"``).
+    u : array_like
+        Input: force [N] (``excitation="force"``) or base displacement [m] (``"base"``).
+    y : array_like
+        Measured displacement of the mass [m].
+    joint : str
+        ``"masing"``, ``"jenkins"``, ``"iwan"`` (uniform slip-force density, 20 elements),
+        ``"bouc_wen"``, ``"kelvin_voigt"``, ``"normal"`` (cubic ``k_s(d)`` force law) or
+        ``"linear"`` (no joint).
+    mass : float, optional
+        Known mass [kg] (held fixed; required for base excitation).
+    substeps : int
+        Integration steps per sample interval.
+    interpolation : {"auto", "linear", "fourier"}
+        Input between samples; ``auto``: ``fourier`` when the record is periodic.
+    periodic : bool, optional
+        Whether the record holds whole periods of a periodic input (derivatives by FFT for
+        the starting values); default: ``interpolation == "fourier"``.
+    multistart : bool
+        Fit every start on the first ``start_samples`` samples and refine the best.
+    estimate_initial_state : bool
+        Fit ``x0`` and ``v0`` (else the record starts from rest).
+
+    Returns
+    -------
+    IdentifiedModel
+    """
+    t0 = time.perf_counter()
+    joint = str(joint).lower().replace("-", "_")
+    if joint not in JOINTS:
+        raise InputError(f"joint must be one of {', '.join(JOINTS)}; got {joint!r}")
+    if excitation not in ("force", "base"):
+        raise InputError(f"excitation must be 'force' or 'base', got {excitation!r}")
+    t = as_1d(t, "t")
+    u = as_1d(u, "u")
+    y = as_1d(y, "y")
+    if not (t.size == u.size == y.size):
+        raise InputError(f"t, u and y differ in length ({t.size}, {u.size}, {y.size})")
+    if t.size < 20:
+        raise InputError(f"{t.size} samples are too few to identify a structure")
+    if np.any(np.diff(t) <= 0):
+        raise InputError("t must be strictly increasing")
+    if excitation == "base" and mass is None:
+        raise InputError("base excitation needs the mass: pass mass=... (kg)")
+    if interpolation == "auto":
+        interpolation = "fourier" if periodic else "linear"
+    if periodic is None:
+        periodic = interpolation == "fourier"
+    lin = equation_error(t, u, y, excitation, mass, periodic=bool(periodic))
+    if not (lin["k"] > 0 and lin["m"] > 0):
+        raise InputError(
+            "the equation-error fit gives a non-positive mass or stiffness "
+            f"(m = {lin['m']:.4g}, k = {lin['k']:.4g}); is the response in metres and "
+            "the input the right channel?"
+        )
+
+    def residual_on(n: int, sub: int = substeps) -> Any:
+        tt, uu, yy = t[:n], u[:n], y[:n]
+        interp = interpolation if n == t.size else "linear"
+
+        def res(v: dict[str, float]) -> np.ndarray:
+            try:
+                s = build_structure(joint, v, excitation)
+                kw = {"force": uu} if excitation == "force" else {"base": uu}
+                r = s.simulate(tt, x0=[v["x0"]], v0=[v["v0"]], substeps=sub,
+                               interpolation=interp, **kw)  # fmt: skip
+            except ContactLabError:
+                return np.full(n, 1e3 * float(np.max(np.abs(yy))) + 1.0)
+            x = r.x
+            if x.size < n:  # failed run: penalise the rest
+                x = np.concatenate([x, np.full(n - x.size, 10 * np.max(np.abs(yy)) + 1.0)])
+            return x - yy
+
+        return res
+
+    def with_state(ps: list[Parameter]) -> list[Parameter]:
+        if not estimate_initial_state:
+            for p in ps:
+                if p.name in ("x0", "v0"):
+                    p.vary = False
+        return ps
+
+    starts = _starts(joint)
+    records: list[dict[str, Any]] = []
+    best_ps = with_state(_params(joint, lin, y, mass, starts[0]))
+    if multistart and len(starts) > 1:
+        n_s = min(int(start_samples), t.size)
+        best_cost = math.inf
+        for st in starts:
+            ps = with_state(_params(joint, lin, y, mass, st))
+            try:
+                fr = least_squares_fit(residual_on(n_s, 2), ps, max_nfev=25, ftol=1e-5,
+                                       xtol=1e-5, gtol=1e-8)  # fmt: skip
+            except ContactLabError as exc:
+                records.append({"start": st, "cost": None, "error": str(exc)})
+                continue
+            cost = float(np.sqrt(fr.chisqr / max(fr.ndata, 1)))
+            records.append({"start": st, "rms_short": cost})
+            if cost < best_cost:
+                best_cost = cost
+                best_ps = [
+                    Parameter(
+                        p.name,
+                        fr.params[p.name].value,
+                        vary=p.vary,
+                        min=p.min,
+                        max=p.max,
+                        unit=p.unit,
+                        scale=p.scale,
+                    )
+                    for p in ps
+                ]
+    fit = least_squares_fit(residual_on(t.size), best_ps, max_nfev=max_nfev, ftol=1e-7,
+                            xtol=1e-7, gtol=1e-10)  # fmt: skip
+    v = fit.values
+    model = IdentifiedModel(
+        structure=build_structure(joint, v, excitation),
+        joint=joint,
+        excitation=excitation,
+        fit=fit,
+        x0=float(v["x0"]),
+        v0=float(v["v0"]),
+        substeps=int(substeps),
+        interpolation=interpolation,
+        rms=float(np.sqrt(fit.chisqr / max(fit.ndata, 1))),
+        starts=records,
+    )
+    model.elapsed = time.perf_counter() - t0
+    return model

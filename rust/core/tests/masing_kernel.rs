@@ -1,0 +1,107 @@
+//! The blocked, vectorisable force kernel against the plain reference loop of the benchmark
+//! (independent code: index stack, libm exp), the anchored branch rule, and the branch memory.
+
+use contactlab_core::curve::{one_minus_exp_neg, Backbone, Exponential};
+use contactlab_core::masing::{
+    branch_memory, masing_force, masing_force_rule, BranchRule, MasingState,
+};
+use proptest::prelude::*;
+
+#[path = "../../../benches/masing_reference.rs"]
+mod reference;
+
+#[test]
+fn one_minus_exp_neg_is_accurate_everywhere() {
+    let mut worst = 0.0_f64;
+    let mut z = 1e-300_f64;
+    while z < 800.0 {
+        let want = if z < 0.5 {
+            -(-z).exp_m1()
+        } else {
+            1.0 - (-z).exp()
+        };
+        worst = worst.max((one_minus_exp_neg(z) / want - 1.0).abs());
+        z *= 1.001_3;
+    }
+    assert!(worst < 1e-15, "worst relative error {worst:e}"); // a few ulp
+    assert_eq!(one_minus_exp_neg(0.0), 0.0);
+    assert_eq!(one_minus_exp_neg(1e6), 1.0);
+}
+
+fn walk() -> impl Strategy<Value = Vec<f64>> {
+    prop::collection::vec(-1.0f64..1.0, 1..3000).prop_map(|steps| {
+        let mut x = 0.0;
+        steps
+            .into_iter()
+            .map(|s| {
+                x += s * 1e-5;
+                x
+            })
+            .collect()
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(128))]
+
+    #[test]
+    fn kernel_matches_the_reference_loop(x in walk(), lam in 1.5f64..2.5) {
+        let (h0, ac) = (40.0, 4.0e4);
+        let c = Exponential::new(h0, ac).unwrap();
+        let mut out = vec![0.0; x.len()];
+        masing_force(&c, lam, &x, &mut out, &mut MasingState::default()).unwrap();
+        let mut want = vec![0.0; x.len()];
+        reference::reference_force(h0, ac, lam, &x, &mut want, &mut Vec::new());
+        for (a, b) in out.iter().zip(&want) {
+            prop_assert!((a - b).abs() <= 1e-12 * h0, "{} vs {}", a, b);
+        }
+    }
+
+    #[test]
+    fn anchored_rule_is_masing_at_lambda_2_and_closes_loops(x in walk(), lam in 1.2f64..3.0) {
+        let c = Exponential::new(40.0, 4.0e4).unwrap();
+        let mut a = vec![0.0; x.len()];
+        let mut b = vec![0.0; x.len()];
+        masing_force(&c, 2.0, &x, &mut a, &mut MasingState::default()).unwrap();
+        let rule = BranchRule::Anchored(2.0);
+        masing_force_rule(&c, rule, &x, &mut b, &mut MasingState::default()).unwrap();
+        for (p, q) in a.iter().zip(&b) {
+            prop_assert!((p - q).abs() <= 1e-12 * 40.0);
+        }
+        // Any λ: chunked equals one pass, and coming back to the first reversal's mirror
+        // point lands on the virgin curve (the anchored branch ends at its target).
+        let rule = BranchRule::Anchored(lam);
+        let cut = x.len() / 3;
+        let mut whole = vec![0.0; x.len()];
+        masing_force_rule(&c, rule, &x, &mut whole, &mut MasingState::default()).unwrap();
+        let mut st = MasingState::default();
+        let mut parts = vec![0.0; x.len()];
+        masing_force_rule(&c, rule, &x[..cut], &mut parts[..cut], &mut st).unwrap();
+        masing_force_rule(&c, rule, &x[cut..], &mut parts[cut..], &mut st).unwrap();
+        prop_assert_eq!(&whole, &parts);
+        let big = x.iter().fold(0.0f64, |m, v| m.max(v.abs())) * 1.5 + 1e-6;
+        let mut o = [0.0; 2];
+        masing_force_rule(&c, rule, &[big, -big], &mut o, &mut st).unwrap();
+        prop_assert!((o[1] - c.eval(-big)).abs() <= 1e-12 * 40.0);
+    }
+
+    #[test]
+    fn branch_memory_matches_the_force_kernels_stack(x in walk()) {
+        let c = Exponential::new(40.0, 4.0e4).unwrap();
+        let (mut anchor, mut target) = (vec![0; x.len()], vec![0; x.len()]);
+        let mut st = MasingState::default();
+        branch_memory(&x, &mut anchor, &mut target, &mut st).unwrap();
+        // The anchor of the last sample is the force kernel's top reversal.
+        let mut fs = MasingState::default();
+        masing_force(&c, 2.0, &x, &mut vec![0.0; x.len()], &mut fs).unwrap();
+        let last = x.len() - 1;
+        match fs.stack.len() {
+            0 => prop_assert_eq!((anchor[last], target[last]), (-1, -1)),
+            1 => prop_assert_eq!((anchor[last], target[last]),
+                                 (fs.stack[0].index as i64, -1 - fs.stack[0].index as i64)),
+            n => prop_assert_eq!((anchor[last], target[last]),
+                                 (fs.stack[n - 1].index as i64, fs.stack[n - 2].index as i64)),
+        }
+        prop_assert_eq!(st.stack.len(), fs.stack.len());
+    }
+}

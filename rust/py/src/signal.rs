@@ -1,0 +1,275 @@
+//! Bindings of `contactlab_core::signal` (the streaming reversal detector), the branch memory
+//! of the Masing rules, and the multi-channel force kernel (Rust threads).
+
+use contactlab_core::masing::{branch_memory, MasingState};
+use contactlab_core::signal::{fold_phase, loop_areas, Excursion, FoldSums, Schmitt};
+use contactlab_core::CoreError;
+use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadwriteArray1};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::errors::{input, to_pyerr};
+use crate::{detach_guarded, slice, MasingCore};
+
+/// Streaming hysteresis-threshold reversal detector (state carried across `push` calls).
+#[pyclass(module = "contactlab._core")]
+struct ReversalDetector {
+    inner: Schmitt,
+}
+
+fn table<'py>(py: Python<'py>, ex: &[Excursion]) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let idx = |f: &dyn Fn(&Excursion) -> u64| -> Vec<i64> {
+        ex.iter()
+            .map(|e| i64::try_from(f(e)).unwrap_or(i64::MAX))
+            .collect()
+    };
+    d.set_item(
+        "sign",
+        ex.iter()
+            .map(|e| i64::from(e.sign))
+            .collect::<Vec<_>>()
+            .into_pyarray(py),
+    )?;
+    d.set_item("start", idx(&|e| e.start).into_pyarray(py))?;
+    d.set_item("extreme", idx(&|e| e.extreme).into_pyarray(py))?;
+    d.set_item("last_beyond", idx(&|e| e.last_beyond).into_pyarray(py))?;
+    d.set_item(
+        "extreme_value",
+        ex.iter()
+            .map(|e| e.extreme_value)
+            .collect::<Vec<_>>()
+            .into_pyarray(py),
+    )?;
+    d.set_item(
+        "returned",
+        ex.iter()
+            .map(|e| e.returned)
+            .collect::<Vec<_>>()
+            .into_pyarray(py),
+    )?;
+    Ok(d)
+}
+
+#[pymethods]
+impl ReversalDetector {
+    #[new]
+    fn new(py: Python<'_>, centre: f64, threshold: f64) -> PyResult<Self> {
+        let inner = Schmitt::new(centre, threshold).map_err(|e| to_pyerr(py, &e))?;
+        Ok(Self { inner })
+    }
+
+    /// Excursions completed in this chunk: dict of arrays `sign, start, extreme,
+    /// last_beyond, extreme_value, returned`. `value` (default `x`) is where extremes are
+    /// located.
+    #[pyo3(signature = (x, value=None))]
+    fn push<'py>(
+        &mut self,
+        py: Python<'py>,
+        x: PyReadonlyArray1<'py, f64>,
+        value: Option<PyReadonlyArray1<'py, f64>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let xs = slice(&x, "x")?;
+        let vs = value.as_ref().map(|v| slice(v, "value")).transpose()?;
+        let mut st = self.inner.clone();
+        let (done, st) = detach_guarded(py, || {
+            let mut done = Vec::new();
+            st.push(xs, vs, &mut done)?;
+            Ok((done, st))
+        })?;
+        self.inner = st;
+        table(py, &done)
+    }
+
+    /// The excursion in progress (0 or 1 rows, same columns as `push`).
+    fn open<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let open: Vec<Excursion> = self.inner.open.iter().copied().collect();
+        table(py, &open)
+    }
+
+    #[getter]
+    fn count(&self) -> u64 {
+        self.inner.count
+    }
+}
+
+type IndexPair<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>);
+
+/// Per-sample branch bookkeeping of the Masing memory rules from the origin:
+/// `(anchor, target)` sample-index arrays (see `contactlab_core::masing::branch_memory`).
+#[pyfunction]
+#[pyo3(name = "branch_memory")]
+fn branch_memory_py<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray1<'py, f64>,
+) -> PyResult<IndexPair<'py>> {
+    let xs = slice(&x, "x")?;
+    let (a, t) = detach_guarded(py, || {
+        let mut a = vec![0_i64; xs.len()];
+        let mut t = vec![0_i64; xs.len()];
+        branch_memory(xs, &mut a, &mut t, &mut MasingState::default())?;
+        Ok((a, t))
+    })?;
+    Ok((a.into_pyarray(py), t.into_pyarray(py)))
+}
+
+/// Forces of several channels, each from the origin with its own model, on up to `threads`
+/// Rust threads inside this one call (GIL released). Channels are handed out one at a time
+/// from a shared counter, so unequal lengths balance.
+#[pyfunction]
+fn force_many<'py>(
+    py: Python<'py>,
+    models: Vec<PyRef<'py, MasingCore>>,
+    xs: Vec<PyReadonlyArray1<'py, f64>>,
+    threads: usize,
+) -> PyResult<Vec<Bound<'py, PyArray1<f64>>>> {
+    if models.len() != xs.len() {
+        return Err(input(
+            py,
+            &format!("{} models but {} signals", models.len(), xs.len()),
+        ));
+    }
+    if threads == 0 {
+        return Err(input(py, "threads must be >= 1"));
+    }
+    let inputs: Vec<&[f64]> = xs.iter().map(|x| slice(x, "x")).collect::<PyResult<_>>()?;
+    let outs: Vec<Bound<'py, PyArray1<f64>>> = inputs
+        .iter()
+        .map(|x| PyArray1::<f64>::zeros(py, x.len(), false))
+        .collect();
+    let mut rws: Vec<PyReadwriteArray1<'py, f64>> =
+        outs.iter().map(PyArrayMethods::readwrite).collect();
+    let mut slices: Vec<&mut [f64]> = Vec::with_capacity(rws.len());
+    for rw in &mut rws {
+        slices.push(
+            rw.as_slice_mut()
+                .map_err(|_| input(py, "output not contiguous"))?,
+        );
+    }
+    let cores: Vec<&MasingCore> = models.iter().map(|m| &**m).collect();
+    detach_guarded(py, || run_many(&cores, &inputs, slices, threads))?;
+    drop(rws);
+    Ok(outs)
+}
+
+/// Work queue over channels on `threads` scoped threads; the first error wins.
+fn run_many(
+    cores: &[&MasingCore],
+    inputs: &[&[f64]],
+    outs: Vec<&mut [f64]>,
+    threads: usize,
+) -> Result<(), CoreError> {
+    let jobs: Vec<(usize, &mut [f64])> = outs.into_iter().enumerate().collect();
+    let queue = std::sync::Mutex::new(jobs);
+    let workers = threads.min(inputs.len()).max(1);
+    let results: Vec<Result<(), CoreError>> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..workers)
+            .map(|_| {
+                s.spawn(|| -> Result<(), CoreError> {
+                    loop {
+                        let job = match queue.lock() {
+                            Ok(mut q) => q.pop(),
+                            Err(_) => None,
+                        };
+                        let Some((i, out)) = job else {
+                            return Ok(());
+                        };
+                        cores[i].force_from_origin(inputs[i], out)?;
+                    }
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+            .collect()
+    });
+    results.into_iter().collect()
+}
+
+/// Phase-bin fold of a periodic recording, accumulated chunk by chunk (see
+/// `contactlab_core::signal::fold_phase`).
+#[pyclass(module = "contactlab._core")]
+struct PhaseFold {
+    sums: FoldSums,
+}
+
+#[pymethods]
+impl PhaseFold {
+    #[new]
+    fn new(py: Python<'_>, n_bins: usize, n_cycles: usize) -> PyResult<Self> {
+        let sums = FoldSums::new(n_bins, n_cycles).map_err(|e| to_pyerr(py, &e))?;
+        Ok(Self { sums })
+    }
+
+    /// Fold the chunk `(t, x, F)` starting at global sample `offset`, phases from the knots.
+    fn push(
+        &mut self,
+        py: Python<'_>,
+        t: PyReadonlyArray1<'_, f64>,
+        x: PyReadonlyArray1<'_, f64>,
+        f: PyReadonlyArray1<'_, f64>,
+        offset: u64,
+        knot_t: PyReadonlyArray1<'_, f64>,
+        knot_phase: PyReadonlyArray1<'_, f64>,
+    ) -> PyResult<()> {
+        let (ts, xs, fs) = (slice(&t, "t")?, slice(&x, "x")?, slice(&f, "F")?);
+        let (kt, kp) = (slice(&knot_t, "knot_t")?, slice(&knot_phase, "knot_phase")?);
+        let mut sums = self.sums.clone();
+        self.sums = detach_guarded(py, || {
+            fold_phase(ts, xs, fs, offset, kt, kp, &mut sums)?;
+            Ok(sums)
+        })?;
+        Ok(())
+    }
+
+    /// The sums so far: dict of arrays (per bin, and per cycle × bin as 2-D arrays).
+    fn sums<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = &self.sums;
+        let d = PyDict::new(py);
+        for (k, v) in [
+            ("count", &s.count),
+            ("sum_x", &s.sum_x),
+            ("sum_F", &s.sum_f),
+            ("sum_phase", &s.sum_phase),
+            ("sum_phase2", &s.sum_phase2),
+            ("sum_xx", &s.sum_xx),
+        ] {
+            d.set_item(k, v.clone().into_pyarray(py))?;
+        }
+        for (k, v) in [
+            ("cycle_count", &s.cycle_count),
+            ("cycle_x", &s.cycle_x),
+            ("cycle_F", &s.cycle_f),
+            ("cycle_phase", &s.cycle_phase),
+        ] {
+            let a = v.clone().into_pyarray(py);
+            d.set_item(k, a.reshape([s.n_cycles, s.n_bins])?)?;
+        }
+        d.set_item("first", s.first.clone().into_pyarray(py))?;
+        Ok(d)
+    }
+}
+
+/// `∮ F dx` of each cycle between consecutive `bounds` (NaN below 3 samples).
+#[pyfunction]
+#[pyo3(name = "loop_areas")]
+fn loop_areas_py<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray1<'py, f64>,
+    f: PyReadonlyArray1<'py, f64>,
+    bounds: Vec<usize>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let (xs, fs) = (slice(&x, "x")?, slice(&f, "F")?);
+    let a = detach_guarded(py, || loop_areas(xs, fs, &bounds))?;
+    Ok(a.into_pyarray(py))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PhaseFold>()?;
+    m.add_function(wrap_pyfunction!(loop_areas_py, m)?)?;
+    m.add_class::<ReversalDetector>()?;
+    m.add_function(wrap_pyfunction!(branch_memory_py, m)?)?;
+    m.add_function(wrap_pyfunction!(force_many, m)?)?;
+    Ok(())
+}

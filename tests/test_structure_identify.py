@@ -1,0 +1,117 @@
+"""Identification of structures with joints: known parameters recovered from simulated
+records with noise on input and output (seeds not used while developing), the Bouc-Wen
+benchmark's training record (skipped without ../shared/data), persistence and the CLI."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import contactlab
+from contactlab.cli import main
+from contactlab.structure import IdentifiedModel, Structure, identify
+
+DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+
+
+def _record(joint: str, params: dict, seed: int, n: int = 1500, fs: float = 500.0):
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / fs
+    u = sum(np.sin(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi)) for f in np.arange(3, 60, 0.5))
+    u *= 6.0 / np.std(u)
+    s = Structure(1.0, 2.0, 4e3)
+    s.add_joint(joint, 0, **params)
+    y = s.simulate(t, force=u, substeps=4).x
+    um = u + 0.01 * np.std(u) * rng.standard_normal(n)
+    ym = y + 0.01 * np.std(y) * rng.standard_normal(n)
+    return t, um, ym, y
+
+
+@pytest.mark.parametrize(
+    "joint,params,seed,checks",
+    [
+        ("jenkins", {"k": 3e3, "fs": 2.0}, 90211,
+         {"m": (1.0, 0.01), "k": (4e3, 0.01), "kj": (3e3, 0.03), "fs": (2.0, 0.03)}),
+        ("bouc_wen", {"alpha": 3e3, "beta": 1.0, "gamma": 300.0, "delta": -100.0, "nu": 1.0},
+         90212, {"m": (1.0, 0.01), "k": (4e3, 0.01), "alpha": (3e3, 0.02),
+                 "gamma": (300.0, 0.05), "delta": (-100.0, 0.08)}),
+    ],
+)  # fmt: skip
+def test_identify_recovers_known_parameters_with_noise(joint, params, seed, checks):
+    t, u, y, y_true = _record(joint, params, seed)
+    m = identify(t, u, y, joint=joint, substeps=2)
+    assert m.fit.success
+    for name, (value, rel) in checks.items():
+        got = m.fit.params[name].value
+        assert abs(got - value) <= rel * abs(value), (name, got, value)
+        assert m.fit.params[name].stderr is not None
+    # 1 % output noise: the residual is at the noise level, the clean response is predicted
+    assert m.rms < 1.5 * 0.01 * np.std(y_true)
+    pred = m.simulate(t, force=u).x
+    assert np.sqrt(np.mean((pred - y_true) ** 2)) < 0.02 * np.std(y_true)
+
+
+def test_identified_model_json_round_trip(tmp_path):
+    t, u, y, _ = _record("jenkins", {"k": 3e3, "fs": 2.0}, 90213, n=600)
+    m = identify(t, u, y, joint="jenkins", substeps=1, multistart=False)
+    m.save(tmp_path / "m.json")
+    m2 = IdentifiedModel.load(tmp_path / "m.json")
+    np.testing.assert_array_equal(m.simulate(t, force=u).x, m2.simulate(t, force=u).x)
+    d = json.loads((tmp_path / "m.json").read_text())
+    assert {"joint", "excitation", "structure", "fit", "x0", "v0"} <= set(d)
+    with pytest.raises(contactlab.InputError, match="force-excited"):
+        m2.simulate(t, base=u)
+
+
+def test_identify_bad_input():
+    t = np.arange(100) / 100.0
+    with pytest.raises(contactlab.InputError, match="joint must be"):
+        identify(t, t, t, joint="spring")
+    with pytest.raises(contactlab.InputError, match="mass"):
+        identify(t, t, t, joint="jenkins", excitation="base")
+    with pytest.raises(contactlab.InputError, match="differ in length"):
+        identify(t, t[:50], t)
+
+
+def test_boucwen_benchmark_holdout():
+    """Trained on period 1 of the benchmark's training record (8192 samples, from rest),
+    simulated over periods 1-5: the error on the held-out period 5 must be below 2e-5 m.
+    The bound: the record's output noise alone gives ~5.2e-6 m, the true model simulated
+    with this integrator 7.3e-6 m; published black-box/grey-box results on the validation
+    multisine are 1e-5…5e-5 m, so 2e-5 m is the better half of them while leaving a
+    factor ~2 for training on one period only (benches/eval_boucwen.py trains on four)."""
+    path = DATA / "boucwen" / "train_multisine.csv"
+    if not path.exists():
+        pytest.skip("../shared/data absent")
+    d = np.loadtxt(path, delimiter=",", comments="#")
+    u, y = d[:, 0], d[:, 1]
+    n = 8192
+    t = np.arange(u.size) / 750.0
+    m = identify(t[:n], u[:n], y[:n], joint="bouc_wen", substeps=2, multistart=False,
+                 estimate_initial_state=False)  # fmt: skip
+    r = m.simulate(t, force=u, interpolation="fourier")
+    e = np.sqrt(np.mean((r.x[4 * n :] - y[4 * n :]) ** 2))
+    assert e < 2e-5, e
+
+
+def test_cli_identify_and_simulate(tmp_path):
+    t, u, y, _ = _record("jenkins", {"k": 3e3, "fs": 2.0}, 90214, n=500)
+    rec = tmp_path / "rec.csv"
+    rec.write_text("t_s,u_force_N,y_disp_mm\n" + "\n".join(
+        f"{a:.9g},{b:.9g},{1e3 * c:.9g}" for a, b, c in zip(t, u, y, strict=True)))  # fmt: skip
+    js, rep = tmp_path / "model.json", tmp_path / "rep"
+    argv = ["identify", str(rec), "--joint", "jenkins", "--json", str(js), "--report", str(rep),
+            "--substeps", "1", "--holdout", "0.2"]  # fmt: skip
+    assert main(argv) == 0
+    doc = json.loads(js.read_text())
+    assert doc["joint"] == "jenkins" and doc["summary"]["rms_holdout"] > 0
+    assert (rep / "report.html").exists() and (rep / "figures" / "joint-loop.png").exists()
+    out = tmp_path / "sim.csv"
+    assert main(["simulate", "structure", str(out), "--structure", str(js), "--input",
+                 str(rec)]) == 0  # fmt: skip
+    sim = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert sim.shape == (500, 4)
+    assert main(["identify", str(tmp_path / "missing.csv")]) == 1
