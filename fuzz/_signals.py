@@ -68,11 +68,13 @@ def build(b: Bytes) -> tuple[str, str]:
     if kind == "tangential":
         ua, uc = b.choice(list(_LEN)), b.choice(list(_FORCE))
         head = f"t [s],x [{ua}],F [{uc}]"
-        a, c = a / _LEN[ua], c / _FORCE[uc]
+        with np.errstate(all="ignore"):
+            a, c = a / _LEN[ua], c / _FORCE[uc]
     else:
         ua, uc = b.choice(list(_LEN)), b.choice(list(_PRESS))
         head = f"t [s],delta [{ua}],p [{uc}]"
-        a, c = a / _LEN[ua], c / _PRESS[uc]
+        with np.errstate(all="ignore"):
+            a, c = a / _LEN[ua], c / _PRESS[uc]
     buf = io.StringIO()
     buf.write(head + "\n")
     with np.errstate(all="ignore"):

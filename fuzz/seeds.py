@@ -57,9 +57,24 @@ def write_seeds(root: Path = HERE / "seeds") -> None:
     (man / "semicolon").write_bytes(
         b"file;kind;material;normal_load [kN]\ntangential.csv;tangential;St;0,05\n"
     )
+    # export: what analyze --json writes for bundled recordings, behind an option byte
+    from contactlab.cli import main as cli
+    from contactlab.data import data_dir
+
+    out = root / "export"
+    out.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        for i, (kind, pattern) in enumerate(
+            (("tangential", "tangential/*.csv"), ("normal", "normal/*.csv"))
+        ):
+            js = Path(tmp) / f"{kind}.json"
+            src = sorted(data_dir().glob(pattern))[0]
+            cli(["analyze", str(src), "--model", kind, "--json", str(js), "--no-progress"])
+            for sel in (0, 3, 8, 16, 25):
+                (out / f"{kind}{i}-{sel}").write_bytes(bytes([sel]) + js.read_bytes())
     # the structured targets decode bytes themselves: a few random starts are enough
     rng = np.random.default_rng(0)
-    for target in ("kernels", "models", "analyze", "diagnose"):
+    for target in ("kernels", "analyze", "diagnose", "track"):
         out = root / target
         out.mkdir(parents=True, exist_ok=True)
         for i in range(8):

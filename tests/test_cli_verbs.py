@@ -198,7 +198,8 @@ def test_unidentifiable_loop_json_says_so(tmp_path):
     assert "NaN" not in text and "Infinity" not in text  # strict JSON
     d = json.loads(text)
     assert d["h0"] is None and d["ac"] is None
-    assert d["identifiable"]["h0"] is False and "NOT separately identifiable" in d["warnings"][0]
+    assert d["identifiable"]["h0"] is False
+    assert any("NOT separately identifiable" in w for w in d["warnings"])
     assert d["h0_ac"] == pytest.approx(40.5 * 34668.1, rel=0.03)  # the truth in the manifest
     assert 0 < d["h0_ac_stderr"] < 0.02 * d["h0_ac"] and d["units"]["h0_ac"] == "N/m"
 

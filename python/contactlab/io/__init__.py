@@ -56,7 +56,9 @@ _LIBRARY_ERRORS = (
     IndexError,
     ValueError,
     TypeError,
-    OverflowError,
+    ArithmeticError,  # OverflowError, ZeroDivisionError
+    NameError,  # scipy.io's UnboundLocalError on a damaged struct
+    AttributeError,
     MemoryError,
     EOFError,
     struct.error,

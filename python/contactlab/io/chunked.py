@@ -171,7 +171,16 @@ class _Finisher:
             check_finite(values, file=self.file, column=col, row_of=row_of)
             v = np.ascontiguousarray(values, dtype=np.float64)
             if self.factors[canon] != 1.0:
-                v = v * self.factors[canon]
+                with np.errstate(over="ignore"):
+                    v = v * self.factors[canon]
+                if not np.all(np.isfinite(v)):  # found by fuzzing (track): 1e306 kN in N
+                    i = int(np.argmax(~np.isfinite(v)))
+                    raise RecordingError(
+                        f"value {float(values[i])} overflows double precision when converted to SI",
+                        file=self.file,
+                        column=col,
+                        row=row_of(i),
+                    )
             if canon == "t":
                 t = v
             else:

@@ -405,7 +405,16 @@ def finish(
         col = names[canon]
         check_finite(values, file=file, column=col, row_of=row_of)
         factor, si = unit_factor(canon, col, file_units.get(canon), file=file, assumed=assumed)
-        v = np.ascontiguousarray(values, dtype=np.float64) * factor
+        with np.errstate(over="ignore"):
+            v = np.ascontiguousarray(values, dtype=np.float64) * factor
+        if not np.all(np.isfinite(v)):  # found by fuzzing: 1e306 kN overflows in N
+            i = int(np.argmax(~np.isfinite(v)))
+            raise RecordingError(
+                f"value {float(values[i])} overflows double precision when converted to SI ({si})",
+                file=file,
+                column=col,
+                row=row_of(i),
+            )
         if canon == "t":
             t = v
         else:

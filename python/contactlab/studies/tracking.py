@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from .._json import jsonable
+from .._physical import MAX_MAGNITUDE
 from ..errors import ContactLabError, ContactLabWarning, InputError
 from ..io import DEFAULT_CHUNK, Recording, read_chunks
 from ..io.units import UnknownUnitError, to_si
@@ -370,6 +371,14 @@ def _blocks(chunks: Iterator[Recording], min_block: int) -> Iterator[Recording]:
     buf: list[Recording] = []
     size = 0
     for c in chunks:
+        for name, v in c.data.items():  # found by fuzzing: 1e300 data overflowed windows
+            if v.size and float(np.max(np.abs(v))) > MAX_MAGNITUDE:
+                i = int(np.argmax(np.abs(v)))
+                raise InputError(
+                    f"{c.source}: {name} reaches {float(v[i]):.3g} {c.units.get(name, '')} "
+                    f"at sample {i + int(c.meta.get('offset', 0))}: beyond any physical value; "
+                    "a unit mix-up or a corrupt file?"
+                )
         buf.append(c)
         size += len(c)
         if size >= min_block:

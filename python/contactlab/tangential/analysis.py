@@ -301,8 +301,9 @@ def collect_warnings(
         warns.append(f"the Masing fit did not converge ({raw.message})")
     if loop is not None and data.on == "averaged" and loop.n_cycles > 2:
         # Is the misfit larger than the cycle-to-cycle noise explains?
-        per_cycle = loop.count / loop.n_cycles
-        noise_var = float(np.nanmean(loop.F_std**2 * per_cycle))
+        v = loop.F_std**2 * (loop.count / loop.n_cycles)
+        # no bin with a spread: nothing to compare with (numpy would warn on the empty mean)
+        noise_var = float(np.nanmean(v)) if np.any(np.isfinite(v)) else math.nan
         if noise_var > 0 and raw.redchi > 4.0 * noise_var:
             warns.append(
                 f"the residuals are {math.sqrt(raw.redchi / noise_var):.1f}× the cycle-to-cycle "

@@ -163,7 +163,10 @@ def _bin_var(loop: AveragedLoop) -> np.ndarray | None:
     if loop.x_var is None or loop.n_cycles <= 1:
         return None
     # spread of the true x inside a bin: the samples' spread less the sensor noise
-    s2x = float(np.nanmean(loop.x_std**2 * loop.count / loop.n_cycles))
+    s2 = loop.x_std**2 * loop.count / loop.n_cycles
+    if not np.any(np.isfinite(s2)):  # no bin with a spread (found by fuzzing: a warning)
+        return None
+    s2x = float(np.nanmean(s2))
     return np.clip(loop.x_var - s2x, 0.0, None)
 
 

@@ -115,8 +115,12 @@ def numeric_energy(loop: AveragedLoop, x: np.ndarray, F: np.ndarray) -> tuple[fl
     if n < 2:
         return float(np.nanmean(e)), math.nan
     per_cycle = loop.count / n
-    s2F = float(np.nanmean(loop.F_std**2 * per_cycle))
-    s2x = float(np.nanmean(loop.x_std**2 * per_cycle))
+    vF, vx = loop.F_std**2 * per_cycle, loop.x_std**2 * per_cycle
+    if not (np.any(np.isfinite(vF)) and np.any(np.isfinite(vx))):
+        # no phase bin with a spread (found by fuzzing: numpy's "Mean of empty slice")
+        return float(np.nanmean(e)), math.nan
+    s2F = float(np.nanmean(vF))
+    s2x = float(np.nanmean(vx))
     var = 0.0
     for k in range(n):
         a, b = int(loop.cycle_bounds[k]), int(loop.cycle_bounds[k + 1])
