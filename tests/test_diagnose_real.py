@@ -84,13 +84,13 @@ def test_measured_loop_names_nothing_unphysical(load):
     names = rep.effect_names
     assert "inertia" not in names or rep.final_model.params["m"] >= 0
     assert "viscous_damping" not in names or rep.final_model.params["c"] >= 0
-    # the friction force is not replaced by another effect: the reconstruction's offset is
-    # small against the plateau force (README: "a small offset"); on a rectangular loop an
-    # offset and a direction-dependent friction force cannot be told apart, so the fitted
-    # offset is not held to the midline of the sliding plateaus
-    plateau, _ = _plateau(t, x, F)
+    # the friction force is not replaced by another effect: the reconstruction's offset sits
+    # near the midline of the sliding plateaus (0.15 N at 250 g); the sticking phases, which
+    # no candidate explains, pull it by up to a tenth of the plateau force (450 g: 0.15 N
+    # fitted against a 0.015 N midline), hence the 15 % margin
+    plateau, midline = _plateau(t, x, F)
     if "force_offset" in names:
-        assert abs(rep.final_model.params["F0"]) < 0.2 * plateau
+        assert abs(rep.final_model.params["F0"] - midline) < 0.15 * plateau
     assert rep.final_model.params["h0"] > 0.7 * plateau
 
 
