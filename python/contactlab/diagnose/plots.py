@@ -26,8 +26,8 @@ def _labels(report: Any) -> tuple[str, str, float, float]:
 def plot_overlay(report: Any, step: int | None = None, ax: Any = None) -> Any:
     """Measured loops with the base model and the model after ``step`` (default: final)."""
     ax = _axes(ax)
-    d = report._data
-    trials = report._trials
+    d = report.prepared
+    trials = report.trials
     fin = trials[-1 if step is None else step]
     xl, yl, sx, sy = _labels(report)
     if report.model == "tangential":
@@ -53,8 +53,8 @@ def plot_overlay(report: Any, step: int | None = None, ax: Any = None) -> Any:
 def plot_residual(report: Any, ax: Any = None) -> Any:
     """Held-out residual (measured minus model) against time, base and final model."""
     ax = _axes(ax)
-    d = report._data
-    t0, t1 = report._trials[0], report._trials[-1]
+    d = report.prepared
+    t0, t1 = report.trials[0], report.trials[-1]
     ax.plot(d.t, d.y - t0.prediction, lw=0.6, color="C3", label="base model")
     ax.plot(d.t, d.y - t1.prediction, lw=0.6, color="C0", label="final model")
     for s in (1, -1):
@@ -69,8 +69,8 @@ def plot_residual(report: Any, ax: Any = None) -> Any:
 def plot_location(report: Any, ax: Any = None, bins: int = 20) -> Any:
     """Share of the base residual power by position within the branch (0 = at a reversal)."""
     ax = _axes(ax)
-    d = report._data
-    e = d.y - report._trials[0].fitted
+    d = report.prepared
+    e = d.y - report.trials[0].fitted
     ph = d.cycles.phase_in_branch
     edges = np.linspace(0.0, 1.0, bins + 1)
     idx = np.clip(np.digitize(ph, edges) - 1, 0, bins - 1)

@@ -116,6 +116,16 @@ class DiagnosisReport:
     def effect_names(self) -> list[str]:
         return [e.name for e in self.effects]
 
+    @property
+    def prepared(self) -> Prepared | None:
+        """The data as the diagnosis saw it (filtered, weighted, cycles found), for plots."""
+        return self._data
+
+    @property
+    def trials(self) -> list[Trial]:
+        """Every model fitted along the way, base first (for plots and inspection)."""
+        return list(self._trials)
+
     def to_dict(self) -> dict[str, Any]:
         return {
             "model": self.model,

@@ -153,6 +153,39 @@ pub struct FoldSums {
 }
 
 impl FoldSums {
+    /// The buffers hold what `n_bins` and `n_cycles` say: the fields are public, so a value
+    /// built by hand (not by [`FoldSums::new`]) is checked before any index uses them.
+    pub fn check_shape(&self) -> Result<(), CoreError> {
+        let bad = |reason| Err(CoreError::InvalidState { reason });
+        if self.n_bins == 0 {
+            return bad("fold sums need at least one bin");
+        }
+        let Some(cells) = self.n_bins.checked_mul(self.n_cycles) else {
+            return bad("fold sums: n_bins * n_cycles overflows");
+        };
+        let per_bin = [
+            &self.count,
+            &self.sum_x,
+            &self.sum_f,
+            &self.sum_phase,
+            &self.sum_phase2,
+            &self.sum_xx,
+        ];
+        let per_cell = [
+            &self.cycle_count,
+            &self.cycle_x,
+            &self.cycle_f,
+            &self.cycle_phase,
+        ];
+        if per_bin.iter().any(|v| v.len() != self.n_bins)
+            || per_cell.iter().any(|v| v.len() != cells)
+            || self.first.len() != self.n_cycles
+        {
+            return bad("fold sums: buffer lengths do not match n_bins and n_cycles");
+        }
+        Ok(())
+    }
+
     pub fn new(n_bins: usize, n_cycles: usize) -> Result<Self, CoreError> {
         if n_bins == 0 {
             return Err(CoreError::InvalidParameter {
@@ -210,6 +243,7 @@ pub fn fold_phase(
     check_same_len("t", t.len(), "x", x.len())?;
     check_same_len("t", t.len(), "F", f.len())?;
     check_same_len("knot_t", kt.len(), "knot_phase", kp.len())?;
+    sums.check_shape()?;
     check_finite("t", t)?;
     check_finite("knot_t", kt)?;
     check_finite("knot_phase", kp)?;
@@ -304,6 +338,19 @@ pub fn loop_areas(x: &[f64], f: &[f64], bounds: &[usize]) -> Result<Vec<f64>, Co
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn fold_sums_built_by_hand_are_checked_not_indexed() {
+        let mut sums = super::FoldSums::new(4, 2).unwrap();
+        sums.n_bins = 0;
+        let t = [0.0, 0.5];
+        let r = super::fold_phase(&t, &t, &t, 0, &[0.0, 1.0], &[0.0, 1.0], &mut sums);
+        assert!(matches!(r, Err(crate::CoreError::InvalidState { .. })));
+        let mut sums = super::FoldSums::new(4, 2).unwrap();
+        sums.n_bins = 8; // buffers still sized for 4
+        let r = super::fold_phase(&t, &t, &t, 0, &[0.0, 1.0], &[0.0, 1.0], &mut sums);
+        assert!(matches!(r, Err(crate::CoreError::InvalidState { .. })));
+    }
+
     use super::*;
 
     fn run(x: &[f64], centre: f64, thr: f64) -> (Vec<Excursion>, Option<Excursion>) {
