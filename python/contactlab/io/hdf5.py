@@ -9,6 +9,7 @@ datasets are read.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
@@ -34,6 +35,90 @@ def import_h5py() -> Any:
     except ImportError:  # pragma: no cover - depends on the installation
         raise InputError("reading HDF5 files needs h5py: pip install 'contactlab[io]'") from None
     return h5py
+
+
+#: libhdf5 (2.0) decodes a global heap collection ("GCOL", the store of variable-length strings
+#: and arrays) by walking its objects until the collection's end; a free-space record (index
+#: 0) of size 0 does not advance the walk, and the library loops forever (found by fuzzing:
+#: fuzz/regressions/read_hdf5). No signal interrupts it, so such a file is refused before
+#: h5py opens it.
+_GCOL = b"GCOL\x01"
+#: More objects than any collection libhdf5 writes can hold (4 KiB collections; larger only
+#: to fit one big object): a walk this long is a damaged file, refused without walking on.
+_MAX_HEAP_OBJECTS = 1_000_000
+
+
+def _superblock_length_size(mm: Any, size: int) -> int | None:
+    """Size of lengths (bytes) from the superblock, found at 0, 512, 1024, ... as libhdf5
+    looks for it; None when there is none (h5py then reports the file as unreadable)."""
+    from .sniff import HDF5_SIGNATURE
+
+    base = 0
+    while base + 16 <= size:
+        if mm[base : base + 8] == HDF5_SIGNATURE:
+            version = mm[base + 8]
+            return int(mm[base + 14] if version < 2 else mm[base + 10])
+        base = 512 if base == 0 else 2 * base
+    return None
+
+
+def _check_global_heaps(mm: Any, size: int, nlen: int, file: str) -> None:
+    """Refuse a global heap collection whose object walk (as libhdf5's
+    ``H5HG__cache_heap_deserialize`` does it) would never reach the collection's end."""
+    hdr = 8 + nlen  # signature, version, 3 reserved bytes, collection size
+    objhdr = 8 + nlen  # index u16, reference count u16, 4 reserved bytes, object size
+    pos = mm.find(_GCOL)
+    while pos != -1:
+        if pos + hdr <= size:
+            coll = int.from_bytes(mm[pos + 8 : pos + 8 + nlen], "little")
+            end = pos + coll
+            p = pos + hdr
+            # a collection reaching beyond the file is an error libhdf5 reports itself
+            steps = 0
+            while end <= size and p < end and p + objhdr <= end:
+                idx = int.from_bytes(mm[p : p + 2], "little")
+                osize = int.from_bytes(mm[p + 8 : p + 8 + nlen], "little")
+                need = objhdr + (osize + 7) // 8 * 8 if idx > 0 else osize
+                steps += 1
+                if need == 0 or steps > _MAX_HEAP_OBJECTS:
+                    raise RecordingError(
+                        f"damaged HDF5 file: the global heap collection at byte {pos} has "
+                        f"{'a free-space record of size 0' if need == 0 else 'too many objects'}"
+                        f" at byte {p}; libhdf5 would never finish reading it",
+                        file=file,
+                    )
+                p += need
+        pos = mm.find(_GCOL, pos + 1)
+
+
+def check_structure(path: str | Path, *, file: str) -> None:
+    """Refuse the damaged structures on which libhdf5 itself hangs instead of failing (it
+    cannot be interrupted from Python). Cheap: one scan for the structures' signatures,
+    memory-mapped. Valid files always pass; a file this does not understand is left to
+    libhdf5, which reports it."""
+    import mmap
+
+    with open(path, "rb") as fh:
+        size = os.fstat(fh.fileno()).st_size
+        if size < 16:
+            return
+        with mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as mm:
+            nlen = _superblock_length_size(mm, size)
+            if nlen not in (2, 4, 8):
+                return  # libhdf5 rejects such a superblock itself
+            _check_global_heaps(mm, size, nlen, file)
+
+
+def open_hdf5(path: str | Path, *, file: str) -> Any:
+    """``h5py.File(path, "r")`` for an untrusted file: structures that make libhdf5 hang are
+    refused first (:func:`check_structure`), and what libhdf5 cannot open is a
+    :class:`RecordingError`."""
+    h5py = import_h5py()
+    check_structure(path, file=file)
+    try:
+        return h5py.File(path, "r")
+    except OSError as exc:
+        raise RecordingError(f"not a readable HDF5 file ({exc})", file=file) from None
 
 
 def text_value(v: Any) -> str:
@@ -119,14 +204,9 @@ def read_hdf5(
 
     Rows in errors are 0-based sample indices.
     """
-    h5py = import_h5py()
     path = Path(path)
     file = str(path)
-    try:
-        f = h5py.File(path, "r")
-    except OSError as exc:
-        raise RecordingError(f"not a readable HDF5 file ({exc})", file=file) from None
-    with f:
+    with open_hdf5(path, file=file) as f:
         kind, mapping, dsets, units, dt = hdf5_layout(f, columns=columns, kind=kind, file=file)
         raw = {c: vector(dsets[n], file=file, column=n) for c, n in mapping.items()}
         check_equal_lengths(raw, mapping, file=file)
