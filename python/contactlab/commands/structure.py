@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -33,9 +34,14 @@ def read_table(path: str) -> dict[str, np.ndarray]:
     if len(names) < 2:
         raise InputError(f"{path}: the first line must name the comma-separated columns")
     try:
-        data = np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2)
+        with warnings.catch_warnings():
+            # numpy warns "input contained no data" for a header alone: refused just below
+            warnings.simplefilter("ignore", UserWarning)
+            data = np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2)
     except ValueError as exc:
         raise InputError(f"{path}: not a numeric table: {exc}") from None
+    if data.size == 0:
+        raise InputError(f"{path}: no data rows after the header line")
     if data.shape[1] != len(names):
         raise InputError(f"{path}: {len(names)} column names but {data.shape[1]} columns")
     out = {}

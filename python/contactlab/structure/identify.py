@@ -135,7 +135,7 @@ class IdentifiedModel:
     def load(cls, path: str | Path) -> IdentifiedModel:
         try:
             d = json.loads(Path(path).read_text())
-        except (OSError, json.JSONDecodeError) as exc:
+        except (OSError, ValueError) as exc:  # ValueError: not UTF-8 or not JSON
             raise InputError(f"cannot read model JSON {path}: {exc}") from None
         return cls.from_dict(d)
 
