@@ -99,6 +99,51 @@ def test_global_heap_walk_that_never_ends_is_refused(tmp_path):
         read_chunks(path, chunk_size=16)
 
 
+def _edit_h5(tmp_path: Path, name: str, edit) -> Path:
+    """A valid HDF5 recording with ``edit(raw, offsets)`` applied; offsets of its (single)
+    group B-tree node and local heap, both relative to byte 0 (no user block)."""
+    path = tmp_path / f"{name}.h5"
+    write_recording(path, _rec())
+    raw = bytearray(path.read_bytes())
+    tree, heap = raw.index(b"TREE"), raw.index(b"HEAP")
+    data = int.from_bytes(raw[heap + 24 : heap + 32], "little")  # data segment address
+    edit(raw, tree, heap, data)
+    path.write_bytes(bytes(raw))
+    return path
+
+
+def _q(v: int) -> bytes:
+    return v.to_bytes(8, "little")
+
+
+def _sibling_self(raw, tree, heap, data):
+    raw[tree + 16 : tree + 24] = _q(tree)  # right sibling: the node itself (libhdf5 loops)
+
+
+def _child_self(raw, tree, heap, data):
+    raw[tree + 5] = 1  # level 1 whose first child is the node itself: endless recursion
+    raw[tree + 32 : tree + 40] = _q(tree)  # (a segmentation fault in libhdf5)
+
+
+def _free_list_self(raw, tree, heap, data):
+    head = int.from_bytes(raw[heap + 16 : heap + 24], "little")
+    raw[data + head : data + head + 8] = _q(head)  # the free block's next: itself (loops)
+
+
+@pytest.mark.parametrize(
+    ("edit", "what"),
+    [
+        (_sibling_self, "its own right sibling"),
+        (_child_self, "has a child of level 1"),
+        (_free_list_self, "free list of the local heap"),
+    ],
+)
+def test_hdf5_structures_libhdf5_never_leaves_are_refused(edit, what, tmp_path):
+    path = _edit_h5(tmp_path, edit.__name__, edit)
+    out = _read_in_child(path)
+    assert out.startswith("RecordingError:") and what in out, out
+
+
 def test_mat73_file_goes_through_the_hdf5_guard(tmp_path):
     import h5py
 

@@ -48,17 +48,26 @@ _GCOL = b"GCOL\x01"
 _MAX_HEAP_OBJECTS = 1_000_000
 
 
-def _superblock_length_size(mm: Any, size: int) -> int | None:
-    """Size of lengths (bytes) from the superblock, found at 0, 512, 1024, ... as libhdf5
-    looks for it; None when there is none (h5py then reports the file as unreadable)."""
+def _superblock(mm: Any, size: int) -> tuple[int, int, int] | None:
+    """``(size of offsets, size of lengths, base address)`` from the superblock, found at 0,
+    512, 1024, ... as libhdf5 looks for it; None when there is none or it is not understood
+    (h5py then reports the file as unreadable)."""
     from .sniff import HDF5_SIGNATURE
 
-    base = 0
-    while base + 16 <= size:
-        if mm[base : base + 8] == HDF5_SIGNATURE:
-            version = mm[base + 8]
-            return int(mm[base + 14] if version < 2 else mm[base + 10])
-        base = 512 if base == 0 else 2 * base
+    at = 0
+    while at + 48 <= size:
+        if mm[at : at + 8] == HDF5_SIGNATURE:
+            version = mm[at + 8]
+            if version < 2:
+                noff, nlen = mm[at + 13], mm[at + 14]
+                base_at = at + (24 if version == 0 else 28)
+            else:
+                noff, nlen = mm[at + 9], mm[at + 10]
+                base_at = at + 12
+            if noff not in (2, 4, 8) or nlen not in (2, 4, 8):
+                return None  # libhdf5 rejects such a superblock itself
+            return noff, nlen, int.from_bytes(mm[base_at : base_at + noff], "little")
+        at = 512 if at == 0 else 2 * at
     return None
 
 
@@ -91,22 +100,100 @@ def _check_global_heaps(mm: Any, size: int, nlen: int, file: str) -> None:
         pos = mm.find(_GCOL, pos + 1)
 
 
+def _check_btrees(mm: Any, size: int, noff: int, nlen: int, base: int, file: str) -> None:
+    """Refuse version-1 B-tree nodes ("TREE") that libhdf5 would follow for ever: a chain of
+    right siblings that comes back on itself (iteration loops) or, in a group's tree, a
+    child that is not a node one level down (descent recurses until the stack overflows, a
+    segmentation fault). Both found by probing the fuzz seeds; valid trees have neither."""
+    undef = (1 << (8 * noff)) - 1
+    hdr = 8 + 2 * noff  # signature, type, level, entries used, left and right siblings
+    nodes: dict[int, tuple[int, int, int, int]] = {}  # at -> (type, level, entries, right)
+    pos = mm.find(b"TREE")
+    while pos != -1:
+        if pos + hdr <= size:
+            right = int.from_bytes(mm[pos + 8 + noff : pos + hdr], "little")
+            entries = int.from_bytes(mm[pos + 6 : pos + 8], "little")
+            nodes[pos] = (mm[pos + 4], mm[pos + 5], entries, right)
+        pos = mm.find(b"TREE", pos + 1)
+
+    def refuse(at: int, why: str) -> None:
+        raise RecordingError(
+            f"damaged HDF5 file: the B-tree node at byte {at} {why}; libhdf5 would never "
+            "finish reading it",
+            file=file,
+        )
+
+    ends: set[int] = set()  # nodes whose right-sibling chain is known to end
+    for start in nodes:
+        seen: list[int] = []
+        at = start
+        while at in nodes and at not in ends:
+            if at in seen:
+                refuse(at, "is its own right sibling through a cycle of siblings")
+            seen.append(at)
+            right = nodes[at][3]
+            at = -1 if right == undef else base + right
+        ends.update(seen)
+    for at, (kind, level, entries, _right) in nodes.items():
+        if kind != 0 or level == 0:
+            continue  # chunk trees' keys depend on the dataset's rank: siblings only
+        for i in range(min(entries, 1 << 16)):
+            c = at + hdr + nlen + i * (nlen + noff)  # keys (heap offsets) and children interleave
+            if c + noff > size:
+                break
+            child = base + int.from_bytes(mm[c : c + noff], "little")
+            if child in nodes and nodes[child][1] != level - 1:
+                refuse(at, f"(level {level}) has a child of level {nodes[child][1]}")
+
+
+def _check_local_heaps(mm: Any, size: int, noff: int, nlen: int, base: int, file: str) -> None:
+    """Refuse a local heap ("HEAP", the names of a group's links) whose free list comes back
+    on itself: libhdf5 follows it for ever (found by probing the fuzz seeds)."""
+    free_null = 1  # H5HL_FREE_NULL: the end of the free list
+    pos = mm.find(b"HEAP")
+    while pos != -1:
+        end = pos + 8 + 2 * nlen + noff
+        if end <= size and mm[pos + 4] == 0:
+            dsize = int.from_bytes(mm[pos + 8 : pos + 8 + nlen], "little")
+            off = int.from_bytes(mm[pos + 8 + nlen : pos + 8 + 2 * nlen], "little")
+            data = base + int.from_bytes(mm[pos + 8 + 2 * nlen : end], "little")
+            seen: set[int] = set()
+            # a block beyond the data segment or the file is an error libhdf5 reports
+            while off != free_null and off + 2 * nlen <= dsize and data + off + 2 * nlen <= size:
+                if off in seen:
+                    raise RecordingError(
+                        f"damaged HDF5 file: the free list of the local heap at byte {pos} "
+                        f"comes back to offset {off}; libhdf5 would never finish reading it",
+                        file=file,
+                    )
+                seen.add(off)
+                off = int.from_bytes(mm[data + off : data + off + nlen], "little")
+        pos = mm.find(b"HEAP", pos + 1)
+
+
 def check_structure(path: str | Path, *, file: str) -> None:
-    """Refuse the damaged structures on which libhdf5 itself hangs instead of failing (it
-    cannot be interrupted from Python). Cheap: one scan for the structures' signatures,
+    """Refuse the damaged structures on which libhdf5 itself hangs or overflows its stack
+    instead of failing (it cannot be interrupted from Python): global heap collections whose
+    walk does not advance, version-1 B-trees with sibling cycles or children on the wrong
+    level, local heaps whose free list cycles. Cheap: a scan for the structures' signatures,
     memory-mapped. Valid files always pass; a file this does not understand is left to
-    libhdf5, which reports it."""
+    libhdf5, which reports it. Not checked: the structures libhdf5 writes only with newer
+    file-format settings (version-2 B-trees, fractal heaps); object header continuation
+    loops and the other damage tried by fuzz/read_hdf5.py libhdf5 reports itself."""
     import mmap
 
     with open(path, "rb") as fh:
         size = os.fstat(fh.fileno()).st_size
-        if size < 16:
+        if size < 48:
             return
         with mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as mm:
-            nlen = _superblock_length_size(mm, size)
-            if nlen not in (2, 4, 8):
-                return  # libhdf5 rejects such a superblock itself
+            sb = _superblock(mm, size)
+            if sb is None:
+                return
+            noff, nlen, base = sb
             _check_global_heaps(mm, size, nlen, file)
+            _check_btrees(mm, size, noff, nlen, base, file)
+            _check_local_heaps(mm, size, noff, nlen, base, file)
 
 
 def open_hdf5(path: str | Path, *, file: str) -> Any:
