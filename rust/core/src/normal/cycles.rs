@@ -71,9 +71,11 @@ fn interpolate(x: &[f64], pos: f64) -> f64 {
     // fuzzing) although the value may not. The same cubic on the samples scaled by 2^-5
     // (exact) keeps every partial sum below f64::MAX; scaled back it is inf only when the
     // interpolated value itself is beyond the range.
-    const K: f64 = 0.031_25;
-    hermite(x, i, s, K) / K
+    hermite(x, i, s, OVERFLOW_SCALE) / OVERFLOW_SCALE
 }
+
+/// 2^-5: on samples scaled by it the Hermite's coefficients and partial sums stay finite.
+const OVERFLOW_SCALE: f64 = 0.031_25;
 
 /// The cubic Hermite between samples `i` and `i + 1` at `s` in (0, 1), on the samples times `k`.
 #[inline]
