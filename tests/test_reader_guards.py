@@ -237,3 +237,28 @@ def test_binary_that_scipy_would_parse_as_v5_is_not_taken_for_v4(tmp_path):
     path.write_bytes(bytes(raw))
     with pytest.raises(RecordingError, match="unknown binary"):
         read_recording(path)
+
+
+def test_deep_valid_hdf5_trees_pass_the_structure_check(tmp_path):
+    """B-trees of level 1 and 2 with sibling chains (a group of 600 links, a dataset of 500
+    chunks), variable-length attributes, and the latest file format: all read."""
+    import h5py
+
+    from contactlab.io.hdf5 import check_structure
+
+    for libver in ("earliest", "latest"):
+        path = tmp_path / f"deep-{libver}.h5"
+        with h5py.File(path, "w", libver=libver) as f:
+            f.create_dataset("t", data=np.arange(5000) / 1000.0).attrs["unit"] = "s"
+            f.create_dataset("x", data=np.sin(np.arange(5000.0)), chunks=(10,))
+            f["x"].attrs["unit"] = "um"
+            f.create_dataset("F", data=np.cos(np.arange(5000.0))).attrs["unit"] = "N"
+            g = f.create_group("many")
+            for i in range(600):
+                g.create_dataset(f"d{i:04d}", data=np.arange(2.0)).attrs["note"] = f"v{i}"
+        raw = path.read_bytes()
+        if libver == "earliest":  # the trees this test is about are there
+            levels = {raw[p + 5] for p in range(len(raw)) if raw.startswith(b"TREE", p)}
+            assert max(levels) >= 1
+        check_structure(path, file=str(path))
+        assert read_recording(path).t.size == 5000
