@@ -95,7 +95,12 @@ def record(b: Bytes, joint: str, exc: str) -> tuple[str, dict[str, float]]:
     with np.errstate(all="ignore"):
         try:
             kw = {"force": u} if exc == "force" else {"base": u}
-            y = s.simulate(t, **kw).x.reshape(n, -1)[:, 0] if n >= 2 else np.zeros(n)
+            y = np.zeros(n)
+            if n >= 2:  # a run that stops early gives the samples reached: hold the last
+                r = s.simulate(t, **kw)
+                x = np.asarray(r.x).reshape(r.t.size, -1)[:, 0]
+                y[: x.size] = x
+                y[x.size :] = x[-1] if x.size else 0.0
         except ContactLabError:  # a structure or input the simulator refuses: a plain response
             y = u / k if exc == "force" else u.copy()
         mode = b.int(0, 15)
