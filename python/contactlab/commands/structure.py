@@ -114,8 +114,9 @@ def _identify(args: argparse.Namespace) -> int:
     if args.report:
         commit_outputs(args.report, rep.files())
     if args.json != "-":
-        hold = summary.get("rms_holdout")
-        print(f"{args.joint}: RMS output error {summary['rms_train']:.4g} m (training)"
+        hold, train = summary.get("rms_holdout"), summary["rms_train"]
+        print(f"{args.joint}: RMS output error "
+              + (f"{train:.4g} m (training)" if train is not None else "n/a (training)")
               + (f", {hold:.4g} m (hold-out)" if hold is not None else "")
               + f"; identified in {model.elapsed:.1f} s")  # fmt: skip
     return 0
