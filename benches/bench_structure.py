@@ -190,8 +190,9 @@ def main() -> None:
     assert r is not None and r.success, r
     diff = float(np.max(np.abs(ref - r.x[:np_])) / np.max(np.abs(ref)))
     diff2 = float(np.max(np.abs(ref2 - r.x[:np_])) / np.max(np.abs(ref2)))
-    print(f"Rust core: {a.n} steps in {rw:.3f} s wall, {rc:.3f} s CPU ({1e9 * rc / a.n:.0f} ns/step "
-          f"CPU, {r.n_iter / r.n_steps:.2f} Newton iterations/step)")  # fmt: skip
+    print(f"Rust core: {a.n} steps in {rw:.3f} s wall, {rc:.3f} s CPU "
+          f"({1e9 * rc / a.n:.0f} ns/step CPU, {r.n_iter / r.n_steps:.2f} Newton "
+          "iterations/step)")  # fmt: skip
     print(f"scalar pure-Python reference: {np_} steps, scaled to {a.n}: {pw:.1f} s wall, "
           f"{pc:.1f} s CPU; max relative difference on the common steps {diff:.2e}")  # fmt: skip
     print(f"numpy n-DOF reference: {np_} steps, scaled to {a.n}: {nw:.1f} s wall, {nc:.1f} s "

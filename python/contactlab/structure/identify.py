@@ -34,6 +34,7 @@ from .._arrays import as_1d
 from .._io_atomic import write_text
 from ..errors import ContactLabError, InputError
 from ..fitting import FitResult, Parameter, least_squares_fit
+from ._blas import with_single_blas_thread
 from .joints import iwan_uniform
 from .model import SimulationResult, Structure
 
@@ -381,6 +382,7 @@ def _starts(joint: str) -> list[dict[str, float]]:
     return [{}]
 
 
+@with_single_blas_thread
 def identify(
     t: Any,
     u: Any,
