@@ -101,20 +101,28 @@ fn newton(
         let mut r = -f1;
         r += m * a1 + c * v1 + k * x1;
         let mut scale = f1.abs() + ((m * a1).abs() + (c * v1).abs() + (k * x1).abs());
-        for ((j, st), tr) in s.joints.iter().zip(&w.joints).zip(trials.iter_mut()) {
+        let mut jac = m + g * c + b * k;
+        if let ([j], [st], [tr]) = (s.joints.as_slice(), w.joints.as_slice(), &mut *trials) {
+            // one joint (the common case): no iterator set-up per Newton iteration
             *tr = j.law.trial(st, w.x, x1, v1);
             scale = scale.max(tr.f.abs());
             r += tr.f;
+            jac += b * tr.kt + g * tr.ct;
+        } else {
+            for ((j, st), tr) in s.joints.iter().zip(&w.joints).zip(trials.iter_mut()) {
+                *tr = j.law.trial(st, w.x, x1, v1);
+                scale = scale.max(tr.f.abs());
+                r += tr.f;
+            }
+            for tr in trials.iter() {
+                jac += b * tr.kt + g * tr.ct;
+            }
         }
         if !r.is_finite() {
             return None;
         }
         if r.abs() <= opts.rtol * scale.max(f64::MIN_POSITIVE) {
             return Some((Step { dx, x1, v1, a1, f1 }, it));
-        }
-        let mut jac = m + g * c + b * k;
-        for tr in trials.iter() {
-            jac += b * tr.kt + g * tr.ct;
         }
         if !(jac != 0.0 && jac.is_finite()) {
             return None;
@@ -328,7 +336,7 @@ mod tests {
 
     /// The scalar path against the dense path on the same structure, input and start.
     fn compare(
-        law: JointLaw,
+        law: &JointLaw,
         two: bool,
         amp: f64,
         base: bool,
@@ -400,8 +408,15 @@ mod tests {
                 .iter()
                 .zip(q.iter())
                 .fold(0.0_f64, |m, (u, v)| m.max((u - v).abs()));
+            // energies that stay at rounding level (a joint that never slips dissipates
+            // nothing) are compared with the input work's size
+            let floor = if name.ends_with("work") || name.ends_with("dissipated") {
+                1e-9 * b.input_work.iter().fold(0.0_f64, |m, v| m.max(v.abs()))
+            } else {
+                0.0
+            };
             assert!(
-                diff <= 1e-7 * size + 1e-300,
+                diff <= 1e-7 * size + floor + 1e-300,
                 "{name} differs by {diff:e} (size {size:e}) for {law:?}"
             );
         }
@@ -411,9 +426,9 @@ mod tests {
     #[test]
     fn scalar_path_agrees_with_the_dense_path_for_every_joint_kind() -> Result<(), CoreError> {
         for law in laws()? {
-            compare(law.clone(), false, 1.0, false, 0.0, 0.0)?;
-            compare(law.clone(), true, 2.0, false, 1e-3, -0.02)?;
-            compare(law, false, 1e-3, true, 0.0, 0.01)?;
+            compare(&law, false, 1.0, false, 0.0, 0.0)?;
+            compare(&law, true, 2.0, false, 1e-3, -0.02)?;
+            compare(&law, false, 1e-3, true, 0.0, 0.01)?;
         }
         Ok(())
     }
@@ -440,7 +455,7 @@ mod tests {
             x0 in -2e-3f64..2e-3, v0 in -0.05f64..0.05,
         ) {
             let law = laws().map_err(|e| TestCaseError::fail(e.to_string()))?.swap_remove(which);
-            compare(law, two, if base { amp * 1e-3 } else { amp }, base, x0, v0)
+            compare(&law, two, if base { amp * 1e-3 } else { amp }, base, x0, v0)
                 .map_err(|e| TestCaseError::fail(e.to_string()))?;
         }
     }
