@@ -114,6 +114,10 @@ def test_bad_input_is_a_typed_error(tmp_path):
         tt = t.copy()
         tt[10:] += 1e-3
         diagnose_structure((tt, u, y), model)
+    with pytest.raises(InputError, match="y channel is constant"):
+        diagnose_structure((t, u, np.zeros_like(y)), model)
+    with pytest.raises(InputError, match="not finite"):
+        diagnose_structure((t, u, np.r_[y[:-1], np.nan]), model)
     with pytest.raises(InputError, match="holdout"):
         diagnose_structure((t, u, y), model, holdout=0.9)
     bad = tmp_path / "bad.json"

@@ -337,8 +337,13 @@ def _fit(
     def res(v: dict[str, float]) -> np.ndarray:
         return _output(model, effects, v, d, n) - d.y[:n]
 
-    fr = least_squares_fit(res, params, max_nfev=max_nfev, ftol=1e-8, xtol=1e-8, gtol=1e-10)
+    # a candidate driven far off (a huge slip force, a runaway coupling) may overflow inside
+    # the solver's trial steps: such trials are rejected by the solver, not warned about
+    with np.errstate(over="ignore", invalid="ignore"):
+        fr = least_squares_fit(res, params, max_nfev=max_nfev, ftol=1e-8, xtol=1e-8, gtol=1e-10)
     v = fr.values
+    if not all(math.isfinite(x) for x in v.values()):
+        raise InputError("the fit ended at non-finite parameters")
     se = {k: p.stderr for k, p in fr.params.items()}
     pred = _output(model, effects, v, d, d.t.size)
     return _Fit(effects, v, se, float(fr.chisqr), int(fr.nvarys), pred), fr
@@ -553,6 +558,9 @@ def diagnose_structure(
             raise InputError(f"unknown structure candidate {nm!r}; choose from "
                              f"{', '.join(STRUCTURE_CANDIDATES)}")  # fmt: skip
     n = t.size
+    for name, a in (("u", u), ("y", y)):
+        if not np.ptp(a) > 0:
+            raise InputError(f"the {name} channel is constant: nothing to diagnose")
     dt_all = np.diff(t)
     if n < 64:
         raise InputError(f"the record has {n} samples; at least 64 are needed")
