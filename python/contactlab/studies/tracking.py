@@ -276,10 +276,31 @@ def _as_float(v: Any) -> float:
     return float(v) if _finite(v) else float("nan")
 
 
+#: options of ``analyze_tangential`` the one-pass window analysis
+#: (:func:`contactlab.tangential.analysis.analyze_window`) takes; others (``on="signal"``,
+#: ``history``) take the whole-window analysis
+_WINDOW_OPTIONS = frozenset(
+    ("force_sign", "n_points", "rel_threshold", "min_cycles", "max_rel_stderr", "fit_offset",
+     "fit_x0", "fit_amplitude", "detrend", "initial")
+)  # fmt: skip
+
+
 def _tangential_window(rec: Recording, options: Mapping[str, Any]) -> tuple[dict, dict]:
     from ..tangential import analyze_tangential
+    from ..tangential.analysis import analyze_window
 
-    res = analyze_tangential(rec, **{"warn": False, **dict(options)})
+    opts = {k: v for k, v in options.items() if k != "warn"}
+    if opts.get("on", "averaged") == "averaged" and opts.get("history", "steady") == "steady":
+        opts.pop("on", None)
+        opts.pop("history", None)
+    if "invert_force" in opts:
+        inv = opts.pop("invert_force")
+        if inv is not None:
+            opts["force_sign"] = -1 if inv else 1
+    if set(opts) <= _WINDOW_OPTIONS:
+        res = analyze_window(rec, **opts)
+    else:
+        res = analyze_tangential(rec, **{"warn": False, **dict(options)})
     d = res.to_dict()
     row: dict[str, Any] = {}
     for q in TANGENTIAL_QUANTITIES:

@@ -195,6 +195,7 @@ class AveragedLoop:
     phase_sq: np.ndarray | None = None  # mean squared phase of each bin's samples
     cycle_bounds: np.ndarray | None = None  # first sample of each cycle, and the end
     x_var: np.ndarray | None = None  # variance of the samples' x inside each bin (all cycles)
+    t_mean: np.ndarray | None = None  # mean time stamp of each bin's samples (all cycles)
 
     @property
     def n_cycles(self) -> int:
@@ -378,6 +379,7 @@ def average_loop(
         phase_sq,
         bounds,
         x_var,
+        sums["sum_t"] / count,
     )
 
 
