@@ -143,6 +143,8 @@ class TrackResult:
     units: dict[str, str]
     cycles: dict[str, np.ndarray]
     meta: dict[str, Any] = field(default_factory=dict)
+    #: each window's whole analysis document (``track(..., keep_documents=True)``)
+    window_docs: list[dict[str, Any]] = field(default_factory=list, repr=False)
 
     @property
     def quantities(self) -> list[str]:
@@ -285,7 +287,9 @@ _WINDOW_OPTIONS = frozenset(
 )  # fmt: skip
 
 
-def _tangential_window(rec: Recording, options: Mapping[str, Any]) -> tuple[dict, dict]:
+def _tangential_window(
+    rec: Recording, options: Mapping[str, Any], keep_doc: bool = False
+) -> tuple[dict, dict]:
     from ..tangential import analyze_tangential
     from ..tangential.analysis import analyze_window
 
@@ -310,6 +314,8 @@ def _tangential_window(rec: Recording, options: Mapping[str, Any]) -> tuple[dict
     row["n_cycles"] = d.get("n_cycles")
     row["warnings"] = " | ".join(res.warnings)
     units = {k: v for k, v in d.get("units", {}).items() if k in row}
+    if keep_doc:
+        row["_doc"] = d
     return row, units
 
 
@@ -431,6 +437,7 @@ def track(
     keep_going: bool = True,
     callback: Callable[[dict[str, Any]], None] | None = None,
     executor: Any = None,
+    keep_documents: bool = False,
 ) -> TrackResult:
     """Fitted quantities of a long recording window by window, in bounded memory.
 
@@ -462,6 +469,9 @@ def track(
         Analyse windows in parallel on a ``concurrent.futures`` executor or a Dask
         ``distributed.Client`` while the file is read on; at most two windows per worker are
         held. The rows equal those of a serial run.
+    keep_documents : bool
+        Keep each tangential window's whole analysis document (``TrackResult.window_docs``;
+        what :func:`contactlab.studies.pooled.pooled_document` pools).
 
     Returns
     -------
@@ -487,7 +497,12 @@ def track(
     if kind_ not in ("tangential", "normal"):
         raise InputError(f"{cr.source}: cannot tell the kind of recording; pass kind=")
     loop_x, loop_F, drive = ("x", "F", "x") if kind_ == "tangential" else ("delta", "p", "p")
-    analyse = _tangential_window if kind_ == "tangential" else _normal_window
+    analyse: Callable[..., tuple[dict, dict]] = (
+        functools.partial(_tangential_window, keep_doc=keep_documents)
+        if kind_ == "tangential"
+        else _normal_window
+    )
+    docs: list[dict[str, Any]] = []
     opts = dict(options or {})
 
     state = CycleState()
@@ -518,6 +533,9 @@ def track(
             if not keep_going:
                 raise
             values, u = {"error": f"window {row['window']}: {exc}"}, {}
+        doc = values.pop("_doc", None)
+        if doc is not None:
+            docs.append(doc)
         row.update(values)
         units.update(u)
         if callback is not None:
@@ -613,7 +631,7 @@ def track(
         "every_mode": mode,
         "every_value": size,
     }
-    return TrackResult(cr.source, kind_, every_text, rows, units, cycles, meta)
+    return TrackResult(cr.source, kind_, every_text, rows, units, cycles, meta, docs)
 
 
 def track_many(
