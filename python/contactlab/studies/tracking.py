@@ -66,7 +66,9 @@ NORMAL_QUANTITIES = ("E_d", "psi", "psi_kv", "k_tan", "k_sec", "delta_max", "del
 MIN_CYCLES = 3
 #: default upper bound on a window's samples (one window is held in memory)
 MAX_WINDOW = 2_000_000
-#: samples per window for ``every="auto"`` (the analysis' samples/s is best near this size)
+#: samples per window for ``every="auto"``: the fit of a window costs about as much as folding
+#: 10^5 samples, so longer windows amortise it, but each window in flight holds ~100 bytes a
+#: sample (2^20 with two threads peaked at 420 MB on 1e7 samples, 2^19 at 216 MB with one)
 AUTO_WINDOW = 1 << 19
 
 _EVERY = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?\d+)?)\s*([A-Za-zµμ]*)\s*$")
@@ -399,7 +401,7 @@ def _blocks(chunks: Iterator[Recording], min_block: int) -> Iterator[Recording]:
     size = 0
     for c in chunks:
         for name, v in c.data.items():  # found by fuzzing: 1e300 data overflowed windows
-            if v.size and float(np.max(np.abs(v))) > MAX_MAGNITUDE:
+            if v.size and max(float(v.max()), -float(v.min())) > MAX_MAGNITUDE:
                 i = int(np.argmax(np.abs(v)))
                 raise InputError(
                     f"{c.source}: {name} reaches {float(v[i]):.3g} {c.units.get(name, '')} "
@@ -438,6 +440,7 @@ def track(
     callback: Callable[[dict[str, Any]], None] | None = None,
     executor: Any = None,
     keep_documents: bool = False,
+    threads: int | None = None,
 ) -> TrackResult:
     """Fitted quantities of a long recording window by window, in bounded memory.
 
@@ -469,6 +472,11 @@ def track(
         Analyse windows in parallel on a ``concurrent.futures`` executor or a Dask
         ``distributed.Client`` while the file is read on; at most two windows per worker are
         held. The rows equal those of a serial run.
+    threads : int, optional
+        Without ``executor``: analyse windows on this many helper threads while the next
+        chunks are read and their cycles found (the Rust kernels release the GIL); default 1
+        (each thread holds up to two windows: 2 threads peak near 300 MB with ``"auto"``
+        windows), 0 analyses each window before reading on. The rows are the same.
     keep_documents : bool
         Keep each tangential window's whole analysis document (``TrackResult.window_docs``;
         what :func:`contactlab.studies.pooled.pooled_document` pools).
@@ -488,6 +496,18 @@ def track(
     >>> bool(abs(res.combined()["h0"] - 40.0) < 4 * res.combined()["h0_stderr"])
     True
     """
+    if executor is None and threads != 0:
+        from concurrent.futures import ThreadPoolExecutor
+
+        n_threads = 1 if threads is None else int(threads)
+        if n_threads < 0:
+            raise InputError(f"threads must be >= 0, got {threads!r}")
+        with ThreadPoolExecutor(n_threads, thread_name_prefix="contactlab-track") as pool:
+            return track(
+                source, every, kind=kind, columns=columns, fs=fs, chunk_size=chunk_size,
+                max_window=max_window, options=options, keep_going=keep_going,
+                callback=callback, executor=pool, keep_documents=keep_documents,
+            )  # fmt: skip
     mode, size = parse_every(every)
     every_text = every if isinstance(every, str) else f"{every}cycles"
     if not (isinstance(max_window, int) and max_window >= 16):

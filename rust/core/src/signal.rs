@@ -347,6 +347,70 @@ pub fn loop_areas(x: &[f64], f: &[f64], bounds: &[usize]) -> Result<Vec<f64>, Co
     Ok(out)
 }
 
+/// Time averages of `v` between consecutive `edges` (trapezoid rule on the samples, the
+/// cumulative integral interpolated linearly at the edges), with numpy's arithmetic:
+/// `c = [0, cumsum(0.5 (v[1:] + v[:-1]) diff(t))]`, `ce = interp(edges, t, c)`,
+/// `diff(ce) / diff(edges)`. `t` strictly increasing (checked), `edges` non-decreasing.
+// Index arithmetic: j + 1 < t.len() inside the search (t.len() >= 2 checked).
+#[allow(clippy::arithmetic_side_effects)]
+pub fn period_means(t: &[f64], v: &[f64], edges: &[f64]) -> Result<Vec<f64>, CoreError> {
+    check_same_len("t", t.len(), "v", v.len())?;
+    check_finite("t", t)?;
+    check_finite("edges", edges)?;
+    if t.len() < 2 {
+        return Err(CoreError::Empty { name: "t" });
+    }
+    for i in 1..t.len() {
+        if t[i] <= t[i - 1] {
+            return Err(CoreError::NotIncreasing {
+                name: "t",
+                index: i,
+                value: t[i],
+                prev: t[i - 1],
+            });
+        }
+    }
+    for i in 1..edges.len() {
+        if edges[i] < edges[i - 1] {
+            return Err(CoreError::NotIncreasing {
+                name: "edges",
+                index: i,
+                value: edges[i],
+                prev: edges[i - 1],
+            });
+        }
+    }
+    let n = t.len();
+    // cumulative integral at sample j, carried while the edges are visited in order
+    let mut ce = Vec::with_capacity(edges.len());
+    let (mut j, mut cj) = (0_usize, 0.0_f64);
+    let step = |j: usize| 0.5 * (v[j + 1] + v[j]) * (t[j + 1] - t[j]);
+    for &e in edges {
+        if e <= t[0] {
+            ce.push(0.0);
+            continue;
+        }
+        while j + 1 < n && t[j + 1] <= e {
+            cj += step(j);
+            j += 1;
+        }
+        if j + 1 >= n {
+            ce.push(cj); // at or beyond the last sample: its value
+        } else if e == t[j] {
+            ce.push(cj);
+        } else {
+            let c1 = cj + step(j);
+            let slope = (c1 - cj) / (t[j + 1] - t[j]);
+            ce.push(slope * (e - t[j]) + cj);
+        }
+    }
+    Ok(ce
+        .windows(2)
+        .zip(edges.windows(2))
+        .map(|(c, e)| (c[1] - c[0]) / (e[1] - e[0]))
+        .collect())
+}
+
 /// Noise sensitivity of each cycle's loop area `x[bounds[k]..bounds[k+1]]`: the shoelace
 /// area is linear in every sample's `F` with coefficient `(x[i-1] - x[i+1]) / 2` and in its
 /// `x` with `(F[i+1] - F[i-1]) / 2` (indices cyclic within the cycle). Returns per cycle

@@ -3,8 +3,8 @@
 
 use contactlab_core::masing::{branch_memory, MasingState};
 use contactlab_core::signal::{
-    cycle_block, fold_phase, loop_area_sensitivity, loop_areas, CycleState, Excursion, FoldSums,
-    Schmitt,
+    cycle_block, fold_phase, loop_area_sensitivity, loop_areas, period_means, CycleState,
+    Excursion, FoldSums, Schmitt,
 };
 use contactlab_core::CoreError;
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadwriteArray1};
@@ -336,10 +336,26 @@ impl CycleTracker {
     }
 }
 
+/// Time averages of `v` between consecutive `edges` (see
+/// `contactlab_core::signal::period_means`).
+#[pyfunction]
+#[pyo3(name = "period_means")]
+fn period_means_py<'py>(
+    py: Python<'py>,
+    t: PyReadonlyArray1<'py, f64>,
+    v: PyReadonlyArray1<'py, f64>,
+    edges: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let (ts, vs, es) = (slice(&t, "t")?, slice(&v, "v")?, slice(&edges, "edges")?);
+    let m = detach_guarded(py, || period_means(ts, vs, es))?;
+    Ok(m.into_pyarray(py))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PhaseFold>()?;
     m.add_function(wrap_pyfunction!(loop_areas_py, m)?)?;
     m.add_function(wrap_pyfunction!(loop_area_sensitivity_py, m)?)?;
+    m.add_function(wrap_pyfunction!(period_means_py, m)?)?;
     m.add_class::<CycleTracker>()?;
     m.add_class::<ReversalDetector>()?;
     m.add_function(wrap_pyfunction!(branch_memory_py, m)?)?;
