@@ -333,3 +333,35 @@ def test_threads_give_the_serial_rows(long_rec):
     np.testing.assert_array_equal(a.cycles["energy"], b.cycles["energy"])
     with pytest.raises(InputError, match="threads"):
         track(long_rec, every="6cycles", threads=-1)
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 10_000), n_bins=st.integers(8, 60), n_cyc=st.integers(1, 9))
+def test_fold_spread_is_the_numpy_spread(seed, n_bins, n_cyc):
+    """PhaseFold.spread (Rust) against preprocess' numpy formulas, cells left empty included."""
+    from contactlab import _core
+    from contactlab.tangential.preprocess import _dphase, _spread
+
+    rng = np.random.default_rng(seed)
+    n = n_cyc * n_bins * 3
+    t = np.sort(rng.uniform(0.0, n_cyc, n))
+    t = t[np.r_[True, np.diff(t) > 0]]
+    x, F = np.sin(2 * np.pi * t) + 0.1 * rng.standard_normal(t.size), rng.standard_normal(t.size)
+    kt = np.linspace(0.0, n_cyc, n_cyc + 1)
+    fold = _core.PhaseFold(n_bins, n_cyc)
+    fold.push(t, x, F, 0, kt, kt.copy())
+    s, got = fold.sums(), fold.spread()
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cx, cF = s["cycle_x"] / s["cycle_count"], s["cycle_F"] / s["cycle_count"]
+        dphi = s["cycle_phase"] / s["cycle_count"] - s["sum_phase"] / s["count"]
+        xm, Fm = s["sum_x"] / s["count"], s["sum_F"] / s["count"]
+        ref_x = _spread(cx - _dphase(xm, n_bins) * dphi)
+        ref_F = _spread(cF - _dphase(Fm, n_bins) * dphi)
+    np.testing.assert_allclose(got["x_std"], ref_x, rtol=1e-12, atol=0)
+    np.testing.assert_allclose(got["F_std"], ref_F, rtol=1e-12, atol=0)
+    with np.errstate(invalid="ignore"):
+        full = np.isfinite(cx).any(axis=1)
+        ref_a = np.full(n_cyc, np.nan)
+        ref_a[full] = 0.5 * (np.nanmax(cx[full], axis=1) - np.nanmin(cx[full], axis=1))
+    np.testing.assert_array_equal(got["amplitude"], ref_a)
+    assert set(fold.sums(cells=False)) == {k for k in s if not k.startswith("cycle_")}

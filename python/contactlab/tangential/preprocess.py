@@ -321,7 +321,7 @@ def average_loop(
     # per-sample temporaries; the bins are numpy.interp's).
     fold = _core.PhaseFold(int(n_points), n_cyc)
     fold.push(ta, xa, Fa, 0, kt, kp)
-    sums = fold.sums()
+    sums = fold.sums(cells=False)
     count = sums["count"]
     if np.any(count == 0):
         raise InputError(
@@ -330,26 +330,20 @@ def average_loop(
         )
     xm = sums["sum_x"] / count
     Fm = sums["sum_F"] / count
-    # per-cycle bin means (cycles x bins); a bin a cycle missed is NaN
-    cc = sums["cycle_count"]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        cx = sums["cycle_x"] / cc
-        cF = sums["cycle_F"] / cc
-        cphi = sums["cycle_phase"] / cc
-    # Where the samples of a cycle sit inside a bin differs from cycle to cycle; on a steep
-    # branch that alone spreads the per-cycle means. Remove it to first order (gradient along
-    # phase, periodic) so the spread measures noise and real cycle-to-cycle change.
     phim = sums["sum_phase"] / count
-    dphi = cphi - phim
-    x_std = _spread(cx - _dphase(xm, n_points) * dphi)
-    F_std = _spread(cF - _dphase(Fm, n_points) * dphi)
+    # Per-cycle bin means (cycles x bins) spread from cycle to cycle. Where the samples of a
+    # cycle sit inside a bin differs from cycle to cycle; on a steep branch that alone spreads
+    # the per-cycle means: it is removed to first order (gradient along phase, periodic), so
+    # the spread measures noise and real cycle-to-cycle change. In Rust over the fold's cells
+    # with the arithmetic of ``_spread`` and ``_dphase`` (numpy reference in the tests).
+    spread = fold.spread()
+    x_std, F_std = spread["x_std"], spread["F_std"]
     # sample index where each cycle starts (a cycle without samples starts where the next
     # does), and where the last one ends
     first = np.r_[sums["first"], end]
     first = np.minimum.accumulate(np.where(first < 0, end, first)[::-1])[::-1]
     bounds = first.astype(np.int64)
-    amps = 0.5 * (np.nanmax(cx, axis=1) - np.nanmin(cx, axis=1))
-    franges = 0.5 * (np.nanmax(cF, axis=1) - np.nanmin(cF, axis=1))
+    amps, franges = spread["amplitude"], spread["force_range"]
     # the area of the cycle's own samples: bin means would cut the corners at the turns
     energies = _core.loop_areas(xa, Fa, bounds.tolist())
     scatter = CycleScatter(

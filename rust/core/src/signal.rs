@@ -347,6 +347,106 @@ pub fn loop_areas(x: &[f64], f: &[f64], bounds: &[usize]) -> Result<Vec<f64>, Co
     Ok(out)
 }
 
+/// Cycle-to-cycle spread of a phase fold: per bin, the standard deviation over the cycles of
+/// the per-cycle bin means of x and F, each corrected to first order for where that cycle's
+/// samples sit inside the bin (`mean - slope · (φ̄_cycle - φ̄_bin)`, the slope along phase a
+/// periodic central difference of the bin means); NaN below 2 cycles with samples in the
+/// bin. Per cycle: half the range of its bin means of x (amplitude) and of F (NaN for a cycle
+/// without samples). The arithmetic is numpy's of `contactlab.tangential.preprocess`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FoldSpread {
+    pub x_std: Vec<f64>,
+    pub f_std: Vec<f64>,
+    pub amplitude: Vec<f64>,
+    pub force_range: Vec<f64>,
+}
+
+// Index arithmetic: b < nb and c < n_cycles, so c * nb + b < the cells `check_shape` checked;
+// (b + 1) % nb and (b + nb - 1) % nb stay below nb (nb >= 1).
+#[allow(clippy::arithmetic_side_effects)]
+pub fn fold_spread(sums: &FoldSums) -> Result<FoldSpread, CoreError> {
+    sums.check_shape()?;
+    let (nb, nc) = (sums.n_bins, sums.n_cycles);
+    let half_n = nb as f64 / 2.0;
+    let mean_of =
+        |v: &[f64]| -> Vec<f64> { v.iter().zip(&sums.count).map(|(s, n)| s / n).collect() };
+    let (xm, fm, phim) = (
+        mean_of(&sums.sum_x),
+        mean_of(&sums.sum_f),
+        mean_of(&sums.sum_phase),
+    );
+    let slope = |m: &[f64], b: usize| (m[(b + 1) % nb] - m[(b + nb - 1) % nb]) * half_n;
+    let gx: Vec<f64> = (0..nb).map(|b| slope(&xm, b)).collect();
+    let gf: Vec<f64> = (0..nb).map(|b| slope(&fm, b)).collect();
+    // corrected per-cycle bin means, NaN where a cycle has no sample in the bin
+    let cell = |c: usize, b: usize, v: &[f64], g: &[f64]| {
+        let k = c * nb + b;
+        let n = sums.cycle_count[k];
+        let dphi = sums.cycle_phase[k] / n - phim[b];
+        v[k] / n - g[b] * dphi
+    };
+    let spread = |v: &[f64], g: &[f64]| -> Vec<f64> {
+        let mut sum = vec![0.0_f64; nb];
+        let mut cnt = vec![0_usize; nb];
+        for c in 0..nc {
+            for b in 0..nb {
+                let a = cell(c, b, v, g);
+                if a.is_finite() {
+                    sum[b] += a;
+                    cnt[b] += 1;
+                }
+            }
+        }
+        let mean: Vec<f64> = sum.iter().zip(&cnt).map(|(s, &k)| s / k as f64).collect();
+        let mut sq = vec![0.0_f64; nb];
+        for c in 0..nc {
+            for b in 0..nb {
+                let a = cell(c, b, v, g);
+                if a.is_finite() {
+                    let d = a - mean[b];
+                    sq[b] += d * d;
+                }
+            }
+        }
+        sq.iter()
+            .zip(&cnt)
+            .map(|(q, &k)| {
+                if k >= 2 {
+                    (q / (k - 1) as f64).sqrt()
+                } else {
+                    f64::NAN
+                }
+            })
+            .collect()
+    };
+    let range = |v: &[f64]| -> Vec<f64> {
+        (0..nc)
+            .map(|c| {
+                let (mut hi, mut lo) = (f64::NEG_INFINITY, f64::INFINITY);
+                for b in 0..nb {
+                    let k = c * nb + b;
+                    let m = v[k] / sums.cycle_count[k];
+                    if !m.is_nan() {
+                        hi = hi.max(m);
+                        lo = lo.min(m);
+                    }
+                }
+                if hi >= lo {
+                    0.5 * (hi - lo)
+                } else {
+                    f64::NAN
+                }
+            })
+            .collect()
+    };
+    Ok(FoldSpread {
+        x_std: spread(&sums.cycle_x, &gx),
+        f_std: spread(&sums.cycle_f, &gf),
+        amplitude: range(&sums.cycle_x),
+        force_range: range(&sums.cycle_f),
+    })
+}
+
 /// Time averages of `v` between consecutive `edges` (trapezoid rule on the samples, the
 /// cumulative integral interpolated linearly at the edges), with numpy's arithmetic:
 /// `c = [0, cumsum(0.5 (v[1:] + v[:-1]) diff(t))]`, `ce = interp(edges, t, c)`,

@@ -3,8 +3,8 @@
 
 use contactlab_core::masing::{branch_memory, MasingState};
 use contactlab_core::signal::{
-    cycle_block, fold_phase, loop_area_sensitivity, loop_areas, period_means, CycleState,
-    Excursion, FoldSums, Schmitt,
+    cycle_block, fold_phase, fold_spread, loop_area_sensitivity, loop_areas, period_means,
+    CycleState, Excursion, FoldSums, Schmitt,
 };
 use contactlab_core::CoreError;
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadwriteArray1};
@@ -224,8 +224,23 @@ impl PhaseFold {
         detach_guarded(py, || fold_phase(ts, xs, fs, offset, kt, kp, sums))
     }
 
-    /// The sums so far: dict of arrays (per bin, and per cycle × bin as 2-D arrays).
-    fn sums<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+    /// Cycle-to-cycle spread per bin (`x_std`, `F_std`) and per-cycle half ranges of the
+    /// bin means (`amplitude`, `force_range`); see `contactlab_core::signal::fold_spread`.
+    fn spread<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let sums = &self.sums;
+        let sp = detach_guarded(py, || fold_spread(sums))?;
+        let d = PyDict::new(py);
+        d.set_item("x_std", sp.x_std.into_pyarray(py))?;
+        d.set_item("F_std", sp.f_std.into_pyarray(py))?;
+        d.set_item("amplitude", sp.amplitude.into_pyarray(py))?;
+        d.set_item("force_range", sp.force_range.into_pyarray(py))?;
+        Ok(d)
+    }
+
+    /// The sums so far: dict of arrays (per bin, and with `cells` per cycle × bin as 2-D
+    /// arrays).
+    #[pyo3(signature = (cells=true))]
+    fn sums<'py>(&self, py: Python<'py>, cells: bool) -> PyResult<Bound<'py, PyDict>> {
         let s = &self.sums;
         let d = PyDict::new(py);
         for (k, v) in [
@@ -239,12 +254,17 @@ impl PhaseFold {
         ] {
             d.set_item(k, v.clone().into_pyarray(py))?;
         }
-        for (k, v) in [
-            ("cycle_count", &s.cycle_count),
-            ("cycle_x", &s.cycle_x),
-            ("cycle_F", &s.cycle_f),
-            ("cycle_phase", &s.cycle_phase),
-        ] {
+        let per_cell: &[(&str, &Vec<f64>)] = if cells {
+            &[
+                ("cycle_count", &s.cycle_count),
+                ("cycle_x", &s.cycle_x),
+                ("cycle_F", &s.cycle_f),
+                ("cycle_phase", &s.cycle_phase),
+            ]
+        } else {
+            &[]
+        };
+        for &(k, v) in per_cell {
             let a = v.clone().into_pyarray(py);
             d.set_item(k, a.reshape([s.n_cycles, s.n_bins])?)?;
         }
