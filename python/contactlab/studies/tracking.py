@@ -6,8 +6,10 @@ and cuts it into windows of N cycles or T seconds (cut at upward crossings of th
 every window holds whole cycles), analyses each window as the whole-recording analyses do and
 keeps only the results:
 
-- tangential windows: :func:`contactlab.tangential.analyze_tangential` — h0, ac (None where
-  the analysis finds them not separately identifiable; ``h0_ac`` always), energy per cycle
+- tangential windows: :func:`contactlab.tangential.analysis.analyze_window` (the numbers of
+  :func:`~contactlab.tangential.analyze_tangential`, the samples folded once in Rust) — h0,
+  ac (None where the analysis finds them not separately identifiable; ``h0_ac`` always),
+  energy per cycle
   analytic and numeric, c_e·ω (eq. 17), k_local0 (eq. 18), k_global (eq. 19), amplitude and
   force offset, each with its standard error;
 - normal windows: :func:`contactlab.normal.analyze_loop` — E_d (with its standard error from

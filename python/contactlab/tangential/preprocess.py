@@ -245,12 +245,14 @@ def _period_means(t: np.ndarray, v: np.ndarray, edges: np.ndarray) -> np.ndarray
 
 
 def _dphase(v: np.ndarray, n: int) -> np.ndarray:
-    """Derivative of bin values along phase (periodic central difference)."""
+    """Derivative of bin values along phase (periodic central difference); the numpy
+    reference of the gradient ``PhaseFold.spread`` applies (tests)."""
     return (np.roll(v, -1) - np.roll(v, 1)) * (n / 2.0)
 
 
 def _spread(a: np.ndarray) -> np.ndarray:
-    """Standard deviation over axis 0 ignoring NaN; NaN where fewer than 2 values."""
+    """Standard deviation over axis 0 ignoring NaN; NaN where fewer than 2 values (the numpy
+    reference of ``PhaseFold.spread``, tests)."""
     ok = np.isfinite(a)
     k = ok.sum(axis=0)
     z = np.where(ok, a, 0.0)
