@@ -16,7 +16,7 @@ Stages (``samples/s`` = recording samples per second of wall time):
   analysed on one helper thread while reading on (the default), serially (``threads=0``),
   and on ``--workers`` processes;
 - ``whole``: ``contactlab analyze`` of a ``--whole-samples`` file (default 1e7): as a user
-  runs it (longer than 2^20 samples: streamed and pooled automatically), with ``--whole`` (read
+  runs it (longer than 2^19 samples: streamed and pooled automatically), with ``--whole`` (read
   into memory: the issue's "before") and with ``--stream``;
 - ``study``: ``--study-files`` recordings analysed serially and on a process pool.
 

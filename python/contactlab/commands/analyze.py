@@ -388,7 +388,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--whole",
         action="store_true",
-        help="tangential recordings longer than 2^20 samples are streamed and pooled "
+        help="tangential recordings longer than 2^19 samples are streamed and pooled "
         "automatically (memory bounded, JSON says 'streamed'); --whole reads them into memory",
     )
     p.add_argument(
