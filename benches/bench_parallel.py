@@ -9,7 +9,9 @@ Eight channels of band-limited noise (1e6 samples each by default) through the M
   the kernel);
 - python processes: a ``ProcessPoolExecutor`` (arrays pickled to the workers and back).
 
-Prints each speed-up over serial; the requirement is >= 1.9x on 2 cores.
+Prints each speed-up over serial; the requirement is >= 1.9x on 2 cores. Unlike a ratio of two
+single-core timings, this figure depends on what else the machine runs: the load average is
+printed before and after (the run is only meaningful on an otherwise idle machine).
 Run: ``.venv/bin/python benches/bench_parallel.py [--channels 8] [--n 1000000]``.
 """
 
@@ -49,6 +51,7 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     args = ap.parse_args()
     cores = os.cpu_count() or 1
+    load_before = os.getloadavg()
     xs = channels(args.channels, args.n)
     ref = [_force(x) for x in xs]
     with ThreadPoolExecutor(cores) as tp, ProcessPoolExecutor(cores) as pp:
@@ -69,6 +72,8 @@ def main() -> None:
                 del out
     total = args.channels * args.n
     print(f"{args.channels} channels x {args.n:.0e} samples, {cores} cores, best of {args.repeat}")
+    load = ", ".join(f"{a:.2f}" for a in load_before + os.getloadavg())
+    print(f"load average (1, 5, 15 min) before and after: {load}")
     serial = best["serial (one core)"]
     for name, t in best.items():
         print(f"{name:<20}{total / t / 1e6:8.1f} Ms/s   speed-up {serial / t:5.2f}x")
