@@ -14,6 +14,12 @@
 //!
 //! Run: `cargo bench -p contactlab-core --bench masing`
 //! (`-- --n 1000000 --repeat 15 --piece 100000 --signal random_walk`).
+//!
+//! On a heavily loaded machine even the per-piece medians drift (the two sides suffer
+//! differently from a busy sibling hyperthread). The CPU-time split from a sampling profiler
+//! does not: `perf record -e cpu-clock BINARY --signal S`, then `perf report --sort sym`, and
+//! add `reference_piece` + libm's `exp`/`expm1` symbols against `kernel_piece` +
+//! `contactlab_core::*` symbols.
 
 use contactlab_core::curve::Exponential;
 use contactlab_core::masing::{masing_force, MasingState};
