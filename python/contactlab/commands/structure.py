@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -34,9 +35,14 @@ def read_table(path: str) -> dict[str, np.ndarray]:
     if len(names) < 2:
         raise InputError(f"{path}: the first line must name the comma-separated columns")
     try:
-        data = np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2)
+        with warnings.catch_warnings():
+            # numpy warns "input contained no data" for a header alone: refused just below
+            warnings.simplefilter("ignore", UserWarning)
+            data = np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2)
     except ValueError as exc:
         raise InputError(f"{path}: not a numeric table: {exc}") from None
+    if data.size == 0:
+        raise InputError(f"{path}: no data rows after the header line")
     if data.shape[1] != len(names):
         raise InputError(f"{path}: {len(names)} column names but {data.shape[1]} columns")
     out = {}
@@ -109,8 +115,9 @@ def _identify(args: argparse.Namespace) -> int:
     if args.report:
         commit_outputs(args.report, rep.files())
     if args.json != "-":
-        hold = summary.get("rms_holdout")
-        print(f"{args.joint}: RMS output error {summary['rms_train']:.4g} m (training)"
+        hold, train = summary.get("rms_holdout"), summary["rms_train"]
+        print(f"{args.joint}: RMS output error "
+              + (f"{train:.4g} m (training)" if train is not None else "n/a (training)")
               + (f", {hold:.4g} m (hold-out)" if hold is not None else "")
               + f"; identified in {model.elapsed:.1f} s")  # fmt: skip
     return 0

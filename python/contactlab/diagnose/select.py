@@ -131,7 +131,11 @@ def fit(
         # clipped: the affine map back can step a rounding error past a bound (h0 = -3e-17)
         return {n: float(np.clip(x0[n] + (w[n] - 1.0) * sc[n], lo[n], hi[n])) for n in names}
 
+    spent = d.extra.get("evaluations")  # the workflow's budget counter (a one-item list)
+
     def resid(w: dict[str, float]) -> np.ndarray:
+        if spent is not None:
+            spent[0] += 1
         return (family.predict(value(w), effects, d)[mask] - y) * sw
 
     res = least_squares_fit(resid, params, ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=400)
