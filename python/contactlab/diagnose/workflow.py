@@ -447,7 +447,8 @@ def diagnose(
             extra = 0.0
             if name == "channel_delay" and abs(p["tau"]) < d.dt:
                 extra = budget  # a sub-sample shift must beat what smoothing the input buys
-            v = judge(name, current, cand, sigma, z, min_gain + extra)
+            prop = d if getattr(family, "proportional_gain", False) else None
+            v = judge(name, current, cand, sigma, z, min_gain + extra, prop)
             # every effect of the candidate model, not only the new one: a refit can push an
             # effect added before to the edge of its physical range
             why = next(
