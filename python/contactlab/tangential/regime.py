@@ -207,8 +207,49 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1), strict=True))
 
 
-def _breakaway(f: np.ndarray, v: np.ndarray, a: int, b: int, window: int, sliding: float) -> float:
-    """Breakaway force of the stick ``[a, b)`` (``f``: the force about the plateaus' midline).
+def _break_time(x: np.ndarray, a: int, b: int, end: int, window: int, sigma: float) -> float | None:
+    """Sample (fractional) at which a stuck plate starts to move with a jump of its
+    acceleration (the friction force dropping from static to kinetic), or None.
+
+    ``x`` is flat before the break and departs as ``c2 s² + c3 s³`` after it (``s`` samples
+    since the break), fitted by least squares with the break on a grid of tenths of a sample
+    between a window before the stick's end and the onset of sliding. Without a drop the
+    acceleration grows from zero (``c2 = 0``); the jump is taken as shown only when freeing
+    ``c2`` lowers the squared error by more than ``9 σ²`` (``σ``: the displacement noise).
+    """
+    hi = min(end + window, x.size)
+    lo = max(a + 4, b - window)
+    first = max(a, lo - 2 * window)
+    if hi - lo < 3:
+        return None
+    i = np.arange(first, hi, dtype=float)
+    xs = x[first:hi]
+    best: dict[bool, tuple[float, float]] = {}
+    for tb in np.arange(lo, min(end + 2, hi - 1), 0.1):
+        sv = np.clip(i - tb, 0.0, None)
+        for quad in (True, False):
+            cols = [np.ones_like(i), sv**2, sv**3] if quad else [np.ones_like(i), sv**3]
+            design = np.column_stack(cols)
+            coef, *_ = np.linalg.lstsq(design, xs, rcond=None)
+            rss = float(np.sum((design @ coef - xs) ** 2))
+            if rss < best.get(quad, (np.inf, 0.0))[0]:
+                best[quad] = (rss, float(tb))
+    if True not in best or best[False][0] - best[True][0] <= 9.0 * sigma**2:
+        return None
+    return best[True][1]
+
+
+def _breakaway(
+    f: np.ndarray,
+    x: np.ndarray,
+    v: np.ndarray,
+    span: tuple[int, int],
+    window: int,
+    sliding: float,
+    sigma: float,
+) -> float:
+    """Breakaway force of the stick ``span = [a, b)`` (``f``: the force about the plateaus'
+    midline; ``sigma``: the displacement noise).
 
     Two things lower a plain maximum of ``|f|`` over the stuck samples. (1) A real joint
     creeps before it slides: the velocity leaves the stick band while the force still rises
@@ -217,40 +258,29 @@ def _breakaway(f: np.ndarray, v: np.ndarray, a: int, b: int, window: int, slidin
     reaches :data:`SLIDE_ONSET` of the stroke's peak speed. (2) The force drops at breakaway
     (static to kinetic friction) and a force reconstructed from the displacement's second
     derivative (``M x''`` of :func:`~contactlab.tangential.frame.frame_friction_force`)
-    smears that drop symmetrically over its window (the same Lepski window as the velocity's):
-    about half the drop is lost. While stuck the force is a smooth ramp (the drive's
-    sinusoid), so a quadratic is fitted on the stuck samples clear of that half window; a
-    symmetric smoother puts the smeared step's midpoint — halfway between the ramp and the
-    kinetic level just after — at the breakaway instant, where the ramp is read. The larger of
-    that and the plain maximum is the breakaway force.
+    smears that drop over its window (the same Lepski window as the velocity's), half a
+    window before the plate moves: about half the drop is lost. While stuck the force is a
+    smooth ramp (the drive's sinusoid), so a quadratic is fitted on the stuck samples clear
+    of that half window and read at the instant the displacement starts to move with a jump
+    of its acceleration (:func:`_break_time`; without a jump there is no drop to recover).
+    The larger of that and the plain maximum is the breakaway force.
     """
+    a, b = span
     n = f.size
     end = b
     while end < n and abs(v[end]) < sliding:
         end += 1
     peak = float(np.max(np.abs(f[a : min(end + 1, n)])))
-    half = window // 2 + 1
-    clear = b - half
-    after = f[end + half : end + half + max(window, 5)]
-    if clear - a < 8 or after.size < 3:
+    tb = _break_time(x, a, b, end, window, sigma)
+    if tb is None:
+        return peak
+    clear = int(min(b, math.floor(tb))) - (window // 2 + 1)
+    if clear - a < 8:
         return peak
     sign = 1.0 if np.mean(f[clear - 4 : clear]) >= 0 else -1.0
-    g = sign * f
     i = np.arange(a, clear, dtype=float) - clear
-    ramp = np.polynomial.Polynomial.fit(i, g[a:clear], 2)
-    kinetic = float(np.median(sign * after))
-    js = np.arange(clear - 1, min(end + half, n))
-    mid = 0.5 * (ramp(js - clear) + kinetic)
-    above = np.flatnonzero(g[js] > mid)
-    # the crossing follows the last sample above the midpoint (noise crossings before it
-    # are undone by a later sample above; after the break the gap only widens)
-    if above.size == 0 or above[-1] + 1 >= js.size:
-        return peak
-    k = int(above[-1])
-    e0, e1 = g[js[k]] - mid[k], g[js[k + 1]] - mid[k + 1]
-    frac = e0 / (e0 - e1) if e0 > e1 else 1.0
-    return max(peak, float(ramp(js[k] + frac - clear)))
-    return peak
+    ramp = np.polynomial.Polynomial.fit(i, sign * f[a:clear], 2)
+    return max(peak, float(ramp(tb - clear)))
 
 
 def stick_slip(
@@ -290,9 +320,10 @@ def stick_slip(
         sp[0], sp[1], sp[2] = min(sp[0], a), max(sp[1], b), sp[2] + (b - a)
     durations, breakaway = [], []
     sliding = SLIDE_ONSET * amp * omega
+    sx = difference_noise(x)
     for a, b, n_stuck in spans.values():
         durations.append(n_stuck * dt)
-        breakaway.append(_breakaway(F - offset, v, a, b, window, max(sliding, thr)))
+        breakaway.append(_breakaway(F - offset, x, v, (a, b), window, max(sliding, thr), sx))
     hit = spans
     return StickSlip(int(turns.size), np.asarray(durations), np.asarray(breakaway), float(thr),
                      float(smooth), len(hit))  # fmt: skip
