@@ -1,9 +1,10 @@
 """The discrepancy workflow on normal-contact recordings (Kelvin-Voigt base, issue 5).
 
 Recordings here are 18 cycles at 80 samples per cycle and effects of 10 % of the output RMS
-(one magnitude for all): at 5 % a channel delay is absorbed by the Kelvin-Voigt damping,
-whose relaxation time ``h/k`` delays ``δ`` by the same first-order phase ``ω τ`` at every
-frequency (benches/eval_diagnose.py --model normal gives the rates by magnitude).
+(one magnitude for all). A channel delay shares its first-order phase ``ω τ`` with the
+Kelvin-Voigt lag at every frequency and is told apart only by the damping's second-order
+amplitude drop across the excitation's frequencies (benches/eval_diagnose.py --model normal
+gives the rates by factor, including single-tone records, where it is not identifiable).
 """
 
 from __future__ import annotations

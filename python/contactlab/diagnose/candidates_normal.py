@@ -22,9 +22,15 @@ Candidates (name: model, parameters):
 
 Identifiability. A channel delay ``τ`` and the Kelvin-Voigt damping give the same first-order
 phase lag at every frequency (``ω τ`` against ``ω h / k``); they differ only in second
-order (the damping also lowers the amplitude by ``1/√(1 + (ω h/k)²)``). A small delay is
-therefore absorbed by a too-large ψ and not named: in benches/eval_diagnose.py it is found
-in none of 12 cases at 2-5 % of the output RMS and in 4 of 6 at 10 % (0.5-2 % noise).
+order: the damping also lowers the amplitude by ``1/√(1 + (ω h/k)²)``, a drop that grows
+with ω². At one frequency the fitted ``k`` absorbs that drop, so a delay is not identifiable
+there: :func:`delay_identifiability` says so in the report (with the largest delay the
+fitted ψ could hide) and the delay is not named. Across excitation blocks at different
+frequencies the drop is not one constant; its signature lives in the blocks farthest from
+the mean frequency, so the delay's held-out gain is concentrated in a few cycles and the
+family uses the proportional-gain form of the consistency rule (:mod:`.select`,
+``proportional_gain``). Below about 0.05 σ² of held-out gain (5 % delay at 1 % output noise)
+the second-order signature is under the noise and nothing is named.
 
 ``δ_r`` is the RMS of the measured displacement, so ``kappa`` and ``a`` are dimensionless;
 the paper's eq. 6 coefficients follow as ``a1 = k``, ``a2 = k a / δ_r``, ``a3 = k κ / δ_r²``.
