@@ -19,7 +19,11 @@ only if all three hold:
    by :func:`proportional_t`: the held-out gain per cycle is expected in proportion to how
    far the candidate moves the prediction in that cycle, and its t statistic uses the
    scatter about that proportion, still with cycles as the units;
-3. the Bayesian information criterion of the fit to all data decreases.
+3. the Bayesian information criterion of the fit to all data decreases;
+4. the gain is at least :data:`MIN_RELATIVE_GAIN` of the current model's held-out MSE: when
+   a model is still far from the noise (a misspecified base on a real measurement), a
+   systematic residual of many σ lets almost any candidate shave a sliver off it with
+   significance, which is no evidence of that effect.
 
 The accepted candidate with the largest held-out gain wins.
 """
@@ -270,6 +274,10 @@ class Verdict:
         }
 
 
+#: rule 4: the smallest held-out gain, as a fraction of the current held-out MSE
+MIN_RELATIVE_GAIN = 0.01
+
+
 def proportional_t(current: Trial, cand: Trial, d: Prepared) -> float:
     """t statistic of the held-out gain with per-cycle gains proportional to the change.
 
@@ -319,8 +327,14 @@ def judge(
     if d is not None and not t > z:
         t = max(t, proportional_t(current, cand, d))
     dbic = cand.full.bic - current.full.bic
+    rel = float(current.heldout_mse - cand.heldout_mse) / current.heldout_mse
     if gain < min_gain:
         reason = f"held-out gain {gain:.3g} σ² below {min_gain:g} σ²"
+    elif rel < MIN_RELATIVE_GAIN:
+        reason = (
+            f"held-out gain {100 * rel:.2g} % of the remaining error (below "
+            f"{100 * MIN_RELATIVE_GAIN:g} %): a sliver of a larger misfit"
+        )
     elif not t > z:
         reason = f"gain not significant across held-out cycles (t = {t:.2f} <= {z:g})"
     elif not dbic < 0:
