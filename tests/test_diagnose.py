@@ -268,3 +268,24 @@ def test_input_noise_does_not_buy_a_sub_sample_delay():
     assert rep._data.extra["u_noise"] == pytest.approx(0.002 * amp, rel=0.2)
     rep = contactlab.diagnose((t, xm, F + 0.02 * h0))
     assert rep.effect_names == ["force_offset"]
+
+
+def test_a_candidate_that_cannot_be_fitted_is_skipped_not_fatal(monkeypatch):
+    """A candidate whose fit fails (the normal joint's solver can reject a trial stiffness
+    with no equilibrium) is reported as not fitted; the diagnosis goes on with the others."""
+    from contactlab.diagnose import workflow
+    from contactlab.errors import ConvergenceError
+
+    real_fit = workflow.fit
+
+    def fit(family, effects, *args, **kwargs):
+        if "inertia" in effects:
+            raise ConvergenceError("the model rejected the parameters the solver tried")
+        return real_fit(family, effects, *args, **kwargs)
+
+    monkeypatch.setattr(workflow, "fit", fit)
+    rec = hidden_effect_recording(["force_offset"], magnitude=0.05, noise=0.01, seed=SEED + 77)
+    rep = contactlab.diagnose(rec, candidates=["force_offset", "inertia"], max_effects=1)
+    assert rep.effect_names == ["force_offset"]
+    (v,) = [v for v in rep.steps[0].candidates if v.name == "inertia"]
+    assert not v.accepted and v.reason.startswith("could not be fitted")

@@ -3,7 +3,7 @@ that carries the truth, the smooth block excitation and the effect-size bookkeep
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -72,6 +72,24 @@ def block_excitation(
         return np.where(tt < 0.0, 0.0, val)
 
     return x, total, max(f)
+
+
+#: frequencies of the three amplitude blocks, relative to the reference frequency
+BLOCK_FREQUENCIES = (1.0, 1.7, 0.6)
+
+
+def block_frequencies(frequencies: Sequence[float] | None) -> np.ndarray:
+    """The three blocks' relative frequencies: the default, one value for all, or three."""
+    if frequencies is None:
+        return np.array(BLOCK_FREQUENCIES)
+    f = np.asarray(list(frequencies), dtype=float)
+    if f.size == 1:
+        f = np.repeat(f, 3)
+    if f.size != 3 or not np.all(np.isfinite(f)) or not np.all(f > 0):
+        raise InputError(
+            f"frequencies must be one or three positive numbers (relative to f0), got {f.tolist()}"
+        )
+    return f
 
 
 def rms(a: np.ndarray) -> float:

@@ -22,9 +22,15 @@ Candidates (name: model, parameters):
 
 Identifiability. A channel delay ``τ`` and the Kelvin-Voigt damping give the same first-order
 phase lag at every frequency (``ω τ`` against ``ω h / k``); they differ only in second
-order (the damping also lowers the amplitude by ``1/√(1 + (ω h/k)²)``). A small delay is
-therefore absorbed by a too-large ψ and not named: in benches/eval_diagnose.py it is found
-in none of 12 cases at 2-5 % of the output RMS and in 4 of 6 at 10 % (0.5-2 % noise).
+order: the damping also lowers the amplitude by ``1/√(1 + (ω h/k)²)``, a drop that grows
+with ω². At one frequency the fitted ``k`` absorbs that drop, so a delay is not identifiable
+there: :func:`delay_identifiability` says so in the report (with the largest delay the
+fitted ψ could hide) and the delay is not named. Across excitation blocks at different
+frequencies the drop is not one constant; its signature lives in the blocks farthest from
+the mean frequency, so the delay's held-out gain is concentrated in a few cycles and the
+family uses the proportional-gain form of the consistency rule (:mod:`.select`,
+``proportional_gain``). Below about 0.05 σ² of held-out gain (5 % delay at 1 % output noise)
+the second-order signature is under the noise and nothing is named.
 
 ``δ_r`` is the RMS of the measured displacement, so ``kappa`` and ``a`` are dimensionless;
 the paper's eq. 6 coefficients follow as ``a1 = k``, ``a2 = k a / δ_r``, ``a3 = k κ / δ_r²``.
@@ -165,6 +171,11 @@ class NormalFamily:
     """Kelvin-Voigt base model with the normal-contact candidate library."""
 
     kind = "normal"
+    #: rule 2 of :mod:`.select` may pass by the proportional-gain test: the record's
+    #: excitation blocks differ in frequency and amplitude, and an effect's signature (a
+    #: delay's amplitude error ∝ ω² once ψ has absorbed its phase, a nonlinearity's ∝ the
+    #: amplitude) lives in some blocks only
+    proportional_gain = True
     base_params = BASE_PARAMS
     candidates = CANDIDATES
     input_name = "p"
@@ -252,13 +263,18 @@ class NormalFamily:
         return None
 
     def implausible(self, name: str, p: dict[str, float], d: Prepared) -> str | None:
-        """Why a fitted effect cannot be physical on this rig, or None."""
+        """Why a fitted effect cannot be physical on this rig, or None (a channel delay on a
+        single-tone record is not identifiable: :func:`delay_identifiability`)."""
+        if name == "channel_delay" and frequency_span(d) < SINGLE_TONE_SPAN:
+            return "a delay cannot be told from the Kelvin-Voigt damping at one frequency"
         return implausible_common(self.candidates[name], p, d)
 
     def regime(self, p: dict[str, float], d: Prepared) -> str:
         psi = p["psi"]
         kind = "viscoelastic (Kelvin-Voigt)" if 0.0 < psi < 1.0 else "outside 0 < ψ < 1"
-        return f"base model regime: {kind}; k = {p['k']:.4g} Pa/m, ψ = {psi:.3g}"
+        text = f"base model regime: {kind}; k = {p['k']:.4g} Pa/m, ψ = {psi:.3g}"
+        note = delay_identifiability(p, d)
+        return text if note is None else f"{text}; {note}"
 
     @staticmethod
     def loop_energy(u: np.ndarray, y: np.ndarray) -> float:
@@ -266,6 +282,44 @@ class NormalFamily:
         from ..masing import loop_area
 
         return loop_area(y, u)
+
+
+#: excitation frequencies closer than this ratio count as one frequency for the delay test
+SINGLE_TONE_SPAN = 1.25
+
+
+def frequency_span(d: Prepared) -> float:
+    """Ratio of the longest to the shortest complete excitation cycle (1 for one tone)."""
+    cyc = d.cycles.cycle
+    lengths = np.bincount(cyc[cyc >= 0])
+    lengths = lengths[lengths > 0]
+    if lengths.size < 2:
+        return 1.0
+    return float(np.max(lengths) / np.min(lengths))
+
+
+def delay_identifiability(p: dict[str, float], d: Prepared) -> str | None:
+    """The identifiability statement for a record excited at one frequency, else None.
+
+    A channel delay ``τ`` lags the displacement by ``ωτ``; Kelvin-Voigt damping by
+    ``arctan(ψ/2π)`` at the excitation frequency. At one frequency both are one phase
+    lag (they differ only by the damping's amplitude drop ``1/√(1 + (ψ/2π)²)``, which the
+    fitted ``k`` absorbs), so the fitted ψ may contain a delay of up to
+    ``arctan(ψ/2π)/ω``; only a record at several frequencies (the delay's lag grows with
+    ω, the damping's levels off) separates them.
+    """
+    span = frequency_span(d)
+    if span >= SINGLE_TONE_SPAN:
+        return None
+    omega = float(d.extra["omega"])
+    lag = float(np.arctan(max(p["psi"], 0.0) / (2.0 * np.pi)))
+    return (
+        f"delay and viscous lag are indistinguishable at one frequency (cycle periods "
+        f"within a factor {span:.2f}): the loop's phase lag {lag:.3g} rad could be the "
+        f"damping ψ = {p['psi']:.3g} or a channel delay of up to {lag / omega:.3g} s, so "
+        "no channel_delay is named on this record; excite at several frequencies (a factor "
+        "≥ 2 apart) to tell them apart"
+    )
 
 
 def start_from_model(model: Any) -> dict[str, float] | None:

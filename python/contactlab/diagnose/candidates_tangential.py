@@ -218,6 +218,10 @@ def _grid(x: np.ndarray, F: np.ndarray) -> tuple[float, float, float]:
     return best
 
 
+#: ac·A from which the base loop is near-rectangular (gross sliding, as regime() says)
+GROSS_SLIDING_ZA = 10.0
+
+
 class TangentialFamily:
     """Masing base model with the tangential candidate library (see module docstring)."""
 
@@ -449,6 +453,15 @@ class TangentialFamily:
             amp = 0.5 * float(np.ptp(d.u))
             if abs(p["x0"]) > 0.5 * amp:
                 return f"a displacement offset of {p['x0']:.3g} m is over half the amplitude"
+        if name == "asymmetry" and p["ac"] * 0.5 * float(np.ptp(d.u)) >= GROSS_SLIDING_ZA:
+            # on a near-rectangular loop h + α|h| moves both plateaus by α h0, as an offset
+            # does: only the short turns differ, so the two cannot be told apart; the offset
+            # (a sensor's zero, the reconstruction's K (y - x)) is the one tried
+            return (
+                f"in gross sliding (ac·A ≥ {GROSS_SLIDING_ZA:g}) an asymmetry shifts both "
+                f"plateaus alike (α h0 = {p['alpha'] * p['h0']:.3g} N), as a force offset "
+                "does: the two cannot be told apart, and force_offset stands for both"
+            )
         return None
 
     def regime(self, p: dict[str, float], d: Prepared) -> str:
@@ -457,7 +470,7 @@ class TangentialFamily:
         q = p["ac"] * amp
         if q < 1.0:
             kind = "pre-sliding (ac·A < 1: only h0·ac, the initial stiffness, is well fixed)"
-        elif q < 10.0:
+        elif q < GROSS_SLIDING_ZA:
             kind = "transition from pre-sliding to sliding (h0 and ac both fixed)"
         else:
             kind = (

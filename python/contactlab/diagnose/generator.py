@@ -25,7 +25,7 @@ displacement, so agreement with the workflow's models is a real check.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
 
 import numpy as np
 from scipy.optimize import brentq
@@ -35,6 +35,7 @@ from ..masing import Masing
 from ._gen_common import (
     HiddenEffectRecording,
     block_excitation,
+    block_frequencies,
     effect_sizes,
     measure,
     rms,
@@ -167,6 +168,7 @@ def hidden_effect_recording(
     anti_alias: tuple[float, float] | None = None,
     bits: int | None = None,
     start: str = "rest",
+    frequencies: Sequence[float] | None = None,
     **base: float,
 ) -> HiddenEffectRecording:
     """Simulate a recording with hidden effects and sensor noise.
@@ -202,6 +204,11 @@ def hidden_effect_recording(
         ``"rest"``: the record starts with the joint at rest on its virgin curve;
         ``"steady"``: the first 1.5 reference cycles after the amplitude ramp are cut, so
         the record starts in the middle of a loop with its history unseen.
+    frequencies : sequence of float, optional
+        Frequencies of the three amplitude blocks relative to ``f0`` (default
+        ``(1, 1.7, 0.6)``); one value gives a single-tone record (every block at that
+        frequency), on which e.g. a normal joint's channel delay and viscous lag cannot be
+        told apart.
     **base
         Base-model parameters: tangential ``h0`` (N, default 50), ``ac`` (1/m, default 5e4),
         ``f0`` (Hz, default 5).
@@ -230,6 +237,7 @@ def hidden_effect_recording(
             anti_alias=anti_alias,
             bits=bits,
             start=start,
+            frequencies=frequencies,
             **base,
         )
     if model != "tangential":
@@ -242,7 +250,7 @@ def hidden_effect_recording(
         raise InputError(f"unknown base parameter(s) {sorted(base)} for the tangential model")
     rng = np.random.default_rng(seed)
     xfun, T, fmax = block_excitation(
-        np.array([0.6, 1.5, 3.0]) / ac, np.array([1.0, 1.7, 0.6]) * f0, cycles_per_block
+        np.array([0.6, 1.5, 3.0]) / ac, block_frequencies(frequencies) * f0, cycles_per_block
     )
     fs = samples_per_cycle * f0
     t = np.arange(round(T * fs) + 1) / fs

@@ -1,16 +1,16 @@
 """Hidden-effect recordings of a normal contact joint (Konowalski's rig, PHYSICS.md §2).
 
 Pressure ``p(t) = p0 + pa(t) sin φ(t)`` in three smooth blocks (``pa = (0.3, 0.6, 0.9)·p0``
-at frequencies ``(1, 1.7, 0.6)·f0``), the joint a Kelvin-Voigt element with the paper's
-order of magnitude (``k = 1.3 MPa/µm``, ``ψ = 0.0887``, ``p0 = 0.5 MPa``, ``f0 = 1 Hz``) plus
-the requested effects, and sensor noise on both channels. See
+at frequencies ``(1, 1.7, 0.6)·f0``, or ``frequencies·f0``), the joint a Kelvin-Voigt element
+with the paper's order of magnitude (``k = 1.3 MPa/µm``, ``ψ = 0.0887``, ``p0 = 0.5 MPa``,
+``f0 = 1 Hz``) plus the requested effects, and sensor noise on both channels. See
 :func:`contactlab.diagnose.hidden_effect_recording` (``model="normal"``) for the arguments.
 The delay is simulated by driving the joint with the closed-form pressure at ``t - τ``.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
 
 import numpy as np
 from scipy.optimize import brentq
@@ -19,6 +19,7 @@ from ..errors import InputError
 from ._gen_common import (
     HiddenEffectRecording,
     block_excitation,
+    block_frequencies,
     effect_sizes,
     measure,
     rms,
@@ -79,6 +80,7 @@ def hidden_effect_recording_normal(
     anti_alias: tuple[float, float] | None = None,
     bits: int | None = None,
     start: str = "rest",
+    frequencies: Sequence[float] | None = None,
     **base: float,
 ) -> HiddenEffectRecording:
     """Normal-contact recording (``p`` in Pa, ``delta`` in m) with hidden effects.
@@ -100,7 +102,7 @@ def hidden_effect_recording_normal(
         raise InputError(f"unknown base parameter(s) {sorted(base)} for the normal model")
     rng = np.random.default_rng(seed)
     pfun, T, fmax = block_excitation(
-        np.array([0.3, 0.6, 0.9]) * p0, np.array([1.0, 1.7, 0.6]) * f0, cycles_per_block
+        np.array([0.3, 0.6, 0.9]) * p0, block_frequencies(frequencies) * f0, cycles_per_block
     )
     fs = samples_per_cycle * f0
     t = np.arange(round(T * fs) + 1) / fs

@@ -12,8 +12,18 @@ only if all three hold:
    ``ln(MSE_current / MSE_candidate)`` have ``mean / standard error > z`` (cycles, not
    samples, are the independent units, so slowly varying residuals do not inflate the
    evidence; ratios, not differences, so that cycles of large amplitude or rate — where
-   rate-dependent effects are largest — do not swamp the others);
-3. the Bayesian information criterion of the fit to all data decreases.
+   rate-dependent effects are largest — do not swamp the others). Families whose effects
+   concentrate in some excitation blocks by their physics (``proportional_gain``: a
+   normal joint's channel delay shows only where ω² differs from the blocks' mean, once
+   the Kelvin-Voigt damping has absorbed its first-order phase) may pass this rule instead
+   by :func:`proportional_t`: the held-out gain per cycle is expected in proportion to how
+   far the candidate moves the prediction in that cycle, and its t statistic uses the
+   scatter about that proportion, still with cycles as the units;
+3. the Bayesian information criterion of the fit to all data decreases;
+4. the gain is at least :data:`MIN_RELATIVE_GAIN` of the current model's held-out MSE: when
+   a model is still far from the noise (a misspecified base on a real measurement), a
+   systematic residual of many σ lets almost any candidate shave a sliver off it with
+   significance, which is no evidence of that effect.
 
 The accepted candidate with the largest held-out gain wins.
 """
@@ -268,17 +278,67 @@ class Verdict:
         }
 
 
+#: rule 4: the smallest held-out gain, as a fraction of the current held-out MSE
+MIN_RELATIVE_GAIN = 0.01
+
+
+def proportional_t(current: Trial, cand: Trial, d: Prepared) -> float:
+    """t statistic of the held-out gain with per-cycle gains proportional to the change.
+
+    Per held-out cycle ``c``, with ``r`` the current model's held-out residual and ``Δ`` the
+    candidate's held-out prediction minus the current one (weights ``w`` of
+    :func:`sample_weight`): ``N_c = Σ w r Δ``, ``D_c = Σ w Δ²``. The held-out squared error
+    falls by ``Σ (2 N_c - D_c)``, i.e. it falls iff ``ĝ = ΣN / ΣD > 1/2`` (the residual's
+    share along the candidate's move exceeds half the move). ``ĝ``'s standard error is the
+    cluster (cycle) sandwich ``√(m/(m-1) Σ (N_c - ĝ D_c)²) / ΣD`` over the ``m`` cycles;
+    returns ``(ĝ - 1/2) / se`` (``-inf`` when the candidate does not move the prediction).
+    """
+    r = d.y - current.prediction
+    delta = cand.prediction - current.prediction
+    w = sample_weight(d)
+    held = current.heldout & cand.heldout
+    cyc = np.where(held, d.cycles.cycle, -1)
+    ids = np.unique(cyc[cyc >= 0])
+    if ids.size < 3:
+        return -np.inf
+    idx = np.searchsorted(ids, cyc[cyc >= 0])
+    n_c = np.bincount(idx, (w * r * delta)[cyc >= 0], ids.size)
+    d_c = np.bincount(idx, (w * delta * delta)[cyc >= 0], ids.size)
+    total = float(np.sum(d_c))
+    if not total > 0:
+        return -np.inf
+    g = float(np.sum(n_c)) / total
+    m = ids.size
+    se = float(np.sqrt(m / (m - 1) * np.sum((n_c - g * d_c) ** 2))) / total
+    return (g - 0.5) / se if se > 0 else (np.inf if g > 0.5 else -np.inf)
+
+
 def judge(
-    name: str, current: Trial, cand: Trial, sigma: float, z: float, min_gain: float
+    name: str,
+    current: Trial,
+    cand: Trial,
+    sigma: float,
+    z: float,
+    min_gain: float,
+    d: Prepared | None = None,
 ) -> Verdict:
-    """Apply the three acceptance rules of the module docstring."""
+    """Apply the three acceptance rules of the module docstring (rule 2's proportional
+    form when ``d`` is given: the family's ``proportional_gain``)."""
     ratio = np.log(current.cycle_mse / cand.cycle_mse)
     gain = float(current.heldout_mse - cand.heldout_mse) / sigma**2
     sd = float(np.std(ratio, ddof=1)) if ratio.size > 1 else np.inf
     t = float(np.mean(ratio) / (sd / np.sqrt(ratio.size))) if sd > 0 else np.inf
+    if d is not None and not t > z:
+        t = max(t, proportional_t(current, cand, d))
     dbic = cand.full.bic - current.full.bic
+    rel = float(current.heldout_mse - cand.heldout_mse) / current.heldout_mse
     if gain < min_gain:
         reason = f"held-out gain {gain:.3g} σ² below {min_gain:g} σ²"
+    elif rel < MIN_RELATIVE_GAIN:
+        reason = (
+            f"held-out gain {100 * rel:.2g} % of the remaining error (below "
+            f"{100 * MIN_RELATIVE_GAIN:g} %): a sliver of a larger misfit"
+        )
     elif not t > z:
         reason = f"gain not significant across held-out cycles (t = {t:.2f} <= {z:g})"
     elif not dbic < 0:

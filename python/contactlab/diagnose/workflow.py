@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 from scipy.signal import decimate, savgol_coeffs
 
-from ..errors import InputError
+from ..errors import ConvergenceError, InputError
 from ._family import Family, Prepared
 from ._inputs import arrays as _arrays
 from ._inputs import check_channels
@@ -265,6 +265,11 @@ def _takes_over(family: Family, base: dict[str, float], p: dict[str, float]) -> 
     return None
 
 
+def _not_fitted(name: str, exc: Exception) -> Verdict:
+    """The verdict on a candidate whose fit failed: not named, and the reason kept."""
+    return Verdict(name, np.nan, np.nan, np.nan, np.nan, False, f"could not be fitted: {exc}")
+
+
 def reduce_long(
     t: np.ndarray, u: np.ndarray, y: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
@@ -456,7 +461,11 @@ def diagnose(
                 start_c.update(family.start_effect(name, start_c, d, -current.full_residual(d)))
             # screening: a candidate whose fit to all data lowers the error by less than
             # min_gain σ² cannot do better on held-out cycles; no cross-validation for it
-            full = fit(family, trial_effects, d, all_samples, start_c, scales)
+            try:
+                full = fit(family, trial_effects, d, all_samples, start_c, scales)
+            except ConvergenceError as exc:  # e.g. a trial stiffness with no equilibrium
+                verdicts.append(_not_fitted(name, exc))
+                continue
             in_gain = (current.full.mse - full.mse) / sigma**2
             if in_gain < min_gain:
                 verdicts.append(
@@ -471,12 +480,17 @@ def diagnose(
                     )
                 )
                 continue
-            cand = evaluate(family, trial_effects, d, start_c, scales, folds, full)
+            try:
+                cand = evaluate(family, trial_effects, d, start_c, scales, folds, full)
+            except ConvergenceError as exc:
+                verdicts.append(_not_fitted(name, exc))
+                continue
             p = cand.full.params
             extra = 0.0
             if name == "channel_delay" and abs(p["tau"]) < d.dt:
                 extra = budget  # a sub-sample shift must beat what smoothing the input buys
-            v = judge(name, current, cand, sigma, z, min_gain + extra)
+            prop = d if getattr(family, "proportional_gain", False) else None
+            v = judge(name, current, cand, sigma, z, min_gain + extra, prop)
             # every effect of the candidate model, not only the new one: a refit can push an
             # effect added before to the edge of its physical range
             why = next(

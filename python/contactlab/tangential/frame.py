@@ -22,7 +22,8 @@ smaller window's estimate (the standard deviation of that difference follows exa
 the two filters' coefficients). The largest window whose estimate the smaller ones do not
 contradict is the widest one whose bias is still below its noise: the usual bias-variance
 balance, without assuming how smooth the motion is. The choice is reported
-(``window``, ``noise_x``, ``noise_y``, ``force_noise``).
+(``window``, ``noise_x``, ``noise_y``, ``force_noise``), with the larger error near the
+force's jumps where a contact sticks and slips (``force_error_near_jumps``, ``jump_share``).
 """
 
 from __future__ import annotations
@@ -121,12 +122,47 @@ def lepski_window(x: np.ndarray, dt: float, sigma: float, *, kappa: float = LEPS
     return chosen
 
 
+def step_error(window: int) -> float:
+    """RMS error, per unit jump, of the filter's ``M x''`` over the ``2 (window // 2 + 1)``
+    samples around an ideal step of the force (``x''`` jumps by ``J/M``: ``x = J t²/2M`` after
+    it), the step half-way between two samples."""
+    half = window // 2 + 1
+    n = 4 * window + 1
+    tt = np.arange(n, dtype=float) - n // 2 - 0.5
+    q = 0.5 * np.where(tt > 0, tt, 0.0) ** 2
+    est = savgol_derivative(q, window, 2, 1.0)
+    c = n // 2
+    err = est[c - half + 1 : c + half + 1] - (tt[c - half + 1 : c + half + 1] > 0)
+    return float(np.sqrt(np.mean(err * err)))
+
+
+def jump_samples(xd: np.ndarray, x: np.ndarray, window: int, dt: float, sigma: float) -> np.ndarray:
+    """Indices where the plate starts or stops sticking (the smoothed velocity enters or
+    leaves ``3σv``, σv from the displacement noise ``sigma``): where the friction force of a
+    stick-slip contact jumps (static to kinetic, sliding to the drive's force)."""
+    thr = 3.0 * sigma * float(np.linalg.norm(savgol_coefficients(window, 1, dt)))
+    if not thr > 0:
+        thr = 1e-9 * float(np.max(np.abs(xd)))
+    stuck = np.abs(xd) < thr
+    edges = np.flatnonzero(np.diff(stuck.astype(np.int8)) != 0) + 1
+    return edges[(edges > window) & (edges < x.size - window)]
+
+
 @dataclass(frozen=True)
 class FrameForce:
     """Result of :func:`frame_friction_force` (SI): the friction force ``F`` and the plate's
     displacement ``x`` (the loop is ``F`` against ``x``), velocity and acceleration, the
     Savitzky-Golay ``window`` (samples and seconds), the channels' noise and the resulting
-    noise of ``F`` (from the filters' coefficients)."""
+    noise of ``F`` (from the filters' coefficients).
+
+    ``force_noise`` is the error of ``F`` where the force is smooth. Where the plate starts or
+    stops sticking the true force jumps and the filter spreads each jump over its window
+    (half a window each side): ``jump_share`` is the share of samples that close to a jump and
+    ``force_error_near_jumps`` the RMS error expected there, from the jumps' sizes (the force
+    a window after minus a window before) and the filter's error at an ideal step
+    (:func:`step_error`); ``force_error`` is the RMS over the whole record. On independent
+    Coulomb-frame simulations (tests/frame_sim.py) away from the jumps the error is the
+    noise (0.011 vs 0.011 N at 250 Hz), near them 0.11-0.14 N."""
 
     t: np.ndarray
     x: np.ndarray
@@ -138,6 +174,9 @@ class FrameForce:
     noise_x: float
     noise_y: float
     force_noise: float
+    jump_share: float = 0.0
+    force_error_near_jumps: float = 0.0
+    force_error: float = 0.0
 
     def recording(self, source: str = "<frame>") -> Recording:
         """A tangential :class:`~contactlab.io.Recording` (``x`` in m, ``F`` in N)."""
@@ -215,7 +254,21 @@ def frame_friction_force(
     fy = C * c1
     fy[window // 2] += K
     f_noise = math.hypot(sx * float(np.linalg.norm(fx)), sy * float(np.linalg.norm(fy)))
-    return FrameForce(ta, xa, F, xd, xdd, int(window), window * dt, sx, sy, f_noise)
+    half = window // 2 + 1
+    jumps = jump_samples(xd, xa, window, dt, sx)
+    near = np.zeros(F.size, bool)
+    sizes = []
+    for j in jumps:
+        near[j - half : j + half] = True
+        before, after = F[max(j - 2 * half, 0) : j - half], F[j + half : j + 2 * half]
+        if before.size and after.size:
+            sizes.append(float(np.median(after) - np.median(before)))
+    share = float(np.mean(near))
+    jump_rms = math.sqrt(float(np.mean(np.square(sizes)))) if sizes else 0.0
+    near_err = math.hypot(f_noise, jump_rms * step_error(window))
+    total = math.sqrt((1.0 - share) * f_noise**2 + share * near_err**2)
+    return FrameForce(ta, xa, F, xd, xdd, int(window), window * dt, sx, sy, f_noise, share,
+                      near_err, total)  # fmt: skip
 
 
 __all__ = [
@@ -225,4 +278,5 @@ __all__ = [
     "lepski_window",
     "savgol_coefficients",
     "savgol_derivative",
+    "step_error",
 ]
