@@ -8,6 +8,7 @@ come from the column names (``x_mm``, ``u_force_N``, ``y [um]``) or default to S
 from __future__ import annotations
 
 import argparse
+import json
 import re
 import warnings
 from pathlib import Path
@@ -161,6 +162,39 @@ def simulate_structure(args: argparse.Namespace) -> int:
     if not r.success:
         raise InputError(f"simulation stopped early ({r.message}); wrote {m} samples")
     print(f"wrote {path} ({m} samples)")
+    return 0
+
+
+def diagnose_structure_cli(args: argparse.Namespace) -> int:
+    """Handler of ``contactlab diagnose FILE --structure MODEL.json``: the identified model is
+    the base; prints the findings, writes ``--json``."""
+    from .._io_atomic import write_text
+    from ..diagnose.structure import diagnose_structure
+    from ..structure import IdentifiedModel
+
+    if args.report:
+        raise InputError("--report is not available with --structure; use --json")
+    model = IdentifiedModel.load(args.structure)
+    cols = read_table(args.file)
+    exc = model.excitation
+    ucol = _pick(cols, args.u, ("u", "f") if exc == "force" else ("y_base", "base", "y"),
+                 "u", args.file)  # fmt: skip
+    ycol = _pick(cols, args.y, ("y_disp", "y", "x") if exc == "force" else ("x", "y_disp"),
+                 "y", args.file)  # fmt: skip
+    if ucol == ycol:
+        raise InputError(f"{args.file}: input and response are the same column {ucol!r}")
+    u, y = cols[ucol], cols[ycol]
+    t = _time(cols, args, u.size, args.file)
+    try:
+        rep = diagnose_structure((t, u, y), model, holdout=args.holdout,
+                                 max_effects=args.max_effects)  # fmt: skip
+    except InputError as exc_:
+        raise InputError(f"{args.file}: {exc_}") from exc_
+    print(rep.summary())
+    if args.json:
+        doc = rep.to_dict()
+        doc["columns"] = {"u": ucol, "y": ycol}
+        write_text(args.json, json.dumps(doc, indent=2, allow_nan=False) + "\n")
     return 0
 
 

@@ -330,7 +330,8 @@ def diagnose(
     folds: int = 2,
     z: float = 3.0,
     min_gain: float = 0.05,
-) -> DiagnosisReport:
+    base: Any = None,
+) -> Any:
     """Find where a model and a measurement disagree, name the missing effect, add it.
 
     Parameters
@@ -353,6 +354,12 @@ def diagnose(
         Significance threshold (t statistic across held-out cycles).
     min_gain : float
         Minimum held-out MSE reduction, in units of the estimated noise variance.
+    base : IdentifiedModel or path, optional
+        Diagnose a structure instead: an identified structure
+        (:func:`contactlab.structure.identify`, or its saved JSON) is the base model and
+        ``recording`` is ``(t, u, y)``; the same when ``model`` is an ``IdentifiedModel``.
+        Returns a :class:`~contactlab.diagnose.structure.StructureDiagnosis` (see
+        :func:`~contactlab.diagnose.structure.diagnose_structure`).
 
     Returns
     -------
@@ -367,6 +374,15 @@ def diagnose(
     >>> report.effect_names
     ['force_offset']
     """
+    from ..structure import IdentifiedModel
+
+    if base is not None or isinstance(model, IdentifiedModel):
+        from .structure import diagnose_structure
+
+        return diagnose_structure(
+            recording, model if base is None else base, candidates=candidates,
+            max_effects=max_effects, z=z, min_gain=min_gain,
+        )  # fmt: skip
     family, start, context = _family(model)
     t, u, y = _arrays(recording, family)
     check_channels(

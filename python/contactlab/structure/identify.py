@@ -35,6 +35,7 @@ from .._io_atomic import write_text
 from .._physical import MAX_MAGNITUDE, check_channel
 from ..errors import ContactLabError, InputError
 from ..fitting import FitResult, Parameter, least_squares_fit
+from ._blas import with_single_blas_thread
 from .joints import iwan_uniform
 from .model import SimulationResult, Structure
 
@@ -382,6 +383,7 @@ def _starts(joint: str) -> list[dict[str, float]]:
     return [{}]
 
 
+@with_single_blas_thread
 def identify(
     t: Any,
     u: Any,
