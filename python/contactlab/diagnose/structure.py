@@ -30,8 +30,9 @@ model's by at least ``min_gain σ²`` (σ: the output noise estimated from the d
 :func:`~contactlab.diagnose._signal.noise_rms`) and by at least ``min_share`` of the gap
 between the current model's held-out MSE and σ², (2) the improvement holds across the
 held-out blocks (per-block log MSE ratios, mean / standard error above ``z``), (3) the
-training BIC decreases, and (4) its parameters are plausible (no negative damping, mass or
-stiffness; ``|e|`` below the mass; a second joint that slips). What no candidate explains is
+training BIC decreases, (4) its parameters are plausible (no negative damping, mass or
+stiffness; ``|e|`` below the mass; a second joint that slips) and (5) determined by the record
+(standard error below the value). What no candidate explains is
 reported as unexplained, with where it lives (near reversals or mid-stroke, its frequency
 against the excitation's, training against hold-out).
 """
@@ -398,6 +399,11 @@ def _implausible(name: str, f: _Fit, model: IdentifiedModel, d: _Data) -> str | 
     return None
 
 
+def _determined(value: float, stderr: float | None) -> bool:
+    """A fitted parameter the record pins down: a finite standard error below its size."""
+    return stderr is not None and math.isfinite(stderr) and stderr < abs(value)
+
+
 def _blocks(n_train: int, n: int, count: int) -> list[slice]:
     edges = np.linspace(n_train, n, count + 1).round().astype(int)
     return [slice(int(a), int(b)) for a, b in itertools.pairwise(edges) if b > a]
@@ -623,6 +629,15 @@ def diagnose_structure(
             if ok and why:
                 ok, reason = False, f"implausible: {why}"
             keys = [k for k, _ in _EXTRA[name]]
+            loose = [k for k in keys if not _determined(cand.values[k], cand.stderr.get(k))]
+            if ok and loose:
+                ok, reason = (
+                    False,
+                    "not determined by the record: "
+                    + ", ".join(
+                        f"{k} = {cand.values[k]:.4g} ± {_fmt(cand.stderr.get(k))}" for k in loose
+                    ),
+                )
             verdicts.append(StructureCandidate(
                 name, ok, reason, cand.heldout_rms(d), gain, tstat,
                 {k: cand.values[k] for k in keys}, {k: cand.stderr.get(k) for k in keys},
