@@ -143,21 +143,25 @@ def simulate_structure(args: argparse.Namespace) -> int:
     t = _time(cols, args, u.size, args.input)
     kw = {"force": u} if exc == "force" else {"base": u}
     if model is not None:
+        s = model.structure
         r = model.simulate(t, periodic=args.periodic, **kw)
     else:
         s = Structure.load(doc_path)
         r = s.simulate(t, periodic=args.periodic, **kw)
-    x = r.x.reshape(r.t.size, -1)
+    # the samples reached: a run that stopped early may hold fewer responses than times
+    x = np.asarray(r.x).reshape(-1, s.n)
+    m = min(x.shape[0], r.t.size, r.joint_force.shape[0])
     header = ["t [s]", f"u [{'N' if exc == 'force' else 'm'}]"]
     header += [f"x{i} [m]" if x.shape[1] > 1 else "x [m]" for i in range(x.shape[1])]
     header += [f"F_joint{j} [N]" for j in range(r.joint_force.shape[1])]
-    uu = u if not args.periodic else u[: r.t.size]
-    table = np.column_stack([r.t, uu[: r.t.size], x, r.joint_force])
+    # the input as run: a periodic run that failed returns its tiled record (fuzz/simulate)
+    uu = np.resize(u, r.t.size)
+    table = np.column_stack([r.t[:m], uu[:m], x[:m], r.joint_force[:m]])
     lines = [",".join(header)] + [",".join(f"{v:.10g}" for v in row) for row in table]
     path = write_text(args.out, "\n".join(lines) + "\n")
     if not r.success:
-        raise InputError(f"simulation stopped early ({r.message}); wrote {r.t.size} samples")
-    print(f"wrote {path} ({r.t.size} samples)")
+        raise InputError(f"simulation stopped early ({r.message}); wrote {m} samples")
+    print(f"wrote {path} ({m} samples)")
     return 0
 
 

@@ -361,6 +361,12 @@ class Structure:
             r = self._run(tt, kk, x0, v0, rtol)
             if not r.success or r.t.size < nt * periods:
                 return r
+            if not all(np.all(np.isfinite(a)) for a in (r.x, r.v, r.joint_energy, r.input_work)):
+                # a diverging response (inf - inf in the period's energies was a NaN, found
+                # by fuzz/simulate): a failure that says so
+                r.success, r.status = False, -2
+                r.message = "the response left the double-precision range (it diverges)"
+                return r
             xa = r.x.reshape(nt * periods, -1)
             a, b = xa[-2 * nt : -nt], xa[-nt:]
             change = float(np.max(np.abs(a - b)) / max(np.max(np.abs(b)), 1e-300))
@@ -389,12 +395,23 @@ class Structure:
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> Structure:
+        if not isinstance(d, dict):
+            raise InputError(f"a structure description is a JSON object, not {type(d).__name__}")
         try:
             s = cls(d["M"], d["C"], d["K"])
         except KeyError as exc:
             raise InputError(f"structure description lacks {exc}") from None
-        for jd in d.get("joints", []):
-            j = Joint.from_dict(jd)
+        joints = d.get("joints", [])
+        if not isinstance(joints, list):
+            raise InputError(f"'joints' must be a list, not {type(joints).__name__}")
+        for jd in joints:
+            try:
+                j = Joint.from_dict(jd)
+            except (KeyError, TypeError, ValueError, AttributeError) as exc:
+                # untrusted JSON (found by fuzz/simulate): a sentence, not a traceback
+                raise InputError(
+                    f"a joint description is malformed ({exc!r}): {jd!r:.80}"
+                ) from None
             s.add_joint(j.kind, j.dof, j.dof2, **j.params, **j.arrays)
         return s
 
@@ -408,7 +425,7 @@ class Structure:
             d = json.loads(Path(path).read_text())
         except (OSError, ValueError) as exc:  # ValueError: not UTF-8 or not JSON
             raise InputError(f"cannot read structure JSON {path}: {exc}") from None
-        return cls.from_dict(d.get("structure", d))
+        return cls.from_dict(d.get("structure", d) if isinstance(d, dict) else d)
 
 
 def _slice(r: SimulationResult, s: slice, t: np.ndarray) -> SimulationResult:

@@ -48,9 +48,14 @@ impl KelvinVoigt {
 
     /// Dissipated energy per cycle, the ellipse area `π pa K sin φ`.
     pub fn loop_energy(&self, pa: f64) -> f64 {
-        // sin φ (< 1) first: π pa overflowing while sin φ underflows to 0 gave inf · 0 = NaN
-        // (found by AFL++); in this order the product is finite or, truly beyond range, inf
-        PI * (self.phase().sin() * self.amplitude(pa) * pa)
+        // π pa K sin φ = pa² (ψ/k) / (2 (1 + g²)), g = ψ/2π: written so, no factor is
+        // inf while another is 0 (π·pa overflowing or K = pa/k overflowing against sin φ
+        // underflowing gave inf · 0 = NaN, found by AFL++); inf only when E truly is
+        if pa == 0.0 {
+            return 0.0;
+        }
+        let g = self.psi / (2.0 * PI);
+        0.5 * pa * (pa * (self.psi / self.k)) / (1.0 + g * g)
     }
 
     /// Steady-state displacement and velocity at times `t` under `pa sin ω t`.
@@ -112,6 +117,14 @@ mod tests {
         let kv = KelvinVoigt::new(1e300, 5e-324, 2.96e-308).unwrap();
         let e = kv.loop_energy(f64::MAX);
         assert!(e.is_finite() && e >= 0.0, "{e}");
+        // the re-run: k = ψ = 5e-324 made K = pa/k inf against sin φ = 0; E = pa² ψ/(2k)
+        let kv = KelvinVoigt::new(5e-324, 5e-324, 4.45e-308).unwrap();
+        assert!(
+            (kv.loop_energy(3.0) / 4.5 - 1.0).abs() < 1e-12,
+            "{}",
+            kv.loop_energy(3.0)
+        );
+        assert_eq!(kv.loop_energy(0.0), 0.0);
         let kv = KelvinVoigt::new(2.0, 0.3, 1.0).unwrap();
         let g = 0.3 / (2.0 * PI);
         let expect = PI * 5.0 * (5.0 / 2.0) * g / (1.0 + g * g); // π pa² sinφ cosφ / k
