@@ -48,7 +48,7 @@ from scipy.signal import savgol_filter
 from ..errors import InputError
 from ..masing import Masing, loop_area
 from ._family import Candidate, ParamSpec, Prepared, implausible_common
-from ._signal import shift
+from ._signal import modulation_gains, shift
 from .scaled_masing import memory, scaled_force
 
 _INF = np.inf
@@ -257,21 +257,19 @@ class TangentialFamily:
         if name != "normal_load":
             return {}
         h = self.predict(p, (), d)
-        tt = d.t - d.t[0]
         f_exc = 1.0 / (d.cycles.period_samples * d.dt)
         f_lo = max(0.05 * f_exc, MIN_LOAD_PERIODS / d.duration)
-        freqs = np.arange(f_lo, 3.0 * f_exc, 0.25 / d.duration)
+        step = 0.25 / d.duration
+        freqs = np.arange(f_lo, 3.0 * f_exc, step)
         # a fluctuation locked to the drive is position_friction's: skip the harmonics
         k = np.round(freqs / f_exc)
         freqs = freqs[(k < 1) | (np.abs(freqs - k * f_exc) >= 1.0 / d.duration)]
-        best, fbest = -1.0, f_exc
-        for f in freqs:
-            A = np.column_stack((h * np.cos(2 * np.pi * f * tt), h * np.sin(2 * np.pi * f * tt)))
-            coef = np.linalg.lstsq(A, residual, rcond=None)[0]
-            gain = float(np.sum((A @ coef) ** 2))
-            if gain > best:
-                best, fbest = gain, float(f)
-        return {"f_n": fbest}
+        if not freqs.size:
+            return {"f_n": f_exc}
+        # the least-squares gain of the pair (h cos, h sin) at every frequency, by FFT
+        j = np.rint((freqs - f_lo) / step).astype(int)
+        gains = modulation_gains(h, residual, d.duration, f_lo, step, int(j[-1]) + 1)[j]
+        return {"f_n": float(freqs[int(np.argmax(gains))])}
 
     def check(self, effects: tuple[str, ...]) -> bool:
         """All tangential effects combine (in the order of the module docstring)."""
