@@ -40,6 +40,7 @@ measured force.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -176,18 +177,31 @@ def series_backbone(h0: float, ac: float, C_s: float, x_max: float) -> tuple[np.
     return u + C_s * f, f
 
 
+def reversal_anchors(reversals: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """For each of ``n`` samples: whether a reversal precedes it (or is it), and the index of
+    the last such reversal (0 where none)."""
+    idx = np.searchsorted(reversals, np.arange(n), side="right") - 1
+    has = idx >= 0
+    r = reversals[np.where(has, idx, 0)] if reversals.size else np.zeros(n, int)
+    return has, r
+
+
 def breakaway(
-    h: np.ndarray, x: np.ndarray, reversals: np.ndarray, s_b: float, ell: float
+    h: np.ndarray,
+    x: np.ndarray,
+    reversals: np.ndarray,
+    s_b: float,
+    ell: float,
+    anchors: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray:
     """Branches with a breakaway peak: after each reversal ``r`` the rise ``h - h_r`` is
     scaled by ``1 + s_b exp(-|x - x_r| / ell)`` — equal to Masing's at the reversal (no
     jump) and far from it, above it in between (static friction above kinetic). Before the
-    first reversal the virgin curve from the origin is treated the same way."""
+    first reversal the virgin curve from the origin is treated the same way. ``anchors``:
+    :func:`reversal_anchors` of ``reversals``, when computed already."""
     if s_b == 0.0:
         return h
-    idx = np.searchsorted(reversals, np.arange(h.size), side="right") - 1
-    has = idx >= 0
-    r = reversals[np.where(has, idx, 0)] if reversals.size else np.zeros(h.size, int)
+    has, r = anchors if anchors is not None else reversal_anchors(reversals, h.size)
     xr = np.where(has, x[r], 0.0)
     hr = np.where(has, h[r], 0.0)
     return hr + (h - hr) * (1.0 + s_b * np.exp(-np.abs(x - xr) / max(ell, 1e-300)))
@@ -216,6 +230,23 @@ def _grid(x: np.ndarray, F: np.ndarray) -> tuple[float, float, float]:
         if r < best[0]:
             best = (r, h0, ac)
     return best
+
+
+def _fixed(d: Prepared, key: str, make: Callable[[], Any]) -> Any:
+    """An array of the model evaluation that depends on the recording only (not on the
+    fitted parameters): computed on the first evaluation, then reused by every fit on ``d``
+    (the fits evaluate the model thousands of times)."""
+    cache = d.extra.setdefault("fixed", {})
+    k = (key, d.t.size)
+    if k not in cache:
+        cache[k] = make()
+    return cache[k]
+
+
+def _track_harmonics(x: np.ndarray, d: Prepared) -> tuple[np.ndarray, ...]:
+    """``cos ξ, sin ξ, cos 2ξ, sin 2ξ`` of ``position_friction``, ``ξ = π (x - x_mid)/x_half``."""
+    xi = np.pi * (x - d.extra["x_mid"]) / d.extra["x_half"]
+    return np.cos(xi), np.sin(xi), np.cos(2 * xi), np.sin(2 * xi)
 
 
 class TangentialFamily:
@@ -338,22 +369,24 @@ class TangentialFamily:
         if "asymmetry" in effects:
             h = h + p["alpha"] * np.abs(h)
         if "parameter_drift" in effects:
-            h = h * (1.0 + p["beta"] * (d.t - d.t[0]) / d.duration)
+            h = h * (1.0 + p["beta"] * _fixed(d, "t_rel", lambda: d.t - d.t[0]) / d.duration)
         if "stick_slip" in effects:
-            h = breakaway(h, x, d.cycles.reversals, p["s_b"], p["ell"])
+            rev = d.cycles.reversals
+            anchors = _fixed(d, "anchors", lambda: reversal_anchors(rev, x.size))
+            h = breakaway(h, x, rev, p["s_b"], p["ell"], anchors)
         if "stribeck" in effects:
-            h = h * (1.0 + p["s"] * np.exp(-np.abs(d.ud) / max(p["v_s"], 1e-300)))
+            speed = _fixed(d, "speed", lambda: np.abs(d.ud))
+            h = h * (1.0 + p["s"] * np.exp(-speed / max(p["v_s"], 1e-300)))
         if "position_friction" in effects:
-            xi = np.pi * (x - d.extra["x_mid"]) / d.extra["x_half"]
-            h = h * (
-                1.0
-                + p["a1"] * np.cos(xi)
-                + p["b1"] * np.sin(xi)
-                + p["a2"] * np.cos(2 * xi)
-                + p["b2"] * np.sin(2 * xi)
+            # the harmonics along the track are fixed unless x itself moves (x0)
+            c1, s1, c2, s2 = (
+                _track_harmonics(x, d)
+                if "displacement_offset" in effects
+                else _fixed(d, "track", lambda: _track_harmonics(x, d))
             )
+            h = h * (1.0 + p["a1"] * c1 + p["b1"] * s1 + p["a2"] * c2 + p["b2"] * s2)
         if "normal_load" in effects:
-            ph = 2.0 * np.pi * p["f_n"] * (d.t - d.t[0])
+            ph = 2.0 * np.pi * p["f_n"] * _fixed(d, "t_rel", lambda: d.t - d.t[0])
             h = h * (1.0 + p["eps_c"] * np.cos(ph) + p["eps_s"] * np.sin(ph))
         F = h
         if "parallel_stiffness" in effects:
@@ -365,7 +398,7 @@ class TangentialFamily:
         if "force_offset" in effects:
             F = F + p["F0"]
         if "force_drift" in effects:
-            F = F + p["F1"] * (d.t - d.t[0]) / d.duration
+            F = F + p["F1"] * _fixed(d, "t_rel", lambda: d.t - d.t[0]) / d.duration
         if "channel_delay" in effects:
             F = shift(F, d.t, p["tau"])
         return F

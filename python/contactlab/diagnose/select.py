@@ -28,6 +28,7 @@ import numpy as np
 from ..errors import InputError
 from ..fitting import Parameter, least_squares_fit
 from ._family import Family, ParamSpec, Prepared
+from ._parallel import pmap
 
 
 @dataclass
@@ -118,11 +119,12 @@ def fit(
     stride = -(-n_all // FIT_SAMPLES)
     if stride > 1:
         mask = mask & (np.arange(mask.size) % stride == 0)
-    y = d.y[mask]
+    idx = np.flatnonzero(mask)  # the samples the fit sees (a gather is cheaper than a mask)
+    y = d.y[idx]
     # residuals in units of the output's RMS: the solver's gradient tolerance is absolute,
     # and a displacement residual in metres (1e-9) would stop it at the first step
     ys = float(np.sqrt(np.mean(y * y))) or 1.0
-    sw = np.sqrt(sample_weight(d)[mask]) / ys  # errors in variables (see sample_weight)
+    sw = np.sqrt(sample_weight(d)[idx]) / ys  # errors in variables (see sample_weight)
 
     lo = {s.name: s.lower for s in specs}
     hi = {s.name: s.upper for s in specs}
@@ -132,7 +134,7 @@ def fit(
         return {n: float(np.clip(x0[n] + (w[n] - 1.0) * sc[n], lo[n], hi[n])) for n in names}
 
     def resid(w: dict[str, float]) -> np.ndarray:
-        return (family.predict(value(w), effects, d)[mask] - y) * sw
+        return (family.predict(value(w), effects, d)[idx] - y) * sw
 
     res = least_squares_fit(resid, params, ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=400)
     w = {n: res.params[n].value for n in names}
@@ -198,18 +200,25 @@ def evaluate(
     scales: dict[str, float],
     folds: int = 2,
     full: FitOut | None = None,
+    parallel: bool = False,
 ) -> Trial:
     """Cross-validated held-out errors and the fit to all data of one model (``full``, when
-    that fit is at hand already)."""
+    that fit is at hand already). With ``parallel`` the fold fits run on threads
+    (:func:`contactlab.diagnose._parallel.pmap`; the same results)."""
     masks = fold_masks(d, folds)
     if full is None:
         full = fit(family, effects, d, np.ones(d.y.size, bool), start, scales)
     fitted = family.predict(full.params, effects, d)
     pred = fitted.copy()
     heldout = np.zeros(d.y.size, bool)
-    for test in masks:
+
+    def fold_prediction(test: np.ndarray) -> np.ndarray:
         f = fit(family, effects, d, ~test, full.params, scales)
-        pred[test] = family.predict(f.params, effects, d)[test]
+        return family.predict(f.params, effects, d)
+
+    held = pmap(fold_prediction, masks) if parallel else [fold_prediction(m) for m in masks]
+    for test, p in zip(masks, held, strict=True):
+        pred[test] = p[test]
         heldout |= test
     err = pred - d.y
     wt = sample_weight(d)

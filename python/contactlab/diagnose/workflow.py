@@ -15,6 +15,7 @@ import dataclasses
 import json
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -24,6 +25,7 @@ from ..errors import InputError
 from ._family import Family, Prepared
 from ._inputs import arrays as _arrays
 from ._inputs import check_channels
+from ._parallel import one_blas_thread, pmap
 from ._signal import check_uniform, dominant_period_samples, noise_rms
 from .locate import locate
 from .model import ExtendedModel
@@ -315,6 +317,51 @@ def eiv_weight(
     return w, float(np.mean(var * w)) / sigma**2
 
 
+def _try_candidate(
+    name: str,
+    family: Family,
+    current: Trial,
+    effects: tuple[str, ...],
+    d: Prepared,
+    scales: dict[str, float],
+    folds: int,
+    sigma: float,
+    z: float,
+    min_gain: float,
+    budget: float,
+    base_fit: dict[str, float],
+    all_samples: np.ndarray,
+) -> tuple[Verdict, Trial | None]:
+    """The verdict on adding ``name`` to the current model (and its trial when it was
+    cross-validated)."""
+    trial_effects = (*effects, name)
+    start_c = dict(current.full.params)
+    if hasattr(family, "start_effect"):
+        start_c.update(family.start_effect(name, start_c, d, -current.full_residual(d)))
+    # screening: a candidate whose fit to all data lowers the error by less than
+    # min_gain σ² cannot do better on held-out cycles; no cross-validation for it
+    full = fit(family, trial_effects, d, all_samples, start_c, scales)
+    in_gain = (current.full.mse - full.mse) / sigma**2
+    if in_gain < min_gain:
+        reason = f"in-sample gain {in_gain:.3g} σ² below {min_gain:g} σ²"
+        return Verdict(name, np.nan, float(in_gain), np.nan, np.nan, False, reason), None
+    cand = evaluate(family, trial_effects, d, start_c, scales, folds, full)
+    p = cand.full.params
+    extra = 0.0
+    if name == "channel_delay" and abs(p["tau"]) < d.dt:
+        extra = budget  # a sub-sample shift must beat what smoothing the input buys
+    v = judge(name, current, cand, sigma, z, min_gain + extra)
+    # every effect of the candidate model, not only the new one: a refit can push an
+    # effect added before to the edge of its physical range
+    why = next(
+        (w for e in trial_effects if (w := family.implausible(e, p, d))), None
+    ) or _takes_over(family, base_fit, p)
+    if v.accepted and why:
+        v = dataclasses.replace(v, accepted=False, reason=f"implausible: {why}")
+    return v, cand
+
+
+@one_blas_thread
 def diagnose(
     recording: Any,
     model: Any = "tangential",
@@ -387,7 +434,7 @@ def diagnose(
     effects: tuple[str, ...] = tuple(model.effects) if isinstance(model, ExtendedModel) else ()
     if not start:
         start = family.initial_base(d)
-    current = evaluate(family, effects, d, start, scales, folds)
+    current = evaluate(family, effects, d, start, scales, folds, parallel=True)
     sigma = noise_rms(current.full_residual(d))
     if sigma <= 0:
         raise InputError("the output channel has no noise at all; cannot judge significance")
@@ -395,7 +442,7 @@ def diagnose(
     w = eiv_weight(family, current.full.params, d, sigma)
     if w is not None:  # errors in variables: refit the base with the likelihood's weights
         d.extra["weight"], budget = w
-        current = evaluate(family, effects, d, current.full.params, scales, folds)
+        current = evaluate(family, effects, d, current.full.params, scales, folds, parallel=True)
         sigma = noise_rms(current.full_residual(d))
     where, location = locate(d, current.full_residual(d), family)
     where.insert(0, family.regime(current.full.params, d))
@@ -417,46 +464,29 @@ def diagnose(
     base_fit = dict(current.full.params)
     all_samples = np.ones(d.y.size, bool)
     while len(added) < max_effects:
+        tried = [n for n in names if n not in effects and family.check((*effects, n))]
+        # the candidates of one step are independent fits: on threads (the model evaluations
+        # release the GIL), each verdict in the library's order as a serial run gives it
+        try_one = partial(
+            _try_candidate,
+            family=family,
+            current=current,
+            effects=effects,
+            d=d,
+            scales=scales,
+            folds=folds,
+            sigma=sigma,
+            z=z,
+            min_gain=min_gain,
+            budget=budget,
+            base_fit=base_fit,
+            all_samples=all_samples,
+        )
+        results = pmap(try_one, tried)
         verdicts, best = [], None
-        for name in names:
-            if name in effects or not family.check((*effects, name)):
-                continue
-            trial_effects = (*effects, name)
-            start_c = dict(current.full.params)
-            if hasattr(family, "start_effect"):
-                start_c.update(family.start_effect(name, start_c, d, -current.full_residual(d)))
-            # screening: a candidate whose fit to all data lowers the error by less than
-            # min_gain σ² cannot do better on held-out cycles; no cross-validation for it
-            full = fit(family, trial_effects, d, all_samples, start_c, scales)
-            in_gain = (current.full.mse - full.mse) / sigma**2
-            if in_gain < min_gain:
-                verdicts.append(
-                    Verdict(
-                        name,
-                        np.nan,
-                        float(in_gain),
-                        np.nan,
-                        np.nan,
-                        False,
-                        f"in-sample gain {in_gain:.3g} σ² below {min_gain:g} σ²",
-                    )
-                )
-                continue
-            cand = evaluate(family, trial_effects, d, start_c, scales, folds, full)
-            p = cand.full.params
-            extra = 0.0
-            if name == "channel_delay" and abs(p["tau"]) < d.dt:
-                extra = budget  # a sub-sample shift must beat what smoothing the input buys
-            v = judge(name, current, cand, sigma, z, min_gain + extra)
-            # every effect of the candidate model, not only the new one: a refit can push an
-            # effect added before to the edge of its physical range
-            why = next(
-                (w for e in trial_effects if (w := family.implausible(e, p, d))), None
-            ) or _takes_over(family, base_fit, p)
-            if v.accepted and why:
-                v = dataclasses.replace(v, accepted=False, reason=f"implausible: {why}")
+        for v, cand in results:
             verdicts.append(v)
-            if v.accepted and (best is None or v.gain > best[0].gain):
+            if cand is not None and v.accepted and (best is None or v.gain > best[0].gain):
                 best = (v, cand)
         steps[-1] = Step(
             steps[-1].added,

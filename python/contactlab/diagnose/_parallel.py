@@ -1,0 +1,76 @@
+"""How a diagnosis uses the cores: candidate fits on threads, BLAS on one thread each.
+
+The fits of a diagnosis are many small least-squares problems (a few thousand residuals, a
+handful of parameters). Their time goes to the model evaluations — the Masing kernel in
+Rust and numpy array arithmetic, both of which release the GIL — so independent fits (the
+candidates of one step, the folds of one model) run on a thread pool. The BLAS calls of the
+solver (an SVD of a 5000 × 3 Jacobian) are far too small to gain from BLAS's own threads; on
+a loaded machine those threads spin waiting for each other (measured: the same SVDs and dot
+products 20× slower in wall time and CPU with OpenBLAS's default of one thread per core
+than with one). :func:`one_blas_thread` limits BLAS to one thread for the duration of a
+diagnosis when ``threadpoolctl`` is installed (a dependency of the package), and is a no-op
+otherwise; results do not depend on it.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from contextlib import AbstractContextManager, nullcontext
+from typing import Any, TypeVar
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+#: most threads a diagnosis uses for its fits (the fits of one step are a dozen or so)
+MAX_WORKERS = 8
+
+
+def workers() -> int:
+    """Threads for independent fits: the cores this process may run on (at most
+    :data:`MAX_WORKERS`); 1 when ``CONTACTLAB_DIAGNOSE_THREADS=1`` asks for a serial run."""
+    env = os.environ.get("CONTACTLAB_DIAGNOSE_THREADS", "").strip()
+    if env.isdigit() and int(env) >= 1:
+        return min(int(env), MAX_WORKERS)
+    try:
+        n = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):  # not Linux
+        n = os.cpu_count() or 1
+    return max(1, min(n, MAX_WORKERS))
+
+
+def _blas_limit() -> AbstractContextManager[Any]:
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:  # optional at run time: only the speed depends on it
+        return nullcontext()
+    return threadpool_limits(limits=1, user_api="blas")
+
+
+def one_blas_thread(fn: F) -> F:
+    """Run ``fn`` with BLAS limited to one thread (restored afterwards)."""
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        with _blas_limit():
+            return fn(*args, **kwargs)
+
+    return wrapper  # type: ignore[return-value]
+
+
+T = TypeVar("T")
+R = TypeVar("R")
+
+
+def pmap(fn: Callable[[T], R], items: Sequence[T]) -> list[R]:
+    """``[fn(i) for i in items]``, on up to :func:`workers` threads; results in order.
+
+    An exception in any call is raised here (the first in ``items``' order), as a serial
+    loop would raise it.
+    """
+    n = min(workers(), len(items))
+    if n <= 1:
+        return [fn(i) for i in items]
+    with ThreadPoolExecutor(n, thread_name_prefix="contactlab-diagnose") as ex:
+        return list(ex.map(fn, items))
