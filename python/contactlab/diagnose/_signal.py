@@ -14,11 +14,10 @@ import itertools
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.ndimage import uniform_filter1d
-from scipy.signal import savgol_coeffs, savgol_filter
 
 from ..errors import InputError
 from ..reversals import excursions
+from ._filters import savgol_coeffs, savgol_filter, uniform_filter1d
 
 _MAD_TO_SIGMA = 1.0 / 0.6744897501960817
 INPUT_FILTER_FRACTION = 0.04

@@ -44,11 +44,11 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from scipy.signal import savgol_filter
 
 from ..errors import InputError
 from ..masing import Masing, loop_area
 from ._family import Candidate, ParamSpec, Prepared, implausible_common
+from ._filters import savgol_filter
 from ._signal import modulation_gains, shift
 from .scaled_masing import memory, scaled_force
 

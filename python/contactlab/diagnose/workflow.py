@@ -19,10 +19,10 @@ from functools import partial
 from typing import Any
 
 import numpy as np
-from scipy.signal import decimate, savgol_coeffs
 
 from ..errors import InputError
 from ._family import Family, Prepared
+from ._filters import decimate, savgol_coeffs
 from ._inputs import arrays as _arrays
 from ._inputs import check_channels
 from ._parallel import one_blas_thread, pmap
