@@ -193,17 +193,23 @@ def breakaway(
     s_b: float,
     ell: float,
     anchors: tuple[np.ndarray, np.ndarray] | None = None,
+    at: np.ndarray | None = None,
 ) -> np.ndarray:
     """Branches with a breakaway peak: after each reversal ``r`` the rise ``h - h_r`` is
     scaled by ``1 + s_b exp(-|x - x_r| / ell)`` — equal to Masing's at the reversal (no
     jump) and far from it, above it in between (static friction above kinetic). Before the
     first reversal the virgin curve from the origin is treated the same way. ``anchors``:
-    :func:`reversal_anchors` of ``reversals``, when computed already."""
+    :func:`reversal_anchors` of ``reversals``, when computed already; ``at``: sample indices,
+    the result at those samples only."""
     if s_b == 0.0:
-        return h
+        return h if at is None else h[at]
     has, r = anchors if anchors is not None else reversal_anchors(reversals, h.size)
+    if at is not None:  # the anchors (reversals) from the whole history, the rest at ``at``
+        has, r = has[at], r[at]
     xr = np.where(has, x[r], 0.0)
     hr = np.where(has, h[r], 0.0)
+    if at is not None:
+        h, x = h[at], x[at]
     return hr + (h - hr) * (1.0 + s_b * np.exp(-np.abs(x - xr) / max(ell, 1e-300)))
 
 
@@ -365,8 +371,19 @@ class TangentialFamily:
             )
         return {"h0": h0, "ac": ac}
 
-    def predict(self, p: dict[str, float], effects: tuple[str, ...], d: Prepared) -> np.ndarray:
-        """Measured force predicted for the measured displacement ``d.u``."""
+    #: :meth:`predict` takes ``at`` (the fits evaluate the model at their samples only)
+    predicts_at = True
+
+    def predict(
+        self,
+        p: dict[str, float],
+        effects: tuple[str, ...],
+        d: Prepared,
+        at: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """Measured force predicted for the measured displacement ``d.u`` (at the sample
+        indices ``at`` only, when given: the Masing element still runs over the whole
+        history, the terms sample by sample only where asked — the same values)."""
         x = d.u
         if "displacement_offset" in effects:
             x = x - p["x0"]
@@ -392,37 +409,46 @@ class TangentialFamily:
             h = h + p["alpha"] * np.abs(h)
         if "parameter_drift" in effects:
             h = h * (1.0 + p["beta"] * _fixed(d, "t_rel", lambda: d.t - d.t[0]) / d.duration)
+        # from here on sample by sample (but the delay, which interpolates between samples):
+        # with ``at``, only at the samples asked for
+        sub = at is not None and "channel_delay" not in effects
+        pick: Callable[[np.ndarray], np.ndarray] = (lambda a: a[at]) if sub else (lambda a: a)
+        xs = pick(x)
         if "stick_slip" in effects:
             rev = d.cycles.reversals
             anchors = _fixed(d, "anchors", lambda: reversal_anchors(rev, x.size))
-            h = breakaway(h, x, rev, p["s_b"], p["ell"], anchors)
+            h = breakaway(h, x, rev, p["s_b"], p["ell"], anchors, at if sub else None)
+        else:
+            h = pick(h)
         if "stribeck" in effects:
-            speed = _fixed(d, "speed", lambda: np.abs(d.ud))
+            speed = pick(_fixed(d, "speed", lambda: np.abs(d.ud)))
             h = h * (1.0 + p["s"] * np.exp(-speed / max(p["v_s"], 1e-300)))
         if "position_friction" in effects:
             # the harmonics along the track are fixed unless x itself moves (x0)
             c1, s1, c2, s2 = (
-                _track_harmonics(x, d)
+                _track_harmonics(xs, d)
                 if "displacement_offset" in effects
-                else _fixed(d, "track", lambda: _track_harmonics(x, d))
+                else map(pick, _fixed(d, "track", lambda: _track_harmonics(x, d)))
             )
             h = h * (1.0 + p["a1"] * c1 + p["b1"] * s1 + p["a2"] * c2 + p["b2"] * s2)
         if "normal_load" in effects:
-            ph = 2.0 * np.pi * p["f_n"] * _fixed(d, "t_rel", lambda: d.t - d.t[0])
+            ph = 2.0 * np.pi * p["f_n"] * pick(_fixed(d, "t_rel", lambda: d.t - d.t[0]))
             h = h * (1.0 + p["eps_c"] * np.cos(ph) + p["eps_s"] * np.sin(ph))
         F = h
         if "parallel_stiffness" in effects:
-            F = F + p["k_p"] * x
+            F = F + p["k_p"] * xs
         if "viscous_damping" in effects:
-            F = F + p["c"] * d.ud
+            F = F + p["c"] * pick(d.ud)
         if "inertia" in effects:
-            F = F + p["m"] * d.udd
+            F = F + p["m"] * pick(d.udd)
         if "force_offset" in effects:
             F = F + p["F0"]
         if "force_drift" in effects:
-            F = F + p["F1"] * _fixed(d, "t_rel", lambda: d.t - d.t[0]) / d.duration
+            F = F + p["F1"] * pick(_fixed(d, "t_rel", lambda: d.t - d.t[0])) / d.duration
         if "channel_delay" in effects:
             F = shift(F, d.t, p["tau"])
+            if at is not None:
+                F = F[at]
         return F if F.flags.writeable else F.copy()
 
     def derived(

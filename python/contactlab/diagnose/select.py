@@ -133,8 +133,15 @@ def fit(
         # clipped: the affine map back can step a rounding error past a bound (h0 = -3e-17)
         return {n: float(np.clip(x0[n] + (w[n] - 1.0) * sc[n], lo[n], hi[n])) for n in names}
 
-    def resid(w: dict[str, float]) -> np.ndarray:
-        return (family.predict(value(w), effects, d)[idx] - y) * sw
+    if getattr(family, "predicts_at", False):  # the model at the fit's samples only
+
+        def resid(w: dict[str, float]) -> np.ndarray:
+            return (family.predict(value(w), effects, d, at=idx) - y) * sw  # type: ignore[call-arg]
+
+    else:
+
+        def resid(w: dict[str, float]) -> np.ndarray:
+            return (family.predict(value(w), effects, d)[idx] - y) * sw
 
     res = least_squares_fit(resid, params, ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=400)
     w = {n: res.params[n].value for n in names}
