@@ -107,6 +107,8 @@ def test_parallel_candidates_give_the_serial_report(monkeypatch):
 
 
 def test_reused_masing_force_is_the_fresh_one():
+    """h0 times the kept unit-element force is Masing(h0, ac) to rounding, for any h0, and
+    what predict hands out is the caller's to change."""
     from contactlab.diagnose._family import Prepared
     from contactlab.diagnose.candidates_tangential import TangentialFamily
 
@@ -114,12 +116,20 @@ def test_reused_masing_force_is_the_fresh_one():
     d = Prepared.build(rec.t, rec.data["x"], rec.data["F"])
     fam = TangentialFamily()
     fam.prepare(d)
-    p = {"h0": 48.0, "ac": 4.6e4, "c": 0.0, "x0": 1e-7}
-    first = fam.predict(p, (), d)
-    again = fam.predict(p, (), d)
-    fresh = contactlab.Masing(48.0, 4.6e4).force(d.u)
-    assert np.array_equal(first, fresh) and np.array_equal(again, fresh)
-    again[:] = 0.0  # what predict hands out is the caller's to change
-    assert np.array_equal(fam.predict(p, (), d), fresh)
-    shifted = fam.predict(p, ("displacement_offset",), d)
-    assert np.array_equal(shifted, contactlab.Masing(48.0, 4.6e4).force(d.u - 1e-7))
+    for h0 in (48.0, 0.013, 7.5e3):
+        p = {"h0": h0, "ac": 4.6e4, "x0": 1e-7}
+        fresh = contactlab.Masing(h0, 4.6e4).force(d.u)
+        for _ in range(2):
+            got = fam.predict(p, (), d)
+            assert np.max(np.abs(got - fresh)) <= 1e-14 * h0
+            got[:] = 0.0
+        shifted = fam.predict(p, ("displacement_offset",), d)
+        ref = contactlab.Masing(h0, 4.6e4).force(d.u - 1e-7)
+        assert np.max(np.abs(shifted - ref)) <= 1e-14 * h0
+        idx = np.arange(3, d.u.size, 7)
+        for eff in [(), ("stick_slip", "stribeck"), ("position_friction", "force_drift")]:
+            q = {**p, "s_b": 0.2, "ell": 3e-6, "s": 0.1, "v_s": 1e-3, "a1": 0.05, "b1": 0.0}
+            q.update(a2=-0.02, b2=0.01, F1=0.3)
+            assert np.array_equal(fam.predict(q, eff, d, at=idx), fam.predict(q, eff, d)[idx])
+    with pytest.raises(contactlab.InputError, match="h0 must be finite"):
+        fam.predict({"h0": 0.0, "ac": 4.6e4}, (), d)

@@ -249,24 +249,27 @@ def _fixed(d: Prepared, key: str, make: Callable[[], Any]) -> Any:
     return cache[k]
 
 
-#: Masing forces kept per recording (the fits' Jacobians step the effects' parameters at
-#: fixed h0, ac: the same force again); 64 of 24 000 samples are 12 MB
+#: unit Masing forces kept per recording (one per ac, x0 tried); 64 of 24 000 samples: 12 MB
 _MASING_KEEP = 64
 
 
 def _masing_force(d: Prepared, h0: float, ac: float, x0: float | None, x: np.ndarray) -> np.ndarray:
-    """``Masing(h0, ac).force(x)``, reused when the very same ``(h0, ac, x0)`` comes again
-    (bit for bit the same array; read-only, as every evaluation builds new arrays from it)."""
+    """``Masing(h0, ac).force(x)`` as ``h0`` times the force of the unit element (h0 = 1),
+    which is kept per ``(ac, x0)``: along a given history the exponential Masing force is
+    linear in h0 (to rounding, 1e-15 h0), and the fits step h0 and the effects' parameters
+    at a fixed ac thousands of times (their Jacobian columns)."""
+    if not (np.isfinite(h0) and h0 > 0):
+        return Masing(h0, ac).force(x)  # the model's own refusal
     cache = d.extra.setdefault("masing", {})
-    key = (h0, ac, x0, x.size)
-    h = cache.get(key)
-    if h is None:
-        h = Masing(h0, ac).force(x)
-        h.flags.writeable = False
+    key = (ac, x0, x.size)
+    g = cache.get(key)
+    if g is None:
+        g = Masing(1.0, ac).force(x)
+        g.flags.writeable = False
         if len(cache) >= _MASING_KEEP:
             cache.clear()
-        cache[key] = h
-    return h
+        cache[key] = g
+    return h0 * g
 
 
 def _track_harmonics(x: np.ndarray, d: Prepared) -> tuple[np.ndarray, ...]:
