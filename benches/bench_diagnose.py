@@ -17,7 +17,13 @@ F noise 1 % of its RMS, h0 = 40 N, ac = 1e5 1/m):
 References, same run, same machine load:
 
 - ``masing``: ``Masing(h0, ac).force`` over the same 1e6 displacements (best of 5);
-- ``startup``: ``contactlab --help`` in a child (interpreter start and CLI import).
+- ``startup``: ``contactlab --help`` in a child (interpreter start and CLI import);
+- ``import``: CPU time of a child importing numpy, scipy.optimize and h5py (the floor of
+  any run of the CLI on an HDF5 file).
+
+``--serial`` also runs each recording with ``CONTACTLAB_DIAGNOSE_THREADS=1`` (one thread for
+the candidate fits) to show what the threads give; the load average is printed because on a
+shared machine the wall time is mostly a matter of it.
 
 Run: ``nice .venv/bin/python benches/bench_diagnose.py [--samples 1e6] [--repeat 3]
 [--format h5|csv] [--profile]``. ``--profile`` runs cProfile on the CLI path of the first
@@ -89,12 +95,15 @@ def masing_reference(n: int) -> float:
     return best
 
 
-def run_cli(args: list[str]) -> dict:
-    exe = Path(sys.executable).with_name("contactlab")
-    cmd = [str(exe), *args]
+def run_cli(args: list[str], env: dict[str, str] | None = None, python: bool = False) -> dict:
+    """The CLI (or, with ``python``, the interpreter) with ``args`` in a child process."""
+    exe = sys.executable if python else str(Path(sys.executable).with_name("contactlab"))
+    cmd = [exe, *args]
     with tempfile.TemporaryFile() as errf:
         t0 = time.perf_counter()
-        p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=errf)
+        p = subprocess.Popen(
+            cmd, stdout=subprocess.PIPE, stderr=errf, env={**os.environ, **(env or {})}
+        )
         assert p.stdout is not None
         out = p.stdout.read()
         _, status, usage = os.wait4(p.pid, 0)
@@ -138,6 +147,9 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=9101)
     ap.add_argument("--profile", action="store_true", help="cProfile the CLI on the first one")
     ap.add_argument("--keep", metavar="DIR", help="also copy the JSON reports into DIR")
+    ap.add_argument(
+        "--serial", action="store_true", help="also run each with CONTACTLAB_DIAGNOSE_THREADS=1"
+    )
     args = ap.parse_args()
     n = int(args.samples)
     kinds = [k for k in args.recordings.split(",") if k]
@@ -152,34 +164,44 @@ def main() -> None:
             return
         t_masing = masing_reference(n)
         t_start = min(run_cli(["--help"])["wall_s"] for _ in range(3))
+        floor = [run_cli(["-c", "import numpy, scipy.optimize, h5py"], python=True)]
+        floor += [run_cli(["-c", "import numpy, scipy.optimize, h5py"], python=True)]
+        t_imp = min(r["cpu_s"] for r in floor)
         print(
-            f"{n:.3g} samples ({args.format}); references: Masing kernel {t_masing * 1e3:.1f} ms "
-            f"({n / t_masing / 1e6:.0f} M samples/s), CLI start-up {t_start:.2f} s"
+            f"{n:.3g} samples ({args.format}), load average {os.getloadavg()[0]:.1f} on "
+            f"{os.cpu_count()} cores; references: Masing kernel {t_masing * 1e3:.1f} ms "
+            f"({n / t_masing / 1e6:.0f} M samples/s), CLI start-up {t_start:.2f} s wall, "
+            f"import numpy+scipy.optimize+h5py {t_imp:.2f} s CPU"
         )
         print(
-            f"{'recording':<10}{'wall s':>8}{'CPU s':>8}{'RSS MB':>8}"
+            f"{'recording':<10}{'run':<9}{'wall s':>8}{'CPU s':>8}{'RSS MB':>8}"
             f"{'/ Masing':>10}{'/ start':>9}  effects"
         )
+        variants = [("threads", {})]
+        if args.serial:
+            variants.append(("serial", {"CONTACTLAB_DIAGNOSE_THREADS": "1"}))
         rows = []
         for kind in kinds:
             out = tmpd / f"{kind}.json"
-            runs = [
-                run_cli(["diagnose", str(files[kind]), "--model", "tangential", "--json", str(out)])
-                for _ in range(args.repeat)
-            ]
-            best = min(runs, key=lambda r: r["wall_s"])
-            rep = json.loads(out.read_text())
-            if args.keep:
-                Path(args.keep).mkdir(parents=True, exist_ok=True)
-                (Path(args.keep) / out.name).write_text(out.read_text())
-            names = [e["name"] for e in rep["effects"]] or ["-"]
-            rows.append({"recording": kind, **{k: v for k, v in best.items() if k != "stdout"}})
-            print(
-                f"{kind:<10}{best['wall_s']:>8.2f}{best['cpu_s']:>8.2f}"
-                f"{best['peak_rss_mb']:>8.0f}{best['wall_s'] / t_masing:>10.0f}"
-                f"{best['wall_s'] / t_start:>9.1f}  {', '.join(names)}"
-            )
-        print(json.dumps({"masing_s": t_masing, "startup_s": t_start, "runs": rows}))
+            for label, env in variants:
+                cmd = ["diagnose", str(files[kind]), "--model", "tangential", "--json", str(out)]
+                runs = [run_cli(cmd, env) for _ in range(args.repeat)]
+                best = min(runs, key=lambda r: r["wall_s"])
+                rep = json.loads(out.read_text())
+                if args.keep:
+                    Path(args.keep).mkdir(parents=True, exist_ok=True)
+                    (Path(args.keep) / f"{kind}_{label}.json").write_text(out.read_text())
+                names = [e["name"] for e in rep["effects"]] or ["-"]
+                row = {k: v for k, v in best.items() if k != "stdout"}
+                rows.append({"recording": kind, "run": label, **row})
+                print(
+                    f"{kind:<10}{label:<9}{best['wall_s']:>8.2f}{best['cpu_s']:>8.2f}"
+                    f"{best['peak_rss_mb']:>8.0f}{best['wall_s'] / t_masing:>10.0f}"
+                    f"{best['wall_s'] / t_start:>9.1f}  {', '.join(names)}"
+                )
+        print(f"load average at the end {os.getloadavg()[0]:.1f}")
+        summary = {"masing_s": t_masing, "startup_s": t_start, "import_cpu_s": t_imp}
+        print(json.dumps({**summary, "runs": rows}))
 
 
 if __name__ == "__main__":
