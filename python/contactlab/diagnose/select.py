@@ -131,7 +131,8 @@ def fit(
 
     def value(w: dict[str, float]) -> dict[str, float]:
         # clipped: the affine map back can step a rounding error past a bound (h0 = -3e-17)
-        return {n: float(np.clip(x0[n] + (w[n] - 1.0) * sc[n], lo[n], hi[n])) for n in names}
+        # (min/max of floats: np.clip's per-call overhead is felt over thousands of calls)
+        return {n: min(max(float(x0[n] + (w[n] - 1.0) * sc[n]), lo[n]), hi[n]) for n in names}
 
     if getattr(family, "predicts_at", False):  # the model at the fit's samples only
 
@@ -199,6 +200,20 @@ def fold_masks(d: Prepared, folds: int) -> list[np.ndarray]:
     return [(cyc >= 0) & (cyc % folds == k) for k in range(folds)]
 
 
+def _cycle_samples(cyc: np.ndarray, ids: np.ndarray) -> list[slice] | list[np.ndarray]:
+    """The samples of each cycle in ``ids``: slices when every cycle is one run of samples
+    (as :func:`contactlab.diagnose._signal.find_cycles` numbers them), else masks."""
+    runs = np.flatnonzero(np.diff(cyc)) + 1
+    starts = np.r_[0, runs]
+    ends = np.r_[runs, cyc.size]
+    label = cyc[starts]
+    own = label[np.isin(label, ids)]
+    if np.unique(own).size != own.size or own.size != ids.size:  # a cycle in pieces
+        return [cyc == k for k in ids]
+    where = dict(zip(label.tolist(), zip(starts.tolist(), ends.tolist(), strict=True), strict=True))
+    return [slice(*where[k]) for k in ids.tolist()]
+
+
 def evaluate(
     family: Family,
     effects: tuple[str, ...],
@@ -231,12 +246,10 @@ def evaluate(
     wt = sample_weight(d)
     cyc = d.cycles.cycle
     ids = np.unique(cyc[heldout])
-    cycle_mse = np.array(
-        [np.sum(wt[sel] * err[sel] ** 2) / np.sum(wt[sel]) for sel in (cyc == k for k in ids)]
-    )
+    sels = _cycle_samples(cyc, ids)
+    cycle_mse = np.array([np.sum(wt[sel] * err[sel] ** 2) / np.sum(wt[sel]) for sel in sels])
     e_meas, e_mod = [], []
-    for k in ids:
-        sel = cyc == k
+    for sel in sels:
         e_meas.append(family.loop_energy(d.u[sel], d.y[sel]))
         e_mod.append(family.loop_energy(d.u[sel], pred[sel]))
     e_meas_a, e_mod_a = np.array(e_meas), np.array(e_mod)
