@@ -67,10 +67,14 @@ def pmap(fn: Callable[[T], R], items: Sequence[T]) -> list[R]:
     """``[fn(i) for i in items]``, on up to :func:`workers` threads; results in order.
 
     An exception in any call is raised here (the first in ``items``' order), as a serial
-    loop would raise it.
+    loop would raise it; the calls not started yet are dropped (Ctrl-C does not wait for
+    them).
     """
     n = min(workers(), len(items))
     if n <= 1:
         return [fn(i) for i in items]
-    with ThreadPoolExecutor(n, thread_name_prefix="contactlab-diagnose") as ex:
+    ex = ThreadPoolExecutor(n, thread_name_prefix="contactlab-diagnose")
+    try:
         return list(ex.map(fn, items))
+    finally:
+        ex.shutdown(wait=True, cancel_futures=True)
