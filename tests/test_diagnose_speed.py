@@ -133,3 +133,21 @@ def test_reused_masing_force_is_the_fresh_one():
             assert np.array_equal(fam.predict(q, eff, d, at=idx), fam.predict(q, eff, d)[idx])
     with pytest.raises(contactlab.InputError, match="h0 must be finite"):
         fam.predict({"h0": 0.0, "ac": 4.6e4}, (), d)
+
+
+def test_pmap_keeps_order_and_raises_the_first_error(monkeypatch):
+    from contactlab.diagnose._parallel import pmap, workers
+
+    monkeypatch.setenv("CONTACTLAB_DIAGNOSE_THREADS", "3")
+    assert workers() == 3
+    assert pmap(lambda i: i * i, list(range(40))) == [i * i for i in range(40)]
+
+    def f(i: int) -> int:
+        if i in (3, 7):
+            raise ValueError(f"bad {i}")
+        return i
+
+    with pytest.raises(ValueError, match="bad 3"):
+        pmap(f, list(range(10)))
+    monkeypatch.setenv("CONTACTLAB_DIAGNOSE_THREADS", "0")  # not a count: the cores
+    assert workers() >= 1
