@@ -29,7 +29,7 @@ from ._parallel import one_blas_thread, pmap
 from ._signal import check_uniform, dominant_period_samples, noise_rms
 from .locate import locate
 from .model import ExtendedModel
-from .select import Trial, Verdict, evaluate, fit, judge
+from .select import Trial, Verdict, evaluate, fit, fold_masks, judge
 
 __all__ = ["DiagnosisReport", "Effect", "Step", "diagnose"]
 
@@ -434,16 +434,21 @@ def diagnose(
     effects: tuple[str, ...] = tuple(model.effects) if isinstance(model, ExtendedModel) else ()
     if not start:
         start = family.initial_base(d)
-    current = evaluate(family, effects, d, start, scales, folds, parallel=True)
-    sigma = noise_rms(current.full_residual(d))
+    fold_masks(d, folds)  # too few cycles to hold any out: said before fitting
+    # the base fitted to all data gives the noise level and the weights; its cross-validation
+    # is run once, with the weights it ends up with
+    base = fit(family, effects, d, np.ones(d.y.size, bool), start, scales)
+    sigma = noise_rms(family.predict(base.params, effects, d) - d.y)
     if sigma <= 0:
         raise InputError("the output channel has no noise at all; cannot judge significance")
     budget = 0.0
-    w = eiv_weight(family, current.full.params, d, sigma)
+    w = eiv_weight(family, base.params, d, sigma)
     if w is not None:  # errors in variables: refit the base with the likelihood's weights
         d.extra["weight"], budget = w
-        current = evaluate(family, effects, d, current.full.params, scales, folds, parallel=True)
+        current = evaluate(family, effects, d, base.params, scales, folds, parallel=True)
         sigma = noise_rms(current.full_residual(d))
+    else:
+        current = evaluate(family, effects, d, start, scales, folds, base, parallel=True)
     where, location = locate(d, current.full_residual(d), family)
     where.insert(0, family.regime(current.full.params, d))
     if reduced:
