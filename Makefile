@@ -11,8 +11,8 @@ $(STAMP): pyproject.toml
 	python3 -m venv $(VENV)
 	$(PIP) install -q --upgrade pip
 	$(PIP) install -q "maturin>=1.9,<2" "numpy>=1.24" "scipy>=1.10" "matplotlib>=3.7" \
-		"pytest>=8" "hypothesis>=6.100" "ruff>=0.6" "mypy>=1.10" "npTDMS>=1.9" "h5py>=3.9" "pyarrow>=14" "tqdm>=4.60" "threadpoolctl>=3.1" \
-		"dask[distributed]>=2024.1"
+		"pytest>=8" "hypothesis>=6.100" "ruff>=0.6" "mypy>=1.10" "npTDMS>=1.9" "h5py>=3.9" "pyarrow>=14" "tqdm>=4.60" \
+		"dask[distributed]>=2024.1" "threadpoolctl>=3.1"
 	touch $(STAMP)
 
 # Build the Rust extension (release) and install the package into the venv.

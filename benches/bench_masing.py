@@ -12,6 +12,7 @@ Run: ``.venv/bin/python benches/bench_masing.py [--n 10000000] [--repeat 15]``.
 from __future__ import annotations
 
 import argparse
+import os
 import time
 
 import numpy as np
@@ -50,7 +51,8 @@ def main() -> None:
     m = contactlab.Masing(40.0, 4.0e4)
     sig = signals(n)
     buf = np.empty(n)
-    print(f"n = {n:.0e} samples, best of {args.repeat} interleaved repeats")
+    load = ", ".join(f"{a:.2f}" for a in os.getloadavg())
+    print(f"n = {n:.0e} samples, best of {args.repeat} interleaved repeats; load {load}")
     print(f"{'signal':<20}{'force Ms/s':>12}{'push(out=) Ms/s':>17}{'numpy exp Ms/s':>16}")
     for name, x in sig.items():
         t_f = t_o = t_e = np.inf

@@ -9,7 +9,11 @@ Eight channels of band-limited noise (1e6 samples each by default) through the M
   the kernel);
 - python processes: a ``ProcessPoolExecutor`` (arrays pickled to the workers and back).
 
-Prints each speed-up over serial; the requirement is >= 1.9x on 2 cores.
+Prints each speed-up over serial; the requirement is >= 1.9x on 2 cores. For the in-process
+modes it also prints the CPU time relative to serial (1.0 means no work added: on idle cores
+the speed-up is then the thread count, less any imbalance). Unlike a ratio of two
+single-core timings, this figure depends on what else the machine runs: the load average is
+printed before and after (the run is only meaningful on an otherwise idle machine).
 Run: ``.venv/bin/python benches/bench_parallel.py [--channels 8] [--n 1000000]``.
 """
 
@@ -49,6 +53,7 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     args = ap.parse_args()
     cores = os.cpu_count() or 1
+    load_before = os.getloadavg()
     xs = channels(args.channels, args.n)
     ref = [_force(x) for x in xs]
     with ThreadPoolExecutor(cores) as tp, ProcessPoolExecutor(cores) as pp:
@@ -60,18 +65,25 @@ def main() -> None:
             "python processes": lambda: list(pp.map(_force, xs)),
         }
         best = dict.fromkeys(runs, np.inf)
+        cpu = dict.fromkeys(runs, np.inf)
         for _ in range(args.repeat):
             for name, f in runs.items():
-                t0 = time.perf_counter()
+                t0, c0 = time.perf_counter(), time.process_time()
                 out = f()
                 best[name] = min(best[name], time.perf_counter() - t0)
+                cpu[name] = min(cpu[name], time.process_time() - c0)
                 assert all(np.array_equal(a, b) for a, b in zip(out, ref, strict=True)), name
                 del out
     total = args.channels * args.n
     print(f"{args.channels} channels x {args.n:.0e} samples, {cores} cores, best of {args.repeat}")
-    serial = best["serial (one core)"]
+    load = ", ".join(f"{a:.2f}" for a in load_before + os.getloadavg())
+    print(f"load average (1, 5, 15 min) before and after: {load}")
+    serial, serial_cpu = best["serial (one core)"], cpu["serial (one core)"]
     for name, t in best.items():
-        print(f"{name:<20}{total / t / 1e6:8.1f} Ms/s   speed-up {serial / t:5.2f}x")
+        # CPU seconds of this process (all its threads; the process pool's workers are not
+        # counted): their ratio to serial is the work parallelism adds, whatever the load.
+        extra = "" if "processes" in name else f"   CPU {cpu[name] / serial_cpu:5.2f}x serial"
+        print(f"{name:<20}{total / t / 1e6:8.1f} Ms/s   speed-up {serial / t:5.2f}x{extra}")
 
 
 if __name__ == "__main__":

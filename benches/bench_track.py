@@ -12,10 +12,12 @@ Stages (``samples/s`` = recording samples per second of wall time):
   reference every ratio is taken against (measured while writing the file);
 - ``read``: :func:`contactlab.io.read_chunks` alone (HDF5 slices, unit conversion, checks);
 - ``cycles``: read + the per-cycle kernel (crossings, ∮F dx, amplitude, offset per cycle);
-- ``track``: :func:`contactlab.track` with ``every="auto"`` (= ``analyze --stream``), serial
-  and with ``--workers`` processes;
-- ``whole``: ``contactlab analyze`` of a ``--whole-samples`` file (default 1e7) read whole
-  (the issue's "before"), and ``analyze --stream`` of the same file (its "after");
+- ``track``: :func:`contactlab.track` with ``every="auto"`` (= ``analyze --stream``): windows
+  analysed on one helper thread while reading on (the default), serially (``threads=0``),
+  and on ``--workers`` processes;
+- ``whole``: ``contactlab analyze`` of a ``--whole-samples`` file (default 1e7): as a user
+  runs it (longer than 2^19 samples: streamed and pooled automatically), with ``--whole`` (read
+  into memory: the issue's "before") and with ``--stream``;
 - ``study``: ``--study-files`` recordings analysed serially and on a process pool.
 
 Run: ``nice .venv/bin/python benches/bench_track.py [--samples 1e8] [--workers 2]``
@@ -75,7 +77,10 @@ def write_file(path: Path, n: int, seed: int = 12) -> dict:
 
 
 def stage(name: str, path: str, workers: int) -> dict:
-    """Run in the child: one stage on ``path``; returns its wall time and a check value."""
+    """Run in the child: one stage on ``path``; returns its wall and CPU time (this process,
+    imports included) and a check value."""
+    import resource
+
     import h5py  # noqa: F401  (imported before the clock starts)
 
     from contactlab.io import read_chunks
@@ -97,7 +102,9 @@ def stage(name: str, path: str, workers: int) -> dict:
 
         import contactlab
 
-        if workers > 1:
+        if name == "track-serial":
+            r = contactlab.track(path, every="auto", threads=0)
+        elif workers > 1:
             import resource
 
             with ProcessPoolExecutor(workers) as ex:
@@ -118,6 +125,8 @@ def stage(name: str, path: str, workers: int) -> dict:
     else:
         raise SystemExit(f"unknown stage {name}")
     out["wall_s"] = time.perf_counter() - t0
+    ru = resource.getrusage(resource.RUSAGE_SELF)
+    out["cpu_s"] = ru.ru_utime + ru.ru_stime
     return out
 
 
@@ -214,19 +223,28 @@ def main() -> None:
             f"reference  Masing kernel alone (push, chunks of {CHUNK}): "
             f"{m_rate / 1e6:8.1f} M samples/s"
         )
-        stages = [("read", 1), ("cycles", 1), ("track", 1), ("track", args.workers)]
+        stages = [
+            ("read", 1),
+            ("cycles", 1),
+            ("track", 1),
+            ("track-serial", 1),
+            ("track", args.workers),
+        ]
         for name, wk in stages:
             if name in skip:
                 continue
             d = run_stage(name, big, wk)
             rate = n / d["wall_s"]
-            label = f"{name} ({wk} proc)" if name == "track" else name
+            label = f"{name} ({wk} proc)" if name == "track" and wk > 1 else name
             extra = {
-                k: v for k, v in d.items() if k not in ("wall_s", "proc_wall_s", "peak_rss_mb", "n")
+                k: v
+                for k, v in d.items()
+                if k not in ("wall_s", "proc_wall_s", "peak_rss_mb", "n", "cpu_s")
             }
             print(
                 f"{label:<16} {d['wall_s']:8.1f} s {rate / 1e6:8.2f} M samples/s  "
-                f"ratio to Masing {rate / m_rate:6.3f}  peak RSS {d['peak_rss_mb']:6.0f} MB"
+                f"ratio to Masing {rate / m_rate:6.3f}  CPU {d['cpu_s']:7.1f} s  "
+                f"peak RSS {d['peak_rss_mb']:6.0f} MB"
                 f"{'' if wk == 1 else ' (parent only)'}  {extra}"
             )
         big.unlink()
@@ -234,7 +252,11 @@ def main() -> None:
             nw = int(args.whole_samples)
             wf = tmp / "whole.h5"
             write_file(wf, nw, seed=13)
-            for label, extra in (("analyze (whole file)", []), ("analyze --stream", ["--stream"])):
+            for label, extra in (
+                ("analyze", []),
+                ("analyze --whole", ["--whole"]),
+                ("analyze --stream", ["--stream"]),
+            ):
                 cmd = [
                     sys.executable,
                     "-m",
@@ -261,6 +283,7 @@ def main() -> None:
                 f"{args.workers} processes {s['pool_s']:.1f} s "
                 f"(x{s['serial_s'] / s['pool_s']:.2f}), identical: {s['identical']}"
             )
+        print(f"load average at the end {os.getloadavg()[0]:.1f}")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 

@@ -14,7 +14,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
 PY=${PY:-$ROOT/.venv/bin/python}
-PY_TARGETS="read_csv read_tdms read_hdf5 read_mat manifest kernels analyze diagnose track export"
+PY_TARGETS="read_csv read_tdms read_hdf5 read_mat manifest kernels analyze diagnose track export identify simulate"
 ALL="$PY_TARGETS core"
 
 usage() { echo "usage: fuzz/run.sh TARGET|all|list SECONDS  (targets: $ALL)" >&2; exit 2; }

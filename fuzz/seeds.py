@@ -74,7 +74,7 @@ def write_seeds(root: Path = HERE / "seeds") -> None:
                 (out / f"{kind}{i}-{sel}").write_bytes(bytes([sel]) + js.read_bytes())
     # the structured targets decode bytes themselves: a few random starts are enough
     rng = np.random.default_rng(0)
-    for target in ("kernels", "analyze", "diagnose", "track"):
+    for target in ("kernels", "analyze", "diagnose", "track", "identify", "simulate"):
         out = root / target
         out.mkdir(parents=True, exist_ok=True)
         for i in range(8):

@@ -192,3 +192,46 @@ def test_track_normal_recording_cli(tmp_path, capsys):
     assert doc["kind"] == "normal" and doc["cycle_units"]["energy"] == "J/m^2"
     assert {"E_d", "E_d_stderr", "psi", "k_tan", "k_sec", "poly_load_0"} <= set(doc["windows"][0])
     assert (rep / "figures" / "psi.png").exists() and (rep / "figures" / "poly-load.png").exists()
+
+
+def test_long_file_is_streamed_with_the_whole_file_keys(rec_file, tmp_path, monkeypatch, capsys):
+    """Above STREAM_ABOVE samples ``analyze`` streams and pools (bounded memory) and writes
+    the whole-file document's keys, values within the errors of the in-memory analysis."""
+    import contactlab.studies.pooled as pooled
+
+    whole, auto = tmp_path / "w.json", tmp_path / "a.json"
+    assert main(["analyze", str(rec_file), "--model", "tangential", "--json", str(whole),
+                 "--no-progress"]) == 0  # fmt: skip
+    monkeypatch.setattr(pooled, "STREAM_ABOVE", 4000)  # the file holds 16 000 samples
+    assert main(["analyze", str(rec_file), "--model", "tangential", "--json", str(auto),
+                 "--no-progress"]) == 0  # fmt: skip
+    assert "streamed: 16000 samples" in capsys.readouterr().out
+    w, a = json.loads(whole.read_text()), json.loads(auto.read_text())
+    assert "streamed" not in w and a["streamed"] is True and "4000" in a["streamed_reason"]
+    assert set(w) <= set(a)
+    assert set(a) - set(w) == {"streamed", "streamed_reason", "n_windows", "n_samples", "every"}
+    assert set(a["fit"]) == set(w["fit"]) and set(a["identifiable"]) == set(w["identifiable"])
+    assert set(a["stick_slip"]) == set(w["stick_slip"])
+    assert a["n_windows"] >= 1 and a["regime"] == w["regime"] == "pre-sliding"
+    for q in ("h0", "ac", "h0_ac", "energy_per_cycle", "energy_per_cycle_numeric", "k_global",
+              "amplitude", "offset"):  # fmt: skip
+        err = (w[f"{q}_stderr"] ** 2 + a[f"{q}_stderr"] ** 2) ** 0.5
+        assert abs(w[q] - a[q]) < 3 * err, q
+    assert a["fit"]["params"]["h0"]["value"] == a["h0"]
+    assert abs(a["loop_area_recorded"] - w["loop_area_recorded"]) < 1e-3 * w["loop_area_recorded"]
+    # --whole keeps the in-memory analysis
+    again = tmp_path / "w2.json"
+    assert main(["analyze", str(rec_file), "--model", "tangential", "--whole", "--json",
+                 str(again), "--no-progress"]) == 0  # fmt: skip
+    assert "streamed" not in json.loads(again.read_text())
+
+
+def test_pool_weights_and_birge():
+    from contactlab.studies.pooled import pool
+
+    m, e, b = pool([1.0, 3.0], [1.0, 1.0])
+    assert m == 2.0 and b == pytest.approx(2**0.5) and e == pytest.approx(2**-0.5 * 2**0.5)
+    m, e, b = pool([1.0, 1.1, None], [0.5, 0.5, 0.1])
+    assert m == pytest.approx(1.05) and b < 1 and e == pytest.approx(0.5 / 2**0.5)
+    m, e, b = pool([2.0, 4.0], [None, None])  # no errors: mean and its scatter error
+    assert m == 3.0 and e == pytest.approx(1.0) and b != b

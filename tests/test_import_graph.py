@@ -41,6 +41,7 @@ PREFIXES = {
     "contactlab.normal": "models",
     "contactlab.structure": "models",
     "contactlab.diagnose": "studies/diagnosis",
+    "contactlab.diagnose.structure": "studies/diagnosis",  # diagnosis on identified structures
     "contactlab.studies": "studies/diagnosis",
     "contactlab.study": "studies/diagnosis",
     "contactlab.normal_study": "studies/diagnosis",

@@ -59,6 +59,12 @@ def _frame(ns):
     assert abs(d["h0"] - 0.8) < 0.03 * 0.8
 
 
+def _structure_diagnosis(ns):
+    rep = ns["rep"]  # the missing joint dashpot is named, with its size, nothing left over
+    assert rep.effects == ["joint_damping"] and not rep.unexplained
+    assert abs(rep.parameters["cj"] - 3.0) < 0.3
+
+
 # What each block claims, keyed by a line that identifies the block.
 CLAIMS = {
     "m = contactlab.Masing(h0=40.0, ac=4e4)": _masing,
@@ -67,6 +73,7 @@ CLAIMS = {
     'hidden_effect_recording(["channel_delay"]': _diagnose,
     "res = run_study(files)": _study,
     "fr = frame_friction_force(": _frame,
+    "rep = contactlab.diagnose((t, yb, x), base=m": _structure_diagnosis,
 }
 
 

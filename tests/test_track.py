@@ -221,3 +221,147 @@ def test_real_friction_frame_data():
         inside = (a.cycles["start"] >= r["t_start"]) & (a.cycles["end"] <= r["t_end"] + 0.01)
         e = abs(r["energy_per_cycle_numeric"])
         assert abs(np.mean(a.cycles["energy"][inside]) - e) < 0.05 * e
+
+
+# -- the one-pass window analysis (issue 9: per-window work in Rust) ----------------------
+
+_WINDOW_CASES = {
+    # fresh seeds; noise on both channels, drifts, another sampling rate, an inverted load
+    # cell, and a gross-sliding loop (which takes the whole-window analysis)
+    "pre-sliding": dict(h0=35.0, ac=6e4, amplitude=15e-6, n_cycles=12, fs=1500.0, frequency=2.0,
+                        noise=0.02, seed=6803),
+    "drifts": dict(h0=22.0, ac=9e4, amplitude=9e-6, n_cycles=10.3, fs=700.0, noise=0.03,
+                   x_noise=0.01, drift=0.4, x_drift=2e-7, seed=6804),
+    "transition": dict(h0=40.0, ac=1.2e5, amplitude=15e-6, n_cycles=8, fs=2500.0, noise=0.01,
+                       seed=6805),
+    "gross sliding": dict(h0=40.0, ac=4e5, amplitude=20e-6, n_cycles=8, fs=2000.0, noise=0.01,
+                          seed=6806),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("case", sorted(_WINDOW_CASES))
+@pytest.mark.parametrize("invert", [False, True])
+def test_window_analysis_equals_the_whole_analysis(case, invert):
+    """analyze_window (one fold, reused) gives analyze_tangential's numbers and verdicts."""
+    from contactlab.tangential.analysis import analyze_window
+
+    rec = synthetic_recording(**_WINDOW_CASES[case])
+    if invert:
+        rec = Recording(rec.t, {"x": rec["x"], "F": -rec["F"]}, rec.units, rec.source, {})
+    a = analyze_tangential(rec, warn=False).to_dict()
+    b = analyze_window(rec).to_dict()
+    sign = -1 if invert else 1
+    assert a["regime"] == b["regime"] and a["force_sign"] == b["force_sign"] == sign
+    assert a["identifiable"]["h0"] == b["identifiable"]["h0"]
+    # the same warnings; the orientation's names the loop area's error, which the window
+    # estimates from the folded loop's spread instead of second differences
+    assert [w[:40] for w in a["warnings"]] == [w[:40] for w in b["warnings"]]
+    assert [w for w in a["warnings"] if "analysed -F" not in w] == [
+        w for w in b["warnings"] if "analysed -F" not in w
+    ]
+    assert (
+        abs(b["loop_area_recorded"] - a["loop_area_recorded"]) < 3 * a["loop_area_recorded_stderr"]
+    )
+    for q in (*contactlab.studies.tracking.TANGENTIAL_QUANTITIES, "force_drift", "x0"):
+        for k in (q, f"{q}_stderr"):
+            if a.get(k) is None:
+                assert b.get(k) is None, k
+            else:
+                np.testing.assert_allclose(b[k], a[k], rtol=1e-9, atol=0, err_msg=k)
+    if case == "gross sliding":
+        assert "stick_slip" in b  # the whole-window analysis ran
+    else:
+        assert "stick_slip" not in b
+
+
+def test_window_analysis_force_sign_given_or_undecided():
+    from contactlab.tangential.analysis import analyze_window
+
+    rec = synthetic_recording(**_WINDOW_CASES["pre-sliding"])
+    fixed = analyze_window(rec, force_sign=-1).to_dict()
+    ref_fixed = analyze_tangential(rec, force_sign=-1, warn=False).to_dict()
+    assert fixed["force_sign"] == ref_fixed["force_sign"] == -1
+    assert "given by the user" in fixed["orientation_reason"]
+    assert fixed["regime"] == ref_fixed["regime"]
+    np.testing.assert_allclose(fixed["h0_ac"], ref_fixed["h0_ac"], rtol=1e-9)
+    # a line (no dissipation): the area does not decide, the full orientation does
+    line = Recording(rec.t, {"x": rec["x"], "F": 1e5 * rec["x"]}, rec.units, rec.source, {})
+    with pytest.warns(contactlab.ContactLabWarning):
+        ref = analyze_tangential(line).to_dict()
+    got = analyze_window(line).to_dict()
+    assert got["force_sign"] == ref["force_sign"] == 1
+    assert got["orientation_reason"] == ref["orientation_reason"]
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 10_000), n=st.integers(2, 400), k=st.integers(2, 12))
+def test_period_means_is_numpy_cumsum_interp(seed, n, k):
+    from contactlab import _core
+
+    rng = np.random.default_rng(seed)
+    t = np.cumsum(rng.uniform(0.01, 1.0, n))
+    v = rng.standard_normal(n) * 10.0 ** rng.uniform(-6, 6)
+    edges = np.sort(rng.uniform(t[0] - 0.5, t[-1] + 0.5, k))
+    c = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ref = np.diff(np.interp(edges, t, c)) / np.diff(edges)
+    np.testing.assert_array_equal(_core.period_means(t, v, edges), ref)
+    with pytest.raises(InputError, match="increasing"):
+        _core.period_means(t[::-1].copy(), v, edges)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 10_000), cuts=st.lists(st.integers(0, 600), max_size=5))
+def test_loop_area_sensitivity_is_the_roll_formula(seed, cuts):
+    from contactlab import _core
+
+    rng = np.random.default_rng(seed)
+    x, F = rng.standard_normal(600), rng.standard_normal(600)
+    bounds = sorted({0, 600, *cuts})
+    g_F, g_x = _core.loop_area_sensitivity(x, F, bounds)
+    for k, (a, b) in enumerate(itertools.pairwise(bounds)):
+        xs, Fs = x[a:b], F[a:b]
+        ref_F = np.sum((0.5 * (np.roll(xs, 1) - np.roll(xs, -1))) ** 2)
+        ref_x = np.sum((0.5 * (np.roll(Fs, -1) - np.roll(Fs, 1))) ** 2)
+        np.testing.assert_allclose([g_F[k], g_x[k]], [ref_F, ref_x], rtol=1e-12, atol=1e-300)
+
+
+def test_threads_give_the_serial_rows(long_rec):
+    a = track(long_rec, every="6cycles", threads=0)
+    b = track(long_rec, every="6cycles", threads=2)
+    assert a.rows == b.rows
+    np.testing.assert_array_equal(a.cycles["energy"], b.cycles["energy"])
+    with pytest.raises(InputError, match="threads"):
+        track(long_rec, every="6cycles", threads=-1)
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 10_000), n_bins=st.integers(8, 60), n_cyc=st.integers(1, 9))
+def test_fold_spread_is_the_numpy_spread(seed, n_bins, n_cyc):
+    """PhaseFold.spread (Rust) against preprocess' numpy formulas, cells left empty included."""
+    from contactlab import _core
+    from contactlab.tangential.preprocess import _dphase, _spread
+
+    rng = np.random.default_rng(seed)
+    n = n_cyc * n_bins * 3
+    t = np.sort(rng.uniform(0.0, n_cyc, n))
+    t = t[np.r_[True, np.diff(t) > 0]]
+    x, F = np.sin(2 * np.pi * t) + 0.1 * rng.standard_normal(t.size), rng.standard_normal(t.size)
+    kt = np.linspace(0.0, n_cyc, n_cyc + 1)
+    fold = _core.PhaseFold(n_bins, n_cyc)
+    fold.push(t, x, F, 0, kt, kt.copy())
+    s, got = fold.sums(), fold.spread()
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cx, cF = s["cycle_x"] / s["cycle_count"], s["cycle_F"] / s["cycle_count"]
+        dphi = s["cycle_phase"] / s["cycle_count"] - s["sum_phase"] / s["count"]
+        xm, Fm = s["sum_x"] / s["count"], s["sum_F"] / s["count"]
+        ref_x = _spread(cx - _dphase(xm, n_bins) * dphi)
+        ref_F = _spread(cF - _dphase(Fm, n_bins) * dphi)
+    np.testing.assert_allclose(got["x_std"], ref_x, rtol=1e-12, atol=0)
+    np.testing.assert_allclose(got["F_std"], ref_F, rtol=1e-12, atol=0)
+    with np.errstate(invalid="ignore"):
+        full = np.isfinite(cx).any(axis=1)
+        ref_a = np.full(n_cyc, np.nan)
+        ref_a[full] = 0.5 * (np.nanmax(cx[full], axis=1) - np.nanmin(cx[full], axis=1))
+    np.testing.assert_array_equal(got["amplitude"], ref_a)
+    assert set(fold.sums(cells=False)) == {k for k in s if not k.startswith("cycle_")}

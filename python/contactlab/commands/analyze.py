@@ -28,6 +28,7 @@ from ._common import (
     parse_columns,
     process_pool,
     quantity,
+    recording_json,
     write_json,
     write_report,
 )
@@ -144,6 +145,52 @@ def _streamed(args: argparse.Namespace, entries: list, columns: dict | None, top
     return 1 if failures else 0
 
 
+def _n_samples(path: Path, columns: dict | None, fs: float | None) -> int:
+    """Samples of a recording without reading it (HDF5, MAT v7.3, TDMS), or an estimate from
+    the size of a text file (16 bytes a row at least); 0 when the file cannot be opened that
+    way (the whole-file reader then reports what is wrong with it)."""
+    from ..errors import ContactLabError
+    from ..io import read_chunks
+
+    try:
+        n = read_chunks(path, columns=columns, kind="tangential", fs=fs).n_samples
+    except (ContactLabError, OSError, ValueError):
+        return 0
+    return int(n) if n is not None else path.stat().st_size // 16
+
+
+def _auto_streamed(
+    args: argparse.Namespace, entry: object, columns: dict | None, topts: dict, ex: object
+) -> dict:
+    """A long tangential recording analysed window by window in bounded memory and pooled
+    into the whole-file document (:mod:`contactlab.studies.pooled`)."""
+    from ..io.recording import RecordingError
+    from ..studies.pooled import STREAM_ABOVE, pooled_document
+    from ..studies.tracking import track
+
+    path = entry.path  # type: ignore[attr-defined]
+    res = track(path, "auto", kind="tangential", columns=columns, fs=args.fs, executor=ex,
+                options=topts, keep_documents=True)  # fmt: skip
+    if not res.window_docs:
+        errors = "; ".join(str(r.get("error")) for r in res.rows if r.get("error"))
+        raise RecordingError(f"no window of the streamed analysis could be fitted: {errors}",
+                             file=str(path))  # fmt: skip
+    n = res.meta["n_samples"]
+    reason = (
+        f"{n} samples > {STREAM_ABOVE}: analysed in {len(res.rows)} windows of whole cycles "
+        f"(every={res.every}) read in chunks, memory bounded; the windows pooled "
+        "(--whole analyses the file in memory)"
+    )
+    doc = pooled_document(res.window_docs, reason=reason)
+    doc.update(n_samples=n, n_windows=len(res.rows), every=res.every)
+    failed = [r for r in res.rows if r.get("error")]
+    if failed:
+        doc["warnings"] = [*doc["warnings"], *(str(r["error"]) for r in failed)]
+    doc = {"file": str(path), "model": "tangential", **entry.tags, **doc}  # type: ignore[attr-defined]
+    doc["_track"] = res
+    return doc
+
+
 def _handler(args: argparse.Namespace) -> int:
     columns = parse_columns(args.columns)
     check_output_targets(json_out=args.json, report=args.report)
@@ -162,6 +209,20 @@ def _handler(args: argparse.Namespace) -> int:
     nopts = {"p0": args.p0, "pa": args.pa}
     if args.stream:
         return _streamed(args, entries, columns, topts)
+    big: set[int] = set()
+    if args.model == "tangential" and not args.whole:
+        from ..studies.pooled import STREAM_ABOVE
+
+        big = {
+            i for i, e in enumerate(entries) if _n_samples(e.path, columns, args.fs) > STREAM_ABOVE
+        }
+    if big and args.report and len(entries) > 1:
+        raise InputError(
+            "--report with several files, some too long to analyse in memory: use "
+            "`contactlab analyze FILE --report DIR` per long file (or --whole)"
+        )
+    if big:
+        return _with_long(args, entries, big, columns, topts, nopts)
     result = run_study(entries, progress=args.progress, keep_going=args.keep_going,
                        tangential_options=topts, normal_options=nopts)  # fmt: skip
     # With --json -, stdout carries the JSON alone; everything else goes to stderr.
@@ -206,6 +267,93 @@ def _handler(args: argparse.Namespace) -> int:
     return 1 if result.failures else 0
 
 
+def _with_long(
+    args: argparse.Namespace,
+    entries: list,
+    big: set[int],
+    columns: dict | None,
+    topts: dict,
+    nopts: dict,
+) -> int:
+    """``analyze`` when some recordings are longer than ``STREAM_ABOVE`` samples: those
+    streamed and pooled (same JSON keys, plus ``streamed``/``streamed_reason``), the others
+    analysed whole."""
+    from .. import __version__
+    from ..errors import ContactLabError
+
+    say = sys.stderr if args.json == "-" else sys.stdout
+    small = [e for i, e in enumerate(entries) if i not in big]
+    result = (
+        run_study(
+            small,
+            progress=args.progress,
+            keep_going=args.keep_going,
+            tangential_options=topts,
+            normal_options=nopts,
+        )
+        if small
+        else None
+    )
+
+    by_path = {}
+    failures = []
+    if result is not None:
+        for r in result.results:
+            if r.ok:
+                by_path[str(r.entry.path)] = recording_json(r)
+                print(f"{r.entry.path}: {_summary_line(r.row, r.entry.kind)}", file=say)
+            else:
+                failures.append({"file": str(r.entry.path), "error": r.error})
+                print(f"{r.entry.path}: FAILED: {r.error}", file=sys.stderr)
+    last = None
+    with process_pool(args.workers) as ex:
+        for i in sorted(big):
+            e = entries[i]
+            try:
+                doc = _auto_streamed(args, e, columns, topts, ex)
+            except ContactLabError as exc:
+                if not args.keep_going:
+                    raise
+                failures.append({"file": str(e.path), "error": str(exc)})
+                print(f"{e.path}: FAILED: {exc}", file=sys.stderr)
+                continue
+            last = doc.pop("_track")
+            by_path[str(e.path)] = doc
+            print(
+                f"{e.path}: {_summary_line(doc, 'tangential')} (streamed: {doc['n_samples']} "
+                f"samples in {doc['n_windows']} windows)",
+                file=say,
+            )
+            for w in doc["warnings"]:
+                print(f"  warning: {w}", file=sys.stderr)
+    recs = [by_path[str(e.path)] for e in entries if str(e.path) in by_path]
+    doc_all: dict = (
+        {**recs[0], "contactlab_version": __version__}
+        if len(recs) == 1 and not failures
+        else {"contactlab_version": __version__, "recordings": recs, "failures": failures}
+    )
+    text = json_text(doc_all) if args.json else None
+    if args.report and last is not None:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from ..report import commit_outputs
+        from ..report.track_report import build_track_report, track_files
+
+        cmd = command_line("analyze", *args.files, "--model", args.model, "--report", args.report)
+        rep = build_track_report(
+            last, f"contactlab analyze (streamed): {last.source}", intro=f"Made by: {cmd}"
+        )
+        for p in commit_outputs(args.report, track_files(last, rep)):
+            if p.suffix == ".html":
+                print(f"wrote {p}", file=say)
+    if args.json:
+        p = write_json(args.json, text)
+        if str(p) != "-":
+            print(f"wrote {p}", file=say)
+    return 1 if failures else 0
+
+
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "analyze",
@@ -236,6 +384,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="long files: read in chunks, analyse windows (--every) and pool them; "
         "memory stays bounded whatever the length",
+    )
+    p.add_argument(
+        "--whole",
+        action="store_true",
+        help="tangential recordings longer than 2^19 samples are streamed and pooled "
+        "automatically (memory bounded, JSON says 'streamed'); --whole reads them into memory",
     )
     p.add_argument(
         "--every", default="auto", help="window of --stream: 'auto' (default), '200cycles' or '10s'"

@@ -1,4 +1,5 @@
-"""``contactlab diagnose FILE --model tangential|normal [--json OUT] [--report DIR]``.
+"""``contactlab diagnose FILE --model tangential|normal [--json OUT] [--report DIR]``, or
+``contactlab diagnose FILE --structure MODEL.json [--json OUT]`` for an identified structure.
 
 Reads the recording (any format :func:`contactlab.io.read_recording` knows), runs
 :func:`contactlab.diagnose`, prints the findings and the gap-shrink table, and optionally
@@ -27,8 +28,22 @@ def add_parser(subparsers: Any) -> None:
     p.add_argument(
         "--model",
         choices=["tangential", "normal"],
-        required=True,
         help="tangential: x, F (Masing base); normal: p, delta (Kelvin-Voigt base)",
+    )
+    p.add_argument(
+        "--structure",
+        metavar="MODEL.json",
+        help="diagnose a structure: this identified model (contactlab identify --json) is "
+        "the base; FILE is a CSV with the input and response columns",
+    )
+    p.add_argument("--u", help="with --structure: input column (force, or base displacement)")
+    p.add_argument("--y", help="with --structure: response column (displacement of the mass)")
+    p.add_argument("--fs", type=float, help="with --structure: sampling rate without a t column")
+    p.add_argument(
+        "--holdout",
+        type=float,
+        default=0.25,
+        help="with --structure: fraction of the record (at its end) no fit sees",
     )
     p.add_argument("--json", metavar="OUT", help="write the result as JSON to OUT")
     p.add_argument(
@@ -46,6 +61,12 @@ def run(args: argparse.Namespace) -> int:
     from ..errors import InputError
     from ..io import read_recording
 
+    if args.structure:
+        from .structure import diagnose_structure_cli
+
+        return diagnose_structure_cli(args)
+    if args.model is None:
+        raise InputError("diagnose needs --model tangential|normal or --structure MODEL.json")
     rec = read_recording(args.file, kind=args.model)
     if args.model == "normal":
         from ..commands._common import with_static_pressure

@@ -8,7 +8,9 @@ come from the column names (``x_mm``, ``u_force_N``, ``y [um]``) or default to S
 from __future__ import annotations
 
 import argparse
+import json
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -33,9 +35,14 @@ def read_table(path: str) -> dict[str, np.ndarray]:
     if len(names) < 2:
         raise InputError(f"{path}: the first line must name the comma-separated columns")
     try:
-        data = np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2)
+        with warnings.catch_warnings():
+            # numpy warns "input contained no data" for a header alone: refused just below
+            warnings.simplefilter("ignore", UserWarning)
+            data = np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2)
     except ValueError as exc:
         raise InputError(f"{path}: not a numeric table: {exc}") from None
+    if data.size == 0:
+        raise InputError(f"{path}: no data rows after the header line")
     if data.shape[1] != len(names):
         raise InputError(f"{path}: {len(names)} column names but {data.shape[1]} columns")
     out = {}
@@ -108,8 +115,9 @@ def _identify(args: argparse.Namespace) -> int:
     if args.report:
         commit_outputs(args.report, rep.files())
     if args.json != "-":
-        hold = summary.get("rms_holdout")
-        print(f"{args.joint}: RMS output error {summary['rms_train']:.4g} m (training)"
+        hold, train = summary.get("rms_holdout"), summary["rms_train"]
+        print(f"{args.joint}: RMS output error "
+              + (f"{train:.4g} m (training)" if train is not None else "n/a (training)")
               + (f", {hold:.4g} m (hold-out)" if hold is not None else "")
               + f"; identified in {model.elapsed:.1f} s")  # fmt: skip
     return 0
@@ -150,6 +158,39 @@ def simulate_structure(args: argparse.Namespace) -> int:
     if not r.success:
         raise InputError(f"simulation stopped early ({r.message}); wrote {r.t.size} samples")
     print(f"wrote {path} ({r.t.size} samples)")
+    return 0
+
+
+def diagnose_structure_cli(args: argparse.Namespace) -> int:
+    """Handler of ``contactlab diagnose FILE --structure MODEL.json``: the identified model is
+    the base; prints the findings, writes ``--json``."""
+    from .._io_atomic import write_text
+    from ..diagnose.structure import diagnose_structure
+    from ..structure import IdentifiedModel
+
+    if args.report:
+        raise InputError("--report is not available with --structure; use --json")
+    model = IdentifiedModel.load(args.structure)
+    cols = read_table(args.file)
+    exc = model.excitation
+    ucol = _pick(cols, args.u, ("u", "f") if exc == "force" else ("y_base", "base", "y"),
+                 "u", args.file)  # fmt: skip
+    ycol = _pick(cols, args.y, ("y_disp", "y", "x") if exc == "force" else ("x", "y_disp"),
+                 "y", args.file)  # fmt: skip
+    if ucol == ycol:
+        raise InputError(f"{args.file}: input and response are the same column {ucol!r}")
+    u, y = cols[ucol], cols[ycol]
+    t = _time(cols, args, u.size, args.file)
+    try:
+        rep = diagnose_structure((t, u, y), model, holdout=args.holdout,
+                                 max_effects=args.max_effects)  # fmt: skip
+    except InputError as exc_:
+        raise InputError(f"{args.file}: {exc_}") from exc_
+    print(rep.summary())
+    if args.json:
+        doc = rep.to_dict()
+        doc["columns"] = {"u": ucol, "y": ycol}
+        write_text(args.json, json.dumps(doc, indent=2, allow_nan=False) + "\n")
     return 0
 
 

@@ -16,6 +16,7 @@ from typing import Any
 
 from .generator import HiddenEffectRecording, hidden_effect_recording
 from .model import ExtendedModel
+from .structure import StructureDiagnosis, diagnose_structure
 from .workflow import DiagnosisReport, Effect, Step, diagnose
 
 __all__ = [
@@ -24,7 +25,9 @@ __all__ = [
     "ExtendedModel",
     "HiddenEffectRecording",
     "Step",
+    "StructureDiagnosis",
     "diagnose",
+    "diagnose_structure",
     "hidden_effect_recording",
 ]
 
@@ -32,7 +35,7 @@ __all__ = [
 class _CallableModule(types.ModuleType):
     """``contactlab.diagnose(...)`` calls :func:`diagnose`; attributes are the subpackage's."""
 
-    def __call__(self, *args: Any, **kwargs: Any) -> DiagnosisReport:
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
         return diagnose(*args, **kwargs)
 
 

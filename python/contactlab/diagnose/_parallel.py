@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import functools
 import os
+import threading
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import AbstractContextManager, nullcontext
@@ -78,3 +79,33 @@ def pmap(fn: Callable[[T], R], items: Sequence[T]) -> list[R]:
         return list(ex.map(fn, items))
     finally:
         ex.shutdown(wait=True, cancel_futures=True)
+
+
+class EvaluationCounter:
+    """Model evaluations a diagnosis has spent (its budget), counted per thread so that fits
+    on several threads neither lose counts nor mix them: :meth:`tick` from any thread,
+    :meth:`mine` the calling thread's count so far, :attr:`total` everyone's."""
+
+    def __init__(self) -> None:
+        self._local = threading.local()
+        self._counts: list[list[int]] = []
+        self._lock = threading.Lock()
+
+    def _slot(self) -> list[int]:
+        c = getattr(self._local, "count", None)
+        if c is None:
+            c = self._local.count = [0]
+            with self._lock:
+                self._counts.append(c)
+        return c
+
+    def tick(self) -> None:
+        self._slot()[0] += 1
+
+    def mine(self) -> int:
+        return self._slot()[0]
+
+    @property
+    def total(self) -> int:
+        with self._lock:
+            return sum(c[0] for c in self._counts)

@@ -91,6 +91,15 @@ BASE_PARAMS = (
 
 #: Relative tolerance of the ODE solves: far below any sensor noise, and cheap.
 RTOL = 1e-6
+#: Step attempts a solve may take per sample (plus a fixed allowance): fitted models need
+#: a few per sample (at most 5 in the slowest fuzz input); a trial parameter set needing
+#: far more is stopped there and treated as a failed solve (see _delta), which bounds the
+#: cost of one evaluation instead of letting a fit's trial point run unbounded.
+MAX_STEPS_PER_SAMPLE = 50
+
+
+def _max_steps(n: int) -> int:
+    return MAX_STEPS_PER_SAMPLE * n + 1000
 
 
 def _delta(res: Any, n: int) -> np.ndarray:
@@ -114,7 +123,8 @@ def kelvin_voigt(t: np.ndarray, pd: np.ndarray, k: float, psi: float, omega: flo
     """Linear Kelvin-Voigt response via :class:`contactlab.normal.KelvinVoigt`."""
     from ..normal import KelvinVoigt
 
-    return _delta(KelvinVoigt(k, psi, omega).simulate(t, pd, rtol=RTOL), pd.size)
+    res = KelvinVoigt(k, psi, omega).simulate(t, pd, rtol=RTOL, max_steps=_max_steps(pd.size))
+    return _delta(res, pd.size)
 
 
 def nonlinear(
@@ -124,7 +134,7 @@ def nonlinear(
     from ..normal import NonlinearContact
 
     model = NonlinearContact(k_s_delta=list(coeffs), psi=psi, omega=omega)
-    return _delta(model.simulate(t, pd, rtol=RTOL), pd.size)
+    return _delta(model.simulate(t, pd, rtol=RTOL, max_steps=_max_steps(pd.size)), pd.size)
 
 
 def frequency_domain(

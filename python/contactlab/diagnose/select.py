@@ -134,14 +134,20 @@ def fit(
         # (min/max of floats: np.clip's per-call overhead is felt over thousands of calls)
         return {n: min(max(float(x0[n] + (w[n] - 1.0) * sc[n]), lo[n]), hi[n]) for n in names}
 
+    spent = d.extra.get("evaluations")  # the workflow's budget counter (EvaluationCounter)
+
     if getattr(family, "predicts_at", False):  # the model at the fit's samples only
 
         def resid(w: dict[str, float]) -> np.ndarray:
+            if spent is not None:
+                spent.tick()
             return (family.predict(value(w), effects, d, at=idx) - y) * sw  # type: ignore[call-arg]
 
     else:
 
         def resid(w: dict[str, float]) -> np.ndarray:
+            if spent is not None:
+                spent.tick()
             return (family.predict(value(w), effects, d)[idx] - y) * sw
 
     res = least_squares_fit(resid, params, ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=400)

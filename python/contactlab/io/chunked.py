@@ -231,7 +231,7 @@ def _vector_length(ds: Any, *, file: str, column: str) -> int:
 def _h5_chunks(
     path: Path, fmt: str, *, columns: Any, kind: Any, fs: Any, chunk: int
 ) -> ChunkedRecording:
-    from .hdf5 import hdf5_layout, import_h5py
+    from .hdf5 import hdf5_layout, import_h5py, open_hdf5
 
     h5py = import_h5py()
     file = str(path)
@@ -250,11 +250,7 @@ def _h5_chunks(
             raise RecordingError(f"{what} differ in length: {sizes}", file=file)
         return kind_, mapping, dsets, units, dt, next(iter(sizes.values()))
 
-    try:
-        f = h5py.File(path, "r")
-    except OSError as exc:
-        raise RecordingError(f"not a readable HDF5 file ({exc})", file=file) from None
-    with f:
+    with open_hdf5(path, file=file) as f:  # refuses what makes libhdf5 hang
         kind_, mapping, _d, units, dt, n = layout(f)
     fin0 = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, meta={"format": fmt})
 

@@ -9,6 +9,7 @@ datasets are read.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
@@ -34,6 +35,177 @@ def import_h5py() -> Any:
     except ImportError:  # pragma: no cover - depends on the installation
         raise InputError("reading HDF5 files needs h5py: pip install 'contactlab[io]'") from None
     return h5py
+
+
+#: libhdf5 (2.0) decodes a global heap collection ("GCOL", the store of variable-length strings
+#: and arrays) by walking its objects until the collection's end; a free-space record (index
+#: 0) of size 0 does not advance the walk, and the library loops forever (found by fuzzing:
+#: fuzz/regressions/read_hdf5). No signal interrupts it, so such a file is refused before
+#: h5py opens it.
+_GCOL = b"GCOL\x01"
+#: More objects than any collection libhdf5 writes can hold (4 KiB collections; larger only
+#: to fit one big object): a walk this long is a damaged file, refused without walking on.
+_MAX_HEAP_OBJECTS = 1_000_000
+
+
+def _superblock(mm: Any, size: int) -> tuple[int, int, int] | None:
+    """``(size of offsets, size of lengths, base address)`` from the superblock, found at 0,
+    512, 1024, ... as libhdf5 looks for it; None when there is none or it is not understood
+    (h5py then reports the file as unreadable)."""
+    from .sniff import HDF5_SIGNATURE
+
+    at = 0
+    while at + 48 <= size:
+        if mm[at : at + 8] == HDF5_SIGNATURE:
+            version = mm[at + 8]
+            if version < 2:
+                noff, nlen = mm[at + 13], mm[at + 14]
+                base_at = at + (24 if version == 0 else 28)
+            else:
+                noff, nlen = mm[at + 9], mm[at + 10]
+                base_at = at + 12
+            if noff not in (2, 4, 8) or nlen not in (2, 4, 8):
+                return None  # libhdf5 rejects such a superblock itself
+            return noff, nlen, int.from_bytes(mm[base_at : base_at + noff], "little")
+        at = 512 if at == 0 else 2 * at
+    return None
+
+
+def _check_global_heaps(mm: Any, size: int, nlen: int, file: str) -> None:
+    """Refuse a global heap collection whose object walk (as libhdf5's
+    ``H5HG__cache_heap_deserialize`` does it) would never reach the collection's end."""
+    hdr = 8 + nlen  # signature, version, 3 reserved bytes, collection size
+    objhdr = 8 + nlen  # index u16, reference count u16, 4 reserved bytes, object size
+    pos = mm.find(_GCOL)
+    while pos != -1:
+        if pos + hdr <= size:
+            coll = int.from_bytes(mm[pos + 8 : pos + 8 + nlen], "little")
+            end = pos + coll
+            p = pos + hdr
+            # a collection reaching beyond the file is an error libhdf5 reports itself
+            steps = 0
+            while end <= size and p < end and p + objhdr <= end:
+                idx = int.from_bytes(mm[p : p + 2], "little")
+                osize = int.from_bytes(mm[p + 8 : p + 8 + nlen], "little")
+                need = objhdr + (osize + 7) // 8 * 8 if idx > 0 else osize
+                steps += 1
+                if need == 0 or steps > _MAX_HEAP_OBJECTS:
+                    raise RecordingError(
+                        f"damaged HDF5 file: the global heap collection at byte {pos} has "
+                        f"{'a free-space record of size 0' if need == 0 else 'too many objects'}"
+                        f" at byte {p}; libhdf5 would never finish reading it",
+                        file=file,
+                    )
+                p += need
+        pos = mm.find(_GCOL, pos + 1)
+
+
+def _check_btrees(mm: Any, size: int, noff: int, nlen: int, base: int, file: str) -> None:
+    """Refuse version-1 B-tree nodes ("TREE") that libhdf5 would follow for ever: a chain of
+    right siblings that comes back on itself (iteration loops) or, in a group's tree, a
+    child that is not a node one level down (descent recurses until the stack overflows, a
+    segmentation fault). Both found by probing the fuzz seeds; valid trees have neither."""
+    undef = (1 << (8 * noff)) - 1
+    hdr = 8 + 2 * noff  # signature, type, level, entries used, left and right siblings
+    nodes: dict[int, tuple[int, int, int, int]] = {}  # at -> (type, level, entries, right)
+    pos = mm.find(b"TREE")
+    while pos != -1:
+        if pos + hdr <= size:
+            right = int.from_bytes(mm[pos + 8 + noff : pos + hdr], "little")
+            entries = int.from_bytes(mm[pos + 6 : pos + 8], "little")
+            nodes[pos] = (mm[pos + 4], mm[pos + 5], entries, right)
+        pos = mm.find(b"TREE", pos + 1)
+
+    def refuse(at: int, why: str) -> None:
+        raise RecordingError(
+            f"damaged HDF5 file: the B-tree node at byte {at} {why}; libhdf5 would never "
+            "finish reading it",
+            file=file,
+        )
+
+    ends: set[int] = set()  # nodes whose right-sibling chain is known to end
+    for start in nodes:
+        seen: list[int] = []
+        at = start
+        while at in nodes and at not in ends:
+            if at in seen:
+                refuse(at, "is its own right sibling through a cycle of siblings")
+            seen.append(at)
+            right = nodes[at][3]
+            at = -1 if right == undef else base + right
+        ends.update(seen)
+    for at, (kind, level, entries, _right) in nodes.items():
+        if kind != 0 or level == 0:
+            continue  # chunk trees' keys depend on the dataset's rank: siblings only
+        for i in range(min(entries, 1 << 16)):
+            c = at + hdr + nlen + i * (nlen + noff)  # keys (heap offsets) and children interleave
+            if c + noff > size:
+                break
+            child = base + int.from_bytes(mm[c : c + noff], "little")
+            if child in nodes and nodes[child][1] != level - 1:
+                refuse(at, f"(level {level}) has a child of level {nodes[child][1]}")
+
+
+def _check_local_heaps(mm: Any, size: int, noff: int, nlen: int, base: int, file: str) -> None:
+    """Refuse a local heap ("HEAP", the names of a group's links) whose free list comes back
+    on itself: libhdf5 follows it for ever (found by probing the fuzz seeds)."""
+    free_null = 1  # H5HL_FREE_NULL: the end of the free list
+    pos = mm.find(b"HEAP")
+    while pos != -1:
+        end = pos + 8 + 2 * nlen + noff
+        if end <= size and mm[pos + 4] == 0:
+            dsize = int.from_bytes(mm[pos + 8 : pos + 8 + nlen], "little")
+            off = int.from_bytes(mm[pos + 8 + nlen : pos + 8 + 2 * nlen], "little")
+            data = base + int.from_bytes(mm[pos + 8 + 2 * nlen : end], "little")
+            seen: set[int] = set()
+            # a block beyond the data segment or the file is an error libhdf5 reports
+            while off != free_null and off + 2 * nlen <= dsize and data + off + 2 * nlen <= size:
+                if off in seen:
+                    raise RecordingError(
+                        f"damaged HDF5 file: the free list of the local heap at byte {pos} "
+                        f"comes back to offset {off}; libhdf5 would never finish reading it",
+                        file=file,
+                    )
+                seen.add(off)
+                off = int.from_bytes(mm[data + off : data + off + nlen], "little")
+        pos = mm.find(b"HEAP", pos + 1)
+
+
+def check_structure(path: str | Path, *, file: str) -> None:
+    """Refuse the damaged structures on which libhdf5 itself hangs or overflows its stack
+    instead of failing (it cannot be interrupted from Python): global heap collections whose
+    walk does not advance, version-1 B-trees with sibling cycles or children on the wrong
+    level, local heaps whose free list cycles. Cheap: a scan for the structures' signatures,
+    memory-mapped. Valid files always pass; a file this does not understand is left to
+    libhdf5, which reports it. Not checked: the structures libhdf5 writes only with newer
+    file-format settings (version-2 B-trees, fractal heaps); object header continuation
+    loops and the other damage tried by fuzz/read_hdf5.py libhdf5 reports itself."""
+    import mmap
+
+    with open(path, "rb") as fh:
+        size = os.fstat(fh.fileno()).st_size
+        if size < 48:
+            return
+        with mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as mm:
+            sb = _superblock(mm, size)
+            if sb is None:
+                return
+            noff, nlen, base = sb
+            _check_global_heaps(mm, size, nlen, file)
+            _check_btrees(mm, size, noff, nlen, base, file)
+            _check_local_heaps(mm, size, noff, nlen, base, file)
+
+
+def open_hdf5(path: str | Path, *, file: str) -> Any:
+    """``h5py.File(path, "r")`` for an untrusted file: structures that make libhdf5 hang are
+    refused first (:func:`check_structure`), and what libhdf5 cannot open is a
+    :class:`RecordingError`."""
+    h5py = import_h5py()
+    check_structure(path, file=file)
+    try:
+        return h5py.File(path, "r")
+    except OSError as exc:
+        raise RecordingError(f"not a readable HDF5 file ({exc})", file=file) from None
 
 
 def text_value(v: Any) -> str:
@@ -119,14 +291,9 @@ def read_hdf5(
 
     Rows in errors are 0-based sample indices.
     """
-    h5py = import_h5py()
     path = Path(path)
     file = str(path)
-    try:
-        f = h5py.File(path, "r")
-    except OSError as exc:
-        raise RecordingError(f"not a readable HDF5 file ({exc})", file=file) from None
-    with f:
+    with open_hdf5(path, file=file) as f:
         kind, mapping, dsets, units, dt = hdf5_layout(f, columns=columns, kind=kind, file=file)
         raw = {c: vector(dsets[n], file=file, column=n) for c, n in mapping.items()}
         check_equal_lengths(raw, mapping, file=file)

@@ -15,7 +15,8 @@ import numpy as np
 import scipy.io
 
 from .._io_atomic import atomic_path
-from .hdf5 import import_h5py, text_value, vector
+from .hdf5 import import_h5py, open_hdf5, text_value, vector
+from .mat5check import check_mat5
 from .recording import (
     Recording,
     RecordingError,
@@ -40,6 +41,11 @@ def _mat_text(v: Any) -> str | None:
 
 
 def _read_v5(path: Path, file: str, columns: Any, kind: Any) -> tuple[Any, ...]:
+    with open(path, "rb") as fh:
+        v4 = 0 in fh.read(4)  # scipy's test: a v4 file has a zero among its first 4 bytes
+    if not v4:
+        # scipy's compiled v5 parser crashes the process on some damaged files: check first
+        check_mat5(path, file=file)
     try:
         info = scipy.io.whosmat(path)
     except Exception as exc:
@@ -110,8 +116,7 @@ def v73_layout(
 
 
 def _read_v73(path: Path, file: str, columns: Any, kind: Any) -> tuple[Any, ...]:
-    h5py = import_h5py()
-    with h5py.File(path, "r") as f:
+    with open_hdf5(path, file=file) as f:
         kind, mapping, units, dt = v73_layout(f, columns=columns, kind=kind, file=file)
         raw = {c: vector(f[n], file=file, column=n) for c, n in mapping.items()}
     return kind, mapping, raw, units, dt

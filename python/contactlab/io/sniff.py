@@ -53,6 +53,11 @@ def _is_mat4(path: Path) -> bool:
     """MATLAB v4 files have no text header; ask scipy whether it can list the variables."""
     import scipy.io
 
+    with open(path, "rb") as fh:
+        if 0 not in fh.read(4):
+            # scipy would take it for a v5 file (its compiled parser, not safe on arbitrary
+            # bytes; a real v5 file starts with its text header and never gets here)
+            return False
     try:
         return bool(scipy.io.whosmat(path))
     except Exception:  # any parse failure means: not a v4 file

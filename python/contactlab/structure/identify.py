@@ -32,8 +32,10 @@ import numpy as np
 
 from .._arrays import as_1d
 from .._io_atomic import write_text
+from .._physical import MAX_MAGNITUDE, check_channel
 from ..errors import ContactLabError, InputError
 from ..fitting import FitResult, Parameter, least_squares_fit
+from ._blas import with_single_blas_thread
 from .joints import iwan_uniform
 from .model import SimulationResult, Structure
 
@@ -135,7 +137,7 @@ class IdentifiedModel:
     def load(cls, path: str | Path) -> IdentifiedModel:
         try:
             d = json.loads(Path(path).read_text())
-        except (OSError, json.JSONDecodeError) as exc:
+        except (OSError, ValueError) as exc:  # ValueError: not UTF-8 or not JSON
             raise InputError(f"cannot read model JSON {path}: {exc}") from None
         return cls.from_dict(d)
 
@@ -381,6 +383,7 @@ def _starts(joint: str) -> list[dict[str, float]]:
     return [{}]
 
 
+@with_single_blas_thread
 def identify(
     t: Any,
     u: Any,
@@ -442,6 +445,15 @@ def identify(
         raise InputError(f"t, u and y differ in length ({t.size}, {u.size}, {y.size})")
     if t.size < 20:
         raise InputError(f"{t.size} samples are too few to identify a structure")
+    # magnitudes a fit can square (found by fuzzing: 1e300 channels overflowed in np.std
+    # and the derivative filters); the input may be zero or constant (free decay, a step)
+    check_channel("y", y, "m", "displacement")
+    big = float(np.max(np.abs(u)))
+    if big > MAX_MAGNITUDE:
+        raise InputError(
+            f"u reaches {big:.3g} {'N' if excitation == 'force' else 'm'}: beyond any "
+            "physical input; a unit mix-up or a corrupt file?"
+        )
     if np.any(np.diff(t) <= 0):
         raise InputError("t must be strictly increasing")
     if excitation == "base" and mass is None:

@@ -406,7 +406,7 @@ class Structure:
     def load(cls, path: str | Path) -> Structure:
         try:
             d = json.loads(Path(path).read_text())
-        except (OSError, json.JSONDecodeError) as exc:
+        except (OSError, ValueError) as exc:  # ValueError: not UTF-8 or not JSON
             raise InputError(f"cannot read structure JSON {path}: {exc}") from None
         return cls.from_dict(d.get("structure", d))
 

@@ -33,12 +33,19 @@ def build_structure_report(
     x[: sim.x.size] = sim.x
     res = x - y
     n_train = t.size if n_train is None else n_train
+
+    def rms(r: np.ndarray) -> float | None:
+        # over the samples the simulation reached: one that stopped early leaves NaN after
+        # (None when it reached none of them: numpy warned "mean of empty slice", fuzz/identify)
+        r = r[np.isfinite(r)]
+        return float(np.sqrt(np.mean(r * r))) if r.size else None
+
     summary: dict[str, Any] = {
-        "rms_train": float(np.sqrt(np.nanmean(res[:n_train] ** 2))),
+        "rms_train": rms(res[:n_train]),
         "simulation_success": bool(sim.success),
     }
     if n_train < t.size:
-        summary["rms_holdout"] = float(np.sqrt(np.nanmean(res[n_train:] ** 2)))
+        summary["rms_holdout"] = rms(res[n_train:])
     rep = Report(title, intro=intro)
     rep.section("Summary")
     rows = [{"quantity": k, "value": v} for k, v in summary.items()]

@@ -6,8 +6,10 @@ and cuts it into windows of N cycles or T seconds (cut at upward crossings of th
 every window holds whole cycles), analyses each window as the whole-recording analyses do and
 keeps only the results:
 
-- tangential windows: :func:`contactlab.tangential.analyze_tangential` — h0, ac (None where
-  the analysis finds them not separately identifiable; ``h0_ac`` always), energy per cycle
+- tangential windows: :func:`contactlab.tangential.analysis.analyze_window` (the numbers of
+  :func:`~contactlab.tangential.analyze_tangential`, the samples folded once in Rust) — h0,
+  ac (None where the analysis finds them not separately identifiable; ``h0_ac`` always),
+  energy per cycle
   analytic and numeric, c_e·ω (eq. 17), k_local0 (eq. 18), k_global (eq. 19), amplitude and
   force offset, each with its standard error;
 - normal windows: :func:`contactlab.normal.analyze_loop` — E_d (with its standard error from
@@ -66,7 +68,9 @@ NORMAL_QUANTITIES = ("E_d", "psi", "psi_kv", "k_tan", "k_sec", "delta_max", "del
 MIN_CYCLES = 3
 #: default upper bound on a window's samples (one window is held in memory)
 MAX_WINDOW = 2_000_000
-#: samples per window for ``every="auto"`` (the analysis' samples/s is best near this size)
+#: samples per window for ``every="auto"``: the fit of a window costs about as much as folding
+#: 10^5 samples, so longer windows amortise it, but each window in flight holds ~100 bytes a
+#: sample (2^20 with two threads peaked at 420 MB on 1e7 samples, 2^19 at 216 MB with one)
 AUTO_WINDOW = 1 << 19
 
 _EVERY = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?\d+)?)\s*([A-Za-zµμ]*)\s*$")
@@ -143,6 +147,8 @@ class TrackResult:
     units: dict[str, str]
     cycles: dict[str, np.ndarray]
     meta: dict[str, Any] = field(default_factory=dict)
+    #: each window's whole analysis document (``track(..., keep_documents=True)``)
+    window_docs: list[dict[str, Any]] = field(default_factory=list, repr=False)
 
     @property
     def quantities(self) -> list[str]:
@@ -276,10 +282,33 @@ def _as_float(v: Any) -> float:
     return float(v) if _finite(v) else float("nan")
 
 
-def _tangential_window(rec: Recording, options: Mapping[str, Any]) -> tuple[dict, dict]:
-    from ..tangential import analyze_tangential
+#: options of ``analyze_tangential`` the one-pass window analysis
+#: (:func:`contactlab.tangential.analysis.analyze_window`) takes; others (``on="signal"``,
+#: ``history``) take the whole-window analysis
+_WINDOW_OPTIONS = frozenset(
+    ("force_sign", "n_points", "rel_threshold", "min_cycles", "max_rel_stderr", "fit_offset",
+     "fit_x0", "fit_amplitude", "detrend", "initial")
+)  # fmt: skip
 
-    res = analyze_tangential(rec, **{"warn": False, **dict(options)})
+
+def _tangential_window(
+    rec: Recording, options: Mapping[str, Any], keep_doc: bool = False
+) -> tuple[dict, dict]:
+    from ..tangential import analyze_tangential
+    from ..tangential.analysis import analyze_window
+
+    opts = {k: v for k, v in options.items() if k != "warn"}
+    if opts.get("on", "averaged") == "averaged" and opts.get("history", "steady") == "steady":
+        opts.pop("on", None)
+        opts.pop("history", None)
+    if "invert_force" in opts:
+        inv = opts.pop("invert_force")
+        if inv is not None:
+            opts["force_sign"] = -1 if inv else 1
+    if set(opts) <= _WINDOW_OPTIONS:
+        res = analyze_window(rec, **opts)
+    else:
+        res = analyze_tangential(rec, **{"warn": False, **dict(options)})
     d = res.to_dict()
     row: dict[str, Any] = {}
     for q in TANGENTIAL_QUANTITIES:
@@ -289,6 +318,8 @@ def _tangential_window(rec: Recording, options: Mapping[str, Any]) -> tuple[dict
     row["n_cycles"] = d.get("n_cycles")
     row["warnings"] = " | ".join(res.warnings)
     units = {k: v for k, v in d.get("units", {}).items() if k in row}
+    if keep_doc:
+        row["_doc"] = d
     return row, units
 
 
@@ -372,7 +403,7 @@ def _blocks(chunks: Iterator[Recording], min_block: int) -> Iterator[Recording]:
     size = 0
     for c in chunks:
         for name, v in c.data.items():  # found by fuzzing: 1e300 data overflowed windows
-            if v.size and float(np.max(np.abs(v))) > MAX_MAGNITUDE:
+            if v.size and max(float(v.max()), -float(v.min())) > MAX_MAGNITUDE:
                 i = int(np.argmax(np.abs(v)))
                 raise InputError(
                     f"{c.source}: {name} reaches {float(v[i]):.3g} {c.units.get(name, '')} "
@@ -410,6 +441,8 @@ def track(
     keep_going: bool = True,
     callback: Callable[[dict[str, Any]], None] | None = None,
     executor: Any = None,
+    keep_documents: bool = False,
+    threads: int | None = None,
 ) -> TrackResult:
     """Fitted quantities of a long recording window by window, in bounded memory.
 
@@ -441,6 +474,14 @@ def track(
         Analyse windows in parallel on a ``concurrent.futures`` executor or a Dask
         ``distributed.Client`` while the file is read on; at most two windows per worker are
         held. The rows equal those of a serial run.
+    threads : int, optional
+        Without ``executor``: analyse windows on this many helper threads while the next
+        chunks are read and their cycles found (the Rust kernels release the GIL); default 1
+        (each thread holds up to two windows: 2 threads peak near 300 MB with ``"auto"``
+        windows), 0 analyses each window before reading on. The rows are the same.
+    keep_documents : bool
+        Keep each tangential window's whole analysis document (``TrackResult.window_docs``;
+        what :func:`contactlab.studies.pooled.pooled_document` pools).
 
     Returns
     -------
@@ -457,6 +498,18 @@ def track(
     >>> bool(abs(res.combined()["h0"] - 40.0) < 4 * res.combined()["h0_stderr"])
     True
     """
+    if executor is None and threads != 0:
+        from concurrent.futures import ThreadPoolExecutor
+
+        n_threads = 1 if threads is None else int(threads)
+        if n_threads < 0:
+            raise InputError(f"threads must be >= 0, got {threads!r}")
+        with ThreadPoolExecutor(n_threads, thread_name_prefix="contactlab-track") as pool:
+            return track(
+                source, every, kind=kind, columns=columns, fs=fs, chunk_size=chunk_size,
+                max_window=max_window, options=options, keep_going=keep_going,
+                callback=callback, executor=pool, keep_documents=keep_documents,
+            )  # fmt: skip
     mode, size = parse_every(every)
     every_text = every if isinstance(every, str) else f"{every}cycles"
     if not (isinstance(max_window, int) and max_window >= 16):
@@ -466,7 +519,12 @@ def track(
     if kind_ not in ("tangential", "normal"):
         raise InputError(f"{cr.source}: cannot tell the kind of recording; pass kind=")
     loop_x, loop_F, drive = ("x", "F", "x") if kind_ == "tangential" else ("delta", "p", "p")
-    analyse = _tangential_window if kind_ == "tangential" else _normal_window
+    analyse: Callable[..., tuple[dict, dict]] = (
+        functools.partial(_tangential_window, keep_doc=keep_documents)
+        if kind_ == "tangential"
+        else _normal_window
+    )
+    docs: list[dict[str, Any]] = []
     opts = dict(options or {})
 
     state = CycleState()
@@ -497,6 +555,9 @@ def track(
             if not keep_going:
                 raise
             values, u = {"error": f"window {row['window']}: {exc}"}, {}
+        doc = values.pop("_doc", None)
+        if doc is not None:
+            docs.append(doc)
         row.update(values)
         units.update(u)
         if callback is not None:
@@ -592,7 +653,7 @@ def track(
         "every_mode": mode,
         "every_value": size,
     }
-    return TrackResult(cr.source, kind_, every_text, rows, units, cycles, meta)
+    return TrackResult(cr.source, kind_, every_text, rows, units, cycles, meta, docs)
 
 
 def track_many(

@@ -48,6 +48,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import _core
 from .._arrays import as_1d
 from .._physical import check_channel
 from ..errors import ContactLabWarning, InputError
@@ -55,8 +56,10 @@ from ..fitting import FitResult
 from ..io import Recording
 from ..masing import loop_area
 from . import steps
-from .orientation import orient
-from .regime import Regime, classify
+from .orientation import Orientation, orient
+from .preprocess import AveragedLoop, average_loop
+from .regime import GROSS_SLIDING_Z as REGIME_GROSS_Z
+from .regime import PRE_SLIDING_Z, Regime, classify, z_from_area_ratio
 from .result import TangentialAnalysis
 from .uncertainty import correl, numeric_energy, reparametrize
 
@@ -398,10 +401,170 @@ def analyze_tangential(
     _check_options(on, history, n_points)
     check_channel("x", xa, "m", "displacement")
     check_channel("F", Fa, "N", "force")
-    steady = history == "steady"
     if invert_force is not None:
         force_sign = -1 if invert_force else 1
     ori = orient(xa, Fa, ta, force_sign=force_sign)
+    res = _analyze(
+        xa,
+        Fa,
+        ta,
+        source,
+        ori,
+        None,
+        on=on,
+        history=history,
+        fit_offset=fit_offset,
+        fit_x0=fit_x0,
+        n_points=n_points,
+        rel_threshold=rel_threshold,
+        min_cycles=min_cycles,
+        max_rel_stderr=max_rel_stderr,
+        fit_amplitude=fit_amplitude,
+        detrend=detrend,
+        initial=initial,
+        streamed=False,
+    )
+    assert res is not None  # only a streamed window hands its case back
+    if warn:
+        for wtxt in res.warnings:
+            warnings.warn(wtxt, ContactLabWarning, stacklevel=2)
+    return res
+
+
+def _fast_orientation(
+    x: np.ndarray, F: np.ndarray, loop: AveragedLoop, force_sign: Any
+) -> Orientation | None:
+    """The force sign from the averaged loop's per-cycle areas (the signed loop area of the
+    complete cycles, its noise error from the bins' cycle-to-cycle spread); None when the
+    area does not decide it (then the full :func:`orient` does)."""
+    from .orientation import SIGNIFICANCE, parse_force_sign
+
+    e = loop.scatter.energy
+    ok = np.isfinite(e)
+    area = float(np.sum(e[ok])) if ok.any() else 0.0
+    n = loop.n_cycles
+    err = math.nan
+    if loop.cycle_bounds is not None and n > 1:
+        per_cycle = loop.count / n
+        vF, vx = loop.F_std**2 * per_cycle, loop.x_std**2 * per_cycle
+        if np.any(np.isfinite(vF)) and np.any(np.isfinite(vx)):
+            g_F, g_x = _core.loop_area_sensitivity(
+                x, F, [int(b) for b in loop.cycle_bounds[: n + 1]]
+            )
+            err = math.sqrt(
+                float(np.sum(g_F)) * float(np.nanmean(vF))
+                + float(np.sum(g_x)) * float(np.nanmean(vx))
+            )
+    fixed = parse_force_sign(force_sign)
+    if fixed is not None:
+        return Orientation(fixed, f"force sign {fixed:+d} given by the user", area, err, "user")
+    if not (math.isfinite(err) and area != 0 and abs(area) > SIGNIFICANCE * err):
+        return None
+    sign = 1 if area > 0 else -1
+    what = "as recorded" if sign > 0 else "after inverting F (the load cell counts the other way)"
+    reason = (
+        f"a passive joint dissipates (∮F dx > 0): the signed loop area is {area:.4g} J "
+        f"± {err:.2g} J, so the force is analysed {what}"
+    )
+    return Orientation(sign, reason, area, err, "loop area")
+
+
+def _fast_regime(z_fit: float | None, ratio: float) -> Regime | None:
+    """The regime of a window whose ``z = ac·A`` is below gross sliding (pre-sliding or
+    transition): what :func:`classify` decides there, without the velocity and stick search
+    of the samples (which only gross sliding uses). None from gross sliding on."""
+    if z_fit is not None and math.isfinite(z_fit):
+        z, src = float(z_fit), "fit"
+    else:
+        z, src = z_from_area_ratio(ratio), "loop area"
+    if not z < REGIME_GROSS_Z:
+        return None
+    zt = f"ac·A = {z:.3g} (from the {src}; loop area {100 * ratio:.0f}% of the rectangle 4·A·h_m)"
+    if z < PRE_SLIDING_Z:
+        return Regime("pre-sliding", f"pre-sliding (microslip): {zt}", z, src, ratio)
+    return Regime("transition", f"transition towards gross sliding: {zt}", z, src, ratio)
+
+
+def analyze_window(
+    recording: Recording,
+    *,
+    force_sign: int | str = "auto",
+    n_points: int | None = None,
+    rel_threshold: float = 0.5,
+    min_cycles: int = 2,
+    max_rel_stderr: float = 0.2,
+    fit_offset: bool = True,
+    fit_x0: bool | None = None,
+    fit_amplitude: bool = True,
+    detrend: bool = True,
+    initial: dict[str, float] | None = None,
+) -> TangentialAnalysis:
+    """:func:`analyze_tangential` of one window of a streamed recording (``on="averaged"``,
+    steady history), with the per-sample work in one pass of Rust kernels.
+
+    The averaged loop is computed once (reversals, phase fold, per-cycle areas; a second fold
+    after drift removal), and reused: the force sign follows from its per-cycle areas, the
+    drift covariance from its bins' mean time, the numeric energy's error from the cycles'
+    area sensitivities. The velocity and stick search over the samples (which only decide
+    between gross sliding and stick-slip) runs only when the loop reaches gross sliding, and
+    then the window is analysed exactly as :func:`analyze_tangential` does. The results are
+    those of :func:`analyze_tangential` (warnings are kept in ``.warnings``, not issued).
+    """
+    xa, Fa, ta, source = _inputs(recording, None, None, None)
+    _check_options("averaged", "steady", n_points)
+    check_channel("x", xa, "m", "displacement")
+    check_channel("F", Fa, "N", "force")
+    opts: dict[str, Any] = {
+        "n_points": n_points,
+        "rel_threshold": rel_threshold,
+        "min_cycles": min_cycles,
+        "max_rel_stderr": max_rel_stderr,
+        "fit_offset": fit_offset,
+        "fit_x0": fit_x0,
+        "fit_amplitude": fit_amplitude,
+        "detrend": detrend,
+        "initial": initial,
+    }
+    loop = average_loop(
+        xa, Fa, ta, n_points=n_points, rel_threshold=rel_threshold, min_cycles=min_cycles
+    )
+    ori = _fast_orientation(xa, Fa, loop, force_sign)
+    res = None
+    if ori is not None:
+        if ori.sign < 0:
+            loop = None  # averaged again on -F
+        res = _analyze(xa, Fa, ta, source, ori, loop, on="averaged", history="steady",
+                       streamed=True, **opts)  # fmt: skip
+    if res is None:  # the sign undecided by the area, or gross sliding: the full analysis
+        return analyze_tangential(recording, force_sign=force_sign, warn=False, **opts)
+    return res
+
+
+def _analyze(
+    xa: np.ndarray,
+    Fa: np.ndarray,
+    ta: np.ndarray | None,
+    source: str,
+    ori: Orientation,
+    first: AveragedLoop | None,
+    *,
+    on: str,
+    history: str,
+    fit_offset: bool,
+    fit_x0: bool | None,
+    n_points: int | None,
+    rel_threshold: float,
+    min_cycles: int,
+    max_rel_stderr: float,
+    fit_amplitude: bool,
+    detrend: bool,
+    initial: dict[str, float] | None,
+    streamed: bool,
+) -> TangentialAnalysis | None:
+    """The analysis after the orientation; ``first``: the loop of ``xa, Fa`` averaged with
+    these options already. ``streamed``: a window of :func:`analyze_window`, which hands back
+    None when its loop reaches gross sliding."""
+    steady = history == "steady"
     pre_warns = [f"analysed -F: {ori.reason}"] if (ori.sign < 0 and ori.by != "user") else []
     if ori.sign < 0:
         Fa = -Fa
@@ -415,6 +578,7 @@ def analyze_tangential(
         n_points=n_points,
         rel_threshold=rel_threshold,
         min_cycles=min_cycles,
+        first=first,
     )
     data = steps.fit_data(det, ta, on=on, steady=steady, rel_threshold=rel_threshold)
     sv = steps.start_values(
@@ -445,21 +609,25 @@ def analyze_tangential(
         derived["h0_lower_bound"] = (h0_lo, math.nan)
         derived["ac_upper_bound"] = (ac_up, math.nan)
     ratio = loop_area_ratio(data, amp.value, derived["energy_per_cycle_numeric"][0])
-    regime = classify(
-        z_fit=evidence["ac_times_amplitude"] if identifiable else None,
-        ratio=ratio,
-        loop=det.loop,
-        x=det.x,
-        F=det.F,
-        t=ta,
-        rev=data.rev,
-        x_raw=xa,
-    )
+    z_fit = evidence["ac_times_amplitude"] if identifiable else None
+    if streamed:
+        fast = _fast_regime(z_fit, ratio)
+        if fast is None:
+            return None
+        regime = fast
+    else:
+        regime = classify(
+            z_fit=z_fit,
+            ratio=ratio,
+            loop=det.loop,
+            x=det.x,
+            F=det.F,
+            t=ta,
+            rev=data.rev,
+            x_raw=xa,
+        )
     apply_regime(regime, amp, fit, identifiable, evidence, derived, max_rel_stderr)
     warns = collect_warnings(pre_warns, raw, data, amp.value, identifiable, evidence, regime)
-    if warn:
-        for wtxt in warns:
-            warnings.warn(wtxt, ContactLabWarning, stacklevel=2)
     vals = raw.values
     return TangentialAnalysis(
         fit=fit,

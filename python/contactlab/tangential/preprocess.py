@@ -195,6 +195,7 @@ class AveragedLoop:
     phase_sq: np.ndarray | None = None  # mean squared phase of each bin's samples
     cycle_bounds: np.ndarray | None = None  # first sample of each cycle, and the end
     x_var: np.ndarray | None = None  # variance of the samples' x inside each bin (all cycles)
+    t_mean: np.ndarray | None = None  # mean time stamp of each bin's samples (all cycles)
 
     @property
     def n_cycles(self) -> int:
@@ -237,19 +238,21 @@ def phase_of(t: np.ndarray, rev: Reversals) -> tuple[np.ndarray, int, int]:
 def _period_means(t: np.ndarray, v: np.ndarray, edges: np.ndarray) -> np.ndarray:
     """Time average of ``v`` between consecutive ``edges`` (trapezoid rule, interpolated at
     the edges). For a periodic signal this does not depend on where the period starts, so
-    the jitter of the turn instants does not leak into it (as sample-counting would)."""
-    c = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))])
-    ce = np.interp(edges, t, c)
-    return np.diff(ce) / np.diff(edges)
+    the jitter of the turn instants does not leak into it (as sample-counting would).
+    One pass in Rust with numpy's arithmetic (``cumsum`` of the trapezoids, ``interp`` at the
+    edges)."""
+    return _core.period_means(t, v, np.ascontiguousarray(edges, dtype=float))
 
 
 def _dphase(v: np.ndarray, n: int) -> np.ndarray:
-    """Derivative of bin values along phase (periodic central difference)."""
+    """Derivative of bin values along phase (periodic central difference); the numpy
+    reference of the gradient ``PhaseFold.spread`` applies (tests)."""
     return (np.roll(v, -1) - np.roll(v, 1)) * (n / 2.0)
 
 
 def _spread(a: np.ndarray) -> np.ndarray:
-    """Standard deviation over axis 0 ignoring NaN; NaN where fewer than 2 values."""
+    """Standard deviation over axis 0 ignoring NaN; NaN where fewer than 2 values (the numpy
+    reference of ``PhaseFold.spread``, tests)."""
     ok = np.isfinite(a)
     k = ok.sum(axis=0)
     z = np.where(ok, a, 0.0)
@@ -320,7 +323,7 @@ def average_loop(
     # per-sample temporaries; the bins are numpy.interp's).
     fold = _core.PhaseFold(int(n_points), n_cyc)
     fold.push(ta, xa, Fa, 0, kt, kp)
-    sums = fold.sums()
+    sums = fold.sums(cells=False)
     count = sums["count"]
     if np.any(count == 0):
         raise InputError(
@@ -329,26 +332,20 @@ def average_loop(
         )
     xm = sums["sum_x"] / count
     Fm = sums["sum_F"] / count
-    # per-cycle bin means (cycles x bins); a bin a cycle missed is NaN
-    cc = sums["cycle_count"]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        cx = sums["cycle_x"] / cc
-        cF = sums["cycle_F"] / cc
-        cphi = sums["cycle_phase"] / cc
-    # Where the samples of a cycle sit inside a bin differs from cycle to cycle; on a steep
-    # branch that alone spreads the per-cycle means. Remove it to first order (gradient along
-    # phase, periodic) so the spread measures noise and real cycle-to-cycle change.
     phim = sums["sum_phase"] / count
-    dphi = cphi - phim
-    x_std = _spread(cx - _dphase(xm, n_points) * dphi)
-    F_std = _spread(cF - _dphase(Fm, n_points) * dphi)
+    # Per-cycle bin means (cycles x bins) spread from cycle to cycle. Where the samples of a
+    # cycle sit inside a bin differs from cycle to cycle; on a steep branch that alone spreads
+    # the per-cycle means: it is removed to first order (gradient along phase, periodic), so
+    # the spread measures noise and real cycle-to-cycle change. In Rust over the fold's cells
+    # with the arithmetic of ``_spread`` and ``_dphase`` (numpy reference in the tests).
+    spread = fold.spread()
+    x_std, F_std = spread["x_std"], spread["F_std"]
     # sample index where each cycle starts (a cycle without samples starts where the next
     # does), and where the last one ends
     first = np.r_[sums["first"], end]
     first = np.minimum.accumulate(np.where(first < 0, end, first)[::-1])[::-1]
     bounds = first.astype(np.int64)
-    amps = 0.5 * (np.nanmax(cx, axis=1) - np.nanmin(cx, axis=1))
-    franges = 0.5 * (np.nanmax(cF, axis=1) - np.nanmin(cF, axis=1))
+    amps, franges = spread["amplitude"], spread["force_range"]
     # the area of the cycle's own samples: bin means would cut the corners at the turns
     energies = _core.loop_areas(xa, Fa, bounds.tolist())
     scatter = CycleScatter(
@@ -378,6 +375,7 @@ def average_loop(
         phase_sq,
         bounds,
         x_var,
+        sums["sum_t"] / count,
     )
 
 

@@ -86,18 +86,21 @@ def detrend(
     n_points: int | None,
     rel_threshold: float,
     min_cycles: int,
+    first: AveragedLoop | None = None,
 ) -> Detrended:
     """Average the loop; with ``enabled`` and ≥ 3 cycles remove the linear force and
     displacement drifts seen in the per-cycle means and average again.
 
     A whole-signal fit (``on="signal"``) goes on without an averaged loop when there are too
-    few cycles; an averaged fit then raises :class:`InputError`.
+    few cycles; an averaged fit then raises :class:`InputError`. ``first``: the loop of
+    ``x, F`` averaged with the same options already (not averaged again).
     """
-    loop: AveragedLoop | None = None
+    loop: AveragedLoop | None = first
     try:
-        loop = average_loop(
-            x, F, t, n_points=n_points, rel_threshold=rel_threshold, min_cycles=min_cycles
-        )
+        if loop is None:
+            loop = average_loop(
+                x, F, t, n_points=n_points, rel_threshold=rel_threshold, min_cycles=min_cycles
+            )
     except InputError:
         if on == "averaged":
             raise
@@ -468,15 +471,19 @@ def drift_covariance(
     if drift is None or d.loop is None or raw.jac is None or raw.covar is None:
         return raw
     tt, tm = drift.tt, drift.t_mid
-    # each bin's mean of (t - tm): what a unit slope removed from that bin
-    T_bin = average_loop(
-        d.x,
-        tt - tm,
-        d.t,
-        n_points=d.loop.x.size,
-        rel_threshold=rel_threshold,
-        min_cycles=min_cycles,
-    ).F
+    # each bin's mean of (t - tm): what a unit slope removed from that bin (the loop was
+    # averaged on these x and t: its bins' mean time is that mean, no second fold needed)
+    if d.loop.t_mean is not None and d.loop.t_mean.size == d.loop.x.size:
+        T_bin = d.loop.t_mean - tm
+    else:
+        T_bin = average_loop(
+            d.x,
+            tt - tm,
+            d.t,
+            n_points=d.loop.x.size,
+            rel_threshold=rel_threshold,
+            min_cycles=min_cycles,
+        ).F
     T = T_bin if d.on == "averaged" else tt - tm
     vals0 = raw.values
     base = res.residual(vals0)

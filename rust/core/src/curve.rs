@@ -139,8 +139,10 @@ impl Backbone for Exponential {
             // ac is tiny and h0 huge (h0 ac finite), which gave NaN or 0 instead of E.
             (self.h0 * self.ac) * z * u * u * exp_chord_area_unit_over_z3(z)
         } else {
+            // (h0/ac)(z - g - z g/2) with z = ac·u expanded: z itself overflows for ac·u beyond
+            // the range (inf - inf was NaN, found by AFL++) while the area h0 u (1 - g/2) does not.
             let g = one_minus_exp_neg(z);
-            self.h0 / self.ac * (z - g - 0.5 * z * g)
+            self.h0 * (u * (1.0 - 0.5 * g) - g / self.ac)
         }
     }
 }
@@ -227,7 +229,9 @@ impl Tabulated {
             return None;
         }
         // partition_point: first index with u > s; s >= 0 = u[0] so it is >= 1.
-        Some(self.u.partition_point(|&v| v <= s) - 1)
+        // NaN (or s < 0 from a direct caller) finds no knot: None, as beyond the table, rather
+        // than an index underflow (found by AFL++ on the public `Backbone` methods).
+        self.u.partition_point(|&v| v <= s).checked_sub(1)
     }
 
     fn eval_pos(&self, s: f64) -> f64 {
@@ -314,6 +318,19 @@ impl Backbone for Tabulated {
             }
         }
     }
+    fn chord_area(&self, u: f64) -> f64 {
+        let s = u.abs();
+        let n = self.u.len();
+        if self.interval(s).is_some() {
+            return self.integral(s) - 0.5 * s * self.eval_pos(s);
+        }
+        // Beyond the last knot f is linear, f = fe + d r (r = s - ue): the r² terms of ∫f and
+        // of s f / 2 cancel, leaving cum_e - ue fe / 2 + r (fe - ue d) / 2. Written so the
+        // area stays finite where r² overflows (inf - inf was NaN, found by AFL++).
+        let (ue, fe, de) = (self.u[n - 1], self.f[n - 1], self.d[n - 1]);
+        let r = s - ue;
+        self.cum[n - 1] - 0.5 * ue * fe + 0.5 * r * (fe - ue * de)
+    }
     fn integral(&self, u: f64) -> f64 {
         let s = u.abs();
         let n = self.u.len();
@@ -387,6 +404,38 @@ mod tests {
         let c = Exponential::new(3.0, 5.0).unwrap();
         let (lo, hi) = (c.chord_area(0.4 - 1e-13), c.chord_area(0.4 + 1e-13));
         assert!((lo / hi - 1.0).abs() < 1e-11);
+    }
+
+    #[test]
+    fn chord_area_when_ac_u_overflows_and_tabulated_nan_input() {
+        // found by AFL++ (fuzz/afl): ac·u = inf made (z - g - z g/2) inf - inf = NaN; the area
+        // of the chord above the curve tends to h0 u / 2 - h0/ac (here h0 u / 2 = 1e300)
+        let c = Exponential::new(2.0, 7.6e221).unwrap();
+        let a = c.chord_area(1e300);
+        assert!((a / 1e300 - 1.0).abs() < 1e-15, "{a}");
+        // the expanded form agrees with the definition ∫h - u h(u)/2 where z is finite
+        let c = Exponential::new(3.0, 5.0).unwrap();
+        for u in [0.5, 2.0, 40.0] {
+            let direct = c.integral(u) - 0.5 * u * c.eval(u);
+            assert!((c.chord_area(u) / direct - 1.0).abs() < 1e-13, "{u}");
+        }
+        // a NaN abscissa is NaN out, not an index underflow (a panic)
+        let t = Tabulated::new(&[0.0, 2.0], &[0.0, 1e-300]).unwrap();
+        assert!(t.eval(f64::NAN).is_nan());
+        assert!(t.chord_area(f64::NAN).is_nan()); // through slope and integral: no panic
+                                                  // beyond the last knot: r² overflowed in ∫f and in s f / 2 (inf - inf, AFL++); the
+                                                  // true area (1/2)(fe - ue d) r + ... is ~ -1e-300 · 1.8e308 / 2 here, finite
+        let a = t.chord_area(f64::MAX);
+        assert!(a.is_finite() && a.abs() < 1e9, "{a}");
+        // the rearranged form is the definition ∫f - s f(s)/2 where nothing overflows
+        let t = Tabulated::new(&[0.0, 1.0, 2.0], &[0.0, 1.0, 1.5]).unwrap();
+        for s in [0.5, 1.5, 2.0, 3.0, 40.0] {
+            let direct = t.integral(s) - 0.5 * s * t.eval(s);
+            assert!(
+                (t.chord_area(s) - direct).abs() < 1e-12 * direct.abs().max(1.0),
+                "{s}"
+            );
+        }
     }
 
     #[test]

@@ -11,6 +11,10 @@
 use crate::curve::Backbone;
 use crate::error::{check_positive, CoreError};
 
+#[path = "masing_kernel.rs"]
+mod kernel;
+use kernel::{eval_block, Run, BLOCK, KNOWN};
+
 /// A remembered reversal point.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Reversal {
@@ -134,7 +138,7 @@ pub enum Closure {
 /// Receives loop closures as the operator runs (rainflow-style cycle counting).
 pub trait Observer {
     /// True when closures are ignored: the force kernel may then defer the forces of new
-    /// reversals (closures would report them as NaN).
+    /// reversals (closures would report them as NaN; see `masing_kernel.rs`).
     const IGNORES: bool = false;
     fn closed(&mut self, closure: Closure);
 }
@@ -174,103 +178,61 @@ impl BranchRule {
     }
 }
 
-/// No pending sample: the value is known.
-const KNOWN: u32 = u32::MAX;
-
-/// The current branch: `h = base + mul · f((x - xa) · inv)` with `base` the anchor's force
-/// `ha`, or, while that force is still deferred, the output of in-block sample `src`.
+/// The current branch: `h = ha + mul · f((x - xa) · inv)`.
 #[derive(Clone, Copy)]
 struct Branch {
     xa: f64,
     ha: f64,
-    src: u32,
     mul: f64,
     inv: f64,
     /// Input value at which this branch closes (±inf: never).
     target: f64,
 }
 
-/// A stretch of a block on one branch: its samples have `h = base + mul · f(u)` (`base` as
-/// in [`Branch`]).
-#[derive(Clone, Copy)]
-struct Run {
-    ha: f64,
-    src: u32,
-    mul: f64,
-}
-
-/// Samples per block of the force kernel: the curve arguments of one block and its run table
-/// stay in L1 between the sequential pass and the vectorised curve pass.
-const BLOCK: usize = 512;
-
-/// One step of the operator: stepping separate from driving, so the force kernel, the cycle
-/// counter and the branch-memory export share the rules. The fast path (same direction, no
-/// closure) is inlined; the rare events are not.
-///
-/// In lazy mode (the force kernel with Masing's scaled rule) a new reversal's force is not
-/// evaluated when it is found: it is the output of the previous sample, which the block's
-/// curve pass computes anyway; the reversal refers to that sample (`srcs`) until the block
-/// ends. Otherwise (cycle counting, the anchored rule whose branch factor needs the forces at
-/// once) it is evaluated on the spot with the same expression, so both agree bit for bit.
+/// One step of the operator: stepping separate from driving, so the cycle counter, the
+/// anchored-rule force kernel and the branch-memory export share the rules (the scaled-rule
+/// force kernel, `kernel`, applies the same rules and tie-breaking). The fast path (same
+/// direction, no closure) is inlined; the rare events are not. Reversal forces are evaluated
+/// on the spot with the same expression as the samples', so both agree bit for bit.
 struct Stepper<'a, C: Backbone> {
     curve: &'a C,
     rule: BranchRule,
     inv_lambda: f64,
     /// Record runs of samples on one branch (the force kernel).
     track: bool,
-    /// Defer reversal forces to the block's curve pass (Masing's scaled rule, no observer).
-    defer: bool,
     xp: f64,
     /// +1, -1, or 0 before the first move.
     dir: f64,
     br: Branch,
     /// Curve argument of the last sample (on branch `br`).
     u: f64,
-    /// Force of the sample before the current block (known).
-    h_before: f64,
-    /// Position of the current sample in its block.
-    pos: u32,
     /// Index in `runs` of the current run.
     run: u16,
     stack: &'a mut Vec<Reversal>,
-    /// Per stack entry: in-block sample whose output is its force, or `KNOWN`.
-    srcs: Vec<u32>,
     runs: Vec<Run>,
 }
 
 impl<'a, C: Backbone> Stepper<'a, C> {
-    fn new(
-        curve: &'a C,
-        rule: BranchRule,
-        track: bool,
-        defer: bool,
-        state: &'a mut MasingState,
-    ) -> Self {
+    fn new(curve: &'a C, rule: BranchRule, track: bool, state: &'a mut MasingState) -> Self {
         let dir = f64::from(state.dir);
         let inv_lambda = 1.0 / rule.lambda();
-        let srcs = vec![KNOWN; state.stack.len()];
         let mut st = Self {
             curve,
             rule,
             inv_lambda,
             track,
-            defer: track && defer && matches!(rule, BranchRule::Scaled(_)),
             xp: state.x,
             dir,
             br: Branch {
                 xa: 0.0,
                 ha: 0.0,
-                src: KNOWN,
                 mul: 1.0,
                 inv: 1.0,
                 target: f64::INFINITY,
             },
             u: 0.0,
-            h_before: state.h,
-            pos: 0,
             run: 0,
             stack: &mut state.stack,
-            srcs,
             runs: Vec::with_capacity(if track { BLOCK + 1 } else { 0 }),
         };
         st.br = st.branch(dir);
@@ -281,7 +243,7 @@ impl<'a, C: Backbone> Stepper<'a, C> {
         st
     }
 
-    /// Force of the last sample, evaluated now (only valid when it is not deferred).
+    /// Force of the last sample.
     #[inline]
     fn last_value(&self) -> f64 {
         self.br.ha + self.br.mul * self.curve.eval(self.u)
@@ -304,7 +266,6 @@ impl<'a, C: Backbone> Stepper<'a, C> {
                 return Branch {
                     xa: 0.0,
                     ha: 0.0,
-                    src: KNOWN,
                     mul: 1.0,
                     inv: 1.0,
                     target: never,
@@ -333,7 +294,6 @@ impl<'a, C: Backbone> Stepper<'a, C> {
         Branch {
             xa: anchor.x,
             ha: anchor.h,
-            src: self.srcs[k],
             mul,
             inv: self.inv_lambda,
             target,
@@ -364,21 +324,12 @@ impl<'a, C: Backbone> Stepper<'a, C> {
         let s = if dx > 0.0 { 1.0 } else { -1.0 };
         if s != self.dir {
             if self.dir != 0.0 {
-                // The reversal is the previous sample; its force is deferred when it lies in
-                // this block and the kernel evaluates the block later.
-                let (h, src) = if !self.defer {
-                    (self.last_value(), KNOWN)
-                } else if self.pos == 0 {
-                    (self.h_before, KNOWN)
-                } else {
-                    (f64::NAN, self.pos - 1)
-                };
+                // The reversal is the previous sample.
                 self.stack.push(Reversal {
                     x: self.xp,
-                    h,
+                    h: self.last_value(),
                     index: index.saturating_sub(1),
                 });
-                self.srcs.push(src);
             }
             self.dir = s;
         }
@@ -396,13 +347,11 @@ impl<'a, C: Backbone> Stepper<'a, C> {
             if n == 1 {
                 let from = self.stack[0];
                 self.stack.clear();
-                self.srcs.clear();
                 observer.closed(Closure::Virgin { from, index });
             } else {
                 let newer = self.stack[n - 1];
                 let older = self.stack[n - 2];
                 self.stack.truncate(n - 2);
-                self.srcs.truncate(n - 2);
                 observer.closed(Closure::Inner {
                     older,
                     newer,
@@ -414,7 +363,7 @@ impl<'a, C: Backbone> Stepper<'a, C> {
         if self.track {
             self.runs.push(Run {
                 ha: self.br.ha,
-                src: self.br.src,
+                src: KNOWN,
                 mul: self.br.mul,
             });
             // At most one run per sample plus the block's first: BLOCK + 1 < 2^16.
@@ -424,57 +373,13 @@ impl<'a, C: Backbone> Stepper<'a, C> {
 
     /// Start a block: its first run is the current branch.
     fn begin_block(&mut self) {
-        self.pos = 0;
         self.run = 0;
         self.runs.clear();
         self.runs.push(Run {
             ha: self.br.ha,
-            src: self.br.src,
+            src: KNOWN,
             mul: self.br.mul,
         });
-    }
-
-    /// End a block whose outputs are `out`: resolve the deferred forces it refers to.
-    fn end_block(&mut self, out: &[f64]) {
-        for (r, src) in self.stack.iter_mut().zip(self.srcs.iter_mut()).rev() {
-            if *src == KNOWN {
-                break; // deferred entries are the newest ones
-            }
-            r.h = out[*src as usize];
-            *src = KNOWN;
-        }
-        if self.br.src != KNOWN {
-            self.br.ha = out[self.br.src as usize];
-            self.br.src = KNOWN;
-        }
-        if let Some(&h) = out.last() {
-            self.h_before = h;
-        }
-    }
-}
-
-/// Curve pass of one block, free of data-dependent branches however short the branches of
-/// the signal are: `out[i] = f(u[i])` over the whole block (auto-vectorised for the
-/// exponential curve); then each run's base is resolved in order (a deferred base is the
-/// output of an earlier sample, itself `base + mul · f(u)` of an earlier run); then
-/// `out[i] = base + mul · out[i]` with the run of sample `i` looked up in `rid`.
-#[inline(always)]
-fn eval_block<C: Backbone>(curve: &C, runs: &mut [Run], u: &[f64], rid: &[u16], out: &mut [f64]) {
-    for (o, &v) in out.iter_mut().zip(u) {
-        *o = curve.eval(v);
-    }
-    for k in 0..runs.len() {
-        let r = runs[k];
-        if r.src != KNOWN {
-            let s = r.src as usize;
-            let from = runs[rid[s] as usize];
-            runs[k].ha = from.ha + from.mul * out[s];
-            runs[k].src = KNOWN;
-        }
-    }
-    for (o, &k) in out.iter_mut().zip(rid) {
-        let r = &runs[k as usize];
-        *o = r.ha + r.mul * *o;
     }
 }
 
@@ -524,48 +429,52 @@ pub fn run_rule<C: Backbone, O: Observer>(
         crate::error::check_same_len("x", x.len(), "out", o.len())?;
     }
     crate::error::check_finite("x", x)?;
-    let saved = state.clone(); // restored when the forces overflow
-    let mut range = Ok(());
     let end = checked_end(state, x.len())?;
-    let mut index = state.count;
-    let track = out.is_some();
-    let mut st = Stepper::new(curve, rule, track, O::IGNORES, state);
-    match out {
-        Some(out) => {
-            let mut ub = [0.0_f64; BLOCK];
-            let mut rid = [0_u16; BLOCK];
-            for (xc, oc) in x.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
-                st.begin_block();
-                for ((&xi, u), r) in xc.iter().zip(ub.iter_mut()).zip(rid.iter_mut()) {
-                    st.advance(xi, index, observer);
-                    *u = st.u;
-                    *r = st.run;
-                    index = index.saturating_add(1); // <= end, checked above
-                    st.pos = st.pos.saturating_add(1); // < BLOCK
+    let saved = state.clone(); // restored when the forces overflow
+    let range = match (out, rule) {
+        // Masing's scaled rule with nobody watching closures: the kernel that defers
+        // reversal forces to the curve pass.
+        (Some(out), BranchRule::Scaled(lam)) if O::IGNORES && kernel::takes(state) => {
+            kernel::scaled_force(curve, lam, x, out, state);
+            crate::error::check_output("force", out)
+        }
+        (out, _) => {
+            let mut index = state.count;
+            let mut st = Stepper::new(curve, rule, out.is_some(), state);
+            let range = if let Some(out) = out {
+                let mut ub = [0.0_f64; BLOCK];
+                let mut rid = [0_u16; BLOCK];
+                for (xc, oc) in x.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
+                    st.begin_block();
+                    for ((&xi, u), r) in xc.iter().zip(ub.iter_mut()).zip(rid.iter_mut()) {
+                        st.advance(xi, index, observer);
+                        *u = st.u;
+                        *r = st.run;
+                        index = index.saturating_add(1); // <= end, checked above
+                    }
+                    let m = xc.len();
+                    eval_block(curve, &mut st.runs, &ub[..m], &rid[..m], oc);
                 }
-                let m = xc.len();
-                eval_block(curve, &mut st.runs, &ub[..m], &rid[..m], oc);
-                st.end_block(oc);
-            }
-            range = crate::error::check_output("force", out);
+                crate::error::check_output("force", out)
+            } else {
+                for &xi in x {
+                    st.advance(xi, index, observer);
+                    index = index.saturating_add(1); // <= end, checked above
+                }
+                Ok(())
+            };
+            let (xp, dir, hp) = (st.xp, st.dir, st.last_value());
+            state.x = xp;
+            state.h = hp;
+            state.dir = dir as i8;
+            state.count = end;
+            range
         }
-        None => {
-            for &xi in x {
-                st.advance(xi, index, observer);
-                index = index.saturating_add(1); // <= end, checked above
-            }
-        }
-    }
-    let (xp, dir) = (st.xp, st.dir);
-    let hp = st.last_value();
+    };
     if let Err(e) = range {
         *state = saved;
         return Err(e);
     }
-    state.x = xp;
-    state.h = hp;
-    state.dir = dir as i8;
-    state.count = end;
     Ok(())
 }
 
@@ -632,7 +541,7 @@ pub fn branch_memory(
     if i64::try_from(end).is_err() {
         return Err(CoreError::TooLong { len: x.len() });
     }
-    let mut st = Stepper::new(&NoCurve, BranchRule::Scaled(2.0), false, false, state);
+    let mut st = Stepper::new(&NoCurve, BranchRule::Scaled(2.0), false, state);
     let samples = x.iter().zip(anchor.iter_mut()).zip(target.iter_mut());
     for (index, ((&xi, a), t)) in (base..).zip(samples) {
         st.advance(xi, index, &mut NoObserver);

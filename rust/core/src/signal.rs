@@ -136,13 +136,14 @@ impl Schmitt {
 pub struct FoldSums {
     pub n_bins: usize,
     pub n_cycles: usize,
-    /// Per bin: samples, Σx, ΣF, Σφ, Σφ², Σx² (φ: phase within the cycle, in [0, 1)).
+    /// Per bin: samples, Σx, ΣF, Σφ, Σφ², Σx², Σt (φ: phase within the cycle, in [0, 1)).
     pub count: Vec<f64>,
     pub sum_x: Vec<f64>,
     pub sum_f: Vec<f64>,
     pub sum_phase: Vec<f64>,
     pub sum_phase2: Vec<f64>,
     pub sum_xx: Vec<f64>,
+    pub sum_t: Vec<f64>,
     /// Per cycle and bin: samples, Σx, ΣF, Σφ.
     pub cycle_count: Vec<f64>,
     pub cycle_x: Vec<f64>,
@@ -170,6 +171,7 @@ impl FoldSums {
             &self.sum_phase,
             &self.sum_phase2,
             &self.sum_xx,
+            &self.sum_t,
         ];
         let per_cell = [
             &self.cycle_count,
@@ -212,6 +214,7 @@ impl FoldSums {
             sum_phase: z(n_bins),
             sum_phase2: z(n_bins),
             sum_xx: z(n_bins),
+            sum_t: z(n_bins),
             cycle_count: z(cells),
             cycle_x: z(cells),
             cycle_f: z(cells),
@@ -271,21 +274,28 @@ pub fn fold_phase(
     let nb = sums.n_bins;
     let (t0, t1) = (kt[0], kt[kt.len() - 1]);
     let mut j = 0_usize;
+    // the segment's slope, computed once per knot interval (the same value numpy.interp
+    // computes per sample, so the phases are bit-identical)
+    let seg_slope = |j: usize| (kp[j + 1] - kp[j]) / (kt[j + 1] - kt[j]);
+    let mut slope = seg_slope(0);
     for (i, ((&ti, &xi), &fi)) in t.iter().zip(x).zip(f).enumerate() {
         if !(ti >= t0 && ti < t1) {
             continue;
         }
         if ti < kt[j] {
             j = 0; // time went back (a new chunk of another stretch): search from the start
+            slope = seg_slope(0);
         }
-        while kt[j + 1] <= ti {
-            j += 1;
+        if kt[j + 1] <= ti {
+            while kt[j + 1] <= ti {
+                j += 1;
+            }
+            slope = seg_slope(j);
         }
         // numpy.interp's arithmetic: the knot's value on the knot, else slope·(t - t_j) + p_j.
         let ph = if ti == kt[j] {
             kp[j]
         } else {
-            let slope = (kp[j + 1] - kp[j]) / (kt[j + 1] - kt[j]);
             slope * (ti - kt[j]) + kp[j]
         };
         let cf = ph.floor();
@@ -301,6 +311,7 @@ pub fn fold_phase(
         sums.sum_phase[b] += frac;
         sums.sum_phase2[b] += frac * frac;
         sums.sum_xx[b] += xi * xi;
+        sums.sum_t[b] += ti;
         let k = c * nb + b;
         sums.cycle_count[k] += 1.0;
         sums.cycle_x[k] += xi;
@@ -333,6 +344,362 @@ pub fn loop_areas(x: &[f64], f: &[f64], bounds: &[usize]) -> Result<Vec<f64>, Co
             f64::NAN
         });
     }
+    Ok(out)
+}
+
+/// Cycle-to-cycle spread of a phase fold: per bin, the standard deviation over the cycles of
+/// the per-cycle bin means of x and F, each corrected to first order for where that cycle's
+/// samples sit inside the bin (`mean - slope · (φ̄_cycle - φ̄_bin)`, the slope along phase a
+/// periodic central difference of the bin means); NaN below 2 cycles with samples in the
+/// bin. Per cycle: half the range of its bin means of x (amplitude) and of F (NaN for a cycle
+/// without samples). The arithmetic is numpy's of `contactlab.tangential.preprocess`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FoldSpread {
+    pub x_std: Vec<f64>,
+    pub f_std: Vec<f64>,
+    pub amplitude: Vec<f64>,
+    pub force_range: Vec<f64>,
+}
+
+// Index arithmetic: b < nb and c < n_cycles, so c * nb + b < the cells `check_shape` checked;
+// (b + 1) % nb and (b + nb - 1) % nb stay below nb (nb >= 1).
+#[allow(clippy::arithmetic_side_effects)]
+pub fn fold_spread(sums: &FoldSums) -> Result<FoldSpread, CoreError> {
+    sums.check_shape()?;
+    let (nb, nc) = (sums.n_bins, sums.n_cycles);
+    let half_n = nb as f64 / 2.0;
+    let mean_of =
+        |v: &[f64]| -> Vec<f64> { v.iter().zip(&sums.count).map(|(s, n)| s / n).collect() };
+    let (xm, fm, phim) = (
+        mean_of(&sums.sum_x),
+        mean_of(&sums.sum_f),
+        mean_of(&sums.sum_phase),
+    );
+    let slope = |m: &[f64], b: usize| (m[(b + 1) % nb] - m[(b + nb - 1) % nb]) * half_n;
+    let gx: Vec<f64> = (0..nb).map(|b| slope(&xm, b)).collect();
+    let gf: Vec<f64> = (0..nb).map(|b| slope(&fm, b)).collect();
+    // corrected per-cycle bin means, NaN where a cycle has no sample in the bin
+    let cell = |c: usize, b: usize, v: &[f64], g: &[f64]| {
+        let k = c * nb + b;
+        let n = sums.cycle_count[k];
+        let dphi = sums.cycle_phase[k] / n - phim[b];
+        v[k] / n - g[b] * dphi
+    };
+    let spread = |v: &[f64], g: &[f64]| -> Vec<f64> {
+        let mut sum = vec![0.0_f64; nb];
+        let mut cnt = vec![0_usize; nb];
+        for c in 0..nc {
+            for b in 0..nb {
+                let a = cell(c, b, v, g);
+                if a.is_finite() {
+                    sum[b] += a;
+                    cnt[b] += 1;
+                }
+            }
+        }
+        let mean: Vec<f64> = sum.iter().zip(&cnt).map(|(s, &k)| s / k as f64).collect();
+        let mut sq = vec![0.0_f64; nb];
+        for c in 0..nc {
+            for b in 0..nb {
+                let a = cell(c, b, v, g);
+                if a.is_finite() {
+                    let d = a - mean[b];
+                    sq[b] += d * d;
+                }
+            }
+        }
+        sq.iter()
+            .zip(&cnt)
+            .map(|(q, &k)| {
+                if k >= 2 {
+                    (q / (k - 1) as f64).sqrt()
+                } else {
+                    f64::NAN
+                }
+            })
+            .collect()
+    };
+    let range = |v: &[f64]| -> Vec<f64> {
+        (0..nc)
+            .map(|c| {
+                let (mut hi, mut lo) = (f64::NEG_INFINITY, f64::INFINITY);
+                for b in 0..nb {
+                    let k = c * nb + b;
+                    let m = v[k] / sums.cycle_count[k];
+                    if !m.is_nan() {
+                        hi = hi.max(m);
+                        lo = lo.min(m);
+                    }
+                }
+                if hi >= lo {
+                    0.5 * (hi - lo)
+                } else {
+                    f64::NAN
+                }
+            })
+            .collect()
+    };
+    Ok(FoldSpread {
+        x_std: spread(&sums.cycle_x, &gx),
+        f_std: spread(&sums.cycle_f, &gf),
+        amplitude: range(&sums.cycle_x),
+        force_range: range(&sums.cycle_f),
+    })
+}
+
+/// Time averages of `v` between consecutive `edges` (trapezoid rule on the samples, the
+/// cumulative integral interpolated linearly at the edges), with numpy's arithmetic:
+/// `c = [0, cumsum(0.5 (v[1:] + v[:-1]) diff(t))]`, `ce = interp(edges, t, c)`,
+/// `diff(ce) / diff(edges)`. `t` strictly increasing (checked), `edges` non-decreasing.
+// Index arithmetic: j + 1 < t.len() inside the search (t.len() >= 2 checked).
+#[allow(clippy::arithmetic_side_effects)]
+pub fn period_means(t: &[f64], v: &[f64], edges: &[f64]) -> Result<Vec<f64>, CoreError> {
+    check_same_len("t", t.len(), "v", v.len())?;
+    check_finite("t", t)?;
+    check_finite("edges", edges)?;
+    if t.len() < 2 {
+        return Err(CoreError::Empty { name: "t" });
+    }
+    for i in 1..t.len() {
+        if t[i] <= t[i - 1] {
+            return Err(CoreError::NotIncreasing {
+                name: "t",
+                index: i,
+                value: t[i],
+                prev: t[i - 1],
+            });
+        }
+    }
+    for i in 1..edges.len() {
+        if edges[i] < edges[i - 1] {
+            return Err(CoreError::NotIncreasing {
+                name: "edges",
+                index: i,
+                value: edges[i],
+                prev: edges[i - 1],
+            });
+        }
+    }
+    let n = t.len();
+    // cumulative integral at sample j, carried while the edges are visited in order
+    let mut ce = Vec::with_capacity(edges.len());
+    let (mut j, mut cj) = (0_usize, 0.0_f64);
+    let step = |j: usize| 0.5 * (v[j + 1] + v[j]) * (t[j + 1] - t[j]);
+    for &e in edges {
+        if e <= t[0] {
+            ce.push(0.0);
+            continue;
+        }
+        while j + 1 < n && t[j + 1] <= e {
+            cj += step(j);
+            j += 1;
+        }
+        if j + 1 >= n {
+            ce.push(cj); // at or beyond the last sample: its value
+        } else if e == t[j] {
+            ce.push(cj);
+        } else {
+            let c1 = cj + step(j);
+            let slope = (c1 - cj) / (t[j + 1] - t[j]);
+            ce.push(slope * (e - t[j]) + cj);
+        }
+    }
+    Ok(ce
+        .windows(2)
+        .zip(edges.windows(2))
+        .map(|(c, e)| (c[1] - c[0]) / (e[1] - e[0]))
+        .collect())
+}
+
+/// Noise sensitivity of each cycle's loop area `x[bounds[k]..bounds[k+1]]`: the shoelace
+/// area is linear in every sample's `F` with coefficient `(x[i-1] - x[i+1]) / 2` and in its
+/// `x` with `(F[i+1] - F[i-1]) / 2` (indices cyclic within the cycle). Returns per cycle
+/// `(Σ coef_F², Σ coef_x²)`, so that independent sample noise `σF`, `σx` gives the area a
+/// variance `σF² Σ coef_F² + σx² Σ coef_x²`.
+// Index arithmetic: i < m = b - a with a <= b <= len checked, so a + (i ± 1) mod m < len.
+#[allow(clippy::arithmetic_side_effects)]
+pub fn loop_area_sensitivity(
+    x: &[f64],
+    f: &[f64],
+    bounds: &[usize],
+) -> Result<(Vec<f64>, Vec<f64>), CoreError> {
+    check_same_len("x", x.len(), "F", f.len())?;
+    let cycles = bounds.len().saturating_sub(1);
+    let (mut out_f, mut out_x) = (Vec::with_capacity(cycles), Vec::with_capacity(cycles));
+    for w in bounds.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if b > x.len() || a > b {
+            return Err(CoreError::InvalidParameter {
+                name: "bounds",
+                value: b as f64,
+                reason: "cycle bounds must be non-decreasing and within the signal",
+            });
+        }
+        let (xs, fs) = (&x[a..b], &f[a..b]);
+        let m = xs.len();
+        let (mut sf, mut sx) = (0.0_f64, 0.0_f64);
+        for i in 0..m {
+            let (p, n) = (
+                if i == 0 { m - 1 } else { i - 1 },
+                if i + 1 == m { 0 } else { i + 1 },
+            );
+            let cf = 0.5 * (xs[p] - xs[n]);
+            let cx = 0.5 * (fs[n] - fs[p]);
+            sf += cf * cf;
+            sx += cx * cx;
+        }
+        out_f.push(sf);
+        out_x.push(sx);
+    }
+    Ok((out_f, out_x))
+}
+
+/// State of [`cycle_block`] between blocks of a stream (see `contactlab.studies._cycles`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CycleState {
+    /// Trigger level: +1 above the band, -1 below, 0 not yet known.
+    pub level: i8,
+    pub have_crossing: bool,
+    pub x_cross: f64,
+    pub f_cross: f64,
+    pub t_cross: f64,
+    /// `∮ F dx` since the last crossing, up to the previous sample.
+    pub acc: f64,
+    /// The previous block's last sample (NaN before the first).
+    pub x_prev: f64,
+    pub f_prev: f64,
+    /// Extrema since the last crossing.
+    pub x_max: f64,
+    pub x_min: f64,
+    pub f_max: f64,
+    pub f_min: f64,
+}
+
+impl Default for CycleState {
+    fn default() -> Self {
+        Self {
+            level: 0,
+            have_crossing: false,
+            x_cross: 0.0,
+            f_cross: 0.0,
+            t_cross: 0.0,
+            acc: 0.0,
+            x_prev: f64::NAN,
+            f_prev: f64::NAN,
+            x_max: f64::NEG_INFINITY,
+            x_min: f64::INFINITY,
+            f_max: f64::NEG_INFINITY,
+            f_min: f64::INFINITY,
+        }
+    }
+}
+
+/// Cycles completed in one block by [`cycle_block`]: every upward crossing of the drive
+/// (global index) and, per complete cycle, start and end time, `∮ F dx` (the polygon of the
+/// cycle's samples, closed by the chord back to its first), amplitude (half the x range) and
+/// offset (centre of the F range).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BlockCycles {
+    pub crossings: Vec<u64>,
+    pub start: Vec<f64>,
+    pub end: Vec<f64>,
+    pub energy: Vec<f64>,
+    pub amplitude: Vec<f64>,
+    pub offset: Vec<f64>,
+}
+
+/// Upward crossings of `drive` through the band `[low, high]` (a Schmitt trigger: the drive
+/// must have been `<= low` since the last `>= high` before a new `>= high` counts) and the
+/// cycles they complete, in one pass over a block starting at global index `offset`; `state`
+/// carries everything across blocks, so any chunking gives the same cycles. A band with
+/// `high <= low` (a constant block) finds no crossing. On error `state` is unchanged.
+// Index arithmetic: i < n (the block length) throughout.
+#[allow(clippy::arithmetic_side_effects, clippy::too_many_arguments)]
+pub fn cycle_block(
+    t: &[f64],
+    x: &[f64],
+    f: &[f64],
+    drive: &[f64],
+    offset: u64,
+    low: f64,
+    high: f64,
+    state: &mut CycleState,
+) -> Result<BlockCycles, CoreError> {
+    let n = x.len();
+    check_same_len("t", t.len(), "x", n)?;
+    check_same_len("x", n, "F", f.len())?;
+    check_same_len("x", n, "drive", drive.len())?;
+    check_finite("t", t)?;
+    check_finite("x", x)?;
+    check_finite("F", f)?;
+    check_finite("drive", drive)?;
+    if !(low.is_finite() && high.is_finite()) {
+        return Err(CoreError::InvalidParameter {
+            name: "levels",
+            value: if low.is_finite() { high } else { low },
+            reason: "trigger levels must be finite",
+        });
+    }
+    u64::try_from(n)
+        .ok()
+        .and_then(|k| offset.checked_add(k))
+        .ok_or(CoreError::TooLong { len: n })?;
+    let mut out = BlockCycles::default();
+    if n == 0 {
+        return Ok(out);
+    }
+    let can_cross = high > low;
+    let mut s = *state;
+    // cum: ∮ F dx since the last crossing (the carried part included)
+    let mut cum = s.acc;
+    let (mut xp, mut fp) = (s.x_prev, s.f_prev);
+    let (mut xmax, mut xmin, mut fmax, mut fmin) = (s.x_max, s.x_min, s.f_max, s.f_min);
+    for i in 0..n {
+        let (xi, fi) = (x[i], f[i]);
+        if xp.is_finite() {
+            cum += 0.5 * (fi + fp) * (xi - xp);
+        }
+        let mark: i8 = if drive[i] <= low {
+            -1
+        } else {
+            i8::from(drive[i] >= high)
+        };
+        let before = s.level;
+        if mark != 0 {
+            s.level = mark;
+        }
+        if can_cross && mark == 1 && before == -1 {
+            // a crossing at i: the cycle since the previous one ends here (its extrema
+            // exclude this sample, which starts the next cycle)
+            out.crossings.push(offset.saturating_add(i as u64));
+            if s.have_crossing {
+                let energy = cum + 0.5 * (fi + s.f_cross) * (s.x_cross - xi);
+                out.start.push(s.t_cross);
+                out.end.push(t[i]);
+                out.energy.push(energy);
+                out.amplitude.push(0.5 * (xmax - xmin));
+                out.offset.push(0.5 * (fmax + fmin));
+            }
+            s.have_crossing = true;
+            s.x_cross = xi;
+            s.f_cross = fi;
+            s.t_cross = t[i];
+            cum = 0.0;
+            (xmax, xmin, fmax, fmin) = (xi, xi, fi, fi);
+        } else {
+            xmax = xmax.max(xi);
+            xmin = xmin.min(xi);
+            fmax = fmax.max(fi);
+            fmin = fmin.min(fi);
+        }
+        xp = xi;
+        fp = fi;
+    }
+    s.acc = cum;
+    s.x_prev = xp;
+    s.f_prev = fp;
+    (s.x_max, s.x_min, s.f_max, s.f_min) = (xmax, xmin, fmax, fmin);
+    *state = s;
     Ok(out)
 }
 
@@ -395,5 +762,88 @@ mod tests {
         assert_eq!(s, before);
         assert!(Schmitt::new(0.0, 0.0).is_err());
         assert!(Schmitt::new(f64::NAN, 1.0).is_err());
+    }
+    #[test]
+    fn cycle_block_any_chunking_equals_one_pass() {
+        let n = 4000_usize;
+        let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-3).collect();
+        let x: Vec<f64> = t
+            .iter()
+            .map(|&s| (s * 37.0).sin() + 0.05 * (s * 3111.0).sin())
+            .collect();
+        let f: Vec<f64> = t.iter().map(|&s| (s * 37.0 + 0.4).sin() + 0.2).collect();
+        let mut st = CycleState::default();
+        let whole = cycle_block(&t, &x, &f, &x, 0, -0.25, 0.25, &mut st).unwrap();
+        // 37 rad/s over 4 s: 23.5 periods -> 23 crossings, 22 complete cycles
+        assert_eq!(whole.crossings.len(), 23);
+        assert_eq!(whole.energy.len(), 22);
+        for k in 0..whole.energy.len() {
+            assert!((whole.amplitude[k] - 1.0).abs() < 0.06);
+            assert!((whole.offset[k] - 0.2).abs() < 0.01);
+            // the loop of sin vs sin(. + 0.4): area π sin(0.4) per cycle, positive orientation
+            assert!((whole.energy[k].abs() - std::f64::consts::PI * 0.4_f64.sin()).abs() < 0.08);
+        }
+        for cuts in [
+            vec![1_usize],
+            vec![17, 18, 2000],
+            vec![3999],
+            vec![500, 1500, 2500],
+        ] {
+            let mut st = CycleState::default();
+            let mut got = BlockCycles::default();
+            let mut a = 0;
+            for &b in cuts.iter().chain(std::iter::once(&n)) {
+                let c = cycle_block(
+                    &t[a..b],
+                    &x[a..b],
+                    &f[a..b],
+                    &x[a..b],
+                    a as u64,
+                    -0.25,
+                    0.25,
+                    &mut st,
+                )
+                .unwrap();
+                got.crossings.extend(c.crossings);
+                got.start.extend(c.start);
+                got.end.extend(c.end);
+                got.amplitude.extend(c.amplitude);
+                got.offset.extend(c.offset);
+                got.energy.extend(c.energy);
+                a = b;
+            }
+            assert_eq!(got.crossings, whole.crossings);
+            assert_eq!(got.amplitude, whole.amplitude);
+            for (g, w) in got.energy.iter().zip(&whole.energy) {
+                assert!((g - w).abs() < 1e-12);
+            }
+        }
+        let before = st;
+        assert!(cycle_block(&[0.0], &[f64::NAN], &[0.0], &[0.0], 0, -1.0, 1.0, &mut st).is_err());
+        assert!(cycle_block(&[0.0], &[0.0], &[0.0], &[0.0], u64::MAX, -1.0, 1.0, &mut st).is_err());
+        assert_eq!(st, before);
+    }
+
+    #[test]
+    fn loop_area_sensitivity_matches_finite_differences() {
+        let x = [0.0, 1.0, 2.0, 1.5, 0.3, -0.4, 0.1];
+        let f = [0.5, 1.0, 0.2, -0.7, -1.0, 0.0, 0.4];
+        let (sf, sx) = loop_area_sensitivity(&x, &f, &[0, 7]).unwrap();
+        let area = |x: &[f64], f: &[f64]| crate::masing::loop_area(x, f).unwrap();
+        let (mut gf, mut gx) = (0.0, 0.0);
+        let h = 1e-6;
+        for i in 0..7 {
+            let mut f2 = f;
+            f2[i] += h;
+            let d = (area(&x, &f2) - area(&x, &f)) / h;
+            gf += d * d;
+            let mut x2 = x;
+            x2[i] += h;
+            let d = (area(&x2, &f) - area(&x, &f)) / h;
+            gx += d * d;
+        }
+        assert!((sf[0] - gf).abs() < 1e-6 * gf.max(1.0), "{} {}", sf[0], gf);
+        assert!((sx[0] - gx).abs() < 1e-6 * gx.max(1.0), "{} {}", sx[0], gx);
+        assert!(loop_area_sensitivity(&x, &f, &[3, 2]).is_err());
     }
 }

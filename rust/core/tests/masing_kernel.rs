@@ -3,7 +3,7 @@
 
 use contactlab_core::curve::{one_minus_exp_neg, Backbone, Exponential};
 use contactlab_core::masing::{
-    branch_memory, masing_force, masing_force_rule, BranchRule, MasingState,
+    branch_memory, masing_force, masing_force_rule, run, BranchRule, Closure, MasingState,
 };
 use proptest::prelude::*;
 
@@ -103,5 +103,100 @@ proptest! {
                                  (fs.stack[n - 1].index as i64, fs.stack[n - 2].index as i64)),
         }
         prop_assert_eq!(st.stack.len(), fs.stack.len());
+    }
+}
+
+/// Signals that mix what the kernel treats differently: stretches where the input reverses
+/// every sample or two, smooth stretches, repeated values, large jumps that close several
+/// loops or rejoin the virgin curve; long enough for several blocks of 512.
+fn mixed() -> impl Strategy<Value = Vec<f64>> {
+    let piece = prop_oneof![
+        // random walk on a grid (exact repeats of earlier extremes)
+        (prop::collection::vec(prop::bool::ANY, 1..700), 1u32..4).prop_map(|(b, k)| (
+            0,
+            b.iter()
+                .map(|&u| if u { 1.0 } else { -1.0 } * f64::from(k))
+                .collect::<Vec<_>>()
+        )),
+        // smooth: a sine stretch
+        (50usize..900, 0.5f64..30.0)
+            .prop_map(|(n, a)| (1, (0..n).map(|i| a * (i as f64 * 0.02).sin()).collect())),
+        // held value
+        (1usize..20).prop_map(|n| (2, vec![0.0; n])),
+        // jump
+        (-60.0f64..60.0).prop_map(|j| (3, vec![j])),
+    ];
+    prop::collection::vec(piece, 1..8).prop_map(|pieces| {
+        let mut x = Vec::new();
+        let mut level = 0.0_f64;
+        for (kind, v) in pieces {
+            for d in v {
+                level = match kind {
+                    0 => level + d,
+                    1 => level + d * 0.05,
+                    2 => level,
+                    _ => d,
+                };
+                x.push(level * 1e-6);
+            }
+        }
+        x
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// The force kernel (deferred reversal forces, branch registers, run table) against the
+    /// operator's stepping code, which evaluates every reversal force on the spot (taken when
+    /// an observer watches closures): bit for bit, in one pass and chunked.
+    #[test]
+    fn kernel_equals_the_eager_stepper_bit_for_bit(x in mixed(), cut in 0usize..2000) {
+        let c = Exponential::new(40.0, 4.0e4).unwrap();
+        let mut fast = vec![0.0; x.len()];
+        let mut sf = MasingState::default();
+        masing_force(&c, 2.0, &x, &mut fast, &mut sf).unwrap();
+        let mut slow = vec![0.0; x.len()];
+        let mut ss = MasingState::default();
+        let mut closures = 0_usize;
+        let mut count = |_: Closure| closures += 1;
+        run(&c, 2.0, &x, Some(&mut slow), &mut ss, &mut count).unwrap();
+        prop_assert_eq!(&fast, &slow);
+        prop_assert_eq!(&sf, &ss);
+        let cut = cut.min(x.len());
+        let mut parts = vec![0.0; x.len()];
+        let mut st = MasingState::default();
+        masing_force(&c, 2.0, &x[..cut], &mut parts[..cut], &mut st).unwrap();
+        masing_force(&c, 2.0, &x[cut..], &mut parts[cut..], &mut st).unwrap();
+        prop_assert_eq!(&fast, &parts);
+        prop_assert_eq!(&sf, &st);
+        let mut want = vec![0.0; x.len()];
+        reference::reference_force(40.0, 4.0e4, 2.0, &x, &mut want, &mut Vec::new());
+        for (a, b) in fast.iter().zip(&want) {
+            prop_assert!((a - b).abs() <= 1e-12 * 40.0, "{} vs {}", a, b);
+        }
+    }
+}
+
+#[test]
+fn states_the_kernel_cannot_continue_take_the_stepping_code() {
+    // A hand-made state that has moved but counts no samples (its first reversal would be
+    // sample -1), and one whose reversal index lies beyond its count.
+    let c = Exponential::new(40.0, 4.0e4).unwrap();
+    let x = [1e-5, 0.5e-5, 2e-5, -1e-5];
+    for v in [
+        vec![2e-5, 10.0, 1.0, 0.0],
+        vec![1e-5, 5.0, -1.0, 3.0, 3e-5, 20.0, 9.0],
+    ] {
+        let st0 = MasingState::from_slice(&v).unwrap();
+        let mut a = [0.0; 4];
+        let mut sa = st0.clone();
+        masing_force(&c, 2.0, &x, &mut a, &mut sa).unwrap();
+        let mut b = [0.0; 4];
+        let mut sb = st0.clone();
+        run(&c, 2.0, &x, Some(&mut b), &mut sb, &mut |_: Closure| {}).unwrap();
+        assert_eq!(a, b);
+        assert_eq!(sa, sb);
+        assert!(a.iter().all(|h| h.is_finite()));
     }
 }

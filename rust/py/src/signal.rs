@@ -2,7 +2,10 @@
 //! of the Masing rules, and the multi-channel force kernel (Rust threads).
 
 use contactlab_core::masing::{branch_memory, MasingState};
-use contactlab_core::signal::{fold_phase, loop_areas, Excursion, FoldSums, Schmitt};
+use contactlab_core::signal::{
+    cycle_block, fold_phase, fold_spread, loop_area_sensitivity, loop_areas, period_means,
+    CycleState, Excursion, FoldSums, Schmitt,
+};
 use contactlab_core::CoreError;
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadwriteArray1};
 use pyo3::prelude::*;
@@ -93,6 +96,7 @@ impl ReversalDetector {
     }
 }
 
+type FloatPair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
 type IndexPair<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>);
 
 /// Per-sample branch bookkeeping of the Masing memory rules from the origin:
@@ -215,16 +219,28 @@ impl PhaseFold {
     ) -> PyResult<()> {
         let (ts, xs, fs) = (slice(&t, "t")?, slice(&x, "x")?, slice(&f, "F")?);
         let (kt, kp) = (slice(&knot_t, "knot_t")?, slice(&knot_phase, "knot_phase")?);
-        let mut sums = self.sums.clone();
-        self.sums = detach_guarded(py, || {
-            fold_phase(ts, xs, fs, offset, kt, kp, &mut sums)?;
-            Ok(sums)
-        })?;
-        Ok(())
+        // fold_phase checks everything before it adds a sample: on error nothing changed
+        let sums = &mut self.sums;
+        detach_guarded(py, || fold_phase(ts, xs, fs, offset, kt, kp, sums))
     }
 
-    /// The sums so far: dict of arrays (per bin, and per cycle × bin as 2-D arrays).
-    fn sums<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+    /// Cycle-to-cycle spread per bin (`x_std`, `F_std`) and per-cycle half ranges of the
+    /// bin means (`amplitude`, `force_range`); see `contactlab_core::signal::fold_spread`.
+    fn spread<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let sums = &self.sums;
+        let sp = detach_guarded(py, || fold_spread(sums))?;
+        let d = PyDict::new(py);
+        d.set_item("x_std", sp.x_std.into_pyarray(py))?;
+        d.set_item("F_std", sp.f_std.into_pyarray(py))?;
+        d.set_item("amplitude", sp.amplitude.into_pyarray(py))?;
+        d.set_item("force_range", sp.force_range.into_pyarray(py))?;
+        Ok(d)
+    }
+
+    /// The sums so far: dict of arrays (per bin, and with `cells` per cycle × bin as 2-D
+    /// arrays).
+    #[pyo3(signature = (cells=true))]
+    fn sums<'py>(&self, py: Python<'py>, cells: bool) -> PyResult<Bound<'py, PyDict>> {
         let s = &self.sums;
         let d = PyDict::new(py);
         for (k, v) in [
@@ -234,15 +250,21 @@ impl PhaseFold {
             ("sum_phase", &s.sum_phase),
             ("sum_phase2", &s.sum_phase2),
             ("sum_xx", &s.sum_xx),
+            ("sum_t", &s.sum_t),
         ] {
             d.set_item(k, v.clone().into_pyarray(py))?;
         }
-        for (k, v) in [
-            ("cycle_count", &s.cycle_count),
-            ("cycle_x", &s.cycle_x),
-            ("cycle_F", &s.cycle_f),
-            ("cycle_phase", &s.cycle_phase),
-        ] {
+        let per_cell: &[(&str, &Vec<f64>)] = if cells {
+            &[
+                ("cycle_count", &s.cycle_count),
+                ("cycle_x", &s.cycle_x),
+                ("cycle_F", &s.cycle_f),
+                ("cycle_phase", &s.cycle_phase),
+            ]
+        } else {
+            &[]
+        };
+        for &(k, v) in per_cell {
             let a = v.clone().into_pyarray(py);
             d.set_item(k, a.reshape([s.n_cycles, s.n_bins])?)?;
         }
@@ -265,9 +287,96 @@ fn loop_areas_py<'py>(
     Ok(a.into_pyarray(py))
 }
 
+/// Per cycle between consecutive `bounds`: `(Σ coef_F², Σ coef_x²)`, the loop area's noise
+/// sensitivities (see `contactlab_core::signal::loop_area_sensitivity`).
+#[pyfunction]
+#[pyo3(name = "loop_area_sensitivity")]
+fn loop_area_sensitivity_py<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray1<'py, f64>,
+    f: PyReadonlyArray1<'py, f64>,
+    bounds: Vec<usize>,
+) -> PyResult<FloatPair<'py>> {
+    let (xs, fs) = (slice(&x, "x")?, slice(&f, "F")?);
+    let (a, b) = detach_guarded(py, || loop_area_sensitivity(xs, fs, &bounds))?;
+    Ok((a.into_pyarray(py), b.into_pyarray(py)))
+}
+
+/// Streaming cycle finder: upward crossings of a drive channel and per-cycle loop energy,
+/// amplitude and offset (see `contactlab_core::signal::cycle_block`).
+#[pyclass(module = "contactlab._core")]
+struct CycleTracker {
+    state: CycleState,
+}
+
+#[pymethods]
+impl CycleTracker {
+    #[new]
+    fn new() -> Self {
+        Self {
+            state: CycleState::default(),
+        }
+    }
+
+    /// One block: dict of arrays `crossings` (global indices), `start`, `end`, `energy`,
+    /// `amplitude`, `offset` (one per complete cycle).
+    #[allow(clippy::too_many_arguments)]
+    fn push<'py>(
+        &mut self,
+        py: Python<'py>,
+        t: PyReadonlyArray1<'py, f64>,
+        x: PyReadonlyArray1<'py, f64>,
+        f: PyReadonlyArray1<'py, f64>,
+        drive: PyReadonlyArray1<'py, f64>,
+        offset: u64,
+        low: f64,
+        high: f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let (ts, xs, fs) = (slice(&t, "t")?, slice(&x, "x")?, slice(&f, "F")?);
+        let ds = slice(&drive, "drive")?;
+        let state = &mut self.state;
+        let c = detach_guarded(py, || cycle_block(ts, xs, fs, ds, offset, low, high, state))?;
+        let d = PyDict::new(py);
+        let idx: Vec<i64> = c
+            .crossings
+            .iter()
+            .map(|&i| i64::try_from(i).unwrap_or(i64::MAX))
+            .collect();
+        d.set_item("crossings", idx.into_pyarray(py))?;
+        for (k, v) in [
+            ("start", c.start),
+            ("end", c.end),
+            ("energy", c.energy),
+            ("amplitude", c.amplitude),
+            ("offset", c.offset),
+        ] {
+            d.set_item(k, v.into_pyarray(py))?;
+        }
+        Ok(d)
+    }
+}
+
+/// Time averages of `v` between consecutive `edges` (see
+/// `contactlab_core::signal::period_means`).
+#[pyfunction]
+#[pyo3(name = "period_means")]
+fn period_means_py<'py>(
+    py: Python<'py>,
+    t: PyReadonlyArray1<'py, f64>,
+    v: PyReadonlyArray1<'py, f64>,
+    edges: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let (ts, vs, es) = (slice(&t, "t")?, slice(&v, "v")?, slice(&edges, "edges")?);
+    let m = detach_guarded(py, || period_means(ts, vs, es))?;
+    Ok(m.into_pyarray(py))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PhaseFold>()?;
     m.add_function(wrap_pyfunction!(loop_areas_py, m)?)?;
+    m.add_function(wrap_pyfunction!(loop_area_sensitivity_py, m)?)?;
+    m.add_function(wrap_pyfunction!(period_means_py, m)?)?;
+    m.add_class::<CycleTracker>()?;
     m.add_class::<ReversalDetector>()?;
     m.add_function(wrap_pyfunction!(branch_memory_py, m)?)?;
     m.add_function(wrap_pyfunction!(force_many, m)?)?;

@@ -40,7 +40,15 @@ pub fn sample_at(x: &[f64], pos: f64) -> Result<f64, CoreError> {
     if x.len() == 1 {
         return Ok(x[0]);
     }
-    Ok(interpolate(x, pos))
+    let v = interpolate(x, pos);
+    if !v.is_finite() {
+        return Err(CoreError::OutOfRange {
+            what: "interpolated sample",
+            index: 0,
+            value: v,
+        });
+    }
+    Ok(v)
 }
 
 /// [`sample_at`] for `x.len() >= 2` and a number `pos`.
@@ -55,11 +63,46 @@ fn interpolate(x: &[f64], pos: f64) -> f64 {
     if s <= 0.0 || i == n - 1 {
         return x[i];
     }
-    let (p0, p1) = (x[i], x[i + 1]);
-    let (m0, m1) = (slope(x, i), slope(x, i + 1));
+    let v = hermite(x, i, s, 1.0);
+    if v.is_finite() {
+        return v;
+    }
+    // Samples near f64::MAX: the slopes and coefficients overflow (inf - inf = NaN, found by
+    // fuzzing) although the value may not. The same cubic on the samples scaled by 2^-5
+    // (exact) keeps every partial sum below f64::MAX; scaled back it is inf only when the
+    // interpolated value itself is beyond the range.
+    hermite(x, i, s, OVERFLOW_SCALE) / OVERFLOW_SCALE
+}
+
+/// 2^-5: on samples scaled by it the Hermite's coefficients and partial sums stay finite.
+const OVERFLOW_SCALE: f64 = 0.031_25;
+
+/// The cubic Hermite between samples `i` and `i + 1` at `s` in (0, 1), on the samples times `k`.
+#[inline]
+#[allow(clippy::arithmetic_side_effects)]
+fn hermite(x: &[f64], i: usize, s: f64, k: f64) -> f64 {
+    let (p0, p1) = (k * x[i], k * x[i + 1]);
+    let (m0, m1) = (scaled_slope(x, i, k), scaled_slope(x, i + 1, k));
     let c2 = 3.0 * (p1 - p0) - 2.0 * m0 - m1;
     let c3 = 2.0 * (p0 - p1) + m0 + m1;
     p0 + s * (m0 + s * (c2 + s * c3))
+}
+
+/// [`slope`] at sample `i` of the samples times `k` (the stencil's three samples are scaled
+/// before they are combined, so nothing overflows on the way).
+// Index arithmetic: the window lo..hi holds i (lo <= i < hi <= x.len(), x.len() >= 2).
+#[inline]
+#[allow(clippy::arithmetic_side_effects)]
+fn scaled_slope(x: &[f64], i: usize, k: f64) -> f64 {
+    if k == 1.0 {
+        return slope(x, i);
+    }
+    // The stencil of `slope` lies within three samples around i: the same window (with the
+    // same end cases) scaled gives the scaled slope.
+    let lo = i.saturating_sub(1).min(x.len().saturating_sub(3));
+    let hi = (lo + 3).min(x.len());
+    let w: Vec<f64> = x[lo..hi].iter().map(|v| k * v).collect();
+    slope(&w, i - lo)
 }
 
 /// Fold `x` into `n_cycles × n_bins` values (row-major, one row per cycle) into `out`.
@@ -119,6 +162,14 @@ pub fn fold_cycles(
             *o = interpolate(x, pos);
         }
     }
+    // Only an interpolant overshooting beyond f64::MAX between samples near it is not finite.
+    if let Some(index) = out.iter().position(|v| !v.is_finite()) {
+        return Err(CoreError::OutOfRange {
+            what: "folded cycle",
+            index,
+            value: out[index],
+        });
+    }
     Ok(())
 }
 
@@ -153,6 +204,27 @@ mod tests {
         assert_eq!(sample_at(&[1.0, 2.0, 3.0], -5.0), Ok(1.0));
         assert_eq!(sample_at(&[1.0, 2.0, 3.0], 9.0), Ok(3.0));
         assert_eq!(sample_at(&[1.0, 2.0, 3.0], f64::INFINITY), Ok(3.0));
+    }
+
+    #[test]
+    fn samples_near_the_double_range_interpolate_without_nan() {
+        // found by AFL++ (fuzz/afl): -3·x[0] overflowed in the end slope, inf - inf gave NaN
+        let mut x = vec![1e-300; 11];
+        x[0] = f64::MAX;
+        x[1] = 1.2e-279;
+        let mut out = vec![0.0; 5 * 31];
+        fold_cycles(&x, 1e-300, 1e-300, 5, 31, &mut out).unwrap();
+        assert!(out.iter().all(|v| v.is_finite()));
+        // the scaled route is the same cubic: on [M/2, M, M/2] the end slope 4·M overflows;
+        // the Hermite midpoint (p0 + p1)/2 + (m0 - m1)/8 with m0 = M, m1 = 0 is 0.875 M
+        let m = f64::MAX;
+        let v = sample_at(&[0.5 * m, m, 0.5 * m], 0.5).unwrap();
+        assert!((v / (0.875 * m) - 1.0).abs() < 1e-15, "{v}");
+        let over = [0.0, f64::MAX, f64::MAX, 0.0];
+        assert!(matches!(
+            sample_at(&over, 1.5),
+            Err(CoreError::OutOfRange { .. })
+        ));
     }
 
     #[test]

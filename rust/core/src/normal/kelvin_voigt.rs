@@ -48,7 +48,9 @@ impl KelvinVoigt {
 
     /// Dissipated energy per cycle, the ellipse area `π pa K sin φ`.
     pub fn loop_energy(&self, pa: f64) -> f64 {
-        PI * pa * self.amplitude(pa) * self.phase().sin()
+        // sin φ (< 1) first: π pa overflowing while sin φ underflows to 0 gave inf · 0 = NaN
+        // (found by AFL++); in this order the product is finite or, truly beyond range, inf
+        PI * (self.phase().sin() * self.amplitude(pa) * pa)
     }
 
     /// Steady-state displacement and velocity at times `t` under `pa sin ω t`.
@@ -102,6 +104,18 @@ mod tests {
         let k11 = pa / (kv.k * kv.k + (h * kv.omega).powi(2)).sqrt();
         assert!((k11 - k_amp).abs() < 1e-15 * k_amp.abs().max(1e-300) * 1e3);
         assert!((kv.phase() - (h * kv.omega / kv.k).atan()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn loop_energy_of_extreme_parameters_is_not_nan() {
+        // found by AFL++ (fuzz/afl): k = 1e300, ψ = 5e-324 (sin φ = 0), pa = f64::MAX
+        let kv = KelvinVoigt::new(1e300, 5e-324, 2.96e-308).unwrap();
+        let e = kv.loop_energy(f64::MAX);
+        assert!(e.is_finite() && e >= 0.0, "{e}");
+        let kv = KelvinVoigt::new(2.0, 0.3, 1.0).unwrap();
+        let g = 0.3 / (2.0 * PI);
+        let expect = PI * 5.0 * (5.0 / 2.0) * g / (1.0 + g * g); // π pa² sinφ cosφ / k
+        assert!((kv.loop_energy(5.0) / expect - 1.0).abs() < 1e-14);
     }
 
     #[test]

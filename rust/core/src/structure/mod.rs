@@ -6,10 +6,12 @@
 //!   contact stiffness), their tangents, events and stored energy.
 //! - [`newmark`]: the integrator, sample-exact outputs, energy bookkeeping.
 //! - [`dense`]: allocation-free LU for the Newton systems.
+//! - `sdof`: the integrator specialised to one DOF (scalars throughout).
 
 pub(crate) mod dense;
 pub mod joint;
 pub mod newmark;
+mod sdof;
 
 pub use joint::{Joint, JointLaw, JointState, MasingCurve, Trial};
 pub use newmark::{simulate, Inputs, Options, Response, Status, Structure};

@@ -19,11 +19,11 @@ use crate::error::{check_finite, check_same_len, CoreError};
 /// A linear structure with joints: dense row-major `n × n` matrices.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Structure {
-    n: usize,
-    m: Vec<f64>,
-    c: Vec<f64>,
-    k: Vec<f64>,
-    joints: Vec<Joint>,
+    pub(super) n: usize,
+    pub(super) m: Vec<f64>,
+    pub(super) c: Vec<f64>,
+    pub(super) k: Vec<f64>,
+    pub(super) joints: Vec<Joint>,
 }
 
 impl Structure {
@@ -371,6 +371,28 @@ pub fn simulate(
             reason: "rtol must be > 0 and max_iter >= 1",
         });
     }
+    if n == 1 {
+        // One DOF: the same scheme on scalars (no matrices, no LU), bit-for-bit the same
+        // arithmetic as the dense path below (checked by the tests in `sdof`).
+        return super::sdof::simulate(s, inp, x0[0], v0[0], opts);
+    }
+    simulate_dense(s, inp, x0, v0, opts, total, total_j)
+}
+
+/// The n-DOF path of [`simulate`] (inputs already checked; `total = len(t)·n`,
+/// `total_j = len(t)·n_joints`).
+pub(super) fn simulate_dense(
+    s: &Structure,
+    inp: &Inputs<'_>,
+    x0: &[f64],
+    v0: &[f64],
+    opts: &Options,
+    total: usize,
+    total_j: usize,
+) -> Result<Response, CoreError> {
+    let n = s.n;
+    let nt = inp.t.len();
+    let nj = s.joints.len();
     let mut states: Vec<JointState> = s.joints.iter().map(|j| j.law.fresh_state()).collect();
     let mut jf = vec![0.0; nj];
     let mut jd = vec![0.0; nj];

@@ -1,0 +1,338 @@
+//! The force kernel of Masing's scaled branch rule (PHYSICS.md §1) with no closure observer:
+//! what `Masing.force`, `MasingOperator.push` and `force_many` run.
+//!
+//! Two passes per block of [`BLOCK`] samples. The first applies the memory rules sample by
+//! sample and records each sample's curve argument `u` and the run of samples on one branch
+//! it belongs to (a run is `h = base + mul · f(u)`). The second ([`eval_block`]) evaluates the
+//! curve over the whole block in one vectorised loop, then the runs' bases, then the forces.
+//!
+//! A new reversal's force is the output of the previous sample, which the second pass computes
+//! anyway; it is not evaluated when the reversal is found (it is *deferred*): the reversal
+//! refers to its sample until the block ends. Deferred entries are the stack's newest ones, the
+//! reversals found in the current block, so their global sample index says which they are and
+//! where their force is.
+//!
+//! The first pass keeps the current branch (anchor, target, deferred source) in registers
+//! and skips the rules, by a predicted test, on samples that move on along their branch.
+//! Elsewhere a reversal is applied without data-dependent branches (the candidate is always
+//! written above the stack top, the top raised by 0 or 1, the branch registers selected by
+//! integer selects); only a closure takes a branch and reloads the branch from the stack.
+
+use super::{MasingState, Reversal};
+use crate::curve::Backbone;
+
+/// No pending sample: the value is known.
+pub(super) const KNOWN: u32 = u32::MAX;
+
+/// Samples per block: the curve arguments of one block and its run table stay in L1 between
+/// the passes.
+pub(super) const BLOCK: usize = 512;
+
+/// A stretch of a block on one branch: its samples have `h = base + mul · f(u)`, `base` being
+/// `ha`, or the output of in-block sample `src` while that force is deferred.
+#[derive(Clone, Copy)]
+pub(super) struct Run {
+    pub(super) ha: f64,
+    pub(super) src: u32,
+    pub(super) mul: f64,
+}
+
+/// Curve pass of one block, free of data-dependent branches however short the branches of
+/// the signal are: `out[i] = f(u[i])` over the whole block (auto-vectorised for the
+/// exponential curve); then each run's base is resolved in order (a deferred base is the
+/// output of an earlier sample, itself `base + mul · f(u)` of an earlier run); then
+/// `out[i] = base + mul · out[i]` with the run of sample `i` looked up in `rid`.
+#[inline(never)]
+pub(super) fn eval_block<C: Backbone>(
+    curve: &C,
+    runs: &mut [Run],
+    u: &[f64],
+    rid: &[u16],
+    out: &mut [f64],
+) {
+    for (o, &v) in out.iter_mut().zip(u) {
+        *o = curve.eval(v);
+    }
+    for k in 0..runs.len() {
+        let r = runs[k];
+        if r.src != KNOWN {
+            let s = r.src as usize;
+            let from = runs[rid[s] as usize];
+            runs[k].ha = from.ha + from.mul * out[s];
+            runs[k].src = KNOWN;
+        }
+    }
+    for (o, &k) in out.iter_mut().zip(rid) {
+        let r = &runs[k as usize];
+        *o = r.ha + r.mul * *o;
+    }
+}
+
+/// Written above the stack top (never read as a reversal).
+const SPARE: Reversal = Reversal {
+    x: 0.0,
+    h: 0.0,
+    index: 0,
+};
+
+/// First-pass state. The stack is the caller's `Vec`, kept longer than its logical length
+/// `n` so that a candidate reversal can be written above the top without a test; the passes
+/// take it as a slice (its pointer and length stay in registers).
+#[derive(Clone, Copy)]
+struct Pass {
+    n: usize,
+    lam: f64,
+    inv_lam: f64,
+    xp: f64,
+    /// +1, -1, or 0 before the first move.
+    dir: f64,
+    /// Current branch, `h = ha + mul · f((x - xa) · inv)`, closing where the input reaches
+    /// `target`; `xa` is the stack top's input, `ha` its force or, while that is deferred,
+    /// the in-block sample `src` whose output it is (kept in registers).
+    xa: f64,
+    ha: f64,
+    src: u32,
+    inv: f64,
+    target: f64,
+    /// Global index of the block's first sample; reversals at or after it are deferred.
+    start: u64,
+    /// Output of the sample before the block.
+    h_before: f64,
+}
+
+/// `a` if `c` else `b`, by a mask: no branch whatever the compiler thinks of `c`.
+#[inline(always)]
+fn pick(c: bool, a: u64, b: u64) -> u64 {
+    let m = 0_u64.wrapping_sub(u64::from(c));
+    b ^ ((a ^ b) & m)
+}
+
+/// Sign bit of an f64.
+const SIGN: u64 = 1 << 63;
+
+/// Where the branch from the top of a stack of `n >= 1` reversals closes: the reversal below
+/// the top, or for `n == 1` the mirror `-x` of the first reversal. Integer selects only: on
+/// x86-64 a select between two f64 on an integer condition becomes a branch, and this one
+/// is a coin toss on a random walk.
+#[inline(always)]
+fn target_of(stk: &[Reversal], n: usize) -> f64 {
+    let k = pick(n >= 2, n.wrapping_sub(2) as u64, 0) as usize;
+    let neg = pick(n == 1, SIGN, 0);
+    f64::from_bits(stk[k].x.to_bits() ^ neg)
+}
+
+/// `a` or `b` by an integer select: on x86-64 a select between two f64 on a non-float
+/// condition becomes a branch, and these conditions are coin tosses on a random walk.
+#[inline(always)]
+fn pickf(c: bool, a: f64, b: f64) -> f64 {
+    f64::from_bits(pick(c, a.to_bits(), b.to_bits()))
+}
+
+impl Pass {
+    /// Load the current branch from the stack (at a block's start and after closures).
+    #[inline(always)]
+    fn load_branch(&mut self, stk: &[Reversal]) {
+        let n = self.n;
+        if n == 0 {
+            (self.xa, self.ha, self.src, self.inv) = (0.0, 0.0, KNOWN, 1.0);
+            self.target = if self.dir >= 0.0 {
+                f64::INFINITY
+            } else {
+                f64::NEG_INFINITY
+            };
+        } else {
+            let top = stk[n.saturating_sub(1)];
+            // Deferred: found in this block (after its first sample).
+            let src = match top.index.checked_sub(self.start) {
+                Some(k) if k < BLOCK as u64 => k as u32,
+                _ => KNOWN,
+            };
+            (self.xa, self.ha, self.src, self.inv) = (top.x, top.h, src, self.inv_lam);
+            self.target = target_of(stk, n);
+        }
+    }
+
+    /// Run record of the current branch.
+    #[inline(always)]
+    fn record(&self) -> Run {
+        let virgin = self.n == 0;
+        Run {
+            ha: if virgin { 0.0 } else { self.ha },
+            src: self.src,
+            mul: if virgin { 1.0 } else { self.lam },
+        }
+    }
+
+    /// The memory rules for input `xi`, block position `p`: a reversal at the previous sample
+    /// and/or closures. Updates the stack, the branch, `dir` and `xp`; returns whether the
+    /// branch changed.
+    ///
+    /// A reversal is handled without a branch: the candidate (the previous sample) is always
+    /// written above the stack top, the top raised by 0 or 1, and the branch registers
+    /// selected. A closure (a quarter of the samples of a random walk, rare otherwise) is a
+    /// branch that reloads the branch from the stack.
+    #[inline(always)]
+    // `&` on booleans on purpose: no branch per condition.
+    #[allow(clippy::needless_bitwise_bool)]
+    fn rules(&mut self, stk: &mut [Reversal], xi: f64, p: usize) -> bool {
+        let dx = xi - self.xp;
+        let moved = dx != 0.0;
+        let s = 1.0_f64.copysign(dx);
+        let rev = moved & (s != self.dir) & (self.dir != 0.0);
+        // The first move sets the direction of the virgin branch (and where it never closes).
+        let first = moved & (self.dir == 0.0);
+        // The reversal is the previous sample, global index start + p - 1 (the caller sees
+        // to it that there is one when p = 0). Its force is `h_before` for p = 0 and is
+        // deferred to in-block sample p - 1 otherwise (`h` is then a placeholder until the
+        // block ends).
+        stk[self.n] = Reversal {
+            x: self.xp,
+            h: self.h_before,
+            index: self.start.wrapping_add(p as u64).wrapping_sub(1),
+        };
+        self.ha = pickf(rev, self.h_before, self.ha);
+        // After a reversal the branch starts at it and heads for the previous top (off the
+        // virgin curve: for the mirror point of the reversal, set below).
+        let from_virgin = rev & (self.n == 0);
+        self.target = pickf(rev, self.xa, self.target);
+        self.xa = pickf(rev, self.xp, self.xa);
+        // p - 1, and KNOWN (u32::MAX) for p = 0
+        self.src = pick(
+            rev,
+            u64::from((p as u32).wrapping_sub(1)),
+            u64::from(self.src),
+        ) as u32;
+        self.n = self.n.saturating_add(usize::from(rev)); // < stk.len()
+        if from_virgin {
+            self.target = -self.xp;
+            self.inv = self.inv_lam;
+        }
+        if moved {
+            self.dir = s;
+            self.xp = xi;
+        }
+        // Off the virgin curve `target` is finite; on it, ±inf in the direction of travel
+        // (never reached) except right at the first move, which rebuilds the branch anyway.
+        let closes = moved & ((xi - self.target) * s >= 0.0);
+        if closes | first {
+            // Wipe out every loop this step closes (several only after a large jump).
+            while self.n > 0 && (xi - target_of(stk, self.n)) * s >= 0.0 {
+                self.n = self.n.saturating_sub(self.n.min(2));
+            }
+            self.load_branch(stk);
+        }
+        rev | closes | first
+    }
+
+    /// First pass over one block (`xc`, global start `self.start`): curve arguments into `u`,
+    /// the runs into `runs` and each sample's run into `rid`. Returns the number of runs.
+    #[inline(never)]
+    fn block(
+        &mut self,
+        stk: &mut [Reversal],
+        xc: &[f64],
+        u: &mut [f64],
+        rid: &mut [u16],
+        runs: &mut [Run; BLOCK + 2],
+    ) -> usize {
+        // Work on a copy in registers (the struct behind `self` would live in memory).
+        let mut st = *self;
+        st.load_branch(stk); // the top's force may have been resolved since
+        runs[0] = st.record();
+        let mut nr = 1_usize;
+        let samples = xc.iter().zip(u.iter_mut()).zip(rid.iter_mut());
+        for (p, ((&xi, ui), ri)) in samples.enumerate() {
+            let dx = xi - st.xp;
+            // Moving on along the branch without reaching its closure point.
+            if dx * st.dir > 0.0 && (xi - st.target) * st.dir < 0.0 {
+                st.xp = xi;
+            } else if st.rules(stk, xi, p) {
+                runs[nr] = st.record();
+                nr = nr.wrapping_add(1); // <= BLOCK + 1
+            }
+            *ui = (st.xp - st.xa) * st.inv;
+            *ri = nr.wrapping_sub(1) as u16; // nr in 1..=BLOCK + 1
+        }
+        *self = st;
+        nr
+    }
+
+    /// The block's forces are `out`: resolve the deferred reversal forces.
+    #[inline(always)]
+    fn end_block(&mut self, stk: &mut [Reversal], out: &[f64]) {
+        for r in stk[..self.n].iter_mut().rev() {
+            if r.index < self.start {
+                break; // deferred entries are the newest ones
+            }
+            let k = usize::try_from(r.index.wrapping_sub(self.start)).unwrap_or(usize::MAX);
+            if let Some(&h) = out.get(k) {
+                r.h = h;
+            }
+        }
+        if let Some(&h) = out.last() {
+            self.h_before = h;
+        }
+    }
+}
+
+/// Whether [`scaled_force`] can continue from `state`: its reversals precede its sample count
+/// (always so for states this crate produced), and, at count 0, it has not moved yet (a
+/// reversal at the first sample would be sample -1).
+pub(super) fn takes(state: &MasingState) -> bool {
+    (state.count > 0 || state.dir == 0) && state.stack.iter().all(|r| r.index < state.count)
+}
+
+/// Masing forces of `x` under the scaled branch rule `h = h_r + lam f((x - x_r) / lam)` into
+/// `out` (same length), continuing from `state` and updating it. The caller has validated the
+/// input, checked that `state.count + x.len()` fits in 63 bits, and that [`takes`] `state`.
+pub(super) fn scaled_force<C: Backbone>(
+    curve: &C,
+    lam: f64,
+    x: &[f64],
+    out: &mut [f64],
+    state: &mut MasingState,
+) {
+    let stack = &mut state.stack;
+    let mut pass = Pass {
+        n: stack.len(),
+        lam,
+        inv_lam: 1.0 / lam,
+        xp: state.x,
+        dir: f64::from(state.dir),
+        xa: 0.0,
+        ha: 0.0,
+        src: KNOWN,
+        inv: 1.0,
+        target: f64::INFINITY,
+        start: state.count,
+        h_before: state.h,
+    };
+    pass.load_branch(stack);
+    let mut runs = [Run {
+        ha: 0.0,
+        src: KNOWN,
+        mul: 1.0,
+    }; BLOCK + 2];
+    let mut ub = [0.0_f64; BLOCK];
+    let mut rid = [0_u16; BLOCK];
+    for (xc, oc) in x.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
+        let m = xc.len();
+        // Room for one candidate above the top per sample.
+        let need = pass.n.saturating_add(m).saturating_add(1);
+        if stack.len() < need {
+            stack.resize(need, SPARE);
+        }
+        let stk = stack.as_mut_slice();
+        let (u, r) = (&mut ub[..m], &mut rid[..m]);
+        let nr = pass.block(stk, xc, u, r, &mut runs);
+        eval_block(curve, &mut runs[..nr], u, r, oc);
+        pass.end_block(stk, oc);
+        pass.start = pass.start.saturating_add(m as u64);
+    }
+    stack.truncate(pass.n);
+    let (xp, dir, h, end) = (pass.xp, pass.dir, pass.h_before, pass.start);
+    state.x = xp;
+    state.h = h;
+    state.dir = dir as i8;
+    state.count = end;
+}
