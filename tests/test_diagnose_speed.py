@@ -151,3 +151,45 @@ def test_pmap_keeps_order_and_raises_the_first_error(monkeypatch):
         pmap(f, list(range(10)))
     monkeypatch.setenv("CONTACTLAB_DIAGNOSE_THREADS", "0")  # not a count: the cores
     assert workers() >= 1
+
+
+def test_a_binding_budget_stops_where_a_serial_run_stops(monkeypatch):
+    """Candidates on threads spend the evaluation budget as a serial run does: the same
+    candidates tried, the same ones left untested, the same sentence."""
+    from contactlab.diagnose import workflow
+
+    rec = hidden_effect_recording(["force_offset"], magnitude=0.05, seed=2)
+    monkeypatch.setenv("CONTACTLAB_DIAGNOSE_THREADS", "1")
+    full = contactlab.diagnose(rec, model="tangential", max_effects=1)
+    assert not any("candidate search stopped" in w for w in full.where)
+    # a budget that runs out in the middle of the first step's candidates
+    monkeypatch.setattr(workflow, "MAX_EVALUATIONS", 700)
+    serial = contactlab.diagnose(rec, model="tangential", max_effects=1)
+    monkeypatch.setenv("CONTACTLAB_DIAGNOSE_THREADS", "2")
+    threaded = contactlab.diagnose(rec, model="tangential", max_effects=1)
+    reasons = [v.reason for v in serial.steps[0].candidates]
+    untested = [r for r in reasons if r.startswith("not tested")]
+    assert 0 < len(untested) < len(reasons)  # the budget binds part-way
+    assert serial.to_json() == threaded.to_json()
+    assert [v.to_dict() for v in serial.steps[0].candidates] == [
+        v.to_dict() for v in threaded.steps[0].candidates
+    ]
+    assert serial.where == threaded.where
+
+
+def test_evaluation_counter_counts_every_thread():
+    from concurrent.futures import ThreadPoolExecutor
+
+    from contactlab.diagnose._parallel import EvaluationCounter
+
+    c = EvaluationCounter()
+
+    def work(n: int) -> int:
+        start = c.mine()
+        for _ in range(n):
+            c.tick()
+        return c.mine() - start
+
+    with ThreadPoolExecutor(4) as ex:
+        got = list(ex.map(work, [1000] * 16))
+    assert got == [1000] * 16 and c.total == 16_000
