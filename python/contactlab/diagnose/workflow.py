@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import sys
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import partial
@@ -421,9 +422,10 @@ def diagnose(
     >>> report.effect_names
     ['force_offset']
     """
-    from ..structure import IdentifiedModel
-
-    if base is not None or isinstance(model, IdentifiedModel):
+    # an IdentifiedModel can only exist once contactlab.structure is imported: no need to
+    # import it (a fifth of a second) to tell
+    structure = sys.modules.get("contactlab.structure")
+    if base is not None or (structure is not None and isinstance(model, structure.IdentifiedModel)):
         from .structure import diagnose_structure
 
         return diagnose_structure(
