@@ -21,13 +21,14 @@ References, same run, same machine load:
 - ``import``: CPU time of a child importing numpy, scipy.optimize and h5py (the floor of
   any run of the CLI on an HDF5 file).
 
-``--serial`` also runs each recording with ``CONTACTLAB_DIAGNOSE_THREADS=1`` (one thread for
-the candidate fits) to show what the threads give; the load average is printed because on a
-shared machine the wall time is mostly a matter of it.
+``--threads-ab`` also runs each recording with ``CONTACTLAB_DIAGNOSE_THREADS=1`` and ``=2``
+(threads for the candidate fits; the default is one per idle core) to show what threads
+give; the load average is printed because on a shared machine the wall time is mostly a
+matter of it.
 
 Run: ``nice .venv/bin/python benches/bench_diagnose.py [--samples 1e6] [--repeat 3]
-[--format h5|csv] [--profile]``. ``--profile`` runs cProfile on the CLI path of the first
-recording and prints the functions with the largest cumulative and own time.
+[--format h5|csv] [--threads-ab] [--profile]``. ``--profile`` runs cProfile on the CLI path
+of the first recording and prints the functions with the largest cumulative and own time.
 """
 
 from __future__ import annotations
@@ -148,7 +149,9 @@ def main() -> None:
     ap.add_argument("--profile", action="store_true", help="cProfile the CLI on the first one")
     ap.add_argument("--keep", metavar="DIR", help="also copy the JSON reports into DIR")
     ap.add_argument(
-        "--serial", action="store_true", help="also run each with CONTACTLAB_DIAGNOSE_THREADS=1"
+        "--threads-ab",
+        action="store_true",
+        help="also run each with CONTACTLAB_DIAGNOSE_THREADS=1 and =2",
     )
     args = ap.parse_args()
     n = int(args.samples)
@@ -177,9 +180,10 @@ def main() -> None:
             f"{'recording':<10}{'run':<9}{'wall s':>8}{'CPU s':>8}{'RSS MB':>8}"
             f"{'/ Masing':>10}{'/ start':>9}  effects"
         )
-        variants = [("threads", {})]
-        if args.serial:
-            variants.append(("serial", {"CONTACTLAB_DIAGNOSE_THREADS": "1"}))
+        variants: list[tuple[str, dict[str, str]]] = [("default", {})]
+        if args.threads_ab:
+            variants.append(("1 thread", {"CONTACTLAB_DIAGNOSE_THREADS": "1"}))
+            variants.append(("2 thread", {"CONTACTLAB_DIAGNOSE_THREADS": "2"}))
         rows = []
         for kind in kinds:
             out = tmpd / f"{kind}.json"
@@ -190,7 +194,8 @@ def main() -> None:
                 rep = json.loads(out.read_text())
                 if args.keep:
                     Path(args.keep).mkdir(parents=True, exist_ok=True)
-                    (Path(args.keep) / f"{kind}_{label}.json").write_text(out.read_text())
+                    tag = label.replace(" ", "")
+                    (Path(args.keep) / f"{kind}_{tag}.json").write_text(out.read_text())
                 names = [e["name"] for e in rep["effects"]] or ["-"]
                 row = {k: v for k, v in best.items() if k != "stdout"}
                 rows.append({"recording": kind, "run": label, **row})
