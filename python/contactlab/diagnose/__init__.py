@@ -12,12 +12,14 @@ from __future__ import annotations
 
 import sys
 import types
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from .generator import HiddenEffectRecording, hidden_effect_recording
 from .model import ExtendedModel
-from .structure import StructureDiagnosis, diagnose_structure
 from .workflow import DiagnosisReport, Effect, Step, diagnose
+
+if TYPE_CHECKING:
+    from .structure import StructureDiagnosis, diagnose_structure
 
 __all__ = [
     "DiagnosisReport",
@@ -30,6 +32,16 @@ __all__ = [
     "diagnose_structure",
     "hidden_effect_recording",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """The structure diagnosis on first use: it imports contactlab.structure and
+    scipy.signal, half a second that a tangential or normal diagnosis does not need."""
+    if name in ("StructureDiagnosis", "diagnose_structure"):
+        from . import structure
+
+        return getattr(structure, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 class _CallableModule(types.ModuleType):

@@ -14,11 +14,10 @@ import itertools
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.ndimage import uniform_filter1d
-from scipy.signal import savgol_coeffs, savgol_filter
 
 from ..errors import InputError
 from ..reversals import excursions
+from ._filters import savgol_coeffs, savgol_filter, uniform_filter1d
 
 _MAD_TO_SIGMA = 1.0 / 0.6744897501960817
 INPUT_FILTER_FRACTION = 0.04
@@ -186,3 +185,49 @@ def shift(y: np.ndarray, t: np.ndarray, tau: float) -> np.ndarray:
     if tau == 0.0:
         return y
     return np.interp(t - tau, t, y)
+
+
+def modulation_gains(
+    h: np.ndarray, r: np.ndarray, duration: float, f_lo: float, step: float, count: int
+) -> np.ndarray:
+    """How much of ``r`` the pair ``h cos 2πft, h sin 2πft`` explains, for ``count``
+    frequencies ``f = f_lo + j·step`` at once: ``‖A (AᵀA)⁻¹ Aᵀ r‖²`` with ``A`` those two
+    columns — what a least-squares fit of the pair at each frequency would give.
+
+    The samples are taken uniformly spaced over ``duration`` (``t_n = n·duration/(N-1)``).
+    The five sums of the 2×2 normal equations (``Σh²cos²``, ``Σh²sin²``, ``Σh²cos·sin``,
+    ``Σh·r·cos``, ``Σh·r·sin``) come from two zero-padded FFTs, exact at these frequencies
+    when ``step·duration`` is ``1/m`` for an integer ``m`` (the FFT length is ``m (N-1)``);
+    other steps are summed directly. ``O(N log N)`` instead of one least-squares solve of
+    ``N × 2`` per frequency.
+    """
+    n = h.size
+    j = np.arange(count)
+    m = 1.0 / (step * duration) if step * duration > 0 else 0.0
+    ts = np.arange(n) * (duration / (n - 1))
+    if m >= 1.0 and abs(m - round(m)) < 1e-9 * m and round(m) * (n - 1) < 2**26:
+        big = round(m) * (n - 1)
+        # Σ g_n e^{-i2π(f_lo + j·step) t_n} = FFT_L(g_n e^{-i2π f_lo t_n})[j], L = m (N-1)
+        s1 = np.fft.fft(h * r * np.exp(-2j * np.pi * f_lo * ts), big)[j % big]
+        s2 = np.fft.fft(h * h * np.exp(-4j * np.pi * f_lo * ts), big)[(2 * j) % big]
+    else:  # direct sums, a block of frequencies at a time
+        f = f_lo + j * step
+        s1 = np.empty(count, complex)
+        s2 = np.empty(count, complex)
+        for a in range(0, count, 64):
+            ph = np.exp(-2j * np.pi * np.outer(f[a : a + 64], ts))
+            s1[a : a + 64] = ph @ (h * r)
+            s2[a : a + 64] = (ph * ph) @ (h * h)
+    hh = float(h @ h)
+    scc = 0.5 * (hh + s2.real)
+    sss = 0.5 * (hh - s2.real)
+    scs = -0.5 * s2.imag
+    bc, bs = s1.real, -s1.imag
+    det = scc * sss - scs * scs
+    ok = det > 1e-10 * hh * hh
+    # where the two columns are (nearly) parallel (f near 0 or Nyquist), the projection on
+    # their common direction, as a minimum-norm least-squares solve gives
+    g = (bc * bc + bs * bs) / hh if hh > 0 else np.zeros(count)
+    q = sss * bc * bc - 2.0 * scs * bc * bs + scc * bs * bs
+    g[ok] = q[ok] / det[ok]
+    return g

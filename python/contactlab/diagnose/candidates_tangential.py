@@ -40,15 +40,16 @@ measured force.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from scipy.signal import savgol_filter
 
 from ..errors import InputError
 from ..masing import Masing, loop_area
 from ._family import Candidate, ParamSpec, Prepared, implausible_common
-from ._signal import shift
+from ._filters import savgol_filter
+from ._signal import modulation_gains, shift
 from .scaled_masing import memory, scaled_force
 
 _INF = np.inf
@@ -176,20 +177,39 @@ def series_backbone(h0: float, ac: float, C_s: float, x_max: float) -> tuple[np.
     return u + C_s * f, f
 
 
+def reversal_anchors(reversals: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """For each of ``n`` samples: whether a reversal precedes it (or is it), and the index of
+    the last such reversal (0 where none)."""
+    idx = np.searchsorted(reversals, np.arange(n), side="right") - 1
+    has = idx >= 0
+    r = reversals[np.where(has, idx, 0)] if reversals.size else np.zeros(n, int)
+    return has, r
+
+
 def breakaway(
-    h: np.ndarray, x: np.ndarray, reversals: np.ndarray, s_b: float, ell: float
+    h: np.ndarray,
+    x: np.ndarray,
+    reversals: np.ndarray,
+    s_b: float,
+    ell: float,
+    anchors: tuple[np.ndarray, np.ndarray] | None = None,
+    at: np.ndarray | None = None,
 ) -> np.ndarray:
     """Branches with a breakaway peak: after each reversal ``r`` the rise ``h - h_r`` is
     scaled by ``1 + s_b exp(-|x - x_r| / ell)`` — equal to Masing's at the reversal (no
     jump) and far from it, above it in between (static friction above kinetic). Before the
-    first reversal the virgin curve from the origin is treated the same way."""
+    first reversal the virgin curve from the origin is treated the same way. ``anchors``:
+    :func:`reversal_anchors` of ``reversals``, when computed already; ``at``: sample indices,
+    the result at those samples only."""
     if s_b == 0.0:
-        return h
-    idx = np.searchsorted(reversals, np.arange(h.size), side="right") - 1
-    has = idx >= 0
-    r = reversals[np.where(has, idx, 0)] if reversals.size else np.zeros(h.size, int)
+        return h if at is None else h[at]
+    has, r = anchors if anchors is not None else reversal_anchors(reversals, h.size)
+    if at is not None:  # the anchors (reversals) from the whole history, the rest at ``at``
+        has, r = has[at], r[at]
     xr = np.where(has, x[r], 0.0)
     hr = np.where(has, h[r], 0.0)
+    if at is not None:
+        h, x = h[at], x[at]
     return hr + (h - hr) * (1.0 + s_b * np.exp(-np.abs(x - xr) / max(ell, 1e-300)))
 
 
@@ -220,6 +240,46 @@ def _grid(x: np.ndarray, F: np.ndarray) -> tuple[float, float, float]:
 
 #: ac·A from which the base loop is near-rectangular (gross sliding, as regime() says)
 GROSS_SLIDING_ZA = 10.0
+
+
+def _fixed(d: Prepared, key: str, make: Callable[[], Any]) -> Any:
+    """An array of the model evaluation that depends on the recording only (not on the
+    fitted parameters): computed on the first evaluation, then reused by every fit on ``d``
+    (the fits evaluate the model thousands of times)."""
+    cache = d.extra.setdefault("fixed", {})
+    k = (key, d.t.size)
+    if k not in cache:
+        cache[k] = make()
+    return cache[k]
+
+
+#: unit Masing forces kept per recording (one per ac, x0 tried); 64 of 24 000 samples: 12 MB
+_MASING_KEEP = 64
+
+
+def _masing_force(d: Prepared, h0: float, ac: float, x0: float | None, x: np.ndarray) -> np.ndarray:
+    """``Masing(h0, ac).force(x)`` as ``h0`` times the force of the unit element (h0 = 1),
+    which is kept per ``(ac, x0)``: along a given history the exponential Masing force is
+    linear in h0 (to rounding, 1e-15 h0), and the fits step h0 and the effects' parameters
+    at a fixed ac thousands of times (their Jacobian columns)."""
+    if not (np.isfinite(h0) and h0 > 0):
+        return Masing(h0, ac).force(x)  # the model's own refusal
+    cache = d.extra.setdefault("masing", {})
+    key = (ac, x0, x.size)
+    g = cache.get(key)
+    if g is None:
+        g = Masing(1.0, ac).force(x)
+        g.flags.writeable = False
+        if len(cache) >= _MASING_KEEP:
+            cache.clear()
+        cache[key] = g
+    return h0 * g
+
+
+def _track_harmonics(x: np.ndarray, d: Prepared) -> tuple[np.ndarray, ...]:
+    """``cos ξ, sin ξ, cos 2ξ, sin 2ξ`` of ``position_friction``, ``ξ = π (x - x_mid)/x_half``."""
+    xi = np.pi * (x - d.extra["x_mid"]) / d.extra["x_half"]
+    return np.cos(xi), np.sin(xi), np.cos(2 * xi), np.sin(2 * xi)
 
 
 class TangentialFamily:
@@ -261,21 +321,19 @@ class TangentialFamily:
         if name != "normal_load":
             return {}
         h = self.predict(p, (), d)
-        tt = d.t - d.t[0]
         f_exc = 1.0 / (d.cycles.period_samples * d.dt)
         f_lo = max(0.05 * f_exc, MIN_LOAD_PERIODS / d.duration)
-        freqs = np.arange(f_lo, 3.0 * f_exc, 0.25 / d.duration)
+        step = 0.25 / d.duration
+        freqs = np.arange(f_lo, 3.0 * f_exc, step)
         # a fluctuation locked to the drive is position_friction's: skip the harmonics
         k = np.round(freqs / f_exc)
         freqs = freqs[(k < 1) | (np.abs(freqs - k * f_exc) >= 1.0 / d.duration)]
-        best, fbest = -1.0, f_exc
-        for f in freqs:
-            A = np.column_stack((h * np.cos(2 * np.pi * f * tt), h * np.sin(2 * np.pi * f * tt)))
-            coef = np.linalg.lstsq(A, residual, rcond=None)[0]
-            gain = float(np.sum((A @ coef) ** 2))
-            if gain > best:
-                best, fbest = gain, float(f)
-        return {"f_n": fbest}
+        if not freqs.size:
+            return {"f_n": f_exc}
+        # the least-squares gain of the pair (h cos, h sin) at every frequency, by FFT
+        j = np.rint((freqs - f_lo) / step).astype(int)
+        gains = modulation_gains(h, residual, d.duration, f_lo, step, int(j[-1]) + 1)[j]
+        return {"f_n": float(freqs[int(np.argmax(gains))])}
 
     def check(self, effects: tuple[str, ...]) -> bool:
         """All tangential effects combine (in the order of the module docstring)."""
@@ -320,8 +378,19 @@ class TangentialFamily:
             )
         return {"h0": h0, "ac": ac}
 
-    def predict(self, p: dict[str, float], effects: tuple[str, ...], d: Prepared) -> np.ndarray:
-        """Measured force predicted for the measured displacement ``d.u``."""
+    #: :meth:`predict` takes ``at`` (the fits evaluate the model at their samples only)
+    predicts_at = True
+
+    def predict(
+        self,
+        p: dict[str, float],
+        effects: tuple[str, ...],
+        d: Prepared,
+        at: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """Measured force predicted for the measured displacement ``d.u`` (at the sample
+        indices ``at`` only, when given: the Masing element still runs over the whole
+        history, the terms sample by sample only where asked — the same values)."""
         x = d.u
         if "displacement_offset" in effects:
             x = x - p["x0"]
@@ -329,7 +398,7 @@ class TangentialFamily:
             xmax = float(np.max(np.abs(x))) or 1.0
             bx, bf = series_backbone(p["h0"], p["ac"], max(p["C_s"], 0.0), xmax)
             core = Masing.from_backbone(bx, bf)
-        else:
+        elif "non_masing_scaling" in effects:
             core = Masing(p["h0"], p["ac"])
         if "non_masing_scaling" in effects:
             # the reversal bookkeeping depends on x (through x0 too: the start at the origin
@@ -339,42 +408,55 @@ class TangentialFamily:
             if mem is None or not np.array_equal(mem.x, x):
                 mem = d.extra["memory"] = memory(x)
             h = scaled_force(core.virgin, p["lam"], mem)
-        else:
+        elif "series_compliance" in effects:
             h = core.force(x)
+        else:
+            h = _masing_force(d, p["h0"], p["ac"], p["x0"] if x is not d.u else None, x)
         if "asymmetry" in effects:
             h = h + p["alpha"] * np.abs(h)
         if "parameter_drift" in effects:
-            h = h * (1.0 + p["beta"] * (d.t - d.t[0]) / d.duration)
+            h = h * (1.0 + p["beta"] * _fixed(d, "t_rel", lambda: d.t - d.t[0]) / d.duration)
+        # from here on sample by sample (but the delay, which interpolates between samples):
+        # with ``at``, only at the samples asked for
+        sub = at is not None and "channel_delay" not in effects
+        pick: Callable[[np.ndarray], np.ndarray] = (lambda a: a[at]) if sub else (lambda a: a)
+        xs = pick(x)
         if "stick_slip" in effects:
-            h = breakaway(h, x, d.cycles.reversals, p["s_b"], p["ell"])
+            rev = d.cycles.reversals
+            anchors = _fixed(d, "anchors", lambda: reversal_anchors(rev, x.size))
+            h = breakaway(h, x, rev, p["s_b"], p["ell"], anchors, at if sub else None)
+        else:
+            h = pick(h)
         if "stribeck" in effects:
-            h = h * (1.0 + p["s"] * np.exp(-np.abs(d.ud) / max(p["v_s"], 1e-300)))
+            speed = pick(_fixed(d, "speed", lambda: np.abs(d.ud)))
+            h = h * (1.0 + p["s"] * np.exp(-speed / max(p["v_s"], 1e-300)))
         if "position_friction" in effects:
-            xi = np.pi * (x - d.extra["x_mid"]) / d.extra["x_half"]
-            h = h * (
-                1.0
-                + p["a1"] * np.cos(xi)
-                + p["b1"] * np.sin(xi)
-                + p["a2"] * np.cos(2 * xi)
-                + p["b2"] * np.sin(2 * xi)
+            # the harmonics along the track are fixed unless x itself moves (x0)
+            c1, s1, c2, s2 = (
+                _track_harmonics(xs, d)
+                if "displacement_offset" in effects
+                else map(pick, _fixed(d, "track", lambda: _track_harmonics(x, d)))
             )
+            h = h * (1.0 + p["a1"] * c1 + p["b1"] * s1 + p["a2"] * c2 + p["b2"] * s2)
         if "normal_load" in effects:
-            ph = 2.0 * np.pi * p["f_n"] * (d.t - d.t[0])
+            ph = 2.0 * np.pi * p["f_n"] * pick(_fixed(d, "t_rel", lambda: d.t - d.t[0]))
             h = h * (1.0 + p["eps_c"] * np.cos(ph) + p["eps_s"] * np.sin(ph))
         F = h
         if "parallel_stiffness" in effects:
-            F = F + p["k_p"] * x
+            F = F + p["k_p"] * xs
         if "viscous_damping" in effects:
-            F = F + p["c"] * d.ud
+            F = F + p["c"] * pick(d.ud)
         if "inertia" in effects:
-            F = F + p["m"] * d.udd
+            F = F + p["m"] * pick(d.udd)
         if "force_offset" in effects:
             F = F + p["F0"]
         if "force_drift" in effects:
-            F = F + p["F1"] * (d.t - d.t[0]) / d.duration
+            F = F + p["F1"] * pick(_fixed(d, "t_rel", lambda: d.t - d.t[0])) / d.duration
         if "channel_delay" in effects:
             F = shift(F, d.t, p["tau"])
-        return F
+            if at is not None:
+                F = F[at]
+        return F if F.flags.writeable else F.copy()
 
     def derived(
         self, p: dict[str, float], se: dict[str, float], effect: str

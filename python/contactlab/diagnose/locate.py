@@ -13,10 +13,9 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from scipy.ndimage import uniform_filter1d
-from scipy.signal import hilbert
 
 from ._family import Prepared
+from ._filters import hilbert, uniform_filter1d
 
 N_HARMONICS = 7
 

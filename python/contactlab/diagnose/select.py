@@ -38,6 +38,7 @@ import numpy as np
 from ..errors import InputError
 from ..fitting import Parameter, least_squares_fit
 from ._family import Family, ParamSpec, Prepared
+from ._parallel import pmap
 
 
 @dataclass
@@ -128,25 +129,36 @@ def fit(
     stride = -(-n_all // FIT_SAMPLES)
     if stride > 1:
         mask = mask & (np.arange(mask.size) % stride == 0)
-    y = d.y[mask]
+    idx = np.flatnonzero(mask)  # the samples the fit sees (a gather is cheaper than a mask)
+    y = d.y[idx]
     # residuals in units of the output's RMS: the solver's gradient tolerance is absolute,
     # and a displacement residual in metres (1e-9) would stop it at the first step
     ys = float(np.sqrt(np.mean(y * y))) or 1.0
-    sw = np.sqrt(sample_weight(d)[mask]) / ys  # errors in variables (see sample_weight)
+    sw = np.sqrt(sample_weight(d)[idx]) / ys  # errors in variables (see sample_weight)
 
     lo = {s.name: s.lower for s in specs}
     hi = {s.name: s.upper for s in specs}
 
     def value(w: dict[str, float]) -> dict[str, float]:
         # clipped: the affine map back can step a rounding error past a bound (h0 = -3e-17)
-        return {n: float(np.clip(x0[n] + (w[n] - 1.0) * sc[n], lo[n], hi[n])) for n in names}
+        # (min/max of floats: np.clip's per-call overhead is felt over thousands of calls)
+        return {n: min(max(float(x0[n] + (w[n] - 1.0) * sc[n]), lo[n]), hi[n]) for n in names}
 
-    spent = d.extra.get("evaluations")  # the workflow's budget counter (a one-item list)
+    spent = d.extra.get("evaluations")  # the workflow's budget counter (EvaluationCounter)
 
-    def resid(w: dict[str, float]) -> np.ndarray:
-        if spent is not None:
-            spent[0] += 1
-        return (family.predict(value(w), effects, d)[mask] - y) * sw
+    if getattr(family, "predicts_at", False):  # the model at the fit's samples only
+
+        def resid(w: dict[str, float]) -> np.ndarray:
+            if spent is not None:
+                spent.tick()
+            return (family.predict(value(w), effects, d, at=idx) - y) * sw  # type: ignore[call-arg]
+
+    else:
+
+        def resid(w: dict[str, float]) -> np.ndarray:
+            if spent is not None:
+                spent.tick()
+            return (family.predict(value(w), effects, d)[idx] - y) * sw
 
     res = least_squares_fit(resid, params, ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=400)
     w = {n: res.params[n].value for n in names}
@@ -204,6 +216,20 @@ def fold_masks(d: Prepared, folds: int) -> list[np.ndarray]:
     return [(cyc >= 0) & (cyc % folds == k) for k in range(folds)]
 
 
+def _cycle_samples(cyc: np.ndarray, ids: np.ndarray) -> list[slice] | list[np.ndarray]:
+    """The samples of each cycle in ``ids``: slices when every cycle is one run of samples
+    (as :func:`contactlab.diagnose._signal.find_cycles` numbers them), else masks."""
+    runs = np.flatnonzero(np.diff(cyc)) + 1
+    starts = np.r_[0, runs]
+    ends = np.r_[runs, cyc.size]
+    label = cyc[starts]
+    own = label[np.isin(label, ids)]
+    if np.unique(own).size != own.size or own.size != ids.size:  # a cycle in pieces
+        return [cyc == k for k in ids]
+    where = dict(zip(label.tolist(), zip(starts.tolist(), ends.tolist(), strict=True), strict=True))
+    return [slice(*where[k]) for k in ids.tolist()]
+
+
 def evaluate(
     family: Family,
     effects: tuple[str, ...],
@@ -212,29 +238,34 @@ def evaluate(
     scales: dict[str, float],
     folds: int = 2,
     full: FitOut | None = None,
+    parallel: bool = False,
 ) -> Trial:
     """Cross-validated held-out errors and the fit to all data of one model (``full``, when
-    that fit is at hand already)."""
+    that fit is at hand already). With ``parallel`` the fold fits run on threads
+    (:func:`contactlab.diagnose._parallel.pmap`; the same results)."""
     masks = fold_masks(d, folds)
     if full is None:
         full = fit(family, effects, d, np.ones(d.y.size, bool), start, scales)
     fitted = family.predict(full.params, effects, d)
     pred = fitted.copy()
     heldout = np.zeros(d.y.size, bool)
-    for test in masks:
+
+    def fold_prediction(test: np.ndarray) -> np.ndarray:
         f = fit(family, effects, d, ~test, full.params, scales)
-        pred[test] = family.predict(f.params, effects, d)[test]
+        return family.predict(f.params, effects, d)
+
+    held = pmap(fold_prediction, masks) if parallel else [fold_prediction(m) for m in masks]
+    for test, p in zip(masks, held, strict=True):
+        pred[test] = p[test]
         heldout |= test
     err = pred - d.y
     wt = sample_weight(d)
     cyc = d.cycles.cycle
     ids = np.unique(cyc[heldout])
-    cycle_mse = np.array(
-        [np.sum(wt[sel] * err[sel] ** 2) / np.sum(wt[sel]) for sel in (cyc == k for k in ids)]
-    )
+    sels = _cycle_samples(cyc, ids)
+    cycle_mse = np.array([np.sum(wt[sel] * err[sel] ** 2) / np.sum(wt[sel]) for sel in sels])
     e_meas, e_mod = [], []
-    for k in ids:
-        sel = cyc == k
+    for sel in sels:
         e_meas.append(family.loop_energy(d.u[sel], d.y[sel]))
         e_mod.append(family.loop_energy(d.u[sel], pred[sel]))
     e_meas_a, e_mod_a = np.array(e_meas), np.array(e_mod)

@@ -13,21 +13,24 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import sys
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any
 
 import numpy as np
-from scipy.signal import decimate, savgol_coeffs
 
 from ..errors import ConvergenceError, InputError
 from ._family import Family, Prepared
+from ._filters import decimate, savgol_coeffs
 from ._inputs import arrays as _arrays
 from ._inputs import check_channels
+from ._parallel import EvaluationCounter, one_blas_thread, pmap
 from ._signal import check_uniform, dominant_period_samples, noise_rms
 from .locate import locate
 from .model import ExtendedModel
-from .select import Trial, Verdict, evaluate, fit, judge
+from .select import Trial, Verdict, evaluate, fit, fold_masks, judge
 
 __all__ = ["DiagnosisReport", "Effect", "Step", "diagnose"]
 
@@ -326,6 +329,58 @@ def eiv_weight(
     return w, float(np.mean(var * w)) / sigma**2
 
 
+def _try_candidate(
+    name: str,
+    family: Family,
+    current: Trial,
+    effects: tuple[str, ...],
+    d: Prepared,
+    scales: dict[str, float],
+    folds: int,
+    sigma: float,
+    z: float,
+    min_gain: float,
+    budget: float,
+    base_fit: dict[str, float],
+    all_samples: np.ndarray,
+) -> tuple[Verdict, Trial | None]:
+    """The verdict on adding ``name`` to the current model (and its trial when it was
+    cross-validated)."""
+    trial_effects = (*effects, name)
+    start_c = dict(current.full.params)
+    if hasattr(family, "start_effect"):
+        start_c.update(family.start_effect(name, start_c, d, -current.full_residual(d)))
+    # screening: a candidate whose fit to all data lowers the error by less than
+    # min_gain σ² cannot do better on held-out cycles; no cross-validation for it
+    try:
+        full = fit(family, trial_effects, d, all_samples, start_c, scales)
+    except ConvergenceError as exc:  # e.g. a trial stiffness with no equilibrium
+        return _not_fitted(name, exc), None
+    in_gain = (current.full.mse - full.mse) / sigma**2
+    if in_gain < min_gain:
+        reason = f"in-sample gain {in_gain:.3g} σ² below {min_gain:g} σ²"
+        return Verdict(name, np.nan, float(in_gain), np.nan, np.nan, False, reason), None
+    try:
+        cand = evaluate(family, trial_effects, d, start_c, scales, folds, full)
+    except ConvergenceError as exc:
+        return _not_fitted(name, exc), None
+    p = cand.full.params
+    extra = 0.0
+    if name == "channel_delay" and abs(p["tau"]) < d.dt:
+        extra = budget  # a sub-sample shift must beat what smoothing the input buys
+    prop = d if getattr(family, "proportional_gain", False) else None
+    v = judge(name, current, cand, sigma, z, min_gain + extra, prop)
+    # every effect of the candidate model, not only the new one: a refit can push an
+    # effect added before to the edge of its physical range
+    why = next(
+        (w for e in trial_effects if (w := family.implausible(e, p, d))), None
+    ) or _takes_over(family, base_fit, p)
+    if v.accepted and why:
+        v = dataclasses.replace(v, accepted=False, reason=f"implausible: {why}")
+    return v, cand
+
+
+@one_blas_thread
 def diagnose(
     recording: Any,
     model: Any = "tangential",
@@ -379,9 +434,10 @@ def diagnose(
     >>> report.effect_names
     ['force_offset']
     """
-    from ..structure import IdentifiedModel
-
-    if base is not None or isinstance(model, IdentifiedModel):
+    # an IdentifiedModel can only exist once contactlab.structure is imported: no need to
+    # import it (a fifth of a second) to tell
+    structure = sys.modules.get("contactlab.structure")
+    if base is not None or (structure is not None and isinstance(model, structure.IdentifiedModel)):
         from .structure import diagnose_structure
 
         return diagnose_structure(
@@ -409,22 +465,27 @@ def diagnose(
     t, u, y, reduced = reduce_long(t, u, y)
     d = Prepared.build(t, u, y)
     d.extra.update(context)
-    d.extra["evaluations"] = spent = [0]  # counted by select.fit
+    d.extra["evaluations"] = spent = EvaluationCounter()  # counted by select.fit
     family.prepare(d)
     scales = family.scales(d)
     effects: tuple[str, ...] = tuple(model.effects) if isinstance(model, ExtendedModel) else ()
     if not start:
         start = family.initial_base(d)
-    current = evaluate(family, effects, d, start, scales, folds)
-    sigma = noise_rms(current.full_residual(d))
+    fold_masks(d, folds)  # too few cycles to hold any out: said before fitting
+    # the base fitted to all data gives the noise level and the weights; its cross-validation
+    # is run once, with the weights it ends up with
+    base_all = fit(family, effects, d, np.ones(d.y.size, bool), start, scales)
+    sigma = noise_rms(family.predict(base_all.params, effects, d) - d.y)
     if sigma <= 0:
         raise InputError("the output channel has no noise at all; cannot judge significance")
     budget = 0.0
-    w = eiv_weight(family, current.full.params, d, sigma)
+    w = eiv_weight(family, base_all.params, d, sigma)
     if w is not None:  # errors in variables: refit the base with the likelihood's weights
         d.extra["weight"], budget = w
-        current = evaluate(family, effects, d, current.full.params, scales, folds)
+        current = evaluate(family, effects, d, base_all.params, scales, folds, parallel=True)
         sigma = noise_rms(current.full_residual(d))
+    else:
+        current = evaluate(family, effects, d, start, scales, folds, base_all, parallel=True)
     where, location = locate(d, current.full_residual(d), family)
     where.insert(0, family.regime(current.full.params, d))
     if reduced:
@@ -445,61 +506,50 @@ def diagnose(
     base_fit = dict(current.full.params)
     all_samples = np.ones(d.y.size, bool)
     untested: list[str] = []
+    used = spent.total  # by the base; then as a serial run would count (below)
     while len(added) < max_effects:
+        tried = [n for n in names if n not in effects and family.check((*effects, n))]
+        # the candidates of one step are independent fits: on threads (the model evaluations
+        # release the GIL), each verdict in the library's order as a serial run gives it
+        try_one = partial(
+            _try_candidate,
+            family=family,
+            current=current,
+            effects=effects,
+            d=d,
+            scales=scales,
+            folds=folds,
+            sigma=sigma,
+            z=z,
+            min_gain=min_gain,
+            budget=budget,
+            base_fit=base_fit,
+            all_samples=all_samples,
+        )
+
+        def counted(name: str, try_one: Any = try_one) -> tuple[Verdict, Trial | None, int]:
+            before = spent.mine()  # a task runs on one thread: these are its evaluations
+            v, cand = try_one(name)
+            return v, cand, spent.mine() - before
+
+        def unless_spent(name: str) -> tuple[Verdict, Trial | None, int] | None:
+            return None if spent.total >= MAX_EVALUATIONS else counted(name)
+
+        # the budget as a serial run spends it: a candidate is tried only while the base and
+        # the candidates before it in the library's order are within it. On threads the
+        # candidates start early; one that finds the budget spent by the others does not
+        # start, and is run here after all if the serial count says it would have been.
         verdicts, best = [], None
-        for name in names:
-            if name in effects or not family.check((*effects, name)):
-                continue
-            if spent[0] >= MAX_EVALUATIONS:
+        for name, out in zip(tried, pmap(unless_spent, tried), strict=True):
+            if used >= MAX_EVALUATIONS:
                 untested.append(name)
                 why = f"not tested: the budget of {MAX_EVALUATIONS} model evaluations is spent"
                 verdicts.append(Verdict(name, np.nan, np.nan, np.nan, np.nan, False, why))
                 continue
-            trial_effects = (*effects, name)
-            start_c = dict(current.full.params)
-            if hasattr(family, "start_effect"):
-                start_c.update(family.start_effect(name, start_c, d, -current.full_residual(d)))
-            # screening: a candidate whose fit to all data lowers the error by less than
-            # min_gain σ² cannot do better on held-out cycles; no cross-validation for it
-            try:
-                full = fit(family, trial_effects, d, all_samples, start_c, scales)
-            except ConvergenceError as exc:  # e.g. a trial stiffness with no equilibrium
-                verdicts.append(_not_fitted(name, exc))
-                continue
-            in_gain = (current.full.mse - full.mse) / sigma**2
-            if in_gain < min_gain:
-                verdicts.append(
-                    Verdict(
-                        name,
-                        np.nan,
-                        float(in_gain),
-                        np.nan,
-                        np.nan,
-                        False,
-                        f"in-sample gain {in_gain:.3g} σ² below {min_gain:g} σ²",
-                    )
-                )
-                continue
-            try:
-                cand = evaluate(family, trial_effects, d, start_c, scales, folds, full)
-            except ConvergenceError as exc:
-                verdicts.append(_not_fitted(name, exc))
-                continue
-            p = cand.full.params
-            extra = 0.0
-            if name == "channel_delay" and abs(p["tau"]) < d.dt:
-                extra = budget  # a sub-sample shift must beat what smoothing the input buys
-            prop = d if getattr(family, "proportional_gain", False) else None
-            v = judge(name, current, cand, sigma, z, min_gain + extra, prop)
-            # every effect of the candidate model, not only the new one: a refit can push an
-            # effect added before to the edge of its physical range
-            why = next(
-                (w for e in trial_effects if (w := family.implausible(e, p, d))), None
-            ) or _takes_over(family, base_fit, p)
-            if v.accepted and why:
-                v = dataclasses.replace(v, accepted=False, reason=f"implausible: {why}")
+            v, cand, n = out if out is not None else counted(name)
+            used += n
             verdicts.append(v)
-            if v.accepted and (best is None or v.gain > best[0].gain):
+            if cand is not None and v.accepted and (best is None or v.gain > best[0].gain):
                 best = (v, cand)
         steps[-1] = Step(
             steps[-1].added,
@@ -517,7 +567,7 @@ def diagnose(
         steps.append(Step(v.name, current.heldout_rms, current.heldout_peak, current.energy_error))
     if untested:
         where.append(
-            f"the candidate search stopped after {spent[0]} model evaluations (its budget "
+            f"the candidate search stopped after {used} model evaluations (its budget "
             f"is {MAX_EVALUATIONS}); not tested: {', '.join(dict.fromkeys(untested))}"
         )
     p, se = current.full.params, current.full.stderr

@@ -1,0 +1,118 @@
+"""How a diagnosis uses the cores: candidate fits on threads, BLAS on one thread each.
+
+The fits of a diagnosis are many small least-squares problems (a few thousand residuals, a
+handful of parameters). Their time goes to the model evaluations — the Masing kernel in
+Rust and numpy array arithmetic, both of which release the GIL — so independent fits (the
+candidates of one step, the folds of one model) run on a thread pool. The BLAS calls of the
+solver (an SVD of a 5000 × 3 Jacobian) are far too small to gain from BLAS's own threads; on
+a loaded machine those threads spin waiting for each other (measured: the same SVDs and dot
+products 20× slower in wall time and CPU with OpenBLAS's default of one thread per core
+than with one). :func:`one_blas_thread` limits BLAS to one thread for the duration of a
+diagnosis when ``threadpoolctl`` is installed (a dependency of the package), and is a no-op
+otherwise; results do not depend on it.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+import threading
+from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from contextlib import AbstractContextManager, nullcontext
+from typing import Any, TypeVar
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+#: most threads a diagnosis uses for its fits (the fits of one step are a dozen or so)
+MAX_WORKERS = 8
+
+
+def workers() -> int:
+    """Threads for independent fits: one per core this process may run on that is not busy
+    already (the 1-minute load average), at least 1 and at most :data:`MAX_WORKERS`;
+    ``CONTACTLAB_DIAGNOSE_THREADS=n`` sets it. On a machine whose cores are all taken, a
+    second thread only adds GIL hand-overs (measured on 2 cores at a load of 6-10: the same
+    or up to 30 % more wall time than one thread), so there a diagnosis runs serially."""
+    env = os.environ.get("CONTACTLAB_DIAGNOSE_THREADS", "").strip()
+    if env.isdigit() and int(env) >= 1:
+        return min(int(env), MAX_WORKERS)
+    try:
+        n = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):  # not Linux
+        n = os.cpu_count() or 1
+    try:
+        idle = n - os.getloadavg()[0]
+    except (AttributeError, OSError):  # no load average on this system
+        idle = n
+    return max(1, min(n, int(idle) + 1, MAX_WORKERS))
+
+
+def _blas_limit() -> AbstractContextManager[Any]:
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:  # optional at run time: only the speed depends on it
+        return nullcontext()
+    return threadpool_limits(limits=1, user_api="blas")
+
+
+def one_blas_thread(fn: F) -> F:
+    """Run ``fn`` with BLAS limited to one thread (restored afterwards)."""
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        with _blas_limit():
+            return fn(*args, **kwargs)
+
+    return wrapper  # type: ignore[return-value]
+
+
+T = TypeVar("T")
+R = TypeVar("R")
+
+
+def pmap(fn: Callable[[T], R], items: Sequence[T]) -> list[R]:
+    """``[fn(i) for i in items]``, on up to :func:`workers` threads; results in order.
+
+    An exception in any call is raised here (the first in ``items``' order), as a serial
+    loop would raise it; the calls not started yet are dropped (Ctrl-C does not wait for
+    them).
+    """
+    n = min(workers(), len(items))
+    if n <= 1:
+        return [fn(i) for i in items]
+    ex = ThreadPoolExecutor(n, thread_name_prefix="contactlab-diagnose")
+    try:
+        return list(ex.map(fn, items))
+    finally:
+        ex.shutdown(wait=True, cancel_futures=True)
+
+
+class EvaluationCounter:
+    """Model evaluations a diagnosis has spent (its budget), counted per thread so that fits
+    on several threads neither lose counts nor mix them: :meth:`tick` from any thread,
+    :meth:`mine` the calling thread's count so far, :attr:`total` everyone's."""
+
+    def __init__(self) -> None:
+        self._local = threading.local()
+        self._counts: list[list[int]] = []
+        self._lock = threading.Lock()
+
+    def _slot(self) -> list[int]:
+        c = getattr(self._local, "count", None)
+        if c is None:
+            c = self._local.count = [0]
+            with self._lock:
+                self._counts.append(c)
+        return c
+
+    def tick(self) -> None:
+        self._slot()[0] += 1
+
+    def mine(self) -> int:
+        return self._slot()[0]
+
+    @property
+    def total(self) -> int:
+        with self._lock:
+            return sum(c[0] for c in self._counts)

@@ -1,0 +1,195 @@
+"""The fast paths of a diagnosis give what the slow ones gave (issue 9): numpy filters against
+scipy.signal / scipy.ndimage, the FFT frequency scan against one least-squares solve per
+frequency, threaded candidate fits against a serial run, the reused Masing force against a
+fresh one. Timings live in benches/bench_diagnose.py."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy import ndimage, signal
+
+import contactlab
+from contactlab.diagnose import _filters, hidden_effect_recording
+from contactlab.diagnose._signal import modulation_gains
+
+
+def _walk(seed: int, n: int) -> np.ndarray:
+    return np.cumsum(np.random.default_rng(seed).normal(size=n)) + 3.0
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    n=st.integers(16, 3000),
+    half=st.integers(2, 12),
+    order=st.integers(1, 4),
+    deriv=st.integers(0, 3),
+    delta=st.floats(1e-4, 10.0),
+)
+def test_savgol_matches_scipy(seed, n, half, order, deriv, delta):
+    w = 2 * half + 1
+    if w > n or order >= w:
+        return
+    x = _walk(seed, n)
+    a = signal.savgol_filter(x, w, order, deriv=deriv, delta=delta, mode="interp")
+    b = _filters.savgol_filter(x, w, order, deriv=deriv, delta=delta, mode="interp")
+    scale = max(float(np.max(np.abs(a))), 1e-300)
+    assert np.max(np.abs(a - b)) <= 1e-11 * scale
+    ca = signal.savgol_coeffs(w, order, deriv=deriv, delta=delta)
+    cb = _filters.savgol_coeffs(w, order, deriv=deriv, delta=delta)
+    assert np.allclose(ca, cb, rtol=1e-11, atol=1e-12 * max(np.max(np.abs(ca)), 1e-300))
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(16, 5000), q=st.integers(2, 45))
+def test_decimate_matches_scipy(seed, n, q):
+    x = _walk(seed, n)
+    a = signal.decimate(x, q, ftype="fir", zero_phase=True)
+    b = _filters.decimate(x, q, ftype="fir", zero_phase=True)
+    assert a.shape == b.shape
+    assert np.max(np.abs(a - b)) <= 1e-12 * np.max(np.abs(a))
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(2, 4000), size=st.integers(1, 600))
+def test_hilbert_and_moving_mean_match_scipy(seed, n, size):
+    x = _walk(seed, n)
+    assert np.allclose(_filters.hilbert(x), signal.hilbert(x), rtol=0, atol=1e-12 * np.ptp(x))
+    a = ndimage.uniform_filter1d(x, size, mode="nearest")
+    b = _filters.uniform_filter1d(x, size, mode="nearest")
+    assert np.max(np.abs(a - b)) <= 1e-10 * (np.ptp(x) + 1e-300)
+
+
+def test_filters_refuse_what_they_do_not_implement():
+    x = _walk(0, 100)
+    with pytest.raises(ValueError, match="interp"):
+        _filters.savgol_filter(x, 7, 3, mode="mirror")
+    with pytest.raises(ValueError, match="odd"):
+        _filters.savgol_coeffs(6, 3)
+    with pytest.raises(ValueError, match="zero-phase FIR"):
+        _filters.decimate(x, 3, ftype="iir")
+
+
+@pytest.mark.parametrize("step_factor", [1.0, 1.0001])  # FFT route, and direct sums
+def test_modulation_gains_match_least_squares(step_factor):
+    rng = np.random.default_rng(11)
+    n, dur = 3001, 12.0
+    t = np.linspace(0.0, dur, n)
+    h = 5.0 * np.sin(2 * np.pi * 1.3 * t) + rng.normal(size=n)
+    r = 0.3 * h * np.cos(2 * np.pi * 0.77 * t + 0.4) + rng.normal(size=n)
+    f_lo, step = 2.0 / dur, step_factor * 0.25 / dur
+    count = 200
+    g = modulation_gains(h, r, dur, f_lo, step, count)
+    ref = []
+    for f in f_lo + np.arange(count) * step:
+        A = np.column_stack((h * np.cos(2 * np.pi * f * t), h * np.sin(2 * np.pi * f * t)))
+        coef = np.linalg.lstsq(A, r, rcond=None)[0]
+        ref.append(float(np.sum((A @ coef) ** 2)))
+    assert np.max(np.abs(g - np.array(ref))) <= 1e-10 * max(ref)
+    assert int(np.argmax(g)) == int(np.argmax(ref))
+    # the strongest line is the hidden modulation at 0.77 Hz
+    assert abs(f_lo + np.argmax(g) * step - 0.77) < 0.25 / dur
+
+
+def test_parallel_candidates_give_the_serial_report(monkeypatch):
+    rec = hidden_effect_recording(["stick_slip"], seed=4321, samples_per_cycle=60)
+    monkeypatch.setenv("CONTACTLAB_DIAGNOSE_THREADS", "1")
+    serial = contactlab.diagnose(rec, model="tangential", max_effects=1)
+    monkeypatch.setenv("CONTACTLAB_DIAGNOSE_THREADS", "2")
+    threaded = contactlab.diagnose(rec, model="tangential", max_effects=1)
+    assert serial.to_json() == threaded.to_json()
+    assert [v.to_dict() for v in serial.steps[0].candidates] == [
+        v.to_dict() for v in threaded.steps[0].candidates
+    ]
+
+
+def test_reused_masing_force_is_the_fresh_one():
+    """h0 times the kept unit-element force is Masing(h0, ac) to rounding, for any h0, and
+    what predict hands out is the caller's to change."""
+    from contactlab.diagnose._family import Prepared
+    from contactlab.diagnose.candidates_tangential import TangentialFamily
+
+    rec = hidden_effect_recording([], seed=77, samples_per_cycle=50)
+    d = Prepared.build(rec.t, rec.data["x"], rec.data["F"])
+    fam = TangentialFamily()
+    fam.prepare(d)
+    for h0 in (48.0, 0.013, 7.5e3):
+        p = {"h0": h0, "ac": 4.6e4, "x0": 1e-7}
+        fresh = contactlab.Masing(h0, 4.6e4).force(d.u)
+        for _ in range(2):
+            got = fam.predict(p, (), d)
+            assert np.max(np.abs(got - fresh)) <= 1e-14 * h0
+            got[:] = 0.0
+        shifted = fam.predict(p, ("displacement_offset",), d)
+        ref = contactlab.Masing(h0, 4.6e4).force(d.u - 1e-7)
+        assert np.max(np.abs(shifted - ref)) <= 1e-14 * h0
+        idx = np.arange(3, d.u.size, 7)
+        for eff in [(), ("stick_slip", "stribeck"), ("position_friction", "force_drift")]:
+            q = {**p, "s_b": 0.2, "ell": 3e-6, "s": 0.1, "v_s": 1e-3, "a1": 0.05, "b1": 0.0}
+            q.update(a2=-0.02, b2=0.01, F1=0.3)
+            assert np.array_equal(fam.predict(q, eff, d, at=idx), fam.predict(q, eff, d)[idx])
+    with pytest.raises(contactlab.InputError, match="h0 must be finite"):
+        fam.predict({"h0": 0.0, "ac": 4.6e4}, (), d)
+
+
+def test_pmap_keeps_order_and_raises_the_first_error(monkeypatch):
+    from contactlab.diagnose._parallel import pmap, workers
+
+    monkeypatch.setenv("CONTACTLAB_DIAGNOSE_THREADS", "3")
+    assert workers() == 3
+    assert pmap(lambda i: i * i, list(range(40))) == [i * i for i in range(40)]
+
+    def f(i: int) -> int:
+        if i in (3, 7):
+            raise ValueError(f"bad {i}")
+        return i
+
+    with pytest.raises(ValueError, match="bad 3"):
+        pmap(f, list(range(10)))
+    monkeypatch.setenv("CONTACTLAB_DIAGNOSE_THREADS", "0")  # not a count: the cores
+    assert workers() >= 1
+
+
+def test_a_binding_budget_stops_where_a_serial_run_stops(monkeypatch):
+    """Candidates on threads spend the evaluation budget as a serial run does: the same
+    candidates tried, the same ones left untested, the same sentence."""
+    from contactlab.diagnose import workflow
+
+    rec = hidden_effect_recording(["force_offset"], magnitude=0.05, seed=2)
+    monkeypatch.setenv("CONTACTLAB_DIAGNOSE_THREADS", "1")
+    full = contactlab.diagnose(rec, model="tangential", max_effects=1)
+    assert not any("candidate search stopped" in w for w in full.where)
+    # a budget that runs out in the middle of the first step's candidates
+    monkeypatch.setattr(workflow, "MAX_EVALUATIONS", 700)
+    serial = contactlab.diagnose(rec, model="tangential", max_effects=1)
+    monkeypatch.setenv("CONTACTLAB_DIAGNOSE_THREADS", "2")
+    threaded = contactlab.diagnose(rec, model="tangential", max_effects=1)
+    reasons = [v.reason for v in serial.steps[0].candidates]
+    untested = [r for r in reasons if r.startswith("not tested")]
+    assert 0 < len(untested) < len(reasons)  # the budget binds part-way
+    assert serial.to_json() == threaded.to_json()
+    assert [v.to_dict() for v in serial.steps[0].candidates] == [
+        v.to_dict() for v in threaded.steps[0].candidates
+    ]
+    assert serial.where == threaded.where
+
+
+def test_evaluation_counter_counts_every_thread():
+    from concurrent.futures import ThreadPoolExecutor
+
+    from contactlab.diagnose._parallel import EvaluationCounter
+
+    c = EvaluationCounter()
+
+    def work(n: int) -> int:
+        start = c.mine()
+        for _ in range(n):
+            c.tick()
+        return c.mine() - start
+
+    with ThreadPoolExecutor(4) as ex:
+        got = list(ex.map(work, [1000] * 16))
+    assert got == [1000] * 16 and c.total == 16_000
