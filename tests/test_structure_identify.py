@@ -115,3 +115,23 @@ def test_cli_identify_and_simulate(tmp_path):
     sim = np.loadtxt(out, delimiter=",", skiprows=1)
     assert sim.shape == (500, 4)
     assert main(["identify", str(tmp_path / "missing.csv")]) == 1
+
+
+def test_cli_simulate_that_stops_early_writes_nothing_unless_partial(tmp_path, capsys):
+    # negative damping: the response grows until Newton gives up part-way
+    s = Structure(1.0, -50.0, 1.0)
+    js = tmp_path / "unstable.json"
+    s.save(js)
+    t = np.arange(2000) * 1e-2
+    src = tmp_path / "in.csv"
+    src.write_text("t,u\n" + "\n".join(f"{a:.9g},{np.sin(a):.9g}" for a in t))
+    out = tmp_path / "sim.csv"
+    argv = ["simulate", "structure", str(out), "--structure", str(js), "--input", str(src)]
+    assert main(argv) == 1
+    said = capsys.readouterr().err
+    assert "stopped early" in said and "nothing written" in said
+    assert not out.exists()
+    assert main([*argv, "--partial"]) == 1
+    assert "wrote" in capsys.readouterr().err
+    sim = np.loadtxt(out, delimiter=",", skiprows=1, ndmin=2)
+    assert 0 < sim.shape[0] < t.size and np.all(np.isfinite(sim))

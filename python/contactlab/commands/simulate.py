@@ -104,4 +104,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="periodic steady state (input repeated until the response repeats)",
     )
+    s.add_argument(
+        "--partial",
+        action="store_true",
+        help="if the integration stops early, write the samples it reached (exit 1 all the "
+        "same); without it a failed run writes nothing",
+    )
     p.set_defaults(handler=_handler)

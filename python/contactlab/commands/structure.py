@@ -158,9 +158,17 @@ def simulate_structure(args: argparse.Namespace) -> int:
     uu = np.resize(u, r.t.size)
     table = np.column_stack([r.t[:m], uu[:m], x[:m], r.joint_force[:m]])
     lines = [",".join(header)] + [",".join(f"{v:.10g}" for v in row) for row in table]
-    path = write_text(args.out, "\n".join(lines) + "\n")
     if not r.success:
-        raise InputError(f"simulation stopped early ({r.message}); wrote {m} samples")
+        # no file on failure, unless asked for: the samples reached are useful to find where
+        # the integrator gave up, but must not pass for a finished run
+        if not getattr(args, "partial", False):
+            raise InputError(
+                f"simulation stopped early ({r.message}) after {m} of {r.t.size} samples; "
+                "nothing written (--partial writes the samples reached)"
+            )
+        write_text(args.out, "\n".join(lines) + "\n")
+        raise InputError(f"simulation stopped early ({r.message}); wrote {m} samples (--partial)")
+    path = write_text(args.out, "\n".join(lines) + "\n")
     print(f"wrote {path} ({m} samples)")
     return 0
 
