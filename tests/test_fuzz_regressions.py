@@ -103,6 +103,11 @@ def test_kernel_kelvin_voigt_extremes():
 
     _input_error(lambda: _core.kv_analytic(1e31, 1.7976931348623157e308, 1e300, 1e7))
     _input_error(lambda: _core.kv_steady_state(1e31, 500.0, 1000.0, 1e7, np.array([-2e305])))
+    # k = pa = 5e-324 with ψ = 178.6: ψ/k = inf against 0.5·pa = 0 gave E_d = NaN as a success
+    out = _core.kv_analytic(5e-324, 178.6122250935734, 0.0020975929644084586, 5e-324)
+    assert all(np.isfinite(v) for v in out) and out[3] >= 0.0
+    # ψ/k underflowing to 0 while E_d = pa² ψ / (2 k (1 + g²)) is ordinary (0.5)
+    assert _core.kv_analytic(1e100, 1e-300, 1.0, 1e200)[3] == pytest.approx(0.5, rel=1e-12)
 
 
 def test_kernel_poly_fit_of_underflowing_abscissae():

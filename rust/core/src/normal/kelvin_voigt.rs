@@ -55,7 +55,20 @@ impl KelvinVoigt {
             return 0.0;
         }
         let g = self.psi / (2.0 * PI);
-        0.5 * pa * (pa * (self.psi / self.k)) / (1.0 + g * g)
+        let direct = 0.5 * pa * (pa * (self.psi / self.k)) / (1.0 + g * g);
+        if direct.is_finite() && direct > 0.0 {
+            return direct;
+        }
+        // a factor overflowed or underflowed (k = pa = 5e-324 with ψ = 179 made ψ/k = inf
+        // against 0.5 pa = 0: NaN, found by the kernels fuzz target): the same product in
+        // logarithms, which is inf or 0 only when E itself is out of range
+        let ln_1p_g2 = if g > 1e150 {
+            2.0 * g.ln()
+        } else {
+            (g * g).ln_1p()
+        };
+        (2.0 * pa.abs().ln() + self.psi.ln() - self.k.ln() - ln_1p_g2 - std::f64::consts::LN_2)
+            .exp()
     }
 
     /// Steady-state displacement and velocity at times `t` under `pa sin ω t`.
@@ -117,6 +130,17 @@ mod tests {
         let kv = KelvinVoigt::new(1e300, 5e-324, 2.96e-308).unwrap();
         let e = kv.loop_energy(f64::MAX);
         assert!(e.is_finite() && e >= 0.0, "{e}");
+        // the kernels fuzz target: k = pa = 5e-324, ψ = 178.6 made ψ/k = inf against
+        // 0.5·pa = 0; E = pa² (ψ/k) / (2 (1 + g²)) underflows to 0
+        let kv =
+            KelvinVoigt::new(5e-324, 178.612_225_093_573_4, 0.002_097_592_964_408_458_6).unwrap();
+        let e = kv.loop_energy(5e-324);
+        assert!(e.is_finite() && e >= 0.0, "{e}");
+        // ψ/k underflowing to 0 while E is ordinary: pa = 1e200, k = 1e100, ψ = 1e-300 give
+        // E = pa² ψ / (2 k (1 + g²)) = 0.5 (the logarithmic route)
+        let kv = KelvinVoigt::new(1e100, 1e-300, 1.0).unwrap();
+        let e = kv.loop_energy(1e200);
+        assert!((e / 0.5 - 1.0).abs() < 1e-12, "{e}");
         // the re-run: k = ψ = 5e-324 made K = pa/k inf against sin φ = 0; E = pa² ψ/(2k)
         let kv = KelvinVoigt::new(5e-324, 5e-324, 4.45e-308).unwrap();
         assert!(
