@@ -199,7 +199,15 @@ class Structure:
             if y.size != nt:
                 raise InputError(f"base has {y.size} samples but t has {nt}")
             if base_velocity is None:
-                yd = np.gradient(y, t, edge_order=2) if nt > 2 else np.gradient(y, t)
+                with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+                    yd = np.gradient(y, t, edge_order=2) if nt > 2 else np.gradient(y, t)
+                if not np.all(np.isfinite(yd)):
+                    i = int(np.argmax(~np.isfinite(yd)))
+                    raise InputError(
+                        f"the base velocity (the derivative of the base displacement) is out "
+                        f"of the double-precision range at sample {i} (base {y[i]:.3g} m, "
+                        "time steps too short for such a displacement)"
+                    )
             else:
                 yd = as_1d(base_velocity, "base_velocity")
                 if yd.size != nt:
