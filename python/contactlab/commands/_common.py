@@ -256,17 +256,22 @@ def with_static_pressure(rec: Any, file: str, p0: float | None, pa: float | None
     p0 = p0 if p0 is not None else tags.get("p0")
     pa = pa if pa is not None else tags.get("pa")
     p = np.asarray(rec["p"], dtype=float)
+    # mean and half range on p / max|p|: a channel near 1e308 overflowed numpy's sum (fuzz
+    # target diagnose) before the channel range check could name it
+    big = float(np.max(np.abs(p))) if p.size and np.all(np.isfinite(p)) else 0.0
+    unit = p / big if big > 0 else p
     if pa is not None:
-        measured = 0.5 * float(np.ptp(p))
+        measured = big * 0.5 * float(np.ptp(unit)) if big > 0 else 0.0
         if abs(measured - pa) > 0.1 * pa:
             print(f"warning: {file}: the pressure's half range {measured:.4g} Pa differs "
                   f"from the nominal pa = {pa:.4g} Pa", file=sys.stderr)  # fmt: skip
     if not dynamic_only(p):
         return rec
     if p0 is None:
+        mean = big * float(np.mean(unit)) if big > 0 else 0.0
         raise InputError(
             f"{file}: the pressure channel holds only the dynamic pressure (mean "
-            f"{float(np.mean(p)):.3g} Pa): give the static pressure with --p0 (e.g. 0.5MPa) "
+            f"{mean:.3g} Pa): give the static pressure with --p0 (e.g. 0.5MPa) "
             "or a file-name tag such as p0-0.5MPa"
         )
     data = dict(rec.data)
