@@ -222,3 +222,18 @@ def test_extrapolation_and_separation_warn():
     kv = KelvinVoigt(1.2e12, 0.1, 1.0, p0=0.3e6)
     with pytest.warns(contactlab.ContactLabWarning, match="separate"):
         kv.simulate(t, p + 0.3e6)
+
+
+def test_default_step_cap_ends_a_run_with_a_message(monkeypatch):
+    # the default cap (per sample plus a base) is passed to the integrator: with a cap of 3
+    # attempts the run stops with success False and says why, instead of running on
+    from contactlab.normal import models
+
+    t = np.linspace(0.0, 2 * np.pi, 400)
+    kv = KelvinVoigt(1.3e12, 0.09, 1.0)
+    assert kv.simulate(t, 0.4e6 * np.sin(t)).success  # the default suffices for a record
+    monkeypatch.setattr(models, "AUTO_STEPS_PER_SAMPLE", 0)
+    monkeypatch.setattr(models, "AUTO_STEPS_BASE", 3)
+    r = kv.simulate(t, 0.4e6 * np.sin(t))
+    assert not r.success and r.t.size < t.size and r.message
+    assert kv.simulate(t, 0.4e6 * np.sin(t), max_steps=0).success  # 0: no cap, as before

@@ -26,6 +26,12 @@ from .._arrays import as_1d, positive
 from ..errors import ContactLabWarning, InputError
 from . import _paper
 
+#: default cap on the ODE's step attempts: this many per sample, plus AUTO_STEPS_BASE (a
+#: record takes a few per sample; an absurd model, e.g. a stiffness of -1e300, otherwise ran
+#: for minutes on two samples: found by the kernels fuzz target)
+AUTO_STEPS_PER_SAMPLE = 20_000
+AUTO_STEPS_BASE = 100_000
+
 if TYPE_CHECKING:
     from .loop import LoopResult
 
@@ -97,7 +103,7 @@ class _ContactModel:
         atol: float | None = None,
         interp: str = "cubic",
         first_step: float | None = None,
-        max_steps: int = 0,
+        max_steps: int | None = None,
     ) -> OdeResult:
         """Displacement response δ(t) to the sampled pressure ``p(t)``.
 
@@ -120,7 +126,10 @@ class _ContactModel:
             Continuation of p between samples (cubic Hermite with ``numpy.gradient`` slopes,
             or straight lines).
         first_step, max_steps :
-            First trial step (s) and a cap on step attempts (0: none).
+            First trial step (s) and a cap on step attempts (0: none; default
+            ``AUTO_STEPS_PER_SAMPLE`` per sample plus ``AUTO_STEPS_BASE``, so that a stiff
+            or absurd model ends with ``success=False`` and a message instead of running
+            for minutes: an ordinary record takes a few steps per sample).
 
         Returns
         -------
@@ -159,6 +168,8 @@ class _ContactModel:
                 raise InputError(f"delta0 must be finite, got {delta0}")
         if interp not in ("cubic", "linear"):
             raise InputError(f"interp must be 'cubic' or 'linear', got {interp!r}")
+        if max_steps is None:
+            max_steps = AUTO_STEPS_PER_SAMPLE * tv.size + AUTO_STEPS_BASE
         if max_steps < 0:
             raise InputError(f"max_steps must be >= 0, got {max_steps}")
         r = _core.normal_simulate(
