@@ -114,6 +114,15 @@ def parse_every(every: str | float | int) -> tuple[str, float]:
     return "time", seconds
 
 
+def _mean_std(a: np.ndarray) -> tuple[float, float]:
+    """Mean and sample standard deviation (NaN for one value) computed on ``a / max|a|``,
+    so that values near the double-precision limit do not overflow the squares."""
+    big = float(np.max(np.abs(a))) if a.size else 0.0
+    u = a / big if (big > 0 and math.isfinite(big)) else a
+    k = big if (big > 0 and math.isfinite(big)) else 1.0
+    return k * float(np.mean(u)), (k * float(np.std(u, ddof=1)) if a.size > 1 else math.nan)
+
+
 @dataclass
 class TrackResult:
     """Quantities per window of a long recording, and per cycle over the whole record.
@@ -186,19 +195,23 @@ class TrackResult:
                 # their scatter
                 fin = v[np.isfinite(v)]
                 if fin.size:
-                    out[q] = float(np.mean(fin))
-                    out[f"{q}_stderr"] = (
-                        float(np.std(fin, ddof=1) / math.sqrt(fin.size))
-                        if fin.size > 1
-                        else float("nan")
-                    )
+                    m, sd = _mean_std(fin)
+                    out[q] = m
+                    out[f"{q}_stderr"] = sd / math.sqrt(fin.size)
                 continue
-            w = 1.0 / s[ok] ** 2
-            mean = float(np.sum(w * v[ok]) / np.sum(w))
-            err = float(1.0 / math.sqrt(np.sum(w)))
+            # weights relative to the smallest error and values relative to the largest, so
+            # that quantities of 1e±300 do not overflow the sums (found by fuzz: track)
+            vk, sk = v[ok], s[ok]
+            smin = float(np.min(sk))
+            w = (smin / sk) ** 2
+            vbig = float(np.max(np.abs(vk))) or 1.0
+            mean = vbig * float(np.sum(w * (vk / vbig)) / np.sum(w))
+            err = smin / math.sqrt(float(np.sum(w)))
             birge = 1.0
             if ok.sum() > 1:
-                chi2 = float(np.sum(w * (v[ok] - mean) ** 2))
+                with np.errstate(over="ignore"):  # inf: windows scattering beyond any error
+                    r = (vk - mean) / sk
+                    chi2 = float(np.sum(r * r))
                 birge = math.sqrt(chi2 / (ok.sum() - 1))
             out[q] = mean
             out[f"{q}_stderr"] = err * max(birge, 1.0)
@@ -206,8 +219,8 @@ class TrackResult:
         e = self.cycles.get("energy")
         if e is not None and e.size:
             out["n_cycles"] = int(e.size)
-            out["cycle_energy_mean"] = float(np.mean(e))
-            out["cycle_energy_std"] = float(np.std(e, ddof=1)) if e.size > 1 else float("nan")
+            # energies of 1e160 J and more overflowed the squares (found by fuzz: track)
+            out["cycle_energy_mean"], out["cycle_energy_std"] = _mean_std(e)
         return out
 
     def to_dict(self, *, cycles: bool = True) -> dict[str, Any]:
