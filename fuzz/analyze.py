@@ -8,11 +8,12 @@ on success the fitted quantities are numbers.
 
 from __future__ import annotations
 
+import math
 import shutil
 import tempfile
 from pathlib import Path
 
-from _harness import Bytes, instrumented, main
+from _harness import Bytes, InvariantViolation, instrumented, main
 
 with instrumented(("contactlab",)):
     from _signals import build, run_cli
@@ -21,8 +22,13 @@ with instrumented(("contactlab",)):
 
 TARGET = "analyze"
 _DIR = Path(tempfile.mkdtemp(prefix="contactlab-fuzz-analyze-"))
-# h0 and ac are None by design when the loop does not identify them apart; h0_ac always is
-REQUIRED = {"tangential": ("h0_ac", "energy_per_cycle"), "normal": ("E_d", "psi", "k_tan")}
+# h0 and ac are None by design when the loop does not identify them apart; in gross sliding
+# h0_ac is None too (only h0 and a lower bound of ac are identified): checked below
+REQUIRED = {"tangential": ("energy_per_cycle",), "normal": ("E_d", "psi", "k_tan")}
+
+
+def _finite(v: object) -> bool:
+    return isinstance(v, (int, float)) and math.isfinite(v)
 
 
 def one_input(data: bytes) -> None:
@@ -32,8 +38,17 @@ def one_input(data: bytes) -> None:
     out = _DIR / "out"
     shutil.rmtree(out, ignore_errors=True)
     out.mkdir()
-    run_cli(["analyze", str(src), "--model", kind, "--json", str(out / "fit.json"),
-             "--no-progress"], out, out / "fit.json", REQUIRED[kind])  # fmt: skip
+    doc = run_cli(["analyze", str(src), "--model", kind, "--json", str(out / "fit.json"),
+                   "--no-progress"], out, out / "fit.json", REQUIRED[kind])  # fmt: skip
+    if doc is None or kind != "tangential":
+        return
+    for r in doc.get("recordings", [doc]):
+        # what a success must give: h0·ac, or (gross sliding) h0 and the bound on ac
+        bounded = _finite(r.get("h0")) and _finite(r.get("ac_lower_bound"))
+        if not (_finite(r.get("h0_ac")) or bounded):
+            raise InvariantViolation(
+                f"success without h0_ac nor h0 + ac_lower_bound (regime {r.get('regime')!r})"
+            )
 
 
 if __name__ == "__main__":

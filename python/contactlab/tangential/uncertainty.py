@@ -133,7 +133,10 @@ def numeric_energy(loop: AveragedLoop, x: np.ndarray, F: np.ndarray) -> tuple[fl
     err = math.sqrt(var) / n
     # Sampling also moves each cycle's polygon across the turns differently; when the areas
     # scatter more than the noise explains, their own spread is the better error.
-    emp = float(np.nanstd(e, ddof=1)) / math.sqrt(n)
+    # (fewer than two finite cycle areas: no spread; numpy warned "Degrees of freedom <= 0",
+    # found by fuzz: track)
+    fin = e[np.isfinite(e)]
+    emp = float(np.std(fin, ddof=1)) / math.sqrt(n) if fin.size > 1 else math.nan
     err = max(err, emp) if math.isfinite(emp) else err
     return float(np.nanmean(e)), err if math.isfinite(err) else math.nan
 
