@@ -607,7 +607,8 @@ def _finish(
             Jfull = Js * rscale / scale  # d r / d value
         _U, s, Vt = np.linalg.svd(Js, full_matrices=False)
         sv = s
-        cond = float(s[0] / s[-1]) if s[-1] > 0 else math.inf
+        with np.errstate(over="ignore"):  # a denormal smallest value: inf (fuzz: track)
+            cond = float(s[0] / s[-1]) if s[-1] > 0 else math.inf
         keep = s > rcond * s[0] if s[0] > 0 else np.zeros_like(s, bool)
         if not keep.all():
             for idx in np.flatnonzero(~keep):

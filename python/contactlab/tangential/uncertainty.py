@@ -135,8 +135,14 @@ def numeric_energy(loop: AveragedLoop, x: np.ndarray, F: np.ndarray) -> tuple[fl
     # scatter more than the noise explains, their own spread is the better error.
     # (fewer than two finite cycle areas: no spread; numpy warned "Degrees of freedom <= 0",
     # found by fuzz: track)
+    # (on the areas over their largest: 1e160-scale areas overflowed the squares)
     fin = e[np.isfinite(e)]
-    emp = float(np.std(fin, ddof=1)) / math.sqrt(n) if fin.size > 1 else math.nan
+    big = float(np.max(np.abs(fin))) if fin.size else 0.0
+    emp = (
+        big * float(np.std(fin / big, ddof=1)) / math.sqrt(n)
+        if fin.size > 1 and big > 0
+        else (0.0 if fin.size > 1 else math.nan)
+    )
     err = max(err, emp) if math.isfinite(emp) else err
     return float(np.nanmean(e)), err if math.isfinite(err) else math.nan
 
