@@ -36,7 +36,6 @@ from .._physical import MAX_MAGNITUDE, check_channel
 from ..errors import ContactLabError, InputError
 from ..fitting import FitResult, Parameter, least_squares_fit
 from ._blas import with_single_blas_thread
-from .joints import iwan_uniform
 from .model import SimulationResult, Structure
 
 JOINTS = ("masing", "jenkins", "iwan", "bouc_wen", "kelvin_voigt", "normal", "linear")
@@ -55,7 +54,7 @@ class IdentifiedModel:
     excitation : {"force", "base"}
     fit : FitResult
         Parameters with standard errors, correlations, identifiability.
-    x0, v0 : float
+    x0, v0 : float, or list of float (one per DOF)
         Estimated initial displacement and velocity of the record.
     substeps : int
         Integration steps per sample used in the fit (and by :meth:`simulate`).
@@ -67,19 +66,28 @@ class IdentifiedModel:
         Each start's initial values and training cost (multi-start).
     elapsed : float
         Wall time of the identification [s].
+    input_dof : int or None
+        Several DOFs, force excitation: the DOF the (1-D) input force acts on.
+    joint_dofs : tuple or None
+        Several DOFs: ``(i, j)`` the joint acts between (``j = None``: the ground).
+    pattern : Pattern or None
+        Several DOFs: which entries of ``M``, ``C``, ``K`` were fitted (chain or masks).
     """
 
     structure: Structure
     joint: str
     excitation: str
     fit: FitResult
-    x0: float = 0.0
-    v0: float = 0.0
+    x0: float | list[float] = 0.0
+    v0: float | list[float] = 0.0
     substeps: int = 4
     interpolation: str = "linear"
     rms: float = math.nan
     starts: list[dict[str, Any]] = field(default_factory=list)
     elapsed: float = math.nan
+    input_dof: int | None = None
+    joint_dofs: tuple[int, int | None] | None = None
+    pattern: Any = None
 
     def simulate(
         self,
@@ -101,6 +109,12 @@ class IdentifiedModel:
             raise InputError("this model is force-excited: pass force=")
         if self.excitation == "base" and base is None:
             raise InputError("this model is base-excited: pass base=")
+        n = self.structure.n
+        if force is not None and n > 1 and np.ndim(force) == 1:
+            # a multi-DOF model's input is the force at input_dof
+            f1 = as_1d(force, "force")
+            force = np.zeros((f1.size, n))
+            force[:, self.input_dof if self.input_dof is not None else n - 1] = f1
         return self.structure.simulate(
             t,
             force=force,
@@ -113,6 +127,15 @@ class IdentifiedModel:
         )
 
     def to_dict(self) -> dict[str, Any]:
+        d = self._to_dict()
+        if self.structure.n > 1:
+            d["n_dofs"] = self.structure.n
+            d["input_dof"] = self.input_dof
+            d["joint_dofs"] = list(self.joint_dofs) if self.joint_dofs else None
+            d["pattern"] = self.pattern.to_dict() if self.pattern is not None else None
+        return d
+
+    def _to_dict(self) -> dict[str, Any]:
         return {
             "kind": "contactlab.structure.IdentifiedModel",
             "joint": self.joint,
@@ -175,18 +198,34 @@ class IdentifiedModel:
                 nfev=int(fd.get("nfev", 0)),
                 residual=np.zeros(0),
             )
+            extra: dict[str, Any] = {}
+            if s.n > 1:
+                from .identify_mdof import pattern_from_dict
+
+                jd = d.get("joint_dofs") or [0, None]
+                extra = {
+                    "input_dof": None if d.get("input_dof") is None else int(d["input_dof"]),
+                    "joint_dofs": (int(jd[0]), None if jd[1] is None else int(jd[1])),
+                    "pattern": pattern_from_dict(d["pattern"]) if d.get("pattern") else None,
+                }
+
+            def state(key: str) -> float | list[float]:
+                v = d.get(key, 0.0)
+                return [float(a) for a in v] if isinstance(v, list) else float(v)
+
             return cls(
                 structure=s,
                 joint=str(d["joint"]),
                 excitation=str(d["excitation"]),
                 fit=fit,
-                x0=float(d.get("x0", 0.0)),
-                v0=float(d.get("v0", 0.0)),
+                x0=state("x0"),
+                v0=state("v0"),
                 substeps=int(d.get("substeps", 1)),
                 interpolation=str(d.get("interpolation", "linear")),
                 rms=float(d.get("rms") or math.nan),
                 starts=list(d.get("starts", [])),
                 elapsed=float(d.get("elapsed") or math.nan),
+                **extra,
             )
         except (KeyError, TypeError, ValueError) as exc:
             raise InputError(f"not an identified-structure model: {exc}") from None
@@ -207,21 +246,22 @@ def _num(v: float) -> float | None:
 # ------------------------------------------------------------------ building models
 def build_structure(joint: str, v: dict[str, float], excitation: str) -> Structure:
     """The SDOF structure of parameter values ``v`` (names as in the fit)."""
+    from .identify_mdof import add_fitted_joint
+
     s = Structure(v["m"], v["c"], v["k"])
-    if joint == "bouc_wen":
-        s.add_joint("bouc_wen", 0, alpha=v["alpha"], beta=1.0, gamma=v["gamma"],
-                    delta=v["delta"], nu=v["nu"])  # fmt: skip
-    elif joint == "masing":
-        s.add_joint("masing", 0, h0=v["h0"], ac=v["ac"], scale=v.get("scale", 2.0))
-    elif joint == "jenkins":
-        s.add_joint("jenkins", 0, k=v["kj"], fs=v["fs"])
-    elif joint == "iwan":
-        s.add_joint("iwan", 0, **iwan_uniform(v["kj"], v["fs"], IWAN_ELEMENTS))
-    elif joint == "kelvin_voigt":
-        s.add_joint("kelvin_voigt", 0, k=v["kj"], c=v["cj"])
-    elif joint == "normal":
-        s.add_joint("normal", 0, coeffs=[v["a1"], v["a2"], v["a3"]])
+    add_fitted_joint(s, joint, v, 0, None)
     return s
+
+
+def _with_state(
+    ps: list[Parameter], estimate: bool, prefixes: tuple[str, ...] = ("x0", "v0")
+) -> list[Parameter]:
+    """Hold the initial-state parameters at their start unless they are estimated."""
+    if not estimate:
+        for p in ps:
+            if p.name.startswith(prefixes):
+                p.vary = False
+    return ps
 
 
 def _derivatives(t: np.ndarray, y: np.ndarray, periodic: bool) -> tuple[np.ndarray, np.ndarray]:
@@ -399,8 +439,22 @@ def identify(
     start_samples: int = 4096,
     max_nfev: int = 200,
     estimate_initial_state: bool = True,
+    structure: Any = "chain",
+    masks: dict[str, Any] | None = None,
+    joint_dofs: Any = (0, None),
+    input_dof: int | None = None,
 ) -> IdentifiedModel:
     """Identify ``m``, ``c``, ``k`` and a joint from input ``u`` and response ``y``.
+
+    With ``y`` of shape ``(n_samples, n_dofs)`` (the displacement of every mass; more than
+    one column), a structure of several DOFs is identified
+    (:mod:`contactlab.structure.identify_mdof`): ``structure="chain"`` (masses ``m{i}``,
+    springs ``k{i}``, dashpots ``c{i}`` between DOF ``i−1`` and ``i``, element 0 to the
+    ground or base) or ``masks={"M": ..., "C": ..., "K": ...}`` (symmetric boolean masks of
+    free entries, parameters ``K[i,j]``), the joint between ``joint_dofs=(i, j)`` (``j`` None:
+    the ground), the force ``u`` acting at ``input_dof`` (default the last DOF) or the base
+    motion ``u`` under every DOF (``mass=`` the masses, needed then). Initial state
+    parameters ``x0_{i}``, ``v0_{i}``.
 
     Parameters
     ----------
@@ -438,6 +492,18 @@ def identify(
         raise InputError(f"joint must be one of {', '.join(JOINTS)}; got {joint!r}")
     if excitation not in ("force", "base"):
         raise InputError(f"excitation must be 'force' or 'base', got {excitation!r}")
+    if np.ndim(y) == 2 and np.shape(y)[1] > 1:
+        from .identify_mdof import identify_mdof
+
+        return identify_mdof(  # type: ignore[no-any-return]
+            t, u, y, joint, excitation, structure=structure, masks=masks,
+            joint_dofs=joint_dofs, input_dof=input_dof, mass=mass, substeps=substeps,
+            interpolation=interpolation, periodic=periodic, multistart=multistart,
+            start_samples=start_samples, max_nfev=max_nfev,
+            estimate_initial_state=estimate_initial_state,
+        )  # fmt: skip
+    if np.ndim(y) == 2 and np.shape(y)[1] == 1:
+        y = np.asarray(y)[:, 0]
     t = as_1d(t, "t")
     u = as_1d(u, "u")
     y = as_1d(y, "y")
@@ -490,11 +556,7 @@ def identify(
         return res
 
     def with_state(ps: list[Parameter]) -> list[Parameter]:
-        if not estimate_initial_state:
-            for p in ps:
-                if p.name in ("x0", "v0"):
-                    p.vary = False
-        return ps
+        return _with_state(ps, estimate_initial_state)
 
     starts = _starts(joint)
     records: list[dict[str, Any]] = []

@@ -28,9 +28,9 @@ def build_structure_report(
     import matplotlib.pyplot as plt
 
     kw = {"force": u} if model.excitation == "force" else {"base": u}
-    sim = model.simulate(t, x0=[model.x0], v0=[model.v0], **kw)
-    x = np.full(t.size, np.nan)
-    x[: sim.x.size] = sim.x
+    sim = model.simulate(t, x0=np.atleast_1d(model.x0), v0=np.atleast_1d(model.v0), **kw)
+    x = np.full(y.shape, np.nan)
+    x[: sim.x.shape[0]] = sim.x
     res = x - y
     n_train = t.size if n_train is None else n_train
 
@@ -70,8 +70,10 @@ def build_structure_report(
     )
     rep.section("Response")
     fig, ax = plt.subplots(2, 1, figsize=(10, 5.5), sharex=True)
-    ax[0].plot(t, y, lw=0.7, label="measured")
-    ax[0].plot(t, x, lw=0.7, label="simulated")
+    multi = y.ndim == 2
+    names = [f" x{i}" for i in range(y.shape[1])] if multi else [""]
+    ax[0].plot(t, y, lw=0.7, label=[f"measured{s}" for s in names])
+    ax[0].plot(t, x, lw=0.7, ls="--" if multi else "-", label=[f"simulated{s}" for s in names])
     if n_train < t.size:
         for a in ax:
             a.axvline(t[n_train], color="k", ls="--", lw=0.8)
@@ -84,6 +86,42 @@ def build_structure_report(
                "of the training part).")  # fmt: skip
     rep.section("Joint loop")
     fig, ax = plt.subplots(figsize=(6, 4.5))
+    if multi:
+        _mdof_loop(ax, model, sim, t, u, y, summary)
+    else:
+        _sdof_reconstructed(ax, model, t, u, y, mass, summary)
+    if sim.joint_force.shape[1] and not multi:
+        ax.plot(x[: sim.x.size], sim.joint_force.sum(axis=1), lw=0.6, label="identified joint")
+    ax.set_xlabel("joint displacement [m]")
+    ax.set_ylabel("joint force [N]")
+    ax.legend(loc="upper left", fontsize=8)
+    rep.figure(fig, "joint-loop", "The joint's force against its displacement.")
+    if model.joint not in ("linear", "kelvin_voigt") and model.structure.joints and not multi:
+        amp = float(np.nanmax(np.abs(y)))
+        amps = np.geomspace(amp / 100, amp, 12)
+        try:
+            ad = amplitude_dependence(model.structure, amps)
+            summary["amplitude_dependence"] = ad.to_dict()
+            rep.section("Amplitude-dependent frequency and damping")
+            fig, ax2 = plt.subplots(1, 2, figsize=(9, 3.5))
+            plot_amplitude_dependence(ad, ax2)
+            rep.figure(fig, "amplitude", "Equivalent-linear natural frequency and damping.")
+        except Exception:
+            pass
+    rep.section("Fit report")
+    rep.preformatted(model.report())
+    return rep, summary
+
+
+def _sdof_reconstructed(
+    ax: Any,
+    model: IdentifiedModel,
+    t: np.ndarray,
+    u: np.ndarray,
+    y: np.ndarray,
+    mass: float | None,
+    summary: dict[str, Any],
+) -> None:
     try:
         ee = equation_error(t, u, y, model.excitation, mass if mass is not None else None)
         m_, c_, k_ = (float(model.structure.M[0, 0]), float(model.structure.C[0, 0]),
@@ -102,24 +140,33 @@ def build_structure_report(
         summary["equation_error_linear"] = {k: ee[k] for k in ("m", "c", "k")}
     except Exception:
         pass
+
+
+def _mdof_loop(ax: Any, model: IdentifiedModel, sim: Any, t: np.ndarray, u: np.ndarray,
+               y: np.ndarray, summary: dict[str, Any]) -> None:  # fmt: skip
+    """Several DOFs: the joint force against the joint's relative displacement, identified
+    and reconstructed from the equations of motion with the identified ``M``, ``C``, ``K``
+    (the force ``b F`` left over, projected on the joint's direction ``b``)."""
+    from .identify_mdof import _derivs
+
+    s = model.structure
+    i, j = model.joint_dofs or (0, None)
+    b = np.zeros(s.n)
+    b[i] = 1.0
+    if j is not None:
+        b[j] = -1.0
+    xd, xdd = _derivs(t, y, False)
+    if model.excitation == "force":
+        f = np.zeros_like(y)
+        f[:, model.input_dof if model.input_dof is not None else s.n - 1] = u
+        left = f - xdd @ s.M.T - xd @ s.C.T - y @ s.K.T
+    else:
+        ud = _derivs(t, u[:, None], False)[0]
+        left = -(xdd @ s.M.T) - (xd - ud) @ s.C.T - (y - u[:, None]) @ s.K.T
+    ax.plot(y @ b, left @ b / float(b @ b), ".", ms=1.5, alpha=0.4, color="0.5",
+            label="reconstructed from the equations of motion")  # fmt: skip
     if sim.joint_force.shape[1]:
-        ax.plot(x[: sim.x.size], sim.joint_force.sum(axis=1), lw=0.6, label="identified joint")
-    ax.set_xlabel("joint displacement [m]")
-    ax.set_ylabel("joint force [N]")
-    ax.legend(loc="upper left", fontsize=8)
-    rep.figure(fig, "joint-loop", "The joint's force against its displacement.")
-    if model.joint not in ("linear", "kelvin_voigt") and model.structure.joints:
-        amp = float(np.nanmax(np.abs(y)))
-        amps = np.geomspace(amp / 100, amp, 12)
-        try:
-            ad = amplitude_dependence(model.structure, amps)
-            summary["amplitude_dependence"] = ad.to_dict()
-            rep.section("Amplitude-dependent frequency and damping")
-            fig, ax2 = plt.subplots(1, 2, figsize=(9, 3.5))
-            plot_amplitude_dependence(ad, ax2)
-            rep.figure(fig, "amplitude", "Equivalent-linear natural frequency and damping.")
-        except Exception:
-            pass
-    rep.section("Fit report")
-    rep.preformatted(model.report())
-    return rep, summary
+        xs = np.asarray(sim.x).reshape(-1, s.n)
+        ax.plot(xs @ b, sim.joint_force.sum(axis=1)[: xs.shape[0]], lw=0.6,
+                label="identified joint")  # fmt: skip
+    summary["joint_dofs"] = [i, j]
