@@ -203,14 +203,19 @@ def _fmt(v: float | None) -> str:
 
 # ------------------------------------------------------------------------------ the models
 def _base_model(base: Any) -> IdentifiedModel:
-    if isinstance(base, IdentifiedModel):
-        return base
     if isinstance(base, (str, Path)):
-        return IdentifiedModel.load(base)
-    raise InputError(
-        "the base structure must be an IdentifiedModel (contactlab.structure.identify) or the "
-        f"path of its saved JSON, got {type(base).__name__}"
-    )
+        base = IdentifiedModel.load(base)
+    if not isinstance(base, IdentifiedModel):
+        raise InputError(
+            "the base structure must be an IdentifiedModel (contactlab.structure.identify) or "
+            f"the path of its saved JSON, got {type(base).__name__}"
+        )
+    if base.structure.n != 1:
+        raise InputError(
+            f"the structure diagnosis takes a single-DOF base model; this one has "
+            f"{base.structure.n} DOFs"
+        )
+    return base
 
 
 def _structure(model: IdentifiedModel, effects: tuple[str, ...], v: dict[str, float]) -> Structure:

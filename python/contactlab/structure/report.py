@@ -108,9 +108,36 @@ def build_structure_report(
             rep.figure(fig, "amplitude", "Equivalent-linear natural frequency and damping.")
         except Exception:
             pass
+    if multi and model.structure.joints:
+        _mdof_amplitude(rep, model, y, summary)
     rep.section("Fit report")
     rep.preformatted(model.report())
     return rep, summary
+
+
+def _mdof_amplitude(rep: Any, model: IdentifiedModel, y: np.ndarray, summary: dict) -> None:
+    """Each mode's frequency and damping ratio against amplitude (equivalent linearisation),
+    up to the record's largest displacement."""
+    import matplotlib.pyplot as plt
+
+    from ..errors import ContactLabError
+    from .amplitude_mdof import modal_amplitude_dependence, plot_modal_amplitude_dependence
+
+    amp = float(np.nanmax(np.abs(y)))
+    amps = np.geomspace(amp / 100, amp, 12)
+    try:
+        ads = [modal_amplitude_dependence(model.structure, amps, mode=i)
+               for i in range(model.structure.n)]  # fmt: skip
+    except ContactLabError as exc:
+        summary["amplitude_dependence"] = {"error": str(exc)}
+        return
+    summary["amplitude_dependence"] = [ad.to_dict() for ad in ads]
+    rep.section("Amplitude-dependent frequency and damping of each mode")
+    fig, ax = plt.subplots(1, 2, figsize=(9, 3.5))
+    plot_modal_amplitude_dependence(ads, ax)
+    rep.figure(fig, "amplitude", "Equivalent-linear natural frequency and damping ratio of "
+               "each mode against the amplitude of its reference DOF (mode shape and joint "
+               "stiffness iterated together).")  # fmt: skip
 
 
 def _sdof_reconstructed(
