@@ -224,8 +224,7 @@ def diagnose_structure_cli(args: argparse.Namespace) -> int:
     from ..diagnose.structure import diagnose_structure
     from ..structure import IdentifiedModel
 
-    if args.report:
-        raise InputError("--report is not available with --structure; use --json")
+    check_output_targets(json_out=args.json, report=args.report)
     model = IdentifiedModel.load(args.structure)
     cols = read_table(args.file)
     exc = model.excitation
@@ -247,6 +246,11 @@ def diagnose_structure_cli(args: argparse.Namespace) -> int:
         doc = rep.to_dict()
         doc["columns"] = {"u": ucol, "y": ycol}
         write_text(args.json, json.dumps(doc, indent=2, allow_nan=False) + "\n")
+    if args.report:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        print(f"report: {rep.write_html(args.report)}")
     return 0
 
 

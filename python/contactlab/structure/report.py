@@ -197,3 +197,169 @@ def _mdof_loop(ax: Any, model: IdentifiedModel, sim: Any, t: np.ndarray, u: np.n
         ax.plot(xs @ b, sim.joint_force.sum(axis=1)[: xs.shape[0]], lw=0.6,
                 label="identified joint")  # fmt: skip
     summary["joint_dofs"] = [i, j]
+
+
+# ------------------------------------------------------------------ structure diagnosis
+def build_diagnosis_report(diag: Any) -> Report:
+    """The HTML report of a :class:`~contactlab.diagnose.structure.StructureDiagnosis`:
+    findings, the named effects with their parameters ± standard errors, the held-out error
+    after each step, measured against simulated response (base and final model), the joint's
+    loop, the residual before and after (time and spectrum), the unexplained part with where
+    it lives, and every candidate's verdict."""
+    from matplotlib.figure import Figure
+
+    from ..report.html import format_measurement
+
+    rec = diag.record
+    if not rec or diag.base_prediction is None or diag.residual is None:
+        from ..errors import InputError
+
+        raise InputError("this diagnosis carries no record (loaded from JSON?): re-run "
+                         "diagnose_structure to write its report")  # fmt: skip
+    t, u, y = rec["t"], rec["u"], rec["y"]
+    base, final = diag.base_prediction, y + diag.residual
+    ntr = diag.n_train
+    sigma = diag.noise_rms
+    r = Report(
+        f"Structure diagnosis: {diag.joint} joint, {diag.excitation} excitation",
+        "Which effect the identified structure misses: the base model and each candidate are "
+        "refitted on the first part of the record and judged on the held-out end, which no fit "
+        "saw (dashed line in the figures).",
+    )
+    r.section("Findings")
+    if diag.effects:
+        for name in diag.effects:
+            keys = [k for k in diag.parameters if k in _EXTRA_KEYS.get(name, ())]
+            r.text(f"Named: {name} — " + ", ".join(
+                f"{k} = {_pm(diag.parameters[k], diag.stderr.get(k), format_measurement)}"
+                for k in keys))  # fmt: skip
+    else:
+        r.text("No candidate improves the held-out error significantly.")
+    r.subheading("Where the model disagrees")
+    for w in diag.where:
+        r.text(w, note=w.startswith("after "))
+    r.text(
+        ("Unexplained: the final model's held-out error is above 1.5 × the noise level."
+         if diag.unexplained else "Explained: the final model's held-out error is within "
+         "1.5 × the noise level."), note=diag.unexplained,
+    )  # fmt: skip
+    r.section("Parameters of the final model")
+    r.table(
+        [
+            {
+                "parameter": k,
+                "value": v,
+                "stderr": diag.stderr.get(k),
+                "added": any(k in _EXTRA_KEYS.get(e, ()) for e in diag.effects),
+            }
+            for k, v in diag.parameters.items()
+        ],
+        ["parameter", Column("value", stderr="stderr"), "added"],
+        caption="Fitted on the training part; standard errors from the fit's covariance.",
+    )
+    r.section("Held-out error after each step")
+    r.table(
+        [
+            {
+                "step": "base model" if s["added"] is None else f"+ {s['added']}",
+                "heldout_rms": s["heldout_rms"],
+                "over_noise": s["heldout_rms"] / sigma,
+                "train_rms": s["train_rms"],
+            }
+            for s in diag.steps
+        ],
+        [
+            "step",
+            Column("heldout_rms", "held-out RMS", unit="m"),
+            Column("over_noise", "/ noise RMS"),
+            Column("train_rms", "training RMS", unit="m"),
+        ],
+    )
+    r.text(f"Noise RMS estimated from the data: {sigma:.4g} m")
+    r.section("Response")
+    fig = Figure(figsize=(10, 6.5), layout="constrained")
+    ax = fig.subplots(3, 1, sharex=True)
+    ax[0].plot(t, u, lw=0.6, color="0.3")
+    ax[0].set_ylabel("force [N]" if diag.excitation == "force" else "base [m]")
+    ax[1].plot(t, y, lw=0.7, color="k", label="measured")
+    ax[1].plot(t, base, lw=0.7, label="base model")
+    if diag.effects:
+        ax[1].plot(t, final, lw=0.7, ls="--", label="final model (+ " +
+                   ", ".join(diag.effects) + ")")  # fmt: skip
+    ax[1].set_ylabel("displacement [m]")
+    ax[1].legend(loc="upper right", fontsize=8)
+    ax[2].plot(t, base - y, lw=0.6, label="base model")
+    if diag.effects:
+        ax[2].plot(t, diag.residual, lw=0.6, label="final model")
+    for a in (2 * sigma, -2 * sigma):
+        ax[2].axhline(a, color="0.5", ls=":", lw=0.8)
+    ax[2].set_ylabel("residual [m]")
+    ax[2].set_xlabel("t [s]")
+    ax[2].legend(loc="upper right", fontsize=8)
+    for a in ax:
+        a.axvline(t[ntr], color="k", ls="--", lw=0.8)
+    r.figure(fig, "response", "Input; measured and simulated displacement (base and final "
+             "model); residual before and after (dotted: ± 2 × noise RMS).", dpi=110)  # fmt: skip
+    r.section("Joint loop")
+    fig = Figure(figsize=(6.5, 4.6), layout="constrained")
+    ax1 = fig.add_subplot()
+    for lab, x, jf in (("base model", base, diag.base_joint_force),
+                       ("final model", final, diag.joint_force)):  # fmt: skip
+        if jf is not None and jf.ndim == 2 and jf.shape[1] and jf.shape[0] == x.size:
+            ax1.plot(x[ntr:], jf[ntr:, 0], lw=0.7, label=f"{lab}: {diag.joint} joint")
+            if jf.shape[1] > 1 and lab == "final model":
+                ax1.plot(x[ntr:], jf[ntr:].sum(axis=1), lw=0.7, ls="--",
+                         label="final model: all joint elements")  # fmt: skip
+    ax1.set_xlabel("displacement of the mass [m]")
+    ax1.set_ylabel("joint force [N]")
+    ax1.legend(loc="upper left", fontsize=8)
+    r.figure(fig, "joint-loop", "The joint's force against the displacement on the held-out "
+             "part (simulated).", dpi=110)  # fmt: skip
+    r.section("Residual: where the unexplained part lives")
+    fig = Figure(figsize=(10, 3.8), layout="constrained")
+    axs = fig.subplots(1, 2)
+    dt = float(np.median(np.diff(t)))
+    v = np.gradient(final, dt)
+    for lab, e in (("base model", (base - y)[ntr:]), ("final model", diag.residual[ntr:])):
+        if lab == "final model" and not diag.effects:
+            continue
+        spec = np.abs(np.fft.rfft((e - e.mean()) * np.hanning(e.size))) ** 2
+        f = np.fft.rfftfreq(e.size, dt)
+        axs[0].semilogy(f[1:], spec[1:] + 1e-300, lw=0.6, label=lab)
+        axs[1].plot(np.abs(v[ntr:]), np.abs(e), ".", ms=1.5, alpha=0.5, label=lab)
+    axs[0].set_xlabel("frequency [Hz]")
+    axs[0].set_ylabel("held-out residual power")
+    axs[1].set_xlabel("|velocity| [m/s] (reversals at the left)")
+    axs[1].set_ylabel("|held-out residual| [m]")
+    axs[1].axhline(2 * sigma, color="0.5", ls=":", lw=0.8)
+    for a in axs:
+        a.legend(fontsize=8)
+    r.figure(fig, "residual-where", "Held-out residual: its spectrum, and its size against the "
+             "speed of the mass (near reversals on the left).", dpi=110)  # fmt: skip
+    r.section("Candidates tried")
+    for i, s in enumerate(diag.steps):
+        if s["candidates"]:
+            r.subheading(f"after step {i} ({s['added'] or 'base model'})")
+            rows = []
+            for c in s["candidates"]:
+                d = c.to_dict()
+                d["parameters"] = ", ".join(
+                    f"{k} = {_pm(val, c.stderr.get(k), format_measurement)}"
+                    for k, val in c.parameters.items()
+                )
+                rows.append(d)
+            r.table(rows, ["name", "accepted", Column("heldout_rms", "held-out RMS", unit="m"),
+                           Column("gain", "gain / σ²"), "t", "parameters", "reason"])  # fmt: skip
+    r.section("Result (JSON)")
+    r.preformatted(diag.to_json())
+    return r
+
+
+#: the parameters each structure candidate adds (as diagnose.structure names them)
+_EXTRA_KEYS = {"joint_damping": ("cj",), "second_joint": ("k2", "fs2"), "base_coupling": ("e",)}
+
+
+def _pm(value: float, stderr: float | None, fmt: Any) -> str:
+    if stderr is None or not np.isfinite(stderr):
+        return f"{value:.4g} (stderr unknown)"
+    return str(fmt(value, stderr))
