@@ -340,6 +340,113 @@ def equation_error(
     }
 
 
+def linear_grid_start(
+    t: np.ndarray,
+    u: np.ndarray,
+    y: np.ndarray,
+    excitation: str,
+    mass: float | None,
+    *,
+    n_freq: int = 24,
+    zetas: tuple[float, ...] = (0.01, 0.05, 0.2, 0.7),
+    keep: int = 3,
+) -> list[dict[str, Any]]:
+    """The linear SDOF model (``m``, ``c``, ``k``) of least output error over a grid of
+    natural frequencies (geometric, from one cycle per record to a sixth of the sampling
+    rate) and damping ratios: starting values when the equation error fails.
+
+    Base excitation: the response depends on ``k/m`` and ``c/m`` only (``m`` given).
+    Force excitation: the response of the unit-stiffness model is scaled by its least-squares
+    factor ``1/k`` (``m = k/ω²``; with a given mass, ``k = m ω²``). Returns the best ``keep``
+    models at distinct frequencies (at least a factor 1.5 apart), best first, each with
+    ``grid_f`` [Hz] and ``grid_rms`` (its output error) [m]; empty when none has a positive
+    scale.
+    """
+    dt = float(np.median(np.diff(t)))
+    f_lo = 1.0 / max(float(t[-1] - t[0]), dt)
+    f_hi = 1.0 / (6.0 * dt)
+    if not f_hi > f_lo:
+        return []
+    found: list[tuple[float, float, float, float, float]] = []  # rms, f, m, c, k
+    x0 = [float(y[0])] if excitation == "base" else None
+    for f in np.geomspace(f_lo, f_hi, n_freq):
+        w = 2 * np.pi * f
+        for z in zetas:
+            if excitation == "base":
+                m = float(mass)  # type: ignore[arg-type]
+                k, c = m * w * w, 2 * z * m * w
+                try:
+                    r = Structure(m, c, k).simulate(t, base=u, x0=x0)
+                except ContactLabError:
+                    continue
+                if r.x.size < t.size:
+                    continue
+                e = r.x - y
+            else:
+                # unit stiffness (or the given mass), then the best scale
+                m1 = 1.0 / (w * w) if mass is None else float(mass)
+                k1 = 1.0 if mass is None else m1 * w * w
+                try:
+                    r = Structure(m1, 2 * z * m1 * w, k1).simulate(t, force=u)
+                except ContactLabError:
+                    continue
+                g = r.x
+                if g.size < t.size or not np.all(np.isfinite(g)):
+                    continue
+                gg = float(g @ g)
+                scale = float(g @ y) / gg if gg > 0 else 0.0
+                if not scale > 0:
+                    continue
+                if mass is None:
+                    k = 1.0 / scale
+                    m, c = k / (w * w), 2 * z * k / w
+                else:
+                    scale = 1.0  # the mass fixes the scale
+                    m, c, k = m1, 2 * z * m1 * w, k1
+                e = scale * g - y
+            rms = float(np.sqrt(np.mean(e * e)))
+            if math.isfinite(rms):
+                found.append((rms, float(f), m, c, k))
+    out: list[dict[str, Any]] = []
+    for rms, f, m, c, k in sorted(found):
+        if all(max(f / o["grid_f"], o["grid_f"] / f) >= 1.5 for o in out):
+            out.append({"m": m, "c": c, "k": k, "grid_f": f, "grid_rms": rms})
+        if len(out) == keep:
+            break
+    return out
+
+
+def _joint_grid_plan(
+    joint: str,
+    lin: dict[str, Any],
+    y: np.ndarray,
+    mass: float | None,
+    t: np.ndarray,
+    res: Any,
+    keep: int = 6,
+) -> list[tuple[dict[str, Any], dict[str, Any], dict[str, float]]]:
+    """The ``keep`` best starts of a friction joint on a grid of total stiffness (natural
+    frequency), joint share and slip force, each judged by one simulation (``res``)."""
+    dt = float(np.median(np.diff(t)))
+    m = float(mass) if mass is not None else float(lin["m"])
+    scored = []
+    for f in np.geomspace(1.0 / max(float(t[-1] - t[0]), dt), 1.0 / (6.0 * dt), 8):
+        k = m * (2 * np.pi * f) ** 2
+        li = {**lin, "m": m, "k": k, "c": 0.02 * math.sqrt(k * m)}
+        for kf in (0.5, 0.85):
+            for ff in (0.01, 0.03, 0.1, 0.3, 1.0, 3.0):
+                st0 = {"f_frac": ff, "k_frac": kf}
+                v = {p.name: p.value for p in _params(joint, li, y, mass, st0)}
+                v["x0"] = float(y[0])
+                e = res(v)
+                rms = float(np.sqrt(np.mean(e * e)))
+                if math.isfinite(rms):
+                    scored.append((rms, float(f), kf, ff, li, st0))
+    scored.sort(key=lambda a: a[0])
+    return [({"f_frac": ff, "k_frac": kf, "grid_f": f, "grid_rms": rms}, li, st0)
+            for rms, f, kf, ff, li, st0 in scored[:keep]]  # fmt: skip
+
+
 def _params(
     joint: str, lin: dict[str, Any], y: np.ndarray, mass: float | None, start: dict[str, float]
 ) -> list[Parameter]:
@@ -529,12 +636,24 @@ def identify(
     if periodic is None:
         periodic = interpolation == "fourier"
     lin = equation_error(t, u, y, excitation, mass, periodic=bool(periodic))
+    lins = [lin]
     if not (lin["k"] > 0 and lin["m"] > 0):
-        raise InputError(
-            "the equation-error fit gives a non-positive mass or stiffness "
-            f"(m = {lin['m']:.4g}, k = {lin['k']:.4g}); is the response in metres and "
-            "the input the right channel?"
-        )
+        # a short or slow record (a few hundred samples, the mass following the base) can
+        # leave the regression's stiffness at or below zero: start from the linear model of
+        # a grid of natural frequencies and damping ratios that best matches the output
+        grid = linear_grid_start(t, u, y, excitation, mass)
+        if not grid:
+            raise InputError(
+                "the equation-error fit gives a non-positive mass or stiffness "
+                f"(m = {lin['m']:.4g}, k = {lin['k']:.4g}), and no linear model on a grid of "
+                "natural frequencies follows the response; is the response in metres and "
+                "the input the right channel?"
+            )
+        # the best few grid models (distinct frequencies) each seed the joint's starts
+        # with light viscous damping: the grid's damping ratio stands in for the joint's
+        # dissipation, which the joint's parameters are to take over
+        lins = [{**lin, **g, "c": 0.02 * math.sqrt(g["k"] * g["m"])} for g in grid]
+        lin = lins[0]
 
     def residual_on(n: int, sub: int = substeps) -> Any:
         tt, uu, yy = t[:n], u[:n], y[:n]
@@ -560,14 +679,23 @@ def identify(
 
     starts = _starts(joint)
     records: list[dict[str, Any]] = []
-    best_ps = with_state(_params(joint, lin, y, mass, starts[0]))
-    if multistart and len(starts) > 1:
-        n_s = min(int(start_samples), t.size)
+    n_s = min(int(start_samples), t.size)
+    plan = [(st0 if len(lins) == 1 else {**st0, "grid_f": li["grid_f"]}, li, st0)
+            for li in lins for st0 in starts]  # fmt: skip
+    if len(lins) > 1 and joint in ("masing", "jenkins", "iwan"):
+        # the linear grid cannot hold the mass against a joint to the fixed ground (what a
+        # frame rubbing on a wall does on a short record): explore the joint's stiffness
+        # share and slip force on the grid of frequencies, one simulation each (first), as
+        # well as the usual starts on the linear grid's models
+        plan = _joint_grid_plan(joint, lin, y, mass, t, residual_on(n_s, 2)) + plan
+    best_ps = with_state(_params(joint, plan[0][1], y, mass, plan[0][2]))
+    if multistart and len(plan) > 1:
+        nfev_s = 25
         best_cost = math.inf
-        for st in starts:
-            ps = with_state(_params(joint, lin, y, mass, st))
+        for st, lin_i, st0 in plan:
+            ps = with_state(_params(joint, lin_i, y, mass, st0))
             try:
-                fr = least_squares_fit(residual_on(n_s, 2), ps, max_nfev=25, ftol=1e-5,
+                fr = least_squares_fit(residual_on(n_s, 2), ps, max_nfev=nfev_s, ftol=1e-5,
                                        xtol=1e-5, gtol=1e-8)  # fmt: skip
             except ContactLabError as exc:
                 records.append({"start": st, "cost": None, "error": str(exc)})
