@@ -73,7 +73,7 @@ def test_chain_with_joint_between_dofs_recovers_parameters():
     assert np.all(err < 0.02), err
 
 
-def test_masks_base_excited_joint_to_ground_recovers_parameters():
+def test_masks_base_excited_joint_to_ground_recovers_parameters(tmp_path):
     rng = np.random.default_rng(40419)
     n = 2000
     t = np.arange(n) / 500.0
@@ -96,6 +96,11 @@ def test_masks_base_excited_joint_to_ground_recovers_parameters():
     assert "M[0,0]" not in p  # the masses were given
     assert m.rms < 1.5 * 0.01 * float(np.std(y_true))
     np.testing.assert_allclose(m.structure.M, M2)
+    # masks survive the JSON round trip; the loaded model predicts the same
+    m.save(tmp_path / "masks.json")
+    m2 = IdentifiedModel.load(tmp_path / "masks.json")
+    assert [n for n, _ in m2.pattern.basis["K"]] == ["K[0,0]", "K[0,1]", "K[1,1]"]
+    np.testing.assert_array_equal(m2.simulate(t, base=u).x, m.simulate(t, base=u).x)
 
 
 def test_mdof_json_round_trip_and_bad_input(tmp_path):
@@ -140,6 +145,14 @@ def test_cli_identify_several_y_channels(tmp_path, capsys):
     assert d["summary"]["rms_holdout"] < 0.05 * float(np.std(y))
     assert (tmp_path / "rep" / "report.html").exists()
     assert "RMS output error" in capsys.readouterr().out
+    # the saved model predicts a new input from the command line, one column per DOF
+    pred = tmp_path / "pred.csv"
+    assert main(["simulate", "structure", str(pred), "--structure", str(out), "--input",
+                 str(csv)]) == 0  # fmt: skip
+    head = pred.read_text().splitlines()[0]
+    assert head.startswith("t [s],u [N],x0 [m],x1 [m]")
+    sim = np.loadtxt(pred, delimiter=",", skiprows=1)
+    assert sim.shape == (t.size, 5)
     rc = main(["identify", str(csv), "--joint", "jenkins", "--y", "x0_m,x1_m", "--joint-dofs",
                "0,x", "--json", str(tmp_path / "bad.json")])  # fmt: skip
     assert rc != 0 and not (tmp_path / "bad.json").exists()

@@ -421,7 +421,8 @@ def identify_mdof(
     xd, _ = _derivs(t, y, bool(periodic))
     d_rms = max(float(np.std(y @ b)), 1e-300)
     y_rms = max(float(np.std(y)), 1e-300)
-    x0s, v0s = y[0], xd[0]
+    # from the measured start when the state is estimated, else the record starts from rest
+    x0s, v0s = (y[0], xd[0]) if estimate_initial_state else (np.zeros(n), np.zeros(n))
 
     def residual_on(nn: int, sub: int) -> Any:
         tt, uu, yy = t[:nn], u[:nn], y[:nn]
