@@ -27,7 +27,6 @@ from typing import Any
 import numpy as np
 import scipy.linalg
 
-from .._arrays import as_1d
 from ..errors import ConvergenceError, InputError
 from .model import Structure
 
@@ -106,15 +105,11 @@ class _JointTable:
             return self.k0, 0.0
         key = float(f"{amp:.10g}")
         if key not in self.cache:
-            from .amplitude import joint_loop
+            from .amplitude import joint_loop, loop_keq_energy
 
             s = Structure(1.0, 0.0, 0.0)
             s.add_joint(self.joint.kind, 0, None, **self.joint.params, **self.joint.arrays)
-            t, d, F = joint_loop(s, key)
-            th = 2 * np.pi * (t - t[0])
-            A = 0.5 * (d.max() - d.min())
-            keq = float(np.trapezoid(F * np.sin(th), th) / (np.pi * A))
-            energy = float(np.trapezoid(F, d))
+            _, keq, energy = loop_keq_energy(*joint_loop(s, key))
             self.cache[key] = (keq, energy)
         return self.cache[key]
 
@@ -160,12 +155,9 @@ def modal_amplitude_dependence(
     >>> [round(float(f), 3) for f in ad.frequency_hz]  # stuck joint → joint slipping
     [8.015, 7.12]
     """
-    if any(j.kind == "kelvin_voigt" for j in structure.joints):
-        raise InputError("modal_amplitude_dependence: a Kelvin-Voigt joint is rate-dependent; "
-                         "add its k and c to the structure instead")  # fmt: skip
-    a = as_1d(amplitudes, "amplitudes")
-    if np.any(a <= 0):
-        raise InputError("amplitudes must be > 0")
+    from .amplitude import checked_amplitudes
+
+    a = checked_amplitudes(structure, amplitudes, "modal_amplitude_dependence")
     n = structure.n
     mode = int(mode)
     if not 0 <= mode < n:

@@ -36,10 +36,12 @@ from .._physical import MAX_MAGNITUDE, check_channel
 from ..errors import ContactLabError, InputError
 from ..fitting import FitResult, Parameter, least_squares_fit
 from ._blas import with_single_blas_thread
+from ._fitkit import IWAN_ELEMENTS, add_fitted_joint, best_start, derivatives, hold_state
 from .model import SimulationResult, Structure
 
 JOINTS = ("masing", "jenkins", "iwan", "bouc_wen", "kelvin_voigt", "normal", "linear")
-IWAN_ELEMENTS = 20
+__all__ = ["IWAN_ELEMENTS", "JOINTS", "IdentifiedModel", "equation_error", "identify",
+           "linear_grid_start"]  # fmt: skip
 
 
 @dataclass
@@ -246,45 +248,9 @@ def _num(v: float) -> float | None:
 # ------------------------------------------------------------------ building models
 def build_structure(joint: str, v: dict[str, float], excitation: str) -> Structure:
     """The SDOF structure of parameter values ``v`` (names as in the fit)."""
-    from .identify_mdof import add_fitted_joint
-
     s = Structure(v["m"], v["c"], v["k"])
     add_fitted_joint(s, joint, v, 0, None)
     return s
-
-
-def _with_state(
-    ps: list[Parameter], estimate: bool, prefixes: tuple[str, ...] = ("x0", "v0")
-) -> list[Parameter]:
-    """Hold the initial-state parameters at their start unless they are estimated."""
-    if not estimate:
-        for p in ps:
-            if p.name.startswith(prefixes):
-                p.vary = False
-    return ps
-
-
-def _derivatives(t: np.ndarray, y: np.ndarray, periodic: bool) -> tuple[np.ndarray, np.ndarray]:
-    if periodic:
-        n = y.size
-        dt = float(t[1] - t[0])
-        w = 2j * np.pi * np.fft.rfftfreq(n, dt)
-        Y = np.fft.rfft(y)
-        return np.fft.irfft(w * Y, n), np.fft.irfft(w * w * Y, n)
-    dt = np.diff(t)
-    win = 15
-    if y.size > 2 * win and np.ptp(dt) <= 1e-6 * dt.mean():
-        # Savitzky-Golay (cubic, 15 samples): second differences of raw samples amplify the
-        # measurement noise by 1/dt², which biases the regression towards zero stiffness.
-        from scipy.signal import savgol_filter
-
-        h = float(dt.mean())
-        return (
-            savgol_filter(y, win, 3, deriv=1, delta=h),
-            savgol_filter(y, win, 3, deriv=2, delta=h),
-        )
-    v = np.gradient(y, t, edge_order=2)
-    return v, np.gradient(v, t, edge_order=2)
 
 
 def equation_error(
@@ -303,7 +269,7 @@ def equation_error(
     ``k`` and ``joint_force = rhs − m x'' − c x' − k x`` (what the joint must supply if the
     linear part were exactly this).
     """
-    xd, xdd = _derivatives(t, y, periodic)
+    xd, xdd = derivatives(t, y, periodic)
     if excitation == "force":
         cols = [xdd, xd, y]
         rhs = u.copy()
@@ -317,7 +283,7 @@ def equation_error(
     else:
         if mass is None:
             raise InputError("base excitation needs the mass (mass=...) for the equation error")
-        ud, _ = _derivatives(t, u, periodic)
+        ud, _ = derivatives(t, u, periodic)
         A = np.stack([xd - ud, y - u], axis=1)
         coef, *_ = np.linalg.lstsq(A, -mass * xdd, rcond=None)
         m, (c, k) = mass, coef
@@ -328,7 +294,7 @@ def equation_error(
     if excitation == "force":
         rhs_c, cols_c = u - m * xdd, [xd, y, sgn]
     else:
-        ud, _ = _derivatives(t, u, periodic)
+        ud, _ = derivatives(t, u, periodic)
         rhs_c, cols_c = -m * xdd, [xd - ud, y - u, sgn]
     cc, *_ = np.linalg.lstsq(np.stack(cols_c, axis=1), rhs_c, rcond=None)
     return {
@@ -602,13 +568,16 @@ def identify(
     if np.ndim(y) == 2 and np.shape(y)[1] > 1:
         from .identify_mdof import identify_mdof
 
-        return identify_mdof(  # type: ignore[no-any-return]
+        fields = identify_mdof(
             t, u, y, joint, excitation, structure=structure, masks=masks,
             joint_dofs=joint_dofs, input_dof=input_dof, mass=mass, substeps=substeps,
             interpolation=interpolation, periodic=periodic, multistart=multistart,
             start_samples=start_samples, max_nfev=max_nfev,
             estimate_initial_state=estimate_initial_state,
         )  # fmt: skip
+        model = IdentifiedModel(**fields)
+        model.elapsed = time.perf_counter() - t0
+        return model
     if np.ndim(y) == 2 and np.shape(y)[1] == 1:
         y = np.asarray(y)[:, 0]
     t = as_1d(t, "t")
@@ -675,7 +644,7 @@ def identify(
         return res
 
     def with_state(ps: list[Parameter]) -> list[Parameter]:
-        return _with_state(ps, estimate_initial_state)
+        return hold_state(ps, estimate_initial_state)
 
     starts = _starts(joint)
     records: list[dict[str, Any]] = []
@@ -690,32 +659,8 @@ def identify(
         plan = _joint_grid_plan(joint, lin, y, mass, t, residual_on(n_s, 2)) + plan
     best_ps = with_state(_params(joint, plan[0][1], y, mass, plan[0][2]))
     if multistart and len(plan) > 1:
-        nfev_s = 25
-        best_cost = math.inf
-        for st, lin_i, st0 in plan:
-            ps = with_state(_params(joint, lin_i, y, mass, st0))
-            try:
-                fr = least_squares_fit(residual_on(n_s, 2), ps, max_nfev=nfev_s, ftol=1e-5,
-                                       xtol=1e-5, gtol=1e-8)  # fmt: skip
-            except ContactLabError as exc:
-                records.append({"start": st, "cost": None, "error": str(exc)})
-                continue
-            cost = float(np.sqrt(fr.chisqr / max(fr.ndata, 1)))
-            records.append({"start": st, "rms_short": cost})
-            if cost < best_cost:
-                best_cost = cost
-                best_ps = [
-                    Parameter(
-                        p.name,
-                        fr.params[p.name].value,
-                        vary=p.vary,
-                        min=p.min,
-                        max=p.max,
-                        unit=p.unit,
-                        scale=p.scale,
-                    )
-                    for p in ps
-                ]
+        tried = [(st, with_state(_params(joint, lin_i, y, mass, st0))) for st, lin_i, st0 in plan]
+        best_ps = best_start(tried, residual_on(n_s, 2), records) or best_ps
     fit = least_squares_fit(residual_on(t.size), best_ps, max_nfev=max_nfev, ftol=1e-7,
                             xtol=1e-7, gtol=1e-10)  # fmt: skip
     v = fit.values

@@ -21,7 +21,6 @@ stretch of the record.
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass
 from typing import Any
 
@@ -31,6 +30,7 @@ from .._arrays import as_1d
 from .._physical import MAX_MAGNITUDE
 from ..errors import ContactLabError, InputError
 from ..fitting import Parameter, least_squares_fit
+from ._fitkit import add_fitted_joint, best_start, column_derivatives, hold_state
 from .model import Structure
 
 MDOF_JOINTS = ("masing", "jenkins", "iwan", "bouc_wen", "linear")
@@ -125,28 +125,6 @@ def pattern_from_dict(d: dict[str, Any]) -> Pattern:
 
 
 # ------------------------------------------------------------------ the joint
-def add_fitted_joint(
-    s: Structure, joint: str, v: dict[str, float], dof: int, dof2: int | None
-) -> None:
-    """Add the joint of fitted values ``v`` (names as in :mod:`.identify`) to ``s``."""
-    from .identify import IWAN_ELEMENTS
-    from .joints import iwan_uniform
-
-    if joint == "bouc_wen":
-        s.add_joint("bouc_wen", dof, dof2, alpha=v["alpha"], beta=1.0, gamma=v["gamma"],
-                    delta=v["delta"], nu=v["nu"])  # fmt: skip
-    elif joint == "masing":
-        s.add_joint("masing", dof, dof2, h0=v["h0"], ac=v["ac"], scale=v.get("scale", 2.0))
-    elif joint == "jenkins":
-        s.add_joint("jenkins", dof, dof2, k=v["kj"], fs=v["fs"])
-    elif joint == "iwan":
-        s.add_joint("iwan", dof, dof2, **iwan_uniform(v["kj"], v["fs"], IWAN_ELEMENTS))
-    elif joint == "kelvin_voigt":
-        s.add_joint("kelvin_voigt", dof, dof2, k=v["kj"], c=v["cj"])
-    elif joint == "normal":
-        s.add_joint("normal", dof, dof2, coeffs=[v["a1"], v["a2"], v["a3"]])
-
-
 def build_mdof(
     pattern: Pattern,
     joint: str,
@@ -161,13 +139,6 @@ def build_mdof(
 
 
 # ------------------------------------------------------------------ equation error
-def _derivs(t: np.ndarray, y: np.ndarray, periodic: bool) -> tuple[np.ndarray, np.ndarray]:
-    from .identify import _derivatives
-
-    vs, acc = zip(*(_derivatives(t, y[:, i], periodic) for i in range(y.shape[1])), strict=True)
-    return np.stack(vs, axis=1), np.stack(acc, axis=1)
-
-
 def equation_error_mdof(
     t: np.ndarray,
     u: np.ndarray,
@@ -190,13 +161,13 @@ def equation_error_mdof(
     force the joint must supply (``joint_force``: ``bᵀ``-projection of the residual force).
     """
     n = pattern.n
-    xd, xdd = _derivs(t, y, periodic)
+    xd, xdd = column_derivatives(t, y, periodic)
     b = np.zeros(n)
     b[joint_dofs[0]] = 1.0
     if joint_dofs[1] is not None:
         b[joint_dofs[1]] = -1.0
     if excitation == "base":
-        ud = _derivs(t, u[:, None], periodic)[0][:, 0]
+        ud = column_derivatives(t, u[:, None], periodic)[0][:, 0]
         xs, xds = y - u[:, None], xd - ud[:, None]
         rhs = -(xdd @ mass.T) if mass is not None else np.zeros_like(y)
     else:
@@ -338,11 +309,9 @@ def identify_mdof(
     start_samples: int = 4096,
     max_nfev: int = 200,
     estimate_initial_state: bool = True,
-) -> Any:
-    """Multi-DOF :func:`~contactlab.structure.identify` (``y`` 2-D); see there."""
-    from .identify import IdentifiedModel, _with_state
-
-    t0 = time.perf_counter()
+) -> dict[str, Any]:
+    """Multi-DOF :func:`~contactlab.structure.identify` (``y`` 2-D; see there): the fields of
+    the :class:`~contactlab.structure.IdentifiedModel` it builds."""
     if joint not in MDOF_JOINTS:
         raise InputError(
             f"with several DOFs, joint must be one of {', '.join(MDOF_JOINTS)}; got {joint!r}"
@@ -418,7 +387,7 @@ def identify_mdof(
                                    periodic=bool(periodic), joint_stiffness=kj,
                                    coulomb=coulomb)  # fmt: skip
 
-    xd, _ = _derivs(t, y, bool(periodic))
+    xd, _ = column_derivatives(t, y, bool(periodic))
     d_rms = max(float(np.std(y @ b)), 1e-300)
     y_rms = max(float(np.std(y)), 1e-300)
     # from the measured start when the state is estimated, else the record starts from rest
@@ -455,44 +424,28 @@ def identify_mdof(
 
     def params(st: dict[str, float]) -> list[Parameter]:
         ps = _start_params(st, ee, pattern, joint, b, d_rms, mass_m, x0s, v0s, y_rms)
-        return _with_state(ps, estimate_initial_state, prefixes=("x0_", "v0_"))
+        return hold_state(ps, estimate_initial_state, prefixes=("x0_", "v0_"))
 
     best_ps = params(starts[0])
     if multistart and len(starts) > 1:
         n_s = min(int(start_samples), nt)
-        best = math.inf
-        for st in starts:
-            ps = params(st)
-            try:
-                fr = least_squares_fit(residual_on(n_s, 2), ps, max_nfev=25, ftol=1e-5,
-                                       xtol=1e-5, gtol=1e-8)  # fmt: skip
-            except ContactLabError as exc:
-                records.append({"start": st, "cost": None, "error": str(exc)})
-                continue
-            cost = float(np.sqrt(fr.chisqr / max(fr.ndata, 1)))
-            records.append({"start": st, "rms_short": cost})
-            if cost < best:
-                best = cost
-                best_ps = [Parameter(p.name, fr.params[p.name].value, vary=p.vary, min=p.min,
-                                     max=p.max, unit=p.unit, scale=p.scale)
-                           for p in ps]  # fmt: skip
+        tried = [(st, params(st)) for st in starts]
+        best_ps = best_start(tried, residual_on(n_s, 2), records) or best_ps
     fit = least_squares_fit(residual_on(nt, substeps), best_ps, max_nfev=max_nfev, ftol=1e-7,
                             xtol=1e-7, gtol=1e-10)  # fmt: skip
     v = fit.values
-    model = IdentifiedModel(
-        structure=build_mdof(pattern, joint, v, jdofs, mass_m),
-        joint=joint,
-        excitation=excitation,
-        fit=fit,
-        x0=[float(v[f"x0_{i}"]) for i in range(n)],
-        v0=[float(v[f"v0_{i}"]) for i in range(n)],
-        substeps=int(substeps),
-        interpolation=interpolation,
-        rms=float(np.sqrt(fit.chisqr / max(fit.ndata, 1))),
-        starts=records,
-        input_dof=input_dof if excitation == "force" else None,
-        joint_dofs=jdofs,
-        pattern=pattern,
-    )
-    model.elapsed = time.perf_counter() - t0
-    return model
+    return {
+        "structure": build_mdof(pattern, joint, v, jdofs, mass_m),
+        "joint": joint,
+        "excitation": excitation,
+        "fit": fit,
+        "x0": [float(v[f"x0_{i}"]) for i in range(n)],
+        "v0": [float(v[f"v0_{i}"]) for i in range(n)],
+        "substeps": int(substeps),
+        "interpolation": interpolation,
+        "rms": float(np.sqrt(fit.chisqr / max(fit.ndata, 1))),
+        "starts": records,
+        "input_dof": input_dof if excitation == "force" else None,
+        "joint_dofs": jdofs,
+        "pattern": pattern,
+    }

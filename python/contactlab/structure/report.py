@@ -174,7 +174,7 @@ def _mdof_loop(ax: Any, model: IdentifiedModel, sim: Any, t: np.ndarray, u: np.n
     """Several DOFs: the joint force against the joint's relative displacement, identified
     and reconstructed from the equations of motion with the identified ``M``, ``C``, ``K``
     (the force ``b F`` left over, projected on the joint's direction ``b``)."""
-    from .identify_mdof import _derivs
+    from ._fitkit import column_derivatives
 
     s = model.structure
     i, j = model.joint_dofs or (0, None)
@@ -182,13 +182,13 @@ def _mdof_loop(ax: Any, model: IdentifiedModel, sim: Any, t: np.ndarray, u: np.n
     b[i] = 1.0
     if j is not None:
         b[j] = -1.0
-    xd, xdd = _derivs(t, y, False)
+    xd, xdd = column_derivatives(t, y, False)
     if model.excitation == "force":
         f = np.zeros_like(y)
         f[:, model.input_dof if model.input_dof is not None else s.n - 1] = u
         left = f - xdd @ s.M.T - xd @ s.C.T - y @ s.K.T
     else:
-        ud = _derivs(t, u[:, None], False)[0]
+        ud = column_derivatives(t, u[:, None], False)[0]
         left = -(xdd @ s.M.T) - (xd - ud) @ s.C.T - (y - u[:, None]) @ s.K.T
     ax.plot(y @ b, left @ b / float(b @ b), ".", ms=1.5, alpha=0.4, color="0.5",
             label="reconstructed from the equations of motion")  # fmt: skip
