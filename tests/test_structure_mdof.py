@@ -128,6 +128,9 @@ def test_mdof_json_round_trip_and_bad_input(tmp_path):
         identify(t, u, y, joint="normal")
     with pytest.raises(contactlab.InputError, match="differ in length"):
         identify(t, u[:-1], y, joint="jenkins")
+    # the structure diagnosis takes one DOF: a sentence, not a wrong answer
+    with pytest.raises(contactlab.InputError, match="single-DOF"):
+        contactlab.diagnose((t, u, y[:, 1]), base=m)
 
 
 def test_cli_identify_several_y_channels(tmp_path, capsys):
