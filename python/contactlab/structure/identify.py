@@ -389,14 +389,14 @@ def _joint_grid_plan(
     mass: float | None,
     t: np.ndarray,
     res: Any,
-    keep: int = 6,
+    keep: int = 10,
 ) -> list[tuple[dict[str, Any], dict[str, Any], dict[str, float]]]:
     """The ``keep`` best starts of a friction joint on a grid of total stiffness (natural
     frequency), joint share and slip force, each judged by one simulation (``res``)."""
     dt = float(np.median(np.diff(t)))
     m = float(mass) if mass is not None else float(lin["m"])
     scored = []
-    for f in np.geomspace(1.0 / max(float(t[-1] - t[0]), dt), 1.0 / (6.0 * dt), 8):
+    for f in np.geomspace(1.0 / max(float(t[-1] - t[0]), dt), 1.0 / (6.0 * dt), 12):
         k = m * (2 * np.pi * f) ** 2
         li = {**lin, "m": m, "k": k, "c": 0.02 * math.sqrt(k * m)}
         for kf in (0.5, 0.85):
