@@ -122,7 +122,7 @@ def plot_amplitude_dependence(ad: AmplitudeDependence, ax: Any = None) -> Any:
     import matplotlib.pyplot as plt
 
     if ax is None:
-        _, ax = plt.subplots(1, 2, figsize=(9, 3.5))
+        _, ax = plt.subplots(1, 2, figsize=(9, 3.5), layout="constrained")
     ax[0].semilogx(ad.amplitude, ad.frequency_hz, "o-")
     ax[0].set_xlabel("amplitude [m]")
     ax[0].set_ylabel("natural frequency [Hz]")

@@ -245,7 +245,7 @@ def plot_modal_amplitude_dependence(ads: list[ModalAmplitudeDependence], ax: Any
     import matplotlib.pyplot as plt
 
     if ax is None:
-        _, ax = plt.subplots(1, 2, figsize=(9, 3.5))
+        _, ax = plt.subplots(1, 2, figsize=(9, 3.5), layout="constrained")
     for ad in ads:
         lab = f"mode {ad.mode + 1} (x{ad.ref_dof})"
         ax[0].semilogx(ad.amplitude, ad.frequency_hz, "o-", label=lab)

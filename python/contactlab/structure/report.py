@@ -103,7 +103,7 @@ def build_structure_report(
             ad = amplitude_dependence(model.structure, amps)
             summary["amplitude_dependence"] = ad.to_dict()
             rep.section("Amplitude-dependent frequency and damping")
-            fig, ax2 = plt.subplots(1, 2, figsize=(9, 3.5))
+            fig, ax2 = plt.subplots(1, 2, figsize=(9, 3.5), layout="constrained")
             plot_amplitude_dependence(ad, ax2)
             rep.figure(fig, "amplitude", "Equivalent-linear natural frequency and damping.")
         except Exception:
@@ -133,7 +133,7 @@ def _mdof_amplitude(rep: Any, model: IdentifiedModel, y: np.ndarray, summary: di
         return
     summary["amplitude_dependence"] = [ad.to_dict() for ad in ads]
     rep.section("Amplitude-dependent frequency and damping of each mode")
-    fig, ax = plt.subplots(1, 2, figsize=(9, 3.5))
+    fig, ax = plt.subplots(1, 2, figsize=(9, 3.5), layout="constrained")
     plot_modal_amplitude_dependence(ads, ax)
     rep.figure(fig, "amplitude", "Equivalent-linear natural frequency and damping ratio of "
                "each mode against the amplitude of its reference DOF (mode shape and joint "
