@@ -122,6 +122,10 @@ def test_mdof_json_round_trip_and_bad_input(tmp_path):
         identify(t, u, y, joint="jenkins", input_dof=2)
     with pytest.raises(contactlab.InputError, match="masses"):
         identify(t, u, y, joint="jenkins", excitation="base")
+    with pytest.raises(contactlab.InputError, match="constant"):
+        identify(t, u, np.column_stack([y[:, 0], np.full(t.size, 1e-3)]), joint="jenkins")
+    with pytest.raises(contactlab.InputError, match="K mask must free every diagonal"):
+        identify(t, u, y, joint="jenkins", masks={"K": [[0, 1], [1, 1]]})
     with pytest.raises(contactlab.InputError, match="symmetric"):
         identify(t, u, y, joint="jenkins", masks={"K": [[1, 1], [0, 1]]})
     with pytest.raises(contactlab.InputError, match="several DOFs"):

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from .._arrays import as_1d
-from .._physical import MAX_MAGNITUDE
+from .._physical import MAX_MAGNITUDE, check_channel
 from ..errors import ContactLabError, InputError
 from ..fitting import Parameter, least_squares_fit
 from ._fitkit import add_fitted_joint, best_start, column_derivatives, hold_state
@@ -90,16 +90,20 @@ def _mask(a: Any, name: str, n: int | None) -> np.ndarray:
 def mask_pattern(masks: dict[str, Any], n: int) -> Pattern:
     """Free entries of ``M``, ``C``, ``K`` given as symmetric boolean masks (a missing
     ``M`` mask: the diagonal; missing ``C``: the same as ``K``)."""
+    unknown = sorted(set(masks) - {"M", "C", "K"})
+    if unknown:
+        raise InputError(f"masks are given for M, C and K only, not {', '.join(unknown)}")
     mk = {k: _mask(v, f"{k} mask", n) for k, v in masks.items() if v is not None}
     if "K" not in mk:
         raise InputError("masks need at least the K mask (free entries of the stiffness)")
+    for kind, m in mk.items():
+        if not np.all(np.diag(m)):
+            i = int(np.argmin(np.diag(m)))
+            raise InputError(f"the {kind} mask must free every diagonal entry ([{i}, {i}] isn't)")
     mk.setdefault("M", np.eye(n, dtype=bool))
     mk.setdefault("C", mk["K"].copy())
     basis: dict[str, list[tuple[str, np.ndarray]]] = {"M": [], "C": [], "K": []}
     for kind in ("M", "C", "K"):
-        if not np.all(np.diag(mk[kind])):
-            i = int(np.argmin(np.diag(mk[kind])))
-            raise InputError(f"the {kind} mask must free every diagonal entry ([{i}, {i}] isn't)")
         for i in range(n):
             for j in range(i, n):
                 if mk[kind][i, j]:
@@ -332,11 +336,12 @@ def identify_mdof(
         raise InputError(f"t, u and y differ in length ({t.size}, {u.size}, {nt})")
     if nt < 20:
         raise InputError(f"{nt} samples are too few to identify a structure")
-    for name, a in (("y", y), ("u", u)):
-        big = float(np.max(np.abs(a)))
-        if big > MAX_MAGNITUDE:
-            raise InputError(f"{name} reaches {big:.3g}: beyond any physical record; a unit "
-                             "mix-up or a corrupt file?")  # fmt: skip
+    big = float(np.max(np.abs(u)))
+    if big > MAX_MAGNITUDE:
+        raise InputError(f"u reaches {big:.3g}: beyond any physical input; a unit mix-up or a "
+                         "corrupt file?")  # fmt: skip
+    for j in range(n):  # each DOF's displacement: in range, not zero, not constant
+        check_channel(f"y[:, {j}]", y[:, j], "m", f"displacement (DOF {j})")
     if np.any(np.diff(t) <= 0):
         raise InputError("t must be strictly increasing")
     if isinstance(structure, str) and structure == "chain" and masks is None:
