@@ -7,37 +7,312 @@
 //! start of the step (the dense path starts from the last acceleration): where the joints are
 //! nearly linear over a step, one residual evaluation meets the tolerance. Both paths converge
 //! to the same tolerance, so they agree to about `rtol` per step (the tests compare them).
+//!
+//! The integrator is generic over the joint set ([`Joints`]) and monomorphised: a single
+//! Masing joint on the exponential curve (the common case) has its own implementation whose
+//! Newton iterations cost one `exp` and no dispatch or division (the active branch's constants
+//! are cached when the memory changes); every other joint set goes through [`Dyn`], the
+//! per-law dispatch of [`JointLaw`].
 
-use super::joint::{JointState, Trial};
+use super::joint::{masing_commit, masing_trial, Joint, JointLaw, JointState, MasingCurve, Trial};
 use super::newmark::{Inputs, Options, Response, Status, Structure};
 use crate::error::CoreError;
+use crate::masing::MasingState;
 
-/// The state at the start of a step (`x`, `v`, `a`, load `f`) and the joints' histories.
+/// Sum of the joint forces at a trial point, the largest single force (for the convergence
+/// scale), and the summed tangents `∂/∂d`, `∂/∂ḋ`.
+#[derive(Debug, Clone, Copy, Default)]
+struct Sum {
+    f: f64,
+    fmax: f64,
+    kt: f64,
+    ct: f64,
+}
+
+/// The joints of a one-DOF structure (all between the DOF and the ground, `d = x`).
+trait Joints {
+    /// Forces and tangents at `x1` (velocity `v1`), moving from the committed `x0`. The trial
+    /// is remembered: [`Joints::commit`] accepts the last one.
+    fn trial(&mut self, x0: f64, x1: f64, v1: f64) -> Sum;
+    /// Earliest fraction `θ ∈ (0, 1)` of the step `x0 → x1` at which a joint changes
+    /// character (see [`JointLaw::event`]); 1 when none does.
+    fn event(&self, x0: f64, x1: f64, v0: f64, v1: f64) -> f64;
+    /// Accept the last trial (at `x1`, from `x0`), with the work bookkeeping.
+    fn commit(&mut self, x0: f64, x1: f64) -> Result<(), CoreError>;
+    /// Write each joint's force, work and dissipated energy at `x` as sample `i`.
+    fn record(&self, x: f64, i: usize, out: &mut Response);
+}
+
+/// Any set of joints, through [`JointLaw`]'s dispatch.
+struct Dyn<'a> {
+    joints: &'a [Joint],
+    states: Vec<JointState>,
+    trials: Vec<Trial>,
+    /// Each joint's force at the committed point, cumulative work, stored energy at the start.
+    jf: Vec<f64>,
+    jwork: Vec<f64>,
+    stored0: Vec<f64>,
+}
+
+impl<'a> Dyn<'a> {
+    /// Joints loaded from the virgin state to `x0`; returns them and their [`Sum`] there.
+    fn new(joints: &'a [Joint], x0: f64, v0: f64) -> Result<(Self, Sum), CoreError> {
+        let nj = joints.len();
+        let mut states: Vec<JointState> = joints.iter().map(|j| j.law.fresh_state()).collect();
+        let mut jf = vec![0.0; nj];
+        let mut sum = Sum::default();
+        for ((j, st), f) in joints.iter().zip(states.iter_mut()).zip(jf.iter_mut()) {
+            let tr = j.law.trial(st, 0.0, x0, v0);
+            j.law.commit(st, 0.0, x0, &tr)?;
+            *f = tr.f;
+            sum.f += tr.f;
+            sum.kt += tr.kt;
+            sum.ct += tr.ct;
+        }
+        let stored0 = joints
+            .iter()
+            .zip(&states)
+            .map(|(j, st)| j.law.stored_energy(st, x0))
+            .collect();
+        Ok((
+            Self {
+                joints,
+                states,
+                trials: vec![Trial::default(); nj],
+                jf,
+                jwork: vec![0.0; nj],
+                stored0,
+            },
+            sum,
+        ))
+    }
+}
+
+impl Joints for Dyn<'_> {
+    #[inline(always)]
+    fn trial(&mut self, x0: f64, x1: f64, v1: f64) -> Sum {
+        let mut out = Sum::default();
+        for ((j, st), tr) in self.joints.iter().zip(&self.states).zip(&mut self.trials) {
+            *tr = j.law.trial(st, x0, x1, v1);
+            out.f += tr.f;
+            out.fmax = out.fmax.max(tr.f.abs());
+            out.kt += tr.kt;
+            out.ct += tr.ct;
+        }
+        out
+    }
+
+    #[inline]
+    fn event(&self, x0: f64, x1: f64, v0: f64, v1: f64) -> f64 {
+        let mut theta = 1.0_f64;
+        for (j, js) in self.joints.iter().zip(&self.states) {
+            if let Some(th) = j.law.event(js, x0, x1, v0, v1) {
+                theta = theta.min(th);
+            }
+        }
+        theta
+    }
+
+    #[inline]
+    fn commit(&mut self, x0: f64, x1: f64) -> Result<(), CoreError> {
+        let parts = self.joints.iter().zip(&self.trials).zip(&mut self.states);
+        let books = self.jwork.iter_mut().zip(&mut self.jf);
+        for (((j, tr), st), (work, f)) in parts.zip(books) {
+            *work += 0.5 * (*f + tr.f) * (x1 - x0);
+            j.law.commit(st, x0, x1, tr)?;
+            *f = tr.f;
+        }
+        Ok(())
+    }
+
+    // Row-major index arithmetic below len(t) · n_joints (the output size checked by the caller).
+    #[inline]
+    #[allow(clippy::arithmetic_side_effects)]
+    fn record(&self, x: f64, i: usize, out: &mut Response) {
+        let nj = self.joints.len();
+        for (jn, j) in self.joints.iter().enumerate() {
+            let at = i * nj + jn;
+            out.joint_force[at] = self.jf[jn];
+            out.joint_work[at] = self.jwork[jn];
+            out.joint_dissipated[at] =
+                self.jwork[jn] - (j.law.stored_energy(&self.states[jn], x) - self.stored0[jn]);
+        }
+    }
+}
+
+/// One Masing joint on the exponential curve `f(u) = h0 (1 − e^(−ac |u|)) sgn u`, branch scale
+/// λ. The branch the joint is on (moving on in its direction) is cached when the memory
+/// changes: `F = ha + A (1 − e^(−p |x − xa|)) sgn(x − xa)`, `∂F/∂x = k0 e^(−p |x − xa|)` with
+/// `A = λ h0`, `p = ac / λ` (`λ = 1`, `xa = ha = 0` on the virgin curve), valid until `x`
+/// reaches the branch's closure target. A trial on that branch costs one `exp`; any other
+/// (a reversal inside the trial, a loop closing) walks the memory as [`masing_trial`] does.
+struct MasingExp {
+    curve: MasingCurve,
+    h0: f64,
+    ac: f64,
+    scale: f64,
+    /// `h0 · ac`, `λ h0`, `ac / λ`.
+    k0: f64,
+    amp_branch: f64,
+    p_branch: f64,
+    st: MasingState,
+    /// The cached branch: anchor, amplitude, exponent rate, and `lim`: the branch holds while
+    /// `x · dir < lim` (`+∞` on the virgin curve).
+    xa: f64,
+    ha: f64,
+    amp: f64,
+    p: f64,
+    lim: f64,
+    /// The last trial: force, tangent, memory update (as [`Trial::aux`]).
+    f: f64,
+    kt: f64,
+    aux: usize,
+    jf: f64,
+    jwork: f64,
+    stored0: f64,
+}
+
+impl MasingExp {
+    /// The joint loaded from the virgin state to `x0`; `None` unless `joints` is exactly one
+    /// Masing joint on the exponential curve.
+    fn new(joints: &[Joint], x0: f64) -> Option<(Self, Sum)> {
+        let [Joint {
+            law: JointLaw::Masing { curve, scale },
+            ..
+        }] = joints
+        else {
+            return None;
+        };
+        let MasingCurve::Exp(c) = curve else {
+            return None;
+        };
+        let (h0, ac, scale) = (c.h0, c.ac, *scale);
+        let mut me = Self {
+            curve: curve.clone(),
+            h0,
+            ac,
+            scale,
+            k0: h0 * ac,
+            amp_branch: scale * h0,
+            p_branch: ac / scale,
+            st: MasingState::default(),
+            xa: 0.0,
+            ha: 0.0,
+            amp: h0,
+            p: ac,
+            lim: f64::INFINITY,
+            f: 0.0,
+            kt: 0.0,
+            aux: 0,
+            jf: 0.0,
+            jwork: 0.0,
+            stored0: 0.0,
+        };
+        let s = me.trial(0.0, x0, 0.0);
+        masing_commit(&mut me.st, x0, me.f, me.aux);
+        me.refresh();
+        me.jf = me.f;
+        me.stored0 = me.stored();
+        Some((me, s))
+    }
+
+    /// Cache the branch that motion in the current direction follows.
+    #[inline(always)]
+    fn refresh(&mut self) {
+        let Some((top, rest)) = self.st.stack.split_last() else {
+            (self.xa, self.ha, self.amp, self.p) = (0.0, 0.0, self.h0, self.ac);
+            self.lim = f64::INFINITY;
+            return;
+        };
+        // Moving on, the branch closes at the reversal below (or, from the first reversal,
+        // rejoins the virgin curve at its mirror point).
+        let target = rest.last().map_or(-top.x, |b| b.x);
+        (self.xa, self.ha) = (top.x, top.h);
+        (self.amp, self.p) = (self.amp_branch, self.p_branch);
+        self.lim = target * f64::from(self.st.dir);
+    }
+
+    #[inline(always)]
+    fn stored(&self) -> f64 {
+        0.5 * self.st.h * self.st.h / self.k0
+    }
+}
+
+impl Joints for MasingExp {
+    // `2 · (reversals kept)`: at most twice the stack length, a Vec's length.
+    #[inline(always)]
+    #[allow(clippy::arithmetic_side_effects)]
+    fn trial(&mut self, _x0: f64, x1: f64, _v1: f64) -> Sum {
+        let dx = x1 - self.st.x;
+        let dir = f64::from(self.st.dir);
+        if dx * dir > 0.0 && x1 * dir < self.lim || dx == 0.0 {
+            let u = x1 - self.xa;
+            let e = (-self.p * u.abs()).exp();
+            self.f = self.ha + (self.amp - self.amp * e).copysign(u);
+            self.kt = self.k0 * e;
+            self.aux = 2 * self.st.stack.len();
+        } else {
+            (self.f, self.kt, self.aux) = masing_trial(&self.curve, self.scale, &self.st, x1);
+        }
+        Sum {
+            f: self.f,
+            fmax: self.f.abs(),
+            kt: self.kt,
+            ct: 0.0,
+        }
+    }
+
+    #[inline(always)]
+    fn event(&self, _x0: f64, _x1: f64, v0: f64, v1: f64) -> f64 {
+        // a velocity reversal (the law is rate-independent, so that is its only event)
+        if v0 * v1 < 0.0 {
+            let t = v0 / (v0 - v1);
+            if t > 0.0 && t < 1.0 {
+                return t;
+            }
+        }
+        1.0
+    }
+
+    #[inline(always)]
+    fn commit(&mut self, x0: f64, x1: f64) -> Result<(), CoreError> {
+        self.jwork += 0.5 * (self.jf + self.f) * (x1 - x0);
+        masing_commit(&mut self.st, x1, self.f, self.aux);
+        self.refresh();
+        self.jf = self.f;
+        Ok(())
+    }
+
+    #[inline(always)]
+    fn record(&self, _x: f64, i: usize, out: &mut Response) {
+        out.joint_force[i] = self.jf;
+        out.joint_work[i] = self.jwork;
+        out.joint_dissipated[i] = self.jwork - (self.stored() - self.stored0);
+    }
+}
+
+/// The state at the start of a step (`x`, `v`, `a`, load `f`), the energies, and the joints'
+/// summed force and tangents there (Newton's predictor).
 struct State {
     x: f64,
     v: f64,
     a: f64,
     f: f64,
-    joints: Vec<JointState>,
-    /// Each joint's force at `x`.
-    jf: Vec<f64>,
-    jwork: Vec<f64>,
-    stored0: Vec<f64>,
     e_in: f64,
     e_damp: f64,
-    /// Σ joint forces, `∂/∂d` and `∂/∂ḋ` at the start of the step (Newton's predictor).
     g: f64,
     kt: f64,
     ct: f64,
 }
 
-/// A converged step (not yet committed).
+/// A converged step (not yet committed) and the joints' sum at its end.
 struct Step {
     dx: f64,
     x1: f64,
     v1: f64,
     a1: f64,
     f1: f64,
+    joints: Sum,
 }
 
 /// External load at fraction `tau` of interval `i → i+1` (the dense path's `load`, n = 1).
@@ -61,18 +336,17 @@ fn load(inp: &Inputs<'_>, i: usize, tau: f64) -> f64 {
     out
 }
 
-/// One Newmark step of length `h` to load `f1`; the joints' trial states in `trials`.
-/// Returns the step and the Newton iterations used, or `None` if Newton failed.
+/// One Newmark step of length `h` to load `f1` (`mck`: the scalar M, C, K). Returns the step
+/// and the Newton iterations used, or `None` if Newton failed.
 #[inline(always)]
-fn newton(
-    s: &Structure,
+fn newton<J: Joints>(
+    jt: &mut J,
+    (m, c, k): (f64, f64, f64),
     w: &State,
     h: f64,
     f1: f64,
-    trials: &mut [Trial],
     opts: &Options,
 ) -> Option<(Step, u64)> {
-    let (m, c, k) = (s.m[0], s.c[0], s.k[0]);
     let (b, g) = (0.25 * h * h, 0.5 * h);
     // Predictor: the step of the equation linearised at its start (joint forces by their
     // tangents there). Where the joints are nearly linear over a step (stuck, or sliding far
@@ -93,6 +367,7 @@ fn newton(
             w.a
         }
     };
+    let jac0 = m + g * c + b * k;
     for it in 1..=opts.max_iter as u64 {
         let asum = w.a + a1;
         let dx = h * w.v + b * asum;
@@ -100,30 +375,25 @@ fn newton(
         let v1 = w.v + g * asum;
         let mut r = -f1;
         r += m * a1 + c * v1 + k * x1;
-        let mut scale = f1.abs() + ((m * a1).abs() + (c * v1).abs() + (k * x1).abs());
-        let mut jac = m + g * c + b * k;
-        if let ([j], [st], [tr]) = (s.joints.as_slice(), w.joints.as_slice(), &mut *trials) {
-            // one joint (the common case): no iterator set-up per Newton iteration
-            *tr = j.law.trial(st, w.x, x1, v1);
-            scale = scale.max(tr.f.abs());
-            r += tr.f;
-            jac += b * tr.kt + g * tr.ct;
-        } else {
-            for ((j, st), tr) in s.joints.iter().zip(&w.joints).zip(trials.iter_mut()) {
-                *tr = j.law.trial(st, w.x, x1, v1);
-                scale = scale.max(tr.f.abs());
-                r += tr.f;
-            }
-            for tr in trials.iter() {
-                jac += b * tr.kt + g * tr.ct;
-            }
-        }
+        let scale = f1.abs() + ((m * a1).abs() + (c * v1).abs() + (k * x1).abs());
+        let js = jt.trial(w.x, x1, v1);
+        let scale = scale.max(js.fmax);
+        r += js.f;
         if !r.is_finite() {
             return None;
         }
         if r.abs() <= opts.rtol * scale.max(f64::MIN_POSITIVE) {
-            return Some((Step { dx, x1, v1, a1, f1 }, it));
+            let st = Step {
+                dx,
+                x1,
+                v1,
+                a1,
+                f1,
+                joints: js,
+            };
+            return Some((st, it));
         }
+        let jac = jac0 + b * js.kt + g * js.ct;
         if !(jac != 0.0 && jac.is_finite()) {
             return None;
         }
@@ -134,41 +404,25 @@ fn newton(
 
 /// Commit a converged step, with the energy bookkeeping.
 #[inline(always)]
-fn accept(s: &Structure, w: &mut State, st: &Step, trials: &[Trial]) -> Result<(), CoreError> {
-    let c = s.c[0];
+fn accept<J: Joints>(jt: &mut J, c: f64, w: &mut State, st: &Step) -> Result<(), CoreError> {
     w.e_in += st.dx * 0.5 * (w.f + st.f1);
     w.e_damp += st.dx * (c * (0.5 * (w.v + st.v1)));
-    for (jn, (j, tr)) in s.joints.iter().zip(trials).enumerate() {
-        w.jwork[jn] += 0.5 * (w.jf[jn] + tr.f) * (st.x1 - w.x);
-        j.law.commit(&mut w.joints[jn], w.x, st.x1, tr)?;
-        w.jf[jn] = tr.f;
-    }
+    jt.commit(w.x, st.x1)?;
     w.x = st.x1;
     w.v = st.v1;
-    w.g = trials.iter().map(|t| t.f).sum();
-    w.kt = trials.iter().map(|t| t.kt).sum();
-    w.ct = trials.iter().map(|t| t.ct).sum();
+    (w.g, w.kt, w.ct) = (st.joints.f, st.joints.kt, st.joints.ct);
     w.a = st.a1;
     w.f = st.f1;
     Ok(())
 }
 
-/// Write the state as sample `i` (`i < len(t)`; the joint arrays are `len(t) × n_joints`).
-// Row-major index arithmetic below len(t) · n_joints, checked by the caller.
+/// Write the state as sample `i` (`i < len(t)`).
 #[inline(always)]
-#[allow(clippy::arithmetic_side_effects)]
-fn record(s: &Structure, w: &State, out: &mut Response, i: usize) {
+fn record<J: Joints>(jt: &J, w: &State, out: &mut Response, i: usize) {
     out.x[i] = w.x;
     out.v[i] = w.v;
     out.a[i] = w.a;
-    let nj = s.joints.len();
-    for (jn, j) in s.joints.iter().enumerate() {
-        let at = i * nj + jn;
-        out.joint_force[at] = w.jf[jn];
-        out.joint_work[at] = w.jwork[jn];
-        out.joint_dissipated[at] =
-            w.jwork[jn] - (j.law.stored_energy(&w.joints[jn], w.x) - w.stored0[jn]);
-    }
+    jt.record(w.x, i, out);
     out.input_work[i] = w.e_in;
     out.damping_work[i] = w.e_damp;
 }
@@ -181,6 +435,23 @@ pub(super) fn simulate(
     v0: f64,
     opts: &Options,
 ) -> Result<Response, CoreError> {
+    if let Some((mut jt, start)) = MasingExp::new(&s.joints, x0) {
+        return run(s, inp, x0, v0, opts, &mut jt, start);
+    }
+    let (mut jt, start) = Dyn::new(&s.joints, x0, v0)?;
+    run(s, inp, x0, v0, opts, &mut jt, start)
+}
+
+/// The integration loop for the joint set `jt` (already loaded to `x0`, with `start` there).
+fn run<J: Joints>(
+    s: &Structure,
+    inp: &Inputs<'_>,
+    x0: f64,
+    v0: f64,
+    opts: &Options,
+    jt: &mut J,
+    start: Sum,
+) -> Result<Response, CoreError> {
     let nt = inp.t.len();
     let nj = s.joints.len();
     let total_j = nt.checked_mul(nj).ok_or(CoreError::InvalidParameter {
@@ -188,26 +459,9 @@ pub(super) fn simulate(
         value: nt as f64,
         reason: "too many samples",
     })?;
-    let mut joints: Vec<JointState> = s.joints.iter().map(|j| j.law.fresh_state()).collect();
-    let mut jf = vec![0.0; nj];
-    let mut start_tangents = (0.0, 0.0, 0.0);
-    for ((j, st), f) in s.joints.iter().zip(joints.iter_mut()).zip(jf.iter_mut()) {
-        let tr = j.law.trial(st, 0.0, x0, v0);
-        j.law.commit(st, 0.0, x0, &tr)?;
-        *f = tr.f;
-        start_tangents.0 += tr.f;
-        start_tangents.1 += tr.kt;
-        start_tangents.2 += tr.ct;
-    }
     let f0 = load(inp, 0, 0.0);
-    let stored0: Vec<f64> = s
-        .joints
-        .iter()
-        .zip(&joints)
-        .map(|(j, st)| j.law.stored_energy(st, x0))
-        .collect();
     // a0 = (f0 − C v0 − K x0 − G0) / M
-    let m = s.m[0];
+    let (m, c, k) = (s.m[0], s.c[0], s.k[0]);
     if !(m != 0.0 && m.is_finite()) {
         return Err(CoreError::InvalidParameter {
             name: "M",
@@ -215,27 +469,18 @@ pub(super) fn simulate(
             reason: "mass matrix is singular",
         });
     }
-    let mut rhs = f0 - s.c[0] * v0 - s.k[0] * x0;
-    for g in &jf {
-        rhs -= g;
-    }
+    let rhs = f0 - c * v0 - k * x0 - start.f;
     let mut w = State {
         x: x0,
         v: v0,
         a: rhs / m,
         f: f0,
-        joints,
-        jf,
-        jwork: vec![0.0; nj],
-        stored0,
         e_in: 0.0,
         e_damp: 0.0,
-        g: 0.0,
-        kt: 0.0,
-        ct: 0.0,
+        g: start.f,
+        kt: start.kt,
+        ct: start.ct,
     };
-    (w.g, w.kt, w.ct) = start_tangents;
-    let mut trials = vec![Trial::default(); nj];
     let mut out = Response {
         x: vec![0.0; nt],
         v: vec![0.0; nt],
@@ -250,7 +495,7 @@ pub(super) fn simulate(
         n_steps: 0,
         n_iter: 0,
     };
-    record(s, &w, &mut out, 0);
+    record(jt, &w, &mut out, 0);
     out.n_out = 1;
     for (i, pair) in inp.t.windows(2).enumerate() {
         let big_h = pair[1] - pair[0];
@@ -263,7 +508,7 @@ pub(super) fn simulate(
             let h = step * big_h;
             let tau1 = if step >= 1.0 - tau { 1.0 } else { tau + step };
             let f1 = load(inp, i, tau1);
-            let Some((st, it)) = newton(s, &w, h, f1, &mut trials, opts) else {
+            let Some((st, it)) = newton(jt, (m, c, k), &w, h, f1, opts) else {
                 halvings = halvings.saturating_add(1);
                 if halvings > opts.max_halvings {
                     out.status = Status::NoConvergence {
@@ -277,20 +522,17 @@ pub(super) fn simulate(
             };
             out.n_iter = out.n_iter.saturating_add(it);
             if events < opts.max_events {
-                let mut theta = 1.0_f64;
-                for (j, js) in s.joints.iter().zip(&w.joints) {
-                    if let Some(th) = j.law.event(js, w.x, st.x1, w.v, st.v1) {
-                        theta = theta.min(th);
+                let theta = jt.event(w.x, st.x1, w.v, st.v1);
+                if theta < 1.0 {
+                    let min_piece = 1e-3 / step;
+                    if theta > min_piece && theta < 1.0 - min_piece {
+                        events = events.saturating_add(1);
+                        frac = step * theta;
+                        continue;
                     }
                 }
-                let min_piece = 1e-3 / step;
-                if theta > min_piece && theta < 1.0 - min_piece {
-                    events = events.saturating_add(1);
-                    frac = step * theta;
-                    continue;
-                }
             }
-            accept(s, &mut w, &st, &trials)?;
+            accept(jt, c, &mut w, &st)?;
             out.n_steps = out.n_steps.saturating_add(1);
             tau = tau1;
             frac = (1.0 - tau).max(0.0);
@@ -302,7 +544,7 @@ pub(super) fn simulate(
             }
         }
         let next = i.saturating_add(1); // < nt
-        record(s, &w, &mut out, next);
+        record(jt, &w, &mut out, next);
         out.n_out = next.saturating_add(1);
     }
     Ok(out)
@@ -319,6 +561,7 @@ mod tests {
     fn laws() -> Result<Vec<JointLaw>, CoreError> {
         Ok(vec![
             JointLaw::masing(MasingCurve::Exp(Exponential::new(3.0, 2e3)?), 2.0)?,
+            JointLaw::masing(MasingCurve::Exp(Exponential::new(2.0, 5e3)?), 1.3)?,
             JointLaw::masing(
                 MasingCurve::Tab(Tabulated::new(
                     &[0.0, 5e-4, 1e-3, 3e-3],
@@ -433,6 +676,71 @@ mod tests {
         Ok(())
     }
 
+    /// The Masing fast path (cached branch, one `exp`) against the dispatch path and the
+    /// operator itself on random walks with nested loops, virgin rejoins, several trials before
+    /// each commit (as Newton makes), and scales other than 2.
+    #[test]
+    fn masing_fast_path_matches_the_operator_on_random_walks() -> Result<(), CoreError> {
+        let curve = MasingCurve::Exp(crate::curve::Exponential::new(40.0, 4e4)?);
+        for &scale in &[2.0, 1.3, 3.7] {
+            let law = JointLaw::masing(curve.clone(), scale)?;
+            let joints = [Joint {
+                law: law.clone(),
+                dof: 0,
+                dof2: None,
+            }];
+            let mut x = 2e-5;
+            let (mut fast, start) = MasingExp::new(&joints, x).ok_or(CoreError::Empty {
+                name: "not a Masing exp joint",
+            })?;
+            let mut st = law.fresh_state();
+            let tr = law.trial(&st, 0.0, x, 0.0);
+            law.commit(&mut st, 0.0, x, &tr)?;
+            assert_eq!(start.f, tr.f);
+            let mut op = crate::masing::MasingState::default();
+            let mut out = [0.0];
+            crate::masing::masing_force(&curve, scale, &[x], &mut out, &mut op)?;
+            let mut seed = 99_u64;
+            let mut uniform = || {
+                seed = seed
+                    .wrapping_mul(6_364_136_223_846_793_005)
+                    .wrapping_add(1_442_695_040_888_963_407);
+                (seed >> 11) as f64 / (1u64 << 53) as f64
+            };
+            for step in 0..4000 {
+                // mostly small moves (loops inside loops), sometimes large, sometimes none
+                let amp = match step % 7 {
+                    0 => 2e-4,
+                    1 => 0.0,
+                    _ => 3e-5 * uniform(),
+                };
+                let xn = x + amp * (uniform() - 0.5);
+                for _ in 0..(step % 3) {
+                    let _ = fast.trial(x, x + 1e-4 * (uniform() - 0.5), 0.0);
+                }
+                let got = fast.trial(x, xn, 0.0);
+                let want = law.trial(&st, x, xn, 0.0);
+                crate::masing::masing_force(&curve, scale, &[xn], &mut out, &mut op)?;
+                let tol = 1e-12 * 40.0 * scale;
+                assert!((got.f - want.f).abs() <= tol, "{} vs {}", got.f, want.f);
+                assert!((got.f - out[0]).abs() <= tol, "{} vs {}", got.f, out[0]);
+                assert!((got.kt - want.kt).abs() <= 1e-12 * want.kt.abs() + 1e-300);
+                assert_eq!(fast.aux, want.aux);
+                fast.commit(x, xn)?;
+                law.commit(&mut st, x, xn, &want)?;
+                if let JointState::Masing(ms) = &st {
+                    assert_eq!(fast.st.stack.len(), ms.stack.len());
+                    for (a, b) in fast.st.stack.iter().zip(&ms.stack) {
+                        assert_eq!((a.x, a.index), (b.x, b.index));
+                        assert!((a.h - b.h).abs() <= tol);
+                    }
+                }
+                x = xn;
+            }
+        }
+        Ok(())
+    }
+
     #[test]
     fn singular_mass_is_an_error() -> Result<(), CoreError> {
         let s = Structure::new(1, &[0.0], &[1.0], &[1.0], vec![])?;
@@ -451,7 +759,7 @@ mod tests {
         #![proptest_config(ProptestConfig::with_cases(24))]
         #[test]
         fn scalar_path_matches_dense_on_random_inputs(
-            which in 0usize..7, two in any::<bool>(), amp in 0.01f64..5.0, base in any::<bool>(),
+            which in 0usize..8, two in any::<bool>(), amp in 0.01f64..5.0, base in any::<bool>(),
             x0 in -2e-3f64..2e-3, v0 in -0.05f64..0.05,
         ) {
             let law = laws().map_err(|e| TestCaseError::fail(e.to_string()))?.swap_remove(which);
