@@ -167,6 +167,10 @@ struct MasingExp {
     f: f64,
     kt: f64,
     aux: usize,
+    /// `|x − xa|` and `e^(−p |x − xa|)` at the last trial on the cached branch in this step
+    /// (`ul` NaN: none).
+    ul: f64,
+    el: f64,
     jf: f64,
     jwork: f64,
     stored0: f64,
@@ -204,6 +208,8 @@ impl MasingExp {
             f: 0.0,
             kt: 0.0,
             aux: 0,
+            ul: f64::NAN,
+            el: 1.0,
             jf: 0.0,
             jwork: 0.0,
             stored0: 0.0,
@@ -232,6 +238,15 @@ impl MasingExp {
         self.lim = target * f64::from(self.st.dir);
     }
 
+    /// A trial off the cached branch (a reversal inside the trial, a loop closing): the
+    /// memory walk of [`masing_trial`]. Out of line, so the Newton loop stays small.
+    #[cold]
+    #[inline(never)]
+    fn walk(&mut self, x1: f64) {
+        (self.f, self.kt, self.aux) = masing_trial(&self.curve, self.scale, &self.st, x1);
+        self.ul = f64::NAN;
+    }
+
     #[inline(always)]
     fn stored(&self) -> f64 {
         0.5 * self.st.h * self.st.h / self.k0
@@ -247,12 +262,23 @@ impl Joints for MasingExp {
         let dir = f64::from(self.st.dir);
         if dx * dir > 0.0 && x1 * dir < self.lim || dx == 0.0 {
             let u = x1 - self.xa;
-            let e = (-self.p * u.abs()).exp();
+            let ua = u.abs();
+            // Newton's later trials move by a small correction from the last one on this
+            // branch: `e^(−p|u|) = e_last · e^(−z)`, `z = p (|u| − |u_last|)`, with `e^(−z)`
+            // by its series (|z| < 1e-3: truncation below 1e-17 relative). NaN `ul`: none.
+            let z = self.p * (ua - self.ul);
+            let e = if z.abs() < 1e-3 {
+                let z2 = z * z;
+                self.el * ((1.0 - z) + z2 * ((0.5 - z * (1.0 / 6.0)) + z2 * (1.0 / 24.0)))
+            } else {
+                (-self.p * ua).exp()
+            };
+            (self.ul, self.el) = (ua, e);
             self.f = self.ha + (self.amp - self.amp * e).copysign(u);
             self.kt = self.k0 * e;
             self.aux = 2 * self.st.stack.len();
         } else {
-            (self.f, self.kt, self.aux) = masing_trial(&self.curve, self.scale, &self.st, x1);
+            self.walk(x1);
         }
         Sum {
             f: self.f,
@@ -279,6 +305,8 @@ impl Joints for MasingExp {
         self.jwork += 0.5 * (self.jf + self.f) * (x1 - x0);
         masing_commit(&mut self.st, x1, self.f, self.aux);
         self.refresh();
+        // each step's first trial is a full `exp` (no drift from chained products)
+        self.ul = f64::NAN;
         self.jf = self.f;
         Ok(())
     }
