@@ -5,10 +5,10 @@
 
 use contactlab_core::curve::{Exponential, Tabulated};
 use contactlab_core::structure::{
-    simulate, Inputs, Joint, JointLaw, MasingCurve, Options, Structure,
+    simulate_into, Buffers, Inputs, Joint, JointLaw, MasingCurve, Options, Structure,
 };
 use contactlab_core::CoreError;
-use numpy::{IntoPyArray, PyReadonlyArray1};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadwriteArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -114,6 +114,51 @@ fn structure_simulate<'py>(
         max_iter,
         ..Options::default()
     };
+    // The outputs are numpy arrays the kernel writes into (no Vec and copy; numpy's large
+    // allocations are also backed by huge pages where the system offers them, so the 64 MB of
+    // a 1e6-sample run are not first-touched 4 kB at a time).
+    let nt = ts.len();
+    let too_many =
+        || crate::errors::to_pyerr(py, &bad("t", "too many samples for the output arrays"));
+    let total = nt.checked_mul(n).ok_or_else(too_many)?;
+    let total_j = nt.checked_mul(joints.len()).ok_or_else(too_many)?;
+    let names = [
+        "x",
+        "v",
+        "a",
+        "joint_force",
+        "joint_work",
+        "joint_dissipated",
+        "input_work",
+        "damping_work",
+    ];
+    let lens = [total, total, total, total_j, total_j, total_j, nt, nt];
+    let arrays: Vec<Bound<'py, PyArray1<f64>>> = lens
+        .iter()
+        .map(|&len| PyArray1::<f64>::zeros(py, len, false))
+        .collect();
+    let mut rws: Vec<PyReadwriteArray1<'py, f64>> =
+        arrays.iter().map(PyArrayMethods::readwrite).collect();
+    let mut slices: Vec<&mut [f64]> = Vec::with_capacity(rws.len());
+    for rw in &mut rws {
+        slices.push(
+            rw.as_slice_mut()
+                .map_err(|_| crate::errors::internal(py, "output array not contiguous"))?,
+        );
+    }
+    let [x, v, a, joint_force, joint_work, joint_dissipated, input_work, damping_work] =
+        <[&mut [f64]; 8]>::try_from(slices)
+            .map_err(|_| crate::errors::internal(py, "output arrays"))?;
+    let mut bufs = Buffers {
+        x,
+        v,
+        a,
+        joint_force,
+        joint_work,
+        joint_dissipated,
+        input_work,
+        damping_work,
+    };
     let r = detach_guarded(py, move || {
         let js = joints
             .iter()
@@ -125,17 +170,13 @@ fn structure_simulate<'py>(
             force: fs,
             base,
         };
-        simulate(&s, &inp, x0s, v0s, &opts)
+        simulate_into(&s, &inp, x0s, v0s, &opts, &mut bufs)
     })?;
+    drop(rws);
     let d = PyDict::new(py);
-    d.set_item("x", r.x.into_pyarray(py))?;
-    d.set_item("v", r.v.into_pyarray(py))?;
-    d.set_item("a", r.a.into_pyarray(py))?;
-    d.set_item("joint_force", r.joint_force.into_pyarray(py))?;
-    d.set_item("joint_work", r.joint_work.into_pyarray(py))?;
-    d.set_item("joint_dissipated", r.joint_dissipated.into_pyarray(py))?;
-    d.set_item("input_work", r.input_work.into_pyarray(py))?;
-    d.set_item("damping_work", r.damping_work.into_pyarray(py))?;
+    for (name, arr) in names.iter().zip(&arrays) {
+        d.set_item(name, arr)?;
+    }
     d.set_item("n_out", r.n_out)?;
     d.set_item("status", r.status.code())?;
     d.set_item("message", r.status.message())?;

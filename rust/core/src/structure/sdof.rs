@@ -15,7 +15,7 @@
 //! per-law dispatch of [`JointLaw`].
 
 use super::joint::{masing_commit, masing_trial, Joint, JointLaw, JointState, MasingCurve, Trial};
-use super::newmark::{Inputs, Options, Response, Status, Structure};
+use super::newmark::{Buffers, Inputs, Options, Status, Structure, Summary};
 use crate::error::CoreError;
 use crate::masing::MasingState;
 
@@ -40,7 +40,7 @@ trait Joints {
     /// Accept the last trial (at `x1`, from `x0`), with the work bookkeeping.
     fn commit(&mut self, x0: f64, x1: f64) -> Result<(), CoreError>;
     /// Write each joint's force, work and dissipated energy at `x` as sample `i`.
-    fn record(&self, x: f64, i: usize, out: &mut Response);
+    fn record(&self, x: f64, i: usize, out: &mut Buffers<'_>);
 }
 
 /// Any set of joints, through [`JointLaw`]'s dispatch.
@@ -128,7 +128,7 @@ impl Joints for Dyn<'_> {
     // Row-major index arithmetic below len(t) · n_joints (the output size checked by the caller).
     #[inline]
     #[allow(clippy::arithmetic_side_effects)]
-    fn record(&self, x: f64, i: usize, out: &mut Response) {
+    fn record(&self, x: f64, i: usize, out: &mut Buffers<'_>) {
         let nj = self.joints.len();
         for (jn, j) in self.joints.iter().enumerate() {
             let at = i * nj + jn;
@@ -312,7 +312,7 @@ impl Joints for MasingExp {
     }
 
     #[inline(always)]
-    fn record(&self, _x: f64, i: usize, out: &mut Response) {
+    fn record(&self, _x: f64, i: usize, out: &mut Buffers<'_>) {
         out.joint_force[i] = self.jf;
         out.joint_work[i] = self.jwork;
         out.joint_dissipated[i] = self.jwork - (self.stored() - self.stored0);
@@ -446,7 +446,7 @@ fn accept<J: Joints>(jt: &mut J, c: f64, w: &mut State, st: &Step) -> Result<(),
 
 /// Write the state as sample `i` (`i < len(t)`).
 #[inline(always)]
-fn record<J: Joints>(jt: &J, w: &State, out: &mut Response, i: usize) {
+fn record<J: Joints>(jt: &J, w: &State, out: &mut Buffers<'_>, i: usize) {
     out.x[i] = w.x;
     out.v[i] = w.v;
     out.a[i] = w.a;
@@ -462,12 +462,13 @@ pub(super) fn simulate(
     x0: f64,
     v0: f64,
     opts: &Options,
-) -> Result<Response, CoreError> {
+    out: &mut Buffers<'_>,
+) -> Result<Summary, CoreError> {
     if let Some((mut jt, start)) = MasingExp::new(&s.joints, x0) {
-        return run(s, inp, x0, v0, opts, &mut jt, start);
+        return run(s, inp, x0, v0, opts, &mut jt, start, out);
     }
     let (mut jt, start) = Dyn::new(&s.joints, x0, v0)?;
-    run(s, inp, x0, v0, opts, &mut jt, start)
+    run(s, inp, x0, v0, opts, &mut jt, start, out)
 }
 
 /// The integration loop for the joint set `jt` (already loaded to `x0`, with `start` there).
@@ -479,14 +480,8 @@ fn run<J: Joints>(
     opts: &Options,
     jt: &mut J,
     start: Sum,
-) -> Result<Response, CoreError> {
-    let nt = inp.t.len();
-    let nj = s.joints.len();
-    let total_j = nt.checked_mul(nj).ok_or(CoreError::InvalidParameter {
-        name: "t",
-        value: nt as f64,
-        reason: "too many samples",
-    })?;
+    out: &mut Buffers<'_>,
+) -> Result<Summary, CoreError> {
     let f0 = load(inp, 0, 0.0);
     // a0 = (f0 − C v0 − K x0 − G0) / M
     let (m, c, k) = (s.m[0], s.c[0], s.k[0]);
@@ -509,22 +504,9 @@ fn run<J: Joints>(
         kt: start.kt,
         ct: start.ct,
     };
-    let mut out = Response {
-        x: vec![0.0; nt],
-        v: vec![0.0; nt],
-        a: vec![0.0; nt],
-        joint_force: vec![0.0; total_j],
-        joint_work: vec![0.0; total_j],
-        joint_dissipated: vec![0.0; total_j],
-        input_work: vec![0.0; nt],
-        damping_work: vec![0.0; nt],
-        status: Status::Success,
-        n_out: 0,
-        n_steps: 0,
-        n_iter: 0,
-    };
-    record(jt, &w, &mut out, 0);
-    out.n_out = 1;
+    let mut sum = Summary::new();
+    record(jt, &w, out, 0);
+    sum.n_out = 1;
     for (i, pair) in inp.t.windows(2).enumerate() {
         let big_h = pair[1] - pair[0];
         let mut tau = 0.0_f64;
@@ -539,16 +521,16 @@ fn run<J: Joints>(
             let Some((st, it)) = newton(jt, (m, c, k), &w, h, f1, opts) else {
                 halvings = halvings.saturating_add(1);
                 if halvings > opts.max_halvings {
-                    out.status = Status::NoConvergence {
+                    sum.status = Status::NoConvergence {
                         time: inp.t[i] + tau * big_h,
                         step: h,
                     };
-                    return Ok(out);
+                    return Ok(sum);
                 }
                 frac = 0.5 * step;
                 continue;
             };
-            out.n_iter = out.n_iter.saturating_add(it);
+            sum.n_iter = sum.n_iter.saturating_add(it);
             if events < opts.max_events {
                 let theta = jt.event(w.x, st.x1, w.v, st.v1);
                 if theta < 1.0 {
@@ -561,27 +543,27 @@ fn run<J: Joints>(
                 }
             }
             accept(jt, c, &mut w, &st)?;
-            out.n_steps = out.n_steps.saturating_add(1);
+            sum.n_steps = sum.n_steps.saturating_add(1);
             tau = tau1;
             frac = (1.0 - tau).max(0.0);
             if !(w.x.is_finite() && w.v.is_finite()) {
-                out.status = Status::NonFinite {
+                sum.status = Status::NonFinite {
                     time: inp.t[i] + tau * big_h,
                 };
-                return Ok(out);
+                return Ok(sum);
             }
         }
         let next = i.saturating_add(1); // < nt
-        record(jt, &w, &mut out, next);
-        out.n_out = next.saturating_add(1);
+        record(jt, &w, out, next);
+        sum.n_out = next.saturating_add(1);
     }
-    Ok(out)
+    Ok(sum)
 }
 
 #[cfg(test)]
 mod tests {
     use super::super::joint::{Joint, JointLaw, MasingCurve};
-    use super::super::newmark::simulate_dense;
+    use super::super::newmark::{simulate, simulate_dense_response};
     use super::*;
     use crate::curve::{Exponential, Tabulated};
     use proptest::prelude::*;
@@ -647,8 +629,8 @@ mod tests {
             },
         };
         let opts = Options::default();
-        let a = simulate(&s, &inp, x0, v0, &opts)?;
-        let b = simulate_dense(&s, &inp, &[x0], &[v0], &opts, nt, nt * s.joints().len())?;
+        let a = simulate(&s, &inp, &[x0], &[v0], &opts)?;
+        let b = simulate_dense_response(&s, &inp, &[x0], &[v0], &opts)?;
         assert_eq!(a.status, b.status);
         assert_eq!(a.n_out, b.n_out);
         assert!(
@@ -770,6 +752,53 @@ mod tests {
     }
 
     #[test]
+    fn output_buffers_of_the_wrong_size_are_an_error() -> Result<(), CoreError> {
+        let s = Structure::new(1, &[1.0], &[0.1], &[10.0], vec![])?;
+        let t = [0.0, 0.1, 0.2];
+        let f = [0.0, 1.0, 0.0];
+        let inp = Inputs {
+            t: &t,
+            force: Some(&f),
+            base: None,
+        };
+        let (mut x, mut v, mut a, mut e1, mut e2) =
+            ([0.0; 3], [0.0; 3], [0.0; 2], [0.0; 3], [0.0; 3]);
+        let mut bufs = Buffers {
+            x: &mut x,
+            v: &mut v,
+            a: &mut a, // one sample short
+            joint_force: &mut [],
+            joint_work: &mut [],
+            joint_dissipated: &mut [],
+            input_work: &mut e1,
+            damping_work: &mut e2,
+        };
+        let r = super::super::newmark::simulate_into(
+            &s,
+            &inp,
+            &[0.0],
+            &[0.0],
+            &Options::default(),
+            &mut bufs,
+        );
+        assert!(r.is_err());
+        let mut a = [0.0; 3];
+        bufs.a = &mut a;
+        let sum = super::super::newmark::simulate_into(
+            &s,
+            &inp,
+            &[0.0],
+            &[0.0],
+            &Options::default(),
+            &mut bufs,
+        )?;
+        assert_eq!(sum.n_out, 3);
+        let whole = simulate(&s, &inp, &[0.0], &[0.0], &Options::default())?;
+        assert_eq!(&whole.x[..], &x[..]);
+        Ok(())
+    }
+
+    #[test]
     fn singular_mass_is_an_error() -> Result<(), CoreError> {
         let s = Structure::new(1, &[0.0], &[1.0], &[1.0], vec![])?;
         let t = [0.0, 1.0];
@@ -779,7 +808,7 @@ mod tests {
             force: Some(&f),
             base: None,
         };
-        assert!(simulate(&s, &inp, 0.0, 0.0, &Options::default()).is_err());
+        assert!(simulate(&s, &inp, &[0.0], &[0.0], &Options::default()).is_err());
         Ok(())
     }
 
