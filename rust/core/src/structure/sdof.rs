@@ -29,11 +29,22 @@ struct Sum {
     ct: f64,
 }
 
+/// A Newton trial point: `x1 = xp + b a1` (`xp`, `b` fixed over the step, `a1` the iterate)
+/// and its velocity `v1`.
+#[derive(Debug, Clone, Copy)]
+struct Point {
+    x1: f64,
+    v1: f64,
+    xp: f64,
+    b: f64,
+    a1: f64,
+}
+
 /// The joints of a one-DOF structure (all between the DOF and the ground, `d = x`).
 trait Joints {
-    /// Forces and tangents at `x1` (velocity `v1`), moving from the committed `x0`. The trial
+    /// Forces and tangents at the trial point `pt`, moving from the committed `x0`. The trial
     /// is remembered: [`Joints::commit`] accepts the last one.
-    fn trial(&mut self, x0: f64, x1: f64, v1: f64) -> Sum;
+    fn trial(&mut self, x0: f64, pt: &Point) -> Sum;
     /// Earliest fraction `θ ∈ (0, 1)` of the step `x0 → x1` at which a joint changes
     /// character (see [`JointLaw::event`]); 1 when none does.
     fn event(&self, x0: f64, x1: f64, v0: f64, v1: f64) -> f64;
@@ -90,7 +101,8 @@ impl<'a> Dyn<'a> {
 
 impl Joints for Dyn<'_> {
     #[inline(always)]
-    fn trial(&mut self, x0: f64, x1: f64, v1: f64) -> Sum {
+    fn trial(&mut self, x0: f64, pt: &Point) -> Sum {
+        let (x1, v1) = (pt.x1, pt.v1);
         let mut out = Sum::default();
         for ((j, st), tr) in self.joints.iter().zip(&self.states).zip(&mut self.trials) {
             *tr = j.law.trial(st, x0, x1, v1);
@@ -156,20 +168,21 @@ struct MasingExp {
     amp_branch: f64,
     p_branch: f64,
     st: MasingState,
-    /// The cached branch: anchor, amplitude, exponent rate, and `lim`: the branch holds while
-    /// `x · dir < lim` (`+∞` on the virgin curve).
+    /// The cached branch, for motion in `dir` (along which `x − xa` has the sign of `dir`):
+    /// `F = cg − sa e`, `e = e^(pd (xa − x))` with `cg = ha + dir A`, `sa = dir A`, `pd = dir p`.
+    /// It holds while `x · dir < lim` (`+∞` on the virgin curve, `−∞`: no cached branch).
     xa: f64,
-    ha: f64,
-    amp: f64,
-    p: f64,
+    cg: f64,
+    sa: f64,
+    pd: f64,
     lim: f64,
     /// The last trial: force, tangent, memory update (as [`Trial::aux`]).
     f: f64,
     kt: f64,
     aux: usize,
-    /// `|x − xa|` and `e^(−p |x − xa|)` at the last trial on the cached branch in this step
-    /// (`ul` NaN: none).
-    ul: f64,
+    /// The exponent `pd (xa − x)` and `e` at the last trial on the cached branch in this step
+    /// (`argl` NaN: none).
+    argl: f64,
     el: f64,
     jf: f64,
     jwork: f64,
@@ -201,20 +214,28 @@ impl MasingExp {
             p_branch: ac / scale,
             st: MasingState::default(),
             xa: 0.0,
-            ha: 0.0,
-            amp: h0,
-            p: ac,
-            lim: f64::INFINITY,
+            cg: 0.0,
+            sa: 0.0,
+            pd: 0.0,
+            lim: f64::NEG_INFINITY,
             f: 0.0,
             kt: 0.0,
             aux: 0,
-            ul: f64::NAN,
+            argl: f64::NAN,
             el: 1.0,
             jf: 0.0,
             jwork: 0.0,
             stored0: 0.0,
         };
-        let s = me.trial(0.0, x0, 0.0);
+        // (the virgin state has no cached branch: this is the memory walk)
+        let pt = Point {
+            x1: x0,
+            v1: 0.0,
+            xp: x0,
+            b: 0.0,
+            a1: 0.0,
+        };
+        let s = me.trial(0.0, &pt);
         masing_commit(&mut me.st, x0, me.f, me.aux);
         me.refresh();
         me.jf = me.f;
@@ -225,17 +246,21 @@ impl MasingExp {
     /// Cache the branch that motion in the current direction follows.
     #[inline(always)]
     fn refresh(&mut self) {
-        let Some((top, rest)) = self.st.stack.split_last() else {
-            (self.xa, self.ha, self.amp, self.p) = (0.0, 0.0, self.h0, self.ac);
-            self.lim = f64::INFINITY;
-            return;
+        let dir = f64::from(self.st.dir);
+        let (xa, ha, amp, p, lim) = match self.st.stack.split_last() {
+            None => (0.0, 0.0, self.h0, self.ac, f64::INFINITY),
+            Some((top, rest)) => {
+                // Moving on, the branch closes at the reversal below (or, from the first
+                // reversal, rejoins the virgin curve at its mirror point).
+                let target = rest.last().map_or(-top.x, |b| b.x);
+                (top.x, top.h, self.amp_branch, self.p_branch, target * dir)
+            }
         };
-        // Moving on, the branch closes at the reversal below (or, from the first reversal,
-        // rejoins the virgin curve at its mirror point).
-        let target = rest.last().map_or(-top.x, |b| b.x);
-        (self.xa, self.ha) = (top.x, top.h);
-        (self.amp, self.p) = (self.amp_branch, self.p_branch);
-        self.lim = target * f64::from(self.st.dir);
+        (self.xa, self.cg, self.sa, self.pd) = (xa, ha + dir * amp, dir * amp, dir * p);
+        // The memory rules keep the current point on the far side of the anchor in the
+        // direction of motion; anything else (or no direction yet) takes the memory walk.
+        let on_branch = dir != 0.0 && (self.st.x - xa) * dir >= 0.0;
+        self.lim = if on_branch { lim } else { f64::NEG_INFINITY };
     }
 
     /// A trial off the cached branch (a reversal inside the trial, a loop closing): the
@@ -244,7 +269,7 @@ impl MasingExp {
     #[inline(never)]
     fn walk(&mut self, x1: f64) {
         (self.f, self.kt, self.aux) = masing_trial(&self.curve, self.scale, &self.st, x1);
-        self.ul = f64::NAN;
+        self.argl = f64::NAN;
     }
 
     #[inline(always)]
@@ -257,24 +282,27 @@ impl Joints for MasingExp {
     // `2 · (reversals kept)`: at most twice the stack length, a Vec's length.
     #[inline(always)]
     #[allow(clippy::arithmetic_side_effects)]
-    fn trial(&mut self, _x0: f64, x1: f64, _v1: f64) -> Sum {
+    fn trial(&mut self, _x0: f64, pt: &Point) -> Sum {
+        let x1 = pt.x1;
         let dx = x1 - self.st.x;
         let dir = f64::from(self.st.dir);
-        if dx * dir > 0.0 && x1 * dir < self.lim || dx == 0.0 {
-            let u = x1 - self.xa;
-            let ua = u.abs();
+        let lim = self.lim;
+        if (dx * dir > 0.0 && x1 * dir < lim) || (dx == 0.0 && lim > f64::NEG_INFINITY) {
+            // −p |x1 − xa| with x1 = xp + b a1: the part without a1 is known before the
+            // iterate, so the exponent is one multiply-add away from it.
+            let arg = self.pd * (self.xa - pt.xp) - (self.pd * pt.b) * pt.a1;
             // Newton's later trials move by a small correction from the last one on this
-            // branch: `e^(−p|u|) = e_last · e^(−z)`, `z = p (|u| − |u_last|)`, with `e^(−z)`
-            // by its series (|z| < 1e-3: truncation below 1e-17 relative). NaN `ul`: none.
-            let z = self.p * (ua - self.ul);
+            // branch: e = e_last · e^z, z = arg − arg_last, with e^z by its series (|z| <
+            // 1e-3: truncation below 1e-17 relative). NaN `argl`: none.
+            let z = arg - self.argl;
             let e = if z.abs() < 1e-3 {
                 let z2 = z * z;
-                self.el * ((1.0 - z) + z2 * ((0.5 - z * (1.0 / 6.0)) + z2 * (1.0 / 24.0)))
+                self.el * ((1.0 + z) + z2 * ((0.5 + z * (1.0 / 6.0)) + z2 * (1.0 / 24.0)))
             } else {
-                (-self.p * ua).exp()
+                arg.min(0.0).exp()
             };
-            (self.ul, self.el) = (ua, e);
-            self.f = self.ha + (self.amp - self.amp * e).copysign(u);
+            (self.argl, self.el) = (arg, e);
+            self.f = self.cg - self.sa * e;
             self.kt = self.k0 * e;
             self.aux = 2 * self.st.stack.len();
         } else {
@@ -306,7 +334,7 @@ impl Joints for MasingExp {
         masing_commit(&mut self.st, x1, self.f, self.aux);
         self.refresh();
         // each step's first trial is a full `exp` (no drift from chained products)
-        self.ul = f64::NAN;
+        self.argl = f64::NAN;
         self.jf = self.f;
         Ok(())
     }
@@ -399,7 +427,8 @@ fn newton<J: Joints>(
     for it in 1..=opts.max_iter as u64 {
         let x1 = xp + b * a1;
         let v1 = vp + g * a1;
-        let js = jt.trial(w.x, x1, v1);
+        let pt = Point { x1, v1, xp, b, a1 };
+        let js = jt.trial(w.x, &pt);
         let (ma, cv, kx) = (m * a1, c * v1, k * x1);
         let r = ((ma + cv) + (kx - f1)) + js.f;
         let scale = (f1.abs() + ((ma.abs() + cv.abs()) + kx.abs())).max(js.fmax);
@@ -720,11 +749,26 @@ mod tests {
                     1 => 0.0,
                     _ => 3e-5 * uniform(),
                 };
-                let xn = x + amp * (uniform() - 0.5);
+                // a trial point as Newton forms it: xp + b a1 (b of a 1e-4 s step)
+                let point = |x1: f64, a1: f64| {
+                    let (b, xp) = (2.5e-9, x1 - 2.5e-9 * a1);
+                    Point {
+                        x1: xp + b * a1,
+                        v1: 0.0,
+                        xp,
+                        b,
+                        a1,
+                    }
+                };
+                let pt = point(x + amp * (uniform() - 0.5), 4e3 * (uniform() - 0.5));
+                let xn = pt.x1;
                 for _ in 0..(step % 3) {
-                    let _ = fast.trial(x, x + 1e-4 * (uniform() - 0.5), 0.0);
+                    let near = point(xn + 1e-4 * (uniform() - 0.5), 1e3 * uniform());
+                    let _ = fast.trial(x, &near);
+                    // and, like Newton's last iterations, a small correction to the point
+                    let _ = fast.trial(x, &point(xn, pt.a1 * (1.0 + 1e-6 * uniform())));
                 }
-                let got = fast.trial(x, xn, 0.0);
+                let got = fast.trial(x, &pt);
                 let want = law.trial(&st, x, xn, 0.0);
                 crate::masing::masing_force(&curve, scale, &[xn], &mut out, &mut op)?;
                 let tol = 1e-12 * 40.0 * scale;
