@@ -69,7 +69,7 @@ fn build_joint(spec: &JointSpec) -> Result<Joint, CoreError> {
 
 /// Newmark simulation of a structure with joints; returns a dict of flat arrays and status.
 #[pyfunction]
-#[pyo3(signature = (n, m, c, k, joints, t, x0, v0, force=None, base=None, base_velocity=None, kr=None, cr=None, rtol=1e-10, max_iter=30))]
+#[pyo3(signature = (n, m, c, k, joints, t, x0, v0, force=None, base=None, base_velocity=None, kr=None, cr=None, rtol=1e-10, max_iter=30, outputs=None))]
 fn structure_simulate<'py>(
     py: Python<'py>,
     n: usize,
@@ -87,6 +87,7 @@ fn structure_simulate<'py>(
     cr: Option<PyReadonlyArray1<'py, f64>>,
     rtol: f64,
     max_iter: usize,
+    outputs: Option<Vec<String>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (ms, cs, ks) = (sl(&m, "M")?, sl(&c, "C")?, sl(&k, "K")?);
     let (ts, x0s, v0s) = (sl(&t, "t")?, sl(&x0, "x0")?, sl(&v0, "v0")?);
@@ -132,7 +133,21 @@ fn structure_simulate<'py>(
         "input_work",
         "damping_work",
     ];
-    let lens = [total, total, total, total_j, total_j, total_j, nt, nt];
+    let mut lens = [total, total, total, total_j, total_j, total_j, nt, nt];
+    // Outputs not asked for are empty arrays, and the kernel does not compute them.
+    if let Some(wanted) = &outputs {
+        if let Some(bad_name) = wanted.iter().find(|w| !names.contains(&w.as_str())) {
+            return Err(crate::errors::input_error(
+                py,
+                format!("unknown output {bad_name:?} (known: {})", names.join(", ")),
+            ));
+        }
+        for (len, name) in lens.iter_mut().zip(names) {
+            if !wanted.iter().any(|w| w == name) {
+                *len = 0;
+            }
+        }
+    }
     let arrays: Vec<Bound<'py, PyArray1<f64>>> = lens
         .iter()
         .map(|&len| PyArray1::<f64>::zeros(py, len, false))

@@ -173,8 +173,9 @@ pub struct Response {
 }
 
 /// Output buffers for [`simulate_into`] (row-major like [`Response`]'s arrays): `x`, `v`,
-/// `a` of `len(t) × n`; the joint arrays `len(t) × n_joints`; the energies `len(t)`. Rows past
-/// the run's `n_out` are left as they were.
+/// `a` of `len(t) × n`; the joint arrays `len(t) × n_joints`; the energies `len(t)`. An empty
+/// buffer is an output the caller does not want (it is not computed). Rows past the run's
+/// `n_out` are left as they were.
 #[derive(Debug)]
 pub struct Buffers<'a> {
     pub x: &'a mut [f64],
@@ -461,7 +462,9 @@ pub fn simulate_into(
         ("input_work buffer", out.input_work.len(), nt),
         ("damping_work buffer", out.damping_work.len(), nt),
     ] {
-        check_same_len(name, len, "output size", want)?;
+        if len != 0 {
+            check_same_len(name, len, "output size", want)?;
+        }
     }
     if let Some(f) = inp.force {
         check_same_len("force", f.len(), "len(t)*n", total)?;
@@ -695,17 +698,34 @@ fn accept(s: &Structure, w: &mut Work, sc: &mut Scratch) -> Result<(), CoreError
 fn record(s: &Structure, w: &Work, out: &mut Buffers<'_>, i: usize) {
     let n = s.n;
     let nj = s.joints.len();
-    out.x[i * n..(i + 1) * n].copy_from_slice(&w.x);
-    out.v[i * n..(i + 1) * n].copy_from_slice(&w.v);
-    out.a[i * n..(i + 1) * n].copy_from_slice(&w.a);
-    for (jn, j) in s.joints.iter().enumerate() {
-        out.joint_force[i * nj + jn] = w.jf[jn];
-        out.joint_work[i * nj + jn] = w.jwork[jn];
-        out.joint_dissipated[i * nj + jn] =
-            w.jwork[jn] - (j.law.stored_energy(&w.states[jn], w.jd[jn]) - w.stored0[jn]);
+    // (an empty buffer: an output not wanted)
+    for (buf, val) in [
+        (&mut *out.x, &w.x),
+        (&mut *out.v, &w.v),
+        (&mut *out.a, &w.a),
+    ] {
+        if let Some(row) = buf.get_mut(i * n..(i + 1) * n) {
+            row.copy_from_slice(val);
+        }
     }
-    out.input_work[i] = w.e_in;
-    out.damping_work[i] = w.e_damp;
+    for (jn, j) in s.joints.iter().enumerate() {
+        let at = i * nj + jn;
+        if let Some(f) = out.joint_force.get_mut(at) {
+            *f = w.jf[jn];
+        }
+        if let Some(f) = out.joint_work.get_mut(at) {
+            *f = w.jwork[jn];
+        }
+        if let Some(d) = out.joint_dissipated.get_mut(at) {
+            *d = w.jwork[jn] - (j.law.stored_energy(&w.states[jn], w.jd[jn]) - w.stored0[jn]);
+        }
+    }
+    if let Some(e) = out.input_work.get_mut(i) {
+        *e = w.e_in;
+    }
+    if let Some(e) = out.damping_work.get_mut(i) {
+        *e = w.e_damp;
+    }
 }
 
 #[cfg(test)]

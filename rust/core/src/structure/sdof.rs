@@ -144,10 +144,11 @@ impl Joints for Dyn<'_> {
         let nj = self.joints.len();
         for (jn, j) in self.joints.iter().enumerate() {
             let at = i * nj + jn;
-            out.joint_force[at] = self.jf[jn];
-            out.joint_work[at] = self.jwork[jn];
-            out.joint_dissipated[at] =
-                self.jwork[jn] - (j.law.stored_energy(&self.states[jn], x) - self.stored0[jn]);
+            put(out.joint_force, at, self.jf[jn]);
+            put(out.joint_work, at, self.jwork[jn]);
+            if let Some(d) = out.joint_dissipated.get_mut(at) {
+                *d = self.jwork[jn] - (j.law.stored_energy(&self.states[jn], x) - self.stored0[jn]);
+            }
         }
     }
 }
@@ -341,9 +342,11 @@ impl Joints for MasingExp {
 
     #[inline(always)]
     fn record(&self, _x: f64, i: usize, out: &mut Buffers<'_>) {
-        out.joint_force[i] = self.jf;
-        out.joint_work[i] = self.jwork;
-        out.joint_dissipated[i] = self.jwork - (self.stored() - self.stored0);
+        put(out.joint_force, i, self.jf);
+        put(out.joint_work, i, self.jwork);
+        if let Some(d) = out.joint_dissipated.get_mut(i) {
+            *d = self.jwork - (self.stored() - self.stored0);
+        }
     }
 }
 
@@ -469,15 +472,23 @@ fn accept<J: Joints>(jt: &mut J, c: f64, w: &mut State, st: &Step) -> Result<(),
     Ok(())
 }
 
+/// `buf[i] = v`, unless the buffer is empty (an output the caller did not ask for).
+#[inline(always)]
+fn put(buf: &mut [f64], i: usize, v: f64) {
+    if let Some(slot) = buf.get_mut(i) {
+        *slot = v;
+    }
+}
+
 /// Write the state as sample `i` (`i < len(t)`).
 #[inline(always)]
 fn record<J: Joints>(jt: &J, w: &State, out: &mut Buffers<'_>, i: usize) {
-    out.x[i] = w.x;
-    out.v[i] = w.v;
-    out.a[i] = w.a;
+    put(out.x, i, w.x);
+    put(out.v, i, w.v);
+    put(out.a, i, w.a);
     jt.record(w.x, i, out);
-    out.input_work[i] = w.e_in;
-    out.damping_work[i] = w.e_damp;
+    put(out.input_work, i, w.e_in);
+    put(out.damping_work, i, w.e_damp);
 }
 
 /// The one-DOF simulation (inputs already checked by `newmark::simulate`).
@@ -588,7 +599,7 @@ fn run<J: Joints>(
 #[cfg(test)]
 mod tests {
     use super::super::joint::{Joint, JointLaw, MasingCurve};
-    use super::super::newmark::{simulate, simulate_dense_response};
+    use super::super::newmark::{simulate, simulate_dense_response, simulate_into};
     use super::*;
     use crate::curve::{Exponential, Tabulated};
     use proptest::prelude::*;
@@ -835,6 +846,63 @@ mod tests {
         assert_eq!(sum.n_out, 3);
         let whole = simulate(&s, &inp, &[0.0], &[0.0], &Options::default())?;
         assert_eq!(&whole.x[..], &x[..]);
+        Ok(())
+    }
+
+    /// Outputs left out (empty buffers) are not computed; the others are the same as in a
+    /// full run, on the Masing fast path, the dispatch path and the dense path.
+    #[test]
+    fn outputs_not_wanted_are_skipped() -> Result<(), CoreError> {
+        let masing = JointLaw::masing(MasingCurve::Exp(Exponential::new(3.0, 2e3)?), 2.0)?;
+        let jenkins = JointLaw::jenkins(300.0, 0.6)?;
+        let nt = 801;
+        let t: Vec<f64> = (0..nt).map(|i| i as f64 * 1e-3).collect();
+        for (n, law) in [(1, masing.clone()), (1, jenkins), (2, masing)] {
+            let joints = vec![Joint {
+                law,
+                dof: 0,
+                dof2: None,
+            }];
+            let (m, c, k) = if n == 1 {
+                (vec![0.8], vec![1.5], vec![900.0])
+            } else {
+                (
+                    vec![0.8, 0.0, 0.0, 0.5],
+                    vec![1.5, -0.5, -0.5, 0.5],
+                    vec![900.0, -400.0, -400.0, 400.0],
+                )
+            };
+            let s = Structure::new(n, &m, &c, &k, joints)?;
+            let u: Vec<f64> = t
+                .iter()
+                .flat_map(|ti| (0..n).map(move |d| (d + 1) as f64 * (25.0 * ti).sin()))
+                .collect();
+            let inp = Inputs {
+                t: &t,
+                force: Some(&u),
+                base: None,
+            };
+            let (x0, v0) = (vec![0.0; n], vec![0.0; n]);
+            let opts = Options::default();
+            let whole = simulate(&s, &inp, &x0, &v0, &opts)?;
+            let mut x = vec![0.0; nt * n];
+            let mut jd = vec![0.0; nt];
+            let mut bufs = Buffers {
+                x: &mut x,
+                v: &mut [],
+                a: &mut [],
+                joint_force: &mut [],
+                joint_work: &mut [],
+                joint_dissipated: &mut jd,
+                input_work: &mut [],
+                damping_work: &mut [],
+            };
+            let sum = simulate_into(&s, &inp, &x0, &v0, &opts, &mut bufs)?;
+            assert_eq!(sum.n_out, nt);
+            assert_eq!((sum.n_steps, sum.n_iter), (whole.n_steps, whole.n_iter));
+            assert_eq!(x, whole.x);
+            assert_eq!(jd, whole.joint_dissipated);
+        }
         Ok(())
     }
 
