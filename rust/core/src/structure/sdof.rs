@@ -10,9 +10,10 @@
 //!
 //! The integrator is generic over the joint set ([`Joints`]) and monomorphised: a single
 //! Masing joint on the exponential curve (the common case) has its own implementation whose
-//! Newton iterations cost one `exp` and no dispatch or division (the active branch's constants
-//! are cached when the memory changes); every other joint set goes through [`Dyn`], the
-//! per-law dispatch of [`JointLaw`].
+//! trials cost one `exp` (Newton's small corrections: a short series) with no dispatch, memory
+//! walk or division (the active branch's constants are cached when the memory changes); every
+//! other joint set goes through [`Dyn`], the per-law dispatch of [`JointLaw`]. Outputs whose
+//! buffer is empty are not computed.
 
 use super::joint::{masing_commit, masing_trial, Joint, JointLaw, JointState, MasingCurve, Trial};
 use super::newmark::{Buffers, Inputs, Options, Status, Structure, Summary};
@@ -300,7 +301,8 @@ impl Joints for MasingExp {
                 let z2 = z * z;
                 self.el * ((1.0 + z) + z2 * ((0.5 + z * (1.0 / 6.0)) + z2 * (1.0 / 24.0)))
             } else {
-                arg.min(0.0).exp()
+                // (≤ 0 up to rounding; a NaN stays NaN and fails the step)
+                (if arg > 0.0 { 0.0 } else { arg }).exp()
             };
             (self.argl, self.el) = (arg, e);
             self.f = self.cg - self.sa * e;
