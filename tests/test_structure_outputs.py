@@ -54,6 +54,15 @@ def test_selected_outputs_with_substeps_and_periodic() -> None:
         assert part.a.size == 0 and part.t.size == full.t.size
 
 
+def test_no_joints_keeps_its_zero_width_joint_arrays() -> None:
+    s = Structure(1.0, 0.5, 100.0)
+    t = np.arange(50) * 1e-2
+    full = s.simulate(t, force=np.sin(t))
+    part = s.simulate(t, force=np.sin(t), outputs=["x"])
+    assert full.joint_force.shape == (50, 0) and part.joint_force.shape == (0, 0)
+    np.testing.assert_array_equal(part.x, full.x)
+
+
 def test_unknown_output_is_an_input_error() -> None:
     s = _structure(1)
     t = np.arange(10) * 1e-3

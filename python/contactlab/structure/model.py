@@ -338,9 +338,9 @@ class Structure:
         m = int(out["n_out"])  # type: ignore[call-overload]
 
         def arr(key: str, width: int) -> np.ndarray:
-            a = np.asarray(out[key])
             # an output not asked for is empty: no rows
-            a = a.reshape(len(t) if a.size else 0, width)[:m]
+            rows = len(t) if outputs is None or key in outputs else 0
+            a = np.asarray(out[key]).reshape(rows, width)[:m]
             return a[:, 0] if width == 1 and key in ("x", "v", "a") else a
 
         status = int(out["status"])  # type: ignore[call-overload]
