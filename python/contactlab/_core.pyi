@@ -101,4 +101,5 @@ def structure_simulate(
     cr: _F | None = None,
     rtol: float = 1e-10,
     max_iter: int = 30,
+    outputs: list[str] | None = None,
 ) -> dict[str, object]: ...

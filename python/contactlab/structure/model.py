@@ -241,6 +241,7 @@ class Structure:
         rtol: float = 1e-10,
         substeps: int = 1,
         interpolation: str = "linear",
+        outputs: Any = None,
     ) -> SimulationResult:
         """Response to a force input and/or base motion sampled at ``t``.
 
@@ -268,6 +269,11 @@ class Structure:
             How inputs are continued between samples when ``substeps > 1``: linear, or
             band-limited (FFT zero padding, for a uniformly sampled periodic input such as a
             multisine record of whole periods).
+        outputs : iterable of str, optional
+            The arrays to compute, among ``x``, ``v``, ``a``, ``joint_force``,
+            ``joint_energy``, ``joint_work``, ``input_work``, ``damping_work`` (default all).
+            The others come back empty (no rows) and cost nothing. A periodic run also
+            computes ``x``, ``v``, ``joint_energy`` and ``input_work`` (its convergence check).
 
         Returns
         -------
@@ -285,6 +291,7 @@ class Structure:
         for name, a in (("x0", x0a), ("v0", v0a)):
             if a.size != n:
                 raise InputError(f"{name} has {a.size} entries, expected {n}")
+        want = _core_outputs(outputs)
         substeps = int(substeps)
         if substeps < 1:
             raise InputError(f"substeps must be >= 1, got {substeps}")
@@ -295,16 +302,24 @@ class Structure:
             r = self.simulate(
                 tf, force, base, x0a, v0a, periodic=periodic, base_velocity=base_velocity,
                 influence=influence, max_periods=max_periods, periodic_tol=periodic_tol,
-                rtol=rtol,
+                rtol=rtol, outputs=outputs,
             )  # fmt: skip
             return _slice(r, slice(None, None, substeps), t[: (r.t.size - 1) // substeps + 1])
         kw = self._inputs(t, force, base, base_velocity, influence)
         if not periodic:
-            return self._run(t, kw, x0a, v0a, rtol)
-        return self._periodic(t, kw, x0a, v0a, rtol, int(max_periods), float(periodic_tol))
+            return self._run(t, kw, x0a, v0a, rtol, want)
+        if want is not None:
+            want = sorted(set(want) | {"x", "v", "joint_dissipated", "input_work"})
+        return self._periodic(t, kw, x0a, v0a, rtol, int(max_periods), float(periodic_tol), want)
 
     def _run(
-        self, t: np.ndarray, kw: dict[str, Any], x0: np.ndarray, v0: np.ndarray, rtol: float
+        self,
+        t: np.ndarray,
+        kw: dict[str, Any],
+        x0: np.ndarray,
+        v0: np.ndarray,
+        rtol: float,
+        outputs: list[str] | None = None,
     ) -> SimulationResult:
         n, nj = self.n, len(self.joints)
         out = _core.structure_simulate(
@@ -317,12 +332,15 @@ class Structure:
             x0,
             v0,
             rtol=rtol,
+            outputs=outputs,
             **kw,
         )
         m = int(out["n_out"])  # type: ignore[call-overload]
 
         def arr(key: str, width: int) -> np.ndarray:
-            a = np.asarray(out[key]).reshape(len(t), width)[:m]
+            # an output not asked for is empty: no rows
+            rows = len(t) if outputs is None or key in outputs else 0
+            a = np.asarray(out[key]).reshape(rows, width)[:m]
             return a[:, 0] if width == 1 and key in ("x", "v", "a") else a
 
         status = int(out["status"])  # type: ignore[call-overload]
@@ -352,6 +370,7 @@ class Structure:
         rtol: float,
         max_periods: int,
         tol: float,
+        outputs: list[str] | None = None,
     ) -> SimulationResult:
         # The period is the record length plus one sample interval (the last sample is not
         # the first one repeated), so the state carried into the next period is the one
@@ -366,7 +385,7 @@ class Structure:
             tt = t[0] + dt * np.arange(nt * periods)
             kk = {k: (np.tile(v, periods) if k in ("force", "base", "base_velocity") else v)
                   for k, v in kw.items()}  # fmt: skip
-            r = self._run(tt, kk, x0, v0, rtol)
+            r = self._run(tt, kk, x0, v0, rtol, outputs)
             if not r.success or r.t.size < nt * periods:
                 return r
             if not all(np.all(np.isfinite(a)) for a in (r.x, r.v, r.joint_energy, r.input_work)):
@@ -434,6 +453,29 @@ class Structure:
         except (OSError, ValueError) as exc:  # ValueError: not UTF-8 or not JSON
             raise InputError(f"cannot read structure JSON {path}: {exc}") from None
         return cls.from_dict(d.get("structure", d) if isinstance(d, dict) else d)
+
+
+_OUTPUTS = {
+    "x": "x",
+    "v": "v",
+    "a": "a",
+    "joint_force": "joint_force",
+    "joint_energy": "joint_dissipated",
+    "joint_work": "joint_work",
+    "input_work": "input_work",
+    "damping_work": "damping_work",
+}
+
+
+def _core_outputs(outputs: Any) -> list[str] | None:
+    """The core's names of the outputs asked for (``None``: all)."""
+    if outputs is None:
+        return None
+    names = [outputs] if isinstance(outputs, str) else list(outputs)
+    for name in names:
+        if name not in _OUTPUTS:
+            raise InputError(f"unknown output {name!r} (known: {', '.join(_OUTPUTS)})")
+    return [_OUTPUTS[name] for name in names]
 
 
 def _slice(r: SimulationResult, s: slice, t: np.ndarray) -> SimulationResult:

@@ -5,10 +5,10 @@
 
 use contactlab_core::curve::{Exponential, Tabulated};
 use contactlab_core::structure::{
-    simulate, Inputs, Joint, JointLaw, MasingCurve, Options, Structure,
+    simulate_into, Buffers, Inputs, Joint, JointLaw, MasingCurve, Options, Structure,
 };
 use contactlab_core::CoreError;
-use numpy::{IntoPyArray, PyReadonlyArray1};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadwriteArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -69,7 +69,7 @@ fn build_joint(spec: &JointSpec) -> Result<Joint, CoreError> {
 
 /// Newmark simulation of a structure with joints; returns a dict of flat arrays and status.
 #[pyfunction]
-#[pyo3(signature = (n, m, c, k, joints, t, x0, v0, force=None, base=None, base_velocity=None, kr=None, cr=None, rtol=1e-10, max_iter=30))]
+#[pyo3(signature = (n, m, c, k, joints, t, x0, v0, force=None, base=None, base_velocity=None, kr=None, cr=None, rtol=1e-10, max_iter=30, outputs=None))]
 fn structure_simulate<'py>(
     py: Python<'py>,
     n: usize,
@@ -87,6 +87,7 @@ fn structure_simulate<'py>(
     cr: Option<PyReadonlyArray1<'py, f64>>,
     rtol: f64,
     max_iter: usize,
+    outputs: Option<Vec<String>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (ms, cs, ks) = (sl(&m, "M")?, sl(&c, "C")?, sl(&k, "K")?);
     let (ts, x0s, v0s) = (sl(&t, "t")?, sl(&x0, "x0")?, sl(&v0, "v0")?);
@@ -114,6 +115,65 @@ fn structure_simulate<'py>(
         max_iter,
         ..Options::default()
     };
+    // The outputs are numpy arrays the kernel writes into (no Vec and copy; numpy's large
+    // allocations are also backed by huge pages where the system offers them, so the 64 MB of
+    // a 1e6-sample run are not first-touched 4 kB at a time).
+    let nt = ts.len();
+    let too_many =
+        || crate::errors::to_pyerr(py, &bad("t", "too many samples for the output arrays"));
+    let total = nt.checked_mul(n).ok_or_else(too_many)?;
+    let total_j = nt.checked_mul(joints.len()).ok_or_else(too_many)?;
+    let names = [
+        "x",
+        "v",
+        "a",
+        "joint_force",
+        "joint_work",
+        "joint_dissipated",
+        "input_work",
+        "damping_work",
+    ];
+    let mut lens = [total, total, total, total_j, total_j, total_j, nt, nt];
+    // Outputs not asked for are empty arrays, and the kernel does not compute them.
+    if let Some(wanted) = &outputs {
+        if let Some(bad_name) = wanted.iter().find(|w| !names.contains(&w.as_str())) {
+            return Err(crate::errors::input_error(
+                py,
+                format!("unknown output {bad_name:?} (known: {})", names.join(", ")),
+            ));
+        }
+        for (len, name) in lens.iter_mut().zip(names) {
+            if !wanted.iter().any(|w| w == name) {
+                *len = 0;
+            }
+        }
+    }
+    let arrays: Vec<Bound<'py, PyArray1<f64>>> = lens
+        .iter()
+        .map(|&len| PyArray1::<f64>::zeros(py, len, false))
+        .collect();
+    let mut rws: Vec<PyReadwriteArray1<'py, f64>> =
+        arrays.iter().map(PyArrayMethods::readwrite).collect();
+    let mut slices: Vec<&mut [f64]> = Vec::with_capacity(rws.len());
+    for rw in &mut rws {
+        slices.push(
+            rw.as_slice_mut()
+                .map_err(|_| crate::errors::internal(py, "output array not contiguous"))?,
+        );
+    }
+    let [x, v, a, joint_force, joint_work, joint_dissipated, input_work, damping_work] =
+        <[&mut [f64]; 8]>::try_from(slices)
+            .map_err(|_| crate::errors::internal(py, "output arrays"))?;
+    let mut bufs = Buffers {
+        x,
+        v,
+        a,
+        joint_force,
+        joint_work,
+        joint_dissipated,
+        input_work,
+        damping_work,
+    };
     let r = detach_guarded(py, move || {
         let js = joints
             .iter()
@@ -125,17 +185,13 @@ fn structure_simulate<'py>(
             force: fs,
             base,
         };
-        simulate(&s, &inp, x0s, v0s, &opts)
+        simulate_into(&s, &inp, x0s, v0s, &opts, &mut bufs)
     })?;
+    drop(rws);
     let d = PyDict::new(py);
-    d.set_item("x", r.x.into_pyarray(py))?;
-    d.set_item("v", r.v.into_pyarray(py))?;
-    d.set_item("a", r.a.into_pyarray(py))?;
-    d.set_item("joint_force", r.joint_force.into_pyarray(py))?;
-    d.set_item("joint_work", r.joint_work.into_pyarray(py))?;
-    d.set_item("joint_dissipated", r.joint_dissipated.into_pyarray(py))?;
-    d.set_item("input_work", r.input_work.into_pyarray(py))?;
-    d.set_item("damping_work", r.damping_work.into_pyarray(py))?;
+    for (name, arr) in names.iter().zip(&arrays) {
+        d.set_item(name, arr)?;
+    }
     d.set_item("n_out", r.n_out)?;
     d.set_item("status", r.status.code())?;
     d.set_item("message", r.status.message())?;

@@ -222,7 +222,12 @@ pub struct Trial {
 // `len - 1`, `len - 2` where len >= 1, 2; `2 * len + 1` <= 2 * stack length + 3.
 #[allow(clippy::arithmetic_side_effects)]
 #[inline(always)]
-fn masing_trial(curve: &MasingCurve, scale: f64, st: &MasingState, x: f64) -> (f64, f64, usize) {
+pub(super) fn masing_trial(
+    curve: &MasingCurve,
+    scale: f64,
+    st: &MasingState,
+    x: f64,
+) -> (f64, f64, usize) {
     let dx = x - st.x;
     let dir = f64::from(st.dir);
     let s = if dx > 0.0 {
@@ -264,6 +269,27 @@ fn masing_trial(curve: &MasingCurve, scale: f64, st: &MasingState, x: f64) -> (f
         let (f, k) = curve.eval_slope((x - xa) / scale);
         return (ha + scale * f, k, 2 * len + usize::from(pushed));
     }
+}
+
+/// Accept the Masing trial at `x` (force `f`, memory update `aux` from [`masing_trial`]): the
+/// same rules as `masing::run`.
+#[inline(always)]
+pub(super) fn masing_commit(st: &mut MasingState, x: f64, f: f64, aux: usize) {
+    let dx = x - st.x;
+    if dx != 0.0 {
+        if aux & 1 == 1 {
+            st.stack.push(Reversal {
+                x: st.x,
+                h: st.h,
+                index: st.count.saturating_sub(1),
+            });
+        }
+        st.stack.truncate(aux / 2);
+        st.dir = if dx > 0.0 { 1 } else { -1 };
+        st.x = x;
+        st.h = f;
+    }
+    st.count = st.count.saturating_add(1);
 }
 
 /// `dz/dd` of the Bouc-Wen law for motion in direction `s`.
@@ -395,22 +421,7 @@ impl JointLaw {
         let dd = d_new - d_old;
         match (self, state) {
             (Self::Masing { .. }, JointState::Masing(st)) => {
-                // The memory update the trial found (same rules as `masing::run`).
-                let dx = d_new - st.x;
-                if dx != 0.0 {
-                    if trial.aux & 1 == 1 {
-                        st.stack.push(Reversal {
-                            x: st.x,
-                            h: st.h,
-                            index: st.count.saturating_sub(1),
-                        });
-                    }
-                    st.stack.truncate(trial.aux / 2);
-                    st.dir = if dx > 0.0 { 1 } else { -1 };
-                    st.x = d_new;
-                    st.h = trial.f;
-                }
-                st.count = st.count.saturating_add(1);
+                masing_commit(st, d_new, trial.f, trial.aux);
                 Ok(())
             }
             (Self::Jenkins { .. } | Self::BoucWen { .. }, JointState::Slider(f)) => {

@@ -14,4 +14,6 @@ pub mod newmark;
 mod sdof;
 
 pub use joint::{Joint, JointLaw, JointState, MasingCurve, Trial};
-pub use newmark::{simulate, Inputs, Options, Response, Status, Structure};
+pub use newmark::{
+    simulate, simulate_into, Buffers, Inputs, Options, Response, Status, Structure, Summary,
+};

@@ -172,6 +172,94 @@ pub struct Response {
     pub n_iter: u64,
 }
 
+/// Output buffers for [`simulate_into`] (row-major like [`Response`]'s arrays): `x`, `v`,
+/// `a` of `len(t) × n`; the joint arrays `len(t) × n_joints`; the energies `len(t)`. An empty
+/// buffer is an output the caller does not want (it is not computed). Rows past the run's
+/// `n_out` are left as they were.
+#[derive(Debug)]
+pub struct Buffers<'a> {
+    pub x: &'a mut [f64],
+    pub v: &'a mut [f64],
+    pub a: &'a mut [f64],
+    pub joint_force: &'a mut [f64],
+    pub joint_work: &'a mut [f64],
+    pub joint_dissipated: &'a mut [f64],
+    pub input_work: &'a mut [f64],
+    pub damping_work: &'a mut [f64],
+}
+
+/// How a run ended (the non-array part of [`Response`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Summary {
+    pub status: Status,
+    pub n_out: usize,
+    pub n_steps: u64,
+    pub n_iter: u64,
+}
+
+impl Summary {
+    pub(super) fn new() -> Self {
+        Self {
+            status: Status::Success,
+            n_out: 0,
+            n_steps: 0,
+            n_iter: 0,
+        }
+    }
+}
+
+impl Response {
+    /// Zeroed arrays for `nt` samples of `n` DOFs and `nj` joints (sizes already checked).
+    fn zeros(nt: usize, total: usize, total_j: usize) -> Self {
+        Self {
+            x: vec![0.0; total],
+            v: vec![0.0; total],
+            a: vec![0.0; total],
+            joint_force: vec![0.0; total_j],
+            joint_work: vec![0.0; total_j],
+            joint_dissipated: vec![0.0; total_j],
+            input_work: vec![0.0; nt],
+            damping_work: vec![0.0; nt],
+            status: Status::Success,
+            n_out: 0,
+            n_steps: 0,
+            n_iter: 0,
+        }
+    }
+
+    fn buffers(&mut self) -> Buffers<'_> {
+        Buffers {
+            x: &mut self.x,
+            v: &mut self.v,
+            a: &mut self.a,
+            joint_force: &mut self.joint_force,
+            joint_work: &mut self.joint_work,
+            joint_dissipated: &mut self.joint_dissipated,
+            input_work: &mut self.input_work,
+            damping_work: &mut self.damping_work,
+        }
+    }
+
+    fn set(&mut self, sum: Summary) {
+        self.status = sum.status;
+        self.n_out = sum.n_out;
+        self.n_steps = sum.n_steps;
+        self.n_iter = sum.n_iter;
+    }
+}
+
+/// `(len(t)·n, len(t)·n_joints)`, the output sizes, or an error if they overflow.
+fn sizes(s: &Structure, nt: usize) -> Result<(usize, usize), CoreError> {
+    let too_many = CoreError::InvalidParameter {
+        name: "t",
+        value: nt as f64,
+        reason: "too many samples",
+    };
+    let total = nt.checked_mul(s.n).ok_or(too_many.clone())?;
+    let total_j = nt.checked_mul(s.joints.len()).ok_or(too_many)?;
+    Ok((total, total_j))
+}
+
 /// The integrator's per-step state.
 struct Work {
     x: Vec<f64>,
@@ -331,9 +419,26 @@ pub fn simulate(
     v0: &[f64],
     opts: &Options,
 ) -> Result<Response, CoreError> {
+    let nt = inp.t.len();
+    let (total, total_j) = sizes(s, nt)?;
+    let mut out = Response::zeros(nt, total, total_j);
+    let sum = simulate_into(s, inp, x0, v0, opts, &mut out.buffers())?;
+    out.set(sum);
+    Ok(out)
+}
+
+/// [`simulate`] writing the samples into the caller's buffers (e.g. arrays the caller then
+/// hands on without a copy); their sizes must be as [`Buffers`] says.
+pub fn simulate_into(
+    s: &Structure,
+    inp: &Inputs<'_>,
+    x0: &[f64],
+    v0: &[f64],
+    opts: &Options,
+    out: &mut Buffers<'_>,
+) -> Result<Summary, CoreError> {
     let n = s.n;
     let nt = inp.t.len();
-    let nj = s.joints.len();
     if nt == 0 {
         return Err(CoreError::Empty { name: "t" });
     }
@@ -342,16 +447,25 @@ pub fn simulate(
     check_same_len("v0", v0.len(), "n", n)?;
     check_finite("x0", x0)?;
     check_finite("v0", v0)?;
-    let total = nt.checked_mul(n).ok_or(CoreError::InvalidParameter {
-        name: "t",
-        value: nt as f64,
-        reason: "too many samples",
-    })?;
-    let total_j = nt.checked_mul(nj).ok_or(CoreError::InvalidParameter {
-        name: "t",
-        value: nt as f64,
-        reason: "too many samples",
-    })?;
+    let (total, total_j) = sizes(s, nt)?;
+    for (name, len, want) in [
+        ("x buffer", out.x.len(), total),
+        ("v buffer", out.v.len(), total),
+        ("a buffer", out.a.len(), total),
+        ("joint_force buffer", out.joint_force.len(), total_j),
+        ("joint_work buffer", out.joint_work.len(), total_j),
+        (
+            "joint_dissipated buffer",
+            out.joint_dissipated.len(),
+            total_j,
+        ),
+        ("input_work buffer", out.input_work.len(), nt),
+        ("damping_work buffer", out.damping_work.len(), nt),
+    ] {
+        if len != 0 {
+            check_same_len(name, len, "output size", want)?;
+        }
+    }
     if let Some(f) = inp.force {
         check_same_len("force", f.len(), "len(t)*n", total)?;
         check_finite("force", f)?;
@@ -372,26 +486,40 @@ pub fn simulate(
         });
     }
     if n == 1 {
-        // One DOF: the same scheme on scalars (no matrices, no LU), bit-for-bit the same
-        // arithmetic as the dense path below (checked by the tests in `sdof`).
-        return super::sdof::simulate(s, inp, x0[0], v0[0], opts);
+        // One DOF: the same scheme on scalars (no matrices, no LU), generic over the joint set
+        // (checked against the dense path by the tests in `sdof`).
+        return super::sdof::simulate(s, inp, x0[0], v0[0], opts, out);
     }
-    simulate_dense(s, inp, x0, v0, opts, total, total_j)
+    simulate_dense(s, inp, x0, v0, opts, out)
 }
 
-/// The n-DOF path of [`simulate`] (inputs already checked; `total = len(t)·n`,
-/// `total_j = len(t)·n_joints`).
+/// The dense path alone, allocating its output (the tests compare the one-DOF path with it).
+#[cfg(test)]
+pub(super) fn simulate_dense_response(
+    s: &Structure,
+    inp: &Inputs<'_>,
+    x0: &[f64],
+    v0: &[f64],
+    opts: &Options,
+) -> Result<Response, CoreError> {
+    let nt = inp.t.len();
+    let (total, total_j) = sizes(s, nt)?;
+    let mut out = Response::zeros(nt, total, total_j);
+    let sum = simulate_dense(s, inp, x0, v0, opts, &mut out.buffers())?;
+    out.set(sum);
+    Ok(out)
+}
+
+/// The n-DOF path of [`simulate_into`] (inputs and buffer sizes already checked).
 pub(super) fn simulate_dense(
     s: &Structure,
     inp: &Inputs<'_>,
     x0: &[f64],
     v0: &[f64],
     opts: &Options,
-    total: usize,
-    total_j: usize,
-) -> Result<Response, CoreError> {
+    out: &mut Buffers<'_>,
+) -> Result<Summary, CoreError> {
     let n = s.n;
-    let nt = inp.t.len();
     let nj = s.joints.len();
     let mut states: Vec<JointState> = s.joints.iter().map(|j| j.law.fresh_state()).collect();
     let mut jf = vec![0.0; nj];
@@ -460,22 +588,9 @@ pub(super) fn simulate_dense(
     sc.lu.solve(&mut rhs);
     w.a.copy_from_slice(&rhs);
 
-    let mut out = Response {
-        x: vec![0.0; total],
-        v: vec![0.0; total],
-        a: vec![0.0; total],
-        joint_force: vec![0.0; total_j],
-        joint_work: vec![0.0; total_j],
-        joint_dissipated: vec![0.0; total_j],
-        input_work: vec![0.0; nt],
-        damping_work: vec![0.0; nt],
-        status: Status::Success,
-        n_out: 0,
-        n_steps: 0,
-        n_iter: 0,
-    };
-    record(s, &w, &mut out, 0);
-    out.n_out = 1;
+    let mut sum = Summary::new();
+    record(s, &w, out, 0);
+    sum.n_out = 1;
     for (i, pair) in inp.t.windows(2).enumerate() {
         let big_h = pair[1] - pair[0];
         let mut tau = 0.0_f64;
@@ -491,16 +606,16 @@ pub(super) fn simulate_dense(
                 None => {
                     halvings = halvings.saturating_add(1);
                     if halvings > opts.max_halvings {
-                        out.status = Status::NoConvergence {
+                        sum.status = Status::NoConvergence {
                             time: inp.t[i] + tau * big_h,
                             step: h,
                         };
-                        return Ok(out);
+                        return Ok(sum);
                     }
                     frac = 0.5 * step;
                     continue;
                 }
-                Some(it) => out.n_iter = out.n_iter.saturating_add(it),
+                Some(it) => sum.n_iter = sum.n_iter.saturating_add(it),
             }
             // Split the step at the earliest joint event strictly inside it.
             if events < opts.max_events {
@@ -520,21 +635,21 @@ pub(super) fn simulate_dense(
                 }
             }
             accept(s, &mut w, &mut sc)?;
-            out.n_steps = out.n_steps.saturating_add(1);
+            sum.n_steps = sum.n_steps.saturating_add(1);
             tau = tau1;
             frac = (1.0 - tau).max(0.0);
             if w.x.iter().chain(&w.v).any(|v| !v.is_finite()) {
-                out.status = Status::NonFinite {
+                sum.status = Status::NonFinite {
                     time: inp.t[i] + tau * big_h,
                 };
-                return Ok(out);
+                return Ok(sum);
             }
         }
         let next = i.saturating_add(1); // < nt
-        record(s, &w, &mut out, next);
-        out.n_out = next.saturating_add(1);
+        record(s, &w, out, next);
+        sum.n_out = next.saturating_add(1);
     }
-    Ok(out)
+    Ok(sum)
 }
 
 /// Commit the converged step in `sc` to `w`, with the energy bookkeeping.
@@ -580,20 +695,37 @@ fn accept(s: &Structure, w: &mut Work, sc: &mut Scratch) -> Result<(), CoreError
 // Row-major index arithmetic: indices < n (dofs), nj (joints) or the sample count, into
 // buffers whose sizes n*n, nt*n and nt*nj were checked in `Structure::new` and `simulate`.
 #[allow(clippy::arithmetic_side_effects)]
-fn record(s: &Structure, w: &Work, out: &mut Response, i: usize) {
+fn record(s: &Structure, w: &Work, out: &mut Buffers<'_>, i: usize) {
     let n = s.n;
     let nj = s.joints.len();
-    out.x[i * n..(i + 1) * n].copy_from_slice(&w.x);
-    out.v[i * n..(i + 1) * n].copy_from_slice(&w.v);
-    out.a[i * n..(i + 1) * n].copy_from_slice(&w.a);
-    for (jn, j) in s.joints.iter().enumerate() {
-        out.joint_force[i * nj + jn] = w.jf[jn];
-        out.joint_work[i * nj + jn] = w.jwork[jn];
-        out.joint_dissipated[i * nj + jn] =
-            w.jwork[jn] - (j.law.stored_energy(&w.states[jn], w.jd[jn]) - w.stored0[jn]);
+    // (an empty buffer: an output not wanted)
+    for (buf, val) in [
+        (&mut *out.x, &w.x),
+        (&mut *out.v, &w.v),
+        (&mut *out.a, &w.a),
+    ] {
+        if let Some(row) = buf.get_mut(i * n..(i + 1) * n) {
+            row.copy_from_slice(val);
+        }
     }
-    out.input_work[i] = w.e_in;
-    out.damping_work[i] = w.e_damp;
+    for (jn, j) in s.joints.iter().enumerate() {
+        let at = i * nj + jn;
+        if let Some(f) = out.joint_force.get_mut(at) {
+            *f = w.jf[jn];
+        }
+        if let Some(f) = out.joint_work.get_mut(at) {
+            *f = w.jwork[jn];
+        }
+        if let Some(d) = out.joint_dissipated.get_mut(at) {
+            *d = w.jwork[jn] - (j.law.stored_energy(&w.states[jn], w.jd[jn]) - w.stored0[jn]);
+        }
+    }
+    if let Some(e) = out.input_work.get_mut(i) {
+        *e = w.e_in;
+    }
+    if let Some(e) = out.damping_work.get_mut(i) {
+        *e = w.e_damp;
+    }
 }
 
 #[cfg(test)]
