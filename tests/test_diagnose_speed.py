@@ -193,3 +193,55 @@ def test_evaluation_counter_counts_every_thread():
     with ThreadPoolExecutor(4) as ex:
         got = list(ex.map(work, [1000] * 16))
     assert got == [1000] * 16 and c.total == 16_000
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(0, 3000), scale=st.floats(1e-9, 1e3))
+def test_second_difference_noise_is_the_tangential_estimate(seed, n, scale):
+    from contactlab.diagnose._signal import second_difference_var
+    from contactlab.tangential.uncertainty import x_noise_var
+
+    x = scale * _walk(seed, n)
+    assert second_difference_var(x) == x_noise_var(x, None)
+
+
+def test_one_verb_parser_is_the_full_parser_for_that_verb():
+    """``contactlab VERB ...`` builds the parser of VERB only; every verb maps to the module
+    that registers it, and parses as the full parser does."""
+    from contactlab import cli
+
+    full = cli.build_parser()
+    verbs = next(a for a in full._actions if a.dest == "verb").choices
+    assert set(verbs) == {cli._verb_module([v]) and v for v in verbs}
+    for verb in verbs:
+        mod = cli._verb_module([verb, "-x"])
+        assert mod is not None
+        only = cli.build_parser(mod)
+        assert list(next(a for a in only._actions if a.dest == "verb").choices) == [verb]
+    argv = ["diagnose", "rec.h5", "--model", "normal", "--p0", "0.5MPa", "--json", "o.json"]
+    assert vars(cli.build_parser(cli._verb_module(argv)).parse_args(argv)) == vars(
+        full.parse_args(argv)
+    )
+    assert cli._verb_module(["--help"]) is None
+    assert cli._verb_module(["diagnos", "x"]) is None
+
+
+def test_cli_diagnose_imports_no_other_verb():
+    """A diagnosis from the command line imports neither the studies, the report, the
+    tangential analysis nor the generator (start-up time, issue 9)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys\n"
+        "from contactlab import cli\n"
+        "cli.build_parser(cli._verb_module(['diagnose'])).parse_args(['diagnose', 'f.h5', "
+        "'--model', 'tangential'])\n"
+        "import contactlab.diagnose.workflow\n"
+        "bad = [m for m in sys.modules if m.startswith(('contactlab.studies', "
+        "'contactlab.report', 'contactlab.tangential', 'contactlab.diagnose.generator', "
+        "'matplotlib', 'pyarrow', 'scipy.signal', 'scipy.stats'))]\n"
+        "print(bad)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
