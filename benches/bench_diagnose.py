@@ -41,7 +41,9 @@ matter of it.
 
 Run: ``nice .venv/bin/python benches/bench_diagnose.py [--samples 1e6] [--repeat 3]
 [--format h5|csv] [--recordings all] [--workdir DIR] [--keep DIR] [--compare DIR]
-[--threads-ab] [--profile]``. ``--profile`` runs cProfile on the CLI path
+[--baseline DIR] [--threads-ab] [--profile]``. ``--baseline DIR`` runs another version of
+the package (its ``contactlab`` folder in DIR) interleaved with this one, as rows ``before``
+and ``after``, and compares their reports. ``--profile`` runs cProfile on the CLI path
 of the first recording and prints the functions with the largest cumulative and own time.
 """
 
@@ -49,11 +51,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import multiprocessing
 import os
 import subprocess
 import sys
 import tempfile
 import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -130,6 +134,13 @@ def write_generated(path: Path, kind: str, n: int, seed: int) -> None:
     write_recording(path, rec)
 
 
+def make_recording(path: Path, kind: str, n: int, seed: int) -> None:
+    if ":" in kind:
+        write_generated(path, kind, n, seed)
+    else:
+        write(path, recording(kind, n, seed))
+
+
 def model_of(kind: str) -> str:
     return "normal" if kind.startswith("n:") else "tangential"
 
@@ -138,11 +149,13 @@ def file_tag(kind: str) -> str:
     return kind.replace(":", "_")
 
 
-def compare(kinds: list[str], new: Path, old: Path) -> None:
+def compare(
+    kinds: list[str], new: Path, old: Path, old_tag: str = "default", new_tag: str = "default"
+) -> None:
     """Effects named and parameter changes (in standard errors) between two kept runs."""
     print(f"{'recording':<28}{'effects (same?)':<40}{'max |Δp|/σ':>12}  parameter")
     for kind in kinds:
-        a, b = old / f"{file_tag(kind)}_default.json", new / f"{file_tag(kind)}_default.json"
+        a, b = old / f"{file_tag(kind)}_{old_tag}.json", new / f"{file_tag(kind)}_{new_tag}.json"
         if not (a.exists() and b.exists()):
             print(f"{kind:<28}(no report in both)")
             continue
@@ -176,7 +189,12 @@ def masing_reference(n: int) -> float:
 
 
 def run_cli(args: list[str], env: dict[str, str] | None = None, python: bool = False) -> dict:
-    """The CLI (or, with ``python``, the interpreter) with ``args`` in a child process."""
+    """The CLI (or, with ``python``, the interpreter) with ``args`` in a child process.
+
+    Peak RSS is the child's ``ru_maxrss``; Linux carries the high-water mark of the address
+    space a child had before ``exec`` into it, which for a ``vfork``ed child is this process's:
+    so this process must stay smaller than the runs it measures (the recordings are made in
+    a separate process)."""
     exe = sys.executable if python else str(Path(sys.executable).with_name("contactlab"))
     cmd = [exe, *args]
     with tempfile.TemporaryFile() as errf:
@@ -234,6 +252,14 @@ def main() -> None:
         help="compare the reports kept in --keep with those kept in DIR (no runs)",
     )
     ap.add_argument(
+        "--baseline",
+        metavar="DIR",
+        help="also run another version of the package, whose `contactlab` package is in DIR "
+        "(e.g. `git archive REV python | tar -x -C /tmp/base`, with the built extension "
+        "copied in), interleaved with this one: rows 'before' and 'after', and their reports "
+        "compared (with --keep)",
+    )
+    ap.add_argument(
         "--threads-ab",
         action="store_true",
         help="also run each with CONTACTLAB_DIAGNOSE_THREADS=1 and =2",
@@ -252,15 +278,17 @@ def main() -> None:
         tmpd = Path(tmp)
         store = Path(args.workdir) if args.workdir else tmpd
         store.mkdir(parents=True, exist_ok=True)
-        files = {}
-        for i, kind in enumerate(kinds):
-            files[kind] = store / f"{file_tag(kind)}_{n}_{args.seed + i}.{args.format}"
-            if files[kind].exists():
-                continue
-            if ":" in kind:
-                write_generated(files[kind], kind, n, args.seed + i)
-            else:
-                write(files[kind], recording(kind, n, args.seed + i))
+        files = {
+            kind: store / f"{file_tag(kind)}_{n}_{args.seed + i}.{args.format}"
+            for i, kind in enumerate(kinds)
+        }
+        todo = [
+            (files[k], k, n, args.seed + i) for i, k in enumerate(kinds) if not files[k].exists()
+        ]
+        if todo:  # in a child: this process stays small (see run_cli on peak RSS)
+            ctx = multiprocessing.get_context("spawn")
+            with ProcessPoolExecutor(1, mp_context=ctx) as ex:
+                list(ex.map(make_recording, *zip(*todo, strict=True)))
         if args.compare:
             compare(kinds, Path(args.keep or "."), Path(args.compare))
             return
@@ -283,16 +311,29 @@ def main() -> None:
             f"{'/ Masing':>10}{'/ start':>9}  effects"
         )
         variants: list[tuple[str, dict[str, str]]] = [("default", {})]
+        if args.baseline:
+            base = os.pathsep.join(
+                [str(Path(args.baseline).resolve()), os.environ.get("PYTHONPATH", "")]
+            )
+            variants = [("before", {"PYTHONPATH": base.rstrip(os.pathsep)}), ("after", {})]
         if args.threads_ab:
             variants.append(("1 thread", {"CONTACTLAB_DIAGNOSE_THREADS": "1"}))
             variants.append(("2 thread", {"CONTACTLAB_DIAGNOSE_THREADS": "2"}))
         rows = []
         for kind in kinds:
-            out = tmpd / f"{file_tag(kind)}.json"
-            for label, env in variants:
-                cmd = ["diagnose", str(files[kind]), "--model", model_of(kind), "--json", str(out)]
-                runs = [run_cli(cmd, env) for _ in range(args.repeat)]
-                best = min(runs, key=lambda r: r["wall_s"])
+            # the variants interleaved, so that a change of the machine's load hits them alike
+            runs: dict[str, list[dict]] = {label: [] for label, _ in variants}
+            outs = {
+                label: tmpd / f"{file_tag(kind)}_{label.replace(' ', '')}.json"
+                for label, _ in variants
+            }
+            for _ in range(args.repeat):
+                for label, env in variants:
+                    cmd = ["diagnose", str(files[kind]), "--model", model_of(kind)]
+                    runs[label].append(run_cli([*cmd, "--json", str(outs[label])], env))
+            for label, _ in variants:
+                out = outs[label]
+                best = min(runs[label], key=lambda r: r["wall_s"])
                 rep = json.loads(out.read_text())
                 if args.keep:
                     Path(args.keep).mkdir(parents=True, exist_ok=True)
@@ -308,6 +349,8 @@ def main() -> None:
                     f"(load {os.getloadavg()[0]:.1f})"
                 )
         print(f"load average at the end {os.getloadavg()[0]:.1f}")
+        if args.baseline and args.keep:
+            compare(kinds, Path(args.keep), Path(args.keep), old_tag="before", new_tag="after")
         summary = {"masing_s": t_masing, "startup_s": t_start, "import_cpu_s": t_imp}
         print(json.dumps({**summary, "runs": rows}))
 

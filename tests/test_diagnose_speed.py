@@ -5,6 +5,8 @@ fresh one. Timings live in benches/bench_diagnose.py."""
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -245,3 +247,49 @@ def test_cli_diagnose_imports_no_other_verb():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+_ALL_TANGENTIAL = (
+    "viscous_damping", "inertia", "parallel_stiffness", "force_offset", "force_drift",
+    "displacement_offset", "asymmetry", "parameter_drift", "stribeck", "position_friction",
+    "stick_slip", "normal_load",
+)  # fmt: skip
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    effects=st.lists(st.sampled_from(_ALL_TANGENTIAL), max_size=4, unique=True),
+    tau_samples=st.one_of(st.just(0.0), st.floats(-40.0, 40.0)),
+    stride=st.integers(1, 13),
+    start=st.integers(0, 12),
+    f_n=st.floats(0.1, 30.0),
+)
+def test_prediction_at_samples_is_the_full_one(effects, tau_samples, stride, start, f_n):
+    """``predict(at=idx)`` (with a delay: the terms at the samples around each shifted time
+    only; the load fluctuation's terms kept per f_n) equals the full prediction at ``idx``,
+    bit for bit, also when called again (memos hit)."""
+    from contactlab.diagnose.candidates_tangential import TangentialFamily
+
+    d = _small_tangential()
+    fam = TangentialFamily()
+    p = {"h0": 48.0, "ac": 4.6e4, "x0": 1e-7, "c": 3.0, "m": 0.01, "k_p": 1e4, "F0": 0.5}
+    p.update(F1=0.3, alpha=0.1, beta=0.05, s=0.1, v_s=1e-3, a1=0.05, b1=0.0, a2=-0.02)
+    p.update(b2=0.01, s_b=0.2, ell=3e-6, eps_c=0.03, eps_s=-0.02, f_n=f_n)
+    p["tau"] = tau_samples * d.dt
+    eff = (*effects, "channel_delay")
+    idx = np.arange(start, d.u.size, stride)
+    for _ in range(2):
+        for e in (tuple(effects), eff):
+            full = fam.predict(p, e, d)
+            assert np.array_equal(fam.predict(p, e, d, at=idx), full[idx])
+
+
+@functools.cache
+def _small_tangential():
+    from contactlab.diagnose._family import Prepared
+    from contactlab.diagnose.candidates_tangential import TangentialFamily
+
+    rec = hidden_effect_recording([], seed=78, samples_per_cycle=40, cycles_per_block=3)
+    d = Prepared.build(rec.t, rec.data["x"], rec.data["F"])
+    TangentialFamily().prepare(d)
+    return d
