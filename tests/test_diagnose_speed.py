@@ -293,3 +293,40 @@ def _small_tangential():
     d = Prepared.build(rec.t, rec.data["x"], rec.data["F"])
     TangentialFamily().prepare(d)
     return d
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    n=st.integers(2, 1500),
+    log_lam=st.floats(-4.0, 3.5),
+    jitter=st.sampled_from([0.0, 1e-3]),
+    noise=st.sampled_from([0.0, 0.02]),
+)
+def test_exact_kelvin_voigt_is_the_integrator_at_tight_tolerance(seed, n, log_lam, jitter, noise):
+    """The exact first-order response (the normal base model a diagnosis fits) against the
+    package's adaptive integrator at rtol 1e-11 — stiff (ωΔt/ψ up to 3000) and non-stiff
+    steps, uneven sampling, noisy pressure — and the kept unit response ``(R - p0)/k``
+    against a direct evaluation."""
+    from contactlab.diagnose._family import Prepared
+    from contactlab.diagnose.candidates_normal import _kelvin_voigt_fit, kelvin_voigt_exact
+    from contactlab.normal import KelvinVoigt
+
+    rng = np.random.default_rng(seed)
+    fs, omega, k = 200.0, 2 * np.pi * 1.3, 1.3e12
+    t = (np.arange(n) + jitter * rng.uniform(-1, 1, n)) / fs
+    p = 3e5 * np.sin(omega * t) + 1e5 * np.sin(2.7 * omega * t + 1.0)
+    p = p + noise * 3e5 * rng.standard_normal(n)
+    psi = 2 * np.pi * omega / (10.0**log_lam * fs)  # a Δt = 10^log_lam
+    if not 1e-6 <= psi <= 10.0:
+        return
+    ref = KelvinVoigt(k, psi, omega).simulate(t, p, rtol=1e-11).delta
+    got = kelvin_voigt_exact(t, p, k, psi, omega)
+    scale = float(np.max(np.abs(ref)))
+    assert np.max(np.abs(got - ref)) <= 1e-8 * scale
+    if n >= 16:
+        p0 = 4e5
+        d = Prepared(t, p + p0, p, 1.0 / fs, 7, p, p, None)  # type: ignore[arg-type]
+        for _ in range(2):  # computed, then kept
+            kept = _kelvin_voigt_fit(d, k, psi, p0, omega)
+            assert np.max(np.abs(kept - got)) <= 1e-12 * scale
