@@ -279,7 +279,10 @@ def _delay_support(d: Prepared, at: np.ndarray, tau: float) -> np.ndarray:
         return hit[1]
     n = d.t.size
     j = np.searchsorted(d.t, d.t[at] - tau, side="right") - 1
-    rows = np.unique(np.concatenate((np.clip(j, 0, n - 1), np.clip(j + 1, 0, n - 1))))
+    need = np.zeros(n, bool)
+    need[np.clip(j, 0, n - 1)] = True
+    need[np.clip(j + 1, 0, n - 1)] = True
+    rows = np.flatnonzero(need)
     memo[key] = (at, rows)
     return rows
 
