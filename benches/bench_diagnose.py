@@ -278,13 +278,15 @@ def main() -> None:
         tmpd = Path(tmp)
         store = Path(args.workdir) if args.workdir else tmpd
         store.mkdir(parents=True, exist_ok=True)
-        files = {
-            kind: store / f"{file_tag(kind)}_{n}_{args.seed + i}.{args.format}"
-            for i, kind in enumerate(kinds)
+        # a recording's seed by its place in the full list: the same recording whatever
+        # subset is run (and found again in --workdir)
+        canon = ["clean", "offset", "damping", *generator_kinds("t"), *generator_kinds("n")]
+        seeds = {
+            k: args.seed + (canon.index(k) if k in canon else len(canon) + i)
+            for i, k in enumerate(kinds)
         }
-        todo = [
-            (files[k], k, n, args.seed + i) for i, k in enumerate(kinds) if not files[k].exists()
-        ]
+        files = {k: store / f"{file_tag(k)}_{n}_{seeds[k]}.{args.format}" for k in kinds}
+        todo = [(files[k], k, n, seeds[k]) for k in kinds if not files[k].exists()]
         if todo:  # in a child: this process stays small (see run_cli on peak RSS)
             ctx = multiprocessing.get_context("spawn")
             with ProcessPoolExecutor(1, mp_context=ctx) as ex:
