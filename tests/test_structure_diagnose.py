@@ -136,13 +136,28 @@ def test_cli_diagnose_structure(tmp_path, capsys):
         f"{a:.6f},{b:.9e},{c:.9e}" for a, b, c in zip(t, u, y, strict=True)) + "\n")  # fmt: skip
     out = tmp_path / "diag.json"
     assert cli_main(["diagnose", str(rec), "--structure", str(mpath), "--json", str(out),
-                     "--max-effects", "1"]) == 0  # fmt: skip
+                     "--max-effects", "1", "--report", str(tmp_path / "rep")]) == 0  # fmt: skip
     doc = json.loads(out.read_text())
+    # the HTML report: every part the diagnosis has, figures beside it, the JSON result
+    html = (tmp_path / "rep" / "diagnose.html").read_text()
+    for part in ("Findings", "Named: base_coupling", "e = 0.", " ± ", "Joint loop",
+                 "Residual: where the unexplained part lives", "Candidates tried",
+                 "held-out RMS"):  # fmt: skip
+        assert part in html, part
+    figs = {p.name for p in (tmp_path / "rep" / "figures").iterdir()}
+    assert {"response.png", "joint-loop.png", "residual-where.png"} <= figs
+    assert json.loads((tmp_path / "rep" / "diagnose.json").read_text())["effects"] == [
+        "base_coupling"
+    ]
     assert doc["model"] == "structure"
     assert doc["effects"] == ["base_coupling"]
     assert doc["columns"] == {"u": "y_base_m", "y": "x_m"}
     assert {"steps", "where", "noise_rms", "unexplained", "parameters"} <= set(doc)
     assert "Added base_coupling" in capsys.readouterr().out
+    # a --report path that is a file: refused before the work, nothing written
+    assert cli_main(["diagnose", str(rec), "--structure", str(mpath), "--report",
+                     str(rec)]) != 0  # fmt: skip
+    assert "--report" in capsys.readouterr().err
     # neither --model nor --structure: a clear error, not a traceback
     assert cli_main(["diagnose", str(rec)]) != 0
     assert "--structure" in capsys.readouterr().err

@@ -135,3 +135,59 @@ def test_cli_simulate_that_stops_early_writes_nothing_unless_partial(tmp_path, c
     assert "wrote" in capsys.readouterr().err
     sim = np.loadtxt(out, delimiter=",", skiprows=1, ndmin=2)
     assert 0 < sim.shape[0] < t.size and np.all(np.isfinite(sim))
+
+
+def _short_frame(seed: int, dt: float, noise: float, n: int = 400):
+    """A base-excited frame with a Jenkins joint to the wall on a short record: 400 samples,
+    1 mm base motion (three tones near 1, 2.7, 4.3 Hz), noise on both channels."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) * dt
+    freqs = np.array([1.0, 2.7, 4.3]) * rng.uniform(0.9, 1.1)
+    arg = 2 * np.pi * freqs[None, :] * t[:, None] + rng.uniform(0, 2 * np.pi, 3)
+    ub = np.sin(arg) @ (np.array([1.0, 0.3, 0.16]) * 1e-3)
+    s = Structure(3.08, 0.67, 1200.0)
+    s.add_joint("jenkins", 0, k=6000.0, fs=0.9)
+    x = s.simulate(t, base=ub, substeps=4).x
+    return (t, ub + noise * np.std(ub) * rng.standard_normal(n),
+            x + noise * np.std(x) * rng.standard_normal(n), noise * np.std(x))  # fmt: skip
+
+
+def test_short_base_excited_record_where_the_equation_error_fails():
+    """400 samples, 1 mm: the regression's stiffness comes out negative (the mass is held by
+    the wall more than by its spring); identify starts from output-error grids instead of
+    stopping with "non-positive stiffness"."""
+    from contactlab.structure.identify import equation_error
+
+    def fails(s: int) -> bool:
+        return equation_error(*_short_frame(s, 1e-3, 0.03)[:3], "base", 3.08)["k"] <= 0
+
+    seed = next(s for s in range(91000, 91100) if fails(s))
+    t, u, y, sigma = _short_frame(seed, 1e-3, 0.03)
+    m = identify(t, u, y, joint="jenkins", excitation="base", mass=3.08, substeps=2)
+    assert m.fit.success
+    assert m.rms < 1.3 * sigma
+    p = m.fit.params
+    for name, value in (("k", 1200.0), ("kj", 6000.0), ("fs", 0.9)):
+        assert p[name].value == pytest.approx(value, rel=0.05), name
+    assert any("grid_f" in r["start"] for r in m.starts)
+
+
+def test_linear_grid_start_finds_the_natural_frequency():
+    from contactlab.structure.identify import linear_grid_start
+
+    rng = np.random.default_rng(91200)
+    t = np.arange(800) / 200.0
+    u = sum(np.sin(2 * np.pi * f * t + rng.uniform(0, 6.3)) for f in (1.3, 2.9, 4.1, 7.7))
+    s = Structure(2.0, 1.5, 800.0)  # 3.18 Hz
+    step = (t.size / 6.0) ** (1 / 23)  # the grid's ratio between frequencies
+    for exc, kw, mass in (("force", {"force": u}, None), ("base", {"base": 1e-3 * u}, 2.0)):
+        x = s.simulate(t, **kw).x
+        uu = kw.get("force", kw.get("base"))
+        g = linear_grid_start(t, uu, x, exc, mass)
+        assert 1 <= len(g) <= 3 and g[0]["grid_rms"] <= g[-1]["grid_rms"]
+        f0 = g[0]["grid_f"]
+        assert 3.18 / step <= f0 <= 3.18 * step, (exc, f0)
+        assert g[0]["k"] / g[0]["m"] == pytest.approx((2 * np.pi * f0) ** 2)
+        if exc == "force":  # the scale: k within the grid's frequency step (squared)
+            assert 800 / step**2 <= g[0]["k"] <= 800 * step**2
+    assert linear_grid_start(t[:2], u[:2], u[:2], "force", None) == []

@@ -95,17 +95,35 @@ def _identify(args: argparse.Namespace) -> int:
     exc = args.excitation
     ucol = _pick(cols, args.u, ("u", "f", "y_base", "base") if exc == "force" else
                  ("y_base", "base", "y"), "u", args.file)  # fmt: skip
-    ycol = _pick(cols, args.y, ("y_disp", "y", "x") if exc == "force" else ("x", "y_disp"),
-                 "y", args.file)  # fmt: skip
-    if ucol == ycol:
-        raise InputError(f"{args.file}: input and response are the same column {ucol!r}")
-    u, y = cols[ucol], cols[ycol]
+    ynames = [c.strip() for c in args.y.split(",")] if args.y and "," in args.y else None
+    if ynames:
+        # several response channels: one displacement per DOF (a multi-DOF structure)
+        ycols = [_pick(cols, c, (), "y", args.file) for c in ynames]
+        if ucol in ycols or len(set(ycols)) < len(ycols):
+            raise InputError(f"{args.file}: --y names the input or a column twice")
+        y = np.stack([cols[c] for c in ycols], axis=1)
+        ycol: str | list[str] = ycols
+    else:
+        ycol = _pick(cols, args.y, ("y_disp", "y", "x") if exc == "force" else
+                     ("x", "y_disp"), "y", args.file)  # fmt: skip
+        if ucol == ycol:
+            raise InputError(f"{args.file}: input and response are the same column {ucol!r}")
+        y = cols[ycol]
+    u = cols[ucol]
     t = _time(cols, args, u.size, args.file)
+    mass = _masses(args.mass)
+    if mass is not None and y.ndim == 1:
+        if len(mass) != 1:
+            raise InputError("--mass: one mass for a single response channel")
+        mass = mass[0]
+    mdof: dict[str, object] = {}
+    if y.ndim == 2:
+        mdof = {"joint_dofs": _joint_dofs(args.joint_dofs), "input_dof": args.input_dof}
     cmd = command_line("identify", args.file, "--joint", args.joint, "--excitation", exc)
     model, rep, summary = identify_record(
-        t, u, y, joint=args.joint, excitation=exc, mass=args.mass, holdout=args.holdout,
+        t, u, y, joint=args.joint, excitation=exc, mass=mass, holdout=args.holdout,
         substeps=args.substeps, periodic=args.periodic, title=f"{Path(args.file).name}: "
-        f"{args.joint} joint", intro=f"Made by: {cmd}",
+        f"{args.joint} joint", intro=f"Made by: {cmd}", **mdof,
     )  # fmt: skip
     doc = model.to_dict()
     doc["summary"] = summary
@@ -121,6 +139,32 @@ def _identify(args: argparse.Namespace) -> int:
               + (f", {hold:.4g} m (hold-out)" if hold is not None else "")
               + f"; identified in {model.elapsed:.1f} s")  # fmt: skip
     return 0
+
+
+def _masses(text: str | None) -> list[float] | None:
+    if text is None:
+        return None
+    try:
+        vals = [float(v) for v in str(text).split(",")]
+    except ValueError:
+        raise InputError(
+            f"--mass must be a number or comma-separated numbers, got {text!r}"
+        ) from None
+    if not all(np.isfinite(v) and v > 0 for v in vals):
+        raise InputError(f"--mass values must be positive and finite, got {text!r}")
+    return vals
+
+
+def _joint_dofs(text: str) -> tuple[int, int | None]:
+    parts = [p.strip().lower() for p in str(text).split(",")]
+    try:
+        i = int(parts[0])
+        j = None if len(parts) < 2 or parts[1] in ("", "ground", "none") else int(parts[1])
+    except ValueError:
+        raise InputError(f"--joint-dofs must be I,J or I,ground, got {text!r}") from None
+    if len(parts) > 2:
+        raise InputError(f"--joint-dofs takes two DOFs, got {text!r}")
+    return i, j
 
 
 def simulate_structure(args: argparse.Namespace) -> int:
@@ -180,8 +224,7 @@ def diagnose_structure_cli(args: argparse.Namespace) -> int:
     from ..diagnose.structure import diagnose_structure
     from ..structure import IdentifiedModel
 
-    if args.report:
-        raise InputError("--report is not available with --structure; use --json")
+    check_output_targets(json_out=args.json, report=args.report)
     model = IdentifiedModel.load(args.structure)
     cols = read_table(args.file)
     exc = model.excitation
@@ -203,6 +246,11 @@ def diagnose_structure_cli(args: argparse.Namespace) -> int:
         doc = rep.to_dict()
         doc["columns"] = {"u": ucol, "y": ycol}
         write_text(args.json, json.dumps(doc, indent=2, allow_nan=False) + "\n")
+    if args.report:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        print(f"report: {rep.write_html(args.report)}")
     return 0
 
 
@@ -218,9 +266,18 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                             "linear"))  # fmt: skip
     p.add_argument("--excitation", default="force", choices=("force", "base"))
     p.add_argument("--u", help="input column (force, or base displacement)")
-    p.add_argument("--y", help="response column (displacement of the mass)")
+    p.add_argument("--y", help="response column (displacement of the mass); several "
+                   "comma-separated columns (one per DOF, in DOF order) identify a chain of "
+                   "masses")  # fmt: skip
     p.add_argument("--fs", type=float, help="sampling rate (Hz) when there is no time column")
-    p.add_argument("--mass", type=float, help="known mass (kg), held fixed; needed for base")
+    p.add_argument("--mass", help="known mass (kg), held fixed; needed for base; one per DOF "
+                   "(comma-separated) with several --y channels")  # fmt: skip
+    p.add_argument("--joint-dofs", default="0,ground",
+                   help="several DOFs: the DOFs the joint joins, I,J or I,ground "
+                   "(default 0,ground)")  # fmt: skip
+    p.add_argument("--input-dof", type=int, default=None,
+                   help="several DOFs, force excitation: the DOF the input force acts on "
+                   "(default the last)")  # fmt: skip
     p.add_argument("--holdout", type=float, default=0.0,
                    help="fraction of the record (at its end) kept out of the fit and "
                    "reported as hold-out error")  # fmt: skip

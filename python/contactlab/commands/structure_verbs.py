@@ -22,6 +22,7 @@ def identify_record(
     periodic: bool,
     title: str,
     intro: str | None = None,
+    **mdof: Any,
 ) -> tuple[Any, Any, dict[str, Any]]:
     import matplotlib
 
@@ -37,7 +38,7 @@ def identify_record(
     model = identify(
         t[:n_train], u[:n_train], y[:n_train], joint=joint, excitation=excitation,
         mass=mass, substeps=substeps, interpolation="fourier" if periodic and holdout == 0
-        else "linear", periodic=periodic,
+        else "linear", periodic=periodic, **mdof,
     )  # fmt: skip
     if periodic:
         model.interpolation = "fourier"

@@ -142,6 +142,11 @@ class StructureDiagnosis:
     n_holdout: int
     final_structure: Structure | None = field(default=None, repr=False)
     residual: np.ndarray | None = field(default=None, repr=False)
+    #: the record and both models' simulations over it, for :meth:`write_html`
+    record: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
+    base_prediction: np.ndarray | None = field(default=None, repr=False)
+    base_joint_force: np.ndarray | None = field(default=None, repr=False)
+    joint_force: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def effect_names(self) -> list[str]:
@@ -167,6 +172,18 @@ class StructureDiagnosis:
 
     def to_json(self, indent: int = 2) -> str:
         return json.dumps(self.to_dict(), indent=indent, allow_nan=False)
+
+    def write_html(self, directory: Any) -> Path:
+        """Write ``diagnose.html`` (measured vs simulated response of the base and the final
+        model, the joint's loop, the residual before and after, the named effects with their
+        parameters ± standard errors, the unexplained part and where it lives), its figures
+        under ``figures/`` and ``diagnose.json`` into ``directory``, all or nothing; returns
+        the HTML's path."""
+        from ..structure.report import build_diagnosis_report
+
+        rep = build_diagnosis_report(self)
+        extra = {"diagnose.json": (self.to_json() + "\n").encode("utf-8")}
+        return rep.write(directory, extra=extra, html_name="diagnose.html")[0]
 
     def summary(self) -> str:
         out = [f"contactlab diagnose — structure ({self.joint} joint, {self.excitation} "
@@ -203,14 +220,19 @@ def _fmt(v: float | None) -> str:
 
 # ------------------------------------------------------------------------------ the models
 def _base_model(base: Any) -> IdentifiedModel:
-    if isinstance(base, IdentifiedModel):
-        return base
     if isinstance(base, (str, Path)):
-        return IdentifiedModel.load(base)
-    raise InputError(
-        "the base structure must be an IdentifiedModel (contactlab.structure.identify) or the "
-        f"path of its saved JSON, got {type(base).__name__}"
-    )
+        base = IdentifiedModel.load(base)
+    if not isinstance(base, IdentifiedModel):
+        raise InputError(
+            "the base structure must be an IdentifiedModel (contactlab.structure.identify) or "
+            f"the path of its saved JSON, got {type(base).__name__}"
+        )
+    if base.structure.n != 1:
+        raise InputError(
+            f"the structure diagnosis takes a single-DOF base model; this one has "
+            f"{base.structure.n} DOFs"
+        )
+    return base
 
 
 def _structure(model: IdentifiedModel, effects: tuple[str, ...], v: dict[str, float]) -> Structure:
@@ -587,6 +609,7 @@ def diagnose_structure(
 
     start = dict(model.fit.values)
     cur, _ = _fit(model, (), _base_params(model, start), d, max_nfev)
+    base_fit = cur
     sigma = noise_rms(cur.pred - y)
     if not sigma > 0:
         raise InputError("the response has no noise at all; cannot judge significance")
@@ -663,7 +686,17 @@ def diagnose_structure(
             f"{final_rms / sigma:.1f} × the noise level: unexplained by the candidates "
             f"({', '.join(names)})"
         )
+    sims = []
+    for f in (base_fit, cur):
+        try:
+            sims.append(np.asarray(_simulate(model, f.effects, f.values, d, n).joint_force))
+        except ContactLabError:
+            sims.append(None)
     return StructureDiagnosis(
+        record={"t": t, "u": u, "y": y},
+        base_prediction=base_fit.pred,
+        base_joint_force=sims[0],
+        joint_force=sims[1],
         joint=model.joint,
         excitation=model.excitation,
         effects=added,

@@ -65,6 +65,26 @@ def joint_loop(structure: Structure, amplitude: float, n: int = 2000) -> tuple[n
     return t[-n - 1 :], d, F
 
 
+def loop_keq_energy(t: np.ndarray, d: np.ndarray, F: np.ndarray) -> tuple[float, float, float]:
+    """``(A, k_eq, E)`` of one cycle of :func:`joint_loop`: half the displacement range, the
+    first-harmonic equivalent stiffness ``(1/(π A)) ∮ F sin θ dθ`` and the loop energy
+    ``∮ F dd``."""
+    th = 2 * np.pi * (t - t[0])
+    A = 0.5 * float(d.max() - d.min())
+    return A, float(np.trapezoid(F * np.sin(th), th) / (np.pi * A)), float(np.trapezoid(F, d))
+
+
+def checked_amplitudes(structure: Structure, amplitudes: Any, who: str) -> np.ndarray:
+    """The amplitudes as a positive 1-D array; a rate-dependent (Kelvin-Voigt) joint refused."""
+    if any(j.kind == "kelvin_voigt" for j in structure.joints):
+        raise InputError(f"{who}: a Kelvin-Voigt joint is rate-dependent; add its k and c to "
+                         "the structure instead")  # fmt: skip
+    a = as_1d(amplitudes, "amplitudes")
+    if np.any(a <= 0):
+        raise InputError("amplitudes must be > 0")
+    return a
+
+
 def amplitude_dependence(structure: Structure, amplitudes: Any) -> AmplitudeDependence:
     """Natural frequency [Hz] and damping ratio of an SDOF structure versus amplitude [m].
 
@@ -78,12 +98,7 @@ def amplitude_dependence(structure: Structure, amplitudes: Any) -> AmplitudeDepe
     """
     if structure.n != 1:
         raise InputError("amplitude_dependence needs a single-DOF structure")
-    if any(j.kind == "kelvin_voigt" for j in structure.joints):
-        raise InputError("amplitude_dependence: a Kelvin-Voigt joint is rate-dependent; "
-                         "add its k and c to the structure instead")  # fmt: skip
-    a = as_1d(amplitudes, "amplitudes")
-    if np.any(a <= 0):
-        raise InputError("amplitudes must be > 0")
+    a = checked_amplitudes(structure, amplitudes, "amplitude_dependence")
     m, c, k = float(structure.M[0, 0]), float(structure.C[0, 0]), float(structure.K[0, 0])
     keq = np.empty(a.size)
     energy = np.empty(a.size)
@@ -93,11 +108,7 @@ def amplitude_dependence(structure: Structure, amplitudes: Any) -> AmplitudeDepe
         if d is None:
             keq[i], energy[i], amp[i] = 0.0, 0.0, ai
             continue
-        th = 2 * np.pi * (t - t[0])
-        A = 0.5 * (d.max() - d.min())
-        amp[i] = A
-        keq[i] = np.trapezoid(F * np.sin(th), th) / (np.pi * A)
-        energy[i] = np.trapezoid(F, d)
+        amp[i], keq[i], energy[i] = loop_keq_energy(t, d, F)
     ktot = k + keq
     if np.any(ktot <= 0):
         raise InputError("the equivalent stiffness is not positive at some amplitude")
@@ -111,7 +122,7 @@ def plot_amplitude_dependence(ad: AmplitudeDependence, ax: Any = None) -> Any:
     import matplotlib.pyplot as plt
 
     if ax is None:
-        _, ax = plt.subplots(1, 2, figsize=(9, 3.5))
+        _, ax = plt.subplots(1, 2, figsize=(9, 3.5), layout="constrained")
     ax[0].semilogx(ad.amplitude, ad.frequency_hz, "o-")
     ax[0].set_xlabel("amplitude [m]")
     ax[0].set_ylabel("natural frequency [Hz]")

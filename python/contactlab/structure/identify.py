@@ -36,11 +36,12 @@ from .._physical import MAX_MAGNITUDE, check_channel
 from ..errors import ContactLabError, InputError
 from ..fitting import FitResult, Parameter, least_squares_fit
 from ._blas import with_single_blas_thread
-from .joints import iwan_uniform
+from ._fitkit import IWAN_ELEMENTS, add_fitted_joint, best_start, derivatives, hold_state
 from .model import SimulationResult, Structure
 
 JOINTS = ("masing", "jenkins", "iwan", "bouc_wen", "kelvin_voigt", "normal", "linear")
-IWAN_ELEMENTS = 20
+__all__ = ["IWAN_ELEMENTS", "JOINTS", "IdentifiedModel", "equation_error", "identify",
+           "linear_grid_start"]  # fmt: skip
 
 
 @dataclass
@@ -55,7 +56,7 @@ class IdentifiedModel:
     excitation : {"force", "base"}
     fit : FitResult
         Parameters with standard errors, correlations, identifiability.
-    x0, v0 : float
+    x0, v0 : float, or list of float (one per DOF)
         Estimated initial displacement and velocity of the record.
     substeps : int
         Integration steps per sample used in the fit (and by :meth:`simulate`).
@@ -67,19 +68,28 @@ class IdentifiedModel:
         Each start's initial values and training cost (multi-start).
     elapsed : float
         Wall time of the identification [s].
+    input_dof : int or None
+        Several DOFs, force excitation: the DOF the (1-D) input force acts on.
+    joint_dofs : tuple or None
+        Several DOFs: ``(i, j)`` the joint acts between (``j = None``: the ground).
+    pattern : Pattern or None
+        Several DOFs: which entries of ``M``, ``C``, ``K`` were fitted (chain or masks).
     """
 
     structure: Structure
     joint: str
     excitation: str
     fit: FitResult
-    x0: float = 0.0
-    v0: float = 0.0
+    x0: float | list[float] = 0.0
+    v0: float | list[float] = 0.0
     substeps: int = 4
     interpolation: str = "linear"
     rms: float = math.nan
     starts: list[dict[str, Any]] = field(default_factory=list)
     elapsed: float = math.nan
+    input_dof: int | None = None
+    joint_dofs: tuple[int, int | None] | None = None
+    pattern: Any = None
 
     def simulate(
         self,
@@ -101,6 +111,12 @@ class IdentifiedModel:
             raise InputError("this model is force-excited: pass force=")
         if self.excitation == "base" and base is None:
             raise InputError("this model is base-excited: pass base=")
+        n = self.structure.n
+        if force is not None and n > 1 and np.ndim(force) == 1:
+            # a multi-DOF model's input is the force at input_dof
+            f1 = as_1d(force, "force")
+            force = np.zeros((f1.size, n))
+            force[:, self.input_dof if self.input_dof is not None else n - 1] = f1
         return self.structure.simulate(
             t,
             force=force,
@@ -113,6 +129,15 @@ class IdentifiedModel:
         )
 
     def to_dict(self) -> dict[str, Any]:
+        d = self._to_dict()
+        if self.structure.n > 1:
+            d["n_dofs"] = self.structure.n
+            d["input_dof"] = self.input_dof
+            d["joint_dofs"] = list(self.joint_dofs) if self.joint_dofs else None
+            d["pattern"] = self.pattern.to_dict() if self.pattern is not None else None
+        return d
+
+    def _to_dict(self) -> dict[str, Any]:
         return {
             "kind": "contactlab.structure.IdentifiedModel",
             "joint": self.joint,
@@ -175,18 +200,34 @@ class IdentifiedModel:
                 nfev=int(fd.get("nfev", 0)),
                 residual=np.zeros(0),
             )
+            extra: dict[str, Any] = {}
+            if s.n > 1:
+                from .identify_mdof import pattern_from_dict
+
+                jd = d.get("joint_dofs") or [0, None]
+                extra = {
+                    "input_dof": None if d.get("input_dof") is None else int(d["input_dof"]),
+                    "joint_dofs": (int(jd[0]), None if jd[1] is None else int(jd[1])),
+                    "pattern": pattern_from_dict(d["pattern"]) if d.get("pattern") else None,
+                }
+
+            def state(key: str) -> float | list[float]:
+                v = d.get(key, 0.0)
+                return [float(a) for a in v] if isinstance(v, list) else float(v)
+
             return cls(
                 structure=s,
                 joint=str(d["joint"]),
                 excitation=str(d["excitation"]),
                 fit=fit,
-                x0=float(d.get("x0", 0.0)),
-                v0=float(d.get("v0", 0.0)),
+                x0=state("x0"),
+                v0=state("v0"),
                 substeps=int(d.get("substeps", 1)),
                 interpolation=str(d.get("interpolation", "linear")),
                 rms=float(d.get("rms") or math.nan),
                 starts=list(d.get("starts", [])),
                 elapsed=float(d.get("elapsed") or math.nan),
+                **extra,
             )
         except (KeyError, TypeError, ValueError) as exc:
             raise InputError(f"not an identified-structure model: {exc}") from None
@@ -208,43 +249,8 @@ def _num(v: float) -> float | None:
 def build_structure(joint: str, v: dict[str, float], excitation: str) -> Structure:
     """The SDOF structure of parameter values ``v`` (names as in the fit)."""
     s = Structure(v["m"], v["c"], v["k"])
-    if joint == "bouc_wen":
-        s.add_joint("bouc_wen", 0, alpha=v["alpha"], beta=1.0, gamma=v["gamma"],
-                    delta=v["delta"], nu=v["nu"])  # fmt: skip
-    elif joint == "masing":
-        s.add_joint("masing", 0, h0=v["h0"], ac=v["ac"], scale=v.get("scale", 2.0))
-    elif joint == "jenkins":
-        s.add_joint("jenkins", 0, k=v["kj"], fs=v["fs"])
-    elif joint == "iwan":
-        s.add_joint("iwan", 0, **iwan_uniform(v["kj"], v["fs"], IWAN_ELEMENTS))
-    elif joint == "kelvin_voigt":
-        s.add_joint("kelvin_voigt", 0, k=v["kj"], c=v["cj"])
-    elif joint == "normal":
-        s.add_joint("normal", 0, coeffs=[v["a1"], v["a2"], v["a3"]])
+    add_fitted_joint(s, joint, v, 0, None)
     return s
-
-
-def _derivatives(t: np.ndarray, y: np.ndarray, periodic: bool) -> tuple[np.ndarray, np.ndarray]:
-    if periodic:
-        n = y.size
-        dt = float(t[1] - t[0])
-        w = 2j * np.pi * np.fft.rfftfreq(n, dt)
-        Y = np.fft.rfft(y)
-        return np.fft.irfft(w * Y, n), np.fft.irfft(w * w * Y, n)
-    dt = np.diff(t)
-    win = 15
-    if y.size > 2 * win and np.ptp(dt) <= 1e-6 * dt.mean():
-        # Savitzky-Golay (cubic, 15 samples): second differences of raw samples amplify the
-        # measurement noise by 1/dt², which biases the regression towards zero stiffness.
-        from scipy.signal import savgol_filter
-
-        h = float(dt.mean())
-        return (
-            savgol_filter(y, win, 3, deriv=1, delta=h),
-            savgol_filter(y, win, 3, deriv=2, delta=h),
-        )
-    v = np.gradient(y, t, edge_order=2)
-    return v, np.gradient(v, t, edge_order=2)
 
 
 def equation_error(
@@ -263,7 +269,7 @@ def equation_error(
     ``k`` and ``joint_force = rhs − m x'' − c x' − k x`` (what the joint must supply if the
     linear part were exactly this).
     """
-    xd, xdd = _derivatives(t, y, periodic)
+    xd, xdd = derivatives(t, y, periodic)
     if excitation == "force":
         cols = [xdd, xd, y]
         rhs = u.copy()
@@ -277,7 +283,7 @@ def equation_error(
     else:
         if mass is None:
             raise InputError("base excitation needs the mass (mass=...) for the equation error")
-        ud, _ = _derivatives(t, u, periodic)
+        ud, _ = derivatives(t, u, periodic)
         A = np.stack([xd - ud, y - u], axis=1)
         coef, *_ = np.linalg.lstsq(A, -mass * xdd, rcond=None)
         m, (c, k) = mass, coef
@@ -288,7 +294,7 @@ def equation_error(
     if excitation == "force":
         rhs_c, cols_c = u - m * xdd, [xd, y, sgn]
     else:
-        ud, _ = _derivatives(t, u, periodic)
+        ud, _ = derivatives(t, u, periodic)
         rhs_c, cols_c = -m * xdd, [xd - ud, y - u, sgn]
     cc, *_ = np.linalg.lstsq(np.stack(cols_c, axis=1), rhs_c, rcond=None)
     return {
@@ -298,6 +304,113 @@ def equation_error(
         "joint_force": jf,
         "coulomb": {"c": float(cc[0]), "k": float(cc[1]), "fs": float(cc[2])},
     }
+
+
+def linear_grid_start(
+    t: np.ndarray,
+    u: np.ndarray,
+    y: np.ndarray,
+    excitation: str,
+    mass: float | None,
+    *,
+    n_freq: int = 24,
+    zetas: tuple[float, ...] = (0.01, 0.05, 0.2, 0.7),
+    keep: int = 3,
+) -> list[dict[str, Any]]:
+    """The linear SDOF model (``m``, ``c``, ``k``) of least output error over a grid of
+    natural frequencies (geometric, from one cycle per record to a sixth of the sampling
+    rate) and damping ratios: starting values when the equation error fails.
+
+    Base excitation: the response depends on ``k/m`` and ``c/m`` only (``m`` given).
+    Force excitation: the response of the unit-stiffness model is scaled by its least-squares
+    factor ``1/k`` (``m = k/ω²``; with a given mass, ``k = m ω²``). Returns the best ``keep``
+    models at distinct frequencies (at least a factor 1.5 apart), best first, each with
+    ``grid_f`` [Hz] and ``grid_rms`` (its output error) [m]; empty when none has a positive
+    scale.
+    """
+    dt = float(np.median(np.diff(t)))
+    f_lo = 1.0 / max(float(t[-1] - t[0]), dt)
+    f_hi = 1.0 / (6.0 * dt)
+    if not f_hi > f_lo:
+        return []
+    found: list[tuple[float, float, float, float, float]] = []  # rms, f, m, c, k
+    x0 = [float(y[0])] if excitation == "base" else None
+    for f in np.geomspace(f_lo, f_hi, n_freq):
+        w = 2 * np.pi * f
+        for z in zetas:
+            if excitation == "base":
+                m = float(mass)  # type: ignore[arg-type]
+                k, c = m * w * w, 2 * z * m * w
+                try:
+                    r = Structure(m, c, k).simulate(t, base=u, x0=x0)
+                except ContactLabError:
+                    continue
+                if r.x.size < t.size:
+                    continue
+                e = r.x - y
+            else:
+                # unit stiffness (or the given mass), then the best scale
+                m1 = 1.0 / (w * w) if mass is None else float(mass)
+                k1 = 1.0 if mass is None else m1 * w * w
+                try:
+                    r = Structure(m1, 2 * z * m1 * w, k1).simulate(t, force=u)
+                except ContactLabError:
+                    continue
+                g = r.x
+                if g.size < t.size or not np.all(np.isfinite(g)):
+                    continue
+                gg = float(g @ g)
+                scale = float(g @ y) / gg if gg > 0 else 0.0
+                if not scale > 0:
+                    continue
+                if mass is None:
+                    k = 1.0 / scale
+                    m, c = k / (w * w), 2 * z * k / w
+                else:
+                    scale = 1.0  # the mass fixes the scale
+                    m, c, k = m1, 2 * z * m1 * w, k1
+                e = scale * g - y
+            rms = float(np.sqrt(np.mean(e * e)))
+            if math.isfinite(rms):
+                found.append((rms, float(f), m, c, k))
+    out: list[dict[str, Any]] = []
+    for rms, f, m, c, k in sorted(found):
+        if all(max(f / o["grid_f"], o["grid_f"] / f) >= 1.5 for o in out):
+            out.append({"m": m, "c": c, "k": k, "grid_f": f, "grid_rms": rms})
+        if len(out) == keep:
+            break
+    return out
+
+
+def _joint_grid_plan(
+    joint: str,
+    lin: dict[str, Any],
+    y: np.ndarray,
+    mass: float | None,
+    t: np.ndarray,
+    res: Any,
+    keep: int = 10,
+) -> list[tuple[dict[str, Any], dict[str, Any], dict[str, float]]]:
+    """The ``keep`` best starts of a friction joint on a grid of total stiffness (natural
+    frequency), joint share and slip force, each judged by one simulation (``res``)."""
+    dt = float(np.median(np.diff(t)))
+    m = float(mass) if mass is not None else float(lin["m"])
+    scored = []
+    for f in np.geomspace(1.0 / max(float(t[-1] - t[0]), dt), 1.0 / (6.0 * dt), 12):
+        k = m * (2 * np.pi * f) ** 2
+        li = {**lin, "m": m, "k": k, "c": 0.02 * math.sqrt(k * m)}
+        for kf in (0.5, 0.85):
+            for ff in (0.01, 0.03, 0.1, 0.3, 1.0, 3.0):
+                st0 = {"f_frac": ff, "k_frac": kf}
+                v = {p.name: p.value for p in _params(joint, li, y, mass, st0)}
+                v["x0"] = float(y[0])
+                e = res(v)
+                rms = float(np.sqrt(np.mean(e * e)))
+                if math.isfinite(rms):
+                    scored.append((rms, float(f), kf, ff, li, st0))
+    scored.sort(key=lambda a: a[0])
+    return [({"f_frac": ff, "k_frac": kf, "grid_f": f, "grid_rms": rms}, li, st0)
+            for rms, f, kf, ff, li, st0 in scored[:keep]]  # fmt: skip
 
 
 def _params(
@@ -399,8 +512,22 @@ def identify(
     start_samples: int = 4096,
     max_nfev: int = 200,
     estimate_initial_state: bool = True,
+    structure: Any = "chain",
+    masks: dict[str, Any] | None = None,
+    joint_dofs: Any = (0, None),
+    input_dof: int | None = None,
 ) -> IdentifiedModel:
     """Identify ``m``, ``c``, ``k`` and a joint from input ``u`` and response ``y``.
+
+    With ``y`` of shape ``(n_samples, n_dofs)`` (the displacement of every mass; more than
+    one column), a structure of several DOFs is identified
+    (:mod:`contactlab.structure.identify_mdof`): ``structure="chain"`` (masses ``m{i}``,
+    springs ``k{i}``, dashpots ``c{i}`` between DOF ``i−1`` and ``i``, element 0 to the
+    ground or base) or ``masks={"M": ..., "C": ..., "K": ...}`` (symmetric boolean masks of
+    free entries, parameters ``K[i,j]``), the joint between ``joint_dofs=(i, j)`` (``j`` None:
+    the ground), the force ``u`` acting at ``input_dof`` (default the last DOF) or the base
+    motion ``u`` under every DOF (``mass=`` the masses, needed then). Initial state
+    parameters ``x0_{i}``, ``v0_{i}``.
 
     Parameters
     ----------
@@ -438,6 +565,21 @@ def identify(
         raise InputError(f"joint must be one of {', '.join(JOINTS)}; got {joint!r}")
     if excitation not in ("force", "base"):
         raise InputError(f"excitation must be 'force' or 'base', got {excitation!r}")
+    if np.ndim(y) == 2 and np.shape(y)[1] > 1:
+        from .identify_mdof import identify_mdof
+
+        fields = identify_mdof(
+            t, u, y, joint, excitation, structure=structure, masks=masks,
+            joint_dofs=joint_dofs, input_dof=input_dof, mass=mass, substeps=substeps,
+            interpolation=interpolation, periodic=periodic, multistart=multistart,
+            start_samples=start_samples, max_nfev=max_nfev,
+            estimate_initial_state=estimate_initial_state,
+        )  # fmt: skip
+        model = IdentifiedModel(**fields)
+        model.elapsed = time.perf_counter() - t0
+        return model
+    if np.ndim(y) == 2 and np.shape(y)[1] == 1:
+        y = np.asarray(y)[:, 0]
     t = as_1d(t, "t")
     u = as_1d(u, "u")
     y = as_1d(y, "y")
@@ -463,12 +605,24 @@ def identify(
     if periodic is None:
         periodic = interpolation == "fourier"
     lin = equation_error(t, u, y, excitation, mass, periodic=bool(periodic))
+    lins = [lin]
     if not (lin["k"] > 0 and lin["m"] > 0):
-        raise InputError(
-            "the equation-error fit gives a non-positive mass or stiffness "
-            f"(m = {lin['m']:.4g}, k = {lin['k']:.4g}); is the response in metres and "
-            "the input the right channel?"
-        )
+        # a short or slow record (a few hundred samples, the mass following the base) can
+        # leave the regression's stiffness at or below zero: start from the linear model of
+        # a grid of natural frequencies and damping ratios that best matches the output
+        grid = linear_grid_start(t, u, y, excitation, mass)
+        if not grid:
+            raise InputError(
+                "the equation-error fit gives a non-positive mass or stiffness "
+                f"(m = {lin['m']:.4g}, k = {lin['k']:.4g}), and no linear model on a grid of "
+                "natural frequencies follows the response; is the response in metres and "
+                "the input the right channel?"
+            )
+        # the best few grid models (distinct frequencies) each seed the joint's starts
+        # with light viscous damping: the grid's damping ratio stands in for the joint's
+        # dissipation, which the joint's parameters are to take over
+        lins = [{**lin, **g, "c": 0.02 * math.sqrt(g["k"] * g["m"])} for g in grid]
+        lin = lins[0]
 
     def residual_on(n: int, sub: int = substeps) -> Any:
         tt, uu, yy = t[:n], u[:n], y[:n]
@@ -490,42 +644,23 @@ def identify(
         return res
 
     def with_state(ps: list[Parameter]) -> list[Parameter]:
-        if not estimate_initial_state:
-            for p in ps:
-                if p.name in ("x0", "v0"):
-                    p.vary = False
-        return ps
+        return hold_state(ps, estimate_initial_state)
 
     starts = _starts(joint)
     records: list[dict[str, Any]] = []
-    best_ps = with_state(_params(joint, lin, y, mass, starts[0]))
-    if multistart and len(starts) > 1:
-        n_s = min(int(start_samples), t.size)
-        best_cost = math.inf
-        for st in starts:
-            ps = with_state(_params(joint, lin, y, mass, st))
-            try:
-                fr = least_squares_fit(residual_on(n_s, 2), ps, max_nfev=25, ftol=1e-5,
-                                       xtol=1e-5, gtol=1e-8)  # fmt: skip
-            except ContactLabError as exc:
-                records.append({"start": st, "cost": None, "error": str(exc)})
-                continue
-            cost = float(np.sqrt(fr.chisqr / max(fr.ndata, 1)))
-            records.append({"start": st, "rms_short": cost})
-            if cost < best_cost:
-                best_cost = cost
-                best_ps = [
-                    Parameter(
-                        p.name,
-                        fr.params[p.name].value,
-                        vary=p.vary,
-                        min=p.min,
-                        max=p.max,
-                        unit=p.unit,
-                        scale=p.scale,
-                    )
-                    for p in ps
-                ]
+    n_s = min(int(start_samples), t.size)
+    plan = [(st0 if len(lins) == 1 else {**st0, "grid_f": li["grid_f"]}, li, st0)
+            for li in lins for st0 in starts]  # fmt: skip
+    if len(lins) > 1 and joint in ("masing", "jenkins", "iwan"):
+        # the linear grid cannot hold the mass against a joint to the fixed ground (what a
+        # frame rubbing on a wall does on a short record): explore the joint's stiffness
+        # share and slip force on the grid of frequencies, one simulation each (first), as
+        # well as the usual starts on the linear grid's models
+        plan = _joint_grid_plan(joint, lin, y, mass, t, residual_on(n_s, 2)) + plan
+    best_ps = with_state(_params(joint, plan[0][1], y, mass, plan[0][2]))
+    if multistart and len(plan) > 1:
+        tried = [(st, with_state(_params(joint, lin_i, y, mass, st0))) for st, lin_i, st0 in plan]
+        best_ps = best_start(tried, residual_on(n_s, 2), records) or best_ps
     fit = least_squares_fit(residual_on(t.size), best_ps, max_nfev=max_nfev, ftol=1e-7,
                             xtol=1e-7, gtol=1e-10)  # fmt: skip
     v = fit.values
