@@ -5,6 +5,8 @@ fresh one. Timings live in benches/bench_diagnose.py."""
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -193,3 +195,138 @@ def test_evaluation_counter_counts_every_thread():
     with ThreadPoolExecutor(4) as ex:
         got = list(ex.map(work, [1000] * 16))
     assert got == [1000] * 16 and c.total == 16_000
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(0, 3000), scale=st.floats(1e-9, 1e3))
+def test_second_difference_noise_is_the_tangential_estimate(seed, n, scale):
+    from contactlab.diagnose._signal import second_difference_var
+    from contactlab.tangential.uncertainty import x_noise_var
+
+    x = scale * _walk(seed, n)
+    assert second_difference_var(x) == x_noise_var(x, None)
+
+
+def test_one_verb_parser_is_the_full_parser_for_that_verb():
+    """``contactlab VERB ...`` builds the parser of VERB only; every verb maps to the module
+    that registers it, and parses as the full parser does."""
+    from contactlab import cli
+
+    full = cli.build_parser()
+    verbs = next(a for a in full._actions if a.dest == "verb").choices
+    assert set(verbs) == {cli._verb_module([v]) and v for v in verbs}
+    for verb in verbs:
+        mod = cli._verb_module([verb, "-x"])
+        assert mod is not None
+        only = cli.build_parser(mod)
+        assert list(next(a for a in only._actions if a.dest == "verb").choices) == [verb]
+    argv = ["diagnose", "rec.h5", "--model", "normal", "--p0", "0.5MPa", "--json", "o.json"]
+    assert vars(cli.build_parser(cli._verb_module(argv)).parse_args(argv)) == vars(
+        full.parse_args(argv)
+    )
+    assert cli._verb_module(["--help"]) is None
+    assert cli._verb_module(["diagnos", "x"]) is None
+
+
+def test_cli_diagnose_imports_no_other_verb():
+    """A diagnosis from the command line imports neither the studies, the report, the
+    tangential analysis nor the generator (start-up time, issue 9)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys\n"
+        "from contactlab import cli\n"
+        "cli.build_parser(cli._verb_module(['diagnose'])).parse_args(['diagnose', 'f.h5', "
+        "'--model', 'tangential'])\n"
+        "import contactlab.diagnose.workflow\n"
+        "bad = [m for m in sys.modules if m.startswith(('contactlab.studies', "
+        "'contactlab.report', 'contactlab.tangential', 'contactlab.diagnose.generator', "
+        "'matplotlib', 'pyarrow', 'scipy.signal', 'scipy.stats'))]\n"
+        "print(bad)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
+
+
+_ALL_TANGENTIAL = (
+    "viscous_damping", "inertia", "parallel_stiffness", "force_offset", "force_drift",
+    "displacement_offset", "asymmetry", "parameter_drift", "stribeck", "position_friction",
+    "stick_slip", "normal_load",
+)  # fmt: skip
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    effects=st.lists(st.sampled_from(_ALL_TANGENTIAL), max_size=4, unique=True),
+    tau_samples=st.one_of(st.just(0.0), st.floats(-40.0, 40.0)),
+    stride=st.integers(1, 13),
+    start=st.integers(0, 12),
+    f_n=st.floats(0.1, 30.0),
+)
+def test_prediction_at_samples_is_the_full_one(effects, tau_samples, stride, start, f_n):
+    """``predict(at=idx)`` (with a delay: the terms at the samples around each shifted time
+    only; the load fluctuation's terms kept per f_n) equals the full prediction at ``idx``,
+    bit for bit, also when called again (memos hit)."""
+    from contactlab.diagnose.candidates_tangential import TangentialFamily
+
+    d = _small_tangential()
+    fam = TangentialFamily()
+    p = {"h0": 48.0, "ac": 4.6e4, "x0": 1e-7, "c": 3.0, "m": 0.01, "k_p": 1e4, "F0": 0.5}
+    p.update(F1=0.3, alpha=0.1, beta=0.05, s=0.1, v_s=1e-3, a1=0.05, b1=0.0, a2=-0.02)
+    p.update(b2=0.01, s_b=0.2, ell=3e-6, eps_c=0.03, eps_s=-0.02, f_n=f_n)
+    p["tau"] = tau_samples * d.dt
+    eff = (*effects, "channel_delay")
+    idx = np.arange(start, d.u.size, stride)
+    for _ in range(2):
+        for e in (tuple(effects), eff):
+            full = fam.predict(p, e, d)
+            assert np.array_equal(fam.predict(p, e, d, at=idx), full[idx])
+
+
+@functools.cache
+def _small_tangential():
+    from contactlab.diagnose._family import Prepared
+    from contactlab.diagnose.candidates_tangential import TangentialFamily
+
+    rec = hidden_effect_recording([], seed=78, samples_per_cycle=40, cycles_per_block=3)
+    d = Prepared.build(rec.t, rec.data["x"], rec.data["F"])
+    TangentialFamily().prepare(d)
+    return d
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    n=st.integers(2, 1500),
+    log_lam=st.floats(-4.0, 3.5),
+    jitter=st.sampled_from([0.0, 1e-3]),
+    noise=st.sampled_from([0.0, 0.02]),
+)
+def test_exact_kelvin_voigt_is_the_integrator_at_tight_tolerance(seed, n, log_lam, jitter, noise):
+    """The exact first-order response (the normal base model a diagnosis fits) against the
+    package's adaptive integrator at rtol 1e-11 — stiff (ωΔt/ψ up to 3000) and non-stiff
+    steps, uneven sampling, noisy pressure — and the kept unit response ``(R - p0)/k``
+    against a direct evaluation."""
+    from contactlab.diagnose._family import Prepared
+    from contactlab.diagnose.candidates_normal import _kelvin_voigt_fit, kelvin_voigt_exact
+    from contactlab.normal import KelvinVoigt
+
+    rng = np.random.default_rng(seed)
+    fs, omega, k = 200.0, 2 * np.pi * 1.3, 1.3e12
+    t = (np.arange(n) + jitter * rng.uniform(-1, 1, n)) / fs
+    p = 3e5 * np.sin(omega * t) + 1e5 * np.sin(2.7 * omega * t + 1.0)
+    p = p + noise * 3e5 * rng.standard_normal(n)
+    psi = 2 * np.pi * omega / (10.0**log_lam * fs)  # a Δt = 10^log_lam
+    if not 1e-6 <= psi <= 10.0:
+        return
+    ref = KelvinVoigt(k, psi, omega).simulate(t, p, rtol=1e-11).delta
+    got = kelvin_voigt_exact(t, p, k, psi, omega)
+    scale = float(np.max(np.abs(ref)))
+    assert np.max(np.abs(got - ref)) <= 1e-8 * scale
+    if n >= 16:
+        p0 = 4e5
+        d = Prepared(t, p + p0, p, 1.0 / fs, 7, p, p, None)  # type: ignore[arg-type]
+        for _ in range(2):  # computed, then kept
+            kept = _kelvin_voigt_fit(d, k, psi, p0, omega)
+            assert np.max(np.abs(kept - got)) <= 1e-12 * scale

@@ -27,6 +27,8 @@ _VERB_MODULES = [
     "contactlab.commands.export",
     "contactlab.commands.structure",
 ]
+#: verbs whose module is not ``contactlab.commands.<verb>``
+_VERB_ALIASES = {"identify": "contactlab.commands.structure"}
 
 
 # Temporaries of the atomic writers: ".report.html.k2j4x9.part" beside "report.html".
@@ -42,14 +44,26 @@ def _os_error_text(exc: OSError) -> str:
     return f"{exc.strerror or exc}: {name}"
 
 
-def build_parser() -> argparse.ArgumentParser:
+def _verb_module(argv: Sequence[str]) -> str | None:
+    """The module of the verb ``argv`` names (its first word not an option), None when it
+    names none of them (``--help``, a misspelt verb: the full parser says what there is)."""
+    verb = next((a for a in argv if not a.startswith("-")), None)
+    if verb is None:
+        return None
+    name = _VERB_ALIASES.get(verb, f"contactlab.commands.{verb}")
+    return name if name in _VERB_MODULES else None
+
+
+def build_parser(verb_module: str | None = None) -> argparse.ArgumentParser:
+    """The parser of every verb, or of the verb of ``verb_module`` only (the verbs' modules
+    import what their options need — a run of one verb need not import the others')."""
     p = argparse.ArgumentParser(
         prog="contactlab",
         description="Hysteresis of contact joints: fit, measure and diagnose contact models.",
     )
     p.add_argument("--version", action="version", version=f"contactlab {__version__}")
     sub = p.add_subparsers(dest="verb", metavar="VERB")
-    for name in _VERB_MODULES:
+    for name in _VERB_MODULES if verb_module is None else [verb_module]:
         try:
             mod = importlib.import_module(name)
         except ModuleNotFoundError as exc:  # a verb whose optional module is absent
@@ -61,7 +75,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(_verb_module(argv))
     args = parser.parse_args(argv)
     if not getattr(args, "handler", None):
         parser.print_help()

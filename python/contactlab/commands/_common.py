@@ -9,15 +9,17 @@ import shlex
 import sys
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from .._io_atomic import write_text
 from .._json import jsonable
 from .._version import __version__
 from ..errors import InputError
-from ..report import commit_outputs
-from ..studies.manifest import scaled, si_unit, unit_factor
-from ..studies.study import RecordingResult, StudyResult
+
+# the studies and the report are imported where used: a verb that needs neither (diagnose)
+# does not pay for them at start-up
+if TYPE_CHECKING:
+    from ..studies.study import RecordingResult, StudyResult
 
 _QTY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-zµμ/]*)\s*$")
 
@@ -37,12 +39,13 @@ def quantity(default_unit: str, *, positive: bool = False):
     ``positive=True`` refuses zero and negative values (a sampling rate, a frequency).
     """
 
-    compatible = {si_unit(default_unit)} if default_unit else {""}
-    # a rate in 1/s may be written rad/s, a frequency in Hz as 1/s (not the other way round:
-    # 1 Hz is 2π rad/s)
-    compatible |= {"1/s": {"rad/s"}, "Hz": {"1/s"}}.get(next(iter(compatible)), set())
-
     def parse(text: str) -> float:
+        from ..studies.manifest import scaled, si_unit, unit_factor
+
+        compatible = {si_unit(default_unit)} if default_unit else {""}
+        # a rate in 1/s may be written rad/s, a frequency in Hz as 1/s (not the other way
+        # round: 1 Hz is 2π rad/s)
+        compatible |= {"1/s": {"rad/s"}, "Hz": {"1/s"}}.get(next(iter(compatible)), set())
         # ArgumentTypeError: argparse shows its message (a ValueError's is replaced).
         m = _QTY.match(text)
         if not m:
@@ -182,6 +185,8 @@ def write_report(
         print(f"note: skipped {name}: {why}", file=sys.stderr)
     if extra:
         files.update(extra)
+    from ..report import commit_outputs
+
     return commit_outputs(directory, files)
 
 

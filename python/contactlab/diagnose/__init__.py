@@ -14,11 +14,11 @@ import sys
 import types
 from typing import TYPE_CHECKING, Any
 
-from .generator import HiddenEffectRecording, hidden_effect_recording
 from .model import ExtendedModel
 from .workflow import DiagnosisReport, Effect, Step, diagnose
 
 if TYPE_CHECKING:
+    from .generator import HiddenEffectRecording, hidden_effect_recording
     from .structure import StructureDiagnosis, diagnose_structure
 
 __all__ = [
@@ -35,12 +35,17 @@ __all__ = [
 
 
 def __getattr__(name: str) -> Any:
-    """The structure diagnosis on first use: it imports contactlab.structure and
-    scipy.signal, half a second that a tangential or normal diagnosis does not need."""
+    """The structure diagnosis and the hidden-effect generator on first use: the first
+    imports contactlab.structure and scipy.signal, half a second that a tangential or normal
+    diagnosis does not need; the second three modules a diagnosis does not use."""
     if name in ("StructureDiagnosis", "diagnose_structure"):
         from . import structure
 
         return getattr(structure, name)
+    if name in ("HiddenEffectRecording", "hidden_effect_recording"):
+        from . import generator
+
+        return getattr(generator, name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 

@@ -1,5 +1,6 @@
-"""The four filters a diagnosis needs, in numpy: Savitzky-Golay coefficients and smoothing,
-zero-phase FIR decimation and the analytic signal.
+"""The filters a diagnosis needs, in numpy: Savitzky-Golay coefficients and smoothing,
+zero-phase FIR decimation, the analytic signal, and the exact first-order response that
+evaluates the linear Kelvin-Voigt base model (:func:`first_order_response`).
 
 They follow :func:`scipy.signal.savgol_coeffs`, :func:`scipy.signal.savgol_filter`
 (``mode="interp"``), :func:`scipy.signal.decimate` (``ftype="fir", zero_phase=True``) and
@@ -132,3 +133,119 @@ def uniform_filter1d(x: np.ndarray, size: int, mode: str = "nearest") -> np.ndar
     xp = np.concatenate((np.full(lo, x[0]), x, np.full(size - 1 - lo, x[-1]))) - m
     c = np.concatenate(([0.0], np.cumsum(xp)))
     return (c[size:] - c[:-size]) / size + m
+
+
+def _exp_moments(lam: np.ndarray) -> tuple[np.ndarray, ...]:
+    """``I_k(λ) = ∫₀¹ e^{-λ(1-u)} uᵏ du`` for k = 0..3: by the recursion
+    ``I_k = (1 - k I_{k-1}) / λ`` from ``I_0 = (1 - e^{-λ})/λ`` where ``λ >= 2`` (each step
+    amplifies an error by at most 3/2), else by the series ``k! Σ_j (-λ)^j / (k+j+1)!``."""
+    out = [np.empty_like(lam) for _ in range(4)]
+    big = lam >= 2.0
+    if np.any(big):
+        lb = lam[big]
+        i_k = -np.expm1(-lb) / lb
+        out[0][big] = i_k
+        for k in (1, 2, 3):
+            i_k = (1.0 - k * i_k) / lb
+            out[k][big] = i_k
+    small = ~big
+    if np.any(small):
+        ls = lam[small]
+        for k in range(4):
+            # k! Σ_j (-λ)^j / (k+j+1)!, 30 terms: 2^30 / 31! is below 1e-24
+            term = np.full_like(ls, math.factorial(k) / math.factorial(k + 1))
+            acc = term.copy()
+            for j in range(1, 30):
+                term = term * (-ls) / (k + j + 1)
+                acc += term
+            out[k][small] = acc
+    return tuple(out)
+
+
+#: largest sum of ``λ`` over a block of the scan in :func:`first_order_response`
+#: (``e^600`` is far from overflow, ``e^-600`` from underflow)
+_SCAN_SPAN = 600.0
+
+
+def hermite_coefficients(t: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Step lengths and the cubic of each step, ``p(u) = c0 + c1 u + c2 u² + c3 u³`` for
+    ``u`` from 0 to 1, of the Hermite interpolant with slopes
+    ``numpy.gradient(p, t, edge_order=2)`` (straight lines for two samples): ``(Δ, c0, c1,
+    c2, c3)``, as :class:`contactlab.normal.KelvinVoigt` continues a sampled pressure."""
+    t = np.asarray(t, dtype=float)
+    p = np.asarray(p, dtype=float)
+    dt = np.diff(t)
+    if p.size == 2:
+        m = np.full(2, (p[1] - p[0]) / dt[0])
+    else:
+        m = np.gradient(p, t, edge_order=2)
+    m0, m1 = dt * m[:-1], dt * m[1:]
+    p0, p1 = p[:-1], p[1:]
+    return dt, p0, m0, 3.0 * (p1 - p0) - 2.0 * m0 - m1, 2.0 * (p0 - p1) + m0 + m1
+
+
+def first_order_response(
+    t: np.ndarray,
+    p: np.ndarray,
+    a: float,
+    gain: float,
+    y0: float,
+    coeffs: tuple[np.ndarray, ...] | None = None,
+) -> np.ndarray:
+    """Exact solution at the samples of ``y' = a (gain · p(t) - y)``, ``y(t[0]) = y0``, with
+    ``p`` between samples the cubic Hermite interpolant of :func:`hermite_coefficients`
+    (``coeffs``: those, when computed already) — the forcing
+    :meth:`contactlab.normal.KelvinVoigt.simulate` integrates by default; its adaptive
+    solver approximates this to its tolerance.
+
+    On a step of length ``Δ`` with ``λ = aΔ`` and ``p(u) = Σ c_k uᵏ`` (``u`` from 0 to 1):
+    ``y₁ = e^{-λ} y₀ + gain · λ Σ c_k I_k(λ)``, ``I_k = ∫₀¹ e^{-λ(1-u)} uᵏ du`` (once, when
+    the steps are equal to 1e-13). The recursion is run in blocks whose ``λ`` sum is at most
+    :data:`_SCAN_SPAN`: ``y_{b+i} = e^{-L_i} (y_b + Σ_{j<i} e^{L_{j+1}} g_{b+j})`` with ``L``
+    the block's running sum of ``λ``, all blocks at once, then a short loop over the blocks'
+    ends (a step's ``λ`` is capped at the span there: ``e^{-600}`` forgets ``y₀`` as well).
+    Kelvin-Voigt ``p = k δ + h δ'`` is ``a = k/h``, ``gain = 1/k``.
+    """
+    n = np.size(p)
+    y = np.empty(n)
+    y[0] = y0
+    if n < 2:
+        return y
+    dt, c0, c1, c2, c3 = hermite_coefficients(t, p) if coeffs is None else coeffs
+    lam = a * dt
+    lo, hi = float(np.min(lam)), float(np.max(lam))
+    uniform = hi - lo <= 1e-13 * hi
+    if uniform:  # equal steps (to rounding): the moments once
+        lam1 = 0.5 * (lo + hi)
+        i0, i1, i2, i3 = (float(v[0]) for v in _exp_moments(np.array([lam1])))
+        g = (gain * lam1) * (c0 * i0 + c1 * i1 + c2 * i2 + c3 * i3)
+        lam1 = min(lam1, _SCAN_SPAN)
+    else:
+        i0, i1, i2, i3 = _exp_moments(lam)
+        g = gain * lam * (c0 * i0 + c1 * i1 + c2 * i2 + c3 * i3)
+        lam = np.minimum(lam, _SCAN_SPAN)
+        lam1 = float(np.max(lam))
+    s = n - 1
+    width = int(max(1, min(s, _SCAN_SPAN // max(lam1, 1e-300))))
+    nb = -(-s // width)
+    pad = nb * width - s
+    g_b = np.concatenate((g, np.zeros(pad))).reshape(nb, width)
+    if uniform:  # the same running sum in every block
+        run = lam1 * np.arange(1, width + 1, dtype=float)
+        acc = np.cumsum(np.exp(run) * g_b, axis=1)  # Σ_{j<=i} e^{L_{j+1}} g_j
+        decay = np.exp(-run)  # e^{-L_{i+1}}
+        ends_a = np.full(nb, decay[-1])
+    else:
+        run = np.cumsum(np.concatenate((lam, np.zeros(pad))).reshape(nb, width), axis=1)
+        acc = np.cumsum(np.exp(run) * g_b, axis=1)
+        decay = np.exp(-run)
+        ends_a = decay[:, -1]
+    ends_c = (ends_a * acc[:, -1]).tolist()
+    ends_l = ends_a.tolist()
+    starts = np.empty(nb)
+    cur = float(y0)
+    for k in range(nb):  # y at each block's start
+        starts[k] = cur
+        cur = ends_l[k] * cur + ends_c[k]
+    y[1:] = (decay * (starts[:, None] + acc)).reshape(-1)[:s]
+    return y

@@ -79,16 +79,26 @@ def input_noise(u: np.ndarray) -> float:
     amplitude only. Zero when that is below :data:`INPUT_NOISE_FLOOR` of the input's RMS
     (a simulated or noise-free input: nothing to filter).
     """
-    from ..tangential.uncertainty import x_noise_var
-
     if u.size < 16:
         return 0.0
     r = u - savgol_filter(u, 7, 3, mode="interp")
     c0 = float(savgol_coeffs(7, 3)[3])
     mad = float(np.median(np.abs(r - np.median(r))))
-    est = min(float(np.sqrt(x_noise_var(u, None))), mad * _MAD_TO_SIGMA / np.sqrt(1.0 - c0))
+    est = min(float(np.sqrt(second_difference_var(u))), mad * _MAD_TO_SIGMA / np.sqrt(1.0 - c0))
     ref = float(np.sqrt(np.mean((u - u.mean()) ** 2)))
     return est if est > INPUT_NOISE_FLOOR * ref else 0.0
+
+
+def second_difference_var(x: np.ndarray) -> float:
+    """Noise variance of ``x`` from the robust scale of its second differences
+    (``var(Δ²x) = 6 σ²`` for white noise): :func:`contactlab.tangential.uncertainty.x_noise_var`
+    without an averaged loop, here so that a diagnosis does not import the tangential
+    analysis (tests/test_diagnose_speed.py checks the two agree)."""
+    d2 = np.diff(x, 2)
+    if d2.size < 10:
+        return 0.0
+    mad = float(np.median(np.abs(d2 - np.median(d2))))
+    return (1.4826 * mad) ** 2 / 6.0
 
 
 def filter_input(u: np.ndarray, period_samples: float, sigma: float) -> tuple[np.ndarray, int]:

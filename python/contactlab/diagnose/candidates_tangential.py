@@ -253,6 +253,56 @@ def _fixed(d: Prepared, key: str, make: Callable[[], Any]) -> Any:
     return cache[k]
 
 
+#: entries of the small per-recording memos below (index sets, load-fluctuation terms)
+_MEMO_KEEP = 64
+
+
+def _memo(d: Prepared, name: str) -> dict[Any, Any]:
+    cache = d.extra.setdefault(name, {})
+    if len(cache) >= _MEMO_KEEP:
+        cache.clear()
+    return cache
+
+
+def _delay_support(d: Prepared, at: np.ndarray, tau: float) -> np.ndarray:
+    """The samples a delayed prediction at the samples ``at`` needs: for each shifted time
+    ``t[at] - tau`` the two samples that bracket it as :func:`numpy.interp` finds them
+    (``t[j] <= t < t[j+1]``, the first or last sample off the ends); ``at`` itself when
+    ``tau`` is 0. Kept per ``(tau, at)``: a fit's Jacobian steps every other parameter at
+    the same delay."""
+    if tau == 0.0:
+        return at
+    memo = _memo(d, "delay_rows")
+    key = (tau, id(at))
+    hit = memo.get(key)
+    if hit is not None and hit[0] is at:  # (the array is held: its id is not reused)
+        return hit[1]
+    n = d.t.size
+    j = np.searchsorted(d.t, d.t[at] - tau, side="right") - 1
+    need = np.zeros(n, bool)
+    need[np.clip(j, 0, n - 1)] = True
+    need[np.clip(j + 1, 0, n - 1)] = True
+    rows = np.flatnonzero(need)
+    memo[key] = (at, rows)
+    return rows
+
+
+def _load_terms(d: Prepared, f_n: float, rows: np.ndarray | None) -> tuple[np.ndarray, ...]:
+    """``cos 2π f_n t``, ``sin 2π f_n t`` of ``normal_load`` (``t`` from the record's start) at
+    the samples ``rows`` (all when None), kept per ``(f_n, rows)``: only a step of ``f_n``
+    changes them."""
+    memo = _memo(d, "load_terms")
+    key = (f_n, None if rows is None else id(rows))
+    hit = memo.get(key)
+    if hit is not None and hit[0] is rows:
+        return hit[1], hit[2]
+    t_rel = _fixed(d, "t_rel", lambda: d.t - d.t[0])
+    ph = 2.0 * np.pi * f_n * (t_rel if rows is None else t_rel[rows])
+    out = (np.cos(ph), np.sin(ph))
+    memo[key] = (rows, *out)
+    return out
+
+
 #: unit Masing forces kept per recording (one per ac, x0 tried); 64 of 24 000 samples: 12 MB
 _MASING_KEEP = 64
 
@@ -416,15 +466,18 @@ class TangentialFamily:
             h = h + p["alpha"] * np.abs(h)
         if "parameter_drift" in effects:
             h = h * (1.0 + p["beta"] * _fixed(d, "t_rel", lambda: d.t - d.t[0]) / d.duration)
-        # from here on sample by sample (but the delay, which interpolates between samples):
-        # with ``at``, only at the samples asked for
-        sub = at is not None and "channel_delay" not in effects
-        pick: Callable[[np.ndarray], np.ndarray] = (lambda a: a[at]) if sub else (lambda a: a)
+        # from here on sample by sample: with ``at``, only at the samples asked for — or, with
+        # a delay (which interpolates between samples), at the two around each shifted time
+        delay = "channel_delay" in effects
+        rows = _delay_support(d, at, p["tau"]) if at is not None and delay else at
+        pick: Callable[[np.ndarray], np.ndarray] = (
+            (lambda a: a) if rows is None else (lambda a: a[rows])
+        )
         xs = pick(x)
         if "stick_slip" in effects:
             rev = d.cycles.reversals
             anchors = _fixed(d, "anchors", lambda: reversal_anchors(rev, x.size))
-            h = breakaway(h, x, rev, p["s_b"], p["ell"], anchors, at if sub else None)
+            h = breakaway(h, x, rev, p["s_b"], p["ell"], anchors, rows)
         else:
             h = pick(h)
         if "stribeck" in effects:
@@ -439,8 +492,8 @@ class TangentialFamily:
             )
             h = h * (1.0 + p["a1"] * c1 + p["b1"] * s1 + p["a2"] * c2 + p["b2"] * s2)
         if "normal_load" in effects:
-            ph = 2.0 * np.pi * p["f_n"] * pick(_fixed(d, "t_rel", lambda: d.t - d.t[0]))
-            h = h * (1.0 + p["eps_c"] * np.cos(ph) + p["eps_s"] * np.sin(ph))
+            cos, sin = _load_terms(d, p["f_n"], rows)
+            h = h * (1.0 + p["eps_c"] * cos + p["eps_s"] * sin)
         F = h
         if "parallel_stiffness" in effects:
             F = F + p["k_p"] * xs
@@ -452,10 +505,13 @@ class TangentialFamily:
             F = F + p["F0"]
         if "force_drift" in effects:
             F = F + p["F1"] * pick(_fixed(d, "t_rel", lambda: d.t - d.t[0])) / d.duration
-        if "channel_delay" in effects:
-            F = shift(F, d.t, p["tau"])
-            if at is not None:
-                F = F[at]
+        if delay:
+            if at is None:
+                F = shift(F, d.t, p["tau"])
+            elif p["tau"] != 0.0:  # (tau = 0: rows is at, F is there already)
+                # F is known at ``rows`` only, which hold both neighbours of every shifted
+                # time: np.interp brackets each by the same two samples as on the full grid
+                F = np.interp(d.t[at] - p["tau"], d.t[rows], F)
         return F if F.flags.writeable else F.copy()
 
     def derived(
