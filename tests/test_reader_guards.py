@@ -262,3 +262,34 @@ def test_deep_valid_hdf5_trees_pass_the_structure_check(tmp_path):
             assert max(levels) >= 1
         check_structure(path, file=str(path))
         assert read_recording(path).t.size == 5000
+
+
+def test_a_long_checked_file_is_scanned_once_until_it_changes(tmp_path, monkeypatch):
+    """``analyze`` opens a long HDF5 file twice; the structure scan (a read of the whole
+    file) runs once, and again when the file changes. Small files are always scanned."""
+    import h5py
+
+    from contactlab.io import hdf5
+
+    scans = []
+    real = hdf5._check_btrees
+    monkeypatch.setattr(hdf5, "_check_btrees", lambda *a: scans.append(1) or real(*a))
+    monkeypatch.setattr(hdf5, "_CACHE_ABOVE", 1 << 16)
+    monkeypatch.setattr(hdf5, "_CHECKED", set())
+    path = tmp_path / "long.h5"
+    with h5py.File(path, "w") as f:
+        f.create_dataset("x", data=np.zeros(20_000))
+    hdf5.check_structure(path, file=str(path))
+    hdf5.check_structure(path, file=str(path))
+    assert len(scans) == 1
+    with h5py.File(path, "a") as f:
+        f["x"][0] = 1.0
+        f.attrs["note"] = "changed"
+    hdf5.check_structure(path, file=str(path))
+    assert len(scans) == 2
+    small = tmp_path / "small.h5"
+    with h5py.File(small, "w") as f:
+        f.create_dataset("x", data=np.zeros(10))
+    for _ in range(2):
+        hdf5.check_structure(small, file=str(small))
+    assert len(scans) == 4

@@ -171,6 +171,12 @@ def _check_local_heaps(mm: Any, size: int, noff: int, nlen: int, base: int, file
         pos = mm.find(b"HEAP", pos + 1)
 
 
+#: long files :func:`check_structure` passed in this process: ``(device, inode, size,
+#: mtime_ns, ctime_ns)``; files from this size on are remembered
+_CHECKED: set[tuple[int, int, int, int, int]] = set()
+_CACHE_ABOVE = 64 << 20
+
+
 def check_structure(path: str | Path, *, file: str) -> None:
     """Refuse the damaged structures on which libhdf5 itself hangs or overflows its stack
     instead of failing (it cannot be interrupted from Python): global heap collections whose
@@ -183,8 +189,17 @@ def check_structure(path: str | Path, *, file: str) -> None:
     import mmap
 
     with open(path, "rb") as fh:
-        size = os.fstat(fh.fileno()).st_size
+        st = os.fstat(fh.fileno())
+        size = st.st_size
         if size < 48:
+            return
+        # A long file already checked in this process and unchanged since (same inode, size,
+        # modification and change times) is not scanned again: `analyze` opens a long file
+        # twice (its length, then the chunks), and each scan reads the whole file (1.6 GB at
+        # 1e8 samples). Only long files: their scan outlasts the timestamps' resolution, and
+        # small files (a fuzzer rewriting one in place) are always scanned.
+        key = (st.st_dev, st.st_ino, size, st.st_mtime_ns, st.st_ctime_ns)
+        if size >= _CACHE_ABOVE and key in _CHECKED:
             return
         with mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as mm:
             sb = _superblock(mm, size)
@@ -194,6 +209,10 @@ def check_structure(path: str | Path, *, file: str) -> None:
             _check_global_heaps(mm, size, nlen, file)
             _check_btrees(mm, size, noff, nlen, base, file)
             _check_local_heaps(mm, size, noff, nlen, base, file)
+        if size >= _CACHE_ABOVE:
+            if len(_CHECKED) >= 256:
+                _CHECKED.clear()
+            _CHECKED.add(key)
 
 
 def open_hdf5(path: str | Path, *, file: str) -> Any:

@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -57,11 +58,11 @@ from ..io import Recording
 from ..masing import loop_area
 from . import steps
 from .orientation import Orientation, orient
-from .preprocess import AveragedLoop, average_loop
+from .preprocess import AveragedLoop, _period_means, average_loop, find_reversals, negated_loop
 from .regime import GROSS_SLIDING_Z as REGIME_GROSS_Z
 from .regime import PRE_SLIDING_Z, Regime, classify, z_from_area_ratio
 from .result import TangentialAnalysis
-from .uncertainty import correl, numeric_energy, reparametrize
+from .uncertainty import correl, numeric_energy, reparametrize, trend
 
 #: ``ac·A`` above which the loop is taken to have reached gross sliding (branch slope at the
 #: turn below e^-3 = 5 % of the initial stiffness: the force has plateaued near ±h0)
@@ -448,8 +449,10 @@ def _fast_orientation(
         per_cycle = loop.count / n
         vF, vx = loop.F_std**2 * per_cycle, loop.x_std**2 * per_cycle
         if np.any(np.isfinite(vF)) and np.any(np.isfinite(vx)):
-            g_F, g_x = _core.loop_area_sensitivity(
-                x, F, [int(b) for b in loop.cycle_bounds[: n + 1]]
+            g_F, g_x = (
+                loop.sensitivity  # of x, F: the loop was folded from them
+                if loop.sensitivity is not None
+                else _core.loop_area_sensitivity(x, F, [int(b) for b in loop.cycle_bounds[: n + 1]])
             )
             err = math.sqrt(
                 float(np.sum(g_F)) * float(np.nanmean(vF))
@@ -525,19 +528,52 @@ def analyze_window(
         "detrend": detrend,
         "initial": initial,
     }
-    loop = average_loop(
-        xa, Fa, ta, n_points=n_points, rel_threshold=rel_threshold, min_cycles=min_cycles
-    )
-    ori = _fast_orientation(xa, Fa, loop, force_sign)
+    pre = _window_detrended(xa, Fa, ta, opts)
+    ori = _fast_orientation(pre.x, pre.F, pre.loop, force_sign)
     res = None
     if ori is not None:
         if ori.sign < 0:
-            loop = None  # averaged again on -F
-        res = _analyze(xa, Fa, ta, source, ori, loop, on="averaged", history="steady",
+            pre = _negated(pre)
+        res = _analyze(xa, Fa, ta, source, ori, pre, on="averaged", history="steady",
                        streamed=True, **opts)  # fmt: skip
     if res is None:  # the sign undecided by the area, or gross sliding: the full analysis
         return analyze_tangential(recording, force_sign=force_sign, warn=False, **opts)
     return res
+
+
+def _window_detrended(
+    xa: np.ndarray, Fa: np.ndarray, ta: np.ndarray | None, opts: dict[str, Any]
+) -> steps.Detrended:
+    """:func:`steps.detrend` of the window with one fold instead of two: the linear drifts
+    come from the period means between the raw displacement's peaks (what the first fold's
+    per-cycle means are: the same Rust kernel on the same edges), so the samples are
+    detrended before the only fold. The same numbers as :func:`steps.detrend`."""
+    n_points, rel = opts["n_points"], opts["rel_threshold"]
+    min_cycles = opts["min_cycles"]
+    rev = find_reversals(xa, ta, rel_threshold=rel)
+    if not (opts["detrend"] and rev.peaks.size - 1 >= 3):
+        loop = average_loop(xa, Fa, ta, n_points=n_points, rel_threshold=rel,
+                            min_cycles=min_cycles)  # fmt: skip
+        return steps.Detrended(xa, Fa, loop, None)
+    tt = ta if ta is not None else np.arange(xa.size, dtype=float)
+    pt = rev.peak_times
+    time = 0.5 * (pt[:-1] + pt[1:])
+    tm = float(np.mean(time))
+    f_drift = trend(time, _period_means(tt, Fa, pt))
+    x_drift = trend(time, _period_means(tt, xa, pt))
+    F = Fa - f_drift[0] * (tt - tm)
+    x = xa - x_drift[0] * (tt - tm)
+    loop = average_loop(x, F, ta, n_points=n_points, rel_threshold=rel, min_cycles=min_cycles)
+    return steps.Detrended(x, F, loop, steps.Drift(f_drift, x_drift, tt, tm))
+
+
+def _negated(d: steps.Detrended) -> steps.Detrended:
+    """The detrended window of ``-F`` (bit for bit: negation commutes with every step)."""
+    dr = d.drift
+    if dr is not None:
+        dr = replace(dr, force=(-dr.force[0], dr.force[1]))
+    loop = negated_loop(d.loop) if d.loop is not None else None
+    return steps.Detrended(d.x, -d.F, loop, dr)
 
 
 def _analyze(
@@ -546,7 +582,7 @@ def _analyze(
     ta: np.ndarray | None,
     source: str,
     ori: Orientation,
-    first: AveragedLoop | None,
+    pre: steps.Detrended | None,
     *,
     on: str,
     history: str,
@@ -561,24 +597,27 @@ def _analyze(
     initial: dict[str, float] | None,
     streamed: bool,
 ) -> TangentialAnalysis | None:
-    """The analysis after the orientation; ``first``: the loop of ``xa, Fa`` averaged with
-    these options already. ``streamed``: a window of :func:`analyze_window`, which hands back
-    None when its loop reaches gross sliding."""
+    """The analysis after the orientation; ``pre``: :func:`steps.detrend` of the oriented
+    ``xa, Fa`` with these options, done already. ``streamed``: a window of
+    :func:`analyze_window`, which hands back None when its loop reaches gross sliding."""
     steady = history == "steady"
     pre_warns = [f"analysed -F: {ori.reason}"] if (ori.sign < 0 and ori.by != "user") else []
     if ori.sign < 0:
         Fa = -Fa
     fit_x0 = True if fit_x0 is None else fit_x0
-    det = steps.detrend(
-        xa,
-        Fa,
-        ta,
-        on=on,
-        enabled=detrend,
-        n_points=n_points,
-        rel_threshold=rel_threshold,
-        min_cycles=min_cycles,
-        first=first,
+    det = (
+        pre
+        if pre is not None
+        else steps.detrend(
+            xa,
+            Fa,
+            ta,
+            on=on,
+            enabled=detrend,
+            n_points=n_points,
+            rel_threshold=rel_threshold,
+            min_cycles=min_cycles,
+        )
     )
     data = steps.fit_data(det, ta, on=on, steady=steady, rel_threshold=rel_threshold)
     sv = steps.start_values(
