@@ -220,6 +220,11 @@ def test_long_file_is_streamed_with_the_whole_file_keys(rec_file, tmp_path, monk
     assert set(a) - set(w) == {"streamed", "streamed_reason", "n_windows", "n_samples", "every"}
     assert set(a["fit"]) == set(w["fit"]) and set(a["identifiable"]) == set(w["identifiable"])
     assert set(a["stick_slip"]) == set(w["stick_slip"])
+    # no window searched for sticks (pre-sliding), but the reversals are counted: those of
+    # the whole file, less at most two per cut between windows
+    n_rev, w_rev = a["stick_slip"]["n_reversals"], w["stick_slip"]["n_reversals"]
+    assert w_rev - 2 * a["n_windows"] <= n_rev <= w_rev
+    assert a["stick_slip"]["reversals_with_stick"] is None
     assert a["n_windows"] >= 1 and a["regime"] == w["regime"] == "pre-sliding"
     for q in ("h0", "ac", "h0_ac", "energy_per_cycle", "energy_per_cycle_numeric", "k_global",
               "amplitude", "offset"):  # fmt: skip

@@ -269,9 +269,11 @@ def test_window_analysis_equals_the_whole_analysis(case, invert):
             else:
                 np.testing.assert_allclose(b[k], a[k], rtol=1e-9, atol=0, err_msg=k)
     if case == "gross sliding":
-        assert "stick_slip" in b  # the whole-window analysis ran
-    else:
-        assert "stick_slip" not in b
+        assert b["stick_slip"] == a["stick_slip"]  # the whole-window analysis ran
+    else:  # reversals counted, the stick search not run
+        assert b["stick_slip"]["n_reversals"] == a["stick_slip"]["n_reversals"]
+        assert b["stick_slip"]["reversals_with_stick"] is None
+        assert set(b["stick_slip"]) == set(a["stick_slip"])
 
 
 @settings(max_examples=200, deadline=None)

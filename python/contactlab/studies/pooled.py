@@ -15,8 +15,9 @@ windows:
 - the regime: the most frequent one, its reason saying how many windows had it; the
   identifiability flags: a parameter counts as identified when it is in every window;
 - warnings: each distinct window warning once, with the number of windows that gave it;
-- ``stick_slip``: the windows' means (None where no window searched for sticks: a streamed
-  window of a pre-sliding or transition loop does not, see
+- ``stick_slip``: ``n_reversals`` summed over the windows; the search's counts and means
+  over the windows that searched for sticks (null where none did: a streamed window of a
+  pre-sliding or transition loop counts its reversals but does not search them, see
   :func:`contactlab.tangential.analysis.analyze_window`).
 
 ``streamed`` (True), ``streamed_reason``, ``n_windows``, ``n_samples`` and ``every`` say how
@@ -195,7 +196,10 @@ def pooled_document(docs: list[dict[str, Any]], *, reason: str) -> dict[str, Any
                 vals = [_num(s.get(k)) for s in sticks]
                 st[k] = float(np.nanmean(vals)) if np.any(np.isfinite(vals)) else None
         for k in ("n_reversals", "reversals_with_stick"):
-            st[k] = float(np.nansum([_num(s.get(k)) for s in sticks]))
+            # over the windows that counted them (streamed windows below gross sliding count
+            # their reversals but do not search them for sticks: null when none did)
+            vals = [_num(s.get(k)) for s in sticks]
+            st[k] = float(np.nansum(vals)) if np.any(np.isfinite(vals)) else None
         out["stick_slip"] = st
     else:
         out["stick_slip"] = template

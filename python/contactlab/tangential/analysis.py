@@ -510,8 +510,10 @@ def analyze_window(
     drift covariance from its bins' mean time, the numeric energy's error from the cycles'
     area sensitivities. The velocity and stick search over the samples (which only decide
     between gross sliding and stick-slip) runs only when the loop reaches gross sliding, and
-    then the window is analysed exactly as :func:`analyze_tangential` does. The results are
-    those of :func:`analyze_tangential` (warnings are kept in ``.warnings``, not issued).
+    then the window is analysed exactly as :func:`analyze_tangential` does; below it,
+    ``stick_slip`` gives the window's reversals and null for what only the search measures.
+    The results are those of :func:`analyze_tangential` (warnings are kept in ``.warnings``,
+    not issued).
     """
     xa, Fa, ta, source = _inputs(recording, None, None, None)
     _check_options("averaged", "steady", n_points)
@@ -574,6 +576,19 @@ def _negated(d: steps.Detrended) -> steps.Detrended:
         dr = replace(dr, force=(-dr.force[0], dr.force[1]))
     loop = negated_loop(d.loop) if d.loop is not None else None
     return steps.Detrended(d.x, -d.F, loop, dr)
+
+
+def _unsearched_sticks(rev: Any, n_samples: int) -> dict[str, Any]:
+    """``stick_slip`` of a streamed window below gross sliding, where the stick search over
+    the samples does not run (it is a gross-sliding verdict, and its velocity estimate costs
+    seconds a window): what the window knows, the reversals it has; NaN (null in JSON) for
+    what only the search measures. The same keys as the whole-window analysis gives."""
+    n_turns = int(rev.peaks.size + rev.valleys.size)
+    if n_turns < 2 or n_samples < 20:  # where the search would give none either
+        return {}
+    unknown = ("reversals_with_stick", "stick_duration", "breakaway_force",
+               "breakaway_force_stderr", "velocity_threshold", "smooth_turn_dwell")  # fmt: skip
+    return {"stick_slip": {"n_reversals": n_turns, **dict.fromkeys(unknown, math.nan)}}
 
 
 def _analyze(
@@ -668,6 +683,9 @@ def _analyze(
     apply_regime(regime, amp, fit, identifiable, evidence, derived, max_rel_stderr)
     warns = collect_warnings(pre_warns, raw, data, amp.value, identifiable, evidence, regime)
     vals = raw.values
+    regime_d = regime.to_dict()
+    if streamed:
+        regime_d.update(_unsearched_sticks(data.rev, xa.size))
     return TangentialAnalysis(
         fit=fit,
         model=steps.model_of(vals),
@@ -678,7 +696,7 @@ def _analyze(
         identifiable=identifiable,
         identifiability=evidence,
         derived=derived,
-        regime=regime.to_dict(),
+        regime=regime_d,
         warnings=warns,
         on=on,
         history=history,
