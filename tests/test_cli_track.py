@@ -4,6 +4,7 @@ written) both simulated and with a real SIGINT."""
 from __future__ import annotations
 
 import json
+import math
 import os
 import signal
 import subprocess
@@ -237,6 +238,36 @@ def test_long_file_is_streamed_with_the_whole_file_keys(rec_file, tmp_path, monk
     assert main(["analyze", str(rec_file), "--model", "tangential", "--whole", "--json",
                  str(again), "--no-progress"]) == 0  # fmt: skip
     assert "streamed" not in json.loads(again.read_text())
+
+
+def test_long_normal_file_is_streamed_with_the_whole_file_keys(tmp_path, monkeypatch, capsys):
+    """Normal-contact recordings are streamed above the same length as tangential ones,
+    with the whole-file document's keys (eq. 16's b1..b4 included) and E_d within errors."""
+    import contactlab.normal as cn
+    import contactlab.studies.pooled as pooled
+    import contactlab.studies.tracking as tracking
+    from contactlab.io import Recording
+
+    t, p, d = cn.synthetic_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=30, seed=5031)
+    f = tmp_path / "C45_p0-0.5MPa_pa-0.4MPa.h5"
+    write_recording(f, Recording(t, {"p": p, "delta": d}, {"p": "Pa", "delta": "m"}))
+    whole, auto = tmp_path / "w.json", tmp_path / "a.json"
+    assert main(["analyze", str(f), "--model", "normal", "--json", str(whole),
+                 "--no-progress"]) == 0  # fmt: skip
+    monkeypatch.setattr(pooled, "STREAM_ABOVE", 4000)  # the file holds 7680 samples
+    monkeypatch.setattr(tracking, "AUTO_WINDOW", 2600)
+    assert main(["analyze", str(f), "--model", "normal", "--json", str(auto),
+                 "--no-progress"]) == 0  # fmt: skip
+    assert "streamed: 7680 samples in 3 windows" in capsys.readouterr().out
+    w, a = json.loads(whole.read_text()), json.loads(auto.read_text())
+    assert set(a) - set(w) == {"streamed", "streamed_reason", "n_windows", "n_samples", "every"}
+    assert set(w) <= set(a) and a["pa_nominal"] == w["pa_nominal"] == 0.4e6
+    err = math.hypot(w["E_d_stderr"], a["E_d_stderr"])
+    assert abs(a["E_d"] - w["E_d"]) < 3 * err
+    for q in ("psi", "psi_kv", "k_tan", "k_sec", "b4"):
+        assert a[q] == pytest.approx(w[q], rel=0.01), q
+    assert len(a["poly_load"]) == len(w["poly_load"])
+    assert a["n_cycles"] <= w["n_cycles"]
 
 
 def test_pool_weights_and_birge():
