@@ -392,33 +392,35 @@ impl WindowFold {
     /// Per bin sums (`count, sum_x, sum_F, sum_phase, sum_phase2, sum_xx, sum_t`) and
     /// `first` (each cycle's first sample, -1 for none).
     fn sums<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let s = &self.inner.sums;
+        let w = &self.inner;
         let d = f64_dict(
             py,
             &[
-                ("count", &s.count),
-                ("sum_x", &s.sum_x),
-                ("sum_F", &s.sum_f),
-                ("sum_phase", &s.sum_phase),
-                ("sum_phase2", &s.sum_phase2),
-                ("sum_xx", &s.sum_xx),
-                ("sum_t", &s.sum_t),
+                ("count", &w.count),
+                ("sum_x", &w.sum_x),
+                ("sum_F", &w.sum_f),
+                ("sum_phase", &w.sum_phase),
+                ("sum_phase2", &w.sum_phase2),
+                ("sum_xx", &w.sum_xx),
+                ("sum_t", &w.sum_t),
             ],
         )?;
-        d.set_item("first", s.first.clone().into_pyarray(py))?;
+        d.set_item("first", w.first.clone().into_pyarray(py))?;
         Ok(d)
     }
 
-    /// As `PhaseFold.spread`.
+    /// As `PhaseFold.spread`: `x_std`, `F_std` per bin, `amplitude`, `force_range` per cycle.
     fn spread<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let sums = &self.inner.sums;
-        let sp = detach_guarded(py, || fold_spread(sums))?;
-        let d = PyDict::new(py);
-        d.set_item("x_std", sp.x_std.into_pyarray(py))?;
-        d.set_item("F_std", sp.f_std.into_pyarray(py))?;
-        d.set_item("amplitude", sp.amplitude.into_pyarray(py))?;
-        d.set_item("force_range", sp.force_range.into_pyarray(py))?;
-        Ok(d)
+        let w = &self.inner;
+        f64_dict(
+            py,
+            &[
+                ("x_std", &w.x_std),
+                ("F_std", &w.f_std),
+                ("amplitude", &w.amplitude),
+                ("force_range", &w.force_range),
+            ],
+        )
     }
 
     /// Per cycle: `bounds` (n + 1 sample indices), `energy` (loop area), `sens_F`, `sens_x`
