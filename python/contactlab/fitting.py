@@ -399,6 +399,7 @@ def least_squares_fit(
         return _finish(ps, [], None, r0, chisqr, ndata, True, 0, "no varied parameters", nfev)
     if ndata < len(names):
         raise InputError(f"{ndata} residuals cannot determine {len(names)} parameters")
+
     def analytic(z: np.ndarray) -> np.ndarray:
         assert jac is not None
         with np.errstate(all="ignore"):  # a non-finite column is reported below
