@@ -563,8 +563,9 @@ def _window_detrended(
     tm = float(np.mean(time))
     f_drift = trend(time, _period_means(tt, Fa, pt))
     x_drift = trend(time, _period_means(tt, xa, pt))
-    F = Fa - f_drift[0] * (tt - tm)
-    x = xa - x_drift[0] * (tt - tm)
+    tau = tt - tm
+    F = Fa - f_drift[0] * tau
+    x = xa - x_drift[0] * tau
     loop = average_loop(x, F, ta, n_points=n_points, rel_threshold=rel, min_cycles=min_cycles)
     return steps.Detrended(x, F, loop, steps.Drift(f_drift, x_drift, tt, tm))
 
