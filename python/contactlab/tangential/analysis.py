@@ -505,15 +505,19 @@ def analyze_window(
     """:func:`analyze_tangential` of one window of a streamed recording (``on="averaged"``,
     steady history), with the per-sample work in one pass of Rust kernels.
 
-    The averaged loop is computed once (reversals, phase fold, per-cycle areas; a second fold
-    after drift removal), and reused: the force sign follows from its per-cycle areas, the
-    drift covariance from its bins' mean time, the numeric energy's error from the cycles'
-    area sensitivities. The velocity and stick search over the samples (which only decide
-    between gross sliding and stick-slip) runs only when the loop reaches gross sliding, and
-    then the window is analysed exactly as :func:`analyze_tangential` does; below it,
-    ``stick_slip`` gives the window's reversals and null for what only the search measures.
-    The results are those of :func:`analyze_tangential` (warnings are kept in ``.warnings``,
-    not issued).
+    The samples are folded once: the drifts come from the period means between the raw
+    displacement's peaks (what :func:`steps.detrend`'s first fold gives them from), the
+    detrended samples are folded in one Rust pass (:func:`contactlab._core.fold_window`:
+    phase bins, cycle bounds, per-cycle areas and their sensitivities, period means), and
+    that loop is reused: the force sign follows from its per-cycle areas (an inverted force
+    negates the fold), the drift covariance from its bins' mean time, the numeric energy's
+    error from the cycles' area sensitivities. The velocity and stick search over the
+    samples (which only decide between gross sliding and stick-slip) runs only when the loop
+    reaches gross sliding, and then the window is analysed exactly as
+    :func:`analyze_tangential` does; below it, ``stick_slip`` gives the window's reversals
+    and null for what only the search measures. The results are those of
+    :func:`analyze_tangential` (warnings are kept in ``.warnings``, not issued; the recorded
+    loop area of the orientation is that of the detrended samples).
     """
     xa, Fa, ta, source = _inputs(recording, None, None, None)
     _check_options("averaged", "steady", n_points)
