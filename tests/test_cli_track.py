@@ -113,6 +113,25 @@ def test_track_ctrl_c_writes_nothing(rec_file, tmp_path, monkeypatch, capsys):
     assert os.listdir(tmp_path) == []
 
 
+def test_auto_streamed_analyze_ctrl_c_writes_nothing(rec_file, tmp_path, monkeypatch, capsys):
+    """Ctrl-C while a window is analysed on a helper thread: exit 130, nothing written."""
+    import contactlab.commands.analyze as analyze_cmd
+    import contactlab.studies.pooled as pooled
+
+    def interrupted(*_a, **_k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(pooled, "STREAM_ABOVE", 4000)
+    monkeypatch.setattr(track_mod, "_tangential_window", interrupted)
+    assert analyze_cmd._window_threads() >= 1
+    out, rep = tmp_path / "o.json", tmp_path / "rep"
+    code = main(["analyze", str(rec_file), "--model", "tangential", "--json", str(out),
+                 "--report", str(rep), "--no-progress"])  # fmt: skip
+    assert code == 130
+    assert "interrupted" in capsys.readouterr().err
+    assert os.listdir(tmp_path) == []
+
+
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
 def test_track_real_sigint_exits_130_without_output(tmp_path):
     rec = synthetic_recording(

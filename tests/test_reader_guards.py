@@ -293,3 +293,27 @@ def test_a_long_checked_file_is_scanned_once_until_it_changes(tmp_path, monkeypa
     for _ in range(2):
         hdf5.check_structure(small, file=str(small))
     assert len(scans) == 4
+
+
+@pytest.mark.parametrize("block", [4, 5, 8, 1 << 24])
+def test_file_view_reads_and_finds_as_bytes_do(tmp_path, monkeypatch, block):
+    """The structure scan's block reader (bounded memory instead of a memory map): slices,
+    single bytes and find, needles straddling the blocks' edges included."""
+    from contactlab.io import hdf5
+
+    monkeypatch.setattr(hdf5._FileView, "BLOCK", block)
+    data = b"xxTREExHEAPTREEyyGCOL\x01zzTRE" + bytes(range(256)) + b"TREE"
+    path = tmp_path / "b.bin"
+    path.write_bytes(data)
+    with open(path, "rb") as fh:
+        v = hdf5._FileView(fh.fileno(), len(data))
+        for needle in (b"TREE", b"HEAP", b"GCOL\x01", b"TRE", b"none"):
+            pos, ref = v.find(needle), data.find(needle)
+            while ref != -1:
+                assert pos == ref, needle
+                pos, ref = v.find(needle, pos + 1), data.find(needle, ref + 1)
+            assert pos == -1
+        assert v[3:9] == data[3:9] and v[len(data) - 2 : len(data) + 5] == data[-2:]
+        assert v[7] == data[7] and v[5:5] == b""
+        with pytest.raises(IndexError):
+            v[len(data)]
