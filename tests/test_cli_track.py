@@ -298,3 +298,17 @@ def test_pool_weights_and_birge():
     assert m == pytest.approx(1.05) and b < 1 and e == pytest.approx(0.5 / 2**0.5)
     m, e, b = pool([2.0, 4.0], [None, None])  # no errors: mean and its scatter error
     assert m == 3.0 and e == pytest.approx(1.0) and b != b
+
+
+def test_analyze_window_threads_from_the_environment(monkeypatch):
+    from contactlab import InputError
+    from contactlab.commands.analyze import _window_threads
+
+    monkeypatch.delenv("CONTACTLAB_ANALYZE_THREADS", raising=False)
+    assert 1 <= _window_threads() <= 2
+    monkeypatch.setenv("CONTACTLAB_ANALYZE_THREADS", "0")
+    assert _window_threads() == 0
+    for bad in ("-1", "two"):
+        monkeypatch.setenv("CONTACTLAB_ANALYZE_THREADS", bad)
+        with pytest.raises(InputError, match="CONTACTLAB_ANALYZE_THREADS"):
+            _window_threads()

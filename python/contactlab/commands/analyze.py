@@ -179,11 +179,23 @@ def _normal_options(entry: object, nopts: dict) -> dict:
 
 def _window_threads() -> int:
     """Helper threads of an auto-streamed analysis (``track(threads=...)``): one per core, at
-    most 2. They analyse windows (the Rust kernels release the GIL) while the main thread
-    reads on; each holds at most two windows (1e7 samples: 243 MB peak with 2, 200 MB with
-    1). The pooled document is the serial one."""
+    most 2, or ``CONTACTLAB_ANALYZE_THREADS`` (0: analyse each window before reading on).
+    They analyse windows (the Rust kernels release the GIL) while the main thread reads on;
+    each holds at most two windows (1e7 samples: about 250 MB peak with 2, 200 MB with 1).
+    The pooled document is the serial one."""
     import os
 
+    env = os.environ.get("CONTACTLAB_ANALYZE_THREADS", "").strip()
+    if env:
+        try:
+            n = int(env)
+        except ValueError:
+            raise InputError(
+                f"CONTACTLAB_ANALYZE_THREADS must be an integer >= 0, got {env!r}"
+            ) from None
+        if n < 0:
+            raise InputError(f"CONTACTLAB_ANALYZE_THREADS must be an integer >= 0, got {env!r}")
+        return n
     return max(1, min(2, os.cpu_count() or 1))
 
 
