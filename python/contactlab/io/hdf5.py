@@ -171,6 +171,15 @@ def _check_local_heaps(mm: Any, size: int, noff: int, nlen: int, base: int, file
         pos = mm.find(b"HEAP", pos + 1)
 
 
+def _read_into(fd: int, buf: memoryview, at: int) -> int:
+    """Fill ``buf`` from byte ``at`` of ``fd`` (fewer bytes at the end of the file)."""
+    if hasattr(os, "preadv"):
+        return os.preadv(fd, [buf], at)
+    data = os.pread(fd, len(buf), at)  # pragma: no cover - platforms without preadv
+    buf[: len(data)] = data
+    return len(data)
+
+
 class _FileView:
     """What the structure checks use of a memory map (``view[i]``, ``view[a:b]``,
     ``view.find(needle, start)``), read by ``os.pread`` in blocks: the scan of a long file
@@ -181,7 +190,8 @@ class _FileView:
 
     def __init__(self, fd: int, size: int) -> None:
         self.fd, self.size = fd, size
-        self._at, self._buf = -1, b""  # the block read last (find resumes in it)
+        self._at, self._n = -1, 0  # the block read last (find resumes in it), its length
+        self._buf = bytearray()  # one buffer for every block: no fresh pages per block
 
     def __getitem__(self, k: int | slice) -> Any:
         if isinstance(k, slice):
@@ -196,11 +206,14 @@ class _FileView:
         pos = max(start, 0)
         while pos < self.size:
             at = pos - pos % self.BLOCK
-            if at != self._at:
+            want = min(self.BLOCK + len(needle) - 1, self.size - at)
+            if at != self._at or self._n < want:
                 # a block and the needle's length after it: a match across the edge is found
-                self._buf = os.pread(self.fd, self.BLOCK + len(needle) - 1, at)
+                if len(self._buf) < want:
+                    self._buf = bytearray(want)
+                self._n = _read_into(self.fd, memoryview(self._buf)[:want], at)
                 self._at = at
-            i = self._buf.find(needle, pos - at)
+            i = self._buf.find(needle, pos - at, self._n)
             if i >= 0:
                 return at + i
             pos = at + self.BLOCK
