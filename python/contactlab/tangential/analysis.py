@@ -58,7 +58,7 @@ from ..io import Recording
 from ..masing import loop_area
 from . import steps
 from .orientation import Orientation, orient
-from .preprocess import AveragedLoop, _period_means, average_loop, find_reversals, negated_loop
+from .preprocess import AveragedLoop, average_loop, find_reversals, negated_loop, period_means
 from .regime import GROSS_SLIDING_Z as REGIME_GROSS_Z
 from .regime import PRE_SLIDING_Z, Regime, classify, z_from_area_ratio
 from .result import TangentialAnalysis
@@ -565,8 +565,8 @@ def _window_detrended(
     pt = rev.peak_times
     time = 0.5 * (pt[:-1] + pt[1:])
     tm = float(np.mean(time))
-    f_drift = trend(time, _period_means(tt, Fa, pt))
-    x_drift = trend(time, _period_means(tt, xa, pt))
+    f_drift = trend(time, period_means(tt, Fa, pt))
+    x_drift = trend(time, period_means(tt, xa, pt))
     tau = tt - tm
     F = Fa - f_drift[0] * tau
     x = xa - x_drift[0] * tau

@@ -296,7 +296,7 @@ def phase_of(t: np.ndarray, rev: Reversals) -> tuple[np.ndarray, int, int]:
     return ph, start, end
 
 
-def _period_means(t: np.ndarray, v: np.ndarray, edges: np.ndarray) -> np.ndarray:
+def period_means(t: np.ndarray, v: np.ndarray, edges: np.ndarray) -> np.ndarray:
     """Time average of ``v`` between consecutive ``edges`` (trapezoid rule, interpolated at
     the edges). For a periodic signal this does not depend on where the period starts, so
     the jitter of the turn instants does not leak into it (as sample-counting would).
