@@ -317,3 +317,19 @@ def test_file_view_reads_and_finds_as_bytes_do(tmp_path, monkeypatch, block):
         assert v[7] == data[7] and v[5:5] == b""
         with pytest.raises(IndexError):
             v[len(data)]
+
+
+@pytest.mark.parametrize("block", [4, 5, 8, 1 << 24])
+def test_file_view_index_answers_as_find_does(tmp_path, monkeypatch, block):
+    from contactlab.io import hdf5
+
+    monkeypatch.setattr(hdf5._FileView, "BLOCK", block)
+    data = b"TREExxHEAPTREEyyGCOL\x01zzTRE" + bytes(range(256)) + b"TREEHEAP"
+    path = tmp_path / "b.bin"
+    path.write_bytes(data)
+    with open(path, "rb") as fh:
+        v = hdf5._FileView(fh.fileno(), len(data))
+        v.index((b"GCOL\x01", b"TREE", b"HEAP"))
+        for needle in (b"TREE", b"HEAP", b"GCOL\x01", b"TRE"):
+            for start in range(len(data) + 2):
+                assert v.find(needle, start) == data.find(needle, start), (needle, start)

@@ -9,6 +9,7 @@ datasets are read.
 
 from __future__ import annotations
 
+import bisect
 import os
 from pathlib import Path
 from typing import Any
@@ -192,6 +193,7 @@ class _FileView:
         self.fd, self.size = fd, size
         self._at, self._n = -1, 0  # the block read last (find resumes in it), its length
         self._buf = bytearray()  # one buffer for every block: no fresh pages per block
+        self._index: dict[bytes, list[int]] = {}  # needle -> every position (see index)
 
     def __getitem__(self, k: int | slice) -> Any:
         if isinstance(k, slice):
@@ -202,7 +204,33 @@ class _FileView:
             raise IndexError("file view index out of range")
         return os.pread(self.fd, 1, k)[0]
 
+    def index(self, needles: tuple[bytes, ...]) -> None:
+        """Find every occurrence of each of ``needles`` in one pass over the file (each block
+        read once, searched for each needle); :meth:`find` then answers from the index."""
+        longest = max(len(nd) for nd in needles)
+        found: dict[bytes, list[int]] = {nd: [] for nd in needles}
+        at = 0
+        while at < self.size:
+            want = min(self.BLOCK + longest - 1, self.size - at)
+            if len(self._buf) < want:
+                self._buf = bytearray(want)
+            n = _read_into(self.fd, memoryview(self._buf)[:want], at)
+            for nd, hits in found.items():
+                # matches starting in this block (one starting beyond it is the next block's)
+                end = min(n, self.BLOCK + len(nd) - 1)
+                i = self._buf.find(nd, 0, end)
+                while i != -1:
+                    hits.append(at + i)
+                    i = self._buf.find(nd, i + 1, end)
+            at += self.BLOCK
+        self._at = -1
+        self._index = found
+
     def find(self, needle: bytes, start: int = 0) -> int:
+        hits = self._index.get(needle)
+        if hits is not None:
+            k = bisect.bisect_left(hits, max(start, 0))
+            return hits[k] if k < len(hits) else -1
         pos = max(start, 0)
         while pos < self.size:
             at = pos - pos % self.BLOCK
@@ -253,6 +281,7 @@ def check_structure(path: str | Path, *, file: str) -> None:
         sb = _superblock(mm, size)
         if sb is None:
             return
+        mm.index((_GCOL, b"TREE", b"HEAP"))  # one pass over the file for the three scans
         noff, nlen, base = sb
         _check_global_heaps(mm, size, nlen, file)
         _check_btrees(mm, size, noff, nlen, base, file)
