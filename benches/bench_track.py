@@ -13,8 +13,10 @@ Stages (``samples/s`` = recording samples per second of wall time):
 - ``read``: :func:`contactlab.io.read_chunks` alone (HDF5 slices, unit conversion, checks);
 - ``cycles``: read + the per-cycle kernel (crossings, ∮F dx, amplitude, offset per cycle);
 - ``track``: :func:`contactlab.track` with ``every="auto"`` (= ``analyze --stream``): windows
-  analysed on one helper thread while reading on (the default), serially (``threads=0``),
-  and on ``--workers`` processes;
+  analysed on one helper thread while reading on (the default), on ``--workers`` threads,
+  serially (``threads=0``), and on ``--workers`` processes;
+- ``analyze``: ``contactlab analyze`` of the long file as a user runs it (auto-streamed,
+  windows on two helper threads), wall and CPU time (M samples per CPU-second) and peak RSS;
 - ``whole``: ``contactlab analyze`` of a ``--whole-samples`` file (default 1e7): as a user
   runs it (longer than 2^19 samples: streamed and pooled automatically), with ``--whole`` (read
   into memory: the issue's "before") and with ``--stream``;
@@ -104,6 +106,8 @@ def stage(name: str, path: str, workers: int) -> dict:
 
         if name == "track-serial":
             r = contactlab.track(path, every="auto", threads=0)
+        elif name == "track-threads":
+            r = contactlab.track(path, every="auto", threads=workers)
         elif workers > 1:
             import resource
 
@@ -130,8 +134,8 @@ def stage(name: str, path: str, workers: int) -> dict:
     return out
 
 
-def child(cmd: list[str]) -> tuple[float, float, str]:
-    """Wall time (s), peak RSS (MB) of a child process and its stdout."""
+def child(cmd: list[str]) -> tuple[float, float, str, float]:
+    """Wall time (s), peak RSS (MB) of a child process, its stdout and its CPU time (s)."""
     t0 = time.perf_counter()
     p = subprocess.Popen(cmd, stdout=subprocess.PIPE, text=True)
     assert p.stdout is not None
@@ -143,7 +147,7 @@ def child(cmd: list[str]) -> tuple[float, float, str]:
         raise SystemExit(f"{cmd} failed with {p.returncode}")
     # ru_maxrss of the waited child (KiB on Linux); pool workers are its children, so their
     # peaks are not in it: see the track stage's note
-    return wall, usage.ru_maxrss / 1024.0, text
+    return wall, usage.ru_maxrss / 1024.0, text, usage.ru_utime + usage.ru_stime
 
 
 def run_stage(name: str, path: Path, workers: int) -> dict:
@@ -157,7 +161,7 @@ def run_stage(name: str, path: Path, workers: int) -> dict:
         "--workers",
         str(workers),
     ]
-    wall, rss, text = child(cmd)
+    wall, rss, text, _cpu = child(cmd)
     d = json.loads(text.strip().splitlines()[-1])
     d.update(proc_wall_s=wall, peak_rss_mb=rss)
     return d
@@ -203,7 +207,12 @@ def main() -> None:
     ap.add_argument("--whole-samples", type=float, default=1e7)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--study-files", type=int, default=12)
-    ap.add_argument("--skip", default="", help="comma-separated stages to skip")
+    ap.add_argument(
+        "--skip",
+        default="",
+        help="comma-separated stages to skip (read, cycles, track, track-threads, "
+        "track-serial, analyze, whole, study)",
+    )
     ap.add_argument("--stage", help=argparse.SUPPRESS)
     ap.add_argument("--file", help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -227,6 +236,7 @@ def main() -> None:
             ("read", 1),
             ("cycles", 1),
             ("track", 1),
+            ("track-threads", args.workers),
             ("track-serial", 1),
             ("track", args.workers),
         ]
@@ -235,7 +245,13 @@ def main() -> None:
                 continue
             d = run_stage(name, big, wk)
             rate = n / d["wall_s"]
-            label = f"{name} ({wk} proc)" if name == "track" and wk > 1 else name
+            label = (
+                f"{name} ({wk} proc)"
+                if name == "track" and wk > 1
+                else f"track ({wk} threads)"
+                if name == "track-threads"
+                else name
+            )
             extra = {
                 k: v
                 for k, v in d.items()
@@ -246,6 +262,18 @@ def main() -> None:
                 f"ratio to Masing {rate / m_rate:6.3f}  CPU {d['cpu_s']:7.1f} s  "
                 f"peak RSS {d['peak_rss_mb']:6.0f} MB"
                 f"{'' if wk == 1 else ' (parent only)'}  {extra}"
+            )
+        if "analyze" not in skip:
+            # the issue's bar: `contactlab analyze` as a user runs it (auto-streamed)
+            cmd = [sys.executable, "-m", "contactlab", "analyze", str(big), "--model",
+                   "tangential", "--no-progress", "--json", str(tmp / "big.json")]  # fmt: skip
+            wall, rss, _, cpu = child(cmd)
+            h0 = json.loads((tmp / "big.json").read_text())
+            print(
+                f"analyze (CLI)    {wall:8.1f} s {n / wall / 1e6:8.2f} M samples/s  "
+                f"ratio to Masing {n / wall / m_rate:6.3f}  CPU {cpu:7.1f} s "
+                f"({n / cpu / 1e6:.2f} M samples per CPU-second)  peak RSS {rss:6.0f} MB  "
+                f"h0 = {h0['h0']:.6f} ± {h0['h0_stderr']:.2g} N"
             )
         big.unlink()
         if "whole" not in skip:
@@ -270,10 +298,11 @@ def main() -> None:
                     str(tmp / "o.json"),
                     *extra,
                 ]
-                wall, rss, _ = child(cmd)
+                wall, rss, _, cpu = child(cmd)
                 print(
                     f"{label:<22} {nw:.0e} samples: {wall:6.1f} s "
-                    f"{nw / wall / 1e6:6.2f} M samples/s, peak RSS {rss:6.0f} MB"
+                    f"{nw / wall / 1e6:6.2f} M samples/s, CPU {cpu:5.1f} s "
+                    f"({nw / cpu / 1e6:.2f} M/CPU-s), peak RSS {rss:6.0f} MB"
                 )
             wf.unlink()
         if "study" not in skip:

@@ -128,3 +128,67 @@ def test_normal_energies_of_an_ellipse_match_the_closed_form():
     en = nloop._energies(pdyn, dz - br.shift, br)
     assert en.E_d == pytest.approx(math.pi * c * amp**2, rel=1e-9)
     assert Masing(1.0, 1.0).h0 == 1.0  # import check of the model type used above
+
+
+def _closed_residual(res, v):
+    """The residuals of an averaged fit from the steady loop in closed form (complex-step
+    friendly in k0, ac, offset): F = ±(h(A) - 2 h(s)) + ±¼ k0 ac e^{-ac s} var(x)."""
+    d = res.data
+    k0, ac, x0, A = v["k0"], v["ac"], v["x0"], v["amplitude"]
+    n = d.xpath.size
+    sg = np.r_[np.ones(n // 2), -np.ones(n - n // 2)]
+    u = np.clip(d.xpath - x0, -A, A)
+    s = 0.5 * (A - sg * u)
+    F = sg * (-k0 / ac * np.expm1(-ac * A) + 2 * k0 / ac * np.expm1(-ac * s))
+    F = F + sg * 0.25 * k0 * ac * np.exp(-ac * s) * d.bin_var + v["offset"]
+    r = (F - d.Fd)[d.sl] * res.w[d.sl]
+    pr = res.prior
+    if pr is None:
+        return r
+    meas = {"x0": pr.x0, "amplitude": pr.amplitude}
+    return np.r_[r, [(v[k] - meas[k]) / pr.sigma * pr.scale for k in pr.names]]
+
+
+@pytest.mark.parametrize(
+    ("ac", "amp_factor", "prior"),
+    [(6e4, 0.999, False), (6e4, 0.97, True), (2e5, 1.02, True), (3.0, 1.0, False)],
+)
+def test_analytic_jacobian_equals_finite_differences(ac, amp_factor, prior):
+    """Residuals.jacobian (closed-form branches, the bins' curvature term, prior rows) against
+    central differences of the residuals the Masing operator gives; amplitudes below and
+    above the bins' range clip some bins; ac = 3 1/m is a nearly linear loop (ac·A ~ 5e-5),
+    where the ac column's two terms cancel."""
+    from contactlab.tangential.analysis import _window_detrended
+
+    rec = synthetic_recording(h0=2e6 / ac, ac=ac, amplitude=15e-6, n_cycles=8, fs=1500.0,
+                              frequency=2.0, noise=0.02, x_noise=0.01, seed=6911)  # fmt: skip
+    opts = {"n_points": None, "rel_threshold": 0.5, "min_cycles": 2, "detrend": True}
+    det = _window_detrended(rec["x"], rec["F"], rec.t, opts)
+    data = steps.fit_data(det, rec.t, on="averaged", steady=True, rel_threshold=0.5)
+    assert data.bin_var is not None
+    pr = steps.PriorRows(("x0", "amplitude"), 1e-8, 15e-6, 2e-8, 0.3) if prior else None
+    res = steps.Residuals(data, data.w, pr)
+    v = {"k0": 2e6, "ac": ac, "offset": 0.05, "x0": 2e-9, "amplitude": 15e-6 * amp_factor}
+    J = res.jacobian(v)
+    # the closed form is the Masing operator's loop (to rounding)
+    np.testing.assert_allclose(_closed_residual(res, v), res(v), rtol=0,
+                               atol=1e-12 * np.max(np.abs(res(v))))  # fmt: skip
+    for k in ("k0", "ac", "offset"):  # complex step: no cancellation, even as ac → 0
+        step = 1e-30 * abs(v[k])
+        cs = _closed_residual(res, dict(v, **{k: v[k] + 1j * step})).imag / step
+        np.testing.assert_allclose(J[k], cs, rtol=0, atol=1e-9 * np.max(np.abs(cs)), err_msg=k)
+    for k, x in v.items():
+        if k in ("k0", "ac", "offset"):
+            continue
+        h = 1e-5 * abs(x)
+        up, dn = dict(v, **{k: x + h}), dict(v, **{k: x - h})
+        fd = (res(up) - res(dn)) / (2 * h)
+        # a bin at a turn switches between clipped and not within the step: skip it
+        kink = np.abs(fd - J[k]) > 1e-3 * np.max(np.abs(fd))
+        assert np.sum(kink) <= 2, k
+        good = ~kink
+        np.testing.assert_allclose(J[k][good], fd[good], rtol=0, atol=1e-6 * np.max(np.abs(fd)),
+                                   err_msg=k)  # fmt: skip
+    with pytest.raises(InputError):
+        steps.Residuals(steps.fit_data(det, rec.t, on="signal", steady=True,
+                                       rel_threshold=0.5), data.w).jacobian(v)  # fmt: skip

@@ -4,6 +4,7 @@ written) both simulated and with a real SIGINT."""
 from __future__ import annotations
 
 import json
+import math
 import os
 import signal
 import subprocess
@@ -107,6 +108,25 @@ def test_track_ctrl_c_writes_nothing(rec_file, tmp_path, monkeypatch, capsys):
             "--no-progress",
         ]
     )
+    assert code == 130
+    assert "interrupted" in capsys.readouterr().err
+    assert os.listdir(tmp_path) == []
+
+
+def test_auto_streamed_analyze_ctrl_c_writes_nothing(rec_file, tmp_path, monkeypatch, capsys):
+    """Ctrl-C while a window is analysed on a helper thread: exit 130, nothing written."""
+    import contactlab.commands.analyze as analyze_cmd
+    import contactlab.studies.pooled as pooled
+
+    def interrupted(*_a, **_k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(pooled, "STREAM_ABOVE", 4000)
+    monkeypatch.setattr(track_mod, "_tangential_window", interrupted)
+    assert analyze_cmd._window_threads() >= 1
+    out, rep = tmp_path / "o.json", tmp_path / "rep"
+    code = main(["analyze", str(rec_file), "--model", "tangential", "--json", str(out),
+                 "--report", str(rep), "--no-progress"])  # fmt: skip
     assert code == 130
     assert "interrupted" in capsys.readouterr().err
     assert os.listdir(tmp_path) == []
@@ -220,6 +240,11 @@ def test_long_file_is_streamed_with_the_whole_file_keys(rec_file, tmp_path, monk
     assert set(a) - set(w) == {"streamed", "streamed_reason", "n_windows", "n_samples", "every"}
     assert set(a["fit"]) == set(w["fit"]) and set(a["identifiable"]) == set(w["identifiable"])
     assert set(a["stick_slip"]) == set(w["stick_slip"])
+    # no window searched for sticks (pre-sliding), but the reversals are counted: those of
+    # the whole file, less at most two per cut between windows
+    n_rev, w_rev = a["stick_slip"]["n_reversals"], w["stick_slip"]["n_reversals"]
+    assert w_rev - 2 * a["n_windows"] <= n_rev <= w_rev
+    assert a["stick_slip"]["reversals_with_stick"] is None
     assert a["n_windows"] >= 1 and a["regime"] == w["regime"] == "pre-sliding"
     for q in ("h0", "ac", "h0_ac", "energy_per_cycle", "energy_per_cycle_numeric", "k_global",
               "amplitude", "offset"):  # fmt: skip
@@ -234,6 +259,36 @@ def test_long_file_is_streamed_with_the_whole_file_keys(rec_file, tmp_path, monk
     assert "streamed" not in json.loads(again.read_text())
 
 
+def test_long_normal_file_is_streamed_with_the_whole_file_keys(tmp_path, monkeypatch, capsys):
+    """Normal-contact recordings are streamed above the same length as tangential ones,
+    with the whole-file document's keys (eq. 16's b1..b4 included) and E_d within errors."""
+    import contactlab.normal as cn
+    import contactlab.studies.pooled as pooled
+    import contactlab.studies.tracking as tracking
+    from contactlab.io import Recording
+
+    t, p, d = cn.synthetic_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=30, seed=5031)
+    f = tmp_path / "C45_p0-0.5MPa_pa-0.4MPa.h5"
+    write_recording(f, Recording(t, {"p": p, "delta": d}, {"p": "Pa", "delta": "m"}))
+    whole, auto = tmp_path / "w.json", tmp_path / "a.json"
+    assert main(["analyze", str(f), "--model", "normal", "--json", str(whole),
+                 "--no-progress"]) == 0  # fmt: skip
+    monkeypatch.setattr(pooled, "STREAM_ABOVE", 4000)  # the file holds 7680 samples
+    monkeypatch.setattr(tracking, "AUTO_WINDOW", 2600)
+    assert main(["analyze", str(f), "--model", "normal", "--json", str(auto),
+                 "--no-progress"]) == 0  # fmt: skip
+    assert "streamed: 7680 samples in 3 windows" in capsys.readouterr().out
+    w, a = json.loads(whole.read_text()), json.loads(auto.read_text())
+    assert set(a) - set(w) == {"streamed", "streamed_reason", "n_windows", "n_samples", "every"}
+    assert set(w) <= set(a) and a["pa_nominal"] == w["pa_nominal"] == 0.4e6
+    err = math.hypot(w["E_d_stderr"], a["E_d_stderr"])
+    assert abs(a["E_d"] - w["E_d"]) < 3 * err
+    for q in ("psi", "psi_kv", "k_tan", "k_sec", "b4"):
+        assert a[q] == pytest.approx(w[q], rel=0.01), q
+    assert len(a["poly_load"]) == len(w["poly_load"])
+    assert a["n_cycles"] <= w["n_cycles"]
+
+
 def test_pool_weights_and_birge():
     from contactlab.studies.pooled import pool
 
@@ -243,3 +298,17 @@ def test_pool_weights_and_birge():
     assert m == pytest.approx(1.05) and b < 1 and e == pytest.approx(0.5 / 2**0.5)
     m, e, b = pool([2.0, 4.0], [None, None])  # no errors: mean and its scatter error
     assert m == 3.0 and e == pytest.approx(1.0) and b != b
+
+
+def test_analyze_window_threads_from_the_environment(monkeypatch):
+    from contactlab import InputError
+    from contactlab.commands.analyze import _window_threads
+
+    monkeypatch.delenv("CONTACTLAB_ANALYZE_THREADS", raising=False)
+    assert 1 <= _window_threads() <= 2
+    monkeypatch.setenv("CONTACTLAB_ANALYZE_THREADS", "0")
+    assert _window_threads() == 0
+    for bad in ("-1", "two"):
+        monkeypatch.setenv("CONTACTLAB_ANALYZE_THREADS", bad)
+        with pytest.raises(InputError, match="CONTACTLAB_ANALYZE_THREADS"):
+            _window_threads()

@@ -262,3 +262,74 @@ def test_deep_valid_hdf5_trees_pass_the_structure_check(tmp_path):
             assert max(levels) >= 1
         check_structure(path, file=str(path))
         assert read_recording(path).t.size == 5000
+
+
+def test_a_long_checked_file_is_scanned_once_until_it_changes(tmp_path, monkeypatch):
+    """``analyze`` opens a long HDF5 file twice; the structure scan (a read of the whole
+    file) runs once, and again when the file changes. Small files are always scanned."""
+    import h5py
+
+    from contactlab.io import hdf5
+
+    scans = []
+    real = hdf5._check_btrees
+    monkeypatch.setattr(hdf5, "_check_btrees", lambda *a: scans.append(1) or real(*a))
+    monkeypatch.setattr(hdf5, "_CACHE_ABOVE", 1 << 16)
+    monkeypatch.setattr(hdf5, "_CHECKED", set())
+    path = tmp_path / "long.h5"
+    with h5py.File(path, "w") as f:
+        f.create_dataset("x", data=np.zeros(20_000))
+    hdf5.check_structure(path, file=str(path))
+    hdf5.check_structure(path, file=str(path))
+    assert len(scans) == 1
+    with h5py.File(path, "a") as f:
+        f["x"][0] = 1.0
+        f.attrs["note"] = "changed"
+    hdf5.check_structure(path, file=str(path))
+    assert len(scans) == 2
+    small = tmp_path / "small.h5"
+    with h5py.File(small, "w") as f:
+        f.create_dataset("x", data=np.zeros(10))
+    for _ in range(2):
+        hdf5.check_structure(small, file=str(small))
+    assert len(scans) == 4
+
+
+@pytest.mark.parametrize("block", [4, 5, 8, 1 << 24])
+def test_file_view_reads_and_finds_as_bytes_do(tmp_path, monkeypatch, block):
+    """The structure scan's block reader (bounded memory instead of a memory map): slices,
+    single bytes and find, needles straddling the blocks' edges included."""
+    from contactlab.io import hdf5
+
+    monkeypatch.setattr(hdf5._FileView, "BLOCK", block)
+    data = b"xxTREExHEAPTREEyyGCOL\x01zzTRE" + bytes(range(256)) + b"TREE"
+    path = tmp_path / "b.bin"
+    path.write_bytes(data)
+    with open(path, "rb") as fh:
+        v = hdf5._FileView(fh.fileno(), len(data))
+        for needle in (b"TREE", b"HEAP", b"GCOL\x01", b"TRE", b"none"):
+            pos, ref = v.find(needle), data.find(needle)
+            while ref != -1:
+                assert pos == ref, needle
+                pos, ref = v.find(needle, pos + 1), data.find(needle, ref + 1)
+            assert pos == -1
+        assert v[3:9] == data[3:9] and v[len(data) - 2 : len(data) + 5] == data[-2:]
+        assert v[7] == data[7] and v[5:5] == b""
+        with pytest.raises(IndexError):
+            v[len(data)]
+
+
+@pytest.mark.parametrize("block", [4, 5, 8, 1 << 24])
+def test_file_view_index_answers_as_find_does(tmp_path, monkeypatch, block):
+    from contactlab.io import hdf5
+
+    monkeypatch.setattr(hdf5._FileView, "BLOCK", block)
+    data = b"TREExxHEAPTREEyyGCOL\x01zzTRE" + bytes(range(256)) + b"TREEHEAP"
+    path = tmp_path / "b.bin"
+    path.write_bytes(data)
+    with open(path, "rb") as fh:
+        v = hdf5._FileView(fh.fileno(), len(data))
+        v.index((b"GCOL\x01", b"TREE", b"HEAP"))
+        for needle in (b"TREE", b"HEAP", b"GCOL\x01", b"TRE"):
+            for start in range(len(data) + 2):
+                assert v.find(needle, start) == data.find(needle, start), (needle, start)

@@ -154,3 +154,26 @@ def test_phase_fold_equals_numpy_bincount_and_streams():
     assert np.array_equal(s["first"], start + np.searchsorted(cyc, np.arange(n_cyc)))
     with pytest.raises(InputError, match="knot_t"):
         fold.push(t, x, F, 0, kt[::-1].copy(), kp)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    n=st.integers(1 << 15, 1 << 17),
+    kind=st.sampled_from(["noise", "sine", "ties", "half-flat", "constant", "spikes"]),
+    seed=st.integers(0, 2**16),
+)
+def test_tail_percentiles_are_numpys(n, kind, seed):
+    from contactlab.tangential.preprocess import tail_percentiles
+
+    rng = np.random.default_rng(seed)
+    x = {
+        "noise": lambda: rng.standard_normal(n),
+        "sine": lambda: np.sin(0.00628 * np.arange(n)) + 1e-3 * rng.standard_normal(n),
+        "ties": lambda: np.round(rng.standard_normal(n), 1),
+        "half-flat": lambda: np.r_[np.zeros(n // 2), rng.standard_normal(n - n // 2)],
+        "constant": lambda: np.full(n, 2.5),
+        "spikes": lambda: np.where(rng.random(n) < 0.02, 1e6, rng.standard_normal(n)),
+    }[kind]()
+    ref = np.percentile(x, [0.5, 99.5])
+    got = tail_percentiles(x)
+    np.testing.assert_allclose(got, ref, rtol=0, atol=4 * np.spacing(np.max(np.abs(x))))

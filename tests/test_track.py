@@ -269,9 +269,44 @@ def test_window_analysis_equals_the_whole_analysis(case, invert):
             else:
                 np.testing.assert_allclose(b[k], a[k], rtol=1e-9, atol=0, err_msg=k)
     if case == "gross sliding":
-        assert "stick_slip" in b  # the whole-window analysis ran
-    else:
-        assert "stick_slip" not in b
+        assert b["stick_slip"] == a["stick_slip"]  # the whole-window analysis ran
+    else:  # reversals counted, the stick search not run
+        assert b["stick_slip"]["n_reversals"] == a["stick_slip"]["n_reversals"]
+        assert b["stick_slip"]["reversals_with_stick"] is None
+        assert set(b["stick_slip"]) == set(a["stick_slip"])
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    pt=st.lists(st.floats(0, 10), max_size=8),
+    vt=st.lists(st.floats(0, 10), max_size=8),
+    ties=st.booleans(),
+)
+def test_phase_knots_vectorised_equals_the_loop(pt, vt, ties):
+    from contactlab.tangential.preprocess import Reversals, _phase_knots, _phase_knots_loop
+
+    p = np.sort(np.asarray(pt, dtype=float))
+    v = np.sort(np.r_[vt, p[:2]] if ties else np.asarray(vt, dtype=float))
+    e = np.empty(0, dtype=np.int64)
+    rev = Reversals(e, e, p, v, 1.0, 0.0)
+    for a, b in zip(_phase_knots(rev), _phase_knots_loop(rev), strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_negated_loop_is_the_fold_of_minus_F():
+    """The window analysis of an inverted load cell negates its one fold instead of folding
+    -F again: bit for bit the same loop."""
+    from contactlab.tangential.preprocess import average_loop, negated_loop
+
+    rec = synthetic_recording(**_WINDOW_CASES["drifts"])
+    a = negated_loop(average_loop(rec["x"], rec["F"], rec.t))
+    b = average_loop(rec["x"], -rec["F"], rec.t)
+    for k in ("x", "F", "count", "x_std", "F_std", "x_var", "t_mean"):
+        np.testing.assert_array_equal(getattr(a, k), getattr(b, k), err_msg=k)
+    for k in ("energy", "mean_force", "force_range", "amplitude", "mean_x"):
+        np.testing.assert_array_equal(getattr(a.scatter, k), getattr(b.scatter, k), err_msg=k)
+    for u, v in zip(a.sensitivity, b.sensitivity, strict=True):
+        np.testing.assert_array_equal(u, v)
 
 
 def test_window_analysis_force_sign_given_or_undecided():

@@ -290,6 +290,7 @@ def least_squares_fit(
     xtol: float = 1e-10,
     gtol: float = 1e-10,
     jac_rel_step: float = 1e-6,
+    jac: Callable[[dict[str, float]], Mapping[str, Any]] | None = None,
 ) -> FitResult:
     """Minimise ``sum(residual_fn(values)**2)`` over the varied parameters.
 
@@ -312,6 +313,10 @@ def least_squares_fit(
         Passed to :func:`scipy.optimize.least_squares`.
     jac_rel_step : float
         Relative step of the central-difference Jacobian used for the covariance.
+    jac : callable, optional
+        Analytic derivatives ``jac(values) -> {name: ∂residual/∂name}`` (arrays of the
+        residual's length) for at least the varied parameters: the solver, the polishing
+        steps and the covariance use them instead of finite differences.
 
     Returns
     -------
@@ -394,10 +399,21 @@ def least_squares_fit(
         return _finish(ps, [], None, r0, chisqr, ndata, True, 0, "no varied parameters", nfev)
     if ndata < len(names):
         raise InputError(f"{ndata} residuals cannot determine {len(names)} parameters")
+
+    def analytic(z: np.ndarray) -> np.ndarray:
+        assert jac is not None
+        with np.errstate(all="ignore"):  # a non-finite column is reported below
+            cols = jac(values_of(z))
+            return np.column_stack(
+                [np.asarray(cols[n], dtype=np.float64).reshape(-1) * s
+                 for n, s in zip(names, scale, strict=True)]
+            ) / rscale  # fmt: skip
+
     try:
         sol = least_squares(
             fun,
             z0,
+            jac=analytic if jac is not None else "2-point",
             bounds=(lo, hi),
             method="trf",
             x_scale=1.0,
@@ -413,6 +429,8 @@ def least_squares_fit(
         ) from exc
 
     def jacobian(z: np.ndarray) -> np.ndarray:
+        if jac is not None:
+            return analytic(z)
         # central differences in the scaled variables (bounds respected by one-sided steps)
         J = np.empty((ndata, len(names)))
         for j in range(len(names)):

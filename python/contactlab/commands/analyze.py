@@ -145,7 +145,7 @@ def _streamed(args: argparse.Namespace, entries: list, columns: dict | None, top
     return 1 if failures else 0
 
 
-def _n_samples(path: Path, columns: dict | None, fs: float | None) -> int:
+def _n_samples(path: Path, columns: dict | None, fs: float | None, kind: str) -> int:
     """Samples of a recording without reading it (HDF5, MAT v7.3, TDMS), or an estimate from
     the size of a text file (16 bytes a row at least); 0 when the file cannot be opened that
     way (the whole-file reader then reports what is wrong with it)."""
@@ -153,24 +153,65 @@ def _n_samples(path: Path, columns: dict | None, fs: float | None) -> int:
     from ..io import read_chunks
 
     try:
-        n = read_chunks(path, columns=columns, kind="tangential", fs=fs).n_samples
+        n = read_chunks(path, columns=columns, kind=kind, fs=fs).n_samples
     except (ContactLabError, OSError, ValueError):
         return 0
     return int(n) if n is not None else path.stat().st_size // 16
 
 
+def _normal_options(entry: object, nopts: dict) -> dict:
+    """The options a study gives a normal recording's analysis: ``p0``, ``pa`` from the
+    command line, else from the file-name tags; ω from a ``frequency`` tag
+    (:func:`contactlab.studies.normal.analyze_normal_recording`, which each window runs)."""
+    import math
+
+    tags = entry.tags  # type: ignore[attr-defined]
+    opts = dict(nopts)
+    for key in ("p0", "pa"):
+        tag = tags.get(key)
+        if opts.get(key) is None and isinstance(tag, float) and math.isfinite(tag):
+            opts[key] = tag
+    freq = tags.get("frequency")
+    if isinstance(freq, float) and math.isfinite(freq) and freq > 0:
+        opts["omega"] = 2.0 * math.pi * freq
+    return opts
+
+
+def _window_threads() -> int:
+    """Helper threads of an auto-streamed analysis (``track(threads=...)``): one per core, at
+    most 2, or ``CONTACTLAB_ANALYZE_THREADS`` (0: analyse each window before reading on).
+    They analyse windows (the Rust kernels release the GIL) while the main thread reads on;
+    each holds at most two windows (1e7 samples: about 250 MB peak with 2, 200 MB with 1).
+    The pooled document is the serial one."""
+    import os
+
+    env = os.environ.get("CONTACTLAB_ANALYZE_THREADS", "").strip()
+    if env:
+        try:
+            n = int(env)
+        except ValueError:
+            raise InputError(
+                f"CONTACTLAB_ANALYZE_THREADS must be an integer >= 0, got {env!r}"
+            ) from None
+        if n < 0:
+            raise InputError(f"CONTACTLAB_ANALYZE_THREADS must be an integer >= 0, got {env!r}")
+        return n
+    return max(1, min(2, os.cpu_count() or 1))
+
+
 def _auto_streamed(
-    args: argparse.Namespace, entry: object, columns: dict | None, topts: dict, ex: object
+    args: argparse.Namespace, entry: object, columns: dict | None, opts: dict, ex: object
 ) -> dict:
-    """A long tangential recording analysed window by window in bounded memory and pooled
-    into the whole-file document (:mod:`contactlab.studies.pooled`)."""
+    """A long recording analysed window by window in bounded memory and pooled into the
+    whole-file document (:mod:`contactlab.studies.pooled`)."""
     from ..io.recording import RecordingError
-    from ..studies.pooled import STREAM_ABOVE, pooled_document
+    from ..studies.pooled import STREAM_ABOVE, pooled_document, pooled_normal_document
     from ..studies.tracking import track
 
     path = entry.path  # type: ignore[attr-defined]
-    res = track(path, "auto", kind="tangential", columns=columns, fs=args.fs, executor=ex,
-                options=topts, keep_documents=True)  # fmt: skip
+    kind = entry.kind  # type: ignore[attr-defined]
+    res = track(path, "auto", kind=kind, columns=columns, fs=args.fs, executor=ex,
+                options=opts, keep_documents=True, threads=_window_threads())  # fmt: skip
     if not res.window_docs:
         errors = "; ".join(str(r.get("error")) for r in res.rows if r.get("error"))
         raise RecordingError(f"no window of the streamed analysis could be fitted: {errors}",
@@ -181,12 +222,13 @@ def _auto_streamed(
         f"(every={res.every}) read in chunks, memory bounded; the windows pooled "
         "(--whole analyses the file in memory)"
     )
-    doc = pooled_document(res.window_docs, reason=reason)
+    pooled = pooled_document if kind == "tangential" else pooled_normal_document
+    doc = pooled(res.window_docs, reason=reason)
     doc.update(n_samples=n, n_windows=len(res.rows), every=res.every)
     failed = [r for r in res.rows if r.get("error")]
     if failed:
         doc["warnings"] = [*doc["warnings"], *(str(r["error"]) for r in failed)]
-    doc = {"file": str(path), "model": "tangential", **entry.tags, **doc}  # type: ignore[attr-defined]
+    doc = {"file": str(path), "model": kind, **entry.tags, **doc}  # type: ignore[attr-defined]
     doc["_track"] = res
     return doc
 
@@ -210,11 +252,13 @@ def _handler(args: argparse.Namespace) -> int:
     if args.stream:
         return _streamed(args, entries, columns, topts)
     big: set[int] = set()
-    if args.model == "tangential" and not args.whole:
+    if not args.whole:
         from ..studies.pooled import STREAM_ABOVE
 
         big = {
-            i for i, e in enumerate(entries) if _n_samples(e.path, columns, args.fs) > STREAM_ABOVE
+            i
+            for i, e in enumerate(entries)
+            if _n_samples(e.path, columns, args.fs, e.kind) > STREAM_ABOVE
         }
     if big and args.report and len(entries) > 1:
         raise InputError(
@@ -310,7 +354,8 @@ def _with_long(
         for i in sorted(big):
             e = entries[i]
             try:
-                doc = _auto_streamed(args, e, columns, topts, ex)
+                opts = topts if e.kind == "tangential" else _normal_options(e, nopts)
+                doc = _auto_streamed(args, e, columns, opts, ex)
             except ContactLabError as exc:
                 if not args.keep_going:
                     raise
@@ -320,7 +365,7 @@ def _with_long(
             last = doc.pop("_track")
             by_path[str(e.path)] = doc
             print(
-                f"{e.path}: {_summary_line(doc, 'tangential')} (streamed: {doc['n_samples']} "
+                f"{e.path}: {_summary_line(doc, e.kind)} (streamed: {doc['n_samples']} "
                 f"samples in {doc['n_windows']} windows)",
                 file=say,
             )
@@ -388,8 +433,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--whole",
         action="store_true",
-        help="tangential recordings longer than 2^19 samples are streamed and pooled "
-        "automatically (memory bounded, JSON says 'streamed'); --whole reads them into memory",
+        help="recordings longer than 2^19 samples (tangential or normal) are streamed and "
+        "pooled automatically (memory bounded, JSON says 'streamed'); --whole reads them into "
+        "memory",
     )
     p.add_argument(
         "--every", default="auto", help="window of --stream: 'auto' (default), '200cycles' or '10s'"

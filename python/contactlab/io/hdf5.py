@@ -9,6 +9,7 @@ datasets are read.
 
 from __future__ import annotations
 
+import bisect
 import os
 from pathlib import Path
 from typing import Any
@@ -171,29 +172,124 @@ def _check_local_heaps(mm: Any, size: int, noff: int, nlen: int, base: int, file
         pos = mm.find(b"HEAP", pos + 1)
 
 
+def _read_into(fd: int, buf: memoryview, at: int) -> int:
+    """Fill ``buf`` from byte ``at`` of ``fd`` (fewer bytes at the end of the file)."""
+    if hasattr(os, "preadv"):
+        return os.preadv(fd, [buf], at)
+    data = os.pread(fd, len(buf), at)  # pragma: no cover - platforms without preadv
+    buf[: len(data)] = data
+    return len(data)
+
+
+class _FileView:
+    """What the structure checks use of a memory map (``view[i]``, ``view[a:b]``,
+    ``view.find(needle, start)``), read by ``os.pread`` in blocks: the scan of a long file
+    holds one block (16 MiB) instead of mapping the whole file, whose pages would count in
+    the process' resident memory (a 1.6 GB file peaked at 1.57 GB)."""
+
+    BLOCK = 1 << 24
+
+    def __init__(self, fd: int, size: int) -> None:
+        self.fd, self.size = fd, size
+        self._at, self._n = -1, 0  # the block read last (find resumes in it), its length
+        self._buf = bytearray()  # one buffer for every block: no fresh pages per block
+        self._index: dict[bytes, list[int]] = {}  # needle -> every position (see index)
+
+    def __getitem__(self, k: int | slice) -> Any:
+        if isinstance(k, slice):
+            a = 0 if k.start is None else max(k.start, 0)
+            b = self.size if k.stop is None else min(k.stop, self.size)
+            return os.pread(self.fd, b - a, a) if b > a else b""
+        if not 0 <= k < self.size:
+            raise IndexError("file view index out of range")
+        return os.pread(self.fd, 1, k)[0]
+
+    def index(self, needles: tuple[bytes, ...]) -> None:
+        """Find every occurrence of each of ``needles`` in one pass over the file (each block
+        read once, searched for each needle); :meth:`find` then answers from the index."""
+        longest = max(len(nd) for nd in needles)
+        found: dict[bytes, list[int]] = {nd: [] for nd in needles}
+        at = 0
+        while at < self.size:
+            want = min(self.BLOCK + longest - 1, self.size - at)
+            if len(self._buf) < want:
+                self._buf = bytearray(want)
+            n = _read_into(self.fd, memoryview(self._buf)[:want], at)
+            for nd, hits in found.items():
+                # matches starting in this block (one starting beyond it is the next block's)
+                end = min(n, self.BLOCK + len(nd) - 1)
+                i = self._buf.find(nd, 0, end)
+                while i != -1:
+                    hits.append(at + i)
+                    i = self._buf.find(nd, i + 1, end)
+            at += self.BLOCK
+        self._at = -1
+        self._index = found
+
+    def find(self, needle: bytes, start: int = 0) -> int:
+        hits = self._index.get(needle)
+        if hits is not None:
+            k = bisect.bisect_left(hits, max(start, 0))
+            return hits[k] if k < len(hits) else -1
+        pos = max(start, 0)
+        while pos < self.size:
+            at = pos - pos % self.BLOCK
+            want = min(self.BLOCK + len(needle) - 1, self.size - at)
+            if at != self._at or self._n < want:
+                # a block and the needle's length after it: a match across the edge is found
+                if len(self._buf) < want:
+                    self._buf = bytearray(want)
+                self._n = _read_into(self.fd, memoryview(self._buf)[:want], at)
+                self._at = at
+            i = self._buf.find(needle, pos - at, self._n)
+            if i >= 0:
+                return at + i
+            pos = at + self.BLOCK
+        return -1
+
+
+#: long files :func:`check_structure` passed in this process: ``(device, inode, size,
+#: mtime_ns, ctime_ns)``; files from this size on are remembered
+_CHECKED: set[tuple[int, int, int, int, int]] = set()
+_CACHE_ABOVE = 64 << 20
+
+
 def check_structure(path: str | Path, *, file: str) -> None:
     """Refuse the damaged structures on which libhdf5 itself hangs or overflows its stack
     instead of failing (it cannot be interrupted from Python): global heap collections whose
     walk does not advance, version-1 B-trees with sibling cycles or children on the wrong
     level, local heaps whose free list cycles. Cheap: a scan for the structures' signatures,
-    memory-mapped. Valid files always pass; a file this does not understand is left to
-    libhdf5, which reports it. Not checked: the structures libhdf5 writes only with newer
-    file-format settings (version-2 B-trees, fractal heaps); object header continuation
-    loops and the other damage tried by fuzz/read_hdf5.py libhdf5 reports itself."""
-    import mmap
-
+    read in blocks (bounded memory). Valid files always pass; a file this does not
+    understand is left to libhdf5, which reports it. Not checked: the structures libhdf5
+    writes only with newer file-format settings (version-2 B-trees, fractal heaps); object
+    header continuation loops and the other damage tried by fuzz/read_hdf5.py libhdf5
+    reports itself."""
     with open(path, "rb") as fh:
-        size = os.fstat(fh.fileno()).st_size
+        st = os.fstat(fh.fileno())
+        size = st.st_size
         if size < 48:
             return
-        with mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as mm:
-            sb = _superblock(mm, size)
-            if sb is None:
-                return
-            noff, nlen, base = sb
-            _check_global_heaps(mm, size, nlen, file)
-            _check_btrees(mm, size, noff, nlen, base, file)
-            _check_local_heaps(mm, size, noff, nlen, base, file)
+        # A long file already checked in this process and unchanged since (same inode, size,
+        # modification and change times) is not scanned again: `analyze` opens a long file
+        # twice (its length, then the chunks), and each scan reads the whole file (1.6 GB at
+        # 1e8 samples). Only long files: their scan outlasts the timestamps' resolution, and
+        # small files (a fuzzer rewriting one in place) are always scanned.
+        key = (st.st_dev, st.st_ino, size, st.st_mtime_ns, st.st_ctime_ns)
+        if size >= _CACHE_ABOVE and key in _CHECKED:
+            return
+        mm = _FileView(fh.fileno(), size)
+        sb = _superblock(mm, size)
+        if sb is None:
+            return
+        mm.index((_GCOL, b"TREE", b"HEAP"))  # one pass over the file for the three scans
+        noff, nlen, base = sb
+        _check_global_heaps(mm, size, nlen, file)
+        _check_btrees(mm, size, noff, nlen, base, file)
+        _check_local_heaps(mm, size, noff, nlen, base, file)
+        if size >= _CACHE_ABOVE:
+            if len(_CHECKED) >= 256:
+                _CHECKED.clear()
+            _CHECKED.add(key)
 
 
 def open_hdf5(path: str | Path, *, file: str) -> Any:

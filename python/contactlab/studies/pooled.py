@@ -1,6 +1,7 @@
 """The whole-record document of a tangential recording analysed window by window.
 
-``contactlab analyze`` of a long recording (more than :data:`STREAM_ABOVE` samples) runs the
+``contactlab analyze`` of a long recording (more than :data:`STREAM_ABOVE` samples; normal-contact
+recordings likewise, :func:`pooled_normal_document`) runs the
 streamed analysis (:func:`contactlab.track`, memory bounded by one chunk and one window) and
 writes the document a whole-file analysis writes, with the same keys, each filled from the
 windows:
@@ -15,8 +16,9 @@ windows:
 - the regime: the most frequent one, its reason saying how many windows had it; the
   identifiability flags: a parameter counts as identified when it is in every window;
 - warnings: each distinct window warning once, with the number of windows that gave it;
-- ``stick_slip``: the windows' means (None where no window searched for sticks: a streamed
-  window of a pre-sliding or transition loop does not, see
+- ``stick_slip``: ``n_reversals`` summed over the windows; the search's counts and means
+  over the windows that searched for sticks (null where none did: a streamed window of a
+  pre-sliding or transition loop counts its reversals but does not search them, see
   :func:`contactlab.tangential.analysis.analyze_window`).
 
 ``streamed`` (True), ``streamed_reason``, ``n_windows``, ``n_samples`` and ``every`` say how
@@ -169,8 +171,7 @@ def pooled_document(docs: list[dict[str, Any]], *, reason: str) -> dict[str, Any
     )
     out["identifiable"] = ident
     # warnings: distinct, counted
-    warns = Counter(w for d in docs for w in d.get("warnings") or [])
-    out["warnings"] = [f"{w} ({c} of {n} windows)" for w, c in warns.items()]
+    out["warnings"] = _counted_warnings(docs)
     sticks = [d["stick_slip"] for d in docs if isinstance(d.get("stick_slip"), dict)]
     template = {
         "n_reversals": None,
@@ -195,7 +196,10 @@ def pooled_document(docs: list[dict[str, Any]], *, reason: str) -> dict[str, Any
                 vals = [_num(s.get(k)) for s in sticks]
                 st[k] = float(np.nanmean(vals)) if np.any(np.isfinite(vals)) else None
         for k in ("n_reversals", "reversals_with_stick"):
-            st[k] = float(np.nansum([_num(s.get(k)) for s in sticks]))
+            # over the windows that counted them (streamed windows below gross sliding count
+            # their reversals but do not search them for sticks: null when none did)
+            vals = [_num(s.get(k)) for s in sticks]
+            st[k] = float(np.nansum(vals)) if np.any(np.isfinite(vals)) else None
         out["stick_slip"] = st
     else:
         out["stick_slip"] = template
@@ -209,4 +213,58 @@ def pooled_document(docs: list[dict[str, Any]], *, reason: str) -> dict[str, Any
     return out
 
 
-__all__ = ["STREAM_ABOVE", "pool", "pooled_document"]
+def _counted_warnings(docs: list[dict[str, Any]]) -> list[str]:
+    warns = Counter(w for d in docs for w in d.get("warnings") or [])
+    return [f"{w} ({c} of {len(docs)} windows)" for w, c in warns.items()]
+
+
+#: normal-contact keys summed over the windows
+_NORMAL_SUMMED = ("n_cycles", "n_discarded")
+
+
+def pooled_normal_document(docs: list[dict[str, Any]], *, reason: str) -> dict[str, Any]:
+    """The whole-record document of a normal-contact recording from its windows'
+    :meth:`NormalAnalysis.to_dict` documents, with the whole-file analysis' keys: ``E_d``
+    (and any quantity with a ``*_stderr``) inverse-variance pooled; counts (``n_cycles``,
+    ``n_discarded``) summed; other numbers (ψ, ψ_KV, k_tan, k_sec, the b coefficients, the
+    cycle scatter, ...) and the polynomials (coefficient by coefficient) averaged over the
+    windows; flags true when true in any window; texts from the first window; warnings each
+    once with the number of windows that gave it."""
+    if not docs:
+        raise ValueError("no window to pool")
+    first = docs[0]
+    out: dict[str, Any] = {}
+    for k, v0 in first.items():
+        if k.endswith("_stderr") or k in ("warnings", "units"):
+            continue
+        vals = [d.get(k) for d in docs]
+        if k in _NORMAL_SUMMED:
+            out[k] = int(sum(int(_num(v)) if math.isfinite(_num(v)) else 0 for v in vals))
+        elif f"{k}_stderr" in first:
+            m, e, _ = pool(vals, [d.get(f"{k}_stderr") for d in docs])
+            out[k] = None if math.isnan(m) else m
+            out[f"{k}_stderr"] = None if math.isnan(e) else e
+        elif isinstance(v0, bool):
+            out[k] = any(bool(v) for v in vals)
+        elif isinstance(v0, (int, float)):
+            num = [_num(v) for v in vals]
+            mean = float(np.nanmean(num)) if np.any(np.isfinite(num)) else None
+            out[k] = round(mean) if isinstance(v0, int) and mean is not None else mean
+        elif isinstance(v0, list) and all(isinstance(c, (int, float)) for c in v0):
+            same = [np.asarray(v, dtype=float) for v in vals if isinstance(v, list)]
+            same = [a for a in same if a.shape == (len(v0),)]
+            out[k] = np.mean(same, axis=0).tolist() if same else v0
+        else:
+            out[k] = v0
+    out["warnings"] = _counted_warnings(docs)
+    units: dict[str, str] = {}
+    for d in docs:
+        for k, u in (d.get("units") or {}).items():
+            units.setdefault(k, u)
+    out["units"] = units
+    out["streamed"] = True
+    out["streamed_reason"] = reason
+    return out
+
+
+__all__ = ["STREAM_ABOVE", "pool", "pooled_document", "pooled_normal_document"]

@@ -336,15 +336,37 @@ def _tangential_window(
     return row, units
 
 
-def _normal_window(rec: Recording, options: Mapping[str, Any]) -> tuple[dict, dict]:
+def _normal_window(
+    rec: Recording, options: Mapping[str, Any], keep_doc: bool = False
+) -> tuple[dict, dict]:
     import warnings
 
     from ..normal import analyze_loop
 
+    if keep_doc:
+        # the document a whole-file analysis writes (eq. 16's b1..b4, E_d's error, ...):
+        # that of a study's recording, the options (p0, pa, omega) given
+        from .manifest import StudyEntry
+        from .normal import analyze_normal_recording
+
+        entry = StudyEntry(Path(rec.source or "window"), "normal")
+        res, doc, extra = analyze_normal_recording(rec, entry, **dict(options))
+        d = res.to_dict()
+        row, units = _normal_row(d)
+        row["warnings"] = " | ".join(extra["warnings"])
+        row["_doc"] = {**doc, **extra}
+        return row, units
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ContactLabWarning)
         res = analyze_loop(rec.t, rec["p"], rec["delta"], **dict(options))
-    d = res.to_dict()
+    row, units = _normal_row(res.to_dict())
+    row["warnings"] = " | ".join(
+        str(w.message) for w in caught if issubclass(w.category, ContactLabWarning)
+    )
+    return row, units
+
+
+def _normal_row(d: dict[str, Any]) -> tuple[dict, dict]:
     du = d.get("units", {})
     row: dict[str, Any] = {}
     units: dict[str, str] = {}
@@ -360,9 +382,6 @@ def _normal_window(rec: Recording, options: Mapping[str, Any]) -> tuple[dict, di
             row[f"{key}_{i}"] = float(c)
             units[f"{key}_{i}"] = coefficient_unit(du.get(key, ""), i)
     row["n_cycles"] = n
-    row["warnings"] = " | ".join(
-        str(w.message) for w in caught if issubclass(w.category, ContactLabWarning)
-    )
     return row, units
 
 
@@ -493,8 +512,9 @@ def track(
         (each thread holds up to two windows: 2 threads peak near 300 MB with ``"auto"``
         windows), 0 analyses each window before reading on. The rows are the same.
     keep_documents : bool
-        Keep each tangential window's whole analysis document (``TrackResult.window_docs``;
-        what :func:`contactlab.studies.pooled.pooled_document` pools).
+        Keep each window's whole analysis document (``TrackResult.window_docs``; what
+        :func:`contactlab.studies.pooled.pooled_document` and
+        :func:`~contactlab.studies.pooled.pooled_normal_document` pool).
 
     Returns
     -------
@@ -532,10 +552,8 @@ def track(
     if kind_ not in ("tangential", "normal"):
         raise InputError(f"{cr.source}: cannot tell the kind of recording; pass kind=")
     loop_x, loop_F, drive = ("x", "F", "x") if kind_ == "tangential" else ("delta", "p", "p")
-    analyse: Callable[..., tuple[dict, dict]] = (
-        functools.partial(_tangential_window, keep_doc=keep_documents)
-        if kind_ == "tangential"
-        else _normal_window
+    analyse: Callable[..., tuple[dict, dict]] = functools.partial(
+        _tangential_window if kind_ == "tangential" else _normal_window, keep_doc=keep_documents
     )
     docs: list[dict[str, Any]] = []
     opts = dict(options or {})

@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -57,11 +58,11 @@ from ..io import Recording
 from ..masing import loop_area
 from . import steps
 from .orientation import Orientation, orient
-from .preprocess import AveragedLoop, average_loop
+from .preprocess import AveragedLoop, average_loop, find_reversals, negated_loop, period_means
 from .regime import GROSS_SLIDING_Z as REGIME_GROSS_Z
 from .regime import PRE_SLIDING_Z, Regime, classify, z_from_area_ratio
 from .result import TangentialAnalysis
-from .uncertainty import correl, numeric_energy, reparametrize
+from .uncertainty import correl, numeric_energy, reparametrize, trend
 
 #: ``ac·A`` above which the loop is taken to have reached gross sliding (branch slope at the
 #: turn below e^-3 = 5 % of the initial stiffness: the force has plateaued near ±h0)
@@ -448,8 +449,10 @@ def _fast_orientation(
         per_cycle = loop.count / n
         vF, vx = loop.F_std**2 * per_cycle, loop.x_std**2 * per_cycle
         if np.any(np.isfinite(vF)) and np.any(np.isfinite(vx)):
-            g_F, g_x = _core.loop_area_sensitivity(
-                x, F, [int(b) for b in loop.cycle_bounds[: n + 1]]
+            g_F, g_x = (
+                loop.sensitivity  # of x, F: the loop was folded from them
+                if loop.sensitivity is not None
+                else _core.loop_area_sensitivity(x, F, [int(b) for b in loop.cycle_bounds[: n + 1]])
             )
             err = math.sqrt(
                 float(np.sum(g_F)) * float(np.nanmean(vF))
@@ -502,13 +505,19 @@ def analyze_window(
     """:func:`analyze_tangential` of one window of a streamed recording (``on="averaged"``,
     steady history), with the per-sample work in one pass of Rust kernels.
 
-    The averaged loop is computed once (reversals, phase fold, per-cycle areas; a second fold
-    after drift removal), and reused: the force sign follows from its per-cycle areas, the
-    drift covariance from its bins' mean time, the numeric energy's error from the cycles'
-    area sensitivities. The velocity and stick search over the samples (which only decide
-    between gross sliding and stick-slip) runs only when the loop reaches gross sliding, and
-    then the window is analysed exactly as :func:`analyze_tangential` does. The results are
-    those of :func:`analyze_tangential` (warnings are kept in ``.warnings``, not issued).
+    The samples are folded once: the drifts come from the period means between the raw
+    displacement's peaks (what :func:`steps.detrend`'s first fold gives them from), the
+    detrended samples are folded in one Rust pass (:func:`contactlab._core.fold_window`:
+    phase bins, cycle bounds, per-cycle areas and their sensitivities, period means), and
+    that loop is reused: the force sign follows from its per-cycle areas (an inverted force
+    negates the fold), the drift covariance from its bins' mean time, the numeric energy's
+    error from the cycles' area sensitivities. The velocity and stick search over the
+    samples (which only decide between gross sliding and stick-slip) runs only when the loop
+    reaches gross sliding, and then the window is analysed exactly as
+    :func:`analyze_tangential` does; below it, ``stick_slip`` gives the window's reversals
+    and null for what only the search measures. The results are those of
+    :func:`analyze_tangential` (warnings are kept in ``.warnings``, not issued; the recorded
+    loop area of the orientation is that of the detrended samples).
     """
     xa, Fa, ta, source = _inputs(recording, None, None, None)
     _check_options("averaged", "steady", n_points)
@@ -525,19 +534,66 @@ def analyze_window(
         "detrend": detrend,
         "initial": initial,
     }
-    loop = average_loop(
-        xa, Fa, ta, n_points=n_points, rel_threshold=rel_threshold, min_cycles=min_cycles
-    )
-    ori = _fast_orientation(xa, Fa, loop, force_sign)
+    pre = _window_detrended(xa, Fa, ta, opts)
+    ori = _fast_orientation(pre.x, pre.F, pre.loop, force_sign)
     res = None
     if ori is not None:
         if ori.sign < 0:
-            loop = None  # averaged again on -F
-        res = _analyze(xa, Fa, ta, source, ori, loop, on="averaged", history="steady",
+            pre = _negated(pre)
+        res = _analyze(xa, Fa, ta, source, ori, pre, on="averaged", history="steady",
                        streamed=True, **opts)  # fmt: skip
     if res is None:  # the sign undecided by the area, or gross sliding: the full analysis
         return analyze_tangential(recording, force_sign=force_sign, warn=False, **opts)
     return res
+
+
+def _window_detrended(
+    xa: np.ndarray, Fa: np.ndarray, ta: np.ndarray | None, opts: dict[str, Any]
+) -> steps.Detrended:
+    """:func:`steps.detrend` of the window with one fold instead of two: the linear drifts
+    come from the period means between the raw displacement's peaks (what the first fold's
+    per-cycle means are: the same Rust kernel on the same edges), so the samples are
+    detrended before the only fold. The same numbers as :func:`steps.detrend`."""
+    n_points, rel = opts["n_points"], opts["rel_threshold"]
+    min_cycles = opts["min_cycles"]
+    rev = find_reversals(xa, ta, rel_threshold=rel)
+    if not (opts["detrend"] and rev.peaks.size - 1 >= 3):
+        loop = average_loop(xa, Fa, ta, n_points=n_points, rel_threshold=rel,
+                            min_cycles=min_cycles)  # fmt: skip
+        return steps.Detrended(xa, Fa, loop, None)
+    tt = ta if ta is not None else np.arange(xa.size, dtype=float)
+    pt = rev.peak_times
+    time = 0.5 * (pt[:-1] + pt[1:])
+    tm = float(np.mean(time))
+    f_drift = trend(time, period_means(tt, Fa, pt))
+    x_drift = trend(time, period_means(tt, xa, pt))
+    tau = tt - tm
+    F = Fa - f_drift[0] * tau
+    x = xa - x_drift[0] * tau
+    loop = average_loop(x, F, ta, n_points=n_points, rel_threshold=rel, min_cycles=min_cycles)
+    return steps.Detrended(x, F, loop, steps.Drift(f_drift, x_drift, tt, tm))
+
+
+def _negated(d: steps.Detrended) -> steps.Detrended:
+    """The detrended window of ``-F`` (bit for bit: negation commutes with every step)."""
+    dr = d.drift
+    if dr is not None:
+        dr = replace(dr, force=(-dr.force[0], dr.force[1]))
+    loop = negated_loop(d.loop) if d.loop is not None else None
+    return steps.Detrended(d.x, -d.F, loop, dr)
+
+
+def _unsearched_sticks(rev: Any, n_samples: int) -> dict[str, Any]:
+    """``stick_slip`` of a streamed window below gross sliding, where the stick search over
+    the samples does not run (it is a gross-sliding verdict, and its velocity estimate costs
+    seconds a window): what the window knows, the reversals it has; NaN (null in JSON) for
+    what only the search measures. The same keys as the whole-window analysis gives."""
+    n_turns = int(rev.peaks.size + rev.valleys.size)
+    if n_turns < 2 or n_samples < 20:  # where the search would give none either
+        return {}
+    unknown = ("reversals_with_stick", "stick_duration", "breakaway_force",
+               "breakaway_force_stderr", "velocity_threshold", "smooth_turn_dwell")  # fmt: skip
+    return {"stick_slip": {"n_reversals": n_turns, **dict.fromkeys(unknown, math.nan)}}
 
 
 def _analyze(
@@ -546,7 +602,7 @@ def _analyze(
     ta: np.ndarray | None,
     source: str,
     ori: Orientation,
-    first: AveragedLoop | None,
+    pre: steps.Detrended | None,
     *,
     on: str,
     history: str,
@@ -561,24 +617,27 @@ def _analyze(
     initial: dict[str, float] | None,
     streamed: bool,
 ) -> TangentialAnalysis | None:
-    """The analysis after the orientation; ``first``: the loop of ``xa, Fa`` averaged with
-    these options already. ``streamed``: a window of :func:`analyze_window`, which hands back
-    None when its loop reaches gross sliding."""
+    """The analysis after the orientation; ``pre``: :func:`steps.detrend` of the oriented
+    ``xa, Fa`` with these options, done already. ``streamed``: a window of
+    :func:`analyze_window`, which hands back None when its loop reaches gross sliding."""
     steady = history == "steady"
     pre_warns = [f"analysed -F: {ori.reason}"] if (ori.sign < 0 and ori.by != "user") else []
     if ori.sign < 0:
         Fa = -Fa
     fit_x0 = True if fit_x0 is None else fit_x0
-    det = steps.detrend(
-        xa,
-        Fa,
-        ta,
-        on=on,
-        enabled=detrend,
-        n_points=n_points,
-        rel_threshold=rel_threshold,
-        min_cycles=min_cycles,
-        first=first,
+    det = (
+        pre
+        if pre is not None
+        else steps.detrend(
+            xa,
+            Fa,
+            ta,
+            on=on,
+            enabled=detrend,
+            n_points=n_points,
+            rel_threshold=rel_threshold,
+            min_cycles=min_cycles,
+        )
     )
     data = steps.fit_data(det, ta, on=on, steady=steady, rel_threshold=rel_threshold)
     sv = steps.start_values(
@@ -629,6 +688,9 @@ def _analyze(
     apply_regime(regime, amp, fit, identifiable, evidence, derived, max_rel_stderr)
     warns = collect_warnings(pre_warns, raw, data, amp.value, identifiable, evidence, regime)
     vals = raw.values
+    regime_d = regime.to_dict()
+    if streamed:
+        regime_d.update(_unsearched_sticks(data.rev, xa.size))
     return TangentialAnalysis(
         fit=fit,
         model=steps.model_of(vals),
@@ -639,7 +701,7 @@ def _analyze(
         identifiable=identifiable,
         identifiability=evidence,
         derived=derived,
-        regime=regime.to_dict(),
+        regime=regime_d,
         warnings=warns,
         on=on,
         history=history,

@@ -19,7 +19,7 @@ The paper (*Experimental investigation of tangential contact stiffness and equiv
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -77,6 +77,43 @@ def _crossing_times(t: np.ndarray, x: np.ndarray, i: np.ndarray, level: np.ndarr
     return np.where(i <= 0, t[0], np.where(flat, t[i], tc))
 
 
+#: above this many samples :func:`tail_percentiles` selects from the tails only
+_TAIL_SELECT_ABOVE = 1 << 15
+
+
+def tail_percentiles(x: np.ndarray, q: float = 0.5) -> tuple[float, float]:
+    """The ``q`` and ``100 - q`` percentiles of ``x`` (the numbers of ``np.percentile``, its
+    linear method) without partitioning all of ``x``: the order statistics they interpolate
+    are selected from the samples beyond a subsample's ``4q`` percentiles (two vectorised
+    passes). Falls back to ``np.percentile`` when a tail holds too few samples (or for short
+    ``x``)."""
+    n = x.size
+    if n <= _TAIL_SELECT_ABOVE:
+        lo, hi = np.percentile(x, [q, 100.0 - q])
+        return float(lo), float(hi)
+    qq = np.array([q, 100.0 - q]) / 100.0
+    vi = (n - 1) * qq  # numpy's virtual index of the linear method
+    i0 = np.floor(vi).astype(np.int64)
+    g = vi - i0
+    sub = x[::16]
+    k = int(np.clip(round(4 * q / 100.0 * (sub.size - 1)), 0, sub.size - 1))
+    part = np.partition(sub, [k, sub.size - 1 - k])
+    low = x[x <= part[k]]
+    high = x[x >= part[sub.size - 1 - k]]
+    n_hi0 = n - high.size  # rank of high's smallest value in x
+    if not (i0[0] + 1 < low.size and i0[1] >= n_hi0 and i0[1] + 1 < n):
+        lo, hi = np.percentile(x, [q, 100.0 - q])
+        return float(lo), float(hi)
+    a_lo = np.partition(low, [i0[0], i0[0] + 1])[[i0[0], i0[0] + 1]]
+    j = i0[1] - n_hi0
+    a_hi = np.partition(high, [j, j + 1])[[j, j + 1]]
+    out = []
+    for (a, b), t in zip((a_lo, a_hi), g, strict=True):
+        d = b - a
+        out.append(float(b - d * (1.0 - t) if t >= 0.5 else a + d * t))  # numpy's _lerp
+    return out[0], out[1]
+
+
 def find_reversals(
     x: np.ndarray,
     t: np.ndarray | None = None,
@@ -110,7 +147,7 @@ def find_reversals(
     ta = np.arange(xa.size, dtype=float) if t is None else as_1d(t, "t")
     if ta.size != xa.size:
         raise InputError(f"t has {ta.size} samples but x has {xa.size}")
-    lo_p, hi_p = np.percentile(xa, [0.5, 99.5])
+    lo_p, hi_p = tail_percentiles(xa)
     centre = 0.5 * (lo_p + hi_p)
     amp = 0.5 * (hi_p - lo_p)
     if threshold is None:
@@ -196,6 +233,10 @@ class AveragedLoop:
     cycle_bounds: np.ndarray | None = None  # first sample of each cycle, and the end
     x_var: np.ndarray | None = None  # variance of the samples' x inside each bin (all cycles)
     t_mean: np.ndarray | None = None  # mean time stamp of each bin's samples (all cycles)
+    # per cycle Σ (∂A/∂F_i)², Σ (∂A/∂x_i)² of the loop area of the samples folded
+    sensitivity: tuple[np.ndarray, np.ndarray] | None = field(
+        default=None, repr=False, compare=False
+    )
 
     @property
     def n_cycles(self) -> int:
@@ -212,7 +253,27 @@ class AveragedLoop:
 
 
 def _phase_knots(rev: Reversals) -> tuple[np.ndarray, np.ndarray]:
-    """Knots ``(time, phase)``: peak k at phase k, the valley after it at k + 1/2."""
+    """Knots ``(time, phase)``: peak k at phase k, the valley after it at k + 1/2 (the first
+    valley after the peak, when it comes before the next peak)."""
+    pt, vt = np.asarray(rev.peak_times, dtype=float), np.asarray(rev.valley_times, dtype=float)
+    n = pt.size
+    j = np.searchsorted(vt, pt, side="right")  # the first valley later than each peak
+    ok = np.zeros(n, dtype=bool)
+    if n > 1 and vt.size:
+        jj = np.minimum(j[:-1], vt.size - 1)
+        ok[:-1] = (j[:-1] < vt.size) & (vt[jj] < pt[1:])
+    kt = np.empty(n + int(ok.sum()))
+    kp = np.empty_like(kt)
+    pos = np.arange(n) + np.r_[0, np.cumsum(ok)[:-1]] if n else np.empty(0, dtype=np.int64)
+    kt[pos], kp[pos] = pt, np.arange(n, dtype=float)
+    if ok.any():
+        kt[pos[ok] + 1] = vt[j[ok]]
+        kp[pos[ok] + 1] = np.flatnonzero(ok) + 0.5
+    return kt, kp
+
+
+def _phase_knots_loop(rev: Reversals) -> tuple[np.ndarray, np.ndarray]:
+    """The plain-loop reference of :func:`_phase_knots` (tests)."""
     pt, vt = rev.peak_times, rev.valley_times
     knots_t, knots_p = [], []
     for k, tp in enumerate(pt):
@@ -235,7 +296,7 @@ def phase_of(t: np.ndarray, rev: Reversals) -> tuple[np.ndarray, int, int]:
     return ph, start, end
 
 
-def _period_means(t: np.ndarray, v: np.ndarray, edges: np.ndarray) -> np.ndarray:
+def period_means(t: np.ndarray, v: np.ndarray, edges: np.ndarray) -> np.ndarray:
     """Time average of ``v`` between consecutive ``edges`` (trapezoid rule, interpolated at
     the edges). For a periodic signal this does not depend on where the period starts, so
     the jitter of the turn instants does not leak into it (as sample-counting would).
@@ -319,11 +380,17 @@ def average_loop(
         n_points = 2 * int(np.clip(np.median(np.diff(rev.peaks)) / 2, 16, 400) // 2)
     if n_points < 8:
         raise InputError(f"n_points must be >= 8, got {n_points}")
-    # One pass in Rust: phase by interpolating the knots, bin sums overall and per cycle (no
-    # per-sample temporaries; the bins are numpy.interp's).
-    fold = _core.PhaseFold(int(n_points), n_cyc)
-    fold.push(ta, xa, Fa, 0, kt, kp)
-    sums = fold.sums(cells=False)
+    # One call in Rust: phase by interpolating the knots, bin sums overall and per cycle (no
+    # per-sample temporaries; the bins are numpy.interp's), the cycles' bounds, loop areas and
+    # their noise sensitivities, the period means between the peaks.
+    wf = _core.fold_window(ta, xa, Fa, kt, kp, int(n_points), n_cyc, rev.peak_times)
+    return _loop_of_fold(wf, rev, int(n_points), start, end)
+
+
+def _loop_of_fold(
+    wf: _core.WindowFold, rev: Reversals, n_points: int, start: int, end: int
+) -> AveragedLoop:
+    sums = wf.sums()
     count = sums["count"]
     if np.any(count == 0):
         raise InputError(
@@ -338,44 +405,51 @@ def average_loop(
     # the per-cycle means: it is removed to first order (gradient along phase, periodic), so
     # the spread measures noise and real cycle-to-cycle change. In Rust over the fold's cells
     # with the arithmetic of ``_spread`` and ``_dphase`` (numpy reference in the tests).
-    spread = fold.spread()
-    x_std, F_std = spread["x_std"], spread["F_std"]
+    spread = wf.spread()
+    cyc = wf.cycles()
     # sample index where each cycle starts (a cycle without samples starts where the next
-    # does), and where the last one ends
-    first = np.r_[sums["first"], end]
-    first = np.minimum.accumulate(np.where(first < 0, end, first)[::-1])[::-1]
-    bounds = first.astype(np.int64)
-    amps, franges = spread["amplitude"], spread["force_range"]
-    # the area of the cycle's own samples: bin means would cut the corners at the turns
-    energies = _core.loop_areas(xa, Fa, bounds.tolist())
+    # does), and where the last one ends; the area of the cycle's own samples (bin means
+    # would cut the corners at the turns)
     scatter = CycleScatter(
-        amplitude=amps,
-        force_range=franges,
-        energy=energies,
+        amplitude=spread["amplitude"],
+        force_range=spread["force_range"],
+        energy=cyc["energy"],
         period=np.diff(rev.peak_times),
-        mean_force=_period_means(ta, Fa, rev.peak_times),
-        mean_x=_period_means(ta, xa, rev.peak_times),
+        mean_force=cyc["mean_F"],
+        mean_x=cyc["mean_x"],
         time=0.5 * (rev.peak_times[:-1] + rev.peak_times[1:]),
     )
     phase = (np.arange(n_points) + 0.5) / n_points
-    phase_sq = sums["sum_phase2"] / count
     x_var = np.clip(sums["sum_xx"] / count - xm * xm, 0.0, None)
     return AveragedLoop(
         phase,
         xm,
         Fm,
         count,
-        x_std,
-        F_std,
+        spread["x_std"],
+        spread["F_std"],
         scatter,
         rev,
         start,
         end,
         phim,
-        phase_sq,
-        bounds,
+        sums["sum_phase2"] / count,
+        cyc["bounds"],
         x_var,
         sums["sum_t"] / count,
+        sensitivity=(cyc["sens_F"], cyc["sens_x"]),
+    )
+
+
+def negated_loop(loop: AveragedLoop) -> AveragedLoop:
+    """The loop of ``-F`` (the same samples' fold with the force negated): exactly what
+    :func:`average_loop` gives for ``-F`` (negation commutes with every sum, mean, spread and
+    loop area: no second fold)."""
+    sc = loop.scatter
+    return replace(
+        loop,
+        F=-loop.F,
+        scatter=replace(sc, energy=-sc.energy, mean_force=-sc.mean_force),
     )
 
 

@@ -391,6 +391,64 @@ class Residuals:
     def __call__(self, v: dict[str, float]) -> np.ndarray:
         return self.residual(v)
 
+    def jacobian(self, v: dict[str, float]) -> dict[str, np.ndarray]:
+        """Analytic ``∂residual/∂(k0, ac, offset, x0, amplitude)`` of an averaged fit
+        (:meth:`residual` unperturbed), from the steady loop's branches in closed form
+        (PHYSICS.md §1): with ``h(y) = (k0/ac)(1 - e^{-ac y})``, ``u = clip(x - x0, ±A)`` and
+        ``s`` half the distance from the branch's turn (``(A - u)/2`` descending, ``(u + A)/2``
+        ascending), ``F = ±(h(A) - 2 h(s))`` plus the bins' curvature term
+        ``±¼ k0 ac e^{-ac s} var(x)`` (:func:`~contactlab.tangential.model.steady_loop_force`,
+        which runs the Masing operator; tests check both against it and finite
+        differences)."""
+        d = self.data
+        if d.on != "averaged":
+            raise InputError("analytic derivatives are those of an averaged fit")
+        k0, ac, x0, A = v["k0"], v["ac"], v["x0"], v["amplitude"]
+        xp = d.xpath
+        n, h = xp.size, xp.size // 2
+        raw = xp - x0
+        u = np.clip(raw, -A, A)
+        inside = (raw > -A) & (raw < A)
+        du_dx0 = np.where(inside, -1.0, 0.0)
+        du_dA = np.where(raw >= A, 1.0, np.where(raw <= -A, -1.0, 0.0))
+        sg = np.r_[np.ones(h), -np.ones(n - h)]  # descending, then ascending bins
+        s = 0.5 * (A - sg * u)
+        ds_dA = 0.5 * (1.0 - sg * du_dA)
+        ds_dx0 = -0.5 * sg * du_dx0
+        e, eA = np.exp(-ac * s), math.exp(-ac * A)
+        hA, hs = -k0 / ac * math.expm1(-ac * A), -k0 / ac * np.expm1(-ac * s)
+        dk0 = sg * (hA - 2.0 * hs) / k0
+        dac = sg * (_h_ac(k0, ac, A) - 2.0 * _h_ac(k0, ac, s))
+        dA = sg * (k0 * eA - 2.0 * k0 * e * ds_dA)
+        dx0 = sg * (-2.0 * k0 * e * ds_dx0)
+        if d.bin_var is not None:
+            G = sg * 0.25 * k0 * ac * e * d.bin_var
+            dk0 = dk0 + G / k0
+            dac = dac + G * (1.0 / ac - s)
+            dA = dA - ac * G * ds_dA
+            dx0 = dx0 - ac * G * ds_dx0
+        sl, w = d.sl, self.w[d.sl]
+        cols = {"k0": dk0, "ac": dac, "offset": np.ones(n), "x0": dx0, "amplitude": dA}
+        out = {k: c[sl] * w for k, c in cols.items()}
+        pr = self.prior
+        if pr is not None:
+            for k in out:
+                rows = [(pr.scale / pr.sigma if k == name else 0.0) for name in pr.names]
+                out[k] = np.concatenate([out[k], rows])
+        return out
+
+
+def _h_ac(k0: float, ac: float, y: Any) -> Any:
+    """``∂h(y)/∂ac`` of ``h(y) = (k0/ac)(1 - e^{-ac y})`` at fixed ``k0``:
+    ``(k0/ac²) g(ac·y)``, ``g(q) = q e^{-q} - (1 - e^{-q})``, by its series below q = 1e-3
+    (``-q²/2 + q³/3 - q⁴/8 + q⁵/30``, truncation below 1e-14 relative), where the two terms
+    cancel (a nearly linear loop, ac → 0)."""
+    q = ac * np.asarray(y, dtype=float)
+    with np.errstate(over="ignore", invalid="ignore"):
+        big = q * np.exp(-q) + np.expm1(-q)
+    small = q * q * (-0.5 + q * (1.0 / 3.0 + q * (-1.0 / 8.0 + q / 30.0)))
+    return k0 / ac**2 * np.where(np.abs(q) < 1e-3, small, big)
+
 
 def _restart(params: list[Parameter], raw: FitResult) -> list[Parameter]:
     """``params`` started from a fit's solution (clipped into their bounds)."""
@@ -428,7 +486,12 @@ def fit(
     (σx estimated from the data), then the turning-point prior rows are added and the fit
     repeated from the solution. Returns ``(fit, final residuals, σx)``."""
     params = start.params
-    raw = least_squares_fit(res, params)
+
+    def jac(r: Residuals) -> Any:
+        # an averaged loop's derivatives in closed form (about 10x fewer model evaluations)
+        return r.jacobian if r.data.on == "averaged" else None
+
+    raw = least_squares_fit(res, params, jac=jac(res))
     x_noise = math.nan
     d = res.data
     if d.on == "signal":
@@ -443,7 +506,7 @@ def fit(
         s_f = math.sqrt(raw.redchi) if raw.redchi > 0 else 1.0
         x0_d, a_d, sig = start.prior
         res = replace(res, prior=PriorRows(names, x0_d, a_d, sig, s_f))
-        raw = least_squares_fit(res, _restart(params, raw))
+        raw = least_squares_fit(res, _restart(params, raw), jac=jac(res))
         _keep_init(raw, params)
     return raw, res, x_noise
 

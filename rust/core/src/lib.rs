@@ -4,6 +4,7 @@
 //!   measured backbones).
 //! - [`masing`]: the Masing operator with non-local memory, cycle counting and loop areas.
 //! - [`signal`]: streaming reversal detection by a hysteresis threshold.
+//! - [`window`]: the per-sample work of one analysis window (fold, cycle areas, detrending).
 //!
 //! Every kernel validates its input and returns [`CoreError`]; none panics on user data.
 
@@ -24,6 +25,7 @@ pub mod masing;
 pub mod normal;
 pub mod signal;
 pub mod structure;
+pub mod window;
 
 pub use curve::{Backbone, Exponential, Tabulated};
 pub use error::CoreError;

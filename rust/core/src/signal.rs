@@ -68,9 +68,12 @@ impl Schmitt {
         done: &mut Vec<Excursion>,
     ) -> Result<(), CoreError> {
         check_finite("x", trigger)?;
+        if let Some(v) = value {
+            // (the trigger itself, checked above, when no separate value is given)
+            check_same_len("x", trigger.len(), "value", v.len())?;
+            check_finite("value", v)?;
+        }
         let value = value.unwrap_or(trigger);
-        check_same_len("x", trigger.len(), "value", value.len())?;
-        check_finite("value", value)?;
         let end = u64::try_from(trigger.len())
             .ok()
             .and_then(|n| self.count.checked_add(n))

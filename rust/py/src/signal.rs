@@ -6,6 +6,7 @@ use contactlab_core::signal::{
     cycle_block, fold_phase, fold_spread, loop_area_sensitivity, loop_areas, period_means,
     CycleState, Excursion, FoldSums, Schmitt,
 };
+use contactlab_core::window::{fold_window, WindowFold as CoreWindowFold};
 use contactlab_core::CoreError;
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadwriteArray1};
 use pyo3::prelude::*;
@@ -371,8 +372,107 @@ fn period_means_py<'py>(
     Ok(m.into_pyarray(py))
 }
 
+/// One analysis window folded (`contactlab_core::window`): fold sums, cycle bounds, loop
+/// areas and their sensitivities, period means.
+#[pyclass(module = "contactlab._core")]
+struct WindowFold {
+    inner: CoreWindowFold,
+}
+
+fn f64_dict<'py>(py: Python<'py>, items: &[(&str, &Vec<f64>)]) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for &(k, v) in items {
+        d.set_item(k, v.clone().into_pyarray(py))?;
+    }
+    Ok(d)
+}
+
+#[pymethods]
+impl WindowFold {
+    /// Per bin sums (`count, sum_x, sum_F, sum_phase, sum_phase2, sum_xx, sum_t`) and
+    /// `first` (each cycle's first sample, -1 for none).
+    fn sums<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let w = &self.inner;
+        let d = f64_dict(
+            py,
+            &[
+                ("count", &w.count),
+                ("sum_x", &w.sum_x),
+                ("sum_F", &w.sum_f),
+                ("sum_phase", &w.sum_phase),
+                ("sum_phase2", &w.sum_phase2),
+                ("sum_xx", &w.sum_xx),
+                ("sum_t", &w.sum_t),
+            ],
+        )?;
+        d.set_item("first", w.first.clone().into_pyarray(py))?;
+        Ok(d)
+    }
+
+    /// As `PhaseFold.spread`: `x_std`, `F_std` per bin, `amplitude`, `force_range` per cycle.
+    fn spread<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let w = &self.inner;
+        f64_dict(
+            py,
+            &[
+                ("x_std", &w.x_std),
+                ("F_std", &w.f_std),
+                ("amplitude", &w.amplitude),
+                ("force_range", &w.force_range),
+            ],
+        )
+    }
+
+    /// Per cycle: `bounds` (n + 1 sample indices), `energy` (loop area), `sens_F`, `sens_x`
+    /// (the area's noise sensitivities), `mean_F`, `mean_x` (period means between the edges).
+    fn cycles<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let w = &self.inner;
+        let d = f64_dict(
+            py,
+            &[
+                ("energy", &w.energy),
+                ("sens_F", &w.sens_f),
+                ("sens_x", &w.sens_x),
+                ("mean_F", &w.mean_f),
+                ("mean_x", &w.mean_x),
+            ],
+        )?;
+        let b: Vec<i64> = w
+            .bounds
+            .iter()
+            .map(|&v| i64::try_from(v).unwrap_or(i64::MAX))
+            .collect();
+        d.set_item("bounds", b.into_pyarray(py))?;
+        Ok(d)
+    }
+}
+
+/// Fold one window (see `contactlab_core::window::fold_window`).
+#[pyfunction]
+#[pyo3(name = "fold_window")]
+#[allow(clippy::too_many_arguments)]
+fn fold_window_py(
+    py: Python<'_>,
+    t: PyReadonlyArray1<'_, f64>,
+    x: PyReadonlyArray1<'_, f64>,
+    f: PyReadonlyArray1<'_, f64>,
+    knot_t: PyReadonlyArray1<'_, f64>,
+    knot_phase: PyReadonlyArray1<'_, f64>,
+    n_bins: usize,
+    n_cycles: usize,
+    edges: PyReadonlyArray1<'_, f64>,
+) -> PyResult<WindowFold> {
+    let (ts, xs, fs) = (slice(&t, "t")?, slice(&x, "x")?, slice(&f, "F")?);
+    let (kt, kp) = (slice(&knot_t, "knot_t")?, slice(&knot_phase, "knot_phase")?);
+    let es = slice(&edges, "edges")?;
+    let inner = detach_guarded(py, || fold_window(ts, xs, fs, kt, kp, n_bins, n_cycles, es))?;
+    Ok(WindowFold { inner })
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PhaseFold>()?;
+    m.add_class::<WindowFold>()?;
+    m.add_function(wrap_pyfunction!(fold_window_py, m)?)?;
     m.add_function(wrap_pyfunction!(loop_areas_py, m)?)?;
     m.add_function(wrap_pyfunction!(loop_area_sensitivity_py, m)?)?;
     m.add_function(wrap_pyfunction!(period_means_py, m)?)?;

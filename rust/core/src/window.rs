@@ -1,0 +1,646 @@
+//! The per-sample work of one analysis window of a tangential recording, in one pass.
+//!
+//! [`fold_window`] folds the window's samples into phase bins (the cycle averaging) and, in
+//! the same pass over the samples (one release of the Python lock), derives everything else
+//! the analysis needs of them: the cycle bounds; each cycle's loop area `∮ F dx` and the
+//! area's noise sensitivities; the period means of `F` and `x` between the peaks; the
+//! cycle-to-cycle spread of the per-cycle bin means and each cycle's half ranges. No
+//! per-cycle-and-bin table is kept: a cycle's bin (a "cell") is a contiguous run of samples
+//! (the phase never decreases), so each cell's mean is complete when the run ends and goes
+//! straight into its bin's running moments (Welford, with the co-moment with the phase that
+//! the spread's phase correction needs). Memory: a few values per bin and per cycle.
+//!
+//! The numbers are those of the separate kernels ([`fold_phase`](crate::signal::fold_phase),
+//! [`fold_spread`](crate::signal::fold_spread), [`loop_areas`](crate::signal::loop_areas),
+//! [`loop_area_sensitivity`](crate::signal::loop_area_sensitivity),
+//! [`period_means`](crate::signal::period_means)) to rounding: the per-bin sums and the
+//! period means bit for bit, the rest to ~1e-12 relative (another summation order).
+
+use crate::error::{check_finite, check_same_len, CoreError};
+
+/// One window folded (see the module docs). Per bin: samples, `Σx`, `ΣF`, `Σφ`, `Σφ²`,
+/// `Σx²`, `Σt` (φ the phase within the cycle), and the cycle-to-cycle spread of the per-cycle
+/// bin means of x and F (phase-corrected as [`crate::signal::fold_spread`]; NaN below two
+/// cycles with samples in the bin). Per cycle: its first sample (-1: none), bounds (`n + 1`
+/// sample indices), loop area (NaN below 3 samples), `Σ coef_F²`, `Σ coef_x²` of the area,
+/// half ranges of its bin means of x and F (NaN without samples). Per period between
+/// consecutive `edges`: the mean of F and of x.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WindowFold {
+    pub n_bins: usize,
+    pub n_cycles: usize,
+    pub count: Vec<f64>,
+    pub sum_x: Vec<f64>,
+    pub sum_f: Vec<f64>,
+    pub sum_phase: Vec<f64>,
+    pub sum_phase2: Vec<f64>,
+    pub sum_xx: Vec<f64>,
+    pub sum_t: Vec<f64>,
+    pub x_std: Vec<f64>,
+    pub f_std: Vec<f64>,
+    pub first: Vec<i64>,
+    pub bounds: Vec<usize>,
+    pub energy: Vec<f64>,
+    pub sens_f: Vec<f64>,
+    pub sens_x: Vec<f64>,
+    pub amplitude: Vec<f64>,
+    pub force_range: Vec<f64>,
+    pub mean_f: Vec<f64>,
+    pub mean_x: Vec<f64>,
+}
+
+/// Running moments of one bin's per-cycle means (Welford): cycles, means of x, F and φ,
+/// their squared deviations and the co-moments of x and F with φ.
+#[derive(Debug, Clone, Copy, Default)]
+struct BinMoments {
+    k: f64,
+    mx: f64,
+    mf: f64,
+    mp: f64,
+    m2x: f64,
+    m2f: f64,
+    m2p: f64,
+    cxp: f64,
+    cfp: f64,
+}
+
+impl BinMoments {
+    fn add(&mut self, x: f64, f: f64, p: f64) {
+        self.k += 1.0;
+        let (dx, df, dp) = (x - self.mx, f - self.mf, p - self.mp);
+        self.mx += dx / self.k;
+        self.mf += df / self.k;
+        self.mp += dp / self.k;
+        let dp_new = p - self.mp;
+        self.m2x += dx * (x - self.mx);
+        self.m2f += df * (f - self.mf);
+        self.m2p += dp * dp_new;
+        self.cxp += dx * dp_new;
+        self.cfp += df * dp_new;
+    }
+
+    /// Sample standard deviation of `m - g φ` (NaN below 2 cycles).
+    fn spread(&self, m2: f64, c: f64, g: f64) -> f64 {
+        if self.k < 2.0 {
+            return f64::NAN;
+        }
+        let var = (m2 - 2.0 * g * c + g * g * self.m2p) / (self.k - 1.0);
+        if var.is_nan() {
+            return f64::NAN; // an empty neighbour bin: no slope (as fold_spread)
+        }
+        var.max(0.0).sqrt()
+    }
+}
+
+/// The loop area (shoelace, scaled and Neumaier-summed as [`crate::masing::loop_area`]) and
+/// the noise sensitivities of one cycle, accumulated sample by sample.
+#[derive(Debug, Clone, Copy, Default)]
+struct CycleArea {
+    m: usize,
+    // scaled, centred samples: the first, the previous
+    x0: f64,
+    f0: f64,
+    xp: f64,
+    fp: f64,
+    sum: f64,
+    comp: f64,
+    // raw samples: the first two and the last two (the cyclic neighbours of the ends)
+    rx: [f64; 2],
+    rf: [f64; 2],
+    lx: [f64; 2],
+    lf: [f64; 2],
+    sens_f: f64,
+    sens_x: f64,
+}
+
+impl CycleArea {
+    fn neumaier(&mut self, term: f64) {
+        let t = self.sum + term;
+        if self.sum.abs() >= term.abs() {
+            self.comp += (self.sum - t) + term;
+        } else {
+            self.comp += (term - t) + self.sum;
+        }
+        self.sum = t;
+    }
+
+    /// Add a sample: `xs`, `fs` scaled and centred, `x`, `f` as recorded.
+    fn push(&mut self, xs: f64, fs: f64, x: f64, f: f64) {
+        if self.m == 0 {
+            (self.x0, self.f0) = (xs, fs);
+        } else {
+            self.neumaier(0.5 * (self.fp + fs) * (xs - self.xp));
+        }
+        if self.m < 2 {
+            self.rx[self.m] = x;
+            self.rf[self.m] = f;
+        }
+        if self.m >= 2 {
+            // the previous sample's neighbours are now known: lx[0] before it, x after it
+            let cf = 0.5 * (self.lx[0] - x);
+            let cx = 0.5 * (f - self.lf[0]);
+            self.sens_f += cf * cf;
+            self.sens_x += cx * cx;
+        }
+        self.lx = [self.lx[1], x];
+        self.lf = [self.lf[1], f];
+        (self.xp, self.fp) = (xs, fs);
+        self.m = self.m.saturating_add(1);
+    }
+
+    /// `(area, Σ coef_F², Σ coef_x²)` of the closed cycle; the area in the samples' units.
+    fn finish(mut self, scale: f64) -> (f64, f64, f64) {
+        if self.m < 3 {
+            return (f64::NAN, 0.0, 0.0);
+        }
+        self.neumaier(0.5 * (self.fp + self.f0) * (self.x0 - self.xp));
+        // the first sample (neighbours: the last and the second) and the last (the one
+        // before it and the first)
+        let (c0f, c0x) = (
+            0.5 * (self.lx[1] - self.rx[1]),
+            0.5 * (self.rf[1] - self.lf[1]),
+        );
+        let (c1f, c1x) = (
+            0.5 * (self.lx[0] - self.rx[0]),
+            0.5 * (self.rf[0] - self.lf[0]),
+        );
+        let sens_f = self.sens_f + c0f * c0f + c1f * c1f;
+        let sens_x = self.sens_x + c0x * c0x + c1x * c1x;
+        ((self.sum + self.comp) * scale, sens_f, sens_x)
+    }
+}
+
+fn bad(name: &'static str, value: f64, reason: &'static str) -> CoreError {
+    CoreError::InvalidParameter {
+        name,
+        value,
+        reason,
+    }
+}
+
+fn check_knots(kt: &[f64], kp: &[f64], n_cycles: usize) -> Result<(), CoreError> {
+    check_same_len("knot_t", kt.len(), "knot_phase", kp.len())?;
+    check_finite("knot_t", kt)?;
+    check_finite("knot_phase", kp)?;
+    if kt.len() < 2 {
+        return Err(CoreError::Empty { name: "knot_t" });
+    }
+    for (i, w) in kt.windows(2).enumerate() {
+        if w[1] <= w[0] {
+            return Err(CoreError::NotIncreasing {
+                name: "knot_t",
+                index: i.saturating_add(1),
+                value: w[1],
+                prev: w[0],
+            });
+        }
+    }
+    let top = kp.last().copied().unwrap_or(0.0);
+    if kp.first().is_some_and(|&p| p < 0.0)
+        || top > n_cycles as f64
+        || kp.windows(2).any(|w| w[1] < w[0])
+    {
+        return Err(bad(
+            "knot_phase",
+            top,
+            "knot phases must be non-decreasing, in [0, n_cycles]",
+        ));
+    }
+    Ok(())
+}
+
+/// Checks `t` (strictly increasing), `x`, `F` (finite, same length) and `edges`
+/// (non-decreasing); returns the largest `|x|` and `|F|` and the mean of F.
+fn check_samples(t: &[f64], x: &[f64], f: &[f64], edges: &[f64]) -> Result<[f64; 3], CoreError> {
+    check_same_len("t", t.len(), "x", x.len())?;
+    check_same_len("t", t.len(), "F", f.len())?;
+    check_finite("t", t)?;
+    check_finite("x", x)?;
+    check_finite("F", f)?;
+    check_finite("edges", edges)?;
+    if t.len() < 2 {
+        return Err(CoreError::Empty { name: "t" });
+    }
+    for (i, w) in t.windows(2).enumerate() {
+        if w[1] <= w[0] {
+            return Err(CoreError::NotIncreasing {
+                name: "t",
+                index: i.saturating_add(1),
+                value: w[1],
+                prev: w[0],
+            });
+        }
+    }
+    for (i, w) in edges.windows(2).enumerate() {
+        if w[1] < w[0] {
+            return Err(CoreError::NotIncreasing {
+                name: "edges",
+                index: i.saturating_add(1),
+                value: w[1],
+                prev: w[0],
+            });
+        }
+    }
+    let sx = x.iter().fold(0.0_f64, |a, &v| a.max(v.abs()));
+    let sf = f.iter().fold(0.0_f64, |a, &v| a.max(v.abs()));
+    // the mean of F / sf (no overflow), the centre of the scaled force
+    let fm = if sf > 0.0 {
+        f.iter().map(|&v| v / sf).sum::<f64>() / f.len() as f64
+    } else {
+        0.0
+    };
+    Ok([sx, sf, fm])
+}
+
+/// Fold `(t, x, F)` (one window, `t` strictly increasing) by the phase knots `(kt, kp)` into
+/// `n_bins` bins per cycle over `n_cycles` cycles, with the phases and bins of
+/// [`crate::signal::fold_phase`], and derive the per-cycle quantities and period means (see
+/// [`WindowFold`]) in the same pass. The samples folded are those with
+/// `kt[0] <= t < kt[last]`; a cycle's samples run from its first folded sample to the next
+/// cycle's (the last to the first sample at or after `kt[last]`).
+// Index arithmetic: b < n_bins and c < n_cycles (checked against the allocations), e < the
+// edges' length inside the loops, i >= 1 where i - 1 is taken.
+#[allow(clippy::arithmetic_side_effects, clippy::too_many_lines)]
+pub fn fold_window(
+    t: &[f64],
+    x: &[f64],
+    f: &[f64],
+    kt: &[f64],
+    kp: &[f64],
+    n_bins: usize,
+    n_cycles: usize,
+    edges: &[f64],
+) -> Result<WindowFold, CoreError> {
+    if n_bins == 0 {
+        return Err(bad("n_bins", 0.0, "must be >= 1"));
+    }
+    if n_cycles > (1 << 32) || n_bins > (1 << 24) {
+        return Err(bad(
+            "n_cycles",
+            n_cycles as f64,
+            "n_cycles × n_bins is too large",
+        ));
+    }
+    check_knots(kt, kp, n_cycles)?;
+    let [sx, sf, fm] = check_samples(t, x, f, edges)?;
+    let (nb, nc) = (n_bins, n_cycles);
+    let z = |k| vec![0.0_f64; k];
+    let mut w = WindowFold {
+        n_bins,
+        n_cycles,
+        count: z(nb),
+        sum_x: z(nb),
+        sum_f: z(nb),
+        sum_phase: z(nb),
+        sum_phase2: z(nb),
+        sum_xx: z(nb),
+        sum_t: z(nb),
+        x_std: z(nb),
+        f_std: z(nb),
+        first: vec![-1; nc],
+        bounds: Vec::new(),
+        energy: vec![f64::NAN; nc],
+        sens_f: z(nc),
+        sens_x: z(nc),
+        amplitude: vec![f64::NAN; nc],
+        force_range: vec![f64::NAN; nc],
+        mean_f: Vec::new(),
+        mean_x: Vec::new(),
+    };
+    let mut moments = vec![BinMoments::default(); nb];
+    let mut ranges = vec![
+        [
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY
+        ];
+        nc
+    ];
+    // scales of the loop areas (as loop_area, over the window: no overflow of the products)
+    let (ux, uf) = (
+        if sx > 0.0 { 1.0 / sx } else { 0.0 },
+        if sf > 0.0 { 1.0 / sf } else { 0.0 },
+    );
+    let area_scale = sx * sf;
+    let (t0, t1) = (kt[0], kt[kt.len() - 1]);
+    let n = t.len();
+    // period means: the cumulative trapezoid integrals and the edges' values (period_means)
+    let mut ce_f = Vec::with_capacity(edges.len());
+    let mut ce_x = Vec::with_capacity(edges.len());
+    let mut e = 0_usize;
+    while e < edges.len() && edges[e] <= t[0] {
+        ce_f.push(0.0);
+        ce_x.push(0.0);
+        e += 1;
+    }
+    let (mut cf, mut cx) = (0.0_f64, 0.0_f64);
+    // the fold
+    let mut j = 0_usize;
+    let seg_slope = |j: usize| (kp[j + 1] - kp[j]) / (kt[j + 1] - kt[j]);
+    let mut slope = seg_slope(0);
+    let mut last_ph = f64::NEG_INFINITY;
+    // the open cell (cycle, bin) and its sums: samples, Σx, ΣF, Σφ
+    let mut cell: Option<(usize, usize)> = None;
+    let mut cell_sums = [0.0_f64; 4];
+    let mut area = CycleArea::default();
+    let mut area_cycle: Option<usize> = None;
+    let mut end = n;
+    let flush_cell =
+        |c: usize, b: usize, s: &[f64; 4], moments: &mut [BinMoments], ranges: &mut [[f64; 4]]| {
+            let (mx, mf, mp) = (s[1] / s[0], s[2] / s[0], s[3] / s[0]);
+            moments[b].add(mx, mf, mp);
+            let r = &mut ranges[c];
+            *r = [r[0].max(mx), r[1].min(mx), r[2].max(mf), r[3].min(mf)];
+        };
+    for i in 0..n {
+        let (ti, xi, fi) = (t[i], x[i], f[i]);
+        if i > 0 {
+            let step_f = 0.5 * (f[i] + f[i - 1]) * (ti - t[i - 1]);
+            let step_x = 0.5 * (x[i] + x[i - 1]) * (ti - t[i - 1]);
+            // edges in [t[i-1], t[i]): period_means' interpolation
+            while e < edges.len() && edges[e] < ti {
+                let ed = edges[e];
+                if ed == t[i - 1] {
+                    ce_f.push(cf);
+                    ce_x.push(cx);
+                } else {
+                    let dt = ti - t[i - 1];
+                    let sl_f = ((cf + step_f) - cf) / dt;
+                    let sl_x = ((cx + step_x) - cx) / dt;
+                    ce_f.push(sl_f * (ed - t[i - 1]) + cf);
+                    ce_x.push(sl_x * (ed - t[i - 1]) + cx);
+                }
+                e += 1;
+            }
+            cf += step_f;
+            cx += step_x;
+        }
+        if !(ti >= t0 && ti < t1) {
+            if ti >= t1 && end == n {
+                end = i;
+            }
+            continue;
+        }
+        if ti < kt[j] {
+            j = 0;
+            slope = seg_slope(0);
+        }
+        if kt[j + 1] <= ti {
+            while kt[j + 1] <= ti {
+                j += 1;
+            }
+            slope = seg_slope(j);
+        }
+        let mut ph = if ti == kt[j] {
+            kp[j]
+        } else {
+            slope * (ti - kt[j]) + kp[j]
+        };
+        // never back (rounding at a knot): each cell stays one run of samples
+        ph = ph.max(last_ph);
+        last_ph = ph;
+        let cfl = ph.floor();
+        let frac = ph - cfl;
+        let c = cfl as usize;
+        if c >= nc {
+            continue;
+        }
+        let b = ((frac * nb as f64) as usize).min(nb - 1);
+        w.count[b] += 1.0;
+        w.sum_x[b] += xi;
+        w.sum_f[b] += fi;
+        w.sum_phase[b] += frac;
+        w.sum_phase2[b] += frac * frac;
+        w.sum_xx[b] += xi * xi;
+        w.sum_t[b] += ti;
+        if cell != Some((c, b)) {
+            if let Some((cc, cb)) = cell {
+                flush_cell(cc, cb, &cell_sums, &mut moments, &mut ranges);
+            }
+            cell = Some((c, b));
+            cell_sums = [0.0; 4];
+        }
+        cell_sums[0] += 1.0;
+        cell_sums[1] += xi;
+        cell_sums[2] += fi;
+        cell_sums[3] += frac;
+        if w.first[c] < 0 {
+            w.first[c] = i64::try_from(i).unwrap_or(i64::MAX);
+        }
+        if area_cycle != Some(c) {
+            if let Some(ac) = area_cycle {
+                (w.energy[ac], w.sens_f[ac], w.sens_x[ac]) = area.finish(area_scale);
+            }
+            area_cycle = Some(c);
+            area = CycleArea::default();
+        }
+        area.push(xi * ux, fi * uf - fm, xi, fi);
+    }
+    if let Some((cc, cb)) = cell {
+        flush_cell(cc, cb, &cell_sums, &mut moments, &mut ranges);
+    }
+    if let Some(ac) = area_cycle {
+        (w.energy[ac], w.sens_f[ac], w.sens_x[ac]) = area.finish(area_scale);
+    }
+    while e < edges.len() {
+        ce_f.push(cf);
+        ce_x.push(cx);
+        e += 1;
+    }
+    for (k, a) in w.energy.iter().enumerate() {
+        if a.is_infinite() {
+            return Err(CoreError::OutOfRange {
+                what: "loop area",
+                index: k,
+                value: *a,
+            });
+        }
+    }
+    let means = |ce: &[f64]| -> Vec<f64> {
+        ce.windows(2)
+            .zip(edges.windows(2))
+            .map(|(c, e)| (c[1] - c[0]) / (e[1] - e[0]))
+            .collect()
+    };
+    w.mean_f = means(&ce_f);
+    w.mean_x = means(&ce_x);
+    // the spread, phase-corrected by each bin's slope along phase (fold_spread)
+    let half_n = nb as f64 / 2.0;
+    let mean_of = |s: &[f64], b: usize| s[b] / w.count[b];
+    for (b, m) in moments.iter().enumerate() {
+        let (bn, bp) = ((b + 1) % nb, (b + nb - 1) % nb);
+        let gx = (mean_of(&w.sum_x, bn) - mean_of(&w.sum_x, bp)) * half_n;
+        let gf = (mean_of(&w.sum_f, bn) - mean_of(&w.sum_f, bp)) * half_n;
+        w.x_std[b] = m.spread(m.m2x, m.cxp, gx);
+        w.f_std[b] = m.spread(m.m2f, m.cfp, gf);
+    }
+    for (c, r) in ranges.iter().enumerate() {
+        if r[0] >= r[1] {
+            w.amplitude[c] = 0.5 * (r[0] - r[1]);
+            w.force_range[c] = 0.5 * (r[2] - r[3]);
+        }
+    }
+    // bounds: each cycle's first sample, an empty cycle starting where the next one does
+    let mut bounds = vec![end; nc + 1];
+    let mut next = end;
+    for (o, &fi) in bounds.iter_mut().zip(&w.first).rev() {
+        if let Ok(v) = usize::try_from(fi) {
+            next = next.min(v);
+        }
+        *o = next;
+    }
+    w.bounds = bounds;
+    Ok(w)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::signal::{
+        fold_phase, fold_spread, loop_area_sensitivity, loop_areas, period_means, FoldSums,
+    };
+    use proptest::prelude::*;
+
+    fn knots(t: &[f64], period: f64, n_cyc: usize) -> (Vec<f64>, Vec<f64>) {
+        // peaks at t0 + k·period, valleys half way
+        let t0 = t[3];
+        let mut kt = Vec::new();
+        let mut kp = Vec::new();
+        for k in 0..=n_cyc {
+            kt.push(t0 + k as f64 * period);
+            kp.push(k as f64);
+            if k < n_cyc {
+                kt.push(t0 + (k as f64 + 0.5) * period);
+                kp.push(k as f64 + 0.5);
+            }
+        }
+        (kt, kp)
+    }
+
+    fn signal(n: usize, seed: u64, scale: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let mut s = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+        let mut noise = move || {
+            s = s
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        let t: Vec<f64> = (0..n).map(|i| 0.37 + i as f64 * 1e-3).collect();
+        let x: Vec<f64> = t
+            .iter()
+            .map(|&v| scale * ((6.0 * v).sin() + 0.01 * noise()))
+            .collect();
+        let f: Vec<f64> = t
+            .iter()
+            .map(|&v| (6.0 * v + 0.4).sin() + 0.05 * noise() + 0.3)
+            .collect();
+        (t, x, f)
+    }
+
+    fn close(a: &[f64], b: &[f64], tol: f64) -> bool {
+        let big = b.iter().fold(
+            0.0_f64,
+            |m, v| if v.is_finite() { m.max(v.abs()) } else { m },
+        );
+        a.len() == b.len()
+            && a.iter().zip(b).all(|(u, v)| {
+                (u.is_nan() && v.is_nan()) || (u - v).abs() <= tol * big.max(f64::MIN_POSITIVE)
+            })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(32))]
+        /// One pass equals the separate kernels: `fold_phase`'s per-bin sums and
+        /// `period_means` bit for bit; `fold_spread`, the bounds numpy derives from the
+        /// fold's first samples, `loop_areas`, `loop_area_sensitivity` to rounding.
+        #[test]
+        fn one_pass_equals_the_separate_kernels(
+            seed in 0u64..1000, n_bins in 4usize..40, n_cyc in 1usize..5, start in 0usize..300,
+            scale in prop::sample::select(vec![1.0, 1e-6, 1e150, 1e-150]),
+        ) {
+            let (t, x, f) = signal(4000, seed, scale);
+            let period = 2.0 * std::f64::consts::PI / 6.0;
+            let (kt, kp) = knots(&t[start..], period, n_cyc);
+            let edges: Vec<f64> = kt.iter().step_by(2).copied().collect();
+            let w = fold_window(&t, &x, &f, &kt, &kp, n_bins, n_cyc, &edges).unwrap();
+            let mut s = FoldSums::new(n_bins, n_cyc).unwrap();
+            fold_phase(&t, &x, &f, 0, &kt, &kp, &mut s).unwrap();
+            prop_assert_eq!(&w.count, &s.count);
+            prop_assert_eq!(&w.sum_x, &s.sum_x);
+            prop_assert_eq!(&w.sum_f, &s.sum_f);
+            prop_assert_eq!(&w.sum_phase, &s.sum_phase);
+            prop_assert_eq!(&w.sum_phase2, &s.sum_phase2);
+            prop_assert_eq!(&w.sum_xx, &s.sum_xx);
+            prop_assert_eq!(&w.sum_t, &s.sum_t);
+            prop_assert_eq!(&w.first, &s.first);
+            let sp = fold_spread(&s).unwrap();
+            prop_assert!(close(&w.x_std, &sp.x_std, 1e-9), "{:?} {:?}", w.x_std, sp.x_std);
+            prop_assert!(close(&w.f_std, &sp.f_std, 1e-9));
+            prop_assert_eq!(&w.amplitude, &sp.amplitude);
+            prop_assert_eq!(&w.force_range, &sp.force_range);
+            // numpy: first = r_[first, end]; where(first < 0, end, first); minimum.accumulate
+            // from the end (end: the first sample at or after the last knot)
+            let end = t.iter().position(|&v| v >= kt[kt.len() - 1]).unwrap_or(t.len());
+            let mut b: Vec<usize> = s
+                .first
+                .iter()
+                .map(|&v| if v < 0 { end } else { v as usize })
+                .chain(std::iter::once(end))
+                .collect();
+            for i in (0..b.len() - 1).rev() {
+                b[i] = b[i].min(b[i + 1]);
+            }
+            prop_assert_eq!(&w.bounds, &b);
+            prop_assert!(close(&w.energy, &loop_areas(&x, &f, &b).unwrap(), 1e-12));
+            let (sf, sx) = loop_area_sensitivity(&x, &f, &b).unwrap();
+            prop_assert!(close(&w.sens_f, &sf, 1e-12));
+            prop_assert!(close(&w.sens_x, &sx, 1e-12));
+            prop_assert_eq!(&w.mean_f, &period_means(&t, &f, &edges).unwrap());
+            prop_assert_eq!(&w.mean_x, &period_means(&t, &x, &edges).unwrap());
+        }
+    }
+
+    #[test]
+    fn short_cycles_and_edges_outside_the_samples() {
+        // 6 samples, two cycles of 1 and 3 samples: NaN area below 3 samples
+        let t = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0];
+        let x = [0.0, 1.0, 0.0, -1.0, 0.0, 1.0];
+        let f = [0.5, 1.0, 0.0, -1.0, -0.5, 1.0];
+        let kt = [0.5, 1.5, 4.5];
+        let kp = [0.0, 1.0, 2.0];
+        let edges = [-1.0, 0.5, 9.0];
+        let w = fold_window(&t, &x, &f, &kt, &kp, 2, 2, &edges).unwrap();
+        assert_eq!(w.bounds, vec![1, 2, 5]);
+        assert!(w.energy[0].is_nan());
+        let a = loop_areas(&x, &f, &[2, 5]).unwrap()[0];
+        assert!((w.energy[1] - a).abs() < 1e-15);
+        assert_eq!(w.mean_f, period_means(&t, &f, &edges).unwrap());
+    }
+
+    #[test]
+    fn bad_input_is_an_error() {
+        let (t, x, f) = signal(2000, 1, 1.0);
+        let (kt, kp) = knots(&t, 1.0, 1);
+        let e = [kt[0], kt[2]];
+        assert!(fold_window(&t, &x, &f, &kt, &kp, 8, 1, &e).is_ok());
+        assert!(fold_window(&t, &x[1..], &f, &kt, &kp, 8, 1, &e).is_err());
+        assert!(fold_window(&t, &x, &f, &kt, &kp, 0, 1, &e).is_err());
+        assert!(fold_window(&t, &x, &f, &kt[..1], &kp[..1], 8, 1, &e).is_err());
+        assert!(fold_window(&t, &x, &f, &kt, &kp, 8, 0, &e).is_err());
+        let mut tb = t.clone();
+        tb[5] = tb[4];
+        assert!(fold_window(&tb, &x, &f, &kt, &kp, 8, 1, &e).is_err());
+        let mut xb = x.clone();
+        xb[7] = f64::NAN;
+        assert!(fold_window(&t, &xb, &f, &kt, &kp, 8, 1, &e).is_err());
+        assert!(fold_window(&t, &x, &f, &kt, &kp, 8, 1, &[e[1], e[0]]).is_err());
+        // areas beyond the double range: an error, not inf
+        let big: Vec<f64> = x.iter().map(|v| v * 1e300).collect();
+        let bigf: Vec<f64> = f.iter().map(|v| v * 1e300).collect();
+        assert!(matches!(
+            fold_window(&t, &big, &bigf, &kt, &kp, 8, 1, &e),
+            Err(CoreError::OutOfRange { .. })
+        ));
+    }
+}
