@@ -28,6 +28,10 @@ pub(super) const KNOWN: u32 = u32::MAX;
 /// the passes.
 pub(super) const BLOCK: usize = 512;
 
+/// A block is run by [`Pass::dense_block`] when the previous one changed branch more often
+/// than once every `DENSE` samples.
+const DENSE: usize = 8;
+
 /// A stretch of a block on one branch: its samples have `h = base + mul · f(u)`, `base` being
 /// `ha`, or the output of in-block sample `src` while that force is deferred.
 #[derive(Clone, Copy)]
@@ -53,14 +57,27 @@ pub(super) fn eval_block<C: Backbone>(
     for (o, &v) in out.iter_mut().zip(u) {
         *o = curve.eval(v);
     }
+    // The bases in order. A deferred base is the output of an earlier sample, mostly one of
+    // the previous run (a reversal's force is the last output of the branch it ends): that
+    // run's base is taken from a register, the others from memory, by an integer select and
+    // without a branch, so the chain from run to run is one select and one add (not a
+    // store-to-load forwarding, nor a mispredicted branch where known and deferred bases
+    // alternate). `mul` is never written here: its load is off the chain.
+    let mut prev_ha = 0.0_f64;
     for k in 0..runs.len() {
         let r = runs[k];
-        if r.src != KNOWN {
-            let s = r.src as usize;
-            let from = runs[rid[s] as usize];
-            runs[k].ha = from.ha + from.mul * out[s];
-            runs[k].src = KNOWN;
-        }
+        let deferred = r.src != KNOWN;
+        // A known base reads (and then ignores) sample 0.
+        let s = pick(deferred, u64::from(r.src), 0) as usize;
+        let fid = usize::from(rid[s]);
+        let term = runs[fid].mul * out[s];
+        let from_prev = fid.wrapping_add(1) == k;
+        let older = runs[fid.min(k.saturating_sub(2))].ha;
+        let from_ha = pickf(from_prev, prev_ha, older);
+        let ha = pickf(deferred, from_ha + term, r.ha);
+        runs[k].ha = ha;
+        runs[k].src = KNOWN;
+        prev_ha = ha;
     }
     for (o, &k) in out.iter_mut().zip(rid) {
         let r = &runs[k as usize];
@@ -105,6 +122,23 @@ struct Pass {
 fn pick(c: bool, a: u64, b: u64) -> u64 {
     let m = 0_u64.wrapping_sub(u64::from(c));
     b ^ ((a ^ b) & m)
+}
+
+/// An integer with the order of the f64 `v` (not NaN): `key(a) < key(b)` exactly when
+/// `a < b`, and `key(-0.0) == key(0.0)`. Sign and magnitude to two's complement.
+#[inline(always)]
+fn key(v: f64) -> i64 {
+    let b = v.to_bits() as i64;
+    let m = b >> 63; // 0, or -1 for a negative sign
+    ((b & i64::MAX) ^ m).wrapping_sub(m)
+}
+
+/// The f64 of a [`key`] (`+0.0` for either zero).
+#[inline(always)]
+fn unkey(k: i64) -> f64 {
+    let m = k >> 63;
+    let mag = (k ^ m).wrapping_sub(m); // |k|
+    f64::from_bits((mag as u64) | ((m as u64) & SIGN))
 }
 
 /// Sign bit of an f64.
@@ -257,6 +291,143 @@ impl Pass {
         nr
     }
 
+    /// First pass for a block where the input reverses often (a random walk reverses every
+    /// ~2 samples; there the predicted test of [`Pass::block`] is a coin toss). Same output
+    /// as [`Pass::block`], without a data-dependent branch in the common case: the candidate
+    /// reversal is always written above the stack top and the top raised by 0 or 1, the
+    /// branch two levels down is always read and kept or not, and a run record is always
+    /// written and counted or not, all by integer selects (a select between two f64 would
+    /// become a branch). The comparisons that decide reversals and closures are made on
+    /// [`key`]s of the inputs, in integer registers, so that the chain from one sample's
+    /// closure to the next (stack top, loaded target, comparison) never crosses to the
+    /// floating-point unit. Left to branches (rare on such a signal): the virgin curve (an
+    /// empty stack) and a closure that reaches the bottom of the stack, both through
+    /// [`Pass::rules`], and a step that closes two or more loops at once. The state lives in
+    /// locals (in registers) and goes through a `Pass` only on those paths. Needs `dir != 0`
+    /// (the first move goes through [`Pass::block`]).
+    #[inline(never)]
+    // `&` on booleans on purpose: no branch per condition.
+    #[allow(clippy::needless_bitwise_bool)]
+    fn dense_block(
+        &mut self,
+        stk: &mut [Reversal],
+        xc: &[f64],
+        u: &mut [f64],
+        rid: &mut [u16],
+        runs: &mut [Run; BLOCK + 2],
+    ) -> usize {
+        self.load_branch(stk); // the top's force may have been resolved since
+        runs[0] = self.record();
+        let mut nr = 1_usize;
+        let (start, lam, inv_lam, h_before) = (self.start, self.lam, self.inv_lam, self.h_before);
+        // Global index of the sample before block position 0.
+        let before = start.wrapping_sub(1);
+        let (mut n, mut xp, mut up) = (self.n, self.xp, self.dir > 0.0);
+        let (mut xa, mut ha, mut src, mut inv) = (self.xa, self.ha, self.src, self.inv);
+        let (mut kxp, mut kxa, mut kt) = (key(xp), key(xa), key(self.target));
+        let samples = xc.iter().zip(u.iter_mut()).zip(rid.iter_mut());
+        for (p, ((&xi, ui), ri)) in samples.enumerate() {
+            let kx = key(xi);
+            let moved = kx != kxp;
+            let rising = kx > kxp;
+            let rev = moved & (rising != up);
+            // Candidate reversal: the previous sample (its force deferred for p > 0).
+            stk[n] = Reversal {
+                x: xp,
+                h: h_before,
+                index: before.wrapping_add(p as u64),
+            };
+            // The branch from it starts there and heads for the current anchor.
+            let kt1 = pick(rev, kxa as u64, kt as u64) as i64;
+            let n1 = n.wrapping_add(usize::from(rev)); // < stk.len()
+                                                       // (x - target) · s >= 0 with s the direction of the step
+            let closes = moved & ((rising & (kx >= kt1)) | (!rising & (kx <= kt1)));
+            if (n == 0) | (closes & (n1 < 4)) {
+                // The virgin curve, or a closure down to the first reversal's branch or
+                // onto the virgin curve: the general rules.
+                let mut q = Pass {
+                    n,
+                    xp,
+                    dir: if up { 1.0 } else { -1.0 },
+                    xa,
+                    ha,
+                    src,
+                    inv,
+                    target: unkey(kt),
+                    ..*self
+                };
+                if q.rules(stk, xi, p) {
+                    runs[nr] = q.record();
+                    nr = nr.wrapping_add(1); // <= BLOCK + 1
+                }
+                (n, xp, up, xa, ha, src, inv) = (q.n, q.xp, q.dir > 0.0, q.xa, q.ha, q.src, q.inv);
+                (kxp, kxa, kt) = (key(xp), key(xa), key(q.target));
+                *ui = (xp - xa) * inv;
+                *ri = nr.wrapping_sub(1) as u16; // nr in 1..=BLOCK + 1
+                continue;
+            }
+            // p - 1, and KNOWN (u32::MAX) for p = 0
+            let src1 = pick(rev, u64::from((p as u32).wrapping_sub(1)), u64::from(src));
+            // An inner loop closes: the branch two levels down, read in any case; its
+            // force is deferred when it was found in this block.
+            let top = stk[n1.saturating_sub(3)];
+            let below = stk[n1.saturating_sub(4)].x;
+            let k = top.index.wrapping_sub(start);
+            let top_src = pick(k < BLOCK as u64, k, u64::from(KNOWN));
+            n = pick(closes, n1.wrapping_sub(2) as u64, n1 as u64) as usize;
+            xa = pickf(closes, top.x, pickf(rev, xp, xa));
+            kxa = pick(closes, key(top.x) as u64, pick(rev, kxp as u64, kxa as u64)) as i64;
+            ha = pickf(closes, top.h, pickf(rev, h_before, ha));
+            src = pick(closes, top_src, src1) as u32;
+            kt = pick(closes, key(below) as u64, kt1 as u64) as i64;
+            up = (moved & rising) | (!moved & up);
+            xp = pickf(moved, xi, xp);
+            kxp = pick(moved, kx as u64, kxp as u64) as i64;
+            inv = inv_lam;
+            if moved & ((rising & (kx >= kt)) | (!rising & (kx <= kt))) {
+                // The step closes further loops (a large jump).
+                let mut q = Pass {
+                    n,
+                    xp,
+                    dir: if up { 1.0 } else { -1.0 },
+                    xa,
+                    ha,
+                    src,
+                    inv,
+                    target: unkey(kt),
+                    ..*self
+                };
+                q.more_closures(stk, xi, q.dir);
+                runs[nr] = q.record();
+                nr = nr.wrapping_add(1); // <= BLOCK + 1
+                (n, xa, ha, src, inv) = (q.n, q.xa, q.ha, q.src, q.inv);
+                (kxa, kt) = (key(xa), key(q.target));
+                *ui = (xp - xa) * inv;
+                *ri = nr.wrapping_sub(1) as u16;
+                continue;
+            }
+            runs[nr] = Run { ha, src, mul: lam };
+            nr = nr.wrapping_add(usize::from(rev | closes)); // <= BLOCK + 1
+            *ui = (xp - xa) * inv_lam;
+            *ri = nr.wrapping_sub(1) as u16;
+        }
+        (self.n, self.xp, self.dir) = (n, xp, if up { 1.0 } else { -1.0 });
+        (self.xa, self.ha, self.src, self.inv) = (xa, ha, src, inv);
+        self.target = unkey(kt);
+        nr
+    }
+
+    /// After a first closure by input `xi` (direction `s`, already the state's direction and
+    /// input), wipe out the further loops the step closes.
+    #[cold]
+    #[inline(never)]
+    fn more_closures(&mut self, stk: &[Reversal], xi: f64, s: f64) {
+        while self.n > 0 && (xi - target_of(stk, self.n)) * s >= 0.0 {
+            self.n = self.n.saturating_sub(self.n.min(2));
+        }
+        self.load_branch(stk);
+    }
+
     /// The block's forces are `out`: resolve the deferred reversal forces.
     #[inline(always)]
     fn end_block(&mut self, stk: &mut [Reversal], out: &[f64]) {
@@ -315,6 +486,7 @@ pub(super) fn scaled_force<C: Backbone>(
     }; BLOCK + 2];
     let mut ub = [0.0_f64; BLOCK];
     let mut rid = [0_u16; BLOCK];
+    let mut dense = false;
     for (xc, oc) in x.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
         let m = xc.len();
         // Room for one candidate above the top per sample.
@@ -323,10 +495,17 @@ pub(super) fn scaled_force<C: Backbone>(
             stack.resize(need, SPARE);
         }
         let stk = stack.as_mut_slice();
+        // The path for this block from the branch changes of the last one.
         let (u, r) = (&mut ub[..m], &mut rid[..m]);
-        let nr = pass.block(stk, xc, u, r, &mut runs);
+        let nr = if dense && pass.dir != 0.0 {
+            pass.dense_block(stk, xc, u, r, &mut runs)
+        } else {
+            pass.block(stk, xc, u, r, &mut runs)
+        };
         eval_block(curve, &mut runs[..nr], u, r, oc);
         pass.end_block(stk, oc);
+        let changes = nr.saturating_sub(1);
+        dense = changes.saturating_mul(DENSE) > m;
         pass.start = pass.start.saturating_add(m as u64);
     }
     stack.truncate(pass.n);
