@@ -124,23 +124,6 @@ fn pick(c: bool, a: u64, b: u64) -> u64 {
     b ^ ((a ^ b) & m)
 }
 
-/// An integer with the order of the f64 `v` (not NaN): `key(a) < key(b)` exactly when
-/// `a < b`, and `key(-0.0) == key(0.0)`. Sign and magnitude to two's complement.
-#[inline(always)]
-fn key(v: f64) -> i64 {
-    let b = v.to_bits() as i64;
-    let m = b >> 63; // 0, or -1 for a negative sign
-    ((b & i64::MAX) ^ m).wrapping_sub(m)
-}
-
-/// The f64 of a [`key`] (`+0.0` for either zero).
-#[inline(always)]
-fn unkey(k: i64) -> f64 {
-    let m = k >> 63;
-    let mag = (k ^ m).wrapping_sub(m); // |k|
-    f64::from_bits((mag as u64) | ((m as u64) & SIGN))
-}
-
 /// Sign bit of an f64.
 const SIGN: u64 = 1 << 63;
 
@@ -293,18 +276,20 @@ impl Pass {
 
     /// First pass for a block where the input reverses often (a random walk reverses every
     /// ~2 samples; there the predicted test of [`Pass::block`] is a coin toss). Same output
-    /// as [`Pass::block`], without a data-dependent branch in the common case: the candidate
-    /// reversal is always written above the stack top and the top raised by 0 or 1, the
-    /// branch two levels down is always read and kept or not, and a run record is always
-    /// written and counted or not, all by integer selects (a select between two f64 would
-    /// become a branch). The comparisons that decide reversals and closures are made on
-    /// [`key`]s of the inputs, in integer registers, so that the chain from one sample's
-    /// closure to the next (stack top, loaded target, comparison) never crosses to the
-    /// floating-point unit. Left to branches (rare on such a signal): the virgin curve (an
-    /// empty stack) and a closure that reaches the bottom of the stack, both through
-    /// [`Pass::rules`], and a step that closes two or more loops at once. The state lives in
-    /// locals (in registers) and goes through a `Pass` only on those paths. Needs `dir != 0`
-    /// (the first move goes through [`Pass::block`]).
+    /// as [`Pass::block`], without a data-dependent branch in the common case.
+    ///
+    /// Only the stack depth `n`, the last input and the direction live in registers: the
+    /// current branch's target is always `stk[n - 2].x` and its anchor `stk[n - 1]` (the
+    /// candidate reversal, always written above the top, is the anchor once the top is raised
+    /// over it), so a reversal raises `n` by one and a closure lowers it by two, by
+    /// arithmetic on the comparison results. The chain from one sample to the next is then
+    /// `n` → load of the target → comparison → `n`; the anchor is loaded off that chain. A run
+    /// record is always written and counted or not.
+    ///
+    /// Left to branches (rare on such a signal): a stack of fewer than two reversals (the
+    /// virgin curve, or the first reversal's branch whose target is a mirror point) and a
+    /// closure down to it, both through [`Pass::rules`]; a step that closes two or more
+    /// loops at once. Needs `dir != 0` (the first move goes through [`Pass::block`]).
     #[inline(never)]
     // `&` on booleans on purpose: no branch per condition.
     #[allow(clippy::needless_bitwise_bool)]
@@ -323,13 +308,10 @@ impl Pass {
         // Global index of the sample before block position 0.
         let before = start.wrapping_sub(1);
         let (mut n, mut xp, mut up) = (self.n, self.xp, self.dir > 0.0);
-        let (mut xa, mut ha, mut src, mut inv) = (self.xa, self.ha, self.src, self.inv);
-        let (mut kxp, mut kxa, mut kt) = (key(xp), key(xa), key(self.target));
         let samples = xc.iter().zip(u.iter_mut()).zip(rid.iter_mut());
         for (p, ((&xi, ui), ri)) in samples.enumerate() {
-            let kx = key(xi);
-            let moved = kx != kxp;
-            let rising = kx > kxp;
+            let moved = xi != xp;
+            let rising = xi > xp;
             let rev = moved & (rising != up);
             // Candidate reversal: the previous sample (its force deferred for p > 0).
             stk[n] = Reversal {
@@ -337,83 +319,64 @@ impl Pass {
                 h: h_before,
                 index: before.wrapping_add(p as u64),
             };
-            // The branch from it starts there and heads for the current anchor.
-            let kt1 = pick(rev, kxa as u64, kt as u64) as i64;
             let n1 = n.wrapping_add(usize::from(rev)); // < stk.len()
-                                                       // (x - target) · s >= 0 with s the direction of the step
-            let closes = moved & ((rising & (kx >= kt1)) | (!rising & (kx <= kt1)));
-            if (n == 0) | (closes & (n1 < 4)) {
-                // The virgin curve, or a closure down to the first reversal's branch or
-                // onto the virgin curve: the general rules.
+            let t = stk[n1.saturating_sub(2)].x;
+            // (x - target) · s >= 0 with s the direction of the step
+            let closes = moved & ((rising & (xi >= t)) | (!rising & (xi <= t)));
+            if (n1 < 2) | (closes & (n1 < 4)) {
+                // The virgin curve or the first reversal's branch, or a closure down to it:
+                // the general rules.
                 let mut q = Pass {
                     n,
                     xp,
                     dir: if up { 1.0 } else { -1.0 },
-                    xa,
-                    ha,
-                    src,
-                    inv,
-                    target: unkey(kt),
                     ..*self
                 };
+                q.load_branch(stk);
                 if q.rules(stk, xi, p) {
                     runs[nr] = q.record();
                     nr = nr.wrapping_add(1); // <= BLOCK + 1
                 }
-                (n, xp, up, xa, ha, src, inv) = (q.n, q.xp, q.dir > 0.0, q.xa, q.ha, q.src, q.inv);
-                (kxp, kxa, kt) = (key(xp), key(xa), key(q.target));
-                *ui = (xp - xa) * inv;
+                (n, xp, up) = (q.n, q.xp, q.dir > 0.0);
+                *ui = (q.xp - q.xa) * q.inv;
                 *ri = nr.wrapping_sub(1) as u16; // nr in 1..=BLOCK + 1
                 continue;
             }
-            // p - 1, and KNOWN (u32::MAX) for p = 0
-            let src1 = pick(rev, u64::from((p as u32).wrapping_sub(1)), u64::from(src));
-            // An inner loop closes: the branch two levels down, read in any case; its
-            // force is deferred when it was found in this block.
-            let top = stk[n1.saturating_sub(3)];
-            let below = stk[n1.saturating_sub(4)].x;
-            let k = top.index.wrapping_sub(start);
-            let top_src = pick(k < BLOCK as u64, k, u64::from(KNOWN));
-            n = pick(closes, n1.wrapping_sub(2) as u64, n1 as u64) as usize;
-            xa = pickf(closes, top.x, pickf(rev, xp, xa));
-            kxa = pick(closes, key(top.x) as u64, pick(rev, kxp as u64, kxa as u64)) as i64;
-            ha = pickf(closes, top.h, pickf(rev, h_before, ha));
-            src = pick(closes, top_src, src1) as u32;
-            kt = pick(closes, key(below) as u64, kt1 as u64) as i64;
+            n = n1.wrapping_sub(usize::from(closes) << 1); // >= 2
             up = (moved & rising) | (!moved & up);
             xp = pickf(moved, xi, xp);
-            kxp = pick(moved, kx as u64, kxp as u64) as i64;
-            inv = inv_lam;
-            if moved & ((rising & (kx >= kt)) | (!rising & (kx <= kt))) {
+            let below = stk[n.wrapping_sub(2)].x;
+            if closes & ((rising & (xi >= below)) | (!rising & (xi <= below))) {
                 // The step closes further loops (a large jump).
                 let mut q = Pass {
                     n,
                     xp,
                     dir: if up { 1.0 } else { -1.0 },
-                    xa,
-                    ha,
-                    src,
-                    inv,
-                    target: unkey(kt),
                     ..*self
                 };
                 q.more_closures(stk, xi, q.dir);
                 runs[nr] = q.record();
                 nr = nr.wrapping_add(1); // <= BLOCK + 1
-                (n, xa, ha, src, inv) = (q.n, q.xa, q.ha, q.src, q.inv);
-                (kxa, kt) = (key(xa), key(q.target));
-                *ui = (xp - xa) * inv;
+                n = q.n;
+                *ui = (xp - q.xa) * q.inv;
                 *ri = nr.wrapping_sub(1) as u16;
                 continue;
             }
-            runs[nr] = Run { ha, src, mul: lam };
+            // The anchor, and whether its force is deferred (found in this block; below
+            // `start` the difference wraps to a huge number: KNOWN).
+            let top = stk[n.wrapping_sub(1)];
+            let src = top.index.wrapping_sub(start).min(u64::from(KNOWN)) as u32;
+            runs[nr] = Run {
+                ha: top.h,
+                src,
+                mul: lam,
+            };
             nr = nr.wrapping_add(usize::from(rev | closes)); // <= BLOCK + 1
-            *ui = (xp - xa) * inv_lam;
+            *ui = (xp - top.x) * inv_lam;
             *ri = nr.wrapping_sub(1) as u16;
         }
         (self.n, self.xp, self.dir) = (n, xp, if up { 1.0 } else { -1.0 });
-        (self.xa, self.ha, self.src, self.inv) = (xa, ha, src, inv);
-        self.target = unkey(kt);
+        self.load_branch(stk);
         nr
     }
 
@@ -446,6 +409,14 @@ impl Pass {
     }
 }
 
+/// Whether every value is finite: one vectorised pass without an early exit (the
+/// `position`-based checks of `crate::error` run a compare and branch per value; they are
+/// called only to name the first bad value once this says there is one).
+pub(super) fn all_finite(v: &[f64]) -> bool {
+    v.chunks(256)
+        .all(|c| c.iter().fold(true, |ok, a| ok & a.is_finite()))
+}
+
 /// Whether [`scaled_force`] can continue from `state`: its reversals precede its sample count
 /// (always so for states this crate produced), and, at count 0, it has not moved yet (a
 /// reversal at the first sample would be sample -1).
@@ -456,13 +427,14 @@ pub(super) fn takes(state: &MasingState) -> bool {
 /// Masing forces of `x` under the scaled branch rule `h = h_r + lam f((x - x_r) / lam)` into
 /// `out` (same length), continuing from `state` and updating it. The caller has validated the
 /// input, checked that `state.count + x.len()` fits in 63 bits, and that [`takes`] `state`.
+/// Returns whether every force is finite (checked block by block while it is in cache).
 pub(super) fn scaled_force<C: Backbone>(
     curve: &C,
     lam: f64,
     x: &[f64],
     out: &mut [f64],
     state: &mut MasingState,
-) {
+) -> bool {
     let stack = &mut state.stack;
     let mut pass = Pass {
         n: stack.len(),
@@ -487,6 +459,7 @@ pub(super) fn scaled_force<C: Backbone>(
     let mut ub = [0.0_f64; BLOCK];
     let mut rid = [0_u16; BLOCK];
     let mut dense = false;
+    let mut finite = true;
     for (xc, oc) in x.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
         let m = xc.len();
         // Room for one candidate above the top per sample.
@@ -503,6 +476,7 @@ pub(super) fn scaled_force<C: Backbone>(
             pass.block(stk, xc, u, r, &mut runs)
         };
         eval_block(curve, &mut runs[..nr], u, r, oc);
+        finite &= all_finite(oc);
         pass.end_block(stk, oc);
         let changes = nr.saturating_sub(1);
         dense = changes.saturating_mul(DENSE) > m;
@@ -514,4 +488,5 @@ pub(super) fn scaled_force<C: Backbone>(
     state.h = h;
     state.dir = dir as i8;
     state.count = end;
+    finite
 }
