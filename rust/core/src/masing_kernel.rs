@@ -58,11 +58,17 @@ pub(super) fn eval_block<C: Backbone>(
         *o = curve.eval(v);
     }
     // The bases in order. A deferred base is the output of an earlier sample, mostly one of
-    // the previous run (a reversal's force is the last output of the branch it ends): that
-    // run's base is taken from a register, the others from memory, by an integer select and
-    // without a branch, so the chain from run to run is one select and one add (not a
-    // store-to-load forwarding, nor a mispredicted branch where known and deferred bases
-    // alternate). `mul` is never written here: its load is off the chain.
+    // the previous run (a reversal's force is the last output of the branch it ends): then
+    // it is `prev + term` with `prev` the previous run's base, in a register. Otherwise it is
+    // a value that needs nothing from the previous run (`other`: a known base, or a deferred
+    // one from an older run, stored at least two runs back). Both as `prev · a + c`, with
+    // `a = 1, c = term` or `a = 0, c = other`, both selected off the chain: the chain from
+    // run to run is one multiply and one add in the floating-point registers — no branch
+    // (known and deferred bases alternate at random on a random walk), no select through the
+    // integer registers, no store-to-load forwarding. `prev · 1 + term` is `prev + term`
+    // exactly; `prev · 0 + other` is `other` (up to the sign of a zero; `prev` finite: a
+    // non-finite force makes the call an error anyway, reported at its first sample). `mul`
+    // is never written here.
     let mut prev_ha = 0.0_f64;
     for k in 0..runs.len() {
         let r = runs[k];
@@ -71,10 +77,11 @@ pub(super) fn eval_block<C: Backbone>(
         let s = pick(deferred, u64::from(r.src), 0) as usize;
         let fid = usize::from(rid[s]);
         let term = runs[fid].mul * out[s];
-        let from_prev = fid.wrapping_add(1) == k;
+        let from_prev = deferred & (fid.wrapping_add(1) == k);
         let older = runs[fid.min(k.saturating_sub(2))].ha;
-        let from_ha = pickf(from_prev, prev_ha, older);
-        let ha = pickf(deferred, from_ha + term, r.ha);
+        let other = pickf(deferred, older + term, r.ha);
+        let a = f64::from(u8::from(from_prev));
+        let ha = prev_ha * a + pickf(from_prev, term, other);
         runs[k].ha = ha;
         runs[k].src = KNOWN;
         prev_ha = ha;
