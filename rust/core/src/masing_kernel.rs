@@ -315,23 +315,51 @@ impl Pass {
         // Global index of the sample before block position 0.
         let before = start.wrapping_sub(1);
         let (mut n, mut xp, mut up) = (self.n, self.xp, self.dir > 0.0);
+        // Curve argument of the last sample (a zero-length step repeats it).
+        let mut ul = (xp - self.xa) * self.inv;
         let samples = xc.iter().zip(u.iter_mut()).zip(rid.iter_mut());
         for (p, ((&xi, ui), ri)) in samples.enumerate() {
-            let moved = xi != xp;
+            if xi == xp {
+                // A zero-length step changes nothing (a predicted branch: rare where the
+                // input reverses often).
+                *ui = ul;
+                *ri = nr.wrapping_sub(1) as u16; // nr in 1..=BLOCK + 1
+                continue;
+            }
             let rising = xi > xp;
-            let rev = moved & (rising != up);
+            if n < 2 {
+                // The virgin curve or the first reversal's branch (whose target is a mirror
+                // point): the general rules.
+                let mut q = Pass {
+                    n,
+                    xp,
+                    dir: if up { 1.0 } else { -1.0 },
+                    ..*self
+                };
+                q.load_branch(stk);
+                if q.rules(stk, xi, p) {
+                    runs[nr] = q.record();
+                    nr = nr.wrapping_add(1); // <= BLOCK + 1
+                }
+                (n, xp, up) = (q.n, q.xp, q.dir > 0.0);
+                ul = (q.xp - q.xa) * q.inv;
+                *ui = ul;
+                *ri = nr.wrapping_sub(1) as u16;
+                continue;
+            }
+            let rev = rising != up;
             // Candidate reversal: the previous sample (its force deferred for p > 0).
             stk[n] = Reversal {
                 x: xp,
                 h: h_before,
                 index: before.wrapping_add(p as u64),
             };
-            let n1 = n.wrapping_add(usize::from(rev)); // < stk.len()
-            let t = stk[n1.saturating_sub(2)].x;
+            let n1 = n.wrapping_add(usize::from(rev)); // in 2..stk.len()
+            let t = stk[n1.wrapping_sub(2)].x;
             // (x - target) · s >= 0 with s the direction of the step
-            let closes = moved & ((rising & (xi >= t)) | (!rising & (xi <= t)));
-            if (n1 < 2) | (closes & (n1 < 4)) {
-                // The virgin curve or the first reversal's branch, or a closure down to it:
+            let closes = (rising & (xi >= t)) | (!rising & (xi <= t));
+            if closes & (n1 < 4) {
+                // A closure down to the first reversal's branch or onto the virgin curve:
                 // the general rules.
                 let mut q = Pass {
                     n,
@@ -345,13 +373,14 @@ impl Pass {
                     nr = nr.wrapping_add(1); // <= BLOCK + 1
                 }
                 (n, xp, up) = (q.n, q.xp, q.dir > 0.0);
-                *ui = (q.xp - q.xa) * q.inv;
-                *ri = nr.wrapping_sub(1) as u16; // nr in 1..=BLOCK + 1
+                ul = (q.xp - q.xa) * q.inv;
+                *ui = ul;
+                *ri = nr.wrapping_sub(1) as u16;
                 continue;
             }
             n = n1.wrapping_sub(usize::from(closes) << 1); // >= 2
-            up = (moved & rising) | (!moved & up);
-            xp = pickf(moved, xi, xp);
+            up = rising;
+            xp = xi;
             let below = stk[n.wrapping_sub(2)].x;
             if closes & ((rising & (xi >= below)) | (!rising & (xi <= below))) {
                 // The step closes further loops (a large jump).
@@ -365,7 +394,8 @@ impl Pass {
                 runs[nr] = q.record();
                 nr = nr.wrapping_add(1); // <= BLOCK + 1
                 n = q.n;
-                *ui = (xp - q.xa) * q.inv;
+                ul = (xp - q.xa) * q.inv;
+                *ui = ul;
                 *ri = nr.wrapping_sub(1) as u16;
                 continue;
             }
@@ -379,7 +409,8 @@ impl Pass {
                 mul: lam,
             };
             nr = nr.wrapping_add(usize::from(rev | closes)); // <= BLOCK + 1
-            *ui = (xp - top.x) * inv_lam;
+            ul = (xp - top.x) * inv_lam;
+            *ui = ul;
             *ri = nr.wrapping_sub(1) as u16;
         }
         (self.n, self.xp, self.dir) = (n, xp, if up { 1.0 } else { -1.0 });
