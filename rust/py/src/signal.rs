@@ -7,7 +7,7 @@ use contactlab_core::signal::{
     CycleState, Excursion, FoldSums, Schmitt,
 };
 use contactlab_core::CoreError;
-use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadwriteArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -119,9 +119,7 @@ fn branch_memory_py<'py>(
 
 /// Forces of several channels, each from the origin with its own model, on up to `threads`
 /// Rust threads inside this one call (GIL released). Channels are handed out one at a time
-/// from a shared counter, so unequal lengths balance. Nothing runs serially but the
-/// argument and result conversion: each output is allocated (and its pages first touched)
-/// by the thread that computes it, and handed to numpy without a copy.
+/// from a shared counter, so unequal lengths balance.
 #[pyfunction]
 fn force_many<'py>(
     py: Python<'py>,
@@ -139,38 +137,48 @@ fn force_many<'py>(
         return Err(input(py, "threads must be >= 1"));
     }
     let inputs: Vec<&[f64]> = xs.iter().map(|x| slice(x, "x")).collect::<PyResult<_>>()?;
+    let outs: Vec<Bound<'py, PyArray1<f64>>> = inputs
+        .iter()
+        .map(|x| PyArray1::<f64>::zeros(py, x.len(), false))
+        .collect();
+    let mut rws: Vec<PyReadwriteArray1<'py, f64>> =
+        outs.iter().map(PyArrayMethods::readwrite).collect();
+    let mut slices: Vec<&mut [f64]> = Vec::with_capacity(rws.len());
+    for rw in &mut rws {
+        slices.push(
+            rw.as_slice_mut()
+                .map_err(|_| input(py, "output not contiguous"))?,
+        );
+    }
     let cores: Vec<&MasingCore> = models.iter().map(|m| &**m).collect();
-    let outs = detach_guarded(py, || run_many(&cores, &inputs, threads))?;
-    Ok(outs.into_iter().map(|v| v.into_pyarray(py)).collect())
+    detach_guarded(py, || run_many(&cores, &inputs, slices, threads))?;
+    drop(rws);
+    Ok(outs)
 }
 
-/// One channel's result, with its number.
-type Channel = (usize, Result<Vec<f64>, CoreError>);
-
-/// Work queue over channels on `threads` scoped threads (an atomic counter hands out the
-/// next channel); each output is allocated in the thread that fills it. The error of the
-/// lowest-numbered failing channel wins.
+/// Work queue over channels on `threads` scoped threads; the first error wins.
 fn run_many(
     cores: &[&MasingCore],
     inputs: &[&[f64]],
+    outs: Vec<&mut [f64]>,
     threads: usize,
-) -> Result<Vec<Vec<f64>>, CoreError> {
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    let next = AtomicUsize::new(0);
+) -> Result<(), CoreError> {
+    let jobs: Vec<(usize, &mut [f64])> = outs.into_iter().enumerate().collect();
+    let queue = std::sync::Mutex::new(jobs);
     let workers = threads.min(inputs.len()).max(1);
-    let done: Vec<Vec<Channel>> = std::thread::scope(|s| {
+    let results: Vec<Result<(), CoreError>> = std::thread::scope(|s| {
         let handles: Vec<_> = (0..workers)
             .map(|_| {
-                s.spawn(|| {
-                    let mut mine = Vec::new();
+                s.spawn(|| -> Result<(), CoreError> {
                     loop {
-                        let i = next.fetch_add(1, Ordering::Relaxed);
-                        let Some(x) = inputs.get(i) else {
-                            return mine;
+                        let job = match queue.lock() {
+                            Ok(mut q) => q.pop(),
+                            Err(_) => None,
                         };
-                        let mut out = vec![0.0; x.len()];
-                        let r = cores[i].force_from_origin(x, &mut out).map(|()| out);
-                        mine.push((i, r));
+                        let Some((i, out)) = job else {
+                            return Ok(());
+                        };
+                        cores[i].force_from_origin(inputs[i], out)?;
                     }
                 })
             })
@@ -180,15 +188,7 @@ fn run_many(
             .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
             .collect()
     });
-    let mut slots: Vec<Option<Result<Vec<f64>, CoreError>>> =
-        std::iter::repeat_with(|| None).take(inputs.len()).collect();
-    for (i, r) in done.into_iter().flatten() {
-        slots[i] = Some(r);
-    }
-    slots
-        .into_iter()
-        .map(|r| r.unwrap_or(Ok(Vec::new())))
-        .collect()
+    results.into_iter().collect()
 }
 
 /// Phase-bin fold of a periodic recording, accumulated chunk by chunk (see
