@@ -77,11 +77,17 @@ pub(super) fn eval_block<C: Backbone>(
         let s = pick(deferred, u64::from(r.src), 0) as usize;
         let fid = usize::from(rid[s]);
         let term = runs[fid].mul * out[s];
-        let from_prev = deferred & (fid.wrapping_add(1) == k);
         let older = runs[fid.min(k.saturating_sub(2))].ha;
-        let other = pickf(deferred, older + term, r.ha);
-        let a = f64::from(u8::from(from_prev));
-        let ha = prev_ha * a + pickf(from_prev, term, other);
+        // Selects by multiplying with 0.0 / 1.0 (every operand finite), the factors computed
+        // in floating point from the indices: LLVM turns integer selects between floats, and
+        // floats converted from booleans, back into branches (coin tosses here).
+        // d = 1 for a deferred base (src < KNOWN), 0 for a known one.
+        let d = (f64::from(KNOWN) - f64::from(r.src)).min(1.0);
+        // a = 1 for a base deferred to the previous run, else 0.
+        let gap = (fid.wrapping_add(1) ^ k) as f64;
+        let a = (d - gap.min(1.0)).max(0.0);
+        let other = r.ha * (1.0 - d) + (older + term) * d;
+        let ha = prev_ha * a + (term * a + other * (1.0 - a));
         runs[k].ha = ha;
         runs[k].src = KNOWN;
         prev_ha = ha;
