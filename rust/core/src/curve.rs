@@ -23,61 +23,114 @@ pub trait Backbone {
     }
 }
 
-/// Taylor coefficients of `expm1(r) / r`, highest first: `1/12!, 1/11!, ..., 1/2!, 1`.
-const EXPM1_COEFFS: [f64; 12] = [
-    1.0 / 479_001_600.0,
-    1.0 / 39_916_800.0,
-    1.0 / 3_628_800.0,
-    1.0 / 362_880.0,
-    1.0 / 40_320.0,
-    1.0 / 5040.0,
-    1.0 / 720.0,
-    1.0 / 120.0,
-    1.0 / 24.0,
-    1.0 / 6.0,
-    1.0 / 2.0,
-    1.0,
+/// `2^(j/64)` for `j = 0..64` as bit patterns of a head (the nearest double) and a tail (the
+/// nearest double to the rest), computed to 80 digits.
+const EXP2_64THS: [[u64; 2]; 64] = [
+    [0x3FF0000000000000, 0x0000000000000000],
+    [0x3FF02C9A3E778061, 0xBC719083535B085D],
+    [0x3FF059B0D3158574, 0x3C8D73E2A475B465],
+    [0x3FF0874518759BC8, 0x3C6186BE4BB284FF],
+    [0x3FF0B5586CF9890F, 0x3C98A62E4ADC610B],
+    [0x3FF0E3EC32D3D1A2, 0x3C403A1727C57B53],
+    [0x3FF11301D0125B51, 0xBC96C51039449B3A],
+    [0x3FF1429AAEA92DE0, 0xBC932FBF9AF1369E],
+    [0x3FF172B83C7D517B, 0xBC819041B9D78A76],
+    [0x3FF1A35BEB6FCB75, 0x3C8E5B4C7B4968E4],
+    [0x3FF1D4873168B9AA, 0x3C9E016E00A2643C],
+    [0x3FF2063B88628CD6, 0x3C8DC775814A8495],
+    [0x3FF2387A6E756238, 0x3C99B07EB6C70573],
+    [0x3FF26B4565E27CDD, 0x3C82BD339940E9D9],
+    [0x3FF29E9DF51FDEE1, 0x3C8612E8AFAD1255],
+    [0x3FF2D285A6E4030B, 0x3C90024754DB41D5],
+    [0x3FF306FE0A31B715, 0x3C86F46AD23182E4],
+    [0x3FF33C08B26416FF, 0x3C932721843659A6],
+    [0x3FF371A7373AA9CB, 0xBC963AEABF42EAE2],
+    [0x3FF3A7DB34E59FF7, 0xBC75E436D661F5E3],
+    [0x3FF3DEA64C123422, 0x3C8ADA0911F09EBC],
+    [0x3FF4160A21F72E2A, 0xBC5EF3691C309278],
+    [0x3FF44E086061892D, 0x3C489B7A04EF80D0],
+    [0x3FF486A2B5C13CD0, 0x3C73C1A3B69062F0],
+    [0x3FF4BFDAD5362A27, 0x3C7D4397AFEC42E2],
+    [0x3FF4F9B2769D2CA7, 0xBC94B309D25957E3],
+    [0x3FF5342B569D4F82, 0xBC807ABE1DB13CAD],
+    [0x3FF56F4736B527DA, 0x3C99BB2C011D93AD],
+    [0x3FF5AB07DD485429, 0x3C96324C054647AD],
+    [0x3FF5E76F15AD2148, 0x3C9BA6F93080E65E],
+    [0x3FF6247EB03A5585, 0xBC9383C17E40B497],
+    [0x3FF6623882552225, 0xBC9BB60987591C34],
+    [0x3FF6A09E667F3BCD, 0xBC9BDD3413B26456],
+    [0x3FF6DFB23C651A2F, 0xBC6BBE3A683C88AB],
+    [0x3FF71F75E8EC5F74, 0xBC816E4786887A99],
+    [0x3FF75FEB564267C9, 0xBC90245957316DD3],
+    [0x3FF7A11473EB0187, 0xBC841577EE04992F],
+    [0x3FF7E2F336CF4E62, 0x3C705D02BA15797E],
+    [0x3FF82589994CCE13, 0xBC9D4C1DD41532D8],
+    [0x3FF868D99B4492ED, 0xBC9FC6F89BD4F6BA],
+    [0x3FF8ACE5422AA0DB, 0x3C96E9F156864B27],
+    [0x3FF8F1AE99157736, 0x3C85CC13A2E3976C],
+    [0x3FF93737B0CDC5E5, 0xBC675FC781B57EBC],
+    [0x3FF97D829FDE4E50, 0xBC9D185B7C1B85D1],
+    [0x3FF9C49182A3F090, 0x3C7C7C46B071F2BE],
+    [0x3FFA0C667B5DE565, 0xBC9359495D1CD533],
+    [0x3FFA5503B23E255D, 0xBC9D2F6EDB8D41E1],
+    [0x3FFA9E6B5579FDBF, 0x3C90FAC90EF7FD31],
+    [0x3FFAE89F995AD3AD, 0x3C97A1CD345DCC81],
+    [0x3FFB33A2B84F15FB, 0xBC62805E3084D708],
+    [0x3FFB7F76F2FB5E47, 0xBC75584F7E54AC3B],
+    [0x3FFBCC1E904BC1D2, 0x3C823DD07A2D9E84],
+    [0x3FFC199BDD85529C, 0x3C811065895048DD],
+    [0x3FFC67F12E57D14B, 0x3C92884DFF483CAD],
+    [0x3FFCB720DCEF9069, 0x3C7503CBD1E949DB],
+    [0x3FFD072D4A07897C, 0xBC9CBC3743797A9C],
+    [0x3FFD5818DCFBA487, 0x3C82ED02D75B3707],
+    [0x3FFDA9E603DB3285, 0x3C9C2300696DB532],
+    [0x3FFDFC97337B9B5F, 0xBC91A5CD4F184B5C],
+    [0x3FFE502EE78B3FF6, 0x3C839E8980A9CC8F],
+    [0x3FFEA4AFA2A490DA, 0xBC9E9C23179C2893],
+    [0x3FFEFA1BEE615A27, 0x3C9DC7F486A4B6B0],
+    [0x3FFF50765B6E4540, 0x3C99D3E12DD8A18B],
+    [0x3FFFA7C1819E90D8, 0x3C874853F3A5931E],
 ];
 
-/// `1 - exp(-z)` for `z >= 0`, accurate to a few ulp for every `z` (small `z` included) and
-/// written without branches or library calls so that loops over it auto-vectorise (SSE2 on a
+/// `1 - exp(-z)` for `z >= 0`, to about an ulp relative for every `z` (small `z` included),
+/// written without branches or library calls so that loops over it vectorise (SSE2 on a
 /// generic x86-64 build). The scalar and vectorised code paths run the same IEEE operations,
 /// so a value computed once per sample and once at a reversal is bit-identical.
 ///
-/// `-z = k ln 2 + r`, `|r| <= ln2 / 2` (Cody–Waite, round-to-nearest by the 1.5·2⁵² trick, no
-/// `round()` call), `p = expm1(r)` by its Taylor polynomial to degree 12 (remainder below
-/// 2e-16 |r|; Estrin's scheme), then `1 - e^{-z} = (1 - 2^k) - 2^k p`: exact `1 - 2^k`, and no cancellation
-/// (for `k = 0` the result is `-p`; for `k <= -1` both terms are at most 1/2 apart in size).
+/// `-z = (64 k + j) ln2/64 + r` with `0 <= j < 64`, `|r| <= ln2/128` (Cody–Waite in two
+/// parts, round-to-nearest by the 1.5·2⁵² trick, no `round()` call), so `e^{-z} = 2^k ·
+/// 2^{j/64} · e^r`; `2^{j/64} = T + t` from a table (head and tail), `p = expm1(r)` by its
+/// Taylor polynomial to degree 6 (remainder below `|r|^7/7! < 3e-20`; Estrin's scheme), then
+/// `1 - e^{-z} = (1 - s) - (s_t + s p)` with `s = 2^k T`, `s_t = 2^k t`. For `k = j = 0`
+/// that is `-p` (no cancellation); for `k = -1` `s` is in `(1/2, 1)` and `1 - s` exact
+/// (Sterbenz), the result at least `1 - 2^{-1/128} ≈ 0.0054` against errors of order `1e-19`
+/// in the bracket; below, the result exceeds 1/2. Checked against libm over the whole range
+/// in `tests/masing_kernel.rs`.
 #[inline(always)]
 pub fn one_minus_exp_neg(z: f64) -> f64 {
-    const LOG2E: f64 = std::f64::consts::LOG2_E;
-    // ln 2 split so that k · LN2_HI is exact for |k| < 2^20.
-    const LN2_HI: f64 = f64::from_bits(0x3FE6_2E42_FEE0_0000); // fdlibm's ln2_hi
-    const LN2_LO: f64 = f64::from_bits(0x3DEA_39EF_3579_3C76); // fdlibm's ln2_lo
+    // 64 / ln 2, and ln 2 / 64 split so that kf · LN2_64_HI is exact for |kf| < 2^20.
+    const INV_LN2_64: f64 = 64.0 * std::f64::consts::LOG2_E;
+    const LN2_64_HI: f64 = f64::from_bits(0x3F86_2E42_FEE0_0000); // fdlibm's ln2_hi / 64
+    const LN2_64_LO: f64 = f64::from_bits(0x3D8A_39EF_3579_3C76); // fdlibm's ln2_lo / 64
     const SHIFTER: f64 = 6_755_399_441_055_744.0; // 1.5 · 2^52
-                                                  // Beyond 708 exp(-z) < 2^-1021: 1 - exp(-z) rounds to 1, and 2^k stays a normal number.
+    // The exponent bias times 64 folded into the shifter: the low bits of `t` are then
+    // `64 (k + 1023) + j >= 0`, a biased exponent and a table index by two shifts and a mask.
+    const BIAS: f64 = 65_472.0; // 1023 · 64
+    // Beyond 708 exp(-z) < 2^-1021: 1 - exp(-z) rounds to 1, and 2^k stays a normal number.
     let z = if z < 708.0 { z } else { 708.0 };
-    let t = -z * LOG2E + SHIFTER;
-    let kf = t - SHIFTER;
-    // Low bits of t hold k in two's complement (|k| < 2^51).
-    let k = (t.to_bits() as i64).wrapping_sub(SHIFTER.to_bits() as i64);
-    let r = (-z - kf * LN2_HI) - kf * LN2_LO;
-    // Estrin's scheme (pairs, then pairs of pairs): about a third of Horner's latency, which
-    // bounds how fast a loop over samples runs (each sample's polynomial is a long chain).
-    let c = &EXPM1_COEFFS; // c[11] = 1, c[10] = 1/2!, ..., c[0] = 1/12!
+    let t = -z * INV_LN2_64 + (SHIFTER + BIAS);
+    let kf = t - (SHIFTER + BIAS);
+    let m = t.to_bits().wrapping_sub(SHIFTER.to_bits()); // 64 (k + 1023) + j, in 102..=65472
+    let r = (-z - kf * LN2_64_HI) - kf * LN2_64_LO;
+    let [head, tail] = EXP2_64THS[(m & 63) as usize];
+    let two_k = f64::from_bits((m >> 6) << 52);
+    let s = f64::from_bits(head) * two_k;
+    let st = f64::from_bits(tail) * two_k;
     let r2 = r * r;
-    let r4 = r2 * r2;
-    let r8 = r4 * r4;
-    let b0 = c[11] + c[10] * r;
-    let b1 = c[9] + c[8] * r;
-    let b2 = c[7] + c[6] * r;
-    let b3 = c[5] + c[4] * r;
-    let b4 = c[3] + c[2] * r;
-    let b5 = c[1] + c[0] * r;
-    let q = ((b0 + b1 * r2) + (b2 + b3 * r2) * r4) + (b4 + b5 * r2) * r8;
+    let q = ((1.0 + r * 0.5) + (1.0 / 6.0 + r * (1.0 / 24.0)) * r2)
+        + (1.0 / 120.0 + r * (1.0 / 720.0)) * (r2 * r2);
     let p = r * q;
-    let two_k = f64::from_bits((k.wrapping_add(1023) << 52) as u64);
-    (1.0 - two_k) - two_k * p
+    (1.0 - s) - (st + s * p)
 }
 
 /// The paper's exponential virgin curve `f(u) = h0 (1 - exp(-ac u))`, odd-extended.
