@@ -62,13 +62,16 @@ pub(super) fn eval_block<C: Backbone>(
     // it is `prev + term` with `prev` the previous run's base, in a register. Otherwise it is
     // a value that needs nothing from the previous run (`other`: a known base, or a deferred
     // one from an older run, stored at least two runs back). Both as `prev · a + c`, with
-    // `a = 1, c = term` or `a = 0, c = other`, both selected off the chain: the chain from
-    // run to run is one multiply and one add in the floating-point registers — no branch
-    // (known and deferred bases alternate at random on a random walk), no select through the
-    // integer registers, no store-to-load forwarding. `prev · 1 + term` is `prev + term`
-    // exactly; `prev · 0 + other` is `other` (up to the sign of a zero; `prev` finite: a
-    // non-finite force makes the call an error anyway, reported at its first sample). `mul`
-    // is never written here.
+    // `a = 1, c = term` or `a = 0, c = other`, `a` and `c` computed off the chain: the chain
+    // from run to run is one multiply and one add in the floating-point registers — no branch
+    // (known and deferred bases alternate at random on a random walk), no store-to-load
+    // forwarding. The selects are products with 0.0 / 1.0 factors, exact for finite operands:
+    // `x · 1 + y · 0` is `x` (up to the sign of a zero). Every operand is finite when the
+    // call can succeed: a non-finite base (a non-finite earlier force) makes it an error
+    // anyway, reported at its first non-finite sample. The placeholder base of a deferred run
+    // is the force before the block: an earlier output, or the state's force, finite in every
+    // state `MasingState::from_slice` accepts or this crate produces. `mul` is never written
+    // here.
     let mut prev_ha = 0.0_f64;
     for k in 0..runs.len() {
         let r = runs[k];
