@@ -124,6 +124,19 @@ def test_force_many_and_out_buffers_equal_force():
         contactlab.force_many(models[0], xs, threads=0)
 
 
+def test_force_many_reports_the_bad_channel_whatever_the_threads():
+    # Outputs are allocated in the worker threads: an error in any channel must still come
+    # back as one typed error (the lowest-numbered bad channel's), no partial list.
+    xs = [np.linspace(0, 1e-5, 300) * k for k in range(1, 6)]
+    xs[3] = xs[3].copy()
+    xs[3][7] = np.inf
+    m = contactlab.Masing(40.0, 4e4)
+    for threads in (1, 2, 4):
+        with pytest.raises(InputError, match="not finite"):
+            contactlab.force_many(m, xs, threads=threads)
+    assert contactlab.force_many(m, [], threads=2) == []
+
+
 def test_phase_fold_equals_numpy_bincount_and_streams():
     from contactlab import _core
     from contactlab.tangential.preprocess import _phase_knots, find_reversals, phase_of

@@ -428,15 +428,20 @@ pub fn run_rule<C: Backbone, O: Observer>(
     if let Some(o) = out.as_deref() {
         crate::error::check_same_len("x", x.len(), "out", o.len())?;
     }
-    crate::error::check_finite("x", x)?;
+    if !kernel::all_finite(x) {
+        crate::error::check_finite("x", x)?;
+    }
     let end = checked_end(state, x.len())?;
     let saved = state.clone(); // restored when the forces overflow
     let range = match (out, rule) {
         // Masing's scaled rule with nobody watching closures: the kernel that defers
         // reversal forces to the curve pass.
         (Some(out), BranchRule::Scaled(lam)) if O::IGNORES && kernel::takes(state) => {
-            kernel::scaled_force(curve, lam, x, out, state);
-            crate::error::check_output("force", out)
+            if kernel::scaled_force(curve, lam, x, out, state) {
+                Ok(())
+            } else {
+                crate::error::check_output("force", out)
+            }
         }
         (out, _) => {
             let mut index = state.count;

@@ -28,6 +28,10 @@ pub(super) const KNOWN: u32 = u32::MAX;
 /// the passes.
 pub(super) const BLOCK: usize = 512;
 
+/// A block is run by [`Pass::dense_block`] when the previous one changed branch more often
+/// than once every `DENSE` samples.
+const DENSE: usize = 8;
+
 /// A stretch of a block on one branch: its samples have `h = base + mul · f(u)`, `base` being
 /// `ha`, or the output of in-block sample `src` while that force is deferred.
 #[derive(Clone, Copy)]
@@ -53,14 +57,43 @@ pub(super) fn eval_block<C: Backbone>(
     for (o, &v) in out.iter_mut().zip(u) {
         *o = curve.eval(v);
     }
+    // The bases in order. A deferred base is the output of an earlier sample, mostly one of
+    // the previous run (a reversal's force is the last output of the branch it ends): then
+    // it is `prev + term` with `prev` the previous run's base, in a register. Otherwise it is
+    // a value that needs nothing from the previous run (`other`: a known base, or a deferred
+    // one from an older run, stored at least two runs back). Both as `prev · a + c`, with
+    // `a = 1, c = term` or `a = 0, c = other`, `a` and `c` computed off the chain: the chain
+    // from run to run is one multiply and one add in the floating-point registers — no branch
+    // (known and deferred bases alternate at random on a random walk), no store-to-load
+    // forwarding. The selects are products with 0.0 / 1.0 factors, exact for finite operands:
+    // `x · 1 + y · 0` is `x` (up to the sign of a zero). Every operand is finite when the
+    // call can succeed: a non-finite base (a non-finite earlier force) makes it an error
+    // anyway, reported at its first non-finite sample. The placeholder base of a deferred run
+    // is the force before the block: an earlier output, or the state's force, finite in every
+    // state `MasingState::from_slice` accepts or this crate produces. `mul` is never written
+    // here.
+    let mut prev_ha = 0.0_f64;
     for k in 0..runs.len() {
         let r = runs[k];
-        if r.src != KNOWN {
-            let s = r.src as usize;
-            let from = runs[rid[s] as usize];
-            runs[k].ha = from.ha + from.mul * out[s];
-            runs[k].src = KNOWN;
-        }
+        let deferred = r.src != KNOWN;
+        // A known base reads (and then ignores) sample 0.
+        let s = pick(deferred, u64::from(r.src), 0) as usize;
+        let fid = usize::from(rid[s]);
+        let term = runs[fid].mul * out[s];
+        let older = runs[fid.min(k.saturating_sub(2))].ha;
+        // Selects by multiplying with 0.0 / 1.0 (every operand finite), the factors computed
+        // in floating point from the indices: LLVM turns integer selects between floats, and
+        // floats converted from booleans, back into branches (coin tosses here).
+        // d = 1 for a deferred base (src < KNOWN), 0 for a known one.
+        let d = (f64::from(KNOWN) - f64::from(r.src)).min(1.0);
+        // a = 1 for a base deferred to the previous run, else 0.
+        let gap = (fid.wrapping_add(1) ^ k) as f64;
+        let a = (d - gap.min(1.0)).max(0.0);
+        let other = r.ha * (1.0 - d) + (older + term) * d;
+        let ha = prev_ha * a + (term * a + other * (1.0 - a));
+        runs[k].ha = ha;
+        runs[k].src = KNOWN;
+        prev_ha = ha;
     }
     for (o, &k) in out.iter_mut().zip(rid) {
         let r = &runs[k as usize];
@@ -257,6 +290,154 @@ impl Pass {
         nr
     }
 
+    /// First pass for a block where the input reverses often (a random walk reverses every
+    /// ~2 samples; there the predicted test of [`Pass::block`] is a coin toss). Same output
+    /// as [`Pass::block`], without a data-dependent branch in the common case.
+    ///
+    /// Only the stack depth `n`, the last input and the direction live in registers: the
+    /// current branch's target is always `stk[n - 2].x` and its anchor `stk[n - 1]` (the
+    /// candidate reversal, always written above the top, is the anchor once the top is raised
+    /// over it), so a reversal raises `n` by one and a closure lowers it by two, by
+    /// arithmetic on the comparison results. The chain from one sample to the next is then
+    /// `n` → load of the target → comparison → `n`; the anchor is loaded off that chain. A run
+    /// record is always written and counted or not.
+    ///
+    /// Left to branches (rare on such a signal): a stack of fewer than two reversals (the
+    /// virgin curve, or the first reversal's branch whose target is a mirror point) and a
+    /// closure down to it, both through [`Pass::rules`]; a step that closes two or more
+    /// loops at once. Needs `dir != 0` (the first move goes through [`Pass::block`]).
+    #[inline(never)]
+    // `&` on booleans on purpose: no branch per condition.
+    #[allow(clippy::needless_bitwise_bool)]
+    fn dense_block(
+        &mut self,
+        stk: &mut [Reversal],
+        xc: &[f64],
+        u: &mut [f64],
+        rid: &mut [u16],
+        runs: &mut [Run; BLOCK + 2],
+    ) -> usize {
+        self.load_branch(stk); // the top's force may have been resolved since
+        runs[0] = self.record();
+        let mut nr = 1_usize;
+        let (start, lam, inv_lam, h_before) = (self.start, self.lam, self.inv_lam, self.h_before);
+        // Global index of the sample before block position 0.
+        let before = start.wrapping_sub(1);
+        let (mut n, mut xp, mut up) = (self.n, self.xp, self.dir > 0.0);
+        // Curve argument of the last sample (a zero-length step repeats it).
+        let mut ul = (xp - self.xa) * self.inv;
+        let samples = xc.iter().zip(u.iter_mut()).zip(rid.iter_mut());
+        for (p, ((&xi, ui), ri)) in samples.enumerate() {
+            if xi == xp {
+                // A zero-length step changes nothing (a predicted branch: rare where the
+                // input reverses often).
+                *ui = ul;
+                *ri = nr.wrapping_sub(1) as u16; // nr in 1..=BLOCK + 1
+                continue;
+            }
+            let rising = xi > xp;
+            if n < 2 {
+                // The virgin curve or the first reversal's branch (whose target is a mirror
+                // point): the general rules.
+                let mut q = Pass {
+                    n,
+                    xp,
+                    dir: if up { 1.0 } else { -1.0 },
+                    ..*self
+                };
+                q.load_branch(stk);
+                if q.rules(stk, xi, p) {
+                    runs[nr] = q.record();
+                    nr = nr.wrapping_add(1); // <= BLOCK + 1
+                }
+                (n, xp, up) = (q.n, q.xp, q.dir > 0.0);
+                ul = (q.xp - q.xa) * q.inv;
+                *ui = ul;
+                *ri = nr.wrapping_sub(1) as u16;
+                continue;
+            }
+            let rev = rising != up;
+            // Candidate reversal: the previous sample (its force deferred for p > 0).
+            stk[n] = Reversal {
+                x: xp,
+                h: h_before,
+                index: before.wrapping_add(p as u64),
+            };
+            let n1 = n.wrapping_add(usize::from(rev)); // in 2..stk.len()
+            let t = stk[n1.wrapping_sub(2)].x;
+            // (x - target) · s >= 0 with s the direction of the step
+            let closes = (rising & (xi >= t)) | (!rising & (xi <= t));
+            if closes & (n1 < 4) {
+                // A closure down to the first reversal's branch or onto the virgin curve:
+                // the general rules.
+                let mut q = Pass {
+                    n,
+                    xp,
+                    dir: if up { 1.0 } else { -1.0 },
+                    ..*self
+                };
+                q.load_branch(stk);
+                if q.rules(stk, xi, p) {
+                    runs[nr] = q.record();
+                    nr = nr.wrapping_add(1); // <= BLOCK + 1
+                }
+                (n, xp, up) = (q.n, q.xp, q.dir > 0.0);
+                ul = (q.xp - q.xa) * q.inv;
+                *ui = ul;
+                *ri = nr.wrapping_sub(1) as u16;
+                continue;
+            }
+            n = n1.wrapping_sub(usize::from(closes) << 1); // >= 2
+            up = rising;
+            xp = xi;
+            let below = stk[n.wrapping_sub(2)].x;
+            if closes & ((rising & (xi >= below)) | (!rising & (xi <= below))) {
+                // The step closes further loops (a large jump).
+                let mut q = Pass {
+                    n,
+                    xp,
+                    dir: if up { 1.0 } else { -1.0 },
+                    ..*self
+                };
+                q.more_closures(stk, xi, q.dir);
+                runs[nr] = q.record();
+                nr = nr.wrapping_add(1); // <= BLOCK + 1
+                n = q.n;
+                ul = (xp - q.xa) * q.inv;
+                *ui = ul;
+                *ri = nr.wrapping_sub(1) as u16;
+                continue;
+            }
+            // The anchor, and whether its force is deferred (found in this block; below
+            // `start` the difference wraps to a huge number: KNOWN).
+            let top = stk[n.wrapping_sub(1)];
+            let src = top.index.wrapping_sub(start).min(u64::from(KNOWN)) as u32;
+            runs[nr] = Run {
+                ha: top.h,
+                src,
+                mul: lam,
+            };
+            nr = nr.wrapping_add(usize::from(rev | closes)); // <= BLOCK + 1
+            ul = (xp - top.x) * inv_lam;
+            *ui = ul;
+            *ri = nr.wrapping_sub(1) as u16;
+        }
+        (self.n, self.xp, self.dir) = (n, xp, if up { 1.0 } else { -1.0 });
+        self.load_branch(stk);
+        nr
+    }
+
+    /// After a first closure by input `xi` (direction `s`, already the state's direction and
+    /// input), wipe out the further loops the step closes.
+    #[cold]
+    #[inline(never)]
+    fn more_closures(&mut self, stk: &[Reversal], xi: f64, s: f64) {
+        while self.n > 0 && (xi - target_of(stk, self.n)) * s >= 0.0 {
+            self.n = self.n.saturating_sub(self.n.min(2));
+        }
+        self.load_branch(stk);
+    }
+
     /// The block's forces are `out`: resolve the deferred reversal forces.
     #[inline(always)]
     fn end_block(&mut self, stk: &mut [Reversal], out: &[f64]) {
@@ -275,6 +456,14 @@ impl Pass {
     }
 }
 
+/// Whether every value is finite: one vectorised pass without an early exit (the
+/// `position`-based checks of `crate::error` run a compare and branch per value; they are
+/// called only to name the first bad value once this says there is one).
+pub(super) fn all_finite(v: &[f64]) -> bool {
+    v.chunks(256)
+        .all(|c| c.iter().fold(true, |ok, a| ok & a.is_finite()))
+}
+
 /// Whether [`scaled_force`] can continue from `state`: its reversals precede its sample count
 /// (always so for states this crate produced), and, at count 0, it has not moved yet (a
 /// reversal at the first sample would be sample -1).
@@ -285,13 +474,14 @@ pub(super) fn takes(state: &MasingState) -> bool {
 /// Masing forces of `x` under the scaled branch rule `h = h_r + lam f((x - x_r) / lam)` into
 /// `out` (same length), continuing from `state` and updating it. The caller has validated the
 /// input, checked that `state.count + x.len()` fits in 63 bits, and that [`takes`] `state`.
+/// Returns whether every force is finite (checked block by block while it is in cache).
 pub(super) fn scaled_force<C: Backbone>(
     curve: &C,
     lam: f64,
     x: &[f64],
     out: &mut [f64],
     state: &mut MasingState,
-) {
+) -> bool {
     let stack = &mut state.stack;
     let mut pass = Pass {
         n: stack.len(),
@@ -315,6 +505,8 @@ pub(super) fn scaled_force<C: Backbone>(
     }; BLOCK + 2];
     let mut ub = [0.0_f64; BLOCK];
     let mut rid = [0_u16; BLOCK];
+    let mut dense = false;
+    let mut finite = true;
     for (xc, oc) in x.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
         let m = xc.len();
         // Room for one candidate above the top per sample.
@@ -323,10 +515,18 @@ pub(super) fn scaled_force<C: Backbone>(
             stack.resize(need, SPARE);
         }
         let stk = stack.as_mut_slice();
+        // The path for this block from the branch changes of the last one.
         let (u, r) = (&mut ub[..m], &mut rid[..m]);
-        let nr = pass.block(stk, xc, u, r, &mut runs);
+        let nr = if dense && pass.dir != 0.0 {
+            pass.dense_block(stk, xc, u, r, &mut runs)
+        } else {
+            pass.block(stk, xc, u, r, &mut runs)
+        };
         eval_block(curve, &mut runs[..nr], u, r, oc);
+        finite &= all_finite(oc);
         pass.end_block(stk, oc);
+        let changes = nr.saturating_sub(1);
+        dense = changes.saturating_mul(DENSE) > m;
         pass.start = pass.start.saturating_add(m as u64);
     }
     stack.truncate(pass.n);
@@ -335,4 +535,5 @@ pub(super) fn scaled_force<C: Backbone>(
     state.h = h;
     state.dir = dir as i8;
     state.count = end;
+    finite
 }

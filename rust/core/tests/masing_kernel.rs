@@ -23,7 +23,19 @@ fn one_minus_exp_neg_is_accurate_everywhere() {
         worst = worst.max((one_minus_exp_neg(z) / want - 1.0).abs());
         z *= 1.001_3;
     }
+    // Densely where the table index and the power of two change (|r| at its largest, and
+    // the cancellation-prone k = -1 range just above ln2/128).
+    for i in 1..200_000 {
+        let z = f64::from(i) * 1e-4;
+        let want = if z < 0.5 {
+            -(-z).exp_m1()
+        } else {
+            1.0 - (-z).exp()
+        };
+        worst = worst.max((one_minus_exp_neg(z) / want - 1.0).abs());
+    }
     assert!(worst < 1e-15, "worst relative error {worst:e}"); // a few ulp
+    eprintln!("one_minus_exp_neg: worst relative error against libm {worst:.2e}");
     assert_eq!(one_minus_exp_neg(0.0), 0.0);
     assert_eq!(one_minus_exp_neg(1e6), 1.0);
 }
@@ -198,5 +210,59 @@ fn states_the_kernel_cannot_continue_take_the_stepping_code() {
         assert_eq!(a, b);
         assert_eq!(sa, sb);
         assert!(a.iter().all(|h| h.is_finite()));
+    }
+}
+
+/// Long stretches that reverse every sample or two (the kernel's dense path takes the block
+/// after one with many branch changes), with what that path leaves to its rare branches mixed
+/// in: repeated values, walks back onto the virgin curve and down to the first reversal's
+/// branch, and jumps that close several loops at once.
+fn dense() -> impl Strategy<Value = Vec<f64>> {
+    let step = prop_oneof![
+        8 => prop::bool::ANY.prop_map(|b| if b { 1.0 } else { -1.0 }),
+        1 => Just(0.0),
+        1 => (-40.0f64..40.0).prop_map(|j| j * 1.5),
+    ];
+    (prop::collection::vec(step, 600..4000), 0.5f64..3.0).prop_map(|(steps, k)| {
+        let mut x = 0.0_f64;
+        steps
+            .into_iter()
+            .map(|d| {
+                // |d| > 1: a jump to a level (which may close many loops), else a step
+                x = if d.abs() > 1.0 { d } else { x + d * k };
+                x * 1e-6
+            })
+            .collect()
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// The dense path (branch-free first pass) against the eager stepper: bit for bit, in one
+    /// pass and in two chunks (a cut moves the blocks, and so which path takes which samples).
+    #[test]
+    fn dense_blocks_equal_the_eager_stepper_bit_for_bit(x in dense(), cut in 0usize..4000) {
+        let c = Exponential::new(40.0, 4.0e4).unwrap();
+        let mut fast = vec![0.0; x.len()];
+        let mut sf = MasingState::default();
+        masing_force(&c, 2.0, &x, &mut fast, &mut sf).unwrap();
+        let mut slow = vec![0.0; x.len()];
+        let mut ss = MasingState::default();
+        run(&c, 2.0, &x, Some(&mut slow), &mut ss, &mut |_: Closure| {}).unwrap();
+        prop_assert_eq!(&fast, &slow);
+        prop_assert_eq!(&sf, &ss);
+        let cut = cut.min(x.len());
+        let mut parts = vec![0.0; x.len()];
+        let mut st = MasingState::default();
+        masing_force(&c, 2.0, &x[..cut], &mut parts[..cut], &mut st).unwrap();
+        masing_force(&c, 2.0, &x[cut..], &mut parts[cut..], &mut st).unwrap();
+        prop_assert_eq!(&fast, &parts);
+        prop_assert_eq!(&sf, &st);
+        let mut want = vec![0.0; x.len()];
+        reference::reference_force(40.0, 4.0e4, 2.0, &x, &mut want, &mut Vec::new());
+        for (a, b) in fast.iter().zip(&want) {
+            prop_assert!((a - b).abs() <= 1e-12 * 40.0, "{} vs {}", a, b);
+        }
     }
 }
