@@ -239,6 +239,25 @@ def _break_time(x: np.ndarray, a: int, b: int, end: int, window: int, sigma: flo
     return best[True][1]
 
 
+def _smooth_peak(g: np.ndarray, window: int) -> float:
+    """Largest value of ``g`` read off a quadratic fitted over half a window either side of
+    its largest sample: the largest of noisy samples overshoots the force by about twice its
+    noise (static equal to kinetic friction: the plateau's noise after the stick), the
+    quadratic averages over the peak instead."""
+    k = int(np.argmax(g))
+    h = max(window // 2, 2)
+    lo, hi = max(k - h, 0), min(k + h + 1, g.size)
+    if hi - lo < 5:
+        return float(g[k])
+    i = np.arange(lo, hi, dtype=float) - k
+    q = np.polynomial.Polynomial.fit(i, g[lo:hi], 2).convert()
+    _, c1, c2 = [*q.coef, 0.0, 0.0][:3]
+    at = [i[0], i[-1]]
+    if c2 < 0:  # a maximum inside the span: the vertex
+        at.append(float(np.clip(-c1 / (2.0 * c2), i[0], i[-1])))
+    return float(np.max(q(np.array(at))))
+
+
 def _breakaway(
     f: np.ndarray,
     x: np.ndarray,
@@ -263,14 +282,15 @@ def _breakaway(
     smooth ramp (the drive's sinusoid), so a quadratic is fitted on the stuck samples clear
     of that half window and read at the instant the displacement starts to move with a jump
     of its acceleration (:func:`_break_time`; without a jump there is no drop to recover).
-    The larger of that and the plain maximum is the breakaway force.
+    The larger of that and the maximum (:func:`_smooth_peak`: not the largest noisy sample)
+    is the breakaway force.
     """
     a, b = span
     n = f.size
     end = b
     while end < n and abs(v[end]) < sliding:
         end += 1
-    peak = float(np.max(np.abs(f[a : min(end + 1, n)])))
+    peak = _smooth_peak(np.abs(f[a : min(end + 1, n)]), window)
     tb = _break_time(x, a, b, end, window, sigma)
     if tb is None:
         return peak
