@@ -5,8 +5,11 @@ Steps (issue 5): (1) fit the base model — Masing with exponential virgin curve
 tangential joint, linear Kelvin-Voigt for a normal joint (PHYSICS.md §1, §2); (2) describe
 where the residual lives (:mod:`.locate`); (3) fit every candidate extension of the current
 model, rank by the error on held-out cycles and accept the best only if it passes the rules
-of :mod:`.select` against the noise level estimated from the data; (4) repeat until no
-candidate helps; (5) report held-out RMS, peak error and loop-energy error after each step.
+of :mod:`.select` against the noise level estimated from the data; (4) after each addition,
+refit without each effect named so far and drop one that, added back, would no longer pass
+those rules (backward elimination: a wrong effect picked first is not kept once the right
+ones are in); repeat until no candidate helps; (5) report held-out RMS, peak error and
+loop-energy error after each step.
 """
 
 from __future__ import annotations
