@@ -396,8 +396,9 @@ def _try_candidate(
     return v, cand
 
 
-#: rounds of the stepwise search (each adds one effect, then drops redundant ones) at most
-MAX_ROUNDS = 8
+#: rounds of the stepwise search (each adds one effect, then drops redundant ones) at most,
+#: per effect the model may hold: room for every addition and as many swaps
+ROUNDS_PER_EFFECT = 2
 
 
 def _drop_check(
@@ -560,7 +561,7 @@ def diagnose(
     untested: list[str] = []
     used = spent.total  # by the base; then as a serial run would count (below)
     visited = {frozenset(effects)}  # effect sets reached (the stepwise search never returns)
-    for _round in range(MAX_ROUNDS):
+    for _round in range(ROUNDS_PER_EFFECT * max_effects + 1):
         tried = [
             n
             for n in names
