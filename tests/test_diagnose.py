@@ -34,8 +34,14 @@ def _check_layout(d: dict) -> None:
         assert set(e) == {"name", "parameters", "stderr"}
         assert all(isinstance(v, float) for v in e["parameters"].values())
     for s in d["steps"]:
-        assert set(s) == {"added", "heldout_rms", "heldout_peak", "energy_error"}
-    assert [s["added"] for s in d["steps"]] == [None] + [e["name"] for e in d["effects"]]
+        assert set(s) == {"added", "removed", "heldout_rms", "heldout_peak", "energy_error"}
+    # forward steps add, backward steps drop: what is left is the effects reported, in order
+    kept = [s["added"] for s in d["steps"][1:] if s["added"] is not None]
+    for s in d["steps"][1:]:
+        if s["removed"] is not None:
+            kept.remove(s["removed"])
+    assert d["steps"][0]["added"] is None and d["steps"][0]["removed"] is None
+    assert kept == [e["name"] for e in d["effects"]]
     assert all(isinstance(w, str) for w in d["where"])
     json.loads(json.dumps(d, allow_nan=False))
 

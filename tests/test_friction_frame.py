@@ -214,3 +214,32 @@ def test_measured_friction_rises_with_the_normal_load(measured):
     # Coulomb: roughly proportional to the disc's weight (450/250 = 1.8); the contact has a
     # preload of its own, so only the order is checked tightly
     assert 1.2 < h2["h0"] / h1["h0"] < 2.4
+
+
+def test_smooth_peak_reads_a_peak_without_the_noise_maximum():
+    """Exact on a noiseless parabola; on a noisy plateau (static equal to kinetic friction)
+    it overshoots less than the largest sample does."""
+    from contactlab.tangential.regime import _smooth_peak
+
+    i = np.arange(60.0)
+    assert _smooth_peak(1.0 - 1e-3 * (i - 31.3) ** 2, 11) == pytest.approx(1.0, abs=1e-9)
+    rng = np.random.default_rng(77)
+    over_max, over_smooth = [], []
+    for _ in range(200):
+        g = 0.8 + rng.normal(0.0, 0.01, 80)
+        over_max.append(np.max(g) - 0.8)
+        over_smooth.append(_smooth_peak(g, 11) - 0.8)
+    assert np.mean(over_smooth) < 0.6 * np.mean(over_max)
+
+
+@pytest.mark.parametrize(("seed", "fs"), [(721, 250.0), (722, 500.0), (723, 1000.0)])
+def test_breakaway_when_static_equals_kinetic_friction(seed, fs):
+    """No drop at breakaway: the breakaway force is the kinetic friction itself (it read up
+    to 8 % high when the largest noisy sample was taken)."""
+    rng = np.random.default_rng(seed)
+    t, x, y, _ = simulate_frame(Fk=0.8, Fs=0.8, fs=fs)
+    sigma = rng.uniform(2e-7, 1e-6)
+    r = frame_friction_force(t, x + rng.normal(0, sigma, x.size), y + rng.normal(0, sigma, x.size),
+                             M=3.08, C=0.669, K=1191.0)  # fmt: skip
+    d = analyze_tangential(r.recording(), warn=False).to_dict()
+    assert d["stick_slip"]["breakaway_force"] == pytest.approx(0.8, rel=0.05)

@@ -42,7 +42,7 @@ def build(report: Any) -> Report:
     r.section("Gap shrink (held-out cycles)")
     rows = [
         {
-            "step": s.added or "base model",
+            "step": s.label,
             "heldout_rms": s.heldout_rms,
             "over_noise": s.heldout_rms / report.noise_rms,
             "heldout_peak": s.heldout_peak,
@@ -68,7 +68,7 @@ def build(report: Any) -> Report:
     r.section("Candidates tried")
     for i, s in enumerate(report.steps):
         if s.candidates:
-            r.subheading(f"after step {i} ({s.added or 'base model'})")
+            r.subheading(f"after step {i} ({s.label})")
             r.table(
                 [v.to_dict() for v in s.candidates],
                 [

@@ -331,9 +331,18 @@ class NormalFamily:
 
     def implausible(self, name: str, p: dict[str, float], d: Prepared) -> str | None:
         """Why a fitted effect cannot be physical on this rig, or None (a channel delay on a
-        single-tone record is not identifiable: :func:`delay_identifiability`)."""
+        single-tone record is not identifiable: :func:`delay_identifiability`; a creep that
+        settles within one excitation period is the record's start-up, not the joint)."""
         if name == "channel_delay" and frequency_span(d) < SINGLE_TONE_SPAN:
             return "a delay cannot be told from the Kelvin-Voigt damping at one frequency"
+        if name == "creep_drift":
+            period = d.cycles.period_samples * d.dt
+            if p["tau_c"] < CREEP_MIN_PERIODS * period:
+                return (
+                    f"the drift settles in τc = {p['tau_c']:.3g} s, within "
+                    f"{CREEP_MIN_PERIODS:g} excitation period ({period:.3g} s): a start-up "
+                    "transient of the record or its model, not creep of the joint"
+                )
         return implausible_common(self.candidates[name], p, d)
 
     def regime(self, p: dict[str, float], d: Prepared) -> str:
@@ -351,6 +360,9 @@ class NormalFamily:
         return loop_area(y, u)
 
 
+#: a creep must take longer than this many excitation periods to settle: a faster "drift"
+#: is the start of the record (a sensor or model transient), which creep cannot be told from
+CREEP_MIN_PERIODS = 1.0
 #: excitation frequencies closer than this ratio count as one frequency for the delay test
 SINGLE_TONE_SPAN = 1.25
 

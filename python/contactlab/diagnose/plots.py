@@ -90,7 +90,7 @@ def plot_location(report: Any, ax: Any = None, bins: int = 20) -> Any:
 def plot_gap(report: Any, ax: Any = None) -> Any:
     """Held-out RMS over the noise level after each step (1 = down to the noise)."""
     ax = _axes(ax)
-    names = ["base"] + [f"+ {s.added}" for s in report.steps[1:]]
+    names = ["base"] + [s.label for s in report.steps[1:]]
     vals = [s.heldout_rms / report.noise_rms for s in report.steps]
     ax.bar(range(len(vals)), vals, color=["C3"] + ["C0"] * (len(vals) - 1))
     ax.axhline(1.0, color="k", lw=0.8, ls="--")

@@ -163,8 +163,16 @@ def fit(
     res = least_squares_fit(resid, params, ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=400)
     w = {n: res.params[n].value for n in names}
     shrink = float(np.sqrt(y.size / n_all))
+    infl = dict.fromkeys(names, 1.0)
+    if n_all == d.y.size and res.jac is not None:  # the fit to all data: its errors are reported
+        lag = int(d.cycles.period_samples // stride)
+        infl.update(zip(res.var_names, stderr_inflation(res.jac, res.residual, lag), strict=True))
     se = {
-        n: (res.params[n].stderr * sc[n] * shrink if res.params[n].stderr is not None else np.inf)
+        n: (
+            res.params[n].stderr * sc[n] * shrink * infl[n]
+            if res.params[n].stderr is not None
+            else np.inf
+        )
         for n in names
     }
     wsum = float(np.sum(sw * sw)) * ys * ys
@@ -179,6 +187,60 @@ def fit(
         res.message,
         res.nfev,
     )
+
+
+def correlation_time(r: np.ndarray, lag: int) -> float:
+    """Integrated autocorrelation time ``1 + 2 Σ ρ_l`` of a residual, in samples (1 for white).
+
+    Geyer's initial positive sequence: lags are summed in pairs ``ρ_l + ρ_(l+1)`` while a pair
+    is positive, up to ``lag``; ``n / time`` is the number of effectively independent samples.
+    """
+    r = r - np.mean(r)
+    n = r.size
+    if n < 4 or not np.any(r):
+        return 1.0
+    f = np.fft.rfft(r, 2 * n)
+    ac = np.fft.irfft(f * np.conj(f), 2 * n)[: min(int(lag), n - 2) + 2]
+    rho = ac / ac[0]
+    total = 1.0
+    for ell in range(1, rho.size - 1, 2):
+        pair = float(rho[ell] + rho[ell + 1])
+        if not pair > 0:
+            break
+        total += 2.0 * pair
+    return total
+
+
+def stderr_inflation(jac: np.ndarray, r: np.ndarray, lag: int) -> np.ndarray:
+    """Factors (>= 1) by which residual autocorrelation widens each parameter's error.
+
+    The least-squares covariance ``s² (JᵀJ)⁻¹`` holds for independent residuals. A model that
+    misses part of a measurement (a real loop it cannot follow everywhere) leaves a residual
+    correlated over many samples, and then far fewer independent residuals back the fit
+    than there are samples. Two corrections, the larger one per parameter, never below 1:
+
+    - the sandwich ``(JᵀJ)⁻¹ S (JᵀJ)⁻¹ · n/(n-p)`` with ``S`` the long-run covariance of the
+      scores ``g_t = J_t r_t`` (Newey-West: Bartlett weights ``1 - l/(L+1)`` up to ``L`` =
+      ``lag`` samples, one excitation period), against the plain covariance;
+    - the effective number of independent residuals ``n / τ`` (:func:`correlation_time`),
+      i.e. ``√τ``: a residual that repeats from cycle to cycle (a systematic misfit) has
+      scores that cancel across the cycle, which the sandwich alone would miss.
+    """
+    n, k = jac.shape
+    if n <= k or k == 0:
+        return np.ones(k)
+    g = jac * r[:, None]
+    S = g.T @ g
+    for ell in range(1, min(int(lag), n - 1) + 1):
+        c = g[ell:].T @ g[:-ell]
+        S += (1.0 - ell / (lag + 1.0)) * (c + c.T)
+    ainv = np.linalg.pinv(jac.T @ jac)
+    plain = np.diag(ainv) * float(r @ r) / (n - k)
+    sand = np.diag(ainv @ S @ ainv) * n / (n - k)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(plain > 0, sand / plain, 1.0)
+    ratio = np.nan_to_num(ratio, nan=1.0, posinf=1.0)
+    return np.sqrt(np.maximum(np.maximum(ratio, correlation_time(r, lag)), 1.0))
 
 
 @dataclass

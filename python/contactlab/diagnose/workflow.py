@@ -5,8 +5,11 @@ Steps (issue 5): (1) fit the base model — Masing with exponential virgin curve
 tangential joint, linear Kelvin-Voigt for a normal joint (PHYSICS.md §1, §2); (2) describe
 where the residual lives (:mod:`.locate`); (3) fit every candidate extension of the current
 model, rank by the error on held-out cycles and accept the best only if it passes the rules
-of :mod:`.select` against the noise level estimated from the data; (4) repeat until no
-candidate helps; (5) report held-out RMS, peak error and loop-energy error after each step.
+of :mod:`.select` against the noise level estimated from the data; (4) after each addition,
+refit without each effect named so far and drop one that, added back, would no longer pass
+those rules (backward elimination: a wrong effect picked first is not kept once the right
+ones are in); repeat until no candidate helps; (5) report held-out RMS, peak error and
+loop-energy error after each step.
 """
 
 from __future__ import annotations
@@ -62,7 +65,9 @@ class Step:
     the held-out cycles (each cycle predicted by the fit that did not see it);
     ``energy_error``: ``Σ |E_model - E_measured| / Σ |E_measured|`` over the held-out cycles,
     ``E`` the loop area of one cycle; ``candidates``: the verdict on each candidate tried
-    after this step.
+    after this step. A step of the backward elimination has ``removed`` set (and ``added``
+    None): the effect dropped because, refitted without it, the model no longer needs it
+    (``removal`` is the verdict on adding it back).
     """
 
     added: str | None
@@ -70,10 +75,21 @@ class Step:
     heldout_peak: float
     energy_error: float
     candidates: tuple[Verdict, ...] = ()
+    #: the effect the backward step dropped (``added`` is None then), with the verdict on it
+    removed: str | None = None
+    removal: Verdict | None = None
+
+    @property
+    def label(self) -> str:
+        """``base model``, ``+ name`` (added) or ``- name`` (dropped by the backward step)."""
+        if self.removed is not None:
+            return f"- {self.removed}"
+        return "base model" if self.added is None else f"+ {self.added}"
 
     def to_dict(self) -> dict[str, Any]:
         return {
             "added": self.added,
+            "removed": self.removed,
             "heldout_rms": self.heldout_rms,
             "heldout_peak": self.heldout_peak,
             "energy_error": _finite_or_none(self.energy_error),
@@ -147,7 +163,7 @@ class DiagnosisReport:
             f"{'step':<24}{'held-out RMS':>14}{'/ noise':>9}{'peak':>12}{'energy err':>12}",
         ]
         for s in self.steps:
-            name = "base model" if s.added is None else f"+ {s.added}"
+            name = s.label
             lines.append(
                 f"{name:<24}{s.heldout_rms:>14.4g}{s.heldout_rms / self.noise_rms:>9.2f}"
                 f"{s.heldout_peak:>12.4g}{100 * s.energy_error:>11.2f}%"
@@ -380,6 +396,43 @@ def _try_candidate(
     return v, cand
 
 
+#: rounds of the stepwise search (each adds one effect, then drops redundant ones) at most,
+#: per effect the model may hold: room for every addition and as many swaps
+ROUNDS_PER_EFFECT = 2
+
+
+def _drop_check(
+    name: str,
+    family: Family,
+    current: Trial,
+    d: Prepared,
+    scales: dict[str, float],
+    folds: int,
+    sigma: float,
+    z: float,
+    min_gain: float,
+    budget: float,
+) -> tuple[Verdict, Trial | None]:
+    """The verdict on keeping ``name`` in the current model (backward elimination).
+
+    The model without ``name`` is refitted (from the current fit) and cross-validated; then
+    ``name`` is judged as a candidate added back to it by the rules of a forward step
+    (:func:`contactlab.diagnose.select.judge`, with the sub-sample delay's budget). Not
+    accepted means the other effects explain what it did: it is dropped. Returns the verdict
+    and the reduced model's trial (None when that could not be fitted: then it is kept).
+    """
+    rest = tuple(e for e in current.effects if e != name)
+    try:
+        reduced = evaluate(family, rest, d, current.full.params, scales, folds)
+    except ConvergenceError as exc:
+        return _not_fitted(name, exc), None
+    extra = 0.0
+    if name == "channel_delay" and abs(current.full.params["tau"]) < d.dt:
+        extra = budget
+    prop = d if getattr(family, "proportional_gain", False) else None
+    return judge(name, reduced, current, sigma, z, min_gain + extra, prop), reduced
+
+
 @one_blas_thread
 def diagnose(
     recording: Any,
@@ -507,8 +560,16 @@ def diagnose(
     all_samples = np.ones(d.y.size, bool)
     untested: list[str] = []
     used = spent.total  # by the base; then as a serial run would count (below)
-    while len(added) < max_effects:
-        tried = [n for n in names if n not in effects and family.check((*effects, n))]
+    visited = {frozenset(effects)}  # effect sets reached (the stepwise search never returns)
+    for _round in range(ROUNDS_PER_EFFECT * max_effects + 1):
+        tried = [
+            n
+            for n in names
+            if len(added) < max_effects
+            and n not in effects
+            and family.check((*effects, n))
+            and frozenset((*effects, n)) not in visited
+        ]
         # the candidates of one step are independent fits: on threads (the model evaluations
         # release the GIL), each verdict in the library's order as a serial run gives it
         try_one = partial(
@@ -551,13 +612,10 @@ def diagnose(
             verdicts.append(v)
             if cand is not None and v.accepted and (best is None or v.gain > best[0].gain):
                 best = (v, cand)
-        steps[-1] = Step(
-            steps[-1].added,
-            steps[-1].heldout_rms,
-            steps[-1].heldout_peak,
-            steps[-1].energy_error,
-            tuple(sorted(verdicts, key=lambda v: v.heldout_rms)),
-        )
+        if verdicts:
+            steps[-1] = dataclasses.replace(
+                steps[-1], candidates=tuple(sorted(verdicts, key=lambda v: v.heldout_rms))
+            )
         if best is None:
             break
         v, current = best
@@ -565,6 +623,32 @@ def diagnose(
         added.append(v.name)
         trials.append(current)
         steps.append(Step(v.name, current.heldout_rms, current.heldout_peak, current.energy_error))
+        visited.add(frozenset(effects))
+        # backward elimination: an effect named early may be redundant once later ones are in
+        while len(added) >= 2 and used < MAX_EVALUATIONS:
+            back = partial(
+                _drop_check, family=family, current=current, d=d, scales=scales,
+                folds=folds, sigma=sigma, z=z, min_gain=min_gain, budget=budget,
+            )  # fmt: skip
+            before = spent.total
+            checks = pmap(back, list(added))
+            used += spent.total - before
+            drop = [(v, r) for v, r in checks if r is not None and not v.accepted]
+            if not drop:
+                break
+            v, current = min(drop, key=lambda vr: vr[0].gain)
+            effects = current.effects
+            added.remove(v.name)
+            trials.append(current)
+            visited.add(frozenset(effects))
+            steps.append(
+                Step(None, current.heldout_rms, current.heldout_peak, current.energy_error,
+                     removed=v.name, removal=v)
+            )  # fmt: skip
+            where.append(
+                f"backward step: {v.name} dropped (refitted without it, the other effects "
+                f"leave it nothing to add: {v.reason})"
+            )
     if untested:
         where.append(
             f"the candidate search stopped after {used} model evaluations (its budget "

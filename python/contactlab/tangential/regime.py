@@ -215,7 +215,8 @@ def _break_time(x: np.ndarray, a: int, b: int, end: int, window: int, sigma: flo
     since the break), fitted by least squares with the break on a grid of tenths of a sample
     between a window before the stick's end and the onset of sliding. Without a drop the
     acceleration grows from zero (``c2 = 0``); the jump is taken as shown only when freeing
-    ``c2`` lowers the squared error by more than ``9 σ²`` (``σ``: the displacement noise).
+    ``c2`` lowers the squared error by more than :func:`_break_threshold` ``· σ²`` (``σ``: the
+    displacement noise).
     """
     hi = min(end + window, x.size)
     lo = max(a + 4, b - window)
@@ -234,9 +235,39 @@ def _break_time(x: np.ndarray, a: int, b: int, end: int, window: int, sigma: flo
             rss = float(np.sum((design @ coef - xs) ** 2))
             if rss < best.get(quad, (np.inf, 0.0))[0]:
                 best[quad] = (rss, float(tb))
-    if True not in best or best[False][0] - best[True][0] <= 9.0 * sigma**2:
+    # the break is searched over many positions: the likelihood-ratio threshold is the χ²(1)
+    # quantile at a 1 % false-alarm rate shared among the whole samples searched (Bonferroni;
+    # a fixed 9 σ² read a drop into 1 in 5 sticks without one and put breakaway 8-10 % high)
+    positions = max(int(min(end + 2, hi - 1) - lo), 1)
+    if True not in best or best[False][0] - best[True][0] <= _break_threshold(positions) * sigma**2:
         return None
     return best[True][1]
+
+
+def _break_threshold(positions: int) -> float:
+    """χ²(1) quantile for a 1 % false-alarm rate over ``positions`` break positions."""
+    from scipy.stats import chi2
+
+    return float(chi2.isf(0.01 / positions, 1))
+
+
+def _smooth_peak(g: np.ndarray, window: int) -> float:
+    """Largest value of ``g`` read off a quadratic fitted over half a window either side of
+    its largest sample: the largest of noisy samples overshoots the force by about twice its
+    noise (static equal to kinetic friction: the plateau's noise after the stick), the
+    quadratic averages over the peak instead."""
+    k = int(np.argmax(g))
+    h = max(window // 2, 2)
+    lo, hi = max(k - h, 0), min(k + h + 1, g.size)
+    if hi - lo < 5:
+        return float(g[k])
+    i = np.arange(lo, hi, dtype=float) - k
+    q = np.polynomial.Polynomial.fit(i, g[lo:hi], 2).convert()
+    _, c1, c2 = [*q.coef, 0.0, 0.0][:3]
+    at = [i[0], i[-1]]
+    if c2 < 0:  # a maximum inside the span: the vertex
+        at.append(float(np.clip(-c1 / (2.0 * c2), i[0], i[-1])))
+    return float(np.max(q(np.array(at))))
 
 
 def _breakaway(
@@ -263,14 +294,15 @@ def _breakaway(
     smooth ramp (the drive's sinusoid), so a quadratic is fitted on the stuck samples clear
     of that half window and read at the instant the displacement starts to move with a jump
     of its acceleration (:func:`_break_time`; without a jump there is no drop to recover).
-    The larger of that and the plain maximum is the breakaway force.
+    The larger of that and the maximum (:func:`_smooth_peak`: not the largest noisy sample)
+    is the breakaway force.
     """
     a, b = span
     n = f.size
     end = b
     while end < n and abs(v[end]) < sliding:
         end += 1
-    peak = float(np.max(np.abs(f[a : min(end + 1, n)])))
+    peak = _smooth_peak(np.abs(f[a : min(end + 1, n)]), window)
     tb = _break_time(x, a, b, end, window, sigma)
     if tb is None:
         return peak

@@ -1,0 +1,89 @@
+"""Stepwise selection (backward elimination), the normal creep's start-up rule and the
+parameter errors under residual autocorrelation (issue 8)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import contactlab
+from contactlab.diagnose import hidden_effect_recording
+from contactlab.diagnose._family import Prepared
+from contactlab.diagnose.candidates_normal import CREEP_MIN_PERIODS, NormalFamily
+from contactlab.diagnose.select import correlation_time, stderr_inflation
+
+
+def _ar1(phi: float, n: int, rng: np.random.Generator) -> np.ndarray:
+    e = rng.normal(size=n)
+    r = np.empty(n)
+    r[0] = e[0] / np.sqrt(1 - phi * phi)
+    for i in range(1, n):
+        r[i] = phi * r[i - 1] + e[i]
+    return r
+
+
+def test_inflation_of_a_mean_under_ar1_matches_the_closed_form():
+    """The error of a mean of AR(1) samples is √((1+φ)/(1-φ)) times the independent one
+    (closed form); white residuals are left alone."""
+    rng = np.random.default_rng(5)
+    n = 20_000
+    jac = np.ones((n, 1))
+    for phi, lo, hi in ((0.0, 1.0, 1.15), (0.8, 0.8, 1.2), (0.95, 0.7, 1.3)):
+        want = np.sqrt((1 + phi) / (1 - phi))
+        got = float(stderr_inflation(jac, _ar1(phi, n, rng), lag=400)[0])
+        assert lo * want <= got <= hi * want, (phi, got, want)
+        tau = correlation_time(_ar1(phi, n, rng), 400)
+        assert tau == pytest.approx((1 + phi) / (1 - phi), rel=0.3)
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    n=st.integers(20, 400),
+    k=st.integers(1, 4),
+    lag=st.integers(0, 60),
+    seed=st.integers(0, 2**31 - 1),
+)
+def test_inflation_is_finite_and_never_narrows(n, k, lag, seed):
+    rng = np.random.default_rng(seed)
+    jac = rng.normal(size=(n, k))
+    jac[:, 0] = 0.0 if seed % 7 == 0 else jac[:, 0]  # a parameter the data do not touch
+    r = rng.normal(size=n) * (seed % 5)  # also all-zero residuals
+    f = stderr_inflation(jac, r, lag)
+    assert f.shape == (k,) and np.all(np.isfinite(f)) and np.all(f >= 1.0)
+
+
+def test_creep_settling_within_a_period_is_a_start_up_transient():
+    t = np.arange(2400) / 200.0
+    p = 5e5 + 1e5 * np.sin(2 * np.pi * t)
+    d = Prepared.build(t, p, p / 1.3e12)
+    fam = NormalFamily()
+    fam.prepare(d)
+    period = d.cycles.period_samples * d.dt
+    fast = {"D": 1e-9, "tau_c": 0.2 * CREEP_MIN_PERIODS * period}
+    why = fam.implausible("creep_drift", fast, d)
+    assert why is not None and "start-up" in why
+    assert fam.implausible("creep_drift", {"D": 1e-9, "tau_c": 3.0 * period}, d) is None
+
+
+def test_backward_step_drops_an_effect_named_too_early():
+    """Behind anti-alias filters at 0.3 / 0.6 of Nyquist a non-Masing branch scale first looks
+    like stick-slip to the forward search; once the scale and the filters' skew are in, the
+    stick-slip adds nothing and the backward step drops it (recorded as a step)."""
+    rec = hidden_effect_recording(
+        ["non_masing_scaling"], magnitude=0.05, noise=0.005, input_noise=0.002,
+        samples_per_cycle=200, anti_alias=(0.3, 0.6), bits=16, seed=92000,
+    )  # fmt: skip
+    rep = contactlab.diagnose(
+        rec, candidates=["non_masing_scaling", "stick_slip", "channel_delay", "force_offset"]
+    )
+    assert sorted(rep.effect_names) == ["channel_delay", "non_masing_scaling"]
+    removed = [s for s in rep.steps if s.removed is not None]
+    assert [s.removed for s in removed] == ["stick_slip"]
+    assert removed[0].added is None and removed[0].label == "- stick_slip"
+    assert not removed[0].removal.accepted
+    assert any(w.startswith("backward step: stick_slip dropped") for w in rep.where)
+    d = rep.to_dict()
+    assert [s["removed"] for s in d["steps"]].count("stick_slip") == 1
+    assert "- stick_slip" in rep.table()
