@@ -312,3 +312,38 @@ def test_analyze_window_threads_from_the_environment(monkeypatch):
         monkeypatch.setenv("CONTACTLAB_ANALYZE_THREADS", bad)
         with pytest.raises(InputError, match="CONTACTLAB_ANALYZE_THREADS"):
             _window_threads()
+
+
+@pytest.mark.parametrize("how", ["flags", "tags"])
+def test_streamed_normal_dynamic_pressure_uses_p0_pa_like_the_whole_file(tmp_path, how, capsys):
+    """A piezo channel (dynamic pressure only, mean zero): ``--stream`` takes ``--p0``/``--pa``
+    (or the file-name tags) as the whole-file analysis does (they were ignored: every window
+    failed asking for p0)."""
+    import contactlab.normal as cn
+    from contactlab.io import Recording
+
+    t, p, d = cn.synthetic_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=24, seed=5041)
+    name = "dyn.h5" if how == "flags" else "C45_p0-0.5MPa_pa-0.4MPa.h5"
+    f = tmp_path / name
+    write_recording(f, Recording(t, {"p": p - 0.5e6, "delta": d}, {"p": "Pa", "delta": "m"}))
+    extra = ["--p0", "0.5MPa", "--pa", "0.4MPa"] if how == "flags" else []
+    whole, streamed = tmp_path / "w.json", tmp_path / "s.json"
+    assert main(["analyze", str(f), "--model", "normal", *extra, "--json", str(whole),
+                 "--no-progress"]) == 0  # fmt: skip
+    assert main(["analyze", str(f), "--model", "normal", *extra, "--stream", "--every",
+                 "8cycles", "--json", str(streamed), "--no-progress"]) == 0  # fmt: skip
+    w, s = json.loads(whole.read_text()), json.loads(streamed.read_text())
+    assert s["streamed"] is True and s["n_windows"] == 3
+    assert w["p0"] == pytest.approx(0.5e6) and s["p0"] == pytest.approx(0.5e6)
+    assert s["pa"] == pytest.approx(w["pa"], rel=0.01)
+    assert abs(s["E_d"] - w["E_d"]) < 3 * math.hypot(w["E_d_stderr"], s["E_d_stderr"])
+    for q in ("psi", "k_tan", "k_sec"):
+        assert s[q] == pytest.approx(w[q], rel=0.02), q
+    # without p0 the channel's mean (zero) is not a static pressure: a clear failure
+    if how == "flags":
+        capsys.readouterr()
+        assert main(["analyze", str(f), "--model", "normal", "--stream", "--every", "8cycles",
+                     "--json", str(tmp_path / "x.json"), "--no-progress"]) != 0  # fmt: skip
+        err = capsys.readouterr().err
+        assert "no window of the streamed analysis" in err and "give the static pressure p0" in err
+        assert "Traceback" not in err and not (tmp_path / "x.json").exists()

@@ -16,6 +16,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import scipy.io
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from contactlab.io import Recording, RecordingError, read_recording, write_recording
 from contactlab.io.mat5check import check_mat5
@@ -333,3 +335,28 @@ def test_file_view_index_answers_as_find_does(tmp_path, monkeypatch, block):
         for needle in (b"TREE", b"HEAP", b"GCOL\x01", b"TRE"):
             for start in range(len(data) + 2):
                 assert v.find(needle, start) == data.find(needle, start), (needle, start)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    data=st.binary(max_size=120).map(lambda b: bytes(b"TREAHP"[c % 6] for c in b)),
+    block=st.integers(1, 40),
+)
+def test_file_view_index_is_every_occurrence(tmp_path_factory, data, block):
+    """The index (the Rust signature search over blocks and their overlaps) holds every
+    occurrence bytes.find gives, overlapping ones ("TT" in "TTT") and those across edges."""
+    from contactlab.io import hdf5
+
+    path = tmp_path_factory.mktemp("idx") / "b.bin"
+    path.write_bytes(data)
+    needles = (b"TREE", b"HEAP", b"EE", b"T")
+    old, hdf5._FileView.BLOCK = hdf5._FileView.BLOCK, block
+    try:
+        with open(path, "rb") as fh:
+            v = hdf5._FileView(fh.fileno(), len(data))
+            v.index(needles)
+    finally:
+        hdf5._FileView.BLOCK = old
+    for nd in needles:
+        ref = [i for i in range(len(data)) if data.startswith(nd, i)]
+        assert v._index[nd] == ref, nd

@@ -73,6 +73,9 @@ class CycleTracker:
 
 def branch_memory(x: _F) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]: ...
 def force_many(models: list[MasingCore], xs: list[_F], threads: int) -> list[_F]: ...
+def signature_positions(
+    block: npt.NDArray[np.uint8], needles: list[bytes], starts_below: int, offset: int
+) -> list[npt.NDArray[np.int64]]: ...
 
 # --- normal contact (contactlab.normal) ---
 def normal_simulate(

@@ -56,11 +56,14 @@ def _summary_line(row: dict, kind: str) -> str:
     return "; ".join(parts)
 
 
-def _streamed(args: argparse.Namespace, entries: list, columns: dict | None, topts: dict) -> int:
+def _streamed(
+    args: argparse.Namespace, entries: list, columns: dict | None, topts: dict, nopts: dict
+) -> int:
     """``--stream``: each file read in chunks, analysed window by window and pooled
     (:func:`contactlab.studies.track`); memory bounded whatever the length."""
     from .. import __version__
     from ..errors import ContactLabError
+    from ..io.recording import RecordingError
     from ..studies.tracking import parse_every, track
 
     parse_every(args.every)
@@ -78,8 +81,14 @@ def _streamed(args: argparse.Namespace, entries: list, columns: dict | None, top
                     columns=columns,
                     fs=args.fs,
                     executor=ex,
-                    options=topts if args.model == "tangential" else None,
+                    options=topts if e.kind == "tangential" else _normal_options(e, nopts),
                 )
+                if res.rows and all(r.get("error") for r in res.rows):
+                    raise RecordingError(
+                        "no window of the streamed analysis could be analysed: "
+                        + "; ".join(sorted({str(r["error"]) for r in res.rows})),
+                        file=str(e.path),
+                    )
             except ContactLabError as exc:
                 if not args.keep_going:
                     raise
@@ -250,7 +259,7 @@ def _handler(args: argparse.Namespace) -> int:
     topts = {"force_sign": args.force_sign}
     nopts = {"p0": args.p0, "pa": args.pa}
     if args.stream:
-        return _streamed(args, entries, columns, topts)
+        return _streamed(args, entries, columns, topts, nopts)
     big: set[int] = set()
     if not args.whole:
         from ..studies.pooled import STREAM_ABOVE

@@ -206,7 +206,11 @@ class _FileView:
 
     def index(self, needles: tuple[bytes, ...]) -> None:
         """Find every occurrence of each of ``needles`` in one pass over the file (each block
-        read once, searched for each needle); :meth:`find` then answers from the index."""
+        read once, searched for every needle by the Rust core with the GIL released:
+        ``memchr``'s memmem, about 10x Python's ``bytes.find``); :meth:`find` then answers
+        from the index."""
+        from .._core import signature_positions
+
         longest = max(len(nd) for nd in needles)
         found: dict[bytes, list[int]] = {nd: [] for nd in needles}
         at = 0
@@ -215,13 +219,12 @@ class _FileView:
             if len(self._buf) < want:
                 self._buf = bytearray(want)
             n = _read_into(self.fd, memoryview(self._buf)[:want], at)
-            for nd, hits in found.items():
-                # matches starting in this block (one starting beyond it is the next block's)
-                end = min(n, self.BLOCK + len(nd) - 1)
-                i = self._buf.find(nd, 0, end)
-                while i != -1:
-                    hits.append(at + i)
-                    i = self._buf.find(nd, i + 1, end)
+            block = np.frombuffer(self._buf, dtype=np.uint8, count=n)
+            # matches starting in this block (one starting beyond it is the next block's)
+            hits = signature_positions(block, list(needles), self.BLOCK, at)
+            del block  # the buffer may be replaced by a larger one (no export held)
+            for nd, h in zip(needles, hits, strict=True):
+                found[nd].extend(h.tolist())
             at += self.BLOCK
         self._at = -1
         self._index = found

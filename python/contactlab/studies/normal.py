@@ -22,6 +22,29 @@ B_UNITS = {"b1": "1/(m·Pa^2)", "b2": "1/(m·Pa)", "b3": "1/m", "b4": "Pa/m"}
 B_PAPER_UNITS = {"b1": "µm⁻¹·MPa⁻²", "b2": "µm⁻¹·MPa⁻¹", "b3": "µm⁻¹", "b4": "MPa/µm"}
 
 
+def loop_options(p: Any, tags: Any, options: Any) -> dict[str, Any]:
+    """The keyword arguments of :func:`~contactlab.normal.analyze_loop` for a recording with
+    pressure channel ``p`` and file-name/manifest ``tags``: ``p0``, ``pa`` as given, else
+    from the tags; ``p0`` dropped when the channel holds the total pressure (its mean is
+    p0); ω from a ``frequency`` tag unless given. Whole-file, streamed and auto-streamed
+    analyses all use this, so that they treat the same options alike."""
+    from ..normal.loop import dynamic_only
+
+    opts = dict(options)
+    for key in ("p0", "pa"):  # the file-name tags and manifest columns, unless given
+        tag = tags.get(key)
+        if opts.get(key) is None and isinstance(tag, float) and math.isfinite(tag):
+            opts[key] = tag
+    if opts.get("p0") is not None and not dynamic_only(p):
+        # a total-pressure channel measures p0 itself (its mean); a given value is the check
+        opts["p0"] = None
+    opts = {k: v for k, v in opts.items() if v is not None or k not in ("p0", "pa")}
+    freq = tags.get("frequency")
+    if "omega" not in opts and isinstance(freq, float) and math.isfinite(freq) and freq > 0:
+        opts["omega"] = 2.0 * math.pi * freq
+    return opts
+
+
 def analyze_normal_recording(
     rec: Any, entry: StudyEntry, **options: Any
 ) -> tuple[Any, dict[str, Any], dict[str, Any]]:
@@ -32,20 +55,8 @@ def analyze_normal_recording(
     the row's ``warnings`` (and the report) rather than raised.
     """
     from ..normal import analyze_loop, fit_pressure_stiffness
-    from ..normal.loop import dynamic_only
 
-    opts = dict(options)
-    for key in ("p0", "pa"):  # the file-name tags and manifest columns, unless given
-        tag = entry.tags.get(key)
-        if opts.get(key) is None and isinstance(tag, float) and math.isfinite(tag):
-            opts[key] = tag
-    if opts.get("p0") is not None and not dynamic_only(rec["p"]):
-        # a total-pressure channel measures p0 itself (its mean); a given value is the check
-        opts["p0"] = None
-    opts = {k: v for k, v in opts.items() if v is not None or k not in ("p0", "pa")}
-    freq = entry.tags.get("frequency")
-    if "omega" not in opts and isinstance(freq, float) and math.isfinite(freq) and freq > 0:
-        opts["omega"] = 2.0 * math.pi * freq
+    opts = loop_options(rec["p"], entry.tags, options)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ContactLabWarning)
         result = analyze_loop(rec.t, rec["p"], rec["delta"], **opts)

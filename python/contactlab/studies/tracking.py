@@ -356,9 +356,12 @@ def _normal_window(
         row["warnings"] = " | ".join(extra["warnings"])
         row["_doc"] = {**doc, **extra}
         return row, units
+    from .normal import loop_options
+
+    opts = loop_options(rec["p"], {}, options)  # the tags are in options (analyze, track)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ContactLabWarning)
-        res = analyze_loop(rec.t, rec["p"], rec["delta"], **dict(options))
+        res = analyze_loop(rec.t, rec["p"], rec["delta"], **opts)
     row, units = _normal_row(res.to_dict())
     row["warnings"] = " | ".join(
         str(w.message) for w in caught if issubclass(w.category, ContactLabWarning)

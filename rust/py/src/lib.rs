@@ -15,6 +15,7 @@ use pyo3::types::PyDict;
 
 mod errors;
 mod normal;
+mod scan;
 mod signal;
 mod structure;
 use errors::{internal, slice, to_pyerr};
@@ -297,5 +298,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     normal::register(m)?;
     structure::register(m)?;
     signal::register(m)?;
+    scan::register(m)?;
     Ok(())
 }
