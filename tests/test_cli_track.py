@@ -347,3 +347,40 @@ def test_streamed_normal_dynamic_pressure_uses_p0_pa_like_the_whole_file(tmp_pat
         err = capsys.readouterr().err
         assert "no window of the streamed analysis" in err and "give the static pressure p0" in err
         assert "Traceback" not in err and not (tmp_path / "x.json").exists()
+
+
+@pytest.mark.parametrize("how", ["flags", "tags"])
+def test_track_normal_dynamic_pressure_takes_p0_pa_and_tags(tmp_path, how, capsys):
+    """``contactlab track`` on a piezo channel (dynamic pressure only) takes ``--p0``/``--pa``
+    or the file-name tags as ``analyze`` does (it had neither: every window failed)."""
+    import contactlab.normal as cn
+    from contactlab.io import Recording
+
+    t, p, d = cn.synthetic_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=24, seed=5043)
+    name = "dyn.h5" if how == "flags" else "C45_p0-0.5MPa_pa-0.4MPa.h5"
+    f = tmp_path / name
+    write_recording(f, Recording(t, {"p": p - 0.5e6, "delta": d}, {"p": "Pa", "delta": "m"}))
+    extra = ["--p0", "0.5MPa", "--pa", "0.4MPa"] if how == "flags" else []
+    whole, tracked = tmp_path / "w.json", tmp_path / "t.json"
+    assert main(["analyze", str(f), "--model", "normal", *extra, "--json", str(whole),
+                 "--no-progress"]) == 0  # fmt: skip
+    assert main(["track", str(f), "--model", "normal", *extra, "--every", "8cycles", "--json",
+                 str(tracked), "--no-progress"]) == 0  # fmt: skip
+    w, tr = json.loads(whole.read_text()), json.loads(tracked.read_text())
+    rows = tr["windows"]
+    assert len(rows) == 3 and not any(r.get("error") for r in rows)
+    for r in rows:
+        assert r["psi"] == pytest.approx(w["psi"], rel=0.05)
+        assert r["k_tan"] == pytest.approx(w["k_tan"], rel=0.05)
+    if how == "flags":  # the flags are for normal contact: refused on a tangential recording
+        from contactlab.tangential import synthetic_recording
+
+        g = tmp_path / "tang.h5"
+        write_recording(g, synthetic_recording(h0=40.0, ac=4e4, amplitude=20e-6, n_cycles=12,
+                                               fs=2000.0, noise=0.01, seed=3))  # fmt: skip
+        capsys.readouterr()
+        assert main(["track", str(g), "--p0", "0.5MPa", "--json", str(tmp_path / "x.json"),
+                     "--no-progress"]) != 0  # fmt: skip
+        err = capsys.readouterr().err
+        assert "--p0/--pa are for normal-contact recordings" in err and "Traceback" not in err
+        assert not (tmp_path / "x.json").exists()

@@ -14,7 +14,9 @@ from __future__ import annotations
 import argparse
 import sys
 
+from ..errors import InputError
 from ._common import (
+    add_pressure_flags,
     add_progress_flags,
     add_workers_flag,
     check_output_targets,
@@ -49,6 +51,7 @@ def _handler(args: argparse.Namespace) -> int:
         from tqdm.auto import tqdm
 
         bar = tqdm(desc="windows", unit="win", file=sys.stderr)
+    options = _options(args)
     print(f"tracking {args.file} every {args.every}", file=say, flush=True)
     try:
         with process_pool(args.workers) as ex:
@@ -60,6 +63,7 @@ def _handler(args: argparse.Namespace) -> int:
                 fs=args.fs,
                 chunk_size=args.chunk_size,
                 executor=ex,
+                options=options,
                 callback=(lambda _row: bar.update(1)) if bar is not None else None,
             )
     finally:
@@ -104,6 +108,24 @@ def _handler(args: argparse.Namespace) -> int:
     return 0
 
 
+def _options(args: argparse.Namespace) -> dict | None:
+    """The per-window analysis options of a normal recording: ``--p0``/``--pa``, else the
+    file-name tags (``p0-0.5MPa``), and ω from a ``frequency`` tag, as ``analyze`` uses them;
+    ``None`` for a tangential recording (where ``--p0``/``--pa`` are refused)."""
+    from ..io import read_chunks
+    from ..studies.manifest import entry_from_file
+    from .analyze import _normal_options
+
+    kind = args.model or read_chunks(args.file, columns=parse_columns(args.columns),
+                                     fs=args.fs).kind  # fmt: skip
+    if kind != "normal":
+        if args.p0 is not None or args.pa is not None:
+            raise InputError(f"{args.file}: --p0/--pa are for normal-contact recordings")
+        return None
+    entry = entry_from_file(args.file, kind="normal")
+    return _normal_options(entry, {"p0": args.p0, "pa": args.pa})
+
+
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "track",
@@ -137,6 +159,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         metavar="N",
         help="samples read at a time (default 1048576)",
     )
+    add_pressure_flags(p)
     add_workers_flag(p, "windows")
     add_progress_flags(p)
     p.set_defaults(handler=_handler)
