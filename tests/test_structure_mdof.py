@@ -163,3 +163,20 @@ def test_cli_identify_several_y_channels(tmp_path, capsys):
     rc = main(["identify", str(csv), "--joint", "jenkins", "--y", "x0_m,x1_m", "--joint-dofs",
                "0,x", "--json", str(tmp_path / "bad.json")])  # fmt: skip
     assert rc != 0 and not (tmp_path / "bad.json").exists()
+
+
+def test_cli_columns_by_bare_name():
+    """``--u u --y x0,x1`` pick the columns ``u [N]``, ``x0 [m]``, ``x1 [m]`` that contactlab's
+    own writers (``simulate structure``, ``write_recording``) head them with."""
+    from contactlab import InputError
+    from contactlab.commands.structure import _pick
+
+    cols = {"t [s]": np.zeros(2), "u [N]": np.zeros(2), "x0 [m]": np.zeros(2), "x1_m": np.zeros(2)}
+    assert _pick(cols, "u", (), "u", "f.csv") == "u [N]"
+    assert _pick(cols, "x1", (), "y", "f.csv") == "x1_m"
+    assert _pick(cols, "x0 [m]", (), "y", "f.csv") == "x0 [m]"
+    with pytest.raises(InputError, match="no column 'x2'"):
+        _pick(cols, "x2", (), "y", "f.csv")
+    both = {"u [N]": np.zeros(2), "u_N": np.zeros(2)}  # ambiguous: refused, not guessed
+    with pytest.raises(InputError, match="no column 'u'"):
+        _pick(both, "u", (), "u", "f.csv")

@@ -66,9 +66,14 @@ def read_table(path: str) -> dict[str, np.ndarray]:
 def _pick(cols: dict[str, np.ndarray], want: str | None, guesses: tuple[str, ...], what: str,
           path: str) -> str:  # fmt: skip
     if want:
-        if want not in cols:
-            raise InputError(f"{path}: no column {want!r} (columns: {', '.join(cols)})")
-        return want
+        if want in cols:
+            return want
+        # a bare name picks the column it heads: "u" for "u [N]" or "u_N" (the headers
+        # contactlab's own writers give)
+        bare = [name for name in cols if _UNIT.sub("", name).strip() == want]
+        if len(bare) == 1:
+            return bare[0]
+        raise InputError(f"{path}: no column {want!r} (columns: {', '.join(cols)})")
     for g in guesses:
         for name in cols:
             low = name.lower()
