@@ -76,3 +76,16 @@ def test_long_clean_record_names_nothing():
     rec = hidden_effect_recording([], seed=23, cycles_per_block=307, samples_per_cycle=1000)
     report = contactlab.diagnose(rec, model="tangential")
     assert report.effect_names == []
+
+
+def test_long_record_of_short_cycles_is_cut_not_decimated():
+    """Fewer than MIN_SAMPLES_PER_CYCLE samples per cycle: no decimation, and the report
+    counts the cycles kept (the factor was 0 and the sentence said "0 of 0 cycles")."""
+    n = 40_000
+    t = np.arange(n) / 1000.0
+    x = 1e-5 * np.sin(2 * np.pi * t * 1000.0 / 20.0)  # 20 samples per cycle
+    F = contactlab.Masing(50.0, 5e4).force(x)
+    tr, _, _, how = reduce_long(t, x, F)
+    assert tr.size == 24_000
+    assert "decimated" not in how
+    assert "first 1200 of 2000 excitation cycles" in how

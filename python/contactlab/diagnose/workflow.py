@@ -291,7 +291,8 @@ def reduce_long(
         return t, u, y, ""
     check_uniform(t)
     per = dominant_period_samples(u)
-    q = int(min(shortest_period_samples(u, per) // MIN_SAMPLES_PER_CYCLE, -(-n // MAX_SAMPLES)))
+    fastest = shortest_period_samples(u, per)
+    q = max(1, int(min(fastest // MIN_SAMPLES_PER_CYCLE, -(-n // MAX_SAMPLES))))
     how = []
     if q > 1:
         u = decimate(u, q, ftype="fir", zero_phase=True)
