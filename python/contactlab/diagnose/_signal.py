@@ -190,6 +190,17 @@ def find_cycles(u: np.ndarray, period_samples: float | None = None) -> Cycles:
     return Cycles(reversals, is_max, cycle, phase, float(period_samples))
 
 
+def shortest_period_samples(u: np.ndarray, period_samples: float) -> float:
+    """Samples per period of the fastest cycles of ``u``: twice the 10th percentile of the
+    half-cycle lengths between its reversals (:func:`find_cycles`), at most
+    ``period_samples`` (the dominant period, which a record of several excitation rates
+    takes from its strongest, not its fastest, block)."""
+    half = np.diff(find_cycles(u, period_samples).reversals)
+    if half.size < 4:
+        return float(period_samples)
+    return min(float(period_samples), 2.0 * float(np.percentile(half, 10)))
+
+
 def shift(y: np.ndarray, t: np.ndarray, tau: float) -> np.ndarray:
     """``y(t - tau)`` by linear interpolation between samples; held constant off the ends."""
     if tau == 0.0:
