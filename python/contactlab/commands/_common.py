@@ -316,3 +316,21 @@ def add_progress_flags(p: Any) -> None:
                    help="always show a progress bar (default: only on a terminal)")  # fmt: skip
     g.add_argument("--no-progress", dest="progress", action="store_false",
                    help="never show a progress bar")  # fmt: skip
+
+
+def normal_options(entry: object, nopts: dict) -> dict:
+    """The options a study gives a normal recording's analysis: ``p0``, ``pa`` from the
+    command line, else from the file-name tags; ω from a ``frequency`` tag
+    (:func:`contactlab.studies.normal.analyze_normal_recording`, which each window runs)."""
+    import math
+
+    tags = entry.tags  # type: ignore[attr-defined]
+    opts = dict(nopts)
+    for key in ("p0", "pa"):
+        tag = tags.get(key)
+        if opts.get(key) is None and isinstance(tag, float) and math.isfinite(tag):
+            opts[key] = tag
+    freq = tags.get("frequency")
+    if isinstance(freq, float) and math.isfinite(freq) and freq > 0:
+        opts["omega"] = 2.0 * math.pi * freq
+    return opts

@@ -25,6 +25,7 @@ from ._common import (
     describe,
     json_document,
     json_text,
+    normal_options,
     parse_columns,
     process_pool,
     quantity,
@@ -81,7 +82,7 @@ def _streamed(
                     columns=columns,
                     fs=args.fs,
                     executor=ex,
-                    options=topts if e.kind == "tangential" else _normal_options(e, nopts),
+                    options=topts if e.kind == "tangential" else normal_options(e, nopts),
                 )
                 if res.rows and all(r.get("error") for r in res.rows):
                     raise RecordingError(
@@ -166,24 +167,6 @@ def _n_samples(path: Path, columns: dict | None, fs: float | None, kind: str) ->
     except (ContactLabError, OSError, ValueError):
         return 0
     return int(n) if n is not None else path.stat().st_size // 16
-
-
-def _normal_options(entry: object, nopts: dict) -> dict:
-    """The options a study gives a normal recording's analysis: ``p0``, ``pa`` from the
-    command line, else from the file-name tags; ω from a ``frequency`` tag
-    (:func:`contactlab.studies.normal.analyze_normal_recording`, which each window runs)."""
-    import math
-
-    tags = entry.tags  # type: ignore[attr-defined]
-    opts = dict(nopts)
-    for key in ("p0", "pa"):
-        tag = tags.get(key)
-        if opts.get(key) is None and isinstance(tag, float) and math.isfinite(tag):
-            opts[key] = tag
-    freq = tags.get("frequency")
-    if isinstance(freq, float) and math.isfinite(freq) and freq > 0:
-        opts["omega"] = 2.0 * math.pi * freq
-    return opts
 
 
 def _window_threads() -> int:
@@ -363,7 +346,7 @@ def _with_long(
         for i in sorted(big):
             e = entries[i]
             try:
-                opts = topts if e.kind == "tangential" else _normal_options(e, nopts)
+                opts = topts if e.kind == "tangential" else normal_options(e, nopts)
                 doc = _auto_streamed(args, e, columns, opts, ex)
             except ContactLabError as exc:
                 if not args.keep_going:

@@ -22,6 +22,7 @@ from ._common import (
     check_output_targets,
     command_line,
     describe,
+    normal_options,
     parse_columns,
     process_pool,
     quantity,
@@ -114,7 +115,6 @@ def _options(args: argparse.Namespace) -> dict | None:
     ``None`` for a tangential recording (where ``--p0``/``--pa`` are refused)."""
     from ..io import read_chunks
     from ..studies.manifest import entry_from_file
-    from .analyze import _normal_options
 
     kind = args.model or read_chunks(args.file, columns=parse_columns(args.columns),
                                      fs=args.fs).kind  # fmt: skip
@@ -123,7 +123,7 @@ def _options(args: argparse.Namespace) -> dict | None:
             raise InputError(f"{args.file}: --p0/--pa are for normal-contact recordings")
         return None
     entry = entry_from_file(args.file, kind="normal")
-    return _normal_options(entry, {"p0": args.p0, "pa": args.pa})
+    return normal_options(entry, {"p0": args.p0, "pa": args.pa})
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
