@@ -34,7 +34,7 @@ from .._arrays import as_1d
 from .._io_atomic import write_text
 from .._physical import MAX_MAGNITUDE, check_channel
 from ..errors import ContactLabError, InputError
-from ..fitting import FitResult, Parameter, least_squares_fit
+from ..fitting import FitResult, Parameter, hac_covariance, least_squares_fit
 from ._blas import with_single_blas_thread
 from ._fitkit import IWAN_ELEMENTS, add_fitted_joint, best_start, derivatives, hold_state
 from .model import SimulationResult, Structure
@@ -663,6 +663,9 @@ def identify(
         best_ps = best_start(tried, residual_on(n_s, 2), records) or best_ps
     fit = least_squares_fit(residual_on(t.size), best_ps, max_nfev=max_nfev, ftol=1e-7,
                             xtol=1e-7, gtol=1e-10)  # fmt: skip
+    # the residuals of an output-error fit are correlated in time (input noise filtered by
+    # the structure): the white-noise covariance understates the errors several-fold
+    fit = hac_covariance(fit)
     v = fit.values
     model = IdentifiedModel(
         structure=build_structure(joint, v, excitation),

@@ -29,7 +29,7 @@ import numpy as np
 from .._arrays import as_1d
 from .._physical import MAX_MAGNITUDE, check_channel
 from ..errors import ContactLabError, InputError
-from ..fitting import Parameter, least_squares_fit
+from ..fitting import Parameter, hac_covariance, least_squares_fit
 from ._fitkit import add_fitted_joint, best_start, column_derivatives, hold_state
 from .model import Structure
 
@@ -438,6 +438,8 @@ def identify_mdof(
         best_ps = best_start(tried, residual_on(n_s, 2), records) or best_ps
     fit = least_squares_fit(residual_on(nt, substeps), best_ps, max_nfev=max_nfev, ftol=1e-7,
                             xtol=1e-7, gtol=1e-10)  # fmt: skip
+    # residuals correlated in time and across DOFs (input noise reaches every DOF)
+    fit = hac_covariance(fit, channels=n)
     v = fit.values
     return {
         "structure": build_mdof(pattern, joint, v, jdofs, mass_m),
