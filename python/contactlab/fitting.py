@@ -19,6 +19,7 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
+from scipy.fft import next_fast_len
 from scipy.optimize import least_squares
 
 from .errors import ConvergenceError, InputError
@@ -786,9 +787,8 @@ def hac_covariance(
     rc = r.reshape(n, channels)
     norms = np.linalg.norm(J, axis=0)
     norms[~(norms > 0)] = 1.0
-    nfft0 = 1 << int(math.ceil(math.log2(2 * n)))
+    nfft0 = 1 << math.ceil(math.log2(2 * n))
     L = _lag_window_length(rc, nfft0) if lags is None else max(0, min(int(lags), n - 1))
-    from scipy.fft import next_fast_len
 
     nfft = next_fast_len(n + L + 1)
     R = np.fft.rfft(rc, nfft, axis=0)  # (f, a)
@@ -826,13 +826,8 @@ def hac_covariance(
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = d / old
     ratio = ratio[np.isfinite(ratio)]
-    note = (
-        f"standard errors allow for correlated residuals (Bartlett lag window of {L} samples"
-        + (
-            f"; {ratio.min():.3g} to {ratio.max():.3g} × the white-noise ones)"
-            if ratio.size
-            else ")"
-        )
+    note = f"standard errors allow for correlated residuals (Bartlett lag window of {L} samples" + (
+        f"; {ratio.min():.3g} to {ratio.max():.3g} × the white-noise ones)" if ratio.size else ")"
     )
     return replace(fit, params=params, covar=covar, correl=correl,
                    notes=[*fit.notes, note])  # fmt: skip
