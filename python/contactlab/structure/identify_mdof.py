@@ -29,8 +29,14 @@ import numpy as np
 from .._arrays import as_1d
 from .._physical import MAX_MAGNITUDE, check_channel
 from ..errors import ContactLabError, InputError
-from ..fitting import Parameter, hac_covariance, least_squares_fit
-from ._fitkit import add_fitted_joint, best_start, column_derivatives, hold_state
+from ..fitting import Parameter, least_squares_fit
+from ._fitkit import (
+    add_fitted_joint,
+    best_start,
+    column_derivatives,
+    hold_state,
+    noise_model_covariance,
+)
 from .model import Structure
 
 MDOF_JOINTS = ("masing", "jenkins", "iwan", "bouc_wen", "linear")
@@ -398,8 +404,8 @@ def identify_mdof(
     # from the measured start when the state is estimated, else the record starts from rest
     x0s, v0s = (y[0], xd[0]) if estimate_initial_state else (np.zeros(n), np.zeros(n))
 
-    def residual_on(nn: int, sub: int) -> Any:
-        tt, uu, yy = t[:nn], u[:nn], y[:nn]
+    def residual_on(nn: int, sub: int, u_in: np.ndarray | None = None) -> Any:
+        tt, uu, yy = t[:nn], (u[:nn] if u_in is None else u_in), y[:nn]
         interp = interpolation if nn == nt else "linear"
         fail = 10 * float(np.max(np.abs(yy))) + 1.0
         if excitation == "force":
@@ -439,8 +445,11 @@ def identify_mdof(
     fit = least_squares_fit(residual_on(nt, substeps), best_ps, max_nfev=max_nfev, ftol=1e-7,
                             xtol=1e-7, gtol=1e-10)  # fmt: skip
     # residuals correlated in time and across DOFs (input noise reaches every DOF)
-    fit = hac_covariance(fit, channels=n)
     v = fit.values
+    r_fit = residual_on(nt, substeps)(v)
+    fit, noise = noise_model_covariance(
+        fit, lambda du: residual_on(nt, substeps, u + du)(v) - r_fit, u, n
+    )
     return {
         "structure": build_mdof(pattern, joint, v, jdofs, mass_m),
         "joint": joint,
@@ -455,4 +464,5 @@ def identify_mdof(
         "input_dof": input_dof if excitation == "force" else None,
         "joint_dofs": jdofs,
         "pattern": pattern,
+        "noise": noise,
     }
