@@ -56,8 +56,11 @@ def test_chain_with_joint_between_dofs_recovers_parameters():
     for name, value in truth_values.items():
         tol = 0.05 if name[0] == "c" else 0.015
         assert abs(p[name].value - value) <= tol * value, (name, p[name].value, value)
-        assert p[name].stderr is not None and p[name].stderr < 0.02 * value
+        # the standard errors allow for the input noise (1 %), and cover the error
+        assert p[name].stderr is not None and p[name].stderr < tol * value
+        assert abs(p[name].value - value) <= 3 * p[name].stderr, (name, p[name])
         assert p[name].identifiable
+    assert m.noise is not None and 0.5 < m.noise["input_noise"] / (0.01 * 6.0) < 2.0
     assert {"x0_0", "v0_0", "x0_1", "v0_1"} <= set(p)
     assert len(m.starts) > 1  # multistart
     # a new input (another multisine, other band) is predicted from rest
