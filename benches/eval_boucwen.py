@@ -52,6 +52,7 @@ def evaluate(joint: str, substeps: int = 4) -> dict[str, float]:
         "params": {k: p.value for k, p in m.fit.params.items()},
         # reported (residual-autocorrelation-corrected) and white-noise standard errors
         "stderr": {k: m.fit.params[k].stderr for k in m.fit.var_names},
+        "noise": m.noise,
         "stderr_white": dict(zip(m.fit.var_names, white_stderr(m.fit), strict=True)),
     }
 
@@ -80,6 +81,7 @@ def main() -> None:
               f"{row['train_rms_m']:.3e} m   identify {row['identify_s']:.1f} s wall, "
               f"{row['identify_cpu_s']:.1f} s CPU "
               f"(load {row['load_avg']:.1f})", flush=True)  # fmt: skip
+        print(f"    noise levels behind the standard errors: {row['noise']}")
         for k, se in row["stderr"].items():
             sw = row["stderr_white"][k]
             se = float("nan") if se is None else se
