@@ -166,3 +166,39 @@ def test_cli_identify_several_y_channels(tmp_path, capsys):
     rc = main(["identify", str(csv), "--joint", "jenkins", "--y", "x0_m,x1_m", "--joint-dofs",
                "0,x", "--json", str(tmp_path / "bad.json")])  # fmt: skip
     assert rc != 0 and not (tmp_path / "bad.json").exists()
+
+
+def test_cli_identify_masks_inline_and_file(tmp_path, capsys):
+    t, u, y, _, _ = _force_record(40431, n=600)
+    csv = tmp_path / "rec.csv"
+    np.savetxt(csv, np.column_stack([t, u, y]), delimiter=",", header="t,u_N,x0_m,x1_m",
+               comments="")  # fmt: skip
+    common = ["identify", str(csv), "--joint", "jenkins", "--y", "x0_m,x1_m", "--joint-dofs",
+              "0,1", "--input-dof", "1", "--substeps", "1"]  # fmt: skip
+    out = tmp_path / "m.json"
+    assert main([*common, "--masks", '{"K": [[1, 1], [1, 1]]}', "--json", str(out)]) == 0
+    d = json.loads(out.read_text())
+    assert d["pattern"]["kind"] == "masks"
+    assert d["pattern"]["parameters"]["K"] == ["K[0,0]", "K[0,1]", "K[1,1]"]
+    assert d["pattern"]["parameters"]["M"] == ["M[0,0]", "M[1,1]"]  # missing M: the diagonal
+    k = d["fit"]["params"]
+    assert (
+        abs(k["K[0,1]"]["value"] / -2e3 - 1) < 0.03 and abs(k["K[1,1]"]["value"] / 2e3 - 1) < 0.03
+    )
+    mfile = tmp_path / "masks.json"
+    mfile.write_text(json.dumps({"K": [[True, False], [False, True]], "C": [[1, 0], [0, 1]]}))
+    out2 = tmp_path / "m2.json"
+    assert main([*common, "--masks", str(mfile), "--json", str(out2)]) == 0
+    assert json.loads(out2.read_text())["pattern"]["parameters"]["K"] == ["K[0,0]", "K[1,1]"]
+    capsys.readouterr()
+    for bad, msg in (("{not json", "--masks is not valid JSON"),
+                     (str(tmp_path / "absent.json"), "cannot read --masks file"),
+                     ("[1, 2]", "cannot read --masks file"),
+                     ('{"K": [[1, 0], [1, 1]]}', "K mask must be symmetric"),
+                     ('{"X": [[1]]}', "masks are given for M, C and K only")):  # fmt: skip
+        bad_out = tmp_path / "bad.json"
+        assert main([*common, "--masks", bad, "--json", str(bad_out)]) != 0
+        assert msg in capsys.readouterr().err and not bad_out.exists()
+    one = ["identify", str(csv), "--joint", "jenkins", "--y", "x0_m", "--masks", "{}"]
+    assert main(one) != 0
+    assert "--masks needs several response channels" in capsys.readouterr().err
