@@ -202,3 +202,31 @@ def test_cli_identify_masks_inline_and_file(tmp_path, capsys):
     one = ["identify", str(csv), "--joint", "jenkins", "--y", "x0_m", "--masks", "{}"]
     assert main(one) != 0
     assert "--masks needs several response channels" in capsys.readouterr().err
+
+
+def test_kelvin_voigt_joint_between_dofs_with_masks():
+    """A spring-damper joint between two masses that are otherwise only grounded (K and C
+    masks on the diagonal): the joint's kj, cj are recovered; where the pattern already
+    has the coupling (a chain) the joint is refused as not identifiable."""
+    rng = np.random.default_rng(40441)
+    n = 800
+    t = np.arange(n) / 500.0
+    u = _multisine(t, rng, 40.0, 6.0)
+    s = Structure(M2, np.diag([2.0, 1.0]), np.diag([4e3, 1e3]))
+    s.add_joint("kelvin_voigt", 0, 1, k=2e3, c=1.5)
+    f = np.zeros((n, 2))
+    f[:, 1] = u
+    y = s.simulate(t, force=f, substeps=2).x
+    um, ym = _noisy(rng, u, y)
+    eye = np.eye(2, dtype=bool)
+    m = identify(t, um, ym, joint="kelvin_voigt", joint_dofs=(0, 1), input_dof=1, substeps=2,
+                 masks={"K": eye, "C": eye})  # fmt: skip
+    p = m.fit.params
+    for name, value, tol in (("kj", 2e3, 0.02), ("cj", 1.5, 0.1), ("K[0,0]", 4e3, 0.02),
+                             ("K[1,1]", 1e3, 0.05), ("M[1,1]", 0.5, 0.02)):  # fmt: skip
+        assert abs(p[name].value - value) <= tol * value, (name, p[name].value)
+        assert abs(p[name].value - value) <= 3 * p[name].stderr, (name, p[name])
+    pred = m.simulate(t, force=u).x
+    assert np.sqrt(np.mean((pred - y) ** 2)) < 0.01 * np.std(y)
+    with pytest.raises(contactlab.InputError, match="duplicates the structure's own spring"):
+        identify(t, um, ym, joint="kelvin_voigt", joint_dofs=(0, 1), input_dof=1)
