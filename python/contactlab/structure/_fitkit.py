@@ -145,8 +145,6 @@ def noise_model_covariance(
     the probes' mean response spectrum. Returns the new fit and
     ``{"input_noise": σ_u, "output_noise": [σ_a ...], "probes": probes}``.
     """
-    from scipy.optimize import nnls
-
     J, r = fit.jac, np.asarray(fit.residual, dtype=float)
     k = len(fit.var_names)
     info: dict[str, Any] = {"input_noise": None, "output_noise": None, "probes": 0}
@@ -164,6 +162,51 @@ def noise_model_covariance(
         if d.shape != r.shape or not np.all(np.isfinite(d)):
             return fit, info
         gw.append(d)
+    try:
+        with np.errstate(all="ignore"):  # extreme records (fuzzing): overflow → white errors
+            covar, su2, sy2 = _noise_sandwich(J, r, gw, n, channels, probes, fit.ndata)
+    except (ValueError, np.linalg.LinAlgError):  # non-finite spectra refused by nnls / svd
+        return fit, info
+    if not (np.all(np.isfinite(covar)) and math.isfinite(su2) and np.all(np.isfinite(sy2))):
+        return fit, info
+    d = np.sqrt(np.clip(np.diag(covar), 0.0, None))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        correl = covar / np.outer(d, d)
+    correl[~np.isfinite(correl)] = 0.0
+    np.fill_diagonal(correl, 1.0)
+    params = {nm: replace(p) for nm, p in fit.params.items()}
+    old = np.sqrt(np.clip(np.diag(fit.covar), 0.0, None))
+    for i, nm in enumerate(fit.var_names):
+        if params[nm].stderr is not None:
+            params[nm].stderr = float(d[i])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = d / old
+    ratio = ratio[np.isfinite(ratio)]
+    info = {"input_noise": math.sqrt(su2), "output_noise": [math.sqrt(float(v)) for v in sy2],
+            "probes": probes}  # fmt: skip
+    note = (
+        f"standard errors allow for input noise (σ_u ≈ {info['input_noise']:.3g}) as well as "
+        "output noise (σ_y ≈ " + ", ".join(f"{v:.3g}" for v in info["output_noise"]) + "), "
+        "estimated from the residual spectrum"
+        + (f"; {ratio.min():.3g} to {ratio.max():.3g} × the white-noise ones" if ratio.size else "")
+    )
+    return replace(fit, params=params, covar=covar, correl=correl,
+                   notes=[*fit.notes, note]), info  # fmt: skip
+
+
+def _noise_sandwich(
+    J: np.ndarray,
+    r: np.ndarray,
+    gw: list[np.ndarray],
+    n: int,
+    channels: int,
+    probes: int,
+    ndata: int,
+) -> tuple[np.ndarray, float, np.ndarray]:
+    """:func:`noise_model_covariance`'s arithmetic: the covariance and ``σ_u²``, ``σ_a²``."""
+    from scipy.optimize import nnls
+
+    k = J.shape[1]
     Gw = np.stack(gw)  # probes × (n · channels)
     Z = Gw @ J  # probes × k: zᵢ = Jᵀ G wᵢ
     Bu = Z.T @ Z / probes
@@ -211,28 +254,6 @@ def noise_model_covariance(
     _U, s, Vt = np.linalg.svd(J / norms, full_matrices=False)
     keep = s > 1e-8 * s[0] if s[0] > 0 else np.zeros_like(s, bool)
     Ainv = (Vt[keep].T / s[keep] ** 2) @ Vt[keep] / np.outer(norms, norms)
-    covar = Ainv @ B @ Ainv * fit.ndata / max(fit.ndata - k, 1)
+    covar = Ainv @ B @ Ainv * ndata / max(ndata - k, 1)
     covar = 0.5 * (covar + covar.T)
-    d = np.sqrt(np.clip(np.diag(covar), 0.0, None))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        correl = covar / np.outer(d, d)
-    correl[~np.isfinite(correl)] = 0.0
-    np.fill_diagonal(correl, 1.0)
-    params = {nm: replace(p) for nm, p in fit.params.items()}
-    old = np.sqrt(np.clip(np.diag(fit.covar), 0.0, None))
-    for i, nm in enumerate(fit.var_names):
-        if params[nm].stderr is not None:
-            params[nm].stderr = float(d[i])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = d / old
-    ratio = ratio[np.isfinite(ratio)]
-    info = {"input_noise": math.sqrt(su2), "output_noise": [math.sqrt(float(v)) for v in sy2],
-            "probes": probes}  # fmt: skip
-    note = (
-        f"standard errors allow for input noise (σ_u ≈ {info['input_noise']:.3g}) as well as "
-        "output noise (σ_y ≈ " + ", ".join(f"{v:.3g}" for v in info["output_noise"]) + "), "
-        "estimated from the residual spectrum"
-        + (f"; {ratio.min():.3g} to {ratio.max():.3g} × the white-noise ones" if ratio.size else "")
-    )
-    return replace(fit, params=params, covar=covar, correl=correl,
-                   notes=[*fit.notes, note]), info  # fmt: skip
+    return covar, su2, sy2
