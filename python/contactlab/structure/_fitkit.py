@@ -115,6 +115,14 @@ def _band_mean(p: np.ndarray, width: int) -> np.ndarray:
     return p[: nb * width].reshape(nb, width, *p.shape[1:]).mean(axis=1)
 
 
+def _white_only(fit: FitResult) -> FitResult:
+    if fit.covar is None:
+        return fit
+    note = ("the noise model could not be evaluated: the standard errors assume white "
+            "residuals and are likely too small")  # fmt: skip
+    return replace(fit, notes=[*fit.notes, note])
+
+
 def noise_model_covariance(
     fit: FitResult,
     respond: Callable[[np.ndarray], np.ndarray],
@@ -149,10 +157,10 @@ def noise_model_covariance(
     k = len(fit.var_names)
     info: dict[str, Any] = {"input_noise": None, "output_noise": None, "probes": 0}
     if J is None or fit.covar is None or k == 0 or r.size != J.shape[0]:
-        return fit, info
+        return _white_only(fit), info
     n = r.size // channels
     if n * channels != r.size or n < 32 or not np.all(np.isfinite(J)):
-        return fit, info
+        return _white_only(fit), info
     eps = 0.01 * max(float(np.sqrt(np.mean(u * u))), 1e-300)
     rng = np.random.default_rng(seed)
     gw = []
@@ -160,15 +168,15 @@ def noise_model_covariance(
         w = rng.standard_normal(n)
         d = np.asarray(respond(eps * w), dtype=float) / eps
         if d.shape != r.shape or not np.all(np.isfinite(d)):
-            return fit, info
+            return _white_only(fit), info
         gw.append(d)
     try:
         with np.errstate(all="ignore"):  # extreme records (fuzzing): overflow → white errors
             covar, su2, sy2 = _noise_sandwich(J, r, gw, n, channels, probes, fit.ndata)
     except (ValueError, np.linalg.LinAlgError):  # non-finite spectra refused by nnls / svd
-        return fit, info
+        return _white_only(fit), info
     if not (np.all(np.isfinite(covar)) and math.isfinite(su2) and np.all(np.isfinite(sy2))):
-        return fit, info
+        return _white_only(fit), info
     d = np.sqrt(np.clip(np.diag(covar), 0.0, None))
     with np.errstate(divide="ignore", invalid="ignore"):
         correl = covar / np.outer(d, d)
