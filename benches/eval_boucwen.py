@@ -50,7 +50,19 @@ def evaluate(joint: str, substeps: int = 4) -> dict[str, float]:
         "nfev": m.fit.nfev,
         "load_avg": os.getloadavg()[0],
         "params": {k: p.value for k, p in m.fit.params.items()},
+        # reported (residual-autocorrelation-corrected) and white-noise standard errors
+        "stderr": {k: m.fit.params[k].stderr for k in m.fit.var_names},
+        "noise": m.noise,
+        "stderr_white": dict(zip(m.fit.var_names, white_stderr(m.fit), strict=True)),
     }
+
+
+def white_stderr(fit) -> np.ndarray:
+    """``sqrt(diag((JᵀJ)⁻¹) χ²/ν)``: the errors were the residuals white."""
+    J, r = fit.jac, fit.residual
+    nrm = np.linalg.norm(J, axis=0)
+    A = np.linalg.pinv((J / nrm).T @ (J / nrm), rcond=1e-16)
+    return np.sqrt(np.diag(A) * (r @ r) / (r.size - J.shape[1])) / nrm
 
 
 def main() -> None:
@@ -69,6 +81,12 @@ def main() -> None:
               f"{row['train_rms_m']:.3e} m   identify {row['identify_s']:.1f} s wall, "
               f"{row['identify_cpu_s']:.1f} s CPU "
               f"(load {row['load_avg']:.1f})", flush=True)  # fmt: skip
+        print(f"    noise levels behind the standard errors: {row['noise']}")
+        for k, se in row["stderr"].items():
+            sw = row["stderr_white"][k]
+            se = float("nan") if se is None else se
+            print(f"    {k:8s} {row['params'][k]:+.6g} ± {se:.3g}"
+                  f" (white-noise ± {sw:.3g})")  # fmt: skip
     if a.json:
         Path(a.json).write_text(json.dumps(rows, indent=2))
 

@@ -48,6 +48,9 @@ def test_identify_recovers_known_parameters_with_noise(joint, params, seed, chec
         got = m.fit.params[name].value
         assert abs(got - value) <= rel * abs(value), (name, got, value)
         assert m.fit.params[name].stderr is not None
+        # honest errors: they allow for the input noise and cover the error
+        assert abs(got - value) <= 3 * m.fit.params[name].stderr, (name, m.fit.params[name])
+    assert 0.5 < m.noise["input_noise"] / (0.01 * 6.0) < 2.0
     # 1 % output noise: the residual is at the noise level, the clean response is predicted
     assert m.rms < 1.5 * 0.01 * np.std(y_true)
     pred = m.simulate(t, force=u).x
@@ -61,7 +64,8 @@ def test_identified_model_json_round_trip(tmp_path):
     m2 = IdentifiedModel.load(tmp_path / "m.json")
     np.testing.assert_array_equal(m.simulate(t, force=u).x, m2.simulate(t, force=u).x)
     d = json.loads((tmp_path / "m.json").read_text())
-    assert {"joint", "excitation", "structure", "fit", "x0", "v0"} <= set(d)
+    assert {"joint", "excitation", "structure", "fit", "x0", "v0", "noise"} <= set(d)
+    assert m2.noise == m.noise and m.noise["input_noise"] >= 0.0
     with pytest.raises(contactlab.InputError, match="force-excited"):
         m2.simulate(t, base=u)
 
@@ -191,3 +195,53 @@ def test_linear_grid_start_finds_the_natural_frequency():
         if exc == "force":  # the scale: k within the grid's frequency step (squared)
             assert 800 / step**2 <= g[0]["k"] <= 800 * step**2
     assert linear_grid_start(t[:2], u[:2], u[:2], "force", None) == []
+
+
+def test_noise_model_covariance_matches_monte_carlo_with_input_and_output_noise():
+    """A model linear in its parameters and its input (two filters of the input): the
+    errors from noise on both channels against the spread over 150 records; the noise
+    levels estimated from the residual spectrum against the true ones."""
+    from scipy.signal import lfilter
+
+    from contactlab.fitting import least_squares_fit
+    from contactlab.structure._fitkit import noise_model_covariance
+
+    rng = np.random.default_rng(31337)
+    n = 1024
+    tt = np.arange(n) / 500.0
+    u0 = sum(np.sin(2 * np.pi * f * tt + rng.uniform(0, 6.3)) for f in np.arange(3, 40, 0.5))
+    r = 0.995  # a lightly damped resonance: the input noise rings for ~200 samples
+
+    def g(x):
+        return lfilter([1.0], [1.0, -2 * r * np.cos(0.15), r * r], x)
+
+    def g2(x):
+        return lfilter([1.0], [1.0, -0.9], x)
+
+    truth = np.array([2.0, 0.5])
+    y0 = truth[0] * g(u0) + truth[1] * g2(u0)
+    su, sy = 0.02 * np.std(u0), 0.002 * np.std(y0)
+    est, err, white, noise = [], [], [], []
+    for _ in range(150):
+        um = u0 + su * rng.standard_normal(n)
+        ym = y0 + sy * rng.standard_normal(n)
+
+        def res(p, uu=um, ym=ym):
+            return p["a"] * g(uu) + p["b"] * g2(uu) - ym
+
+        fit = least_squares_fit(res, {"a": 1.0, "b": 1.0})
+        v = fit.values
+        r0 = res(v)
+        out, info = noise_model_covariance(fit, lambda du, v=v, r0=r0, um=um: res(v, um + du)
+                                           - r0, um)  # fmt: skip
+        est.append([v["a"], v["b"]])
+        err.append([out.params["a"].stderr, out.params["b"].stderr])
+        white.append([fit.params["a"].stderr, fit.params["b"].stderr])
+        noise.append([info["input_noise"], info["output_noise"][0]])
+    spread = np.std(est, axis=0)
+    rms_err = np.sqrt(np.mean(np.square(err), axis=0))
+    np.testing.assert_allclose(rms_err, spread, rtol=0.2)
+    assert np.all(np.mean(white, axis=0) < 0.5 * spread)  # the white-noise errors do not
+    np.testing.assert_allclose(np.median(noise, axis=0), [su, sy], rtol=0.15)
+    cover = np.mean(np.abs(np.array(est) - truth) <= 2 * np.array(err))
+    assert 0.88 <= cover <= 0.99

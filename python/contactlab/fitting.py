@@ -19,6 +19,7 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
+from scipy.fft import next_fast_len
 from scipy.optimize import least_squares
 
 from .errors import ConvergenceError, InputError
@@ -731,3 +732,120 @@ def add_covariance(fit: FitResult, extra: np.ndarray, *, note: str | None = None
             params[n].stderr = float(d[i])
     notes = list(fit.notes) + ([note] if note else [])
     return replace(fit, params=params, covar=covar, correl=correl, notes=notes)
+
+
+def _lag_window_length(r: np.ndarray, nfft: int) -> int:
+    """Lags the residuals (samples × channels) stay correlated over: the last lag at which
+    the pooled autocorrelation, RMS-averaged over 128 lags, exceeds 2/√N (white noise's
+    level is 1/√N), doubled so that the Bartlett taper keeps most of the tail; at least
+    N/8, at most N/2."""
+    n = r.shape[0]
+    spec = np.abs(np.fft.rfft(r, nfft, axis=0)) ** 2
+    acov = np.fft.irfft(spec.sum(axis=1), nfft)[: n // 2]
+    if not acov[0] > 0:
+        return 0
+    rho2 = (acov / acov[0]) ** 2
+    w = min(128, max(1, rho2.size))
+    smooth = np.sqrt(np.convolve(rho2, np.ones(w) / w, mode="valid"))
+    over = np.flatnonzero(smooth[1:] > 2.0 / math.sqrt(n))
+    last = int(over[-1]) + 1 + w if over.size else 1
+    # at least an eighth of the record: a lightly damped resonance driven by input noise
+    # can carry little of the residuals' variance (hidden under white output noise) yet
+    # most of it at the frequencies the parameters are sensitive to
+    return min(max(2 * last, n // 8), n // 2)
+
+
+def hac_covariance(
+    fit: FitResult, *, channels: int = 1, lags: int | None = None, rcond: float = 1e-8
+) -> FitResult:
+    """A copy of ``fit`` whose covariance allows for correlated residuals (a sandwich).
+
+    ``(JᵀJ)⁻¹ χ²/ν`` is right for independent residuals of equal variance. An output-error
+    fit of a dynamic model (a structure's simulated response) has residuals correlated in
+    time: noise on the input reaches them filtered by the structure (a resonant, slowly
+    decaying correlation), as do sensor filters and unmodelled dynamics. Then the covariance
+    is ``(JᵀJ)⁻¹ Jᵀ Ω J (JᵀJ)⁻¹`` with ``Ω`` the residuals' covariance, estimated here
+    (stationary residuals) from their sample auto- and cross-covariances tapered by a
+    Bartlett lag window (a Newey-West type estimate; positive semi-definite):
+    ``Jᵀ Ω J = (1/N_fft) Σ_f Ĵ(f)ᴴ S(f) Ĵ(f)`` with ``S`` the tapered cross-spectrum of the
+    channels, zero-padded so no lag wraps around. White residuals give back the usual
+    covariance (up to the estimate's noise).
+
+    Parameters
+    ----------
+    fit : FitResult
+        With its Jacobian (``fit.jac``) and residual; returned unchanged without them.
+    channels : int
+        The residual vector is ``samples × channels`` flattened row by row (e.g. every DOF's
+        displacement at each sample); channels may be correlated with each other.
+    lags : int, optional
+        Bartlett window half-length in samples; default from the residuals (the lag their
+        autocorrelation stays above the white-noise level, doubled; at least N/8, at most
+        N/2).
+    rcond : float
+        Singular-value cut-off, as in :func:`least_squares_fit`.
+
+    Returns
+    -------
+    FitResult
+        Standard errors, covariance and correlations replaced; a note gives the window and
+        the ratio of the new standard errors to the white-noise ones. Parameters flagged not
+        identifiable stay so.
+    """
+    J, r = fit.jac, np.asarray(fit.residual, dtype=float)
+    k = len(fit.var_names)
+    if J is None or fit.covar is None or k == 0 or r.size != J.shape[0]:
+        return fit
+    if channels < 1 or r.size % channels:
+        raise InputError(f"{r.size} residuals do not split into {channels} channels")
+    n = r.size // channels
+    if n < 4 or not (np.all(np.isfinite(J)) and np.all(np.isfinite(r))):
+        return fit
+    Jc = J.reshape(n, channels, k)
+    rc = r.reshape(n, channels)
+    norms = np.linalg.norm(J, axis=0)
+    norms[~(norms > 0)] = 1.0
+    nfft0 = 1 << math.ceil(math.log2(2 * n))
+    L = _lag_window_length(rc, nfft0) if lags is None else max(0, min(int(lags), n - 1))
+
+    nfft = next_fast_len(n + L + 1)
+    R = np.fft.rfft(rc, nfft, axis=0)  # (f, a)
+    Jf = np.fft.rfft(Jc / norms, nfft, axis=0)  # (f, a, k)
+    lag = np.arange(nfft)
+    lag = np.minimum(lag, nfft - lag)
+    taper = np.clip(1.0 - lag / (L + 1.0), 0.0, None)
+    B = np.zeros((k, k))
+    wts = np.full(nfft // 2 + 1, 2.0)  # rfft bins stand for their mirror images too
+    wts[0] = 1.0
+    if nfft % 2 == 0:
+        wts[-1] = 1.0
+    for a in range(channels):
+        for b in range(channels):
+            c_ab = np.fft.irfft(R[:, a] * np.conj(R[:, b]), nfft) / n  # lag l: r_a(t) r_b(t-l)
+            S = np.fft.rfft(c_ab * taper, nfft)
+            B += np.real(np.einsum("f,fi,fj->ij", wts * S, np.conj(Jf[:, a]), Jf[:, b]))
+    B = 0.5 * (B + B.T) / nfft
+    _U, s, Vt = np.linalg.svd(J / norms, full_matrices=False)
+    keep = s > rcond * s[0] if s[0] > 0 else np.zeros_like(s, bool)
+    Ainv = (Vt[keep].T / s[keep] ** 2) @ Vt[keep]
+    dof = fit.ndata / max(fit.ndata - k, 1)
+    covar = (Ainv @ B @ Ainv) * dof / np.outer(norms, norms)
+    covar = 0.5 * (covar + covar.T)
+    d = np.sqrt(np.clip(np.diag(covar), 0.0, None))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        correl = covar / np.outer(d, d)
+    correl[~np.isfinite(correl)] = 0.0
+    np.fill_diagonal(correl, 1.0)
+    params = {nm: replace(p) for nm, p in fit.params.items()}
+    old = np.sqrt(np.clip(np.diag(fit.covar), 0.0, None))
+    for i, nm in enumerate(fit.var_names):
+        if params[nm].stderr is not None:
+            params[nm].stderr = float(d[i])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = d / old
+    ratio = ratio[np.isfinite(ratio)]
+    note = f"standard errors allow for correlated residuals (Bartlett lag window of {L} samples" + (
+        f"; {ratio.min():.3g} to {ratio.max():.3g} × the white-noise ones)" if ratio.size else ")"
+    )
+    return replace(fit, params=params, covar=covar, correl=correl,
+                   notes=[*fit.notes, note])  # fmt: skip

@@ -124,6 +124,10 @@ def _identify(args: argparse.Namespace) -> int:
     mdof: dict[str, object] = {}
     if y.ndim == 2:
         mdof = {"joint_dofs": _joint_dofs(args.joint_dofs), "input_dof": args.input_dof}
+        if args.masks is not None:
+            mdof["masks"] = _masks(args.masks)
+    elif args.masks is not None:
+        raise InputError("--masks needs several response channels (--y x0,x1,...)")
     cmd = command_line("identify", args.file, "--joint", args.joint, "--excitation", exc)
     model, rep, summary = identify_record(
         t, u, y, joint=args.joint, excitation=exc, mass=mass, holdout=args.holdout,
@@ -158,6 +162,26 @@ def _masses(text: str | None) -> list[float] | None:
     if not all(np.isfinite(v) and v > 0 for v in vals):
         raise InputError(f"--mass values must be positive and finite, got {text!r}")
     return vals
+
+
+def _masks(text: str) -> dict[str, object]:
+    """``--masks``: inline JSON (starting with ``{``) or a JSON file, ``{"K": [[...]], "C":
+    ..., "M": ...}`` (boolean matrices of free entries; checked by ``identify``)."""
+    src = "--masks"
+    raw = str(text).strip()
+    if not raw.startswith("{"):
+        src = f"--masks file {raw}"
+        try:
+            raw = Path(raw).read_text()
+        except (OSError, ValueError) as exc:
+            raise InputError(f"cannot read {src}: {exc}") from None
+    try:
+        d = json.loads(raw)
+    except ValueError as exc:
+        raise InputError(f"{src} is not valid JSON: {exc}") from None
+    if not isinstance(d, dict):
+        raise InputError(f'{src} must be a JSON object like {{"K": [[true, true], ...]}}')
+    return d
 
 
 def _joint_dofs(text: str) -> tuple[int, int | None]:
@@ -283,6 +307,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--input-dof", type=int, default=None,
                    help="several DOFs, force excitation: the DOF the input force acts on "
                    "(default the last)")  # fmt: skip
+    p.add_argument("--masks", default=None,
+                   help='several DOFs: free entries of M, C, K instead of a chain, as inline '
+                   'JSON or a JSON file, e.g. \'{"K": [[1, 1], [1, 1]]}\' (missing M: the '
+                   "diagonal; missing C: as K)")  # fmt: skip
     p.add_argument("--holdout", type=float, default=0.0,
                    help="fraction of the record (at its end) kept out of the fit and "
                    "reported as hold-out error")  # fmt: skip

@@ -36,7 +36,14 @@ from .._physical import MAX_MAGNITUDE, check_channel
 from ..errors import ContactLabError, InputError
 from ..fitting import FitResult, Parameter, least_squares_fit
 from ._blas import with_single_blas_thread
-from ._fitkit import IWAN_ELEMENTS, add_fitted_joint, best_start, derivatives, hold_state
+from ._fitkit import (
+    IWAN_ELEMENTS,
+    add_fitted_joint,
+    best_start,
+    derivatives,
+    hold_state,
+    noise_model_covariance,
+)
 from .model import SimulationResult, Structure
 
 JOINTS = ("masing", "jenkins", "iwan", "bouc_wen", "kelvin_voigt", "normal", "linear")
@@ -74,6 +81,11 @@ class IdentifiedModel:
         Several DOFs: ``(i, j)`` the joint acts between (``j = None``: the ground).
     pattern : Pattern or None
         Several DOFs: which entries of ``M``, ``C``, ``K`` were fitted (chain or masks).
+    noise : dict or None
+        The noise levels the standard errors allow for, estimated from the residual
+        spectrum: ``input_noise`` (σ of white noise on ``u``), ``output_noise`` (one σ per
+        displacement channel [m]) and ``probes`` (see
+        :func:`contactlab.structure._fitkit.noise_model_covariance`).
     """
 
     structure: Structure
@@ -90,6 +102,7 @@ class IdentifiedModel:
     input_dof: int | None = None
     joint_dofs: tuple[int, int | None] | None = None
     pattern: Any = None
+    noise: dict[str, Any] | None = None
 
     def simulate(
         self,
@@ -151,7 +164,15 @@ class IdentifiedModel:
             "elapsed": _num(self.elapsed),
             "fit": self.fit.to_dict(),
             "starts": self.starts,
-            "units": {"x0": "m", "v0": "m/s", "rms": "m", "elapsed": "s"},
+            "noise": self.noise,
+            "units": {
+                "x0": "m",
+                "v0": "m/s",
+                "rms": "m",
+                "elapsed": "s",
+                "noise.output_noise": "m",
+                "noise.input_noise": "N" if self.excitation == "force" else "m",
+            },
         }
 
     def save(self, path: str | Path) -> None:
@@ -227,6 +248,7 @@ class IdentifiedModel:
                 rms=float(d.get("rms") or math.nan),
                 starts=list(d.get("starts", [])),
                 elapsed=float(d.get("elapsed") or math.nan),
+                noise=d.get("noise") if isinstance(d.get("noise"), dict) else None,
                 **extra,
             )
         except (KeyError, TypeError, ValueError) as exc:
@@ -624,8 +646,8 @@ def identify(
         lins = [{**lin, **g, "c": 0.02 * math.sqrt(g["k"] * g["m"])} for g in grid]
         lin = lins[0]
 
-    def residual_on(n: int, sub: int = substeps) -> Any:
-        tt, uu, yy = t[:n], u[:n], y[:n]
+    def residual_on(n: int, sub: int = substeps, u_in: np.ndarray | None = None) -> Any:
+        tt, uu, yy = t[:n], (u[:n] if u_in is None else u_in), y[:n]
         interp = interpolation if n == t.size else "linear"
 
         def res(v: dict[str, float]) -> np.ndarray:
@@ -663,7 +685,13 @@ def identify(
         best_ps = best_start(tried, residual_on(n_s, 2), records) or best_ps
     fit = least_squares_fit(residual_on(t.size), best_ps, max_nfev=max_nfev, ftol=1e-7,
                             xtol=1e-7, gtol=1e-10)  # fmt: skip
+    # the residuals of an output-error fit are correlated in time (input noise filtered by
+    # the structure): the white-noise covariance understated the errors several-fold
     v = fit.values
+    r_fit = residual_on(t.size)(v)
+    fit, noise = noise_model_covariance(
+        fit, lambda du: residual_on(t.size, substeps, u + du)(v) - r_fit, u
+    )
     model = IdentifiedModel(
         structure=build_structure(joint, v, excitation),
         joint=joint,
@@ -675,6 +703,7 @@ def identify(
         interpolation=interpolation,
         rms=float(np.sqrt(fit.chisqr / max(fit.ndata, 1))),
         starts=records,
+        noise=noise,
     )
     model.elapsed = time.perf_counter() - t0
     return model

@@ -11,7 +11,10 @@ parameter × basis matrix, so the model stays linear in its linear parameters:
     ``M x'' + C (x' − r ẏ) + K (x − r y) + b F_joint = 0`` (base motion ``y``, ``r`` = ones)
 
 with ``b = e_i − e_j`` the joint's direction (``joint_dofs=(i, j)``; ``j = None``: the fixed
-ground). Starting values come from the equation error of these equations (derivatives of
+ground). A ``kelvin_voigt`` joint (``kj``, ``cj``) is one more spring and dashpot across
+``b``: it is accepted only where the pattern has no stiffness or damping entry along the same
+direction (e.g. masks of grounded masses and the joint between them). Starting values come
+from the equation error of these equations (derivatives of
 the measured displacements), with and without a Coulomb term ``fs sign(bᵀ x')``; the
 output-error fit (:func:`contactlab.fitting.least_squares_fit`) then refines all parameters
 and the initial state ``x0``, ``v0`` of every DOF, from several starts fitted on a short
@@ -30,10 +33,16 @@ from .._arrays import as_1d
 from .._physical import MAX_MAGNITUDE, check_channel
 from ..errors import ContactLabError, InputError
 from ..fitting import Parameter, least_squares_fit
-from ._fitkit import add_fitted_joint, best_start, column_derivatives, hold_state
+from ._fitkit import (
+    add_fitted_joint,
+    best_start,
+    column_derivatives,
+    hold_state,
+    noise_model_covariance,
+)
 from .model import Structure
 
-MDOF_JOINTS = ("masing", "jenkins", "iwan", "bouc_wen", "linear")
+MDOF_JOINTS = ("masing", "jenkins", "iwan", "bouc_wen", "kelvin_voigt", "linear")
 
 
 @dataclass
@@ -221,7 +230,12 @@ def _positive_starts(pattern: Pattern, vals: dict[str, float]) -> dict[str, floa
 
 
 # ------------------------------------------------------------------ parameters
-def _joint_params(joint: str, kj: float, fs: float, st: dict[str, float], dr: float) -> list:
+def _joint_params(
+    joint: str, kj: float, fs: float, st: dict[str, float], dr: float, cj: float = 0.0
+) -> list:
+    if joint == "kelvin_voigt":
+        return [Parameter("kj", kj, min=0.0, unit="N/m"), Parameter("cj", cj, min=0.0,
+                                                                   unit="N s/m")]  # fmt: skip
     if joint == "bouc_wen":
         return [
             Parameter("alpha", kj, min=1e-9 * kj, unit="N/m"),
@@ -238,6 +252,8 @@ def _joint_params(joint: str, kj: float, fs: float, st: dict[str, float], dr: fl
 
 
 def _mdof_starts(joint: str) -> list[dict[str, float]]:
+    if joint == "kelvin_voigt":
+        return [{"k_frac": 0.5}]
     if joint == "bouc_wen":
         return [{"gamma": g, "delta": d, "k_frac": 0.5}
                 for (g, d) in ((0.5, -0.5), (0.5, 0.5), (-0.25, 0.5))]  # fmt: skip
@@ -286,7 +302,11 @@ def _start_params(
             sc = max(abs(vals[name]), 1e-3 * scale, 1e-300)
             lo = 0.0 if positive else -math.inf
             ps.append(Parameter(name, vals[name], min=lo, unit=unit, scale=sc))
-    ps += _joint_params(joint, max(kj, 1e-300), max(fs, 1e-300), st, max(d_rms, 1e-300))
+    cb = float(b @ pattern.matrix("C", vals) @ b)  # damping seen across the joint
+    cj = 0.5 * cb if cb > 0 else 1e-3 * math.sqrt(max(kj, 1e-300) * max(
+        float(np.trace(mass)) if mass is not None else 1.0, 1e-300))  # fmt: skip
+    ps += _joint_params(joint, max(kj, 1e-300), max(fs, 1e-300), st, max(d_rms, 1e-300),
+                        cj)  # fmt: skip
     for i in range(pattern.n):
         ps.append(Parameter(f"x0_{i}", float(x0[i]), unit="m", scale=y_rms))
         ps.append(Parameter(f"v0_{i}", float(v0[i]), unit="m/s", scale=y_rms * 2 * np.pi * 10))
@@ -386,6 +406,20 @@ def identify_mdof(
     if j_j is not None:
         b[j_j] = -1.0
     jdofs = (i_j, j_j)
+    if joint == "kelvin_voigt":
+        # a linear spring-damper across the joint is one more stiffness and damping entry:
+        # identifiable only where the pattern has none along the same direction
+        bb = np.outer(b, b).ravel()
+        for kind, what in (("K", "spring"), ("C", "dashpot")):
+            Bm = np.stack([B.ravel() for _, B in pattern.basis[kind]], axis=1)
+            coef, *_ = np.linalg.lstsq(Bm, bb, rcond=None)
+            if np.linalg.norm(Bm @ coef - bb) < 1e-9:
+                where = "the ground" if j_j is None else f"DOF {j_j}"
+                raise InputError(
+                    f"a Kelvin-Voigt joint between DOF {i_j} and {where} duplicates the "
+                    f"structure's own {what} there ({kind} entries of the "
+                    f"{pattern.kind}); give masks= that leave that coupling out"
+                )
 
     def ee(kj: float, coulomb: bool) -> dict[str, Any]:
         return equation_error_mdof(t, u, y, pattern, excitation, input_dof or 0, jdofs, mass_m,
@@ -398,8 +432,8 @@ def identify_mdof(
     # from the measured start when the state is estimated, else the record starts from rest
     x0s, v0s = (y[0], xd[0]) if estimate_initial_state else (np.zeros(n), np.zeros(n))
 
-    def residual_on(nn: int, sub: int) -> Any:
-        tt, uu, yy = t[:nn], u[:nn], y[:nn]
+    def residual_on(nn: int, sub: int, u_in: np.ndarray | None = None) -> Any:
+        tt, uu, yy = t[:nn], (u[:nn] if u_in is None else u_in), y[:nn]
         interp = interpolation if nn == nt else "linear"
         fail = 10 * float(np.max(np.abs(yy))) + 1.0
         if excitation == "force":
@@ -438,7 +472,12 @@ def identify_mdof(
         best_ps = best_start(tried, residual_on(n_s, 2), records) or best_ps
     fit = least_squares_fit(residual_on(nt, substeps), best_ps, max_nfev=max_nfev, ftol=1e-7,
                             xtol=1e-7, gtol=1e-10)  # fmt: skip
+    # residuals correlated in time and across DOFs (input noise reaches every DOF)
     v = fit.values
+    r_fit = residual_on(nt, substeps)(v)
+    fit, noise = noise_model_covariance(
+        fit, lambda du: residual_on(nt, substeps, u + du)(v) - r_fit, u, n
+    )
     return {
         "structure": build_mdof(pattern, joint, v, jdofs, mass_m),
         "joint": joint,
@@ -453,4 +492,5 @@ def identify_mdof(
         "input_dof": input_dof if excitation == "force" else None,
         "joint_dofs": jdofs,
         "pattern": pattern,
+        "noise": noise,
     }
