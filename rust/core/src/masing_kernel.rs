@@ -17,6 +17,14 @@
 //! Elsewhere a reversal is applied without data-dependent branches (the candidate is always
 //! written above the stack top, the top raised by 0 or 1, the branch registers selected by
 //! integer selects); only a closure takes a branch and reloads the branch from the stack.
+//!
+//! A block after one that changed branch more than once every [`DENSE`] samples (a random
+//! walk) takes the dense path instead: [`Pass::dense_block`] applies the rules with no
+//! data-dependent branch and writes per sample only the curve argument, the anchor's sample
+//! index and its force where known (no run table, whose bookkeeping cost as much as the rules
+//! there); [`eval_dense`] evaluates the curve over the block, then each force as the anchor's
+//! output (an earlier sample of the block, through one indexed buffer) or the known base, plus
+//! `lam · f(u)`. Both paths give the stepper's forces bit for bit.
 
 use super::{MasingState, Reversal};
 use crate::curve::Backbone;
