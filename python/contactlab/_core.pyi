@@ -73,7 +73,11 @@ class CycleTracker:
 
 def branch_memory(x: _F) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]: ...
 def force_many(
-    models: list[MasingCore], xs: list[_F], threads: int, outs: list[_F] | None = None
+    models: list[MasingCore],
+    xs: list[_F],
+    threads: int,
+    outs: list[_F] | None = None,
+    cpu_times: bool = False,
 ) -> tuple[list[_F], list[dict[str, Any]]]: ...
 def signature_positions(
     block: npt.NDArray[np.uint8], needles: list[bytes], starts_below: int, offset: int

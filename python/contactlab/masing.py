@@ -300,7 +300,9 @@ def force_many(
                 raise InputError(f"out[{i}]: {e}") from None
     if stats is not None and not isinstance(stats, list):
         raise InputError(f"stats must be a list to fill, got {type(stats).__name__}")
-    res, per_thread = _core.force_many([m._core for m in ms], sigs, int(threads), outs)
+    res, per_thread = _core.force_many(
+        [m._core for m in ms], sigs, int(threads), outs, stats is not None
+    )
     if stats is not None:
         stats.extend(per_thread)
     return res

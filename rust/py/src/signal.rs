@@ -125,15 +125,17 @@ fn branch_memory_py<'py>(
 /// longest channel first, one at a time from a shared queue). Into `outs` when given (one
 /// contiguous float64 array per channel, reused between calls: no fresh pages to fault in),
 /// else into new arrays. Returns the outputs and one dict per worker thread (`jobs`,
-/// `samples`, `start`, `end`, `cpu`, `wait`; seconds, `cpu`/`wait` None where unknown).
+/// `samples`, `start`, `end`, `cpu`, `wait`; seconds; `cpu`/`wait` only with `cpu_times`
+/// and where the system tells, else None).
 #[pyfunction]
-#[pyo3(signature = (models, xs, threads, outs=None))]
+#[pyo3(signature = (models, xs, threads, outs=None, cpu_times=false))]
 fn force_many<'py>(
     py: Python<'py>,
     models: Vec<PyRef<'py, MasingCore>>,
     xs: Vec<PyReadonlyArray1<'py, f64>>,
     threads: usize,
     outs: Option<Vec<Bound<'py, PyArray1<f64>>>>,
+    cpu_times: bool,
 ) -> PyResult<ManyForces<'py>> {
     if models.len() != xs.len() {
         return Err(input(
@@ -191,6 +193,7 @@ fn force_many<'py>(
         run_jobs(
             jobs,
             threads,
+            cpu_times,
             |j| j.0.len(),
             |i, (x, out)| cores[i].force_from_origin(x, out),
         )
