@@ -127,7 +127,7 @@ def test_force_many_and_out_buffers_equal_force():
 
 
 def test_force_many_reports_the_bad_channel_whatever_the_threads():
-    # Outputs are allocated in the worker threads: an error in any channel must still come
+    # Channels run on worker threads (longest first): an error in any channel must still come
     # back as one typed error (the lowest-numbered bad channel's), no partial list.
     xs = [np.linspace(0, 1e-5, 300) * k for k in range(1, 6)]
     xs[3] = xs[3].copy()
