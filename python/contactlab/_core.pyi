@@ -1,6 +1,6 @@
 """Type stubs for the Rust extension ``contactlab._core`` (hand-written)."""
 
-from typing import final
+from typing import Any, final
 
 import numpy as np
 import numpy.typing as npt
@@ -72,7 +72,13 @@ class CycleTracker:
     ) -> dict[str, np.ndarray]: ...
 
 def branch_memory(x: _F) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]: ...
-def force_many(models: list[MasingCore], xs: list[_F], threads: int) -> list[_F]: ...
+def force_many(
+    models: list[MasingCore],
+    xs: list[_F],
+    threads: int,
+    outs: list[_F] | None = None,
+    cpu_times: bool = False,
+) -> tuple[list[_F], list[dict[str, Any]]]: ...
 def signature_positions(
     block: npt.NDArray[np.uint8], needles: list[bytes], starts_below: int, offset: int
 ) -> list[npt.NDArray[np.int64]]: ...
