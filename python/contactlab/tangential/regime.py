@@ -207,6 +207,15 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1), strict=True))
 
 
+def _long_runs(mask: np.ndarray, min_len: int) -> list[tuple[int, int]]:
+    """``[start, end)`` of each run of True at least ``min_len`` long (the short ones, most
+    of a noisy record's, dropped in numpy before any Python loop sees them)."""
+    d = np.diff(np.r_[np.int8(0), mask.astype(np.int8), np.int8(0)])
+    starts, ends = np.flatnonzero(d == 1), np.flatnonzero(d == -1)
+    keep = (ends - starts) >= min_len
+    return list(zip(starts[keep].tolist(), ends[keep].tolist(), strict=True))
+
+
 def _break_time(x: np.ndarray, a: int, b: int, end: int, window: int, sigma: float) -> float | None:
     """Sample (fractional) at which a stuck plate starts to move with a jump of its
     acceleration (the friction force dropping from static to kinetic), or None.
@@ -341,9 +350,7 @@ def stick_slip(
     smooth = 2.0 * thr / (amp * omega**2) if amp > 0 else math.inf
     min_len = max(4, math.ceil(STICK_DWELL_FACTOR * smooth / dt))
     spans: dict[int, list[int]] = {}  # turn -> [first stuck sample, end, stuck samples]
-    for a, b in _runs(np.abs(v) < thr):
-        if b - a < min_len:
-            continue
+    for a, b in _long_runs(np.abs(v) < thr, min_len):
         mid = tt[(a + b - 1) // 2]
         k = int(np.argmin(np.abs(tt[turns] - mid)))
         if abs(tt[turns[k]] - mid) > 0.25 * period + 0.5 * (b - a) * dt:
