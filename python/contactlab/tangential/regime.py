@@ -359,10 +359,11 @@ def stick_slip(
         sp[0], sp[1], sp[2] = min(sp[0], a), max(sp[1], b), sp[2] + (b - a)
     durations, breakaway = [], []
     sliding = SLIDE_ONSET * amp * omega
-    sx = difference_noise(x)
+    sx = difference_noise(x) if spans else 0.0  # only the breakaway search needs it
+    f = F - offset if spans else F  # once, not a whole-record copy per stick
     for a, b, n_stuck in spans.values():
         durations.append(n_stuck * dt)
-        breakaway.append(_breakaway(F - offset, x, v, (a, b), window, max(sliding, thr), sx))
+        breakaway.append(_breakaway(f, x, v, (a, b), window, max(sliding, thr), sx))
     hit = spans
     return StickSlip(int(turns.size), np.asarray(durations), np.asarray(breakaway), float(thr),
                      float(smooth), len(hit))  # fmt: skip
