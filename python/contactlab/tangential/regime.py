@@ -87,7 +87,7 @@ def velocity(t: np.ndarray | None, x: np.ndarray) -> tuple[np.ndarray, float, in
     """Savitzky-Golay velocity (Lepski window), the stick threshold ``3 σv`` and the window
     (samples)."""
     tt = np.arange(x.size, dtype=float) if t is None else t
-    dt = float(np.median(np.diff(tt)))
+    dt = float(np.median(np.diff(tt), overwrite_input=True))  # partitions its own copy
     sx = difference_noise(x)
     window = min(lepski_window(x, dt, sx), max(5, (x.size // 2) * 2 - 1))
     v = savgol_derivative(x, window, 1, dt)
@@ -346,11 +346,12 @@ def stick_slip(
         period = 2.0 * float(np.median(np.diff(tt[turns])))
     amp = 0.5 * float(np.ptp(x[turns[0] : turns[-1] + 1]))
     omega = 2.0 * math.pi / period
-    dt = float(np.median(np.diff(tt)))
+    dt = float(np.median(np.diff(tt), overwrite_input=True))  # partitions its own copy
     smooth = 2.0 * thr / (amp * omega**2) if amp > 0 else math.inf
     min_len = max(4, math.ceil(STICK_DWELL_FACTOR * smooth / dt))
     spans: dict[int, list[int]] = {}  # turn -> [first stuck sample, end, stuck samples]
-    for a, b in _long_runs(np.abs(v) < thr, min_len):
+    # |v| < thr as two comparisons: no whole-record float temporary
+    for a, b in _long_runs((v < thr) & (v > -thr), min_len):
         mid = tt[(a + b - 1) // 2]
         k = int(np.argmin(np.abs(tt[turns] - mid)))
         if abs(tt[turns[k]] - mid) > 0.25 * period + 0.5 * (b - a) * dt:
