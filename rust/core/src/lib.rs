@@ -2,6 +2,7 @@
 //!
 //! - [`curve`]: virgin curves (the exponential curve of the tangential-contact paper, tabulated
 //!   measured backbones).
+//! - [`loop_fit`]: Levenberg–Marquardt fit of the steady Masing loop to an averaged cycle.
 //! - [`masing`]: the Masing operator with non-local memory, cycle counting and loop areas.
 //! - [`scan`]: byte-signature search (the HDF5 structure checks).
 //! - [`signal`]: streaming reversal detection by a hysteresis threshold.
@@ -22,6 +23,7 @@
 
 pub mod curve;
 pub mod error;
+pub mod loop_fit;
 pub mod masing;
 pub mod normal;
 pub mod scan;

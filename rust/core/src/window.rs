@@ -252,6 +252,35 @@ fn check_samples(t: &[f64], x: &[f64], f: &[f64], edges: &[f64]) -> Result<[f64;
     Ok([sx, sf, fm])
 }
 
+/// The cumulative integrals at the edges `edges[e..]` below `t1` (inside the sample step
+/// `t0..t1` whose trapezoids are `step_f`, `step_x` on top of `cf`, `cx`), as
+/// `period_means` interpolates them; returns the first edge not below `t1`.
+#[inline(never)]
+#[allow(clippy::arithmetic_side_effects)]
+fn interpolate_edges(
+    edges: &[f64],
+    mut e: usize,
+    (t0, t1): (f64, f64),
+    (cf, step_f, ce_f): (f64, f64, &mut Vec<f64>),
+    (cx, step_x, ce_x): (f64, f64, &mut Vec<f64>),
+) -> usize {
+    while e < edges.len() && edges[e] < t1 {
+        let ed = edges[e];
+        if ed == t0 {
+            ce_f.push(cf);
+            ce_x.push(cx);
+        } else {
+            let dt = t1 - t0;
+            let sl_f = ((cf + step_f) - cf) / dt;
+            let sl_x = ((cx + step_x) - cx) / dt;
+            ce_f.push(sl_f * (ed - t0) + cf);
+            ce_x.push(sl_x * (ed - t0) + cx);
+        }
+        e += 1;
+    }
+    e
+}
+
 /// Fold `(t, x, F)` (one window, `t` strictly increasing) by the phase knots `(kt, kp)` into
 /// `n_bins` bins per cycle over `n_cycles` cycles, with the phases and bins of
 /// [`crate::signal::fold_phase`], and derive the per-cycle quantities and period means (see
@@ -358,20 +387,16 @@ pub fn fold_window(
         if i > 0 {
             let step_f = 0.5 * (f[i] + f[i - 1]) * (ti - t[i - 1]);
             let step_x = 0.5 * (x[i] + x[i - 1]) * (ti - t[i - 1]);
-            // edges in [t[i-1], t[i]): period_means' interpolation
-            while e < edges.len() && edges[e] < ti {
-                let ed = edges[e];
-                if ed == t[i - 1] {
-                    ce_f.push(cf);
-                    ce_x.push(cx);
-                } else {
-                    let dt = ti - t[i - 1];
-                    let sl_f = ((cf + step_f) - cf) / dt;
-                    let sl_x = ((cx + step_x) - cx) / dt;
-                    ce_f.push(sl_f * (ed - t[i - 1]) + cf);
-                    ce_x.push(sl_x * (ed - t[i - 1]) + cx);
-                }
-                e += 1;
+            // edges in [t[i-1], t[i]): period_means' interpolation (out of line: inlined,
+            // its two divisions were hoisted into every sample's path)
+            if e < edges.len() && edges[e] < ti {
+                e = interpolate_edges(
+                    edges,
+                    e,
+                    (t[i - 1], ti),
+                    (cf, step_f, &mut ce_f),
+                    (cx, step_x, &mut ce_x),
+                );
             }
             cf += step_f;
             cx += step_x;
@@ -400,9 +425,10 @@ pub fn fold_window(
         // never back (rounding at a knot): each cell stays one run of samples
         ph = ph.max(last_ph);
         last_ph = ph;
-        let cfl = ph.floor();
-        let frac = ph - cfl;
-        let c = cfl as usize;
+        // ph >= kp[0] >= 0 and finite, below 2^33: truncation is floor (bit for bit) without
+        // the libm call a generic x86-64 build makes of f64::floor
+        let c = ph as usize;
+        let frac = ph - c as f64;
         if c >= nc {
             continue;
         }
