@@ -541,11 +541,39 @@ def track(
         if n_threads < 0:
             raise InputError(f"threads must be >= 0, got {threads!r}")
         with ThreadPoolExecutor(n_threads, thread_name_prefix="contactlab-track") as pool:
-            return track(
+            # each helper thread analyses one window while the next is read: n + 1 windows
+            # in memory (an executor given by the caller gets two per worker)
+            return _track(
                 source, every, kind=kind, columns=columns, fs=fs, chunk_size=chunk_size,
                 max_window=max_window, options=options, keep_going=keep_going,
                 callback=callback, executor=pool, keep_documents=keep_documents,
+                slots=n_threads + 1,
             )  # fmt: skip
+    return _track(
+        source, every, kind=kind, columns=columns, fs=fs, chunk_size=chunk_size,
+        max_window=max_window, options=options, keep_going=keep_going, callback=callback,
+        executor=executor, keep_documents=keep_documents, slots=None,
+    )  # fmt: skip
+
+
+def _track(
+    source: str | Path | Recording,
+    every: str | float,
+    *,
+    kind: str | None,
+    columns: dict[str, str] | None,
+    fs: float | None,
+    chunk_size: int,
+    max_window: int,
+    options: Mapping[str, Any] | None,
+    keep_going: bool,
+    callback: Callable[[dict[str, Any]], None] | None,
+    executor: Any,
+    keep_documents: bool,
+    slots: int | None,
+) -> TrackResult:
+    """:func:`track` on ``executor`` (None: serial); ``slots``: windows in flight at most
+    (default two per worker)."""
     mode, size = parse_every(every)
     every_text = every if isinstance(every, str) else f"{every}cycles"
     if not (isinstance(max_window, int) and max_window >= 16):
@@ -579,7 +607,7 @@ def track(
     from .executor import n_workers
 
     in_flight: deque[tuple[dict[str, Any], Any]] = deque()
-    limit = 2 * n_workers(executor)
+    limit = slots if slots is not None else 2 * n_workers(executor)
     dask = executor is not None and type(executor).__module__.split(".")[0] == "distributed"
 
     def collect(row: dict[str, Any], job: Any) -> None:

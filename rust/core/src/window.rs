@@ -337,6 +337,8 @@ pub fn fold_window(
         mean_x: Vec::new(),
     };
     let mut moments = vec![BinMoments::default(); nb];
+    // per bin: samples, Σx, ΣF, Σφ, Σφ², Σx², Σt (scattered into `w` after the pass)
+    let mut bins = vec![[0.0_f64; 8]; nb];
     let mut ranges = vec![
         [
             f64::NEG_INFINITY,
@@ -433,13 +435,15 @@ pub fn fold_window(
             continue;
         }
         let b = ((frac * nb as f64) as usize).min(nb - 1);
-        w.count[b] += 1.0;
-        w.sum_x[b] += xi;
-        w.sum_f[b] += fi;
-        w.sum_phase[b] += frac;
-        w.sum_phase2[b] += frac * frac;
-        w.sum_xx[b] += xi * xi;
-        w.sum_t[b] += ti;
+        // one bin's sums in one cache line (the same additions, in the same order)
+        let s = &mut bins[b];
+        s[0] += 1.0;
+        s[1] += xi;
+        s[2] += fi;
+        s[3] += frac;
+        s[4] += frac * frac;
+        s[5] += xi * xi;
+        s[6] += ti;
         if cell != Some((c, b)) {
             if let Some((cc, cb)) = cell {
                 flush_cell(cc, cb, &cell_sums, &mut moments, &mut ranges);
@@ -465,6 +469,15 @@ pub fn fold_window(
     }
     if let Some((cc, cb)) = cell {
         flush_cell(cc, cb, &cell_sums, &mut moments, &mut ranges);
+    }
+    for (b, s) in bins.iter().enumerate() {
+        w.count[b] = s[0];
+        w.sum_x[b] = s[1];
+        w.sum_f[b] = s[2];
+        w.sum_phase[b] = s[3];
+        w.sum_phase2[b] = s[4];
+        w.sum_xx[b] = s[5];
+        w.sum_t[b] = s[6];
     }
     if let Some(ac) = area_cycle {
         (w.energy[ac], w.sens_f[ac], w.sens_x[ac]) = area.finish(area_scale);
