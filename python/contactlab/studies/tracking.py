@@ -69,8 +69,9 @@ MIN_CYCLES = 3
 #: default upper bound on a window's samples (one window is held in memory)
 MAX_WINDOW = 2_000_000
 #: samples per window for ``every="auto"``: the fit of a window costs about as much as folding
-#: 10^5 samples, so longer windows amortise it, but each window in flight holds ~100 bytes a
-#: sample (2^20 with two threads peaked at 420 MB on 1e7 samples, 2^19 at 216 MB with one)
+#: 10^5 samples, so longer windows amortise it, but each window in flight holds ~40 bytes a
+#: sample (on 1e8 samples with two threads: 2^19 peaked at 216 MB, 3·2^18 at 272 MB, 2^20 at
+#: 304 MB)
 AUTO_WINDOW = 1 << 19
 
 _EVERY = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?\d+)?)\s*([A-Za-zµμ]*)\s*$")
@@ -512,8 +513,9 @@ def track(
     threads : int, optional
         Without ``executor``: analyse windows on this many helper threads while the next
         chunks are read and their cycles found (the Rust kernels release the GIL); default 1
-        (each thread holds up to two windows: 2 threads peak near 300 MB with ``"auto"``
-        windows), 0 analyses each window before reading on. The rows are the same.
+        (``threads + 1`` windows in flight: 2 threads peaked at 216 MB on 1e8 samples with
+        ``"auto"`` windows), 0 analyses each window before reading on. The rows are the
+        same.
     keep_documents : bool
         Keep each window's whole analysis document (``TrackResult.window_docs``; what
         :func:`contactlab.studies.pooled.pooled_document` and
