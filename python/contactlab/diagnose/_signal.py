@@ -14,6 +14,7 @@ import itertools
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.fft import next_fast_len
 
 from ..errors import InputError
 from ..reversals import excursions
@@ -44,14 +45,21 @@ def check_uniform(t: np.ndarray) -> float:
 
 
 def dominant_period_samples(u: np.ndarray) -> float:
-    """Samples per period of the strongest spectral line of ``u`` (mean removed)."""
+    """Samples per period of the strongest spectral line of ``u`` (mean removed).
+
+    The windowed record is zero-padded to a fast FFT length (:func:`scipy.fft.next_fast_len`:
+    an odd or prime length such as 999 256 took 20 times as long and 8 times the memory),
+    so the lines are those of the record's own length, interpolated: the period is
+    ``L / k`` on the padded grid of ``L`` points.
+    """
     n = u.size
-    spec = np.abs(np.fft.rfft((u - u.mean()) * np.hanning(n)))
+    size = next_fast_len(n, real=True)
+    spec = np.abs(np.fft.rfft((u - u.mean()) * np.hanning(n), size))
     spec[0] = 0.0
     k = int(np.argmax(spec))
     if k == 0:
         raise InputError("the excitation signal is constant; no cycles to analyse")
-    return n / k
+    return size / k
 
 
 def smooth_window(period_samples: float, fraction: float = 0.08, least: int = 7) -> int:
@@ -252,3 +260,64 @@ def modulation_gains(
     q = sss * bc * bc - 2.0 * scs * bc * bs + scc * bs * bs
     g[ok] = q[ok] / det[ok]
     return g
+
+
+@dataclass(frozen=True)
+class Knots:
+    """Turning points of a record between the samples kept from it.
+
+    A Masing element's memory holds the turning points of its input; a record kept every
+    q-th sample loses the true extremes between the samples, and every branch after a
+    reversal starts from the wrong point (up to ``A (1 - cos(π q / s))`` at ``s`` samples per
+    cycle). Knots are the raw-rate samples that carry that memory: every local extremum of
+    the input the candidates see (the filtered one) and every reversal of :func:`find_cycles`.
+    The element run over the kept samples with the knots merged in (:meth:`merge`) gives, at
+    the kept samples, exactly what it gives on the whole record (rate independence: a
+    monotone stretch between extrema leaves no memory).
+
+    ``pos``: where each knot goes (:func:`numpy.insert` positions among the kept samples);
+    ``x``: the input at the knots; ``grid``: the positions of the kept samples in the merged
+    sequence; ``t``: its times; ``reversals``: the merged positions of the raw reversals.
+    """
+
+    pos: np.ndarray
+    x: np.ndarray
+    grid: np.ndarray
+    t: np.ndarray
+    reversals: np.ndarray
+
+    def merge(self, x: np.ndarray, offset: float = 0.0) -> np.ndarray:
+        """The kept input ``x`` with the knots (shifted by ``-offset`` like ``x``) merged in."""
+        return np.insert(x, self.pos, self.x - offset)
+
+
+def local_extrema(u: np.ndarray) -> np.ndarray:
+    """Indices of the local extrema of ``u`` (the first sample of a flat top or bottom)."""
+    steps = np.flatnonzero(np.diff(u))
+    if steps.size < 2:
+        return steps[:0]
+    up = np.diff(u)[steps] > 0
+    turn = np.flatnonzero(up[1:] != up[:-1])
+    return steps[turn] + 1
+
+
+def turning_knots(
+    t: np.ndarray, u: np.ndarray, reversals: np.ndarray, q: int, stop: int, limit: int
+) -> tuple[Knots, bool]:
+    """:class:`Knots` of ``u`` (raw rate, times ``t``) for the samples ``0, q, 2q, … < stop``.
+
+    At most ``limit`` knots: an input whose local extrema are more (noise left in it) keeps
+    the reversals only, and the second value says so (the memory is then exact up to the
+    noise-sized inner loops it drops)."""
+    last = ((stop - 1) // q) * q
+    ext = local_extrema(u[: last + 1])
+    exact = ext.size <= limit
+    raw = np.union1d(ext, reversals) if exact else np.asarray(reversals, dtype=np.int64)
+    raw = raw[(raw % q != 0) & (raw < last)]
+    pos = raw // q + 1
+    grid_raw = np.arange(0, last + 1, q)
+    merged_raw = np.insert(grid_raw, pos, raw)
+    grid = np.arange(grid_raw.size) + np.searchsorted(pos, np.arange(grid_raw.size), "right")
+    rev = np.asarray(reversals, dtype=np.int64)
+    rev = np.searchsorted(merged_raw, rev[rev <= last])
+    return Knots(pos, u[raw], grid, t[merged_raw], rev), exact

@@ -49,7 +49,7 @@ from ..errors import InputError
 from ..masing import Masing, loop_area
 from ._family import Candidate, ParamSpec, Prepared, implausible_common
 from ._filters import savgol_filter
-from ._signal import modulation_gains, shift
+from ._signal import Knots, modulation_gains, shift
 from .scaled_masing import memory, scaled_force
 
 _INF = np.inf
@@ -444,8 +444,13 @@ class TangentialFamily:
         x = d.u
         if "displacement_offset" in effects:
             x = x - p["x0"]
+        # a record kept every q-th sample (workflow.subsample_long): the element and the
+        # terms up to the breakaway run over the kept samples with the turning points
+        # between them merged in (xm), which gives the full-rate values at the kept samples
+        kn: Knots | None = d.extra.get("knots")
+        xm = x if kn is None else kn.merge(x, p["x0"] if x is not d.u else 0.0)
         if "series_compliance" in effects:
-            xmax = float(np.max(np.abs(x))) or 1.0
+            xmax = float(np.max(np.abs(xm))) or 1.0
             bx, bf = series_backbone(p["h0"], p["ac"], max(p["C_s"], 0.0), xmax)
             core = Masing.from_backbone(bx, bf)
         elif "non_masing_scaling" in effects:
@@ -455,17 +460,18 @@ class TangentialFamily:
             # and the mirrored targets on the virgin curve), so a cached one is reused only
             # for the very same displacement (issue 13)
             mem = d.extra.get("memory")
-            if mem is None or not np.array_equal(mem.x, x):
-                mem = d.extra["memory"] = memory(x)
+            if mem is None or not np.array_equal(mem.x, xm):
+                mem = d.extra["memory"] = memory(xm)
             h = scaled_force(core.virgin, p["lam"], mem)
         elif "series_compliance" in effects:
-            h = core.force(x)
+            h = core.force(xm)
         else:
-            h = _masing_force(d, p["h0"], p["ac"], p["x0"] if x is not d.u else None, x)
+            h = _masing_force(d, p["h0"], p["ac"], p["x0"] if x is not d.u else None, xm)
         if "asymmetry" in effects:
             h = h + p["alpha"] * np.abs(h)
         if "parameter_drift" in effects:
-            h = h * (1.0 + p["beta"] * _fixed(d, "t_rel", lambda: d.t - d.t[0]) / d.duration)
+            tm = d.t if kn is None else kn.t
+            h = h * (1.0 + p["beta"] * _fixed(d, "t_rel_m", lambda: tm - d.t[0]) / d.duration)
         # from here on sample by sample: with ``at``, only at the samples asked for — or, with
         # a delay (which interpolates between samples), at the two around each shifted time
         delay = "channel_delay" in effects
@@ -475,11 +481,12 @@ class TangentialFamily:
         )
         xs = pick(x)
         if "stick_slip" in effects:
-            rev = d.cycles.reversals
-            anchors = _fixed(d, "anchors", lambda: reversal_anchors(rev, x.size))
-            h = breakaway(h, x, rev, p["s_b"], p["ell"], anchors, rows)
+            rev = d.cycles.reversals if kn is None else kn.reversals
+            anchors = _fixed(d, "anchors", lambda: reversal_anchors(rev, xm.size))
+            mrows = rows if kn is None else kn.grid if rows is None else kn.grid[rows]
+            h = breakaway(h, xm, rev, p["s_b"], p["ell"], anchors, mrows)
         else:
-            h = pick(h)
+            h = pick(h if kn is None else h[kn.grid])
         if "stribeck" in effects:
             speed = pick(_fixed(d, "speed", lambda: np.abs(d.ud)))
             h = h * (1.0 + p["s"] * np.exp(-speed / max(p["v_s"], 1e-300)))
@@ -555,7 +562,9 @@ class TangentialFamily:
         the steepest slope of the exponential element, at a reversal. The measured path is
         what marks a sticking phase (the force changes while the displacement does not),
         which a steep element crosses in a fraction of a micrometre."""
-        h = Masing(p["h0"], p["ac"]).force(d.u)
+        kn: Knots | None = d.extra.get("knots")
+        h = Masing(p["h0"], p["ac"]).force(d.u if kn is None else kn.merge(d.u))
+        h = h if kn is None else h[kn.grid]
         kmax = p["h0"] * p["ac"]
         w = min(d.window, d.y.size - (1 - d.y.size % 2))
         yd = savgol_filter(d.y, w, 3, deriv=1, mode="interp")
