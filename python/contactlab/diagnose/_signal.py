@@ -299,25 +299,3 @@ def local_extrema(u: np.ndarray) -> np.ndarray:
     up = np.diff(u)[steps] > 0
     turn = np.flatnonzero(up[1:] != up[:-1])
     return steps[turn] + 1
-
-
-def turning_knots(
-    t: np.ndarray, u: np.ndarray, reversals: np.ndarray, q: int, stop: int, limit: int
-) -> tuple[Knots, bool]:
-    """:class:`Knots` of ``u`` (raw rate, times ``t``) for the samples ``0, q, 2q, … < stop``.
-
-    At most ``limit`` knots: an input whose local extrema are more (noise left in it) keeps
-    the reversals only, and the second value says so (the memory is then exact up to the
-    noise-sized inner loops it drops)."""
-    last = ((stop - 1) // q) * q
-    ext = local_extrema(u[: last + 1])
-    exact = ext.size <= limit
-    raw = np.union1d(ext, reversals) if exact else np.asarray(reversals, dtype=np.int64)
-    raw = raw[(raw % q != 0) & (raw < last)]
-    pos = raw // q + 1
-    grid_raw = np.arange(0, last + 1, q)
-    merged_raw = np.insert(grid_raw, pos, raw)
-    grid = np.arange(grid_raw.size) + np.searchsorted(pos, np.arange(grid_raw.size), "right")
-    rev = np.asarray(reversals, dtype=np.int64)
-    rev = np.searchsorted(merged_raw, rev[rev <= last])
-    return Knots(pos, u[raw], grid, t[merged_raw], rev), exact

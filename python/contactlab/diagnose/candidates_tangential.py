@@ -49,6 +49,7 @@ from ..errors import InputError
 from ..masing import Masing, loop_area
 from ._family import Candidate, ParamSpec, Prepared, implausible_common
 from ._filters import savgol_filter
+from ._kept import delayed
 from ._signal import Knots, modulation_gains, shift
 from .scaled_masing import memory, scaled_force
 
@@ -441,6 +442,10 @@ class TangentialFamily:
         """Measured force predicted for the measured displacement ``d.u`` (at the sample
         indices ``at`` only, when given: the Masing element still runs over the whole
         history, the terms sample by sample only where asked — the same values)."""
+        if "channel_delay" in effects and "raw_input" in d.extra and p["tau"] != 0.0:
+            # a kept record (workflow.subsample_long): the model at the shifted raw positions
+            rest = tuple(e for e in effects if e != "channel_delay")
+            return self.predict(p, rest, delayed(d, p["tau"]), at)
         x = d.u
         if "displacement_offset" in effects:
             x = x - p["x0"]

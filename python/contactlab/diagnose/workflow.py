@@ -28,6 +28,7 @@ from ..errors import ConvergenceError, InputError
 from ._family import Family, Prepared
 from ._filters import decimate, savgol_coeffs
 from ._inputs import arrays as _arrays
+from ._kept import RawInput, knots_at
 from ._inputs import check_channels
 from ._parallel import EvaluationCounter, one_blas_thread, pmap
 from ._signal import (
@@ -41,7 +42,6 @@ from ._signal import (
     noise_rms,
     shortest_period_samples,
     smooth_window,
-    turning_knots,
 )
 from .locate import locate
 from .model import ExtendedModel
@@ -371,7 +371,10 @@ def subsample_long(t: np.ndarray, u: np.ndarray, y: np.ndarray) -> tuple[Prepare
         q = max(1, int(fastest // MIN_KEPT_PER_CYCLE))
     stop = min(n, (MAX_SAMPLES - 1) * q + 1)
     g = slice(0, stop, q)
-    knots, exact = turning_knots(t, uf, cyc.reversals, q, stop, 4 * MAX_SAMPLES)
+    raw, exact = RawInput.build(
+        float(t[0]), dt, uf, ud, udd, cyc.reversals, q, limit=4 * MAX_SAMPLES
+    )
+    knots = knots_at(raw, np.arange(0, stop, q))
     cycle = cyc.cycle[g].copy()
     last = ((stop - 1) // q) * q
     if stop < n:  # the cycle cut at the end belongs to no fold
@@ -384,7 +387,9 @@ def subsample_long(t: np.ndarray, u: np.ndarray, y: np.ndarray) -> tuple[Prepare
         cyc.phase_in_branch[g],
         per / q,
     )
-    extra: dict[str, Any] = {"u_raw": u[g], "u_noise": sig, "u_filter": wf, "knots": knots}
+    extra: dict[str, Any] = {
+        "u_raw": u[g], "u_noise": sig, "u_filter": wf, "knots": knots, "raw_input": raw,
+    }  # fmt: skip
     d = Prepared(t[g], uf[g], y[g], dt * q, smooth_window(per / q), ud[g], udd[g], cycles, extra)
     how = [f"kept every {q}th sample (no filter; the {knots.pos.size} turning points between "
            "them kept in the Masing memory)"]  # fmt: skip

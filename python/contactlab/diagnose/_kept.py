@@ -1,0 +1,110 @@
+"""Long tangential records kept every q-th sample, with what the model needs from the raw
+rate: the turning points between the kept samples (:class:`~._signal.Knots`) and, for a
+channel delay, the input at shifted times.
+
+:func:`contactlab.diagnose.workflow.subsample_long` keeps every q-th sample of a long record
+and computes everything the candidates see (filtered input, derivatives, cycles) at the raw
+rate; :class:`RawInput` holds those raw-rate arrays. :func:`knots_at` gives the knots for
+kept samples at any (fractional) raw positions, :func:`delayed` the recording as the model
+sees it a delay ``tau`` earlier: the model evaluated there *is* the full-rate model shifted
+by ``tau`` (interpolated between raw samples, as :func:`~._signal.shift` does at the raw
+rate), where interpolating the model between kept samples would miss by ``(π q / s)²`` of
+the force at ``s`` samples per cycle.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._family import Prepared
+from ._signal import Knots, local_extrema
+
+#: shifted recordings kept per delay (a fit steps the other parameters at one delay)
+_DELAYED_KEEP = 4
+
+
+@dataclass(frozen=True)
+class RawInput:
+    """The raw-rate arrays behind a kept record: times ``t0 + i·dt``, the input the
+    candidates see (``u``, filtered), its derivatives, the turning points (raw indices of the
+    local extrema of ``u`` and of the reversals, sorted), the reversals, and the factor."""
+
+    t0: float
+    dt: float
+    u: np.ndarray
+    ud: np.ndarray
+    udd: np.ndarray
+    turns: np.ndarray
+    reversals: np.ndarray
+    q: int
+
+    @classmethod
+    def build(
+        cls,
+        t0: float,
+        dt: float,
+        u: np.ndarray,
+        ud: np.ndarray,
+        udd: np.ndarray,
+        reversals: np.ndarray,
+        q: int,
+        limit: int,
+    ) -> tuple[RawInput, bool]:
+        """With the turning points of ``u``: all its local extrema and the reversals, or,
+        when the extrema are more than ``limit`` (noise left in the input), the reversals
+        only — the second value says which (True: all)."""
+        rev = np.asarray(reversals, dtype=np.int64)
+        ext = local_extrema(u)
+        exact = ext.size <= limit
+        turns = np.union1d(ext, rev) if exact else rev
+        return cls(t0, dt, u, ud, udd, turns, rev, q), exact
+
+
+def knots_at(raw: RawInput, pos: np.ndarray) -> Knots:
+    """:class:`~._signal.Knots` for kept samples at the ascending raw positions ``pos``
+    (fractional when shifted): every turning point before the last kept sample and not
+    on a kept sample, at its raw position."""
+    r = raw.turns[raw.turns < pos[-1]]
+    k = np.searchsorted(pos, r, side="left")  # the first kept sample at or after the knot
+    off = pos[k] != r
+    r, k = r[off], k[off]
+    merged = np.insert(pos.astype(float), k, r)
+    grid = np.arange(pos.size) + np.searchsorted(k, np.arange(pos.size), side="right")
+    rev = raw.reversals[raw.reversals <= pos[-1]]
+    return Knots(k, raw.u[r], grid, raw.t0 + raw.dt * merged, np.searchsorted(merged, rev))
+
+
+def _at(a: np.ndarray, pos: np.ndarray) -> np.ndarray:
+    """``a`` at fractional indices ``pos`` (within ``[0, a.size - 1]``), linearly."""
+    i = np.minimum(pos.astype(np.int64), a.size - 2)
+    f = pos - i
+    return a[i] + f * (a[i + 1] - a[i])
+
+
+def delayed(d: Prepared, tau: float) -> Prepared:
+    """The kept record ``d`` as the model sees it ``tau`` earlier: input, derivatives and
+    knots at the raw positions ``i·q - tau/dt`` (held at the ends), times shifted, the
+    output and the cycles as they are; the model on it without the delay is the delayed
+    model at the kept samples. Kept per ``tau``."""
+    raw: RawInput = d.extra["raw_input"]
+    memo = d.extra.setdefault("delayed", {})
+    hit = memo.get(tau)
+    if hit is not None:
+        return hit
+    n = raw.u.size
+    pos = np.clip(np.arange(d.t.size) * float(raw.q) - tau / raw.dt, 0.0, n - 1.0)
+    ts = raw.t0 + raw.dt * pos
+    extra = {k: d.extra[k] for k in ("x_mid", "x_half") if k in d.extra}
+    extra["knots"] = knots_at(raw, pos)
+    # times from the record's start (drifts, load fluctuation), as the full-rate model has
+    extra["fixed"] = {("t_rel", d.t.size): ts - d.t[0]}
+    out = Prepared(
+        ts, _at(raw.u, pos), d.y, d.dt, d.window, _at(raw.ud, pos), _at(raw.udd, pos),
+        d.cycles, extra,
+    )  # fmt: skip
+    if len(memo) >= _DELAYED_KEEP:
+        memo.clear()
+    memo[tau] = out
+    return out
