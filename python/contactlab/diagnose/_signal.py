@@ -286,9 +286,18 @@ class Knots:
     t: np.ndarray
     reversals: np.ndarray
 
+    @property
+    def size(self) -> int:
+        """Length of the merged sequence."""
+        return self.t.size
+
     def merge(self, x: np.ndarray, offset: float = 0.0) -> np.ndarray:
-        """The kept input ``x`` with the knots (shifted by ``-offset`` like ``x``) merged in."""
-        return np.insert(x, self.pos, self.x - offset)
+        """The kept input ``x`` with the knots (shifted by ``-offset`` like ``x``) merged in
+        (what ``numpy.insert(x, pos, knots - offset)`` gives, without its sort)."""
+        out = np.empty(self.t.size)
+        out[self.grid] = x
+        out[self.pos + np.arange(self.pos.size)] = self.x - offset
+        return out
 
 
 def local_extrema(u: np.ndarray) -> np.ndarray:

@@ -453,7 +453,14 @@ class TangentialFamily:
         # terms up to the breakaway run over the kept samples with the turning points
         # between them merged in (xm), which gives the full-rate values at the kept samples
         kn: Knots | None = d.extra.get("knots")
-        xm = x if kn is None else kn.merge(x, p["x0"] if x is not d.u else 0.0)
+        x0 = p["x0"] if x is not d.u else None
+        if kn is None:
+            xm = x
+        else:  # merged once per displacement (x0) and kept: the fits step x0 rarely
+            memo = _memo(d, "merged")
+            xm = memo.get(x0)
+            if xm is None:
+                xm = memo[x0] = kn.merge(x, x0 or 0.0)
         if "series_compliance" in effects:
             xmax = float(np.max(np.abs(xm))) or 1.0
             bx, bf = series_backbone(p["h0"], p["ac"], max(p["C_s"], 0.0), xmax)
@@ -471,7 +478,7 @@ class TangentialFamily:
         elif "series_compliance" in effects:
             h = core.force(xm)
         else:
-            h = _masing_force(d, p["h0"], p["ac"], p["x0"] if x is not d.u else None, xm)
+            h = _masing_force(d, p["h0"], p["ac"], x0, xm)
         if "asymmetry" in effects:
             h = h + p["alpha"] * np.abs(h)
         if "parameter_drift" in effects:
