@@ -14,6 +14,7 @@ the force at ``s`` samples per cycle.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,13 +24,16 @@ from ._signal import Knots, local_extrema
 
 #: shifted recordings kept per delay (a fit steps the other parameters at one delay)
 _DELAYED_KEEP = 4
+#: sample sets (fits, folds) whose spans are kept
+_SPANS_KEEP = 64
 
 
 @dataclass(frozen=True)
 class RawInput:
     """The raw-rate arrays behind a kept record: times ``t0 + i·dt``, the input the
     candidates see (``u``, filtered), its derivatives, the turning points (raw indices of the
-    local extrema of ``u`` and of the reversals, sorted), the reversals, and the factor."""
+    first sample, the local extrema of ``u`` and the reversals, sorted), the reversals, and
+    the factor."""
 
     t0: float
     dt: float
@@ -58,7 +62,8 @@ class RawInput:
         rev = np.asarray(reversals, dtype=np.int64)
         ext = local_extrema(u)
         exact = ext.size <= limit
-        turns = np.union1d(ext, rev) if exact else rev
+        # the first sample too: the element starts at the origin, so it may be a turn
+        turns = np.union1d(np.union1d(ext, rev) if exact else rev, [0])
         return cls(t0, dt, u, ud, udd, turns, rev, q), exact
 
 
@@ -73,7 +78,50 @@ def knots_at(raw: RawInput, pos: np.ndarray) -> Knots:
     merged = np.insert(pos.astype(float), k, r)
     grid = np.arange(pos.size) + np.searchsorted(k, np.arange(pos.size), side="right")
     rev = raw.reversals[raw.reversals <= pos[-1]]
-    return Knots(k, raw.u[r], grid, raw.t0 + raw.dt * merged, np.searchsorted(merged, rev))
+    turns = np.searchsorted(merged, raw.turns[raw.turns <= pos[-1]])
+    t = raw.t0 + raw.dt * merged
+    return Knots(k, raw.u[r], grid, t, np.searchsorted(merged, rev), turns)
+
+
+class Span:
+    """What the values at some kept samples need of a merged sequence: the positions
+    ``index`` in it of those samples and of every turning point (None: all of it),
+    the positions ``rows`` of the samples asked for within that, the reversals' positions,
+    the times, and ``token`` (telling apart spans of equal length in caches)."""
+
+    _tokens = itertools.count(1)
+
+    def __init__(self, kn: Knots, rows: np.ndarray | None) -> None:
+        if rows is None:
+            self.index, self.rows, self.reversals, self.t = None, kn.grid, kn.reversals, kn.t
+            self.token = 0
+        else:
+            keep = np.zeros(kn.size, bool)  # (a mask: a sorted union without a sort)
+            keep[kn.turns] = True
+            keep[kn.reversals] = True
+            keep[kn.grid[rows]] = True
+            self.index = np.flatnonzero(keep)
+            self.rows = np.searchsorted(self.index, kn.grid[rows])
+            self.reversals = np.searchsorted(self.index, kn.reversals)
+            self.t = kn.t[self.index]
+            self.token = next(self._tokens)
+        self.size = kn.size if self.index is None else self.index.size
+        self.anchors: tuple[np.ndarray, np.ndarray] | None = None  # filled by the model
+
+
+def span(d: Prepared, kn: Knots, rows: np.ndarray | None) -> Span:
+    """:class:`Span` of the kept record ``d`` for the samples ``rows`` (all when None), kept
+    per ``rows`` (a fit asks for the same samples thousands of times)."""
+    memo = d.extra.setdefault("spans", {})
+    key = None if rows is None else id(rows)
+    hit = memo.get(key)
+    if hit is not None and hit[0] is rows:  # (the array is held: its id is not reused)
+        return hit[1]
+    if len(memo) >= _SPANS_KEEP:
+        memo.clear()
+    out = Span(kn, rows)
+    memo[key] = (rows, out)
+    return out
 
 
 def _at(a: np.ndarray, pos: np.ndarray) -> np.ndarray:

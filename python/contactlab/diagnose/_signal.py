@@ -277,7 +277,8 @@ class Knots:
 
     ``pos``: where each knot goes (:func:`numpy.insert` positions among the kept samples);
     ``x``: the input at the knots; ``grid``: the positions of the kept samples in the merged
-    sequence; ``t``: its times; ``reversals``: the merged positions of the raw reversals.
+    sequence; ``t``: its times; ``reversals``: the merged positions of the raw reversals;
+    ``turns``: those of every turning point (knots and turning points on kept samples).
     """
 
     pos: np.ndarray
@@ -285,6 +286,7 @@ class Knots:
     grid: np.ndarray
     t: np.ndarray
     reversals: np.ndarray
+    turns: np.ndarray
 
     @property
     def size(self) -> int:

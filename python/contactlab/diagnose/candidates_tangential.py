@@ -49,7 +49,7 @@ from ..errors import InputError
 from ..masing import Masing, loop_area
 from ._family import Candidate, ParamSpec, Prepared, implausible_common
 from ._filters import savgol_filter
-from ._kept import delayed
+from ._kept import delayed, span
 from ._signal import Knots, modulation_gains, shift
 from .scaled_masing import memory, scaled_force
 
@@ -308,15 +308,17 @@ def _load_terms(d: Prepared, f_n: float, rows: np.ndarray | None) -> tuple[np.nd
 _MASING_KEEP = 64
 
 
-def _masing_force(d: Prepared, h0: float, ac: float, x0: float | None, x: np.ndarray) -> np.ndarray:
+def _masing_force(
+    d: Prepared, h0: float, ac: float, x0: float | None, x: np.ndarray, token: int = 0
+) -> np.ndarray:
     """``Masing(h0, ac).force(x)`` as ``h0`` times the force of the unit element (h0 = 1),
-    which is kept per ``(ac, x0)``: along a given history the exponential Masing force is
+    which is kept per ``(ac, x0)`` and history (``token``: a span of a kept record): along a given history the exponential Masing force is
     linear in h0 (to rounding, 1e-15 h0), and the fits step h0 and the effects' parameters
     at a fixed ac thousands of times (their Jacobian columns)."""
     if not (np.isfinite(h0) and h0 > 0):
         return Masing(h0, ac).force(x)  # the model's own refusal
     cache = d.extra.setdefault("masing", {})
-    key = (ac, x0, x.size)
+    key = (ac, x0, x.size, token)
     g = cache.get(key)
     if g is None:
         g = Masing(1.0, ac).force(x)
@@ -451,16 +453,20 @@ class TangentialFamily:
             x = x - p["x0"]
         # a record kept every q-th sample (workflow.subsample_long): the element and the
         # terms up to the breakaway run over the kept samples with the turning points
-        # between them merged in (xm), which gives the full-rate values at the kept samples
+        # between them merged in (xm), which gives the full-rate values at the kept samples;
+        # with ``at``, over the samples asked for and the turning points only (``sp``)
         kn: Knots | None = d.extra.get("knots")
         x0 = p["x0"] if x is not d.u else None
-        if kn is None:
+        sp = None if kn is None else span(d, kn, at)
+        if kn is None or sp is None:
             xm = x
         else:  # merged once per displacement (x0) and kept: the fits step x0 rarely
             memo = _memo(d, "merged")
             xm = memo.get(x0)
             if xm is None:
                 xm = memo[x0] = kn.merge(x, x0 or 0.0)
+            if sp.index is not None:
+                xm = xm[sp.index]
         if "series_compliance" in effects:
             xmax = float(np.max(np.abs(xm))) or 1.0
             bx, bf = series_backbone(p["h0"], p["ac"], max(p["C_s"], 0.0), xmax)
@@ -478,12 +484,12 @@ class TangentialFamily:
         elif "series_compliance" in effects:
             h = core.force(xm)
         else:
-            h = _masing_force(d, p["h0"], p["ac"], x0, xm)
+            h = _masing_force(d, p["h0"], p["ac"], x0, xm, 0 if sp is None else sp.token)
         if "asymmetry" in effects:
             h = h + p["alpha"] * np.abs(h)
         if "parameter_drift" in effects:
-            tm = d.t if kn is None else kn.t
-            h = h * (1.0 + p["beta"] * _fixed(d, "t_rel_m", lambda: tm - d.t[0]) / d.duration)
+            t_rel = _fixed(d, "t_rel", lambda: d.t - d.t[0]) if sp is None else sp.t - d.t[0]
+            h = h * (1.0 + p["beta"] * t_rel / d.duration)
         # from here on sample by sample: with ``at``, only at the samples asked for — or, with
         # a delay (which interpolates between samples), at the two around each shifted time
         delay = "channel_delay" in effects
@@ -493,12 +499,16 @@ class TangentialFamily:
         )
         xs = pick(x)
         if "stick_slip" in effects:
-            rev = d.cycles.reversals if kn is None else kn.reversals
-            anchors = _fixed(d, "anchors", lambda: reversal_anchors(rev, xm.size))
-            mrows = rows if kn is None else kn.grid if rows is None else kn.grid[rows]
-            h = breakaway(h, xm, rev, p["s_b"], p["ell"], anchors, mrows)
+            if sp is None:
+                rev = d.cycles.reversals
+                anchors = _fixed(d, "anchors", lambda: reversal_anchors(rev, x.size))
+                h = breakaway(h, x, rev, p["s_b"], p["ell"], anchors, rows)
+            else:
+                if sp.anchors is None:
+                    sp.anchors = reversal_anchors(sp.reversals, sp.size)
+                h = breakaway(h, xm, sp.reversals, p["s_b"], p["ell"], sp.anchors, sp.rows)
         else:
-            h = pick(h if kn is None else h[kn.grid])
+            h = pick(h) if sp is None else h[sp.rows]
         if "stribeck" in effects:
             speed = pick(_fixed(d, "speed", lambda: np.abs(d.ud)))
             h = h * (1.0 + p["s"] * np.exp(-speed / max(p["v_s"], 1e-300)))
