@@ -6,7 +6,13 @@ samples per cycle), and the branch that follows starts from the wrong point. At 
 rig records (hundreds of samples per cycle) this is far below the noise; a long record that
 is decimated until its *dominant* (slowest) block keeps 64 samples per cycle left the fastest
 block of the generator with 22 and a clean record was diagnosed with a channel delay of
--4e-5 s and a normal-load modulation. The factor is now set by the fastest cycles.
+-4e-5 s and a normal-load modulation. The factor is now set by the fastest cycles (normal
+records, :func:`reduce_long`).
+
+A long tangential record is now kept every q-th sample over its whole length
+(:func:`subsample_long`, q from the length) with the turning points between the kept samples
+in the Masing memory (:class:`~contactlab.diagnose._signal.Knots`): the model at the kept
+samples is the full-rate model, checked below for every effect of the library.
 """
 
 from __future__ import annotations
@@ -199,4 +205,4 @@ def test_kept_record_spans_the_whole_recording(kept_and_full):
     labelled = d.t[d.cycles.cycle >= 0]
     assert labelled[0] - d.t[0] < 0.02 * d.duration and d.t[-1] - labelled[-1] < 0.02 * d.duration
     assert d.cycles.n_cycles == full.cycles.n_cycles
-    assert f"kept every {q}th sample" in how and "first" not in how
+    assert f"kept one sample in {q} over its whole length" in how and "first" not in how

@@ -312,9 +312,10 @@ def _masing_force(
     d: Prepared, h0: float, ac: float, x0: float | None, x: np.ndarray, token: int = 0
 ) -> np.ndarray:
     """``Masing(h0, ac).force(x)`` as ``h0`` times the force of the unit element (h0 = 1),
-    which is kept per ``(ac, x0)`` and history (``token``: a span of a kept record): along a given history the exponential Masing force is
-    linear in h0 (to rounding, 1e-15 h0), and the fits step h0 and the effects' parameters
-    at a fixed ac thousands of times (their Jacobian columns)."""
+    which is kept per ``(ac, x0)`` and history (``token``: a span of a kept record): along a
+    given history the exponential Masing force is linear in h0 (to rounding, 1e-15 h0), and
+    the fits step h0 and the effects' parameters at a fixed ac thousands of times (their
+    Jacobian columns)."""
     if not (np.isfinite(h0) and h0 > 0):
         return Masing(h0, ac).force(x)  # the model's own refusal
     cache = d.extra.setdefault("masing", {})

@@ -28,8 +28,8 @@ from ..errors import ConvergenceError, InputError
 from ._family import Family, Prepared
 from ._filters import decimate, savgol_coeffs
 from ._inputs import arrays as _arrays
-from ._kept import RawInput, knots_at
 from ._inputs import check_channels
+from ._kept import RawInput, knots_at
 from ._parallel import EvaluationCounter, one_blas_thread, pmap
 from ._signal import (
     Cycles,
@@ -265,12 +265,11 @@ def _family(model: Any) -> tuple[Family, dict[str, float], dict[str, float]]:
     raise InputError(f"cannot diagnose a model of type {type(model).__name__}")
 
 
-#: longest record diagnosed sample by sample; longer ones are decimated (anti-aliased, zero
-#: phase) to no fewer than MIN_SAMPLES_PER_CYCLE per period of the fastest cycles (the
-#: Masing memory holds the sampled extremes: at 22 samples per cycle the true turning point
-#: is up to 1 % of the amplitude beyond them, a bias a long record's low noise shows as a
-#: delay) and, if still longer, diagnosed on their first MAX_SAMPLES samples (said so in
-#: the report)
+#: longest record diagnosed sample by sample. Longer tangential ones keep every q-th sample
+#: over their whole length with the turning points between them (:func:`subsample_long`);
+#: longer normal ones are decimated (anti-aliased, zero phase) to no fewer than
+#: MIN_SAMPLES_PER_CYCLE per period of the fastest cycles and, if still longer, diagnosed on
+#: their first MAX_SAMPLES samples (said so in the report)
 MAX_SAMPLES = 24_000
 #: Model evaluations (residual calls of every fit, numerical Jacobians included) a diagnosis
 #: may spend. Typical runs use 1 000-8 000; the slowest of 657 random fuzz inputs 7 237 (a
@@ -391,8 +390,8 @@ def subsample_long(t: np.ndarray, u: np.ndarray, y: np.ndarray) -> tuple[Prepare
         "u_raw": u[g], "u_noise": sig, "u_filter": wf, "knots": knots, "raw_input": raw,
     }  # fmt: skip
     d = Prepared(t[g], uf[g], y[g], dt * q, smooth_window(per / q), ud[g], udd[g], cycles, extra)
-    how = [f"kept every {q}th sample (no filter; the {knots.pos.size} turning points between "
-           "them kept in the Masing memory)"]  # fmt: skip
+    how = [f"kept one sample in {q} over its whole length (no filter; the {knots.pos.size} "
+           "turning points between them kept in the Masing memory)"]  # fmt: skip
     if not exact:
         how.append("the input's local extrema too many: its reversals only kept as turning points")
     if stop < n:
