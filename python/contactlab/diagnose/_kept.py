@@ -75,8 +75,10 @@ def knots_at(raw: RawInput, pos: np.ndarray) -> Knots:
     k = np.searchsorted(pos, r, side="left")  # the first kept sample at or after the knot
     off = pos[k] != r
     r, k = r[off], k[off]
-    merged = np.insert(pos.astype(float), k, r)
     grid = np.arange(pos.size) + np.searchsorted(k, np.arange(pos.size), side="right")
+    merged = np.empty(pos.size + k.size)  # (numpy.insert would sort the positions)
+    merged[grid] = pos
+    merged[k + np.arange(k.size)] = r
     rev = raw.reversals[raw.reversals <= pos[-1]]
     turns = np.searchsorted(merged, raw.turns[raw.turns <= pos[-1]])
     t = raw.t0 + raw.dt * merged
@@ -124,11 +126,12 @@ def span(d: Prepared, kn: Knots, rows: np.ndarray | None) -> Span:
     return out
 
 
-def _at(a: np.ndarray, pos: np.ndarray) -> np.ndarray:
-    """``a`` at fractional indices ``pos`` (within ``[0, a.size - 1]``), linearly."""
-    i = np.minimum(pos.astype(np.int64), a.size - 2)
+def _at(pos: np.ndarray, n: int, *arrays: np.ndarray) -> list[np.ndarray]:
+    """Each of ``arrays`` (``n`` samples) at the fractional indices ``pos`` (within
+    ``[0, n - 1]``), linearly."""
+    i = np.minimum(pos.astype(np.int64), n - 2)
     f = pos - i
-    return a[i] + f * (a[i + 1] - a[i])
+    return [a[i] + f * (a[i + 1] - a[i]) for a in arrays]
 
 
 def delayed(d: Prepared, tau: float) -> Prepared:
@@ -148,10 +151,8 @@ def delayed(d: Prepared, tau: float) -> Prepared:
     extra["knots"] = knots_at(raw, pos)
     # times from the record's start (drifts, load fluctuation), as the full-rate model has
     extra["fixed"] = {("t_rel", d.t.size): ts - d.t[0]}
-    out = Prepared(
-        ts, _at(raw.u, pos), d.y, d.dt, d.window, _at(raw.ud, pos), _at(raw.udd, pos),
-        d.cycles, extra,
-    )  # fmt: skip
+    u, ud, udd = _at(pos, n, raw.u, raw.ud, raw.udd)
+    out = Prepared(ts, u, d.y, d.dt, d.window, ud, udd, d.cycles, extra)
     if len(memo) >= _DELAYED_KEEP:
         memo.clear()
     memo[tau] = out
