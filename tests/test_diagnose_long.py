@@ -208,3 +208,28 @@ def test_kept_record_spans_the_whole_recording(kept_and_full):
     assert labelled[0] - d.t[0] < 0.02 * d.duration and d.t[-1] - labelled[-1] < 0.02 * d.duration
     assert d.cycles.n_cycles == full.cycles.n_cycles
     assert f"kept one sample in {q} over its whole length" in how and "first" not in how
+
+
+def test_kept_record_of_short_cycles_is_cut_and_says_so():
+    """Cycles too short to keep MIN_KEPT_PER_CYCLE samples at the length's q: q is lowered
+    (here to 1) and only the first MAX_SAMPLES samples are diagnosed, said in the sentence;
+    the cycle cut at the end belongs to no fold."""
+    n = 40_000
+    t = np.arange(n) / 1000.0
+    x = 1e-5 * np.sin(2 * np.pi * t * 1000.0 / 20.0)  # 20 samples per cycle
+    F = contactlab.Masing(50.0, 5e4).force(x)
+    d, how = subsample_long(t, x, F)
+    assert d.t.size == MAX_SAMPLES and d.dt == pytest.approx(1e-3)
+    assert "first 1200 of 2000 excitation cycles" in how
+    assert d.cycles.cycle[-1] == -1
+
+
+def test_too_many_extrema_keep_the_reversals_only():
+    """An input whose local extrema exceed the limit (noise left in it) keeps the reversals
+    (and the first sample) as turning points, and says it is not exact."""
+    u = np.random.default_rng(5).normal(size=5_000)
+    rev = np.array([100, 900, 2500])
+    raw, exact = RawInput.build(0.0, 1.0, u, u, u, rev, 10, limit=100)
+    assert not exact and raw.turns.tolist() == [0, 100, 900, 2500]
+    raw, exact = RawInput.build(0.0, 1.0, u, u, u, rev, 10, limit=10_000)
+    assert exact and raw.turns.size > 1_000 and set(rev) <= set(raw.turns.tolist())
