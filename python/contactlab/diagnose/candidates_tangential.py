@@ -49,7 +49,8 @@ from ..errors import InputError
 from ..masing import Masing, loop_area
 from ._family import Candidate, ParamSpec, Prepared, implausible_common
 from ._filters import savgol_filter
-from ._signal import modulation_gains, shift
+from ._kept import delayed, span
+from ._signal import Knots, modulation_gains, shift
 from .scaled_masing import memory, scaled_force
 
 _INF = np.inf
@@ -307,15 +308,18 @@ def _load_terms(d: Prepared, f_n: float, rows: np.ndarray | None) -> tuple[np.nd
 _MASING_KEEP = 64
 
 
-def _masing_force(d: Prepared, h0: float, ac: float, x0: float | None, x: np.ndarray) -> np.ndarray:
+def _masing_force(
+    d: Prepared, h0: float, ac: float, x0: float | None, x: np.ndarray, token: int = 0
+) -> np.ndarray:
     """``Masing(h0, ac).force(x)`` as ``h0`` times the force of the unit element (h0 = 1),
-    which is kept per ``(ac, x0)``: along a given history the exponential Masing force is
-    linear in h0 (to rounding, 1e-15 h0), and the fits step h0 and the effects' parameters
-    at a fixed ac thousands of times (their Jacobian columns)."""
+    which is kept per ``(ac, x0)`` and history (``token``: a span of a kept record): along a
+    given history the exponential Masing force is linear in h0 (to rounding, 1e-15 h0), and
+    the fits step h0 and the effects' parameters at a fixed ac thousands of times (their
+    Jacobian columns)."""
     if not (np.isfinite(h0) and h0 > 0):
         return Masing(h0, ac).force(x)  # the model's own refusal
     cache = d.extra.setdefault("masing", {})
-    key = (ac, x0, x.size)
+    key = (ac, x0, x.size, token)
     g = cache.get(key)
     if g is None:
         g = Masing(1.0, ac).force(x)
@@ -441,11 +445,31 @@ class TangentialFamily:
         """Measured force predicted for the measured displacement ``d.u`` (at the sample
         indices ``at`` only, when given: the Masing element still runs over the whole
         history, the terms sample by sample only where asked — the same values)."""
+        if "channel_delay" in effects and "raw_input" in d.extra and p["tau"] != 0.0:
+            # a kept record (workflow.subsample_long): the model at the shifted raw positions
+            rest = tuple(e for e in effects if e != "channel_delay")
+            return self.predict(p, rest, delayed(d, p["tau"]), at)
         x = d.u
         if "displacement_offset" in effects:
             x = x - p["x0"]
+        # a record kept every q-th sample (workflow.subsample_long): the element and the
+        # terms up to the breakaway run over the kept samples with the turning points
+        # between them merged in (xm), which gives the full-rate values at the kept samples;
+        # with ``at``, over the samples asked for and the turning points only (``sp``)
+        kn: Knots | None = d.extra.get("knots")
+        x0 = p["x0"] if x is not d.u else None
+        sp = None if kn is None else span(d, kn, at)
+        if kn is None or sp is None:
+            xm = x
+        else:  # merged once per displacement (x0) and kept: the fits step x0 rarely
+            memo = _memo(d, "merged")
+            xm = memo.get(x0)
+            if xm is None:
+                xm = memo[x0] = kn.merge(x, x0 or 0.0)
+            if sp.index is not None:
+                xm = xm[sp.index]
         if "series_compliance" in effects:
-            xmax = float(np.max(np.abs(x))) or 1.0
+            xmax = float(np.max(np.abs(xm))) or 1.0
             bx, bf = series_backbone(p["h0"], p["ac"], max(p["C_s"], 0.0), xmax)
             core = Masing.from_backbone(bx, bf)
         elif "non_masing_scaling" in effects:
@@ -455,17 +479,18 @@ class TangentialFamily:
             # and the mirrored targets on the virgin curve), so a cached one is reused only
             # for the very same displacement (issue 13)
             mem = d.extra.get("memory")
-            if mem is None or not np.array_equal(mem.x, x):
-                mem = d.extra["memory"] = memory(x)
+            if mem is None or not np.array_equal(mem.x, xm):
+                mem = d.extra["memory"] = memory(xm)
             h = scaled_force(core.virgin, p["lam"], mem)
         elif "series_compliance" in effects:
-            h = core.force(x)
+            h = core.force(xm)
         else:
-            h = _masing_force(d, p["h0"], p["ac"], p["x0"] if x is not d.u else None, x)
+            h = _masing_force(d, p["h0"], p["ac"], x0, xm, 0 if sp is None else sp.token)
         if "asymmetry" in effects:
             h = h + p["alpha"] * np.abs(h)
         if "parameter_drift" in effects:
-            h = h * (1.0 + p["beta"] * _fixed(d, "t_rel", lambda: d.t - d.t[0]) / d.duration)
+            t_rel = _fixed(d, "t_rel", lambda: d.t - d.t[0]) if sp is None else sp.t - d.t[0]
+            h = h * (1.0 + p["beta"] * t_rel / d.duration)
         # from here on sample by sample: with ``at``, only at the samples asked for — or, with
         # a delay (which interpolates between samples), at the two around each shifted time
         delay = "channel_delay" in effects
@@ -475,11 +500,16 @@ class TangentialFamily:
         )
         xs = pick(x)
         if "stick_slip" in effects:
-            rev = d.cycles.reversals
-            anchors = _fixed(d, "anchors", lambda: reversal_anchors(rev, x.size))
-            h = breakaway(h, x, rev, p["s_b"], p["ell"], anchors, rows)
+            if sp is None:
+                rev = d.cycles.reversals
+                anchors = _fixed(d, "anchors", lambda: reversal_anchors(rev, x.size))
+                h = breakaway(h, x, rev, p["s_b"], p["ell"], anchors, rows)
+            else:
+                if sp.anchors is None:
+                    sp.anchors = reversal_anchors(sp.reversals, sp.size)
+                h = breakaway(h, xm, sp.reversals, p["s_b"], p["ell"], sp.anchors, sp.rows)
         else:
-            h = pick(h)
+            h = pick(h) if sp is None else h[sp.rows]
         if "stribeck" in effects:
             speed = pick(_fixed(d, "speed", lambda: np.abs(d.ud)))
             h = h * (1.0 + p["s"] * np.exp(-speed / max(p["v_s"], 1e-300)))
@@ -555,7 +585,9 @@ class TangentialFamily:
         the steepest slope of the exponential element, at a reversal. The measured path is
         what marks a sticking phase (the force changes while the displacement does not),
         which a steep element crosses in a fraction of a micrometre."""
-        h = Masing(p["h0"], p["ac"]).force(d.u)
+        kn: Knots | None = d.extra.get("knots")
+        h = Masing(p["h0"], p["ac"]).force(d.u if kn is None else kn.merge(d.u))
+        h = h if kn is None else h[kn.grid]
         kmax = p["h0"] * p["ac"]
         w = min(d.window, d.y.size - (1 - d.y.size % 2))
         yd = savgol_filter(d.y, w, 3, deriv=1, mode="interp")

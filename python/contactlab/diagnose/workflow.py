@@ -29,8 +29,20 @@ from ._family import Family, Prepared
 from ._filters import decimate, savgol_coeffs
 from ._inputs import arrays as _arrays
 from ._inputs import check_channels
+from ._kept import RawInput, knots_at
 from ._parallel import EvaluationCounter, one_blas_thread, pmap
-from ._signal import check_uniform, dominant_period_samples, noise_rms, shortest_period_samples
+from ._signal import (
+    Cycles,
+    check_uniform,
+    derivatives,
+    dominant_period_samples,
+    filter_input,
+    find_cycles,
+    input_noise,
+    noise_rms,
+    shortest_period_samples,
+    smooth_window,
+)
 from .locate import locate
 from .model import ExtendedModel
 from .select import Trial, Verdict, evaluate, fit, fold_masks, judge
@@ -253,12 +265,11 @@ def _family(model: Any) -> tuple[Family, dict[str, float], dict[str, float]]:
     raise InputError(f"cannot diagnose a model of type {type(model).__name__}")
 
 
-#: longest record diagnosed sample by sample; longer ones are decimated (anti-aliased, zero
-#: phase) to no fewer than MIN_SAMPLES_PER_CYCLE per period of the fastest cycles (the
-#: Masing memory holds the sampled extremes: at 22 samples per cycle the true turning point
-#: is up to 1 % of the amplitude beyond them, a bias a long record's low noise shows as a
-#: delay) and, if still longer, diagnosed on their first MAX_SAMPLES samples (said so in
-#: the report)
+#: longest record diagnosed sample by sample. Longer tangential ones keep every q-th sample
+#: over their whole length with the turning points between them (:func:`subsample_long`);
+#: longer normal ones are decimated (anti-aliased, zero phase) to no fewer than
+#: MIN_SAMPLES_PER_CYCLE per period of the fastest cycles and, if still longer, diagnosed on
+#: their first MAX_SAMPLES samples (said so in the report)
 MAX_SAMPLES = 24_000
 #: Model evaluations (residual calls of every fit, numerical Jacobians included) a diagnosis
 #: may spend. Typical runs use 1 000-8 000; the slowest of 657 random fuzz inputs 7 237 (a
@@ -322,6 +333,73 @@ def reduce_long(
             f"diagnosed on its first {MAX_SAMPLES * q / per:.0f} of {cycles:.0f} excitation cycles"
         )
     return t, u, y, f"the record of {n} samples was " + " and ".join(how)
+
+
+#: fewest samples per cycle of the fastest cycles that a tangential record is subsampled to
+#: (:func:`subsample_long`): the Masing memory is exact at any rate with the knots, but the
+#: delay's interpolation, the reversal anchors and the cycle split want a dozen per cycle
+MIN_KEPT_PER_CYCLE = 12
+
+
+def subsample_long(t: np.ndarray, u: np.ndarray, y: np.ndarray) -> tuple[Prepared, str]:
+    """A long tangential record kept every q-th sample over its whole length (q from the
+    record's length, so that at most :data:`MAX_SAMPLES` are kept), ready for the
+    candidates, and a sentence saying how.
+
+    Everything the candidates see is computed at the raw rate and then sampled: the
+    filtered input, its derivatives, the cycles and the input noise. No anti-alias filter:
+    the kept force samples are the measured ones, so the model at the kept samples is the
+    full-rate model there (a low-pass filter would take the loop's corners out of the
+    force but not out of the model's prediction). The turning points between the kept
+    samples go with them as :class:`~contactlab.diagnose._signal.Knots`, which the Masing
+    element runs over, so its memory holds the true extremes. When the fastest cycles
+    would keep fewer than :data:`MIN_KEPT_PER_CYCLE` samples, q is lowered and only the
+    first :data:`MAX_SAMPLES` kept samples are diagnosed (said so).
+    """
+    n = t.size
+    dt = check_uniform(t)
+    per = dominant_period_samples(u)
+    ud, udd = derivatives(u, dt, smooth_window(per))
+    cyc = find_cycles(u, per)
+    sig = input_noise(u)
+    uf, wf = filter_input(u, per, sig)
+    half = np.diff(cyc.reversals)
+    fastest = min(per, 2.0 * float(np.percentile(half, 10))) if half.size >= 4 else per
+    q = -(-n // MAX_SAMPLES)
+    if fastest / q < MIN_KEPT_PER_CYCLE:
+        q = max(1, int(fastest // MIN_KEPT_PER_CYCLE))
+    stop = min(n, (MAX_SAMPLES - 1) * q + 1)
+    g = slice(0, stop, q)
+    raw, exact = RawInput.build(
+        float(t[0]), dt, uf, ud, udd, cyc.reversals, q, limit=4 * MAX_SAMPLES
+    )
+    knots = knots_at(raw, np.arange(0, stop, q))
+    cycle = cyc.cycle[g].copy()
+    last = ((stop - 1) // q) * q
+    if stop < n:  # the cycle cut at the end belongs to no fold
+        cycle[cycle > np.count_nonzero(cyc.reversals[cyc.is_max] <= last) - 2] = -1
+    keep = cyc.reversals <= last
+    cycles = Cycles(
+        np.rint(cyc.reversals[keep] / q).astype(int),
+        cyc.is_max[keep],
+        cycle,
+        cyc.phase_in_branch[g],
+        per / q,
+    )
+    extra: dict[str, Any] = {
+        "u_raw": u[g], "u_noise": sig, "u_filter": wf, "knots": knots, "raw_input": raw,
+    }  # fmt: skip
+    d = Prepared(t[g], uf[g], y[g], dt * q, smooth_window(per / q), ud[g], udd[g], cycles, extra)
+    how = [f"kept one sample in {q} over its whole length (no filter; the {knots.pos.size} "
+           "turning points between them kept in the Masing memory)"]  # fmt: skip
+    if not exact:
+        how.append("the input's local extrema too many: its reversals only kept as turning points")
+    if stop < n:
+        how.append(
+            f"diagnosed on its first {stop / per:.0f} of {n / per:.0f} excitation cycles "
+            f"(the fastest cycles have {fastest:.0f} samples)"
+        )
+    return d, f"the record of {n} samples was " + " and ".join(how)
 
 
 def eiv_weight(
@@ -519,8 +597,11 @@ def diagnose(
                 f"unknown {family.kind} candidate {n!r}; choose from {', '.join(family.candidates)}"
             )
     n_in = t.size
-    t, u, y, reduced = reduce_long(t, u, y)
-    d = Prepared.build(t, u, y)
+    if family.kind == "tangential" and n_in > MAX_SAMPLES:
+        d, reduced = subsample_long(t, u, y)
+    else:
+        t, u, y, reduced = reduce_long(t, u, y)
+        d = Prepared.build(t, u, y)
     d.extra.update(context)
     d.extra["evaluations"] = spent = EvaluationCounter()  # counted by select.fit
     family.prepare(d)
@@ -547,7 +628,7 @@ def diagnose(
     where.insert(0, family.regime(current.full.params, d))
     if reduced:
         where.insert(1, reduced)
-    location["samples"] = {"recording": n_in, "diagnosed": int(t.size)}
+    location["samples"] = {"recording": n_in, "diagnosed": int(d.t.size)}
     if w is not None:
         low = float(np.mean(d.extra["weight"] < 0.5))
         location["low_weight_fraction"] = low
