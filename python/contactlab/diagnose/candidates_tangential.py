@@ -40,6 +40,7 @@ measured force.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable
 from typing import Any
 
@@ -514,10 +515,64 @@ class TangentialFamily:
                 F = np.interp(d.t[at] - p["tau"], d.t[rows], F)
         return F if F.flags.writeable else F.copy()
 
+    #: :meth:`derived` takes the model's effects and the data (keywords ``effects``, ``d``)
+    derived_from_data = True
+
+    def model_breakaway(self, p: dict[str, float], effects: tuple[str, ...], d: Prepared) -> float:
+        """The breakaway force of the fitted model as the sticks of the data measure it: the
+        mean over the strokes between reversals of the largest force within ``3 ell`` of
+        the reversal, about the model's own zero (the force offset and drift taken off).
+
+        This is the quantity :func:`contactlab.tangential.regime.stick_slip` reads off the
+        measured sticks (the largest ``|F - offset|`` while stuck and up to the onset of
+        sliding). It is read off the whole model, not off the breakaway term alone: on the
+        measured frame the friction along the track (``position_friction``) is 18 % lower
+        at the stroke's ends, where the breakaway happens, than its mean ``h0``; a full
+        branch of the term alone from ``-h0`` (:func:`breakaway_force`) put the breakaway
+        1.2x too high there.
+        """
+        F = self.predict(p, effects, d)
+        if "force_offset" in effects:
+            F = F - p["F0"]
+        if "force_drift" in effects:
+            F = F - p["F1"] * (d.t - d.t[0]) / d.duration
+        rev = d.cycles.reversals
+        reach = 3.0 * p["ell"] if "stick_slip" in effects else 3.0 / p["ac"]
+        peaks = []
+        for a, b in itertools.pairwise(rev):
+            s = 1.0 if d.u[b] > d.u[a] else -1.0
+            near = s * (d.u[a:b] - d.u[a]) <= reach
+            if np.any(near):
+                peaks.append(float(np.max(s * F[a:b][near])))
+        return float(np.mean(peaks)) if peaks else np.nan
+
     def derived(
-        self, p: dict[str, float], se: dict[str, float], effect: str
+        self,
+        p: dict[str, float],
+        se: dict[str, float],
+        effect: str,
+        *,
+        effects: tuple[str, ...] | None = None,
+        d: Prepared | None = None,
     ) -> tuple[dict[str, float], dict[str, float]]:
-        """Extra reported quantities of an effect (with delta-method standard errors)."""
+        """Extra reported quantities of an effect (with delta-method standard errors).
+
+        ``stick_slip``'s ``breakaway_force``: with the model's ``effects`` and the data
+        ``d``, :meth:`model_breakaway` (comparable with ``analyze``'s breakaway force of the
+        sticks); without them, the peak of a full branch of the breakaway term
+        (:func:`breakaway_force`), which ignores the other effects.
+        """
+        if effect == "stick_slip" and effects is not None and d is not None:
+            val = self.model_breakaway(p, effects, d)
+            var = 0.0
+            for k, s in se.items():
+                if not (np.isfinite(s) and s > 0):
+                    continue
+                step = 1e-3 * s
+                q = dict(p)
+                q[k] += step
+                var += ((self.model_breakaway(q, effects, d) - val) / step * s) ** 2
+            return {"breakaway_force": val}, {"breakaway_force": float(np.sqrt(var))}
         if effect == "series_compliance" and p["C_s"] > 0:
             return {"k_s": 1.0 / p["C_s"]}, {"k_s": se["C_s"] / p["C_s"] ** 2}
         if effect == "asymmetry":
