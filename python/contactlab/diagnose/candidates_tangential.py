@@ -241,6 +241,11 @@ def _grid(x: np.ndarray, F: np.ndarray) -> tuple[float, float, float]:
 
 #: ac·A from which the base loop is near-rectangular (gross sliding, as regime() says)
 GROSS_SLIDING_ZA = 10.0
+#: a gross-sliding base whose h0 is this many combined standard errors from the plateau
+#: force is re-anchored to it (TangentialFamily.anchor); h0 is then held within
+#: ANCHOR_BAND plateau errors of the plateau
+ANCHOR_SIGMAS = 3.0
+ANCHOR_BAND = 2.0
 
 
 def _fixed(d: Prepared, key: str, make: Callable[[], Any]) -> Any:
@@ -337,8 +342,63 @@ class TangentialFamily:
     """Masing base model with the tangential candidate library (see module docstring)."""
 
     kind = "tangential"
-    base_params = BASE_PARAMS
     candidates = CANDIDATES
+    #: the base's h0 held to this band and ac to at least ``ac_floor`` (:meth:`anchor`)
+    h0_band: tuple[float, float] | None = None
+    ac_floor: float = 0.0
+
+    @property
+    def base_params(self) -> tuple[ParamSpec, ...]:
+        """``h0`` and ``ac``; within the plateau's band once :meth:`anchor` has set one."""
+        if self.h0_band is None:
+            return BASE_PARAMS
+        lo, hi = self.h0_band
+        return (
+            ParamSpec("h0", "N", _INF, lo, hi, "F"),
+            ParamSpec("ac", "1/m", _INF, self.ac_floor, _INF, "ac"),
+        )
+
+    def anchor(self, p: dict[str, float], se: dict[str, float], d: Prepared) -> str | None:
+        """Fix the base first when it is in the wrong regime: in gross sliding (``ac·A`` of
+        the base fit at least :data:`GROSS_SLIDING_ZA`) the plateau measures ``h0``
+        directly and ``ac`` is only bounded from below
+        (:func:`contactlab.tangential.regime.plateau`, on the measured displacement, as
+        ``analyze`` reads it). When the base's ``h0`` lies more than
+        :data:`ANCHOR_SIGMAS` combined standard errors from the plateau (the least-squares
+        fit trades ``h0`` against what the Masing element cannot follow: the sticks, the
+        friction varying along the track), ``h0`` is held within
+        :data:`ANCHOR_BAND` plateau errors of it and ``ac`` above the bound from then on
+        (the base and every candidate), so no effect is credited with moving ``h0`` back.
+        Returns a sentence saying so, or None (nothing changed)."""
+        from ..tangential.preprocess import average_loop
+        from ..tangential.regime import plateau, velocity
+
+        amp = 0.5 * float(np.ptp(d.u))
+        if self.h0_band is not None or p["ac"] * amp < GROSS_SLIDING_ZA:
+            return None
+        x = d.extra.get("u_raw", d.u)
+        try:
+            loop = average_loop(x, d.y, d.t)
+            v, thr, _ = velocity(d.t, x)
+            pl = plateau(loop, x, d.y, v, thr)
+        except (InputError, ValueError):  # no loop to average: no plateau to anchor to
+            return None
+        if pl is None or not (np.isfinite(pl.h0_stderr) and pl.h0_stderr > 0):
+            return None
+        err = float(np.hypot(se["h0"] if np.isfinite(se["h0"]) else 0.0, pl.h0_stderr))
+        off = abs(p["h0"] - pl.h0) / err
+        if off <= ANCHOR_SIGMAS:
+            return None
+        band = ANCHOR_BAND * pl.h0_stderr
+        self.h0_band = (pl.h0 - band, pl.h0 + band)
+        self.ac_floor = min(pl.ac_lower_bound, p["ac"])
+        return (
+            f"base re-anchored to the plateau: in gross sliding h0 is the plateau force "
+            f"{pl.h0:.4g} ± {pl.h0_stderr:.2g} N, but the least-squares base put it at "
+            f"{p['h0']:.4g} N ({off:.1f} σ away); h0 is held within ±{band:.2g} N of the "
+            f"plateau and ac ≥ {self.ac_floor:.3g} 1/m (only a lower bound is identified)"
+        )
+
     input_name = "x"
     output_name = "F"
     input_unit = "m"

@@ -444,6 +444,10 @@ def _drop_check(
     return judge(name, reduced, current, sigma, z, min_gain + extra, prop), reduced
 
 
+#: the swap move's threshold on the t statistic of the per-cycle gain (see _swap_search)
+SWAP_Z = 0.0
+
+
 def _swap_search(
     family: Family,
     names: list[str],
@@ -454,7 +458,6 @@ def _swap_search(
     scales: dict[str, float],
     folds: int,
     sigma: float,
-    z: float,
     min_gain: float,
     budget: float,
     base_fit: dict[str, float],
@@ -464,8 +467,11 @@ def _swap_search(
     not in the model.
 
     Each swapped model is judged against the current one by the rules of a forward step
-    (:func:`_try_candidate` with the effect taken out: the in-sample screening, then the
-    held-out gain, its consistency across cycles, the BIC, and plausibility). Returns the
+    (:func:`_try_candidate` with the effect taken out: the in-sample screening, the held-out
+    gain of at least ``min_gain`` σ² and :data:`~contactlab.diagnose.select.MIN_RELATIVE_GAIN`
+    of the current error, the BIC, plausibility), except that the gain across held-out
+    cycles need only be positive on average (``t > SWAP_Z``), not significant: a swap does
+    not make the model larger, it picks the better of two of the same size. Returns the
     best accepted swap ``(effect out, verdict on the one in, its trial)`` or None, every
     verdict (named ``"out ⇄ in"``), and the model evaluations spent.
     """
@@ -484,7 +490,7 @@ def _swap_search(
         out, name = pair
         rest = tuple(e for e in effects if e != out)
         return _try_candidate(
-            name, family, current, rest, d, scales, folds, sigma, z, min_gain, budget,
+            name, family, current, rest, d, scales, folds, sigma, SWAP_Z, min_gain, budget,
             base_fit, all_samples,
         )  # fmt: skip
 
@@ -604,7 +610,20 @@ def diagnose(
         sigma = noise_rms(current.full_residual(d))
     else:
         current = evaluate(family, effects, d, start, scales, folds, base_all, parallel=True)
+    anchor = getattr(family, "anchor", None)
+    anchored = anchor(current.full.params, current.full.stderr, d) if anchor else None
+    unanchored = {}
+    if anchored:  # the base was in the wrong regime: fixed before any effect is tried
+        unanchored = {
+            "heldout_rms": current.heldout_rms,
+            "h0": current.full.params["h0"],
+            "h0_stderr": _finite_or_none(current.full.stderr["h0"]),
+        }
+        current = evaluate(family, effects, d, current.full.params, scales, folds, parallel=True)
     where, location = locate(d, current.full_residual(d), family)
+    if anchored:
+        location["base_unanchored"] = unanchored
+        where.insert(0, anchored)
     where.insert(0, family.regime(current.full.params, d))
     if reduced:
         where.insert(1, reduced)
@@ -685,7 +704,7 @@ def diagnose(
             # swap move: no effect can be added (the set is full, or nothing else helps);
             # an effect named early may stand in for one never tried because the set filled
             swap, swap_verdicts, n = _swap_search(
-                family, names, current, tuple(added), visited, d, scales, folds, sigma, z,
+                family, names, current, tuple(added), visited, d, scales, folds, sigma,
                 min_gain, budget, base_fit, all_samples,
             )  # fmt: skip
             used += n
@@ -708,16 +727,22 @@ def diagnose(
                     f"predicts the held-out cycles better: gain {v.gain:.3g} σ², t = "
                     f"{v.t_stat:.2f})"
                 )
-                continue
-        if best is None:
+                best = None
+            elif best is None:
+                break
+        elif best is None:
             break
-        v, current = best
-        effects = current.effects
-        added.append(v.name)
-        trials.append(current)
-        steps.append(Step(v.name, current.heldout_rms, current.heldout_peak, current.energy_error))
-        visited.add(frozenset(effects))
-        # backward elimination: an effect named early may be redundant once later ones are in
+        if best is not None:
+            v, current = best
+            effects = current.effects
+            added.append(v.name)
+            trials.append(current)
+            steps.append(
+                Step(v.name, current.heldout_rms, current.heldout_peak, current.energy_error)
+            )
+            visited.add(frozenset(effects))
+        # backward elimination (after an addition or a swap): an effect named early may be
+        # redundant once later ones are in
         while len(added) >= 2 and used < MAX_EVALUATIONS:
             back = partial(
                 _drop_check, family=family, current=current, d=d, scales=scales,
