@@ -368,8 +368,9 @@ class TangentialFamily:
         fit trades ``h0`` against what the Masing element cannot follow: the sticks, the
         friction varying along the track), ``h0`` is held within
         :data:`ANCHOR_BAND` plateau errors of it and ``ac`` above the bound from then on
-        (the base and every candidate), so no effect is credited with moving ``h0`` back.
-        Returns a sentence saying so, or None (nothing changed)."""
+        (the base and every candidate), so no effect is credited with moving ``h0`` back;
+        the band stays with the family (a refit of the final model keeps it). Returns a
+        sentence saying so, or None (nothing changed)."""
         from ..tangential.preprocess import average_loop
         from ..tangential.regime import plateau, velocity
 

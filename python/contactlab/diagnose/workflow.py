@@ -17,6 +17,7 @@ RMS, peak error and loop-energy error after each step.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import json
 import sys
@@ -610,8 +611,10 @@ def diagnose(
         sigma = noise_rms(current.full_residual(d))
     else:
         current = evaluate(family, effects, d, start, scales, folds, base_all, parallel=True)
-    anchor = getattr(family, "anchor", None)
-    anchored = anchor(current.full.params, current.full.stderr, d) if anchor else None
+    anchored = None
+    if hasattr(family, "anchor"):  # on a copy: a model passed in keeps its own family
+        family = copy.copy(family)
+        anchored = family.anchor(current.full.params, current.full.stderr, d)
     unanchored = {}
     if anchored:  # the base was in the wrong regime: fixed before any effect is tried
         unanchored = {
