@@ -40,6 +40,7 @@ measured force.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable
 from typing import Any
 
@@ -241,6 +242,11 @@ def _grid(x: np.ndarray, F: np.ndarray) -> tuple[float, float, float]:
 
 #: ac·A from which the base loop is near-rectangular (gross sliding, as regime() says)
 GROSS_SLIDING_ZA = 10.0
+#: a gross-sliding base whose h0 is this many combined standard errors from the plateau
+#: force is re-anchored to it (TangentialFamily.anchor); h0 is then held within
+#: ANCHOR_BAND plateau errors of the plateau
+ANCHOR_SIGMAS = 3.0
+ANCHOR_BAND = 2.0
 
 
 def _fixed(d: Prepared, key: str, make: Callable[[], Any]) -> Any:
@@ -340,8 +346,64 @@ class TangentialFamily:
     """Masing base model with the tangential candidate library (see module docstring)."""
 
     kind = "tangential"
-    base_params = BASE_PARAMS
     candidates = CANDIDATES
+    #: the base's h0 held to this band and ac to at least ``ac_floor`` (:meth:`anchor`)
+    h0_band: tuple[float, float] | None = None
+    ac_floor: float = 0.0
+
+    @property
+    def base_params(self) -> tuple[ParamSpec, ...]:
+        """``h0`` and ``ac``; within the plateau's band once :meth:`anchor` has set one."""
+        if self.h0_band is None:
+            return BASE_PARAMS
+        lo, hi = self.h0_band
+        return (
+            ParamSpec("h0", "N", _INF, lo, hi, "F"),
+            ParamSpec("ac", "1/m", _INF, self.ac_floor, _INF, "ac"),
+        )
+
+    def anchor(self, p: dict[str, float], se: dict[str, float], d: Prepared) -> str | None:
+        """Fix the base first when it is in the wrong regime: in gross sliding (``ac·A`` of
+        the base fit at least :data:`GROSS_SLIDING_ZA`) the plateau measures ``h0``
+        directly and ``ac`` is only bounded from below
+        (:func:`contactlab.tangential.regime.plateau`, on the measured displacement, as
+        ``analyze`` reads it). When the base's ``h0`` lies more than
+        :data:`ANCHOR_SIGMAS` combined standard errors from the plateau (the least-squares
+        fit trades ``h0`` against what the Masing element cannot follow: the sticks, the
+        friction varying along the track), ``h0`` is held within
+        :data:`ANCHOR_BAND` plateau errors of it and ``ac`` above the bound from then on
+        (the base and every candidate), so no effect is credited with moving ``h0`` back;
+        the band stays with the family (a refit of the final model keeps it). Returns a
+        sentence saying so, or None (nothing changed)."""
+        from ..tangential.preprocess import average_loop
+        from ..tangential.regime import plateau, velocity
+
+        amp = 0.5 * float(np.ptp(d.u))
+        if self.h0_band is not None or p["ac"] * amp < GROSS_SLIDING_ZA:
+            return None
+        x = d.extra.get("u_raw", d.u)
+        try:
+            loop = average_loop(x, d.y, d.t)
+            v, thr, _ = velocity(d.t, x)
+            pl = plateau(loop, x, d.y, v, thr)
+        except (InputError, ValueError):  # no loop to average: no plateau to anchor to
+            return None
+        if pl is None or not (np.isfinite(pl.h0_stderr) and pl.h0_stderr > 0):
+            return None
+        err = float(np.hypot(se["h0"] if np.isfinite(se["h0"]) else 0.0, pl.h0_stderr))
+        off = abs(p["h0"] - pl.h0) / err
+        if off <= ANCHOR_SIGMAS:
+            return None
+        band = ANCHOR_BAND * pl.h0_stderr
+        self.h0_band = (pl.h0 - band, pl.h0 + band)
+        self.ac_floor = min(pl.ac_lower_bound, p["ac"])
+        return (
+            f"base re-anchored to the plateau: in gross sliding h0 is the plateau force "
+            f"{pl.h0:.4g} ± {pl.h0_stderr:.2g} N, but the least-squares base put it at "
+            f"{p['h0']:.4g} N ({off:.1f} σ away); h0 is held within ±{band:.2g} N of the "
+            f"plateau and ac ≥ {self.ac_floor:.3g} 1/m (only a lower bound is identified)"
+        )
+
     input_name = "x"
     output_name = "F"
     input_unit = "m"
@@ -544,10 +606,66 @@ class TangentialFamily:
                 F = np.interp(d.t[at] - p["tau"], d.t[rows], F)
         return F if F.flags.writeable else F.copy()
 
+    #: :meth:`derived` takes the model's effects and the data (keywords ``effects``, ``d``)
+    derived_from_data = True
+
+    def model_breakaway(self, p: dict[str, float], effects: tuple[str, ...], d: Prepared) -> float:
+        """The breakaway force of the fitted model as the sticks of the data measure it: the
+        mean over the strokes between reversals of the largest force within ``20/ac + 3 ell``
+        of the reversal, about the model's own zero (the force offset and drift taken off).
+
+        This is the quantity :func:`contactlab.tangential.regime.stick_slip` reads off the
+        measured sticks (the largest ``|F - offset|`` while stuck and up to the onset of
+        sliding). It is read off the whole model, not off the breakaway term alone: on the
+        measured frame the friction along the track (``position_friction``) is 18 % lower
+        at the stroke's ends, where the breakaway happens, than its mean ``h0``; a full
+        branch of the term alone from ``-h0`` (:func:`breakaway_force`) put the breakaway
+        1.2x too high there.
+        """
+        F = self.predict(p, effects, d)
+        if "force_offset" in effects:
+            F = F - p["F0"]
+        if "force_drift" in effects:
+            F = F - p["F1"] * (d.t - d.t[0]) / d.duration
+        rev = d.cycles.reversals
+        # the peak lies within a few slip distances (ell) of the reversal, once the branch
+        # has covered its swing (20/ac: to within 2e^-10): beyond, the term has decayed
+        reach = 20.0 / p["ac"] + (3.0 * p["ell"] if "stick_slip" in effects else 0.0)
+        peaks = []
+        for a, b in itertools.pairwise(rev):
+            s = 1.0 if d.u[b] > d.u[a] else -1.0
+            near = s * (d.u[a:b] - d.u[a]) <= reach
+            if np.any(near):
+                peaks.append(float(np.max(s * F[a:b][near])))
+        return float(np.mean(peaks)) if peaks else np.nan
+
     def derived(
-        self, p: dict[str, float], se: dict[str, float], effect: str
+        self,
+        p: dict[str, float],
+        se: dict[str, float],
+        effect: str,
+        *,
+        effects: tuple[str, ...] | None = None,
+        d: Prepared | None = None,
     ) -> tuple[dict[str, float], dict[str, float]]:
-        """Extra reported quantities of an effect (with delta-method standard errors)."""
+        """Extra reported quantities of an effect (with delta-method standard errors).
+
+        ``stick_slip``'s ``breakaway_force``: with the model's ``effects`` and the data
+        ``d``, :meth:`model_breakaway` (comparable with ``analyze``'s breakaway force of the
+        sticks); without them, the peak of a full branch of the breakaway term
+        (:func:`breakaway_force`), which ignores the other effects.
+        """
+        if effect == "stick_slip" and effects is not None and d is not None:
+            val = self.model_breakaway(p, effects, d)
+            var = 0.0
+            for k, s in se.items():
+                if not (np.isfinite(s) and s > 0):
+                    continue
+                step = 1e-3 * s
+                q = dict(p)
+                q[k] += step
+                var += ((self.model_breakaway(q, effects, d) - val) / step * s) ** 2
+            return {"breakaway_force": val}, {"breakaway_force": float(np.sqrt(var))}
         if effect == "series_compliance" and p["C_s"] > 0:
             return {"k_s": 1.0 / p["C_s"]}, {"k_s": se["C_s"] / p["C_s"] ** 2}
         if effect == "asymmetry":

@@ -8,12 +8,16 @@ model, rank by the error on held-out cycles and accept the best only if it passe
 of :mod:`.select` against the noise level estimated from the data; (4) after each addition,
 refit without each effect named so far and drop one that, added back, would no longer pass
 those rules (backward elimination: a wrong effect picked first is not kept once the right
-ones are in); repeat until no candidate helps; (5) report held-out RMS, peak error and
-loop-energy error after each step.
+ones are in); repeat until no candidate helps; then, with the set full (``max_effects``) or
+two or more named, try replacing each named effect by each candidate not in the model and
+keep the swap the held-out rules prefer (a wrong effect picked while the set filled up
+would otherwise keep the right one from ever being tried), and go on; (5) report held-out
+RMS, peak error and loop-energy error after each step.
 """
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import json
 import sys
@@ -79,7 +83,8 @@ class Step:
     ``E`` the loop area of one cycle; ``candidates``: the verdict on each candidate tried
     after this step. A step of the backward elimination has ``removed`` set (and ``added``
     None): the effect dropped because, refitted without it, the model no longer needs it
-    (``removal`` is the verdict on adding it back).
+    (``removal`` is the verdict on adding it back). A swap has both: ``removed`` replaced by
+    ``added``, which predicts the held-out cycles better (``removal`` is the verdict on it).
     """
 
     added: str | None
@@ -93,7 +98,10 @@ class Step:
 
     @property
     def label(self) -> str:
-        """``base model``, ``+ name`` (added) or ``- name`` (dropped by the backward step)."""
+        """``base model``, ``+ name`` (added), ``- name`` (dropped by the backward step) or
+        ``out ⇄ in`` (a swap)."""
+        if self.removed is not None and self.added is not None:
+            return f"{self.removed} ⇄ {self.added}"
         if self.removed is not None:
             return f"- {self.removed}"
         return "base model" if self.added is None else f"+ {self.added}"
@@ -515,6 +523,66 @@ def _drop_check(
     return judge(name, reduced, current, sigma, z, min_gain + extra, prop), reduced
 
 
+#: the swap move's threshold on the t statistic of the per-cycle gain (see _swap_search)
+SWAP_Z = 0.0
+
+
+def _swap_search(
+    family: Family,
+    names: list[str],
+    current: Trial,
+    named: tuple[str, ...],
+    visited: set[frozenset[str]],
+    d: Prepared,
+    scales: dict[str, float],
+    folds: int,
+    sigma: float,
+    min_gain: float,
+    budget: float,
+    base_fit: dict[str, float],
+    all_samples: np.ndarray,
+) -> tuple[tuple[str, Verdict, Trial] | None, list[Verdict], int]:
+    """The swap move: every effect ``named`` by this diagnosis replaced by every candidate
+    not in the model.
+
+    Each swapped model is judged against the current one by the rules of a forward step
+    (:func:`_try_candidate` with the effect taken out: the in-sample screening, the held-out
+    gain of at least ``min_gain`` σ² and :data:`~contactlab.diagnose.select.MIN_RELATIVE_GAIN`
+    of the current error, the BIC, plausibility), except that the gain across held-out
+    cycles need only be positive on average (``t > SWAP_Z``), not significant: a swap does
+    not make the model larger, it picks the better of two of the same size. Returns the
+    best accepted swap ``(effect out, verdict on the one in, its trial)`` or None, every
+    verdict (named ``"out ⇄ in"``), and the model evaluations spent.
+    """
+    spent = d.extra["evaluations"]
+    effects = current.effects
+    pairs = [
+        (out, name)
+        for out in named
+        for name in names
+        if name not in effects
+        and family.check(rest := (*(e for e in effects if e != out), name))
+        and frozenset(rest) not in visited
+    ]
+
+    def one(pair: tuple[str, str]) -> tuple[Verdict, Trial | None]:
+        out, name = pair
+        rest = tuple(e for e in effects if e != out)
+        return _try_candidate(
+            name, family, current, rest, d, scales, folds, sigma, SWAP_Z, min_gain, budget,
+            base_fit, all_samples,
+        )  # fmt: skip
+
+    before = spent.total
+    results = pmap(one, pairs)
+    verdicts, best = [], None
+    for (out, _), (v, cand) in zip(pairs, results, strict=True):
+        verdicts.append(dataclasses.replace(v, name=f"{out} ⇄ {v.name}"))
+        if cand is not None and v.accepted and (best is None or v.gain > best[1].gain):
+            best = (out, v, cand)
+    return best, verdicts, spent.total - before
+
+
 @one_blas_thread
 def diagnose(
     recording: Any,
@@ -624,7 +692,22 @@ def diagnose(
         sigma = noise_rms(current.full_residual(d))
     else:
         current = evaluate(family, effects, d, start, scales, folds, base_all, parallel=True)
+    anchored = None
+    if hasattr(family, "anchor"):  # on a copy: a model passed in keeps its own family
+        family = copy.copy(family)
+        anchored = family.anchor(current.full.params, current.full.stderr, d)
+    unanchored = {}
+    if anchored:  # the base was in the wrong regime: fixed before any effect is tried
+        unanchored = {
+            "heldout_rms": current.heldout_rms,
+            "h0": current.full.params["h0"],
+            "h0_stderr": _finite_or_none(current.full.stderr["h0"]),
+        }
+        current = evaluate(family, effects, d, current.full.params, scales, folds, parallel=True)
     where, location = locate(d, current.full_residual(d), family)
+    if anchored:
+        location["base_unanchored"] = unanchored
+        where.insert(0, anchored)
     where.insert(0, family.regime(current.full.params, d))
     if reduced:
         where.insert(1, reduced)
@@ -701,15 +784,49 @@ def diagnose(
             steps[-1] = dataclasses.replace(
                 steps[-1], candidates=tuple(sorted(verdicts, key=lambda v: v.heldout_rms))
             )
-        if best is None:
+        if best is None and added and used < MAX_EVALUATIONS and len(added) >= min(2, max_effects):
+            # swap move: no effect can be added (the set is full, or nothing else helps);
+            # an effect named early may stand in for one never tried because the set filled
+            swap, swap_verdicts, n = _swap_search(
+                family, names, current, tuple(added), visited, d, scales, folds, sigma,
+                min_gain, budget, base_fit, all_samples,
+            )  # fmt: skip
+            used += n
+            if swap_verdicts:
+                steps[-1] = dataclasses.replace(
+                    steps[-1], candidates=steps[-1].candidates + tuple(swap_verdicts)
+                )
+            if swap is not None:
+                out, v, current = swap
+                effects = current.effects
+                added[added.index(out)] = v.name
+                trials.append(current)
+                visited.add(frozenset(effects))
+                steps.append(
+                    Step(v.name, current.heldout_rms, current.heldout_peak,
+                         current.energy_error, removed=out, removal=v)
+                )  # fmt: skip
+                where.append(
+                    f"swap: {out} replaced by {v.name} (the model with {v.name} instead "
+                    f"predicts the held-out cycles better: gain {v.gain:.3g} σ², t = "
+                    f"{v.t_stat:.2f})"
+                )
+                best = None
+            elif best is None:
+                break
+        elif best is None:
             break
-        v, current = best
-        effects = current.effects
-        added.append(v.name)
-        trials.append(current)
-        steps.append(Step(v.name, current.heldout_rms, current.heldout_peak, current.energy_error))
-        visited.add(frozenset(effects))
-        # backward elimination: an effect named early may be redundant once later ones are in
+        if best is not None:
+            v, current = best
+            effects = current.effects
+            added.append(v.name)
+            trials.append(current)
+            steps.append(
+                Step(v.name, current.heldout_rms, current.heldout_peak, current.energy_error)
+            )
+            visited.add(frozenset(effects))
+        # backward elimination (after an addition or a swap): an effect named early may be
+        # redundant once later ones are in
         while len(added) >= 2 and used < MAX_EVALUATIONS:
             back = partial(
                 _drop_check, family=family, current=current, d=d, scales=scales,
@@ -744,7 +861,8 @@ def diagnose(
     for name in added:
         ps = {s.name: p[s.name] for s in family.candidates[name].params}
         ss = {s.name: se[s.name] for s in family.candidates[name].params}
-        dp, ds = family.derived(p, se, name)
+        more = {"effects": effects, "d": d} if getattr(family, "derived_from_data", False) else {}
+        dp, ds = family.derived(p, se, name, **more)
         out_effects.append(Effect(name, {**ps, **dp}, {**ss, **ds}))
     final = ExtendedModel(family, effects, p, se, family.context(d))
     gap = current.heldout_rms / sigma
