@@ -128,9 +128,9 @@ def test_swap_step_label_and_json():
 def test_swap_move_reaches_an_effect_never_tried_because_the_set_filled():
     """Behind anti-alias filters at 0.3 / 0.6 of Nyquist, Stribeck friction first looks like
     parallel stiffness + stick-slip + a branch scale; with max_effects = 3 reached, stribeck
-    is never tried as an addition. The swap move replaces parallel_stiffness by stribeck,
-    then stick_slip by the filters' channel skew, and the backward step drops the branch
-    scale: the truth (stribeck and the skew) is named, and each swap is a step."""
+    is never tried as an addition. The swap move replaces an effect by stribeck; each swap is a
+    step. With the channel delay among the candidates the truth (stribeck and the filters'
+    skew) is named, by whichever route the search takes."""
     rec = hidden_effect_recording(
         ["stribeck"], magnitude=0.05, noise=0.005, input_noise=0.002,
         samples_per_cycle=200, anti_alias=(0.3, 0.6), bits=16, seed=92010,
@@ -141,6 +141,11 @@ def test_swap_move_reaches_an_effect_never_tried_because_the_set_filled():
                     "channel_delay"],
     )  # fmt: skip
     assert sorted(rep.effect_names) == ["channel_delay", "stribeck"]
+    # without the delay candidate the set fills with stand-ins before stribeck is tried
+    rep = contactlab.diagnose(
+        rec, candidates=["parallel_stiffness", "stick_slip", "non_masing_scaling", "stribeck"]
+    )
+    assert "stribeck" in rep.effect_names
     swaps = [s for s in rep.steps if s.removed is not None and s.added is not None]
     assert swaps and swaps[0].added == "stribeck"
     assert all(s.removal is not None and s.removal.accepted for s in swaps)
