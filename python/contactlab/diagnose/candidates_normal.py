@@ -314,6 +314,37 @@ class NormalFamily:
             delta = shift(delta, d.t, p["tau"])
         return delta
 
+    def noise_variance(self, p: dict[str, float], effects: tuple[str, ...], d: Prepared) -> float:
+        """Output variance per sample the input's sensor noise causes through this model
+        (errors in variables, :func:`contactlab.diagnose.select.noise_term`).
+
+        ``T = Σ_f S(f) |H(f)|² |L(f)|²`` over the spectrum of the noise in the input the
+        candidates see (:func:`input_noise_spectrum`), with ``H = 1/(k (1 + i ω h/k + i η))``
+        the Kelvin-Voigt (and hysteretic) compliance and ``L`` the linear interpolation of a
+        channel delay's fractional sample ``φ``: ``|L|² = 1 - 2φ(1-φ)(1 - cos ωΔt)``. The
+        stiffness nonlinearities are taken at their linear stiffness ``k`` (a few per cent
+        of ``T`` at the effects' sizes; taking the local stiffness would let a softening
+        candidate lower the corrected error by raising ``T`` without bound).
+        """
+        spec = input_noise_spectrum(d)
+        if spec is None:
+            return 0.0
+        f, s = spec
+        w = 2.0 * np.pi * f
+        den = 1.0 + 1j * w * p["psi"] / (2.0 * np.pi * d.extra["omega"])
+        if "hysteretic_damping" in effects:
+            den = den + 1j * p["eta"]
+        g = s / np.abs(den) ** 2
+        if "channel_delay" in effects:
+            phi = float(p["tau"] / d.dt) % 1.0
+            g = g * (1.0 - 2.0 * phi * (1.0 - phi) * (1.0 - np.cos(w * d.dt)))
+        return float(np.sum(g)) / p["k"] ** 2
+
+    def noise_variance_bound(self, p: dict[str, float], d: Prepared) -> float:
+        """:meth:`noise_variance` without damping or delay (its largest value at ``k``)."""
+        spec = input_noise_spectrum(d)
+        return 0.0 if spec is None else float(np.sum(spec[1])) / p["k"] ** 2
+
     def derived(
         self, p: dict[str, float], se: dict[str, float], effect: str
     ) -> tuple[dict[str, float], dict[str, float]]:
@@ -365,6 +396,50 @@ class NormalFamily:
 CREEP_MIN_PERIODS = 1.0
 #: excitation frequencies closer than this ratio count as one frequency for the delay test
 SINGLE_TONE_SPAN = 1.25
+
+
+#: the input-noise spectrum is read above this many times the fastest excitation
+#: frequency (the pressure drive is a sum of tones; its window leakage is gone there)
+NOISE_BAND_HARMONICS = 6.0
+
+
+def input_noise_spectrum(d: Prepared) -> tuple[np.ndarray, np.ndarray] | None:
+    """The input-noise power per frequency bin in the input the candidates see, or None
+    when the input carries no measurable noise (``d.extra["u_noise"]`` 0).
+
+    Welch's periodogram of the measured input (Hann, 1024 samples or the record); above
+    :data:`NOISE_BAND_HARMONICS` times the fastest excitation frequency (and 24 bins) it is
+    noise only, and below it the noise is taken at the median level of the octave above
+    (the drive's tones hide it there). Multiplied by the power response of the zero-phase
+    filter the candidates see the input through (``d.extra["u_filter"]``) and by the bin
+    width, so that the sum is the filtered noise's variance. Kept in ``d.extra``.
+    """
+    if "u_noise_spectrum" in d.extra:
+        return d.extra["u_noise_spectrum"]
+    out = None
+    if float(d.extra.get("u_noise", 0.0)) > 0.0 and d.u.size >= 64:
+        from scipy.signal import savgol_coeffs, welch
+
+        from ._signal import shortest_period_samples
+
+        u = np.asarray(d.extra.get("u_raw", d.u), float)
+        nper = min(u.size, 1024)
+        fs = 1.0 / d.dt
+        f, s = welch(u, fs=fs, window="hann", nperseg=nper, detrend="linear")
+        fast = 1.0 / (shortest_period_samples(u, d.cycles.period_samples) * d.dt)
+        nyq = 0.5 * fs
+        lo = min(max(NOISE_BAND_HARMONICS * fast, 24.0 * fs / nper), 0.5 * nyq)
+        band = (f >= lo) & (f <= min(2.0 * lo, nyq))
+        if np.any(band):
+            s = np.where(f < lo, float(np.median(s[band])), s)
+            wlen = int(d.extra.get("u_filter", 0))
+            if wlen:
+                c = savgol_coeffs(wlen, 3)
+                j = np.arange(wlen) - wlen // 2
+                s = s * np.abs(np.exp(-2j * np.pi * np.outer(f * d.dt, j)) @ c) ** 2
+            out = (f, s * float(f[1] - f[0]))
+    d.extra["u_noise_spectrum"] = out
+    return out
 
 
 def frequency_span(d: Prepared) -> float:
