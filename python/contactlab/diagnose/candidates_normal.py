@@ -211,15 +211,28 @@ def nonlinear(
 
 
 def frequency_domain(
-    t: np.ndarray, pd: np.ndarray, k: float, psi: float, omega: float, eta: float
+    t: np.ndarray,
+    pd: np.ndarray,
+    k: float,
+    psi: float,
+    omega: float,
+    eta: float,
+    history: np.ndarray | None = None,
 ) -> np.ndarray:
     """``δ̂ = p̂ / (k + i ω h + i η k sgn ω)`` on a periodic continuation of the record.
 
     The record is continued by a raised-cosine blend from its last value back to its first
     (at least as long as the record and ten Kelvin-Voigt time constants), so the continuation
     is smooth, the record starts in equilibrium with ``p(t0)`` (as the time-domain models do)
-    and the non-local hysteretic kernel sees no artificial jump.
+    and the non-local hysteretic kernel sees no artificial jump. ``history``: pressure
+    samples before the record (at the same spacing) that the joint saw; the response is
+    computed over them and returned for the record only.
     """
+    if history is not None and history.size:
+        m0 = history.size
+        full = np.concatenate([history, pd])
+        tt = t[0] + (np.arange(full.size) - m0) * float(t[1] - t[0])
+        return frequency_domain(tt, full, k, psi, omega, eta)[m0:]
     n = pd.size
     dt = float(t[1] - t[0])
     tau_kv = psi / (2.0 * np.pi * omega)
@@ -299,7 +312,7 @@ class NormalFamily:
         om = d.extra["omega"]
         k, psi = p["k"], p["psi"]
         if "hysteretic_damping" in effects:
-            delta = frequency_domain(d.t, pd, k, psi, om, p["eta"])
+            delta = frequency_domain(d.t, pd, k, psi, om, p["eta"], run_in(d, pd))
         elif "stiffness_nonlinearity" in effects or "asymmetric_branches" in effects:
             dr = d.extra["delta_r"]
             a = p.get("a", 0.0) if "asymmetric_branches" in effects else 0.0
@@ -440,6 +453,38 @@ def input_noise_spectrum(d: Prepared) -> tuple[np.ndarray, np.ndarray] | None:
             out = (f, s * float(f[1] - f[0]))
     d.extra["u_noise_spectrum"] = out
     return out
+
+
+#: excitation periods (the dominant one) of run-in history before the record that the
+#: hysteretic candidate assumes (:func:`run_in`)
+RUN_IN_PERIODS = 3.0
+
+
+def run_in(d: Prepared, pd: np.ndarray) -> np.ndarray | None:
+    """The pressure history the hysteretic candidate assumes before the record.
+
+    The ideal hysteretic loss ``i η k sgn ω`` is non-causal with a memory that decays only
+    as ``1/t``: the displacement at the start of a record still carries the response to
+    what the joint saw before, seconds earlier. A record that starts in steady state was
+    preceded by the same excitation; that history is taken as the record's first complete
+    cycle (maximum to maximum) repeated over :data:`RUN_IN_PERIODS` dominant periods,
+    ramped in from rest over the first of them and ending in phase with the record's first
+    sample. A record that starts from rest has a small first cycle, so its history is small
+    too. None when the record has no complete cycle.
+    """
+    rev = d.cycles.reversals[d.cycles.is_max]
+    if rev.size < 2:
+        return None
+    i0, i1 = int(rev[0]), int(rev[1])
+    c = i1 - i0
+    per = float(d.cycles.period_samples)
+    length = int(np.ceil(RUN_IN_PERIODS * per / c)) * c
+    reps = length // c + 2
+    ext = np.tile(pd[i0:i1], reps)
+    end = (reps - 1) * c + (-i0) % c
+    hist = ext[end - length : end]
+    ramp = np.clip(np.arange(length) / per, 0.0, 1.0)
+    return hist * (ramp * ramp * (3.0 - 2.0 * ramp))
 
 
 def frequency_span(d: Prepared) -> float:
