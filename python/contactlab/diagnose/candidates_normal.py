@@ -469,8 +469,9 @@ def run_in(d: Prepared, pd: np.ndarray) -> np.ndarray | None:
     preceded by the same excitation; that history is taken as the record's first complete
     cycle (maximum to maximum) repeated over :data:`RUN_IN_PERIODS` dominant periods,
     ramped in from rest over the first of them and ending in phase with the record's first
-    sample. A record that starts from rest has a small first cycle, so its history is small
-    too. None when the record has no complete cycle.
+    sample. None for a record that starts from rest (over the first quarter of a dominant
+    period the pressure stays below half the first complete cycle's amplitude) or that has
+    no complete cycle.
     """
     rev = d.cycles.reversals[d.cycles.is_max]
     if rev.size < 2:
@@ -478,6 +479,9 @@ def run_in(d: Prepared, pd: np.ndarray) -> np.ndarray | None:
     i0, i1 = int(rev[0]), int(rev[1])
     c = i1 - i0
     per = float(d.cycles.period_samples)
+    amp = float(np.max(np.abs(pd[i0:i1])))
+    if float(np.max(np.abs(pd[: max(int(0.25 * per), 1)]))) < 0.5 * amp:
+        return None  # the record starts from rest: no history
     length = int(np.ceil(RUN_IN_PERIODS * per / c)) * c
     reps = length // c + 2
     ext = np.tile(pd[i0:i1], reps)
