@@ -387,6 +387,13 @@ class NormalFamily:
                     f"{CREEP_MIN_PERIODS:g} excitation period ({period:.3g} s): a start-up "
                     "transient of the record or its model, not creep of the joint"
                 )
+            if p["tau_c"] > CREEP_MAX_DURATIONS * d.duration:
+                return (
+                    f"the drift does not settle within the record (τc = {p['tau_c']:.3g} s, "
+                    f"more than {CREEP_MAX_DURATIONS:g} × its {d.duration:.3g} s): a straight "
+                    "drift, which creep of the joint cannot be told from a drifting "
+                    "displacement sensor or a slow model misfit by"
+                )
         return implausible_common(self.candidates[name], p, d)
 
     def regime(self, p: dict[str, float], d: Prepared) -> str:
@@ -407,6 +414,10 @@ class NormalFamily:
 #: a creep must take longer than this many excitation periods to settle: a faster "drift"
 #: is the start of the record (a sensor or model transient), which creep cannot be told from
 CREEP_MIN_PERIODS = 1.0
+#: a creep must settle visibly within the record: with τc above this many record durations
+#: the drift is straight to within a sixth of its size (1 - e^(-1/3) against 1/3), and creep
+#: (a settling) is not told from a sensor drift or a slow misfit of the model
+CREEP_MAX_DURATIONS = 3.0
 #: excitation frequencies closer than this ratio count as one frequency for the delay test
 SINGLE_TONE_SPAN = 1.25
 
