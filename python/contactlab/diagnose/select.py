@@ -26,6 +26,13 @@ only if all three hold:
    significance, which is no evidence of that effect.
 
 The accepted candidate with the largest held-out gain wins.
+
+Errors in variables (families with a ``noise_variance``, the normal contact): the model is
+driven by the measured input, so its prediction carries the input's noise as the model
+filters it, ``T(θ)`` per sample (:func:`noise_term`). A model that filters more (more
+damping, a delay interpolating between samples) would win by that alone. Fits minimise the
+corrected sum ``Σ r² - n T(θ)``, unbiased for every candidate, and the rules above compare
+a candidate's held-out errors as if it passed the current model's ``T``.
 """
 
 from __future__ import annotations
