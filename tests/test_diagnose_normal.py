@@ -12,6 +12,8 @@ from __future__ import annotations
 import matplotlib
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.signal import savgol_filter
 
 import contactlab
@@ -304,3 +306,40 @@ def test_creep_must_settle_within_the_record_and_after_a_period():
         "creep_drift", {**base, "tau_c": 2 * CREEP_MAX_DURATIONS * d.duration}, d
     )
     assert long is not None and "does not settle" in long
+
+
+_NOISY: dict[str, Prepared] = {}
+
+
+def _noisy_prepared() -> Prepared:
+    if "d" not in _NOISY:
+        t, p, y, _, _ = _noisy_kv(5, 0.01, spc=120)
+        d = Prepared.build(t, p, y)
+        NormalFamily().prepare(d)
+        _NOISY["d"] = d
+    return _NOISY["d"]
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    k=st.floats(1e10, 1e14),
+    psi=st.floats(1e-6, 10.0),
+    dpsi=st.floats(0.0, 5.0),
+    eta=st.floats(0.0, 2.0),
+    frac=st.floats(0.0, 3.0),
+)
+def test_noise_term_invariants(k, psi, dpsi, eta, frac):
+    # T >= 0, at most the undamped bound, ∝ 1/k², falls with damping (ψ, η), and a delay
+    # of whole samples leaves it unchanged while a fraction of one lowers it
+    fam = NormalFamily()
+    d = _noisy_prepared()
+    par = {"k": k, "psi": psi, "eta": eta, "tau": frac * d.dt}
+    base = fam.noise_variance(par, (), d)
+    assert 0.0 < base <= fam.noise_variance_bound(par, d) * (1 + 1e-12)
+    assert fam.noise_variance({**par, "k": 2 * k}, (), d) == pytest.approx(base / 4, rel=1e-9)
+    assert fam.noise_variance({**par, "psi": psi + dpsi}, (), d) <= base * (1 + 1e-12)
+    assert fam.noise_variance(par, ("hysteretic_damping",), d) <= base * (1 + 1e-12)
+    delayed = fam.noise_variance(par, ("channel_delay",), d)
+    assert delayed <= base * (1 + 1e-12)
+    whole = fam.noise_variance({**par, "tau": round(frac) * d.dt}, ("channel_delay",), d)
+    assert whole == pytest.approx(base, rel=1e-6)
