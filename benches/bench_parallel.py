@@ -1,29 +1,31 @@
 """Many channels on all cores: one core vs Rust threads inside one call vs Python threads and
-processes over the GIL-free kernel, measured in the same run.
+processes over the GIL-free kernel, measured in interleaved pairs in the same run.
 
-Eight channels of band-limited noise (1e6 samples each by default) through the Masing operator:
+Eight channels of band-limited noise (1e6 samples each by default) through the Masing operator.
+Each parallel mode is paired with the serial run it is compared with (``Masing.force`` channel
+after channel on one core), the two run back to back in alternating order, ``--repeat`` times,
+the modes in a rotating order:
 
-- serial: ``Masing.force`` channel after channel (one core);
-- rust threads: ``contactlab.force_many(model, channels, threads=cores)``;
-- python threads: a ``ThreadPoolExecutor`` calling ``Masing.force`` (the GIL is released in
-  the kernel);
-- python processes: a ``ProcessPoolExecutor`` (arrays pickled to the workers and back).
+- rust threads: ``contactlab.force_many(model, channels, threads=cores)``, new output arrays
+  (as serial ``Masing.force``);
+- rust threads, out reused: the same into output arrays given with ``out=`` (paired with serial
+  ``Masing.force(x, out=buf)``): no fresh output pages, so the first-touch page clearing, which
+  on this VM is sometimes ten times slower than usual, is out of both sides;
+- python threads: a ``ThreadPoolExecutor`` calling ``Masing.force`` (GIL released in the
+  kernel);
+- python processes: a ``ProcessPoolExecutor`` (arrays pickled to the workers and back;
+  ``--no-processes`` skips them).
 
-The modes run in turn, ``--repeat`` times, in a rotating order (so that a change of load hits
-them alike). For each repeat the wall speed-up of a mode is serial / mode of that repeat; the
-report gives its median over the repeats and the ratio of the best times (min / min). The
-requirement is >= 1.9x on 2 cores.
-
-The machine may be shared, so wall time alone says little. Each mode's CPU time is measured
-too (this process's threads; for the process pool, each worker reports its own), giving:
-
-- ``work``: CPU seconds of the mode / CPU seconds of serial (1.0: parallelism adds no work);
-- ``busy``: CPU seconds / wall seconds of the mode (how many cores it actually had);
-- ``cpu speed-up``: cores x serial CPU / mode CPU, the speed-up on idle cores if the work is
-  spread evenly (what the wall speed-up tends to when nothing else runs).
-
-The load average and ``uptime`` are printed before and after.
-Run: ``.venv/bin/python benches/bench_parallel.py [--channels 8] [--n 1000000] [--repeat 9]``.
+For each mode: the speed-up of each pair (serial wall / mode wall), their median and the ratio
+of the best times (min / min); the requirement is >= 1.9x on 2 cores. CPU time (this process's
+threads; the pool's workers report their own) gives ``work`` (mode CPU / serial CPU of the
+pair: 1.0 when parallelism adds no work) and ``cpu speed-up`` (cores x serial CPU / mode CPU:
+what the wall speed-up tends to on idle cores with an even split). For the Rust threads the
+core reports each worker's jobs, start, end, CPU and run-queue wait (``stats=``): ``imbal``
+is (last end - first end) / wall, ``start`` the latest thread start, ``wait`` the summed time
+the workers were runnable without a CPU (other load), ``idle`` the part of the mode's wall x
+threads during which its workers were not on a CPU. ``uptime`` is printed before and after.
+Run: ``.venv/bin/python benches/bench_parallel.py [--channels 8] [--n 4000000] [--repeat 11]``.
 """
 
 from __future__ import annotations
@@ -75,12 +77,23 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--channels", type=int, default=8)
     ap.add_argument("--n", type=int, default=1_000_000)
-    ap.add_argument("--repeat", type=int, default=9)
+    ap.add_argument("--repeat", type=int, default=11)
+    ap.add_argument("--no-processes", action="store_true")
     args = ap.parse_args()
     cores = os.cpu_count() or 1
     before = uptime()
     xs = channels(args.channels, args.n)
     ref = [_force(x) for x in xs]
+    bufs = [np.zeros(x.size) for x in xs]
+    pbufs = [np.zeros(x.size) for x in xs]
+    stats: dict[str, list[list[dict]]] = {}
+
+    def rust(name: str, out: list[np.ndarray] | None) -> list[np.ndarray]:
+        st: list[dict] = []
+        res = contactlab.force_many(MODEL, xs, threads=cores, out=out, stats=st)
+        stats.setdefault(name, []).append(st)
+        return res
+
     with ThreadPoolExecutor(cores) as tp, ProcessPoolExecutor(cores) as pp:
         list(pp.map(_force, xs[:cores]))  # start the workers outside the timing
 
@@ -88,51 +101,79 @@ def main() -> None:
             done = list(pp.map(_force_timed, xs))
             return [f for f, _ in done], sum(c for _, c in done)
 
-        runs = {
-            "serial (one core)": lambda: [_force(x) for x in xs],
-            "rust threads": lambda: contactlab.force_many(MODEL, xs, threads=cores),
-            "python threads": lambda: list(tp.map(_force, xs)),
-            "python processes": processes,
+        def serial() -> list[np.ndarray]:
+            return [_force(x) for x in xs]
+
+        def serial_reused() -> list[np.ndarray]:
+            return [MODEL.force(x, out=b) for x, b in zip(xs, bufs, strict=True)]
+
+        pairs = {
+            "rust threads": (serial, lambda: rust("rust threads", None)),
+            "rust threads, out reused": (
+                serial_reused,
+                lambda: rust("rust threads, out reused", pbufs),
+            ),
+            "python threads": (serial, lambda: list(tp.map(_force, xs))),
         }
-        names = list(runs)
-        wall: dict[str, list[float]] = {k: [] for k in names}
-        cpu: dict[str, list[float]] = {k: [] for k in names}
+        if not args.no_processes:
+            pairs["python processes"] = (serial, processes)
+        names = list(pairs)
+        # per mode: [(serial wall, serial cpu, mode wall, mode cpu), ...]
+        rec: dict[str, list[tuple[float, float, float, float]]] = {k: [] for k in names}
+
+        def timed(f):
+            t0, c0 = time.perf_counter(), time.process_time()
+            out = f()
+            dt, dc = time.perf_counter() - t0, time.process_time() - c0
+            if isinstance(out, tuple):  # the pool's workers report their own CPU time
+                out, dc = out[0], dc + out[1]
+            assert all(np.array_equal(a, b) for a, b in zip(out, ref, strict=True))
+            return dt, dc
+
         for r in range(args.repeat):
-            for name in names[r % len(names) :] + names[: r % len(names)]:
-                t0, c0 = time.perf_counter(), time.process_time()
-                out = runs[name]()
-                dt, dc = time.perf_counter() - t0, time.process_time() - c0
-                if isinstance(out, tuple):  # the pool's workers report their own CPU time
-                    out, dc = out[0], dc + out[1]
-                wall[name].append(dt)
-                cpu[name].append(dc)
-                assert all(np.array_equal(a, b) for a, b in zip(out, ref, strict=True)), name
-                del out
+            for k, name in enumerate(names[r % len(names) :] + names[: r % len(names)]):
+                s_run, m_run = pairs[name]
+                if (r + k) % 2 == 0:
+                    sw, sc = timed(s_run)
+                    mw, mc = timed(m_run)
+                else:
+                    mw, mc = timed(m_run)
+                    sw, sc = timed(s_run)
+                rec[name].append((sw, sc, mw, mc))
     after = uptime()
-    total = args.channels * args.n
     print(
         f"{args.channels} channels x {args.n:.0e} samples, {cores} cores, {args.repeat} "
-        "interleaved repeats (rotating order)"
+        "interleaved pairs per mode (rotating order, alternating within a pair)"
     )
     print(f"before: {before.strip()}\nafter:  {after.strip()}")
-    s_wall, s_cpu = wall[names[0]], cpu[names[0]]
+    total = args.channels * args.n
+    med = statistics.median
     print(
-        f"{'mode':<19}{'Ms/s':>7}{'speed-up med':>14}{'min/min':>9}{'work':>7}{'busy':>7}"
-        f"{'cpu speed-up':>14}"
+        f"{'mode':<26}{'Ms/s':>7}{'serial':>7}{'speed-up med':>13}{'min/min':>9}{'work':>6}"
+        f"{'cpu speed-up':>13}{'imbal':>7}{'start ms':>9}{'wait ms':>8}{'idle':>6}"
     )
     for name in names:
-        w, c = wall[name], cpu[name]
-        med = statistics.median(a / b for a, b in zip(s_wall, w, strict=True))
-        mm = min(s_wall) / min(w)
-        work = statistics.median(c) / statistics.median(s_cpu)
-        busy = statistics.median(a / b for a, b in zip(c, w, strict=True))
-        cpu_up = cores * statistics.median(s_cpu) / statistics.median(c)
-        if name == names[0]:
-            cpu_up = 1.0
-        print(
-            f"{name:<19}{total / min(w) / 1e6:7.1f}{med:13.2f}x{mm:8.2f}x{work:7.2f}{busy:7.2f}"
-            f"{cpu_up:13.2f}x"
+        sw, sc, mw, mc = (list(v) for v in zip(*rec[name], strict=True))
+        up = med(a / b for a, b in zip(sw, mw, strict=True))
+        mm = min(sw) / min(mw)
+        work = med(b / a for a, b in zip(sc, mc, strict=True))
+        cpu_up = cores / work
+        line = (
+            f"{name:<26}{total / min(mw) / 1e6:7.1f}{total / min(sw) / 1e6:7.1f}{up:12.2f}x"
+            f"{mm:8.2f}x{work:6.2f}{cpu_up:12.2f}x"
         )
+        if name in stats:
+            imbal, start, wait, idle = [], [], [], []
+            for st, wall in zip(stats[name], mw, strict=True):
+                ends = [s["end"] for s in st]
+                imbal.append((max(ends) - min(ends)) / wall)
+                start.append(max(s["start"] for s in st) * 1e3)
+                if all(s["cpu"] is not None for s in st):
+                    wait.append(sum(s["wait"] for s in st) * 1e3)
+                    idle.append(1.0 - sum(s["cpu"] for s in st) / (wall * len(st)))
+            line += f"{med(imbal):7.3f}{med(start):9.2f}"
+            line += f"{med(wait):8.1f}{med(idle):6.2f}" if wait else f"{'-':>8}{'-':>6}"
+        print(line)
 
 
 if __name__ == "__main__":

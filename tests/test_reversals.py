@@ -3,6 +3,8 @@ output buffers against the pure-Python versions they replaced (tests/signal_refe
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -125,7 +127,7 @@ def test_force_many_and_out_buffers_equal_force():
 
 
 def test_force_many_reports_the_bad_channel_whatever_the_threads():
-    # Outputs are allocated in the worker threads: an error in any channel must still come
+    # Channels run on worker threads (longest first): an error in any channel must still come
     # back as one typed error (the lowest-numbered bad channel's), no partial list.
     xs = [np.linspace(0, 1e-5, 300) * k for k in range(1, 6)]
     xs[3] = xs[3].copy()
@@ -135,6 +137,44 @@ def test_force_many_reports_the_bad_channel_whatever_the_threads():
         with pytest.raises(InputError, match="not finite"):
             contactlab.force_many(m, xs, threads=threads)
     assert contactlab.force_many(m, [], threads=2) == []
+
+
+def test_force_many_into_given_outputs_with_per_thread_stats():
+    rng = np.random.default_rng(8)
+    xs = [np.cumsum(rng.normal(size=n)) * 1e-6 for n in (3000, 10, 0, 2500, 40)]
+    m = contactlab.Masing(40.0, 4e4)
+    want = [m.operator().push(x) for x in xs]
+    for threads in (1, 2, 3):
+        outs = [np.full(x.size, np.nan) for x in xs]
+        stats: list[dict] = []
+        got = contactlab.force_many(m, xs, threads=threads, out=outs, stats=stats)
+        assert all(g is o for g, o in zip(got, outs, strict=True))
+        assert all(np.array_equal(g, w) for g, w in zip(got, want, strict=True))
+        # one dict per worker; every channel run once; times ordered
+        assert len(stats) == min(threads, len(xs))
+        assert sum(s["jobs"] for s in stats) == len(xs)
+        assert sum(s["samples"] for s in stats) == sum(x.size for x in xs)
+        for s in stats:
+            assert 0.0 <= s["start"] <= s["end"]
+            # the per-thread CPU and run-queue times come from Linux's schedstat
+            if Path("/proc/thread-self/schedstat").exists():
+                assert s["cpu"] >= 0.0 and s["wait"] >= 0.0
+            else:
+                assert s["cpu"] is None and s["wait"] is None
+    with pytest.raises(InputError, match="2 output arrays but 5 signals"):
+        contactlab.force_many(m, xs, out=outs[:2])
+    bad = list(outs)
+    bad[3] = np.empty(7)
+    with pytest.raises(InputError, match=r"out\[3\]: out has 7 samples"):
+        contactlab.force_many(m, xs, out=bad)
+    bad[3] = outs[0]  # the same array twice
+    with pytest.raises(InputError, match=r"out\[3\]"):
+        contactlab.force_many(m, xs, out=bad)
+    bad[3] = xs[3]  # an output that is an input
+    with pytest.raises(InputError, match=r"out\[3\]"):
+        contactlab.force_many(m, xs, out=bad)
+    with pytest.raises(InputError, match="stats must be a list"):
+        contactlab.force_many(m, xs, stats={})
 
 
 def test_phase_fold_equals_numpy_bincount_and_streams():

@@ -1,6 +1,6 @@
 """Type stubs for the Rust extension ``contactlab._core`` (hand-written)."""
 
-from typing import final
+from typing import Any, final
 
 import numpy as np
 import numpy.typing as npt
@@ -61,7 +61,20 @@ def fold_window(
     edges: _F,
 ) -> WindowFold: ...
 def loop_areas(x: _F, f: _F, bounds: list[int]) -> _F: ...
+def fit_steady_loop(
+    x: _F,
+    f: _F,
+    w: _F,
+    bin_var: _F | None,
+    prior: tuple[float | None, float | None, float, float] | None,
+    setup: tuple[list[float], list[bool], list[float], list[float], list[float]],
+    tol: tuple[float, float, float, float],
+    max_nfev: int,
+) -> tuple[list[float], int, int]: ...
 def period_means(t: _F, v: _F, edges: _F) -> _F: ...
+def detrend_pair(
+    t: _F, tm: float, f: _F, slope_f: float, x: _F, slope_x: float
+) -> tuple[_F, _F]: ...
 def loop_area_sensitivity(x: _F, f: _F, bounds: list[int]) -> tuple[_F, _F]: ...
 
 @final
@@ -72,7 +85,13 @@ class CycleTracker:
     ) -> dict[str, np.ndarray]: ...
 
 def branch_memory(x: _F) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]: ...
-def force_many(models: list[MasingCore], xs: list[_F], threads: int) -> list[_F]: ...
+def force_many(
+    models: list[MasingCore],
+    xs: list[_F],
+    threads: int,
+    outs: list[_F] | None = None,
+    cpu_times: bool = False,
+) -> tuple[list[_F], list[dict[str, Any]]]: ...
 def signature_positions(
     block: npt.NDArray[np.uint8], needles: list[bytes], starts_below: int, offset: int
 ) -> list[npt.NDArray[np.int64]]: ...

@@ -243,12 +243,27 @@ def _out_buffer(out: Any, n: int) -> np.ndarray | None:
     return out
 
 
-def force_many(models: Any, signals: Any, threads: int | None = None) -> list[np.ndarray]:
+def force_many(
+    models: Any,
+    signals: Any,
+    threads: int | None = None,
+    out: Any = None,
+    stats: list[dict[str, Any]] | None = None,
+) -> list[np.ndarray]:
     """Forces of several channels or recordings at once, on all cores.
 
     Each signal starts at the origin with its own model (one :class:`Masing` for all, or a
     sequence with one per signal). The work runs on ``threads`` Rust threads inside one call
-    with the GIL released (default: the number of CPUs), handing out one channel at a time.
+    with the GIL released (default: the number of CPUs), handing out one channel at a time,
+    longest first, so that the threads finish together.
+
+    ``out``: a sequence of float64 arrays, one per signal and of its length, written in place
+    and returned (reused between calls: fresh output pages cost the first touch, which on
+    some machines rivals the kernel). ``stats``: a list that receives one dict per worker
+    thread — ``jobs``, ``samples``, ``start`` and ``end`` (seconds since the call began),
+    ``cpu`` (CPU seconds) and ``wait`` (seconds runnable but waiting for a CPU; both None
+    where the system does not tell) — to see whether the split, the start or other load
+    limits the scaling.
 
     Examples
     --------
@@ -273,7 +288,24 @@ def force_many(models: Any, signals: Any, threads: int | None = None) -> list[np
         threads = os.cpu_count() or 1
     if not (isinstance(threads, int | np.integer) and threads >= 1):
         raise InputError(f"threads must be an integer >= 1, got {threads!r}")
-    return _core.force_many([m._core for m in ms], sigs, int(threads))
+    outs = None
+    if out is not None:
+        outs = list(out)
+        if len(outs) != len(sigs):
+            raise InputError(f"{len(outs)} output arrays but {len(sigs)} signals")
+        for i, (o, x) in enumerate(zip(outs, sigs, strict=True)):
+            try:
+                _out_buffer(o, x.size)
+            except InputError as e:
+                raise InputError(f"out[{i}]: {e}") from None
+    if stats is not None and not isinstance(stats, list):
+        raise InputError(f"stats must be a list to fill, got {type(stats).__name__}")
+    res, per_thread = _core.force_many(
+        [m._core for m in ms], sigs, int(threads), outs, stats is not None
+    )
+    if stats is not None:
+        stats.extend(per_thread)
+    return res
 
 
 @dataclass(frozen=True)

@@ -2,7 +2,9 @@
 //!
 //! - [`curve`]: virgin curves (the exponential curve of the tangential-contact paper, tabulated
 //!   measured backbones).
+//! - [`loop_fit`]: Levenberg–Marquardt fit of the steady Masing loop to an averaged cycle.
 //! - [`masing`]: the Masing operator with non-local memory, cycle counting and loop areas.
+//! - [`parallel`]: independent jobs (channels, recordings) on scoped threads.
 //! - [`scan`]: byte-signature search (the HDF5 structure checks).
 //! - [`signal`]: streaming reversal detection by a hysteresis threshold.
 //! - [`window`]: the per-sample work of one analysis window (fold, cycle areas, detrending).
@@ -22,8 +24,10 @@
 
 pub mod curve;
 pub mod error;
+pub mod loop_fit;
 pub mod masing;
 pub mod normal;
+pub mod parallel;
 pub mod scan;
 pub mod signal;
 pub mod structure;

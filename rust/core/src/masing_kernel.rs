@@ -17,6 +17,14 @@
 //! Elsewhere a reversal is applied without data-dependent branches (the candidate is always
 //! written above the stack top, the top raised by 0 or 1, the branch registers selected by
 //! integer selects); only a closure takes a branch and reloads the branch from the stack.
+//!
+//! A block after one that changed branch more than once every [`DENSE`] samples (a random
+//! walk) takes the dense path instead: [`Pass::dense_block`] applies the rules with no
+//! data-dependent branch and writes per sample only the curve argument, the anchor's sample
+//! index and its force where known (no run table, whose bookkeeping cost as much as the rules
+//! there); [`eval_dense`] evaluates the curve over the block, then each force as the anchor's
+//! output (an earlier sample of the block, through one indexed buffer) or the known base, plus
+//! `lam · f(u)`. Both paths give the stepper's forces bit for bit.
 
 use super::{MasingState, Reversal};
 use crate::curve::Backbone;
@@ -98,6 +106,64 @@ pub(super) fn eval_block<C: Backbone>(
     for (o, &k) in out.iter_mut().zip(rid) {
         let r = &runs[k as usize];
         *o = r.ha + r.mul * *o;
+    }
+}
+
+/// Anchor index of a sample on the virgin curve (its base is 0, its multiplier 1).
+const VIRGIN: u64 = u64::MAX;
+
+/// Per-sample records of a dense block ([`Pass::dense_block`]).
+pub(super) struct Dense {
+    u: [f64; BLOCK],
+    /// Padding: arrays 4 KiB apart alias in the store-to-load check (the stores of one
+    /// sample would all share their low 12 address bits).
+    _pad0: [f64; 40],
+    idx: [u64; BLOCK],
+    _pad1: [f64; 40],
+    /// `kh[p]`: the known base of sample `p` (an anchor before the block, or 0 on the virgin
+    /// curve); `kh[BLOCK + p]`: the output of sample `p` once computed, the base of the
+    /// samples anchored at it.
+    kh: [f64; 2 * BLOCK],
+    _pad2: [f64; 40],
+    mm: [f64; BLOCK],
+}
+
+impl Dense {
+    pub(super) fn new() -> Box<Self> {
+        Box::new(Self {
+            u: [0.0; BLOCK],
+            _pad0: [0.0; 40],
+            idx: [0; BLOCK],
+            _pad1: [0.0; 40],
+            kh: [0.0; 2 * BLOCK],
+            _pad2: [0.0; 40],
+            mm: [0.0; BLOCK],
+        })
+    }
+}
+
+/// Curve pass of a dense block: `out[p] = f(u[p])` over the block (vectorised), then in
+/// order `out[p] = base + mm[p] · out[p]` with `base` the output of the in-block anchor
+/// sample (`idx[p] - start < BLOCK`) or the known `kh[p]`, picked by an index into one
+/// buffer (no data-dependent branch).
+#[inline(never)]
+pub(super) fn eval_dense<C: Backbone>(curve: &C, d: &mut Dense, start: u64, out: &mut [f64]) {
+    let m = out.len().min(BLOCK);
+    let out = &mut out[..m];
+    for (o, &v) in out.iter_mut().zip(&d.u[..m]) {
+        *o = curve.eval(v);
+    }
+    for (p, o) in out.iter_mut().enumerate() {
+        let rel = d.idx[p].wrapping_sub(start);
+        // the anchor's output (BLOCK + rel) when it is in this block, else the known base
+        let j = pick(
+            rel < BLOCK as u64,
+            (BLOCK as u64).wrapping_add(rel),
+            p as u64,
+        ) as usize;
+        let v = d.kh[j & (2 * BLOCK - 1)] + d.mm[p] * *o;
+        d.kh[BLOCK.wrapping_add(p) & (2 * BLOCK - 1)] = v;
+        *o = v;
     }
 }
 
@@ -290,49 +356,62 @@ impl Pass {
         nr
     }
 
+    /// The record of the current sample for [`eval_dense`]: the anchor's global sample
+    /// index ([`VIRGIN`] on the virgin curve), its force as far as it is known (a deferred
+    /// one is resolved by the index), and the branch's multiplier.
+    #[inline(always)]
+    fn anchor(&self, stk: &[Reversal]) -> (u64, f64, f64) {
+        if self.n == 0 {
+            (VIRGIN, 0.0, 1.0)
+        } else {
+            let top = stk[self.n.saturating_sub(1)];
+            (top.index, top.h, self.lam)
+        }
+    }
+
     /// First pass for a block where the input reverses often (a random walk reverses every
-    /// ~2 samples; there the predicted test of [`Pass::block`] is a coin toss). Same output
-    /// as [`Pass::block`], without a data-dependent branch in the common case.
+    /// ~2 samples; there the predicted test of [`Pass::block`] is a coin toss). It writes, per
+    /// sample, the curve argument `u`, the anchor's sample index `idx`, its force `kh` where
+    /// known (before the block) and the branch multiplier `mm`; [`eval_dense`] resolves the
+    /// rest. No run table: a branch change costs nothing more than a step on. Returns the
+    /// number of branch changes.
     ///
     /// Only the stack depth `n`, the last input and the direction live in registers: the
     /// current branch's target is always `stk[n - 2].x` and its anchor `stk[n - 1]` (the
     /// candidate reversal, always written above the top, is the anchor once the top is raised
     /// over it), so a reversal raises `n` by one and a closure lowers it by two, by
-    /// arithmetic on the comparison results. The chain from one sample to the next is then
-    /// `n` → load of the target → comparison → `n`; the anchor is loaded off that chain. A run
-    /// record is always written and counted or not.
+    /// arithmetic on the comparison results, without a data-dependent branch.
     ///
     /// Left to branches (rare on such a signal): a stack of fewer than two reversals (the
     /// virgin curve, or the first reversal's branch whose target is a mirror point) and a
     /// closure down to it, both through [`Pass::rules`]; a step that closes two or more
-    /// loops at once. Needs `dir != 0` (the first move goes through [`Pass::block`]).
+    /// loops at once; a zero-length step. Needs `dir != 0` (the first move goes through
+    /// [`Pass::block`]).
     #[inline(never)]
     // `&` on booleans on purpose: no branch per condition.
     #[allow(clippy::needless_bitwise_bool)]
-    fn dense_block(
-        &mut self,
-        stk: &mut [Reversal],
-        xc: &[f64],
-        u: &mut [f64],
-        rid: &mut [u16],
-        runs: &mut [Run; BLOCK + 2],
-    ) -> usize {
+    fn dense_block(&mut self, stk: &mut [Reversal], xc: &[f64], d: &mut Dense) -> usize {
         self.load_branch(stk); // the top's force may have been resolved since
-        runs[0] = self.record();
-        let mut nr = 1_usize;
         let (start, lam, inv_lam, h_before) = (self.start, self.lam, self.inv_lam, self.h_before);
         // Global index of the sample before block position 0.
         let before = start.wrapping_sub(1);
         let (mut n, mut xp, mut up) = (self.n, self.xp, self.dir > 0.0);
-        // Curve argument of the last sample (a zero-length step repeats it).
+        let mut changes = 0_usize;
+        // Record of the last sample (a zero-length step repeats it).
         let mut ul = (xp - self.xa) * self.inv;
-        let samples = xc.iter().zip(u.iter_mut()).zip(rid.iter_mut());
-        for (p, ((&xi, ui), ri)) in samples.enumerate() {
+        let (mut li, mut lk, mut lm) = self.anchor(stk);
+        let m = xc.len().min(BLOCK);
+        let (u, idx, kh, mm) = (
+            &mut d.u[..m],
+            &mut d.idx[..m],
+            &mut d.kh[..m],
+            &mut d.mm[..m],
+        );
+        for (p, &xi) in xc[..m].iter().enumerate() {
             if xi == xp {
                 // A zero-length step changes nothing (a predicted branch: rare where the
                 // input reverses often).
-                *ui = ul;
-                *ri = nr.wrapping_sub(1) as u16; // nr in 1..=BLOCK + 1
+                (u[p], idx[p], kh[p], mm[p]) = (ul, li, lk, lm);
                 continue;
             }
             let rising = xi > xp;
@@ -346,14 +425,11 @@ impl Pass {
                     ..*self
                 };
                 q.load_branch(stk);
-                if q.rules(stk, xi, p) {
-                    runs[nr] = q.record();
-                    nr = nr.wrapping_add(1); // <= BLOCK + 1
-                }
+                changes = changes.wrapping_add(usize::from(q.rules(stk, xi, p)));
                 (n, xp, up) = (q.n, q.xp, q.dir > 0.0);
                 ul = (q.xp - q.xa) * q.inv;
-                *ui = ul;
-                *ri = nr.wrapping_sub(1) as u16;
+                (li, lk, lm) = q.anchor(stk);
+                (u[p], idx[p], kh[p], mm[p]) = (ul, li, lk, lm);
                 continue;
             }
             let rev = rising != up;
@@ -377,19 +453,17 @@ impl Pass {
                     ..*self
                 };
                 q.load_branch(stk);
-                if q.rules(stk, xi, p) {
-                    runs[nr] = q.record();
-                    nr = nr.wrapping_add(1); // <= BLOCK + 1
-                }
+                changes = changes.wrapping_add(usize::from(q.rules(stk, xi, p)));
                 (n, xp, up) = (q.n, q.xp, q.dir > 0.0);
                 ul = (q.xp - q.xa) * q.inv;
-                *ui = ul;
-                *ri = nr.wrapping_sub(1) as u16;
+                (li, lk, lm) = q.anchor(stk);
+                (u[p], idx[p], kh[p], mm[p]) = (ul, li, lk, lm);
                 continue;
             }
             n = n1.wrapping_sub(usize::from(closes) << 1); // >= 2
             up = rising;
             xp = xi;
+            changes = changes.wrapping_add(usize::from(rev | closes)); // <= BLOCK
             let below = stk[n.wrapping_sub(2)].x;
             if closes & ((rising & (xi >= below)) | (!rising & (xi <= below))) {
                 // The step closes further loops (a large jump).
@@ -400,31 +474,20 @@ impl Pass {
                     ..*self
                 };
                 q.more_closures(stk, xi, q.dir);
-                runs[nr] = q.record();
-                nr = nr.wrapping_add(1); // <= BLOCK + 1
                 n = q.n;
                 ul = (xp - q.xa) * q.inv;
-                *ui = ul;
-                *ri = nr.wrapping_sub(1) as u16;
+                (li, lk, lm) = q.anchor(stk);
+                (u[p], idx[p], kh[p], mm[p]) = (ul, li, lk, lm);
                 continue;
             }
-            // The anchor, and whether its force is deferred (found in this block; below
-            // `start` the difference wraps to a huge number: KNOWN).
             let top = stk[n.wrapping_sub(1)];
-            let src = top.index.wrapping_sub(start).min(u64::from(KNOWN)) as u32;
-            runs[nr] = Run {
-                ha: top.h,
-                src,
-                mul: lam,
-            };
-            nr = nr.wrapping_add(usize::from(rev | closes)); // <= BLOCK + 1
             ul = (xp - top.x) * inv_lam;
-            *ui = ul;
-            *ri = nr.wrapping_sub(1) as u16;
+            (li, lk, lm) = (top.index, top.h, lam);
+            (u[p], idx[p], kh[p], mm[p]) = (ul, li, lk, lm);
         }
         (self.n, self.xp, self.dir) = (n, xp, if up { 1.0 } else { -1.0 });
         self.load_branch(stk);
-        nr
+        changes
     }
 
     /// After a first closure by input `xi` (direction `s`, already the state's direction and
@@ -505,6 +568,8 @@ pub(super) fn scaled_force<C: Backbone>(
     }; BLOCK + 2];
     let mut ub = [0.0_f64; BLOCK];
     let mut rid = [0_u16; BLOCK];
+    // The dense path's records, allocated at its first block.
+    let mut dense_rec: Option<Box<Dense>> = None;
     let mut dense = false;
     let mut finite = true;
     for (xc, oc) in x.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
@@ -516,16 +581,19 @@ pub(super) fn scaled_force<C: Backbone>(
         }
         let stk = stack.as_mut_slice();
         // The path for this block from the branch changes of the last one.
-        let (u, r) = (&mut ub[..m], &mut rid[..m]);
-        let nr = if dense && pass.dir != 0.0 {
-            pass.dense_block(stk, xc, u, r, &mut runs)
+        let changes = if dense && pass.dir != 0.0 {
+            let d = dense_rec.get_or_insert_with(Dense::new);
+            let c = pass.dense_block(stk, xc, d);
+            eval_dense(curve, d, pass.start, oc);
+            c
         } else {
-            pass.block(stk, xc, u, r, &mut runs)
+            let (u, r) = (&mut ub[..m], &mut rid[..m]);
+            let nr = pass.block(stk, xc, u, r, &mut runs);
+            eval_block(curve, &mut runs[..nr], u, r, oc);
+            nr.saturating_sub(1)
         };
-        eval_block(curve, &mut runs[..nr], u, r, oc);
         finite &= all_finite(oc);
         pass.end_block(stk, oc);
-        let changes = nr.saturating_sub(1);
         dense = changes.saturating_mul(DENSE) > m;
         pass.start = pass.start.saturating_add(m as u64);
     }

@@ -2,12 +2,12 @@
 //! of the Masing rules, and the multi-channel force kernel (Rust threads).
 
 use contactlab_core::masing::{branch_memory, MasingState};
+use contactlab_core::parallel::run_jobs;
 use contactlab_core::signal::{
     cycle_block, fold_phase, fold_spread, loop_area_sensitivity, loop_areas, period_means,
     CycleState, Excursion, FoldSums, Schmitt,
 };
-use contactlab_core::window::{fold_window, WindowFold as CoreWindowFold};
-use contactlab_core::CoreError;
+use contactlab_core::window::{detrend_pair, fold_window, WindowFold as CoreWindowFold};
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadwriteArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -98,6 +98,8 @@ impl ReversalDetector {
 }
 
 type FloatPair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
+/// Outputs of `force_many` and one statistics dict per worker thread.
+type ManyForces<'py> = (Vec<Bound<'py, PyArray1<f64>>>, Vec<Bound<'py, PyDict>>);
 type IndexPair<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>);
 
 /// Per-sample branch bookkeeping of the Masing memory rules from the origin:
@@ -119,15 +121,22 @@ fn branch_memory_py<'py>(
 }
 
 /// Forces of several channels, each from the origin with its own model, on up to `threads`
-/// Rust threads inside this one call (GIL released). Channels are handed out one at a time
-/// from a shared counter, so unequal lengths balance.
+/// Rust threads inside this one call (GIL released; `contactlab_core::parallel::run_jobs`:
+/// longest channel first, one at a time from a shared queue). Into `outs` when given (one
+/// contiguous float64 array per channel, reused between calls: no fresh pages to fault in),
+/// else into new arrays. Returns the outputs and one dict per worker thread (`jobs`,
+/// `samples`, `start`, `end`, `cpu`, `wait`; seconds; `cpu`/`wait` only with `cpu_times`
+/// and where the system tells, else None).
 #[pyfunction]
+#[pyo3(signature = (models, xs, threads, outs=None, cpu_times=false))]
 fn force_many<'py>(
     py: Python<'py>,
     models: Vec<PyRef<'py, MasingCore>>,
     xs: Vec<PyReadonlyArray1<'py, f64>>,
     threads: usize,
-) -> PyResult<Vec<Bound<'py, PyArray1<f64>>>> {
+    outs: Option<Vec<Bound<'py, PyArray1<f64>>>>,
+    cpu_times: bool,
+) -> PyResult<ManyForces<'py>> {
     if models.len() != xs.len() {
         return Err(input(
             py,
@@ -138,58 +147,70 @@ fn force_many<'py>(
         return Err(input(py, "threads must be >= 1"));
     }
     let inputs: Vec<&[f64]> = xs.iter().map(|x| slice(x, "x")).collect::<PyResult<_>>()?;
-    let outs: Vec<Bound<'py, PyArray1<f64>>> = inputs
-        .iter()
-        .map(|x| PyArray1::<f64>::zeros(py, x.len(), false))
-        .collect();
-    let mut rws: Vec<PyReadwriteArray1<'py, f64>> =
-        outs.iter().map(PyArrayMethods::readwrite).collect();
-    let mut slices: Vec<&mut [f64]> = Vec::with_capacity(rws.len());
-    for rw in &mut rws {
-        slices.push(
-            rw.as_slice_mut()
-                .map_err(|_| input(py, "output not contiguous"))?,
-        );
+    let outs: Vec<Bound<'py, PyArray1<f64>>> = match outs {
+        Some(o) if o.len() != inputs.len() => {
+            return Err(input(
+                py,
+                &format!("{} output arrays but {} signals", o.len(), inputs.len()),
+            ));
+        }
+        Some(o) => o,
+        None => inputs
+            .iter()
+            .map(|x| PyArray1::<f64>::zeros(py, x.len(), false))
+            .collect(),
+    };
+    let mut rws: Vec<PyReadwriteArray1<'py, f64>> = Vec::with_capacity(outs.len());
+    for (i, o) in outs.iter().enumerate() {
+        rws.push(o.try_readwrite().map_err(|_| {
+            input(
+                py,
+                &format!(
+                    "out[{i}] must be a writeable array shared with no signal or other output"
+                ),
+            )
+        })?);
+    }
+    let mut jobs: Vec<(&[f64], &mut [f64])> = Vec::with_capacity(rws.len());
+    for (i, (rw, x)) in rws.iter_mut().zip(&inputs).enumerate() {
+        let o = rw
+            .as_slice_mut()
+            .map_err(|_| input(py, &format!("out[{i}] must be contiguous")))?;
+        if o.len() != x.len() {
+            return Err(input(
+                py,
+                &format!(
+                    "out[{i}] has {} samples but signal {i} has {}",
+                    o.len(),
+                    x.len()
+                ),
+            ));
+        }
+        jobs.push((x, o));
     }
     let cores: Vec<&MasingCore> = models.iter().map(|m| &**m).collect();
-    detach_guarded(py, || run_many(&cores, &inputs, slices, threads))?;
+    let stats = detach_guarded(py, || {
+        run_jobs(
+            jobs,
+            threads,
+            cpu_times,
+            |j| j.0.len(),
+            |i, (x, out)| cores[i].force_from_origin(x, out),
+        )
+    })?;
     drop(rws);
-    Ok(outs)
-}
-
-/// Work queue over channels on `threads` scoped threads; the first error wins.
-fn run_many(
-    cores: &[&MasingCore],
-    inputs: &[&[f64]],
-    outs: Vec<&mut [f64]>,
-    threads: usize,
-) -> Result<(), CoreError> {
-    let jobs: Vec<(usize, &mut [f64])> = outs.into_iter().enumerate().collect();
-    let queue = std::sync::Mutex::new(jobs);
-    let workers = threads.min(inputs.len()).max(1);
-    let results: Vec<Result<(), CoreError>> = std::thread::scope(|s| {
-        let handles: Vec<_> = (0..workers)
-            .map(|_| {
-                s.spawn(|| -> Result<(), CoreError> {
-                    loop {
-                        let job = match queue.lock() {
-                            Ok(mut q) => q.pop(),
-                            Err(_) => None,
-                        };
-                        let Some((i, out)) = job else {
-                            return Ok(());
-                        };
-                        cores[i].force_from_origin(inputs[i], out)?;
-                    }
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
-            .collect()
-    });
-    results.into_iter().collect()
+    let mut dicts = Vec::with_capacity(stats.len());
+    for s in stats {
+        let d = PyDict::new(py);
+        d.set_item("jobs", s.jobs)?;
+        d.set_item("samples", s.samples)?;
+        d.set_item("start", s.start)?;
+        d.set_item("end", s.end)?;
+        d.set_item("cpu", s.cpu)?;
+        d.set_item("wait", s.wait)?;
+        dicts.push(d);
+    }
+    Ok((outs, dicts))
 }
 
 /// Phase-bin fold of a periodic recording, accumulated chunk by chunk (see
@@ -469,7 +490,28 @@ fn fold_window_py(
     Ok(WindowFold { inner })
 }
 
+type Arr<'py> = Bound<'py, PyArray1<f64>>;
+
+/// Remove the linear drifts of F and x in one pass (see
+/// `contactlab_core::window::detrend_pair`).
+#[pyfunction]
+#[pyo3(name = "detrend_pair")]
+fn detrend_pair_py<'py>(
+    py: Python<'py>,
+    t: PyReadonlyArray1<'py, f64>,
+    tm: f64,
+    f: PyReadonlyArray1<'py, f64>,
+    slope_f: f64,
+    x: PyReadonlyArray1<'py, f64>,
+    slope_x: f64,
+) -> PyResult<(Arr<'py>, Arr<'py>)> {
+    let (ts, fs, xs) = (slice(&t, "t")?, slice(&f, "F")?, slice(&x, "x")?);
+    let (a, b) = detach_guarded(py, || detrend_pair(ts, tm, (fs, slope_f), (xs, slope_x)))?;
+    Ok((a.into_pyarray(py), b.into_pyarray(py)))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(detrend_pair_py, m)?)?;
     m.add_class::<PhaseFold>()?;
     m.add_class::<WindowFold>()?;
     m.add_function(wrap_pyfunction!(fold_window_py, m)?)?;
