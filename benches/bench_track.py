@@ -134,10 +134,10 @@ def stage(name: str, path: str, workers: int) -> dict:
     return out
 
 
-def child(cmd: list[str]) -> tuple[float, float, str, float]:
+def child(cmd: list[str], env: dict | None = None) -> tuple[float, float, str, float]:
     """Wall time (s), peak RSS (MB) of a child process, its stdout and its CPU time (s)."""
     t0 = time.perf_counter()
-    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, text=True)
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, text=True, env=env)
     assert p.stdout is not None
     text = p.stdout.read()
     _, status, usage = os.wait4(p.pid, 0)
@@ -213,6 +213,12 @@ def main() -> None:
         help="comma-separated stages to skip (read, cycles, track, track-threads, "
         "track-serial, analyze, whole, study)",
     )
+    ap.add_argument(
+        "--analyze-threads",
+        default="",
+        help="comma-separated CONTACTLAB_ANALYZE_THREADS values to run the analyze stage with "
+        "(e.g. 0,1,2: serial, one and two helper threads); default: as a user runs it",
+    )
     ap.add_argument("--stage", help=argparse.SUPPRESS)
     ap.add_argument("--file", help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -267,14 +273,20 @@ def main() -> None:
             # the issue's bar: `contactlab analyze` as a user runs it (auto-streamed)
             cmd = [sys.executable, "-m", "contactlab", "analyze", str(big), "--model",
                    "tangential", "--no-progress", "--json", str(tmp / "big.json")]  # fmt: skip
-            wall, rss, _, cpu = child(cmd)
-            h0 = json.loads((tmp / "big.json").read_text())
-            print(
-                f"analyze (CLI)    {wall:8.1f} s {n / wall / 1e6:8.2f} M samples/s  "
-                f"ratio to Masing {n / wall / m_rate:6.3f}  CPU {cpu:7.1f} s "
-                f"({n / cpu / 1e6:.2f} M samples per CPU-second)  peak RSS {rss:6.0f} MB  "
-                f"h0 = {h0['h0']:.6f} ± {h0['h0_stderr']:.2g} N"
-            )
+            for threads in args.analyze_threads.split(",") if args.analyze_threads else [""]:
+                env = dict(os.environ)
+                if threads:
+                    env["CONTACTLAB_ANALYZE_THREADS"] = threads
+                wall, rss, _, cpu = child(cmd, env)
+                h0 = json.loads((tmp / "big.json").read_text())
+                label = f"analyze (CLI{', threads ' + threads if threads else ''})"
+                print(
+                    f"{label:<24} {wall:8.1f} s {n / wall / 1e6:8.2f} M samples/s  "
+                    f"ratio to Masing {n / wall / m_rate:6.3f}  CPU {cpu:7.1f} s "
+                    f"({n / cpu / 1e6:.2f} M samples per CPU-second)  peak RSS {rss:6.0f} MB  "
+                    f"h0 = {h0['h0']:.6f} ± {h0['h0_stderr']:.2g} N  "
+                    f"load {os.getloadavg()[0]:.1f}"
+                )
         big.unlink()
         if "whole" not in skip:
             nw = int(args.whole_samples)

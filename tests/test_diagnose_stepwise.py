@@ -87,3 +87,72 @@ def test_backward_step_drops_an_effect_named_too_early():
     d = rep.to_dict()
     assert [s["removed"] for s in d["steps"]].count("stick_slip") == 1
     assert "- stick_slip" in rep.table()
+
+
+@settings(max_examples=8, deadline=None)
+@given(
+    s_b=st.floats(0.05, 0.5),
+    ell_ac=st.floats(3.0, 30.0),
+    h0=st.floats(0.1, 50.0),
+)
+def test_model_breakaway_matches_the_full_branch_peak(s_b, ell_ac, h0):
+    """In gross sliding (ac·A = 200) every branch starts from -h0, so the breakaway force
+    read off the simulated model at the reversals equals the peak of a full branch of the
+    breakaway term (breakaway_force, a grid maximum of the closed form)."""
+    from contactlab.diagnose.candidates_tangential import TangentialFamily, breakaway_force
+
+    t = np.arange(4000) / 400.0
+    x = 1e-3 * np.sin(2 * np.pi * t)
+    ac = 200.0 / 1e-3
+    d = Prepared.build(t, x, np.zeros_like(x))
+    fam = TangentialFamily()
+    fam.prepare(d)
+    p = {"h0": h0, "ac": ac, "s_b": s_b, "ell": ell_ac / ac}
+    got = fam.model_breakaway(p, ("stick_slip",), d)
+    want = breakaway_force(h0, ac, s_b, ell_ac / ac)
+    assert got == pytest.approx(want, rel=2e-3)
+    # without the term, the model's force near the reversal is the plateau h0
+    assert fam.model_breakaway(p, (), d) == pytest.approx(h0, rel=1e-3)
+
+
+def test_swap_step_label_and_json():
+    from contactlab.diagnose.workflow import Step
+
+    s = Step("stribeck", 1.0, 2.0, 0.1, removed="parallel_stiffness")
+    assert s.label == "parallel_stiffness ⇄ stribeck"
+    assert s.to_dict()["added"] == "stribeck" and s.to_dict()["removed"] == "parallel_stiffness"
+    assert Step(None, 1.0, 2.0, 0.1, removed="x").label == "- x"
+    assert Step("x", 1.0, 2.0, 0.1).label == "+ x"
+
+
+def test_swap_move_reaches_an_effect_never_tried_because_the_set_filled():
+    """Behind anti-alias filters at 0.3 / 0.6 of Nyquist, Stribeck friction first looks like
+    parallel stiffness + stick-slip + a branch scale; with max_effects = 3 reached, stribeck
+    is never tried as an addition. The swap move replaces an effect by stribeck; each swap is a
+    step. With the channel delay among the candidates the truth (stribeck and the filters'
+    skew) is named, by whichever route the search takes."""
+    rec = hidden_effect_recording(
+        ["stribeck"], magnitude=0.05, noise=0.005, input_noise=0.002,
+        samples_per_cycle=200, anti_alias=(0.3, 0.6), bits=16, seed=92010,
+    )  # fmt: skip
+    rep = contactlab.diagnose(
+        rec,
+        candidates=["parallel_stiffness", "stick_slip", "non_masing_scaling", "stribeck",
+                    "channel_delay"],
+    )  # fmt: skip
+    assert sorted(rep.effect_names) == ["channel_delay", "stribeck"]
+    # without the delay candidate the set fills with stand-ins before stribeck is tried
+    rep = contactlab.diagnose(
+        rec, candidates=["parallel_stiffness", "stick_slip", "non_masing_scaling", "stribeck"]
+    )
+    assert "stribeck" in rep.effect_names
+    swaps = [s for s in rep.steps if s.removed is not None and s.added is not None]
+    assert swaps and swaps[0].added == "stribeck"
+    assert all(s.removal is not None and s.removal.accepted for s in swaps)
+    assert all(s.heldout_rms < rep.steps[0].heldout_rms for s in swaps)
+    assert any(w.startswith(f"swap: {swaps[0].removed} replaced by stribeck") for w in rep.where)
+    js = rep.to_dict()["steps"]
+    assert any(s["removed"] == swaps[0].removed and s["added"] == "stribeck" for s in js)
+    assert f"{swaps[0].removed} ⇄ stribeck" in rep.table()
+    # the verdicts on the swaps tried are kept with the step they were tried after
+    assert any("⇄" in v.name for s in rep.steps for v in s.candidates)

@@ -400,3 +400,28 @@ def test_fold_spread_is_the_numpy_spread(seed, n_bins, n_cyc):
         ref_a[full] = 0.5 * (np.nanmax(cx[full], axis=1) - np.nanmin(cx[full], axis=1))
     np.testing.assert_array_equal(got["amplitude"], ref_a)
     assert set(fold.sums(cells=False)) == {k for k in s if not k.startswith("cycle_")}
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 10_000),
+    n=st.integers(1, 300),
+    exp=st.integers(-200, 200),
+    slopes=st.tuples(st.floats(-1e6, 1e6), st.floats(-1e-3, 1e-3)),
+)
+def test_detrend_pair_is_numpys_expression_bit_for_bit(seed, n, exp, slopes):
+    """The window's drift removal in one Rust pass equals numpy's ``v - s·(t - tm)``."""
+    from contactlab import _core
+    from contactlab.tangential.analysis import _detrended
+
+    rng = np.random.default_rng(seed)
+    t = np.cumsum(rng.uniform(1e-4, 1.0, n))
+    tm = float(np.mean(t))
+    F = rng.standard_normal(n) * 10.0**exp
+    x = rng.standard_normal(n) * 1e-5
+    a, b = _core.detrend_pair(t, tm, F, slopes[0], x, slopes[1])
+    np.testing.assert_array_equal(a, _detrended(F, t, tm, slopes[0]))
+    np.testing.assert_array_equal(b, _detrended(x, t, tm, slopes[1]))
+    np.testing.assert_array_equal(a, F - slopes[0] * (t - tm))
+    with pytest.raises(InputError):
+        _core.detrend_pair(t, tm, F[: n - 1], 1.0, x, 1.0)

@@ -61,7 +61,20 @@ def fold_window(
     edges: _F,
 ) -> WindowFold: ...
 def loop_areas(x: _F, f: _F, bounds: list[int]) -> _F: ...
+def fit_steady_loop(
+    x: _F,
+    f: _F,
+    w: _F,
+    bin_var: _F | None,
+    prior: tuple[float | None, float | None, float, float] | None,
+    setup: tuple[list[float], list[bool], list[float], list[float], list[float]],
+    tol: tuple[float, float, float, float],
+    max_nfev: int,
+) -> tuple[list[float], int, int]: ...
 def period_means(t: _F, v: _F, edges: _F) -> _F: ...
+def detrend_pair(
+    t: _F, tm: float, f: _F, slope_f: float, x: _F, slope_x: float
+) -> tuple[_F, _F]: ...
 def loop_area_sensitivity(x: _F, f: _F, bounds: list[int]) -> tuple[_F, _F]: ...
 
 @final

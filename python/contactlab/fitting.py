@@ -292,6 +292,7 @@ def least_squares_fit(
     gtol: float = 1e-10,
     jac_rel_step: float = 1e-6,
     jac: Callable[[dict[str, float]], Mapping[str, Any]] | None = None,
+    solver: Callable[..., tuple[Any, int, int]] | None = None,
 ) -> FitResult:
     """Minimise ``sum(residual_fn(values)**2)`` over the varied parameters.
 
@@ -318,6 +319,14 @@ def least_squares_fit(
         Analytic derivatives ``jac(values) -> {name: ∂residual/∂name}`` (arrays of the
         residual's length) for at least the varied parameters: the solver, the polishing
         steps and the covariance use them instead of finite differences.
+    solver : callable, optional
+        Replaces SciPy's trust-region solver (e.g. a compiled Levenberg–Marquardt of a
+        known model: ``steps.Residuals.solver``). Called as ``solver(z0, names, scale, lo,
+        hi, fixed, rscale, ftol, xtol, gtol, max_nfev)`` in the scaled variables
+        ``z = value / scale`` (bounds ``lo, hi`` scaled, residuals divided by ``rscale``);
+        returns ``(z, nfev, status)`` with the status codes of ``least_squares`` (0: the
+        evaluation budget ran out, reported as not converged). The polishing steps, the
+        trust check and the covariance are the same as after SciPy's solver.
 
     Returns
     -------
@@ -335,6 +344,7 @@ def least_squares_fit(
     (2.0, True)
     """
     ps = _as_params(params)
+    start = [replace(p) for p in ps.values()] if solver is not None else []
     names = [k for k, p in ps.items() if p.vary]
     for p in ps.values():
         if not math.isfinite(p.value):
@@ -410,24 +420,16 @@ def least_squares_fit(
                  for n, s in zip(names, scale, strict=True)]
             ) / rscale  # fmt: skip
 
-    try:
-        sol = least_squares(
-            fun,
-            z0,
-            jac=analytic if jac is not None else "2-point",
-            bounds=(lo, hi),
-            method="trf",
-            x_scale=1.0,
-            loss=loss,
-            ftol=ftol,
-            xtol=xtol,
-            gtol=gtol,
-            max_nfev=max_nfev,
-        )
-    except InputError as exc:
-        raise ConvergenceError(
-            f"the model rejected the parameters the solver tried ({exc}); tighten the bounds"
-        ) from exc
+    if solver is not None:
+        z, rs, nfev_s, status = _run_solver(solver, fun, z0, names, scale, lo, hi, fixed,
+                                           rscale, ftol, xtol, gtol, max_nfev)  # fmt: skip
+        nfev += nfev_s
+        sol = None
+    else:
+        z, rs, status, sol = _scipy_solve(fun, z0, lo, hi, analytic if jac is not None else None,
+                                          loss, ftol, xtol, gtol, max_nfev)  # fmt: skip
+    success = status > 0 if sol is None else bool(sol.success)
+    message = _STATUS.get(status, "") if sol is None else str(sol.message)
 
     def jacobian(z: np.ndarray) -> np.ndarray:
         if jac is not None:
@@ -442,9 +444,6 @@ def least_squares_fit(
             J[:, j] = (fun(up) - fun(dn)) / (up[j] - dn[j])
         return J
 
-    z = sol.x
-    rs = np.asarray(sol.fun, dtype=np.float64)
-    success, status, message = bool(sol.success), int(sol.status), str(sol.message)
     J = jacobian(z)
     if success and loss == "linear":
         z, rs, J, success, status, message = _polish(fun, jacobian, z, rs, J, lo, hi, names)
@@ -483,7 +482,84 @@ def least_squares_fit(
         for n in names:
             res.params[n].stderr = None
         res.notes.extend(notes)
+    if solver is not None and not res.success:
+        # the given solver's end point failed (its budget, or the trust check where the
+        # model has kinks near the minimum): SciPy's solver from the same start decides, so
+        # a fit converges or fails exactly as without a solver
+        ref = least_squares_fit(
+            residual_fn, start, scale_covar=scale_covar, rcond=rcond,
+            max_rel_stderr=max_rel_stderr, loss=loss, max_nfev=max_nfev, ftol=ftol,
+            xtol=xtol, gtol=gtol, jac_rel_step=jac_rel_step, jac=jac,
+        )  # fmt: skip
+        ref.nfev += res.nfev
+        return ref
     return res
+
+
+#: SciPy's ``least_squares`` messages by status (for a solver given to
+#: :func:`least_squares_fit`)
+_STATUS = {
+    0: "The maximum number of function evaluations is exceeded.",
+    1: "`gtol` termination condition is satisfied.",
+    2: "`ftol` termination condition is satisfied.",
+    3: "`xtol` termination condition is satisfied.",
+    4: "Both `ftol` and `xtol` termination conditions are satisfied.",
+}
+
+
+def _run_solver(
+    solver: Callable[..., tuple[Any, int, int]],
+    fun: Callable[[np.ndarray], np.ndarray],
+    z0: np.ndarray,
+    names: list[str],
+    scale: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    fixed: dict[str, float],
+    rscale: float,
+    ftol: float,
+    xtol: float,
+    gtol: float,
+    max_nfev: int | None,
+) -> tuple[np.ndarray, np.ndarray, int, int]:
+    """A given solver's end point, its scaled residuals, evaluations and status."""
+    budget = int(max_nfev) if max_nfev is not None else 100 * len(names)
+    z, nfev, status = solver(z0, names, scale, lo, hi, fixed, rscale, ftol, xtol, gtol, budget)
+    z = np.clip(np.asarray(z, dtype=np.float64).reshape(-1), lo, hi)
+    return z, fun(z), int(nfev), int(status)
+
+
+def _scipy_solve(
+    fun: Callable[[np.ndarray], np.ndarray],
+    z0: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    analytic: Callable[[np.ndarray], np.ndarray] | None,
+    loss: str,
+    ftol: float,
+    xtol: float,
+    gtol: float,
+    max_nfev: int | None,
+) -> tuple[np.ndarray, np.ndarray, int, Any]:
+    try:
+        sol = least_squares(
+            fun,
+            z0,
+            jac=analytic if analytic is not None else "2-point",
+            bounds=(lo, hi),
+            method="trf",
+            x_scale=1.0,
+            loss=loss,
+            ftol=ftol,
+            xtol=xtol,
+            gtol=gtol,
+            max_nfev=max_nfev,
+        )
+    except InputError as exc:
+        raise ConvergenceError(
+            f"the model rejected the parameters the solver tried ({exc}); tighten the bounds"
+        ) from exc
+    return sol.x, np.asarray(sol.fun, dtype=np.float64), int(sol.status), sol
 
 
 def _rms(r: np.ndarray) -> float:

@@ -14,6 +14,7 @@ import itertools
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.fft import next_fast_len
 
 from ..errors import InputError
 from ..reversals import excursions
@@ -44,14 +45,21 @@ def check_uniform(t: np.ndarray) -> float:
 
 
 def dominant_period_samples(u: np.ndarray) -> float:
-    """Samples per period of the strongest spectral line of ``u`` (mean removed)."""
+    """Samples per period of the strongest spectral line of ``u`` (mean removed).
+
+    The windowed record is zero-padded to a fast FFT length (:func:`scipy.fft.next_fast_len`:
+    an odd or prime length such as 999 256 took 20 times as long and 8 times the memory),
+    so the lines are those of the record's own length, interpolated: the period is
+    ``L / k`` on the padded grid of ``L`` points.
+    """
     n = u.size
-    spec = np.abs(np.fft.rfft((u - u.mean()) * np.hanning(n)))
+    size = next_fast_len(n, real=True)
+    spec = np.abs(np.fft.rfft((u - u.mean()) * np.hanning(n), size))
     spec[0] = 0.0
     k = int(np.argmax(spec))
     if k == 0:
         raise InputError("the excitation signal is constant; no cycles to analyse")
-    return n / k
+    return size / k
 
 
 def smooth_window(period_samples: float, fraction: float = 0.08, least: int = 7) -> int:
@@ -252,3 +260,53 @@ def modulation_gains(
     q = sss * bc * bc - 2.0 * scs * bc * bs + scc * bs * bs
     g[ok] = q[ok] / det[ok]
     return g
+
+
+@dataclass(frozen=True)
+class Knots:
+    """Turning points of a record between the samples kept from it.
+
+    A Masing element's memory holds the turning points of its input; a record kept every
+    q-th sample loses the true extremes between the samples, and every branch after a
+    reversal starts from the wrong point (up to ``A (1 - cos(π q / s))`` at ``s`` samples per
+    cycle). Knots are the raw-rate samples that carry that memory: every local extremum of
+    the input the candidates see (the filtered one) and every reversal of :func:`find_cycles`.
+    The element run over the kept samples with the knots merged in (:meth:`merge`) gives, at
+    the kept samples, exactly what it gives on the whole record (rate independence: a
+    monotone stretch between extrema leaves no memory).
+
+    ``pos``: where each knot goes (:func:`numpy.insert` positions among the kept samples);
+    ``x``: the input at the knots; ``grid``: the positions of the kept samples in the merged
+    sequence; ``t``: its times; ``reversals``: the merged positions of the raw reversals;
+    ``turns``: those of every turning point (knots and turning points on kept samples).
+    """
+
+    pos: np.ndarray
+    x: np.ndarray
+    grid: np.ndarray
+    t: np.ndarray
+    reversals: np.ndarray
+    turns: np.ndarray
+
+    @property
+    def size(self) -> int:
+        """Length of the merged sequence."""
+        return self.t.size
+
+    def merge(self, x: np.ndarray, offset: float = 0.0) -> np.ndarray:
+        """The kept input ``x`` with the knots (shifted by ``-offset`` like ``x``) merged in
+        (what ``numpy.insert(x, pos, knots - offset)`` gives, without its sort)."""
+        out = np.empty(self.t.size)
+        out[self.grid] = x
+        out[self.pos + np.arange(self.pos.size)] = self.x - offset
+        return out
+
+
+def local_extrema(u: np.ndarray) -> np.ndarray:
+    """Indices of the local extrema of ``u`` (the first sample of a flat top or bottom)."""
+    steps = np.flatnonzero(np.diff(u))
+    if steps.size < 2:
+        return steps[:0]
+    up = np.diff(u)[steps] > 0
+    turn = np.flatnonzero(up[1:] != up[:-1])
+    return steps[turn] + 1

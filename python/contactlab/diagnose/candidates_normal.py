@@ -211,15 +211,28 @@ def nonlinear(
 
 
 def frequency_domain(
-    t: np.ndarray, pd: np.ndarray, k: float, psi: float, omega: float, eta: float
+    t: np.ndarray,
+    pd: np.ndarray,
+    k: float,
+    psi: float,
+    omega: float,
+    eta: float,
+    history: np.ndarray | None = None,
 ) -> np.ndarray:
     """``δ̂ = p̂ / (k + i ω h + i η k sgn ω)`` on a periodic continuation of the record.
 
     The record is continued by a raised-cosine blend from its last value back to its first
     (at least as long as the record and ten Kelvin-Voigt time constants), so the continuation
     is smooth, the record starts in equilibrium with ``p(t0)`` (as the time-domain models do)
-    and the non-local hysteretic kernel sees no artificial jump.
+    and the non-local hysteretic kernel sees no artificial jump. ``history``: pressure
+    samples before the record (at the same spacing) that the joint saw; the response is
+    computed over them and returned for the record only.
     """
+    if history is not None and history.size:
+        m0 = history.size
+        full = np.concatenate([history, pd])
+        tt = t[0] + (np.arange(full.size) - m0) * float(t[1] - t[0])
+        return frequency_domain(tt, full, k, psi, omega, eta)[m0:]
     n = pd.size
     dt = float(t[1] - t[0])
     tau_kv = psi / (2.0 * np.pi * omega)
@@ -299,7 +312,7 @@ class NormalFamily:
         om = d.extra["omega"]
         k, psi = p["k"], p["psi"]
         if "hysteretic_damping" in effects:
-            delta = frequency_domain(d.t, pd, k, psi, om, p["eta"])
+            delta = frequency_domain(d.t, pd, k, psi, om, p["eta"], run_in(d, pd))
         elif "stiffness_nonlinearity" in effects or "asymmetric_branches" in effects:
             dr = d.extra["delta_r"]
             a = p.get("a", 0.0) if "asymmetric_branches" in effects else 0.0
@@ -313,6 +326,37 @@ class NormalFamily:
         if "channel_delay" in effects:
             delta = shift(delta, d.t, p["tau"])
         return delta
+
+    def noise_variance(self, p: dict[str, float], effects: tuple[str, ...], d: Prepared) -> float:
+        """Output variance per sample the input's sensor noise causes through this model
+        (errors in variables, :func:`contactlab.diagnose.select.noise_term`).
+
+        ``T = Σ_f S(f) |H(f)|² |L(f)|²`` over the spectrum of the noise in the input the
+        candidates see (:func:`input_noise_spectrum`), with ``H = 1/(k (1 + i ω h/k + i η))``
+        the Kelvin-Voigt (and hysteretic) compliance and ``L`` the linear interpolation of a
+        channel delay's fractional sample ``φ``: ``|L|² = 1 - 2φ(1-φ)(1 - cos ωΔt)``. The
+        stiffness nonlinearities are taken at their linear stiffness ``k`` (a few per cent
+        of ``T`` at the effects' sizes; taking the local stiffness would let a softening
+        candidate lower the corrected error by raising ``T`` without bound).
+        """
+        spec = input_noise_spectrum(d)
+        if spec is None:
+            return 0.0
+        f, s = spec
+        w = 2.0 * np.pi * f
+        den = 1.0 + 1j * w * p["psi"] / (2.0 * np.pi * d.extra["omega"])
+        if "hysteretic_damping" in effects:
+            den = den + 1j * p["eta"]
+        g = s / np.abs(den) ** 2
+        if "channel_delay" in effects:
+            phi = float(p["tau"] / d.dt) % 1.0
+            g = g * (1.0 - 2.0 * phi * (1.0 - phi) * (1.0 - np.cos(w * d.dt)))
+        return float(np.sum(g)) / p["k"] ** 2
+
+    def noise_variance_bound(self, p: dict[str, float], d: Prepared) -> float:
+        """:meth:`noise_variance` without damping or delay (its largest value at ``k``)."""
+        spec = input_noise_spectrum(d)
+        return 0.0 if spec is None else float(np.sum(spec[1])) / p["k"] ** 2
 
     def derived(
         self, p: dict[str, float], se: dict[str, float], effect: str
@@ -343,6 +387,13 @@ class NormalFamily:
                     f"{CREEP_MIN_PERIODS:g} excitation period ({period:.3g} s): a start-up "
                     "transient of the record or its model, not creep of the joint"
                 )
+            if p["tau_c"] > CREEP_MAX_DURATIONS * d.duration:
+                return (
+                    f"the drift does not settle within the record (τc = {p['tau_c']:.3g} s, "
+                    f"more than {CREEP_MAX_DURATIONS:g} × its {d.duration:.3g} s): a straight "
+                    "drift, which creep of the joint cannot be told from a drifting "
+                    "displacement sensor or a slow model misfit by"
+                )
         return implausible_common(self.candidates[name], p, d)
 
     def regime(self, p: dict[str, float], d: Prepared) -> str:
@@ -363,8 +414,92 @@ class NormalFamily:
 #: a creep must take longer than this many excitation periods to settle: a faster "drift"
 #: is the start of the record (a sensor or model transient), which creep cannot be told from
 CREEP_MIN_PERIODS = 1.0
+#: a creep must settle visibly within the record: with τc above this many record durations
+#: the drift is straight to within a sixth of its size (1 - e^(-1/3) against 1/3), and creep
+#: (a settling) is not told from a sensor drift or a slow misfit of the model
+CREEP_MAX_DURATIONS = 3.0
 #: excitation frequencies closer than this ratio count as one frequency for the delay test
 SINGLE_TONE_SPAN = 1.25
+
+
+#: the input-noise spectrum is read above this many times the fastest excitation
+#: frequency (the pressure drive is a sum of tones; its window leakage is gone there)
+NOISE_BAND_HARMONICS = 6.0
+
+
+def input_noise_spectrum(d: Prepared) -> tuple[np.ndarray, np.ndarray] | None:
+    """The input-noise power per frequency bin in the input the candidates see, or None
+    when the input carries no measurable noise (``d.extra["u_noise"]`` 0).
+
+    Welch's periodogram of the measured input (Hann, 1024 samples or the record); above
+    :data:`NOISE_BAND_HARMONICS` times the fastest excitation frequency (and 24 bins) it is
+    noise only, and below it the noise is taken at the median level of the octave above
+    (the drive's tones hide it there). Multiplied by the power response of the zero-phase
+    filter the candidates see the input through (``d.extra["u_filter"]``) and by the bin
+    width, so that the sum is the filtered noise's variance. Kept in ``d.extra``.
+    """
+    if "u_noise_spectrum" in d.extra:
+        return d.extra["u_noise_spectrum"]
+    out = None
+    if float(d.extra.get("u_noise", 0.0)) > 0.0 and d.u.size >= 64:
+        from scipy.signal import savgol_coeffs, welch
+
+        from ._signal import shortest_period_samples
+
+        u = np.asarray(d.extra.get("u_raw", d.u), float)
+        nper = min(u.size, 1024)
+        fs = 1.0 / d.dt
+        f, s = welch(u, fs=fs, window="hann", nperseg=nper, detrend="linear")
+        fast = 1.0 / (shortest_period_samples(u, d.cycles.period_samples) * d.dt)
+        nyq = 0.5 * fs
+        lo = min(max(NOISE_BAND_HARMONICS * fast, 24.0 * fs / nper), 0.5 * nyq)
+        band = (f >= lo) & (f <= min(2.0 * lo, nyq))
+        if np.any(band):
+            s = np.where(f < lo, float(np.median(s[band])), s)
+            wlen = int(d.extra.get("u_filter", 0))
+            if wlen:
+                c = savgol_coeffs(wlen, 3)
+                j = np.arange(wlen) - wlen // 2
+                s = s * np.abs(np.exp(-2j * np.pi * np.outer(f * d.dt, j)) @ c) ** 2
+            out = (f, s * float(f[1] - f[0]))
+    d.extra["u_noise_spectrum"] = out
+    return out
+
+
+#: excitation periods (the dominant one) of run-in history before the record that the
+#: hysteretic candidate assumes (:func:`run_in`)
+RUN_IN_PERIODS = 3.0
+
+
+def run_in(d: Prepared, pd: np.ndarray) -> np.ndarray | None:
+    """The pressure history the hysteretic candidate assumes before the record.
+
+    The ideal hysteretic loss ``i η k sgn ω`` is non-causal with a memory that decays only
+    as ``1/t``: the displacement at the start of a record still carries the response to
+    what the joint saw before, seconds earlier. A record that starts in steady state was
+    preceded by the same excitation; that history is taken as the record's first complete
+    cycle (maximum to maximum) repeated over :data:`RUN_IN_PERIODS` dominant periods,
+    ramped in from rest over the first of them and ending in phase with the record's first
+    sample. None for a record that starts from rest (over the first quarter of a dominant
+    period the pressure stays below half the first complete cycle's amplitude) or that has
+    no complete cycle.
+    """
+    rev = d.cycles.reversals[d.cycles.is_max]
+    if rev.size < 2:
+        return None
+    i0, i1 = int(rev[0]), int(rev[1])
+    c = i1 - i0
+    per = float(d.cycles.period_samples)
+    amp = float(np.max(np.abs(pd[i0:i1])))
+    if float(np.max(np.abs(pd[: max(int(0.25 * per), 1)]))) < 0.5 * amp:
+        return None  # the record starts from rest: no history
+    length = int(np.ceil(RUN_IN_PERIODS * per / c)) * c
+    reps = length // c + 2
+    ext = np.tile(pd[i0:i1], reps)
+    end = (reps - 1) * c + (-i0) % c
+    hist = ext[end - length : end]
+    ramp = np.clip(np.arange(length) / per, 0.0, 1.0)
+    return hist * (ramp * ramp * (3.0 - 2.0 * ramp))
 
 
 def frequency_span(d: Prepared) -> float:

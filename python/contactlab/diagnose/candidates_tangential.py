@@ -40,6 +40,7 @@ measured force.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable
 from typing import Any
 
@@ -49,7 +50,8 @@ from ..errors import InputError
 from ..masing import Masing, loop_area
 from ._family import Candidate, ParamSpec, Prepared, implausible_common
 from ._filters import savgol_filter
-from ._signal import modulation_gains, shift
+from ._kept import delayed, span
+from ._signal import Knots, modulation_gains, shift
 from .scaled_masing import memory, scaled_force
 
 _INF = np.inf
@@ -240,6 +242,11 @@ def _grid(x: np.ndarray, F: np.ndarray) -> tuple[float, float, float]:
 
 #: ac·A from which the base loop is near-rectangular (gross sliding, as regime() says)
 GROSS_SLIDING_ZA = 10.0
+#: a gross-sliding base whose h0 is this many combined standard errors from the plateau
+#: force is re-anchored to it (TangentialFamily.anchor); h0 is then held within
+#: ANCHOR_BAND plateau errors of the plateau
+ANCHOR_SIGMAS = 3.0
+ANCHOR_BAND = 2.0
 
 
 def _fixed(d: Prepared, key: str, make: Callable[[], Any]) -> Any:
@@ -307,15 +314,18 @@ def _load_terms(d: Prepared, f_n: float, rows: np.ndarray | None) -> tuple[np.nd
 _MASING_KEEP = 64
 
 
-def _masing_force(d: Prepared, h0: float, ac: float, x0: float | None, x: np.ndarray) -> np.ndarray:
+def _masing_force(
+    d: Prepared, h0: float, ac: float, x0: float | None, x: np.ndarray, token: int = 0
+) -> np.ndarray:
     """``Masing(h0, ac).force(x)`` as ``h0`` times the force of the unit element (h0 = 1),
-    which is kept per ``(ac, x0)``: along a given history the exponential Masing force is
-    linear in h0 (to rounding, 1e-15 h0), and the fits step h0 and the effects' parameters
-    at a fixed ac thousands of times (their Jacobian columns)."""
+    which is kept per ``(ac, x0)`` and history (``token``: a span of a kept record): along a
+    given history the exponential Masing force is linear in h0 (to rounding, 1e-15 h0), and
+    the fits step h0 and the effects' parameters at a fixed ac thousands of times (their
+    Jacobian columns)."""
     if not (np.isfinite(h0) and h0 > 0):
         return Masing(h0, ac).force(x)  # the model's own refusal
     cache = d.extra.setdefault("masing", {})
-    key = (ac, x0, x.size)
+    key = (ac, x0, x.size, token)
     g = cache.get(key)
     if g is None:
         g = Masing(1.0, ac).force(x)
@@ -336,8 +346,64 @@ class TangentialFamily:
     """Masing base model with the tangential candidate library (see module docstring)."""
 
     kind = "tangential"
-    base_params = BASE_PARAMS
     candidates = CANDIDATES
+    #: the base's h0 held to this band and ac to at least ``ac_floor`` (:meth:`anchor`)
+    h0_band: tuple[float, float] | None = None
+    ac_floor: float = 0.0
+
+    @property
+    def base_params(self) -> tuple[ParamSpec, ...]:
+        """``h0`` and ``ac``; within the plateau's band once :meth:`anchor` has set one."""
+        if self.h0_band is None:
+            return BASE_PARAMS
+        lo, hi = self.h0_band
+        return (
+            ParamSpec("h0", "N", _INF, lo, hi, "F"),
+            ParamSpec("ac", "1/m", _INF, self.ac_floor, _INF, "ac"),
+        )
+
+    def anchor(self, p: dict[str, float], se: dict[str, float], d: Prepared) -> str | None:
+        """Fix the base first when it is in the wrong regime: in gross sliding (``ac·A`` of
+        the base fit at least :data:`GROSS_SLIDING_ZA`) the plateau measures ``h0``
+        directly and ``ac`` is only bounded from below
+        (:func:`contactlab.tangential.regime.plateau`, on the measured displacement, as
+        ``analyze`` reads it). When the base's ``h0`` lies more than
+        :data:`ANCHOR_SIGMAS` combined standard errors from the plateau (the least-squares
+        fit trades ``h0`` against what the Masing element cannot follow: the sticks, the
+        friction varying along the track), ``h0`` is held within
+        :data:`ANCHOR_BAND` plateau errors of it and ``ac`` above the bound from then on
+        (the base and every candidate), so no effect is credited with moving ``h0`` back;
+        the band stays with the family (a refit of the final model keeps it). Returns a
+        sentence saying so, or None (nothing changed)."""
+        from ..tangential.preprocess import average_loop
+        from ..tangential.regime import plateau, velocity
+
+        amp = 0.5 * float(np.ptp(d.u))
+        if self.h0_band is not None or p["ac"] * amp < GROSS_SLIDING_ZA:
+            return None
+        x = d.extra.get("u_raw", d.u)
+        try:
+            loop = average_loop(x, d.y, d.t)
+            v, thr, _ = velocity(d.t, x)
+            pl = plateau(loop, x, d.y, v, thr)
+        except (InputError, ValueError):  # no loop to average: no plateau to anchor to
+            return None
+        if pl is None or not (np.isfinite(pl.h0_stderr) and pl.h0_stderr > 0):
+            return None
+        err = float(np.hypot(se["h0"] if np.isfinite(se["h0"]) else 0.0, pl.h0_stderr))
+        off = abs(p["h0"] - pl.h0) / err
+        if off <= ANCHOR_SIGMAS:
+            return None
+        band = ANCHOR_BAND * pl.h0_stderr
+        self.h0_band = (pl.h0 - band, pl.h0 + band)
+        self.ac_floor = min(pl.ac_lower_bound, p["ac"])
+        return (
+            f"base re-anchored to the plateau: in gross sliding h0 is the plateau force "
+            f"{pl.h0:.4g} ± {pl.h0_stderr:.2g} N, but the least-squares base put it at "
+            f"{p['h0']:.4g} N ({off:.1f} σ away); h0 is held within ±{band:.2g} N of the "
+            f"plateau and ac ≥ {self.ac_floor:.3g} 1/m (only a lower bound is identified)"
+        )
+
     input_name = "x"
     output_name = "F"
     input_unit = "m"
@@ -441,11 +507,31 @@ class TangentialFamily:
         """Measured force predicted for the measured displacement ``d.u`` (at the sample
         indices ``at`` only, when given: the Masing element still runs over the whole
         history, the terms sample by sample only where asked — the same values)."""
+        if "channel_delay" in effects and "raw_input" in d.extra and p["tau"] != 0.0:
+            # a kept record (workflow.subsample_long): the model at the shifted raw positions
+            rest = tuple(e for e in effects if e != "channel_delay")
+            return self.predict(p, rest, delayed(d, p["tau"]), at)
         x = d.u
         if "displacement_offset" in effects:
             x = x - p["x0"]
+        # a record kept every q-th sample (workflow.subsample_long): the element and the
+        # terms up to the breakaway run over the kept samples with the turning points
+        # between them merged in (xm), which gives the full-rate values at the kept samples;
+        # with ``at``, over the samples asked for and the turning points only (``sp``)
+        kn: Knots | None = d.extra.get("knots")
+        x0 = p["x0"] if x is not d.u else None
+        sp = None if kn is None else span(d, kn, at)
+        if kn is None or sp is None:
+            xm = x
+        else:  # merged once per displacement (x0) and kept: the fits step x0 rarely
+            memo = _memo(d, "merged")
+            xm = memo.get(x0)
+            if xm is None:
+                xm = memo[x0] = kn.merge(x, x0 or 0.0)
+            if sp.index is not None:
+                xm = xm[sp.index]
         if "series_compliance" in effects:
-            xmax = float(np.max(np.abs(x))) or 1.0
+            xmax = float(np.max(np.abs(xm))) or 1.0
             bx, bf = series_backbone(p["h0"], p["ac"], max(p["C_s"], 0.0), xmax)
             core = Masing.from_backbone(bx, bf)
         elif "non_masing_scaling" in effects:
@@ -455,17 +541,18 @@ class TangentialFamily:
             # and the mirrored targets on the virgin curve), so a cached one is reused only
             # for the very same displacement (issue 13)
             mem = d.extra.get("memory")
-            if mem is None or not np.array_equal(mem.x, x):
-                mem = d.extra["memory"] = memory(x)
+            if mem is None or not np.array_equal(mem.x, xm):
+                mem = d.extra["memory"] = memory(xm)
             h = scaled_force(core.virgin, p["lam"], mem)
         elif "series_compliance" in effects:
-            h = core.force(x)
+            h = core.force(xm)
         else:
-            h = _masing_force(d, p["h0"], p["ac"], p["x0"] if x is not d.u else None, x)
+            h = _masing_force(d, p["h0"], p["ac"], x0, xm, 0 if sp is None else sp.token)
         if "asymmetry" in effects:
             h = h + p["alpha"] * np.abs(h)
         if "parameter_drift" in effects:
-            h = h * (1.0 + p["beta"] * _fixed(d, "t_rel", lambda: d.t - d.t[0]) / d.duration)
+            t_rel = _fixed(d, "t_rel", lambda: d.t - d.t[0]) if sp is None else sp.t - d.t[0]
+            h = h * (1.0 + p["beta"] * t_rel / d.duration)
         # from here on sample by sample: with ``at``, only at the samples asked for — or, with
         # a delay (which interpolates between samples), at the two around each shifted time
         delay = "channel_delay" in effects
@@ -475,11 +562,16 @@ class TangentialFamily:
         )
         xs = pick(x)
         if "stick_slip" in effects:
-            rev = d.cycles.reversals
-            anchors = _fixed(d, "anchors", lambda: reversal_anchors(rev, x.size))
-            h = breakaway(h, x, rev, p["s_b"], p["ell"], anchors, rows)
+            if sp is None:
+                rev = d.cycles.reversals
+                anchors = _fixed(d, "anchors", lambda: reversal_anchors(rev, x.size))
+                h = breakaway(h, x, rev, p["s_b"], p["ell"], anchors, rows)
+            else:
+                if sp.anchors is None:
+                    sp.anchors = reversal_anchors(sp.reversals, sp.size)
+                h = breakaway(h, xm, sp.reversals, p["s_b"], p["ell"], sp.anchors, sp.rows)
         else:
-            h = pick(h)
+            h = pick(h) if sp is None else h[sp.rows]
         if "stribeck" in effects:
             speed = pick(_fixed(d, "speed", lambda: np.abs(d.ud)))
             h = h * (1.0 + p["s"] * np.exp(-speed / max(p["v_s"], 1e-300)))
@@ -514,10 +606,66 @@ class TangentialFamily:
                 F = np.interp(d.t[at] - p["tau"], d.t[rows], F)
         return F if F.flags.writeable else F.copy()
 
+    #: :meth:`derived` takes the model's effects and the data (keywords ``effects``, ``d``)
+    derived_from_data = True
+
+    def model_breakaway(self, p: dict[str, float], effects: tuple[str, ...], d: Prepared) -> float:
+        """The breakaway force of the fitted model as the sticks of the data measure it: the
+        mean over the strokes between reversals of the largest force within ``20/ac + 3 ell``
+        of the reversal, about the model's own zero (the force offset and drift taken off).
+
+        This is the quantity :func:`contactlab.tangential.regime.stick_slip` reads off the
+        measured sticks (the largest ``|F - offset|`` while stuck and up to the onset of
+        sliding). It is read off the whole model, not off the breakaway term alone: on the
+        measured frame the friction along the track (``position_friction``) is 18 % lower
+        at the stroke's ends, where the breakaway happens, than its mean ``h0``; a full
+        branch of the term alone from ``-h0`` (:func:`breakaway_force`) put the breakaway
+        1.2x too high there.
+        """
+        F = self.predict(p, effects, d)
+        if "force_offset" in effects:
+            F = F - p["F0"]
+        if "force_drift" in effects:
+            F = F - p["F1"] * (d.t - d.t[0]) / d.duration
+        rev = d.cycles.reversals
+        # the peak lies within a few slip distances (ell) of the reversal, once the branch
+        # has covered its swing (20/ac: to within 2e^-10): beyond, the term has decayed
+        reach = 20.0 / p["ac"] + (3.0 * p["ell"] if "stick_slip" in effects else 0.0)
+        peaks = []
+        for a, b in itertools.pairwise(rev):
+            s = 1.0 if d.u[b] > d.u[a] else -1.0
+            near = s * (d.u[a:b] - d.u[a]) <= reach
+            if np.any(near):
+                peaks.append(float(np.max(s * F[a:b][near])))
+        return float(np.mean(peaks)) if peaks else np.nan
+
     def derived(
-        self, p: dict[str, float], se: dict[str, float], effect: str
+        self,
+        p: dict[str, float],
+        se: dict[str, float],
+        effect: str,
+        *,
+        effects: tuple[str, ...] | None = None,
+        d: Prepared | None = None,
     ) -> tuple[dict[str, float], dict[str, float]]:
-        """Extra reported quantities of an effect (with delta-method standard errors)."""
+        """Extra reported quantities of an effect (with delta-method standard errors).
+
+        ``stick_slip``'s ``breakaway_force``: with the model's ``effects`` and the data
+        ``d``, :meth:`model_breakaway` (comparable with ``analyze``'s breakaway force of the
+        sticks); without them, the peak of a full branch of the breakaway term
+        (:func:`breakaway_force`), which ignores the other effects.
+        """
+        if effect == "stick_slip" and effects is not None and d is not None:
+            val = self.model_breakaway(p, effects, d)
+            var = 0.0
+            for k, s in se.items():
+                if not (np.isfinite(s) and s > 0):
+                    continue
+                step = 1e-3 * s
+                q = dict(p)
+                q[k] += step
+                var += ((self.model_breakaway(q, effects, d) - val) / step * s) ** 2
+            return {"breakaway_force": val}, {"breakaway_force": float(np.sqrt(var))}
         if effect == "series_compliance" and p["C_s"] > 0:
             return {"k_s": 1.0 / p["C_s"]}, {"k_s": se["C_s"] / p["C_s"] ** 2}
         if effect == "asymmetry":
@@ -555,7 +703,9 @@ class TangentialFamily:
         the steepest slope of the exponential element, at a reversal. The measured path is
         what marks a sticking phase (the force changes while the displacement does not),
         which a steep element crosses in a fraction of a micrometre."""
-        h = Masing(p["h0"], p["ac"]).force(d.u)
+        kn: Knots | None = d.extra.get("knots")
+        h = Masing(p["h0"], p["ac"]).force(d.u if kn is None else kn.merge(d.u))
+        h = h if kn is None else h[kn.grid]
         kmax = p["h0"] * p["ac"]
         w = min(d.window, d.y.size - (1 - d.y.size % 2))
         yd = savgol_filter(d.y, w, 3, deriv=1, mode="interp")

@@ -26,6 +26,13 @@ only if all three hold:
    significance, which is no evidence of that effect.
 
 The accepted candidate with the largest held-out gain wins.
+
+Errors in variables (families with a ``noise_variance``, the normal contact): the model is
+driven by the measured input, so its prediction carries the input's noise as the model
+filters it, ``T(θ)`` per sample (:func:`noise_term`). A model that filters more (more
+damping, a delay interpolating between samples) would win by that alone. Fits minimise the
+corrected sum ``Σ r² - n T(θ)``, unbiased for every candidate, and the rules above compare
+a candidate's held-out errors as if it passed the current model's ``T``.
 """
 
 from __future__ import annotations
@@ -75,6 +82,29 @@ def sample_weight(d: Prepared) -> np.ndarray:
     """
     w = d.extra.get("weight")
     return np.ones(d.y.size) if w is None else w
+
+
+def noise_term(family: Family, p: dict[str, float], effects: tuple[str, ...], d: Prepared) -> float:
+    """Output variance per sample that the input's sensor noise causes through the model
+    ``θ`` (``T(θ) = ∫ S_u |H_θ|²``; the family's ``noise_variance``, 0 when it has none or
+    the input carries no measurable noise).
+
+    Errors in variables: the model is driven by the measured input, so its prediction
+    carries the input noise filtered by the model itself, and a model that filters more
+    (more damping, a delay interpolating between samples) shows a smaller error for that
+    reason alone. ``E[Σ r²] = n (σy² + bias² + T(θ))``, so the corrected sum of squares
+    ``Σ r² - n T(θ)`` is unbiased for every candidate; fits minimise it (:func:`fit`) and
+    :func:`judge` compares held-out errors with it.
+    """
+    f = getattr(family, "noise_variance", None)
+    return 0.0 if f is None else float(f(p, effects, d))
+
+
+def noise_bound(family: Family, p: dict[str, float], d: Prepared) -> float:
+    """An upper bound of :func:`noise_term` over the damping and delay at the stiffness in
+    ``p`` (the family's ``noise_variance_bound``; 0 when it has none)."""
+    f = getattr(family, "noise_variance_bound", None)
+    return 0.0 if f is None else float(f(p, d))
 
 
 def specs_for(family: Family, effects: tuple[str, ...]) -> list[ParamSpec]:
@@ -145,28 +175,50 @@ def fit(
         return {n: min(max(float(x0[n] + (w[n] - 1.0) * sc[n]), lo[n]), hi[n]) for n in names}
 
     spent = d.extra.get("evaluations")  # the workflow's budget counter (EvaluationCounter)
+    # errors in variables (corrected least squares, see noise_term): the objective is
+    # Σ w r² - n T(θ), passed to the solver as one more residual √(n (C - T(θ))) with C a
+    # constant above any T the fit reaches (the input noise through the model's compliance
+    # at half the starting stiffness or more), so no candidate wins by filtering the input
+    c_top = 4.0 * noise_bound(family, x0, d)
+    n_fit = float(np.sum(sample_weight(d)[idx]))
 
     if getattr(family, "predicts_at", False):  # the model at the fit's samples only
 
-        def resid(w: dict[str, float]) -> np.ndarray:
+        def plain(w: dict[str, float]) -> np.ndarray:
             if spent is not None:
                 spent.tick()
             return (family.predict(value(w), effects, d, at=idx) - y) * sw  # type: ignore[call-arg]
 
     else:
 
-        def resid(w: dict[str, float]) -> np.ndarray:
+        def plain(w: dict[str, float]) -> np.ndarray:
             if spent is not None:
                 spent.tick()
             return (family.predict(value(w), effects, d)[idx] - y) * sw
 
+    resid = plain
+    if c_top > 0:
+
+        def resid(w: dict[str, float]) -> np.ndarray:
+            extra = n_fit * max(c_top - noise_term(family, value(w), effects, d), 0.0)
+            return np.append(plain(w), np.sqrt(extra) / ys)
+
     res = least_squares_fit(resid, params, ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=400)
     w = {n: res.params[n].value for n in names}
-    shrink = float(np.sqrt(y.size / n_all))
+    chisqr = float(res.chisqr) * ys * ys
+    resid_vec, jac = res.residual, res.jac
+    rss = chisqr
+    if c_top > 0:  # the corrected sum of squares, Σ w r² - n T(θ) (never below a tenth of Σ w r²)
+        raw = float(np.sum(resid_vec[:-1] ** 2)) * ys * ys
+        rss = max(raw - n_fit * noise_term(family, value(w), effects, d), 0.1 * raw)
+        resid_vec = resid_vec[:-1]
+        jac = None if jac is None else jac[:-1]
+    # the errors scale with the corrected residual, not with the constant C the solver saw
+    shrink = float(np.sqrt(y.size / n_all)) * float(np.sqrt(rss / chisqr)) if chisqr > 0 else 1.0
     infl = dict.fromkeys(names, 1.0)
-    if n_all == d.y.size and res.jac is not None:  # the fit to all data: its errors are reported
+    if n_all == d.y.size and jac is not None:  # the fit to all data: its errors are reported
         lag = int(d.cycles.period_samples // stride)
-        infl.update(zip(res.var_names, stderr_inflation(res.jac, res.residual, lag), strict=True))
+        infl.update(zip(res.var_names, stderr_inflation(jac, resid_vec, lag), strict=True))
     se = {
         n: (
             res.params[n].stderr * sc[n] * shrink * infl[n]
@@ -179,8 +231,8 @@ def fit(
     return FitOut(
         value(w),
         se,
-        float(res.chisqr) * ys * ys,
-        float(res.chisqr) * ys * ys / wsum,
+        rss,
+        rss / wsum,
         res.ndata,
         res.nvarys,
         res.success,
@@ -266,6 +318,11 @@ class Trial:
     def heldout_mse(self) -> float:
         return self.heldout_rms**2
 
+    @property
+    def noise_term(self) -> float:
+        """:func:`noise_term` of the fit to all data (0 when not known)."""
+        return float(self.extra.get("noise_term", 0.0))
+
 
 def fold_masks(d: Prepared, folds: int) -> list[np.ndarray]:
     """Test masks: cycle k (from one maximum of the input to the next) in fold k mod folds."""
@@ -344,6 +401,7 @@ def evaluate(
         float(np.max(np.abs(eh))),
         energy_error,
         fitted,
+        {"noise_term": noise_term(family, full.params, effects, d)},
     )
 
 
@@ -375,6 +433,11 @@ class Verdict:
 MIN_RELATIVE_GAIN = 0.01
 
 
+def _noise_of(trial: Any) -> float:
+    """A trial's input-noise term (0 for an object that has none)."""
+    return float(getattr(trial, "noise_term", 0.0))
+
+
 def proportional_t(current: Trial, cand: Trial, d: Prepared) -> float:
     """t statistic of the held-out gain with per-cycle gains proportional to the change.
 
@@ -395,7 +458,10 @@ def proportional_t(current: Trial, cand: Trial, d: Prepared) -> float:
     if ids.size < 3:
         return -np.inf
     idx = np.searchsorted(ids, cyc[cyc >= 0])
-    n_c = np.bincount(idx, (w * r * delta)[cyc >= 0], ids.size)
+    # errors in variables: the candidate's error is read as if it carried the current
+    # model's input-noise term (:func:`noise_term`), i.e. each sample gains (T_c - T)/2 in N
+    dt_half = 0.5 * (_noise_of(cand) - _noise_of(current))
+    n_c = np.bincount(idx, (w * (r * delta + dt_half))[cyc >= 0], ids.size)
     d_c = np.bincount(idx, (w * delta * delta)[cyc >= 0], ids.size)
     total = float(np.sum(d_c))
     if not total > 0:
@@ -417,14 +483,19 @@ def judge(
 ) -> Verdict:
     """Apply the three acceptance rules of the module docstring (rule 2's proportional
     form when ``d`` is given: the family's ``proportional_gain``)."""
-    ratio = np.log(current.cycle_mse / cand.cycle_mse)
-    gain = float(current.heldout_mse - cand.heldout_mse) / sigma**2
+    # errors in variables: the candidate's held-out errors are compared as if it passed the
+    # input noise as the current model does (corrected least squares, :func:`noise_term`)
+    shift = _noise_of(cand) - _noise_of(current)
+    cand_cycle = np.maximum(cand.cycle_mse - shift, 1e-3 * cand.cycle_mse)
+    cand_mse = cand.heldout_mse - shift
+    ratio = np.log(current.cycle_mse / cand_cycle)
+    gain = float(current.heldout_mse - cand_mse) / sigma**2
     sd = float(np.std(ratio, ddof=1)) if ratio.size > 1 else np.inf
     t = float(np.mean(ratio) / (sd / np.sqrt(ratio.size))) if sd > 0 else np.inf
     if d is not None and not t > z:
         t = max(t, proportional_t(current, cand, d))
     dbic = cand.full.bic - current.full.bic
-    rel = float(current.heldout_mse - cand.heldout_mse) / current.heldout_mse
+    rel = float(current.heldout_mse - cand_mse) / current.heldout_mse
     if gain < min_gain:
         reason = f"held-out gain {gain:.3g} σ² below {min_gain:g} σ²"
     elif rel < MIN_RELATIVE_GAIN:

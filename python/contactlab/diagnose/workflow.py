@@ -8,12 +8,16 @@ model, rank by the error on held-out cycles and accept the best only if it passe
 of :mod:`.select` against the noise level estimated from the data; (4) after each addition,
 refit without each effect named so far and drop one that, added back, would no longer pass
 those rules (backward elimination: a wrong effect picked first is not kept once the right
-ones are in); repeat until no candidate helps; (5) report held-out RMS, peak error and
-loop-energy error after each step.
+ones are in); repeat until no candidate helps; then, with the set full (``max_effects``) or
+two or more named, try replacing each named effect by each candidate not in the model and
+keep the swap the held-out rules prefer (a wrong effect picked while the set filled up
+would otherwise keep the right one from ever being tried), and go on; (5) report held-out
+RMS, peak error and loop-energy error after each step.
 """
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import json
 import sys
@@ -29,8 +33,20 @@ from ._family import Family, Prepared
 from ._filters import decimate, savgol_coeffs
 from ._inputs import arrays as _arrays
 from ._inputs import check_channels
+from ._kept import RawInput, knots_at
 from ._parallel import EvaluationCounter, one_blas_thread, pmap
-from ._signal import check_uniform, dominant_period_samples, noise_rms, shortest_period_samples
+from ._signal import (
+    Cycles,
+    check_uniform,
+    derivatives,
+    dominant_period_samples,
+    filter_input,
+    find_cycles,
+    input_noise,
+    noise_rms,
+    shortest_period_samples,
+    smooth_window,
+)
 from .locate import locate
 from .model import ExtendedModel
 from .select import Trial, Verdict, evaluate, fit, fold_masks, judge
@@ -67,7 +83,8 @@ class Step:
     ``E`` the loop area of one cycle; ``candidates``: the verdict on each candidate tried
     after this step. A step of the backward elimination has ``removed`` set (and ``added``
     None): the effect dropped because, refitted without it, the model no longer needs it
-    (``removal`` is the verdict on adding it back).
+    (``removal`` is the verdict on adding it back). A swap has both: ``removed`` replaced by
+    ``added``, which predicts the held-out cycles better (``removal`` is the verdict on it).
     """
 
     added: str | None
@@ -81,7 +98,10 @@ class Step:
 
     @property
     def label(self) -> str:
-        """``base model``, ``+ name`` (added) or ``- name`` (dropped by the backward step)."""
+        """``base model``, ``+ name`` (added), ``- name`` (dropped by the backward step) or
+        ``out ⇄ in`` (a swap)."""
+        if self.removed is not None and self.added is not None:
+            return f"{self.removed} ⇄ {self.added}"
         if self.removed is not None:
             return f"- {self.removed}"
         return "base model" if self.added is None else f"+ {self.added}"
@@ -253,12 +273,11 @@ def _family(model: Any) -> tuple[Family, dict[str, float], dict[str, float]]:
     raise InputError(f"cannot diagnose a model of type {type(model).__name__}")
 
 
-#: longest record diagnosed sample by sample; longer ones are decimated (anti-aliased, zero
-#: phase) to no fewer than MIN_SAMPLES_PER_CYCLE per period of the fastest cycles (the
-#: Masing memory holds the sampled extremes: at 22 samples per cycle the true turning point
-#: is up to 1 % of the amplitude beyond them, a bias a long record's low noise shows as a
-#: delay) and, if still longer, diagnosed on their first MAX_SAMPLES samples (said so in
-#: the report)
+#: longest record diagnosed sample by sample. Longer tangential ones keep every q-th sample
+#: over their whole length with the turning points between them (:func:`subsample_long`);
+#: longer normal ones are decimated (anti-aliased, zero phase) to no fewer than
+#: MIN_SAMPLES_PER_CYCLE per period of the fastest cycles and, if still longer, diagnosed on
+#: their first MAX_SAMPLES samples (said so in the report)
 MAX_SAMPLES = 24_000
 #: Model evaluations (residual calls of every fit, numerical Jacobians included) a diagnosis
 #: may spend. Typical runs use 1 000-8 000; the slowest of 657 random fuzz inputs 7 237 (a
@@ -322,6 +341,73 @@ def reduce_long(
             f"diagnosed on its first {MAX_SAMPLES * q / per:.0f} of {cycles:.0f} excitation cycles"
         )
     return t, u, y, f"the record of {n} samples was " + " and ".join(how)
+
+
+#: fewest samples per cycle of the fastest cycles that a tangential record is subsampled to
+#: (:func:`subsample_long`): the Masing memory is exact at any rate with the knots, but the
+#: delay's interpolation, the reversal anchors and the cycle split want a dozen per cycle
+MIN_KEPT_PER_CYCLE = 12
+
+
+def subsample_long(t: np.ndarray, u: np.ndarray, y: np.ndarray) -> tuple[Prepared, str]:
+    """A long tangential record kept every q-th sample over its whole length (q from the
+    record's length, so that at most :data:`MAX_SAMPLES` are kept), ready for the
+    candidates, and a sentence saying how.
+
+    Everything the candidates see is computed at the raw rate and then sampled: the
+    filtered input, its derivatives, the cycles and the input noise. No anti-alias filter:
+    the kept force samples are the measured ones, so the model at the kept samples is the
+    full-rate model there (a low-pass filter would take the loop's corners out of the
+    force but not out of the model's prediction). The turning points between the kept
+    samples go with them as :class:`~contactlab.diagnose._signal.Knots`, which the Masing
+    element runs over, so its memory holds the true extremes. When the fastest cycles
+    would keep fewer than :data:`MIN_KEPT_PER_CYCLE` samples, q is lowered and only the
+    first :data:`MAX_SAMPLES` kept samples are diagnosed (said so).
+    """
+    n = t.size
+    dt = check_uniform(t)
+    per = dominant_period_samples(u)
+    ud, udd = derivatives(u, dt, smooth_window(per))
+    cyc = find_cycles(u, per)
+    sig = input_noise(u)
+    uf, wf = filter_input(u, per, sig)
+    half = np.diff(cyc.reversals)
+    fastest = min(per, 2.0 * float(np.percentile(half, 10))) if half.size >= 4 else per
+    q = -(-n // MAX_SAMPLES)
+    if fastest / q < MIN_KEPT_PER_CYCLE:
+        q = max(1, int(fastest // MIN_KEPT_PER_CYCLE))
+    stop = min(n, (MAX_SAMPLES - 1) * q + 1)
+    g = slice(0, stop, q)
+    raw, exact = RawInput.build(
+        float(t[0]), dt, uf, ud, udd, cyc.reversals, q, limit=4 * MAX_SAMPLES
+    )
+    knots = knots_at(raw, np.arange(0, stop, q))
+    cycle = cyc.cycle[g].copy()
+    last = ((stop - 1) // q) * q
+    if stop < n:  # the cycle cut at the end belongs to no fold
+        cycle[cycle > np.count_nonzero(cyc.reversals[cyc.is_max] <= last) - 2] = -1
+    keep = cyc.reversals <= last
+    cycles = Cycles(
+        np.rint(cyc.reversals[keep] / q).astype(int),
+        cyc.is_max[keep],
+        cycle,
+        cyc.phase_in_branch[g],
+        per / q,
+    )
+    extra: dict[str, Any] = {
+        "u_raw": u[g], "u_noise": sig, "u_filter": wf, "knots": knots, "raw_input": raw,
+    }  # fmt: skip
+    d = Prepared(t[g], uf[g], y[g], dt * q, smooth_window(per / q), ud[g], udd[g], cycles, extra)
+    how = [f"kept one sample in {q} over its whole length (no filter; the {knots.pos.size} "
+           "turning points between them kept in the Masing memory)"]  # fmt: skip
+    if not exact:
+        how.append("the input's local extrema too many: its reversals only kept as turning points")
+    if stop < n:
+        how.append(
+            f"diagnosed on its first {stop / per:.0f} of {n / per:.0f} excitation cycles "
+            f"(the fastest cycles have {fastest:.0f} samples)"
+        )
+    return d, f"the record of {n} samples was " + " and ".join(how)
 
 
 def eiv_weight(
@@ -437,6 +523,66 @@ def _drop_check(
     return judge(name, reduced, current, sigma, z, min_gain + extra, prop), reduced
 
 
+#: the swap move's threshold on the t statistic of the per-cycle gain (see _swap_search)
+SWAP_Z = 0.0
+
+
+def _swap_search(
+    family: Family,
+    names: list[str],
+    current: Trial,
+    named: tuple[str, ...],
+    visited: set[frozenset[str]],
+    d: Prepared,
+    scales: dict[str, float],
+    folds: int,
+    sigma: float,
+    min_gain: float,
+    budget: float,
+    base_fit: dict[str, float],
+    all_samples: np.ndarray,
+) -> tuple[tuple[str, Verdict, Trial] | None, list[Verdict], int]:
+    """The swap move: every effect ``named`` by this diagnosis replaced by every candidate
+    not in the model.
+
+    Each swapped model is judged against the current one by the rules of a forward step
+    (:func:`_try_candidate` with the effect taken out: the in-sample screening, the held-out
+    gain of at least ``min_gain`` σ² and :data:`~contactlab.diagnose.select.MIN_RELATIVE_GAIN`
+    of the current error, the BIC, plausibility), except that the gain across held-out
+    cycles need only be positive on average (``t > SWAP_Z``), not significant: a swap does
+    not make the model larger, it picks the better of two of the same size. Returns the
+    best accepted swap ``(effect out, verdict on the one in, its trial)`` or None, every
+    verdict (named ``"out ⇄ in"``), and the model evaluations spent.
+    """
+    spent = d.extra["evaluations"]
+    effects = current.effects
+    pairs = [
+        (out, name)
+        for out in named
+        for name in names
+        if name not in effects
+        and family.check(rest := (*(e for e in effects if e != out), name))
+        and frozenset(rest) not in visited
+    ]
+
+    def one(pair: tuple[str, str]) -> tuple[Verdict, Trial | None]:
+        out, name = pair
+        rest = tuple(e for e in effects if e != out)
+        return _try_candidate(
+            name, family, current, rest, d, scales, folds, sigma, SWAP_Z, min_gain, budget,
+            base_fit, all_samples,
+        )  # fmt: skip
+
+    before = spent.total
+    results = pmap(one, pairs)
+    verdicts, best = [], None
+    for (out, _), (v, cand) in zip(pairs, results, strict=True):
+        verdicts.append(dataclasses.replace(v, name=f"{out} ⇄ {v.name}"))
+        if cand is not None and v.accepted and (best is None or v.gain > best[1].gain):
+            best = (out, v, cand)
+    return best, verdicts, spent.total - before
+
+
 @one_blas_thread
 def diagnose(
     recording: Any,
@@ -519,8 +665,11 @@ def diagnose(
                 f"unknown {family.kind} candidate {n!r}; choose from {', '.join(family.candidates)}"
             )
     n_in = t.size
-    t, u, y, reduced = reduce_long(t, u, y)
-    d = Prepared.build(t, u, y)
+    if family.kind == "tangential" and n_in > MAX_SAMPLES:
+        d, reduced = subsample_long(t, u, y)
+    else:
+        t, u, y, reduced = reduce_long(t, u, y)
+        d = Prepared.build(t, u, y)
     d.extra.update(context)
     d.extra["evaluations"] = spent = EvaluationCounter()  # counted by select.fit
     family.prepare(d)
@@ -543,11 +692,26 @@ def diagnose(
         sigma = noise_rms(current.full_residual(d))
     else:
         current = evaluate(family, effects, d, start, scales, folds, base_all, parallel=True)
+    anchored = None
+    if hasattr(family, "anchor"):  # on a copy: a model passed in keeps its own family
+        family = copy.copy(family)
+        anchored = family.anchor(current.full.params, current.full.stderr, d)
+    unanchored = {}
+    if anchored:  # the base was in the wrong regime: fixed before any effect is tried
+        unanchored = {
+            "heldout_rms": current.heldout_rms,
+            "h0": current.full.params["h0"],
+            "h0_stderr": _finite_or_none(current.full.stderr["h0"]),
+        }
+        current = evaluate(family, effects, d, current.full.params, scales, folds, parallel=True)
     where, location = locate(d, current.full_residual(d), family)
+    if anchored:
+        location["base_unanchored"] = unanchored
+        where.insert(0, anchored)
     where.insert(0, family.regime(current.full.params, d))
     if reduced:
         where.insert(1, reduced)
-    location["samples"] = {"recording": n_in, "diagnosed": int(t.size)}
+    location["samples"] = {"recording": n_in, "diagnosed": int(d.t.size)}
     if w is not None:
         low = float(np.mean(d.extra["weight"] < 0.5))
         location["low_weight_fraction"] = low
@@ -620,15 +784,49 @@ def diagnose(
             steps[-1] = dataclasses.replace(
                 steps[-1], candidates=tuple(sorted(verdicts, key=lambda v: v.heldout_rms))
             )
-        if best is None:
+        if best is None and added and used < MAX_EVALUATIONS and len(added) >= min(2, max_effects):
+            # swap move: no effect can be added (the set is full, or nothing else helps);
+            # an effect named early may stand in for one never tried because the set filled
+            swap, swap_verdicts, n = _swap_search(
+                family, names, current, tuple(added), visited, d, scales, folds, sigma,
+                min_gain, budget, base_fit, all_samples,
+            )  # fmt: skip
+            used += n
+            if swap_verdicts:
+                steps[-1] = dataclasses.replace(
+                    steps[-1], candidates=steps[-1].candidates + tuple(swap_verdicts)
+                )
+            if swap is not None:
+                out, v, current = swap
+                effects = current.effects
+                added[added.index(out)] = v.name
+                trials.append(current)
+                visited.add(frozenset(effects))
+                steps.append(
+                    Step(v.name, current.heldout_rms, current.heldout_peak,
+                         current.energy_error, removed=out, removal=v)
+                )  # fmt: skip
+                where.append(
+                    f"swap: {out} replaced by {v.name} (the model with {v.name} instead "
+                    f"predicts the held-out cycles better: gain {v.gain:.3g} σ², t = "
+                    f"{v.t_stat:.2f})"
+                )
+                best = None
+            elif best is None:
+                break
+        elif best is None:
             break
-        v, current = best
-        effects = current.effects
-        added.append(v.name)
-        trials.append(current)
-        steps.append(Step(v.name, current.heldout_rms, current.heldout_peak, current.energy_error))
-        visited.add(frozenset(effects))
-        # backward elimination: an effect named early may be redundant once later ones are in
+        if best is not None:
+            v, current = best
+            effects = current.effects
+            added.append(v.name)
+            trials.append(current)
+            steps.append(
+                Step(v.name, current.heldout_rms, current.heldout_peak, current.energy_error)
+            )
+            visited.add(frozenset(effects))
+        # backward elimination (after an addition or a swap): an effect named early may be
+        # redundant once later ones are in
         while len(added) >= 2 and used < MAX_EVALUATIONS:
             back = partial(
                 _drop_check, family=family, current=current, d=d, scales=scales,
@@ -663,7 +861,8 @@ def diagnose(
     for name in added:
         ps = {s.name: p[s.name] for s in family.candidates[name].params}
         ss = {s.name: se[s.name] for s in family.candidates[name].params}
-        dp, ds = family.derived(p, se, name)
+        more = {"effects": effects, "d": d} if getattr(family, "derived_from_data", False) else {}
+        dp, ds = family.derived(p, se, name, **more)
         out_effects.append(Effect(name, {**ps, **dp}, {**ss, **ds}))
     final = ExtendedModel(family, effects, p, se, family.context(d))
     gap = current.heldout_rms / sigma

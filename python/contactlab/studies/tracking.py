@@ -69,8 +69,9 @@ MIN_CYCLES = 3
 #: default upper bound on a window's samples (one window is held in memory)
 MAX_WINDOW = 2_000_000
 #: samples per window for ``every="auto"``: the fit of a window costs about as much as folding
-#: 10^5 samples, so longer windows amortise it, but each window in flight holds ~100 bytes a
-#: sample (2^20 with two threads peaked at 420 MB on 1e7 samples, 2^19 at 216 MB with one)
+#: 10^5 samples, so longer windows amortise it, but each window in flight holds ~40 bytes a
+#: sample (on 1e8 samples with two threads: 2^19 peaked at 216 MB, 3·2^18 at 272 MB, 2^20 at
+#: 304 MB)
 AUTO_WINDOW = 1 << 19
 
 _EVERY = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?\d+)?)\s*([A-Za-zµμ]*)\s*$")
@@ -512,8 +513,9 @@ def track(
     threads : int, optional
         Without ``executor``: analyse windows on this many helper threads while the next
         chunks are read and their cycles found (the Rust kernels release the GIL); default 1
-        (each thread holds up to two windows: 2 threads peak near 300 MB with ``"auto"``
-        windows), 0 analyses each window before reading on. The rows are the same.
+        (``threads + 1`` windows in flight: 2 threads peaked at 216 MB on 1e8 samples with
+        ``"auto"`` windows), 0 analyses each window before reading on. The rows are the
+        same.
     keep_documents : bool
         Keep each window's whole analysis document (``TrackResult.window_docs``; what
         :func:`contactlab.studies.pooled.pooled_document` and
@@ -541,11 +543,39 @@ def track(
         if n_threads < 0:
             raise InputError(f"threads must be >= 0, got {threads!r}")
         with ThreadPoolExecutor(n_threads, thread_name_prefix="contactlab-track") as pool:
-            return track(
+            # each helper thread analyses one window while the next is read: n + 1 windows
+            # in memory (an executor given by the caller gets two per worker)
+            return _track(
                 source, every, kind=kind, columns=columns, fs=fs, chunk_size=chunk_size,
                 max_window=max_window, options=options, keep_going=keep_going,
                 callback=callback, executor=pool, keep_documents=keep_documents,
+                slots=n_threads + 1,
             )  # fmt: skip
+    return _track(
+        source, every, kind=kind, columns=columns, fs=fs, chunk_size=chunk_size,
+        max_window=max_window, options=options, keep_going=keep_going, callback=callback,
+        executor=executor, keep_documents=keep_documents, slots=None,
+    )  # fmt: skip
+
+
+def _track(
+    source: str | Path | Recording,
+    every: str | float,
+    *,
+    kind: str | None,
+    columns: dict[str, str] | None,
+    fs: float | None,
+    chunk_size: int,
+    max_window: int,
+    options: Mapping[str, Any] | None,
+    keep_going: bool,
+    callback: Callable[[dict[str, Any]], None] | None,
+    executor: Any,
+    keep_documents: bool,
+    slots: int | None,
+) -> TrackResult:
+    """:func:`track` on ``executor`` (None: serial); ``slots``: windows in flight at most
+    (default two per worker)."""
     mode, size = parse_every(every)
     every_text = every if isinstance(every, str) else f"{every}cycles"
     if not (isinstance(max_window, int) and max_window >= 16):
@@ -579,7 +609,7 @@ def track(
     from .executor import n_workers
 
     in_flight: deque[tuple[dict[str, Any], Any]] = deque()
-    limit = 2 * n_workers(executor)
+    limit = slots if slots is not None else 2 * n_workers(executor)
     dask = executor is not None and type(executor).__module__.split(".")[0] == "distributed"
 
     def collect(row: dict[str, Any], job: Any) -> None:

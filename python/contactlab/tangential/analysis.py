@@ -567,11 +567,20 @@ def _window_detrended(
     tm = float(np.mean(time))
     f_drift = trend(time, period_means(tt, Fa, pt))
     x_drift = trend(time, period_means(tt, xa, pt))
-    tau = tt - tm
-    F = Fa - f_drift[0] * tau
-    x = xa - x_drift[0] * tau
+    # Fa - s·(tt - tm) for both channels in one Rust pass without the interpreter lock (bit
+    # for bit numpy's a + (tt - tm)·(-s), which is a - s·τ): 16 bytes a sample at the peak
+    # instead of 32 (τ, a product and the two results), one pass instead of six
+    F, x = _core.detrend_pair(tt, tm, Fa, f_drift[0], xa, x_drift[0])
     loop = average_loop(x, F, ta, n_points=n_points, rel_threshold=rel, min_cycles=min_cycles)
     return steps.Detrended(x, F, loop, steps.Drift(f_drift, x_drift, tt, tm))
+
+
+def _detrended(v: np.ndarray, tt: np.ndarray, tm: float, slope: float) -> np.ndarray:
+    """``v - slope * (tt - tm)`` in numpy (the reference of ``_core.detrend_pair``, tests)."""
+    out = np.subtract(tt, tm)
+    np.multiply(out, -slope, out=out)
+    np.add(v, out, out=out)
+    return out
 
 
 def _negated(d: steps.Detrended) -> steps.Detrended:

@@ -21,11 +21,13 @@ Perturbations of the inputs (for the covariance terms) are explicit keyword argu
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
+from .. import _core
 from ..errors import InputError
 from ..fitting import FitResult, Parameter, add_covariance, least_squares_fit
 from ..masing import Masing, loop_area
@@ -437,6 +439,64 @@ class Residuals:
                 out[k] = np.concatenate([out[k], rows])
         return out
 
+    def solver(self) -> Callable[..., tuple[np.ndarray, int, int]] | None:
+        """The compiled Levenberg–Marquardt solver of this averaged fit
+        (:func:`contactlab._core.fit_steady_loop`: the residuals and derivatives of
+        :meth:`jacobian` in closed form, the whole solve with the interpreter lock released),
+        as :func:`~contactlab.fitting.least_squares_fit`'s ``solver``; None where the fit is
+        not an averaged one over all bins (the SciPy solver then runs)."""
+        d = self.data
+        if d.on != "averaged" or d.start != 0 or d.stop is not None:
+            return None
+        pr = self.prior
+        prior = None
+        if pr is not None:
+            prior = (
+                pr.x0 if "x0" in pr.names else None,
+                pr.amplitude if "amplitude" in pr.names else None,
+                pr.sigma,
+                pr.scale,
+            )
+        x = np.ascontiguousarray(d.xpath, dtype=np.float64)
+        F = np.ascontiguousarray(d.Fd, dtype=np.float64)
+        w = np.ascontiguousarray(self.w, dtype=np.float64)
+        bv = None if d.bin_var is None else np.ascontiguousarray(d.bin_var, dtype=np.float64)
+
+        def solve(
+            z0: np.ndarray,
+            names: list[str],
+            scale: np.ndarray,
+            lo: np.ndarray,
+            hi: np.ndarray,
+            fixed: dict[str, float],
+            rscale: float,
+            ftol: float,
+            xtol: float,
+            gtol: float,
+            max_nfev: int,
+        ) -> tuple[np.ndarray, int, int]:
+            pos = {n: i for i, n in enumerate(_ORDER)}
+            values, vary = [0.0] * 5, [False] * 5
+            sc, lower, upper = [1.0] * 5, [-math.inf] * 5, [math.inf] * 5
+            for n, v in fixed.items():
+                values[pos[n]] = float(v)
+            for j, n in enumerate(names):
+                i = pos[n]
+                values[i], vary[i] = float(z0[j] * scale[j]), True
+                sc[i], lower[i], upper[i] = float(scale[j]), float(lo[j]), float(hi[j])
+            setup = (values, vary, sc, lower, upper)
+            got, nfev, status = _core.fit_steady_loop(
+                x, F, w, bv, prior, setup, (rscale, ftol, xtol, gtol), max_nfev
+            )
+            z = np.array([got[pos[n]] / scale[j] for j, n in enumerate(names)])
+            return z, nfev, status
+
+        return solve
+
+
+#: parameter order of the compiled steady-loop fit
+_ORDER = ("k0", "ac", "offset", "x0", "amplitude")
+
 
 def _h_ac(k0: float, ac: float, y: Any) -> Any:
     """``∂h(y)/∂ac`` of ``h(y) = (k0/ac)(1 - e^{-ac y})`` at fixed ``k0``:
@@ -480,18 +540,31 @@ def eiv_weights(res: Residuals, raw: FitResult, s2x: float) -> np.ndarray:
 
 
 def fit(
-    res: Residuals, start: StartValues, *, fit_x0: bool, fit_amplitude: bool
+    res: Residuals,
+    start: StartValues,
+    *,
+    fit_x0: bool,
+    fit_amplitude: bool,
+    native: bool = True,
 ) -> tuple[FitResult, Residuals, float]:
     """Step 4: least squares; a whole-signal fit is refitted with errors-in-variables weights
     (σx estimated from the data), then the turning-point prior rows are added and the fit
-    repeated from the solution. Returns ``(fit, final residuals, σx)``."""
+    repeated from the solution. Returns ``(fit, final residuals, σx)``.
+
+    An averaged fit is solved by the compiled Levenberg–Marquardt (:meth:`Residuals.solver`,
+    without the interpreter lock) unless ``native=False``: SciPy's trust-region solver, the
+    reference the tests compare it with. Both end in the same Gauss-Newton polish and
+    covariance (:func:`~contactlab.fitting.least_squares_fit`)."""
     params = start.params
 
     def jac(r: Residuals) -> Any:
         # an averaged loop's derivatives in closed form (about 10x fewer model evaluations)
         return r.jacobian if r.data.on == "averaged" else None
 
-    raw = least_squares_fit(res, params, jac=jac(res))
+    def solver(r: Residuals) -> Any:
+        return r.solver() if native else None
+
+    raw = least_squares_fit(res, params, jac=jac(res), solver=solver(res))
     x_noise = math.nan
     d = res.data
     if d.on == "signal":
@@ -506,7 +579,7 @@ def fit(
         s_f = math.sqrt(raw.redchi) if raw.redchi > 0 else 1.0
         x0_d, a_d, sig = start.prior
         res = replace(res, prior=PriorRows(names, x0_d, a_d, sig, s_f))
-        raw = least_squares_fit(res, _restart(params, raw), jac=jac(res))
+        raw = least_squares_fit(res, _restart(params, raw), jac=jac(res), solver=solver(res))
         _keep_init(raw, params)
     return raw, res, x_noise
 

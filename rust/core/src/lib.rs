@@ -2,6 +2,7 @@
 //!
 //! - [`curve`]: virgin curves (the exponential curve of the tangential-contact paper, tabulated
 //!   measured backbones).
+//! - [`loop_fit`]: Levenberg–Marquardt fit of the steady Masing loop to an averaged cycle.
 //! - [`masing`]: the Masing operator with non-local memory, cycle counting and loop areas.
 //! - [`parallel`]: independent jobs (channels, recordings) on scoped threads.
 //! - [`scan`]: byte-signature search (the HDF5 structure checks).
@@ -23,6 +24,7 @@
 
 pub mod curve;
 pub mod error;
+pub mod loop_fit;
 pub mod masing;
 pub mod normal;
 pub mod parallel;

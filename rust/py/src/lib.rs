@@ -14,6 +14,7 @@ use pyo3::sync::PyOnceLock;
 use pyo3::types::PyDict;
 
 mod errors;
+mod loop_fit;
 mod normal;
 mod scan;
 mod signal;
@@ -299,5 +300,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     structure::register(m)?;
     signal::register(m)?;
     scan::register(m)?;
+    loop_fit::register(m)?;
     Ok(())
 }

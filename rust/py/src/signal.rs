@@ -7,7 +7,7 @@ use contactlab_core::signal::{
     cycle_block, fold_phase, fold_spread, loop_area_sensitivity, loop_areas, period_means,
     CycleState, Excursion, FoldSums, Schmitt,
 };
-use contactlab_core::window::{fold_window, WindowFold as CoreWindowFold};
+use contactlab_core::window::{detrend_pair, fold_window, WindowFold as CoreWindowFold};
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadwriteArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -490,7 +490,28 @@ fn fold_window_py(
     Ok(WindowFold { inner })
 }
 
+type Arr<'py> = Bound<'py, PyArray1<f64>>;
+
+/// Remove the linear drifts of F and x in one pass (see
+/// `contactlab_core::window::detrend_pair`).
+#[pyfunction]
+#[pyo3(name = "detrend_pair")]
+fn detrend_pair_py<'py>(
+    py: Python<'py>,
+    t: PyReadonlyArray1<'py, f64>,
+    tm: f64,
+    f: PyReadonlyArray1<'py, f64>,
+    slope_f: f64,
+    x: PyReadonlyArray1<'py, f64>,
+    slope_x: f64,
+) -> PyResult<(Arr<'py>, Arr<'py>)> {
+    let (ts, fs, xs) = (slice(&t, "t")?, slice(&f, "F")?, slice(&x, "x")?);
+    let (a, b) = detach_guarded(py, || detrend_pair(ts, tm, (fs, slope_f), (xs, slope_x)))?;
+    Ok((a.into_pyarray(py), b.into_pyarray(py)))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(detrend_pair_py, m)?)?;
     m.add_class::<PhaseFold>()?;
     m.add_class::<WindowFold>()?;
     m.add_function(wrap_pyfunction!(fold_window_py, m)?)?;
