@@ -44,13 +44,21 @@ POLYORDER = 3
 
 
 def _lag_noise(v: np.ndarray, lag: int, order: int) -> float:
-    d = v
-    for _ in range(order):
-        d = d[lag:] - d[:-lag]
-    if d.size < 10:
+    m = v.size - order * lag
+    if m < 10:
         return math.nan
+    # the differences in one buffer (in place; the same values as fresh arrays), the medians
+    # partition it in place: two n-sized arrays at most however long the record
+    d = np.subtract(v[lag:], v[:-lag])
+    for k in range(2, order + 1):
+        size = v.size - k * lag
+        np.subtract(d[lag : lag + size], d[:size], out=d[:size])
+    d = d[:m]
+    med = np.median(d, overwrite_input=True)
+    np.subtract(d, med, out=d)
+    np.abs(d, out=d)
     c = math.comb(2 * order, order)
-    return 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(c)
+    return 1.4826 * float(np.median(d, overwrite_input=True)) / math.sqrt(c)
 
 
 def difference_noise(v: np.ndarray, order: int = 4) -> float:
@@ -96,23 +104,24 @@ def lepski_window(x: np.ndarray, dt: float, sigma: float, *, kappa: float = LEPS
     """Savitzky-Golay window (odd, samples) for ``x''`` by Lepski's rule (module docstring).
 
     Candidate windows grow geometrically from 7 samples to a fifth of the record (at most
-    401); with no measurable noise the smallest is used.
+    401); with no measurable noise the smallest is used. The comparisons run over the record
+    in blocks (:func:`_lepski_square_sums`): O(n) time, memory independent of its length.
     """
     n = x.size
     top = min(401, max(7, n // 5))
     cands = sorted({w | 1 for w in np.geomspace(7, top, 16).astype(int) if w >= 7})
     if sigma <= 0 or len(cands) < 2:
         return cands[0]
-    ests = {w: savgol_derivative(x, w, 2, dt) for w in cands}
+    sq = _lepski_square_sums(np.asarray(x, dtype=float), cands, dt)
     chosen = cands[0]
     for i, w in enumerate(cands[1:], start=1):
         ok = True
         cw = savgol_coefficients(w, 2, dt)
-        for wp in cands[:i]:
+        count = n - 2 * (w // 2)
+        for j, wp in enumerate(cands[:i]):
             cp = np.pad(savgol_coefficients(wp, 2, dt), (w - wp) // 2)
             sd = sigma * float(np.linalg.norm(cw - cp))
-            inner = slice(w // 2, n - w // 2)
-            rms = float(np.sqrt(np.mean((ests[w][inner] - ests[wp][inner]) ** 2)))
+            rms = math.sqrt(sq[i, j] / count)
             if rms > kappa * sd:
                 ok = False
                 break
@@ -120,6 +129,52 @@ def lepski_window(x: np.ndarray, dt: float, sigma: float, *, kappa: float = LEPS
             break
         chosen = w
     return chosen
+
+
+#: samples per block of :func:`_lepski_square_sums`
+LEPSKI_BLOCK = 1 << 16
+
+
+def _lepski_square_sums(
+    x: np.ndarray, cands: list[int], dt: float, block: int = LEPSKI_BLOCK
+) -> np.ndarray:
+    """``S[i, j]`` (``j < i``): sum of the squared differences between the Savitzky-Golay
+    ``x''`` of windows ``cands[i]`` and ``cands[j]`` over the samples where the wider window
+    fits inside the record (``w//2 … n - w//2``: there both are plain convolutions, the
+    polynomial end fits of :func:`savgol_derivative` lie outside).
+
+    Block by block with a halo of the widest half window, so memory does not grow with the
+    record: each estimate is the dot product of :func:`savgol_derivative`'s convolution (the
+    same filter, summed in another order: equal to rounding, ~1e-13 of the estimates' RMS),
+    the sums of squares added block by block. Buffers are allocated once.
+    """
+    from scipy.signal import savgol_coeffs
+
+    n, k = x.size, len(cands)
+    halves = [w // 2 for w in cands]
+    halo = halves[-1]
+    coeffs = [savgol_coeffs(w, POLYORDER, deriv=2, delta=dt) for w in cands]
+    est = np.empty((k, block))
+    diff = np.empty((k, block))
+    out = np.zeros((k, k))
+    for s in range(0, n, block):
+        e = min(s + block, n)
+        lo, hi = max(s - halo, 0), min(e + halo, n)
+        seg = x[lo:hi]
+        for i, (c, h) in enumerate(zip(coeffs, halves, strict=True)):
+            a, b = max(s, h), min(e, n - h)  # where window cands[i] fits in the record
+            if b > a:
+                valid = np.convolve(seg, c, mode="valid")  # centred at lo + h + index
+                est[i, a - s : b - s] = valid[a - lo - h : b - lo - h]
+        for i in range(1, k):
+            a, b = max(s, halves[i]), min(e, n - halves[i])
+            if b <= a:
+                continue
+            d = diff[:i, : b - a]
+            np.subtract(est[:i, a - s : b - s], est[i, a - s : b - s], out=d)
+            np.multiply(d, d, out=d)
+            out[i, :i] += d.sum(axis=1)
+    return out
 
 
 def step_error(window: int) -> float:

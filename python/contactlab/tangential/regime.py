@@ -87,7 +87,7 @@ def velocity(t: np.ndarray | None, x: np.ndarray) -> tuple[np.ndarray, float, in
     """Savitzky-Golay velocity (Lepski window), the stick threshold ``3 σv`` and the window
     (samples)."""
     tt = np.arange(x.size, dtype=float) if t is None else t
-    dt = float(np.median(np.diff(tt)))
+    dt = float(np.median(np.diff(tt), overwrite_input=True))  # partitions its own copy
     sx = difference_noise(x)
     window = min(lepski_window(x, dt, sx), max(5, (x.size // 2) * 2 - 1))
     v = savgol_derivative(x, window, 1, dt)
@@ -205,6 +205,15 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     """``[start, end)`` of each run of True."""
     d = np.diff(np.r_[0, mask.astype(np.int8), 0])
     return list(zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1), strict=True))
+
+
+def _long_runs(mask: np.ndarray, min_len: int) -> list[tuple[int, int]]:
+    """``[start, end)`` of each run of True at least ``min_len`` long (the short ones, most
+    of a noisy record's, dropped in numpy before any Python loop sees them)."""
+    d = np.diff(np.r_[np.int8(0), mask.astype(np.int8), np.int8(0)])
+    starts, ends = np.flatnonzero(d == 1), np.flatnonzero(d == -1)
+    keep = (ends - starts) >= min_len
+    return list(zip(starts[keep].tolist(), ends[keep].tolist(), strict=True))
 
 
 def _break_time(x: np.ndarray, a: int, b: int, end: int, window: int, sigma: float) -> float | None:
@@ -337,13 +346,12 @@ def stick_slip(
         period = 2.0 * float(np.median(np.diff(tt[turns])))
     amp = 0.5 * float(np.ptp(x[turns[0] : turns[-1] + 1]))
     omega = 2.0 * math.pi / period
-    dt = float(np.median(np.diff(tt)))
+    dt = float(np.median(np.diff(tt), overwrite_input=True))  # partitions its own copy
     smooth = 2.0 * thr / (amp * omega**2) if amp > 0 else math.inf
     min_len = max(4, math.ceil(STICK_DWELL_FACTOR * smooth / dt))
     spans: dict[int, list[int]] = {}  # turn -> [first stuck sample, end, stuck samples]
-    for a, b in _runs(np.abs(v) < thr):
-        if b - a < min_len:
-            continue
+    # |v| < thr as two comparisons: no whole-record float temporary
+    for a, b in _long_runs((v < thr) & (v > -thr), min_len):
         mid = tt[(a + b - 1) // 2]
         k = int(np.argmin(np.abs(tt[turns] - mid)))
         if abs(tt[turns[k]] - mid) > 0.25 * period + 0.5 * (b - a) * dt:
@@ -352,10 +360,11 @@ def stick_slip(
         sp[0], sp[1], sp[2] = min(sp[0], a), max(sp[1], b), sp[2] + (b - a)
     durations, breakaway = [], []
     sliding = SLIDE_ONSET * amp * omega
-    sx = difference_noise(x)
+    sx = difference_noise(x) if spans else 0.0  # only the breakaway search needs it
+    f = F - offset if spans else F  # once, not a whole-record copy per stick
     for a, b, n_stuck in spans.values():
         durations.append(n_stuck * dt)
-        breakaway.append(_breakaway(F - offset, x, v, (a, b), window, max(sliding, thr), sx))
+        breakaway.append(_breakaway(f, x, v, (a, b), window, max(sliding, thr), sx))
     hit = spans
     return StickSlip(int(turns.size), np.asarray(durations), np.asarray(breakaway), float(thr),
                      float(smooth), len(hit))  # fmt: skip
