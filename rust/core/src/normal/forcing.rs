@@ -132,6 +132,11 @@ impl<'a> Forcing<'a> {
         self.p
     }
 
+    /// Whether exact slopes `dpdt` were given.
+    pub fn has_dpdt(&self) -> bool {
+        self.dpdt.is_some()
+    }
+
     /// How `p` is continued between samples.
     pub fn interp(&self) -> Interp {
         self.interp

@@ -215,6 +215,7 @@ fn advance(
             y
         };
         let mut iters = 0_u32;
+        let mut prev = f64::INFINITY; // the previous Newton step's size
         let (mut q1, mut y_it);
         loop {
             y_it = y1;
@@ -239,17 +240,28 @@ fn advance(
             }
             y1 -= step;
             iters = iters.saturating_add(1);
-            // converged to the tolerance, or to the rounding of the step's terms
+            // converged: the step is below the tolerance (or the rounding of the step's terms),
+            // or the equation is linear in δ₁ (k_s independent of δ: the step was exact), or
+            // the quadratic convergence puts the next step, about |s|³/|s_prev|², below it
             let floor = 8.0 * f64::EPSILON * (y.abs() + q1.n.abs() + y1.abs());
-            if step.abs() <= tol.max(floor) {
+            let eps = tol.max(floor);
+            let s_abs = step.abs();
+            let linear = q1.dn == 0.0 && q1.dm == 0.0;
+            if s_abs <= eps
+                || linear
+                || (prev.is_finite()
+                    && 4.0 * s_abs < prev
+                    && s_abs * s_abs * s_abs <= eps * prev * prev)
+            {
                 break;
             }
+            prev = s_abs;
             if iters >= MAX_NEWTON {
                 return Ok(Err(Status::NoConvergence { time: t1 }));
             }
         }
         // the state carried on: the end values at the last iterate, moved to the converged δ
-        // to first order (the last Newton step is below the tolerance)
+        // to first order (the last Newton step is small: its square is below the tolerance)
         let dy = y1 - y_it;
         q1.n += q1.dn * dy;
         q1.m += q1.dm * dy;
@@ -353,11 +365,20 @@ pub fn simulate_grid(
     let pv = forcing.values();
     let cubic = forcing.interp() == Interp::Cubic;
     let mut slope0 = forcing.slope(0);
+    // equal steps and no given dp/dt: the interior slopes of numpy.gradient are central
+    // differences (the general three-point formula with equal spacing, without its divisions)
+    let inv_2h = 0.5 / (0.5 * (lo + hi));
+    let central = uniform && !forcing.has_dpdt();
+    let last = n.saturating_sub(1);
     for (i, w) in t.windows(2).enumerate() {
         let span = w[1] - w[0];
         // the cubic Hermite segment (Forcing::segment), the slope at its start carried over
         let j = i.saturating_add(1);
-        let slope1 = forcing.slope(j);
+        let slope1 = if central && j < last {
+            (pv[j.saturating_add(1)] - pv[i]) * inv_2h
+        } else {
+            forcing.slope(j)
+        };
         let seg = if cubic {
             Segment::hermite(w[0], span, pv[i], pv[j], slope0, slope1)
         } else {
