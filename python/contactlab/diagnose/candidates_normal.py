@@ -52,9 +52,10 @@ from typing import Any
 import numpy as np
 from scipy import fft
 
-from ..errors import InputError
+from .. import _core
+from ..errors import ConvergenceError, InputError
 from ._family import Candidate, ParamSpec, Prepared, implausible_common
-from ._filters import first_order_response, hermite_coefficients
+from ._filters import first_order_response
 from ._signal import shift
 
 _INF = np.inf
@@ -173,16 +174,25 @@ def _kelvin_voigt_fit(d: Prepared, k: float, psi: float, p0: float, omega: float
     key = (psi, omega, d.t.size)
     unit = cache.get(key)
     if unit is None:
-        coeffs = d.extra.get("hermite")
-        if coeffs is None or coeffs[0].size != d.t.size - 1:
-            coeffs = d.extra["hermite"] = hermite_coefficients(d.t, d.u)
-        a = 2.0 * np.pi * omega / psi
-        unit = first_order_response(d.t, d.u, a, 1.0, float(d.u[0]), coeffs)
+        unit = _unit_response(d.t, d.u, psi, omega)
         unit.flags.writeable = False
         if len(cache) >= _UNIT_KEEP:
             cache.clear()
         cache[key] = unit
     return (unit - p0) / k
+
+
+def _unit_response(t: np.ndarray, u: np.ndarray, psi: float, omega: float) -> np.ndarray:
+    """The unit-stiffness Kelvin-Voigt response to ``u`` from equilibrium with ``u[0]``:
+    :func:`contactlab.diagnose._filters.first_order_response` (``a = 2π ω / ψ``, gain 1),
+    computed by the Rust fixed-grid integrator with a constant stiffness, which is that exact
+    solution under the same cubic Hermite pressure (to 1e-9 of the range, tested) in one pass
+    instead of numpy's blocked scan (4-5 times faster at 24 000 samples)."""
+    # (the step's equation is linear for a constant stiffness: solved exactly, ``tol`` unused)
+    r = _core.normal_simulate_grid(t, u, "constant", np.ones(1), psi, omega, float(u[0]), 1, 1.0)
+    if int(r["status"]) != 0:
+        raise ConvergenceError(f"Kelvin-Voigt response: {r['message']}")
+    return np.asarray(r["delta"])
 
 
 def _creep_shape(d: Prepared, tc: float) -> np.ndarray:

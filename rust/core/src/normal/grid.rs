@@ -364,6 +364,7 @@ pub fn simulate_grid(
 
     let pv = forcing.values();
     let cubic = forcing.interp() == Interp::Cubic;
+    let delta_law = matches!(model.stiffness(), Stiffness::Delta(_));
     let mut slope0 = forcing.slope(0);
     // equal steps and no given dp/dt: the interior slopes of numpy.gradient are central
     // differences (the general three-point formula with equal spacing, without its divisions)
@@ -387,7 +388,8 @@ pub fn simulate_grid(
         slope0 = slope1;
         // the start-up layer: a δ0 off the slow manifold decays as e^{−a (t − t0)}, which a
         // cubic N cannot follow over a step of λ ≫ 1; its steps are cut to λ ≤ LAYER_LAMBDA
-        let in_layer = a * (w[0] - t[0]) < LAYER_SPAN;
+        // (only a δ-dependent k_s puts δ into N; otherwise N is the forcing's cubic over p)
+        let in_layer = delta_law && a * (w[0] - t[0]) < LAYER_SPAN;
         let mut m_i = if in_layer {
             let need = (a * span / LAYER_LAMBDA).ceil();
             if need > m_sub {
