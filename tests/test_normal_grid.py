@@ -125,3 +125,16 @@ def test_a_runaway_ends_with_a_failure_status():
     assert not res.success
     assert res.delta.size < t.size
     assert "stiffness" in res.message or "converge" in res.message
+
+
+def test_unit_response_takes_strided_times():
+    """A decimated record's times are a strided view (``t[::q]``): the base model's unit
+    response takes them as they are and equals the closed form."""
+    from contactlab.diagnose.candidates_normal import _unit_response
+
+    t, p = blocks(120.0, 4)
+    tq, pq = t[::3], p[::3]
+    assert not tq.flags.c_contiguous
+    got = _unit_response(tq, pq, 0.1, 2 * np.pi * F0)
+    exact = first_order_response(tq, pq, 2 * np.pi * 2 * np.pi * F0 / 0.1, 1.0, pq[0])
+    assert np.max(np.abs(got - exact)) <= 1e-9 * np.ptp(exact)
