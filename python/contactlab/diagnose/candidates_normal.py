@@ -9,8 +9,10 @@ recording. Evaluated by its exact solution under the pressure between samples th
 :class:`contactlab.normal.KelvinVoigt` integrates (:func:`kelvin_voigt_exact`: a linear
 first-order response, 15-50 times faster than the package's adaptive integrator, which
 approximates it to its tolerance; kept per ψ, as the fits step the other parameters at a
-fixed ψ most of the time); the stiffness candidates by
-:class:`contactlab.normal.NonlinearContact`.
+fixed ψ most of the time; computed by the Rust fixed-grid integrator with a constant
+stiffness, :func:`_unit_response`); the stiffness candidates by
+:meth:`contactlab.normal.NonlinearContact.simulate_grid` (eq. 17 on the record's own
+samples; see :data:`GRID_STEPS_PER_PERIOD` for its error against the adaptive solve).
 
 Candidates (name: model, parameters):
 
@@ -39,7 +41,8 @@ the second-order signature is under the noise and nothing is named.
 ``δ_r`` is the RMS of the measured displacement, so ``kappa`` and ``a`` are dimensionless;
 the paper's eq. 6 coefficients follow as ``a1 = k``, ``a2 = k a / δ_r``, ``a3 = k κ / δ_r²``.
 Both stiffness candidates run through :class:`contactlab.normal.NonlinearContact` (eq. 17,
-where the damping ``ψ k_s / (2π ω)`` follows the stiffness as in the paper). The hysteretic
+where the damping ``ψ k_s / (2π ω)`` follows the stiffness as in the paper), by its
+fixed-grid route :meth:`~contactlab.normal.NonlinearContact.simulate_grid`. The hysteretic
 model is linear and solved by FFT on a smooth periodic continuation of the record (its ideal
 form is non-causal, so it has no time-domain integrator); for ``η = 0`` it reproduces the
 Kelvin-Voigt integration. Hysteretic damping combined with a stiffness nonlinearity is not offered.
