@@ -112,6 +112,17 @@ def normal_simulate(
     first_step: float | None = None,
     max_steps: int = 0,
 ) -> dict[str, object]: ...
+def normal_simulate_grid(
+    t: _F,
+    p: _F,
+    law: str,
+    coeffs: _F,
+    psi: float,
+    omega: float,
+    delta0: float,
+    substeps: int,
+    tol: float,
+) -> dict[str, object]: ...
 def normal_equilibrium(law: str, coeffs: _F, psi: float, omega: float, p: float) -> float: ...
 def kv_analytic(
     k: float, psi: float, omega: float, pa: float

@@ -200,7 +200,7 @@ def first_order_response(
 
     On a step of length ``Δ`` with ``λ = aΔ`` and ``p(u) = Σ c_k uᵏ`` (``u`` from 0 to 1):
     ``y₁ = e^{-λ} y₀ + gain · λ Σ c_k I_k(λ)``, ``I_k = ∫₀¹ e^{-λ(1-u)} uᵏ du`` (once, when
-    the steps are equal to 1e-13). The recursion is run in blocks whose ``λ`` sum is at most
+    the steps are equal to 1e-9). The recursion is run in blocks whose ``λ`` sum is at most
     :data:`_SCAN_SPAN`: ``y_{b+i} = e^{-L_i} (y_b + Σ_{j<i} e^{L_{j+1}} g_{b+j})`` with ``L``
     the block's running sum of ``λ``, all blocks at once, then a short loop over the blocks'
     ends (a step's ``λ`` is capped at the span there: ``e^{-600}`` forgets ``y₀`` as well).
@@ -214,7 +214,10 @@ def first_order_response(
     dt, c0, c1, c2, c3 = hermite_coefficients(t, p) if coeffs is None else coeffs
     lam = a * dt
     lo, hi = float(np.min(lam)), float(np.max(lam))
-    uniform = hi - lo <= 1e-13 * hi
+    # equal steps: the moments once. Times stored as k / fs differ from equal steps by
+    # rounding (1e-11 of a step at 1e6 samples, so 1e-13 missed them); a step 1e-9 off
+    # changes a moment by that fraction, far below the interpolant's own error
+    uniform = hi - lo <= 1e-9 * hi
     if uniform:  # equal steps (to rounding): the moments once
         lam1 = 0.5 * (lo + hi)
         i0, i1, i2, i3 = (float(v[0]) for v in _exp_moments(np.array([lam1])))

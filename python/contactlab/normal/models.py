@@ -10,6 +10,13 @@ Both are solved as ``δ' = (2π ω / ψ)(p / k_s − δ)`` by the Rust core (ROD
 Rosenbrock method with error control, stepping sample to sample over a cubic-Hermite or linear
 continuation of p between samples). ω is the angular frequency at which ψ holds; for a
 pressure that is not a single sine it must still be given.
+
+:meth:`~_ContactModel.simulate_grid` is the fast route for a well-sampled record: a
+fixed-grid exponential integrator on the samples' own times (the stiff decay exact, the
+quasi-static displacement ``p / k_s`` continued by cubic Hermite interpolation over each
+step), several times faster than the adaptive solve and within 1e-4 of the displacement
+range of it at 128 or more steps per period of the fastest excitation (exact for a constant
+stiffness).
 """
 
 from __future__ import annotations
@@ -209,6 +216,109 @@ class _ContactModel:
     def _failure_hint(self, delta: np.ndarray) -> str:
         """Extra explanation appended to a failed solve's message (override)."""
         return ""
+
+    def simulate_grid(
+        self,
+        t: Any,
+        p: Any,
+        *,
+        p0: float | None = None,
+        delta0: float | str = "equilibrium",
+        substeps: int = 1,
+        tol: float | None = None,
+    ) -> OdeResult:
+        """Displacement response on the samples' own grid (fixed steps, no error control).
+
+        Each sample interval is cut into ``substeps`` equal steps (more where the start from
+        ``delta0`` decays, so that start-up transient is followed). A step integrates the
+        stiff decay exactly and continues the quasi-static displacement ``n = p / k_s``
+        (``p`` the cubic Hermite continuation :meth:`simulate` uses) by the cubic Hermite
+        interpolant of its values and rates at the step's ends; its local error is about
+        ``(Δt ω)⁴ / 384`` of the displacement for a step ``Δt``. For a constant stiffness
+        the result is the exact response to that continuation. Use :meth:`simulate` (error
+        control) for records with fewer than about 128 steps per period of their fastest
+        content, or when the response may reach ``k_s = 0`` (an implicit step can step over
+        such a point between samples).
+
+        Parameters
+        ----------
+        t, p, p0, delta0 :
+            As in :meth:`simulate` (the cubic continuation with ``numpy.gradient`` slopes).
+        substeps : int
+            Equal steps per sample interval (1 to 2**20).
+        tol : float, optional
+            Absolute tolerance (m) of each step's Newton iteration; default ``1e-12`` of
+            the displacement scale ``max|p| / k_s(0)``.
+
+        Returns
+        -------
+        OdeResult
+            ``n_steps`` is the number of steps; ``njev``, ``nlu`` and ``n_rejected`` are 0.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from contactlab.normal import NonlinearContact
+        >>> m = NonlinearContact(k_s_delta=[1.3e12, 0.0, 2.0e25], psi=0.09, omega=1.0)
+        >>> t = np.arange(4 * 256 + 1) * (2 * np.pi / 256)
+        >>> p = 0.4e6 * np.sin(t)
+        >>> a, b = m.simulate(t, p, rtol=1e-10), m.simulate_grid(t, p)
+        >>> bool(np.max(np.abs(a.delta - b.delta)) < 1e-6 * np.ptp(a.delta))
+        True
+        """
+        tv = as_1d(t, "t")
+        pv = as_1d(p, "p")
+        if tv.size != pv.size:
+            raise InputError(f"t has {tv.size} samples but p has {pv.size}")
+        if tv.size < 2:
+            raise InputError("at least two samples are needed")
+        base = self.p0 if p0 is None else float(p0)
+        pd = pv - base if base else pv
+        self._check_pressure(pd)
+        if isinstance(substeps, bool) or not isinstance(substeps, int | np.integer):
+            raise InputError(f"substeps must be an integer, got {substeps!r}")
+        if not 1 <= substeps <= 2**20:
+            raise InputError(f"substeps must be between 1 and 2**20, got {substeps}")
+        if tol is None:
+            tol = 1e-12 * self._delta_scale(float(np.max(np.abs(pd))))
+        tol = positive(tol, "tol")
+        if isinstance(delta0, str):
+            if delta0 != "equilibrium":
+                raise InputError(f"delta0 must be a number or 'equilibrium', got {delta0!r}")
+            d0 = self.equilibrium(float(pd[0]))
+        else:
+            d0 = float(delta0)
+            if not math.isfinite(d0):
+                raise InputError(f"delta0 must be finite, got {delta0}")
+        r = _core.normal_simulate_grid(
+            tv,
+            np.ascontiguousarray(pd),
+            self._law,
+            self._coeffs,
+            self.psi,
+            self.omega,
+            d0,
+            int(substeps),
+            tol,
+        )
+        n_out = int(r["n_out"])
+        res = OdeResult(
+            t=tv[:n_out],
+            delta=r["delta"],
+            velocity=r["velocity"],
+            success=r["status"] == 0,
+            status=int(r["status"]),
+            message=str(r["message"]),
+            nfev=int(r["nfev"]),
+            njev=0,
+            nlu=0,
+            n_steps=int(r["n_accepted"]),
+            n_rejected=0,
+        )
+        if not res.success:
+            res.message += self._failure_hint(res.delta)
+        self._check_solution(res.delta)
+        return res
 
 
 class KelvinVoigt(_ContactModel):

@@ -4,7 +4,7 @@
 #![allow(clippy::needless_pass_by_value)]
 
 use contactlab_core::normal::{
-    cycles, ode, poly, ContactModel, Forcing, Interp, KelvinVoigt, Stiffness,
+    cycles, grid, ode, poly, ContactModel, Forcing, Interp, KelvinVoigt, Stiffness,
 };
 use contactlab_core::CoreError;
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
@@ -100,6 +100,50 @@ fn normal_simulate<'py>(
     d.set_item("nlu", out.stats.nlu)?;
     d.set_item("n_accepted", out.stats.n_accepted)?;
     d.set_item("n_rejected", out.stats.n_rejected)?;
+    Ok(d)
+}
+
+/// Eq. 17 on the samples' own grid (`grid::simulate_grid`); returns a dict like
+/// `normal_simulate`'s.
+#[pyfunction]
+#[pyo3(signature = (t, p, law, coeffs, psi, omega, delta0, substeps, tol))]
+fn normal_simulate_grid<'py>(
+    py: Python<'py>,
+    t: PyReadonlyArray1<'py, f64>,
+    p: PyReadonlyArray1<'py, f64>,
+    law: &str,
+    coeffs: PyReadonlyArray1<'py, f64>,
+    psi: f64,
+    omega: f64,
+    delta0: f64,
+    substeps: usize,
+    tol: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let ts = slice(&t, "t")?;
+    let ps = slice(&p, "p")?;
+    let cs = slice(&coeffs, "coeffs")?;
+    let law = law.to_owned();
+    let (mut delta, mut vel, out) = detach_guarded(py, move || {
+        let model = build_model(&law, cs, psi, omega)?;
+        let forcing = Forcing::new(ts, ps, None, Interp::Cubic)?;
+        let n = forcing.len();
+        let mut delta = vec![0.0; n];
+        let mut vel = vec![0.0; n];
+        let out = grid::simulate_grid(
+            &model, &forcing, delta0, substeps, tol, &mut delta, &mut vel,
+        )?;
+        Ok((delta, vel, out))
+    })?;
+    delta.truncate(out.n_out);
+    vel.truncate(out.n_out);
+    let d = PyDict::new(py);
+    d.set_item("delta", delta.into_pyarray(py))?;
+    d.set_item("velocity", vel.into_pyarray(py))?;
+    d.set_item("n_out", out.n_out)?;
+    d.set_item("status", out.status.code())?;
+    d.set_item("message", out.status.message())?;
+    d.set_item("nfev", out.stats.nfev)?;
+    d.set_item("n_accepted", out.stats.n_accepted)?;
     Ok(d)
 }
 
@@ -237,6 +281,7 @@ fn fold_cycles<'py>(
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(normal_simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(normal_simulate_grid, m)?)?;
     m.add_function(wrap_pyfunction!(normal_equilibrium, m)?)?;
     m.add_function(wrap_pyfunction!(kv_analytic, m)?)?;
     m.add_function(wrap_pyfunction!(kv_steady_state, m)?)?;

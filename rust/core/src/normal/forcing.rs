@@ -29,6 +29,23 @@ pub struct Segment {
 }
 
 impl Segment {
+    /// The cubic Hermite segment from `(t0, p0)` to `(t0 + h, p1)` with slopes `d0`, `d1`.
+    #[inline]
+    pub fn hermite(t0: f64, h: f64, p0: f64, p1: f64, d0: f64, d1: f64) -> Self {
+        let (m0, m1) = (h * d0, h * d1);
+        Self {
+            t0,
+            h,
+            inv_h: 1.0 / h,
+            c: [
+                p0,
+                m0,
+                3.0 * (p1 - p0) - 2.0 * m0 - m1,
+                2.0 * (p0 - p1) + m0 + m1,
+            ],
+        }
+    }
+
     /// `p(t)`.
     #[inline]
     pub fn value(&self, t: f64) -> f64 {
@@ -115,6 +132,16 @@ impl<'a> Forcing<'a> {
         self.p
     }
 
+    /// Whether exact slopes `dpdt` were given.
+    pub fn has_dpdt(&self) -> bool {
+        self.dpdt.is_some()
+    }
+
+    /// How `p` is continued between samples.
+    pub fn interp(&self) -> Interp {
+        self.interp
+    }
+
     /// Slope at sample `i < len` (given, or `numpy.gradient(..., edge_order=2)`).
     // Index arithmetic only: `i < len` (checked by the caller) and `len >= 2` (checked by
     // `Forcing::new`), so no index over- or underflows.
@@ -159,13 +186,7 @@ impl<'a> Forcing<'a> {
         let c = match self.interp {
             Interp::Linear => [p0, p1 - p0, 0.0, 0.0],
             Interp::Cubic => {
-                let (m0, m1) = (h * self.slope(i), h * self.slope(i + 1));
-                [
-                    p0,
-                    m0,
-                    3.0 * (p1 - p0) - 2.0 * m0 - m1,
-                    2.0 * (p0 - p1) + m0 + m1,
-                ]
+                return Segment::hermite(t0, h, p0, p1, self.slope(i), self.slope(i + 1));
             }
         };
         Segment {

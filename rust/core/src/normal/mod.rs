@@ -5,11 +5,14 @@
 //! - [`model`]: the contact ODE `δ' = (2π ω / ψ)(p / k_s − δ)` for constant, δ- or
 //!   p-dependent stiffness (eq. 17).
 //! - [`forcing`]: the sampled pressure continued between samples (linear or cubic Hermite).
+//! - [`grid`]: the fixed-grid exponential integrator on the record's own samples (the
+//!   diagnosis' fits; [`ode`] is its accurate reference).
 //! - [`ode`]: RODAS4 with error control, stepping sample to sample, for recordings of any length.
 //! - [`cycles`]: folding a recording into whole cycles on a common phase grid.
 
 pub mod cycles;
 pub mod forcing;
+pub mod grid;
 pub mod kelvin_voigt;
 pub mod model;
 pub mod ode;

@@ -151,6 +151,9 @@ pub enum Status {
     StepSizeTooSmall { time: f64, step: f64 },
     /// `max_steps` attempts were used up.
     MaxSteps { time: f64 },
+    /// A step's implicit equation had no solution the iteration could find (fixed-grid
+    /// integrator, [`super::grid::simulate_grid`]).
+    NoConvergence { time: f64 },
     /// The solution reached a state where the stiffness `k_s` is not positive (the model is
     /// undefined there), at `name = at` (δ or p) with `k_s = value`.
     NonPositiveStiffness {
@@ -179,6 +182,10 @@ impl Status {
                 format!("Required step size is less than spacing between numbers (step {step:e} at t = {time}).")
             }
             Status::MaxSteps { time } => format!("Maximum number of steps reached at t = {time}."),
+            Status::NoConvergence { time } => format!(
+                "The fixed-grid step did not converge at t = {time}: the model has no \
+                 solution near the previous state there."
+            ),
             Status::NonPositiveStiffness {
                 time,
                 name,
