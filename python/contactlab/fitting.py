@@ -796,7 +796,12 @@ def add_covariance(fit: FitResult, extra: np.ndarray, *, note: str | None = None
     k = len(fit.var_names)
     if extra.shape != (k, k) or not np.all(np.isfinite(extra)):
         raise InputError(f"extra covariance must be a finite {k}x{k} array, got {extra.shape}")
-    covar = fit.covar + 0.5 * (extra + extra.T)
+    return with_covariance(fit, fit.covar + 0.5 * (extra + extra.T), note=note)
+
+
+def with_covariance(fit: FitResult, covar: np.ndarray, *, note: str | None = None) -> FitResult:
+    """``fit`` with the parameter covariance ``covar``: standard errors and correlations
+    follow from it, and ``note`` (if any) is added to the fit's notes."""
     d = np.sqrt(np.clip(np.diag(covar), 0.0, None))
     with np.errstate(divide="ignore", invalid="ignore"):
         correl = covar / np.outer(d, d)
@@ -808,6 +813,16 @@ def add_covariance(fit: FitResult, extra: np.ndarray, *, note: str | None = None
             params[n].stderr = float(d[i])
     notes = list(fit.notes) + ([note] if note else [])
     return replace(fit, params=params, covar=covar, correl=correl, notes=notes)
+
+
+def stderr_ratio(fit: FitResult, covar: np.ndarray) -> np.ndarray:
+    """The standard errors from ``covar`` over ``fit``'s own, where both are finite and
+    the old one is not zero."""
+    new = np.sqrt(np.clip(np.diag(covar), 0.0, None))
+    old = np.sqrt(np.clip(np.diag(fit.covar), 0.0, None))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = new / old
+    return ratio[np.isfinite(ratio)]
 
 
 def _lag_window_length(r: np.ndarray, nfft: int) -> int:
@@ -907,21 +922,8 @@ def hac_covariance(
     dof = fit.ndata / max(fit.ndata - k, 1)
     covar = (Ainv @ B @ Ainv) * dof / np.outer(norms, norms)
     covar = 0.5 * (covar + covar.T)
-    d = np.sqrt(np.clip(np.diag(covar), 0.0, None))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        correl = covar / np.outer(d, d)
-    correl[~np.isfinite(correl)] = 0.0
-    np.fill_diagonal(correl, 1.0)
-    params = {nm: replace(p) for nm, p in fit.params.items()}
-    old = np.sqrt(np.clip(np.diag(fit.covar), 0.0, None))
-    for i, nm in enumerate(fit.var_names):
-        if params[nm].stderr is not None:
-            params[nm].stderr = float(d[i])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = d / old
-    ratio = ratio[np.isfinite(ratio)]
+    ratio = stderr_ratio(fit, covar)
     note = f"standard errors allow for correlated residuals (Bartlett lag window of {L} samples" + (
         f"; {ratio.min():.3g} to {ratio.max():.3g} × the white-noise ones)" if ratio.size else ")"
     )
-    return replace(fit, params=params, covar=covar, correl=correl,
-                   notes=[*fit.notes, note])  # fmt: skip
+    return with_covariance(fit, covar, note=note)

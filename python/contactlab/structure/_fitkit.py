@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ContactLabError
-from ..fitting import FitResult, Parameter, least_squares_fit
+from ..fitting import FitResult, Parameter, least_squares_fit, stderr_ratio, with_covariance
 from .joints import iwan_uniform
 from .model import Structure
 
@@ -177,19 +177,7 @@ def noise_model_covariance(
         return _white_only(fit), info
     if not (np.all(np.isfinite(covar)) and math.isfinite(su2) and np.all(np.isfinite(sy2))):
         return _white_only(fit), info
-    d = np.sqrt(np.clip(np.diag(covar), 0.0, None))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        correl = covar / np.outer(d, d)
-    correl[~np.isfinite(correl)] = 0.0
-    np.fill_diagonal(correl, 1.0)
-    params = {nm: replace(p) for nm, p in fit.params.items()}
-    old = np.sqrt(np.clip(np.diag(fit.covar), 0.0, None))
-    for i, nm in enumerate(fit.var_names):
-        if params[nm].stderr is not None:
-            params[nm].stderr = float(d[i])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = d / old
-    ratio = ratio[np.isfinite(ratio)]
+    ratio = stderr_ratio(fit, covar)
     info = {"input_noise": math.sqrt(su2), "output_noise": [math.sqrt(float(v)) for v in sy2],
             "probes": probes}  # fmt: skip
     note = (
@@ -198,8 +186,7 @@ def noise_model_covariance(
         "estimated from the residual spectrum"
         + (f"; {ratio.min():.3g} to {ratio.max():.3g} × the white-noise ones" if ratio.size else "")
     )
-    return replace(fit, params=params, covar=covar, correl=correl,
-                   notes=[*fit.notes, note]), info  # fmt: skip
+    return with_covariance(fit, covar, note=note), info
 
 
 def _noise_sandwich(
