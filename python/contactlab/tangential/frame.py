@@ -112,7 +112,8 @@ def force_kernel(window: int) -> np.ndarray:
     samples of a force (linear between them) is the kernel ``[1, 4, 1]/6``. So the
     reconstruction, which smooths every term of the equation of motion by ``g``
     (:func:`frame_friction_force`), gives ``force_kernel ⊛ F_f`` plus noise:
-    ``g ⊛ [1, 4, 1]/6``. :func:`contactlab.diagnose.diagnose` passes every candidate's
+    ``g ⊛ [1, 4, 1]/6`` (for a sinusoid at ``θ`` radians per sample the inertial term's
+    smoothing differs from it by ``θ²/12`` of that term). :func:`contactlab.diagnose.diagnose` passes every candidate's
     predicted force through the same kernel (``output_filter``), so that no candidate can
     win by imitating the smoothing of the force's jumps at stick and slip.
     """
@@ -335,16 +336,18 @@ def frame_friction_force(
     xd = savgol_derivative(xa, window, 1, dt)
     xdd = savgol_derivative(xa, window, 2, dt)
     yd = savgol_derivative(ya, window, 1, dt)
-    # every term smoothed by the same g (force_kernel): M x'' is g ⊛ Δ²x/dt² already, so
-    # K (y - x) and C (y' - x') (central differences) pass g too and F is the plain equation
-    # of motion smoothed by g, i.e. force_kernel ⊛ F_f plus noise. Within half a window of
+    # every term smoothed alike (force_kernel): M x'' is g ⊛ Δ²x/dt² already, i.e.
+    # force_kernel ⊛ M x'', so K (y - x) and C (y' - x') pass the same smoothing and F is
+    # force_kernel ⊛ F_f plus noise. Within half a window of
     # the ends (the polynomial end fits) the unsmoothed terms, as before.
     c2 = savgol_coefficients(window, 2, dt)
     g = np.cumsum(np.cumsum(c2 * dt * dt))[:-2]
-    gp = np.pad(g, 1)  # window taps, centred
+    # K (y - x) through the whole kernel (g and the second difference's [1, 4, 1]/6), the
+    # small damping term (C ẋ is ~1 % of the force) through g and a central difference
+    gk = np.convolve(g, np.array([1.0, 4.0, 1.0]) / 6.0)  # window taps: force_kernel
     gd = np.convolve(g, np.array([1.0, 0.0, -1.0]) / (2.0 * dt))  # g ⊛ central difference
-    fx = -K * gp - C * gd - M * c2  # F = fy ⊛ y + fx ⊛ x (convolution taps)
-    fy = K * gp + C * gd
+    fx = -K * gk - C * gd - M * c2  # F = fy ⊛ y + fx ⊛ x (convolution taps)
+    fy = K * gk + C * gd
     F = K * (ya - xa) + C * (yd - xd) - M * xdd
     half = window // 2
     if xa.size > 2 * half:
