@@ -384,7 +384,7 @@ class TangentialFamily:
         x = d.extra.get("u_raw", d.u)
         try:
             loop = average_loop(x, d.y, d.t)
-            v, thr, _ = velocity(d.t, x)
+            v, thr, window = velocity(d.t, x)
             pl = plateau(loop, x, d.y, v, thr)
         except (InputError, ValueError):  # no loop to average: no plateau to anchor to
             return None
@@ -403,6 +403,49 @@ class TangentialFamily:
             f"{p['h0']:.4g} N ({off:.1f} σ away); h0 is held within ±{band:.2g} N of the "
             f"plateau and ac ≥ {self.ac_floor:.3g} 1/m (only a lower bound is identified)"
         )
+
+    def sticking(self, d: Prepared) -> np.ndarray:
+        """The samples where the contact sticks: the displacement stands still within its
+        noise (``|v| < 3 σv``, the Savitzky-Golay velocity of
+        :func:`contactlab.tangential.regime.velocity`) for at least
+        :data:`~contactlab.tangential.regime.STICK_DWELL_FACTOR` times as long as a smooth
+        turn of the stroke would, within a quarter period of a reversal — the sticks
+        ``analyze`` reports (:func:`contactlab.tangential.regime.stick_slip`) — widened by
+        half the velocity filter's window either side (the filter spreads the start of the
+        motion over that: on Coulomb frames the samples it missed, 1.5 % of the record,
+        carried all of a spurious delay's gain).
+
+        While stuck, the force is whatever holds the body still (a frame's drive ramping
+        from the sliding force through zero to the breakaway force), not a function of the
+        displacement, which does not move: a model driven by the displacement cannot
+        predict it, and the one candidate that lowers the error there is a negative
+        channel delay, which reads the force's change off the displacement after the stick
+        (measured on Coulomb frames: all of the delay's held-out gain comes from the stuck
+        samples, on the true force as on the reconstructed one). A displacement-driven rig
+        never dwells that long at a turn: the mask is empty there.
+        """
+        from ..tangential.regime import STICK_DWELL_FACTOR, _long_runs, velocity
+
+        x = d.extra.get("u_raw", d.u)
+        mask = np.zeros(x.size, bool)
+        rev = d.cycles.reversals
+        amp = 0.5 * float(np.ptp(x))
+        if rev.size < 2 or x.size < 20 or not amp > 0:
+            return mask
+        v, thr, window = velocity(d.t, x)
+        period = d.cycles.period_samples * d.dt
+        omega = 2.0 * np.pi / period
+        smooth = 2.0 * thr / (amp * omega**2)
+        min_len = max(4, int(np.ceil(STICK_DWELL_FACTOR * smooth / d.dt)))
+        quarter = 0.25 * d.cycles.period_samples
+        for a, b in _long_runs((v < thr) & (v > -thr), min_len):
+            mid = 0.5 * (a + b - 1)
+            k = int(np.argmin(np.abs(rev - mid)))
+            if abs(rev[k] - mid) <= quarter + 0.5 * (b - a):
+                # the velocity filter spreads the departure from rest over half its window:
+                # that close to a detected stick a sample may still be stuck
+                mask[max(a - window // 2, 0) : b + window // 2] = True
+        return mask
 
     input_name = "x"
     output_name = "F"
@@ -506,11 +549,33 @@ class TangentialFamily:
     ) -> np.ndarray:
         """Measured force predicted for the measured displacement ``d.u`` (at the sample
         indices ``at`` only, when given: the Masing element still runs over the whole
-        history, the terms sample by sample only where asked — the same values)."""
+        history, the terms sample by sample only where asked — the same values).
+
+        A force channel with a declared measurement filter (``d.extra["output_filter"]``:
+        the taps of a zero-phase smoothing, e.g. a force reconstructed from a frame's
+        equation of motion, :attr:`contactlab.tangential.FrameForce.force_filter`) is
+        predicted through that same filter, whatever the effects: the model's force is
+        smoothed as the measurement was, so no candidate can win by imitating the
+        smoothing (the record's ends, where the filter is not defined, are weighted out by
+        :func:`contactlab.diagnose.diagnose`)."""
+        taps = d.extra.get("output_filter")
+        if taps is None:
+            return self._force(p, effects, d, at)
+        F = np.convolve(self._force(p, effects, d), taps, mode="same")
+        return F if at is None else F[at]
+
+    def _force(
+        self,
+        p: dict[str, float],
+        effects: tuple[str, ...],
+        d: Prepared,
+        at: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """The joint's force at the sensor, before any declared measurement filter."""
         if "channel_delay" in effects and "raw_input" in d.extra and p["tau"] != 0.0:
             # a kept record (workflow.subsample_long): the model at the shifted raw positions
             rest = tuple(e for e in effects if e != "channel_delay")
-            return self.predict(p, rest, delayed(d, p["tau"]), at)
+            return self._force(p, rest, delayed(d, p["tau"]), at)
         x = d.u
         if "displacement_offset" in effects:
             x = x - p["x0"]
