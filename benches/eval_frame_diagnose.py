@@ -17,9 +17,11 @@ every other name is spurious. Each case is diagnosed four ways:
   and noise (``output_filter``, ``output_noise``).
 
 Cases are drawn per seed: sampling 250/500/1000 Hz, Fk 0.5-1.2 N, Fs/Fk in {1, 1.1, 1.25,
-1.5}, displacement noise 0.2-1.5 µm. Prints one JSON line per case, then the tables.
+1.5}, displacement noise 0.2-1.5 µm; with ``filters``, both displacement channels also pass
+causal 2nd-order Butterworth anti-alias filters, cut-offs drawn per seed from 0.2/0.2,
+0.3/0.3 and 0.2/0.4 of Nyquist (x/y). Prints one JSON line per case, then the tables.
 
-    python benches/eval_frame_diagnose.py [first_seed] [count] [modes]
+    python benches/eval_frame_diagnose.py [first_seed] [count] [modes] [filters]
 """
 
 from __future__ import annotations
@@ -52,16 +54,23 @@ def case(seed: int) -> tuple[float, float, float, float]:
     return fs, fk, ratio * fk, sigma
 
 
-def run(seed: int, modes: list[str]) -> dict:
+def run(seed: int, modes: list[str], filters: bool = False) -> dict:
     fs, fk, fsx, sigma = case(seed)
     rng = np.random.default_rng(seed + 1000)
     t, x, y, F = simulate_frame(Fk=fk, Fs=fsx, fs=fs)
     xm = x + rng.normal(0, sigma, x.size)
     ym = y + rng.normal(0, sigma, x.size)
+    cuts = None
+    if filters:
+        from scipy.signal import butter, lfilter
+
+        cuts = [(0.2, 0.2), (0.3, 0.3), (0.2, 0.4)][int(rng.integers(3))]
+        xm = lfilter(*butter(2, cuts[0]), xm)
+        ym = lfilter(*butter(2, cuts[1]), ym)
     r = frame_friction_force(t, xm, ym, M=M, C=C, K=K)
     Fn = F + rng.normal(0, r.force_noise, F.size)
     row = {"seed": seed, "fs": fs, "Fk": round(fk, 3), "Fs": round(fsx, 3),
-           "sigma_um": round(sigma * 1e6, 2), "window": r.window}  # fmt: skip
+           "sigma_um": round(sigma * 1e6, 2), "window": r.window, "filters": cuts}  # fmt: skip
     for m in modes:
         t0 = time.process_time()
         if m == "true":
@@ -91,9 +100,10 @@ def main() -> None:
     count = int(sys.argv[2]) if len(sys.argv) > 2 else 12
     modes = sys.argv[3].split(",") if len(sys.argv) > 3 else ["true", "true_stick", "recon",
                                                                "declared"]  # fmt: skip
+    filters = len(sys.argv) > 4 and sys.argv[4] == "filters"
     rows = []
     for seed in range(first, first + count):
-        row = run(seed, modes)
+        row = run(seed, modes, filters)
         rows.append(row)
         print(json.dumps(row), flush=True)
     print()

@@ -409,7 +409,7 @@ class TangentialFamily:
         noise (``|v| < 3 σv``, the Savitzky-Golay velocity of
         :func:`contactlab.tangential.regime.velocity`) for at least
         :data:`~contactlab.tangential.regime.STICK_DWELL_FACTOR` times as long as a smooth
-        turn of the stroke would, within a quarter period of a reversal — the sticks
+        turn of that stroke's amplitude would, within a quarter period of a reversal — the sticks
         ``analyze`` reports (:func:`contactlab.tangential.regime.stick_slip`) — widened by
         half the velocity filter's window either side (the filter spreads the start of the
         motion over that: on Coulomb frames the samples it missed, 1.5 % of the record,
@@ -435,13 +435,19 @@ class TangentialFamily:
         v, thr, window = velocity(d.t, x)
         period = d.cycles.period_samples * d.dt
         omega = 2.0 * np.pi / period
-        smooth = 2.0 * thr / (amp * omega**2)
-        min_len = max(4, int(np.ceil(STICK_DWELL_FACTOR * smooth / d.dt)))
+        # the smooth dwell of a turn of the stroke's own amplitude (the larger half swing
+        # either side of the reversal): a record starting from rest ramps its amplitude
+        # up, and its first small turns dwell long without sticking
+        swing = np.abs(np.diff(x[rev]))
+        local = 0.5 * np.maximum(np.r_[swing, swing[-1]], np.r_[swing[0], swing])
+        smooth = 2.0 * thr / (np.maximum(local, 1e-300) * omega**2)
         quarter = 0.25 * d.cycles.period_samples
-        for a, b in _long_runs((v < thr) & (v > -thr), min_len):
+        shortest = max(4, int(np.ceil(STICK_DWELL_FACTOR * float(np.min(smooth)) / d.dt)))
+        for a, b in _long_runs((v < thr) & (v > -thr), shortest):
             mid = 0.5 * (a + b - 1)
             k = int(np.argmin(np.abs(rev - mid)))
-            if abs(rev[k] - mid) <= quarter + 0.5 * (b - a):
+            need = max(4, int(np.ceil(STICK_DWELL_FACTOR * float(smooth[k]) / d.dt)))
+            if b - a >= need and abs(rev[k] - mid) <= quarter + 0.5 * (b - a):
                 # the velocity filter spreads the departure from rest over half its window:
                 # that close to a detected stick a sample may still be stuck
                 mask[max(a - window // 2, 0) : b + window // 2] = True
