@@ -422,7 +422,8 @@ class TangentialFamily:
         channel delay, which reads the force's change off the displacement after the stick
         (measured on Coulomb frames: all of the delay's held-out gain comes from the stuck
         samples, on the true force as on the reconstructed one). A displacement-driven rig
-        never dwells that long at a turn: the mask is empty there.
+        never dwells that long at a turn: the mask is empty there, as it is when the velocity
+        filter spans more than a quarter period (too few samples a cycle to tell a stick).
         """
         from ..tangential.regime import STICK_DWELL_FACTOR, _long_runs, velocity
 
@@ -433,6 +434,8 @@ class TangentialFamily:
         if rev.size < 2 or x.size < 20 or not amp > 0:
             return mask
         v, thr, window = velocity(d.t, x)
+        if window > 0.25 * d.cycles.period_samples:  # too few samples a cycle to tell
+            return mask
         period = d.cycles.period_samples * d.dt
         omega = 2.0 * np.pi / period
         # the smooth dwell of a turn of the stroke's own amplitude (the larger half swing
@@ -447,7 +450,8 @@ class TangentialFamily:
             mid = 0.5 * (a + b - 1)
             k = int(np.argmin(np.abs(rev - mid)))
             need = max(4, int(np.ceil(STICK_DWELL_FACTOR * float(smooth[k]) / d.dt)))
-            if b - a >= need and abs(rev[k] - mid) <= quarter + 0.5 * (b - a):
+            # a stick holds a turn, not a whole stroke: at most half a period
+            if need <= b - a <= 2 * quarter and abs(rev[k] - mid) <= quarter + 0.5 * (b - a):
                 # the velocity filter spreads the departure from rest over half its window:
                 # that close to a detected stick a sample may still be stuck
                 mask[max(a - window // 2, 0) : b + window // 2] = True
