@@ -404,12 +404,17 @@ class TangentialFamily:
             f"plateau and ac ≥ {self.ac_floor:.3g} 1/m (only a lower bound is identified)"
         )
 
+    #: a stick changes the force by at least this share of its range (1st to 99th
+    #: percentile) while the displacement stands still (:meth:`sticking`)
+    STICK_FORCE_SHARE = 0.25
+
     def sticking(self, d: Prepared) -> np.ndarray:
         """The samples where the contact sticks: the displacement stands still within its
         noise (``|v| < 3 σv``, the Savitzky-Golay velocity of
         :func:`contactlab.tangential.regime.velocity`) for at least
         :data:`~contactlab.tangential.regime.STICK_DWELL_FACTOR` times as long as a smooth
-        turn of that stroke's amplitude would, within a quarter period of a reversal — the sticks
+        turn of that stroke's amplitude would, within a quarter period of a reversal, while
+        the force changes by at least :attr:`STICK_FORCE_SHARE` of its range — the sticks
         ``analyze`` reports (:func:`contactlab.tangential.regime.stick_slip`) — widened by
         half the velocity filter's window either side (the filter spreads the start of the
         motion over that: on Coulomb frames the samples it missed, 1.5 % of the record,
@@ -445,13 +450,19 @@ class TangentialFamily:
         local = 0.5 * np.maximum(np.r_[swing, swing[-1]], np.r_[swing[0], swing])
         smooth = 2.0 * thr / (np.maximum(local, 1e-300) * omega**2)
         quarter = 0.25 * d.cycles.period_samples
+        lo, hi = np.percentile(d.y, [1.0, 99.0])
+        swing_f = self.STICK_FORCE_SHARE * float(hi - lo)
         shortest = max(4, int(np.ceil(STICK_DWELL_FACTOR * float(np.min(smooth)) / d.dt)))
         for a, b in _long_runs((v < thr) & (v > -thr), shortest):
             mid = 0.5 * (a + b - 1)
             k = int(np.argmin(np.abs(rev - mid)))
             need = max(4, int(np.ceil(STICK_DWELL_FACTOR * float(smooth[k]) / d.dt)))
             # a stick holds a turn, not a whole stroke: at most half a period
-            if need <= b - a <= 2 * quarter and abs(rev[k] - mid) <= quarter + 0.5 * (b - a):
+            if (
+                need <= b - a <= 2 * quarter
+                and abs(rev[k] - mid) <= quarter + 0.5 * (b - a)
+                and float(np.ptp(d.y[a:b])) >= swing_f
+            ):
                 # the velocity filter spreads the departure from rest over half its window:
                 # that close to a detected stick a sample may still be stuck
                 mask[max(a - window // 2, 0) : b + window // 2] = True
