@@ -453,16 +453,18 @@ class TangentialFamily:
         lo, hi = np.percentile(d.y, [1.0, 99.0])
         swing_f = self.STICK_FORCE_SHARE * float(hi - lo)
         shortest = max(4, int(np.ceil(STICK_DWELL_FACTOR * float(np.min(smooth)) / d.dt)))
+        spans: dict[int, list[int]] = {}  # reversal -> [first stuck sample, end]
         for a, b in _long_runs((v < thr) & (v > -thr), shortest):
             mid = 0.5 * (a + b - 1)
             k = int(np.argmin(np.abs(rev - mid)))
             need = max(4, int(np.ceil(STICK_DWELL_FACTOR * float(smooth[k]) / d.dt)))
-            # a stick holds a turn, not a whole stroke: at most half a period
-            if (
-                need <= b - a <= 2 * quarter
-                and abs(rev[k] - mid) <= quarter + 0.5 * (b - a)
-                and float(np.ptp(d.y[a:b])) >= swing_f
-            ):
+            if b - a >= need and abs(rev[k] - mid) <= quarter + 0.5 * (b - a):
+                sp = spans.setdefault(k, [a, b])  # noise splits a stick into runs
+                sp[0], sp[1] = min(sp[0], a), max(sp[1], b)
+        for a, b in spans.values():
+            # a stick holds a turn, not a whole stroke (at most half a period), and the
+            # force changes while it holds
+            if b - a <= 2 * quarter and float(np.ptp(d.y[a:b])) >= swing_f:
                 # the velocity filter spreads the departure from rest over half its window:
                 # that close to a detected stick a sample may still be stuck
                 mask[max(a - window // 2, 0) : b + window // 2] = True
