@@ -129,3 +129,19 @@ def test_a_filter_on_a_normal_record_is_refused():
     rec = hidden_effect_recording([], model="normal", seed=64006)
     with pytest.raises(InputError, match="tangential model only"):
         contactlab.diagnose(rec, model="normal", output_filter=[0.25, 0.5, 0.25])
+
+
+@pytest.mark.parametrize("seed", [64007, 64008])
+def test_sticks_use_the_velocity_analyze_uses(seed):
+    """The diagnosis reads the sticks off regime.velocity's velocity, computed with numpy's
+    Savitzky-Golay weights (no scipy.signal import on the diagnose path): same window, same
+    velocity to rounding."""
+    from contactlab.diagnose.candidates_tangential import _sg_dot
+    from contactlab.tangential.frame import difference_noise, lepski_window
+    from contactlab.tangential.regime import velocity
+
+    t, xm, _, _, _ = _frame(seed, 500.0, 0.8, 1.1)
+    v, thr, window = velocity(t, xm)
+    sx = difference_noise(xm)
+    assert lepski_window(xm, t[1] - t[0], sx, coefficients=_sg_dot) == window
+    assert np.allclose(_sg_dot(window, 1, t[1] - t[0]), savgol_coefficients(window, 1, t[1] - t[0]))

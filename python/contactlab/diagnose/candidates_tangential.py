@@ -49,7 +49,7 @@ import numpy as np
 from ..errors import InputError
 from ..masing import Masing, loop_area
 from ._family import Candidate, ParamSpec, Prepared, implausible_common
-from ._filters import savgol_filter
+from ._filters import savgol_coeffs, savgol_filter
 from ._kept import delayed, span
 from ._signal import Knots, modulation_gains, shift
 from .scaled_masing import memory, scaled_force
@@ -249,6 +249,12 @@ ANCHOR_SIGMAS = 3.0
 ANCHOR_BAND = 2.0
 
 
+def _sg_dot(window: int, deriv: int, dt: float) -> np.ndarray:
+    """Cubic Savitzky-Golay weights of the ``deriv``-th derivative, dot orientation (as
+    :func:`contactlab.tangential.frame.savgol_coefficients`, in numpy)."""
+    return savgol_coeffs(window, 3, deriv, dt)[::-1]
+
+
 def _fixed(d: Prepared, key: str, make: Callable[[], Any]) -> Any:
     """An array of the model evaluation that depends on the recording only (not on the
     fitted parameters): computed on the first evaluation, then reused by every fit on ``d``
@@ -384,7 +390,7 @@ class TangentialFamily:
         x = d.extra.get("u_raw", d.u)
         try:
             loop = average_loop(x, d.y, d.t)
-            v, thr, window = velocity(d.t, x)
+            v, thr, _ = velocity(d.t, x)
             pl = plateau(loop, x, d.y, v, thr)
         except (InputError, ValueError):  # no loop to average: no plateau to anchor to
             return None
@@ -430,7 +436,8 @@ class TangentialFamily:
         never dwells that long at a turn: the mask is empty there, as it is when the velocity
         filter spans more than a quarter period (too few samples a cycle to tell a stick).
         """
-        from ..tangential.regime import STICK_DWELL_FACTOR, _long_runs, velocity
+        from ..tangential.frame import difference_noise, lepski_window
+        from ..tangential.regime import STICK_DWELL_FACTOR, VELOCITY_SIGMAS, _long_runs
 
         x = d.extra.get("u_raw", d.u)
         mask = np.zeros(x.size, bool)
@@ -438,7 +445,15 @@ class TangentialFamily:
         amp = 0.5 * float(np.ptp(x))
         if rev.size < 2 or x.size < 20 or not amp > 0:
             return mask
-        v, thr, window = velocity(d.t, x)
+        # regime.velocity (the sticks analyze reports) with numpy's Savitzky-Golay filters:
+        # the same values to rounding, without importing scipy.signal (0.3 s a diagnosis)
+        sx = difference_noise(x)
+        window = min(lepski_window(x, d.dt, sx, coefficients=_sg_dot), (x.size // 2) * 2 - 1)
+        window = max(window, 5)
+        v = savgol_filter(x, window, 3, deriv=1, delta=d.dt, mode="interp")
+        thr = VELOCITY_SIGMAS * sx * float(np.linalg.norm(_sg_dot(window, 1, d.dt)))
+        if not thr > 0:
+            thr = 1e-9 * float(np.max(np.abs(v)))
         if window > 0.25 * d.cycles.period_samples:  # too few samples a cycle to tell
             return mask
         period = d.cycles.period_samples * d.dt

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -121,26 +122,36 @@ def force_kernel(window: int) -> np.ndarray:
     return np.convolve(g, np.array([1.0, 4.0, 1.0]) / 6.0)
 
 
-def lepski_window(x: np.ndarray, dt: float, sigma: float, *, kappa: float = LEPSKI_KAPPA) -> int:
+def lepski_window(
+    x: np.ndarray,
+    dt: float,
+    sigma: float,
+    *,
+    kappa: float = LEPSKI_KAPPA,
+    coefficients: Callable[[int, int, float], np.ndarray] | None = None,
+) -> int:
     """Savitzky-Golay window (odd, samples) for ``x''`` by Lepski's rule (module docstring).
 
     Candidate windows grow geometrically from 7 samples to a fifth of the record (at most
     401); with no measurable noise the smallest is used. The comparisons run over the record
     in blocks (:func:`_lepski_square_sums`): O(n) time, memory independent of its length.
+    ``coefficients(window, deriv, dt)``: the filter weights (dot orientation) when not
+    :func:`savgol_coefficients` (a numpy implementation spares importing scipy.signal).
     """
+    coefficients = coefficients or savgol_coefficients
     n = x.size
     top = min(401, max(7, n // 5))
     cands = sorted({w | 1 for w in np.geomspace(7, top, 16).astype(int) if w >= 7})
     if sigma <= 0 or len(cands) < 2:
         return cands[0]
-    sq = _lepski_square_sums(np.asarray(x, dtype=float), cands, dt)
+    sq = _lepski_square_sums(np.asarray(x, dtype=float), cands, dt, coefficients=coefficients)
     chosen = cands[0]
     for i, w in enumerate(cands[1:], start=1):
         ok = True
-        cw = savgol_coefficients(w, 2, dt)
+        cw = coefficients(w, 2, dt)
         count = n - 2 * (w // 2)
         for j, wp in enumerate(cands[:i]):
-            cp = np.pad(savgol_coefficients(wp, 2, dt), (w - wp) // 2)
+            cp = np.pad(coefficients(wp, 2, dt), (w - wp) // 2)
             sd = sigma * float(np.linalg.norm(cw - cp))
             rms = math.sqrt(sq[i, j] / count)
             if rms > kappa * sd:
@@ -157,7 +168,11 @@ LEPSKI_BLOCK = 1 << 16
 
 
 def _lepski_square_sums(
-    x: np.ndarray, cands: list[int], dt: float, block: int = LEPSKI_BLOCK
+    x: np.ndarray,
+    cands: list[int],
+    dt: float,
+    block: int = LEPSKI_BLOCK,
+    coefficients: Callable[[int, int, float], np.ndarray] | None = None,
 ) -> np.ndarray:
     """``S[i, j]`` (``j < i``): sum of the squared differences between the Savitzky-Golay
     ``x''`` of windows ``cands[i]`` and ``cands[j]`` over the samples where the wider window
@@ -169,12 +184,15 @@ def _lepski_square_sums(
     same filter, summed in another order: equal to rounding, ~1e-13 of the estimates' RMS),
     the sums of squares added block by block. Buffers are allocated once.
     """
-    from scipy.signal import savgol_coeffs
-
     n, k = x.size, len(cands)
     halves = [w // 2 for w in cands]
     halo = halves[-1]
-    coeffs = [savgol_coeffs(w, POLYORDER, deriv=2, delta=dt) for w in cands]
+    if coefficients is None:
+        from scipy.signal import savgol_coeffs
+
+        coeffs = [savgol_coeffs(w, POLYORDER, deriv=2, delta=dt) for w in cands]
+    else:  # convolution orientation: the dot weights reversed
+        coeffs = [coefficients(w, 2, dt)[::-1] for w in cands]
     est = np.empty((k, block))
     diff = np.empty((k, block))
     out = np.zeros((k, k))
