@@ -36,11 +36,10 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from frame_sim import simulate_frame  # noqa: E402
-
-import contactlab  # noqa: E402
-from contactlab.diagnose.candidates_tangential import TangentialFamily  # noqa: E402
-from contactlab.tangential import frame_friction_force  # noqa: E402
+import contactlab
+from contactlab.diagnose.candidates_tangential import TangentialFamily
+from contactlab.tangential import frame_friction_force
+from frame_sim import simulate_frame
 
 M, C, K = 3.08, 0.669, 1191.0
 

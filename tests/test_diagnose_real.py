@@ -162,7 +162,7 @@ def test_measured_loop_sticks_are_not_judged_and_breakaway_agrees():
     Where diagnose still names stick_slip, its breakaway force (read off the fitted model at
     the reversals) agrees with analyze's within two combined standard errors."""
     for load in ("250", "450"):
-        (t, x, _), rep = _diagnosed(load)
+        (t, _, _), rep = _diagnosed(load)
         ss = _analyzed(load)["stick_slip"]
         share = ss["stick_duration"] * ss["reversals_with_stick"] / (t[-1] - t[0])
         stuck = rep.location["sticking_fraction"]

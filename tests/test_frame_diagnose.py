@@ -141,7 +141,14 @@ def test_sticks_use_the_velocity_analyze_uses(seed):
     from contactlab.tangential.regime import velocity
 
     t, xm, _, _, _ = _frame(seed, 500.0, 0.8, 1.1)
+    from contactlab.diagnose._filters import savgol_filter
+
     v, thr, window = velocity(t, xm)
+    dt = float(t[1] - t[0])
     sx = difference_noise(xm)
-    assert lepski_window(xm, t[1] - t[0], sx, coefficients=_sg_dot) == window
-    assert np.allclose(_sg_dot(window, 1, t[1] - t[0]), savgol_coefficients(window, 1, t[1] - t[0]))
+    assert lepski_window(xm, dt, sx, coefficients=_sg_dot) == window
+    c1 = _sg_dot(window, 1, dt)
+    assert np.allclose(c1, savgol_coefficients(window, 1, dt))
+    assert 3.0 * sx * float(np.linalg.norm(c1)) == pytest.approx(thr, rel=1e-12)
+    v2 = savgol_filter(xm, window, 3, deriv=1, delta=dt)
+    assert np.allclose(v2, v, rtol=0, atol=1e-9 * float(np.max(np.abs(v))))

@@ -114,9 +114,10 @@ def force_kernel(window: int) -> np.ndarray:
     reconstruction, which smooths every term of the equation of motion by ``g``
     (:func:`frame_friction_force`), gives ``force_kernel ⊛ F_f`` plus noise:
     ``g ⊛ [1, 4, 1]/6`` (for a sinusoid at ``θ`` radians per sample the inertial term's
-    smoothing differs from it by ``θ²/12`` of that term). :func:`contactlab.diagnose.diagnose` passes every candidate's
-    predicted force through the same kernel (``output_filter``), so that no candidate can
-    win by imitating the smoothing of the force's jumps at stick and slip.
+    smoothing differs from it by ``θ²/12`` of that term). :func:`contactlab.diagnose.diagnose`
+    passes every candidate's predicted force through the same kernel (``output_filter``), so
+    that no candidate can win by imitating the smoothing of the force's jumps at stick and
+    slip.
     """
     g = np.cumsum(np.cumsum(savgol_coefficients(window, 2, 1.0)))[:-2]
     return np.convolve(g, np.array([1.0, 4.0, 1.0]) / 6.0)
