@@ -437,7 +437,7 @@ class TangentialFamily:
         filter spans more than a quarter period (too few samples a cycle to tell a stick).
         """
         from ..tangential.frame import difference_noise, lepski_window
-        from ..tangential.regime import STICK_DWELL_FACTOR, VELOCITY_SIGMAS, _long_runs
+        from ..tangential.regime import STICK_DWELL_FACTOR, VELOCITY_SIGMAS, long_runs
 
         x = d.extra.get("u_raw", d.u)
         mask = np.zeros(x.size, bool)
@@ -469,7 +469,7 @@ class TangentialFamily:
         swing_f = self.STICK_FORCE_SHARE * float(hi - lo)
         shortest = max(4, int(np.ceil(STICK_DWELL_FACTOR * float(np.min(smooth)) / d.dt)))
         spans: dict[int, list[int]] = {}  # reversal -> [first stuck sample, end]
-        for a, b in _long_runs((v < thr) & (v > -thr), shortest):
+        for a, b in long_runs((v < thr) & (v > -thr), shortest):
             mid = 0.5 * (a + b - 1)
             k = int(np.argmin(np.abs(rev - mid)))
             need = max(4, int(np.ceil(STICK_DWELL_FACTOR * float(smooth[k]) / d.dt)))
