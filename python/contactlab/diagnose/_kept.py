@@ -157,3 +157,27 @@ def delayed(d: Prepared, tau: float) -> Prepared:
         memo.clear()
     memo[tau] = out
     return out
+
+
+def shifted(d: Prepared, tau: float) -> Prepared:
+    """The kept normal-contact record ``d`` as the model sees it ``tau`` earlier: the
+    pressure and its slope at the raw positions ``i·q - tau/dt`` (held at the ends, linearly
+    between raw samples), times shifted by ``tau`` (still equally spaced), the output and the
+    cycles as they are; the model on it without the delay is the delayed model at the kept
+    samples (:func:`delayed` for a tangential record). Kept per ``tau``."""
+    raw: RawInput = d.extra["raw_input"]
+    memo = d.extra.setdefault("shifted", {})
+    hit = memo.get(tau)
+    if hit is not None:
+        return hit
+    n = raw.u.size
+    pos = np.arange(d.t.size) * float(raw.q) - tau / raw.dt
+    ts = raw.t0 + raw.dt * pos
+    u, ud, udd = _at(np.clip(pos, 0.0, n - 1.0), n, raw.u, raw.ud, raw.udd)
+    extra = {k: d.extra[k] for k in ("omega", "delta_r") if k in d.extra}
+    extra["u_slope"] = ud
+    out = Prepared(ts, u, d.y, d.dt, d.window, ud, udd, d.cycles, extra)
+    if len(memo) >= _DELAYED_KEEP:
+        memo.clear()
+    memo[tau] = out
+    return out

@@ -59,6 +59,7 @@ from .. import _core
 from ..errors import ConvergenceError, InputError
 from ._family import Candidate, ParamSpec, Prepared, implausible_common
 from ._filters import first_order_response
+from ._kept import shifted
 from ._signal import shift
 
 _INF = np.inf
@@ -177,7 +178,7 @@ def _kelvin_voigt_fit(d: Prepared, k: float, psi: float, p0: float, omega: float
     key = (psi, omega, d.t.size)
     unit = cache.get(key)
     if unit is None:
-        unit = _unit_response(d.t, d.u, psi, omega)
+        unit = _unit_response(d.t, d.u, psi, omega, d.extra.get("u_slope"))
         unit.flags.writeable = False
         if len(cache) >= _UNIT_KEEP:
             cache.clear()
@@ -185,16 +186,22 @@ def _kelvin_voigt_fit(d: Prepared, k: float, psi: float, p0: float, omega: float
     return (unit - p0) / k
 
 
-def _unit_response(t: np.ndarray, u: np.ndarray, psi: float, omega: float) -> np.ndarray:
+def _unit_response(
+    t: np.ndarray, u: np.ndarray, psi: float, omega: float, dudt: np.ndarray | None = None
+) -> np.ndarray:
     """The unit-stiffness Kelvin-Voigt response to ``u`` from equilibrium with ``u[0]``:
     :func:`contactlab.diagnose._filters.first_order_response` (``a = 2π ω / ψ``, gain 1),
     computed by the Rust fixed-grid integrator with a constant stiffness, which is that exact
     solution under the same cubic Hermite pressure (to 1e-9 of the range, tested) in one pass
-    instead of numpy's blocked scan (4-5 times faster at 24 000 samples)."""
+    instead of numpy's blocked scan (4-5 times faster at 24 000 samples). ``dudt``: the
+    pressure's slopes at the samples (a kept long record's, from the raw rate), else finite
+    differences."""
     # (the step's equation is linear for a constant stiffness: solved exactly, ``tol`` unused)
     # (t of a decimated record is a strided view: the core takes contiguous arrays)
     tc, uc = np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(u, dtype=float)
-    r = _core.normal_simulate_grid(tc, uc, "constant", np.ones(1), psi, omega, float(u[0]), 1, 1.0)
+    r = _core.normal_simulate_grid(
+        tc, uc, "constant", np.ones(1), psi, omega, float(u[0]), 1, 1.0, dudt
+    )
     if int(r["status"]) != 0:
         raise ConvergenceError(f"Kelvin-Voigt response: {r['message']}")
     return np.asarray(r["delta"])
@@ -235,17 +242,23 @@ def grid_substeps(t: np.ndarray, omega: float) -> int:
 
 
 def nonlinear(
-    t: np.ndarray, pd: np.ndarray, coeffs: tuple[float, ...], psi: float, omega: float
+    t: np.ndarray,
+    pd: np.ndarray,
+    coeffs: tuple[float, ...],
+    psi: float,
+    omega: float,
+    dpdt: np.ndarray | None = None,
 ) -> np.ndarray:
     """Eq. 17 with ``k_s(δ) = Σ coeffs[i] δ^i``, via
     :meth:`contactlab.normal.NonlinearContact.simulate_grid` (the fixed-grid integrator on
     the record's samples, :func:`grid_substeps` steps per interval: 3-7 times faster than
     the adaptive :meth:`~contactlab.normal.NonlinearContact.simulate` at :data:`RTOL`; its
-    error, far below the noise, is given at :data:`GRID_STEPS_PER_PERIOD`)."""
+    error, far below the noise, is given at :data:`GRID_STEPS_PER_PERIOD`). ``dpdt``: the
+    pressure's slopes at the samples, if known."""
     from ..normal import NonlinearContact
 
     model = NonlinearContact(k_s_delta=list(coeffs), psi=psi, omega=omega)
-    res = model.simulate_grid(t, pd, substeps=grid_substeps(t, omega))
+    res = model.simulate_grid(t, pd, substeps=grid_substeps(t, omega), dpdt=dpdt)
     return _delta(res, pd.size)
 
 
@@ -358,6 +371,13 @@ class NormalFamily:
         """Measured displacement predicted for the measured pressure ``d.u``."""
         if not self.check(effects):
             raise InputError("hysteretic damping cannot be combined with a stiffness nonlinearity")
+        if "channel_delay" in effects and "raw_input" in d.extra and p["tau"] != 0.0:
+            # a kept long record: the model on the pressure at the raw shifted times
+            rest = tuple(e for e in effects if e not in ("channel_delay", "creep_drift"))
+            delta = self.predict(p, rest, shifted(d, p["tau"]))
+            if "creep_drift" in effects:
+                delta = delta + p["D"] * _creep_shape(d, max(p["tau_c"], 1e-6 * d.duration))
+            return delta
         pd = d.u - p["p0"]
         om = d.extra["omega"]
         k, psi = p["k"], p["psi"]
@@ -367,7 +387,8 @@ class NormalFamily:
             dr = d.extra["delta_r"]
             a = p.get("a", 0.0) if "asymmetric_branches" in effects else 0.0
             kap = p.get("kappa", 0.0) if "stiffness_nonlinearity" in effects else 0.0
-            delta = nonlinear(d.t, pd, (k, k * a / dr, k * kap / dr**2), psi, om)
+            coeffs = (k, k * a / dr, k * kap / dr**2)
+            delta = nonlinear(d.t, pd, coeffs, psi, om, d.extra.get("u_slope"))
         else:
             delta = _kelvin_voigt_fit(d, k, psi, p["p0"], om)
         if "creep_drift" in effects:
