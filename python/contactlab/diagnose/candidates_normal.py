@@ -160,6 +160,8 @@ def kelvin_voigt_exact(
     return first_order_response(t, pd, 2.0 * np.pi * omega / psi, 1.0 / k, kv.equilibrium(pd[0]))
 
 
+#: stiffness-law responses kept per recording (a Jacobian's columns: up to 7 parameters)
+_NONLINEAR_KEEP = 8
 #: unit responses kept per recording (one per ψ, ω tried); 64 of 24 000 samples: 12 MB
 _UNIT_KEEP = 64
 
@@ -362,6 +364,30 @@ class NormalFamily:
         k = float(pd @ pd) / float(pd @ d.y) if float(pd @ d.y) > 0 else self.scales(d)["k"]
         return {"k": abs(k), "psi": 0.1, "p0": p0}
 
+    def start_effect(
+        self, name: str, p: dict[str, float], d: Prepared, residual: np.ndarray
+    ) -> dict[str, float]:
+        """Starting values of ``creep_drift`` from the current residual (measured minus
+        model): the ``τ_c`` of :data:`CREEP_START_GRID` whose shape ``1 - exp(-t/τ_c)``,
+        its mean removed (``p0`` takes a constant), explains most of it, and ``D`` its
+        least-squares size; nothing for the other candidates."""
+        if name != "creep_drift":
+            return {}
+        r = residual - np.mean(residual)
+        best, start = -1.0, {}
+        period = d.cycles.period_samples * d.dt
+        for tc in np.geomspace(CREEP_MIN_PERIODS * period, CREEP_MAX_DURATIONS * d.duration,
+                               CREEP_START_GRID):  # fmt: skip
+            sh = _creep_shape(d, float(tc))
+            sh = sh - np.mean(sh)
+            ss = float(sh @ sh)
+            if ss <= 0:
+                continue
+            sr = float(sh @ r)
+            if sr * sr / ss > best:
+                best, start = sr * sr / ss, {"D": sr / ss, "tau_c": float(tc)}
+        return start
+
     def check(self, effects: tuple[str, ...]) -> bool:
         """Whether these effects can be combined."""
         stiff = {"stiffness_nonlinearity", "asymmetric_branches"} & set(effects)
@@ -388,7 +414,17 @@ class NormalFamily:
             a = p.get("a", 0.0) if "asymmetric_branches" in effects else 0.0
             kap = p.get("kappa", 0.0) if "stiffness_nonlinearity" in effects else 0.0
             coeffs = (k, k * a / dr, k * kap / dr**2)
-            delta = nonlinear(d.t, pd, coeffs, psi, om, d.extra.get("u_slope"))
+            # kept per parameters: a fit's Jacobian steps the creep's parameters, and a
+            # delay's, at the same stiffness law (a quarter to a third of its evaluations)
+            memo = d.extra.setdefault("nonlinear", {})
+            key = (coeffs, psi, p["p0"], om, d.t.size)
+            delta = memo.get(key)
+            if delta is None:
+                delta = nonlinear(d.t, pd, coeffs, psi, om, d.extra.get("u_slope"))
+                delta.flags.writeable = False
+                if len(memo) >= _NONLINEAR_KEEP:
+                    memo.clear()
+                memo[key] = delta
         else:
             delta = _kelvin_voigt_fit(d, k, psi, p["p0"], om)
         if "creep_drift" in effects:
@@ -489,6 +525,8 @@ CREEP_MIN_PERIODS = 1.0
 #: the drift is straight to within a sixth of its size (1 - e^(-1/3) against 1/3), and creep
 #: (a settling) is not told from a sensor drift or a slow misfit of the model
 CREEP_MAX_DURATIONS = 3.0
+#: τ_c tried (log-spaced over the plausible range) for the creep's starting values
+CREEP_START_GRID = 24
 #: excitation frequencies closer than this ratio count as one frequency for the delay test
 SINGLE_TONE_SPAN = 1.25
 
