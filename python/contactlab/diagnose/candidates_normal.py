@@ -321,6 +321,12 @@ class NormalFamily:
     #: delay's amplitude error ∝ ω² once ψ has absorbed its phase, a nonlinearity's ∝ the
     #: amplitude) lives in some blocks only
     proportional_gain = True
+    #: the model evaluations release the GIL for milliseconds each (the integrator): a fit's
+    #: finite-difference columns run on threads (:func:`._parallel.column_map`)
+    parallel_jacobian = True
+    #: the polish after each fit stops at steps below :data:`.select.POLISH_STOP` standard
+    #: errors (its central-difference Jacobians were half of a diagnosis' evaluations)
+    quick_polish = True
     base_params = BASE_PARAMS
     candidates = CANDIDATES
     input_name = "p"
@@ -369,8 +375,9 @@ class NormalFamily:
     ) -> dict[str, float]:
         """Starting values of ``creep_drift`` from the current residual (measured minus
         model): the ``τ_c`` of :data:`CREEP_START_GRID` whose shape ``1 - exp(-t/τ_c)``,
-        its mean removed (``p0`` takes a constant), explains most of it, and ``D`` its
-        least-squares size; nothing for the other candidates."""
+        its mean removed, explains most of it, ``D`` its least-squares size, and ``p0``
+        moved to take that mean back (a constant displacement is ``-Δp0 / k``); nothing
+        for the other candidates."""
         if name != "creep_drift":
             return {}
         r = residual - np.mean(residual)
@@ -386,6 +393,9 @@ class NormalFamily:
             sr = float(sh @ r)
             if sr * sr / ss > best:
                 best, start = sr * sr / ss, {"D": sr / ss, "tau_c": float(tc)}
+        if start:  # p0 takes the drift's mean back: δ = (p - p0) / k at the base
+            mean = float(np.mean(_creep_shape(d, start["tau_c"])))
+            start["p0"] = p["p0"] + p["k"] * start["D"] * mean
         return start
 
     def check(self, effects: tuple[str, ...]) -> bool:
