@@ -114,10 +114,11 @@ def specs_for(family: Family, effects: tuple[str, ...]) -> list[ParamSpec]:
     return out
 
 
-#: the Gauss-Newton polish after a candidate's solver stops once its next step is below this
-#: many standard errors, for a family with ``quick_polish`` (normal contact) (:func:`contactlab.fitting.least_squares_fit`'s ``polish_stop``):
-#: every held-out and in-sample error moves by far less than the noise, and each step is a
-#: central-difference Jacobian (six of ten model evaluations of a diagnosis went to these)
+#: the Gauss-Newton polish after a candidate's solver stops once its next step is below
+#: this many standard errors (:func:`contactlab.fitting.least_squares_fit`'s ``polish_stop``)
+#: for a family with ``quick_polish`` (normal contact): every held-out and in-sample error
+#: moves by far less than the noise, and each step is a central-difference Jacobian (half
+#: of the model evaluations of a long normal diagnosis went to these)
 POLISH_STOP = 0.01
 
 
