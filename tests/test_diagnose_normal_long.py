@@ -171,4 +171,6 @@ def test_delayed_model_is_smooth_across_whole_samples(monkeypatch):
     left = (at(tau0) - at(tau0 - h)) / h
     scale = float(np.max(np.abs(right)))
     assert scale > 0
-    assert float(np.max(np.abs(right - left))) < 0.01 * scale
+    # measured: 1.1e-5 of the derivative's size (the difference quotients' own error); 1.1e-2
+    # with linear interpolation
+    assert float(np.max(np.abs(right - left))) < 1e-3 * scale
