@@ -174,3 +174,20 @@ def test_delayed_model_is_smooth_across_whole_samples(monkeypatch):
     # measured: 1.1e-5 of the derivative's size (the difference quotients' own error); 1.1e-2
     # with linear interpolation
     assert float(np.max(np.abs(right - left))) < 1e-3 * scale
+
+
+def test_record_of_short_cycles_is_cut_not_thinned():
+    """30 samples per cycle (18 in the fastest block): no sample can be dropped, so a record
+    longer than MAX_SAMPLES is diagnosed on its first cycles, and the report says only that."""
+    rec = _record(None)
+    t, u, y = rec.t[::40], rec["p"][::40], rec["delta"][::40]
+    t = np.arange(4 * t.size) * (t[1] - t[0])
+    u, y = np.tile(u, 4), np.tile(y, 4)
+    saved = wf.MAX_SAMPLES
+    try:
+        wf.MAX_SAMPLES = 1000
+        d, how = wf.subsample_normal(t, u, y)
+    finally:
+        wf.MAX_SAMPLES = saved
+    assert d.t.size == 1000 and d.extra["raw_input"].q == 1
+    assert "kept one sample" not in how and "diagnosed on its first" in how

@@ -470,8 +470,11 @@ def subsample_normal(t: np.ndarray, u: np.ndarray, y: np.ndarray) -> tuple[Prepa
         np.ascontiguousarray(t[g]), uk, np.ascontiguousarray(y[g]), dt * q,
         smooth_window(per / q), ud[g], udd[g], cycles, extra,
     )  # fmt: skip
-    how = [f"kept one sample in {q} over its whole length (no filter; the pressure between "
-           "them from its full-rate slopes)"]  # fmt: skip
+    how = []
+    if q > 1:
+        whole = "" if stop < n else " over its whole length"
+        how.append(f"kept one sample in {q}{whole} (no filter; the pressure between them from "
+                   "its full-rate slopes)")  # fmt: skip
     if stop < n:
         how.append(
             f"diagnosed on its first {stop / per:.0f} of {n / per:.0f} excitation cycles "
