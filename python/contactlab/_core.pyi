@@ -122,6 +122,7 @@ def normal_simulate_grid(
     delta0: float,
     substeps: int,
     tol: float,
+    dpdt: _F | None = None,
 ) -> dict[str, object]: ...
 def normal_equilibrium(law: str, coeffs: _F, psi: float, omega: float, p: float) -> float: ...
 def kv_analytic(

@@ -14,6 +14,7 @@ AIC and BIC follow lmfit: ``n ln(χ²/n) + 2k`` and ``n ln(χ²/n) + k ln n``.
 from __future__ import annotations
 
 import math
+import threading
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any
@@ -293,6 +294,8 @@ def least_squares_fit(
     jac_rel_step: float = 1e-6,
     jac: Callable[[dict[str, float]], Mapping[str, Any]] | None = None,
     solver: Callable[..., tuple[Any, int, int]] | None = None,
+    workers: Callable[[Callable[[Any], Any], Iterable[Any]], Iterable[Any]] | None = None,
+    polish_stop: float = 0.0,
 ) -> FitResult:
     """Minimise ``sum(residual_fn(values)**2)`` over the varied parameters.
 
@@ -327,6 +330,14 @@ def least_squares_fit(
         returns ``(z, nfev, status)`` with the status codes of ``least_squares`` (0: the
         evaluation budget ran out, reported as not converged). The polishing steps, the
         trust check and the covariance are the same as after SciPy's solver.
+    workers : map-like callable, optional
+        Evaluates the finite-difference Jacobians' columns (SciPy's solver's and the
+        covariance's) as ``workers(fn, items)``, e.g. a thread pool's ``map`` when
+        ``residual_fn`` releases the GIL: the same numbers as evaluated one by one.
+    polish_stop : float
+        The Gauss-Newton steps that follow the solver stop once the next step is below this
+        many standard errors in every parameter (each step costs a central-difference
+        Jacobian); 0, the default, steps on while the cost falls (to rounding).
 
     Returns
     -------
@@ -377,6 +388,7 @@ def least_squares_fit(
     hi = np.array([ps[n].max for n in names]) / scale
     fixed = {k: p.value for k, p in ps.items() if not p.vary}
     nfev = 0
+    counting = threading.Lock()  # ``workers`` may call raw_fun on several threads
 
     def values_of(z: np.ndarray) -> dict[str, float]:
         v = dict(fixed)
@@ -385,7 +397,8 @@ def least_squares_fit(
 
     def raw_fun(z: np.ndarray) -> np.ndarray:
         nonlocal nfev
-        nfev += 1
+        with counting:
+            nfev += 1
         with np.errstate(all="ignore"):  # an overflowing trial step is refused below
             return np.asarray(residual_fn(values_of(z)), dtype=np.float64).reshape(-1)
 
@@ -427,7 +440,7 @@ def least_squares_fit(
         sol = None
     else:
         z, rs, status, sol = _scipy_solve(fun, z0, lo, hi, analytic if jac is not None else None,
-                                          loss, ftol, xtol, gtol, max_nfev)  # fmt: skip
+                                          loss, ftol, xtol, gtol, max_nfev, workers)  # fmt: skip
     success = status > 0 if sol is None else bool(sol.success)
     message = _STATUS.get(status, "") if sol is None else str(sol.message)
 
@@ -436,17 +449,24 @@ def least_squares_fit(
             return analytic(z)
         # central differences in the scaled variables (bounds respected by one-sided steps)
         J = np.empty((ndata, len(names)))
+        steps = []
         for j in range(len(names)):
             h = jac_rel_step * max(abs(z[j]), 1.0)
             up, dn = z.copy(), z.copy()
             up[j] = min(z[j] + h, hi[j])
             dn[j] = max(z[j] - h, lo[j])
-            J[:, j] = (fun(up) - fun(dn)) / (up[j] - dn[j])
+            steps += [up, dn]
+        f = list((workers or map)(fun, steps))
+        for j in range(len(names)):
+            up, dn = steps[2 * j], steps[2 * j + 1]
+            J[:, j] = (f[2 * j] - f[2 * j + 1]) / (up[j] - dn[j])
         return J
 
     J = jacobian(z)
     if success and loss == "linear":
-        z, rs, J, success, status, message = _polish(fun, jacobian, z, rs, J, lo, hi, names)
+        z, rs, J, success, status, message = _polish(
+            fun, jacobian, z, rs, J, lo, hi, names, polish_stop
+        )
     with np.errstate(over="ignore"):
         r = rs * rscale
     with np.errstate(over="ignore"):
@@ -489,7 +509,7 @@ def least_squares_fit(
         ref = least_squares_fit(
             residual_fn, start, scale_covar=scale_covar, rcond=rcond,
             max_rel_stderr=max_rel_stderr, loss=loss, max_nfev=max_nfev, ftol=ftol,
-            xtol=xtol, gtol=gtol, jac_rel_step=jac_rel_step, jac=jac,
+            xtol=xtol, gtol=gtol, jac_rel_step=jac_rel_step, jac=jac, workers=workers,
         )  # fmt: skip
         ref.nfev += res.nfev
         return ref
@@ -540,6 +560,7 @@ def _scipy_solve(
     xtol: float,
     gtol: float,
     max_nfev: int | None,
+    workers: Callable[[Callable[[Any], Any], Iterable[Any]], Iterable[Any]] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int, Any]:
     try:
         sol = least_squares(
@@ -554,6 +575,7 @@ def _scipy_solve(
             xtol=xtol,
             gtol=gtol,
             max_nfev=max_nfev,
+            workers=workers,
         )
     except InputError as exc:
         raise ConvergenceError(
@@ -580,6 +602,21 @@ def _sumsq(r: np.ndarray) -> float:
 TRUST_STEP = 0.25
 
 
+def _step_in_stderr(step: np.ndarray, J: np.ndarray, var: float) -> float:
+    """The largest ``|step|`` in units of its parameter's standard error (Jacobian ``J``,
+    residual variance ``var``); inf when the errors cannot be computed."""
+    if not np.all(np.isfinite(J)):
+        return np.inf
+    try:
+        cov = np.linalg.pinv(J.T @ J, rcond=1e-13) * var
+    except np.linalg.LinAlgError:
+        return np.inf
+    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    if not np.all(sd > 0):
+        return np.inf
+    return float(np.max(np.abs(step) / sd))
+
+
 def _polish(
     fun: Callable[[np.ndarray], np.ndarray],
     jacobian: Callable[[np.ndarray], np.ndarray],
@@ -589,6 +626,7 @@ def _polish(
     lo: np.ndarray,
     hi: np.ndarray,
     names: list[str],
+    stop: float = 0.0,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool, int, str]:
     """Gauss-Newton steps from the solver's end point until they stop paying, then the trust
     check: the step still possible must be a negligible fraction of each parameter's standard
@@ -599,9 +637,12 @@ def _polish(
     reporting success. Parameters at a bound are held there.
     """
     cost = float(r @ r)
+    nfree = r.size - len(names)
     for _ in range(30):
         step = _gn_step(J, r, z, lo, hi)
         if step is None or not np.any(step):
+            break
+        if stop > 0 and nfree > 0 and _step_in_stderr(step, J, cost / nfree) < stop:
             break
         z_new = np.clip(z + step, lo, hi)
         try:
@@ -623,7 +664,6 @@ def _polish(
             break
     # trust: one more step from here, measured in standard errors
     step = _gn_step(J, r, z, lo, hi)
-    nfree = r.size - len(names)
     if step is not None and nfree > 0 and np.all(np.isfinite(J)):
         try:
             cov = np.linalg.pinv(J.T @ J, rcond=1e-13) * (cost / nfree)

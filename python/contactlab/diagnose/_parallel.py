@@ -88,6 +88,52 @@ def pmap(fn: Callable[[T], R], items: Sequence[T]) -> list[R]:
         ex.shutdown(wait=True, cancel_futures=True)
 
 
+#: threads that evaluate the finite-difference columns of a fit's Jacobian
+#: (:func:`column_map`); one pool for the process, its tasks never wait on other tasks
+_COLUMN_THREADS = 2
+_column_pool: ThreadPoolExecutor | None = None
+_column_lock = threading.Lock()
+_in_column = threading.local()
+
+
+def in_column() -> bool:
+    """Whether this thread is evaluating a Jacobian column for :func:`column_map` (whose
+    caller has counted the evaluation already)."""
+    return bool(getattr(_in_column, "on", False))
+
+
+def column_map(
+    counter: EvaluationCounter | None,
+) -> Callable[[Callable[[T], R], Sequence[T]], list[R]] | None:
+    """A map-like callable for :func:`contactlab.fitting.least_squares_fit`'s ``workers``:
+    a fit's finite-difference columns (independent model evaluations that release the GIL)
+    on :data:`_COLUMN_THREADS` threads, counted in ``counter`` by the calling thread (so a
+    fit's evaluations stay its thread's, :meth:`EvaluationCounter.mine`); the numbers are
+    those of a serial loop. None when :func:`workers` says one thread (a busy machine)."""
+    global _column_pool
+    if workers() <= 1:
+        return None
+    with _column_lock:
+        if _column_pool is None:
+            _column_pool = ThreadPoolExecutor(_COLUMN_THREADS, thread_name_prefix="contactlab-jac")
+        pool = _column_pool
+
+    def one(fn: Callable[[T], R], x: T) -> R:
+        _in_column.on = True
+        try:
+            return fn(x)
+        finally:
+            _in_column.on = False
+
+    def run(fn: Callable[[T], R], items: Sequence[T]) -> list[R]:
+        items = list(items)
+        if counter is not None:
+            counter.tick(len(items))
+        return list(pool.map(functools.partial(one, fn), items))
+
+    return run
+
+
 class EvaluationCounter:
     """Model evaluations a diagnosis has spent (its budget), counted per thread so that fits
     on several threads neither lose counts nor mix them: :meth:`tick` from any thread,
@@ -106,8 +152,8 @@ class EvaluationCounter:
                 self._counts.append(c)
         return c
 
-    def tick(self) -> None:
-        self._slot()[0] += 1
+    def tick(self, n: int = 1) -> None:
+        self._slot()[0] += n
 
     def mine(self) -> int:
         return self._slot()[0]

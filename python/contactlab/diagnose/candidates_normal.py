@@ -59,6 +59,7 @@ from .. import _core
 from ..errors import ConvergenceError, InputError
 from ._family import Candidate, ParamSpec, Prepared, implausible_common
 from ._filters import first_order_response
+from ._kept import shifted
 from ._signal import shift
 
 _INF = np.inf
@@ -159,6 +160,8 @@ def kelvin_voigt_exact(
     return first_order_response(t, pd, 2.0 * np.pi * omega / psi, 1.0 / k, kv.equilibrium(pd[0]))
 
 
+#: stiffness-law responses kept per recording (a Jacobian's columns: up to 7 parameters)
+_NONLINEAR_KEEP = 8
 #: unit responses kept per recording (one per ψ, ω tried); 64 of 24 000 samples: 12 MB
 _UNIT_KEEP = 64
 
@@ -177,7 +180,7 @@ def _kelvin_voigt_fit(d: Prepared, k: float, psi: float, p0: float, omega: float
     key = (psi, omega, d.t.size)
     unit = cache.get(key)
     if unit is None:
-        unit = _unit_response(d.t, d.u, psi, omega)
+        unit = _unit_response(d.t, d.u, psi, omega, d.extra.get("u_slope"))
         unit.flags.writeable = False
         if len(cache) >= _UNIT_KEEP:
             cache.clear()
@@ -185,16 +188,22 @@ def _kelvin_voigt_fit(d: Prepared, k: float, psi: float, p0: float, omega: float
     return (unit - p0) / k
 
 
-def _unit_response(t: np.ndarray, u: np.ndarray, psi: float, omega: float) -> np.ndarray:
+def _unit_response(
+    t: np.ndarray, u: np.ndarray, psi: float, omega: float, dudt: np.ndarray | None = None
+) -> np.ndarray:
     """The unit-stiffness Kelvin-Voigt response to ``u`` from equilibrium with ``u[0]``:
     :func:`contactlab.diagnose._filters.first_order_response` (``a = 2π ω / ψ``, gain 1),
     computed by the Rust fixed-grid integrator with a constant stiffness, which is that exact
     solution under the same cubic Hermite pressure (to 1e-9 of the range, tested) in one pass
-    instead of numpy's blocked scan (4-5 times faster at 24 000 samples)."""
+    instead of numpy's blocked scan (4-5 times faster at 24 000 samples). ``dudt``: the
+    pressure's slopes at the samples (a kept long record's, from the raw rate), else finite
+    differences."""
     # (the step's equation is linear for a constant stiffness: solved exactly, ``tol`` unused)
     # (t of a decimated record is a strided view: the core takes contiguous arrays)
     tc, uc = np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(u, dtype=float)
-    r = _core.normal_simulate_grid(tc, uc, "constant", np.ones(1), psi, omega, float(u[0]), 1, 1.0)
+    r = _core.normal_simulate_grid(
+        tc, uc, "constant", np.ones(1), psi, omega, float(u[0]), 1, 1.0, dudt
+    )
     if int(r["status"]) != 0:
         raise ConvergenceError(f"Kelvin-Voigt response: {r['message']}")
     return np.asarray(r["delta"])
@@ -235,17 +244,23 @@ def grid_substeps(t: np.ndarray, omega: float) -> int:
 
 
 def nonlinear(
-    t: np.ndarray, pd: np.ndarray, coeffs: tuple[float, ...], psi: float, omega: float
+    t: np.ndarray,
+    pd: np.ndarray,
+    coeffs: tuple[float, ...],
+    psi: float,
+    omega: float,
+    dpdt: np.ndarray | None = None,
 ) -> np.ndarray:
     """Eq. 17 with ``k_s(δ) = Σ coeffs[i] δ^i``, via
     :meth:`contactlab.normal.NonlinearContact.simulate_grid` (the fixed-grid integrator on
     the record's samples, :func:`grid_substeps` steps per interval: 3-7 times faster than
     the adaptive :meth:`~contactlab.normal.NonlinearContact.simulate` at :data:`RTOL`; its
-    error, far below the noise, is given at :data:`GRID_STEPS_PER_PERIOD`)."""
+    error, far below the noise, is given at :data:`GRID_STEPS_PER_PERIOD`). ``dpdt``: the
+    pressure's slopes at the samples, if known."""
     from ..normal import NonlinearContact
 
     model = NonlinearContact(k_s_delta=list(coeffs), psi=psi, omega=omega)
-    res = model.simulate_grid(t, pd, substeps=grid_substeps(t, omega))
+    res = model.simulate_grid(t, pd, substeps=grid_substeps(t, omega), dpdt=dpdt)
     return _delta(res, pd.size)
 
 
@@ -306,6 +321,12 @@ class NormalFamily:
     #: delay's amplitude error ∝ ω² once ψ has absorbed its phase, a nonlinearity's ∝ the
     #: amplitude) lives in some blocks only
     proportional_gain = True
+    #: the model evaluations release the GIL for milliseconds each (the integrator): a fit's
+    #: finite-difference columns run on threads (:func:`._parallel.column_map`)
+    parallel_jacobian = True
+    #: the polish after each fit stops at steps below :data:`.select.POLISH_STOP` standard
+    #: errors (its central-difference Jacobians were half of a diagnosis' evaluations)
+    quick_polish = True
     base_params = BASE_PARAMS
     candidates = CANDIDATES
     input_name = "p"
@@ -349,6 +370,34 @@ class NormalFamily:
         k = float(pd @ pd) / float(pd @ d.y) if float(pd @ d.y) > 0 else self.scales(d)["k"]
         return {"k": abs(k), "psi": 0.1, "p0": p0}
 
+    def start_effect(
+        self, name: str, p: dict[str, float], d: Prepared, residual: np.ndarray
+    ) -> dict[str, float]:
+        """Starting values of ``creep_drift`` from the current residual (measured minus
+        model): the ``τ_c`` of :data:`CREEP_START_GRID` whose shape ``1 - exp(-t/τ_c)``,
+        its mean removed, explains most of it, ``D`` its least-squares size, and ``p0``
+        moved to take that mean back (a constant displacement is ``-Δp0 / k``); nothing
+        for the other candidates."""
+        if name != "creep_drift":
+            return {}
+        r = residual - np.mean(residual)
+        best, start = -1.0, {}
+        period = d.cycles.period_samples * d.dt
+        for tc in np.geomspace(CREEP_MIN_PERIODS * period, CREEP_MAX_DURATIONS * d.duration,
+                               CREEP_START_GRID):  # fmt: skip
+            sh = _creep_shape(d, float(tc))
+            sh = sh - np.mean(sh)
+            ss = float(sh @ sh)
+            if ss <= 0:
+                continue
+            sr = float(sh @ r)
+            if sr * sr / ss > best:
+                best, start = sr * sr / ss, {"D": sr / ss, "tau_c": float(tc)}
+        if start:  # p0 takes the drift's mean back: δ = (p - p0) / k at the base
+            mean = float(np.mean(_creep_shape(d, start["tau_c"])))
+            start["p0"] = p["p0"] + p["k"] * start["D"] * mean
+        return start
+
     def check(self, effects: tuple[str, ...]) -> bool:
         """Whether these effects can be combined."""
         stiff = {"stiffness_nonlinearity", "asymmetric_branches"} & set(effects)
@@ -358,6 +407,13 @@ class NormalFamily:
         """Measured displacement predicted for the measured pressure ``d.u``."""
         if not self.check(effects):
             raise InputError("hysteretic damping cannot be combined with a stiffness nonlinearity")
+        if "channel_delay" in effects and "raw_input" in d.extra and p["tau"] != 0.0:
+            # a kept long record: the model on the pressure at the raw shifted times
+            rest = tuple(e for e in effects if e not in ("channel_delay", "creep_drift"))
+            delta = self.predict(p, rest, shifted(d, p["tau"]))
+            if "creep_drift" in effects:
+                delta = delta + p["D"] * _creep_shape(d, max(p["tau_c"], 1e-6 * d.duration))
+            return delta
         pd = d.u - p["p0"]
         om = d.extra["omega"]
         k, psi = p["k"], p["psi"]
@@ -367,7 +423,18 @@ class NormalFamily:
             dr = d.extra["delta_r"]
             a = p.get("a", 0.0) if "asymmetric_branches" in effects else 0.0
             kap = p.get("kappa", 0.0) if "stiffness_nonlinearity" in effects else 0.0
-            delta = nonlinear(d.t, pd, (k, k * a / dr, k * kap / dr**2), psi, om)
+            coeffs = (k, k * a / dr, k * kap / dr**2)
+            # kept per parameters: a fit's Jacobian steps the creep's parameters, and a
+            # delay's, at the same stiffness law (a quarter to a third of its evaluations)
+            memo = d.extra.setdefault("nonlinear", {})
+            key = (coeffs, psi, p["p0"], om, d.t.size)
+            delta = memo.get(key)
+            if delta is None:
+                delta = nonlinear(d.t, pd, coeffs, psi, om, d.extra.get("u_slope"))
+                delta.flags.writeable = False
+                if len(memo) >= _NONLINEAR_KEEP:
+                    memo.clear()
+                memo[key] = delta
         else:
             delta = _kelvin_voigt_fit(d, k, psi, p["p0"], om)
         if "creep_drift" in effects:
@@ -468,6 +535,8 @@ CREEP_MIN_PERIODS = 1.0
 #: the drift is straight to within a sixth of its size (1 - e^(-1/3) against 1/3), and creep
 #: (a settling) is not told from a sensor drift or a slow misfit of the model
 CREEP_MAX_DURATIONS = 3.0
+#: τ_c tried (log-spaced over the plausible range) for the creep's starting values
+CREEP_START_GRID = 24
 #: excitation frequencies closer than this ratio count as one frequency for the delay test
 SINGLE_TONE_SPAN = 1.25
 

@@ -275,9 +275,9 @@ def _family(model: Any) -> tuple[Family, dict[str, float], dict[str, float]]:
 
 #: longest record diagnosed sample by sample. Longer tangential ones keep every q-th sample
 #: over their whole length with the turning points between them (:func:`subsample_long`);
-#: longer normal ones are decimated (anti-aliased, zero phase) to no fewer than
-#: MIN_SAMPLES_PER_CYCLE per period of the fastest cycles and, if still longer, diagnosed on
-#: their first MAX_SAMPLES samples (said so in the report)
+#: longer normal ones likewise (:func:`subsample_normal`). :func:`reduce_long` (decimated,
+#: anti-aliased, zero phase, to no fewer than MIN_SAMPLES_PER_CYCLE per period of the fastest
+#: cycles and cut to the first MAX_SAMPLES samples) is the route before
 MAX_SAMPLES = 24_000
 #: Model evaluations (residual calls of every fit, numerical Jacobians included) a diagnosis
 #: may spend. Typical runs use 1 000-8 000; the slowest of 657 random fuzz inputs 7 237 (a
@@ -402,6 +402,79 @@ def subsample_long(t: np.ndarray, u: np.ndarray, y: np.ndarray) -> tuple[Prepare
            "turning points between them kept in the Masing memory)"]  # fmt: skip
     if not exact:
         how.append("the input's local extrema too many: its reversals only kept as turning points")
+    if stop < n:
+        how.append(
+            f"diagnosed on its first {stop / per:.0f} of {n / per:.0f} excitation cycles "
+            f"(the fastest cycles have {fastest:.0f} samples)"
+        )
+    return d, f"the record of {n} samples was " + " and ".join(how)
+
+
+#: fewest samples per cycle of the fastest cycles that a normal record is kept at
+#: (:func:`subsample_normal`): the model integrates the pressure's cubic Hermite between kept
+#: samples with the slopes taken at the raw rate, whose error is ``(2π/s)⁴/384`` of the
+#: displacement at ``s`` samples per cycle (2e-4 at 12, a fortieth of 1 % output noise)
+MIN_KEPT_PER_CYCLE_NORMAL = 12
+
+
+def subsample_normal(t: np.ndarray, u: np.ndarray, y: np.ndarray) -> tuple[Prepared, str]:
+    """A long normal-contact record kept every q-th sample over its whole length (q from
+    the record's length, so that at most :data:`MAX_SAMPLES` are kept), ready for the
+    candidates, and a sentence saying how.
+
+    As :func:`subsample_long` does for a tangential record: the filtered pressure, its slope
+    and the cycles are computed at the raw rate and then sampled, and the displacement
+    samples kept are the measured ones (no anti-alias filter, which would act on the
+    measured displacement but not on the model's). The model integrates the pressure
+    between kept samples by its cubic Hermite with the raw-rate slopes (``d.extra["u_slope"]``),
+    so a drift, a creep and the frequency blocks are seen over the whole record, and a
+    channel delay is evaluated on the pressure at the raw shifted times
+    (:func:`contactlab.diagnose._kept.shifted`). When the fastest cycles would keep fewer
+    than :data:`MIN_KEPT_PER_CYCLE_NORMAL` samples, q is lowered and only the first
+    :data:`MAX_SAMPLES` kept samples are diagnosed (said so).
+    """
+    n = t.size
+    dt = check_uniform(t)
+    per = dominant_period_samples(u)
+    ud, udd = derivatives(u, dt, smooth_window(per))
+    cyc = find_cycles(u, per)
+    sig = input_noise(u)
+    uf, _ = filter_input(u, per, sig)
+    fastest = shortest_period_samples(u, per)
+    q = -(-n // MAX_SAMPLES)
+    if fastest / q < MIN_KEPT_PER_CYCLE_NORMAL:
+        q = max(1, int(fastest // MIN_KEPT_PER_CYCLE_NORMAL))
+    stop = min(n, (MAX_SAMPLES - 1) * q + 1)
+    g = slice(0, stop, q)
+    cycle = cyc.cycle[g].copy()
+    last = ((stop - 1) // q) * q
+    if stop < n:  # the cycle cut at the end belongs to no fold
+        cycle[cycle > np.count_nonzero(cyc.reversals[cyc.is_max] <= last) - 2] = -1
+    keep = cyc.reversals <= last
+    cycles = Cycles(
+        np.rint(cyc.reversals[keep] / q).astype(int),
+        cyc.is_max[keep],
+        cycle,
+        cyc.phase_in_branch[g],
+        per / q,
+    )
+    raw = RawInput(float(t[0]), dt, uf, ud, udd, cyc.reversals, cyc.reversals, q)
+    uk = np.ascontiguousarray(uf[g])
+    # the input noise as the candidates see it: the filtered pressure's noise, folded into
+    # the kept band (white there), read off the kept samples with no further filter
+    extra: dict[str, Any] = {
+        "u_raw": uk, "u_noise": sig, "u_filter": 0, "u_slope": np.ascontiguousarray(ud[g]),
+        "raw_input": raw,
+    }  # fmt: skip
+    d = Prepared(
+        np.ascontiguousarray(t[g]), uk, np.ascontiguousarray(y[g]), dt * q,
+        smooth_window(per / q), ud[g], udd[g], cycles, extra,
+    )  # fmt: skip
+    how = []
+    if q > 1:
+        whole = "" if stop < n else " over its whole length"
+        how.append(f"kept one sample in {q}{whole} (no filter; the pressure between them from "
+                   "its full-rate slopes)")  # fmt: skip
     if stop < n:
         how.append(
             f"diagnosed on its first {stop / per:.0f} of {n / per:.0f} excitation cycles "
@@ -775,6 +848,8 @@ def diagnose(
         d = Prepared.build(t, u, y)
     elif family.kind == "tangential" and n_in > MAX_SAMPLES:
         d, reduced = subsample_long(t, u, y)
+    elif family.kind == "normal" and n_in > MAX_SAMPLES:
+        d, reduced = subsample_normal(t, u, y)
     else:
         t, u, y, reduced = reduce_long(t, u, y)
         d = Prepared.build(t, u, y)

@@ -226,6 +226,7 @@ class _ContactModel:
         delta0: float | str = "equilibrium",
         substeps: int = 1,
         tol: float | None = None,
+        dpdt: Any = None,
     ) -> OdeResult:
         """Displacement response on the samples' own grid (fixed steps, no error control).
 
@@ -249,6 +250,9 @@ class _ContactModel:
         tol : float, optional
             Absolute tolerance (m) of each step's Newton iteration; default ``1e-12`` of
             the displacement scale ``max|p| / k_s(0)``.
+        dpdt : array_like, optional
+            The pressure's slopes at the samples (Pa/s) for the cubic continuation, instead
+            of ``numpy.gradient`` slopes (e.g. known at a higher rate than ``t``).
 
         Returns
         -------
@@ -300,6 +304,7 @@ class _ContactModel:
             d0,
             int(substeps),
             tol,
+            None if dpdt is None else np.ascontiguousarray(as_1d(dpdt, "dpdt")),
         )
         n_out = int(r["n_out"])
         res = OdeResult(

@@ -104,9 +104,10 @@ fn normal_simulate<'py>(
 }
 
 /// Eq. 17 on the samples' own grid (`grid::simulate_grid`); returns a dict like
-/// `normal_simulate`'s.
+/// `normal_simulate`'s. `dpdt`: the pressure's exact slopes at the samples (else finite
+/// differences).
 #[pyfunction]
-#[pyo3(signature = (t, p, law, coeffs, psi, omega, delta0, substeps, tol))]
+#[pyo3(signature = (t, p, law, coeffs, psi, omega, delta0, substeps, tol, dpdt=None))]
 fn normal_simulate_grid<'py>(
     py: Python<'py>,
     t: PyReadonlyArray1<'py, f64>,
@@ -118,14 +119,19 @@ fn normal_simulate_grid<'py>(
     delta0: f64,
     substeps: usize,
     tol: f64,
+    dpdt: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let ts = slice(&t, "t")?;
     let ps = slice(&p, "p")?;
     let cs = slice(&coeffs, "coeffs")?;
+    let ds = match &dpdt {
+        Some(d) => Some(slice(d, "dpdt")?),
+        None => None,
+    };
     let law = law.to_owned();
     let (mut delta, mut vel, out) = detach_guarded(py, move || {
         let model = build_model(&law, cs, psi, omega)?;
-        let forcing = Forcing::new(ts, ps, None, Interp::Cubic)?;
+        let forcing = Forcing::new(ts, ps, ds, Interp::Cubic)?;
         let n = forcing.len();
         let mut delta = vec![0.0; n];
         let mut vel = vec![0.0; n];
