@@ -221,6 +221,7 @@ def test_kept_record_of_short_cycles_is_cut_and_says_so():
     d, how = subsample_long(t, x, F)
     assert d.t.size == MAX_SAMPLES and d.dt == pytest.approx(1e-3)
     assert "first 1200 of 2000 excitation cycles" in how
+    assert "one sample in" not in how  # q = 1: nothing is thinned, the record is only cut
     assert d.cycles.cycle[-1] == -1
 
 

@@ -398,8 +398,11 @@ def subsample_long(t: np.ndarray, u: np.ndarray, y: np.ndarray) -> tuple[Prepare
         "u_raw": u[g], "u_noise": sig, "u_filter": wf, "knots": knots, "raw_input": raw,
     }  # fmt: skip
     d = Prepared(t[g], uf[g], y[g], dt * q, smooth_window(per / q), ud[g], udd[g], cycles, extra)
-    how = [f"kept one sample in {q} over its whole length (no filter; the {knots.pos.size} "
-           "turning points between them kept in the Masing memory)"]  # fmt: skip
+    how = []
+    if q > 1:
+        whole = "" if stop < n else " over its whole length"
+        how.append(f"kept one sample in {q}{whole} (no filter; the {knots.pos.size} turning "
+                   "points between them kept in the Masing memory)")  # fmt: skip
     if not exact:
         how.append("the input's local extrema too many: its reversals only kept as turning points")
     if stop < n:
