@@ -123,7 +123,7 @@ proptest! {
         }
         let mut outs: Vec<Vec<f64>> = sigs.iter().map(|s| vec![f64::NAN; s.len()]).collect();
         let stats = force_channels(
-            &models, &sigs, outs.iter_mut().map(|o| o.as_mut_slice()).collect(),
+            &models, &sigs, outs.iter_mut().map(Vec::as_mut_slice).collect(),
             &mut states, threads, piece, true,
         ).unwrap();
         for (i, (w, we)) in want.iter().enumerate() {
