@@ -19,7 +19,7 @@
 use super::{kernel, BranchRule, MasingState, Reversal};
 use crate::curve::Backbone;
 use crate::error::CoreError;
-use crate::parallel::{run_jobs, ThreadStats};
+use crate::parallel::{schedstat, ThreadStats};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
@@ -91,6 +91,24 @@ pub fn split<C: Backbone>(
     state: &MasingState,
     piece: usize,
 ) -> Result<Option<Split>, CoreError> {
+    let mut pieces = Vec::new();
+    let end = split_each(curve, scale, x, state, piece, |off, st| {
+        pieces.push((off, st));
+    })?;
+    Ok(end.map(|end| Split { pieces, end }))
+}
+
+/// [`split`] handing each boundary `(offset, start state)` to `emit` as soon as it is found
+/// (the first is `(0, state)`); returns the end state (`None`, with nothing emitted, for a
+/// state the kernel does not continue from).
+pub fn split_each<C: Backbone>(
+    curve: &C,
+    scale: f64,
+    x: &[f64],
+    state: &MasingState,
+    piece: usize,
+    mut emit: impl FnMut(usize, MasingState),
+) -> Result<Option<MasingState>, CoreError> {
     crate::error::check_positive("scale", scale)?;
     if !kernel::all_finite(x) {
         crate::error::check_finite("x", x)?;
@@ -109,12 +127,12 @@ pub fn split<C: Backbone>(
         .collect();
     let (mut xp, mut dir) = (state.x, f64::from(state.dir));
     let mut tgt = target(&stk, dir);
-    let mut pieces = vec![(0_usize, state.clone())];
+    emit(0, state.clone());
     let mut offset = 0_usize;
     for xc in x.chunks(piece) {
         if offset > 0 && stk.len() <= (piece / 4).saturating_add(64) {
             let h = resolve(curve, lam, inv, &mut stk, xp);
-            pieces.push((
+            emit(
                 offset,
                 MasingState {
                     x: xp,
@@ -123,7 +141,7 @@ pub fn split<C: Backbone>(
                     count: start.saturating_add(offset as u64), // <= end, checked
                     stack: stk.iter().map(|e| e.r).collect(),
                 },
-            ));
+            );
         }
         for (p, &xi) in xc.iter().enumerate() {
             let dx = xi - xp;
@@ -168,14 +186,13 @@ pub fn split<C: Backbone>(
     } else {
         resolve(curve, lam, inv, &mut stk, xp)
     };
-    let end = MasingState {
+    Ok(Some(MasingState {
         x: xp,
         h,
         dir: dir as i8,
         count: end,
         stack: stk.iter().map(|e| e.r).collect(),
-    };
-    Ok(Some(Split { pieces, end }))
+    }))
 }
 
 /// Forces of one piece of a [`split`] channel into `out` (same length), from its start
@@ -199,14 +216,16 @@ pub fn force_piece<C: Backbone>(
 
 /// A channel's model, as [`force_channels`] sees it.
 pub trait Channel: Sync {
-    /// The pieces of `x` from `state` ([`split`]), or `None` to run it whole (a branch
-    /// rule other than the scaled one, or a state the kernel does not continue from).
+    /// The pieces of `x` from `state`, each boundary to `emit` as found ([`split_each`]);
+    /// the end state, or `None` (nothing emitted) to run it whole (a branch rule other than
+    /// the scaled one, or a state the kernel does not continue from).
     fn split(
         &self,
         x: &[f64],
         state: &MasingState,
         piece: usize,
-    ) -> Result<Option<Split>, CoreError>;
+        emit: &mut dyn FnMut(usize, MasingState),
+    ) -> Result<Option<MasingState>, CoreError>;
     /// One piece ([`force_piece`]).
     fn piece(&self, x: &[f64], out: &mut [f64], state: &mut MasingState)
         -> Result<bool, CoreError>;
@@ -226,9 +245,10 @@ impl<C: Backbone + Sync> Channel for Model<'_, C> {
         x: &[f64],
         state: &MasingState,
         piece: usize,
-    ) -> Result<Option<Split>, CoreError> {
+        emit: &mut dyn FnMut(usize, MasingState),
+    ) -> Result<Option<MasingState>, CoreError> {
         match self.rule {
-            BranchRule::Scaled(l) => split(self.curve, l, x, state, piece),
+            BranchRule::Scaled(l) => split_each(self.curve, l, x, state, piece, emit),
             BranchRule::Anchored(_) => Ok(None),
         }
     }
@@ -250,31 +270,110 @@ impl<C: Backbone + Sync> Channel for Model<'_, C> {
     }
 }
 
-/// A unit of the second phase of [`force_channels`].
+/// A unit of work of [`force_channels`].
+enum Work<'a> {
+    /// Run the pre-pass of a channel, queueing its pieces as their boundaries are found.
+    Split { x: &'a [f64], out: &'a mut [f64] },
+    /// A piece of a split channel, from its start state.
+    Piece {
+        x: &'a [f64],
+        out: &'a mut [f64],
+        state: MasingState,
+    },
+    /// A whole channel, serially.
+    Whole { x: &'a [f64], out: &'a mut [f64] },
+}
+
+/// A queued unit: popped by (`rank`, samples) largest first, then in order of queueing.
 struct Job<'a> {
     channel: usize,
-    x: &'a [f64],
-    out: &'a mut [f64],
-    state: MasingState,
-    /// A piece of a split channel (else the whole channel).
-    piece: bool,
+    rank: u8,
+    size: usize,
+    seq: usize,
+    work: Work<'a>,
+}
+
+impl Job<'_> {
+    fn key(&self) -> (u8, usize, std::cmp::Reverse<usize>) {
+        (self.rank, self.size, std::cmp::Reverse(self.seq))
+    }
+}
+impl PartialEq for Job<'_> {
+    fn eq(&self, o: &Self) -> bool {
+        self.key() == o.key()
+    }
+}
+impl Eq for Job<'_> {}
+impl PartialOrd for Job<'_> {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Job<'_> {
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        self.key().cmp(&o.key())
+    }
+}
+
+/// The shared queue: jobs, and pre-passes not finished (more pieces may come).
+struct Queue<'a> {
+    jobs: std::collections::BinaryHeap<Job<'a>>,
+    pending: usize,
+    seq: usize,
 }
 
 /// What one channel's run came to.
 #[derive(Default)]
 struct Outcome {
-    split: Option<Result<Option<Split>, CoreError>>,
     error: Option<CoreError>,
     end: Option<MasingState>,
+    nonfinite: bool,
+}
+
+/// Which channels to split (`threads > 1`): any longer than an even share of the total
+/// (it would hold one thread up), then the shortest splittable ones until the split total
+/// reaches the longest channel, so that the pieces can even out what whole channels leave
+/// unequal (threads of unequal speed included) while as little as possible pays the
+/// pre-pass.
+fn to_split(lens: &[usize], threads: usize, piece: usize) -> Vec<bool> {
+    let mut pick = vec![false; lens.len()];
+    if threads < 2 {
+        return pick;
+    }
+    let total: usize = lens.iter().fold(0, |a, &n| a.saturating_add(n));
+    let longest = lens.iter().copied().max().unwrap_or(0);
+    let share = total.checked_div(threads).unwrap_or(total);
+    let min = piece.saturating_mul(2);
+    let mut got = 0_usize;
+    for (c, &n) in lens.iter().enumerate() {
+        if n >= min && n > share {
+            pick[c] = true;
+            got = got.saturating_add(n);
+        }
+    }
+    let mut order: Vec<usize> = (0..lens.len()).filter(|&c| lens[c] >= min).collect();
+    order.sort_by_key(|&c| (lens[c], c));
+    for c in order {
+        if got >= longest {
+            break;
+        }
+        if !pick[c] {
+            pick[c] = true;
+            got = got.saturating_add(lens[c]);
+        }
+    }
+    pick
 }
 
 /// Forces of several channels on up to `threads` threads, each continuing from its state in
-/// `states` (updated on success; all unchanged on error). Channels of at least two pieces
-/// are [`split`] (first phase, one channel per job) and their pieces run as jobs of their own
-/// (second phase, pieces and whole channels from one queue, longest first); with one thread
-/// nothing is split. Outputs are those of the serial kernel bit for bit. The error is that of
-/// the lowest-numbered failing channel. Per-thread statistics cover both phases; `prepass`
-/// and `prepass_cpu` are the first phase's share.
+/// `states` (updated on success; all unchanged on error), bit for bit the serial kernel.
+///
+/// One queue holds three kinds of job: the pre-pass of the channels chosen for splitting
+/// (first: their pieces are queued as the pass finds each boundary, so other threads start
+/// on them at once), whole channels (longest first), then pieces (largest first). With one
+/// thread nothing is split. The error is that of the lowest-numbered failing channel.
+/// Per-thread statistics: jobs and samples of forces (pieces and whole channels), times
+/// from the call's start, CPU and wait; `prepass` and `prepass_cpu` the pre-passes' share.
 pub fn force_channels(
     models: &[&dyn Channel],
     xs: &[&[f64]],
@@ -295,100 +394,184 @@ pub fn force_channels(
     }
     let piece = piece.max(1);
     let t0 = Instant::now();
+    let lens: Vec<usize> = xs.iter().map(|x| x.len()).collect();
+    let pick = to_split(&lens, threads, piece);
     let outcomes: Vec<Mutex<Outcome>> = (0..nch).map(|_| Mutex::new(Outcome::default())).collect();
-    let put = |c: usize, f: &dyn Fn(&mut Outcome)| {
+    let mut heap = std::collections::BinaryHeap::with_capacity(nch);
+    for (c, out) in outs.iter_mut().enumerate() {
+        let out: &mut [f64] = out;
+        let x = xs[c];
+        let (rank, work) = if pick[c] {
+            (2, Work::Split { x, out })
+        } else {
+            (1, Work::Whole { x, out })
+        };
+        heap.push(Job {
+            channel: c,
+            rank,
+            size: x.len(),
+            seq: c,
+            work,
+        });
+    }
+    let pending = pick.iter().filter(|&&p| p).count();
+    let queue = Mutex::new(Queue {
+        jobs: heap,
+        pending,
+        seq: nch,
+    });
+    let ready = std::sync::Condvar::new();
+    let failed = AtomicBool::new(false);
+    // Pieces may come: every thread; else no more threads than channels.
+    let workers = if pending > 0 {
+        threads
+    } else {
+        threads.min(nch)
+    }
+    .max(1);
+    let starts: &[MasingState] = states;
+    let note = |c: usize, f: &mut dyn FnMut(&mut Outcome)| {
         if let Ok(mut o) = outcomes[c].lock() {
             f(&mut o);
         }
     };
-    // Phase 1: split the channels worth splitting.
-    let wide = threads > 1;
-    let to_split: Vec<usize> = (0..nch)
-        .filter(|&c| wide && xs[c].len() >= piece.saturating_mul(2))
-        .collect();
-    let first = if to_split.is_empty() {
-        Vec::new()
-    } else {
-        run_jobs(
-            to_split,
-            threads,
-            cpu_times,
-            |&c| xs[c].len(),
-            |_, c| {
-                let r = models[c].split(xs[c], &states[c], piece);
-                put(c, &|o| o.split = Some(r.clone()));
-                Ok(())
-            },
-        )?
-    };
-    let t1 = t0.elapsed().as_secs_f64();
-    // Phase 2: pieces and whole channels.
-    let mut jobs: Vec<Job<'_>> = Vec::new();
-    for (c, out) in outs.iter_mut().enumerate() {
-        let x = xs[c];
-        let sp = outcomes[c].lock().ok().and_then(|mut o| o.split.take());
-        match sp {
-            Some(Err(e)) => put(c, &|o| o.error = Some(e.clone())),
-            Some(Ok(Some(s))) => {
-                let offs: Vec<usize> = s.pieces.iter().map(|p| p.0).skip(1).collect();
-                let mut rest_x = x;
-                let mut rest_o: &mut [f64] = out;
-                let mut at = 0_usize;
-                for (k, (_, st)) in s.pieces.into_iter().enumerate() {
-                    let next = offs.get(k).copied().unwrap_or(x.len());
-                    let len = next.saturating_sub(at).min(rest_x.len());
-                    let (px, tx) = rest_x.split_at(len);
-                    let (po, to) = std::mem::take(&mut rest_o).split_at_mut(len);
-                    (rest_x, rest_o) = (tx, to);
-                    at = next;
-                    jobs.push(Job {
-                        channel: c,
-                        x: px,
-                        out: po,
-                        state: st,
-                        piece: true,
+    let worker = || -> ThreadStats {
+        let before = if cpu_times { schedstat() } else { None };
+        let mut st = ThreadStats {
+            start: t0.elapsed().as_secs_f64(),
+            ..ThreadStats::default()
+        };
+        let mut pre_cpu = 0.0_f64;
+        loop {
+            let job = {
+                let Ok(mut q) = queue.lock() else { break };
+                loop {
+                    if failed.load(Ordering::Relaxed) {
+                        break None;
+                    }
+                    if let Some(j) = q.jobs.pop() {
+                        break Some(j);
+                    }
+                    if q.pending == 0 {
+                        break None;
+                    }
+                    match ready.wait(q) {
+                        Ok(g) => q = g,
+                        Err(_) => return st,
+                    }
+                }
+            };
+            let Some(Job {
+                channel: c, work, ..
+            }) = job
+            else {
+                break;
+            };
+            match work {
+                Work::Split { x, out } => {
+                    let (w0, c0) = (
+                        t0.elapsed().as_secs_f64(),
+                        cpu_times.then(schedstat).flatten(),
+                    );
+                    let mut rest_x = x;
+                    let mut rest_o: &mut [f64] = out;
+                    let mut prev: Option<(usize, MasingState)> = None;
+                    let mut cut = |upto: usize, next: Option<(usize, MasingState)>| {
+                        if let Some((off, state)) = prev.take() {
+                            let len = upto.saturating_sub(off).min(rest_x.len());
+                            let (px, tx) = rest_x.split_at(len);
+                            let (po, to) = std::mem::take(&mut rest_o).split_at_mut(len);
+                            (rest_x, rest_o) = (tx, to);
+                            if let Ok(mut q) = queue.lock() {
+                                let seq = q.seq;
+                                q.seq = seq.saturating_add(1);
+                                q.jobs.push(Job {
+                                    channel: c,
+                                    rank: 0,
+                                    size: len,
+                                    seq,
+                                    work: Work::Piece {
+                                        x: px,
+                                        out: po,
+                                        state,
+                                    },
+                                });
+                                ready.notify_one();
+                            }
+                        }
+                        prev = next;
+                    };
+                    let r = models[c].split(x, &starts[c], piece, &mut |off, s| {
+                        cut(off, Some((off, s)));
                     });
+                    match r {
+                        Ok(Some(end)) => {
+                            cut(x.len(), None);
+                            note(c, &mut |o| o.end = Some(end.clone()));
+                        }
+                        Ok(None) => {
+                            // not splittable: run whole
+                            st.jobs = st.jobs.saturating_add(1);
+                            st.samples = st.samples.saturating_add(x.len());
+                            let mut s = starts[c].clone();
+                            match models[c].whole(rest_x, rest_o, &mut s) {
+                                Ok(()) => note(c, &mut |o| o.end = Some(s.clone())),
+                                Err(e) => note(c, &mut |o| o.error = Some(e.clone())),
+                            }
+                        }
+                        Err(e) => {
+                            note(c, &mut |o| o.error = Some(e.clone()));
+                        }
+                    }
+                    if let Ok(mut q) = queue.lock() {
+                        q.pending = q.pending.saturating_sub(1);
+                    }
+                    ready.notify_all();
+                    st.prepass += t0.elapsed().as_secs_f64() - w0;
+                    if let (Some(a), Some(b)) = (c0, c0.and_then(|_| schedstat())) {
+                        pre_cpu += b.0.saturating_sub(a.0) as f64 * 1e-9;
+                    }
                 }
-                put(c, &|o| o.end = Some(s.end.clone()));
+                Work::Piece { x, out, mut state } => {
+                    st.jobs = st.jobs.saturating_add(1);
+                    st.samples = st.samples.saturating_add(x.len());
+                    match models[c].piece(x, out, &mut state) {
+                        Ok(true) => {}
+                        Ok(false) => note(c, &mut |o| o.nonfinite = true),
+                        Err(e) => note(c, &mut |o| o.error = Some(e.clone())),
+                    }
+                }
+                Work::Whole { x, out } => {
+                    st.jobs = st.jobs.saturating_add(1);
+                    st.samples = st.samples.saturating_add(x.len());
+                    let mut s = starts[c].clone();
+                    match models[c].whole(x, out, &mut s) {
+                        Ok(()) => note(c, &mut |o| o.end = Some(s.clone())),
+                        Err(e) => note(c, &mut |o| o.error = Some(e.clone())),
+                    }
+                }
             }
-            Some(Ok(None)) | None => jobs.push(Job {
-                channel: c,
-                x,
-                out,
-                state: states[c].clone(),
-                piece: false,
-            }),
         }
-    }
-    let bad: Vec<AtomicBool> = (0..nch).map(|_| AtomicBool::new(false)).collect();
-    let second = run_jobs(
-        jobs,
-        threads,
-        cpu_times,
-        |j| j.x.len(),
-        |_, j| {
-            let Job {
-                channel: c,
-                x,
-                out,
-                mut state,
-                piece,
-            } = j;
-            if piece {
-                match models[c].piece(x, out, &mut state) {
-                    Ok(true) => {}
-                    Ok(false) => bad[c].store(true, Ordering::Relaxed),
-                    Err(e) => put(c, &|o| o.error = Some(e.clone())),
-                }
-            } else {
-                match models[c].whole(x, out, &mut state) {
-                    Ok(()) => put(c, &|o| o.end = Some(state.clone())),
-                    Err(e) => put(c, &|o| o.error = Some(e.clone())),
-                }
-            }
-            Ok(())
-        },
-    )?;
+        st.end = t0.elapsed().as_secs_f64();
+        if let (Some(a), Some(b)) = (before, before.and_then(|_| schedstat())) {
+            st.cpu = Some(b.0.saturating_sub(a.0) as f64 * 1e-9);
+            st.wait = Some(b.1.saturating_sub(a.1) as f64 * 1e-9);
+            st.prepass_cpu = Some(pre_cpu);
+        }
+        st
+    };
+    let stats: Vec<ThreadStats> = if workers == 1 {
+        vec![worker()]
+    } else {
+        std::thread::scope(|s| {
+            let handles: Vec<_> = (0..workers).map(|_| s.spawn(worker)).collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+                .collect()
+        })
+    };
+    drop(queue);
     // The lowest-numbered failing channel's error; else every state advances.
     let mut ends = Vec::with_capacity(nch);
     for (c, cell) in outcomes.into_iter().enumerate() {
@@ -396,12 +579,12 @@ pub fn force_channels(
         if let Some(e) = o.error {
             return Err(e);
         }
-        if bad[c].load(Ordering::Relaxed) {
+        if o.nonfinite {
             crate::error::check_output("force", outs[c])?;
         }
         ends.push(o.end);
     }
-    for ((st, end), out) in states.iter_mut().zip(ends).zip(&outs) {
+    for (st, (end, out)) in states.iter_mut().zip(ends.into_iter().zip(&outs)) {
         if let Some(mut e) = end {
             // the last output, as the serial kernel keeps it
             if let Some(&h) = out.last() {
@@ -410,32 +593,5 @@ pub fn force_channels(
             *st = e;
         }
     }
-    Ok(merge(&first, &second, t1))
-}
-
-/// Per-thread statistics of both phases: the second's jobs and samples, times from the
-/// call's start, CPU and wait summed; `prepass` (wall) and `prepass_cpu` from the first.
-fn merge(first: &[ThreadStats], second: &[ThreadStats], t1: f64) -> Vec<ThreadStats> {
-    let n = first.len().max(second.len());
-    (0..n)
-        .map(|k| {
-            let a = first.get(k);
-            let b = second.get(k);
-            let add = |u: Option<f64>, v: Option<f64>| match (u, v) {
-                (Some(u), Some(v)) => Some(u + v),
-                (u, None) => u,
-                (None, v) => v,
-            };
-            ThreadStats {
-                jobs: b.map_or(0, |b| b.jobs),
-                samples: b.map_or(0, |b| b.samples),
-                start: a.map_or_else(|| b.map_or(t1, |b| t1 + b.start), |a| a.start),
-                end: b.map_or_else(|| a.map_or(t1, |a| a.end), |b| t1 + b.end),
-                cpu: add(a.and_then(|a| a.cpu), b.and_then(|b| b.cpu)),
-                wait: add(a.and_then(|a| a.wait), b.and_then(|b| b.wait)),
-                prepass: a.map_or(0.0, |a| a.end - a.start),
-                prepass_cpu: a.and_then(|a| a.cpu),
-            }
-        })
-        .collect()
+    Ok(stats)
 }

@@ -41,7 +41,7 @@ pub struct ThreadStats {
 }
 
 /// `(on-CPU ns, run-queue wait ns)` of the calling thread from `/proc/thread-self/schedstat`.
-fn schedstat() -> Option<(u64, u64)> {
+pub(crate) fn schedstat() -> Option<(u64, u64)> {
     let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
     let mut it = s.split_ascii_whitespace().map(str::parse::<u64>);
     match (it.next(), it.next()) {

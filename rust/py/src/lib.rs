@@ -264,9 +264,10 @@ impl masing::split::Channel for MasingCore {
         x: &[f64],
         state: &MasingState,
         piece: usize,
-    ) -> Result<Option<masing::split::Split>, CoreError> {
+        emit: &mut dyn FnMut(usize, MasingState),
+    ) -> Result<Option<MasingState>, CoreError> {
         let rule = self.rule();
-        with_curve!(&self.curve, curve => masing::split::Model { curve, rule }.split(x, state, piece))
+        with_curve!(&self.curve, curve => masing::split::Model { curve, rule }.split(x, state, piece, emit))
     }
     fn piece(
         &self,
