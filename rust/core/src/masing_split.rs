@@ -125,74 +125,201 @@ pub fn split_each<C: Backbone>(
         .iter()
         .map(|&r| Entry { r, known: true })
         .collect();
-    let (mut xp, mut dir) = (state.x, f64::from(state.dir));
-    let mut tgt = target(&stk, dir);
+    // `stk[..n]` is the stack; above it, room for a candidate per sample of a block.
+    let mut n = stk.len();
+    let mut w = Walk {
+        xp: state.x,
+        dir: f64::from(state.dir),
+        h0: state.h,
+        start,
+    };
     emit(0, state.clone());
     let mut offset = 0_usize;
+    let mut dense = false;
     for xc in x.chunks(piece) {
-        if offset > 0 && stk.len() <= (piece / 4).saturating_add(64) {
-            let h = resolve(curve, lam, inv, &mut stk, xp);
+        if offset > 0 && n <= (piece / 4).saturating_add(64) {
+            let h = resolve(curve, lam, inv, &mut stk[..n], w.xp);
             emit(
                 offset,
                 MasingState {
-                    x: xp,
+                    x: w.xp,
                     h,
-                    dir: dir as i8,
+                    dir: w.dir as i8,
                     count: start.saturating_add(offset as u64), // <= end, checked
-                    stack: stk.iter().map(|e| e.r).collect(),
+                    stack: stk[..n].iter().map(|e| e.r).collect(),
                 },
             );
         }
-        for (p, &xi) in xc.iter().enumerate() {
-            let dx = xi - xp;
-            // Moving on along the branch without reaching its closure point.
-            if dx * dir > 0.0 && (xi - tgt) * dir < 0.0 {
-                xp = xi;
-                continue;
+        let mut at = offset;
+        for xb in xc.chunks(BLK) {
+            let need = n.saturating_add(xb.len()).saturating_add(1);
+            if stk.len() < need {
+                stk.resize(need, SPARE);
             }
-            if dx == 0.0 {
-                continue; // a zero-length step changes nothing
-            }
-            let s = if dx > 0.0 { 1.0 } else { -1.0 };
-            if s != dir {
-                if dir != 0.0 {
-                    // The reversal is the previous sample. At the call's first sample its
-                    // force is the state's (as the kernel takes it), otherwise evaluated
-                    // when a boundary needs it.
-                    let i = offset.saturating_add(p);
-                    stk.push(Entry {
-                        r: Reversal {
-                            x: xp,
-                            h: state.h,
-                            index: start.saturating_add(i as u64).saturating_sub(1),
-                        },
-                        known: i == 0,
-                    });
-                }
-                dir = s;
-            }
-            // Wipe out every loop this step closes.
-            while !stk.is_empty() && (xi - target(&stk, s)) * s >= 0.0 {
-                let n = stk.len();
-                stk.truncate(n.saturating_sub(n.min(2)));
-            }
-            tgt = target(&stk, dir);
-            xp = xi;
+            let changes = if dense && w.dir != 0.0 && at > 0 {
+                w.dense(&mut stk, &mut n, xb, at)
+            } else {
+                w.smooth(&mut stk, &mut n, xb, at)
+            };
+            dense = changes.saturating_mul(8) > xb.len();
+            at = at.saturating_add(xb.len());
         }
         offset = offset.saturating_add(xc.len());
     }
     let h = if x.is_empty() {
         state.h
     } else {
-        resolve(curve, lam, inv, &mut stk, xp)
+        resolve(curve, lam, inv, &mut stk[..n], w.xp)
     };
     Ok(Some(MasingState {
-        x: xp,
+        x: w.xp,
         h,
-        dir: dir as i8,
+        dir: w.dir as i8,
         count: end,
-        stack: stk.iter().map(|e| e.r).collect(),
+        stack: stk[..n].iter().map(|e| e.r).collect(),
     }))
+}
+
+/// Samples per block of the pre-pass (the path for a block follows the branch changes of
+/// the one before, as in the kernel).
+const BLK: usize = 512;
+
+/// Written above the stack top.
+const SPARE: Entry = Entry {
+    r: Reversal {
+        x: 0.0,
+        h: 0.0,
+        index: 0,
+    },
+    known: false,
+};
+
+/// The pre-pass's walk through the memory rules: last input, direction, the state's force
+/// (that of a reversal at the call's first sample) and the call's first global index.
+struct Walk {
+    xp: f64,
+    dir: f64,
+    h0: f64,
+    start: u64,
+}
+
+impl Walk {
+    /// The rules for input `xi` at call position `i` (the serial kernel's: a reversal at the
+    /// previous sample, then every closure the step makes); `stk[..*n]` the stack with room
+    /// above. Returns whether the branch changed.
+    #[inline(always)]
+    fn rules(&mut self, stk: &mut [Entry], n: &mut usize, xi: f64, i: usize) -> bool {
+        let dx = xi - self.xp;
+        if dx == 0.0 {
+            return false; // a zero-length step changes nothing
+        }
+        let s = if dx > 0.0 { 1.0 } else { -1.0 };
+        let rev = s != self.dir && self.dir != 0.0;
+        if rev {
+            // The reversal is the previous sample. At the call's first sample its force is
+            // the state's (as the kernel takes it), otherwise evaluated when a boundary
+            // needs it.
+            stk[*n] = Entry {
+                r: Reversal {
+                    x: self.xp,
+                    h: self.h0,
+                    index: self.start.saturating_add(i as u64).saturating_sub(1),
+                },
+                known: i == 0,
+            };
+            *n = n.saturating_add(1);
+        }
+        self.dir = s;
+        let before = *n;
+        // Wipe out every loop this step closes.
+        while *n > 0 && (xi - target(&stk[..*n], s)) * s >= 0.0 {
+            *n = n.saturating_sub((*n).min(2));
+        }
+        self.xp = xi;
+        rev || *n != before
+    }
+
+    /// A block where the input mostly moves on along its branch: a predicted test per
+    /// sample, the rules elsewhere. Returns the number of branch changes.
+    #[inline(never)]
+    fn smooth(&mut self, stk: &mut [Entry], n: &mut usize, xb: &[f64], at: usize) -> usize {
+        let mut tgt = target(&stk[..*n], self.dir);
+        let mut changes = 0_usize;
+        for (p, &xi) in xb.iter().enumerate() {
+            let dx = xi - self.xp;
+            // Moving on along the branch without reaching its closure point.
+            if dx * self.dir > 0.0 && (xi - tgt) * self.dir < 0.0 {
+                self.xp = xi;
+                continue;
+            }
+            if self.rules(stk, n, xi, at.saturating_add(p)) {
+                changes = changes.saturating_add(1);
+            }
+            tgt = target(&stk[..*n], self.dir);
+        }
+        changes
+    }
+
+    /// A block where the input reverses every sample or two (a random walk, broadband
+    /// noise): the candidate reversal is always written above the top and the top raised
+    /// by 0 or 1 and lowered by 0 or 2 by arithmetic on the comparisons, with no
+    /// data-dependent branch (the kernel's dense path, without the forces). Left to
+    /// [`Walk::rules`]: a stack of fewer than two reversals or a closure down to one, a
+    /// step closing two loops or more, a zero-length step. Needs `dir != 0` and `at > 0`.
+    #[inline(never)]
+    // `&` on booleans on purpose: no branch per condition.
+    #[allow(clippy::needless_bitwise_bool)]
+    fn dense(&mut self, stk: &mut [Entry], n: &mut usize, xb: &[f64], at: usize) -> usize {
+        let mut changes = 0_usize;
+        let (mut k, mut xp, mut up) = (*n, self.xp, self.dir > 0.0);
+        let before = self.start.saturating_add(at as u64).saturating_sub(1);
+        for (p, &xi) in xb.iter().enumerate() {
+            if xi == xp {
+                continue;
+            }
+            let rising = xi > xp;
+            if k < 2 {
+                (self.xp, self.dir) = (xp, if up { 1.0 } else { -1.0 });
+                let c = self.rules(stk, &mut k, xi, at.saturating_add(p));
+                changes = changes.saturating_add(usize::from(c));
+                (xp, up) = (self.xp, self.dir > 0.0);
+                continue;
+            }
+            let rev = rising != up;
+            stk[k] = Entry {
+                r: Reversal {
+                    x: xp,
+                    h: 0.0,
+                    index: before.wrapping_add(p as u64),
+                },
+                known: false,
+            };
+            let k1 = k.wrapping_add(usize::from(rev)); // >= 2
+            let t = stk[k1.wrapping_sub(2)].r.x;
+            let closes = (rising & (xi >= t)) | (!rising & (xi <= t));
+            if closes & (k1 < 4) {
+                (self.xp, self.dir) = (xp, if up { 1.0 } else { -1.0 });
+                let c = self.rules(stk, &mut k, xi, at.saturating_add(p));
+                changes = changes.saturating_add(usize::from(c));
+                (xp, up) = (self.xp, self.dir > 0.0);
+                continue;
+            }
+            k = k1.wrapping_sub(usize::from(closes) << 1); // >= 2
+            up = rising;
+            xp = xi;
+            changes = changes.wrapping_add(usize::from(rev | closes));
+            let below = stk[k.wrapping_sub(2)].r.x;
+            if closes & ((rising & (xi >= below)) | (!rising & (xi <= below))) {
+                // the step closes further loops (a large jump)
+                let s = if rising { 1.0 } else { -1.0 };
+                while k > 0 && (xi - target(&stk[..k], s)) * s >= 0.0 {
+                    k = k.saturating_sub(k.min(2));
+                }
+            }
+        }
+        (*n, self.xp, self.dir) = (k, xp, if up { 1.0 } else { -1.0 });
+        changes
+    }
 }
 
 /// Forces of one piece of a [`split`] channel into `out` (same length), from its start

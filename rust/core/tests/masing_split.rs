@@ -1,6 +1,7 @@
 //! A channel split into pieces ([`split`]) and run on several threads ([`force_channels`])
 //! against the serial kernel: forces and final states bit for bit, over random signals
-//! (reversals at piece edges included: pieces of 1 to 40 samples), start states, piece
+//! (reversals at piece edges included: pieces of 1 to 40 samples, and 300 to 2000 so that
+//! the pre-pass takes its dense path on whole blocks), start states, piece
 //! lengths and thread counts, for both curve kinds and both branch rules.
 
 use contactlab_core::curve::{Exponential, Tabulated};
@@ -65,7 +66,8 @@ proptest! {
     /// split's end state is the serial one.
     #[test]
     fn pieces_equal_the_serial_kernel_bit_for_bit(
-        x in signal(), prefix in 0usize..600, piece in 1usize..40, lam in 1.5f64..2.5,
+        x in signal(), prefix in 0usize..600, piece in prop_oneof![1usize..40, 300usize..2000],
+        lam in 1.5f64..2.5,
     ) {
         let c = Exponential::new(40.0, 4.0e4).unwrap();
         // a start state from a prefix of the signal (the origin when empty)
