@@ -102,21 +102,23 @@ class Masing:
         x: Any,
         state: Any = None,
         out: np.ndarray | None = None,
-        threads: int | None = None,
+        threads: int | None = 1,
     ) -> np.ndarray:
         """Force for the displacement history ``x`` (starting at the origin unless ``state``).
 
         ``out``: a float64 array of the same length to write into (reused between calls, as a
         fit's model evaluations do); returned. ``threads``: Rust threads for one long record
-        (default: every CPU from 2^20 samples on, one below). The record is then cut into
-        pieces whose start states a comparisons-only pre-pass finds, and the pieces share the
-        threads; the forces are those of one thread bit for bit.
+        (``None``: every CPU; default 1, so that callers already running in parallel do not
+        oversubscribe). From 2^17 samples on the record is then cut into pieces of 2^16 whose
+        start states a comparisons-only pre-pass finds (costing 0.1-0.6 of the force
+        kernel's CPU, by how often the input reverses), and the pieces share the threads;
+        the forces are those of one thread bit for bit.
         """
         xa = as_1d(x, "x", finite=False)  # the core names a non-finite sample's index
         op = self.operator()
         if state is not None:
             op.state = state
-        return op.push(xa, out=out, threads=_threads_for(threads, xa.size))
+        return op.push(xa, out=out, threads=_threads_for(threads))
 
     def operator(self) -> MasingOperator:
         """A stateful operator for streaming a recording chunk by chunk."""
@@ -162,23 +164,17 @@ class Masing:
         return restore(np.ascontiguousarray(k), x, sc)
 
 
-#: Samples from which ``Masing.force`` uses every CPU by default.
-_SPLIT_FROM = 1 << 20
-
-
 def _check_threads(threads: Any) -> int:
     if isinstance(threads, bool) or not (isinstance(threads, int | np.integer) and threads >= 1):
         raise InputError(f"threads must be an integer >= 1, got {threads!r}")
     return int(threads)
 
 
-def _threads_for(threads: int | None, n: int) -> int:
-    """``threads``, or by default every CPU for a long record and one for a short one."""
+def _threads_for(threads: int | None) -> int:
+    """``threads``, or every CPU for ``None``."""
     import os
 
-    if threads is None:
-        return (os.cpu_count() or 1) if n >= _SPLIT_FROM else 1
-    return _check_threads(threads)
+    return (os.cpu_count() or 1) if threads is None else _check_threads(threads)
 
 
 @contextlib.contextmanager
