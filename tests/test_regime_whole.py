@@ -148,6 +148,6 @@ def test_long_runs_are_the_runs_at_least_that_long():
     mask = rng.random(5000) < 0.8
     for min_len in (1, 4, 9):
         want = [(int(a), int(b)) for a, b in ref._runs(mask) if b - a >= min_len]
-        assert regime._long_runs(mask, min_len) == want
-    assert regime._long_runs(np.zeros(0, bool), 4) == []
-    assert regime._long_runs(np.ones(6, bool), 4) == [(0, 6)]
+        assert regime.long_runs(mask, min_len) == want
+    assert regime.long_runs(np.zeros(0, bool), 4) == []
+    assert regime.long_runs(np.ones(6, bool), 4) == [(0, 6)]

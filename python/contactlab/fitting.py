@@ -725,11 +725,7 @@ def _finish(
             factor = 1.0 / rscale**2
         cov_s = inv * factor
         covar = cov_s * np.outer(scale, scale)
-        d = np.sqrt(np.clip(np.diag(covar), 0.0, None))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            correl = covar / np.outer(d, d)
-        correl[~np.isfinite(correl)] = 0.0
-        np.fill_diagonal(correl, 1.0)
+        d, correl = stderr_and_correl(covar)
         for i, n in enumerate(names):
             p = ps[n]
             if p.identifiable is False:
@@ -799,14 +795,22 @@ def add_covariance(fit: FitResult, extra: np.ndarray, *, note: str | None = None
     return with_covariance(fit, fit.covar + 0.5 * (extra + extra.T), note=note)
 
 
-def with_covariance(fit: FitResult, covar: np.ndarray, *, note: str | None = None) -> FitResult:
-    """``fit`` with the parameter covariance ``covar``: standard errors and correlations
-    follow from it, and ``note`` (if any) is added to the fit's notes."""
+def stderr_and_correl(covar: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Standard errors (the root of the covariance's diagonal, negative round-off clipped to
+    zero) and the correlation matrix; a parameter with zero variance gets zero correlation
+    with every other and 1 with itself."""
     d = np.sqrt(np.clip(np.diag(covar), 0.0, None))
     with np.errstate(divide="ignore", invalid="ignore"):
         correl = covar / np.outer(d, d)
     correl[~np.isfinite(correl)] = 0.0
     np.fill_diagonal(correl, 1.0)
+    return d, correl
+
+
+def with_covariance(fit: FitResult, covar: np.ndarray, *, note: str | None = None) -> FitResult:
+    """``fit`` with the parameter covariance ``covar``: standard errors and correlations
+    follow from it, and ``note`` (if any) is added to the fit's notes."""
+    d, correl = stderr_and_correl(covar)
     params = {n: replace(p) for n, p in fit.params.items()}
     for i, n in enumerate(fit.var_names):
         if params[n].stderr is not None:

@@ -49,7 +49,7 @@ import numpy as np
 from ..errors import InputError
 from ..masing import Masing, loop_area
 from ._family import Candidate, ParamSpec, Prepared, implausible_common
-from ._filters import savgol_filter
+from ._filters import savgol_coeffs, savgol_filter
 from ._kept import delayed, span
 from ._signal import Knots, modulation_gains, shift
 from .scaled_masing import memory, scaled_force
@@ -249,6 +249,12 @@ ANCHOR_SIGMAS = 3.0
 ANCHOR_BAND = 2.0
 
 
+def _sg_dot(window: int, deriv: int, dt: float) -> np.ndarray:
+    """Cubic Savitzky-Golay weights of the ``deriv``-th derivative, dot orientation (as
+    :func:`contactlab.tangential.frame.savgol_coefficients`, in numpy)."""
+    return savgol_coeffs(window, 3, deriv, dt)[::-1]
+
+
 def _fixed(d: Prepared, key: str, make: Callable[[], Any]) -> Any:
     """An array of the model evaluation that depends on the recording only (not on the
     fitted parameters): computed on the first evaluation, then reused by every fit on ``d``
@@ -404,6 +410,81 @@ class TangentialFamily:
             f"plateau and ac ≥ {self.ac_floor:.3g} 1/m (only a lower bound is identified)"
         )
 
+    #: a stick changes the force by at least this share of its range (1st to 99th
+    #: percentile) while the displacement stands still (:meth:`sticking`)
+    STICK_FORCE_SHARE = 0.25
+
+    def sticking(self, d: Prepared) -> np.ndarray:
+        """The samples where the contact sticks: the displacement stands still within its
+        noise (``|v| < 3 σv``, the Savitzky-Golay velocity of
+        :func:`contactlab.tangential.regime.velocity`) for at least
+        :data:`~contactlab.tangential.regime.STICK_DWELL_FACTOR` times as long as a smooth
+        turn of that stroke's amplitude would, within a quarter period of a reversal, while
+        the force changes by at least :attr:`STICK_FORCE_SHARE` of its range — the sticks
+        ``analyze`` reports (:func:`contactlab.tangential.regime.stick_slip`) — widened by
+        half the velocity filter's window either side (the filter spreads the start of the
+        motion over that: on Coulomb frames the samples it missed, 1.5 % of the record,
+        carried all of a spurious delay's gain).
+
+        While stuck, the force is whatever holds the body still (a frame's drive ramping
+        from the sliding force through zero to the breakaway force), not a function of the
+        displacement, which does not move: a model driven by the displacement cannot
+        predict it, and the one candidate that lowers the error there is a negative
+        channel delay, which reads the force's change off the displacement after the stick
+        (measured on Coulomb frames: all of the delay's held-out gain comes from the stuck
+        samples, on the true force as on the reconstructed one). A displacement-driven rig
+        never dwells that long at a turn: the mask is empty there, as it is when the velocity
+        filter spans more than a quarter period (too few samples a cycle to tell a stick).
+        """
+        from ..tangential.frame import difference_noise, lepski_window
+        from ..tangential.regime import STICK_DWELL_FACTOR, VELOCITY_SIGMAS, long_runs
+
+        x = d.extra.get("u_raw", d.u)
+        mask = np.zeros(x.size, bool)
+        rev = d.cycles.reversals
+        amp = 0.5 * float(np.ptp(x))
+        if rev.size < 2 or x.size < 20 or not amp > 0:
+            return mask
+        # regime.velocity (the sticks analyze reports) with numpy's Savitzky-Golay filters:
+        # the same values to rounding, without importing scipy.signal (0.3 s a diagnosis)
+        sx = difference_noise(x)
+        window = min(lepski_window(x, d.dt, sx, coefficients=_sg_dot), (x.size // 2) * 2 - 1)
+        window = max(window, 5)
+        v = savgol_filter(x, window, 3, deriv=1, delta=d.dt, mode="interp")
+        thr = VELOCITY_SIGMAS * sx * float(np.linalg.norm(_sg_dot(window, 1, d.dt)))
+        if not thr > 0:
+            thr = 1e-9 * float(np.max(np.abs(v)))
+        if window > 0.25 * d.cycles.period_samples:  # too few samples a cycle to tell
+            return mask
+        period = d.cycles.period_samples * d.dt
+        omega = 2.0 * np.pi / period
+        # the smooth dwell of a turn of the stroke's own amplitude (the larger half swing
+        # either side of the reversal): a record starting from rest ramps its amplitude
+        # up, and its first small turns dwell long without sticking
+        swing = np.abs(np.diff(x[rev]))
+        local = 0.5 * np.maximum(np.r_[swing, swing[-1]], np.r_[swing[0], swing])
+        smooth = 2.0 * thr / (np.maximum(local, 1e-300) * omega**2)
+        quarter = 0.25 * d.cycles.period_samples
+        lo, hi = np.percentile(d.y, [1.0, 99.0])
+        swing_f = self.STICK_FORCE_SHARE * float(hi - lo)
+        shortest = max(4, int(np.ceil(STICK_DWELL_FACTOR * float(np.min(smooth)) / d.dt)))
+        spans: dict[int, list[int]] = {}  # reversal -> [first stuck sample, end]
+        for a, b in long_runs((v < thr) & (v > -thr), shortest):
+            mid = 0.5 * (a + b - 1)
+            k = int(np.argmin(np.abs(rev - mid)))
+            need = max(4, int(np.ceil(STICK_DWELL_FACTOR * float(smooth[k]) / d.dt)))
+            if b - a >= need and abs(rev[k] - mid) <= quarter + 0.5 * (b - a):
+                sp = spans.setdefault(k, [a, b])  # noise splits a stick into runs
+                sp[0], sp[1] = min(sp[0], a), max(sp[1], b)
+        for a, b in spans.values():
+            # a stick holds a turn, not a whole stroke (at most half a period), and the
+            # force changes while it holds
+            if b - a <= 2 * quarter and float(np.ptp(d.y[a:b])) >= swing_f:
+                # the velocity filter spreads the departure from rest over half its window:
+                # that close to a detected stick a sample may still be stuck
+                mask[max(a - window // 2, 0) : b + window // 2] = True
+        return mask
+
     input_name = "x"
     output_name = "F"
     input_unit = "m"
@@ -506,11 +587,33 @@ class TangentialFamily:
     ) -> np.ndarray:
         """Measured force predicted for the measured displacement ``d.u`` (at the sample
         indices ``at`` only, when given: the Masing element still runs over the whole
-        history, the terms sample by sample only where asked — the same values)."""
+        history, the terms sample by sample only where asked — the same values).
+
+        A force channel with a declared measurement filter (``d.extra["output_filter"]``:
+        the taps of a zero-phase smoothing, e.g. a force reconstructed from a frame's
+        equation of motion, :attr:`contactlab.tangential.FrameForce.force_filter`) is
+        predicted through that same filter, whatever the effects: the model's force is
+        smoothed as the measurement was, so no candidate can win by imitating the
+        smoothing (the record's ends, where the filter is not defined, are weighted out by
+        :func:`contactlab.diagnose.diagnose`)."""
+        taps = d.extra.get("output_filter")
+        if taps is None:
+            return self._force(p, effects, d, at)
+        F = np.convolve(self._force(p, effects, d), taps, mode="same")
+        return F if at is None else F[at]
+
+    def _force(
+        self,
+        p: dict[str, float],
+        effects: tuple[str, ...],
+        d: Prepared,
+        at: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """The joint's force at the sensor, before any declared measurement filter."""
         if "channel_delay" in effects and "raw_input" in d.extra and p["tau"] != 0.0:
             # a kept record (workflow.subsample_long): the model at the shifted raw positions
             rest = tuple(e for e in effects if e != "channel_delay")
-            return self.predict(p, rest, delayed(d, p["tau"]), at)
+            return self._force(p, rest, delayed(d, p["tau"]), at)
         x = d.u
         if "displacement_offset" in effects:
             x = x - p["x0"]

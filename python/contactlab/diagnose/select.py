@@ -154,7 +154,9 @@ def fit(
     ]
     # long records: the fit sees every stride-th sample of the mask (the solver's work grows
     # with the number of residuals); held-out errors are still taken on every sample, and
-    # the standard errors are scaled to the full count
+    # the standard errors are those of the strided fit: its estimate uses those samples only
+    # (they were scaled down to the full count, sqrt(stride) too small: on 20 fresh seeds the
+    # force offset's z scattered with SD 2.57, 2.17 on 195k-sample kept records)
     n_all = int(np.count_nonzero(mask))
     stride = -(-n_all // FIT_SAMPLES)
     if stride > 1:
@@ -218,7 +220,7 @@ def fit(
         resid_vec = resid_vec[:-1]
         jac = None if jac is None else jac[:-1]
     # the errors scale with the corrected residual, not with the constant C the solver saw
-    shrink = float(np.sqrt(y.size / n_all)) * float(np.sqrt(rss / chisqr)) if chisqr > 0 else 1.0
+    shrink = float(np.sqrt(rss / chisqr)) if chisqr > 0 else 1.0
     infl = dict.fromkeys(names, 1.0)
     if n_all == d.y.size and jac is not None:  # the fit to all data: its errors are reported
         lag = int(d.cycles.period_samples // stride)

@@ -432,7 +432,94 @@ def eiv_weight(
     gain = float(np.sum(savgol_coeffs(wlen, 3) ** 2)) if wlen else 1.0
     var = (s * su) ** 2 * gain
     w = sigma**2 / (sigma**2 + var)
-    return w, float(np.mean(var * w)) / sigma**2
+    prior = d.extra.get("weight")  # samples weighted out before (sticks, a filter's ends)
+    if prior is None:
+        return w, float(np.mean(var * w)) / sigma**2
+    w = w * prior
+    return w, float(np.sum(var * w) / max(float(np.sum(prior)), 1.0)) / sigma**2
+
+
+def _declared(
+    recording: Any, family: Family, taps: Any, noise: float | None, n: int
+) -> tuple[np.ndarray | None, float | None]:
+    """The output's declared measurement filter and noise RMS: the arguments, else the
+    recording's ``meta`` (``output_filter``, ``output_noise``); checked."""
+    meta = getattr(recording, "meta", None)
+    if not isinstance(meta, dict):
+        meta = {}
+    if taps is None:
+        taps = meta.get("output_filter")
+    if noise is None:
+        noise = meta.get("output_noise")
+    if taps is not None:
+        if family.kind != "tangential":
+            raise InputError("output_filter is supported for the tangential model only")
+        try:
+            a = np.asarray(taps, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError("output_filter must be a sequence of filter taps (numbers)") from None
+        if a.ndim != 1 or a.size % 2 != 1 or not np.all(np.isfinite(a)):
+            raise InputError(
+                f"output_filter must be an odd number of finite taps (a zero-phase filter), "
+                f"got shape {a.shape}"
+            )
+        if not abs(float(np.sum(a)) - 1.0) < 1e-6:
+            raise InputError(
+                f"output_filter's taps sum to {float(np.sum(a)):.6g}; a measurement filter "
+                "passes a constant force unchanged (sum 1)"
+            )
+        if a.size >= n // 4:
+            raise InputError(
+                f"output_filter has {a.size} taps for a record of {n} samples: too long a "
+                "filter to leave anything to diagnose"
+            )
+        taps = None if a.size == 1 else a
+    if noise is not None:
+        if not (isinstance(noise, (int, float, np.floating)) and np.isfinite(noise) and noise > 0):
+            raise InputError(f"output_noise must be a finite number > 0, got {noise!r}")
+        noise = float(noise)
+    return taps, noise
+
+
+def _prior_weight(
+    family: Family, d: Prepared, taps: np.ndarray | None
+) -> tuple[dict[str, Any] | None, list[str]]:
+    """Samples no candidate is judged on, weighted 0 in every fit and held-out error
+    (``d.extra["weight"]``): the half filter at either end of a record whose output passed a
+    declared filter (:func:`diagnose`'s ``output_filter``, set as ``d.extra["output_filter"]``
+    here) and the family's sticking samples (:meth:`TangentialFamily.sticking`). Returns the
+    report's ``location`` entries and sentences, or ``(None, [])`` when nothing is weighted
+    out."""
+    w = np.ones(d.y.size)
+    loc: dict[str, Any] = {}
+    notes = []
+    if taps is not None:
+        d.extra["output_filter"] = taps
+        h = taps.size // 2
+        w[:h] = 0.0
+        w[w.size - h :] = 0.0
+        loc["output_filter"] = {"taps": int(taps.size), "span_s": float(taps.size * d.dt)}
+        notes.append(
+            f"the force passed a declared filter of {taps.size} taps ({1e3 * taps.size * d.dt:.3g} "
+            "ms, e.g. a reconstruction's smoothing): every candidate's prediction passes the "
+            f"same filter; the {h} samples at either end, where it is not defined, are not used"
+        )
+    stuck = family.sticking(d) if hasattr(family, "sticking") else None
+    if stuck is not None and np.any(stuck):
+        if taps is not None:  # the filter spreads the stuck force over half its span
+            stuck = np.convolve(stuck, np.ones(taps.size), mode="same") > 0.5
+        w[stuck] = 0.0
+        share = float(np.mean(stuck))
+        loc["sticking_fraction"] = share
+        notes.append(
+            f"{100 * share:.0f} % of the samples stick (the displacement stands still within "
+            "its noise at the reversals while the force changes): the force there is set by "
+            "what holds the body, not by the displacement, and no candidate is judged on them"
+        )
+    if not loc:
+        return None, []
+    d.extra["weight"] = w
+    return loc, notes
 
 
 def _try_candidate(
@@ -594,6 +681,8 @@ def diagnose(
     z: float = 3.0,
     min_gain: float = 0.05,
     base: Any = None,
+    output_filter: Any = None,
+    output_noise: float | None = None,
 ) -> Any:
     """Find where a model and a measurement disagree, name the missing effect, add it.
 
@@ -623,6 +712,17 @@ def diagnose(
         ``recording`` is ``(t, u, y)``; the same when ``model`` is an ``IdentifiedModel``.
         Returns a :class:`~contactlab.diagnose.structure.StructureDiagnosis` (see
         :func:`~contactlab.diagnose.structure.diagnose_structure`).
+    output_filter : array_like, optional
+        Tangential only: the taps (odd count, zero phase) of a smoothing the force channel
+        went through, e.g. a force reconstructed from a frame's equation of motion
+        (:attr:`contactlab.tangential.FrameForce.force_filter`). Every candidate's predicted
+        force passes the same filter, and the half filter at either end of the record
+        (where it is not defined) counts for nothing. Default: the recording's
+        ``meta["output_filter"]`` (set by :meth:`~contactlab.tangential.FrameForce.recording`).
+    output_noise : float, optional
+        The output channel's noise RMS when known (a filtered channel's noise is correlated
+        and its differences understate it). Default: ``meta["output_noise"]`` of the
+        recording, else estimated from the base model's residual.
 
     Returns
     -------
@@ -664,13 +764,22 @@ def diagnose(
             raise InputError(
                 f"unknown {family.kind} candidate {n!r}; choose from {', '.join(family.candidates)}"
             )
+    taps, declared_noise = _declared(recording, family, output_filter, output_noise, t.size)
     n_in = t.size
-    if family.kind == "tangential" and n_in > MAX_SAMPLES:
+    if taps is not None and n_in > MAX_SAMPLES:  # a filter at the raw rate: no subsampling
+        t, u, y = t[:MAX_SAMPLES], u[:MAX_SAMPLES], y[:MAX_SAMPLES]
+        reduced = (
+            f"the record of {n_in} samples was diagnosed on its first {MAX_SAMPLES} (its force "
+            "passed a declared filter, which holds at the raw rate only)"
+        )
+        d = Prepared.build(t, u, y)
+    elif family.kind == "tangential" and n_in > MAX_SAMPLES:
         d, reduced = subsample_long(t, u, y)
     else:
         t, u, y, reduced = reduce_long(t, u, y)
         d = Prepared.build(t, u, y)
     d.extra.update(context)
+    prior, prior_notes = _prior_weight(family, d, taps)
     d.extra["evaluations"] = spent = EvaluationCounter()  # counted by select.fit
     family.prepare(d)
     scales = family.scales(d)
@@ -681,7 +790,7 @@ def diagnose(
     # the base fitted to all data gives the noise level and the weights; its cross-validation
     # is run once, with the weights it ends up with
     base_all = fit(family, effects, d, np.ones(d.y.size, bool), start, scales)
-    sigma = noise_rms(family.predict(base_all.params, effects, d) - d.y)
+    sigma = declared_noise or noise_rms(family.predict(base_all.params, effects, d) - d.y)
     if sigma <= 0:
         raise InputError("the output channel has no noise at all; cannot judge significance")
     budget = 0.0
@@ -689,7 +798,7 @@ def diagnose(
     if w is not None:  # errors in variables: refit the base with the likelihood's weights
         d.extra["weight"], budget = w
         current = evaluate(family, effects, d, base_all.params, scales, folds, parallel=True)
-        sigma = noise_rms(current.full_residual(d))
+        sigma = declared_noise or noise_rms(current.full_residual(d))
     else:
         current = evaluate(family, effects, d, start, scales, folds, base_all, parallel=True)
     anchored = None
@@ -712,6 +821,9 @@ def diagnose(
     if reduced:
         where.insert(1, reduced)
     location["samples"] = {"recording": n_in, "diagnosed": int(d.t.size)}
+    if prior is not None:
+        location.update(prior)
+        where[2 if reduced else 1 : 2 if reduced else 1] = prior_notes
     if w is not None:
         low = float(np.mean(d.extra["weight"] < 0.5))
         location["low_weight_fraction"] = low

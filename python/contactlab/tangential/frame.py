@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -100,26 +101,58 @@ def savgol_coefficients(window: int, deriv: int, dt: float) -> np.ndarray:
     return savgol_coeffs(window, POLYORDER, deriv=deriv, delta=dt, use="dot")
 
 
-def lepski_window(x: np.ndarray, dt: float, sigma: float, *, kappa: float = LEPSKI_KAPPA) -> int:
+def force_kernel(window: int) -> np.ndarray:
+    """The smoothing the reconstruction applies to the friction force: ``window`` taps,
+    symmetric, positive, summing to 1.
+
+    The cubic Savitzky-Golay ``x''`` filter ``c₂`` (``window`` taps) annihilates constants
+    and straight lines, so it factors exactly as ``c₂ = g ⊛ Δ²/dt²`` with ``g`` of
+    ``window - 2`` taps (the double cumulative sum of ``c₂ dt²``): the filter's ``x''`` is the
+    plain second difference smoothed by ``g``. A second difference is the hat-weighted mean
+    of ``x''`` over a sample either side (``Δ²x/dt² = ∫ x''(t + s) Λ(s/dt) ds/dt``), which on
+    samples of a force (linear between them) is the kernel ``[1, 4, 1]/6``. So the
+    reconstruction, which smooths every term of the equation of motion by ``g``
+    (:func:`frame_friction_force`), gives ``force_kernel ⊛ F_f`` plus noise:
+    ``g ⊛ [1, 4, 1]/6`` (for a sinusoid at ``θ`` radians per sample the inertial term's
+    smoothing differs from it by ``θ²/12`` of that term). :func:`contactlab.diagnose.diagnose`
+    passes every candidate's predicted force through the same kernel (``output_filter``), so
+    that no candidate can win by imitating the smoothing of the force's jumps at stick and
+    slip.
+    """
+    g = np.cumsum(np.cumsum(savgol_coefficients(window, 2, 1.0)))[:-2]
+    return np.convolve(g, np.array([1.0, 4.0, 1.0]) / 6.0)
+
+
+def lepski_window(
+    x: np.ndarray,
+    dt: float,
+    sigma: float,
+    *,
+    kappa: float = LEPSKI_KAPPA,
+    coefficients: Callable[[int, int, float], np.ndarray] | None = None,
+) -> int:
     """Savitzky-Golay window (odd, samples) for ``x''`` by Lepski's rule (module docstring).
 
     Candidate windows grow geometrically from 7 samples to a fifth of the record (at most
     401); with no measurable noise the smallest is used. The comparisons run over the record
     in blocks (:func:`_lepski_square_sums`): O(n) time, memory independent of its length.
+    ``coefficients(window, deriv, dt)``: the filter weights (dot orientation) when not
+    :func:`savgol_coefficients` (a numpy implementation spares importing scipy.signal).
     """
+    coefficients = coefficients or savgol_coefficients
     n = x.size
     top = min(401, max(7, n // 5))
     cands = sorted({w | 1 for w in np.geomspace(7, top, 16).astype(int) if w >= 7})
     if sigma <= 0 or len(cands) < 2:
         return cands[0]
-    sq = _lepski_square_sums(np.asarray(x, dtype=float), cands, dt)
+    sq = _lepski_square_sums(np.asarray(x, dtype=float), cands, dt, coefficients=coefficients)
     chosen = cands[0]
     for i, w in enumerate(cands[1:], start=1):
         ok = True
-        cw = savgol_coefficients(w, 2, dt)
+        cw = coefficients(w, 2, dt)
         count = n - 2 * (w // 2)
         for j, wp in enumerate(cands[:i]):
-            cp = np.pad(savgol_coefficients(wp, 2, dt), (w - wp) // 2)
+            cp = np.pad(coefficients(wp, 2, dt), (w - wp) // 2)
             sd = sigma * float(np.linalg.norm(cw - cp))
             rms = math.sqrt(sq[i, j] / count)
             if rms > kappa * sd:
@@ -136,7 +169,11 @@ LEPSKI_BLOCK = 1 << 16
 
 
 def _lepski_square_sums(
-    x: np.ndarray, cands: list[int], dt: float, block: int = LEPSKI_BLOCK
+    x: np.ndarray,
+    cands: list[int],
+    dt: float,
+    block: int = LEPSKI_BLOCK,
+    coefficients: Callable[[int, int, float], np.ndarray] | None = None,
 ) -> np.ndarray:
     """``S[i, j]`` (``j < i``): sum of the squared differences between the Savitzky-Golay
     ``x''`` of windows ``cands[i]`` and ``cands[j]`` over the samples where the wider window
@@ -148,12 +185,15 @@ def _lepski_square_sums(
     same filter, summed in another order: equal to rounding, ~1e-13 of the estimates' RMS),
     the sums of squares added block by block. Buffers are allocated once.
     """
-    from scipy.signal import savgol_coeffs
-
     n, k = x.size, len(cands)
     halves = [w // 2 for w in cands]
     halo = halves[-1]
-    coeffs = [savgol_coeffs(w, POLYORDER, deriv=2, delta=dt) for w in cands]
+    if coefficients is None:
+        from scipy.signal import savgol_coeffs
+
+        coeffs = [savgol_coeffs(w, POLYORDER, deriv=2, delta=dt) for w in cands]
+    else:  # convolution orientation: the dot weights reversed
+        coeffs = [coefficients(w, 2, dt)[::-1] for w in cands]
     est = np.empty((k, block))
     diff = np.empty((k, block))
     out = np.zeros((k, k))
@@ -232,11 +272,22 @@ class FrameForce:
     jump_share: float = 0.0
     force_error_near_jumps: float = 0.0
     force_error: float = 0.0
+    #: the smoothing the reconstruction applied to the friction force (:func:`force_kernel`):
+    #: away from the record's ends, ``F`` is this kernel convolved with the true force, plus
+    #: noise of RMS ``force_noise``
+    force_filter: np.ndarray | None = None
 
     def recording(self, source: str = "<frame>") -> Recording:
-        """A tangential :class:`~contactlab.io.Recording` (``x`` in m, ``F`` in N)."""
+        """A tangential :class:`~contactlab.io.Recording` (``x`` in m, ``F`` in N) whose
+        ``meta`` declares the reconstruction's smoothing and noise (``output_filter``:
+        :attr:`force_filter`, ``output_noise``: :attr:`force_noise`), which
+        :func:`contactlab.diagnose.diagnose` applies to every candidate and takes as the
+        force's noise level."""
+        meta: dict[str, object] = {"output_noise": self.force_noise}
+        if self.force_filter is not None:
+            meta["output_filter"] = self.force_filter
         return Recording(self.t, {"x": self.x, "F": self.F}, {"x": "m", "F": "N"},
-                         source=source)  # fmt: skip
+                         source=source, meta=meta)  # fmt: skip
 
 
 def frame_friction_force(
@@ -273,7 +324,11 @@ def frame_friction_force(
     >>> t = np.arange(2500) * 0.004; w = 2 * np.pi
     >>> x = 1e-3 * np.sin(w * t); y = 2e-3 * np.sin(w * t)
     >>> r = frame_friction_force(t, x, y, M=3.0, C=0.0, K=1000.0)
-    >>> float(np.max(np.abs(r.F - (1000 * 1e-3 + 3.0 * w**2 * 1e-3) * np.sin(w * t)))) < 1e-4
+    >>> F = (1000 * 1e-3 + 3.0 * w**2 * 1e-3) * np.sin(w * t)  # the true force
+    >>> float(np.max(np.abs(r.F - F))) < 1e-3  # the smoothing: 5e-4 N of 1.1 N
+    True
+    >>> inner = slice(r.window, -r.window)  # the declared smoothing, away from the ends
+    >>> float(np.max(np.abs(r.F - np.convolve(F, r.force_filter, "same"))[inner])) < 2e-5
     True
     """
     ta = as_1d(t, "t")
@@ -300,16 +355,25 @@ def frame_friction_force(
     xd = savgol_derivative(xa, window, 1, dt)
     xdd = savgol_derivative(xa, window, 2, dt)
     yd = savgol_derivative(ya, window, 1, dt)
+    # every term smoothed alike (force_kernel): M x'' is g ⊛ Δ²x/dt² already, i.e.
+    # force_kernel ⊛ M x'', so K (y - x) and C (y' - x') pass the same smoothing and F is
+    # force_kernel ⊛ F_f plus noise. Within half a window of
+    # the ends (the polynomial end fits) the unsmoothed terms, as before.
+    c2 = savgol_coefficients(window, 2, dt)
+    g = np.cumsum(np.cumsum(c2 * dt * dt))[:-2]
+    # K (y - x) through the whole kernel (g and the second difference's [1, 4, 1]/6), the
+    # small damping term (C ẋ is ~1 % of the force) through g and a central difference
+    gk = np.convolve(g, np.array([1.0, 4.0, 1.0]) / 6.0)  # window taps: force_kernel
+    gd = np.convolve(g, np.array([1.0, 0.0, -1.0]) / (2.0 * dt))  # g ⊛ central difference
+    fx = -K * gk - C * gd - M * c2  # F = fy ⊛ y + fx ⊛ x (convolution taps)
+    fy = K * gk + C * gd
     F = K * (ya - xa) + C * (yd - xd) - M * xdd
-    # noise of F: K (y - x) direct, C and M through the filters' coefficients (x's terms
-    # combine into one filter of x: -K δ - C c1 - M c2)
-    c1, c2 = savgol_coefficients(window, 1, dt), savgol_coefficients(window, 2, dt)
-    fx = -C * c1 - M * c2
-    fx[window // 2] -= K
-    fy = C * c1
-    fy[window // 2] += K
+    half = window // 2
+    if xa.size > 2 * half:
+        inner = np.convolve(ya, fy, mode="valid") + np.convolve(xa, fx, mode="valid")
+        F[half : xa.size - half] = inner
     f_noise = math.hypot(sx * float(np.linalg.norm(fx)), sy * float(np.linalg.norm(fy)))
-    half = window // 2 + 1
+    half = half + 1
     jumps = jump_samples(xd, xa, window, dt, sx)
     near = np.zeros(F.size, bool)
     sizes = []
@@ -323,12 +387,13 @@ def frame_friction_force(
     near_err = math.hypot(f_noise, jump_rms * step_error(window))
     total = math.sqrt((1.0 - share) * f_noise**2 + share * near_err**2)
     return FrameForce(ta, xa, F, xd, xdd, int(window), window * dt, sx, sy, f_noise, share,
-                      near_err, total)  # fmt: skip
+                      near_err, total, force_kernel(window))  # fmt: skip
 
 
 __all__ = [
     "FrameForce",
     "difference_noise",
+    "force_kernel",
     "frame_friction_force",
     "lepski_window",
     "savgol_coefficients",

@@ -207,7 +207,7 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1), strict=True))
 
 
-def _long_runs(mask: np.ndarray, min_len: int) -> list[tuple[int, int]]:
+def long_runs(mask: np.ndarray, min_len: int) -> list[tuple[int, int]]:
     """``[start, end)`` of each run of True at least ``min_len`` long (the short ones, most
     of a noisy record's, dropped in numpy before any Python loop sees them)."""
     d = np.diff(np.r_[np.int8(0), mask.astype(np.int8), np.int8(0)])
@@ -351,7 +351,7 @@ def stick_slip(
     min_len = max(4, math.ceil(STICK_DWELL_FACTOR * smooth / dt))
     spans: dict[int, list[int]] = {}  # turn -> [first stuck sample, end, stuck samples]
     # |v| < thr as two comparisons: no whole-record float temporary
-    for a, b in _long_runs((v < thr) & (v > -thr), min_len):
+    for a, b in long_runs((v < thr) & (v > -thr), min_len):
         mid = tt[(a + b - 1) // 2]
         k = int(np.argmin(np.abs(tt[turns] - mid)))
         if abs(tt[turns[k]] - mid) > 0.25 * period + 0.5 * (b - a) * dt:
@@ -459,7 +459,9 @@ __all__ = [
     "Regime",
     "StickSlip",
     "classify",
+    "long_runs",
     "plateau",
     "stick_slip",
+    "velocity",
     "z_from_area_ratio",
 ]

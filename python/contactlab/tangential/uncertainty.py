@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from .. import _core
-from ..fitting import FitResult, Parameter
+from ..fitting import FitResult, Parameter, stderr_and_correl
 from ..masing import loop_area
 from .preprocess import AveragedLoop
 
@@ -186,11 +186,7 @@ def reparametrize(raw: FitResult) -> FitResult:
         T[i_k, i_k] = 1.0 / ac
         T[i_k, i_a] = -k0 / ac**2
         covar = T @ raw.covar @ T.T
-        d = np.sqrt(np.clip(np.diag(covar), 0.0, None))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            correl = covar / np.outer(d, d)
-        correl[~np.isfinite(correl)] = 0.0
-        np.fill_diagonal(correl, 1.0)
+        d, correl = stderr_and_correl(covar)
         for i, n in enumerate(names):
             src = raw.params["k0" if n == "h0" else n]
             if src.stderr is None and src.identifiable is False:
