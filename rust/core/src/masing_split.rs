@@ -8,9 +8,17 @@
 //! curve evaluation per sample) and records the state at piece boundaries; the forces of the
 //! reversals still on the stack there (each evaluated once, oldest first, with the kernel's
 //! own expression) and of the sample before the boundary are the only curve evaluations.
-//! The pieces are then independent: [`force_channels`] hands them out from one queue
-//! (`crate::parallel::run_jobs`, longest first), so two threads of unequal speed finish
-//! together, and one long channel uses every thread.
+//! The pieces are then independent: [`force_channels`] hands them out from one queue,
+//! largest first, so two threads of unequal speed finish together, and one long channel
+//! uses every thread.
+//!
+//! The pre-pass is not free (0.1-0.3 of the kernel's CPU on smooth input, where reading the
+//! input from memory is most of it, about 0.6 on a random walk, where the rules are), so
+//! [`force_channels`] splits only the channels that balancing needs, and stops a channel's
+//! pre-pass where the rest, run as one last piece by the pre-pass's own thread, takes no
+//! longer than the other threads need for the pieces already queued: for one channel on two
+//! threads at `1 / (2 - p)` of it with `p` the pre-pass's cost relative to the kernel, so
+//! the wall time is `1 / (2 - p)` of one thread's instead of `(1 + p) / 2`.
 //!
 //! A boundary is skipped where the stack is deeper than a quarter of the piece length plus 64 (its
 //! copy would cost a noticeable share of the piece's work): a signal of ever-shrinking
@@ -20,7 +28,7 @@ use super::{kernel, BranchRule, MasingState, Reversal};
 use crate::curve::Backbone;
 use crate::error::CoreError;
 use crate::parallel::{schedstat, ThreadStats};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 
@@ -92,30 +100,47 @@ pub fn split<C: Backbone>(
     piece: usize,
 ) -> Result<Option<Split>, CoreError> {
     let mut pieces = Vec::new();
-    let end = split_each(curve, scale, x, state, piece, |off, st| {
+    let walked = split_each(curve, scale, x, state, piece, |off, st| {
         pieces.push((off, st));
+        true
     })?;
-    Ok(end.map(|end| Split { pieces, end }))
+    Ok(match walked {
+        Walked::Ended(end) => Some(Split { pieces, end }),
+        Walked::Whole | Walked::Stopped => None,
+    })
+}
+
+/// How a pre-pass ([`split_each`]) ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Walked {
+    /// Nothing emitted: a state the kernel does not continue from (or a rule that is not
+    /// split); run the channel whole.
+    Whole,
+    /// Through the whole input; the end state (the serial kernel's).
+    Ended(MasingState),
+    /// `emit` said stop at its last boundary: the last piece runs to the end of the input
+    /// (its run gives the end state).
+    Stopped,
 }
 
 /// [`split`] handing each boundary `(offset, start state)` to `emit` as soon as it is found
-/// (the first is `(0, state)`); returns the end state (`None`, with nothing emitted, for a
-/// state the kernel does not continue from).
+/// (the first is `(0, state)`). `emit` returns whether to go on: `false` ends the pre-pass
+/// there, the piece from that boundary then runs to the end of `x` ([`Walked::Stopped`]).
 pub fn split_each<C: Backbone>(
     curve: &C,
     scale: f64,
     x: &[f64],
     state: &MasingState,
     piece: usize,
-    mut emit: impl FnMut(usize, MasingState),
-) -> Result<Option<MasingState>, CoreError> {
+    mut emit: impl FnMut(usize, MasingState) -> bool,
+) -> Result<Walked, CoreError> {
     crate::error::check_positive("scale", scale)?;
     if !kernel::all_finite(x) {
         crate::error::check_finite("x", x)?;
     }
     let end = super::checked_end(state, x.len())?;
     if !kernel::takes(state) {
-        return Ok(None);
+        return Ok(Walked::Whole);
     }
     let piece = piece.max(1);
     let (lam, inv) = (scale, 1.0 / scale);
@@ -133,13 +158,15 @@ pub fn split_each<C: Backbone>(
         h0: state.h,
         start,
     };
-    emit(0, state.clone());
+    if !emit(0, state.clone()) {
+        return Ok(Walked::Stopped);
+    }
     let mut offset = 0_usize;
     let mut dense = false;
     for xc in x.chunks(piece) {
         if offset > 0 && n <= (piece / 4).saturating_add(64) {
             let h = resolve(curve, lam, inv, &mut stk[..n], w.xp);
-            emit(
+            let go_on = emit(
                 offset,
                 MasingState {
                     x: w.xp,
@@ -149,6 +176,9 @@ pub fn split_each<C: Backbone>(
                     stack: stk[..n].iter().map(|e| e.r).collect(),
                 },
             );
+            if !go_on {
+                return Ok(Walked::Stopped);
+            }
         }
         let mut at = offset;
         for xb in xc.chunks(BLK) {
@@ -171,7 +201,7 @@ pub fn split_each<C: Backbone>(
     } else {
         resolve(curve, lam, inv, &mut stk[..n], w.xp)
     };
-    Ok(Some(MasingState {
+    Ok(Walked::Ended(MasingState {
         x: w.xp,
         h,
         dir: w.dir as i8,
@@ -343,16 +373,15 @@ pub fn force_piece<C: Backbone>(
 
 /// A channel's model, as [`force_channels`] sees it.
 pub trait Channel: Sync {
-    /// The pieces of `x` from `state`, each boundary to `emit` as found ([`split_each`]);
-    /// the end state, or `None` (nothing emitted) to run it whole (a branch rule other than
-    /// the scaled one, or a state the kernel does not continue from).
+    /// The pieces of `x` from `state`, each boundary to `emit` as found ([`split_each`];
+    /// [`Walked::Whole`] for a branch rule other than the scaled one).
     fn split(
         &self,
         x: &[f64],
         state: &MasingState,
         piece: usize,
-        emit: &mut dyn FnMut(usize, MasingState),
-    ) -> Result<Option<MasingState>, CoreError>;
+        emit: &mut dyn FnMut(usize, MasingState) -> bool,
+    ) -> Result<Walked, CoreError>;
     /// One piece ([`force_piece`]).
     fn piece(&self, x: &[f64], out: &mut [f64], state: &mut MasingState)
         -> Result<bool, CoreError>;
@@ -372,11 +401,11 @@ impl<C: Backbone + Sync> Channel for Model<'_, C> {
         x: &[f64],
         state: &MasingState,
         piece: usize,
-        emit: &mut dyn FnMut(usize, MasingState),
-    ) -> Result<Option<MasingState>, CoreError> {
+        emit: &mut dyn FnMut(usize, MasingState) -> bool,
+    ) -> Result<Walked, CoreError> {
         match self.rule {
             BranchRule::Scaled(l) => split_each(self.curve, l, x, state, piece, emit),
-            BranchRule::Anchored(_) => Ok(None),
+            BranchRule::Anchored(_) => Ok(Walked::Whole),
         }
     }
     fn piece(
@@ -401,11 +430,13 @@ impl<C: Backbone + Sync> Channel for Model<'_, C> {
 enum Work<'a> {
     /// Run the pre-pass of a channel, queueing its pieces as their boundaries are found.
     Split { x: &'a [f64], out: &'a mut [f64] },
-    /// A piece of a split channel, from its start state.
+    /// A piece of a split channel, from its start state; the last one's run gives the
+    /// channel's end state.
     Piece {
         x: &'a [f64],
         out: &'a mut [f64],
         state: MasingState,
+        last: bool,
     },
     /// A whole channel, serially.
     Whole { x: &'a [f64], out: &'a mut [f64] },
@@ -548,6 +579,8 @@ pub fn force_channels(
         seq: nch,
     });
     let ready = std::sync::Condvar::new();
+    // Samples of each channel's pieces queued or running.
+    let outstanding: Vec<AtomicUsize> = (0..nch).map(|_| AtomicUsize::new(0)).collect();
     let failed = AtomicBool::new(false);
     // Pieces may come: every thread; else no more threads than channels.
     let workers = if pending > 0 {
@@ -609,6 +642,8 @@ pub fn force_channels(
                             let (px, tx) = rest_x.split_at(len);
                             let (po, to) = std::mem::take(&mut rest_o).split_at_mut(len);
                             (rest_x, rest_o) = (tx, to);
+                            let last = next.is_none();
+                            outstanding[c].fetch_add(len, Ordering::Relaxed);
                             if let Ok(mut q) = queue.lock() {
                                 let seq = q.seq;
                                 q.seq = seq.saturating_add(1);
@@ -621,6 +656,7 @@ pub fn force_channels(
                                         x: px,
                                         out: po,
                                         state,
+                                        last,
                                     },
                                 });
                                 ready.notify_one();
@@ -628,15 +664,17 @@ pub fn force_channels(
                         }
                         prev = next;
                     };
+                    // Stop where the rest, run as one piece by this thread, takes no longer
+                    // than the other threads need for the pieces queued and not yet done.
+                    let others = threads.saturating_sub(1).max(1);
                     let r = models[c].split(x, &starts[c], piece, &mut |off, s| {
                         cut(off, Some((off, s)));
+                        let queued = outstanding[c].load(Ordering::Relaxed);
+                        off == 0 || x.len().saturating_sub(off).saturating_mul(others) > queued
                     });
                     match r {
-                        Ok(Some(end)) => {
-                            cut(x.len(), None);
-                            note(c, &mut |o| o.end = Some(end.clone()));
-                        }
-                        Ok(None) => {
+                        Ok(Walked::Ended(_) | Walked::Stopped) => cut(x.len(), None),
+                        Ok(Walked::Whole) => {
                             // not splittable: run whole
                             st.jobs = st.jobs.saturating_add(1);
                             st.samples = st.samples.saturating_add(x.len());
@@ -659,7 +697,12 @@ pub fn force_channels(
                         pre_cpu += b.0.saturating_sub(a.0) as f64 * 1e-9;
                     }
                 }
-                Work::Piece { x, out, mut state } => {
+                Work::Piece {
+                    x,
+                    out,
+                    mut state,
+                    last,
+                } => {
                     st.jobs = st.jobs.saturating_add(1);
                     st.samples = st.samples.saturating_add(x.len());
                     match models[c].piece(x, out, &mut state) {
@@ -667,6 +710,10 @@ pub fn force_channels(
                         Ok(false) => note(c, &mut |o| o.nonfinite = true),
                         Err(e) => note(c, &mut |o| o.error = Some(e.clone())),
                     }
+                    if last {
+                        note(c, &mut |o| o.end = Some(state.clone()));
+                    }
+                    outstanding[c].fetch_sub(x.len(), Ordering::Relaxed);
                 }
                 Work::Whole { x, out } => {
                     st.jobs = st.jobs.saturating_add(1);

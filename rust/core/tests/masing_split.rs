@@ -5,7 +5,9 @@
 //! lengths and thread counts, for both curve kinds and both branch rules.
 
 use contactlab_core::curve::{Exponential, Tabulated};
-use contactlab_core::masing::split::{force_channels, force_piece, split, Channel, Model};
+use contactlab_core::masing::split::{
+    force_channels, force_piece, split, split_each, Channel, Model, Walked,
+};
 use contactlab_core::masing::{masing_force, masing_force_rule, BranchRule, MasingState};
 use contactlab_core::CoreError;
 use proptest::prelude::*;
@@ -92,6 +94,36 @@ proptest! {
         }
         prop_assert_eq!(bits(&got), bits(&want));
         prop_assert_eq!(state_bits(&sp.end), state_bits(&want_end));
+    }
+
+    /// A pre-pass stopped at any boundary: the pieces before it and the rest as one piece
+    /// equal the serial kernel, and the rest ends in the serial end state.
+    #[test]
+    fn a_stopped_prepass_leaves_a_last_piece_to_the_end(
+        x in signal(), piece in 1usize..60, stop_at in 0usize..40,
+    ) {
+        let c = Exponential::new(40.0, 4.0e4).unwrap();
+        let st0 = MasingState::default();
+        let (want, want_end) = serial(&c, BranchRule::Scaled(2.0), &x, &st0);
+        let mut pieces = Vec::new();
+        let walked = split_each(&c, 2.0, &x, &st0, piece, |off, st| {
+            pieces.push((off, st));
+            pieces.len() <= stop_at
+        })
+        .unwrap();
+        let stopped = walked == Walked::Stopped;
+        prop_assert!(stopped || matches!(walked, Walked::Ended(_)));
+        let offs: Vec<usize> = pieces.iter().map(|p| p.0).chain([x.len()]).collect();
+        let mut got = vec![f64::NAN; x.len()];
+        let mut last = MasingState::default();
+        for (k, (off, st)) in pieces.iter().enumerate() {
+            let mut st = st.clone();
+            let end = offs[k + 1];
+            force_piece(&c, 2.0, &x[*off..end], &mut got[*off..end], &mut st).unwrap();
+            last = st;
+        }
+        prop_assert_eq!(bits(&got), bits(&want));
+        prop_assert_eq!(state_bits(&last), state_bits(&want_end));
     }
 
     /// Several channels (both curves, both rules, own start states) on 1 to 4 threads.

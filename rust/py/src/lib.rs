@@ -264,8 +264,8 @@ impl masing::split::Channel for MasingCore {
         x: &[f64],
         state: &MasingState,
         piece: usize,
-        emit: &mut dyn FnMut(usize, MasingState),
-    ) -> Result<Option<MasingState>, CoreError> {
+        emit: &mut dyn FnMut(usize, MasingState) -> bool,
+    ) -> Result<masing::split::Walked, CoreError> {
         let rule = self.rule();
         with_curve!(&self.curve, curve => masing::split::Model { curve, rule }.split(x, state, piece, emit))
     }
