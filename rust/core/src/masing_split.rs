@@ -163,6 +163,7 @@ pub fn split_each<C: Backbone>(
     }
     let mut offset = 0_usize;
     let mut dense = false;
+    let mut calm = false;
     for xc in x.chunks(piece) {
         if offset > 0 && n <= (piece / 4).saturating_add(64) {
             let h = resolve(curve, lam, inv, &mut stk[..n], w.xp);
@@ -189,9 +190,11 @@ pub fn split_each<C: Backbone>(
             let changes = if dense && w.dir != 0.0 && at > 0 {
                 w.dense(&mut stk, &mut n, xb, at)
             } else {
-                w.smooth(&mut stk, &mut n, xb, at)
+                w.smooth(&mut stk, &mut n, xb, at, calm)
             };
             dense = changes.saturating_mul(8) > xb.len();
+            // fewer than one change per 64 samples
+            calm = changes.saturating_mul(64) < xb.len();
             at = at.saturating_add(xb.len());
         }
         offset = offset.saturating_add(xc.len());
@@ -270,9 +273,21 @@ impl Walk {
     }
 
     /// A block where the input mostly moves on along its branch: a predicted test per
-    /// sample, the rules elsewhere. Returns the number of branch changes.
+    /// sample, the rules where needed; with `groups` (where the branch rarely changes:
+    /// elsewhere the group test mostly fails and costs) by [`Walk::grouped`]. Returns the
+    /// number of branch changes.
     #[inline(never)]
-    fn smooth(&mut self, stk: &mut [Entry], n: &mut usize, xb: &[f64], at: usize) -> usize {
+    fn smooth(
+        &mut self,
+        stk: &mut [Entry],
+        n: &mut usize,
+        xb: &[f64],
+        at: usize,
+        groups: bool,
+    ) -> usize {
+        if groups {
+            return self.grouped(stk, n, xb, at);
+        }
         let mut tgt = target(&stk[..*n], self.dir);
         let mut changes = 0_usize;
         for (p, &xi) in xb.iter().enumerate() {
@@ -286,6 +301,43 @@ impl Walk {
                 changes = changes.saturating_add(1);
             }
             tgt = target(&stk[..*n], self.dir);
+        }
+        changes
+    }
+
+    /// [`Walk::smooth`] by groups of eight samples: those that all move on along the branch
+    /// without reaching its closure point only move the last input (one branch-free test
+    /// per group); a group that does not pass goes sample by sample.
+    #[inline(never)]
+    // `&` on booleans on purpose: one branch-free test per group.
+    #[allow(clippy::needless_bitwise_bool)]
+    fn grouped(&mut self, stk: &mut [Entry], n: &mut usize, xb: &[f64], at: usize) -> usize {
+        let mut tgt = target(&stk[..*n], self.dir);
+        let mut changes = 0_usize;
+        for (g, xg) in xb.chunks(8).enumerate() {
+            let d = self.dir;
+            let mut on = xg.len() == 8;
+            let mut prev = self.xp;
+            for &v in xg {
+                on &= ((v - prev) * d > 0.0) & ((v - tgt) * d < 0.0);
+                prev = v;
+            }
+            if on {
+                self.xp = prev;
+                continue;
+            }
+            for (q, &xi) in xg.iter().enumerate() {
+                let dx = xi - self.xp;
+                if dx * self.dir > 0.0 && (xi - tgt) * self.dir < 0.0 {
+                    self.xp = xi;
+                    continue;
+                }
+                let i = at.saturating_add(g.saturating_mul(8)).saturating_add(q);
+                if self.rules(stk, n, xi, i) {
+                    changes = changes.saturating_add(1);
+                }
+                tgt = target(&stk[..*n], self.dir);
+            }
         }
         changes
     }

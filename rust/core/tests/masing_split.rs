@@ -247,3 +247,32 @@ fn errors_name_the_lowest_channel_and_leave_every_state() {
         "{r:?}"
     );
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Slow input (the pre-pass's grouped test on calm blocks) with reversals, repeats and
+    /// closures placed anywhere within its groups of eight.
+    #[test]
+    fn calm_input_with_events_anywhere_equals_the_serial_kernel(
+        period in 600.0f64..4000.0, events in prop::collection::vec((0usize..20_000, -3.0f64..3.0), 0..12),
+        piece in prop_oneof![3usize..40, 500usize..5000],
+    ) {
+        let c = Exponential::new(40.0, 4.0e4).unwrap();
+        let mut x: Vec<f64> = (0..20_000)
+            .map(|i| 1e-5 * (f64::from(i) * std::f64::consts::TAU / period).sin())
+            .collect();
+        for (at, v) in events {
+            x[at] = if v.abs() < 0.3 { x[at.saturating_sub(1)] } else { v * 1e-5 };
+        }
+        let (want, want_end) = serial(&c, BranchRule::Scaled(2.0), &x, &MasingState::default());
+        let m = Model { curve: &c, rule: BranchRule::Scaled(2.0) };
+        let mut st = vec![MasingState::default()];
+        let mut out = vec![f64::NAN; x.len()];
+        force_channels(&[&m], &[&x], vec![&mut out], &mut st, 2, piece, false).unwrap();
+        prop_assert_eq!(bits(&out), bits(&want));
+        prop_assert_eq!(state_bits(&st[0]), state_bits(&want_end));
+        let sp = split(&c, 2.0, &x, &MasingState::default(), piece).unwrap().unwrap();
+        prop_assert_eq!(state_bits(&sp.end), state_bits(&want_end));
+    }
+}
