@@ -7,7 +7,10 @@ after channel on one core), the two run back to back in alternating order, ``--r
 the modes in a rotating order:
 
 - rust threads: ``contactlab.force_many(model, channels, threads=cores)``, new output arrays
-  (as serial ``Masing.force``);
+  (as serial ``Masing.force``): the channels that balancing needs are cut into pieces of 2^16
+  samples after a comparisons-only pre-pass, and pieces and whole channels share one queue;
+- rust threads, whole channels: the same with nothing split (a piece longer than any channel;
+  the scheme before the pre-pass), out reused;
 - rust threads, out reused: the same into output arrays given with ``out=`` (paired with serial
   ``Masing.force(x, out=buf)``): no fresh output pages, so the first-touch page clearing, which
   on this VM is sometimes ten times slower than usual, is out of both sides;
@@ -16,16 +19,23 @@ the modes in a rotating order:
 - python processes: a ``ProcessPoolExecutor`` (arrays pickled to the workers and back;
   ``--no-processes`` skips them).
 
-For each mode: the speed-up of each pair (serial wall / mode wall), their median and the ratio
-of the best times (min / min); the requirement is >= 1.9x on 2 cores. CPU time (this process's
-threads; the pool's workers report their own) gives ``work`` (mode CPU / serial CPU of the
-pair: 1.0 when parallelism adds no work) and ``cpu speed-up`` (cores x serial CPU / mode CPU:
-what the wall speed-up tends to on idle cores with an even split). For the Rust threads the
-core reports each worker's jobs, start, end, CPU and run-queue wait (``stats=``): ``imbal``
-is (last end - first end) / wall, ``start`` the latest thread start, ``wait`` the summed time
-the workers were runnable without a CPU (other load), ``idle`` the part of the mode's wall x
-threads during which its workers were not on a CPU. ``uptime`` is printed before and after.
-Run: ``.venv/bin/python benches/bench_parallel.py [--channels 8] [--n 4000000] [--repeat 11]``.
+A last row (``--long``, default 1e8 samples; 0 skips it) is ONE channel: ``force_many`` on one
+thread vs on all cores, outputs reused, interleaved pairs likewise: the pre-pass and the pieces
+alone carry the scaling there.
+
+For each mode: the speed-up of each pair (serial wall / mode wall), their median, quartiles and
+range (the spread of the paired ratios), and the ratio of the best times (min / min); the
+requirement is >= 1.9x on 2 cores. ``prepass`` is the pre-pass's CPU as a share of the paired
+serial run's CPU (what splitting costs: the wall speed-up cannot exceed cores / (1 + prepass)). CPU
+time (this process's threads; the pool's workers report their own) gives ``work`` (mode CPU /
+serial CPU of the pair: 1.0 when parallelism adds no work) and ``cpu speed-up`` (cores x serial CPU
+/ mode CPU: what the wall speed-up tends to on idle cores with an even split). For the Rust threads
+the core reports each worker's jobs, start, end, CPU and run-queue wait (``stats=``): ``imbal`` is
+(last end - first end) / wall, ``start`` the latest thread start, ``wait`` the summed time the
+workers were runnable without a CPU (other load), ``idle`` the part of the mode's wall x threads
+during which its workers were not on a CPU. ``uptime`` is printed before and after.
+Run: ``.venv/bin/python benches/bench_parallel.py [--channels 8] [--n 4000000] [--repeat 21]
+[--long 1e8]``.
 """
 
 from __future__ import annotations
@@ -41,6 +51,7 @@ import numpy as np
 from scipy import signal
 
 import contactlab
+from contactlab import _core
 
 MODEL = contactlab.Masing(40.0, 4.0e4)
 
@@ -77,7 +88,10 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--channels", type=int, default=8)
     ap.add_argument("--n", type=int, default=1_000_000)
-    ap.add_argument("--repeat", type=int, default=11)
+    ap.add_argument("--repeat", type=int, default=21)
+    ap.add_argument(
+        "--long", type=float, default=1e8, help="samples of the one-channel row (0: none)"
+    )
     ap.add_argument("--no-processes", action="store_true")
     args = ap.parse_args()
     cores = os.cpu_count() or 1
@@ -88,10 +102,37 @@ def main() -> None:
     pbufs = [np.zeros(x.size) for x in xs]
     stats: dict[str, list[list[dict]]] = {}
 
+    wbufs = [np.zeros(x.size) for x in xs]
+
     def rust(name: str, out: list[np.ndarray] | None) -> list[np.ndarray]:
         st: list[dict] = []
         res = contactlab.force_many(MODEL, xs, threads=cores, out=out, stats=st)
         stats.setdefault(name, []).append(st)
+        return res
+
+    def whole() -> list[np.ndarray]:
+        # piece longer than any channel: every channel one job (nothing split)
+        res, st = _core.force_many(
+            [MODEL._core] * len(xs), xs, cores, wbufs, True, max(x.size for x in xs) + 1
+        )
+        stats.setdefault("rust threads, whole channels", []).append(st)
+        return res
+
+    long_x = channels(1, int(args.long)) if args.long >= 1 else []
+    long_ref = [_force(x) for x in long_x]
+    lbufs = [np.zeros(x.size) for x in long_x]
+    lpbufs = [np.zeros(x.size) for x in long_x]
+
+    def long_serial() -> list[np.ndarray]:
+        st: list[dict] = []
+        res = contactlab.force_many(MODEL, long_x, threads=1, out=lbufs, stats=st)
+        stats.setdefault("one channel serial", []).append(st)
+        return res
+
+    def long_par() -> list[np.ndarray]:
+        st: list[dict] = []
+        res = contactlab.force_many(MODEL, long_x, threads=cores, out=lpbufs, stats=st)
+        stats.setdefault("one channel", []).append(st)
         return res
 
     with ThreadPoolExecutor(cores) as tp, ProcessPoolExecutor(cores) as pp:
@@ -113,10 +154,13 @@ def main() -> None:
                 serial_reused,
                 lambda: rust("rust threads, out reused", pbufs),
             ),
+            "rust threads, whole channels": (serial_reused, whole),
             "python threads": (serial, lambda: list(tp.map(_force, xs))),
         }
         if not args.no_processes:
             pairs["python processes"] = (serial, processes)
+        if long_x:
+            pairs[f"one channel of {args.long:.0e}"] = (long_serial, long_par)
         names = list(pairs)
         # per mode: [(serial wall, serial cpu, mode wall, mode cpu), ...]
         rec: dict[str, list[tuple[float, float, float, float]]] = {k: [] for k in names}
@@ -127,7 +171,8 @@ def main() -> None:
             dt, dc = time.perf_counter() - t0, time.process_time() - c0
             if isinstance(out, tuple):  # the pool's workers report their own CPU time
                 out, dc = out[0], dc + out[1]
-            assert all(np.array_equal(a, b) for a, b in zip(out, ref, strict=True))
+            want = long_ref if len(out) == len(long_ref) and out[0].size != ref[0].size else ref
+            assert all(np.array_equal(a, b) for a, b in zip(out, want, strict=True))
             return dt, dc
 
         for r in range(args.repeat):
@@ -146,22 +191,34 @@ def main() -> None:
         "interleaved pairs per mode (rotating order, alternating within a pair)"
     )
     print(f"before: {before.strip()}\nafter:  {after.strip()}")
-    total = args.channels * args.n
     med = statistics.median
     print(
-        f"{'mode':<26}{'Ms/s':>7}{'serial':>7}{'speed-up med':>13}{'min/min':>9}{'work':>6}"
-        f"{'cpu speed-up':>13}{'imbal':>7}{'start ms':>9}{'wait ms':>8}{'idle':>6}"
+        f"{'mode':<29}{'Ms/s':>7}{'serial':>7}{'speed-up med':>13}{'q1-q3':>12}{'range':>12}"
+        f"{'min/min':>8}{'work':>6}{'cpu speed-up':>13}{'prepass':>8}{'imbal':>7}"
+        f"{'start ms':>9}{'wait ms':>8}{'idle':>6}"
     )
     for name in names:
+        total = int(args.long) if name.startswith("one channel") else args.channels * args.n
         sw, sc, mw, mc = (list(v) for v in zip(*rec[name], strict=True))
-        up = med(a / b for a, b in zip(sw, mw, strict=True))
+        ups = sorted(a / b for a, b in zip(sw, mw, strict=True))
+        up = med(ups)
+        q = statistics.quantiles(ups, n=4) if len(ups) > 1 else [up, up, up]
         mm = min(sw) / min(mw)
         work = med(b / a for a, b in zip(sc, mc, strict=True))
         cpu_up = cores / work
+        key = "one channel" if name.startswith("one channel") else name
+        pre = "-"
+        if key in stats and all(s.get("prepass_cpu") is not None for st in stats[key] for s in st):
+            shares = [
+                sum(s["prepass_cpu"] for s in st) / c for st, c in zip(stats[key], sc, strict=True)
+            ]
+            pre = f"{med(shares):.3f}"
         line = (
-            f"{name:<26}{total / min(mw) / 1e6:7.1f}{total / min(sw) / 1e6:7.1f}{up:12.2f}x"
-            f"{mm:8.2f}x{work:6.2f}{cpu_up:12.2f}x"
+            f"{name:<29}{total / min(mw) / 1e6:7.1f}{total / min(sw) / 1e6:7.1f}{up:12.2f}x"
+            f"{q[0]:6.2f}-{q[2]:<5.2f}{ups[0]:6.2f}-{ups[-1]:<5.2f}"
+            f"{mm:7.2f}x{work:6.2f}{cpu_up:12.2f}x{pre:>8}"
         )
+        name = key
         if name in stats:
             imbal, start, wait, idle = [], [], [], []
             for st, wall in zip(stats[name], mw, strict=True):

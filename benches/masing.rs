@@ -12,6 +12,11 @@
 //! 1.3), given for the medians and for the minima. The outputs of the last repeat are
 //! compared (max |difference| / h0).
 //!
+//! The pre-pass of the split kernel (`masing::split::split_each`: the memory rules with no
+//! curve evaluation, what cutting a channel into independent pieces costs) is timed the same
+//! way on the same pieces from the same states: `pre ns` and `pre/kern` (the wall speed-up of
+//! one channel on two threads is at most `2 - pre/kern`).
+//!
 //! Run: `cargo bench -p contactlab-core --bench masing`
 //! (`-- --n 1000000 --repeat 15 --piece 100000 --signal random_walk`).
 //!
@@ -22,6 +27,7 @@
 //! `contactlab_core::*` symbols.
 
 use contactlab_core::curve::Exponential;
+use contactlab_core::masing::split::{split_each, Walked};
 use contactlab_core::masing::{masing_force, MasingState};
 use std::hint::black_box;
 use std::time::Instant;
@@ -68,6 +74,16 @@ fn kernel_piece(c: &Exponential, x: &[f64], out: &mut [f64], p: Range, st: &mut 
     black_box(out);
 }
 
+/// The split kernel's pre-pass over one piece from `st` (one piece: no boundary inside).
+#[inline(never)]
+fn prepass_piece(c: &Exponential, x: &[f64], p: Range, st: &MasingState) -> usize {
+    let w = split_each(c, 2.0, black_box(&x[p]), st, usize::MAX, |_, _| true).unwrap();
+    match black_box(w) {
+        Walked::Ended(e) => e.stack.len(),
+        Walked::Whole | Walked::Stopped => 0,
+    }
+}
+
 type Range = std::ops::Range<usize>;
 
 fn main() {
@@ -101,17 +117,31 @@ fn main() {
          interleaved repeats, summed; generic build"
     );
     println!(
-        "{:<20}{:>12}{:>12}{:>9}{:>12}{:>12}{:>9}{:>13}",
-        "signal", "kern ns", "ref ns", "ratio", "kern min", "ref min", "ratio", "max |d|/h0"
+        "{:<20}{:>12}{:>12}{:>9}{:>12}{:>12}{:>9}{:>13}{:>9}{:>10}",
+        "signal",
+        "kern ns",
+        "ref ns",
+        "ratio",
+        "kern min",
+        "ref min",
+        "ratio",
+        "max |d|/h0",
+        "pre ns",
+        "pre/kern"
     );
     let mut worst = f64::INFINITY;
     for (name, x) in &cases {
         let mut t_k = vec![vec![0.0; repeat]; pieces.len()];
         let mut t_r = vec![vec![0.0; repeat]; pieces.len()];
+        let mut t_p = vec![vec![0.0; repeat]; pieces.len()];
         for r in 0..repeat {
             let mut st = MasingState::default();
             rf.reset();
             for (k, p) in pieces.iter().enumerate() {
+                let before = st.clone();
+                let t0 = Instant::now();
+                prepass_piece(&curve, x, p.clone(), &before);
+                t_p[k][r] = t0.elapsed().as_secs_f64();
                 let mut time_ref = || {
                     let t0 = Instant::now();
                     reference_piece(&mut rf, x, &mut out_ref, p.clone());
@@ -137,6 +167,7 @@ fn main() {
         let min = |v: &mut [f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
         let (k_med, r_med) = (total(&mut t_k, median), total(&mut t_r, median));
         let (k_min, r_min) = (total(&mut t_k, min), total(&mut t_r, min));
+        let p_med = total(&mut t_p, median);
         let diff = out
             .iter()
             .zip(&out_ref)
@@ -146,12 +177,14 @@ fn main() {
         worst = worst.min(ratio);
         let ns = |t: f64| t / n as f64 * 1e9;
         println!(
-            "{name:<20}{:>12.2}{:>12.2}{ratio:>9.2}{:>12.2}{:>12.2}{:>9.2}{diff:>13.1e}",
+            "{name:<20}{:>12.2}{:>12.2}{ratio:>9.2}{:>12.2}{:>12.2}{:>9.2}{diff:>13.1e}{:>9.2}{:>10.3}",
             ns(k_med),
             ns(r_med),
             ns(k_min),
             ns(r_min),
             r_min / k_min,
+            ns(p_med),
+            p_med / k_med,
         );
     }
     println!(

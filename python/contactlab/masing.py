@@ -97,17 +97,28 @@ class Masing:
         return self._backbone is None
 
     # -- history-dependent response --------------------------------------------------------
-    def force(self, x: Any, state: Any = None, out: np.ndarray | None = None) -> np.ndarray:
+    def force(
+        self,
+        x: Any,
+        state: Any = None,
+        out: np.ndarray | None = None,
+        threads: int | None = 1,
+    ) -> np.ndarray:
         """Force for the displacement history ``x`` (starting at the origin unless ``state``).
 
         ``out``: a float64 array of the same length to write into (reused between calls, as a
-        fit's model evaluations do); returned.
+        fit's model evaluations do); returned. ``threads``: Rust threads for one long record
+        (``None``: every CPU; default 1, so that callers already running in parallel do not
+        oversubscribe). From 2^17 samples on the record is then cut into pieces of 2^16 whose
+        start states a comparisons-only pre-pass finds (costing 0.1-0.6 of the force
+        kernel's CPU, by how often the input reverses), and the pieces share the threads;
+        the forces are those of one thread bit for bit.
         """
         xa = as_1d(x, "x", finite=False)  # the core names a non-finite sample's index
         op = self.operator()
         if state is not None:
             op.state = state
-        return op.push(xa, out=out)
+        return op.push(xa, out=out, threads=_threads_for(threads))
 
     def operator(self) -> MasingOperator:
         """A stateful operator for streaming a recording chunk by chunk."""
@@ -153,6 +164,19 @@ class Masing:
         return restore(np.ascontiguousarray(k), x, sc)
 
 
+def _check_threads(threads: Any) -> int:
+    if isinstance(threads, bool) or not (isinstance(threads, int | np.integer) and threads >= 1):
+        raise InputError(f"threads must be an integer >= 1, got {threads!r}")
+    return int(threads)
+
+
+def _threads_for(threads: int | None) -> int:
+    """``threads``, or every CPU for ``None``."""
+    import os
+
+    return (os.cpu_count() or 1) if threads is None else _check_threads(threads)
+
+
 @contextlib.contextmanager
 def _one_thread() -> Iterator[None]:
     """An operator is stateful: a second thread pushing while the first one is (the kernel
@@ -180,11 +204,16 @@ class MasingOperator:
         self.model = model
         self._core = model._core.fresh()
 
-    def push(self, chunk: Any, out: np.ndarray | None = None) -> np.ndarray:
-        """Forces for the next chunk of displacement samples (into ``out`` when given)."""
+    def push(self, chunk: Any, out: np.ndarray | None = None, threads: int = 1) -> np.ndarray:
+        """Forces for the next chunk of displacement samples (into ``out`` when given).
+
+        ``threads`` > 1 splits a long chunk over that many Rust threads (see
+        :meth:`Masing.force`); the result is the same bit for bit.
+        """
         x = as_1d(chunk, "x", allow_empty=True, finite=False)
+        threads = _check_threads(threads)
         with _one_thread():
-            return self._core.push(x, _out_buffer(out, x.size))
+            return self._core.push(x, _out_buffer(out, x.size), threads)
 
     def cycles(self, chunk: Any) -> CycleTable:
         """Closed cycles in the next chunk (advances the state like ``push``)."""
@@ -254,16 +283,20 @@ def force_many(
 
     Each signal starts at the origin with its own model (one :class:`Masing` for all, or a
     sequence with one per signal). The work runs on ``threads`` Rust threads inside one call
-    with the GIL released (default: the number of CPUs), handing out one channel at a time,
-    longest first, so that the threads finish together.
+    with the GIL released (default: the number of CPUs). Channels of 2^17 samples or more are
+    cut into pieces of 2^16 whose start states a comparisons-only pre-pass finds (one channel
+    per thread); then pieces and short channels are handed out one at a time from one queue,
+    longest first, so that threads of unequal speed finish together. The forces are those of
+    :meth:`Masing.force` on one thread, bit for bit.
 
     ``out``: a sequence of float64 arrays, one per signal and of its length, written in place
     and returned (reused between calls: fresh output pages cost the first touch, which on
     some machines rivals the kernel). ``stats``: a list that receives one dict per worker
     thread — ``jobs``, ``samples``, ``start`` and ``end`` (seconds since the call began),
     ``cpu`` (CPU seconds) and ``wait`` (seconds runnable but waiting for a CPU; both None
-    where the system does not tell) — to see whether the split, the start or other load
-    limits the scaling.
+    where the system does not tell), ``prepass`` and ``prepass_cpu`` (the pre-pass's share
+    of the wall and CPU seconds) — to see whether the split, the start or other load limits
+    the scaling.
 
     Examples
     --------
@@ -284,10 +317,7 @@ def force_many(
     for i, m in enumerate(ms):
         if not isinstance(m, Masing):
             raise InputError(f"models[{i}] must be a contactlab.Masing, got {type(m).__name__}")
-    if threads is None:
-        threads = os.cpu_count() or 1
-    if not (isinstance(threads, int | np.integer) and threads >= 1):
-        raise InputError(f"threads must be an integer >= 1, got {threads!r}")
+    threads = (os.cpu_count() or 1) if threads is None else _check_threads(threads)
     outs = None
     if out is not None:
         outs = list(out)

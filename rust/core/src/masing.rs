@@ -15,6 +15,9 @@ use crate::error::{check_positive, CoreError};
 mod kernel;
 use kernel::{eval_block, Run, BLOCK, KNOWN};
 
+#[path = "masing_split.rs"]
+pub mod split;
+
 /// A remembered reversal point.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Reversal {

@@ -33,10 +33,15 @@ pub struct ThreadStats {
     pub cpu: Option<f64>,
     /// Seconds the thread was runnable but waited for a CPU (None where not available).
     pub wait: Option<f64>,
+    /// Seconds of a first phase before the jobs (the pre-pass of
+    /// `crate::masing::split::force_channels`), 0 without one.
+    pub prepass: f64,
+    /// CPU seconds of that phase (None where not available or without one).
+    pub prepass_cpu: Option<f64>,
 }
 
 /// `(on-CPU ns, run-queue wait ns)` of the calling thread from `/proc/thread-self/schedstat`.
-fn schedstat() -> Option<(u64, u64)> {
+pub(crate) fn schedstat() -> Option<(u64, u64)> {
     let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
     let mut it = s.split_ascii_whitespace().map(str::parse::<u64>);
     match (it.next(), it.next()) {

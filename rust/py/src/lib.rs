@@ -122,12 +122,16 @@ impl MasingCore {
 
     /// Forces for the chunk `x`, continuing the carried history; into `out` when given
     /// (same length, contiguous float64), else into a new array.
-    #[pyo3(signature = (x, out=None))]
+    /// With `threads > 1` a long chunk runs in pieces of `piece` samples on that many threads
+    /// (`contactlab_core::masing::split`), bit for bit the same.
+    #[pyo3(signature = (x, out=None, threads=1, piece=masing::split::PIECE))]
     fn push<'py>(
         &mut self,
         py: Python<'py>,
         x: PyReadonlyArray1<'py, f64>,
         out: Option<Bound<'py, PyArray1<f64>>>,
+        threads: usize,
+        piece: usize,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let xs = slice(&x, "x")?;
         // A new output is allocated by numpy, which asks the OS for transparent huge pages on
@@ -146,7 +150,22 @@ impl MasingCore {
             let out = rw
                 .as_slice_mut()
                 .map_err(|_| errors::input(py, "out must be contiguous"))?;
+            let me = &*self;
             st = detach_guarded(py, || {
+                if threads > 1 {
+                    let mut sts = [st];
+                    masing::split::force_channels(
+                        &[me],
+                        &[xs],
+                        vec![out],
+                        &mut sts,
+                        threads,
+                        piece,
+                        false,
+                    )?;
+                    let [s] = sts;
+                    return Ok(s);
+                }
                 with_curve!(curve, c => masing::masing_force_rule(c, rule, xs, out, &mut st))?;
                 Ok(st)
             })?;
@@ -239,14 +258,33 @@ impl MasingCore {
     }
 }
 
-impl MasingCore {
-    /// Forces of `x` from the origin (no carried state): one channel of `force_many`.
-    pub(crate) fn force_from_origin(&self, x: &[f64], out: &mut [f64]) -> Result<(), CoreError> {
-        let mut st = MasingState::default();
+impl masing::split::Channel for MasingCore {
+    fn split(
+        &self,
+        x: &[f64],
+        state: &MasingState,
+        piece: usize,
+        emit: &mut dyn FnMut(usize, MasingState) -> bool,
+    ) -> Result<masing::split::Walked, CoreError> {
         let rule = self.rule();
-        with_curve!(&self.curve, c => masing::masing_force_rule(c, rule, x, out, &mut st))
+        with_curve!(&self.curve, curve => masing::split::Model { curve, rule }.split(x, state, piece, emit))
     }
+    fn piece(
+        &self,
+        x: &[f64],
+        out: &mut [f64],
+        state: &mut MasingState,
+    ) -> Result<bool, CoreError> {
+        let rule = self.rule();
+        with_curve!(&self.curve, curve => masing::split::Model { curve, rule }.piece(x, out, state))
+    }
+    fn whole(&self, x: &[f64], out: &mut [f64], state: &mut MasingState) -> Result<(), CoreError> {
+        let rule = self.rule();
+        with_curve!(&self.curve, c => masing::masing_force_rule(c, rule, x, out, state))
+    }
+}
 
+impl MasingCore {
     fn map<'py>(
         &self,
         py: Python<'py>,

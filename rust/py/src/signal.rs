@@ -1,8 +1,8 @@
 //! Bindings of `contactlab_core::signal` (the streaming reversal detector), the branch memory
 //! of the Masing rules, and the multi-channel force kernel (Rust threads).
 
+use contactlab_core::masing::split::{force_channels, Channel, PIECE};
 use contactlab_core::masing::{branch_memory, MasingState};
-use contactlab_core::parallel::run_jobs;
 use contactlab_core::signal::{
     cycle_block, fold_phase, fold_spread, loop_area_sensitivity, loop_areas, period_means,
     CycleState, Excursion, FoldSums, Schmitt,
@@ -121,14 +121,16 @@ fn branch_memory_py<'py>(
 }
 
 /// Forces of several channels, each from the origin with its own model, on up to `threads`
-/// Rust threads inside this one call (GIL released; `contactlab_core::parallel::run_jobs`:
-/// longest channel first, one at a time from a shared queue). Into `outs` when given (one
+/// Rust threads inside this one call (GIL released; `contactlab_core::masing::split::
+/// force_channels`: channels of at least two pieces of `piece` samples are split by a
+/// comparisons-only pre-pass, then pieces and short channels go longest first from one shared
+/// queue; bit for bit the serial kernel). Into `outs` when given (one
 /// contiguous float64 array per channel, reused between calls: no fresh pages to fault in),
 /// else into new arrays. Returns the outputs and one dict per worker thread (`jobs`,
-/// `samples`, `start`, `end`, `cpu`, `wait`; seconds; `cpu`/`wait` only with `cpu_times`
-/// and where the system tells, else None).
+/// `samples`, `start`, `end`, `cpu`, `wait`, `prepass`, `prepass_cpu`; seconds; the CPU
+/// times only with `cpu_times` and where the system tells, else None).
 #[pyfunction]
-#[pyo3(signature = (models, xs, threads, outs=None, cpu_times=false))]
+#[pyo3(signature = (models, xs, threads, outs=None, cpu_times=false, piece=PIECE))]
 fn force_many<'py>(
     py: Python<'py>,
     models: Vec<PyRef<'py, MasingCore>>,
@@ -136,6 +138,7 @@ fn force_many<'py>(
     threads: usize,
     outs: Option<Vec<Bound<'py, PyArray1<f64>>>>,
     cpu_times: bool,
+    piece: usize,
 ) -> PyResult<ManyForces<'py>> {
     if models.len() != xs.len() {
         return Err(input(
@@ -188,15 +191,11 @@ fn force_many<'py>(
         }
         jobs.push((x, o));
     }
-    let cores: Vec<&MasingCore> = models.iter().map(|m| &**m).collect();
+    let cores: Vec<&dyn Channel> = models.iter().map(|m| &**m as &dyn Channel).collect();
+    let (xs, os): (Vec<&[f64]>, Vec<&mut [f64]>) = jobs.into_iter().unzip();
+    let mut states = vec![MasingState::default(); xs.len()];
     let stats = detach_guarded(py, || {
-        run_jobs(
-            jobs,
-            threads,
-            cpu_times,
-            |j| j.0.len(),
-            |i, (x, out)| cores[i].force_from_origin(x, out),
-        )
+        force_channels(&cores, &xs, os, &mut states, threads, piece, cpu_times)
     })?;
     drop(rws);
     let mut dicts = Vec::with_capacity(stats.len());
@@ -208,6 +207,8 @@ fn force_many<'py>(
         d.set_item("end", s.end)?;
         d.set_item("cpu", s.cpu)?;
         d.set_item("wait", s.wait)?;
+        d.set_item("prepass", s.prepass)?;
+        d.set_item("prepass_cpu", s.prepass_cpu)?;
         dicts.push(d);
     }
     Ok((outs, dicts))
