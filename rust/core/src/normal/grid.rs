@@ -15,13 +15,25 @@
 //! extrapolation of the last states; one step when `k_s` does not depend on δ). An interval
 //! whose iteration fails is retried in shorter steps.
 //!
+//! Error control: each step compares its cubic `N` with the quintic Hermite that also matches
+//! `N''` (exact along the solution, from `p''` of the forcing's segment) at both ends. Their
+//! difference `u²(1−u)²(α + βu)` is the leading term of the cubic's interpolation error; its
+//! effect on δ₁ (the step's weights of that term, over the Newton derivative, which carries
+//! the magnification `k_s / k_t` where the tangent stiffness `k_t` is small) is the local
+//! error estimate. A sample interval with a step above [`ERROR_TOL`] of the displacement
+//! scale is redone in twice as many steps (up to [`RETRY_FACTOR`] times as many), and the
+//! next interval starts at that count (halved when well below the tolerance). Measured
+//! against RODAS4 at rtol 1e-11 over the diagnosis' laws: the error stays within 1.1e-4 of
+//! the displacement range, also where `k_s` dips to a third of `k`.
+//!
 //! Properties:
 //! - For a constant `k_s`, `N = p / k` is the forcing's own cubic and the step is the exact
 //!   solution under that forcing (the Kelvin-Voigt response the diagnosis fits).
 //! - L-stable: the stiff decay is integrated exactly, so any `λ` is stable.
 //! - The local error is the interpolation error of `N`, `O(h⁴ N'''')`, about
-//!   `(ω h)⁴ / 384` of the displacement per step; every sample interval may be split into
-//!   `substeps` equal steps over the same cubic forcing where the record is sampled coarsely.
+//!   `(ω h)⁴ / 384` of the displacement per step; every sample interval is split into at
+//!   least `substeps` equal steps over the same cubic forcing, and more where the error
+//!   estimate asks for them.
 //! - Work: a few multiplications and 1–3 Newton iterations per step; the moments are computed
 //!   once when the steps are equal (to 1e-9), else per interval.
 //!
@@ -50,6 +62,17 @@ const LAYER_MAX_SUBSTEPS: f64 = 4096.0;
 /// A step whose cubic `N` has a u³ term above this fraction of the displacement scale is
 /// retried in shorter steps (see `simulate_grid`).
 const JUMP: f64 = 0.1;
+
+/// A step whose error estimate (see `advance`) is above this fraction of the displacement
+/// scale is retried in shorter steps. The error over a record stays within about 4 times
+/// this (measured: 1.1e-4 of the range at most over 979 random laws and records; 5.1e-4 at
+/// 1e-4; 3.7e-5 at 1e-5, which takes 1.5 times the steps on a noisy record at 111 samples per
+/// period where this takes 1.02-1.1 times).
+const ERROR_TOL: f64 = 3e-5;
+
+/// After an interval that needed more steps than asked, the next one starts with as many,
+/// or half as many when its worst estimate was below this fraction of the tolerance.
+const COARSEN: f64 = 1.0 / 32.0;
 
 /// An interval whose iteration fails is retried in up to this many times as many steps.
 const RETRY_FACTOR: f64 = 64.0;
@@ -87,7 +110,44 @@ pub fn exp_moments(lam: f64) -> [f64; 4] {
     out
 }
 
-/// The step's constants: `e^{−λ}` and `λ W₀, λ V₀, λ W₁, λ V₁`.
+/// `λ ∫₀¹ e^{−λ s} s² (1 − s)^j ds` for j = 2, 3 (`s = 1 − u`): the weights of the step's
+/// error estimate. Series `Σ_i (−λ)^i / i! · B_i` (`B_i = ∫ s^{2+i} (1−s)^j ds`, a Beta
+/// function) where `λ < 2`; else the moments `K_k = ∫₀¹ e^{−λ s} s^k ds` by the upward
+/// recursion `K_k = (k K_{k−1} − e^{−λ}) / λ` (an error grows by at most `k/λ ≤ 5/2` per
+/// step), whose combination does not cancel for large λ (`K_k ≈ k!/λ^{k+1}`).
+fn error_moments(lam: f64) -> [f64; 2] {
+    if lam < 2.0 {
+        // B(a, b) = (a−1)! (b−1)! / (a+b−1)!, a = 3 + i, b = j + 1
+        let mut out = [0.0; 2];
+        for (j, o) in [2_u32, 3].into_iter().zip(out.iter_mut()) {
+            let jf = f64::from(j);
+            // B_0 = 2! j! / (j+3)!, B_{i+1} = B_i (3+i) / (j+4+i); term_i = B_i (−λ)^i / i!
+            let mut term = 2.0 * (1..=j).map(f64::from).product::<f64>()
+                / (1..=j + 3).map(f64::from).product::<f64>();
+            let mut acc = term;
+            for i in 0_u32..30 {
+                let fi = f64::from(i);
+                term *= -lam / (fi + 1.0) * (3.0 + fi) / (jf + 4.0 + fi);
+                acc += term;
+            }
+            *o = lam * acc;
+        }
+        return out;
+    }
+    let e = (-lam.min(MAX_LAMBDA)).exp();
+    let mut k = [0.0; 6];
+    k[0] = -(-lam).exp_m1() / lam;
+    for i in 1..6 {
+        k[i] = (i as f64 * k[i - 1] - e) / lam;
+    }
+    [
+        lam * (k[2] - 2.0 * k[3] + k[4]),
+        lam * (k[2] - 3.0 * k[3] + 3.0 * k[4] - k[5]),
+    ]
+}
+
+/// The step's constants: `e^{−λ}`, `λ W₀, λ V₀, λ W₁, λ V₁`, and the error weights
+/// `ea = λ ∫ e^{−λ(1−u)} u²(1−u)² du`, `eb = λ ∫ e^{−λ(1−u)} u³(1−u)² du`.
 #[derive(Debug, Clone, Copy)]
 struct Weights {
     decay: f64,
@@ -95,18 +155,23 @@ struct Weights {
     v0: f64,
     w1: f64,
     v1: f64,
+    ea: f64,
+    eb: f64,
 }
 
 impl Weights {
     fn new(lam: f64) -> Self {
         let l = lam.min(MAX_LAMBDA);
         let [i0, i1, i2, i3] = exp_moments(lam);
+        let [ea, eb] = error_moments(lam);
         Self {
             decay: (-l).exp(),
             w0: lam * (i0 - 3.0 * i2 + 2.0 * i3),
             v0: lam * (i1 - 2.0 * i2 + i3),
             w1: lam * (3.0 * i2 - 2.0 * i3),
             v1: lam * (i3 - i2),
+            ea,
+            eb,
         }
     }
 }
@@ -121,6 +186,11 @@ struct Quasi {
     dm: f64,
     /// `δ' = a (n − δ)`.
     f: f64,
+    /// `1/k_s` and `k_s'`, `k_s''` for a δ-dependent `k_s` (zero otherwise), for
+    /// [`curvature`].
+    ik: f64,
+    k1: f64,
+    k2: f64,
 }
 
 /// `n = p / k_s`, `N' = ∂n/∂t + ∂n/∂δ · δ'` and their exact derivatives in δ. Only a
@@ -130,13 +200,7 @@ struct Quasi {
 fn quasi(model: &ContactModel, p: f64, dp: f64, delta: f64) -> Result<Quasi, CoreError> {
     let a = model.rate();
     if let Stiffness::Delta(c) = model.stiffness() {
-        // k, k', k'' in one Horner pass
-        let (mut k, mut k1, mut k2) = (0.0, 0.0, 0.0);
-        for &ci in c.iter().rev() {
-            k2 = k2 * delta + 2.0 * k1;
-            k1 = k1 * delta + k;
-            k = k * delta + ci;
-        }
+        let (k, k1, k2) = horner2(c, delta);
         if !(k > 0.0 && k.is_finite()) {
             return Err(CoreError::NonPositiveStiffness {
                 name: "delta",
@@ -157,6 +221,9 @@ fn quasi(model: &ContactModel, p: f64, dp: f64, delta: f64) -> Result<Quasi, Cor
             dn,
             dm: ntd + dn2 * f + dn * a * (dn - 1.0),
             f,
+            ik,
+            k1,
+            k2,
         });
     }
     let e = model.eval(p, dp, delta)?;
@@ -167,7 +234,55 @@ fn quasi(model: &ContactModel, p: f64, dp: f64, delta: f64) -> Result<Quasi, Cor
         dn: 0.0,
         dm: 0.0,
         f: e.f,
+        ik: 0.0,
+        k1: 0.0,
+        k2: 0.0,
     })
+}
+
+/// `k`, `k'`, `k''` of the polynomial `c` at `x` in one Horner pass.
+#[inline]
+fn horner2(c: &[f64], x: f64) -> (f64, f64, f64) {
+    let (mut k, mut k1, mut k2) = (0.0, 0.0, 0.0);
+    for &ci in c.iter().rev() {
+        k2 = k2 * x + 2.0 * k1;
+        k1 = k1 * x + k;
+        k = k * x + ci;
+    }
+    (k, k1, k2)
+}
+
+/// `N''` along the solution at `(p, dp/dt, d²p/dt²)`, `q` the values there (`N'` in
+/// `q.m`, `δ'` in `q.f`): with `n = p g(δ)`, `g = 1/k_s`,
+/// `N'' = p'' g + 2 p' g' δ' + p g'' δ'² + p g' δ''` and `δ'' = a (N' − δ')`; for a
+/// pressure-dependent `k_s`, `N = n(p)` and `N'' = n_pp p'² + n_p p''`. Not finite where
+/// `k_s ≤ 0` (the caller takes that as a failed estimate).
+#[inline(always)]
+fn curvature(model: &ContactModel, p: f64, dp: f64, dp2: f64, q: &Quasi) -> f64 {
+    match model.stiffness() {
+        Stiffness::Constant(k) => dp2 / k,
+        Stiffness::Delta(_) => {
+            let ik2 = q.ik * q.ik;
+            let g1 = -q.k1 * ik2;
+            let g2 = (2.0 * q.k1 * q.k1 * q.ik - q.k2) * ik2;
+            let d2 = model.rate() * (q.m - q.f);
+            dp2 * q.ik + 2.0 * dp * g1 * q.f + p * (g2 * q.f * q.f + g1 * d2)
+        }
+        Stiffness::Pressure(c) => {
+            let (k, k1, k2) = horner2(c, p);
+            let ik = 1.0 / k;
+            let np = (k - p * k1) * ik * ik;
+            let npp = -(p * k2 * k + 2.0 * k1 * (k - p * k1)) * ik * ik * ik;
+            npp * dp * dp + np * dp2
+        }
+    }
+}
+
+/// `d²p/dt²` of the segment at `t`.
+#[inline]
+fn second_deriv(seg: &Segment, t: f64) -> f64 {
+    let s = (t - seg.t0) * seg.inv_h;
+    (2.0 * seg.c[2] + 6.0 * s * seg.c[3]) * seg.inv_h * seg.inv_h
 }
 
 /// The integration state between steps: δ and its end values, and the predictor's history
@@ -176,6 +291,10 @@ fn quasi(model: &ContactModel, p: f64, dp: f64, delta: f64) -> Result<Quasi, Cor
 struct State {
     y: f64,
     q0: Quasi,
+    /// `N''` at `y` under the current segment's `p''`, and `p`, `dp/dt` there.
+    m2: f64,
+    p: f64,
+    dp: f64,
     y_prev: f64,
     y_prev2: f64,
     h_last: f64,
@@ -183,9 +302,16 @@ struct State {
 }
 
 /// `n` equal steps of length `h` over one sample interval `[t0, t_end]` of the forcing `seg`.
-/// `Ok(Ok(resolved))`: done, `resolved` false when a step's cubic `N` had a third-order term
-/// above `jump` (a fast transient the steps do not follow); `Ok(Err(status))` when a step's
-/// iteration fails (the state is then partly advanced).
+/// `Ok(Ok(worst))`: done, `worst` the largest over the steps of the error estimate over
+/// `etol` and of the cubic `N`'s third-order term over `jump` (a fast transient the steps do
+/// not follow): above 1 (or NaN) the interval is not resolved. `Ok(Err(status))` when a
+/// step's iteration fails (the state is then partly advanced).
+///
+/// The error estimate: the step's cubic Hermite `N` against the quintic Hermite that also
+/// matches `N''` at both ends (the same data and one derivative more). Their difference is
+/// `u²(1−u)²(α + βu)`; it changes the step's right-hand side by `α ea + β eb`, and δ₁ by that
+/// over the Newton derivative `dg` (which carries the δ-dependence of `N₁`: a small
+/// tangent stiffness magnifies the error by `k_s / k_t`).
 #[allow(clippy::too_many_arguments)]
 fn advance(
     model: &ContactModel,
@@ -196,12 +322,19 @@ fn advance(
     h: f64,
     wt: &Weights,
     tol: f64,
-    jump: f64,
+    inv_etol: f64,
+    inv_jump: f64,
     st: &mut State,
     stats: &mut Stats,
-) -> Result<Result<bool, Status>, CoreError> {
+) -> Result<Result<f64, Status>, CoreError> {
     let a = model.rate();
-    let mut resolved = true;
+    let mut worst = 0.0_f64;
+    // a constant k_s makes N the forcing's cubic over k: the step is exact, nothing to estimate
+    let estimate = !matches!(model.stiffness(), Stiffness::Constant(_));
+    // N'' at the interval's start under this segment's p'' (p and p' are continuous)
+    if estimate {
+        st.m2 = curvature(model, st.p, st.dp, second_deriv(seg, t0), &st.q0);
+    }
     for s in 1..=n {
         let t1 = if s == n { t_end } else { t0 + s as f64 * h };
         let (p1, dp1) = seg.value_deriv(t1);
@@ -216,7 +349,7 @@ fn advance(
         };
         let mut iters = 0_u32;
         let mut prev = f64::INFINITY; // the previous Newton step's size
-        let (mut q1, mut y_it);
+        let (mut q1, mut y_it, mut inv_dg);
         loop {
             y_it = y1;
             q1 = match quasi(model, p1, dp1, y1) {
@@ -233,8 +366,8 @@ fn advance(
             };
             stats.nfev = stats.nfev.saturating_add(1);
             let g = y1 - base - wt.w1 * q1.n - wt.v1 * h * q1.m;
-            let dg = 1.0 - wt.w1 * q1.dn - wt.v1 * h * q1.dm;
-            let step = g / dg;
+            inv_dg = 1.0 / (1.0 - wt.w1 * q1.dn - wt.v1 * h * q1.dm);
+            let step = g * inv_dg;
             if !step.is_finite() {
                 return Ok(Err(Status::NoConvergence { time: t1 }));
             }
@@ -266,10 +399,23 @@ fn advance(
         q1.n += q1.dn * dy;
         q1.m += q1.dm * dy;
         q1.f = a * (q1.n - y1);
-        // the u³ coefficient of the step's cubic N: O(h³ N''') on a smooth solution
+        // the step's cubic N = N₀ + h N'₀ u + c2 u² + c3 u³ (c3 is O(h³ N''') on a smooth
+        // solution), and the quintic's extra term u²(1−u)²(α + βu) from N'' at both ends
         let c3 = 2.0 * (st.q0.n - q1.n) + h * (st.q0.m + q1.m);
-        if c3.abs() > jump {
-            resolved = false;
+        let mut ratio = c3.abs() * inv_jump;
+        let mut m2_1 = 0.0;
+        if estimate {
+            m2_1 = curvature(model, p1, dp1, second_deriv(seg, t1), &q1);
+            let c2 = 3.0 * (q1.n - st.q0.n) - h * (2.0 * st.q0.m + q1.m);
+            let hh = h * h;
+            let alpha = 0.5 * hh * st.m2 - c2;
+            let beta = 0.5 * hh * m2_1 - c2 - 3.0 * c3 - alpha;
+            let est = (alpha * wt.ea + beta * wt.eb) * inv_dg;
+            ratio = ratio.max(est.abs() * inv_etol);
+        }
+        // NaN (k_s <= 0 at the converged end, an overflow) counts as unresolved and stays
+        if ratio > worst || ratio.is_nan() {
+            worst = ratio;
         }
         stats.n_accepted = stats.n_accepted.saturating_add(1);
         st.equal_run = if h == st.h_last {
@@ -282,8 +428,11 @@ fn advance(
         st.y_prev = y;
         st.y = y1;
         st.q0 = q1;
+        st.m2 = m2_1;
+        st.p = p1;
+        st.dp = dp1;
     }
-    Ok(Ok(resolved))
+    Ok(Ok(worst))
 }
 
 /// Integrate `model` driven by `forcing` from `delta0` at the first sample on the samples'
@@ -344,7 +493,9 @@ pub fn simulate_grid(
     // taken as resolved: smooth records give (ω h)³/6 of the scale, 1e-4 at 64 samples per
     // period, and 0.3 % noise on p about 1e-2
     let p_max = forcing.values().iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-    let jump = JUMP * p_max / model.k_s(0.0, 0.0).abs();
+    let scale = p_max / model.k_s(0.0, 0.0).abs();
+    let jump = JUMP * scale;
+    let etol = ERROR_TOL * scale;
     let w_uni = Weights::new(a * h_uni);
 
     let mut stats = Stats::default();
@@ -356,6 +507,9 @@ pub fn simulate_grid(
     let mut st = State {
         y: delta0,
         q0: q_first,
+        m2: 0.0,
+        p: p_first,
+        dp: dp_first,
         y_prev: delta0,
         y_prev2: delta0,
         h_last: 0.0,
@@ -371,6 +525,10 @@ pub fn simulate_grid(
     let inv_2h = 0.5 / (0.5 * (lo + hi));
     let central = uniform && !forcing.has_dpdt();
     let last = n.saturating_sub(1);
+    // how many times the asked steps the last interval needed (a power of two)
+    let mut refine = 1.0_f64;
+    // the weights of the last refined equal steps
+    let mut w_refined: Option<(f64, Weights)> = None;
     for (i, w) in t.windows(2).enumerate() {
         let span = w[1] - w[0];
         // the cubic Hermite segment (Forcing::segment), the slope at its start carried over
@@ -390,7 +548,7 @@ pub fn simulate_grid(
         // cubic N cannot follow over a step of λ ≫ 1; its steps are cut to λ ≤ LAYER_LAMBDA
         // (only a δ-dependent k_s puts δ into N; otherwise N is the forcing's cubic over p)
         let in_layer = delta_law && a * (w[0] - t[0]) < LAYER_SPAN;
-        let mut m_i = if in_layer {
+        let m_base = if in_layer {
             let need = (a * span / LAYER_LAMBDA).ceil();
             if need > m_sub {
                 need.min(LAYER_MAX_SUBSTEPS)
@@ -401,16 +559,24 @@ pub fn simulate_grid(
             m_sub
         };
         // an interval whose iteration fails (a poor start far from the step's solution, an
-        // iterate where k_s <= 0) or whose N jumps (a near-singular k_s: δ moves by much of
-        // its range within a sample) is retried from its start in twice as many steps, up to
-        // RETRY_FACTOR times as many; a failure there ends the solve
+        // iterate where k_s <= 0), whose error estimate is above the tolerance or whose N
+        // jumps (a near-singular k_s: δ moves by much of its range within a sample) is
+        // retried from its start in twice as many steps, up to RETRY_FACTOR times as many;
+        // a failure there ends the solve
         let saved = st;
-        let cap = (m_i * RETRY_FACTOR).min(MAX_SUBSTEPS);
+        let cap = (m_base * RETRY_FACTOR).min(MAX_SUBSTEPS);
+        let mut m_i = (m_base * refine).min(cap);
         loop {
             let (h, wt) = if uniform && m_i == m_sub {
                 (h_uni, w_uni)
+            } else if let Some((m_w, w_w)) = w_refined.filter(|&(m_w, _)| uniform && m_w == m_i) {
+                (span / m_w, w_w)
             } else {
-                (span / m_i, Weights::new(a * span / m_i))
+                let wt = Weights::new(a * span / m_i);
+                if uniform {
+                    w_refined = Some((m_i, wt));
+                }
+                (span / m_i, wt)
             };
             let out = advance(
                 model,
@@ -421,14 +587,25 @@ pub fn simulate_grid(
                 h,
                 &wt,
                 tol,
-                jump,
+                1.0 / etol,
+                1.0 / jump,
                 &mut st,
                 &mut stats,
             )?;
             match out {
-                Ok(true) => break,
-                Ok(false) if 2.0 * m_i > cap => break, // as fine as it goes: keep it
-                Ok(false) => {
+                Ok(worst) if worst <= 1.0 => {
+                    refine = if worst < COARSEN {
+                        (0.5 * m_i / m_base).max(1.0)
+                    } else {
+                        m_i / m_base
+                    };
+                    break;
+                }
+                Ok(_) if 2.0 * m_i > cap => {
+                    refine = m_i / m_base;
+                    break; // as fine as it goes: keep it
+                }
+                Ok(_) => {
                     stats.n_rejected = stats.n_rejected.saturating_add(1);
                     st = saved;
                     m_i *= 2.0;
@@ -581,54 +758,134 @@ mod tests {
         assert!(simulate_grid(&m, &f, 0.0, 1, 1e-12, &mut d[..9], &mut v).is_err());
     }
 
-    /// A known defect, kept visible (`cargo test -- --ignored`): where a strongly
-    /// asymmetric law brings k_s down to about 0.3 k on the soft side at low damping, the
-    /// grid's step control (the `JUMP` test on N's cubic term) does not refine, and the error
-    /// is 2.6e-3 of the range at the proptest's 4 steps per sample (1.1e-4 at 8). The
-    /// random proptest above found it; `make test` runs on a fixed seed until it is mended.
+    /// The law where the step control before this error estimate missed its bound: a
+    /// strongly asymmetric law brings k_s down to 0.25 k on the soft side and the tangent
+    /// stiffness through zero at low damping (ψ = 0.01). Before: 2.6e-3 of the range at 4
+    /// steps per sample (1.1e-4 at 8); ψ = 0.02: 2.5e-3; 128 samples per period at 2 steps:
+    /// 1.5e-3. With the error control (measured): 2.6e-6, 1.6e-5, 9.3e-6, and 3.0e-5 at one
+    /// step per sample, in 1.3-8 times the steps asked.
     #[test]
-    #[ignore = "known defect: 2.6e-3 of the range where k_s dips to 0.3 k at psi = 0.01"]
     fn grid_agrees_with_rodas4_where_k_s_dips_to_a_third() {
-        let (k, amp, kappa, asym, per) = (
-            1.3,
-            0.4,
-            0.049_135_624_659_892_2,
-            0.385_052_801_547_322,
-            64.0,
-        );
+        let (k, amp, kappa, asym) = (1.3, 0.4, 0.049_135_624_659_892_2, 0.385_052_801_547_322);
         let dr = amp / k * 0.75;
-        let m = ContactModel::new(
-            Stiffness::Delta(vec![k, k * asym / dr, k * kappa / (dr * dr)]),
-            0.01,
-            1.0,
-        )
-        .unwrap();
-        let (t, p) = record((3.0 * per) as usize, per, amp);
-        let d0 = m.equilibrium(p[0]).unwrap();
-        let r = reference(&m, &t, &p, d0);
-        let (d, out) = grid(&m, &t, &p, d0, 4);
-        assert_eq!(out.status, Status::Success);
-        let e = max_rel(&d, &r);
-        assert!(e < 2e-4, "max error {e:.3e} of the displacement range");
+        for (psi, per, sub) in [
+            (0.01, 64.0, 4),
+            (0.02, 64.0, 4),
+            (0.01, 128.0, 2),
+            (0.01, 64.0, 1),
+        ] {
+            let m = ContactModel::new(
+                Stiffness::Delta(vec![k, k * asym / dr, k * kappa / (dr * dr)]),
+                psi,
+                1.0,
+            )
+            .unwrap();
+            let (t, p) = record((3.0 * per) as usize, per, amp);
+            let d0 = m.equilibrium(p[0]).unwrap();
+            let r = reference(&m, &t, &p, d0);
+            let (d, out) = grid(&m, &t, &p, d0, sub);
+            assert_eq!(out.status, Status::Success);
+            let e = max_rel(&d, &r);
+            assert!(
+                e < 1e-4,
+                "psi {psi} per {per} sub {sub}: max error {e:.3e} of the range"
+            );
+            // the control refined: more steps than asked, each retry counted
+            assert!(out.stats.n_accepted > (t.len() as u64 - 1) * sub as u64);
+            assert!(out.stats.n_rejected > 0);
+        }
+    }
+
+    #[test]
+    fn error_moments_match_quadrature_on_both_branches() {
+        for lam in [1e-8, 0.3, 1.999_999, 2.0, 5.0, 40.0, 700.0, 1e6] {
+            let got = error_moments(lam);
+            for (j, g) in got.iter().enumerate() {
+                // λ ∫ e^{−λ(1−u)} u^{2+j} (1−u)² du, midpoint rule in s = 1 − u on a grid
+                // fine against 1/λ
+                let m = 2_000_000;
+                let top = (60.0 / lam).min(1.0);
+                let q: f64 = (0..m)
+                    .map(|i| {
+                        let s = top * (i as f64 + 0.5) / m as f64;
+                        let u = 1.0 - s;
+                        lam * (-lam * s).exp() * u.powi(2 + j as i32) * s * s
+                    })
+                    .sum::<f64>()
+                    * top
+                    / m as f64;
+                assert!((g - q).abs() < 1e-6 * q.abs(), "{lam} {j} {g} {q}");
+            }
+        }
+    }
+
+    /// `curvature` (N'' along a solution) against a central second difference of
+    /// `N = n(p(t), δ(t))` on a short accurate integration (RK4, 1e-4 steps) through the
+    /// point, for the three laws.
+    #[test]
+    fn curvature_is_the_second_derivative_of_n_along_the_solution() {
+        let p_of = |t: f64| (0.3 + 0.2 * (1.3 * t).sin(), 0.26 * (1.3 * t).cos());
+        let p2_of = |t: f64| -0.338 * (1.3 * t).sin();
+        let laws = [
+            Stiffness::Constant(1.3),
+            Stiffness::Delta(vec![1.3, 0.7, 2.1]),
+            Stiffness::Pressure(vec![1.3, 0.9, 1.5]),
+        ];
+        for law in laws {
+            let m = ContactModel::new(law, 0.5, 1.0).unwrap();
+            let rhs = |t: f64, y: f64| m.f(p_of(t).0, y).unwrap();
+            let n_of = |t: f64, y: f64| {
+                let (p, dp) = p_of(t);
+                quasi(&m, p, dp, y).unwrap().n
+            };
+            let (t0, y0) = (0.7, 0.25);
+            // RK4 from (t0, y0) by ±h in 100 steps each
+            let walk = |h: f64| {
+                let (mut t, mut y) = (t0, y0);
+                let dt = h / 100.0;
+                for _ in 0..100 {
+                    let k1 = rhs(t, y);
+                    let k2 = rhs(t + 0.5 * dt, y + 0.5 * dt * k1);
+                    let k3 = rhs(t + 0.5 * dt, y + 0.5 * dt * k2);
+                    let k4 = rhs(t + dt, y + dt * k3);
+                    y += dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+                    t += dt;
+                }
+                y
+            };
+            let h = 1e-3;
+            let fd =
+                (n_of(t0 + h, walk(h)) - 2.0 * n_of(t0, y0) + n_of(t0 - h, walk(-h))) / (h * h);
+            let (p, dp) = p_of(t0);
+            let q = quasi(&m, p, dp, y0).unwrap();
+            let got = curvature(&m, p, dp, p2_of(t0), &q);
+            // the second difference is off by h² N''''/12 (measured 3e-5 for the δ law,
+            // whose start 0.035 off the slow manifold decays at 12/s; 1e-2 at h = 1e-2)
+            assert!((got - fd).abs() < 1e-4 * (1.0 + got.abs()), "{got} {fd}");
+        }
     }
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(64))]
         // eq. 17 with k_s = k (1 + a δ/δr + κ (δ/δr)²) over the diagnosis' parameter ranges
-        // (κ up to 10, |a| up to 0.4), 64 to 400 samples per period, ψ from 0.01 to 1, at
-        // least 128 steps per period of the faster component, with or without 0.3 % noise on
-        // p: within 2e-4 of the range (measured over 400 cases: 9.8e-5 at most, at κ ≈ 8
-        // with noise; 6.3e-5 without; 1e-6 to 1e-8 for mild laws)
+        // (κ from -0.15 to 10, |a| up to 0.4), ψ from 0.005 to 1 and 32 to 2000 samples per
+        // period (both log-uniform), one step per sample or at least 128 steps per period of
+        // the faster component, with or without 0.3 % noise on p, equal or unequal steps:
+        // within 2e-4 of the range (measured over 979 draws with a reference: 1.1e-4 at
+        // most, at κ ≈ 5-8 with one step per sample and noise; no failed solve where the
+        // reference succeeds)
         #[test]
         fn grid_agrees_with_rodas4(
             kappa in -0.15_f64..10.0,
             asym in -0.4_f64..0.4,
-            psi in 0.01_f64..1.0,
-            per in 64.0_f64..400.0,
+            log_psi in 0.005_f64.ln()..0.0,
+            log_per in 32.0_f64.ln()..2000.0_f64.ln(),
             jitter in prop::bool::ANY,
             noisy in prop::bool::ANY,
+            coarse in prop::bool::ANY,
         ) {
             let (k, amp) = (1.3, 0.4);
+            let (psi, per) = (log_psi.exp(), log_per.exp());
             let dr = amp / k * 0.75;
             let m = ContactModel::new(
                 Stiffness::Delta(vec![k, k * asym / dr, k * kappa / (dr * dr)]), psi, 1.0,
@@ -648,12 +905,15 @@ mod tests {
                     *v += 0.2 * (2.0 * PI / per) * ((j * 7 % 5) as f64 / 5.0);
                 }
             }
-            let d0 = m.equilibrium(p[0]).unwrap();
+            let d0 = m.equilibrium(p[0]);
+            prop_assume!(d0.is_ok()); // no equilibrium at the first sample
+            let d0 = d0.unwrap();
             let (r, ro) = reference_run(&m, &t, &p, d0);
             // a softening law can run away to k_s = 0 on the soft side: no reference there
             prop_assume!(ro.status == Status::Success);
-            // at least 128 steps per period of the faster component (1.7 ω)
-            let sub = (128.0 * 1.7 / per).ceil() as usize;
+            // one step per sample (the error control alone), or at least 128 steps per
+            // period of the faster component (1.7 ω)
+            let sub = if coarse { 1 } else { (128.0 * 1.7 / per).ceil() as usize };
             let (d, out) = grid(&m, &t, &p, d0, sub);
             prop_assert_eq!(out.status, Status::Success);
             let e = max_rel(&d, &r);
