@@ -84,14 +84,18 @@ def test_constant_stiffness_is_the_exact_kelvin_voigt_response(psi, spp, seed):
     assert np.max(np.abs(got.delta - exact)) <= 1e-9 * np.ptp(exact)
 
 
-def test_substeps_converge_at_fourth_order():
+def test_substeps_stay_within_the_error_control():
     t, p = blocks(64.0, 3)
     dr = 0.7 * PA / K
     m = NonlinearContact(k_s_delta=[K, 0.0, 3.0 * K / dr**2], psi=0.1, omega=2 * np.pi * F0)
     ref = m.simulate(t, p, rtol=1e-11).delta
     e = [np.max(np.abs(m.simulate_grid(t, p, substeps=s).delta - ref)) for s in (1, 2, 4)]
-    # 16 per halving asymptotically; measured 7.4 and 14.6 on this noisy record
-    assert e[1] < e[0] / 6 and e[2] < e[1] / 6, e
+    # the error control refines each sample interval until its estimate is within its
+    # tolerance, so the error no longer falls 16× per halving of the base step (before the
+    # control: 7.4× and 14.6× on this record); measured 3.3e-12, 1.5e-12, 1.0e-13 of a 1.04e-7
+    # range: every grid within 1e-4 of the range, and finer base steps still converge
+    span = np.ptp(ref)
+    assert max(e) <= 1e-4 * span and e[2] < e[0] / 6, (e, span)
 
 
 def test_grid_substeps_rule():
