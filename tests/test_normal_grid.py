@@ -101,7 +101,7 @@ def test_substeps_stay_within_the_error_control():
 def test_grid_substeps_rule():
     t = np.arange(1000) / 1000.0
     assert grid_substeps(t, 2 * np.pi * 10.0) == 1  # 100 samples per period
-    assert grid_substeps(t, 2 * np.pi * 50.0) == 5  # 20 samples per period: 96 steps
+    assert grid_substeps(t, 2 * np.pi * 50.0) == 2  # 20 samples per period: 32 steps
 
 
 def test_bad_input_is_a_clear_error():
