@@ -123,7 +123,7 @@ fn error_moments(lam: f64) -> [f64; 2] {
             let jf = f64::from(j);
             // B_0 = 2! j! / (j+3)!, B_{i+1} = B_i (3+i) / (j+4+i); term_i = B_i (−λ)^i / i!
             let mut term = 2.0 * (1..=j).map(f64::from).product::<f64>()
-                / (1..=j + 3).map(f64::from).product::<f64>();
+                / (1..=j.saturating_add(3)).map(f64::from).product::<f64>();
             let mut acc = term;
             for i in 0_u32..30 {
                 let fi = f64::from(i);
@@ -137,8 +137,10 @@ fn error_moments(lam: f64) -> [f64; 2] {
     let e = (-lam.min(MAX_LAMBDA)).exp();
     let mut k = [0.0; 6];
     k[0] = -(-lam).exp_m1() / lam;
-    for i in 1..6 {
-        k[i] = (i as f64 * k[i - 1] - e) / lam;
+    let mut prev = k[0];
+    for (i, ki) in k.iter_mut().enumerate().skip(1) {
+        *ki = (i as f64 * prev - e) / lam;
+        prev = *ki;
     }
     [
         lam * (k[2] - 2.0 * k[3] + k[4]),
