@@ -19,6 +19,14 @@ the modes in a rotating order:
 - python processes: a ``ProcessPoolExecutor`` (arrays pickled to the workers and back;
   ``--no-processes`` skips them).
 
+A ``ceiling`` row is what the machine itself allows: the same kernel with no memory traffic and
+nothing shared (``_core.force_repeat``: independent jobs, each the force of one 16384-sample
+signal, in cache, computed over and over into the job's own buffer; as many samples in all as
+the channels), one thread vs all cores, interleaved pairs likewise. A mode's speed-up divided by
+the ceiling's (``of ceiling``, medians) is the part of the machine's scaling the code delivers;
+what is left below the requirement beyond that is the machine's (a shared VM's cores slow each
+other down: frequency, cache, memory).
+
 A last row (``--long``, default 1e8 samples; 0 skips it) is ONE channel: ``force_many`` on one
 thread vs on all cores, outputs reused, interleaved pairs likewise: the pre-pass and the pieces
 alone carry the scaling there.
@@ -118,6 +126,14 @@ def main() -> None:
         stats.setdefault("rust threads, whole channels", []).append(st)
         return res
 
+    small = channels(1, 16384)[0]
+    ceil_jobs = 64 * cores
+    ceil_reps = max(1, round(args.channels * args.n / (ceil_jobs * small.size)))
+
+    def ceiling(threads: int, name: str) -> None:
+        st = _core.force_repeat(MODEL._core, small, ceil_jobs, ceil_reps, threads)
+        stats.setdefault(name, []).append(st)
+
     long_x = channels(1, int(args.long)) if args.long >= 1 else []
     long_ref = [_force(x) for x in long_x]
     lbufs = [np.zeros(x.size) for x in long_x]
@@ -156,6 +172,10 @@ def main() -> None:
             ),
             "rust threads, whole channels": (serial_reused, whole),
             "python threads": (serial, lambda: list(tp.map(_force, xs))),
+            "ceiling (in cache)": (
+                lambda: ceiling(1, "ceiling serial"),
+                lambda: ceiling(cores, "ceiling (in cache)"),
+            ),
         }
         if not args.no_processes:
             pairs["python processes"] = (serial, processes)
@@ -169,6 +189,8 @@ def main() -> None:
             t0, c0 = time.perf_counter(), time.process_time()
             out = f()
             dt, dc = time.perf_counter() - t0, time.process_time() - c0
+            if out is None:  # the ceiling: nothing to compare
+                return dt, dc
             if isinstance(out, tuple):  # the pool's workers report their own CPU time
                 out, dc = out[0], dc + out[1]
             want = long_ref if len(out) == len(long_ref) and out[0].size != ref[0].size else ref
@@ -197,8 +219,13 @@ def main() -> None:
         f"{'min/min':>8}{'work':>6}{'cpu speed-up':>13}{'prepass':>8}{'imbal':>7}"
         f"{'start ms':>9}{'wait ms':>8}{'idle':>6}"
     )
+    ceil_up = (
+        med(a[0] / a[2] for a in rec["ceiling (in cache)"]) if rec["ceiling (in cache)"] else None
+    )
     for name in names:
         total = int(args.long) if name.startswith("one channel") else args.channels * args.n
+        if name.startswith("ceiling"):
+            total = ceil_jobs * ceil_reps * small.size
         sw, sc, mw, mc = (list(v) for v in zip(*rec[name], strict=True))
         ups = sorted(a / b for a, b in zip(sw, mw, strict=True))
         up = med(ups)
@@ -231,6 +258,12 @@ def main() -> None:
             line += f"{med(imbal):7.3f}{med(start):9.2f}"
             line += f"{med(wait):8.1f}{med(idle):6.2f}" if wait else f"{'-':>8}{'-':>6}"
         print(line)
+    if ceil_up:
+        print("\nof ceiling (mode median / ceiling median, same run):")
+        for name in names:
+            if not name.startswith("ceiling"):
+                up = med(a[0] / a[2] for a in rec[name])
+                print(f"  {name:<29}{up / ceil_up:6.3f}  ({up:.2f}x of {ceil_up:.2f}x)")
 
 
 if __name__ == "__main__":

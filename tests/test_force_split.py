@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 from scipy.signal import lfilter
 
 import contactlab
-from contactlab import InputError
+from contactlab import InputError, _core
 
 
 def _signals(n: int, seed: int) -> dict[str, np.ndarray]:
@@ -118,3 +118,21 @@ def test_bad_input_on_the_split_path_is_a_clear_error():
         tab.force(y, threads=2)
     assert str(one.value) == str(two.value)
     assert "200001" in str(two.value)
+
+
+def test_force_repeat_the_benchmarks_ceiling_runs_every_job_and_checks_its_input():
+    """``_core.force_repeat`` (the in-cache ceiling of benches/bench_parallel.py): every job
+    runs once whatever the threads, and a bad signal is an InputError naming the sample."""
+    m = contactlab.Masing(40.0, 4.0e4)
+    x = 20e-6 * np.sin(np.linspace(0.0, 12.0, 3000))
+    for threads in (1, 2, 3):
+        st = _core.force_repeat(m._core, x, 7, 3, threads)
+        assert len(st) == min(threads, 7)
+        assert sum(s["jobs"] for s in st) == 7
+        assert all(0.0 <= s["start"] <= s["end"] for s in st)
+    bad = x.copy()
+    bad[17] = np.nan
+    with pytest.raises(contactlab.InputError, match="17"):
+        _core.force_repeat(m._core, bad, 2, 1, 2)
+    with pytest.raises(contactlab.InputError, match="threads"):
+        _core.force_repeat(m._core, x, 2, 1, 0)

@@ -93,6 +93,9 @@ def force_many(
     cpu_times: bool = False,
     piece: int = ...,
 ) -> tuple[list[_F], list[dict[str, Any]]]: ...
+def force_repeat(
+    model: MasingCore, x: _F, jobs: int, repeats: int, threads: int
+) -> list[dict[str, Any]]: ...
 def signature_positions(
     block: npt.NDArray[np.uint8], needles: list[bytes], starts_below: int, offset: int
 ) -> list[npt.NDArray[np.int64]]: ...

@@ -3,6 +3,7 @@
 
 use contactlab_core::masing::split::{force_channels, Channel, PIECE};
 use contactlab_core::masing::{branch_memory, MasingState};
+use contactlab_core::parallel::run_jobs;
 use contactlab_core::signal::{
     cycle_block, fold_phase, fold_spread, loop_area_sensitivity, loop_areas, period_means,
     CycleState, Excursion, FoldSums, Schmitt,
@@ -212,6 +213,55 @@ fn force_many<'py>(
         dicts.push(d);
     }
     Ok((outs, dicts))
+}
+
+/// The machine's own scaling, for the benchmarks: `jobs` independent jobs, each the force of
+/// the same short signal `x` from the origin `repeats` times into the job's own buffer
+/// (`x` and the buffer stay in cache: no memory traffic, no shared data written, no split),
+/// on up to `threads` threads (`contactlab_core::parallel::run_jobs`). What `force_many`'s
+/// speed-up is compared with in the same run. Returns one statistics dict per thread.
+#[pyfunction]
+#[pyo3(signature = (model, x, jobs, repeats, threads))]
+fn force_repeat<'py>(
+    py: Python<'py>,
+    model: PyRef<'py, MasingCore>,
+    x: PyReadonlyArray1<'py, f64>,
+    jobs: usize,
+    repeats: usize,
+    threads: usize,
+) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    if threads == 0 {
+        return Err(input(py, "threads must be >= 1"));
+    }
+    let xs = slice(&x, "x")?;
+    let core: &dyn Channel = &*model;
+    let stats = detach_guarded(py, || {
+        run_jobs(
+            vec![xs.len(); jobs],
+            threads,
+            true,
+            |n| *n,
+            |_, n| {
+                let mut out = vec![0.0; n];
+                for _ in 0..repeats {
+                    core.whole(xs, &mut out, &mut MasingState::default())?;
+                }
+                std::hint::black_box(&out);
+                Ok(())
+            },
+        )
+    })?;
+    let mut dicts = Vec::with_capacity(stats.len());
+    for s in stats {
+        let d = PyDict::new(py);
+        d.set_item("jobs", s.jobs)?;
+        d.set_item("start", s.start)?;
+        d.set_item("end", s.end)?;
+        d.set_item("cpu", s.cpu)?;
+        d.set_item("wait", s.wait)?;
+        dicts.push(d);
+    }
+    Ok(dicts)
 }
 
 /// Phase-bin fold of a periodic recording, accumulated chunk by chunk (see
@@ -523,5 +573,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ReversalDetector>()?;
     m.add_function(wrap_pyfunction!(branch_memory_py, m)?)?;
     m.add_function(wrap_pyfunction!(force_many, m)?)?;
+    m.add_function(wrap_pyfunction!(force_repeat, m)?)?;
     Ok(())
 }
