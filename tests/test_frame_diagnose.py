@@ -152,3 +152,19 @@ def test_sticks_use_the_velocity_analyze_uses(seed):
     assert 3.0 * sx * float(np.linalg.norm(c1)) == pytest.approx(thr, rel=1e-12)
     v2 = savgol_filter(xm, window, 3, deriv=1, delta=dt)
     assert np.allclose(v2, v, rtol=0, atol=1e-9 * float(np.max(np.abs(v))))
+
+
+def test_reconstructed_force_is_on_the_displacements_clock():
+    """``FrameForce.recording()`` declares ``same_clock``: the force is computed from the
+    displacement's own samples, so no delay between them is tried (the measured 250 g frame
+    named an 8 ms one, 2 samples, without it), and the report says so; asked for by name,
+    the candidate is tried."""
+    _, _, _, r, _ = _frame(64003, 250.0, 0.8, 1.1)
+    rec = r.recording()
+    assert rec.meta["same_clock"] is True
+    rep = contactlab.diagnose(rec, max_effects=1)
+    assert any(w.startswith("channel_delay not tried") for w in rep.where)
+    assert not any(v.name == "channel_delay" for s in rep.steps for v in s.candidates)
+    asked = contactlab.diagnose(rec, candidates=["channel_delay"], max_effects=1)
+    assert not any(w.startswith("channel_delay not tried") for w in asked.where)
+    assert any(v.name == "channel_delay" for v in asked.steps[0].candidates)

@@ -557,6 +557,24 @@ def _declared(
     return taps, noise
 
 
+def _same_clock(recording: Any, names: list[str], candidates: Sequence[str] | None) -> str | None:
+    """A recording whose ``meta["same_clock"]`` is true has an output computed from the
+    input's own samples (e.g. a friction force reconstructed from the displacements of a
+    frame, :meth:`contactlab.tangential.FrameForce.recording`): the two channels cannot be
+    skewed in time, so ``channel_delay`` is not tried (unless asked for by name in
+    ``candidates``); removed from ``names`` in place, and the sentence that says so."""
+    meta = getattr(recording, "meta", None)
+    if not (isinstance(meta, dict) and meta.get("same_clock")) or candidates is not None:
+        return None
+    if "channel_delay" not in names:
+        return None
+    names.remove("channel_delay")
+    return (
+        "channel_delay not tried: the output was computed from the input's own samples "
+        "(same clock), so it cannot lag them"
+    )
+
+
 def _prior_weight(
     family: Family, d: Prepared, taps: np.ndarray | None
 ) -> tuple[dict[str, Any] | None, list[str]]:
@@ -841,6 +859,7 @@ def diagnose(
                 f"unknown {family.kind} candidate {n!r}; choose from {', '.join(family.candidates)}"
             )
     taps, declared_noise = _declared(recording, family, output_filter, output_noise, t.size)
+    clock_note = _same_clock(recording, names, candidates)
     n_in = t.size
     if taps is not None and n_in > MAX_SAMPLES:  # a filter at the raw rate: no subsampling
         t, u, y = t[:MAX_SAMPLES], u[:MAX_SAMPLES], y[:MAX_SAMPLES]
@@ -902,6 +921,8 @@ def diagnose(
     if prior is not None:
         location.update(prior)
         where[2 if reduced else 1 : 2 if reduced else 1] = prior_notes
+    if clock_note:
+        where.insert(1, clock_note)
     if w is not None:
         low = float(np.mean(d.extra["weight"] < 0.5))
         location["low_weight_fraction"] = low

@@ -282,8 +282,9 @@ class FrameForce:
         ``meta`` declares the reconstruction's smoothing and noise (``output_filter``:
         :attr:`force_filter`, ``output_noise``: :attr:`force_noise`), which
         :func:`contactlab.diagnose.diagnose` applies to every candidate and takes as the
-        force's noise level."""
-        meta: dict[str, object] = {"output_noise": self.force_noise}
+        force's noise level, and ``same_clock``: the force is computed from the displacement's
+        own samples, so it cannot lag them and ``channel_delay`` is not a candidate."""
+        meta: dict[str, object] = {"output_noise": self.force_noise, "same_clock": True}
         if self.force_filter is not None:
             meta["output_filter"] = self.force_filter
         return Recording(self.t, {"x": self.x, "F": self.F}, {"x": "m", "F": "N"},
