@@ -62,6 +62,58 @@ def _lag_noise(v: np.ndarray, lag: int, order: int) -> float:
     return 1.4826 * float(np.median(d, overwrite_input=True)) / math.sqrt(c)
 
 
+def spectral_noise(v: np.ndarray, *, quantile: float = 0.25, bands: int = 24) -> float:
+    """Noise standard deviation of ``v`` from the floor of its spectrum, for noise that a
+    sensor's low-pass (anti-alias) filter has coloured.
+
+    The record is pre-whitened by its second difference (so the large, slow signal leaks
+    nothing into the floor; the difference's gain is divided out again) and Hann-windowed; in
+    each of ``bands`` log-spaced frequency bands the lower ``quantile`` of the periodogram,
+    divided by the exponential distribution's ``-ln(1 - quantile)``, is the level of the
+    noise between the signal's harmonics. The pass band is the first run of bands where that
+    level has stopped falling (log-log slope above -1) after the signal's decline; below it
+    the noise is taken as flat at the pass-band level (a low-pass filter passes low
+    frequencies unchanged), above it at the observed level, capped at the pass band's (the
+    filter's roll-off). σ² is the mean of that noise spectrum over all frequencies. NaN when
+    fewer than three bands have enough bins or no pass band shows (the signal dominates up to
+    the roll-off)."""
+    v = np.asarray(v, dtype=float)
+    if v.size < 64:
+        return math.nan
+    d = np.diff(v, 2)
+    d = d - float(np.mean(d))
+    n = d.size
+    w = np.hanning(n)
+    P = np.abs(np.fft.rfft(d * w)) ** 2 / float(np.sum(w * w))
+    k = np.arange(P.size)
+    gain = (2.0 * np.sin(np.pi * k / n)) ** 4
+    edges = np.unique(np.geomspace(4, P.size, bands + 1).astype(int))
+    scale = -math.log(1.0 - quantile)
+    lo, hi, lv = [], [], []
+    for a, b in itertools.pairwise(edges):
+        if b - a >= 8:
+            lo.append(int(a))
+            hi.append(int(b))
+            lv.append(float(np.quantile(P[a:b] / gain[a:b], quantile)) / scale)
+    if len(lv) < 3 or not all(x > 0 for x in lv):
+        return math.nan
+    f = np.sqrt(np.array(lo, float) * np.array(hi, float))
+    level = np.array(lv)
+    slope = np.diff(np.log(level)) / np.diff(np.log(f))
+    first = next((i for i, sl in enumerate(slope) if sl > -1.0), None)
+    if first is None:
+        return math.nan
+    last = first
+    while last + 1 < slope.size and slope[last] > -1.0:
+        last += 1
+    passband = float(np.median(level[first : last + 1]))
+    total = lo[first] * passband  # under the signal: flat at the pass-band level
+    total += float(np.sum((np.array(hi[first:]) - np.array(lo[first:])) * np.minimum(
+        level[first:], passband)))  # fmt: skip
+    total += max(P.size - hi[-1], 0) * min(float(level[-1]), passband)
+    return math.sqrt(total / P.size)
+
+
 def difference_noise(v: np.ndarray, order: int = 4) -> float:
     """Noise standard deviation of ``v`` from its ``order``-th differences (MAD scale;
     ``var(Δᵏ v) = C(2k, k) σ²`` for white noise).
@@ -70,9 +122,14 @@ def difference_noise(v: np.ndarray, order: int = 4) -> float:
     one-sample differences; differences at lag L see it once L exceeds the correlation
     length. So the estimate is taken at lags 1, 2, 4, 8, 16: noise alone grows slowly with
     the lag and levels off, a smooth signal grows like L⁴ (16× per doubling). The estimate
-    is read where it grows least between two lags, if that growth is below 4× (a plateau);
-    otherwise the signal dominates every lag and the lag-1 value (an upper bound of white
-    noise) is returned.
+    is read where it grows least between two lags, if that growth is below 4× (a plateau).
+
+    Without a plateau the noise is correlated beyond the lags where the signal is still
+    small (a strong anti-alias filter: at 250 Hz with a cut-off at 0.2 of Nyquist the lag-1
+    value reads such noise ~15× low): then the estimate at the lag of least growth, but no
+    more than the noise floor of the spectrum (:func:`spectral_noise`: both read signal as
+    well as noise there, each in its own way) and no less than the lag-1 value (an upper
+    bound of white noise, which is what is left when neither sees any noise).
     """
     lags = [lag for lag in (1, 2, 4, 8, 16) if v.size > order * lag + 10]
     if not lags:
@@ -82,7 +139,13 @@ def difference_noise(v: np.ndarray, order: int = 4) -> float:
         return float(est[0]) if est and math.isfinite(est[0]) else 0.0
     ratios = [b / a if a > 0 else math.inf for a, b in itertools.pairwise(est)]
     k = int(np.argmin(ratios))
-    return float(est[k + 1] if ratios[k] < 4.0 else est[0])
+    if ratios[k] < 4.0:
+        return float(est[k + 1])
+    floor = spectral_noise(v)
+    least = float(est[k + 1])
+    if math.isfinite(floor):
+        least = min(least, floor)
+    return max(float(est[0]), least)
 
 
 def savgol_derivative(v: np.ndarray, window: int, deriv: int, dt: float) -> np.ndarray:
@@ -538,5 +601,6 @@ __all__ = [
     "read_frame",
     "savgol_coefficients",
     "savgol_derivative",
+    "spectral_noise",
     "step_error",
 ]
