@@ -76,6 +76,11 @@ def build_parser(verb_module: str | None = None) -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
+    # `--frame -3,0.6,1191`: argparse would take the negative value for an option and say
+    # only "expected one argument"; joined, the frame's own check names the bad mass
+    for i in range(len(argv) - 2, -1, -1):
+        if argv[i] == "--frame" and argv[i + 1][:2] in {f"-{d}" for d in "0123456789."}:
+            argv[i : i + 2] = [f"--frame={argv[i + 1]}"]
     parser = build_parser(_verb_module(argv))
     args = parser.parse_args(argv)
     if not getattr(args, "handler", None):

@@ -334,3 +334,112 @@ def normal_options(entry: object, nopts: dict) -> dict:
     if isinstance(freq, float) and math.isfinite(freq) and freq > 0:
         opts["omega"] = 2.0 * math.pi * freq
     return opts
+
+
+def add_frame_flags(p: Any) -> None:
+    """``--frame M,C,K`` with ``--frame-x`` / ``--frame-y``: the file holds a base-excited
+    friction frame's displacements; the friction force is reconstructed from its equation of
+    motion (:func:`contactlab.tangential.read_frame`)."""
+    p.add_argument(
+        "--frame",
+        metavar="M,C,K",
+        help="tangential: the file holds a friction frame's top-plate (x) and base (y) "
+        "displacements; reconstruct the friction force F = K (y - x) + C (y' - x') - M x'' "
+        "with this mass, damping and stiffness (kg, N s/m, N/m), e.g. 3.0799,0.669,1191 or "
+        "M=3.0799,C=0.669,K=1191",
+    )
+    p.add_argument(
+        "--frame-x",
+        metavar="COLUMN",
+        help="with --frame: the top-plate displacement column (default: the column named "
+        "with x/top/plate; unit from the name, e.g. _mm or [mm], else m)",
+    )
+    p.add_argument(
+        "--frame-y",
+        metavar="COLUMN",
+        help="with --frame: the base displacement column (default: the column named with "
+        "y/base; unit from the name, else m)",
+    )
+
+
+def frame_option(args: Any) -> dict[str, Any] | None:
+    """The parsed ``--frame`` (``{"M", "C", "K", "x", "y"}``), or None; ``--frame-x``/``-y``
+    without ``--frame`` and ``--frame`` with a normal model are :class:`InputError`."""
+    text = getattr(args, "frame", None)
+    fx, fy = getattr(args, "frame_x", None), getattr(args, "frame_y", None)
+    if text is None:
+        if fx or fy:
+            raise InputError("--frame-x/--frame-y name a frame's columns: give --frame M,C,K too")
+        return None
+    if getattr(args, "model", None) == "normal":
+        raise InputError("--frame gives a tangential recording (x, F): use --model tangential")
+    if getattr(args, "columns", None):
+        raise InputError("--frame reads the displacements: name them with --frame-x/--frame-y, "
+                         "not --columns")  # fmt: skip
+    from ..tangential.frame import parse_frame
+
+    M, C, K = parse_frame(text)
+    return {"M": M, "C": C, "K": K, "x": fx, "y": fy}
+
+
+def output_filter_taps(text: str | None) -> Any:
+    """``--output-filter``: ``savgol:WINDOW[:ORDER]`` (a Savitzky-Golay smoothing, quadratic
+    by default: the same weights as cubic), ``mean:WINDOW`` (a centred moving average) or
+    ``frame:WINDOW`` (the smoothing of :func:`contactlab.tangential.frame_friction_force`
+    with that window) → the filter's taps (odd count, zero phase, sum 1), or None."""
+    if text is None:
+        return None
+    import numpy as np
+
+    kind, _, rest = text.strip().partition(":")
+    kind = kind.strip().lower()
+    fields = [f.strip() for f in rest.split(":")] if rest else []
+    usage = ("--output-filter: give savgol:WINDOW[:ORDER], mean:WINDOW or frame:WINDOW "
+             "(WINDOW an odd number of samples), e.g. savgol:11")  # fmt: skip
+    if kind not in ("savgol", "mean", "frame") or not fields or len(fields) > 2:
+        raise InputError(f"{usage}; got {text!r}")
+    if len(fields) == 2 and kind != "savgol":
+        raise InputError(f"{usage}; only savgol takes an ORDER, got {text!r}")
+    try:
+        window = int(fields[0])
+        order = int(fields[1]) if len(fields) == 2 else 2  # smoothing: 2 and 3 are the same
+    except ValueError:
+        raise InputError(f"{usage}; got {text!r}") from None
+    least = {"savgol": 3, "mean": 1, "frame": 5}[kind]
+    if window < least or window % 2 == 0:
+        raise InputError(
+            f"--output-filter {text!r}: the window must be an odd number of samples >= {least} "
+            f"(a zero-phase filter is centred), got {window}"
+        )
+    if kind == "mean":
+        return np.full(window, 1.0 / window)
+    if kind == "frame":
+        from ..tangential.frame import force_kernel
+
+        return force_kernel(window)
+    if not 0 <= order < window:
+        raise InputError(
+            f"--output-filter {text!r}: the polynomial order must be >= 0 and below the "
+            f"window ({window}), got {order}"
+        )
+    from scipy.signal import savgol_coeffs
+
+    return savgol_coeffs(window, order, deriv=0, use="dot")
+
+
+def positive_number(name: str):
+    """argparse ``type=``: a finite number > 0 (an error naming the option otherwise)."""
+
+    def parse(text: str) -> float:
+        import math
+
+        try:
+            v = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} {text!r}: not a number") from None
+        if not (math.isfinite(v) and v > 0):
+            raise argparse.ArgumentTypeError(f"{name} {text!r}: must be a finite number > 0")
+        return v
+
+    parse.__name__ = "number > 0"
+    return parse

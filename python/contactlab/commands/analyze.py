@@ -17,12 +17,14 @@ from ..errors import InputError
 from ..studies.manifest import entry_from_file
 from ..studies.study import run_study
 from ._common import (
+    add_frame_flags,
     add_pressure_flags,
     add_progress_flags,
     add_workers_flag,
     check_output_targets,
     command_line,
     describe,
+    frame_option,
     json_document,
     json_text,
     normal_options,
@@ -226,8 +228,11 @@ def _auto_streamed(
 
 
 def _handler(args: argparse.Namespace) -> int:
+    frame = frame_option(args)
     columns = parse_columns(args.columns)
     check_output_targets(json_out=args.json, report=args.report)
+    if frame is not None and args.stream:
+        raise InputError("--frame reconstructs the force from the whole record: drop --stream")
     entries = []
     for f in args.files:
         if Path(f).is_dir():
@@ -237,14 +242,14 @@ def _handler(args: argparse.Namespace) -> int:
         if any(Path(f).resolve() == e.path.resolve() for e in entries):
             raise InputError(f"{f}: given twice (it would be analysed and counted twice)")
         e = entry_from_file(f, kind=args.model)
-        e.columns, e.fs = columns, args.fs
+        e.columns, e.fs, e.frame = columns, args.fs, frame
         entries.append(e)
     topts = {"force_sign": args.force_sign}
     nopts = {"p0": args.p0, "pa": args.pa}
     if args.stream:
         return _streamed(args, entries, columns, topts, nopts)
     big: set[int] = set()
-    if not args.whole:
+    if not args.whole and frame is None:  # a frame is reconstructed whole
         from ..studies.pooled import STREAM_ABOVE
 
         big = {
@@ -265,6 +270,12 @@ def _handler(args: argparse.Namespace) -> int:
     say = sys.stderr if args.json == "-" else sys.stdout
     for r in result.results:
         if r.ok:
+            rebuilt = (r.extra or {}).get("frame_reconstruction")
+            if rebuilt:
+                from ..tangential.frame import describe_reconstruction
+
+                print(f"{r.entry.path}: friction frame: {describe_reconstruction(rebuilt)}",
+                      file=say)  # fmt: skip
             print(f"{r.entry.path}: {_summary_line(r.row, r.entry.kind)}", file=say)
             if r.row.get("warnings"):
                 for w in str(r.row["warnings"]).split(" | "):
@@ -282,6 +293,9 @@ def _handler(args: argparse.Namespace) -> int:
             "--model",
             args.model,
             *(["--columns", args.columns] if args.columns else []),
+            *(["--frame", args.frame] if frame else []),
+            *(["--frame-x", args.frame_x] if args.frame_x else []),
+            *(["--frame-y", args.frame_y] if args.frame_y else []),
             "--report",
             args.report,
         )
@@ -413,6 +427,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "loop area ∮F dx positive (a passive joint dissipates)",
     )
     add_pressure_flags(p)
+    add_frame_flags(p)
     p.add_argument("--keep-going", action="store_true",
                    help="skip recordings that fail (exit code 1) instead of stopping")  # fmt: skip
     p.add_argument("-v", "--verbose", action="store_true", help="print each fit report")

@@ -50,9 +50,26 @@ def add_parser(subparsers: Any) -> None:
         "--report", metavar="DIR", help="write DIR/diagnose.html (+ figures/, diagnose.json)"
     )
     p.add_argument("--max-effects", type=int, default=3, help="stop after this many additions")
-    from ..commands._common import add_pressure_flags
+    from ..commands._common import add_frame_flags, add_pressure_flags, positive_number
 
     add_pressure_flags(p)
+    add_frame_flags(p)
+    p.add_argument(
+        "--output-filter",
+        metavar="KIND:WINDOW",
+        help="tangential: the force channel went through this known smoothing, which every "
+        "candidate's prediction then passes too: savgol:WINDOW[:ORDER] (Savitzky-Golay), "
+        "mean:WINDOW (moving average) or frame:WINDOW (a frame reconstruction's); WINDOW an "
+        "odd number of samples. With --frame: the reconstruction's own (default)",
+    )
+    p.add_argument(
+        "--output-noise",
+        metavar="N",
+        type=positive_number("--output-noise"),
+        help="the force channel's noise RMS in N when known (a smoothed channel's differences "
+        "understate it); with --frame: the reconstruction's (default)",
+    )
+    p.add_argument("--columns", help="column mapping, e.g. 'x=disp,F=force' (default: by name)")
     p.set_defaults(handler=run)
 
 
@@ -65,21 +82,56 @@ def run(args: argparse.Namespace) -> int:
         from .structure import diagnose_structure_cli
 
         return diagnose_structure_cli(args)
+    from ..commands._common import frame_option, output_filter_taps, parse_columns
+
+    frame = frame_option(args)
+    if args.model is None and frame is not None:
+        args.model = "tangential"
     if args.model is None:
         raise InputError("diagnose needs --model tangential|normal or --structure MODEL.json")
-    rec = read_recording(args.file, kind=args.model)
+    taps = output_filter_taps(args.output_filter)
+    if args.model == "normal" and (taps is not None or args.output_noise is not None):
+        raise InputError("--output-filter/--output-noise are for the tangential model (a force "
+                         "channel's smoothing)")  # fmt: skip
+    rebuilt = None
+    if frame is not None:
+        from ..tangential import read_frame
+
+        rebuilt = read_frame(args.file, frame["M"], frame["C"], frame["K"], x=frame["x"],
+                             y=frame["y"])  # fmt: skip
+        rec = rebuilt.recording(args.file)
+        print(f"{args.file}: friction frame: {rebuilt.describe()}")
+        if taps is not None or args.output_noise is not None:
+            print("note: --output-filter/--output-noise replace the reconstruction's own")
+    else:
+        rec = read_recording(args.file, kind=args.model, columns=parse_columns(args.columns))
     if args.model == "normal":
         from ..commands._common import with_static_pressure
 
         rec = with_static_pressure(rec, args.file, getattr(args, "p0", None),
                                    getattr(args, "pa", None))  # fmt: skip
     try:
-        report = diagnose(rec, model=args.model, max_effects=args.max_effects)
+        report = diagnose(rec, model=args.model, max_effects=args.max_effects,
+                          output_filter=taps, output_noise=args.output_noise)  # fmt: skip
     except InputError as exc:  # name the file: the workflow only sees arrays
         raise InputError(f"{args.file}: {exc}") from exc
     print(report.summary())
     if args.json:
-        write_text(args.json, report.to_json() + "\n")
+        import json
+
+        doc = report.to_dict()
+        meta = rec.meta if isinstance(rec.meta, dict) else {}
+        used = taps if taps is not None else meta.get("output_filter")
+        noise = args.output_noise if args.output_noise is not None else meta.get("output_noise")
+        if used is not None or noise is not None:
+            doc["declared_output"] = {
+                "filter": args.output_filter or ("frame reconstruction" if rebuilt else None),
+                "filter_taps": None if used is None else len(used),
+                "noise": None if noise is None else float(noise),
+            }
+        if rebuilt is not None:
+            doc["frame_reconstruction"] = rebuilt.to_dict()
+        write_text(args.json, json.dumps(doc, indent=2, allow_nan=False) + "\n")
     if args.report:
         import matplotlib
 

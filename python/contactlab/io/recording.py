@@ -7,6 +7,7 @@ analysis code never sees µm or MPa. Canonical channel names: tangential ``x`` (
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -16,10 +17,16 @@ import numpy as np
 from ..errors import InputError
 from .units import SI_UNITS, UnknownUnitError, split_name, to_si
 
-#: canonical channel -> physical dimension
-DIMENSIONS = {"t": "time", "x": "length", "F": "force", "p": "pressure", "delta": "length"}
+#: canonical channel -> physical dimension (``y``: a frame's base displacement)
+DIMENSIONS = {"t": "time", "x": "length", "F": "force", "p": "pressure", "delta": "length",
+              "y": "length"}  # fmt: skip
 #: the channels each kind of recording needs
 KIND_CHANNELS = {"tangential": ("x", "F"), "normal": ("p", "delta")}
+#: a base-excited friction frame's displacements (top plate ``x``, base ``y``): read only
+#: when asked for (``kind="frame"``), never guessed, so not one of :data:`KIND_CHANNELS`
+FRAME_CHANNELS = ("x", "y")
+#: words that name a frame's top plate / base displacement column, after ``x`` / ``y``
+FRAME_WORDS = {"x": ("x", "top", "plate", "mass"), "y": ("y", "base", "ground", "shaker")}
 #: names recognised (case-insensitive, unit stripped) for each canonical channel, best first
 ALIASES: dict[str, tuple[str, ...]] = {
     "t": ("t", "time", "zeit", "timestamp", "time_s", "times"),
@@ -181,8 +188,8 @@ def resolve_columns(
     Returns ``(kind, {canonical: file_name})``; ``"t"`` is included when a time column exists.
     Explicit ``columns`` entries match the full name or the name without its unit.
     """
-    if kind not in (None, "tangential", "normal"):
-        raise InputError(f"kind must be 'tangential', 'normal' or None, got {kind!r}")
+    if kind not in (None, "tangential", "normal", "frame"):
+        raise InputError(f"kind must be 'tangential', 'normal', 'frame' or None, got {kind!r}")
     columns = dict(columns or {})
     bases = {c: split_name(c)[0].strip().lower() for c in available}
     mapping: dict[str, str] = {}
@@ -215,6 +222,14 @@ def resolve_columns(
                     return c
         return None
 
+    if kind == "frame":
+        for canon in FRAME_CHANNELS:
+            if canon not in mapping:
+                mapping[canon] = frame_column(available, canon, mapping, file=file)
+        hit = guess("t")
+        if "t" not in mapping and hit is not None:
+            mapping["t"] = hit
+        return kind, mapping
     if kind is None:
         for k, chans in KIND_CHANNELS.items():
             if all(c in mapping for c in chans):
@@ -247,6 +262,35 @@ def resolve_columns(
                 column=canon,
             )
     return kind, mapping
+
+
+def frame_column(available: list[str], canon: str, mapping: dict[str, str], *, file: str) -> str:
+    """The column of a frame's ``x`` (top plate) or ``y`` (base) displacement: the one column
+    whose name (unit stripped, split into words at ``_``, spaces, ``-`` and ``.``) has the
+    word ``x`` / ``y``, else one of :data:`FRAME_WORDS`; a name that fits none or several is
+    a :class:`RecordingError` asking for the column."""
+    used = set(mapping.values())
+    words = {c: re.split(r"[\s_\-.]+", split_name(c)[0].strip().lower()) for c in available}
+    for word in FRAME_WORDS[canon]:
+        hits = [c for c in available if c not in used and word in words[c]]
+        other = "y" if canon == "x" else "x"
+        hits = [c for c in hits if other not in words[c] or word == canon]
+        if len(hits) == 1:
+            return hits[0]
+        if len(hits) > 1:
+            raise RecordingError(
+                f"several columns could be the frame's {canon!r} ({', '.join(hits)}); name it "
+                f"with --frame-{canon} (columns={{{canon!r}: ...}})",
+                file=file,
+                column=canon,
+            )
+    what = "top-plate" if canon == "x" else "base"
+    raise RecordingError(
+        f"no column for the frame's {what} displacement {canon!r}; columns are {available}; "
+        f"name it with --frame-{canon} (columns={{{canon!r}: ...}})",
+        file=file,
+        column=canon,
+    )
 
 
 def unit_factor(

@@ -110,6 +110,9 @@ class StudyEntry:
     columns: dict[str, str] | None = None
     fs: float | None = None
     source: str = ""  # "manifest.csv row 3" or the file name, for error messages
+    #: a friction frame's displacements (``{"M", "C", "K"}`` and optional ``x``, ``y`` column
+    #: names): the friction force is reconstructed (:func:`contactlab.tangential.read_frame`)
+    frame: dict[str, Any] | None = None
 
     @property
     def name(self) -> str:

@@ -154,7 +154,24 @@ def analyze_entry(
     """Read and analyse one recording; its row holds the tags, then the analysis outputs."""
     from ..io import read_recording
 
-    rec = read_recording(entry.path, columns=entry.columns, kind=entry.kind, fs=entry.fs)
+    frame = None
+    if entry.frame is not None:
+        from ..tangential import read_frame
+
+        if entry.kind != "tangential":
+            raise InputError(f"{entry.path}: a friction frame gives a tangential recording "
+                             f"(x, F), not a {entry.kind} one")  # fmt: skip
+        f = entry.frame
+        frame = read_frame(entry.path, f["M"], f["C"], f["K"], x=f.get("x"), y=f.get("y"),
+                           fs=entry.fs)  # fmt: skip
+        rec = frame.recording(str(entry.path))
+        rec.meta.update(columns=frame.columns, file_units=frame.file_units)
+        cols, funits = frame.columns or {}, frame.file_units or {}
+        assumed_frame = [cols[k] for k in ("x", "y") if k in cols and not funits.get(k)]
+        if assumed_frame:
+            rec.meta["units_assumed_si"] = assumed_frame
+    else:
+        rec = read_recording(entry.path, columns=entry.columns, kind=entry.kind, fs=entry.fs)
     base = {"file": entry.path.name, "kind": entry.kind, **entry.tags}
     # provenance: what was read (a units-assumed-SI note matters when a file has no units)
     base["format"] = entry.path.suffix.lower().lstrip(".")
@@ -173,6 +190,12 @@ def analyze_entry(
         d = tangential_row(analysis.to_dict())
         row, u = _flatten(d, d.get("units", {}) or {})
         extra: dict[str, Any] = {}
+        if frame is not None:  # the reconstruction's figures: JSON object, table columns
+            fd = frame.to_dict()
+            extra["frame_reconstruction"] = fd
+            for k in ("window", "window_s", "force_noise", "noise_x", "noise_y"):
+                row[f"frame_{k}"] = fd[k]
+                u[f"frame_{k}"] = fd["units"][k]  # type: ignore[index]
     else:
         from .normal import analyze_normal_recording
 

@@ -8,7 +8,7 @@ equivalent damping* with the corrected formulas of PHYSICS.md §1.
 from __future__ import annotations
 
 from .analysis import analyze_tangential
-from .frame import FrameForce, frame_friction_force
+from .frame import FrameForce, frame_friction_force, read_frame
 from .plots import plot_loop, plot_residuals
 from .preprocess import AveragedLoop, CycleScatter, Reversals, average_loop, find_reversals
 from .result import UNITS, TangentialAnalysis
@@ -27,5 +27,6 @@ __all__ = [
     "frame_friction_force",
     "plot_loop",
     "plot_residuals",
+    "read_frame",
     "synthetic_recording",
 ]

@@ -62,6 +62,58 @@ def _lag_noise(v: np.ndarray, lag: int, order: int) -> float:
     return 1.4826 * float(np.median(d, overwrite_input=True)) / math.sqrt(c)
 
 
+def spectral_noise(v: np.ndarray, *, quantile: float = 0.25, bands: int = 24) -> float:
+    """Noise standard deviation of ``v`` from the floor of its spectrum, for noise that a
+    sensor's low-pass (anti-alias) filter has coloured.
+
+    The record is pre-whitened by its second difference (so the large, slow signal leaks
+    nothing into the floor; the difference's gain is divided out again) and Hann-windowed; in
+    each of ``bands`` log-spaced frequency bands the lower ``quantile`` of the periodogram,
+    divided by the exponential distribution's ``-ln(1 - quantile)``, is the level of the
+    noise between the signal's harmonics. The pass band is the first run of bands where that
+    level has stopped falling (log-log slope above -1) after the signal's decline; below it
+    the noise is taken as flat at the pass-band level (a low-pass filter passes low
+    frequencies unchanged), above it at the observed level, capped at the pass band's (the
+    filter's roll-off). σ² is the mean of that noise spectrum over all frequencies. NaN when
+    fewer than three bands have enough bins or no pass band shows (the signal dominates up to
+    the roll-off)."""
+    v = np.asarray(v, dtype=float)
+    if v.size < 64:
+        return math.nan
+    d = np.diff(v, 2)
+    d = d - float(np.mean(d))
+    n = d.size
+    w = np.hanning(n)
+    P = np.abs(np.fft.rfft(d * w)) ** 2 / float(np.sum(w * w))
+    k = np.arange(P.size)
+    gain = (2.0 * np.sin(np.pi * k / n)) ** 4
+    edges = np.unique(np.geomspace(4, P.size, bands + 1).astype(int))
+    scale = -math.log(1.0 - quantile)
+    lo, hi, lv = [], [], []
+    for a, b in itertools.pairwise(edges):
+        if b - a >= 8:
+            lo.append(int(a))
+            hi.append(int(b))
+            lv.append(float(np.quantile(P[a:b] / gain[a:b], quantile)) / scale)
+    if len(lv) < 3 or not all(x > 0 for x in lv):
+        return math.nan
+    f = np.sqrt(np.array(lo, float) * np.array(hi, float))
+    level = np.array(lv)
+    slope = np.diff(np.log(level)) / np.diff(np.log(f))
+    first = next((i for i, sl in enumerate(slope) if sl > -1.0), None)
+    if first is None:
+        return math.nan
+    last = first
+    while last + 1 < slope.size and slope[last] > -1.0:
+        last += 1
+    passband = float(np.median(level[first : last + 1]))
+    total = lo[first] * passband  # under the signal: flat at the pass-band level
+    total += float(np.sum((np.array(hi[first:]) - np.array(lo[first:])) * np.minimum(
+        level[first:], passband)))  # fmt: skip
+    total += max(P.size - hi[-1], 0) * min(float(level[-1]), passband)
+    return math.sqrt(total / P.size)
+
+
 def difference_noise(v: np.ndarray, order: int = 4) -> float:
     """Noise standard deviation of ``v`` from its ``order``-th differences (MAD scale;
     ``var(Δᵏ v) = C(2k, k) σ²`` for white noise).
@@ -70,9 +122,14 @@ def difference_noise(v: np.ndarray, order: int = 4) -> float:
     one-sample differences; differences at lag L see it once L exceeds the correlation
     length. So the estimate is taken at lags 1, 2, 4, 8, 16: noise alone grows slowly with
     the lag and levels off, a smooth signal grows like L⁴ (16× per doubling). The estimate
-    is read where it grows least between two lags, if that growth is below 4× (a plateau);
-    otherwise the signal dominates every lag and the lag-1 value (an upper bound of white
-    noise) is returned.
+    is read where it grows least between two lags, if that growth is below 4× (a plateau).
+
+    Without a plateau the noise is correlated beyond the lags where the signal is still
+    small (a strong anti-alias filter: at 250 Hz with a cut-off at 0.2 of Nyquist the lag-1
+    value reads such noise ~15× low): then the estimate at the lag of least growth, but no
+    more than the noise floor of the spectrum (:func:`spectral_noise`: both read signal as
+    well as noise there, each in its own way) and no less than the lag-1 value (an upper
+    bound of white noise, which is what is left when neither sees any noise).
     """
     lags = [lag for lag in (1, 2, 4, 8, 16) if v.size > order * lag + 10]
     if not lags:
@@ -82,7 +139,13 @@ def difference_noise(v: np.ndarray, order: int = 4) -> float:
         return float(est[0]) if est and math.isfinite(est[0]) else 0.0
     ratios = [b / a if a > 0 else math.inf for a, b in itertools.pairwise(est)]
     k = int(np.argmin(ratios))
-    return float(est[k + 1] if ratios[k] < 4.0 else est[0])
+    if ratios[k] < 4.0:
+        return float(est[k + 1])
+    floor = spectral_noise(v)
+    least = float(est[k + 1])
+    if math.isfinite(floor):
+        least = min(least, floor)
+    return max(float(est[0]), least)
 
 
 def savgol_derivative(v: np.ndarray, window: int, deriv: int, dt: float) -> np.ndarray:
@@ -276,6 +339,43 @@ class FrameForce:
     #: away from the record's ends, ``F`` is this kernel convolved with the true force, plus
     #: noise of RMS ``force_noise``
     force_filter: np.ndarray | None = None
+    #: the frame's ``{"M": kg, "C": N s/m, "K": N/m}``, and where the displacements came
+    #: from when read from a file (:func:`read_frame`: ``{"x": column, "y": column, "t": ...}``
+    #: and their units in the file)
+    frame: dict[str, float] | None = None
+    columns: dict[str, str] | None = None
+    file_units: dict[str, str] | None = None
+    source: str = "<frame>"
+
+    def to_dict(self) -> dict[str, object]:
+        """The reconstruction's figures (SI; JSON-ready): the Savitzky-Golay window, the
+        channels' noise, the force's noise and error, the frame and the columns read."""
+        out: dict[str, object] = {
+            "window": int(self.window),
+            "window_s": float(self.window_s),
+            "noise_x": float(self.noise_x),
+            "noise_y": float(self.noise_y),
+            "force_noise": float(self.force_noise),
+            "force_error": float(self.force_error),
+            "force_error_near_jumps": float(self.force_error_near_jumps),
+            "jump_share": float(self.jump_share),
+            "force_filter_taps": 0 if self.force_filter is None else int(self.force_filter.size),
+        }
+        if self.frame is not None:
+            out.update({k: float(v) for k, v in self.frame.items()})
+        if self.columns is not None:
+            out["columns"] = dict(self.columns)
+        if self.file_units is not None:
+            out["file_units"] = dict(self.file_units)
+        out["units"] = {"window": "samples", "window_s": "s", "noise_x": "m", "noise_y": "m",
+                        "force_noise": "N", "force_error": "N", "force_error_near_jumps": "N",
+                        "jump_share": "", "M": "kg", "C": "N s/m", "K": "N/m"}  # fmt: skip
+        return out
+
+    def describe(self) -> str:
+        """One paragraph: which columns in which units, the frame, the window and noises
+        (:func:`describe_reconstruction` of :meth:`to_dict`)."""
+        return describe_reconstruction(self.to_dict())
 
     def recording(self, source: str = "<frame>") -> Recording:
         """A tangential :class:`~contactlab.io.Recording` (``x`` in m, ``F`` in N) whose
@@ -287,6 +387,8 @@ class FrameForce:
         meta: dict[str, object] = {"output_noise": self.force_noise, "same_clock": True}
         if self.force_filter is not None:
             meta["output_filter"] = self.force_filter
+        if source == "<frame>":
+            source = self.source
         return Recording(self.t, {"x": self.x, "F": self.F}, {"x": "m", "F": "N"},
                          source=source, meta=meta)  # fmt: skip
 
@@ -388,16 +490,118 @@ def frame_friction_force(
     near_err = math.hypot(f_noise, jump_rms * step_error(window))
     total = math.sqrt((1.0 - share) * f_noise**2 + share * near_err**2)
     return FrameForce(ta, xa, F, xd, xdd, int(window), window * dt, sx, sy, f_noise, share,
-                      near_err, total, force_kernel(window))  # fmt: skip
+                      near_err, total, force_kernel(window),
+                      {"M": float(M), "C": float(C), "K": float(K)})  # fmt: skip
+
+
+def describe_reconstruction(d: dict[str, object]) -> str:
+    """:meth:`FrameForce.to_dict` as a sentence: the columns read and their units, the
+    frame, the Savitzky-Golay window and the noise of x, y and F."""
+    parts = []
+    cols = d.get("columns")
+    if isinstance(cols, dict) and cols:
+        units = d.get("file_units")
+        units = units if isinstance(units, dict) else {}
+        said = []
+        for k, v in cols.items():
+            unit = units.get(k) or ("no unit: taken as s" if k == "t" else "no unit: taken as m")
+            said.append(f"{k} = {v!r} ({unit})")
+        parts.append("columns " + ", ".join(said))
+    if all(isinstance(d.get(k), float) for k in "MCK"):
+        parts.append(f"M = {d['M']:.6g} kg, C = {d['C']:.6g} N s/m, K = {d['K']:.6g} N/m")
+    w, ws = d.get("window"), d.get("window_s")
+    nx, ny, nf = d.get("noise_x"), d.get("noise_y"), d.get("force_noise")
+    if isinstance(w, int) and all(isinstance(v, float) for v in (ws, nx, ny, nf)):
+        parts.append(
+            f"F = K (y - x) + C (y' - x') - M x'' with a cubic Savitzky-Golay window of {w} "
+            f"samples ({1e3 * ws:.3g} ms); noise of x {1e6 * nx:.3g} um, of y "  # type: ignore[operator]
+            f"{1e6 * ny:.3g} um, of F {nf:.3g} N"  # type: ignore[operator]
+        )
+    return "; ".join(parts)
+
+
+def parse_frame(text: str) -> tuple[float, float, float]:
+    """``"3.0799,0.669,1191"`` or ``"M=3.0799,C=0.669,K=1191"`` (SI: kg, N s/m, N/m) → the
+    frame's ``(M, C, K)``; a clear :class:`~contactlab.InputError` otherwise. ``M`` and ``C``
+    must be >= 0, ``K`` > 0 (the base drives the plate through the columns)."""
+    parts = [p.strip() for p in str(text).replace(";", ",").split(",") if p.strip()]
+    if len(parts) != 3:
+        raise InputError(
+            f"--frame {text!r}: give the frame's mass, damping and stiffness as M,C,K "
+            "(kg, N s/m, N/m), e.g. 3.0799,0.669,1191 or M=3.0799,C=0.669,K=1191"
+        )
+    named = [p for p in parts if "=" in p]
+    if named and len(named) != 3:
+        raise InputError(f"--frame {text!r}: name all three (M=..,C=..,K=..) or none")
+    values: dict[str, str] = {}
+    for key, p in zip("MCK", parts, strict=True):
+        if named:
+            k, v = (q.strip() for q in p.split("=", 1))
+            if k.upper() not in ("M", "C", "K") or k.upper() in values:
+                raise InputError(f"--frame {text!r}: {k!r} is not one of M, C, K (each once)")
+            values[k.upper()] = v
+        else:
+            values[key] = p
+    out: list[float] = []
+    for key, unit in (("M", "kg"), ("C", "N s/m"), ("K", "N/m")):
+        try:
+            num = float(values[key])
+        except ValueError:
+            raise InputError(f"--frame: {key} = {values[key]!r} is not a number ({unit})") from None
+        if not math.isfinite(num) or num < 0 or (key == "K" and num == 0):
+            need = "> 0" if key == "K" else ">= 0"
+            raise InputError(f"--frame: {key} = {values[key]} {unit}: must be finite and {need}")
+        out.append(num)
+    return out[0], out[1], out[2]
+
+
+def read_frame(
+    path: object,
+    M: float,
+    C: float,
+    K: float,
+    *,
+    x: str | None = None,
+    y: str | None = None,
+    fs: float | None = None,
+    window: int | None = None,
+) -> FrameForce:
+    """Read a frame's displacements from a file (CSV, TDMS, HDF5, MAT; see
+    :func:`contactlab.io.read_recording`) and reconstruct the friction force
+    (:func:`frame_friction_force`).
+
+    ``x``, ``y``: the top-plate and base displacement columns; default: the one column whose
+    name has the word ``x`` (or ``top``, ``plate``) / ``y`` (or ``base``). Units from the
+    name (``x [mm]``, ``x_top_plate_disp_mm``), else metres; the result names the columns and
+    units it used (:attr:`FrameForce.columns`, :attr:`FrameForce.file_units`).
+    """
+    from ..io import read_recording
+
+    columns = {k: v for k, v in (("x", x), ("y", y)) if v}
+    rec = read_recording(str(path), columns=columns or None, kind="frame", fs=fs)
+    try:
+        r = frame_friction_force(rec.t, rec["x"], rec["y"], M, C, K, window=window)
+    except InputError as exc:
+        raise InputError(f"{path}: {exc}") from exc
+    meta = rec.meta or {}
+    cols = {k: str(v) for k, v in dict(meta.get("columns") or {}).items()}
+    units = {k: str(v) if v else "" for k, v in dict(meta.get("file_units") or {}).items()}
+    import dataclasses
+
+    return dataclasses.replace(r, columns=cols, file_units=units, source=str(path))
 
 
 __all__ = [
     "FrameForce",
+    "describe_reconstruction",
     "difference_noise",
     "force_kernel",
     "frame_friction_force",
     "lepski_window",
+    "parse_frame",
+    "read_frame",
     "savgol_coefficients",
     "savgol_derivative",
+    "spectral_noise",
     "step_error",
 ]
