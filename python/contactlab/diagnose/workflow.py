@@ -202,7 +202,8 @@ class DiagnosisReport:
                 f"{k} = {v:.4g} ± {e.stderr.get(k, np.nan):.2g}" for k, v in e.parameters.items()
             )
             out.append(f"Added {e.name}: {ps}")
-        out += ["", self.table(), f"noise RMS (estimated): {self.noise_rms:.4g}"]
+        how = "declared" if self.location.get("noise_declared") else "estimated"
+        out += ["", self.table(), f"noise RMS ({how}): {self.noise_rms:.4g}"]
         return "\n".join(out)
 
     # -- figures ------------------------------------------------------------------------------
@@ -918,6 +919,7 @@ def diagnose(
     if reduced:
         where.insert(1, reduced)
     location["samples"] = {"recording": n_in, "diagnosed": int(d.t.size)}
+    location["noise_declared"] = declared_noise is not None
     if prior is not None:
         location.update(prior)
         where[2 if reduced else 1 : 2 if reduced else 1] = prior_notes
