@@ -28,7 +28,7 @@ hidden_effect_recording = functools.partial(hidden_effect_recording, samples_per
 
 
 def _check_layout(d: dict) -> None:
-    assert set(d) == {"model", "effects", "steps", "where", "noise_rms"}
+    assert set(d) == {"model", "effects", "steps", "where", "noise_rms", "final_model"}
     assert isinstance(d["model"], str) and isinstance(d["noise_rms"], float)
     for e in d["effects"]:
         assert set(e) == {"name", "parameters", "stderr"}

@@ -486,6 +486,20 @@ class NormalFamily:
 
         return KelvinVoigt(p["k"], p["psi"], context["omega"], p0=p["p0"])
 
+    def coefficients(
+        self, p: dict[str, float], effects: tuple[str, ...], context: dict[str, float]
+    ) -> dict[str, float]:
+        """The stiffness law's coefficients in the paper's eq. 6 (SI: Pa/m, Pa/m², Pa/m³):
+        ``a1 = k``, ``a2 = k a / δ_r``, ``a3 = k κ / δ_r²``. ``κ`` and ``a`` are relative to
+        ``δ_r``, the RMS of the displacement the fit saw (``context``), which the effects
+        themselves change (a 5 % stiffening makes it about 5 % smaller, ``κ`` about 9 %
+        smaller than on the linear record's scale): records are compared by these."""
+        dr = context.get("delta_r", 1.0)
+        a = p.get("a", 0.0) if "asymmetric_branches" in effects else 0.0
+        kap = p.get("kappa", 0.0) if "stiffness_nonlinearity" in effects else 0.0
+        k = p["k"]
+        return {"a1": k, "a2": k * a / dr, "a3": k * kap / dr**2}
+
     def slope(self, p: dict[str, float], d: Prepared) -> None:
         """The linear base has one compliance ``1/k`` everywhere: pressure noise adds the same
         output error at every sample, so no sample is weighted differently."""

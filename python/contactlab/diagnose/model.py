@@ -84,14 +84,26 @@ class ExtendedModel:
         out.fit_result_ = res  # type: ignore[attr-defined]
         return out
 
+    def coefficients(self) -> dict[str, float] | None:
+        """Normal contact: the stiffness law's coefficients of the paper's eq. 6 (``a1`` Pa/m,
+        ``a2`` Pa/m², ``a3`` Pa/m³), independent of the record's displacement scale ``δ_r``
+        that ``kappa`` and ``a`` are relative to; None for the tangential model."""
+        f = getattr(self.family, "coefficients", None)
+        return None if f is None else f(self.params, self.effects, self.context)
+
     def to_dict(self) -> dict[str, Any]:
-        return {
+        out = {
             "model": self.kind,
             "effects": list(self.effects),
             "parameters": dict(self.params),
             "context": dict(self.context),
             "stderr": {k: (v if np.isfinite(v) else None) for k, v in self.stderr.items()},
         }
+        coeffs = self.coefficients()
+        if coeffs is not None:
+            out["coefficients"] = coeffs
+            out["coefficient_units"] = {"a1": "Pa/m", "a2": "Pa/m^2", "a3": "Pa/m^3"}
+        return out
 
     def report(self) -> str:
         """Parameters with standard errors, one per line."""

@@ -172,6 +172,7 @@ class DiagnosisReport:
             "steps": [s.to_dict() for s in self.steps],
             "where": list(self.where),
             "noise_rms": self.noise_rms,
+            "final_model": self.final_model.to_dict(),
         }
 
     def to_json(self, indent: int = 2) -> str:
@@ -202,6 +203,16 @@ class DiagnosisReport:
                 f"{k} = {v:.4g} ± {e.stderr.get(k, np.nan):.2g}" for k, v in e.parameters.items()
             )
             out.append(f"Added {e.name}: {ps}")
+        coeffs = self.final_model.coefficients()
+        if coeffs is not None and ({"a", "kappa"} & set(self.final_model.params)):
+            out.append(
+                "Stiffness law (eq. 6): "
+                + ", ".join(
+                    f"{k} = {v:.4g} {u}"
+                    for (k, v), u in zip(coeffs.items(), ("Pa/m", "Pa/m²", "Pa/m³"), strict=True)
+                )
+                + f" (κ and a are relative to δ_r = {self.final_model.context['delta_r']:.4g} m)"
+            )
         how = "declared" if self.location.get("noise_declared") else "estimated"
         out += ["", self.table(), f"noise RMS ({how}): {self.noise_rms:.4g}"]
         return "\n".join(out)
