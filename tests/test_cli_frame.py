@@ -197,3 +197,23 @@ def test_frame_columns_that_cannot_be_told_apart(tmp_path, capsys):
     assert "no column for the frame's top-plate displacement" in capsys.readouterr().err
     assert main(["analyze", str(path), "--model", "tangential", "--frame", FRAME, "--stream"]) == 1
     assert "drop --stream" in capsys.readouterr().err
+
+
+def test_frame_report_of_a_sliding_loop(sim_file, tmp_path):
+    """``--report`` on a stick-slip frame: the loop plot is titled by the plateau (its h0 and
+    ac's lower bound; it raised KeyError 'h0_ac' when h0 and ac were not both identified) and
+    the table carries the reconstruction's window and noise."""
+    out = tmp_path / "rep"
+    assert main(["analyze", str(sim_file[0]), "--model", "tangential", "--frame",
+                 "3.08,0.669,1191", "--report", str(out)]) == 0  # fmt: skip
+    assert (out / "report.html").is_file()
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from contactlab.tangential import analyze_tangential, plot_loop
+
+    rec = read_frame(sim_file[0], 3.08, 0.669, 1191.0).recording()
+    title = plot_loop(analyze_tangential(rec, warn=False)).get_title()
+    assert "(plateau)" in title and "ac ≥" in title
+    header = (out / "study_tangential.csv").read_text().splitlines()[0]
+    assert "frame_window [samples]" in header and "frame_force_noise [N]" in header

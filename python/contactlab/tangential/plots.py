@@ -53,9 +53,15 @@ def plot_loop(analysis: TangentialAnalysis, ax: Any = None, *, show_scatter: boo
             f"h0 = {p['h0'].value:.4g} ± {p['h0'].stderr:.2g} N, "
             f"ac = {p['ac'].value:.4g} ± {p['ac'].stderr:.2g} 1/m"
         )
-    else:
+    elif "h0_ac" in a.derived:
         k, e = a.derived["h0_ac"]
         title = f"h0·ac = {k:.4g} ± {e:.2g} N/m (h0, ac not separable)"
+    else:  # gross sliding / stick-slip: h0 from the plateau, ac only bounded below
+        h0, e = a.derived.get("h0_plateau", (p["h0"].value, p["h0"].stderr))
+        bound = a.derived.get("ac_lower_bound")
+        acb = bound[0] if isinstance(bound, tuple) else bound
+        tail = f", ac ≥ {acb:.3g} 1/m" if isinstance(acb, float) else ""
+        title = f"h0 = {h0:.4g} ± {e:.2g} N (plateau){tail}"
     ax.set_title(title, fontsize=9)
     ax.set_xlabel("displacement x (µm)")
     ax.set_ylabel("tangential force F (N)")
