@@ -28,6 +28,7 @@ besides the reference: 15-30 minutes). Not part of the test suite.
 from __future__ import annotations
 
 import argparse
+import inspect
 import itertools
 import json
 import time
@@ -37,6 +38,8 @@ from typing import Any
 
 import numpy as np
 from scipy.signal import savgol_filter
+
+import contactlab
 
 REFERENCE: dict[str, Any] = {
     "noise": 0.005,
@@ -97,15 +100,23 @@ def _skew_visibility(rec: Any, model: str) -> float:
     return skew * float(np.sqrt(np.mean(dy * dy))) / sigma
 
 
-def _second_order_gain(job: dict[str, Any], rec: Any) -> float:
-    """Normal contact: what a channel delay (hidden plus filter skew) adds that the
-    Kelvin-Voigt family cannot absorb, in units of the output noise variance.
+#: diagnose's default threshold on the held-out gain (σ²): a hidden effect whose oracle gain
+#: (:func:`oracle_gain`) is below it is below detectability
+MIN_GAIN = float(inspect.signature(contactlab.diagnose).parameters["min_gain"].default)
 
-    A delay ``τ`` and the damping share their first-order phase lag ``ωτ``, so the fitted ψ
-    takes that part; only the second-order remainder identifies a delay. Measured on the
-    same recording without sensor noise or quantisation (same seed, filters, start): the
-    mean-square misfit of the true effects without a delay, minus that with one, each
-    fitted to all samples, over ``σy²``.
+
+def oracle_gain(job: dict[str, Any], rec: Any, effect: str) -> float:
+    """Normal contact: what the hidden ``effect`` adds, with its true parameters, beyond what
+    the rest of the model absorbs, in units of the output noise variance.
+
+    Measured on the same recording without sensor noise or quantisation (same seed, anti-alias
+    filters, start): the mean-square misfit of the true model without ``effect`` minus that
+    of the true model, each fitted to all samples from the true parameters, over ``σy²``.
+    The true model holds a channel delay (the hidden one plus the filter skew) when either
+    is there. A channel delay and the Kelvin-Voigt damping share their first-order phase lag
+    ``ωτ``, so the fitted ψ takes that part and only the second-order remainder is left
+    (:func:`_second_order_gain`). Below :data:`MIN_GAIN` the effect is below detectability:
+    no held-out rule at that threshold can name it, whatever the method.
     """
     from contactlab.diagnose import hidden_effect_recording, select
     from contactlab.diagnose._family import Prepared
@@ -129,11 +140,23 @@ def _second_order_gain(job: dict[str, Any], rec: Any) -> float:
     for _name, par in rec.truth["effects"].items():
         start.update(par)
     start["tau"] = start.get("tau", 0.0) + rec.truth["sensors"]["filter_skew"]
-    others = tuple(e for e in job["effects"] if e != "channel_delay")
+    full = tuple(e for e in job["effects"] if e != "channel_delay")
+    if start["tau"] != 0.0:
+        full = (*full, "channel_delay")
+    if effect not in full:
+        return 0.0
+    others = tuple(e for e in full if e != effect)
     mask = np.ones(d.y.size, bool)
     m0 = select.fit(fam, others, d, mask, start, scales).mse
-    m1 = select.fit(fam, (*others, "channel_delay"), d, mask, start, scales).mse
+    m1 = select.fit(fam, full, d, mask, start, scales).mse
     return (m0 - m1) / rec.truth["noise_rms"]["delta"] ** 2
+
+
+def _second_order_gain(job: dict[str, Any], rec: Any) -> float:
+    """Normal contact: what a channel delay (hidden plus filter skew) adds that the
+    Kelvin-Voigt family cannot absorb, in units of the output noise variance
+    (:func:`oracle_gain` of the delay)."""
+    return oracle_gain(job, rec, "channel_delay")
 
 
 def run_case(job: dict[str, Any]) -> dict[str, Any]:
@@ -163,9 +186,13 @@ def run_case(job: dict[str, Any]) -> dict[str, Any]:
     # the normal family's yardstick of identifiability (_second_order_gain): the delay is
     # in the truth when what it adds beyond the damping's phase exceeds the noise (> 1 σ²),
     # either answer counts between 0.09 and 1 σ² (0.3-1 σ in RMS, as above), out below
+    # below detectability (normal contact, one hidden effect): its oracle gain under MIN_GAIN
+    oracle = None
+    if model == "normal" and len(effects) == 1:
+        oracle = oracle_gain(job, rec, effects[0])
     right2, gain2 = right, None
     if model == "normal" and "channel_delay" in truth | either:
-        gain2 = _second_order_gain(job, rec)
+        gain2 = oracle if tuple(effects) == ("channel_delay",) else _second_order_gain(job, rec)
         truth2 = set(effects) - {"channel_delay"}
         either2 = set()
         if gain2 > 1.0:
@@ -183,6 +210,8 @@ def run_case(job: dict[str, Any]) -> dict[str, Any]:
         "right": bool(right and len(named) == len(set(named))),
         "right_second_order": bool(right2 and len(named) == len(set(named))),
         "delay_gain_second_order": gain2,
+        "oracle_gain": oracle,
+        "below_detectability": oracle is not None and oracle < MIN_GAIN,
         "skew_visibility": vis,
         "after_over_noise": after,
         "error": err,
@@ -355,6 +384,27 @@ def evaluate_model(model: str, args: argparse.Namespace, pool: ProcessPoolExecut
             f"{sum(c['identifiability_stated'] for c in unident)}/{len(unident)} say so, "
             f"named there: {[c['named'] for c in unident]}"
         )
+    # below detectability: the hidden effect with its true parameters gains less than MIN_GAIN
+    # σ² on the clean record (oracle_gain); counted as wrong in the raw rates above, and
+    # shown apart with that figure
+    below = [c for c in eff_all if c.get("below_detectability")]
+    if model == "normal":
+        det = [c for c in xn if not c.get("below_detectability")]
+        rates["single_with_x_noise_detectable"] = sum(c["right"] for c in det) / max(len(det), 1)
+        print(
+            f"\nBelow detectability (oracle gain of the true effect < {MIN_GAIN:g} σ²): "
+            f"{len(below)} of {len(eff_all)} single-effect cases"
+        )
+        for c in below:
+            print(
+                f"  [{c['level']}] seed {c['seed']} {c['effects']}: oracle "
+                f"{c['oracle_gain']:.3g} σ², named {c['named']} "
+                f"({'right' if c['right'] else 'wrong'} by the raw yardstick)"
+            )
+        print(
+            f"  single effects with x noise: raw {sum(c['right'] for c in xn)}/{len(xn)}, "
+            f"detectable cases only {sum(c['right'] for c in det)}/{len(det)}"
+        )
     print("\nFailures:")
     for c in cases:
         if not c["right"]:
@@ -362,6 +412,11 @@ def evaluate_model(model: str, args: argparse.Namespace, pool: ProcessPoolExecut
                 f"  [{c['level']}] seed {c['seed']}: hidden {c['effects'] or 'none'} "
                 f"(truth {c['truth']}), named {c['named']}"
                 + (" (identifiability stated)" if c["identifiability_stated"] else "")
+                + (
+                    f" (below detectability: oracle {c['oracle_gain']:.3g} σ²)"
+                    if c.get("below_detectability")
+                    else ""
+                )
                 + (f" — error: {c['error']}" if c["error"] else "")
             )
     print("\nBars (issue 8):")
@@ -372,6 +427,8 @@ def evaluate_model(model: str, args: argparse.Namespace, pool: ProcessPoolExecut
     ]
     if "single_with_x_noise_identifiable" in rates:
         bars.insert(1, ("… identifiable cases only", "single_with_x_noise_identifiable", 0.95))
+    if "single_with_x_noise_detectable" in rates:
+        bars.insert(1, ("… detectable cases only", "single_with_x_noise_detectable", 0.95))
     if "single_with_x_noise_second_order" in rates:
         bars.insert(1, ("… second-order delay yardstick", "single_with_x_noise_second_order", 0.95))
     for text, key, bar in bars:

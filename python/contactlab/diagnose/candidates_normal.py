@@ -25,6 +25,8 @@ Candidates (name: model, parameters):
 - ``creep_drift``: ``δ += D (1 - exp(-t/τ_c))``, the joint settling over the cycles;
   ``D`` (m), ``tau_c`` (s).
 - ``channel_delay``: ``δ(t) = δ_model(t - τ)``, the displacement channel lags; ``tau`` (s).
+  Between samples by Keys' cubic convolution (:func:`~._signal.shift_cubic`): flat over the
+  band the filtered input noise lives in, so a fraction of a sample smooths nothing.
 
 Identifiability. A channel delay ``τ`` and the Kelvin-Voigt damping give the same first-order
 phase lag at every frequency (``ω τ`` against ``ω h / k``); they differ only in second
@@ -58,9 +60,9 @@ from scipy import fft
 from .. import _core
 from ..errors import ConvergenceError, InputError
 from ._family import Candidate, ParamSpec, Prepared, implausible_common
-from ._filters import first_order_response
+from ._filters import first_order_response, savgol_coeffs, savgol_filter
 from ._kept import shifted
-from ._signal import shift
+from ._signal import cubic_shift_power, shift_cubic, shortest_period_samples
 
 _INF = np.inf
 
@@ -336,12 +338,14 @@ class NormalFamily:
     output_unit = "m"
 
     def prepare(self, d: Prepared) -> None:
-        """Mean pressure, excitation angular frequency and displacement scale.
+        """Mean pressure, excitation angular frequency and displacement scale; the input the
+        candidates see smoothed as far as the excitation's band allows (:func:`smooth_input`).
 
         Values already in ``d.extra`` (from a fitted model's context) are kept: ``omega`` and
         ``delta_r`` belong to the model's parameters.
         """
         d.extra.setdefault("omega", 2.0 * np.pi / (d.cycles.period_samples * d.dt))
+        smooth_input(d)
         if "delta_r" not in d.extra:
             if not np.isfinite(d.y).all():
                 raise InputError("delta_r is needed to simulate a fitted normal model")
@@ -442,7 +446,7 @@ class NormalFamily:
             tc = max(p["tau_c"], 1e-6 * d.duration)
             delta = delta + p["D"] * _creep_shape(d, tc)
         if "channel_delay" in effects:
-            delta = shift(delta, d.t, p["tau"])
+            delta = shift_cubic(delta, d.dt, p["tau"])
         return delta
 
     def noise_variance(self, p: dict[str, float], effects: tuple[str, ...], d: Prepared) -> float:
@@ -451,8 +455,10 @@ class NormalFamily:
 
         ``T = Σ_f S(f) |H(f)|² |L(f)|²`` over the spectrum of the noise in the input the
         candidates see (:func:`input_noise_spectrum`), with ``H = 1/(k (1 + i ω h/k + i η))``
-        the Kelvin-Voigt (and hysteretic) compliance and ``L`` the linear interpolation of a
-        channel delay's fractional sample ``φ``: ``|L|² = 1 - 2φ(1-φ)(1 - cos ωΔt)``. The
+        the Kelvin-Voigt (and hysteretic) compliance and ``L`` the cubic interpolation of a
+        channel delay's fractional sample (:func:`~._signal.cubic_shift_power`; 1 on a kept
+        long record, whose delay shifts the pressure at the raw rate, far above the band the
+        filtered noise lives in). The
         stiffness nonlinearities are taken at their linear stiffness ``k`` (a few per cent
         of ``T`` at the effects' sizes; taking the local stiffness would let a softening
         candidate lower the corrected error by raising ``T`` without bound).
@@ -466,9 +472,8 @@ class NormalFamily:
         if "hysteretic_damping" in effects:
             den = den + 1j * p["eta"]
         g = s / np.abs(den) ** 2
-        if "channel_delay" in effects:
-            phi = float(p["tau"] / d.dt) % 1.0
-            g = g * (1.0 - 2.0 * phi * (1.0 - phi) * (1.0 - np.cos(w * d.dt)))
+        if "channel_delay" in effects and "raw_input" not in d.extra:
+            g = g * cubic_shift_power(float(p["tau"] / d.dt), w * d.dt)
         return float(np.sum(g)) / p["k"] ** 2
 
     def noise_variance_bound(self, p: dict[str, float], d: Prepared) -> float:
@@ -556,6 +561,87 @@ CREEP_START_GRID = 24
 SINGLE_TONE_SPAN = 1.25
 
 
+#: the normal family's input filter (:func:`smooth_input`) passes the excitation up to this
+#: many times its fastest frequency (the tones and their second harmonic) ...
+INPUT_PASS_HARMONICS = 2.0
+#: ... with a gain within this of 1 (a tenth of the second-order signature of a 5 % channel
+#: delay, the smallest model difference the diagnosis resolves, 1e-3 of the displacement)
+INPUT_PASS_ERROR = 1e-4
+#: Savitzky-Golay polynomial orders :func:`smooth_input` chooses among
+INPUT_FILTER_ORDERS = (3, 5, 7, 9)
+#: its longest window, as a fraction of the fastest excitation period
+INPUT_MAX_WINDOW = 0.6
+
+
+def input_filter_choice(fastest_samples: float, current: int) -> tuple[int, int]:
+    """The Savitzky-Golay filter ``(window, order)`` of least white-noise gain ``Σ c²`` whose
+    gain stays within :data:`INPUT_PASS_ERROR` of 1 up to :data:`INPUT_PASS_HARMONICS` times
+    the fastest excitation frequency (``1 / fastest_samples`` cycles per sample), windows up
+    to :data:`INPUT_MAX_WINDOW` of the fastest period; ``(current, 3)`` (the cubic every
+    family sees, :func:`contactlab.diagnose._signal.filter_input`) when none smooths more."""
+    best = (current, 3)
+    best_gain = float(np.sum(savgol_coeffs(current, 3) ** 2)) if current >= 5 else 1.0
+    f = np.linspace(0.0, INPUT_PASS_HARMONICS / fastest_samples, 48)
+
+    def flat(n: int, order: int) -> bool:
+        c = savgol_coeffs(2 * n + 1, order)
+        h = np.exp(-2j * np.pi * np.outer(f, np.arange(-n, n + 1))) @ c
+        return float(np.max(np.abs(1.0 - h))) <= INPUT_PASS_ERROR
+
+    top = (int(INPUT_MAX_WINDOW * fastest_samples) - 1) // 2  # half windows
+    for order in INPUT_FILTER_ORDERS:
+        lo = order // 2 + 1  # the shortest window that smooths at all: order + 2 or + 3
+        if lo > top or not flat(lo, order):
+            continue
+        hi = top
+        while lo < hi:  # the longest flat window (the error grows with the window)
+            mid = (lo + hi + 1) // 2
+            if flat(mid, order):
+                lo = mid
+            else:
+                hi = mid - 1
+        c = savgol_coeffs(2 * lo + 1, order)
+        if float(c @ c) < best_gain:
+            best, best_gain = (2 * lo + 1, order), float(c @ c)
+    return best
+
+
+def smooth_input(d: Prepared) -> None:
+    """The input the normal candidates see: the measured pressure through the Savitzky-Golay
+    filter of :func:`input_filter_choice` when it carries noise (``d.extra["u_noise"]`` > 0)
+    and was filtered at the record's own rate (not a kept long record, whose input is
+    filtered at the raw rate).
+
+    Errors in variables: the input noise the candidates pass on is most of the held-out
+    error at 1 % x noise (``T`` of :meth:`NormalFamily.noise_variance`: 1.4 σ² of output
+    noise through the every-family cubic over 4 % of a period), and its share differs by
+    candidate (a delay instead of damping passes more of it) by more than the second-order
+    signature a delay is told from damping by. The pressure of a normal rig is a few tones:
+    a filter flat to 1e-4 over their band and their second harmonic and cutting above
+    (a 9th-order polynomial over half the fastest period, 5.7 times its frequency at -3 dB)
+    removes most of that noise (``T`` 0.65 times, its difference between damping and
+    delay a quarter) and leaves the excitation as measured. ``d.extra["u_filter"]`` and
+    ``["u_filter_order"]`` record the filter.
+    """
+    if "u_filter_order" in d.extra or "raw_input" in d.extra:
+        return
+    if not float(d.extra.get("u_noise", 0.0)) > 0.0 or d.u.size < 64:
+        return
+    u = np.asarray(d.extra.get("u_raw", d.u), float)
+    per = float(d.cycles.period_samples)
+    fastest = shortest_period_samples(u, per)
+    current = int(d.extra.get("u_filter", 0))
+    n, order = input_filter_choice(fastest, current)
+    n = min(n, u.size - (1 - u.size % 2))
+    if order == 3 or n <= order + 1:
+        d.extra["u_filter_order"] = 3
+        return
+    d.u = savgol_filter(u, n, order, mode="interp")
+    d.extra["u_filter"] = n
+    d.extra["u_filter_order"] = order
+    d.extra.pop("u_noise_spectrum", None)
+
+
 #: the input-noise spectrum is read above this many times the fastest excitation
 #: frequency (the pressure drive is a sum of tones; its window leakage is gone there)
 NOISE_BAND_HARMONICS = 6.0
@@ -576,9 +662,7 @@ def input_noise_spectrum(d: Prepared) -> tuple[np.ndarray, np.ndarray] | None:
         return d.extra["u_noise_spectrum"]
     out = None
     if float(d.extra.get("u_noise", 0.0)) > 0.0 and d.u.size >= 64:
-        from scipy.signal import savgol_coeffs, welch
-
-        from ._signal import shortest_period_samples
+        from scipy.signal import welch
 
         u = np.asarray(d.extra.get("u_raw", d.u), float)
         nper = min(u.size, 1024)
@@ -592,7 +676,7 @@ def input_noise_spectrum(d: Prepared) -> tuple[np.ndarray, np.ndarray] | None:
             s = np.where(f < lo, float(np.median(s[band])), s)
             wlen = int(d.extra.get("u_filter", 0))
             if wlen:
-                c = savgol_coeffs(wlen, 3)
+                c = savgol_coeffs(wlen, int(d.extra.get("u_filter_order", 3)))
                 j = np.arange(wlen) - wlen // 2
                 s = s * np.abs(np.exp(-2j * np.pi * np.outer(f * d.dt, j)) @ c) ** 2
             out = (f, s * float(f[1] - f[0]))

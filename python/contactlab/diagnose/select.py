@@ -32,7 +32,11 @@ driven by the measured input, so its prediction carries the input's noise as the
 filters it, ``T(θ)`` per sample (:func:`noise_term`). A model that filters more (more
 damping, a delay interpolating between samples) would win by that alone. Fits minimise the
 corrected sum ``Σ r² - n T(θ)``, unbiased for every candidate, and the rules above compare
-a candidate's held-out errors as if it passed the current model's ``T``.
+a candidate's held-out errors as if it passed the current model's ``T``. A held-out cycle
+carries the ``T`` of the fold fit that predicted it (:attr:`Trial.cycle_noise`), which the
+comparison subtracts: a fold fit of a delay model may sit at another damping and delay than
+the fit to all data and pass a quarter σ² more of the input noise (measured at 1 % x noise),
+which the full fit's ``T`` would have charged to the candidate as a loss.
 """
 
 from __future__ import annotations
@@ -350,6 +354,24 @@ class Trial:
         """:func:`noise_term` of the fit to all data (0 when not known)."""
         return float(self.extra.get("noise_term", 0.0))
 
+    @property
+    def heldout_noise(self) -> float:
+        """:func:`noise_term` the held-out errors carry: each held-out sample's from the
+        fold fit that predicted it, weighted as :attr:`heldout_rms` (0 when not known)."""
+        return float(self.extra.get("heldout_noise", self.noise_term))
+
+    @property
+    def cycle_noise(self) -> np.ndarray | float:
+        """:func:`noise_term` each held-out cycle of :attr:`cycle_mse` carries (that of the
+        fold fit that predicted it)."""
+        return self.extra.get("cycle_noise", self.noise_term)
+
+    @property
+    def sample_noise(self) -> np.ndarray | float:
+        """:func:`noise_term` per sample of :attr:`prediction` (a held-out sample's from the
+        fold fit that predicted it, the full fit's elsewhere)."""
+        return self.extra.get("sample_noise", self.noise_term)
+
 
 def fold_masks(d: Prepared, folds: int) -> list[np.ndarray]:
     """Test masks: cycle k (from one maximum of the input to the next) in fold k mod folds."""
@@ -395,14 +417,19 @@ def evaluate(
     fitted = family.predict(full.params, effects, d)
     pred = fitted.copy()
     heldout = np.zeros(d.y.size, bool)
+    t_full = noise_term(family, full.params, effects, d)
+    # errors in variables: a held-out sample carries the input noise as the fold fit that
+    # predicted it passes it (its damping and delay), not as the fit to all data does
+    t_sample = np.full(d.y.size, t_full)
 
-    def fold_prediction(test: np.ndarray) -> np.ndarray:
+    def fold_prediction(test: np.ndarray) -> tuple[np.ndarray, float]:
         f = fit(family, effects, d, ~test, full.params, scales)
-        return family.predict(f.params, effects, d)
+        return family.predict(f.params, effects, d), noise_term(family, f.params, effects, d)
 
     held = pmap(fold_prediction, masks) if parallel else [fold_prediction(m) for m in masks]
-    for test, p in zip(masks, held, strict=True):
+    for test, (p, t_fold) in zip(masks, held, strict=True):
         pred[test] = p[test]
+        t_sample[test] = t_fold
         heldout |= test
     err = pred - d.y
     wt = sample_weight(d)
@@ -410,6 +437,7 @@ def evaluate(
     ids = np.unique(cyc[heldout])
     sels = _cycle_samples(cyc, ids)
     cycle_mse = np.array([np.sum(wt[sel] * err[sel] ** 2) / np.sum(wt[sel]) for sel in sels])
+    cycle_noise = np.array([np.sum(wt[sel] * t_sample[sel]) / np.sum(wt[sel]) for sel in sels])
     e_meas, e_mod = [], []
     for sel in sels:
         e_meas.append(family.loop_energy(d.u[sel], d.y[sel]))
@@ -428,7 +456,12 @@ def evaluate(
         float(np.max(np.abs(eh))),
         energy_error,
         fitted,
-        {"noise_term": noise_term(family, full.params, effects, d)},
+        {
+            "noise_term": t_full,
+            "heldout_noise": float(np.sum(wh * t_sample[heldout]) / np.sum(wh)),
+            "cycle_noise": cycle_noise,
+            "sample_noise": t_sample,
+        },
     )
 
 
@@ -460,9 +493,10 @@ class Verdict:
 MIN_RELATIVE_GAIN = 0.01
 
 
-def _noise_of(trial: Any) -> float:
-    """A trial's input-noise term (0 for an object that has none)."""
-    return float(getattr(trial, "noise_term", 0.0))
+def _noise_of(trial: Any, what: str = "heldout_noise") -> Any:
+    """A trial's input-noise term its held-out errors carry (``what``: ``heldout_noise``,
+    ``cycle_noise`` or ``sample_noise`` of :class:`Trial`; 0 for an object that has none)."""
+    return getattr(trial, what, 0.0)
 
 
 def proportional_t(current: Trial, cand: Trial, d: Prepared) -> float:
@@ -487,7 +521,7 @@ def proportional_t(current: Trial, cand: Trial, d: Prepared) -> float:
     idx = np.searchsorted(ids, cyc[cyc >= 0])
     # errors in variables: the candidate's error is read as if it carried the current
     # model's input-noise term (:func:`noise_term`), i.e. each sample gains (T_c - T)/2 in N
-    dt_half = 0.5 * (_noise_of(cand) - _noise_of(current))
+    dt_half = 0.5 * (_noise_of(cand, "sample_noise") - _noise_of(current, "sample_noise"))
     n_c = np.bincount(idx, (w * (r * delta + dt_half))[cyc >= 0], ids.size)
     d_c = np.bincount(idx, (w * delta * delta)[cyc >= 0], ids.size)
     total = float(np.sum(d_c))
@@ -512,8 +546,10 @@ def judge(
     form when ``d`` is given: the family's ``proportional_gain``)."""
     # errors in variables: the candidate's held-out errors are compared as if it passed the
     # input noise as the current model does (corrected least squares, :func:`noise_term`)
-    shift = _noise_of(cand) - _noise_of(current)
-    cand_cycle = np.maximum(cand.cycle_mse - shift, 1e-3 * cand.cycle_mse)
+    # (each held-out error with the noise term of the fold fit that made it)
+    shift = float(_noise_of(cand)) - float(_noise_of(current))
+    c_shift = _noise_of(cand, "cycle_noise") - _noise_of(current, "cycle_noise")
+    cand_cycle = np.maximum(cand.cycle_mse - c_shift, 1e-3 * cand.cycle_mse)
     cand_mse = cand.heldout_mse - shift
     ratio = np.log(current.cycle_mse / cand_cycle)
     gain = float(current.heldout_mse - cand_mse) / sigma**2
