@@ -62,6 +62,12 @@ def _lag_noise(v: np.ndarray, lag: int, order: int) -> float:
     return 1.4826 * float(np.median(d, overwrite_input=True)) / math.sqrt(c)
 
 
+#: :func:`spectral_noise`: a band run whose log-log slope (power per frequency, across two
+#: bands) is above this has stopped falling like a signal's floor (≤ -2 between a smooth
+#: motion's harmonics) and is read as a noise pass band
+FLAT_SLOPE = -1.5
+
+
 def spectral_noise(v: np.ndarray, *, quantile: float = 0.25, bands: int = 24) -> float:
     """Noise standard deviation of ``v`` from the floor of its spectrum, for noise that a
     sensor's low-pass (anti-alias) filter has coloured.
@@ -71,12 +77,12 @@ def spectral_noise(v: np.ndarray, *, quantile: float = 0.25, bands: int = 24) ->
     each of ``bands`` log-spaced frequency bands the lower ``quantile`` of the periodogram,
     divided by the exponential distribution's ``-ln(1 - quantile)``, is the level of the
     noise between the signal's harmonics. The pass band is the first run of bands where that
-    level has stopped falling (log-log slope above -1) after the signal's decline; below it
-    the noise is taken as flat at the pass-band level (a low-pass filter passes low
-    frequencies unchanged), above it at the observed level, capped at the pass band's (the
-    filter's roll-off). σ² is the mean of that noise spectrum over all frequencies. NaN when
-    fewer than three bands have enough bins or no pass band shows (the signal dominates up to
-    the roll-off)."""
+    level has stopped falling (log-log slope above :data:`FLAT_SLOPE` across two bands)
+    after the signal's decline. Below it the noise is taken as flat at the pass-band level
+    (a low-pass filter passes low frequencies unchanged), above it at the observed level,
+    capped at the pass band's (the filter's roll-off). σ² is the mean of that noise spectrum
+    over all frequencies. NaN when fewer than three bands have enough bins or no pass band
+    shows (the signal dominates up to the roll-off, or there is no noise)."""
     v = np.asarray(v, dtype=float)
     if v.size < 64:
         return math.nan
@@ -99,14 +105,17 @@ def spectral_noise(v: np.ndarray, *, quantile: float = 0.25, bands: int = 24) ->
         return math.nan
     f = np.sqrt(np.array(lo, float) * np.array(hi, float))
     level = np.array(lv)
-    slope = np.diff(np.log(level)) / np.diff(np.log(f))
-    first = next((i for i, sl in enumerate(slope) if sl > -1.0), None)
+    # slopes over two bands (a factor ~1.5 in frequency): one band pair's scatter does not
+    # make a pass band of a signal's floor
+    logf, logl = np.log(f), np.log(level)
+    slope = (logl[2:] - logl[:-2]) / (logf[2:] - logf[:-2])
+    first = next((i for i, sl in enumerate(slope) if sl > FLAT_SLOPE), None)
     if first is None:
         return math.nan
     last = first
-    while last + 1 < slope.size and slope[last] > -1.0:
+    while last + 1 < slope.size and slope[last + 1] > FLAT_SLOPE:
         last += 1
-    passband = float(np.median(level[first : last + 1]))
+    passband = float(np.median(level[first : last + 3]))
     total = lo[first] * passband  # under the signal: flat at the pass-band level
     total += float(np.sum((np.array(hi[first:]) - np.array(lo[first:])) * np.minimum(
         level[first:], passband)))  # fmt: skip
@@ -128,8 +137,9 @@ def difference_noise(v: np.ndarray, order: int = 4) -> float:
     small (a strong anti-alias filter: at 250 Hz with a cut-off at 0.2 of Nyquist the lag-1
     value reads such noise ~15× low): then the estimate at the lag of least growth, but no
     more than the noise floor of the spectrum (:func:`spectral_noise`: both read signal as
-    well as noise there, each in its own way) and no less than the lag-1 value (an upper
-    bound of white noise, which is what is left when neither sees any noise).
+    well as noise there, each in its own way) and no less than the lag-1 value. When the
+    spectrum shows no noise floor either, the lag-1 value (an upper bound of white noise:
+    a clean record).
     """
     lags = [lag for lag in (1, 2, 4, 8, 16) if v.size > order * lag + 10]
     if not lags:
@@ -142,10 +152,9 @@ def difference_noise(v: np.ndarray, order: int = 4) -> float:
     if ratios[k] < 4.0:
         return float(est[k + 1])
     floor = spectral_noise(v)
-    least = float(est[k + 1])
-    if math.isfinite(floor):
-        least = min(least, floor)
-    return max(float(est[0]), least)
+    if not math.isfinite(floor):  # no noise floor in sight either: the signal dominates
+        return float(est[0])
+    return max(float(est[0]), min(float(est[k + 1]), floor))
 
 
 def savgol_derivative(v: np.ndarray, window: int, deriv: int, dt: float) -> np.ndarray:
