@@ -330,3 +330,42 @@ def test_exact_kelvin_voigt_is_the_integrator_at_tight_tolerance(seed, n, log_la
         for _ in range(2):  # computed, then kept
             kept = _kelvin_voigt_fit(d, k, psi, p0, omega)
             assert np.max(np.abs(kept - got)) <= 1e-12 * scale
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    n=st.integers(8, 5000),
+    nper=st.integers(2, 1100),
+    fs=st.floats(1.0, 1e5),
+)
+def test_welch_matches_scipy(seed, n, nper, fs):
+    from scipy.signal import welch
+
+    nper = min(nper, n)
+    x = np.random.default_rng(seed).normal(size=n) + np.linspace(0.0, 3.0, n)
+    f0, p0 = welch(x, fs=fs, window="hann", nperseg=nper, detrend="linear")
+    f1, p1 = _filters.welch(x, fs, nper)
+    assert np.allclose(f1, f0, rtol=1e-12, atol=0.0)
+    assert np.allclose(p1, p0, rtol=1e-9, atol=1e-12 * float(np.var(x)) / fs)
+
+
+def test_normal_diagnosis_with_input_noise_imports_no_scipy_signal():
+    """The input-noise spectrum of the normal family (Welch) is numpy's: a diagnosis run
+    imports neither scipy.signal nor scipy.stats (half a second of a 1e6-sample run)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys\n"
+        "import numpy as np\n"
+        "import contactlab\n"
+        "rng = np.random.default_rng(5)\n"
+        "t = np.arange(6000) / 200.0\n"
+        "p = 5e5 + 2e5 * np.sin(2 * np.pi * t) + 1e3 * rng.normal(size=t.size)\n"
+        "d = (p - 5e5) / 1.3e12 + 2e-10 * rng.normal(size=t.size)\n"
+        "contactlab.diagnose((t, p, d), model='normal', max_effects=1)\n"
+        "print([m for m in sys.modules if m.startswith(('scipy.signal', 'scipy.stats'))])\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip().splitlines()[-1] == "[]"

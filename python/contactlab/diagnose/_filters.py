@@ -1,10 +1,12 @@
 """The filters a diagnosis needs, in numpy: Savitzky-Golay coefficients and smoothing,
-zero-phase FIR decimation, the analytic signal, and the exact first-order response that
-evaluates the linear Kelvin-Voigt base model (:func:`first_order_response`).
+zero-phase FIR decimation, the analytic signal, Welch's periodogram, and the exact
+first-order response that evaluates the linear Kelvin-Voigt base model
+(:func:`first_order_response`).
 
 They follow :func:`scipy.signal.savgol_coeffs`, :func:`scipy.signal.savgol_filter`
 (``mode="interp"``), :func:`scipy.signal.decimate` (``ftype="fir", zero_phase=True``) and
-:func:`scipy.signal.hilbert` step for step (same designs, same edge handling, same output
+:func:`scipy.signal.hilbert` and :func:`scipy.signal.welch` (Hann window, half overlap, linear
+detrend, density scaling) step for step (same designs, same edge handling, same output
 alignment) and agree with them to rounding (tests/test_diagnose_speed.py). They exist because
 importing :mod:`scipy.signal` (which imports :mod:`scipy.stats`) costs about half a second,
 a sixth of a ``contactlab diagnose`` run on a million samples; nothing else on that path
@@ -119,6 +121,31 @@ def hilbert(x: np.ndarray) -> np.ndarray:
         g[0] = 1.0
         g[1 : (n + 1) // 2] = 2.0
     return np.fft.ifft(np.fft.fft(x) * g)
+
+
+def welch(x: np.ndarray, fs: float, nperseg: int) -> tuple[np.ndarray, np.ndarray]:
+    """Welch's one-sided power spectral density of ``x`` (per Hz), as
+    ``scipy.signal.welch(x, fs, window="hann", nperseg=nperseg, detrend="linear")``:
+    segments of ``nperseg`` samples overlapping by half, each less its least-squares line,
+    through a periodic Hann window, the periodograms averaged."""
+    x = np.asarray(x, float)
+    if not 2 <= nperseg <= x.size:
+        raise ValueError(f"welch: nperseg {nperseg} must be within 2..{x.size}")
+    step = nperseg - nperseg // 2
+    segs = sliding_window_view(x, nperseg)[::step]
+    t = np.arange(nperseg) - 0.5 * (nperseg - 1)
+    tt = float(t @ t)
+    seg = segs - segs.mean(axis=1, keepdims=True)
+    if tt > 0:
+        seg = seg - np.outer(seg @ t / tt, t)
+    win = 0.5 - 0.5 * np.cos(2.0 * np.pi * np.arange(nperseg) / nperseg)
+    spec = np.abs(np.fft.rfft(seg * win, axis=1)) ** 2
+    p = spec.mean(axis=0) / (fs * float(win @ win))
+    if nperseg % 2:
+        p[1:] *= 2.0
+    else:
+        p[1:-1] *= 2.0
+    return np.fft.rfftfreq(nperseg, 1.0 / fs), p
 
 
 def uniform_filter1d(x: np.ndarray, size: int, mode: str = "nearest") -> np.ndarray:

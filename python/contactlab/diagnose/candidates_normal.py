@@ -60,7 +60,7 @@ from scipy import fft
 from .. import _core
 from ..errors import ConvergenceError, InputError
 from ._family import Candidate, ParamSpec, Prepared, implausible_common
-from ._filters import first_order_response, savgol_coeffs, savgol_filter
+from ._filters import first_order_response, savgol_coeffs, savgol_filter, welch
 from ._kept import shifted
 from ._signal import cubic_shift_power, shift_cubic, shortest_period_samples
 
@@ -662,12 +662,10 @@ def input_noise_spectrum(d: Prepared) -> tuple[np.ndarray, np.ndarray] | None:
         return d.extra["u_noise_spectrum"]
     out = None
     if float(d.extra.get("u_noise", 0.0)) > 0.0 and d.u.size >= 64:
-        from scipy.signal import welch
-
         u = np.asarray(d.extra.get("u_raw", d.u), float)
         nper = min(u.size, 1024)
         fs = 1.0 / d.dt
-        f, s = welch(u, fs=fs, window="hann", nperseg=nper, detrend="linear")
+        f, s = welch(u, fs, nper)
         fast = 1.0 / (shortest_period_samples(u, d.cycles.period_samples) * d.dt)
         nyq = 0.5 * fs
         lo = min(max(NOISE_BAND_HARMONICS * fast, 24.0 * fs / nper), 0.5 * nyq)
