@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 from scipy.signal import savgol_filter
 
-import contactlab
+from contactlab.diagnose.workflow import diagnose as diagnose_workflow
 
 REFERENCE: dict[str, Any] = {
     "noise": 0.005,
@@ -102,7 +102,7 @@ def _skew_visibility(rec: Any, model: str) -> float:
 
 #: diagnose's default threshold on the held-out gain (σ²): a hidden effect whose oracle gain
 #: (:func:`oracle_gain`) is below it is below detectability
-MIN_GAIN = float(inspect.signature(contactlab.diagnose).parameters["min_gain"].default)
+MIN_GAIN = float(inspect.signature(diagnose_workflow).parameters["min_gain"].default)
 
 
 def oracle_gain(job: dict[str, Any], rec: Any, effect: str) -> float:
