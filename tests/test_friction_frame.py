@@ -85,6 +85,8 @@ def test_exact_data_and_a_given_window():
         ({"window": 6}, "odd number"),
         ({"t": np.r_[0.0, np.cumsum(np.full(2499, 0.004)) * np.r_[1.0, np.full(2498, 1.01)]]},
          "uniformly"),
+        ({"x": np.r_[np.zeros(100), 1e300, np.zeros(2399)]}, "x reaches 1e.300 m at sample 100"),
+        ({"y": np.full(2500, np.inf)}, r"y\[0\] is not finite"),
     ],
 )  # fmt: skip
 def test_bad_input_is_named(kwargs, match):

@@ -36,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._arrays import as_1d
+from .._physical import MAX_MAGNITUDE
 from ..errors import InputError
 from ..io import Recording
 
@@ -453,6 +454,13 @@ def frame_friction_force(
             raise InputError(f"{name} must be a finite number >= 0, got {v!r}")
     if ta.size < 20:
         raise InputError(f"{ta.size} samples are too few to differentiate (at least 20)")
+    for name, v in (("x", xa), ("y", ya)):
+        i = int(np.argmax(np.abs(v)))
+        if not abs(float(v[i])) <= MAX_MAGNITUDE:
+            raise InputError(
+                f"{name} reaches {float(v[i]):.3g} m at sample {i}: beyond any physical "
+                "displacement; a unit mix-up or a corrupt file?"
+            )
     dts = np.diff(ta)
     dt = float(np.median(dts))
     if not dt > 0 or np.max(np.abs(dts - dt)) > 1e-3 * dt:
