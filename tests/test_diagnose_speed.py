@@ -155,6 +155,30 @@ def test_pmap_keeps_order_and_raises_the_first_error(monkeypatch):
     assert workers() >= 1
 
 
+def test_threads_follow_the_load_now_not_the_lagging_average(monkeypatch):
+    """The thread count takes the smaller of the 1-minute load average and the tasks
+    runnable now: just after other work ended (average high, nothing running) a diagnosis
+    uses the idle cores; under sustained load (both high) it runs serially."""
+    import os
+
+    from contactlab.diagnose import _parallel
+
+    monkeypatch.delenv("CONTACTLAB_DIAGNOSE_THREADS", raising=False)
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1}, raising=False)
+    monkeypatch.setattr(os, "getloadavg", lambda: (1.7, 1.5, 1.2))
+    monkeypatch.setattr(_parallel, "running_elsewhere", lambda: 0.0)
+    assert _parallel.workers() == 2
+    monkeypatch.setattr(_parallel, "running_elsewhere", lambda: 3.0)
+    assert _parallel.workers() == 1
+    monkeypatch.setattr(_parallel, "running_elsewhere", lambda: None)  # not Linux
+    assert _parallel.workers() == 1
+    monkeypatch.setattr(os, "getloadavg", lambda: (0.2, 0.5, 1.2))
+    assert _parallel.workers() == 2
+    monkeypatch.undo()
+    now = _parallel.running_elsewhere()
+    assert now is None or now >= 0.0
+
+
 def test_a_binding_budget_stops_where_a_serial_run_stops(monkeypatch):
     """Candidates on threads spend the evaluation budget as a serial run does: the same
     candidates tried, the same ones left untested, the same sentence."""

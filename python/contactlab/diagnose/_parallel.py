@@ -28,12 +28,28 @@ F = TypeVar("F", bound=Callable[..., Any])
 MAX_WORKERS = 8
 
 
+def running_elsewhere() -> float | None:
+    """Tasks runnable on the machine right now besides the caller (``procs_running`` of
+    ``/proc/stat`` less one), or None where the system does not tell."""
+    try:
+        with open("/proc/stat", "rb") as f:
+            for line in f:
+                if line.startswith(b"procs_running"):
+                    return max(float(line.split()[1]) - 1.0, 0.0)
+    except (OSError, ValueError, IndexError):
+        return None
+    return None
+
+
 def workers() -> int:
     """Threads for independent fits: one per core this process may run on that is not busy
-    already (the 1-minute load average), at least 1 and at most :data:`MAX_WORKERS`;
-    ``CONTACTLAB_DIAGNOSE_THREADS=n`` sets it. On a machine whose cores are all taken, a
-    second thread only adds GIL hand-overs (measured on 2 cores at a load of 6-10: the same
-    or up to 30 % more wall time than one thread), so there a diagnosis runs serially."""
+    already, at least 1 and at most :data:`MAX_WORKERS`; ``CONTACTLAB_DIAGNOSE_THREADS=n``
+    sets it. Busy is the smaller of the 1-minute load average and the tasks runnable right
+    now (:func:`running_elsewhere`): the average lags, so a diagnosis started just after
+    other work ended would otherwise run serially on idle cores for up to a minute. On a
+    machine whose cores are all taken, a second thread only adds GIL hand-overs (measured on
+    2 cores at a load of 6-10: the same or up to 30 % more wall time than one thread), so
+    there a diagnosis runs serially."""
     env = os.environ.get("CONTACTLAB_DIAGNOSE_THREADS", "").strip()
     if env.isdigit() and int(env) >= 1:
         return min(int(env), MAX_WORKERS)
@@ -42,10 +58,13 @@ def workers() -> int:
     except (AttributeError, OSError):  # not Linux
         n = os.cpu_count() or 1
     try:
-        idle = n - os.getloadavg()[0]
+        busy = os.getloadavg()[0]
     except (AttributeError, OSError):  # no load average on this system
-        idle = n
-    return max(1, min(n, int(idle) + 1, MAX_WORKERS))
+        busy = 0.0
+    now = running_elsewhere()
+    if now is not None:
+        busy = min(busy, now)
+    return max(1, min(n, int(n - busy) + 1, MAX_WORKERS))
 
 
 def _blas_limit() -> AbstractContextManager[Any]:
