@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._arrays import scan
 from .errors import InputError
 
 MAX_MAGNITUDE = 1e100
@@ -30,10 +31,11 @@ def check_channel(name: str, v: np.ndarray, unit: str, what: str) -> None:
     ...
     contactlab.errors.InputError: F is constant (3 N in all 5 samples): ...
     """
-    a = np.abs(v)
-    i = int(np.argmax(a))
-    big = float(a[i])
+    v = np.asarray(v, dtype=np.float64)
+    _finite, lo, hi = scan(v)  # the largest magnitude is max(-min, max)
+    big = max(-lo, hi) if v.size else 0.0
     if big > MAX_MAGNITUDE:
+        i = int(np.argmax(np.abs(v)))
         raise InputError(
             f"{name} reaches {float(v[i]):.3g} {unit} at sample {i}: beyond any physical "
             f"{what}; a unit mix-up or a corrupt file?"
@@ -43,7 +45,7 @@ def check_channel(name: str, v: np.ndarray, unit: str, what: str) -> None:
             f"{name} is zero in all {v.size} samples: the {what} sensor recorded nothing, so "
             "there is no loop to analyse"
         )
-    spread = float(np.ptp(v))
+    spread = hi - lo
     if spread <= 1e-12 * big:
         raise InputError(
             f"{name} is constant ({float(v[0]):.6g} {unit} in all {v.size} samples): the "

@@ -380,12 +380,12 @@ def time_from_fs(n: int, fs: float | None, *, file: str, t0: float = 0.0) -> np.
 
 
 def check_finite(a: np.ndarray, *, file: str, column: str, row_of: RowOf = _plain) -> None:
-    bad = ~np.isfinite(a)
-    if bad.any():
-        i = int(np.argmax(bad))
-        raise RecordingError(
-            f"value {float(a[i])} is not a finite number", file=file, column=column, row=row_of(i)
-        )
+    if np.isfinite(a).all():
+        return
+    i = int(np.argmax(~np.isfinite(a)))
+    raise RecordingError(
+        f"value {float(a[i])} is not a finite number", file=file, column=column, row=row_of(i)
+    )
 
 
 def check_equal_lengths(

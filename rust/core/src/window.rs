@@ -67,10 +67,12 @@ struct BinMoments {
 impl BinMoments {
     fn add(&mut self, x: f64, f: f64, p: f64) {
         self.k += 1.0;
+        // one division a cell instead of three (this runs every few samples)
+        let r = 1.0 / self.k;
         let (dx, df, dp) = (x - self.mx, f - self.mf, p - self.mp);
-        self.mx += dx / self.k;
-        self.mf += df / self.k;
-        self.mp += dp / self.k;
+        self.mx += dx * r;
+        self.mf += df * r;
+        self.mp += dp * r;
         let dp_new = p - self.mp;
         self.m2x += dx * (x - self.mx);
         self.m2f += df * (f - self.mf);
@@ -92,82 +94,67 @@ impl BinMoments {
     }
 }
 
-/// The loop area (shoelace, scaled and Neumaier-summed as [`crate::masing::loop_area`]) and
-/// the noise sensitivities of one cycle, accumulated sample by sample.
+/// Neumaier (compensated) sum: the loop areas' summation (as [`crate::masing::loop_area`]).
 #[derive(Debug, Clone, Copy, Default)]
-struct CycleArea {
-    m: usize,
-    // scaled, centred samples: the first, the previous
-    x0: f64,
-    f0: f64,
-    xp: f64,
-    fp: f64,
+struct Neumaier {
     sum: f64,
     comp: f64,
-    // raw samples: the first two and the last two (the cyclic neighbours of the ends)
-    rx: [f64; 2],
-    rf: [f64; 2],
-    lx: [f64; 2],
-    lf: [f64; 2],
-    sens_f: f64,
-    sens_x: f64,
 }
 
-impl CycleArea {
-    fn neumaier(&mut self, term: f64) {
+impl Neumaier {
+    fn add(&mut self, term: f64) {
         let t = self.sum + term;
-        if self.sum.abs() >= term.abs() {
-            self.comp += (self.sum - t) + term;
+        // (sum - t) + term when |sum| >= |term|, else (term - t) + sum: as selects, not a
+        // branch (the same numbers; the branch was mispredicted where the area crosses zero)
+        let first = self.sum.abs() >= term.abs();
+        let (big, small) = if first {
+            (self.sum, term)
         } else {
-            self.comp += (term - t) + self.sum;
-        }
+            (term, self.sum)
+        };
+        self.comp += (big - t) + small;
         self.sum = t;
     }
+}
 
-    /// Add a sample: `xs`, `fs` scaled and centred, `x`, `f` as recorded.
-    fn push(&mut self, xs: f64, fs: f64, x: f64, f: f64) {
-        if self.m == 0 {
-            (self.x0, self.f0) = (xs, fs);
-        } else {
-            self.neumaier(0.5 * (self.fp + fs) * (xs - self.xp));
-        }
-        if self.m < 2 {
-            self.rx[self.m] = x;
-            self.rf[self.m] = f;
-        }
-        if self.m >= 2 {
-            // the previous sample's neighbours are now known: lx[0] before it, x after it
-            let cf = 0.5 * (self.lx[0] - x);
-            let cx = 0.5 * (f - self.lf[0]);
-            self.sens_f += cf * cf;
-            self.sens_x += cx * cx;
-        }
-        self.lx = [self.lx[1], x];
-        self.lf = [self.lf[1], f];
-        (self.xp, self.fp) = (xs, fs);
-        self.m = self.m.saturating_add(1);
+/// The loop area of one cycle's samples (shoelace, scaled and Neumaier-summed as
+/// [`crate::masing::loop_area`]) and its noise sensitivities, in one tight loop: `(area, Σ coef_F², Σ coef_x²)`, the area in the
+/// samples' units; `ux`, `uf` scale x and F, `fm` centres the scaled F. Run once a cycle is
+/// complete, on samples still in cache, instead of sample by sample inside the fold (where
+/// its state competed for registers with the fold's).
+// Index arithmetic: m >= 3, so m - 1 and m - 2 are samples of the cycle.
+#[allow(clippy::arithmetic_side_effects)]
+fn cycle_area(x: &[f64], f: &[f64], ux: f64, uf: f64, fm: f64, scale: f64) -> (f64, f64, f64) {
+    let m = x.len().min(f.len());
+    if m < 3 {
+        return (f64::NAN, 0.0, 0.0);
     }
-
-    /// `(area, Σ coef_F², Σ coef_x²)` of the closed cycle; the area in the samples' units.
-    fn finish(mut self, scale: f64) -> (f64, f64, f64) {
-        if self.m < 3 {
-            return (f64::NAN, 0.0, 0.0);
-        }
-        self.neumaier(0.5 * (self.fp + self.f0) * (self.x0 - self.xp));
-        // the first sample (neighbours: the last and the second) and the last (the one
-        // before it and the first)
-        let (c0f, c0x) = (
-            0.5 * (self.lx[1] - self.rx[1]),
-            0.5 * (self.rf[1] - self.lf[1]),
-        );
-        let (c1f, c1x) = (
-            0.5 * (self.lx[0] - self.rx[0]),
-            0.5 * (self.rf[0] - self.lf[0]),
-        );
-        let sens_f = self.sens_f + c0f * c0f + c1f * c1f;
-        let sens_x = self.sens_x + c0x * c0x + c1x * c1x;
-        ((self.sum + self.comp) * scale, sens_f, sens_x)
+    let (x, f) = (&x[..m], &f[..m]);
+    let mut a = Neumaier::default();
+    let (x0, f0) = (x[0] * ux, f[0] * uf - fm);
+    let (mut xp, mut fp) = (x0, f0);
+    for (&xi, &fi) in x[1..].iter().zip(&f[1..]) {
+        let (xs, fs) = (xi * ux, fi * uf - fm);
+        a.add(0.5 * (fp + fs) * (xs - xp));
+        (xp, fp) = (xs, fs);
     }
+    a.add(0.5 * (fp + f0) * (x0 - xp));
+    let (mut sf, mut sx) = (0.0_f64, 0.0_f64);
+    for (xw, fw) in x.windows(3).zip(f.windows(3)) {
+        let cf = 0.5 * (xw[0] - xw[2]);
+        let cx = 0.5 * (fw[2] - fw[0]);
+        sf += cf * cf;
+        sx += cx * cx;
+    }
+    // the first sample (neighbours: the last and the second), then the last (the one before
+    // it and the first)
+    let (c0f, c0x) = (0.5 * (x[m - 1] - x[1]), 0.5 * (f[1] - f[m - 1]));
+    let (c1f, c1x) = (0.5 * (x[m - 2] - x[0]), 0.5 * (f[0] - f[m - 2]));
+    (
+        (a.sum + a.comp) * scale,
+        sf + c0f * c0f + c1f * c1f,
+        sx + c0x * c0x + c1x * c1x,
+    )
 }
 
 fn bad(name: &'static str, value: f64, reason: &'static str) -> CoreError {
@@ -433,10 +420,19 @@ pub fn fold_window(
     let seg_slope = |j: usize| (kp[j + 1] - kp[j]) / (kt[j + 1] - kt[j]);
     let mut slope = seg_slope(0);
     let mut last_ph = f64::NEG_INFINITY;
-    // the open cell (cycle, bin) and its sums: samples, Σx, ΣF, Σφ
+    // the open cell (cycle c, bin b) and its sums: samples, Σx, ΣF, Σφ. The cell is tracked by
+    // the phase intervals it covers, [c_lo, c_hi) and, within the cycle, [b_lo, b_hi) of
+    // frac·n_bins: a sample inside both is in the same cell, with no float-to-integer
+    // conversion (two saturating conversions a sample were a quarter of the pass); the
+    // indices are those of `floor` as before, bit for bit
     let mut cell: Option<(usize, usize)> = None;
+    let (mut c_lo, mut c_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    let (mut b_lo, mut b_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    let (mut cc, mut cb) = (0_usize, 0_usize);
+    let nbf = nb as f64;
     let mut cell_sums = [0.0_f64; 4];
-    let mut area = CycleArea::default();
+    // the open cycle's samples: [a0, a1)
+    let (mut a0, mut a1) = (0_usize, 0_usize);
     let mut area_cycle: Option<usize> = None;
     let mut end = n;
     let flush_cell =
@@ -446,6 +442,7 @@ pub fn fold_window(
             let r = &mut ranges[c];
             *r = [r[0].max(mx), r[1].min(mx), r[2].max(mf), r[3].min(mf)];
         };
+    let (mut k_lo, mut k_hi, mut p_lo) = (kt[0], kt[1], kp[0]);
     for i in 0..n {
         let (ti, xi, fi) = (t[i], x[i], f[i]);
         if i > 0 {
@@ -471,34 +468,75 @@ pub fn fold_window(
             }
             continue;
         }
-        if ti < kt[j] {
-            j = 0;
-            slope = seg_slope(0);
-        }
-        if kt[j + 1] <= ti {
+        if ti < k_lo || k_hi <= ti {
+            if ti < kt[j] {
+                j = 0;
+            }
             while kt[j + 1] <= ti {
                 j += 1;
             }
             slope = seg_slope(j);
+            (k_lo, k_hi, p_lo) = (kt[j], kt[j + 1], kp[j]);
         }
-        let mut ph = if ti == kt[j] {
-            kp[j]
+        let mut ph = if ti == k_lo {
+            p_lo
         } else {
-            slope * (ti - kt[j]) + kp[j]
+            slope * (ti - k_lo) + p_lo
         };
         // never back (rounding at a knot): each cell stays one run of samples
-        ph = ph.max(last_ph);
-        last_ph = ph;
-        // ph >= kp[0] >= 0 and finite, below 2^33: truncation is floor (bit for bit) without
-        // the libm call a generic x86-64 build makes of f64::floor
-        let c = ph as usize;
-        let frac = ph - c as f64;
-        if c >= nc {
-            continue;
+        if ph < last_ph {
+            ph = last_ph;
         }
-        let b = ((frac * nb as f64) as usize).min(nb - 1);
+        last_ph = ph;
+        if !(ph >= c_lo && ph < c_hi) {
+            // another cycle: ph >= kp[0] >= 0 and finite, below 2^33, so the conversion is
+            // floor
+            let c = ph as usize;
+            if c >= nc {
+                continue;
+            }
+            c_lo = c as f64;
+            c_hi = c_lo + 1.0;
+            cc = c;
+            (b_lo, b_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+            if w.first[c] < 0 {
+                w.first[c] = i64::try_from(i).unwrap_or(i64::MAX);
+            }
+            if let Some(ac) = area_cycle {
+                (w.energy[ac], w.sens_f[ac], w.sens_x[ac]) =
+                    cycle_area(&x[a0..i], &f[a0..i], ux, uf, fm, area_scale);
+            }
+            area_cycle = Some(c);
+            a0 = i;
+        }
+        let frac = ph - c_lo;
+        let g = frac * nbf;
+        if !(g >= b_lo && g < b_hi) {
+            // another bin (or cycle): the cell is complete
+            let b;
+            if g >= b_hi && g < b_hi + 1.0 && cb + 2 < nb {
+                // the next bin (not the last): b_hi = cb + 1 exactly, so floor(g) = cb + 1
+                b = cb + 1;
+                b_lo = b_hi;
+                b_hi += 1.0;
+            } else {
+                b = (g as usize).min(nb - 1);
+                b_lo = b as f64;
+                b_hi = if b + 1 == nb {
+                    f64::INFINITY
+                } else {
+                    b_lo + 1.0
+                };
+            }
+            if let Some((oc, ob)) = cell {
+                flush_cell(oc, ob, &cell_sums, &mut moments, &mut ranges);
+            }
+            cb = b;
+            cell = Some((cc, cb));
+            cell_sums = [0.0; 4];
+        }
         // one bin's sums in one cache line (the same additions, in the same order)
-        let s = &mut bins[b];
+        let s = &mut bins[cb];
         s[0] += 1.0;
         s[1] += xi;
         s[2] += fi;
@@ -506,28 +544,11 @@ pub fn fold_window(
         s[4] += frac * frac;
         s[5] += xi * xi;
         s[6] += ti;
-        if cell != Some((c, b)) {
-            if let Some((cc, cb)) = cell {
-                flush_cell(cc, cb, &cell_sums, &mut moments, &mut ranges);
-            }
-            cell = Some((c, b));
-            cell_sums = [0.0; 4];
-        }
         cell_sums[0] += 1.0;
         cell_sums[1] += xi;
         cell_sums[2] += fi;
         cell_sums[3] += frac;
-        if w.first[c] < 0 {
-            w.first[c] = i64::try_from(i).unwrap_or(i64::MAX);
-        }
-        if area_cycle != Some(c) {
-            if let Some(ac) = area_cycle {
-                (w.energy[ac], w.sens_f[ac], w.sens_x[ac]) = area.finish(area_scale);
-            }
-            area_cycle = Some(c);
-            area = CycleArea::default();
-        }
-        area.push(xi * ux, fi * uf - fm, xi, fi);
+        a1 = i + 1;
     }
     if let Some((cc, cb)) = cell {
         flush_cell(cc, cb, &cell_sums, &mut moments, &mut ranges);
@@ -542,7 +563,8 @@ pub fn fold_window(
         w.sum_t[b] = s[6];
     }
     if let Some(ac) = area_cycle {
-        (w.energy[ac], w.sens_f[ac], w.sens_x[ac]) = area.finish(area_scale);
+        (w.energy[ac], w.sens_f[ac], w.sens_x[ac]) =
+            cycle_area(&x[a0..a1], &f[a0..a1], ux, uf, fm, area_scale);
     }
     while e < edges.len() {
         ce_f.push(cf);

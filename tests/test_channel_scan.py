@@ -1,0 +1,53 @@
+"""`_arrays.scan` (finiteness and extremes of a channel) against plain reductions, and the
+checks built on it still name the bad sample."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from contactlab._arrays import as_1d, scan
+from contactlab._physical import check_channel
+from contactlab.errors import InputError
+from contactlab.io.recording import RecordingError, check_finite
+
+
+def _numpy(a):
+    ok = [bool(np.isfinite(v)) for v in a]
+    good = [float(v) for v, k in zip(a, ok, strict=True) if k]
+    return all(ok), min(good, default=float("inf")), max(good, default=float("-inf"))
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    n=st.integers(0, 3 * 4096),
+    seed=st.integers(0, 2**32 - 1),
+    bad=st.sampled_from([None, np.nan, np.inf, -np.inf]),
+    scale=st.sampled_from([1.0, 1e-300, 1e300]),
+)
+def test_scan_equals_plain_reductions(n, seed, bad, scale):
+    rng = np.random.default_rng(seed)
+    a = rng.standard_normal(n) * scale
+    if bad is not None and n:
+        a[rng.integers(n)] = bad
+    got = scan(a)
+    want = _numpy(a)
+    assert got == want
+    assert scan(a, extremes=False)[0] == want[0]
+
+
+def test_long_channel_checks_name_the_sample():
+    a = np.linspace(-1.0, 1.0, 5 * 4096)
+    a[12345] = np.nan
+    with pytest.raises(InputError, match=r"x\[12345\] is not finite"):
+        as_1d(a, "x")
+    with pytest.raises(RecordingError, match="row 12345"):
+        check_finite(a, file="f.csv", column="x")
+    b = np.full(5 * 4096, 2.5)
+    with pytest.raises(InputError, match="constant"):
+        check_channel("F", b, "N", "force")
+    b[777] = -3e120
+    with pytest.raises(InputError, match="at sample 777"):
+        check_channel("F", b, "N", "force")
+    with pytest.raises(InputError, match="zero in all"):
+        check_channel("F", np.zeros(5 * 4096), "N", "force")
