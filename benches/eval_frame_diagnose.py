@@ -5,7 +5,8 @@ displacements, the friction force reconstructed by :func:`contactlab.tangential.
 frame_friction_force` as a user would from measured frames.
 
 A Coulomb frame's only effect beyond Masing is static above kinetic friction (Fs > Fk);
-every other name is spurious. Each case is diagnosed four ways:
+every other name is spurious (an inertia term on a reconstructed force is the frame's own
+``M x''``: ``diagnose`` reports it as a reading of M, printed apart). Each case is diagnosed four ways:
 
 - ``true``: the simulation's own friction force with white noise of the reconstruction's
   level (what a force sensor would give), the diagnosis as it was before issue 8's fix
@@ -88,6 +89,9 @@ def run(seed: int, modes: list[str], filters: bool = False) -> dict:
         row[m] = rep.effect_names
         row[m + "_params"] = {e.name: {k: float(f"{v:.4g}") for k, v in e.parameters.items()}
                               for e in rep.effects}  # fmt: skip
+        fc = rep.location.get("frame_constants") or {}
+        if fc:  # an inertia term read as the frame's own mass (not named as a joint effect)
+            row[m + "_M_read"] = round(fc["M_read"], 5)
         row[m + "_h0"] = round(rep.final_model.params["h0"], 4)
         row[m + "_gap"] = round(rep.steps[-1].heldout_rms / rep.noise_rms, 2)
         row[m + "_cpu_s"] = round(time.process_time() - t0, 2)
@@ -110,6 +114,10 @@ def main() -> None:
         names = collections.Counter(n for r in rows for n in r[m])
         clean = sum(1 for r in rows if not set(r[m]) - {"stick_slip", "stribeck"})
         h0 = [abs(r[m + "_h0"] / r["Fk"] - 1) for r in rows]
+        mass = [r[m + "_M_read"] for r in rows if m + "_M_read" in r]
+        if mass:
+            print(f"{m:11s} the frame's M read from an inertia term in {len(mass)} case(s): "
+                  f"{', '.join(f'{v:.4g}' for v in mass)} kg (given {M} kg)")  # fmt: skip
         print(f"{m:11s} only Fs>Fk effects (stick_slip/stribeck) or nothing: {clean}/{len(rows)};"
               f" names {dict(names)}; |h0/Fk - 1| median {100 * np.median(h0):.2f} % max "
               f"{100 * np.max(h0):.2f} %")  # fmt: skip

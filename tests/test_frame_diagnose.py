@@ -168,3 +168,32 @@ def test_reconstructed_force_is_on_the_displacements_clock():
     asked = contactlab.diagnose(rec, candidates=["channel_delay"], max_effects=1)
     assert not any(w.startswith("channel_delay not tried") for w in asked.where)
     assert any(v.name == "channel_delay" for v in asked.steps[0].candidates)
+
+
+def test_an_inertia_term_on_a_frame_force_is_read_as_the_frames_mass():
+    """Displacement channels behind anti-alias filters of different cut-offs (0.2 / 0.4 of
+    Nyquist, causal Butterworth): the reconstructed force carries a term in ẍ, which the
+    diagnosis finds as inertia. On a frame's ``recording()`` that term is the frame's own
+    ``M x''``, so it is reported as a reading of M (M + m, a few per mille above the frame's)
+    and not named as an effect of the joint; plain arrays (no frame known) still name it.
+    Fresh seed (the evaluation's filtered seeds are 65101-65112, 66101-66112)."""
+    from scipy.signal import butter, lfilter
+
+    t, x, y, F = simulate_frame(Fk=0.8, Fs=0.8, fs=500.0)
+    rng = np.random.default_rng(64411)
+    xm = lfilter(*butter(2, 0.2), x + rng.normal(0, 5e-7, x.size))
+    ym = lfilter(*butter(2, 0.4), y + rng.normal(0, 5e-7, y.size))
+    r = frame_friction_force(t, xm, ym, M=M, C=C, K=K)
+    rec = r.recording()
+    assert rec.meta["frame"] == {"M": M, "C": C, "K": K}
+    plain = contactlab.diagnose((t, xm, r.F), candidates=["inertia"], max_effects=1)
+    assert plain.effect_names == ["inertia"]
+    rep = contactlab.diagnose(rec, candidates=["inertia"], max_effects=1)
+    assert rep.effect_names == []
+    fc = rep.location["frame_constants"]
+    assert fc["from_effect"] == "inertia" and fc["M_given"] == M
+    assert 1.0005 < fc["M_read"] / M < 1.03
+    assert "inertia" in rep.final_model.effects
+    assert any(w.startswith("the frame's mass reads M = ") for w in rep.where)
+    assert rep.to_dict()["frame_constants"]["M_read"] == fc["M_read"]
+    assert "frame_constants" not in plain.to_dict()

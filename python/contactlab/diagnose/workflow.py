@@ -173,6 +173,12 @@ class DiagnosisReport:
             "where": list(self.where),
             "noise_rms": self.noise_rms,
             "final_model": self.final_model.to_dict(),
+            # a frame's reconstructed force: its mass read from an inertia term
+            **(
+                {"frame_constants": dict(self.location["frame_constants"])}
+                if "frame_constants" in self.location
+                else {}
+            ),
         }
 
     def to_json(self, indent: int = 2) -> str:
@@ -585,6 +591,47 @@ def _same_clock(recording: Any, names: list[str], candidates: Sequence[str] | No
         "channel_delay not tried: the output was computed from the input's own samples "
         "(same clock), so it cannot lag them"
     )
+
+
+def _frame_constants(
+    recording: Any, effects: list[Effect], where: list[str], location: dict[str, Any]
+) -> list[Effect]:
+    """A force reconstructed from a frame's equation of motion (``meta["frame"]``:
+    :meth:`contactlab.tangential.FrameForce.recording`, ``F = K (y - x) + C (y' - x') - M x''``)
+    contains the frame's inertia ``- M x''``: an ``inertia`` term ``m x''`` in the diagnosis is
+    exactly a different ``M`` (``M + m``), whether ``M`` is off or the two displacement
+    channels' filters differ in phase. It is reported as that reading of ``M``
+    (``location["frame_constants"]`` and a sentence) and not named as an effect of the joint;
+    the final model keeps the term. Other effects stay named: a parallel stiffness or a
+    viscous term acts on ``x`` alone, the frame's ``K`` and ``C`` on ``x - y``."""
+    meta = getattr(recording, "meta", None)
+    frame = meta.get("frame") if isinstance(meta, dict) else None
+    if not isinstance(frame, dict) or "M" not in frame:
+        return effects
+    kept = []
+    for e in effects:
+        if e.name != "inertia" or "m" not in e.parameters:
+            kept.append(e)
+            continue
+        M0, m = float(frame["M"]), float(e.parameters["m"])
+        sm = e.stderr.get("m")
+        sm = float(sm) if sm is not None and np.isfinite(sm) else float("nan")
+        location["frame_constants"] = {
+            "M_given": M0,
+            "M_read": M0 + m,
+            "M_read_stderr": _finite_or_none(sm),
+            "relative": m / M0 if M0 > 0 else None,
+            "from_effect": "inertia",
+            "units": {"M_given": "kg", "M_read": "kg", "M_read_stderr": "kg"},
+        }
+        rel = f" ({100.0 * m / M0:+.2f} %)" if M0 > 0 else ""
+        where.append(
+            f"the frame's mass reads M = {M0 + m:.5g} ± {sm:.2g} kg where {M0:.5g} kg was given"
+            f"{rel}: an inertia term m = {m:.3g} kg in a force reconstructed from the frame's "
+            "equation of motion is its own M x'' (M off, or the x and y channels filtered with "
+            "different phase); reported as a reading of M, not as an effect of the joint"
+        )
+    return kept
 
 
 def _prior_weight(
@@ -1089,6 +1136,7 @@ def diagnose(
         dp, ds = family.derived(p, se, name, **more)
         out_effects.append(Effect(name, {**ps, **dp}, {**ss, **ds}))
     final = ExtendedModel(family, effects, p, se, family.context(d))
+    out_effects = _frame_constants(recording, out_effects, where, location)
     gap = current.heldout_rms / sigma
     if gap > 1.5:
         where.append(

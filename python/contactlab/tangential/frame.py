@@ -393,8 +393,12 @@ class FrameForce:
         :attr:`force_filter`, ``output_noise``: :attr:`force_noise`), which
         :func:`contactlab.diagnose.diagnose` applies to every candidate and takes as the
         force's noise level, and ``same_clock``: the force is computed from the displacement's
-        own samples, so it cannot lag them and ``channel_delay`` is not a candidate."""
+        own samples, so it cannot lag them and ``channel_delay`` is not a candidate; and
+        ``frame``: the constants ``M, C, K`` it used (an inertia term the diagnosis finds is
+        the frame's own ``M x''``: reported as a reading of ``M``, not as a joint effect)."""
         meta: dict[str, object] = {"output_noise": self.force_noise, "same_clock": True}
+        if self.frame is not None:
+            meta["frame"] = dict(self.frame)
         if self.force_filter is not None:
             meta["output_filter"] = self.force_filter
         if source == "<frame>":
