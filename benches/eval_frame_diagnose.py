@@ -6,7 +6,8 @@ frame_friction_force` as a user would from measured frames.
 
 A Coulomb frame's only effect beyond Masing is static above kinetic friction (Fs > Fk);
 every other name is spurious (an inertia term on a reconstructed force is the frame's own
-``M x''``: ``diagnose`` reports it as a reading of M, printed apart). Each case is diagnosed four ways:
+``M x''``: ``diagnose`` reports it as a reading of M, printed apart). Each case is diagnosed
+four ways:
 
 - ``true``: the simulation's own friction force with white noise of the reconstruction's
   level (what a force sensor would give), the diagnosis as it was before issue 8's fix

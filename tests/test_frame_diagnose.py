@@ -179,7 +179,7 @@ def test_an_inertia_term_on_a_frame_force_is_read_as_the_frames_mass():
     Fresh seed (the evaluation's filtered seeds are 65101-65112, 66101-66112)."""
     from scipy.signal import butter, lfilter
 
-    t, x, y, F = simulate_frame(Fk=0.8, Fs=0.8, fs=500.0)
+    t, x, y, _ = simulate_frame(Fk=0.8, Fs=0.8, fs=500.0)
     rng = np.random.default_rng(64411)
     xm = lfilter(*butter(2, 0.2), x + rng.normal(0, 5e-7, x.size))
     ym = lfilter(*butter(2, 0.4), y + rng.normal(0, 5e-7, y.size))
