@@ -13,8 +13,13 @@ import re
 import sys
 from collections.abc import Sequence
 
+from ._malloc import keep_freed_memory
 from ._version import __version__
 from .errors import ContactLabError
+
+# a command-line run is this process: freed arrays of a few MB stay in it for reuse instead
+# of being page-faulted and zeroed by the kernel again (streamed analyses, see _malloc)
+keep_freed_memory()
 
 # Modules providing `add_parser(subparsers)`; each sets `handler` via set_defaults.
 _VERB_MODULES = [
