@@ -719,10 +719,12 @@ pub fn cycle_block(
         }
         for (&xi, &fi) in x[j..c].iter().zip(&f[j..c]) {
             cum += 0.5 * (fi + fp) * (xi - xp);
-            xmax = xmax.max(xi);
-            xmin = xmin.min(xi);
-            fmax = fmax.max(fi);
-            fmin = fmin.min(fi);
+            // compare-and-select (finite samples, checked above): f64::max/min's NaN rules
+            // cost a compare, a blend and a dependency each on a generic x86-64 build
+            xmax = if xi > xmax { xi } else { xmax };
+            xmin = if xi < xmin { xi } else { xmin };
+            fmax = if fi > fmax { fi } else { fmax };
+            fmin = if fi < fmin { fi } else { fmin };
             xp = xi;
             fp = fi;
         }
