@@ -20,9 +20,9 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
-from scipy.fft import next_fast_len
-from scipy.optimize import least_squares
 
+from . import _trf
+from ._arrays import next_fast_len
 from .errors import ConvergenceError, InputError
 
 
@@ -562,7 +562,16 @@ def _scipy_solve(
     max_nfev: int | None,
     workers: Callable[[Callable[[Any], Any], Iterable[Any]], Iterable[Any]] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int, Any]:
+    bounded = not np.all((lo == -np.inf) & (hi == np.inf))
+    eps = float(np.finfo(float).eps)
     try:
+        if analytic is None and loss == "linear" and bounded and min(ftol, xtol, gtol) >= eps:
+            # the same trial points and end point as scipy's (contactlab._trf), without the
+            # half second of importing scipy.optimize
+            sol = _trf.solve(fun, z0, lo, hi, ftol, xtol, gtol, max_nfev, workers)
+            return sol.x, np.asarray(sol.fun, dtype=np.float64), int(sol.status), sol
+        from scipy.optimize import least_squares
+
         sol = least_squares(
             fun,
             z0,
