@@ -549,6 +549,12 @@ class NormalFamily:
 
         return loop_area(y, u)
 
+    @staticmethod
+    def loop_energies(u: np.ndarray, y: np.ndarray, bounds: list[int]) -> np.ndarray:
+        """:meth:`loop_energy` of each run ``bounds[k]:bounds[k+1]`` of at least 3 samples
+        (NaN below) in one call (``u``, ``y``: contiguous float64, finite)."""
+        return _core.loop_areas(y, u, bounds)
+
 
 #: a creep must take longer than this many excitation periods to settle: a faster "drift"
 #: is the start of the record (a sensor or model transient), which creep cannot be told from

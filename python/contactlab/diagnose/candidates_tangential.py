@@ -46,6 +46,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import _core
 from ..errors import InputError
 from ..masing import Masing, loop_area
 from ._family import Candidate, ParamSpec, Prepared, implausible_common
@@ -874,3 +875,9 @@ class TangentialFamily:
     def loop_energy(u: np.ndarray, y: np.ndarray) -> float:
         """Energy dissipated around one cycle, ``∮ F dx``."""
         return loop_area(u, y)
+
+    @staticmethod
+    def loop_energies(u: np.ndarray, y: np.ndarray, bounds: list[int]) -> np.ndarray:
+        """:meth:`loop_energy` of each run ``bounds[k]:bounds[k+1]`` of at least 3 samples
+        (NaN below) in one call (``u``, ``y``: contiguous float64, finite)."""
+        return _core.loop_areas(u, y, bounds)
