@@ -671,7 +671,6 @@ class TangentialFamily:
         pick: Callable[[np.ndarray], np.ndarray] = (
             (lambda a: a) if rows is None else (lambda a: a[rows])
         )
-        xs = pick(x)
         if "stick_slip" in effects:
             if sp is None:
                 rev = d.cycles.reversals
@@ -689,7 +688,7 @@ class TangentialFamily:
         if "position_friction" in effects:
             # the harmonics along the track are fixed unless x itself moves (x0)
             c1, s1, c2, s2 = (
-                _track_harmonics(xs, d)
+                _track_harmonics(pick(x), d)
                 if "displacement_offset" in effects
                 else map(pick, _fixed(d, "track", lambda: _track_harmonics(x, d)))
             )
@@ -699,7 +698,7 @@ class TangentialFamily:
             h = h * (1.0 + p["eps_c"] * cos + p["eps_s"] * sin)
         F = h
         if "parallel_stiffness" in effects:
-            F = F + p["k_p"] * xs
+            F = F + p["k_p"] * pick(x)  # (picked where needed: a gather per evaluation)
         if "viscous_damping" in effects:
             F = F + p["c"] * pick(d.ud)
         if "inertia" in effects:
