@@ -1,7 +1,9 @@
 """Least-squares fits with lmfit-style results: parameters with standard errors, correlations,
 χ², AIC/BIC and an honest account of what the data identify.
 
-Built on :func:`scipy.optimize.least_squares`. The covariance is ``(JᵀJ)⁻¹`` from a central
+Built on :func:`scipy.optimize.least_squares` (its bounded trust-region path, the one every
+fit with bounds and a finite-difference Jacobian takes, as :mod:`contactlab._trf`: the same
+numbers without importing :mod:`scipy.optimize`). The covariance is ``(JᵀJ)⁻¹`` from a central
 difference Jacobian at the optimum, scaled by the reduced χ² (``scale_covar=True``, the lmfit
 default, right when the residuals are unweighted or their scale is unknown). ``(JᵀJ)⁻¹`` is
 taken by SVD: a direction of parameter space the data do not constrain (singular value below
