@@ -43,8 +43,10 @@ Run: ``nice .venv/bin/python benches/bench_diagnose.py [--samples 1e6] [--repeat
 [--format h5|csv] [--recordings all] [--workdir DIR] [--keep DIR] [--compare DIR]
 [--baseline DIR] [--threads-ab] [--profile]``. ``--baseline DIR`` runs another version of
 the package (its ``contactlab`` folder in DIR) interleaved with this one, as rows ``before``
-and ``after``, and compares their reports. ``--profile`` runs cProfile on the CLI path
-of the first recording and prints the functions with the largest cumulative and own time.
+and ``after``, compares their reports (with ``--keep``) and sums up the times before and
+after (ratios per recording, totals, recordings over 3 s). ``--profile`` runs cProfile on
+the CLI path of the first recording and prints the functions with the largest cumulative
+and own time.
 """
 
 from __future__ import annotations
@@ -172,6 +174,32 @@ def compare(
         names = ",".join(eb) or "-"
         print(f"{kind:<28}{names + ('' if ea == eb else ' (was ' + ','.join(ea) + ')'):<40}"
               f"{worst:>12.2g}  {which}")  # fmt: skip
+
+
+def summarise(rows: list[dict]) -> None:
+    """Before against after (``--baseline``): per recording the ratio of the best wall and
+    CPU times, and over all recordings their sums and the median ratio; the recordings over
+    3 s of wall before and after."""
+    by = {(r["recording"], r["run"]): r for r in rows}
+    kinds = list(dict.fromkeys(r["recording"] for r in rows))
+    pairs = [(by[k, "before"], by[k, "after"]) for k in kinds if (k, "after") in by]
+    if not pairs:
+        return
+    print(f"{'recording':<28}{'wall before':>12}{'after':>8}{'ratio':>7}"
+          f"{'CPU before':>12}{'after':>8}{'ratio':>7}")  # fmt: skip
+    for b, a in pairs:
+        print(f"{b['recording']:<28}{b['wall_s']:>12.2f}{a['wall_s']:>8.2f}"
+              f"{a['wall_s'] / b['wall_s']:>7.2f}{b['cpu_s']:>12.2f}{a['cpu_s']:>8.2f}"
+              f"{a['cpu_s'] / b['cpu_s']:>7.2f}")  # fmt: skip
+    for what in ("wall_s", "cpu_s"):
+        tb = sum(b[what] for b, _ in pairs)
+        ta = sum(a[what] for _, a in pairs)
+        med = float(np.median([a[what] / b[what] for b, a in pairs]))
+        over = [sum(r[what] > 3.0 for r in side) for side in zip(*pairs, strict=True)]
+        print(
+            f"{what[:-2]}: total {tb:.1f} s before, {ta:.1f} s after ({ta / tb:.2f}x, median "
+            f"ratio {med:.2f}); recordings over 3 s: {over[0]} before, {over[1]} after"
+        )
 
 
 def masing_reference(n: int) -> float:
@@ -351,6 +379,8 @@ def main() -> None:
                     f"(load {os.getloadavg()[0]:.1f})"
                 )
         print(f"load average at the end {os.getloadavg()[0]:.1f}")
+        if args.baseline:
+            summarise(rows)
         if args.baseline and args.keep:
             compare(kinds, Path(args.keep), Path(args.keep), old_tag="before", new_tag="after")
         summary = {"masing_s": t_masing, "startup_s": t_start, "import_cpu_s": t_imp}

@@ -85,3 +85,29 @@ def positive(value: Any, name: str) -> float:
     if not np.isfinite(v) or v <= 0:
         raise InputError(f"{name} must be finite and > 0, got {v}")
     return v
+
+
+def next_fast_len(target: int, real: bool = False) -> int:
+    """The smallest FFT length ``>= target`` that is a product of 2, 3 and 5 (``real``) or of
+    2, 3, 5, 7 and 11 (complex): :func:`scipy.fft.next_fast_len` without importing
+    :mod:`scipy.fft` (a third of a second; tested equal to it)."""
+    n = int(target)
+    if n < 1:
+        raise InputError(f"an FFT length must be a positive integer, got {target!r}")
+    if n <= (6 if real else 12):
+        return n
+    best = 1 << (n - 1).bit_length()  # a power of 2 >= n
+    # depth-first over the products of the primes, each prime from the last one used on
+    # (every product once), pruned at the best length found
+    stack = [(1, 0)]
+    primes = (2, 3, 5) if real else (2, 3, 5, 7, 11)
+    while stack:
+        v, i = stack.pop()
+        if v >= n:
+            best = min(best, v)
+            continue
+        for j in range(i, len(primes)):
+            w = v * primes[j]
+            if w < best:
+                stack.append((w, j))
+    return best

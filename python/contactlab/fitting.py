@@ -1,7 +1,9 @@
 """Least-squares fits with lmfit-style results: parameters with standard errors, correlations,
 χ², AIC/BIC and an honest account of what the data identify.
 
-Built on :func:`scipy.optimize.least_squares`. The covariance is ``(JᵀJ)⁻¹`` from a central
+Built on :func:`scipy.optimize.least_squares` (its bounded trust-region path, the one every
+fit with bounds and a finite-difference Jacobian takes, as :mod:`contactlab._trf`: the same
+numbers without importing :mod:`scipy.optimize`). The covariance is ``(JᵀJ)⁻¹`` from a central
 difference Jacobian at the optimum, scaled by the reduced χ² (``scale_covar=True``, the lmfit
 default, right when the residuals are unweighted or their scale is unknown). ``(JᵀJ)⁻¹`` is
 taken by SVD: a direction of parameter space the data do not constrain (singular value below
@@ -20,9 +22,9 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
-from scipy.fft import next_fast_len
-from scipy.optimize import least_squares
 
+from . import _trf
+from ._arrays import next_fast_len
 from .errors import ConvergenceError, InputError
 
 
@@ -562,7 +564,16 @@ def _scipy_solve(
     max_nfev: int | None,
     workers: Callable[[Callable[[Any], Any], Iterable[Any]], Iterable[Any]] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int, Any]:
+    bounded = not np.all((lo == -np.inf) & (hi == np.inf))
+    eps = float(np.finfo(float).eps)
     try:
+        if analytic is None and loss == "linear" and bounded and min(ftol, xtol, gtol) >= eps:
+            # the same trial points and end point as scipy's (contactlab._trf), without the
+            # half second of importing scipy.optimize
+            sol = _trf.solve(fun, z0, lo, hi, ftol, xtol, gtol, max_nfev, workers)
+            return sol.x, np.asarray(sol.fun, dtype=np.float64), int(sol.status), sol
+        from scipy.optimize import least_squares
+
         sol = least_squares(
             fun,
             z0,

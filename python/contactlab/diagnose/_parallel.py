@@ -18,7 +18,7 @@ import functools
 import os
 import threading
 from collections.abc import Callable, Sequence
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import AbstractContextManager, nullcontext
 from typing import Any, TypeVar
 
@@ -90,8 +90,17 @@ T = TypeVar("T")
 R = TypeVar("R")
 
 
-def pmap(fn: Callable[[T], R], items: Sequence[T]) -> list[R]:
+def pmap(
+    fn: Callable[[T], R], items: Sequence[T], cost: Callable[[T], float] | None = None
+) -> list[R]:
     """``[fn(i) for i in items]``, on up to :func:`workers` threads; results in order.
+
+    ``cost``: the expected work of a call; on threads the costliest start first (ties in
+    ``items``' order), so that a long fit started last does not leave the other threads
+    idle at the end (the candidates of a tangential step: ``normal_load``, the last of the
+    library, took 2.0 of the 3.9 CPU seconds of a 1e6-sample step; on two threads the step
+    takes 3.0 s in the library's order, 2.45 s with the costliest first). Each call's
+    result is the same whatever the order.
 
     An exception in any call is raised here (the first in ``items``' order), as a serial
     loop would raise it; the calls not started yet are dropped (Ctrl-C does not wait for
@@ -100,9 +109,15 @@ def pmap(fn: Callable[[T], R], items: Sequence[T]) -> list[R]:
     n = min(workers(), len(items))
     if n <= 1:
         return [fn(i) for i in items]
+    order = list(range(len(items)))
+    if cost is not None:
+        order.sort(key=lambda k: -cost(items[k]))  # (stable: ties keep their order)
     ex = ThreadPoolExecutor(n, thread_name_prefix="contactlab-diagnose")
     try:
-        return list(ex.map(fn, items))
+        futures: list[Future[R] | None] = [None] * len(items)
+        for k in order:
+            futures[k] = ex.submit(fn, items[k])
+        return [f.result() for f in futures if f is not None]
     finally:
         ex.shutdown(wait=True, cancel_futures=True)
 

@@ -14,8 +14,8 @@ import itertools
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.fft import next_fast_len
 
+from .._arrays import next_fast_len
 from ..errors import InputError
 from ..reversals import excursions
 from ._filters import savgol_coeffs, savgol_filter, uniform_filter1d

@@ -726,6 +726,14 @@ def _try_candidate(
     return v, cand
 
 
+def _fit_cost(family: Family, name: str) -> int:
+    """Expected work of trying candidate ``name``, for the order the candidates of a step
+    start in on threads (:func:`~contactlab.diagnose._parallel.pmap`; the results do not
+    depend on it): its parameter count (the Jacobian's columns; the candidates with a
+    nonlinear frequency, slip distance or speed carry two or more)."""
+    return len(family.candidates[name].params)
+
+
 #: rounds of the stepwise search (each adds one effect, then drops redundant ones) at most,
 #: per effect the model may hold: room for every addition and as many swaps
 ROUNDS_PER_EFFECT = 2
@@ -814,7 +822,7 @@ def _swap_search(
         )  # fmt: skip
 
     before = spent.total
-    results = pmap(one, pairs)
+    results = pmap(one, pairs, cost=lambda pair: _fit_cost(family, pair[1]))
     verdicts, best = [], None
     for (out, _), (v, cand) in zip(pairs, results, strict=True):
         verdicts.append(dataclasses.replace(v, name=f"{out} ⇄ {v.name}"))
@@ -1040,7 +1048,8 @@ def diagnose(
         # candidates start early; one that finds the budget spent by the others does not
         # start, and is run here after all if the serial count says it would have been.
         verdicts, best = [], None
-        for name, out in zip(tried, pmap(unless_spent, tried), strict=True):
+        outs = pmap(unless_spent, tried, cost=partial(_fit_cost, family))
+        for name, out in zip(tried, outs, strict=True):
             if used >= MAX_EVALUATIONS:
                 untested.append(name)
                 why = f"not tested: the budget of {MAX_EVALUATIONS} model evaluations is spent"

@@ -24,7 +24,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..masing import Masing
 
@@ -169,6 +168,8 @@ def initial_guess(amplitude: float, half_force_range: float, energy: float) -> t
     elif r >= area_ratio(hi):
         z = hi
     else:
+        from scipy.optimize import brentq  # (here: importing it costs half a second)
+
         z = brentq(lambda zz: area_ratio(zz) - r, lo, hi, xtol=1e-10)
     ac = z / A
     h0 = hm / -math.expm1(-z)
