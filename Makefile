@@ -44,7 +44,7 @@ test: rust-lint rust-test py-lint pytest
 # Benchmarks (not part of `make test`): criterion for the Rust core, then the Python-level
 # scripts. LSODA over 1e7 samples takes ~20 min; bench_normal's --scipy-n shortens it.
 bench: develop
-	cargo bench -p contactlab-core --locked --bench masing --bench normal
+	cargo bench -p contactlab-core --locked --bench masing --bench normal --bench window
 	$(PY) benches/bench_masing.py
 	$(PY) benches/bench_normal.py --scipy-n 1e6
 	$(PY) benches/bench_study.py
