@@ -230,3 +230,21 @@ def test_branch_scale_follows_a_changing_displacement_offset():
     got = FAM.predict(p, eff, d)
     want = scaled_force(Masing(50.0, 5e4).virgin, 1.6, memory(x - 4e-6))
     np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * 50.0)
+
+
+@pytest.mark.parametrize("start", ["rest", "steady"])
+def test_force_drift_starts_at_zero_where_the_record_starts(start):
+    """The generator's force drift is zero at the record's first sample, as the candidate's
+    ``F1 (t - t0)/T`` is: a steady start cuts the start-up off, and a drift anchored at the
+    uncut axis left an offset F1·t_cut/T in the record that the truth did not list (steady
+    force_drift records were named force_drift + force_offset). Noise-free channels, the
+    same seed with and without the drift: the difference runs from 0 to F1."""
+    kw = dict(seed=91235, start=start, noise=1e-9, input_noise=0.0, anti_alias=None, bits=None)
+    a = hidden_effect_recording(["force_drift"], **kw)
+    b = hidden_effect_recording([], **kw)
+    F1 = a.truth["effects"]["force_drift"]["F1"]
+    dF = a["F"] - b["F"]
+    assert np.allclose(a["x"], b["x"])
+    assert abs(dF[0]) < 1e-6 * abs(F1)
+    assert dF[-1] == pytest.approx(F1, rel=1e-6)
+    assert np.allclose(dF, F1 * (a.t - a.t[0]) / (a.t[-1] - a.t[0]), atol=1e-6 * abs(F1))

@@ -88,8 +88,13 @@ def _tangential_force(
     h0: float,
     ac: float,
     period: float,
+    t_start: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Noise-free measured ``(x, F)`` with the given effect parameters (by effect name)."""
+    """Noise-free measured ``(x, F)`` with the given effect parameters (by effect name).
+    ``t_start``: where the record will begin (a steady start cuts the start-up off); the
+    force drift is zero there, as the candidate's is at the record's first sample (anchored
+    at ``t[0]`` of the uncut axis, a steady record began with an offset F1·t_cut/T that the
+    truth did not list)."""
     tau = effects.get("channel_delay", 0.0)
     xc = xfun(t - tau)  # the contact moves as x(t - τ) when the force channel lags by τ
     if "non_masing_scaling" in effects:
@@ -132,7 +137,8 @@ def _tangential_force(
     if "force_offset" in effects:
         F = F + effects["force_offset"]
     if "force_drift" in effects:
-        F = F + effects["force_drift"] * (t - t[0]) / (t[-1] - t[0])
+        ts = t[0] if t_start is None else t_start
+        F = F + effects["force_drift"] * (t - ts) / (t[-1] - ts)
     return x_meas, F
 
 
@@ -255,11 +261,12 @@ def hidden_effect_recording(
     fs = samples_per_cycle * f0
     t = np.arange(round(T * fs) + 1) / fs
     period = 1.0 / fmax
+    keep = start_index(start, t, f0, 0.6 * f0)
     _x0, F0 = _tangential_force({}, t, xfun, h0, ac, period)
     Fr = rms(F0)
 
     def size(name: str, value: float) -> float:
-        x1, F1 = _tangential_force({name: value}, t, xfun, h0, ac, period)
+        x1, F1 = _tangential_force({name: value}, t, xfun, h0, ac, period, float(t[keep]))
         # measured output change, on the measured displacement (what a base fit would see)
         F_on_x1 = Masing(h0, ac).force(x1)
         return rms(F1 - F_on_x1) / Fr
@@ -279,8 +286,7 @@ def hidden_effect_recording(
         ):
             sign = 1.0 if rng.random() < 0.5 else -1.0
         params[name] = _solve_size(name, target, sign, size, h0, ac, Fr, period)
-    x, F = _tangential_force(params, t, xfun, h0, ac, period)
-    keep = start_index(start, t, f0, 0.6 * f0)
+    x, F = _tangential_force(params, t, xfun, h0, ac, period, float(t[keep]))
     t, x, F = t[keep:] - t[keep], x[keep:], F[keep:]
     x_noise = (
         0.2 * noise * rms(x) if input_noise is None else input_noise * float(np.max(np.abs(x)))
