@@ -11,8 +11,11 @@ those rules (backward elimination: a wrong effect picked first is not kept once 
 ones are in); repeat until no candidate helps; then, with the set full (``max_effects``) or
 two or more named, try replacing each named effect by each candidate not in the model and
 keep the swap the held-out rules prefer (a wrong effect picked while the set filled up
-would otherwise keep the right one from ever being tried), and go on; (5) report held-out
-RMS, peak error and loop-energy error after each step.
+would otherwise keep the right one from ever being tried), and go on; when neither an
+addition nor a swap passes but a candidate still lowered the held-out error by
+:data:`PAIR_GATE` σ², try two candidates at once (:func:`_pair_search`: two effects can each
+be weak or misleading alone and plain together), each of which must be needed beside the
+other; (5) report held-out RMS, peak error and loop-energy error after each step.
 """
 
 from __future__ import annotations
@@ -86,6 +89,7 @@ class Step:
     None): the effect dropped because, refitted without it, the model no longer needs it
     (``removal`` is the verdict on adding it back). A swap has both: ``removed`` replaced by
     ``added``, which predicts the held-out cycles better (``removal`` is the verdict on it).
+    A pair move (:func:`_pair_search`) has ``added`` ``"a + b"``: both added at once.
     """
 
     added: str | None
@@ -790,8 +794,9 @@ def _swap_search(
     return best, verdicts, spent.total - before
 
 
-#: the pair move tries pairs among this many candidates not in the model, those with the
-#: largest gains seen at any step of the search (see _pair_search)
+#: the pair move (families with ``pair_move``: tangential; a normal joint's fits integrate
+#: an ODE, and its library combines few effects) tries pairs among this many candidates not
+#: in the model, those with the largest gains seen at any step of the search (_pair_search)
 PAIR_POOL = 6
 #: ... when a single candidate at the current step lowered the error by at least this many
 #: σ² (held out, or in its fit to all data) but was not accepted; below it, nothing is left
@@ -1164,7 +1169,12 @@ def diagnose(
             pool = [n for n in sorted(seen, key=lambda n: -seen[n]) if n not in effects]
             gains = [v.gain for v in verdicts if np.isfinite(v.gain)]
             pair = None
-            if max(gains, default=0.0) >= PAIR_GATE and used < MAX_EVALUATIONS and len(pool) > 1:
+            if (
+                getattr(family, "pair_move", False)
+                and max(gains, default=0.0) >= PAIR_GATE
+                and used < MAX_EVALUATIONS
+                and len(pool) > 1
+            ):
                 pair, pair_verdicts, n = _pair_search(
                     family, pool[:PAIR_POOL], current, tuple(added), max_effects, visited, d,
                     scales, folds, sigma, z, min_gain, budget, base_fit, all_samples,
