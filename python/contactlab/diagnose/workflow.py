@@ -53,7 +53,7 @@ from ._signal import (
 )
 from .locate import locate
 from .model import ExtendedModel
-from .select import FitOut, Trial, Verdict, evaluate, fit, fold_masks, judge
+from .select import MIN_RELATIVE_GAIN, FitOut, Trial, Verdict, evaluate, fit, fold_masks, judge
 
 __all__ = ["DiagnosisReport", "Effect", "Step", "diagnose"]
 
@@ -800,7 +800,9 @@ def _swap_search(
 PAIR_POOL = 6
 #: ... when a single candidate at the current step lowered the error by at least this many
 #: σ² (held out, or in its fit to all data) but was not accepted; below it, nothing is left
-#: that two effects could share
+#: that two effects could share. Far from the noise (a real loop the library cannot
+#: follow, 66 σ after the search) the bar is MIN_RELATIVE_GAIN of the current error
+#: instead: a few σ² there are a sliver of a larger misfit, as for a single effect
 PAIR_GATE = 1.0
 #: ... and cross-validates this many of the pair models, those whose fits to all data
 #: lower the error most
@@ -1171,7 +1173,8 @@ def diagnose(
             pair = None
             if (
                 getattr(family, "pair_move", False)
-                and max(gains, default=0.0) >= PAIR_GATE
+                and max(gains, default=0.0)
+                >= max(PAIR_GATE, MIN_RELATIVE_GAIN * current.heldout_mse / sigma**2)
                 and used < MAX_EVALUATIONS
                 and len(pool) > 1
             ):
