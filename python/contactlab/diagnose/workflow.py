@@ -663,7 +663,7 @@ def _try_candidate(
 ) -> tuple[Verdict, Trial | None]:
     """The verdict on adding ``name`` to the current model (and its trial when it was
     cross-validated); ``also``: effects added together with it (the pair move); ``full``:
-    the candidate model's fit to all data when it is at hand (:func:`_fit_new`)."""
+    the candidate model's fit to all data when it is at hand (:func:`_pair_search`)."""
     trial_effects = (*effects, *also, name)
     start_c = _start_new(family, current, (*also, name), d)
     # screening: a candidate whose fit to all data lowers the error by less than
