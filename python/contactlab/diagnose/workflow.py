@@ -1178,30 +1178,30 @@ def diagnose(
                 and used < MAX_EVALUATIONS
                 and len(pool) > 1
             ):
-                pair, pair_verdicts, n = _pair_search(
+                pair, pair_verdicts, n_pair = _pair_search(
                     family, pool[:PAIR_POOL], current, tuple(added), max_effects, visited, d,
                     scales, folds, sigma, z, min_gain, budget, base_fit, all_samples,
                 )  # fmt: skip
-                used += n
+                used += n_pair
                 if pair_verdicts:
                     steps[-1] = dataclasses.replace(
                         steps[-1], candidates=steps[-1].candidates + tuple(pair_verdicts)
                     )
             if pair is None:
                 break
-            out, (a, b), v, current = pair
+            gone, (a, b), v, current = pair
             effects = current.effects
-            if out is not None:
-                added.remove(out)
+            if gone is not None:
+                added.remove(gone)
             added += [a, b]
             trials.append(current)
             visited.add(frozenset(effects))
             steps.append(
                 Step(f"{a} + {b}", current.heldout_rms, current.heldout_peak,
-                     current.energy_error, removed=out, removal=v if out else None)
+                     current.energy_error, removed=gone, removal=v if gone else None)
             )  # fmt: skip
             where.append(
-                f"pair: {a} and {b} added together{f' in place of {out}' if out else ''} "
+                f"pair: {a} and {b} added together{f' in place of {gone}' if gone else ''} "
                 f"(neither was accepted alone; together they predict the held-out cycles "
                 f"better: gain {v.gain:.3g} σ², t = {v.t_stat:.2f}, and each is needed beside "
                 "the other)"
