@@ -354,6 +354,9 @@ class TangentialFamily:
 
     kind = "tangential"
     candidates = CANDIDATES
+    #: the search tries two candidates at once when no single one passes
+    #: (:func:`contactlab.diagnose.workflow._pair_search`)
+    pair_move = True
     #: the base's h0 held to this band and ac to at least ``ac_floor`` (:meth:`anchor`)
     h0_band: tuple[float, float] | None = None
     ac_floor: float = 0.0

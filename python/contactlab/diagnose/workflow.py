@@ -11,14 +11,18 @@ those rules (backward elimination: a wrong effect picked first is not kept once 
 ones are in); repeat until no candidate helps; then, with the set full (``max_effects``) or
 two or more named, try replacing each named effect by each candidate not in the model and
 keep the swap the held-out rules prefer (a wrong effect picked while the set filled up
-would otherwise keep the right one from ever being tried), and go on; (5) report held-out
-RMS, peak error and loop-energy error after each step.
+would otherwise keep the right one from ever being tried), and go on; when neither an
+addition nor a swap passes but a candidate still lowered the held-out error by
+:data:`PAIR_GATE` σ², try two candidates at once (:func:`_pair_search`: two effects can each
+be weak or misleading alone and plain together), each of which must be needed beside the
+other; (5) report held-out RMS, peak error and loop-energy error after each step.
 """
 
 from __future__ import annotations
 
 import copy
 import dataclasses
+import itertools
 import json
 import sys
 from collections.abc import Sequence
@@ -49,7 +53,7 @@ from ._signal import (
 )
 from .locate import locate
 from .model import ExtendedModel
-from .select import Trial, Verdict, evaluate, fit, fold_masks, judge
+from .select import MIN_RELATIVE_GAIN, FitOut, Trial, Verdict, evaluate, fit, fold_masks, judge
 
 __all__ = ["DiagnosisReport", "Effect", "Step", "diagnose"]
 
@@ -85,6 +89,7 @@ class Step:
     None): the effect dropped because, refitted without it, the model no longer needs it
     (``removal`` is the verdict on adding it back). A swap has both: ``removed`` replaced by
     ``added``, which predicts the held-out cycles better (``removal`` is the verdict on it).
+    A pair move (:func:`_pair_search`) has ``added`` ``"a + b"``: both added at once.
     """
 
     added: str | None
@@ -675,6 +680,17 @@ def _prior_weight(
     return loc, notes
 
 
+def _start_new(
+    family: Family, current: Trial, new: tuple[str, ...], d: Prepared
+) -> dict[str, float]:
+    """Starting parameters of the current model with the effects ``new`` added."""
+    start = dict(current.full.params)
+    if hasattr(family, "start_effect"):
+        for e in new:
+            start.update(family.start_effect(e, start, d, -current.full_residual(d)))
+    return start
+
+
 def _try_candidate(
     name: str,
     family: Family,
@@ -689,19 +705,21 @@ def _try_candidate(
     budget: float,
     base_fit: dict[str, float],
     all_samples: np.ndarray,
+    also: tuple[str, ...] = (),
+    full: FitOut | None = None,
 ) -> tuple[Verdict, Trial | None]:
     """The verdict on adding ``name`` to the current model (and its trial when it was
-    cross-validated)."""
-    trial_effects = (*effects, name)
-    start_c = dict(current.full.params)
-    if hasattr(family, "start_effect"):
-        start_c.update(family.start_effect(name, start_c, d, -current.full_residual(d)))
+    cross-validated); ``also``: effects added together with it (the pair move); ``full``:
+    the candidate model's fit to all data when it is at hand (:func:`_pair_search`)."""
+    trial_effects = (*effects, *also, name)
+    start_c = _start_new(family, current, (*also, name), d)
     # screening: a candidate whose fit to all data lowers the error by less than
     # min_gain σ² cannot do better on held-out cycles; no cross-validation for it
-    try:
-        full = fit(family, trial_effects, d, all_samples, start_c, scales)
-    except ConvergenceError as exc:  # e.g. a trial stiffness with no equilibrium
-        return _not_fitted(name, exc), None
+    if full is None:
+        try:
+            full = fit(family, trial_effects, d, all_samples, start_c, scales)
+        except ConvergenceError as exc:  # e.g. a trial stiffness with no equilibrium
+            return _not_fitted(name, exc), None
     in_gain = (current.full.mse - full.mse) / sigma**2
     if in_gain < min_gain:
         reason = f"in-sample gain {in_gain:.3g} σ² below {min_gain:g} σ²"
@@ -712,7 +730,7 @@ def _try_candidate(
         return _not_fitted(name, exc), None
     p = cand.full.params
     extra = 0.0
-    if name == "channel_delay" and abs(p["tau"]) < d.dt:
+    if "channel_delay" in (*also, name) and abs(p["tau"]) < d.dt:
         extra = budget  # a sub-sample shift must beat what smoothing the input buys
     prop = d if getattr(family, "proportional_gain", False) else None
     v = judge(name, current, cand, sigma, z, min_gain + extra, prop)
@@ -828,6 +846,112 @@ def _swap_search(
         verdicts.append(dataclasses.replace(v, name=f"{out} ⇄ {v.name}"))
         if cand is not None and v.accepted and (best is None or v.gain > best[1].gain):
             best = (out, v, cand)
+    return best, verdicts, spent.total - before
+
+
+#: the pair move (families with ``pair_move``: tangential; a normal joint's fits integrate
+#: an ODE, and its library combines few effects) tries pairs among this many candidates not
+#: in the model, those with the largest gains seen at any step of the search (_pair_search)
+PAIR_POOL = 6
+#: ... when a single candidate at the current step lowered the error by at least this many
+#: σ² (held out, or in its fit to all data) but was not accepted; below it, nothing is left
+#: that two effects could share. Far from the noise (a real loop the library cannot
+#: follow, 66 σ after the search) the bar is MIN_RELATIVE_GAIN of the current error
+#: instead: a few σ² there are a sliver of a larger misfit, as for a single effect
+PAIR_GATE = 1.0
+#: ... and cross-validates this many of the pair models, those whose fits to all data
+#: lower the error most
+PAIR_TRIALS = 4
+
+
+def _pair_search(
+    family: Family,
+    pool: list[str],
+    current: Trial,
+    named: tuple[str, ...],
+    max_effects: int,
+    visited: set[frozenset[str]],
+    d: Prepared,
+    scales: dict[str, float],
+    folds: int,
+    sigma: float,
+    z: float,
+    min_gain: float,
+    budget: float,
+    base_fit: dict[str, float],
+    all_samples: np.ndarray,
+) -> tuple[tuple[str | None, tuple[str, str], Verdict, Trial] | None, list[Verdict], int]:
+    """The pair move: two candidates added at once, to the current model or in place of
+    one effect ``named`` by this diagnosis.
+
+    Greedy steps add the one candidate that helps most alone. Two effects can each be weak
+    or misleading alone and plain together: a force offset and a force drift (a ramp that
+    starts at 0 needs the offset to centre it), or a channel delay and a breakaway after
+    each reversal (each alone is mimicked by a branch scale, which a greedy step then
+    names). Every pair ``{a, b}`` of ``pool`` (the candidates with the largest gains seen
+    so far) gives the models ``current + a + b`` and ``current - out + a + b``; each is
+    fitted to all data, and the :data:`PAIR_TRIALS` that lower the error most are judged
+    against the current model by the rules of a forward step (:func:`_try_candidate`:
+    significance ``t > z``, the gain thresholds, the BIC, plausibility of every effect).
+    Since a pair is two claims, each of ``a`` and ``b`` must also pass those rules added
+    back to the pair model without it (:func:`_drop_check`): each is needed beside the
+    other. Returns the best accepted move ``(effect out or None, (a, b), verdict, trial)``
+    or None, the verdicts on the pair models judged (named ``"a + b"`` or
+    ``"out ⇄ a + b"``), and the model evaluations spent.
+    """
+    spent = d.extra["evaluations"]
+    effects = current.effects
+    moves: list[tuple[str | None, tuple[str, str]]] = []
+    # added to the model while there is room (an effect the pair makes redundant is then
+    # dropped by the backward step), else in place of one named effect
+    outs = [None] if len(named) + 2 <= max_effects else list(named)
+    for out in outs:
+        rest = tuple(e for e in effects if e != out)
+        for a, b in itertools.combinations(pool, 2):
+            if family.check((*rest, a, b)) and frozenset((*rest, a, b)) not in visited:
+                moves.append((out, (a, b)))
+
+    def rest_of(move: tuple[str | None, tuple[str, str]]) -> tuple[str, ...]:
+        return tuple(e for e in effects if e != move[0])
+
+    def full_fit(move: tuple[str | None, tuple[str, str]]) -> FitOut | None:
+        start = _start_new(family, current, move[1], d)
+        try:
+            return fit(family, (*rest_of(move), *move[1]), d, all_samples, start, scales)
+        except ConvergenceError:
+            return None
+
+    def judged(
+        item: tuple[tuple[str | None, tuple[str, str]], FitOut],
+    ) -> tuple[Verdict, Trial | None]:
+        move, full = item
+        (a, b), rest = move[1], rest_of(move)
+        v, cand = _try_candidate(
+            b, family, current, rest, d, scales, folds, sigma, z, min_gain, budget,
+            base_fit, all_samples, also=(a,), full=full,
+        )  # fmt: skip
+        if cand is None or not v.accepted:
+            return v, cand
+        for e in (a, b):  # each is needed beside the other
+            w, _ = _drop_check(e, family, cand, d, scales, folds, sigma, z, min_gain, budget)
+            if not w.accepted:
+                why = f"{e} not needed beside the other: {w.reason}"
+                return dataclasses.replace(v, accepted=False, reason=why), cand
+        return v, cand
+
+    before = spent.total
+    fits = pmap(full_fit, moves)
+    ranked = sorted(
+        ((m, f) for m, f in zip(moves, fits, strict=True) if f is not None),
+        key=lambda mf: mf[1].mse,
+    )[:PAIR_TRIALS]
+    results = pmap(judged, ranked)
+    verdicts, best = [], None
+    for ((out, pair), _), (v, cand) in zip(ranked, results, strict=True):
+        label = " + ".join(pair) if out is None else f"{out} ⇄ {' + '.join(pair)}"
+        verdicts.append(dataclasses.replace(v, name=label))
+        if cand is not None and v.accepted and (best is None or v.gain > best[2].gain):
+            best = (out, pair, v, cand)
     return best, verdicts, spent.total - before
 
 
@@ -1008,6 +1132,7 @@ def diagnose(
     untested: list[str] = []
     used = spent.total  # by the base; then as a serial run would count (below)
     visited = {frozenset(effects)}  # effect sets reached (the stepwise search never returns)
+    seen: dict[str, float] = {}  # the largest held-out (or screening) gain of each candidate
     for _round in range(ROUNDS_PER_EFFECT * max_effects + 1):
         tried = [
             n
@@ -1064,6 +1189,10 @@ def diagnose(
             steps[-1] = dataclasses.replace(
                 steps[-1], candidates=tuple(sorted(verdicts, key=lambda v: v.heldout_rms))
             )
+        for v in verdicts:  # the pair move's pool: the largest gains seen at any step
+            if np.isfinite(v.gain):
+                seen[v.name] = max(seen.get(v.name, -np.inf), v.gain)
+        swapped = False
         if best is None and added and used < MAX_EVALUATIONS and len(added) >= min(2, max_effects):
             # swap move: no effect can be added (the set is full, or nothing else helps);
             # an effect named early may stand in for one never tried because the set filled
@@ -1091,11 +1220,48 @@ def diagnose(
                     f"predicts the held-out cycles better: gain {v.gain:.3g} σ², t = "
                     f"{v.t_stat:.2f})"
                 )
-                best = None
-            elif best is None:
+                best, swapped = None, True
+        if best is None and not swapped:
+            # pair move: no single effect can be added or swapped in, yet one of them
+            # lowered the error by a sizeable amount without significance; two together may
+            pool = [n for n in sorted(seen, key=lambda n: -seen[n]) if n not in effects]
+            gains = [v.gain for v in verdicts if np.isfinite(v.gain)]
+            pair = None
+            if (
+                getattr(family, "pair_move", False)
+                and max(gains, default=0.0)
+                >= max(PAIR_GATE, MIN_RELATIVE_GAIN * current.heldout_mse / sigma**2)
+                and used < MAX_EVALUATIONS
+                and len(pool) > 1
+            ):
+                pair, pair_verdicts, n_pair = _pair_search(
+                    family, pool[:PAIR_POOL], current, tuple(added), max_effects, visited, d,
+                    scales, folds, sigma, z, min_gain, budget, base_fit, all_samples,
+                )  # fmt: skip
+                used += n_pair
+                if pair_verdicts:
+                    steps[-1] = dataclasses.replace(
+                        steps[-1], candidates=steps[-1].candidates + tuple(pair_verdicts)
+                    )
+            if pair is None:
                 break
-        elif best is None:
-            break
+            gone, (a, b), v, current = pair
+            effects = current.effects
+            if gone is not None:
+                added.remove(gone)
+            added += [a, b]
+            trials.append(current)
+            visited.add(frozenset(effects))
+            steps.append(
+                Step(f"{a} + {b}", current.heldout_rms, current.heldout_peak,
+                     current.energy_error, removed=gone, removal=v if gone else None)
+            )  # fmt: skip
+            where.append(
+                f"pair: {a} and {b} added together{f' in place of {gone}' if gone else ''} "
+                f"(neither was accepted alone; together they predict the held-out cycles "
+                f"better: gain {v.gain:.3g} σ², t = {v.t_stat:.2f}, and each is needed beside "
+                "the other)"
+            )
         if best is not None:
             v, current = best
             effects = current.effects
