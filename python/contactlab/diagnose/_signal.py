@@ -11,6 +11,7 @@ nothing at the sampling rates of hysteresis recordings.
 from __future__ import annotations
 
 import itertools
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -354,3 +355,61 @@ def local_extrema(u: np.ndarray) -> np.ndarray:
     up = np.diff(u)[steps] > 0
     turn = np.flatnonzero(up[1:] != up[:-1])
     return steps[turn] + 1
+
+
+def minimize_bounded(
+    fun: Callable[[float], float], lo: float, hi: float, xtol: float, maxiter: int = 60
+) -> tuple[float, float, int]:
+    """The minimum of a function of one variable on ``[lo, hi]`` by Brent's method (golden
+    sections with parabolic steps; SciPy's ``fminbound``, absolute tolerance ``xtol``).
+    Returns ``(x, fun(x), evaluations)``; on a unimodal ``fun`` the minimum to within
+    ``xtol``, otherwise a local one (a bracket of one lobe is the caller's to choose)."""
+    golden = 0.5 * (3.0 - 5.0**0.5)
+    a, b = lo, hi
+    v = w = x = a + golden * (b - a)
+    fv = fw = fx = fun(x)
+    n = 1
+    d = e = 0.0
+    while n < maxiter:
+        m = 0.5 * (a + b)
+        tol1 = 1.5e-8 * abs(x) + xtol / 3.0
+        tol2 = 2.0 * tol1
+        if abs(x - m) <= tol2 - 0.5 * (b - a):
+            break
+        golden_step = True
+        if abs(e) > tol1:  # try a parabola through x, w, v
+            r = (x - w) * (fx - fv)
+            q = (x - v) * (fx - fw)
+            p = (x - v) * q - (x - w) * r
+            q = 2.0 * (q - r)
+            if q > 0.0:
+                p = -p
+            q = abs(q)
+            if abs(p) < abs(0.5 * q * e) and q * (a - x) < p < q * (b - x):
+                e, d = d, p / q
+                u = x + d
+                if u - a < tol2 or b - u < tol2:  # not too close to the ends
+                    d = tol1 if m >= x else -tol1
+                golden_step = False
+        if golden_step:
+            e = (a if x >= m else b) - x
+            d = golden * e
+        u = x + (d if abs(d) >= tol1 else (tol1 if d > 0 else -tol1))
+        fu = fun(u)
+        n += 1
+        if fu <= fx:
+            if u >= x:
+                a = x
+            else:
+                b = x
+            v, fv, w, fw, x, fx = w, fw, x, fx, u, fu
+        else:
+            if u < x:
+                a = u
+            else:
+                b = u
+            if fu <= fw or w == x:
+                v, fv, w, fw = w, fw, u, fu
+            elif fu <= fv or v == x or v == w:
+                v, fv = u, fu
+    return x, fx, n

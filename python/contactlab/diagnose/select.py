@@ -120,9 +120,9 @@ def specs_for(family: Family, effects: tuple[str, ...]) -> list[ParamSpec]:
 
 #: the Gauss-Newton polish after a candidate's solver stops once its next step is below
 #: this many standard errors (:func:`contactlab.fitting.least_squares_fit`'s ``polish_stop``)
-#: for a family with ``quick_polish`` (normal contact): every held-out and in-sample error
-#: moves by far less than the noise, and each step is a central-difference Jacobian (half
-#: of the model evaluations of a long normal diagnosis went to these)
+#: for a family with ``quick_polish`` (normal and tangential contact): every held-out and
+#: in-sample error moves by far less than the noise, and each step is a central-difference
+#: Jacobian (half of the model evaluations of a long normal diagnosis went to these)
 POLISH_STOP = 0.01
 #: the solver's relative tolerances (``ftol``, ``xtol``) for such a family: the Gauss-Newton
 #: polish takes its end point to within POLISH_STOP standard errors of the minimum whichever
@@ -159,16 +159,6 @@ def fit(
         span = s.upper - s.lower if np.isfinite(s.upper - s.lower) else sc[s.name]
         # strictly inside the bounds, so a start at "absent" (often a bound) can move
         x0[s.name] = float(np.clip(v, s.lower + 1e-6 * span, s.upper - 1e-6 * span))
-    params = [
-        Parameter(
-            s.name,
-            1.0,
-            min=(s.lower - x0[s.name]) / sc[s.name] + 1.0,
-            max=(s.upper - x0[s.name]) / sc[s.name] + 1.0,
-            unit=s.unit,
-        )
-        for s in specs
-    ]
     # long records: the fit sees every stride-th sample of the mask (the solver's work grows
     # with the number of residuals); held-out errors are still taken on every sample, and
     # the standard errors are those of the strided fit: its estimate uses those samples only
@@ -184,6 +174,28 @@ def fit(
     # and a displacement residual in metres (1e-9) would stop it at the first step
     ys = float(np.sqrt(np.mean(y * y))) or 1.0
     sw = np.sqrt(sample_weight(d)[idx]) / ys  # errors in variables (see sample_weight)
+    spent = d.extra.get("evaluations")  # the workflow's budget counter (EvaluationCounter)
+    searched = 0
+    search = getattr(family, "search_start", None)
+    if search is not None and noise_bound(family, x0, d) == 0.0:
+        # a family's own search of a parameter the solver crawls along (normal_load's
+        # frequency, with its linear amplitudes projected out): the solver starts there
+        x0, searched = search(effects, d, idx, y, sw, x0)
+        if spent is not None and not in_column():
+            spent.tick(searched)
+        for s in specs:  # (strictly inside the bounds, as above)
+            span = s.upper - s.lower if np.isfinite(s.upper - s.lower) else sc[s.name]
+            x0[s.name] = float(np.clip(x0[s.name], s.lower + 1e-6 * span, s.upper - 1e-6 * span))
+    params = [
+        Parameter(
+            s.name,
+            1.0,
+            min=(s.lower - x0[s.name]) / sc[s.name] + 1.0,
+            max=(s.upper - x0[s.name]) / sc[s.name] + 1.0,
+            unit=s.unit,
+        )
+        for s in specs
+    ]
 
     lo = {s.name: s.lower for s in specs}
     hi = {s.name: s.upper for s in specs}
@@ -193,7 +205,6 @@ def fit(
         # (min/max of floats: np.clip's per-call overhead is felt over thousands of calls)
         return {n: min(max(float(x0[n] + (w[n] - 1.0) * sc[n]), lo[n]), hi[n]) for n in names}
 
-    spent = d.extra.get("evaluations")  # the workflow's budget counter (EvaluationCounter)
     # errors in variables (corrected least squares, see noise_term): the objective is
     # Σ w r² - n T(θ), passed to the solver as one more residual √(n (C - T(θ))) with C a
     # constant above any T the fit reaches (the input noise through the model's compliance
@@ -268,7 +279,7 @@ def fit(
         res.nvarys,
         res.success,
         res.message,
-        res.nfev,
+        res.nfev + searched,
     )
 
 
