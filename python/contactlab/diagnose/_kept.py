@@ -75,7 +75,9 @@ def knots_at(raw: RawInput, pos: np.ndarray) -> Knots:
     k = np.searchsorted(pos, r, side="left")  # the first kept sample at or after the knot
     off = pos[k] != r
     r, k = r[off], k[off]
-    grid = np.arange(pos.size) + np.searchsorted(k, np.arange(pos.size), side="right")
+    # the kept sample j moves up by the knots at or before it (k is sorted, within 0..size-1):
+    # a running count, not a binary search per kept sample
+    grid = np.arange(pos.size) + np.cumsum(np.bincount(k, minlength=pos.size))[: pos.size]
     merged = np.empty(pos.size + k.size)  # (numpy.insert would sort the positions)
     merged[grid] = pos
     merged[k + np.arange(k.size)] = r
@@ -134,6 +136,27 @@ def _at(pos: np.ndarray, n: int, *arrays: np.ndarray) -> list[np.ndarray]:
     return [a[i] + f * (a[i + 1] - a[i]) for a in arrays]
 
 
+def _at_shift(q: int, s: float, m: int, n: int, *arrays: np.ndarray) -> list[np.ndarray]:
+    """:func:`_at` at the positions ``k·q - s``, ``k = 0..m-1``, clipped to ``[0, n - 1]``:
+    every position between two raw samples has the same fraction, so the interior is two
+    strided views of each array (no gather); the clipped ends take the end samples."""
+    i0 = int(np.floor(-s))
+    f = -s - i0  # in [0, 1): position k·q + i0 + f
+    k_lo = max(0, -(i0 // q))  # the first k with k·q + i0 >= 0
+    k_hi = min(m - 1, (n - 2 - i0) // q)  # the last with k·q + i0 + 1 <= n - 1
+    out = []
+    for a in arrays:
+        v = np.empty(m)
+        v[:k_lo] = a[0]
+        if k_hi >= k_lo:
+            lo = a[k_lo * q + i0 : k_hi * q + i0 + 1 : q]
+            hi = a[k_lo * q + i0 + 1 : k_hi * q + i0 + 2 : q]
+            v[k_lo : k_hi + 1] = lo + f * (hi - lo)
+        v[max(k_hi + 1, k_lo) :] = a[n - 1]
+        out.append(v)
+    return out
+
+
 def delayed(d: Prepared, tau: float) -> Prepared:
     """The kept record ``d`` as the model sees it ``tau`` earlier: input, derivatives and
     knots at the raw positions ``i·q - tau/dt`` (held at the ends), times shifted, the
@@ -151,7 +174,7 @@ def delayed(d: Prepared, tau: float) -> Prepared:
     extra["knots"] = knots_at(raw, pos)
     # times from the record's start (drifts, load fluctuation), as the full-rate model has
     extra["fixed"] = {("t_rel", d.t.size): ts - d.t[0]}
-    u, ud, udd = _at(pos, n, raw.u, raw.ud, raw.udd)
+    u, ud, udd = _at_shift(raw.q, tau / raw.dt, d.t.size, n, raw.u, raw.ud, raw.udd)
     out = Prepared(ts, u, d.y, d.dt, d.window, ud, udd, d.cycles, extra)
     if len(memo) >= _DELAYED_KEEP:
         memo.clear()
