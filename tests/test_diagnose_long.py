@@ -234,3 +234,23 @@ def test_too_many_extrema_keep_the_reversals_only():
     assert not exact and raw.turns.tolist() == [0, 100, 900, 2500]
     raw, exact = RawInput.build(0.0, 1.0, u, u, u, rev, 10, limit=10_000)
     assert exact and raw.turns.size > 1_000 and set(rev) <= set(raw.turns.tolist())
+
+
+def test_shifted_positions_by_strided_views_are_the_gathered_ones():
+    """The delayed kept record's input (_kept._at_shift: positions k·q - s by strided views)
+    is the linear interpolation at those positions (_kept._at, a gather), clipped ends too,
+    for whole and fractional shifts of either sign."""
+    from contactlab.diagnose._kept import _at, _at_shift
+
+    rng = np.random.default_rng(84123)
+    for _ in range(500):
+        n = int(rng.integers(5, 300))
+        q = int(rng.integers(1, 9))
+        m = int(rng.integers(1, n // q + 2))
+        s = float(rng.normal() * rng.choice([0.3, 3.0, 30.0, 300.0]))
+        if rng.random() < 0.2:
+            s = float(round(s))
+        a, b = rng.normal(size=(2, n))
+        pos = np.clip(np.arange(m) * float(q) - s, 0.0, n - 1.0)
+        for ref, got in zip(_at(pos, n, a, b), _at_shift(q, s, m, n, a, b), strict=True):
+            assert np.allclose(got, ref, rtol=0, atol=1e-12)
