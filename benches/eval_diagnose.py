@@ -219,6 +219,12 @@ def run_case(job: dict[str, Any]) -> dict[str, Any]:
     }
 
 
+def _rate(cases: list[dict[str, Any]], key: str = "right") -> float:
+    """Share of ``cases`` with ``key`` true; NaN when there are none (a partial design, e.g.
+    pairs only: ``--factors none --effects none``)."""
+    return sum(c[key] for c in cases) / len(cases) if cases else float("nan")
+
+
 def _label(level: Any) -> str:
     return "none" if level is None else str(level)
 
@@ -337,8 +343,7 @@ def evaluate_model(model: str, args: argparse.Namespace, pool: ProcessPoolExecut
         sub = [c for c in single if c["level"] == name]
         eff = [c for c in sub if c["effects"]]
         cl = [c for c in sub if not c["effects"]]
-        r1 = sum(c["right"] for c in eff) / len(eff)
-        r0 = sum(c["right"] for c in cl) / len(cl)
+        r1, r0 = _rate(eff), _rate(cl)
         levels[name] = (r1, r0)
         print(
             f"{name:<34}{sum(c['right'] for c in eff):>12}/{len(eff):<4} {100 * r1:5.1f} %"
@@ -355,14 +360,12 @@ def evaluate_model(model: str, args: argparse.Namespace, pool: ProcessPoolExecut
     clean_all = [c for c in single if not c["effects"]]
     xn = [c for c in eff_all if c["cond"]["input_noise"] > 0]
     rates = {
-        "single_with_x_noise": sum(c["right"] for c in xn) / len(xn),
-        "clean_nothing": sum(c["right"] for c in clean_all) / len(clean_all),
-        "pairs": sum(c["right"] for c in two) / max(len(two), 1),
+        "single_with_x_noise": _rate(xn),
+        "clean_nothing": _rate(clean_all),
+        "pairs": _rate(two),
     }
     if model == "normal":
-        rates["single_with_x_noise_second_order"] = sum(c["right_second_order"] for c in xn) / len(
-            xn
-        )
+        rates["single_with_x_noise_second_order"] = _rate(xn, "right_second_order")
         print("\nDelay cases by the second-order yardstick (gain beyond the damping's phase, σ²):")
         for c in eff_all:
             if c["delay_gain_second_order"] is not None:
@@ -378,7 +381,7 @@ def evaluate_model(model: str, args: argparse.Namespace, pool: ProcessPoolExecut
     ]
     if unident:
         ident = [c for c in xn if c not in unident]
-        rates["single_with_x_noise_identifiable"] = sum(c["right"] for c in ident) / len(ident)
+        rates["single_with_x_noise_identifiable"] = _rate(ident)
         print(
             f"\nSingle-tone records with a hidden channel delay (not identifiable): "
             f"{sum(c['identifiability_stated'] for c in unident)}/{len(unident)} say so, "
@@ -390,7 +393,7 @@ def evaluate_model(model: str, args: argparse.Namespace, pool: ProcessPoolExecut
     below = [c for c in eff_all if c.get("below_detectability")]
     if model == "normal":
         det = [c for c in xn if not c.get("below_detectability")]
-        rates["single_with_x_noise_detectable"] = sum(c["right"] for c in det) / max(len(det), 1)
+        rates["single_with_x_noise_detectable"] = _rate(det)
         print(
             f"\nBelow detectability (oracle gain of the true effect < {MIN_GAIN:g} σ²): "
             f"{len(below)} of {len(eff_all)} single-effect cases"
@@ -432,6 +435,9 @@ def evaluate_model(model: str, args: argparse.Namespace, pool: ProcessPoolExecut
     if "single_with_x_noise_second_order" in rates:
         bars.insert(1, ("… second-order delay yardstick", "single_with_x_noise_second_order", 0.95))
     for text, key, bar in bars:
+        if not rates[key] == rates[key]:  # NaN: no case of this kind in the design
+            print(f"  {text:<32}   n/a  (no such case in this run)")
+            continue
         print(
             f"  {text:<32} {100 * rates[key]:5.1f} %  (bar {100 * bar:.0f} %: "
             f"{'met' if rates[key] >= bar else 'NOT met'})"
