@@ -461,11 +461,28 @@ def monotone_path(x: np.ndarray, turns: np.ndarray) -> np.ndarray:
     the projected path has no noise-made micro-reversals: sensor noise on ``x`` would otherwise
     open spurious inner loops with the full initial stiffness and bias the fit.
 
+    One Rust call (:func:`contactlab._core.monotone_path`: the pool-adjacent-violators
+    algorithm in the arithmetic of ``scipy.optimize.isotonic_regression``, whose numbers it
+    gives, without importing SciPy: half a second, under the interpreter lock, in the first
+    window of a streamed analysis; :func:`_monotone_path_scipy` is the reference).
+
     Examples
     --------
     >>> monotone_path(np.array([0.0, 2.0, 1.0, 3.0, 2.0, 1.5, 1.6, 0.0]), np.array([3]))
     array([0.  , 1.5 , 1.5 , 3.  , 2.  , 1.55, 1.55, 0.  ])
     """
+    xa = np.ascontiguousarray(x, dtype=float)
+    return _core.monotone_path(xa, _path_edges(turns, xa.size))
+
+
+def _path_edges(turns: np.ndarray, n: int) -> np.ndarray:
+    """The stretches' bounds: 0, the turns inside the signal, ``n`` (sorted, distinct)."""
+    t = np.asarray(turns, dtype=np.int64)
+    return np.unique(np.r_[0, t[(t > 0) & (t < n)], n]).astype(np.int64)
+
+
+def _monotone_path_scipy(x: np.ndarray, turns: np.ndarray) -> np.ndarray:
+    """The SciPy reference of :func:`monotone_path` (tests)."""
     from scipy.optimize import isotonic_regression
 
     xa = np.asarray(x, dtype=float)

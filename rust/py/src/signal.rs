@@ -1,6 +1,7 @@
 //! Bindings of `contactlab_core::signal` (the streaming reversal detector), the branch memory
 //! of the Masing rules, and the multi-channel force kernel (Rust threads).
 
+use contactlab_core::isotonic::monotone_path;
 use contactlab_core::masing::split::{force_channels, Channel, PIECE};
 use contactlab_core::masing::{branch_memory, MasingState};
 use contactlab_core::parallel::run_jobs;
@@ -561,7 +562,26 @@ fn detrend_pair_py<'py>(
     Ok((a.into_pyarray(py), b.into_pyarray(py)))
 }
 
+/// `x` projected on monotone stretches between `edges` (isotonic regressions; see
+/// `contactlab_core::isotonic::monotone_path`).
+#[pyfunction]
+#[pyo3(name = "monotone_path")]
+fn monotone_path_py<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray1<'py, f64>,
+    edges: PyReadonlyArray1<'py, i64>,
+) -> PyResult<Arr<'py>> {
+    let xs = slice(&x, "x")?;
+    let mut ed = Vec::new();
+    for &e in &edges.as_array() {
+        ed.push(usize::try_from(e).map_err(|_| input(py, "edges must be >= 0"))?);
+    }
+    let out = detach_guarded(py, || monotone_path(xs, &ed))?;
+    Ok(out.into_pyarray(py))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(monotone_path_py, m)?)?;
     m.add_function(wrap_pyfunction!(detrend_pair_py, m)?)?;
     m.add_class::<PhaseFold>()?;
     m.add_class::<WindowFold>()?;
