@@ -120,6 +120,7 @@ def find_reversals(
     *,
     rel_threshold: float = 0.5,
     threshold: float | None = None,
+    checked: bool = False,
 ) -> Reversals:
     """Reversal points of ``x`` with a hysteresis threshold.
 
@@ -134,6 +135,9 @@ def find_reversals(
         range). Noise peaks smaller than the band never count as reversals.
     threshold : float, optional
         Absolute band half-width (overrides ``rel_threshold``).
+    checked : bool
+        ``x`` and ``t`` are float64 arrays of one length, finite, ``t`` increasing (the
+        caller checked them: a window's samples, scanned once instead of once a step).
 
     Examples
     --------
@@ -143,8 +147,12 @@ def find_reversals(
     >>> r.peaks.size, r.valleys.size
     (3, 3)
     """
-    xa = as_1d(x, "x")
-    ta = np.arange(xa.size, dtype=float) if t is None else as_1d(t, "t")
+    if checked:
+        xa = np.asarray(x, dtype=float)
+        ta = np.arange(xa.size, dtype=float) if t is None else np.asarray(t, dtype=float)
+    else:
+        xa = as_1d(x, "x")
+        ta = np.arange(xa.size, dtype=float) if t is None else as_1d(t, "t")
     if ta.size != xa.size:
         raise InputError(f"t has {ta.size} samples but x has {xa.size}")
     lo_p, hi_p = tail_percentiles(xa)
@@ -332,6 +340,7 @@ def average_loop(
     rel_threshold: float = 0.5,
     threshold: float | None = None,
     min_cycles: int = 2,
+    checked: bool = False,
 ) -> AveragedLoop:
     """Average a tangential recording's loops over its periods.
 
@@ -347,6 +356,9 @@ def average_loop(
         Reversal band, see :func:`find_reversals`.
     min_cycles : int, default 2
         Fewer complete cycles raise :class:`InputError`.
+    checked : bool
+        ``x``, ``F`` and ``t`` are float64 arrays of one length, finite, ``t`` increasing
+        (see :func:`find_reversals`; the fold checks them again in its pass).
 
     Examples
     --------
@@ -357,14 +369,18 @@ def average_loop(
     >>> loop.n_cycles, round(loop.amplitude, 2)
     (4, 1.0)
     """
-    xa = as_1d(x, "x")
-    Fa = as_1d(F, "F")
+    if checked:
+        xa, Fa = np.asarray(x, dtype=float), np.asarray(F, dtype=float)
+        ta = np.arange(xa.size, dtype=float) if t is None else np.asarray(t, dtype=float)
+    else:
+        xa = as_1d(x, "x")
+        Fa = as_1d(F, "F")
+        ta = np.arange(xa.size, dtype=float) if t is None else as_1d(t, "t")
     if Fa.size != xa.size:
         raise InputError(f"x has {xa.size} samples but F has {Fa.size}")
-    ta = np.arange(xa.size, dtype=float) if t is None else as_1d(t, "t")
     if ta.size != xa.size:
         raise InputError(f"t has {ta.size} samples but x has {xa.size}")
-    rev = find_reversals(xa, ta, rel_threshold=rel_threshold, threshold=threshold)
+    rev = find_reversals(xa, ta, rel_threshold=rel_threshold, threshold=threshold, checked=True)
     n_cyc = max(int(rev.peaks.size) - 1, 0)
     if n_cyc < min_cycles:
         raise InputError(
