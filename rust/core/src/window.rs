@@ -65,10 +65,12 @@ struct BinMoments {
 }
 
 impl BinMoments {
-    fn add(&mut self, x: f64, f: f64, p: f64) {
+    /// `recip[k]` is `1.0 / k` (the same number the division gives: a table lookup instead of
+    /// a division a cell, which was a fifth of the cells' flush).
+    fn add(&mut self, x: f64, f: f64, p: f64, recip: &[f64]) {
         self.k += 1.0;
-        // one division a cell instead of three (this runs every few samples)
-        let r = 1.0 / self.k;
+        // one reciprocal a cell instead of three divisions (this runs every few samples)
+        let r = recip.get(self.k as usize).copied().unwrap_or(1.0 / self.k);
         let (dx, df, dp) = (x - self.mx, f - self.mf, p - self.mp);
         self.mx += dx * r;
         self.mf += df * r;
@@ -435,10 +437,12 @@ pub fn fold_window(
     let (mut a0, mut a1) = (0_usize, 0_usize);
     let mut area_cycle: Option<usize> = None;
     let mut end = n;
+    // 1/k for the cycles a bin can collect (k <= n_cycles)
+    let recip: Vec<f64> = (0..=nc).map(|k| 1.0 / k as f64).collect();
     let flush_cell =
         |c: usize, b: usize, s: &[f64; 4], moments: &mut [BinMoments], ranges: &mut [[f64; 4]]| {
             let (mx, mf, mp) = (s[1] / s[0], s[2] / s[0], s[3] / s[0]);
-            moments[b].add(mx, mf, mp);
+            moments[b].add(mx, mf, mp, &recip);
             let r = &mut ranges[c];
             *r = [r[0].max(mx), r[1].min(mx), r[2].max(mf), r[3].min(mf)];
         };

@@ -7,7 +7,7 @@ use contactlab_core::masing::{branch_memory, MasingState};
 use contactlab_core::parallel::run_jobs;
 use contactlab_core::signal::{
     cycle_block, fold_phase, fold_spread, loop_area_sensitivity, loop_areas, period_means,
-    CycleState, Excursion, FoldSums, Schmitt,
+    period_means_pair, CycleState, Excursion, FoldSums, Schmitt,
 };
 use contactlab_core::window::{detrend_pair, fold_window, WindowFold as CoreWindowFold};
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadwriteArray1};
@@ -445,6 +445,23 @@ fn period_means_py<'py>(
     Ok(m.into_pyarray(py))
 }
 
+/// Period means of two channels on one time axis in one pass (see
+/// `contactlab_core::signal::period_means_pair`).
+#[pyfunction]
+#[pyo3(name = "period_means_pair")]
+fn period_means_pair_py<'py>(
+    py: Python<'py>,
+    t: PyReadonlyArray1<'py, f64>,
+    f: PyReadonlyArray1<'py, f64>,
+    x: PyReadonlyArray1<'py, f64>,
+    edges: PyReadonlyArray1<'py, f64>,
+) -> PyResult<(Arr<'py>, Arr<'py>)> {
+    let (ts, fs, xs) = (slice(&t, "t")?, slice(&f, "F")?, slice(&x, "x")?);
+    let es = slice(&edges, "edges")?;
+    let (a, b) = detach_guarded(py, || period_means_pair(ts, fs, xs, es))?;
+    Ok((a.into_pyarray(py), b.into_pyarray(py)))
+}
+
 /// One analysis window folded (`contactlab_core::window`): fold sums, cycle bounds, loop
 /// areas and their sensitivities, period means.
 #[pyclass(module = "contactlab._core")]
@@ -589,6 +606,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(loop_areas_py, m)?)?;
     m.add_function(wrap_pyfunction!(loop_area_sensitivity_py, m)?)?;
     m.add_function(wrap_pyfunction!(period_means_py, m)?)?;
+    m.add_function(wrap_pyfunction!(period_means_pair_py, m)?)?;
     m.add_class::<CycleTracker>()?;
     m.add_class::<ReversalDetector>()?;
     m.add_function(wrap_pyfunction!(branch_memory_py, m)?)?;
