@@ -590,7 +590,10 @@ def _window_detrended(
     # Fa - s·(tt - tm) for both channels in one Rust pass without the interpreter lock (bit
     # for bit numpy's a + (tt - tm)·(-s), which is a - s·τ): 16 bytes a sample at the peak
     # instead of 32 (τ, a product and the two results), one pass instead of six
-    F, x = _core.detrend_pair(tt, tm, Fa, f_drift[0], xa, x_drift[0])
+    # (into numpy.empty arrays: numpy's allocator asks for huge pages, where the core's own
+    # buffers faulted in every 4 KiB page, 5 ms of system time a window of 2^19 samples)
+    F, x = np.empty_like(Fa), np.empty_like(xa)
+    _core.detrend_pair_into(tt, tm, Fa, f_drift[0], xa, x_drift[0], F, x)
     # x, F and t were checked above (the detrended samples are finite: the fold checks them
     # again in its pass), so the fold's reversal search does not scan them a second time
     loop = average_loop(x, F, ta, n_points=n_points, rel_threshold=rel, min_cycles=min_cycles,
