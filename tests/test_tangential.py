@@ -555,3 +555,16 @@ def test_brentq_refuses_an_unbracketed_root():
 
     with pytest.raises(InputError, match="same sign"):
         brentq(lambda z: z * z + 1.0, -1.0, 1.0)
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    v=st.lists(
+        st.one_of(st.floats(0.0, 1e6), st.just(float("nan"))), min_size=1, max_size=30
+    ).filter(lambda v: not all(math.isnan(a) for a in v))
+)
+def test_tip_nanmean_is_numpys_bit_for_bit(v):
+    from contactlab.tangential.turns import _nanmean
+
+    a = np.asarray(v)
+    assert _nanmean(a) == float(np.nanmean(a))

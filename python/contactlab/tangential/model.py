@@ -59,7 +59,8 @@ def steady_loop_force(
     second = out[2 + one.size :]
     F = np.concatenate([second[1 : h + 1], second[h + 2 :]])
     if x_var is not None and model.is_exponential:
-        dist = np.r_[top - u[:h], u[h:] - bot]  # from the turn that starts each branch
+        # from the turn that starts each branch (np.concatenate: np.r_ costs ~20 µs a call)
+        dist = np.concatenate([top - u[:h], u[h:] - bot])
         curv = 0.5 * model.h0 * model.ac**2 * np.exp(-0.5 * model.ac * dist)
         curv[h:] *= -1.0  # descending branches curve up, ascending ones down
         F = F + 0.5 * curv * x_var

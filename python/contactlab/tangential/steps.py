@@ -413,7 +413,7 @@ class Residuals:
         inside = (raw > -A) & (raw < A)
         du_dx0 = np.where(inside, -1.0, 0.0)
         du_dA = np.where(raw >= A, 1.0, np.where(raw <= -A, -1.0, 0.0))
-        sg = np.r_[np.ones(h), -np.ones(n - h)]  # descending, then ascending bins
+        sg = np.where(np.arange(n) < h, 1.0, -1.0)  # descending, then ascending bins
         s = 0.5 * (A - sg * u)
         ds_dA = 0.5 * (1.0 - sg * du_dA)
         ds_dx0 = -0.5 * sg * du_dx0
