@@ -24,6 +24,12 @@ Stages (``samples/s`` = recording samples per second of wall time):
 
 Run: ``nice .venv/bin/python benches/bench_track.py [--samples 1e8] [--workers 2]``
 (tens of minutes at 1e8 on 2 cores; ``--samples 2e6`` for a quick look).
+``--recording FILE`` analyses a file an earlier run wrote (x, F) instead of writing one (the
+kernel reference is then timed on its displacement), ``--repeat N`` runs the analyze stage N
+times and prints the medians: e.g. ``--recording t1e8.h5 --skip read,cycles,track,
+track-serial,track-threads,whole,study --analyze-threads 2 --repeat 3``. Run it with another
+build's interpreter for that build's figures (the stage runs ``sys.executable -m contactlab``).
+``benches/compare_track.py`` checks that two builds' windows agree.
 """
 
 from __future__ import annotations
