@@ -24,6 +24,12 @@ Stages (``samples/s`` = recording samples per second of wall time):
 
 Run: ``nice .venv/bin/python benches/bench_track.py [--samples 1e8] [--workers 2]``
 (tens of minutes at 1e8 on 2 cores; ``--samples 2e6`` for a quick look).
+``--recording FILE`` analyses a file an earlier run wrote (x, F) instead of writing one (the
+kernel reference is then timed on its displacement), ``--repeat N`` runs the analyze stage N
+times and prints the medians: e.g. ``--recording t1e8.h5 --skip read,cycles,track,
+track-serial,track-threads,whole,study --analyze-threads 2 --repeat 3``. Run it with another
+build's interpreter for that build's figures (the stage runs ``sys.executable -m contactlab``).
+``benches/compare_track.py`` checks that two builds' windows agree.
 """
 
 from __future__ import annotations
@@ -76,6 +82,26 @@ def write_file(path: Path, n: int, seed: int = 12) -> dict:
             dx[a:b] = x + 2e-8 * rng.standard_normal(b - a)
             dF[a:b] = F + 0.4 * rng.standard_normal(b - a)
     return {"write_s": time.perf_counter() - t0, "masing_s": t_kernel, "bytes": path.stat().st_size}
+
+
+def kernel_on_file(path: Path) -> dict:
+    """The Masing kernel's time on the displacement of an existing recording (``--recording``:
+    a file written by an earlier run is analysed again, not rewritten), chunk by chunk as
+    :func:`write_file` times it; returns its size in samples too."""
+    import h5py
+
+    import contactlab
+
+    op = contactlab.Masing(h0=H0, ac=AC).operator()
+    t_kernel = 0.0
+    with h5py.File(path, "r") as f:
+        n = int(f["x"].shape[0])
+        for a in range(0, n, CHUNK):
+            x = f["x"][a : min(a + CHUNK, n)]
+            k0 = time.perf_counter()
+            op.push(x)
+            t_kernel += time.perf_counter() - k0
+    return {"masing_s": t_kernel, "bytes": path.stat().st_size, "n": n}
 
 
 def stage(name: str, path: str, workers: int) -> dict:
@@ -219,6 +245,14 @@ def main() -> None:
         help="comma-separated CONTACTLAB_ANALYZE_THREADS values to run the analyze stage with "
         "(e.g. 0,1,2: serial, one and two helper threads); default: as a user runs it",
     )
+    ap.add_argument(
+        "--recording",
+        help="analyse this tangential HDF5 recording (written by an earlier run, x and F) "
+        "instead of writing one; it is not deleted. --samples is then its length",
+    )
+    ap.add_argument(
+        "--repeat", type=int, default=1, help="runs of the analyze stage (medians printed)"
+    )
     ap.add_argument("--stage", help=argparse.SUPPRESS)
     ap.add_argument("--file", help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -230,10 +264,16 @@ def main() -> None:
     tmp = Path(tempfile.mkdtemp(prefix="contactlab-bench-track-"))
     try:
         print(f"cores: {os.cpu_count()}, load average {os.getloadavg()[0]:.1f}")
-        big = tmp / "long.h5"
-        w = write_file(big, n)
+        if args.recording:
+            big = Path(args.recording)
+            w = kernel_on_file(big)
+            n = w["n"]
+            print(f"recording {big}: {n:.3g} samples, {w['bytes'] / 1e9:.2f} GB")
+        else:
+            big = tmp / "long.h5"
+            w = write_file(big, n)
+            print(f"wrote {n:.3g} samples, {w['bytes'] / 1e9:.2f} GB in {w['write_s']:.1f} s")
         m_rate = n / w["masing_s"]
-        print(f"wrote {n:.3g} samples, {w['bytes'] / 1e9:.2f} GB in {w['write_s']:.1f} s")
         print(
             f"reference  Masing kernel alone (push, chunks of {CHUNK}): "
             f"{m_rate / 1e6:8.1f} M samples/s"
@@ -277,17 +317,28 @@ def main() -> None:
                 env = dict(os.environ)
                 if threads:
                     env["CONTACTLAB_ANALYZE_THREADS"] = threads
-                wall, rss, _, cpu = child(cmd, env)
-                h0 = json.loads((tmp / "big.json").read_text())
                 label = f"analyze (CLI{', threads ' + threads if threads else ''})"
-                print(
-                    f"{label:<24} {wall:8.1f} s {n / wall / 1e6:8.2f} M samples/s  "
-                    f"ratio to Masing {n / wall / m_rate:6.3f}  CPU {cpu:7.1f} s "
-                    f"({n / cpu / 1e6:.2f} M samples per CPU-second)  peak RSS {rss:6.0f} MB  "
-                    f"h0 = {h0['h0']:.6f} ± {h0['h0_stderr']:.2g} N  "
-                    f"load {os.getloadavg()[0]:.1f}"
-                )
-        big.unlink()
+                runs = []
+                for _ in range(args.repeat):
+                    wall, rss, _, cpu = child(cmd, env)
+                    runs.append((wall, cpu, rss))
+                    h0 = json.loads((tmp / "big.json").read_text())
+                    print(
+                        f"{label:<24} {wall:8.1f} s {n / wall / 1e6:8.2f} M samples/s  "
+                        f"ratio to Masing {n / wall / m_rate:6.3f}  CPU {cpu:7.1f} s "
+                        f"({n / cpu / 1e6:.2f} M samples per CPU-second)  peak RSS {rss:6.0f} MB"
+                        f"  h0 = {h0['h0']:.6f} ± {h0['h0_stderr']:.2g} N  "
+                        f"load {os.getloadavg()[0]:.1f}"
+                    )
+                if len(runs) > 1:
+                    wall, cpu, rss = (float(np.median(c)) for c in zip(*runs, strict=True))
+                    print(
+                        f"{label + ' median':<24} {wall:8.1f} s {n / wall / 1e6:8.2f} M samples/s"
+                        f"  ratio to Masing {n / wall / m_rate:6.3f}  CPU {cpu:7.1f} s  "
+                        f"peak RSS {rss:6.0f} MB (of {len(runs)} runs)"
+                    )
+        if not args.recording:
+            big.unlink()
         if "whole" not in skip:
             nw = int(args.whole_samples)
             wf = tmp / "whole.h5"

@@ -321,11 +321,14 @@ def test_file_view_reads_and_finds_as_bytes_do(tmp_path, monkeypatch, block):
             v[len(data)]
 
 
+@pytest.mark.parametrize("threads", [1, 2, 3])
 @pytest.mark.parametrize("block", [4, 5, 8, 1 << 24])
-def test_file_view_index_answers_as_find_does(tmp_path, monkeypatch, block):
+def test_file_view_index_answers_as_find_does(tmp_path, monkeypatch, block, threads):
+    """The same index from one scanning thread or several (alternate blocks)."""
     from contactlab.io import hdf5
 
     monkeypatch.setattr(hdf5._FileView, "BLOCK", block)
+    monkeypatch.setattr(hdf5, "_SCAN_THREADS", threads)
     data = b"TREExxHEAPTREEyyGCOL\x01zzTRE" + bytes(range(256)) + b"TREEHEAP"
     path = tmp_path / "b.bin"
     path.write_bytes(data)

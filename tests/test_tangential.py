@@ -101,6 +101,33 @@ def test_monotone_path_is_monotone_between_turns(seed, n):
         assert np.mean(y[a:b]) == pytest.approx(np.mean(x[a:b]), abs=1e-9)
 
 
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 10_000),
+    n=st.integers(1, 300),
+    k=st.integers(0, 6),
+    ties=st.booleans(),
+)
+def test_monotone_path_is_scipys_isotonic_regression(seed, n, k, ties):
+    """The Rust projection gives SciPy's numbers (ties pooled, both directions, turns at the
+    ends and repeated)."""
+    from contactlab.tangential.preprocess import _monotone_path_scipy
+
+    rng = np.random.default_rng(seed)
+    x = np.cumsum(rng.standard_normal(n))
+    if ties:  # runs of equal values (a quantised sensor)
+        x = np.round(x)
+    turns = np.sort(rng.integers(0, n + 1, size=k))
+    np.testing.assert_allclose(
+        monotone_path(x, turns), _monotone_path_scipy(x, turns), rtol=1e-14, atol=1e-14
+    )
+
+
+def test_monotone_path_refuses_non_finite_samples():
+    with pytest.raises(InputError, match="x"):
+        monotone_path(np.array([0.0, np.nan, 1.0]), np.array([1]))
+
+
 # -- averaging -------------------------------------------------------------------------------
 
 
@@ -502,3 +529,42 @@ def test_displacement_drift_is_removed():
     assert abs(d - rate) < 4 * dd
     assert abs(_z(res, "h0", H0)) < 3 and abs(_z(res, "ac", AC)) < 3
     assert res.to_dict()["units"]["displacement_drift"] == "m/s"
+
+
+@settings(max_examples=80, deadline=None)
+@given(r=st.floats(0.0, 1.0), xtol=st.sampled_from([1e-10, 2e-12, 1e-6]))
+def test_brentq_is_scipys_to_the_last_bit(r, xtol):
+    """The start value's root finder (no SciPy import in a window's thread) gives SciPy's
+    brentq root bit for bit, on the area-ratio equation it solves and on a cubic."""
+    from scipy.optimize import brentq as scipy_brentq
+
+    from contactlab.tangential.model import area_ratio, brentq
+
+    lo, hi = 1e-3, 60.0
+    r = area_ratio(lo) + r * (area_ratio(hi) - area_ratio(lo))
+    if not area_ratio(lo) < r < area_ratio(hi):
+        return
+    f = lambda z: area_ratio(z) - r  # noqa: E731
+    assert brentq(f, lo, hi, xtol=xtol) == scipy_brentq(f, lo, hi, xtol=xtol)
+    g = lambda x: x**3 - 2 * x - 5 + r  # noqa: E731
+    assert brentq(g, 2.0, 3.0) == scipy_brentq(g, 2.0, 3.0)
+
+
+def test_brentq_refuses_an_unbracketed_root():
+    from contactlab.tangential.model import brentq
+
+    with pytest.raises(InputError, match="same sign"):
+        brentq(lambda z: z * z + 1.0, -1.0, 1.0)
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    v=st.lists(
+        st.one_of(st.floats(0.0, 1e6), st.just(float("nan"))), min_size=1, max_size=30
+    ).filter(lambda v: not all(math.isnan(a) for a in v))
+)
+def test_tip_nanmean_is_numpys_bit_for_bit(v):
+    from contactlab.tangential.turns import _nanmean
+
+    a = np.asarray(v)
+    assert _nanmean(a) == float(np.nanmean(a))

@@ -425,3 +425,10 @@ def test_detrend_pair_is_numpys_expression_bit_for_bit(seed, n, exp, slopes):
     np.testing.assert_array_equal(a, F - slopes[0] * (t - tm))
     with pytest.raises(InputError):
         _core.detrend_pair(t, tm, F[: n - 1], 1.0, x, 1.0)
+    # into numpy's arrays (what the window analysis uses): the same numbers
+    oF, ox = np.full(n, np.nan), np.full(n, np.nan)
+    _core.detrend_pair_into(t, tm, F, slopes[0], x, slopes[1], oF, ox)
+    np.testing.assert_array_equal(oF, a)
+    np.testing.assert_array_equal(ox, b)
+    with pytest.raises(InputError):
+        _core.detrend_pair_into(t, tm, F, 1.0, x, 1.0, oF[: n - 1], ox)

@@ -58,7 +58,7 @@ from ..io import Recording
 from ..masing import loop_area
 from . import steps
 from .orientation import Orientation, orient
-from .preprocess import AveragedLoop, average_loop, find_reversals, negated_loop, period_means
+from .preprocess import AveragedLoop, average_loop, find_reversals, negated_loop
 from .regime import GROSS_SLIDING_Z as REGIME_GROSS_Z
 from .regime import PRE_SLIDING_Z, Regime, classify, z_from_area_ratio
 from .result import TangentialAnalysis
@@ -169,27 +169,44 @@ def identifiability(
     return identifiable, evidence
 
 
+#: the model's quantities at the amplitude (:func:`_model_quantities`), in its order
+_MODEL_QUANTITIES = (
+    "energy_per_cycle",
+    "equivalent_damping",
+    "k_local_amplitude",
+    "k_global",
+    "peak_force",
+)
+
+
+def _model_quantities(v: dict[str, float], A: float) -> np.ndarray:
+    """Energy per cycle, c_e·ω = E / (π A²) (eq. 17), local stiffness at the amplitude
+    (eq. 18), global stiffness (eq. 19) and peak force of the model ``v`` at amplitude ``A``:
+    one model for the five (their errors from one set of perturbed parameter values)."""
+    m = steps.model_of(v)
+    e = float(m.loop_energy(A))
+    return np.array(
+        [
+            e,
+            e / (math.pi * A * A),
+            float(m.local_stiffness(A)),
+            float(m.global_stiffness(A)),
+            float(m.virgin(A)),
+        ]
+    )
+
+
 def derived_quantities(
     raw: FitResult, amp: steps.Amplitude, det: steps.Detrended, start: int
 ) -> dict[str, tuple[float, float]]:
     """Energy per cycle (analytic and loop area), c_e·ω (eq. 17), stiffness (eqs. 18-19),
     peak force and drifts, each ``(value, stderr)``."""
 
-    def energy(v: dict[str, float], A: float) -> float:
-        return float(steps.model_of(v).loop_energy(A))
-
-    def prop(fn: Any) -> tuple[float, float]:
-        return steps.propagate(raw, amp, fn)
-
     k0 = raw.params["k0"]
     derived: dict[str, tuple[float, float]] = {}
     derived["h0_ac"] = (float(k0.value), float(k0.stderr) if k0.stderr is not None else math.nan)
-    derived["energy_per_cycle"] = prop(energy)
-    derived["equivalent_damping"] = prop(lambda v, A: energy(v, A) / (math.pi * A * A))
+    derived.update(steps.propagate_many(raw, amp, _MODEL_QUANTITIES, _model_quantities))
     derived["k_local0"] = derived["h0_ac"]
-    derived["k_local_amplitude"] = prop(lambda v, A: float(steps.model_of(v).local_stiffness(A)))
-    derived["k_global"] = prop(lambda v, A: float(steps.model_of(v).global_stiffness(A)))
-    derived["peak_force"] = prop(lambda v, A: float(steps.model_of(v).virgin(A)))
     loop, xa, Fa = det.loop, det.x, det.F
     drift = det.force_drift
     if loop is not None:
@@ -556,22 +573,31 @@ def _window_detrended(
     detrended before the only fold. The same numbers as :func:`steps.detrend`."""
     n_points, rel = opts["n_points"], opts["rel_threshold"]
     min_cycles = opts["min_cycles"]
-    rev = find_reversals(xa, ta, rel_threshold=rel)
+    rev = find_reversals(xa, ta, rel_threshold=rel)  # checks x and t
+    Fa = as_1d(Fa, "F")
     if not (opts["detrend"] and rev.peaks.size - 1 >= 3):
         loop = average_loop(xa, Fa, ta, n_points=n_points, rel_threshold=rel,
-                            min_cycles=min_cycles)  # fmt: skip
+                            min_cycles=min_cycles, checked=True)  # fmt: skip
         return steps.Detrended(xa, Fa, loop, None)
     tt = ta if ta is not None else np.arange(xa.size, dtype=float)
     pt = rev.peak_times
     time = 0.5 * (pt[:-1] + pt[1:])
     tm = float(np.mean(time))
-    f_drift = trend(time, period_means(tt, Fa, pt))
-    x_drift = trend(time, period_means(tt, xa, pt))
+    # period_means of F and of x in one pass over t (bit for bit the two calls)
+    f_means, x_means = _core.period_means_pair(tt, Fa, xa, np.ascontiguousarray(pt, dtype=float))
+    f_drift = trend(time, f_means)
+    x_drift = trend(time, x_means)
     # Fa - s·(tt - tm) for both channels in one Rust pass without the interpreter lock (bit
     # for bit numpy's a + (tt - tm)·(-s), which is a - s·τ): 16 bytes a sample at the peak
     # instead of 32 (τ, a product and the two results), one pass instead of six
-    F, x = _core.detrend_pair(tt, tm, Fa, f_drift[0], xa, x_drift[0])
-    loop = average_loop(x, F, ta, n_points=n_points, rel_threshold=rel, min_cycles=min_cycles)
+    # (into numpy.empty arrays: numpy's allocator asks for huge pages, where the core's own
+    # buffers faulted in every 4 KiB page, 5 ms of system time a window of 2^19 samples)
+    F, x = np.empty_like(Fa), np.empty_like(xa)
+    _core.detrend_pair_into(tt, tm, Fa, f_drift[0], xa, x_drift[0], F, x)
+    # x, F and t were checked above (the detrended samples are finite: the fold checks them
+    # again in its pass), so the fold's reversal search does not scan them a second time
+    loop = average_loop(x, F, ta, n_points=n_points, rel_threshold=rel, min_cycles=min_cycles,
+                        checked=True)  # fmt: skip
     return steps.Detrended(x, F, loop, steps.Drift(f_drift, x_drift, tt, tm))
 
 

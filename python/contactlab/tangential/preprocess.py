@@ -120,6 +120,7 @@ def find_reversals(
     *,
     rel_threshold: float = 0.5,
     threshold: float | None = None,
+    checked: bool = False,
 ) -> Reversals:
     """Reversal points of ``x`` with a hysteresis threshold.
 
@@ -134,6 +135,9 @@ def find_reversals(
         range). Noise peaks smaller than the band never count as reversals.
     threshold : float, optional
         Absolute band half-width (overrides ``rel_threshold``).
+    checked : bool
+        ``x`` and ``t`` are float64 arrays of one length, finite, ``t`` increasing (the
+        caller checked them: a window's samples, scanned once instead of once a step).
 
     Examples
     --------
@@ -143,8 +147,12 @@ def find_reversals(
     >>> r.peaks.size, r.valleys.size
     (3, 3)
     """
-    xa = as_1d(x, "x")
-    ta = np.arange(xa.size, dtype=float) if t is None else as_1d(t, "t")
+    if checked:
+        xa = np.asarray(x, dtype=float)
+        ta = np.arange(xa.size, dtype=float) if t is None else np.asarray(t, dtype=float)
+    else:
+        xa = as_1d(x, "x")
+        ta = np.arange(xa.size, dtype=float) if t is None else as_1d(t, "t")
     if ta.size != xa.size:
         raise InputError(f"t has {ta.size} samples but x has {xa.size}")
     lo_p, hi_p = tail_percentiles(xa)
@@ -332,6 +340,7 @@ def average_loop(
     rel_threshold: float = 0.5,
     threshold: float | None = None,
     min_cycles: int = 2,
+    checked: bool = False,
 ) -> AveragedLoop:
     """Average a tangential recording's loops over its periods.
 
@@ -347,6 +356,9 @@ def average_loop(
         Reversal band, see :func:`find_reversals`.
     min_cycles : int, default 2
         Fewer complete cycles raise :class:`InputError`.
+    checked : bool
+        ``x``, ``F`` and ``t`` are float64 arrays of one length, finite, ``t`` increasing
+        (see :func:`find_reversals`; the fold checks them again in its pass).
 
     Examples
     --------
@@ -357,14 +369,18 @@ def average_loop(
     >>> loop.n_cycles, round(loop.amplitude, 2)
     (4, 1.0)
     """
-    xa = as_1d(x, "x")
-    Fa = as_1d(F, "F")
+    if checked:
+        xa, Fa = np.asarray(x, dtype=float), np.asarray(F, dtype=float)
+        ta = np.arange(xa.size, dtype=float) if t is None else np.asarray(t, dtype=float)
+    else:
+        xa = as_1d(x, "x")
+        Fa = as_1d(F, "F")
+        ta = np.arange(xa.size, dtype=float) if t is None else as_1d(t, "t")
     if Fa.size != xa.size:
         raise InputError(f"x has {xa.size} samples but F has {Fa.size}")
-    ta = np.arange(xa.size, dtype=float) if t is None else as_1d(t, "t")
     if ta.size != xa.size:
         raise InputError(f"t has {ta.size} samples but x has {xa.size}")
-    rev = find_reversals(xa, ta, rel_threshold=rel_threshold, threshold=threshold)
+    rev = find_reversals(xa, ta, rel_threshold=rel_threshold, threshold=threshold, checked=True)
     n_cyc = max(int(rev.peaks.size) - 1, 0)
     if n_cyc < min_cycles:
         raise InputError(
@@ -461,11 +477,28 @@ def monotone_path(x: np.ndarray, turns: np.ndarray) -> np.ndarray:
     the projected path has no noise-made micro-reversals: sensor noise on ``x`` would otherwise
     open spurious inner loops with the full initial stiffness and bias the fit.
 
+    One Rust call (:func:`contactlab._core.monotone_path`: the pool-adjacent-violators
+    algorithm in the arithmetic of ``scipy.optimize.isotonic_regression``, whose numbers it
+    gives, without importing SciPy: half a second, under the interpreter lock, in the first
+    window of a streamed analysis; :func:`_monotone_path_scipy` is the reference).
+
     Examples
     --------
     >>> monotone_path(np.array([0.0, 2.0, 1.0, 3.0, 2.0, 1.5, 1.6, 0.0]), np.array([3]))
     array([0.  , 1.5 , 1.5 , 3.  , 2.  , 1.55, 1.55, 0.  ])
     """
+    xa = np.ascontiguousarray(x, dtype=float)
+    return _core.monotone_path(xa, _path_edges(turns, xa.size))
+
+
+def _path_edges(turns: np.ndarray, n: int) -> np.ndarray:
+    """The stretches' bounds: 0, the turns inside the signal, ``n`` (sorted, distinct)."""
+    t = np.asarray(turns, dtype=np.int64)
+    return np.unique(np.r_[0, t[(t > 0) & (t < n)], n]).astype(np.int64)
+
+
+def _monotone_path_scipy(x: np.ndarray, turns: np.ndarray) -> np.ndarray:
+    """The SciPy reference of :func:`monotone_path` (tests)."""
     from scipy.optimize import isotonic_regression
 
     xa = np.asarray(x, dtype=float)

@@ -413,7 +413,7 @@ class Residuals:
         inside = (raw > -A) & (raw < A)
         du_dx0 = np.where(inside, -1.0, 0.0)
         du_dA = np.where(raw >= A, 1.0, np.where(raw <= -A, -1.0, 0.0))
-        sg = np.r_[np.ones(h), -np.ones(n - h)]  # descending, then ascending bins
+        sg = np.where(np.arange(n) < h, 1.0, -1.0)  # descending, then ascending bins
         s = 0.5 * (A - sg * u)
         ds_dA = 0.5 * (1.0 - sg * du_dA)
         ds_dx0 = -0.5 * sg * du_dx0
@@ -741,6 +741,22 @@ def propagate(raw: FitResult, amp: Amplitude, fn: Any) -> tuple[float, float]:
     return propagate_fit(raw, fn, amp.value, amp.extra, amp.g_amp)
 
 
+def propagate_many(
+    raw: FitResult, amp: Amplitude, names: tuple[str, ...], fn: Any
+) -> dict[str, tuple[float, float]]:
+    """:func:`propagate` of each element of the vector ``fn(values, A)`` (named ``names``):
+    one set of perturbed parameter values for all of them (the same steps, hence the same
+    numbers as one :func:`propagate` per element) where the amplitude is fitted; one
+    :func:`propagate` per element where it is not (its extra error term is scalar)."""
+    if amp.fitted:
+        val, err = raw.propagate(lambda v: fn(v, v["amplitude"]))
+        vals, errs = np.atleast_1d(val), np.atleast_1d(err)
+        return {n: (float(vals[i]), float(errs[i])) for i, n in enumerate(names)}
+    return {
+        n: propagate(raw, amp, lambda v, A, i=i: float(fn(v, A)[i])) for i, n in enumerate(names)
+    }
+
+
 __all__ = [
     "Amplitude",
     "Detrended",
@@ -758,6 +774,7 @@ __all__ = [
     "fixed_amplitude_covariance",
     "model_of",
     "propagate",
+    "propagate_many",
     "start_values",
     "turn_covariance",
 ]

@@ -47,13 +47,20 @@ def _truncation_var(
     return d2 / (1.0 - ratio**4) ** 2
 
 
+def _nanmean(v: np.ndarray) -> float:
+    """``np.nanmean`` of a short array with its arithmetic (NaN as 0 in the sum, divided by
+    the count of the others), without its dispatch (a tenth of the call)."""
+    nan = np.isnan(v)
+    return float(np.where(nan, 0.0, v).sum() / (v.size - int(nan.sum())))
+
+
 def _tip_fit(loop: AveragedLoop, first: int, k: int) -> tuple[float, float] | None:
     n = loop.x.size
-    idx = np.r_[np.arange(first - k, first), np.arange(first, first + k)] % n
+    idx = np.arange(first - k, first + k) % n  # k bins either side of the turn
     turn = first / n  # phase of the turn: 0 (peak) or 1/2 (valley)
     assert loop.phase_mean is not None and loop.phase_sq is not None
     pm, p2 = loop.phase_mean[idx], loop.phase_sq[idx]
-    before = np.r_[np.ones(k, bool), np.zeros(k, bool)]
+    before = np.arange(2 * k) < k
     ref = np.where(before & (turn == 0.0), 1.0, turn)  # bins before the peak sit just below 1
     m1 = np.abs(pm - ref)
     m2 = p2 - 2.0 * ref * pm + ref * ref
@@ -64,7 +71,7 @@ def _tip_fit(loop: AveragedLoop, first: int, k: int) -> tuple[float, float] | No
     dof = 2 * k - 3
     s2_fit = float(resid @ resid) / dof if dof > 0 else 0.0
     sb = loop.x_std[idx] / math.sqrt(loop.n_cycles)
-    s2_bins = float(np.nanmean(sb**2)) if np.any(np.isfinite(sb)) else 0.0
+    s2_bins = _nanmean(sb**2) if np.any(np.isfinite(sb)) else 0.0
     s2 = max(s2_fit, s2_bins)
     var0 = s2 * float(np.linalg.inv(X.T @ X)[0, 0])
     if not np.isfinite(var0):

@@ -2,6 +2,7 @@
 //!
 //! - [`curve`]: virgin curves (the exponential curve of the tangential-contact paper, tabulated
 //!   measured backbones).
+//! - [`isotonic`]: isotonic regression (PAVA) and the monotone projection of a path.
 //! - [`loop_fit`]: Levenberg–Marquardt fit of the steady Masing loop to an averaged cycle.
 //! - [`masing`]: the Masing operator with non-local memory, cycle counting and loop areas.
 //! - [`parallel`]: independent jobs (channels, recordings) on scoped threads.
@@ -24,6 +25,7 @@
 
 pub mod curve;
 pub mod error;
+pub mod isotonic;
 pub mod loop_fit;
 pub mod masing;
 pub mod normal;

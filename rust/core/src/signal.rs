@@ -521,6 +521,90 @@ pub fn period_means(t: &[f64], v: &[f64], edges: &[f64]) -> Result<Vec<f64>, Cor
         .collect())
 }
 
+/// [`period_means`] of two channels on one time axis in one pass (the checks of `t` and
+/// `edges` once, `t` read once): `(means of f, means of x)`, each bit for bit what
+/// [`period_means`] gives for it (the same steps, sums and interpolation).
+// Index arithmetic: j + 1 < t.len() inside the search (t.len() >= 2 checked).
+#[allow(clippy::arithmetic_side_effects)]
+pub fn period_means_pair(
+    t: &[f64],
+    f: &[f64],
+    x: &[f64],
+    edges: &[f64],
+) -> Result<(Vec<f64>, Vec<f64>), CoreError> {
+    check_same_len("t", t.len(), "v", f.len())?;
+    check_same_len("t", t.len(), "v", x.len())?;
+    if t.len() < 2 {
+        check_finite("t", t)?;
+        check_finite("edges", edges)?;
+        return Err(CoreError::Empty { name: "t" });
+    }
+    // finite and strictly increasing in one pass (NaN fails the comparison); the separate
+    // checks name the first failure
+    let mut ok = t[0].is_finite();
+    for w in t.windows(2) {
+        ok &= w[1] > w[0] && w[1].is_finite();
+    }
+    if !ok {
+        check_finite("t", t)?;
+        for i in 1..t.len() {
+            if t[i] <= t[i - 1] {
+                return Err(CoreError::NotIncreasing {
+                    name: "t",
+                    index: i,
+                    value: t[i],
+                    prev: t[i - 1],
+                });
+            }
+        }
+    }
+    check_finite("edges", edges)?;
+    for i in 1..edges.len() {
+        if edges[i] < edges[i - 1] {
+            return Err(CoreError::NotIncreasing {
+                name: "edges",
+                index: i,
+                value: edges[i],
+                prev: edges[i - 1],
+            });
+        }
+    }
+    let n = t.len();
+    let mut ce_f = Vec::with_capacity(edges.len());
+    let mut ce_x = Vec::with_capacity(edges.len());
+    let (mut j, mut cf, mut cx) = (0_usize, 0.0_f64, 0.0_f64);
+    for &e in edges {
+        if e <= t[0] {
+            ce_f.push(0.0);
+            ce_x.push(0.0);
+            continue;
+        }
+        while j + 1 < n && t[j + 1] <= e {
+            let dt = t[j + 1] - t[j];
+            cf += 0.5 * (f[j + 1] + f[j]) * dt;
+            cx += 0.5 * (x[j + 1] + x[j]) * dt;
+            j += 1;
+        }
+        if j + 1 >= n || e == t[j] {
+            ce_f.push(cf);
+            ce_x.push(cx);
+        } else {
+            let dt = t[j + 1] - t[j];
+            let c1f = cf + 0.5 * (f[j + 1] + f[j]) * dt;
+            let c1x = cx + 0.5 * (x[j + 1] + x[j]) * dt;
+            ce_f.push((c1f - cf) / dt * (e - t[j]) + cf);
+            ce_x.push((c1x - cx) / dt * (e - t[j]) + cx);
+        }
+    }
+    let means = |ce: &[f64]| -> Vec<f64> {
+        ce.windows(2)
+            .zip(edges.windows(2))
+            .map(|(c, e)| (c[1] - c[0]) / (e[1] - e[0]))
+            .collect()
+    };
+    Ok((means(&ce_f), means(&ce_x)))
+}
+
 /// Noise sensitivity of each cycle's loop area `x[bounds[k]..bounds[k+1]]`: the shoelace
 /// area is linear in every sample's `F` with coefficient `(x[i-1] - x[i+1]) / 2` and in its
 /// `x` with `(F[i+1] - F[i-1]) / 2` (indices cyclic within the cycle). Returns per cycle
@@ -1082,6 +1166,43 @@ mod tests {
             proptest::prop_assert_eq!(sa.x_prev.to_bits(), sb.x_prev.to_bits());
             proptest::prop_assert_eq!(sa.have_crossing, sb.have_crossing);
         }
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn period_means_pair_is_two_period_means_bit_for_bit(
+            steps in proptest::collection::vec(0.001_f64..0.1, 1..300),
+            fs in proptest::collection::vec(-3.0_f64..3.0, 300),
+            xs in proptest::collection::vec(-2.0_f64..2.0, 300),
+            mut edges in proptest::collection::vec(-0.5_f64..20.0, 0..12),
+            on_samples in proptest::collection::vec(0_usize..300, 0..4),
+        ) {
+            let mut t = vec![0.0_f64];
+            for s in &steps {
+                let last = t[t.len() - 1];
+                t.push(last + s);
+            }
+            let n = t.len();
+            for k in on_samples {
+                edges.push(t[k % n]); // edges exactly on samples
+            }
+            edges.sort_by(f64::total_cmp);
+            let (f, x) = (&fs[..n], &xs[..n]);
+            let (mf, mx) = period_means_pair(&t, f, x, &edges).unwrap();
+            proptest::prop_assert_eq!(bits(&mf), bits(&period_means(&t, f, &edges).unwrap()));
+            proptest::prop_assert_eq!(bits(&mx), bits(&period_means(&t, x, &edges).unwrap()));
+        }
+    }
+
+    #[test]
+    fn period_means_pair_refuses_what_period_means_does() {
+        let t = [0.0, 1.0, 1.0, 2.0];
+        let v = [0.0; 4];
+        assert!(period_means_pair(&t, &v, &v, &[0.5, 1.5]).is_err());
+        assert!(period_means_pair(&[0.0, f64::NAN], &v[..2], &v[..2], &[0.5]).is_err());
+        assert!(period_means_pair(&[0.0, 1.0], &v[..2], &v[..2], &[0.5, 0.2]).is_err());
+        assert!(period_means_pair(&[0.0], &v[..1], &v[..1], &[]).is_err());
+        assert!(period_means_pair(&[0.0, 1.0], &v[..2], &v[..1], &[]).is_err());
     }
 
     #[test]

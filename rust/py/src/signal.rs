@@ -1,14 +1,17 @@
 //! Bindings of `contactlab_core::signal` (the streaming reversal detector), the branch memory
 //! of the Masing rules, and the multi-channel force kernel (Rust threads).
 
+use contactlab_core::isotonic::monotone_path;
 use contactlab_core::masing::split::{force_channels, Channel, PIECE};
 use contactlab_core::masing::{branch_memory, MasingState};
 use contactlab_core::parallel::run_jobs;
 use contactlab_core::signal::{
     cycle_block, fold_phase, fold_spread, loop_area_sensitivity, loop_areas, period_means,
-    CycleState, Excursion, FoldSums, Schmitt,
+    period_means_pair, CycleState, Excursion, FoldSums, Schmitt,
 };
-use contactlab_core::window::{detrend_pair, fold_window, WindowFold as CoreWindowFold};
+use contactlab_core::window::{
+    detrend_pair, detrend_pair_into, fold_window, WindowFold as CoreWindowFold,
+};
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadwriteArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -444,6 +447,23 @@ fn period_means_py<'py>(
     Ok(m.into_pyarray(py))
 }
 
+/// Period means of two channels on one time axis in one pass (see
+/// `contactlab_core::signal::period_means_pair`).
+#[pyfunction]
+#[pyo3(name = "period_means_pair")]
+fn period_means_pair_py<'py>(
+    py: Python<'py>,
+    t: PyReadonlyArray1<'py, f64>,
+    f: PyReadonlyArray1<'py, f64>,
+    x: PyReadonlyArray1<'py, f64>,
+    edges: PyReadonlyArray1<'py, f64>,
+) -> PyResult<(Arr<'py>, Arr<'py>)> {
+    let (ts, fs, xs) = (slice(&t, "t")?, slice(&f, "F")?, slice(&x, "x")?);
+    let es = slice(&edges, "edges")?;
+    let (a, b) = detach_guarded(py, || period_means_pair(ts, fs, xs, es))?;
+    Ok((a.into_pyarray(py), b.into_pyarray(py)))
+}
+
 /// One analysis window folded (`contactlab_core::window`): fold sums, cycle bounds, loop
 /// areas and their sensitivities, period means.
 #[pyclass(module = "contactlab._core")]
@@ -561,14 +581,64 @@ fn detrend_pair_py<'py>(
     Ok((a.into_pyarray(py), b.into_pyarray(py)))
 }
 
+/// `detrend_pair` into the caller's arrays (``numpy.empty``: numpy's allocator asks for huge
+/// pages, where a fresh `Vec` of a window's length faulted in every 4 KiB page, 5 ms of
+/// system time a window of 2^19 samples).
+#[pyfunction]
+#[pyo3(name = "detrend_pair_into")]
+#[allow(clippy::too_many_arguments)]
+fn detrend_pair_into_py<'py>(
+    py: Python<'py>,
+    t: PyReadonlyArray1<'py, f64>,
+    tm: f64,
+    f: PyReadonlyArray1<'py, f64>,
+    slope_f: f64,
+    x: PyReadonlyArray1<'py, f64>,
+    slope_x: f64,
+    mut out_f: PyReadwriteArray1<'py, f64>,
+    mut out_x: PyReadwriteArray1<'py, f64>,
+) -> PyResult<()> {
+    let (ts, fs, xs) = (slice(&t, "t")?, slice(&f, "F")?, slice(&x, "x")?);
+    let of = out_f
+        .as_slice_mut()
+        .map_err(|_| input(py, "out_F must be a contiguous array"))?;
+    let ox = out_x
+        .as_slice_mut()
+        .map_err(|_| input(py, "out_x must be a contiguous array"))?;
+    detach_guarded(py, || {
+        detrend_pair_into(ts, tm, (fs, slope_f), (xs, slope_x), (of, ox))
+    })
+}
+
+/// `x` projected on monotone stretches between `edges` (isotonic regressions; see
+/// `contactlab_core::isotonic::monotone_path`).
+#[pyfunction]
+#[pyo3(name = "monotone_path")]
+fn monotone_path_py<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray1<'py, f64>,
+    edges: PyReadonlyArray1<'py, i64>,
+) -> PyResult<Arr<'py>> {
+    let xs = slice(&x, "x")?;
+    let mut ed = Vec::new();
+    for &e in &edges.as_array() {
+        ed.push(usize::try_from(e).map_err(|_| input(py, "edges must be >= 0"))?);
+    }
+    let out = detach_guarded(py, || monotone_path(xs, &ed))?;
+    Ok(out.into_pyarray(py))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(monotone_path_py, m)?)?;
     m.add_function(wrap_pyfunction!(detrend_pair_py, m)?)?;
+    m.add_function(wrap_pyfunction!(detrend_pair_into_py, m)?)?;
     m.add_class::<PhaseFold>()?;
     m.add_class::<WindowFold>()?;
     m.add_function(wrap_pyfunction!(fold_window_py, m)?)?;
     m.add_function(wrap_pyfunction!(loop_areas_py, m)?)?;
     m.add_function(wrap_pyfunction!(loop_area_sensitivity_py, m)?)?;
     m.add_function(wrap_pyfunction!(period_means_py, m)?)?;
+    m.add_function(wrap_pyfunction!(period_means_pair_py, m)?)?;
     m.add_class::<CycleTracker>()?;
     m.add_class::<ReversalDetector>()?;
     m.add_function(wrap_pyfunction!(branch_memory_py, m)?)?;
