@@ -73,6 +73,52 @@ def test_trf_same_trial_points_and_end_point_as_scipy(seed, n, m, tol, max_nfev)
     assert got.message == ref.message
 
 
+@settings(max_examples=25, deadline=None)
+@given(
+    seed=st.integers(0, 10_000),
+    n=st.integers(1, 5),
+    m=st.integers(6, 300),
+    tol=st.sampled_from([1e-6, 1e-8, 1e-10]),
+    max_nfev=st.sampled_from([None, 3, 8, 400]),
+)
+def test_trf_with_an_analytic_jacobian_as_scipy(seed, n, m, tol, max_nfev):
+    """``jac=callable``: the same residual and Jacobian evaluations at the same points in the
+    same order, end point, status and counts as scipy.optimize.least_squares."""
+    model, y, z0, lo, hi = _problem(seed, n, m)
+    t = np.linspace(0.0, 1.0, m)
+    calls: list[tuple[str, np.ndarray]] = []
+
+    def fun(z: np.ndarray) -> np.ndarray:
+        calls.append(("f", z.copy()))
+        return model(z) - y
+
+    def jac(z: np.ndarray) -> np.ndarray:
+        calls.append(("J", z.copy()))
+        e = np.exp(-(1.0 + z[1 % n] ** 2) * t)
+        cols = [e]
+        if n > 1:
+            cols.append(z[0] * e * (-2.0 * z[1] * t))
+        else:  # d/dz0 of z0 exp(-(1 + z0²) t)
+            cols[0] = e + z[0] * e * (-2.0 * z[0] * t)
+        cols += [t**k for k in range(2, n)]
+        return np.column_stack(cols)
+
+    ref = least_squares(fun, z0, jac=jac, bounds=(lo, hi), method="trf", x_scale=1.0,
+                        ftol=tol, xtol=tol, gtol=tol, max_nfev=max_nfev)  # fmt: skip
+    ref_calls = list(calls)
+    calls.clear()
+    got = _trf.solve(fun, z0, lo, hi, tol, tol, tol, max_nfev, jac=jac)
+    assert [k for k, _ in calls] == [k for k, _ in ref_calls]
+    for (_, a), (_, b) in zip(calls, ref_calls, strict=True):
+        assert np.array_equal(a, b)
+    assert np.array_equal(got.x, ref.x)
+    assert np.array_equal(got.fun, ref.fun)
+    assert (got.status, got.nfev, got.njev, got.success) == (
+        ref.status, ref.nfev, ref.njev, ref.success
+    )  # fmt: skip
+    assert got.message == ref.message
+
+
 def test_trf_with_workers_and_an_active_bound():
     """Jacobian columns through a map-like ``workers`` and an optimum on a bound: as SciPy."""
     t = np.linspace(0.0, 1.0, 200)

@@ -409,12 +409,15 @@ def solve(
     gtol: float,
     max_nfev: int | None,
     workers: Callable[[Callable[[Any], Any], Iterable[Any]], Iterable[Any]] | None = None,
+    jac: Callable[[np.ndarray], Any] | None = None,
 ) -> Solution:
     """``scipy.optimize.least_squares(fun, x0, jac="2-point", bounds=(lb, ub),
     method="trf", x_scale=1.0, loss="linear", ftol=ftol, xtol=xtol, gtol=gtol,
     max_nfev=max_nfev, workers=workers)`` for bounds not all infinite and tolerances of at
     least the machine epsilon (:func:`contactlab.fitting.least_squares_fit` passes nothing
-    else here)."""
+    else here); with a callable ``jac`` (a dense analytic Jacobian), ``jac=jac`` instead of
+    the forward differences, as scipy calls it (after ``fun`` at the start, then at every
+    accepted point)."""
     x0 = np.atleast_1d(np.asarray(x0)).astype(float)
     lb = np.asarray(lb, dtype=float)
     ub = np.asarray(ub, dtype=float)
@@ -427,16 +430,20 @@ def solve(
     x0 = make_strictly_feasible(x0, lb, ub)
     vf = _Cached(fun, x0)
 
-    def jac(x: np.ndarray) -> np.ndarray:
+    analytic = jac
+
+    def jacobian(x: np.ndarray) -> np.ndarray:
+        if analytic is not None:
+            return np.atleast_2d(np.asarray(analytic(x), dtype=float))
         f0 = vf.at(x)  # (the residuals there: kept from the step that reached x)
         return np.atleast_2d(forward_jacobian(vf._call, vf.x.copy(), f0, lb, ub, workers))
 
     f0 = vf.at(x0)
-    J0 = jac(x0)
+    J0 = jacobian(x0)
     if not np.all(np.isfinite(f0)):
         raise ValueError("Residuals are not finite in the initial point.")
-    x, f, status, nfev, njev = _trf_bounds(vf.at, jac, x0, f0, J0, lb, ub, ftol, xtol, gtol,
-                                           max_nfev)  # fmt: skip
+    x, f, status, nfev, njev = _trf_bounds(vf.at, jacobian, x0, f0, J0, lb, ub, ftol, xtol,
+                                           gtol, max_nfev)  # fmt: skip
     return Solution(x, f, status, nfev, njev)
 
 
