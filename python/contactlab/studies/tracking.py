@@ -42,7 +42,7 @@ import numpy as np
 from .._json import jsonable
 from .._physical import MAX_MAGNITUDE
 from ..errors import ContactLabError, ContactLabWarning, InputError
-from ..io import DEFAULT_CHUNK, Recording, read_chunks
+from ..io import Recording, read_chunks
 from ..io.units import UnknownUnitError, to_si
 from ._cycles import MIN_BLOCK, CycleState, block_cycles
 from .columns import CYCLE_UNITS
@@ -69,10 +69,15 @@ MIN_CYCLES = 3
 #: default upper bound on a window's samples (one window is held in memory)
 MAX_WINDOW = 2_000_000
 #: samples per window for ``every="auto"``: the fit of a window costs about as much as folding
-#: 10^5 samples, so longer windows amortise it, but each window in flight holds ~40 bytes a
-#: sample (on 1e8 samples with two threads: 2^19 peaked at 216 MB, 3·2^18 at 272 MB, 2^20 at
-#: 304 MB)
-AUTO_WINDOW = 1 << 19
+#: 10^5 samples (about 20 ms a window), so longer windows amortise it, but each window in
+#: flight holds ~40 bytes a sample (t, x, F and the detrended x, F), and about 3.3 windows are
+#: held at the peak (two analysed, one being cut out of the read chunks). On 1e8 samples with
+#: two threads and :data:`TRACK_CHUNK` chunks: 2^20 peaked at 245-250 MB (2^19 at ~190 MB)
+AUTO_WINDOW = 1 << 20
+#: samples read at a time by :func:`track`: the rest of a chunk split between two windows is a
+#: view that keeps the whole chunk alive until the next window is cut, so shorter chunks hold
+#: less (1e8 samples, 2^20 windows: chunks of 2^20 peaked at 274 MB, 2^18 at 247 MB)
+TRACK_CHUNK = 1 << 18
 
 _EVERY = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?\d+)?)\s*([A-Za-zµμ]*)\s*$")
 
@@ -471,7 +476,7 @@ def track(
     kind: str | None = None,
     columns: dict[str, str] | None = None,
     fs: float | None = None,
-    chunk_size: int = DEFAULT_CHUNK,
+    chunk_size: int = TRACK_CHUNK,
     max_window: int = MAX_WINDOW,
     options: Mapping[str, Any] | None = None,
     keep_going: bool = True,
@@ -495,7 +500,7 @@ def track(
     kind, columns, fs
         As for :func:`contactlab.io.read_recording`.
     chunk_size : int
-        Samples read at a time.
+        Samples read at a time (default :data:`TRACK_CHUNK`).
     max_window : int
         Refuse windows longer than this many samples (one window is held in memory).
     options : mapping, optional
@@ -513,8 +518,8 @@ def track(
     threads : int, optional
         Without ``executor``: analyse windows on this many helper threads while the next
         chunks are read and their cycles found (the Rust kernels release the GIL); default 1
-        (``threads + 1`` windows in flight: 2 threads peaked at 216 MB on 1e8 samples with
-        ``"auto"`` windows), 0 analyses each window before reading on. The rows are the
+        (``threads + 1`` windows in flight: 2 threads peaked at about 250 MB on 1e8 samples
+        with ``"auto"`` windows), 0 analyses each window before reading on. The rows are the
         same.
     keep_documents : bool
         Keep each window's whole analysis document (``TrackResult.window_docs``; what
@@ -763,6 +768,7 @@ __all__ = [
     "MIN_CYCLES",
     "NORMAL_QUANTITIES",
     "TANGENTIAL_QUANTITIES",
+    "TRACK_CHUNK",
     "TrackResult",
     "parse_every",
     "track",
