@@ -448,6 +448,12 @@ pub fn fold_window(
     let (mut cc, mut cb) = (0_usize, 0_usize);
     let nbf = nb as f64;
     let mut cell_sums = [0.0_f64; 4];
+    // the open cell's bin sums, kept in registers while the cell's run of samples lasts and
+    // stored back when it ends (the same additions in the same order as adding into
+    // `bins[cb]` sample by sample, which the compiler kept in memory: a load and a store of
+    // seven sums a sample)
+    let mut cur = [0.0_f64; 8];
+    let mut cur_bin: Option<usize> = None;
     // the open cycle's samples: [a0, a1)
     let (mut a0, mut a1) = (0_usize, 0_usize);
     let mut area_cycle: Option<usize> = None;
@@ -550,19 +556,23 @@ pub fn fold_window(
             if let Some((oc, ob)) = cell {
                 flush_cell(oc, ob, &cell_sums, &mut moments, &mut ranges);
             }
+            if let Some(ob) = cur_bin {
+                bins[ob] = cur;
+            }
             cb = b;
+            cur = bins[cb];
+            cur_bin = Some(cb);
             cell = Some((cc, cb));
             cell_sums = [0.0; 4];
         }
-        // one bin's sums in one cache line (the same additions, in the same order)
-        let s = &mut bins[cb];
-        s[0] += 1.0;
-        s[1] += xi;
-        s[2] += fi;
-        s[3] += frac;
-        s[4] += frac * frac;
-        s[5] += xi * xi;
-        s[6] += ti;
+        // the bin's sums (the same additions, in the same order)
+        cur[0] += 1.0;
+        cur[1] += xi;
+        cur[2] += fi;
+        cur[3] += frac;
+        cur[4] += frac * frac;
+        cur[5] += xi * xi;
+        cur[6] += ti;
         cell_sums[0] += 1.0;
         cell_sums[1] += xi;
         cell_sums[2] += fi;
@@ -571,6 +581,9 @@ pub fn fold_window(
     }
     if let Some((cc, cb)) = cell {
         flush_cell(cc, cb, &cell_sums, &mut moments, &mut ranges);
+    }
+    if let Some(ob) = cur_bin {
+        bins[ob] = cur;
     }
     for (b, s) in bins.iter().enumerate() {
         w.count[b] = s[0];
