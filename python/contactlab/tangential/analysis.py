@@ -657,7 +657,7 @@ def _analyze(
     :func:`analyze_window`, which hands back None when its loop reaches gross sliding."""
     steady = history == "steady"
     pre_warns = [f"analysed -F: {ori.reason}"] if (ori.sign < 0 and ori.by != "user") else []
-    if ori.sign < 0:
+    if ori.sign < 0 and pre is None:  # (a detrended window is negated already: no copy)
         Fa = -Fa
     fit_x0 = True if fit_x0 is None else fit_x0
     det = (
