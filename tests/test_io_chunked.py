@@ -136,3 +136,66 @@ def test_nan_named_alike_in_every_binary_format(tmp_path, ext, opts) -> None:
     with pytest.raises(RecordingError) as chunked:
         list(read_chunks(p, chunk_size=50))
     assert str(chunked.value) == str(whole.value) and chunked.value.row == 211
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    t0=st.floats(-1e6, 1e6, allow_nan=False),
+    dt=st.floats(1e-9, 10.0),
+    offset=st.integers(0, 2**52),
+    n=st.integers(0, 40),
+)
+def test_time_axis_is_numpys_bit_for_bit(t0: float, dt: float, offset: int, n: int) -> None:
+    from contactlab import _core
+
+    t = np.empty(n)
+    _core.fill_time(t, t0, dt, offset)
+    want = t0 + dt * np.arange(offset, offset + n, dtype=np.float64)
+    assert t.tobytes() == want.tobytes()
+
+
+def test_chunks_of_a_sampled_file_carry_time_and_ranges(tmp_path) -> None:
+    import h5py
+
+    rec = _rec(n=1000, seed=3)
+    p = tmp_path / "sampled.h5"
+    with h5py.File(p, "w") as f:
+        f["x"] = rec["x"] * 1e6  # µm: the chunks are converted to m
+        f["x"].attrs["unit"] = "um"
+        f["F"] = rec["F"]
+        f.attrs["dt"] = 2.5e-4
+    chunks = list(read_chunks(p, chunk_size=333))
+    for c in chunks:
+        a = c.meta["offset"]
+        want_t = 2.5e-4 * np.arange(a, a + len(c), dtype=np.float64)
+        assert c.t.tobytes() == want_t.tobytes()
+        for k in ("x", "F"):
+            assert c.meta["ranges"][k] == (float(c[k].min()), float(c[k].max()))
+    np.testing.assert_allclose(_joined(chunks)["x"], rec["x"], rtol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("value", "unit", "message"),
+    [
+        (np.inf, None, "value inf is not a finite number"),
+        (-np.inf, "kN", "value -inf is not a finite number"),
+        (1e306, "kN", "value 1e+306 overflows double precision when converted to SI"),
+    ],
+)
+def test_non_finite_and_overflow_named_with_their_row(tmp_path, value, unit, message) -> None:
+    import h5py
+
+    rec = _rec(n=300)
+    F = rec["F"].copy()
+    F[257] = value
+    p = tmp_path / "bad.h5"
+    with h5py.File(p, "w") as f:
+        f["t"] = rec.t
+        f["x"] = rec["x"]
+        f["F"] = F
+        if unit:
+            f["F"].attrs["unit"] = unit
+    with pytest.raises(RecordingError) as chunked:
+        list(read_chunks(p, chunk_size=64))
+    assert message in str(chunked.value) and chunked.value.row == 257
+    assert chunked.value.column == "F"

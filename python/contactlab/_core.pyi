@@ -104,6 +104,7 @@ def force_repeat(
 def signature_positions(
     block: npt.NDArray[np.uint8], needles: list[bytes], starts_below: int, offset: int
 ) -> list[npt.NDArray[np.int64]]: ...
+def fill_time(out: _F, t0: float, dt: float, offset: int) -> None: ...
 
 # --- normal contact (contactlab.normal) ---
 def normal_simulate(

@@ -3,7 +3,8 @@
 :func:`read_chunks` opens a recording like :func:`contactlab.io.read_recording` (same column
 guessing, units, ``kind``, ``fs``) and yields it as consecutive :class:`Recording` chunks of at
 most ``chunk_size`` samples, SI inside, each with ``meta["offset"]`` (index of its first
-sample). Only one chunk of the needed channels is in memory at a time:
+sample) and ``meta["ranges"]`` (each channel's smallest and largest value in the chunk, SI).
+Only one chunk of the needed channels is in memory at a time:
 
 - HDF5 and MAT v7.3: datasets read by slices (h5py);
 - TDMS: channels read by ``offset``/``length`` (npTDMS streaming mode: only the segments
@@ -20,6 +21,7 @@ non-finite values, time going back or repeating (also across chunk boundaries) a
 from __future__ import annotations
 
 import itertools
+import math
 import warnings
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -28,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import _core
 from ..errors import InputError
 from .recording import (
     Recording,
@@ -165,36 +168,46 @@ class _Finisher:
             return self.row_of(offset + i)
 
         data: dict[str, np.ndarray] = {}
+        ranges: dict[str, tuple[float, float]] = {}
         t = None
         for canon, values in raw.items():
             col = self.mapping[canon]
-            check_finite(values, file=self.file, column=col, row_of=row_of)
             v = np.ascontiguousarray(values, dtype=np.float64)
-            if self.factors[canon] != 1.0:
-                with np.errstate(over="ignore"):
-                    v = v * self.factors[canon]
-                if not np.all(np.isfinite(v)):  # found by fuzzing (track): 1e306 kN in N
-                    i = int(np.argmax(~np.isfinite(v)))
-                    raise RecordingError(
-                        f"value {float(values[i])} overflows double precision when converted to SI",
-                        file=self.file,
-                        column=col,
-                        row=row_of(i),
-                    )
+            factor = self.factors[canon]
+            if factor != 1.0:
+                with np.errstate(over="ignore", invalid="ignore"):
+                    v = v * factor
+            # the range in SI (the magnitude check and the cycle trigger of a streamed analysis
+            # use it: meta["ranges"]) is the finiteness check too: numpy's min and max are NaN
+            # when a value is, and ±inf when one is (or overflowed in the conversion)
+            lo, hi = (float(v.min()), float(v.max())) if v.size else (math.inf, -math.inf)
+            if not (math.isfinite(lo) and math.isfinite(hi)) and v.size:
+                # the whole-file reader's checks find the value and raise
+                check_finite(values, file=self.file, column=col, row_of=row_of)
+                i = int(np.argmax(~np.isfinite(v)))  # found by fuzzing (track): 1e306 kN in N
+                raise RecordingError(
+                    f"value {float(values[i])} overflows double precision when converted to SI",
+                    file=self.file,
+                    column=col,
+                    row=row_of(i),
+                )
             if canon == "t":
                 t = v
             else:
                 data[canon] = v
+                ranges[canon] = (lo, hi)
         if t is None:
             # a time axis made from the sampling interval is increasing and gap-free by
-            # construction: nothing to check
+            # construction: nothing to check. One pass, bit for bit
+            # t0 + dt * np.arange(offset, offset + n)
             assert self.dt is not None
-            t = self.t0 + self.dt * np.arange(offset, offset + n, dtype=np.float64)
+            t = np.empty(n, dtype=np.float64)
+            _core.fill_time(t, self.t0, self.dt, offset)
         else:
             self._check_time(t, row_of)
         if n:
             self.prev_t = float(t[-1])
-        meta = dict(self.meta, offset=offset)
+        meta = dict(self.meta, offset=offset, ranges=ranges)
         return Recording(t, data, dict(self.units), self.file, meta)
 
 
@@ -417,12 +430,14 @@ def _csv_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> 
 
 def _whole_chunks(rec: Recording, chunk: int) -> ChunkedRecording:
     n = len(rec)
+    # a recording made of a chunk carries that chunk's ranges: not those of these chunks
+    meta = {k: v for k, v in rec.meta.items() if k != "ranges"}
 
     def gen() -> Iterator[Recording]:
         for a in range(0, n, chunk):
             b = min(a + chunk, n)
             data = {k: v[a:b] for k, v in rec.data.items()}
-            yield Recording(rec.t[a:b], data, dict(rec.units), rec.source, dict(rec.meta, offset=a))
+            yield Recording(rec.t[a:b], data, dict(rec.units), rec.source, dict(meta, offset=a))
 
     return ChunkedRecording(
         rec.source,

@@ -48,6 +48,13 @@ class Cycles:
     offset: np.ndarray = field(default_factory=lambda: np.empty(0))
 
 
+def trigger_levels(lo: float, hi: float) -> tuple[float, float]:
+    """The trigger band ``(low, high)`` of a block whose drive spans ``[lo, hi]``: centred,
+    :data:`BAND` of the half range wide on each side."""
+    centre, half = 0.5 * (hi + lo), 0.5 * (hi - lo) * BAND
+    return centre - half, centre + half
+
+
 def block_cycles(
     t: np.ndarray,
     x: np.ndarray,
@@ -61,12 +68,12 @@ def block_cycles(
 
     ``x``/``F`` are the loop's abscissa and ordinate (``x, F`` or ``delta, p``), ``drive`` the
     channel whose crossings mark the cycles, ``offset`` the global index of the block's first
-    sample. ``levels = (low, high)`` fixes the trigger band (default: from the block's range).
+    sample. ``levels = (low, high)`` fixes the trigger band (default: :func:`trigger_levels`
+    of the drive's range in the block).
     """
     if levels is None:
         lo_d, hi_d = (float(drive.min()), float(drive.max())) if drive.size else (0.0, 0.0)
-        centre, half = 0.5 * (hi_d + lo_d), 0.5 * (hi_d - lo_d) * BAND
-        low, high = centre - half, centre + half
+        low, high = trigger_levels(lo_d, hi_d)
     else:
         low, high = float(levels[0]), float(levels[1])
     d = s.tracker.push(t, x, F, drive, int(offset), low, high)
@@ -80,4 +87,4 @@ def block_cycles(
     )
 
 
-__all__ = ["BAND", "MIN_BLOCK", "CycleState", "Cycles", "block_cycles"]
+__all__ = ["BAND", "MIN_BLOCK", "CycleState", "Cycles", "block_cycles", "trigger_levels"]

@@ -44,7 +44,7 @@ from .._physical import MAX_MAGNITUDE
 from ..errors import ContactLabError, ContactLabWarning, InputError
 from ..io import Recording, read_chunks
 from ..io.units import UnknownUnitError, to_si
-from ._cycles import MIN_BLOCK, CycleState, block_cycles
+from ._cycles import MIN_BLOCK, CycleState, block_cycles, trigger_levels
 from .columns import CYCLE_UNITS
 from .study import coefficient_unit
 
@@ -438,26 +438,44 @@ def _part(rec: Recording, a: int, b: int) -> Recording:
     return Recording(rec.t[a:b], data, rec.units, rec.source, dict(rec.meta, offset=off + a))
 
 
-def _blocks(chunks: Iterator[Recording], min_block: int) -> Iterator[Recording]:
-    """Chunks joined until each holds at least ``min_block`` samples (the last may be short)."""
+def _blocks(
+    chunks: Iterator[Recording], min_block: int
+) -> Iterator[tuple[Recording, dict[str, tuple[float, float]] | None]]:
+    """Chunks joined until each holds at least ``min_block`` samples (the last may be short),
+    each with its channels' ranges (``(min, max)``; None when a chunk came without them)."""
     buf: list[Recording] = []
     size = 0
+    ranges: dict[str, tuple[float, float]] | None = {}
     for c in chunks:
+        # the reader's one pass found each channel's range (read_chunks: meta["ranges"]);
+        # taken out of the meta, which the windows inherit
+        got = c.meta.pop("ranges", None)
+        if got is None or any(name not in got for name in c.data):
+            got = {
+                name: (float(v.min()), float(v.max())) if v.size else (math.inf, -math.inf)
+                for name, v in c.data.items()
+            }
         for name, v in c.data.items():  # found by fuzzing: 1e300 data overflowed windows
-            if v.size and max(float(v.max()), -float(v.min())) > MAX_MAGNITUDE:
+            lo, hi = got[name]
+            if v.size and max(hi, -lo) > MAX_MAGNITUDE:
                 i = int(np.argmax(np.abs(v)))
                 raise InputError(
                     f"{c.source}: {name} reaches {float(v[i]):.3g} {c.units.get(name, '')} "
                     f"at sample {i + int(c.meta.get('offset', 0))}: beyond any physical value; "
                     "a unit mix-up or a corrupt file?"
                 )
+        if ranges is not None:
+            ranges = {
+                k: (min(ranges[k][0], lo), max(ranges[k][1], hi)) if k in ranges else (lo, hi)
+                for k, (lo, hi) in got.items()
+            }
         buf.append(c)
         size += len(c)
         if size >= min_block:
-            yield _join(buf)
-            buf, size = [], 0
+            yield _join(buf), ranges
+            buf, size, ranges = [], 0, {}
     if buf:
-        yield _join(buf)
+        yield _join(buf), ranges
 
 
 def _join(parts: list[Recording]) -> Recording:
@@ -659,11 +677,14 @@ def _track(
             collect(*in_flight.popleft())
 
     try:
-        for block in _blocks(iter(cr), MIN_BLOCK):
+        for block, ranges in _blocks(iter(cr), MIN_BLOCK):
             off = int(block.meta.get("offset", n_total))
             buf.add(block)
             n_total = off + len(block)
-            got = block_cycles(block.t, block[loop_x], block[loop_F], block[drive], off, state)
+            levels = trigger_levels(*ranges[drive]) if ranges and len(block) else None
+            got = block_cycles(
+                block.t, block[loop_x], block[loop_F], block[drive], off, state, levels
+            )
             for k in cyc:
                 cyc[k].append(np.asarray(getattr(got, k), dtype=float))
             if window_t0 is None:

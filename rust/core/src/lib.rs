@@ -8,6 +8,7 @@
 //! - [`parallel`]: independent jobs (channels, recordings) on scoped threads.
 //! - [`scan`]: byte-signature search (the HDF5 structure checks).
 //! - [`signal`]: streaming reversal detection by a hysteresis threshold.
+//! - [`stream`]: the reading side of a streamed analysis (chunk checks, time axis).
 //! - [`window`]: the per-sample work of one analysis window (fold, cycle areas, detrending).
 //!
 //! Every kernel validates its input and returns [`CoreError`]; none panics on user data.
@@ -32,6 +33,7 @@ pub mod normal;
 pub mod parallel;
 pub mod scan;
 pub mod signal;
+pub mod stream;
 pub mod structure;
 pub mod window;
 

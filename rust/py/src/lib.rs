@@ -18,6 +18,7 @@ mod loop_fit;
 mod normal;
 mod scan;
 mod signal;
+mod stream;
 mod structure;
 use errors::{internal, slice, to_pyerr};
 
@@ -338,6 +339,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     structure::register(m)?;
     signal::register(m)?;
     scan::register(m)?;
+    stream::register(m)?;
     loop_fit::register(m)?;
     Ok(())
 }
