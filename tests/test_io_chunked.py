@@ -199,3 +199,28 @@ def test_non_finite_and_overflow_named_with_their_row(tmp_path, value, unit, mes
         list(read_chunks(p, chunk_size=64))
     assert message in str(chunked.value) and chunked.value.row == 257
     assert chunked.value.column == "F"
+
+
+def test_hdf5_datasets_libhdf5_must_decode_read_alike(tmp_path) -> None:
+    """Only plain little-endian float64 is read from the file's bytes: compressed, shuffled,
+    big-endian, float32 and integer datasets go through libhdf5, with the same samples."""
+    import h5py
+
+    rec = _rec(n=1000, seed=5)
+    p = tmp_path / "mixed.h5"
+    with h5py.File(p, "w") as f:
+        f["t"] = rec.t.astype(">f8")
+        f.create_dataset("x", data=rec["x"], chunks=(128,), compression="gzip", shuffle=True)
+        f["F"] = rec["F"].astype(np.float32)
+        f["F"].attrs["unit"] = "N"
+    whole = read_recording(p)
+    j = _joined(list(read_chunks(p, chunk_size=300)))
+    for k in ("t", "x", "F"):
+        assert j[k].tobytes() == whole[k].tobytes()
+    with h5py.File(q := tmp_path / "ints.h5", "w") as f:
+        f["x"] = np.arange(500, dtype=np.int32)
+        f["F"] = np.arange(500, dtype="<f8")
+        f.attrs["dt"] = 1e-3
+    j = _joined(list(read_chunks(q, chunk_size=64)))
+    np.testing.assert_array_equal(j["x"], np.arange(500))
+    np.testing.assert_array_equal(j["F"], np.arange(500))

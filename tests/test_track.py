@@ -432,3 +432,49 @@ def test_detrend_pair_is_numpys_expression_bit_for_bit(seed, n, exp, slopes):
     np.testing.assert_array_equal(ox, b)
     with pytest.raises(InputError):
         _core.detrend_pair_into(t, tm, F, 1.0, x, 1.0, oF[: n - 1], ox)
+
+
+@pytest.mark.parametrize("every", ["3cycles", "7s", "auto"])
+def test_windows_read_in_place_hold_their_samples(long_rec, tmp_path, monkeypatch, every):
+    """Windows are views of the arrays the file is read into (HDF5 read from the file's bytes,
+    the time axis made from the sampling interval): each holds exactly the samples of its
+    span, whether short windows share an array or a long one outgrows it, and the rows are
+    those of the same samples in memory."""
+    import h5py
+
+    from contactlab.studies import tracking
+
+    dt = 1 / 1500.0
+    n = len(long_rec)
+    with h5py.File(p := tmp_path / "sampled.h5", "w") as f:
+        f.create_dataset("x", data=long_rec["x"], chunks=(1000,))  # chunked
+        f["F"] = long_rec["F"]  # contiguous
+        f.attrs["dt"] = dt
+    with h5py.File(p, "r") as f:  # both read from the file's bytes
+        from contactlab.io.hdf5 import direct_read
+
+        assert all(direct_read(f[k], p.stat().st_size) is not None for k in ("x", "F"))
+    seen: list[tuple[int, np.ndarray, np.ndarray, np.ndarray]] = []
+    analyse = tracking._tangential_window
+
+    def spy(rec, options, keep_doc=False):
+        seen.append((rec.meta["offset"], rec.t.copy(), rec["x"].copy(), rec["F"].copy()))
+        return analyse(rec, options, keep_doc)
+
+    monkeypatch.setattr(tracking, "_tangential_window", spy)
+    r = track(p, every=every, chunk_size=700, threads=0)
+    assert len(seen) == len(r.rows) >= 1
+    for (a, t, x, F), row in zip(seen, r.rows, strict=True):
+        assert row["n_samples"] == t.size == x.size == F.size
+        assert t.tobytes() == (dt * np.arange(a, a + t.size, dtype=np.float64)).tobytes()
+        assert x.tobytes() == long_rec["x"][a : a + x.size].tobytes()
+        assert F.tobytes() == long_rec["F"][a : a + F.size].tobytes()
+    same = Recording(
+        dt * np.arange(n, dtype=np.float64),
+        {"x": long_rec["x"], "F": long_rec["F"]},
+        {"x": "m", "F": "N"},
+    )
+    m = track(same, every=every, chunk_size=700, threads=0)
+    assert m.rows == r.rows
+    for k in r.cycles:
+        assert r.cycles[k].tobytes() == m.cycles[k].tobytes()

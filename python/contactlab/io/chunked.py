@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
 import warnings
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -46,6 +47,10 @@ from .sniff import content_format, format_of
 
 #: default samples per chunk (8 MiB per channel)
 DEFAULT_CHUNK = 1 << 20
+
+#: ``alloc(n, names)``: the arrays a chunk of ``n`` samples is written into, one per name
+#: (``"t"`` and each channel)
+Alloc = Callable[[int, list[str]], dict[str, np.ndarray]]
 
 
 @dataclass
@@ -75,9 +80,33 @@ class ChunkedRecording:
     n_samples: int | None
     meta: dict[str, Any]
     _open: Callable[[], Iterator[Recording]] = field(repr=False)
+    _open_into: Callable[[Alloc], Iterator[Recording]] | None = field(default=None, repr=False)
+    #: ``(t0, dt)`` when the time axis is made from a sampling interval: sample ``i`` is at
+    #: ``t0 + dt * i`` (``contactlab._core.fill_time``), else None (a time column)
+    time_step: tuple[float, float] | None = None
 
     def __iter__(self) -> Iterator[Recording]:
         return self._open()
+
+    def chunks_into(self, alloc: Alloc) -> Iterator[Recording]:
+        """The chunks, with the time axis and each channel (SI) written into the arrays that
+        ``alloc(n, names)`` returns for a chunk of ``n`` samples: a dict of each of ``names``
+        (``"t"`` and the channels) to a writable contiguous float64 array of ``n`` samples,
+        which become the chunk's arrays. HDF5 datasets stored as plain float64 are read
+        straight into them (no array allocated per chunk, no copy); other data is copied.
+        ``alloc`` is called for a chunk only once the previous chunk has been taken from the
+        iterator."""
+        if self._open_into is not None:
+            yield from self._open_into(alloc)
+            return
+        for c in self._open():
+            out = alloc(len(c), ["t", *c.data])
+            np.copyto(out["t"], c.t)
+            data = {}
+            for k, v in c.data.items():
+                np.copyto(out[k], v)
+                data[k] = out[k]
+            yield Recording(out["t"], data, c.units, c.source, c.meta)
 
 
 class _Finisher:
@@ -138,6 +167,11 @@ class _Finisher:
             m["units_assumed_si"] = assumed
         self.meta = m
 
+    @property
+    def time_step(self) -> tuple[float, float] | None:
+        """``(t0, dt)`` of a time axis made from the sampling interval, else None."""
+        return None if self.dt is None else (float(self.t0), float(self.dt))
+
     def _check_time(self, t: np.ndarray, row_of: Callable[[int], int]) -> None:
         """The whole-file reader's time checks, judged against the first chunk's median step
         and across the boundary with the previous chunk."""
@@ -158,7 +192,12 @@ class _Finisher:
         if t.size >= 2:
             check_time(t, file=self.file, column=col, row_of=row_of, step=self.step)
 
-    def __call__(self, raw: dict[str, np.ndarray], offset: int) -> Recording:
+    def __call__(
+        self, raw: dict[str, np.ndarray], offset: int, out: dict[str, np.ndarray] | None = None
+    ) -> Recording:
+        """The chunk of samples ``offset..`` from the file's values ``raw`` (by canonical
+        name); with ``out`` (``"t"`` and each channel), the SI values are written there (a
+        ``raw`` array that is its ``out`` array itself is converted in place)."""
         check_equal_lengths(raw, self.mapping, file=self.file)
         n = next(iter(raw.values())).size
         if self.prev_t is None and n < 2:  # as the whole-file check of the time says
@@ -172,11 +211,22 @@ class _Finisher:
         t = None
         for canon, values in raw.items():
             col = self.mapping[canon]
+            dest = None if out is None else out[canon]
             v = np.ascontiguousarray(values, dtype=np.float64)
             factor = self.factors[canon]
             if factor != 1.0:
-                with np.errstate(over="ignore", invalid="ignore"):
-                    v = v * factor
+                if dest is None:
+                    with np.errstate(over="ignore", invalid="ignore"):
+                        v = v * factor
+                else:
+                    if values is dest:  # read in place: the file's values for the messages
+                        values = v = dest.copy()
+                    with np.errstate(over="ignore", invalid="ignore"):
+                        np.multiply(v, factor, out=dest)
+                    v = dest
+            elif dest is not None and values is not dest:
+                np.copyto(dest, v)
+                v = dest
             # the range in SI (the magnitude check and the cycle trigger of a streamed analysis
             # use it: meta["ranges"]) is the finiteness check too: numpy's min and max are NaN
             # when a value is, and ±inf when one is (or overflowed in the conversion)
@@ -201,7 +251,7 @@ class _Finisher:
             # construction: nothing to check. One pass, bit for bit
             # t0 + dt * np.arange(offset, offset + n)
             assert self.dt is not None
-            t = np.empty(n, dtype=np.float64)
+            t = np.empty(n, dtype=np.float64) if out is None else out["t"]
             _core.fill_time(t, self.t0, self.dt, offset)
         else:
             self._check_time(t, row_of)
@@ -241,6 +291,30 @@ def _vector_length(ds: Any, *, file: str, column: str) -> int:
     return int(np.prod(ds.shape, dtype=np.int64))
 
 
+def _direct_reads(path: Path, dsets: dict[str, Any], mapping: dict[str, str], fmt: str) -> dict:
+    """The channels (canonical name → :class:`~contactlab.io.hdf5.DirectRead`) whose samples
+    are read from the file's bytes, each first checked against libhdf5 on its first samples."""
+    from .hdf5 import direct_read
+
+    if fmt != "hdf5":
+        return {}
+    size = path.stat().st_size
+    out = {}
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        for c, m in mapping.items():
+            d = direct_read(dsets[m], size)
+            if d is None:
+                continue
+            k = min(64, int(dsets[m].shape[0]))
+            mine = np.empty(k)
+            if d.read(fd, 0, mine) and mine.tobytes() == np.asarray(dsets[m][:k]).tobytes():
+                out[c] = d
+    finally:
+        os.close(fd)
+    return out
+
+
 def _h5_chunks(
     path: Path, fmt: str, *, columns: Any, kind: Any, fs: Any, chunk: int
 ) -> ChunkedRecording:
@@ -267,7 +341,9 @@ def _h5_chunks(
         kind_, mapping, _d, units, dt, n = layout(f)
     fin0 = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, meta={"format": fmt})
 
-    def gen() -> Iterator[Recording]:
+    names = ["t", *(c for c in mapping if c != "t")]
+
+    def gen(alloc: Alloc | None) -> Iterator[Recording]:
         fin = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, meta={"format": fmt})
         with h5py.File(path, "r") as f:
             dsets = {n_: f[n_] for n_ in mapping.values()} if fmt == "mat73" else None
@@ -277,16 +353,32 @@ def _h5_chunks(
                 alld = datasets(f)
                 dsets = {n_: alld[n_] for n_ in mapping.values()}
             if n < 2:
-                yield fin(
-                    {c: _slice(dsets[m], 0, n, file=file, column=m) for c, m in mapping.items()}, 0
-                )
+                raw = {c: _slice(dsets[m], 0, n, file=file, column=m) for c, m in mapping.items()}
+                yield fin(raw, 0, None if alloc is None else alloc(n, names))
                 return
-            for a in range(0, n, chunk):
-                b = min(a + chunk, n)
-                raw = {c: _slice(dsets[m], a, b, file=file, column=m) for c, m in mapping.items()}
-                yield fin(raw, a)
+            direct = _direct_reads(path, dsets, mapping, fmt)
+            fd = os.open(path, os.O_RDONLY) if direct else None
+            try:
+                for a in range(0, n, chunk):
+                    b = min(a + chunk, n)
+                    out = None if alloc is None else alloc(b - a, names)
+                    raw = {}
+                    for c, m in mapping.items():
+                        d = direct.get(c)
+                        if d is not None and fd is not None:
+                            buf = np.empty(b - a) if out is None else out[c]
+                            if d.read(fd, a, buf):
+                                raw[c] = buf
+                                continue
+                        raw[c] = _slice(dsets[m], a, b, file=file, column=m)
+                    yield fin(raw, a, out)
+            finally:
+                if fd is not None:
+                    os.close(fd)
 
-    return ChunkedRecording(file, kind_, fin0.units, mapping, n, fin0.meta, gen)
+    return ChunkedRecording(
+        file, kind_, fin0.units, mapping, n, fin0.meta, lambda: gen(None), gen, fin0.time_step
+    )
 
 
 def _tdms_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> ChunkedRecording:
@@ -350,7 +442,9 @@ def _tdms_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) ->
                 }
                 yield fin(raw, a)
 
-    return ChunkedRecording(file, kind_, fin0.units, mapping, n, fin0.meta, gen)
+    return ChunkedRecording(
+        file, kind_, fin0.units, mapping, n, fin0.meta, gen, time_step=fin0.time_step
+    )
 
 
 def _csv_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> ChunkedRecording:
@@ -425,7 +519,9 @@ def _csv_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> 
         if offset == 0:
             raise RecordingError("header but no data rows", file=file)
 
-    return ChunkedRecording(file, kind_, fin0.units, mapping, None, fin0.meta, gen)
+    return ChunkedRecording(
+        file, kind_, fin0.units, mapping, None, fin0.meta, gen, time_step=fin0.time_step
+    )
 
 
 def _whole_chunks(rec: Recording, chunk: int) -> ChunkedRecording:

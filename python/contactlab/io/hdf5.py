@@ -463,3 +463,81 @@ def write_hdf5(path: str | Path, rec: Recording, **_: Any) -> Path:
             if rec.kind:
                 f.attrs["kind"] = rec.kind
     return Path(path)
+
+
+class DirectRead:
+    """Where the samples of an uncompressed 1-d little-endian float64 dataset lie in the file,
+    read with ``os.preadv`` straight into the caller's array (:func:`direct_read`): the bytes
+    libhdf5 would copy through its chunk cache, without the copy (a streamed read of a 1.6 GB
+    file: 0.52-0.58 -> 0.29-0.30 CPU-s, and no array allocated per chunk).
+
+    ``pieces``: ``(first sample, samples, byte offset)`` of each stored piece (the one extent
+    of a contiguous dataset, or every chunk), in sample order.
+    """
+
+    def __init__(self, pieces: list[tuple[int, int, int]]) -> None:
+        self.pieces = pieces
+        self.starts = [p[0] for p in pieces]
+
+    def read(self, fd: int, a: int, out: np.ndarray) -> bool:
+        """Samples ``a : a + out.size`` into ``out`` (contiguous float64); False when the file
+        gave fewer bytes than asked (truncated: the caller lets libhdf5 report it)."""
+        b = a + out.size
+        k = bisect.bisect_right(self.starts, a) - 1
+        mv = memoryview(out).cast("B")
+        at = 0
+        while a < b:
+            start, count, offset = self.pieces[k]
+            m = min(b, start + count) - a
+            want = 8 * m
+            if os.preadv(fd, [mv[at : at + want]], offset + 8 * (a - start)) != want:
+                return False
+            at += want
+            a += m
+            k += 1
+        return True
+
+
+def direct_read(ds: Any, file_size: int) -> DirectRead | None:
+    """The :class:`DirectRead` of dataset ``ds`` when its stored bytes are its values as this
+    machine holds float64 (1-d, ``<f8`` on a little-endian machine, no filter, no external
+    storage, every chunk written and whole, each inside the file, a file without user block);
+    None otherwise (libhdf5 reads it)."""
+    import sys
+
+    h5py = import_h5py()
+    try:
+        if sys.byteorder != "little" or ds.ndim != 1 or ds.dtype.str != "<f8":
+            return None
+        if ds.file.userblock_size != 0:
+            return None
+        dcpl = ds.id.get_create_plist()
+        if dcpl.get_nfilters() != 0 or dcpl.get_external_count() != 0:
+            return None
+        n = int(ds.shape[0])
+        layout = dcpl.get_layout()
+        pieces: list[tuple[int, int, int]] = []
+        if layout == h5py.h5d.CONTIGUOUS:
+            off = ds.id.get_offset()
+            if off is None:
+                return None
+            pieces = [(0, n, int(off))]
+        elif layout == h5py.h5d.CHUNKED and hasattr(ds.id, "chunk_iter"):
+            c = int(ds.chunks[0])
+            infos: list[Any] = []
+            ds.id.chunk_iter(infos.append)
+            for info in infos:
+                if info.filter_mask != 0 or info.byte_offset is None or info.size != 8 * c:
+                    return None
+                start = int(info.chunk_offset[0])
+                pieces.append((start, min(c, n - start), int(info.byte_offset)))
+            pieces.sort()
+            if [p[0] for p in pieces] != list(range(0, n, c)):
+                return None  # chunks never written (fill value): libhdf5 knows
+        else:
+            return None
+    except (AttributeError, TypeError, ValueError, OSError, RuntimeError):
+        return None  # anything unexpected: libhdf5 reads it
+    if any(count <= 0 or off < 0 or off + 8 * count > file_size for _s, count, off in pieces):
+        return None
+    return DirectRead(pieces)

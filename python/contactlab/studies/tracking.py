@@ -395,47 +395,85 @@ def _normal_row(d: dict[str, Any]) -> tuple[dict, dict]:
 
 
 class _Windows:
-    """Pieces of the stream not yet handed to a window, by global sample index."""
+    """The samples of the stream not yet handed to a window, by global sample index, in one
+    array per channel (and ``t``, unless made from the sampling interval) that the reader
+    writes the chunks into (:meth:`~contactlab.io.ChunkedRecording.chunks_into`): a window
+    is a view of it, no copy.
 
-    def __init__(self) -> None:
-        self.pieces: list[Recording] = []
+    Windows cut one after the other share the array until the next might not fit in what is
+    left of it; then a new one is started, sized for a window as long as the last plus a
+    chunk, and the samples already read past the cut (less than a chunk) are copied over. A
+    window that outgrows its array moves to one twice as long (rare: the first window, or one
+    much longer than the last). A time axis made from the sampling interval (``time_step``)
+    is made for each window instead (bit for bit the chunks'), and each chunk's on its own.
+    """
+
+    def __init__(self, first_window: int, time_step: tuple[float, float] | None) -> None:
+        self.arrays: dict[str, np.ndarray] = {}
+        self.cap = 0
+        self.head = 0  # index in the arrays of global sample self.start
+        self.used = 0  # samples of the arrays handed to the reader
         self.start = 0  # global index of the first sample kept
-        self.n = 0
+        self.n = 0  # samples added and not yet in a window
+        self.expect = max(int(first_window), 1)  # samples of the next window, about
+        self.chunk = 0  # longest chunk read
+        self.time_step = time_step
+        self.proto: Recording | None = None
+
+    def _move(self, cap: int, names: list[str]) -> None:
+        rest = self.used - self.head
+        new = {k: np.empty(cap) for k in names}
+        for k, a in self.arrays.items():
+            new[k][:rest] = a[self.head : self.used]
+        self.arrays, self.cap, self.head, self.used = new, cap, 0, rest
+
+    def alloc(self, m: int, names: list[str]) -> dict[str, np.ndarray]:
+        """Room for the next chunk of ``m`` samples (``read_chunks``' ``alloc``)."""
+        self.chunk = max(self.chunk, m)
+        kept = [k for k in names if not (k == "t" and self.time_step is not None)]
+        if self.arrays and list(self.arrays) != kept:
+            raise InputError(f"the chunks' channels changed: {list(self.arrays)} -> {kept}")
+        if self.used + m > self.cap:
+            open_part = self.used - self.head
+            self._move(max(self.expect + self.chunk, 2 * open_part + m), kept)
+        a = self.used
+        self.used += m
+        out = {k: v[a : self.used] for k, v in self.arrays.items()}
+        if "t" not in out:
+            out["t"] = np.empty(m)
+        return out
 
     def add(self, rec: Recording) -> None:
-        self.pieces.append(rec)
+        """The next ``len(rec)`` samples (written where :meth:`alloc` said) are read."""
+        if self.proto is None:
+            self.proto = rec
         self.n += len(rec)
 
     def take(self, stop: int) -> Recording:
-        """Samples ``[start, stop)`` as one recording; they are dropped from the buffer.
+        """Samples ``[start, stop)`` as one recording (views); they leave the buffer."""
+        from .. import _core
 
-        Only the window's pieces are copied (joined); the rest of a split piece stays a view,
-        so cutting many short windows out of one long block costs no more than the block.
-        """
-        need = stop - self.start
-        parts: list[Recording] = []
-        while need > 0:
-            p = self.pieces[0]
-            if len(p) <= need:
-                parts.append(self.pieces.pop(0))
-                need -= len(p)
-            else:
-                parts.append(_part(p, 0, need))
-                self.pieces[0] = _part(p, need, len(p))
-                need = 0
-        rec = _join(parts)
-        self.n -= stop - self.start
-        self.start = stop
-        return Recording(
-            rec.t, rec.data, rec.units, rec.source, dict(rec.meta, offset=stop - len(rec))
-        )
-
-
-def _part(rec: Recording, a: int, b: int) -> Recording:
-    """Samples ``a:b`` of ``rec`` as views (no copy)."""
-    off = int(rec.meta.get("offset", 0))
-    data = {c: v[a:b] for c, v in rec.data.items()}
-    return Recording(rec.t[a:b], data, rec.units, rec.source, dict(rec.meta, offset=off + a))
+        assert self.proto is not None
+        k = stop - self.start
+        a, b = self.head, self.head + k
+        if self.time_step is None:
+            t = self.arrays["t"][a:b]
+        else:
+            t = np.empty(k)
+            _core.fill_time(t, self.time_step[0], self.time_step[1], self.start)
+        data = {c: v[a:b] for c, v in self.arrays.items() if c != "t"}
+        p = self.proto
+        rec = Recording(t, data, p.units, p.source, dict(p.meta, offset=self.start))
+        self.head, self.start, self.n = b, stop, self.n - k
+        self.expect = k + k // 64  # the next window's length, and some
+        # room for the next window up to the end of the chunk it ends in (chunks start at
+        # multiples of the chunk length): the chunk may run past the window's end
+        c = max(self.chunk, 1)
+        end = -(-(stop + max(self.expect, 4 * c)) // c) * c
+        room = end - stop
+        if self.head + room > self.cap:
+            self._move(max(room, self.used - self.head + c), list(self.arrays))
+        return rec
 
 
 def _blocks(
@@ -620,7 +658,12 @@ def _track(
     }
     rows: list[dict[str, Any]] = []
     units: dict[str, str] = {"t_start": "s", "t_end": "s", "t_mid": "s"}
-    buf = _Windows()
+    # the first window's array: sized for an "auto" window (or a chunk; it grows), at most
+    # the recording
+    first = AUTO_WINDOW if mode == "auto" else chunk_size
+    buf = _Windows(
+        first if cr.n_samples is None else max(min(first, cr.n_samples), 1), cr.time_step
+    )
     n_cross = 0  # crossings so far
     cycles_at_start = 0  # complete cycles before the current window
     next_cross_target = int(size) if mode == "cycles" else None
@@ -677,7 +720,7 @@ def _track(
             collect(*in_flight.popleft())
 
     try:
-        for block, ranges in _blocks(iter(cr), MIN_BLOCK):
+        for block, ranges in _blocks(cr.chunks_into(buf.alloc), MIN_BLOCK):
             off = int(block.meta.get("offset", n_total))
             buf.add(block)
             n_total = off + len(block)
