@@ -89,6 +89,23 @@ class CycleTracker:
         self, t: _F, x: _F, f: _F, drive: _F, offset: int, low: float, high: float
     ) -> dict[str, np.ndarray]: ...
 
+class CycleStream:
+    def __new__(cls) -> CycleStream: ...
+    def push(
+        self, t: _F, x: _F, f: _F, drive: _F, offset: int, low: float, high: float
+    ) -> dict[str, np.ndarray]: ...
+    def push_sampled(
+        self,
+        t0: float,
+        dt: float,
+        x: _F,
+        f: _F,
+        drive: _F,
+        offset: int,
+        low: float,
+        high: float,
+    ) -> dict[str, np.ndarray]: ...
+
 def branch_memory(x: _F) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]: ...
 def force_many(
     models: list[MasingCore],

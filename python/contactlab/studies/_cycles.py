@@ -10,8 +10,10 @@ follow a slowly drifting or shrinking amplitude.
 Per cycle: the loop energy ∮ F dx (trapezoids, closed by the chord from the cycle's last
 sample back to its first, i.e. the area of the polygon of the samples, as
 :func:`contactlab.loop_area` computes it), the displacement amplitude (half its range) and
-the force offset (centre of its range). One pass per block in Rust (``_core.CycleTracker``, GIL
-released); the state carried between blocks is a few scalars.
+the force offset (centre of its range). One pass per block in Rust (``_core.CycleStream``, GIL
+released; x and F checked finite in the same pass); the state carried between blocks is a few
+scalars. A recording sampled at a fixed interval needs no time array: the times of the
+crossings are computed (``time_step``).
 """
 
 from __future__ import annotations
@@ -33,7 +35,7 @@ class CycleState:
     crossing, ∮ F dx and extrema since it, the previous sample), kept in the Rust tracker."""
 
     def __init__(self) -> None:
-        self.tracker = _core.CycleTracker()
+        self.tracker = _core.CycleStream()
 
 
 @dataclass
@@ -63,20 +65,27 @@ def block_cycles(
     offset: int,
     s: CycleState,
     levels: tuple[float, float] | None = None,
+    time_step: tuple[float, float] | None = None,
 ) -> Cycles:
     """Crossings of ``drive`` and the cycles they complete in one block; updates ``s``.
 
     ``x``/``F`` are the loop's abscissa and ordinate (``x, F`` or ``delta, p``), ``drive`` the
     channel whose crossings mark the cycles, ``offset`` the global index of the block's first
     sample. ``levels = (low, high)`` fixes the trigger band (default: :func:`trigger_levels`
-    of the drive's range in the block).
+    of the drive's range in the block). ``time_step = (t0, dt)``: the recording is sampled
+    every ``dt`` from ``t0`` (sample ``i`` at ``t0 + dt * i``, bit for bit
+    ``contactlab._core.fill_time``) and ``t`` is not read.
     """
     if levels is None:
         lo_d, hi_d = (float(drive.min()), float(drive.max())) if drive.size else (0.0, 0.0)
         low, high = trigger_levels(lo_d, hi_d)
     else:
         low, high = float(levels[0]), float(levels[1])
-    d = s.tracker.push(t, x, F, drive, int(offset), low, high)
+    if time_step is None:
+        d = s.tracker.push(t, x, F, drive, int(offset), low, high)
+    else:
+        t0, dt = time_step
+        d = s.tracker.push_sampled(float(t0), float(dt), x, F, drive, int(offset), low, high)
     return Cycles(
         crossings=d["crossings"],
         start=d["start"],

@@ -726,8 +726,9 @@ def _track(
             n_total = off + len(block)
             levels = trigger_levels(*ranges[drive]) if ranges and len(block) else None
             got = block_cycles(
-                block.t, block[loop_x], block[loop_F], block[drive], off, state, levels
-            )
+                block.t, block[loop_x], block[loop_F], block[drive], off, state, levels,
+                cr.time_step,
+            )  # fmt: skip
             for k in cyc:
                 cyc[k].append(np.asarray(getattr(got, k), dtype=float))
             if window_t0 is None:

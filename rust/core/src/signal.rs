@@ -735,8 +735,7 @@ fn next_crossing(drive: &[f64], from: usize, low: f64, high: f64, level: &mut i8
 /// cycles they complete, in one pass over a block starting at global index `offset`; `state`
 /// carries everything across blocks, so any chunking gives the same cycles. A band with
 /// `high <= low` (a constant block) finds no crossing. On error `state` is unchanged.
-// Index arithmetic: i < n (the block length) throughout.
-#[allow(clippy::arithmetic_side_effects, clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments)]
 pub fn cycle_block(
     t: &[f64],
     x: &[f64],
@@ -747,28 +746,99 @@ pub fn cycle_block(
     high: f64,
     state: &mut CycleState,
 ) -> Result<BlockCycles, CoreError> {
+    check_same_len("t", t.len(), "x", x.len())?;
+    check_same_len("x", x.len(), "F", f.len())?;
+    check_same_len("x", x.len(), "drive", drive.len())?;
+    check_finite("t", t)?;
+    cycle_block_with(|c| t[c], x, f, drive, offset, (low, high), state)
+}
+
+/// [`cycle_block`] of a recording sampled every `dt` from `t0`, without a time array: block
+/// sample `i` is at `t0 + dt * (offset + i)`, bit for bit [`crate::stream::fill_time`]'s
+/// (and numpy's `t0 + dt * arange`). The same cycles as [`cycle_block`] given that time
+/// axis.
+#[allow(clippy::too_many_arguments)]
+pub fn cycle_block_sampled(
+    t0: f64,
+    dt: f64,
+    x: &[f64],
+    f: &[f64],
+    drive: &[f64],
+    offset: u64,
+    low: f64,
+    high: f64,
+    state: &mut CycleState,
+) -> Result<BlockCycles, CoreError> {
+    for (name, value) in [("t0", t0), ("dt", dt)] {
+        if !value.is_finite() {
+            return Err(CoreError::InvalidParameter {
+                name,
+                value,
+                reason: "the time axis' start and step must be finite",
+            });
+        }
+    }
+    u64::try_from(x.len())
+        .ok()
+        .and_then(|k| offset.checked_add(k))
+        .filter(|&end| end <= 1 << 53)
+        .ok_or(CoreError::TooLong { len: x.len() })?;
+    // exact: offset + c < 2^53
+    #[allow(clippy::cast_precision_loss, clippy::arithmetic_side_effects)]
+    let time = |c: usize| t0 + dt * ((offset + c as u64) as f64);
+    cycle_block_with(time, x, f, drive, offset, (low, high), state)
+}
+
+/// The first of the checks of `x`, `F` and `drive` that fails, in that order (what a block
+/// with a non-finite sample reports), else `other`.
+fn first_non_finite(x: &[f64], f: &[f64], drive: &[f64], other: CoreError) -> CoreError {
+    check_finite("x", x)
+        .and_then(|()| check_finite("F", f))
+        .and_then(|()| check_finite("drive", drive))
+        .err()
+        .unwrap_or(other)
+}
+
+/// [`cycle_block`] with the time of block sample `c` from `time(c)` (read at crossings only).
+/// `x` and `F` are checked finite in the pass itself (the pass is bound by the chain of
+/// additions of `∮ F dx`, and the test costs nothing beside it); a block with a non-finite
+/// sample reports the first as the separate checks would, and leaves `state` unchanged.
+// Index arithmetic: i < n (the block length) throughout.
+#[allow(clippy::arithmetic_side_effects, clippy::too_many_lines)]
+fn cycle_block_with(
+    time: impl Fn(usize) -> f64,
+    x: &[f64],
+    f: &[f64],
+    drive: &[f64],
+    offset: u64,
+    (low, high): (f64, f64),
+    state: &mut CycleState,
+) -> Result<BlockCycles, CoreError> {
     let n = x.len();
-    check_same_len("t", t.len(), "x", n)?;
     check_same_len("x", n, "F", f.len())?;
     check_same_len("x", n, "drive", drive.len())?;
-    check_finite("t", t)?;
-    check_finite("x", x)?;
-    check_finite("F", f)?;
+    // the errors in the order of the separate checks: x, F, drive, then the parameters
     if !std::ptr::eq(drive, x) {
-        // a tangential stream's drive is its x: checked once
-        check_finite("drive", drive)?;
+        // a tangential stream's drive is its x: checked in the pass
+        if let Err(e) = check_finite("drive", drive) {
+            return Err(first_non_finite(x, f, drive, e));
+        }
     }
     if !(low.is_finite() && high.is_finite()) {
-        return Err(CoreError::InvalidParameter {
+        let e = CoreError::InvalidParameter {
             name: "levels",
             value: if low.is_finite() { high } else { low },
             reason: "trigger levels must be finite",
-        });
+        };
+        return Err(first_non_finite(x, f, drive, e));
     }
-    u64::try_from(n)
+    if u64::try_from(n)
         .ok()
         .and_then(|k| offset.checked_add(k))
-        .ok_or(CoreError::TooLong { len: n })?;
+        .is_none()
+    {
+        return Err(first_non_finite(x, f, drive, CoreError::TooLong { len: n }));
+    }
     let mut out = BlockCycles::default();
     if n == 0 {
         return Ok(out);
@@ -780,6 +850,8 @@ pub fn cycle_block(
     let (mut xp, mut fp) = (s.x_prev, s.f_prev);
     let (mut xmax, mut xmin, mut fmax, mut fmin) = (s.x_max, s.x_min, s.f_max, s.f_min);
     let mut i = 0;
+    // every sample of x and F finite (the pass visits each once)
+    let mut finite = true;
     while i < n {
         // the next crossing (the trigger level follows the drive up to it), then the samples
         // before it in one tight pass: the trapezoids in the same order as one sample at a
@@ -792,6 +864,7 @@ pub fn cycle_block(
         let mut j = i;
         if j < c && !xp.is_finite() {
             // the record's first sample: no trapezoid before it
+            finite &= x[j].is_finite() & f[j].is_finite();
             (xmax, xmin, fmax, fmin) = (
                 xmax.max(x[j]),
                 xmin.min(x[j]),
@@ -802,6 +875,7 @@ pub fn cycle_block(
             j += 1;
         }
         for (&xi, &fi) in x[j..c].iter().zip(&f[j..c]) {
+            finite &= xi.is_finite() & fi.is_finite();
             cum += 0.5 * (fi + fp) * (xi - xp);
             // compare-and-select (finite samples, checked above): f64::max/min's NaN rules
             // cost a compare, a blend and a dependency each on a generic x86-64 build
@@ -818,6 +892,7 @@ pub fn cycle_block(
         // a crossing at c: the cycle since the previous one ends here (its extrema exclude
         // this sample, which starts the next cycle)
         let (xi, fi) = (x[c], f[c]);
+        finite &= xi.is_finite() & fi.is_finite();
         if xp.is_finite() {
             cum += 0.5 * (fi + fp) * (xi - xp);
         }
@@ -825,7 +900,7 @@ pub fn cycle_block(
         if s.have_crossing {
             let energy = cum + 0.5 * (fi + s.f_cross) * (s.x_cross - xi);
             out.start.push(s.t_cross);
-            out.end.push(t[c]);
+            out.end.push(time(c));
             out.energy.push(energy);
             out.amplitude.push(0.5 * (xmax - xmin));
             out.offset.push(0.5 * (fmax + fmin));
@@ -833,12 +908,18 @@ pub fn cycle_block(
         s.have_crossing = true;
         s.x_cross = xi;
         s.f_cross = fi;
-        s.t_cross = t[c];
+        s.t_cross = time(c);
         cum = 0.0;
         (xmax, xmin, fmax, fmin) = (xi, xi, fi, fi);
         xp = xi;
         fp = fi;
         i = c + 1;
+    }
+    if !finite {
+        let e = CoreError::InvalidState {
+            reason: "a non-finite sample was seen but not found again",
+        };
+        return Err(first_non_finite(x, f, drive, e));
     }
     if !can_cross {
         // no crossing possible (high <= low): the level is the block's last mark
@@ -1264,6 +1345,73 @@ mod tests {
         assert!(cycle_block(&[0.0], &[f64::NAN], &[0.0], &[0.0], 0, -1.0, 1.0, &mut st).is_err());
         assert!(cycle_block(&[0.0], &[0.0], &[0.0], &[0.0], u64::MAX, -1.0, 1.0, &mut st).is_err());
         assert_eq!(st, before);
+    }
+
+    #[test]
+    fn sampled_cycle_block_equals_the_stamped_one_bit_for_bit() {
+        let n = 5000_usize;
+        let (t0, dt) = (0.125, 1.0 / 3000.0);
+        let mut t = vec![0.0; n];
+        crate::stream::fill_time(&mut t, t0, dt, 0).unwrap();
+        let x: Vec<f64> = t
+            .iter()
+            .map(|&s| (s * 41.0).sin() + 0.07 * (s * 2917.0).sin())
+            .collect();
+        let f: Vec<f64> = t.iter().map(|&s| (s * 41.0 + 0.3).cos() - 0.1).collect();
+        for cuts in [vec![], vec![1_usize, 2], vec![777, 3001], vec![4999]] {
+            let (mut sa, mut sb) = (CycleState::default(), CycleState::default());
+            let mut a = 0;
+            for &b in cuts.iter().chain(std::iter::once(&n)) {
+                let r = a..b;
+                let (xs, fs) = (&x[r.clone()], &f[r.clone()]);
+                let one = cycle_block(&t[r], xs, fs, xs, a as u64, -0.3, 0.3, &mut sa).unwrap();
+                let two =
+                    cycle_block_sampled(t0, dt, xs, fs, xs, a as u64, -0.3, 0.3, &mut sb).unwrap();
+                assert_eq!(one, two);
+                assert_eq!(sa, sb);
+                a = b;
+            }
+        }
+        let mut st = CycleState::default();
+        assert!(cycle_block_sampled(f64::NAN, dt, &x, &f, &x, 0, -1.0, 1.0, &mut st).is_err());
+        assert!(cycle_block_sampled(t0, dt, &x, &f, &x, 1 << 53, -1.0, 1.0, &mut st).is_err());
+    }
+
+    #[test]
+    fn cycle_block_reports_the_first_non_finite_sample_as_the_separate_checks() {
+        let n = 300;
+        let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-2).collect();
+        let x: Vec<f64> = t.iter().map(|&s| (s * 9.0).sin()).collect();
+        let f: Vec<f64> = t.iter().map(|&s| (s * 9.0).cos()).collect();
+        for (xi, fi, p) in [
+            (Some(5), None, 0),
+            (Some(250), Some(3), 0),
+            (None, Some(299), 1),
+        ] {
+            for levels in [(-0.5, 0.5), (f64::NAN, 0.5)] {
+                let (mut xb, mut fb) = (x.clone(), f.clone());
+                if let Some(i) = xi {
+                    xb[i] = f64::INFINITY;
+                }
+                if let Some(i) = fi {
+                    fb[i] = f64::NAN;
+                }
+                let mut st = CycleState::default();
+                let before = st;
+                let e = cycle_block(&t, &xb, &fb, &xb, 0, levels.0, levels.1, &mut st);
+                let want = if p == 0 {
+                    check_finite("x", &xb).unwrap_err()
+                } else {
+                    check_finite("F", &fb).unwrap_err()
+                };
+                // NaN fields compare as text
+                assert_eq!(format!("{:?}", e.unwrap_err()), format!("{want:?}"));
+                assert_eq!(format!("{st:?}"), format!("{before:?}"));
+                // a separate drive (normal recordings): x, then F, then the drive
+                let e = cycle_block(&t, &xb, &fb, &fb, 0, levels.0, levels.1, &mut st);
+                assert_eq!(format!("{:?}", e.unwrap_err()), format!("{want:?}"));
+            }
+        }
     }
 
     #[test]
