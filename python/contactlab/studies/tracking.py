@@ -465,7 +465,7 @@ class _Windows:
         p = self.proto
         rec = Recording(t, data, p.units, p.source, dict(p.meta, offset=self.start))
         self.head, self.start, self.n = b, stop, self.n - k
-        self.expect = k + k // 64  # the next window's length, and some
+        self.expect = k + k // 256  # the next window's length, and some
         # room for the next window up to the end of the chunk it ends in (chunks start at
         # multiples of the chunk length): the chunk may run past the window's end
         c = max(self.chunk, 1)
