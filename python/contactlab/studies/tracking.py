@@ -418,7 +418,7 @@ class _Windows:
         self.expect = max(int(first_window), 1)  # samples of the next window, about
         self.chunk = 0  # longest chunk read
         self.time_step = time_step
-        self.proto: Recording | None = None
+        self.proto: tuple[dict[str, str], str, dict[str, Any]] | None = None
 
     def _move(self, cap: int, names: list[str]) -> None:
         rest = self.used - self.head
@@ -445,8 +445,9 @@ class _Windows:
 
     def add(self, rec: Recording) -> None:
         """The next ``len(rec)`` samples (written where :meth:`alloc` said) are read."""
-        if self.proto is None:
-            self.proto = rec
+        if self.proto is None:  # what the windows inherit (not the arrays: they would
+            # keep the first window's array alive to the end)
+            self.proto = (rec.units, rec.source, rec.meta)
         self.n += len(rec)
 
     def take(self, stop: int) -> Recording:
@@ -462,8 +463,8 @@ class _Windows:
             t = np.empty(k)
             _core.fill_time(t, self.time_step[0], self.time_step[1], self.start)
         data = {c: v[a:b] for c, v in self.arrays.items() if c != "t"}
-        p = self.proto
-        rec = Recording(t, data, p.units, p.source, dict(p.meta, offset=self.start))
+        units, source, meta = self.proto
+        rec = Recording(t, data, dict(units), source, dict(meta, offset=self.start))
         self.head, self.start, self.n = b, stop, self.n - k
         self.expect = k + k // 256  # the next window's length, and some
         # room for the next window up to the end of the chunk it ends in (chunks start at
