@@ -89,6 +89,7 @@ class CycleTracker:
         self, t: _F, x: _F, f: _F, drive: _F, offset: int, low: float, high: float
     ) -> dict[str, np.ndarray]: ...
 
+@final
 class CycleStream:
     def __new__(cls) -> CycleStream: ...
     def push(
