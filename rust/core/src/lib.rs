@@ -31,6 +31,7 @@ pub mod masing;
 pub mod normal;
 pub mod parallel;
 pub mod scan;
+pub mod select;
 pub mod signal;
 pub mod structure;
 pub mod window;
