@@ -660,6 +660,19 @@ pub fn period_means_pair(
             });
         }
     }
+    Ok(period_means_pair_checked(t, f, x, edges))
+}
+
+/// [`period_means_pair`] of checked samples: `t` finite, strictly increasing and at least
+/// two samples, `f` and `x` as long, `edges` finite and non-decreasing (the callers' checks).
+// Index arithmetic: j + 1 < n where j + 1 is taken (trapezoids_until stops there).
+#[allow(clippy::arithmetic_side_effects)]
+pub(crate) fn period_means_pair_checked(
+    t: &[f64],
+    f: &[f64],
+    x: &[f64],
+    edges: &[f64],
+) -> (Vec<f64>, Vec<f64>) {
     let n = t.len();
     let mut ce_f = Vec::with_capacity(edges.len());
     let mut ce_x = Vec::with_capacity(edges.len());
@@ -688,7 +701,7 @@ pub fn period_means_pair(
             .map(|(c, e)| (c[1] - c[0]) / (e[1] - e[0]))
             .collect()
     };
-    Ok((means(&ce_f), means(&ce_x)))
+    (means(&ce_f), means(&ce_x))
 }
 
 /// [`period_means_pair`]'s cumulative trapezoid integrals `(cf, cx)` of `F` and `x` carried
