@@ -257,24 +257,50 @@ fn check_edges(edges: &[f64]) -> Result<(), CoreError> {
     Ok(())
 }
 
-/// [`check_samples`]' checks and numbers in one pass over the samples (the same maxima, and
+/// Whether every value of `v` is finite, and the largest `|v|` (0 for none): four lanes of
+/// compare-selects (`f64::max`'s NaN handling kept the loop scalar).
+// Index arithmetic: k < 4.
+#[allow(clippy::arithmetic_side_effects)]
+fn finite_max_abs(v: &[f64]) -> (bool, f64) {
+    let mut m = [0.0_f64; 4];
+    let mut ok = [true; 4];
+    let mut chunks = v.chunks_exact(4);
+    for c in &mut chunks {
+        for k in 0..4 {
+            let a = c[k].abs();
+            m[k] = if a > m[k] { a } else { m[k] };
+            ok[k] &= c[k].is_finite();
+        }
+    }
+    for (k, &x) in chunks.remainder().iter().enumerate() {
+        let a = x.abs();
+        m[k] = if a > m[k] { a } else { m[k] };
+        ok[k] &= x.is_finite();
+    }
+    let big = m.iter().fold(0.0_f64, |a, &b| if b > a { b } else { a });
+    (ok.iter().all(|&o| o), big)
+}
+
+/// [`check_samples`'] checks and numbers in a vectorised pass a channel (the same maxima, and
 /// the mean of `F / sf` summed in the same order once `sf` is known: a second pass over F
 /// only); None when a check fails (the separate checks then name the first failure).
-#[allow(clippy::arithmetic_side_effects)]
+// bitwise ands: no early exit, so the loop over t vectorises
+#[allow(clippy::arithmetic_side_effects, clippy::needless_bitwise_bool)]
 fn clean_samples(t: &[f64], x: &[f64], f: &[f64]) -> Option<[f64; 3]> {
     if t.len() < 2 {
         return None;
     }
-    let (mut sx, mut sf) = (0.0_f64, 0.0_f64);
-    let mut ok = true;
-    let mut prev = f64::NEG_INFINITY;
-    for ((&ti, &xi), &fi) in t.iter().zip(x).zip(f) {
-        // finite and strictly increasing t; finite x, F (NaN fails every comparison)
-        ok &= ti > prev && ti.is_finite() && xi.is_finite() && fi.is_finite();
-        prev = ti;
-        sx = sx.max(xi.abs());
-        sf = sf.max(fi.abs());
-    }
+    // finite and strictly increasing t (NaN fails every comparison); finite x, F and their
+    // largest magnitudes: a pass a channel, each vectorised (the largest of magnitudes is
+    // the same number in any order)
+    let ok = t[0].is_finite()
+        && t[..t.len() - 1]
+            .iter()
+            .zip(&t[1..])
+            .fold(true, |o, (&a, &b)| o & (b > a) & b.is_finite());
+    let (ok_x, sx) = finite_max_abs(x);
+    let (ok_f, sf) = finite_max_abs(f);
+    let ok = ok && ok_x && ok_f;
     if !ok {
         return None;
     }
