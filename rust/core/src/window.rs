@@ -281,7 +281,7 @@ fn finite_max_abs(v: &[f64]) -> (bool, f64) {
     (ok.iter().all(|&o| o), big)
 }
 
-/// [`check_samples`'] checks and numbers in a vectorised pass a channel (the same maxima, and
+/// [`check_samples`]' checks and numbers in a vectorised pass a channel (the same maxima, and
 /// the mean of `F / sf` summed in the same order once `sf` is known: a second pass over F
 /// only); None when a check fails (the separate checks then name the first failure).
 // bitwise ands: no early exit, so the loop over t vectorises
