@@ -230,3 +230,30 @@ def test_tail_percentiles_are_numpys(n, kind, seed):
     ref = np.percentile(x, [0.5, 99.5])
     got = tail_percentiles(x)
     np.testing.assert_allclose(got, ref, rtol=0, atol=4 * np.spacing(np.max(np.abs(x))))
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    n=st.integers(1, 1 << 17),
+    kind=st.sampled_from(["noise", "ties", "spikes", "signed-zeros"]),
+    seed=st.integers(0, 2**16),
+    fr=st.lists(st.floats(0, 1), min_size=1, max_size=5),
+)
+def test_order_stats_are_a_sorts(n, kind, seed, fr):
+    """The Rust selection behind tail_percentiles: the values of a sort, exactly, for the
+    ranks next to both ends (0.5 % and 99.5 %: from the tails) and anywhere else."""
+    from contactlab import _core
+
+    rng = np.random.default_rng(seed)
+    x = {
+        "noise": lambda: rng.standard_normal(n),
+        "ties": lambda: np.round(rng.standard_normal(n), 1),
+        "spikes": lambda: np.where(rng.random(n) < 0.02, 1e6, rng.standard_normal(n)),
+        "signed-zeros": lambda: np.round(rng.standard_normal(n)) * 0.0,
+    }[kind]()
+    ranks = [0, n // 200, min(n // 200 + 1, n - 1), n - 1 - n // 200, n - 1]
+    ranks += [int(f * (n - 1)) for f in fr]
+    got = _core.order_stats(x, ranks)
+    assert np.array_equal(got, np.sort(x)[ranks])
+    with pytest.raises(InputError):
+        _core.order_stats(x, [n])

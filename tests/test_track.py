@@ -328,6 +328,30 @@ def test_window_analysis_force_sign_given_or_undecided():
     assert got["orientation_reason"] == ref["orientation_reason"]
 
 
+@pytest.mark.parametrize(
+    ("channel", "index", "value", "message"),
+    [
+        ("x", 500, np.nan, r"x\[500\] is not finite"),
+        ("F", 700, np.inf, r"F\[700\] is not finite"),
+        ("t", 900, np.nan, r"t\[900\] is not finite"),
+        ("t", 901, "dup", r"t\[901\] .* does not exceed"),
+        ("x", 5, 1e200, "x reaches 1e\\+200 m at sample 5"),
+    ],
+)
+def test_window_analysis_names_a_bad_sample(channel, index, value, message):
+    """The window path scans x and F once (check_channel) and skips the conversions' second
+    scan: a bad sample is still named (the messages the window path gave before)."""
+    from contactlab.tangential.analysis import analyze_window
+
+    rec = synthetic_recording(**_WINDOW_CASES["drifts"])
+    t, x, F = rec.t.copy(), rec["x"].copy(), rec["F"].copy()
+    a = {"t": t, "x": x, "F": F}[channel]
+    a[index] = a[index - 1] if value == "dup" else value
+    bad = Recording(t, {"x": x, "F": F}, rec.units, rec.source, {})
+    with pytest.raises(InputError, match=message):
+        analyze_window(bad)
+
+
 @settings(max_examples=40, deadline=None)
 @given(seed=st.integers(0, 10_000), n=st.integers(2, 400), k=st.integers(2, 12))
 def test_period_means_is_numpy_cumsum_interp(seed, n, k):

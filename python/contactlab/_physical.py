@@ -19,10 +19,12 @@ MAX_MAGNITUDE = 1e100
 MIN_MAGNITUDE = 1e-100
 
 
-def check_channel(name: str, v: np.ndarray, unit: str, what: str) -> None:
+def check_channel(name: str, v: np.ndarray, unit: str, what: str) -> bool:
     """Refuse a channel that is out of any physical scale, zero throughout, or constant.
 
-    ``what`` names the sensor in the sentence (e.g. "force").
+    ``what`` names the sensor in the sentence (e.g. "force"). Returns whether every sample
+    is finite (the scan the checks made; a NaN or inf is not refused here, the caller's
+    conversion names it), so a caller need not scan the channel again.
 
     Examples
     --------
@@ -32,7 +34,7 @@ def check_channel(name: str, v: np.ndarray, unit: str, what: str) -> None:
     contactlab.errors.InputError: F is constant (3 N in all 5 samples): ...
     """
     v = np.asarray(v, dtype=np.float64)
-    _finite, lo, hi = scan(v)  # the largest magnitude is max(-min, max)
+    finite, lo, hi = scan(v)  # the largest magnitude is max(-min, max)
     big = max(-lo, hi) if v.size else 0.0
     if big > MAX_MAGNITUDE:
         i = int(np.argmax(np.abs(v)))
@@ -51,6 +53,7 @@ def check_channel(name: str, v: np.ndarray, unit: str, what: str) -> None:
             f"{name} is constant ({float(v[0]):.6g} {unit} in all {v.size} samples): the "
             f"{what} sensor recorded no change, so there is no loop to analyse"
         )
+    return finite
 
 
 __all__ = ["MAX_MAGNITUDE", "MIN_MAGNITUDE", "check_channel"]

@@ -538,8 +538,8 @@ def analyze_window(
     """
     xa, Fa, ta, source = _inputs(recording, None, None, None)
     _check_options("averaged", "steady", n_points)
-    check_channel("x", xa, "m", "displacement")
-    check_channel("F", Fa, "N", "force")
+    finite_x = check_channel("x", xa, "m", "displacement")
+    finite_f = check_channel("F", Fa, "N", "force")
     opts: dict[str, Any] = {
         "n_points": n_points,
         "rel_threshold": rel_threshold,
@@ -551,7 +551,9 @@ def analyze_window(
         "detrend": detrend,
         "initial": initial,
     }
-    pre = _window_detrended(xa, Fa, ta, opts)
+    # (a recording's channels are contiguous float64 arrays unless replaced since)
+    plain = all(a.dtype == np.float64 and a.ndim == 1 and a.flags.c_contiguous for a in (xa, Fa))
+    pre = _window_detrended(xa, Fa, ta, opts, checked=finite_x and finite_f and plain)
     ori = _fast_orientation(pre.x, pre.F, pre.loop, force_sign)
     res = None
     if ori is not None:
@@ -565,16 +567,26 @@ def analyze_window(
 
 
 def _window_detrended(
-    xa: np.ndarray, Fa: np.ndarray, ta: np.ndarray | None, opts: dict[str, Any]
+    xa: np.ndarray,
+    Fa: np.ndarray,
+    ta: np.ndarray | None,
+    opts: dict[str, Any],
+    checked: bool = False,
 ) -> steps.Detrended:
     """:func:`steps.detrend` of the window with one fold instead of two: the linear drifts
     come from the period means between the raw displacement's peaks (what the first fold's
     per-cycle means are: the same Rust kernel on the same edges), so the samples are
-    detrended before the only fold. The same numbers as :func:`steps.detrend`."""
+    detrended before the only fold. The same numbers as :func:`steps.detrend`. ``checked``:
+    x and F (a recording's float64 channels) were scanned finite by :func:`check_channel`,
+    so only t is checked here (else x, t and F are, naming a non-finite sample)."""
     n_points, rel = opts["n_points"], opts["rel_threshold"]
     min_cycles = opts["min_cycles"]
-    rev = find_reversals(xa, ta, rel_threshold=rel)  # checks x and t
-    Fa = as_1d(Fa, "F")
+    if checked:
+        tc = None if ta is None else as_1d(ta, "t")
+        rev = find_reversals(xa, tc, rel_threshold=rel, checked=True)
+    else:
+        rev = find_reversals(xa, ta, rel_threshold=rel)  # checks x and t
+        Fa = as_1d(Fa, "F")
     if not (opts["detrend"] and rev.peaks.size - 1 >= 3):
         loop = average_loop(xa, Fa, ta, n_points=n_points, rel_threshold=rel,
                             min_cycles=min_cycles, checked=True)  # fmt: skip

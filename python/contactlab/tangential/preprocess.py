@@ -82,33 +82,24 @@ _TAIL_SELECT_ABOVE = 1 << 15
 
 
 def tail_percentiles(x: np.ndarray, q: float = 0.5) -> tuple[float, float]:
-    """The ``q`` and ``100 - q`` percentiles of ``x`` (the numbers of ``np.percentile``, its
-    linear method) without partitioning all of ``x``: the order statistics they interpolate
-    are selected from the samples beyond a subsample's ``4q`` percentiles (two vectorised
-    passes). Falls back to ``np.percentile`` when a tail holds too few samples (or for short
-    ``x``)."""
+    """The ``q`` and ``100 - q`` percentiles of ``x`` (finite; the numbers of
+    ``np.percentile``, its linear method) without partitioning all of ``x``: the order
+    statistics they interpolate come from :func:`contactlab._core.order_stats`, which selects
+    them from the samples beyond a subsample's thresholds (one pass in Rust, where numpy's
+    selection took a partition of a subsample and two boolean masks of ``x``). numpy's
+    interpolation of them is kept as it is; ``np.percentile`` itself for short ``x``."""
     n = x.size
-    if n <= _TAIL_SELECT_ABOVE:
-        lo, hi = np.percentile(x, [q, 100.0 - q])
-        return float(lo), float(hi)
     qq = np.array([q, 100.0 - q]) / 100.0
     vi = (n - 1) * qq  # numpy's virtual index of the linear method
     i0 = np.floor(vi).astype(np.int64)
     g = vi - i0
-    sub = x[::16]
-    k = int(np.clip(round(4 * q / 100.0 * (sub.size - 1)), 0, sub.size - 1))
-    part = np.partition(sub, [k, sub.size - 1 - k])
-    low = x[x <= part[k]]
-    high = x[x >= part[sub.size - 1 - k]]
-    n_hi0 = n - high.size  # rank of high's smallest value in x
-    if not (i0[0] + 1 < low.size and i0[1] >= n_hi0 and i0[1] + 1 < n):
+    if n <= _TAIL_SELECT_ABOVE or not (0 <= i0[0] and i0[1] + 1 < n):
         lo, hi = np.percentile(x, [q, 100.0 - q])
         return float(lo), float(hi)
-    a_lo = np.partition(low, [i0[0], i0[0] + 1])[[i0[0], i0[0] + 1]]
-    j = i0[1] - n_hi0
-    a_hi = np.partition(high, [j, j + 1])[[j, j + 1]]
+    ranks = [int(i0[0]), int(i0[0]) + 1, int(i0[1]), int(i0[1]) + 1]
+    v = _core.order_stats(np.ascontiguousarray(x, dtype=float), ranks)
     out = []
-    for (a, b), t in zip((a_lo, a_hi), g, strict=True):
+    for a, b, t in ((v[0], v[1], g[0]), (v[2], v[3], g[1])):
         d = b - a
         out.append(float(b - d * (1.0 - t) if t >= 0.5 else a + d * t))  # numpy's _lerp
     return out[0], out[1]

@@ -32,6 +32,7 @@ pub mod masing;
 pub mod normal;
 pub mod parallel;
 pub mod scan;
+pub mod select;
 pub mod signal;
 pub mod stream;
 pub mod structure;

@@ -3,12 +3,13 @@
 //! [`fold_window`] folds the window's samples into phase bins (the cycle averaging) and, in
 //! the same pass over the samples (one release of the Python lock), derives everything else
 //! the analysis needs of them: the cycle bounds; each cycle's loop area `∮ F dx` and the
-//! area's noise sensitivities; the period means of `F` and `x` between the peaks; the
-//! cycle-to-cycle spread of the per-cycle bin means and each cycle's half ranges. No
+//! area's noise sensitivities; the cycle-to-cycle spread of the per-cycle bin means and each cycle's half ranges. No
 //! per-cycle-and-bin table is kept: a cycle's bin (a "cell") is a contiguous run of samples
 //! (the phase never decreases), so each cell's mean is complete when the run ends and goes
 //! straight into its bin's running moments (Welford, with the co-moment with the phase that
-//! the spread's phase correction needs). Memory: a few values per bin and per cycle.
+//! the spread's phase correction needs). Memory: a few values per bin and per cycle. The
+//! period means of `F` and `x` between the peaks take a pass of their own in the same call
+//! ([`crate::signal::period_means_pair`]'s, whose two running sums stay in registers there).
 //!
 //! The numbers are those of the separate kernels ([`fold_phase`](crate::signal::fold_phase),
 //! [`fold_spread`](crate::signal::fold_spread), [`loop_areas`](crate::signal::loop_areas),
@@ -17,6 +18,7 @@
 //! period means bit for bit, the rest to ~1e-12 relative (another summation order).
 
 use crate::error::{check_finite, check_same_len, CoreError};
+use crate::signal::period_means_pair_checked;
 
 /// One window folded (see the module docs). Per bin: samples, `Σx`, `ΣF`, `Σφ`, `Σφ²`,
 /// `Σx²`, `Σt` (φ the phase within the cycle), and the cycle-to-cycle spread of the per-cycle
@@ -142,9 +144,12 @@ fn cycle_area(x: &[f64], f: &[f64], ux: f64, uf: f64, fm: f64, scale: f64) -> (f
     }
     a.add(0.5 * (fp + f0) * (x0 - xp));
     let (mut sf, mut sx) = (0.0_f64, 0.0_f64);
-    for (xw, fw) in x.windows(3).zip(f.windows(3)) {
-        let cf = 0.5 * (xw[0] - xw[2]);
-        let cx = 0.5 * (fw[2] - fw[0]);
+    // each sample's neighbours i - 1 and i + 1 as four slices of one length (`windows(3)`
+    // of both channels kept bounds checks and a reload from the stack in the loop)
+    let (xa, xb, fa, fb) = (&x[..m - 2], &x[2..], &f[..m - 2], &f[2..]);
+    for (((&x0, &x2), &f0), &f2) in xa.iter().zip(xb).zip(fa).zip(fb) {
+        let cf = 0.5 * (x0 - x2);
+        let cx = 0.5 * (f2 - f0);
         sf += cf * cf;
         sx += cx * cx;
     }
@@ -252,24 +257,50 @@ fn check_edges(edges: &[f64]) -> Result<(), CoreError> {
     Ok(())
 }
 
-/// [`check_samples`]' checks and numbers in one pass over the samples (the same maxima, and
+/// Whether every value of `v` is finite, and the largest `|v|` (0 for none): four lanes of
+/// compare-selects (`f64::max`'s NaN handling kept the loop scalar).
+// Index arithmetic: k < 4.
+#[allow(clippy::arithmetic_side_effects)]
+fn finite_max_abs(v: &[f64]) -> (bool, f64) {
+    let mut m = [0.0_f64; 4];
+    let mut ok = [true; 4];
+    let mut chunks = v.chunks_exact(4);
+    for c in &mut chunks {
+        for k in 0..4 {
+            let a = c[k].abs();
+            m[k] = if a > m[k] { a } else { m[k] };
+            ok[k] &= c[k].is_finite();
+        }
+    }
+    for (k, &x) in chunks.remainder().iter().enumerate() {
+        let a = x.abs();
+        m[k] = if a > m[k] { a } else { m[k] };
+        ok[k] &= x.is_finite();
+    }
+    let big = m.iter().fold(0.0_f64, |a, &b| if b > a { b } else { a });
+    (ok.iter().all(|&o| o), big)
+}
+
+/// [`check_samples`]' checks and numbers in a vectorised pass a channel (the same maxima, and
 /// the mean of `F / sf` summed in the same order once `sf` is known: a second pass over F
 /// only); None when a check fails (the separate checks then name the first failure).
-#[allow(clippy::arithmetic_side_effects)]
+// bitwise ands: no early exit, so the loop over t vectorises
+#[allow(clippy::arithmetic_side_effects, clippy::needless_bitwise_bool)]
 fn clean_samples(t: &[f64], x: &[f64], f: &[f64]) -> Option<[f64; 3]> {
     if t.len() < 2 {
         return None;
     }
-    let (mut sx, mut sf) = (0.0_f64, 0.0_f64);
-    let mut ok = true;
-    let mut prev = f64::NEG_INFINITY;
-    for ((&ti, &xi), &fi) in t.iter().zip(x).zip(f) {
-        // finite and strictly increasing t; finite x, F (NaN fails every comparison)
-        ok &= ti > prev && ti.is_finite() && xi.is_finite() && fi.is_finite();
-        prev = ti;
-        sx = sx.max(xi.abs());
-        sf = sf.max(fi.abs());
-    }
+    // finite and strictly increasing t (NaN fails every comparison); finite x, F and their
+    // largest magnitudes: a pass a channel, each vectorised (the largest of magnitudes is
+    // the same number in any order)
+    let ok = t[0].is_finite()
+        && t[..t.len() - 1]
+            .iter()
+            .zip(&t[1..])
+            .fold(true, |o, (&a, &b)| o & (b > a) & b.is_finite());
+    let (ok_x, sx) = finite_max_abs(x);
+    let (ok_f, sf) = finite_max_abs(f);
+    let ok = ok && ok_x && ok_f;
     if !ok {
         return None;
     }
@@ -318,35 +349,6 @@ pub fn detrend_pair_into(
     Ok(())
 }
 
-/// The cumulative integrals at the edges `edges[e..]` below `t1` (inside the sample step
-/// `t0..t1` whose trapezoids are `step_f`, `step_x` on top of `cf`, `cx`), as
-/// `period_means` interpolates them; returns the first edge not below `t1`.
-#[inline(never)]
-#[allow(clippy::arithmetic_side_effects)]
-fn interpolate_edges(
-    edges: &[f64],
-    mut e: usize,
-    (t0, t1): (f64, f64),
-    (cf, step_f, ce_f): (f64, f64, &mut Vec<f64>),
-    (cx, step_x, ce_x): (f64, f64, &mut Vec<f64>),
-) -> usize {
-    while e < edges.len() && edges[e] < t1 {
-        let ed = edges[e];
-        if ed == t0 {
-            ce_f.push(cf);
-            ce_x.push(cx);
-        } else {
-            let dt = t1 - t0;
-            let sl_f = ((cf + step_f) - cf) / dt;
-            let sl_x = ((cx + step_x) - cx) / dt;
-            ce_f.push(sl_f * (ed - t0) + cf);
-            ce_x.push(sl_x * (ed - t0) + cx);
-        }
-        e += 1;
-    }
-    e
-}
-
 /// Fold `(t, x, F)` (one window, `t` strictly increasing) by the phase knots `(kt, kp)` into
 /// `n_bins` bins per cycle over `n_cycles` cycles, with the phases and bins of
 /// [`crate::signal::fold_phase`], and derive the per-cycle quantities and period means (see
@@ -355,7 +357,10 @@ fn interpolate_edges(
 /// cycle's (the last to the first sample at or after `kt[last]`).
 // Index arithmetic: b < n_bins and c < n_cycles (checked against the allocations), e < the
 // edges' length inside the loops, i >= 1 where i - 1 is taken.
+// Not inlined: with fat LTO the binding inlined it into its wrapper, where the fold's loop
+// kept more of its state on the stack (26 against 22 ms a window of 2^20 samples).
 #[allow(clippy::arithmetic_side_effects, clippy::too_many_lines)]
+#[inline(never)]
 pub fn fold_window(
     t: &[f64],
     x: &[f64],
@@ -422,16 +427,6 @@ pub fn fold_window(
     let area_scale = sx * sf;
     let (t0, t1) = (kt[0], kt[kt.len() - 1]);
     let n = t.len();
-    // period means: the cumulative trapezoid integrals and the edges' values (period_means)
-    let mut ce_f = Vec::with_capacity(edges.len());
-    let mut ce_x = Vec::with_capacity(edges.len());
-    let mut e = 0_usize;
-    while e < edges.len() && edges[e] <= t[0] {
-        ce_f.push(0.0);
-        ce_x.push(0.0);
-        e += 1;
-    }
-    let (mut cf, mut cx) = (0.0_f64, 0.0_f64);
     // the fold
     let mut j = 0_usize;
     let seg_slope = |j: usize| (kp[j + 1] - kp[j]) / (kt[j + 1] - kt[j]);
@@ -470,23 +465,6 @@ pub fn fold_window(
     let (mut k_lo, mut k_hi, mut p_lo) = (kt[0], kt[1], kp[0]);
     for i in 0..n {
         let (ti, xi, fi) = (t[i], x[i], f[i]);
-        if i > 0 {
-            let step_f = 0.5 * (f[i] + f[i - 1]) * (ti - t[i - 1]);
-            let step_x = 0.5 * (x[i] + x[i - 1]) * (ti - t[i - 1]);
-            // edges in [t[i-1], t[i]): period_means' interpolation (out of line: inlined,
-            // its two divisions were hoisted into every sample's path)
-            if e < edges.len() && edges[e] < ti {
-                e = interpolate_edges(
-                    edges,
-                    e,
-                    (t[i - 1], ti),
-                    (cf, step_f, &mut ce_f),
-                    (cx, step_x, &mut ce_x),
-                );
-            }
-            cf += step_f;
-            cx += step_x;
-        }
         if !(ti >= t0 && ti < t1) {
             if ti >= t1 && end == n {
                 end = i;
@@ -598,11 +576,6 @@ pub fn fold_window(
         (w.energy[ac], w.sens_f[ac], w.sens_x[ac]) =
             cycle_area(&x[a0..a1], &f[a0..a1], ux, uf, fm, area_scale);
     }
-    while e < edges.len() {
-        ce_f.push(cf);
-        ce_x.push(cx);
-        e += 1;
-    }
     for (k, a) in w.energy.iter().enumerate() {
         if a.is_infinite() {
             return Err(CoreError::OutOfRange {
@@ -612,14 +585,9 @@ pub fn fold_window(
             });
         }
     }
-    let means = |ce: &[f64]| -> Vec<f64> {
-        ce.windows(2)
-            .zip(edges.windows(2))
-            .map(|(c, e)| (c[1] - c[0]) / (e[1] - e[0]))
-            .collect()
-    };
-    w.mean_f = means(&ce_f);
-    w.mean_x = means(&ce_x);
+    // the period means between the edges in a pass of their own (period_means_pair's: the
+    // same numbers; in this loop its two running sums were kept on the stack)
+    (w.mean_f, w.mean_x) = period_means_pair_checked(t, f, x, edges);
     // the spread, phase-corrected by each bin's slope along phase (fold_spread)
     let half_n = nb as f64 / 2.0;
     let mean_of = |s: &[f64], b: usize| s[b] / w.count[b];

@@ -5,6 +5,7 @@ use contactlab_core::isotonic::monotone_path;
 use contactlab_core::masing::split::{force_channels, Channel, PIECE};
 use contactlab_core::masing::{branch_memory, MasingState};
 use contactlab_core::parallel::run_jobs;
+use contactlab_core::select::order_stats;
 use contactlab_core::signal::{
     cycle_block, fold_phase, fold_spread, loop_area_sensitivity, loop_areas, period_means,
     period_means_pair, CycleState, Excursion, FoldSums, Schmitt,
@@ -464,6 +465,21 @@ fn period_means_pair_py<'py>(
     Ok((a.into_pyarray(py), b.into_pyarray(py)))
 }
 
+/// The values of rank `ranks` (0-based, ascending values) of `x`, those of a sort
+/// (`contactlab_core::select::order_stats`: near the ends of a long sample from its tails
+/// only); `x` finite (the caller's check).
+#[pyfunction]
+#[pyo3(name = "order_stats")]
+fn order_stats_py<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray1<'py, f64>,
+    ranks: Vec<usize>,
+) -> PyResult<Arr<'py>> {
+    let xs = slice(&x, "x")?;
+    let v = detach_guarded(py, || order_stats(xs, &ranks))?;
+    Ok(v.into_pyarray(py))
+}
+
 /// One analysis window folded (`contactlab_core::window`): fold sums, cycle bounds, loop
 /// areas and their sensitivities, period means.
 #[pyclass(module = "contactlab._core")]
@@ -639,6 +655,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(loop_area_sensitivity_py, m)?)?;
     m.add_function(wrap_pyfunction!(period_means_py, m)?)?;
     m.add_function(wrap_pyfunction!(period_means_pair_py, m)?)?;
+    m.add_function(wrap_pyfunction!(order_stats_py, m)?)?;
     m.add_class::<CycleTracker>()?;
     m.add_class::<ReversalDetector>()?;
     m.add_function(wrap_pyfunction!(branch_memory_py, m)?)?;

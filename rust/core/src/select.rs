@@ -1,0 +1,219 @@
+//! Order statistics (the k-th smallest values) of a long sample near its ends, without
+//! partitioning all of it: the robust amplitude of a displacement (its 0.5 and 99.5
+//! percentiles, `contactlab.tangential.preprocess.tail_percentiles`) needs four values of a
+//! window of a million samples.
+//!
+//! A strided subsample's order statistics give two thresholds; one pass gathers the samples
+//! at or below the low one and at or above the high one (about 2 % of them each), and the
+//! ranks are selected in those tails. The values are those a sort of the whole sample gives
+//! (exact: an order statistic is one of the samples); where a tail turns out too short for a
+//! rank (a subsample that misjudges the distribution), the whole sample is selected from.
+
+use crate::error::CoreError;
+
+/// Below this many samples the whole sample is selected from (no subsample).
+const SUBSAMPLE_ABOVE: usize = 1 << 15;
+/// Every this many samples one goes into the subsample.
+const STRIDE: usize = 32;
+/// Samples a block of the tails' gathering.
+const GATHER: usize = 2048;
+
+/// The `rank`-th smallest value of `v` for each of `ranks` (ascending), selected in place.
+fn select_into(v: &mut [f64], ranks: &[usize], offset: usize, out: &mut [f64]) {
+    for (&r, o) in ranks.iter().zip(out.iter_mut()) {
+        let k = r.saturating_sub(offset);
+        if k < v.len() {
+            let (_, m, _) = v.select_nth_unstable_by(k, f64::total_cmp);
+            *o = *m;
+        }
+    }
+}
+
+/// The values of rank `ranks` (0-based: rank 0 is the smallest) of `x`, exactly those of a
+/// sort of `x` (by value: `-0.0` and `0.0` are one value, the one returned either). `x`
+/// finite (the caller's check; a NaN only makes the numbers meaningless).
+///
+/// # Errors
+/// [`CoreError::Empty`] for an empty `x`, [`CoreError::InvalidParameter`] for a rank not
+/// below `x.len()`.
+// Index arithmetic: ranks < n (checked), sub ranks < sub.len(), counts <= n.
+#[allow(clippy::arithmetic_side_effects)]
+pub fn order_stats(x: &[f64], ranks: &[usize]) -> Result<Vec<f64>, CoreError> {
+    let n = x.len();
+    if n == 0 {
+        return Err(CoreError::Empty { name: "x" });
+    }
+    if let Some(&r) = ranks.iter().find(|&&r| r >= n) {
+        return Err(CoreError::InvalidParameter {
+            name: "rank",
+            value: r as f64,
+            reason: "must be below the number of samples",
+        });
+    }
+    let mut order: Vec<usize> = (0..ranks.len()).collect();
+    order.sort_by_key(|&i| ranks[i]);
+    let sorted: Vec<usize> = order.iter().map(|&i| ranks[i]).collect();
+    let mut vals = vec![0.0_f64; ranks.len()];
+    let half = n / 2;
+    let n_low = sorted.iter().filter(|&&r| r < half).count();
+    let (low_r, high_r) = sorted.split_at(n_low);
+    let mut done = false;
+    if n > SUBSAMPLE_ABOVE {
+        done = tails(x, low_r, high_r, &mut vals);
+    }
+    if !done {
+        let mut all = x.to_vec();
+        select_into(&mut all, &sorted, 0, &mut vals);
+    }
+    let mut out = vec![0.0_f64; ranks.len()];
+    for (&i, &v) in order.iter().zip(&vals) {
+        out[i] = v;
+    }
+    Ok(out)
+}
+
+/// [`order_stats`] of the ranks `low` (below `n/2`) and `high` (the rest), both ascending,
+/// from the tails of `x`, into `vals` (low's then high's); false when a tail is too short.
+#[allow(clippy::arithmetic_side_effects)]
+fn tails(x: &[f64], low: &[usize], high: &[usize], vals: &mut [f64]) -> bool {
+    let n = x.len();
+    let mut sub: Vec<f64> = x.iter().step_by(STRIDE).copied().collect();
+    let m = sub.len();
+    // a subsample rank whose value has about twice the samples the rank needs below it
+    // (and 16 subsample values more): a tail short of the rank is rare, and then only slower
+    let sub_rank = |r: usize| (2 * (r + 2) * m / n + 16).min(m - 1);
+    let t_lo = low.last().map(|&r| {
+        let k = sub_rank(r);
+        *sub.select_nth_unstable_by(k, f64::total_cmp).1
+    });
+    let t_hi = high.first().map(|&r| {
+        let k = m - 1 - sub_rank(n - 1 - r);
+        *sub.select_nth_unstable_by(k, f64::total_cmp).1
+    });
+    drop(sub);
+    // the tails by value (every sample at or below t_lo: the smallest samples of x, ±0
+    // together, so a rank of x is the same rank of the low tail; the high tail's ranks are
+    // x's less the samples below it)
+    let lo = t_lo.unwrap_or(f64::NEG_INFINITY);
+    let hi = t_hi.unwrap_or(f64::INFINITY);
+    // branch-free: each sample is written at the tail's end, which moves on only when the
+    // sample belongs to the tail (the buffers grow a block ahead)
+    let (mut lv, mut hv) = (Vec::new(), Vec::new());
+    let (mut nl, mut nh) = (0_usize, 0_usize);
+    for block in x.chunks(GATHER) {
+        lv.resize(nl + GATHER, 0.0);
+        hv.resize(nh + GATHER, 0.0);
+        let (lb, hb) = (&mut lv[nl..nl + GATHER], &mut hv[nh..nh + GATHER]);
+        let (mut il, mut ih) = (0_usize, 0_usize);
+        for &v in block {
+            lb[il & (GATHER - 1)] = v;
+            hb[ih & (GATHER - 1)] = v;
+            il += usize::from(v <= lo);
+            ih += usize::from(v >= hi);
+        }
+        nl += il;
+        nh += ih;
+    }
+    lv.truncate(nl);
+    hv.truncate(nh);
+    let below_hi = n - hv.len();
+    if low.last().is_some_and(|&r| r >= lv.len()) || high.first().is_some_and(|&r| r < below_hi) {
+        return false;
+    }
+    let (v_lo, v_hi) = vals.split_at_mut(low.len());
+    select_into(&mut lv, low, 0, v_lo);
+    select_into(&mut hv, high, below_hi, v_hi);
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn sorted(x: &[f64]) -> Vec<f64> {
+        let mut s = x.to_vec();
+        s.sort_by(f64::total_cmp);
+        s
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(48))]
+        /// The values a sort gives, for ranks near both ends and in the middle, on noisy
+        /// sines, heavy tails (a few huge outliers), quantised samples (ties, ±0) and short
+        /// samples (no subsample).
+        #[test]
+        fn equals_a_sort(
+            seed in 0u64..100_000, n in prop::sample::select(vec![5usize, 1000, 40_000, 300_000]),
+            kind in 0usize..4, fr in prop::collection::vec(0.0f64..1.0, 1..6),
+        ) {
+            let mut s = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(3);
+            let mut rnd = move || {
+                s = s.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+                ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+            };
+            let x: Vec<f64> = (0..n)
+                .map(|i| {
+                    let base = (i as f64 * 0.0063).sin() + 0.05 * rnd();
+                    match kind {
+                        0 => base,
+                        1 => if rnd() > 0.499 { 1e6 * rnd() } else { base },
+                        2 => (2.0 * base).round(),
+                        _ => if i % 7 == 0 { -0.0 } else { (3.0 * rnd()).round() },
+                    }
+                })
+                .collect();
+            let srt = sorted(&x);
+            // the tails' ranks (0.5 %, 99.5 % and their neighbours) and arbitrary ones
+            let mut ranks = vec![0, n / 200, n / 200 + 1, n - 1 - n / 200, n - 1];
+            ranks.extend(fr.iter().map(|f| ((n - 1) as f64 * f) as usize));
+            let got = order_stats(&x, &ranks).unwrap();
+            for (r, g) in ranks.iter().zip(&got) {
+                // by value (±0 are one value)
+                prop_assert!(*g == srt[*r], "rank {} of {}: {} vs {}", r, n, g, srt[*r]);
+            }
+        }
+    }
+
+    fn xs(n: usize) -> Vec<f64> {
+        (0..n)
+            .map(|i| {
+                if i % STRIDE == 0 {
+                    i as f64 * 1e-3
+                } else {
+                    1e3 + i as f64
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_subsample_that_misjudges_falls_back() {
+        // the stride's samples all small, the others large: the low threshold is far too
+        // low a value for the rank (a tail too short), so the whole sample is selected from
+        let n = 100_000;
+        assert!(!tails(&xs(n), &[500], &[], &mut [0.0]));
+        let x = xs(n);
+        let srt = sorted(&x);
+        let ranks = [n / 2 - 1, 500, 99_000, 10];
+        let got = order_stats(&x, &ranks).unwrap();
+        for (r, g) in ranks.iter().zip(&got) {
+            assert_eq!(*g, srt[*r]);
+        }
+        let y: Vec<f64> = x.iter().map(|v| -v).collect();
+        assert!(!tails(&y, &[], &[n - 501], &mut [0.0]));
+        let got = order_stats(&y, &[3, n - 501]).unwrap();
+        assert_eq!(got, vec![-srt[n - 4], -srt[500]]);
+    }
+
+    #[test]
+    fn bad_input_is_an_error() {
+        assert!(order_stats(&[], &[0]).is_err());
+        assert!(order_stats(&[1.0, 2.0], &[2]).is_err());
+        assert_eq!(order_stats(&[2.0, 1.0], &[]).unwrap(), Vec::<f64>::new());
+        assert_eq!(
+            order_stats(&[2.0, 1.0, 3.0], &[1, 0, 2]).unwrap(),
+            vec![2.0, 1.0, 3.0]
+        );
+    }
+}
