@@ -295,3 +295,20 @@ def test_a_candidate_that_cannot_be_fitted_is_skipped_not_fatal(monkeypatch):
     assert rep.effect_names == ["force_offset"]
     (v,) = [v for v in rep.steps[0].candidates if v.name == "inertia"]
     assert not v.accepted and v.reason.startswith("could not be fitted")
+
+
+def test_cli_diagnose_takes_fs_for_a_file_without_time(tmp_path, capsys):
+    from contactlab.cli import main
+
+    rec = hidden_effect_recording(["asymmetry"], magnitude=0.05, noise=0.01, seed=SEED + 8)
+    fs = 1.0 / float(rec.t[1] - rec.t[0])
+    path = tmp_path / "no_t.csv"
+    np.savetxt(path, np.column_stack([rec["x"], rec["F"]]), delimiter=",", header="x,F",
+               comments="", fmt="%.17g")  # fmt: skip
+    assert main(["diagnose", str(path), "--model", "tangential"]) == 1
+    assert "fs=" in capsys.readouterr().err
+    out = tmp_path / "d.json"
+    code = main(["diagnose", str(path), "--model", "tangential", "--fs", repr(fs),
+                 "--json", str(out)])  # fmt: skip
+    assert code == 0
+    assert [e["name"] for e in json.loads(out.read_text())["effects"]] == ["asymmetry"]

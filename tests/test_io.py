@@ -381,3 +381,43 @@ def test_recording_window():
     assert len(rec.window(t0=0.9)) == 10 and len(rec.window(t1=0.1)) == 10
     with pytest.raises(InputError, match="holds 0 samples"):
         rec.window(5.0, 6.0)
+
+
+@pytest.mark.parametrize("chunked", [False, True])
+def test_csv_without_header_row(tmp_path, chunked):
+    """A file whose first line holds numbers has no header row: that line is data, and the
+    columns are named by the last comment when it lists them (remarks in parentheses dropped,
+    as exporters write ``# u_N,y_m (fs=750 Hz, 5 periods)``), else by position."""
+    from contactlab.io import read_chunks
+
+    def read(p, **kw):
+        if not chunked:
+            return read_recording(p, **kw)
+        parts = list(read_chunks(p, chunk_size=2, **kw))
+        return Recording(
+            np.concatenate([c.t for c in parts]),
+            {k: np.concatenate([c[k] for c in parts]) for k in parts[0].data},
+            dict(parts[0].units),
+            source="chunks",
+        )
+
+    named = tmp_path / "named.csv"
+    named.write_text("# rig 2\n# u_N,y_m (fs=750 Hz, 5 periods x 8 samples, 50 N rms)\n"
+                     "-2.5,1e-6\n3.5,2e-6\n4.5,-1e-6\n")  # fmt: skip
+    rec = read(named, columns={"x": "y_m", "F": "u_N"}, fs=750.0)
+    np.testing.assert_array_equal(rec["x"], [1e-6, 2e-6, -1e-6])  # the first line is data
+    np.testing.assert_array_equal(rec["F"], [-2.5, 3.5, 4.5])
+    np.testing.assert_allclose(rec.t, np.arange(3) / 750.0)
+
+    bare = tmp_path / "bare.txt"
+    bare.write_text("# no names here\n1 10\n2 20\n3 30\n")
+    rec = read(bare, columns={"x": "1", "F": "0"}, fs=10.0)
+    np.testing.assert_array_equal(rec["x"], [10, 20, 30])
+    np.testing.assert_array_equal(rec["F"], [1, 2, 3])
+    with pytest.raises(RecordingError, match=r"columns are \['0', '1'\]"):
+        read(bare, columns={"x": "disp", "F": "0"}, fs=10.0)
+
+    comma = tmp_path / "comma.csv"  # decimal commas with ';' are numbers, not names
+    comma.write_text("1,5;2,5\n3,5;4,5\n")
+    rec = read(comma, columns={"x": "0", "F": "1"}, fs=1.0)
+    np.testing.assert_array_equal(rec["x"], [1.5, 3.5])

@@ -245,3 +245,22 @@ def test_noise_model_covariance_matches_monte_carlo_with_input_and_output_noise(
     np.testing.assert_allclose(np.median(noise, axis=0), [su, sy], rtol=0.15)
     cover = np.mean(np.abs(np.array(est) - truth) <= 2 * np.array(err))
     assert 0.88 <= cover <= 0.99
+
+
+def test_joint_verbs_on_the_benchmark_record_say_what_it_is(tmp_path, capsys):
+    """The record names its columns in a comment line (no header row): `analyze` and
+    `diagnose` read them by those names; a structure driven by a multisine is no friction
+    loop, and `diagnose` says so in a sentence (exit 1, no traceback)."""
+    path = DATA / "boucwen" / "train_multisine.csv"
+    if not path.exists():
+        pytest.skip("../shared/data absent")
+    cols = ["--columns", "x=y_displacement_m,F=u_force_N", "--fs", "750"]
+    code = main(["diagnose", str(path), "--model", "tangential", *cols])
+    err = capsys.readouterr().err
+    assert code == 1 and "no friction loop" in err and "Traceback" not in err
+    out = tmp_path / "a.json"
+    assert main(["analyze", str(path), "--model", "tangential", *cols, "--json", str(out)]) == 0
+    d = json.loads(out.read_text())
+    assert d["regime"] == "transition"  # not pre-sliding: the model is warned about
+    assert any("describe the loop poorly" in w for w in d["warnings"])
+    assert 5e-4 < d["amplitude"] < 1e-3  # the response's half range, read from y_displacement_m

@@ -38,7 +38,7 @@ def add_parser(subparsers: Any) -> None:
     )
     p.add_argument("--u", help="with --structure: input column (force, or base displacement)")
     p.add_argument("--y", help="with --structure: response column (displacement of the mass)")
-    p.add_argument("--fs", type=float, help="with --structure: sampling rate without a t column")
+    p.add_argument("--fs", type=float, help="sampling rate when a file has no time column")
     p.add_argument(
         "--holdout",
         type=float,
@@ -104,7 +104,8 @@ def run(args: argparse.Namespace) -> int:
         if taps is not None or args.output_noise is not None:
             print("note: --output-filter/--output-noise replace the reconstruction's own")
     else:
-        rec = read_recording(args.file, kind=args.model, columns=parse_columns(args.columns))
+        rec = read_recording(args.file, kind=args.model, columns=parse_columns(args.columns),
+                             fs=args.fs)  # fmt: skip
     if args.model == "normal":
         from ..commands._common import with_static_pressure
 

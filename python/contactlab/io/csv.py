@@ -50,18 +50,58 @@ def read_header(path: Path, enc: str = "utf-8-sig") -> tuple[list[str], str | No
             if s.startswith("#"):
                 comments.append(s[1:].strip())
                 continue
-            for delim in ("\t", ";", ","):
-                if delim in s:
-                    names = [c.strip().strip('"') for c in next(_csv.reader([s], delimiter=delim))]
-                    return names, delim, lineno, comments
-            toks: list[str] = []
-            for tok in s.split():  # "x [um]" split by whitespace: rejoin the unit
-                if toks and tok[:1] in "[(":
-                    toks[-1] += " " + tok
-                else:
-                    toks.append(tok)
-            return toks, None, lineno, comments
+            delim = next((d for d in ("\t", ";", ",") if d in s), None)
+            names = _fields(s, delim)
+            if _all_numbers(names, delim):
+                # no header row: the first line holds numbers (a header kept as the last
+                # comment, as some exporters write it, names the columns; else their position)
+                names = _comment_names(comments, delim, len(names))
+                return names, delim, lineno - 1, comments
+            return names, delim, lineno, comments
     raise RecordingError("no header row (the file is empty)", file=str(path))
+
+
+def _fields(s: str, delim: str | None) -> list[str]:
+    """The cells of a header line (whitespace-delimited: a unit ``x [um]`` rejoined)."""
+    if delim is not None:
+        return [c.strip().strip('"') for c in next(_csv.reader([s], delimiter=delim))]
+    toks: list[str] = []
+    for tok in s.split():  # "x [um]" split by whitespace: rejoin the unit
+        if toks and tok[:1] in "[(":
+            toks[-1] += " " + tok
+        else:
+            toks.append(tok)
+    return toks
+
+
+def _number(cell: str, delim: str | None) -> bool:
+    c = cell.strip()
+    if delim in ("\t", ";"):
+        c = c.replace(",", ".")  # a decimal comma
+    try:
+        float(c)
+    except ValueError:
+        return False
+    return bool(c)
+
+
+def _all_numbers(cells: list[str], delim: str | None) -> bool:
+    return bool(cells) and all(_number(c, delim) for c in cells)
+
+
+#: a remark in parentheses holding a delimiter or "=" (``(fs=750 Hz, 5 periods)``), not a unit
+_REMARK = re.compile(r"\([^()]*[,;=\t][^()]*\)")
+
+
+def _comment_names(comments: list[str], delim: str | None, n: int) -> list[str]:
+    """Column names of a file without a header row: the last comment's cells when they are
+    ``n`` distinct names (remarks in parentheses dropped), else ``"0"``, ``"1"``, … (the
+    columns' positions, which ``columns=`` then maps: ``x=1,F=0``)."""
+    if comments:
+        cells = [c for c in _fields(_REMARK.sub("", comments[-1]).strip(), delim) if c]
+        if len(cells) == n and len(set(cells)) == n and not any(_number(c, delim) for c in cells):
+            return cells
+    return [str(i) for i in range(n)]
 
 
 _DECIMAL_COMMA = re.compile(r"^\s*[+-]?\d+,\d*(?:[eE][+-]?\d+)?\s*$")
