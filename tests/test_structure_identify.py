@@ -263,4 +263,6 @@ def test_joint_verbs_on_the_benchmark_record_say_what_it_is(tmp_path, capsys):
     d = json.loads(out.read_text())
     assert d["regime"] == "transition"  # not pre-sliding: the model is warned about
     assert any("describe the loop poorly" in w for w in d["warnings"])
+    # the cycles' area beyond the rectangle that bounds any friction loop: not one loop
+    assert any("do not repeat one loop" in w for w in d["warnings"])
     assert 5e-4 < d["amplitude"] < 1e-3  # the response's half range, read from y_displacement_m

@@ -69,6 +69,10 @@ from .uncertainty import correl, numeric_energy, reparametrize, trend
 GROSS_SLIDING_Z = 3.0
 #: loop area / (4 A × half force range) above which a loop counts as nearly rectangular
 GROSS_SLIDING_AREA_RATIO = 0.6
+#: above this ``E / (4 A h_m)`` the recorded cycles' mean area exceeds what a friction loop of
+#: the averaged loop's size can enclose (a rectangle gives 1; noise and drift add a few %): the
+#: cycles are not one repeated loop (a multisine's response gives 3.3)
+NOT_ONE_LOOP_AREA_RATIO = 1.25
 
 
 def _inputs(
@@ -310,6 +314,14 @@ def collect_warnings(
         warns.append(
             f"amplitude {amplitude:.3g} m leaves the pre-sliding regime (gross sliding): "
             f"{regime.reason}; the pre-sliding model and its ac describe the loop poorly"
+        )
+    if ratio > NOT_ONE_LOOP_AREA_RATIO:
+        warns.append(
+            f"the recorded cycles enclose {100 * ratio:.0f}% of the rectangle 4·A·h_m that "
+            "bounds any friction loop of the averaged loop's size: the cycles do not repeat "
+            "one loop (an irregular or multi-frequency excitation, or the response of a "
+            "structure rather than of a joint?), so the averaged loop and the fitted "
+            "parameters do not describe them"
         )
     if not identifiable:
         warns.append(evidence["message"])
