@@ -230,8 +230,9 @@ class _Finisher:
             # the range in SI (the magnitude check and the cycle trigger of a streamed analysis
             # use it: meta["ranges"]) is the finiteness check too: numpy's min and max are NaN
             # when a value is, and ±inf when one is (or overflowed in the conversion)
-            lo, hi = (float(v.min()), float(v.max())) if v.size else (math.inf, -math.inf)
-            if not (math.isfinite(lo) and math.isfinite(hi)) and v.size:
+            # (one pass of the core: finiteness, min and max; numpy took two passes)
+            finite, lo, hi = _core.finite_min_max(v) if v.size else (True, math.inf, -math.inf)
+            if not finite:
                 # the whole-file reader's checks find the value and raise
                 check_finite(values, file=self.file, column=col, row_of=row_of)
                 i = int(np.argmax(~np.isfinite(v)))  # found by fuzzing (track): 1e306 kN in N

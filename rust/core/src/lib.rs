@@ -26,6 +26,7 @@
 
 pub mod curve;
 pub mod error;
+pub mod extrema;
 pub mod isotonic;
 pub mod loop_fit;
 pub mod masing;
