@@ -363,3 +363,38 @@ def test_file_view_index_is_every_occurrence(tmp_path_factory, data, block):
     for nd in needles:
         ref = [i for i in range(len(data)) if data.startswith(nd, i)]
         assert v._index[nd] == ref, nd
+
+
+def test_structure_check_started_ahead_is_waited_for_and_damage_still_named(tmp_path, monkeypatch):
+    """The command line starts the scan of a long HDF5 file before importing the analysis
+    (``prefetch_structure_check``); the call that opens the file waits for it instead of
+    scanning again, and a damaged file is refused by that call with its own message."""
+    from contactlab.cli import _prefetch
+    from contactlab.io import hdf5
+
+    scans = []
+    real = hdf5._check_btrees
+    monkeypatch.setattr(hdf5, "_check_btrees", lambda *a: scans.append(1) or real(*a))
+    monkeypatch.setattr(hdf5, "_CACHE_ABOVE", 1 << 10)
+    monkeypatch.setattr(hdf5, "_CHECKED", set())
+    path, _ = _gcol_file(tmp_path)
+    _prefetch(["analyze", str(path), "--model", "tangential"])
+    hdf5.check_structure(path, file=str(path))
+    assert read_recording(path).t.size == 64
+    assert len(scans) == 1  # the scan started ahead, waited for; not run again
+    assert not hdf5._PENDING
+    # not an HDF5 file, a verb that reads nothing, a small file: nothing started
+    text = tmp_path / "run.csv"
+    text.write_text("t,x\n" + "0,1\n" * 400)
+    assert not hdf5.prefetch_structure_check(text)
+    assert not hdf5.prefetch_structure_check(tmp_path / "absent.h5")
+    # damage: the scan ahead fails quietly, the opening call names it
+    (tmp_path / "bad").mkdir()
+    bad, at = _gcol_file(tmp_path / "bad")
+    raw = bytearray(bad.read_bytes())
+    raw[at + 16 + 8 : at + 16 + 16] = (128).to_bytes(8, "little")
+    bad.write_bytes(bytes(raw))
+    assert hdf5.prefetch_structure_check(bad)
+    with pytest.raises(RecordingError, match=r"global heap collection at byte \d+"):
+        read_recording(bad)
+    assert not hdf5._PENDING

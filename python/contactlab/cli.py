@@ -92,12 +92,35 @@ def main(argv: Sequence[str] | None = None) -> int:
     return _main(list(argv))
 
 
+#: verbs that read recordings named on their command line
+_READING_VERBS = {"analyze", "track", "diagnose"}
+
+
+def _prefetch(argv: list[str]) -> None:
+    """Start the structure check of each long HDF5 file named on the command line of a verb
+    that reads recordings (:func:`contactlab.io.hdf5.prefetch_structure_check`: a scan of the
+    whole file) before the verb's modules are imported, which then runs alongside."""
+    verb = next((a for a in argv if not a.startswith("-")), None)
+    if verb not in _READING_VERBS:
+        return
+    import os
+
+    files = [a for a in argv if not a.startswith("-") and a != verb and os.path.isfile(a)]
+    if not files:
+        return
+    from .io.hdf5 import prefetch_structure_check
+
+    for f in files:
+        prefetch_structure_check(f)
+
+
 def _main(argv: list[str]) -> int:
     # `--frame -3,0.6,1191`: argparse would take the negative value for an option and say
     # only "expected one argument"; joined, the frame's own check names the bad mass
     for i in range(len(argv) - 2, -1, -1):
         if argv[i] == "--frame" and argv[i + 1][:2] in {f"-{d}" for d in "0123456789."}:
             argv[i : i + 2] = [f"--frame={argv[i + 1]}"]
+    _prefetch(argv)
     parser = build_parser(_verb_module(argv))
     args = parser.parse_args(argv)
     if not getattr(args, "handler", None):

@@ -485,7 +485,10 @@ def monotone_path(x: np.ndarray, turns: np.ndarray) -> np.ndarray:
 def _path_edges(turns: np.ndarray, n: int) -> np.ndarray:
     """The stretches' bounds: 0, the turns inside the signal, ``n`` (sorted, distinct)."""
     t = np.asarray(turns, dtype=np.int64)
-    return np.unique(np.r_[0, t[(t > 0) & (t < n)], n]).astype(np.int64)
+    # np.unique's numbers; np.unique itself imports numpy.ma (20 ms under the interpreter
+    # lock in the first window of a streamed analysis)
+    e = np.sort(np.r_[0, t[(t > 0) & (t < n)], n].astype(np.int64))
+    return e[np.r_[True, e[1:] != e[:-1]]]
 
 
 def _monotone_path_scipy(x: np.ndarray, turns: np.ndarray) -> np.ndarray:
