@@ -25,6 +25,7 @@ streamed analysis.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import functools
 import io
@@ -526,6 +527,18 @@ def _join(parts: list[Recording]) -> Recording:
     return Recording(t, data, dict(first.units), first.source, dict(first.meta))
 
 
+def _one_blas_thread() -> Any:
+    """BLAS limited to one thread while windows are analysed on helper threads (restored
+    afterwards; a no-op without ``threadpoolctl``): the windows' least-squares problems are a
+    few hundred rows, which threaded BLAS does not speed up, and its threads spin after each
+    call on cores the helper threads and the reader already fill."""
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:  # optional at run time: only the speed depends on it
+        return contextlib.nullcontext()
+    return threadpool_limits(limits=1, user_api="blas")
+
+
 def track(
     source: str | Path | Recording,
     every: str | float = "100cycles",
@@ -604,7 +617,10 @@ def track(
         n_threads = 1 if threads is None else int(threads)
         if n_threads < 0:
             raise InputError(f"threads must be >= 0, got {threads!r}")
-        with ThreadPoolExecutor(n_threads, thread_name_prefix="contactlab-track") as pool:
+        with (
+            ThreadPoolExecutor(n_threads, thread_name_prefix="contactlab-track") as pool,
+            _one_blas_thread(),
+        ):
             # each helper thread analyses one window while the next is read: n + 1 windows
             # in memory (an executor given by the caller gets two per worker)
             return _track(
