@@ -1506,11 +1506,12 @@ mod tests {
     proptest::proptest! {
         #[test]
         fn period_means_pair_is_two_period_means_bit_for_bit(
-            steps in proptest::collection::vec(0.001_f64..0.1, 1..300),
-            fs in proptest::collection::vec(-3.0_f64..3.0, 300),
-            xs in proptest::collection::vec(-2.0_f64..2.0, 300),
-            mut edges in proptest::collection::vec(-0.5_f64..20.0, 0..12),
-            on_samples in proptest::collection::vec(0_usize..300, 0..4),
+            // up to 1000 samples: periods longer than a block of trapezoids_until (128)
+            steps in proptest::collection::vec(0.001_f64..0.1, 1..1000),
+            fs in proptest::collection::vec(-3.0_f64..3.0, 1000),
+            xs in proptest::collection::vec(-2.0_f64..2.0, 1000),
+            mut edges in proptest::collection::vec(-0.5_f64..60.0, 0..12),
+            on_samples in proptest::collection::vec(0_usize..1000, 0..4),
         ) {
             let mut t = vec![0.0_f64];
             for s in &steps {
