@@ -922,84 +922,6 @@ fn first_non_finite(x: &[f64], f: &[f64], drive: &[f64], other: CoreError) -> Co
         .unwrap_or(other)
 }
 
-/// The running sums of [`cycle_block_with`] over a run of samples without a crossing: `∮ F dx`
-/// (`cum`), the previous sample, the extrema `[x_max, x_min, F_max, F_min]` and whether every
-/// sample was finite.
-struct Span {
-    cum: f64,
-    xp: f64,
-    fp: f64,
-    ext: [f64; 4],
-    finite: bool,
-}
-
-impl Span {
-    /// Samples a block of [`Span::run`]: its trapezoids on the stack (2 KiB).
-    const BLOCK: usize = 256;
-
-    /// Add the samples `xs`, `fs` (one length, at least one; `xp`, `fp` finite or the first
-    /// trapezoid is NaN as in the one-sample loop) bit for bit as the one-sample loop
-    /// `cum += 0.5 * (fi + fp) * (xi - xp)` with compare-and-select extrema: a block's
-    /// trapezoids are computed first (independent: vectorised), then summed in order (the
-    /// same additions in the same order), so the pass is bound by the sum's chain of
-    /// additions alone (4.0 -> 1.9 ns a sample); the finiteness of the samples is read from
-    /// four lanes of `v · 0` (0 for a finite v, NaN otherwise) over the block.
-    // Index arithmetic: a < b <= m in the blocks.
-    #[allow(clippy::arithmetic_side_effects)]
-    #[inline(never)]
-    fn run(&mut self, xs: &[f64], fs: &[f64]) {
-        let m = xs.len().min(fs.len());
-        if m == 0 {
-            return;
-        }
-        let [mut xmax, mut xmin, mut fmax, mut fmin] = self.ext;
-        let mut cum = self.cum + 0.5 * (fs[0] + self.fp) * (xs[0] - self.xp);
-        let mut lanes = [0.0_f64; 4];
-        let mut terms = [0.0_f64; Self::BLOCK];
-        // extrema and finiteness over one block (in L1): the finiteness from lanes, the
-        // extrema one sample at a time (ties of 0.0 and -0.0 resolved as before)
-        let mut scan = |xc: &[f64], fc: &[f64]| {
-            let mut ch = xc.chunks_exact(4).zip(fc.chunks_exact(4));
-            for (x4, f4) in &mut ch {
-                for l in 0..4 {
-                    lanes[l] += x4[l] * 0.0 + f4[l] * 0.0;
-                }
-            }
-            let rest = xc.len() - xc.len() % 4;
-            for (&xi, &fi) in xc[rest..].iter().zip(&fc[rest..]) {
-                lanes[0] += xi * 0.0 + fi * 0.0;
-            }
-            for (&xi, &fi) in xc.iter().zip(fc) {
-                xmax = if xi > xmax { xi } else { xmax };
-                xmin = if xi < xmin { xi } else { xmin };
-                fmax = if fi > fmax { fi } else { fmax };
-                fmin = if fi < fmin { fi } else { fmin };
-            }
-        };
-        scan(&xs[..1], &fs[..1]);
-        let mut a = 1;
-        while a < m {
-            let b = m.min(a + Self::BLOCK);
-            let k = b - a;
-            let (xc, xq, fc, fq) = (&xs[a..b], &xs[a - 1..b - 1], &fs[a..b], &fs[a - 1..b - 1]);
-            for ((((t, &xi), &xo), &fi), &fo) in
-                terms[..k].iter_mut().zip(xc).zip(xq).zip(fc).zip(fq)
-            {
-                *t = 0.5 * (fi + fo) * (xi - xo);
-            }
-            for &t in &terms[..k] {
-                cum += t;
-            }
-            scan(xc, fc);
-            a = b;
-        }
-        self.finite &= lanes.iter().all(|&z| z == 0.0);
-        self.cum = cum;
-        self.ext = [xmax, xmin, fmax, fmin];
-        (self.xp, self.fp) = (xs[m - 1], fs[m - 1]);
-    }
-}
-
 /// [`cycle_block`] with the time of block sample `c` from `time(c)` (read at crossings only).
 /// `x` and `F` are checked finite in the pass itself (the pass is bound by the chain of
 /// additions of `∮ F dx`, and the test costs nothing beside it); a block with a non-finite
@@ -1075,17 +997,17 @@ fn cycle_block_with(
             (xp, fp) = (x[j], f[j]);
             j += 1;
         }
-        if j < c {
-            let mut sp = Span {
-                cum,
-                xp,
-                fp,
-                ext: [xmax, xmin, fmax, fmin],
-                finite,
-            };
-            sp.run(&x[j..c], &f[j..c]);
-            (cum, xp, fp, finite) = (sp.cum, sp.xp, sp.fp, sp.finite);
-            [xmax, xmin, fmax, fmin] = sp.ext;
+        for (&xi, &fi) in x[j..c].iter().zip(&f[j..c]) {
+            finite &= xi.is_finite() & fi.is_finite();
+            cum += 0.5 * (fi + fp) * (xi - xp);
+            // compare-and-select (finite samples, checked above): f64::max/min's NaN rules
+            // cost a compare, a blend and a dependency each on a generic x86-64 build
+            xmax = if xi > xmax { xi } else { xmax };
+            xmin = if xi < xmin { xi } else { xmin };
+            fmax = if fi > fmax { fi } else { fmax };
+            fmin = if fi < fmin { fi } else { fmin };
+            xp = xi;
+            fp = fi;
         }
         if c >= n {
             break;
@@ -1430,7 +1352,7 @@ mod tests {
         v.iter().map(|a| a.to_bits()).collect()
     }
 
-    /// Runs between crossings far longer than a block of `Span::run` (cycles of 700 to 3000
+    /// Runs between crossings of hundreds to thousands of samples (cycles of 700 to 3000
     /// samples, noisy, chunks cut anywhere, the drive x itself or another channel): the
     /// one-sample loop's numbers, bit for bit.
     #[test]
