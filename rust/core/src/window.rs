@@ -6,8 +6,9 @@
 //! area's noise sensitivities; the cycle-to-cycle spread of the per-cycle bin means and each cycle's half ranges. No
 //! per-cycle-and-bin table is kept: a cycle's bin (a "cell") is a contiguous run of samples
 //! (the phase never decreases), so each cell's mean is complete when the run ends and goes
-//! straight into its bin's running moments (Welford, with the co-moment with the phase that
-//! the spread's phase correction needs). Memory: a few values per bin and per cycle. The
+//! straight into its bin's moments (sums shifted by the bin's first cell mean, with the
+//! co-moment with the phase that the spread's phase correction needs; see `Bin`). Memory: a
+//! few values per bin and per cycle. The
 //! period means of `F` and `x` between the peaks take a pass of their own in the same call
 //! ([`crate::signal::period_means_pair`]'s, whose two running sums stay in registers there).
 //!
