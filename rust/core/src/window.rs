@@ -552,26 +552,34 @@ pub fn fold_window(
     let mut a0 = start;
     let mut a1 = end;
     let mut area_cycle: Option<usize> = None;
+    // the phase of sample i where the inner loop below computed it (in the same knot
+    // segment, so as this path would), else -1 (phases are >= kp[0] >= 0)
+    let mut carried = -1.0_f64;
     let mut i = start;
     while i < end {
         // a sample that may start a knot segment, a cycle or a cell
         let ti = t[i];
-        if ti >= k_hi {
-            // ti < t1 = kt[last]: j + 1 stays a knot
-            while kt[j + 1] <= ti {
-                j += 1;
-            }
-            slope = seg_slope(j);
-            (k_lo, k_hi, p_lo) = (kt[j], kt[j + 1], kp[j]);
-        }
-        let raw = if ti == k_lo {
-            p_lo
+        let (ph, clamped) = if carried >= 0.0 {
+            (carried, false)
         } else {
-            slope * (ti - k_lo) + p_lo
+            if ti >= k_hi {
+                // ti < t1 = kt[last]: j + 1 stays a knot
+                while kt[j + 1] <= ti {
+                    j += 1;
+                }
+                slope = seg_slope(j);
+                (k_lo, k_hi, p_lo) = (kt[j], kt[j + 1], kp[j]);
+            }
+            let raw = if ti == k_lo {
+                p_lo
+            } else {
+                slope * (ti - k_lo) + p_lo
+            };
+            // never back (rounding at a knot): each cell stays one run of samples
+            let clamped = raw < last_ph;
+            (if clamped { last_ph } else { raw }, clamped)
         };
-        // never back (rounding at a knot): each cell stays one run of samples
-        let clamped = raw < last_ph;
-        let ph = if clamped { last_ph } else { raw };
+        carried = -1.0;
         last_ph = ph;
         if !(ph >= c_lo && ph < c_hi) {
             // another cycle: ph >= kp[0] >= 0 and finite, below 2^33, so the conversion is
@@ -616,7 +624,7 @@ pub fn fold_window(
                 };
             }
             if cb != usize::MAX {
-                let n = (i - cell_start) as f64;
+                let n = (i - cell_start) as i64 as f64;
                 flush_cell(&mut bins[cb], &mut ranges[cc], n, (cx, cf, cp), &cur);
             }
             cc = cyc;
@@ -654,6 +662,7 @@ pub fn fold_window(
             let ph = slope * (ti - k_lo) + p_lo;
             let frac = ph - c_lo;
             if frac * nbf >= g_hi {
+                carried = ph;
                 break;
             }
             last_ph = ph;
@@ -671,7 +680,7 @@ pub fn fold_window(
         }
     }
     if cb != usize::MAX {
-        let n = (a1 - cell_start) as f64;
+        let n = (a1 - cell_start) as i64 as f64;
         flush_cell(&mut bins[cb], &mut ranges[cc], n, (cx, cf, cp), &cur);
     }
     for (b, s) in bins.iter().enumerate() {
