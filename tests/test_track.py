@@ -426,6 +426,54 @@ def test_fold_spread_is_the_numpy_spread(seed, n_bins, n_cyc):
     assert set(fold.sums(cells=False)) == {k for k in s if not k.startswith("cycle_")}
 
 
+@settings(max_examples=8, deadline=None)
+@given(
+    seed=st.integers(0, 10_000),
+    offset=st.sampled_from([0.0, 1e3, -7e5]),
+    spread=st.sampled_from([1e-6, 1e-3]),
+)
+def test_window_fold_spread_is_exact_on_the_cells(seed, offset, spread):
+    """The fold's spread against exact rational arithmetic on the same cell means (the cell
+    sums fold_phase gives, divided in double as both do) and slopes, on a large offset with a
+    small variation (x around 1e3 varying by 1e-6): <= 1e-12 relative. (Welford's running
+    mean rounded at the offset's scale: ~1e-7 here.)"""
+    from fractions import Fraction
+
+    from contactlab import _core
+
+    rng = np.random.default_rng(seed)
+    n_bins, n_cyc, per = 24, 12, 70
+    t = np.arange(n_cyc * per + 40, dtype=float) * 1e-3 + rng.uniform(0, 1e-4)
+    w = 2 * np.pi / (per * 1e-3)
+    x = offset + spread * (np.sin(w * t) + 0.05 * rng.standard_normal(t.size))
+    F = offset + spread * (np.cos(w * t + 0.3) + 0.05 * rng.standard_normal(t.size))
+    kt = t[5] + per * 1e-3 * np.arange(n_cyc + 1) + 1e-4 * rng.uniform(size=n_cyc + 1)
+    kp = np.arange(n_cyc + 1, dtype=float)
+    wf = _core.fold_window(t, x, F, kt, kp, n_bins, n_cyc, kt)
+    fold = _core.PhaseFold(n_bins, n_cyc)
+    fold.push(t, x, F, 0, kt, kp)
+    s = fold.sums()
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cx, cF = s["cycle_x"] / s["cycle_count"], s["cycle_F"] / s["cycle_count"]
+        cp = s["cycle_phase"] / s["cycle_count"]
+        xm, Fm = s["sum_x"] / s["count"], s["sum_F"] / s["count"]
+    got = wf.spread()
+    for v, m, key in ((cx, xm, "x_std"), (cF, Fm, "F_std")):
+        g = (np.roll(m, -1) - np.roll(m, 1)) * (n_bins / 2.0)
+        # m - g·φ per cell, exactly (the constant g·mean(φ) of fold_spread does not change
+        # the spread)
+        exact = np.empty(v.shape, dtype=object)
+        for (c, b), val in np.ndenumerate(v):
+            ok = s["cycle_count"][c, b] > 0
+            exact[c, b] = Fraction(val) - Fraction(g[b]) * Fraction(cp[c, b]) if ok else None
+        ref = []
+        for b in range(n_bins):
+            a = [e for e in exact[:, b] if e is not None]
+            mean = sum(a) / len(a)
+            ref.append(float(sum((e - mean) ** 2 for e in a) / (len(a) - 1)) ** 0.5)
+        np.testing.assert_allclose(got[key], ref, rtol=1e-12, atol=0)
+
+
 @settings(max_examples=60, deadline=None)
 @given(
     seed=st.integers(0, 10_000),

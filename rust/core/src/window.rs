@@ -6,8 +6,9 @@
 //! area's noise sensitivities; the cycle-to-cycle spread of the per-cycle bin means and each cycle's half ranges. No
 //! per-cycle-and-bin table is kept: a cycle's bin (a "cell") is a contiguous run of samples
 //! (the phase never decreases), so each cell's mean is complete when the run ends and goes
-//! straight into its bin's running moments (Welford, with the co-moment with the phase that
-//! the spread's phase correction needs). Memory: a few values per bin and per cycle. The
+//! straight into its bin's moments (sums shifted by the bin's first cell mean, with the
+//! co-moment with the phase that the spread's phase correction needs; see `Bin`). Memory: a
+//! few values per bin and per cycle. The
 //! period means of `F` and `x` between the peaks take a pass of their own in the same call
 //! ([`crate::signal::period_means_pair`]'s, whose two running sums stay in registers there).
 //!
@@ -51,50 +52,70 @@ pub struct WindowFold {
     pub mean_x: Vec<f64>,
 }
 
-/// Running moments of one bin's per-cycle means (Welford): cycles, means of x, F and φ,
-/// their squared deviations and the co-moments of x and F with φ.
+/// One phase bin during the pass: its sample sums (in sample order: `Σx`, `ΣF`, `Σφ`, `Σφ²`,
+/// `Σx²`, `Σt`), its samples, and the moments of its per-cycle means (the cells' means of x,
+/// F and φ) as sums shifted by the bin's first cell mean: cycles, the shift, the sums of the
+/// shifted means, of their squares and of their products with the shifted phase. The shifted
+/// sums are independent additions (Welford's running means were a dependent chain of
+/// divisions and products a cell, which runs every few samples); the shift keeps them
+/// accurate: a shifted mean is the exact difference of two close doubles, so an offset far
+/// above the spread (x around 1e3 varying by 1e-6) costs no digits, where Welford's running
+/// mean rounded at the offset's scale.
 #[derive(Debug, Clone, Copy, Default)]
-struct BinMoments {
+struct Bin {
+    sums: [f64; 6],
+    samples: f64,
     k: f64,
-    mx: f64,
-    mf: f64,
-    mp: f64,
-    m2x: f64,
-    m2f: f64,
-    m2p: f64,
-    cxp: f64,
-    cfp: f64,
+    shift: [f64; 3],
+    /// Σdx, Σdf, Σdp, Σdx², Σdf², Σdp², Σdx·dp, Σdf·dp
+    d: [f64; 8],
 }
 
-impl BinMoments {
-    /// `recip[k]` is `1.0 / k` (the same number the division gives: a table lookup instead of
-    /// a division a cell, which was a fifth of the cells' flush).
-    fn add(&mut self, x: f64, f: f64, p: f64, recip: &[f64]) {
+impl Bin {
+    /// A complete cell of `n` samples with sums `cx`, `cf`, `cp` of x, F, φ: its means into
+    /// the bin's moments; returns the means of x and F (the cycle's ranges).
+    #[inline(always)]
+    fn add_cell(&mut self, n: f64, cx: f64, cf: f64, cp: f64) -> (f64, f64) {
+        // the divisions of fold_spread's cell means (the same numbers)
+        let (mx, mf, mp) = (cx / n, cf / n, cp / n);
+        if self.k == 0.0 {
+            self.shift = [mx, mf, mp];
+        }
+        let (dx, df, dp) = (mx - self.shift[0], mf - self.shift[1], mp - self.shift[2]);
         self.k += 1.0;
-        // one reciprocal a cell instead of three divisions (this runs every few samples)
-        let r = recip.get(self.k as usize).copied().unwrap_or(1.0 / self.k);
-        let (dx, df, dp) = (x - self.mx, f - self.mf, p - self.mp);
-        self.mx += dx * r;
-        self.mf += df * r;
-        self.mp += dp * r;
-        let dp_new = p - self.mp;
-        self.m2x += dx * (x - self.mx);
-        self.m2f += df * (f - self.mf);
-        self.m2p += dp * dp_new;
-        self.cxp += dx * dp_new;
-        self.cfp += df * dp_new;
+        let d = &mut self.d;
+        d[0] += dx;
+        d[1] += df;
+        d[2] += dp;
+        d[3] += dx * dx;
+        d[4] += df * df;
+        d[5] += dp * dp;
+        d[6] += dx * dp;
+        d[7] += df * dp;
+        (mx, mf)
     }
 
-    /// Sample standard deviation of `m - g φ` (NaN below 2 cycles).
-    fn spread(&self, m2: f64, c: f64, g: f64) -> f64 {
-        if self.k < 2.0 {
-            return f64::NAN;
+    /// Sample standard deviations of `mx - gx·φ` and `mf - gf·φ` over the cycles (NaN below
+    /// two cycles, or where a slope is NaN: an empty neighbour bin, as fold_spread).
+    fn spread(&self, gx: f64, gf: f64) -> (f64, f64) {
+        let k = self.k;
+        if k < 2.0 {
+            return (f64::NAN, f64::NAN);
         }
-        let var = (m2 - 2.0 * g * c + g * g * self.m2p) / (self.k - 1.0);
-        if var.is_nan() {
-            return f64::NAN; // an empty neighbour bin: no slope (as fold_spread)
-        }
-        var.max(0.0).sqrt()
+        let d = &self.d;
+        // centred moments of the shifted means: the squares, the co-moments with φ
+        let m2p = d[5] - d[2] * d[2] / k;
+        let one = |sd: f64, sdd: f64, sdp: f64, g: f64| {
+            let m2 = sdd - sd * sd / k;
+            let c = sdp - sd * d[2] / k;
+            let var = (m2 - 2.0 * g * c + g * g * m2p) / (k - 1.0);
+            if var.is_nan() {
+                f64::NAN
+            } else {
+                var.max(0.0).sqrt()
+            }
+        };
+        (one(d[0], d[3], d[6], gx), one(d[1], d[4], d[7], gf))
     }
 }
 
@@ -121,11 +142,18 @@ impl Neumaier {
     }
 }
 
-/// The loop area of one cycle's samples (shoelace, scaled and Neumaier-summed as
-/// [`crate::masing::loop_area`]) and its noise sensitivities, in one tight loop: `(area, Σ coef_F², Σ coef_x²)`, the area in the
-/// samples' units; `ux`, `uf` scale x and F, `fm` centres the scaled F. Run once a cycle is
-/// complete, on samples still in cache, instead of sample by sample inside the fold (where
-/// its state competed for registers with the fold's).
+/// Lanes of the cycle sums (independent chains of additions).
+const LANES: usize = 4;
+
+/// The loop area of one cycle's samples (shoelace, scaled and compensated as
+/// [`crate::masing::loop_area`]) and its noise sensitivities: `(area, Σ coef_F², Σ coef_x²)`,
+/// the area in the samples' units; `ux`, `uf` scale x and F, `fm` centres the scaled F. Run
+/// once a cycle is complete, on samples still in cache. The sums run in four lanes (sample
+/// `i` in lane `i mod 4`), each area lane compensated (Knuth's two-sum: the exact rounding
+/// error of each addition, what Neumaier's ordered one gives, without its compare and
+/// selects) and the lanes combined by a compensated sum: the area to ~1e-16 of its terms'
+/// scale, as the sequential Neumaier sum, in independent chains of additions (the
+/// sequential sum was one chain of dependent additions a sample).
 // Index arithmetic: m >= 3, so m - 1 and m - 2 are samples of the cycle.
 #[allow(clippy::arithmetic_side_effects)]
 fn cycle_area(x: &[f64], f: &[f64], ux: f64, uf: f64, fm: f64, scale: f64) -> (f64, f64, f64) {
@@ -134,22 +162,62 @@ fn cycle_area(x: &[f64], f: &[f64], ux: f64, uf: f64, fm: f64, scale: f64) -> (f
         return (f64::NAN, 0.0, 0.0);
     }
     let (x, f) = (&x[..m], &f[..m]);
-    let mut a = Neumaier::default();
-    let (x0, f0) = (x[0] * ux, f[0] * uf - fm);
-    let (mut xp, mut fp) = (x0, f0);
-    for (&xi, &fi) in x[1..].iter().zip(&f[1..]) {
-        let (xs, fs) = (xi * ux, fi * uf - fm);
-        a.add(0.5 * (fp + fs) * (xs - xp));
-        (xp, fp) = (xs, fs);
+    // the shoelace terms 0.5·(F[i-1] + F[i])·(x[i] - x[i-1]) of the scaled samples, i >= 1
+    let term = |xp: f64, xs: f64, fp: f64, fs: f64| {
+        let (xp, xs, fp, fs) = (xp * ux, xs * ux, fp * uf - fm, fs * uf - fm);
+        0.5 * (fp + fs) * (xs - xp)
+    };
+    let (mut s, mut c) = ([0.0_f64; LANES], [0.0_f64; LANES]);
+    let (xa, xb, fa, fb) = (&x[..m - 1], &x[1..], &f[..m - 1], &f[1..]);
+    let mut it = xa
+        .chunks_exact(LANES)
+        .zip(xb.chunks_exact(LANES))
+        .zip(fa.chunks_exact(LANES))
+        .zip(fb.chunks_exact(LANES));
+    for (((xa, xb), fa), fb) in &mut it {
+        for k in 0..LANES {
+            let v = term(xa[k], xb[k], fa[k], fb[k]);
+            // two-sum: t + e = s + v exactly
+            let t = s[k] + v;
+            let bb = t - s[k];
+            c[k] += (s[k] - (t - bb)) + (v - bb);
+            s[k] = t;
+        }
     }
-    a.add(0.5 * (fp + f0) * (x0 - xp));
-    let (mut sf, mut sx) = (0.0_f64, 0.0_f64);
-    // each sample's neighbours i - 1 and i + 1 as four slices of one length (`windows(3)`
-    // of both channels kept bounds checks and a reload from the stack in the loop)
+    let mut a = Neumaier::default();
+    for &v in &s {
+        a.add(v);
+    }
+    a.comp += c.iter().sum::<f64>();
+    let done = (m - 1) / LANES * LANES;
+    for i in done..m - 1 {
+        a.add(term(xa[i], xb[i], fa[i], fb[i]));
+    }
+    // the closing term, last sample to first
+    a.add(term(x[m - 1], x[0], f[m - 1], f[0]));
+    // each sample's neighbours i - 1 and i + 1 as four slices of one length
     let (xa, xb, fa, fb) = (&x[..m - 2], &x[2..], &f[..m - 2], &f[2..]);
-    for (((&x0, &x2), &f0), &f2) in xa.iter().zip(xb).zip(fa).zip(fb) {
-        let cf = 0.5 * (x0 - x2);
-        let cx = 0.5 * (f2 - f0);
+    let (mut sf, mut sx) = ([0.0_f64; LANES], [0.0_f64; LANES]);
+    let mut it = xa
+        .chunks_exact(LANES)
+        .zip(xb.chunks_exact(LANES))
+        .zip(fa.chunks_exact(LANES))
+        .zip(fb.chunks_exact(LANES));
+    for (((xa, xb), fa), fb) in &mut it {
+        for k in 0..LANES {
+            let cf = 0.5 * (xa[k] - xb[k]);
+            let cx = 0.5 * (fb[k] - fa[k]);
+            sf[k] += cf * cf;
+            sx[k] += cx * cx;
+        }
+    }
+    let (mut sf, mut sx) = (
+        (sf[0] + sf[1]) + (sf[2] + sf[3]),
+        (sx[0] + sx[1]) + (sx[2] + sx[3]),
+    );
+    for i in (m - 2) / LANES * LANES..m - 2 {
+        let cf = 0.5 * (xa[i] - xb[i]);
+        let cx = 0.5 * (fb[i] - fa[i]);
         sf += cf * cf;
         sx += cx * cx;
     }
@@ -232,15 +300,25 @@ fn check_samples(t: &[f64], x: &[f64], f: &[f64], edges: &[f64]) -> Result<[f64;
         }
     }
     check_edges(edges)?;
-    let sx = x.iter().fold(0.0_f64, |a, &v| a.max(v.abs()));
-    let sf = f.iter().fold(0.0_f64, |a, &v| a.max(v.abs()));
-    // the mean of F / sf (no overflow), the centre of the scaled force
-    let fm = if sf > 0.0 {
-        f.iter().map(|&v| v / sf).sum::<f64>() / f.len() as f64
+    let (_, sx, _) = finite_max_abs(x);
+    let (_, sf, sum_f) = finite_max_abs(f);
+    Ok([sx, sf, force_centre(f, sum_f, sf)])
+}
+
+/// The mean of `F / sf`, the centre of the scaled force in the loop areas (any value near the
+/// mean serves: the shoelace sum of a closed loop does not depend on it but for rounding):
+/// from the sum of F (`sum_f`, summed with the channel's check) where that is finite, else
+/// summed over `F / sf` (no overflow).
+fn force_centre(f: &[f64], sum_f: f64, sf: f64) -> f64 {
+    if sf <= 0.0 {
+        return 0.0;
+    }
+    let n = f.len() as f64;
+    if sum_f.is_finite() {
+        sum_f / sf / n
     } else {
-        0.0
-    };
-    Ok([sx, sf, fm])
+        f.iter().map(|&v| v / sf).sum::<f64>() / n
+    }
 }
 
 fn check_edges(edges: &[f64]) -> Result<(), CoreError> {
@@ -257,33 +335,37 @@ fn check_edges(edges: &[f64]) -> Result<(), CoreError> {
     Ok(())
 }
 
-/// Whether every value of `v` is finite, and the largest `|v|` (0 for none): four lanes of
-/// compare-selects (`f64::max`'s NaN handling kept the loop scalar).
+/// Whether every value of `v` is finite, the largest `|v|` (0 for none) and the sum of `v`
+/// (four lanes; inf or NaN where it overflows): four lanes of compare-selects (`f64::max`'s
+/// NaN handling kept the loop scalar).
 // Index arithmetic: k < 4.
 #[allow(clippy::arithmetic_side_effects)]
-fn finite_max_abs(v: &[f64]) -> (bool, f64) {
+fn finite_max_abs(v: &[f64]) -> (bool, f64, f64) {
     let mut m = [0.0_f64; 4];
+    let mut s = [0.0_f64; 4];
     let mut ok = [true; 4];
     let mut chunks = v.chunks_exact(4);
     for c in &mut chunks {
         for k in 0..4 {
             let a = c[k].abs();
             m[k] = if a > m[k] { a } else { m[k] };
+            s[k] += c[k];
             ok[k] &= c[k].is_finite();
         }
     }
     for (k, &x) in chunks.remainder().iter().enumerate() {
         let a = x.abs();
         m[k] = if a > m[k] { a } else { m[k] };
+        s[k] += x;
         ok[k] &= x.is_finite();
     }
     let big = m.iter().fold(0.0_f64, |a, &b| if b > a { b } else { a });
-    (ok.iter().all(|&o| o), big)
+    (ok.iter().all(|&o| o), big, (s[0] + s[1]) + (s[2] + s[3]))
 }
 
-/// [`check_samples`]' checks and numbers in a vectorised pass a channel (the same maxima, and
-/// the mean of `F / sf` summed in the same order once `sf` is known: a second pass over F
-/// only); None when a check fails (the separate checks then name the first failure).
+/// [`check_samples`]' checks and numbers in a vectorised pass a channel (the maxima, and the
+/// sum of F for its centre in the same pass); None when a check fails (the separate checks
+/// then name the first failure).
 // bitwise ands: no early exit, so the loop over t vectorises
 #[allow(clippy::arithmetic_side_effects, clippy::needless_bitwise_bool)]
 fn clean_samples(t: &[f64], x: &[f64], f: &[f64]) -> Option<[f64; 3]> {
@@ -298,18 +380,13 @@ fn clean_samples(t: &[f64], x: &[f64], f: &[f64]) -> Option<[f64; 3]> {
             .iter()
             .zip(&t[1..])
             .fold(true, |o, (&a, &b)| o & (b > a) & b.is_finite());
-    let (ok_x, sx) = finite_max_abs(x);
-    let (ok_f, sf) = finite_max_abs(f);
+    let (ok_x, sx, _) = finite_max_abs(x);
+    let (ok_f, sf, sum_f) = finite_max_abs(f);
     let ok = ok && ok_x && ok_f;
     if !ok {
         return None;
     }
-    let fm = if sf > 0.0 {
-        f.iter().map(|&v| v / sf).sum::<f64>() / f.len() as f64
-    } else {
-        0.0
-    };
-    Some([sx, sf, fm])
+    Some([sx, sf, force_centre(f, sum_f, sf)])
 }
 
 /// `F - s_F·(t - tm)` and `x - s_x·(t - tm)` (the window's linear drifts removed), one
@@ -349,14 +426,34 @@ pub fn detrend_pair_into(
     Ok(())
 }
 
+/// A complete cell (`n` samples, sums `cx`, `cf`, `cp` of x, F, φ) of a bin whose sample
+/// sums are now `cur`: into the bin and the cycle's ranges `r` of cell means.
+#[inline(always)]
+fn flush_cell(
+    bin: &mut Bin,
+    r: &mut [f64; 4],
+    n: f64,
+    (cx, cf, cp): (f64, f64, f64),
+    cur: &[f64; 6],
+) {
+    bin.sums = *cur;
+    bin.samples += n;
+    let (mx, mf) = bin.add_cell(n, cx, cf, cp);
+    // f64::max and min without their NaN handling (a NaN mean is skipped by both)
+    r[0] = if mx > r[0] { mx } else { r[0] };
+    r[1] = if mx < r[1] { mx } else { r[1] };
+    r[2] = if mf > r[2] { mf } else { r[2] };
+    r[3] = if mf < r[3] { mf } else { r[3] };
+}
+
 /// Fold `(t, x, F)` (one window, `t` strictly increasing) by the phase knots `(kt, kp)` into
 /// `n_bins` bins per cycle over `n_cycles` cycles, with the phases and bins of
 /// [`crate::signal::fold_phase`], and derive the per-cycle quantities and period means (see
 /// [`WindowFold`]) in the same pass. The samples folded are those with
 /// `kt[0] <= t < kt[last]`; a cycle's samples run from its first folded sample to the next
 /// cycle's (the last to the first sample at or after `kt[last]`).
-// Index arithmetic: b < n_bins and c < n_cycles (checked against the allocations), e < the
-// edges' length inside the loops, i >= 1 where i - 1 is taken.
+// Index arithmetic: b < n_bins and c < n_cycles (checked against the allocations), j + 1 <
+// the knots' length (t < kt[last] inside the loop), i < end <= n inside the loops.
 // Not inlined: with fat LTO the binding inlined it into its wrapper, where the fold's loop
 // kept more of its state on the stack (26 against 22 ms a window of 2^20 samples).
 #[allow(clippy::arithmetic_side_effects, clippy::too_many_lines)]
@@ -407,9 +504,8 @@ pub fn fold_window(
         mean_f: Vec::new(),
         mean_x: Vec::new(),
     };
-    let mut moments = vec![BinMoments::default(); nb];
-    // per bin: samples, Σx, ΣF, Σφ, Σφ², Σx², Σt (scattered into `w` after the pass)
-    let mut bins = vec![[0.0_f64; 8]; nb];
+    let mut bins = vec![Bin::default(); nb];
+    // per cycle: the largest and smallest cell mean of x, of F
     let mut ranges = vec![
         [
             f64::NEG_INFINITY,
@@ -426,81 +522,77 @@ pub fn fold_window(
     );
     let area_scale = sx * sf;
     let (t0, t1) = (kt[0], kt[kt.len() - 1]);
-    let n = t.len();
-    // the fold
-    let mut j = 0_usize;
+    // the samples folded: [start, end) (t increasing), less those past the last cycle (a
+    // suffix: the phase never decreases)
+    let start = t.partition_point(|&v| v < t0);
+    let end = t.partition_point(|&v| v < t1);
+    let (t_all, x_all, f_all) = (t, x, f);
+    let (t, x, f) = (&t[..end], &x[..end], &f[..end]);
     let seg_slope = |j: usize| (kp[j + 1] - kp[j]) / (kt[j + 1] - kt[j]);
-    let mut slope = seg_slope(0);
+    let mut j = 0_usize;
+    let (mut k_lo, mut k_hi, mut p_lo, mut slope) = (kt[0], kt[1], kp[0], seg_slope(0));
     let mut last_ph = f64::NEG_INFINITY;
-    // the open cell (cycle c, bin b) and its sums: samples, Σx, ΣF, Σφ. The cell is tracked by
-    // the phase intervals it covers, [c_lo, c_hi) and, within the cycle, [b_lo, b_hi) of
-    // frac·n_bins: a sample inside both is in the same cell, with no float-to-integer
-    // conversion (two saturating conversions a sample were a quarter of the pass); the
-    // indices are those of `floor` as before, bit for bit
-    let mut cell: Option<(usize, usize)> = None;
+    // the open cell (cycle cc, bin cb) is tracked by the phase intervals it covers, [c_lo,
+    // c_hi) and, within the cycle, [b_lo, b_hi) of frac·n_bins: a sample inside both is in
+    // the same cell, with no float-to-integer conversion; the indices are those of `floor`
+    // as fold_phase's, bit for bit
     let (mut c_lo, mut c_hi) = (f64::INFINITY, f64::NEG_INFINITY);
     let (mut b_lo, mut b_hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    let (mut cc, mut cb) = (0_usize, 0_usize);
+    // the current cycle; the open cell's cycle and bin (MAX: none yet)
+    let mut cyc = 0_usize;
+    let (mut cc, mut cb) = (usize::MAX, usize::MAX);
     let nbf = nb as f64;
-    let mut cell_sums = [0.0_f64; 4];
-    // the open cell's bin sums, kept in registers while the cell's run of samples lasts and
-    // stored back when it ends (the same additions in the same order as adding into
-    // `bins[cb]` sample by sample, which the compiler kept in memory: a load and a store of
-    // seven sums a sample)
-    let mut cur = [0.0_f64; 8];
-    let mut cur_bin: Option<usize> = None;
-    // the open cycle's samples: [a0, a1)
-    let (mut a0, mut a1) = (0_usize, 0_usize);
+    // the open cell's first sample and sums of x, F, φ; its bin's sample sums, kept in
+    // registers while the cell's run of samples lasts (the same additions in the same order
+    // as adding into the bin sample by sample)
+    let mut cell_start = start;
+    let (mut cx, mut cf, mut cp) = (0.0_f64, 0.0_f64, 0.0_f64);
+    let mut cur = [0.0_f64; 6];
+    // the open cycle's first sample, and the end of the folded samples
+    let mut a0 = start;
+    let mut a1 = end;
     let mut area_cycle: Option<usize> = None;
-    let mut end = n;
-    // 1/k for the cycles a bin can collect (k <= n_cycles)
-    let recip: Vec<f64> = (0..=nc).map(|k| 1.0 / k as f64).collect();
-    let flush_cell =
-        |c: usize, b: usize, s: &[f64; 4], moments: &mut [BinMoments], ranges: &mut [[f64; 4]]| {
-            let (mx, mf, mp) = (s[1] / s[0], s[2] / s[0], s[3] / s[0]);
-            moments[b].add(mx, mf, mp, &recip);
-            let r = &mut ranges[c];
-            *r = [r[0].max(mx), r[1].min(mx), r[2].max(mf), r[3].min(mf)];
-        };
-    let (mut k_lo, mut k_hi, mut p_lo) = (kt[0], kt[1], kp[0]);
-    for i in 0..n {
-        let (ti, xi, fi) = (t[i], x[i], f[i]);
-        if !(ti >= t0 && ti < t1) {
-            if ti >= t1 && end == n {
-                end = i;
-            }
-            continue;
-        }
-        if ti < k_lo || k_hi <= ti {
-            if ti < kt[j] {
-                j = 0;
-            }
-            while kt[j + 1] <= ti {
-                j += 1;
-            }
-            slope = seg_slope(j);
-            (k_lo, k_hi, p_lo) = (kt[j], kt[j + 1], kp[j]);
-        }
-        let mut ph = if ti == k_lo {
-            p_lo
+    // the phase of sample i where the inner loop below computed it (in the same knot
+    // segment, so as this path would), else -1 (phases are >= kp[0] >= 0)
+    let mut carried = -1.0_f64;
+    let mut i = start;
+    while i < end {
+        // a sample that may start a knot segment, a cycle or a cell
+        let ti = t[i];
+        let (ph, clamped) = if carried >= 0.0 {
+            (carried, false)
         } else {
-            slope * (ti - k_lo) + p_lo
+            if ti >= k_hi {
+                // ti < t1 = kt[last]: j + 1 stays a knot
+                while kt[j + 1] <= ti {
+                    j += 1;
+                }
+                slope = seg_slope(j);
+                (k_lo, k_hi, p_lo) = (kt[j], kt[j + 1], kp[j]);
+            }
+            let raw = if ti == k_lo {
+                p_lo
+            } else {
+                slope * (ti - k_lo) + p_lo
+            };
+            // never back (rounding at a knot): each cell stays one run of samples
+            let clamped = raw < last_ph;
+            (if clamped { last_ph } else { raw }, clamped)
         };
-        // never back (rounding at a knot): each cell stays one run of samples
-        if ph < last_ph {
-            ph = last_ph;
-        }
+        carried = -1.0;
         last_ph = ph;
         if !(ph >= c_lo && ph < c_hi) {
             // another cycle: ph >= kp[0] >= 0 and finite, below 2^33, so the conversion is
             // floor
             let c = ph as usize;
             if c >= nc {
-                continue;
+                // past the last cycle, as every later sample
+                a1 = i;
+                break;
             }
             c_lo = c as f64;
             c_hi = c_lo + 1.0;
-            cc = c;
+            cyc = c;
             (b_lo, b_hi) = (f64::INFINITY, f64::NEG_INFINITY);
             if w.first[c] < 0 {
                 w.first[c] = i64::try_from(i).unwrap_or(i64::MAX);
@@ -531,46 +623,74 @@ pub fn fold_window(
                     b_lo + 1.0
                 };
             }
-            if let Some((oc, ob)) = cell {
-                flush_cell(oc, ob, &cell_sums, &mut moments, &mut ranges);
+            if cb != usize::MAX {
+                let n = (i - cell_start) as i64 as f64;
+                flush_cell(&mut bins[cb], &mut ranges[cc], n, (cx, cf, cp), &cur);
             }
-            if let Some(ob) = cur_bin {
-                bins[ob] = cur;
-            }
+            cc = cyc;
             cb = b;
-            cur = bins[cb];
-            cur_bin = Some(cb);
-            cell = Some((cc, cb));
-            cell_sums = [0.0; 4];
+            cur = bins[cb].sums;
+            cell_start = i;
+            (cx, cf, cp) = (0.0, 0.0, 0.0);
         }
-        // the bin's sums (the same additions, in the same order)
-        cur[0] += 1.0;
-        cur[1] += xi;
-        cur[2] += fi;
-        cur[3] += frac;
-        cur[4] += frac * frac;
-        cur[5] += xi * xi;
-        cur[6] += ti;
-        cell_sums[0] += 1.0;
-        cell_sums[1] += xi;
-        cell_sums[2] += fi;
-        cell_sums[3] += frac;
-        a1 = i + 1;
+        let (xi, fi) = (x[i], f[i]);
+        cur[0] += xi;
+        cur[1] += fi;
+        cur[2] += frac;
+        cur[3] += frac * frac;
+        cur[4] += xi * xi;
+        cur[5] += ti;
+        cx += xi;
+        cf += fi;
+        cp += frac;
+        i += 1;
+        if clamped {
+            // the next sample's phase may need the clamp too
+            continue;
+        }
+        // The samples that follow in the same knot segment, cycle and bin. Within a segment
+        // the phase is a monotone function of t (so no clamp: this sample was not clamped),
+        // and g < g_hi places a sample in the cell: g >= b_lo (monotone) and frac < 1
+        // (frac >= 1 gives g >= n_bins); the last bin's edge n_bins is its cycle's end but
+        // for rounding, which the path above decides.
+        let g_hi = if b_hi > nbf { nbf } else { b_hi };
+        while i < end {
+            let ti = t[i];
+            if ti >= k_hi {
+                break;
+            }
+            let ph = slope * (ti - k_lo) + p_lo;
+            let frac = ph - c_lo;
+            if frac * nbf >= g_hi {
+                carried = ph;
+                break;
+            }
+            last_ph = ph;
+            let (xi, fi) = (x[i], f[i]);
+            cur[0] += xi;
+            cur[1] += fi;
+            cur[2] += frac;
+            cur[3] += frac * frac;
+            cur[4] += xi * xi;
+            cur[5] += ti;
+            cx += xi;
+            cf += fi;
+            cp += frac;
+            i += 1;
+        }
     }
-    if let Some((cc, cb)) = cell {
-        flush_cell(cc, cb, &cell_sums, &mut moments, &mut ranges);
-    }
-    if let Some(ob) = cur_bin {
-        bins[ob] = cur;
+    if cb != usize::MAX {
+        let n = (a1 - cell_start) as i64 as f64;
+        flush_cell(&mut bins[cb], &mut ranges[cc], n, (cx, cf, cp), &cur);
     }
     for (b, s) in bins.iter().enumerate() {
-        w.count[b] = s[0];
-        w.sum_x[b] = s[1];
-        w.sum_f[b] = s[2];
-        w.sum_phase[b] = s[3];
-        w.sum_phase2[b] = s[4];
-        w.sum_xx[b] = s[5];
-        w.sum_t[b] = s[6];
+        w.count[b] = s.samples;
+        w.sum_x[b] = s.sums[0];
+        w.sum_f[b] = s.sums[1];
+        w.sum_phase[b] = s.sums[2];
+        w.sum_phase2[b] = s.sums[3];
+        w.sum_xx[b] = s.sums[4];
+        w.sum_t[b] = s.sums[5];
     }
     if let Some(ac) = area_cycle {
         (w.energy[ac], w.sens_f[ac], w.sens_x[ac]) =
@@ -587,16 +707,15 @@ pub fn fold_window(
     }
     // the period means between the edges in a pass of their own (period_means_pair's: the
     // same numbers; in this loop its two running sums were kept on the stack)
-    (w.mean_f, w.mean_x) = period_means_pair_checked(t, f, x, edges);
+    (w.mean_f, w.mean_x) = period_means_pair_checked(t_all, f_all, x_all, edges);
     // the spread, phase-corrected by each bin's slope along phase (fold_spread)
     let half_n = nb as f64 / 2.0;
     let mean_of = |s: &[f64], b: usize| s[b] / w.count[b];
-    for (b, m) in moments.iter().enumerate() {
+    for (b, m) in bins.iter().enumerate() {
         let (bn, bp) = ((b + 1) % nb, (b + nb - 1) % nb);
         let gx = (mean_of(&w.sum_x, bn) - mean_of(&w.sum_x, bp)) * half_n;
         let gf = (mean_of(&w.sum_f, bn) - mean_of(&w.sum_f, bp)) * half_n;
-        w.x_std[b] = m.spread(m.m2x, m.cxp, gx);
-        w.f_std[b] = m.spread(m.m2f, m.cfp, gf);
+        (w.x_std[b], w.f_std[b]) = m.spread(gx, gf);
     }
     for (c, r) in ranges.iter().enumerate() {
         if r[0] >= r[1] {
@@ -723,6 +842,130 @@ mod tests {
             prop_assert!(close(&w.sens_x, &sx, 1e-12));
             prop_assert_eq!(&w.mean_f, &period_means(&t, &f, &edges).unwrap());
             prop_assert_eq!(&w.mean_x, &period_means(&t, &x, &edges).unwrap());
+        }
+    }
+
+    /// Equal, NaN where NaN.
+    fn same(a: &[f64], b: &[f64]) -> bool {
+        a.len() == b.len()
+            && a.iter()
+                .zip(b)
+                .all(|(u, v)| u == v || (u.is_nan() && v.is_nan()))
+    }
+
+    /// The phases fold_phase gives (numpy.interp's arithmetic), None where they decrease
+    /// (rounding at a knot: fold_window holds the phase there, fold_phase does not).
+    fn monotone_phases(t: &[f64], kt: &[f64], kp: &[f64]) -> Option<()> {
+        let mut last = f64::NEG_INFINITY;
+        for &ti in t {
+            if !(ti >= kt[0] && ti < kt[kt.len() - 1]) {
+                continue;
+            }
+            let j = kt.partition_point(|&k| k <= ti) - 1;
+            let slope = (kp[j + 1] - kp[j]) / (kt[j + 1] - kt[j]);
+            let ph = if ti == kt[j] {
+                kp[j]
+            } else {
+                slope * (ti - kt[j]) + kp[j]
+            };
+            if ph < last {
+                return None;
+            }
+            last = ph;
+        }
+        Some(())
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(200))]
+        /// Irregular sampling and knots: flat knot segments (a phase that stands still),
+        /// steep ones (bins and cycles without samples), knots between samples and on them,
+        /// one or two bins, samples before the first knot and after the last: the per-bin
+        /// sums, first samples, bounds and ranges are fold_phase's bit for bit, the spread,
+        /// areas and sensitivities the separate kernels' to rounding.
+        #[test]
+        fn irregular_knots_fold_as_fold_phase(
+            seed in 0u64..1_000_000, n_bins in 1usize..12, n_cyc in 1usize..6,
+            n in 20usize..400, n_knots in 2usize..30,
+        ) {
+            let mut s = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(7);
+            let mut u = move || {
+                s = s
+                    .wrapping_mul(6_364_136_223_846_793_005)
+                    .wrapping_add(1_442_695_040_888_963_407);
+                (s >> 11) as f64 / (1u64 << 53) as f64
+            };
+            let mut t = Vec::with_capacity(n);
+            let mut v = 0.0;
+            for _ in 0..n {
+                v += 0.05 + u();
+                t.push(v);
+            }
+            let x: Vec<f64> = t.iter().map(|&ti| (0.7 * ti).sin() + 0.1 * u()).collect();
+            let f: Vec<f64> = t.iter().map(|&ti| (0.7 * ti + 0.5).cos() + 0.1 * u() - 3.0).collect();
+            // knots: some on samples, some between, from before the first sample to after
+            // the last
+            let span = t[n - 1] - t[0];
+            let mut kt: Vec<f64> = (0..n_knots)
+                .map(|_| {
+                    if u() < 0.3 {
+                        t[(u() * n as f64) as usize % n]
+                    } else {
+                        t[0] - 0.1 * span + 1.2 * span * u()
+                    }
+                })
+                .collect();
+            kt.sort_by(f64::total_cmp);
+            kt.dedup();
+            prop_assume!(kt.len() >= 2);
+            let mut kp: Vec<f64> = (0..kt.len())
+                .map(|_| if u() < 0.2 { 0.0 } else { u() * n_cyc as f64 })
+                .collect();
+            kp.sort_by(f64::total_cmp);
+            if u() < 0.3 {
+                kp[0] = 0.0;
+            }
+            if u() < 0.3 {
+                let last = kp.len() - 1;
+                kp[last] = n_cyc as f64;
+            }
+            prop_assume!(monotone_phases(&t, &kt, &kp).is_some());
+            let edges: Vec<f64> = kt.iter().step_by(2).copied().collect();
+            let w = fold_window(&t, &x, &f, &kt, &kp, n_bins, n_cyc, &edges).unwrap();
+            let mut sm = FoldSums::new(n_bins, n_cyc).unwrap();
+            fold_phase(&t, &x, &f, 0, &kt, &kp, &mut sm).unwrap();
+            prop_assert_eq!(&w.count, &sm.count);
+            prop_assert_eq!(&w.sum_x, &sm.sum_x);
+            prop_assert_eq!(&w.sum_f, &sm.sum_f);
+            prop_assert_eq!(&w.sum_phase, &sm.sum_phase);
+            prop_assert_eq!(&w.sum_phase2, &sm.sum_phase2);
+            prop_assert_eq!(&w.sum_xx, &sm.sum_xx);
+            prop_assert_eq!(&w.sum_t, &sm.sum_t);
+            prop_assert_eq!(&w.first, &sm.first);
+            let sp = fold_spread(&sm).unwrap();
+            prop_assert!(close(&w.x_std, &sp.x_std, 1e-8), "{:?} {:?}", w.x_std, sp.x_std);
+            prop_assert!(close(&w.f_std, &sp.f_std, 1e-8));
+            prop_assert!(same(&w.amplitude, &sp.amplitude), "{:?} {:?}", w.amplitude, sp.amplitude);
+            prop_assert!(same(&w.force_range, &sp.force_range));
+            let end = t.iter().position(|&v| v >= kt[kt.len() - 1]).unwrap_or(t.len());
+            let mut b: Vec<usize> = sm
+                .first
+                .iter()
+                .map(|&v| if v < 0 { end } else { v as usize })
+                .chain(std::iter::once(end))
+                .collect();
+            for i in (0..b.len() - 1).rev() {
+                b[i] = b[i].min(b[i + 1]);
+            }
+            prop_assert_eq!(&w.bounds, &b);
+            // the areas of the cycles' own samples: the last cycle's run to the last sample
+            // folded (a cycle past n_cycles folds none)
+            let areas = loop_areas(&x, &f, &b).unwrap();
+            let (sf, sx) = loop_area_sensitivity(&x, &f, &b).unwrap();
+            prop_assert!(close(&w.energy, &areas, 1e-12), "{:?} {:?}", w.energy, areas);
+            prop_assert!(close(&w.sens_f, &sf, 1e-12));
+            prop_assert!(close(&w.sens_x, &sx, 1e-12));
+            prop_assert_eq!(&w.mean_f, &period_means(&t, &f, &edges).unwrap());
         }
     }
 
