@@ -398,3 +398,31 @@ def test_structure_check_started_ahead_is_waited_for_and_damage_still_named(tmp_
     with pytest.raises(RecordingError, match=r"global heap collection at byte \d+"):
         read_recording(bad)
     assert not hdf5._PENDING
+
+
+def test_a_scan_started_ahead_stops_when_the_command_line_ends(tmp_path, monkeypatch):
+    """A usage error or Ctrl-C ends the run before it opens the file: the scan started ahead
+    stops at its next block (the exit does not wait for a read of the whole file), and the
+    file is not recorded as checked."""
+    import threading
+
+    from contactlab.io import hdf5
+
+    monkeypatch.setattr(hdf5, "_CACHE_ABOVE", 1 << 10)
+    monkeypatch.setattr(hdf5, "_CHECKED", set())
+    monkeypatch.setattr(hdf5, "_STOP", threading.Event())
+    monkeypatch.setattr(hdf5._FileView, "BLOCK", 64)  # many blocks: the stop lands in one
+    started = threading.Event()
+    real = hdf5._FileView._scan_blocks
+
+    def slow(self, *a, **k):
+        started.set()
+        hdf5._STOP.wait(5)  # the stop arrives while the scan runs
+        return real(self, *a, **k)
+
+    monkeypatch.setattr(hdf5._FileView, "_scan_blocks", slow)
+    path, _ = _gcol_file(tmp_path)
+    assert hdf5.prefetch_structure_check(path)
+    assert started.wait(5)
+    hdf5.stop_prefetched_checks()
+    assert not hdf5._PENDING and not hdf5._CHECKED

@@ -255,6 +255,8 @@ class _FileView:
         buf = owner._buf if owner is not None else bytearray()
         out: dict[int, list[list[int]]] = {}
         for at in starts:
+            if _STOP.is_set():  # the process is ending (stop_prefetched_checks)
+                raise InputError("the structure check was stopped: the process is ending")
             want = min(self.BLOCK + longest - 1, self.size - at)
             if len(buf) < want:
                 buf = bytearray(want)
@@ -345,6 +347,22 @@ _PENDING: dict[tuple[int, int, int, int, int], threading.Thread] = {}
 _PENDING_LOCK = threading.Lock()
 #: the HDF5 format signature (at offset 0, or 512, 1024, ... after a user block)
 _SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+#: set when the process ends (:func:`stop_prefetched_checks`): scans stop at their next block
+_STOP = threading.Event()
+
+
+def stop_prefetched_checks() -> None:
+    """Stop the scans of checks started ahead that are still running (the command line ends
+    before it opened their file: a usage error, an interrupt), so that the process does not
+    wait for a scan of a long file at exit; a check stopped so is not recorded as passed."""
+    with _PENDING_LOCK:
+        running = list(_PENDING.values())
+    if running:
+        _STOP.set()
+        for th in running:
+            th.join()
 
 
 def prefetch_structure_check(path: str | Path) -> bool:
