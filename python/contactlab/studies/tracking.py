@@ -397,17 +397,16 @@ def _normal_row(d: dict[str, Any]) -> tuple[dict, dict]:
 
 class _Windows:
     """The samples of the stream not yet handed to a window, by global sample index, in one
-    array per channel and ``t`` that the reader writes the chunks into
-    (:meth:`~contactlab.io.ChunkedRecording.chunks_into`): a window is a view of it, no copy.
+    array per channel (and ``t``, unless made from the sampling interval) that the reader
+    writes the chunks into (:meth:`~contactlab.io.ChunkedRecording.chunks_into`): a window
+    is a view of it, no copy.
 
     Windows cut one after the other share the array until the next might not fit in what is
     left of it; then a new one is started, sized for a window as long as the last plus a
     chunk, and the samples already read past the cut (less than a chunk) are copied over. A
     window that outgrows its array moves to one twice as long (rare: the first window, or one
-    much longer than the last). A time axis made from the sampling interval is written by
-    the reader into the array like a channel (``fill_time`` of each chunk: the window's time
-    stamps bit for bit); it used to be made once more for each window and each chunk's in an
-    array of its own (0.4 s of the reading thread on 1e8 samples, and a fresh 2 MB a chunk).
+    much longer than the last). A time axis made from the sampling interval (``time_step``)
+    is made for each window instead (bit for bit the chunks'), and each chunk's on its own.
     """
 
     def __init__(self, first_window: int, time_step: tuple[float, float] | None) -> None:
@@ -432,7 +431,7 @@ class _Windows:
     def alloc(self, m: int, names: list[str]) -> dict[str, np.ndarray]:
         """Room for the next chunk of ``m`` samples (``read_chunks``' ``alloc``)."""
         self.chunk = max(self.chunk, m)
-        kept = list(names)
+        kept = [k for k in names if not (k == "t" and self.time_step is not None)]
         if self.arrays and list(self.arrays) != kept:
             raise InputError(f"the chunks' channels changed: {list(self.arrays)} -> {kept}")
         if self.used + m > self.cap:
@@ -440,7 +439,10 @@ class _Windows:
             self._move(max(self.expect + self.chunk, 2 * open_part + m), kept)
         a = self.used
         self.used += m
-        return {k: v[a : self.used] for k, v in self.arrays.items()}
+        out = {k: v[a : self.used] for k, v in self.arrays.items()}
+        if "t" not in out:
+            out["t"] = np.empty(m)
+        return out
 
     def add(self, rec: Recording) -> None:
         """The next ``len(rec)`` samples (written where :meth:`alloc` said) are read."""
@@ -451,10 +453,16 @@ class _Windows:
 
     def take(self, stop: int) -> Recording:
         """Samples ``[start, stop)`` as one recording (views); they leave the buffer."""
+        from .. import _core
+
         assert self.proto is not None
         k = stop - self.start
         a, b = self.head, self.head + k
-        t = self.arrays["t"][a:b]
+        if self.time_step is None:
+            t = self.arrays["t"][a:b]
+        else:
+            t = np.empty(k)
+            _core.fill_time(t, self.time_step[0], self.time_step[1], self.start)
         data = {c: v[a:b] for c, v in self.arrays.items() if c != "t"}
         units, source, meta = self.proto
         rec = Recording(t, data, dict(units), source, dict(meta, offset=self.start))
