@@ -394,6 +394,54 @@ def test_threads_give_the_serial_rows(long_rec):
         track(long_rec, every="6cycles", threads=-1)
 
 
+def test_threads_read_on_when_a_younger_window_finishes_first(long_rec, monkeypatch):
+    """On helper threads the reader waits for any window to finish, not the oldest: windows
+    whose analysis times vary (a younger one done first) give the serial rows, the callbacks
+    come in window order, and no more than threads + 1 windows are ever unfinished."""
+    import threading
+    import time
+
+    from contactlab.studies import tracking
+
+    real = tracking._tangential_window
+    lock = threading.Lock()
+    state = {"open": 0, "most": 0, "calls": 0}
+
+    def slow(rec, opts, **kw):
+        with lock:
+            state["calls"] += 1
+            k = state["calls"]
+        time.sleep(0.03 if k % 3 == 1 else 0.0)  # every third window the slowest
+        return real(rec, opts, **kw)
+
+    from concurrent.futures import ThreadPoolExecutor
+
+    submit = ThreadPoolExecutor.submit
+
+    def counted(self, fn, *a, **k):
+        with lock:
+            state["open"] += 1
+            state["most"] = max(state["most"], state["open"])
+        fut = submit(self, fn, *a, **k)
+
+        def done(_f):
+            with lock:
+                state["open"] -= 1
+
+        fut.add_done_callback(done)
+        return fut
+
+    monkeypatch.setattr(tracking, "_tangential_window", slow)
+    monkeypatch.setattr(ThreadPoolExecutor, "submit", counted)
+    order = []
+    b = track(long_rec, every="3cycles", threads=2, callback=lambda r: order.append(r["window"]))
+    monkeypatch.undo()
+    a = track(long_rec, every="3cycles", threads=0)
+    assert a.rows == b.rows and len(b.rows) >= 8
+    assert order == list(range(1, len(b.rows) + 1))
+    assert state["most"] <= 3
+
+
 @settings(max_examples=25, deadline=None)
 @given(seed=st.integers(0, 10_000), n_bins=st.integers(8, 60), n_cyc=st.integers(1, 9))
 def test_fold_spread_is_the_numpy_spread(seed, n_bins, n_cyc):

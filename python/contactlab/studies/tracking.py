@@ -34,6 +34,8 @@ import math
 import re
 from collections import deque
 from collections.abc import Callable, Iterator, Mapping, Sequence
+from concurrent.futures import FIRST_COMPLETED
+from concurrent.futures import wait as futures_wait
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -733,6 +735,18 @@ def _track(
             else executor.submit(analyse, rec, opts)
         )
         in_flight.append((row, fut))
+        if slots is not None:
+            # our helper threads: a window holds its samples until its analysis is done, so
+            # the limit counts the windows not done yet, and the reader goes on as soon as any
+            # is (waiting for the oldest left a helper thread idle whenever a younger window
+            # finished first: the two threads were busy 65 % of a run); finished windows are
+            # collected in order
+            busy = [f for _, f in in_flight if not f.done()]
+            if len(busy) >= limit:
+                futures_wait(busy, return_when=FIRST_COMPLETED)
+            while in_flight and in_flight[0][1].done():
+                collect(*in_flight.popleft())
+            return
         while len(in_flight) >= limit:
             collect(*in_flight.popleft())
 
