@@ -411,8 +411,12 @@ def test_threads_read_on_when_a_younger_window_finishes_first(long_rec, monkeypa
         with lock:
             state["calls"] += 1
             k = state["calls"]
-        time.sleep(0.03 if k % 3 == 1 else 0.0)  # every third window the slowest
-        return real(rec, opts, **kw)
+        try:
+            time.sleep(0.03 if k % 3 == 1 else 0.0)  # every third window the slowest
+            return real(rec, opts, **kw)
+        finally:  # before the future is done (a done-callback would run after the reader
+            with lock:  # may already have seen it done and submitted the next window)
+                state["open"] -= 1
 
     from concurrent.futures import ThreadPoolExecutor
 
@@ -422,14 +426,7 @@ def test_threads_read_on_when_a_younger_window_finishes_first(long_rec, monkeypa
         with lock:
             state["open"] += 1
             state["most"] = max(state["most"], state["open"])
-        fut = submit(self, fn, *a, **k)
-
-        def done(_f):
-            with lock:
-                state["open"] -= 1
-
-        fut.add_done_callback(done)
-        return fut
+        return submit(self, fn, *a, **k)
 
     monkeypatch.setattr(tracking, "_tangential_window", slow)
     monkeypatch.setattr(ThreadPoolExecutor, "submit", counted)
