@@ -20,7 +20,9 @@ Stages (``samples/s`` = recording samples per second of wall time):
 - ``whole``: ``contactlab analyze`` of a ``--whole-samples`` file (default 1e7): as a user
   runs it (longer than 2^19 samples: streamed and pooled automatically), with ``--whole`` (read
   into memory: the issue's "before") and with ``--stream``;
-- ``study``: ``--study-files`` recordings analysed serially and on a process pool.
+- ``study``: ``--study-files`` recordings analysed serially, on a process pool and on a thread
+  pool (``run_study(executor=...)``), after a warm-up, in ``--study-repeat`` interleaved
+  runs: median speed-up, its range and the ratio of the best times.
 
 Run: ``nice .venv/bin/python benches/bench_track.py [--samples 1e8] [--workers 2]``
 (tens of minutes at 1e8 on 2 cores; ``--samples 2e6`` for a quick look).
@@ -38,6 +40,7 @@ import argparse
 import json
 import os
 import shutil
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -193,8 +196,8 @@ def run_stage(name: str, path: Path, workers: int) -> dict:
     return d
 
 
-def many_recordings(tmp: Path, n_files: int, workers: int) -> dict:
-    from concurrent.futures import ProcessPoolExecutor
+def many_recordings(tmp: Path, n_files: int, workers: int, repeat: int) -> dict:
+    from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 
     from contactlab.io import write_recording
     from contactlab.studies import run_study
@@ -215,16 +218,39 @@ def many_recordings(tmp: Path, n_files: int, workers: int) -> dict:
         p = tmp / f"Al-Al_W50N_A20um_{i:03d}.h5"
         write_recording(p, rec)
         files.append(p)
-    t0 = time.perf_counter()
-    a = run_study(files, progress=False, keep_recordings=False)
-    t_serial = time.perf_counter() - t0
-    with ProcessPoolExecutor(workers) as ex:
+    # warm-up: the first study in a process pays lazy imports and first-call costs that the
+    # pool's forked workers would not (a serial-first timing gave x2.9 on 2 cores)
+    a = run_study(files[:2], progress=False, keep_recordings=False)
+    serial, pooled, threaded = [], [], []
+    with ProcessPoolExecutor(workers) as ex, ThreadPoolExecutor(workers) as tx:
         list(ex.map(abs, range(workers)))  # start the workers before timing
-        t0 = time.perf_counter()
-        b = run_study(files, progress=False, executor=ex)
-        t_pool = time.perf_counter() - t0
-    same = a.to_csv("tangential") == b.to_csv("tangential")
-    return {"files": n_files, "serial_s": t_serial, "pool_s": t_pool, "identical": same}
+        b = run_study(files[:workers], progress=False, executor=ex)  # and warm them up
+        same = True
+        for r in range(repeat):  # interleaved, alternating order within a pair
+            runs = [("s", None), ("p", ex), ("t", tx)]
+            for kind, executor in runs if r % 2 == 0 else runs[::-1]:
+                t0 = time.perf_counter()
+                res = run_study(files, progress=False, executor=executor, keep_recordings=False)
+                dt = time.perf_counter() - t0
+                {"s": serial, "p": pooled, "t": threaded}[kind].append(dt)
+                if kind == "s":
+                    a = res
+                else:
+                    b = res
+                    same = same and a.to_csv("tangential") == b.to_csv("tangential")
+    med = statistics.median
+    return {
+        "files": n_files,
+        "repeat": repeat,
+        "serial_s": med(serial),
+        "pool_s": med(pooled),
+        "threads_s": med(threaded),
+        "pool_up": sorted(s / p for s, p in zip(serial, pooled, strict=True)),
+        "threads_up": sorted(s / p for s, p in zip(serial, threaded, strict=True)),
+        "pool_minmin": min(serial) / min(pooled),
+        "threads_minmin": min(serial) / min(threaded),
+        "identical": same,
+    }
 
 
 def main() -> None:
@@ -233,6 +259,9 @@ def main() -> None:
     ap.add_argument("--whole-samples", type=float, default=1e7)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--study-files", type=int, default=12)
+    ap.add_argument(
+        "--study-repeat", type=int, default=5, help="interleaved serial/pool pairs of the study"
+    )
     ap.add_argument(
         "--skip",
         default="",
@@ -377,12 +406,16 @@ def main() -> None:
                 )
             wf.unlink()
         if "study" not in skip:
-            s = many_recordings(tmp, args.study_files, args.workers)
-            print(
-                f"study of {s['files']} recordings: serial {s['serial_s']:.1f} s, "
-                f"{args.workers} processes {s['pool_s']:.1f} s "
-                f"(x{s['serial_s'] / s['pool_s']:.2f}), identical: {s['identical']}"
-            )
+            s = many_recordings(tmp, args.study_files, args.workers, args.study_repeat)
+            med = statistics.median
+            for key, label in (("pool", "processes"), ("threads", "threads")):
+                ups = s[f"{key}_up"]
+                print(
+                    f"study of {s['files']} recordings, {s['repeat']} interleaved pairs: serial "
+                    f"{s['serial_s']:.2f} s, {args.workers} {label} {s[f'{key}_s']:.2f} s: "
+                    f"x{med(ups):.2f} median (range {ups[0]:.2f}-{ups[-1]:.2f}, min/min "
+                    f"x{s[f'{key}_minmin']:.2f}), identical: {s['identical']}"
+                )
         print(f"load average at the end {os.getloadavg()[0]:.1f}")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
