@@ -31,6 +31,13 @@ A last row (``--long``, default 1e8 samples; 0 skips it) is ONE channel: ``force
 thread vs on all cores, outputs reused, interleaved pairs likewise: the pre-pass and the pieces
 alone carry the scaling there.
 
+The allocator is set as the command-line interface sets it (``contactlab._malloc.
+keep_freed_memory``: freed arrays of up to 32 MB stay in the process for reuse), on both sides of
+every pair: with glibc's defaults each fresh 32 MB output is mapped anew and page-faulted, and on
+this VM such faults sometimes cost ten times the usual (memory the host must back again), which
+made the fresh-output modes' pairs scatter from 0.4x to 6x (``python threads`` reached a median
+of 3x against 1.5-1.9x with the memory kept). ``--glibc-defaults`` leaves the allocator alone.
+
 For each mode: the speed-up of each pair (serial wall / mode wall), their median, quartiles and
 range (the spread of the paired ratios), and the ratio of the best times (min / min); the
 requirement is >= 1.9x on 2 cores. ``prepass`` is the pre-pass's CPU as a share of the paired
@@ -101,7 +108,14 @@ def main() -> None:
         "--long", type=float, default=1e8, help="samples of the one-channel row (0: none)"
     )
     ap.add_argument("--no-processes", action="store_true")
+    ap.add_argument(
+        "--glibc-defaults", action="store_true", help="leave the allocator's thresholds alone"
+    )
     args = ap.parse_args()
+    if not args.glibc_defaults:
+        from contactlab._malloc import keep_freed_memory
+
+        keep_freed_memory()
     cores = os.cpu_count() or 1
     before = uptime()
     xs = channels(args.channels, args.n)
@@ -213,6 +227,10 @@ def main() -> None:
         "interleaved pairs per mode (rotating order, alternating within a pair)"
     )
     print(f"before: {before.strip()}\nafter:  {after.strip()}")
+    print(
+        "allocator: "
+        + ("glibc defaults" if args.glibc_defaults else "freed memory kept (as the CLI)")
+    )
     med = statistics.median
     print(
         f"{'mode':<29}{'Ms/s':>7}{'serial':>7}{'speed-up med':>13}{'q1-q3':>12}{'range':>12}"
