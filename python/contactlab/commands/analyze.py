@@ -175,8 +175,9 @@ def _window_threads() -> int:
     """Helper threads of an auto-streamed analysis (``track(threads=...)``): one per core, at
     most 2, or ``CONTACTLAB_ANALYZE_THREADS`` (0: analyse each window before reading on).
     They analyse windows (the Rust kernels release the GIL) while the main thread reads on;
-    at most threads + 1 windows (2^20 samples each) are unanalysed at a time (peak 225-229 MB
-    on 1e7 samples, 234-259 MB on 1e8, with 2). The pooled document is the serial one."""
+    at most threads + 2 windows (2^20 samples each) are unanalysed at a time, those waiting
+    for a thread without their time axis (peak 240-241 MB on 1e7 samples, 245-263 MB on 1e8,
+    with 2). The pooled document is the serial one."""
     import os
 
     env = os.environ.get("CONTACTLAB_ANALYZE_THREADS", "").strip()

@@ -313,11 +313,71 @@ _WINDOW_OPTIONS = frozenset(
 )  # fmt: skip
 
 
+class _WindowSamples:
+    """A window of a recording sampled every ``dt`` from ``t0`` whose time axis is made when
+    its analysis starts (:meth:`recording`, on the helper thread or worker): a window waiting
+    for a helper holds its channels only, 8 bytes a sample less, and the reader does not fill
+    the axis. The axis is :func:`contactlab._core.fill_time`'s, bit for bit the one
+    :meth:`_Windows.take` made before."""
+
+    __slots__ = ("data", "meta", "source", "start", "time_step", "units")
+
+    def __init__(
+        self,
+        data: dict[str, np.ndarray],
+        units: dict[str, str],
+        source: str,
+        meta: dict[str, Any],
+        time_step: tuple[float, float],
+        start: int,
+    ) -> None:
+        self.data, self.units, self.source, self.meta = data, units, source, meta
+        self.time_step, self.start = time_step, start
+
+    def __getstate__(self) -> tuple[Any, ...]:
+        return tuple(getattr(self, k) for k in self.__slots__)
+
+    def __setstate__(self, state: tuple[Any, ...]) -> None:
+        for k, v in zip(self.__slots__, state, strict=True):
+            setattr(self, k, v)
+
+    def __len__(self) -> int:
+        return len(next(iter(self.data.values())))
+
+    def time(self, i: int) -> float:
+        """The time of sample ``i`` of the window (that of :meth:`recording`'s axis)."""
+        from .. import _core
+
+        one = np.empty(1)
+        _core.fill_time(one, self.time_step[0], self.time_step[1], self.start + i)
+        return float(one[0])
+
+    def recording(self) -> Recording:
+        from .. import _core
+
+        t = np.empty(len(self))
+        _core.fill_time(t, self.time_step[0], self.time_step[1], self.start)
+        return Recording(t, self.data, self.units, self.source, self.meta)
+
+
+def _window_recording(rec: Recording | _WindowSamples) -> Recording:
+    return rec.recording() if isinstance(rec, _WindowSamples) else rec
+
+
+def _time_bounds(rec: Recording | _WindowSamples) -> tuple[float, float]:
+    """The first and last sample times of a window."""
+    if isinstance(rec, _WindowSamples):
+        return rec.time(0), rec.time(len(rec) - 1)
+    return float(rec.t[0]), float(rec.t[-1])
+
+
 def _tangential_window(
-    rec: Recording, options: Mapping[str, Any], keep_doc: bool = False
+    rec: Recording | _WindowSamples, options: Mapping[str, Any], keep_doc: bool = False
 ) -> tuple[dict, dict]:
     from ..tangential import analyze_tangential
     from ..tangential.analysis import analyze_window
+
+    rec = _window_recording(rec)
 
     opts = {k: v for k, v in options.items() if k != "warn"}
     if opts.get("on", "averaged") == "averaged" and opts.get("history", "steady") == "steady":
@@ -346,9 +406,11 @@ def _tangential_window(
 
 
 def _normal_window(
-    rec: Recording, options: Mapping[str, Any], keep_doc: bool = False
+    rec: Recording | _WindowSamples, options: Mapping[str, Any], keep_doc: bool = False
 ) -> tuple[dict, dict]:
     import warnings
+
+    rec = _window_recording(rec)
 
     from ..normal import analyze_loop
 
@@ -453,21 +515,23 @@ class _Windows:
             self.proto = (rec.units, rec.source, rec.meta)
         self.n += len(rec)
 
-    def take(self, stop: int) -> Recording:
-        """Samples ``[start, stop)`` as one recording (views); they leave the buffer."""
-        from .. import _core
-
+    def take(self, stop: int) -> Recording | _WindowSamples:
+        """Samples ``[start, stop)`` as one recording (views); they leave the buffer. With a
+        time axis made from the sampling interval, a :class:`_WindowSamples` whose axis is
+        made when its analysis starts."""
         assert self.proto is not None
         k = stop - self.start
         a, b = self.head, self.head + k
-        if self.time_step is None:
-            t = self.arrays["t"][a:b]
-        else:
-            t = np.empty(k)
-            _core.fill_time(t, self.time_step[0], self.time_step[1], self.start)
         data = {c: v[a:b] for c, v in self.arrays.items() if c != "t"}
         units, source, meta = self.proto
-        rec = Recording(t, data, dict(units), source, dict(meta, offset=self.start))
+        rec: Recording | _WindowSamples
+        if self.time_step is None:
+            t = self.arrays["t"][a:b]
+            rec = Recording(t, data, dict(units), source, dict(meta, offset=self.start))
+        else:
+            rec = _WindowSamples(
+                data, dict(units), source, dict(meta, offset=self.start), self.time_step, self.start
+            )
         self.head, self.start, self.n = b, stop, self.n - k
         self.expect = k + k // 256  # the next window's length, and some
         # room for the next window up to the end of the chunk it ends in (chunks start at
@@ -590,9 +654,9 @@ def track(
     threads : int, optional
         Without ``executor``: analyse windows on this many helper threads while the next
         chunks are read and their cycles found (the Rust kernels release the GIL); default 1
-        (``threads + 1`` windows in flight: 2 threads peaked at about 250 MB on 1e8 samples
-        with ``"auto"`` windows), 0 analyses each window before reading on. The rows are the
-        same.
+        (``threads + 2`` windows in flight, those waiting for a thread without their time
+        axis: 2 threads peaked at 245-263 MB on 1e8 samples with ``"auto"`` windows), 0
+        analyses each window before reading on. The rows are the same.
     keep_documents : bool
         Keep each window's whole analysis document (``TrackResult.window_docs``; what
         :func:`contactlab.studies.pooled.pooled_document` and
@@ -623,13 +687,16 @@ def track(
             ThreadPoolExecutor(n_threads, thread_name_prefix="contactlab-track") as pool,
             _one_blas_thread(),
         ):
-            # each helper thread analyses one window while the next is read: n + 1 windows
-            # in memory (an executor given by the caller gets two per worker)
+            # each helper thread analyses one window while the next two are read or wait:
+            # n + 2 windows in memory, those waiting without their time axis (with n + 1 the
+            # threads waited for the reader: 1e8 samples on 2 threads, interleaved runs
+            # 4.43-5.15 s against 4.45-5.96 s, peak 245-263 against 240-255 MB); an executor
+            # given by the caller gets two per worker
             return _track(
                 source, every, kind=kind, columns=columns, fs=fs, chunk_size=chunk_size,
                 max_window=max_window, options=options, keep_going=keep_going,
                 callback=callback, executor=pool, keep_documents=keep_documents,
-                slots=n_threads + 1,
+                slots=n_threads + 2,
             )  # fmt: skip
     return _track(
         source, every, kind=kind, columns=columns, fs=fs, chunk_size=chunk_size,
@@ -715,11 +782,12 @@ def _track(
     def emit(stop: int, n_cycles_before_stop: int) -> None:
         nonlocal cycles_at_start
         rec = buf.take(stop)
+        t_first, t_last = _time_bounds(rec)
         row: dict[str, Any] = {
             "window": len(rows) + 1,
-            "t_start": float(rec.t[0]),
-            "t_end": float(rec.t[-1]),
-            "t_mid": 0.5 * float(rec.t[0] + rec.t[-1]),
+            "t_start": t_first,
+            "t_end": t_last,
+            "t_mid": 0.5 * (t_first + t_last),
             "cycle_start": cycles_at_start,
             "cycle_end": n_cycles_before_stop,
             "n_samples": len(rec),
