@@ -384,3 +384,25 @@ def test_track_normal_dynamic_pressure_takes_p0_pa_and_tags(tmp_path, how, capsy
         err = capsys.readouterr().err
         assert "--p0/--pa are for normal-contact recordings" in err and "Traceback" not in err
         assert not (tmp_path / "x.json").exists()
+
+
+def test_track_threads_flag_and_api_defaults(rec_file, tmp_path, capsys):
+    """`--threads` (default one per core, as analyze) and the default chunk size are the
+    API's: the JSON equals contactlab.track's, serial or on helper threads; bad counts and
+    `--threads` with `--workers` are refused with a sentence."""
+    from contactlab.studies.tracking import track, track_json
+
+    want = json.loads(track_json(track(rec_file, every="5cycles", threads=0)))
+    for extra in ([], ["--threads", "0"], ["--threads", "2"]):
+        out = tmp_path / f"o{len(extra)}{''.join(extra)}.json"
+        args = ["track", str(rec_file), "--every", "5cycles", "--json", str(out)]
+        assert main(args + extra + ["--no-progress"]) == 0
+        got = json.loads(out.read_text())
+        for k in ("windows", "combined", "cycles"):
+            assert got[k] == want[k], (extra, k)
+    capsys.readouterr()
+    assert main(["track", str(rec_file), "--threads", "-1", "--no-progress"]) == 1
+    assert "--threads must be >= 0" in capsys.readouterr().err
+    code = main(["track", str(rec_file), "--threads", "1", "--workers", "2", "--no-progress"])
+    assert code == 1
+    assert "--workers runs processes" in capsys.readouterr().err

@@ -26,6 +26,7 @@ from ._common import (
     parse_columns,
     process_pool,
     quantity,
+    window_threads,
     write_json,
 )
 
@@ -53,6 +54,13 @@ def _handler(args: argparse.Namespace) -> int:
 
         bar = tqdm(desc="windows", unit="win", file=sys.stderr)
     options = _options(args)
+    threads = None
+    if args.workers is None:
+        threads = window_threads() if args.threads is None else args.threads
+        if threads < 0:
+            raise InputError(f"--threads must be >= 0, got {threads}")
+    elif args.threads is not None:
+        raise InputError("--threads is for helper threads; --workers runs processes instead")
     print(f"tracking {args.file} every {args.every}", file=say, flush=True)
     try:
         with process_pool(args.workers) as ex:
@@ -64,6 +72,7 @@ def _handler(args: argparse.Namespace) -> int:
                 fs=args.fs,
                 chunk_size=args.chunk_size,
                 executor=ex,
+                threads=threads,
                 options=options,
                 callback=(lambda _row: bar.update(1)) if bar is not None else None,
             )
@@ -155,11 +164,19 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--chunk-size",
         type=int,
-        default=1 << 20,
+        default=1 << 18,
         metavar="N",
-        help="samples read at a time (default 1048576)",
+        help="samples read at a time (default 262144, as contactlab.track)",
     )
     add_pressure_flags(p)
     add_workers_flag(p, "windows")
+    p.add_argument(
+        "--threads",
+        type=int,
+        default=None,
+        metavar="N",
+        help="without --workers: analyse windows on N helper threads while reading on "
+        "(default: one per core, at most 2, as analyze; 0: each window before reading on)",
+    )
     add_progress_flags(p)
     p.set_defaults(handler=_handler)

@@ -29,7 +29,6 @@ import contextlib
 import csv
 import functools
 import io
-import json
 import math
 import re
 from collections import deque
@@ -42,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from .._json import jsonable
+from .._json import dumps, jsonable
 from .._physical import MAX_MAGNITUDE
 from ..errors import ContactLabError, ContactLabWarning, InputError
 from ..io import Recording, read_chunks
@@ -654,9 +653,10 @@ def track(
     threads : int, optional
         Without ``executor``: analyse windows on this many helper threads while the next
         chunks are read and their cycles found (the Rust kernels release the GIL); default 1
-        (``threads + 2`` windows in flight, those waiting for a thread without their time
-        axis: 2 threads peaked at 245-263 MB on 1e8 samples with ``"auto"`` windows), 0
-        analyses each window before reading on. The rows are the same.
+        (``threads + 1`` windows in flight, ``threads + 2`` from two threads on, those
+        waiting for a thread without their time axis: 2 threads peaked at 245-263 MB on 1e8
+        samples with ``"auto"`` windows), 0 analyses each window before reading on. The rows
+        are the same.
     keep_documents : bool
         Keep each window's whole analysis document (``TrackResult.window_docs``; what
         :func:`contactlab.studies.pooled.pooled_document` and
@@ -687,16 +687,17 @@ def track(
             ThreadPoolExecutor(n_threads, thread_name_prefix="contactlab-track") as pool,
             _one_blas_thread(),
         ):
-            # each helper thread analyses one window while the next two are read or wait:
-            # n + 2 windows in memory, those waiting without their time axis (with n + 1 the
-            # threads waited for the reader: 1e8 samples on 2 threads, interleaved runs
-            # 4.43-5.15 s against 4.45-5.96 s, peak 245-263 against 240-255 MB); an executor
-            # given by the caller gets two per worker
+            # each helper thread analyses one window while the next is read: n + 1 windows
+            # in memory, those waiting without their time axis; n + 2 for two threads or more,
+            # which together outpace the reader (with n + 1 they waited for it: 1e8 samples
+            # on 2 threads, interleaved runs 4.43-5.15 s against 4.45-5.96 s, peak 245-263
+            # against 240-255 MB); one thread is three times slower than the reader and
+            # always has a window waiting. An executor given by the caller gets two per worker
             return _track(
                 source, every, kind=kind, columns=columns, fs=fs, chunk_size=chunk_size,
                 max_window=max_window, options=options, keep_going=keep_going,
                 callback=callback, executor=pool, keep_documents=keep_documents,
-                slots=n_threads + 2,
+                slots=n_threads + (2 if n_threads >= 2 else 1),
             )  # fmt: skip
     return _track(
         source, every, kind=kind, columns=columns, fs=fs, chunk_size=chunk_size,
@@ -921,8 +922,11 @@ def track_many(
 
 
 def track_json(result: TrackResult, *, cycles: bool = True) -> str:
-    """The result as JSON text (NaN → null)."""
-    return json.dumps(jsonable(result.to_dict(cycles=cycles)), indent=1, allow_nan=False) + "\n"
+    """The result as JSON text (NaN → null; each per-cycle array on one line)."""
+    doc = result.to_dict(cycles=False)
+    if cycles:  # the arrays as they are: jsonable converts numbers at numpy's speed
+        doc["cycles"] = dict(result.cycles)
+    return dumps(jsonable(doc), indent=1) + "\n"
 
 
 __all__ = [
