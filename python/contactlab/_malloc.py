@@ -56,4 +56,22 @@ def keep_freed_memory() -> bool:
     return ok
 
 
-__all__ = ["keep_freed_memory"]
+def release_freed_memory() -> bool:
+    """Give the freed memory the process keeps (:func:`keep_freed_memory`) back to the
+    system (glibc ``malloc_trim``), when a streamed pass is over and what follows (figures,
+    a report) allocates differently: otherwise the windows' freed arrays and the report's
+    allocations add up in the peak (1e8-sample ``analyze --report``: 310 MB). True when
+    memory was released; a no-op without glibc."""
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
+        trim = libc.malloc_trim
+    except (OSError, AttributeError):
+        return False
+    trim.argtypes = [ctypes.c_size_t]
+    trim.restype = ctypes.c_int
+    return bool(trim(0))
+
+
+__all__ = ["keep_freed_memory", "release_freed_memory"]

@@ -203,6 +203,9 @@ def _auto_streamed(
         doc["warnings"] = [*doc["warnings"], *(str(r["error"]) for r in failed)]
     doc = {"file": str(path), "model": kind, **entry.tags, **doc}  # type: ignore[attr-defined]
     doc["_track"] = res
+    from .._malloc import release_freed_memory
+
+    release_freed_memory()  # the windows' arrays, before a report's figures are drawn
     return doc
 
 

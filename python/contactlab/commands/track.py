@@ -79,6 +79,9 @@ def _handler(args: argparse.Namespace) -> int:
     finally:
         if bar is not None:
             bar.close()
+    from .._malloc import release_freed_memory
+
+    release_freed_memory()  # the windows' arrays, before the JSON and the figures are made
     comb = res.combined()
     print(
         f"{res.source}: {len(res.rows)} windows, {comb.get('n_cycles', 0)} cycles, "
