@@ -652,3 +652,42 @@ def test_cycles_csv_as_the_csv_writer_wrote_it(long_rec):
     for k in res.cycles:
         res.cycles[k] = res.cycles[k][:0]
     assert res.cycles_csv() == reference() == reference().splitlines()[0] + "\n"
+
+
+@pytest.mark.parametrize("kind", ["tangential", "normal"])
+def test_per_cycle_table_does_not_depend_on_the_chunk_size(tmp_path, kind):
+    """The cycle trigger is judged on fixed global sample ranges (CYCLE_SEGMENT), so reading
+    the same file in chunks of any length gives the same windows and per-cycle table, bit for
+    bit (before, each chunk's own range set it: 2^18 against 2^20 chunks moved 735 of 1e5
+    cycle starts)."""
+    from contactlab.studies import tracking
+
+    seg = 4096
+    n = 5 * seg + 1234  # several segments and a partial one
+    t = np.arange(n) / 2000.0
+    rng = np.random.default_rng(11)
+    amp = 1.0 + 0.4 * np.sin(2 * np.pi * 0.05 * t)  # the trigger band follows the amplitude
+    drive = amp * np.sin(2 * np.pi * 3.1 * t) + 0.01 * rng.standard_normal(n)
+    if kind == "tangential":
+        rec = Recording(t, {"x": 20e-6 * drive, "F": 30.0 * np.tanh(2 * drive)},
+                        {"x": "m", "F": "N"})  # fmt: skip
+    else:
+        p = 1e6 * (2.0 + drive)  # positive pressure
+        rec = Recording(t, {"p": p, "delta": 1e-6 * (p / 1e6) ** 0.7}, {"p": "Pa", "delta": "m"})
+    path = tmp_path / f"{kind}.h5"
+    write_recording(path, rec)
+    old = tracking.CYCLE_SEGMENT
+    try:
+        tracking.CYCLE_SEGMENT = seg
+        runs = [
+            track(path, every="4cycles", kind=kind, chunk_size=c, threads=0, keep_going=True)
+            for c in (seg, 700, 3 * seg + 5, 10 * seg)
+        ]
+    finally:
+        tracking.CYCLE_SEGMENT = old
+    ref = runs[0]
+    assert ref.cycles["energy"].size >= 20
+    for r in runs[1:]:
+        assert r.rows == ref.rows
+        for k in ref.cycles:
+            assert r.cycles[k].tobytes() == ref.cycles[k].tobytes(), k

@@ -4,8 +4,9 @@ A cycle runs from one upward crossing of the drive channel (``x`` of a tangentia
 ``p`` of a normal one) to the next. Crossings are found with a Schmitt trigger: the signal
 must fall below ``centre - band`` before an upward passage of ``centre + band`` counts, so
 noise at the level cannot count twice. ``centre`` and ``band`` come from each block's range
-(blocks of at least :data:`MIN_BLOCK` samples, so at least one cycle of a slow test), and
-follow a slowly drifting or shrinking amplitude.
+and follow a slowly drifting or shrinking amplitude; :func:`contactlab.track` hands in blocks
+of fixed global sample ranges (``tracking.CYCLE_SEGMENT``, 2^18 samples), so that the cycles
+do not depend on the chunks a file is read in.
 
 Per cycle: the loop energy ∮ F dx (trapezoids, closed by the chord from the cycle's last
 sample back to its first, i.e. the area of the polygon of the samples, as
@@ -24,7 +25,8 @@ import numpy as np
 
 from .. import _core
 
-#: smallest block the thresholds are judged on (samples)
+#: smallest block the thresholds were judged on before fixed segments (samples; kept for
+#: callers of :func:`block_cycles`)
 MIN_BLOCK = 1 << 16
 #: half width of the trigger band as a fraction of the block's half range
 BAND = 0.25

@@ -46,7 +46,7 @@ from .._physical import MAX_MAGNITUDE
 from ..errors import ContactLabError, ContactLabWarning, InputError
 from ..io import Recording, read_chunks
 from ..io.units import UnknownUnitError, to_si
-from ._cycles import MIN_BLOCK, CycleState, block_cycles, trigger_levels
+from ._cycles import CycleState, block_cycles, trigger_levels
 from .columns import CYCLE_UNITS
 from .study import coefficient_unit
 
@@ -80,6 +80,9 @@ AUTO_WINDOW = 1 << 20
 #: view that keeps the whole chunk alive until the next window is cut, so shorter chunks hold
 #: less (1e8 samples, 2^20 windows: chunks of 2^20 peaked at 274 MB, 2^18 at 247 MB)
 TRACK_CHUNK = 1 << 18
+#: samples of the blocks whose drive's range sets the cycle trigger (:func:`_segments`): fixed
+#: global sample ranges, so that the per-cycle table is the same whatever the chunk size
+CYCLE_SEGMENT = TRACK_CHUNK
 
 _EVERY = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?\d+)?)\s*([A-Za-zµμ]*)\s*$")
 
@@ -548,14 +551,21 @@ class _Windows:
         return rec
 
 
-def _blocks(
-    chunks: Iterator[Recording], min_block: int
-) -> Iterator[tuple[Recording, dict[str, tuple[float, float]] | None]]:
-    """Chunks joined until each holds at least ``min_block`` samples (the last may be short),
-    each with its channels' ranges (``(min, max)``; None when a chunk came without them)."""
+def _segments(
+    chunks: Iterator[Recording], size: int
+) -> Iterator[tuple[Recording, dict[str, tuple[float, float]]]]:
+    """The chunks re-cut into blocks of the samples ``[k·size, (k+1)·size)`` (global
+    indices; the last block holds what is left), each with its channels' ranges
+    (``(min, max)``). The cycle trigger is judged on a block's range (:func:`block_cycles`),
+    so the per-cycle table does not depend on the chunks the file is read in (a chunk of
+    ``size`` samples at a multiple of it passes as it is: reading in chunks of ``size`` gives
+    the blocks it always gave). Chunks of other lengths are cut (views) or joined (copied)."""
+    from .. import _core
+
     buf: list[Recording] = []
-    size = 0
-    ranges: dict[str, tuple[float, float]] | None = {}
+    held = 0  # samples in buf
+    ranges: dict[str, tuple[float, float]] = {}
+    pos = 0  # global index of the next sample
     for c in chunks:
         # the reader's one pass found each channel's range (read_chunks: meta["ranges"]);
         # taken out of the meta, which the windows inherit
@@ -574,16 +584,28 @@ def _blocks(
                     f"at sample {i + int(c.meta.get('offset', 0))}: beyond any physical value; "
                     "a unit mix-up or a corrupt file?"
                 )
-        if ranges is not None:
+        off = int(c.meta.get("offset", pos))
+        a, n = 0, len(c)
+        while a < n:
+            b = min(n, a + size - held)  # to the end of the current block, or of the chunk
+            if a == 0 and b == n:
+                piece, part = c, got
+            else:
+                meta = dict(c.meta, offset=off + a)
+                piece = Recording(c.t[a:b], {k: v[a:b] for k, v in c.data.items()},
+                                  c.units, c.source, meta)  # fmt: skip
+                part = {k: _core.finite_min_max(v)[1:] for k, v in piece.data.items()}
             ranges = {
                 k: (min(ranges[k][0], lo), max(ranges[k][1], hi)) if k in ranges else (lo, hi)
-                for k, (lo, hi) in got.items()
+                for k, (lo, hi) in part.items()
             }
-        buf.append(c)
-        size += len(c)
-        if size >= min_block:
-            yield _join(buf), ranges
-            buf, size, ranges = [], 0, {}
+            buf.append(piece)
+            held += b - a
+            a = b
+            if held == size:
+                yield _join(buf), ranges
+                buf, held, ranges = [], 0, {}
+        pos = off + n
     if buf:
         yield _join(buf), ranges
 
@@ -825,7 +847,7 @@ def _track(
             collect(*in_flight.popleft())
 
     try:
-        for block, ranges in _blocks(cr.chunks_into(buf.alloc), MIN_BLOCK):
+        for block, ranges in _segments(cr.chunks_into(buf.alloc), CYCLE_SEGMENT):
             off = int(block.meta.get("offset", n_total))
             buf.add(block)
             n_total = off + len(block)
