@@ -22,7 +22,9 @@ Stages (``samples/s`` = recording samples per second of wall time):
   into memory: the issue's "before") and with ``--stream``;
 - ``study``: ``--study-files`` recordings analysed serially, on a process pool and on a thread
   pool (``run_study(executor=...)``), after a warm-up, in ``--study-repeat`` interleaved
-  runs: median speed-up, its range and the ratio of the best times.
+  runs: median speed-up, its range and the ratio of the best times. ``--study-mix K`` makes
+  every K-th recording eight times as long (a real study's files differ: the one-at-a-time
+  collection used to leave a worker idle behind a long file);
 
 Run: ``nice .venv/bin/python benches/bench_track.py [--samples 1e8] [--workers 2]``
 (tens of minutes at 1e8 on 2 cores; ``--samples 2e6`` for a quick look).
@@ -196,7 +198,7 @@ def run_stage(name: str, path: Path, workers: int) -> dict:
     return d
 
 
-def many_recordings(tmp: Path, n_files: int, workers: int, repeat: int) -> dict:
+def many_recordings(tmp: Path, n_files: int, workers: int, repeat: int, mix: int = 0) -> dict:
     from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 
     from contactlab.io import write_recording
@@ -209,7 +211,7 @@ def many_recordings(tmp: Path, n_files: int, workers: int, repeat: int) -> dict:
             h0=H0,
             ac=AC,
             amplitude=AMP,
-            n_cycles=40,
+            n_cycles=40 * (8 if mix and i % mix == 0 else 1),
             fs=2000.0,
             frequency=2.0,
             noise=0.01,
@@ -241,6 +243,7 @@ def many_recordings(tmp: Path, n_files: int, workers: int, repeat: int) -> dict:
     med = statistics.median
     return {
         "files": n_files,
+        "mix": mix,
         "repeat": repeat,
         "serial_s": med(serial),
         "pool_s": med(pooled),
@@ -259,6 +262,9 @@ def main() -> None:
     ap.add_argument("--whole-samples", type=float, default=1e7)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--study-files", type=int, default=12)
+    ap.add_argument(
+        "--study-mix", type=int, default=0, help="every K-th study recording 8x longer (0: none)"
+    )
     ap.add_argument(
         "--study-repeat", type=int, default=5, help="interleaved serial/pool pairs of the study"
     )
@@ -406,12 +412,16 @@ def main() -> None:
                 )
             wf.unlink()
         if "study" not in skip:
-            s = many_recordings(tmp, args.study_files, args.workers, args.study_repeat)
+            s = many_recordings(
+                tmp, args.study_files, args.workers, args.study_repeat, args.study_mix
+            )
             med = statistics.median
             for key, label in (("pool", "processes"), ("threads", "threads")):
                 ups = s[f"{key}_up"]
                 print(
-                    f"study of {s['files']} recordings, {s['repeat']} interleaved pairs: serial "
+                    f"study of {s['files']} recordings"
+                    + (f" (every {s['mix']}th 8x longer)" if s["mix"] else "")
+                    + f", {s['repeat']} interleaved pairs: serial "
                     f"{s['serial_s']:.2f} s, {args.workers} {label} {s[f'{key}_s']:.2f} s: "
                     f"x{med(ups):.2f} median (range {ups[0]:.2f}-{ups[-1]:.2f}, min/min "
                     f"x{s[f'{key}_minmin']:.2f}), identical: {s['identical']}"

@@ -11,7 +11,7 @@ never holds more than a few recordings at a time.
 from __future__ import annotations
 
 import os
-from collections import deque
+import queue
 from collections.abc import Callable, Iterable, Iterator
 from typing import Any, TypeVar
 
@@ -44,9 +44,17 @@ def ordered_map(
     executor: Any = None,
     *,
     in_flight: int | None = None,
+    max_held: int | None = None,
 ) -> Iterator[R]:
-    """``fn(item)`` for each item, in order: serially (``executor=None``) or on ``executor``
-    with at most ``in_flight`` tasks submitted and not yet collected (default 2 per worker).
+    """``fn(item)`` for each item, in order: serially (``executor=None``) or on ``executor``.
+
+    At most ``in_flight`` tasks are submitted and not yet finished (default 2 per worker), so
+    that every worker always has its next task queued; a new task is submitted as soon as any
+    task finishes, not only when the oldest one is collected, so one slow recording does not
+    leave the other workers idle. Results that finished before an earlier one are held until
+    their turn, at most ``max_held`` of them (default 8 per worker, at least 16); when that many
+    are waiting, nothing more is submitted until the oldest task finishes. So at most
+    ``in_flight + max_held`` results or inputs exist at a time, however many items there are.
 
     ``fn`` and the items must pickle for process pools and Dask (module-level functions,
     ``functools.partial``). An exception of a task is raised when its turn comes; the tasks
@@ -61,26 +69,73 @@ def ordered_map(
             f"executor must have a submit() method (concurrent.futures executor or "
             f"distributed.Client), got {type(executor).__name__}"
         )
-    limit = in_flight if in_flight is not None else 2 * n_workers(executor)
+    workers = n_workers(executor)
+    limit = in_flight if in_flight is not None else 2 * workers
     if limit < 1:
         raise InputError(f"in_flight must be >= 1, got {limit}")
+    held_limit = max_held if max_held is not None else max(16, 8 * workers)
+    if held_limit < 0:
+        raise InputError(f"max_held must be >= 0, got {held_limit}")
     dask = _is_dask(executor)
-    pending: deque[Any] = deque()
+    futures: dict[int, Any] = {}  # submitted and not yet yielded, by position
+    finished: queue.SimpleQueue[int] = queue.SimpleQueue()  # positions, from done callbacks
+    done: set[int] = set()  # finished and not yet yielded
+    callbacks = True  # False: futures without add_done_callback; wait for the oldest instead
 
-    def submit(item: T) -> Any:
-        if dask:  # pure=False: the same input twice is two tasks, not one cached result
-            return executor.submit(fn, item, pure=False)
-        return executor.submit(fn, item)
+    def submit(pos: int, item: T) -> None:
+        nonlocal callbacks
+        fut = executor.submit(fn, item, pure=False) if dask else executor.submit(fn, item)
+        # pure=False: for Dask, the same input twice is two tasks, not one cached result
+        futures[pos] = fut
+        add = getattr(fut, "add_done_callback", None) if callbacks else None
+        if callable(add):
+            add(lambda _f, pos=pos: finished.put(pos))
+        else:
+            callbacks = False
 
+    source = iter(items)
+    submitted = yielded = 0
+    exhausted = False
     try:
-        for item in items:
-            pending.append(submit(item))
-            if len(pending) >= limit:
-                yield pending.popleft().result()
-        while pending:
-            yield pending.popleft().result()
+        while True:
+            running = submitted - yielded - len(done)
+            while not exhausted and running < limit and submitted - yielded < limit + held_limit:
+                try:
+                    item = next(source)
+                except StopIteration:
+                    exhausted = True
+                    break
+                submit(submitted, item)
+                submitted += 1
+                running += 1
+            if not callbacks:  # the oldest one's turn: wait for it
+                if yielded == submitted:
+                    return
+                fut = futures.pop(yielded)
+                yielded += 1
+                yield fut.result()
+                continue
+            if yielded in done:  # the oldest has finished: its turn (then refill first)
+                done.discard(yielded)
+                fut = futures.pop(yielded)
+                yielded += 1
+                yield fut.result()  # a task's exception is raised here, in its turn
+                continue
+            if exhausted and yielded == submitted:
+                return
+            while True:  # wait for any task to finish; interruptible by Ctrl-C
+                try:
+                    done.add(finished.get(timeout=0.25))
+                    break
+                except queue.Empty:
+                    continue
+            while True:  # and collect whatever else has finished meanwhile
+                try:
+                    done.add(finished.get_nowait())
+                except queue.Empty:
+                    break
     finally:
-        for fut in pending:
+        for fut in futures.values():
             fut.cancel()
 
 
