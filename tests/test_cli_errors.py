@@ -75,7 +75,10 @@ def test_study_ctrl_c_leaves_report_dir_as_it_was(tmp_path, outdir, monkeypatch,
 
     monkeypatch.setattr(study_mod, "analyze_entry", interrupted)
     before = _snapshot(outdir)
-    code = main(["study", str(tmp_path), "--report", str(outdir), "--no-progress"])
+    # in this process (--workers 0), so that the patched function is the one called
+    code = main(
+        ["study", str(tmp_path), "--report", str(outdir), "--no-progress", "--workers", "0"]
+    )
     assert code == 130
     assert "interrupted" in capsys.readouterr().err
     assert calls == ["Al-Al_W100N_A10um.csv"]  # sorted: stopped at the first

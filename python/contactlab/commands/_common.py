@@ -166,10 +166,12 @@ def write_report(
     extra: Mapping[str, bytes] | None = None,
     progress: bool | None = None,
     command: str | None = None,
+    executor: Any = None,
 ) -> list[Path]:
     """Render the report and tables in memory, then write them all or nothing.
 
-    ``command`` (the command line that made it) is quoted at the top of the report.
+    ``command`` (the command line that made it) is quoted at the top of the report; a process
+    pool as ``executor`` draws the figures on its workers (the same report).
     """
     import matplotlib
 
@@ -177,7 +179,9 @@ def write_report(
     from ..report.study_report import build_report
 
     intro = f"Made by: {command}" if command else None
-    rep = build_report(result, title, study_plots=study_plots, progress=progress, intro=intro)
+    rep = build_report(
+        result, title, study_plots=study_plots, progress=progress, intro=intro, executor=executor
+    )
     files = rep.files()
     tables, skipped = table_files(result)
     files.update(tables)
@@ -284,9 +288,40 @@ def with_static_pressure(rec: Any, file: str, p0: float | None, pa: float | None
     return Recording(rec.t, data, dict(rec.units), rec.source, dict(rec.meta or {}))
 
 
-def add_workers_flag(p: Any, what: str) -> None:
+def add_workers_flag(p: Any, what: str, *, per_core: bool = False) -> None:
+    """``--workers N``: processes; by default serial, or (``per_core``) one per core, at most
+    8, with ``--workers 0`` for serial (see :func:`resolve_workers`)."""
+    if per_core:
+        help_ = (
+            f"analyse {what} and draw the report's figures in N processes "
+            "(default: one per core, at most 8; 0: serially in this process)"
+        )
+        p.add_argument("--workers", type=int, default=None, metavar="N", help=help_)
+        return
     p.add_argument("--workers", type=int, default=None, metavar="N",
                    help=f"analyse {what} in N processes (default: serially)")  # fmt: skip
+
+
+def default_workers() -> int | None:
+    """One process per core this process may use, at most 8; None (serial) on one core."""
+    import os
+
+    try:
+        n = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):  # not on Linux
+        n = os.cpu_count() or 1
+    n = min(n, 8)
+    return n if n > 1 else None
+
+
+def resolve_workers(workers: int | None) -> int | None:
+    """``--workers`` of a verb that uses all cores by default: None -> one per core
+    (:func:`default_workers`), 0 -> None (serial), N >= 1 -> N; negative is refused."""
+    if workers is None:
+        return default_workers()
+    if workers < 0:
+        raise InputError(f"--workers must be >= 0 (0: serially), got {workers}")
+    return workers or None
 
 
 def _ignore_sigint() -> None:

@@ -103,23 +103,35 @@ def demo_entries(quick: bool = False) -> list:
     return out
 
 
-def run_demo(out: Path, *, quick: bool = False, progress: bool | None = None) -> list[Path]:
-    """Run the demo and write every output into ``out``; returns the written paths."""
+def run_demo(
+    out: Path, *, quick: bool = False, progress: bool | None = None, workers: int | None = None
+) -> list[Path]:
+    """Run the demo and write every output into ``out``; returns the written paths.
+
+    ``workers``: processes that analyse the recordings and draw the report's figures (None:
+    all in this process); the outputs are the same.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
     from ..report import commit_outputs
     from ..report.study_report import build_report
     from ..studies import run_study
+    from ._common import process_pool
 
     files = masing_outputs()
-    result = run_study(demo_entries(quick), progress=progress)
     intro = (
         "Example study bundled with contactlab (synthetic recordings with realistic sensor "
         "noise, offsets, quantisation and drift; see contactlab.data.generate). The table's "
         "true_h0 / true_ac columns are the values the recordings were made with."
     )
-    rep = build_report(result, "contactlab demo: example study", intro=intro, progress=progress)
+    with process_pool(workers) as ex:
+        result = run_study(
+            demo_entries(quick), progress=progress, executor=ex, keep_recordings=True
+        )
+        rep = build_report(
+            result, "contactlab demo: example study", intro=intro, progress=progress, executor=ex
+        )
     files.update(rep.files())
     files.update(result.table_files())
     return commit_outputs(out, files)
@@ -127,7 +139,10 @@ def run_demo(out: Path, *, quick: bool = False, progress: bool | None = None) ->
 
 def _handler(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
-    paths = run_demo(Path(args.out), quick=args.quick, progress=args.progress)
+    from ._common import resolve_workers
+
+    workers = resolve_workers(args.workers)
+    paths = run_demo(Path(args.out), quick=args.quick, progress=args.progress, workers=workers)
     for p in paths:
         if p.parent == Path(args.out):
             print(f"wrote {p}")
@@ -141,6 +156,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("demo", help="run the bundled demonstration and write its outputs")
     p.add_argument("--out", default="demo-output", help="output folder (default: demo-output)")
     p.add_argument("--quick", action="store_true", help="a reduced set (one file per material)")
+    p.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="analyse the recordings and draw the figures in N processes (default: "
+                   "one per core, at most 8; 0: serially in this process)")  # fmt: skip
     g = p.add_mutually_exclusive_group()
     g.add_argument("--progress", dest="progress", action="store_true", default=None)
     g.add_argument("--no-progress", dest="progress", action="store_false")

@@ -21,6 +21,7 @@ from ._common import (
     json_document,
     json_text,
     process_pool,
+    resolve_workers,
     write_json,
     write_report,
 )
@@ -28,7 +29,7 @@ from ._common import (
 
 def _handler(args: argparse.Namespace) -> int:
     check_output_targets(json_out=args.json, report=args.report)
-    with process_pool(args.workers) as ex:
+    with process_pool(resolve_workers(args.workers)) as ex:
         result = run_study(
             args.manifest,
             progress=args.progress,
@@ -36,19 +37,25 @@ def _handler(args: argparse.Namespace) -> int:
             executor=ex,
             keep_recordings=True,  # the report draws them
         )
-    for r in result.failures:
-        print(f"FAILED: {r.error}", file=sys.stderr)
-    n_ok = sum(r.ok for r in result.results)
-    print(f"analysed {n_ok} of {len(result.results)} recordings")
-    warned = [r.entry.name for r in result.results if r.ok and r.row.get("warnings")]
-    if warned:
-        print(f"{len(warned)} with warnings (listed in the report): {', '.join(warned)}",
-              file=sys.stderr)  # fmt: skip
-    doc = json_text(json_document(result)) if args.json else None
-    cmd = command_line("study", args.manifest, "--report", args.report)
-    paths = write_report(
-        args.report, result, args.title, study_plots=True, progress=args.progress, command=cmd
-    )
+        for r in result.failures:
+            print(f"FAILED: {r.error}", file=sys.stderr)
+        n_ok = sum(r.ok for r in result.results)
+        print(f"analysed {n_ok} of {len(result.results)} recordings", flush=True)
+        warned = [r.entry.name for r in result.results if r.ok and r.row.get("warnings")]
+        if warned:
+            print(f"{len(warned)} with warnings (listed in the report): {', '.join(warned)}",
+                  file=sys.stderr)  # fmt: skip
+        doc = json_text(json_document(result)) if args.json else None
+        cmd = command_line("study", args.manifest, "--report", args.report)
+        paths = write_report(
+            args.report,
+            result,
+            args.title,
+            study_plots=True,
+            progress=args.progress,
+            command=cmd,
+            executor=ex,
+        )
     for p in paths:
         if p.suffix in (".html", ".csv", ".parquet"):
             print(f"wrote {p}")
@@ -69,6 +76,6 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--title", default="contactlab study", help="report title")
     p.add_argument("--keep-going", action="store_true",
                    help="skip recordings that fail (exit code 1) instead of stopping")  # fmt: skip
-    add_workers_flag(p, "recordings")
+    add_workers_flag(p, "recordings", per_core=True)
     add_progress_flags(p)
     p.set_defaults(handler=_handler)

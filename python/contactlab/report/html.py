@@ -226,17 +226,42 @@ class Report:
         """
         import matplotlib.pyplot as plt
 
-        stem = slugify(name)
-        fname, k = f"{stem}.png", 2
-        while fname in self._figures:
-            fname, k = f"{stem}-{k}.png", k + 1
         try:
             png = figure_png(fig, dpi=dpi)
         finally:
             plt.close(fig)
+        return self.png(png, name, caption)
+
+    def png(self, png: bytes, name: str, caption: str = "") -> str:
+        """Embed a figure already rendered to PNG bytes (as :meth:`figure` does after
+        rendering); returns its file name, ``<name>.png`` or ``<name>-2.png``... when taken."""
+        stem = slugify(name)
+        fname, k = f"{stem}.png", 2
+        while fname in self._figures:
+            fname, k = f"{stem}-{k}.png", k + 1
         self._figures[fname] = _Figure(fname, png, caption)
         self._blocks().append(("fig", fname))
         return fname
+
+    def blocks(self) -> list[tuple[str, Any]]:
+        """The blocks added so far outside any section, figures with their PNG bytes:
+        ``(kind, payload)`` with ``("fig", (png, name, caption))``; :meth:`extend` adds them to
+        another report (a part rendered in another process)."""
+        out: list[tuple[str, Any]] = []
+        for kind, payload in self._preamble:
+            if kind == "fig":
+                f = self._figures[payload]
+                payload = (f.png, f.name.removesuffix(".png"), f.caption)
+            out.append((kind, payload))
+        return out
+
+    def extend(self, blocks: Iterable[tuple[str, Any]]) -> None:
+        """Add blocks from :meth:`blocks` of another report, in order, to the current section."""
+        for kind, payload in blocks:
+            if kind == "fig":
+                self.png(*payload)
+            else:
+                self._blocks().append((kind, payload))
 
     def table(
         self,
