@@ -9,6 +9,7 @@ centre polynomials of Konowalski's eq. 1.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from typing import Any
@@ -205,7 +206,11 @@ def build_report(
         if study_plots and len(rows) > 1:
             jobs.extend(("study", kind, rows, units, k, nparts, dpi) for k in range(nparts))
         if details:
-            jobs.extend(("detail", kind, r, dpi) for r in result.of_kind(kind) if r.ok)
+            for r in result.of_kind(kind):
+                if r.ok:
+                    if pool is not None and kind == "tangential":  # its figure needs no samples
+                        r = dataclasses.replace(r, recording=None)
+                    jobs.append(("detail", kind, r, dpi))
     parts = ordered_map(_render_part, jobs, pool)
     try:
         for kind, rows in plan:
