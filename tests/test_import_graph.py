@@ -32,6 +32,7 @@ PREFIXES = {
     "contactlab._json": "base",
     "contactlab._range": "base",
     "contactlab._malloc": "base",  # the CLI's allocator thresholds (glibc mallopt)
+    "contactlab._filters": "base",  # numpy Savitzky-Golay and friends (no scipy.signal import)
     "contactlab._trf": "base",  # scipy's bounded least-squares solver (for contactlab.fitting)
     "contactlab.data": "base",  # bundled files only (the generator is contactlab._datagen)
     "contactlab.masing": "masing/fitting/io",

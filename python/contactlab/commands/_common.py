@@ -480,9 +480,9 @@ def output_filter_taps(text: str | None) -> Any:
             f"--output-filter {text!r}: the polynomial order must be >= 0 and below the "
             f"window ({window}), got {order}"
         )
-    from scipy.signal import savgol_coeffs
+    from .._filters import savgol_coeffs
 
-    return savgol_coeffs(window, order, deriv=0, use="dot")
+    return savgol_coeffs(window, order, deriv=0)[::-1]  # dot orientation
 
 
 def positive_number(name: str):

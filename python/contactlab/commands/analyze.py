@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Any
 
 from ..errors import InputError
 from ..studies.manifest import entry_from_file
@@ -20,9 +21,9 @@ from ._common import (
     add_frame_flags,
     add_pressure_flags,
     add_progress_flags,
-    add_workers_flag,
     check_output_targets,
     command_line,
+    default_workers,
     describe,
     frame_option,
     json_document,
@@ -75,7 +76,7 @@ def _streamed(
         raise InputError("--stream --report takes one file (or use `contactlab track` per file)")
     say = sys.stderr if args.json == "-" else sys.stdout
     docs, failures, last = [], [], None
-    with process_pool(args.workers) as ex:
+    with process_pool(args.workers or None) as ex:
         for e in entries:
             try:
                 res = track(
@@ -213,6 +214,8 @@ def _handler(args: argparse.Namespace) -> int:
     frame = frame_option(args)
     columns = parse_columns(args.columns)
     check_output_targets(json_out=args.json, report=args.report)
+    if args.workers is not None and args.workers < 0:
+        raise InputError(f"--workers must be >= 0 (0: serially), got {args.workers}")
     if frame is not None and args.stream:
         raise InputError("--frame reconstructs the force from the whole record: drop --stream")
     entries = []
@@ -246,8 +249,25 @@ def _handler(args: argparse.Namespace) -> int:
         )
     if big:
         return _with_long(args, entries, big, columns, topts, nopts)
+    # several files: one process per core (--workers N sets it), the report's figures too
+    workers = args.workers or None  # 0: serially
+    if args.workers is None and len(entries) >= _POOL_FROM:
+        workers = default_workers()
+    with process_pool(workers) as ex:
+        return _in_memory(args, entries, frame, topts, nopts, ex)
+
+
+#: files from which ``analyze`` (not streamed) uses a process per core by default
+_POOL_FROM = 4
+
+
+def _in_memory(
+    args: argparse.Namespace, entries: list, frame: Any, topts: dict, nopts: dict, ex: Any
+) -> int:
+    """``analyze`` of recordings read whole: on ``ex`` (a process pool) or serially."""
     result = run_study(entries, progress=args.progress, keep_going=args.keep_going,
-                       tangential_options=topts, normal_options=nopts)  # fmt: skip
+                       tangential_options=topts, normal_options=nopts, executor=ex,
+                       keep_recordings=True)  # fmt: skip
     # With --json -, stdout carries the JSON alone; everything else goes to stderr.
     say = sys.stderr if args.json == "-" else sys.stdout
     for r in result.results:
@@ -288,6 +308,7 @@ def _handler(args: argparse.Namespace) -> int:
             study_plots=len(entries) > 1,
             progress=args.progress,
             command=cmd,
+            executor=ex,
         )
         for p in paths:
             if p.suffix == ".html":
@@ -338,7 +359,7 @@ def _with_long(
                 failures.append({"file": str(r.entry.path), "error": r.error})
                 print(f"{r.entry.path}: FAILED: {r.error}", file=sys.stderr)
     last = None
-    with process_pool(args.workers) as ex:
+    with process_pool(args.workers or None) as ex:
         for i in sorted(big):
             e = entries[i]
             try:
@@ -429,6 +450,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--every", default="auto", help="window of --stream: 'auto' (default), '200cycles' or '10s'"
     )
-    add_workers_flag(p, "the windows of --stream")
+    p.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="analyse the recordings (four or more files: one process per core by "
+                   "default) or the windows of --stream in N processes (0: in this "
+                   "process)")  # fmt: skip
     add_progress_flags(p)
     p.set_defaults(handler=_handler)

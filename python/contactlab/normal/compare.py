@@ -38,7 +38,7 @@ def measured_velocity(
     about 1/8 of a period when ``omega`` is known, else 15). ``method="spectral"``: FFT
     derivative keeping the first ``harmonics`` harmonics of ``omega``.
     """
-    from scipy.signal import savgol_filter
+    from .._filters import savgol_filter
 
     n = delta.size
     dt = float(np.median(np.diff(t)))

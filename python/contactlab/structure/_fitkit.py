@@ -63,7 +63,7 @@ def derivatives(t: np.ndarray, y: np.ndarray, periodic: bool) -> tuple[np.ndarra
     if y.size > 2 * win and np.ptp(dt) <= 1e-6 * dt.mean():
         # Savitzky-Golay (cubic, 15 samples): second differences of raw samples amplify the
         # measurement noise by 1/dt², which biases the regression towards zero stiffness.
-        from scipy.signal import savgol_filter
+        from .._filters import savgol_filter
 
         h = float(dt.mean())
         return (

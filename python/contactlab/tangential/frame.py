@@ -161,7 +161,7 @@ def difference_noise(v: np.ndarray, order: int = 4) -> float:
 def savgol_derivative(v: np.ndarray, window: int, deriv: int, dt: float) -> np.ndarray:
     """``deriv``-th derivative of ``v`` by a cubic Savitzky-Golay filter of ``window``
     samples (sampling interval ``dt``; the ends by the filter's own polynomial fit)."""
-    from scipy.signal import savgol_filter
+    from .._filters import savgol_filter
 
     return savgol_filter(v, window, POLYORDER, deriv=deriv, delta=dt, mode="interp")
 
@@ -169,9 +169,9 @@ def savgol_derivative(v: np.ndarray, window: int, deriv: int, dt: float) -> np.n
 def savgol_coefficients(window: int, deriv: int, dt: float) -> np.ndarray:
     """Savitzky-Golay weights of the ``deriv``-th derivative (dot with a centred window):
     white noise σ on the samples gives the estimate a noise ``σ ‖weights‖``."""
-    from scipy.signal import savgol_coeffs
+    from .._filters import savgol_coeffs
 
-    return savgol_coeffs(window, POLYORDER, deriv=deriv, delta=dt, use="dot")
+    return savgol_coeffs(window, POLYORDER, deriv=deriv, delta=dt)[::-1]  # dot: not reversed
 
 
 def force_kernel(window: int) -> np.ndarray:
@@ -262,7 +262,7 @@ def _lepski_square_sums(
     halves = [w // 2 for w in cands]
     halo = halves[-1]
     if coefficients is None:
-        from scipy.signal import savgol_coeffs
+        from .._filters import savgol_coeffs
 
         coeffs = [savgol_coeffs(w, POLYORDER, deriv=2, delta=dt) for w in cands]
     else:  # convolution orientation: the dot weights reversed
