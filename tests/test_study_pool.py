@@ -109,3 +109,18 @@ def test_study_real_sigint_during_the_pooled_report_exits_130_without_output(fol
     assert proc.returncode in (130, -signal.SIGINT), err
     assert "interrupted" in err and "Traceback" not in err
     assert not out.exists()
+
+
+def test_analyze_of_several_files_on_processes_equals_serial(folder, tmp_path):
+    more = ("PVC-steel_W30N_A10um.tdms", "steel-steel_W75N_A1um.h5")
+    files = [
+        *sorted(str(p) for p in folder.glob("Al-Al_*")),
+        *(str(data_dir() / "tangential" / n) for n in more),
+    ]
+    assert len(files) >= 4  # the default then is a process per core
+    one, two = tmp_path / "serial.json", tmp_path / "pooled.json"
+    base = ["analyze", *files, "--model", "tangential", "--no-progress"]
+    assert main([*base, "--json", str(one), "--workers", "0"]) == 0
+    assert main([*base, "--json", str(two)]) == 0
+    assert one.read_bytes() == two.read_bytes()
+    assert main([*base, "--json", str(tmp_path / "x.json"), "--workers", "-1"]) != 0
