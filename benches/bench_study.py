@@ -2,13 +2,18 @@
 
 Each stage is reported per item and as a ratio to a same-run reference: one plain matplotlib
 line figure of the same size and resolution rendered to PNG (the floor any report with
-figures pays). Run: ``.venv/bin/python benches/bench_study.py [--repeat 3]``.
+figures pays). The analysis and the figures are timed serially and on ``--workers`` processes
+(as ``contactlab study`` and ``demo`` run them), with the speed-up against the serial stage of
+the same run; the pooled outputs are checked to be the serial ones.
+Run: ``.venv/bin/python benches/bench_study.py [--repeat 3] [--workers 2]``.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import time
+from concurrent.futures import ProcessPoolExecutor
 
 import matplotlib
 
@@ -43,6 +48,7 @@ def reference_figure() -> bytes:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--workers", type=int, default=os.cpu_count() or 1)
     args = ap.parse_args()
     t_ref, _ = best_of(reference_figure, args.repeat * 3)
     t_study, res = best_of(lambda: run_study(manifest_path(), progress=False), args.repeat)
@@ -62,6 +68,21 @@ def main() -> None:
     for name, t, n, unit in rows:
         print(f"{name:<20}{t:>10.2f}{1e3 * t / n:>15.1f}{t / n / t_ref:>13.2f}  per {unit}")
     print(f"total {t_study + t_rep + t_html + t_tab:.1f} s for {n_rec} recordings, {n_fig} figures")
+    if args.workers < 2:
+        return
+    with ProcessPoolExecutor(args.workers) as ex:
+        run_study(manifest_path(), progress=False, executor=ex)  # start the workers
+        p_study, pres = best_of(
+            lambda: run_study(manifest_path(), progress=False, executor=ex, keep_recordings=True),
+            args.repeat,
+        )
+        p_rep, prep = best_of(lambda: build_report(pres, "bench", executor=ex), args.repeat)
+    same = res.table_files() == pres.table_files() and prep.figures == rep.figures
+    print(f"on {args.workers} processes (outputs identical to the serial ones: {same}):")
+    for name, t, tp in (("read + analyse", t_study, p_study), ("figures (report)", t_rep, p_rep)):
+        print(f"{name:<20}{tp:>10.2f} s  x{t / tp:.2f} the serial stage")
+    tot, ptot = t_study + t_rep, p_study + p_rep
+    print(f"analysis and figures: {tot:.1f} s serial, {ptot:.1f} s pooled: x{tot / ptot:.2f}")
 
 
 if __name__ == "__main__":
