@@ -124,3 +124,43 @@ def test_analyze_of_several_files_on_processes_equals_serial(folder, tmp_path):
     assert main([*base, "--json", str(two)]) == 0
     assert one.read_bytes() == two.read_bytes()
     assert main([*base, "--json", str(tmp_path / "x.json"), "--workers", "-1"]) != 0
+
+
+def _dies(entry, **_):
+    import os
+
+    os._exit(3)  # a worker killed mid-task (as the kernel's OOM killer would)
+
+
+def test_a_worker_that_dies_is_an_error_not_a_traceback(folder, tmp_path, monkeypatch, capsys):
+    import multiprocessing
+
+    import contactlab.studies.study as study_mod
+
+    if multiprocessing.get_start_method() != "fork":
+        pytest.skip("the patched function reaches the workers only when they are forked")
+    monkeypatch.setattr(study_mod, "analyze_entry", _dies)
+    out = tmp_path / "rep"
+    assert main(["study", str(folder), "--report", str(out), "--workers", "2"]) == 1
+    err = capsys.readouterr().err
+    assert "a worker process ended unexpectedly" in err and "Traceback" not in err
+    assert not out.exists()
+
+
+def test_no_process_pool_here(folder, tmp_path, monkeypatch, capsys):
+    import concurrent.futures
+
+    class Refused(ProcessPoolExecutor):
+        def __init__(self, *_a, **_k):
+            raise OSError(38, "Function not implemented")
+
+    monkeypatch.setattr(concurrent.futures, "ProcessPoolExecutor", Refused)
+    # the default: a note, then the serial run
+    out = tmp_path / "rep"
+    assert main(["study", str(folder), "--report", str(out), "--no-progress"]) == 0
+    assert "cannot start worker processes here" in capsys.readouterr().err
+    assert (out / "report.html").exists()
+    # asked for: an error that names the way out
+    assert main(["study", str(folder), "--report", str(tmp_path / "r2"), "--workers", "2"]) == 1
+    err = capsys.readouterr().err
+    assert "--workers 0 runs in this process" in err and "Traceback" not in err

@@ -142,6 +142,17 @@ def _main(argv: list[str]) -> int:
     except KeyboardInterrupt:
         print(f"contactlab {args.verb}: interrupted; no partial outputs written", file=sys.stderr)
         return 130
+    except RuntimeError as exc:  # a worker process was killed (out of memory, a signal)
+        futures = sys.modules.get("concurrent.futures")  # imported by whatever started a pool
+        if futures is None or not isinstance(exc, futures.BrokenExecutor):
+            raise
+        print(
+            f"contactlab {args.verb}: error: a worker process ended unexpectedly ({exc}); "
+            "it may have run out of memory: try fewer --workers (0: in this process); no "
+            "partial outputs written",
+            file=sys.stderr,
+        )
+        return 1
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -355,8 +355,12 @@ def window_threads() -> int:
     return max(1, min(2, os.cpu_count() or 1))
 
 
-def process_pool(workers: int | None) -> Any:
-    """A ``ProcessPoolExecutor`` for ``--workers N`` (a null context for None)."""
+def process_pool(workers: int | None, *, auto: bool = False) -> Any:
+    """A ``ProcessPoolExecutor`` for ``--workers N`` (a null context for None).
+
+    Where no process pool can be started (no POSIX semaphores, a sandbox): with ``auto`` (the
+    count was the default, not asked for) a note and the serial run, else an error that says
+    to use ``--workers 0``."""
     import contextlib
 
     if workers is None:
@@ -365,7 +369,17 @@ def process_pool(workers: int | None) -> Any:
         raise InputError(f"--workers must be >= 1, got {workers}")
     from concurrent.futures import ProcessPoolExecutor
 
-    return ProcessPoolExecutor(workers, initializer=_ignore_sigint)
+    try:
+        return ProcessPoolExecutor(workers, initializer=_ignore_sigint)
+    except (OSError, ImportError, NotImplementedError) as exc:
+        if not auto:
+            raise InputError(
+                f"--workers {workers}: cannot start worker processes here ({exc}); "
+                "--workers 0 runs in this process"
+            ) from None
+        print(f"note: cannot start worker processes here ({exc}); running in this process",
+              file=sys.stderr)  # fmt: skip
+        return contextlib.nullcontext(None)
 
 
 def add_progress_flags(p: Any) -> None:

@@ -253,7 +253,7 @@ def _handler(args: argparse.Namespace) -> int:
     workers = args.workers or None  # 0: serially
     if args.workers is None and len(entries) >= _POOL_FROM:
         workers = default_workers()
-    with process_pool(workers) as ex:
+    with process_pool(workers, auto=args.workers is None) as ex:
         return _in_memory(args, entries, frame, topts, nopts, ex)
 
 

@@ -104,12 +104,18 @@ def demo_entries(quick: bool = False) -> list:
 
 
 def run_demo(
-    out: Path, *, quick: bool = False, progress: bool | None = None, workers: int | None = None
+    out: Path,
+    *,
+    quick: bool = False,
+    progress: bool | None = None,
+    workers: int | None = None,
+    auto: bool = False,
 ) -> list[Path]:
     """Run the demo and write every output into ``out``; returns the written paths.
 
     ``workers``: processes that analyse the recordings and draw the report's figures (None:
-    all in this process); the outputs are the same.
+    all in this process; ``auto``: the count was not asked for, so a machine that cannot
+    start processes runs serially); the outputs are the same.
     """
     import matplotlib
 
@@ -125,7 +131,7 @@ def run_demo(
         "noise, offsets, quantisation and drift; see contactlab.data.generate). The table's "
         "true_h0 / true_ac columns are the values the recordings were made with."
     )
-    with process_pool(workers) as ex:
+    with process_pool(workers, auto=auto) as ex:
         result = run_study(
             demo_entries(quick), progress=progress, executor=ex, keep_recordings=True
         )
@@ -142,7 +148,13 @@ def _handler(args: argparse.Namespace) -> int:
     from ._common import resolve_workers
 
     workers = resolve_workers(args.workers)
-    paths = run_demo(Path(args.out), quick=args.quick, progress=args.progress, workers=workers)
+    paths = run_demo(
+        Path(args.out),
+        quick=args.quick,
+        progress=args.progress,
+        workers=workers,
+        auto=args.workers is None,
+    )
     for p in paths:
         if p.parent == Path(args.out):
             print(f"wrote {p}")

@@ -29,7 +29,7 @@ from ._common import (
 
 def _handler(args: argparse.Namespace) -> int:
     check_output_targets(json_out=args.json, report=args.report)
-    with process_pool(resolve_workers(args.workers)) as ex:
+    with process_pool(resolve_workers(args.workers), auto=args.workers is None) as ex:
         result = run_study(
             args.manifest,
             progress=args.progress,
