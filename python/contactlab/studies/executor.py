@@ -4,8 +4,10 @@
 ``result()``: a :class:`concurrent.futures.ThreadPoolExecutor` or ``ProcessPoolExecutor``, or
 a Dask ``distributed.Client`` (a cluster; ``pip install 'contactlab[scale]'``). Results come
 back in the order of the inputs, identical to a serial run (the same function on the same
-data), and only a bounded number of tasks is in flight, so a study of thousands of files
-never holds more than a few recordings at a time.
+data), and only a bounded number of tasks is in flight (2 per worker) or finished ahead of
+its turn (8 per worker, at least 16), so a study of thousands of files never holds more
+than that many recordings at a time. A free worker gets the next task as soon as any task
+finishes, so one long recording does not stall the others.
 """
 
 from __future__ import annotations

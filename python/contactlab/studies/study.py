@@ -417,8 +417,8 @@ def run_study(
     executor : optional
         Run the recordings in parallel: a ``concurrent.futures`` executor (threads or
         processes) or a Dask ``distributed.Client`` (see :mod:`contactlab.studies.executor`).
-        Results come in the order of the study and equal the serial run's; a few recordings
-        are in flight at a time.
+        Results come in the order of the study and equal the serial run's; a bounded number
+        of recordings is in flight at a time (:func:`contactlab.studies.ordered_map`).
     keep_recordings : bool, optional
         Keep each recording's samples in its result (``RecordingResult.recording``, drawn
         behind the normal loops of the report). Default: yes for a serial run, no with an
