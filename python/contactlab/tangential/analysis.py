@@ -118,6 +118,15 @@ def _check_options(on: str, history: str, n_points: int | None) -> None:
         raise InputError(f"n_points must be even and >= 8, got {n_points}")
 
 
+def _percent(rel: float) -> str:
+    """A relative standard error as a percentage for a message: beyond 1000 % the figure
+    says nothing more than that the parameter is not determined ("1175301844650%" read as
+    noise), so it is given as such."""
+    if not math.isfinite(rel) or rel >= 10.0:
+        return "over 1000% (undetermined)"
+    return f"{100 * rel:.0f}%"
+
+
 def identifiability(
     fit: FitResult, raw: FitResult, amplitude: float, max_rel_stderr: float
 ) -> tuple[bool, dict[str, Any]]:
@@ -143,7 +152,7 @@ def identifiability(
         msg = (
             f"h0 and ac are NOT separately identifiable from this loop: ac·A = {z:.3g} "
             f"(the loop is {'nearly linear, a pure stiffness' if z < 0.5 else 'too noisy'}); "
-            f"relative errors h0 {100 * rel_h0:.0f}%, ac {100 * rel_ac:.0f}%, correlation "
+            f"relative errors h0 {_percent(rel_h0)}, ac {_percent(rel_ac)}, correlation "
             f"{corr:+.3f}. Identified: h0·ac = {k0.value:.6g} ± {k0.stderr or math.nan:.3g} N/m"
             f" ({100 * rel_k0:.2f}%); ac < {ac_up:.3g} 1/m and h0 > {h0_lo:.3g} N (2σ)."
         )
