@@ -2,9 +2,10 @@
 
 Each stage is reported per item and as a ratio to a same-run reference: one plain matplotlib
 line figure of the same size and resolution rendered to PNG (the floor any report with
-figures pays). The analysis and the figures are timed serially and on ``--workers`` processes
-(as ``contactlab study`` and ``demo`` run them), with the speed-up against the serial stage of
-the same run; the pooled outputs are checked to be the serial ones.
+figures pays). The analysis and the figures are then timed on ``--workers`` processes (as
+``contactlab study`` and ``demo`` run them) in interleaved pairs with the serial run (the
+order alternating): median speed-up and range; the pooled outputs are checked to be the
+serial ones.
 Run: ``.venv/bin/python benches/bench_study.py [--repeat 3] [--workers 2]``.
 """
 
@@ -70,19 +71,36 @@ def main() -> None:
     print(f"total {t_study + t_rep + t_html + t_tab:.1f} s for {n_rec} recordings, {n_fig} figures")
     if args.workers < 2:
         return
+    import statistics
+
+    def serial_run():
+        r = run_study(manifest_path(), progress=False)
+        return r, build_report(r, "bench")
+
     with ProcessPoolExecutor(args.workers) as ex:
-        run_study(manifest_path(), progress=False, executor=ex)  # start the workers
-        p_study, pres = best_of(
-            lambda: run_study(manifest_path(), progress=False, executor=ex, keep_recordings=True),
-            args.repeat,
-        )
-        p_rep, prep = best_of(lambda: build_report(pres, "bench", executor=ex), args.repeat)
-    same = res.table_files() == pres.table_files() and prep.figures == rep.figures
-    print(f"on {args.workers} processes (outputs identical to the serial ones: {same}):")
-    for name, t, tp in (("read + analyse", t_study, p_study), ("figures (report)", t_rep, p_rep)):
-        print(f"{name:<20}{tp:>10.2f} s  x{t / tp:.2f} the serial stage")
-    tot, ptot = t_study + t_rep, p_study + p_rep
-    print(f"analysis and figures: {tot:.1f} s serial, {ptot:.1f} s pooled: x{tot / ptot:.2f}")
+
+        def pooled_run():
+            r = run_study(manifest_path(), progress=False, executor=ex, keep_recordings=True)
+            return r, build_report(r, "bench", executor=ex)
+
+        pooled_run()  # start and warm up the workers
+        ratios, same = [], True
+        for k in range(max(args.repeat, 2)):  # interleaved pairs, the order alternating
+            times = {}
+            for name, f in (("s", serial_run), ("p", pooled_run))[:: 1 if k % 2 == 0 else -1]:
+                t0 = time.perf_counter()
+                r, rp = f()
+                times[name] = time.perf_counter() - t0
+                if name == "p":
+                    same = same and r.table_files() == res.table_files()
+                    same = same and rp.figures == rep.figures
+            ratios.append(times["s"] / times["p"])
+    ratios.sort()
+    print(
+        f"analysis and figures on {args.workers} processes, {len(ratios)} interleaved pairs "
+        f"with the serial run: x{statistics.median(ratios):.2f} median (range "
+        f"{ratios[0]:.2f}-{ratios[-1]:.2f}); outputs identical to the serial ones: {same}"
+    )
 
 
 if __name__ == "__main__":

@@ -164,3 +164,23 @@ def test_no_process_pool_here(folder, tmp_path, monkeypatch, capsys):
     assert main(["study", str(folder), "--report", str(tmp_path / "r2"), "--workers", "2"]) == 1
     err = capsys.readouterr().err
     assert "--workers 0 runs in this process" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("n", [2, 3, 5])
+def test_study_figure_parts_interleave_to_the_whole(folder, n):
+    import matplotlib.pyplot as plt
+
+    from contactlab.studies.plots import tangential_study_figures
+
+    result = run_study(folder, progress=False)
+    rows, units = result.table("tangential"), result.units("tangential")
+    whole = tangential_study_figures(rows, units)
+    parts = [tangential_study_figures(rows, units, part=(k, n)) for k in range(n)]
+    names = [name for name, _, _ in whole]
+    merged = [None] * len(names)
+    for k, figs in enumerate(parts):
+        for j, (name, _, _) in enumerate(figs):
+            merged[k + j * n] = name
+    assert len(names) >= 3 and merged == names
+    for _, fig, _ in whole + [f for p in parts for f in p]:
+        plt.close(fig)

@@ -149,9 +149,14 @@ def _render_part(job: tuple) -> list[tuple[str, Any]]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    make = tangential_study_figures if kind == "tangential" else normal_study_figures
     sub = Report("")
-    for i, (name, fig, cap) in enumerate(make(rows, units)):
+    if kind == "tangential":  # only this part's figures are drawn: k, k + n, ...
+        figs = tangential_study_figures(rows, units, part=(part, nparts))
+        places = range(part, part + nparts * len(figs), nparts)
+    else:  # two figures: made whole, each part renders its own
+        figs = normal_study_figures(rows, units)
+        places = range(len(figs))
+    for i, (name, fig, cap) in zip(places, figs, strict=True):
         if i % nparts == part:
             sub.figure(fig, name, cap, dpi=dpi)
             sub.text(str(i))  # its place among all parts' figures

@@ -153,13 +153,20 @@ def plot_study(
 
 
 def tangential_study_figures(
-    rows: Sequence[Mapping[str, Any]], units: Mapping[str, str] | None = None
+    rows: Sequence[Mapping[str, Any]],
+    units: Mapping[str, str] | None = None,
+    *,
+    part: tuple[int, int] = (0, 1),
 ) -> list[tuple[str, Any, str]]:
     """One figure per material and quantity: against load (left) and amplitude (right).
 
     Materials with fewer than two recordings are left out. Returns ``(name, figure,
-    caption)`` triples; the caller owns (and closes) the figures.
+    caption)`` triples; the caller owns (and closes) the figures. ``part=(k, n)``: only the
+    figures ``k, k + n, k + 2n, ...`` of the whole list, the others not drawn at all (a
+    report split over ``n`` processes).
     """
+    k_part, n_parts = part
+    index = -1
     import matplotlib.pyplot as plt
 
     units = {"normal_load": "N", "amplitude": "m", "amplitude_nominal": "m", **(units or {})}
@@ -175,6 +182,9 @@ def tangential_study_figures(
         amp_group = amp_x = "amplitude_nominal" if nominal else "amplitude"
         for key, label, unit, secondary in TANGENTIAL_QUANTITIES:
             if not any(math.isfinite(_num(r, key)) for r in mrows):
+                continue
+            index += 1
+            if index % n_parts != k_part:
                 continue
             fig, (a1, a2) = plt.subplots(1, 2, figsize=(9.0, 3.6), constrained_layout=True)
             plot_study(mrows, key, "normal_load", amp_group, unit=unit, label=label,
