@@ -107,3 +107,20 @@ def test_keep_going_survives_an_unexpected_error(tmp_path, monkeypatch):
     ] * 2
     with pytest.raises(ZeroDivisionError):  # without keep_going a bug stays a bug
         study_mod.run_study(tmp_path, progress=False)
+
+
+def test_unnamed_columns_hint_names_the_flags(tmp_path, capsys):
+    """A CSV whose columns say nothing of their kind (the friction frame's): the message
+    names the command line's flags as well as the Python keywords."""
+    f = tmp_path / "frame.csv"
+    f.write_text("t_s,top_mm,base_mm\n0,0,0\n0.004,0.1,0.2\n0.008,0.2,0.3\n")
+    assert main(["track", str(f)]) == 1
+    err = capsys.readouterr().err
+    assert "frame.csv" in err and "--model" in err and "--columns 'x=" in err
+    assert main(["analyze", str(f), "--model", "tangential"]) == 1
+    err = capsys.readouterr().err
+    assert "no column for 'x'" in err and "--columns 'x=your column'" in err
+    g = tmp_path / "not.csv"
+    g.write_text("disp_m,force_N\n0,0\n1e-6,1\n2e-6,3\n")
+    assert main(["track", str(g)]) == 1
+    assert "--fs or --columns 't=" in capsys.readouterr().err

@@ -152,7 +152,8 @@ class _Finisher:
                 self.dt = float(dt)
             else:
                 raise RecordingError(
-                    "no time column and no sampling rate: pass fs= (Hz) or columns={'t': ...}",
+                    "no time column and no sampling rate: pass fs= (Hz) or columns={'t': ...} "
+                    "(command line: --fs or --columns 't=...')",
                     file=file,
                 )
         self.t0 = t0

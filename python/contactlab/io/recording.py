@@ -244,7 +244,8 @@ def resolve_columns(
     if kind is None:
         raise RecordingError(
             f"cannot tell a tangential (x, F) from a normal (p, delta) recording; columns are "
-            f"{available}; pass kind= and columns={{'x': ..., 'F': ...}}",
+            f"{available}; pass kind= and columns={{'x': ..., 'F': ...}} (command line: --model "
+            "tangential|normal and --columns 'x=...,F=...')",
             file=file,
         )
     for canon in (*KIND_CHANNELS[kind], "t"):
@@ -257,7 +258,7 @@ def resolve_columns(
             raise RecordingError(
                 f"no column for {canon!r} ({DIMENSIONS[canon]}) of a {kind} recording; columns "
                 f"are {available}; name it e.g. {ALIASES[canon][0]!r} or pass columns="
-                f"{{{canon!r}: 'your column'}}",
+                f"{{{canon!r}: 'your column'}} (command line: --columns '{canon}=your column')",
                 file=file,
                 column=canon,
             )
@@ -371,7 +372,9 @@ def check_time(
 def time_from_fs(n: int, fs: float | None, *, file: str, t0: float = 0.0) -> np.ndarray:
     if fs is None:
         raise RecordingError(
-            "no time column and no sampling rate: pass fs= (Hz) or columns={'t': ...}", file=file
+            "no time column and no sampling rate: pass fs= (Hz) or columns={'t': ...} (command "
+            "line: --fs or --columns 't=...')",
+            file=file,
         )
     fs = float(fs)
     if not np.isfinite(fs) or fs <= 0:

@@ -758,7 +758,9 @@ def _track(
     cr = read_chunks(source, chunk_size=chunk_size, columns=columns, kind=kind, fs=fs)
     kind_ = cr.kind
     if kind_ not in ("tangential", "normal"):
-        raise InputError(f"{cr.source}: cannot tell the kind of recording; pass kind=")
+        raise InputError(
+            f"{cr.source}: cannot tell the kind of recording; pass kind= (command line: --model)"
+        )
     loop_x, loop_F, drive = ("x", "F", "x") if kind_ == "tangential" else ("delta", "p", "p")
     analyse: Callable[..., tuple[dict, dict]] = functools.partial(
         _tangential_window if kind_ == "tangential" else _normal_window, keep_doc=keep_documents
