@@ -12,6 +12,7 @@ count.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
 from ..errors import InputError
@@ -83,22 +84,31 @@ def _handler(args: argparse.Namespace) -> int:
 
     release_freed_memory()  # the windows' arrays, before the JSON and the figures are made
     comb = res.combined()
+    if not any(k.endswith("_stderr") for k in comb):
+        failed = [r for r in res.rows if r.get("error")]
+        why = f" ({failed[0]['error']})" if failed else ""
+        raise InputError(
+            f"{res.source}: none of the {len(res.rows)} windows could be analysed{why}; "
+            "nothing written"
+        )
     print(
-        f"{res.source}: {len(res.rows)} windows, {comb.get('n_cycles', 0)} cycles, "
-        f"{res.meta['n_samples']} samples",
+        f"{res.source}: {len(res.rows)} window{'s' if len(res.rows) != 1 else ''}, "
+        f"{comb.get('n_cycles', 0)} cycles, {res.meta['n_samples']} samples",
         file=say,
     )
     for key, unit, f in _SHOW[res.kind]:
         if key in comb:
             birge = comb.get(f"{key}_birge")
             how = f"pooled; Birge ratio {birge:.2g}" if birge is not None else "mean of the windows"
+            err = comb.get(f"{key}_stderr")
+            pm = f" ± {err * f:.2g}" if err is not None and math.isfinite(err) else ""
+            if not pm:
+                how += "; one window: no error from their scatter"
             print(
-                f"  {key} = {comb[key] * f:.5g} ± {comb[f'{key}_stderr'] * f:.2g} {unit} ({how})",
-                file=say,
+                f"  {key} = {comb[key] * f:.5g}{pm}{' ' + unit if unit else ''} ({how})", file=say
             )
-    for r in res.rows:
-        if r.get("error"):
-            print(f"  warning: {r['error']}", file=sys.stderr)
+    for note in res.notes(comb):
+        print(f"  warning: {note}", file=sys.stderr)
     doc = track_json(res) if args.json else None  # rendered before anything is written
     if args.report:
         import matplotlib

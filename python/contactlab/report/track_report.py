@@ -54,8 +54,7 @@ def build_track_report(
         _columns(result, with_time=False),
         "all windows pooled (inverse-variance mean; error widened by the Birge ratio)",
     )
-    failed = [r["error"] for r in result.rows if r.get("error")]
-    for msg in failed:
+    for msg in result.notes(comb):  # failed windows, the windows' warnings, scatter
         rep.text(msg, note=True)
     rep.section(f"Quantities against {against}")
     for name, fig in track_figures(result, against=against):

@@ -125,6 +125,12 @@ def parse_every(every: str | float | int) -> tuple[str, float]:
     return "time", seconds
 
 
+#: a pooled quantity whose windows' Birge ratio exceeds this is noted (TrackResult.notes)
+BIRGE_NOTE = 3.0
+
+_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+
+
 def _mean_std(a: np.ndarray) -> tuple[float, float]:
     """Mean and sample standard deviation (NaN for one value) computed on ``a / max|a|``,
     so that values near the double-precision limit do not overflow the squares."""
@@ -234,8 +240,46 @@ class TrackResult:
             out["cycle_energy_mean"], out["cycle_energy_std"] = _mean_std(e)
         return out
 
+    def notes(self, combined: dict[str, Any] | None = None) -> list[str]:
+        """What a reader of the pooled values must know, one line each: windows that could not
+        be analysed, the windows' own warnings (each kind once, with how many windows gave
+        it: the first window's text) and quantities whose windows scatter beyond their errors
+        (Birge ratio above :data:`BIRGE_NOTE`: the pooled value is a weighted mean of values
+        that changed, not a constant)."""
+        comb = self.combined() if combined is None else combined
+        n = len(self.rows)
+        out: list[str] = []
+        failed = [r for r in self.rows if r.get("error")]
+        if failed:
+            out.append(f"{len(failed)} of {n} windows could not be analysed ({failed[0]['error']})")
+        kinds: dict[str, list[Any]] = {}  # a warning's text with its numbers blanked
+        for r in self.rows:
+            seen = set()
+            for w in filter(None, str(r.get("warnings") or "").split(" | ")):
+                key = _NUMBER.sub("#", w)
+                if key in seen:
+                    continue
+                seen.add(key)
+                kinds.setdefault(key, [0, r.get("window"), w])[0] += 1
+        for count, window, text in kinds.values():
+            out.append(f"{count} of {n} windows warn (window {window}: {text})")
+        spread = []
+        for q in self.quantities:
+            b = comb.get(f"{q}_birge")
+            if b is not None and not b <= BIRGE_NOTE and n >= 3:  # NaN/inf: beyond any error
+                spread.append(f"{q} {b:.3g}" if math.isfinite(b) else f"{q} (beyond any)")
+        if spread:
+            out.append(
+                "the windows scatter beyond their standard errors (Birge ratio "
+                + ", ".join(spread)
+                + "): these change over the record (or the errors are optimistic); their "
+                "pooled values are weighted means, not constants - see them against time"
+            )
+        return out
+
     def to_dict(self, *, cycles: bool = True) -> dict[str, Any]:
-        """JSON-ready: ``windows`` (rows), ``combined``, ``cycles`` (arrays), ``units``."""
+        """JSON-ready: ``windows`` (rows), ``combined``, ``notes`` (:meth:`notes`), ``cycles``
+        (arrays), ``units``."""
         cu = CYCLE_UNITS[self.kind]
         comb = self.combined()
         units = dict(self.units)
@@ -249,6 +293,7 @@ class TrackResult:
             "every": self.every,
             "windows": self.rows,
             "combined": comb,
+            "notes": self.notes(comb),
             "units": units,
             "cycle_units": dict(cu),
             "meta": self.meta,

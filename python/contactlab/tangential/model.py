@@ -61,9 +61,16 @@ def steady_loop_force(
     if x_var is not None and model.is_exponential:
         # from the turn that starts each branch (np.concatenate: np.r_ costs ~20 µs a call)
         dist = np.concatenate([top - u[:h], u[h:] - bot])
-        curv = 0.5 * model.h0 * model.ac**2 * np.exp(-0.5 * model.ac * dist)
-        curv[h:] *= -1.0  # descending branches curve up, ascending ones down
-        F = F + 0.5 * curv * x_var
+        ac, h0 = np.float64(model.ac), np.float64(model.h0)
+        with np.errstate(over="ignore", invalid="ignore"):  # a fit straying to a huge ac
+            curv = 0.5 * h0 * np.square(ac) * np.exp(-0.5 * ac * dist)
+            curv[h:] *= -1.0  # descending branches curve up, ascending ones down
+            corr = 0.5 * curv * x_var
+        if not np.isfinite(corr).all():
+            # ac so large that the branch turns within a bin: the term (a bin mean's force is
+            # never beyond ±h0 of its neighbours') is bounded by h0, and 0 where x_var is
+            corr = np.where(np.isnan(corr), 0.0, np.clip(corr, -h0, h0))
+        F = F + corr
     return F
 
 

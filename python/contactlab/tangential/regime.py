@@ -235,15 +235,28 @@ def _break_time(x: np.ndarray, a: int, b: int, end: int, window: int, sigma: flo
     i = np.arange(first, hi, dtype=float)
     xs = x[first:hi]
     best: dict[bool, tuple[float, float]] = {}
-    for tb in np.arange(lo, min(end + 2, hi - 1), 0.1):
-        sv = np.clip(i - tb, 0.0, None)
+
+    def search(grid: np.ndarray) -> None:
+        for tb in grid:
+            sv = np.clip(i - tb, 0.0, None)
+            for quad in (True, False):
+                cols = [np.ones_like(i), sv**2, sv**3] if quad else [np.ones_like(i), sv**3]
+                design = np.column_stack(cols)
+                coef, *_ = np.linalg.lstsq(design, xs, rcond=None)
+                rss = float(np.sum((design @ coef - xs) ** 2))
+                if rss < best.get(quad, (np.inf, 0.0))[0]:
+                    best[quad] = (rss, float(tb))
+
+    stop = min(end + 2, hi - 1)
+    if stop - lo <= _FINE_SEARCH:
+        search(np.arange(lo, stop, 0.1))
+    else:
+        # a long search (each position a least-squares fit over the whole span: quadratic in
+        # the span): whole samples first, then tenths about each model's best
+        search(np.arange(lo, stop, 1.0))
         for quad in (True, False):
-            cols = [np.ones_like(i), sv**2, sv**3] if quad else [np.ones_like(i), sv**3]
-            design = np.column_stack(cols)
-            coef, *_ = np.linalg.lstsq(design, xs, rcond=None)
-            rss = float(np.sum((design @ coef - xs) ** 2))
-            if rss < best.get(quad, (np.inf, 0.0))[0]:
-                best[quad] = (rss, float(tb))
+            c = best[quad][1]
+            search(np.arange(max(lo, c - 0.9), min(stop, c + 1.0), 0.1))
     # the break is searched over many positions: the likelihood-ratio threshold is the χ²(1)
     # quantile at a 1 % false-alarm rate shared among the whole samples searched (Bonferroni;
     # a fixed 9 σ² read a drop into 1 in 5 sticks without one and put breakaway 8-10 % high)
@@ -251,6 +264,10 @@ def _break_time(x: np.ndarray, a: int, b: int, end: int, window: int, sigma: flo
     if True not in best or best[False][0] - best[True][0] <= _break_threshold(positions) * sigma**2:
         return None
     return best[True][1]
+
+
+#: break searches spanning up to this many samples run on tenths of a sample throughout
+_FINE_SEARCH = 200
 
 
 def _break_threshold(positions: int) -> float:
@@ -287,9 +304,11 @@ def _breakaway(
     window: int,
     sliding: float,
     sigma: float,
+    reach: int | None = None,
 ) -> float:
     """Breakaway force of the stick ``span = [a, b)`` (``f``: the force about the plateaus'
-    midline; ``sigma``: the displacement noise).
+    midline; ``sigma``: the displacement noise; ``reach``: how far past the stick, in
+    samples, sliding may start; None: anywhere).
 
     Two things lower a plain maximum of ``|f|`` over the stuck samples. (1) A real joint
     creeps before it slides: the velocity leaves the stick band while the force still rises
@@ -309,9 +328,14 @@ def _breakaway(
     a, b = span
     n = f.size
     end = b
-    while end < n and abs(v[end]) < sliding:
+    # the onset of sliding: at most `reach` samples on (a quarter period; on a record that
+    # never slides, noise say, the search would otherwise run to its end)
+    stop = n if reach is None else min(n, b + reach)
+    while end < stop and abs(v[end]) < sliding:
         end += 1
     peak = _smooth_peak(np.abs(f[a : min(end + 1, n)]), window)
+    if reach is not None and end >= stop:
+        return peak  # no sliding within reach of the stick: no break to look for
     tb = _break_time(x, a, b, end, window, sigma)
     if tb is None:
         return peak
@@ -361,10 +385,11 @@ def stick_slip(
     durations, breakaway = [], []
     sliding = SLIDE_ONSET * amp * omega
     sx = difference_noise(x) if spans else 0.0  # only the breakaway search needs it
+    reach = max(4 * window, math.ceil(0.25 * period / dt)) if dt > 0 else x.size
     f = F - offset if spans else F  # once, not a whole-record copy per stick
     for a, b, n_stuck in spans.values():
         durations.append(n_stuck * dt)
-        breakaway.append(_breakaway(f, x, v, (a, b), window, max(sliding, thr), sx))
+        breakaway.append(_breakaway(f, x, v, (a, b), window, max(sliding, thr), sx, reach))
     hit = spans
     return StickSlip(int(turns.size), np.asarray(durations), np.asarray(breakaway), float(thr),
                      float(smooth), len(hit))  # fmt: skip

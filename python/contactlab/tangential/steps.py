@@ -295,9 +295,12 @@ def start_values(
     # bin means or samples is biased: bins cut the tips, noise widens the extremes)
     a_fixed = prior[1] if (prior is not None and not fit_amplitude) else a0
     k0 = h0_init * ac_init
+    # ac·A at most 1e6 (a rectangle within a millionth of the stroke: no loop tells more; on a
+    # noise-only record the fit would run on until ac² overflows)
+    ac_max = max(_Z_MAX / a0, 10.0 * ac_init) if a0 > 0 else math.inf
     params = [
         Parameter("k0", k0, min=1e-9 * k0, unit="N/m"),
-        Parameter("ac", ac_init, min=1e-9 * ac_init, unit="1/m"),
+        Parameter("ac", ac_init, min=1e-9 * ac_init, max=ac_max, unit="1/m"),
         Parameter(
             "offset", off0 if fit_offset else 0.0, vary=fit_offset, unit="N", scale=max(hm0, 1e-300)
         ),
@@ -493,6 +496,9 @@ class Residuals:
 
         return solve
 
+
+#: the largest ac·A a fit may reach
+_Z_MAX = 1e6
 
 #: parameter order of the compiled steady-loop fit
 _ORDER = ("k0", "ac", "offset", "x0", "amplitude")
