@@ -124,3 +124,39 @@ def test_unnamed_columns_hint_names_the_flags(tmp_path, capsys):
     g.write_text("disp_m,force_N\n0,0\n1e-6,1\n2e-6,3\n")
     assert main(["track", str(g)]) == 1
     assert "--fs or --columns 't=" in capsys.readouterr().err
+
+
+def test_json_that_is_the_input_is_refused(tmp_path, capsys):
+    """`--json` naming the recording itself would replace it with the result."""
+    from contactlab.io import write_recording
+    from contactlab.tangential import synthetic_recording
+
+    p = tmp_path / "in.csv"
+    write_recording(p, synthetic_recording(h0=40.0, ac=4e4, amplitude=20e-6, n_cycles=6, seed=3))
+    before = p.read_bytes()
+    for argv in (["track", str(p), "--every", "3cycles"], ["analyze", str(p), "--model",
+                 "tangential"]):  # fmt: skip
+        assert main([*argv, "--json", str(p)]) == 1
+        err = capsys.readouterr().err
+        assert "is the input" in err and "--json" in err
+        assert p.read_bytes() == before
+
+
+def test_keep_going_with_nothing_analysed_writes_nothing(tmp_path, outdir, capsys):
+    bad = [tmp_path / "a.csv", tmp_path / "b.csv"]
+    for b in bad:
+        b.write_text("t [s],x [m],F [N]\n0,0,abc\n")
+    (outdir / "r.json").write_text("previous")
+    before = _snapshot(outdir)
+    code = main(["analyze", *map(str, bad), "--model", "tangential", "--keep-going",
+                 "--report", str(outdir), "--json", str(outdir / "r.json")])  # fmt: skip
+    assert code == 1
+    err = capsys.readouterr().err
+    assert "none of the 2 recordings could be analysed" in err
+    assert _snapshot(outdir) == before
+
+
+def test_quantity_flags_refuse_infinity(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["track", "x.csv", "--fs", "1e400"])
+    assert exc.value.code == 2 and "finite" in capsys.readouterr().err

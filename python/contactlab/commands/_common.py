@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
+import os
 import re
 import shlex
 import sys
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -65,6 +67,8 @@ def quantity(default_unit: str, *, positive: bool = False):
                 f"{text!r}: {unit} is not a unit of this option (give {default_unit}, or "
                 f"a multiple of it)"
             )
+        if not math.isfinite(value):  # 1e400 reads as inf; nan is no value
+            raise argparse.ArgumentTypeError(f"{text!r}: must be a finite number")
         if positive and not value > 0:
             raise argparse.ArgumentTypeError(f"{text!r}: must be > 0")
         return value
@@ -127,11 +131,14 @@ def _first_existing(path: Path) -> Path:
     return p
 
 
-def check_output_targets(*, json_out: str | None = None, report: str | None = None) -> None:
+def check_output_targets(
+    *, json_out: str | None = None, report: str | None = None, inputs: Sequence[Any] = ()
+) -> None:
     """Refuse output paths that cannot be written *before* a long analysis runs.
 
     ``--report`` must be a folder (or not exist yet) below a folder; ``--json`` must not be a
-    folder. Raises :class:`~contactlab.InputError` naming the option and the path.
+    folder, nor one of the ``inputs`` (the recording it would replace). Raises
+    :class:`~contactlab.InputError` naming the option and the path.
     """
     if report:
         r = Path(report)
@@ -147,6 +154,30 @@ def check_output_targets(*, json_out: str | None = None, report: str | None = No
         anc = _first_existing(j.parent)
         if not anc.is_dir():
             raise InputError(f"--json {json_out}: {anc} is a file, not a folder")
+        if j.exists():
+            for src in inputs:
+                try:
+                    same = os.path.samefile(j, src)
+                except OSError:  # an input that does not exist: its reader says so
+                    same = False
+                if same:
+                    raise InputError(
+                        f"--json {json_out}: is the input {src}; writing the result there "
+                        "would replace the recording (give another file name)"
+                    )
+
+
+def refuse_if_none_analysed(n_ok: int, failures: Sequence[Any]) -> None:
+    """With ``--keep-going``, outputs are written when some recordings were analysed (the
+    failures listed in them); when none was, an error, and the previous outputs stay as they
+    were (a report of nothing would replace them)."""
+    if n_ok == 0 and failures:
+        first = failures[0]
+        text = first.get("error") if isinstance(first, Mapping) else first
+        raise InputError(
+            f"none of the {len(failures)} recordings could be analysed (first: {text}); "
+            "nothing written"
+        )
 
 
 def write_json(path: str, doc: Mapping[str, Any] | str) -> Path:

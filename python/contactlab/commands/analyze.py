@@ -33,6 +33,7 @@ from ._common import (
     process_pool,
     quantity,
     recording_json,
+    refuse_if_none_analysed,
     write_json,
     write_report,
 )
@@ -122,6 +123,7 @@ def _streamed(
                     "units": units,
                 }
             )
+    refuse_if_none_analysed(len(docs), failures)
     doc: dict = (
         {**docs[0], "contactlab_version": __version__}
         if len(docs) == 1 and not failures
@@ -213,7 +215,7 @@ def _auto_streamed(
 def _handler(args: argparse.Namespace) -> int:
     frame = frame_option(args)
     columns = parse_columns(args.columns)
-    check_output_targets(json_out=args.json, report=args.report)
+    check_output_targets(json_out=args.json, report=args.report, inputs=args.files)
     if args.workers is not None and args.workers < 0:
         raise InputError(f"--workers must be >= 0 (0: serially), got {args.workers}")
     if frame is not None and args.stream:
@@ -286,6 +288,8 @@ def _in_memory(
                 print(r.analysis.report(), file=say)
         else:
             print(f"{r.entry.path}: FAILED: {r.error}", file=sys.stderr)
+    refuse_if_none_analysed(sum(r.ok for r in result.results),
+                            [str(r.error) for r in result.failures])  # fmt: skip
     doc = json_text(json_document(result)) if args.json else None
     if args.report:
         title = f"contactlab analyze ({args.model}, {len(entries)} recording(s))"
@@ -381,6 +385,7 @@ def _with_long(
             for w in doc["warnings"]:
                 print(f"  warning: {w}", file=sys.stderr)
     recs = [by_path[str(e.path)] for e in entries if str(e.path) in by_path]
+    refuse_if_none_analysed(len(recs), failures)
     doc_all: dict = (
         {**recs[0], "contactlab_version": __version__}
         if len(recs) == 1 and not failures

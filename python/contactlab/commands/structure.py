@@ -95,7 +95,7 @@ def _identify(args: argparse.Namespace) -> int:
     from ..report import commit_outputs
     from .structure_verbs import identify_record
 
-    check_output_targets(json_out=args.json, report=args.report)
+    check_output_targets(json_out=args.json, report=args.report, inputs=[args.file])
     cols = read_table(args.file)
     exc = args.excitation
     ucol = _pick(cols, args.u, ("u", "f", "y_base", "base") if exc == "force" else
@@ -253,7 +253,7 @@ def diagnose_structure_cli(args: argparse.Namespace) -> int:
     from ..diagnose.structure import diagnose_structure
     from ..structure import IdentifiedModel
 
-    check_output_targets(json_out=args.json, report=args.report)
+    check_output_targets(json_out=args.json, report=args.report, inputs=[args.file, args.structure])
     model = IdentifiedModel.load(args.structure)
     cols = read_table(args.file)
     exc = model.excitation

@@ -21,6 +21,7 @@ from ._common import (
     json_document,
     json_text,
     process_pool,
+    refuse_if_none_analysed,
     resolve_workers,
     write_json,
     write_report,
@@ -28,7 +29,7 @@ from ._common import (
 
 
 def _handler(args: argparse.Namespace) -> int:
-    check_output_targets(json_out=args.json, report=args.report)
+    check_output_targets(json_out=args.json, report=args.report, inputs=[args.manifest])
     with process_pool(resolve_workers(args.workers), auto=args.workers is None) as ex:
         result = run_study(
             args.manifest,
@@ -40,6 +41,7 @@ def _handler(args: argparse.Namespace) -> int:
         for r in result.failures:
             print(f"FAILED: {r.error}", file=sys.stderr)
         n_ok = sum(r.ok for r in result.results)
+        refuse_if_none_analysed(n_ok, [str(r.error) for r in result.failures])
         print(f"analysed {n_ok} of {len(result.results)} recordings", flush=True)
         warned = [r.entry.name for r in result.results if r.ok and r.row.get("warnings")]
         if warned:

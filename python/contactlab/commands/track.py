@@ -46,7 +46,7 @@ _SHOW = {
 def _handler(args: argparse.Namespace) -> int:
     from ..studies.tracking import parse_every, track, track_json
 
-    check_output_targets(json_out=args.json, report=args.report)
+    check_output_targets(json_out=args.json, report=args.report, inputs=[args.file])
     parse_every(args.every)  # a bad --every fails before the file is opened
     say = sys.stderr if args.json == "-" else sys.stdout
     bar = None
