@@ -16,7 +16,8 @@ import sys
 from pathlib import Path
 
 from ..errors import InputError
-from ._common import command_line, describe, quantity
+from ._common import command_line, describe
+from .simulate import finite_quantity
 
 #: exit code when a requested value is not identifiable (bad input in general exits 1)
 EXIT_NOT_IDENTIFIABLE = 3
@@ -33,9 +34,24 @@ def area(text: str) -> float:
     if not m:
         raise argparse.ArgumentTypeError(f"{text!r} is not an area (e.g. 50cm2, 5e-3m2, 100mm2)")
     v = float(m.group(1)) * _AREA_F[m.group(2)]
-    if not v > 0:
-        raise argparse.ArgumentTypeError(f"{text!r}: must be > 0")
+    if not (v > 0 and v < float("inf")):
+        raise argparse.ArgumentTypeError(f"{text!r}: must be a finite area > 0")
     return v
+
+
+def points(text: str) -> int:
+    """argparse ``type=``: rows of the pressure–overclosure table, an integer in 3..10000."""
+    from ..fem.characteristics import MAX_POINTS, MIN_POINTS
+
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not an integer (give {MIN_POINTS}..{MAX_POINTS})"
+        ) from None
+    if not MIN_POINTS <= n <= MAX_POINTS:
+        raise argparse.ArgumentTypeError(f"{text!r}: must be in {MIN_POINTS}..{MAX_POINTS}")
+    return n
 
 
 def _handler(args: argparse.Namespace) -> int:
@@ -108,14 +124,15 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="unit system of the exported numbers (default SI)")  # fmt: skip
     p.add_argument("--recording", help="which recording of a multi-recording JSON (index/name)")
     p.add_argument("--area", type=area, help="nominal contact area (tangential; e.g. 50cm2)")
-    p.add_argument("--normal-load", type=quantity("N", positive=True),
+    p.add_argument("--normal-load", type=finite_quantity("N", positive=True),
                    help="normal load W (tangential; default from the tags, e.g. W50N)")  # fmt: skip
-    p.add_argument("--amplitude", type=quantity("m", positive=True),
+    p.add_argument("--amplitude", type=finite_quantity("m", positive=True),
                    help="amplitude of the joint spring/dashpot (tangential; 20um)")  # fmt: skip
-    p.add_argument("--frequency", type=quantity("Hz", positive=True),
+    p.add_argument("--frequency", type=finite_quantity("Hz", positive=True),
                    help="frequency of the viscous values (normal: default the test's)")  # fmt: skip
-    p.add_argument("--points", type=int, default=25,
-                   help="rows of the pressure–overclosure table (default 25)")  # fmt: skip
+    p.add_argument("--points", type=points, default=25,
+                   help="rows of the pressure–overclosure table over the measured range, "
+                   "3..10000 (default 25; solvers interpolate linearly between rows)")  # fmt: skip
     p.add_argument("--check", action="store_true",
                    help="first run the CalculiX checks on these values (needs ccx)")  # fmt: skip
     p.set_defaults(handler=_handler)

@@ -10,8 +10,101 @@ may carry a unit (``--amplitude 20um``, ``--p0 0.5MPa``).
 from __future__ import annotations
 
 import argparse
+import math
+from collections.abc import Callable
+from typing import TYPE_CHECKING
 
+from ..errors import InputError
 from ._common import describe, quantity
+
+if TYPE_CHECKING:
+    from ..io import Recording
+
+#: most samples one run may generate: ~160 MB per float64 channel, several working copies
+#: while the signal is made, and a CSV of ~1 GB; a longer record is better made in pieces
+MAX_SAMPLES = 20_000_000
+
+
+def finite_quantity(default_unit: str, *, positive: bool = False) -> Callable[[str], float]:
+    """argparse ``type=``: :func:`quantity` that also refuses non-finite values (``1e400``)."""
+    parse = quantity(default_unit, positive=positive)
+    rng = "a finite number > 0" if positive else "a finite number"
+
+    def check(text: str) -> float:
+        value = parse(text)
+        if not math.isfinite(value):
+            raise argparse.ArgumentTypeError(f"{text!r}: must be {rng} ({default_unit})")
+        return value
+
+    check.__name__ = parse.__name__
+    return check
+
+
+def real(*, minimum: float | None = None) -> Callable[[str], float]:
+    """argparse ``type=``: a finite float, ``>= minimum`` when given."""
+    rng = "a finite number" + ("" if minimum is None else f" >= {minimum:g}")
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number (give {rng})") from None
+        if not math.isfinite(value) or (minimum is not None and value < minimum):
+            raise argparse.ArgumentTypeError(f"{text!r}: must be {rng}")
+        return value
+
+    parse.__name__ = "number"
+    return parse
+
+
+def integer(minimum: int, maximum: int | None = None) -> Callable[[str], int]:
+    """argparse ``type=``: an integer in ``minimum..maximum`` (no upper bound when None)."""
+    rng = f"an integer >= {minimum}" if maximum is None else f"an integer in {minimum}..{maximum}"
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text.strip())
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not {rng}") from None
+        if value < minimum or (maximum is not None and value > maximum):
+            raise argparse.ArgumentTypeError(f"{text!r}: must be {rng}")
+        return value
+
+    parse.__name__ = "integer"
+    return parse
+
+
+def _check_length(args: argparse.Namespace) -> None:
+    """Refuse a record too long to generate before any memory is spent on it."""
+    if args.model == "tangential":
+        n = args.cycles * args.fs / args.frequency
+        how = "--cycles × --fs / --frequency"
+    else:
+        n = args.cycles * args.samples_per_cycle
+        how = "--cycles × --samples-per-cycle"
+    if not n <= MAX_SAMPLES:
+        raise InputError(
+            f"{how} = {n:.4g} samples; at most {MAX_SAMPLES:,} can be generated in one run "
+            "(make fewer cycles or a lower rate)"
+        )
+
+
+def _check_finite(rec: Recording, args: argparse.Namespace) -> None:
+    """The generated channels must be finite: magnitudes that overflow are refused."""
+    import numpy as np
+
+    for name in ["t", *rec.channels]:
+        data = rec.t if name == "t" else rec[name]
+        if not np.all(np.isfinite(data)):
+            flags = (
+                "--h0, --amplitude, --noise, --offset, --x-offset, --drift"
+                if args.model == "tangential"
+                else "--p0, --pa, --noise"
+            )
+            raise InputError(
+                f"channel {name!r} of the simulated recording is not finite (the magnitudes "
+                f"overflow double precision): give smaller values of {flags}; nothing written"
+            )
 
 
 def _handler(args: argparse.Namespace) -> int:
@@ -21,32 +114,37 @@ def _handler(args: argparse.Namespace) -> int:
         from .structure import simulate_structure
 
         return simulate_structure(args)
+    import numpy as np
+
+    _check_length(args)
     if args.model == "tangential":
         from ..tangential import synthetic_recording
 
-        rec = synthetic_recording(
-            h0=args.h0,
-            ac=args.ac,
-            amplitude=args.amplitude,
-            frequency=args.frequency,
-            n_cycles=args.cycles,
-            fs=args.fs,
-            noise=0.01 if args.noise is None else args.noise,
-            seed=args.seed,
-            offset=args.offset,
-            x_offset=args.x_offset,
-            drift=args.drift,
-            adc_bits=args.adc_bits,
-        )
+        with np.errstate(over="ignore", invalid="ignore"):  # overflow is refused below
+            rec = synthetic_recording(
+                h0=args.h0,
+                ac=args.ac,
+                amplitude=args.amplitude,
+                frequency=args.frequency,
+                n_cycles=args.cycles,
+                fs=args.fs,
+                noise=0.01 if args.noise is None else args.noise,
+                seed=args.seed,
+                offset=args.offset,
+                x_offset=args.x_offset,
+                drift=args.drift,
+                adc_bits=args.adc_bits,
+            )
     else:
         from ..normal import synthetic_recording as normal_synthetic
 
         kwargs = {"noise": "realistic" if args.noise is None else args.noise, "seed": args.seed}
         if args.normal_model:
             kwargs["model"] = args.normal_model
-        t, p, delta = normal_synthetic(
-            args.p0, args.pa, args.omega, args.cycles, args.samples_per_cycle, **kwargs
-        )
+        with np.errstate(over="ignore", invalid="ignore"):  # overflow is refused below
+            t, p, delta = normal_synthetic(
+                args.p0, args.pa, args.omega, args.cycles, args.samples_per_cycle, **kwargs
+            )
         rec = Recording(
             t,
             {"p": p, "delta": delta},
@@ -54,6 +152,7 @@ def _handler(args: argparse.Namespace) -> int:
             source="contactlab simulate normal",
             meta={"p0": args.p0, "pa": args.pa, "omega": args.omega},
         )
+    _check_finite(rec, args)
     path = write_recording(args.out, rec)
     print(f"wrote {path} ({len(rec.t)} samples)")
     return 0
@@ -68,32 +167,48 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("model", choices=("tangential", "normal", "structure"))
     p.add_argument("out", metavar="OUT", help="output file (.csv .tdms .h5 .mat)")
     g = p.add_argument_group("tangential")
-    g.add_argument("--h0", type=quantity("N"), default=40.0, help="saturation force (N)")
-    g.add_argument("--ac", type=quantity("1/m"), default=4e4, help="curvature (1/m)")
-    g.add_argument("--amplitude", type=quantity("m"), default=20e-6,
-                   help="displacement amplitude (m; e.g. 20um)")  # fmt: skip
-    g.add_argument("--frequency", type=quantity("Hz", positive=True), default=1.0, help="Hz")
+    g.add_argument("--h0", type=finite_quantity("N", positive=True), default=40.0,
+                   help="saturation force (N, > 0)")  # fmt: skip
+    g.add_argument("--ac", type=finite_quantity("1/m", positive=True), default=4e4,
+                   help="curvature (1/m, > 0)")  # fmt: skip
+    g.add_argument("--amplitude", type=finite_quantity("m", positive=True), default=20e-6,
+                   help="displacement amplitude (m, > 0; e.g. 20um)")  # fmt: skip
+    g.add_argument("--frequency", type=finite_quantity("Hz", positive=True), default=1.0,
+                   help="Hz, > 0")  # fmt: skip
     g.add_argument(
-        "--fs", type=quantity("Hz", positive=True), default=500.0, help="sampling rate (Hz)"
+        "--fs",
+        type=finite_quantity("Hz", positive=True),
+        default=500.0,
+        help="sampling rate (Hz, > 0)",
     )
-    g.add_argument("--offset", type=quantity("N"), default=0.0, help="load-cell zero offset (N)")
-    g.add_argument("--x-offset", type=quantity("m"), default=0.0,
+    g.add_argument("--offset", type=finite_quantity("N"), default=0.0,
+                   help="load-cell zero offset (N)")  # fmt: skip
+    g.add_argument("--x-offset", type=finite_quantity("m"), default=0.0,
                    help="displacement-sensor zero offset (m)")  # fmt: skip
-    g.add_argument("--drift", type=float, default=0.0, help="force drift (N/s)")
-    g.add_argument("--adc-bits", type=int, default=None, help="quantise to this many bits")
+    g.add_argument("--drift", type=real(), default=0.0,
+                   help="force drift (N/s, a finite number of either sign)")  # fmt: skip
+    g.add_argument("--adc-bits", type=integer(4, 32), default=None,
+                   help="quantise to this many bits (4..32)")  # fmt: skip
     n = p.add_argument_group("normal")
-    n.add_argument("--p0", type=quantity("Pa"), default=0.5e6, help="static pressure (Pa)")
-    n.add_argument("--pa", type=quantity("Pa"), default=0.4e6, help="pressure amplitude (Pa)")
-    n.add_argument("--omega", type=quantity("1/s"), default=1.0, help="angular frequency (1/s)")
-    n.add_argument("--samples-per-cycle", type=int, default=400)
+    n.add_argument("--p0", type=finite_quantity("Pa", positive=True), default=0.5e6,
+                   help="static pressure (Pa, > 0)")  # fmt: skip
+    n.add_argument("--pa", type=finite_quantity("Pa", positive=True), default=0.4e6,
+                   help="pressure amplitude (Pa, > 0 and <= p0)")  # fmt: skip
+    n.add_argument("--omega", type=finite_quantity("1/s", positive=True), default=1.0,
+                   help="angular frequency (1/s, > 0)")  # fmt: skip
+    n.add_argument("--samples-per-cycle", type=integer(8), default=400,
+                   help="samples per cycle (an integer >= 8; default 400)")  # fmt: skip
     n.add_argument("--normal-model", default=None, choices=("nonlinear", "linear", "table2"),
                    help="eq. 17 (default), Kelvin-Voigt, or the Table 2 loop itself")  # fmt: skip
-    p.add_argument("--cycles", type=int, default=5, help="number of cycles")
-    p.add_argument("--noise", type=float, default=None,
+    p.add_argument("--cycles", type=integer(1), default=5,
+                   help=f"number of cycles (an integer >= 1; at most {MAX_SAMPLES:,} samples "
+                   "in all)")  # fmt: skip
+    p.add_argument("--noise", type=real(minimum=0.0), default=None,
                    help="tangential: force noise as a fraction of the peak force (default "
                    "0.01); normal: relative to each channel's peak-to-peak value (default: "
-                   "realistic sensor noise and 16-bit quantisation); 0 = exact")  # fmt: skip
-    p.add_argument("--seed", type=int, default=0)
+                   "realistic sensor noise and 16-bit quantisation); 0 = exact, >= 0")  # fmt: skip
+    p.add_argument("--seed", type=integer(0), default=0,
+                   help="noise generator seed (a non-negative integer; default 0)")  # fmt: skip
     s = p.add_argument_group("structure (a model from `contactlab identify --json`)")
     s.add_argument("--structure", help="model JSON (identified model or Structure.save)")
     s.add_argument("--input", help="CSV with the input column and a time column (else --fs)")

@@ -35,6 +35,25 @@ class NotIdentifiableError(InputError):
     """A requested joint value rests on parameters the fit did not identify (reason given)."""
 
 
+#: bounds of ``points`` (rows of the pressure–overclosure table): the table samples the fitted
+#: loading polynomial over the measured range, so three rows are the least that show its
+#: curvature; FE solvers interpolate linearly between rows, and beyond a few thousand rows
+#: the table only grows the input deck (10000 rows ≈ 0.6 MB of CalculiX input)
+MIN_POINTS = 3
+MAX_POINTS = 10_000
+
+
+def check_points(points: object, where: str = "points") -> int:
+    """``points`` as an int in ``MIN_POINTS..MAX_POINTS``, else :class:`InputError`."""
+    if isinstance(points, bool) or not isinstance(points, (int, np.integer)):
+        raise InputError(
+            f"{where} must be an integer in {MIN_POINTS}..{MAX_POINTS}, got {points!r}"
+        )
+    if not MIN_POINTS <= int(points) <= MAX_POINTS:
+        raise InputError(f"{where} must be in {MIN_POINTS}..{MAX_POINTS}, got {points}")
+    return int(points)
+
+
 @dataclass(frozen=True)
 class Value:
     """One exported number: SI value, its standard error (NaN if none), dimension and origin.
@@ -102,6 +121,7 @@ def load_result(path: str | Path, recording: str | None = None) -> dict[str, Any
         ) from None
     if not isinstance(doc, dict):
         raise InputError(f"{path}: expected a JSON object from `contactlab analyze --json`")
+    _not_other_result(doc, path)
     if "recordings" in doc:
         recs = doc["recordings"]
         if not isinstance(recs, list) or not recs:
@@ -123,6 +143,23 @@ def load_result(path: str | Path, recording: str | None = None) -> dict[str, Any
     if recording not in (None, "0"):
         raise InputError(f"{path}: holds one recording; --recording {recording} does not apply")
     return doc
+
+
+def _not_other_result(doc: dict[str, Any], path: str | Path) -> None:
+    """Refuse the JSON of another verb (track, diagnose, identify) by what it holds."""
+    if "windows" in doc and "every" in doc:
+        what = "a track result (`contactlab track --json`)"
+    elif "final_model" in doc and "steps" in doc:
+        what = "a diagnose result (`contactlab diagnose --json`)"
+    elif "recordings" in doc or "model" in doc:
+        return
+    else:
+        what = "not one recording's result of `contactlab analyze --json` (it has no 'model' key)"
+        raise InputError(f"{path}: {what}; export needs the JSON of `contactlab analyze --json`")
+    raise InputError(
+        f"{path}: is {what}; export needs the JSON of `contactlab analyze --json` (one "
+        "recording's fit: 'model' normal or tangential)"
+    )
 
 
 def _num(d: dict[str, Any], key: str, where: str, *, positive: bool = False) -> float:
@@ -188,7 +225,7 @@ def _normal(
         i = int(np.argmax(p_abs > 0))
         d_at_zero = float(np.interp(0.0, p_abs[i - 1 : i + 1], grid[i - 1 : i + 1]))
         lo = 0.0
-    n = max(int(points), 3)
+    n = check_points(points)
     dd = np.linspace(max(dmin, d_at_zero), dmax, n)
     pp = p0 + _poly(load, dd)
     if p_abs[0] > 0:
@@ -414,7 +451,8 @@ def joint_characteristics(
         Tangential: the amplitude (m) and frequency (Hz) of the spring/dashpot values. Normal:
         the frequency (Hz) of the viscous coefficient (default the test's).
     points : int
-        Rows of the pressure–overclosure table over the measured range.
+        Rows of the pressure–overclosure table over the measured range (3..10000;
+        :data:`MIN_POINTS`, :data:`MAX_POINTS`).
 
     Raises
     ------
@@ -437,10 +475,15 @@ def joint_characteristics(
     if kind == "normal":
         if frequency is not None and not frequency > 0:
             raise InputError("frequency must be > 0")
-        return _normal(result, where, frequency=frequency, points=points)
+        return _normal(result, where, frequency=frequency, points=check_points(points))
     if kind == "tangential":
         return _tangential(result, where, area=area, normal_load=normal_load,
                            amplitude=amplitude, frequency=frequency)  # fmt: skip
+    if kind is None:
+        raise InputError(
+            f"{where}: no 'model' key: not one recording's result of `contactlab analyze "
+            "--json` (export needs 'model' normal or tangential)"
+        )
     raise InputError(f"{where}: 'model' is {kind!r}; expected 'normal' or 'tangential'")
 
 

@@ -60,6 +60,15 @@ _TOKEN_TAG = {
     "pa": "pa",
 }
 _KNOWN = {"file", "kind", "material", "columns", *TAG_UNITS}
+# dimension(s) a tag's unit must have (contactlab.io.units): 1/s is accepted for a frequency
+_TAG_DIMS: dict[str, tuple[str, ...]] = {
+    "normal_load": ("force",),
+    "amplitude_nominal": ("length",),
+    "frequency": ("frequency", "rate"),
+    "fs": ("frequency", "rate"),
+    "p0": ("pressure",),
+    "pa": ("pressure",),
+}
 _KINDS = ("tangential", "normal")
 
 
@@ -231,6 +240,13 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
         keys.append(key)
         if unit is not None:
             f, si[key] = _unit(unit, where)
+            dims = _TAG_DIMS.get(key)
+            dim = units.lookup(unit)[1]  # known: _unit accepted it
+            if dims is not None and dim not in dims:
+                raise InputError(
+                    f"{where}: [{unit}] is a unit of {dim}, but {key} is a "
+                    f"{' or '.join(dims)} (give it in {TAG_UNITS[key]} or a multiple of it)"
+                )
             factors.append(f)
         else:
             factors.append(None)
@@ -259,7 +275,7 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
             raise InputError(f"{where}, column 'file': {fpath} is a folder, not a recording file")
         tags = tags_from_filename(fpath)
         columns = None
-        for key, factor, cell in zip(keys, factors, cells, strict=True):
+        for j, (key, factor, cell) in enumerate(zip(keys, factors, cells, strict=True)):
             cell = cell.strip()
             if key == "file" or cell == "":
                 continue
@@ -273,6 +289,11 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
                     tags[key] = scaled(cell, factor if factor is not None else 1.0)
                 except ValueError:
                     raise InputError(f"{where}, column {key!r}: {cell!r} is not a number") from None
+                col = f"{where}, column {j + 1} ({header[j].strip()!r})"
+                if not math.isfinite(tags[key]):
+                    raise InputError(f"{col}: {cell!r} is not a finite number")
+                if key in TAG_UNITS and not tags[key] > 0:
+                    raise InputError(f"{col}: {cell!r}: {key} must be > 0")
             else:
                 tags[key] = cell
         kind = _infer_kind(tags)
