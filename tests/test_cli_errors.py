@@ -135,7 +135,7 @@ def test_json_that_is_the_input_is_refused(tmp_path, capsys):
     write_recording(p, synthetic_recording(h0=40.0, ac=4e4, amplitude=20e-6, n_cycles=6, seed=3))
     before = p.read_bytes()
     for argv in (["track", str(p), "--every", "3cycles"], ["analyze", str(p), "--model",
-                 "tangential"]):  # fmt: skip
+                 "tangential"], ["diagnose", str(p), "--model", "tangential"]):  # fmt: skip
         assert main([*argv, "--json", str(p)]) == 1
         err = capsys.readouterr().err
         assert "is the input" in err and "--json" in err

@@ -11,7 +11,29 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from .._io_atomic import write_text
+#: ``--holdout``: the range :func:`contactlab.diagnose.diagnose_structure` accepts, the default
+HOLDOUT_RANGE = (0.05, 0.5)
+HOLDOUT_DEFAULT = 0.25
+
+#: the flags that only mean something with ``--structure``
+_STRUCTURE_ONLY = (("u", "--u"), ("y", "--y"), ("holdout", "--holdout"))
+
+
+def _holdout(text: str) -> float:
+    """argparse ``type=`` of ``--holdout``: a fraction in :data:`HOLDOUT_RANGE`."""
+    lo, hi = HOLDOUT_RANGE
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--holdout {text!r}: not a number") from None
+    if not lo <= v <= hi:  # (NaN fails it too)
+        raise argparse.ArgumentTypeError(
+            f"--holdout {text!r}: must be a fraction of the record in [{lo}, {hi}]"
+        )
+    return v
+
+
+_holdout.__name__ = "fraction"
 
 
 def add_parser(subparsers: Any) -> None:
@@ -38,12 +60,19 @@ def add_parser(subparsers: Any) -> None:
     )
     p.add_argument("--u", help="with --structure: input column (force, or base displacement)")
     p.add_argument("--y", help="with --structure: response column (displacement of the mass)")
-    p.add_argument("--fs", type=float, help="sampling rate when a file has no time column")
+    from ..commands._common import quantity
+
+    p.add_argument(
+        "--fs",
+        type=quantity("Hz", positive=True),
+        help="sampling rate when a file has no time column",
+    )
     p.add_argument(
         "--holdout",
-        type=float,
-        default=0.25,
-        help="with --structure: fraction of the record (at its end) no fit sees",
+        type=_holdout,
+        default=None,
+        help=f"with --structure: fraction of the record (at its end) no fit sees, in "
+        f"[{HOLDOUT_RANGE[0]}, {HOLDOUT_RANGE[1]}] (default {HOLDOUT_DEFAULT})",
     )
     p.add_argument("--json", metavar="OUT", help="write the result as JSON to OUT")
     p.add_argument(
@@ -73,15 +102,87 @@ def add_parser(subparsers: Any) -> None:
     p.set_defaults(handler=run)
 
 
+def _check_long(path: str, columns: dict | None, kind: str, fs: float | None) -> None:
+    """Check a long recording's first chunk before it is read whole (as ``analyze`` and
+    ``track`` read it in chunks), and refuse one whose arrays cannot fit in memory.
+
+    The whole-file readers read every channel before they check it: an HDF5 file declaring
+    a billion samples it never wrote would be read, and allocated, in full before its first
+    repeated time stamp is found. Raises :class:`~contactlab.InputError` naming the file.
+    """
+    from pathlib import Path
+
+    from ..errors import ContactLabError, InputError
+    from ..io import read_chunks
+    from ..studies.pooled import STREAM_ABOVE
+
+    # a probe only: whatever it cannot open, the whole-file reader names (a damaged file,
+    # a missing column), so nothing it raises is reported from here
+    try:
+        chunked = read_chunks(path, columns=columns, kind=kind, fs=fs)
+        n = chunked.n_samples
+    except Exception:
+        return
+    if n is None or n <= STREAM_ABOVE:
+        return
+    chunks = iter(chunked)
+    try:
+        next(chunks, None)  # the same checks and messages as the chunked verbs
+    except ContactLabError:
+        raise
+    except Exception:
+        return
+    finally:
+        close = getattr(chunks, "close", None)
+        if close is not None:
+            close()
+    need = int(n) * (1 + len(chunked.units)) * 8 * _COPIES
+    free = _available_memory()
+    if free is not None and need > free:
+        raise InputError(
+            f"{Path(path)}: {int(n)} samples: too long to diagnose in memory (about "
+            f"{need / 2**30:.1f} GiB needed, {free / 2**30:.1f} GiB available); diagnose a part "
+            "of it (or use `contactlab analyze`/`track`, which read it in chunks)"
+        )
+
+
+#: arrays of a record's length the reading and the diagnosis hold at once (the channels as
+#: read, in SI, and the workflow's own)
+_COPIES = 3
+
+
+def _available_memory() -> int | None:
+    """Bytes of memory available to this process (Linux ``MemAvailable``), None if unknown."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        return None
+    return None
+
+
 def run(args: argparse.Namespace) -> int:
+    import contextlib
+    import json
+
+    from .._io_atomic import atomic_path
+    from ..commands._common import check_output_targets
     from ..diagnose import diagnose
-    from ..errors import InputError
+    from ..errors import ConvergenceError, InputError
     from ..io import read_recording
 
     if args.structure:
         from .structure import diagnose_structure_cli
 
+        if args.holdout is None:
+            args.holdout = HOLDOUT_DEFAULT
         return diagnose_structure_cli(args)
+    for dest, flag in _STRUCTURE_ONLY:
+        if getattr(args, dest, None) is not None:
+            raise InputError(f"{flag} is for a structure: give it with --structure MODEL.json")
+    check_output_targets(json_out=args.json, report=args.report, inputs=[args.file])
     from ..commands._common import frame_option, output_filter_taps, parse_columns
 
     frame = frame_option(args)
@@ -93,6 +194,7 @@ def run(args: argparse.Namespace) -> int:
     if args.model == "normal" and (taps is not None or args.output_noise is not None):
         raise InputError("--output-filter/--output-noise are for the tangential model (a force "
                          "channel's smoothing)")  # fmt: skip
+    columns = parse_columns(args.columns)
     rebuilt = None
     if frame is not None:
         from ..tangential import read_frame
@@ -104,8 +206,8 @@ def run(args: argparse.Namespace) -> int:
         if taps is not None or args.output_noise is not None:
             print("note: --output-filter/--output-noise replace the reconstruction's own")
     else:
-        rec = read_recording(args.file, kind=args.model, columns=parse_columns(args.columns),
-                             fs=args.fs)  # fmt: skip
+        _check_long(args.file, columns, args.model, args.fs)
+        rec = read_recording(args.file, kind=args.model, columns=columns, fs=args.fs)
     if args.model == "normal":
         from ..commands._common import with_static_pressure
 
@@ -114,12 +216,13 @@ def run(args: argparse.Namespace) -> int:
     try:
         report = diagnose(rec, model=args.model, max_effects=args.max_effects,
                           output_filter=taps, output_noise=args.output_noise)  # fmt: skip
-    except InputError as exc:  # name the file: the workflow only sees arrays
-        raise InputError(f"{args.file}: {exc}") from exc
-    print(report.summary())
+    except (InputError, ConvergenceError) as exc:  # name the file: the workflow sees arrays
+        kind = ConvergenceError if isinstance(exc, ConvergenceError) else InputError
+        raise kind(f"{args.file}: {exc}") from exc
+    # every output rendered in memory before any is written (a report that cannot be
+    # drawn, or Ctrl-C, leaves the previous outputs as they were)
+    text = None
     if args.json:
-        import json
-
         doc = report.to_dict()
         meta = rec.meta if isinstance(rec.meta, dict) else {}
         used = taps if taps is not None else meta.get("output_filter")
@@ -132,11 +235,28 @@ def run(args: argparse.Namespace) -> int:
             }
         if rebuilt is not None:
             doc["frame_reconstruction"] = rebuilt.to_dict()
-        write_text(args.json, json.dumps(doc, indent=2, allow_nan=False) + "\n")
+        try:
+            text = json.dumps(doc, indent=2, allow_nan=False) + "\n"
+        except ValueError as exc:  # a NaN or infinity left in the result
+            raise InputError(f"{args.file}: the result cannot be written as JSON ({exc})") from None
+    files = None
     if args.report:
         import matplotlib
 
         matplotlib.use("Agg")
-        path = report.write_html(args.report)
-        print(f"report: {path}")
+        from ..diagnose._html import report_files
+
+        files = report_files(report)
+    print(report.summary())
+    # the JSON is staged beside its target and renamed into place only once the report is
+    # committed: a report that cannot be written leaves the JSON as it was
+    with contextlib.ExitStack() as stack:
+        if text is not None:
+            tmp = stack.enter_context(atomic_path(args.json))
+            tmp.write_text(text, encoding="utf-8")
+        if files is not None:
+            from ..report import commit_outputs
+
+            paths = commit_outputs(args.report, files)
+            print(f"report: {paths[0]}")
     return 0

@@ -85,9 +85,17 @@ def build(report: Any) -> Report:
     return r
 
 
+def report_files(report: Any) -> dict[str, bytes]:
+    """Every file of the report, rendered in memory (relative name → content):
+    ``diagnose.html`` first, its figures under ``figures/`` and ``diagnose.json``."""
+    files = build(report).files("diagnose.html")
+    files["diagnose.json"] = (report.to_json() + "\n").encode("utf-8")
+    return files
+
+
 def write_html(report: Any, directory: str | Path) -> Path:
-    """Write ``diagnose.html``, its figures and ``diagnose.json`` into ``directory``."""
-    r = build(report)
-    extra = {"diagnose.json": (report.to_json() + "\n").encode("utf-8")}
-    paths = r.write(directory, extra=extra, html_name="diagnose.html")
-    return paths[0]
+    """Write ``diagnose.html``, its figures and ``diagnose.json`` into ``directory``, all or
+    nothing."""
+    from ..report import commit_outputs
+
+    return commit_outputs(directory, report_files(report))[0]

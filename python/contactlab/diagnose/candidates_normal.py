@@ -468,6 +468,9 @@ class NormalFamily:
         spec = input_noise_spectrum(d)
         if spec is None:
             return 0.0
+        k2 = p["k"] ** 2
+        if not k2 > 0.0:  # a compliance 1/k without bound: the limit, not a division by zero
+            return np.inf
         f, s = spec
         w = 2.0 * np.pi * f
         den = 1.0 + 1j * w * p["psi"] / (2.0 * np.pi * d.extra["omega"])
@@ -476,12 +479,15 @@ class NormalFamily:
         g = s / np.abs(den) ** 2
         if "channel_delay" in effects and "raw_input" not in d.extra:
             g = g * cubic_shift_power(float(p["tau"] / d.dt), w * d.dt)
-        return float(np.sum(g)) / p["k"] ** 2
+        return float(np.sum(g)) / k2
 
     def noise_variance_bound(self, p: dict[str, float], d: Prepared) -> float:
         """:meth:`noise_variance` without damping or delay (its largest value at ``k``)."""
         spec = input_noise_spectrum(d)
-        return 0.0 if spec is None else float(np.sum(spec[1])) / p["k"] ** 2
+        if spec is None:
+            return 0.0
+        k2 = p["k"] ** 2
+        return float(np.sum(spec[1])) / k2 if k2 > 0.0 else np.inf
 
     def derived(
         self, p: dict[str, float], se: dict[str, float], effect: str

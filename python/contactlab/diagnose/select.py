@@ -46,7 +46,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import ConvergenceError, InputError
 from ..fitting import Parameter, least_squares_fit
 from ._family import Family, ParamSpec, Prepared
 from ._parallel import column_map, in_column, pmap
@@ -252,7 +252,14 @@ def fit(
     rss = chisqr
     if c_top > 0:  # the corrected sum of squares, Σ w r² - n T(θ) (never below a tenth of Σ w r²)
         raw = float(np.sum(resid_vec[:-1] ** 2)) * ys * ys
-        rss = max(raw - n_fit * noise_term(family, value(w), effects, d), 0.1 * raw)
+        t_end = noise_term(family, value(w), effects, d)
+        if not np.isfinite(t_end):  # (a stiffness fitted to zero: its compliance unbounded)
+            raise ConvergenceError(
+                f"the fit of {' + '.join(('base', *effects))} ended at a degenerate point "
+                f"({', '.join(f'{n} = {v:.3g}' for n, v in value(w).items())}): the input "
+                "noise through the model is unbounded — the record does not determine it"
+            )
+        rss = max(raw - n_fit * t_end, 0.1 * raw)
         resid_vec = resid_vec[:-1]
         jac = None if jac is None else jac[:-1]
     # the errors scale with the corrected residual, not with the constant C the solver saw

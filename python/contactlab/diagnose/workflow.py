@@ -541,10 +541,17 @@ def eiv_weight(
 
 
 def _declared(
-    recording: Any, family: Family, taps: Any, noise: float | None, n: int
+    recording: Any,
+    family: Family,
+    taps: Any,
+    noise: float | None,
+    n: int,
+    y: np.ndarray | None = None,
 ) -> tuple[np.ndarray | None, float | None]:
     """The output's declared measurement filter and noise RMS: the arguments, else the
-    recording's ``meta`` (``output_filter``, ``output_noise``); checked."""
+    recording's ``meta`` (``output_filter``, ``output_noise``); checked (a noise RMS above the
+    output's whole swing ``y`` is not a noise level of that channel, and its square would
+    overflow the weights)."""
     meta = getattr(recording, "meta", None)
     if not isinstance(meta, dict):
         meta = {}
@@ -579,6 +586,14 @@ def _declared(
         if not (isinstance(noise, (int, float, np.floating)) and np.isfinite(noise) and noise > 0):
             raise InputError(f"output_noise must be a finite number > 0, got {noise!r}")
         noise = float(noise)
+        swing = float(np.ptp(y)) if y is not None and y.size else None
+        if swing is not None and noise > swing:
+            unit = family.output_unit
+            raise InputError(
+                f"output_noise {noise:.6g} {unit} exceeds the whole swing of channel "
+                f"{family.output_name!r} ({swing:.6g} {unit} peak to peak): not a noise RMS "
+                "of that channel — check its value and unit"
+            )
     return taps, noise
 
 
@@ -1051,7 +1066,7 @@ def diagnose(
             raise InputError(
                 f"unknown {family.kind} candidate {n!r}; choose from {', '.join(family.candidates)}"
             )
-    taps, declared_noise = _declared(recording, family, output_filter, output_noise, t.size)
+    taps, declared_noise = _declared(recording, family, output_filter, output_noise, t.size, y)
     clock_note = _same_clock(recording, names, candidates)
     n_in = t.size
     if taps is not None and n_in > MAX_SAMPLES:  # a filter at the raw rate: no subsampling
