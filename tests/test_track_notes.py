@@ -125,3 +125,16 @@ def test_curvature_term_bounded_for_a_huge_ac():
     with np.errstate(over="raise", invalid="raise", divide="raise"):
         F = steady_loop_force(Masing(1.0, 1e200), xb, 0.0, 1e-5, np.full(8, 1e-12))
     assert np.isfinite(F).all() and np.abs(F).max() <= 2.0 + 1e-12
+
+
+def test_time_windows_widened_to_whole_cycles_are_noted():
+    res = track(_step_recording(4715), every="100ms")
+    assert any("hold at least 3 cycles" in n and "not 0.1 s" in n for n in res.notes())
+
+
+def test_every_must_be_finite():
+    from contactlab.errors import InputError
+    from contactlab.studies.tracking import parse_every
+
+    with pytest.raises(InputError, match="finite"):
+        parse_every("1e400s")

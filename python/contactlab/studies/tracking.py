@@ -120,8 +120,8 @@ def parse_every(every: str | float | int) -> tuple[str, float]:
         if dim != "time":
             raise InputError(f"every={every!r}: {unit!r} is neither 'cycles' nor a time unit")
         seconds = value * factor
-    if not seconds > 0:
-        raise InputError(f"every={every!r}: a window must last > 0 s")
+    if not (seconds > 0 and math.isfinite(seconds)):
+        raise InputError(f"every={every!r}: a window must last a finite time > 0 s")
     return "time", seconds
 
 
@@ -263,6 +263,13 @@ class TrackResult:
                 kinds.setdefault(key, [0, r.get("window"), w])[0] += 1
         for count, window, text in kinds.values():
             out.append(f"{count} of {n} windows warn (window {window}: {text})")
+        mode, size = parse_every(self.every)
+        spans = [r["t_end"] - r["t_start"] for r in self.rows if "t_end" in r and "t_start" in r]
+        if mode == "time" and spans and float(np.median(spans)) > 1.5 * size:
+            out.append(
+                f"windows of {self.every} hold at least {MIN_CYCLES} cycles: they last "
+                f"{float(np.median(spans)):.3g} s (median), not {size:.3g} s"
+            )
         spread = []
         for q in self.quantities:
             b = comb.get(f"{q}_birge")
