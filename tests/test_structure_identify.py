@@ -119,6 +119,13 @@ def test_cli_identify_and_simulate(tmp_path):
     sim = np.loadtxt(out, delimiter=",", skiprows=1)
     assert sim.shape == (500, 4)
     assert main(["identify", str(tmp_path / "missing.csv")]) == 1
+    # a report that cannot be written leaves the previous JSON as it was
+    before = js.read_bytes()
+    blocker = tmp_path / "blocker"
+    blocker.write_text("a file where the report's folder would be")
+    argv[argv.index("--report") + 1] = str(blocker / "rep")
+    assert main(argv) == 1
+    assert js.read_bytes() == before
 
 
 def test_cli_simulate_that_stops_early_writes_nothing_unless_partial(tmp_path, capsys):

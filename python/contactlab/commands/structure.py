@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ._common import check_output_targets, command_line, describe, write_json
+from ._common import check_output_targets, command_line, describe, json_text, write_json
 
 _UNIT = re.compile(r"(?:\[([^\]]+)\]|_([A-Za-z]+))\s*$")
 
@@ -137,10 +137,14 @@ def _identify(args: argparse.Namespace) -> int:
     doc = model.to_dict()
     doc["summary"] = summary
     doc["columns"] = {"u": ucol, "y": ycol}
-    if args.json:
-        write_json(args.json, doc)
-    if args.report:
-        commit_outputs(args.report, rep.files())
+    # everything rendered first; the report (all or nothing) before the JSON: a report that
+    # cannot be written leaves the previous JSON as it was
+    text = json_text(doc) if args.json else None
+    files = rep.files() if args.report else None
+    if files is not None:
+        commit_outputs(args.report, files)
+    if text is not None:
+        write_json(args.json, text)
     if args.json != "-":
         hold, train = summary.get("rms_holdout"), summary["rms_train"]
         print(f"{args.joint}: RMS output error "
@@ -271,15 +275,18 @@ def diagnose_structure_cli(args: argparse.Namespace) -> int:
     except InputError as exc_:
         raise InputError(f"{args.file}: {exc_}") from exc_
     print(rep.summary())
-    if args.json:
+    text = None
+    if args.json:  # rendered first; written after the report (all or nothing)
         doc = rep.to_dict()
         doc["columns"] = {"u": ucol, "y": ycol}
-        write_text(args.json, json.dumps(doc, indent=2, allow_nan=False) + "\n")
+        text = json.dumps(doc, indent=2, allow_nan=False) + "\n"
     if args.report:
         import matplotlib
 
         matplotlib.use("Agg")
         print(f"report: {rep.write_html(args.report)}")
+    if text is not None:
+        write_text(args.json, text)
     return 0
 
 
