@@ -41,7 +41,9 @@ from .recording import (
     check_time,
     real_values,
     resolve_columns,
+    step_of_rate,
     unit_factor,
+    user_rate,
 )
 from .sniff import content_format, format_of
 
@@ -138,18 +140,19 @@ class _Finisher:
             if canon != "t":
                 self.units[canon] = si
         self.dt = None
+        self.dt_source = ""  # what the time step came from, for the messages
         if "t" not in mapping:
             if fs is not None:
-                fs = float(fs)
-                if not np.isfinite(fs) or fs <= 0:
-                    raise InputError(f"fs must be finite and > 0, got {fs}")
-                self.dt = 1.0 / fs
+                fs = user_rate(fs, file=file)
+                self.dt = step_of_rate(fs, file=file, label="fs")
+                self.dt_source = f"fs = {fs:g}"
             elif dt is not None:
                 if not np.isfinite(dt) or dt <= 0:
                     raise RecordingError(
                         f"sampling interval {dt} is not a positive time step", file=file
                     )
                 self.dt = float(dt)
+                self.dt_source = f"sampling interval {self.dt:g} from start time {t0:g}"
             else:
                 raise RecordingError(
                     "no time column and no sampling rate: pass fs= (Hz) or columns={'t': ...} "
@@ -255,6 +258,15 @@ class _Finisher:
             assert self.dt is not None
             t = np.empty(n, dtype=np.float64) if out is None else out["t"]
             _core.fill_time(t, self.t0, self.dt, offset)
+            # found by audit (--fs 1e-308): a step so large that the axis overflows, or so
+            # small against the start time that it stops increasing; the axis is monotonic,
+            # so its last stamps tell
+            if n and (not math.isfinite(t[-1]) or (n >= 2 and t[-1] <= t[-2])):
+                raise RecordingError(
+                    f"{self.dt_source} gives no increasing, finite time axis for "
+                    f"{offset + n} samples",
+                    file=self.file,
+                )
         else:
             self._check_time(t, row_of)
         if n:
@@ -320,7 +332,7 @@ def _direct_reads(path: Path, dsets: dict[str, Any], mapping: dict[str, str], fm
 def _h5_chunks(
     path: Path, fmt: str, *, columns: Any, kind: Any, fs: Any, chunk: int
 ) -> ChunkedRecording:
-    from .hdf5 import hdf5_layout, import_h5py, open_hdf5
+    from .hdf5 import h5_guard, hdf5_layout, import_h5py, open_hdf5
 
     h5py = import_h5py()
     file = str(path)
@@ -347,7 +359,7 @@ def _h5_chunks(
 
     def gen(alloc: Alloc | None) -> Iterator[Recording]:
         fin = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, meta={"format": fmt})
-        with h5py.File(path, "r") as f:
+        with h5_guard(file), h5py.File(path, "r") as f:
             dsets = {n_: f[n_] for n_ in mapping.values()} if fmt == "mat73" else None
             if dsets is None:
                 from .hdf5 import datasets
@@ -384,7 +396,7 @@ def _h5_chunks(
 
 
 def _tdms_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> ChunkedRecording:
-    from .tdms import import_nptdms
+    from .tdms import import_nptdms, quiet_nptdms, tdms_lengths, tdms_time_step
 
     nptdms = import_nptdms()
     file = str(path)
@@ -403,29 +415,24 @@ def _tdms_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) ->
                 chans[f"{g.name}/{ch.name}"] = ch
         return fh, tf, chans
 
-    fh, tf, chans = open_tdms()
-    with tf, fh:
-        kind_, mapping = resolve_columns(list(chans), columns=columns, kind=kind, file=file)
-        units: dict[str, str | None] = {}
-        sizes = {}
-        for canon, name in mapping.items():
-            u = chans[name].properties.get("unit_string")
-            units[canon] = str(u) if u not in (None, "") else None
-            sizes[name] = len(chans[name])
-        if len(set(sizes.values())) > 1:
-            raise RecordingError(f"channels differ in length: {sizes}", file=file)
-        n = next(iter(sizes.values()))
-        dt, t0 = None, 0.0
-        if "t" not in mapping and fs is None:
-            ref = chans[mapping[next(c for c in mapping if c != "t")]]
-            inc = ref.properties.get("wf_increment")
-            if inc is not None:
-                dt = float(inc)
-                t0 = float(ref.properties.get("wf_start_offset", 0.0) or 0.0)
-                if not np.isfinite(dt) or dt <= 0:
-                    raise RecordingError(
-                        f"wf_increment {dt} is not a positive time step", file=file, column=ref.name
-                    )
+    with quiet_nptdms() as quiet:
+        fh, tf, chans = open_tdms()
+        with tf, fh:
+            if not chans and quiet.truncated:
+                raise RecordingError("truncated file? no channel could be read", file=file)
+            kind_, mapping = resolve_columns(list(chans), columns=columns, kind=kind, file=file)
+            units: dict[str, str | None] = {}
+            sizes = {}
+            for canon, name in mapping.items():
+                u = chans[name].properties.get("unit_string")
+                units[canon] = str(u) if u not in (None, "") else None
+                sizes[name] = len(chans[name])
+            tdms_lengths(sizes, quiet, file=file)
+            n = next(iter(sizes.values()))
+            dt, t0 = None, 0.0
+            if "t" not in mapping and fs is None:
+                ref = chans[mapping[next(c for c in mapping if c != "t")]]
+                dt, t0 = tdms_time_step(ref, file=file)
     fin0 = _Finisher(
         mapping, units, kind=kind_, file=file, fs=fs, dt=dt, t0=t0, meta={"format": "tdms"}
     )
@@ -434,14 +441,16 @@ def _tdms_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) ->
         fin = _Finisher(
             mapping, units, kind=kind_, file=file, fs=fs, dt=dt, t0=t0, meta={"format": "tdms"}
         )
-        fh, tf, chans = open_tdms()
+        with quiet_nptdms():
+            fh, tf, chans = open_tdms()
         with tf, fh:
             for a in range(0, max(n, 1), chunk):
                 length = min(chunk, n - a)
-                raw = {
-                    c: real_values(chans[m].read_data(a, length), file=file, column=m)
-                    for c, m in mapping.items()
-                }
+                with quiet_nptdms():
+                    raw = {
+                        c: real_values(chans[m].read_data(a, length), file=file, column=m)
+                        for c, m in mapping.items()
+                    }
                 yield fin(raw, a)
 
     return ChunkedRecording(

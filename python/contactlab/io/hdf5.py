@@ -10,8 +10,10 @@ datasets are read.
 from __future__ import annotations
 
 import bisect
+import contextlib
 import os
 import threading
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -24,8 +26,10 @@ from .recording import (
     RecordingError,
     check_equal_lengths,
     finish,
+    metadata_scalar,
     real_values,
     resolve_columns,
+    step_of_rate,
     time_from_interval,
 )
 
@@ -425,14 +429,43 @@ def text_value(v: Any) -> str:
     return str(v)
 
 
-def datasets(f: Any) -> dict[str, Any]:
-    """Every numeric dataset: by full path (no leading slash) and by its last name."""
+@contextlib.contextmanager
+def h5_guard(file: str) -> Iterator[None]:
+    """Turn what h5py raises on a damaged file while visiting or reading it (a bad object
+    header, a soft-link loop, a missing object: RuntimeError, OSError, KeyError) into a
+    :class:`RecordingError`; found by audit (a byte flipped in an object header)."""
+    try:
+        yield
+    except (RuntimeError, OSError, KeyError) as exc:
+        why = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
+        raise RecordingError(f"not a readable HDF5 file (damaged: {why})", file=file) from None
+
+
+#: what a dataset of each dtype kind holds, for the message of a channel it cannot be
+_KIND_WORDS = {
+    "c": "complex",
+    "S": "text",
+    "U": "text",
+    "O": "text (or references)",
+    "V": "compound (a table, not numbers)",
+    "M": "a date",
+    "m": "a time delta",
+}
+
+
+def datasets(f: Any, unusable: dict[str, str] | None = None) -> dict[str, Any]:
+    """Every numeric dataset: by full path (no leading slash) and by its last name. The
+    others go into ``unusable`` (when given): full path to what they hold."""
     h5py = import_h5py()
     out: dict[str, Any] = {}
 
     def visit(name: str, obj: Any) -> None:
-        if isinstance(obj, h5py.Dataset) and obj.dtype.kind in "fiub":
-            out[name] = obj
+        if isinstance(obj, h5py.Dataset):
+            if obj.dtype.kind in "fiub":
+                out[name] = obj
+            elif unusable is not None:
+                k = obj.dtype.kind
+                unusable[name] = _KIND_WORDS.get(k, f"of type {obj.dtype}")
 
     f.visititems(visit)
     short: dict[str, Any] = {}
@@ -459,14 +492,18 @@ def unit_attr(ds: Any) -> str | None:
     return None
 
 
-def _dt_attr(objs: list[Any]) -> float | None:
+def _dt_attr(objs: list[Any], *, file: str) -> float | None:
     for obj in objs:
+        where = "" if obj.name in ("/", None) else f" of {obj.name.lstrip('/')!r}"
         for key in ("dt", "wf_increment", "sampling_interval"):
             if key in obj.attrs:
-                return float(np.asarray(obj.attrs[key]).reshape(-1)[0])
+                label = f"attribute {key!r}{where}"
+                return metadata_scalar(obj.attrs[key], file=file, label=label, kind="step")
         for key in ("fs", "sampling_rate", "sample_rate"):
             if key in obj.attrs:
-                return 1.0 / float(np.asarray(obj.attrs[key]).reshape(-1)[0])
+                label = f"attribute {key!r}{where}"
+                fs = metadata_scalar(obj.attrs[key], file=file, label=label, kind="rate")
+                return step_of_rate(fs, file=file, label=label)
     return None
 
 
@@ -475,13 +512,17 @@ def hdf5_layout(
 ) -> tuple[str | None, dict[str, str], dict[str, Any], dict[str, str | None], float | None]:
     """What a reader needs before touching the data: ``(kind, mapping, datasets, units, dt)``;
     ``dt`` is the sampling interval from the attributes (None when absent or a ``t`` exists)."""
-    dsets = datasets(f)
-    names = [n for n in dsets if not n.startswith("#")]
-    kind, mapping = resolve_columns(names, columns=columns, kind=kind, file=file)
-    units = {c: unit_attr(dsets[n]) for c, n in mapping.items()}
-    dt = None
-    if "t" not in mapping:
-        dt = _dt_attr([dsets[n] for n in mapping.values()] + [f])
+    unusable: dict[str, str] = {}
+    with h5_guard(file):
+        dsets = datasets(f, unusable)
+        names = [n for n in dsets if not n.startswith("#")]
+        kind, mapping = resolve_columns(
+            names, columns=columns, kind=kind, file=file, unusable=unusable
+        )
+        units = {c: unit_attr(dsets[n]) for c, n in mapping.items()}
+        dt = None
+        if "t" not in mapping:
+            dt = _dt_attr([dsets[n] for n in mapping.values()] + [f], file=file)
     return kind, mapping, dsets, units, dt
 
 
@@ -500,7 +541,8 @@ def read_hdf5(
     file = str(path)
     with open_hdf5(path, file=file) as f:
         kind, mapping, dsets, units, dt = hdf5_layout(f, columns=columns, kind=kind, file=file)
-        raw = {c: vector(dsets[n], file=file, column=n) for c, n in mapping.items()}
+        with h5_guard(file):
+            raw = {c: vector(dsets[n], file=file, column=n) for c, n in mapping.items()}
         check_equal_lengths(raw, mapping, file=file)
         t_fallback = None
         if "t" not in raw and fs is None and dt is not None:

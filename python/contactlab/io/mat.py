@@ -15,15 +15,17 @@ import numpy as np
 import scipy.io
 
 from .._io_atomic import atomic_path
-from .hdf5 import import_h5py, open_hdf5, text_value, vector
+from .hdf5 import h5_guard, import_h5py, open_hdf5, text_value, vector
 from .mat5check import check_mat5
 from .recording import (
     Recording,
     RecordingError,
     check_equal_lengths,
     finish,
+    metadata_scalar,
     real_values,
     resolve_columns,
+    step_of_rate,
     time_from_interval,
 )
 from .sniff import content_format
@@ -51,7 +53,10 @@ def _read_v5(path: Path, file: str, columns: Any, kind: Any) -> tuple[Any, ...]:
     except Exception as exc:
         raise RecordingError(f"not a readable MATLAB file ({exc})", file=file) from None
     numeric = [n for n, _shape, cls in info if cls in ("double", "single") or "int" in cls]
-    kind, mapping = resolve_columns(numeric, columns=columns, kind=kind, file=file)
+    unusable = {n: f"a MATLAB {cls}" for n, _shape, cls in info if n not in numeric}
+    kind, mapping = resolve_columns(
+        numeric, columns=columns, kind=kind, file=file, unusable=unusable
+    )
     names = set(mapping.values())
     extra = [n for n, _s, _c in info if n == "units" or n in {f"{m}_unit" for m in names}]
     extra += [n for n, _s, _c in info if n in ("dt", "fs")]
@@ -76,18 +81,48 @@ def _read_v5(path: Path, file: str, columns: Any, kind: Any) -> tuple[Any, ...]:
         if u is None:
             u = split_name(n)[1]
         units[c] = u
-    dt = None
-    if "dt" in d:
-        dt = float(np.asarray(d["dt"]).reshape(-1)[0])
-    elif "fs" in d:
-        dt = 1.0 / float(np.asarray(d["fs"]).reshape(-1)[0])
+    dt = _dt_of(d, file)
     return kind, mapping, raw, units, dt
+
+
+def _dt_of(d: Any, file: str) -> float | None:
+    """The sampling interval from a variable ``dt`` or ``fs`` of ``d`` (a dict of scipy's
+    values or an open v7.3 file), checked; None when there is neither."""
+    for key, kind in (("dt", "step"), ("fs", "rate")):
+        if key in d:
+            v = d[key]
+            if hasattr(v, "attrs") and hasattr(v, "shape"):  # a v7.3 dataset
+                v = np.empty(0) if v.attrs.get("MATLAB_empty", 0) else v[()]
+            label = f"variable {key!r}"
+            x = metadata_scalar(v, file=file, label=label, kind=kind)
+            return x if kind == "step" else step_of_rate(x, file=file, label=label)
+    return None
+
+
+def _v73_text(f: Any, path: str, *, file: str, column: str) -> str | None:
+    """The text of the v7.3 dataset at ``path`` (a unit); anything else is refused."""
+    h5py = import_h5py()
+    obj = f[path]
+    if not isinstance(obj, h5py.Dataset):
+        raise RecordingError(
+            f"the unit {path!r} is a {type(obj).__name__.lower()}, not text",
+            file=file,
+            column=column,
+        )
+    return text_value(obj[()]).strip() or None
 
 
 def v73_layout(
     f: Any, *, columns: Any, kind: Any, file: str
 ) -> tuple[str | None, dict[str, str], dict[str, str | None], float | None]:
     """``(kind, mapping, units, dt)`` of an open MAT v7.3 file, without reading the data."""
+    with h5_guard(file):
+        return _v73_layout(f, columns=columns, kind=kind, file=file)
+
+
+def _v73_layout(
+    f: Any, *, columns: Any, kind: Any, file: str
+) -> tuple[str | None, dict[str, str], dict[str, str | None], float | None]:
     h5py = import_h5py()
     numeric = [
         n
@@ -101,24 +136,20 @@ def v73_layout(
     for c, n in mapping.items():
         u = None
         if "units" in f and isinstance(f["units"], h5py.Group) and n in f["units"]:
-            u = text_value(f["units"][n][()]).strip() or None
+            u = _v73_text(f, f"units/{n}", file=file, column=n)
         if u is None and f"{n}_unit" in f:
-            u = text_value(f[f"{n}_unit"][()]).strip() or None
+            u = _v73_text(f, f"{n}_unit", file=file, column=n)
         if u is None:
             u = split_name(n)[1]
         units[c] = u
-    dt = None
-    if "dt" in f:
-        dt = float(np.asarray(f["dt"][()]).reshape(-1)[0])
-    elif "fs" in f:
-        dt = 1.0 / float(np.asarray(f["fs"][()]).reshape(-1)[0])
-    return kind, mapping, units, dt
+    return kind, mapping, units, _dt_of(f, file)
 
 
 def _read_v73(path: Path, file: str, columns: Any, kind: Any) -> tuple[Any, ...]:
     with open_hdf5(path, file=file) as f:
         kind, mapping, units, dt = v73_layout(f, columns=columns, kind=kind, file=file)
-        raw = {c: vector(f[n], file=file, column=n) for c, n in mapping.items()}
+        with h5_guard(file):
+            raw = {c: vector(f[n], file=file, column=n) for c, n in mapping.items()}
     return kind, mapping, raw, units, dt
 
 

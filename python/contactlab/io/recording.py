@@ -7,6 +7,7 @@ analysis code never sees µm or MPa. Canonical channel names: tangential ``x`` (
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -182,12 +183,29 @@ def resolve_columns(
     columns: dict[str, str] | None,
     kind: str | None,
     file: str,
+    unusable: dict[str, str] | None = None,
 ) -> tuple[str | None, dict[str, str]]:
     """Map canonical channel names to names in the file.
 
     Returns ``(kind, {canonical: file_name})``; ``"t"`` is included when a time column exists.
     Explicit ``columns`` entries match the full name or the name without its unit.
+    ``unusable`` maps the file's objects that cannot be channels (not real numbers) to what
+    they hold (``"complex"``, ``"text"``, ...): a missing channel's message names those that
+    would have matched.
     """
+    unusable = dict(unusable or {})
+
+    def not_real(*wanted: str) -> str:
+        """``; 'F' is complex: ...`` for the unusable objects named like one of ``wanted``."""
+        low = {w.strip().lower() for w in wanted}
+        hits = [
+            f"{n!r} is {what}"
+            for n, what in unusable.items()
+            if n.strip().lower() in low or split_name(n)[0].strip().lower() in low
+            or n.rsplit("/", 1)[-1].strip().lower() in low
+        ]  # fmt: skip
+        return f"; {', '.join(hits[:5])}: a channel must hold real numbers" if hits else ""
+
     if kind not in (None, "tangential", "normal", "frame"):
         raise InputError(f"kind must be 'tangential', 'normal', 'frame' or None, got {kind!r}")
     columns = dict(columns or {})
@@ -208,7 +226,8 @@ def resolve_columns(
         hit = find(name)
         if hit is None:
             raise RecordingError(
-                f"column {name!r} (asked for {canon!r}) not found; columns are {available}",
+                f"column {name!r} (asked for {canon!r}) not found; columns are {available}"
+                f"{not_real(name)}",
                 file=file,
                 column=name,
             )
@@ -244,7 +263,8 @@ def resolve_columns(
     if kind is None:
         raise RecordingError(
             f"cannot tell a tangential (x, F) from a normal (p, delta) recording; columns are "
-            f"{available}; pass kind= and columns={{'x': ..., 'F': ...}} (command line: --model "
+            f"{available}{not_real(*ALIASES['F'], *ALIASES['p'])}; pass kind= and columns="
+            "{'x': ..., 'F': ...} (command line: --model "
             "tangential|normal and --columns 'x=...,F=...')",
             file=file,
         )
@@ -257,7 +277,8 @@ def resolve_columns(
         elif canon != "t":
             raise RecordingError(
                 f"no column for {canon!r} ({DIMENSIONS[canon]}) of a {kind} recording; columns "
-                f"are {available}; name it e.g. {ALIASES[canon][0]!r} or pass columns="
+                f"are {available}{not_real(*ALIASES[canon])}; name it e.g. "
+                f"{ALIASES[canon][0]!r} or pass columns="
                 f"{{{canon!r}: 'your column'}} (command line: --columns '{canon}=your column')",
                 file=file,
                 column=canon,
@@ -369,6 +390,88 @@ def check_time(
         )
 
 
+#: what :func:`metadata_scalar` asks of each kind of value, and how its message says it
+_SCALAR_KINDS = {
+    "rate": "a sampling rate must be a positive number",
+    "step": "a time step must be a positive number",
+    "offset": "a start time must be a finite number",
+}
+
+
+def _shown(v: Any) -> str:
+    """A metadata value as an error message shows it (short)."""
+    if isinstance(v, (bytes, np.bytes_)):
+        v = bytes(v).decode("utf-8", "replace")
+    if isinstance(v, (str, np.str_)):
+        text = repr(str(v))
+    elif isinstance(v, (float, np.floating)):
+        text = f"{float(v):g}"
+    else:
+        text = str(v)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def metadata_scalar(value: Any, *, file: str, label: str, kind: str) -> float:
+    """A sampling rate (``kind="rate"``), time step (``"step"``) or start time (``"offset"``)
+    read from a file's metadata (``label`` names it, e.g. ``"attribute 'fs'"``), as a float:
+    one finite real number (the first of an array), rate and step > 0. Anything else (empty,
+    text, complex, a group, 0, NaN, ...) is a :class:`RecordingError` naming file and label.
+    Shared by every reader, whole-file and chunked."""
+
+    def refuse(why: str) -> RecordingError:
+        return RecordingError(f"{label} {why}: {_SCALAR_KINDS[kind]}", file=file)
+
+    if hasattr(value, "keys") and not isinstance(value, np.ndarray):  # an HDF5 group
+        raise refuse("is a group, not a number")
+    if isinstance(value, (str, bytes, np.str_, np.bytes_)):
+        a = np.asarray([value], dtype=object)
+    else:
+        try:
+            a = np.asarray(value)
+        except Exception:  # an object numpy cannot hold
+            raise refuse(f"is a {type(value).__name__}, not a number") from None
+    if a.size == 0:
+        raise refuse("is empty")
+    v = a.reshape(-1)[0]
+    if isinstance(v, (bytes, np.bytes_, str, np.str_)):
+        try:
+            x = float(bytes(v).decode("utf-8") if isinstance(v, (bytes, np.bytes_)) else v)
+        except (ValueError, UnicodeDecodeError):
+            raise refuse(f"is {_shown(v)}, not a number") from None
+    elif np.iscomplexobj(a) or isinstance(v, complex):
+        raise refuse(f"is complex ({_shown(v)})")
+    elif a.dtype.kind == "b" or isinstance(v, bool):
+        raise refuse(f"is a boolean ({v})")
+    else:
+        try:
+            with np.errstate(over="ignore", invalid="ignore"):
+                x = float(v)
+        except (TypeError, ValueError):
+            raise refuse(f"is {_shown(v)}, not a number") from None
+    if not math.isfinite(x) or (kind != "offset" and x <= 0):
+        raise refuse(f"is {_shown(x)}")
+    return x
+
+
+def step_of_rate(fs: float, *, file: str, label: str) -> float:
+    """The sampling interval ``1/fs`` of a valid rate; a rate so large that the step underflows
+    (0 or subnormal) or so small that it overflows is a :class:`RecordingError`."""
+    with np.errstate(over="ignore", divide="ignore"):
+        dt = 1.0 / fs
+    if not math.isfinite(dt) or dt < np.finfo(np.float64).tiny:
+        raise RecordingError(
+            f"{label} is {_shown(fs)}: its sampling interval 1/fs = {dt:g} s "
+            f"{'underflows' if dt < 1 else 'overflows'} double precision",
+            file=file,
+        )
+    return dt
+
+
+def user_rate(fs: Any, *, file: str) -> float:
+    """The sampling rate given by the caller (``fs=``, ``--fs``), checked like a file's."""
+    return metadata_scalar(fs, file=file, label="fs", kind="rate")
+
+
 def time_from_fs(n: int, fs: float | None, *, file: str, t0: float = 0.0) -> np.ndarray:
     if fs is None:
         raise RecordingError(
@@ -376,10 +479,17 @@ def time_from_fs(n: int, fs: float | None, *, file: str, t0: float = 0.0) -> np.
             "line: --fs or --columns 't=...')",
             file=file,
         )
-    fs = float(fs)
-    if not np.isfinite(fs) or fs <= 0:
-        raise InputError(f"fs must be finite and > 0, got {fs}")
-    return t0 + np.arange(n, dtype=np.float64) / fs
+    fs = user_rate(fs, file=file)
+    step_of_rate(fs, file=file, label="fs")
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        t = t0 + np.arange(n, dtype=np.float64) / fs
+    # found by audit: fs = 1e-308 makes the axis overflow, a huge fs makes its steps vanish
+    if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+        raise RecordingError(
+            f"fs is {_shown(fs)}: it gives no increasing, finite time axis for {n} samples",
+            file=file,
+        )
+    return t
 
 
 def check_finite(a: np.ndarray, *, file: str, column: str, row_of: RowOf = _plain) -> None:

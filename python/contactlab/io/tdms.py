@@ -8,6 +8,7 @@ needed channels are read from disk.
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +21,7 @@ from .recording import (
     RecordingError,
     check_equal_lengths,
     finish,
+    metadata_scalar,
     real_values,
     resolve_columns,
     time_from_interval,
@@ -32,6 +34,64 @@ def import_nptdms() -> Any:
     except ImportError:  # pragma: no cover - depends on the installation
         raise InputError("reading TDMS files needs npTDMS: pip install 'contactlab[io]'") from None
     return nptdms
+
+
+class quiet_nptdms:
+    """Within it, npTDMS logs nothing to stderr (its warnings about a damaged file are
+    collected instead: :attr:`truncated` tells whether it found the last segment short); the
+    loggers' filters are restored on exit."""
+
+    def __init__(self) -> None:
+        self.messages: list[str] = []
+        self._loggers: list[logging.Logger] = []
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        self.messages.append(record.getMessage())
+        return False
+
+    def __enter__(self) -> quiet_nptdms:
+        import_nptdms()
+        self._loggers = [logging.getLogger("nptdms")] + [
+            lg
+            for name, lg in list(logging.root.manager.loggerDict.items())
+            if name.startswith("nptdms.") and isinstance(lg, logging.Logger)
+        ]
+        for lg in self._loggers:
+            lg.addFilter(self)
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        for lg in self._loggers:
+            lg.removeFilter(self)
+
+    @property
+    def truncated(self) -> bool:
+        return any("less data than expected" in m for m in self.messages)
+
+
+def tdms_lengths(
+    lengths: dict[str, int], quiet: quiet_nptdms, *, file: str, what: str = "channels"
+) -> None:
+    """Refuse channels of different lengths, suspecting truncation when npTDMS found the
+    last segment short."""
+    if len(set(lengths.values())) > 1:
+        hint = "truncated file? " if quiet.truncated else ""
+        raise RecordingError(f"{hint}{what} differ in length: {lengths}", file=file)
+
+
+def tdms_time_step(ref: Any, *, file: str) -> tuple[float | None, float]:
+    """``(wf_increment, wf_start_offset)`` of channel ``ref``, checked (None: no increment)."""
+    props = ref.properties
+    inc = props.get("wf_increment")
+    if inc is None:
+        return None, 0.0
+    where = f"of channel {ref.name!r}"
+    dt = metadata_scalar(inc, file=file, label=f"property 'wf_increment' {where}", kind="step")
+    t0 = props.get("wf_start_offset")
+    if t0 is None or (isinstance(t0, str) and t0 == ""):
+        return dt, 0.0
+    label = f"property 'wf_start_offset' {where}"
+    return dt, metadata_scalar(t0, file=file, label=label, kind="offset")
 
 
 def read_tdms(
@@ -50,6 +110,13 @@ def read_tdms(
     path = Path(path)
     file = str(path)
     # Our own handle: npTDMS leaks the one it opens when parsing fails (ResourceWarning).
+    with quiet_nptdms() as quiet:
+        return _read_tdms(nptdms, path, file, quiet, columns=columns, kind=kind, fs=fs)
+
+
+def _read_tdms(
+    nptdms: Any, path: Path, file: str, quiet: quiet_nptdms, *, columns: Any, kind: Any, fs: Any
+) -> Recording:
     fh = open(path, "rb")
     try:
         tf = nptdms.TdmsFile.open(fh)
@@ -62,6 +129,8 @@ def read_tdms(
             for ch in g.channels():
                 chans.setdefault(ch.name, ch)
                 chans[f"{g.name}/{ch.name}"] = ch
+        if not chans and quiet.truncated:
+            raise RecordingError("truncated file? no channel could be read", file=file)
         kind, mapping = resolve_columns(list(chans), columns=columns, kind=kind, file=file)
         raw: dict[str, np.ndarray] = {}
         units: dict[str, str | None] = {}
@@ -70,16 +139,16 @@ def read_tdms(
             raw[canon] = real_values(ch[:], file=file, column=name)
             u = ch.properties.get("unit_string")
             units[canon] = str(u) if u not in (None, "") else None
+        tdms_lengths({mapping[c]: v.size for c, v in raw.items()}, quiet, file=file)
         check_equal_lengths(raw, mapping, file=file)
         t_fallback = None
-        if "t" not in raw:
+        if "t" not in raw and fs is None:
             ref = chans[mapping[next(c for c in mapping if c != "t")]]
-            inc = ref.properties.get("wf_increment")
-            if inc is not None and fs is None:
-                t0 = float(ref.properties.get("wf_start_offset", 0.0) or 0.0)
+            inc, t0 = tdms_time_step(ref, file=file)
+            if inc is not None:
                 n = next(iter(raw.values())).size
                 t_fallback = time_from_interval(
-                    float(inc), n, file=file, t0=t0, name="wf_increment", column=ref.name
+                    inc, n, file=file, t0=t0, name="wf_increment", column=ref.name
                 )
         return finish(
             raw,
