@@ -87,7 +87,7 @@ def _expect(path, match, capsys):
         ({"fs": np.nan}, "attribute 'fs' is nan"),
         ({"dt": "abc"}, "attribute 'dt' is 'abc', not a number: a time step"),
         ({"dt": 0.0}, "attribute 'dt' is 0"),
-        ({"fs": 1e-320}, "attribute 'fs' .*overflows"),
+        ({"fs": 1e-320}, "attribute 'fs' .*beyond any data acquisition"),
     ],
 )
 def test_hdf5_bad_rate(tmp_path, capsys, attrs, match):
@@ -267,3 +267,14 @@ def test_tdms_truncated_quiet(tmp_path, capsys):
     assert len(err.strip().splitlines()) == 1, err
     assert {n: logging.getLogger(n).level for n in levels} == levels
     assert {n: list(logging.getLogger(n).filters) for n in levels} == filters
+
+
+@pytest.mark.parametrize("fs", ["1e200", "1e13", "1e-10"])
+def test_sampling_rate_beyond_any_acquisition(tmp_path, capsys, fs):
+    """fs = 1e200 Hz passed the reader and divided by zero in the drift's trend."""
+    p = tmp_path / "no_t.csv"
+    x = 1e-5 * np.sin(np.linspace(0, 12 * np.pi, 600))
+    p.write_text("x [m],F [N]\n" + "\n".join(f"{v:.9g},{1e6 * v:.9g}" for v in x))
+    assert main(["analyze", str(p), "--model", "tangential", "--fs", fs]) == 1
+    err = capsys.readouterr().err
+    assert "beyond any data acquisition" in err and "Traceback" not in err

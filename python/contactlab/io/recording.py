@@ -450,7 +450,19 @@ def metadata_scalar(value: Any, *, file: str, label: str, kind: str) -> float:
             raise refuse(f"is {_shown(v)}, not a number") from None
     if not math.isfinite(x) or (kind != "offset" and x <= 0):
         raise refuse(f"is {_shown(x)}")
+    # found by audit: fs = 1e200 Hz passed, and the analysis divided by its squared steps
+    step = x if kind == "step" else 1.0 / x if kind == "rate" else None
+    if step is not None and not (STEP_RANGE[0] <= step <= STEP_RANGE[1]):
+        raise RecordingError(
+            f"{label} is {_shown(x)}: a sampling interval of {step:.3g} s is beyond any data "
+            f"acquisition ({STEP_RANGE[0]:g} to {STEP_RANGE[1]:g} s); check its unit",
+            file=file,
+        )
     return x
+
+
+#: sampling intervals a recording may have, s (1 THz to one every 30 years)
+STEP_RANGE = (1e-12, 1e9)
 
 
 def step_of_rate(fs: float, *, file: str, label: str) -> float:
