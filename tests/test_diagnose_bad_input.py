@@ -72,7 +72,8 @@ def test_declared_but_unwritten_hdf5_is_refused_before_it_is_read_whole(tmp_path
             d.attrs["unit"] = unit
     assert main(["diagnose", "--model", "tangential", str(path)]) == 1
     line = _one_error_line(capsys)
-    assert str(path) in line and "duplicated" in line
+    assert str(path) in line and "stores 0 bytes" in line
+    assert "declares" in line and "none of it was written" in line
 
 
 def test_failing_report_leaves_the_previous_json(quick, tmp_path, capsys, monkeypatch):
@@ -179,3 +180,10 @@ def test_normal_noise_variance_at_zero_stiffness_is_unbounded(monkeypatch):
     assert fam.noise_variance_bound(p, d) == np.inf
     p["k"] = 1e12
     assert 0.0 < fam.noise_variance(p, (), d) < fam.noise_variance_bound(p, d) * 1.0001
+
+
+def test_long_threshold_is_the_streamed_verbs():
+    from contactlab.commands import diagnose as d
+    from contactlab.studies.pooled import STREAM_ABOVE
+
+    assert d._LONG == STREAM_ABOVE

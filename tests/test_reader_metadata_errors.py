@@ -278,3 +278,16 @@ def test_sampling_rate_beyond_any_acquisition(tmp_path, capsys, fs):
     assert main(["analyze", str(p), "--model", "tangential", "--fs", fs]) == 1
     err = capsys.readouterr().err
     assert "beyond any data acquisition" in err and "Traceback" not in err
+
+
+def test_hdf5_declaring_more_than_it_stores(tmp_path):
+    """A long dataset with no chunk written is refused by the whole-file reader before it
+    allocates the declared length (8 GB a channel for 1e9 samples)."""
+    import h5py
+
+    p = tmp_path / "empty.h5"
+    with h5py.File(p, "w") as f:
+        for name in ("t", "x", "F"):
+            f.create_dataset(name, shape=(10**9,), dtype="f8", chunks=(65536,))
+    with pytest.raises(RecordingError, match="stores 0 bytes: none of it was written"):
+        contactlab.read_recording(p, kind="tangential")

@@ -481,7 +481,34 @@ def vector(ds: Any, *, file: str, column: str) -> np.ndarray:
         raise RecordingError(
             f"dataset has shape {shape}; a channel must be a vector", file=file, column=column
         )
+    _check_stored(ds, file=file, column=column)
     return real_values(ds[()], file=file, column=column).reshape(-1)
+
+
+def _check_stored(ds: Any, *, file: str, column: str) -> None:
+    """Refuse a long dataset that declares more than it stores (found by audit: a 1.9 KB file
+    declaring 1e9 samples was read whole, 8 GB a channel of fill values): none of it written,
+    or under a sixteenth where nothing is compressed."""
+    nominal = int(ds.size) * int(ds.dtype.itemsize)
+    if nominal <= _CHECK_STORED_ABOVE:
+        return
+    try:
+        stored = int(ds.id.get_storage_size())
+        filtered = bool(ds.compression or ds.shuffle or ds.scaleoffset)
+    except (AttributeError, RuntimeError, ValueError, TypeError):
+        return
+    if stored == 0 or (not filtered and stored * 16 < nominal):
+        raise RecordingError(
+            f"dataset declares {ds.size} samples ({nominal / 2**20:.0f} MB) but stores "
+            f"{stored} bytes: {'none' if stored == 0 else 'most'} of it was "
+            f"{'' if stored == 0 else 'never '}written (a recording stopped early?)",
+            file=file,
+            column=column,
+        )
+
+
+#: datasets above this many bytes are checked for unwritten storage (_check_stored)
+_CHECK_STORED_ABOVE = 8 << 20
 
 
 def unit_attr(ds: Any) -> str | None:
