@@ -131,7 +131,16 @@ def _v73_layout(
         and isinstance(obj, h5py.Dataset)
         and text_value(obj.attrs.get("MATLAB_class", b"double")) in ("double", "single")
     ]
-    kind, mapping = resolve_columns(numeric, columns=columns, kind=kind, file=file)
+    structs = {
+        n: "a MATLAB struct"
+        for n, obj in f.items()
+        if isinstance(n, str)
+        and isinstance(obj, h5py.Group)
+        and text_value(obj.attrs.get("MATLAB_class", b"")) == "struct"
+    }
+    kind, mapping = resolve_columns(
+        numeric, columns=columns, kind=kind, file=file, unusable=structs
+    )
     units: dict[str, str | None] = {}
     for c, n in mapping.items():
         u = None

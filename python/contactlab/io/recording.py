@@ -204,7 +204,18 @@ def resolve_columns(
             if n.strip().lower() in low or split_name(n)[0].strip().lower() in low
             or n.rsplit("/", 1)[-1].strip().lower() in low
         ]  # fmt: skip
-        return f"; {', '.join(hits[:5])}: a channel must hold real numbers" if hits else ""
+        return (f"; {', '.join(hits[:5])}: a channel must hold real numbers" if hits else "") \
+            + structs()  # fmt: skip
+
+    def structs() -> str:
+        """``; 'data' is a MATLAB struct: ...`` (channels inside a struct are not read)."""
+        names = [n for n, what in unusable.items() if what == "a MATLAB struct" and n != "units"]
+        if not names:
+            return ""
+        return (f"; {', '.join(repr(n) for n in names[:3])} "
+                f"{'is a MATLAB struct' if len(names) == 1 else 'are MATLAB structs'}, whose "
+                "fields are not read: save them as variables (in MATLAB: save(file, '-struct', "
+                f"{names[0]!r}))")  # fmt: skip
 
     if kind not in (None, "tangential", "normal", "frame"):
         raise InputError(f"kind must be 'tangential', 'normal', 'frame' or None, got {kind!r}")
