@@ -449,6 +449,9 @@ def classify(
     pl = plateau(loop, x, F, v, thr) if (loop is not None and z >= GROSS_SLIDING_Z) else None
     st = stick_slip(t, x, F, rev, v, thr, window, pl.offset if pl is not None else 0.0)
     zt = f"ac·A = {z:.3g} (from the {src}; loop area {100 * ratio:.0f}% of the rectangle 4·A·h_m)"
+    if not math.isfinite(z):  # an area no friction loop of this size encloses
+        zt = (f"ac·A undetermined (the loop area is {100 * ratio:.0f}% of the rectangle "
+              "4·A·h_m, which bounds any friction loop)")  # fmt: skip
     if z < PRE_SLIDING_Z:
         return Regime("pre-sliding", f"pre-sliding (microslip): {zt}", z, src, ratio, None, st)
     if z < GROSS_SLIDING_Z or (pl is None and src != "fit"):
