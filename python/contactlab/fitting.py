@@ -792,10 +792,13 @@ def _finish(
             for idx in np.flatnonzero(~keep):
                 v = Vt[idx]
                 involved = [names[i] for i in np.flatnonzero(np.abs(v) > 0.1)]
+                what = (f"the combination of {', '.join(involved)}" if len(involved) > 1
+                        else ", ".join(involved))  # fmt: skip
+                rel = s[idx] / s[0] if s[0] > 0 else 0.0
                 notes.append(
-                    "the data do not constrain the combination of "
-                    + ", ".join(involved)
-                    + f" (singular value {s[idx]:.3g} vs {s[0]:.3g})"
+                    f"the data do not determine {what}: the fit is {rel:.1e} times as sensitive "
+                    "to it as to its best-determined direction (singular values "
+                    f"{s[idx]:.3g} vs {s[0]:.3g})"
                 )
                 for n in involved:
                     ps[n].identifiable = False
