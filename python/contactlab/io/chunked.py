@@ -396,7 +396,13 @@ def _h5_chunks(
 
 
 def _tdms_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> ChunkedRecording:
-    from .tdms import import_nptdms, quiet_nptdms, tdms_lengths, tdms_time_step
+    from .tdms import (
+        import_nptdms,
+        quiet_nptdms,
+        refuse_unread_tdms,
+        tdms_lengths,
+        tdms_time_step,
+    )
 
     nptdms = import_nptdms()
     file = str(path)
@@ -418,8 +424,7 @@ def _tdms_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) ->
     with quiet_nptdms() as quiet:
         fh, tf, chans = open_tdms()
         with tf, fh:
-            if not chans and quiet.truncated:
-                raise RecordingError("truncated file? no channel could be read", file=file)
+            refuse_unread_tdms(path, chans, quiet, file=file)
             kind_, mapping = resolve_columns(list(chans), columns=columns, kind=kind, file=file)
             units: dict[str, str | None] = {}
             sizes = {}

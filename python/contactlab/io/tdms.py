@@ -9,6 +9,8 @@ needed channels are read from disk.
 from __future__ import annotations
 
 import logging
+import os
+import struct
 from pathlib import Path
 from typing import Any
 
@@ -67,6 +69,74 @@ class quiet_nptdms:
     @property
     def truncated(self) -> bool:
         return any("less data than expected" in m for m in self.messages)
+
+
+#: a TDMS segment's lead-in: tag, table-of-contents mask, version, next-segment offset and
+#: raw-data offset (both from the lead-in's end)
+_LEAD_IN = 28
+_TOC_BIG_ENDIAN = 1 << 6
+#: most segments walked looking for damage (a file of many small segments stays fast)
+_MAX_SEGMENTS = 100_000
+
+
+def tdms_damage(path: Path) -> str | None:
+    """Where the TDMS file at ``path`` is cut short or damaged, in words (None: its segments'
+    lead-ins and metadata are all there). Walks the segments' lead-ins, so a file cut inside
+    a lead-in or inside a segment's metadata (npTDMS then reads no channel, or drops the
+    segment, with only a log message) is named as such."""
+    size = os.path.getsize(path)
+    pos, k = 0, 0
+    with open(path, "rb") as fh:
+        while pos < size and k < _MAX_SEGMENTS:
+            k += 1
+            fh.seek(pos)
+            head = fh.read(_LEAD_IN)
+            if len(head) >= 4 and head[:4] not in (b"TDSm", b"TDSh"):
+                return f"segment {k} at byte {pos} does not start with a TDMS tag ({head[:4]!r})"
+            if len(head) < _LEAD_IN:
+                return (
+                    f"truncated: the file ends at byte {size}, {size - pos} bytes into the "
+                    f"{_LEAD_IN}-byte lead-in of segment {k} (at byte {pos})"
+                )
+            (toc,) = struct.unpack("<I", head[4:8])
+            order = ">" if toc & _TOC_BIG_ENDIAN else "<"
+            nxt, raw = struct.unpack(order + "QQ", head[12:28])
+            meta_end = pos + _LEAD_IN + raw
+            if raw > nxt and nxt != 0xFFFFFFFFFFFFFFFF:
+                return (
+                    f"segment {k} (at byte {pos}) declares its metadata ({raw} bytes) longer "
+                    f"than the segment ({nxt} bytes)"
+                )
+            if meta_end > size:
+                return (
+                    f"truncated: the file ends at byte {size}, inside the metadata of segment "
+                    f"{k} (bytes {pos + _LEAD_IN} to {meta_end})"
+                )
+            if nxt == 0xFFFFFFFFFFFFFFFF:  # an unfinished last segment (acquisition stopped)
+                return None
+            end = pos + _LEAD_IN + nxt
+            if end > size:
+                return (
+                    f"truncated: the file ends at byte {size}, inside the data of segment {k} "
+                    f"(bytes {meta_end} to {end})"
+                )
+            pos = end
+    return None
+
+
+def refuse_unread_tdms(
+    path: Path, chans: dict[str, Any], quiet: quiet_nptdms, *, file: str
+) -> None:
+    """Refuse a file npTDMS read no channel from, or whose last segment's metadata it found
+    cut short, naming where the file is truncated or damaged (the columns would be ``[]``)."""
+    incomplete = any("metadata is incomplete" in m for m in quiet.messages)
+    if chans and not incomplete:
+        return
+    damage = tdms_damage(path)
+    if damage is not None and (not chans or "metadata" in damage or "lead-in" in damage):
+        raise RecordingError(f"not a readable TDMS file (damaged: {damage})", file=file)
+    if not chans and quiet.truncated:
+        raise RecordingError("truncated file? no channel could be read", file=file)
 
 
 def tdms_lengths(
@@ -129,8 +199,7 @@ def _read_tdms(
             for ch in g.channels():
                 chans.setdefault(ch.name, ch)
                 chans[f"{g.name}/{ch.name}"] = ch
-        if not chans and quiet.truncated:
-            raise RecordingError("truncated file? no channel could be read", file=file)
+        refuse_unread_tdms(path, chans, quiet, file=file)
         kind, mapping = resolve_columns(list(chans), columns=columns, kind=kind, file=file)
         raw: dict[str, np.ndarray] = {}
         units: dict[str, str | None] = {}
