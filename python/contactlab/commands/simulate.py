@@ -25,8 +25,28 @@ if TYPE_CHECKING:
 MAX_SAMPLES = 20_000_000
 
 
-def finite_quantity(default_unit: str, *, positive: bool = False) -> Callable[[str], float]:
-    """argparse ``type=``: :func:`quantity` that also refuses non-finite values (``1e400``)."""
+#: physically meaningful ranges of the simulation's quantities, SI: ``(low, high, what)``;
+#: ``low`` None for a signed quantity bounded in magnitude by ``high``. Found by audit:
+#: ``--amplitude 1e30`` (m) was accepted and written as a recording.
+RANGES: dict[str, tuple[float | None, float, str]] = {
+    "h0": (1e-6, 1e8, "a saturation force"),
+    "ac": (1e-2, 1e10, "a curvature (saturation within 0.1 nm to 100 m)"),
+    "amplitude": (1e-9, 1.0, "a displacement amplitude of a contact"),
+    "frequency": (1e-6, 1e6, "an excitation frequency"),
+    "fs": (1e-3, 1e9, "a sampling rate"),
+    "offset": (None, 1e8, "a load-cell zero offset"),
+    "x_offset": (None, 1.0, "a displacement-sensor zero offset"),
+    "p0": (1.0, 1e10, "a contact pressure"),
+    "pa": (1.0, 1e10, "a pressure amplitude"),
+    "omega": (1e-6, 1e7, "an angular frequency"),
+}
+
+
+def finite_quantity(
+    default_unit: str, *, positive: bool = False, bounds: str | None = None
+) -> Callable[[str], float]:
+    """argparse ``type=``: :func:`quantity` that also refuses non-finite values (``1e400``)
+    and, with ``bounds`` (a key of :data:`RANGES`), values outside the physical range."""
     parse = quantity(default_unit, positive=positive)
     rng = "a finite number > 0" if positive else "a finite number"
 
@@ -34,22 +54,39 @@ def finite_quantity(default_unit: str, *, positive: bool = False) -> Callable[[s
         value = parse(text)
         if not math.isfinite(value):
             raise argparse.ArgumentTypeError(f"{text!r}: must be {rng} ({default_unit})")
+        if bounds is not None:
+            lo, hi, what = RANGES[bounds]
+            if lo is None and not abs(value) <= hi:
+                raise argparse.ArgumentTypeError(
+                    f"{text!r} = {value:g} {default_unit}: {what} must be within "
+                    f"±{hi:g} {default_unit}"
+                )
+            if lo is not None and not lo <= value <= hi:
+                raise argparse.ArgumentTypeError(
+                    f"{text!r} = {value:g} {default_unit}: {what} must be in "
+                    f"{lo:g}..{hi:g} {default_unit}"
+                )
         return value
 
     check.__name__ = parse.__name__
     return check
 
 
-def real(*, minimum: float | None = None) -> Callable[[str], float]:
-    """argparse ``type=``: a finite float, ``>= minimum`` when given."""
+def real(*, minimum: float | None = None, maximum: float | None = None) -> Callable[[str], float]:
+    """argparse ``type=``: a finite float, ``>= minimum`` and ``<= maximum`` when given."""
     rng = "a finite number" + ("" if minimum is None else f" >= {minimum:g}")
+    rng += "" if maximum is None else f"{' and' if minimum is not None else ''} <= {maximum:g}"
 
     def parse(text: str) -> float:
         try:
             value = float(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"{text!r} is not a number (give {rng})") from None
-        if not math.isfinite(value) or (minimum is not None and value < minimum):
+        if (
+            not math.isfinite(value)
+            or (minimum is not None and value < minimum)
+            or (maximum is not None and value > maximum)
+        ):
             raise argparse.ArgumentTypeError(f"{text!r}: must be {rng}")
         return value
 
@@ -167,35 +204,35 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("model", choices=("tangential", "normal", "structure"))
     p.add_argument("out", metavar="OUT", help="output file (.csv .tdms .h5 .mat)")
     g = p.add_argument_group("tangential")
-    g.add_argument("--h0", type=finite_quantity("N", positive=True), default=40.0,
+    g.add_argument("--h0", type=finite_quantity("N", positive=True, bounds="h0"), default=40.0,
                    help="saturation force (N, > 0)")  # fmt: skip
-    g.add_argument("--ac", type=finite_quantity("1/m", positive=True), default=4e4,
+    g.add_argument("--ac", type=finite_quantity("1/m", positive=True, bounds="ac"), default=4e4,
                    help="curvature (1/m, > 0)")  # fmt: skip
-    g.add_argument("--amplitude", type=finite_quantity("m", positive=True), default=20e-6,
-                   help="displacement amplitude (m, > 0; e.g. 20um)")  # fmt: skip
-    g.add_argument("--frequency", type=finite_quantity("Hz", positive=True), default=1.0,
-                   help="Hz, > 0")  # fmt: skip
+    g.add_argument("--amplitude", type=finite_quantity("m", positive=True, bounds="amplitude"),
+                   default=20e-6, help="displacement amplitude (m, 1nm..1m: 20um)")  # fmt: skip
+    g.add_argument("--frequency", type=finite_quantity("Hz", positive=True, bounds="frequency"),
+                   default=1.0, help="Hz, 1e-6..1e6")  # fmt: skip
     g.add_argument(
         "--fs",
-        type=finite_quantity("Hz", positive=True),
+        type=finite_quantity("Hz", positive=True, bounds="fs"),
         default=500.0,
         help="sampling rate (Hz, > 0)",
     )
-    g.add_argument("--offset", type=finite_quantity("N"), default=0.0,
+    g.add_argument("--offset", type=finite_quantity("N", bounds="offset"), default=0.0,
                    help="load-cell zero offset (N)")  # fmt: skip
-    g.add_argument("--x-offset", type=finite_quantity("m"), default=0.0,
+    g.add_argument("--x-offset", type=finite_quantity("m", bounds="x_offset"), default=0.0,
                    help="displacement-sensor zero offset (m)")  # fmt: skip
     g.add_argument("--drift", type=real(), default=0.0,
                    help="force drift (N/s, a finite number of either sign)")  # fmt: skip
     g.add_argument("--adc-bits", type=integer(4, 32), default=None,
                    help="quantise to this many bits (4..32)")  # fmt: skip
     n = p.add_argument_group("normal")
-    n.add_argument("--p0", type=finite_quantity("Pa", positive=True), default=0.5e6,
+    n.add_argument("--p0", type=finite_quantity("Pa", positive=True, bounds="p0"), default=0.5e6,
                    help="static pressure (Pa, > 0)")  # fmt: skip
-    n.add_argument("--pa", type=finite_quantity("Pa", positive=True), default=0.4e6,
+    n.add_argument("--pa", type=finite_quantity("Pa", positive=True, bounds="pa"), default=0.4e6,
                    help="pressure amplitude (Pa, > 0 and <= p0)")  # fmt: skip
-    n.add_argument("--omega", type=finite_quantity("1/s", positive=True), default=1.0,
-                   help="angular frequency (1/s, > 0)")  # fmt: skip
+    n.add_argument("--omega", type=finite_quantity("1/s", positive=True, bounds="omega"),
+                   default=1.0, help="angular frequency (1/s, 1e-6..1e7)")  # fmt: skip
     n.add_argument("--samples-per-cycle", type=integer(8), default=400,
                    help="samples per cycle (an integer >= 8; default 400)")  # fmt: skip
     n.add_argument("--normal-model", default=None, choices=("nonlinear", "linear", "table2"),
@@ -203,10 +240,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--cycles", type=integer(1), default=5,
                    help=f"number of cycles (an integer >= 1; at most {MAX_SAMPLES:,} samples "
                    "in all)")  # fmt: skip
-    p.add_argument("--noise", type=real(minimum=0.0), default=None,
+    p.add_argument("--noise", type=real(minimum=0.0, maximum=10.0), default=None,
                    help="tangential: force noise as a fraction of the peak force (default "
                    "0.01); normal: relative to each channel's peak-to-peak value (default: "
-                   "realistic sensor noise and 16-bit quantisation); 0 = exact, >= 0")  # fmt: skip
+                   "realistic sensor noise and 16-bit quantisation); 0 = exact, 0..10")  # fmt: skip
     p.add_argument("--seed", type=integer(0), default=0,
                    help="noise generator seed (a non-negative integer; default 0)")  # fmt: skip
     s = p.add_argument_group("structure (a model from `contactlab identify --json`)")
