@@ -52,7 +52,7 @@ def build_track_report(
     rep.table(
         [comb],
         _columns(result, with_time=False),
-        "all windows pooled (inverse-variance mean; error widened by the Birge ratio)",
+        "all windows pooled (weighted by window size; error widened by the Birge ratio)",
     )
     for msg in result.notes(comb):  # failed windows, the windows' warnings, scatter
         rep.text(msg, note=True)

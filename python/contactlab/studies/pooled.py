@@ -6,8 +6,9 @@ streamed analysis (:func:`contactlab.track`, memory bounded by one chunk and one
 writes the document a whole-file analysis writes, with the same keys, each filled from the
 windows:
 
-- a quantity with a standard error: the inverse-variance weighted mean over the windows that
-  determine it, its error widened by the Birge ratio when the windows scatter beyond their
+- a quantity with a standard error: the weighted mean over the windows that determine it
+  (:func:`pool`: weights by window size, a window's own error only where it is far above the
+  typical one), its error widened by the Birge ratio when the windows scatter beyond their
   errors (as :meth:`~contactlab.studies.TrackResult.combined`);
 - the fit's parameters likewise; its covariance ``(Σ C_k⁻¹)⁻¹`` over the windows' covariances
   (independent data), ``chisqr``, ``ndata``, ``nfev`` summed;
@@ -49,11 +50,33 @@ def _num(v: Any) -> float:
     )
 
 
-def pool(values: list[Any], errors: list[Any]) -> tuple[float, float, float]:
-    """``(mean, stderr, birge)``: inverse-variance weighted mean of the windows with a finite
-    value and positive error, its error times the Birge ratio when that exceeds 1. Without
-    any error: the plain mean and the standard error of the windows' scatter (NaN, NaN, NaN
-    without a value)."""
+#: a window's own standard error sets its weight only when it exceeds this many times the
+#: error typical of its size (``c/√n``, ``c`` the median of ``s·√n`` over the windows)
+OWN_ERROR_ABOVE = 3.0
+
+
+def pool(
+    values: list[Any] | np.ndarray,
+    errors: list[Any] | np.ndarray,
+    sizes: list[Any] | np.ndarray | None = None,
+) -> tuple[float, float, float]:
+    """``(mean, stderr, birge)`` of windows with a finite value and a positive error.
+
+    With ``sizes`` (cycles or samples per window, three windows or more): each window is
+    weighted by the error typical of its size, ``c/√n`` with ``c`` the median of ``s·√n``,
+    unless its own error ``s`` is more than :data:`OWN_ERROR_ABOVE` times that (a window
+    that determines the quantity badly keeps its own, smaller weight). A window's own
+    error is estimated from the same noisy samples as its value and is correlated with it (a
+    window whose h0 came out low also came out with a smaller error), so inverse-variance
+    weights bias the mean: 666 windows of 3 cycles, 1 % noise on both channels, h0 −0.31 %
+    (z −4.9) with ``1/s²`` against −0.13 % with these weights. Without sizes: ``1/s²``.
+
+    ``stderr`` is ``1/sqrt(Σ w)`` times the Birge ratio ``sqrt(χ²/(n-1))`` (χ² with each
+    window's own error) when that exceeds 1. Without any error: the plain mean and the
+    standard error of the windows' scatter (NaN, NaN, NaN without a value). Weights are
+    relative to the smallest error and values to the largest, so that quantities of 1e±300
+    do not overflow the sums.
+    """
     v = np.array([_num(a) for a in values])
     s = np.array([_num(a) for a in errors])
     ok = np.isfinite(v) & np.isfinite(s) & (s > 0)
@@ -61,24 +84,40 @@ def pool(values: list[Any], errors: list[Any]) -> tuple[float, float, float]:
         fin = v[np.isfinite(v)]
         if not fin.size:
             return math.nan, math.nan, math.nan
-        se = float(np.std(fin, ddof=1) / math.sqrt(fin.size)) if fin.size > 1 else math.nan
-        return float(np.mean(fin)), se, math.nan
-    w = 1.0 / s[ok] ** 2
-    mean = float(np.sum(w * v[ok]) / np.sum(w))
-    err = float(1.0 / math.sqrt(np.sum(w)))
+        big = float(np.max(np.abs(fin))) or 1.0
+        u = fin / big
+        se = big * float(np.std(u, ddof=1)) / math.sqrt(fin.size) if fin.size > 1 else math.nan
+        return big * float(np.mean(u)), se, math.nan
+    vk, sk = v[ok], s[ok]
+    smin = float(np.min(sk))
+    rel = sk / smin
+    if sizes is not None and ok.sum() >= 3:
+        n = np.array([_num(a) for a in sizes])[ok]
+        c = float(np.median(rel * np.sqrt(n))) if np.all(np.isfinite(n) & (n > 0)) else math.nan
+        if math.isfinite(c):
+            typical = c / np.sqrt(n)
+            rel = np.where(rel > OWN_ERROR_ABOVE * typical, rel, typical)
+    w = 1.0 / rel**2
+    vbig = float(np.max(np.abs(vk))) or 1.0
+    mean = vbig * float(np.sum(w * (vk / vbig)) / np.sum(w))
+    err = smin / math.sqrt(float(np.sum(w)))
     birge = 1.0
     if ok.sum() > 1:
-        birge = math.sqrt(float(np.sum(w * (v[ok] - mean) ** 2)) / (ok.sum() - 1))
+        with np.errstate(over="ignore"):  # inf: windows scattering beyond any error
+            r = (vk - mean) / sk
+            chi2 = float(np.sum(r * r))
+        birge = math.sqrt(chi2 / (ok.sum() - 1))
     return mean, err * max(birge, 1.0), birge
 
 
 def _pool_fit(fits: list[dict[str, Any]]) -> dict[str, Any]:
     out = dict(fits[0])
+    sizes = [f.get("ndata") for f in fits]
     params = {}
     for name, p0 in fits[0]["params"].items():
         vals = [f["params"].get(name, {}).get("value") for f in fits]
         errs = [f["params"].get(name, {}).get("stderr") for f in fits]
-        m, e, _ = pool(vals, errs)
+        m, e, _ = pool(vals, errs, sizes)
         p = dict(p0, value=None if math.isnan(m) else m, stderr=None if math.isnan(e) else e)
         p["identifiable"] = all(f["params"].get(name, {}).get("identifiable") for f in fits)
         p["init_value"] = None
@@ -112,7 +151,7 @@ def _pool_fit(fits: list[dict[str, Any]]) -> dict[str, Any]:
     out["redchi"] = out["chisqr"] / dof if dof > 0 else None
     out["condition"] = float(np.nanmax([_num(f.get("condition")) for f in fits]))
     out["success"] = all(bool(f.get("success")) for f in fits)
-    out["message"] = f"{len(fits)} window fits pooled (inverse-variance weights)"
+    out["message"] = f"{len(fits)} window fits pooled (weights by window size, see pool)"
     notes = Counter(n for f in fits for n in f.get("notes") or [])
     out["notes"] = [f"{n} ({c} of {len(fits)} windows)" for n, c in notes.items()]
     return out
@@ -126,6 +165,7 @@ def pooled_document(docs: list[dict[str, Any]], *, reason: str) -> dict[str, Any
     n = len(docs)
     out: dict[str, Any] = {}
     first = docs[0]
+    sizes = [d.get("n_cycles") for d in docs]
     for k, v0 in first.items():
         if k.endswith("_stderr"):
             continue
@@ -138,7 +178,7 @@ def pooled_document(docs: list[dict[str, Any]], *, reason: str) -> dict[str, Any
         elif k in _SUMMED:
             out[k] = int(sum(int(d.get(k) or 0) for d in docs))
         elif f"{k}_stderr" in first:
-            m, e, _ = pool([d.get(k) for d in docs], [d.get(f"{k}_stderr") for d in docs])
+            m, e, _ = pool([d.get(k) for d in docs], [d.get(f"{k}_stderr") for d in docs], sizes)
             out[k] = None if math.isnan(m) else m
             out[f"{k}_stderr"] = None if math.isnan(e) else e
         elif k in _NO_POOL or isinstance(v0, (str, bool)) or v0 is None:
@@ -225,7 +265,7 @@ _NORMAL_SUMMED = ("n_cycles", "n_discarded")
 def pooled_normal_document(docs: list[dict[str, Any]], *, reason: str) -> dict[str, Any]:
     """The whole-record document of a normal-contact recording from its windows'
     :meth:`NormalAnalysis.to_dict` documents, with the whole-file analysis' keys: ``E_d``
-    (and any quantity with a ``*_stderr``) inverse-variance pooled; counts (``n_cycles``,
+    (and any quantity with a ``*_stderr``) pooled by :func:`pool`; counts (``n_cycles``,
     ``n_discarded``) summed; other numbers (ψ, ψ_KV, k_tan, k_sec, the b coefficients, the
     cycle scatter, ...) and the polynomials (coefficient by coefficient) averaged over the
     windows; flags true when true in any window; texts from the first window; warnings each
@@ -234,6 +274,7 @@ def pooled_normal_document(docs: list[dict[str, Any]], *, reason: str) -> dict[s
         raise ValueError("no window to pool")
     first = docs[0]
     out: dict[str, Any] = {}
+    sizes = [d.get("n_cycles") for d in docs]
     for k, v0 in first.items():
         if k.endswith("_stderr") or k in ("warnings", "units"):
             continue
@@ -241,7 +282,7 @@ def pooled_normal_document(docs: list[dict[str, Any]], *, reason: str) -> dict[s
         if k in _NORMAL_SUMMED:
             out[k] = int(sum(int(_num(v)) if math.isfinite(_num(v)) else 0 for v in vals))
         elif f"{k}_stderr" in first:
-            m, e, _ = pool(vals, [d.get(f"{k}_stderr") for d in docs])
+            m, e, _ = pool(vals, [d.get(f"{k}_stderr") for d in docs], sizes)
             out[k] = None if math.isnan(m) else m
             out[f"{k}_stderr"] = None if math.isnan(e) else e
         elif isinstance(v0, bool):

@@ -18,8 +18,8 @@ keeps only the results:
 - every cycle of the record (:mod:`._cycles`): loop energy ∮F dx, amplitude, offset.
 
 Memory holds one chunk and one window, whatever the length of the record.
-:meth:`TrackResult.combined` pools the windows (inverse-variance weights, widened by the
-Birge ratio when the windows scatter more than their errors say): the whole-record result of a
+:meth:`TrackResult.combined` pools the windows (weights by window size, the error widened by
+the Birge ratio when the windows scatter more than their errors say): the whole-record result of a
 streamed analysis.
 """
 
@@ -48,6 +48,7 @@ from ..io import Recording, read_chunks
 from ..io.units import UnknownUnitError, to_si
 from ._cycles import CycleState, block_cycles, trigger_levels
 from .columns import CYCLE_UNITS
+from .pooled import pool
 from .study import coefficient_unit
 
 #: tangential quantities tracked per window (each with ``*_stderr``)
@@ -196,14 +197,18 @@ class TrackResult:
     def combined(self) -> dict[str, Any]:
         """The windows pooled into one whole-record result.
 
-        Each quantity with a standard error is the inverse-variance weighted mean over the
-        windows that determine it; its ``*_stderr`` is ``1/sqrt(Σ w)`` times the Birge ratio
-        ``sqrt(χ²/(n-1))`` when that exceeds 1 (windows scattering beyond their errors: the
-        joint changed, or the errors are optimistic). ``*_birge`` gives the ratio. A quantity
+        Each quantity with a standard error is the weighted mean over the windows that
+        determine it (:func:`contactlab.studies.pooled.pool`: each window weighted by the
+        error typical of its number of cycles, not by its own error, which is correlated with
+        its value; a window whose own error is far above the typical one keeps its own); its
+        ``*_stderr`` is ``1/sqrt(Σ w)`` times the Birge ratio ``sqrt(χ²/(n-1))`` when that
+        exceeds 1 (windows scattering beyond their errors: the joint changed, or the errors
+        are optimistic). ``*_birge`` gives the ratio. A quantity
         the window analysis gives no error for (ψ, k_tan, ... of normal loops) is the plain
         mean over the windows with the standard error of that mean.
         """
         out: dict[str, Any] = {"n_windows": len(self.rows)}
+        sizes = self.column("n_cycles") if "n_cycles" in self.columns() else None
         for q in self.quantities:
             v, s = self.column(q), self.column(f"{q}_stderr")
             ok = np.isfinite(v) & np.isfinite(s) & (s > 0)
@@ -216,22 +221,9 @@ class TrackResult:
                     out[q] = m
                     out[f"{q}_stderr"] = sd / math.sqrt(fin.size)
                 continue
-            # weights relative to the smallest error and values relative to the largest, so
-            # that quantities of 1e±300 do not overflow the sums (found by fuzz: track)
-            vk, sk = v[ok], s[ok]
-            smin = float(np.min(sk))
-            w = (smin / sk) ** 2
-            vbig = float(np.max(np.abs(vk))) or 1.0
-            mean = vbig * float(np.sum(w * (vk / vbig)) / np.sum(w))
-            err = smin / math.sqrt(float(np.sum(w)))
-            birge = 1.0
-            if ok.sum() > 1:
-                with np.errstate(over="ignore"):  # inf: windows scattering beyond any error
-                    r = (vk - mean) / sk
-                    chi2 = float(np.sum(r * r))
-                birge = math.sqrt(chi2 / (ok.sum() - 1))
+            mean, err, birge = pool(v, s, sizes)
             out[q] = mean
-            out[f"{q}_stderr"] = err * max(birge, 1.0)
+            out[f"{q}_stderr"] = err
             out[f"{q}_birge"] = birge
         e = self.cycles.get("energy")
         if e is not None and e.size:
