@@ -217,3 +217,56 @@ def test_frame_report_of_a_sliding_loop(sim_file, tmp_path):
     assert "(plateau)" in title and "ac ≥" in title
     header = (out / "study_tangential.csv").read_text().splitlines()[0]
     assert "frame_window [samples]" in header and "frame_force_noise [N]" in header
+
+
+def test_track_frame_windows_agree_with_analyze(sim_file, tmp_path, capsys):
+    """``track --frame``: the simulated frame reconstructed once and tracked window by window;
+    the windows' pooled h0 agrees with ``analyze --frame`` of the whole record and with the
+    simulation's kinetic friction, and the JSON records the reconstruction."""
+    path, *_ = sim_file
+    a, t = tmp_path / "a.json", tmp_path / "t.json"
+    assert main(["analyze", str(path), "--model", "tangential", "--frame", FRAME,
+                 "--json", str(a)]) == 0  # fmt: skip
+    assert main(["track", str(path), "--frame", FRAME, "--every", "3cycles", "--json", str(t)]) == 0
+    said = capsys.readouterr().out
+    assert "friction frame: columns x = 'x_top [um]' (um)" in said
+    whole, tr = json.loads(a.read_text()), json.loads(t.read_text())
+    assert tr["kind"] == "tangential" and len(tr["windows"]) >= 1
+    assert tr["meta"]["frame_reconstruction"]["window"] == whole["frame_reconstruction"]["window"]
+    h0 = tr["combined"]["h0"]
+    assert h0 == pytest.approx(whole["h0"], rel=0.05)
+    assert 0.6 < h0 < 0.85  # Fk 0.7 N, Fs 0.8 N
+
+
+@pytest.mark.parametrize("load", ["250"])
+def test_track_measured_frame(load, tmp_path):
+    path = _measured(load)
+    out = tmp_path / "t.json"
+    assert main(["track", str(path), "--frame", FRAME, "--every", "5cycles",
+                 "--json", str(out)]) == 0  # fmt: skip
+    d = json.loads(out.read_text())
+    ref = read_frame(path, 3.0799, 0.669, 1191.0)
+    v = np.gradient(ref.x, ref.t)
+    fast = np.abs(v) > 0.5 * np.max(np.abs(v))
+    plateau = 0.5 * (np.median(ref.F[fast & (v > 0)]) - np.median(ref.F[fast & (v < 0)]))
+    for w in d["windows"]:
+        assert w["h0"] == pytest.approx(plateau, rel=0.1)
+
+
+@pytest.mark.parametrize(
+    ("extra", "says"),
+    [
+        (["--frame-x", "x_top"], "give --frame M,C,K too"),
+        (["--frame", FRAME, "--columns", "x=x_top,F=y_base"], "not --columns"),
+        (["--frame", FRAME, "--model", "normal"], "use --model tangential"),
+        (["--frame", FRAME, "--p0", "1MPa"], "normal-contact"),
+        (["--frame", "3,0.6"], "M,C,K"),
+    ],
+)
+def test_track_frame_flags_refused(sim_file, tmp_path, capsys, extra, says):
+    path, *_ = sim_file
+    out = tmp_path / "t.json"
+    assert main(["track", str(path), *extra, "--json", str(out)]) != 0
+    err = capsys.readouterr().err
+    assert says in err and "Traceback" not in err
+    assert not out.exists()

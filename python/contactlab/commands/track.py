@@ -17,12 +17,14 @@ import sys
 
 from ..errors import InputError
 from ._common import (
+    add_frame_flags,
     add_pressure_flags,
     add_progress_flags,
     add_workers_flag,
     check_output_targets,
     command_line,
     describe,
+    frame_option,
     normal_options,
     parse_columns,
     process_pool,
@@ -49,11 +51,7 @@ def _handler(args: argparse.Namespace) -> int:
     check_output_targets(json_out=args.json, report=args.report, inputs=[args.file])
     parse_every(args.every)  # a bad --every fails before the file is opened
     say = sys.stderr if args.json == "-" else sys.stdout
-    bar = None
-    if args.progress or (args.progress is None and sys.stderr.isatty()):
-        from tqdm.auto import tqdm
-
-        bar = tqdm(desc="windows", unit="win", file=sys.stderr)
+    frame = frame_option(args)  # before the file is read: it has no force column
     options = _options(args)
     threads = None
     if args.workers is None:
@@ -62,15 +60,32 @@ def _handler(args: argparse.Namespace) -> int:
             raise InputError(f"--threads must be >= 0, got {threads}")
     elif args.threads is not None:
         raise InputError("--threads is for helper threads; --workers runs processes instead")
+    source, rebuilt = args.file, None
+    if frame is not None:
+        # the force is reconstructed from the whole record (derivatives, smoothing): the
+        # frame's displacements are read whole, then tracked window by window
+        from ..tangential import read_frame
+        from ..tangential.frame import describe_reconstruction
+
+        fr = read_frame(args.file, frame["M"], frame["C"], frame["K"], x=frame["x"],
+                        y=frame["y"], fs=args.fs)  # fmt: skip
+        source = fr.recording(args.file)
+        rebuilt = fr.to_dict()
+        print(f"{args.file}: friction frame: {describe_reconstruction(rebuilt)}", file=say)
     print(f"tracking {args.file} every {args.every}", file=say, flush=True)
+    bar = None
+    if args.progress or (args.progress is None and sys.stderr.isatty()):
+        from tqdm.auto import tqdm
+
+        bar = tqdm(desc="windows", unit="win", file=sys.stderr)
     try:
         with process_pool(args.workers) as ex:
             res = track(
-                args.file,
+                source,
                 args.every,
-                kind=args.model,
+                kind="tangential" if frame is not None else args.model,
                 columns=parse_columns(args.columns),
-                fs=args.fs,
+                fs=None if frame is not None else args.fs,
                 chunk_size=args.chunk_size,
                 executor=ex,
                 threads=threads,
@@ -83,6 +98,8 @@ def _handler(args: argparse.Namespace) -> int:
     from .._malloc import release_freed_memory
 
     release_freed_memory()  # the windows' arrays, before the JSON and the figures are made
+    if rebuilt is not None:
+        res.meta["frame_reconstruction"] = rebuilt
     comb = res.combined()
     if not any(k.endswith("_stderr") for k in comb):
         failed = [r for r in res.rows if r.get("error")]
@@ -117,7 +134,12 @@ def _handler(args: argparse.Namespace) -> int:
         from ..report import commit_outputs
         from ..report.track_report import build_track_report, track_files
 
-        cmd = command_line("track", args.file, "--every", args.every, "--report", args.report)
+        cmd = command_line(
+            "track", args.file, "--every", args.every, "--report", args.report,
+            *(["--frame", args.frame] if frame else []),
+            *(["--frame-x", args.frame_x] if args.frame_x else []),
+            *(["--frame-y", args.frame_y] if args.frame_y else []),
+        )  # fmt: skip
         rep = build_track_report(
             res, f"contactlab track: {args.file}", against=args.against, intro=f"Made by: {cmd}"
         )
@@ -138,6 +160,10 @@ def _options(args: argparse.Namespace) -> dict | None:
     from ..io import read_chunks
     from ..studies.manifest import entry_from_file
 
+    if getattr(args, "frame", None) is not None:  # a frame gives a tangential recording
+        if args.p0 is not None or args.pa is not None:
+            raise InputError(f"{args.file}: --p0/--pa are for normal-contact recordings")
+        return None
     kind = args.model or read_chunks(args.file, columns=parse_columns(args.columns),
                                      fs=args.fs).kind  # fmt: skip
     if kind != "normal":
@@ -181,6 +207,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         metavar="N",
         help="samples read at a time (default 262144, as contactlab.track)",
     )
+    add_frame_flags(p)
     add_pressure_flags(p)
     add_workers_flag(p, "windows")
     p.add_argument(
