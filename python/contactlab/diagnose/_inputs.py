@@ -43,6 +43,59 @@ def arrays(recording: Any, family: Family) -> tuple[np.ndarray, np.ndarray, np.n
     return ta, u, y
 
 
+class GlitchError(InputError):
+    """A channel holds a sensor glitch: a few samples orders of magnitude outside the rest.
+    ``channel``, ``sample`` (0-based index of the largest) and ``value`` are attributes, so
+    a caller that knows the file can add where it is (a CSV line)."""
+
+    def __init__(self, message: str, *, channel: str, sample: int, value: float) -> None:
+        super().__init__(message)
+        self.channel = channel
+        self.sample = sample
+        self.value = value
+
+
+#: a sample this many robust standard deviations (1.4826 × the median absolute deviation)
+#: from its channel's median is no measurement of the same quantity: a sensor glitch
+GLITCH_SCALE = 1e3
+#: ... when at most this many samples (or a thousandth of the record) are that far out; more
+#: is a change of the signal itself (a record that starts at rest, then loads), not a glitch
+GLITCH_MAX_SAMPLES = 3
+
+
+def check_glitches(t: np.ndarray, named: dict[str, tuple[np.ndarray, str]]) -> None:
+    """Refuse a channel with a sensor glitch (found by audit: a normal recording whose
+    displacement, ~0.1 µm throughout, read −2.17 m at one sample was fitted, the fit dragged
+    by the glitch). A glitch is a sample more than :data:`GLITCH_SCALE` robust standard
+    deviations from the channel's median, and there are only a few of them; the message
+    names the channel, the sample (0-based), its time and value, and how to go on."""
+    for name, (v, unit) in named.items():
+        n = v.size
+        if n < 8:
+            continue
+        med = float(np.median(v))
+        dev = np.abs(v - med)
+        scale = 1.4826 * float(np.median(dev))
+        if not scale > 0.0:  # more than half the samples equal: no spread to judge by
+            continue
+        far = np.flatnonzero(dev > GLITCH_SCALE * scale)
+        if far.size == 0 or far.size > max(GLITCH_MAX_SAMPLES, n // 1000):
+            continue
+        i = int(far[np.argmax(dev[far])])
+        others = "" if far.size == 1 else f" (and {far.size - 1} more such sample(s))"
+        raise GlitchError(
+            f"channel {name!r} reads {float(v[i]):.6g} {unit} at sample {i} (t = "
+            f"{float(t[i]):.9g} s){others}, {float(dev[i]) / scale:.3g} times the channel's "
+            f"robust spread (1.4826 × median absolute deviation = {scale:.3g} {unit}) from its "
+            f"median {med:.3g} {unit}: a sensor glitch, not a measurement; remove or replace "
+            "the sample(s) (e.g. by the neighbours' mean), or cut the record around them, and "
+            "run again",
+            channel=name,
+            sample=i,
+            value=float(v[i]),
+        )
+
+
 #: channels beyond these magnitudes (in SI units) are not measurements: a unit or scaling
 #: error, and squares of them overflow
 _MAX_ABS = 1e100

@@ -36,7 +36,7 @@ from ..errors import ConvergenceError, InputError
 from ._family import Family, Prepared
 from ._filters import decimate, savgol_coeffs
 from ._inputs import arrays as _arrays
-from ._inputs import check_channels
+from ._inputs import check_channels, check_glitches
 from ._kept import RawInput, knots_at
 from ._parallel import EvaluationCounter, one_blas_thread, pmap
 from ._signal import (
@@ -1051,9 +1051,9 @@ def diagnose(
         )  # fmt: skip
     family, start, context = _family(model)
     t, u, y = _arrays(recording, family)
-    check_channels(
-        t, {family.input_name: (u, family.input_unit), family.output_name: (y, family.output_unit)}
-    )
+    named = {family.input_name: (u, family.input_unit), family.output_name: (y, family.output_unit)}
+    check_channels(t, named)
+    check_glitches(t, named)
     if folds < 2:
         raise InputError(f"folds must be >= 2, got {folds}")
     if max_effects < 0:
