@@ -294,17 +294,20 @@ def test_hdf5_declaring_more_than_it_stores(tmp_path):
 
 
 def test_matlab_struct_variables_are_named_with_the_way_out(tmp_path):
-    """Channels saved inside a struct (`data.x`, `data.F`) are not read: the message says so
-    and how to save them as variables, for MAT v5 and v7.3 (it said 'columns are []')."""
+    """Channels saved inside a struct inside a struct (`data.run.x`) are not read: the message
+    says so and how to save them as variables, for MAT v5 and v7.3 (it said 'columns are []').
+    One level of struct (`data.x`) is read: tests/test_io_mat_struct.py."""
     import h5py
     import scipy.io
 
     x = 1e-5 * np.sin(np.linspace(0, 12 * np.pi, 600))
     v5 = tmp_path / "s5.mat"
-    scipy.io.savemat(v5, {"data": {"x": x, "F": 1e6 * x}})
+    scipy.io.savemat(v5, {"data": {"run": {"x": x, "F": 1e6 * x}}})
     v73 = tmp_path / "s73.mat"
     with h5py.File(v73, "w", userblock_size=512) as f:
         g = f.create_group("data")
+        g.attrs["MATLAB_class"] = np.bytes_("struct")
+        g = g.create_group("run")
         g.attrs["MATLAB_class"] = np.bytes_("struct")
         for k, v in (("x", x), ("F", 1e6 * x)):
             d = g.create_dataset(k, data=v.reshape(-1, 1))
@@ -312,5 +315,5 @@ def test_matlab_struct_variables_are_named_with_the_way_out(tmp_path):
     with open(v73, "r+b") as fh:  # MATLAB's header in the user block
         fh.write(b"MATLAB 7.3 MAT-file".ljust(128, b" "))
     for p in (v5, v73):
-        with pytest.raises(RecordingError, match=r"'data' is a MATLAB struct.*'-struct', 'data'"):
+        with pytest.raises(RecordingError, match=r"'data.run' is a MATLAB struct.*'-struct', 's'"):
             contactlab.read_recording(p)

@@ -339,10 +339,10 @@ def _h5_chunks(
 
     def layout(f: Any) -> tuple[Any, ...]:
         if fmt == "mat73":
-            from .mat import v73_layout
+            from .mat import v73_dataset, v73_layout
 
             kind_, mapping, units, dt = v73_layout(f, columns=columns, kind=kind, file=file)
-            dsets = {n: f[n] for n in mapping.values()}
+            dsets = {n: v73_dataset(f, n) for n in mapping.values()}
         else:
             kind_, mapping, dsets, units, dt = hdf5_layout(f, columns=columns, kind=kind, file=file)
         sizes = {n: _vector_length(dsets[n], file=file, column=n) for n in mapping.values()}
@@ -360,7 +360,12 @@ def _h5_chunks(
     def gen(alloc: Alloc | None) -> Iterator[Recording]:
         fin = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, meta={"format": fmt})
         with h5_guard(file), h5py.File(path, "r") as f:
-            dsets = {n_: f[n_] for n_ in mapping.values()} if fmt == "mat73" else None
+            if fmt == "mat73":
+                from .mat import v73_dataset
+
+                dsets = {n_: v73_dataset(f, n_) for n_ in mapping.values()}
+            else:
+                dsets = None
             if dsets is None:
                 from .hdf5 import datasets
 

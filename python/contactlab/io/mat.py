@@ -1,9 +1,11 @@
 """MATLAB .mat recordings: v4-v7 through ``scipy.io``, v7.3 (HDF5 inside) through h5py.
 
-Each channel is a vector variable. Units, in order of preference: a struct variable ``units``
-with one text field per channel, a text variable ``<name>_unit``, or the name itself
-(``x_um``; see :func:`contactlab.io.units.split_name`). Only the needed variables are read
-(``variable_names=`` for scipy, lazy datasets for v7.3).
+Each channel is a vector variable, or a vector field of a scalar struct variable (saved as
+``save(file, 'data')`` with ``data.x``, ``data.F``): such a channel is named ``data.x``, and
+also ``x`` when no variable and no other struct has that name. Units, in order of
+preference: a struct variable ``units`` with one text field per channel, a text variable
+``<name>_unit``, or the name itself (``x_um``; see :func:`contactlab.io.units.split_name`).
+Only the needed variables are read (``variable_names=`` for scipy, lazy datasets for v7.3).
 """
 
 from __future__ import annotations
@@ -42,6 +44,56 @@ def _mat_text(v: Any) -> str | None:
     return None
 
 
+def struct_names(top: list[str], fields: dict[str, list[str]]) -> tuple[list[str], dict[str, str]]:
+    """The channel names a file offers and the full name of each: ``top`` (variables) and
+    ``struct.field`` for each struct's vector fields (``fields``: struct to its fields), plus
+    the bare field name where it is unambiguous (no variable of that name, one struct with
+    it). Returns ``(names, full)``, ``full`` mapping each short name to ``struct.field``."""
+    full_names = [f"{st}.{f}" for st, fs in fields.items() for f in fs]
+    count: dict[str, int] = {}
+    for fs in fields.values():
+        for f in fs:
+            count[f] = count.get(f, 0) + 1
+    short = {
+        f: f"{st}.{f}" for st, fs in fields.items() for f in fs if count[f] == 1 and f not in top
+    }
+    return [*top, *short, *full_names], short
+
+
+def _v5_struct_fields(
+    path: Path, info: list[Any], unusable: dict[str, str], file: str
+) -> dict[str, np.ndarray]:
+    """The vector fields of the file's scalar struct variables (but ``units``), as
+    ``{"struct.field": values}``; a struct array or a field that is no numeric vector goes
+    into ``unusable``."""
+    structs = [n for n, shape, cls in info if cls == "struct" and n != "units"]
+    if not structs:
+        return {}
+    d = scipy.io.loadmat(path, variable_names=structs, squeeze_me=True)
+    out: dict[str, np.ndarray] = {}
+    for st in structs:
+        v = np.asarray(d.get(st))
+        if v.dtype.names is None:
+            continue
+        if v.size != 1:
+            unusable[st] = f"a MATLAB struct array ({v.size} elements)"
+            continue
+        rec = v.reshape(-1)[0]
+        for f in v.dtype.names:
+            a = np.asarray(rec[f])
+            if a.dtype == object and a.size == 1:
+                a = np.asarray(a.reshape(-1)[0])
+            if a.dtype.kind in "fiu" and a.ndim <= 2:
+                out[f"{st}.{f}"] = a
+            else:
+                what = {"U": "text", "S": "text", "c": "complex", "b": "logical"}.get(
+                    a.dtype.kind, "a MATLAB struct" if a.dtype.names else "not numeric"
+                )
+                unusable[f"{st}.{f}"] = what
+        unusable.pop(st, None)
+    return out
+
+
 def _read_v5(path: Path, file: str, columns: Any, kind: Any) -> tuple[Any, ...]:
     with open(path, "rb") as fh:
         v4 = 0 in fh.read(4)  # scipy's test: a v4 file has a zero among its first 4 bytes
@@ -54,17 +106,25 @@ def _read_v5(path: Path, file: str, columns: Any, kind: Any) -> tuple[Any, ...]:
         raise RecordingError(f"not a readable MATLAB file ({exc})", file=file) from None
     numeric = [n for n, _shape, cls in info if cls in ("double", "single") or "int" in cls]
     unusable = {n: f"a MATLAB {cls}" for n, _shape, cls in info if n not in numeric}
+    fields = _v5_struct_fields(path, info, unusable, file)
+    by_struct: dict[str, list[str]] = {}
+    for full in fields:
+        st, f = full.split(".", 1)
+        by_struct.setdefault(st, []).append(f)
+    available, short = struct_names(numeric, by_struct)
     kind, mapping = resolve_columns(
-        numeric, columns=columns, kind=kind, file=file, unusable=unusable
+        available, columns=columns, kind=kind, file=file, unusable=unusable
     )
-    names = set(mapping.values())
+    mapping = {c: short.get(n, n) for c, n in mapping.items()}
+    names = {n for n in mapping.values() if n not in fields}
     extra = [n for n, _s, _c in info if n == "units" or n in {f"{m}_unit" for m in names}]
     extra += [n for n, _s, _c in info if n in ("dt", "fs")]
     d = scipy.io.loadmat(path, variable_names=[*names, *extra], squeeze_me=True)
+    d.update(fields)
     raw = {}
     for c, n in mapping.items():
         a = real_values(d[n], file=file, column=n)
-        if a.ndim > 1:
+        if a.ndim > 1 and len([k for k in a.shape if k != 1]) > 1:
             raise RecordingError(
                 f"variable has shape {a.shape}; a channel must be a vector", file=file, column=n
             )
@@ -73,13 +133,14 @@ def _read_v5(path: Path, file: str, columns: Any, kind: Any) -> tuple[Any, ...]:
     ustruct = d.get("units")
     for c, n in mapping.items():
         u = None
+        leaf = n.rsplit(".", 1)[-1]
         if ustruct is not None and getattr(ustruct, "dtype", None) is not None:
-            if ustruct.dtype.names and n in ustruct.dtype.names:
-                u = _mat_text(ustruct[n])
+            if ustruct.dtype.names and leaf in ustruct.dtype.names:
+                u = _mat_text(ustruct[leaf])
         if u is None and f"{n}_unit" in d:
             u = _mat_text(d[f"{n}_unit"])
         if u is None:
-            u = split_name(n)[1]
+            u = split_name(leaf)[1]
         units[c] = u
     dt = _dt_of(d, file)
     return kind, mapping, raw, units, dt
@@ -135,30 +196,51 @@ def _v73_layout(
         n: "a MATLAB struct"
         for n, obj in f.items()
         if isinstance(n, str)
+        and n != "units"
         and isinstance(obj, h5py.Group)
         and text_value(obj.attrs.get("MATLAB_class", b"")) == "struct"
     }
+    by_struct: dict[str, list[str]] = {}
+    for st in list(structs):
+        for fn, obj in f[st].items():
+            if not isinstance(fn, str):
+                continue
+            cls = text_value(obj.attrs.get("MATLAB_class", b""))
+            if isinstance(obj, h5py.Dataset) and cls in ("double", "single"):
+                by_struct.setdefault(st, []).append(fn)
+            else:
+                structs[f"{st}.{fn}"] = f"a MATLAB {cls or type(obj).__name__.lower()}"
+        del structs[st]  # its fields are listed (read, or named as unusable)
+    available, short = struct_names(numeric, by_struct)
     kind, mapping = resolve_columns(
-        numeric, columns=columns, kind=kind, file=file, unusable=structs
+        available, columns=columns, kind=kind, file=file, unusable=structs
     )
+    mapping = {c: short.get(n, n) for c, n in mapping.items()}
     units: dict[str, str | None] = {}
     for c, n in mapping.items():
         u = None
-        if "units" in f and isinstance(f["units"], h5py.Group) and n in f["units"]:
-            u = _v73_text(f, f"units/{n}", file=file, column=n)
-        if u is None and f"{n}_unit" in f:
+        leaf = n.rsplit(".", 1)[-1]
+        if "units" in f and isinstance(f["units"], h5py.Group) and leaf in f["units"]:
+            u = _v73_text(f, f"units/{leaf}", file=file, column=n)
+        if u is None and "." not in n and f"{n}_unit" in f:
             u = _v73_text(f, f"{n}_unit", file=file, column=n)
         if u is None:
-            u = split_name(n)[1]
+            u = split_name(leaf)[1]
         units[c] = u
     return kind, mapping, units, _dt_of(f, file)
+
+
+def v73_dataset(f: Any, name: str) -> Any:
+    """The dataset of channel ``name`` of an open v7.3 file: a variable, or ``struct.field``
+    (MATLAB names hold neither ``.`` nor ``/``)."""
+    return f[name.replace(".", "/")]
 
 
 def _read_v73(path: Path, file: str, columns: Any, kind: Any) -> tuple[Any, ...]:
     with open_hdf5(path, file=file) as f:
         kind, mapping, units, dt = v73_layout(f, columns=columns, kind=kind, file=file)
         with h5_guard(file):
-            raw = {c: vector(f[n], file=file, column=n) for c, n in mapping.items()}
+            raw = {c: vector(v73_dataset(f, n), file=file, column=n) for c, n in mapping.items()}
     return kind, mapping, raw, units, dt
 
 

@@ -203,6 +203,7 @@ def resolve_columns(
             for n, what in unusable.items()
             if n.strip().lower() in low or split_name(n)[0].strip().lower() in low
             or n.rsplit("/", 1)[-1].strip().lower() in low
+            or n.rsplit(".", 1)[-1].strip().lower() in low  # a MATLAB struct's field
         ]  # fmt: skip
         return (f"; {', '.join(hits[:5])}: a channel must hold real numbers" if hits else "") \
             + structs()  # fmt: skip
@@ -212,10 +213,15 @@ def resolve_columns(
         names = [n for n, what in unusable.items() if what == "a MATLAB struct" and n != "units"]
         if not names:
             return ""
+        # a struct's vector fields are read (data.x); a struct inside one is not
+        how = (
+            f"s = {names[0]}; save(file, '-struct', 's')"
+            if "." in names[0]
+            else f"save(file, '-struct', {names[0]!r})"
+        )
         return (f"; {', '.join(repr(n) for n in names[:3])} "
                 f"{'is a MATLAB struct' if len(names) == 1 else 'are MATLAB structs'}, whose "
-                "fields are not read: save them as variables (in MATLAB: save(file, '-struct', "
-                f"{names[0]!r}))")  # fmt: skip
+                f"fields are not read: save them as variables (in MATLAB: {how})")  # fmt: skip
 
     if kind not in (None, "tangential", "normal", "frame"):
         raise InputError(f"kind must be 'tangential', 'normal', 'frame' or None, got {kind!r}")
