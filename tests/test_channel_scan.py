@@ -43,7 +43,7 @@ def test_long_channel_checks_name_the_sample():
     a[12345] = np.nan
     with pytest.raises(InputError, match=r"x\[12345\] is not finite"):
         as_1d(a, "x")
-    with pytest.raises(RecordingError, match="row 12345"):
+    with pytest.raises(RecordingError, match="sample 12345: "):
         check_finite(a, file="f.csv", column="x")
     b = np.full(5 * 4096, 2.5)
     with pytest.raises(InputError, match="constant"):

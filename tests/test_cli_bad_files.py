@@ -22,8 +22,10 @@ def _good_csv(path, n_cycles=4.0, fs=200.0):
     [
         ("unit.csv", "t [s],x [furlong],F [N]\n0,0,0\n0.1,1,1\n",
          ["unit.csv", "x [furlong]", "furlong"]),
-        ("cell.csv", "t [s],x [um],F [N]\n0,0,0\n0.1,abc,1\n0.2,2,2\n", ["cell.csv", "row 3"]),
-        ("dup.csv", "t [s],x [um],F [N]\n0,0,0\n0.1,1,1\n0.1,2,2\n0.2,3,3\n", ["dup.csv", "row"]),
+        ("cell.csv", "t [s],x [um],F [N]\n0,0,0\n0.1,abc,1\n0.2,2,2\n",
+         ["cell.csv", "sample 1 (line 3 of cell.csv)"]),
+        ("dup.csv", "t [s],x [um],F [N]\n0,0,0\n0.1,1,1\n0.1,2,2\n0.2,3,3\n",
+         ["dup.csv", "sample 2 (line 4 of dup.csv)"]),
         ("fake.h5", "t,x,F\n0,0,0\n", ["fake.h5"]),
         ("fake.mat", "not a MAT file at all", ["fake.mat"]),
         ("fake.tdms", "t,x,F\n", ["fake.tdms"]),

@@ -84,7 +84,7 @@ def test_track_bad_input(tmp_path, capsys):
     p.write_text("t [s],x [um],F [N]\n0,1,2\n0.001,oops,3\n")
     assert main(["track", str(p), "--every", "5cycles"]) == 1
     err = capsys.readouterr().err
-    assert "run.csv" in err and "column 'x [um]'" in err and "row 3" in err
+    assert "run.csv" in err and "column 'x [um]'" in err and "sample 1 (line 3 of run.csv)" in err
     assert main(["track", str(p), "--every", "soon"]) == 1
     assert "every='soon'" in capsys.readouterr().err
 

@@ -121,7 +121,7 @@ def test_analyze_bad_file_no_partial_outputs(tangential_file, tmp_path, capsys):
                  "--report", str(rep), "--json", str(js)])  # fmt: skip
     assert code == 1
     err = capsys.readouterr().err
-    assert "bad.csv" in err and "row" in err
+    assert "bad.csv" in err and "sample 2 (line 4 of bad.csv)" in err
     assert not rep.exists() and not js.exists()
 
 

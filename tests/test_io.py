@@ -143,7 +143,7 @@ def test_csv_errors_name_file_column_and_row(tmp_path, text, match, column, row)
     assert err.column == column
     assert err.row == row
     if row is not None:
-        assert f"row {row}" in str(err)
+        assert f"(line {row} of bad.csv)" in str(err) and f"sample {row - 2} " in str(err)
     assert isinstance(err, InputError)
 
 

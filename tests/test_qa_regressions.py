@@ -69,12 +69,14 @@ def test_unsorted_time_message_has_plain_numbers_with_unit(tmp_path):
     msg = str(ei.value)
     assert "np.float64" not in msg
     assert "0.002 s is unsorted" in msg and "previous is 0.003 s" in msg
-    assert "row 5" in msg and "'t [ms]'" in msg
+    assert "(line 5 of" in msg and "'t [ms]'" in msg
 
 
 def test_nan_cell_message_has_plain_numbers(tmp_path):
     f = _short_csv(tmp_path / "n.csv", ["0,0,0", "1,nan,1", "2,2,2"])
-    with pytest.raises(RecordingError, match=r"'x \[um\]', row 3: value nan is not") as ei:
+    with pytest.raises(
+        RecordingError, match=r"'x \[um\]', sample 1 \(line 3 of n.csv\): value nan is not"
+    ) as ei:
         read_recording(f)
     assert "np.float64" not in str(ei.value)
 

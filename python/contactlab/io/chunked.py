@@ -36,6 +36,7 @@ from ..errors import InputError
 from .recording import (
     Recording,
     RecordingError,
+    at_sample,
     check_equal_lengths,
     check_finite,
     check_time,
@@ -130,7 +131,7 @@ class _Finisher:
         meta: dict[str, Any] | None = None,
     ) -> None:
         self.mapping, self.kind, self.file = mapping, kind, file
-        self.row_of = row_of or (lambda i: i)
+        self.row_of = row_of  # a sample's line of a text file (None: binary)
         assumed: list[str] = []
         self.factors: dict[str, float] = {}
         self.units: dict[str, str] = {}
@@ -176,25 +177,30 @@ class _Finisher:
         """``(t0, dt)`` of a time axis made from the sampling interval, else None."""
         return None if self.dt is None else (float(self.t0), float(self.dt))
 
-    def _check_time(self, t: np.ndarray, row_of: Callable[[int], int]) -> None:
+    def _check_time(self, t: np.ndarray, offset: int) -> None:
         """The whole-file reader's time checks, judged against the first chunk's median step
         and across the boundary with the previous chunk."""
         col = self.tcol
         if self.prev_t is None:
             if t.size >= 2:
                 self.step = float(np.median(np.diff(t)))
-            check_time(t, file=self.file, column=col, row_of=row_of, step=self.step)
+            check_time(
+                t, file=self.file, column=col, row_of=self.row_of, step=self.step, offset=offset
+            )
             return
         if t.size:  # the boundary: the previous chunk's last stamp, then this one's first
             check_time(
                 np.array([self.prev_t, t[0]]),
                 file=self.file,
                 column=col,
-                row_of=lambda i: row_of(i - 1),
+                row_of=self.row_of,
                 step=self.step,
+                offset=offset - 1,
             )
         if t.size >= 2:
-            check_time(t, file=self.file, column=col, row_of=row_of, step=self.step)
+            check_time(
+                t, file=self.file, column=col, row_of=self.row_of, step=self.step, offset=offset
+            )
 
     def __call__(
         self, raw: dict[str, np.ndarray], offset: int, out: dict[str, np.ndarray] | None = None
@@ -206,9 +212,6 @@ class _Finisher:
         n = next(iter(raw.values())).size
         if self.prev_t is None and n < 2:  # as the whole-file check of the time says
             raise RecordingError(f"only {n} sample(s)", file=self.file, column=self.tcol)
-
-        def row_of(i: int) -> int:
-            return self.row_of(offset + i)
 
         data: dict[str, np.ndarray] = {}
         ranges: dict[str, tuple[float, float]] = {}
@@ -238,13 +241,13 @@ class _Finisher:
             finite, lo, hi = _core.finite_min_max(v) if v.size else (True, math.inf, -math.inf)
             if not finite:
                 # the whole-file reader's checks find the value and raise
-                check_finite(values, file=self.file, column=col, row_of=row_of)
+                check_finite(values, file=self.file, column=col, row_of=self.row_of, offset=offset)
                 i = int(np.argmax(~np.isfinite(v)))  # found by fuzzing (track): 1e306 kN in N
                 raise RecordingError(
                     f"value {float(values[i])} overflows double precision when converted to SI",
                     file=self.file,
                     column=col,
-                    row=row_of(i),
+                    **at_sample(i, self.row_of, offset),
                 )
             if canon == "t":
                 t = v
@@ -268,7 +271,7 @@ class _Finisher:
                     file=self.file,
                 )
         else:
-            self._check_time(t, row_of)
+            self._check_time(t, offset)
         if n:
             self.prev_t = float(t[-1])
         meta = dict(self.meta, offset=offset, ranges=ranges)

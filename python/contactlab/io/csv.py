@@ -114,10 +114,12 @@ def decimal_comma(
     from the first data line. Only possible when the delimiter is not a comma."""
     if delim == ",":
         return False
+    k = -1  # the data row's sample index
     with open(path, encoding=enc, errors="replace") as fh:
         for lineno, line in enumerate(fh):
             if lineno < first_data_line or not line.strip() or line.lstrip().startswith("#"):
                 continue
+            k += 1
             cells = line.rstrip("\r\n").split(delim) if delim else line.split()
             return any(_DECIMAL_COMMA.match(c) for c in cells)
     return False
@@ -149,10 +151,12 @@ def locate_bad_cell(
     enc: str = "utf-8-sig",
 ) -> RecordingError:
     """Scan the file to find the first cell that is not a number."""
+    k = -1  # the data row's sample index
     with open(path, encoding=enc, errors="replace") as fh:
         for lineno, line in enumerate(fh):
             if lineno < first_data_line or not line.strip() or line.lstrip().startswith("#"):
                 continue
+            k += 1
             cells = line.rstrip("\r\n").split(delim) if delim else line.split()
             for c in cols:
                 if c >= len(cells):
@@ -160,7 +164,8 @@ def locate_bad_cell(
                         f"line has {len(cells)} fields, column {names[c]!r} is field {c + 1}",
                         file=str(path),
                         column=names[c],
-                        row=lineno + 1,
+                        sample=k,
+                        line=lineno + 1,
                     )
                 cell = cells[c].strip().strip('"')
                 try:
@@ -172,7 +177,8 @@ def locate_bad_cell(
                         f"cell {cells[c].strip()!r} is not a number",
                         file=str(path),
                         column=names[c],
-                        row=lineno + 1,
+                        sample=k,
+                        line=lineno + 1,
                     )
     return RecordingError("cannot be parsed as numbers", file=str(path))
 

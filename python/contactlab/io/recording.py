@@ -8,6 +8,7 @@ analysis code never sees µm or MPa. Canonical channel names: tangential ``x`` (
 from __future__ import annotations
 
 import math
+import os
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -51,8 +52,11 @@ ALIASES: dict[str, tuple[str, ...]] = {
 class RecordingError(InputError):
     """A recording that cannot be read as asked; the message names file, column and row.
 
-    Attributes ``file``, ``column`` and ``row`` (1-based line of the file for text formats,
-    0-based sample index otherwise) are set when known.
+    Attributes ``file``, ``column``, ``sample`` (0-based sample index), ``line`` (1-based
+    line of a text file) and ``row`` (the line for text formats, the sample index otherwise)
+    are set when known. Every format words a sample alike: ``sample 1234`` (binary formats),
+    ``sample 1234 (line 1236 of run.csv)`` (text); ``row`` alone (a line not yet counted as a
+    sample) is worded ``line 1236``.
     """
 
     def __init__(
@@ -62,17 +66,24 @@ class RecordingError(InputError):
         file: str | None = None,
         column: str | None = None,
         row: int | None = None,
+        sample: int | None = None,
+        line: int | None = None,
     ) -> None:
         self.file = file
         self.column = column
-        self.row = row
+        self.sample = sample
+        self.line = line if line is not None else (row if sample is None else None)
+        self.row = self.line if self.line is not None else sample
         parts = []
         if file is not None:
             parts.append(str(file))
         if column is not None:
             parts.append(f"column {column!r}")
-        if row is not None:
-            parts.append(f"row {row}")
+        if sample is not None:
+            of = f" of {os.path.basename(file)}" if file else ""
+            parts.append(f"sample {sample}" + ("" if line is None else f" (line {line}{of})"))
+        elif self.line is not None:
+            parts.append(f"line {self.line}")
         prefix = ", ".join(parts)
         super().__init__(f"{prefix}: {message}" if prefix else message)
 
@@ -351,7 +362,14 @@ def unit_factor(
     return factor, SI_UNITS[udim]
 
 
+#: a sample's (0-based, whole record) line of a text file; None for binary formats
 RowOf = Callable[[int], int]
+
+
+def at_sample(i: int, row_of: RowOf | None, offset: int = 0) -> dict[str, int | None]:
+    """``sample=``/``line=`` of a :class:`RecordingError` for sample ``offset + i``."""
+    k = offset + int(i)
+    return {"sample": k, "line": None if row_of is None else row_of(k)}
 
 
 def real_values(values: Any, *, file: str, column: str) -> np.ndarray:
@@ -369,17 +387,20 @@ def real_values(values: Any, *, file: str, column: str) -> np.ndarray:
         raise RecordingError(f"values are not numeric ({exc})", file=file, column=column) from None
 
 
-def _plain(i: int) -> int:
-    return i
-
-
 def check_time(
-    t: np.ndarray, *, file: str, column: str, row_of: RowOf = _plain, step: float | None = None
+    t: np.ndarray,
+    *,
+    file: str,
+    column: str,
+    row_of: RowOf | None = None,
+    step: float | None = None,
+    offset: int = 0,
 ) -> None:
     """Time stamps finite, strictly increasing, without gaps (> 1.5 median step).
 
-    ``row_of`` converts a sample index into the row reported (e.g. a line of a text file);
-    ``step`` replaces the median step as the reference (a chunk judged by the first one's).
+    ``row_of`` gives a sample's line of a text file (None: a binary format), ``offset`` the
+    index of ``t[0]`` in the record; ``step`` replaces the median step as the reference (a
+    chunk judged by the first one's).
     """
     if t.size < 2:
         raise RecordingError(f"only {t.size} sample(s)", file=file, column=column)
@@ -392,7 +413,7 @@ def check_time(
             f"time stamp {float(t[i]):.9g} s is {what}; previous is {float(t[i - 1]):.9g} s",
             file=file,
             column=column,
-            row=row_of(i),
+            **at_sample(i, row_of, offset),
         )
     med = float(np.median(d)) if step is None else float(step)
     gaps = np.flatnonzero(d > 1.5 * med)
@@ -403,7 +424,7 @@ def check_time(
             f"({gaps.size} gap(s) in all)",
             file=file,
             column=column,
-            row=row_of(i),
+            **at_sample(i, row_of, offset),
         )
 
 
@@ -521,12 +542,17 @@ def time_from_fs(n: int, fs: float | None, *, file: str, t0: float = 0.0) -> np.
     return t
 
 
-def check_finite(a: np.ndarray, *, file: str, column: str, row_of: RowOf = _plain) -> None:
+def check_finite(
+    a: np.ndarray, *, file: str, column: str, row_of: RowOf | None = None, offset: int = 0
+) -> None:
     if np.isfinite(a).all():
         return
     i = int(np.argmax(~np.isfinite(a)))
     raise RecordingError(
-        f"value {float(a[i])} is not a finite number", file=file, column=column, row=row_of(i)
+        f"value {float(a[i])} is not a finite number",
+        file=file,
+        column=column,
+        **at_sample(i, row_of, offset),
     )
 
 
@@ -574,14 +600,14 @@ def finish(
     kind: str | None,
     file: str,
     fs: float | None,
-    row_of: RowOf = _plain,
+    row_of: RowOf | None = None,
     t_fallback: np.ndarray | None = None,
     meta: dict[str, Any] | None = None,
 ) -> Recording:
     """Convert raw columns to SI, build ``t`` and check everything; shared by all readers.
 
     ``raw`` maps canonical name to values in file units; ``names`` to the file's names;
-    ``row_of`` turns a sample index into the row an error names (identity: 0-based index).
+    ``row_of`` gives a sample's line of a text file, for the errors (None: a binary format).
     """
     assumed: list[str] = []
     data: dict[str, np.ndarray] = {}
@@ -599,7 +625,7 @@ def finish(
                 f"value {float(values[i])} overflows double precision when converted to SI ({si})",
                 file=file,
                 column=col,
-                row=row_of(i),
+                **at_sample(i, row_of),
             )
         if canon == "t":
             t = v
