@@ -310,6 +310,7 @@ def collect_warnings(
     identifiable: bool,
     evidence: dict[str, Any],
     regime: Regime,
+    weights: np.ndarray | None = None,
 ) -> list[str]:
     """Everything the user should know about the fit: regime, identifiability, convergence,
     and a misfit beyond the cycle-to-cycle noise."""
@@ -342,16 +343,42 @@ def collect_warnings(
     elif not raw.success:
         warns.append(f"the Masing fit did not converge ({raw.message})")
     if loop is not None and data.on == "averaged" and loop.n_cycles > 2:
-        # Is the misfit larger than the cycle-to-cycle noise explains?
-        v = loop.F_std**2 * (loop.count / loop.n_cycles)
-        # no bin with a spread: nothing to compare with (numpy would warn on the empty mean)
-        noise_var = float(np.nanmean(v)) if np.any(np.isfinite(v)) else math.nan
-        if noise_var > 0 and raw.redchi > 4.0 * noise_var:
+        ratio_noise = misfit_ratio(raw, data, weights)
+        if ratio_noise > 2.0:
             warns.append(
-                f"the residuals are {math.sqrt(raw.redchi / noise_var):.1f}× the cycle-to-cycle "
-                "noise: the exponential Masing model misses systematic features of this loop"
+                f"the residuals are {ratio_noise:.1f}× the cycle-to-cycle noise of force and "
+                "displacement: the exponential Masing model misses systematic features of this "
+                "loop (look at the loop plot; a lag between the channels, viscous damping or a "
+                "changing loop also do this)"
             )
     return warns
+
+
+def misfit_ratio(raw: FitResult, data: steps.FitData, weights: np.ndarray | None) -> float:
+    """RMS of an averaged fit's residuals over what the cycle-to-cycle noise explains (1 for
+    a model that fits to the noise; NaN when there is no spread to compare with).
+
+    A bin's mean force errs by its force noise and its mean displacement by the displacement
+    noise, which the model turns into a force error ``k σx`` (``k``: the branch's local
+    stiffness, ``h0·ac`` at the turns, :func:`steps.branch_slope`): the expected squared
+    residual of bin ``i`` is ``(σF,i² + k_i² σx,i²) / count_i`` (per-sample variances from
+    the cycle-to-cycle spread), weighted as the fit weights it. Force noise alone is not
+    enough: with a noisy displacement channel and a clean force the residuals were 2.0-3.0×
+    the force's spread, a warning about a model that fits."""
+    loop = data.loop
+    if loop is None or loop.n_cycles < 2:
+        return math.nan
+    vF, vx = steps.loop_noise(loop)
+    k = steps.branch_slope(raw.values, data.xpath)
+    expected = vF + k * k * np.nan_to_num(vx, nan=0.0)
+    ok = np.isfinite(expected)
+    if not ok.any():  # no bin with a spread (numpy would warn on an empty mean)
+        return math.nan
+    w2 = (weights[: loop.count.size] ** 2 if weights is not None else loop.count) / loop.count
+    noise = float(np.mean((w2 * expected)[ok]))
+    if not noise > 0:
+        return math.nan
+    return math.sqrt(raw.redchi / noise)
 
 
 def analyze_tangential(
@@ -754,7 +781,7 @@ def _analyze(
             x_raw=xa,
         )
     apply_regime(regime, amp, fit, identifiable, evidence, derived, max_rel_stderr)
-    warns = collect_warnings(pre_warns, raw, data, amp.value, identifiable, evidence, regime)
+    warns = collect_warnings(pre_warns, raw, data, amp.value, identifiable, evidence, regime, res.w)
     vals = raw.values
     regime_d = regime.to_dict()
     if streamed:

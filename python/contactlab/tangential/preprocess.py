@@ -285,6 +285,36 @@ def _phase_knots_loop(rev: Reversals) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(knots_t), np.asarray(knots_p)
 
 
+#: turns either side whose instants are averaged into a turn's phase knot
+SMOOTH_TURNS = 4
+
+
+def smooth_turn_times(times: np.ndarray, k: int = SMOOTH_TURNS) -> np.ndarray:
+    """Turn instants (peaks, or valleys) averaged over the ``k`` turns either side: a
+    straight line through the ``2k + 1`` turns around each (the centred mean inside, the
+    end lines' values at the ends), so a steady drive's turns keep their instants.
+
+    Each instant comes from the band crossings of two pairs of noisy samples, so the samples
+    there decide their own phase: a sample whose noise moved the crossing falls in another
+    bin, and the bins next to the crossings are biased in ``x`` (not in ``F``). With 1 %
+    displacement noise those bins' residuals grew to 5σ at 2000 cycles (the averaged fit's
+    residuals 2.0-2.2x its noise, a misfit warning on a model that fits). Averaging over
+    ``2k + 1`` turns dilutes each sample's share of its phase ``2k + 1`` fold (and the
+    jitter of the instants ``sqrt(2k + 1)`` fold). Fewer than ``2k + 1`` turns: unchanged."""
+    v = np.asarray(times, dtype=float)
+    n, w = v.size, 2 * k + 1
+    if n < w or k < 1:
+        return v
+    out = v.copy()
+    c = np.concatenate([[0.0], np.cumsum(v)])
+    out[k : n - k] = (c[w:] - c[: n - w + 1]) / w
+    j = np.arange(w, dtype=float)
+    for sl, idx in ((slice(0, w), np.arange(k)), (slice(n - w, n), np.arange(w - k, w))):
+        b, a = np.polyfit(j, v[sl], 1)
+        out[sl][idx] = a + b * j[idx]
+    return out
+
+
 def phase_of(t: np.ndarray, rev: Reversals) -> tuple[np.ndarray, int, int]:
     """Phase of each sample of the complete cycles; returns ``(phase, start, end)`` where
     samples ``start:end`` are covered (phase ``k + φ`` for cycle ``k``, φ in [0, 1))."""
@@ -379,7 +409,8 @@ def average_loop(
             f"±{rev.threshold:.3g} m around x = {rev.centre:.3g} m; "
             f"at least {min_cycles} are needed"
         )
-    kt, kp = _phase_knots(rev)
+    kt, kp = _phase_knots(replace(rev, peak_times=smooth_turn_times(rev.peak_times),
+                                  valley_times=smooth_turn_times(rev.valley_times)))  # fmt: skip
     start = int(np.searchsorted(ta, kt[0], side="left"))
     end = int(np.searchsorted(ta, kt[-1], side="left"))
     if n_points is None:
