@@ -5,7 +5,10 @@ From sampled dynamic pressure p(t) and normal contact displacement δ(t):
 1. estimate the excitation frequency (windowed FFT peak, refined by the phase drift of the
    fundamental between the two halves of the record), cut the record into whole cycles that
    start where the fundamental of p crosses its mean upwards, drop the start-up cycles and
-   average the rest on a common phase grid (cycle-to-cycle scatter reported);
+   average the rest on a common phase grid (cycle-to-cycle scatter reported); each channel
+   of the averaged cycle keeps the harmonics that stand above the noise the cycle-to-cycle
+   scatter gives them (the extremes of a noisy curve overshoot: 1 % noise on δ made ψ of
+   5-cycle windows 4 % low);
 2. split loading (dp/dt > 0) from unloading with a Savitzky-Golay derivative of the averaged
    cycle and fit each branch with a polynomial p(δ) (degree 4 by default, eq. 1); the centre
    curve is their mean (Table 2 satisfies this to the printed digits);
@@ -89,6 +92,8 @@ class LoopResult:
     samples_per_cycle: float
     cycle_scatter: float
     cycle_scatter_rel: float
+    #: scatter of the cycles' contributions to E_d (√n times its jackknife standard error
+    #: over the cycles), so that ``E_d_cycle_std / sqrt(n_cycles)`` is E_d's standard error
     E_d_cycle_std: float
     degree: int
     resampled: bool
@@ -258,6 +263,88 @@ def _loop_energy(p: np.ndarray, d: np.ndarray) -> np.ndarray:
     k = np.arange(1, kmax + 1)
     prod = np.conj(P[..., 1 : kmax + 1]) * D[..., 1 : kmax + 1]
     return -4 * np.pi * np.sum(k * prod.imag, axis=-1)
+
+
+#: a harmonic of the averaged cycle is signal when its power exceeds this many times the
+#: variance the cycle-to-cycle scatter gives it (complex Gaussian noise exceeds it with
+#: probability e^-3 = 5 %). A harmonic of the loop left out shifts the extremes by its
+#: amplitude, one of noise kept only by the square of its slope: on 5-cycle windows with
+#: 1 % noise the range of δ came out 0.09 % short at 6, within 0.03 % at 3, 0.9 % long at 1
+_SIGNIFICANT = 3.0
+#: the harmonics kept end after this many insignificant ones in a row (odd-only spectra of
+#: symmetric loops skip one)
+_GAP = 3
+
+
+def _noise_power(X: np.ndarray) -> np.ndarray:
+    """Variance of each harmonic of the averaged cycle (row mean of the spectra ``X``, one
+    row a cycle, column k the k-th harmonic), from the cycle-to-cycle scatter pooled over
+    neighbouring harmonics (``|j - k| <= max(2, k/4)``: noise spectra are smooth, and a few
+    cycles hold few degrees of freedom per harmonic). One cycle: the median power of the
+    upper half of the spectrum, taken as white."""
+    n, m = X.shape
+    if n < 2:
+        upper = np.abs(X[0, max(1, m // 2) :]) ** 2
+        floor = float(np.median(upper)) / np.log(2) if upper.size else 0.0
+        return np.full(m, floor)
+    v = np.sum(np.abs(X - X.mean(axis=0)) ** 2, axis=0) / (n * (n - 1))
+    v[0] = 0.0
+    c = np.concatenate(([0.0], np.cumsum(v[1:])))  # c[j] = v[1] + ... + v[j]
+    k = np.arange(m)
+    w = np.maximum(2, k // 4)
+    lo = np.clip(k - w, 1, m - 1)
+    hi = np.clip(k + w, 1, m - 1)
+    return (c[hi] - c[lo - 1]) / (hi - lo + 1)
+
+
+def _harmonics_kept(X: np.ndarray, bins: int) -> int:
+    """Highest harmonic of the averaged cycle that a channel (spectra ``X`` of its cycles)
+    holds above its noise: harmonics 1..K are kept, from the first on until ``_GAP`` in a
+    row are noise. Each channel has its own: a noiseless one keeps all it holds."""
+    kmax = (bins - 1) // 2  # no Nyquist term (no defined derivative)
+    power = np.abs(X.mean(axis=0)) ** 2
+    v = _noise_power(X)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(v > 0, power / np.where(v > 0, v, 1.0), np.where(power > 0, np.inf, 0))
+    last, gap = 1, 0
+    for k in range(1, kmax + 1):
+        if ratio[k] > _SIGNIFICANT:
+            last, gap = k, 0
+        else:
+            gap += 1
+            if gap >= _GAP:
+                break
+    return last
+
+
+def _band_limited(X: np.ndarray, K: int, bins: int) -> np.ndarray:
+    """The averaged cycle from the mean spectrum ``X`` (rfft / bins) with harmonics 0..K."""
+    Y = np.zeros(bins // 2 + 1, dtype=complex)
+    Y[: K + 1] = X[: K + 1]
+    return np.fft.irfft(Y * bins, n=bins)
+
+
+def _energy_spectral(Pk: np.ndarray, Dk: np.ndarray, K: int) -> np.ndarray:
+    """∮ p dδ from the spectra (rfft / bins, last axis) over the harmonics 1..K."""
+    k = np.arange(1, K + 1)
+    prod = np.conj(Pk[..., 1 : K + 1]) * Dk[..., 1 : K + 1]
+    return -4 * np.pi * np.sum(k * prod.imag, axis=-1)
+
+
+def _energy_jackknife_std(Ps: np.ndarray, Ds: np.ndarray, K: int) -> float:
+    """Scatter of the cycles' contributions to E_d of the averaged cycle: √n times the
+    jackknife standard error of E_d (the averaged cycles' loop energy is bilinear in p and
+    δ, so the product of the two channels' noise falls as 1/n², not 1/n as in the energies
+    of single cycles)."""
+    n = Ps.shape[0]
+    if n < 2:
+        return 0.0
+    Pm, Dm = Ps.mean(axis=0), Ds.mean(axis=0)
+    P_out = (n * Pm - Ps) / (n - 1)  # the mean spectra without cycle i (row i)
+    D_out = (n * Dm - Ds) / (n - 1)
+    e = _energy_spectral(P_out, D_out, K)
+    var = (n - 1) / n * float(np.sum((e - e.mean()) ** 2))
+    return float(np.sqrt(n * var))
 
 
 def _poly_shift(c: np.ndarray, s: float) -> np.ndarray:
@@ -625,19 +712,29 @@ def analyze_loop(
     dm = D.mean(axis=0)
     p_mean = float(pm.mean())
     pdyn = pm - p_mean
+    # step 4b: the harmonics of the averaged cycle above its noise (from the cycle-to-cycle
+    # scatter). The loop's extremes, curves and area are taken from them: the largest of
+    # the noisy samples near a turning point overshoots it (by ~1 % of the range of δ at
+    # 1 % noise on 4 cycles of 1000 samples, which made ψ 4 % low), and the noise of the
+    # two channels at the harmonics the loop does not hold only scatters E_d.
+    Ps = np.fft.rfft(P, axis=1) / bins
+    Ds = np.fft.rfft(D, axis=1) / bins
+    kp, kd = _harmonics_kept(Ps, bins), _harmonics_kept(Ds, bins)
+    ps = _band_limited(Ps.mean(axis=0), kp, bins) - p_mean
+    ds = _band_limited(Ds.mean(axis=0), kd, bins)
     if pa is not None and not (np.isfinite(pa) and pa > 0):
         raise InputError(f"pa must be a finite pressure > 0, got {pa!r}")
-    p0_val, pa_meas = _pressure_levels(pdyn, p_mean, p0, pa)
+    p0_val, pa_meas = _pressure_levels(ps, p_mean, p0, pa)
     if n_used > 1:
         dstd = D.std(axis=0, ddof=1)
-        e_std = float(np.std(_loop_energy(P - P.mean(axis=1, keepdims=True), D), ddof=1))
+        e_std = _energy_jackknife_std(Ps, Ds, min(kp, kd))
     else:
         dstd = np.zeros(bins)
         e_std = 0.0
-    br = _branches(pdyn, dm, degree, zero_delta)
+    br = _branches(ps, ds, degree, zero_delta)
     dz = dm - br.shift
-    en = _energies(pdyn, dz, br)
-    k_tan, k_sec, k_s = _stiffness(br, dz, en, pa_meas, zero_delta)
+    en = _energies(ps, ds - br.shift, br)
+    k_tan, k_sec, k_s = _stiffness(br, ds - br.shift, en, pa_meas, zero_delta)
     w = cyc.omega
     scatter = float(np.sqrt(np.mean(dstd**2)))
     return LoopResult(
