@@ -172,6 +172,9 @@ def analyze_entry(
             rec.meta["units_assumed_si"] = assumed_frame
     else:
         rec = read_recording(entry.path, columns=entry.columns, kind=entry.kind, fs=entry.fs)
+    from ..diagnose._inputs import check_recording_glitches
+
+    check_recording_glitches(rec)  # a sensor glitch is refused, as diagnose refuses it
     base = {"file": entry.path.name, "kind": entry.kind, **entry.tags}
     # provenance: what was read (a units-assumed-SI note matters when a file has no units)
     base["format"] = entry.path.suffix.lower().lstrip(".")
