@@ -691,6 +691,21 @@ def _unsearched_sticks(rev: Any, n_samples: int) -> dict[str, Any]:
     return {"stick_slip": {"n_reversals": n_turns, **dict.fromkeys(unknown, math.nan)}}
 
 
+def _transient_warning(loop: AveragedLoop, amplitude: float, stderr: float) -> list[str]:
+    """A start-up or run-out transient averaged in (:mod:`.startup`), when the shift it makes
+    in the mean cycle amplitude is at least half the amplitude's standard error."""
+    from .startup import transient_cycles
+
+    sc = loop.scatter
+    tr = transient_cycles(sc.amplitude, sc.time, sc.period, sc.energy)
+    if tr is None:
+        return []
+    err = stderr if stderr is not None and math.isfinite(stderr) else 0.0
+    if abs(tr.shift * amplitude) < 0.5 * err:
+        return []
+    return [tr.message()]
+
+
 def _analyze(
     xa: np.ndarray,
     Fa: np.ndarray,
@@ -782,6 +797,8 @@ def _analyze(
         )
     apply_regime(regime, amp, fit, identifiable, evidence, derived, max_rel_stderr)
     warns = collect_warnings(pre_warns, raw, data, amp.value, identifiable, evidence, regime, res.w)
+    if steady and det.loop is not None:
+        warns += _transient_warning(det.loop, amp.value, amp.stderr)
     vals = raw.values
     regime_d = regime.to_dict()
     if streamed:
