@@ -232,6 +232,10 @@ def _handler(args: argparse.Namespace) -> int:
         e.columns, e.fs, e.frame = columns, args.fs, frame
         entries.append(e)
     topts = {"force_sign": args.force_sign}
+    if args.delay is not None:
+        if args.model != "tangential":
+            raise InputError("--delay is for tangential recordings (force against displacement)")
+        topts["delay"] = args.delay
     nopts = {"p0": args.p0, "pa": args.pa}
     if args.stream:
         return _streamed(args, entries, columns, topts, nopts)
@@ -258,6 +262,14 @@ def _handler(args: argparse.Namespace) -> int:
     with process_pool(workers, auto=args.workers is None) as ex:
         return _in_memory(args, entries, frame, topts, nopts, ex)
 
+
+#: ``--delay``'s help (analyze; track and diagnose say it shorter)
+DELAY_HELP = (
+    "tangential: a known delay of the force channel behind the displacement (e.g. 1.1ms; "
+    "negative: the force leads), corrected before the analysis by shifting the force (the "
+    "samples left without force data are dropped). Any delay left is estimated "
+    "(channel_delay in the JSON) and named in a warning when it matters"
+)
 
 #: files from which ``analyze`` (not streamed) uses a process per core by default
 _POOL_FROM = 4
@@ -434,6 +446,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="tangential: analyse F (+1) or -F (-1); auto (default): the sign that makes the "
         "loop area ∮F dx positive (a passive joint dissipates)",
     )
+    p.add_argument("--delay", type=quantity("s"), default=None, help=DELAY_HELP)
     add_pressure_flags(p)
     add_frame_flags(p)
     p.add_argument("--keep-going", action="store_true",

@@ -98,6 +98,13 @@ def add_parser(subparsers: Any) -> None:
         help="the force channel's noise RMS in N when known (a smoothed channel's differences "
         "understate it); with --frame: the reconstruction's (default)",
     )
+    p.add_argument(
+        "--delay",
+        type=quantity("s"),
+        default=None,
+        help="tangential: a known delay of the force behind the displacement (e.g. 1.1ms), "
+        "corrected before the diagnosis (the force read that much later)",
+    )
     p.add_argument("--columns", help="column mapping, e.g. 'x=disp,F=force' (default: by name)")
     p.set_defaults(handler=run)
 
@@ -236,6 +243,14 @@ def run(args: argparse.Namespace) -> int:
     else:
         _check_long(args.file, columns, args.model, args.fs)
         rec = read_recording(args.file, kind=args.model, columns=columns, fs=args.fs)
+    if getattr(args, "delay", None) is not None:
+        if args.model != "tangential":
+            raise InputError("--delay is for tangential recordings (force against displacement)")
+        from ..tangential.lag import shifted_recording
+
+        rec, dropped = shifted_recording(rec, args.delay)
+        print(f"{args.file}: force read {1e3 * args.delay:.4g} ms later (--delay); {dropped} "
+              "samples left without force data dropped")  # fmt: skip
     if args.model == "normal":
         from ..commands._common import with_static_pressure
 

@@ -53,6 +53,10 @@ def _handler(args: argparse.Namespace) -> int:
     say = sys.stderr if args.json == "-" else sys.stdout
     frame = frame_option(args)  # before the file is read: it has no force column
     options = _options(args)
+    if args.delay is not None:
+        if options is not None:  # a normal recording's options
+            raise InputError(f"{args.file}: --delay is for tangential recordings")
+        options = {"delay": args.delay}
     threads = None
     if args.workers is None:
         threads = window_threads() if args.threads is None else args.threads
@@ -206,6 +210,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         default=1 << 18,
         metavar="N",
         help="samples read at a time (default 262144, as contactlab.track)",
+    )
+    p.add_argument(
+        "--delay",
+        type=quantity("s"),
+        default=None,
+        help="tangential: a known delay of the force behind the displacement (e.g. 1.1ms), "
+        "corrected in every window before its analysis (as analyze --delay)",
     )
     add_frame_flags(p)
     add_pressure_flags(p)

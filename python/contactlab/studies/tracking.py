@@ -360,7 +360,7 @@ def _as_float(v: Any) -> float:
 #: ``history``) take the whole-window analysis
 _WINDOW_OPTIONS = frozenset(
     ("force_sign", "n_points", "rel_threshold", "min_cycles", "max_rel_stderr", "fit_offset",
-     "fit_x0", "fit_amplitude", "detrend", "initial")
+     "fit_x0", "fit_amplitude", "detrend", "initial", "delay")
 )  # fmt: skip
 
 

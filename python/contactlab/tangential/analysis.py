@@ -56,7 +56,7 @@ from ..errors import ContactLabWarning, InputError
 from ..fitting import FitResult
 from ..io import Recording
 from ..masing import loop_area
-from . import steps
+from . import lag, steps
 from .orientation import Orientation, orient
 from .preprocess import AveragedLoop, average_loop, find_reversals, negated_loop
 from .regime import GROSS_SLIDING_Z as REGIME_GROSS_Z
@@ -401,6 +401,7 @@ def analyze_tangential(
     force_sign: int | str = "auto",
     initial: dict[str, float] | None = None,
     warn: bool = True,
+    delay: float | None = None,
 ) -> TangentialAnalysis:
     """Fit the Masing model to a tangential recording and derive the paper's quantities.
 
@@ -450,6 +451,13 @@ def analyze_tangential(
     warn : bool
         Issue :class:`ContactLabWarning` for each warning (they are kept in ``.warnings``
         either way).
+    delay : float, optional
+        A known delay of the force channel behind the displacement (s; negative: the force
+        leads), corrected before the analysis: the force is read ``delay`` later
+        (:func:`contactlab.tangential.lag.shift_force`; the samples left without force data
+        are dropped). Reported as ``delay`` and ``delay_dropped_samples``. Whatever it is,
+        the averaged fit estimates the delay that remains (``channel_delay`` ±
+        ``channel_delay_stderr``, s) and warns when it matters (:mod:`.lag`).
 
     Returns
     -------
@@ -469,6 +477,9 @@ def analyze_tangential(
     check_channel("F", Fa, "N", "force")
     if invert_force is not None:
         force_sign = -1 if invert_force else 1
+    dropped = 0
+    if delay is not None:
+        ta, xa, Fa, dropped = lag.shift_force(ta, xa, Fa, delay)
     ori = orient(xa, Fa, ta, force_sign=force_sign)
     res = _analyze(
         xa,
@@ -489,8 +500,10 @@ def analyze_tangential(
         detrend=detrend,
         initial=initial,
         streamed=False,
+        delay=delay,
     )
     assert res is not None  # only a streamed window hands its case back
+    lag.record(res, delay, dropped)
     if warn:
         for wtxt in res.warnings:
             warnings.warn(wtxt, ContactLabWarning, stacklevel=2)
@@ -566,6 +579,7 @@ def analyze_window(
     fit_amplitude: bool = True,
     detrend: bool = True,
     initial: dict[str, float] | None = None,
+    delay: float | None = None,
 ) -> TangentialAnalysis:
     """:func:`analyze_tangential` of one window of a streamed recording (``on="averaged"``,
     steady history), with the per-sample work in one pass of Rust kernels.
@@ -588,6 +602,9 @@ def analyze_window(
     _check_options("averaged", "steady", n_points)
     finite_x = check_channel("x", xa, "m", "displacement")
     finite_f = check_channel("F", Fa, "N", "force")
+    dropped = 0
+    if delay is not None:  # ``delay`` as in analyze_tangential
+        ta, xa, Fa, dropped = lag.shift_force(ta, xa, Fa, delay)
     opts: dict[str, Any] = {
         "n_points": n_points,
         "rel_threshold": rel_threshold,
@@ -608,9 +625,11 @@ def analyze_window(
         if ori.sign < 0:
             pre = _negated(pre)
         res = _analyze(xa, Fa, ta, source, ori, pre, on="averaged", history="steady",
-                       streamed=True, **opts)  # fmt: skip
+                       streamed=True, delay=delay, **opts)  # fmt: skip
     if res is None:  # the sign undecided by the area, or gross sliding: the full analysis
-        return analyze_tangential(recording, force_sign=force_sign, warn=False, **opts)
+        return analyze_tangential(recording, force_sign=force_sign, warn=False, delay=delay,
+                                  **opts)  # fmt: skip
+    lag.record(res, delay, dropped)
     return res
 
 
@@ -726,6 +745,7 @@ def _analyze(
     detrend: bool,
     initial: dict[str, float] | None,
     streamed: bool,
+    delay: float | None = None,
 ) -> TangentialAnalysis | None:
     """The analysis after the orientation; ``pre``: :func:`steps.detrend` of the oriented
     ``xa, Fa`` with these options, done already. ``streamed``: a window of
@@ -799,6 +819,9 @@ def _analyze(
     warns = collect_warnings(pre_warns, raw, data, amp.value, identifiable, evidence, regime, res.w)
     if steady and det.loop is not None:
         warns += _transient_warning(det.loop, amp.value, amp.stderr)
+    if on == "averaged":  # the delay between the channels the loop shows (:mod:`.lag`)
+        warns += lag.annotate(derived, fit, raw, res, data, sliding=regime.sliding,
+                              misfit=misfit_ratio(raw, data, res.w), applied=delay)  # fmt: skip
     vals = raw.values
     regime_d = regime.to_dict()
     if streamed:
