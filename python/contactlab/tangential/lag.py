@@ -30,6 +30,14 @@ loop (pre-sliding and transition, residuals within twice the noise): on a platea
 sliding, stick-slip) ``h0`` comes from the plateau, which a delay does not move, and a loop
 the model misses would read its misfit as a delay. The estimate itself (``channel_delay``,
 ``channel_delay_stderr``, s) is reported everywhere the averaged fit runs.
+
+Measured on fresh seeds (1 Hz, 1 kHz, 100 cycles, 1 % noise on both channels, 8 seeds each):
+true 1.1 ms reads 1.07 ± 0.13 ms (pre-sliding, ac·A 0.8) and 1.08 ± 0.08 ms (transition, 2);
+no delay 0.00 ± 0.11 and -0.03 ± 0.08 ms (0 warnings); viscous damping (2 % of the force)
+-2.2 ms in pre-sliding (named as a lead), +0.5 ± 0.25 ms (not significant) in transition.
+NOT reliable, hence never warned about: gross sliding (ac·A 10: 1.1 ms reads 0.18 ± 0.04 ms),
+and a noise-free displacement channel (1.1 ms reads 0.06 ms); with a noise-free force the
+stated error is 3-5x too small (x-only noise: 1.07 ± 0.05 ms against a stated 0.013).
 """
 
 from __future__ import annotations
