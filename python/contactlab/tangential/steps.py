@@ -449,9 +449,8 @@ class Residuals:
     def solver(self) -> Callable[..., tuple[np.ndarray, int, int]] | None:
         """The compiled Levenberg–Marquardt solver of this averaged fit
         (:func:`contactlab._core.fit_steady_loop`: the residuals and derivatives of
-        :meth:`jacobian` in closed form, the whole solve with the interpreter lock released;
-        it clips bins beyond a turn, and the polish after it moves to their continuation,
-        :func:`_beyond_turns`),
+        :meth:`jacobian` in closed form with the bins beyond a turn continued as
+        :func:`_beyond_turns` does, the whole solve with the interpreter lock released),
         as :func:`~contactlab.fitting.least_squares_fit`'s ``solver``; None where the fit is
         not an averaged one over all bins (the SciPy solver then runs)."""
         d = self.data
@@ -518,8 +517,9 @@ def _beyond_turns(
     noise, ∝ 1/(number of cycles) (1 % noise on x: -0.17 % at 3 cycles, z -0.4). On the
     branch's tangent at the turn (force and slope continuous, the curvature term's too) the
     force error stays linear in the noise at every bin, and its mean vanishes. The compiled
-    solver clips; its Gauss-Newton polish (:func:`~contactlab.fitting.least_squares_fit`)
-    ends on these residuals.
+    solver (``rust/core/src/loop_fit.rs``) continues the bins the same way; a first version
+    that left it clipping and let the polish move the fit took 10 → 21 ms a 10⁶-sample
+    window.
 
     With ``s = (A ∓ (x - x0)) / 2`` (descending, ascending bins) and ``s_c`` its clipped
     value (0 or ``A``), the loop's force ``±(h(A) - 2 h(s) + ¼ k0 ac e^{-ac s} var)`` goes on

@@ -8,8 +8,11 @@
 //! `h(y) = (k0/ac)(1 - e^{-ac y})`, `u = clip(x - x0, ±A)` and `s` half the distance from the
 //! branch's turn (`(A - u)/2` on the descending first half of the bins, `(u + A)/2` on the
 //! ascending second half), `F = ±(h(A) - 2 h(s)) + offset` plus the bins' curvature term
-//! `±¼ k0 ac e^{-ac s} var(x)` — the same formulas as `steps.Residuals.jacobian` in Python,
-//! which the tests check against the Masing operator.
+//! `±¼ k0 ac e^{-ac s} var(x)`; a bin beyond a turn (`x - x0` outside `±A`) continues the
+//! branch's tangent at that turn, `∓ k0 e^{-ac s} (2 + ¼ ac² var) (s_raw - s)` (a bin mean's
+//! noise puts the bins next to a turn beyond it; clipped, they biased the fitted amplitude
+//! low) — the same formulas as `steps.Residuals.jacobian` and `steps._beyond_turns` in
+//! Python, which the tests check against the Masing operator.
 //!
 //! [`fit_steady_loop`] minimises `Σ r²` in the caller's scaled variables (`z = value /
 //! scale`, residuals divided by `rscale`), the bounds held by projection, and reports how it
@@ -130,8 +133,22 @@ impl<'a> SteadyLoop<'a> {
             let e = (-ac * s).exp();
             let h_s = -k0 / ac * (-ac * s).exp_m1();
             let mut force = sg * (h_a - 2.0 * h_s);
-            let g = self.bin_var.map_or(0.0, |v| sg * 0.25 * k0 * ac * e * v[i]);
+            let var = self.bin_var.map_or(0.0, |v| v[i]);
+            let g = if self.bin_var.is_some() {
+                sg * 0.25 * k0 * ac * e * var
+            } else {
+                0.0
+            };
             force += g + offset;
+            // beyond a turn: the branch's tangent there (force, slope and curvature term
+            // continuous; `steps._beyond_turns`): `∓ k0 e^{-ac s} (2 + ¼ ac² var) (s_raw - s)`
+            let dd = 0.5 * (a - sg * raw) - s;
+            let q = 2.0 + 0.25 * ac * ac * var;
+            let beyond = if inside { 0.0 } else { -sg * k0 * e * q * dd };
+            let beyond_ok = dd != 0.0 && beyond.is_finite();
+            if beyond_ok {
+                force += beyond;
+            }
             let w = self.w[i];
             r[i] = (force - self.f[i]) * w;
             if let Some(jm) = jac.as_deref_mut() {
@@ -146,6 +163,22 @@ impl<'a> SteadyLoop<'a> {
                     d_ac += g * (1.0 / ac - s);
                     d_a -= ac * g * ds_da;
                     d_x0 -= ac * g * ds_dx0;
+                }
+                if beyond_ok {
+                    // s is 0 (the branch's own turn) or A (the next turn) here
+                    let far = if s > 0.0 { 1.0 } else { 0.0 };
+                    let parts = [
+                        beyond / k0,
+                        -sg * k0 * dd * e * (0.5 * ac * var - s * q),
+                        -0.5 * k0 * q * e,
+                        -sg * k0 * q * e * ((0.5 - far) - ac * dd * far),
+                    ];
+                    if parts.iter().all(|v| v.is_finite()) {
+                        d_k0 += parts[0];
+                        d_ac += parts[1];
+                        d_x0 += parts[2];
+                        d_a += parts[3];
+                    }
                 }
                 jm[i] = d_k0 * w;
                 jm[rows + i] = d_ac * w;
@@ -498,7 +531,7 @@ mod tests {
                 for i in 0..rows {
                     let fd = (ru[i] - rd[i]) / (2.0 * h);
                     if (fd - jac[k * rows + i]).abs() > 1e-5 * big {
-                        kinks += 1; // a bin at a turn switches clipping inside the step
+                        kinks += 1; // a bin at a turn switches branch inside the step
                     }
                 }
                 prop_assert!(kinks <= 2, "parameter {k}: {kinks} rows differ");
@@ -531,6 +564,36 @@ mod tests {
             for k in [0, 1, 4] {
                 prop_assert!((fit.values[k] / truth[k] - 1.0).abs() < 1e-6, "{k}: {fit:?}");
             }
+        }
+    }
+
+    /// Past a turn the force goes on along the branch's tangent: continuous in value and
+    /// slope across `x0 ± A`, linear beyond (no clipping to the turn's force).
+    #[test]
+    fn bins_beyond_a_turn_continue_the_tangent() {
+        let (k0, ac, a) = (2e6, 5e4, 15e-6);
+        let p = [k0, ac, 0.0, 0.0, a];
+        for bv in [None, Some(3e-14)] {
+            // descending half (first bin of the 2-bin loop) around its own turn at x = +A
+            let force = |x: f64| {
+                let v = bv.map(|b| vec![b; 2]);
+                model(&[x, -x], &p, v.as_deref())[0]
+            };
+            let h = 1e-10;
+            let (below, at, above) = (force(a - h), force(a), force(a + h));
+            let (far1, far2) = (force(a + 1e-7), force(a + 2e-7));
+            let slope_in = (at - below) / h;
+            let slope_out = (above - at) / h;
+            assert!(
+                (slope_in / slope_out - 1.0).abs() < 1e-3,
+                "{slope_in} {slope_out}"
+            );
+            // linear beyond: equal steps
+            assert!(((far2 - far1) / (far1 - at) - 1.0).abs() < 1e-9);
+            assert!(
+                far2 > far1 && far1 > at,
+                "the force keeps rising past the turn"
+            );
         }
     }
 
