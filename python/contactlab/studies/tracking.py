@@ -500,6 +500,10 @@ def _normal_window(
     import warnings
 
     rec = _window_recording(rec)
+    if int((rec.meta or {}).get("offset", 0)) > 0 and "discard_cycles" not in options:
+        # a window after the first starts mid-record, at an upward crossing: no start-up
+        # cycle to drop (dropping one left 3 of a 5-cycle window's 4 whole cycles)
+        options = {**dict(options), "discard_cycles": 0}
 
     from ..normal import analyze_loop
 
