@@ -458,8 +458,11 @@ def displacement_noise_share(raw: Any, data: Any) -> float:
     vF, vx = steps.loop_noise(loop)
     k = steps.branch_slope(raw.values, data.xpath)
     with np.errstate(over="ignore", invalid="ignore"):
-        ex = float(np.nanmean(k * k * vx))
-        eF = float(np.nanmean(vF))
+        a, b = k * k * vx, np.asarray(vF, dtype=float)
+    a, b = a[np.isfinite(a)], b[np.isfinite(b)]
+    if not (a.size and b.size):
+        return math.nan
+    ex, eF = float(np.mean(a)), float(np.mean(b))
     tot = ex + eF
     return ex / tot if math.isfinite(tot) and tot > 0 else math.nan
 
