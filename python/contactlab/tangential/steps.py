@@ -673,12 +673,25 @@ def fit(
     raw = least_squares_fit(res, params, jac=jac(res), solver=solver(res))
     x_noise = math.nan
     d = res.data
+    with_prior = start.prior is not None and (fit_amplitude or fit_x0)
+    s_f = math.sqrt(raw.redchi) if raw.redchi > 0 else 1.0
     if d.on == "averaged":
         w_eiv = averaged_eiv_weights(res, raw)
         if w_eiv is not None:
             res = replace(res, w=w_eiv)
-            raw = least_squares_fit(res, _restart(params, raw), jac=jac(res), solver=solver(res))
-            _keep_init(raw, params)
+            if with_prior:
+                # one fit with the new weights and the prior rows (not one after the other:
+                # a fit less a window, 2.5 ms of 45 on 1e6 samples); the rows' scale from
+                # the reweighted residuals at the first solution
+                r = res({k: p.value for k, p in raw.params.items()})
+                nfree = r.size - raw.nvarys
+                chi = float(r @ r) / nfree if nfree > 0 else math.nan
+                s_f = math.sqrt(chi) if math.isfinite(chi) and chi > 0 else 1.0
+            else:
+                raw = least_squares_fit(
+                    res, _restart(params, raw), jac=jac(res), solver=solver(res)
+                )
+                _keep_init(raw, params)
     elif d.on == "signal":
         s2x = x_noise_var(d.x, d.loop)
         x_noise = math.sqrt(s2x)
@@ -686,9 +699,10 @@ def fit(
             res = replace(res, w=eiv_weights(res, raw, s2x))
             raw = least_squares_fit(res, _restart(params, raw))
             _keep_init(raw, params)
-    if start.prior is not None and (fit_amplitude or fit_x0):
+            s_f = math.sqrt(raw.redchi) if raw.redchi > 0 else 1.0
+    if with_prior:
+        assert start.prior is not None
         names = tuple(n for n, on in (("x0", fit_x0), ("amplitude", fit_amplitude)) if on)
-        s_f = math.sqrt(raw.redchi) if raw.redchi > 0 else 1.0
         x0_d, a_d, sig = start.prior
         res = replace(res, prior=PriorRows(names, x0_d, a_d, sig, s_f))
         raw = least_squares_fit(res, _restart(params, raw), jac=jac(res), solver=solver(res))
