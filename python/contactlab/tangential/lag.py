@@ -51,11 +51,6 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from . import result as _result
-
-# the JSON units of the keys this module adds to a result (``derived``)
-_result.UNITS.setdefault("delay", "s")
-_result.UNITS.setdefault("channel_delay", "s")
 
 #: ``|τ| / σ_τ`` above which an estimated delay can be named in a warning
 SIGNIFICANCE = 4.0

@@ -23,6 +23,8 @@ UNITS = {
     "offset": "N",
     "x0": "m",
     "amplitude": "m",
+    "delay": "s",  # a known channel delay corrected (contactlab.tangential.lag)
+    "channel_delay": "s",  # the delay estimated from the loop
     "energy_per_cycle": "J",
     "energy_per_cycle_numeric": "J",
     "equivalent_damping": "N/m",
