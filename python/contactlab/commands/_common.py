@@ -614,7 +614,10 @@ def infer_model(
         )
     chans = ("x", "F") if kind == "tangential" else ("p", "delta")
     named = ", ".join(f"{c}={cr.columns[c]!r}" for c in chans if c in cr.columns)
-    return kind, f"{file}: model {kind}, inferred from the columns {named} (--model sets it)"
+    import textwrap
+
+    text = f"{file}: model {kind}, inferred from the columns {named} (--model sets it)"
+    return kind, textwrap.fill(text, width=100, subsequent_indent="   ", break_long_words=False)
 
 
 def wrap_warning(text: str, *, prefix: str = "  warning: ", width: int = 100) -> str:
@@ -636,3 +639,21 @@ def force_sign(text: str) -> str:
     show ``{auto,+1,-1}`` without a duplicate)."""
     t = text.strip()
     return "+1" if t in ("1", "+1") else t
+
+
+class DefaultsShown(argparse.HelpFormatter):
+    """``--help`` that states each option's default (``(default: 500.0)``) unless its help
+    already says it or there is none (None, False)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        text = action.help or ""
+        d = action.default
+        if (
+            "default" in text
+            or d is None
+            or d is False
+            or d is argparse.SUPPRESS
+            or not action.option_strings
+        ):
+            return text
+        return f"{text} (default: %(default)s)"

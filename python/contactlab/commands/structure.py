@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ._common import check_output_targets, describe, json_text, made_by, write_json
+from ._common import check_output_targets, describe, json_text, made_by, quantity, write_json
 
 _UNIT = re.compile(r"(?:\[([^\]]+)\]|_([A-Za-z]+))\s*$")
 
@@ -214,7 +214,9 @@ def simulate_structure(args: argparse.Namespace) -> int:
     try:
         model: IdentifiedModel | None = IdentifiedModel.load(doc_path)
     except InputError:
-        model = None
+        if not doc_path.is_file():
+            raise  # missing, or a folder: said before the input is read
+        model = None  # perhaps a Structure.save file (read below)
     cols = read_table(args.input)
     exc = model.excitation if model else ("base" if args.base else "force")
     ucol = _pick(cols, args.u, ("u", "f") if exc == "force" else ("y_base", "base", "y"), "u",
@@ -304,11 +306,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    choices=("masing", "jenkins", "iwan", "bouc_wen", "kelvin_voigt", "normal",
                             "linear"))  # fmt: skip
     p.add_argument("--excitation", default="force", choices=("force", "base"))
-    p.add_argument("--u", help="input column (force, or base displacement)")
-    p.add_argument("--y", help="response column (displacement of the mass); several "
+    p.add_argument("--u", metavar="COLUMN", help="input column (force, or base displacement)")
+    p.add_argument("--y", metavar="COLUMN",
+                   help="response column (displacement of the mass); several "
                    "comma-separated columns (one per DOF, in DOF order) identify a chain of "
                    "masses")  # fmt: skip
-    p.add_argument("--fs", type=float, help="sampling rate (Hz) when there is no time column")
+    p.add_argument("--fs", type=quantity("Hz", positive=True), metavar="RATE",
+                   help="sampling rate when there is no time column, e.g. 1kHz")  # fmt: skip
     p.add_argument("--mass", help="known mass (kg), held fixed; needed for base; one per DOF "
                    "(comma-separated) with several --y channels")  # fmt: skip
     p.add_argument("--joint-dofs", default="0,ground",
@@ -328,6 +332,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--periodic", action="store_true",
                    help="the record holds whole periods of a periodic input (band-limited "
                    "interpolation between samples)")  # fmt: skip
-    p.add_argument("--json", help="write the model (and summary) as JSON ('-': stdout)")
-    p.add_argument("--report", help="write report.html and figures/ into this folder")
+    p.add_argument("--json", metavar="OUT",
+                   help="write the model (and summary) as JSON ('-': stdout)")  # fmt: skip
+    p.add_argument("--report", metavar="DIR", help="write report.html and figures/ here")
     p.set_defaults(handler=_identify)
