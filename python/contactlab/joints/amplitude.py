@@ -399,7 +399,9 @@ def fit_amplitude(
     law : str or law
         "segalman" (default), "iwan", "jenkins" started from the table, or a law instance.
     fixed : names, optional
-        Parameters held (default: Segalman's ``beta``, which only macro-slip shows).
+        Parameters held. Default: Segalman's ``beta``, and without a stiffness column its
+        ``K_T`` (Iwan's ``k``), which micro-slip damping cannot separate from the others
+        (the result's notes say so).
     viscous : bool
         Add a linear viscous damping ``c0`` [N s/m] to ``c_eq`` (structural damping besides
         the joint's).
@@ -436,8 +438,7 @@ def fit_amplitude(
     if E_meas is None and "c_eq" in cols:
         E_meas = cols["c_eq"] * math.pi * 2.0 * math.pi * freq * A**2
     start = _resolve(law, A, E_meas, cols.get(stiffness_kind))
-    fixed_set = set(fixed) if fixed is not None else ({"beta"} if start.name == "segalman"
-                                                       else set())  # fmt: skip
+    fixed_set, why = _default_fixed(start, fixed, stiffness_kind in cols)
     params = _law_params(start, fixed_set, bounds)
     if viscous:
         if "c_eq" not in cols:
@@ -464,6 +465,8 @@ def fit_amplitude(
         return np.where(np.isfinite(r), r, 10.0)  # an amplitude the law failed at: penalised
 
     res = least_squares_fit(residual, params)
+    if why:
+        res.notes.append(f"held: {why}")
     _mark_identifiability(res)
     pred, fails = predict(res.values)
     fitted = start.with_params([res.params[n].value for n in names])
@@ -565,16 +568,22 @@ class SteppedSineFit:
             zeta = c / (2.0 * v["m"] * wn)
             return np.concatenate([wn / (2.0 * math.pi), zeta, c])
 
+        failures: dict[str, str] = {}
         try:
-            val, err = self.result.propagate(props)
+            val = props(self.result.values)
         except ContactLabError as exc:
             return {"amplitude": A, "failures": {"all": str(exc)}}  # type: ignore[dict-item]
+        try:
+            _, err = self.result.propagate(props)
+        except ContactLabError as exc:  # a parameter at its bound: the difference steps leave it
+            err = np.full(val.size, np.nan)
+            failures["stderr"] = f"standard errors not propagated: {exc}"
         n = A.size
         val = np.asarray(val, dtype=float)
         err = np.asarray(err, dtype=float)
         return {"amplitude": A, "f_n": val[:n], "zeta": val[n : 2 * n], "c_eq": val[2 * n :],
                 "f_n_stderr": err[:n], "zeta_stderr": err[n : 2 * n],
-                "c_eq_stderr": err[2 * n :]}  # fmt: skip
+                "c_eq_stderr": err[2 * n :], "failures": failures}  # fmt: skip
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -599,21 +608,74 @@ class SteppedSineFit:
         }
 
 
+#: parameters a damping-dominated fit holds by default, and why
+_HELD = {
+    "segalman": (
+        ("beta", "K_T"),
+        "in micro-slip the energy and the loss of stiffness depend "
+        "only on χ and R = F_S (χ+1) / (φmax^(χ+2) (β + (χ+1)/(χ+2))), not on K_T, "
+        "F_S and β apart (Segalman 2005); K_T and β are held, F_S carries R",
+    ),
+    "iwan": (
+        ("k",),
+        "in micro-slip the energy k² A³ / (3 fs_max) depends only on "
+        "k² / fs_max; k is held, fs_max carries the ratio",
+    ),
+}
+
+
+def _default_fixed(law: Any, fixed: Sequence[str] | None, stiffness_given: bool
+                   ) -> tuple[set[str], str | None]:  # fmt: skip
+    """The parameters to hold and a note saying why (None when ``fixed`` was given)."""
+    if fixed is not None:
+        return set(fixed), None
+    held, why = _HELD.get(law.name, ((), None))
+    if law.name == "segalman" and stiffness_given:
+        return {"beta"}, None
+    if law.name == "iwan" and stiffness_given:
+        return set(), None
+    return set(held), why
+
+
 def fit_stepped_sine(sweeps: Sequence[Sweep], *, law: Any = "segalman",
-                     fixed: Sequence[str] | None = None) -> SteppedSineFit:  # fmt: skip
+                     fixed: Sequence[str] | None = None, sweep_stiffness: bool = True,
+                     weighting: str = "relative") -> SteppedSineFit:  # fmt: skip
     """Fit a mode with a joint to first-harmonic stepped-sine points (all sweeps at once).
 
-    At each point the first harmonic balance ``F = [k − m ω² + i ω c0 + K(|X|)] X`` must
-    hold, ``X = |X| e^{iφ}`` the response relative to the force and ``K(A) = k_eq(A) +
-    i E(A) / (π A²)`` the joint's complex stiffness (:func:`equivalent_properties`). The
-    residual is that balance over ``|F|`` (real and imaginary parts). ``m``, ``k``, ``c0``
-    enter linearly and are eliminated at each trial of the law's parameters (variable
-    projection), then fitted jointly with them for the covariance.
+    At each point the measured dynamic stiffness ``K = F / X`` (``X = |X| e^{iφ}``, the
+    response relative to the force) is compared with the model's first harmonic balance
+    ``D = k − m ω² + k_eq(A) + i (ω c0 + E(A) / (π A²))``, ``A = |X|``, with the joint's
+    ``k_eq`` and ``E`` from :func:`equivalent_properties`. Residuals: the real part over
+    ``|K|`` (stiffness) and the imaginary part over ``Im K`` (damping: a relative error at
+    every point, not only near resonance, where a small drift of the natural frequency
+    between sweeps would otherwise outweigh it). ``m``, ``k``, ``c0`` enter linearly and are
+    eliminated at each trial of the law's parameters (variable projection), then fitted
+    jointly with them for the covariance.
 
     The law is started from the phase-resonance points of the sweeps (their equivalent
-    damping against amplitude, :meth:`Sweep.phase_resonance`). Points at which the law
-    cannot be evaluated are penalised and listed in ``failures``; nothing is raised for
-    them.
+    damping against amplitude, :meth:`Sweep.phase_resonance`); by default the parameters
+    that micro-slip data cannot separate are held (Segalman's ``K_T`` and ``β``, Iwan's
+    ``k``: the result's notes say why). Points at which the law cannot be evaluated are
+    penalised and listed in ``failures``; nothing is raised for them.
+
+    Parameters
+    ----------
+    sweeps : list of Sweep
+        The stepped-sine sweeps, fitted together.
+    law : str or law
+        "segalman" (default), "iwan", "jenkins" started from the phase-resonance table, or
+        a law instance.
+    fixed : names, optional
+        Law parameters held (default: those micro-slip cannot separate, see above).
+    sweep_stiffness : bool, default True
+        Give each sweep after the first its own modal stiffness offset ``dk_j``: the natural
+        frequency of a built-up beam drifts between sweeps (temperature, settling; on the
+        Brake-Reuss beam data it moves non-monotonically by 0.3 Hz with amplitude, which no
+        softening joint produces), and without the offsets that drift is taken for joint
+        stiffness and biases the damping. The backbone uses the first sweep's stiffness.
+    weighting : {"relative", "resonance"}
+        "relative": the damping residual of each point relative to its own ``Im K``;
+        "resonance": relative to ``|K|`` (the points near resonance weigh most).
     """
     if not sweeps:
         raise InputError("give at least one sweep")
@@ -623,6 +685,11 @@ def fit_stepped_sine(sweeps: Sequence[Sweep], *, law: Any = "segalman",
     X = np.concatenate([s.displacement * np.exp(1j * s.phase) for s in sw])
     A = np.abs(X)
     w = 2.0 * math.pi * f
+    K = F / X
+    if not np.all(K.imag > 0):
+        i = int(np.argmax(~(K.imag > 0)))
+        raise InputError(f"point {i} ({f[i]:.4g} Hz): the response leads the force (phase "
+                         f"{np.angle(X[i]):.3g} rad), which a passive mode cannot do")  # fmt: skip
     res_pts = [p for s in sw if (p := s.phase_resonance()) is not None]
     if not res_pts:
         raise InputError("no sweep crosses phase resonance (−π/2): cannot start the fit")
@@ -631,67 +698,80 @@ def fit_stepped_sine(sweeps: Sequence[Sweep], *, law: Any = "segalman",
     fr = np.array([p["frequency"] for p in res_pts])
     order = np.argsort(Ar)
     Ar, cr, fr = Ar[order], cr[order], fr[order]
-    # viscous part: the damping extrapolated to zero amplitude, the joint's the rest
+    # viscous part: half the damping at the smallest amplitude, the joint's the rest
     c0_start = max(0.5 * float(cr[0]), 1e-12)
     E_start = np.clip(cr - c0_start, 1e-3 * cr, None) * math.pi * 2 * math.pi * fr * Ar**2
-    # stiffness start: K_T of the joint a tenth of the modal stiffness (m from the damping
-    # and the resonance's sharpness is not needed: the linear terms are solved exactly)
     start = _resolve(law, Ar, E_start, None)
-    fixed_set = set(fixed) if fixed is not None else ({"beta"} if start.name == "segalman"
-                                                       else set())  # fmt: skip
+    fixed_set, why = _default_fixed(start, fixed, False)
     names = list(start.param_names)
     # the amplitude grid the law is evaluated on (log-spaced), interpolated to the points
     grid = np.geomspace(float(A.min()) * 0.98, float(A.max()) * 1.02, 48)
     fmid = float(np.median(f))
     failures: dict[str, str] = {}
+    if weighting not in ("resonance", "relative"):
+        raise InputError(f"weighting must be 'resonance' or 'relative', got {weighting!r}")
+    sR = np.abs(K)
+    sI = K.imag if weighting == "relative" else sR
 
-    def joint(v: Mapping[str, float]) -> np.ndarray:
+    def joint(v: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
         lw = start.with_params([v[n] for n in names])
         p = equivalent_properties(lw, grid, fmid)
         failures.clear()  # those of the latest trial: the end point's when the fit is done
-        for i, why in p.failures.items():
-            failures[f"{grid[i]:.4g} m"] = why
+        for i, reason in p.failures.items():
+            failures[f"{grid[i]:.4g} m"] = reason
         ok = np.isfinite(p.k_eq) & np.isfinite(p.energy)
         if not ok.any():
-            return np.full(A.size, np.nan + 0j)
+            return np.full(A.size, np.nan), np.full(A.size, np.nan)
         lg = np.log(grid[ok])
         keq = np.interp(np.log(A), lg, p.k_eq[ok])
         im = np.interp(np.log(A), lg, p.energy[ok] / (math.pi * grid[ok] ** 2))
-        return keq + 1j * im
+        return keq, im
 
-    # linear columns: k X, −m ω² X, i ω c0 X
-    cols = np.stack([X, -(w**2) * X, 1j * w * X], axis=1) / F[:, None]
+    zero = np.zeros_like(w)
+    # linear columns (k, m, c0) of the two residual parts
+    Lr = np.concatenate([np.stack([1.0 / sR, -(w**2) / sR, zero], axis=1),
+                         np.stack([zero, zero, w / sI], axis=1)], axis=0)  # fmt: skip
+    lin_names = ["k", "m", "c0"]
+    lin_units = ["N/m", "kg", "N s/m"]
+    if sweep_stiffness:
+        # each sweep's own modal stiffness change (a drift between sweeps), relative to k
+        sizes = [s.frequency.size for s in sw]
+        start_i = np.cumsum([0, *sizes])
+        for j in range(1, len(sw)):
+            col = np.zeros(2 * A.size)
+            col[start_i[j] : start_i[j + 1]] = 1.0 / sR[start_i[j] : start_i[j + 1]]
+            Lr = np.column_stack([Lr, col])
+            lin_names.append(f"dk_{j}")
+            lin_units.append("N/m")
 
-    def split(z: np.ndarray) -> np.ndarray:
-        return np.concatenate([z.real, z.imag])
-
-    Lr = np.concatenate([cols.real, cols.imag], axis=0)
+    def base(v: Mapping[str, float]) -> np.ndarray:
+        keq, im = joint(v)
+        return np.concatenate([(keq - K.real) / sR, (im - K.imag) / sI])
 
     def residual_nl(v: Mapping[str, float]) -> np.ndarray:
-        Kj = joint(v)
-        base = split(Kj * X / F - 1.0)
-        if not np.all(np.isfinite(base)):
-            return np.where(np.isfinite(base), base, 10.0)
-        beta = np.linalg.lstsq(Lr, -base, rcond=None)[0]
-        return base + Lr @ beta
+        b = base(v)
+        if not np.all(np.isfinite(b)):
+            return np.where(np.isfinite(b), b, 10.0)
+        beta = np.linalg.lstsq(Lr, -b, rcond=None)[0]
+        return b + Lr @ beta
 
     params = _law_params(start, fixed_set, None)
     res1 = least_squares_fit(residual_nl, params)
     v1 = res1.values
-    base = split(joint(v1) * X / F - 1.0)
-    beta = np.linalg.lstsq(Lr, -base, rcond=None)[0]
+    beta = np.linalg.lstsq(Lr, -base(v1), rcond=None)[0]
     params = _law_params(start.with_params([v1[n] for n in names]), fixed_set, None)
-    for n, b, u in zip(("k", "m", "c0"), beta, ("N/m", "kg", "N s/m"), strict=True):
+    for n, b, u in zip(lin_names, beta, lin_units, strict=True):
         params[n] = Parameter(n, float(b), unit=u, scale=abs(float(b)) or 1.0)
 
     def residual(v: Mapping[str, float]) -> np.ndarray:
-        lin = np.array([v["k"], v["m"], v["c0"]])
-        r = split(joint(v) * X / F - 1.0) + Lr @ lin
+        r = base(v) + Lr @ np.array([v[n] for n in lin_names])
         return np.where(np.isfinite(r), r, 10.0)
 
     res = least_squares_fit(residual, params)
     if not res1.success:
         res.notes.append(f"the search over the law's parameters ended: {res1.message}")
+    if why:
+        res.notes.append(f"held: {why}")
     _mark_identifiability(res)
     joint(res.values)  # the end point's failures
     law_fit = start.with_params([res.params[n].value for n in names])
