@@ -212,23 +212,70 @@ def _term_columns(terms: Sequence[str], t: np.ndarray, x: np.ndarray) -> np.ndar
     return np.column_stack(cols) if cols else np.zeros((x.size, 0))
 
 
-def thin_indices(rec: JointRecord, keep_every: int) -> np.ndarray:
-    """Every ``keep_every``-th sample plus each turning point of ``x`` (the extremes between
-    crossings of a band of 1 % of the range), first and last: a rate-independent law gives
-    the same force at the kept samples as on the whole record (its force depends only on the
-    sequence of turning points and the current displacement)."""
+def turning_points(x: np.ndarray, gate: float) -> np.ndarray:
+    """Indices of the turning points of ``x``: the extremes between which it moves by more
+    than ``gate`` (a hysteresis threshold, as the gate of ASTM E1049-85 peak counting; 0
+    keeps every local extremum)."""
+    d = np.diff(x)
+    nz = np.flatnonzero(d != 0)
+    if nz.size == 0:
+        return np.zeros(0, dtype=np.int64)
+    s = np.sign(d[nz])
+    # candidates: the last sample of each monotone run (a change of sign of the steps)
+    cand = nz[np.flatnonzero(s[1:] != s[:-1])] + 1
+    if gate <= 0 or cand.size == 0:
+        return cand.astype(np.int64)
+    # hysteresis over the candidates (the first sample included: the first run's start)
+    pts = np.concatenate([[0], cand]).astype(np.int64)
+    v = x[pts]
+    out: list[int] = []
+    hi = lo = 0  # positions in pts while no direction is set
+    direction, ext = 0, 0
+    for j in range(1, pts.size):
+        if direction == 0:
+            if v[j] > v[hi]:
+                hi = j
+            if v[j] < v[lo]:
+                lo = j
+            if v[hi] - v[lo] > gate:
+                first, ext, direction = (lo, hi, 1) if hi > lo else (hi, lo, -1)
+                out.append(int(pts[first]))
+            continue
+        if direction > 0:
+            if v[j] >= v[ext]:
+                ext = j
+            elif v[ext] - v[j] > gate:
+                out.append(int(pts[ext]))
+                direction, ext = -1, j
+        else:
+            if v[j] <= v[ext]:
+                ext = j
+            elif v[j] - v[ext] > gate:
+                out.append(int(pts[ext]))
+                direction, ext = 1, j
+    if direction != 0:
+        out.append(int(pts[ext]))
+    return np.asarray(out, dtype=np.int64)
+
+
+def thin_indices(rec: JointRecord, keep_every: int, gate: float = 1e-3) -> np.ndarray:
+    """Every ``keep_every``-th sample plus each turning point of ``x``, first and last.
+
+    Turning points: :func:`turning_points` with a gate of ``gate`` times the range of ``x``.
+    A rate-independent law gives the same force at the kept samples as on the whole record
+    (its force depends only on the sequence of turning points and the current displacement),
+    up to the effect of reversals smaller than the gate (exact with ``gate=0``).
+    """
     n = rec.n
     if keep_every <= 1:
         return np.arange(n)
-    idx = set(range(0, n, keep_every)) | {n - 1}
     x = rec.x
-    lo, hi = float(np.min(x)), float(np.max(x))
-    if hi > lo:
-        # turning points at every scale: extremes of excursions about several levels
-        for centre in np.linspace(lo, hi, 9)[1:-1]:
-            ex = excursions(x, float(centre), 0.005 * (hi - lo))
-            idx.update(int(i) for i in ex.extreme)
-    return np.array(sorted(idx), dtype=np.int64)
+    rng = float(np.max(x) - np.min(x))
+    keep = np.zeros(n, bool)
+    keep[::keep_every] = True
+    keep[-1] = True
+    keep[turning_points(x, gate * rng)] = True
+    return np.flatnonzero(keep)
 
 
 @dataclass
