@@ -12,8 +12,9 @@ from ._common import period, reconstructed
 #: (MAX_DELAY_FRACTION, the largest plausible delay as a fraction of the excitation period,
 #: is shared with the normal family's delay: :data:`contactlab.diagnose._family`)
 #: the largest plausible delay in absolute terms: no sensor chain skews two channels by
-#: tens of milliseconds (an 8-pole anti-alias filter at 0.4 fs delays by about a sample; a converter's decimation
-#: filter by a few tens of its output samples, alike on both channels of one converter)
+#: tens of milliseconds (an 8-pole anti-alias filter at 0.4 fs delays by about a sample; a
+#: converter's decimation filter by a few tens of its output samples, alike on both
+#: channels of one converter)
 MAX_DELAY_SECONDS = 0.010
 
 
