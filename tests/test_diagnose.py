@@ -279,17 +279,17 @@ def test_input_noise_does_not_buy_a_sub_sample_delay():
 def test_a_candidate_that_cannot_be_fitted_is_skipped_not_fatal(monkeypatch):
     """A candidate whose fit fails (the normal joint's solver can reject a trial stiffness
     with no equilibrium) is reported as not fitted; the diagnosis goes on with the others."""
-    from contactlab.diagnose import workflow
+    from contactlab.diagnose import search
     from contactlab.errors import ConvergenceError
 
-    real_fit = workflow.fit
+    real_fit = search.fit
 
     def fit(family, effects, *args, **kwargs):
         if "inertia" in effects:
             raise ConvergenceError("the model rejected the parameters the solver tried")
         return real_fit(family, effects, *args, **kwargs)
 
-    monkeypatch.setattr(workflow, "fit", fit)
+    monkeypatch.setattr(search, "fit", fit)  # the search's moves fit the candidates
     rec = hidden_effect_recording(["force_offset"], magnitude=0.05, noise=0.01, seed=SEED + 77)
     rep = contactlab.diagnose(rec, candidates=["force_offset", "inertia"], max_effects=1)
     assert rep.effect_names == ["force_offset"]
