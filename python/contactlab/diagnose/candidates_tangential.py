@@ -485,7 +485,7 @@ class TangentialFamily:
                 raise InputError(
                     f"the loop runs the wrong way: ∮F dx = {loop_area(d.u, d.y):.3g} J over the "
                     "recording, but a passive joint dissipates (∮F dx > 0); the force channel "
-                    "is recorded with the opposite sign — negate F"
+                    "is recorded with the opposite sign — negate F (force_sign=-1, --force-sign -1)"
                 )
             raise InputError(
                 f"the force does not follow the displacement: the best Masing curve explains "
