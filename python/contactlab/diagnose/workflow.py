@@ -592,7 +592,7 @@ def _regime_sentence(
     own = family.regime(p, d)
     if regime.source != "analyze":
         return regime.reason or own
-    tail = own.split("; ", 1)[1] if own and "; " in own else ""
+    tail = own.rsplit("; ", 1)[1] if own and "; " in own else ""
     return f"{regime.reason}; base model: {tail}" if tail else regime.reason
 
 

@@ -75,6 +75,10 @@ class Backlash(EffectModel):
         return {"b": 0.02 * amplitude(d)}
 
     def apply(self, core, p, ctx):
+        if not (p["h0"] > 0 and p["ac"] > 0 and np.isfinite(p["h0"] * p["ac"])):
+            from ....masing import Masing
+
+            return Masing(p["h0"], p["ac"]).force(ctx.xm)  # (the element's own refusal)
         rev = ctx.d.cycles.reversals if ctx.sp is None else ctx.sp.reversals
         return gap_force(p["h0"], p["ac"], max(p["b"], 0.0), ctx.xm, rev)
 

@@ -69,6 +69,8 @@ class PowerLawMicroslip(EffectModel):
 
         F_S, K_T = p["h0"], p["h0"] * p["ac"]
         chi, beta = p["chi"], max(p["beta"], 0.0)
+        if not (F_S > 0 and K_T > 0 and np.isfinite(K_T) and -1.0 < chi < 0.0):
+            return Masing(p["h0"], p["ac"]).force(ctx.xm)  # (the element's own refusal)
         phi, _, _ = segalman_constants(F_S, K_T, chi, beta)
         s = np.linspace(0.0, 1.0, _POINTS)
         u = phi * s**2  # dense near the origin, where the power law bends
