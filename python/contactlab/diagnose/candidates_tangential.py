@@ -108,6 +108,9 @@ GROSS_SLIDING_ZA = 10.0
 #: ANCHOR_BAND plateau errors of the plateau
 ANCHOR_SIGMAS = 3.0
 ANCHOR_BAND = 2.0
+#: ... or within this share of the plateau force, the larger (the final model keeps h0
+#: within 5 % of the plateau analyze reads: issue 29)
+H0_HOLD = 0.025
 
 
 def _sg_dot(window: int, deriv: int, dt: float) -> np.ndarray:
@@ -221,46 +224,69 @@ class TangentialFamily:
         )
 
     def anchor(self, p: dict[str, float], se: dict[str, float], d: Prepared) -> str | None:
-        """Fix the base first when it is in the wrong regime: in gross sliding (``ac·A`` of
-        the base fit at least :data:`GROSS_SLIDING_ZA`) the plateau measures ``h0``
-        directly and ``ac`` is only bounded from below
-        (:func:`contactlab.tangential.regime.plateau`, on the measured displacement, as
-        ``analyze`` reads it). When the base's ``h0`` lies more than
-        :data:`ANCHOR_SIGMAS` combined standard errors from the plateau (the least-squares
-        fit trades ``h0`` against what the Masing element cannot follow: the sticks, the
-        friction varying along the track), ``h0`` is held within
-        :data:`ANCHOR_BAND` plateau errors of it and ``ac`` above the bound from then on
-        (the base and every candidate), so no effect is credited with moving ``h0`` back;
-        the band stays with the family (a refit of the final model keeps it). Returns a
-        sentence saying so, or None (nothing changed)."""
+        """Hold ``h0`` at the plateau in the sliding regimes: there the plateau measures
+        ``h0`` directly and ``ac`` is only bounded from below.
+
+        The plateau is the one ``analyze`` reads (``d.extra["regime_info"]``, set by the
+        workflow from :func:`contactlab.tangential.analyze_tangential`: the same regime
+        decision and the same plateau); without it, :func:`contactlab.tangential.regime.
+        plateau` on this record when the base fit is in gross sliding (``ac·A`` at least
+        :data:`GROSS_SLIDING_ZA`). ``h0`` is then held within ``max(ANCHOR_BAND plateau
+        errors, H0_HOLD h0)`` of the plateau and ``ac`` above the plateau's bound from then
+        on (the base and every candidate), so that no effect trades ``h0`` against a misfit
+        and the final model keeps the friction force ``analyze`` found; the band stays with
+        the family (a refit of the final model keeps it). Returns a sentence when the base
+        had to be moved into the band (its least-squares ``h0`` more than
+        :data:`ANCHOR_SIGMAS` combined standard errors from the plateau, or outside the
+        band), None otherwise."""
+        if self.h0_band is not None:
+            return None
+        info = d.extra.get("regime_info") or {}
+        if info.get("h0_source") == "plateau" and info.get("plateau_h0"):
+            h0_pl = float(info["plateau_h0"])
+            se_pl = float(info.get("plateau_stderr") or np.nan)
+            ac_lb = info.get("ac_lower_bound")
+            what = "the plateau analyze reads"
+        else:
+            pl = self._own_plateau(p, d)
+            if pl is None:
+                return None
+            h0_pl, se_pl, ac_lb = pl.h0, pl.h0_stderr, pl.ac_lower_bound
+            what = "the plateau"
+        if not (np.isfinite(se_pl) and se_pl > 0):
+            return None
+        band = max(ANCHOR_BAND * se_pl, H0_HOLD * h0_pl)
+        self.h0_band = (h0_pl - band, h0_pl + band)
+        if ac_lb is not None and np.isfinite(ac_lb):
+            self.ac_floor = min(float(ac_lb), p["ac"])
+        err = float(np.hypot(se["h0"] if np.isfinite(se["h0"]) else 0.0, se_pl))
+        off = abs(p["h0"] - h0_pl) / err
+        if off <= ANCHOR_SIGMAS and abs(p["h0"] - h0_pl) <= band:
+            return None
+        floor = f" and ac ≥ {self.ac_floor:.3g} 1/m (only a lower bound is identified)"
+        return (
+            f"base re-anchored to the plateau: in the sliding regime h0 is {what}, "
+            f"{h0_pl:.4g} ± {se_pl:.2g} N, but the least-squares base put it at "
+            f"{p['h0']:.4g} N ({off:.1f} σ away); h0 is held within ±{band:.2g} N of the "
+            f"plateau{floor if self.ac_floor > 0 else ''}"
+        )
+
+    def _own_plateau(self, p: dict[str, float], d: Prepared) -> Any:
+        """The plateau of this record (:func:`contactlab.tangential.regime.plateau`) when
+        the base fit is in gross sliding, else None."""
         from ..tangential.preprocess import average_loop
         from ..tangential.regime import plateau, velocity
 
         amp = 0.5 * float(np.ptp(d.u))
-        if self.h0_band is not None or p["ac"] * amp < GROSS_SLIDING_ZA:
+        if p["ac"] * amp < GROSS_SLIDING_ZA:
             return None
         x = d.extra.get("u_raw", d.u)
         try:
             loop = average_loop(x, d.y, d.t)
             v, thr, _ = velocity(d.t, x)
-            pl = plateau(loop, x, d.y, v, thr)
+            return plateau(loop, x, d.y, v, thr)
         except (InputError, ValueError):  # no loop to average: no plateau to anchor to
             return None
-        if pl is None or not (np.isfinite(pl.h0_stderr) and pl.h0_stderr > 0):
-            return None
-        err = float(np.hypot(se["h0"] if np.isfinite(se["h0"]) else 0.0, pl.h0_stderr))
-        off = abs(p["h0"] - pl.h0) / err
-        if off <= ANCHOR_SIGMAS:
-            return None
-        band = ANCHOR_BAND * pl.h0_stderr
-        self.h0_band = (pl.h0 - band, pl.h0 + band)
-        self.ac_floor = min(pl.ac_lower_bound, p["ac"])
-        return (
-            f"base re-anchored to the plateau: in gross sliding h0 is the plateau force "
-            f"{pl.h0:.4g} ± {pl.h0_stderr:.2g} N, but the least-squares base put it at "
-            f"{p['h0']:.4g} N ({off:.1f} σ away); h0 is held within ±{band:.2g} N of the "
-            f"plateau and ac ≥ {self.ac_floor:.3g} 1/m (only a lower bound is identified)"
-        )
 
     #: a stick changes the force by at least this share of its range (1st to 99th
     #: percentile) while the displacement stands still (:meth:`sticking`)
@@ -544,7 +570,8 @@ class TangentialFamily:
         x = ctx.x
         ctx.x0 = p["x0"] if x is not d.u else None
         self._merge(ctx)
-        for e in staged("element_input"):
+        reshaped = staged("element_input")
+        for e in reshaped:
             ctx.xm = e.apply(ctx.xm, p, ctx)
         for e in staged("core"):
             ctx.core = e.apply(ctx.core, p, ctx)
@@ -553,6 +580,8 @@ class TangentialFamily:
             h = elements[0].apply(ctx.core, p, ctx)
         elif ctx.core is not None:
             h = ctx.core.force(ctx.xm)
+        elif reshaped:  # (the kept unit forces are of the displacement itself)
+            h = Masing(p["h0"], p["ac"]).force(ctx.xm)
         else:
             token = 0 if ctx.sp is None else ctx.sp.token
             h = _masing_force(d, p["h0"], p["ac"], ctx.x0, ctx.xm, token)

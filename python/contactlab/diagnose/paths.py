@@ -105,12 +105,9 @@ class KindPath:
         t, u, y, reduced = reduce_long(t, u, y)
         return Prepared.build(t, u, y), reduced
 
-    def regime(
-        self, t: np.ndarray, u: np.ndarray, y: np.ndarray, d: Prepared, p: dict[str, float]
-    ) -> RegimeDecision:
-        """The regime sentence of the base fit (the family's own)."""
-        text = self.family.regime(p, d)
-        return RegimeDecision("", text or "", "base fit")
+    def regime(self, t: np.ndarray, u: np.ndarray, y: np.ndarray) -> RegimeDecision:
+        """No regime decision outside the base fit: the family's own sentence is used."""
+        return RegimeDecision("", "", "base fit")
 
     def check_final(
         self, regime: RegimeDecision, p: dict[str, float], effects: tuple[str, ...]
@@ -149,9 +146,7 @@ class TangentialPath(KindPath):
     def subsample(self, t: np.ndarray, u: np.ndarray, y: np.ndarray) -> tuple[Prepared, str]:
         return subsample_long(t, u, y)
 
-    def regime(
-        self, t: np.ndarray, u: np.ndarray, y: np.ndarray, d: Prepared, p: dict[str, float]
-    ) -> RegimeDecision:
+    def regime(self, t: np.ndarray, u: np.ndarray, y: np.ndarray) -> RegimeDecision:
         """The regime ``analyze`` decides on the same record (force sign applied already),
         with its plateau ``h0`` and the sticks' breakaway force; the base fit's own
         sentence when ``analyze`` cannot read the record (too few cycles, no loop)."""
@@ -160,9 +155,7 @@ class TangentialPath(KindPath):
         try:
             an = analyze_tangential(t=t, x=u, F=y, force_sign=1, warn=False)
         except (ContactLabError, ValueError, FloatingPointError) as exc:
-            text = self.family.regime(p, d)
-            return RegimeDecision("", f"{text} (analyze could not read the record: {exc})",
-                                  "base fit")  # fmt: skip
+            return RegimeDecision("", "", "base fit", extra={"analyze_error": str(exc)})
         reg = an.regime or {}
         name = str(reg.get("regime", ""))
         h0 = se = None
@@ -184,7 +177,7 @@ class TangentialPath(KindPath):
             h0,
             se,
             float(fb) if isinstance(fb, (int, float)) else None,
-            {"h0_source": h0_source},
+            {"h0_source": h0_source, "ac_lower_bound": _lower_bound(an)},
         )
 
     def check_final(
@@ -226,6 +219,12 @@ class TangentialPath(KindPath):
             else " with no effect that redefines it: the base model trades h0 against a misfit"
         )
         return doc, text
+
+
+def _lower_bound(an: Any) -> float | None:
+    """``ac``'s lower bound ``analyze`` reads off the plateau (None without one)."""
+    v = (an.derived or {}).get("ac_lower_bound")
+    return float(v[0]) if v is not None and np.isfinite(v[0]) else None
 
 
 def kind_path(family: Family) -> KindPath:

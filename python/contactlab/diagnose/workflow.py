@@ -446,11 +446,12 @@ def diagnose(
     d.extra["evaluations"] = EvaluationCounter()  # counted by select.fit
     family.prepare(d)
     effects: tuple[str, ...] = tuple(model.effects) if isinstance(model, ExtendedModel) else ()
-    b = _fit_base(family, effects, d, start, folds, declared_noise)
-    regime = path.regime(t, u, y, d, b.current.full.params)
+    regime = path.regime(t, u, y)  # the one decision analyze, track and diagnose share
     d.extra["regime_info"] = {
-        "name": regime.name, "plateau_h0": regime.h0, "breakaway_force": regime.breakaway_force,
+        "name": regime.name, "plateau_h0": regime.h0, "plateau_stderr": regime.h0_stderr,
+        "breakaway_force": regime.breakaway_force, **regime.extra,
     }  # fmt: skip
+    b = _fit_base(family, effects, d, start, folds, declared_noise)
     where, location = _describe_base(b, d, regime, notes, reduced, prior, prior_notes)
     location["samples"] = {"recording": int(t.size), "diagnosed": int(d.t.size)}
     location["noise_declared"] = declared_noise is not None
@@ -591,7 +592,8 @@ def _regime_sentence(
     """The regime (analyze's decision where there is one) and the base model's numbers."""
     own = family.regime(p, d)
     if regime.source != "analyze":
-        return regime.reason or own
+        err = regime.extra.get("analyze_error")
+        return own if not err else f"{own} (analyze could not read the record: {err})"
     tail = own.rsplit("; ", 1)[1] if own and "; " in own else ""
     return f"{regime.reason}; base model: {tail}" if tail else regime.reason
 

@@ -63,6 +63,13 @@ class ChannelDelay(EffectModel):
             )
         per = period(d)
         tau = p["tau"]
+        if tau < 0:
+            return Plausibility(
+                False,
+                f"a delay of {1e3 * tau:.3g} ms is negative: the force would lead the "
+                "displacement, which no passive measurement chain does (docs/effects.md §3); "
+                "a damping look-alike (viscous_damping, rate_dependent_presliding)",
+            )
         if abs(tau) > MAX_DELAY_FRACTION * per:
             return Plausibility(
                 False,

@@ -14,6 +14,10 @@ MIN_LOAD_PERIODS = 2.0
 #: function of the position (up and down strokes alike) must reach this: below, friction
 #: varying along the track (position_friction) explains it as well
 MIN_DIRECTION_SHARE = 0.25
+#: largest plausible fluctuation of the normal load, relative: a joint whose normal load
+#: swings by more than this within the record is not "loaded with fluctuations" but a
+#: different test; a fit beyond it absorbs a misfit of the base model
+MAX_FLUCTUATION = 0.3
 #: position bins of that test
 _BINS = 32
 
@@ -112,6 +116,14 @@ class NormalLoad(EffectModel):
                 False,
                 f"a load fluctuation of {p['f_n']:.3g} Hz makes fewer than "
                 f"{MIN_LOAD_PERIODS:g} periods in the record: a drift (parameter_drift)",
+            )
+        eps = float(np.hypot(p["eps_c"], p["eps_s"]))
+        if eps > MAX_FLUCTUATION:
+            return Plausibility(
+                False,
+                f"a normal load swinging by ±{100 * eps:.0f} % (plausible: up to "
+                f"±{100 * MAX_FLUCTUATION:g} %) is not a fluctuation of the loaded joint: the "
+                "base model's misfit is read as one",
             )
         k = self.harmonic(d, p)
         if k:
