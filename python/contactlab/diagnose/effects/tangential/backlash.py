@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 from ..._family import ParamSpec
@@ -23,8 +25,7 @@ def play(x: np.ndarray, b: float, rev: np.ndarray) -> np.ndarray:
     u = np.empty_like(x)
     bounds = np.r_[0, rev, x.size] if rev.size else np.array([0, x.size])
     ur = 0.0
-    for a, e in zip(bounds[:-1], bounds[1:], strict=True):
-        a, e = int(a), int(e)
+    for a, e in itertools.pairwise(bounds.tolist()):
         if e <= a:
             continue
         seg = x[a:e]
