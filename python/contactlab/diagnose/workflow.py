@@ -460,7 +460,8 @@ def diagnose(
         b.family, names, d, b.scales, folds, b.sigma, z, min_gain, b.budget,
         dict(b.current.full.params), max_effects, Step,
     )  # fmt: skip
-    st = search.run(SearchState(b.current, steps, where, [b.current]))
+    spent = d.extra["evaluations"].total  # by the base; then as a serial run counts them
+    st = search.run(SearchState(b.current, steps, where, [b.current], used=spent))
     return _report(b.family, path, recording, regime, d, st, b.sigma, location)
 
 
@@ -624,7 +625,10 @@ def _report(
         out_effects.append(Effect(name, {**ps, **dp}, {**ss, **ds}, why))
     final = ExtendedModel(family, effects, p, se, family.context(d))
     out_effects = _frame_constants(recording, out_effects, where, location)
-    check, moved = path.check_final(regime, p, effects)
+    model_force = None
+    if regime.h0 is not None:  # the final model's force, read as analyze read the data
+        model_force = (d.t, d.extra.get("u_raw", d.u), family.predict(p, effects, d))
+    check, moved = path.check_final(regime, p, effects, model_force)
     if check is not None:
         location["h0_check"] = check
     if moved:
