@@ -23,7 +23,8 @@ def play(x: np.ndarray, b: float, rev: np.ndarray) -> np.ndarray:
     if b <= 0.0:
         return x.copy()
     u = np.empty_like(x)
-    bounds = np.r_[0, rev, x.size] if rev.size else np.array([0, x.size])
+    # each stretch ends at its turning point (included): the next one starts after it
+    bounds = np.r_[0, rev + 1, x.size] if rev.size else np.array([0, x.size])
     ur = 0.0
     for a, e in itertools.pairwise(bounds.tolist()):
         if e <= a:
