@@ -40,8 +40,12 @@ def test_registry_lists_every_effect_once_with_its_parameters():
             assert s.lower <= s.upper and s.unit
     assert {n for n, e in tang.items() if e.acts_through == "velocity"} == VELOCITY
     # composition order: input, element, terms on the force, then the measurement
-    chain = [e.name for e in ordered("tangential", ("channel_delay", "force_offset",
-                                                    "displacement_offset", "asymmetry"))]
+    chain = [
+        e.name
+        for e in ordered(
+            "tangential", ("channel_delay", "force_offset", "displacement_offset", "asymmetry")
+        )
+    ]
     assert chain == ["displacement_offset", "asymmetry", "force_offset", "channel_delay"]
 
 
@@ -168,14 +172,13 @@ def test_load_fluctuation_direction_share_tells_time_from_position():
 def test_detectable_delegates_to_the_power_module_or_says_it_is_missing():
     eff = registry("tangential")["viscous_damping"]
     try:
-        import contactlab.diagnose.power  # noqa: F401
+        import contactlab.diagnose.power
     except ImportError:
-        with pytest.raises(NotImplementedError, match="diagnose.power"):
+        with pytest.raises(NotImplementedError, match=r"diagnose\.power"):
             eff.detectable(object())
     else:  # wired: a stated bound in the effect's own unit
-        from contactlab.diagnose import hidden_effect_recording
-
         import contactlab
+        from contactlab.diagnose import hidden_effect_recording
 
         rep = contactlab.diagnose(hidden_effect_recording([], seed=3), max_effects=0)
         bound = eff.detectable(rep)

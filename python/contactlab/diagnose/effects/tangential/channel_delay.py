@@ -27,8 +27,9 @@ class ChannelDelay(EffectModel):
     physics = (
         "The force and displacement channels pass different anti-alias filters or "
         "converters: F(t) = h(t - τ), τ < 0 when the displacement's filter is the slower. "
-        "A skew of a few samples; it shifts the loop's corners along the velocity (a thin loop looks damped) and acts through the velocity like a "
-        "viscous term, Stribeck friction and inertia."
+        "A skew of a few samples; it shifts the loop's corners along the velocity (a thin "
+        "loop looks damped) and acts through the velocity like a viscous term, Stribeck "
+        "friction and inertia."
     )
     acts_through = "velocity"
     stage = "output"
