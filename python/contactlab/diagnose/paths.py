@@ -181,21 +181,31 @@ class TangentialPath(KindPath):
         )
 
     def check_final(
-        self, regime: RegimeDecision, p: dict[str, float], effects: tuple[str, ...]
+        self,
+        regime: RegimeDecision,
+        p: dict[str, float],
+        effects: tuple[str, ...],
+        model_force: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     ) -> tuple[dict[str, Any] | None, str | None]:
-        """``h0`` of the final model against the plateau ``analyze`` reads in gross sliding
-        and stick-slip: within :data:`H0_TOLERANCE`, or a sentence saying why it moved (an
-        effect that redefines ``h0``: a drift makes it the value at the start, an asymmetry
-        the mean of the two directions, a breakaway or Stribeck term the sliding force far
-        from the reversals)."""
+        """The friction force of the final model against the one ``analyze`` reads in gross
+        sliding and stick-slip (its plateau, or its fit where the stroke has no plateau).
+
+        ``model_force``: ``(t, x, F_model)``, the final model's force on the record; it is
+        read by ``analyze`` exactly as the data were (``h0_model_reading``), which is what a
+        user comparing the two would see whatever the effects do to the meaning of ``h0``
+        (a branch scale makes the loop's half height ``λ h0 / 2``, a drift makes ``h0`` the
+        mid-record value). Within :data:`H0_TOLERANCE`, or a sentence saying why it moved."""
         if regime.h0 is None or not regime.h0 > 0:
             return None, None
         h0 = float(p["h0"])
-        ratio = h0 / regime.h0
+        read = _model_reading(model_force, regime) if model_force is not None else None
+        ratio = (read if read is not None else h0) / regime.h0
         doc: dict[str, Any] = {
             "h0_plateau": regime.h0,
             "h0_plateau_stderr": _finite(regime.h0_stderr),
+            "h0_source": regime.extra.get("h0_source"),
             "h0_final": h0,
+            "h0_model_reading": read,
             "ratio": ratio,
             "within_tolerance": bool(abs(ratio - 1.0) <= H0_TOLERANCE),
         }
@@ -209,9 +219,11 @@ class TangentialPath(KindPath):
         }
         reasons = [f"{e}: {why[e]}" for e in effects if e in why]
         doc["why"] = reasons
+        what = "plateau" if regime.extra.get("h0_source") == "plateau" else "friction force"
         text = (
-            f"the final model's h0 = {h0:.4g} N is {100 * (ratio - 1):+.1f} % from the plateau "
-            f"{regime.h0:.4g} N that analyze reads"
+            f"the final model's friction force ({'read by analyze: ' if read else 'h0 = '}"
+            f"{read if read else h0:.4g} N) is {100 * (ratio - 1):+.1f} % from the {what} "
+            f"{regime.h0:.4g} N that analyze reads on the data"
         )
         text += (
             f" because {'; '.join(reasons)}"
@@ -219,6 +231,24 @@ class TangentialPath(KindPath):
             else " with no effect that redefines it: the base model trades h0 against a misfit"
         )
         return doc, text
+
+
+def _model_reading(
+    model_force: tuple[np.ndarray, np.ndarray, np.ndarray], regime: RegimeDecision
+) -> float | None:
+    """``h0`` as ``analyze`` reads it off the final model's force on the record (its plateau
+    where the data have one, else its fit), None when it cannot."""
+    from ..tangential import analyze_tangential
+
+    t, x, F = model_force
+    try:
+        an = analyze_tangential(t=t, x=x, F=F, force_sign=1, warn=False)
+    except (ContactLabError, ValueError, FloatingPointError):
+        return None
+    plateau = (an.derived or {}).get("h0_plateau")
+    if regime.extra.get("h0_source") == "plateau" and plateau is not None:
+        return float(plateau[0])
+    return float(an.fit.params["h0"].value) if an.fit is not None else None
 
 
 def _lower_bound(an: Any) -> float | None:

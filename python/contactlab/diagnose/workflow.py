@@ -224,7 +224,8 @@ class DiagnosisReport:
         return f"noise RMS ({how}): {self.noise_rms:.4g} {unit}".rstrip()
 
     def summary(self) -> str:
-        """Findings, effects with parameters (with their units), and the gap-shrink table."""
+        """Findings, effects with parameters (with their units) and the argument that makes
+        each physically plausible, and the gap-shrink table."""
         how = " (inferred from the channels; model= sets it)" if self.model_inferred else ""
         out = [f"contactlab diagnose — {self.model} model{how}", ""]
         out += ["Where the base model disagrees:"] + [f"  - {w}" for w in self.where]
@@ -516,7 +517,8 @@ def diagnose(
         b.family, names, d, b.scales, folds, b.sigma, z, min_gain, b.budget,
         dict(b.current.full.params), max_effects, Step,
     )  # fmt: skip
-    st = search.run(SearchState(b.current, steps, where, [b.current]))
+    spent = d.extra["evaluations"].total  # by the base; then as a serial run counts them
+    st = search.run(SearchState(b.current, steps, where, [b.current], used=spent))
     report = _report(b.family, path, recording, regime, d, st, b.sigma, location)
     report.model_inferred = inferred
     return report
@@ -682,7 +684,10 @@ def _report(
         out_effects.append(Effect(name, {**ps, **dp}, {**ss, **ds}, why))
     final = ExtendedModel(family, effects, p, se, family.context(d))
     out_effects = _frame_constants(recording, out_effects, where, location)
-    check, moved = path.check_final(regime, p, effects)
+    model_force = None
+    if regime.h0 is not None:  # the final model's force, read as analyze read the data
+        model_force = (d.t, d.extra.get("u_raw", d.u), family.predict(p, effects, d))
+    check, moved = path.check_final(regime, p, effects, model_force)
     if check is not None:
         location["h0_check"] = check
     if moved:
@@ -695,13 +700,5 @@ def _report(
             "any candidate of the library"
         )
     return DiagnosisReport(
-        family.kind,
-        out_effects,
-        st.steps,
-        where,
-        sigma,
-        final,
-        location,
-        d,
-        st.trials,
+        family.kind, out_effects, st.steps, where, sigma, final, location, d, st.trials
     )

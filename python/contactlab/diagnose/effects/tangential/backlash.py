@@ -8,7 +8,7 @@ import numpy as np
 
 from ..._family import ParamSpec
 from .._base import EffectModel, Plausibility, register
-from ._common import amplitude
+from ._common import actual_turns, amplitude
 
 
 def play(x: np.ndarray, b: float, rev: np.ndarray) -> np.ndarray:
@@ -23,7 +23,8 @@ def play(x: np.ndarray, b: float, rev: np.ndarray) -> np.ndarray:
     if b <= 0.0:
         return x.copy()
     u = np.empty_like(x)
-    bounds = np.r_[0, rev, x.size] if rev.size else np.array([0, x.size])
+    # each stretch ends at its turning point (included): the next one starts after it
+    bounds = np.r_[0, rev + 1, x.size] if rev.size else np.array([0, x.size])
     ur = 0.0
     for a, e in itertools.pairwise(bounds.tolist()):
         if e <= a:
@@ -55,12 +56,8 @@ class Backlash(EffectModel):
     order = 16
     size_param = "b"
 
-    def start(self, p, d, residual):
-        return {"b": 0.02 * amplitude(d)}
-
     def apply(self, xm, p, ctx):
-        rev = ctx.d.cycles.reversals if ctx.sp is None else ctx.sp.reversals
-        return play(xm, max(p["b"], 0.0), rev)
+        return play(xm, max(p["b"], 0.0), actual_turns(ctx))
 
     def plausible(self, d, p):
         base = super().plausible(d, p)

@@ -26,9 +26,10 @@ class ChannelDelay(EffectModel):
     description = "force channel lags the displacement channel by tau"
     physics = (
         "The force and displacement channels pass different anti-alias filters or "
-        "converters: F(t) = h(t - τ). A skew of a few samples; it shifts the loop's corners "
-        "along the velocity (a thin loop looks damped) and acts through the velocity like a "
-        "viscous term, Stribeck friction and inertia."
+        "converters: F(t) = h(t - τ), τ < 0 when the displacement's filter is the slower. "
+        "A skew of a few samples; it shifts the loop's corners along the velocity (a thin "
+        "loop looks damped) and acts through the velocity like a viscous term, Stribeck "
+        "friction and inertia."
     )
     acts_through = "velocity"
     stage = "output"
@@ -63,13 +64,9 @@ class ChannelDelay(EffectModel):
             )
         per = period(d)
         tau = p["tau"]
-        if tau < 0:
-            return Plausibility(
-                False,
-                f"a delay of {1e3 * tau:.3g} ms is negative: the force would lead the "
-                "displacement, which no passive measurement chain does (docs/effects.md §3); "
-                "a damping look-alike (viscous_damping, rate_dependent_presliding)",
-            )
+        # (a negative delay, the force leading, is kept: docs/effects.md §3 calls a
+        # leading force a damping look-alike, but unequal anti-alias filters make one when
+        # the displacement channel's is the slower — the difference of group delays)
         if abs(tau) > MAX_DELAY_FRACTION * per:
             return Plausibility(
                 False,

@@ -7,6 +7,7 @@ import numpy as np
 
 from ..._family import ParamSpec
 from .._base import EffectModel, Plausibility, register
+from ._common import actual_turns, turning_points  # noqa: F401  (re-exported)
 
 
 def turning_point_force(virgin, lam: float, x: np.ndarray, rev: np.ndarray) -> np.ndarray:
@@ -52,8 +53,7 @@ class NonMasingScaling(EffectModel):
         from ....masing import Masing
 
         core = core if core is not None else Masing(p["h0"], p["ac"])
-        rev = ctx.d.cycles.reversals if ctx.sp is None else ctx.sp.reversals
-        return turning_point_force(core.virgin, p["lam"], ctx.xm, rev)
+        return turning_point_force(core.virgin, p["lam"], ctx.xm, actual_turns(ctx))
 
     def plausible(self, d, p):
         base = super().plausible(d, p)

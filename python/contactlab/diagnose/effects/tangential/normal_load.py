@@ -126,6 +126,14 @@ class NormalLoad(EffectModel):
                 "base model's misfit is read as one",
             )
         k = self.harmonic(d, p)
+        if k == 1:
+            return Plausibility(
+                False,
+                f"a load fluctuation at the drive frequency ({p['f_n']:.4g} Hz) is, in phase "
+                "with x, friction varying along the track, and in quadrature (∝ ẋ, times the "
+                "friction's own sign) a friction growing with the sliding speed: the velocity "
+                "effects and position_friction stand for it",
+            )
         if k:
             cos, sin = load_terms(d, p["f_n"], None)
             share = direction_share(d, p["eps_c"] * cos + p["eps_s"] * sin)
