@@ -210,7 +210,8 @@ def test_frame_report_of_a_sliding_loop(sim_file, tmp_path):
     import matplotlib
 
     matplotlib.use("Agg")
-    from contactlab.tangential import analyze_tangential, plot_loop
+    from contactlab.report.tangential import plot_loop
+    from contactlab.tangential import analyze_tangential
 
     rec = read_frame(sim_file[0], 3.08, 0.669, 1191.0).recording()
     title = plot_loop(analyze_tangential(rec, warn=False)).get_title()

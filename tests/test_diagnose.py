@@ -139,11 +139,21 @@ def test_plots_and_html(tmp_path):
     rep = contactlab.diagnose(rec)
     from matplotlib.figure import Figure
 
-    for fn in (rep.plot_overlay, rep.plot_residual, rep.plot_location, rep.plot_gap):
+    from contactlab.report.diagnosis import write_html
+    from contactlab.report.diagnosis_plots import (
+        plot_gap,
+        plot_location,
+        plot_overlay,
+        plot_residual,
+    )
+
+    for fn in (plot_overlay, plot_residual, plot_location, plot_gap):
         ax = Figure().add_subplot()
-        assert fn(ax=ax) is ax
+        assert fn(rep, ax=ax) is ax
         assert ax.has_data()
-    path = rep.write_html(tmp_path / "out")
+    with pytest.deprecated_call():  # the old method forwards (issue 32)
+        rep.plot_gap(ax=Figure().add_subplot())
+    path = write_html(rep, tmp_path / "out")
     text = path.read_text(encoding="utf-8")
     assert text.count("data:image/png;base64,") == 4
     assert "&quot;viscous_damping&quot;" in text and "Gap shrink" in text

@@ -11,8 +11,8 @@ import pytest
 
 import contactlab
 from contactlab.cli import main
-from contactlab.diagnose._inputs import GlitchError, check_glitches
 from contactlab.io import Recording, write_recording
+from contactlab.io.checks import GlitchError, check_glitches
 
 
 def _normal(n_glitch: int = 1) -> Recording:
@@ -117,7 +117,7 @@ def test_track_names_the_glitch_in_its_window(tmp_path: Path, kind: str) -> None
 def test_glitch_suspect_is_a_safe_prefilter() -> None:
     """The cheap pre-check never misses what the full check finds (random records with 0-3
     glitches of random size and place)."""
-    from contactlab.diagnose._inputs import GLITCH_SCALE, glitch_suspect
+    from contactlab.io.checks import GLITCH_SCALE, glitch_suspect
 
     rng = np.random.default_rng(11)
     for _ in range(300):

@@ -92,9 +92,16 @@ def test_clean_normal_data_names_nothing_and_two_effects_are_found():
     assert isinstance(rep.final_model.base, contactlab.normal.KelvinVoigt)
     from matplotlib.figure import Figure
 
-    for fn in (rep.plot_overlay, rep.plot_residual, rep.plot_location, rep.plot_gap):
+    from contactlab.report.diagnosis_plots import (
+        plot_gap,
+        plot_location,
+        plot_overlay,
+        plot_residual,
+    )
+
+    for fn in (plot_overlay, plot_residual, plot_location, plot_gap):
         ax = Figure().add_subplot()
-        assert fn(ax=ax) is ax
+        assert fn(rep, ax=ax) is ax
     # a model object starts the fit and fixes the frequency at which ψ holds
     kv = contactlab.normal.KelvinVoigt(1.0e12, 0.2, 2 * np.pi * rec.truth["base"]["f0"])
     again = contactlab.diagnose(rec, model=kv)

@@ -28,6 +28,12 @@ MODULES = sorted(
         "contactlab.normal_study",
         "contactlab.study",
         "contactlab.study_plots",
+        # issue 32: plots and reports moved to contactlab.report
+        "contactlab.diagnose.plots",
+        "contactlab.structure.report",
+        "contactlab.studies.plots",
+        "contactlab.studies.track_plots",
+        "contactlab.tangential.plots",
     }
 )
 

@@ -172,7 +172,7 @@ def analyze_entry(
             rec.meta["units_assumed_si"] = assumed_frame
     else:
         rec = read_recording(entry.path, columns=entry.columns, kind=entry.kind, fs=entry.fs)
-    from ..diagnose._inputs import check_recording_glitches
+    from ..io.checks import check_recording_glitches
 
     check_recording_glitches(rec)  # a sensor glitch is refused, as diagnose refuses it
     base = {"file": entry.path.name, "kind": entry.kind, **entry.tags}
@@ -289,7 +289,7 @@ class StudyResult:
 
     def _repr_html_(self) -> str:
         """Summary tables in notebooks (the full report: ``report.study_report``)."""
-        from ..report.html import table_html
+        from .._html import table_html
         from .columns import NORMAL_COLUMNS, TANGENTIAL_COLUMNS
 
         parts = []
