@@ -141,7 +141,7 @@ def test_output_filter_is_declared_to_the_diagnosis(tmp_path):
     savgol:11`` passes every candidate through the same filter (the API's ``output_filter``)."""
     from scipy.signal import savgol_coeffs, savgol_filter
 
-    from contactlab.diagnose import hidden_effect_recording
+    from contactlab.synthetic.diagnosis import hidden_effect_recording
 
     rec = hidden_effect_recording([], seed=5)
     F = savgol_filter(rec["F"], 11, 2)

@@ -17,8 +17,8 @@ import pytest
 
 import contactlab
 from contactlab import InputError
-from contactlab.diagnose import ExtendedModel, hidden_effect_recording
-from contactlab.diagnose.generator import TANGENTIAL_EFFECTS
+from contactlab.diagnose import ExtendedModel
+from contactlab.synthetic.diagnosis import TANGENTIAL_EFFECTS, hidden_effect_recording
 
 matplotlib.use("Agg")
 
@@ -125,7 +125,7 @@ def test_where_statements_point_at_the_effect():
 
 
 def test_callable_package_attribute_and_plain_arrays():
-    import contactlab.diagnose.generator as gen  # the subpackage stays importable
+    import contactlab.synthetic.diagnosis as gen
 
     rec = gen.hidden_effect_recording(["force_offset"], seed=SEED + 5)
     a = contactlab.diagnose(rec.arrays(), model="tangential")
@@ -229,7 +229,7 @@ def test_unexplained_gap_is_reported_not_hidden():
 
 def test_independent_synthetic_recordings():
     # recordings from contactlab.tangential's own simulator (another route to the data)
-    from contactlab.tangential.synthetic import synthetic_recording
+    from contactlab.synthetic.tangential import synthetic_recording
 
     kw = {"frequency": 5.0, "n_cycles": 16, "fs": 600.0, "noise": 0.01, "seed": SEED % 1000}
     clean = synthetic_recording(50.0, 5e4, 4e-5, **kw)

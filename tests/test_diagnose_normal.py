@@ -17,10 +17,10 @@ from hypothesis import strategies as st
 from scipy.signal import savgol_filter
 
 import contactlab
-from contactlab.diagnose import hidden_effect_recording
 from contactlab.diagnose._family import Prepared
 from contactlab.diagnose.candidates_normal import NormalFamily, frequency_domain
-from contactlab.diagnose.generator_normal import NORMAL_EFFECTS
+from contactlab.synthetic.diagnosis import hidden_effect_recording
+from contactlab.synthetic.diagnosis_normal import NORMAL_EFFECTS
 
 matplotlib.use("Agg")
 

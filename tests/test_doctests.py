@@ -34,6 +34,10 @@ MODULES = sorted(
         "contactlab.studies.plots",
         "contactlab.studies.track_plots",
         "contactlab.tangential.plots",
+        "contactlab.diagnose.generator",
+        "contactlab.diagnose.generator_normal",
+        "contactlab.normal.synthetic",
+        "contactlab.tangential.synthetic",
     }
 )
 

@@ -17,7 +17,6 @@ from contactlab.normal import (
     analyze_loop,
     compare,
     fit_pressure_stiffness,
-    synthetic_recording,
 )
 from contactlab.normal.compare import measured_velocity
 from contactlab.report.normal import (
@@ -27,6 +26,7 @@ from contactlab.report.normal import (
     plot_phase_portrait,
     plot_velocity,
 )
+from contactlab.synthetic.normal import synthetic_recording
 
 
 @pytest.fixture(scope="module")

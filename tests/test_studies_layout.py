@@ -33,6 +33,13 @@ OLD_NEW = [
     ),
     ("contactlab.normal.compare", "contactlab.report.normal", "plot_loops"),
     ("contactlab.diagnose.plots", "contactlab.report.diagnosis_plots", "plot_overlay"),
+    # issue 32: synthetic data in contactlab.synthetic
+    ("contactlab.tangential", "contactlab.synthetic.tangential", "synthetic_recording"),
+    ("contactlab.tangential.synthetic", "contactlab.synthetic.tangential", "synthetic_recording"),
+    ("contactlab.normal", "contactlab.synthetic.normal", "table2_model"),
+    ("contactlab.normal.synthetic", "contactlab.synthetic.normal", "synthetic_recording"),
+    ("contactlab.diagnose", "contactlab.synthetic.diagnosis", "hidden_effect_recording"),
+    ("contactlab.diagnose.generator", "contactlab.synthetic.diagnosis", "HiddenEffectRecording"),
     ("contactlab.normal_study", "contactlab.studies.normal", "analyze_normal_recording"),
 ]
 

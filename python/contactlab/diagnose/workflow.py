@@ -1099,7 +1099,7 @@ def diagnose(
     Examples
     --------
     >>> import contactlab
-    >>> from contactlab.diagnose import hidden_effect_recording
+    >>> from contactlab.synthetic.diagnosis import hidden_effect_recording
     >>> rec = hidden_effect_recording(["force_offset"], magnitude=0.05, seed=2)
     >>> report = contactlab.diagnose(rec, model="tangential")
     >>> report.effect_names

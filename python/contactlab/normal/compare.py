@@ -160,7 +160,8 @@ def compare(
 
     Examples
     --------
-    >>> from contactlab.normal import KelvinVoigt, compare, synthetic_recording
+    >>> from contactlab.normal import KelvinVoigt, compare
+    >>> from contactlab.synthetic.normal import synthetic_recording
     >>> t, p, d = synthetic_recording(model="linear", n_cycles=6, seed=0)
     >>> c = compare(t, p, d, KelvinVoigt(1.206e12, 0.0887, 1.0))
     >>> c.metrics["KelvinVoigt"]["rms_delta_rel"] < 0.01

@@ -791,7 +791,7 @@ def track(
 
     Examples
     --------
-    >>> from contactlab.tangential import synthetic_recording
+    >>> from contactlab.synthetic.tangential import synthetic_recording
     >>> rec = synthetic_recording(h0=40.0, ac=4e4, amplitude=20e-6, n_cycles=12, fs=2000.0,
     ...                           noise=0.01, seed=2)
     >>> res = track(rec, every="4cycles")  # 10 complete cycles: 4 + 4, and a 2-cycle tail
@@ -1034,7 +1034,7 @@ def track_many(
     Examples
     --------
     >>> from concurrent.futures import ThreadPoolExecutor
-    >>> from contactlab.tangential import synthetic_recording
+    >>> from contactlab.synthetic.tangential import synthetic_recording
     >>> recs = [synthetic_recording(h0=40.0, ac=4e4, amplitude=20e-6, n_cycles=8, fs=1000.0,
     ...                             noise=0.01, seed=s) for s in (1, 2)]
     >>> with ThreadPoolExecutor(2) as ex:

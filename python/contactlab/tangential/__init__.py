@@ -12,7 +12,6 @@ from .analysis import analyze_tangential
 from .frame import FrameForce, frame_friction_force, read_frame
 from .preprocess import AveragedLoop, CycleScatter, Reversals, average_loop, find_reversals
 from .result import UNITS, TangentialAnalysis
-from .synthetic import synthetic_recording
 
 __all__ = [
     "UNITS",
@@ -26,11 +25,14 @@ __all__ = [
     "find_reversals",
     "frame_friction_force",
     "read_frame",
-    "synthetic_recording",
 ]
 
-# moved to the report layer (issue 32): the old names warn and forward
+# moved to the report layer and to contactlab.synthetic (issue 32): the old names warn and forward
 __getattr__ = forward(
     __name__,
-    {"plot_loop": "contactlab.report.tangential", "plot_residuals": "contactlab.report.tangential"},
+    {
+        "plot_loop": "contactlab.report.tangential",
+        "plot_residuals": "contactlab.report.tangential",
+        "synthetic_recording": "contactlab.synthetic.tangential",
+    },
 )
