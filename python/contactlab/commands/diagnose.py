@@ -304,7 +304,7 @@ def run(args: argparse.Namespace) -> int:
         import matplotlib
 
         matplotlib.use("Agg")
-        from ..diagnose._html import report_files
+        from ..report.diagnosis import report_files
 
         files = report_files(report)
     print(report.summary())

@@ -29,7 +29,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError
+from .._moved import moved
+from ..errors import ConvergenceError, InputError
 from ._family import Family, Prepared
 from ._inputs import arrays as _arrays
 from ._inputs import check_channels, check_glitches
@@ -259,35 +260,47 @@ class DiagnosisReport:
 
     # -- figures ------------------------------------------------------------------------------
     def plot_overlay(self, step: int | None = None, ax: Any = None) -> Any:
-        """Measured and modelled loops (output against input), base model and final model."""
-        from .plots import plot_overlay
-
-        return plot_overlay(self, step=step, ax=ax)
+        """Measured and modelled loops (output against input), base model and final model.
+        Deprecated: use :func:`contactlab.report.diagnosis_plots.plot_overlay`."""
+        fn = moved(
+            "contactlab.diagnose.DiagnosisReport",
+            "plot_overlay",
+            "contactlab.report.diagnosis_plots",
+        )
+        return fn(self, step=step, ax=ax)
 
     def plot_residual(self, ax: Any = None) -> Any:
-        """Held-out residual over time, before (base) and after (final model)."""
-        from .plots import plot_residual
-
-        return plot_residual(self, ax=ax)
+        """Held-out residual over time, before (base) and after (final model).
+        Deprecated: use :func:`contactlab.report.diagnosis_plots.plot_residual`."""
+        return moved(
+            "contactlab.diagnose.DiagnosisReport",
+            "plot_residual",
+            "contactlab.report.diagnosis_plots",
+        )(self, ax=ax)
 
     def plot_location(self, ax: Any = None) -> Any:
-        """Where the base residual lives: residual power by position in the branch."""
-        from .plots import plot_location
-
-        return plot_location(self, ax=ax)
+        """Where the base residual lives: residual power by position in the branch.
+        Deprecated: use :func:`contactlab.report.diagnosis_plots.plot_location`."""
+        return moved(
+            "contactlab.diagnose.DiagnosisReport",
+            "plot_location",
+            "contactlab.report.diagnosis_plots",
+        )(self, ax=ax)
 
     def write_html(self, directory: Any) -> Any:
         """Write a self-contained ``diagnose.html`` (figures embedded, also as PNGs under
-        ``figures/``) and ``diagnose.json`` into ``directory``; returns the HTML's path."""
-        from ._html import write_html
-
-        return write_html(self, directory)
+        ``figures/``) and ``diagnose.json`` into ``directory``; returns the HTML's path.
+        Deprecated: use :func:`contactlab.report.diagnosis.write_html`."""
+        return moved(
+            "contactlab.diagnose.DiagnosisReport", "write_html", "contactlab.report.diagnosis"
+        )(self, directory)
 
     def plot_gap(self, ax: Any = None) -> Any:
-        """Held-out RMS (in units of the noise level) after each step."""
-        from .plots import plot_gap
-
-        return plot_gap(self, ax=ax)
+        """Held-out RMS (in units of the noise level) after each step.
+        Deprecated: use :func:`contactlab.report.diagnosis_plots.plot_gap`."""
+        return moved(
+            "contactlab.diagnose.DiagnosisReport", "plot_gap", "contactlab.report.diagnosis_plots"
+        )(self, ax=ax)
 
 
 def _family(model: Any) -> tuple[Family, dict[str, float], dict[str, float]]:
@@ -470,7 +483,7 @@ def diagnose(
     Examples
     --------
     >>> import contactlab
-    >>> from contactlab.diagnose import hidden_effect_recording
+    >>> from contactlab.synthetic.diagnosis import hidden_effect_recording
     >>> rec = hidden_effect_recording(["force_offset"], magnitude=0.05, seed=2)
     >>> report = contactlab.diagnose(rec, model="tangential")
     >>> report.effect_names

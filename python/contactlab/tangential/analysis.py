@@ -485,7 +485,7 @@ def analyze_tangential(
 
     Examples
     --------
-    >>> from contactlab.tangential import synthetic_recording
+    >>> from contactlab.synthetic.tangential import synthetic_recording
     >>> rec = synthetic_recording(h0=20.0, ac=1e5, amplitude=10e-6, n_cycles=5, seed=0)
     >>> res = analyze_tangential(rec)
     >>> res.identifiable, abs(res.fit.params["h0"].value - 20) < 3 * res.fit.params["h0"].stderr
