@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from .._moved import moved
-from ..errors import ConvergenceError, InputError
+from ..errors import InputError
 from ._family import Family, Prepared
 from ._inputs import arrays as _arrays
 from ._inputs import check_channels, check_glitches
