@@ -10,20 +10,20 @@
 //! co-moment with the phase that the spread's phase correction needs; see `Bin`). Memory: a
 //! few values per bin and per cycle. The
 //! period means of `F` and `x` between the peaks take a pass of their own in the same call
-//! ([`crate::signal::period_means_pair`]'s, whose two running sums stay in registers there).
+//! ([`crate::fold::period_means_pair`]'s, whose two running sums stay in registers there).
 //!
-//! The numbers are those of the separate kernels ([`fold_phase`](crate::signal::fold_phase),
-//! [`fold_spread`](crate::signal::fold_spread), [`loop_areas`](crate::signal::loop_areas),
-//! [`loop_area_sensitivity`](crate::signal::loop_area_sensitivity),
-//! [`period_means`](crate::signal::period_means)) to rounding: the per-bin sums and the
+//! The numbers are those of the separate kernels ([`fold_phase`](crate::fold::fold_phase),
+//! [`fold_spread`](crate::fold::fold_spread), [`loop_areas`](crate::loop_area::loop_areas),
+//! [`loop_area_sensitivity`](crate::loop_area::loop_area_sensitivity),
+//! [`period_means`](crate::fold::period_means)) to rounding: the per-bin sums and the
 //! period means bit for bit, the rest to ~1e-12 relative (another summation order).
 
 use crate::error::{check_finite, check_same_len, CoreError};
-use crate::signal::period_means_pair_checked;
+use crate::fold::period_means_pair_checked;
 
 /// One window folded (see the module docs). Per bin: samples, `Σx`, `ΣF`, `Σφ`, `Σφ²`,
 /// `Σx²`, `Σt` (φ the phase within the cycle), and the cycle-to-cycle spread of the per-cycle
-/// bin means of x and F (phase-corrected as [`crate::signal::fold_spread`]; NaN below two
+/// bin means of x and F (phase-corrected as [`crate::fold::fold_spread`]; NaN below two
 /// cycles with samples in the bin). Per cycle: its first sample (-1: none), bounds (`n + 1`
 /// sample indices), loop area (NaN below 3 samples), `Σ coef_F²`, `Σ coef_x²` of the area,
 /// half ranges of its bin means of x and F (NaN without samples). Per period between
@@ -448,7 +448,7 @@ fn flush_cell(
 
 /// Fold `(t, x, F)` (one window, `t` strictly increasing) by the phase knots `(kt, kp)` into
 /// `n_bins` bins per cycle over `n_cycles` cycles, with the phases and bins of
-/// [`crate::signal::fold_phase`], and derive the per-cycle quantities and period means (see
+/// [`crate::fold::fold_phase`], and derive the per-cycle quantities and period means (see
 /// [`WindowFold`]) in the same pass. The samples folded are those with
 /// `kt[0] <= t < kt[last]`; a cycle's samples run from its first folded sample to the next
 /// cycle's (the last to the first sample at or after `kt[last]`).
@@ -739,9 +739,8 @@ pub fn fold_window(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::signal::{
-        fold_phase, fold_spread, loop_area_sensitivity, loop_areas, period_means, FoldSums,
-    };
+    use crate::fold::{fold_phase, fold_spread, period_means, FoldSums};
+    use crate::loop_area::{loop_area_sensitivity, loop_areas};
     use proptest::prelude::*;
 
     fn knots(t: &[f64], period: f64, n_cyc: usize) -> (Vec<f64>, Vec<f64>) {
