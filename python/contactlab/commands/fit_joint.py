@@ -82,6 +82,8 @@ def _handler(args: argparse.Namespace) -> int:
     laws = _laws(args.law)
     check_output_targets(json_out=args.json, report=args.report,
                          inputs=[*args.fit, *(args.predict or [])])  # fmt: skip
+    if args.elements < 1:
+        raise InputError(f"--elements must be >= 1, got {args.elements}")
     if args.max_samples is not None and args.max_samples < 100:
         raise InputError(f"--max-samples must be >= 100, got {args.max_samples}")
     names = [Path(f).resolve() for f in [*args.fit, *(args.predict or [])]]
