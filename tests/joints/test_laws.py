@@ -314,6 +314,11 @@ def test_odd_symmetry(seed: int, which: int) -> None:
 
 
 DISSIPATIVE = [law for law in all_laws() if law.name != "kelvin_voigt"]
+#: laws whose small cycles about a loaded state drift (Dahl-type state equations have no
+#: Masing memory: the up and down branches' slopes differ there, so the loop ratchets towards
+#: the unloaded state and ∮F dx of one cycle includes the change of stored energy; seen:
+#: Dahl, 1e-5 m cycles after a 1e-3 m history, -3.8e-7 J after 3 cycles)
+RATCHETING = {"dahl", "lugre", "bouc_wen"}
 
 
 @settings(max_examples=25, deadline=None)
@@ -327,8 +332,10 @@ def test_energy_per_cycle_nonnegative(seed: int, which: int, amp: float, offset:
     law = DISSIPATIVE[which]
     rng = np.random.default_rng(seed)
     _, pre = _history(seed, 100)
-    n = 400
-    ph = np.arange(3 * n + 1) / n
+    n, cycles = 400, 3
+    if law.name in RATCHETING:  # minor loops about a loaded state do not close: from rest
+        pre, offset, cycles = np.zeros(1), 0.0, 8
+    ph = np.arange(cycles * n + 1) / n
     x = np.concatenate([pre, pre[-1] + offset + amp * np.sin(2 * np.pi * ph + rng.uniform(0, 6))])
     t = np.arange(x.size) * 1e-3
     F = law.force(t, x)
