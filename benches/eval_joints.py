@@ -247,8 +247,10 @@ def tribo() -> None:
     ex = excursions(x, 0.5 * (lo + hi), 0.25 * (hi - lo))
     peaks = np.asarray(ex.extreme[ex.sign > 0], dtype=np.int64)
     print(f"\n=== micro-tribometer: {rec.n} samples under load, {peaks.size} stroke maxima")
-    first_rev = int(ex.extreme[0])  # the end of the virgin loading
-    mid = int(peaks[min(25, peaks.size - 1)])  # the end of cycle 25 (maximum to maximum)
+    # the stage rests at its lower end when the load comes on, then strokes up: the virgin
+    # loading ends at the first maximum; cycles run from maximum to maximum
+    first_rev = int(peaks[0])
+    mid = int(peaks[min(25, peaks.size - 1)])  # the end of cycle 25
     train = np.zeros(rec.n, bool)
     train[first_rev:mid] = True
     test = np.zeros(rec.n, bool)
@@ -256,7 +258,7 @@ def tribo() -> None:
     virgin = np.zeros(rec.n, bool)
     virgin[:first_rev] = True
     fit_rec = JointRecord(rec.t, rec.x, rec.F, "cycles 1-25", train)
-    print(f"fit window: samples {first_rev}-{mid} (cycles 1-25 after the virgin loading); "
+    print(f"fit window: samples {first_rev}-{mid} (the 25 cycles after the virgin loading); "
           f"test: the {rec.n - mid} samples after; virgin curve: the first {first_rev} "
           "samples")  # fmt: skip
     print(f"{'law':<14} {'NRMSE last25':>12} {'SNR last25':>10} {'E/cycle err':>11} "
