@@ -17,17 +17,18 @@ from typing import Any
 
 from ..errors import InputError
 from ._common import (
+    add_reader_flags,
     check_output_targets,
-    command_line,
     describe,
     json_text,
+    made_by,
     parse_columns,
-    quantity,
     write_json,
 )
 
 
-def _read(files: list[str], columns: dict | None, fs: float | None, role: str) -> list[Any]:
+def _read(files: list[str], columns: dict | None, fs: float | None, role: str,
+          resample: bool = False) -> list[Any]:  # fmt: skip
     from ..io import read_recording
     from ..joints.records import as_record
 
@@ -38,7 +39,7 @@ def _read(files: list[str], columns: dict | None, fs: float | None, role: str) -
             raise InputError(f"--{role} {f}: is a folder, not a recording file")
         if not p.is_file():
             raise InputError(f"--{role} {f}: no such file")
-        rec = read_recording(p, columns=columns, kind="tangential", fs=fs)
+        rec = read_recording(p, columns=columns, kind="tangential", fs=fs, resample=resample)
         out.append(as_record(rec, name=p.name))
     return out
 
@@ -90,8 +91,8 @@ def _handler(args: argparse.Namespace) -> int:
     if len(set(names)) != len(names):
         raise InputError("a file is given twice (in --fit and --predict, or twice in one): "
                          "a held-out score needs a recording the fit did not see")  # fmt: skip
-    train = _read(args.fit, columns, args.fs, "fit")
-    held = _read(args.predict or [], columns, args.fs, "predict")
+    train = _read(args.fit, columns, args.fs, "fit", args.resample)
+    held = _read(args.predict or [], columns, args.fs, "predict", args.resample)
     say = sys.stderr if args.json == "-" else sys.stdout
     fits = []
     for law in laws:
@@ -132,9 +133,9 @@ def _handler(args: argparse.Namespace) -> int:
         from ..report import commit_outputs
         from ..report.joints_report import build_joint_report
 
-        cmd = command_line("fit-joint", "--law", args.law, "--fit", *args.fit,
-                           *(["--predict", *args.predict] if args.predict else []),
-                           "--report", args.report)  # fmt: skip
+        cmd = made_by(args, "fit-joint", "--law", args.law, "--fit", *args.fit,
+                      *(["--predict", *args.predict] if args.predict else []),
+                      "--report", args.report)  # fmt: skip
         rep = build_joint_report(fits, table, records, roles,
                                  f"contactlab fit-joint ({', '.join(laws)})",
                                  intro=f"Made by: {cmd}")  # fmt: skip
@@ -171,9 +172,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    "backlash:<law> (default: lugre)")  # fmt: skip
     p.add_argument("--json", metavar="OUT", help="write results as JSON (SI; '-' = stdout)")
     p.add_argument("--report", metavar="DIR", help="write report.html and figures here")
-    p.add_argument("--columns", help="column mapping, e.g. 'x=disp,F=force' (default: by name)")
-    p.add_argument("--fs", type=quantity("Hz", positive=True),
-                   help="sampling rate when a file has no time")  # fmt: skip
+    add_reader_flags(p, model=False)
     p.add_argument("--offset", action="store_true",
                    help="fit a constant force in parallel (asymmetric friction, a load-cell "
                    "zero)")  # fmt: skip
