@@ -27,7 +27,9 @@ import argparse
 import math
 import sys
 import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -40,15 +42,15 @@ DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 FRICTION_LAWS = [
     "jenkins",
     "iwan",
-    "segalman",
-    "maxwell_slip",
     "dahl",
     "lugre",
-    "bouc_wen",
-    "masing",
-    "gms",
     "backlash:jenkins",
+    "segalman",
+    "masing",
+    "bouc_wen",
+    "maxwell_slip",
     "backlash:dahl",
+    "gms",
 ]
 
 
@@ -70,7 +72,27 @@ def _row(name: str, r: dict) -> str:
             f"{num('trac', '8.4f')} {num('energy_error', '+9.4f')}")  # fmt: skip
 
 
-def friction(max_samples: int) -> None:
+_RECS: list[JointRecord] = []
+
+
+def _fold(law: str, k: int, max_samples: int) -> tuple[str, Any, str, float]:
+    """One fold of the cross-validation (in a worker process): fit on every harmonic test
+    but test k, predict test k. Returns (name, prediction or None, message, CPU s)."""
+    if not _RECS:
+        _RECS.extend(_fd_records(DATA / "friction_damper"))
+    t0 = time.process_time()
+    held = _RECS[k]
+    train = [r for j, r in enumerate(_RECS) if j != k]
+    try:
+        f = fit(train, law=law, offset=True, asymmetry=True, max_samples=max_samples)
+        pred = f.force(held.t, held.x)
+        msg = "" if f.success else f.message
+    except ContactLabError as exc:
+        pred, msg = None, str(exc)
+    return held.name, pred, msg, time.process_time() - t0
+
+
+def friction(max_samples: int, jobs: int = 1) -> None:
     folder = DATA / "friction_damper"
     if not folder.is_dir():
         print("friction damper: ../shared/data/friction_damper absent, skipped")
@@ -83,28 +105,29 @@ def friction(max_samples: int) -> None:
     print("=== friction damper: leave-one-test-out cross-validation over the 13 harmonic tests")
     print(f"    (each fold fitted on 12 tests, laws driven with ~{max_samples} samples; "
           "scores on every sample of the held-out test)")  # fmt: skip
-    cv_pred: dict[str, dict[str, np.ndarray]] = {}
-    cv_time: dict[str, float] = {}
+    cv_pred: dict[str, dict[str, np.ndarray]] = {law: {} for law in FRICTION_LAWS}
+    cv_time: dict[str, float] = dict.fromkeys(FRICTION_LAWS, 0.0)
     failed: dict[str, list[str]] = {}
-    for law in FRICTION_LAWS:
-        t0 = time.process_time()
-        preds = {}
-        for k, held in enumerate(recs):
-            train = [r for j, r in enumerate(recs) if j != k]
-            try:
-                f = fit(train, law=law, offset=True, asymmetry=True, max_samples=max_samples)
-                preds[held.name] = f.force(held.t, held.x)
-                if not f.success:
-                    failed.setdefault(law, []).append(f"{held.name}: {f.message}")
-            except ContactLabError as exc:
-                failed.setdefault(law, []).append(f"{held.name}: {exc}")
-        cv_time[law] = time.process_time() - t0
-        cv_pred[law] = preds
-        if len(preds) == len(recs):
-            row = compare({law: preds}, recs).pooled(law)
-            print(_row(law, row) + f"   ({cv_time[law]:.0f} CPU s)", flush=True)
-        else:
-            print(f"{law:<18} failed on {len(recs) - len(preds)} folds", flush=True)
+    tasks = [(law, k) for law in FRICTION_LAWS for k in range(len(recs))]
+    done = dict.fromkeys(FRICTION_LAWS, 0)
+    with ProcessPoolExecutor(jobs) as ex:
+        futs = {ex.submit(_fold, law, k, max_samples): (law, k) for law, k in tasks}
+        for fut in as_completed(futs):
+            law, _ = futs[fut]
+            name, pred, msg, cpu = fut.result()
+            cv_time[law] += cpu
+            done[law] += 1
+            if pred is not None:
+                cv_pred[law][name] = pred
+            if msg:
+                failed.setdefault(law, []).append(f"{name}: {msg}")
+            if done[law] == len(recs):
+                if len(cv_pred[law]) == len(recs):
+                    row = compare({law: cv_pred[law]}, recs).pooled(law)
+                    print(_row(law, row) + f"   ({cv_time[law]:.0f} CPU s)", flush=True)
+                else:
+                    print(f"{law:<18} failed on {len(recs) - len(cv_pred[law])} folds",
+                          flush=True)  # fmt: skip
     base = compare({"LuGre (authors)": lugre}, recs)
     print(_row("LuGre (authors)", base.pooled("LuGre (authors)")) + "   (published baseline)")
     complete = {k: v for k, v in cv_pred.items() if len(v) == len(recs)}
@@ -306,13 +329,14 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--part", default="all", choices=("friction", "beam", "tribo", "speed", "all"))
     ap.add_argument("--max-samples", type=int, default=4000)
+    ap.add_argument("--jobs", type=int, default=2, help="processes of the cross-validation")
     a = ap.parse_args(argv)
     if a.part in ("beam", "all"):
         beam()
     if a.part in ("tribo", "all"):
         tribo()
     if a.part in ("friction", "all"):
-        friction(a.max_samples)
+        friction(a.max_samples, a.jobs)
     if a.part in ("speed", "all"):
         speed()
     return 0
