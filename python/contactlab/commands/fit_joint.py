@@ -17,14 +17,37 @@ from typing import Any
 
 from ..errors import InputError
 from ._common import (
+    FORCE_SIGN_CHOICES,
     add_reader_flags,
     check_output_targets,
     describe,
+    force_sign,
     json_text,
     made_by,
     parse_columns,
     write_json,
 )
+
+
+def _signed(rec: Any, sign: str, say: Any) -> Any:
+    """The record with its force sign as asked: ``auto`` makes the loops' work ∮F dx
+    positive (a passive joint dissipates; some instruments record the reaction)."""
+    import numpy as np
+
+    from ..joints.records import JointRecord
+
+    if sign == "+1":
+        return rec
+    flip = sign == "-1"
+    if sign == "auto":
+        work = float(np.sum(0.5 * (rec.F[1:] + rec.F[:-1]) * np.diff(rec.x)))
+        flip = work < 0
+        if flip:
+            print(f"{rec.name}: force sign -1 (the loops' work ∮F dx is negative with the "
+                  "recorded sign; --force-sign +1 keeps it)", file=say)  # fmt: skip
+    if not flip:
+        return rec
+    return JointRecord(rec.t, rec.x, -rec.F, rec.name, rec.mask)
 
 
 def _read(files: list[str], columns: dict | None, fs: float | None, role: str,
@@ -94,6 +117,8 @@ def _handler(args: argparse.Namespace) -> int:
     train = _read(args.fit, columns, args.fs, "fit", args.resample)
     held = _read(args.predict or [], columns, args.fs, "predict", args.resample)
     say = sys.stderr if args.json == "-" else sys.stdout
+    train = [_signed(r, args.force_sign, say) for r in train]
+    held = [_signed(r, args.force_sign, say) for r in held]
     fits = []
     for law in laws:
         f = fit(train, law=law, offset=args.offset, stiffness=args.stiffness,
@@ -173,6 +198,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", metavar="OUT", help="write results as JSON (SI; '-' = stdout)")
     p.add_argument("--report", metavar="DIR", help="write report.html and figures here")
     add_reader_flags(p, model=False)
+    p.add_argument("--force-sign", type=force_sign, choices=FORCE_SIGN_CHOICES, default="auto",
+                   help="fit F (+1) or -F (-1); auto (default): per recording, the sign that "
+                   "makes the loops' work ∮F dx positive (a passive joint dissipates)")  # fmt: skip
     p.add_argument("--offset", action="store_true",
                    help="fit a constant force in parallel (asymmetric friction, a load-cell "
                    "zero)")  # fmt: skip
