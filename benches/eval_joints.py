@@ -83,8 +83,10 @@ def _fold(law: str, k: int, max_samples: int) -> tuple[str, Any, str, float]:
     t0 = time.process_time()
     held = _RECS[k]
     train = [r for j, r in enumerate(_RECS) if j != k]
+    name, _, extra = law.partition("+")  # "dahl+cm": with a parallel damping and inertia
     try:
-        f = fit(train, law=law, offset=True, asymmetry=True, max_samples=max_samples)
+        f = fit(train, law=name, offset=True, asymmetry=True, damping="c" in extra,
+                mass="m" in extra, max_samples=max_samples)  # fmt: skip
         pred = f.force(held.t, held.x)
         msg = "" if f.success else f.message
     except ContactLabError as exc:
@@ -92,7 +94,7 @@ def _fold(law: str, k: int, max_samples: int) -> tuple[str, Any, str, float]:
     return held.name, pred, msg, time.process_time() - t0
 
 
-def friction(max_samples: int, jobs: int = 1) -> None:
+def friction(max_samples: int, jobs: int = 1, laws: list[str] | None = None) -> None:
     folder = DATA / "friction_damper"
     if not folder.is_dir():
         print("friction damper: ../shared/data/friction_damper absent, skipped")
@@ -105,11 +107,12 @@ def friction(max_samples: int, jobs: int = 1) -> None:
     print("=== friction damper: leave-one-test-out cross-validation over the 13 harmonic tests")
     print(f"    (each fold fitted on 12 tests, laws driven with ~{max_samples} samples; "
           "scores on every sample of the held-out test)")  # fmt: skip
-    cv_pred: dict[str, dict[str, np.ndarray]] = {law: {} for law in FRICTION_LAWS}
-    cv_time: dict[str, float] = dict.fromkeys(FRICTION_LAWS, 0.0)
     failed: dict[str, list[str]] = {}
-    tasks = [(law, k) for law in FRICTION_LAWS for k in range(len(recs))]
-    done = dict.fromkeys(FRICTION_LAWS, 0)
+    laws = laws or FRICTION_LAWS
+    cv_pred: dict[str, dict[str, np.ndarray]] = {law: {} for law in laws}
+    cv_time: dict[str, float] = dict.fromkeys(laws, 0.0)
+    tasks = [(law, k) for law in laws for k in range(len(recs))]
+    done = dict.fromkeys(laws, 0)
     with ProcessPoolExecutor(jobs) as ex:
         futs = {ex.submit(_fold, law, k, max_samples): (law, k) for law, k in tasks}
         for fut in as_completed(futs):
@@ -147,7 +150,9 @@ def friction(max_samples: int, jobs: int = 1) -> None:
     print(f"{'pooled':<8} {a['snr_db']:24.2f} {b['snr_db']:10.2f} {a['nrmse']:24.4f} "
           f"{b['nrmse']:12.4f}")  # fmt: skip
     print(f"held-out gain over LuGre: {a['snr_db'] - b['snr_db']:+.2f} dB")
-    final = fit(recs, law=best, offset=True, asymmetry=True, max_samples=max_samples)
+    name, _, extra = best.partition("+")
+    final = fit(recs, law=name, offset=True, asymmetry=True, damping="c" in extra,
+                mass="m" in extra, max_samples=max_samples)  # fmt: skip
     print(f"\n{best} fitted on all 13 harmonic tests (the model for other records):")
     print(final.report())
     quakes = sorted(folder.glob("*earthquake*"))
@@ -330,13 +335,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--part", default="all", choices=("friction", "beam", "tribo", "speed", "all"))
     ap.add_argument("--max-samples", type=int, default=4000)
     ap.add_argument("--jobs", type=int, default=2, help="processes of the cross-validation")
+    ap.add_argument("--laws", help="comma-separated laws of the cross-validation (default: all; "
+                    "'<law>+cm' adds a parallel damping and inertia)")  # fmt: skip
     a = ap.parse_args(argv)
     if a.part in ("beam", "all"):
         beam()
     if a.part in ("tribo", "all"):
         tribo()
     if a.part in ("friction", "all"):
-        friction(a.max_samples, a.jobs)
+        friction(a.max_samples, a.jobs, a.laws.split(",") if a.laws else None)
     if a.part in ("speed", "all"):
         speed()
     return 0
