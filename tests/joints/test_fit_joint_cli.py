@@ -39,7 +39,8 @@ def test_fit_and_predict_with_json_and_report(files, tmp_path, capsys):
     out = tmp_path / "res.json"
     rep = tmp_path / "rep"
     code = main(["fit-joint", "--law", "jenkins,dahl", "--fit", str(files[0]), str(files[1]),
-                 "--predict", str(files[2]), "--json", str(out), "--report", str(rep)])  # fmt: skip
+                 "--predict", str(files[2]), "--offset", "--asymmetry", "--json", str(out),
+                 "--report", str(rep)])  # fmt: skip
     assert code == 0
     text = capsys.readouterr().out
     assert "held out (pooled): SNR" in text

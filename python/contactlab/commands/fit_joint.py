@@ -122,8 +122,8 @@ def _handler(args: argparse.Namespace) -> int:
     fits = []
     for law in laws:
         f = fit(train, law=law, offset=args.offset, stiffness=args.stiffness,
-                damping=args.damping, mass=args.mass, max_samples=args.max_samples,
-                n_elements=args.elements)  # fmt: skip
+                damping=args.damping, mass=args.mass, asymmetry=args.asymmetry,
+                max_samples=args.max_samples, n_elements=args.elements)  # fmt: skip
         fits.append(f)
         state = "converged" if f.success else f"NOT converged ({f.message})"
         print(f"{f.name}: {state} in {f.seconds:.2f} s: {_param_line(f)}", file=say)
@@ -207,6 +207,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--stiffness", action="store_true", help="fit a parallel linear stiffness")
     p.add_argument("--damping", action="store_true", help="fit a parallel viscous term")
     p.add_argument("--mass", action="store_true", help="fit an inertia term m·ẍ in parallel")
+    p.add_argument("--asymmetry", action="store_true",
+                   help="fit a direction-dependent gain a·|F_law| (friction that differs "
+                   "between the two directions, e.g. a self-energising band brake)")  # fmt: skip
     p.add_argument("--elements", type=int, default=4, metavar="N",
                    help="elements of maxwell_slip / gms (default 4)")  # fmt: skip
     p.add_argument("--max-samples", type=int, default=None, metavar="N",
