@@ -32,9 +32,13 @@ _VERB_MODULES = [
     "contactlab.commands.diagnose",
     "contactlab.commands.export",
     "contactlab.commands.structure",
+    "contactlab.commands.fit_joint",
 ]
 #: verbs whose module is not ``contactlab.commands.<verb>``
-_VERB_ALIASES = {"identify": "contactlab.commands.structure"}
+_VERB_ALIASES = {
+    "identify": "contactlab.commands.structure",
+    "fit-joint": "contactlab.commands.fit_joint",
+}
 
 
 # Temporaries of the atomic writers: ".report.html.k2j4x9.part" beside "report.html".
