@@ -98,8 +98,13 @@ def public_modules() -> list[str]:
     return sorted(out)
 
 
-# the API page's module list, written before the pages are read (api.rst includes it)
-(HERE / "_api_modules.rst.inc").write_text(
+# The API page, written before the pages are read (autosummary's stub generation reads the
+# source files as they are, so the module list must be in api.rst itself, not included).
+(HERE / "api.rst").write_text(
+    "API reference\n=============\n\n"
+    "Generated from the docstrings (numpydoc) of every public module of the package, found "
+    "by walking\nit at build time, so a module that moves is documented where it now lives. "
+    "A module or name\nstarting with an underscore is private and not listed.\n\n"
     ".. autosummary::\n   :toctree: generated\n\n"
     + "".join(f"   {m}\n" for m in public_modules()),
     encoding="utf-8",
