@@ -637,7 +637,8 @@ def infer_model(
     """The model of a recording: ``model`` when given, else inferred from its column names
     exactly as the readers infer it (``contactlab.io.read_chunks``, which reads only the
     header). Returns ``(model, sentence)``; the sentence (None when the model was given)
-    says what was inferred from which columns, for the console."""
+    says what was inferred from which columns, for the console (``model tangential, inferred
+    from the columns x='Position [mm]', F='Friction [uN]' (--model sets it)``)."""
     if model is not None:
         return model, None
     from ..io import read_chunks
@@ -651,10 +652,15 @@ def infer_model(
         )
     chans = ("x", "F") if kind == "tangential" else ("p", "delta")
     named = ", ".join(f"{c}={cr.columns[c]!r}" for c in chans if c in cr.columns)
+    return kind, f"model {kind}, inferred from the columns {named} (--model sets it)"
+
+
+def wrapped(text: str, width: int = 100) -> str:
+    """``text`` wrapped to ``width`` characters, continuation lines indented."""
     import textwrap
 
-    text = f"{file}: model {kind}, inferred from the columns {named} (--model sets it)"
-    return kind, textwrap.fill(text, width=100, subsequent_indent="   ", break_long_words=False)
+    return textwrap.fill(text, width=width, subsequent_indent="   ", break_long_words=False,
+                         break_on_hyphens=False)  # fmt: skip
 
 
 def wrap_warning(text: str, *, prefix: str = "  warning: ", width: int = 100) -> str:

@@ -229,7 +229,13 @@ class DiagnosisReport:
         each physically plausible, and the gap-shrink table."""
         how = " (inferred from the channels; model= sets it)" if self.model_inferred else ""
         out = [f"contactlab diagnose — {self.model} model{how}", ""]
-        out += ["Where the base model disagrees:"] + [f"  - {w}" for w in self.where]
+        import textwrap
+
+        def wrap(text: str, first: str, rest: str) -> str:
+            return textwrap.fill(text, width=100, initial_indent=first, subsequent_indent=rest,
+                                 break_long_words=False, break_on_hyphens=False)  # fmt: skip
+
+        out += ["Where the base model disagrees:"] + [wrap(w, "  - ", "    ") for w in self.where]
         out.append("")
         if not self.effects:
             out.append("No candidate improves the held-out error significantly.")
@@ -241,9 +247,9 @@ class DiagnosisReport:
                 se = e.stderr.get(k, np.nan)
                 pm = f" ± {se:.2g}" if np.isfinite(se) else " (error not identifiable)"
                 parts.append(f"{k} = {v:.4g}{pm}{u}")
-            out.append(f"Added {e.name}: {', '.join(parts)}")
+            out.append(wrap(f"Added {e.name}: {', '.join(parts)}", "", "    "))
             if e.plausibility:
-                out.append(f"  why plausible: {e.plausibility}")
+                out.append(wrap(f"why plausible: {e.plausibility}", "  ", "    "))
         coeffs = self.final_model.coefficients()
         if coeffs is not None and ({"a", "kappa"} & set(self.final_model.params)):
             out.append(
