@@ -28,7 +28,17 @@ hidden_effect_recording = functools.partial(hidden_effect_recording, samples_per
 
 
 def _check_layout(d: dict) -> None:
-    assert set(d) == {"model", "effects", "steps", "where", "noise_rms", "final_model"}
+    # issue 29: both channels' noise, the stated power of each candidate not named, and the
+    # test of structure left in the residual
+    assert set(d) == {
+        "model", "effects", "steps", "where", "noise_rms", "final_model", "channel_noise",
+        "not_detected", "unexplained",
+    }  # fmt: skip
+    named = {e["name"] for e in d["effects"]}
+    for b in d["not_detected"]:
+        assert b["effect"] not in named
+        assert {"effect", "parameter", "detectable_above", "unit"} <= set(b)
+    assert isinstance(d["unexplained"]["flagged"], bool)
     assert isinstance(d["model"], str) and isinstance(d["noise_rms"], float)
     for e in d["effects"]:
         assert set(e) == {"name", "parameters", "stderr"}

@@ -155,6 +155,14 @@ class DiagnosisReport:
     location: dict[str, Any] = field(repr=False, default_factory=dict)
     _data: Prepared | None = field(repr=False, default=None)
     _trials: list[Trial] = field(repr=False, default_factory=list)
+    # -- issue 29 items 1-3 (detection.py, power.py, misfit.py) -----------------------------
+    #: noise of both channels, estimated separately (:class:`.detection.ChannelNoise`)
+    channel_noise: Any = field(repr=False, default=None)
+    #: per candidate not named: the smallest magnitude this record would have revealed
+    #: (:class:`.power.Detectable`)
+    not_detected: list[Any] = field(repr=False, default_factory=list)
+    #: structure the final model leaves over phase and branch (:class:`.misfit.Unexplained`)
+    unexplained: Any = field(repr=False, default=None)
 
     @property
     def effect_names(self) -> list[str]:
@@ -178,6 +186,14 @@ class DiagnosisReport:
             "where": list(self.where),
             "noise_rms": self.noise_rms,
             "final_model": self.final_model.to_dict(),
+            # issue 29: both channels' noise, stated power, unexplained structure
+            **({"channel_noise": self.channel_noise.to_dict()} if self.channel_noise else {}),
+            **(
+                {"not_detected": [b.to_dict() for b in self.not_detected]}
+                if self.channel_noise
+                else {}
+            ),
+            **({"unexplained": self.unexplained.to_dict()} if self.unexplained else {}),
             # a frame's reconstructed force: its mass read from an inertia term
             **(
                 {"frame_constants": dict(self.location["frame_constants"])}
@@ -226,6 +242,15 @@ class DiagnosisReport:
             )
         how = "declared" if self.location.get("noise_declared") else "estimated"
         out += ["", self.table(), f"noise RMS ({how}): {self.noise_rms:.4g}"]
+        if self.channel_noise is not None:  # issue 29: stated power, unexplained structure
+            cn = self.channel_noise
+            out.append(
+                f"channel noise: input {cn.input:.3g} {cn.input_unit}, output "
+                f"{cn.output:.3g} {cn.output_unit}"
+            )
+            out += [f"  - {b.sentence()}" for b in self.not_detected]
+        if self.unexplained is not None:
+            out.append(self.unexplained.sentence())
         return "\n".join(out)
 
     # -- figures ------------------------------------------------------------------------------
@@ -1329,6 +1354,17 @@ def diagnose(
         out_effects.append(Effect(name, {**ps, **dp}, {**ss, **ds}))
     final = ExtendedModel(family, effects, p, se, family.context(d))
     out_effects = _frame_constants(recording, out_effects, where, location)
+    # -- issue 29 items 1-3: both channels' noise, what each candidate not named would have
+    # needed to be seen, and structure the final model leaves (detection.py)
+    from .detection import assess
+
+    checks = assess(
+        family, d, current, sigma, z=z, gain_floor=min_gain + budget, folds=folds,
+        candidates=names, declared_output=declared_noise,
+    )  # fmt: skip
+    location["detection"] = {k: checks[k] for k in ("z", "gain_floor", "folds", "candidates")}
+    if checks["unexplained"] is not None and checks["unexplained"].flagged:
+        where.append(checks["unexplained"].sentence())
     gap = current.heldout_rms / sigma
     if gap > 1.5:
         where.append(
@@ -1337,5 +1373,6 @@ def diagnose(
             "candidate of the library"
         )
     return DiagnosisReport(
-        family.kind, out_effects, steps, where, sigma, final, location, d, trials
-    )
+        family.kind, out_effects, steps, where, sigma, final, location, d, trials,
+        checks["noise"], checks["not_detected"], checks["unexplained"],
+    )  # fmt: skip
