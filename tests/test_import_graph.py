@@ -43,6 +43,7 @@ PREFIXES = {
     "contactlab.tangential": "models",
     "contactlab.normal": "models",
     "contactlab.structure": "models",
+    "contactlab.joints": "models",
     "contactlab.diagnose": "studies/diagnosis",
     "contactlab.diagnose.structure": "studies/diagnosis",  # diagnosis on identified structures
     "contactlab.studies": "studies/diagnosis",

@@ -165,7 +165,14 @@ def _handler(args: argparse.Namespace) -> int:
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("demo", help="run the bundled demonstration and write its outputs")
+    p = sub.add_parser(
+        "demo",
+        help="run the bundled demonstration and write its outputs",
+        description="Analyse the example study bundled with contactlab (synthetic recordings "
+        "of three material pairs over loads and amplitudes, tangential and normal, in CSV, "
+        "TDMS, HDF5 and MAT files) and write report.html, figures/*.png, loops.png and the "
+        "study tables into --out. Nothing is read from outside the package.",
+    )
     p.add_argument("--out", default="demo-output", help="output folder (default: demo-output)")
     p.add_argument("--quick", action="store_true", help="a reduced set (one file per material)")
     p.add_argument("--workers", type=int, default=None, metavar="N",

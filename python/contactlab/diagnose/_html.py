@@ -60,7 +60,7 @@ def build(report: Any) -> Report:
             Column("energy_error", "loop-energy error", unit="%"),
         ],
     )
-    r.text(f"Noise RMS estimated from the data: {report.noise_rms:.4g}")
+    r.text(report.noise_text()[0].upper() + report.noise_text()[1:])
     for name, caption, method in FIGURES:
         fig = Figure(figsize=(7.0, 4.4), layout="constrained")
         getattr(report, method)(ax=fig.add_subplot())

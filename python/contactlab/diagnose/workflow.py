@@ -155,6 +155,8 @@ class DiagnosisReport:
     location: dict[str, Any] = field(repr=False, default_factory=dict)
     _data: Prepared | None = field(repr=False, default=None)
     _trials: list[Trial] = field(repr=False, default_factory=list)
+    #: whether ``model`` was inferred from the recording's channels (``diagnose(model=None)``)
+    model_inferred: bool = False
     # -- issue 29 items 1-3 (detection.py, power.py, misfit.py) -----------------------------
     #: noise of both channels, estimated separately (:class:`.detection.ChannelNoise`)
     channel_noise: Any = field(repr=False, default=None)
@@ -205,31 +207,52 @@ class DiagnosisReport:
     def to_json(self, indent: int = 2) -> str:
         return json.dumps(self.to_dict(), indent=indent, allow_nan=False)
 
-    def table(self) -> str:
-        """The gap-shrink table as text."""
+    def table(self, unit: str = "") -> str:
+        """The gap-shrink table as text (``unit``: the output's, named in the header)."""
+        u = f" [{unit}]" if unit else ""
         lines = [
-            f"{'step':<24}{'held-out RMS':>14}{'/ noise':>9}{'peak':>12}{'energy err':>12}",
+            f"{'step':<24}{'held-out RMS' + u:>18}{'/ noise':>9}{'peak' + u:>12}{'energy err':>12}",
         ]
         for s in self.steps:
             name = s.label
             lines.append(
-                f"{name:<24}{s.heldout_rms:>14.4g}{s.heldout_rms / self.noise_rms:>9.2f}"
+                f"{name:<24}{s.heldout_rms:>18.4g}{s.heldout_rms / self.noise_rms:>9.2f}"
                 f"{s.heldout_peak:>12.4g}{100 * s.energy_error:>11.2f}%"
             )
         return "\n".join(lines)
 
+    def param_units(self) -> dict[str, str]:
+        """SI unit of every parameter name of the family (base and candidates)."""
+        fam = self.final_model.family
+        specs = list(getattr(fam, "base_params", ()))
+        for cand in getattr(fam, "candidates", {}).values():
+            specs.extend(getattr(cand, "params", ()))
+        return {s.name: s.unit for s in specs}
+
+    def noise_text(self) -> str:
+        """``noise RMS (declared|estimated from the data): 0.0123 N``, as the console and the
+        HTML report both say it."""
+        how = "declared" if self.location.get("noise_declared") else "estimated from the data"
+        unit = getattr(self.final_model.family, "output_unit", "")
+        return f"noise RMS ({how}): {self.noise_rms:.4g} {unit}".rstrip()
+
     def summary(self) -> str:
-        """Findings, effects with parameters, and the gap-shrink table, as text."""
-        out = [f"contactlab diagnose — {self.model} model", ""]
+        """Findings, effects with parameters (with their units), and the gap-shrink table."""
+        how = " (inferred from the channels; model= sets it)" if self.model_inferred else ""
+        out = [f"contactlab diagnose — {self.model} model{how}", ""]
         out += ["Where the base model disagrees:"] + [f"  - {w}" for w in self.where]
         out.append("")
         if not self.effects:
             out.append("No candidate improves the held-out error significantly.")
+        units = self.param_units()
         for e in self.effects:
-            ps = ", ".join(
-                f"{k} = {v:.4g} ± {e.stderr.get(k, np.nan):.2g}" for k, v in e.parameters.items()
-            )
-            out.append(f"Added {e.name}: {ps}")
+            parts = []
+            for k, v in e.parameters.items():
+                u = f" {units[k]}" if units.get(k) else ""
+                se = e.stderr.get(k, np.nan)
+                pm = f" ± {se:.2g}" if np.isfinite(se) else " (error not identifiable)"
+                parts.append(f"{k} = {v:.4g}{pm}{u}")
+            out.append(f"Added {e.name}: {', '.join(parts)}")
         coeffs = self.final_model.coefficients()
         if coeffs is not None and ({"a", "kappa"} & set(self.final_model.params)):
             out.append(
@@ -240,8 +263,8 @@ class DiagnosisReport:
                 )
                 + f" (κ and a are relative to δ_r = {self.final_model.context['delta_r']:.4g} m)"
             )
-        how = "declared" if self.location.get("noise_declared") else "estimated"
-        out += ["", self.table(), f"noise RMS ({how}): {self.noise_rms:.4g}"]
+        unit = getattr(self.final_model.family, "output_unit", "")
+        out += ["", self.table(unit), self.noise_text()]
         if self.channel_noise is not None:  # issue 29: stated power, unexplained structure
             cn = self.channel_noise
             out.append(
@@ -998,9 +1021,37 @@ def _pair_search(
 
 
 @one_blas_thread
+def infer_model(recording: Any) -> str:
+    """The model family of a recording when none is given, as the command line infers it:
+    ``"tangential"`` for channels ``x``, ``F``, ``"normal"`` for ``p``, ``delta`` (a
+    :class:`~contactlab.io.Recording`'s ``kind``, a dict's keys); a tuple ``(t, x, F)`` is
+    tangential. Anything else is an :class:`~contactlab.InputError` asking for ``model=``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> infer_model({"t": np.arange(3.0), "p": np.ones(3), "delta": np.ones(3)})
+    'normal'
+    """
+    kind = getattr(recording, "kind", None)
+    if kind in ("tangential", "normal"):
+        return str(kind)
+    if isinstance(recording, dict):
+        if "x" in recording and "F" in recording:
+            return "tangential"
+        if "p" in recording and "delta" in recording:
+            return "normal"
+    if isinstance(recording, tuple):
+        return "tangential"
+    raise InputError(
+        "cannot tell the model of the recording (channels x, F: tangential; p, delta: "
+        "normal): give model='tangential' or 'normal'"
+    )
+
+
 def diagnose(
     recording: Any,
-    model: Any = "tangential",
+    model: Any = None,
     *,
     candidates: Sequence[str] | None = None,
     max_effects: int = 3,
@@ -1019,8 +1070,10 @@ def diagnose(
         The measurement: a Recording with channels ``x``, ``F`` (tangential) or ``p``,
         ``delta`` (normal) in SI units, a dict with ``t`` and those keys, or a tuple
         ``(t, x, F)`` / ``(t, p, delta)``. Uniform sampling; several excitation cycles.
-    model : {"tangential", "normal"} or model object
-        Base model family, or a model whose parameters start the fit
+    model : {"tangential", "normal"}, model object or None
+        Base model family (None, the default: inferred from the recording's channels by
+        :func:`infer_model`, as the command line infers it; the report's ``model_inferred``
+        says so), or a model whose parameters start the fit
         (:class:`contactlab.Masing`, a normal-contact model, or an :class:`ExtendedModel`
         from an earlier diagnosis, whose effects are kept).
     candidates : sequence of str, optional
@@ -1074,6 +1127,9 @@ def diagnose(
             recording, model if base is None else base, candidates=candidates,
             max_effects=max_effects, z=z, min_gain=min_gain,
         )  # fmt: skip
+    inferred = model is None and base is None
+    if inferred:
+        model = infer_model(recording)
     family, start, context = _family(model)
     t, u, y = _arrays(recording, family)
     named = {family.input_name: (u, family.input_unit), family.output_name: (y, family.output_unit)}
@@ -1373,6 +1429,7 @@ def diagnose(
             "candidate of the library"
         )
     return DiagnosisReport(
-        family.kind, out_effects, steps, where, sigma, final, location, d, trials,
-        checks["noise"], checks["not_detected"], checks["unexplained"],
+        family.kind, out_effects, steps, where, sigma, final, location, d, trials, inferred,
+        channel_noise=checks["noise"], not_detected=checks["not_detected"],
+        unexplained=checks["unexplained"],
     )  # fmt: skip

@@ -181,10 +181,9 @@ class IdentifiedModel:
 
     @classmethod
     def load(cls, path: str | Path) -> IdentifiedModel:
-        try:
-            d = json.loads(Path(path).read_text())
-        except (OSError, ValueError) as exc:  # ValueError: not UTF-8 or not JSON
-            raise InputError(f"cannot read model JSON {path}: {exc}") from None
+        from .model import load_json
+
+        d = load_json(path, "model JSON (`contactlab identify --json`)")
         return cls.from_dict(d)
 
     @classmethod

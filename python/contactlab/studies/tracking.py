@@ -732,6 +732,7 @@ def track(
     executor: Any = None,
     keep_documents: bool = False,
     threads: int | None = None,
+    resample: bool = False,
 ) -> TrackResult:
     """Fitted quantities of a long recording window by window, in bounded memory.
 
@@ -745,8 +746,10 @@ def track(
         :data:`AUTO_WINDOW` samples). Windows are cut at upward crossings of the drive
         (``x`` or ``p``), so they hold whole cycles; the first also holds the lead-in before
         the first crossing, and a last, shorter window is analysed when it has >= 3 cycles.
-    kind, columns, fs
-        As for :func:`contactlab.io.read_recording`.
+    kind, columns, fs, resample
+        As for :func:`contactlab.io.read_recording` (``resample``: a non-uniform time axis
+        interpolated onto a uniform grid, chunk by chunk; see
+        :func:`contactlab.io.read_chunks`).
     chunk_size : int
         Samples read at a time (default :data:`TRACK_CHUNK`).
     max_window : int
@@ -810,12 +813,12 @@ def track(
                 source, every, kind=kind, columns=columns, fs=fs, chunk_size=chunk_size,
                 max_window=max_window, options=options, keep_going=keep_going,
                 callback=callback, executor=pool, keep_documents=keep_documents,
-                slots=n_threads + (2 if n_threads >= 2 else 1),
+                slots=n_threads + (2 if n_threads >= 2 else 1), resample=resample,
             )  # fmt: skip
     return _track(
         source, every, kind=kind, columns=columns, fs=fs, chunk_size=chunk_size,
         max_window=max_window, options=options, keep_going=keep_going, callback=callback,
-        executor=executor, keep_documents=keep_documents, slots=None,
+        executor=executor, keep_documents=keep_documents, slots=None, resample=resample,
     )  # fmt: skip
 
 
@@ -834,6 +837,7 @@ def _track(
     executor: Any,
     keep_documents: bool,
     slots: int | None,
+    resample: bool = False,
 ) -> TrackResult:
     """:func:`track` on ``executor`` (None: serial); ``slots``: windows in flight at most
     (default two per worker)."""
@@ -841,7 +845,8 @@ def _track(
     every_text = every if isinstance(every, str) else f"{every}cycles"
     if not (isinstance(max_window, int) and max_window >= 16):
         raise InputError(f"max_window must be an integer >= 16, got {max_window!r}")
-    cr = read_chunks(source, chunk_size=chunk_size, columns=columns, kind=kind, fs=fs)
+    cr = read_chunks(source, chunk_size=chunk_size, columns=columns, kind=kind, fs=fs,
+                     resample=resample)  # fmt: skip
     kind_ = cr.kind
     if kind_ not in ("tangential", "normal"):
         raise InputError(
