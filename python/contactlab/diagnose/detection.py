@@ -223,7 +223,7 @@ def assess(
     and ``unexplained`` (:class:`contactlab.diagnose.misfit.Unexplained` or None), plus the
     settings they were computed at (``z``, ``gain_floor``, ``folds``, ``candidates``).
     """
-    from .misfit import unexplained_structure
+    from .misfit import eiv_tolerance, unexplained_structure
     from .power import POWER, _setting, detectable_above
 
     params = dict(current.full.params)
@@ -255,7 +255,10 @@ def assess(
                 _setting_cache=st,
             )
         )
-    misfit = unexplained_structure(d, residual, sigma, unit=family.output_unit)
+    misfit = unexplained_structure(
+        d, residual, sigma, unit=family.output_unit,
+        tolerance=eiv_tolerance(slope, noise.input_seen),
+    )  # fmt: skip
     return {
         "noise": noise,
         "not_detected": bounds,
