@@ -432,6 +432,12 @@ def detectable_above(
         per[s.name] = b
         rel[s.name] = None if b is None else b * float(np.sqrt(np.mean(j * j))) / st.y_rms
     mags = [s for s in cand.params if np.isfinite(s.null)]
+    if not mags:  # no parameter whose value means "absent" (e.g. a frame's fixed mass)
+        s0 = cand.params[0]
+        return Detectable(
+            name, s0.name, None, s0.unit, None, None, shape, per,
+            reason="no parameter of this effect has a value meaning 'absent': no bound",
+        )  # fmt: skip
     if not per or any(v is None for v in per.values()):
         worst = next((s for s in mags if per.get(s.name) is None), mags[0])
         return Detectable(
