@@ -130,7 +130,7 @@ def test_output_noise_beyond_the_channel_is_refused(recorded, capsys, noise):
     argv = ["diagnose", "--model", "tangential", str(path), "--output-noise", noise]
     assert main(argv) == 1
     line = _one_error_line(capsys)
-    assert str(path) in line and "output_noise" in line and "swing" in line
+    assert str(path) in line and "--output-noise" in line and "swing" in line
 
 
 @pytest.mark.parametrize("noise", ["nan", "inf", "-1", "0"])

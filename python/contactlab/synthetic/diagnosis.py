@@ -31,7 +31,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..diagnose.candidates_tangential import breakaway
-from ..diagnose.scaled_masing import memory, scaled_force
+from ..diagnose.effects.tangential.non_masing_scaling import turning_point_force, turning_points
 from ..errors import InputError
 from ..masing import Masing
 from ._common import (
@@ -98,7 +98,10 @@ def _tangential_force(
     tau = effects.get("channel_delay", 0.0)
     xc = xfun(t - tau)  # the contact moves as x(t - τ) when the force channel lags by τ
     if "non_masing_scaling" in effects:
-        h = scaled_force(Masing(h0, ac).virgin, effects["non_masing_scaling"], memory(xc))
+        # from rest at the actual turning points of the contact's motion (docs/effects.md)
+        turns = turning_points(xc, 1e-9 * float(np.ptp(xc)))
+        lam = effects["non_masing_scaling"]
+        h = turning_point_force(Masing(h0, ac).virgin, lam, xc, turns)
     else:
         h = Masing(h0, ac).force(xc)
     if "asymmetry" in effects:
