@@ -29,8 +29,17 @@ hidden_effect_recording = functools.partial(hidden_effect_recording, samples_per
 
 def _check_layout(d: dict) -> None:
     # the issue-5 layout; later issues extend it (29: "regime", "h0_check", the effects'
-    # "plausibility", the detection keys), never rename or drop a key
-    assert {"model", "effects", "steps", "where", "noise_rms", "final_model"} <= set(d)
+    # "plausibility"; both channels' noise, the stated power of each candidate not named and
+    # the test of structure left in the residual), never rename or drop a key
+    assert {
+        "model", "effects", "steps", "where", "noise_rms", "final_model", "channel_noise",
+        "not_detected", "unexplained",
+    } <= set(d)  # fmt: skip
+    named = {e["name"] for e in d["effects"]}
+    for b in d["not_detected"]:
+        assert b["effect"] not in named
+        assert {"effect", "parameter", "detectable_above", "unit"} <= set(b)
+    assert isinstance(d["unexplained"]["flagged"], bool)
     assert isinstance(d["model"], str) and isinstance(d["noise_rms"], float)
     for e in d["effects"]:
         assert {"name", "parameters", "stderr"} <= set(e)

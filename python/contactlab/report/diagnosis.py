@@ -18,15 +18,17 @@ FIGURES = (
 )
 
 
-def build(report: Any) -> Report:
-    """The :class:`~contactlab.report.Report` of ``report`` (figures drawn off-screen)."""
+def build(report: Any, intro: str | None = None) -> Report:
+    """The :class:`~contactlab.report.Report` of ``report`` (figures drawn off-screen);
+    ``intro`` (the "Made by" line of a command-line run) heads it."""
     from matplotlib.figure import Figure
 
-    r = Report(
-        f"Model discrepancy: {report.model} contact",
+    lead = (
         "Where the base model and the measurement disagree, which candidate effects explain "
-        "it (chosen by their error on held-out cycles) and how much the gap shrinks.",
+        "it (chosen by their error on held-out cycles) and how much the gap shrinks."
     )
+    r = Report(f"Model discrepancy: {report.model} contact",
+               f"{intro}\n\n{lead}" if intro else lead)  # fmt: skip
     r.section("Where the base model disagrees")
     for w in report.where:
         r.text(w, note=w.startswith("after "))
@@ -86,10 +88,10 @@ def build(report: Any) -> Report:
     return r
 
 
-def report_files(report: Any) -> dict[str, bytes]:
+def report_files(report: Any, intro: str | None = None) -> dict[str, bytes]:
     """Every file of the report, rendered in memory (relative name → content):
     ``diagnose.html`` first, its figures under ``figures/`` and ``diagnose.json``."""
-    files = build(report).files("diagnose.html")
+    files = build(report, intro).files("diagnose.html")
     files["diagnose.json"] = (report.to_json() + "\n").encode("utf-8")
     return files
 

@@ -107,7 +107,10 @@ def _tangential_force(
     if "asymmetry" in effects:
         h = h + effects["asymmetry"] * np.abs(h)
     if "parameter_drift" in effects:
-        h = h * (1.0 + effects["parameter_drift"] * (t - t[0]) / (t[-1] - t[0]))
+        # h0(t) = h0 (1 + β (t - t_m)/T) over the record kept (docs/effects.md: h0 the
+        # mid-record value), t_m its middle and T its length
+        t0 = t[0] if t_start is None else t_start
+        h = h * (1.0 + effects["parameter_drift"] * ((t - t0) / (t[-1] - t0) - 0.5))
     v, a = _derivs(xfun, t - tau, period)
     if "stick_slip" in effects:
         # reversals of the contact's own motion (sign changes of its exact velocity)
