@@ -155,7 +155,7 @@ impl MasingCore {
             st = detach_guarded(py, || {
                 if threads > 1 {
                     let mut sts = [st];
-                    masing::split::force_channels(
+                    masing::channels::force_channels(
                         &[me],
                         &[xs],
                         vec![out],
@@ -259,7 +259,7 @@ impl MasingCore {
     }
 }
 
-impl masing::split::Channel for MasingCore {
+impl masing::channels::Channel for MasingCore {
     fn split(
         &self,
         x: &[f64],
@@ -268,7 +268,7 @@ impl masing::split::Channel for MasingCore {
         emit: &mut dyn FnMut(usize, MasingState) -> bool,
     ) -> Result<masing::split::Walked, CoreError> {
         let rule = self.rule();
-        with_curve!(&self.curve, curve => masing::split::Model { curve, rule }.split(x, state, piece, emit))
+        with_curve!(&self.curve, curve => masing::channels::Model { curve, rule }.split(x, state, piece, emit))
     }
     fn piece(
         &self,
@@ -277,7 +277,7 @@ impl masing::split::Channel for MasingCore {
         state: &mut MasingState,
     ) -> Result<bool, CoreError> {
         let rule = self.rule();
-        with_curve!(&self.curve, curve => masing::split::Model { curve, rule }.piece(x, out, state))
+        with_curve!(&self.curve, curve => masing::channels::Model { curve, rule }.piece(x, out, state))
     }
     fn whole(&self, x: &[f64], out: &mut [f64], state: &mut MasingState) -> Result<(), CoreError> {
         let rule = self.rule();

@@ -5,7 +5,8 @@ use contactlab_core::cycles::{cycle_block, CycleState};
 use contactlab_core::fold::{fold_phase, fold_spread, period_means, period_means_pair, FoldSums};
 use contactlab_core::isotonic::monotone_path;
 use contactlab_core::loop_area::{loop_area_sensitivity, loop_areas};
-use contactlab_core::masing::split::{force_channels, Channel, PIECE};
+use contactlab_core::masing::channels::{force_channels, Channel};
+use contactlab_core::masing::split::PIECE;
 use contactlab_core::masing::{branch_memory, MasingState};
 use contactlab_core::parallel::run_jobs;
 use contactlab_core::reversal::{Excursion, Schmitt};
@@ -126,7 +127,7 @@ fn branch_memory_py<'py>(
 }
 
 /// Forces of several channels, each from the origin with its own model, on up to `threads`
-/// Rust threads inside this one call (GIL released; `contactlab_core::masing::split::
+/// Rust threads inside this one call (GIL released; `contactlab_core::masing::channels::
 /// force_channels`: channels of at least two pieces of `piece` samples are split by a
 /// comparisons-only pre-pass, then pieces and short channels go longest first from one shared
 /// queue; bit for bit the serial kernel). Into `outs` when given (one
