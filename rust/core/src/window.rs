@@ -613,7 +613,7 @@ fn next_bin(g: f64, b_hi: f64, cb: usize, nb: usize) -> (usize, f64, f64) {
 // the knots' length (t < kt[last] inside the loop), i < end <= n inside the loops.
 // Not inlined: with fat LTO the binding inlined it into its wrapper, where the fold's loop
 // kept more of its state on the stack (26 against 22 ms a window of 2^20 samples).
-#[allow(clippy::arithmetic_side_effects, clippy::too_many_lines)]
+#[allow(clippy::arithmetic_side_effects)]
 #[inline(never)]
 pub fn fold_window(
     t: &[f64],

@@ -314,7 +314,6 @@ struct State {
 /// `u²(1−u)²(α + βu)`; it changes the step's right-hand side by `α ea + β eb`, and δ₁ by that
 /// over the Newton derivative `dg` (which carries the δ-dependence of `N₁`: a small
 /// tangent stiffness magnifies the error by `k_s / k_t`).
-#[allow(clippy::too_many_arguments)]
 fn advance(
     model: &ContactModel,
     seg: &Segment,
