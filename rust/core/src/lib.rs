@@ -3,6 +3,8 @@
 //! - [`curve`]: virgin curves (the exponential curve of the tangential-contact paper, tabulated
 //!   measured backbones).
 //! - [`isotonic`]: isotonic regression (PAVA) and the monotone projection of a path.
+//! - [`joints`]: displacement-driven joint laws (Jenkins, Iwan, Segalman, Maxwell-slip, Dahl,
+//!   LuGre, Bouc-Wen, composed in series / parallel / behind a backlash).
 //! - [`loop_fit`]: Levenberg–Marquardt fit of the steady Masing loop to an averaged cycle.
 //! - [`masing`]: the Masing operator with non-local memory, cycle counting and loop areas.
 //! - [`parallel`]: independent jobs (channels, recordings) on scoped threads.
@@ -33,6 +35,7 @@ pub mod error;
 pub mod extrema;
 pub mod fold;
 pub mod isotonic;
+pub mod joints;
 pub mod loop_area;
 pub mod loop_fit;
 pub mod masing;

@@ -30,7 +30,9 @@ pub fn class_of(e: &CoreError) -> Class {
         | CoreError::InvalidState { .. }
         | CoreError::OutOfRange { .. }
         | CoreError::TooLong { .. }
-        | CoreError::NonPositiveStiffness { .. } => Class::Input,
+        | CoreError::NonPositiveStiffness { .. }
+        | CoreError::NoSolution { .. }
+        | CoreError::InvalidLaw { .. } => Class::Input,
     }
 }
 

@@ -13,6 +13,7 @@ mod cycles;
 mod error;
 mod fold;
 mod isotonic;
+mod joints;
 mod loop_area;
 mod loop_fit;
 mod masing;
@@ -24,6 +25,9 @@ mod stream;
 mod structure;
 mod window;
 use error::{internal, to_pyerr};
+// The old name of `error`, still used by `joints.rs` (owned by another change; drop the alias
+// once it imports `crate::error`).
+use error as errors;
 
 /// A float array returned to Python.
 pub(crate) type Arr<'py> = Bound<'py, numpy::PyArray1<f64>>;
@@ -75,5 +79,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     scan::register(m)?;
     stream::register(m)?;
     loop_fit::register(m)?;
+    joints::register(m)?;
     Ok(())
 }

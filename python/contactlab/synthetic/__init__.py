@@ -1,0 +1,1 @@
+"""Synthetic recordings: independent generators of the measurement chain (see docs/effects.md)."""
