@@ -46,17 +46,12 @@ def frame_records() -> list[tuple[str, object, int]]:
 
 
 def tribo_records() -> list[tuple[str, object, int]]:
-    """The tribometer's loaded part (7.7 s to 209.8 s), µN and mm to SI, resampled to its
-    median step (5 ms) by linear interpolation: its sampling is not uniform (5 and 9-10 ms
-    steps) and its unit µN is not one the readers know."""
-    a = np.loadtxt(DATA / "microtribometer" / "test_data_2.txt", skiprows=1)
-    t, x, F = a[:, 0], a[:, 2] * 1e-3, a[:, 3] * 1e-6
-    keep = (t > 8.0) & (t < 209.0)
-    t, x, F = t[keep], x[keep], F[keep]
-    dt = float(np.median(np.diff(t)))
-    tu = np.arange(t[0], t[-1], dt)
-    rec = Recording(tu - tu[0], {"x": np.interp(tu, t, x), "F": np.interp(tu, t, F)},
-                    {"x": "m", "F": "N"}, "microtribometer")  # fmt: skip
+    """The tribometer as the command line reads it: ``--resample`` (its 5 and 9-10 ms
+    steps brought to the median step), units µN and mm to SI, the whole record."""
+    from contactlab.io import read_recording
+
+    path = DATA / "microtribometer" / "test_data_2.txt"
+    rec = read_recording(str(path), kind="tangential", resample=True)
     return [("microtribometer", rec, -1)]
 
 

@@ -95,7 +95,7 @@ def test_failing_report_leaves_the_previous_json(quick, tmp_path, capsys, monkey
 
 
 def test_interrupt_while_rendering_writes_nothing(quick, tmp_path, capsys, monkeypatch):
-    import contactlab.diagnose._html as html
+    import contactlab.report.diagnosis as html
 
     prev = tmp_path / "prev.json"
     prev.write_text("PREV", encoding="utf-8")

@@ -2,7 +2,14 @@
 
 Base model (PHYSICS.md §1): Masing hysteresis with the exponential virgin curve
 ``f(u) = h0 (1 - exp(-ac u))`` and branch scale 2, force ``h = M(x)`` for the measured
-displacement history ``x``. Candidate effects, each with its own fitted parameters:
+displacement history ``x``. The candidate effects are objects, one file each under
+``diagnose/effects/tangential/`` (:func:`contactlab.diagnose.effects.registry`), defined
+physically in ``docs/effects.md``: each has its parameters (name, unit, bounds, the value
+meaning "absent"), what it does at its stage of the composition
+(:meth:`~contactlab.diagnose.effects.EffectModel.apply`), whether a fitted value is
+physical on a record and why (:meth:`~contactlab.diagnose.effects.EffectModel.plausible`)
+and the smallest size a record reveals
+(:meth:`~contactlab.diagnose.effects.EffectModel.detectable`). A new effect is one new file.
 
 ========================  =========================================================  =========
 name                      measured force ``F`` (or measured ``x``)                   params
@@ -16,26 +23,30 @@ name                      measured force ``F`` (or measured ``x``)              
 ``displacement_offset``   ``h = M(x - x0)`` (displacement sensor zero off the origin)  x0 [m]
 ``channel_delay``         ``F(t) = h(t - τ)`` (force channel lags displacement)       tau [s]
 ``asymmetry``             ``F = h + α |h|``: saturation ``h0(1 ± α)`` per direction   alpha [-]
-``non_masing_scaling``    branch scale ``λ`` instead of 2, loops kept closed           lam [-]
-``parameter_drift``       ``h0(t) = h0 (1 + β t/T)``, i.e. ``F = h (1 + β t/T)``      beta [-]
+``non_masing_scaling``    branches ``h_r + λ f((x - x_r)/λ)`` from rest at the turns  lam [-]
+``parameter_drift``       ``F = h (1 + β (t - t_m)/T)``, ``t_m`` mid-record           beta [-]
+``stribeck``              ``F = h (1 + s exp(-|ẋ|/v_s))``                              s, v_s
+``position_friction``     ``F = h (1 + Σ a_k cos kπξ + b_k sin kπξ)``                  a_k, b_k
+``stick_slip``            breakaway ``s_b`` after each reversal over ``ell``           s_b, ell
+``normal_load``           ``F = h (1 + ε_c cos 2π f_n t + ε_s sin 2π f_n t)``          eps, f_n
+``power_law_microslip``   Segalman's Iwan element (F_S = h0, K_T = h0 ac)             chi, beta
+``backlash``              ``F = M(u)``, ``u`` the play operator of ``x`` (width 2b)   b [m]
+``rate_dependent_         ``F = h + σ1 ẋ k(x)/k0`` (LuGre micro-damping)              sigma1
+presliding``
 ========================  =========================================================  =========
 
 Notes on exactness. The exponential Masing force is linear in ``h0`` at fixed ``ac`` along a
 history, so the drift factor is exact. A linear spring in series with a Masing element is
-again a Masing element whose virgin curve is ``x(u) = u + C_s f(u)`` against ``f(u)`` (the
-branch rule ``x - x_r = λ g⁻¹((F - F_r)/λ)`` holds for the sum because both parts obey it),
-so the series compliance is solved exactly by reparametrising the virgin curve and using
-:meth:`contactlab.Masing.from_backbone`. The branch scale uses
-:mod:`contactlab.diagnose.scaled_masing` (λ-scaled branch shape anchored at both ends),
-because ``Masing(..., scale=λ)`` jumps where the memory rules end a branch and so cannot
-be fitted to noisy data. ``ẋ`` and ``ẍ`` are Savitzky-Golay derivatives of the
-measured displacement; the delay is a fractional-sample shift by linear interpolation.
-Beyond the issue's list, ``force_drift`` and ``displacement_offset`` cover two common sensor
-faults that no other candidate can stand in for. When several effects are active they
-compose in this order: displacement offset on the input; series compliance and branch
-scale inside the Masing element; asymmetry and drift on its force; the additive terms
-(parallel stiffness, viscous, inertia, offset, force drift); the delay on the total
-measured force.
+again a Masing element whose virgin curve is ``x(u) = u + C_s f(u)`` against ``f(u)``, so
+the series compliance is solved exactly by reparametrising the virgin curve
+(:meth:`contactlab.Masing.from_backbone`); Segalman's element likewise (an Iwan model obeys
+Masing's rules). The branch scale and the play operator run on the actual turning points of
+the filtered input (a hysteresis of a few input-noise standard deviations). ``ẋ`` and ``ẍ``
+are Savitzky-Golay derivatives of the measured displacement; the delay is a
+fractional-sample shift by linear interpolation. When several effects are active they
+compose by stage (:data:`contactlab.diagnose.effects.TANGENTIAL_STAGES`): the displacement
+the contact sees; the element; terms on its force; the breakaway; factors on the friction;
+the additive terms; the delay on the total measured force.
 """
 
 from __future__ import annotations
@@ -718,6 +729,10 @@ class TangentialFamily:
         :meth:`~contactlab.diagnose.effects.EffectModel.plausible`)."""
         ok, why = EFFECTS[name].plausible(d, p)
         return None if ok else why
+
+    def identified(self, name: str, p: dict[str, float], se: dict[str, float]) -> str | None:
+        """Why a fitted effect's size is not identified (within its error of "absent")."""
+        return EFFECTS[name].identified(p, se)
 
     def plausibility(self, name: str, p: dict[str, float], d: Prepared) -> tuple[bool, str]:
         """The effect's plausibility verdict and its argument in numbers."""

@@ -102,6 +102,13 @@ def _try_candidate(
     ) or _takes_over(family, base_fit, p)
     if v.accepted and why:
         v = dataclasses.replace(v, accepted=False, reason=f"implausible: {why}")
+    if v.accepted and hasattr(family, "identified"):
+        # each new effect's size must stand out of its own error (issue 29: a held-out gain
+        # the effect shares with a base parameter it trades off with is not its own)
+        unid = next((w for e in (*also, name) if (w := family.identified(e, p, cand.full.stderr))),
+                    None)  # fmt: skip
+        if unid:
+            v = dataclasses.replace(v, accepted=False, reason=unid)
     return v, cand
 
 

@@ -156,6 +156,29 @@ class EffectModel:
                     )
         return Plausibility(True, self.argument(recording, p))
 
+    #: a named effect's size must lie this many standard errors from "absent"
+    IDENTIFIED_SIGMAS: ClassVar[float] = 2.0
+
+    def size(self, p: dict[str, float], se: dict[str, float]) -> tuple[float, float]:
+        """The effect's size (distance of ``size_param`` from its null) and its standard
+        error; effects with several amplitude parameters combine them."""
+        s = next((q for q in self.params if q.name == self.size_param), self.params[0])
+        null = s.null if np.isfinite(s.null) else 0.0
+        return abs(p[s.name] - null), float(se.get(s.name, np.inf))
+
+    def identified(self, p: dict[str, float], se: dict[str, float]) -> str | None:
+        """Why the fitted effect is not identified (its size within
+        :attr:`IDENTIFIED_SIGMAS` standard errors of "absent": its parameters trade off with
+        the others', and the held-out gain it brings is not its own), or None."""
+        v, e = self.size(p, se)
+        if np.isfinite(e) and v < self.IDENTIFIED_SIGMAS * e:
+            return (
+                f"not identifiable: its size {v:.3g} ± {e:.2g} is within "
+                f"{self.IDENTIFIED_SIGMAS:g} standard errors of no effect (its parameters "
+                "trade off with the others')"
+            )
+        return None
+
     def argument(self, recording: Prepared, p: dict[str, float]) -> str:
         """The physical argument for a plausible fitted effect, in numbers."""
         vals = ", ".join(f"{s.name} = {p[s.name]:.4g} {s.unit}" for s in self.params)

@@ -81,6 +81,18 @@ class NormalLoad(EffectModel):
     order = 14
     size_param = "eps_c"
 
+    def size(self, p, se):
+        """The amplitude over (eps_c, eps_s), with its delta-method error."""
+        names = (
+            "eps_c",
+            "eps_s",
+        )
+        v = float(np.sqrt(sum(p[n] ** 2 for n in names)))
+        if v == 0:
+            return 0.0, float(np.inf)
+        e2 = sum((p[n] / v * se.get(n, np.inf)) ** 2 for n in names)
+        return v, float(np.sqrt(e2))
+
     def start(self, p, d, residual):
         """The frequency whose ``h cos, h sin`` pair explains most of the residual, scanned
         from 0.05 excitation frequencies (at least two periods in the record) to 3, at a

@@ -34,6 +34,20 @@ class PositionFriction(EffectModel):
     order = 12
     size_param = "a1"
 
+    def size(self, p, se):
+        """The amplitude over (a1, b1, a2, b2), with its delta-method error."""
+        names = (
+            "a1",
+            "b1",
+            "a2",
+            "b2",
+        )
+        v = float(np.sqrt(sum(p[n] ** 2 for n in names)))
+        if v == 0:
+            return 0.0, float(np.inf)
+        e2 = sum((p[n] / v * se.get(n, np.inf)) ** 2 for n in names)
+        return v, float(np.sqrt(e2))
+
     def apply(self, h, p, ctx):
         d = ctx.d
         if "displacement_offset" in ctx.effects:
