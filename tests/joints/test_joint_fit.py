@@ -182,6 +182,8 @@ def test_bad_input_is_refused_with_a_named_error():
         fit(t, x, F, law="jenkins", fixed=["sigma0"])
     with pytest.raises(InputError, match=r"x.* not finite"):
         fit(t, np.where(t > 1, np.nan, x), F, law="jenkins")
+    with pytest.raises(InputError, match="max_samples must be"):
+        fit(t, x, F, law="jenkins", max_samples=0)
     with pytest.raises(InputError, match="give t, x and F"):
         fit(t, x, law="jenkins")
 

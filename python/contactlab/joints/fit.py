@@ -618,6 +618,12 @@ def fit(
         recs = as_records(records, fs=fs)
     for r in recs:
         r.require_force()
+    if max_samples is not None and not (isinstance(max_samples, int) and max_samples >= 10):
+        raise InputError(
+            f"max_samples must be an integer >= 10 (or None: all), got {max_samples!r}"
+        )
+    if not (isinstance(n_elements, int) and n_elements >= 1):
+        raise InputError(f"n_elements must be an integer >= 1, got {n_elements!r}")
     terms = [n for n, on in (("offset", offset), ("k_parallel", stiffness),
                              ("c_parallel", damping), ("mass", mass),
                              ("asymmetry", asymmetry)) if on]  # fmt: skip
