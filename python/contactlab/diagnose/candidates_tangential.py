@@ -4,21 +4,21 @@ Base model (PHYSICS.md §1): Masing hysteresis with the exponential virgin curve
 ``f(u) = h0 (1 - exp(-ac u))`` and branch scale 2, force ``h = M(x)`` for the measured
 displacement history ``x``. Candidate effects, each with its own fitted parameters:
 
-========================  =========================================================  =========
-name                      measured force ``F`` (or measured ``x``)                   params
-========================  =========================================================  =========
-``viscous_damping``       ``F = h + c ẋ``                                             c  [N s/m]
-``inertia``               ``F = h + m ẍ``  (mass between sensor and contact)          m  [kg]
-``parallel_stiffness``    ``F = h + k_p x`` (rig flexures in parallel)                k_p [N/m]
-``series_compliance``     ``x = x_c + C_s h`` (rig compliance in series)              C_s [m/N]
-``force_offset``          ``F = h + F0`` (sensor bias)                                F0 [N]
-``force_drift``           ``F = h + F1 (t - t0)/T`` (load-cell zero drifting)        F1 [N]
-``displacement_offset``   ``h = M(x - x0)`` (displacement sensor zero off the origin)  x0 [m]
-``channel_delay``         ``F(t) = h(t - τ)`` (force channel lags displacement)       tau [s]
-``asymmetry``             ``F = h + α |h|``: saturation ``h0(1 ± α)`` per direction   alpha [-]
-``non_masing_scaling``    branch scale ``λ`` instead of 2, loops kept closed           lam [-]
-``parameter_drift``       ``h0(t) = h0 (1 + β t/T)``, i.e. ``F = h (1 + β t/T)``      beta [-]
-========================  =========================================================  =========
+=======================  ===========================================================  =========
+name                     measured force ``F`` (or measured ``x``)                     params
+=======================  ===========================================================  =========
+``viscous_damping``      ``F = h + c ẋ``                                              c [N s/m]
+``inertia``              ``F = h + m ẍ`` (mass between sensor and contact)            m [kg]
+``parallel_stiffness``   ``F = h + k_p x`` (rig flexures in parallel)                 k_p [N/m]
+``series_compliance``    ``x = x_c + C_s h`` (rig compliance in series)               C_s [m/N]
+``force_offset``         ``F = h + F0`` (sensor bias)                                 F0 [N]
+``force_drift``          ``F = h + F1 (t - t0)/T`` (load-cell zero drifting)          F1 [N]
+``displacement_offset``  ``h = M(x - x0)`` (displacement sensor zero off the origin)  x0 [m]
+``channel_delay``        ``F(t) = h(t - τ)`` (force channel lags displacement)        tau [s]
+``asymmetry``            ``F = h + α |h|``: saturation ``h0(1 ± α)`` per direction    alpha [-]
+``non_masing_scaling``   branch scale ``λ`` instead of 2, loops kept closed           lam [-]
+``parameter_drift``      ``h0(t) = h0 (1 + β t/T)``, i.e. ``F = h (1 + β t/T)``       beta [-]
+=======================  ===========================================================  =========
 
 Notes on exactness. The exponential Masing force is linear in ``h0`` at fixed ``ac`` along a
 history, so the drift factor is exact. A linear spring in series with a Masing element is
