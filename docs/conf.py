@@ -135,6 +135,15 @@ os.environ.setdefault("CONTACTLAB_DOCS", "1")
 OPTIONAL_PAGES = {"effects": "User guides", "architecture": "Reference"}
 
 
+# The repository's ARCHITECTURE.md (the layers and where code goes), shown as a page of its
+# own: docs/architecture.md includes it, written here when it exists (and not committed).
+if (ROOT / "ARCHITECTURE.md").exists():
+    (HERE / "architecture.md").write_text(
+        "```{include} ../ARCHITECTURE.md\n:relative-docs: docs/\n:relative-images:\n```\n",
+        encoding="utf-8",
+    )
+
+
 def _optional_toc(app, docname, source):
     """Append the optional pages that exist to the index's table of contents."""
     if docname != "index":

@@ -18,9 +18,9 @@ from typing import Any
 from ..errors import InputError
 from ._common import (
     check_output_targets,
-    command_line,
     describe,
     json_text,
+    made_by,
     parse_columns,
     quantity,
     write_json,
@@ -130,7 +130,7 @@ def _handler(args: argparse.Namespace) -> int:
         from ..report import commit_outputs
         from ..report.joints_report import build_joint_report
 
-        cmd = command_line("fit-joint", "--law", args.law, "--fit", *args.fit,
+        cmd = made_by(args, "fit-joint", "--law", args.law, "--fit", *args.fit,
                            *(["--predict", *args.predict] if args.predict else []),
                            "--report", args.report)  # fmt: skip
         rep = build_joint_report(fits, table, records, roles,
