@@ -306,7 +306,7 @@ def test_cli_diagnose_takes_fs_for_a_file_without_time(tmp_path, capsys):
     np.savetxt(path, np.column_stack([rec["x"], rec["F"]]), delimiter=",", header="x,F",
                comments="", fmt="%.17g")  # fmt: skip
     assert main(["diagnose", str(path), "--model", "tangential"]) == 1
-    assert "fs=" in capsys.readouterr().err
+    assert "--fs" in capsys.readouterr().err  # the hint names the flag (issue 31)
     out = tmp_path / "d.json"
     code = main(["diagnose", str(path), "--model", "tangential", "--fs", repr(fs),
                  "--json", str(out)])  # fmt: skip
