@@ -12,7 +12,7 @@ $(STAMP): pyproject.toml
 	$(PIP) install -q --upgrade pip
 	$(PIP) install -q "maturin>=1.9,<2" "numpy>=1.24" "scipy>=1.10" "matplotlib>=3.7" \
 		"pytest>=8" "hypothesis>=6.100" "ruff>=0.6" "mypy>=1.10" "npTDMS>=1.9" "h5py>=3.9" "pyarrow>=14" "tqdm>=4.60" \
-		"dask[distributed]>=2024.1" "threadpoolctl>=3.1"
+		"dask[distributed]>=2024.1" "threadpoolctl>=3.1" "import-linter>=2.1"
 	touch $(STAMP)
 
 # The documentation's tools, in a stamp of their own: `make test` does not need them.
@@ -41,9 +41,11 @@ rust-lint:
 	cargo fmt --all --check
 	cargo clippy --workspace --all-targets --locked -q -- -D warnings
 
-py-lint: $(STAMP)
+# lint-imports: the layer, independence and no-cycle contracts of pyproject.toml (ARCHITECTURE.md)
+py-lint: develop
 	$(VENV)/bin/ruff check $(PYSRC)
 	$(VENV)/bin/ruff format --check $(PYSRC)
+	$(VENV)/bin/lint-imports
 
 pytest: develop
 	$(PY) -m pytest -q -p no:cacheprovider

@@ -15,7 +15,7 @@ import contactlab
 from contactlab.cli import cli_wording, join_negative_values, main
 from contactlab.commands.structure import read_table
 from contactlab.io import write_recording
-from contactlab.tangential import synthetic_recording
+from contactlab.synthetic.tangential import synthetic_recording
 
 INFERRED = re.compile(r"model tangential, inferred from the columns x='x \[m\]', F='F \[N\]'")
 

@@ -100,6 +100,17 @@ def add_parser(subparsers: Any) -> None:
         help="tangential: a known delay of the force behind the displacement (e.g. 1.1ms), "
         "corrected before the diagnosis (the force read that much later)",
     )
+    from ..commands._common import FORCE_SIGN_CHOICES, force_sign
+
+    p.add_argument(
+        "--force-sign",
+        type=force_sign,
+        choices=FORCE_SIGN_CHOICES,
+        default=None,
+        help="tangential: diagnose F (+1) or -F (-1), as analyze takes it; auto: the sign that "
+        "makes the loop area ∮F dx positive (a passive joint dissipates). Default: F as "
+        "recorded (a loop that runs the wrong way is refused, naming this flag)",
+    )
     p.set_defaults(handler=run)
 
 
@@ -257,6 +268,9 @@ def run(args: argparse.Namespace) -> int:
         rec, dropped = shifted_recording(rec, args.delay)
         print(f"{args.file}: force read {1e3 * args.delay:.4g} ms later (--delay); {dropped} "
               "samples left without force data dropped")  # fmt: skip
+    sign = getattr(args, "force_sign", None)
+    if sign is not None and args.model != "tangential":
+        raise InputError("--force-sign is for tangential recordings (the force's sign)")
     if args.model == "normal":
         from ..commands._common import with_static_pressure
 
@@ -264,7 +278,8 @@ def run(args: argparse.Namespace) -> int:
                                    getattr(args, "pa", None))  # fmt: skip
     try:
         report = diagnose(rec, model=args.model, max_effects=args.max_effects,
-                          output_filter=taps, output_noise=args.output_noise)  # fmt: skip
+                          output_filter=taps, output_noise=args.output_noise,
+                          **({"force_sign": sign} if sign is not None else {}))  # fmt: skip
     except (InputError, ConvergenceError) as exc:  # name the file: the workflow sees arrays
         kind = ConvergenceError if isinstance(exc, ConvergenceError) else InputError
         raise kind(f"{args.file}: {exc}") from exc
@@ -294,7 +309,7 @@ def run(args: argparse.Namespace) -> int:
 
         matplotlib.use("Agg")
         from ..commands._common import made_by
-        from ..diagnose._html import report_files
+        from ..report.diagnosis import report_files
 
         files = report_files(report, intro=f"Made by: {made_by(args, 'diagnose', args.file)}")
     print(report.summary())

@@ -7,7 +7,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from ..report import Column, Report
+from .._html import Column, Report
+from . import diagnosis_plots
 
 FIGURES = (
     ("loops", "Loops: measurement, base model and final model", "plot_overlay"),
@@ -65,7 +66,7 @@ def build(report: Any, intro: str | None = None) -> Report:
     r.text(report.noise_text()[0].upper() + report.noise_text()[1:])
     for name, caption, method in FIGURES:
         fig = Figure(figsize=(7.0, 4.4), layout="constrained")
-        getattr(report, method)(ax=fig.add_subplot())
+        getattr(diagnosis_plots, method)(report, ax=fig.add_subplot())
         r.figure(fig, name, caption, dpi=110)
     r.section("Candidates tried")
     for i, s in enumerate(report.steps):
@@ -98,6 +99,6 @@ def report_files(report: Any, intro: str | None = None) -> dict[str, bytes]:
 def write_html(report: Any, directory: str | Path) -> Path:
     """Write ``diagnose.html``, its figures and ``diagnose.json`` into ``directory``, all or
     nothing."""
-    from ..report import commit_outputs
+    from .._outputs import commit_outputs
 
     return commit_outputs(directory, report_files(report))[0]
