@@ -434,9 +434,11 @@ def infer_model(recording: Any) -> str:
     if kind in ("tangential", "normal"):
         return str(kind)
     if isinstance(recording, dict):
-        if "x" in recording and "F" in recording:
+        # the family whose channels are there (the family's own check then names a missing
+        # one: {"x": ..., "force": ...} is a tangential recording without 'F')
+        if "x" in recording or "F" in recording:
             return "tangential"
-        if "p" in recording and "delta" in recording:
+        if "p" in recording or "delta" in recording:
             return "normal"
     if isinstance(recording, tuple):
         return "tangential"
