@@ -8,6 +8,7 @@ and exit non-zero; Ctrl-C exits 130 without leaving partial outputs (writers are
 from __future__ import annotations
 
 import argparse
+import contextlib
 import gc
 import importlib
 import re
@@ -32,9 +33,13 @@ _VERB_MODULES = [
     "contactlab.commands.diagnose",
     "contactlab.commands.export",
     "contactlab.commands.structure",
+    "contactlab.commands.fit_joint",
 ]
 #: verbs whose module is not ``contactlab.commands.<verb>``
-_VERB_ALIASES = {"identify": "contactlab.commands.structure"}
+_VERB_ALIASES = {
+    "identify": "contactlab.commands.structure",
+    "fit-joint": "contactlab.commands.fit_joint",
+}
 
 
 # Temporaries of the atomic writers: ".report.html.k2j4x9.part" beside "report.html".
@@ -83,7 +88,14 @@ def build_parser(verb_module: str | None = None) -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     if argv is None:  # the process's own command line: it ends when this returns
         try:
-            return _main(sys.argv[1:])
+            code = _main(sys.argv[1:])
+            if code == _INTERRUPTED:
+                _exit_interrupted()
+            return code
+        except KeyboardInterrupt:  # before the verb's handler started, or after it ended
+            print("contactlab: interrupted; no partial outputs written", file=sys.stderr)
+            _exit_interrupted()
+            raise  # not reached
         finally:
             # a structure scan started ahead for a file the run never opened (a usage error,
             # Ctrl-C) stops at its next block instead of holding the exit for the whole file
@@ -95,6 +107,28 @@ def main(argv: Sequence[str] | None = None) -> int:
             # for memory the process is about to give back anyway
             gc.freeze()
     return _main(list(argv))
+
+
+#: the exit status of an interrupted run (128 + SIGINT), as a shell reports it
+_INTERRUPTED = 130
+
+
+def _exit_interrupted() -> None:
+    """End an interrupted run now, with status 130: the pools' workers are killed and the
+    interpreter's exit handlers are skipped (they join the pools' threads, which can wait for
+    ever on a worker blocked where SIGINT reached only the parent). Nothing is lost: outputs
+    are written all or nothing, and an interrupted run wrote none."""
+    import os
+
+    try:
+        from .commands._common import kill_worker_processes
+
+        kill_worker_processes()
+    finally:
+        for stream in (sys.stdout, sys.stderr):
+            with contextlib.suppress(Exception):
+                stream.flush()
+        os._exit(_INTERRUPTED)
 
 
 #: verbs that read recordings named on their command line
@@ -119,29 +153,81 @@ def _prefetch(argv: list[str]) -> None:
         prefetch_structure_check(f)
 
 
+#: a Python hint followed by its command-line form: ``pass fs= (Hz) or columns={'t': ...}
+#: (command line: --fs or --columns 't=...')`` -> ``give --fs or --columns 't=...'``
+_PY_HINT = re.compile(
+    r"(?:pass |give )?(?:[a-z_]+=(?:\{[^{}]*\}|[^\s(),;]*)(?: \([^)]*\))?(?:,? (?:and|or) )?)+"
+    r" \(command line: ([^)]*)\)"
+)
+#: a Python spelling in parentheses after the command-line one: ``--frame-x (columns={...})``
+_PY_ASIDE = re.compile(r" \((?:columns|resample|kind|fs)=[^)]*\)")
+#: keyword arguments named in messages -> their flags
+_PY_NAMES = re.compile(r"\b(max_effects|chunk_size|max_window|output_noise|output_filter)\b")
+
+
+def cli_wording(message: str) -> str:
+    """An error message of the library as the command line says it: the hints name flags,
+    not keyword arguments (``columns={'x': ...}`` -> ``--columns``, ``max_effects`` ->
+    ``--max-effects``).
+
+    Examples
+    --------
+    >>> cli_wording("no time column: pass fs= (Hz) or columns={'t': ...} (command line: "
+    ...             "--fs or --columns 't=...')")
+    "no time column: give --fs or --columns 't=...'"
+    >>> cli_wording("max_effects must be >= 0, got -1")
+    '--max-effects must be >= 0, got -1'
+    """
+    text = _PY_HINT.sub(lambda m: "give " + m.group(1), message)
+    text = _PY_ASIDE.sub("", text)
+    return _PY_NAMES.sub(lambda m: "--" + m.group(1).replace("_", "-"), text)
+
+
+_NEGATIVE = re.compile(r"^-(\d|\.\d)")
+
+
+def join_negative_values(argv: list[str]) -> list[str]:
+    """``--area -50cm2`` as ``--area=-50cm2`` (and ``--frame -3,0.6,1191``, ``--delay -1ms``):
+    argparse takes a word starting with ``-`` for an option unless it is a plain number, and
+    would say only "expected one argument". A long option followed by a word that starts
+    with a minus and a digit gets it as its value (no verb has a positional that could be
+    a negative number: positionals are files).
+
+    Examples
+    --------
+    >>> join_negative_values(["export", "r.json", "--area", "-50cm2", "--check"])
+    ['export', 'r.json', '--area=-50cm2', '--check']
+    """
+    out = list(argv)
+    for i in range(len(out) - 2, -1, -1):
+        if out[i] == "--":
+            break
+        if out[i].startswith("--") and "=" not in out[i] and _NEGATIVE.match(out[i + 1]):
+            out[i : i + 2] = [f"{out[i]}={out[i + 1]}"]
+    return out
+
+
 def _main(argv: list[str]) -> int:
-    # `--frame -3,0.6,1191`: argparse would take the negative value for an option and say
-    # only "expected one argument"; joined, the frame's own check names the bad mass
-    for i in range(len(argv) - 2, -1, -1):
-        if argv[i] == "--frame" and argv[i + 1][:2] in {f"-{d}" for d in "0123456789."}:
-            argv[i : i + 2] = [f"--frame={argv[i + 1]}"]
+    given = list(argv)  # as typed, for the reports' "Made by" line
+    argv = join_negative_values(argv)
     _prefetch(argv)
     parser = build_parser(_verb_module(argv))
     args = parser.parse_args(argv)
+    args.argv = given
     if not getattr(args, "handler", None):
         parser.print_help()
         return 2
     try:
         return int(args.handler(args) or 0)
     except ContactLabError as exc:
-        print(f"contactlab {args.verb}: error: {exc}", file=sys.stderr)
+        print(f"contactlab {args.verb}: error: {cli_wording(str(exc))}", file=sys.stderr)
         return 1
     except OSError as exc:  # the file system said no (permissions, full disk, a file in the way)
         print(f"contactlab {args.verb}: error: {_os_error_text(exc)}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print(f"contactlab {args.verb}: interrupted; no partial outputs written", file=sys.stderr)
-        return 130
+        return _INTERRUPTED
     except RuntimeError as exc:  # a worker process was killed (out of memory, a signal)
         futures = sys.modules.get("concurrent.futures")  # imported by whatever started a pool
         if futures is None or not isinstance(exc, futures.BrokenExecutor):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import os
@@ -256,6 +257,17 @@ def table_files(
     return files, skipped
 
 
+def made_by(args: Any, verb: str = "", *fallback: Any) -> str:
+    """The command line that made a report, as typed (``cli.main`` keeps it in
+    ``args.argv``): running it again repeats the run, every option included (``--fs``,
+    ``--columns``, ``--resample``, ...). Without it (a handler called from Python), the
+    line :func:`command_line` makes of ``verb`` and ``fallback``."""
+    argv = getattr(args, "argv", None)
+    if argv:
+        return " ".join(shlex.quote(w) for w in ["contactlab", *map(str, argv)])
+    return command_line(verb, *fallback)
+
+
 def command_line(verb: str, *parts: Any) -> str:
     """A shell-quoted ``contactlab VERB ...`` line for the report's provenance."""
     words = ["contactlab", verb]
@@ -401,7 +413,7 @@ def process_pool(workers: int | None, *, auto: bool = False) -> Any:
     from concurrent.futures import ProcessPoolExecutor
 
     try:
-        return ProcessPoolExecutor(workers, initializer=_ignore_sigint)
+        return _InterruptiblePool(ProcessPoolExecutor(workers, initializer=_ignore_sigint))
     except (OSError, ImportError, NotImplementedError) as exc:
         if not auto:
             raise InputError(
@@ -411,6 +423,42 @@ def process_pool(workers: int | None, *, auto: bool = False) -> Any:
         print(f"note: cannot start worker processes here ({exc}); running in this process",
               file=sys.stderr)  # fmt: skip
         return contextlib.nullcontext(None)
+
+
+class _InterruptiblePool:
+    """A process pool's context that does not wait for its workers after Ctrl-C.
+
+    On a normal exit the pool shuts down as usual (waiting for its tasks). On an interrupt
+    (or any other escaping exception) the queued tasks are cancelled and the worker processes
+    are killed at once: waiting for them could block for ever where SIGINT reached only the
+    parent (``kill -INT pid``, ``timeout -s INT``), since the workers ignore SIGINT and one may
+    be blocked on a queue's lock that the interrupted parent will never release."""
+
+    def __init__(self, executor: Any) -> None:
+        self.executor = executor
+
+    def __enter__(self) -> Any:
+        return self.executor
+
+    def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
+        if exc_type is None:
+            self.executor.shutdown(wait=True)
+            return
+        kill_worker_processes()
+        self.executor.shutdown(wait=False, cancel_futures=True)
+
+
+def kill_worker_processes() -> None:
+    """Kill every child process this process started through multiprocessing (the pools'
+    workers); they hold no outputs (every output is written by the parent, all or nothing)."""
+    import multiprocessing
+
+    for child in multiprocessing.active_children():
+        with contextlib.suppress(Exception):
+            child.kill()
+    for child in multiprocessing.active_children():
+        with contextlib.suppress(Exception):
+            child.join(timeout=1.0)
 
 
 def add_progress_flags(p: Any) -> None:
@@ -546,3 +594,109 @@ def positive_number(name: str):
 
     parse.__name__ = "number > 0"
     return parse
+
+
+#: ``--model``'s help, the same in every verb that reads a recording
+MODEL_HELP = (
+    "tangential (x, F: Masing) or normal (p, delta: Konowalski); default: inferred from the "
+    "column names (a force column: tangential; a pressure column: normal), and the "
+    "inference is printed"
+)
+
+
+def add_reader_flags(p: Any, *, model: bool = True) -> None:
+    """The flags every verb that reads a recording shares, worded alike: ``--model``,
+    ``--columns``, ``--fs`` and ``--resample``."""
+    if model:
+        p.add_argument("--model", choices=("tangential", "normal"), metavar="{tangential,normal}",
+                       help=MODEL_HELP)  # fmt: skip
+    p.add_argument(
+        "--columns",
+        metavar="MAP",
+        help="which column is which, e.g. 'x=Position,F=Friction' (names with or without "
+        "their unit, or positions 0, 1, ... of a header-less file; default: by name)",
+    )
+    p.add_argument(
+        "--fs",
+        type=quantity("Hz", positive=True),
+        metavar="RATE",
+        help="sampling rate when a file has no time column, e.g. 1kHz",
+    )
+    p.add_argument(
+        "--resample",
+        action="store_true",
+        help="non-uniform time stamps: interpolate onto a uniform grid of the median step "
+        "(steps up to 4 grid steps are bridged and the largest is reported; a longer one is "
+        "a real gap and still refused)",
+    )
+
+
+def infer_model(
+    file: str, model: str | None, columns: dict[str, str] | None, fs: float | None
+) -> tuple[str, str | None]:
+    """The model of a recording: ``model`` when given, else inferred from its column names
+    exactly as the readers infer it (``contactlab.io.read_chunks``, which reads only the
+    header). Returns ``(model, sentence)``; the sentence (None when the model was given)
+    says what was inferred from which columns, for the console (``model tangential, inferred
+    from the columns x='Position [mm]', F='Friction [uN]' (--model sets it)``)."""
+    if model is not None:
+        return model, None
+    from ..io import read_chunks
+
+    cr = read_chunks(file, columns=columns, fs=fs)
+    kind = cr.kind
+    if kind not in ("tangential", "normal"):
+        raise InputError(
+            f"{file}: cannot tell a tangential (x, F) from a normal (p, delta) recording: "
+            "give --model tangential|normal"
+        )
+    chans = ("x", "F") if kind == "tangential" else ("p", "delta")
+    named = ", ".join(f"{c}={cr.columns[c]!r}" for c in chans if c in cr.columns)
+    return kind, f"model {kind}, inferred from the columns {named} (--model sets it)"
+
+
+def wrapped(text: str, width: int = 100) -> str:
+    """``text`` wrapped to ``width`` characters, continuation lines indented."""
+    import textwrap
+
+    return textwrap.fill(text, width=width, subsequent_indent="   ", break_long_words=False,
+                         break_on_hyphens=False)  # fmt: skip
+
+
+def wrap_warning(text: str, *, prefix: str = "  warning: ", width: int = 100) -> str:
+    """A warning wrapped to ``width`` characters, continuation lines indented under it."""
+    import textwrap
+
+    return textwrap.fill(
+        text, width=width, initial_indent=prefix, subsequent_indent=" " * len(prefix),
+        break_long_words=False, break_on_hyphens=False,
+    )  # fmt: skip
+
+
+#: ``--force-sign``'s values as ``--help`` shows them (``1`` is read as ``+1``)
+FORCE_SIGN_CHOICES = ("auto", "+1", "-1")
+
+
+def force_sign(text: str) -> str:
+    """argparse ``type=`` of ``--force-sign``: ``1`` and ``+1`` alike (the choices then
+    show ``{auto,+1,-1}`` without a duplicate)."""
+    t = text.strip()
+    return "+1" if t in ("1", "+1") else t
+
+
+class DefaultsShown(argparse.HelpFormatter):
+    """``--help`` that states each option's default (``(default: 500.0)``) unless its help
+    already says it or there is none (None, False)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        text = action.help or ""
+        d = action.default
+        if (
+            "default" in text
+            or d is None
+            or d is False
+            or d is argparse.SUPPRESS
+            or not action.option_strings
+        ):
+            return text
+        return f"{text} (default: %(default)s)"

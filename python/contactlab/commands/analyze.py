@@ -18,22 +18,28 @@ from ..errors import InputError
 from ..studies.manifest import entry_from_file
 from ..studies.study import run_study
 from ._common import (
+    FORCE_SIGN_CHOICES,
     add_frame_flags,
     add_pressure_flags,
     add_progress_flags,
+    add_reader_flags,
     check_output_targets,
-    command_line,
     default_workers,
     describe,
+    force_sign,
     frame_option,
+    infer_model,
     json_document,
     json_text,
+    made_by,
     normal_options,
     parse_columns,
     process_pool,
     quantity,
     recording_json,
     refuse_if_none_analysed,
+    wrap_warning,
+    wrapped,
     write_json,
     write_report,
 )
@@ -43,10 +49,33 @@ _SUMMARY = {
     "tangential": [("h0", "N", 1.0), ("ac", "1/m", 1.0), ("h0_ac", "N/m", 1.0),
                    ("amplitude", "um", 1e6),
                    ("energy_per_cycle", "J", 1.0), ("equivalent_damping", "N/m", 1.0),
-                   ("k_local0", "N/m", 1.0), ("k_global", "N/m", 1.0)],
+                   ("k_local0", "N/m", 1.0), ("k_global", "N/m", 1.0), ("mu", "", 1.0),
+                   ("normal_load", "N", 1.0)],
     "normal": [("E_d", "J/m^2", 1.0), ("psi", "", 1.0), ("psi_kv", "", 1.0),
                ("k_tan", "Pa/m", 1.0), ("k_sec", "Pa/m", 1.0)],
 }  # fmt: skip
+
+
+#: width the console's summary lines and warnings are wrapped to
+WIDTH = 100
+
+
+def summary_lines(head: str, row: dict, kind: str, tail: str = "", width: int = WIDTH) -> str:
+    """``head: key = value ± error unit; ...`` (then ``tail``) packed into lines of at most
+    ``width`` characters, continuation lines indented, never breaking inside a quantity."""
+    parts = [p for p in _summary_line(row, kind).split("; ") if p]
+    if tail:
+        parts.append(tail)
+    lines: list[str] = []
+    cur, fresh = f"{head}:", True
+    for part in parts:
+        if not fresh and len(cur) + 2 + len(part) > width:
+            lines.append(cur + ";")
+            cur, fresh = "  ", True
+        cur += (" " if fresh else "; ") + part
+        fresh = False
+    lines.append(cur)
+    return "\n".join(lines)
 
 
 def _summary_line(row: dict, kind: str) -> str:
@@ -105,8 +134,12 @@ def _streamed(
             full = res.to_dict(cycles=False)
             comb = full["combined"]
             print(
-                f"{e.path}: {_summary_line(comb, args.model)} (streamed: {len(res.rows)} "
-                f"windows, {comb.get('n_cycles', 0)} cycles)",
+                summary_lines(
+                    str(e.path),
+                    comb,
+                    args.model,
+                    f"(streamed: {len(res.rows)} windows, {comb.get('n_cycles', 0)} cycles)",
+                ),
                 file=say,
             )
             units = {k: u for k, u in full["units"].items() if k in comb}
@@ -137,7 +170,8 @@ def _streamed(
         from ..report import commit_outputs
         from ..report.track_report import build_track_report, track_files
 
-        cmd = command_line(
+        cmd = made_by(
+            args,
             "analyze",
             *args.files,
             "--model",
@@ -220,6 +254,22 @@ def _handler(args: argparse.Namespace) -> int:
         raise InputError(f"--workers must be >= 0 (0: serially), got {args.workers}")
     if frame is not None and args.stream:
         raise InputError("--frame reconstructs the force from the whole record: drop --stream")
+    say = sys.stderr if args.json == "-" else sys.stdout
+    if frame is not None and args.model is None:
+        args.model = "tangential"  # a frame's displacements give a tangential recording
+    if args.model is None:
+        kinds = {}
+        for f in args.files:
+            if Path(f).is_file():
+                kinds[f], note = infer_model(f, None, columns, args.fs)
+                print(wrapped(f"{f}: {note}"), file=say)
+        if len(set(kinds.values())) > 1:
+            raise InputError(
+                "the files are of different kinds ("
+                + ", ".join(f"{f}: {k}" for f, k in kinds.items())
+                + "): analyse them separately, or give --model"
+            )
+        args.model = next(iter(kinds.values()), "tangential")
     entries = []
     for f in args.files:
         if Path(f).is_dir():
@@ -229,7 +279,7 @@ def _handler(args: argparse.Namespace) -> int:
         if any(Path(f).resolve() == e.path.resolve() for e in entries):
             raise InputError(f"{f}: given twice (it would be analysed and counted twice)")
         e = entry_from_file(f, kind=args.model)
-        e.columns, e.fs, e.frame = columns, args.fs, frame
+        e.columns, e.fs, e.frame, e.resample = columns, args.fs, frame, args.resample
         entries.append(e)
     topts = {"force_sign": args.force_sign}
     if args.delay is not None:
@@ -292,10 +342,10 @@ def _in_memory(
 
                 print(f"{r.entry.path}: friction frame: {describe_reconstruction(rebuilt)}",
                       file=say)  # fmt: skip
-            print(f"{r.entry.path}: {_summary_line(r.row, r.entry.kind)}", file=say)
+            print(summary_lines(str(r.entry.path), r.row, r.entry.kind), file=say)
             if r.row.get("warnings"):
                 for w in str(r.row["warnings"]).split(" | "):
-                    print(f"  warning: {w}", file=sys.stderr)
+                    print(wrap_warning(str(w)), file=sys.stderr)
             if args.verbose and hasattr(r.analysis, "report"):
                 print(r.analysis.report(), file=say)
         else:
@@ -305,7 +355,8 @@ def _in_memory(
     doc = json_text(json_document(result)) if args.json else None
     if args.report:
         title = f"contactlab analyze ({args.model}, {len(entries)} recording(s))"
-        cmd = command_line(
+        cmd = made_by(
+            args,
             "analyze",
             *args.files,
             "--model",
@@ -370,7 +421,7 @@ def _with_long(
         for r in result.results:
             if r.ok:
                 by_path[str(r.entry.path)] = recording_json(r)
-                print(f"{r.entry.path}: {_summary_line(r.row, r.entry.kind)}", file=say)
+                print(summary_lines(str(r.entry.path), r.row, r.entry.kind), file=say)
             else:
                 failures.append({"file": str(r.entry.path), "error": r.error})
                 print(f"{r.entry.path}: FAILED: {r.error}", file=sys.stderr)
@@ -390,12 +441,16 @@ def _with_long(
             last = doc.pop("_track")
             by_path[str(e.path)] = doc
             print(
-                f"{e.path}: {_summary_line(doc, e.kind)} (streamed: {doc['n_samples']} "
-                f"samples in {doc['n_windows']} windows)",
+                summary_lines(
+                    str(e.path),
+                    doc,
+                    e.kind,
+                    f"(streamed: {doc['n_samples']} samples in {doc['n_windows']} windows)",
+                ),
                 file=say,
             )
             for w in doc["warnings"]:
-                print(f"  warning: {w}", file=sys.stderr)
+                print(wrap_warning(str(w)), file=sys.stderr)
     recs = [by_path[str(e.path)] for e in entries if str(e.path) in by_path]
     refuse_if_none_analysed(len(recs), failures)
     doc_all: dict = (
@@ -411,7 +466,7 @@ def _with_long(
         from ..report import commit_outputs
         from ..report.track_report import build_track_report, track_files
 
-        cmd = command_line("analyze", *args.files, "--model", args.model, "--report", args.report)
+        cmd = made_by(args, "analyze", *args.files, "--model", args.model, "--report", args.report)
         rep = build_track_report(
             last, f"contactlab analyze (streamed): {last.source}", intro=f"Made by: {cmd}"
         )
@@ -432,16 +487,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         description=describe(__doc__),
     )
     p.add_argument("files", nargs="+", metavar="FILE", help="recordings (.csv .tdms .h5 .mat)")
-    p.add_argument("--model", required=True, choices=("tangential", "normal"))
+    add_reader_flags(p)
     p.add_argument("--json", metavar="OUT", help="write results as JSON (SI; '-' = stdout)")
     p.add_argument("--report", metavar="DIR", help="write report.html, figures and tables here")
-    p.add_argument("--columns", help="column mapping, e.g. 'x=disp,F=force' (default: by name)")
-    p.add_argument(
-        "--fs", type=quantity("Hz", positive=True), help="sampling rate when a file has no time"
-    )
     p.add_argument(
         "--force-sign",
-        choices=("auto", "+1", "-1", "1"),
+        type=force_sign,
+        choices=FORCE_SIGN_CHOICES,
         default="auto",
         help="tangential: analyse F (+1) or -F (-1); auto (default): the sign that makes the "
         "loop area ∮F dx positive (a passive joint dissipates)",

@@ -47,26 +47,21 @@ def add_parser(subparsers: Any) -> None:
         ),
     )
     p.add_argument("file", metavar="FILE", help="recording (CSV, TDMS, HDF5, MAT)")
-    p.add_argument(
-        "--model",
-        choices=["tangential", "normal"],
-        help="tangential: x, F (Masing base); normal: p, delta (Kelvin-Voigt base)",
-    )
+    from ..commands._common import add_reader_flags
+
+    add_reader_flags(p)
     p.add_argument(
         "--structure",
         metavar="MODEL.json",
         help="diagnose a structure: this identified model (contactlab identify --json) is "
         "the base; FILE is a CSV with the input and response columns",
     )
-    p.add_argument("--u", help="with --structure: input column (force, or base displacement)")
-    p.add_argument("--y", help="with --structure: response column (displacement of the mass)")
+    p.add_argument("--u", metavar="COLUMN",
+                   help="with --structure: input column (force, or base displacement)")  # fmt: skip
+    p.add_argument("--y", metavar="COLUMN",
+                   help="with --structure: response column (displacement of the mass)")  # fmt: skip
     from ..commands._common import quantity
 
-    p.add_argument(
-        "--fs",
-        type=quantity("Hz", positive=True),
-        help="sampling rate when a file has no time column",
-    )
     p.add_argument(
         "--holdout",
         type=_holdout,
@@ -105,7 +100,17 @@ def add_parser(subparsers: Any) -> None:
         help="tangential: a known delay of the force behind the displacement (e.g. 1.1ms), "
         "corrected before the diagnosis (the force read that much later)",
     )
-    p.add_argument("--columns", help="column mapping, e.g. 'x=disp,F=force' (default: by name)")
+    from ..commands._common import FORCE_SIGN_CHOICES, force_sign
+
+    p.add_argument(
+        "--force-sign",
+        type=force_sign,
+        choices=FORCE_SIGN_CHOICES,
+        default=None,
+        help="tangential: diagnose F (+1) or -F (-1), as analyze takes it; auto: the sign that "
+        "makes the loop area ∮F dx positive (a passive joint dissipates). Default: F as "
+        "recorded (a loop that runs the wrong way is refused, naming this flag)",
+    )
     p.set_defaults(handler=run)
 
 
@@ -223,13 +228,20 @@ def run(args: argparse.Namespace) -> int:
     frame = frame_option(args)
     if args.model is None and frame is not None:
         args.model = "tangential"
+    columns = parse_columns(args.columns)
     if args.model is None:
-        raise InputError("diagnose needs --model tangential|normal or --structure MODEL.json")
+        from ..commands._common import infer_model, wrapped
+
+        try:
+            args.model, note = infer_model(args.file, None, columns, args.fs)
+        except InputError as exc:
+            raise InputError(f"{exc} (or --structure MODEL.json: a structure's input and "
+                             "response record)") from None  # fmt: skip
+        print(wrapped(f"{args.file}: {note}"))
     taps = output_filter_taps(args.output_filter)
     if args.model == "normal" and (taps is not None or args.output_noise is not None):
         raise InputError("--output-filter/--output-noise are for the tangential model (a force "
                          "channel's smoothing)")  # fmt: skip
-    columns = parse_columns(args.columns)
     rebuilt = None
     if frame is not None:
         from ..tangential import read_frame
@@ -242,7 +254,12 @@ def run(args: argparse.Namespace) -> int:
             print("note: --output-filter/--output-noise replace the reconstruction's own")
     else:
         _check_long(args.file, columns, args.model, args.fs)
-        rec = read_recording(args.file, kind=args.model, columns=columns, fs=args.fs)
+        rec = read_recording(args.file, kind=args.model, columns=columns, fs=args.fs,
+                             resample=args.resample)  # fmt: skip
+        if rec.meta.get("resampled"):
+            from ..io.recording import describe_resampling
+
+            print(f"{args.file}: {describe_resampling(rec.meta['resampled'])}")
     if getattr(args, "delay", None) is not None:
         if args.model != "tangential":
             raise InputError("--delay is for tangential recordings (force against displacement)")
@@ -251,6 +268,9 @@ def run(args: argparse.Namespace) -> int:
         rec, dropped = shifted_recording(rec, args.delay)
         print(f"{args.file}: force read {1e3 * args.delay:.4g} ms later (--delay); {dropped} "
               "samples left without force data dropped")  # fmt: skip
+    sign = getattr(args, "force_sign", None)
+    if sign is not None and args.model != "tangential":
+        raise InputError("--force-sign is for tangential recordings (the force's sign)")
     if args.model == "normal":
         from ..commands._common import with_static_pressure
 
@@ -258,7 +278,8 @@ def run(args: argparse.Namespace) -> int:
                                    getattr(args, "pa", None))  # fmt: skip
     try:
         report = diagnose(rec, model=args.model, max_effects=args.max_effects,
-                          output_filter=taps, output_noise=args.output_noise)  # fmt: skip
+                          output_filter=taps, output_noise=args.output_noise,
+                          **({"force_sign": sign} if sign is not None else {}))  # fmt: skip
     except (InputError, ConvergenceError) as exc:  # name the file: the workflow sees arrays
         kind = ConvergenceError if isinstance(exc, ConvergenceError) else InputError
         raise kind(f"{args.file}: {exc}") from exc
@@ -287,9 +308,10 @@ def run(args: argparse.Namespace) -> int:
         import matplotlib
 
         matplotlib.use("Agg")
-        from ..diagnose._html import report_files
+        from ..commands._common import made_by
+        from ..report.diagnosis import report_files
 
-        files = report_files(report)
+        files = report_files(report, intro=f"Made by: {made_by(args, 'diagnose', args.file)}")
     print(report.summary())
     # the JSON is staged beside its target and renamed into place only once the report is
     # committed: a report that cannot be written leaves the JSON as it was

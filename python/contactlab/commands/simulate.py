@@ -15,7 +15,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from ..errors import InputError
-from ._common import describe, quantity
+from ._common import DefaultsShown, describe, quantity
 
 if TYPE_CHECKING:
     from ..io import Recording
@@ -155,7 +155,7 @@ def _handler(args: argparse.Namespace) -> int:
 
     _check_length(args)
     if args.model == "tangential":
-        from ..tangential import synthetic_recording
+        from ..synthetic.tangential import synthetic_recording
 
         with np.errstate(over="ignore", invalid="ignore"):  # overflow is refused below
             rec = synthetic_recording(
@@ -173,7 +173,7 @@ def _handler(args: argparse.Namespace) -> int:
                 adc_bits=args.adc_bits,
             )
     else:
-        from ..normal import synthetic_recording as normal_synthetic
+        from ..synthetic.normal import synthetic_recording as normal_synthetic
 
         kwargs = {"noise": "realistic" if args.noise is None else args.noise, "seed": args.seed}
         if args.normal_model:
@@ -200,6 +200,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "simulate",
         help="write a synthetic recording (tangential Masing or normal contact)",
         description=describe(__doc__),
+        formatter_class=DefaultsShown,
     )
     p.add_argument("model", choices=("tangential", "normal", "structure"))
     p.add_argument("out", metavar="OUT", help="output file (.csv .tdms .h5 .mat)")
@@ -216,6 +217,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--fs",
         type=finite_quantity("Hz", positive=True, bounds="fs"),
         default=500.0,
+        metavar="RATE",
         help="sampling rate (Hz, > 0)",
     )
     g.add_argument("--offset", type=finite_quantity("N", bounds="offset"), default=0.0,
@@ -247,9 +249,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=integer(0), default=0,
                    help="noise generator seed (a non-negative integer; default 0)")  # fmt: skip
     s = p.add_argument_group("structure (a model from `contactlab identify --json`)")
-    s.add_argument("--structure", help="model JSON (identified model or Structure.save)")
-    s.add_argument("--input", help="CSV with the input column and a time column (else --fs)")
-    s.add_argument("--u", help="input column name")
+    s.add_argument("--structure", metavar="MODEL.json",
+                   help="model JSON (identified model or Structure.save)")  # fmt: skip
+    s.add_argument("--input", metavar="FILE",
+                   help="CSV with the input column and a time column (else --fs)")  # fmt: skip
+    s.add_argument("--u", metavar="COLUMN", help="input column name")
     s.add_argument("--base", action="store_true", help="the input is base displacement")
     s.add_argument(
         "--periodic",

@@ -16,29 +16,32 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ._common import check_output_targets, command_line, describe, json_text, write_json
+from ._common import check_output_targets, describe, json_text, made_by, quantity, write_json
 
 _UNIT = re.compile(r"(?:\[([^\]]+)\]|_([A-Za-z]+))\s*$")
 
 
 def read_table(path: str) -> dict[str, np.ndarray]:
     """Columns of a CSV (header line, optional ``#``), converted to SI from unit suffixes."""
+    from ..io.csv import read_header, sniff_encoding
     from ..studies.manifest import unit_factor
 
     p = Path(path)
+    # the header as `analyze` finds it: `#` comment lines before it are skipped (they may hold
+    # commas), a header written as the last comment (`# t,u,y`) names the columns
     try:
-        with p.open(encoding="utf-8", errors="replace") as fh:
-            header = fh.readline().lstrip("#").strip()
+        enc = sniff_encoding(p)
+        names, delim, header_line, _comments = read_header(p, enc)
     except OSError as exc:
         raise InputError(f"{path}: cannot read ({exc.strerror})") from None
-    names = [h.strip() for h in header.split(",")]
     if len(names) < 2:
-        raise InputError(f"{path}: the first line must name the comma-separated columns")
+        raise InputError(f"{path}: the header line must name the columns (comma-separated)")
     try:
         with warnings.catch_warnings():
             # numpy warns "input contained no data" for a header alone: refused just below
             warnings.simplefilter("ignore", UserWarning)
-            data = np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2)
+            data = np.loadtxt(p, delimiter=delim, skiprows=header_line + 1, ndmin=2,
+                              comments="#", encoding=enc)  # fmt: skip
     except ValueError as exc:
         raise InputError(f"{path}: not a numeric table: {exc}") from None
     if data.size == 0:
@@ -128,7 +131,7 @@ def _identify(args: argparse.Namespace) -> int:
             mdof["masks"] = _masks(args.masks)
     elif args.masks is not None:
         raise InputError("--masks needs several response channels (--y x0,x1,...)")
-    cmd = command_line("identify", args.file, "--joint", args.joint, "--excitation", exc)
+    cmd = made_by(args, "identify", args.file, "--joint", args.joint, "--excitation", exc)
     model, rep, summary = identify_record(
         t, u, y, joint=args.joint, excitation=exc, mass=mass, holdout=args.holdout,
         substeps=args.substeps, periodic=args.periodic, title=f"{Path(args.file).name}: "
@@ -211,7 +214,9 @@ def simulate_structure(args: argparse.Namespace) -> int:
     try:
         model: IdentifiedModel | None = IdentifiedModel.load(doc_path)
     except InputError:
-        model = None
+        if not doc_path.is_file():
+            raise  # missing, or a folder: said before the input is read
+        model = None  # perhaps a Structure.save file (read below)
     cols = read_table(args.input)
     exc = model.excitation if model else ("base" if args.base else "force")
     ucol = _pick(cols, args.u, ("u", "f") if exc == "force" else ("y_base", "base", "y"), "u",
@@ -284,7 +289,9 @@ def diagnose_structure_cli(args: argparse.Namespace) -> int:
         import matplotlib
 
         matplotlib.use("Agg")
-        print(f"report: {rep.write_html(args.report)}")
+        from ..report.structure import write_diagnosis_html
+
+        print(f"report: {write_diagnosis_html(rep, args.report)}")
     if text is not None:
         write_text(args.json, text)
     return 0
@@ -301,11 +308,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    choices=("masing", "jenkins", "iwan", "bouc_wen", "kelvin_voigt", "normal",
                             "linear"))  # fmt: skip
     p.add_argument("--excitation", default="force", choices=("force", "base"))
-    p.add_argument("--u", help="input column (force, or base displacement)")
-    p.add_argument("--y", help="response column (displacement of the mass); several "
+    p.add_argument("--u", metavar="COLUMN", help="input column (force, or base displacement)")
+    p.add_argument("--y", metavar="COLUMN",
+                   help="response column (displacement of the mass); several "
                    "comma-separated columns (one per DOF, in DOF order) identify a chain of "
                    "masses")  # fmt: skip
-    p.add_argument("--fs", type=float, help="sampling rate (Hz) when there is no time column")
+    p.add_argument("--fs", type=quantity("Hz", positive=True), metavar="RATE",
+                   help="sampling rate when there is no time column, e.g. 1kHz")  # fmt: skip
     p.add_argument("--mass", help="known mass (kg), held fixed; needed for base; one per DOF "
                    "(comma-separated) with several --y channels")  # fmt: skip
     p.add_argument("--joint-dofs", default="0,ground",
@@ -325,6 +334,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--periodic", action="store_true",
                    help="the record holds whole periods of a periodic input (band-limited "
                    "interpolation between samples)")  # fmt: skip
-    p.add_argument("--json", help="write the model (and summary) as JSON ('-': stdout)")
-    p.add_argument("--report", help="write report.html and figures/ into this folder")
+    p.add_argument("--json", metavar="OUT",
+                   help="write the model (and summary) as JSON ('-': stdout)")  # fmt: skip
+    p.add_argument("--report", metavar="DIR", help="write report.html and figures/ here")
     p.set_defaults(handler=_identify)

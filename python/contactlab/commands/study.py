@@ -16,10 +16,10 @@ from ._common import (
     add_progress_flags,
     add_workers_flag,
     check_output_targets,
-    command_line,
     describe,
     json_document,
     json_text,
+    made_by,
     process_pool,
     refuse_if_none_analysed,
     resolve_workers,
@@ -48,7 +48,7 @@ def _handler(args: argparse.Namespace) -> int:
             print(f"{len(warned)} with warnings (listed in the report): {', '.join(warned)}",
                   file=sys.stderr)  # fmt: skip
         doc = json_text(json_document(result)) if args.json else None
-        cmd = command_line("study", args.manifest, "--report", args.report)
+        cmd = made_by(args, "study", args.manifest, "--report", args.report)
         paths = write_report(
             args.report,
             result,

@@ -20,16 +20,20 @@ from ._common import (
     add_frame_flags,
     add_pressure_flags,
     add_progress_flags,
+    add_reader_flags,
     add_workers_flag,
     check_output_targets,
-    command_line,
     describe,
     frame_option,
+    infer_model,
+    made_by,
     normal_options,
     parse_columns,
     process_pool,
     quantity,
     window_threads,
+    wrap_warning,
+    wrapped,
     write_json,
 )
 
@@ -52,6 +56,10 @@ def _handler(args: argparse.Namespace) -> int:
     parse_every(args.every)  # a bad --every fails before the file is opened
     say = sys.stderr if args.json == "-" else sys.stdout
     frame = frame_option(args)  # before the file is read: it has no force column
+    note = None
+    if frame is None:
+        args.model, note = infer_model(args.file, args.model, parse_columns(args.columns),
+                                       args.fs)  # fmt: skip
     options = _options(args)
     if args.delay is not None:
         if options is not None:  # a normal recording's options
@@ -76,7 +84,8 @@ def _handler(args: argparse.Namespace) -> int:
         source = fr.recording(args.file)
         rebuilt = fr.to_dict()
         print(f"{args.file}: friction frame: {describe_reconstruction(rebuilt)}", file=say)
-    print(f"tracking {args.file} every {args.every}", file=say, flush=True)
+    print(wrapped(f"tracking {args.file} every {args.every}" + (f"; {note}" if note else "")),
+          file=say, flush=True)  # fmt: skip
     bar = None
     if args.progress or (args.progress is None and sys.stderr.isatty()):
         from tqdm.auto import tqdm
@@ -95,6 +104,7 @@ def _handler(args: argparse.Namespace) -> int:
                 threads=threads,
                 options=options,
                 callback=(lambda _row: bar.update(1)) if bar is not None else None,
+                resample=args.resample,
             )
     finally:
         if bar is not None:
@@ -129,7 +139,7 @@ def _handler(args: argparse.Namespace) -> int:
                 f"  {key} = {comb[key] * f:.5g}{pm}{' ' + unit if unit else ''} ({how})", file=say
             )
     for note in res.notes(comb):
-        print(f"  warning: {note}", file=sys.stderr)
+        print(wrap_warning(str(note)), file=sys.stderr)
     doc = track_json(res) if args.json else None  # rendered before anything is written
     if args.report:
         import matplotlib
@@ -138,7 +148,7 @@ def _handler(args: argparse.Namespace) -> int:
         from ..report import commit_outputs
         from ..report.track_report import build_track_report, track_files
 
-        cmd = command_line(
+        cmd = made_by(args,
             "track", args.file, "--every", args.every, "--report", args.report,
             *(["--frame", args.frame] if frame else []),
             *(["--frame-x", args.frame_x] if args.frame_x else []),
@@ -190,7 +200,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         default="100cycles",
         help="window length: '100cycles' or a time, '10s' (default 100cycles)",
     )
-    p.add_argument("--model", choices=("tangential", "normal"), help="default: from the columns")
+    add_reader_flags(p)
     p.add_argument(
         "--json",
         metavar="OUT",
@@ -199,10 +209,6 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--report", metavar="DIR", help="write report.html, figures and tables here")
     p.add_argument(
         "--against", choices=("time", "cycle"), default="time", help="x axis of the plots"
-    )
-    p.add_argument("--columns", help="column mapping, e.g. 'x=disp,F=force' (default: by name)")
-    p.add_argument(
-        "--fs", type=quantity("Hz", positive=True), help="sampling rate when a file has no time"
     )
     p.add_argument(
         "--chunk-size",

@@ -115,9 +115,15 @@ def load_result(path: str | Path, recording: str | None = None) -> dict[str, Any
         raise InputError(f"{path}: no such file")
     try:
         doc = json.loads(p.read_text(encoding="utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+    except UnicodeDecodeError:
         raise InputError(
-            f"{path}: not a JSON file written by `contactlab analyze --json` ({exc})"
+            f"{path}: a binary file, not the JSON `contactlab analyze --json` writes (export "
+            "reads that JSON, not the recording: run `contactlab analyze FILE --json OUT` first)"
+        ) from None
+    except json.JSONDecodeError as exc:
+        raise InputError(
+            f"{path}: not a JSON file (line {exc.lineno}): export reads the JSON "
+            "`contactlab analyze --json` writes"
         ) from None
     if not isinstance(doc, dict):
         raise InputError(f"{path}: expected a JSON object from `contactlab analyze --json`")

@@ -1,4 +1,5 @@
-"""Reading and writing recordings: CSV/text, NI TDMS, HDF5 and MATLAB .mat, SI inside.
+"""Reading and writing recordings: CSV/text, NI TDMS, HDF5, MATLAB .mat and NumPy .npy/.npz,
+SI inside.
 
 Typical use (a file with columns ``t [ms], x [um], F [N]``)::
 
@@ -48,7 +49,7 @@ __all__ = [
 ]
 
 
-_FORMAT_NAMES = {"tdms": "TDMS", "hdf5": "HDF5", "mat": "MATLAB"}
+_FORMAT_NAMES = {"tdms": "TDMS", "hdf5": "HDF5", "mat": "MATLAB", "npy": "NumPy"}
 _LIBRARY_ERRORS = (
     OSError,
     RuntimeError,
@@ -84,6 +85,10 @@ def _reader(fmt: str) -> Callable[..., Recording]:
         from .hdf5 import read_hdf5
 
         return read_hdf5
+    if fmt == "npy":
+        from .npy import read_npy
+
+        return read_npy
     from .mat import read_mat
 
     return read_mat
@@ -96,13 +101,15 @@ def read_recording(
     kind: str | None = None,
     fs: float | None = None,
     format: str | None = None,
+    resample: bool = False,
 ) -> Recording:
     """Read a recording file into a :class:`Recording` in SI units.
 
     Parameters
     ----------
     path : str or Path
-        ``.csv``/``.txt``/``.tsv``/``.dat``, ``.tdms``, ``.h5``/``.hdf5`` or ``.mat``.
+        ``.csv``/``.txt``/``.tsv``/``.dat``, ``.tdms``, ``.h5``/``.hdf5``, ``.mat``,
+        ``.npy`` or ``.npz`` (layouts: :mod:`contactlab.io.npy`).
     columns : dict, optional
         Canonical name (``"t"``, ``"x"``, ``"F"``, ``"p"``, ``"delta"``) to the column,
         channel, dataset or variable name in the file (with or without its unit).
@@ -111,8 +118,13 @@ def read_recording(
         Which channels are needed (``x, F`` or ``p, delta``); None guesses from the names.
     fs : float, optional
         Sampling rate (Hz) when the file has no time column or time increment.
-    format : {"csv", "tdms", "hdf5", "mat"}, optional
+    format : {"csv", "tdms", "hdf5", "mat", "npy", "npz"}, optional
         Override the extension.
+    resample : bool
+        Interpolate a non-uniformly sampled record onto the uniform grid of its median step
+        (steps up to four grid steps are bridged; a longer one is a real gap and still an
+        error); ``meta["resampled"]`` tells the largest gap bridged. See
+        :func:`contactlab.io.recording.resample_uniform`.
 
     Returns
     -------
@@ -137,9 +149,9 @@ def read_recording(
     p = Path(path)
     fmt = format_of(p, format)
     if fmt == "csv":
-        return _reader(fmt)(p, columns=columns, kind=kind, fs=fs)
+        return _reader(fmt)(p, columns=columns, kind=kind, fs=fs, resample=resample)
     try:
-        return _reader(fmt)(p, columns=columns, kind=kind, fs=fs)
+        return _reader(fmt)(p, columns=columns, kind=kind, fs=fs, resample=resample)
     except ContactLabError:
         raise
     except _LIBRARY_ERRORS as exc:
@@ -172,6 +184,8 @@ def write_recording(path: str | Path, rec: Recording, **options: Any) -> Path:
         from .tdms import write_tdms as writer
     elif fmt == "hdf5":
         from .hdf5 import write_hdf5 as writer
+    elif fmt == "npy":
+        from .npy import write_npy as writer
     else:
         from .mat import write_mat as writer
     return writer(p, rec, **options)

@@ -34,6 +34,7 @@ import numpy as np
 from .. import _core
 from ..errors import InputError
 from .recording import (
+    RESAMPLE_MAX_GAP,
     Recording,
     RecordingError,
     at_sample,
@@ -129,8 +130,15 @@ class _Finisher:
         t0: float = 0.0,
         row_of: Callable[[int], int] | None = None,
         meta: dict[str, Any] | None = None,
+        resample: bool = False,
     ) -> None:
         self.mapping, self.kind, self.file = mapping, kind, file
+        # resampling onto the grid t0 + step·k: the grid's next index, the previous chunk's
+        # last sample (interpolation across the boundary), what was bridged so far
+        self.resample = resample and "t" in mapping
+        self.grid_next = 0
+        self.carry: tuple[float, dict[str, float]] | None = None
+        self.bridged = {"largest_step": 0.0, "steps_bridged": 0, "n_read": 0}
         self.row_of = row_of  # a sample's line of a text file (None: binary)
         assumed: list[str] = []
         self.factors: dict[str, float] = {}
@@ -179,14 +187,15 @@ class _Finisher:
 
     def _check_time(self, t: np.ndarray, offset: int) -> None:
         """The whole-file reader's time checks, judged against the first chunk's median step
-        and across the boundary with the previous chunk."""
+        and across the boundary with the previous chunk (with ``resample``: steps up to
+        :data:`~contactlab.io.recording.RESAMPLE_MAX_GAP` grid steps allowed)."""
         col = self.tcol
+        gap = RESAMPLE_MAX_GAP if self.resample else 1.5
         if self.prev_t is None:
             if t.size >= 2:
                 self.step = float(np.median(np.diff(t)))
-            check_time(
-                t, file=self.file, column=col, row_of=self.row_of, step=self.step, offset=offset
-            )
+            check_time(t, file=self.file, column=col, row_of=self.row_of, step=self.step,
+                       offset=offset, max_gap=gap)  # fmt: skip
             return
         if t.size:  # the boundary: the previous chunk's last stamp, then this one's first
             check_time(
@@ -196,11 +205,38 @@ class _Finisher:
                 row_of=self.row_of,
                 step=self.step,
                 offset=offset - 1,
+                max_gap=gap,
             )
         if t.size >= 2:
-            check_time(
-                t, file=self.file, column=col, row_of=self.row_of, step=self.step, offset=offset
-            )
+            check_time(t, file=self.file, column=col, row_of=self.row_of, step=self.step,
+                       offset=offset, max_gap=gap)  # fmt: skip
+
+    def _resample(
+        self, t: np.ndarray, data: dict[str, np.ndarray]
+    ) -> tuple[np.ndarray, dict[str, np.ndarray], int]:
+        """This chunk's part of the uniform grid (step: the first chunk's median step),
+        interpolated from the chunk and the previous chunk's last sample; and the grid index
+        of its first sample."""
+        assert self.step is not None
+        if self.carry is not None:
+            tt = np.concatenate([[self.carry[0]], t])
+            dd = {k: np.concatenate([[self.carry[1][k]], v]) for k, v in data.items()}
+        else:
+            tt, dd = t, data
+            self.t_grid0 = float(t[0])
+        if tt.size >= 2:
+            steps = np.diff(tt)
+            b = self.bridged
+            b["largest_step"] = max(b["largest_step"], float(steps.max()))
+            b["steps_bridged"] += int(np.count_nonzero(steps > 1.5 * self.step))
+        self.bridged["n_read"] += int(t.size)
+        first = self.grid_next
+        k_last = int(np.floor((float(tt[-1]) - self.t_grid0) / self.step * (1 + 1e-12)))
+        grid = self.t_grid0 + self.step * np.arange(first, k_last + 1, dtype=np.float64)
+        out = {k: np.interp(grid, tt, v) for k, v in dd.items()}
+        self.grid_next = k_last + 1
+        self.carry = (float(t[-1]), {k: float(v[-1]) for k, v in data.items()})
+        return grid, out, first
 
     def __call__(
         self, raw: dict[str, np.ndarray], offset: int, out: dict[str, np.ndarray] | None = None
@@ -275,6 +311,14 @@ class _Finisher:
         if n:
             self.prev_t = float(t[-1])
         meta = dict(self.meta, offset=offset, ranges=ranges)
+        if self.resample and n:
+            t, data, meta["offset"] = self._resample(t, data)
+            meta["ranges"] = {
+                k: (float(v.min()), float(v.max())) for k, v in data.items() if v.size
+            }
+            # what was bridged so far (the last chunk's: the whole record's)
+            meta["resampled"] = dict(self.bridged, step=self.step, resampled=True,
+                                     n_samples=self.grid_next)  # fmt: skip
         return Recording(t, data, dict(self.units), self.file, meta)
 
 
@@ -333,7 +377,7 @@ def _direct_reads(path: Path, dsets: dict[str, Any], mapping: dict[str, str], fm
 
 
 def _h5_chunks(
-    path: Path, fmt: str, *, columns: Any, kind: Any, fs: Any, chunk: int
+    path: Path, fmt: str, *, columns: Any, kind: Any, fs: Any, chunk: int, resample: bool = False
 ) -> ChunkedRecording:
     from .hdf5 import h5_guard, hdf5_layout, import_h5py, open_hdf5
 
@@ -361,7 +405,10 @@ def _h5_chunks(
     names = ["t", *(c for c in mapping if c != "t")]
 
     def gen(alloc: Alloc | None) -> Iterator[Recording]:
-        fin = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, meta={"format": fmt})
+        fin = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, meta={"format": fmt},
+                        resample=resample)  # fmt: skip
+        if resample:
+            alloc = None  # a resampled chunk's length is not the samples read
         with h5_guard(file), h5py.File(path, "r") as f:
             if fmt == "mat73":
                 from .mat import v73_dataset
@@ -398,12 +445,14 @@ def _h5_chunks(
                 if fd is not None:
                     os.close(fd)
 
-    return ChunkedRecording(
-        file, kind_, fin0.units, mapping, n, fin0.meta, lambda: gen(None), gen, fin0.time_step
-    )
+    return ChunkedRecording(file, kind_, fin0.units, mapping, None if resample else n,
+                            fin0.meta, lambda: gen(None), None if resample else gen,
+                            fin0.time_step)  # fmt: skip
 
 
-def _tdms_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> ChunkedRecording:
+def _tdms_chunks(
+    path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int, resample: bool = False
+) -> ChunkedRecording:
     from .tdms import (
         import_nptdms,
         quiet_nptdms,
@@ -451,9 +500,8 @@ def _tdms_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) ->
     )
 
     def gen() -> Iterator[Recording]:
-        fin = _Finisher(
-            mapping, units, kind=kind_, file=file, fs=fs, dt=dt, t0=t0, meta={"format": "tdms"}
-        )
+        fin = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, t0=t0,
+                        meta={"format": "tdms"}, resample=resample)  # fmt: skip
         with quiet_nptdms():
             fh, tf, chans = open_tdms()
         with tf, fh:
@@ -466,12 +514,13 @@ def _tdms_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) ->
                     }
                 yield fin(raw, a)
 
-    return ChunkedRecording(
-        file, kind_, fin0.units, mapping, n, fin0.meta, gen, time_step=fin0.time_step
-    )
+    return ChunkedRecording(file, kind_, fin0.units, mapping, None if resample else n,
+                            fin0.meta, gen, time_step=fin0.time_step)  # fmt: skip
 
 
-def _csv_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> ChunkedRecording:
+def _csv_chunks(
+    path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int, resample: bool = False
+) -> ChunkedRecording:
     from .csv import decimal_comma, line_of_sample, locate_bad_cell, read_header, sniff_encoding
     from .units import split_name
 
@@ -501,7 +550,8 @@ def _csv_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> 
     fin0 = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, row_of=row_of, meta=meta)
 
     def gen() -> Iterator[Recording]:
-        fin = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, row_of=row_of, meta=meta)
+        fin = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, row_of=row_of, meta=meta,
+                        resample=resample)  # fmt: skip
         offset = 0
         with open(path, encoding=enc, errors="strict", newline="") as fh:
             try:
@@ -548,6 +598,32 @@ def _csv_chunks(path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int) -> 
     )
 
 
+def _npy_chunks(
+    path: Path, *, columns: Any, kind: Any, fs: Any, chunk: int, resample: bool = False
+) -> ChunkedRecording:
+    """An ``.npy`` memory-mapped and read slice by slice (an ``.npz`` is read whole: its
+    arrays are zip members)."""
+    from .npy import npy_chunk_source, read_npy
+
+    file = str(path)
+    if content_format(path) == "npz":
+        rec = read_npy(path, columns=columns, kind=kind, fs=fs, resample=resample)
+        return _whole_chunks(rec, chunk)
+    kind_, mapping, units, dt, n, meta, slices = npy_chunk_source(
+        path, columns=columns, kind=kind, fs=fs
+    )
+    fin0 = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, meta=meta)
+
+    def gen() -> Iterator[Recording]:
+        fin = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, meta=meta,
+                        resample=resample)  # fmt: skip
+        for a, raw in slices(chunk):
+            yield fin(raw, a)
+
+    return ChunkedRecording(file, kind_, fin0.units, mapping, None if resample else n,
+                            fin0.meta, gen, time_step=fin0.time_step)  # fmt: skip
+
+
 def _whole_chunks(rec: Recording, chunk: int) -> ChunkedRecording:
     n = len(rec)
     # a recording made of a chunk carries that chunk's ranges: not those of these chunks
@@ -578,12 +654,15 @@ def read_chunks(
     kind: str | None = None,
     fs: float | None = None,
     format: str | None = None,
+    resample: bool = False,
 ) -> ChunkedRecording:
     """Open a recording for reading in chunks of at most ``chunk_size`` samples.
 
     Parameters are those of :func:`contactlab.io.read_recording`; a :class:`Recording` (already
     in memory) is handed out in chunks too. Column resolution and units are checked at once,
-    the data as the chunks are read.
+    the data as the chunks are read. With ``resample``, each chunk is interpolated onto the
+    uniform grid of the first chunk's median step (chunks then hold about ``chunk_size``
+    samples; ``meta["resampled"]`` of the last chunk tells the largest gap bridged).
 
     Returns
     -------
@@ -603,17 +682,21 @@ def read_chunks(
         return _whole_chunks(path, chunk)
     p = Path(path)
     fmt = format_of(p, format)
+    opts = {"columns": columns, "kind": kind, "fs": fs, "chunk": chunk, "resample": resample}
     if fmt == "csv":
-        return _csv_chunks(p, columns=columns, kind=kind, fs=fs, chunk=chunk)
+        return _csv_chunks(p, **opts)
     if fmt == "tdms":
-        return _tdms_chunks(p, columns=columns, kind=kind, fs=fs, chunk=chunk)
+        return _tdms_chunks(p, **opts)
     if fmt == "hdf5":
-        return _h5_chunks(p, "hdf5", columns=columns, kind=kind, fs=fs, chunk=chunk)
+        return _h5_chunks(p, "hdf5", **opts)
+    if fmt == "npy":
+        return _npy_chunks(p, **opts)
     if content_format(p) == "mat73":
-        return _h5_chunks(p, "mat73", columns=columns, kind=kind, fs=fs, chunk=chunk)
+        return _h5_chunks(p, "mat73", **opts)
     from .mat import read_mat
 
-    return _whole_chunks(read_mat(p, columns=columns, kind=kind, fs=fs), chunk)
+    rec = read_mat(p, columns=columns, kind=kind, fs=fs, resample=resample)
+    return _whole_chunks(rec, chunk)
 
 
 __all__ = ["DEFAULT_CHUNK", "ChunkedRecording", "read_chunks"]

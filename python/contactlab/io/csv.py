@@ -189,6 +189,7 @@ def read_csv(
     columns: dict[str, str] | None = None,
     kind: str | None = None,
     fs: float | None = None,
+    resample: bool = False,
 ) -> Recording:
     """Read a CSV/text recording; see :func:`contactlab.io.read_recording`.
 
@@ -242,6 +243,7 @@ def read_csv(
         kind=kind,
         file=file,
         fs=fs,
+        resample=resample,
         row_of=lambda i: line_of_sample(path, first_data, i, enc),
         meta={
             "format": "csv",

@@ -559,6 +559,7 @@ def read_hdf5(
     columns: dict[str, str] | None = None,
     kind: str | None = None,
     fs: float | None = None,
+    resample: bool = False,
 ) -> Recording:
     """Read an HDF5 recording; see :func:`contactlab.io.read_recording`.
 
@@ -582,6 +583,7 @@ def read_hdf5(
             kind=kind,
             file=file,
             fs=fs,
+            resample=resample,
             t_fallback=t_fallback,
             meta={"format": "hdf5"},
         )

@@ -250,6 +250,7 @@ def read_mat(
     columns: dict[str, str] | None = None,
     kind: str | None = None,
     fs: float | None = None,
+    resample: bool = False,
 ) -> Recording:
     """Read a MATLAB recording (v4-v7 or v7.3); see :func:`contactlab.io.read_recording`.
 
@@ -272,6 +273,7 @@ def read_mat(
         kind=kind,
         file=file,
         fs=fs,
+        resample=resample,
         t_fallback=t_fallback,
         meta={"format": "mat73" if v73 else "mat"},
     )

@@ -21,9 +21,12 @@ from .units import SI_UNITS, UnknownUnitError, split_name, to_si
 
 #: canonical channel -> physical dimension (``y``: a frame's base displacement)
 DIMENSIONS = {"t": "time", "x": "length", "F": "force", "p": "pressure", "delta": "length",
-              "y": "length"}  # fmt: skip
+              "y": "length", "N": "force"}  # fmt: skip
 #: the channels each kind of recording needs
 KIND_CHANNELS = {"tangential": ("x", "F"), "normal": ("p", "delta")}
+#: channels read along when a column is named like one (never needed): a tangential test's
+#: normal force ``N`` (a tribometer's ``Normal [uN]``), kept so that μ = F/N can be given
+OPTIONAL_CHANNELS = {"tangential": ("N",)}
 #: a base-excited friction frame's displacements (top plate ``x``, base ``y``): read only
 #: when asked for (``kind="frame"``), never guessed, so not one of :data:`KIND_CHANNELS`
 FRAME_CHANNELS = ("x", "y")
@@ -32,7 +35,22 @@ FRAME_WORDS = {"x": ("x", "top", "plate", "mass"), "y": ("y", "base", "ground", 
 #: names recognised (case-insensitive, unit stripped) for each canonical channel, best first
 ALIASES: dict[str, tuple[str, ...]] = {
     "t": ("t", "time", "zeit", "timestamp", "time_s", "times"),
-    "x": ("x", "disp", "displacement", "u", "x_t", "tangential displacement", "s", "ux", "weg"),
+    "x": (
+        "x",
+        "disp",
+        "displacement",
+        "u",
+        "x_t",
+        "tangential displacement",
+        "s",
+        "ux",
+        "weg",
+        "position",
+        "pos",
+        "stroke",
+        "tangential position",
+        "stage position",
+    ),
     "F": (
         "f",
         "force",
@@ -43,7 +61,12 @@ ALIASES: dict[str, tuple[str, ...]] = {
         "h",
         "tangential force",
         "kraft",
+        "tangential",
+        "shear force",
+        "friction (tangential) force",
+        "reibkraft",
     ),
+    "N": ("normal", "normal force", "normal load", "fn", "f_n", "fz", "normalkraft"),
     "p": ("p", "pressure", "contact pressure", "sigma", "p_n", "druck"),
     "delta": ("delta", "δ", "d", "normal displacement", "disp", "displacement", "dn", "weg"),
 }
@@ -296,13 +319,14 @@ def resolve_columns(
             "tangential|normal and --columns 'x=...,F=...')",
             file=file,
         )
-    for canon in (*KIND_CHANNELS[kind], "t"):
+    optional = ("t", *OPTIONAL_CHANNELS.get(kind, ()))
+    for canon in (*KIND_CHANNELS[kind], *optional):
         if canon in mapping:
             continue
         hit = guess(canon)
         if hit is not None:
             mapping[canon] = hit
-        elif canon != "t":
+        elif canon not in optional:
             raise RecordingError(
                 f"no column for {canon!r} ({DIMENSIONS[canon]}) of a {kind} recording; columns "
                 f"are {available}{not_real(*ALIASES[canon])}; name it e.g. "
@@ -387,6 +411,11 @@ def real_values(values: Any, *, file: str, column: str) -> np.ndarray:
         raise RecordingError(f"values are not numeric ({exc})", file=file, column=column) from None
 
 
+#: ``resample=True`` bridges a step of up to this many median steps by interpolation (at most
+#: three samples missing in a row); a longer step is a real gap and is still refused
+RESAMPLE_MAX_GAP = 4.0
+
+
 def check_time(
     t: np.ndarray,
     *,
@@ -395,12 +424,14 @@ def check_time(
     row_of: RowOf | None = None,
     step: float | None = None,
     offset: int = 0,
+    max_gap: float = 1.5,
 ) -> None:
-    """Time stamps finite, strictly increasing, without gaps (> 1.5 median step).
+    """Time stamps finite, strictly increasing, without gaps (> ``max_gap`` median steps).
 
     ``row_of`` gives a sample's line of a text file (None: a binary format), ``offset`` the
     index of ``t[0]`` in the record; ``step`` replaces the median step as the reference (a
-    chunk judged by the first one's).
+    chunk judged by the first one's). ``max_gap`` is 1.5 (a record read as it is) or
+    :data:`RESAMPLE_MAX_GAP` (a record to be resampled: longer steps are bridged).
     """
     if t.size < 2:
         raise RecordingError(f"only {t.size} sample(s)", file=file, column=column)
@@ -416,16 +447,97 @@ def check_time(
             **at_sample(i, row_of, offset),
         )
     med = float(np.median(d)) if step is None else float(step)
-    gaps = np.flatnonzero(d > 1.5 * med)
+    gaps = np.flatnonzero(d > max_gap * med)
     if gaps.size:
         i = int(gaps[0]) + 1
+        if max_gap > 1.5:
+            hint = (
+                f"; --resample bridges steps up to {max_gap:g} times the step ("
+                f"{max_gap * med:.6g} s), a longer one is a real gap: split the recording there"
+            )
+        else:
+            nonuniform = int(np.count_nonzero(d > 1.5 * med))
+            real = int(np.count_nonzero(d > RESAMPLE_MAX_GAP * med))
+            hint = (
+                "; if the sampling is merely non-uniform, --resample (resample=True) "
+                "interpolates the record onto a uniform grid"
+                if real == 0 and nonuniform
+                else ""
+            )
         raise RecordingError(
             f"gap in time: {d[gaps[0]]:.6g} s between samples where the step is {med:.6g} s "
-            f"({gaps.size} gap(s) in all)",
+            f"({gaps.size} gap(s) in all){hint}",
             file=file,
             column=column,
             **at_sample(i, row_of, offset),
         )
+
+
+def uniform_grid(t: np.ndarray, step: float, t0: float | None = None) -> np.ndarray:
+    """``t0 + step·k`` for every ``k >= 0`` up to ``t[-1]`` (``t0`` defaults to ``t[0]``)."""
+    t0 = float(t[0]) if t0 is None else float(t0)
+    n = int(np.floor((float(t[-1]) - t0) / step * (1 + 1e-12))) + 1
+    return t0 + step * np.arange(max(n, 0), dtype=np.float64)
+
+
+def resample_uniform(
+    t: np.ndarray,
+    data: dict[str, np.ndarray],
+    *,
+    file: str,
+    column: str,
+    row_of: RowOf | None = None,
+) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, Any]]:
+    """A non-uniformly sampled record on the uniform grid of its median step.
+
+    The rule: the step of the grid is the median step of the time stamps; a step of up to
+    :data:`RESAMPLE_MAX_GAP` times it is bridged by linear interpolation of every channel; a
+    longer one is a real gap and is refused (:class:`RecordingError` naming the sample). Time
+    stamps must still be strictly increasing. A record whose steps all lie within 10⁻⁶ of the
+    median is returned as it is.
+
+    Returns
+    -------
+    t, data, info
+        The grid, the channels on it, and ``info`` (``step``, ``largest_step``,
+        ``steps_bridged``: steps above 1.5 times the grid step, ``n_read``, ``n_samples``,
+        ``resampled``: False when the record was uniform already).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.array([0.0, 0.005, 0.010, 0.020, 0.025])
+    >>> tt, d, info = resample_uniform(t, {"x": 2 * t}, file="f", column="t")
+    >>> np.round(tt, 9).tolist(), round(info["largest_step"], 3), info["steps_bridged"]
+    ([0.0, 0.005, 0.01, 0.015, 0.02, 0.025], 0.01, 1)
+    """
+    check_time(t, file=file, column=column, row_of=row_of, max_gap=RESAMPLE_MAX_GAP)
+    d = np.diff(t)
+    med = float(np.median(d))
+    info: dict[str, Any] = {
+        "step": med,
+        "largest_step": float(d.max()),
+        "steps_bridged": int(np.count_nonzero(d > 1.5 * med)),
+        "n_read": int(t.size),
+    }
+    if np.all(np.abs(d - med) <= 1e-6 * med):
+        info.update(n_samples=int(t.size), resampled=False)
+        return t, data, info
+    grid = uniform_grid(t, med)
+    out = {k: np.interp(grid, t, v) for k, v in data.items()}
+    info.update(n_samples=int(grid.size), resampled=True)
+    return grid, out, info
+
+
+def describe_resampling(info: dict[str, Any]) -> str:
+    """One sentence on what :func:`resample_uniform` did (for the console and the report)."""
+    if not info.get("resampled"):
+        return f"--resample: the time stamps are uniform already (step {info['step']:.6g} s)"
+    return (
+        f"resampled onto a uniform {info['step']:.6g} s grid by linear interpolation "
+        f"({info['n_read']} -> {info['n_samples']} samples); largest gap bridged "
+        f"{info['largest_step']:.6g} s ({info['steps_bridged']} step(s) over 1.5x the grid step)"
+    )
 
 
 #: what :func:`metadata_scalar` asks of each kind of value, and how its message says it
@@ -603,11 +715,14 @@ def finish(
     row_of: RowOf | None = None,
     t_fallback: np.ndarray | None = None,
     meta: dict[str, Any] | None = None,
+    resample: bool = False,
 ) -> Recording:
     """Convert raw columns to SI, build ``t`` and check everything; shared by all readers.
 
     ``raw`` maps canonical name to values in file units; ``names`` to the file's names;
     ``row_of`` gives a sample's line of a text file, for the errors (None: a binary format).
+    ``resample``: a non-uniform time axis is interpolated onto a uniform grid
+    (:func:`resample_uniform`; ``meta["resampled"]`` says what was done).
     """
     assumed: list[str] = []
     data: dict[str, np.ndarray] = {}
@@ -641,8 +756,11 @@ def finish(
         tcol = "t"
     else:
         tcol = names["t"]
-    check_time(t, file=file, column=tcol, row_of=row_of)
     m = dict(meta or {})
+    if resample:
+        t, data, m["resampled"] = resample_uniform(t, data, file=file, column=tcol, row_of=row_of)
+    else:
+        check_time(t, file=file, column=tcol, row_of=row_of)
     m.setdefault("kind", kind)
     m["columns"] = dict(names)
     m["file_units"] = dict(file_units)

@@ -18,13 +18,17 @@ EXTENSIONS = {
     ".hdf5": "hdf5",
     ".hdf": "hdf5",
     ".mat": "mat",
+    ".npy": "npy",
+    ".npz": "npy",
 }
-NAMES = {"csv": "a text (CSV)", "tdms": "a TDMS", "hdf5": "an HDF5", "mat": "a MATLAB .mat"}
+NAMES = {"csv": "a text (CSV)", "tdms": "a TDMS", "hdf5": "an HDF5", "mat": "a MATLAB .mat",
+         "npy": "a NumPy .npy", "npz": "a NumPy .npz (zip)"}  # fmt: skip
 
 
 def content_format(path: Path) -> str:
-    """``"tdms"``, ``"hdf5"``, ``"mat"`` (v4-v7), ``"mat73"`` (HDF5 based), ``"csv"`` or
-    ``"binary"`` (unknown binary), from the content alone."""
+    """``"tdms"``, ``"hdf5"``, ``"mat"`` (v4-v7), ``"mat73"`` (HDF5 based), ``"npy"``,
+    ``"npz"`` (a zip archive), ``"csv"`` or ``"binary"`` (unknown binary), from the content
+    alone."""
     with open(path, "rb") as fh:
         head = fh.read(1024)
     if head.startswith(b"TDSm"):
@@ -35,6 +39,10 @@ def content_format(path: Path) -> str:
         return "mat73"
     if head.startswith(b"MATLAB 5.0 MAT-file"):
         return "mat"
+    if head.startswith(b"\x93NUMPY"):
+        return "npy"
+    if head.startswith((b"PK\x03\x04", b"PK\x05\x06")):
+        return "npz"
     if b"\x00" in head:
         return "binary"
     try:
@@ -70,6 +78,8 @@ def format_of(path: Path, fmt: str | None = None) -> str:
         raise RecordingError("no such file", file=str(path))
     if path.is_dir():
         raise RecordingError("is a directory, not a recording file", file=str(path))
+    if fmt == "npz":
+        fmt = "npy"  # one reader for both
     if fmt is None:
         fmt = EXTENSIONS.get(path.suffix.lower())
         if fmt is None:
@@ -85,6 +95,7 @@ def format_of(path: Path, fmt: str | None = None) -> str:
         "tdms": ("tdms",),
         "hdf5": ("hdf5", "mat73"),
         "mat": ("mat", "mat73"),
+        "npy": ("npz", "npy") if path.suffix.lower() == ".npz" else ("npy",),
     }[fmt]
     if content not in ok:
         found = {"mat73": "a MATLAB v7.3 (HDF5)", "binary": "an unknown binary"}.get(

@@ -170,6 +170,7 @@ def read_tdms(
     columns: dict[str, str] | None = None,
     kind: str | None = None,
     fs: float | None = None,
+    resample: bool = False,
 ) -> Recording:
     """Read a TDMS recording; see :func:`contactlab.io.read_recording`.
 
@@ -181,11 +182,20 @@ def read_tdms(
     file = str(path)
     # Our own handle: npTDMS leaks the one it opens when parsing fails (ResourceWarning).
     with quiet_nptdms() as quiet:
-        return _read_tdms(nptdms, path, file, quiet, columns=columns, kind=kind, fs=fs)
+        return _read_tdms(nptdms, path, file, quiet, columns=columns, kind=kind, fs=fs,
+                          resample=resample)  # fmt: skip
 
 
 def _read_tdms(
-    nptdms: Any, path: Path, file: str, quiet: quiet_nptdms, *, columns: Any, kind: Any, fs: Any
+    nptdms: Any,
+    path: Path,
+    file: str,
+    quiet: quiet_nptdms,
+    *,
+    columns: Any,
+    kind: Any,
+    fs: Any,
+    resample: bool = False,
 ) -> Recording:
     fh = open(path, "rb")
     try:
@@ -226,6 +236,7 @@ def _read_tdms(
             kind=kind,
             file=file,
             fs=fs,
+            resample=resample,
             t_fallback=t_fallback,
             meta={"format": "tdms"},
         )

@@ -50,14 +50,27 @@ _add("length", ("m", "meter", "metre"), 1.0)
 _add("length", ("mm", "millimeter", "millimetre"), 1e-3)
 _add("length", ("um", "micron", "microns", "micrometer"), 1e-6)
 _add("length", ("nm", "nanometer", "nanometre"), 1e-9)
+# US customary units, exact by definition (international yard and pound, 1959): 1 in =
+# 0.0254 m, 1 mil = 0.001 in, 1 lbf = 0.45359237 kg x 9.80665 m/s^2 (standard gravity),
+# 1 kip = 1000 lbf, 1 psi = 1 lbf/in^2, 1 ksi = 1000 psi
+_INCH = 0.0254
+_LBF = 0.45359237 * 9.80665
+_add("length", ("in", "inch", "inches"), _INCH)
+_add("length", ("mil", "mils", "thou"), _INCH * 1e-3)
 _add("force", ("n", "newton", "newtons"), 1.0)
 _add("force", ("mn",), 1e-3)
+_add("force", ("un",), 1e-6)
+_add("force", ("lbf",), _LBF)
+_add("force", ("kip", "kips", "klbf"), _LBF * 1e3)
 _add("force", ("kn", "kilonewton"), 1e3)
 _add("pressure", ("pa", "n/m2", "n/m^2", "n/m²"), 1.0)
 _add("pressure", ("kpa",), 1e3)
 _add("pressure", ("mpa", "n/mm2", "n/mm^2", "n/mm²"), 1e6)
 _add("pressure", ("gpa",), 1e9)
 _add("pressure", ("bar",), 1e5)
+_add("pressure", ("mbar",), 1e2)
+_add("pressure", ("psi", "lbf/in2", "lbf/in^2", "lbf/in²"), _LBF / _INCH**2)
+_add("pressure", ("ksi",), _LBF / _INCH**2 * 1e3)
 _add("dimensionless", ("", "-", "1"), 1.0)
 _add("frequency", ("Hz",), 1.0)
 _add("frequency", ("kHz",), 1e3)
@@ -72,12 +85,17 @@ _add("energy", ("uJ",), 1e-6)
 _add("stiffness", ("N/m",), 1.0)
 _add("stiffness", ("N/mm",), 1e3)
 _add("stiffness", ("N/um",), 1e6)
+_add("stiffness", ("kN/mm",), 1e6)
+_add("stiffness", ("lbf/in",), _LBF / _INCH)
 
 # Case is ignored ("Pa", "pa", "MPA" are the same; all-caps headers such as "MM" or "MS" mean
 # mm and ms; "m" is metre, minute is "min") except where the capital could be a real mega
-# unit: "MN" (meganewton) and "MJ" (megajoule) are unknown rather than read as mN and mJ,
-# 10^9 times too small.
-_MILLI = {"mn", "mj"}
+# unit: "MN" (meganewton), "MJ" (megajoule) and "Mbar" are unknown rather than read as mN,
+# mJ and mbar, 10^9 times too small.
+_MILLI = {"mn", "mj", "mbar"}
+#: units not taken from a ``name_unit`` suffix: ``F_in`` is more often an input force than a
+#: force in inches (``F [in]`` and ``F / in`` are read as written)
+_NO_SUFFIX = {"in"}
 
 
 class UnknownUnitError(InputError):
@@ -116,8 +134,8 @@ def to_si(unit: str, *, where: str = "") -> tuple[float, str]:
     if hit is None:
         loc = f" in {where}" if where else ""
         raise UnknownUnitError(
-            f"unknown unit {unit!r}{loc}; known units: s, ms, us, m, mm, um, nm, N, mN, kN, "
-            "Pa, kPa, MPa, GPa, bar, N/mm2"
+            f"unknown unit {unit!r}{loc}; known units: s, ms, us, m, mm, um, nm, in, mil, N, "
+            "mN, uN, kN, lbf, kip, Pa, kPa, MPa, GPa, bar, psi, ksi, N/mm2 (µ may be written u)"
         )
     return hit
 
@@ -147,6 +165,8 @@ def split_name(column: str) -> tuple[str, str | None]:
         return m.group("name"), m.group("unit").strip()
     for rx in (_SLASH, _SUFFIX):
         m = rx.match(column)
+        if rx is _SUFFIX and m and normalize(m.group("unit")) in _NO_SUFFIX:
+            continue
         if m and lookup(m.group("unit")) is not None:
             return m.group("name").strip(), m.group("unit")
     return column.strip(), None

@@ -31,12 +31,12 @@ from typing import Any
 import numpy as np
 
 from .._arrays import as_1d
+from .._blas import with_single_blas_thread
 from .._io_atomic import write_text
 from .._physical import MAX_MAGNITUDE, check_channel
 from ..errors import ContactLabError, InputError
 from ..fitting import FitResult, Parameter, least_squares_fit
-from ._blas import with_single_blas_thread
-from ._fitkit import (
+from .fitkit import (
     IWAN_ELEMENTS,
     add_fitted_joint,
     best_start,
@@ -181,10 +181,9 @@ class IdentifiedModel:
 
     @classmethod
     def load(cls, path: str | Path) -> IdentifiedModel:
-        try:
-            d = json.loads(Path(path).read_text())
-        except (OSError, ValueError) as exc:  # ValueError: not UTF-8 or not JSON
-            raise InputError(f"cannot read model JSON {path}: {exc}") from None
+        from .model import load_json
+
+        d = load_json(path, "model JSON (`contactlab identify --json`)")
         return cls.from_dict(d)
 
     @classmethod

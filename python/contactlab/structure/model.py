@@ -448,11 +448,32 @@ class Structure:
 
     @classmethod
     def load(cls, path: str | Path) -> Structure:
-        try:
-            d = json.loads(Path(path).read_text())
-        except (OSError, ValueError) as exc:  # ValueError: not UTF-8 or not JSON
-            raise InputError(f"cannot read structure JSON {path}: {exc}") from None
+        d = load_json(path, "structure JSON (Structure.save, or `contactlab identify --json`)")
         return cls.from_dict(d.get("structure", d) if isinstance(d, dict) else d)
+
+
+def load_json(path: str | Path, what: str) -> Any:
+    """The JSON document in ``path``; a missing file, a folder, a binary file or text that is
+    not JSON is an :class:`~contactlab.InputError` of one line naming the file and ``what``
+    it should be (never the codec's or the OS's raw message)."""
+    p = Path(path)
+    if not p.exists():
+        raise InputError(f"{path}: no such file (expected a {what})")
+    if p.is_dir():
+        raise InputError(f"{path}: is a folder, not a {what}")
+    try:
+        raw = p.read_bytes()
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read ({exc.strerror})") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        raise InputError(f"{path}: a binary file, not a {what}") from None
+    try:
+        return json.loads(text)
+    except ValueError as exc:
+        raise InputError(f"{path}: not JSON (line {getattr(exc, 'lineno', '?')}): expected a "
+                         f"{what}") from None  # fmt: skip
 
 
 _OUTPUTS = {

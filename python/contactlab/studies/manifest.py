@@ -118,6 +118,8 @@ class StudyEntry:
     units: dict[str, str] = field(default_factory=dict)  # SI units of numeric tags
     columns: dict[str, str] | None = None
     fs: float | None = None
+    #: interpolate a non-uniform time axis onto a uniform grid (``--resample``)
+    resample: bool = False
     source: str = ""  # "manifest.csv row 3" or the file name, for error messages
     #: a friction frame's displacements (``{"M", "C", "K"}`` and optional ``x``, ``y`` column
     #: names): the friction force is reconstructed (:func:`contactlab.tangential.read_frame`)

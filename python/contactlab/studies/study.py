@@ -171,8 +171,9 @@ def analyze_entry(
         if assumed_frame:
             rec.meta["units_assumed_si"] = assumed_frame
     else:
-        rec = read_recording(entry.path, columns=entry.columns, kind=entry.kind, fs=entry.fs)
-    from ..diagnose._inputs import check_recording_glitches
+        rec = read_recording(entry.path, columns=entry.columns, kind=entry.kind, fs=entry.fs,
+                             resample=entry.resample)  # fmt: skip
+    from ..io.checks import check_recording_glitches
 
     check_recording_glitches(rec)  # a sensor glitch is refused, as diagnose refuses it
     base = {"file": entry.path.name, "kind": entry.kind, **entry.tags}
@@ -193,6 +194,13 @@ def analyze_entry(
         d = tangential_row(analysis.to_dict())
         row, u = _flatten(d, d.get("units", {}) or {})
         extra: dict[str, Any] = {}
+        if "N" in rec.data:  # a recorded normal force: μ = F/N on the sliding plateau
+            from ..tangential.friction import sliding_friction
+
+            sf = sliding_friction(rec.t, rec["x"], rec["F"], rec["N"])
+            row.update(sf.to_dict())
+            extra.update(sf.to_dict())
+            u.update(sf.units, mu_up="1", mu_down="1")
         if frame is not None:  # the reconstruction's figures: JSON object, table columns
             fd = frame.to_dict()
             extra["frame_reconstruction"] = fd
@@ -206,6 +214,16 @@ def analyze_entry(
         row, u = _flatten(d, d.get("units", {}) or {})
     units.update(u)
     base.update(row)
+    resampled = (rec.meta or {}).get("resampled")
+    if resampled:
+        from ..io.recording import describe_resampling
+
+        base["resampled_largest_gap"] = float(resampled["largest_step"])
+        units["resampled_largest_gap"] = "s"
+        note = describe_resampling(resampled)
+        ws = [note, *(w for w in str(base.get("warnings") or "").split(" | ") if w)]
+        base["warnings"] = " | ".join(ws)
+        extra = {**extra, "warnings": ws}
     if assumed:
         # A header without units is the commonest way to get metres where µm were meant:
         # say so beside the results (terminal, JSON, report), not only in a provenance column.
@@ -289,7 +307,7 @@ class StudyResult:
 
     def _repr_html_(self) -> str:
         """Summary tables in notebooks (the full report: ``report.study_report``)."""
-        from ..report.html import table_html
+        from .._html import table_html
         from .columns import NORMAL_COLUMNS, TANGENTIAL_COLUMNS
 
         parts = []

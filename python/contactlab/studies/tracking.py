@@ -335,10 +335,17 @@ class TrackResult:
 
     def plot(self, name: str, *, against: str = "time", ax: Any = None) -> Any:
         """``name`` (with error bars when it has a standard error) against window mid time
-        (``against="time"``) or cycle count (``"cycle"``); returns the axes."""
-        from .track_plots import plot_quantity
+        (``against="time"``) or cycle count (``"cycle"``); returns the axes.
 
-        return plot_quantity(self, name, against=against, ax=ax)
+        Deprecated (issue 32: studies return results, the report draws them): use
+        :func:`contactlab.report.track_plots.plot_quantity`.
+        """
+        from .._moved import moved
+
+        fn = moved(
+            "contactlab.TrackResult", "plot", "contactlab.report.track_plots", "plot_quantity"
+        )
+        return fn(self, name, against=against, ax=ax)
 
     def __repr__(self) -> str:
         return (
@@ -439,7 +446,7 @@ def _with_glitch_check(
 ) -> Callable[..., tuple[dict, dict]]:
     @functools.wraps(fn)
     def run(rec: Recording | _WindowSamples, *args: Any, **kwargs: Any) -> tuple[dict, dict]:
-        from ..diagnose._inputs import check_recording_glitches
+        from ..io.checks import check_recording_glitches
 
         try:
             row, units = fn(rec, *args, **kwargs)
@@ -732,6 +739,7 @@ def track(
     executor: Any = None,
     keep_documents: bool = False,
     threads: int | None = None,
+    resample: bool = False,
 ) -> TrackResult:
     """Fitted quantities of a long recording window by window, in bounded memory.
 
@@ -745,8 +753,10 @@ def track(
         :data:`AUTO_WINDOW` samples). Windows are cut at upward crossings of the drive
         (``x`` or ``p``), so they hold whole cycles; the first also holds the lead-in before
         the first crossing, and a last, shorter window is analysed when it has >= 3 cycles.
-    kind, columns, fs
-        As for :func:`contactlab.io.read_recording`.
+    kind, columns, fs, resample
+        As for :func:`contactlab.io.read_recording` (``resample``: a non-uniform time axis
+        interpolated onto a uniform grid, chunk by chunk; see
+        :func:`contactlab.io.read_chunks`).
     chunk_size : int
         Samples read at a time (default :data:`TRACK_CHUNK`).
     max_window : int
@@ -781,7 +791,7 @@ def track(
 
     Examples
     --------
-    >>> from contactlab.tangential import synthetic_recording
+    >>> from contactlab.synthetic.tangential import synthetic_recording
     >>> rec = synthetic_recording(h0=40.0, ac=4e4, amplitude=20e-6, n_cycles=12, fs=2000.0,
     ...                           noise=0.01, seed=2)
     >>> res = track(rec, every="4cycles")  # 10 complete cycles: 4 + 4, and a 2-cycle tail
@@ -810,12 +820,12 @@ def track(
                 source, every, kind=kind, columns=columns, fs=fs, chunk_size=chunk_size,
                 max_window=max_window, options=options, keep_going=keep_going,
                 callback=callback, executor=pool, keep_documents=keep_documents,
-                slots=n_threads + (2 if n_threads >= 2 else 1),
+                slots=n_threads + (2 if n_threads >= 2 else 1), resample=resample,
             )  # fmt: skip
     return _track(
         source, every, kind=kind, columns=columns, fs=fs, chunk_size=chunk_size,
         max_window=max_window, options=options, keep_going=keep_going, callback=callback,
-        executor=executor, keep_documents=keep_documents, slots=None,
+        executor=executor, keep_documents=keep_documents, slots=None, resample=resample,
     )  # fmt: skip
 
 
@@ -834,6 +844,7 @@ def _track(
     executor: Any,
     keep_documents: bool,
     slots: int | None,
+    resample: bool = False,
 ) -> TrackResult:
     """:func:`track` on ``executor`` (None: serial); ``slots``: windows in flight at most
     (default two per worker)."""
@@ -841,7 +852,8 @@ def _track(
     every_text = every if isinstance(every, str) else f"{every}cycles"
     if not (isinstance(max_window, int) and max_window >= 16):
         raise InputError(f"max_window must be an integer >= 16, got {max_window!r}")
-    cr = read_chunks(source, chunk_size=chunk_size, columns=columns, kind=kind, fs=fs)
+    cr = read_chunks(source, chunk_size=chunk_size, columns=columns, kind=kind, fs=fs,
+                     resample=resample)  # fmt: skip
     kind_ = cr.kind
     if kind_ not in ("tangential", "normal"):
         raise InputError(
@@ -1022,7 +1034,7 @@ def track_many(
     Examples
     --------
     >>> from concurrent.futures import ThreadPoolExecutor
-    >>> from contactlab.tangential import synthetic_recording
+    >>> from contactlab.synthetic.tangential import synthetic_recording
     >>> recs = [synthetic_recording(h0=40.0, ac=4e4, amplitude=20e-6, n_cycles=8, fs=1000.0,
     ...                             noise=0.01, seed=s) for s in (1, 2)]
     >>> with ThreadPoolExecutor(2) as ex:

@@ -1,0 +1,707 @@
+"""Fit a joint law to measured force-displacement histories and predict new ones.
+
+:func:`fit` drives a law of :mod:`contactlab.joints.laws` with the measured displacement of
+one or several records and adjusts its parameters (shared by all records) so that its force
+matches the measured one in the least-squares sense:
+
+    min_θ,β  Σ_records Σ_samples ( law_θ(t, x) + Σ_j β_j φ_j(t, x) − F )²
+
+``φ_j`` are optional linear terms in parallel with the law: a force offset (``offset=True``:
+a load-cell zero), a stiffness ``x``, a viscous term ``ẋ``, an inertia ``ẍ`` (``stiffness``,
+``damping``, ``mass``; derivatives by second-order central differences on the record's own
+time axis) and a direction-dependent gain ``a |F_law|`` (``asymmetry``: the law's force
+scaled by ``1 + a`` when positive and ``1 − a`` when negative, as the capstan effect of a
+self-energising band brake makes its friction differ between the two directions, while a
+clearance's dead band stays at zero force, which an offset would move).
+
+The linear coefficients are eliminated at every trial θ by linear least squares (variable
+projection, G. H. Golub, V. Pereyra, SIAM J. Numer. Anal. 10 (1973)), so the nonlinear
+search runs over the law's parameters only; a last joint fit of all parameters from that
+optimum gives the covariance of everything.
+
+Conventions follow :func:`contactlab.fitting.least_squares_fit`: parameters with standard
+errors from ``(JᵀJ)⁻¹`` scaled by the reduced χ², correlations, and a parameter the data do
+not determine (a direction of the Jacobian below its singular-value cut-off) reported as
+``not identifiable: <why>`` with no standard error, never ± nan. A fit that does not
+converge returns ``success=False`` with the solver's message; only malformed input raises.
+
+Start values come from the records (:func:`loop_features`): the plateau of the force (the
+Coulomb force of a sliding joint), the travel after a reversal over which the force swings
+through 80 % of its range (a secant stiffness) and the typical speed, mapped onto each law's
+parameters (:func:`start_law`); when the fit from there ends poorly, it is repeated from
+stiffer and softer starts and the best one kept.
+
+Each law starts relaxed (force 0, no history) at its record's first displacement; a
+record's ``mask`` selects the samples compared (a run-in excluded, a training window).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import ContactLabError, InputError
+from ..fitting import FitResult, Parameter, json_number, least_squares_fit
+from ..reversals import excursions
+from .records import JointRecord, as_records
+
+#: linear terms in parallel with the law: name -> unit of the coefficient
+TERMS = {"offset": "N", "k_parallel": "N/m", "c_parallel": "N s/m", "mass": "kg",
+         "asymmetry": ""}  # fmt: skip
+#: terms whose column is computed from the displacement (the others from the law's force)
+_STATIC = ("offset", "k_parallel", "c_parallel", "mass")
+
+#: parameters held at their start value unless ``fixed`` says otherwise (weakly determined
+#: shape exponents and redundant scales)
+DEFAULT_FIXED: dict[str, tuple[str, ...]] = {
+    "lugre": ("delta",),
+    "gms": ("delta", "alpha0"),
+    "masing": ("scale",),
+    "bouc_wen": ("nu",),
+    "dahl": (),
+}
+
+
+@dataclass(frozen=True)
+class LoopFeatures:
+    """Scales of a set of records that start values are made of.
+
+    ``force_level`` [N]: half the robust range of F (1-99 %); ``force_mid`` [N]: its middle;
+    ``swing_length`` [m]: median travel after a reversal for the force to swing through 80 %
+    of ``2·force_level``; ``stiffness`` [N/m] = ``1.6 force_level / swing_length``;
+    ``speed`` [m/s]: median |ẋ|; ``stroke`` [m]: half the displacement range.
+    """
+
+    force_level: float
+    force_mid: float
+    swing_length: float
+    stiffness: float
+    speed: float
+    stroke: float
+
+
+def loop_features(records: Sequence[JointRecord]) -> LoopFeatures:
+    """Start-value scales from the records' loops (see :class:`LoopFeatures`)."""
+    Fs = np.concatenate([r.require_force()[r.selected()] for r in records])
+    q1, q99 = np.percentile(Fs, [1.0, 99.0])
+    level = 0.5 * float(q99 - q1)
+    if not level > 0:
+        raise InputError("the measured force is constant: there is no loop to fit")
+    mid = 0.5 * float(q99 + q1)
+    swings, speeds, strokes = [], [], []
+    for r in records:
+        x, F = r.x, r.require_force()
+        lo, hi = float(np.min(x)), float(np.max(x))
+        strokes.append(0.5 * (hi - lo))
+        speeds.append(float(np.median(np.abs(np.gradient(x, r.t)))))
+        if not hi > lo:
+            continue
+        ex = excursions(x, 0.5 * (lo + hi), 0.25 * (hi - lo))
+        turns = np.asarray(ex.extreme, dtype=np.int64)
+        for a, b in itertools.pairwise(turns):
+            seg_F = F[a : b + 1]
+            target = 0.8 * 2.0 * level
+            moved = np.abs(seg_F - seg_F[0])
+            k = int(np.argmax(moved >= target)) if np.any(moved >= target) else -1
+            if k > 0:
+                swings.append(abs(float(x[a + k] - x[a])))
+    stroke = max(float(np.median(strokes)), 1e-300)
+    swing = float(np.median(swings)) if swings else 0.5 * stroke
+    swing = min(max(swing, 1e-6 * stroke), 2.0 * stroke)
+    speed = float(np.median(speeds))
+    if not speed > 0:
+        speed = stroke
+    return LoopFeatures(level, mid, swing, 1.6 * level / swing, speed, stroke)
+
+
+def _leaf_start(name: str, f: LoopFeatures, stiff: float, n_elements: int) -> Any:
+    from .laws import LAWS
+
+    Fc, k0, v = f.force_level, f.stiffness * stiff, f.speed
+    cls = LAWS[name]
+    if name == "jenkins":
+        return cls(k=k0, fs=Fc)
+    if name == "iwan":
+        return cls(k=2.0 * k0, fs_max=Fc)
+    if name == "segalman":
+        return cls(F_S=Fc, K_T=2.0 * k0, chi=-0.5, beta=0.1)
+    if name == "maxwell_slip":
+        n = n_elements
+        phi = (np.arange(n) + 1.0) / n * 2.0 * Fc / k0  # slip displacements up to the swing
+        w = np.full(n, 2.0 * k0 / n)
+        fs = w * phi
+        fs *= Fc / fs.sum()
+        return cls(k=w, fs=fs)
+    if name == "gms":
+        n = n_elements
+        return cls(k=np.full(n, 2.0 * k0 / n) * (np.arange(n) + 1.0) ** -0.5 * 1.5,
+                   alpha=np.full(n, 1.0 / n), Fc=Fc, Fs=1.1 * Fc, vs=0.3 * v, C=20.0 * Fc,
+                   delta=2.0, sigma2=0.01 * Fc / v)  # fmt: skip
+    if name == "dahl":
+        return cls(sigma0=2.0 * k0, Fc=Fc, alpha=1.0)
+    if name == "lugre":
+        return cls(sigma0=2.0 * k0, sigma1=0.01 * Fc / v, sigma2=0.01 * Fc / v, Fc=Fc,
+                   Fs=1.1 * Fc, vs=0.3 * v, delta=2.0)  # fmt: skip
+    if name == "bouc_wen":
+        # ν = 1: saturation force α / (β (γ + δ)) = Fc with γ = δ = 1/2
+        return cls(alpha=2.0 * k0, beta=2.0 * k0 / Fc, gamma=0.5, delta=0.5, nu=1.0)
+    if name == "masing":
+        return cls(h0=Fc, ac=2.0 * k0 / Fc, scale=2.0)
+    if name == "kelvin_voigt":
+        return cls(k=k0, c=0.01 * Fc / v)
+    raise InputError(
+        f"law {name!r} needs its parts: give an instance (e.g. Parallel(Jenkins(k, fs), k=..)) "
+        "or a chain such as 'backlash:jenkins'"
+    )
+
+
+def start_law(law: str, records: Any, *, stiffness_factor: float = 1.0,
+              n_elements: int = 4) -> Any:  # fmt: skip
+    """A law named ``law`` with start values from the records' loops.
+
+    ``law`` is a registry name (:data:`contactlab.joints.LAWS`) or a chain of them joined by
+    ``:`` for laws behind a clearance, e.g. ``"backlash:lugre"`` (a dead band, its width
+    started at a fifth of the swing length, in series with a LuGre law). Maxwell-slip and
+    generalised Maxwell-slip get ``n_elements`` elements.
+    """
+    from .laws import LAWS
+
+    recs = as_records(records)
+    f = loop_features(recs)
+    parts = [p.strip().lower() for p in str(law).split(":")]
+    for p in parts:
+        if p not in LAWS:
+            raise InputError(f"unknown law {p!r}; known: {', '.join(sorted(LAWS))}")
+    if parts[0] == "backlash":
+        if len(parts) != 2:
+            raise InputError("give the law behind the clearance: e.g. 'backlash:jenkins'")
+        inner = _leaf_start(parts[1], f, 2.0 * stiffness_factor, n_elements)
+        return LAWS["backlash"](0.2 * f.swing_length, inner)
+    if len(parts) != 1:
+        raise InputError(f"law {law!r}: only 'backlash:<law>' chains are known")
+    return _leaf_start(parts[0], f, stiffness_factor, n_elements)
+
+
+def _derivatives(t: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    v = np.gradient(x, t, edge_order=2) if t.size > 2 else np.gradient(x, t)
+    a = np.gradient(v, t, edge_order=2) if t.size > 2 else np.gradient(v, t)
+    return v, a
+
+
+def _term_columns(terms: Sequence[str], t: np.ndarray, x: np.ndarray) -> np.ndarray:
+    terms = [n for n in terms if n in _STATIC]
+    cols = []
+    v = a = None
+    if "c_parallel" in terms or "mass" in terms:
+        v, a = _derivatives(t, x)
+    for n in terms:
+        if n == "offset":
+            cols.append(np.ones_like(x))
+        elif n == "k_parallel":
+            cols.append(x - x[0])
+        elif n == "c_parallel":
+            cols.append(v)
+        elif n == "mass":
+            cols.append(a)
+    return np.column_stack(cols) if cols else np.zeros((x.size, 0))
+
+
+def turning_points(x: np.ndarray, gate: float) -> np.ndarray:
+    """Indices of the turning points of ``x``: the extremes between which it moves by more
+    than ``gate`` (a hysteresis threshold, as the gate of ASTM E1049-85 peak counting; 0
+    keeps every local extremum)."""
+    d = np.diff(x)
+    nz = np.flatnonzero(d != 0)
+    if nz.size == 0:
+        return np.zeros(0, dtype=np.int64)
+    s = np.sign(d[nz])
+    # candidates: the last sample of each monotone run (a change of sign of the steps)
+    cand = nz[np.flatnonzero(s[1:] != s[:-1])] + 1
+    if gate <= 0 or cand.size == 0:
+        return cand.astype(np.int64)
+    # hysteresis over the candidates (the first sample included: the first run's start)
+    pts = np.concatenate([[0], cand]).astype(np.int64)
+    v = x[pts]
+    out: list[int] = []
+    hi = lo = 0  # positions in pts while no direction is set
+    direction, ext = 0, 0
+    for j in range(1, pts.size):
+        if direction == 0:
+            if v[j] > v[hi]:
+                hi = j
+            if v[j] < v[lo]:
+                lo = j
+            if v[hi] - v[lo] > gate:
+                first, ext, direction = (lo, hi, 1) if hi > lo else (hi, lo, -1)
+                out.append(int(pts[first]))
+            continue
+        if direction > 0:
+            if v[j] >= v[ext]:
+                ext = j
+            elif v[ext] - v[j] > gate:
+                out.append(int(pts[ext]))
+                direction, ext = -1, j
+        else:
+            if v[j] <= v[ext]:
+                ext = j
+            elif v[j] - v[ext] > gate:
+                out.append(int(pts[ext]))
+                direction, ext = 1, j
+    if direction != 0:
+        out.append(int(pts[ext]))
+    return np.asarray(out, dtype=np.int64)
+
+
+def thin_indices(rec: JointRecord, keep_every: int, gate: float = 1e-3) -> np.ndarray:
+    """Every ``keep_every``-th sample plus each turning point of ``x``, first and last.
+
+    Turning points: :func:`turning_points` with a gate of ``gate`` times the range of ``x``.
+    A rate-independent law gives the same force at the kept samples as on the whole record
+    (its force depends only on the sequence of turning points and the current displacement),
+    up to the effect of reversals smaller than the gate (exact with ``gate=0``).
+    """
+    n = rec.n
+    if keep_every <= 1:
+        return np.arange(n)
+    x = rec.x
+    rng = float(np.max(x) - np.min(x))
+    keep = np.zeros(n, bool)
+    keep[::keep_every] = True
+    keep[-1] = True
+    keep[turning_points(x, gate * rng)] = True
+    return np.flatnonzero(keep)
+
+
+@dataclass
+class _Prepared:
+    """A record as a fit evaluates it: the samples the law runs on, the compared ones."""
+
+    rec: JointRecord
+    run: np.ndarray  # indices of the samples the law is driven with
+    cmp: np.ndarray  # positions within ``run`` compared
+    F: np.ndarray  # measured force at the compared samples
+    phi: np.ndarray  # linear terms' columns at the compared samples
+
+
+def _prepare(recs: list[JointRecord], terms: Sequence[str],
+             max_samples: int | None) -> list[_Prepared]:  # fmt: skip
+    total = sum(r.n for r in recs)
+    every = 1 if max_samples is None or total <= max_samples else math.ceil(total / max_samples)
+    out = []
+    for r in recs:
+        F = r.require_force()
+        run = thin_indices(r, every)
+        sel = np.ones(r.n, bool) if r.mask is None else r.mask
+        cmp = np.flatnonzero(sel[run])
+        if cmp.size == 0:
+            cmp = np.arange(run.size)
+        phi = _term_columns(terms, r.t, r.x)[run[cmp]]
+        out.append(_Prepared(r, run, cmp, F[run[cmp]], phi))
+    return out
+
+
+def _law_forces(law: Any, prep: list[_Prepared]) -> np.ndarray:
+    parts = []
+    for p in prep:
+        t, x = p.rec.t[p.run], p.rec.x[p.run]
+        parts.append(np.asarray(law.force(t, x, float(x[0])), dtype=float)[p.cmp])
+    return np.concatenate(parts)
+
+
+def _linear_solve(phi: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    if phi.shape[1] == 0:
+        return np.zeros(0)
+    sc = np.sqrt(np.sum(phi**2, axis=0))
+    sc[sc == 0] = 1.0
+    beta = np.linalg.lstsq(phi / sc, rhs, rcond=None)[0]
+    return beta / sc
+
+
+@dataclass
+class JointFit:
+    """A law fitted to records (:func:`fit`): predicts forces with :meth:`force`.
+
+    Attributes
+    ----------
+    law : JointLaw
+        The law with the fitted parameters.
+    terms : dict
+        Coefficients of the linear terms in parallel (``offset`` N, ``k_parallel`` N/m,
+        ``c_parallel`` N s/m, ``mass`` kg) that were fitted.
+    result : FitResult
+        The least-squares result over the law's parameters and the terms: values, standard
+        errors, correlations, χ², AIC/BIC, ``success`` and ``message``.
+    records : list of str
+        Names of the records fitted.
+    n_samples : int
+        Samples compared (after thinning).
+    seconds : float
+        Wall time of the fit.
+    """
+
+    law: Any
+    terms: dict[str, float]
+    result: FitResult
+    records: list[str]
+    n_samples: int
+    seconds: float = 0.0
+    thinned_every: int = 1
+    starts_tried: int = 1
+    name: str = ""
+    notes: list[str] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        if not self.name:
+            self.name = self.law.name
+
+    @property
+    def success(self) -> bool:
+        return bool(self.result.success)
+
+    @property
+    def message(self) -> str:
+        return self.result.message
+
+    @property
+    def params(self) -> dict[str, Parameter]:
+        """The fitted parameters (the law's, then the terms') with standard errors."""
+        return self.result.params
+
+    @property
+    def correl(self) -> dict[str, dict[str, float]]:
+        return self.result.correl_dict()
+
+    def force(self, t: Any, x: Any, x0: float | None = None) -> np.ndarray:
+        """Predicted force for the displacement history ``x`` at times ``t``.
+
+        The law starts relaxed at ``x0`` (default: the first displacement), as in the fit.
+        """
+        from .._arrays import as_1d
+
+        xa = as_1d(x, "x")
+        ta = as_1d(t, "t")
+        if ta.size != xa.size:
+            raise InputError(f"t has {ta.size} samples, x has {xa.size}")
+        start = float(xa[0]) if x0 is None else float(x0)
+        P = np.asarray(self.law.force(ta, xa, start), dtype=float)
+        F = P.copy()
+        names = [n for n in _STATIC if n in self.terms]
+        if names:
+            F += _term_columns(names, ta, xa) @ np.array([self.terms[n] for n in names])
+        if "asymmetry" in self.terms:
+            F += self.terms["asymmetry"] * np.abs(P)
+        return F
+
+    def report(self) -> str:
+        """A text report: the law, the fit statistics, parameters with errors, notes."""
+        head = [f"[[Joint law]] {self.law!r}", f"    records: {', '.join(self.records)}",
+                f"    samples compared: {self.n_samples}"
+                + (f" (every {self.thinned_every}th + turning points)"
+                   if self.thinned_every > 1 else "")]  # fmt: skip
+        extra = [f"    {n}" for n in self.notes]
+        return "\n".join(head + [self.result.report()] + (["[[Joint fit notes]]", *extra]
+                                                          if extra else []))  # fmt: skip
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-safe summary (SI values, a ``units`` map)."""
+        params = {}
+        for n, p in self.params.items():
+            params[n] = {
+                "value": json_number(p.value),
+                "stderr": json_number(p.stderr),
+                "identifiable": p.identifiable,
+                "vary": p.vary,
+                "note": p.note,
+                "unit": p.unit,
+            }
+        r = self.result
+        return {
+            "law": self.law.name,
+            "name": self.name,
+            "law_repr": repr(self.law),
+            "params": params,
+            "terms": {k: json_number(v) for k, v in self.terms.items()},
+            "correl": r.correl_dict() or None,
+            "success": bool(r.success),
+            "message": r.message,
+            "chisqr": json_number(r.chisqr),
+            "redchi": json_number(r.redchi),
+            "aic": json_number(r.aic),
+            "bic": json_number(r.bic),
+            "nfev": int(r.nfev),
+            "records": list(self.records),
+            "n_samples": self.n_samples,
+            "thinned_every": self.thinned_every,
+            "seconds": json_number(self.seconds),
+            "notes": list(r.notes) + list(self.notes),
+            "units": {n: p.unit for n, p in self.params.items()},
+        }
+
+
+def _resolve_law(law: Any, recs: list[JointRecord], stiffness_factor: float,
+                 n_elements: int) -> Any:  # fmt: skip
+    from .laws import LAWS, JointLaw
+
+    if isinstance(law, JointLaw):
+        return law
+    if isinstance(law, type) and issubclass(law, JointLaw):
+        law = law.name
+    if isinstance(law, str):
+        return start_law(law, recs, stiffness_factor=stiffness_factor, n_elements=n_elements)
+    raise InputError(f"law must be a name ({', '.join(sorted(LAWS))}), a law class or a law "
+                     f"instance, got {type(law).__name__}")  # fmt: skip
+
+
+def _fixed_names(law: Any, fixed: Any) -> set[str]:
+    names = law.param_names
+    if fixed is None:
+        base = law.name
+        defaults = DEFAULT_FIXED.get(base, ())
+        if base == "backlash":
+            inner = law.laws[0]
+            pre = inner.name
+            defaults = tuple(f"{pre}.{n}" for n in DEFAULT_FIXED.get(inner.name, ()))
+        return {n for n in defaults if n in names}
+    out = set(fixed.keys() if isinstance(fixed, Mapping) else fixed)
+    unknown = out - set(names)
+    if unknown:
+        raise InputError(f"fixed: unknown parameter(s) {', '.join(sorted(unknown))} of "
+                         f"{law.name} ({', '.join(names)})")  # fmt: skip
+    return out
+
+
+def _parameters(law: Any, fixed: set[str], bounds: Mapping[str, tuple[float, float]] | None
+                ) -> dict[str, Parameter]:  # fmt: skip
+    units = law.units
+    lb = law.bounds
+    out = {}
+    for n, v in law.params.items():
+        lo, hi = lb[n]
+        if bounds and n in bounds:
+            lo, hi = bounds[n]
+        scale = None
+        if v == 0:
+            scale = 1.0
+        # a parameter whose lower bound is excluded (stiffness, forces) is kept off it
+        if lo == 0.0 and v > 0 and n not in fixed:
+            lo = 1e-9 * v if not (bounds and n in bounds) else lo
+        out[n] = Parameter(n, float(v), vary=n not in fixed, min=lo, max=hi, unit=units[n],
+                           scale=scale)  # fmt: skip
+    return out
+
+
+def _identifiability_notes(res: FitResult) -> None:
+    """``not identifiable: <why>`` on every parameter the fit flagged."""
+    for n, p in res.params.items():
+        if p.identifiable is False:
+            why = next((s for s in res.notes if n in s), None)
+            if p.note and p.note.startswith("not identifiable"):
+                continue
+            text = why or p.note or "the data do not constrain it"
+            p.note = f"not identifiable: {text}"
+            p.stderr = None
+
+
+def fit(
+    records: Any,
+    x: Any = None,
+    F: Any = None,
+    *,
+    law: Any = "lugre",
+    fixed: Iterable[str] | Mapping[str, float] | None = None,
+    bounds: Mapping[str, tuple[float, float]] | None = None,
+    offset: bool = False,
+    stiffness: bool = False,
+    damping: bool = False,
+    mass: bool = False,
+    asymmetry: bool = False,
+    fs: float | None = None,
+    max_samples: int | None = None,
+    n_elements: int = 4,
+    restarts: bool = True,
+    max_nfev: int | None = None,
+    name: str = "",
+) -> JointFit:
+    """Fit a joint law to one or several measured records (shared parameters).
+
+    Parameters
+    ----------
+    records : array or record(s)
+        Either the time axis ``t`` [s] of one record (with ``x`` and ``F`` given), or a record
+        or a list of records (:func:`contactlab.joints.records.as_record`: ``(t, x, F)``
+        tuples, mappings, :class:`JointRecord`, :class:`contactlab.io.Recording`), fitted
+        together.
+    x, F : array, optional
+        Displacement [m] and force [N] of the one record whose time is ``records``.
+    law : str, law class or law instance, default "lugre"
+        A registry name (``"jenkins"``, ``"iwan"``, ``"segalman"``, ``"maxwell_slip"``,
+        ``"gms"``, ``"dahl"``, ``"lugre"``, ``"bouc_wen"``, ``"masing"``,
+        ``"kelvin_voigt"``) or ``"backlash:<name>"``, started from the loops
+        (:func:`start_law`); or a law instance, whose parameters are the start values (any
+        composition: ``Series``, ``Parallel``, ``Backlash``).
+    fixed : names or mapping, optional
+        Parameters held at their start value (a mapping also sets the value). Default: the
+        law's weakly determined shape parameters (:data:`DEFAULT_FIXED`).
+    bounds : mapping, optional
+        ``name -> (lo, hi)`` replacing the law's own bounds.
+    offset, stiffness, damping, mass, asymmetry : bool
+        Fit a constant force, a parallel stiffness, a parallel viscous term, an inertia term
+        in parallel with the law, a direction-dependent gain of the law's force (linear
+        coefficients, see the module docstring).
+    fs : float, optional
+        Sampling rate of records given without a time axis.
+    max_samples : int, optional
+        When the records hold more samples, the law is driven with every n-th sample plus
+        every turning point of the displacement (:func:`thin_indices`; exact for the
+        rate-independent laws, a coarser input path for the rate-dependent ones) so that the
+        fit costs about ``max_samples`` samples per evaluation. Default: all samples.
+    n_elements : int
+        Elements of a Maxwell-slip / generalised Maxwell-slip law named by string.
+    restarts : bool
+        When the first fit fails or explains less than 90 % of the force's variance, fit
+        again from 4× stiffer and softer starts and keep the best.
+    max_nfev : int, optional
+        Evaluation budget of each solver run.
+    name : str
+        Label of the fitted model in comparisons (default: the law's name).
+
+    Returns
+    -------
+    JointFit
+        ``success=False`` (with the solver's message) when the fit did not converge.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from contactlab.joints import Jenkins, fit
+    >>> t = np.linspace(0.0, 3.0, 1201)
+    >>> x = 2e-3 * np.sin(2 * np.pi * t)
+    >>> F = Jenkins(k=5e3, fs=4.0).force(t, x)
+    >>> res = fit(t, x, F, law="jenkins")
+    >>> round(res.params["k"].value), round(res.params["fs"].value, 6), res.success
+    (5000, 4.0, True)
+    """
+    t0 = time.perf_counter()
+    if x is not None or F is not None:
+        if x is None or F is None:
+            raise InputError("give t, x and F of one record, or a list of records")
+        recs = as_records((records, x, F), fs=fs)
+    else:
+        recs = as_records(records, fs=fs)
+    for r in recs:
+        r.require_force()
+    terms = [n for n, on in (("offset", offset), ("k_parallel", stiffness),
+                             ("c_parallel", damping), ("mass", mass),
+                             ("asymmetry", asymmetry)) if on]  # fmt: skip
+    asym = "asymmetry" in terms
+    prep = _prepare(recs, terms, max_samples)
+    every = max(1, math.ceil(sum(r.n for r in recs) / max_samples)) if max_samples else 1
+    Fm = np.concatenate([p.F for p in prep])
+    phi = np.concatenate([p.phi for p in prep], axis=0)
+    first = _resolve_law(law, recs, 1.0, n_elements)
+    fixed_names = _fixed_names(first, fixed)
+    fixed_values = dict(fixed) if isinstance(fixed, Mapping) else {}
+    if fixed_values:
+        first = first.with_params(fixed_values)
+
+    def run_from(start_law_: Any) -> tuple[FitResult, Any]:
+        params = _parameters(start_law_, fixed_names, bounds)
+        names = list(start_law_.param_names)
+
+        def law_of(v: Mapping[str, float]) -> Any:
+            return start_law_.with_params([v[n] for n in names])
+
+        def residual(v: Mapping[str, float]) -> np.ndarray:
+            P = _law_forces(law_of(v), prep)
+            cols = np.column_stack([phi, np.abs(P)]) if asym else phi
+            beta = _linear_solve(cols, Fm - P)
+            return P + cols @ beta - Fm
+
+        res = least_squares_fit(residual, params, max_nfev=max_nfev)
+        return res, law_of(res.values)
+
+    candidates = [first]
+    tried = 0
+    best: tuple[FitResult, Any] | None = None
+    errors: list[str] = []
+    var = float(np.sum((Fm - Fm.mean()) ** 2))
+    while candidates:
+        cand = candidates.pop(0)
+        tried += 1
+        try:
+            res, fitted = run_from(cand)
+        except ContactLabError as exc:
+            errors.append(str(exc))
+            res = None
+        if res is not None and (best is None or res.chisqr < best[0].chisqr):
+            best = (res, fitted)
+        good = best is not None and best[0].success and best[0].chisqr < 0.1 * var
+        if restarts and tried == 1 and not good and isinstance(law, str):
+            for factor in (4.0, 0.25):
+                try:
+                    c = _resolve_law(law, recs, factor, n_elements)
+                    candidates.append(c.with_params(fixed_values) if fixed_values else c)
+                except ContactLabError as exc:
+                    errors.append(str(exc))
+    if best is None:
+        raise InputError(f"the law {first.name} could not be evaluated from any start: "
+                         f"{errors[0] if errors else 'no start'}")  # fmt: skip
+    res_law, fitted = best
+    # the final joint fit of the law's parameters and the linear terms: the covariance of all
+    P = _law_forces(fitted, prep)
+    beta = _linear_solve(np.column_stack([phi, np.abs(P)]) if asym else phi, Fm - P)
+    params = _parameters(fitted, fixed_names, bounds)
+    for p in params.values():  # the nonlinear fit's end point: keep its bounds' sense
+        p.min = min(p.min, p.value)
+    for i, n in enumerate(terms):
+        params[n] = Parameter(n, float(beta[i]), unit=TERMS[n],
+                              scale=None if beta[i] != 0 else 1.0)  # fmt: skip
+    names = list(fitted.param_names)
+
+    def full_residual(v: Mapping[str, float]) -> np.ndarray:
+        lw = fitted.with_params([v[n] for n in names])
+        b = np.array([v[n] for n in terms if n in _STATIC])
+        P = _law_forces(lw, prep)
+        out = P + phi @ b - Fm
+        if asym:
+            out += v["asymmetry"] * np.abs(P)
+        return out
+
+    try:
+        res = least_squares_fit(full_residual, params, max_nfev=max_nfev)
+        final_law = fitted.with_params([res.params[n].value for n in names])
+    except ContactLabError as exc:
+        res, final_law = res_law, fitted
+        errors.append(f"the joint covariance fit failed ({exc}); the law's fit is reported")
+    if not res_law.success and res.success:
+        res.notes.append(f"the search over the law's parameters ended: {res_law.message}")
+    _identifiability_notes(res)
+    explained = 1.0 - res.chisqr / var if var > 0 else math.nan
+    if explained < 0.1:
+        errors.insert(0, (
+            f"the fitted {final_law.name} law explains {100 * max(explained, 0.0):.0f} % of "
+            "the force's variance: it cannot produce these loops (a force of the opposite "
+            "sign, whose loops run the active way? a record with no joint motion?)"
+        ))  # fmt: skip
+        if all(p.identifiable is False for p in res.params.values() if p.vary):
+            res.success = False
+            res.message = "no parameter is determined by the data: " + errors[0]
+    out = JointFit(
+        law=final_law,
+        terms={n: res.params[n].value for n in terms},
+        result=res,
+        records=[r.name for r in recs],
+        n_samples=int(Fm.size),
+        seconds=time.perf_counter() - t0,
+        thinned_every=every,
+        starts_tried=tried,
+        name=name,
+        notes=errors[:3],
+    )
+    return out
