@@ -32,7 +32,7 @@ def main() -> None:
     args = ap.parse_args()
 
     from contactlab.cli import main as cli
-    from contactlab.diagnose import select, workflow
+    from contactlab.diagnose import search, select, workflow
 
     plain = select.fit
     log: list[tuple[tuple[str, ...], int, int, float, bool]] = []
@@ -45,6 +45,7 @@ def main() -> None:
 
     select.fit = counted  # evaluate() calls it from select, the workflow by its own name
     workflow.fit = counted  # type: ignore[attr-defined]
+    search.fit = counted  # type: ignore[attr-defined]  (the search's moves)
     with tempfile.TemporaryDirectory() as tmp:
         for path in args.files:
             log.clear()

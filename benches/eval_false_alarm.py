@@ -63,7 +63,7 @@ def _levels(model: str, rng: np.random.Generator) -> dict[str, Any]:
 
 
 def _excitation(amp: float, f0: float, cycles: int, fs: float):
-    from contactlab.diagnose._gen_common import block_excitation
+    from contactlab.synthetic._common import block_excitation
 
     # three blocks; their lengths add up to `cycles` complete cycles (two more are drawn:
     # the amplitude's ramp from rest, and the cycles counted from one maximum to the next)

@@ -11,8 +11,8 @@ from contactlab import InputError, Masing
 from contactlab.diagnose._family import Prepared
 from contactlab.diagnose._signal import find_cycles, noise_rms, shift
 from contactlab.diagnose.candidates_tangential import TangentialFamily
-from contactlab.diagnose.generator import TANGENTIAL_EFFECTS, hidden_effect_recording
 from contactlab.diagnose.scaled_masing import memory, scaled_force
+from contactlab.synthetic.diagnosis import TANGENTIAL_EFFECTS, hidden_effect_recording
 
 FAM = TangentialFamily()
 
@@ -228,7 +228,14 @@ def test_branch_scale_follows_a_changing_displacement_offset():
     FAM.predict(p, eff, d)  # first call fills any cache with x0 = 0
     p["x0"] = 4e-6
     got = FAM.predict(p, eff, d)
-    want = scaled_force(Masing(50.0, 5e4).virgin, 1.6, memory(x - 4e-6))
+    # the branch scale from rest at the actual turning points (docs/effects.md), of x - x0
+    from contactlab.diagnose.effects.tangential.non_masing_scaling import (
+        turning_point_force,
+        turning_points,
+    )
+
+    turns = turning_points(d.u, 1e-3 * float(np.ptp(d.u)))
+    want = turning_point_force(Masing(50.0, 5e4).virgin, 1.6, d.u - 4e-6, turns)
     np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * 50.0)
 
 

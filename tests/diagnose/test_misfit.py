@@ -7,9 +7,9 @@ import pytest
 
 import contactlab
 from contactlab.diagnose._family import Prepared
-from contactlab.diagnose._gen_common import block_excitation
 from contactlab.diagnose.misfit import BINS, null_quantile, unexplained_structure
 from contactlab.diagnose.scaled_masing import memory, scaled_force
+from contactlab.synthetic._common import block_excitation
 
 
 @pytest.fixture(scope="module")

@@ -100,6 +100,17 @@ def add_parser(subparsers: Any) -> None:
         help="tangential: a known delay of the force behind the displacement (e.g. 1.1ms), "
         "corrected before the diagnosis (the force read that much later)",
     )
+    from ..commands._common import FORCE_SIGN_CHOICES, force_sign
+
+    p.add_argument(
+        "--force-sign",
+        type=force_sign,
+        choices=FORCE_SIGN_CHOICES,
+        default=None,
+        help="tangential: diagnose F (+1) or -F (-1), as analyze takes it; auto: the sign that "
+        "makes the loop area ∮F dx positive (a passive joint dissipates). Default: F as "
+        "recorded (a loop that runs the wrong way is refused, naming this flag)",
+    )
     p.set_defaults(handler=run)
 
 
@@ -219,10 +230,14 @@ def run(args: argparse.Namespace) -> int:
         args.model = "tangential"
     columns = parse_columns(args.columns)
     if args.model is None:
-        from ..commands._common import infer_model
+        from ..commands._common import infer_model, wrapped
 
-        args.model, note = infer_model(args.file, None, columns, args.fs)
-        print(note)
+        try:
+            args.model, note = infer_model(args.file, None, columns, args.fs)
+        except InputError as exc:
+            raise InputError(f"{exc} (or --structure MODEL.json: a structure's input and "
+                             "response record)") from None  # fmt: skip
+        print(wrapped(f"{args.file}: {note}"))
     taps = output_filter_taps(args.output_filter)
     if args.model == "normal" and (taps is not None or args.output_noise is not None):
         raise InputError("--output-filter/--output-noise are for the tangential model (a force "
@@ -253,6 +268,9 @@ def run(args: argparse.Namespace) -> int:
         rec, dropped = shifted_recording(rec, args.delay)
         print(f"{args.file}: force read {1e3 * args.delay:.4g} ms later (--delay); {dropped} "
               "samples left without force data dropped")  # fmt: skip
+    sign = getattr(args, "force_sign", None)
+    if sign is not None and args.model != "tangential":
+        raise InputError("--force-sign is for tangential recordings (the force's sign)")
     if args.model == "normal":
         from ..commands._common import with_static_pressure
 
@@ -260,7 +278,8 @@ def run(args: argparse.Namespace) -> int:
                                    getattr(args, "pa", None))  # fmt: skip
     try:
         report = diagnose(rec, model=args.model, max_effects=args.max_effects,
-                          output_filter=taps, output_noise=args.output_noise)  # fmt: skip
+                          output_filter=taps, output_noise=args.output_noise,
+                          **({"force_sign": sign} if sign is not None else {}))  # fmt: skip
     except (InputError, ConvergenceError) as exc:  # name the file: the workflow sees arrays
         kind = ConvergenceError if isinstance(exc, ConvergenceError) else InputError
         raise kind(f"{args.file}: {exc}") from exc
@@ -289,9 +308,10 @@ def run(args: argparse.Namespace) -> int:
         import matplotlib
 
         matplotlib.use("Agg")
-        from ..diagnose._html import report_files
+        from ..commands._common import made_by
+        from ..report.diagnosis import report_files
 
-        files = report_files(report)
+        files = report_files(report, intro=f"Made by: {made_by(args, 'diagnose', args.file)}")
     print(report.summary())
     # the JSON is staged beside its target and renamed into place only once the report is
     # committed: a report that cannot be written leaves the JSON as it was

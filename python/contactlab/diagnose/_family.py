@@ -97,32 +97,11 @@ class Prepared:
         return cls(t, uf, yy, dt, window, ud, udd, cyc, extra)
 
 
-#: largest plausible channel delay, as a fraction of the excitation period: anti-alias
+#: largest plausible channel delay, as a fraction of the excitation period (both families'
+#: ``channel_delay`` effects, :mod:`contactlab.diagnose.effects`): anti-alias
 #: filters and converters of a test rig skew channels by a few samples, which at any sensible
 #: sampling rate is well below 2 % of a period (7°); a larger "delay" is a model error.
 MAX_DELAY_FRACTION = 0.02
-
-
-def implausible_common(cand: Candidate, p: dict[str, float], d: Prepared) -> str | None:
-    """Reason a fitted effect is physically implausible, or None (checks shared by families):
-    a parameter at the edge of its physical range, a delay of a large fraction of a period."""
-    for s in cand.params:
-        v = p[s.name]
-        if not np.isfinite(v):
-            return f"{s.name} is not finite"
-        span = s.upper - s.lower if np.isfinite(s.upper - s.lower) else None
-        for bound in (s.lower, s.upper):
-            if np.isfinite(bound) and span and abs(v - bound) <= 1e-3 * span and bound != s.null:
-                return f"{s.name} = {v:.4g} {s.unit} sits at the limit of its physical range"
-    if "tau" in p and cand.name == "channel_delay":
-        period = d.cycles.period_samples * d.dt
-        if abs(p["tau"]) > MAX_DELAY_FRACTION * period:
-            return (
-                f"a delay of {p['tau']:.3g} s is {100 * abs(p['tau']) / period:.1f} % of the "
-                f"excitation period (plausible: below {100 * MAX_DELAY_FRACTION:g} %): the base "
-                "model, not the sensors, is off"
-            )
-    return None
 
 
 class Family(Protocol):

@@ -59,46 +59,18 @@ import numpy as np
 from .. import _core
 from .._arrays import next_fast_len
 from ..errors import ConvergenceError, InputError
-from ._family import Candidate, ParamSpec, Prepared, implausible_common
+from ._family import Candidate, ParamSpec, Prepared
 from ._filters import first_order_response, savgol_coeffs, savgol_filter, welch
 from ._kept import shifted
-from ._signal import cubic_shift_power, shift_cubic, shortest_period_samples
+from ._signal import cubic_shift_power, shortest_period_samples
+from .effects import ordered, registry
 
 _INF = np.inf
 
-CANDIDATES: dict[str, Candidate] = {
-    c.name: c
-    for c in (
-        Candidate(
-            "stiffness_nonlinearity",
-            (ParamSpec("kappa", "-", 0.0, -0.15, 10.0, "one"),),
-            "stiffness growing with displacement, k_s(δ) = k (1 + κ (δ/δ_r)²) (eq. 17)",
-        ),
-        Candidate(
-            "hysteretic_damping",
-            (ParamSpec("eta", "-", 0.0, 0.0, 2.0, "psi"),),
-            "rate-independent loss factor η (energy per cycle independent of frequency)",
-        ),
-        Candidate(
-            "creep_drift",
-            (
-                ParamSpec("D", "m", 0.0, -_INF, _INF, "delta"),
-                ParamSpec("tau_c", "s", np.nan, 0.0, _INF, "T"),
-            ),
-            "displacement creeping over the cycles, D (1 - exp(-t/τ_c))",
-        ),
-        Candidate(
-            "channel_delay",
-            (ParamSpec("tau", "s", 0.0, -_INF, _INF, "tau"),),
-            "displacement channel lags the pressure channel by tau",
-        ),
-        Candidate(
-            "asymmetric_branches",
-            (ParamSpec("a", "-", 0.0, -0.4, 0.4, "one"),),
-            "different stiffness on the compression and relief sides, k (1 + a δ/δ_r)",
-        ),
-    )
-}
+#: the library: one :class:`~contactlab.diagnose.effects.EffectModel` per file under
+#: ``diagnose/effects/normal/`` (parameters, bounds, what it does, its plausibility)
+EFFECTS = registry("normal")
+CANDIDATES: dict[str, Candidate] = {name: e.candidate for name, e in EFFECTS.items()}
 
 BASE_PARAMS = (
     ParamSpec("k", "Pa/m", _INF, 0.0, _INF, "k"),
@@ -380,13 +352,17 @@ class NormalFamily:
     def start_effect(
         self, name: str, p: dict[str, float], d: Prepared, residual: np.ndarray
     ) -> dict[str, float]:
+        """Starting values of an effect's nonlinear parameters from the current residual
+        (the effect's own :meth:`~contactlab.diagnose.effects.EffectModel.start`)."""
+        return EFFECTS[name].start(p, d, residual)
+
+    @staticmethod
+    def creep_start(p: dict[str, float], d: Prepared, residual: np.ndarray) -> dict[str, float]:
         """Starting values of ``creep_drift`` from the current residual (measured minus
         model): the ``τ_c`` of :data:`CREEP_START_GRID` whose shape ``1 - exp(-t/τ_c)``,
         its mean removed, explains most of it, ``D`` its least-squares size, and ``p0``
         moved to take that mean back (a constant displacement is ``-Δp0 / k``); nothing
         for the other candidates."""
-        if name != "creep_drift":
-            return {}
         r = residual - np.mean(residual)
         best, start = -1.0, {}
         period = d.cycles.period_samples * d.dt
@@ -424,13 +400,15 @@ class NormalFamily:
         pd = d.u - p["p0"]
         om = d.extra["omega"]
         k, psi = p["k"], p["psi"]
-        if "hysteretic_damping" in effects:
-            delta = frequency_domain(d.t, pd, k, psi, om, p["eta"], run_in(d, pd))
-        elif "stiffness_nonlinearity" in effects or "asymmetric_branches" in effects:
-            dr = d.extra["delta_r"]
-            a = p.get("a", 0.0) if "asymmetric_branches" in effects else 0.0
-            kap = p.get("kappa", 0.0) if "stiffness_nonlinearity" in effects else 0.0
-            coeffs = (k, k * a / dr, k * kap / dr**2)
+        chain = ordered("normal", effects)
+        staged = lambda name: [e for e in chain if e.stage == name]  # noqa: E731
+        laws, elements = staged("law"), staged("element")
+        if elements:
+            delta = elements[0].apply(pd, p, d)
+        elif laws:
+            coeffs: tuple[float, float, float] = (k, 0.0, 0.0)
+            for e in laws:
+                coeffs = e.apply(coeffs, p, d)
             # kept per parameters: a fit's Jacobian steps the creep's parameters, and a
             # delay's, at the same stiffness law (a quarter to a third of its evaluations)
             memo = d.extra.setdefault("nonlinear", {})
@@ -444,11 +422,8 @@ class NormalFamily:
                 memo[key] = delta
         else:
             delta = _kelvin_voigt_fit(d, k, psi, p["p0"], om)
-        if "creep_drift" in effects:
-            tc = max(p["tau_c"], 1e-6 * d.duration)
-            delta = delta + p["D"] * _creep_shape(d, tc)
-        if "channel_delay" in effects:
-            delta = shift_cubic(delta, d.dt, p["tau"])
+        for e in staged("additive") + staged("output"):
+            delta = e.apply(delta, p, d)
         return delta
 
     def noise_variance(self, p: dict[str, float], effects: tuple[str, ...], d: Prepared) -> float:
@@ -519,27 +494,20 @@ class NormalFamily:
         return None
 
     def implausible(self, name: str, p: dict[str, float], d: Prepared) -> str | None:
-        """Why a fitted effect cannot be physical on this rig, or None (a channel delay on a
-        single-tone record is not identifiable: :func:`delay_identifiability`; a creep that
+        """Why a fitted effect cannot be physical on this rig, or None (the effect's own
+        :meth:`~contactlab.diagnose.effects.EffectModel.plausible`: a channel delay on a
+        single-tone record is not identifiable, :func:`delay_identifiability`; a creep that
         settles within one excitation period is the record's start-up, not the joint)."""
-        if name == "channel_delay" and frequency_span(d) < SINGLE_TONE_SPAN:
-            return "a delay cannot be told from the Kelvin-Voigt damping at one frequency"
-        if name == "creep_drift":
-            period = d.cycles.period_samples * d.dt
-            if p["tau_c"] < CREEP_MIN_PERIODS * period:
-                return (
-                    f"the drift settles in τc = {p['tau_c']:.3g} s, within "
-                    f"{CREEP_MIN_PERIODS:g} excitation period ({period:.3g} s): a start-up "
-                    "transient of the record or its model, not creep of the joint"
-                )
-            if p["tau_c"] > CREEP_MAX_DURATIONS * d.duration:
-                return (
-                    f"the drift does not settle within the record (τc = {p['tau_c']:.3g} s, "
-                    f"more than {CREEP_MAX_DURATIONS:g} × its {d.duration:.3g} s): a straight "
-                    "drift, which creep of the joint cannot be told from a drifting "
-                    "displacement sensor or a slow model misfit by"
-                )
-        return implausible_common(self.candidates[name], p, d)
+        ok, why = EFFECTS[name].plausible(d, p)
+        return None if ok else why
+
+    def identified(self, name: str, p: dict[str, float], se: dict[str, float]) -> str | None:
+        """Why a fitted effect's size is not identified (within its error of "absent")."""
+        return EFFECTS[name].identified(p, se)
+
+    def plausibility(self, name: str, p: dict[str, float], d: Prepared) -> tuple[bool, str]:
+        """The effect's plausibility verdict and its argument in numbers."""
+        return tuple(EFFECTS[name].plausible(d, p))  # type: ignore[return-value]
 
     def regime(self, p: dict[str, float], d: Prepared) -> str:
         psi = p["psi"]

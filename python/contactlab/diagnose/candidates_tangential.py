@@ -2,7 +2,14 @@
 
 Base model (PHYSICS.md §1): Masing hysteresis with the exponential virgin curve
 ``f(u) = h0 (1 - exp(-ac u))`` and branch scale 2, force ``h = M(x)`` for the measured
-displacement history ``x``. Candidate effects, each with its own fitted parameters:
+displacement history ``x``. The candidate effects are objects, one file each under
+``diagnose/effects/tangential/`` (:func:`contactlab.diagnose.effects.registry`), defined
+physically in ``docs/effects.md``: each has its parameters (name, unit, bounds, the value
+meaning "absent"), what it does at its stage of the composition
+(:meth:`~contactlab.diagnose.effects.EffectModel.apply`), whether a fitted value is
+physical on a record and why (:meth:`~contactlab.diagnose.effects.EffectModel.plausible`)
+and the smallest size a record reveals
+(:meth:`~contactlab.diagnose.effects.EffectModel.detectable`). A new effect is one new file.
 
 ========================  =========================================================  =========
 name                      measured force ``F`` (or measured ``x``)                   params
@@ -16,26 +23,30 @@ name                      measured force ``F`` (or measured ``x``)              
 ``displacement_offset``   ``h = M(x - x0)`` (displacement sensor zero off the origin)  x0 [m]
 ``channel_delay``         ``F(t) = h(t - τ)`` (force channel lags displacement)       tau [s]
 ``asymmetry``             ``F = h + α |h|``: saturation ``h0(1 ± α)`` per direction   alpha [-]
-``non_masing_scaling``    branch scale ``λ`` instead of 2, loops kept closed           lam [-]
-``parameter_drift``       ``h0(t) = h0 (1 + β t/T)``, i.e. ``F = h (1 + β t/T)``      beta [-]
+``non_masing_scaling``    branches ``h_r + λ f((x - x_r)/λ)`` from rest at the turns  lam [-]
+``parameter_drift``       ``F = h (1 + β (t - t_m)/T)``, ``t_m`` mid-record           beta [-]
+``stribeck``              ``F = h (1 + s exp(-|ẋ|/v_s))``                              s, v_s
+``position_friction``     ``F = h (1 + Σ a_k cos kπξ + b_k sin kπξ)``                  a_k, b_k
+``stick_slip``            breakaway ``s_b`` after each reversal over ``ell``           s_b, ell
+``normal_load``           ``F = h (1 + ε_c cos 2π f_n t + ε_s sin 2π f_n t)``          eps, f_n
+``power_law_microslip``   Segalman's Iwan element (F_S = h0, K_T = h0 ac)             chi, beta
+``backlash``              ``F = M(u)``, ``u`` the play operator of ``x`` (width 2b)   b [m]
+``rate_dependent_         ``F = h + σ1 ẋ k(x)/k0`` (LuGre micro-damping)              sigma1
+presliding``
 ========================  =========================================================  =========
 
 Notes on exactness. The exponential Masing force is linear in ``h0`` at fixed ``ac`` along a
 history, so the drift factor is exact. A linear spring in series with a Masing element is
-again a Masing element whose virgin curve is ``x(u) = u + C_s f(u)`` against ``f(u)`` (the
-branch rule ``x - x_r = λ g⁻¹((F - F_r)/λ)`` holds for the sum because both parts obey it),
-so the series compliance is solved exactly by reparametrising the virgin curve and using
-:meth:`contactlab.Masing.from_backbone`. The branch scale uses
-:mod:`contactlab.diagnose.scaled_masing` (λ-scaled branch shape anchored at both ends),
-because ``Masing(..., scale=λ)`` jumps where the memory rules end a branch and so cannot
-be fitted to noisy data. ``ẋ`` and ``ẍ`` are Savitzky-Golay derivatives of the
-measured displacement; the delay is a fractional-sample shift by linear interpolation.
-Beyond the issue's list, ``force_drift`` and ``displacement_offset`` cover two common sensor
-faults that no other candidate can stand in for. When several effects are active they
-compose in this order: displacement offset on the input; series compliance and branch
-scale inside the Masing element; asymmetry and drift on its force; the additive terms
-(parallel stiffness, viscous, inertia, offset, force drift); the delay on the total
-measured force.
+again a Masing element whose virgin curve is ``x(u) = u + C_s f(u)`` against ``f(u)``, so
+the series compliance is solved exactly by reparametrising the virgin curve
+(:meth:`contactlab.Masing.from_backbone`); Segalman's element likewise (an Iwan model obeys
+Masing's rules). The branch scale and the play operator run on the actual turning points of
+the filtered input (a hysteresis of a few input-noise standard deviations). ``ẋ`` and ``ẍ``
+are Savitzky-Golay derivatives of the measured displacement; the delay is a
+fractional-sample shift by linear interpolation. When several effects are active they
+compose by stage (:data:`contactlab.diagnose.effects.TANGENTIAL_STAGES`): the displacement
+the contact sees; the element; terms on its force; the breakaway; factors on the friction;
+the additive terms; the delay on the total measured force.
 """
 
 from __future__ import annotations
@@ -49,179 +60,39 @@ import numpy as np
 from .. import _core
 from ..errors import InputError
 from ..masing import Masing, loop_area
-from ._family import Candidate, ParamSpec, Prepared, implausible_common
+from ._family import Candidate, ParamSpec, Prepared
 from ._filters import savgol_coeffs, savgol_filter
 from ._kept import delayed, span
-from ._signal import Knots, minimize_bounded, modulation_gains, shift
-from .scaled_masing import memory, scaled_force
+from ._signal import Knots, minimize_bounded
+from .effects import ForceContext, ordered, registry
+from .effects.tangential import normal_load as _normal_load
+from .effects.tangential.series_compliance import series_backbone
+from .effects.tangential.stick_slip import breakaway, breakaway_force, reversal_anchors
+
+__all__ = [
+    "CANDIDATES",
+    "EFFECTS",
+    "TangentialFamily",
+    "breakaway",
+    "breakaway_force",
+    "reversal_anchors",
+    "series_backbone",
+]
 
 _INF = np.inf
 
-# Physical ranges of the real-friction effects (a fit at their edge is refused as
-# implausible): static over kinetic friction of dry metal pairs is at most about 2 (a full
-# branch peaks near h0 (1 + 2 s_b) when the slip distance is long against 1/ac: s_b <= 0.5);
-# Stribeck's low-speed excess within -0.5..1 of the sliding force; friction along a track
-# varies by tens of per cent, not by its own size (each Fourier coefficient within ±0.3);
-# the friction force of the two directions differs by less than a factor 3 (|alpha| <= 0.5).
-CANDIDATES: dict[str, Candidate] = {
-    c.name: c
-    for c in (
-        Candidate(
-            "viscous_damping",
-            (ParamSpec("c", "N s/m", 0.0, 0.0, _INF, "c"),),
-            "viscous force c·ẋ in parallel with the contact",
-        ),
-        Candidate(
-            "inertia",
-            (ParamSpec("m", "kg", 0.0, 0.0, _INF, "m"),),
-            "inertial force m·ẍ of the mass between force sensor and contact",
-        ),
-        Candidate(
-            "parallel_stiffness",
-            (ParamSpec("k_p", "N/m", 0.0, 0.0, _INF, "k"),),
-            "linear spring k_p·x in parallel (rig flexures, guides)",
-        ),
-        Candidate(
-            "series_compliance",
-            (ParamSpec("C_s", "m/N", 0.0, 0.0, _INF, "C"),),
-            "measured displacement includes rig compliance C_s·F",
-        ),
-        Candidate(
-            "force_offset",
-            (ParamSpec("F0", "N", 0.0, -_INF, _INF, "F"),),
-            "constant force-sensor bias F0",
-        ),
-        Candidate(
-            "force_drift",
-            (ParamSpec("F1", "N", 0.0, -_INF, _INF, "F"),),
-            "force-sensor zero drifting linearly, by F1 over the recording",
-        ),
-        Candidate(
-            "displacement_offset",
-            (ParamSpec("x0", "m", 0.0, -_INF, _INF, "x"),),
-            "displacement-sensor zero: the contact sees x - x0",
-        ),
-        Candidate(
-            "channel_delay",
-            (ParamSpec("tau", "s", 0.0, -_INF, _INF, "tau"),),
-            "force channel lags the displacement channel by tau",
-        ),
-        Candidate(
-            "asymmetry",
-            (ParamSpec("alpha", "-", 0.0, -0.5, 0.5, "one"),),
-            "saturation force h0(1+alpha) in the positive, h0(1-alpha) in the negative direction",
-        ),
-        Candidate(
-            "non_masing_scaling",
-            (ParamSpec("lam", "-", 2.0, 0.2, 20.0, "one"),),
-            "branch scale lam instead of Masing's 2 (generalised Masing rule)",
-        ),
-        Candidate(
-            "parameter_drift",
-            (ParamSpec("beta", "-", 0.0, -0.95, 5.0, "one"),),
-            "saturation force drifting over the recording: h0(t) = h0 (1 + beta t/T)",
-        ),
-        Candidate(
-            "stribeck",
-            (
-                ParamSpec("s", "-", 0.0, -0.5, 1.0, "one"),
-                ParamSpec("v_s", "m/s", np.nan, 0.0, _INF, "v"),
-            ),
-            "velocity-dependent friction: F = h (1 + s exp(-|ẋ|/v_s)) (Stribeck, s > 0: "
-            "friction weakening with sliding speed)",
-        ),
-        Candidate(
-            "position_friction",
-            tuple(ParamSpec(n, "-", 0.0, -0.3, 0.3, "one") for n in ("a1", "b1", "a2", "b2")),
-            "friction varying along the track (wavy plateaus): F = h (1 + Σ a_k cos(kπ ξ) + "
-            "b_k sin(kπ ξ)), ξ the position scaled to -1..1 over the stroke, k = 1, 2",
-        ),
-        Candidate(
-            "stick_slip",
-            (
-                ParamSpec("s_b", "-", 0.0, 0.0, 0.5, "one"),
-                ParamSpec("ell", "m", np.nan, 0.0, _INF, "x"),
-            ),
-            "breakaway after each reversal: the branch rises s_b above Masing's and falls back "
-            "over a slip distance ell (static friction above kinetic)",
-        ),
-        Candidate(
-            "normal_load",
-            (
-                ParamSpec("eps_c", "-", 0.0, -0.5, 0.5, "one"),
-                ParamSpec("eps_s", "-", 0.0, -0.5, 0.5, "one"),
-                ParamSpec("f_n", "Hz", np.nan, 0.0, _INF, "fq"),
-            ),
-            "normal load fluctuating at its own frequency f_n: F = h (1 + eps_c cos 2π f_n t "
-            "+ eps_s sin 2π f_n t)",
-        ),
-    )
-}
+#: the library: one :class:`~contactlab.diagnose.effects.EffectModel` per file under
+#: ``diagnose/effects/tangential/`` (parameters, bounds, what it does, its plausibility)
+EFFECTS = registry("tangential")
+CANDIDATES: dict[str, Candidate] = {name: e.candidate for name, e in EFFECTS.items()}
 
 BASE_PARAMS = (
     ParamSpec("h0", "N", _INF, 0.0, _INF, "F"),
     ParamSpec("ac", "1/m", _INF, 0.0, _INF, "ac"),
 )
 
-_SERIES_POINTS = 400
 #: a normal-load fluctuation must make this many periods in the record; slower, it is a drift
-MIN_LOAD_PERIODS = 2.0
-
-
-def series_backbone(h0: float, ac: float, C_s: float, x_max: float) -> tuple[np.ndarray, ...]:
-    """Virgin curve of a Masing element in series with compliance ``C_s``, as points.
-
-    ``x(u) = u + C_s f(u)`` against ``f(u)``, ``u`` from 0 to ``3 x_max`` on a grid that is
-    dense where the curve bends.
-    """
-    s = np.linspace(0.0, 1.0, _SERIES_POINTS)
-    u = 3.0 * x_max * s * s
-    f = h0 * -np.expm1(-ac * u)
-    return u + C_s * f, f
-
-
-def reversal_anchors(reversals: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """For each of ``n`` samples: whether a reversal precedes it (or is it), and the index of
-    the last such reversal (0 where none)."""
-    idx = np.searchsorted(reversals, np.arange(n), side="right") - 1
-    has = idx >= 0
-    r = reversals[np.where(has, idx, 0)] if reversals.size else np.zeros(n, int)
-    return has, r
-
-
-def breakaway(
-    h: np.ndarray,
-    x: np.ndarray,
-    reversals: np.ndarray,
-    s_b: float,
-    ell: float,
-    anchors: tuple[np.ndarray, np.ndarray] | None = None,
-    at: np.ndarray | None = None,
-) -> np.ndarray:
-    """Branches with a breakaway peak: after each reversal ``r`` the rise ``h - h_r`` is
-    scaled by ``1 + s_b exp(-|x - x_r| / ell)`` — equal to Masing's at the reversal (no
-    jump) and far from it, above it in between (static friction above kinetic). Before the
-    first reversal the virgin curve from the origin is treated the same way. ``anchors``:
-    :func:`reversal_anchors` of ``reversals``, when computed already; ``at``: sample indices,
-    the result at those samples only."""
-    if s_b == 0.0:
-        return h if at is None else h[at]
-    has, r = anchors if anchors is not None else reversal_anchors(reversals, h.size)
-    if at is not None:  # the anchors (reversals) from the whole history, the rest at ``at``
-        has, r = has[at], r[at]
-    xr = np.where(has, x[r], 0.0)
-    hr = np.where(has, h[r], 0.0)
-    if at is not None:
-        h, x = h[at], x[at]
-    return hr + (h - hr) * (1.0 + s_b * np.exp(-np.abs(x - xr) / max(ell, 1e-300)))
-
-
-def breakaway_force(h0: float, ac: float, s_b: float, ell: float) -> float:
-    """Peak force of a full branch from ``-h0`` with the breakaway of :func:`breakaway`
-    (the static friction force; ``h0`` without breakaway)."""
-    u = np.linspace(0.0, 20.0 / ac + 20.0 * ell, 4001)
-    rise = 2.0 * h0 * -np.expm1(-ac * u / 2.0)
-    return float(np.max(-h0 + rise * (1.0 + s_b * np.exp(-u / max(ell, 1e-300)))))
+MIN_LOAD_PERIODS = _normal_load.MIN_LOAD_PERIODS
 
 
 def _grid(x: np.ndarray, F: np.ndarray) -> tuple[float, float, float]:
@@ -248,6 +119,9 @@ GROSS_SLIDING_ZA = 10.0
 #: ANCHOR_BAND plateau errors of the plateau
 ANCHOR_SIGMAS = 3.0
 ANCHOR_BAND = 2.0
+#: ... or within this share of the plateau force, the larger (the final model keeps h0
+#: within 5 % of the plateau analyze reads: issue 29)
+H0_HOLD = 0.025
 
 
 def _sg_dot(window: int, deriv: int, dt: float) -> np.ndarray:
@@ -256,7 +130,7 @@ def _sg_dot(window: int, deriv: int, dt: float) -> np.ndarray:
     return savgol_coeffs(window, 3, deriv, dt)[::-1]
 
 
-def _fixed(d: Prepared, key: str, make: Callable[[], Any]) -> Any:
+def fixed(d: Prepared, key: str, make: Callable[[], Any]) -> Any:
     """An array of the model evaluation that depends on the recording only (not on the
     fitted parameters): computed on the first evaluation, then reused by every fit on ``d``
     (the fits evaluate the model thousands of times)."""
@@ -271,14 +145,14 @@ def _fixed(d: Prepared, key: str, make: Callable[[], Any]) -> Any:
 _MEMO_KEEP = 64
 
 
-def _memo(d: Prepared, name: str) -> dict[Any, Any]:
+def memo(d: Prepared, name: str) -> dict[Any, Any]:
     cache = d.extra.setdefault(name, {})
     if len(cache) >= _MEMO_KEEP:
         cache.clear()
     return cache
 
 
-def _delay_support(d: Prepared, at: np.ndarray, tau: float) -> np.ndarray:
+def delay_support(d: Prepared, at: np.ndarray, tau: float) -> np.ndarray:
     """The samples a delayed prediction at the samples ``at`` needs: for each shifted time
     ``t[at] - tau`` the two samples that bracket it as :func:`numpy.interp` finds them
     (``t[j] <= t < t[j+1]``, the first or last sample off the ends); ``at`` itself when
@@ -286,9 +160,9 @@ def _delay_support(d: Prepared, at: np.ndarray, tau: float) -> np.ndarray:
     the same delay."""
     if tau == 0.0:
         return at
-    memo = _memo(d, "delay_rows")
+    rows_memo = memo(d, "delay_rows")
     key = (tau, id(at))
-    hit = memo.get(key)
+    hit = rows_memo.get(key)
     if hit is not None and hit[0] is at:  # (the array is held: its id is not reused)
         return hit[1]
     n = d.t.size
@@ -297,24 +171,8 @@ def _delay_support(d: Prepared, at: np.ndarray, tau: float) -> np.ndarray:
     need[np.clip(j, 0, n - 1)] = True
     need[np.clip(j + 1, 0, n - 1)] = True
     rows = np.flatnonzero(need)
-    memo[key] = (at, rows)
+    rows_memo[key] = (at, rows)
     return rows
-
-
-def _load_terms(d: Prepared, f_n: float, rows: np.ndarray | None) -> tuple[np.ndarray, ...]:
-    """``cos 2π f_n t``, ``sin 2π f_n t`` of ``normal_load`` (``t`` from the record's start) at
-    the samples ``rows`` (all when None), kept per ``(f_n, rows)``: only a step of ``f_n``
-    changes them."""
-    memo = _memo(d, "load_terms")
-    key = (f_n, None if rows is None else id(rows))
-    hit = memo.get(key)
-    if hit is not None and hit[0] is rows:
-        return hit[1], hit[2]
-    t_rel = _fixed(d, "t_rel", lambda: d.t - d.t[0])
-    ph = 2.0 * np.pi * f_n * (t_rel if rows is None else t_rel[rows])
-    out = (np.cos(ph), np.sin(ph))
-    memo[key] = (rows, *out)
-    return out
 
 
 #: unit Masing forces kept per recording (one per ac, x0 tried); 64 of 24 000 samples: 12 MB
@@ -341,12 +199,6 @@ def _masing_force(
             cache.clear()
         cache[key] = g
     return h0 * g
-
-
-def _track_harmonics(x: np.ndarray, d: Prepared) -> tuple[np.ndarray, ...]:
-    """``cos ξ, sin ξ, cos 2ξ, sin 2ξ`` of ``position_friction``, ``ξ = π (x - x_mid)/x_half``."""
-    xi = np.pi * (x - d.extra["x_mid"]) / d.extra["x_half"]
-    return np.cos(xi), np.sin(xi), np.cos(2 * xi), np.sin(2 * xi)
 
 
 class TangentialFamily:
@@ -383,46 +235,69 @@ class TangentialFamily:
         )
 
     def anchor(self, p: dict[str, float], se: dict[str, float], d: Prepared) -> str | None:
-        """Fix the base first when it is in the wrong regime: in gross sliding (``ac·A`` of
-        the base fit at least :data:`GROSS_SLIDING_ZA`) the plateau measures ``h0``
-        directly and ``ac`` is only bounded from below
-        (:func:`contactlab.tangential.regime.plateau`, on the measured displacement, as
-        ``analyze`` reads it). When the base's ``h0`` lies more than
-        :data:`ANCHOR_SIGMAS` combined standard errors from the plateau (the least-squares
-        fit trades ``h0`` against what the Masing element cannot follow: the sticks, the
-        friction varying along the track), ``h0`` is held within
-        :data:`ANCHOR_BAND` plateau errors of it and ``ac`` above the bound from then on
-        (the base and every candidate), so no effect is credited with moving ``h0`` back;
-        the band stays with the family (a refit of the final model keeps it). Returns a
-        sentence saying so, or None (nothing changed)."""
+        """Hold ``h0`` at the plateau in the sliding regimes: there the plateau measures
+        ``h0`` directly and ``ac`` is only bounded from below.
+
+        The plateau is the one ``analyze`` reads (``d.extra["regime_info"]``, set by the
+        workflow from :func:`contactlab.tangential.analyze_tangential`: the same regime
+        decision and the same plateau); without it, :func:`contactlab.tangential.regime.
+        plateau` on this record when the base fit is in gross sliding (``ac·A`` at least
+        :data:`GROSS_SLIDING_ZA`). ``h0`` is then held within ``max(ANCHOR_BAND plateau
+        errors, H0_HOLD h0)`` of the plateau and ``ac`` above the plateau's bound from then
+        on (the base and every candidate), so that no effect trades ``h0`` against a misfit
+        and the final model keeps the friction force ``analyze`` found; the band stays with
+        the family (a refit of the final model keeps it). Returns a sentence when the base
+        had to be moved into the band (its least-squares ``h0`` more than
+        :data:`ANCHOR_SIGMAS` combined standard errors from the plateau, or outside the
+        band), None otherwise."""
+        if self.h0_band is not None:
+            return None
+        info = d.extra.get("regime_info") or {}
+        if info.get("h0_source") == "plateau" and info.get("plateau_h0"):
+            h0_pl = float(info["plateau_h0"])
+            se_pl = float(info.get("plateau_stderr") or np.nan)
+            ac_lb = info.get("ac_lower_bound")
+            what = "the plateau analyze reads"
+        else:
+            pl = self._own_plateau(p, d)
+            if pl is None:
+                return None
+            h0_pl, se_pl, ac_lb = pl.h0, pl.h0_stderr, pl.ac_lower_bound
+            what = "the plateau"
+        if not (np.isfinite(se_pl) and se_pl > 0):
+            return None
+        band = max(ANCHOR_BAND * se_pl, H0_HOLD * h0_pl)
+        self.h0_band = (h0_pl - band, h0_pl + band)
+        if ac_lb is not None and np.isfinite(ac_lb):
+            self.ac_floor = min(float(ac_lb), p["ac"])
+        err = float(np.hypot(se["h0"] if np.isfinite(se["h0"]) else 0.0, se_pl))
+        off = abs(p["h0"] - h0_pl) / err
+        if off <= ANCHOR_SIGMAS and abs(p["h0"] - h0_pl) <= band:
+            return None
+        floor = f" and ac ≥ {self.ac_floor:.3g} 1/m (only a lower bound is identified)"
+        return (
+            f"base re-anchored to the plateau: in the sliding regime h0 is {what}, "
+            f"{h0_pl:.4g} ± {se_pl:.2g} N, but the least-squares base put it at "
+            f"{p['h0']:.4g} N ({off:.1f} σ away); h0 is held within ±{band:.2g} N of the "
+            f"plateau{floor if self.ac_floor > 0 else ''}"
+        )
+
+    def _own_plateau(self, p: dict[str, float], d: Prepared) -> Any:
+        """The plateau of this record (:func:`contactlab.tangential.regime.plateau`) when
+        the base fit is in gross sliding, else None."""
         from ..tangential.preprocess import average_loop
         from ..tangential.regime import plateau, velocity
 
         amp = 0.5 * float(np.ptp(d.u))
-        if self.h0_band is not None or p["ac"] * amp < GROSS_SLIDING_ZA:
+        if p["ac"] * amp < GROSS_SLIDING_ZA:
             return None
         x = d.extra.get("u_raw", d.u)
         try:
             loop = average_loop(x, d.y, d.t)
             v, thr, _ = velocity(d.t, x)
-            pl = plateau(loop, x, d.y, v, thr)
+            return plateau(loop, x, d.y, v, thr)
         except (InputError, ValueError):  # no loop to average: no plateau to anchor to
             return None
-        if pl is None or not (np.isfinite(pl.h0_stderr) and pl.h0_stderr > 0):
-            return None
-        err = float(np.hypot(se["h0"] if np.isfinite(se["h0"]) else 0.0, pl.h0_stderr))
-        off = abs(p["h0"] - pl.h0) / err
-        if off <= ANCHOR_SIGMAS:
-            return None
-        band = ANCHOR_BAND * pl.h0_stderr
-        self.h0_band = (pl.h0 - band, pl.h0 + band)
-        self.ac_floor = min(pl.ac_lower_bound, p["ac"])
-        return (
-            f"base re-anchored to the plateau: in gross sliding h0 is the plateau force "
-            f"{pl.h0:.4g} ± {pl.h0_stderr:.2g} N, but the least-squares base put it at "
-            f"{p['h0']:.4g} N ({off:.1f} σ away); h0 is held within ±{band:.2g} N of the "
-            f"plateau and ac ≥ {self.ac_floor:.3g} 1/m (only a lower bound is identified)"
-        )
 
     #: a stick changes the force by at least this share of its range (1st to 99th
     #: percentile) while the displacement stands still (:meth:`sticking`)
@@ -518,33 +393,9 @@ class TangentialFamily:
     def start_effect(
         self, name: str, p: dict[str, float], d: Prepared, residual: np.ndarray
     ) -> dict[str, float]:
-        """Starting values of an effect's nonlinear parameters from the current residual.
-
-        ``normal_load``: the frequency whose ``h cos, h sin`` pair explains most of the
-        residual (measured minus model), scanned from 0.05 excitation frequencies (at least
-        two periods in the record) to 3, at a quarter of the record's frequency resolution;
-        ``stick_slip``: a slip distance of ``1/ac``; ``stribeck``: ``v_s`` of the RMS speed.
-        """
-        if name == "stick_slip":
-            return {"ell": 1.0 / p["ac"]}
-        if name == "stribeck":
-            return {"v_s": float(np.sqrt(np.mean(d.ud**2)))}
-        if name != "normal_load":
-            return {}
-        h = self.predict(p, (), d)
-        f_exc = 1.0 / (d.cycles.period_samples * d.dt)
-        f_lo = max(0.05 * f_exc, MIN_LOAD_PERIODS / d.duration)
-        step = 0.25 / d.duration
-        freqs = np.arange(f_lo, 3.0 * f_exc, step)
-        # a fluctuation locked to the drive is position_friction's: skip the harmonics
-        k = np.round(freqs / f_exc)
-        freqs = freqs[(k < 1) | (np.abs(freqs - k * f_exc) >= 1.0 / d.duration)]
-        if not freqs.size:
-            return {"f_n": f_exc}
-        # the least-squares gain of the pair (h cos, h sin) at every frequency, by FFT
-        j = np.rint((freqs - f_lo) / step).astype(int)
-        gains = modulation_gains(h, residual, d.duration, f_lo, step, int(j[-1]) + 1)[j]
-        return {"f_n": float(freqs[int(np.argmax(gains))])}
+        """Starting values of an effect's nonlinear parameters from the current residual
+        (the effect's own :meth:`~contactlab.diagnose.effects.EffectModel.start`)."""
+        return EFFECTS[name].start(p, d, residual)
 
     #: the load-frequency search (:meth:`search_start`): a grid of ``LOAD_GRID`` points either
     #: side of the start, ``LOAD_GRID_STEP`` of the record's frequency resolution ``1/T``
@@ -586,8 +437,8 @@ class TangentialFamily:
         rr = float(r0 @ r0)
         spent = 1
         lo_e, hi_e = (
-            CANDIDATES["normal_load"].params[0].lower,
-            CANDIDATES["normal_load"].params[0].upper,
+            EFFECTS["normal_load"].params[0].lower,
+            EFFECTS["normal_load"].params[0].upper,
         )
         seen: dict[float, tuple[float, float, float]] = {}
 
@@ -630,7 +481,15 @@ class TangentialFamily:
         return dict(p, f_n=float(f), eps_c=ec, eps_s=es), spent
 
     def check(self, effects: tuple[str, ...]) -> bool:
-        """All tangential effects combine (in the order of the module docstring)."""
+        """Effects combine in the order of their stages, with at most one element law
+        (``stage == "element"``: the branch scale, the power-law microslip, the backlash
+        replace the exponential element; each may sit behind a series compliance), and no
+        element law other than the branch scale behind a series compliance."""
+        stages = [EFFECTS[e].stage for e in effects]
+        if stages.count("element") > 1:
+            return False
+        if "element" in stages and "core" in stages and "non_masing_scaling" not in effects:
+            return False
         return True
 
     def scales(self, d: Prepared) -> dict[str, float]:
@@ -663,7 +522,7 @@ class TangentialFamily:
                 raise InputError(
                     f"the loop runs the wrong way: ∮F dx = {loop_area(d.u, d.y):.3g} J over the "
                     "recording, but a passive joint dissipates (∮F dx > 0); the force channel "
-                    "is recorded with the opposite sign — negate F"
+                    "is recorded with the opposite sign — negate F (force_sign=-1, --force-sign -1)"
                 )
             raise InputError(
                 f"the force does not follow the displacement: the best Masing curve explains "
@@ -706,111 +565,88 @@ class TangentialFamily:
         d: Prepared,
         at: np.ndarray | None = None,
     ) -> np.ndarray:
-        """The joint's force at the sensor, before any declared measurement filter."""
+        """The joint's force at the sensor, before any declared measurement filter: the
+        effects composed in the order of their stage
+        (:data:`~contactlab.diagnose.effects.TANGENTIAL_STAGES`), each by its own
+        :meth:`~contactlab.diagnose.effects.EffectModel.apply`."""
         if "channel_delay" in effects and "raw_input" in d.extra and p["tau"] != 0.0:
             # a kept record (workflow.subsample_long): the model at the shifted raw positions
             rest = tuple(e for e in effects if e != "channel_delay")
             return self._force(p, rest, delayed(d, p["tau"]), at)
-        x = d.u
-        if "displacement_offset" in effects:
-            x = x - p["x0"]
-        # a record kept every q-th sample (workflow.subsample_long): the element and the
-        # terms up to the breakaway run over the kept samples with the turning points
-        # between them merged in (xm), which gives the full-rate values at the kept samples;
-        # with ``at``, over the samples asked for and the turning points only (``sp``)
-        kn: Knots | None = d.extra.get("knots")
-        x0 = p["x0"] if x is not d.u else None
-        sp = None if kn is None else span(d, kn, at)
-        if kn is None or sp is None:
-            xm = x
-        else:  # merged once per displacement (x0) and kept: the fits step x0 rarely
-            memo = _memo(d, "merged")
-            xm = memo.get(x0)
-            if xm is None:
-                xm = memo[x0] = kn.merge(x, x0 or 0.0)
-            if sp.index is not None:  # the span of it a fit's samples need, kept likewise:
-                # gathered for every evaluation before (11 000 of 30 000 samples of a
-                # 1e6-sample record), though a kept unit force mostly makes it unneeded
-                memo = _memo(d, "merged_span")
-                key = (x0, sp.token)
-                part = memo.get(key)
-                if part is None:
-                    part = memo[key] = xm[sp.index]
-                xm = part
-        if "series_compliance" in effects:
-            xmax = float(np.max(np.abs(xm))) or 1.0
-            bx, bf = series_backbone(p["h0"], p["ac"], max(p["C_s"], 0.0), xmax)
-            core = Masing.from_backbone(bx, bf)
-        elif "non_masing_scaling" in effects:
-            core = Masing(p["h0"], p["ac"])
-        if "non_masing_scaling" in effects:
-            # the reversal bookkeeping depends on x (through x0 too: the start at the origin
-            # and the mirrored targets on the virgin curve), so a cached one is reused only
-            # for the very same displacement (issue 13)
-            mem = d.extra.get("memory")
-            if mem is None or not np.array_equal(mem.x, xm):
-                mem = d.extra["memory"] = memory(xm)
-            h = scaled_force(core.virgin, p["lam"], mem)
-        elif "series_compliance" in effects:
-            h = core.force(xm)
+        chain = ordered("tangential", effects)
+        staged = lambda name: [e for e in chain if e.stage == name]  # noqa: E731
+        ctx = ForceContext(d, effects, d.u, d.u, None, at=at, rows=at)
+        for e in staged("input"):
+            ctx.x = e.apply(ctx.x, p, ctx)
+        x = ctx.x
+        ctx.x0 = p["x0"] if x is not d.u else None
+        self._merge(ctx)
+        reshaped = staged("element_input")
+        for e in reshaped:
+            ctx.xm = e.apply(ctx.xm, p, ctx)
+        for e in staged("core"):
+            ctx.core = e.apply(ctx.core, p, ctx)
+        elements = staged("element")
+        if elements:
+            h = elements[0].apply(ctx.core, p, ctx)
+        elif ctx.core is not None:
+            h = ctx.core.force(ctx.xm)
+        elif reshaped:  # (the kept unit forces are of the displacement itself)
+            h = Masing(p["h0"], p["ac"]).force(ctx.xm)
         else:
-            h = _masing_force(d, p["h0"], p["ac"], x0, xm, 0 if sp is None else sp.token)
-        if "asymmetry" in effects:
-            h = h + p["alpha"] * np.abs(h)
-        if "parameter_drift" in effects:
-            t_rel = _fixed(d, "t_rel", lambda: d.t - d.t[0]) if sp is None else sp.t - d.t[0]
-            h = h * (1.0 + p["beta"] * t_rel / d.duration)
+            token = 0 if ctx.sp is None else ctx.sp.token
+            h = _masing_force(d, p["h0"], p["ac"], ctx.x0, ctx.xm, token)
+        ctx.scratch["element"] = h
+        for e in staged("element_force"):
+            h = e.apply(h, p, ctx)
         # from here on sample by sample: with ``at``, only at the samples asked for — or, with
-        # a delay (which interpolates between samples), at the two around each shifted time
-        delay = "channel_delay" in effects
-        rows = _delay_support(d, at, p["tau"]) if at is not None and delay else at
-        pick: Callable[[np.ndarray], np.ndarray] = (
-            (lambda a: a) if rows is None else (lambda a: a[rows])
-        )
-        if "stick_slip" in effects:
-            if sp is None:
-                rev = d.cycles.reversals
-                anchors = _fixed(d, "anchors", lambda: reversal_anchors(rev, x.size))
-                h = breakaway(h, x, rev, p["s_b"], p["ell"], anchors, rows)
-            else:
-                if sp.anchors is None:
-                    sp.anchors = reversal_anchors(sp.reversals, sp.size)
-                h = breakaway(h, xm, sp.reversals, p["s_b"], p["ell"], sp.anchors, sp.rows)
+        # a delay (which interpolates between samples), at the samples around each shift
+        if at is not None:
+            for e in chain:
+                need = getattr(e, "rows_needed", None)
+                if need is not None:
+                    ctx.rows = need(d, at, p)
+        branch = staged("branch")
+        if branch:
+            h = branch[0].apply(h, p, ctx)
         else:
-            h = pick(h) if sp is None else h[sp.rows]
-        if "stribeck" in effects:
-            speed = pick(_fixed(d, "speed", lambda: np.abs(d.ud)))
-            h = h * (1.0 + p["s"] * np.exp(-speed / max(p["v_s"], 1e-300)))
-        if "position_friction" in effects:
-            # the harmonics along the track are fixed unless x itself moves (x0)
-            c1, s1, c2, s2 = (
-                _track_harmonics(pick(x), d)
-                if "displacement_offset" in effects
-                else map(pick, _fixed(d, "track", lambda: _track_harmonics(x, d)))
-            )
-            h = h * (1.0 + p["a1"] * c1 + p["b1"] * s1 + p["a2"] * c2 + p["b2"] * s2)
-        if "normal_load" in effects:
-            cos, sin = _load_terms(d, p["f_n"], rows)
-            h = h * (1.0 + p["eps_c"] * cos + p["eps_s"] * sin)
+            h = ctx.pick(h) if ctx.sp is None else h[ctx.sp.rows]
+        for e in staged("factor"):
+            h = e.apply(h, p, ctx)
         F = h
-        if "parallel_stiffness" in effects:
-            F = F + p["k_p"] * pick(x)  # (picked where needed: a gather per evaluation)
-        if "viscous_damping" in effects:
-            F = F + p["c"] * pick(d.ud)
-        if "inertia" in effects:
-            F = F + p["m"] * pick(d.udd)
-        if "force_offset" in effects:
-            F = F + p["F0"]
-        if "force_drift" in effects:
-            F = F + p["F1"] * pick(_fixed(d, "t_rel", lambda: d.t - d.t[0])) / d.duration
-        if delay:
-            if at is None:
-                F = shift(F, d.t, p["tau"])
-            elif p["tau"] != 0.0:  # (tau = 0: rows is at, F is there already)
-                # F is known at ``rows`` only, which hold both neighbours of every shifted
-                # time: np.interp brackets each by the same two samples as on the full grid
-                F = np.interp(d.t[at] - p["tau"], d.t[rows], F)
+        for e in staged("additive"):
+            F = e.apply(F, p, ctx)
+        for e in staged("output"):
+            F = e.apply(F, p, ctx)
         return F if F.flags.writeable else F.copy()
+
+    @staticmethod
+    def _merge(ctx: ForceContext) -> None:
+        """The displacement the element runs over (``ctx.xm``) and the span (``ctx.sp``).
+
+        A record kept every q-th sample (workflow.subsample_long): the element and the terms
+        up to the breakaway run over the kept samples with the turning points between them
+        merged in, which gives the full-rate values at the kept samples; with ``at``, over
+        the samples asked for and the turning points only (the span)."""
+        d, x, x0 = ctx.d, ctx.x, ctx.x0
+        kn: Knots | None = d.extra.get("knots")
+        sp = None if kn is None else span(d, kn, ctx.at)
+        ctx.sp = sp
+        if kn is None or sp is None:
+            ctx.xm = x
+            return
+        merged = memo(d, "merged")  # merged once per displacement (x0) and kept
+        xm = merged.get(x0)
+        if xm is None:
+            xm = merged[x0] = kn.merge(x, x0 or 0.0)
+        if sp.index is not None:  # the span of it a fit's samples need, kept likewise
+            parts = memo(d, "merged_span")
+            key = (x0, sp.token)
+            part = parts.get(key)
+            if part is None:
+                part = parts[key] = xm[sp.index]
+            xm = part
+        ctx.xm = xm
 
     #: :meth:`derived` takes the model's effects and the data (keywords ``effects``, ``d``)
     derived_from_data = True
@@ -854,50 +690,16 @@ class TangentialFamily:
         effects: tuple[str, ...] | None = None,
         d: Prepared | None = None,
     ) -> tuple[dict[str, float], dict[str, float]]:
-        """Extra reported quantities of an effect (with delta-method standard errors).
+        """Extra reported quantities of an effect (with delta-method standard errors), from
+        the effect's own :meth:`~contactlab.diagnose.effects.EffectModel.derived`.
 
         ``stick_slip``'s ``breakaway_force``: with the model's ``effects`` and the data
         ``d``, :meth:`model_breakaway` (comparable with ``analyze``'s breakaway force of the
         sticks); without them, the peak of a full branch of the breakaway term
         (:func:`breakaway_force`), which ignores the other effects.
         """
-        if effect == "stick_slip" and effects is not None and d is not None:
-            val = self.model_breakaway(p, effects, d)
-            var = 0.0
-            for k, s in se.items():
-                if not (np.isfinite(s) and s > 0):
-                    continue
-                step = 1e-3 * s
-                q = dict(p)
-                q[k] += step
-                var += ((self.model_breakaway(q, effects, d) - val) / step * s) ** 2
-            return {"breakaway_force": val}, {"breakaway_force": float(np.sqrt(var))}
-        if effect == "series_compliance" and p["C_s"] > 0:
-            return {"k_s": 1.0 / p["C_s"]}, {"k_s": se["C_s"] / p["C_s"] ** 2}
-        if effect == "asymmetry":
-            h0, a = p["h0"], p["alpha"]
-            s = float(np.hypot(se["h0"] * (1 + a), h0 * se["alpha"]))
-            s2 = float(np.hypot(se["h0"] * (1 - a), h0 * se["alpha"]))
-            return {"h0_plus": h0 * (1 + a), "h0_minus": h0 * (1 - a)}, {
-                "h0_plus": s,
-                "h0_minus": s2,
-            }
-        if effect == "stick_slip":
-            keys = ("h0", "ac", "s_b", "ell")
-            val = breakaway_force(*(p[k] for k in keys))
-            var = 0.0
-            for i, k in enumerate(keys):
-                step = 1e-4 * abs(p[k]) or 1e-12
-                q = [p[j] for j in keys]
-                q[i] += step
-                var += ((breakaway_force(*q) - val) / step * se.get(k, np.inf)) ** 2
-            return {"breakaway_force": val}, {"breakaway_force": float(np.sqrt(var))}
-        if effect == "parameter_drift":
-            h0, b = p["h0"], p["beta"]
-            return {"h0_end": h0 * (1 + b)}, {
-                "h0_end": float(np.hypot(se["h0"] * (1 + b), h0 * se["beta"]))
-            }
-        return {}, {}
+        more = {} if effects is None or d is None else {"effects": effects, "d": d, "family": self}
+        return EFFECTS[effect].derived(p, se, **more)
 
     def base_model(self, p: dict[str, float], context: dict[str, float]) -> Any:
         return Masing(p["h0"], p["ac"])
@@ -923,40 +725,18 @@ class TangentialFamily:
         return np.clip(k, 0.0, kmax)
 
     def implausible(self, name: str, p: dict[str, float], d: Prepared) -> str | None:
-        """Why a fitted effect cannot be physical on this rig, or None."""
-        why = implausible_common(self.candidates[name], p, d)
-        if why:
-            return why
-        if name == "non_masing_scaling" and not 0.5 <= p["lam"] <= 8.0:
-            return f"branch scale lam = {p['lam']:.3g} is outside 0.5..8 (no known joint)"
-        if name == "normal_load":
-            if p["f_n"] < MIN_LOAD_PERIODS / d.duration:
-                return (
-                    f"a load fluctuation of {p['f_n']:.3g} Hz makes fewer than "
-                    f"{MIN_LOAD_PERIODS:g} periods in the record: a drift (parameter_drift)"
-                )
-            f_exc = 1.0 / (d.cycles.period_samples * d.dt)
-            k = round(p["f_n"] / f_exc)
-            if k >= 1 and abs(p["f_n"] - k * f_exc) < 1.0 / d.duration:
-                return (
-                    f"a load fluctuation at {p['f_n']:.4g} Hz, harmonic {k} of the excitation, "
-                    "cannot be told from friction that varies along the track "
-                    "(position_friction)"
-                )
-        if name == "displacement_offset":
-            amp = 0.5 * float(np.ptp(d.u))
-            if abs(p["x0"]) > 0.5 * amp:
-                return f"a displacement offset of {p['x0']:.3g} m is over half the amplitude"
-        if name == "asymmetry" and p["ac"] * 0.5 * float(np.ptp(d.u)) >= GROSS_SLIDING_ZA:
-            # on a near-rectangular loop h + α|h| moves both plateaus by α h0, as an offset
-            # does: only the short turns differ, so the two cannot be told apart; the offset
-            # (a sensor's zero, the reconstruction's K (y - x)) is the one tried
-            return (
-                f"in gross sliding (ac·A ≥ {GROSS_SLIDING_ZA:g}) an asymmetry shifts both "
-                f"plateaus alike (α h0 = {p['alpha'] * p['h0']:.3g} N), as a force offset "
-                "does: the two cannot be told apart, and force_offset stands for both"
-            )
-        return None
+        """Why a fitted effect cannot be physical on this rig, or None (the effect's own
+        :meth:`~contactlab.diagnose.effects.EffectModel.plausible`)."""
+        ok, why = EFFECTS[name].plausible(d, p)
+        return None if ok else why
+
+    def identified(self, name: str, p: dict[str, float], se: dict[str, float]) -> str | None:
+        """Why a fitted effect's size is not identified (within its error of "absent")."""
+        return EFFECTS[name].identified(p, se)
+
+    def plausibility(self, name: str, p: dict[str, float], d: Prepared) -> tuple[bool, str]:
+        """The effect's plausibility verdict and its argument in numbers."""
+        return tuple(EFFECTS[name].plausible(d, p))  # type: ignore[return-value]
 
     def regime(self, p: dict[str, float], d: Prepared) -> str:
         """Pre-sliding, transition or gross sliding, from ``ac·A`` of the base fit."""

@@ -1,0 +1,1 @@
+"""Normal-contact effects (one module each, registered on import)."""

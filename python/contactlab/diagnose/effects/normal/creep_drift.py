@@ -1,0 +1,63 @@
+"""``creep_drift``: the joint settling over the cycles."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..._family import ParamSpec
+from .._base import EffectModel, Plausibility, register
+
+
+@register
+class CreepDrift(EffectModel):
+    name = "creep_drift"
+    kind = "normal"
+    params = (
+        ParamSpec("D", "m", 0.0, -np.inf, np.inf, "delta"),
+        ParamSpec("tau_c", "s", np.nan, 0.0, np.inf, "T"),
+    )
+    description = "displacement creeping over the cycles, D (1 - exp(-t/τ_c))"
+    physics = (
+        "The joint settles under its mean load (asperities creeping): δ += D (1 - "
+        "exp(-t/τ_c)), slower than an excitation period, settling within the record."
+    )
+    stage = "additive"
+    order = 2
+    size_param = "D"
+
+    def start(self, p, d, residual):
+        from ...candidates_normal import NormalFamily
+
+        return NormalFamily.creep_start(p, d, residual)
+
+    def apply(self, delta, p, ctx):
+        from ...candidates_normal import _creep_shape
+
+        return delta + p["D"] * _creep_shape(ctx, max(p["tau_c"], 1e-6 * ctx.duration))
+
+    def plausible(self, d, p):
+        from ...candidates_normal import CREEP_MAX_DURATIONS, CREEP_MIN_PERIODS
+
+        period = d.cycles.period_samples * d.dt
+        if p["tau_c"] < CREEP_MIN_PERIODS * period:
+            return Plausibility(
+                False,
+                f"the drift settles in τc = {p['tau_c']:.3g} s, within "
+                f"{CREEP_MIN_PERIODS:g} excitation period ({period:.3g} s): a start-up "
+                "transient of the record or its model, not creep of the joint",
+            )
+        if p["tau_c"] > CREEP_MAX_DURATIONS * d.duration:
+            return Plausibility(
+                False,
+                f"the drift does not settle within the record (τc = {p['tau_c']:.3g} s, "
+                f"more than {CREEP_MAX_DURATIONS:g} × its {d.duration:.3g} s): a straight "
+                "drift, which creep of the joint cannot be told from a drifting "
+                "displacement sensor or a slow model misfit by",
+            )
+        return super().plausible(d, p)
+
+    def argument(self, d, p):
+        return (
+            f"the joint settles by {p['D']:.3g} m with τc = {p['tau_c']:.3g} s, between an "
+            f"excitation period and the {d.duration:.3g} s record"
+        )

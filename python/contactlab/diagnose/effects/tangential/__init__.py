@@ -1,0 +1,1 @@
+"""Tangential effects (one module each, registered on import)."""

@@ -1,0 +1,63 @@
+"""``asymmetry``: a friction force that differs between the two sliding directions."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..._family import ParamSpec
+from .._base import EffectModel, Plausibility, register
+from ._common import amplitude
+
+#: ac·A from which the base loop is near-rectangular (gross sliding)
+GROSS_SLIDING_ZA = 10.0
+
+
+@register
+class Asymmetry(EffectModel):
+    name = "asymmetry"
+    kind = "tangential"
+    params = (ParamSpec("alpha", "-", 0.0, -0.5, 0.5, "one"),)
+    description = (
+        "saturation force h0(1+alpha) in the positive, h0(1-alpha) in the negative direction"
+    )
+    physics = (
+        "The friction force differs between the two sliding directions (a self-energising "
+        "band, a tilted contact): F = h + α |h|, saturating at h0 (1 ± α)."
+    )
+    stage = "element_force"
+    rank = 0
+    order = 8
+    size_param = "alpha"
+
+    def apply(self, h, p, ctx):
+        return h + p["alpha"] * np.abs(h)
+
+    def derived(self, p, se, **more):
+        h0, a = p["h0"], p["alpha"]
+        s = float(np.hypot(se["h0"] * (1 + a), h0 * se["alpha"]))
+        s2 = float(np.hypot(se["h0"] * (1 - a), h0 * se["alpha"]))
+        return {"h0_plus": h0 * (1 + a), "h0_minus": h0 * (1 - a)}, {
+            "h0_plus": s,
+            "h0_minus": s2,
+        }
+
+    def plausible(self, d, p):
+        base = super().plausible(d, p)
+        if base.ok and p["ac"] * amplitude(d) >= GROSS_SLIDING_ZA:
+            # on a near-rectangular loop h + α|h| moves both plateaus by α h0, as an offset
+            # does: only the short turns differ, so the two cannot be told apart
+            return Plausibility(
+                False,
+                f"in gross sliding (ac·A ≥ {GROSS_SLIDING_ZA:g}) an asymmetry shifts both "
+                f"plateaus alike (α h0 = {p['alpha'] * p['h0']:.3g} N), as a force offset "
+                "does: the two cannot be told apart, and force_offset stands for both",
+            )
+        return base
+
+    def argument(self, d, p):
+        h0, a = p["h0"], p["alpha"]
+        return (
+            f"the friction force is {h0 * (1 + a):.4g} N one way and {h0 * (1 - a):.4g} N the "
+            f"other (α = {a:.3g}): the turns, not only the plateaus, differ between the "
+            "directions, which a force offset cannot follow"
+        )

@@ -1,0 +1,42 @@
+"""``displacement_offset``: the displacement sensor's zero off the contact's origin."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..._family import ParamSpec
+from .._base import EffectModel, Plausibility, register
+from ._common import amplitude
+
+
+@register
+class DisplacementOffset(EffectModel):
+    name = "displacement_offset"
+    kind = "tangential"
+    params = (ParamSpec("x0", "m", 0.0, -np.inf, np.inf, "x"),)
+    description = "displacement-sensor zero: the contact sees x - x0"
+    physics = (
+        "The displacement sensor's zero is not where the contact started: h = M(x - x0). "
+        "Seen on the virgin curve (a record from rest) and on the first turn."
+    )
+    stage = "input"
+    order = 6
+    size_param = "x0"
+
+    def apply(self, x, p, ctx):
+        return x - p["x0"]
+
+    def plausible(self, d, p):
+        base = super().plausible(d, p)
+        if base.ok and abs(p["x0"]) > 0.5 * amplitude(d):
+            return Plausibility(
+                False, f"a displacement offset of {p['x0']:.3g} m is over half the amplitude"
+            )
+        return base
+
+    def argument(self, d, p):
+        a = amplitude(d)
+        return (
+            f"x0 = {p['x0']:.3g} m ({100 * p['x0'] / a:.1f} % of the amplitude {a:.3g} m): "
+            "the virgin curve starts off the sensor's zero"
+        )

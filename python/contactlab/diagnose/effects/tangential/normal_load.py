@@ -1,0 +1,177 @@
+"""``normal_load``: the normal load (and with it the friction force) fluctuating in time."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..._family import ParamSpec
+from ..._signal import modulation_gains
+from .._base import EffectModel, Plausibility, register
+
+#: a normal-load fluctuation must make this many periods in the record; slower, it is a drift
+MIN_LOAD_PERIODS = 2.0
+#: at a harmonic of the drive, the share of the fluctuation's variance that is not one
+#: function of the position (up and down strokes alike) must reach this: below, friction
+#: varying along the track (position_friction) explains it as well
+MIN_DIRECTION_SHARE = 0.25
+#: largest plausible fluctuation of the normal load, relative: a joint whose normal load
+#: swings by more than this within the record is not "loaded with fluctuations" but a
+#: different test; a fit beyond it absorbs a misfit of the base model
+MAX_FLUCTUATION = 0.3
+#: position bins of that test
+_BINS = 32
+
+
+def load_terms(d, f_n: float, rows: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """``cos 2π f_n t``, ``sin 2π f_n t`` (``t`` from the record's start) at the samples
+    ``rows`` (all when None), kept per ``(f_n, rows)``: only a step of ``f_n`` changes
+    them."""
+    from ...candidates_tangential import fixed, memo
+
+    m = memo(d, "load_terms")
+    key = (f_n, None if rows is None else id(rows))
+    hit = m.get(key)
+    if hit is not None and hit[0] is rows:
+        return hit[1], hit[2]
+    t_rel = fixed(d, "t_rel", lambda: d.t - d.t[0])
+    ph = 2.0 * np.pi * f_n * (t_rel if rows is None else t_rel[rows])
+    out = (np.cos(ph), np.sin(ph))
+    m[key] = (rows, *out)
+    return out
+
+
+def direction_share(d, mod: np.ndarray) -> float:
+    """Share of the variance of ``mod`` (one value per sample) that is not a function of the
+    position alone: ``mod`` minus its mean in each of :data:`_BINS` position bins (the up
+    and down strokes pooled), over ``mod``'s variance."""
+    x = d.u
+    lo, hi = float(np.min(x)), float(np.max(x))
+    if not hi > lo:
+        return 1.0
+    b = np.minimum(((x - lo) / (hi - lo) * _BINS).astype(int), _BINS - 1)
+    cnt = np.bincount(b, minlength=_BINS)
+    mean = np.bincount(b, weights=mod, minlength=_BINS) / np.maximum(cnt, 1)
+    rest = mod - mean[b]
+    var = float(np.var(mod))
+    return float(np.mean(rest * rest)) / var if var > 0 else 1.0
+
+
+@register
+class NormalLoad(EffectModel):
+    name = "normal_load"
+    kind = "tangential"
+    params = (
+        ParamSpec("eps_c", "-", 0.0, -0.5, 0.5, "one"),
+        ParamSpec("eps_s", "-", 0.0, -0.5, 0.5, "one"),
+        ParamSpec("f_n", "Hz", np.nan, 0.0, np.inf, "fq"),
+    )
+    description = (
+        "normal load fluctuating at its own frequency f_n: F = h (1 + eps_c cos 2π f_n t "
+        "+ eps_s sin 2π f_n t)"
+    )
+    physics = (
+        "The normal load, and with it the friction force, fluctuates in time: F = h (1 + ε "
+        "cos(2π f_n t + φ)). At its own frequency, or locked to the drive (a harmonic k f, "
+        "as when the normal load is coupled to the tangential motion): then it is told from "
+        "friction varying along the track by its part that differs between the up and down "
+        "strokes at the same position (a function of time, not of position)."
+    )
+    stage = "factor"
+    rank = 2
+    order = 14
+    size_param = "eps_c"
+
+    def size(self, p, se):
+        """The amplitude over (eps_c, eps_s), with its delta-method error."""
+        names = (
+            "eps_c",
+            "eps_s",
+        )
+        v = float(np.sqrt(sum(p[n] ** 2 for n in names)))
+        if v == 0:
+            return 0.0, float(np.inf)
+        e2 = sum((p[n] / v * se.get(n, np.inf)) ** 2 for n in names)
+        return v, float(np.sqrt(e2))
+
+    def start(self, p, d, residual):
+        """The frequency whose ``h cos, h sin`` pair explains most of the residual, scanned
+        from 0.05 excitation frequencies (at least two periods in the record) to 3, at a
+        quarter of the record's frequency resolution, the drive's harmonics included."""
+        from ...candidates_tangential import TangentialFamily
+
+        h = TangentialFamily().predict(p, (), d)
+        f_exc = 1.0 / (d.cycles.period_samples * d.dt)
+        f_lo = max(0.05 * f_exc, MIN_LOAD_PERIODS / d.duration)
+        step = 0.25 / d.duration
+        freqs = np.arange(f_lo, 3.0 * f_exc, step)
+        if not freqs.size:
+            return {"f_n": f_exc}
+        gains = modulation_gains(h, residual, d.duration, f_lo, step, freqs.size)
+        return {"f_n": float(freqs[int(np.argmax(gains[: freqs.size]))])}
+
+    def apply(self, h, p, ctx):
+        cos, sin = load_terms(ctx.d, p["f_n"], ctx.rows)
+        return h * (1.0 + p["eps_c"] * cos + p["eps_s"] * sin)
+
+    def harmonic(self, d, p) -> int:
+        """The drive harmonic ``k`` the fluctuation is locked to (0: none)."""
+        f_exc = 1.0 / (d.cycles.period_samples * d.dt)
+        k = round(p["f_n"] / f_exc)
+        return k if k >= 1 and abs(p["f_n"] - k * f_exc) < 1.0 / d.duration else 0
+
+    def plausible(self, d, p):
+        base = super().plausible(d, p)
+        if not base.ok:
+            return base
+        if p["f_n"] < MIN_LOAD_PERIODS / d.duration:
+            return Plausibility(
+                False,
+                f"a load fluctuation of {p['f_n']:.3g} Hz makes fewer than "
+                f"{MIN_LOAD_PERIODS:g} periods in the record: a drift (parameter_drift)",
+            )
+        eps = float(np.hypot(p["eps_c"], p["eps_s"]))
+        if eps > MAX_FLUCTUATION:
+            return Plausibility(
+                False,
+                f"a normal load swinging by ±{100 * eps:.0f} % (plausible: up to "
+                f"±{100 * MAX_FLUCTUATION:g} %) is not a fluctuation of the loaded joint: the "
+                "base model's misfit is read as one",
+            )
+        k = self.harmonic(d, p)
+        if k == 1:
+            return Plausibility(
+                False,
+                f"a load fluctuation at the drive frequency ({p['f_n']:.4g} Hz) is, in phase "
+                "with x, friction varying along the track, and in quadrature (∝ ẋ, times the "
+                "friction's own sign) a friction growing with the sliding speed: the velocity "
+                "effects and position_friction stand for it",
+            )
+        if k:
+            cos, sin = load_terms(d, p["f_n"], None)
+            share = direction_share(d, p["eps_c"] * cos + p["eps_s"] * sin)
+            if share < MIN_DIRECTION_SHARE:
+                return Plausibility(
+                    False,
+                    f"a load fluctuation at {p['f_n']:.4g} Hz, harmonic {k} of the excitation, "
+                    f"is {100 * (1 - share):.0f} % one function of the position (the same on "
+                    "up and down strokes): friction varying along the track "
+                    "(position_friction) explains it as well",
+                )
+        return base
+
+    def argument(self, d, p):
+        eps = float(np.hypot(p["eps_c"], p["eps_s"]))
+        k = self.harmonic(d, p)
+        if k:
+            cos, sin = load_terms(d, p["f_n"], None)
+            share = direction_share(d, p["eps_c"] * cos + p["eps_s"] * sin)
+            return (
+                f"the friction force fluctuates by ±{100 * eps:.1f} % at {p['f_n']:.4g} Hz, "
+                f"harmonic {k} of the drive (a normal load coupled to the motion); "
+                f"{100 * share:.0f} % of it differs between up and down strokes at the same "
+                "position, which friction varying along the track cannot do"
+            )
+        return (
+            f"the friction force fluctuates by ±{100 * eps:.1f} % at {p['f_n']:.4g} Hz, not a "
+            "harmonic of the drive: a normal load varying in time"
+        )

@@ -1,0 +1,48 @@
+"""``parameter_drift``: the friction force drifting over the record (wear, run-in)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..._family import ParamSpec
+from .._base import EffectModel, register
+
+
+@register
+class ParameterDrift(EffectModel):
+    name = "parameter_drift"
+    kind = "tangential"
+    params = (ParamSpec("beta", "-", 0.0, -1.9, 1.9, "one"),)
+    description = (
+        "saturation force drifting over the recording: h0(t) = h0 (1 + beta (t - t_m)/T), "
+        "h0 the value at mid-record t_m"
+    )
+    physics = (
+        "The friction force changes over the record (run-in, wear, heating): h0(t) = "
+        "h0 (1 + β (t - t_m)/T), t_m the record's middle (docs/effects.md), so h0 stays the "
+        "record's mean friction force, the plateau analyze reads. The loops grow or shrink "
+        "about their centre, unlike a sensor drift."
+    )
+    stage = "element_force"
+    rank = 1
+    order = 10
+    size_param = "beta"
+
+    def apply(self, h, p, ctx):
+        return h * (1.0 + p["beta"] * (ctx.t_rel / ctx.d.duration - 0.5))
+
+    def derived(self, p, se, **more):
+        h0, b = p["h0"], p["beta"]
+        vals, errs = {}, {}
+        for key, k in (("h0_start", -0.5), ("h0_end", 0.5)):
+            vals[key] = h0 * (1 + k * b)
+            errs[key] = float(np.hypot(se["h0"] * (1 + k * b), h0 * k * se["beta"]))
+        return vals, errs
+
+    def argument(self, d, p):
+        h0, b = p["h0"], p["beta"]
+        return (
+            f"the friction force goes from {h0 * (1 - b / 2):.4g} N to {h0 * (1 + b / 2):.4g} N "
+            f"over the {d.duration:.3g} s record (mean {h0:.4g} N): the loops grow or shrink "
+            "about their centre"
+        )

@@ -1,0 +1,75 @@
+"""``stribeck``: friction that changes with the sliding speed at low speed."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..._family import ParamSpec
+from .._base import EffectModel, Plausibility, register
+
+#: a measured breakaway within this share of the plateau shows no low-speed excess
+BREAKAWAY_TOLERANCE = 0.05
+
+
+@register
+class Stribeck(EffectModel):
+    name = "stribeck"
+    kind = "tangential"
+    params = (
+        ParamSpec("s", "-", 0.0, -0.5, 1.0, "one"),
+        ParamSpec("v_s", "m/s", np.nan, 0.0, np.inf, "v"),
+    )
+    description = (
+        "velocity-dependent friction: F = h (1 + s exp(-|ẋ|/v_s)) (Stribeck, s > 0: "
+        "friction weakening with sliding speed)"
+    )
+    physics = (
+        "The friction coefficient falls from its static value as the sliding speed rises "
+        "(Stribeck): F = h (1 + s exp(-|ẋ|/v_s)). s > 0: the force right after a reversal "
+        "(speed near zero) is s h0 above the plateau — a breakaway the sticks measure. Acts "
+        "through the velocity, like a delay, a viscous term and inertia."
+    )
+    acts_through = "velocity"
+    stage = "factor"
+    rank = 0
+    order = 11
+    size_param = "s"
+
+    def start(self, p, d, residual):
+        return {"v_s": float(np.sqrt(np.mean(d.ud**2)))}
+
+    def apply(self, h, p, ctx):
+        speed = ctx.pick(ctx.fixed("speed", lambda: np.abs(ctx.d.ud)))
+        return h * (1.0 + p["s"] * np.exp(-speed / max(p["v_s"], 1e-300)))
+
+    def plausible(self, d, p):
+        base = super().plausible(d, p)
+        if not base.ok:
+            return base
+        reg = d.extra.get("regime_info") or {}
+        fb, hp = reg.get("breakaway_force"), reg.get("plateau_h0")
+        if fb is not None and hp and np.isfinite(fb) and np.isfinite(hp):
+            low = p["h0"] * (1.0 + p["s"])
+            if p["s"] < 0 and fb >= (1.0 - BREAKAWAY_TOLERANCE) * hp:
+                return Plausibility(
+                    False,
+                    f"s = {p['s']:.3g} puts the low-speed friction at {low:.4g} N, below the "
+                    f"plateau, but the sticks break away at {fb:.4g} N against a plateau of "
+                    f"{hp:.4g} N: the friction does not fall at low speed",
+                )
+            if p["s"] > 0 and abs(fb - hp) <= BREAKAWAY_TOLERANCE * hp:
+                return Plausibility(
+                    False,
+                    f"s = {p['s']:.3g} puts the low-speed friction at {low:.4g} N, but the "
+                    f"measured breakaway {fb:.4g} N equals the plateau {hp:.4g} N (within "
+                    f"{100 * BREAKAWAY_TOLERANCE:g} %): no low-speed excess",
+                )
+        return base
+
+    def argument(self, d, p):
+        return (
+            f"the friction at low speed is {p['h0'] * (1 + p['s']):.4g} N against "
+            f"{p['h0']:.4g} N at speeds well above v_s = {p['v_s']:.3g} m/s "
+            f"(s = {p['s']:.3g}): friction {'weakening' if p['s'] > 0 else 'strengthening'} "
+            "with speed"
+        )

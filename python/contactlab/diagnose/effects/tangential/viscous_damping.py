@@ -1,0 +1,39 @@
+"""``viscous_damping``: a viscous force ``c ẋ`` in parallel with the contact."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..._family import ParamSpec
+from .._base import EffectModel, register
+from ._common import peak_speed
+
+
+@register
+class ViscousDamping(EffectModel):
+    name = "viscous_damping"
+    kind = "tangential"
+    params = (ParamSpec("c", "N s/m", 0.0, 0.0, np.inf, "c"),)
+    description = "viscous force c·ẋ in parallel with the contact"
+    physics = (
+        "A dashpot in parallel with the contact (lubricant film, the rig's guides, air): "
+        "F = h + c ẋ, ẋ the sliding velocity. Dissipates π c ω A² per cycle, growing with "
+        "frequency; acts through the velocity like a delay, Stribeck friction and inertia."
+    )
+    acts_through = "velocity"
+    stage = "additive"
+    rank = 2
+    order = 0
+    size_param = "c"
+
+    def apply(self, F, p, ctx):
+        return F + p["c"] * ctx.pick(ctx.d.ud)
+
+    def argument(self, d, p):
+        v = peak_speed(d)
+        h0 = p.get("h0", np.nan)
+        return (
+            f"c = {p['c']:.3g} N s/m gives {p['c'] * v:.3g} N at the peak speed {v:.3g} m/s "
+            f"({100 * p['c'] * v / h0:.0f} % of h0 = {h0:.4g} N): a force in phase with the "
+            "velocity beside the friction"
+        )

@@ -1,0 +1,604 @@
+"""The moves of the stepwise candidate search: a candidate tried (forward), an effect
+checked for removal (backward), a swap, a pair (moved from :mod:`.workflow`)."""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+from dataclasses import dataclass, field
+from functools import partial
+from typing import Any
+
+import numpy as np
+
+from ..errors import ConvergenceError
+from ._family import Family, Prepared
+from ._parallel import pmap
+from .select import MIN_RELATIVE_GAIN, FitOut, Trial, Verdict, evaluate, fit, judge
+
+#: an effect may refine the base model, not replace it: the base parameters that carry the
+#: joint's physics (tangential h0, the friction force; normal k, the contact stiffness) may
+#: move by at most this fraction from the base fit when an effect is added
+MAX_BASE_SHIFT = 0.3
+_ANCHORS = {"tangential": ("h0",), "normal": ("k",)}
+
+
+def _takes_over(family: Family, base: dict[str, float], p: dict[str, float]) -> str | None:
+    for name in _ANCHORS.get(family.kind, ()):
+        b, v = base[name], p[name]
+        if b > 0 and abs(v / b - 1.0) > MAX_BASE_SHIFT:
+            return (
+                f"it takes over the base model ({name} from {b:.4g} to {v:.4g}): the base "
+                "is in the wrong regime or the effect is not what the data show"
+            )
+    return None
+
+
+def _not_fitted(name: str, exc: Exception) -> Verdict:
+    """The verdict on a candidate whose fit failed: not named, and the reason kept."""
+    return Verdict(name, np.nan, np.nan, np.nan, np.nan, False, f"could not be fitted: {exc}")
+
+
+def _start_new(
+    family: Family, current: Trial, new: tuple[str, ...], d: Prepared
+) -> dict[str, float]:
+    """Starting parameters of the current model with the effects ``new`` added."""
+    start = dict(current.full.params)
+    if hasattr(family, "start_effect"):
+        for e in new:
+            start.update(family.start_effect(e, start, d, -current.full_residual(d)))
+    return start
+
+
+def _try_candidate(
+    name: str,
+    family: Family,
+    current: Trial,
+    effects: tuple[str, ...],
+    d: Prepared,
+    scales: dict[str, float],
+    folds: int,
+    sigma: float,
+    z: float,
+    min_gain: float,
+    budget: float,
+    base_fit: dict[str, float],
+    all_samples: np.ndarray,
+    also: tuple[str, ...] = (),
+    full: FitOut | None = None,
+) -> tuple[Verdict, Trial | None]:
+    """The verdict on adding ``name`` to the current model (and its trial when it was
+    cross-validated); ``also``: effects added together with it (the pair move); ``full``:
+    the candidate model's fit to all data when it is at hand (:func:`_pair_search`)."""
+    trial_effects = (*effects, *also, name)
+    start_c = _start_new(family, current, (*also, name), d)
+    # screening: a candidate whose fit to all data lowers the error by less than
+    # min_gain σ² cannot do better on held-out cycles; no cross-validation for it
+    if full is None:
+        try:
+            full = fit(family, trial_effects, d, all_samples, start_c, scales)
+        except ConvergenceError as exc:  # e.g. a trial stiffness with no equilibrium
+            return _not_fitted(name, exc), None
+    in_gain = (current.full.mse - full.mse) / sigma**2
+    if in_gain < min_gain:
+        reason = f"in-sample gain {in_gain:.3g} σ² below {min_gain:g} σ²"
+        return Verdict(name, np.nan, float(in_gain), np.nan, np.nan, False, reason), None
+    try:
+        cand = evaluate(family, trial_effects, d, start_c, scales, folds, full)
+    except ConvergenceError as exc:
+        return _not_fitted(name, exc), None
+    p = cand.full.params
+    # errors in variables: every candidate must beat what the input's noise alone does to
+    # the weighted error (the budget). A sub-sample delay wins by smoothing the input; a
+    # track-dependent friction by the turning points noisy x pushes outward (at 1 % x noise
+    # position_friction gained 0.08 σ² on clean records against a budget of 0.70 σ²)
+    extra = budget
+    prop = d if getattr(family, "proportional_gain", False) else None
+    v = judge(name, current, cand, sigma, z, min_gain + extra, prop)
+    # every effect of the candidate model, not only the new one: a refit can push an
+    # effect added before to the edge of its physical range
+    why = next(
+        (w for e in trial_effects if (w := family.implausible(e, p, d))), None
+    ) or _takes_over(family, base_fit, p)
+    if v.accepted and why:
+        v = dataclasses.replace(v, accepted=False, reason=f"implausible: {why}")
+    if v.accepted and hasattr(family, "identified"):
+        # each new effect's size must stand out of its own error (issue 29: a held-out gain
+        # the effect shares with a base parameter it trades off with is not its own)
+        unid = next((w for e in (*also, name) if (w := family.identified(e, p, cand.full.stderr))),
+                    None)  # fmt: skip
+        if unid:
+            v = dataclasses.replace(v, accepted=False, reason=unid)
+    return v, cand
+
+
+def _fit_cost(family: Family, name: str) -> int:
+    """Expected work of trying candidate ``name``, for the order the candidates of a step
+    start in on threads (:func:`~contactlab.diagnose._parallel.pmap`; the results do not
+    depend on it): its parameter count (the Jacobian's columns; the candidates with a
+    nonlinear frequency, slip distance or speed carry two or more)."""
+    return len(family.candidates[name].params)
+
+
+#: rounds of the stepwise search (each adds one effect, then drops redundant ones) at most,
+#: per effect the model may hold: room for every addition and as many swaps
+ROUNDS_PER_EFFECT = 2
+
+
+def _drop_check(
+    name: str,
+    family: Family,
+    current: Trial,
+    d: Prepared,
+    scales: dict[str, float],
+    folds: int,
+    sigma: float,
+    z: float,
+    min_gain: float,
+    budget: float,
+) -> tuple[Verdict, Trial | None]:
+    """The verdict on keeping ``name`` in the current model (backward elimination).
+
+    The model without ``name`` is refitted (from the current fit) and cross-validated; then
+    ``name`` is judged as a candidate added back to it by the rules of a forward step
+    (:func:`contactlab.diagnose.select.judge`, with the input-noise budget). Not
+    accepted means the other effects explain what it did: it is dropped. Returns the verdict
+    and the reduced model's trial (None when that could not be fitted: then it is kept).
+    """
+    rest = tuple(e for e in current.effects if e != name)
+    try:
+        reduced = evaluate(family, rest, d, current.full.params, scales, folds)
+    except ConvergenceError as exc:
+        return _not_fitted(name, exc), None
+    extra = budget  # the forward rule's input-noise floor (_try_candidate)
+    prop = d if getattr(family, "proportional_gain", False) else None
+    return judge(name, reduced, current, sigma, z, min_gain + extra, prop), reduced
+
+
+#: the swap move's threshold on the t statistic of the per-cycle gain (see _swap_search)
+SWAP_Z = 0.0
+
+
+def _swap_search(
+    family: Family,
+    names: list[str],
+    current: Trial,
+    named: tuple[str, ...],
+    visited: set[frozenset[str]],
+    d: Prepared,
+    scales: dict[str, float],
+    folds: int,
+    sigma: float,
+    min_gain: float,
+    budget: float,
+    base_fit: dict[str, float],
+    all_samples: np.ndarray,
+) -> tuple[tuple[str, Verdict, Trial] | None, list[Verdict], int]:
+    """The swap move: every effect ``named`` by this diagnosis replaced by every candidate
+    not in the model.
+
+    Each swapped model is judged against the current one by the rules of a forward step
+    (:func:`_try_candidate` with the effect taken out: the in-sample screening, the held-out
+    gain of at least ``min_gain`` σ² and :data:`~contactlab.diagnose.select.MIN_RELATIVE_GAIN`
+    of the current error, the BIC, plausibility), except that the gain across held-out
+    cycles need only be positive on average (``t > SWAP_Z``), not significant: a swap does
+    not make the model larger, it picks the better of two of the same size. Returns the
+    best accepted swap ``(effect out, verdict on the one in, its trial)`` or None, every
+    verdict (named ``"out ⇄ in"``), and the model evaluations spent.
+    """
+    spent = d.extra["evaluations"]
+    effects = current.effects
+    pairs = [
+        (out, name)
+        for out in named
+        for name in names
+        if name not in effects
+        and family.check(rest := (*(e for e in effects if e != out), name))
+        and frozenset(rest) not in visited
+    ]
+
+    def one(pair: tuple[str, str]) -> tuple[Verdict, Trial | None]:
+        out, name = pair
+        rest = tuple(e for e in effects if e != out)
+        return _try_candidate(
+            name, family, current, rest, d, scales, folds, sigma, SWAP_Z, min_gain, budget,
+            base_fit, all_samples,
+        )  # fmt: skip
+
+    before = spent.total
+    results = pmap(one, pairs, cost=lambda pair: _fit_cost(family, pair[1]))
+    verdicts, best = [], None
+    for (out, _), (v, cand) in zip(pairs, results, strict=True):
+        verdicts.append(dataclasses.replace(v, name=f"{out} ⇄ {v.name}"))
+        if cand is not None and v.accepted and (best is None or v.gain > best[1].gain):
+            best = (out, v, cand)
+    return best, verdicts, spent.total - before
+
+
+#: the pair move (families with ``pair_move``: tangential; a normal joint's fits integrate
+#: an ODE, and its library combines few effects) tries pairs among this many candidates not
+#: in the model, those with the largest gains seen at any step of the search (_pair_search)
+PAIR_POOL = 6
+#: ... when a single candidate at the current step lowered the error by at least this many
+#: σ² (held out, or in its fit to all data) but was not accepted; below it, nothing is left
+#: that two effects could share. Far from the noise (a real loop the library cannot
+#: follow, 66 σ after the search) the bar is MIN_RELATIVE_GAIN of the current error
+#: instead: a few σ² there are a sliver of a larger misfit, as for a single effect
+PAIR_GATE = 1.0
+#: ... and cross-validates this many of the pair models, those whose fits to all data
+#: lower the error most
+PAIR_TRIALS = 4
+
+
+def _pair_search(
+    family: Family,
+    pool: list[str],
+    current: Trial,
+    named: tuple[str, ...],
+    max_effects: int,
+    visited: set[frozenset[str]],
+    d: Prepared,
+    scales: dict[str, float],
+    folds: int,
+    sigma: float,
+    z: float,
+    min_gain: float,
+    budget: float,
+    base_fit: dict[str, float],
+    all_samples: np.ndarray,
+) -> tuple[tuple[str | None, tuple[str, str], Verdict, Trial] | None, list[Verdict], int]:
+    """The pair move: two candidates added at once, to the current model or in place of
+    one effect ``named`` by this diagnosis.
+
+    Greedy steps add the one candidate that helps most alone. Two effects can each be weak
+    or misleading alone and plain together: a force offset and a force drift (a ramp that
+    starts at 0 needs the offset to centre it), or a channel delay and a breakaway after
+    each reversal (each alone is mimicked by a branch scale, which a greedy step then
+    names). Every pair ``{a, b}`` of ``pool`` (the candidates with the largest gains seen
+    so far) gives the models ``current + a + b`` and ``current - out + a + b``; each is
+    fitted to all data, and the :data:`PAIR_TRIALS` that lower the error most are judged
+    against the current model by the rules of a forward step (:func:`_try_candidate`:
+    significance ``t > z``, the gain thresholds, the BIC, plausibility of every effect).
+    Since a pair is two claims, each of ``a`` and ``b`` must also pass those rules added
+    back to the pair model without it (:func:`_drop_check`): each is needed beside the
+    other. Returns the best accepted move ``(effect out or None, (a, b), verdict, trial)``
+    or None, the verdicts on the pair models judged (named ``"a + b"`` or
+    ``"out ⇄ a + b"``), and the model evaluations spent.
+    """
+    spent = d.extra["evaluations"]
+    effects = current.effects
+    moves: list[tuple[str | None, tuple[str, str]]] = []
+    # added to the model while there is room (an effect the pair makes redundant is then
+    # dropped by the backward step), else in place of one named effect
+    outs = [None] if len(named) + 2 <= max_effects else list(named)
+    for out in outs:
+        rest = tuple(e for e in effects if e != out)
+        for a, b in itertools.combinations(pool, 2):
+            if family.check((*rest, a, b)) and frozenset((*rest, a, b)) not in visited:
+                moves.append((out, (a, b)))
+
+    def rest_of(move: tuple[str | None, tuple[str, str]]) -> tuple[str, ...]:
+        return tuple(e for e in effects if e != move[0])
+
+    def full_fit(move: tuple[str | None, tuple[str, str]]) -> FitOut | None:
+        start = _start_new(family, current, move[1], d)
+        try:
+            return fit(family, (*rest_of(move), *move[1]), d, all_samples, start, scales)
+        except ConvergenceError:
+            return None
+
+    def judged(
+        item: tuple[tuple[str | None, tuple[str, str]], FitOut],
+    ) -> tuple[Verdict, Trial | None]:
+        move, full = item
+        (a, b), rest = move[1], rest_of(move)
+        v, cand = _try_candidate(
+            b, family, current, rest, d, scales, folds, sigma, z, min_gain, budget,
+            base_fit, all_samples, also=(a,), full=full,
+        )  # fmt: skip
+        if cand is None or not v.accepted:
+            return v, cand
+        for e in (a, b):  # each is needed beside the other
+            w, _ = _drop_check(e, family, cand, d, scales, folds, sigma, z, min_gain, budget)
+            if not w.accepted:
+                why = f"{e} not needed beside the other: {w.reason}"
+                return dataclasses.replace(v, accepted=False, reason=why), cand
+        return v, cand
+
+    before = spent.total
+    fits = pmap(full_fit, moves)
+    ranked = sorted(
+        ((m, f) for m, f in zip(moves, fits, strict=True) if f is not None),
+        key=lambda mf: mf[1].mse,
+    )[:PAIR_TRIALS]
+    results = pmap(judged, ranked)
+    verdicts, best = [], None
+    for ((out, pair), _), (v, cand) in zip(ranked, results, strict=True):
+        label = " + ".join(pair) if out is None else f"{out} ⇄ {' + '.join(pair)}"
+        verdicts.append(dataclasses.replace(v, name=label))
+        if cand is not None and v.accepted and (best is None or v.gain > best[2].gain):
+            best = (out, pair, v, cand)
+    return best, verdicts, spent.total - before
+
+
+#: Model evaluations (residual calls of every fit, numerical Jacobians included) a diagnosis
+#: may spend (the workflow's ``MAX_EVALUATIONS``, which the search reads at run time)
+def _max_evaluations() -> int:
+    from . import workflow
+
+    return int(workflow.MAX_EVALUATIONS)
+
+
+@dataclass
+class SearchState:
+    """Where the stepwise search stands: the current model's trial, the effects named by this
+    diagnosis (``added``), the effect sets reached, the steps and sentences so far, the
+    candidates' largest gains (the pair move's pool) and the evaluations spent."""
+
+    current: Trial
+    steps: list[Any]
+    where: list[str]
+    trials: list[Trial]
+    added: list[str] = field(default_factory=list)
+    visited: set[frozenset[str]] = field(default_factory=set)
+    seen: dict[str, float] = field(default_factory=dict)
+    untested: list[str] = field(default_factory=list)
+    used: int = 0
+
+    @property
+    def effects(self) -> tuple[str, ...]:
+        return self.current.effects
+
+
+@dataclass
+class StepwiseSearch:
+    """The stepwise search of :func:`contactlab.diagnose.diagnose` (see its module
+    docstring): forward steps, swaps, pairs and backward elimination, until no move passes;
+    then the parsimony rule for effects acting through one signal (:meth:`parsimony`)."""
+
+    family: Family
+    names: list[str]
+    d: Prepared
+    scales: dict[str, float]
+    folds: int
+    sigma: float
+    z: float
+    min_gain: float
+    budget: float
+    base_fit: dict[str, float]
+    max_effects: int
+    make_step: Any  # workflow.Step
+
+    def __post_init__(self) -> None:
+        self.all_samples = np.ones(self.d.y.size, bool)
+        self.spent = self.d.extra["evaluations"]
+
+    def _rules(self) -> dict[str, Any]:
+        return {
+            "d": self.d, "scales": self.scales, "folds": self.folds, "sigma": self.sigma,
+            "min_gain": self.min_gain, "budget": self.budget,
+        }  # fmt: skip
+
+    def run(self, st: SearchState) -> SearchState:
+        st.visited.add(frozenset(st.effects))
+        for _round in range(ROUNDS_PER_EFFECT * self.max_effects + 1):
+            verdicts, best = self.forward(st)
+            moved = False
+            if best is None:
+                moved = self.swap(st)
+            if best is None and not moved:
+                if not self.pair(st, verdicts):
+                    break
+            if best is not None:
+                v, st.current = best
+                st.added.append(v.name)
+                st.trials.append(st.current)
+                st.steps.append(self.make_step(v.name, *self._errors(st.current)))
+                st.visited.add(frozenset(st.effects))
+            self.backward(st)
+        if st.untested:
+            st.where.append(
+                f"the candidate search stopped after {st.used} model evaluations (its budget "
+                f"is {_max_evaluations()}); not tested: {', '.join(dict.fromkeys(st.untested))}"
+            )
+        self.parsimony(st)
+        return st
+
+    @staticmethod
+    def _errors(tr: Trial) -> tuple[float, float, float]:
+        return tr.heldout_rms, tr.heldout_peak, tr.energy_error
+
+    def forward(self, st: SearchState) -> tuple[list[Verdict], tuple[Verdict, Trial] | None]:
+        """Every candidate not in the model tried (in parallel), each verdict in the
+        library's order as a serial run gives it, within the evaluation budget."""
+        limit = _max_evaluations()
+        effects = st.effects
+        tried = [
+            n
+            for n in self.names
+            if len(st.added) < self.max_effects
+            and n not in effects
+            and self.family.check((*effects, n))
+            and frozenset((*effects, n)) not in st.visited
+        ]
+        try_one = partial(
+            _try_candidate, family=self.family, current=st.current, effects=effects, z=self.z,
+            base_fit=self.base_fit, all_samples=self.all_samples, **self._rules(),
+        )  # fmt: skip
+        spent = self.spent
+
+        def counted(name: str) -> tuple[Verdict, Trial | None, int]:
+            before = spent.mine()  # a task runs on one thread: these are its evaluations
+            v, cand = try_one(name)
+            return v, cand, spent.mine() - before
+
+        def unless_spent(name: str) -> tuple[Verdict, Trial | None, int] | None:
+            return None if spent.total >= limit else counted(name)
+
+        # the budget as a serial run spends it: a candidate is tried only while the base and
+        # the candidates before it in the library's order are within it; one a thread found
+        # the budget spent for is run here after all if the serial count says it would be
+        verdicts: list[Verdict] = []
+        best = None
+        outs = pmap(unless_spent, tried, cost=partial(_fit_cost, self.family))
+        for name, out in zip(tried, outs, strict=True):
+            if st.used >= limit:
+                st.untested.append(name)
+                why = f"not tested: the budget of {limit} model evaluations is spent"
+                verdicts.append(Verdict(name, np.nan, np.nan, np.nan, np.nan, False, why))
+                continue
+            v, cand, n = out if out is not None else counted(name)
+            st.used += n
+            verdicts.append(v)
+            if cand is not None and v.accepted and (best is None or v.gain > best[0].gain):
+                best = (v, cand)
+        if verdicts:
+            st.steps[-1] = dataclasses.replace(
+                st.steps[-1], candidates=tuple(sorted(verdicts, key=lambda v: v.heldout_rms))
+            )
+        for v in verdicts:  # the pair move's pool: the largest gains seen at any step
+            if np.isfinite(v.gain):
+                st.seen[v.name] = max(st.seen.get(v.name, -np.inf), v.gain)
+        return verdicts, best
+
+    def swap(self, st: SearchState) -> bool:
+        """No effect can be added: an effect named early may stand in for one never tried
+        because the set filled up. True when a swap was made."""
+        if not (st.added and st.used < _max_evaluations()):
+            return False
+        if len(st.added) < min(2, self.max_effects):
+            return False
+        swap, verdicts, n = _swap_search(
+            self.family, self.names, st.current, tuple(st.added), st.visited, self.d,
+            self.scales, self.folds, self.sigma, self.min_gain, self.budget, self.base_fit,
+            self.all_samples,
+        )  # fmt: skip
+        st.used += n
+        if verdicts:
+            st.steps[-1] = dataclasses.replace(
+                st.steps[-1], candidates=st.steps[-1].candidates + tuple(verdicts)
+            )
+        if swap is None:
+            return False
+        out, v, st.current = swap
+        st.added[st.added.index(out)] = v.name
+        st.trials.append(st.current)
+        st.visited.add(frozenset(st.effects))
+        st.steps.append(self.make_step(v.name, *self._errors(st.current), removed=out, removal=v))
+        st.where.append(
+            f"swap: {out} replaced by {v.name} (the model with {v.name} instead predicts the "
+            f"held-out cycles better: gain {v.gain:.3g} σ², t = {v.t_stat:.2f})"
+        )
+        return True
+
+    def pair(self, st: SearchState, verdicts: list[Verdict]) -> bool:
+        """No single effect can be added or swapped in, yet one lowered the error by a
+        sizeable amount without significance: two together may. True when a pair was
+        added."""
+        pool = [n for n in sorted(st.seen, key=lambda n: -st.seen[n]) if n not in st.effects]
+        gains = [v.gain for v in verdicts if np.isfinite(v.gain)]
+        gate = max(PAIR_GATE, MIN_RELATIVE_GAIN * st.current.heldout_mse / self.sigma**2)
+        if not (
+            getattr(self.family, "pair_move", False)
+            and max(gains, default=0.0) >= gate
+            and st.used < _max_evaluations()
+            and len(pool) > 1
+        ):
+            return False
+        pair, pair_verdicts, n_pair = _pair_search(
+            self.family, pool[:PAIR_POOL], st.current, tuple(st.added), self.max_effects,
+            st.visited, self.d, self.scales, self.folds, self.sigma, self.z, self.min_gain,
+            self.budget, self.base_fit, self.all_samples,
+        )  # fmt: skip
+        st.used += n_pair
+        if pair_verdicts:
+            st.steps[-1] = dataclasses.replace(
+                st.steps[-1], candidates=st.steps[-1].candidates + tuple(pair_verdicts)
+            )
+        if pair is None:
+            return False
+        gone, (a, b), v, st.current = pair
+        if gone is not None:
+            st.added.remove(gone)
+        st.added += [a, b]
+        st.trials.append(st.current)
+        st.visited.add(frozenset(st.effects))
+        st.steps.append(
+            self.make_step(f"{a} + {b}", *self._errors(st.current), removed=gone,
+                           removal=v if gone else None)
+        )  # fmt: skip
+        st.where.append(
+            f"pair: {a} and {b} added together{f' in place of {gone}' if gone else ''} "
+            f"(neither was accepted alone; together they predict the held-out cycles better: "
+            f"gain {v.gain:.3g} σ², t = {v.t_stat:.2f}, and each is needed beside the other)"
+        )
+        return True
+
+    def backward(self, st: SearchState) -> None:
+        """Backward elimination (after an addition or a swap): an effect named early may be
+        redundant once later ones are in."""
+        while len(st.added) >= 2 and st.used < _max_evaluations():
+            back = partial(
+                _drop_check, family=self.family, current=st.current, z=self.z, **self._rules()
+            )
+            before = self.spent.total
+            checks = pmap(back, list(st.added))
+            st.used += self.spent.total - before
+            drop = [(v, r) for v, r in checks if r is not None and not v.accepted]
+            if not drop:
+                break
+            v, st.current = min(drop, key=lambda vr: vr[0].gain)
+            self._drop(st, v, "backward step", "refitted without it, the other effects leave it "
+                       f"nothing to add: {v.reason}")  # fmt: skip
+
+    def _drop(self, st: SearchState, v: Verdict, what: str, why: str) -> None:
+        st.added.remove(v.name)
+        st.trials.append(st.current)
+        st.visited.add(frozenset(st.effects))
+        st.steps.append(self.make_step(None, *self._errors(st.current), removed=v.name, removal=v))
+        st.where.append(f"{what}: {v.name} dropped ({why})")
+
+    def parsimony(self, st: SearchState) -> None:
+        """Effects that act through the same signal (``acts_through``: the velocity for a
+        delay, viscous damping, Stribeck friction, inertia, pre-sliding damping) are named
+        together only when each is separately significant after the others at
+        :data:`PARSIMONY_Z` times the search's threshold (each one's gain, refitted without
+        it, must stand on its own, not on a misfit the others share). The weakest is
+        dropped until that holds; a sentence says which and why."""
+        from .effects import registry
+
+        reg = registry(self.family.kind)
+        while st.used < _max_evaluations():
+            groups: dict[str, list[str]] = {}
+            for e in st.added:
+                g = reg[e].acts_through if e in reg else None
+                if g:
+                    groups.setdefault(g, []).append(e)
+            shared = [(g, es) for g, es in groups.items() if len(es) >= 2]
+            if not shared:
+                return
+            group, members = shared[0]
+            back = partial(
+                _drop_check, family=self.family, current=st.current, z=PARSIMONY_Z * self.z,
+                **self._rules(),
+            )  # fmt: skip
+            before = self.spent.total
+            checks = pmap(back, members)
+            st.used += self.spent.total - before
+            weak = [(v, r) for v, r in checks if r is not None and not v.accepted]
+            if not weak:
+                st.where.append(
+                    f"{' and '.join(members)} all act through the {group}; each is "
+                    f"significant after the other{'s' if len(members) > 2 else ''} "
+                    f"(t = {', '.join(f'{v.t_stat:.1f}' for v, _ in checks)}, threshold "
+                    f"{PARSIMONY_Z * self.z:g}): named together"
+                )
+                return
+            v, st.current = min(weak, key=lambda vr: vr[0].gain)
+            others = ", ".join(m for m in members if m != v.name)
+            self._drop(st, v, "parsimony", f"it acts through the {group} as {others} does, and "
+                       f"is not separately significant after it: {v.reason}")  # fmt: skip
+
+
+#: the parsimony rule's threshold on the t statistic, in units of the search's ``z``
+PARSIMONY_Z = 1.5
