@@ -126,17 +126,17 @@ def run_one(job: tuple[str, int, str]) -> dict[str, Any]:
             flagged=bool(u is not None and u.flagged),
             misfit_p=None if u is None else u.p_value,
             # T over its threshold (before the calibration factor): the null's quantiles
-            misfit_ratio=None if u is None else u.statistic / u.threshold * _calibration(),
+            misfit_ratio=None if u is None else u.statistic / u.threshold * _calibration(u),
             misfit_cycles=None if u is None else u.cycles,
         )
     out["cpu"] = time.process_time() - t0
     return out
 
 
-def _calibration() -> float:
-    from contactlab.diagnose.misfit import CALIBRATION
+def _calibration(u: Any) -> float:
+    from contactlab.diagnose.misfit import CALIBRATION, POOL_BELOW, POOLED_CALIBRATION
 
-    return CALIBRATION
+    return POOLED_CALIBRATION if u.cycles < POOL_BELOW else CALIBRATION
 
 
 def calibration_table(results: list[dict[str, Any]]) -> str:

@@ -463,6 +463,9 @@ def stated_power(report: Any, *, seed: int = 0) -> list[Detectable]:
     list of Detectable
         In the library's order; empty when the report does not carry its data.
     """
+    kept = getattr(report, "not_detected", None)
+    if kept and seed == 0:  # stated by the diagnosis itself, with the same settings and seed
+        return list(kept)
     d = report.prepared
     if d is None or not report.trials:
         return []
