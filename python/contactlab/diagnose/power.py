@@ -108,7 +108,7 @@ class Detectable:
             "parameter": self.parameter,
             "detectable_above": self.detectable_above,
             "unit": self.unit,
-            "null": self.null,
+            "null": self.null if np.isfinite(self.null) else None,
             "relative_size": self.relative_size,
             "power": POWER,
             "at": dict(self.at),
@@ -400,6 +400,15 @@ def detectable_above(
         if np.isfinite(s.null):
             p0[s.name] = s.null
     trial = (*effects, name)
+    if not any(np.isfinite(s.null) for s in cand.params):
+        first = cand.params[0]
+        return Detectable(
+            name, first.name, None, first.unit, float("nan"), None, shape,
+            reason=(
+                "no parameter value means absent (the effect replaces the element's shape, "
+                "not a size away from a null): no bound to state"
+            ),
+        )  # fmt: skip
     if not family.check(trial):
         return Detectable(
             name, cand.params[0].name, None, cand.params[0].unit,
