@@ -55,6 +55,7 @@ __all__ = [
     "ChannelNoise",
     "channel_noise",
     "effective_variance",
+    "model_slope",
 ]
 
 #: the per-record false-alarm rate the naming rules are calibrated to stay below, and the
@@ -203,6 +204,18 @@ def effective_variance(
     return sy2 + (np.asarray(slope, float) * su) ** 2
 
 
+def model_slope(family: Any, params: dict[str, float], d: Prepared) -> np.ndarray | None:
+    """The model's local slope ``|dy/du|`` per sample, through which the input's noise
+    reaches the output: the family's own (``Family.slope``: a Masing element's, steep after
+    each reversal), else for a model with a stiffness ``k`` (normal contact) its static
+    compliance ``1/k`` (a Kelvin-Voigt element passes slow input noise at that gain); None
+    when neither is known."""
+    s = family.slope(params, d) if hasattr(family, "slope") else None
+    if s is None and params.get("k", 0.0) > 0:
+        s = np.full(d.y.size, 1.0 / float(params["k"]))
+    return s
+
+
 def assess(
     family: Any,
     d: Prepared,
@@ -224,37 +237,18 @@ def assess(
     settings they were computed at (``z``, ``gain_floor``, ``folds``, ``candidates``).
     """
     from .misfit import eiv_tolerance, unexplained_structure
-    from .power import POWER, _setting, detectable_above
+    from .power import POWER, _setting, bounds_for
 
     params = dict(current.full.params)
     effects = tuple(current.effects)
     residual = -current.full_residual(d)  # measured minus model
-    slope = family.slope(params, d) if hasattr(family, "slope") else None
+    slope = model_slope(family, params, d)
     noise = channel_noise(
         d, residual, declared_output=declared_output, slope=slope,
         input_unit=family.input_unit, output_unit=family.output_unit,
     )  # fmt: skip
     st = _setting(d, current, noise, slope, sigma, z, gain_floor, folds, seed)
-    bounds = []
-    for n in candidates:
-        if n in effects or n not in family.candidates:
-            continue
-        bounds.append(
-            detectable_above(
-                family,
-                params,
-                effects,
-                n,
-                d,
-                noise=noise,
-                sigma=sigma,
-                z=z,
-                gain_floor=st.gain_floor,
-                current=current,
-                folds=folds,
-                _setting_cache=st,
-            )
-        )
+    bounds = bounds_for(family, params, effects, candidates, d, noise, sigma, current, st)
     misfit = unexplained_structure(
         d, residual, sigma, unit=family.output_unit,
         tolerance=eiv_tolerance(slope, noise.input_seen),
