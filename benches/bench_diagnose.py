@@ -111,8 +111,8 @@ _GEN_BLOCK = 1.0 + 1.0 / 1.7 + 1.0 / 0.6
 
 def generator_kinds(spec: str) -> list[str]:
     """``t:all`` / ``n:all`` expanded to every effect of that library (and ``:none``)."""
-    from contactlab.diagnose.generator import TANGENTIAL_EFFECTS
-    from contactlab.diagnose.generator_normal import NORMAL_EFFECTS
+    from contactlab.synthetic.diagnosis import TANGENTIAL_EFFECTS
+    from contactlab.synthetic.diagnosis_normal import NORMAL_EFFECTS
 
     lib = {"t": TANGENTIAL_EFFECTS, "n": NORMAL_EFFECTS}[spec[0]]
     return [f"{spec[0]}:none"] + [f"{spec[0]}:{e}" for e in lib]
@@ -120,8 +120,8 @@ def generator_kinds(spec: str) -> list[str]:
 
 def write_generated(path: Path, kind: str, n: int, seed: int) -> None:
     """A hidden-effect generator recording (``t:NAME`` / ``n:NAME``) of about ``n`` samples."""
-    from contactlab.diagnose import hidden_effect_recording
     from contactlab.io import write_recording
+    from contactlab.synthetic.diagnosis import hidden_effect_recording
 
     model = {"t": "tangential", "n": "normal"}[kind[0]]
     effect = kind[2:]

@@ -203,7 +203,7 @@ def many_recordings(tmp: Path, n_files: int, workers: int, repeat: int, mix: int
 
     from contactlab.io import write_recording
     from contactlab.studies import run_study
-    from contactlab.tangential import synthetic_recording
+    from contactlab.synthetic.tangential import synthetic_recording
 
     files = []
     for i in range(n_files):

@@ -76,10 +76,10 @@ QUICK = {
 
 def effects_of(model: str) -> tuple[str, ...]:
     if model == "tangential":
-        from contactlab.diagnose.generator import TANGENTIAL_EFFECTS
+        from contactlab.synthetic.diagnosis import TANGENTIAL_EFFECTS
 
         return TANGENTIAL_EFFECTS
-    from contactlab.diagnose.generator_normal import NORMAL_EFFECTS
+    from contactlab.synthetic.diagnosis_normal import NORMAL_EFFECTS
 
     return NORMAL_EFFECTS
 
@@ -118,9 +118,10 @@ def oracle_gain(job: dict[str, Any], rec: Any, effect: str) -> float:
     (:func:`_second_order_gain`). Below :data:`MIN_GAIN` the effect is below detectability:
     no held-out rule at that threshold can name it, whatever the method.
     """
-    from contactlab.diagnose import hidden_effect_recording, select
+    from contactlab.diagnose import select
     from contactlab.diagnose._family import Prepared
     from contactlab.diagnose.candidates_normal import NormalFamily
+    from contactlab.synthetic.diagnosis import hidden_effect_recording
 
     cond = job["cond"]
     kw = {k: v for k, v in cond.items() if k not in ("magnitude", "noise", "input_noise", "bits")}
@@ -161,7 +162,7 @@ def _second_order_gain(job: dict[str, Any], rec: Any) -> float:
 
 def run_case(job: dict[str, Any]) -> dict[str, Any]:
     import contactlab
-    from contactlab.diagnose import hidden_effect_recording
+    from contactlab.synthetic.diagnosis import hidden_effect_recording
 
     model, effects, cond, seed = job["model"], job["effects"], job["cond"], job["seed"]
     kw = {k: v for k, v in cond.items() if k != "magnitude"}

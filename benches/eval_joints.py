@@ -27,7 +27,9 @@ import argparse
 import math
 import sys
 import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -40,15 +42,15 @@ DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 FRICTION_LAWS = [
     "jenkins",
     "iwan",
-    "segalman",
-    "maxwell_slip",
     "dahl",
     "lugre",
-    "bouc_wen",
-    "masing",
-    "gms",
     "backlash:jenkins",
+    "segalman",
+    "masing",
+    "bouc_wen",
+    "maxwell_slip",
     "backlash:dahl",
+    "gms",
 ]
 
 
@@ -70,7 +72,29 @@ def _row(name: str, r: dict) -> str:
             f"{num('trac', '8.4f')} {num('energy_error', '+9.4f')}")  # fmt: skip
 
 
-def friction(max_samples: int) -> None:
+_RECS: list[JointRecord] = []
+
+
+def _fold(law: str, k: int, max_samples: int) -> tuple[str, Any, str, float]:
+    """One fold of the cross-validation (in a worker process): fit on every harmonic test
+    but test k, predict test k. Returns (name, prediction or None, message, CPU s)."""
+    if not _RECS:
+        _RECS.extend(_fd_records(DATA / "friction_damper"))
+    t0 = time.process_time()
+    held = _RECS[k]
+    train = [r for j, r in enumerate(_RECS) if j != k]
+    name, _, extra = law.partition("+")  # "dahl+cm": with a parallel damping and inertia
+    try:
+        f = fit(train, law=name, offset=True, asymmetry=True, damping="c" in extra,
+                mass="m" in extra, max_samples=max_samples)  # fmt: skip
+        pred = f.force(held.t, held.x)
+        msg = "" if f.success else f.message
+    except ContactLabError as exc:
+        pred, msg = None, str(exc)
+    return held.name, pred, msg, time.process_time() - t0
+
+
+def friction(max_samples: int, jobs: int = 1, laws: list[str] | None = None) -> None:
     folder = DATA / "friction_damper"
     if not folder.is_dir():
         print("friction damper: ../shared/data/friction_damper absent, skipped")
@@ -83,28 +107,30 @@ def friction(max_samples: int) -> None:
     print("=== friction damper: leave-one-test-out cross-validation over the 13 harmonic tests")
     print(f"    (each fold fitted on 12 tests, laws driven with ~{max_samples} samples; "
           "scores on every sample of the held-out test)")  # fmt: skip
-    cv_pred: dict[str, dict[str, np.ndarray]] = {}
-    cv_time: dict[str, float] = {}
     failed: dict[str, list[str]] = {}
-    for law in FRICTION_LAWS:
-        t0 = time.process_time()
-        preds = {}
-        for k, held in enumerate(recs):
-            train = [r for j, r in enumerate(recs) if j != k]
-            try:
-                f = fit(train, law=law, offset=True, asymmetry=True, max_samples=max_samples)
-                preds[held.name] = f.force(held.t, held.x)
-                if not f.success:
-                    failed.setdefault(law, []).append(f"{held.name}: {f.message}")
-            except ContactLabError as exc:
-                failed.setdefault(law, []).append(f"{held.name}: {exc}")
-        cv_time[law] = time.process_time() - t0
-        cv_pred[law] = preds
-        if len(preds) == len(recs):
-            row = compare({law: preds}, recs).pooled(law)
-            print(_row(law, row) + f"   ({cv_time[law]:.0f} CPU s)", flush=True)
-        else:
-            print(f"{law:<18} failed on {len(recs) - len(preds)} folds", flush=True)
+    laws = laws or FRICTION_LAWS
+    cv_pred: dict[str, dict[str, np.ndarray]] = {law: {} for law in laws}
+    cv_time: dict[str, float] = dict.fromkeys(laws, 0.0)
+    tasks = [(law, k) for law in laws for k in range(len(recs))]
+    done = dict.fromkeys(laws, 0)
+    with ProcessPoolExecutor(jobs) as ex:
+        futs = {ex.submit(_fold, law, k, max_samples): (law, k) for law, k in tasks}
+        for fut in as_completed(futs):
+            law, _ = futs[fut]
+            name, pred, msg, cpu = fut.result()
+            cv_time[law] += cpu
+            done[law] += 1
+            if pred is not None:
+                cv_pred[law][name] = pred
+            if msg:
+                failed.setdefault(law, []).append(f"{name}: {msg}")
+            if done[law] == len(recs):
+                if len(cv_pred[law]) == len(recs):
+                    row = compare({law: cv_pred[law]}, recs).pooled(law)
+                    print(_row(law, row) + f"   ({cv_time[law]:.0f} CPU s)", flush=True)
+                else:
+                    print(f"{law:<18} failed on {len(recs) - len(cv_pred[law])} folds",
+                          flush=True)  # fmt: skip
     base = compare({"LuGre (authors)": lugre}, recs)
     print(_row("LuGre (authors)", base.pooled("LuGre (authors)")) + "   (published baseline)")
     complete = {k: v for k, v in cv_pred.items() if len(v) == len(recs)}
@@ -124,7 +150,9 @@ def friction(max_samples: int) -> None:
     print(f"{'pooled':<8} {a['snr_db']:24.2f} {b['snr_db']:10.2f} {a['nrmse']:24.4f} "
           f"{b['nrmse']:12.4f}")  # fmt: skip
     print(f"held-out gain over LuGre: {a['snr_db'] - b['snr_db']:+.2f} dB")
-    final = fit(recs, law=best, offset=True, asymmetry=True, max_samples=max_samples)
+    name, _, extra = best.partition("+")
+    final = fit(recs, law=name, offset=True, asymmetry=True, damping="c" in extra,
+                mass="m" in extra, max_samples=max_samples)  # fmt: skip
     print(f"\n{best} fitted on all 13 harmonic tests (the model for other records):")
     print(final.report())
     quakes = sorted(folder.glob("*earthquake*"))
@@ -247,8 +275,10 @@ def tribo() -> None:
     ex = excursions(x, 0.5 * (lo + hi), 0.25 * (hi - lo))
     peaks = np.asarray(ex.extreme[ex.sign > 0], dtype=np.int64)
     print(f"\n=== micro-tribometer: {rec.n} samples under load, {peaks.size} stroke maxima")
-    first_rev = int(ex.extreme[0])  # the end of the virgin loading
-    mid = int(peaks[min(25, peaks.size - 1)])  # the end of cycle 25 (maximum to maximum)
+    # the stage rests at its lower end when the load comes on, then strokes up: the virgin
+    # loading ends at the first maximum; cycles run from maximum to maximum
+    first_rev = int(peaks[0])
+    mid = int(peaks[min(25, peaks.size - 1)])  # the end of cycle 25
     train = np.zeros(rec.n, bool)
     train[first_rev:mid] = True
     test = np.zeros(rec.n, bool)
@@ -256,7 +286,7 @@ def tribo() -> None:
     virgin = np.zeros(rec.n, bool)
     virgin[:first_rev] = True
     fit_rec = JointRecord(rec.t, rec.x, rec.F, "cycles 1-25", train)
-    print(f"fit window: samples {first_rev}-{mid} (cycles 1-25 after the virgin loading); "
+    print(f"fit window: samples {first_rev}-{mid} (the 25 cycles after the virgin loading); "
           f"test: the {rec.n - mid} samples after; virgin curve: the first {first_rev} "
           "samples")  # fmt: skip
     print(f"{'law':<14} {'NRMSE last25':>12} {'SNR last25':>10} {'E/cycle err':>11} "
@@ -304,13 +334,16 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--part", default="all", choices=("friction", "beam", "tribo", "speed", "all"))
     ap.add_argument("--max-samples", type=int, default=4000)
+    ap.add_argument("--jobs", type=int, default=2, help="processes of the cross-validation")
+    ap.add_argument("--laws", help="comma-separated laws of the cross-validation (default: all; "
+                    "'<law>+cm' adds a parallel damping and inertia)")  # fmt: skip
     a = ap.parse_args(argv)
     if a.part in ("beam", "all"):
         beam()
     if a.part in ("tribo", "all"):
         tribo()
     if a.part in ("friction", "all"):
-        friction(a.max_samples)
+        friction(a.max_samples, a.jobs, a.laws.split(",") if a.laws else None)
     if a.part in ("speed", "all"):
         speed()
     return 0

@@ -66,7 +66,7 @@ def main() -> None:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
 
-        from contactlab.structure import plot_modal_amplitude_dependence
+        from contactlab.report.structure_plots import plot_modal_amplitude_dependence
 
         fig, ax = plt.subplots(2, 2, figsize=(10, 7))
         for row, joint in enumerate(("jenkins to ground", "masing between")):

@@ -11,8 +11,8 @@
 //! Run: `cargo bench -p contactlab-core --bench reversals` (`-- --n 1048576 --repeat 31`).
 
 use contactlab_core::error::check_finite;
+use contactlab_core::reversal::Schmitt;
 use contactlab_core::select::order_stats;
-use contactlab_core::signal::Schmitt;
 use std::hint::black_box;
 use std::time::Instant;
 

@@ -10,8 +10,9 @@ import pytest
 from contactlab import InputError
 from contactlab.masing import Masing
 from contactlab.normal import loop as nloop
-from contactlab.normal import synthetic_recording as normal_recording
-from contactlab.tangential import analysis, steps, synthetic_recording
+from contactlab.synthetic.normal import synthetic_recording as normal_recording
+from contactlab.synthetic.tangential import synthetic_recording
+from contactlab.tangential import analysis, steps
 from contactlab.tangential.uncertainty import reparametrize
 
 

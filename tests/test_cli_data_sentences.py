@@ -4,8 +4,6 @@ the data (typed error, exit code 1, no traceback, no numpy warning) or an honest
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pytest
 
@@ -30,7 +28,8 @@ TANGENTIAL = {
     "zero_displacement": (np.zeros(T.size), F, "x is zero in all"),
     "huge_force": (X, F * 1e299, "beyond any physical force"),
     "huge_displacement": (X * 1e300, F, "beyond any physical displacement"),
-    "tiny_force": (X, F * 1e-300, "F is zero in all"),
+    "tiny_force": (X, F * 1e-300, "far below any physical force"),
+    "tiny_displacement": (X * 1e-157, F, "far below any physical displacement"),
 }
 NORMAL = {
     "constant_pressure": (np.full(T.size, 0.5e6), D, "p is constant"),
@@ -63,14 +62,13 @@ def test_normal_bad_data_gets_a_sentence(case, tmp_path, capsys):
     assert expected in err and not any(s in err for s in INTERNAL)
 
 
-def test_noise_only_force_is_an_honest_result(tmp_path, capsys):
+def test_noise_only_force_is_refused_with_a_sentence(tmp_path, capsys):
+    """Pure noise on the force (issue 31: it gave "± nan N/m (inf%)" and "ac < inf")."""
     f = np.random.default_rng(3).normal(size=T.size)
     path = _write(tmp_path / "noise.csv", "t [s],x [m],F [N]", X, f)
     out = tmp_path / "o.json"
-    assert main(["analyze", str(path), "--model", "tangential", "--json", str(out)]) == 0
-    d = json.loads(out.read_text())
-    assert d["h0"] is None and d["ac"] is None
-    assert d["identifiable"]["h0_ac"] is False
-    assert "Not even h0·ac is determined" in d["identifiable"]["message"]
+    assert main(["analyze", str(path), "--model", "tangential", "--json", str(out)]) == 1
+    assert not out.exists()
     err = capsys.readouterr().err
-    assert not any(s in err for s in ("Traceback", "RuntimeWarning"))
+    assert "no friction loop in this recording" in err and "not distinguishable from zero" in err
+    assert not any(s in err for s in (*INTERNAL, "nan", "inf"))

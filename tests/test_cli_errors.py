@@ -129,7 +129,7 @@ def test_unnamed_columns_hint_names_the_flags(tmp_path, capsys):
 def test_json_that_is_the_input_is_refused(tmp_path, capsys):
     """`--json` naming the recording itself would replace it with the result."""
     from contactlab.io import write_recording
-    from contactlab.tangential import synthetic_recording
+    from contactlab.synthetic.tangential import synthetic_recording
 
     p = tmp_path / "in.csv"
     write_recording(p, synthetic_recording(h0=40.0, ac=4e4, amplitude=20e-6, n_cycles=6, seed=3))

@@ -141,7 +141,7 @@ def test_output_filter_is_declared_to_the_diagnosis(tmp_path):
     savgol:11`` passes every candidate through the same filter (the API's ``output_filter``)."""
     from scipy.signal import savgol_coeffs, savgol_filter
 
-    from contactlab.diagnose import hidden_effect_recording
+    from contactlab.synthetic.diagnosis import hidden_effect_recording
 
     rec = hidden_effect_recording([], seed=5)
     F = savgol_filter(rec["F"], 11, 2)
@@ -210,7 +210,8 @@ def test_frame_report_of_a_sliding_loop(sim_file, tmp_path):
     import matplotlib
 
     matplotlib.use("Agg")
-    from contactlab.tangential import analyze_tangential, plot_loop
+    from contactlab.report.tangential import plot_loop
+    from contactlab.tangential import analyze_tangential
 
     rec = read_frame(sim_file[0], 3.08, 0.669, 1191.0).recording()
     title = plot_loop(analyze_tangential(rec, warn=False)).get_title()

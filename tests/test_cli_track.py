@@ -16,7 +16,8 @@ import pytest
 import contactlab.studies.tracking as track_mod
 from contactlab.cli import main
 from contactlab.io import write_recording
-from contactlab.tangential import synthetic_recording
+from contactlab.synthetic.normal import synthetic_recording as normal_recording
+from contactlab.synthetic.tangential import synthetic_recording
 
 
 @pytest.fixture(scope="module")
@@ -191,10 +192,9 @@ def test_analyze_stream_agrees_with_whole_file(rec_file, tmp_path):
 
 
 def test_track_normal_recording_cli(tmp_path, capsys):
-    import contactlab.normal as cn
     from contactlab.io import Recording
 
-    t, p, d = cn.synthetic_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=13, seed=5022)
+    t, p, d = normal_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=13, seed=5022)
     f = tmp_path / "C45_p0-0.5MPa_pa-0.4MPa.csv"
     write_recording(f, Recording(t, {"p": p, "delta": d}, {"p": "Pa", "delta": "m"}))
     rep, out = tmp_path / "rep", tmp_path / "o.json"
@@ -262,12 +262,11 @@ def test_long_file_is_streamed_with_the_whole_file_keys(rec_file, tmp_path, monk
 def test_long_normal_file_is_streamed_with_the_whole_file_keys(tmp_path, monkeypatch, capsys):
     """Normal-contact recordings are streamed above the same length as tangential ones,
     with the whole-file document's keys (eq. 16's b1..b4 included) and E_d within errors."""
-    import contactlab.normal as cn
     import contactlab.studies.pooled as pooled
     import contactlab.studies.tracking as tracking
     from contactlab.io import Recording
 
-    t, p, d = cn.synthetic_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=30, seed=5031)
+    t, p, d = normal_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=30, seed=5031)
     f = tmp_path / "C45_p0-0.5MPa_pa-0.4MPa.h5"
     write_recording(f, Recording(t, {"p": p, "delta": d}, {"p": "Pa", "delta": "m"}))
     whole, auto = tmp_path / "w.json", tmp_path / "a.json"
@@ -319,10 +318,9 @@ def test_streamed_normal_dynamic_pressure_uses_p0_pa_like_the_whole_file(tmp_pat
     """A piezo channel (dynamic pressure only, mean zero): ``--stream`` takes ``--p0``/``--pa``
     (or the file-name tags) as the whole-file analysis does (they were ignored: every window
     failed asking for p0)."""
-    import contactlab.normal as cn
     from contactlab.io import Recording
 
-    t, p, d = cn.synthetic_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=24, seed=5041)
+    t, p, d = normal_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=24, seed=5041)
     name = "dyn.h5" if how == "flags" else "C45_p0-0.5MPa_pa-0.4MPa.h5"
     f = tmp_path / name
     write_recording(f, Recording(t, {"p": p - 0.5e6, "delta": d}, {"p": "Pa", "delta": "m"}))
@@ -353,10 +351,9 @@ def test_streamed_normal_dynamic_pressure_uses_p0_pa_like_the_whole_file(tmp_pat
 def test_track_normal_dynamic_pressure_takes_p0_pa_and_tags(tmp_path, how, capsys):
     """``contactlab track`` on a piezo channel (dynamic pressure only) takes ``--p0``/``--pa``
     or the file-name tags as ``analyze`` does (it had neither: every window failed)."""
-    import contactlab.normal as cn
     from contactlab.io import Recording
 
-    t, p, d = cn.synthetic_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=24, seed=5043)
+    t, p, d = normal_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=24, seed=5043)
     name = "dyn.h5" if how == "flags" else "C45_p0-0.5MPa_pa-0.4MPa.h5"
     f = tmp_path / name
     write_recording(f, Recording(t, {"p": p - 0.5e6, "delta": d}, {"p": "Pa", "delta": "m"}))
@@ -373,7 +370,7 @@ def test_track_normal_dynamic_pressure_takes_p0_pa_and_tags(tmp_path, how, capsy
         assert r["psi"] == pytest.approx(w["psi"], rel=0.05)
         assert r["k_tan"] == pytest.approx(w["k_tan"], rel=0.05)
     if how == "flags":  # the flags are for normal contact: refused on a tangential recording
-        from contactlab.tangential import synthetic_recording
+        from contactlab.synthetic.tangential import synthetic_recording
 
         g = tmp_path / "tang.h5"
         write_recording(g, synthetic_recording(h0=40.0, ac=4e4, amplitude=20e-6, n_cycles=12,

@@ -17,8 +17,8 @@ import pytest
 
 import contactlab
 from contactlab import InputError
-from contactlab.diagnose import ExtendedModel, hidden_effect_recording
-from contactlab.diagnose.generator import TANGENTIAL_EFFECTS
+from contactlab.diagnose import ExtendedModel
+from contactlab.synthetic.diagnosis import TANGENTIAL_EFFECTS, hidden_effect_recording
 
 matplotlib.use("Agg")
 
@@ -29,8 +29,17 @@ hidden_effect_recording = functools.partial(hidden_effect_recording, samples_per
 
 def _check_layout(d: dict) -> None:
     # the issue-5 layout; later issues extend it (29: "regime", "h0_check", the effects'
-    # "plausibility", the detection keys), never rename or drop a key
-    assert {"model", "effects", "steps", "where", "noise_rms", "final_model"} <= set(d)
+    # "plausibility"; both channels' noise, the stated power of each candidate not named and
+    # the test of structure left in the residual), never rename or drop a key
+    assert {
+        "model", "effects", "steps", "where", "noise_rms", "final_model", "channel_noise",
+        "not_detected", "unexplained",
+    } <= set(d)  # fmt: skip
+    named = {e["name"] for e in d["effects"]}
+    for b in d["not_detected"]:
+        assert b["effect"] not in named
+        assert {"effect", "parameter", "detectable_above", "unit"} <= set(b)
+    assert isinstance(d["unexplained"]["flagged"], bool)
     assert isinstance(d["model"], str) and isinstance(d["noise_rms"], float)
     for e in d["effects"]:
         assert {"name", "parameters", "stderr"} <= set(e)
@@ -67,8 +76,10 @@ def test_clean_data_names_nothing():
     _check_layout(d)
     assert d["effects"] == [] and len(d["steps"]) == 1
     assert rep.steps[0].heldout_rms <= 1.5 * rep.noise_rms
-    # every candidate was tried and refused, with a reason
-    assert len(rep.steps[0].candidates) == len(TANGENTIAL_EFFECTS)
+    # every candidate of the library was tried and refused, with a reason
+    from contactlab.diagnose.effects import registry
+
+    assert {v.name for v in rep.steps[0].candidates} == set(registry("tangential"))
     assert all(not v.accepted for v in rep.steps[0].candidates)
 
 
@@ -128,7 +139,7 @@ def test_where_statements_point_at_the_effect():
 
 
 def test_callable_package_attribute_and_plain_arrays():
-    import contactlab.diagnose.generator as gen  # the subpackage stays importable
+    import contactlab.synthetic.diagnosis as gen
 
     rec = gen.hidden_effect_recording(["force_offset"], seed=SEED + 5)
     a = contactlab.diagnose(rec.arrays(), model="tangential")
@@ -142,11 +153,21 @@ def test_plots_and_html(tmp_path):
     rep = contactlab.diagnose(rec)
     from matplotlib.figure import Figure
 
-    for fn in (rep.plot_overlay, rep.plot_residual, rep.plot_location, rep.plot_gap):
+    from contactlab.report.diagnosis import write_html
+    from contactlab.report.diagnosis_plots import (
+        plot_gap,
+        plot_location,
+        plot_overlay,
+        plot_residual,
+    )
+
+    for fn in (plot_overlay, plot_residual, plot_location, plot_gap):
         ax = Figure().add_subplot()
-        assert fn(ax=ax) is ax
+        assert fn(rep, ax=ax) is ax
         assert ax.has_data()
-    path = rep.write_html(tmp_path / "out")
+    with pytest.deprecated_call():  # the old method forwards (issue 32)
+        rep.plot_gap(ax=Figure().add_subplot())
+    path = write_html(rep, tmp_path / "out")
     text = path.read_text(encoding="utf-8")
     assert text.count("data:image/png;base64,") == 4
     assert "&quot;viscous_damping&quot;" in text and "Gap shrink" in text
@@ -181,7 +202,7 @@ def test_bad_input_is_named():
     with pytest.raises(InputError, match="unknown tangential candidate"):
         contactlab.diagnose(rec, candidates=["wear"])
     with pytest.raises(InputError, match="channels 'x' and 'F'"):
-        contactlab.diagnose({"t": t, "x": x, "force": F})
+        contactlab.diagnose({"t": t, "x": x, "force": F}, model="tangential")
     n = 260  # two cycles only: nothing to hold out
     with pytest.raises(InputError, match="complete excitation cycles"):
         contactlab.diagnose((t[:n], rec.data["x"][:n], rec.data["F"][:n]))
@@ -222,7 +243,7 @@ def test_unexplained_gap_is_reported_not_hidden():
 
 def test_independent_synthetic_recordings():
     # recordings from contactlab.tangential's own simulator (another route to the data)
-    from contactlab.tangential.synthetic import synthetic_recording
+    from contactlab.synthetic.tangential import synthetic_recording
 
     kw = {"frequency": 5.0, "n_cycles": 16, "fs": 600.0, "noise": 0.01, "seed": SEED % 1000}
     clean = synthetic_recording(50.0, 5e4, 4e-5, **kw)
@@ -309,7 +330,7 @@ def test_cli_diagnose_takes_fs_for_a_file_without_time(tmp_path, capsys):
     np.savetxt(path, np.column_stack([rec["x"], rec["F"]]), delimiter=",", header="x,F",
                comments="", fmt="%.17g")  # fmt: skip
     assert main(["diagnose", str(path), "--model", "tangential"]) == 1
-    assert "fs=" in capsys.readouterr().err
+    assert "--fs" in capsys.readouterr().err
     out = tmp_path / "d.json"
     code = main(["diagnose", str(path), "--model", "tangential", "--fs", repr(fs),
                  "--json", str(out)])  # fmt: skip

@@ -95,7 +95,7 @@ def test_failing_report_leaves_the_previous_json(quick, tmp_path, capsys, monkey
 
 
 def test_interrupt_while_rendering_writes_nothing(quick, tmp_path, capsys, monkeypatch):
-    import contactlab.diagnose._html as html
+    import contactlab.report.diagnosis as html
 
     prev = tmp_path / "prev.json"
     prev.write_text("PREV", encoding="utf-8")
@@ -130,7 +130,7 @@ def test_output_noise_beyond_the_channel_is_refused(recorded, capsys, noise):
     argv = ["diagnose", "--model", "tangential", str(path), "--output-noise", noise]
     assert main(argv) == 1
     line = _one_error_line(capsys)
-    assert str(path) in line and "output_noise" in line and "swing" in line
+    assert str(path) in line and "--output-noise" in line and "swing" in line
 
 
 @pytest.mark.parametrize("noise", ["nan", "inf", "-1", "0"])

@@ -9,7 +9,8 @@ import json
 import numpy as np
 
 import contactlab
-from contactlab.diagnose import candidates_normal, hidden_effect_recording, workflow
+from contactlab.diagnose import candidates_normal, workflow
+from contactlab.synthetic.diagnosis import hidden_effect_recording
 
 
 def test_spent_budget_leaves_candidates_untested_and_says_so(monkeypatch):

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import contactlab
-from contactlab.diagnose import hidden_effect_recording
+from contactlab.synthetic.diagnosis import hidden_effect_recording
 
 
 @pytest.mark.parametrize("seed", [82001, 82002])

@@ -11,12 +11,13 @@ import pytest
 
 import contactlab
 from contactlab.cli import main
-from contactlab.diagnose._inputs import GlitchError, check_glitches
 from contactlab.io import Recording, write_recording
+from contactlab.io.checks import GlitchError, check_glitches
+from contactlab.synthetic.normal import synthetic_recording as normal_recording
 
 
 def _normal(n_glitch: int = 1) -> Recording:
-    t, p, delta = contactlab.normal.synthetic_recording(0.5e6, 0.4e6, 1.0, 5, 400, seed=1)
+    t, p, delta = normal_recording(0.5e6, 0.4e6, 1.0, 5, 400, seed=1)
     delta = delta.copy()
     for k in range(n_glitch):
         delta[1234 + 7 * k] = -2.17
@@ -48,7 +49,7 @@ def test_glitch_cli_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str])
 
 
 def test_tangential_glitch_refused_too() -> None:
-    from contactlab.tangential import synthetic_recording
+    from contactlab.synthetic.tangential import synthetic_recording
 
     rec = synthetic_recording(40.0, 4e4, 20e-6, n_cycles=5, seed=0)
     F = rec["F"].copy()
@@ -87,14 +88,14 @@ def test_track_names_the_glitch_in_its_window(tmp_path: Path, kind: str) -> None
     """``track``: the window holding the glitch fails with the glitch named, its sample
     counted in the file; the other windows are analysed."""
     if kind == "normal":
-        t, p, delta = contactlab.normal.synthetic_recording(0.5e6, 0.4e6, 1.0, 12, 400, seed=3)
+        t, p, delta = normal_recording(0.5e6, 0.4e6, 1.0, 12, 400, seed=3)
         delta = delta.copy()
         i = 2600
         delta[i] = -2.17
         rec = Recording(t, {"p": p, "delta": delta}, {"p": "Pa", "delta": "m"}, "g")
         every, what = "4cycles", "channel 'delta' reads -2.17 m"
     else:
-        from contactlab.tangential import synthetic_recording
+        from contactlab.synthetic.tangential import synthetic_recording
 
         base = synthetic_recording(40.0, 4e4, 20e-6, n_cycles=12, fs=2000.0, seed=4)
         F = base["F"].copy()
@@ -117,7 +118,7 @@ def test_track_names_the_glitch_in_its_window(tmp_path: Path, kind: str) -> None
 def test_glitch_suspect_is_a_safe_prefilter() -> None:
     """The cheap pre-check never misses what the full check finds (random records with 0-3
     glitches of random size and place)."""
-    from contactlab.diagnose._inputs import GLITCH_SCALE, glitch_suspect
+    from contactlab.io.checks import GLITCH_SCALE, glitch_suspect
 
     rng = np.random.default_rng(11)
     for _ in range(300):

@@ -8,10 +8,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from contactlab.diagnose import hidden_effect_recording, select
+from contactlab.diagnose import select
 from contactlab.diagnose._family import Prepared
 from contactlab.diagnose._signal import minimize_bounded
 from contactlab.diagnose.candidates_tangential import TangentialFamily
+from contactlab.synthetic.diagnosis import hidden_effect_recording
 
 
 class _OldPath(TangentialFamily):

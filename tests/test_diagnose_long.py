@@ -23,9 +23,9 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 import contactlab
-from contactlab.diagnose import hidden_effect_recording
 from contactlab.diagnose._signal import find_cycles, shortest_period_samples
 from contactlab.diagnose.workflow import MIN_SAMPLES_PER_CYCLE, reduce_long
+from contactlab.synthetic.diagnosis import hidden_effect_recording
 
 
 def _two_tones(n1: int, n2: int, p1: float, p2: float) -> np.ndarray:

@@ -17,10 +17,10 @@ from hypothesis import strategies as st
 from scipy.signal import savgol_filter
 
 import contactlab
-from contactlab.diagnose import hidden_effect_recording
 from contactlab.diagnose._family import Prepared
 from contactlab.diagnose.candidates_normal import NormalFamily, frequency_domain
-from contactlab.diagnose.generator_normal import NORMAL_EFFECTS
+from contactlab.synthetic.diagnosis import hidden_effect_recording
+from contactlab.synthetic.diagnosis_normal import NORMAL_EFFECTS
 
 matplotlib.use("Agg")
 
@@ -92,9 +92,16 @@ def test_clean_normal_data_names_nothing_and_two_effects_are_found():
     assert isinstance(rep.final_model.base, contactlab.normal.KelvinVoigt)
     from matplotlib.figure import Figure
 
-    for fn in (rep.plot_overlay, rep.plot_residual, rep.plot_location, rep.plot_gap):
+    from contactlab.report.diagnosis_plots import (
+        plot_gap,
+        plot_location,
+        plot_overlay,
+        plot_residual,
+    )
+
+    for fn in (plot_overlay, plot_residual, plot_location, plot_gap):
         ax = Figure().add_subplot()
-        assert fn(ax=ax) is ax
+        assert fn(rep, ax=ax) is ax
     # a model object starts the fit and fixes the frequency at which ψ holds
     kv = contactlab.normal.KelvinVoigt(1.0e12, 0.2, 2 * np.pi * rec.truth["base"]["f0"])
     again = contactlab.diagnose(rec, model=kv)

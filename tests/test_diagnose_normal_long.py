@@ -18,13 +18,13 @@ import numpy as np
 import pytest
 
 import contactlab
-from contactlab.diagnose import hidden_effect_recording
 from contactlab.diagnose import workflow as wf
 from contactlab.diagnose._family import Prepared
 from contactlab.diagnose.candidates_normal import NormalFamily
 from contactlab.diagnose.select import fit
 from contactlab.fitting import Parameter, least_squares_fit
 from contactlab.normal import NonlinearContact
+from contactlab.synthetic.diagnosis import hidden_effect_recording
 
 EFFECTS = (
     None,

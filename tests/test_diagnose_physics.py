@@ -11,8 +11,8 @@ from contactlab import InputError, Masing
 from contactlab.diagnose._family import Prepared
 from contactlab.diagnose._signal import find_cycles, noise_rms, shift
 from contactlab.diagnose.candidates_tangential import TangentialFamily
-from contactlab.diagnose.generator import TANGENTIAL_EFFECTS, hidden_effect_recording
 from contactlab.diagnose.scaled_masing import memory, scaled_force
+from contactlab.synthetic.diagnosis import TANGENTIAL_EFFECTS, hidden_effect_recording
 
 FAM = TangentialFamily()
 

@@ -14,8 +14,9 @@ from hypothesis import strategies as st
 from scipy import ndimage, signal
 
 import contactlab
-from contactlab.diagnose import _filters, hidden_effect_recording
+from contactlab.diagnose import _filters
 from contactlab.diagnose._signal import modulation_gains
+from contactlab.synthetic.diagnosis import hidden_effect_recording
 
 
 def _walk(seed: int, n: int) -> np.ndarray:
@@ -267,7 +268,7 @@ def test_cli_diagnose_imports_no_other_verb():
         "'--model', 'tangential'])\n"
         "import contactlab.diagnose.workflow\n"
         "bad = [m for m in sys.modules if m.startswith(('contactlab.studies', "
-        "'contactlab.report', 'contactlab.tangential', 'contactlab.diagnose.generator', "
+        "'contactlab.report', 'contactlab.tangential', 'contactlab.synthetic', "
         "'matplotlib', 'pyarrow', 'scipy.signal', 'scipy.stats'))]\n"
         "print(bad)\n"
     )

@@ -9,10 +9,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import contactlab
-from contactlab.diagnose import hidden_effect_recording
 from contactlab.diagnose._family import Prepared
 from contactlab.diagnose.candidates_normal import CREEP_MIN_PERIODS, NormalFamily
 from contactlab.diagnose.select import correlation_time, stderr_inflation
+from contactlab.synthetic.diagnosis import hidden_effect_recording
 
 
 def _ar1(phi: float, n: int, rng: np.random.Generator) -> np.ndarray:

@@ -28,6 +28,16 @@ MODULES = sorted(
         "contactlab.normal_study",
         "contactlab.study",
         "contactlab.study_plots",
+        # issue 32: plots and reports moved to contactlab.report
+        "contactlab.diagnose.plots",
+        "contactlab.structure.report",
+        "contactlab.studies.plots",
+        "contactlab.studies.track_plots",
+        "contactlab.tangential.plots",
+        "contactlab.diagnose.generator",
+        "contactlab.diagnose.generator_normal",
+        "contactlab.normal.synthetic",
+        "contactlab.tangential.synthetic",
     }
 )
 

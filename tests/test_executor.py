@@ -13,7 +13,7 @@ import pytest
 from contactlab import InputError
 from contactlab.data import data_dir
 from contactlab.studies import ordered_map, run_study, track_many
-from contactlab.tangential import synthetic_recording
+from contactlab.synthetic.tangential import synthetic_recording
 
 
 def _square(v: int) -> int:

@@ -23,7 +23,9 @@ from contactlab.fem import (
 from contactlab.fem.ccx import parse_dat
 from contactlab.fem.checks import _interaction_lines, _loop_energy, pinned_spring_beam_frequency
 from contactlab.fem.models import Beam, Block, beam_deck, two_block_deck
-from contactlab.tangential import analyze_tangential, synthetic_recording
+from contactlab.synthetic.normal import synthetic_recording as normal_recording
+from contactlab.synthetic.tangential import synthetic_recording
+from contactlab.tangential import analyze_tangential
 
 
 @pytest.fixture(scope="module")
@@ -47,7 +49,7 @@ def tangential_small() -> dict:
 
 @pytest.fixture(scope="module")
 def normal() -> dict:
-    t, p, delta = cn.synthetic_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=4, seed=13)
+    t, p, delta = normal_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=4, seed=13)
     return {**cn.analyze_loop(t, p, delta).to_dict(), "model": "normal", "file": "C45.csv"}
 
 

@@ -15,7 +15,9 @@ import pytest
 import contactlab.normal as cn
 from contactlab.fem.ccx import CCX_PACKAGE, ccx_version, find_ccx
 from contactlab.fem.checks import check_dynamics, check_normal, check_tangential
-from contactlab.tangential import analyze_tangential, synthetic_recording
+from contactlab.synthetic.normal import synthetic_recording as normal_recording
+from contactlab.synthetic.tangential import synthetic_recording
+from contactlab.tangential import analyze_tangential
 
 pytestmark = pytest.mark.skipif(
     find_ccx() is None, reason=f"ccx (CalculiX) not installed: apt-get install {CCX_PACKAGE}"
@@ -36,7 +38,7 @@ def test_ccx_version() -> None:
 
 @pytest.mark.parametrize("seed,p0,pa", [(2102, 0.5e6, 0.4e6), (2103, 1.0e6, 0.5e6)])
 def test_normal_table_and_compliance(seed: int, p0: float, pa: float) -> None:
-    t, p, delta = cn.synthetic_recording(p0=p0, pa=pa, omega=1.0, n_cycles=4, seed=seed)
+    t, p, delta = normal_recording(p0=p0, pa=pa, omega=1.0, n_cycles=4, seed=seed)
     res = {**cn.analyze_loop(t, p, delta).to_dict(), "model": "normal", "file": "sim.csv"}
     chk = check_normal(res)
     print(chk.report())

@@ -16,8 +16,8 @@ from hypothesis import strategies as st
 
 import contactlab
 from contactlab import InputError
-from contactlab.diagnose import hidden_effect_recording
 from contactlab.diagnose.candidates_tangential import TangentialFamily
+from contactlab.synthetic.diagnosis import hidden_effect_recording
 from contactlab.tangential import frame_friction_force
 from contactlab.tangential.frame import force_kernel, savgol_coefficients
 from frame_sim import simulate_frame

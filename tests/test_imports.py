@@ -71,10 +71,10 @@ def test_data_generator_command_still_runs_from_the_data_package():
     )
     assert "usage: python -m contactlab.data.generate" in done.stdout
     assert "--no-normal" in done.stdout
-    from contactlab import _datagen
     from contactlab.data import generate
+    from contactlab.synthetic import bundled
 
-    assert generate.generate is _datagen.generate
+    assert generate.generate is bundled.generate
 
 
 def test_importing_the_data_package_loads_no_model():

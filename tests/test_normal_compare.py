@@ -17,14 +17,16 @@ from contactlab.normal import (
     analyze_loop,
     compare,
     fit_pressure_stiffness,
+)
+from contactlab.normal.compare import measured_velocity
+from contactlab.report.normal import (
     plot_comparison,
     plot_displacement,
     plot_loops,
     plot_phase_portrait,
     plot_velocity,
-    synthetic_recording,
 )
-from contactlab.normal.compare import measured_velocity
+from contactlab.synthetic.normal import synthetic_recording
 
 
 @pytest.fixture(scope="module")

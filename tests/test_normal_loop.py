@@ -10,13 +10,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import contactlab
-from contactlab.normal import (
-    TABLE2_MPA_UM,
-    KelvinVoigt,
-    analyze_loop,
-    synthetic_recording,
-)
-from contactlab.normal._paper import loop_poly_to_si
+from contactlab.normal import TABLE2_MPA_UM, KelvinVoigt, analyze_loop
+from contactlab.normal.paper import loop_poly_to_si
+from contactlab.synthetic.normal import synthetic_recording
 
 P = np.polynomial.polynomial
 

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 import contactlab
-from contactlab.normal import KelvinVoigt, NonlinearContact, OdeResult, table2_model
+from contactlab.normal import KelvinVoigt, NonlinearContact, OdeResult
+from contactlab.synthetic.normal import table2_model
 
 A_T2 = np.array([1.32596e12, 1.59811e18, 2.92127e24, 2.87416e30])  # Table 2 k_s(δ), SI
 
@@ -98,7 +99,8 @@ def test_pressure_law_with_constant_stiffness_equals_kelvin_voigt():
 
 def test_pressure_law_matches_delta_law_on_the_centre_curve():
     # k_s(p) fitted along the Table 2 centre curve reproduces the k_s(δ) model closely.
-    from contactlab.normal import fit_pressure_stiffness, synthetic_recording
+    from contactlab.normal import fit_pressure_stiffness
+    from contactlab.synthetic.normal import synthetic_recording
 
     fit = fit_pressure_stiffness([synthetic_recording(n_cycles=4, noise=None)])
     m_p = fit.model(0.5e6)

@@ -20,7 +20,8 @@ import warnings
 import numpy as np
 import pytest
 
-from contactlab.normal import analyze_loop, synthetic_recording
+from contactlab.normal import analyze_loop
+from contactlab.synthetic.normal import synthetic_recording
 
 SPC = 500  # samples per cycle
 

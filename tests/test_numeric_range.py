@@ -15,7 +15,9 @@ import contactlab.normal as cn
 from contactlab import InputError, Parameter, least_squares_fit
 from contactlab.cli import main
 from contactlab.io import Recording, write_recording
-from contactlab.tangential import analyze_tangential, synthetic_recording
+from contactlab.synthetic.normal import synthetic_recording as normal_recording
+from contactlab.synthetic.tangential import synthetic_recording
+from contactlab.tangential import analyze_tangential
 
 # (force factor, displacement factor): 40 N, 20 µm become 4 nN / 2 nm ... 4 kN / 1 mm
 TANGENTIAL_UNITS = [(1e-10, 1e-4), (1e-5, 1e-2), (1.0, 1.0), (1e2, 50.0)]
@@ -53,7 +55,7 @@ def test_tangential_results_do_not_depend_on_units(tangential_reference, sf, sx)
 
 @pytest.mark.parametrize(("sp", "sd"), [(1e-9, 1e-3), (1e-3, 1.0), (1.0, 1.0), (1e3, 1e2)])
 def test_normal_results_do_not_depend_on_units(sp, sd):
-    t, p, d = cn.synthetic_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=4, seed=7)
+    t, p, d = normal_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=4, seed=7)
     ref = cn.analyze_loop(t, p, d)
     got = cn.analyze_loop(t, p * sp, d * sd)
     assert got.psi == pytest.approx(ref.psi, rel=1e-9)

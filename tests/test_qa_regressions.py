@@ -395,7 +395,7 @@ def test_python_dash_m_contactlab():
 def test_diagnose_cli_names_the_file_when_the_recording_is_too_short(tmp_path, capsys):
     from contactlab.cli import main
     from contactlab.io import write_recording
-    from contactlab.tangential import synthetic_recording
+    from contactlab.synthetic.tangential import synthetic_recording
 
     rec = synthetic_recording(h0=40.0, ac=4e4, amplitude=20e-6, n_cycles=2, fs=400.0, seed=2)
     path = tmp_path / "short_run.csv"

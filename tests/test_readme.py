@@ -1,6 +1,8 @@
-"""The README never lies: every ```python block in it runs as written (in a temp folder) and
-does what its comments say; every ``contactlab ...`` command line it shows is accepted by the
-CLI; the two ``make`` targets it starts with exist."""
+"""The README and the documentation's guides never lie: every ```python block in them runs as
+written (in a temp folder) and does what its comments say; every ``contactlab ...`` command
+line they show is accepted by the CLI; the two ``make`` targets the README starts with
+exist. The guides are Markdown pages of ``docs/`` (MyST), so the blocks moved there from the
+README are still run here."""
 
 from __future__ import annotations
 
@@ -14,10 +16,21 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
 TEXT = README.read_text(encoding="utf-8")
-BLOCKS = re.findall(r"```python\n(.*?)```", TEXT, re.S)
+#: the README, then every Markdown page of the documentation (built pages excluded)
+_BUILT = {"_build", "generated", "auto_examples"}
+PAGES = [
+    README,
+    *sorted(
+        p
+        for p in (ROOT / "docs").rglob("*.md")
+        if not _BUILT & set(p.relative_to(ROOT / "docs").parts)
+    ),
+]
+ALL_TEXT = "\n".join(p.read_text(encoding="utf-8") for p in PAGES)
+BLOCKS = re.findall(r"```python\n(.*?)```", ALL_TEXT, re.S)
 COMMANDS = [
     line.split(" #")[0].strip()
-    for block in re.findall(r"```bash\n(.*?)```", TEXT, re.S)
+    for block in re.findall(r"```bash\n(.*?)```", ALL_TEXT, re.S)
     # a line ending in a backslash continues on the next (comments stripped first)
     for line in re.sub(r"\\[ \t]*\n", " ", re.sub(r"[ \t]+#[^\n]*", "", block)).splitlines()
     if line.strip().startswith("contactlab ")

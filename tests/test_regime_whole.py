@@ -16,13 +16,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import regime_reference as ref
-from contactlab.tangential import (
-    analyze_tangential,
-    frame,
-    frame_friction_force,
-    regime,
-    synthetic_recording,
-)
+from contactlab.synthetic.tangential import synthetic_recording
+from contactlab.tangential import analyze_tangential, frame, frame_friction_force, regime
 from frame_sim import simulate_frame
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "friction_frame"

@@ -175,7 +175,8 @@ def test_failed_integration_returns_partial_result():
 
 
 def test_amplitude_dependence_jenkins_closed_form():
-    from contactlab.structure.amplitude import amplitude_dependence, plot_amplitude_dependence
+    from contactlab.report.structure_plots import plot_amplitude_dependence
+    from contactlab.structure.amplitude import amplitude_dependence
 
     m, c, k, kj, fs = 1.0, 0.5, 1000.0, 1000.0, 1.0
     s = Structure(m, c, k)

@@ -11,11 +11,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import contactlab
+from contactlab.report.structure_plots import plot_modal_amplitude_dependence
 from contactlab.structure import (
     Structure,
     modal_amplitude_dependence,
     phase_resonance,
-    plot_modal_amplitude_dependence,
 )
 from contactlab.structure.amplitude import amplitude_dependence
 

@@ -211,7 +211,7 @@ def test_noise_model_covariance_matches_monte_carlo_with_input_and_output_noise(
     from scipy.signal import lfilter
 
     from contactlab.fitting import least_squares_fit
-    from contactlab.structure._fitkit import noise_model_covariance
+    from contactlab.structure.fitkit import noise_model_covariance
 
     rng = np.random.default_rng(31337)
     n = 1024

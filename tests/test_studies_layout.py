@@ -13,7 +13,33 @@ import pytest
 OLD_NEW = [
     ("contactlab.study", "contactlab.studies.study", "run_study"),
     ("contactlab.manifest", "contactlab.studies.manifest", "read_manifest"),
-    ("contactlab.study_plots", "contactlab.studies.plots", "tangential_study_figures"),
+    ("contactlab.study_plots", "contactlab.report.study_plots", "tangential_study_figures"),
+    # issue 32: every plot and report writer lives in contactlab.report
+    ("contactlab.studies.plots", "contactlab.report.study_plots", "tangential_study_figures"),
+    ("contactlab.studies.track_plots", "contactlab.report.track_plots", "plot_quantity"),
+    ("contactlab.tangential.plots", "contactlab.report.tangential", "plot_loop"),
+    ("contactlab.tangential", "contactlab.report.tangential", "plot_residuals"),
+    ("contactlab.normal", "contactlab.report.normal", "plot_comparison"),
+    (
+        "contactlab.structure",
+        "contactlab.report.structure_plots",
+        "plot_modal_amplitude_dependence",
+    ),
+    ("contactlab.structure.report", "contactlab.report.structure", "build_structure_report"),
+    (
+        "contactlab.structure.amplitude",
+        "contactlab.report.structure_plots",
+        "plot_amplitude_dependence",
+    ),
+    ("contactlab.normal.compare", "contactlab.report.normal", "plot_loops"),
+    ("contactlab.diagnose.plots", "contactlab.report.diagnosis_plots", "plot_overlay"),
+    # issue 32: synthetic data in contactlab.synthetic
+    ("contactlab.tangential", "contactlab.synthetic.tangential", "synthetic_recording"),
+    ("contactlab.tangential.synthetic", "contactlab.synthetic.tangential", "synthetic_recording"),
+    ("contactlab.normal", "contactlab.synthetic.normal", "table2_model"),
+    ("contactlab.normal.synthetic", "contactlab.synthetic.normal", "synthetic_recording"),
+    ("contactlab.diagnose", "contactlab.synthetic.diagnosis", "hidden_effect_recording"),
+    ("contactlab.diagnose.generator", "contactlab.synthetic.diagnosis", "HiddenEffectRecording"),
     ("contactlab.normal_study", "contactlab.studies.normal", "analyze_normal_recording"),
 ]
 

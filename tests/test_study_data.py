@@ -6,11 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from contactlab._datagen import MATERIALS, NORMAL_P0, generate, truth
 from contactlab.data import data_dir, manifest_path
 from contactlab.io import read_recording
 from contactlab.studies.manifest import read_manifest
 from contactlab.studies.study import run_study
+from contactlab.synthetic.bundled import MATERIALS, NORMAL_P0, generate, truth
 
 
 @pytest.fixture(scope="module")

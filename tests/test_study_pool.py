@@ -170,7 +170,7 @@ def test_no_process_pool_here(folder, tmp_path, monkeypatch, capsys):
 def test_study_figure_parts_interleave_to_the_whole(folder, n):
     import matplotlib.pyplot as plt
 
-    from contactlab.studies.plots import tangential_study_figures
+    from contactlab.report.study_plots import tangential_study_figures
 
     result = run_study(folder, progress=False)
     rows, units = result.table("tangential"), result.units("tangential")

@@ -16,14 +16,14 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
 from contactlab.masing import Masing
-from contactlab.studies.manifest import StudyEntry
-from contactlab.studies.plots import (
+from contactlab.report.study_plots import (
     display_unit,
     normal_study_figures,
     plot_study,
     tangential_study_figures,
     trends,
 )
+from contactlab.studies.manifest import StudyEntry
 from contactlab.studies.study import RecordingResult, StudyResult, _flatten
 
 

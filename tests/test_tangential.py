@@ -19,14 +19,9 @@ from hypothesis import strategies as st
 
 from contactlab import ContactLabWarning, InputError, Masing, loop_area
 from contactlab.io import Recording, read_recording, write_recording
-from contactlab.tangential import (
-    analyze_tangential,
-    average_loop,
-    find_reversals,
-    plot_loop,
-    plot_residuals,
-    synthetic_recording,
-)
+from contactlab.report.tangential import plot_loop, plot_residuals
+from contactlab.synthetic.tangential import synthetic_recording
+from contactlab.tangential import analyze_tangential, average_loop, find_reversals
 from contactlab.tangential.model import area_ratio, initial_guess, steady_loop_force
 from contactlab.tangential.preprocess import monotone_path
 

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from contactlab.io import Recording
-from contactlab.tangential import analyze_tangential, synthetic_recording
+from contactlab.synthetic.tangential import synthetic_recording
+from contactlab.tangential import analyze_tangential
 from contactlab.tangential.model import area_ratio
 from contactlab.tangential.regime import z_from_area_ratio
 

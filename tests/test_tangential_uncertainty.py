@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 
 from contactlab import Masing
-from contactlab import _datagen as gen
-from contactlab.tangential import analyze_tangential, average_loop, synthetic_recording
+from contactlab.synthetic import bundled as gen
+from contactlab.synthetic.tangential import synthetic_recording
+from contactlab.tangential import analyze_tangential, average_loop
 
 H0, AC, A = 20.0, 1e5, 10e-6
 

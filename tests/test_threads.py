@@ -12,7 +12,9 @@ import numpy as np
 
 import contactlab.normal as cn
 from contactlab import Masing, least_squares_fit
-from contactlab.tangential import analyze_tangential, synthetic_recording
+from contactlab.synthetic.normal import synthetic_recording as normal_recording
+from contactlab.synthetic.tangential import synthetic_recording
+from contactlab.tangential import analyze_tangential
 
 WORKERS = 4
 
@@ -83,7 +85,7 @@ def test_fits_and_normal_loops_in_threads_equal_serial():
         return r.params["a"].value, r.params["k"].value, r.params["k"].stderr
 
     def loop(seed):
-        t, p, d = cn.synthetic_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=4, seed=seed)
+        t, p, d = normal_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=4, seed=seed)
         res = cn.analyze_loop(t, p, d)
         return res.psi, res.k_tan, res.k_sec
 

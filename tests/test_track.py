@@ -16,7 +16,9 @@ from contactlab import InputError
 from contactlab.io import Recording, write_recording
 from contactlab.studies._cycles import CycleState, block_cycles
 from contactlab.studies.tracking import parse_every, track
-from contactlab.tangential import analyze_tangential, synthetic_recording
+from contactlab.synthetic.normal import synthetic_recording as normal_recording
+from contactlab.synthetic.tangential import synthetic_recording
+from contactlab.tangential import analyze_tangential
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 
@@ -179,7 +181,7 @@ def test_too_short_for_a_window():
 def test_normal_recording_tracks_loop_quantities():
     import contactlab.normal as cn
 
-    t, p, d = cn.synthetic_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=20, seed=5021)
+    t, p, d = normal_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=20, seed=5021)
     rec = Recording(t, {"p": p, "delta": d}, {"p": "Pa", "delta": "m"})
     r = track(rec, every="5cycles")
     whole = cn.analyze_loop(t, p, d)

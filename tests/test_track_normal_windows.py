@@ -5,10 +5,11 @@ from __future__ import annotations
 
 import contactlab
 from contactlab.io import Recording
+from contactlab.synthetic.normal import synthetic_recording as normal_recording
 
 
 def test_later_windows_keep_their_first_cycle(tmp_path):
-    t, p, delta = contactlab.normal.synthetic_recording(0.5e6, 0.4e6, 1.0, 24, 400, seed=5)
+    t, p, delta = normal_recording(0.5e6, 0.4e6, 1.0, 24, 400, seed=5)
     rec = Recording(t, {"p": p, "delta": delta}, {"p": "Pa", "delta": "m"}, "n")
     res = contactlab.track(rec, every="6cycles")
     assert len(res.rows) >= 3

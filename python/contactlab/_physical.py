@@ -42,10 +42,15 @@ def check_channel(name: str, v: np.ndarray, unit: str, what: str) -> bool:
             f"{name} reaches {float(v[i]):.3g} {unit} at sample {i}: beyond any physical "
             f"{what}; a unit mix-up or a corrupt file?"
         )
-    if big < MIN_MAGNITUDE:
+    if big == 0.0:
         raise InputError(
             f"{name} is zero in all {v.size} samples: the {what} sensor recorded nothing, so "
             "there is no loop to analyse"
+        )
+    if big < MIN_MAGNITUDE:
+        raise InputError(
+            f"{name} is at most {big:.3g} {unit} in magnitude in all {v.size} samples: far "
+            f"below any physical {what}; a unit mix-up or a corrupt file?"
         )
     spread = hi - lo
     if spread <= 1e-12 * big:

@@ -8,6 +8,7 @@ and exit non-zero; Ctrl-C exits 130 without leaving partial outputs (writers are
 from __future__ import annotations
 
 import argparse
+import contextlib
 import gc
 import importlib
 import re
@@ -87,7 +88,14 @@ def build_parser(verb_module: str | None = None) -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     if argv is None:  # the process's own command line: it ends when this returns
         try:
-            return _main(sys.argv[1:])
+            code = _main(sys.argv[1:])
+            if code == _INTERRUPTED:
+                _exit_interrupted()
+            return code
+        except KeyboardInterrupt:  # before the verb's handler started, or after it ended
+            print("contactlab: interrupted; no partial outputs written", file=sys.stderr)
+            _exit_interrupted()
+            raise  # not reached
         finally:
             # a structure scan started ahead for a file the run never opened (a usage error,
             # Ctrl-C) stops at its next block instead of holding the exit for the whole file
@@ -99,6 +107,28 @@ def main(argv: Sequence[str] | None = None) -> int:
             # for memory the process is about to give back anyway
             gc.freeze()
     return _main(list(argv))
+
+
+#: the exit status of an interrupted run (128 + SIGINT), as a shell reports it
+_INTERRUPTED = 130
+
+
+def _exit_interrupted() -> None:
+    """End an interrupted run now, with status 130: the pools' workers are killed and the
+    interpreter's exit handlers are skipped (they join the pools' threads, which can wait for
+    ever on a worker blocked where SIGINT reached only the parent). Nothing is lost: outputs
+    are written all or nothing, and an interrupted run wrote none."""
+    import os
+
+    try:
+        from .commands._common import kill_worker_processes
+
+        kill_worker_processes()
+    finally:
+        for stream in (sys.stdout, sys.stderr):
+            with contextlib.suppress(Exception):
+                stream.flush()
+        os._exit(_INTERRUPTED)
 
 
 #: verbs that read recordings named on their command line
@@ -197,7 +227,7 @@ def _main(argv: list[str]) -> int:
         return 1
     except KeyboardInterrupt:
         print(f"contactlab {args.verb}: interrupted; no partial outputs written", file=sys.stderr)
-        return 130
+        return _INTERRUPTED
     except RuntimeError as exc:  # a worker process was killed (out of memory, a signal)
         futures = sys.modules.get("concurrent.futures")  # imported by whatever started a pool
         if futures is None or not isinstance(exc, futures.BrokenExecutor):

@@ -1,20 +1,8 @@
-"""Deprecated: moved to :mod:`contactlab.studies.plots`; this module forwards to it."""
+"""Deprecated: moved to :mod:`contactlab.report.study_plots` (issue 32); this module forwards
+to it."""
 
 from __future__ import annotations
 
-import importlib
-import warnings
-from typing import Any
+from ._moved import forward_all
 
-_NEW = "contactlab.studies.plots"
-
-
-def __getattr__(name: str) -> Any:
-    if name.startswith("__"):  # import machinery probing (__path__ …), not a user
-        raise AttributeError(name)
-    warnings.warn(
-        f"contactlab.study_plots is deprecated; import {name} from {_NEW}",
-        DeprecationWarning,
-        stacklevel=2,
-    )
-    return getattr(importlib.import_module(_NEW), name)
+__getattr__ = forward_all("contactlab.study_plots", "contactlab.report.study_plots")

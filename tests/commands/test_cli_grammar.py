@@ -15,7 +15,7 @@ import contactlab
 from contactlab.cli import cli_wording, join_negative_values, main
 from contactlab.commands.structure import read_table
 from contactlab.io import write_recording
-from contactlab.tangential import synthetic_recording
+from contactlab.synthetic.tangential import synthetic_recording
 
 INFERRED = re.compile(r"model tangential, inferred from the columns x='x \[m\]', F='F \[N\]'")
 
@@ -35,11 +35,15 @@ def test_model_inferred_alike_and_said(rec_csv, capsys):
     assert INFERRED.search(capsys.readouterr().out)
     assert main(["track", rec_csv, "--every", "3cycles"]) == 0
     assert INFERRED.search(capsys.readouterr().out)
-    assert main(["diagnose", rec_csv, "--max-effects", "0"]) == 0
+    assert main(["diagnose", rec_csv, "--max-effects", "0", "--report", "diag"]) == 0
     out = capsys.readouterr().out
     assert INFERRED.search(out)
-    # diagnose's console output carries units
+    # diagnose's console output carries units, in lines of at most 100 characters
     assert "held-out RMS [N]" in out and re.search(r"noise RMS \(estimated .*\): \S+ N", out)
+    assert max(len(s) for s in out.splitlines()) <= 100
+    html = Path("diag/diagnose.html").read_text()
+    assert "Made by: contactlab diagnose run.csv --max-effects 0 --report diag" in html
+    assert "estimated from the data" in html  # as the console says it
     # given explicitly: no inference line
     assert main(["analyze", rec_csv, "--model", "tangential"]) == 0
     assert "inferred" not in capsys.readouterr().out

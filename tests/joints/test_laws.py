@@ -28,6 +28,7 @@ from contactlab.joints import (
     Segalman,
     Series,
 )
+from contactlab.joints import _reference as ref
 
 
 def all_laws() -> list[JointLaw]:
@@ -207,6 +208,107 @@ def test_series_of_springs() -> None:
     np.testing.assert_allclose(law.force(None, x), 7500.0 * x, rtol=1e-12)
 
 
+# -- the Rust kernels against the plain-Python reference ------------------------------------------
+def reference_force(law: JointLaw, t, x, x0: float = 0.0) -> np.ndarray:
+    f, _, _ = ref.run(law._ref(), None if t is None else list(t), list(x), None, x0)
+    return np.asarray(f)
+
+
+def random_history(seed: int, n: int = 400):
+    """Random walk with reversals of all sizes, occasional holds and jumps, uneven times."""
+    rng = np.random.default_rng(seed)
+    t = np.cumsum(rng.uniform(1e-5, 2e-3, n))
+    steps = rng.normal(0, 1e-4, n) * rng.choice([0.0, 0.1, 1.0, 10.0], n, p=[0.05, 0.3, 0.5, 0.15])
+    return t, np.cumsum(steps) * rng.uniform(0.3, 3.0)
+
+
+@pytest.mark.parametrize("law", all_laws(), ids=lambda law: law.name)
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_rust_equals_reference(law: JointLaw, seed: int) -> None:
+    t, x = random_history(seed)
+    x0 = [0.0, 1e-4, -3e-4][seed]
+    got = law.force(t, x, x0=x0)
+    want = reference_force(law, t, x, x0)
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * max(1.0, np.abs(want).max()))
+    if not law.rate_dependent:
+        np.testing.assert_array_equal(law.force(None, x, x0=x0), got)
+
+
+@settings(max_examples=15, deadline=None)
+@given(
+    seed=st.integers(0, 2**31),
+    which=st.sampled_from(["segalman", "gms", "lugre", "bouc_wen", "dahl", "series", "backlash"]),
+    p=st.floats(0.2, 5.0),
+)
+def test_rust_equals_reference_random_parameters(seed: int, which: str, p: float) -> None:
+    law = {
+        "segalman": Segalman(5.0 * p, 1e4 / p, -0.9 + 0.17 * p, 0.2 * p),
+        "gms": GeneralizedMaxwellSlip(
+            [1e4 * p, 2e4, 3e3],
+            [0.2, 0.3 * p, 0.5],
+            4.0,
+            4.0 + p,
+            1e-3 * p,
+            1e4 / p,
+            0.5 + p,
+            0.1 * p,
+        ),
+        "lugre": LuGre(1e5 * p, 300.0 * p, 10.0 / p, 4.0, 4.0 + p, 1e-3 * p, 0.5 + p),
+        "bouc_wen": BoucWen(1e4 * p, 0.5 * p, 0.3 * p, 0.7, 0.6 + p),
+        "dahl": Dahl(1e4 * p, 5.0, 0.3 * p),
+        "series": Series(KelvinVoigt(2e4 * p, 0.1 * p), Dahl(1e4, 5.0 / p), Jenkins(3e4, 4.0 * p)),
+        "backlash": Backlash(1e-4 * p, Parallel(Iwan(1e4 * p, 5.0), k=10.0 * p, c=0.5)),
+    }[which]
+    t, x = random_history(seed, 200)
+    got = law.force(t, x)
+    want = reference_force(law, t, x)
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * max(1.0, np.abs(want).max()))
+
+
+def test_reference_chunked_state_is_carried() -> None:
+    law = Series(KelvinVoigt(5e4), LuGre(1e5, 300.0, 10.0, 4.0, 5.0, 1e-3))
+    t, x = random_history(7, 200)
+    f1, st_, tp = ref.run(law._ref(), list(t[:90]), list(x[:90]))
+    f2, _, _ = ref.run(law._ref(), list(t[90:]), list(x[90:]), st_, 0.0, tp)
+    np.testing.assert_array_equal(np.r_[f1, f2], reference_force(law, t, x))
+
+
+def test_masing_with_other_scale_not_in_composites() -> None:
+    with pytest.raises(contactlab.InputError, match="scale 2"):
+        Parallel(MasingLaw(5.0, 3e3, 1.5)).force(None, [0.0, 1e-4])
+    # alone, any scale runs on the Masing operator
+    m = contactlab.Masing(5.0, 3e3, 1.5)
+    x = np.array([0.0, 1e-4, -2e-4, 3e-4])
+    np.testing.assert_array_equal(MasingLaw(5.0, 3e3, 1.5).force(None, x), m.force(x))
+
+
+def test_stiff_lugre_is_stable_at_any_sampling() -> None:
+    """Bristle relaxation length Fc/σ0 from 4e-12 m to 4e-4 m against sample travel 1e-6 m:
+    finite forces, and the steady force reached to 1e-12 once sliding."""
+    t = np.linspace(0.0, 1.0, 1001)
+    x = 1e-3 * t
+    for s0 in (1e4, 1e8, 1e12):
+        law = LuGre(s0, 0.0, 0.0, 4.0, 5.0, 1e-3)
+        F = law.force(t, x)
+        assert np.all(np.isfinite(F))
+        if s0 >= 1e8:
+            assert F[-1] == pytest.approx(float(law.steady_force(1e-3)), rel=1e-12)
+
+
+def test_long_signal_chunked_matches_one_pass() -> None:
+    law = Parallel(Segalman(5.0, 1e4, -0.5, 0.2), LuGre(1e5, 300.0, 10.0, 4.0, 5.0, 1e-3), k=50.0)
+    rng = np.random.default_rng(11)
+    n = 200_000
+    t = np.arange(n) * 1e-4
+    x = 1e-3 * np.sin(2 * np.pi * 5 * t) * (1 + 0.5 * np.sin(2 * np.pi * 0.3 * t))
+    x += np.cumsum(rng.normal(0, 2e-7, n))
+    whole = law.force(t, x)
+    op = law.operator()
+    cuts = np.unique(np.r_[0, rng.integers(0, n, 30), n])
+    parts = [op.push(t[a:b], x[a:b]) for a, b in itertools.pairwise(cuts)]
+    np.testing.assert_array_equal(np.concatenate(parts), whole)
+
+
 # -- streaming, parameters ----------------------------------------------------------------------
 @pytest.mark.parametrize("law", all_laws(), ids=lambda law: law.name)
 def test_chunked_equals_one_pass(law: JointLaw) -> None:
@@ -278,7 +380,7 @@ def test_bad_signals() -> None:
     law = LuGre(1e5, 300.0, 10.0, 4.0, 5.0, 1e-3)
     with pytest.raises(contactlab.InputError, match=r"x\[2\] is not finite"):
         law.force([0.0, 1.0, 2.0], [0.0, 1.0, np.nan])
-    with pytest.raises(contactlab.InputError, match=r"t\[2\] = 1.0 does not exceed"):
+    with pytest.raises(contactlab.InputError, match=r"t\[2\] = 1(\.0)? does not exceed"):
         law.force([0.0, 1.0, 1.0], [0.0, 1.0, 2.0])
     with pytest.raises(contactlab.InputError, match=r"t\[1\] is not finite"):
         law.force([0.0, np.inf], [0.0, 1.0])
@@ -310,15 +412,16 @@ def _history(seed: int, n: int = 300):
 def test_odd_symmetry(seed: int, which: int) -> None:
     law = SYMMETRIC[which]
     t, x = _history(seed)
-    np.testing.assert_allclose(law.force(t, -x), -law.force(t, x), rtol=1e-12, atol=1e-12)
+    f = law.force(t, x)
+    # exact for the closed-form laws; a series split is found to ~1e-14 of the force
+    np.testing.assert_allclose(law.force(t, -x), -f, rtol=0, atol=1e-11 * np.abs(f).max())
 
 
-DISSIPATIVE = [law for law in all_laws() if law.name != "kelvin_voigt"]
-#: laws whose small cycles about a loaded state drift (Dahl-type state equations have no
-#: Masing memory: the up and down branches' slopes differ there, so the loop ratchets towards
-#: the unloaded state and ∮F dx of one cycle includes the change of stored energy; seen:
-#: Dahl, 1e-5 m cycles after a 1e-3 m history, -3.8e-7 J after 3 cycles)
-RATCHETING = {"dahl", "lugre", "bouc_wen"}
+# Not the generalised Maxwell-slip model: a sliding element's force rises towards a higher
+# Stribeck limit as the motion slows without the matching work (it moves in time, not with
+# displacement), and the next sticking phase returns it elastically: the model is not passive
+# (cycles with -2e-3 of F·A were found).
+DISSIPATIVE = [law for law in all_laws() if law.name not in ("kelvin_voigt", "gms")]
 
 
 @settings(max_examples=25, deadline=None)
@@ -329,18 +432,21 @@ RATCHETING = {"dahl", "lugre", "bouc_wen"}
     offset=st.floats(-1e-3, 1e-3),
 )
 def test_energy_per_cycle_nonnegative(seed: int, which: int, amp: float, offset: float) -> None:
+    """∮ F dx >= 0 over a closed cycle, after a random history. Dahl-type laws (Dahl, LuGre,
+    Bouc-Wen) approach their steady cycle geometrically (a factor exp(-4 σ0 A / Fc) a cycle:
+    0.92 for A = 1e-5 m here), so 150 cycles are driven and the non-closure of the last one
+    (its force drift times the amplitude) is allowed for."""
     law = DISSIPATIVE[which]
     rng = np.random.default_rng(seed)
     _, pre = _history(seed, 100)
-    n, cycles = 400, 3
-    if law.name in RATCHETING:  # minor loops about a loaded state do not close: from rest
-        pre, offset, cycles = np.zeros(1), 0.0, 8
-    ph = np.arange(cycles * n + 1) / n
+    n = 200
+    ph = np.arange(150 * n + 1) / n
     x = np.concatenate([pre, pre[-1] + offset + amp * np.sin(2 * np.pi * ph + rng.uniform(0, 6))])
     t = np.arange(x.size) * 1e-3
     F = law.force(t, x)
     E = cycle_energy(x, F, n)
-    assert E >= -1e-9 * (np.abs(F).max() * amp + 1e-30)
+    drift = abs(F[-1] - F[-n - 1])
+    assert E >= -1e-9 * np.abs(F).max() * amp - 2.0 * drift * amp
 
 
 @settings(max_examples=30, deadline=None)

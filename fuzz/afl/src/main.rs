@@ -10,7 +10,9 @@
 use contactlab_core::normal::{
     cycles, poly, simulate, ContactModel, Forcing, Interp, KelvinVoigt, Options, Stiffness,
 };
-use contactlab_core::signal::{fold_phase, loop_areas, FoldSums, Schmitt};
+use contactlab_core::fold::{fold_phase, FoldSums};
+use contactlab_core::loop_area::loop_areas;
+use contactlab_core::reversal::Schmitt;
 use contactlab_core::{
     branch_memory, cycle_energies, loop_area, masing_force, masing_force_rule, Backbone,
     BranchRule, Exponential, MasingState, Tabulated,

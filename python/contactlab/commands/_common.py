@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import os
@@ -412,7 +413,7 @@ def process_pool(workers: int | None, *, auto: bool = False) -> Any:
     from concurrent.futures import ProcessPoolExecutor
 
     try:
-        return ProcessPoolExecutor(workers, initializer=_ignore_sigint)
+        return _InterruptiblePool(ProcessPoolExecutor(workers, initializer=_ignore_sigint))
     except (OSError, ImportError, NotImplementedError) as exc:
         if not auto:
             raise InputError(
@@ -422,6 +423,42 @@ def process_pool(workers: int | None, *, auto: bool = False) -> Any:
         print(f"note: cannot start worker processes here ({exc}); running in this process",
               file=sys.stderr)  # fmt: skip
         return contextlib.nullcontext(None)
+
+
+class _InterruptiblePool:
+    """A process pool's context that does not wait for its workers after Ctrl-C.
+
+    On a normal exit the pool shuts down as usual (waiting for its tasks). On an interrupt
+    (or any other escaping exception) the queued tasks are cancelled and the worker processes
+    are killed at once: waiting for them could block for ever where SIGINT reached only the
+    parent (``kill -INT pid``, ``timeout -s INT``), since the workers ignore SIGINT and one may
+    be blocked on a queue's lock that the interrupted parent will never release."""
+
+    def __init__(self, executor: Any) -> None:
+        self.executor = executor
+
+    def __enter__(self) -> Any:
+        return self.executor
+
+    def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
+        if exc_type is None:
+            self.executor.shutdown(wait=True)
+            return
+        kill_worker_processes()
+        self.executor.shutdown(wait=False, cancel_futures=True)
+
+
+def kill_worker_processes() -> None:
+    """Kill every child process this process started through multiprocessing (the pools'
+    workers); they hold no outputs (every output is written by the parent, all or nothing)."""
+    import multiprocessing
+
+    for child in multiprocessing.active_children():
+        with contextlib.suppress(Exception):
+            child.kill()
+    for child in multiprocessing.active_children():
+        with contextlib.suppress(Exception):
+            child.join(timeout=1.0)
 
 
 def add_progress_flags(p: Any) -> None:
@@ -600,7 +637,8 @@ def infer_model(
     """The model of a recording: ``model`` when given, else inferred from its column names
     exactly as the readers infer it (``contactlab.io.read_chunks``, which reads only the
     header). Returns ``(model, sentence)``; the sentence (None when the model was given)
-    says what was inferred from which columns, for the console."""
+    says what was inferred from which columns, for the console (``model tangential, inferred
+    from the columns x='Position [mm]', F='Friction [uN]' (--model sets it)``)."""
     if model is not None:
         return model, None
     from ..io import read_chunks
@@ -614,10 +652,15 @@ def infer_model(
         )
     chans = ("x", "F") if kind == "tangential" else ("p", "delta")
     named = ", ".join(f"{c}={cr.columns[c]!r}" for c in chans if c in cr.columns)
+    return kind, f"model {kind}, inferred from the columns {named} (--model sets it)"
+
+
+def wrapped(text: str, width: int = 100) -> str:
+    """``text`` wrapped to ``width`` characters, continuation lines indented."""
     import textwrap
 
-    text = f"{file}: model {kind}, inferred from the columns {named} (--model sets it)"
-    return kind, textwrap.fill(text, width=100, subsequent_indent="   ", break_long_words=False)
+    return textwrap.fill(text, width=width, subsequent_indent="   ", break_long_words=False,
+                         break_on_hyphens=False)  # fmt: skip
 
 
 def wrap_warning(text: str, *, prefix: str = "  warning: ", width: int = 100) -> str:

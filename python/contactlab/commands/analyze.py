@@ -39,6 +39,7 @@ from ._common import (
     recording_json,
     refuse_if_none_analysed,
     wrap_warning,
+    wrapped,
     write_json,
     write_report,
 )
@@ -261,7 +262,7 @@ def _handler(args: argparse.Namespace) -> int:
         for f in args.files:
             if Path(f).is_file():
                 kinds[f], note = infer_model(f, None, columns, args.fs)
-                print(note, file=say)
+                print(wrapped(f"{f}: {note}"), file=say)
         if len(set(kinds.values())) > 1:
             raise InputError(
                 "the files are of different kinds ("

@@ -110,8 +110,11 @@ def run_demo(
     progress: bool | None = None,
     workers: int | None = None,
     auto: bool = False,
+    command: str | None = None,
 ) -> list[Path]:
     """Run the demo and write every output into ``out``; returns the written paths.
+
+    ``command``: the command line that ran it, quoted at the top of the report.
 
     ``workers``: processes that analyse the recordings and draw the report's figures (None:
     all in this process; ``auto``: the count was not asked for, so a machine that cannot
@@ -126,7 +129,7 @@ def run_demo(
     from ._common import process_pool
 
     files = masing_outputs()
-    intro = (
+    intro = (f"Made by: {command}. " if command else "") + (
         "Example study bundled with contactlab (synthetic recordings with realistic sensor "
         "noise, offsets, quantisation and drift; see contactlab.data.generate). The table's "
         "true_h0 / true_ac columns are the values the recordings were made with."
@@ -145,7 +148,7 @@ def run_demo(
 
 def _handler(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
-    from ._common import resolve_workers
+    from ._common import made_by, resolve_workers
 
     workers = resolve_workers(args.workers)
     paths = run_demo(
@@ -154,6 +157,7 @@ def _handler(args: argparse.Namespace) -> int:
         progress=args.progress,
         workers=workers,
         auto=args.workers is None,
+        command=made_by(args, "demo", "--out", args.out),
     )
     for p in paths:
         if p.parent == Path(args.out):
@@ -165,6 +169,8 @@ def _handler(args: argparse.Namespace) -> int:
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
+    from ._common import add_progress_flags
+
     p = sub.add_parser(
         "demo",
         help="run the bundled demonstration and write its outputs",
@@ -178,7 +184,5 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--workers", type=int, default=None, metavar="N",
                    help="analyse the recordings and draw the figures in N processes (default: "
                    "one per core, at most 8; 0: serially in this process)")  # fmt: skip
-    g = p.add_mutually_exclusive_group()
-    g.add_argument("--progress", dest="progress", action="store_true", default=None)
-    g.add_argument("--no-progress", dest="progress", action="store_false")
+    add_progress_flags(p)
     p.set_defaults(handler=_handler)

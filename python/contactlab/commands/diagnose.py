@@ -230,10 +230,14 @@ def run(args: argparse.Namespace) -> int:
         args.model = "tangential"
     columns = parse_columns(args.columns)
     if args.model is None:
-        from ..commands._common import infer_model
+        from ..commands._common import infer_model, wrapped
 
-        args.model, note = infer_model(args.file, None, columns, args.fs)
-        print(note)
+        try:
+            args.model, note = infer_model(args.file, None, columns, args.fs)
+        except InputError as exc:
+            raise InputError(f"{exc} (or --structure MODEL.json: a structure's input and "
+                             "response record)") from None  # fmt: skip
+        print(wrapped(f"{args.file}: {note}"))
     taps = output_filter_taps(args.output_filter)
     if args.model == "normal" and (taps is not None or args.output_noise is not None):
         raise InputError("--output-filter/--output-noise are for the tangential model (a force "
@@ -304,9 +308,10 @@ def run(args: argparse.Namespace) -> int:
         import matplotlib
 
         matplotlib.use("Agg")
-        from ..diagnose._html import report_files
+        from ..commands._common import made_by
+        from ..report.diagnosis import report_files
 
-        files = report_files(report)
+        files = report_files(report, intro=f"Made by: {made_by(args, 'diagnose', args.file)}")
     print(report.summary())
     # the JSON is staged beside its target and renamed into place only once the report is
     # committed: a report that cannot be written leaves the JSON as it was

@@ -17,17 +17,41 @@ from typing import Any
 
 from ..errors import InputError
 from ._common import (
+    FORCE_SIGN_CHOICES,
+    add_reader_flags,
     check_output_targets,
-    command_line,
     describe,
+    force_sign,
     json_text,
+    made_by,
     parse_columns,
-    quantity,
     write_json,
 )
 
 
-def _read(files: list[str], columns: dict | None, fs: float | None, role: str) -> list[Any]:
+def _signed(rec: Any, sign: str, say: Any) -> Any:
+    """The record with its force sign as asked: ``auto`` makes the loops' work ∮F dx
+    positive (a passive joint dissipates; some instruments record the reaction)."""
+    import numpy as np
+
+    from ..joints.records import JointRecord
+
+    if sign == "+1":
+        return rec
+    flip = sign == "-1"
+    if sign == "auto":
+        work = float(np.sum(0.5 * (rec.F[1:] + rec.F[:-1]) * np.diff(rec.x)))
+        flip = work < 0
+        if flip:
+            print(f"{rec.name}: force sign -1 (the loops' work ∮F dx is negative with the "
+                  "recorded sign; --force-sign +1 keeps it)", file=say)  # fmt: skip
+    if not flip:
+        return rec
+    return JointRecord(rec.t, rec.x, -rec.F, rec.name, rec.mask)
+
+
+def _read(files: list[str], columns: dict | None, fs: float | None, role: str,
+          resample: bool = False) -> list[Any]:  # fmt: skip
     from ..io import read_recording
     from ..joints.records import as_record
 
@@ -38,7 +62,7 @@ def _read(files: list[str], columns: dict | None, fs: float | None, role: str) -
             raise InputError(f"--{role} {f}: is a folder, not a recording file")
         if not p.is_file():
             raise InputError(f"--{role} {f}: no such file")
-        rec = read_recording(p, columns=columns, kind="tangential", fs=fs)
+        rec = read_recording(p, columns=columns, kind="tangential", fs=fs, resample=resample)
         out.append(as_record(rec, name=p.name))
     return out
 
@@ -82,20 +106,24 @@ def _handler(args: argparse.Namespace) -> int:
     laws = _laws(args.law)
     check_output_targets(json_out=args.json, report=args.report,
                          inputs=[*args.fit, *(args.predict or [])])  # fmt: skip
+    if args.elements < 1:
+        raise InputError(f"--elements must be >= 1, got {args.elements}")
     if args.max_samples is not None and args.max_samples < 100:
         raise InputError(f"--max-samples must be >= 100, got {args.max_samples}")
     names = [Path(f).resolve() for f in [*args.fit, *(args.predict or [])]]
     if len(set(names)) != len(names):
         raise InputError("a file is given twice (in --fit and --predict, or twice in one): "
                          "a held-out score needs a recording the fit did not see")  # fmt: skip
-    train = _read(args.fit, columns, args.fs, "fit")
-    held = _read(args.predict or [], columns, args.fs, "predict")
+    train = _read(args.fit, columns, args.fs, "fit", args.resample)
+    held = _read(args.predict or [], columns, args.fs, "predict", args.resample)
     say = sys.stderr if args.json == "-" else sys.stdout
+    train = [_signed(r, args.force_sign, say) for r in train]
+    held = [_signed(r, args.force_sign, say) for r in held]
     fits = []
     for law in laws:
         f = fit(train, law=law, offset=args.offset, stiffness=args.stiffness,
-                damping=args.damping, mass=args.mass, max_samples=args.max_samples,
-                n_elements=args.elements)  # fmt: skip
+                damping=args.damping, mass=args.mass, asymmetry=args.asymmetry,
+                max_samples=args.max_samples, n_elements=args.elements)  # fmt: skip
         fits.append(f)
         state = "converged" if f.success else f"NOT converged ({f.message})"
         print(f"{f.name}: {state} in {f.seconds:.2f} s: {_param_line(f)}", file=say)
@@ -130,9 +158,9 @@ def _handler(args: argparse.Namespace) -> int:
         from ..report import commit_outputs
         from ..report.joints_report import build_joint_report
 
-        cmd = command_line("fit-joint", "--law", args.law, "--fit", *args.fit,
-                           *(["--predict", *args.predict] if args.predict else []),
-                           "--report", args.report)  # fmt: skip
+        cmd = made_by(args, "fit-joint", "--law", args.law, "--fit", *args.fit,
+                      *(["--predict", *args.predict] if args.predict else []),
+                      "--report", args.report)  # fmt: skip
         rep = build_joint_report(fits, table, records, roles,
                                  f"contactlab fit-joint ({', '.join(laws)})",
                                  intro=f"Made by: {cmd}")  # fmt: skip
@@ -169,15 +197,19 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    "backlash:<law> (default: lugre)")  # fmt: skip
     p.add_argument("--json", metavar="OUT", help="write results as JSON (SI; '-' = stdout)")
     p.add_argument("--report", metavar="DIR", help="write report.html and figures here")
-    p.add_argument("--columns", help="column mapping, e.g. 'x=disp,F=force' (default: by name)")
-    p.add_argument("--fs", type=quantity("Hz", positive=True),
-                   help="sampling rate when a file has no time")  # fmt: skip
+    add_reader_flags(p, model=False)
+    p.add_argument("--force-sign", type=force_sign, choices=FORCE_SIGN_CHOICES, default="auto",
+                   help="fit F (+1) or -F (-1); auto (default): per recording, the sign that "
+                   "makes the loops' work ∮F dx positive (a passive joint dissipates)")  # fmt: skip
     p.add_argument("--offset", action="store_true",
                    help="fit a constant force in parallel (asymmetric friction, a load-cell "
                    "zero)")  # fmt: skip
     p.add_argument("--stiffness", action="store_true", help="fit a parallel linear stiffness")
     p.add_argument("--damping", action="store_true", help="fit a parallel viscous term")
     p.add_argument("--mass", action="store_true", help="fit an inertia term m·ẍ in parallel")
+    p.add_argument("--asymmetry", action="store_true",
+                   help="fit a direction-dependent gain a·|F_law| (friction that differs "
+                   "between the two directions, e.g. a self-energising band brake)")  # fmt: skip
     p.add_argument("--elements", type=int, default=4, metavar="N",
                    help="elements of maxwell_slip / gms (default 4)")  # fmt: skip
     p.add_argument("--max-samples", type=int, default=None, metavar="N",

@@ -155,7 +155,7 @@ def _handler(args: argparse.Namespace) -> int:
 
     _check_length(args)
     if args.model == "tangential":
-        from ..tangential import synthetic_recording
+        from ..synthetic.tangential import synthetic_recording
 
         with np.errstate(over="ignore", invalid="ignore"):  # overflow is refused below
             rec = synthetic_recording(
@@ -173,7 +173,7 @@ def _handler(args: argparse.Namespace) -> int:
                 adc_bits=args.adc_bits,
             )
     else:
-        from ..normal import synthetic_recording as normal_synthetic
+        from ..synthetic.normal import synthetic_recording as normal_synthetic
 
         kwargs = {"noise": "realistic" if args.noise is None else args.noise, "seed": args.seed}
         if args.normal_model:

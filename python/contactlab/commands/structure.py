@@ -289,7 +289,9 @@ def diagnose_structure_cli(args: argparse.Namespace) -> int:
         import matplotlib
 
         matplotlib.use("Agg")
-        print(f"report: {rep.write_html(args.report)}")
+        from ..report.structure import write_diagnosis_html
+
+        print(f"report: {write_diagnosis_html(rep, args.report)}")
     if text is not None:
         write_text(args.json, text)
     return 0

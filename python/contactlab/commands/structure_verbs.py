@@ -27,8 +27,8 @@ def identify_record(
     import matplotlib
 
     matplotlib.use("Agg")
+    from ..report.structure import build_structure_report
     from ..structure.identify import identify
-    from ..structure.report import build_structure_report
 
     if not (0.0 <= holdout < 0.9):
         raise InputError(f"--holdout must be in [0, 0.9), got {holdout}")

@@ -33,6 +33,7 @@ from ._common import (
     quantity,
     window_threads,
     wrap_warning,
+    wrapped,
     write_json,
 )
 
@@ -55,11 +56,10 @@ def _handler(args: argparse.Namespace) -> int:
     parse_every(args.every)  # a bad --every fails before the file is opened
     say = sys.stderr if args.json == "-" else sys.stdout
     frame = frame_option(args)  # before the file is read: it has no force column
+    note = None
     if frame is None:
         args.model, note = infer_model(args.file, args.model, parse_columns(args.columns),
                                        args.fs)  # fmt: skip
-        if note:
-            print(note, file=say)
     options = _options(args)
     if args.delay is not None:
         if options is not None:  # a normal recording's options
@@ -84,7 +84,8 @@ def _handler(args: argparse.Namespace) -> int:
         source = fr.recording(args.file)
         rebuilt = fr.to_dict()
         print(f"{args.file}: friction frame: {describe_reconstruction(rebuilt)}", file=say)
-    print(f"tracking {args.file} every {args.every}", file=say, flush=True)
+    print(wrapped(f"tracking {args.file} every {args.every}" + (f"; {note}" if note else "")),
+          file=say, flush=True)  # fmt: skip
     bar = None
     if args.progress or (args.progress is None and sys.stderr.isatty()):
         from tqdm.auto import tqdm

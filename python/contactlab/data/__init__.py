@@ -1,7 +1,7 @@
 """Bundled example recordings for ``contactlab demo`` and the tutorials.
 
 Synthetic but realistic (sensor noise, offsets, ADC quantisation, slow drift), made by the
-seeded script :mod:`contactlab._datagen` (``python -m contactlab.data.generate``):
+seeded script :mod:`contactlab.synthetic.bundled` (``python -m contactlab.data.generate``):
 
 - tangential: three material pairs (Al/Al, PVC/steel, steel/steel) at three normal loads and
   three amplitudes each, Masing hysteresis with an exponential virgin curve (the tangential

@@ -1,6 +1,6 @@
 """``python -m contactlab.data.generate [--out DIR]``: remake the bundled example recordings.
 
-The generator is :mod:`contactlab._datagen` (it simulates with the models, which the data
+The generator is :mod:`contactlab.synthetic.bundled` (it simulates with the models, which the data
 package must not import); this module forwards the command and its names there.
 """
 
@@ -9,7 +9,7 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-_HOME = "contactlab._datagen"
+_HOME = "contactlab.synthetic.bundled"
 
 
 def __getattr__(name: str) -> Any:

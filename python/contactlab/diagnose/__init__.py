@@ -2,7 +2,7 @@
 missing, and how much the gap shrinks once it is added (issue 5).
 
 >>> import contactlab
->>> from contactlab.diagnose import hidden_effect_recording
+>>> from contactlab.synthetic.diagnosis import hidden_effect_recording
 >>> report = contactlab.diagnose(hidden_effect_recording(["channel_delay"], seed=0))
 >>> report.effect_names
 ['channel_delay']
@@ -14,23 +14,21 @@ import sys
 import types
 from typing import TYPE_CHECKING, Any
 
+from .._moved import moved
 from .model import ExtendedModel
 from .workflow import DiagnosisReport, Effect, Step, diagnose
 
 if TYPE_CHECKING:
-    from .generator import HiddenEffectRecording, hidden_effect_recording
     from .structure import StructureDiagnosis, diagnose_structure
 
 __all__ = [
     "DiagnosisReport",
     "Effect",
     "ExtendedModel",
-    "HiddenEffectRecording",
     "Step",
     "StructureDiagnosis",
     "diagnose",
     "diagnose_structure",
-    "hidden_effect_recording",
 ]
 
 
@@ -42,10 +40,8 @@ def __getattr__(name: str) -> Any:
         from . import structure
 
         return getattr(structure, name)
-    if name in ("HiddenEffectRecording", "hidden_effect_recording"):
-        from . import generator
-
-        return getattr(generator, name)
+    if name in ("HiddenEffectRecording", "hidden_effect_recording"):  # moved (issue 32)
+        return moved(__name__, name, "contactlab.synthetic.diagnosis")
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 

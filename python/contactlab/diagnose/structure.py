@@ -49,10 +49,10 @@ from typing import Any
 import numpy as np
 from scipy.signal import savgol_filter
 
+from .._blas import with_single_blas_thread
 from ..errors import ContactLabError, InputError
 from ..fitting import FitResult, Parameter, least_squares_fit
 from ..structure import IdentifiedModel
-from ..structure._blas import with_single_blas_thread
 from ..structure.identify import build_structure
 from ..structure.model import SimulationResult, Structure
 from ._signal import dominant_period_samples, noise_rms, smooth_window
@@ -178,12 +178,17 @@ class StructureDiagnosis:
         model, the joint's loop, the residual before and after, the named effects with their
         parameters ± standard errors, the unexplained part and where it lives), its figures
         under ``figures/`` and ``diagnose.json`` into ``directory``, all or nothing; returns
-        the HTML's path."""
-        from ..structure.report import build_diagnosis_report
+        the HTML's path. Deprecated (issue 32: the diagnosis returns results, the report draws
+        them): use :func:`contactlab.report.structure.write_diagnosis_html`."""
+        from .._moved import moved
 
-        rep = build_diagnosis_report(self)
-        extra = {"diagnose.json": (self.to_json() + "\n").encode("utf-8")}
-        return rep.write(directory, extra=extra, html_name="diagnose.html")[0]
+        fn = moved(
+            "contactlab.diagnose.StructureDiagnosis",
+            "write_html",
+            "contactlab.report.structure",
+            "write_diagnosis_html",
+        )
+        return fn(self, directory)
 
     def summary(self) -> str:
         out = [f"contactlab diagnose — structure ({self.joint} joint, {self.excitation} "

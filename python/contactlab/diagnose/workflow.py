@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from .._moved import moved
 from ..errors import InputError
 from ._family import Family, Prepared
 from ._inputs import arrays as _arrays
@@ -157,6 +158,14 @@ class DiagnosisReport:
     _trials: list[Trial] = field(repr=False, default_factory=list)
     #: whether ``model`` was inferred from the recording's channels (``diagnose(model=None)``)
     model_inferred: bool = False
+    # -- issue 29 items 1-3 (detection.py, power.py, misfit.py) -----------------------------
+    #: noise of both channels, estimated separately (:class:`.detection.ChannelNoise`)
+    channel_noise: Any = field(repr=False, default=None)
+    #: per candidate not named: the smallest magnitude this record would have revealed
+    #: (:class:`.power.Detectable`)
+    not_detected: list[Any] = field(repr=False, default_factory=list)
+    #: structure the final model leaves over phase and branch (:class:`.misfit.Unexplained`)
+    unexplained: Any = field(repr=False, default=None)
 
     @property
     def effect_names(self) -> list[str]:
@@ -183,6 +192,14 @@ class DiagnosisReport:
             # issue 29 item 5: the regime analyze decides, the final h0 against its plateau
             **({"regime": self.location["regime"]} if "regime" in self.location else {}),
             **({"h0_check": self.location["h0_check"]} if "h0_check" in self.location else {}),
+            # issue 29: both channels' noise, stated power, unexplained structure
+            **({"channel_noise": self.channel_noise.to_dict()} if self.channel_noise else {}),
+            **(
+                {"not_detected": [b.to_dict() for b in self.not_detected]}
+                if self.channel_noise
+                else {}
+            ),
+            **({"unexplained": self.unexplained.to_dict()} if self.unexplained else {}),
             # a frame's reconstructed force: its mass read from an inertia term
             **(
                 {"frame_constants": dict(self.location["frame_constants"])}
@@ -228,7 +245,13 @@ class DiagnosisReport:
         each physically plausible, and the gap-shrink table."""
         how = " (inferred from the channels; model= sets it)" if self.model_inferred else ""
         out = [f"contactlab diagnose — {self.model} model{how}", ""]
-        out += ["Where the base model disagrees:"] + [f"  - {w}" for w in self.where]
+        import textwrap
+
+        def wrap(text: str, first: str, rest: str) -> str:
+            return textwrap.fill(text, width=100, initial_indent=first, subsequent_indent=rest,
+                                 break_long_words=False, break_on_hyphens=False)  # fmt: skip
+
+        out += ["Where the base model disagrees:"] + [wrap(w, "  - ", "    ") for w in self.where]
         out.append("")
         if not self.effects:
             out.append("No candidate improves the held-out error significantly.")
@@ -240,9 +263,9 @@ class DiagnosisReport:
                 se = e.stderr.get(k, np.nan)
                 pm = f" ± {se:.2g}" if np.isfinite(se) else " (error not identifiable)"
                 parts.append(f"{k} = {v:.4g}{pm}{u}")
-            out.append(f"Added {e.name}: {', '.join(parts)}")
+            out.append(wrap(f"Added {e.name}: {', '.join(parts)}", "", "    "))
             if e.plausibility:
-                out.append(f"  why plausible: {e.plausibility}")
+                out.append(wrap(f"why plausible: {e.plausibility}", "  ", "    "))
         coeffs = self.final_model.coefficients()
         if coeffs is not None and ({"a", "kappa"} & set(self.final_model.params)):
             out.append(
@@ -255,39 +278,60 @@ class DiagnosisReport:
             )
         unit = getattr(self.final_model.family, "output_unit", "")
         out += ["", self.table(unit), self.noise_text()]
+        if self.channel_noise is not None:  # issue 29: stated power, unexplained structure
+            cn = self.channel_noise
+            out.append(
+                f"channel noise: input {cn.input:.3g} {cn.input_unit}, output "
+                f"{cn.output:.3g} {cn.output_unit}"
+            )
+            out += [f"  - {b.sentence()}" for b in self.not_detected]
+        if self.unexplained is not None:
+            out.append(self.unexplained.sentence())
         return "\n".join(out)
 
     # -- figures ------------------------------------------------------------------------------
     def plot_overlay(self, step: int | None = None, ax: Any = None) -> Any:
-        """Measured and modelled loops (output against input), base model and final model."""
-        from .plots import plot_overlay
-
-        return plot_overlay(self, step=step, ax=ax)
+        """Measured and modelled loops (output against input), base model and final model.
+        Deprecated: use :func:`contactlab.report.diagnosis_plots.plot_overlay`."""
+        fn = moved(
+            "contactlab.diagnose.DiagnosisReport",
+            "plot_overlay",
+            "contactlab.report.diagnosis_plots",
+        )
+        return fn(self, step=step, ax=ax)
 
     def plot_residual(self, ax: Any = None) -> Any:
-        """Held-out residual over time, before (base) and after (final model)."""
-        from .plots import plot_residual
-
-        return plot_residual(self, ax=ax)
+        """Held-out residual over time, before (base) and after (final model).
+        Deprecated: use :func:`contactlab.report.diagnosis_plots.plot_residual`."""
+        return moved(
+            "contactlab.diagnose.DiagnosisReport",
+            "plot_residual",
+            "contactlab.report.diagnosis_plots",
+        )(self, ax=ax)
 
     def plot_location(self, ax: Any = None) -> Any:
-        """Where the base residual lives: residual power by position in the branch."""
-        from .plots import plot_location
-
-        return plot_location(self, ax=ax)
+        """Where the base residual lives: residual power by position in the branch.
+        Deprecated: use :func:`contactlab.report.diagnosis_plots.plot_location`."""
+        return moved(
+            "contactlab.diagnose.DiagnosisReport",
+            "plot_location",
+            "contactlab.report.diagnosis_plots",
+        )(self, ax=ax)
 
     def write_html(self, directory: Any) -> Any:
         """Write a self-contained ``diagnose.html`` (figures embedded, also as PNGs under
-        ``figures/``) and ``diagnose.json`` into ``directory``; returns the HTML's path."""
-        from ._html import write_html
-
-        return write_html(self, directory)
+        ``figures/``) and ``diagnose.json`` into ``directory``; returns the HTML's path.
+        Deprecated: use :func:`contactlab.report.diagnosis.write_html`."""
+        return moved(
+            "contactlab.diagnose.DiagnosisReport", "write_html", "contactlab.report.diagnosis"
+        )(self, directory)
 
     def plot_gap(self, ax: Any = None) -> Any:
-        """Held-out RMS (in units of the noise level) after each step."""
-        from .plots import plot_gap
-
-        return plot_gap(self, ax=ax)
+        """Held-out RMS (in units of the noise level) after each step.
+        Deprecated: use :func:`contactlab.report.diagnosis_plots.plot_gap`."""
+        return moved(
+            "contactlab.diagnose.DiagnosisReport", "plot_gap", "contactlab.report.diagnosis_plots"
+        )(self, ax=ax)
 
 
 def _family(model: Any) -> tuple[Family, dict[str, float], dict[str, float]]:
@@ -470,7 +514,7 @@ def diagnose(
     Examples
     --------
     >>> import contactlab
-    >>> from contactlab.diagnose import hidden_effect_recording
+    >>> from contactlab.synthetic.diagnosis import hidden_effect_recording
     >>> rec = hidden_effect_recording(["force_offset"], magnitude=0.05, seed=2)
     >>> report = contactlab.diagnose(rec, model="tangential")
     >>> report.effect_names
@@ -519,8 +563,22 @@ def diagnose(
     )  # fmt: skip
     spent = d.extra["evaluations"].total  # by the base; then as a serial run counts them
     st = search.run(SearchState(b.current, steps, where, [b.current], used=spent))
+    # issue 29 items 1-3: both channels' noise, what each candidate not named would have
+    # needed to be seen, and structure the final model leaves (detection.py)
+    from .detection import assess
+
+    checks = assess(
+        b.family, d, st.current, b.sigma, z=z, gain_floor=min_gain + b.budget, folds=folds,
+        candidates=names, declared_output=declared_noise,
+    )  # fmt: skip
+    location["detection"] = {k: checks[k] for k in ("z", "gain_floor", "folds", "candidates")}
+    if checks["unexplained"] is not None and checks["unexplained"].flagged:
+        st.where.append(checks["unexplained"].sentence())
     report = _report(b.family, path, recording, regime, d, st, b.sigma, location)
     report.model_inferred = inferred
+    report.channel_noise = checks["noise"]
+    report.not_detected = checks["not_detected"]
+    report.unexplained = checks["unexplained"]
     return report
 
 

@@ -508,7 +508,7 @@ def resample_uniform(
     >>> import numpy as np
     >>> t = np.array([0.0, 0.005, 0.010, 0.020, 0.025])
     >>> tt, d, info = resample_uniform(t, {"x": 2 * t}, file="f", column="t")
-    >>> tt.tolist(), round(info["largest_step"], 3), info["steps_bridged"]
+    >>> np.round(tt, 9).tolist(), round(info["largest_step"], 3), info["steps_bridged"]
     ([0.0, 0.005, 0.01, 0.015, 0.02, 0.025], 0.01, 1)
     """
     check_time(t, file=file, column=column, row_of=row_of, max_gap=RESAMPLE_MAX_GAP)

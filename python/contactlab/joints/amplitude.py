@@ -319,11 +319,14 @@ def _start_from_table(name: str, A: np.ndarray, E: np.ndarray | None,
                       k: np.ndarray | None) -> Any:  # fmt: skip
     """A Segalman / Iwan / Jenkins law started from the table: the log-log slope of E gives
     χ (E ∝ A^(χ+3) in micro-slip), its level R, and the stiffness (or, without one, a
-    macro-slip displacement 3× the largest amplitude) K_T."""
+    macro-slip displacement 10× the largest amplitude: a K_T held there leaves F_S room to
+    set R while every amplitude stays in micro-slip) K_T."""
     from .laws import LAWS
 
     amax = float(np.max(A))
-    if E is not None and np.sum(E > 0) >= 2:
+    if name in ("iwan", "jenkins"):
+        chi = 0.0
+    elif E is not None and np.sum(E > 0) >= 2:
         ok = E > 0
         slope = float(np.polyfit(np.log(A[ok]), np.log(E[ok]), 1)[0])
         chi = min(max(slope - 3.0, -0.9), 0.0)
@@ -336,8 +339,8 @@ def _start_from_table(name: str, A: np.ndarray, E: np.ndarray | None,
     else:
         R = None
     if KT is None and R is not None:
-        # φmax = 3 A_max with β = 0: K_T = R φmax^(χ+1) / (χ+1)
-        KT = R * (3.0 * amax) ** (chi + 1.0) / (chi + 1.0)
+        # φmax = 10 A_max with β = 0: K_T = R φmax^(χ+1) / (χ+1)
+        KT = R * (10.0 * amax) ** (chi + 1.0) / (chi + 1.0)
     if KT is None:
         raise InputError("give an energy or damping column, or a stiffness column, to start from")
     if R is not None:
@@ -515,8 +518,9 @@ class Sweep:
 
     def phase_resonance(self) -> dict[str, float] | None:
         """The point where the phase crosses −π/2 (linear interpolation between the two
-        points around it): frequency, force, displacement and equivalent damping
-        ``c = F / (ω X)`` [N s/m] there; None when the sweep does not cross it."""
+        points around it): frequency, force, displacement and the equivalent damping
+        ``c = F / (ω X)`` [N s/m] there (interpolated as ``Im(F/X) / ω``, equal to it at
+        phase resonance); None when the sweep does not cross it."""
         ph = np.unwrap(self.phase) + math.pi / 2.0
         idx = np.flatnonzero(np.sign(ph[:-1]) != np.sign(ph[1:]))
         if idx.size == 0:
@@ -528,8 +532,11 @@ class Sweep:
             return float(a[i] + w * (a[i + 1] - a[i]))
 
         f, F, X = at(self.frequency), at(self.force), at(self.displacement)
-        omega = 2.0 * math.pi * f
-        return {"frequency": f, "force": F, "displacement": X, "c_eq": F / (omega * X)}
+        # the damping from the quadrature part of the dynamic stiffness, Im(F/X)/ω, which
+        # varies slowly across resonance (F and X each pass through an extreme there)
+        K = self.force / (self.displacement * np.exp(1j * self.phase))
+        c = at(K.imag / (2.0 * math.pi * self.frequency))
+        return {"frequency": f, "force": F, "displacement": X, "c_eq": c}
 
 
 @dataclass
@@ -704,7 +711,7 @@ def fit_stepped_sine(sweeps: Sequence[Sweep], *, law: Any = "segalman",
     start = _resolve(law, Ar, E_start, None)
     fixed_set, why = _default_fixed(start, fixed, False)
     names = list(start.param_names)
-    # the amplitude grid the law is evaluated on (log-spaced), interpolated to the points
+    # a law without closed forms is simulated on a log-spaced amplitude grid, interpolated
     grid = np.geomspace(float(A.min()) * 0.98, float(A.max()) * 1.02, 48)
     fmid = float(np.median(f))
     failures: dict[str, str] = {}
@@ -715,6 +722,9 @@ def fit_stepped_sine(sweeps: Sequence[Sweep], *, law: Any = "segalman",
 
     def joint(v: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
         lw = start.with_params([v[n] for n in names])
+        if closed_form_available(lw):  # cheap: at every point's own amplitude
+            p = equivalent_properties(lw, A, fmid)
+            return p.k_eq, p.energy / (math.pi * A**2)
         p = equivalent_properties(lw, grid, fmid)
         failures.clear()  # those of the latest trial: the end point's when the fit is done
         for i, reason in p.failures.items():

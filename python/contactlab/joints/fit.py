@@ -682,6 +682,16 @@ def fit(
     if not res_law.success and res.success:
         res.notes.append(f"the search over the law's parameters ended: {res_law.message}")
     _identifiability_notes(res)
+    explained = 1.0 - res.chisqr / var if var > 0 else math.nan
+    if explained < 0.1:
+        errors.insert(0, (
+            f"the fitted {final_law.name} law explains {100 * max(explained, 0.0):.0f} % of "
+            "the force's variance: it cannot produce these loops (a force of the opposite "
+            "sign, whose loops run the active way? a record with no joint motion?)"
+        ))  # fmt: skip
+        if all(p.identifiable is False for p in res.params.values() if p.vary):
+            res.success = False
+            res.message = "no parameter is determined by the data: " + errors[0]
     out = JointFit(
         law=final_law,
         terms={n: res.params[n].value for n in terms},

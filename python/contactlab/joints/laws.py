@@ -221,6 +221,16 @@ class JointLaw:
         """The plain-Python reference of this law (tests, and the fallback kernel)."""
         raise NotImplementedError
 
+    def _core_spec(self) -> tuple[str, list[float], list[Any]]:
+        """``(kind, own parameters, children)`` as the Rust core builds the law."""
+        return (self.name, [float(v) for v in self._values()], [])
+
+    def _kernel(self, x0: float) -> Any:
+        """The Rust operator of this law, relaxed at ``x0``."""
+        from .. import _core
+
+        return _core.JointOperatorCore(self._core_spec(), x0)
+
     def operator(self, x0: float = 0.0) -> JointOperator:
         """A stateful operator for a recording streamed in chunks.
 
@@ -280,8 +290,7 @@ class JointOperator:
 
     def reset(self) -> None:
         """Back to the relaxed state at ``x0``."""
-        self._kernel = self.law._ref()
-        self._state: Any = None
+        self._kernel = self.law._kernel(self.x0)
         self._t_prev: float | None = None
         self._started = False
 
@@ -313,25 +322,10 @@ class JointOperator:
             if self._started and self._t_prev is None:
                 raise InputError("t was None for an earlier chunk: pass None for every chunk")
             _check_time(ta, self._t_prev)
-        try:
-            f, self._state, self._t_prev = ref.run(
-                self._kernel,
-                None if ta is None else ta.tolist(),
-                xa.tolist(),
-                self._state,
-                self.x0,
-                self._t_prev,
-            )
-        except ArithmeticError as exc:
-            raise InputError(f"{self.law.name}: {exc}") from None
+        out = self._kernel.push(ta, xa)
         self._started = True
-        out = np.asarray(f, dtype=float)
-        if out.size and not np.isfinite(out).all():
-            i = int(np.argmax(~np.isfinite(out)))
-            raise InputError(
-                f"{self.law.name}: force[{i}] is out of the double-precision range "
-                f"({out[i]}): rescale the data"
-            )
+        if ta is not None and ta.size:
+            self._t_prev = float(ta[-1])
         return out
 
 
@@ -838,11 +832,35 @@ class MasingLaw(_Leaf):
         return Masing(self.h0, self.ac, self.scale)
 
     def _ref(self) -> ref.RefLaw:
-        return _MasingKernel(self.masing())
+        if self._model is None and self.scale == 2.0:
+            return ref.RefMasingExp(self.h0, self.ac)
+        return _MasingRef(self.masing())
+
+    def _core_spec(self) -> tuple[str, list[float], list[Any]]:
+        if self._model is not None or self.scale != 2.0:
+            raise InputError(
+                "masing: inside a series, parallel or backlash law only the exponential curve "
+                f"with Masing's rule (scale 2) is available, got {self!r}"
+            )
+        return super()._core_spec()
+
+    def _kernel(self, x0: float) -> Any:
+        return _MasingKernel(self.masing(), x0)
 
 
-class _MasingKernel(ref.RefLaw):
-    """Adapter: the Rust Masing operator, sample by sample (relative to ``x0``)."""
+class _MasingKernel:
+    """The Masing operator (any backbone and scale) behind the joint-law operator."""
+
+    def __init__(self, model: Any, x0: float) -> None:
+        self.op, self.x0 = model.operator(), x0
+
+    def push(self, t: Any, x: np.ndarray) -> np.ndarray:
+        return self.op.push(x - self.x0 if self.x0 else x)
+
+
+class _MasingRef(ref.RefLaw):
+    """Reference stand-in for a Masing law with a tabulated curve or a scale other than 2:
+    the Masing operator, sample by sample (relative to ``x0``)."""
 
     def __init__(self, model: Any) -> None:
         self.model = model
@@ -883,6 +901,9 @@ class _Composite(JointLaw):
         for law in self.laws:
             out += law._values()
         return out
+
+    def _core_spec(self) -> tuple[str, list[float], list[Any]]:
+        return (self.name, [float(v) for v in self._own()], [law._core_spec() for law in self.laws])
 
     def _split(self, values: list[float]) -> tuple[list[float], list[JointLaw]]:
         n = len(self._OWN)

@@ -11,20 +11,15 @@ SI units throughout (Pa, m, J/m², Pa/m); the paper's MPa and µm only for displ
 
 from __future__ import annotations
 
-from ._paper import TABLE2_MPA_UM
+from .._moved import forward
 from .compare import (
     Comparison,
     compare,
-    plot_comparison,
-    plot_displacement,
-    plot_loops,
-    plot_phase_portrait,
-    plot_velocity,
 )
 from .loop import LoopResult, analyze_loop
 from .models import KelvinVoigt, NonlinearContact, OdeResult
+from .paper import TABLE2_MPA_UM
 from .stiffness import PressureStiffnessFit, fit_pressure_stiffness
-from .synthetic import synthetic_recording, table2_model, table2_psi
 
 __all__ = [
     "TABLE2_MPA_UM",
@@ -37,12 +32,19 @@ __all__ = [
     "analyze_loop",
     "compare",
     "fit_pressure_stiffness",
-    "plot_comparison",
-    "plot_displacement",
-    "plot_loops",
-    "plot_phase_portrait",
-    "plot_velocity",
-    "synthetic_recording",
-    "table2_model",
-    "table2_psi",
 ]
+
+# moved to the report layer and to contactlab.synthetic (issue 32): the old names warn and forward
+__getattr__ = forward(
+    __name__,
+    {
+        "plot_comparison": "contactlab.report.normal",
+        "plot_displacement": "contactlab.report.normal",
+        "plot_loops": "contactlab.report.normal",
+        "plot_phase_portrait": "contactlab.report.normal",
+        "plot_velocity": "contactlab.report.normal",
+        "synthetic_recording": "contactlab.synthetic.normal",
+        "table2_model": "contactlab.synthetic.normal",
+        "table2_psi": "contactlab.synthetic.normal",
+    },
+)

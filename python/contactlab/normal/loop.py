@@ -38,7 +38,7 @@ from .. import _core
 from .._arrays import as_1d, positive
 from .._physical import check_channel
 from ..errors import ContactLabWarning, InputError
-from . import _paper
+from . import paper as _paper
 
 _UNITS = {
     "E_d": "J/m^2",
@@ -824,7 +824,8 @@ def analyze_loop(
 
     Examples
     --------
-    >>> from contactlab.normal import analyze_loop, synthetic_recording
+    >>> from contactlab.normal import analyze_loop
+    >>> from contactlab.synthetic.normal import synthetic_recording
     >>> t, p, d = synthetic_recording(model="table2", n_cycles=4, noise=None)
     >>> res = analyze_loop(t, p, d)
     >>> [round(a, 3) for a in res.table2()["unload"]]

@@ -31,7 +31,7 @@ import numpy as np
 from .. import _core
 from .._arrays import as_1d, positive
 from ..errors import ContactLabWarning, InputError
-from . import _paper
+from . import paper as _paper
 
 #: default cap on the ODE's step attempts: this many per sample, plus AUTO_STEPS_BASE (a
 #: record takes a few per sample; an absurd model, e.g. a stiffness of -1e300, otherwise ran

@@ -22,7 +22,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import ContactLabWarning, InputError
-from . import _paper
+from . import paper as _paper
 from .loop import LoopResult, analyze_loop
 from .models import NonlinearContact
 
@@ -140,7 +140,8 @@ def fit_pressure_stiffness(
 
     Examples
     --------
-    >>> from contactlab.normal import fit_pressure_stiffness, synthetic_recording
+    >>> from contactlab.normal import fit_pressure_stiffness
+    >>> from contactlab.synthetic.normal import synthetic_recording
     >>> recs = [synthetic_recording(p0=p0, n_cycles=4, noise=None) for p0 in (0.5e6, 1.0e6)]
     >>> fit = fit_pressure_stiffness(recs)
     >>> fit.b.shape

@@ -6,8 +6,7 @@ set of files all or nothing, so a failed or interrupted run leaves the output fo
 
 from __future__ import annotations
 
-from ._outputs import commit_outputs
-from .html import (
+from .._html import (
     Column,
     Report,
     figure_png,
@@ -16,6 +15,7 @@ from .html import (
     slugify,
     table_html,
 )
+from .._outputs import commit_outputs
 
 __all__ = [
     "Column",

@@ -16,10 +16,10 @@ from typing import Any
 
 import numpy as np
 
+from .._html import Column, Report
 from ..studies.columns import NORMAL_COLUMNS, TANGENTIAL_COLUMNS
-from ..studies.plots import display_unit, normal_study_figures, tangential_study_figures, trends
 from ..studies.study import RecordingResult, StudyResult
-from .html import Column, Report
+from .study_plots import display_unit, normal_study_figures, tangential_study_figures, trends
 
 
 def _present(columns: Sequence[Column], rows: Sequence[dict]) -> list[Column]:
@@ -45,7 +45,7 @@ def _label(r: RecordingResult) -> str:
 def _tangential_detail(rep: Report, r: RecordingResult, dpi: int) -> None:
     import matplotlib.pyplot as plt
 
-    from ..tangential import plot_loop, plot_residuals
+    from .tangential import plot_loop, plot_residuals
 
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(9.0, 3.4), constrained_layout=True)
     plot_loop(r.analysis, ax=a1)

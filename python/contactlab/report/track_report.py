@@ -6,9 +6,9 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..studies.track_plots import LABELS, track_figures
+from .._html import Column, Report
 from ..studies.tracking import CYCLE_UNITS, TrackResult
-from .html import Column, Report
+from .track_plots import LABELS, track_figures
 
 #: display (label, unit, scale) of the tracked quantities' SI units
 _DISPLAY = {

@@ -12,12 +12,12 @@ identify joints from input/response records (issue 10).
 
 from __future__ import annotations
 
+from .._moved import forward
 from .amplitude_mdof import (
     ModalAmplitudeDependence,
     PhaseResonance,
     modal_amplitude_dependence,
     phase_resonance,
-    plot_modal_amplitude_dependence,
 )
 from .identify import IdentifiedModel, identify
 from .joints import Joint, iwan_uniform, make_joint
@@ -38,5 +38,9 @@ __all__ = [
     "modal_amplitude_dependence",
     "modes",
     "phase_resonance",
-    "plot_modal_amplitude_dependence",
 ]
+
+# moved to the report layer (issue 32): the old names warn and forward
+__getattr__ = forward(
+    __name__, {"plot_modal_amplitude_dependence": "contactlab.report.structure_plots"}
+)

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from .._arrays import as_1d
+from .._moved import forward
 from ..errors import InputError
 from .model import Structure
 
@@ -117,18 +118,5 @@ def amplitude_dependence(structure: Structure, amplitudes: Any) -> AmplitudeDepe
     return AmplitudeDependence(amp, wn / (2 * np.pi), zeta, keq, energy)
 
 
-def plot_amplitude_dependence(ad: AmplitudeDependence, ax: Any = None) -> Any:
-    """Frequency and damping ratio versus amplitude (two axes); returns the axes."""
-    import matplotlib.pyplot as plt
-
-    if ax is None:
-        _, ax = plt.subplots(1, 2, figsize=(9, 3.5), layout="constrained")
-    ax[0].semilogx(ad.amplitude, ad.frequency_hz, "o-")
-    ax[0].set_xlabel("amplitude [m]")
-    ax[0].set_ylabel("natural frequency [Hz]")
-    ax[1].semilogx(ad.amplitude, 100 * ad.damping_ratio, "o-")
-    ax[1].set_xlabel("amplitude [m]")
-    ax[1].set_ylabel("damping ratio [%]")
-    for a in ax:
-        a.grid(True, alpha=0.3)
-    return ax
+# moved to the report layer (issue 32): the old names warn and forward
+__getattr__ = forward(__name__, {"plot_amplitude_dependence": "contactlab.report.structure_plots"})

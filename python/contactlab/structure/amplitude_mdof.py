@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 import scipy.linalg
 
+from .._moved import forward
 from ..errors import ConvergenceError, InputError
 from .model import Structure
 
@@ -240,25 +241,6 @@ def _mode(M: np.ndarray, K: np.ndarray, mode: int, prev: np.ndarray | None) -> t
     return float(w2[i]), phi[:, i]
 
 
-def plot_modal_amplitude_dependence(ads: list[ModalAmplitudeDependence], ax: Any = None) -> Any:
-    """Frequency and damping ratio against amplitude, one line per mode; returns the axes."""
-    import matplotlib.pyplot as plt
-
-    if ax is None:
-        _, ax = plt.subplots(1, 2, figsize=(9, 3.5), layout="constrained")
-    for ad in ads:
-        lab = f"mode {ad.mode + 1} (x{ad.ref_dof})"
-        ax[0].semilogx(ad.amplitude, ad.frequency_hz, "o-", label=lab)
-        ax[1].semilogx(ad.amplitude, 100 * ad.damping_ratio, "o-", label=lab)
-    ax[0].set_ylabel("natural frequency [Hz]")
-    ax[1].set_ylabel("damping ratio [%]")
-    for a in ax:
-        a.set_xlabel("amplitude of the reference DOF [m]")
-        a.grid(True, alpha=0.3)
-        a.legend(fontsize=8)
-    return ax
-
-
 @dataclass
 class PhaseResonance:
     """A mode's frequency and damping ratio measured on a periodic steady state (stepped
@@ -354,3 +336,9 @@ def phase_resonance(
     work = float(np.sum(np.sin(w * r.t) * (v @ p))) / (npp * f)
     zeta = work / (4 * np.pi * 0.5 * w * w * float(xa @ structure.M @ xa))
     return PhaseResonance(mode, ref, float(abs(X[ref])), f, zeta, p, X, runs)
+
+
+# moved to the report layer (issue 32): the old names warn and forward
+__getattr__ = forward(
+    __name__, {"plot_modal_amplitude_dependence": "contactlab.report.structure_plots"}
+)

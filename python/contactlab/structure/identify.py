@@ -31,12 +31,12 @@ from typing import Any
 import numpy as np
 
 from .._arrays import as_1d
+from .._blas import with_single_blas_thread
 from .._io_atomic import write_text
 from .._physical import MAX_MAGNITUDE, check_channel
 from ..errors import ContactLabError, InputError
 from ..fitting import FitResult, Parameter, least_squares_fit
-from ._blas import with_single_blas_thread
-from ._fitkit import (
+from .fitkit import (
     IWAN_ELEMENTS,
     add_fitted_joint,
     best_start,

@@ -33,7 +33,7 @@ from .._arrays import as_1d
 from .._physical import MAX_MAGNITUDE, check_channel
 from ..errors import ContactLabError, InputError
 from ..fitting import Parameter, least_squares_fit
-from ._fitkit import (
+from .fitkit import (
     add_fitted_joint,
     best_start,
     column_derivatives,

@@ -6,7 +6,7 @@ itself in a notebook without importing the report builder (which imports the stu
 
 from __future__ import annotations
 
-from ..report.html import Column
+from .._html import Column
 
 #: SI units of the per-cycle quantities of :func:`contactlab.studies.tracking.track`
 CYCLE_UNITS = {

@@ -173,7 +173,7 @@ def analyze_entry(
     else:
         rec = read_recording(entry.path, columns=entry.columns, kind=entry.kind, fs=entry.fs,
                              resample=entry.resample)  # fmt: skip
-    from ..diagnose._inputs import check_recording_glitches
+    from ..io.checks import check_recording_glitches
 
     check_recording_glitches(rec)  # a sensor glitch is refused, as diagnose refuses it
     base = {"file": entry.path.name, "kind": entry.kind, **entry.tags}
@@ -307,7 +307,7 @@ class StudyResult:
 
     def _repr_html_(self) -> str:
         """Summary tables in notebooks (the full report: ``report.study_report``)."""
-        from ..report.html import table_html
+        from .._html import table_html
         from .columns import NORMAL_COLUMNS, TANGENTIAL_COLUMNS
 
         parts = []

@@ -335,10 +335,17 @@ class TrackResult:
 
     def plot(self, name: str, *, against: str = "time", ax: Any = None) -> Any:
         """``name`` (with error bars when it has a standard error) against window mid time
-        (``against="time"``) or cycle count (``"cycle"``); returns the axes."""
-        from .track_plots import plot_quantity
+        (``against="time"``) or cycle count (``"cycle"``); returns the axes.
 
-        return plot_quantity(self, name, against=against, ax=ax)
+        Deprecated (issue 32: studies return results, the report draws them): use
+        :func:`contactlab.report.track_plots.plot_quantity`.
+        """
+        from .._moved import moved
+
+        fn = moved(
+            "contactlab.TrackResult", "plot", "contactlab.report.track_plots", "plot_quantity"
+        )
+        return fn(self, name, against=against, ax=ax)
 
     def __repr__(self) -> str:
         return (
@@ -439,7 +446,7 @@ def _with_glitch_check(
 ) -> Callable[..., tuple[dict, dict]]:
     @functools.wraps(fn)
     def run(rec: Recording | _WindowSamples, *args: Any, **kwargs: Any) -> tuple[dict, dict]:
-        from ..diagnose._inputs import check_recording_glitches
+        from ..io.checks import check_recording_glitches
 
         try:
             row, units = fn(rec, *args, **kwargs)
@@ -784,7 +791,7 @@ def track(
 
     Examples
     --------
-    >>> from contactlab.tangential import synthetic_recording
+    >>> from contactlab.synthetic.tangential import synthetic_recording
     >>> rec = synthetic_recording(h0=40.0, ac=4e4, amplitude=20e-6, n_cycles=12, fs=2000.0,
     ...                           noise=0.01, seed=2)
     >>> res = track(rec, every="4cycles")  # 10 complete cycles: 4 + 4, and a 2-cycle tail
@@ -1027,7 +1034,7 @@ def track_many(
     Examples
     --------
     >>> from concurrent.futures import ThreadPoolExecutor
-    >>> from contactlab.tangential import synthetic_recording
+    >>> from contactlab.synthetic.tangential import synthetic_recording
     >>> recs = [synthetic_recording(h0=40.0, ac=4e4, amplitude=20e-6, n_cycles=8, fs=1000.0,
     ...                             noise=0.01, seed=s) for s in (1, 2)]
     >>> with ThreadPoolExecutor(2) as ex:

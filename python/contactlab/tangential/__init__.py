@@ -7,12 +7,11 @@ equivalent damping* with the corrected formulas of PHYSICS.md §1.
 
 from __future__ import annotations
 
+from .._moved import forward
 from .analysis import analyze_tangential
 from .frame import FrameForce, frame_friction_force, read_frame
-from .plots import plot_loop, plot_residuals
 from .preprocess import AveragedLoop, CycleScatter, Reversals, average_loop, find_reversals
 from .result import UNITS, TangentialAnalysis
-from .synthetic import synthetic_recording
 
 __all__ = [
     "UNITS",
@@ -25,8 +24,15 @@ __all__ = [
     "average_loop",
     "find_reversals",
     "frame_friction_force",
-    "plot_loop",
-    "plot_residuals",
     "read_frame",
-    "synthetic_recording",
 ]
+
+# moved to the report layer and to contactlab.synthetic (issue 32): the old names warn and forward
+__getattr__ = forward(
+    __name__,
+    {
+        "plot_loop": "contactlab.report.tangential",
+        "plot_residuals": "contactlab.report.tangential",
+        "synthetic_recording": "contactlab.synthetic.tangential",
+    },
+)

@@ -182,6 +182,26 @@ def identifiability(
     return identifiable, evidence
 
 
+def _refuse_no_loop(evidence: dict[str, Any], energy: tuple[float, float]) -> None:
+    """Refuse a recording without a loop: neither the loop's initial stiffness h0·ac is
+    determined nor its area (the energy per cycle from the samples) distinguishable from
+    zero at 3 standard errors. Pure noise, a disconnected force channel or unrelated
+    channels would otherwise give a result of undetermined numbers ("± nan", "ac < inf")."""
+    if evidence["h0_ac"]:
+        return
+    e, e_err = energy
+    if math.isfinite(e_err) and e_err > 0 and abs(e) > 3 * e_err:
+        return
+    area = f"{e:.3g} ± {e_err:.2g} J" if math.isfinite(e_err) else f"{e:.3g} J"
+    raise InputError(
+        "no friction loop in this recording: the force does not follow the displacement "
+        f"(the loop's initial stiffness h0·ac is undetermined, relative error "
+        f"{_percent(evidence['rel_stderr_h0_ac'])}, and the loop area {area} per cycle is "
+        "not distinguishable from zero): a noise-only or disconnected force channel, or "
+        "unrelated channels?"
+    )
+
+
 #: the model's quantities at the amplitude (:func:`_model_quantities`), in its order
 _MODEL_QUANTITIES = (
     "energy_per_cycle",
@@ -465,7 +485,7 @@ def analyze_tangential(
 
     Examples
     --------
-    >>> from contactlab.tangential import synthetic_recording
+    >>> from contactlab.synthetic.tangential import synthetic_recording
     >>> rec = synthetic_recording(h0=20.0, ac=1e5, amplitude=10e-6, n_cycles=5, seed=0)
     >>> res = analyze_tangential(rec)
     >>> res.identifiable, abs(res.fit.params["h0"].value - 20) < 3 * res.fit.params["h0"].stderr
@@ -794,6 +814,7 @@ def _analyze(
     h0_lo = evidence.pop("h0_lower_bound")
     ac_up = evidence.pop("ac_upper_bound")
     derived = derived_quantities(raw, amp, det, data.start)
+    _refuse_no_loop(evidence, derived["energy_per_cycle_numeric"])
     if not identifiable:
         derived["h0_lower_bound"] = (h0_lo, math.nan)
         derived["ac_upper_bound"] = (ac_up, math.nan)

@@ -56,6 +56,12 @@ pub enum CoreError {
     /// A signal is too long for the sample counter (global indices must fit in 63 bits).
     #[error("a chunk of {len} samples would overflow the operator's sample counter")]
     TooLong { len: usize },
+    /// A composite joint law (series, backlash) found no force balance in a step.
+    #[error("{what}: no force balance at sample {index} (a law whose force decreases as its displacement grows)")]
+    NoSolution { what: &'static str, index: usize },
+    /// A joint-law description names no known law or has the wrong shape.
+    #[error("joint law {kind:?}: {reason}")]
+    InvalidLaw { kind: String, reason: String },
     /// A stiffness function is not positive where it is evaluated.
     #[error("stiffness is not positive ({value}) at {name} = {at}")]
     NonPositiveStiffness {

@@ -14,6 +14,7 @@ use pyo3::sync::PyOnceLock;
 use pyo3::types::PyDict;
 
 mod errors;
+mod joints;
 mod loop_fit;
 mod normal;
 mod scan;
@@ -341,5 +342,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     scan::register(m)?;
     stream::register(m)?;
     loop_fit::register(m)?;
+    joints::register(m)?;
     Ok(())
 }

@@ -1,15 +1,15 @@
 //! Bindings of `contactlab_core::signal` (the streaming reversal detector), the branch memory
 //! of the Masing rules, and the multi-channel force kernel (Rust threads).
 
+use contactlab_core::cycles::{cycle_block, CycleState};
+use contactlab_core::fold::{fold_phase, fold_spread, period_means, period_means_pair, FoldSums};
 use contactlab_core::isotonic::monotone_path;
+use contactlab_core::loop_area::{loop_area_sensitivity, loop_areas};
 use contactlab_core::masing::split::{force_channels, Channel, PIECE};
 use contactlab_core::masing::{branch_memory, MasingState};
 use contactlab_core::parallel::run_jobs;
+use contactlab_core::reversal::{Excursion, Schmitt};
 use contactlab_core::select::order_stats;
-use contactlab_core::signal::{
-    cycle_block, fold_phase, fold_spread, loop_area_sensitivity, loop_areas, period_means,
-    period_means_pair, CycleState, Excursion, FoldSums, Schmitt,
-};
 use contactlab_core::window::{
     detrend_pair, detrend_pair_into, fold_window, WindowFold as CoreWindowFold,
 };
@@ -269,7 +269,7 @@ fn force_repeat<'py>(
 }
 
 /// Phase-bin fold of a periodic recording, accumulated chunk by chunk (see
-/// `contactlab_core::signal::fold_phase`).
+/// `contactlab_core::fold::fold_phase`).
 #[pyclass(module = "contactlab._core")]
 struct PhaseFold {
     sums: FoldSums,
@@ -302,7 +302,7 @@ impl PhaseFold {
     }
 
     /// Cycle-to-cycle spread per bin (`x_std`, `F_std`) and per-cycle half ranges of the
-    /// bin means (`amplitude`, `force_range`); see `contactlab_core::signal::fold_spread`.
+    /// bin means (`amplitude`, `force_range`); see `contactlab_core::fold::fold_spread`.
     fn spread<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let sums = &self.sums;
         let sp = detach_guarded(py, || fold_spread(sums))?;
@@ -365,7 +365,7 @@ fn loop_areas_py<'py>(
 }
 
 /// Per cycle between consecutive `bounds`: `(Σ coef_F², Σ coef_x²)`, the loop area's noise
-/// sensitivities (see `contactlab_core::signal::loop_area_sensitivity`).
+/// sensitivities (see `contactlab_core::loop_area::loop_area_sensitivity`).
 #[pyfunction]
 #[pyo3(name = "loop_area_sensitivity")]
 fn loop_area_sensitivity_py<'py>(
@@ -380,7 +380,7 @@ fn loop_area_sensitivity_py<'py>(
 }
 
 /// Streaming cycle finder: upward crossings of a drive channel and per-cycle loop energy,
-/// amplitude and offset (see `contactlab_core::signal::cycle_block`).
+/// amplitude and offset (see `contactlab_core::cycles::cycle_block`).
 #[pyclass(module = "contactlab._core")]
 struct CycleTracker {
     state: CycleState,
@@ -434,7 +434,7 @@ impl CycleTracker {
 }
 
 /// Time averages of `v` between consecutive `edges` (see
-/// `contactlab_core::signal::period_means`).
+/// `contactlab_core::fold::period_means`).
 #[pyfunction]
 #[pyo3(name = "period_means")]
 fn period_means_py<'py>(
@@ -449,7 +449,7 @@ fn period_means_py<'py>(
 }
 
 /// Period means of two channels on one time axis in one pass (see
-/// `contactlab_core::signal::period_means_pair`).
+/// `contactlab_core::fold::period_means_pair`).
 #[pyfunction]
 #[pyo3(name = "period_means_pair")]
 fn period_means_pair_py<'py>(

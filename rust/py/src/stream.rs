@@ -1,7 +1,7 @@
 //! Binding of `contactlab_core::stream` and of the streaming cycle finder
-//! (`contactlab_core::signal::cycle_block`): the reading side of a streamed analysis.
+//! (`contactlab_core::cycles::cycle_block`): the reading side of a streamed analysis.
 
-use contactlab_core::signal::{cycle_block, cycle_block_sampled, BlockCycles, CycleState};
+use contactlab_core::cycles::{cycle_block, cycle_block_sampled, BlockCycles, CycleState};
 use contactlab_core::stream::fill_time;
 use numpy::{IntoPyArray, PyReadonlyArray1, PyReadwriteArray1};
 use pyo3::prelude::*;
@@ -28,7 +28,7 @@ fn fill_time_py<'py>(
 
 /// Streaming cycle finder of a long recording (`contactlab.studies._cycles`): upward
 /// crossings of a drive channel and per-cycle loop energy, amplitude and offset (see
-/// `contactlab_core::signal::cycle_block`), the state carried from block to block.
+/// `contactlab_core::cycles::cycle_block`), the state carried from block to block.
 #[pyclass(module = "contactlab._core")]
 struct CycleStream {
     state: CycleState,
@@ -85,7 +85,7 @@ impl CycleStream {
     }
 
     /// One block of a recording sampled every `dt` from `t0` (no time array; see
-    /// `contactlab_core::signal::cycle_block_sampled`): as `push`.
+    /// `contactlab_core::cycles::cycle_block_sampled`): as `push`.
     #[allow(clippy::too_many_arguments)]
     fn push_sampled<'py>(
         &mut self,

@@ -7,6 +7,10 @@
 //! - [`newmark`]: the integrator, sample-exact outputs, energy bookkeeping.
 //! - [`dense`]: allocation-free LU for the Newton systems.
 //! - `sdof`: the integrator specialised to one DOF (scalars throughout).
+//!
+//! This module holds what both integrators share (the structure, inputs, options, outputs)
+//! and the one front, [`simulate`] / [`simulate_into`], that checks the inputs and picks the
+//! integrator; `newmark` and `sdof` depend on it, not on each other.
 
 pub(crate) mod dense;
 pub mod joint;
@@ -14,6 +18,335 @@ pub mod newmark;
 mod sdof;
 
 pub use joint::{Joint, JointLaw, JointState, MasingCurve, Trial};
-pub use newmark::{
-    simulate, simulate_into, Buffers, Inputs, Options, Response, Status, Structure, Summary,
-};
+
+use crate::error::{check_finite, check_same_len, CoreError};
+
+/// A linear structure with joints: dense row-major `n × n` matrices.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Structure {
+    n: usize,
+    m: Vec<f64>,
+    c: Vec<f64>,
+    k: Vec<f64>,
+    joints: Vec<Joint>,
+}
+
+impl Structure {
+    /// `m`, `c`, `k`: row-major `n × n`. `M` must be nonsingular (checked when simulating).
+    pub fn new(
+        n: usize,
+        m: &[f64],
+        c: &[f64],
+        k: &[f64],
+        joints: Vec<Joint>,
+    ) -> Result<Self, CoreError> {
+        if n == 0 {
+            return Err(CoreError::Empty { name: "M" });
+        }
+        let nn = n.checked_mul(n).ok_or(CoreError::InvalidParameter {
+            name: "n",
+            value: n as f64,
+            reason: "too many degrees of freedom",
+        })?;
+        for (name, a) in [("M", m), ("C", c), ("K", k)] {
+            check_same_len(name, a.len(), "n*n", nn)?;
+            check_finite(name, a)?;
+        }
+        for j in &joints {
+            let bad = j.dof >= n || j.dof2.is_some_and(|d| d >= n || d == j.dof);
+            if bad {
+                return Err(CoreError::InvalidParameter {
+                    name: "joint dof",
+                    value: j.dof as f64,
+                    reason: "joint degrees of freedom must be < n and distinct",
+                });
+            }
+        }
+        Ok(Self {
+            n,
+            m: m.to_vec(),
+            c: c.to_vec(),
+            k: k.to_vec(),
+            joints,
+        })
+    }
+
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    pub fn joints(&self) -> &[Joint] {
+        &self.joints
+    }
+}
+
+/// Iteration controls.
+#[derive(Debug, Clone, Copy)]
+pub struct Options {
+    /// Newton converges when the residual norm is below `rtol` times the size of the forces.
+    pub rtol: f64,
+    /// Newton iterations per step before the step is halved.
+    pub max_iter: usize,
+    /// Step halvings allowed per sample interval before the run stops with a failure.
+    pub max_halvings: usize,
+    /// Event sub-steps allowed per sample interval.
+    pub max_events: usize,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            rtol: 1e-10,
+            max_iter: 30,
+            max_halvings: 12,
+            max_events: 16,
+        }
+    }
+}
+
+/// Why a simulation stopped.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Status {
+    Success,
+    /// Newton did not converge even on the smallest sub-step.
+    NoConvergence {
+        time: f64,
+        step: f64,
+    },
+    /// The state became NaN or infinite.
+    NonFinite {
+        time: f64,
+    },
+}
+
+impl Status {
+    /// scipy-style: 0 success, -1 failure.
+    pub fn code(&self) -> i32 {
+        match self {
+            Status::Success => 0,
+            _ => -1,
+        }
+    }
+
+    pub fn message(&self) -> String {
+        match self {
+            Status::Success => "The integration reached the last sample.".into(),
+            Status::NoConvergence { time, step } => format!(
+                "Newton iterations did not converge at t = {time} (smallest step {step:e})."
+            ),
+            Status::NonFinite { time } => format!("The response became non-finite at t = {time}."),
+        }
+    }
+}
+
+/// Base motion: `(y, ẏ, K r, C r)`, displacement and velocity at the samples and the coupling
+/// vectors (`n` each).
+pub type Base<'a> = (&'a [f64], &'a [f64], &'a [f64], &'a [f64]);
+
+/// Excitation sampled at the time points `t`.
+#[derive(Debug, Clone, Copy)]
+pub struct Inputs<'a> {
+    pub t: &'a [f64],
+    /// Row-major `len(t) × n` external forces, or `None`.
+    pub force: Option<&'a [f64]>,
+    /// `(y, ẏ, K r, C r)`: base displacement and velocity at `t`, coupling vectors (`n` each).
+    pub base: Option<Base<'a>>,
+}
+
+/// Sampled response; arrays are row-major (sample-major), `n_out` rows are valid.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Response {
+    pub x: Vec<f64>,
+    pub v: Vec<f64>,
+    pub a: Vec<f64>,
+    /// `len(t) × n_joints` joint forces.
+    pub joint_force: Vec<f64>,
+    /// `len(t) × n_joints` cumulative work done on each joint.
+    pub joint_work: Vec<f64>,
+    /// `len(t) × n_joints` cumulative dissipated energy (work minus stored energy).
+    pub joint_dissipated: Vec<f64>,
+    /// Cumulative input work of the external and base forces.
+    pub input_work: Vec<f64>,
+    /// Cumulative energy dissipated by C.
+    pub damping_work: Vec<f64>,
+    pub status: Status,
+    pub n_out: usize,
+    /// Accepted steps (sample intervals plus event and halving sub-steps).
+    pub n_steps: u64,
+    /// Newton iterations in total.
+    pub n_iter: u64,
+}
+
+/// Output buffers for [`simulate_into`] (row-major like [`Response`]'s arrays): `x`, `v`,
+/// `a` of `len(t) × n`; the joint arrays `len(t) × n_joints`; the energies `len(t)`. An empty
+/// buffer is an output the caller does not want (it is not computed). Rows past the run's
+/// `n_out` are left as they were.
+#[derive(Debug)]
+pub struct Buffers<'a> {
+    pub x: &'a mut [f64],
+    pub v: &'a mut [f64],
+    pub a: &'a mut [f64],
+    pub joint_force: &'a mut [f64],
+    pub joint_work: &'a mut [f64],
+    pub joint_dissipated: &'a mut [f64],
+    pub input_work: &'a mut [f64],
+    pub damping_work: &'a mut [f64],
+}
+
+/// How a run ended (the non-array part of [`Response`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Summary {
+    pub status: Status,
+    pub n_out: usize,
+    pub n_steps: u64,
+    pub n_iter: u64,
+}
+
+impl Summary {
+    fn new() -> Self {
+        Self {
+            status: Status::Success,
+            n_out: 0,
+            n_steps: 0,
+            n_iter: 0,
+        }
+    }
+}
+
+impl Response {
+    /// Zeroed arrays for `nt` samples of `n` DOFs and `nj` joints (sizes already checked).
+    fn zeros(nt: usize, total: usize, total_j: usize) -> Self {
+        Self {
+            x: vec![0.0; total],
+            v: vec![0.0; total],
+            a: vec![0.0; total],
+            joint_force: vec![0.0; total_j],
+            joint_work: vec![0.0; total_j],
+            joint_dissipated: vec![0.0; total_j],
+            input_work: vec![0.0; nt],
+            damping_work: vec![0.0; nt],
+            status: Status::Success,
+            n_out: 0,
+            n_steps: 0,
+            n_iter: 0,
+        }
+    }
+
+    fn buffers(&mut self) -> Buffers<'_> {
+        Buffers {
+            x: &mut self.x,
+            v: &mut self.v,
+            a: &mut self.a,
+            joint_force: &mut self.joint_force,
+            joint_work: &mut self.joint_work,
+            joint_dissipated: &mut self.joint_dissipated,
+            input_work: &mut self.input_work,
+            damping_work: &mut self.damping_work,
+        }
+    }
+
+    fn set(&mut self, sum: Summary) {
+        self.status = sum.status;
+        self.n_out = sum.n_out;
+        self.n_steps = sum.n_steps;
+        self.n_iter = sum.n_iter;
+    }
+}
+
+/// `(len(t)·n, len(t)·n_joints)`, the output sizes, or an error if they overflow.
+fn sizes(s: &Structure, nt: usize) -> Result<(usize, usize), CoreError> {
+    let too_many = CoreError::InvalidParameter {
+        name: "t",
+        value: nt as f64,
+        reason: "too many samples",
+    };
+    let total = nt.checked_mul(s.n).ok_or(too_many.clone())?;
+    let total_j = nt.checked_mul(s.joints.len()).ok_or(too_many)?;
+    Ok((total, total_j))
+}
+
+/// Simulate `structure` under `inputs` from `(x0, v0)` at `t[0]` (joints start in their virgin
+/// state at d = 0 and are loaded monotonically to the initial position).
+///
+/// Malformed input is an `Err`; a step that cannot converge ends the run with a failure
+/// status and `n_out` valid samples (the response up to there).
+pub fn simulate(
+    s: &Structure,
+    inp: &Inputs<'_>,
+    x0: &[f64],
+    v0: &[f64],
+    opts: &Options,
+) -> Result<Response, CoreError> {
+    let nt = inp.t.len();
+    let (total, total_j) = sizes(s, nt)?;
+    let mut out = Response::zeros(nt, total, total_j);
+    let sum = simulate_into(s, inp, x0, v0, opts, &mut out.buffers())?;
+    out.set(sum);
+    Ok(out)
+}
+
+/// [`simulate`] writing the samples into the caller's buffers (e.g. arrays the caller then
+/// hands on without a copy); their sizes must be as [`Buffers`] says.
+pub fn simulate_into(
+    s: &Structure,
+    inp: &Inputs<'_>,
+    x0: &[f64],
+    v0: &[f64],
+    opts: &Options,
+    out: &mut Buffers<'_>,
+) -> Result<Summary, CoreError> {
+    let n = s.n;
+    let nt = inp.t.len();
+    if nt == 0 {
+        return Err(CoreError::Empty { name: "t" });
+    }
+    crate::normal::forcing::check_time(inp.t)?;
+    check_same_len("x0", x0.len(), "n", n)?;
+    check_same_len("v0", v0.len(), "n", n)?;
+    check_finite("x0", x0)?;
+    check_finite("v0", v0)?;
+    let (total, total_j) = sizes(s, nt)?;
+    for (name, len, want) in [
+        ("x buffer", out.x.len(), total),
+        ("v buffer", out.v.len(), total),
+        ("a buffer", out.a.len(), total),
+        ("joint_force buffer", out.joint_force.len(), total_j),
+        ("joint_work buffer", out.joint_work.len(), total_j),
+        (
+            "joint_dissipated buffer",
+            out.joint_dissipated.len(),
+            total_j,
+        ),
+        ("input_work buffer", out.input_work.len(), nt),
+        ("damping_work buffer", out.damping_work.len(), nt),
+    ] {
+        if len != 0 {
+            check_same_len(name, len, "output size", want)?;
+        }
+    }
+    if let Some(f) = inp.force {
+        check_same_len("force", f.len(), "len(t)*n", total)?;
+        check_finite("force", f)?;
+    }
+    if let Some((y, yd, kr, cr)) = inp.base {
+        check_same_len("base", y.len(), "t", nt)?;
+        check_same_len("base_velocity", yd.len(), "t", nt)?;
+        check_same_len("K r", kr.len(), "n", n)?;
+        check_same_len("C r", cr.len(), "n", n)?;
+        check_finite("base", y)?;
+        check_finite("base_velocity", yd)?;
+    }
+    if !(opts.rtol.is_finite() && opts.rtol > 0.0) || opts.max_iter == 0 {
+        return Err(CoreError::InvalidParameter {
+            name: "rtol",
+            value: opts.rtol,
+            reason: "rtol must be > 0 and max_iter >= 1",
+        });
+    }
+    if n == 1 {
+        // One DOF: the same scheme on scalars (no matrices, no LU), generic over the joint set
+        // (checked against the dense path by the tests in `sdof`).
+        return sdof::simulate(s, inp, x0[0], v0[0], opts, out);
+    }
+    newmark::simulate_dense(s, inp, x0, v0, opts, out)
+}

@@ -11,11 +11,9 @@
 use crate::curve::Backbone;
 use crate::error::{check_positive, CoreError};
 
-#[path = "masing_kernel.rs"]
 mod kernel;
 use kernel::{eval_block, Run, BLOCK, KNOWN};
 
-#[path = "masing_split.rs"]
 pub mod split;
 
 /// A remembered reversal point.
@@ -141,7 +139,7 @@ pub enum Closure {
 /// Receives loop closures as the operator runs (rainflow-style cycle counting).
 pub trait Observer {
     /// True when closures are ignored: the force kernel may then defer the forces of new
-    /// reversals (closures would report them as NaN; see `masing_kernel.rs`).
+    /// reversals (closures would report them as NaN; see `masing/kernel.rs`).
     const IGNORES: bool = false;
     fn closed(&mut self, closure: Closure);
 }

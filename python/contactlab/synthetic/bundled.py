@@ -45,9 +45,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ._io_atomic import write_text
-from .data import DATA_DIR
-from .masing import Masing
+from .._io_atomic import write_text
+from ..data import DATA_DIR
+from ..masing import Masing
 
 SEED = 20091  # one seed for the whole set; each file derives its own stream from it
 FREQUENCY = 1.0  # Hz, as in the paper
@@ -133,7 +133,7 @@ def write_tangential(path: Path, t: np.ndarray, x: np.ndarray, f: np.ndarray) ->
             ["%.3f", "%.4f", "%.6f"],
         )
         return write_text(path, text)
-    from .io import Recording, write_recording
+    from ..io import Recording, write_recording
 
     rec = Recording(
         t,
@@ -155,7 +155,7 @@ def write_normal(path: Path, t: np.ndarray, p: np.ndarray, delta: np.ndarray) ->
             ["%.5f", "%.6f", "%.5f"],
         )
         return write_text(path, text)
-    from .io import Recording, write_recording
+    from ..io import Recording, write_recording
 
     rec = Recording(
         t, {"p": p * 1e-6, "delta": delta * 1e6}, {"p": "MPa", "delta": "um"},

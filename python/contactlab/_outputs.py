@@ -14,7 +14,7 @@ import tempfile
 from collections.abc import Mapping
 from pathlib import Path, PurePosixPath
 
-from ..errors import InputError
+from .errors import InputError
 
 
 def _check_relative(name: str) -> PurePosixPath:

@@ -7,7 +7,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from ..report import Column, Report
+from .._html import Column, Report
+from . import diagnosis_plots
 
 FIGURES = (
     ("loops", "Loops: measurement, base model and final model", "plot_overlay"),
@@ -17,15 +18,17 @@ FIGURES = (
 )
 
 
-def build(report: Any) -> Report:
-    """The :class:`~contactlab.report.Report` of ``report`` (figures drawn off-screen)."""
+def build(report: Any, intro: str | None = None) -> Report:
+    """The :class:`~contactlab.report.Report` of ``report`` (figures drawn off-screen);
+    ``intro`` (the "Made by" line of a command-line run) heads it."""
     from matplotlib.figure import Figure
 
-    r = Report(
-        f"Model discrepancy: {report.model} contact",
+    lead = (
         "Where the base model and the measurement disagree, which candidate effects explain "
-        "it (chosen by their error on held-out cycles) and how much the gap shrinks.",
+        "it (chosen by their error on held-out cycles) and how much the gap shrinks."
     )
+    r = Report(f"Model discrepancy: {report.model} contact",
+               f"{intro}\n\n{lead}" if intro else lead)  # fmt: skip
     r.section("Where the base model disagrees")
     for w in report.where:
         r.text(w, note=w.startswith("after "))
@@ -66,7 +69,7 @@ def build(report: Any) -> Report:
     r.text(report.noise_text()[0].upper() + report.noise_text()[1:])
     for name, caption, method in FIGURES:
         fig = Figure(figsize=(7.0, 4.4), layout="constrained")
-        getattr(report, method)(ax=fig.add_subplot())
+        getattr(diagnosis_plots, method)(report, ax=fig.add_subplot())
         r.figure(fig, name, caption, dpi=110)
     r.section("Candidates tried")
     for i, s in enumerate(report.steps):
@@ -88,10 +91,10 @@ def build(report: Any) -> Report:
     return r
 
 
-def report_files(report: Any) -> dict[str, bytes]:
+def report_files(report: Any, intro: str | None = None) -> dict[str, bytes]:
     """Every file of the report, rendered in memory (relative name → content):
     ``diagnose.html`` first, its figures under ``figures/`` and ``diagnose.json``."""
-    files = build(report).files("diagnose.html")
+    files = build(report, intro).files("diagnose.html")
     files["diagnose.json"] = (report.to_json() + "\n").encode("utf-8")
     return files
 
@@ -99,6 +102,6 @@ def report_files(report: Any) -> dict[str, bytes]:
 def write_html(report: Any, directory: str | Path) -> Path:
     """Write ``diagnose.html``, its figures and ``diagnose.json`` into ``directory``, all or
     nothing."""
-    from ..report import commit_outputs
+    from .._outputs import commit_outputs
 
     return commit_outputs(directory, report_files(report))[0]

@@ -1,0 +1,509 @@
+"""Stated power: the smallest effect a record would have revealed (issue 29, item 2).
+
+For a candidate that a diagnosis did not name, "not detected" alone says nothing about
+whether the effect is absent or the record too short and noisy to show it. This module
+states, per candidate, the smallest magnitude that *this* record would have revealed with
+95 % probability under the diagnosis's own acceptance rules — "channel delay: not detected;
+would be seen above 0.6 ms" — so that a missed effect larger than the bound is a miss and
+one below it an honest answer.
+
+Method (linearised, under the effective variance). At the current model's fit ``θ̂`` the
+candidate adds, to first order, ``a · j`` to the predicted output, ``a`` the candidate's
+magnitude parameter away from its null value and ``j = ∂y/∂a`` (central differences at
+the null; the candidate's shape parameters — a Stribeck speed, a slip distance, a load
+frequency — held at stated values, :func:`shape_values`). The current model's parameters
+absorb the part of ``j`` they can: ``j⊥ = j - J_b β`` (weighted least squares with the
+diagnosis's sample weights ``w``). With ``e`` the noise, whose variance per sample is the
+effective variance ``V = σy² + s² σu²`` (:func:`contactlab.diagnose.detection.effective_variance`:
+a smooth direction sees the input noise before the candidates' filter), the diagnosis's
+statistics are, per held-out cycle ``c`` with weight ``W_c = Σ_c w``:
+
+- the current model's error grows by ``a² A_c + 2 a B_c`` with ``A_c = Σ_c w j⊥² / W_c`` and
+  ``B_c = Σ_c w j⊥ e / W_c`` (Gaussian, variance ``Σ_c w² j⊥² V / W_c²``);
+- the candidate, fitted on the other fold, misses by ``δ = Σ W_c B_c / Σ W_c A_c`` over
+  that fold's cycles, which costs it ``δ² A_c + 2 δ B_c``.
+
+These are drawn (common random numbers) and pushed through the rules of
+:func:`contactlab.diagnose.select.judge`: the per-cycle log ratios' ``t > z``, the held-out
+gain above ``min_gain`` σ² plus the input-noise budget, and above
+:data:`~contactlab.diagnose.select.MIN_RELATIVE_GAIN` of the current error. The bound is
+the smallest ``|a|`` at which at least 95 % of the draws pass (bisection on ``log |a|``).
+The BIC rule (``k ln n`` over a fit of at most 5000 samples) is far weaker than the gain
+rule and is not modelled; neither is a family's alternative proportional t (normal
+contact), which can only make detection easier: there the bound is conservative.
+
+:func:`detectable_above` gives one candidate's bound; :func:`stated_power` every candidate a
+report did not name. ``benches/eval_false_alarm.py --power`` checks the bound against
+simulation (the effect hidden at the bound is named in about 95 % of records).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ._family import Family, ParamSpec, Prepared
+from .detection import ChannelNoise, effective_variance
+from .select import MIN_RELATIVE_GAIN, sample_weight, specs_for
+
+__all__ = ["Detectable", "detectable_above", "shape_values", "stated_power"]
+
+#: the detection probability the bound is stated at
+POWER = 0.95
+#: random draws of the linearised statistics per magnitude tried
+DRAWS = 400
+#: the bound is searched up to an effect of this RMS relative to the output's RMS
+LARGEST_RELATIVE = 2.0
+
+
+@dataclass(frozen=True)
+class Detectable:
+    """The smallest magnitude of one candidate effect that a record would have revealed.
+
+    Attributes
+    ----------
+    effect : str
+        Candidate name.
+    parameter : str
+        The magnitude parameter the bound is about (the least favourable of the
+        candidate's magnitude parameters when it has several).
+    detectable_above : float or None
+        Smallest ``|value - null|`` of ``parameter`` detected with probability
+        :data:`POWER` at the diagnosis's false-alarm rate (None: not detectable on this
+        record below an effect of :data:`LARGEST_RELATIVE` times the output's RMS, or not
+        computable — see ``reason``).
+    unit : str
+        Unit of ``parameter`` and of the bound.
+    null : float
+        The parameter's value meaning "effect absent" (0, or 2 for a Masing branch scale).
+    relative_size : float or None
+        The bound as the RMS change of the output it causes, relative to the output's RMS
+        (the generator's ``magnitude``).
+    at : dict
+        Shape parameters held fixed for the bound (e.g. a Stribeck speed), SI units.
+    per_parameter : dict
+        The bound of each magnitude parameter of the candidate.
+    reason : str
+        Why the bound is None (empty otherwise).
+    """
+
+    effect: str
+    parameter: str
+    detectable_above: float | None
+    unit: str
+    null: float = 0.0
+    relative_size: float | None = None
+    at: dict[str, float] = field(default_factory=dict)
+    per_parameter: dict[str, float | None] = field(default_factory=dict)
+    reason: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON layout (a contract): ``effect``, ``parameter``, ``detectable_above`` (SI,
+        or null), ``unit``, ``null``, ``relative_size``, ``power``, ``at``,
+        ``per_parameter``, ``reason``."""
+        return {
+            "effect": self.effect,
+            "parameter": self.parameter,
+            "detectable_above": self.detectable_above,
+            "unit": self.unit,
+            "null": self.null,
+            "relative_size": self.relative_size,
+            "power": POWER,
+            "at": dict(self.at),
+            "per_parameter": dict(self.per_parameter),
+            "reason": self.reason,
+        }
+
+    def sentence(self) -> str:
+        """``"channel_delay: not detected; would be seen above 0.6 ms (tau)"``."""
+        if self.detectable_above is None:
+            return f"{self.effect}: not detected; {self.reason}"
+        v, u = _display(self.detectable_above, self.unit)
+        dev = f"|{self.parameter} - {self.null:g}|" if self.null != 0.0 else f"|{self.parameter}|"
+        rel = (
+            f", {100 * self.relative_size:.2g} % of the output RMS"
+            if self.relative_size is not None
+            else ""
+        )
+        return (
+            f"{self.effect}: not detected; would be seen above {v:.2g} {u} "
+            f"({dev}{rel}; {100 * POWER:.0f} % power)"
+        )
+
+
+def _display(v: float, unit: str) -> tuple[float, str]:
+    """A value in a readable unit (seconds in ms or µs, metres in µm or nm)."""
+    if unit == "s":
+        return (v * 1e3, "ms") if v >= 1e-4 else (v * 1e6, "µs")
+    if unit == "m":
+        return (v * 1e6, "µm") if v >= 1e-7 else (v * 1e9, "nm")
+    if unit == "-":
+        return v, ""
+    return v, unit
+
+
+def shape_values(family: Family, name: str, p: dict[str, float], d: Prepared) -> dict[str, float]:
+    """Values of a candidate's shape parameters (those without an "absent" value) at which
+    its bound is stated: a Stribeck speed of half the RMS input speed, a breakaway slip
+    distance of ``1/ac``, a load fluctuation at 0.23 of the excitation frequency (no
+    harmonic), a creep time of a quarter of the record; otherwise 0.3 of the parameter's
+    typical scale (as :func:`contactlab.diagnose.select.fit` starts it)."""
+    scales = family.scales(d)
+    period = d.cycles.period_samples * d.dt
+    out = {}
+    for s in family.candidates[name].params:
+        if np.isfinite(s.null):
+            continue
+        if s.name == "v_s":
+            v = 0.5 * float(np.sqrt(np.mean(d.ud * d.ud)))
+        elif s.name == "ell" and p.get("ac", 0) > 0:
+            v = 1.0 / p["ac"]
+        elif s.name == "f_n":
+            v = max(0.23 / period, 3.0 / d.duration)
+        elif s.name == "tau_c":
+            v = 0.25 * d.duration
+        else:
+            v = 0.3 * float(scales.get(s.name, scales.get(s.scale, 1.0)))
+        out[s.name] = float(v)
+    return out
+
+
+def _step(s: ParamSpec, value: float, scales: dict[str, float]) -> float:
+    sc = float(scales.get(s.name, scales.get(s.scale, 1.0)))
+    return 1e-3 * sc if np.isfinite(sc) and sc > 0 else 1e-6
+
+
+def _derivative(
+    family: Family,
+    p: dict[str, float],
+    effects: tuple[str, ...],
+    d: Prepared,
+    s: ParamSpec,
+    h: float,
+) -> np.ndarray:
+    """∂y/∂(s.name) at ``p`` (central differences; one-sided at a bound)."""
+    v = p[s.name]
+    up = min(v + h, s.upper)
+    dn = max(v - h, s.lower)
+    if up - dn <= 0:
+        return np.zeros(d.y.size)
+    pu, pd = dict(p), dict(p)
+    pu[s.name], pd[s.name] = up, dn
+    return (family.predict(pu, effects, d) - family.predict(pd, effects, d)) / (up - dn)
+
+
+def _project(j: np.ndarray, jb: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """``j`` minus its weighted least-squares projection on the columns of ``jb``."""
+    if jb.shape[1] == 0:
+        return j
+    sw = np.sqrt(w)
+    a = jb * sw[:, None]
+    norm = np.sqrt(np.sum(a * a, axis=0))
+    keep = norm > 0
+    if not keep.any():
+        return j
+    beta, *_ = np.linalg.lstsq(a[:, keep] / norm[keep], j * sw, rcond=None)
+    return j - (jb[:, keep] / norm[keep]) @ beta
+
+
+@dataclass
+class _Setting:
+    """What the bound of one record needs, shared by its candidates."""
+
+    w: np.ndarray
+    var: np.ndarray | float
+    cycle_of: np.ndarray  # cycle index (0..m-1) of each held-out sample, -1 elsewhere
+    fold_of_cycle: np.ndarray
+    cycle_mse: np.ndarray
+    sigma: float
+    z: float
+    gain_floor: float
+    y_rms: float
+    rng_normals: np.ndarray  # (DRAWS, m)
+
+
+def _setting(
+    d: Prepared,
+    current: Any,
+    noise: ChannelNoise,
+    slope: np.ndarray | None,
+    sigma: float,
+    z: float,
+    gain_floor: float,
+    folds: int,
+    seed: int,
+) -> _Setting:
+    w = sample_weight(d)
+    cyc = d.cycles.cycle
+    ids = np.unique(cyc[cyc >= 0])
+    where = np.full(cyc.size, -1)
+    held = cyc >= 0
+    where[held] = np.searchsorted(ids, cyc[held])
+    mse = np.asarray(getattr(current, "cycle_mse", np.full(ids.size, sigma**2)), float)
+    if mse.size != ids.size:
+        mse = np.full(ids.size, sigma**2)
+    rel = MIN_RELATIVE_GAIN * float(getattr(current, "heldout_mse", sigma**2)) / sigma**2
+    rng = np.random.default_rng(seed)
+    return _Setting(
+        w=w,
+        var=effective_variance(slope, noise),
+        cycle_of=where,
+        fold_of_cycle=ids % folds,
+        cycle_mse=mse,
+        sigma=sigma,
+        z=z,
+        gain_floor=max(gain_floor, rel),
+        y_rms=float(np.sqrt(np.mean(d.y * d.y))) or 1.0,
+        rng_normals=rng.standard_normal((DRAWS, ids.size)),
+    )
+
+
+def _power_curve(jp: np.ndarray, st: _Setting) -> Any:
+    """The detection probability as a function of the magnitude ``a`` (linearised)."""
+    held = st.cycle_of >= 0
+    m = st.fold_of_cycle.size
+    idx = st.cycle_of[held]
+    w, jh = st.w[held], jp[held]
+    var = st.var[held] if np.ndim(st.var) else st.var
+    W = np.bincount(idx, w, m)
+    ok = W > 0
+    Wsafe = np.where(ok, W, 1.0)
+    A = np.bincount(idx, w * jh * jh, m) / Wsafe
+    sdB = np.sqrt(np.bincount(idx, w * w * jh * jh * var, m)) / Wsafe
+    B = st.rng_normals * sdB  # (draws, m)
+    folds = np.unique(st.fold_of_cycle)
+    delta = np.zeros_like(B)
+    for k in folds:
+        train = st.fold_of_cycle != k
+        den = float(np.sum(W[train] * A[train]))
+        if den > 0:
+            dk = (B[:, train] @ W[train]) / den
+            delta[:, st.fold_of_cycle == k] = dk[:, None]
+    mc = st.cycle_mse
+    sig2 = st.sigma**2
+    Wtot = float(np.sum(W))
+
+    def power(a: float) -> float:
+        cur = mc + a * a * A + 2.0 * a * B
+        cand = mc + delta * delta * A + 2.0 * delta * B
+        cur_ok = np.maximum(cur, 1e-12 * mc)
+        cand_ok = np.maximum(cand, 1e-3 * mc)
+        ratio = np.log(cur_ok / cand_ok)[:, ok]
+        n = ratio.shape[1]
+        if n < 2:
+            return 0.0
+        sd = np.std(ratio, axis=1, ddof=1)
+        t = np.where(sd > 0, np.mean(ratio, axis=1) / (sd / np.sqrt(n)), np.inf)
+        gain = ((cur - cand) @ W) / Wtot / sig2
+        return float(np.mean((t > st.z) & (gain >= st.gain_floor)))
+
+    return power
+
+
+def _bound(jp: np.ndarray, st: _Setting) -> float | None:
+    """Smallest ``a`` with detection probability at least :data:`POWER`, or None."""
+    size = float(np.sqrt(np.mean(jp * jp)))
+    if not size > 0:
+        return None
+    power = _power_curve(jp, st)
+    top = LARGEST_RELATIVE * st.y_rms / size
+    q = float(np.sum(st.w * jp * jp) / np.sum(st.w)) / st.sigma**2
+    lo = min(top, np.sqrt(max(st.gain_floor, 1e-6) / max(q, 1e-300)))
+    if power(lo) >= POWER:
+        hi = lo
+        lo = hi / 64.0
+    else:
+        hi = lo
+        while power(hi) < POWER:
+            if hi >= top:
+                return None
+            hi = min(2.0 * hi, top)
+    for _ in range(20):
+        mid = float(np.sqrt(lo * hi))
+        if power(mid) >= POWER:
+            hi = mid
+        else:
+            lo = mid
+        if hi / lo < 1.01:
+            break
+    return hi
+
+
+def detectable_above(
+    family: Family,
+    params: dict[str, float],
+    effects: tuple[str, ...],
+    name: str,
+    d: Prepared,
+    *,
+    noise: ChannelNoise,
+    sigma: float,
+    z: float = 3.0,
+    gain_floor: float = 0.05,
+    current: Any = None,
+    folds: int = 2,
+    seed: int = 0,
+    _setting_cache: _Setting | None = None,
+) -> Detectable:
+    """The smallest magnitude of candidate ``name`` this record would have revealed.
+
+    Parameters
+    ----------
+    family : Family
+        The model family (tangential or normal contact).
+    params : dict
+        The current model's fitted parameters (base and named effects).
+    effects : tuple of str
+        The effects in the current model.
+    name : str
+        The candidate (not in ``effects``).
+    d : Prepared
+        The recording as the diagnosis saw it (with its sample weights).
+    noise : ChannelNoise
+        Both channels' noise (:func:`contactlab.diagnose.detection.channel_noise`).
+    sigma : float
+        The output noise level the acceptance rules measure gains in.
+    z : float
+        The t threshold of the acceptance rules.
+    gain_floor : float
+        The smallest held-out gain accepted, σ² (``min_gain`` plus the input-noise budget).
+    current : Trial, optional
+        The current model's cross-validated trial (its per-cycle held-out errors); default
+        ``σ²`` per cycle.
+    folds : int
+        Folds of the cross-validation.
+    seed : int
+        Seed of the draws (the bound is reproducible).
+
+    Returns
+    -------
+    Detectable
+
+    Examples
+    --------
+    >>> import contactlab
+    >>> from contactlab.diagnose import hidden_effect_recording
+    >>> from contactlab.diagnose.power import stated_power
+    >>> rep = contactlab.diagnose(hidden_effect_recording([], seed=3), max_effects=0)
+    >>> b = {x.effect: x for x in stated_power(rep)}["channel_delay"]
+    >>> b.unit, 0 < b.detectable_above < 1e-3
+    ('s', True)
+    """
+    cand = family.candidates[name]
+    scales = family.scales(d)
+    shape = shape_values(family, name, params, d)
+    p0 = dict(params)
+    p0.update(shape)
+    for s in cand.params:
+        if np.isfinite(s.null):
+            p0[s.name] = s.null
+    trial = (*effects, name)
+    if not family.check(trial):
+        return Detectable(
+            name, cand.params[0].name, None, cand.params[0].unit,
+            reason="not combinable with the effects named",
+        )  # fmt: skip
+    st = _setting_cache
+    if st is None:
+        slope = family.slope(params, d) if hasattr(family, "slope") else None
+        st = _setting(d, current, noise, slope, sigma, z, gain_floor, folds, seed)
+    base_specs = specs_for(family, effects)
+    jb = np.column_stack(
+        [
+            _derivative(family, p0, trial, d, s, _step(s, p0[s.name], scales))
+            for s in base_specs
+            if np.isfinite(p0.get(s.name, np.nan))
+        ]
+        or [np.zeros(d.y.size)]
+    )
+    per: dict[str, float | None] = {}
+    rel: dict[str, float | None] = {}
+    for s in cand.params:
+        if not np.isfinite(s.null):
+            continue
+        j = _derivative(family, p0, trial, d, s, _step(s, s.null, scales))
+        if not np.all(np.isfinite(j)):
+            per[s.name] = rel[s.name] = None
+            continue
+        jp = _project(j, jb, st.w)
+        b = _bound(jp, st)
+        per[s.name] = b
+        rel[s.name] = None if b is None else b * float(np.sqrt(np.mean(j * j))) / st.y_rms
+    mags = [s for s in cand.params if np.isfinite(s.null)]
+    if not per or any(v is None for v in per.values()):
+        worst = next((s for s in mags if per.get(s.name) is None), mags[0])
+        return Detectable(
+            name, worst.name, None, worst.unit, worst.null, None, shape, per,
+            reason=(
+                f"not detectable on this record below an effect of {LARGEST_RELATIVE:g}× "
+                "the output's RMS (the current model's parameters absorb it, or the record "
+                "is too short or noisy)"
+            ),
+        )  # fmt: skip
+    worst = max(mags, key=lambda s: rel[s.name] or 0.0)
+    return Detectable(
+        name, worst.name, per[worst.name], worst.unit, worst.null, rel[worst.name], shape, per
+    )
+
+
+def stated_power(report: Any, *, seed: int = 0) -> list[Detectable]:
+    """The bound of every candidate a diagnosis did not name (:func:`detectable_above`).
+
+    Parameters
+    ----------
+    report : DiagnosisReport
+        A tangential or normal diagnosis (:func:`contactlab.diagnose.diagnose`).
+    seed : int
+        Seed of the draws.
+
+    Returns
+    -------
+    list of Detectable
+        In the library's order; empty when the report does not carry its data.
+    """
+    d = report.prepared
+    if d is None or not report.trials:
+        return []
+    fam = report.final_model.family
+    current = report.trials[-1]
+    params = dict(current.full.params)
+    effects = tuple(current.effects)
+    settings = report.location.get("detection", {})
+    sigma = float(report.noise_rms)
+    noise = getattr(report, "channel_noise", None)
+    if noise is None:
+        from .detection import channel_noise
+
+        noise = channel_noise(d, current.full_residual(d))
+    slope = fam.slope(params, d) if hasattr(fam, "slope") else None
+    st = _setting(
+        d, current, noise, slope, sigma, float(settings.get("z", 3.0)),
+        float(settings.get("gain_floor", 0.05)), int(settings.get("folds", 2)), seed,
+    )  # fmt: skip
+    names = settings.get("candidates") or list(fam.candidates)
+    out = []
+    for n in names:
+        if n in effects or n not in fam.candidates:
+            continue
+        try:
+            out.append(
+                detectable_above(
+                    fam,
+                    params,
+                    effects,
+                    n,
+                    d,
+                    noise=noise,
+                    sigma=sigma,
+                    z=st.z,
+                    gain_floor=st.gain_floor,
+                    current=current,
+                    _setting_cache=st,
+                )
+            )
+        except (ValueError, FloatingPointError, np.linalg.LinAlgError) as exc:
+            spec = fam.candidates[n].params[0]
+            out.append(Detectable(n, spec.name, None, spec.unit, reason=f"not computable: {exc}"))
+    return out

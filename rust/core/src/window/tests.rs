@@ -1,0 +1,272 @@
+use super::*;
+use crate::fold::{fold_phase, fold_spread, period_means, FoldSums};
+use crate::loop_area::{loop_area_sensitivity, loop_areas};
+use proptest::prelude::*;
+
+fn knots(t: &[f64], period: f64, n_cyc: usize) -> (Vec<f64>, Vec<f64>) {
+    // peaks at t0 + k·period, valleys half way
+    let t0 = t[3];
+    let mut kt = Vec::new();
+    let mut kp = Vec::new();
+    for k in 0..=n_cyc {
+        kt.push(t0 + k as f64 * period);
+        kp.push(k as f64);
+        if k < n_cyc {
+            kt.push(t0 + (k as f64 + 0.5) * period);
+            kp.push(k as f64 + 0.5);
+        }
+    }
+    (kt, kp)
+}
+
+fn signal(n: usize, seed: u64, scale: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let mut s = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+    let mut noise = move || {
+        s = s
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+    };
+    let t: Vec<f64> = (0..n).map(|i| 0.37 + i as f64 * 1e-3).collect();
+    let x: Vec<f64> = t
+        .iter()
+        .map(|&v| scale * ((6.0 * v).sin() + 0.01 * noise()))
+        .collect();
+    let f: Vec<f64> = t
+        .iter()
+        .map(|&v| (6.0 * v + 0.4).sin() + 0.05 * noise() + 0.3)
+        .collect();
+    (t, x, f)
+}
+
+fn close(a: &[f64], b: &[f64], tol: f64) -> bool {
+    let big = b.iter().fold(
+        0.0_f64,
+        |m, v| if v.is_finite() { m.max(v.abs()) } else { m },
+    );
+    a.len() == b.len()
+        && a.iter().zip(b).all(|(u, v)| {
+            (u.is_nan() && v.is_nan()) || (u - v).abs() <= tol * big.max(f64::MIN_POSITIVE)
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+    /// One pass equals the separate kernels: `fold_phase`'s per-bin sums and
+    /// `period_means` bit for bit; `fold_spread`, the bounds numpy derives from the
+    /// fold's first samples, `loop_areas`, `loop_area_sensitivity` to rounding.
+    #[test]
+    fn one_pass_equals_the_separate_kernels(
+        seed in 0u64..1000, n_bins in 4usize..40, n_cyc in 1usize..5, start in 0usize..300,
+        scale in prop::sample::select(vec![1.0, 1e-6, 1e150, 1e-150]),
+    ) {
+        let (t, x, f) = signal(4000, seed, scale);
+        let period = 2.0 * std::f64::consts::PI / 6.0;
+        let (kt, kp) = knots(&t[start..], period, n_cyc);
+        let edges: Vec<f64> = kt.iter().step_by(2).copied().collect();
+        let w = fold_window(&t, &x, &f, &kt, &kp, n_bins, n_cyc, &edges).unwrap();
+        let mut s = FoldSums::new(n_bins, n_cyc).unwrap();
+        fold_phase(&t, &x, &f, 0, &kt, &kp, &mut s).unwrap();
+        prop_assert_eq!(&w.count, &s.count);
+        prop_assert_eq!(&w.sum_x, &s.sum_x);
+        prop_assert_eq!(&w.sum_f, &s.sum_f);
+        prop_assert_eq!(&w.sum_phase, &s.sum_phase);
+        prop_assert_eq!(&w.sum_phase2, &s.sum_phase2);
+        prop_assert_eq!(&w.sum_xx, &s.sum_xx);
+        prop_assert_eq!(&w.sum_t, &s.sum_t);
+        prop_assert_eq!(&w.first, &s.first);
+        let sp = fold_spread(&s).unwrap();
+        // running moments against a two-pass spread: a small spread is the square root of
+        // a cancelling variance (seen 1.6e-9 of the largest in 1000 cases)
+        prop_assert!(close(&w.x_std, &sp.x_std, 1e-8), "{:?} {:?}", w.x_std, sp.x_std);
+        prop_assert!(close(&w.f_std, &sp.f_std, 1e-8));
+        prop_assert_eq!(&w.amplitude, &sp.amplitude);
+        prop_assert_eq!(&w.force_range, &sp.force_range);
+        // numpy: first = r_[first, end]; where(first < 0, end, first); minimum.accumulate
+        // from the end (end: the first sample at or after the last knot)
+        let end = t.iter().position(|&v| v >= kt[kt.len() - 1]).unwrap_or(t.len());
+        let mut b: Vec<usize> = s
+            .first
+            .iter()
+            .map(|&v| if v < 0 { end } else { v as usize })
+            .chain(std::iter::once(end))
+            .collect();
+        for i in (0..b.len() - 1).rev() {
+            b[i] = b[i].min(b[i + 1]);
+        }
+        prop_assert_eq!(&w.bounds, &b);
+        prop_assert!(close(&w.energy, &loop_areas(&x, &f, &b).unwrap(), 1e-12));
+        let (sf, sx) = loop_area_sensitivity(&x, &f, &b).unwrap();
+        prop_assert!(close(&w.sens_f, &sf, 1e-12));
+        prop_assert!(close(&w.sens_x, &sx, 1e-12));
+        prop_assert_eq!(&w.mean_f, &period_means(&t, &f, &edges).unwrap());
+        prop_assert_eq!(&w.mean_x, &period_means(&t, &x, &edges).unwrap());
+    }
+}
+
+/// Equal, NaN where NaN.
+fn same(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(u, v)| u == v || (u.is_nan() && v.is_nan()))
+}
+
+/// The phases fold_phase gives (numpy.interp's arithmetic), None where they decrease
+/// (rounding at a knot: fold_window holds the phase there, fold_phase does not).
+fn monotone_phases(t: &[f64], kt: &[f64], kp: &[f64]) -> Option<()> {
+    let mut last = f64::NEG_INFINITY;
+    for &ti in t {
+        if !(ti >= kt[0] && ti < kt[kt.len() - 1]) {
+            continue;
+        }
+        let j = kt.partition_point(|&k| k <= ti) - 1;
+        let slope = (kp[j + 1] - kp[j]) / (kt[j + 1] - kt[j]);
+        let ph = if ti == kt[j] {
+            kp[j]
+        } else {
+            slope * (ti - kt[j]) + kp[j]
+        };
+        if ph < last {
+            return None;
+        }
+        last = ph;
+    }
+    Some(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+    /// Irregular sampling and knots: flat knot segments (a phase that stands still),
+    /// steep ones (bins and cycles without samples), knots between samples and on them,
+    /// one or two bins, samples before the first knot and after the last: the per-bin
+    /// sums, first samples, bounds and ranges are fold_phase's bit for bit, the spread,
+    /// areas and sensitivities the separate kernels' to rounding.
+    #[test]
+    fn irregular_knots_fold_as_fold_phase(
+        seed in 0u64..1_000_000, n_bins in 1usize..12, n_cyc in 1usize..6,
+        n in 20usize..400, n_knots in 2usize..30,
+    ) {
+        let mut s = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(7);
+        let mut u = move || {
+            s = s
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut t = Vec::with_capacity(n);
+        let mut v = 0.0;
+        for _ in 0..n {
+            v += 0.05 + u();
+            t.push(v);
+        }
+        let x: Vec<f64> = t.iter().map(|&ti| (0.7 * ti).sin() + 0.1 * u()).collect();
+        let f: Vec<f64> = t.iter().map(|&ti| (0.7 * ti + 0.5).cos() + 0.1 * u() - 3.0).collect();
+        // knots: some on samples, some between, from before the first sample to after
+        // the last
+        let span = t[n - 1] - t[0];
+        let mut kt: Vec<f64> = (0..n_knots)
+            .map(|_| {
+                if u() < 0.3 {
+                    t[(u() * n as f64) as usize % n]
+                } else {
+                    t[0] - 0.1 * span + 1.2 * span * u()
+                }
+            })
+            .collect();
+        kt.sort_by(f64::total_cmp);
+        kt.dedup();
+        prop_assume!(kt.len() >= 2);
+        let mut kp: Vec<f64> = (0..kt.len())
+            .map(|_| if u() < 0.2 { 0.0 } else { u() * n_cyc as f64 })
+            .collect();
+        kp.sort_by(f64::total_cmp);
+        if u() < 0.3 {
+            kp[0] = 0.0;
+        }
+        if u() < 0.3 {
+            let last = kp.len() - 1;
+            kp[last] = n_cyc as f64;
+        }
+        prop_assume!(monotone_phases(&t, &kt, &kp).is_some());
+        let edges: Vec<f64> = kt.iter().step_by(2).copied().collect();
+        let w = fold_window(&t, &x, &f, &kt, &kp, n_bins, n_cyc, &edges).unwrap();
+        let mut sm = FoldSums::new(n_bins, n_cyc).unwrap();
+        fold_phase(&t, &x, &f, 0, &kt, &kp, &mut sm).unwrap();
+        prop_assert_eq!(&w.count, &sm.count);
+        prop_assert_eq!(&w.sum_x, &sm.sum_x);
+        prop_assert_eq!(&w.sum_f, &sm.sum_f);
+        prop_assert_eq!(&w.sum_phase, &sm.sum_phase);
+        prop_assert_eq!(&w.sum_phase2, &sm.sum_phase2);
+        prop_assert_eq!(&w.sum_xx, &sm.sum_xx);
+        prop_assert_eq!(&w.sum_t, &sm.sum_t);
+        prop_assert_eq!(&w.first, &sm.first);
+        let sp = fold_spread(&sm).unwrap();
+        prop_assert!(close(&w.x_std, &sp.x_std, 1e-8), "{:?} {:?}", w.x_std, sp.x_std);
+        prop_assert!(close(&w.f_std, &sp.f_std, 1e-8));
+        prop_assert!(same(&w.amplitude, &sp.amplitude), "{:?} {:?}", w.amplitude, sp.amplitude);
+        prop_assert!(same(&w.force_range, &sp.force_range));
+        let end = t.iter().position(|&v| v >= kt[kt.len() - 1]).unwrap_or(t.len());
+        let mut b: Vec<usize> = sm
+            .first
+            .iter()
+            .map(|&v| if v < 0 { end } else { v as usize })
+            .chain(std::iter::once(end))
+            .collect();
+        for i in (0..b.len() - 1).rev() {
+            b[i] = b[i].min(b[i + 1]);
+        }
+        prop_assert_eq!(&w.bounds, &b);
+        // the areas of the cycles' own samples: the last cycle's run to the last sample
+        // folded (a cycle past n_cycles folds none)
+        let areas = loop_areas(&x, &f, &b).unwrap();
+        let (sf, sx) = loop_area_sensitivity(&x, &f, &b).unwrap();
+        prop_assert!(close(&w.energy, &areas, 1e-12), "{:?} {:?}", w.energy, areas);
+        prop_assert!(close(&w.sens_f, &sf, 1e-12));
+        prop_assert!(close(&w.sens_x, &sx, 1e-12));
+        prop_assert_eq!(&w.mean_f, &period_means(&t, &f, &edges).unwrap());
+    }
+}
+
+#[test]
+fn short_cycles_and_edges_outside_the_samples() {
+    // 6 samples, two cycles of 1 and 3 samples: NaN area below 3 samples
+    let t = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0];
+    let x = [0.0, 1.0, 0.0, -1.0, 0.0, 1.0];
+    let f = [0.5, 1.0, 0.0, -1.0, -0.5, 1.0];
+    let kt = [0.5, 1.5, 4.5];
+    let kp = [0.0, 1.0, 2.0];
+    let edges = [-1.0, 0.5, 9.0];
+    let w = fold_window(&t, &x, &f, &kt, &kp, 2, 2, &edges).unwrap();
+    assert_eq!(w.bounds, vec![1, 2, 5]);
+    assert!(w.energy[0].is_nan());
+    let a = loop_areas(&x, &f, &[2, 5]).unwrap()[0];
+    assert!((w.energy[1] - a).abs() < 1e-15);
+    assert_eq!(w.mean_f, period_means(&t, &f, &edges).unwrap());
+}
+
+#[test]
+fn bad_input_is_an_error() {
+    let (t, x, f) = signal(2000, 1, 1.0);
+    let (kt, kp) = knots(&t, 1.0, 1);
+    let e = [kt[0], kt[2]];
+    assert!(fold_window(&t, &x, &f, &kt, &kp, 8, 1, &e).is_ok());
+    assert!(fold_window(&t, &x[1..], &f, &kt, &kp, 8, 1, &e).is_err());
+    assert!(fold_window(&t, &x, &f, &kt, &kp, 0, 1, &e).is_err());
+    assert!(fold_window(&t, &x, &f, &kt[..1], &kp[..1], 8, 1, &e).is_err());
+    assert!(fold_window(&t, &x, &f, &kt, &kp, 8, 0, &e).is_err());
+    let mut tb = t.clone();
+    tb[5] = tb[4];
+    assert!(fold_window(&tb, &x, &f, &kt, &kp, 8, 1, &e).is_err());
+    let mut xb = x.clone();
+    xb[7] = f64::NAN;
+    assert!(fold_window(&t, &xb, &f, &kt, &kp, 8, 1, &e).is_err());
+    assert!(fold_window(&t, &x, &f, &kt, &kp, 8, 1, &[e[1], e[0]]).is_err());
+    // areas beyond the double range: an error, not inf
+    let big: Vec<f64> = x.iter().map(|v| v * 1e300).collect();
+    let bigf: Vec<f64> = f.iter().map(|v| v * 1e300).collect();
+    assert!(matches!(
+        fold_window(&t, &big, &bigf, &kt, &kp, 8, 1, &e),
+        Err(CoreError::OutOfRange { .. })
+    ));
+}
