@@ -216,7 +216,7 @@ POWER_TRIES = 4
 
 
 def _power_one(job: tuple[str, int]) -> dict[str, Any]:
-    from contactlab.diagnose import hidden_effect_recording
+    from contactlab.synthetic.diagnosis import hidden_effect_recording
     from contactlab.diagnose.workflow import diagnose
 
     effect, seed = job

@@ -178,7 +178,7 @@ def test_detectable_delegates_to_the_power_module_or_says_it_is_missing():
             eff.detectable(object())
     else:  # wired: a stated bound in the effect's own unit
         import contactlab
-        from contactlab.diagnose import hidden_effect_recording
+        from contactlab.synthetic.diagnosis import hidden_effect_recording
 
         rep = contactlab.diagnose(hidden_effect_recording([], seed=3), max_effects=0)
         bound = eff.detectable(rep)

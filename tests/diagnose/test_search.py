@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from contactlab.diagnose import hidden_effect_recording
 from contactlab.diagnose._family import Prepared
 from contactlab.diagnose._parallel import EvaluationCounter
 from contactlab.diagnose._signal import noise_rms
@@ -13,6 +12,7 @@ from contactlab.diagnose.candidates_tangential import TangentialFamily
 from contactlab.diagnose.search import SearchState, StepwiseSearch
 from contactlab.diagnose.select import evaluate, fit, fold_masks
 from contactlab.diagnose.workflow import Step
+from contactlab.synthetic.diagnosis import hidden_effect_recording
 
 
 def _search(rec, effects):

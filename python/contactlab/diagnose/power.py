@@ -384,7 +384,7 @@ def detectable_above(
     Examples
     --------
     >>> import contactlab
-    >>> from contactlab.diagnose import hidden_effect_recording
+    >>> from contactlab.synthetic.diagnosis import hidden_effect_recording
     >>> from contactlab.diagnose.power import stated_power
     >>> rep = contactlab.diagnose(hidden_effect_recording([], seed=3), max_effects=0)
     >>> b = {x.effect: x for x in stated_power(rep)}["channel_delay"]
@@ -432,6 +432,12 @@ def detectable_above(
         per[s.name] = b
         rel[s.name] = None if b is None else b * float(np.sqrt(np.mean(j * j))) / st.y_rms
     mags = [s for s in cand.params if np.isfinite(s.null)]
+    if not mags:  # an element law that replaces the base's (no value means "absent")
+        first = cand.params[0]
+        return Detectable(
+            name, first.name, None, first.unit, first.null, None, shape, per,
+            reason="not nested in the base model: no parameter value means 'absent'",
+        )  # fmt: skip
     if not per or any(v is None for v in per.values()):
         worst = next((s for s in mags if per.get(s.name) is None), mags[0])
         return Detectable(
