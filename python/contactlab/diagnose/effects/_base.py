@@ -159,6 +159,12 @@ class EffectModel:
                     )
         return Plausibility(True, self.argument(recording, p))
 
+    def base_equivalent(self, p: dict[str, float]) -> dict[str, float]:
+        """The base parameters this effect's model is equivalent to, where it rescales the
+        base (a branch scale λ: loops of a Masing element with ``h0 λ / 2``); empty when it
+        does not. The search compares these, not the raw values, with the base fit."""
+        return {}
+
     #: a named effect's size must lie this many standard errors from "absent"
     IDENTIFIED_SIGMAS: ClassVar[float] = 2.0
 
