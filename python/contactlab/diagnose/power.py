@@ -295,7 +295,8 @@ def _power_curve(jp: np.ndarray, st: _Setting) -> Any:
         if n < 2:
             return 0.0
         sd = np.std(ratio, axis=1, ddof=1)
-        t = np.where(sd > 0, np.mean(ratio, axis=1) / (sd / np.sqrt(n)), np.inf)
+        with np.errstate(divide="ignore", invalid="ignore"):  # (sd = 0: t = inf below)
+            t = np.where(sd > 0, np.mean(ratio, axis=1) / (sd / np.sqrt(n)), np.inf)
         gain = ((cur - cand) @ W) / Wtot / sig2
         return float(np.mean((t > st.z) & (gain >= st.gain_floor)))
 
