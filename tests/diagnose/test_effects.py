@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from contactlab.diagnose._family import Prepared
 from contactlab.diagnose.candidates_normal import CANDIDATES as NORMAL
 from contactlab.diagnose.candidates_tangential import CANDIDATES, TangentialFamily
-from contactlab.diagnose.effects import EffectModel, Plausibility, ordered, registry
+from contactlab.diagnose.effects import EffectModel, ordered, registry
 from contactlab.diagnose.effects.tangential.backlash import play
 from contactlab.diagnose.effects.tangential.non_masing_scaling import (
     turning_point_force,
