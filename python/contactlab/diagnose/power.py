@@ -45,7 +45,7 @@ from typing import Any
 import numpy as np
 
 from ._family import Family, ParamSpec, Prepared
-from .detection import ChannelNoise, effective_variance, model_slope
+from .detection import ChannelNoise, effective_variance
 from .select import MIN_RELATIVE_GAIN, sample_weight, specs_for
 
 __all__ = ["Detectable", "detectable_above", "shape_values", "stated_power"]
@@ -108,7 +108,7 @@ class Detectable:
             "parameter": self.parameter,
             "detectable_above": self.detectable_above,
             "unit": self.unit,
-            "null": self.null if np.isfinite(self.null) else None,
+            "null": self.null if self.null is None or np.isfinite(self.null) else None,
             "relative_size": self.relative_size,
             "power": POWER,
             "at": dict(self.at),
@@ -295,7 +295,8 @@ def _power_curve(jp: np.ndarray, st: _Setting) -> Any:
         if n < 2:
             return 0.0
         sd = np.std(ratio, axis=1, ddof=1)
-        t = np.where(sd > 0, np.mean(ratio, axis=1) / (sd / np.sqrt(n)), np.inf)
+        with np.errstate(divide="ignore", invalid="ignore"):  # (sd = 0: t = inf below)
+            t = np.where(sd > 0, np.mean(ratio, axis=1) / (sd / np.sqrt(n)), np.inf)
         gain = ((cur - cand) @ W) / Wtot / sig2
         return float(np.mean((t > st.z) & (gain >= st.gain_floor)))
 
@@ -384,7 +385,7 @@ def detectable_above(
     Examples
     --------
     >>> import contactlab
-    >>> from contactlab.diagnose import hidden_effect_recording
+    >>> from contactlab.synthetic.diagnosis import hidden_effect_recording
     >>> from contactlab.diagnose.power import stated_power
     >>> rep = contactlab.diagnose(hidden_effect_recording([], seed=3), max_effects=0)
     >>> b = {x.effect: x for x in stated_power(rep)}["channel_delay"]
@@ -400,15 +401,6 @@ def detectable_above(
         if np.isfinite(s.null):
             p0[s.name] = s.null
     trial = (*effects, name)
-    if not any(np.isfinite(s.null) for s in cand.params):
-        first = cand.params[0]
-        return Detectable(
-            name, first.name, None, first.unit, float("nan"), None, shape,
-            reason=(
-                "no parameter value means absent (the effect replaces the element's shape, "
-                "not a size away from a null): no bound to state"
-            ),
-        )  # fmt: skip
     if not family.check(trial):
         return Detectable(
             name, cand.params[0].name, None, cand.params[0].unit,
@@ -416,7 +408,7 @@ def detectable_above(
         )  # fmt: skip
     st = _setting_cache
     if st is None:
-        slope = model_slope(family, params, d)
+        slope = family.slope(params, d) if hasattr(family, "slope") else None
         st = _setting(d, current, noise, slope, sigma, z, gain_floor, folds, seed)
     base_specs = specs_for(family, effects)
     jb = np.column_stack(
@@ -441,11 +433,11 @@ def detectable_above(
         per[s.name] = b
         rel[s.name] = None if b is None else b * float(np.sqrt(np.mean(j * j))) / st.y_rms
     mags = [s for s in cand.params if np.isfinite(s.null)]
-    if not mags:  # no parameter whose value means "absent" (e.g. a frame's fixed mass)
-        s0 = cand.params[0]
+    if not mags:  # an element law that replaces the base's (no value means "absent")
+        first = cand.params[0]
         return Detectable(
-            name, s0.name, None, s0.unit, None, None, shape, per,
-            reason="no parameter of this effect has a value meaning 'absent': no bound",
+            name, first.name, None, first.unit, first.null, None, shape, per,
+            reason="not nested in the base model: no parameter value means 'absent'",
         )  # fmt: skip
     if not per or any(v is None for v in per.values()):
         worst = next((s for s in mags if per.get(s.name) is None), mags[0])
@@ -478,9 +470,6 @@ def stated_power(report: Any, *, seed: int = 0) -> list[Detectable]:
     list of Detectable
         In the library's order; empty when the report does not carry its data.
     """
-    kept = getattr(report, "not_detected", None)
-    if kept and seed == 0:  # stated by the diagnosis itself, with the same settings and seed
-        return list(kept)
     d = report.prepared
     if d is None or not report.trials:
         return []
@@ -495,43 +484,33 @@ def stated_power(report: Any, *, seed: int = 0) -> list[Detectable]:
         from .detection import channel_noise
 
         noise = channel_noise(d, current.full_residual(d))
-    slope = model_slope(fam, params, d)
+    slope = fam.slope(params, d) if hasattr(fam, "slope") else None
     st = _setting(
         d, current, noise, slope, sigma, float(settings.get("z", 3.0)),
         float(settings.get("gain_floor", 0.05)), int(settings.get("folds", 2)), seed,
     )  # fmt: skip
     names = settings.get("candidates") or list(fam.candidates)
-    return bounds_for(fam, params, effects, names, d, noise, sigma, current, st)
-
-
-def bounds_for(
-    family: Family,
-    params: dict[str, float],
-    effects: tuple[str, ...],
-    names: list[str],
-    d: Prepared,
-    noise: ChannelNoise,
-    sigma: float,
-    current: Any,
-    st: _Setting,
-) -> list[Detectable]:
-    """:func:`detectable_above` of every candidate in ``names`` not in ``effects``; a
-    candidate whose bound cannot be computed (its model refuses the null, a singular
-    projection) gets ``detectable_above`` None and the reason."""
-    from ..errors import ContactLabError
-
     out = []
     for n in names:
-        if n in effects or n not in family.candidates:
+        if n in effects or n not in fam.candidates:
             continue
-        kw = {"noise": noise, "sigma": sigma, "z": st.z, "gain_floor": st.gain_floor}
         try:
             out.append(
                 detectable_above(
-                    family, params, effects, n, d, current=current, _setting_cache=st, **kw
+                    fam,
+                    params,
+                    effects,
+                    n,
+                    d,
+                    noise=noise,
+                    sigma=sigma,
+                    z=st.z,
+                    gain_floor=st.gain_floor,
+                    current=current,
+                    _setting_cache=st,
                 )
             )
-        except (ContactLabError, ValueError, FloatingPointError, np.linalg.LinAlgError) as exc:
-            spec = family.candidates[n].params[0]
+        except (ValueError, FloatingPointError, np.linalg.LinAlgError) as exc:
+            spec = fam.candidates[n].params[0]
             out.append(Detectable(n, spec.name, None, spec.unit, reason=f"not computable: {exc}"))
     return out

@@ -50,7 +50,7 @@ from ._signal import noise_rms
 from .locate import locate
 from .model import ExtendedModel
 from .paths import KindPath, RegimeDecision, kind_path
-from .search import SearchState, StepwiseSearch, _pair_search  # noqa: F401
+from .search import MAX_EVALUATIONS, SearchState, StepwiseSearch, _pair_search  # noqa: F401
 from .select import Trial, Verdict, evaluate, fit, fold_masks
 
 __all__ = ["DiagnosisReport", "Effect", "Step", "diagnose"]
@@ -367,14 +367,6 @@ def _family(model: Any) -> tuple[Family, dict[str, float], dict[str, float]]:
         ctx = {"omega": float(model.omega)} if hasattr(model, "omega") else {}
         return NormalFamily(), start, ctx
     raise InputError(f"cannot diagnose a model of type {type(model).__name__}")
-
-
-#: Model evaluations (residual calls of every fit, numerical Jacobians included) a diagnosis
-#: may spend. Typical runs use 1 000-8 000; the slowest of 657 random fuzz inputs 7 237 (a
-#: minute on a loaded machine); without a bound the search (candidates x rounds x folds fits
-#: of up to 400 iterations each) could take hours. Once spent, the candidates not yet tried
-#: are reported as untested, with a sentence saying so.
-MAX_EVALUATIONS = 40_000
 
 
 def _frame_constants(
