@@ -567,7 +567,7 @@ def diagnose(
     st = search.run(SearchState(b.current, steps, where, [b.current], used=spent))
     # issue 29 items 1-3: both channels' noise, what each candidate not named would have
     # needed to be seen, and structure the final model leaves (detection.py)
-    from .detection import assess
+    from .assessment import assess
 
     checks = assess(
         b.family, d, st.current, b.sigma, z=z, gain_floor=min_gain + b.budget, folds=folds,
