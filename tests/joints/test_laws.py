@@ -491,3 +491,11 @@ def test_initial_stiffness_is_the_slope_from_rest() -> None:
         h = 1e-13  # Segalman's slope departs from K_T as sqrt(u) for chi = -1/2
         slope = float(law.force(None, [h])[0]) / h
         assert slope == pytest.approx(law.initial_stiffness, rel=1e-4, abs=1e-6), law.name
+
+
+def test_subclass_runs_on_its_parents_kernel() -> None:
+    class Named(Jenkins):
+        name = "named"
+
+    x = np.array([0.0, 1e-3, -2e-3])
+    np.testing.assert_array_equal(Named(1e4, 5.0).force(None, x), Jenkins(1e4, 5.0).force(None, x))
