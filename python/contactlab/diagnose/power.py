@@ -432,6 +432,16 @@ def detectable_above(
         per[s.name] = b
         rel[s.name] = None if b is None else b * float(np.sqrt(np.mean(j * j))) / st.y_rms
     mags = [s for s in cand.params if np.isfinite(s.null)]
+    if not mags:
+        # no parameter value means "absent" (an effect that replaces the base model's law,
+        # power_law_microslip): its size has no zero to be detected against
+        first = cand.params[0] if cand.params else None
+        return Detectable(
+            name, "" if first is None else first.name, None, "" if first is None else first.unit,
+            0.0, None, shape, per,
+            reason="not stated: no parameter value of this effect means 'absent' (it replaces "
+            "the base model's law rather than adding to it)",
+        )  # fmt: skip
     if not per or any(v is None for v in per.values()):
         worst = next((s for s in mags if per.get(s.name) is None), mags[0])
         return Detectable(
