@@ -45,7 +45,7 @@ from typing import Any
 import numpy as np
 
 from ._family import Family, ParamSpec, Prepared
-from .detection import ChannelNoise, effective_variance
+from .detection import ChannelNoise, effective_variance, model_slope
 from .select import MIN_RELATIVE_GAIN, sample_weight, specs_for
 
 __all__ = ["Detectable", "detectable_above", "shape_values", "stated_power"]
@@ -108,7 +108,7 @@ class Detectable:
             "parameter": self.parameter,
             "detectable_above": self.detectable_above,
             "unit": self.unit,
-            "null": self.null,
+            "null": self.null if self.null is None or np.isfinite(self.null) else None,
             "relative_size": self.relative_size,
             "power": POWER,
             "at": dict(self.at),
@@ -295,7 +295,8 @@ def _power_curve(jp: np.ndarray, st: _Setting) -> Any:
         if n < 2:
             return 0.0
         sd = np.std(ratio, axis=1, ddof=1)
-        t = np.where(sd > 0, np.mean(ratio, axis=1) / (sd / np.sqrt(n)), np.inf)
+        with np.errstate(divide="ignore", invalid="ignore"):  # (sd = 0: t = inf below)
+            t = np.where(sd > 0, np.mean(ratio, axis=1) / (sd / np.sqrt(n)), np.inf)
         gain = ((cur - cand) @ W) / Wtot / sig2
         return float(np.mean((t > st.z) & (gain >= st.gain_floor)))
 
@@ -407,7 +408,7 @@ def detectable_above(
         )  # fmt: skip
     st = _setting_cache
     if st is None:
-        slope = family.slope(params, d) if hasattr(family, "slope") else None
+        slope = model_slope(family, params, d)
         st = _setting(d, current, noise, slope, sigma, z, gain_floor, folds, seed)
     base_specs = specs_for(family, effects)
     jb = np.column_stack(
@@ -432,15 +433,11 @@ def detectable_above(
         per[s.name] = b
         rel[s.name] = None if b is None else b * float(np.sqrt(np.mean(j * j))) / st.y_rms
     mags = [s for s in cand.params if np.isfinite(s.null)]
-    if not mags:
-        # no parameter value means "absent" (an effect that replaces the base model's law,
-        # power_law_microslip): its size has no zero to be detected against
-        first = cand.params[0] if cand.params else None
+    if not mags:  # an element law that replaces the base's (no value means "absent")
+        first = cand.params[0]
         return Detectable(
-            name, "" if first is None else first.name, None, "" if first is None else first.unit,
-            0.0, None, shape, per,
-            reason="not stated: no parameter value of this effect means 'absent' (it replaces "
-            "the base model's law rather than adding to it)",
+            name, first.name, None, first.unit, first.null, None, shape, per,
+            reason="not nested in the base model: no parameter value means 'absent'",
         )  # fmt: skip
     if not per or any(v is None for v in per.values()):
         worst = next((s for s in mags if per.get(s.name) is None), mags[0])
@@ -466,13 +463,16 @@ def stated_power(report: Any, *, seed: int = 0) -> list[Detectable]:
     report : DiagnosisReport
         A tangential or normal diagnosis (:func:`contactlab.diagnose.diagnose`).
     seed : int
-        Seed of the draws.
+        Seed of the draws (0: the bounds the diagnosis stated itself are returned).
 
     Returns
     -------
     list of Detectable
         In the library's order; empty when the report does not carry its data.
     """
+    kept = getattr(report, "not_detected", None)
+    if kept and seed == 0:  # stated by the diagnosis itself, with the same settings and seed
+        return list(kept)
     d = report.prepared
     if d is None or not report.trials:
         return []
@@ -487,33 +487,43 @@ def stated_power(report: Any, *, seed: int = 0) -> list[Detectable]:
         from .detection import channel_noise
 
         noise = channel_noise(d, current.full_residual(d))
-    slope = fam.slope(params, d) if hasattr(fam, "slope") else None
+    slope = model_slope(fam, params, d)
     st = _setting(
         d, current, noise, slope, sigma, float(settings.get("z", 3.0)),
         float(settings.get("gain_floor", 0.05)), int(settings.get("folds", 2)), seed,
     )  # fmt: skip
     names = settings.get("candidates") or list(fam.candidates)
+    return bounds_for(fam, params, effects, names, d, noise, sigma, current, st)
+
+
+def bounds_for(
+    family: Family,
+    params: dict[str, float],
+    effects: tuple[str, ...],
+    names: list[str],
+    d: Prepared,
+    noise: ChannelNoise,
+    sigma: float,
+    current: Any,
+    st: _Setting,
+) -> list[Detectable]:
+    """:func:`detectable_above` of every candidate in ``names`` not in ``effects``; a
+    candidate whose bound cannot be computed (its model refuses the null, a singular
+    projection) gets ``detectable_above`` None and the reason."""
+    from ..errors import ContactLabError
+
     out = []
     for n in names:
-        if n in effects or n not in fam.candidates:
+        if n in effects or n not in family.candidates:
             continue
+        kw = {"noise": noise, "sigma": sigma, "z": st.z, "gain_floor": st.gain_floor}
         try:
             out.append(
                 detectable_above(
-                    fam,
-                    params,
-                    effects,
-                    n,
-                    d,
-                    noise=noise,
-                    sigma=sigma,
-                    z=st.z,
-                    gain_floor=st.gain_floor,
-                    current=current,
-                    _setting_cache=st,
+                    family, params, effects, n, d, current=current, _setting_cache=st, **kw
                 )
             )
-        except (ValueError, FloatingPointError, np.linalg.LinAlgError) as exc:
-            spec = fam.candidates[n].params[0]
+        except (ContactLabError, ValueError, FloatingPointError, np.linalg.LinAlgError) as exc:
+            spec = family.candidates[n].params[0]
             out.append(Detectable(n, spec.name, None, spec.unit, reason=f"not computable: {exc}"))
     return out
