@@ -273,7 +273,7 @@ def run_case(case):
     import warnings
 
     import contactlab
-    from contactlab.diagnose import hidden_effect_recording
+    from contactlab.synthetic.diagnosis import hidden_effect_recording
     from contactlab.synthetic.rig import rig_recording
 
     warnings.simplefilter("ignore")

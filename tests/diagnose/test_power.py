@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import contactlab
-from contactlab.diagnose import hidden_effect_recording
 from contactlab.diagnose.power import DRAWS, _power_curve, _Setting, stated_power
+from contactlab.synthetic.diagnosis import hidden_effect_recording
 
 
 def _direct_power(a: float, jp: np.ndarray, jb: np.ndarray, st: _Setting, reps: int) -> float:

@@ -384,7 +384,7 @@ def detectable_above(
     Examples
     --------
     >>> import contactlab
-    >>> from contactlab.diagnose import hidden_effect_recording
+    >>> from contactlab.synthetic.diagnosis import hidden_effect_recording
     >>> from contactlab.diagnose.power import stated_power
     >>> rep = contactlab.diagnose(hidden_effect_recording([], seed=3), max_effects=0)
     >>> b = {x.effect: x for x in stated_power(rep)}["channel_delay"]
