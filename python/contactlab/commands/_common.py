@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import contextlib
 import json
 import math
 import os
@@ -420,21 +419,10 @@ class _InterruptiblePool:
         if exc_type is None:
             self.executor.shutdown(wait=True)
             return
+        from ..studies.executor import kill_worker_processes
+
         kill_worker_processes()
         self.executor.shutdown(wait=False, cancel_futures=True)
-
-
-def kill_worker_processes() -> None:
-    """Kill every child process this process started through multiprocessing (the pools'
-    workers); they hold no outputs (every output is written by the parent, all or nothing)."""
-    import multiprocessing
-
-    for child in multiprocessing.active_children():
-        with contextlib.suppress(Exception):
-            child.kill()
-    for child in multiprocessing.active_children():
-        with contextlib.suppress(Exception):
-            child.join(timeout=1.0)
 
 
 def add_progress_flags(p: Any) -> None:

@@ -343,6 +343,14 @@ class _Windows:
         return rec
 
 
+def _noting(chunks: Iterator[Recording], noted: dict[str, Any]) -> Iterator[Recording]:
+    """The chunks as they come, keeping the last one's ``meta["resampled"]`` in ``noted``."""
+    for c in chunks:
+        if "resampled" in c.meta:
+            noted["resampled"] = c.meta["resampled"]
+        yield c
+
+
 def _segments(
     chunks: Iterator[Recording], size: int
 ) -> Iterator[tuple[Recording, dict[str, tuple[float, float]]]]:
@@ -553,6 +561,7 @@ def _track(
         raise InputError(f"max_window must be an integer >= 16, got {max_window!r}")
     cr = read_chunks(source, chunk_size=chunk_size, columns=columns, kind=kind, fs=fs,
                      resample=resample)  # fmt: skip
+    noted: dict[str, Any] = {}
     kind_ = cr.kind
     if kind_ not in ("tangential", "normal"):
         raise InputError(
@@ -576,7 +585,7 @@ def _track(
     out = _Dispatch(analyse, dict(options or {}), executor, slots, keep_going, callback, buf)
     n_total = 0
     try:
-        for block, ranges in _segments(cr.chunks_into(buf.alloc), CYCLE_SEGMENT):
+        for block, ranges in _segments(_noting(cr.chunks_into(buf.alloc), noted), CYCLE_SEGMENT):
             off = int(block.meta.get("offset", n_total))
             buf.add(block)
             n_total = off + len(block)
@@ -612,6 +621,7 @@ def _track(
         )
     cycles = {k: (np.concatenate(v) if v else np.empty(0)) for k, v in cyc.items()}
     meta = {
+        **noted,  # resampled: what --resample bridged (the last chunk's: the whole record's)
         "n_samples": n_total,
         "n_windows": len(out.rows),
         "tail_samples_left_out": tail,
