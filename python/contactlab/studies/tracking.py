@@ -6,7 +6,7 @@ and cuts it into windows of N cycles or T seconds (cut at upward crossings of th
 every window holds whole cycles), analyses each window as the whole-recording analyses do and
 keeps only the results:
 
-- tangential windows: :func:`contactlab.tangential.analysis.analyze_window` (the numbers of
+- tangential windows: :func:`contactlab.tangential.window.analyze_window` (the numbers of
   :func:`~contactlab.tangential.analyze_tangential`, the samples folded once in Rust) — h0,
   ac (None where the analysis finds them not separately identifiable; ``h0_ac`` always),
   energy per cycle
@@ -62,7 +62,7 @@ from .track_result import (  # noqa: F401  (the constants and TrackResult, re-ex
 )
 
 #: options of ``analyze_tangential`` the one-pass window analysis
-#: (:func:`contactlab.tangential.analysis.analyze_window`) takes; others (``on="signal"``,
+#: (:func:`contactlab.tangential.window.analyze_window`) takes; others (``on="signal"``,
 #: ``history``) take the whole-window analysis
 _WINDOW_OPTIONS = frozenset(
     ("force_sign", "n_points", "rel_threshold", "min_cycles", "max_rel_stderr", "fit_offset",
@@ -169,7 +169,7 @@ def _tangential_window(
     rec: Recording | _WindowSamples, options: Mapping[str, Any], keep_doc: bool = False
 ) -> tuple[dict, dict]:
     from ..tangential import analyze_tangential
-    from ..tangential.analysis import analyze_window
+    from ..tangential.window import analyze_window
 
     rec = _window_recording(rec)
 
