@@ -25,6 +25,7 @@ if TYPE_CHECKING:
         loop_area,
         loop_areas,
     )
+    from .simulation import Simulator
     from .studies.tracking import TrackResult, track
     from .tangential import TangentialAnalysis, analyze_tangential
 
@@ -50,6 +51,7 @@ _LAZY = {
     "force_many": "masing",
     "TangentialAnalysis": "tangential",
     "analyze_tangential": "tangential",
+    "Simulator": "simulation",
     "TrackResult": "studies.tracking",
     "track": "studies.tracking",
 }
@@ -81,6 +83,7 @@ __all__ = [
     "Parameter",
     "Recording",
     "RecordingError",
+    "Simulator",
     "TangentialAnalysis",
     "TrackResult",
     "__version__",

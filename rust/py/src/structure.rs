@@ -55,6 +55,7 @@ fn build_joint(spec: &JointSpec) -> Result<Joint, CoreError> {
             JointLaw::kelvin_voigt(p[0], p[1])?
         }
         "normal" => JointLaw::normal(a)?,
+        "law" => JointLaw::law(contactlab_core::joints::AnyLaw::from_flat(a)?)?,
         _ => return Err(bad("joint kind", "unknown joint kind")),
     };
     Ok(Joint {
