@@ -284,7 +284,12 @@ def main() -> None:
     ap.add_argument("--ode", action="store_true", help="also the normal ODE against odeint")
     args = ap.parse_args()
     big = 1_000_000 if args.quick else 10_000_000
-    simd = getattr(getattr(contactlab, "_core", None), "simd_level", lambda: "n/a")()
+    try:
+        from contactlab import _core
+
+        simd = _core.simd_level()
+    except (ImportError, AttributeError):  # a build before the dispatch
+        simd = "n/a (before runtime dispatch)"
     print(
         f"contactlab {contactlab.__version__}; SIMD level {simd}; load "
         f"{', '.join(f'{a:.2f}' for a in os.getloadavg())}; {os.cpu_count()} CPUs; medians of "
