@@ -12,17 +12,21 @@ import json
 import re
 import warnings
 from pathlib import Path
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from ..errors import InputError
 from ._common import check_output_targets, describe, json_text, made_by, quantity, write_json
+
+if TYPE_CHECKING:
+    import numpy as np
 
 _UNIT = re.compile(r"(?:\[([^\]]+)\]|_([A-Za-z]+))\s*$")
 
 
 def read_table(path: str) -> dict[str, np.ndarray]:
     """Columns of a CSV (header line, optional ``#``), converted to SI from unit suffixes."""
+    import numpy as np
+
     from ..io.csv import read_header, sniff_encoding
     from ..studies.manifest import unit_factor
 
@@ -86,6 +90,8 @@ def _pick(cols: dict[str, np.ndarray], want: str | None, guesses: tuple[str, ...
 
 
 def _time(cols: dict[str, np.ndarray], args: argparse.Namespace, n: int, path: str) -> np.ndarray:
+    import numpy as np
+
     for name in cols:
         if name.lower() in ("t", "time") or name.lower().startswith(("t_", "t [", "time")):
             return cols[name]
@@ -95,6 +101,8 @@ def _time(cols: dict[str, np.ndarray], args: argparse.Namespace, n: int, path: s
 
 
 def _identify(args: argparse.Namespace) -> int:
+    import numpy as np
+
     from ..report import commit_outputs
     from .structure_verbs import identify_record
 
@@ -158,6 +166,8 @@ def _identify(args: argparse.Namespace) -> int:
 
 
 def _masses(text: str | None) -> list[float] | None:
+    import numpy as np
+
     if text is None:
         return None
     try:
@@ -205,6 +215,8 @@ def _joint_dofs(text: str) -> tuple[int, int | None]:
 
 def simulate_structure(args: argparse.Namespace) -> int:
     """Handler of ``contactlab simulate structure OUT --structure MODEL --input FILE``."""
+    import numpy as np
+
     from .._io_atomic import write_text
     from ..structure import IdentifiedModel, Structure
 
