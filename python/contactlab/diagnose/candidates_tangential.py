@@ -11,29 +11,28 @@ physical on a record and why (:meth:`~contactlab.diagnose.effects.EffectModel.pl
 and the smallest size a record reveals
 (:meth:`~contactlab.diagnose.effects.EffectModel.detectable`). A new effect is one new file.
 
-========================  =========================================================  =========
-name                      measured force ``F`` (or measured ``x``)                   params
-========================  =========================================================  =========
-``viscous_damping``       ``F = h + c ẋ``                                             c  [N s/m]
-``inertia``               ``F = h + m ẍ``  (mass between sensor and contact)          m  [kg]
-``parallel_stiffness``    ``F = h + k_p x`` (rig flexures in parallel)                k_p [N/m]
-``series_compliance``     ``x = x_c + C_s h`` (rig compliance in series)              C_s [m/N]
-``force_offset``          ``F = h + F0`` (sensor bias)                                F0 [N]
-``force_drift``           ``F = h + F1 (t - t0)/T`` (load-cell zero drifting)        F1 [N]
-``displacement_offset``   ``h = M(x - x0)`` (displacement sensor zero off the origin)  x0 [m]
-``channel_delay``         ``F(t) = h(t - τ)`` (force channel lags displacement)       tau [s]
-``asymmetry``             ``F = h + α |h|``: saturation ``h0(1 ± α)`` per direction   alpha [-]
-``non_masing_scaling``    branches ``h_r + λ f((x - x_r)/λ)`` from rest at the turns  lam [-]
-``parameter_drift``       ``F = h (1 + β (t - t_m)/T)``, ``t_m`` mid-record           beta [-]
-``stribeck``              ``F = h (1 + s exp(-|ẋ|/v_s))``                              s, v_s
-``position_friction``     ``F = h (1 + Σ a_k cos kπξ + b_k sin kπξ)``                  a_k, b_k
-``stick_slip``            breakaway ``s_b`` after each reversal over ``ell``           s_b, ell
-``normal_load``           ``F = h (1 + ε_c cos 2π f_n t + ε_s sin 2π f_n t)``          eps, f_n
-``power_law_microslip``   Segalman's Iwan element (F_S = h0, K_T = h0 ac)             chi, beta
-``backlash``              ``F = M(u)``, ``u`` the play operator of ``x`` (width 2b)   b [m]
-``rate_dependent_         ``F = h + σ1 ẋ k(x)/k0`` (LuGre micro-damping)              sigma1
-presliding``
-========================  =========================================================  =========
+=============================  =========================================================== =========
+name                           measured force ``F`` (or measured ``x``)                    params
+=============================  =========================================================== =========
+``viscous_damping``            ``F = h + c ẋ``                                             c [N s/m]
+``inertia``                    ``F = h + m ẍ`` (mass between sensor and contact)           m [kg]
+``parallel_stiffness``         ``F = h + k_p x`` (rig flexures in parallel)                k_p [N/m]
+``series_compliance``          ``x = x_c + C_s h`` (rig compliance in series)              C_s [m/N]
+``force_offset``               ``F = h + F0`` (sensor bias)                                F0 [N]
+``force_drift``                ``F = h + F1 (t - t0)/T`` (load-cell zero drifting)         F1 [N]
+``displacement_offset``        ``h = M(x - x0)`` (displacement sensor zero off the origin) x0 [m]
+``channel_delay``              ``F(t) = h(t - τ)`` (force channel lags displacement)       tau [s]
+``asymmetry``                  ``F = h + α |h|``: saturation ``h0(1 ± α)`` per direction   alpha [-]
+``non_masing_scaling``         branches ``h_r + λ f((x - x_r)/λ)`` from rest at the turns  lam [-]
+``parameter_drift``            ``F = h (1 + β (t - t_m)/T)``, ``t_m`` mid-record           beta [-]
+``stribeck``                   ``F = h (1 + s exp(-|ẋ|/v_s))``                             s, v_s
+``position_friction``          ``F = h (1 + Σ a_k cos kπξ + b_k sin kπξ)``                 a_k, b_k
+``stick_slip``                 breakaway ``s_b`` after each reversal over ``ell``          s_b, ell
+``normal_load``                ``F = h (1 + ε_c cos 2π f_n t + ε_s sin 2π f_n t)``         eps, f_n
+``power_law_microslip``        Segalman's Iwan element (F_S = h0, K_T = h0 ac)             chi, beta
+``backlash``                   ``F = M(u)``, ``u`` the play operator of ``x`` (width 2b)   b [m]
+``rate_dependent_presliding``  ``F = h + σ1 ẋ k(x)/k0`` (LuGre micro-damping)              sigma1
+=============================  =========================================================== =========
 
 Notes on exactness. The exponential Masing force is linear in ``h0`` at fixed ``ac`` along a
 history, so the drift factor is exact. A linear spring in series with a Masing element is

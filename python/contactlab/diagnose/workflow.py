@@ -426,9 +426,11 @@ def infer_model(recording: Any) -> str:
     if kind in ("tangential", "normal"):
         return str(kind)
     if isinstance(recording, dict):
-        if "x" in recording and "F" in recording:
+        # the family whose channels are there (the family's own check then names a missing
+        # one: {"x": ..., "force": ...} is a tangential recording without 'F')
+        if "x" in recording or "F" in recording:
             return "tangential"
-        if "p" in recording and "delta" in recording:
+        if "p" in recording or "delta" in recording:
             return "normal"
     if isinstance(recording, tuple):
         return "tangential"
@@ -452,6 +454,7 @@ def diagnose(
     output_filter: Any = None,
     output_noise: float | None = None,
     force_sign: int | str | None = None,
+    delay: float | None = None,
 ) -> Any:
     """Find where a model and a measurement disagree, name the missing effect, add it.
 
@@ -498,6 +501,11 @@ def diagnose(
         Tangential only, as ``analyze`` takes it: diagnose ``force_sign·F``; ``"auto"``: the
         sign that makes the loop dissipate (``∮F dx > 0``). Default (None): the force as
         recorded, and a loop that runs the wrong way is refused with a sentence saying so.
+    delay : float, optional
+        Tangential only, as ``analyze`` and ``track`` take it: a known delay (s) of the force
+        channel behind the displacement; the force is read that much later
+        (:func:`contactlab.tangential.lag.delayed_recording`) before the diagnosis, and the
+        samples the shift leaves without force data are dropped.
 
     Returns
     -------
@@ -526,6 +534,8 @@ def diagnose(
     if inferred:
         model = infer_model(recording)
     family, start, context = _family(model)
+    if delay is not None:
+        recording = _delayed(recording, family, delay)
     path = kind_path(family)
     t, u, y = _checked_arrays(recording, family, folds, max_effects, z, min_gain)
     y, sign_note = path.orient(t, u, y, force_sign)
@@ -557,7 +567,7 @@ def diagnose(
     st = search.run(SearchState(b.current, steps, where, [b.current], used=spent))
     # issue 29 items 1-3: both channels' noise, what each candidate not named would have
     # needed to be seen, and structure the final model leaves (detection.py)
-    from .detection import assess
+    from .assessment import assess
 
     checks = assess(
         b.family, d, st.current, b.sigma, z=z, gain_floor=min_gain + b.budget, folds=folds,
@@ -599,6 +609,15 @@ def _candidate_names(family: Family, candidates: Sequence[str] | None) -> list[s
                 f"unknown {family.kind} candidate {n!r}; choose from {', '.join(family.candidates)}"
             )
     return names
+
+
+def _delayed(recording: Any, family: Family, delay: float) -> Any:
+    """``diagnose(..., delay=)``: the tangential recording with its force read later."""
+    if family.kind != "tangential":
+        raise InputError("delay= is for tangential recordings (force against displacement)")
+    from ..tangential.lag import delayed_recording
+
+    return delayed_recording(recording, delay)
 
 
 def _meta(recording: Any) -> dict[str, Any]:
