@@ -472,7 +472,7 @@ def stated_power(report: Any, *, seed: int = 0) -> list[Detectable]:
     report : DiagnosisReport
         A tangential or normal diagnosis (:func:`contactlab.diagnose.diagnose`).
     seed : int
-        Seed of the draws.
+        Seed of the draws (0: the bounds the diagnosis stated itself are returned).
 
     Returns
     -------
