@@ -65,8 +65,12 @@ def bounds() -> dict[str, dict[str, object]]:
 
 
 def test_every_candidate_has_a_bound_in_its_units(bounds: dict) -> None:
+    from contactlab.diagnose.candidates_tangential import TangentialFamily
+
     b = bounds[0.002]
-    assert len(b) == 15
+    assert list(b) == list(TangentialFamily().candidates)  # nothing named: every candidate
+    for x in b.values():  # a bound in the parameter's unit, or None with the reason
+        assert (x.detectable_above is None) == bool(x.reason), x
     assert b["channel_delay"].unit == "s" and 0 < b["channel_delay"].detectable_above < 1e-3
     assert b["parallel_stiffness"].unit == "N/m"
     assert b["non_masing_scaling"].null == 2.0
