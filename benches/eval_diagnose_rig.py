@@ -96,8 +96,11 @@ def draw_factors(rng, kind):
     }
 
 
-def plan(mode, base_seed):
-    """Cases: (generator, kind, effect or None, variant, seed, factors)."""
+def plan(mode, base_seed, scale=1.0):
+    """Cases: (generator, kind, effect or None, variant, seed, factors).
+
+    ``scale`` multiplies the number of records per cell of the full plan (at least 1 each).
+    """
     sizes = {
         "quick": {
             "rig_t_clean": 6,
@@ -129,6 +132,11 @@ def plan(mode, base_seed):
             "quick_effects": (),
         },
     }[mode]
+    if scale != 1.0:
+        sizes = {
+            k: (max(1, round(v * scale)) if isinstance(v, int) and v else v)
+            for k, v in sizes.items()
+        }
     cases = []
     seed = base_seed
 
@@ -234,7 +242,8 @@ def rig_normal_effect(effect, fac, rng, k=1.3e12, pa=0.4e6):
         return {}
     return {
         effect: {
-            "stiffness_nonlinearity": {"a2": sgn * 0.3 * k / da},
+            # hardening in compression (δ > 0); k + a2·δ stays monotone beyond the stroke
+            "stiffness_nonlinearity": {"a2": 0.2 * k / da},
             "hysteretic_damping": {"eta": 0.05},
             "creep_drift": {"D": sgn * 0.3 * da, "tau_c": 0.2 * T_rec},
             "channel_delay": {"tau": 0.015 / fac["f"]},
@@ -273,7 +282,7 @@ def run_case(case):
     import warnings
 
     import contactlab
-    from contactlab.diagnose import hidden_effect_recording
+    from contactlab.synthetic.diagnosis import hidden_effect_recording
     from contactlab.synthetic.rig import rig_recording
 
     warnings.simplefilter("ignore")
@@ -338,6 +347,13 @@ def run_case(case):
                 **base,
             )
             out["pkg_samples"] = int(recording.t.size)
+            if kind == "tangential":  # the generator sets its own amplitude: ac·A as made
+                ac = recording.truth.get("base", {}).get("ac", 5e4)
+                x = np.asarray(recording.data["x"])
+                out["factors"] = {
+                    **fac,
+                    "acA": round(float(ac * np.percentile(np.abs(x), 99.5)), 3),
+                }
             out["truth"] = {k: v for k, v in recording.truth.get("effects", {}).items()}
         rep = contactlab.diagnose(recording, model=kind)
         d = rep.to_dict()
@@ -750,7 +766,9 @@ def main(argv=None):
     ap.add_argument("--seeds", choices=("fresh", "tune"), default="fresh")
     ap.add_argument("--seed-base", type=int, default=None, help="replay a FRESH run")
     ap.add_argument("--jobs", type=int, default=2, help="worker processes (at most 2)")
+    ap.add_argument("--scale", type=float, default=1.0, help="records per cell × this")
     ap.add_argument("--no-measured", action="store_true")
+    ap.add_argument("--measured-only", action="store_true")
     ap.add_argument("--label", default="")
     ap.add_argument("--out", type=Path, default=None, help="also write the tables here")
     ap.add_argument("--raw", type=Path, default=None, help="write per-record results (JSON)")
@@ -766,14 +784,35 @@ def main(argv=None):
     else:
         base = 10_000_000 + (int(time.time()) % 1_000_000) * 1000
     mode = "quick" if args.quick else "full"
-    cases = plan(mode, base)
+    if args.measured_only:
+        text = "\n".join(
+            [
+                f"## {args.label} measured records, "
+                f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}",
+                "",
+                *measured(args.quick),
+            ]
+        )
+        print(text)
+        if args.out:
+            args.out.write_text(text + "\n")
+        return
+    cases = plan(mode, base, args.scale)
     print(
         f"seeds: {args.seeds} base {base} ({len(cases)} records, mode {mode}, jobs {jobs})",
         flush=True,
     )
     t0 = time.time()
     with ProcessPoolExecutor(max_workers=jobs, initializer=_init_worker) as pool:
-        results = list(pool.map(run_case, cases, chunksize=1))
+        results = []
+        for i, r in enumerate(pool.map(run_case, cases, chunksize=1), 1):
+            results.append(r)
+            if i % 10 == 0 or i == len(cases):
+                print(
+                    f"  {i}/{len(cases)} records, {time.time() - t0:.0f} s",
+                    file=sys.stderr,
+                    flush=True,
+                )
     head = (
         f"{args.label} seeds {args.seeds} base {base}, {mode}, "
         f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, wall {time.time() - t0:.0f} s"

@@ -253,8 +253,8 @@ POWER_TRIES = 4
 
 
 def _power_one(job: tuple[str, int]) -> dict[str, Any]:
-    from contactlab.diagnose import hidden_effect_recording
     from contactlab.diagnose.workflow import diagnose
+    from contactlab.synthetic.diagnosis import hidden_effect_recording
 
     effect, seed = job
     rep = diagnose(hidden_effect_recording([], seed=seed, **POWER_SETTING))

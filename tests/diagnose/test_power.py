@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import contactlab
-from contactlab.diagnose import hidden_effect_recording
 from contactlab.diagnose.power import DRAWS, _power_curve, _Setting, stated_power
+from contactlab.synthetic.diagnosis import hidden_effect_recording
 
 
 def _direct_power(a: float, jp: np.ndarray, jb: np.ndarray, st: _Setting, reps: int) -> float:
@@ -65,10 +65,11 @@ def bounds() -> dict[str, dict[str, object]]:
 
 
 def test_every_candidate_has_a_bound_in_its_units(bounds: dict) -> None:
-    from contactlab.diagnose.candidates_tangential import TangentialFamily
+    from contactlab.diagnose.effects import registry
 
     b = bounds[0.002]
-    assert list(b) == list(TangentialFamily().candidates)  # nothing named: every candidate
+    assert set(b) == set(registry("tangential"))  # every candidate of the library
+    assert b["power_law_microslip"].detectable_above is None  # not nested: no "absent"
     for x in b.values():  # a bound in the parameter's unit, or None with the reason
         assert (x.detectable_above is None) == bool(x.reason), x
     assert b["channel_delay"].unit == "s" and 0 < b["channel_delay"].detectable_above < 1e-3
