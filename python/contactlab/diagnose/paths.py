@@ -110,10 +110,15 @@ class KindPath:
         return RegimeDecision("", "", "base fit")
 
     def check_final(
-        self, regime: RegimeDecision, p: dict[str, float], effects: tuple[str, ...]
+        self,
+        regime: RegimeDecision,
+        p: dict[str, float],
+        effects: tuple[str, ...],
+        model_force: Any = None,
     ) -> tuple[dict[str, Any] | None, str | None]:
         """The final model's physical parameters against ``analyze``'s (None: nothing to
-        check), and a sentence when they moved."""
+        check), and a sentence when they moved (``model_force``: the final model's output,
+        as the tangential path takes it; unused here)."""
         return None, None
 
 
