@@ -14,7 +14,8 @@ F noise 1 % of its RMS, h0 = 40 N, ac = 1e5 1/m):
 - ``offset``: plus a force-sensor bias of 1 N (``force_offset``);
 - ``damping``: plus a viscous force ``c ẋ`` of 2 % of the force RMS (``viscous_damping``).
 
-Recordings of the hidden-effect generator (:func:`contactlab.diagnose.hidden_effect_recording`,
+Recordings of the hidden-effect generator
+(:func:`contactlab.synthetic.diagnosis.hidden_effect_recording`,
 its default rig, 1000 samples per reference cycle, as many cycles as make ``--samples``):
 
 - ``t:none`` (tangential, no effect), ``t:NAME`` (one effect NAME of the tangential library

@@ -1,7 +1,7 @@
 """Evaluation of the discrepancy workflow on recordings that look like measurements (issue 8).
 
-Recordings come from :func:`contactlab.diagnose.hidden_effect_recording` with the sensors of
-a real rig: noise on both channels, causal anti-alias filters, ADC quantisation, a record
+Recordings come from :func:`contactlab.synthetic.diagnosis.hidden_effect_recording` with the
+sensors of a real rig: noise on both channels, causal anti-alias filters, ADC quantisation, a record
 that starts from rest or in steady state, 50-2000 samples per cycle. A reference condition
 (output noise 0.5 % of its RMS, input noise 0.2 % of the amplitude, 200 samples per cycle,
 start from rest, both channels filtered at half the Nyquist frequency, 16 bits, effect size

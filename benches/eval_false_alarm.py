@@ -125,9 +125,46 @@ def run_one(job: tuple[str, int, str]) -> dict[str, Any]:
             named=rep.effect_names,
             flagged=bool(u is not None and u.flagged),
             misfit_p=None if u is None else u.p_value,
+            # T over its threshold (before the calibration factor): the null's quantiles
+            misfit_ratio=None if u is None else u.statistic / u.threshold * _calibration(u),
+            misfit_cycles=None if u is None else u.cycles,
         )
     out["cpu"] = time.process_time() - t0
     return out
+
+
+def _calibration(u: Any) -> float:
+    from contactlab.diagnose.misfit import CALIBRATION, POOL_BELOW, POOLED_CALIBRATION
+
+    return POOLED_CALIBRATION if u.cycles < POOL_BELOW else CALIBRATION
+
+
+def calibration_table(results: list[dict[str, Any]]) -> str:
+    """Quantiles of the structure test's T over its uncalibrated threshold on clean records,
+    few-cycle records (pooled scatter) apart: the factor that brings the rate to 3 %."""
+    lines = ["\nstructure test on clean records: T / uncalibrated threshold"]
+    from contactlab.diagnose.misfit import POOL_BELOW
+
+    for name, sel in (
+        (f"pooled (cycles < {POOL_BELOW})", lambda m: m < POOL_BELOW),
+        ("per bin", lambda m: m >= POOL_BELOW),
+    ):
+        r = np.array(
+            [
+                x["misfit_ratio"]
+                for x in results
+                if x.get("misfit_ratio") is not None
+                and x["virgin"] == "exp"
+                and sel(x["misfit_cycles"])
+            ]
+        )
+        if r.size:
+            q = np.quantile(r, [0.5, 0.9, 0.97])
+            lines.append(
+                f"  {name:<22} n {r.size:>4}: median {q[0]:.2f}, 90 % {q[1]:.2f}, 97 % {q[2]:.2f}, "
+                f"above 1: {int(np.sum(r > 1))}"
+            )
+    return "\n".join(lines)
 
 
 def _upper(k: int, n: int, conf: float = 0.95) -> float:
@@ -216,8 +253,8 @@ POWER_TRIES = 4
 
 
 def _power_one(job: tuple[str, int]) -> dict[str, Any]:
-    from contactlab.diagnose import hidden_effect_recording
     from contactlab.diagnose.workflow import diagnose
+    from contactlab.synthetic.diagnosis import hidden_effect_recording
 
     effect, seed = job
     rep = diagnose(hidden_effect_recording([], seed=seed, **POWER_SETTING))
@@ -254,6 +291,7 @@ def main() -> None:
             results = list(ex.map(run_one, jobs))
         for m in models:
             print(table(results, m), flush=True)
+        print(calibration_table(results), flush=True)
     if a.tanh:
         jobs = [("tangential", a.seed0 + 500 + i, "tanh") for i in range(a.tanh)]
         with ProcessPoolExecutor(a.jobs) as ex:

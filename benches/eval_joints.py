@@ -54,6 +54,10 @@ FRICTION_LAWS = [
 ]
 
 
+#: the laws fitted to the micro-tribometer (its source fits LuGre)
+TRIBO_LAWS = ["dahl", "lugre", "masing", "segalman", "jenkins", "bouc_wen", "maxwell_slip"]
+
+
 def _fd_records(folder: Path) -> list[JointRecord]:
     recs = []
     for i in range(13):
@@ -291,7 +295,7 @@ def tribo() -> None:
           "samples")  # fmt: skip
     print(f"{'law':<14} {'NRMSE last25':>12} {'SNR last25':>10} {'E/cycle err':>11} "
           f"{'NRMSE virgin':>12} {'fit s':>6}")  # fmt: skip
-    for law in ("dahl", "lugre", "masing", "segalman", "maxwell_slip", "jenkins", "bouc_wen"):
+    for law in TRIBO_LAWS:
         t0 = time.perf_counter()
         try:
             f = fit([fit_rec], law=law, offset=True, max_samples=8000)

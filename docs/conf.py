@@ -9,6 +9,7 @@ sphinx-gallery (``docs/examples/plot_*.py`` run at every build). Built with ``-W
 from __future__ import annotations
 
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -51,7 +52,14 @@ myst_enable_extensions = ["dollarmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3
 
 autosummary_generate = True
-autodoc_default_options = {"members": True, "undoc-members": False, "show-inheritance": False}
+# each object documented once, in the module that defines it (a package's ``__all__``
+# re-exports would describe it a second time)
+autodoc_default_options = {
+    "members": True,
+    "undoc-members": False,
+    "show-inheritance": False,
+    "ignore-module-all": True,
+}
 autodoc_typehints = "none"  # the numpydoc sections say the types
 autodoc_member_order = "bysource"
 numpydoc_show_class_members = False
@@ -67,7 +75,6 @@ numpydoc_xref_param_type = False
 # are generated from the package, so they cannot point to a module that does not exist.
 nitpicky = True
 nitpick_ignore_regex = [(r"py:.*", r".*")]
-
 
 
 def public_modules() -> list[str]:
@@ -105,8 +112,7 @@ def public_modules() -> list[str]:
     "Generated from the docstrings (numpydoc) of every public module of the package, found "
     "by walking\nit at build time, so a module that moves is documented where it now lives. "
     "A module or name\nstarting with an underscore is private and not listed.\n\n"
-    ".. autosummary::\n   :toctree: generated\n\n"
-    + "".join(f"   {m}\n" for m in public_modules()),
+    ".. autosummary::\n   :toctree: generated\n\n" + "".join(f"   {m}\n" for m in public_modules()),
     encoding="utf-8",
 )
 
@@ -129,6 +135,15 @@ os.environ.setdefault("CONTACTLAB_DOCS", "1")
 OPTIONAL_PAGES = {"effects": "User guides", "architecture": "Reference"}
 
 
+# The repository's ARCHITECTURE.md (the layers and where code goes), shown as a page of its
+# own: docs/architecture.md includes it, written here when it exists (and not committed).
+if (ROOT / "ARCHITECTURE.md").exists():
+    (HERE / "architecture.md").write_text(
+        "```{include} ../ARCHITECTURE.md\n:relative-docs: docs/\n:relative-images:\n```\n",
+        encoding="utf-8",
+    )
+
+
 def _optional_toc(app, docname, source):
     """Append the optional pages that exist to the index's table of contents."""
     if docname != "index":
@@ -139,5 +154,21 @@ def _optional_toc(app, docname, source):
         source[0] += "\n```\n"
 
 
+#: plain-text idioms of the docstrings that reStructuredText would read as markup: ``|F|``
+#: (an absolute value, not a substitution) and ``*SPRING`` (a solver keyword, not emphasis)
+_ABS = re.compile(r"(?<![\\|`\w])\|(?=[^\s|])([^|`\n]*?[^\s|])\|(?![|_\w])")
+_KEYWORD = re.compile(r"(?<![\w*`\\])\*(?=[A-Z]{2})")
+
+
+def _plain_text(app, what, name, obj, options, lines):
+    """Escape ``|x|`` and ``*KEYWORD`` in docstrings, outside literals and tables."""
+    for i, line in enumerate(lines):
+        stripped = line.lstrip()
+        if stripped.startswith(("|", "+-", "+=", ">>>", "...")) or "``" in line:
+            continue
+        lines[i] = _KEYWORD.sub(r"\\*", _ABS.sub(r"\\|\1\\|", line))
+
+
 def setup(app):
     app.connect("source-read", _optional_toc)
+    app.connect("autodoc-process-docstring", _plain_text)

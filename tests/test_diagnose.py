@@ -58,7 +58,14 @@ def _check_layout(d: dict) -> None:
     json.loads(json.dumps(d, allow_nan=False))
 
 
-@pytest.mark.parametrize("effect", TANGENTIAL_EFFECTS)
+#: the branch scale from rest at the turning points (docs/effects.md) makes every branch
+#: after the first a Masing branch of (λ h0/2, 2 ac/λ): a base refit absorbs all but the
+#: amplitude-dependent loop offset and the first loading, under 1 % of the force's RMS
+#: whatever λ (1.1-3), so at a 5 % raw size it is not identifiable (tested apart below)
+ALONE = [e for e in TANGENTIAL_EFFECTS if e != "non_masing_scaling"]
+
+
+@pytest.mark.parametrize("effect", ALONE)
 def test_each_effect_is_named_alone(effect):
     rec = hidden_effect_recording([effect], magnitude=0.05, noise=0.01, seed=SEED)
     rep = contactlab.diagnose(rec, model="tangential")
@@ -66,6 +73,20 @@ def test_each_effect_is_named_alone(effect):
     assert rep.steps[-1].heldout_rms <= 1.5 * rep.noise_rms
     assert rep.steps[-1].heldout_rms < rep.steps[0].heldout_rms
     _check_layout(rep.to_dict())
+
+
+def test_branch_scale_is_named_when_its_offset_and_first_loading_show():
+    """λ = 2.9 from rest at 0.2 % noise: named, h0 back at the truth (50 N) where the base
+    fit read the loop's height λ h0/2 = 72 N; at 5 % raw size (λ = 2.13) nothing is named
+    (not identifiable beside a base refit: see ALONE)."""
+    rec = hidden_effect_recording(["non_masing_scaling"], magnitude=0.3, noise=0.002, seed=SEED)
+    rep = contactlab.diagnose(rec, model="tangential")
+    assert rep.effect_names == ["non_masing_scaling"]
+    assert rep.final_model.params["lam"] == pytest.approx(2.89, rel=0.15)
+    assert rep.final_model.params["h0"] == pytest.approx(50.0, rel=0.15)
+    assert "settles" in rep.effects[0].plausibility
+    weak = hidden_effect_recording(["non_masing_scaling"], magnitude=0.05, noise=0.01, seed=SEED)
+    assert contactlab.diagnose(weak, model="tangential").effect_names == []
 
 
 def test_clean_data_names_nothing():

@@ -9,13 +9,13 @@ import json
 import numpy as np
 
 import contactlab
-from contactlab.diagnose import candidates_normal, workflow
+from contactlab.diagnose import candidates_normal, search
 from contactlab.synthetic.diagnosis import hidden_effect_recording
 
 
 def test_spent_budget_leaves_candidates_untested_and_says_so(monkeypatch):
     rec = hidden_effect_recording(["force_offset"], magnitude=0.05, seed=2)
-    monkeypatch.setattr(workflow, "MAX_EVALUATIONS", 1)  # spent by the base fit already
+    monkeypatch.setattr(search, "MAX_EVALUATIONS", 1)  # spent by the base fit already
     report = contactlab.diagnose(rec, model="tangential")
     assert report.effect_names == []
     reasons = [v.reason for v in report.steps[0].candidates]

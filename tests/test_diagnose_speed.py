@@ -183,7 +183,7 @@ def test_threads_follow_the_load_now_not_the_lagging_average(monkeypatch):
 def test_a_binding_budget_stops_where_a_serial_run_stops(monkeypatch):
     """Candidates on threads spend the evaluation budget as a serial run does: the same
     candidates tried, the same ones left untested, the same sentence."""
-    from contactlab.diagnose import workflow
+    from contactlab.diagnose import search
 
     rec = hidden_effect_recording(["force_offset"], magnitude=0.05, seed=2)
     monkeypatch.setenv("CONTACTLAB_DIAGNOSE_THREADS", "1")
@@ -192,7 +192,7 @@ def test_a_binding_budget_stops_where_a_serial_run_stops(monkeypatch):
     # a budget that runs out in the middle of the first step's candidates (5 of 15 left
     # untested; 700 left 3 before the fits' quick tolerances and the load-frequency search,
     # and none since)
-    monkeypatch.setattr(workflow, "MAX_EVALUATIONS", 400)
+    monkeypatch.setattr(search, "MAX_EVALUATIONS", 400)
     serial = contactlab.diagnose(rec, model="tangential", max_effects=1)
     monkeypatch.setenv("CONTACTLAB_DIAGNOSE_THREADS", "2")
     threaded = contactlab.diagnose(rec, model="tangential", max_effects=1)

@@ -67,10 +67,12 @@ def test_creep_settling_within_a_period_is_a_start_up_transient():
     assert fam.implausible("creep_drift", {"D": 1e-9, "tau_c": 3.0 * period}, d) is None
 
 
-def test_backward_step_drops_an_effect_named_too_early():
-    """Behind anti-alias filters at 0.3 / 0.6 of Nyquist a non-Masing branch scale first looks
-    like stick-slip to the forward search; once the scale and the filters' skew are in, the
-    stick-slip adds nothing and the backward step drops it (recorded as a step)."""
+def test_filtered_branch_scale_names_the_skew_and_the_scale():
+    """Behind anti-alias filters at 0.3 / 0.6 of Nyquist a non-Masing branch scale (from
+    rest at the turning points, docs/effects.md) and the filters' skew (a negative delay:
+    the displacement's filter is the slower) are both named. (Before the branch scale
+    followed the actual turning points, the forward search named stick-slip first and the
+    backward step dropped it; that step is tested in tests/diagnose/test_search.py.)"""
     rec = hidden_effect_recording(
         ["non_masing_scaling"], magnitude=0.05, noise=0.005, input_noise=0.002,
         samples_per_cycle=200, anti_alias=(0.3, 0.6), bits=16, seed=92000,
@@ -79,14 +81,7 @@ def test_backward_step_drops_an_effect_named_too_early():
         rec, candidates=["non_masing_scaling", "stick_slip", "channel_delay", "force_offset"]
     )
     assert sorted(rep.effect_names) == ["channel_delay", "non_masing_scaling"]
-    removed = [s for s in rep.steps if s.removed is not None]
-    assert [s.removed for s in removed] == ["stick_slip"]
-    assert removed[0].added is None and removed[0].label == "- stick_slip"
-    assert not removed[0].removal.accepted
-    assert any(w.startswith("backward step: stick_slip dropped") for w in rep.where)
-    d = rep.to_dict()
-    assert [s["removed"] for s in d["steps"]].count("stick_slip") == 1
-    assert "- stick_slip" in rep.table()
+    assert rep.final_model.params["tau"] < 0
 
 
 @settings(max_examples=8, deadline=None)

@@ -93,7 +93,12 @@ def test_the_spurious_delay_came_from_the_sticks(monkeypatch):
     Fn = F + rng.normal(0, r.force_noise, F.size)
     assert contactlab.diagnose((t, xm, Fn)).effect_names == []
     monkeypatch.setattr(TangentialFamily, "sticking", lambda self, d: np.zeros(d.t.size, bool))
-    rep = contactlab.diagnose((t, xm, Fn))
+    # the library of issue 8 (the element laws added since, a play of 0.3 µm among them,
+    # are other ways to misread the sticks)
+    from contactlab.diagnose.effects import registry
+
+    old = [n for n, e in registry("tangential").items() if e.order < 15]
+    rep = contactlab.diagnose((t, xm, Fn), candidates=old)
     assert "channel_delay" in rep.effect_names
     assert rep.final_model.params["tau"] < 0
 

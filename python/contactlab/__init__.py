@@ -17,6 +17,7 @@ if TYPE_CHECKING:
     from .fitting import FitResult, Parameter, least_squares_fit
     from .io import Recording, RecordingError, read_recording, write_recording
     from .masing import CycleTable, Masing, MasingOperator, cycle_energies, force_many, loop_area
+    from .simulation import Simulator
     from .studies.tracking import TrackResult, track
     from .tangential import TangentialAnalysis, analyze_tangential
 
@@ -41,6 +42,7 @@ _LAZY = {
     "force_many": "masing",
     "TangentialAnalysis": "tangential",
     "analyze_tangential": "tangential",
+    "Simulator": "simulation",
     "TrackResult": "studies.tracking",
     "track": "studies.tracking",
 }
@@ -72,6 +74,7 @@ __all__ = [
     "Parameter",
     "Recording",
     "RecordingError",
+    "Simulator",
     "TangentialAnalysis",
     "TrackResult",
     "__version__",

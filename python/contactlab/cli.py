@@ -121,7 +121,7 @@ def _exit_interrupted() -> None:
     import os
 
     try:
-        from .commands._common import kill_worker_processes
+        from .studies.executor import kill_worker_processes
 
         kill_worker_processes()
     finally:

@@ -7,10 +7,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from contactlab.diagnose import hidden_effect_recording
 from contactlab.diagnose._family import Prepared
 from contactlab.diagnose.candidates_tangential import TangentialFamily
 from contactlab.diagnose.detection import ChannelNoise, channel_noise, effective_variance
+from contactlab.synthetic.diagnosis import hidden_effect_recording
 
 
 @pytest.mark.parametrize("xn", [0.005, 0.02])

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import contactlab
-from contactlab.diagnose import hidden_effect_recording
 from contactlab.diagnose.power import DRAWS, _power_curve, _Setting, stated_power
+from contactlab.synthetic.diagnosis import hidden_effect_recording
 
 
 def _direct_power(a: float, jp: np.ndarray, jb: np.ndarray, st: _Setting, reps: int) -> float:
@@ -66,7 +66,10 @@ def bounds() -> dict[str, dict[str, object]]:
 
 def test_every_candidate_has_a_bound_in_its_units(bounds: dict) -> None:
     b = bounds[0.002]
-    assert len(b) == 15
+    from contactlab.diagnose.effects import registry
+
+    assert set(b) == set(registry("tangential"))  # every candidate of the library
+    assert b["power_law_microslip"].detectable_above is None  # not nested: no "absent"
     assert b["channel_delay"].unit == "s" and 0 < b["channel_delay"].detectable_above < 1e-3
     assert b["parallel_stiffness"].unit == "N/m"
     assert b["non_masing_scaling"].null == 2.0

@@ -92,5 +92,20 @@ def test_cli_resample_states_the_bridged_gap(tmp_path, capsys):
     p.write_text("t [s],x [m],F [N]\n" + "".join(f"{a:.17g},{b:.17g},{c:.17g}\n" for a, b, c in
                                                  zip(t, x, F, strict=True)))  # fmt: skip
     assert main(["analyze", str(p), "--resample"]) == 0
-    err = capsys.readouterr().err
+    err = " ".join(capsys.readouterr().err.split())
     assert "largest gap bridged 0.01 s" in err
+
+
+def test_track_and_stream_resample_and_say_so(tmp_path, capsys):
+    p = tmp_path / "nu.csv"
+    t = _times(4000, doubled=tuple(range(100, 3900, 97)))
+    x = 2e-5 * np.sin(2 * np.pi * 2 * t)
+    F = 10 * np.tanh(x / 1e-5)
+    p.write_text("t [s],x [m],F [N]\n" + "".join(f"{a:.17g},{b:.17g},{c:.17g}\n" for a, b, c in
+                                                 zip(t, x, F, strict=True)))  # fmt: skip
+    assert main(["track", str(p), "--every", "10cycles", "--resample", "--no-progress"]) == 0
+    assert "largest gap bridged 0.01 s" in " ".join(capsys.readouterr().out.split())
+    assert main(["analyze", str(p), "--stream", "--every", "10cycles", "--resample"]) == 0
+    assert "largest gap bridged 0.01 s" in " ".join(capsys.readouterr().out.split())
+    assert main(["track", str(p), "--every", "10cycles", "--no-progress"]) == 1
+    assert "--resample" in capsys.readouterr().err

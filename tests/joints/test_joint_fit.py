@@ -182,6 +182,8 @@ def test_bad_input_is_refused_with_a_named_error():
         fit(t, x, F, law="jenkins", fixed=["sigma0"])
     with pytest.raises(InputError, match=r"x.* not finite"):
         fit(t, np.where(t > 1, np.nan, x), F, law="jenkins")
+    with pytest.raises(InputError, match="max_samples must be"):
+        fit(t, x, F, law="jenkins", max_samples=0)
     with pytest.raises(InputError, match="give t, x and F"):
         fit(t, x, law="jenkins")
 
@@ -194,3 +196,17 @@ def test_to_dict_is_json_and_names_units():
     json.dumps(d, allow_nan=False)
     assert d["units"]["k"] == "N/m" and d["units"]["offset"] == "N"
     assert d["law"] == "jenkins" and math.isfinite(d["chisqr"])
+
+
+def test_bouc_wen_identifies_the_products_beta_gamma_and_beta_delta():
+    from contactlab.joints import BoucWen
+
+    t = np.linspace(0.0, 3.0, 900)
+    x = 2e-3 * np.sin(2 * np.pi * t)
+    F = BoucWen(alpha=5e3, beta=800.0, gamma=0.5, delta=0.5).force(t, x)
+    F = F + np.random.default_rng(0).normal(0, 0.05, t.size)
+    res = fit(t, x, F, law="bouc_wen")
+    assert res.success and not res.params["beta"].vary  # ν = 1: β only scales γ, δ
+    b = res.law.beta
+    assert b * res.law.gamma == pytest.approx(400.0, rel=0.05)
+    assert b * res.law.delta == pytest.approx(400.0, rel=0.05)

@@ -27,6 +27,7 @@ from contactlab.joints import (
     Parallel,
     Segalman,
     Series,
+    from_spec,
 )
 from contactlab.joints import _reference as ref
 
@@ -471,3 +472,22 @@ def test_memory_wiped_out(seed: int, which: str) -> None:
     a = law.force(None, with_minor)[-5:]
     b = law.force(None, without)[-5:]
     np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("law", all_laws(), ids=lambda law: law.name)
+def test_spec_round_trip(law: JointLaw) -> None:
+    if law.name == "masing":
+        assert from_spec(law.spec()) == law
+        return
+    back = from_spec(law.spec())
+    assert back == law and back.param_names == law.param_names
+    assert law.initial_stiffness >= 0
+
+
+def test_initial_stiffness_is_the_slope_from_rest() -> None:
+    for law in all_laws():
+        if law.rate_dependent:
+            continue
+        h = 1e-13  # Segalman's slope departs from K_T as sqrt(u) for chi = -1/2
+        slope = float(law.force(None, [h])[0]) / h
+        assert slope == pytest.approx(law.initial_stiffness, rel=1e-4, abs=1e-6), law.name

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import contextlib
 import json
 import math
 import os
@@ -293,42 +292,18 @@ def add_pressure_flags(p: Any) -> None:
 
 
 def with_static_pressure(rec: Any, file: str, p0: float | None, pa: float | None) -> Any:
-    """A normal recording whose pressure channel holds only the dynamic part, with the static
-    pressure added (from ``--p0``, else the file-name tag ``p0-...``); unchanged otherwise.
-    A nominal ``pa`` (``--pa`` or tag) that the pressure's half range misses by more than
-    10 % is reported on stderr, naming both."""
-
-    import numpy as np
-
-    from ..io import Recording
-    from ..normal.loop import dynamic_only
+    """:func:`contactlab.normal.pressure.with_static_pressure` with ``--p0``/``--pa``, else
+    the file-name tags ``p0-...``/``pa-...``; its notes go to stderr as warnings."""
+    from ..normal.pressure import with_static_pressure as add_static
     from ..studies.manifest import tags_from_filename
 
     tags = tags_from_filename(file)
     p0 = p0 if p0 is not None else tags.get("p0")
     pa = pa if pa is not None else tags.get("pa")
-    p = np.asarray(rec["p"], dtype=float)
-    # mean and half range on p / max|p|: a channel near 1e308 overflowed numpy's sum (fuzz
-    # target diagnose) before the channel range check could name it
-    big = float(np.max(np.abs(p))) if p.size and np.all(np.isfinite(p)) else 0.0
-    unit = p / big if big > 0 else p
-    if pa is not None:
-        measured = big * 0.5 * float(np.ptp(unit)) if big > 0 else 0.0
-        if abs(measured - pa) > 0.1 * pa:
-            print(f"warning: {file}: the pressure's half range {measured:.4g} Pa differs "
-                  f"from the nominal pa = {pa:.4g} Pa", file=sys.stderr)  # fmt: skip
-    if not dynamic_only(p):
-        return rec
-    if p0 is None:
-        mean = big * float(np.mean(unit)) if big > 0 else 0.0
-        raise InputError(
-            f"{file}: the pressure channel holds only the dynamic pressure (mean "
-            f"{mean:.3g} Pa): give the static pressure with --p0 (e.g. 0.5MPa) "
-            "or a file-name tag such as p0-0.5MPa"
-        )
-    data = dict(rec.data)
-    data["p"] = p + p0
-    return Recording(rec.t, data, dict(rec.units), rec.source, dict(rec.meta or {}))
+    rec, notes = add_static(rec, p0, pa, source=file)
+    for note in notes:
+        print(f"warning: {note}", file=sys.stderr)
+    return rec
 
 
 def add_workers_flag(p: Any, what: str, *, per_core: bool = False) -> None:
@@ -444,21 +419,10 @@ class _InterruptiblePool:
         if exc_type is None:
             self.executor.shutdown(wait=True)
             return
+        from ..studies.executor import kill_worker_processes
+
         kill_worker_processes()
         self.executor.shutdown(wait=False, cancel_futures=True)
-
-
-def kill_worker_processes() -> None:
-    """Kill every child process this process started through multiprocessing (the pools'
-    workers); they hold no outputs (every output is written by the parent, all or nothing)."""
-    import multiprocessing
-
-    for child in multiprocessing.active_children():
-        with contextlib.suppress(Exception):
-            child.kill()
-    for child in multiprocessing.active_children():
-        with contextlib.suppress(Exception):
-            child.join(timeout=1.0)
 
 
 def add_progress_flags(p: Any) -> None:

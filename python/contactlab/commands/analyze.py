@@ -1,4 +1,4 @@
-"""``contactlab analyze FILE... --model tangential|normal [--json OUT] [--report DIR]``.
+"""``contactlab analyze FILE [FILE ...] [--model tangential|normal] [--json OUT] [--report DIR]``.
 
 Reads each recording (CSV/TDMS/HDF5/MAT, SI inside), runs the tangential analysis (Masing fit,
 energy analytic and numeric, c_e·ω, stiffness; the tangential paper's eqs. 1-19) or the normal
@@ -116,6 +116,7 @@ def _streamed(
                     columns=columns,
                     fs=args.fs,
                     executor=ex,
+                    resample=args.resample,
                     options=topts if e.kind == "tangential" else normal_options(e, nopts),
                 )
                 if res.rows and all(r.get("error") for r in res.rows):
@@ -131,6 +132,10 @@ def _streamed(
                 print(f"{e.path}: FAILED: {exc}", file=sys.stderr)
                 continue
             last = res
+            if res.meta.get("resampled"):
+                from ..io.recording import describe_resampling
+
+                print(wrapped(f"{e.path}: {describe_resampling(res.meta['resampled'])}"), file=say)
             full = res.to_dict(cycles=False)
             comb = full["combined"]
             print(
@@ -221,6 +226,7 @@ def _auto_streamed(
     path = entry.path  # type: ignore[attr-defined]
     kind = entry.kind  # type: ignore[attr-defined]
     res = track(path, "auto", kind=kind, columns=columns, fs=args.fs, executor=ex,
+                resample=getattr(args, "resample", False),
                 options=opts, keep_documents=True, threads=_window_threads())  # fmt: skip
     if not res.window_docs:
         errors = "; ".join(str(r.get("error")) for r in res.rows if r.get("error"))

@@ -260,14 +260,9 @@ def run(args: argparse.Namespace) -> int:
             from ..io.recording import describe_resampling
 
             print(f"{args.file}: {describe_resampling(rec.meta['resampled'])}")
-    if getattr(args, "delay", None) is not None:
-        if args.model != "tangential":
-            raise InputError("--delay is for tangential recordings (force against displacement)")
-        from ..tangential.lag import shifted_recording
-
-        rec, dropped = shifted_recording(rec, args.delay)
-        print(f"{args.file}: force read {1e3 * args.delay:.4g} ms later (--delay); {dropped} "
-              "samples left without force data dropped")  # fmt: skip
+    delay = getattr(args, "delay", None)
+    if delay is not None and args.model != "tangential":
+        raise InputError("--delay is for tangential recordings (force against displacement)")
     sign = getattr(args, "force_sign", None)
     if sign is not None and args.model != "tangential":
         raise InputError("--force-sign is for tangential recordings (the force's sign)")
@@ -278,11 +273,15 @@ def run(args: argparse.Namespace) -> int:
                                    getattr(args, "pa", None))  # fmt: skip
     try:
         report = diagnose(rec, model=args.model, max_effects=args.max_effects,
-                          output_filter=taps, output_noise=args.output_noise,
+                          output_filter=taps, output_noise=args.output_noise, delay=delay,
                           **({"force_sign": sign} if sign is not None else {}))  # fmt: skip
     except (InputError, ConvergenceError) as exc:  # name the file: the workflow sees arrays
         kind = ConvergenceError if isinstance(exc, ConvergenceError) else InputError
         raise kind(f"{args.file}: {exc}") from exc
+    if delay is not None:
+        dropped = rec.t.size - report.location["samples"]["recording"]
+        print(f"{args.file}: force read {1e3 * delay:.4g} ms later (--delay); {dropped} "
+              "samples left without force data dropped")  # fmt: skip
     # every output rendered in memory before any is written (a report that cannot be
     # drawn, or Ctrl-C, leaves the previous outputs as they were)
     text = None

@@ -1,8 +1,8 @@
 """``contactlab simulate tangential|normal OUT [parameters]``: write a synthetic recording.
 
 Tangential: Masing hysteresis with an exponential virgin curve under a sine displacement
-(:func:`contactlab.tangential.synthetic_recording`). Normal: Konowalski's contact under
-``p = pa sin(ω t)`` about p0 (:func:`contactlab.normal.synthetic_recording`). The format
+(:func:`contactlab.synthetic.tangential.synthetic_recording`). Normal: Konowalski's contact under
+``p = pa sin(ω t)`` about p0 (:func:`contactlab.synthetic.normal.synthetic_recording`). The format
 follows OUT's extension (.csv .tdms .h5 .mat); values are SI, quantities on the command line
 may carry a unit (``--amplitude 20um``, ``--p0 0.5MPa``).
 """

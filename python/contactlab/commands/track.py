@@ -138,6 +138,10 @@ def _handler(args: argparse.Namespace) -> int:
             print(
                 f"  {key} = {comb[key] * f:.5g}{pm}{' ' + unit if unit else ''} ({how})", file=say
             )
+    if res.meta.get("resampled"):
+        from ..io.recording import describe_resampling
+
+        print(wrapped(f"  {describe_resampling(res.meta['resampled'])}"), file=say)
     for note in res.notes(comb):
         print(wrap_warning(str(note)), file=sys.stderr)
     doc = track_json(res) if args.json else None  # rendered before anything is written

@@ -52,6 +52,7 @@ Kelvin-Voigt integration. Hysteretic damping combined with a stiffness nonlinear
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -64,6 +65,8 @@ from ._filters import first_order_response, savgol_coeffs, savgol_filter, welch
 from ._kept import shifted
 from ._signal import cubic_shift_power, shortest_period_samples
 from .effects import ordered, registry
+from .effects.normal.channel_delay import SINGLE_TONE_SPAN, frequency_span
+from .effects.normal.creep_drift import CREEP_MAX_DURATIONS, CREEP_MIN_PERIODS
 
 _INF = np.inf
 
@@ -289,6 +292,15 @@ def frequency_domain(
     return np.fft.irfft(P / (k + 1j * w * h + 1j * eta * k * sgn), m)[:n]
 
 
+@dataclass(frozen=True)
+class NormalContext:
+    """What a normal-contact effect's ``apply`` sees: the record and the family (its
+    numerics: the hysteretic solve, the creep's shape)."""
+
+    d: Prepared
+    family: NormalFamily
+
+
 class NormalFamily:
     """Kelvin-Voigt base model with the normal-contact candidate library."""
 
@@ -354,7 +366,7 @@ class NormalFamily:
     ) -> dict[str, float]:
         """Starting values of an effect's nonlinear parameters from the current residual
         (the effect's own :meth:`~contactlab.diagnose.effects.EffectModel.start`)."""
-        return EFFECTS[name].start(p, d, residual)
+        return EFFECTS[name].start(p, d, residual, family=self)
 
     @staticmethod
     def creep_start(p: dict[str, float], d: Prepared, residual: np.ndarray) -> dict[str, float]:
@@ -401,14 +413,15 @@ class NormalFamily:
         om = d.extra["omega"]
         k, psi = p["k"], p["psi"]
         chain = ordered("normal", effects)
+        ctx = NormalContext(d, self)
         staged = lambda name: [e for e in chain if e.stage == name]  # noqa: E731
         laws, elements = staged("law"), staged("element")
         if elements:
-            delta = elements[0].apply(pd, p, d)
+            delta = elements[0].apply(pd, p, ctx)
         elif laws:
             coeffs: tuple[float, float, float] = (k, 0.0, 0.0)
             for e in laws:
-                coeffs = e.apply(coeffs, p, d)
+                coeffs = e.apply(coeffs, p, ctx)
             # kept per parameters: a fit's Jacobian steps the creep's parameters, and a
             # delay's, at the same stiffness law (a quarter to a third of its evaluations)
             memo = d.extra.setdefault("nonlinear", {})
@@ -423,8 +436,20 @@ class NormalFamily:
         else:
             delta = _kelvin_voigt_fit(d, k, psi, p["p0"], om)
         for e in staged("additive") + staged("output"):
-            delta = e.apply(delta, p, d)
+            delta = e.apply(delta, p, ctx)
         return delta
+
+    @staticmethod
+    def hysteretic(pd: np.ndarray, p: dict[str, float], d: Prepared) -> np.ndarray:
+        """Displacement of the Kelvin-Voigt joint with a hysteretic loss ``eta``
+        (:func:`frequency_domain`, with the run-in of a record in steady state)."""
+        return frequency_domain(d.t, pd, p["k"], p["psi"], d.extra["omega"], p["eta"],
+                                run_in(d, pd))  # fmt: skip
+
+    @staticmethod
+    def creep_shape(d: Prepared, tc: float) -> np.ndarray:
+        """``1 - exp(-(t - t0)/τ_c)``, kept per ``τ_c``."""
+        return _creep_shape(d, tc)
 
     def noise_variance(self, p: dict[str, float], effects: tuple[str, ...], d: Prepared) -> float:
         """Output variance per sample the input's sensor noise causes through this model
@@ -530,17 +555,8 @@ class NormalFamily:
         return _core.loop_areas(y, u, bounds)
 
 
-#: a creep must take longer than this many excitation periods to settle: a faster "drift"
-#: is the start of the record (a sensor or model transient), which creep cannot be told from
-CREEP_MIN_PERIODS = 1.0
-#: a creep must settle visibly within the record: with τc above this many record durations
-#: the drift is straight to within a sixth of its size (1 - e^(-1/3) against 1/3), and creep
-#: (a settling) is not told from a sensor drift or a slow misfit of the model
-CREEP_MAX_DURATIONS = 3.0
 #: τ_c tried (log-spaced over the plausible range) for the creep's starting values
 CREEP_START_GRID = 24
-#: excitation frequencies closer than this ratio count as one frequency for the delay test
-SINGLE_TONE_SPAN = 1.25
 
 
 #: the normal family's input filter (:func:`smooth_input`) passes the excitation up to this
@@ -698,16 +714,6 @@ def run_in(d: Prepared, pd: np.ndarray) -> np.ndarray | None:
     hist = ext[end - length : end]
     ramp = np.clip(np.arange(length) / per, 0.0, 1.0)
     return hist * (ramp * ramp * (3.0 - 2.0 * ramp))
-
-
-def frequency_span(d: Prepared) -> float:
-    """Ratio of the longest to the shortest complete excitation cycle (1 for one tone)."""
-    cyc = d.cycles.cycle
-    lengths = np.bincount(cyc[cyc >= 0])
-    lengths = lengths[lengths > 0]
-    if lengths.size < 2:
-        return 1.0
-    return float(np.max(lengths) / np.min(lengths))
 
 
 def delay_identifiability(p: dict[str, float], d: Prepared) -> str | None:

@@ -11,29 +11,28 @@ physical on a record and why (:meth:`~contactlab.diagnose.effects.EffectModel.pl
 and the smallest size a record reveals
 (:meth:`~contactlab.diagnose.effects.EffectModel.detectable`). A new effect is one new file.
 
-========================  =========================================================  =========
-name                      measured force ``F`` (or measured ``x``)                   params
-========================  =========================================================  =========
-``viscous_damping``       ``F = h + c ẋ``                                             c  [N s/m]
-``inertia``               ``F = h + m ẍ``  (mass between sensor and contact)          m  [kg]
-``parallel_stiffness``    ``F = h + k_p x`` (rig flexures in parallel)                k_p [N/m]
-``series_compliance``     ``x = x_c + C_s h`` (rig compliance in series)              C_s [m/N]
-``force_offset``          ``F = h + F0`` (sensor bias)                                F0 [N]
-``force_drift``           ``F = h + F1 (t - t0)/T`` (load-cell zero drifting)        F1 [N]
-``displacement_offset``   ``h = M(x - x0)`` (displacement sensor zero off the origin)  x0 [m]
-``channel_delay``         ``F(t) = h(t - τ)`` (force channel lags displacement)       tau [s]
-``asymmetry``             ``F = h + α |h|``: saturation ``h0(1 ± α)`` per direction   alpha [-]
-``non_masing_scaling``    branches ``h_r + λ f((x - x_r)/λ)`` from rest at the turns  lam [-]
-``parameter_drift``       ``F = h (1 + β (t - t_m)/T)``, ``t_m`` mid-record           beta [-]
-``stribeck``              ``F = h (1 + s exp(-|ẋ|/v_s))``                              s, v_s
-``position_friction``     ``F = h (1 + Σ a_k cos kπξ + b_k sin kπξ)``                  a_k, b_k
-``stick_slip``            breakaway ``s_b`` after each reversal over ``ell``           s_b, ell
-``normal_load``           ``F = h (1 + ε_c cos 2π f_n t + ε_s sin 2π f_n t)``          eps, f_n
-``power_law_microslip``   Segalman's Iwan element (F_S = h0, K_T = h0 ac)             chi, beta
-``backlash``              ``F = M(u)``, ``u`` the play operator of ``x`` (width 2b)   b [m]
-``rate_dependent_         ``F = h + σ1 ẋ k(x)/k0`` (LuGre micro-damping)              sigma1
-presliding``
-========================  =========================================================  =========
+=============================  =========================================================== =========
+name                           measured force ``F`` (or measured ``x``)                    params
+=============================  =========================================================== =========
+``viscous_damping``            ``F = h + c ẋ``                                             c [N s/m]
+``inertia``                    ``F = h + m ẍ`` (mass between sensor and contact)           m [kg]
+``parallel_stiffness``         ``F = h + k_p x`` (rig flexures in parallel)                k_p [N/m]
+``series_compliance``          ``x = x_c + C_s h`` (rig compliance in series)              C_s [m/N]
+``force_offset``               ``F = h + F0`` (sensor bias)                                F0 [N]
+``force_drift``                ``F = h + F1 (t - t0)/T`` (load-cell zero drifting)         F1 [N]
+``displacement_offset``        ``h = M(x - x0)`` (displacement sensor zero off the origin) x0 [m]
+``channel_delay``              ``F(t) = h(t - τ)`` (force channel lags displacement)       tau [s]
+``asymmetry``                  ``F = h + α |h|``: saturation ``h0(1 ± α)`` per direction   alpha [-]
+``non_masing_scaling``         branches ``h_r + λ f((x - x_r)/λ)`` from rest at the turns  lam [-]
+``parameter_drift``            ``F = h (1 + β (t - t_m)/T)``, ``t_m`` mid-record           beta [-]
+``stribeck``                   ``F = h (1 + s exp(-|ẋ|/v_s))``                             s, v_s
+``position_friction``          ``F = h (1 + Σ a_k cos kπξ + b_k sin kπξ)``                 a_k, b_k
+``stick_slip``                 breakaway ``s_b`` after each reversal over ``ell``          s_b, ell
+``normal_load``                ``F = h (1 + ε_c cos 2π f_n t + ε_s sin 2π f_n t)``         eps, f_n
+``power_law_microslip``        Segalman's Iwan element (F_S = h0, K_T = h0 ac)             chi, beta
+``backlash``                   ``F = M(u)``, ``u`` the play operator of ``x`` (width 2b)   b [m]
+``rate_dependent_presliding``  ``F = h + σ1 ẋ k(x)/k0`` (LuGre micro-damping)              sigma1
+=============================  =========================================================== =========
 
 Notes on exactness. The exponential Masing force is linear in ``h0`` at fixed ``ac`` along a
 history, so the drift factor is exact. A linear spring in series with a Masing element is
@@ -52,7 +51,6 @@ the additive terms; the delay on the total measured force.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -65,6 +63,7 @@ from ._filters import savgol_coeffs, savgol_filter
 from ._kept import delayed, span
 from ._signal import Knots, minimize_bounded
 from .effects import ForceContext, ordered, registry
+from .effects.tangential import memo
 from .effects.tangential import normal_load as _normal_load
 from .effects.tangential.series_compliance import series_backbone
 from .effects.tangential.stick_slip import breakaway, breakaway_force, reversal_anchors
@@ -128,51 +127,6 @@ def _sg_dot(window: int, deriv: int, dt: float) -> np.ndarray:
     """Cubic Savitzky-Golay weights of the ``deriv``-th derivative, dot orientation (as
     :func:`contactlab.tangential.frame.savgol_coefficients`, in numpy)."""
     return savgol_coeffs(window, 3, deriv, dt)[::-1]
-
-
-def fixed(d: Prepared, key: str, make: Callable[[], Any]) -> Any:
-    """An array of the model evaluation that depends on the recording only (not on the
-    fitted parameters): computed on the first evaluation, then reused by every fit on ``d``
-    (the fits evaluate the model thousands of times)."""
-    cache = d.extra.setdefault("fixed", {})
-    k = (key, d.t.size)
-    if k not in cache:
-        cache[k] = make()
-    return cache[k]
-
-
-#: entries of the small per-recording memos below (index sets, load-fluctuation terms)
-_MEMO_KEEP = 64
-
-
-def memo(d: Prepared, name: str) -> dict[Any, Any]:
-    cache = d.extra.setdefault(name, {})
-    if len(cache) >= _MEMO_KEEP:
-        cache.clear()
-    return cache
-
-
-def delay_support(d: Prepared, at: np.ndarray, tau: float) -> np.ndarray:
-    """The samples a delayed prediction at the samples ``at`` needs: for each shifted time
-    ``t[at] - tau`` the two samples that bracket it as :func:`numpy.interp` finds them
-    (``t[j] <= t < t[j+1]``, the first or last sample off the ends); ``at`` itself when
-    ``tau`` is 0. Kept per ``(tau, at)``: a fit's Jacobian steps every other parameter at
-    the same delay."""
-    if tau == 0.0:
-        return at
-    rows_memo = memo(d, "delay_rows")
-    key = (tau, id(at))
-    hit = rows_memo.get(key)
-    if hit is not None and hit[0] is at:  # (the array is held: its id is not reused)
-        return hit[1]
-    n = d.t.size
-    j = np.searchsorted(d.t, d.t[at] - tau, side="right") - 1
-    need = np.zeros(n, bool)
-    need[np.clip(j, 0, n - 1)] = True
-    need[np.clip(j + 1, 0, n - 1)] = True
-    rows = np.flatnonzero(need)
-    rows_memo[key] = (at, rows)
-    return rows
 
 
 #: unit Masing forces kept per recording (one per ac, x0 tried); 64 of 24 000 samples: 12 MB
@@ -395,7 +349,7 @@ class TangentialFamily:
     ) -> dict[str, float]:
         """Starting values of an effect's nonlinear parameters from the current residual
         (the effect's own :meth:`~contactlab.diagnose.effects.EffectModel.start`)."""
-        return EFFECTS[name].start(p, d, residual)
+        return EFFECTS[name].start(p, d, residual, family=self)
 
     #: the load-frequency search (:meth:`search_start`): a grid of ``LOAD_GRID`` points either
     #: side of the start, ``LOAD_GRID_STEP`` of the record's frequency resolution ``1/T``

@@ -55,6 +55,7 @@ __all__ = [
     "ChannelNoise",
     "channel_noise",
     "effective_variance",
+    "model_slope",
 ]
 
 #: the per-record false-alarm rate the naming rules are calibrated to stay below, and the
@@ -203,69 +204,13 @@ def effective_variance(
     return sy2 + (np.asarray(slope, float) * su) ** 2
 
 
-def assess(
-    family: Any,
-    d: Prepared,
-    current: Any,
-    sigma: float,
-    *,
-    z: float,
-    gain_floor: float,
-    folds: int,
-    candidates: list[str],
-    declared_output: float | None = None,
-    seed: int = 0,
-) -> dict[str, Any]:
-    """The diagnosis's closing checks (issue 29, items 1-3) on its final model.
-
-    Returns a dict with ``noise`` (:class:`ChannelNoise`), ``not_detected`` (a list of
-    :class:`contactlab.diagnose.power.Detectable`, every candidate not in the final model)
-    and ``unexplained`` (:class:`contactlab.diagnose.misfit.Unexplained` or None), plus the
-    settings they were computed at (``z``, ``gain_floor``, ``folds``, ``candidates``).
-    """
-    from .misfit import eiv_tolerance, unexplained_structure
-    from .power import POWER, _setting, detectable_above
-
-    params = dict(current.full.params)
-    effects = tuple(current.effects)
-    residual = -current.full_residual(d)  # measured minus model
-    slope = family.slope(params, d) if hasattr(family, "slope") else None
-    noise = channel_noise(
-        d, residual, declared_output=declared_output, slope=slope,
-        input_unit=family.input_unit, output_unit=family.output_unit,
-    )  # fmt: skip
-    st = _setting(d, current, noise, slope, sigma, z, gain_floor, folds, seed)
-    bounds = []
-    for n in candidates:
-        if n in effects or n not in family.candidates:
-            continue
-        bounds.append(
-            detectable_above(
-                family,
-                params,
-                effects,
-                n,
-                d,
-                noise=noise,
-                sigma=sigma,
-                z=z,
-                gain_floor=st.gain_floor,
-                current=current,
-                folds=folds,
-                _setting_cache=st,
-            )
-        )
-    misfit = unexplained_structure(
-        d, residual, sigma, unit=family.output_unit,
-        tolerance=eiv_tolerance(slope, noise.input_seen),
-    )  # fmt: skip
-    return {
-        "noise": noise,
-        "not_detected": bounds,
-        "unexplained": misfit,
-        "z": z,
-        "gain_floor": st.gain_floor,
-        "folds": folds,
-        "power": POWER,
-        "candidates": list(candidates),
-    }
+def model_slope(family: Any, params: dict[str, float], d: Prepared) -> np.ndarray | None:
+    """The model's local slope ``|dy/du|`` per sample, through which the input's noise
+    reaches the output: the family's own (``Family.slope``: a Masing element's, steep after
+    each reversal), else for a model with a stiffness ``k`` (normal contact) its static
+    compliance ``1/k`` (a Kelvin-Voigt element passes slow input noise at that gain); None
+    when neither is known."""
+    s = family.slope(params, d) if hasattr(family, "slope") else None
+    if s is None and params.get("k", 0.0) > 0:
+        s = np.full(d.y.size, 1.0 / float(params["k"]))
+    return s

@@ -108,7 +108,7 @@ class Detectable:
             "parameter": self.parameter,
             "detectable_above": self.detectable_above,
             "unit": self.unit,
-            "null": self.null,
+            "null": self.null if self.null is None or np.isfinite(self.null) else None,
             "relative_size": self.relative_size,
             "power": POWER,
             "at": dict(self.at),
@@ -295,7 +295,8 @@ def _power_curve(jp: np.ndarray, st: _Setting) -> Any:
         if n < 2:
             return 0.0
         sd = np.std(ratio, axis=1, ddof=1)
-        t = np.where(sd > 0, np.mean(ratio, axis=1) / (sd / np.sqrt(n)), np.inf)
+        with np.errstate(divide="ignore", invalid="ignore"):  # (sd = 0: t = inf below)
+            t = np.where(sd > 0, np.mean(ratio, axis=1) / (sd / np.sqrt(n)), np.inf)
         gain = ((cur - cand) @ W) / Wtot / sig2
         return float(np.mean((t > st.z) & (gain >= st.gain_floor)))
 
@@ -384,7 +385,7 @@ def detectable_above(
     Examples
     --------
     >>> import contactlab
-    >>> from contactlab.diagnose import hidden_effect_recording
+    >>> from contactlab.synthetic.diagnosis import hidden_effect_recording
     >>> from contactlab.diagnose.power import stated_power
     >>> rep = contactlab.diagnose(hidden_effect_recording([], seed=3), max_effects=0)
     >>> b = {x.effect: x for x in stated_power(rep)}["channel_delay"]
@@ -432,6 +433,12 @@ def detectable_above(
         per[s.name] = b
         rel[s.name] = None if b is None else b * float(np.sqrt(np.mean(j * j))) / st.y_rms
     mags = [s for s in cand.params if np.isfinite(s.null)]
+    if not mags:  # an element law that replaces the base's (no value means "absent")
+        first = cand.params[0]
+        return Detectable(
+            name, first.name, None, first.unit, first.null, None, shape, per,
+            reason="not nested in the base model: no parameter value means 'absent'",
+        )  # fmt: skip
     if not per or any(v is None for v in per.values()):
         worst = next((s for s in mags if per.get(s.name) is None), mags[0])
         return Detectable(

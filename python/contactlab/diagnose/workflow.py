@@ -50,7 +50,7 @@ from ._signal import noise_rms
 from .locate import locate
 from .model import ExtendedModel
 from .paths import KindPath, RegimeDecision, kind_path
-from .search import SearchState, StepwiseSearch, _pair_search  # noqa: F401
+from .search import MAX_EVALUATIONS, SearchState, StepwiseSearch, _pair_search  # noqa: F401
 from .select import Trial, Verdict, evaluate, fit, fold_masks
 
 __all__ = ["DiagnosisReport", "Effect", "Step", "diagnose"]
@@ -369,14 +369,6 @@ def _family(model: Any) -> tuple[Family, dict[str, float], dict[str, float]]:
     raise InputError(f"cannot diagnose a model of type {type(model).__name__}")
 
 
-#: Model evaluations (residual calls of every fit, numerical Jacobians included) a diagnosis
-#: may spend. Typical runs use 1 000-8 000; the slowest of 657 random fuzz inputs 7 237 (a
-#: minute on a loaded machine); without a bound the search (candidates x rounds x folds fits
-#: of up to 400 iterations each) could take hours. Once spent, the candidates not yet tried
-#: are reported as untested, with a sentence saying so.
-MAX_EVALUATIONS = 40_000
-
-
 def _frame_constants(
     recording: Any, effects: list[Effect], where: list[str], location: dict[str, Any]
 ) -> list[Effect]:
@@ -434,9 +426,11 @@ def infer_model(recording: Any) -> str:
     if kind in ("tangential", "normal"):
         return str(kind)
     if isinstance(recording, dict):
-        if "x" in recording and "F" in recording:
+        # the family whose channels are there (the family's own check then names a missing
+        # one: {"x": ..., "force": ...} is a tangential recording without 'F')
+        if "x" in recording or "F" in recording:
             return "tangential"
-        if "p" in recording and "delta" in recording:
+        if "p" in recording or "delta" in recording:
             return "normal"
     if isinstance(recording, tuple):
         return "tangential"
@@ -460,6 +454,7 @@ def diagnose(
     output_filter: Any = None,
     output_noise: float | None = None,
     force_sign: int | str | None = None,
+    delay: float | None = None,
 ) -> Any:
     """Find where a model and a measurement disagree, name the missing effect, add it.
 
@@ -506,6 +501,11 @@ def diagnose(
         Tangential only, as ``analyze`` takes it: diagnose ``force_sign·F``; ``"auto"``: the
         sign that makes the loop dissipate (``∮F dx > 0``). Default (None): the force as
         recorded, and a loop that runs the wrong way is refused with a sentence saying so.
+    delay : float, optional
+        Tangential only, as ``analyze`` and ``track`` take it: a known delay (s) of the force
+        channel behind the displacement; the force is read that much later
+        (:func:`contactlab.tangential.lag.delayed_recording`) before the diagnosis, and the
+        samples the shift leaves without force data are dropped.
 
     Returns
     -------
@@ -534,6 +534,8 @@ def diagnose(
     if inferred:
         model = infer_model(recording)
     family, start, context = _family(model)
+    if delay is not None:
+        recording = _delayed(recording, family, delay)
     path = kind_path(family)
     t, u, y = _checked_arrays(recording, family, folds, max_effects, z, min_gain)
     y, sign_note = path.orient(t, u, y, force_sign)
@@ -565,7 +567,7 @@ def diagnose(
     st = search.run(SearchState(b.current, steps, where, [b.current], used=spent))
     # issue 29 items 1-3: both channels' noise, what each candidate not named would have
     # needed to be seen, and structure the final model leaves (detection.py)
-    from .detection import assess
+    from .assessment import assess
 
     checks = assess(
         b.family, d, st.current, b.sigma, z=z, gain_floor=min_gain + b.budget, folds=folds,
@@ -607,6 +609,15 @@ def _candidate_names(family: Family, candidates: Sequence[str] | None) -> list[s
                 f"unknown {family.kind} candidate {n!r}; choose from {', '.join(family.candidates)}"
             )
     return names
+
+
+def _delayed(recording: Any, family: Family, delay: float) -> Any:
+    """``diagnose(..., delay=)``: the tangential recording with its force read later."""
+    if family.kind != "tangential":
+        raise InputError("delay= is for tangential recordings (force against displacement)")
+    from ..tangential.lag import delayed_recording
+
+    return delayed_recording(recording, delay)
 
 
 def _meta(recording: Any) -> dict[str, Any]:

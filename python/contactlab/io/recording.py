@@ -1,8 +1,9 @@
 """The :class:`Recording` container, its error type and the checks every reader shares.
 
-A recording holds SI data only: readers convert on the way in (see :mod:`.units`), so the
-analysis code never sees µm or MPa. Canonical channel names: tangential ``x`` (m) and ``F``
-(N); normal ``p`` (Pa) and ``delta`` (m); time ``t`` (s).
+A recording holds SI data only: readers convert on the way in (see
+:mod:`contactlab.io.units`), so the analysis code never sees µm or MPa. Canonical channel
+names: tangential ``x`` (m) and ``F`` (N); normal ``p`` (Pa) and ``delta`` (m); time ``t``
+(s).
 """
 
 from __future__ import annotations

@@ -39,6 +39,7 @@ from .laws import (
     ParamSpec,
     Segalman,
     Series,
+    from_spec,
 )
 from .records import JointRecord
 
@@ -73,6 +74,7 @@ __all__ = [
     "fit",
     "fit_amplitude",
     "fit_stepped_sine",
+    "from_spec",
     "secant_stiffness",
     "start_law",
 ]

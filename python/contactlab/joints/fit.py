@@ -63,7 +63,7 @@ DEFAULT_FIXED: dict[str, tuple[str, ...]] = {
     "lugre": ("delta",),
     "gms": ("delta", "alpha0"),
     "masing": ("scale",),
-    "bouc_wen": ("nu",),
+    "bouc_wen": ("beta", "nu"),  # with ν held, β only scales γ and δ
     "dahl": (),
 }
 
@@ -312,6 +312,28 @@ def _law_forces(law: Any, prep: list[_Prepared]) -> np.ndarray:
         t, x = p.rec.t[p.run], p.rec.x[p.run]
         parts.append(np.asarray(law.force(t, x, float(x[0])), dtype=float)[p.cmp])
     return np.concatenate(parts)
+
+
+def _guarded(residual: Any, Fm: np.ndarray) -> Any:
+    """``residual`` that, once it has been evaluated, answers a trial point the law refuses
+    (a Bouc-Wen whose β(γ+δ) turns negative, a force out of range) with a residual 10× the
+    measured force's size, so that the solver steps back instead of the fit failing; at the
+    start point the law's error is raised (bad input)."""
+    started = False
+    big = 10.0 * (float(np.sqrt(np.mean(Fm**2))) or 1.0)
+
+    def wrapped(v: Mapping[str, float]) -> np.ndarray:
+        nonlocal started
+        try:
+            out = residual(v)
+        except InputError:
+            if not started:
+                raise
+            return np.full(Fm.size, big)
+        started = True
+        return out
+
+    return wrapped
 
 
 def _linear_solve(phi: np.ndarray, rhs: np.ndarray) -> np.ndarray:
@@ -596,6 +618,12 @@ def fit(
         recs = as_records(records, fs=fs)
     for r in recs:
         r.require_force()
+    if max_samples is not None and not (isinstance(max_samples, int) and max_samples >= 10):
+        raise InputError(
+            f"max_samples must be an integer >= 10 (or None: all), got {max_samples!r}"
+        )
+    if not (isinstance(n_elements, int) and n_elements >= 1):
+        raise InputError(f"n_elements must be an integer >= 1, got {n_elements!r}")
     terms = [n for n, on in (("offset", offset), ("k_parallel", stiffness),
                              ("c_parallel", damping), ("mass", mass),
                              ("asymmetry", asymmetry)) if on]  # fmt: skip
@@ -623,7 +651,7 @@ def fit(
             beta = _linear_solve(cols, Fm - P)
             return P + cols @ beta - Fm
 
-        res = least_squares_fit(residual, params, max_nfev=max_nfev)
+        res = least_squares_fit(_guarded(residual, Fm), params, max_nfev=max_nfev)
         return res, law_of(res.values)
 
     candidates = [first]
@@ -674,7 +702,7 @@ def fit(
         return out
 
     try:
-        res = least_squares_fit(full_residual, params, max_nfev=max_nfev)
+        res = least_squares_fit(_guarded(full_residual, Fm), params, max_nfev=max_nfev)
         final_law = fitted.with_params([res.params[n].value for n in names])
     except ContactLabError as exc:
         res, final_law = res_law, fitted

@@ -221,15 +221,22 @@ class JointLaw:
         """The plain-Python reference of this law (tests, and the fallback kernel)."""
         raise NotImplementedError
 
-    def _core_spec(self) -> tuple[str, list[float], list[Any]]:
-        """``(kind, own parameters, children)`` as the Rust core builds the law."""
+    def spec(self) -> tuple[str, list[float], list[Any]]:
+        """``(kind, own parameters, children)``: the description the Rust core builds the law
+        from (children: the specs of the laws a composite holds); :func:`from_spec` inverts
+        it."""
         return (self.name, [float(v) for v in self._values()], [])
+
+    @property
+    def initial_stiffness(self) -> float:
+        """Tangent stiffness from the relaxed state, N/m (0 for a law behind an open gap)."""
+        return _initial_stiffness(self)
 
     def _kernel(self, x0: float) -> Any:
         """The Rust operator of this law, relaxed at ``x0``."""
         from .. import _core
 
-        return _core.JointOperatorCore(self._core_spec(), x0)
+        return _core.JointOperatorCore(self.spec(), x0)
 
     def operator(self, x0: float = 0.0) -> JointOperator:
         """A stateful operator for a recording streamed in chunks.
@@ -836,13 +843,13 @@ class MasingLaw(_Leaf):
             return ref.RefMasingExp(self.h0, self.ac)
         return _MasingRef(self.masing())
 
-    def _core_spec(self) -> tuple[str, list[float], list[Any]]:
+    def spec(self) -> tuple[str, list[float], list[Any]]:
         if self._model is not None or self.scale != 2.0:
             raise InputError(
                 "masing: inside a series, parallel or backlash law only the exponential curve "
                 f"with Masing's rule (scale 2) is available, got {self!r}"
             )
-        return super()._core_spec()
+        return super().spec()
 
     def _kernel(self, x0: float) -> Any:
         return _MasingKernel(self.masing(), x0)
@@ -902,8 +909,8 @@ class _Composite(JointLaw):
             out += law._values()
         return out
 
-    def _core_spec(self) -> tuple[str, list[float], list[Any]]:
-        return (self.name, [float(v) for v in self._own()], [law._core_spec() for law in self.laws])
+    def spec(self) -> tuple[str, list[float], list[Any]]:
+        return (self.name, [float(v) for v in self._own()], [law.spec() for law in self.laws])
 
     def _split(self, values: list[float]) -> tuple[list[float], list[JointLaw]]:
         n = len(self._OWN)
@@ -1027,6 +1034,79 @@ class Backlash(_Composite):
 
     def _ref(self) -> ref.RefLaw:
         return ref.RefBacklash(self.gap, self.laws[0]._ref())
+
+
+def _initial_stiffness(law: JointLaw) -> float:
+    if isinstance(law, Iwan):
+        return law.k
+    if isinstance(law, Segalman):
+        return law.K_T
+    if isinstance(law, (Jenkins, KelvinVoigt)):
+        return law.k
+    if isinstance(law, (MaxwellSlip, GeneralizedMaxwellSlip)):
+        return float(np.sum(law.k))
+    if isinstance(law, (Dahl, LuGre)):
+        return law.sigma0
+    if isinstance(law, BoucWen):
+        return law.alpha
+    if isinstance(law, MasingLaw):
+        return float(law.masing().local_stiffness(0.0))
+    if isinstance(law, Parallel):
+        return law.k + sum(x.initial_stiffness for x in law.laws)
+    if isinstance(law, Series):
+        ks = [x.initial_stiffness for x in law.laws]
+        return 0.0 if min(ks) <= 0 else 1.0 / sum(1.0 / k for k in ks)
+    if isinstance(law, Backlash):
+        return law.laws[0].initial_stiffness if law.gap == 0 else 0.0
+    raise InputError(f"{law.name}: no initial stiffness")  # pragma: no cover
+
+
+def from_spec(spec: Any) -> JointLaw:
+    """The law a :meth:`JointLaw.spec` describes.
+
+    Parameters
+    ----------
+    spec : tuple
+        ``(kind, params, children)`` (lists may be any sequences).
+
+    Returns
+    -------
+    JointLaw
+        A new law equal to the one the spec was taken from.
+    """
+    try:
+        kind, params, children = spec
+        p = [float(v) for v in params]
+        kids = [from_spec(c) for c in children]
+    except (TypeError, ValueError):
+        raise InputError(f"a joint-law spec is (kind, params, children), got {spec!r}") from None
+    cls = LAWS.get(str(kind))
+    if cls is None:
+        raise InputError(f"unknown joint law {kind!r}: use one of {', '.join(LAWS)}")
+    if cls in (Series, Parallel, Backlash):
+        if cls is Series:
+            return Series(*kids)
+        if cls is Parallel:
+            if len(p) != 2:
+                raise InputError(f"parallel takes 2 parameters (k, c), got {len(p)}")
+            return Parallel(*kids, k=p[0], c=p[1])
+        if len(p) != 1 or len(kids) != 1:
+            raise InputError("backlash takes 1 parameter (gap) and 1 law")
+        return Backlash(p[0], kids[0])
+    if kids:
+        raise InputError(f"{kind} takes no child laws")
+    if cls is MaxwellSlip:
+        n = len(p) // 2
+        return MaxwellSlip(p[:n], p[n:])
+    if cls is GeneralizedMaxwellSlip:
+        n = (len(p) - 6) // 2
+        if n < 1 or len(p) != 2 * n + 6:
+            raise InputError(f"gms takes 2 n + 6 parameters, got {len(p)}")
+        return GeneralizedMaxwellSlip(p[:n], p[n : 2 * n], *p[2 * n :])
+    try:
+        return cls(*p)
+    except TypeError as exc:
+        raise InputError(f"{kind}: {exc}") from None
 
 
 #: Registry of the joint laws by name.

@@ -40,6 +40,9 @@ def build(report: Any, intro: str | None = None) -> Report:
             for k, v in e.parameters.items()
         ]
         r.table(rows, ["effect", "parameter", Column("value", stderr="stderr")])
+        for e in report.effects:  # the physical argument for each (issue 29)
+            if getattr(e, "plausibility", ""):
+                r.text(f"{e.name}: {e.plausibility}")
     else:
         r.text("None: no candidate improves the held-out error significantly.")
     r.section("Gap shrink (held-out cycles)")

@@ -14,6 +14,9 @@ ground, which stays fixed under base excitation) and adds its force ``F(d)`` to 
 - ``kelvin_voigt``: ``F = k d + c ḋ``.
 - ``normal``: nonlinear contact stiffness ``F = k_s(d) d``, ``k_s(d) = a1 + a2 d + a3 d² + …``
   (Konowalski's eq. 6, the same polynomial law as :class:`contactlab.normal.NonlinearContact`).
+- ``law``: any rate-independent law of :mod:`contactlab.joints` (Segalman, Dahl, Maxwell-slip,
+  a backlash, laws in series or parallel, …), ``add_joint("law", dof, law=Segalman(...))``;
+  stored as the flat float encoding :func:`encode_law` of its spec (array ``spec``).
 """
 
 from __future__ import annotations
@@ -35,6 +38,7 @@ PARAMS: dict[str, tuple[str, ...]] = {
     "bouc_wen": ("alpha", "beta", "gamma", "delta", "nu"),
     "kelvin_voigt": ("k", "c"),
     "normal": (),
+    "law": (),
 }
 
 UNITS: dict[str, str] = {
@@ -95,6 +99,8 @@ class Joint:
             return p["alpha"]
         if self.kind == "normal":
             return float(a["coeffs"][0])
+        if self.kind == "law":
+            return decode_law(a["spec"]).initial_stiffness
         raise InputError(f"unknown joint kind {self.kind!r}")
 
     @property
@@ -116,6 +122,8 @@ class Joint:
             return ("iwan", self.dof, j, empty, a["k"], a["fs"])
         if self.kind == "normal":
             return ("normal", self.dof, j, empty, a["coeffs"], empty)
+        if self.kind == "law":
+            return ("law", self.dof, j, empty, a["spec"], empty)
         vals = np.array([p[n] for n in PARAMS[self.kind]], dtype=float)
         return (self.kind, self.dof, j, vals, empty, empty)
 
@@ -217,6 +225,8 @@ def make_joint(kind: str, dof: int, dof2: int | None = None, **kw: Any) -> Joint
             raise InputError(f"joint parameter beta must be >= 0, got {params['beta']}")
     elif kind == "kelvin_voigt":
         params = take(("k", "c"), k={"nonneg": True}, c={"nonneg": True})
+    elif kind == "law":
+        arrays["spec"] = _law_array(kw)
     elif kind == "normal":
         if "coeffs" not in kw:
             raise InputError("a normal-contact joint needs coeffs (k_s(d) = a1 + a2 d + ...)")
@@ -224,7 +234,7 @@ def make_joint(kind: str, dof: int, dof2: int | None = None, **kw: Any) -> Joint
     else:
         raise InputError(
             f"unknown joint kind {kind!r}: use masing, jenkins, iwan, bouc_wen, "
-            "kelvin_voigt or normal"
+            "kelvin_voigt, normal or law"
         )
     if kw:
         raise InputError(f"joint {kind!r} does not take parameter(s) {', '.join(sorted(kw))}")
@@ -256,3 +266,77 @@ def iwan_uniform(k_total: float, f_total: float, n: int = 20) -> dict[str, np.nd
     n = int(n)
     phi = 2.0 * f_total / k_total * (np.arange(n) + 0.5) / n
     return {"k": np.full(n, k_total / n), "fs": k_total / n * phi}
+
+
+#: Kind codes of the flat encoding of a joint-law spec (the Rust core's
+#: ``contactlab_core::joints::AnyLaw::from_flat`` reads the same table).
+LAW_CODES: tuple[str, ...] = (
+    "jenkins", "iwan", "segalman", "masing", "maxwell_slip", "gms", "dahl", "lugre",
+    "bouc_wen", "kelvin_voigt", "parallel", "series", "backlash",
+)  # fmt: skip
+
+
+def encode_law(law: Any) -> np.ndarray:
+    """Flat float encoding of a :class:`contactlab.joints.JointLaw` (or its spec):
+    ``[code, n_params, params..., n_children, children...]``, depth first."""
+    spec = law.spec() if hasattr(law, "spec") else law
+    out: list[float] = []
+
+    def walk(sp: Any) -> None:
+        kind, params, children = sp
+        out.extend([float(LAW_CODES.index(kind)), float(len(params)), *map(float, params)])
+        out.append(float(len(children)))
+        for c in children:
+            walk(c)
+
+    walk(spec)
+    return np.asarray(out, dtype=float)
+
+
+def decode_law(flat: Any) -> Any:
+    """The :class:`contactlab.joints.JointLaw` of a flat encoding (:func:`encode_law`)."""
+    from ..joints import from_spec
+
+    v = [float(x) for x in np.asarray(flat, dtype=float).reshape(-1)]
+    pos = 0
+
+    def take() -> float:
+        nonlocal pos
+        if pos >= len(v):
+            raise InputError("joint-law encoding ends early")
+        pos += 1
+        return v[pos - 1]
+
+    def walk() -> tuple[str, list[float], list[Any]]:
+        code = int(take())
+        if not 0 <= code < len(LAW_CODES):
+            raise InputError(f"joint-law encoding has an unknown kind code {code}")
+        params = [take() for _ in range(int(take()))]
+        children = [walk() for _ in range(int(take()))]
+        return (LAW_CODES[code], params, children)
+
+    spec = walk()
+    if pos != len(v):
+        raise InputError("joint-law encoding has trailing values")
+    return from_spec(spec)
+
+
+def _law_array(kw: dict[str, Any]) -> np.ndarray:
+    """The ``spec`` array of a ``law`` joint from ``law=`` (a JointLaw) or ``spec=`` (its
+    encoding, as :meth:`Joint.to_dict` stores it)."""
+    from ..joints import JointLaw
+
+    if "law" in kw:
+        law = kw.pop("law")
+        if not isinstance(law, JointLaw):
+            raise InputError(f"joint 'law' needs a contactlab.joints law, got {type(law).__name__}")
+    elif "spec" in kw:
+        law = decode_law(_array("spec", kw.pop("spec")))
+    else:
+        raise InputError("joint 'law' needs law=<a contactlab.joints law>")
+    if law.rate_dependent:
+        raise InputError(
+            f"joint 'law': {law.name} is rate-dependent; structure joints take rate-independent "
+            "laws (Kelvin-Voigt for viscous terms)"
+        )
+    return encode_law(law)

@@ -12,6 +12,7 @@ finishes, so one long recording does not stall the others.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import queue
 from collections.abc import Callable, Iterable, Iterator
@@ -141,4 +142,17 @@ def ordered_map(
             fut.cancel()
 
 
-__all__ = ["n_workers", "ordered_map"]
+def kill_worker_processes() -> None:
+    """Kill every child process this process started through multiprocessing (the pools'
+    workers); they hold no outputs (every output is written by the parent, all or nothing)."""
+    import multiprocessing
+
+    for child in multiprocessing.active_children():
+        with contextlib.suppress(Exception):
+            child.kill()
+    for child in multiprocessing.active_children():
+        with contextlib.suppress(Exception):
+            child.join(timeout=1.0)
+
+
+__all__ = ["kill_worker_processes", "n_workers", "ordered_map"]

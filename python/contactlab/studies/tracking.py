@@ -644,6 +644,14 @@ class _Windows:
         return rec
 
 
+def _noting(chunks: Iterator[Recording], noted: dict[str, Any]) -> Iterator[Recording]:
+    """The chunks as they come, keeping the last one's ``meta["resampled"]`` in ``noted``."""
+    for c in chunks:
+        if "resampled" in c.meta:
+            noted["resampled"] = c.meta["resampled"]
+        yield c
+
+
 def _segments(
     chunks: Iterator[Recording], size: int
 ) -> Iterator[tuple[Recording, dict[str, tuple[float, float]]]]:
@@ -854,6 +862,7 @@ def _track(
         raise InputError(f"max_window must be an integer >= 16, got {max_window!r}")
     cr = read_chunks(source, chunk_size=chunk_size, columns=columns, kind=kind, fs=fs,
                      resample=resample)  # fmt: skip
+    noted: dict[str, Any] = {}
     kind_ = cr.kind
     if kind_ not in ("tangential", "normal"):
         raise InputError(
@@ -947,7 +956,7 @@ def _track(
             collect(*in_flight.popleft())
 
     try:
-        for block, ranges in _segments(cr.chunks_into(buf.alloc), CYCLE_SEGMENT):
+        for block, ranges in _segments(_noting(cr.chunks_into(buf.alloc), noted), CYCLE_SEGMENT):
             off = int(block.meta.get("offset", n_total))
             buf.add(block)
             n_total = off + len(block)
@@ -1007,6 +1016,7 @@ def _track(
         )
     cycles = {k: (np.concatenate(v) if v else np.empty(0)) for k, v in cyc.items()}
     meta = {
+        **noted,  # resampled: what --resample bridged (the last chunk's: the whole record's)
         "n_samples": n_total,
         "n_windows": len(rows),
         "tail_samples_left_out": tail,

@@ -511,3 +511,54 @@ def shifted_recording(rec: Any, delay: float) -> tuple[Any, int]:
             for k, a in rec.data.items()}  # fmt: skip
     meta = dict(rec.meta or {}, delay=float(delay), delay_dropped_samples=dropped)
     return replace(rec, t=t, data=data, meta=meta), dropped
+
+
+def delayed_recording(recording: Any, delay: float) -> Any:
+    """A tangential recording in any of the forms the workflows take, with its force read
+    ``delay`` seconds later (:func:`shift_force`; ``delay > 0``: the recorded force lags the
+    displacement), every other channel cut to the samples kept.
+
+    Parameters
+    ----------
+    recording : contactlab.io.Recording, dict or tuple
+        A Recording with channels ``x`` and ``F`` (its meta gains ``delay`` and
+        ``delay_dropped_samples``, as :func:`shifted_recording` sets them), a dict with ``t``,
+        ``x``, ``F`` (other keys of the time axis' length cut alike), or ``(t, x, F)``.
+    delay : float
+        The force channel's delay behind the displacement (s).
+
+    Returns
+    -------
+    Recording, dict or tuple
+        The same form as given.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(400) * 1e-3
+    >>> x, F = np.sin(2 * np.pi * t), np.cos(2 * np.pi * t)
+    >>> tt, xs, Fs = delayed_recording((t, x, F), 2e-3)
+    >>> bool(np.array_equal(Fs, F[2:])), xs.size
+    (True, 398)
+    """
+    if hasattr(recording, "t") and hasattr(recording, "data"):
+        return shifted_recording(recording, delay)[0]
+    if isinstance(recording, dict):
+        t = recording.get("t")
+        if t is None or "x" not in recording or "F" not in recording:
+            raise InputError("delay= needs the channels 't', 'x' and 'F' of a tangential recording")
+        ta = np.asarray(t, dtype=float)
+        ts, x, F, _ = shift_force(ta, np.asarray(recording["x"], dtype=float),
+                                  np.asarray(recording["F"], dtype=float), delay)  # fmt: skip
+        lo = int(np.searchsorted(ta, ts[0])) if ts is not None and ts.size else 0
+        out = {k: (np.asarray(v)[lo : lo + x.size] if np.ndim(v) == 1 and len(v) == ta.size
+                   else v) for k, v in recording.items()}  # fmt: skip
+        out.update(t=ts, x=x, F=F)
+        return out
+    if isinstance(recording, (tuple, list)) and len(recording) == 3:
+        t, x, F = (np.asarray(a, dtype=float) for a in recording)
+        ts, xs, Fs, _ = shift_force(t, x, F, delay)
+        return ts, xs, Fs
+    raise InputError(
+        "delay= needs a contactlab.io.Recording, a dict with 't', 'x', 'F' or a tuple (t, x, F)"
+    )

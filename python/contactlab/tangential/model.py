@@ -12,6 +12,7 @@ In both, the turning points ``x0 ± A`` are fit parameters rather than the measu
 the maximum of noisy samples overestimates the amplitude, and the Masing loop is most
 sensitive exactly there (errors-in-variables bias of several standard errors otherwise).
 ``x0`` is the paper's branch shift.
+
 - ``virgin_signal_force``: a recording that starts at rest, at displacement ``x0``, on the
   virgin curve.
 

@@ -27,7 +27,9 @@ Lepski's rule (:mod:`contactlab.tangential.frame`); its noise ``σv`` follows fr
 displacement noise (fourth differences) and the filter's coefficients. A sample "sticks" when
 ``|v| < 3 σv``; a smooth sinusoidal turn of amplitude A at ω stays below that for
 ``2·3σv / (A ω²)``; a stick is a run at least ``STICK_DWELL_FACTOR`` times longer (and ≥ 4
-samples), within a quarter period of a reversal.
+samples), within a quarter period of a reversal, during which the force changes (by more than
+``STICK_FORCE_SHARE`` of the loop's force half-range). A still stretch where the force stands
+still too is a dwell of the drive (a stage resting at its stroke ends) and is counted apart.
 """
 
 from __future__ import annotations
@@ -47,6 +49,10 @@ PRE_SLIDING_Z = 1.0
 GROSS_SLIDING_Z = 3.0
 #: fraction of the branch's swing that defines the end of the transition to the plateau
 PLATEAU_FRACTION = 0.95
+#: a plateau found from the stroke's last sixth (a long, compliant transition) changes by less
+#: than this share of the swing from Δx₉₅ on (an exponential branch that reaches 95 % of its
+#: swing by 1.5 A, ac·A ≳ 4, changes by under 7 % there)
+PLATEAU_FLATNESS = 0.10
 #: a stick lasts this many times longer than a smooth turn spends below the velocity threshold
 STICK_DWELL_FACTOR = 3.0
 VELOCITY_SIGMAS = 3.0
@@ -54,6 +60,10 @@ VELOCITY_SIGMAS = 3.0
 STICK_SHARE = 0.5
 #: sliding has set in once the speed reaches this fraction of the stroke's peak speed A ω
 SLIDE_ONSET = 0.1
+#: a still stretch at a reversal is a stick only where the force changes while the position
+#: stands (by more than this share of the loop's force half-range); position and force both
+#: still is a dwell of the drive (a stage resting at its stroke ends), not sticking
+STICK_FORCE_SHARE = 0.25
 
 
 def z_from_area_ratio(ratio: float) -> float:
@@ -108,6 +118,51 @@ def _first_crossing(u: np.ndarray, phase: np.ndarray, F: np.ndarray, level: floa
     return float(max(u[o][int(np.argmax(hit))], 0.0))
 
 
+def _reach(
+    loop: AveragedLoop,
+    desc: np.ndarray,
+    u_d: np.ndarray,
+    u_a: np.ndarray,
+    amplitude: float,
+    ref: tuple[float, float],
+    limit: float,
+    flat: bool,
+) -> float | None:
+    """``Δx₉₅`` of the averaged loop's branches against reference levels taken over
+    ``ref`` (in units of the amplitude, distance from the turn), or None where a branch does
+    not reach 95 % of its swing within ``limit`` amplitudes (or, with ``flat``, changes by
+    more than ``PLATEAU_FLATNESS`` of the swing beyond that point)."""
+    mid_d = (u_d > ref[0] * amplitude) & (u_d <= ref[1] * amplitude)
+    mid_a = (u_a > ref[0] * amplitude) & (u_a <= ref[1] * amplitude)
+    if not (np.any(mid_d) and np.any(mid_a)):
+        return None
+    lo, hi = float(np.mean(loop.F[desc][mid_d])), float(np.mean(loop.F[~desc][mid_a]))
+    swing = hi - lo
+    if not swing > 0:
+        return None
+    d1 = _first_crossing(u_d, loop.phase[desc], loop.F[desc], hi - PLATEAU_FRACTION * swing,
+                         rising=False)  # fmt: skip
+    d2 = _first_crossing(u_a, loop.phase[~desc], loop.F[~desc], lo + PLATEAU_FRACTION * swing,
+                         rising=True)  # fmt: skip
+    if d1 is None or d2 is None:
+        return None
+    dx95 = max(d1, d2)
+    if dx95 > limit * amplitude:
+        return None
+    if flat:
+        beyond_d, beyond_a = u_d >= dx95, u_a >= dx95
+        for u, f in (
+            (u_d[beyond_d], loop.F[desc][beyond_d]),
+            (u_a[beyond_a], loop.F[~desc][beyond_a]),
+        ):
+            if u.size < 3 or not np.ptp(u) > 0:
+                return None
+            slope = np.polyfit(u, f, 1)[0]
+            if abs(slope) * float(np.ptp(u)) > PLATEAU_FLATNESS * swing:
+                return None
+    return dx95
+
+
 def plateau(
     loop: AveragedLoop, x: np.ndarray, F: np.ndarray, v: np.ndarray, thr: float
 ) -> Plateau | None:
@@ -126,22 +181,16 @@ def plateau(
         return None
     desc = loop.descending
     u_d, u_a = xmax - loop.x[desc], loop.x[~desc] - xmin
-    mid_d = (u_d > 2 * amplitude / 3) & (u_d < 4 * amplitude / 3)
-    mid_a = (u_a > 2 * amplitude / 3) & (u_a < 4 * amplitude / 3)
-    if not (np.any(mid_d) and np.any(mid_a)):
-        return None
-    lo, hi = float(np.mean(loop.F[desc][mid_d])), float(np.mean(loop.F[~desc][mid_a]))
-    swing = hi - lo
-    if not swing > 0:
-        return None
-    d1 = _first_crossing(u_d, loop.phase[desc], loop.F[desc], hi - PLATEAU_FRACTION * swing,
-                         rising=False)  # fmt: skip
-    d2 = _first_crossing(u_a, loop.phase[~desc], loop.F[~desc], lo + PLATEAU_FRACTION * swing,
-                         rising=True)  # fmt: skip
-    if d1 is None or d2 is None:
-        return None
-    dx95 = max(d1, d2)
-    if dx95 > 2.0 * amplitude / 3.0:
+    # the reference levels: the branches' mean force over the middle third of the stroke;
+    # failing that (a long, compliant transition: a rig's or a stage's, not an exponential
+    # branch's), over its last sixth, where the branch must then be flat (it changes by less
+    # than 10 % of the swing from Δx₉₅ on) and reach 95 % of its swing by three quarters
+    dx95 = None
+    for ref, limit, flat in (((2 / 3, 4 / 3), 2 / 3, False), ((5 / 3, 2.0), 1.5, True)):
+        dx95 = _reach(loop, desc, u_d, u_a, amplitude, ref, limit, flat)
+        if dx95 is not None:
+            break
+    if dx95 is None:
         return None
     sliding = np.abs(v) > thr
     rev = loop.reversals
@@ -178,6 +227,8 @@ class StickSlip:
     velocity_threshold: float
     smooth_dwell: float
     turns_with_stick: int
+    #: reversals where position and force both stood still (the drive dwelled): not sticks
+    turns_with_dwell: int = 0
 
     @property
     def share(self) -> float:
@@ -198,6 +249,7 @@ class StickSlip:
             "breakaway_force_stderr": sem,
             "velocity_threshold": self.velocity_threshold,
             "smooth_turn_dwell": self.smooth_dwell,
+            "reversals_with_dwell": self.turns_with_dwell,
         }
 
 
@@ -382,6 +434,7 @@ def stick_slip(
             continue
         sp = spans.setdefault(k, [a, b, 0])
         sp[0], sp[1], sp[2] = min(sp[0], a), max(sp[1], b), sp[2] + (b - a)
+    dwells = _drop_dwells(spans, F, turns)
     durations, breakaway = [], []
     sliding = SLIDE_ONSET * amp * omega
     sx = difference_noise(x) if spans else 0.0  # only the breakaway search needs it
@@ -392,7 +445,23 @@ def stick_slip(
         breakaway.append(_breakaway(f, x, v, (a, b), window, max(sliding, thr), sx, reach))
     hit = spans
     return StickSlip(int(turns.size), np.asarray(durations), np.asarray(breakaway), float(thr),
-                     float(smooth), len(hit))  # fmt: skip
+                     float(smooth), len(hit), dwells)  # fmt: skip
+
+
+def _drop_dwells(spans: dict[int, list[int]], F: np.ndarray, turns: np.ndarray) -> int:
+    """Remove from ``spans`` the still stretches over which the force stood still too (a
+    dwell of the drive: sticking is the position standing while the force changes); returns
+    how many were removed. The force's change over a stretch is its range there, against the
+    loop's force half-range (robust: 1st to 99th percentile over the reversals' span)."""
+    if not spans:
+        return 0
+    lo, hi = np.percentile(F[turns[0] : turns[-1] + 1], [1.0, 99.0])
+    half = 0.5 * float(hi - lo)
+    dwell = [k for k, (a, b, _n) in spans.items()
+             if not float(np.ptp(F[a:b])) > STICK_FORCE_SHARE * half]  # fmt: skip
+    for k in dwell:
+        del spans[k]
+    return len(dwell)
 
 
 @dataclass
@@ -446,7 +515,9 @@ def classify(
         z, src = z_from_area_ratio(ratio), "loop area"
     xv = x if x_raw is None else x_raw
     v, thr, window = velocity(t, xv) if xv.size >= 20 else (np.zeros(xv.size), 0.0, 5)
-    pl = plateau(loop, x, F, v, thr) if (loop is not None and z >= GROSS_SLIDING_Z) else None
+    # a plateau is looked for from the transition on: a transition that is not exponential
+    # (a compliant rig, a stage) can reach one while the fitted ac·A reads below 3
+    pl = plateau(loop, x, F, v, thr) if (loop is not None and z >= PRE_SLIDING_Z) else None
     st = stick_slip(t, x, F, rev, v, thr, window, pl.offset if pl is not None else 0.0)
     zt = f"ac·A = {z:.3g} (from the {src}; loop area {100 * ratio:.0f}% of the rectangle 4·A·h_m)"
     if not math.isfinite(z):  # an area no friction loop of this size encloses
@@ -454,7 +525,7 @@ def classify(
               "4·A·h_m, which bounds any friction loop)")  # fmt: skip
     if z < PRE_SLIDING_Z:
         return Regime("pre-sliding", f"pre-sliding (microslip): {zt}", z, src, ratio, None, st)
-    if z < GROSS_SLIDING_Z or (pl is None and src != "fit"):
+    if (z < GROSS_SLIDING_Z and pl is None) or (pl is None and src != "fit"):
         why = "" if z < GROSS_SLIDING_Z else "; no plateau over the middle of the stroke"
         return Regime("transition", f"transition towards gross sliding: {zt}{why}", z, src,
                       ratio, pl, st)  # fmt: skip
@@ -469,6 +540,11 @@ def classify(
             f"{pl.dx95:.3g} m of each stroke"
         )
     name = "gross sliding"
+    if st is not None and st.turns_with_dwell:
+        text += (
+            f"; the drive dwells at {st.turns_with_dwell} of {st.n_turns} reversals (position "
+            "and force both still): a rest of the stage, not sticking"
+        )
     if st is not None and st.present:
         sd = st.to_dict()
         name = "stick-slip"

@@ -90,7 +90,6 @@ fn next_crossing(drive: &[f64], from: usize, low: f64, high: f64, level: &mut i8
 /// cycles they complete, in one pass over a block starting at global index `offset`; `state`
 /// carries everything across blocks, so any chunking gives the same cycles. A band with
 /// `high <= low` (a constant block) finds no crossing. On error `state` is unchanged.
-#[allow(clippy::too_many_arguments)]
 pub fn cycle_block(
     t: &[f64],
     x: &[f64],
@@ -112,7 +111,6 @@ pub fn cycle_block(
 /// sample `i` is at `t0 + dt * (offset + i)`, bit for bit [`crate::stream::fill_time`]'s
 /// (and numpy's `t0 + dt * arange`). The same cycles as [`cycle_block`] given that time
 /// axis.
-#[allow(clippy::too_many_arguments)]
 pub fn cycle_block_sampled(
     t0: f64,
     dt: f64,
@@ -139,7 +137,7 @@ pub fn cycle_block_sampled(
         .filter(|&end| end <= 1 << 53)
         .ok_or(CoreError::TooLong { len: x.len() })?;
     // exact: offset + c < 2^53
-    #[allow(clippy::cast_precision_loss, clippy::arithmetic_side_effects)]
+    #[allow(clippy::arithmetic_side_effects)]
     let time = |c: usize| t0 + dt * ((offset + c as u64) as f64);
     cycle_block_with(time, x, f, drive, offset, (low, high), state)
 }
@@ -159,7 +157,7 @@ fn first_non_finite(x: &[f64], f: &[f64], drive: &[f64], other: CoreError) -> Co
 /// additions of `∮ F dx`, and the test costs nothing beside it); a block with a non-finite
 /// sample reports the first as the separate checks would, and leaves `state` unchanged.
 // Index arithmetic: i < n (the block length) throughout.
-#[allow(clippy::arithmetic_side_effects, clippy::too_many_lines)]
+#[allow(clippy::arithmetic_side_effects)]
 fn cycle_block_with(
     time: impl Fn(usize) -> f64,
     x: &[f64],
@@ -297,7 +295,7 @@ mod tests {
 
     /// The one-sample-at-a-time loop `cycle_block` replaced (its next crossing is now found
     /// first and the samples before it summed in one tight pass): the reference.
-    #[allow(clippy::arithmetic_side_effects, clippy::too_many_arguments)]
+    #[allow(clippy::arithmetic_side_effects)]
     fn cycle_block_reference(
         t: &[f64],
         x: &[f64],

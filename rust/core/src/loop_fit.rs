@@ -107,7 +107,7 @@ impl<'a> SteadyLoop<'a> {
     /// (length [`Self::n_rows`]); with `jac`, their derivatives too, column by column
     /// (`jac[j·rows + i] = ∂r_i/∂p_j`).
     // i < n inside the loops (zipped iterators); j < 5.
-    #[allow(clippy::arithmetic_side_effects, clippy::many_single_char_names)]
+    #[allow(clippy::arithmetic_side_effects)]
     pub fn evaluate(&self, p: &[f64; N_PARAMS], r: &mut [f64], mut jac: Option<&mut [f64]>) {
         let [k0, ac, offset, x0, a] = *p;
         let n = self.x.len();
@@ -325,7 +325,7 @@ impl Scaled<'_> {
 /// status reached (0: not converged). Errors: bad input, or non-finite residuals at the
 /// start.
 // index arithmetic over k <= 5 varied parameters
-#[allow(clippy::arithmetic_side_effects, clippy::too_many_lines)]
+#[allow(clippy::arithmetic_side_effects)]
 pub fn fit_steady_loop(data: &SteadyLoop<'_>, setup: &FitSetup) -> Result<LoopFit, CoreError> {
     check_finite("values", &setup.values)?;
     check_finite("scale", &setup.scale)?;

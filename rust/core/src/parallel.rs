@@ -34,7 +34,7 @@ pub struct ThreadStats {
     /// Seconds the thread was runnable but waited for a CPU (None where not available).
     pub wait: Option<f64>,
     /// Seconds of a first phase before the jobs (the pre-pass of
-    /// `crate::masing::split::force_channels`), 0 without one.
+    /// `crate::masing::channels::force_channels`), 0 without one.
     pub prepass: f64,
     /// CPU seconds of that phase (None where not available or without one).
     pub prepass_cpu: Option<f64>,

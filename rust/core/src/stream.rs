@@ -18,11 +18,9 @@ pub fn fill_time(out: &mut [f64], t0: f64, dt: f64, offset: u64) -> Result<(), C
     }
     // the indices as doubles, counted up in lanes (exact: whole numbers below 2^53; a
     // 64-bit integer to double conversion per sample has no SSE2 instruction)
-    #[allow(clippy::cast_precision_loss)]
     let k0 = offset as f64;
     let mut k = [0.0_f64; LANES];
     for (j, kj) in k.iter_mut().enumerate() {
-        #[allow(clippy::cast_precision_loss)]
         let jf = j as f64;
         *kj = k0 + jf;
     }

@@ -446,6 +446,163 @@ fn flush_cell(
     r[3] = if mf < r[3] { mf } else { r[3] };
 }
 
+/// `n_bins >= 1`, and `n_cycles × n_bins` cells that fit.
+fn check_sizes(n_bins: usize, n_cycles: usize) -> Result<(), CoreError> {
+    if n_bins == 0 {
+        return Err(bad("n_bins", 0.0, "must be >= 1"));
+    }
+    if n_cycles > (1 << 32) || n_bins > (1 << 24) {
+        return Err(bad(
+            "n_cycles",
+            n_cycles as f64,
+            "n_cycles × n_bins is too large",
+        ));
+    }
+    Ok(())
+}
+
+impl WindowFold {
+    /// Zero sums, NaN per-cycle quantities, no bounds or period means yet.
+    fn empty(n_bins: usize, n_cycles: usize) -> Self {
+        let z = |k| vec![0.0_f64; k];
+        let (nb, nc) = (n_bins, n_cycles);
+        WindowFold {
+            n_bins,
+            n_cycles,
+            count: z(nb),
+            sum_x: z(nb),
+            sum_f: z(nb),
+            sum_phase: z(nb),
+            sum_phase2: z(nb),
+            sum_xx: z(nb),
+            sum_t: z(nb),
+            x_std: z(nb),
+            f_std: z(nb),
+            first: vec![-1; nc],
+            bounds: Vec::new(),
+            energy: vec![f64::NAN; nc],
+            sens_f: z(nc),
+            sens_x: z(nc),
+            amplitude: vec![f64::NAN; nc],
+            force_range: vec![f64::NAN; nc],
+            mean_f: Vec::new(),
+            mean_x: Vec::new(),
+        }
+    }
+}
+
+/// A cycle's range of cell means before its first cell: [max x, min x, max F, min F].
+const NO_RANGE: [f64; 4] = [
+    f64::NEG_INFINITY,
+    f64::INFINITY,
+    f64::NEG_INFINITY,
+    f64::INFINITY,
+];
+
+/// One knot segment of the phase: `φ(t) = slope (t - k_lo) + p_lo` on `[k_lo, k_hi)`.
+struct Segment {
+    k_lo: f64,
+    k_hi: f64,
+    p_lo: f64,
+    slope: f64,
+}
+
+impl Segment {
+    /// The segment from knot `j` (`j + 1` a knot).
+    // Index arithmetic: j + 1 < the knots' length (the caller's).
+    #[allow(clippy::arithmetic_side_effects)]
+    #[inline(always)]
+    fn of(kt: &[f64], kp: &[f64], j: usize) -> Self {
+        Segment {
+            k_lo: kt[j],
+            k_hi: kt[j + 1],
+            p_lo: kp[j],
+            slope: (kp[j + 1] - kp[j]) / (kt[j + 1] - kt[j]),
+        }
+    }
+}
+
+/// The open cell's running sums: its bin's sample sums (x, F, φ, φ², x², t) carried from
+/// the bin, and the cell's own sums of x, F, φ (kept in registers while the cell's run of
+/// samples lasts: the same additions in the same order as adding into the bin sample by
+/// sample).
+#[derive(Default, Clone, Copy)]
+struct Cell {
+    cur: [f64; 6],
+    cx: f64,
+    cf: f64,
+    cp: f64,
+}
+
+impl Cell {
+    /// The complete cell into its bin and its cycle's ranges `r`; `n` its samples.
+    #[inline(always)]
+    fn flush(&self, bin: &mut Bin, r: &mut [f64; 4], n: f64) {
+        flush_cell(bin, r, n, (self.cx, self.cf, self.cp), &self.cur);
+    }
+
+    #[inline(always)]
+    fn add(&mut self, xi: f64, fi: f64, frac: f64, ti: f64) {
+        self.cur[0] += xi;
+        self.cur[1] += fi;
+        self.cur[2] += frac;
+        self.cur[3] += frac * frac;
+        self.cur[4] += xi * xi;
+        self.cur[5] += ti;
+        self.cx += xi;
+        self.cf += fi;
+        self.cp += frac;
+    }
+
+    /// The samples from `i` that follow in the same knot segment `seg`, cycle (from `c_lo`)
+    /// and bin (`g < g_hi`, `g = frac · n_bins`): added; returns the first sample not taken,
+    /// its phase when computed here (else -1) and the last phase taken.
+    // Index arithmetic: i < end <= the slices' length.
+    #[allow(clippy::arithmetic_side_effects)]
+    #[inline(always)]
+    fn run(
+        &mut self,
+        (t, x, f): (&[f64], &[f64], &[f64]),
+        mut i: usize,
+        end: usize,
+        seg: &Segment,
+        (c_lo, nbf, g_hi): (f64, f64, f64),
+        mut last_ph: f64,
+    ) -> (usize, f64, f64) {
+        while i < end {
+            let ti = t[i];
+            if ti >= seg.k_hi {
+                break;
+            }
+            let ph = seg.slope * (ti - seg.k_lo) + seg.p_lo;
+            let frac = ph - c_lo;
+            if frac * nbf >= g_hi {
+                return (i, ph, last_ph);
+            }
+            last_ph = ph;
+            self.add(x[i], f[i], frac, ti);
+            i += 1;
+        }
+        (i, -1.0, last_ph)
+    }
+}
+
+/// The bin of `g = frac · n_bins` when the open bin `[b_hi - 1, b_hi)` (number `cb`) does
+/// not hold it: `(b, b_lo, b_hi)`, the last bin open above.
+// Index arithmetic: cb + 2 < nb checked; nb >= 1.
+#[allow(clippy::arithmetic_side_effects)]
+#[inline(always)]
+fn next_bin(g: f64, b_hi: f64, cb: usize, nb: usize) -> (usize, f64, f64) {
+    if g >= b_hi && g < b_hi + 1.0 && cb + 2 < nb {
+        // the next bin (not the last): b_hi = cb + 1 exactly, so floor(g) = cb + 1
+        return (cb + 1, b_hi, b_hi + 1.0);
+    }
+    let b = (g as usize).min(nb - 1);
+    let lo = b as f64;
+    let hi = if b + 1 == nb { f64::INFINITY } else { lo + 1.0 };
+    (b, lo, hi)
+}
+
 /// Fold `(t, x, F)` (one window, `t` strictly increasing) by the phase knots `(kt, kp)` into
 /// `n_bins` bins per cycle over `n_cycles` cycles, with the phases and bins of
 /// [`crate::fold::fold_phase`], and derive the per-cycle quantities and period means (see
@@ -456,7 +613,7 @@ fn flush_cell(
 // the knots' length (t < kt[last] inside the loop), i < end <= n inside the loops.
 // Not inlined: with fat LTO the binding inlined it into its wrapper, where the fold's loop
 // kept more of its state on the stack (26 against 22 ms a window of 2^20 samples).
-#[allow(clippy::arithmetic_side_effects, clippy::too_many_lines)]
+#[allow(clippy::arithmetic_side_effects)]
 #[inline(never)]
 pub fn fold_window(
     t: &[f64],
@@ -468,53 +625,14 @@ pub fn fold_window(
     n_cycles: usize,
     edges: &[f64],
 ) -> Result<WindowFold, CoreError> {
-    if n_bins == 0 {
-        return Err(bad("n_bins", 0.0, "must be >= 1"));
-    }
-    if n_cycles > (1 << 32) || n_bins > (1 << 24) {
-        return Err(bad(
-            "n_cycles",
-            n_cycles as f64,
-            "n_cycles × n_bins is too large",
-        ));
-    }
+    check_sizes(n_bins, n_cycles)?;
     check_knots(kt, kp, n_cycles)?;
     let [sx, sf, fm] = check_samples(t, x, f, edges)?;
     let (nb, nc) = (n_bins, n_cycles);
-    let z = |k| vec![0.0_f64; k];
-    let mut w = WindowFold {
-        n_bins,
-        n_cycles,
-        count: z(nb),
-        sum_x: z(nb),
-        sum_f: z(nb),
-        sum_phase: z(nb),
-        sum_phase2: z(nb),
-        sum_xx: z(nb),
-        sum_t: z(nb),
-        x_std: z(nb),
-        f_std: z(nb),
-        first: vec![-1; nc],
-        bounds: Vec::new(),
-        energy: vec![f64::NAN; nc],
-        sens_f: z(nc),
-        sens_x: z(nc),
-        amplitude: vec![f64::NAN; nc],
-        force_range: vec![f64::NAN; nc],
-        mean_f: Vec::new(),
-        mean_x: Vec::new(),
-    };
+    let mut w = WindowFold::empty(nb, nc);
     let mut bins = vec![Bin::default(); nb];
     // per cycle: the largest and smallest cell mean of x, of F
-    let mut ranges = vec![
-        [
-            f64::NEG_INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::INFINITY
-        ];
-        nc
-    ];
+    let mut ranges = vec![NO_RANGE; nc];
     // scales of the loop areas (as loop_area, over the window: no overflow of the products)
     let (ux, uf) = (
         if sx > 0.0 { 1.0 / sx } else { 0.0 },
@@ -528,9 +646,8 @@ pub fn fold_window(
     let end = t.partition_point(|&v| v < t1);
     let (t_all, x_all, f_all) = (t, x, f);
     let (t, x, f) = (&t[..end], &x[..end], &f[..end]);
-    let seg_slope = |j: usize| (kp[j + 1] - kp[j]) / (kt[j + 1] - kt[j]);
     let mut j = 0_usize;
-    let (mut k_lo, mut k_hi, mut p_lo, mut slope) = (kt[0], kt[1], kp[0], seg_slope(0));
+    let mut seg = Segment::of(kt, kp, 0);
     let mut last_ph = f64::NEG_INFINITY;
     // the open cell (cycle cc, bin cb) is tracked by the phase intervals it covers, [c_lo,
     // c_hi) and, within the cycle, [b_lo, b_hi) of frac·n_bins: a sample inside both is in
@@ -546,8 +663,7 @@ pub fn fold_window(
     // registers while the cell's run of samples lasts (the same additions in the same order
     // as adding into the bin sample by sample)
     let mut cell_start = start;
-    let (mut cx, mut cf, mut cp) = (0.0_f64, 0.0_f64, 0.0_f64);
-    let mut cur = [0.0_f64; 6];
+    let mut cell = Cell::default();
     // the open cycle's first sample, and the end of the folded samples
     let mut a0 = start;
     let mut a1 = end;
@@ -562,18 +678,17 @@ pub fn fold_window(
         let (ph, clamped) = if carried >= 0.0 {
             (carried, false)
         } else {
-            if ti >= k_hi {
+            if ti >= seg.k_hi {
                 // ti < t1 = kt[last]: j + 1 stays a knot
                 while kt[j + 1] <= ti {
                     j += 1;
                 }
-                slope = seg_slope(j);
-                (k_lo, k_hi, p_lo) = (kt[j], kt[j + 1], kp[j]);
+                seg = Segment::of(kt, kp, j);
             }
-            let raw = if ti == k_lo {
-                p_lo
+            let raw = if ti == seg.k_lo {
+                seg.p_lo
             } else {
-                slope * (ti - k_lo) + p_lo
+                seg.slope * (ti - seg.k_lo) + seg.p_lo
             };
             // never back (rounding at a knot): each cell stays one run of samples
             let clamped = raw < last_ph;
@@ -609,40 +724,20 @@ pub fn fold_window(
         if !(g >= b_lo && g < b_hi) {
             // another bin (or cycle): the cell is complete
             let b;
-            if g >= b_hi && g < b_hi + 1.0 && cb + 2 < nb {
-                // the next bin (not the last): b_hi = cb + 1 exactly, so floor(g) = cb + 1
-                b = cb + 1;
-                b_lo = b_hi;
-                b_hi += 1.0;
-            } else {
-                b = (g as usize).min(nb - 1);
-                b_lo = b as f64;
-                b_hi = if b + 1 == nb {
-                    f64::INFINITY
-                } else {
-                    b_lo + 1.0
-                };
-            }
+            (b, b_lo, b_hi) = next_bin(g, b_hi, cb, nb);
             if cb != usize::MAX {
                 let n = (i - cell_start) as i64 as f64;
-                flush_cell(&mut bins[cb], &mut ranges[cc], n, (cx, cf, cp), &cur);
+                cell.flush(&mut bins[cb], &mut ranges[cc], n);
             }
             cc = cyc;
             cb = b;
-            cur = bins[cb].sums;
+            cell = Cell {
+                cur: bins[cb].sums,
+                ..Cell::default()
+            };
             cell_start = i;
-            (cx, cf, cp) = (0.0, 0.0, 0.0);
         }
-        let (xi, fi) = (x[i], f[i]);
-        cur[0] += xi;
-        cur[1] += fi;
-        cur[2] += frac;
-        cur[3] += frac * frac;
-        cur[4] += xi * xi;
-        cur[5] += ti;
-        cx += xi;
-        cf += fi;
-        cp += frac;
+        cell.add(x[i], f[i], frac, ti);
         i += 1;
         if clamped {
             // the next sample's phase may need the clamp too
@@ -654,35 +749,32 @@ pub fn fold_window(
         // (frac >= 1 gives g >= n_bins); the last bin's edge n_bins is its cycle's end but
         // for rounding, which the path above decides.
         let g_hi = if b_hi > nbf { nbf } else { b_hi };
-        while i < end {
-            let ti = t[i];
-            if ti >= k_hi {
-                break;
-            }
-            let ph = slope * (ti - k_lo) + p_lo;
-            let frac = ph - c_lo;
-            if frac * nbf >= g_hi {
-                carried = ph;
-                break;
-            }
-            last_ph = ph;
-            let (xi, fi) = (x[i], f[i]);
-            cur[0] += xi;
-            cur[1] += fi;
-            cur[2] += frac;
-            cur[3] += frac * frac;
-            cur[4] += xi * xi;
-            cur[5] += ti;
-            cx += xi;
-            cf += fi;
-            cp += frac;
-            i += 1;
-        }
+        (i, carried, last_ph) = cell.run((t, x, f), i, end, &seg, (c_lo, nbf, g_hi), last_ph);
     }
     if cb != usize::MAX {
         let n = (a1 - cell_start) as i64 as f64;
-        flush_cell(&mut bins[cb], &mut ranges[cc], n, (cx, cf, cp), &cur);
+        cell.flush(&mut bins[cb], &mut ranges[cc], n);
     }
+    if let Some(ac) = area_cycle {
+        (w.energy[ac], w.sens_f[ac], w.sens_x[ac]) =
+            cycle_area(&x[a0..a1], &f[a0..a1], ux, uf, fm, area_scale);
+    }
+    finish(&mut w, &bins, &ranges, (t_all, f_all, x_all, edges), end)?;
+    Ok(w)
+}
+
+/// [`fold_window`]'s last steps after the pass over the samples: the bin sums into `w`, the
+/// loop-area check, the period means, the spread, the per-cycle ranges and the bounds.
+// Index arithmetic: b < n_bins, the bins' and sums' length.
+#[allow(clippy::arithmetic_side_effects)]
+fn finish(
+    w: &mut WindowFold,
+    bins: &[Bin],
+    ranges: &[[f64; 4]],
+    (t_all, f_all, x_all, edges): (&[f64], &[f64], &[f64], &[f64]),
+    end: usize,
+) -> Result<(), CoreError> {
+    let (nb, nc) = (w.n_bins, w.n_cycles);
     for (b, s) in bins.iter().enumerate() {
         w.count[b] = s.samples;
         w.sum_x[b] = s.sums[0];
@@ -691,10 +783,6 @@ pub fn fold_window(
         w.sum_phase2[b] = s.sums[3];
         w.sum_xx[b] = s.sums[4];
         w.sum_t[b] = s.sums[5];
-    }
-    if let Some(ac) = area_cycle {
-        (w.energy[ac], w.sens_f[ac], w.sens_x[ac]) =
-            cycle_area(&x[a0..a1], &f[a0..a1], ux, uf, fm, area_scale);
     }
     for (k, a) in w.energy.iter().enumerate() {
         if a.is_infinite() {
@@ -733,7 +821,7 @@ pub fn fold_window(
         *o = next;
     }
     w.bounds = bounds;
-    Ok(w)
+    Ok(())
 }
 
 #[cfg(test)]

@@ -5,9 +5,8 @@
 //! lengths and thread counts, for both curve kinds and both branch rules.
 
 use contactlab_core::curve::{Exponential, Tabulated};
-use contactlab_core::masing::split::{
-    force_channels, force_piece, split, split_each, Channel, Model, Walked,
-};
+use contactlab_core::masing::channels::{force_channels, Channel, Model};
+use contactlab_core::masing::split::{force_piece, split, split_each, Walked};
 use contactlab_core::masing::{masing_force, masing_force_rule, BranchRule, MasingState};
 use contactlab_core::CoreError;
 use proptest::prelude::*;

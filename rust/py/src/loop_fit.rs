@@ -5,7 +5,7 @@ use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 
 use crate::detach_guarded;
-use crate::errors::slice;
+use crate::error::slice;
 
 type Five = [f64; N_PARAMS];
 
@@ -15,7 +15,7 @@ type Five = [f64; N_PARAMS];
 /// nfev, status)` (status as SciPy's `least_squares`: 0 = evaluation budget exhausted).
 #[pyfunction]
 #[pyo3(name = "fit_steady_loop")]
-#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+#[allow(clippy::type_complexity)]
 fn fit_steady_loop_py(
     py: Python<'_>,
     x: PyReadonlyArray1<'_, f64>,

@@ -1,8 +1,5 @@
 //! Bindings of `contactlab_core::normal`: array/error conversion and GIL release only.
 
-// PyO3 hands arguments over by value (readonly array borrows); nothing to consume.
-#![allow(clippy::needless_pass_by_value)]
-
 use contactlab_core::normal::{
     cycles, grid, ode, poly, ContactModel, Forcing, Interp, KelvinVoigt, Stiffness,
 };
@@ -12,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::detach_guarded;
-use crate::errors::{slice, to_pyerr};
+use crate::error::{slice, to_pyerr};
 
 fn bad(name: &'static str, reason: &'static str) -> CoreError {
     CoreError::InvalidParameter {

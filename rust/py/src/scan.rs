@@ -7,7 +7,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 
 use crate::detach_guarded;
-use crate::errors::input;
+use crate::error::input;
 
 /// Every position (``offset`` + index in ``block``) of each of ``needles`` that starts
 /// before ``starts_below`` in ``block`` (a ``uint8`` array): one ``int64`` array a needle.

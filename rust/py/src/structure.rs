@@ -1,8 +1,5 @@
 //! Bindings of `contactlab_core::structure`: array/error conversion and GIL release only.
 
-// PyO3 hands arguments over by value (readonly array borrows); nothing to consume.
-#![allow(clippy::needless_pass_by_value)]
-
 use contactlab_core::curve::{Exponential, Tabulated};
 use contactlab_core::structure::{
     simulate_into, Buffers, Inputs, Joint, JointLaw, MasingCurve, Options, Structure,
@@ -13,7 +10,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::detach_guarded;
-use crate::errors::slice as sl;
+use crate::error::slice as sl;
 
 fn bad(name: &'static str, reason: &'static str) -> CoreError {
     CoreError::InvalidParameter {
@@ -58,6 +55,7 @@ fn build_joint(spec: &JointSpec) -> Result<Joint, CoreError> {
             JointLaw::kelvin_voigt(p[0], p[1])?
         }
         "normal" => JointLaw::normal(a)?,
+        "law" => JointLaw::law(contactlab_core::joints::AnyLaw::from_flat(a)?)?,
         _ => return Err(bad("joint kind", "unknown joint kind")),
     };
     Ok(Joint {
@@ -104,7 +102,7 @@ fn structure_simulate<'py>(
         )),
         (None, None, None, None) => None,
         _ => {
-            return Err(crate::errors::to_pyerr(
+            return Err(crate::error::to_pyerr(
                 py,
                 &bad("base", "base, base_velocity, kr and cr go together"),
             ))
@@ -120,7 +118,7 @@ fn structure_simulate<'py>(
     // a 1e6-sample run are not first-touched 4 kB at a time).
     let nt = ts.len();
     let too_many =
-        || crate::errors::to_pyerr(py, &bad("t", "too many samples for the output arrays"));
+        || crate::error::to_pyerr(py, &bad("t", "too many samples for the output arrays"));
     let total = nt.checked_mul(n).ok_or_else(too_many)?;
     let total_j = nt.checked_mul(joints.len()).ok_or_else(too_many)?;
     let names = [
@@ -137,7 +135,7 @@ fn structure_simulate<'py>(
     // Outputs not asked for are empty arrays, and the kernel does not compute them.
     if let Some(wanted) = &outputs {
         if let Some(bad_name) = wanted.iter().find(|w| !names.contains(&w.as_str())) {
-            return Err(crate::errors::input_error(
+            return Err(crate::error::input(
                 py,
                 format!("unknown output {bad_name:?} (known: {})", names.join(", ")),
             ));
@@ -158,12 +156,12 @@ fn structure_simulate<'py>(
     for rw in &mut rws {
         slices.push(
             rw.as_slice_mut()
-                .map_err(|_| crate::errors::internal(py, "output array not contiguous"))?,
+                .map_err(|_| crate::error::internal(py, "output array not contiguous"))?,
         );
     }
     let [x, v, a, joint_force, joint_work, joint_dissipated, input_work, damping_work] =
         <[&mut [f64]; 8]>::try_from(slices)
-            .map_err(|_| crate::errors::internal(py, "output arrays"))?;
+            .map_err(|_| crate::error::internal(py, "output arrays"))?;
     let mut bufs = Buffers {
         x,
         v,

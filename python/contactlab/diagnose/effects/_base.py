@@ -122,8 +122,11 @@ class EffectModel:
         """What the effect does to the base model's prediction (or input) at its stage."""
         raise NotImplementedError(f"{self.name}: apply at stage {self.stage}")
 
-    def start(self, p: dict[str, float], d: Prepared, residual: np.ndarray) -> dict[str, float]:
-        """Starting values of the nonlinear parameters from the current residual."""
+    def start(
+        self, p: dict[str, float], d: Prepared, residual: np.ndarray, family: Any = None
+    ) -> dict[str, float]:
+        """Starting values of the nonlinear parameters from the current residual (``family``:
+        the model family asking, for effects that need its base prediction)."""
         return {}
 
     def derived(
@@ -155,6 +158,12 @@ class EffectModel:
                         f"{s.name} = {v:.4g} {s.unit} sits at the limit of its physical range",
                     )
         return Plausibility(True, self.argument(recording, p))
+
+    def base_equivalent(self, p: dict[str, float]) -> dict[str, float]:
+        """The base parameters this effect's model is equivalent to, where it rescales the
+        base (a branch scale λ: loops of a Masing element with ``h0 λ / 2``); empty when it
+        does not. The search compares these, not the raw values, with the base fit."""
+        return {}
 
     #: a named effect's size must lie this many standard errors from "absent"
     IDENTIFIED_SIGMAS: ClassVar[float] = 2.0
@@ -189,8 +198,8 @@ class EffectModel:
         and the calibrated false-alarm rate, in the effect's own unit (a
         :class:`contactlab.diagnose.power.Detectable`).
 
-        ``recording``: a :class:`~contactlab.diagnose.DiagnosisReport` (the bound for its
-        final model and data), or a recording, which is diagnosed first. Delegates to
+        ``recording``: the :class:`~contactlab.diagnose.DiagnosisReport` of the record (the
+        bound for its final model and data). Delegates to
         :func:`contactlab.diagnose.power.stated_power` (issue 29 item 2); raises
         :class:`NotImplementedError` where that module is not installed."""
         try:
@@ -201,9 +210,10 @@ class EffectModel:
             ) from None
         report = recording
         if not hasattr(report, "final_model"):
-            from ..workflow import diagnose
-
-            report = diagnose(recording, self.kind)
+            raise TypeError(
+                f"{self.name}.detectable() takes the DiagnosisReport of the record "
+                "(contactlab.diagnose(recording)), which holds the data and the fitted model"
+            )
         if self.name in report.effect_names:
             raise ValueError(f"{self.name} is named by this diagnosis: it was detected")
         for bound in power.stated_power(report):

@@ -42,6 +42,12 @@ impl Law for Dahl {
         let a = self.sigma0 / self.fc;
         let u = dx.abs();
         // y = 1 - s F / Fc obeys dy/du = -a y^α
+        if self.alpha == 1.0 {
+            // F -> s Fc exponentially in the travelled distance (y e^{-a u}, y Fc = Fc - s F,
+            // written without a division)
+            st.f = s * (self.fc - (self.fc - s * st.f) * (-a * u).exp());
+            return st.f;
+        }
         let y = 1.0 - s * st.f / self.fc;
         let al = self.alpha;
         let yn = if y <= 0.0 {

@@ -14,6 +14,11 @@ use crate::error::{check_positive, CoreError};
 pub(crate) fn stribeck(fc: f64, fs: f64, vs: f64, delta: f64, v: f64) -> f64 {
     let r = v.abs() / vs;
     let p = if delta == 2.0 { r * r } else { r.powf(delta) };
+    // far past the Stribeck velocity the exponential is below 1e-21 of (Fs - Fc): skipped,
+    // which also keeps libm's slow subnormal path (exp below -708) out of the loop
+    if p > 48.0 {
+        return fc;
+    }
     fc + (fs - fc) * (-p).exp()
 }
 
@@ -79,12 +84,13 @@ impl Law for LuGre {
                 (v, stribeck(self.fc, self.fs, self.vs, self.delta, v))
             }
         };
+        let ig = 1.0 / g;
         if dx != 0.0 {
             let zss = sign(dx) * g / self.sigma0;
-            st.z = zss + (st.z - zss) * (-self.sigma0 * dx.abs() / g).exp();
+            st.z = zss + (st.z - zss) * (-self.sigma0 * dx.abs() * ig).exp();
         }
         let z = st.z;
-        let zdot = v - self.sigma0 * v.abs() * z / g;
+        let zdot = v - self.sigma0 * v.abs() * z * ig;
         self.sigma0 * z + self.sigma1 * zdot + self.sigma2 * v
     }
 }

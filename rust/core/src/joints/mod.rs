@@ -319,6 +319,39 @@ impl AnyLaw {
         })
     }
 
+    /// The law of a flat encoding `[code, n_params, params..., n_children, children...]`
+    /// (depth first; `code` indexes [`FLAT_KINDS`]), as `contactlab.structure.joints`
+    /// writes it for a structure joint.
+    pub fn from_flat(flat: &[f64]) -> Result<Self, CoreError> {
+        let mut pos = 0usize;
+        let law = Self::walk_flat(flat, &mut pos, 0)?;
+        if pos != flat.len() {
+            return Err(flat_error("has values after the last law"));
+        }
+        Ok(law)
+    }
+
+    fn walk_flat(flat: &[f64], pos: &mut usize, depth: usize) -> Result<Self, CoreError> {
+        if depth > 64 {
+            return Err(flat_error("is nested too deeply"));
+        }
+        let code = flat_count(flat, pos, FLAT_KINDS.len().saturating_sub(1))?;
+        let kind = FLAT_KINDS
+            .get(code)
+            .ok_or_else(|| flat_error("has an unknown kind code"))?;
+        let np = flat_count(flat, pos, flat.len())?;
+        let mut params = Vec::with_capacity(np);
+        for _ in 0..np {
+            params.push(flat_take(flat, pos)?);
+        }
+        let nc = flat_count(flat, pos, flat.len())?;
+        let mut children = Vec::with_capacity(nc);
+        for _ in 0..nc {
+            children.push(Self::walk_flat(flat, pos, depth.saturating_add(1))?);
+        }
+        Self::build(kind, &params, children)
+    }
+
     /// True when the force depends on the velocity (times are then required).
     pub fn rate_dependent(&self) -> bool {
         match self {
@@ -360,6 +393,51 @@ impl AnyLaw {
             (Self::BoucWen(l), AnyState::BoucWen(s)) => run(l, s, t_prev, t, x, out),
             (law, s) => run(law, s, t_prev, t, x, out),
         }
+    }
+}
+
+/// Kind codes of [`AnyLaw::from_flat`] (the table of `contactlab.structure.joints.LAW_CODES`).
+pub const FLAT_KINDS: [&str; 13] = [
+    "jenkins",
+    "iwan",
+    "segalman",
+    "masing",
+    "maxwell_slip",
+    "gms",
+    "dahl",
+    "lugre",
+    "bouc_wen",
+    "kelvin_voigt",
+    "parallel",
+    "series",
+    "backlash",
+];
+
+fn flat_error(reason: &str) -> CoreError {
+    CoreError::InvalidLaw {
+        kind: "flat encoding".to_string(),
+        reason: reason.to_string(),
+    }
+}
+
+fn flat_take(flat: &[f64], pos: &mut usize) -> Result<f64, CoreError> {
+    let v = flat
+        .get(*pos)
+        .copied()
+        .ok_or_else(|| flat_error("ends early"))?;
+    *pos = pos.saturating_add(1);
+    Ok(v)
+}
+
+/// A count (or code) in `0..=max`, stored as a float.
+fn flat_count(flat: &[f64], pos: &mut usize, max: usize) -> Result<usize, CoreError> {
+    let v = flat_take(flat, pos)?;
+    if v.is_finite() && v >= 0.0 && v.fract() == 0.0 && v <= max as f64 {
+        Ok(v as usize)
+    } else {
+        Err(flat_error(
+            "has a count or kind code that is not a small non-negative integer",
+        ))
     }
 }
 

@@ -123,6 +123,25 @@ fn bad_input_is_an_error_not_a_panic() {
     op.push(Some(&[2.0, 3.0]), &[0.0, 1e-4], &mut out).unwrap();
 }
 
+#[test]
+fn flat_encoding_builds_the_same_law() {
+    // Parallel(k=100, c=1; Backlash(2e-4; Jenkins(1e4, 5)))
+    let flat = [
+        10.0, 2.0, 100.0, 1.0, 1.0, 12.0, 1.0, 2e-4, 1.0, 0.0, 2.0, 1e4, 5.0, 0.0,
+    ];
+    let law = AnyLaw::from_flat(&flat).unwrap();
+    assert_eq!(law, laws()[13]);
+    for bad in [
+        &flat[..5],
+        &[13.0, 0.0, 0.0][..],
+        &[0.0, 2.0, 1.0, 1.0, 0.0, 7.0][..],
+        &[0.0, 2.5, 1.0, 1.0, 0.0][..],
+        &[0.0, f64::NAN][..],
+    ] {
+        assert!(AnyLaw::from_flat(bad).is_err(), "{bad:?}");
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(40))]
 

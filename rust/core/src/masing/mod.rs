@@ -14,6 +14,7 @@ use crate::error::{check_positive, CoreError};
 mod kernel;
 use kernel::{eval_block, Run, BLOCK, KNOWN};
 
+pub mod channels;
 pub mod split;
 
 /// A remembered reversal point.

@@ -314,7 +314,6 @@ struct State {
 /// `u²(1−u)²(α + βu)`; it changes the step's right-hand side by `α ea + β eb`, and δ₁ by that
 /// over the Newton derivative `dg` (which carries the δ-dependence of `N₁`: a small
 /// tangent stiffness magnifies the error by `k_s / k_t`).
-#[allow(clippy::too_many_arguments)]
 fn advance(
     model: &ContactModel,
     seg: &Segment,
@@ -437,27 +436,16 @@ fn advance(
     Ok(Ok(worst))
 }
 
-/// Integrate `model` driven by `forcing` from `delta0` at the first sample on the samples'
-/// own grid (each interval in `substeps` equal steps), writing δ and δ' at every sample into
-/// `delta` and `velocity`.
-///
-/// `tol` is the absolute tolerance (m) of each step's Newton iteration. Malformed input is an
-/// `Err`; a solution that reaches `k_s ≤ 0` or a step whose iteration does not converge ends
-/// the solve with a failure status and the samples computed up to there, as
-/// [`super::ode::simulate`] does. `stats.n_accepted` counts steps, `stats.nfev` model
-/// evaluations.
-pub fn simulate_grid(
-    model: &ContactModel,
-    forcing: &Forcing<'_>,
-    delta0: f64,
-    substeps: usize,
-    tol: f64,
-    delta: &mut [f64],
-    velocity: &mut [f64],
-) -> Result<Outcome, CoreError> {
-    let n = forcing.len();
-    check_same_len("t", n, "delta (output)", delta.len())?;
-    check_same_len("t", n, "velocity (output)", velocity.len())?;
+/// The shortest and longest sample step of `t`.
+fn step_range(t: &[f64]) -> (f64, f64) {
+    t.windows(2).fold((f64::INFINITY, 0.0_f64), |(lo, hi), w| {
+        let d = w[1] - w[0];
+        (lo.min(d), hi.max(d))
+    })
+}
+
+/// The checks of [`simulate_grid`]'s options.
+fn check_options(delta0: f64, substeps: usize, tol: f64) -> Result<(), CoreError> {
     if !delta0.is_finite() {
         return Err(CoreError::InvalidParameter {
             name: "delta0",
@@ -479,16 +467,68 @@ pub fn simulate_grid(
             reason: "must be positive and finite",
         });
     }
+    Ok(())
+}
+
+/// Substeps of an interval in the start-up layer (`a_span = a · span`): enough for
+/// `λ <= LAYER_LAMBDA`, at least `m_sub`, at most `LAYER_MAX_SUBSTEPS`.
+fn layer_substeps(a_span: f64, m_sub: f64) -> f64 {
+    let need = (a_span / LAYER_LAMBDA).ceil();
+    if need > m_sub {
+        need.min(LAYER_MAX_SUBSTEPS)
+    } else {
+        m_sub
+    }
+}
+
+/// Step and weights of `m_i` equal steps over `span`: those of the last refined interval
+/// when the record's steps are uniform and it had as many (kept in `cache`).
+fn refined_weights(
+    cache: &mut Option<(f64, Weights)>,
+    uniform: bool,
+    a: f64,
+    span: f64,
+    m_i: f64,
+) -> (f64, Weights) {
+    if let Some((m_w, w_w)) = cache.filter(|&(m_w, _)| uniform && m_w == m_i) {
+        return (span / m_w, w_w);
+    }
+    let wt = Weights::new(a * span / m_i);
+    if uniform {
+        *cache = Some((m_i, wt));
+    }
+    (span / m_i, wt)
+}
+
+/// Integrate `model` driven by `forcing` from `delta0` at the first sample on the samples'
+/// own grid (each interval in `substeps` equal steps), writing δ and δ' at every sample into
+/// `delta` and `velocity`.
+///
+/// `tol` is the absolute tolerance (m) of each step's Newton iteration. Malformed input is an
+/// `Err`; a solution that reaches `k_s ≤ 0` or a step whose iteration does not converge ends
+/// the solve with a failure status and the samples computed up to there, as
+/// [`super::ode::simulate`] does. `stats.n_accepted` counts steps, `stats.nfev` model
+/// evaluations.
+pub fn simulate_grid(
+    model: &ContactModel,
+    forcing: &Forcing<'_>,
+    delta0: f64,
+    substeps: usize,
+    tol: f64,
+    delta: &mut [f64],
+    velocity: &mut [f64],
+) -> Result<Outcome, CoreError> {
+    let n = forcing.len();
+    check_same_len("t", n, "delta (output)", delta.len())?;
+    check_same_len("t", n, "velocity (output)", velocity.len())?;
+    check_options(delta0, substeps, tol)?;
     let t = forcing.times();
     let a = model.rate();
     let m_sub = substeps as f64;
     // equal steps: one set of weights for the whole record. Sample times stored as
     // `k / fs` differ from equal steps by rounding (1e-11 of a step at 1e6 samples); a step
     // 1e-9 off changes the weights by that fraction, far below the method's error
-    let (lo, hi) = t.windows(2).fold((f64::INFINITY, 0.0_f64), |(lo, hi), w| {
-        let d = w[1] - w[0];
-        (lo.min(d), hi.max(d))
-    });
+    let (lo, hi) = step_range(t);
     let uniform = hi - lo <= UNIFORM_STEPS * hi;
     let h_uni = 0.5 * (lo + hi) / m_sub;
     // the displacement scale max|p| / k_s(0), and the largest u³ term of a step's cubic N
@@ -551,12 +591,7 @@ pub fn simulate_grid(
         // (only a δ-dependent k_s puts δ into N; otherwise N is the forcing's cubic over p)
         let in_layer = delta_law && a * (w[0] - t[0]) < LAYER_SPAN;
         let m_base = if in_layer {
-            let need = (a * span / LAYER_LAMBDA).ceil();
-            if need > m_sub {
-                need.min(LAYER_MAX_SUBSTEPS)
-            } else {
-                m_sub
-            }
+            layer_substeps(a * span, m_sub)
         } else {
             m_sub
         };
@@ -571,14 +606,8 @@ pub fn simulate_grid(
         loop {
             let (h, wt) = if uniform && m_i == m_sub {
                 (h_uni, w_uni)
-            } else if let Some((m_w, w_w)) = w_refined.filter(|&(m_w, _)| uniform && m_w == m_i) {
-                (span / m_w, w_w)
             } else {
-                let wt = Weights::new(a * span / m_i);
-                if uniform {
-                    w_refined = Some((m_i, wt));
-                }
-                (span / m_i, wt)
+                refined_weights(&mut w_refined, uniform, a, span, m_i)
             };
             let out = advance(
                 model,
@@ -607,19 +636,14 @@ pub fn simulate_grid(
                     refine = m_i / m_base;
                     break; // as fine as it goes: keep it
                 }
-                Ok(_) => {
-                    stats.n_rejected = stats.n_rejected.saturating_add(1);
-                    st = saved;
-                    m_i *= 2.0;
+                Err(status) if 2.0 * m_i > cap => {
+                    return Ok(Outcome {
+                        status,
+                        n_out: j,
+                        stats,
+                    });
                 }
-                Err(status) => {
-                    if 2.0 * m_i > cap {
-                        return Ok(Outcome {
-                            status,
-                            n_out: j,
-                            stats,
-                        });
-                    }
+                Ok(_) | Err(_) => {
                     stats.n_rejected = stats.n_rejected.saturating_add(1);
                     st = saved;
                     m_i *= 2.0;

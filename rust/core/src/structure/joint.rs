@@ -8,6 +8,7 @@
 
 use crate::curve::{Backbone, Exponential, Tabulated};
 use crate::error::{check_finite, check_positive, CoreError};
+use crate::joints::{AnyLaw, AnyState, Law};
 use crate::masing::{MasingState, Reversal};
 use crate::normal::poly;
 
@@ -84,6 +85,9 @@ pub enum JointLaw {
         slope: Vec<f64>,
         energy: Vec<f64>,
     },
+    /// A rate-independent law of [`crate::joints`] (exact along each monotone step; tangent
+    /// by a one-sided difference in the direction of motion), with its initial stiffness.
+    Law { law: Box<AnyLaw>, k0: f64 },
 }
 
 impl JointLaw {
@@ -177,7 +181,27 @@ impl JointLaw {
             Self::Iwan { k, .. } => k.iter().sum(),
             Self::BoucWen { alpha, .. } => *alpha,
             Self::Normal { slope, .. } => poly::eval(slope, 0.0),
+            Self::Law { k0, .. } => *k0,
         }
+    }
+
+    /// A joint of a rate-independent [`crate::joints`] law (a rate-dependent one is refused:
+    /// the integrator's step has no time for it).
+    pub fn law(law: AnyLaw) -> Result<Self, CoreError> {
+        if law.rate_dependent() {
+            return Err(CoreError::InvalidLaw {
+                kind: "structure joint".to_string(),
+                reason: "a rate-dependent law (LuGre, generalised Maxwell-slip, a viscous term) \
+                         is not a structure joint; use kelvin_voigt for viscous terms"
+                    .to_string(),
+            });
+        }
+        let st = law.start(0.0);
+        let k0 = law_tangent(&law, &st, 0.0, 0.0, 1.0).1;
+        Ok(Self::Law {
+            law: Box::new(law),
+            k0,
+        })
     }
 
     /// The virgin state (d = 0, F = 0).
@@ -187,6 +211,7 @@ impl JointLaw {
             Self::Jenkins { .. } | Self::BoucWen { .. } => JointState::Slider(0.0),
             Self::Iwan { k, .. } => JointState::Sliders(vec![0.0; k.len()]),
             Self::KelvinVoigt { .. } | Self::Normal { .. } => JointState::Elastic,
+            Self::Law { law, .. } => JointState::Law(Box::new(law.start(0.0))),
         }
     }
 }
@@ -200,6 +225,19 @@ pub enum JointState {
     /// Iwan: each element's force.
     Sliders(Vec<f64>),
     Elastic,
+    /// A [`crate::joints`] law's state.
+    Law(Box<AnyState>),
+}
+
+/// Force of `law` at `d` from `st` (unchanged) and its tangent by a one-sided difference in
+/// the direction `dir` of the motion (`h`: 1e-7 of the step, at least 1e-9 of |d| and 1e-15).
+fn law_tangent(law: &AnyLaw, st: &AnyState, d_old: f64, d: f64, dir: f64) -> (f64, f64) {
+    let mut s = st.clone();
+    let f = law.step(&mut s, None, d);
+    let h = (1e-7 * (d - d_old).abs()).max(1e-9 * d.abs()).max(1e-15) * dir;
+    let mut s2 = st.clone();
+    let f2 = law.step(&mut s2, None, d + h);
+    (f, ((f2 - f) / h).max(0.0))
 }
 
 /// Force and tangents at a trial displacement.
@@ -404,6 +442,15 @@ impl JointLaw {
                 kt: poly::eval(slope, d_new),
                 ..Trial::default()
             },
+            (Self::Law { law, .. }, JointState::Law(st)) => {
+                let dir = if dd < 0.0 { -1.0 } else { 1.0 };
+                let (f, kt) = law_tangent(law, st, d_old, d_new, dir);
+                Trial {
+                    f,
+                    kt,
+                    ..Trial::default()
+                }
+            }
             // A state of another law never reaches here (states are made by `fresh_state`).
             _ => Trial::default(),
         }
@@ -433,6 +480,10 @@ impl JointLaw {
                     let ft = *f + ki * dd;
                     *f = if ft.abs() > fi { fi.copysign(ft) } else { ft };
                 }
+                Ok(())
+            }
+            (Self::Law { law, .. }, JointState::Law(st)) => {
+                let _ = law.step(st, None, d_new);
                 Ok(())
             }
             _ => Ok(()),
@@ -465,6 +516,11 @@ impl JointLaw {
             }
             (Self::KelvinVoigt { k, .. }, _) => 0.5 * k * d * d,
             (Self::Normal { energy, .. }, _) => poly::eval(energy, d),
+            // F² / (2 k0) as for Masing (exact for every closed cycle)
+            (Self::Law { law, k0 }, JointState::Law(st)) if *k0 > 0.0 => {
+                let f = law.step(&mut (**st).clone(), None, d);
+                0.5 * f * f / k0
+            }
             _ => 0.0,
         }
     }

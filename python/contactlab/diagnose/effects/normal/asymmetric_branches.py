@@ -23,7 +23,7 @@ class AsymmetricBranches(EffectModel):
 
     def apply(self, coeffs, p, ctx):
         k, a2, a3 = coeffs
-        return (k, a2 + p["k"] * p["a"] / ctx.extra["delta_r"], a3)
+        return (k, a2 + p["k"] * p["a"] / ctx.d.extra["delta_r"], a3)
 
     def argument(self, d, p):
         return (

@@ -4,8 +4,21 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._family import MAX_DELAY_FRACTION, ParamSpec
+from ..._family import MAX_DELAY_FRACTION, ParamSpec, Prepared
 from .._base import EffectModel, Plausibility, register
+
+#: excitation frequencies closer than this ratio count as one frequency for the delay test
+SINGLE_TONE_SPAN = 1.25
+
+
+def frequency_span(d: Prepared) -> float:
+    """Ratio of the longest to the shortest complete excitation cycle (1 for one tone)."""
+    cyc = d.cycles.cycle
+    lengths = np.bincount(cyc[cyc >= 0])
+    lengths = lengths[lengths > 0]
+    if lengths.size < 2:
+        return 1.0
+    return float(np.max(lengths) / np.min(lengths))
 
 
 @register
@@ -27,11 +40,9 @@ class NormalChannelDelay(EffectModel):
     def apply(self, delta, p, ctx):
         from ..._signal import shift_cubic
 
-        return shift_cubic(delta, ctx.dt, p["tau"])
+        return shift_cubic(delta, ctx.d.dt, p["tau"])
 
     def plausible(self, d, p):
-        from ...candidates_normal import SINGLE_TONE_SPAN, frequency_span
-
         if frequency_span(d) < SINGLE_TONE_SPAN:
             return Plausibility(
                 False, "a delay cannot be told from the Kelvin-Voigt damping at one frequency"

@@ -7,6 +7,14 @@ import numpy as np
 from ..._family import ParamSpec
 from .._base import EffectModel, Plausibility, register
 
+#: a creep must take longer than this many excitation periods to settle: a faster "drift"
+#: is the start of the record (a sensor or model transient), which creep cannot be told from
+CREEP_MIN_PERIODS = 1.0
+#: a creep must settle visibly within the record: with τc above this many record durations
+#: the drift is straight to within a sixth of its size (1 - e^(-1/3) against 1/3), and creep
+#: (a settling) is not told from a sensor drift or a slow misfit of the model
+CREEP_MAX_DURATIONS = 3.0
+
 
 @register
 class CreepDrift(EffectModel):
@@ -25,19 +33,14 @@ class CreepDrift(EffectModel):
     order = 2
     size_param = "D"
 
-    def start(self, p, d, residual):
-        from ...candidates_normal import NormalFamily
-
-        return NormalFamily.creep_start(p, d, residual)
+    def start(self, p, d, residual, family=None):
+        return family.creep_start(p, d, residual)
 
     def apply(self, delta, p, ctx):
-        from ...candidates_normal import _creep_shape
-
-        return delta + p["D"] * _creep_shape(ctx, max(p["tau_c"], 1e-6 * ctx.duration))
+        d = ctx.d
+        return delta + p["D"] * ctx.family.creep_shape(d, max(p["tau_c"], 1e-6 * d.duration))
 
     def plausible(self, d, p):
-        from ...candidates_normal import CREEP_MAX_DURATIONS, CREEP_MIN_PERIODS
-
         period = d.cycles.period_samples * d.dt
         if p["tau_c"] < CREEP_MIN_PERIODS * period:
             return Plausibility(

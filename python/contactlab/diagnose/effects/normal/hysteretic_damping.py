@@ -21,11 +21,7 @@ class HystereticDamping(EffectModel):
     size_param = "eta"
 
     def apply(self, pd, p, ctx):
-        from ...candidates_normal import frequency_domain, run_in
-
-        return frequency_domain(
-            ctx.t, pd, p["k"], p["psi"], ctx.extra["omega"], p["eta"], run_in(ctx, pd)
-        )
+        return ctx.family.hysteretic(pd, p, ctx.d)
 
     def argument(self, d, p):
         return (

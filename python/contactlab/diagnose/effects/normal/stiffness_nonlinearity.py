@@ -23,7 +23,7 @@ class StiffnessNonlinearity(EffectModel):
 
     def apply(self, coeffs, p, ctx):
         k, a2, a3 = coeffs
-        return (k, a2, a3 + p["k"] * p["kappa"] / ctx.extra["delta_r"] ** 2)
+        return (k, a2, a3 + p["k"] * p["kappa"] / ctx.d.extra["delta_r"] ** 2)
 
     def argument(self, d, p):
         return (

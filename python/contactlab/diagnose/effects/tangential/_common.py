@@ -3,6 +3,9 @@ arguments quote them."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 
 from ..._family import Prepared
@@ -88,3 +91,48 @@ def actual_turns(ctx) -> np.ndarray:
         return ctx.sp.reversals
     band = max(TURN_SIGMAS * float(d.extra.get("u_noise", 0.0)), TURN_SHARE * float(np.ptp(d.u)))
     return ctx.fixed("turning_points", lambda: turning_points(d.u, band))
+
+
+def fixed(d: Prepared, key: str, make: Callable[[], Any]) -> Any:
+    """An array of the model evaluation that depends on the recording only (not on the
+    fitted parameters): computed on the first evaluation, then reused by every fit on ``d``
+    (the fits evaluate the model thousands of times)."""
+    cache = d.extra.setdefault("fixed", {})
+    k = (key, d.t.size)
+    if k not in cache:
+        cache[k] = make()
+    return cache[k]
+
+
+#: entries of the small per-recording memos below (index sets, load-fluctuation terms)
+_MEMO_KEEP = 64
+
+
+def memo(d: Prepared, name: str) -> dict[Any, Any]:
+    cache = d.extra.setdefault(name, {})
+    if len(cache) >= _MEMO_KEEP:
+        cache.clear()
+    return cache
+
+
+def delay_support(d: Prepared, at: np.ndarray, tau: float) -> np.ndarray:
+    """The samples a delayed prediction at the samples ``at`` needs: for each shifted time
+    ``t[at] - tau`` the two samples that bracket it as :func:`numpy.interp` finds them
+    (``t[j] <= t < t[j+1]``, the first or last sample off the ends); ``at`` itself when
+    ``tau`` is 0. Kept per ``(tau, at)``: a fit's Jacobian steps every other parameter at
+    the same delay."""
+    if tau == 0.0:
+        return at
+    rows_memo = memo(d, "delay_rows")
+    key = (tau, id(at))
+    hit = rows_memo.get(key)
+    if hit is not None and hit[0] is at:  # (the array is held: its id is not reused)
+        return hit[1]
+    n = d.t.size
+    j = np.searchsorted(d.t, d.t[at] - tau, side="right") - 1
+    need = np.zeros(n, bool)
+    need[np.clip(j, 0, n - 1)] = True
+    need[np.clip(j + 1, 0, n - 1)] = True
+    rows = np.flatnonzero(need)
+    rows_memo[key] = (at, rows)
+    return rows

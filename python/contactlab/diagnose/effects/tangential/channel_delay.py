@@ -7,7 +7,7 @@ import numpy as np
 from ..._family import MAX_DELAY_FRACTION, ParamSpec
 from ..._signal import shift
 from .._base import EffectModel, Plausibility, register
-from ._common import period, reconstructed
+from ._common import delay_support, period, reconstructed
 
 #: (MAX_DELAY_FRACTION, the largest plausible delay as a fraction of the excitation period,
 #: is shared with the normal family's delay: :data:`contactlab.diagnose._family`)
@@ -39,8 +39,6 @@ class ChannelDelay(EffectModel):
     def rows_needed(self, d, at, p):
         """The samples a delayed prediction at ``at`` needs (both neighbours of each shifted
         time)."""
-        from ...candidates_tangential import delay_support
-
         return delay_support(d, at, p["tau"])
 
     def apply(self, F, p, ctx):

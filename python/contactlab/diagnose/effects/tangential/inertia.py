@@ -28,6 +28,9 @@ class Inertia(EffectModel):
     #: an inertial force beyond this share of the friction force means the sensor weighs the
     #: moving part more than it measures the contact: a misfit of the base model instead
     MAX_FORCE_SHARE = 1.0
+    #: ... and no fixture between a load cell and a contact weighs a tonne (docs/effects.md:
+    #: "kg for a tribometer, tonnes never"); a fit beyond it reads a misfit as a mass
+    MAX_MASS = 1000.0
 
     def apply(self, F, p, ctx):
         return F + p["m"] * ctx.pick(ctx.d.udd)
@@ -36,6 +39,13 @@ class Inertia(EffectModel):
         base = super().plausible(d, p)
         if not base.ok:
             return base
+        if p["m"] > self.MAX_MASS:
+            return Plausibility(
+                False,
+                f"a mass of {p['m']:.3g} kg between sensor and contact (plausible: below "
+                f"{self.MAX_MASS:g} kg, a fixture): the base model's misfit in phase with the "
+                "acceleration is read as one",
+            )
         a = peak_acceleration(d)
         h0 = p.get("h0", np.nan)
         f = p["m"] * a

@@ -55,6 +55,10 @@ class NonMasingScaling(EffectModel):
         core = core if core is not None else Masing(p["h0"], p["ac"])
         return turning_point_force(core.virgin, p["lam"], ctx.xm, actual_turns(ctx))
 
+    def base_equivalent(self, p):
+        """The steady loop is a Masing loop of ``(λ h0 / 2, 2 ac / λ)`` (docs/effects.md)."""
+        return {"h0": p["h0"] * p["lam"] / 2.0, "ac": 2.0 * p["ac"] / p["lam"]}
+
     def plausible(self, d, p):
         base = super().plausible(d, p)
         if base.ok and not 0.5 <= p["lam"] <= 8.0:

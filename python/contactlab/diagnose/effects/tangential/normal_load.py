@@ -7,6 +7,7 @@ import numpy as np
 from ..._family import ParamSpec
 from ..._signal import modulation_gains
 from .._base import EffectModel, Plausibility, register
+from ._common import fixed, memo
 
 #: a normal-load fluctuation must make this many periods in the record; slower, it is a drift
 MIN_LOAD_PERIODS = 2.0
@@ -26,8 +27,6 @@ def load_terms(d, f_n: float, rows: np.ndarray | None) -> tuple[np.ndarray, np.n
     """``cos 2π f_n t``, ``sin 2π f_n t`` (``t`` from the record's start) at the samples
     ``rows`` (all when None), kept per ``(f_n, rows)``: only a step of ``f_n`` changes
     them."""
-    from ...candidates_tangential import fixed, memo
-
     m = memo(d, "load_terms")
     key = (f_n, None if rows is None else id(rows))
     hit = m.get(key)
@@ -93,13 +92,11 @@ class NormalLoad(EffectModel):
         e2 = sum((p[n] / v * se.get(n, np.inf)) ** 2 for n in names)
         return v, float(np.sqrt(e2))
 
-    def start(self, p, d, residual):
+    def start(self, p, d, residual, family=None):
         """The frequency whose ``h cos, h sin`` pair explains most of the residual, scanned
         from 0.05 excitation frequencies (at least two periods in the record) to 3, at a
         quarter of the record's frequency resolution, the drive's harmonics included."""
-        from ...candidates_tangential import TangentialFamily
-
-        h = TangentialFamily().predict(p, (), d)
+        h = family.predict(p, (), d)
         f_exc = 1.0 / (d.cycles.period_samples * d.dt)
         f_lo = max(0.05 * f_exc, MIN_LOAD_PERIODS / d.duration)
         step = 0.25 / d.duration

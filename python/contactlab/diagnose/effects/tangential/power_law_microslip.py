@@ -61,7 +61,7 @@ class PowerLawMicroslip(EffectModel):
     order = 15
     size_param = "chi"
 
-    def start(self, p, d, residual):
+    def start(self, p, d, residual, family=None):
         return {"chi": -0.5, "beta": 0.5}
 
     def apply(self, core, p, ctx):

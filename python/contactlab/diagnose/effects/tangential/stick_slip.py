@@ -73,7 +73,7 @@ class StickSlip(EffectModel):
     order = 13
     size_param = "s_b"
 
-    def start(self, p, d, residual):
+    def start(self, p, d, residual, family=None):
         return {"ell": 1.0 / p["ac"]}
 
     def apply(self, h, p, ctx):

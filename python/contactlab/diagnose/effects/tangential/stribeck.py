@@ -35,7 +35,7 @@ class Stribeck(EffectModel):
     order = 11
     size_param = "s"
 
-    def start(self, p, d, residual):
+    def start(self, p, d, residual, family=None):
         return {"v_s": float(np.sqrt(np.mean(d.ud**2)))}
 
     def apply(self, h, p, ctx):

@@ -1,0 +1,61 @@
+"""The diagnosis's closing checks on its final model (issue 29, items 1-3): both channels'
+noise (:mod:`.detection`), the stated power of every candidate not named (:mod:`.power`) and
+the structure the final residual still holds (:mod:`.misfit`), in one call for the workflow.
+(Kept apart from :mod:`.detection`, which the other two build on: no import cycle.)"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ._family import Prepared
+from .detection import channel_noise, model_slope
+from .misfit import eiv_tolerance, unexplained_structure
+from .power import POWER, _setting, bounds_for
+
+__all__ = ["assess"]
+
+
+def assess(
+    family: Any,
+    d: Prepared,
+    current: Any,
+    sigma: float,
+    *,
+    z: float,
+    gain_floor: float,
+    folds: int,
+    candidates: list[str],
+    declared_output: float | None = None,
+    seed: int = 0,
+) -> dict[str, Any]:
+    """The diagnosis's closing checks (issue 29, items 1-3) on its final model.
+
+    Returns a dict with ``noise`` (:class:`~.detection.ChannelNoise`), ``not_detected`` (a list of
+    :class:`contactlab.diagnose.power.Detectable`, every candidate not in the final model)
+    and ``unexplained`` (:class:`contactlab.diagnose.misfit.Unexplained` or None), plus the
+    settings they were computed at (``z``, ``gain_floor``, ``folds``, ``candidates``).
+    """
+    params = dict(current.full.params)
+    effects = tuple(current.effects)
+    residual = -current.full_residual(d)  # measured minus model
+    slope = model_slope(family, params, d)
+    noise = channel_noise(
+        d, residual, declared_output=declared_output, slope=slope,
+        input_unit=family.input_unit, output_unit=family.output_unit,
+    )  # fmt: skip
+    st = _setting(d, current, noise, slope, sigma, z, gain_floor, folds, seed)
+    bounds = bounds_for(family, params, effects, candidates, d, noise, sigma, current, st)
+    misfit = unexplained_structure(
+        d, residual, sigma, unit=family.output_unit,
+        tolerance=eiv_tolerance(slope, noise.input_seen),
+    )  # fmt: skip
+    return {
+        "noise": noise,
+        "not_detected": bounds,
+        "unexplained": misfit,
+        "z": z,
+        "gain_floor": st.gain_floor,
+        "folds": folds,
+        "power": POWER,
+        "candidates": list(candidates),
+    }
