@@ -67,7 +67,10 @@ class _Flaky(Jenkins):
     """A Jenkins element whose evaluation fails beyond 1 mm (a stand-in for a law that
     cannot be integrated at some amplitude)."""
 
-    name = "flaky"
+    name = "flaky"  # not "jenkins": no closed form, the simulated-cycle route
+
+    def spec(self):
+        return ("jenkins", [self.k, self.fs], [])  # the core runs it as a Jenkins element
 
     def force(self, t, x, x0=0.0):
         if np.max(np.abs(x)) > 1e-3:
