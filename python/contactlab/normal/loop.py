@@ -36,6 +36,7 @@ import numpy as np
 
 from .. import _core
 from .._arrays import as_1d, positive
+from .._options import takes_options
 from .._physical import check_channel
 from ..errors import ContactLabWarning, InputError
 from . import paper as _paper
@@ -629,6 +630,7 @@ def _stiffness(
 # --- main entry point ----------------------------------------------------------------------
 
 
+@takes_options
 def analyze_loop(
     t: Any,
     p: Any,
