@@ -551,7 +551,7 @@ def analyze_tangential(
     lag.record(res, delay, dropped)
     if warn:
         for wtxt in res.warnings:
-            warnings.warn(wtxt, ContactLabWarning, stacklevel=2)
+            warnings.warn(wtxt, ContactLabWarning, stacklevel=3)
     return res
 
 
