@@ -1,7 +1,7 @@
 """Sphinx configuration of the contactlab documentation (``make docs``).
 
 Sphinx with numpydoc (the package's docstrings are numpydoc), MyST (the guides are Markdown,
-so their ```python blocks are run by ``tests/test_readme.py`` like the README's) and
+so their ```python blocks are run by ``tests/package/test_readme.py`` like the README's) and
 sphinx-gallery (``docs/examples/plot_*.py`` run at every build). Built with ``-W --keep-going
 -n``: any warning, an unresolved cross-reference included, fails the build.
 """

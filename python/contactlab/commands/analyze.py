@@ -14,6 +14,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from .._options import as_dict
 from ..errors import InputError
 from ._common import (
     FORCE_SIGN_CHOICES,
@@ -287,12 +288,14 @@ def _handler(args: argparse.Namespace) -> int:
         e = entry_from_file(f, kind=args.model)
         e.columns, e.fs, e.frame, e.resample = columns, args.fs, frame, args.resample
         entries.append(e)
-    topts = {"force_sign": args.force_sign}
-    if args.delay is not None:
-        if args.model != "tangential":
-            raise InputError("--delay is for tangential recordings (force against displacement)")
-        topts["delay"] = args.delay
-    nopts = {"p0": args.p0, "pa": args.pa}
+    if args.delay is not None and args.model != "tangential":
+        raise InputError("--delay is for tangential recordings (force against displacement)")
+    # the flags parsed into the typed options (issue 32); the library takes them as dicts too
+    from ..normal.options import Options as NormalOptions
+    from ..tangential.options import Options as TangentialOptions
+
+    topts = as_dict(TangentialOptions(force_sign=args.force_sign, delay=args.delay))
+    nopts = as_dict(NormalOptions(p0=args.p0, pa=args.pa))
     if args.stream:
         return _streamed(args, entries, columns, topts, nopts)
     big: set[int] = set()

@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from .._moved import moved
+from .._options import takes_options
 from ..errors import InputError
 from ._family import Family, Prepared
 from ._inputs import arrays as _arrays
@@ -442,6 +443,7 @@ def infer_model(recording: Any) -> str:
 
 
 @one_blas_thread
+@takes_options
 def diagnose(
     recording: Any,
     model: Any = None,

@@ -36,6 +36,7 @@ import numpy as np
 
 from .. import _core
 from .._arrays import as_1d, positive
+from .._options import takes_options
 from .._physical import check_channel
 from ..errors import ContactLabWarning, InputError
 from . import paper as _paper
@@ -519,7 +520,7 @@ def _pressure_levels(
             f"the measured dynamic amplitude pa = {pa:.4g} Pa differs from the nominal "
             f"{pa_nominal:.4g} Pa by {100 * (pa / pa_nominal - 1):+.0f}%",
             ContactLabWarning,
-            stacklevel=3,
+            stacklevel=4,  # helper, analyze_loop, its options wrapper, the caller
         )
     return p0_val, pa
 
@@ -557,7 +558,7 @@ def _branches(pdyn: np.ndarray, dm: np.ndarray, degree: int, zero_delta: bool) -
             warnings.warn(
                 "the centre curve does not cross p = 0 inside the loop; δ is left as recorded",
                 ContactLabWarning,
-                stacklevel=3,
+                stacklevel=4,  # helper, analyze_loop, its options wrapper, the caller
             )
         else:
             r = float(roots[np.argmin(np.abs(roots))])
@@ -597,7 +598,7 @@ def _energies(pdyn: np.ndarray, dz: np.ndarray, br: _Branches) -> _Energies:
             f"the loop area is not positive (E_d = {E_d:.3g} J/m²): loading and unloading "
             "may be swapped or the loop is dominated by noise",
             ContactLabWarning,
-            stacklevel=3,
+            stacklevel=4,  # helper, analyze_loop, its options wrapper, the caller
         )
     return _Energies(E_d, E_d_poly, E_pu, E_pd, d_max, d_min)
 
@@ -621,7 +622,7 @@ def _stiffness(
             f"k_s(δ) is not positive over the loop's range (k_s = {kmin:.3g} Pa/m at "
             f"δ = {kat:.3g} m); a nonlinear model built on it is invalid there",
             ContactLabWarning,
-            stacklevel=3,
+            stacklevel=4,  # helper, analyze_loop, its options wrapper, the caller
         )
     return k_tan, k_sec, k_s
 
@@ -629,6 +630,7 @@ def _stiffness(
 # --- main entry point ----------------------------------------------------------------------
 
 
+@takes_options
 def analyze_loop(
     t: Any,
     p: Any,

@@ -209,7 +209,6 @@ def build_diagnosis_report(diag: Any) -> Report:
     after each step, measured against simulated response (base and final model), the joint's
     loop, the residual before and after (time and spectrum), the unexplained part with where
     it lives, and every candidate's verdict."""
-    from matplotlib.figure import Figure
 
     from .._html import format_measurement
 
@@ -219,9 +218,8 @@ def build_diagnosis_report(diag: Any) -> Report:
 
         raise InputError("this diagnosis carries no record (loaded from JSON?): re-run "
                          "diagnose_structure to write its report")  # fmt: skip
-    t, u, y = rec["t"], rec["u"], rec["y"]
+    y = rec["y"]
     base, final = diag.base_prediction, y + diag.residual
-    ntr = diag.n_train
     sigma = diag.noise_rms
     r = Report(
         f"Structure diagnosis: {diag.joint} joint, {diag.excitation} excitation",
@@ -229,12 +227,25 @@ def build_diagnosis_report(diag: Any) -> Report:
         "refitted on the first part of the record and judged on the held-out end, which no fit "
         "saw (dashed line in the figures).",
     )
+    _diag_findings(r, diag, format_measurement)
+    _diag_tables(r, diag, sigma)
+    _diag_response(r, diag, base, final, sigma)
+    _diag_joint_loop(r, diag, base, final)
+    _diag_residual(r, diag, base, final, sigma)
+    _diag_candidates(r, diag, format_measurement)
+    r.section("Result (JSON)")
+    r.preformatted(diag.to_json())
+    return r
+
+
+def _diag_findings(r: Report, diag: Any, fmt: Any) -> None:
+    """Findings: the named effects, where the model disagrees, explained or not."""
     r.section("Findings")
     if diag.effects:
         for name in diag.effects:
             keys = [k for k in diag.parameters if k in _EXTRA_KEYS.get(name, ())]
             r.text(f"Named: {name} — " + ", ".join(
-                f"{k} = {_pm(diag.parameters[k], diag.stderr.get(k), format_measurement)}"
+                f"{k} = {_pm(diag.parameters[k], diag.stderr.get(k), fmt)}"
                 for k in keys))  # fmt: skip
     else:
         r.text("No candidate improves the held-out error significantly.")
@@ -246,6 +257,10 @@ def build_diagnosis_report(diag: Any) -> Report:
          if diag.unexplained else "Explained: the final model's held-out error is within "
          "1.5 × the noise level."), note=diag.unexplained,
     )  # fmt: skip
+
+
+def _diag_tables(r: Report, diag: Any, sigma: float) -> None:
+    """The final model's parameters and the held-out error after each step."""
     r.section("Parameters of the final model")
     r.table(
         [
@@ -279,6 +294,14 @@ def build_diagnosis_report(diag: Any) -> Report:
         ],
     )
     r.text(f"Noise RMS estimated from the data: {sigma:.4g} m")
+
+
+def _diag_response(r: Report, diag: Any, base: np.ndarray, final: np.ndarray, sigma: float) -> None:
+    """Input, measured and simulated displacement, residual before and after."""
+    from matplotlib.figure import Figure
+
+    t, y, ntr = diag.record["t"], diag.record["y"], diag.n_train
+    u = diag.record["u"]
     r.section("Response")
     fig = Figure(figsize=(10, 6.5), layout="constrained")
     ax = fig.subplots(3, 1, sharex=True)
@@ -303,6 +326,13 @@ def build_diagnosis_report(diag: Any) -> Report:
         a.axvline(t[ntr], color="k", ls="--", lw=0.8)
     r.figure(fig, "response", "Input; measured and simulated displacement (base and final "
              "model); residual before and after (dotted: ± 2 × noise RMS).", dpi=110)  # fmt: skip
+
+
+def _diag_joint_loop(r: Report, diag: Any, base: np.ndarray, final: np.ndarray) -> None:
+    """The joint's simulated force against the displacement on the held-out part."""
+    from matplotlib.figure import Figure
+
+    ntr = diag.n_train
     r.section("Joint loop")
     fig = Figure(figsize=(6.5, 4.6), layout="constrained")
     ax1 = fig.add_subplot()
@@ -318,6 +348,13 @@ def build_diagnosis_report(diag: Any) -> Report:
     ax1.legend(loc="upper left", fontsize=8)
     r.figure(fig, "joint-loop", "The joint's force against the displacement on the held-out "
              "part (simulated).", dpi=110)  # fmt: skip
+
+
+def _diag_residual(r: Report, diag: Any, base: np.ndarray, final: np.ndarray, sigma: float) -> None:
+    """The held-out residual's spectrum and its size against the speed of the mass."""
+    from matplotlib.figure import Figure
+
+    t, y, ntr = diag.record["t"], diag.record["y"], diag.n_train
     r.section("Residual: where the unexplained part lives")
     fig = Figure(figsize=(10, 3.8), layout="constrained")
     axs = fig.subplots(1, 2)
@@ -339,6 +376,10 @@ def build_diagnosis_report(diag: Any) -> Report:
         a.legend(fontsize=8)
     r.figure(fig, "residual-where", "Held-out residual: its spectrum, and its size against the "
              "speed of the mass (near reversals on the left).", dpi=110)  # fmt: skip
+
+
+def _diag_candidates(r: Report, diag: Any, fmt: Any) -> None:
+    """Every candidate's verdict after each step."""
     r.section("Candidates tried")
     for i, s in enumerate(diag.steps):
         if s["candidates"]:
@@ -347,15 +388,11 @@ def build_diagnosis_report(diag: Any) -> Report:
             for c in s["candidates"]:
                 d = c.to_dict()
                 d["parameters"] = ", ".join(
-                    f"{k} = {_pm(val, c.stderr.get(k), format_measurement)}"
-                    for k, val in c.parameters.items()
+                    f"{k} = {_pm(val, c.stderr.get(k), fmt)}" for k, val in c.parameters.items()
                 )
                 rows.append(d)
             r.table(rows, ["name", "accepted", Column("heldout_rms", "held-out RMS", unit="m"),
                            Column("gain", "gain / σ²"), "t", "parameters", "reason"])  # fmt: skip
-    r.section("Result (JSON)")
-    r.preformatted(diag.to_json())
-    return r
 
 
 #: the parameters each structure candidate adds (as diagnose.structure names them)

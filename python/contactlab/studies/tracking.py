@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from .._json import dumps, jsonable
+from .._options import as_dict
 from .._physical import MAX_MAGNITUDE
 from ..errors import ContactLabError, ContactLabWarning, InputError
 from ..io import Recording, read_chunks
@@ -468,9 +469,10 @@ def track(
         Samples read at a time (default :data:`TRACK_CHUNK`).
     max_window : int
         Refuse windows longer than this many samples (one window is held in memory).
-    options : mapping, optional
+    options : Options or mapping, optional
         Keyword arguments of the per-window analysis (``analyze_tangential`` or
-        ``normal.analyze_loop``).
+        ``normal.analyze_loop``): :class:`contactlab.tangential.Options` /
+        :class:`contactlab.normal.Options` or a dict of the same names.
     keep_going : bool
         A window the analysis cannot fit gets a row with ``error`` (default) instead of
         stopping the run. Errors of the file itself always stop it.
@@ -507,6 +509,7 @@ def track(
     >>> bool(abs(res.combined()["h0"] - 40.0) < 4 * res.combined()["h0_stderr"])
     True
     """
+    options = as_dict(options)  # a contactlab.tangential/normal.Options or a dict
     if executor is None and threads != 0:
         from concurrent.futures import ThreadPoolExecutor
 

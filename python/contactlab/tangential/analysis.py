@@ -50,6 +50,7 @@ import numpy as np
 
 from .._arrays import as_1d
 from .._moved import forward
+from .._options import takes_options
 from .._physical import check_channel
 from ..errors import ContactLabWarning, InputError
 from ..fitting import FitResult
@@ -424,6 +425,7 @@ def misfit_ratio(raw: FitResult, data: steps.FitData, weights: np.ndarray | None
     return math.sqrt(raw.redchi / noise)
 
 
+@takes_options
 def analyze_tangential(
     recording: Recording | None = None,
     *,
@@ -549,7 +551,7 @@ def analyze_tangential(
     lag.record(res, delay, dropped)
     if warn:
         for wtxt in res.warnings:
-            warnings.warn(wtxt, ContactLabWarning, stacklevel=2)
+            warnings.warn(wtxt, ContactLabWarning, stacklevel=3)
     return res
 
 

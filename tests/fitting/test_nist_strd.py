@@ -3,7 +3,7 @@ difficulty), from both certified start points: at least 6 significant digits on 
 parameter and standard error, or ``success=False`` with a reason — never a wrong answer
 reported as a success. Data and certified values: tests/data/nist/ (see its README).
 
-``python tests/test_nist_strd.py`` prints the table (problem, start, digits on parameters,
+``python tests/fitting/test_nist_strd.py`` prints the table (problem, start, digits on parameters,
 digits on standard errors).
 """
 
@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import nist_strd
 from contactlab.fitting import least_squares_fit
 

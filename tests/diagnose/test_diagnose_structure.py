@@ -16,7 +16,7 @@ from contactlab.diagnose.structure import StructureDiagnosis, diagnose_structure
 from contactlab.errors import InputError
 from contactlab.structure import IdentifiedModel, Structure, identify
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "friction_frame"
+DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "friction_frame"
 MASS = 3.08
 
 

@@ -56,7 +56,7 @@ def test_unknown_attribute_is_an_attribute_error():
 def test_version_has_one_home_matching_pyproject():
     from contactlab._version import __version__
 
-    pyproject = Path(__file__).resolve().parents[1] / "pyproject.toml"
+    pyproject = Path(__file__).resolve().parents[2] / "pyproject.toml"
     version = re.search(r'^version = "([^"]+)"', pyproject.read_text(), re.MULTILINE)
     assert version is not None
     assert contactlab.__version__ == __version__ == version.group(1)

@@ -21,7 +21,7 @@ from contactlab.cli import main
 from contactlab.tangential import frame_friction_force, read_frame
 from frame_sim import simulate_frame
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "friction_frame"
+DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "friction_frame"
 FRAME = "3.0799,0.669,1191"  # the data set's README (kg, N s/m, N/m)
 
 

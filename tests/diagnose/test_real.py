@@ -23,7 +23,7 @@ import contactlab
 from contactlab.diagnose._family import MAX_DELAY_FRACTION
 from contactlab.diagnose.candidates_tangential import CANDIDATES
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "friction_frame"
+DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "friction_frame"
 M, C, K = 3.0799, 0.6690, 1191.0  # kg, N s/m, N/m (README of the data set)
 
 

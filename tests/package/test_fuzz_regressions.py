@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-FUZZ = Path(__file__).resolve().parents[1] / "fuzz"
+FUZZ = Path(__file__).resolve().parents[2] / "fuzz"
 CASES = sorted(
     p for p in (FUZZ / "regressions").glob("*/*") if p.is_file() and not p.name.endswith(".md")
 )

@@ -20,7 +20,7 @@ from contactlab.synthetic.normal import synthetic_recording as normal_recording
 from contactlab.synthetic.tangential import synthetic_recording
 from contactlab.tangential import analyze_tangential
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data"
 
 
 def _reference(t, x, F, drive, lo, hi):

@@ -20,7 +20,7 @@ from contactlab.synthetic.tangential import synthetic_recording
 from contactlab.tangential import analyze_tangential, frame, frame_friction_force, regime
 from frame_sim import simulate_frame
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "friction_frame"
+DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "friction_frame"
 M, C, K = 3.0799, 0.6690, 1191.0
 
 

@@ -14,7 +14,7 @@ import contactlab
 from contactlab.cli import main
 from contactlab.structure import IdentifiedModel, Structure, identify
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data"
 
 
 def _record(joint: str, params: dict, seed: int, n: int = 1500, fs: float = 500.0):

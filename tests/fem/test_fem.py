@@ -332,7 +332,7 @@ def test_real_macro_slip_frame() -> None:
 
     from contactlab import Recording
 
-    data = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "friction_frame"
+    data = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "friction_frame"
     if not data.is_dir():
         pytest.skip("friction_frame data: ../shared/data absent")
     mus = []

@@ -296,7 +296,7 @@ def test_hdf5_declaring_more_than_it_stores(tmp_path):
 def test_matlab_struct_variables_are_named_with_the_way_out(tmp_path):
     """Channels saved inside a struct inside a struct (`data.run.x`) are not read: the message
     says so and how to save them as variables, for MAT v5 and v7.3 (it said 'columns are []').
-    One level of struct (`data.x`) is read: tests/test_io_mat_struct.py."""
+    One level of struct (`data.x`) is read: tests/io/test_mat_struct.py."""
     import h5py
     import scipy.io
 

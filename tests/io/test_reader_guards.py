@@ -22,7 +22,7 @@ from hypothesis import strategies as st
 from contactlab.io import Recording, RecordingError, read_recording, write_recording
 from contactlab.io.mat5check import check_mat5
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 FUZZ = REPO / "fuzz" / "regressions"
 SCIPY_MATLAB_FILES = Path(scipy.io.__file__).parent / "matlab" / "tests" / "data"
 

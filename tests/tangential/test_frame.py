@@ -20,7 +20,7 @@ from contactlab.masing import loop_area
 from contactlab.tangential import analyze_tangential, frame_friction_force
 from frame_sim import simulate_frame
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "friction_frame"
+DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "friction_frame"
 M, C, K = 3.0799, 0.6690, 1191.0  # the README's frame (C, K: the authors' initial guesses)
 
 
