@@ -110,7 +110,11 @@ class KindPath:
         return RegimeDecision("", "", "base fit")
 
     def check_final(
-        self, regime: RegimeDecision, p: dict[str, float], effects: tuple[str, ...]
+        self,
+        regime: RegimeDecision,
+        p: dict[str, float],
+        effects: tuple[str, ...],
+        model_force: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     ) -> tuple[dict[str, Any] | None, str | None]:
         """The final model's physical parameters against ``analyze``'s (None: nothing to
         check), and a sentence when they moved."""
