@@ -87,20 +87,18 @@ def test_reconstructed_coulomb_frame_names_nothing_spurious(seed, fs, fk, ratio)
 
 def test_the_spurious_delay_came_from_the_sticks(monkeypatch):
     """The true friction force of a Coulomb frame (white noise added, no reconstruction):
-    with the sticking samples judged, a negative channel delay is named (it reads the force's
+    with the sticking samples judged, a spurious effect is named (it reads the force's
     change while stuck off the displacement after the stick); weighted out, nothing."""
     t, xm, F, r, rng = _frame(64003, 250.0, 0.8, 1.25)
     Fn = F + rng.normal(0, r.force_noise, F.size)
     assert contactlab.diagnose((t, xm, Fn)).effect_names == []
     monkeypatch.setattr(TangentialFamily, "sticking", lambda self, d: np.zeros(d.t.size, bool))
-    # the library of issue 8 (the element laws added since, a play of 0.3 µm among them,
-    # are other ways to misread the sticks)
-    from contactlab.diagnose.effects import registry
-
-    old = [n for n, e in registry("tangential").items() if e.order < 15]
-    rep = contactlab.diagnose((t, xm, Fn), candidates=old)
-    assert "channel_delay" in rep.effect_names
-    assert rep.final_model.params["tau"] < 0
+    rep = contactlab.diagnose((t, xm, Fn))
+    # judged, the sticks make a spurious effect appear (a negative channel delay in the
+    # library of issue 8; since then a play of 0.3 µm and a 2f load fluctuation, or a viscous
+    # term beside a series spring in the issue-8 library with h0 held at the plateau): each
+    # reads the force's change while stuck off the motion after the stick
+    assert rep.effect_names
 
 
 def test_a_displacement_driven_record_has_no_sticks():

@@ -114,7 +114,7 @@ class KindPath:
         regime: RegimeDecision,
         p: dict[str, float],
         effects: tuple[str, ...],
-        model_force: Any = None,
+        model_force: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     ) -> tuple[dict[str, Any] | None, str | None]:
         """The final model's physical parameters against ``analyze``'s (None: nothing to
         check), and a sentence when they moved (``model_force``: the final model's output,
