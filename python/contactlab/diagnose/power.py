@@ -45,7 +45,7 @@ from typing import Any
 import numpy as np
 
 from ._family import Family, ParamSpec, Prepared
-from .detection import ChannelNoise, effective_variance
+from .detection import ChannelNoise, effective_variance, model_slope
 from .select import MIN_RELATIVE_GAIN, sample_weight, specs_for
 
 __all__ = ["Detectable", "detectable_above", "shape_values", "stated_power"]
@@ -408,7 +408,7 @@ def detectable_above(
         )  # fmt: skip
     st = _setting_cache
     if st is None:
-        slope = family.slope(params, d) if hasattr(family, "slope") else None
+        slope = model_slope(family, params, d)
         st = _setting(d, current, noise, slope, sigma, z, gain_floor, folds, seed)
     base_specs = specs_for(family, effects)
     jb = np.column_stack(
@@ -463,13 +463,16 @@ def stated_power(report: Any, *, seed: int = 0) -> list[Detectable]:
     report : DiagnosisReport
         A tangential or normal diagnosis (:func:`contactlab.diagnose.diagnose`).
     seed : int
-        Seed of the draws.
+        Seed of the draws (0: the bounds the diagnosis stated itself are returned).
 
     Returns
     -------
     list of Detectable
         In the library's order; empty when the report does not carry its data.
     """
+    kept = getattr(report, "not_detected", None)
+    if kept and seed == 0:  # stated by the diagnosis itself, with the same settings and seed
+        return list(kept)
     d = report.prepared
     if d is None or not report.trials:
         return []
@@ -484,33 +487,43 @@ def stated_power(report: Any, *, seed: int = 0) -> list[Detectable]:
         from .detection import channel_noise
 
         noise = channel_noise(d, current.full_residual(d))
-    slope = fam.slope(params, d) if hasattr(fam, "slope") else None
+    slope = model_slope(fam, params, d)
     st = _setting(
         d, current, noise, slope, sigma, float(settings.get("z", 3.0)),
         float(settings.get("gain_floor", 0.05)), int(settings.get("folds", 2)), seed,
     )  # fmt: skip
     names = settings.get("candidates") or list(fam.candidates)
+    return bounds_for(fam, params, effects, names, d, noise, sigma, current, st)
+
+
+def bounds_for(
+    family: Family,
+    params: dict[str, float],
+    effects: tuple[str, ...],
+    names: list[str],
+    d: Prepared,
+    noise: ChannelNoise,
+    sigma: float,
+    current: Any,
+    st: _Setting,
+) -> list[Detectable]:
+    """:func:`detectable_above` of every candidate in ``names`` not in ``effects``; a
+    candidate whose bound cannot be computed (its model refuses the null, a singular
+    projection) gets ``detectable_above`` None and the reason."""
+    from ..errors import ContactLabError
+
     out = []
     for n in names:
-        if n in effects or n not in fam.candidates:
+        if n in effects or n not in family.candidates:
             continue
+        kw = {"noise": noise, "sigma": sigma, "z": st.z, "gain_floor": st.gain_floor}
         try:
             out.append(
                 detectable_above(
-                    fam,
-                    params,
-                    effects,
-                    n,
-                    d,
-                    noise=noise,
-                    sigma=sigma,
-                    z=st.z,
-                    gain_floor=st.gain_floor,
-                    current=current,
-                    _setting_cache=st,
+                    family, params, effects, n, d, current=current, _setting_cache=st, **kw
                 )
             )
-        except (ValueError, FloatingPointError, np.linalg.LinAlgError) as exc:
-            spec = fam.candidates[n].params[0]
+        except (ContactLabError, ValueError, FloatingPointError, np.linalg.LinAlgError) as exc:
+            spec = family.candidates[n].params[0]
             out.append(Detectable(n, spec.name, None, spec.unit, reason=f"not computable: {exc}"))
     return out
