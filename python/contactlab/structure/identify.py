@@ -24,6 +24,7 @@ from __future__ import annotations
 import json
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -537,6 +538,7 @@ def identify(
     masks: dict[str, Any] | None = None,
     joint_dofs: Any = (0, None),
     input_dof: int | None = None,
+    progress: Callable[[str], None] | None = None,
 ) -> IdentifiedModel:
     """Identify ``m``, ``c``, ``k`` and a joint from input ``u`` and response ``y``.
 
@@ -575,6 +577,9 @@ def identify(
         Fit every start on the first ``start_samples`` samples and refine the best.
     estimate_initial_state : bool
         Fit ``x0`` and ``v0`` (else the record starts from rest).
+    progress : callable, optional
+        Called with the stage (``"starts"``, ``"fit"``, ``"errors"``) after every simulation
+        of a single-DOF identification (a progress bar counts them).
 
     Returns
     -------
@@ -649,7 +654,13 @@ def identify(
         tt, uu, yy = t[:n], (u[:n] if u_in is None else u_in), y[:n]
         interp = interpolation if n == t.size else "linear"
 
+        stage = (
+            "errors" if u_in is not None else "fit" if n == t.size and sub == substeps else "starts"
+        )
+
         def res(v: dict[str, float]) -> np.ndarray:
+            if progress is not None:
+                progress(stage)
             try:
                 s = build_structure(joint, v, excitation)
                 kw = {"force": uu} if excitation == "force" else {"base": uu}
