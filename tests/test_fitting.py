@@ -157,3 +157,23 @@ def test_model_errors_during_fit_become_convergence_errors():
 
     with pytest.raises(ConvergenceError, match="bounds"):
         least_squares_fit(bad, {"a": 1.0})
+
+
+def test_text_report_writes_an_undetermined_value_as_such():
+    """No "+/- nan" nor an absurd "-0.0158 +/- 47.4 s" in the text report (issue 31): a
+    parameter without a finite standard error, or with one over 1000 % of its value, is
+    written "not identifiable"."""
+    import dataclasses
+
+    from contactlab.fitting import least_squares_fit
+
+    x = np.linspace(0.0, 1.0, 50)
+    y = 2.0 * x + 0.5
+    res = least_squares_fit(lambda p: p["a"] * x + p["b"] - y, {"a": 1.0, "b": 0.0})
+    a, b = res.params["a"], res.params["b"]
+    res.params["a"] = dataclasses.replace(a, stderr=float("nan"))
+    res.params["b"] = dataclasses.replace(b, value=-0.0158, stderr=47.4)
+    text = res.report()
+    assert "nan" not in text and "47.4 " not in text
+    assert text.count("not identifiable") == 2
+    assert "over 1000 % of the value" in text

@@ -27,6 +27,11 @@ from . import _trf
 from ._arrays import next_fast_len
 from .errors import ConvergenceError, InputError
 
+#: a relative standard error at or above this (1000 %) says the data do not determine the
+#: value: the text report writes "not identifiable" instead of a figure such as "± nan" or
+#: "-0.0158 +/- 47.4 s" (issue 31)
+UNDETERMINED_REL_STDERR = 10.0
+
 
 @dataclass
 class Parameter:
@@ -196,10 +201,13 @@ class FitResult:
             if not p.vary:
                 lines.append(f"    {p.name}: {p.value:.8g}{unit} (fixed)")
                 continue
-            if p.stderr is None:
-                err = "+/- (not determined)"
+            rel = p.rel_stderr if p.stderr is not None else None
+            if p.stderr is None or not math.isfinite(p.stderr):
+                err = "(not identifiable: no finite standard error)"
+            elif rel is not None and not rel < UNDETERMINED_REL_STDERR:
+                err = (f"(not identifiable: standard error {p.stderr:.2g}, over "
+                       f"{100 * UNDETERMINED_REL_STDERR:.0f} % of the value)")  # fmt: skip
             else:
-                rel = p.rel_stderr
                 err = f"+/- {p.stderr:.4g}" + (f" ({100 * rel:.2f}%)" if rel is not None else "")
             flag = "" if p.identifiable is not False else "  [NOT IDENTIFIABLE]"
             init = f" (init = {p.init_value:.6g})" if p.init_value is not None else ""

@@ -750,7 +750,8 @@ def _unsearched_sticks(rev: Any, n_samples: int) -> dict[str, Any]:
     if n_turns < 2 or n_samples < 20:  # where the search would give none either
         return {}
     unknown = ("reversals_with_stick", "stick_duration", "breakaway_force",
-               "breakaway_force_stderr", "velocity_threshold", "smooth_turn_dwell")  # fmt: skip
+               "breakaway_force_stderr", "velocity_threshold", "smooth_turn_dwell",
+               "reversals_with_dwell")  # fmt: skip
     return {"stick_slip": {"n_reversals": n_turns, **dict.fromkeys(unknown, math.nan)}}
 
 
