@@ -72,10 +72,12 @@ def test_parameter_lines_say_not_identifiable():
                         note="not identifiable: the joint never slips"),
         "m": Parameter("m", 1.5, vary=False, unit="kg"),
         "kj": Parameter("kj", 3e3, stderr=float("nan"), unit="N/m"),
+        "c": Parameter("c", 0.02, stderr=47.4, unit="N s/m"),
     })  # fmt: skip
     text = structure_cmd.parameter_lines(fit)
     assert "k  = 4012 ± 21 N/m" in text
     assert "fs = 2 N (not identifiable: the joint never slips)" in text
     assert "m  = 1.5 kg (held fixed)" in text
     assert "kj = 3000 N/m (not identifiable: no finite standard error)" in text
+    assert "c  = 0.02 N s/m (not identifiable: standard error 47, over 1000 % of the value)" in text
     assert "nan" not in text

@@ -180,6 +180,7 @@ def parameter_lines(fit: Any) -> str:
     """The fitted parameters, one a line: ``  k = 3012 ± 25 N/m``; a fixed one says so, an
     unidentified one is written ``not identifiable: <why>`` (never ``± nan``)."""
     from .._html import format_measurement
+    from ..fitting import UNDETERMINED_REL_STDERR
 
     lines = ["fitted parameters (± 1 standard error):"]
     width = max((len(n) for n in fit.params), default=0)
@@ -192,6 +193,10 @@ def parameter_lines(fit: Any) -> str:
             why = p.note if p.note else "no finite standard error"
             why = why.removeprefix("not identifiable: ")
             lines.append(f"{head}{p.value:.6g}{unit} (not identifiable: {why})")
+        elif p.rel_stderr is not None and not p.rel_stderr < UNDETERMINED_REL_STDERR:
+            lines.append(f"{head}{p.value:.6g}{unit} (not identifiable: standard error "
+                         f"{p.stderr:.2g}, over {100 * UNDETERMINED_REL_STDERR:.0f} % of the "
+                         "value)")  # fmt: skip
         else:
             lines.append(f"{head}{format_measurement(p.value, p.stderr)}{unit}")
     return "\n".join(lines)
