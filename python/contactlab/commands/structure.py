@@ -371,7 +371,9 @@ def diagnose_structure_cli(args: argparse.Namespace) -> int:
         matplotlib.use("Agg")
         from ..report.structure import write_diagnosis_html
 
-        print(f"report: {write_diagnosis_html(rep, args.report)}")
+        cmd = made_by(args, "diagnose", args.file, "--structure", args.structure,
+                      "--report", args.report)  # fmt: skip
+        print(f"report: {write_diagnosis_html(rep, args.report, intro=f'Made by: {cmd}')}")
     if text is not None:
         write_text(args.json, text)
     return 0
