@@ -179,8 +179,8 @@ def _identify(args: argparse.Namespace) -> int:
 def parameter_lines(fit: Any) -> str:
     """The fitted parameters, one a line: ``  k = 3012 ± 25 N/m``; a fixed one says so, an
     unidentified one is written ``not identifiable: <why>`` (never ``± nan``)."""
-    from .._html import format_measurement
     from ..fitting import UNDETERMINED_REL_STDERR
+    from ..report import format_measurement
 
     lines = ["fitted parameters (± 1 standard error):"]
     width = max((len(n) for n in fit.params), default=0)
