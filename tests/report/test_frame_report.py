@@ -113,3 +113,17 @@ def test_no_nan_or_absurd_error_in_report_and_console(frame250, tmp_path, capsys
     for m in re.finditer(r"([-+]?\d[\d.e+-]*) \+/- ([\d.e+-]+)", text):
         v, e = float(m.group(1)), float(m.group(2))
         assert e < 1e3 * max(abs(v), 1e-300), m.group(0)
+
+
+def test_identified_fit_off_the_plateau_draws_both(analysis):
+    # an identified exponential fit whose asymptote is off the plateau (the micro-tribometer:
+    # fit 2.606 N, plateau 2.32 N): the curve is drawn with its own h0 in the legend, the
+    # plateau levels beside it, and the title names both
+    a = type(analysis)(**{**analysis.__dict__, "identifiable": True})
+    ax = plot_loop(a)
+    fit_h0 = a.fit.params["h0"].value
+    h0 = a.derived["h0_plateau"][0]
+    labels = [str(line.get_label()) for line in ax.get_lines()]
+    assert any(lab.startswith("Masing fit (its h0 = ") for lab in labels), labels
+    assert f"{fit_h0:.4g}" in ax.get_title() and f"{h0:.4g}" in ax.get_title()
+    assert any("plateau" in str(c.get_label()) for c in ax.collections)

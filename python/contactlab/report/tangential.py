@@ -21,15 +21,19 @@ def _axes(ax: Any) -> Any:
     return ax
 
 
-def _plateau_case(a: TangentialAnalysis) -> bool:
-    """h0 comes from the plateau and the exponential fit identifies neither h0 nor ac: the
-    plots show the plateau levels, not the fit's curve (whose h0 is another number)."""
+def _plateau_levels(a: TangentialAnalysis) -> bool:
+    """h0 comes from the plateau (and its levels are known): the loop plot draws them."""
     return (
-        not a.identifiable
-        and a.identifiability.get("h0_source") == "plateau"
+        a.identifiability.get("h0_source") == "plateau"
         and "h0_plateau" in a.derived
         and "plateau_offset" in a.meta
     )
+
+
+def _plateau_case(a: TangentialAnalysis) -> bool:
+    """h0 comes from the plateau and the exponential fit identifies neither h0 nor ac: the
+    plots show the plateau levels, not the fit's curve (whose h0 is another number)."""
+    return not a.identifiable and _plateau_levels(a)
 
 
 def plateau_residual(a: TangentialAnalysis) -> tuple[np.ndarray, np.ndarray]:
@@ -73,14 +77,18 @@ def plot_loop(analysis: TangentialAnalysis, ax: Any = None, *, show_scatter: boo
                 label=f"±1σ cycle to cycle ({loop.n_cycles} cycles)",
             )
         ax.plot(loop.x * um, loop.F, ".", ms=3, color="C0", label="averaged loop")
-        if plateau:
+        if not plateau:  # the fit's curve, its own h0 named when the plateau's is reported
+            label = "Masing fit"
+            if _plateau_levels(a):
+                label += f" (its h0 = {a.fit.params['h0'].value:.4g} N)"
+            ax.plot(a.x[order] * um, a.F_model[order], "-", color="C3", lw=1.5, label=label)
+        if _plateau_levels(a):
             h0 = a.derived["h0_plateau"][0]
             off = float(a.meta["plateau_offset"])
             lo, hi = float(loop.x.min()) * um, float(loop.x.max()) * um
-            ax.hlines([off + h0, off - h0], lo, hi, colors="C3", linestyles="--", lw=1.5,
+            ax.hlines([off + h0, off - h0], lo, hi, colors="C2" if not plateau else "C3",
+                      linestyles="--", lw=1.5,
                       label=f"plateau levels offset ± h0 (h0 = {h0:.4g} N)")  # fmt: skip
-        else:
-            ax.plot(a.x[order] * um, a.F_model[order], "-", color="C3", lw=1.5, label="Masing fit")
     else:
         s = a.meta.get("fit_start", 0)
         ax.plot(a.x * um, a.F, ",", color="C0", alpha=0.5, label="signal")
