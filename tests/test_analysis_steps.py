@@ -163,7 +163,7 @@ def test_analytic_jacobian_equals_finite_differences(ac, amp_factor, prior):
     above the bins' range put some bins beyond a turn (on their branch's tangent there);
     ac = 3 1/m is a nearly linear loop (ac·A ~ 5e-5), where the ac column's two terms
     cancel."""
-    from contactlab.tangential.analysis import _window_detrended
+    from contactlab.tangential.window import _window_detrended
 
     rec = synthetic_recording(h0=2e6 / ac, ac=ac, amplitude=15e-6, n_cycles=8, fs=1500.0,
                               frequency=2.0, noise=0.02, x_noise=0.01, seed=6911)  # fmt: skip

@@ -101,7 +101,7 @@ def test_interrupt_while_rendering_writes_nothing(quick, tmp_path, capsys, monke
     prev.write_text("PREV", encoding="utf-8")
     (tmp_path / "rep").mkdir()
 
-    def interrupted(report):
+    def interrupted(report, **_kw):  # intro= carries the report's Made by line
         raise KeyboardInterrupt
 
     monkeypatch.setattr(html, "report_files", interrupted)

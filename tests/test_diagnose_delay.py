@@ -13,10 +13,11 @@ from contactlab.tangential.lag import delayed_recording, shifted_recording
 
 
 def test_delay_equals_the_recording_shifted_by_hand():
-    rec = hidden_effect_recording(["channel_delay"], seed=11)
+    rec = hidden_effect_recording(["force_offset"], seed=11)
     d = 0.7 / 1000
-    a = contactlab.diagnose(rec, model="tangential", delay=d, max_effects=1)
-    b = contactlab.diagnose(shifted_recording(rec, d)[0], model="tangential", max_effects=1)
+    kw = {"model": "tangential", "candidates": ["force_offset", "viscous_damping"]}
+    a = contactlab.diagnose(rec, delay=d, **kw)
+    b = contactlab.diagnose(shifted_recording(rec, d)[0], **kw)
     assert a.to_dict() == b.to_dict()
     assert a.location["samples"]["recording"] < rec.t.size  # the shifted-out tail is dropped
 

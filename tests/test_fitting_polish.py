@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from contactlab import fitting
+from contactlab import _lsq
 
 T = np.linspace(0.0, 3.0, 200)
 # an exponential decay with a misfit of the same sign as its curvature (r·r'' > 0): the true
@@ -43,7 +43,7 @@ def _polish(z0: float) -> tuple[float, int, bool]:
         return _fun(z)
 
     z = np.array([z0])
-    out = fitting._polish(fun, _jac, z, _fun(z), _jac(z), np.array([0.0]), np.array([10.0]), ["k"])
+    out = _lsq.polish(fun, _jac, z, _fun(z), _jac(z), np.array([0.0]), np.array([10.0]), ["k"])
     return float(out[0][0]), calls[0], bool(out[3])
 
 
@@ -56,6 +56,6 @@ def test_polish_zigzag_takes_the_parabola_step(monkeypatch):
     assert ok and calls <= 12
     assert abs(z - zmin) < 1e-6 * zmin
     # without the parabola step the same polish spends all its 30 steps, short of the minimum
-    monkeypatch.setattr(fitting, "LINE_SEARCH_OFF", np.inf)
+    monkeypatch.setattr(_lsq, "LINE_SEARCH_OFF", np.inf)
     z_old, calls_old, _ = _polish(1.003 * zmin)
     assert calls_old >= 30 and abs(z_old - zmin) > abs(z - zmin)

@@ -14,7 +14,7 @@ from contactlab import InputError, _core
 from contactlab.fitting import least_squares_fit
 from contactlab.synthetic.tangential import synthetic_recording
 from contactlab.tangential import steps
-from contactlab.tangential.analysis import _window_detrended
+from contactlab.tangential.window import _window_detrended
 
 _OPTS = {"n_points": None, "rel_threshold": 0.5, "min_cycles": 2, "detrend": True}
 

@@ -7,7 +7,7 @@ import importlib
 
 import pytest
 
-MODULES = ["loop", "models", "synthetic", "stiffness", "compare"]
+MODULES = ["loop", "models", "pressure", "stiffness", "compare"]
 
 
 @pytest.mark.parametrize("name", MODULES)

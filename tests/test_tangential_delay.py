@@ -11,7 +11,7 @@ import pytest
 import contactlab
 from contactlab.errors import InputError
 from contactlab.tangential import analyze_tangential
-from contactlab.tangential.analysis import analyze_window
+from contactlab.tangential.window import analyze_window
 
 H0, AC, A = 40.0, 4e4, 20e-6
 

@@ -245,7 +245,7 @@ _WINDOW_CASES = {
 @pytest.mark.parametrize("invert", [False, True])
 def test_window_analysis_equals_the_whole_analysis(case, invert):
     """analyze_window (one fold, reused) gives analyze_tangential's numbers and verdicts."""
-    from contactlab.tangential.analysis import analyze_window
+    from contactlab.tangential.window import analyze_window
 
     rec = synthetic_recording(**_WINDOW_CASES[case])
     if invert:
@@ -312,7 +312,7 @@ def test_negated_loop_is_the_fold_of_minus_F():
 
 
 def test_window_analysis_force_sign_given_or_undecided():
-    from contactlab.tangential.analysis import analyze_window
+    from contactlab.tangential.window import analyze_window
 
     rec = synthetic_recording(**_WINDOW_CASES["pre-sliding"])
     fixed = analyze_window(rec, force_sign=-1).to_dict()
@@ -343,7 +343,7 @@ def test_window_analysis_force_sign_given_or_undecided():
 def test_window_analysis_names_a_bad_sample(channel, index, value, message):
     """The window path scans x and F once (check_channel) and skips the conversions' second
     scan: a bad sample is still named (the messages the window path gave before)."""
-    from contactlab.tangential.analysis import analyze_window
+    from contactlab.tangential.window import analyze_window
 
     rec = synthetic_recording(**_WINDOW_CASES["drifts"])
     t, x, F = rec.t.copy(), rec["x"].copy(), rec["F"].copy()
@@ -531,7 +531,7 @@ def test_window_fold_spread_is_exact_on_the_cells(seed, offset, spread):
 def test_detrend_pair_is_numpys_expression_bit_for_bit(seed, n, exp, slopes):
     """The window's drift removal in one Rust pass equals numpy's ``v - s·(t - tm)``."""
     from contactlab import _core
-    from contactlab.tangential.analysis import _detrended
+    from contactlab.tangential.window import _detrended
 
     rng = np.random.default_rng(seed)
     t = np.cumsum(rng.uniform(1e-4, 1.0, n))

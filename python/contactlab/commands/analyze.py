@@ -15,8 +15,6 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import InputError
-from ..studies.manifest import entry_from_file
-from ..studies.study import run_study
 from ._common import (
     FORCE_SIGN_CHOICES,
     add_frame_flags,
@@ -253,6 +251,8 @@ def _auto_streamed(
 
 
 def _handler(args: argparse.Namespace) -> int:
+    from ..studies.manifest import entry_from_file
+
     frame = frame_option(args)
     columns = parse_columns(args.columns)
     check_output_targets(json_out=args.json, report=args.report, inputs=args.files)
@@ -335,6 +335,8 @@ def _in_memory(
     args: argparse.Namespace, entries: list, frame: Any, topts: dict, nopts: dict, ex: Any
 ) -> int:
     """``analyze`` of recordings read whole: on ``ex`` (a process pool) or serially."""
+    from ..studies.study import run_study
+
     result = run_study(entries, progress=args.progress, keep_going=args.keep_going,
                        tangential_options=topts, normal_options=nopts, executor=ex,
                        keep_recordings=True)  # fmt: skip
@@ -406,6 +408,7 @@ def _with_long(
     analysed whole."""
     from .. import __version__
     from ..errors import ContactLabError
+    from ..studies.study import run_study
 
     say = sys.stderr if args.json == "-" else sys.stdout
     small = [e for i, e in enumerate(entries) if i not in big]

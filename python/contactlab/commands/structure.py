@@ -14,9 +14,7 @@ import re
 import sys
 import warnings
 from pathlib import Path
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from ..errors import InputError
 from ._common import (
@@ -29,11 +27,16 @@ from ._common import (
     write_json,
 )
 
+if TYPE_CHECKING:
+    import numpy as np
+
 _UNIT = re.compile(r"(?:\[([^\]]+)\]|_([A-Za-z]+))\s*$")
 
 
 def read_table(path: str) -> dict[str, np.ndarray]:
     """Columns of a CSV (header line, optional ``#``), converted to SI from unit suffixes."""
+    import numpy as np
+
     from ..io.csv import read_header, sniff_encoding
     from ..studies.manifest import unit_factor
 
@@ -97,6 +100,8 @@ def _pick(cols: dict[str, np.ndarray], want: str | None, guesses: tuple[str, ...
 
 
 def _time(cols: dict[str, np.ndarray], args: argparse.Namespace, n: int, path: str) -> np.ndarray:
+    import numpy as np
+
     for name in cols:
         if name.lower() in ("t", "time") or name.lower().startswith(("t_", "t [", "time")):
             return cols[name]
@@ -106,6 +111,8 @@ def _time(cols: dict[str, np.ndarray], args: argparse.Namespace, n: int, path: s
 
 
 def _identify(args: argparse.Namespace) -> int:
+    import numpy as np
+
     from ..report import commit_outputs
     from .structure_verbs import identify_record
 
@@ -238,6 +245,8 @@ def _progress_bar(progress: bool | None) -> _Bar | None:
 
 
 def _masses(text: str | None) -> list[float] | None:
+    import numpy as np
+
     if text is None:
         return None
     try:
@@ -285,6 +294,8 @@ def _joint_dofs(text: str) -> tuple[int, int | None]:
 
 def simulate_structure(args: argparse.Namespace) -> int:
     """Handler of ``contactlab simulate structure OUT --structure MODEL --input FILE``."""
+    import numpy as np
+
     from .._io_atomic import write_text
     from ..structure import IdentifiedModel, Structure
 

@@ -268,7 +268,7 @@ class DiagnosisReport:
                 out.append(wrap(f"why plausible: {e.plausibility}", "  ", "    "))
         coeffs = self.final_model.coefficients()
         if coeffs is not None and ({"a", "kappa"} & set(self.final_model.params)):
-            out.append(
+            law = (
                 "Stiffness law (eq. 6): "
                 + ", ".join(
                     f"{k} = {v:.4g} {u}"
@@ -276,6 +276,7 @@ class DiagnosisReport:
                 )
                 + f" (κ and a are relative to δ_r = {self.final_model.context['delta_r']:.4g} m)"
             )
+            out.append(wrap(law, "", "    "))
         unit = getattr(self.final_model.family, "output_unit", "")
         out += ["", self.table(unit), self.noise_text()]
         if self.channel_noise is not None:  # issue 29: stated power, unexplained structure
@@ -284,9 +285,9 @@ class DiagnosisReport:
                 f"channel noise: input {cn.input:.3g} {cn.input_unit}, output "
                 f"{cn.output:.3g} {cn.output_unit}"
             )
-            out += [f"  - {b.sentence()}" for b in self.not_detected]
+            out += [wrap(b.sentence(), "  - ", "    ") for b in self.not_detected]
         if self.unexplained is not None:
-            out.append(self.unexplained.sentence())
+            out.append(wrap(self.unexplained.sentence(), "", "    "))
         return "\n".join(out)
 
     # -- figures ------------------------------------------------------------------------------
