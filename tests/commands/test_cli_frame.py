@@ -215,7 +215,7 @@ def test_frame_report_of_a_sliding_loop(sim_file, tmp_path):
 
     rec = read_frame(sim_file[0], 3.08, 0.669, 1191.0).recording()
     title = plot_loop(analyze_tangential(rec, warn=False)).get_title()
-    assert "(plateau)" in title and "ac ≥" in title
+    assert "(plateau, dashed)" in title and "ac ≥" in title
     header = (out / "study_tangential.csv").read_text().splitlines()[0]
     assert "frame_window [samples]" in header and "frame_force_noise [N]" in header
 

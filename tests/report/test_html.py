@@ -69,7 +69,7 @@ def test_report_is_self_contained_and_pngs_match(tmp_path):
     assert "link" not in p.tags and "script" not in p.tags
     assert 'id="results"' in text and 'id="results-2"' in text
     assert "Test &lt;report&gt;" in text and "&lt;N&gt;" in text
-    assert "40.00 ± 0.25" in text and "h0 [N]" in text
+    assert "40.00 ± 0.25" in text.replace("\u00a0", " ") and "h0 [N]" in text
     assert re.search(r"<td>—</td>", text)  # NaN shown as a dash, not 'nan'
     assert plt.get_fignums() == []  # figures closed after rendering
 

@@ -203,12 +203,13 @@ def _mdof_loop(ax: Any, model: IdentifiedModel, sim: Any, t: np.ndarray, u: np.n
 
 
 # ------------------------------------------------------------------ structure diagnosis
-def build_diagnosis_report(diag: Any) -> Report:
+def build_diagnosis_report(diag: Any, intro: str | None = None) -> Report:
     """The HTML report of a :class:`~contactlab.diagnose.structure.StructureDiagnosis`:
     findings, the named effects with their parameters ± standard errors, the held-out error
     after each step, measured against simulated response (base and final model), the joint's
     loop, the residual before and after (time and spectrum), the unexplained part with where
-    it lives, and every candidate's verdict."""
+    it lives, and every candidate's verdict. ``intro`` (the "Made by" line of a command-line
+    run) heads it."""
 
     from .._html import format_measurement
 
@@ -227,6 +228,8 @@ def build_diagnosis_report(diag: Any) -> Report:
         "refitted on the first part of the record and judged on the held-out end, which no fit "
         "saw (dashed line in the figures).",
     )
+    if intro:
+        r.text(intro)
     _diag_findings(r, diag, format_measurement)
     _diag_tables(r, diag, sigma)
     _diag_response(r, diag, base, final, sigma)
@@ -345,7 +348,11 @@ def _diag_joint_loop(r: Report, diag: Any, base: np.ndarray, final: np.ndarray) 
                          label="final model: all joint elements")  # fmt: skip
     ax1.set_xlabel("displacement of the mass [m]")
     ax1.set_ylabel("joint force [N]")
-    ax1.legend(loc="upper left", fontsize=8)
+    if ax1.get_lines():
+        ax1.legend(loc="upper left", fontsize=8)
+    else:  # a linear model has no joint (matplotlib warned of a legend with no entries)
+        ax1.text(0.5, 0.5, f"no joint force: the {diag.joint} model has no joint",
+                 ha="center", va="center", transform=ax1.transAxes)  # fmt: skip
     r.figure(fig, "joint-loop", "The joint's force against the displacement on the held-out "
              "part (simulated).", dpi=110)  # fmt: skip
 
@@ -405,7 +412,7 @@ def _pm(value: float, stderr: float | None, fmt: Any) -> str:
     return str(fmt(value, stderr))
 
 
-def write_diagnosis_html(diag: Any, directory: Any) -> Path:
+def write_diagnosis_html(diag: Any, directory: Any, intro: str | None = None) -> Path:
     """Write a structure diagnosis as ``diagnose.html`` (see :func:`build_diagnosis_report`),
     its figures under ``figures/`` and ``diagnose.json`` into ``directory``, all or nothing.
 
@@ -415,12 +422,14 @@ def write_diagnosis_html(diag: Any, directory: Any) -> Path:
         The result of :func:`contactlab.diagnose.diagnose_structure`.
     directory : path
         Output folder (created if missing).
+    intro : str, optional
+        A line heading the report (the command line that made it).
 
     Returns
     -------
     Path
         The HTML file written.
     """
-    rep = build_diagnosis_report(diag)
+    rep = build_diagnosis_report(diag, intro)
     extra = {"diagnose.json": (diag.to_json() + "\n").encode("utf-8")}
     return rep.write(directory, extra=extra, html_name="diagnose.html")[0]

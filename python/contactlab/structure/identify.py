@@ -24,6 +24,7 @@ from __future__ import annotations
 import json
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -537,6 +538,7 @@ def identify(
     masks: dict[str, Any] | None = None,
     joint_dofs: Any = (0, None),
     input_dof: int | None = None,
+    progress: Callable[[str], None] | None = None,
 ) -> IdentifiedModel:
     """Identify ``m``, ``c``, ``k`` and a joint from input ``u`` and response ``y``.
 
@@ -575,6 +577,9 @@ def identify(
         Fit every start on the first ``start_samples`` samples and refine the best.
     estimate_initial_state : bool
         Fit ``x0`` and ``v0`` (else the record starts from rest).
+    progress : callable, optional
+        Called with the stage (``"starts"``, ``"fit"``, ``"errors"``) after every simulation
+        of a single-DOF identification (a progress bar counts them).
 
     Returns
     -------
@@ -602,7 +607,7 @@ def identify(
         periodic = interpolation == "fourier"
     lin, lins = _linear_starts(t, u, y, excitation, mass, bool(periodic))
 
-    residual_on = _SdofResidual(joint, excitation, t, u, y, interpolation, substeps)
+    residual_on = _SdofResidual(joint, excitation, t, u, y, interpolation, substeps, progress)
 
     starts = _starts(joint)
     records: list[dict[str, Any]] = []
@@ -699,22 +704,28 @@ def _linear_starts(
 class _SdofResidual:
     """``residual_on(n, sub, u_in)``: the output-error residual of the first ``n`` samples
     (simulated with ``sub`` substeps, the input ``u_in`` if given) as a function of the
-    fitted values."""
+    fitted values. ``progress`` (optional) is called with the stage after each simulation."""
 
     def __init__(
         self, joint: str, excitation: str, t: np.ndarray, u: np.ndarray, y: np.ndarray,
-        interpolation: str, substeps: int,
+        interpolation: str, substeps: int, progress: Callable[[str], None] | None = None,
     ) -> None:  # fmt: skip
         self.joint, self.excitation, self.t, self.u, self.y = joint, excitation, t, u, y
         self.interpolation, self.substeps = interpolation, substeps
+        self.progress = progress
 
     def __call__(self, n: int, sub: int | None = None, u_in: np.ndarray | None = None) -> Any:
         sub = self.substeps if sub is None else sub
         t, u, y, joint, excitation = self.t, self.u, self.y, self.joint, self.excitation
         tt, uu, yy = t[:n], (u[:n] if u_in is None else u_in), y[:n]
         interp = self.interpolation if n == t.size else "linear"
+        progress = self.progress
+        full = n == t.size and sub == self.substeps
+        stage = "errors" if u_in is not None else "fit" if full else "starts"
 
         def res(v: dict[str, float]) -> np.ndarray:
+            if progress is not None:
+                progress(stage)
             try:
                 s = build_structure(joint, v, excitation)
                 kw = {"force": uu} if excitation == "force" else {"base": uu}

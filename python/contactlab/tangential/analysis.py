@@ -730,6 +730,12 @@ def _analyze(
             "orientation_reason": ori.reason,
             "orientation_by": ori.by,
             "loop_area_recorded": (ori.loop_area, ori.loop_area_stderr),
+            # the plateau levels' mid-point and branch length, for the loop plot's levels
+            **(
+                {"plateau_offset": regime.plateau.offset, "plateau_dx95": regime.plateau.dx95}
+                if regime.plateau is not None
+                else {}
+            ),
         },
     )
 
