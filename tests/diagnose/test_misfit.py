@@ -79,3 +79,14 @@ def test_tanh_virgin_curve_is_flagged() -> None:
     assert rep.unexplained is not None and rep.unexplained.flagged, rep.effect_names
     assert any("systematic misfit that no candidate explains" in w for w in rep.where)
     assert rep.to_dict()["unexplained"]["flagged"] is True
+
+
+@pytest.mark.parametrize("nu", [2, 3, 5, 20, 100])
+def test_t_quantile_equals_scipys(nu):
+    """The diagnosis imports no SciPy: its own Student-t quantile against scipy.stats."""
+    from scipy.stats import t
+
+    from contactlab.diagnose.misfit import t_quantile
+
+    for p in (0.6, 0.975, 0.999, 1 - 0.03 / 80):
+        assert t_quantile(p, nu) == pytest.approx(t.ppf(p, nu), rel=1e-10)

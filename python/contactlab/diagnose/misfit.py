@@ -37,6 +37,7 @@ output's units and as a percentage of the output's range.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
@@ -226,6 +227,35 @@ def _branch_of(d: Prepared) -> np.ndarray:
     return out
 
 
+def t_quantile(p: float, nu: int) -> float:
+    """Student's t quantile of probability ``p`` (> 0.5) with ``nu`` degrees of freedom: the
+    Cornish-Fisher expansion about the normal quantile (Abramowitz & Stegun 26.7.5) refined
+    by Newton steps on the distribution function, integrated from the density by Simpson's
+    rule (within 1e-12 of SciPy's quantile for nu >= 2, 3e-4 for nu = 1, in the tests). Numpy
+    and the standard library only: a diagnosis imports no SciPy."""
+    from statistics import NormalDist
+
+    z = NormalDist().inv_cdf(p)
+    n = float(nu)
+    z2 = z * z
+    x = z + (z2 + 1.0) * z / (4.0 * n) + ((5.0 * z2 + 16.0) * z2 + 3.0) * z / (96.0 * n * n)
+    log_c = math.lgamma((n + 1.0) / 2.0) - math.lgamma(n / 2.0) - 0.5 * math.log(n * math.pi)
+
+    def pdf(s: np.ndarray) -> np.ndarray:
+        return np.exp(log_c - (n + 1.0) / 2.0 * np.log1p(s * s / n))
+
+    for _ in range(8):
+        s = np.linspace(0.0, x, 4001)
+        w = np.ones(s.size)
+        w[1:-1:2], w[2:-1:2] = 4.0, 2.0
+        cdf = 0.5 + float(np.sum(w * pdf(s))) * (x / 4000.0) / 3.0
+        step = (cdf - p) / float(pdf(np.array([x]))[0])
+        x -= step
+        if abs(step) < 1e-12 * abs(x):
+            break
+    return float(x)
+
+
 def unexplained_structure(
     d: Prepared,
     residual: np.ndarray,
@@ -345,9 +375,7 @@ def unexplained_structure(
     p_val = float(1.0 - np.searchsorted(sums, T, side="left") / sums.size)
     flagged = T > thr
     # where: bins beyond a Bonferroni level of the two-sided t over the bins
-    from scipy.stats import t as student
-
-    t_crit = float(student.ppf(1.0 - 0.5 * alpha / nb, m - 1))
+    t_crit = t_quantile(1.0 - 0.5 * alpha / nb, m - 1)
     full_idx = np.flatnonzero(full)
     prof_mean = np.full(2 * bins, np.nan)
     prof_t = np.full(2 * bins, np.nan)
