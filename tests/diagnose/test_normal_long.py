@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 import contactlab
+from contactlab.diagnose import _prepare as prep
 from contactlab.diagnose import workflow as wf
 from contactlab.diagnose._family import Prepared
 from contactlab.diagnose.candidates_normal import NormalFamily
@@ -61,7 +62,7 @@ def test_kept_model_is_the_full_rate_model(monkeypatch, effect):
     ideal loss is non-causal and sees the periodic continuation after the record, whose
     length in time differs with the rate (FFT lengths): 1.5e-2 here, of which the last 5 %
     of the record 0.19 and the rest 6.7e-3; 1.8e-3 at 325 491 samples kept one in 14."""
-    monkeypatch.setattr(wf, "MAX_SAMPLES", 1000)
+    monkeypatch.setattr(prep, "MAX_SAMPLES", 1000)
     rec = _record(effect)
     t, u, y = rec.t, rec["p"], rec["delta"]
     fam = NormalFamily()
@@ -102,7 +103,7 @@ def test_kept_slopes_matter():
 def test_long_normal_record_diagnosed_over_its_whole_length(monkeypatch):
     """A delay needs the record's several frequency blocks: on a long record (kept one in
     ~30 here) it is named with its size, and the report says the whole length was used."""
-    monkeypatch.setattr(wf, "MAX_SAMPLES", 2000)
+    monkeypatch.setattr(prep, "MAX_SAMPLES", 2000)
     rec = hidden_effect_recording(
         ["channel_delay"], model="normal", seed=70123, cycles_per_block=24,
         samples_per_cycle=800, magnitude=0.1,
@@ -157,7 +158,7 @@ def test_delayed_model_is_smooth_across_whole_samples(monkeypatch):
     """The kept model's derivative in the delay is the same on both sides of a whole number
     of raw samples (cubic Hermite between them): with linear interpolation it jumps there and
     a fit's Gauss-Newton steps stalled (9.39 ms stuck at 10.00 ms on a 1 kHz record)."""
-    monkeypatch.setattr(wf, "MAX_SAMPLES", 1000)
+    monkeypatch.setattr(prep, "MAX_SAMPLES", 1000)
     rec = _record("channel_delay")
     t, u, y = rec.t, rec["p"], rec["delta"]
     fam = NormalFamily()
@@ -186,11 +187,11 @@ def test_record_of_short_cycles_is_cut_not_thinned():
     t, u, y = rec.t[::40], rec["p"][::40], rec["delta"][::40]
     t = np.arange(4 * t.size) * (t[1] - t[0])
     u, y = np.tile(u, 4), np.tile(y, 4)
-    saved = wf.MAX_SAMPLES
+    saved = prep.MAX_SAMPLES
     try:
-        wf.MAX_SAMPLES = 1000
+        prep.MAX_SAMPLES = 1000  # where subsample_normal reads it (workflow re-exports it)
         d, how = wf.subsample_normal(t, u, y)
     finally:
-        wf.MAX_SAMPLES = saved
+        prep.MAX_SAMPLES = saved
     assert d.t.size == 1000 and d.extra["raw_input"].q == 1
     assert "kept one sample" not in how and "diagnosed on its first" in how
