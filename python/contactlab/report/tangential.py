@@ -174,7 +174,7 @@ def plot_residuals(analysis: TangentialAnalysis, ax: Any = None) -> Any:
 
 
 def residual_title(shown: np.ndarray) -> str:
-    """``RMS = ... N, n points`` of exactly the residuals ``shown`` (unweighted:
+    """The title ``RMS = <value> N, <n> points`` of exactly the residuals ``shown`` (unweighted:
     the fit's reduced χ² of a weighted fit is another number)."""
     r = np.asarray(shown, dtype=float)
     r = r[np.isfinite(r)]
