@@ -50,7 +50,10 @@ FRICTION_LAWS = [
     "bouc_wen",
     "maxwell_slip",
     "backlash:dahl",
+    "backlash:lugre",
     "gms",
+    "backlash:jenkins+cm",
+    "dahl+cm",
 ]
 
 
@@ -337,7 +340,7 @@ def speed() -> None:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--part", default="all", choices=("friction", "beam", "tribo", "speed", "all"))
-    ap.add_argument("--max-samples", type=int, default=4000)
+    ap.add_argument("--max-samples", type=int, default=20000)
     ap.add_argument("--jobs", type=int, default=2, help="processes of the cross-validation")
     ap.add_argument("--laws", help="comma-separated laws of the cross-validation (default: all; "
                     "'<law>+cm' adds a parallel damping and inertia)")  # fmt: skip

@@ -68,7 +68,10 @@ class _Flaky(Jenkins):
     cannot be integrated at some amplitude). Its own name keeps it off the closed forms (its
     cycles are simulated); its force is a plain Jenkins element's."""
 
-    name = "flaky"
+    name = "flaky"  # not "jenkins": no closed form, the simulated-cycle route
+
+    def spec(self):
+        return ("jenkins", [self.k, self.fs], [])  # the core runs it as a Jenkins element
 
     def force(self, t, x, x0=0.0):
         if np.max(np.abs(x)) > 1e-3:

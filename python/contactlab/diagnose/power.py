@@ -108,7 +108,7 @@ class Detectable:
             "parameter": self.parameter,
             "detectable_above": self.detectable_above,
             "unit": self.unit,
-            "null": self.null if self.null is None or np.isfinite(self.null) else None,
+            "null": self.null if self.null is not None and np.isfinite(self.null) else None,
             "relative_size": self.relative_size,
             "power": POWER,
             "at": dict(self.at),
@@ -401,6 +401,15 @@ def detectable_above(
         if np.isfinite(s.null):
             p0[s.name] = s.null
     trial = (*effects, name)
+    if not any(np.isfinite(s.null) for s in cand.params):
+        first = cand.params[0]
+        return Detectable(
+            name, first.name, None, first.unit, float("nan"), None, shape,
+            reason=(
+                "no parameter value means absent (the effect replaces the element's shape, "
+                "not a size away from a null): no bound to state"
+            ),
+        )  # fmt: skip
     if not family.check(trial):
         return Detectable(
             name, cand.params[0].name, None, cand.params[0].unit,
@@ -433,11 +442,11 @@ def detectable_above(
         per[s.name] = b
         rel[s.name] = None if b is None else b * float(np.sqrt(np.mean(j * j))) / st.y_rms
     mags = [s for s in cand.params if np.isfinite(s.null)]
-    if not mags:  # an element law that replaces the base's (no value means "absent")
-        first = cand.params[0]
+    if not mags:  # no parameter whose value means "absent" (e.g. a frame's fixed mass)
+        s0 = cand.params[0]
         return Detectable(
-            name, first.name, None, first.unit, first.null, None, shape, per,
-            reason="not nested in the base model: no parameter value means 'absent'",
+            name, s0.name, None, s0.unit, None, None, shape, per,
+            reason="no parameter of this effect has a value meaning 'absent': no bound",
         )  # fmt: skip
     if not per or any(v is None for v in per.values()):
         worst = next((s for s in mags if per.get(s.name) is None), mags[0])

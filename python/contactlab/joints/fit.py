@@ -284,9 +284,11 @@ class _Prepared:
 
     rec: JointRecord
     run: np.ndarray  # indices of the samples the law is driven with
-    cmp: np.ndarray  # positions within ``run`` compared
+    cmp: np.ndarray | None  # positions within ``run`` compared (None: all of them)
     F: np.ndarray  # measured force at the compared samples
     phi: np.ndarray  # linear terms' columns at the compared samples
+    t: np.ndarray  # time and displacement at ``run`` (taken once, not at every evaluation)
+    x: np.ndarray
 
 
 def _prepare(recs: list[JointRecord], terms: Sequence[str],
@@ -302,16 +304,20 @@ def _prepare(recs: list[JointRecord], terms: Sequence[str],
         if cmp.size == 0:
             cmp = np.arange(run.size)
         phi = _term_columns(terms, r.t, r.x)[run[cmp]]
-        out.append(_Prepared(r, run, cmp, F[run[cmp]], phi))
+        every_one = cmp.size == run.size
+        t_run = r.t if run.size == r.n else np.ascontiguousarray(r.t[run])
+        x_run = r.x if run.size == r.n else np.ascontiguousarray(r.x[run])
+        out.append(_Prepared(r, run, None if every_one else cmp, F[run[cmp]], phi, t_run,
+                             x_run))  # fmt: skip
     return out
 
 
 def _law_forces(law: Any, prep: list[_Prepared]) -> np.ndarray:
     parts = []
     for p in prep:
-        t, x = p.rec.t[p.run], p.rec.x[p.run]
-        parts.append(np.asarray(law.force(t, x, float(x[0])), dtype=float)[p.cmp])
-    return np.concatenate(parts)
+        f = np.asarray(law.force(p.t, p.x, float(p.x[0])), dtype=float)
+        parts.append(f if p.cmp is None else f[p.cmp])
+    return parts[0] if len(parts) == 1 else np.concatenate(parts)
 
 
 def _guarded(residual: Any, Fm: np.ndarray) -> Any:
@@ -647,6 +653,8 @@ def fit(
 
         def residual(v: Mapping[str, float]) -> np.ndarray:
             P = _law_forces(law_of(v), prep)
+            if not terms:
+                return P - Fm
             cols = np.column_stack([phi, np.abs(P)]) if asym else phi
             beta = _linear_solve(cols, Fm - P)
             return P + cols @ beta - Fm

@@ -20,7 +20,7 @@ windows:
 - ``stick_slip``: ``n_reversals`` summed over the windows; the search's counts and means
   over the windows that searched for sticks (null where none did: a streamed window of a
   pre-sliding or transition loop counts its reversals but does not search them, see
-  :func:`contactlab.tangential.analysis.analyze_window`).
+  :func:`contactlab.tangential.window.analyze_window`).
 
 ``streamed`` (True), ``streamed_reason``, ``n_windows``, ``n_samples`` and ``every`` say how
 it was made.
