@@ -83,7 +83,8 @@ def run(name: str, rec: object, sign: int) -> dict:
         rep = contactlab.diagnose(rec)
     doc = rep.to_dict()
     p = rep.final_model.params
-    period = float(doc.get("period", np.nan)) if "period" in doc else np.nan
+    d = rep.prepared
+    period = float(d.cycles.period_samples * d.dt) if d is not None else np.nan
     h0_an = an_d.get("h0")
     named = rep.effect_names
     out = {
@@ -102,6 +103,7 @@ def run(name: str, rec: object, sign: int) -> dict:
         "period": period,
         "tau_share": (abs(p["tau"]) / period if "channel_delay" in named and period > 0 else 0.0),
         "where": rep.where,
+        "h0_check": doc.get("h0_check"),
     }
     return out
 

@@ -1,6 +1,6 @@
 """Diagnosis on structures (issue 10): how often is the right effect named?
 
-Base-excited frames with a Jenkins joint to the wall (tests/test_structure_diagnose.py's
+Base-excited frames with a Jenkins joint to the wall (tests/diagnose/test_diagnose_structure.py's
 generator) with each missing effect (none, joint_damping, second_joint, base_coupling), on
 fresh seeds, at two sampling rates (4 ms and 2 ms), started from rest (a start-up transient),
 with 0.2 % noise on the base and the response channels, optionally both channels through the

@@ -1,7 +1,7 @@
 """Sphinx configuration of the contactlab documentation (``make docs``).
 
 Sphinx with numpydoc (the package's docstrings are numpydoc), MyST (the guides are Markdown,
-so their ```python blocks are run by ``tests/test_readme.py`` like the README's) and
+so their ```python blocks are run by ``tests/package/test_readme.py`` like the README's) and
 sphinx-gallery (``docs/examples/plot_*.py`` run at every build). Built with ``-W --keep-going
 -n``: any warning, an unresolved cross-reference included, fails the build.
 """
@@ -74,7 +74,7 @@ numpydoc_xref_param_type = False
 # resolve from another module's page; they render as plain code. The API pages themselves
 # are generated from the package, so they cannot point to a module that does not exist.
 nitpicky = True
-nitpick_ignore_regex = [(r"py:.*", r".*")]
+nitpick_ignore_regex = [(r"py:.*", r"(?s).*")]  # (?s): a target broken over two lines too
 
 
 def public_modules() -> list[str]:

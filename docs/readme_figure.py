@@ -18,7 +18,8 @@ import matplotlib.pyplot as plt
 
 from contactlab.data import data_dir
 from contactlab.io import read_recording
-from contactlab.tangential import analyze_tangential, plot_loop
+from contactlab.report.tangential import plot_loop
+from contactlab.tangential import analyze_tangential
 
 OUT = Path(__file__).resolve().parent / "_static" / "readme-loop.png"
 

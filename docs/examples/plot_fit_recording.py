@@ -10,7 +10,9 @@ from the loop area.
 
 import matplotlib.pyplot as plt
 
-from contactlab.tangential import analyze_tangential, plot_loop, synthetic_recording
+from contactlab.report.tangential import plot_loop
+from contactlab.synthetic.tangential import synthetic_recording
+from contactlab.tangential import analyze_tangential
 
 rec = synthetic_recording(
     h0=40.0, ac=4e4, amplitude=20e-6, n_cycles=6, fs=2000.0, noise=0.01, seed=1

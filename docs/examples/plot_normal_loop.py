@@ -10,8 +10,9 @@ dissipated per cycle ``E_d`` and the energy dissipation coefficient ``ψ``.
 import matplotlib.pyplot as plt
 
 import contactlab.normal as cn
+from contactlab.synthetic.normal import synthetic_recording
 
-t, p, delta = cn.synthetic_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=4, seed=0)
+t, p, delta = synthetic_recording(p0=0.5e6, pa=0.4e6, omega=1.0, n_cycles=4, seed=0)
 loop = cn.analyze_loop(t, p, delta)
 print(f"E_d = {loop.E_d:.4g} J/m², psi = {loop.psi:.4f}, k_tan = {loop.k_tan:.4g} Pa/m")
 for curve, coeffs in loop.table2().items():

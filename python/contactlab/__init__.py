@@ -16,7 +16,15 @@ if TYPE_CHECKING:
     from . import diagnose, normal
     from .fitting import FitResult, Parameter, least_squares_fit
     from .io import Recording, RecordingError, read_recording, write_recording
-    from .masing import CycleTable, Masing, MasingOperator, cycle_energies, force_many, loop_area
+    from .masing import (
+        CycleTable,
+        Masing,
+        MasingOperator,
+        cycle_energies,
+        force_many,
+        loop_area,
+        loop_areas,
+    )
     from .simulation import Simulator
     from .studies.tracking import TrackResult, track
     from .tangential import TangentialAnalysis, analyze_tangential
@@ -39,6 +47,7 @@ _LAZY = {
     "MasingOperator": "masing",
     "cycle_energies": "masing",
     "loop_area": "masing",
+    "loop_areas": "masing",
     "force_many": "masing",
     "TangentialAnalysis": "tangential",
     "analyze_tangential": "tangential",
@@ -84,6 +93,7 @@ __all__ = [
     "force_many",
     "least_squares_fit",
     "loop_area",
+    "loop_areas",
     "normal",
     "read_recording",
     "track",

@@ -7,8 +7,8 @@ They follow :func:`scipy.signal.savgol_coeffs`, :func:`scipy.signal.savgol_filte
 (``mode="interp"``), :func:`scipy.signal.decimate` (``ftype="fir", zero_phase=True``) and
 :func:`scipy.signal.hilbert` and :func:`scipy.signal.welch` (Hann window, half overlap, linear
 detrend, density scaling) step for step (same designs, same edge handling, same output
-alignment) and agree with them to rounding (tests/test_diagnose_speed.py,
-tests/test_filters.py). They exist because importing :mod:`scipy.signal` (which imports
+alignment) and agree with them to rounding (tests/diagnose/test_fast_paths.py,
+tests/base/test_filters.py). They exist because importing :mod:`scipy.signal` (which imports
 :mod:`scipy.stats`) costs 0.5-1.2 s: a sixth of a ``contactlab diagnose`` run on a million
 samples, and four fifths of a ``contactlab analyze`` of one tangential recording (1.4-1.6 s
 -> 0.3 s), paid again by every worker process of a study.

@@ -27,14 +27,18 @@ _CSS = """
 body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;margin:2em auto;
 max-width:1100px;padding:0 1em;color:#222;line-height:1.45}
 h1{border-bottom:2px solid #345;padding-bottom:.2em}h2{border-bottom:1px solid #bbb;margin-top:2em}
-table{border-collapse:collapse;font-size:.85em;margin:.6em 0 1.2em}
-th,td{border:1px solid #ccc;padding:.2em .5em;text-align:right;white-space:nowrap}
-th{background:#eef1f5}td.s{text-align:left}caption{caption-side:top;text-align:left;
+table{border-collapse:collapse;font-size:.8em;margin:.6em 0 1.2em;max-width:100%}
+th,td{border:1px solid #ccc;padding:.2em .4em;text-align:right;white-space:normal}
+th{background:#eef1f5;vertical-align:bottom;overflow-wrap:break-word}
+td.s{text-align:left;overflow-wrap:anywhere}caption{caption-side:top;text-align:left;
 font-style:italic;padding:.2em 0}figure{margin:1em 0}figure img{max-width:100%;
 border:1px solid #ddd}figcaption{font-size:.9em;color:#444}pre{background:#f6f8fa;padding:.6em;
 overflow-x:auto;font-size:.8em}.note{color:#7a4b00;background:#fff6e0;padding:.4em .6em;
 border-left:3px solid #e0a000}nav ul{columns:2}.tablewrap{overflow-x:auto}
 """
+
+#: the no-break space that holds "± error" together in a table cell
+NBSP = "\u00a0"
 
 _SLUG = re.compile(r"[^a-z0-9]+")
 
@@ -134,6 +138,12 @@ class Column:
         return text, numeric
 
 
+def _header_html(text: str) -> str:
+    """A column header, escaped, that may wrap at its spaces and after the ``·`` and ``/`` of
+    a compound unit (``[µm⁻¹·<wbr>MPa⁻²]``), so that a wide table fits a narrow page."""
+    return "".join(html.escape(ch) + ("<wbr>" if ch in "·/" else "") for ch in text)
+
+
 def table_html(
     rows: Sequence[Mapping[str, Any]], columns: Sequence[Column], caption: str = ""
 ) -> str:
@@ -142,13 +152,16 @@ def table_html(
     out = ['<div class="tablewrap"><table>']
     if caption:
         out.append(f"<caption>{esc(caption)}</caption>")
-    out.append("<tr>" + "".join(f"<th>{esc(c.header())}</th>" for c in columns) + "</tr>")
+    out.append("<tr>" + "".join(f"<th>{_header_html(c.header())}</th>" for c in columns) + "</tr>")
     for r in rows:
         cells = []
         for c in columns:
             text, numeric = c.cell(r)
             cls = "" if numeric else ' class="s"'
-            cells.append(f"<td{cls}>{esc(text)}</td>")
+            # a narrow window wraps "value ± error" before the ± only (no-break space after
+            # it), a text cell anywhere (a long file name), a header at its spaces (issue 31:
+            # the demo's summary scrolled sideways at 1400 px)
+            cells.append(f"<td{cls}>{esc(text.replace(' ± ', ' ±' + NBSP))}</td>")
         out.append("<tr>" + "".join(cells) + "</tr>")
     out.append("</table></div>")
     return "".join(out)

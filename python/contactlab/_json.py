@@ -4,11 +4,10 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 
 def jsonable(value: Any) -> Any:
@@ -17,6 +16,13 @@ def jsonable(value: Any) -> Any:
         return {str(k): jsonable(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
         return [jsonable(v) for v in value]
+    # numpy only if it is loaded: without it there are no numpy values (and the command
+    # line's start-up does not pay for importing it)
+    np = sys.modules.get("numpy")
+    if np is None:
+        if isinstance(value, float) and not math.isfinite(value):
+            return None
+        return str(value) if isinstance(value, Path) else value
     if isinstance(value, np.ndarray):
         if value.ndim and value.dtype.kind in "biuf":
             # numbers: numpy's own list conversion gives plain ints, floats and bools (a

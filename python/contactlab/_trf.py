@@ -13,7 +13,7 @@ Developers) step for step: the same trial points in the same order, the same eva
 count (``max_nfev`` counts the solver's own evaluations, not the Jacobian's columns), the
 same end point and status. ``numpy.linalg.svd`` stands for ``scipy.linalg.svd`` (both
 LAPACK's ``gesdd``; its factors put in the Fortran layout scipy's have).
-``tests/test_trf.py`` checks it against SciPy on random problems.
+``tests/base/test_trf.py`` checks it against SciPy on random problems.
 :func:`contactlab.fitting.least_squares_fit` uses it where it applies and SciPy otherwise.
 """
 

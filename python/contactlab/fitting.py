@@ -16,16 +16,20 @@ AIC and BIC follow lmfit: ``n ln(χ²/n) + 2k`` and ``n ln(χ²/n) + k ln n``.
 from __future__ import annotations
 
 import math
-import threading
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
-from . import _trf
 from ._arrays import next_fast_len
-from .errors import ConvergenceError, InputError
+from ._lsq import STATUS, Scaled, check_params, end_checks, polish, sumsq
+from .errors import InputError
+
+#: a relative standard error at or above this (1000 %) says the data do not determine the
+#: value: the text report writes "not identifiable" instead of a figure such as "± nan" or
+#: "-0.0158 +/- 47.4 s" (issue 31)
+UNDETERMINED_REL_STDERR = 10.0
 
 
 @dataclass
@@ -196,10 +200,13 @@ class FitResult:
             if not p.vary:
                 lines.append(f"    {p.name}: {p.value:.8g}{unit} (fixed)")
                 continue
-            if p.stderr is None:
-                err = "+/- (not determined)"
+            rel = p.rel_stderr if p.stderr is not None else None
+            if p.stderr is None or not math.isfinite(p.stderr):
+                err = "(not identifiable: no finite standard error)"
+            elif rel is not None and not rel < UNDETERMINED_REL_STDERR:
+                err = (f"(not identifiable: standard error {p.stderr:.2g}, over "
+                       f"{100 * UNDETERMINED_REL_STDERR:.0f} % of the value)")  # fmt: skip
             else:
-                rel = p.rel_stderr
                 err = f"+/- {p.stderr:.4g}" + (f" ({100 * rel:.2f}%)" if rel is not None else "")
             flag = "" if p.identifiable is not False else "  [NOT IDENTIFIABLE]"
             init = f" (init = {p.init_value:.6g})" if p.init_value is not None else ""
@@ -250,14 +257,6 @@ def _nested(a: np.ndarray) -> list[list[Any]]:
 
 def _scalar(a: np.ndarray) -> Any:
     return float(a) if a.ndim == 0 else a
-
-
-def _scale_of(p: Parameter) -> float:
-    if p.scale is not None:
-        if not (math.isfinite(p.scale) and p.scale > 0):
-            raise InputError(f"parameter {p.name!r}: scale must be finite and > 0, got {p.scale}")
-        return float(p.scale)
-    return abs(p.value) if p.value != 0 else 1.0
 
 
 def _as_params(params: Any) -> dict[str, Parameter]:
@@ -358,148 +357,32 @@ def least_squares_fit(
     """
     ps = _as_params(params)
     start = [replace(p) for p in ps.values()] if solver is not None else []
-    names = [k for k, p in ps.items() if p.vary]
-    for p in ps.values():
-        if not math.isfinite(p.value):
-            raise InputError(
-                f"parameter {p.name!r} has a non-finite initial value {p.value}: the data or "
-                "the start estimate derived from them are not usable (a constant channel, an "
-                "overflow?)"
-            )
-        for side, bound in (("lower", p.min), ("upper", p.max)):
-            if math.isnan(bound):
-                raise InputError(
-                    f"parameter {p.name!r}: the {side} bound is NaN (bounds derived from "
-                    "data that have none, e.g. a constant or empty channel?); give a number, "
-                    "or ±inf for no bound"
-                )
-        if p.vary and p.min >= p.max:
-            raise InputError(
-                f"parameter {p.name!r}: empty range [{p.min}, {p.max}] (min must be < max)"
-            )
-        if p.vary and not (p.min <= p.value <= p.max):
-            raise InputError(
-                f"parameter {p.name!r}: initial value {p.value} outside [{p.min}, {p.max}]"
-            )
-        p.init_value = p.value if p.vary else None
-    # Fit in scaled variables (value / scale, scale = |initial value| unless given) so that
-    # parameters that differ by orders of magnitude (h0 ~ 10 N, ac ~ 1e5 1/m) are equally
-    # well conditioned.
-    scale = np.array([_scale_of(ps[n]) for n in names])
-    lo = np.array([ps[n].min for n in names]) / scale
-    hi = np.array([ps[n].max for n in names]) / scale
-    fixed = {k: p.value for k, p in ps.items() if not p.vary}
-    nfev = 0
-    counting = threading.Lock()  # ``workers`` may call raw_fun on several threads
-
-    def values_of(z: np.ndarray) -> dict[str, float]:
-        v = dict(fixed)
-        v.update({n: float(zi * s) for n, zi, s in zip(names, z, scale, strict=True)})
-        return {k: v[k] for k in ps}
-
-    def raw_fun(z: np.ndarray) -> np.ndarray:
-        nonlocal nfev
-        with counting:
-            nfev += 1
-        with np.errstate(all="ignore"):  # an overflowing trial step is refused below
-            return np.asarray(residual_fn(values_of(z)), dtype=np.float64).reshape(-1)
-
-    z0 = np.array([ps[n].value for n in names]) / scale
-    r0 = raw_fun(z0)
-    if not np.all(np.isfinite(r0)):
-        i = int(np.argmax(~np.isfinite(r0)))
-        raise InputError(f"residual[{i}] is not finite at the initial parameter values")
-    ndata = int(r0.size)
-    # Residuals are scaled too (by their size at the start), so that the solver's tolerances
-    # and χ² neither overflow nor underflow and a fit gives the same relative result in any
-    # units (nN/nm to kN/mm): least_squares' gtol is absolute in the cost's units.
-    rscale = _rms(r0)
-    if not (rscale > 0 and math.isfinite(rscale)):
-        rscale = 1.0
-
-    def fun(z: np.ndarray) -> np.ndarray:
-        return raw_fun(z) / rscale
-
+    check_params(ps)
+    pb = Scaled(ps, residual_fn, jac, jac_rel_step, workers)
+    names, lo, hi = pb.names, pb.lo, pb.hi
+    z0, r0 = pb.start()
+    ndata, rscale, fun = pb.ndata, pb.rscale, pb.fun
     if not names:
-        chisqr = _sumsq(r0)
-        return _finish(ps, [], None, r0, chisqr, ndata, True, 0, "no varied parameters", nfev)
+        chisqr = sumsq(r0)
+        return _finish(ps, [], None, r0, chisqr, ndata, True, 0, "no varied parameters", pb.nfev)
     if ndata < len(names):
         raise InputError(f"{ndata} residuals cannot determine {len(names)} parameters")
-
-    def analytic(z: np.ndarray) -> np.ndarray:
-        assert jac is not None
-        with np.errstate(all="ignore"):  # a non-finite column is reported below
-            cols = jac(values_of(z))
-            return np.column_stack(
-                [np.asarray(cols[n], dtype=np.float64).reshape(-1) * s
-                 for n, s in zip(names, scale, strict=True)]
-            ) / rscale  # fmt: skip
-
-    if solver is not None:
-        z, rs, nfev_s, status = _run_solver(solver, fun, z0, names, scale, lo, hi, fixed,
-                                           rscale, ftol, xtol, gtol, max_nfev)  # fmt: skip
-        nfev += nfev_s
-        sol = None
-    else:
-        z, rs, status, sol = _scipy_solve(fun, z0, lo, hi, analytic if jac is not None else None,
-                                          loss, ftol, xtol, gtol, max_nfev, workers)  # fmt: skip
+    z, rs, status, sol = pb.solve(solver, z0, loss, ftol, xtol, gtol, max_nfev)
     success = status > 0 if sol is None else bool(sol.success)
-    message = _STATUS.get(status, "") if sol is None else str(sol.message)
-
-    def jacobian(z: np.ndarray) -> np.ndarray:
-        if jac is not None:
-            return analytic(z)
-        # central differences in the scaled variables (bounds respected by one-sided steps)
-        J = np.empty((ndata, len(names)))
-        steps = []
-        for j in range(len(names)):
-            h = jac_rel_step * max(abs(z[j]), 1.0)
-            up, dn = z.copy(), z.copy()
-            up[j] = min(z[j] + h, hi[j])
-            dn[j] = max(z[j] - h, lo[j])
-            steps += [up, dn]
-        f = list((workers or map)(fun, steps))
-        for j in range(len(names)):
-            up, dn = steps[2 * j], steps[2 * j + 1]
-            J[:, j] = (f[2 * j] - f[2 * j + 1]) / (up[j] - dn[j])
-        return J
-
-    J = jacobian(z)
+    message = STATUS.get(status, "") if sol is None else str(sol.message)
+    J = pb.jacobian(z)
     if success and loss == "linear":
-        z, rs, J, success, status, message = _polish(
-            fun, jacobian, z, rs, J, lo, hi, names, polish_stop
+        z, rs, J, success, status, message = polish(
+            fun, pb.jacobian, z, rs, J, lo, hi, names, polish_stop
         )
-    with np.errstate(over="ignore"):
-        r = rs * rscale
-    with np.errstate(over="ignore"):
-        chisqr = float(np.float64(_sumsq(rs)) * np.float64(rscale) ** 2)
-    notes = []
-    if not np.all(np.isfinite(J)):
-        success, status = False, -3
-        message = "the model is not finite next to the end point (its Jacobian overflows)"
-    elif _rms(rs) < 1e5 * np.finfo(float).eps * _rms(J @ z):
-        # residuals at the rounding level of the model's values: the parameters are exact
-        # to rounding, but χ² and so the standard errors are rounding noise (NIST Lanczos1)
-        notes.append(
-            "the residuals are at the floating-point rounding level of the model (an exact "
-            "fit): standard errors are not determined"
-        )
-    res = _finish(
-        ps,
-        names,
-        (J, scale, rscale) if np.all(np.isfinite(J)) else None,
-        r,
-        chisqr,
-        ndata,
-        success,
-        status,
-        message,
-        nfev,
-        values=values_of(z),
-        scale_covar=scale_covar,
-        rcond=rcond,
-        max_rel_stderr=max_rel_stderr,
+    r, chisqr, notes, (success, status, message) = end_checks(
+        J, rs, z, rscale, (success, status, message)
     )
+    res = _finish(
+        ps, names, (J, pb.scale, rscale) if np.all(np.isfinite(J)) else None, r, chisqr,
+        ndata, success, status, message, pb.nfev, values=pb.values_of(z),
+        scale_covar=scale_covar, rcond=rcond, max_rel_stderr=max_rel_stderr,
+    )  # fmt: skip
     if notes:
         for n in names:
             res.params[n].stderr = None
@@ -516,236 +399,6 @@ def least_squares_fit(
         ref.nfev += res.nfev
         return ref
     return res
-
-
-#: SciPy's ``least_squares`` messages by status (for a solver given to
-#: :func:`least_squares_fit`)
-_STATUS = {
-    0: "The maximum number of function evaluations is exceeded.",
-    1: "`gtol` termination condition is satisfied.",
-    2: "`ftol` termination condition is satisfied.",
-    3: "`xtol` termination condition is satisfied.",
-    4: "Both `ftol` and `xtol` termination conditions are satisfied.",
-}
-
-
-def _run_solver(
-    solver: Callable[..., tuple[Any, int, int]],
-    fun: Callable[[np.ndarray], np.ndarray],
-    z0: np.ndarray,
-    names: list[str],
-    scale: np.ndarray,
-    lo: np.ndarray,
-    hi: np.ndarray,
-    fixed: dict[str, float],
-    rscale: float,
-    ftol: float,
-    xtol: float,
-    gtol: float,
-    max_nfev: int | None,
-) -> tuple[np.ndarray, np.ndarray, int, int]:
-    """A given solver's end point, its scaled residuals, evaluations and status."""
-    budget = int(max_nfev) if max_nfev is not None else 100 * len(names)
-    z, nfev, status = solver(z0, names, scale, lo, hi, fixed, rscale, ftol, xtol, gtol, budget)
-    z = np.clip(np.asarray(z, dtype=np.float64).reshape(-1), lo, hi)
-    return z, fun(z), int(nfev), int(status)
-
-
-def _scipy_solve(
-    fun: Callable[[np.ndarray], np.ndarray],
-    z0: np.ndarray,
-    lo: np.ndarray,
-    hi: np.ndarray,
-    analytic: Callable[[np.ndarray], np.ndarray] | None,
-    loss: str,
-    ftol: float,
-    xtol: float,
-    gtol: float,
-    max_nfev: int | None,
-    workers: Callable[[Callable[[Any], Any], Iterable[Any]], Iterable[Any]] | None = None,
-) -> tuple[np.ndarray, np.ndarray, int, Any]:
-    bounded = not np.all((lo == -np.inf) & (hi == np.inf))
-    eps = float(np.finfo(float).eps)
-    try:
-        if loss == "linear" and bounded and min(ftol, xtol, gtol) >= eps:
-            # the same trial points and end point as scipy's (contactlab._trf), without the
-            # half second (and ~45 MB) of importing scipy.optimize, also with an analytic
-            # Jacobian (a window of a streamed analysis whose native solver stopped at a
-            # kink imported it mid-run, 13 % of the GIL's time and the peak memory)
-            sol = _trf.solve(fun, z0, lo, hi, ftol, xtol, gtol, max_nfev, workers, analytic)
-            return sol.x, np.asarray(sol.fun, dtype=np.float64), int(sol.status), sol
-        from scipy.optimize import least_squares
-
-        sol = least_squares(
-            fun,
-            z0,
-            jac=analytic if analytic is not None else "2-point",
-            bounds=(lo, hi),
-            method="trf",
-            x_scale=1.0,
-            loss=loss,
-            ftol=ftol,
-            xtol=xtol,
-            gtol=gtol,
-            max_nfev=max_nfev,
-            workers=workers,
-        )
-    except InputError as exc:
-        raise ConvergenceError(
-            f"the model rejected the parameters the solver tried ({exc}); tighten the bounds"
-        ) from exc
-    return sol.x, np.asarray(sol.fun, dtype=np.float64), int(sol.status), sol
-
-
-def _rms(r: np.ndarray) -> float:
-    """Root mean square without overflow or underflow of the squares."""
-    m = float(np.max(np.abs(r))) if r.size else 0.0
-    if not (m > 0 and math.isfinite(m)):
-        return m
-    return m * float(np.sqrt(np.mean((r / m) ** 2)))
-
-
-def _sumsq(r: np.ndarray) -> float:
-    """``r @ r`` (inf when it exceeds the float range, rather than a warning)."""
-    with np.errstate(over="ignore"):
-        return r.size * _rms(r) ** 2 if r.size else 0.0
-
-
-#: largest remaining Gauss-Newton step, in standard errors, of a fit reported as converged
-TRUST_STEP = 0.25
-#: the polish's Gauss-Newton step is shortened or lengthened (:func:`_polish`) when the
-#: parabola of the cost along it puts the minimum this far (as a fraction of the step) from
-#: its end
-LINE_SEARCH_OFF = 0.2
-
-
-def _step_in_stderr(step: np.ndarray, J: np.ndarray, var: float) -> float:
-    """The largest ``|step|`` in units of its parameter's standard error (Jacobian ``J``,
-    residual variance ``var``); inf when the errors cannot be computed."""
-    if not np.all(np.isfinite(J)):
-        return np.inf
-    try:
-        cov = np.linalg.pinv(J.T @ J, rcond=1e-13) * var
-    except np.linalg.LinAlgError:
-        return np.inf
-    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    if not np.all(sd > 0):
-        return np.inf
-    return float(np.max(np.abs(step) / sd))
-
-
-def _polish(
-    fun: Callable[[np.ndarray], np.ndarray],
-    jacobian: Callable[[np.ndarray], np.ndarray],
-    z: np.ndarray,
-    r: np.ndarray,
-    J: np.ndarray,
-    lo: np.ndarray,
-    hi: np.ndarray,
-    names: list[str],
-    stop: float = 0.0,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool, int, str]:
-    """Gauss-Newton steps from the solver's end point until they stop paying, then the trust
-    check: the step still possible must be a negligible fraction of each parameter's standard
-    error, or the fit is reported ``success=False`` naming the parameter.
-
-    The trust-region solver stops on *relative* changes, which can leave a slow, ill-
-    conditioned fit (NIST's ENSO, Lanczos, MGH17) several digits short of its minimum while
-    reporting success. Parameters at a bound are held there.
-    """
-    cost = float(r @ r)
-    nfree = r.size - len(names)
-    prev: np.ndarray | None = None  # the last step taken
-    for _ in range(30):
-        step = _gn_step(J, r, z, lo, hi)
-        if step is None or not np.any(step):
-            break
-        if stop > 0 and nfree > 0 and _step_in_stderr(step, J, cost / nfree) < stop:
-            break
-        z_new = np.clip(z + step, lo, hi)
-        try:
-            r_new = fun(z_new)
-        except InputError:
-            break  # the model refuses the step's end (a parameter at its closed bound)
-        if not np.all(np.isfinite(r_new)):
-            break
-        cost_new = float(r_new @ r_new)
-        # a step that turns back on the previous one: its length from the cost along it, a
-        # parabola through the cost here, its slope (2 rᵀJ·step) and the cost at the step's
-        # end. Gauss-Newton's curvature omits the residual's own (Σ r ∇²r), which a model
-        # missing structure (a residual of many σ) and an oscillating term (a load
-        # fluctuation's frequency, whose phase drifts over the record) make large: the full
-        # steps then overshoot and zigzag about the minimum, shrinking by a few per cent a
-        # step (30 steps, each a central-difference Jacobian, on a 1e6-sample record). One
-        # evaluation more at the parabola's minimum when it lies off the full step, kept
-        # when it is lower.
-        slope = 2.0 * float(r @ (J @ (z_new - z)))
-        curv = cost_new - cost - slope
-        back = prev is not None and float(prev @ (z_new - z)) < 0
-        prev = z_new - z
-        if back and slope < 0 and curv > 0:
-            alpha = -slope / (2.0 * curv)
-            if abs(alpha - 1.0) > LINE_SEARCH_OFF:
-                z_alt = np.clip(z + alpha * (z_new - z), lo, hi)
-                try:
-                    r_alt = fun(z_alt)
-                except InputError:
-                    r_alt = None
-                if r_alt is not None and np.all(np.isfinite(r_alt)):
-                    cost_alt = float(r_alt @ r_alt)
-                    if cost_alt < cost_new:
-                        z_new, r_new, cost_new = z_alt, r_alt, cost_alt
-        if cost_new > cost:
-            break
-        moved = np.max(np.abs(z_new - z) / np.maximum(np.abs(z), 1e-300))
-        try:
-            J_new = jacobian(z_new)
-        except InputError:
-            break
-        z, r, cost, J = z_new, r_new, cost_new, J_new
-        if moved < 1e-14:
-            break
-    # trust: one more step from here, measured in standard errors
-    step = _gn_step(J, r, z, lo, hi)
-    if step is not None and nfree > 0 and np.all(np.isfinite(J)):
-        try:
-            cov = np.linalg.pinv(J.T @ J, rcond=1e-13) * (cost / nfree)
-        except np.linalg.LinAlgError:
-            cov = None
-        if cov is not None:
-            sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-            with np.errstate(divide="ignore", invalid="ignore"):
-                ratio = np.where(sd > 0, np.abs(step) / sd, 0.0)
-            # a step below 1e-10 of the value is rounding noise whatever the error says
-            # (an exact fit's standard errors are themselves rounding noise)
-            ratio[np.abs(step) <= 1e-10 * np.abs(z)] = 0.0
-            worst = int(np.argmax(ratio))
-            # A model with kinks (reversal points that move with the parameters) leaves
-            # Gauss-Newton steps of a few hundredths of a standard error that no solver
-            # removes; a quarter of a standard error changes no reported digit that matters.
-            if ratio[worst] > TRUST_STEP:
-                return (z, r, J, False, -2,
-                        f"not converged: a further Gauss-Newton step would move {names[worst]} "
-                        f"by {ratio[worst]:.2g} standard errors (the minimum is not reached; "
-                        "try other starting values or bounds)")  # fmt: skip
-    return z, r, J, True, 1, f"converged (Gauss-Newton step below {TRUST_STEP:g} standard errors)"
-
-
-def _gn_step(
-    J: np.ndarray, r: np.ndarray, z: np.ndarray, lo: np.ndarray, hi: np.ndarray
-) -> np.ndarray | None:
-    """The Gauss-Newton step ``-J⁺ r``, parameters at a bound held fixed (None if J is not
-    finite)."""
-    if not (np.all(np.isfinite(J)) and np.all(np.isfinite(r))):
-        return None
-    tol = 1e-12 * np.maximum(np.abs(z), 1.0)
-    free = ~(((z - lo) <= tol) | ((hi - z) <= tol))
-    step = np.zeros_like(z)
-    if not free.any():
-        return step
-    sol, *_ = np.linalg.lstsq(J[:, free], -r, rcond=1e-13)
-    step[free] = sol
-    return step
 
 
 def _finish(
@@ -806,7 +459,7 @@ def _finish(
         # in the scaled residuals rscale cancels from (JᵀJ)⁻¹·χ²/ν; unscaled (weights given
         # as 1/σ) the covariance is (JᵀJ)⁻¹ of the original residuals
         if scale_covar and nfree > 0:
-            factor = _sumsq(r / rscale) / nfree
+            factor = sumsq(r / rscale) / nfree
         else:
             factor = 1.0 / rscale**2
         cov_s = inv * factor

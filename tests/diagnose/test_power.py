@@ -65,11 +65,13 @@ def bounds() -> dict[str, dict[str, object]]:
 
 
 def test_every_candidate_has_a_bound_in_its_units(bounds: dict) -> None:
-    b = bounds[0.002]
     from contactlab.diagnose.effects import registry
 
+    b = bounds[0.002]
     assert set(b) == set(registry("tangential"))  # every candidate of the library
     assert b["power_law_microslip"].detectable_above is None  # not nested: no "absent"
+    for x in b.values():  # a bound in the parameter's unit, or None with the reason
+        assert (x.detectable_above is None) == bool(x.reason), x
     assert b["channel_delay"].unit == "s" and 0 < b["channel_delay"].detectable_above < 1e-3
     assert b["parallel_stiffness"].unit == "N/m"
     assert b["non_masing_scaling"].null == 2.0

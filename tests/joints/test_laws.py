@@ -491,3 +491,59 @@ def test_initial_stiffness_is_the_slope_from_rest() -> None:
         h = 1e-13  # Segalman's slope departs from K_T as sqrt(u) for chi = -1/2
         slope = float(law.force(None, [h])[0]) / h
         assert slope == pytest.approx(law.initial_stiffness, rel=1e-4, abs=1e-6), law.name
+
+
+def test_subclass_runs_on_its_parents_kernel() -> None:
+    class Named(Jenkins):
+        name = "named"
+
+    x = np.array([0.0, 1e-3, -2e-3])
+    np.testing.assert_array_equal(Named(1e4, 5.0).force(None, x), Jenkins(1e4, 5.0).force(None, x))
+
+
+_WILD = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from([0.0, -1.0, 1e-300, 1e300, 1.0, 0.5, 2.0, -0.999]),
+)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    kind=st.sampled_from(sorted(set(LAWS) - {"series", "parallel", "backlash", "masing"})),
+    params=st.lists(_WILD, min_size=0, max_size=12),
+    x=st.lists(_WILD, min_size=0, max_size=20),
+    dt=st.lists(st.one_of(st.floats(-1.0, 1.0), st.just(np.nan), st.just(np.inf)), max_size=20),
+)
+def test_any_input_gives_forces_or_an_input_error(kind, params, x, dt) -> None:
+    """Whatever the parameters and samples, a law returns finite forces or raises InputError
+    (never another exception, a Rust panic or a NaN)."""
+    try:
+        law = from_spec((kind, params, []))
+    except contactlab.InputError:
+        return
+    n = min(len(x), len(dt))
+    t = np.cumsum(np.asarray(dt[:n], dtype=float)) if n else np.zeros(0)
+    try:
+        F = law.force(t, np.asarray(x[:n], dtype=float))
+    except contactlab.InputError:
+        return
+    assert F.shape == (n,) and np.all(np.isfinite(F))
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    which=st.integers(0, len(all_laws()) - 1),
+    x=st.lists(st.one_of(st.floats(-1e-2, 1e-2), _WILD), min_size=1, max_size=30),
+    dt=st.lists(
+        st.one_of(st.floats(1e-300, 1.0), st.sampled_from([0.0, -1e-3, 1e-320])), max_size=30
+    ),
+)
+def test_valid_law_on_wild_signals(which, x, dt) -> None:
+    law = all_laws()[which]
+    n = min(len(x), len(dt))
+    t = np.cumsum(np.asarray(dt[:n], dtype=float))
+    try:
+        F = law.force(t, np.asarray(x[:n], dtype=float))
+    except contactlab.InputError:
+        return
+    assert F.shape == (n,) and np.all(np.isfinite(F))

@@ -14,9 +14,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from .._options import as_dict
 from ..errors import InputError
-from ..studies.manifest import entry_from_file
-from ..studies.study import run_study
 from ._common import (
     FORCE_SIGN_CHOICES,
     add_frame_flags,
@@ -253,6 +252,8 @@ def _auto_streamed(
 
 
 def _handler(args: argparse.Namespace) -> int:
+    from ..studies.manifest import entry_from_file
+
     frame = frame_option(args)
     columns = parse_columns(args.columns)
     check_output_targets(json_out=args.json, report=args.report, inputs=args.files)
@@ -287,12 +288,14 @@ def _handler(args: argparse.Namespace) -> int:
         e = entry_from_file(f, kind=args.model)
         e.columns, e.fs, e.frame, e.resample = columns, args.fs, frame, args.resample
         entries.append(e)
-    topts = {"force_sign": args.force_sign}
-    if args.delay is not None:
-        if args.model != "tangential":
-            raise InputError("--delay is for tangential recordings (force against displacement)")
-        topts["delay"] = args.delay
-    nopts = {"p0": args.p0, "pa": args.pa}
+    if args.delay is not None and args.model != "tangential":
+        raise InputError("--delay is for tangential recordings (force against displacement)")
+    # the flags parsed into the typed options (issue 32); the library takes them as dicts too
+    from ..normal.options import Options as NormalOptions
+    from ..tangential.options import Options as TangentialOptions
+
+    topts = as_dict(TangentialOptions(force_sign=args.force_sign, delay=args.delay))
+    nopts = as_dict(NormalOptions(p0=args.p0, pa=args.pa))
     if args.stream:
         return _streamed(args, entries, columns, topts, nopts)
     big: set[int] = set()
@@ -335,6 +338,8 @@ def _in_memory(
     args: argparse.Namespace, entries: list, frame: Any, topts: dict, nopts: dict, ex: Any
 ) -> int:
     """``analyze`` of recordings read whole: on ``ex`` (a process pool) or serially."""
+    from ..studies.study import run_study
+
     result = run_study(entries, progress=args.progress, keep_going=args.keep_going,
                        tangential_options=topts, normal_options=nopts, executor=ex,
                        keep_recordings=True)  # fmt: skip
@@ -406,6 +411,7 @@ def _with_long(
     analysed whole."""
     from .. import __version__
     from ..errors import ContactLabError
+    from ..studies.study import run_study
 
     say = sys.stderr if args.json == "-" else sys.stdout
     small = [e for i, e in enumerate(entries) if i not in big]

@@ -272,9 +272,8 @@ def run(args: argparse.Namespace) -> int:
         rec = with_static_pressure(rec, args.file, getattr(args, "p0", None),
                                    getattr(args, "pa", None))  # fmt: skip
     try:
-        report = diagnose(rec, model=args.model, max_effects=args.max_effects,
-                          output_filter=taps, output_noise=args.output_noise, delay=delay,
-                          **({"force_sign": sign} if sign is not None else {}))  # fmt: skip
+        opts = _options(args.model, taps, args.output_noise, delay, sign)
+        report = diagnose(rec, model=args.model, max_effects=args.max_effects, options=opts)
     except (InputError, ConvergenceError) as exc:  # name the file: the workflow sees arrays
         kind = ConvergenceError if isinstance(exc, ConvergenceError) else InputError
         raise kind(f"{args.file}: {exc}") from exc
@@ -324,3 +323,12 @@ def run(args: argparse.Namespace) -> int:
             paths = commit_outputs(args.report, files)
             print(f"report: {paths[0]}")
     return 0
+
+
+def _options(model: str | None, taps: Any, noise: float | None, delay: Any, sign: Any) -> Any:
+    """The parsed flags as the diagnosis's typed options (issue 32)."""
+    if model == "normal":
+        return {"output_filter": taps, "output_noise": noise}
+    from ..tangential.options import Options
+
+    return Options(delay=delay, force_sign=sign, output_filter=taps, output_noise=noise)

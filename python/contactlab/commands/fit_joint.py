@@ -1,4 +1,4 @@
-"""``contactlab fit-joint --fit FILE... [--predict FILE...] --law NAME[,NAME...]``.
+"""``contactlab fit-joint --fit FILE [FILE ...] [--predict FILE [FILE ...]] --law NAME[,NAME...]``.
 
 Fits joint laws (contactlab.joints: Jenkins, Iwan, Segalman, Maxwell-slip, Dahl, LuGre,
 Bouc-Wen, Masing, a law behind a clearance such as backlash:jenkins) to the force against

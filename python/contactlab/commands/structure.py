@@ -9,20 +9,34 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import re
+import sys
 import warnings
 from pathlib import Path
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from ..errors import InputError
-from ._common import check_output_targets, describe, json_text, made_by, quantity, write_json
+from ._common import (
+    add_progress_flags,
+    check_output_targets,
+    describe,
+    json_text,
+    made_by,
+    quantity,
+    write_json,
+)
+
+if TYPE_CHECKING:
+    import numpy as np
 
 _UNIT = re.compile(r"(?:\[([^\]]+)\]|_([A-Za-z]+))\s*$")
 
 
 def read_table(path: str) -> dict[str, np.ndarray]:
     """Columns of a CSV (header line, optional ``#``), converted to SI from unit suffixes."""
+    import numpy as np
+
     from ..io.csv import read_header, sniff_encoding
     from ..studies.manifest import unit_factor
 
@@ -86,6 +100,8 @@ def _pick(cols: dict[str, np.ndarray], want: str | None, guesses: tuple[str, ...
 
 
 def _time(cols: dict[str, np.ndarray], args: argparse.Namespace, n: int, path: str) -> np.ndarray:
+    import numpy as np
+
     for name in cols:
         if name.lower() in ("t", "time") or name.lower().startswith(("t_", "t [", "time")):
             return cols[name]
@@ -95,6 +111,8 @@ def _time(cols: dict[str, np.ndarray], args: argparse.Namespace, n: int, path: s
 
 
 def _identify(args: argparse.Namespace) -> int:
+    import numpy as np
+
     from ..report import commit_outputs
     from .structure_verbs import identify_record
 
@@ -131,12 +149,19 @@ def _identify(args: argparse.Namespace) -> int:
             mdof["masks"] = _masks(args.masks)
     elif args.masks is not None:
         raise InputError("--masks needs several response channels (--y x0,x1,...)")
-    cmd = made_by(args, "identify", args.file, "--joint", args.joint, "--excitation", exc)
-    model, rep, summary = identify_record(
-        t, u, y, joint=args.joint, excitation=exc, mass=mass, holdout=args.holdout,
-        substeps=args.substeps, periodic=args.periodic, title=f"{Path(args.file).name}: "
-        f"{args.joint} joint", intro=f"Made by: {cmd}", **mdof,
-    )  # fmt: skip
+    cmd = made_by(args, "identify", args.file, "--joint", args.joint, "--excitation", exc,
+                  *(["--fs", args.fs] if args.fs else []))  # fmt: skip
+    bar = _progress_bar(args.progress) if y.ndim == 1 else None
+    try:
+        model, rep, summary = identify_record(
+            t, u, y, joint=args.joint, excitation=exc, mass=mass, holdout=args.holdout,
+            substeps=args.substeps, periodic=args.periodic, title=f"{Path(args.file).name}: "
+            f"{args.joint} joint", intro=f"Made by: {cmd}",
+            progress=bar.step if bar is not None else None, **mdof,
+        )  # fmt: skip
+    finally:
+        if bar is not None:
+            bar.close()
     doc = model.to_dict()
     doc["summary"] = summary
     doc["columns"] = {"u": ucol, "y": ycol}
@@ -154,10 +179,74 @@ def _identify(args: argparse.Namespace) -> int:
               + (f"{train:.4g} m (training)" if train is not None else "n/a (training)")
               + (f", {hold:.4g} m (hold-out)" if hold is not None else "")
               + f"; identified in {model.elapsed:.1f} s")  # fmt: skip
+        print(parameter_lines(model.fit))
     return 0
 
 
+def parameter_lines(fit: Any) -> str:
+    """The fitted parameters, one a line: ``  k = 3012 ± 25 N/m``; a fixed one says so, an
+    unidentified one is written ``not identifiable: <why>`` (never ``± nan``)."""
+    from ..fitting import UNDETERMINED_REL_STDERR
+    from ..report import format_measurement
+
+    lines = ["fitted parameters (± 1 standard error):"]
+    width = max((len(n) for n in fit.params), default=0)
+    for name, p in fit.params.items():
+        unit = f" {p.unit}" if getattr(p, "unit", "") else ""
+        head = f"  {name:<{width}} = "
+        if not p.vary:
+            lines.append(f"{head}{p.value:.6g}{unit} (held fixed)")
+        elif p.identifiable is False or p.stderr is None or not math.isfinite(p.stderr):
+            why = p.note if p.note else "no finite standard error"
+            why = why.removeprefix("not identifiable: ")
+            lines.append(f"{head}{p.value:.6g}{unit} (not identifiable: {why})")
+        elif p.rel_stderr is not None and not p.rel_stderr < UNDETERMINED_REL_STDERR:
+            lines.append(f"{head}{p.value:.6g}{unit} (not identifiable: standard error "
+                         f"{p.stderr:.2g}, over {100 * UNDETERMINED_REL_STDERR:.0f} % of the "
+                         "value)")  # fmt: skip
+        else:
+            lines.append(f"{head}{format_measurement(p.value, p.stderr)}{unit}")
+    return "\n".join(lines)
+
+
+#: seconds before the progress bar shows (a quicker run prints none)
+PROGRESS_DELAY = 1.0
+
+
+class _Bar:
+    """A tqdm bar of the simulations an identification runs, on stderr, shown after a
+    second (a quick run prints none); its description follows the stage."""
+
+    def __init__(self) -> None:
+        from tqdm.auto import tqdm
+
+        self._bar = tqdm(desc="identify: starts", unit="sim", file=sys.stderr,
+                         delay=PROGRESS_DELAY, leave=False)  # fmt: skip
+        self._stage = "starts"
+
+    def step(self, stage: str) -> None:
+        if stage == "done":
+            self.close()
+            return
+        if stage != self._stage:
+            self._stage = stage
+            self._bar.set_description_str(f"identify: {stage}", refresh=False)
+        self._bar.update(1)
+
+    def close(self) -> None:
+        self._bar.close()
+
+
+def _progress_bar(progress: bool | None) -> _Bar | None:
+    """A bar when ``--progress``, or on a terminal unless ``--no-progress``."""
+    if progress or (progress is None and sys.stderr.isatty()):
+        return _Bar()
+    return None
+
+
 def _masses(text: str | None) -> list[float] | None:
+    import numpy as np
+
     if text is None:
         return None
     try:
@@ -205,6 +294,8 @@ def _joint_dofs(text: str) -> tuple[int, int | None]:
 
 def simulate_structure(args: argparse.Namespace) -> int:
     """Handler of ``contactlab simulate structure OUT --structure MODEL --input FILE``."""
+    import numpy as np
+
     from .._io_atomic import write_text
     from ..structure import IdentifiedModel, Structure
 
@@ -291,7 +382,9 @@ def diagnose_structure_cli(args: argparse.Namespace) -> int:
         matplotlib.use("Agg")
         from ..report.structure import write_diagnosis_html
 
-        print(f"report: {write_diagnosis_html(rep, args.report)}")
+        cmd = made_by(args, "diagnose", args.file, "--structure", args.structure,
+                      "--report", args.report)  # fmt: skip
+        print(f"report: {write_diagnosis_html(rep, args.report, intro=f'Made by: {cmd}')}")
     if text is not None:
         write_text(args.json, text)
     return 0
@@ -337,4 +430,5 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", metavar="OUT",
                    help="write the model (and summary) as JSON ('-': stdout)")  # fmt: skip
     p.add_argument("--report", metavar="DIR", help="write report.html and figures/ here")
+    add_progress_flags(p)
     p.set_defaults(handler=_identify)

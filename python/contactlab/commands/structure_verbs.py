@@ -22,6 +22,7 @@ def identify_record(
     periodic: bool,
     title: str,
     intro: str | None = None,
+    progress: Any = None,
     **mdof: Any,
 ) -> tuple[Any, Any, dict[str, Any]]:
     import matplotlib
@@ -39,7 +40,10 @@ def identify_record(
         t[:n_train], u[:n_train], y[:n_train], joint=joint, excitation=excitation,
         mass=mass, substeps=substeps, interpolation="fourier" if periodic and holdout == 0
         else "linear", periodic=periodic, **mdof,
+        **({"progress": progress} if progress is not None and not mdof else {}),
     )  # fmt: skip
+    if progress is not None:
+        progress("done")  # the simulations are over: a bar closes before the report is drawn
     if periodic:
         model.interpolation = "fourier"
     rep, summary = build_structure_report(

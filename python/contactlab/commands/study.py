@@ -11,7 +11,6 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ..studies.study import run_study
 from ._common import (
     add_progress_flags,
     add_workers_flag,
@@ -29,6 +28,8 @@ from ._common import (
 
 
 def _handler(args: argparse.Namespace) -> int:
+    from ..studies.study import run_study
+
     check_output_targets(json_out=args.json, report=args.report, inputs=[args.manifest])
     with process_pool(resolve_workers(args.workers), auto=args.workers is None) as ex:
         result = run_study(

@@ -102,7 +102,7 @@ def second_difference_var(x: np.ndarray) -> float:
     """Noise variance of ``x`` from the robust scale of its second differences
     (``var(Δ²x) = 6 σ²`` for white noise): :func:`contactlab.tangential.uncertainty.x_noise_var`
     without an averaged loop, here so that a diagnosis does not import the tangential
-    analysis (tests/test_diagnose_speed.py checks the two agree)."""
+    analysis (tests/diagnose/test_fast_paths.py checks the two agree)."""
     d2 = np.diff(x, 2)
     if d2.size < 10:
         return 0.0

@@ -526,10 +526,6 @@ class NormalFamily:
         ok, why = EFFECTS[name].plausible(d, p)
         return None if ok else why
 
-    def identified(self, name: str, p: dict[str, float], se: dict[str, float]) -> str | None:
-        """Why a fitted effect's size is not identified (within its error of "absent")."""
-        return EFFECTS[name].identified(p, se)
-
     def plausibility(self, name: str, p: dict[str, float], d: Prepared) -> tuple[bool, str]:
         """The effect's plausibility verdict and its argument in numbers."""
         return tuple(EFFECTS[name].plausible(d, p))  # type: ignore[return-value]

@@ -206,6 +206,11 @@ class TangentialFamily:
         band), None otherwise."""
         if self.h0_band is not None:
             return None
+        if p["ac"] * 0.5 * float(np.ptp(d.u)) < GROSS_SLIDING_ZA:
+            # not rectangular: the plateau is read where the loop still bends, and effects
+            # that act along the stroke (a viscous term, Stribeck, a parallel spring) move
+            # it; h0 stays the fit's (the final check reports how it compares)
+            return None
         info = d.extra.get("regime_info") or {}
         if info.get("h0_source") == "plateau" and info.get("plateau_h0"):
             h0_pl = float(info["plateau_h0"])

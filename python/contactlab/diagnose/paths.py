@@ -110,10 +110,15 @@ class KindPath:
         return RegimeDecision("", "", "base fit")
 
     def check_final(
-        self, regime: RegimeDecision, p: dict[str, float], effects: tuple[str, ...]
+        self,
+        regime: RegimeDecision,
+        p: dict[str, float],
+        effects: tuple[str, ...],
+        model_force: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     ) -> tuple[dict[str, Any] | None, str | None]:
         """The final model's physical parameters against ``analyze``'s (None: nothing to
-        check), and a sentence when they moved."""
+        check), and a sentence when they moved (``model_force``: the final model's output,
+        as the tangential path takes it; unused here)."""
         return None, None
 
 
@@ -162,7 +167,10 @@ class TangentialPath(KindPath):
         plateau = (an.derived or {}).get("h0_plateau")
         h0_source = None
         if name in ("gross sliding", "stick-slip"):
-            if plateau is not None:
+            # the h0 analyze reports: its plateau's where analyze takes h0 from it (no fit, or
+            # a fit whose exponential asymptote the plateau contradicts), else its fit's (an
+            # exponential loop's plateau mean lies ~1 % under the asymptote at ac·A 5)
+            if plateau is not None and an.identifiability.get("h0_source") == "plateau":
                 h0, se, h0_source = float(plateau[0]), float(plateau[1]), "plateau"
             elif an.fit is not None:  # sliding, no plateau over the stroke: analyze's fit
                 ph = an.fit.params["h0"]

@@ -45,7 +45,7 @@ from typing import Any
 import numpy as np
 
 from ._family import Family, ParamSpec, Prepared
-from .detection import ChannelNoise, effective_variance
+from .detection import ChannelNoise, effective_variance, model_slope
 from .select import MIN_RELATIVE_GAIN, sample_weight, specs_for
 
 __all__ = ["Detectable", "detectable_above", "shape_values", "stated_power"]
@@ -108,7 +108,7 @@ class Detectable:
             "parameter": self.parameter,
             "detectable_above": self.detectable_above,
             "unit": self.unit,
-            "null": self.null if self.null is None or np.isfinite(self.null) else None,
+            "null": self.null if self.null is not None and np.isfinite(self.null) else None,
             "relative_size": self.relative_size,
             "power": POWER,
             "at": dict(self.at),
@@ -401,6 +401,15 @@ def detectable_above(
         if np.isfinite(s.null):
             p0[s.name] = s.null
     trial = (*effects, name)
+    if not any(np.isfinite(s.null) for s in cand.params):
+        first = cand.params[0]
+        return Detectable(
+            name, first.name, None, first.unit, float("nan"), None, shape,
+            reason=(
+                "no parameter value means absent (the effect replaces the element's shape, "
+                "not a size away from a null): no bound to state"
+            ),
+        )  # fmt: skip
     if not family.check(trial):
         return Detectable(
             name, cand.params[0].name, None, cand.params[0].unit,
@@ -408,7 +417,7 @@ def detectable_above(
         )  # fmt: skip
     st = _setting_cache
     if st is None:
-        slope = family.slope(params, d) if hasattr(family, "slope") else None
+        slope = model_slope(family, params, d)
         st = _setting(d, current, noise, slope, sigma, z, gain_floor, folds, seed)
     base_specs = specs_for(family, effects)
     jb = np.column_stack(
@@ -433,11 +442,11 @@ def detectable_above(
         per[s.name] = b
         rel[s.name] = None if b is None else b * float(np.sqrt(np.mean(j * j))) / st.y_rms
     mags = [s for s in cand.params if np.isfinite(s.null)]
-    if not mags:  # an element law that replaces the base's (no value means "absent")
-        first = cand.params[0]
+    if not mags:  # no parameter whose value means "absent" (e.g. a frame's fixed mass)
+        s0 = cand.params[0]
         return Detectable(
-            name, first.name, None, first.unit, first.null, None, shape, per,
-            reason="not nested in the base model: no parameter value means 'absent'",
+            name, s0.name, None, s0.unit, None, None, shape, per,
+            reason="no parameter of this effect has a value meaning 'absent': no bound",
         )  # fmt: skip
     if not per or any(v is None for v in per.values()):
         worst = next((s for s in mags if per.get(s.name) is None), mags[0])
@@ -463,13 +472,16 @@ def stated_power(report: Any, *, seed: int = 0) -> list[Detectable]:
     report : DiagnosisReport
         A tangential or normal diagnosis (:func:`contactlab.diagnose.diagnose`).
     seed : int
-        Seed of the draws.
+        Seed of the draws (0: the bounds the diagnosis stated itself are returned).
 
     Returns
     -------
     list of Detectable
         In the library's order; empty when the report does not carry its data.
     """
+    kept = getattr(report, "not_detected", None)
+    if kept and seed == 0:  # stated by the diagnosis itself, with the same settings and seed
+        return list(kept)
     d = report.prepared
     if d is None or not report.trials:
         return []
@@ -484,33 +496,43 @@ def stated_power(report: Any, *, seed: int = 0) -> list[Detectable]:
         from .detection import channel_noise
 
         noise = channel_noise(d, current.full_residual(d))
-    slope = fam.slope(params, d) if hasattr(fam, "slope") else None
+    slope = model_slope(fam, params, d)
     st = _setting(
         d, current, noise, slope, sigma, float(settings.get("z", 3.0)),
         float(settings.get("gain_floor", 0.05)), int(settings.get("folds", 2)), seed,
     )  # fmt: skip
     names = settings.get("candidates") or list(fam.candidates)
+    return bounds_for(fam, params, effects, names, d, noise, sigma, current, st)
+
+
+def bounds_for(
+    family: Family,
+    params: dict[str, float],
+    effects: tuple[str, ...],
+    names: list[str],
+    d: Prepared,
+    noise: ChannelNoise,
+    sigma: float,
+    current: Any,
+    st: _Setting,
+) -> list[Detectable]:
+    """:func:`detectable_above` of every candidate in ``names`` not in ``effects``; a
+    candidate whose bound cannot be computed (its model refuses the null, a singular
+    projection) gets ``detectable_above`` None and the reason."""
+    from ..errors import ContactLabError
+
     out = []
     for n in names:
-        if n in effects or n not in fam.candidates:
+        if n in effects or n not in family.candidates:
             continue
+        kw = {"noise": noise, "sigma": sigma, "z": st.z, "gain_floor": st.gain_floor}
         try:
             out.append(
                 detectable_above(
-                    fam,
-                    params,
-                    effects,
-                    n,
-                    d,
-                    noise=noise,
-                    sigma=sigma,
-                    z=st.z,
-                    gain_floor=st.gain_floor,
-                    current=current,
-                    _setting_cache=st,
+                    family, params, effects, n, d, current=current, _setting_cache=st, **kw
                 )
             )
-        except (ValueError, FloatingPointError, np.linalg.LinAlgError) as exc:
-            spec = fam.candidates[n].params[0]
+        except (ContactLabError, ValueError, FloatingPointError, np.linalg.LinAlgError) as exc:
+            spec = family.candidates[n].params[0]
             out.append(Detectable(n, spec.name, None, spec.unit, reason=f"not computable: {exc}"))
     return out

@@ -579,29 +579,8 @@ def diagnose_structure(
     """
     model = _base_model(base)
     t, u, y = _record(recording)
-    if not 0.05 <= holdout <= 0.5:
-        raise InputError(f"holdout must be in [0.05, 0.5], got {holdout}")
-    if max_effects < 0 or blocks < 3:
-        raise InputError(f"max_effects must be >= 0 and blocks >= 3 (got {max_effects}, {blocks})")
-    if not (z > 0 and min_gain >= 0):
-        raise InputError(f"z must be > 0 and min_gain >= 0, got z={z}, min_gain={min_gain}")
-    names = list(STRUCTURE_CANDIDATES) if candidates is None else list(candidates)
-    for nm in names:
-        if nm not in STRUCTURE_CANDIDATES:
-            raise InputError(f"unknown structure candidate {nm!r}; choose from "
-                             f"{', '.join(STRUCTURE_CANDIDATES)}")  # fmt: skip
+    names, dt = _checked_settings(t, u, y, candidates, holdout, max_effects, blocks, z, min_gain)
     n = t.size
-    for name, a in (("u", u), ("y", y)):
-        if not np.ptp(a) > 0:
-            raise InputError(f"the {name} channel is constant: nothing to diagnose")
-    dt_all = np.diff(t)
-    if n < 64:
-        raise InputError(f"the record has {n} samples; at least 64 are needed")
-    if np.any(dt_all <= 0):
-        raise InputError("t must be strictly increasing")
-    dt = float(np.median(dt_all))
-    if np.any(np.abs(dt_all - dt) > 1e-3 * dt):
-        raise InputError("t must be uniformly sampled for the structure diagnosis")
     n_train = round(n * (1.0 - holdout))
     base_acc = None
     if model.excitation == "base":
@@ -630,48 +609,10 @@ def diagnose_structure(
         for name in names:
             if name in added:
                 continue
-            if model.excitation == "force" and name in ("joint_damping", "base_coupling"):
-                why = ("a dashpot on the mass's velocity is the structure's C under force "
-                       "excitation (refitted with the base): not distinguishable"
-                       if name == "joint_damping" else "needs base excitation")  # fmt: skip
-                verdicts.append(StructureCandidate(name, False, why))
-                continue
-            effects = (*cur.effects, name)
-            fits = []
-            for extra in _extra_starts(name, model, cur, d):
-                ps = _base_params(model, cur.values)
-                for e in cur.effects:  # parameters of effects added before
-                    for key, unit in _EXTRA[e]:
-                        val = cur.values[key]
-                        ps.append(Parameter(key, val, min=0.0 if key != "e" else -np.inf,
-                                            unit=unit, scale=abs(val) or None))  # fmt: skip
-                try:
-                    fits.append(_fit(model, effects, ps + extra, d, max_nfev)[0])
-                except ContactLabError as exc:
-                    verdicts.append(StructureCandidate(name, False, f"fit failed: {exc}"))
-            if not fits:
-                continue
-            cand = min(fits, key=lambda f: f.train_rss)
-            ok, reason, gain, tstat = _judge(name, cur, cand, d, sigma, z, min_gain, min_share)
-            why = _implausible(name, cand, model, d)
-            if ok and why:
-                ok, reason = False, f"implausible: {why}"
-            keys = [k for k, _ in _EXTRA[name]]
-            loose = [k for k in keys if not _determined(cand.values[k], cand.stderr.get(k))]
-            if ok and loose:
-                ok, reason = (
-                    False,
-                    "not determined by the record: "
-                    + ", ".join(
-                        f"{k} = {cand.values[k]:.4g} ± {_fmt(cand.stderr.get(k))}" for k in loose
-                    ),
-                )
-            verdicts.append(StructureCandidate(
-                name, ok, reason, cand.heldout_rms(d), gain, tstat,
-                {k: cand.values[k] for k in keys}, {k: cand.stderr.get(k) for k in keys},
-            ))  # fmt: skip
-            if ok and (best is None or gain > best[0]):
-                best = (gain, name, cand)
+            tried = _try_candidate(name, model, cur, d, sigma, (z, min_gain, min_share),
+                                   max_nfev, verdicts)  # fmt: skip
+            if tried is not None and (best is None or tried[0] > best[0]):
+                best = (tried[0], name, tried[1])
         steps[-1]["candidates"] = sorted(
             verdicts, key=lambda c: c.heldout_rms if math.isfinite(c.heldout_rms) else math.inf
         )
@@ -691,28 +632,100 @@ def diagnose_structure(
             f"{final_rms / sigma:.1f} × the noise level: unexplained by the candidates "
             f"({', '.join(names)})"
         )
-    sims = []
-    for f in (base_fit, cur):
-        try:
-            sims.append(np.asarray(_simulate(model, f.effects, f.values, d, n).joint_force))
-        except ContactLabError:
-            sims.append(None)
+    sims = [_joint_force(model, f, d, n) for f in (base_fit, cur)]
     return StructureDiagnosis(
-        record={"t": t, "u": u, "y": y},
-        base_prediction=base_fit.pred,
-        base_joint_force=sims[0],
-        joint_force=sims[1],
-        joint=model.joint,
-        excitation=model.excitation,
-        effects=added,
-        parameters=dict(cur.values),
-        stderr=dict(cur.stderr),
-        steps=steps,
-        where=where,
-        noise_rms=sigma,
-        unexplained=unexplained,
-        n_train=n_train,
-        n_holdout=n - n_train,
-        final_structure=_structure(model, cur.effects, cur.values),
-        residual=cur.pred - y,
-    )
+        record={"t": t, "u": u, "y": y}, base_prediction=base_fit.pred,
+        base_joint_force=sims[0], joint_force=sims[1], joint=model.joint,
+        excitation=model.excitation, effects=added, parameters=dict(cur.values),
+        stderr=dict(cur.stderr), steps=steps, where=where, noise_rms=sigma,
+        unexplained=unexplained, n_train=n_train, n_holdout=n - n_train,
+        final_structure=_structure(model, cur.effects, cur.values), residual=cur.pred - y,
+    )  # fmt: skip
+
+
+def _checked_settings(
+    t: np.ndarray, u: np.ndarray, y: np.ndarray, candidates: Any, holdout: float,
+    max_effects: int, blocks: int, z: float, min_gain: float,
+) -> tuple[list[str], float]:  # fmt: skip
+    """The candidates' names and the sampling step, once the settings and the record's
+    channels and time axis are checked."""
+    if not 0.05 <= holdout <= 0.5:
+        raise InputError(f"holdout must be in [0.05, 0.5], got {holdout}")
+    if max_effects < 0 or blocks < 3:
+        raise InputError(f"max_effects must be >= 0 and blocks >= 3 (got {max_effects}, {blocks})")
+    if not (z > 0 and min_gain >= 0):
+        raise InputError(f"z must be > 0 and min_gain >= 0, got z={z}, min_gain={min_gain}")
+    names = list(STRUCTURE_CANDIDATES) if candidates is None else list(candidates)
+    for nm in names:
+        if nm not in STRUCTURE_CANDIDATES:
+            raise InputError(f"unknown structure candidate {nm!r}; choose from "
+                             f"{', '.join(STRUCTURE_CANDIDATES)}")  # fmt: skip
+    n = t.size
+    for name, a in (("u", u), ("y", y)):
+        if not np.ptp(a) > 0:
+            raise InputError(f"the {name} channel is constant: nothing to diagnose")
+    dt_all = np.diff(t)
+    if n < 64:
+        raise InputError(f"the record has {n} samples; at least 64 are needed")
+    if np.any(dt_all <= 0):
+        raise InputError("t must be strictly increasing")
+    dt = float(np.median(dt_all))
+    if np.any(np.abs(dt_all - dt) > 1e-3 * dt):
+        raise InputError("t must be uniformly sampled for the structure diagnosis")
+    return names, dt
+
+
+def _try_candidate(
+    name: str, model: Any, cur: Any, d: Any, sigma: float,
+    thresholds: tuple[float, float, float], max_nfev: int, verdicts: list[StructureCandidate],
+) -> tuple[float, Any] | None:  # fmt: skip
+    """Fit candidate ``name`` on top of the current model ``cur``; its verdict is appended to
+    ``verdicts``; ``(gain, fit)`` when it is accepted."""
+    z, min_gain, min_share = thresholds
+    if model.excitation == "force" and name in ("joint_damping", "base_coupling"):
+        why = ("a dashpot on the mass's velocity is the structure's C under force "
+               "excitation (refitted with the base): not distinguishable"
+               if name == "joint_damping" else "needs base excitation")  # fmt: skip
+        verdicts.append(StructureCandidate(name, False, why))
+        return None
+    effects = (*cur.effects, name)
+    fits = []
+    for extra in _extra_starts(name, model, cur, d):
+        ps = _base_params(model, cur.values)
+        for e in cur.effects:  # parameters of effects added before
+            for key, unit in _EXTRA[e]:
+                val = cur.values[key]
+                ps.append(Parameter(key, val, min=0.0 if key != "e" else -np.inf,
+                                    unit=unit, scale=abs(val) or None))  # fmt: skip
+        try:
+            fits.append(_fit(model, effects, ps + extra, d, max_nfev)[0])
+        except ContactLabError as exc:
+            verdicts.append(StructureCandidate(name, False, f"fit failed: {exc}"))
+    if not fits:
+        return None
+    cand = min(fits, key=lambda f: f.train_rss)
+    ok, reason, gain, tstat = _judge(name, cur, cand, d, sigma, z, min_gain, min_share)
+    why = _implausible(name, cand, model, d)
+    if ok and why:
+        ok, reason = False, f"implausible: {why}"
+    keys = [k for k, _ in _EXTRA[name]]
+    loose = [k for k in keys if not _determined(cand.values[k], cand.stderr.get(k))]
+    if ok and loose:
+        ok, reason = (
+            False,
+            "not determined by the record: "
+            + ", ".join(f"{k} = {cand.values[k]:.4g} ± {_fmt(cand.stderr.get(k))}" for k in loose),
+        )
+    verdicts.append(StructureCandidate(
+        name, ok, reason, cand.heldout_rms(d), gain, tstat,
+        {k: cand.values[k] for k in keys}, {k: cand.stderr.get(k) for k in keys},
+    ))  # fmt: skip
+    return (gain, cand) if ok else None
+
+
+def _joint_force(model: Any, f: Any, d: Any, n: int) -> np.ndarray | None:
+    """The joint force of fit ``f`` over the whole record (None when it does not simulate)."""
+    try:
+        return np.asarray(_simulate(model, f.effects, f.values, d, n).joint_force)
+    except ContactLabError:
+        return None

@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from .._moved import moved
+from .._options import takes_options
 from ..errors import InputError
 from ._family import Family, Prepared
 from ._inputs import arrays as _arrays
@@ -268,7 +269,7 @@ class DiagnosisReport:
                 out.append(wrap(f"why plausible: {e.plausibility}", "  ", "    "))
         coeffs = self.final_model.coefficients()
         if coeffs is not None and ({"a", "kappa"} & set(self.final_model.params)):
-            out.append(
+            law = (
                 "Stiffness law (eq. 6): "
                 + ", ".join(
                     f"{k} = {v:.4g} {u}"
@@ -276,6 +277,7 @@ class DiagnosisReport:
                 )
                 + f" (κ and a are relative to δ_r = {self.final_model.context['delta_r']:.4g} m)"
             )
+            out.append(wrap(law, "", "    "))
         unit = getattr(self.final_model.family, "output_unit", "")
         out += ["", self.table(unit), self.noise_text()]
         if self.channel_noise is not None:  # issue 29: stated power, unexplained structure
@@ -284,9 +286,9 @@ class DiagnosisReport:
                 f"channel noise: input {cn.input:.3g} {cn.input_unit}, output "
                 f"{cn.output:.3g} {cn.output_unit}"
             )
-            out += [f"  - {b.sentence()}" for b in self.not_detected]
+            out += [wrap(b.sentence(), "  - ", "    ") for b in self.not_detected]
         if self.unexplained is not None:
-            out.append(self.unexplained.sentence())
+            out.append(wrap(self.unexplained.sentence(), "", "    "))
         return "\n".join(out)
 
     # -- figures ------------------------------------------------------------------------------
@@ -441,6 +443,7 @@ def infer_model(recording: Any) -> str:
 
 
 @one_blas_thread
+@takes_options
 def diagnose(
     recording: Any,
     model: Any = None,

@@ -225,7 +225,15 @@ class JointLaw:
         """``(kind, own parameters, children)``: the description the Rust core builds the law
         from (children: the specs of the laws a composite holds); :func:`from_spec` inverts
         it."""
-        return (self.name, [float(v) for v in self._values()], [])
+        return (self._kind(), [float(v) for v in self._values()], [])
+
+    def _kind(self) -> str:
+        """Registry name of the nearest registered class (a subclass with a name of its own
+        runs on its parent's kernel)."""
+        for cls in type(self).__mro__:
+            if LAWS.get(getattr(cls, "name", "")) is cls:
+                return cls.name
+        raise InputError(f"{self.name}: not derived from a registered joint law")
 
     @property
     def initial_stiffness(self) -> float:
@@ -910,7 +918,7 @@ class _Composite(JointLaw):
         return out
 
     def spec(self) -> tuple[str, list[float], list[Any]]:
-        return (self.name, [float(v) for v in self._own()], [law.spec() for law in self.laws])
+        return (self._kind(), [float(v) for v in self._own()], [law.spec() for law in self.laws])
 
     def _split(self, values: list[float]) -> tuple[list[float], list[JointLaw]]:
         n = len(self._OWN)

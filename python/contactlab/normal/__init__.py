@@ -18,6 +18,7 @@ from .compare import (
 )
 from .loop import LoopResult, analyze_loop
 from .models import KelvinVoigt, NonlinearContact, OdeResult
+from .options import Options
 from .paper import TABLE2_MPA_UM
 from .stiffness import PressureStiffnessFit, fit_pressure_stiffness
 
@@ -28,6 +29,7 @@ __all__ = [
     "LoopResult",
     "NonlinearContact",
     "OdeResult",
+    "Options",
     "PressureStiffnessFit",
     "analyze_loop",
     "compare",

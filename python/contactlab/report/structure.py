@@ -203,13 +203,13 @@ def _mdof_loop(ax: Any, model: IdentifiedModel, sim: Any, t: np.ndarray, u: np.n
 
 
 # ------------------------------------------------------------------ structure diagnosis
-def build_diagnosis_report(diag: Any) -> Report:
+def build_diagnosis_report(diag: Any, intro: str | None = None) -> Report:
     """The HTML report of a :class:`~contactlab.diagnose.structure.StructureDiagnosis`:
     findings, the named effects with their parameters ± standard errors, the held-out error
     after each step, measured against simulated response (base and final model), the joint's
     loop, the residual before and after (time and spectrum), the unexplained part with where
-    it lives, and every candidate's verdict."""
-    from matplotlib.figure import Figure
+    it lives, and every candidate's verdict. ``intro`` (the "Made by" line of a command-line
+    run) heads it."""
 
     from .._html import format_measurement
 
@@ -219,9 +219,8 @@ def build_diagnosis_report(diag: Any) -> Report:
 
         raise InputError("this diagnosis carries no record (loaded from JSON?): re-run "
                          "diagnose_structure to write its report")  # fmt: skip
-    t, u, y = rec["t"], rec["u"], rec["y"]
+    y = rec["y"]
     base, final = diag.base_prediction, y + diag.residual
-    ntr = diag.n_train
     sigma = diag.noise_rms
     r = Report(
         f"Structure diagnosis: {diag.joint} joint, {diag.excitation} excitation",
@@ -229,12 +228,27 @@ def build_diagnosis_report(diag: Any) -> Report:
         "refitted on the first part of the record and judged on the held-out end, which no fit "
         "saw (dashed line in the figures).",
     )
+    if intro:
+        r.text(intro)
+    _diag_findings(r, diag, format_measurement)
+    _diag_tables(r, diag, sigma)
+    _diag_response(r, diag, base, final, sigma)
+    _diag_joint_loop(r, diag, base, final)
+    _diag_residual(r, diag, base, final, sigma)
+    _diag_candidates(r, diag, format_measurement)
+    r.section("Result (JSON)")
+    r.preformatted(diag.to_json())
+    return r
+
+
+def _diag_findings(r: Report, diag: Any, fmt: Any) -> None:
+    """Findings: the named effects, where the model disagrees, explained or not."""
     r.section("Findings")
     if diag.effects:
         for name in diag.effects:
             keys = [k for k in diag.parameters if k in _EXTRA_KEYS.get(name, ())]
             r.text(f"Named: {name} — " + ", ".join(
-                f"{k} = {_pm(diag.parameters[k], diag.stderr.get(k), format_measurement)}"
+                f"{k} = {_pm(diag.parameters[k], diag.stderr.get(k), fmt)}"
                 for k in keys))  # fmt: skip
     else:
         r.text("No candidate improves the held-out error significantly.")
@@ -246,6 +260,10 @@ def build_diagnosis_report(diag: Any) -> Report:
          if diag.unexplained else "Explained: the final model's held-out error is within "
          "1.5 × the noise level."), note=diag.unexplained,
     )  # fmt: skip
+
+
+def _diag_tables(r: Report, diag: Any, sigma: float) -> None:
+    """The final model's parameters and the held-out error after each step."""
     r.section("Parameters of the final model")
     r.table(
         [
@@ -279,6 +297,14 @@ def build_diagnosis_report(diag: Any) -> Report:
         ],
     )
     r.text(f"Noise RMS estimated from the data: {sigma:.4g} m")
+
+
+def _diag_response(r: Report, diag: Any, base: np.ndarray, final: np.ndarray, sigma: float) -> None:
+    """Input, measured and simulated displacement, residual before and after."""
+    from matplotlib.figure import Figure
+
+    t, y, ntr = diag.record["t"], diag.record["y"], diag.n_train
+    u = diag.record["u"]
     r.section("Response")
     fig = Figure(figsize=(10, 6.5), layout="constrained")
     ax = fig.subplots(3, 1, sharex=True)
@@ -303,6 +329,13 @@ def build_diagnosis_report(diag: Any) -> Report:
         a.axvline(t[ntr], color="k", ls="--", lw=0.8)
     r.figure(fig, "response", "Input; measured and simulated displacement (base and final "
              "model); residual before and after (dotted: ± 2 × noise RMS).", dpi=110)  # fmt: skip
+
+
+def _diag_joint_loop(r: Report, diag: Any, base: np.ndarray, final: np.ndarray) -> None:
+    """The joint's simulated force against the displacement on the held-out part."""
+    from matplotlib.figure import Figure
+
+    ntr = diag.n_train
     r.section("Joint loop")
     fig = Figure(figsize=(6.5, 4.6), layout="constrained")
     ax1 = fig.add_subplot()
@@ -315,9 +348,20 @@ def build_diagnosis_report(diag: Any) -> Report:
                          label="final model: all joint elements")  # fmt: skip
     ax1.set_xlabel("displacement of the mass [m]")
     ax1.set_ylabel("joint force [N]")
-    ax1.legend(loc="upper left", fontsize=8)
+    if ax1.get_lines():
+        ax1.legend(loc="upper left", fontsize=8)
+    else:  # a linear model has no joint (matplotlib warned of a legend with no entries)
+        ax1.text(0.5, 0.5, f"no joint force: the {diag.joint} model has no joint",
+                 ha="center", va="center", transform=ax1.transAxes)  # fmt: skip
     r.figure(fig, "joint-loop", "The joint's force against the displacement on the held-out "
              "part (simulated).", dpi=110)  # fmt: skip
+
+
+def _diag_residual(r: Report, diag: Any, base: np.ndarray, final: np.ndarray, sigma: float) -> None:
+    """The held-out residual's spectrum and its size against the speed of the mass."""
+    from matplotlib.figure import Figure
+
+    t, y, ntr = diag.record["t"], diag.record["y"], diag.n_train
     r.section("Residual: where the unexplained part lives")
     fig = Figure(figsize=(10, 3.8), layout="constrained")
     axs = fig.subplots(1, 2)
@@ -339,6 +383,10 @@ def build_diagnosis_report(diag: Any) -> Report:
         a.legend(fontsize=8)
     r.figure(fig, "residual-where", "Held-out residual: its spectrum, and its size against the "
              "speed of the mass (near reversals on the left).", dpi=110)  # fmt: skip
+
+
+def _diag_candidates(r: Report, diag: Any, fmt: Any) -> None:
+    """Every candidate's verdict after each step."""
     r.section("Candidates tried")
     for i, s in enumerate(diag.steps):
         if s["candidates"]:
@@ -347,15 +395,11 @@ def build_diagnosis_report(diag: Any) -> Report:
             for c in s["candidates"]:
                 d = c.to_dict()
                 d["parameters"] = ", ".join(
-                    f"{k} = {_pm(val, c.stderr.get(k), format_measurement)}"
-                    for k, val in c.parameters.items()
+                    f"{k} = {_pm(val, c.stderr.get(k), fmt)}" for k, val in c.parameters.items()
                 )
                 rows.append(d)
             r.table(rows, ["name", "accepted", Column("heldout_rms", "held-out RMS", unit="m"),
                            Column("gain", "gain / σ²"), "t", "parameters", "reason"])  # fmt: skip
-    r.section("Result (JSON)")
-    r.preformatted(diag.to_json())
-    return r
 
 
 #: the parameters each structure candidate adds (as diagnose.structure names them)
@@ -368,7 +412,7 @@ def _pm(value: float, stderr: float | None, fmt: Any) -> str:
     return str(fmt(value, stderr))
 
 
-def write_diagnosis_html(diag: Any, directory: Any) -> Path:
+def write_diagnosis_html(diag: Any, directory: Any, intro: str | None = None) -> Path:
     """Write a structure diagnosis as ``diagnose.html`` (see :func:`build_diagnosis_report`),
     its figures under ``figures/`` and ``diagnose.json`` into ``directory``, all or nothing.
 
@@ -378,12 +422,14 @@ def write_diagnosis_html(diag: Any, directory: Any) -> Path:
         The result of :func:`contactlab.diagnose.diagnose_structure`.
     directory : path
         Output folder (created if missing).
+    intro : str, optional
+        A line heading the report (the command line that made it).
 
     Returns
     -------
     Path
         The HTML file written.
     """
-    rep = build_diagnosis_report(diag)
+    rep = build_diagnosis_report(diag, intro)
     extra = {"diagnose.json": (diag.to_json() + "\n").encode("utf-8")}
     return rep.write(directory, extra=extra, html_name="diagnose.html")[0]

@@ -24,6 +24,7 @@ from __future__ import annotations
 import json
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -537,6 +538,7 @@ def identify(
     masks: dict[str, Any] | None = None,
     joint_dofs: Any = (0, None),
     input_dof: int | None = None,
+    progress: Callable[[str], None] | None = None,
 ) -> IdentifiedModel:
     """Identify ``m``, ``c``, ``k`` and a joint from input ``u`` and response ``y``.
 
@@ -575,17 +577,16 @@ def identify(
         Fit every start on the first ``start_samples`` samples and refine the best.
     estimate_initial_state : bool
         Fit ``x0`` and ``v0`` (else the record starts from rest).
+    progress : callable, optional
+        Called with the stage (``"starts"``, ``"fit"``, ``"errors"``) after every simulation
+        of a single-DOF identification (a progress bar counts them).
 
     Returns
     -------
     IdentifiedModel
     """
     t0 = time.perf_counter()
-    joint = str(joint).lower().replace("-", "_")
-    if joint not in JOINTS:
-        raise InputError(f"joint must be one of {', '.join(JOINTS)}; got {joint!r}")
-    if excitation not in ("force", "base"):
-        raise InputError(f"excitation must be 'force' or 'base', got {excitation!r}")
+    joint = _checked_kind(joint, excitation)
     if np.ndim(y) == 2 and np.shape(y)[1] > 1:
         from .identify_mdof import identify_mdof
 
@@ -599,6 +600,55 @@ def identify(
         model = IdentifiedModel(**fields)
         model.elapsed = time.perf_counter() - t0
         return model
+    t, u, y = _checked_sdof_record(t, u, y, excitation, mass)
+    if interpolation == "auto":
+        interpolation = "fourier" if periodic else "linear"
+    if periodic is None:
+        periodic = interpolation == "fourier"
+    lin, lins = _linear_starts(t, u, y, excitation, mass, bool(periodic))
+
+    residual_on = _SdofResidual(joint, excitation, t, u, y, interpolation, substeps, progress)
+
+    starts = _starts(joint)
+    records: list[dict[str, Any]] = []
+    n_s = min(int(start_samples), t.size)
+    plan = [(st0 if len(lins) == 1 else {**st0, "grid_f": li["grid_f"]}, li, st0)
+            for li in lins for st0 in starts]  # fmt: skip
+    if len(lins) > 1 and joint in ("masing", "jenkins", "iwan"):
+        # the linear grid cannot hold the mass against a joint to the fixed ground (what a
+        # frame rubbing on a wall does on a short record): explore the joint's stiffness
+        # share and slip force on the grid of frequencies, one simulation each (first), as
+        # well as the usual starts on the linear grid's models
+        plan = _joint_grid_plan(joint, lin, y, mass, t, residual_on(n_s, 2)) + plan
+    est = estimate_initial_state
+    best_ps = hold_state(_params(joint, plan[0][1], y, mass, plan[0][2]), est)
+    if multistart and len(plan) > 1:
+        tried = [(st, hold_state(_params(joint, li, y, mass, st0), est)) for st, li, st0 in plan]
+        best_ps = best_start(tried, residual_on(n_s, 2), records) or best_ps
+    fit = least_squares_fit(residual_on(t.size), best_ps, max_nfev=max_nfev, ftol=1e-7,
+                            xtol=1e-7, gtol=1e-10)  # fmt: skip
+    # the residuals of an output-error fit are correlated in time (input noise filtered by
+    # the structure): the white-noise covariance understated the errors several-fold
+    v = fit.values
+    r_fit = residual_on(t.size)(v)
+    fit, noise = noise_model_covariance(
+        fit, lambda du: residual_on(t.size, substeps, u + du)(v) - r_fit, u
+    )
+    model = IdentifiedModel(
+        structure=build_structure(joint, v, excitation), joint=joint, excitation=excitation,
+        fit=fit, x0=float(v["x0"]), v0=float(v["v0"]), substeps=int(substeps),
+        interpolation=interpolation, rms=float(np.sqrt(fit.chisqr / max(fit.ndata, 1))),
+        starts=records, noise=noise,
+    )  # fmt: skip
+    model.elapsed = time.perf_counter() - t0
+    return model
+
+
+def _checked_sdof_record(
+    t: Any, u: Any, y: Any, excitation: str, mass: float | None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One DOF's record as checked arrays: same lengths, enough samples, physical magnitudes,
+    increasing time, the mass given under base excitation."""
     if np.ndim(y) == 2 and np.shape(y)[1] == 1:
         y = np.asarray(y)[:, 0]
     t = as_1d(t, "t")
@@ -621,11 +671,15 @@ def identify(
         raise InputError("t must be strictly increasing")
     if excitation == "base" and mass is None:
         raise InputError("base excitation needs the mass: pass mass=... (kg)")
-    if interpolation == "auto":
-        interpolation = "fourier" if periodic else "linear"
-    if periodic is None:
-        periodic = interpolation == "fourier"
-    lin = equation_error(t, u, y, excitation, mass, periodic=bool(periodic))
+    return t, u, y
+
+
+def _linear_starts(
+    t: np.ndarray, u: np.ndarray, y: np.ndarray, excitation: str, mass: float | None,
+    periodic: bool,
+) -> tuple[dict[str, Any], list[dict[str, Any]]]:  # fmt: skip
+    """The equation-error linear model and the linear models that seed the joint's starts."""
+    lin = equation_error(t, u, y, excitation, mass, periodic=periodic)
     lins = [lin]
     if not (lin["k"] > 0 and lin["m"] > 0):
         # a short or slow record (a few hundred samples, the mass following the base) can
@@ -644,12 +698,34 @@ def identify(
         # dissipation, which the joint's parameters are to take over
         lins = [{**lin, **g, "c": 0.02 * math.sqrt(g["k"] * g["m"])} for g in grid]
         lin = lins[0]
+    return lin, lins
 
-    def residual_on(n: int, sub: int = substeps, u_in: np.ndarray | None = None) -> Any:
+
+class _SdofResidual:
+    """``residual_on(n, sub, u_in)``: the output-error residual of the first ``n`` samples
+    (simulated with ``sub`` substeps, the input ``u_in`` if given) as a function of the
+    fitted values. ``progress`` (optional) is called with the stage after each simulation."""
+
+    def __init__(
+        self, joint: str, excitation: str, t: np.ndarray, u: np.ndarray, y: np.ndarray,
+        interpolation: str, substeps: int, progress: Callable[[str], None] | None = None,
+    ) -> None:  # fmt: skip
+        self.joint, self.excitation, self.t, self.u, self.y = joint, excitation, t, u, y
+        self.interpolation, self.substeps = interpolation, substeps
+        self.progress = progress
+
+    def __call__(self, n: int, sub: int | None = None, u_in: np.ndarray | None = None) -> Any:
+        sub = self.substeps if sub is None else sub
+        t, u, y, joint, excitation = self.t, self.u, self.y, self.joint, self.excitation
         tt, uu, yy = t[:n], (u[:n] if u_in is None else u_in), y[:n]
-        interp = interpolation if n == t.size else "linear"
+        interp = self.interpolation if n == t.size else "linear"
+        progress = self.progress
+        full = n == t.size and sub == self.substeps
+        stage = "errors" if u_in is not None else "fit" if full else "starts"
 
         def res(v: dict[str, float]) -> np.ndarray:
+            if progress is not None:
+                progress(stage)
             try:
                 s = build_structure(joint, v, excitation)
                 kw = {"force": uu} if excitation == "force" else {"base": uu}
@@ -664,45 +740,13 @@ def identify(
 
         return res
 
-    def with_state(ps: list[Parameter]) -> list[Parameter]:
-        return hold_state(ps, estimate_initial_state)
 
-    starts = _starts(joint)
-    records: list[dict[str, Any]] = []
-    n_s = min(int(start_samples), t.size)
-    plan = [(st0 if len(lins) == 1 else {**st0, "grid_f": li["grid_f"]}, li, st0)
-            for li in lins for st0 in starts]  # fmt: skip
-    if len(lins) > 1 and joint in ("masing", "jenkins", "iwan"):
-        # the linear grid cannot hold the mass against a joint to the fixed ground (what a
-        # frame rubbing on a wall does on a short record): explore the joint's stiffness
-        # share and slip force on the grid of frequencies, one simulation each (first), as
-        # well as the usual starts on the linear grid's models
-        plan = _joint_grid_plan(joint, lin, y, mass, t, residual_on(n_s, 2)) + plan
-    best_ps = with_state(_params(joint, plan[0][1], y, mass, plan[0][2]))
-    if multistart and len(plan) > 1:
-        tried = [(st, with_state(_params(joint, lin_i, y, mass, st0))) for st, lin_i, st0 in plan]
-        best_ps = best_start(tried, residual_on(n_s, 2), records) or best_ps
-    fit = least_squares_fit(residual_on(t.size), best_ps, max_nfev=max_nfev, ftol=1e-7,
-                            xtol=1e-7, gtol=1e-10)  # fmt: skip
-    # the residuals of an output-error fit are correlated in time (input noise filtered by
-    # the structure): the white-noise covariance understated the errors several-fold
-    v = fit.values
-    r_fit = residual_on(t.size)(v)
-    fit, noise = noise_model_covariance(
-        fit, lambda du: residual_on(t.size, substeps, u + du)(v) - r_fit, u
-    )
-    model = IdentifiedModel(
-        structure=build_structure(joint, v, excitation),
-        joint=joint,
-        excitation=excitation,
-        fit=fit,
-        x0=float(v["x0"]),
-        v0=float(v["v0"]),
-        substeps=int(substeps),
-        interpolation=interpolation,
-        rms=float(np.sqrt(fit.chisqr / max(fit.ndata, 1))),
-        starts=records,
-        noise=noise,
-    )
-    model.elapsed = time.perf_counter() - t0
-    return model
+def _checked_kind(joint: str, excitation: str) -> str:
+    """The joint's name in canonical spelling; a typed error for an unknown joint or
+    excitation."""
+    joint = str(joint).lower().replace("-", "_")
+    if joint not in JOINTS:
+        raise InputError(f"joint must be one of {', '.join(JOINTS)}; got {joint!r}")
+    if excitation not in ("force", "base"):
+        raise InputError(f"excitation must be 'force' or 'base', got {excitation!r}")
+    return joint

@@ -340,63 +340,11 @@ def identify_mdof(
         raise InputError(
             f"with several DOFs, joint must be one of {', '.join(MDOF_JOINTS)}; got {joint!r}"
         )
-    t = as_1d(t, "t")
-    u = as_1d(u, "u")
-    try:
-        y = np.array(y, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"y cannot be converted to a float array: {exc}") from None
-    if y.ndim != 2:
-        raise InputError(f"y must be (n_samples, n_dofs), got shape {y.shape}")
-    if not np.all(np.isfinite(y)):
-        i, j = np.argwhere(~np.isfinite(y))[0]
-        raise InputError(f"y[{i}, {j}] is not finite")
+    t, u, y = _checked_mdof_record(t, u, y)
     nt, n = y.shape
-    if not (t.size == u.size == nt):
-        raise InputError(f"t, u and y differ in length ({t.size}, {u.size}, {nt})")
-    if nt < 20:
-        raise InputError(f"{nt} samples are too few to identify a structure")
-    big = float(np.max(np.abs(u)))
-    if big > MAX_MAGNITUDE:
-        raise InputError(f"u reaches {big:.3g}: beyond any physical input; a unit mix-up or a "
-                         "corrupt file?")  # fmt: skip
-    for j in range(n):  # each DOF's displacement: in range, not zero, not constant
-        check_channel(f"y[:, {j}]", y[:, j], "m", f"displacement (DOF {j})")
-    if np.any(np.diff(t) <= 0):
-        raise InputError("t must be strictly increasing")
-    if isinstance(structure, str) and structure == "chain" and masks is None:
-        pattern = chain_pattern(n)
-    elif masks is not None or structure == "masks":
-        pattern = mask_pattern(dict(masks or {}), n)
-    else:
-        raise InputError(
-            f"structure must be 'chain' or masks=... of free entries, got {structure!r}"
-        )
-    try:
-        jd = tuple(joint_dofs)
-        i_j = int(jd[0])
-        j_j = None if len(jd) < 2 or jd[1] is None else int(jd[1])
-    except (TypeError, ValueError, IndexError):
-        raise InputError(f"joint_dofs must be (i, j) or (i, None), got {joint_dofs!r}") from None
-    for d in (i_j, j_j):
-        if d is not None and not 0 <= d < n:
-            raise InputError(f"joint_dofs {joint_dofs!r}: DOF {d} is outside 0..{n - 1}")
-    if i_j == j_j:
-        raise InputError("joint_dofs must name two different DOFs (or one and None: ground)")
-    if excitation == "force":
-        input_dof = n - 1 if input_dof is None else int(input_dof)
-        if not 0 <= input_dof < n:
-            raise InputError(f"input_dof = {input_dof} is outside 0..{n - 1}")
-    mass_m = None
-    if mass is not None:
-        mm = np.asarray(mass, dtype=float)
-        mass_m = np.diag(mm) if mm.ndim == 1 else mm
-        if mass_m.shape != (n, n) or not np.all(np.isfinite(mass_m)):
-            raise InputError(f"mass must be {n} masses or an {n}×{n} matrix, got {mm.shape}")
-        if np.any(np.diag(mass_m) <= 0):
-            raise InputError("mass: every diagonal entry must be > 0")
-    elif excitation == "base":
-        raise InputError("base excitation needs the masses: pass mass=[m0, m1, ...] (kg)")
+    pattern = _pattern(structure, masks, n)
+    i_j, j_j, input_dof = _dofs(joint_dofs, input_dof, excitation, n)
+    mass_m = _mass_matrix(mass, n, excitation)
     if interpolation == "auto":
         interpolation = "fourier" if periodic else "linear"
     if periodic is None:
@@ -407,19 +355,7 @@ def identify_mdof(
         b[j_j] = -1.0
     jdofs = (i_j, j_j)
     if joint == "kelvin_voigt":
-        # a linear spring-damper across the joint is one more stiffness and damping entry:
-        # identifiable only where the pattern has none along the same direction
-        bb = np.outer(b, b).ravel()
-        for kind, what in (("K", "spring"), ("C", "dashpot")):
-            Bm = np.stack([B.ravel() for _, B in pattern.basis[kind]], axis=1)
-            coef, *_ = np.linalg.lstsq(Bm, bb, rcond=None)
-            if np.linalg.norm(Bm @ coef - bb) < 1e-9:
-                where = "the ground" if j_j is None else f"DOF {j_j}"
-                raise InputError(
-                    f"a Kelvin-Voigt joint between DOF {i_j} and {where} duplicates the "
-                    f"structure's own {what} there ({kind} entries of the "
-                    f"{pattern.kind}); give masks= that leave that coupling out"
-                )
+        _check_kv_joint(pattern, b, i_j, j_j)
 
     def ee(kj: float, coulomb: bool) -> dict[str, Any]:
         return equation_error_mdof(t, u, y, pattern, excitation, input_dof or 0, jdofs, mass_m,
@@ -494,3 +430,98 @@ def identify_mdof(
         "pattern": pattern,
         "noise": noise,
     }
+
+
+def _checked_mdof_record(t: Any, u: Any, y: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Several DOFs' record as checked arrays: ``y`` (samples × DOFs) finite, same lengths,
+    enough samples, physical magnitudes, increasing time."""
+    t = as_1d(t, "t")
+    u = as_1d(u, "u")
+    try:
+        y = np.array(y, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"y cannot be converted to a float array: {exc}") from None
+    if y.ndim != 2:
+        raise InputError(f"y must be (n_samples, n_dofs), got shape {y.shape}")
+    if not np.all(np.isfinite(y)):
+        i, j = np.argwhere(~np.isfinite(y))[0]
+        raise InputError(f"y[{i}, {j}] is not finite")
+    nt, n = y.shape
+    if not (t.size == u.size == nt):
+        raise InputError(f"t, u and y differ in length ({t.size}, {u.size}, {nt})")
+    if nt < 20:
+        raise InputError(f"{nt} samples are too few to identify a structure")
+    big = float(np.max(np.abs(u)))
+    if big > MAX_MAGNITUDE:
+        raise InputError(f"u reaches {big:.3g}: beyond any physical input; a unit mix-up or a "
+                         "corrupt file?")  # fmt: skip
+    for j in range(n):  # each DOF's displacement: in range, not zero, not constant
+        check_channel(f"y[:, {j}]", y[:, j], "m", f"displacement (DOF {j})")
+    if np.any(np.diff(t) <= 0):
+        raise InputError("t must be strictly increasing")
+    return t, u, y
+
+
+def _pattern(structure: Any, masks: dict[str, Any] | None, n: int) -> Any:
+    """The free entries of ``M``, ``C``, ``K``: a chain of ``n`` DOFs or the given masks."""
+    if isinstance(structure, str) and structure == "chain" and masks is None:
+        return chain_pattern(n)
+    elif masks is not None or structure == "masks":
+        return mask_pattern(dict(masks or {}), n)
+    else:
+        raise InputError(
+            f"structure must be 'chain' or masks=... of free entries, got {structure!r}"
+        )
+
+
+def _dofs(
+    joint_dofs: Any, input_dof: int | None, excitation: str, n: int
+) -> tuple[int, int | None, int | None]:
+    """The joint's DOFs ``(i, j or None)`` and the force's DOF, checked against ``n``."""
+    try:
+        jd = tuple(joint_dofs)
+        i_j = int(jd[0])
+        j_j = None if len(jd) < 2 or jd[1] is None else int(jd[1])
+    except (TypeError, ValueError, IndexError):
+        raise InputError(f"joint_dofs must be (i, j) or (i, None), got {joint_dofs!r}") from None
+    for d in (i_j, j_j):
+        if d is not None and not 0 <= d < n:
+            raise InputError(f"joint_dofs {joint_dofs!r}: DOF {d} is outside 0..{n - 1}")
+    if i_j == j_j:
+        raise InputError("joint_dofs must name two different DOFs (or one and None: ground)")
+    if excitation == "force":
+        input_dof = n - 1 if input_dof is None else int(input_dof)
+        if not 0 <= input_dof < n:
+            raise InputError(f"input_dof = {input_dof} is outside 0..{n - 1}")
+    return i_j, j_j, input_dof
+
+
+def _mass_matrix(mass: Any, n: int, excitation: str) -> np.ndarray | None:
+    """The given masses as an ``n``×``n`` matrix (None: to be identified)."""
+    mass_m = None
+    if mass is not None:
+        mm = np.asarray(mass, dtype=float)
+        mass_m = np.diag(mm) if mm.ndim == 1 else mm
+        if mass_m.shape != (n, n) or not np.all(np.isfinite(mass_m)):
+            raise InputError(f"mass must be {n} masses or an {n}×{n} matrix, got {mm.shape}")
+        if np.any(np.diag(mass_m) <= 0):
+            raise InputError("mass: every diagonal entry must be > 0")
+    elif excitation == "base":
+        raise InputError("base excitation needs the masses: pass mass=[m0, m1, ...] (kg)")
+    return mass_m
+
+
+def _check_kv_joint(pattern: Any, b: np.ndarray, i_j: int, j_j: int | None) -> None:
+    """A linear spring-damper across the joint is one more stiffness and damping entry:
+    identifiable only where the pattern has none along the same direction."""
+    bb = np.outer(b, b).ravel()
+    for kind, what in (("K", "spring"), ("C", "dashpot")):
+        Bm = np.stack([B.ravel() for _, B in pattern.basis[kind]], axis=1)
+        coef, *_ = np.linalg.lstsq(Bm, bb, rcond=None)
+        if np.linalg.norm(Bm @ coef - bb) < 1e-9:
+            where = "the ground" if j_j is None else f"DOF {j_j}"
+            raise InputError(
+                f"a Kelvin-Voigt joint between DOF {i_j} and {where} duplicates the "
+                f"structure's own {what} there ({kind} entries of the "
+                f"{pattern.kind}); give masks= that leave that coupling out"
+            )

@@ -268,13 +268,7 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
         fname = raw["file"].strip()
         if not fname:
             raise InputError(f"{where}, column 'file': empty file name")
-        fpath = Path(fname)
-        if not fpath.is_absolute():
-            fpath = mpath.parent / fpath
-        if not fpath.exists():
-            raise InputError(f"{where}, column 'file': {fpath} does not exist")
-        if not fpath.is_file():
-            raise InputError(f"{where}, column 'file': {fpath} is a folder, not a recording file")
+        fpath = _recording_path(mpath, fname, where)
         tags = tags_from_filename(fpath)
         columns = None
         for j, (key, factor, cell) in enumerate(zip(keys, factors, cells, strict=True)):
@@ -321,6 +315,18 @@ def read_manifest(path: str | os.PathLike[str]) -> list[StudyEntry]:
     if not entries:
         raise InputError(f"manifest {mpath} lists no recordings")
     return entries
+
+
+def _recording_path(mpath: Path, fname: str, where: str) -> Path:
+    """A manifest row's recording file (relative to the manifest's folder), which exists."""
+    fpath = Path(fname)
+    if not fpath.is_absolute():
+        fpath = mpath.parent / fpath
+    if not fpath.exists():
+        raise InputError(f"{where}, column 'file': {fpath} does not exist")
+    if not fpath.is_file():
+        raise InputError(f"{where}, column 'file': {fpath} is a folder, not a recording file")
+    return fpath
 
 
 __all__ = ["TAG_UNITS", "StudyEntry", "entry_from_file", "read_manifest", "si_unit",

@@ -20,7 +20,7 @@ windows:
 - ``stick_slip``: ``n_reversals`` summed over the windows; the search's counts and means
   over the windows that searched for sticks (null where none did: a streamed window of a
   pre-sliding or transition loop counts its reversals but does not search them, see
-  :func:`contactlab.tangential.analysis.analyze_window`).
+  :func:`contactlab.tangential.window.analyze_window`).
 
 ``streamed`` (True), ``streamed_reason``, ``n_windows``, ``n_samples`` and ``every`` say how
 it was made.
@@ -223,6 +223,7 @@ def pooled_document(docs: list[dict[str, Any]], *, reason: str) -> dict[str, Any
         "breakaway_force_stderr": None,
         "velocity_threshold": None,
         "smooth_turn_dwell": None,
+        "reversals_with_dwell": None,
         "units": {
             "stick_duration": "s",
             "breakaway_force": "N",
@@ -237,7 +238,7 @@ def pooled_document(docs: list[dict[str, Any]], *, reason: str) -> dict[str, Any
             if k != "units":
                 vals = [_num(s.get(k)) for s in sticks]
                 st[k] = float(np.nanmean(vals)) if np.any(np.isfinite(vals)) else None
-        for k in ("n_reversals", "reversals_with_stick"):
+        for k in ("n_reversals", "reversals_with_stick", "reversals_with_dwell"):
             # over the windows that counted them (streamed windows below gross sliding count
             # their reversals but do not search them for sticks: null when none did)
             vals = [_num(s.get(k)) for s in sticks]

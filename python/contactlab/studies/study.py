@@ -431,8 +431,9 @@ def run_study(
         If False (default) the first recording that cannot be read or analysed stops the study
         with its error (naming the file). If True it is recorded in ``failures`` and skipped
         (unexpected errors too, with their type, so one odd file does not cost a long study).
-    tangential_options, normal_options : mapping, optional
-        Keyword arguments for the per-recording analyses.
+    tangential_options, normal_options : Options or mapping, optional
+        Keyword arguments for the per-recording analyses: :class:`contactlab.tangential.Options`
+        / :class:`contactlab.normal.Options` or dicts of the same names.
     callback : callable, optional
         Called with each :class:`RecordingResult` as it completes.
     executor : optional
@@ -459,8 +460,10 @@ def run_study(
     >>> row["material"], row["normal_load"], round(row["h0"], 1)  # SI: N, N
     ('Al/Al', 50.0, 21.0)
     """
+    from .._options import as_dict
     from .executor import ordered_map
 
+    tangential_options, normal_options = as_dict(tangential_options), as_dict(normal_options)
     entries = collect_entries(source)
     keep = executor is None if keep_recordings is None else bool(keep_recordings)
     task = functools.partial(

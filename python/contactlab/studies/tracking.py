@@ -6,7 +6,7 @@ and cuts it into windows of N cycles or T seconds (cut at upward crossings of th
 every window holds whole cycles), analyses each window as the whole-recording analyses do and
 keeps only the results:
 
-- tangential windows: :func:`contactlab.tangential.analysis.analyze_window` (the numbers of
+- tangential windows: :func:`contactlab.tangential.window.analyze_window` (the numbers of
   :func:`~contactlab.tangential.analyze_tangential`, the samples folded once in Rust) — h0,
   ac (None where the analysis finds them not separately identifiable; ``h0_ac`` always),
   energy per cycle
@@ -26,344 +26,44 @@ streamed analysis.
 from __future__ import annotations
 
 import contextlib
-import csv
 import functools
-import io
 import math
-import re
 from collections import deque
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED
 from concurrent.futures import wait as futures_wait
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from .._json import dumps, jsonable
+from .._options import as_dict
 from .._physical import MAX_MAGNITUDE
 from ..errors import ContactLabError, ContactLabWarning, InputError
 from ..io import Recording, read_chunks
-from ..io.units import UnknownUnitError, to_si
 from ._cycles import CycleState, block_cycles, trigger_levels
 from .columns import CYCLE_UNITS
-from .pooled import pool
 from .study import coefficient_unit
-
-#: tangential quantities tracked per window (each with ``*_stderr``)
-TANGENTIAL_QUANTITIES = (
-    "h0",
-    "ac",
-    "h0_ac",
-    "energy_per_cycle",
-    "energy_per_cycle_numeric",
-    "equivalent_damping",
-    "k_local0",
-    "k_global",
-    "amplitude",
-    "offset",
+from .track_cuts import WindowCuts
+from .track_result import (  # noqa: F401  (the constants and TrackResult, re-exported)
+    _EVERY,
+    AUTO_WINDOW,
+    BIRGE_NOTE,
+    CYCLE_SEGMENT,
+    MAX_WINDOW,
+    MIN_CYCLES,
+    NORMAL_QUANTITIES,
+    TANGENTIAL_QUANTITIES,
+    TRACK_CHUNK,
+    TrackResult,
+    _as_float,
+    _finite,
+    parse_every,
 )
-#: normal quantities tracked per window (``E_d`` with ``E_d_stderr``)
-NORMAL_QUANTITIES = ("E_d", "psi", "psi_kv", "k_tan", "k_sec", "delta_max", "delta_min", "p0", "pa")
-#: fewest cycles in a window: N crossing-to-crossing cycles hold N - 1 complete peak-to-peak
-#: cycles, and the window analyses average at least 2 of those
-MIN_CYCLES = 3
-#: default upper bound on a window's samples (one window is held in memory)
-MAX_WINDOW = 2_000_000
-#: samples per window for ``every="auto"``: the fit of a window costs about as much as folding
-#: 10^5 samples (about 20 ms a window), so longer windows amortise it, but each window in
-#: flight holds ~40 bytes a sample (t, x, F and the detrended x, F), and about 3.3 windows are
-#: held at the peak (two analysed, one being cut out of the read chunks). On 1e8 samples with
-#: two threads and :data:`TRACK_CHUNK` chunks: 2^20 peaked at 245-250 MB (2^19 at ~190 MB)
-AUTO_WINDOW = 1 << 20
-#: samples read at a time by :func:`track`: the rest of a chunk split between two windows is a
-#: view that keeps the whole chunk alive until the next window is cut, so shorter chunks hold
-#: less (1e8 samples, 2^20 windows: chunks of 2^20 peaked at 274 MB, 2^18 at 247 MB)
-TRACK_CHUNK = 1 << 18
-#: samples of the blocks whose drive's range sets the cycle trigger (:func:`_segments`): fixed
-#: global sample ranges, so that the per-cycle table is the same whatever the chunk size
-CYCLE_SEGMENT = TRACK_CHUNK
-
-_EVERY = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?\d+)?)\s*([A-Za-zµμ]*)\s*$")
-
-
-def parse_every(every: str | float | int) -> tuple[str, float]:
-    """``"100cycles"`` → ``("cycles", 100)``, ``"10s"``/``"2min"``/``"500 ms"`` →
-    ``("time", seconds)``, ``"auto"`` → ``("auto", 0)`` (whole cycles, about
-    :data:`AUTO_WINDOW` samples per window). A bare number counts cycles."""
-    if isinstance(every, str) and every.strip().lower() == "auto":
-        return "auto", 0.0
-    if isinstance(every, (int, float)) and not isinstance(every, bool):
-        text = f"{every}cycles"
-    elif isinstance(every, str):
-        text = every
-    else:
-        raise InputError(f"every must be e.g. '100cycles' or '10s', got {every!r}")
-    m = _EVERY.match(text)
-    if not m:
-        raise InputError(f"every={every!r}: give a number and a unit, e.g. '100cycles' or '10s'")
-    value, unit = float(m.group(1)), m.group(2).lower()
-    if unit in ("", "cycle", "cycles", "cyc", "c"):
-        if value < MIN_CYCLES or value != int(value):
-            raise InputError(
-                f"every={every!r}: a window needs a whole number >= {MIN_CYCLES} of cycles"
-            )
-        return "cycles", float(int(value))
-    factors = {"min": 60.0, "h": 3600.0}
-    if unit in factors:
-        seconds = value * factors[unit]
-    else:
-        try:
-            factor, dim = to_si(unit)
-        except UnknownUnitError:
-            dim, factor = "", 0.0
-        if dim != "time":
-            raise InputError(f"every={every!r}: {unit!r} is neither 'cycles' nor a time unit")
-        seconds = value * factor
-    if not (seconds > 0 and math.isfinite(seconds)):
-        raise InputError(f"every={every!r}: a window must last a finite time > 0 s")
-    return "time", seconds
-
-
-#: a pooled quantity whose windows' Birge ratio exceeds this is noted (TrackResult.notes)
-BIRGE_NOTE = 3.0
-
-_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
-
-
-def _mean_std(a: np.ndarray) -> tuple[float, float]:
-    """Mean and sample standard deviation (NaN for one value) computed on ``a / max|a|``,
-    so that values near the double-precision limit do not overflow the squares."""
-    big = float(np.max(np.abs(a))) if a.size else 0.0
-    u = a / big if (big > 0 and math.isfinite(big)) else a
-    k = big if (big > 0 and math.isfinite(big)) else 1.0
-    return k * float(np.mean(u)), (k * float(np.std(u, ddof=1)) if a.size > 1 else math.nan)
-
-
-@dataclass
-class TrackResult:
-    """Quantities per window of a long recording, and per cycle over the whole record.
-
-    Attributes
-    ----------
-    source : str
-        The recording.
-    kind : str
-        ``"tangential"`` or ``"normal"``.
-    every : str
-        The window length asked for.
-    rows : list of dict
-        One per window: ``window``, ``t_start``, ``t_end``, ``t_mid`` (s), ``cycle_start``,
-        ``cycle_end`` (complete cycles before the window's ends), ``n_samples``, then the
-        analysis' quantities in SI with ``*_stderr``; ``error`` when a window could not be
-        analysed.
-    units : dict
-        SI unit of every column.
-    cycles : dict of str to ndarray
-        Per cycle: ``start``, ``end`` (s), ``energy`` (J, or J/m² for normal),
-        ``amplitude`` (m), ``offset`` (N or Pa).
-    meta : dict
-        Samples read, windows analysed, tail left out.
-    """
-
-    source: str
-    kind: str
-    every: str
-    rows: list[dict[str, Any]]
-    units: dict[str, str]
-    cycles: dict[str, np.ndarray]
-    meta: dict[str, Any] = field(default_factory=dict)
-    #: each window's whole analysis document (``track(..., keep_documents=True)``)
-    window_docs: list[dict[str, Any]] = field(default_factory=list, repr=False)
-
-    @property
-    def quantities(self) -> list[str]:
-        """The tracked quantities present (those with a value in some window)."""
-        names = TANGENTIAL_QUANTITIES if self.kind == "tangential" else NORMAL_QUANTITIES
-        extra = [c for c in self.columns() if c.startswith("poly_") and "stderr" not in c]
-        return [q for q in (*names, *extra) if any(_finite(r.get(q)) for r in self.rows)]
-
-    def column(self, name: str) -> np.ndarray:
-        """One column over the windows as floats (None → NaN)."""
-        return np.array([_as_float(r.get(name)) for r in self.rows], dtype=float)
-
-    def columns(self) -> list[str]:
-        cols: list[str] = []
-        for r in self.rows:
-            cols.extend(k for k in r if k not in cols)
-        return cols
-
-    def combined(self) -> dict[str, Any]:
-        """The windows pooled into one whole-record result.
-
-        Each quantity with a standard error is the weighted mean over the windows that
-        determine it (:func:`contactlab.studies.pooled.pool`: each window weighted by the
-        error typical of its number of cycles, not by its own error, which is correlated with
-        its value; a window whose own error is far above the typical one keeps its own); its
-        ``*_stderr`` is ``1/sqrt(Σ w)`` times the Birge ratio ``sqrt(χ²/(n-1))`` when that
-        exceeds 1 (windows scattering beyond their errors: the joint changed, or the errors
-        are optimistic). ``*_birge`` gives the ratio. A quantity
-        the window analysis gives no error for (ψ, k_tan, ... of normal loops) is the plain
-        mean over the windows with the standard error of that mean.
-        """
-        out: dict[str, Any] = {"n_windows": len(self.rows)}
-        sizes = self.column("n_cycles") if "n_cycles" in self.columns() else None
-        for q in self.quantities:
-            v, s = self.column(q), self.column(f"{q}_stderr")
-            ok = np.isfinite(v) & np.isfinite(s) & (s > 0)
-            if not ok.any():
-                # no standard error per window: the mean of the windows and its error from
-                # their scatter
-                fin = v[np.isfinite(v)]
-                if fin.size:
-                    m, sd = _mean_std(fin)
-                    out[q] = m
-                    out[f"{q}_stderr"] = sd / math.sqrt(fin.size)
-                continue
-            mean, err, birge = pool(v, s, sizes)
-            out[q] = mean
-            out[f"{q}_stderr"] = err
-            out[f"{q}_birge"] = birge
-        e = self.cycles.get("energy")
-        if e is not None and e.size:
-            out["n_cycles"] = int(e.size)
-            # energies of 1e160 J and more overflowed the squares (found by fuzz: track)
-            out["cycle_energy_mean"], out["cycle_energy_std"] = _mean_std(e)
-        return out
-
-    def notes(self, combined: dict[str, Any] | None = None) -> list[str]:
-        """What a reader of the pooled values must know, one line each: windows that could not
-        be analysed, the windows' own warnings (each kind once, with how many windows gave
-        it: the first window's text) and quantities whose windows scatter beyond their errors
-        (Birge ratio above :data:`BIRGE_NOTE`: the pooled value is a weighted mean of values
-        that changed, not a constant)."""
-        comb = self.combined() if combined is None else combined
-        n = len(self.rows)
-        out: list[str] = []
-        failed = [r for r in self.rows if r.get("error")]
-        if failed:
-            out.append(f"{len(failed)} of {n} windows could not be analysed ({failed[0]['error']})")
-        kinds: dict[str, list[Any]] = {}  # a warning's text with its numbers blanked
-        for r in self.rows:
-            seen = set()
-            for w in filter(None, str(r.get("warnings") or "").split(" | ")):
-                key = _NUMBER.sub("#", w)
-                if key in seen:
-                    continue
-                seen.add(key)
-                kinds.setdefault(key, [0, r.get("window"), w])[0] += 1
-        for count, window, text in kinds.values():
-            out.append(f"{count} of {n} windows warn (window {window}: {text})")
-        mode, size = parse_every(self.every)
-        spans = [r["t_end"] - r["t_start"] for r in self.rows if "t_end" in r and "t_start" in r]
-        if mode == "time" and spans and float(np.median(spans)) > 1.5 * size:
-            out.append(
-                f"windows of {self.every} hold at least {MIN_CYCLES} cycles: they last "
-                f"{float(np.median(spans)):.3g} s (median), not {size:.3g} s"
-            )
-        spread = []
-        for q in self.quantities:
-            b = comb.get(f"{q}_birge")
-            if b is not None and not b <= BIRGE_NOTE and n >= 3:  # NaN/inf: beyond any error
-                spread.append(f"{q} {b:.3g}" if math.isfinite(b) else f"{q} (beyond any)")
-        if spread:
-            out.append(
-                "the windows scatter beyond their standard errors (Birge ratio "
-                + ", ".join(spread)
-                + "): these change over the record (or the errors are optimistic); their "
-                "pooled values are weighted means, not constants - see them against time"
-            )
-        return out
-
-    def to_dict(self, *, cycles: bool = True) -> dict[str, Any]:
-        """JSON-ready: ``windows`` (rows), ``combined``, ``notes`` (:meth:`notes`), ``cycles``
-        (arrays), ``units``."""
-        cu = CYCLE_UNITS[self.kind]
-        comb = self.combined()
-        units = dict(self.units)
-        for k in list(comb):
-            base = k.removesuffix("_stderr")
-            if base in self.units:
-                units.setdefault(k, self.units[base])
-        d: dict[str, Any] = {
-            "source": self.source,
-            "kind": self.kind,
-            "every": self.every,
-            "windows": self.rows,
-            "combined": comb,
-            "notes": self.notes(comb),
-            "units": units,
-            "cycle_units": dict(cu),
-            "meta": self.meta,
-        }
-        if cycles:
-            d["cycles"] = {k: v.tolist() for k, v in self.cycles.items()}
-        return d
-
-    def to_csv(self) -> str:
-        """The window table as CSV; header cells carry SI units (``h0 [N]``)."""
-        cols = self.columns()
-        buf = io.StringIO()
-        w = csv.writer(buf, lineterminator="\n")
-        w.writerow([f"{c} [{self.units[c]}]" if self.units.get(c) else c for c in cols])
-        for r in self.rows:
-            w.writerow(
-                [
-                    "" if r.get(c) is None else repr(r[c]) if isinstance(r[c], float) else str(r[c])
-                    for c in cols
-                ]
-            )
-        return buf.getvalue()
-
-    def cycles_csv(self) -> str:
-        """The per-cycle table as CSV (``cycle, start [s], end [s], energy [J], ...``)."""
-        cu = CYCLE_UNITS[self.kind]
-        names = list(self.cycles)
-        buf = io.StringIO()
-        w = csv.writer(buf, lineterminator="\n")
-        w.writerow(["cycle", *(f"{k} [{cu[k]}]" for k in names)])
-        # the rows csv.writer wrote from [i + 1, repr(float(v)), ...] (numbers need no
-        # quoting), joined at C speed: 1e5 cycles in 0.1 s instead of 1.4 s
-        cols = [map(repr, np.asarray(self.cycles[k], dtype=float).tolist()) for k in names]
-        n = self.cycles[names[0]].size if names else 0
-        rows = map(",".join, zip(map(str, range(1, n + 1)), *cols, strict=True))
-        for line in rows:
-            buf.write(line)
-            buf.write("\n")
-        return buf.getvalue()
-
-    def plot(self, name: str, *, against: str = "time", ax: Any = None) -> Any:
-        """``name`` (with error bars when it has a standard error) against window mid time
-        (``against="time"``) or cycle count (``"cycle"``); returns the axes.
-
-        Deprecated (issue 32: studies return results, the report draws them): use
-        :func:`contactlab.report.track_plots.plot_quantity`.
-        """
-        from .._moved import moved
-
-        fn = moved(
-            "contactlab.TrackResult", "plot", "contactlab.report.track_plots", "plot_quantity"
-        )
-        return fn(self, name, against=against, ax=ax)
-
-    def __repr__(self) -> str:
-        return (
-            f"TrackResult({self.source!r}, {self.kind}, every={self.every!r}, "
-            f"{len(self.rows)} windows, {self.cycles['energy'].size} cycles)"
-        )
-
-
-def _finite(v: Any) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-
-
-def _as_float(v: Any) -> float:
-    return float(v) if _finite(v) else float("nan")
-
 
 #: options of ``analyze_tangential`` the one-pass window analysis
-#: (:func:`contactlab.tangential.analysis.analyze_window`) takes; others (``on="signal"``,
+#: (:func:`contactlab.tangential.window.analyze_window`) takes; others (``on="signal"``,
 #: ``history``) take the whole-window analysis
 _WINDOW_OPTIONS = frozenset(
     ("force_sign", "n_points", "rel_threshold", "min_cycles", "max_rel_stderr", "fit_offset",
@@ -470,7 +170,7 @@ def _tangential_window(
     rec: Recording | _WindowSamples, options: Mapping[str, Any], keep_doc: bool = False
 ) -> tuple[dict, dict]:
     from ..tangential import analyze_tangential
-    from ..tangential.analysis import analyze_window
+    from ..tangential.window import analyze_window
 
     rec = _window_recording(rec)
 
@@ -769,9 +469,10 @@ def track(
         Samples read at a time (default :data:`TRACK_CHUNK`).
     max_window : int
         Refuse windows longer than this many samples (one window is held in memory).
-    options : mapping, optional
+    options : Options or mapping, optional
         Keyword arguments of the per-window analysis (``analyze_tangential`` or
-        ``normal.analyze_loop``).
+        ``normal.analyze_loop``): :class:`contactlab.tangential.Options` /
+        :class:`contactlab.normal.Options` or a dict of the same names.
     keep_going : bool
         A window the analysis cannot fit gets a row with ``error`` (default) instead of
         stopping the run. Errors of the file itself always stop it.
@@ -808,6 +509,7 @@ def track(
     >>> bool(abs(res.combined()["h0"] - 40.0) < 4 * res.combined()["h0_stderr"])
     True
     """
+    options = as_dict(options)  # a contactlab.tangential/normal.Options or a dict
     if executor is None and threads != 0:
         from concurrent.futures import ThreadPoolExecutor
 
@@ -872,89 +574,19 @@ def _track(
     analyse: Callable[..., tuple[dict, dict]] = functools.partial(
         _tangential_window if kind_ == "tangential" else _normal_window, keep_doc=keep_documents
     )
-    docs: list[dict[str, Any]] = []
-    opts = dict(options or {})
-
     state = CycleState()
     cyc: dict[str, list[np.ndarray]] = {
         k: [] for k in ("start", "end", "energy", "amplitude", "offset")
     }
-    rows: list[dict[str, Any]] = []
-    units: dict[str, str] = {"t_start": "s", "t_end": "s", "t_mid": "s"}
     # the first window's array: sized for an "auto" window (or a chunk; it grows), at most
     # the recording
     first = AUTO_WINDOW if mode == "auto" else chunk_size
     buf = _Windows(
         first if cr.n_samples is None else max(min(first, cr.n_samples), 1), cr.time_step
     )
-    n_cross = 0  # crossings so far
-    cycles_at_start = 0  # complete cycles before the current window
-    next_cross_target = int(size) if mode == "cycles" else None
-    first_crossings: list[int] = []
-    window_t0: float | None = None
-    crossings_in_window = 0
+    cuts = WindowCuts(mode, size, AUTO_WINDOW)  # (a module global: tests shrink it)
+    out = _Dispatch(analyse, dict(options or {}), executor, slots, keep_going, callback, buf)
     n_total = 0
-
-    from .executor import n_workers
-
-    in_flight: deque[tuple[dict[str, Any], Any]] = deque()
-    limit = slots if slots is not None else 2 * n_workers(executor)
-    dask = executor is not None and type(executor).__module__.split(".")[0] == "distributed"
-
-    def collect(row: dict[str, Any], job: Any) -> None:
-        try:
-            values, u = job() if executor is None else job.result()
-        except ContactLabError as exc:
-            if not keep_going:
-                raise
-            values, u = {"error": f"window {row['window']}: {exc}"}, {}
-        doc = values.pop("_doc", None)
-        if doc is not None:
-            docs.append(doc)
-        row.update(values)
-        units.update(u)
-        if callback is not None:
-            callback(row)
-
-    def emit(stop: int, n_cycles_before_stop: int) -> None:
-        nonlocal cycles_at_start
-        rec = buf.take(stop)
-        t_first, t_last = _time_bounds(rec)
-        row: dict[str, Any] = {
-            "window": len(rows) + 1,
-            "t_start": t_first,
-            "t_end": t_last,
-            "t_mid": 0.5 * (t_first + t_last),
-            "cycle_start": cycles_at_start,
-            "cycle_end": n_cycles_before_stop,
-            "n_samples": len(rec),
-        }
-        rows.append(row)
-        cycles_at_start = n_cycles_before_stop
-        if executor is None:
-            collect(row, functools.partial(analyse, rec, opts))
-            return
-        fut = (
-            executor.submit(analyse, rec, opts, pure=False)
-            if dask
-            else executor.submit(analyse, rec, opts)
-        )
-        in_flight.append((row, fut))
-        if slots is not None:
-            # our helper threads: a window holds its samples until its analysis is done, so
-            # the limit counts the windows not done yet, and the reader goes on as soon as any
-            # is (waiting for the oldest left a helper thread idle whenever a younger window
-            # finished first: the two threads were busy 65 % of a run); finished windows are
-            # collected in order
-            busy = [f for _, f in in_flight if not f.done()]
-            if len(busy) >= limit:
-                futures_wait(busy, return_when=FIRST_COMPLETED)
-            while in_flight and in_flight[0][1].done():
-                collect(*in_flight.popleft())
-            return
-        while len(in_flight) >= limit:
-            collect(*in_flight.popleft())
-
     try:
         for block, ranges in _segments(_noting(cr.chunks_into(buf.alloc), noted), CYCLE_SEGMENT):
             off = int(block.meta.get("offset", n_total))
@@ -967,33 +599,11 @@ def _track(
             )  # fmt: skip
             for k in cyc:
                 cyc[k].append(np.asarray(getattr(got, k), dtype=float))
-            if window_t0 is None:
-                window_t0 = float(block.t[0])
-            if mode == "auto":
-                first_crossings.extend(got.crossings[:64].tolist())
-                if len(first_crossings) >= 3:
-                    per_cycle = float(np.median(np.diff(first_crossings)))
-                    size = float(max(MIN_CYCLES + 1, round(AUTO_WINDOW / per_cycle)))
-                    mode, next_cross_target = "cycles", int(size)
+            cuts.block(float(block.t[0]), got.crossings)
             for g in got.crossings.tolist():
-                n_cross += 1
-                crossings_in_window += 1
-                # complete cycles before crossing g: crossings so far minus the first one
-                done = n_cross - 1
-                if mode == "auto":
-                    cut = False
-                elif mode == "cycles":
-                    assert next_cross_target is not None
-                    cut = n_cross == next_cross_target + 1
-                    if cut:
-                        next_cross_target += int(size)
-                else:
-                    t_g = float(block.t[g - off])
-                    cut = t_g - window_t0 >= size and crossings_in_window > MIN_CYCLES
-                if cut:
-                    emit(g, done)
-                    window_t0 = float(block.t[g - off])
-                    crossings_in_window = 1
+                if cuts.crossing(float(block.t[g - off])):
+                    # complete cycles before crossing g: crossings so far minus the first one
+                    out.emit(g, cuts.n_cross - 1)
             if buf.n > max_window:  # the open window (cut windows have left the buffer)
                 raise InputError(
                     f"{cr.source}: a window of every={every_text!r} holds more than "
@@ -1001,30 +611,118 @@ def _track(
                 )
         # the tail: analysed when it holds MIN_CYCLES complete cycles
         tail = buf.n
-        if tail and crossings_in_window > MIN_CYCLES:
-            emit(n_total, max(n_cross - 1, 0))
+        if tail and cuts.crossings_in_window > MIN_CYCLES:
+            out.emit(n_total, max(cuts.n_cross - 1, 0))
             tail = 0
-        while in_flight:
-            collect(*in_flight.popleft())
+        out.drain()
     finally:
-        for _row, fut in in_flight:
-            fut.cancel()
-    if not rows:
+        out.cancel()
+    if not out.rows:
         raise InputError(
-            f"{cr.source}: found {max(n_cross - 1, 0)} complete cycle(s) in {n_total} samples; "
-            f"tracking needs windows of at least {MIN_CYCLES} cycles"
+            f"{cr.source}: found {max(cuts.n_cross - 1, 0)} complete cycle(s) in {n_total} "
+            f"samples; tracking needs windows of at least {MIN_CYCLES} cycles"
         )
     cycles = {k: (np.concatenate(v) if v else np.empty(0)) for k, v in cyc.items()}
     meta = {
         **noted,  # resampled: what --resample bridged (the last chunk's: the whole record's)
         "n_samples": n_total,
-        "n_windows": len(rows),
+        "n_windows": len(out.rows),
         "tail_samples_left_out": tail,
         "chunk_size": chunk_size,
-        "every_mode": mode,
-        "every_value": size,
+        "every_mode": cuts.mode,
+        "every_value": cuts.size,
     }
-    return TrackResult(cr.source, kind_, every_text, rows, units, cycles, meta, docs)
+    return TrackResult(cr.source, kind_, every_text, out.rows, out.units, cycles, meta, out.docs)
+
+
+class _Dispatch:
+    """The windows of :func:`track` to their analysis, serially or on ``executor`` with at
+    most ``slots`` (default two per worker) in flight, and their rows in window order."""
+
+    def __init__(
+        self,
+        analyse: Callable[..., tuple[dict, dict]],
+        opts: dict[str, Any],
+        executor: Any,
+        slots: int | None,
+        keep_going: bool,
+        callback: Callable[[dict[str, Any]], None] | None,
+        buf: _Windows,
+    ) -> None:
+        from .executor import n_workers
+
+        self.analyse, self.opts, self.executor, self.slots = analyse, opts, executor, slots
+        self.keep_going, self.callback, self.buf = keep_going, callback, buf
+        self.rows: list[dict[str, Any]] = []
+        self.units: dict[str, str] = {"t_start": "s", "t_end": "s", "t_mid": "s"}
+        self.docs: list[dict[str, Any]] = []
+        self.in_flight: deque[tuple[dict[str, Any], Any]] = deque()
+        self.cycles_at_start = 0  # complete cycles before the current window
+        self.limit = slots if slots is not None else 2 * n_workers(executor)
+        module = type(executor).__module__.split(".")[0]
+        self.dask = executor is not None and module == "distributed"
+
+    def collect(self, row: dict[str, Any], job: Any) -> None:
+        try:
+            values, u = job() if self.executor is None else job.result()
+        except ContactLabError as exc:
+            if not self.keep_going:
+                raise
+            values, u = {"error": f"window {row['window']}: {exc}"}, {}
+        doc = values.pop("_doc", None)
+        if doc is not None:
+            self.docs.append(doc)
+        row.update(values)
+        self.units.update(u)
+        if self.callback is not None:
+            self.callback(row)
+
+    def emit(self, stop: int, n_cycles_before_stop: int) -> None:
+        rec = self.buf.take(stop)
+        t_first, t_last = _time_bounds(rec)
+        row: dict[str, Any] = {
+            "window": len(self.rows) + 1,
+            "t_start": t_first,
+            "t_end": t_last,
+            "t_mid": 0.5 * (t_first + t_last),
+            "cycle_start": self.cycles_at_start,
+            "cycle_end": n_cycles_before_stop,
+            "n_samples": len(rec),
+        }
+        self.rows.append(row)
+        self.cycles_at_start = n_cycles_before_stop
+        ex, in_flight = self.executor, self.in_flight
+        if ex is None:
+            self.collect(row, functools.partial(self.analyse, rec, self.opts))
+            return
+        fut = (
+            ex.submit(self.analyse, rec, self.opts, pure=False)
+            if self.dask
+            else ex.submit(self.analyse, rec, self.opts)
+        )
+        in_flight.append((row, fut))
+        if self.slots is not None:
+            # our helper threads: a window holds its samples until its analysis is done, so
+            # the limit counts the windows not done yet, and the reader goes on as soon as any
+            # is (waiting for the oldest left a helper thread idle whenever a younger window
+            # finished first: the two threads were busy 65 % of a run); finished windows are
+            # collected in order
+            busy = [f for _, f in in_flight if not f.done()]
+            if len(busy) >= self.limit:
+                futures_wait(busy, return_when=FIRST_COMPLETED)
+            while in_flight and in_flight[0][1].done():
+                self.collect(*in_flight.popleft())
+            return
+        while len(in_flight) >= self.limit:
+            self.collect(*in_flight.popleft())
+
+    def drain(self) -> None:
+        while self.in_flight:
+            self.collect(*self.in_flight.popleft())
+
+    def cancel(self) -> None:
+        for _row, fut in self.in_flight:
+            fut.cancel()
 
 
 def track_many(

@@ -26,9 +26,9 @@ and MATLAB .mat.
 
 Normal (Konowalski 2009; PHYSICS.md §2). Dynamic pressure ``p = pa sin(ω t)`` about the static
 pressure p0 = 0.5 ... 2.5 MPa, pa = 0.4 MPa, ω = 1 1/s, 256 samples per cycle as the paper's
-rig; the displacement comes from :func:`contactlab.normal.synthetic_recording` (the nonlinear
-model, eq. 17, with a stiffness that grows with p0) with its sensor noise and quantisation,
-plus an imperfect zeroing of the displacement probe.
+rig; the displacement comes from :func:`contactlab.synthetic.normal.synthetic_recording` (the
+nonlinear model, eq. 17, with a stiffness that grows with p0) with its sensor noise and
+quantisation, plus an imperfect zeroing of the displacement probe.
 
 The manifest lists each file with its tags and the true parameters (``true_h0``, ``true_ac``),
 so a study can be checked against the truth.
@@ -167,7 +167,7 @@ def write_normal(path: Path, t: np.ndarray, p: np.ndarray, delta: np.ndarray) ->
 def normal_signal(p0: float, rng: np.random.Generator) -> tuple[np.ndarray, ...]:
     """Time (s), total pressure p0 + pa sin ωt (Pa) and displacement δ (m) of one test.
 
-    :func:`contactlab.normal.synthetic_recording` gives the steady-state response of the
+    :func:`contactlab.synthetic.normal.synthetic_recording` gives the steady-state response of the
     nonlinear model (eq. 17) with its "realistic" sensor noise (0.2 % of pa on p, 2 nm on δ,
     16-bit quantisation); the displacement probe's zeroing under p0 is left imperfect here
     (a residual offset of up to ±20 nm).

@@ -4,7 +4,8 @@ Pressure ``p(t) = p0 + pa(t) sin φ(t)`` in three smooth blocks (``pa = (0.3, 0.
 at frequencies ``(1, 1.7, 0.6)·f0``, or ``frequencies·f0``), the joint a Kelvin-Voigt element
 with the paper's order of magnitude (``k = 1.3 MPa/µm``, ``ψ = 0.0887``, ``p0 = 0.5 MPa``,
 ``f0 = 1 Hz``) plus the requested effects, and sensor noise on both channels. See
-:func:`contactlab.diagnose.hidden_effect_recording` (``model="normal"``) for the arguments.
+:func:`contactlab.synthetic.diagnosis.hidden_effect_recording` (``model="normal"``) for the
+arguments.
 The delay is simulated by driving the joint with the closed-form pressure at ``t - τ``.
 """
 
@@ -87,7 +88,7 @@ def hidden_effect_recording_normal(
 
     Base parameters: ``k`` (Pa/m, default 1.3e12), ``psi`` (default 0.0887), ``p0`` (Pa,
     default 5e5), ``f0`` (Hz, default 1). Other arguments as
-    :func:`contactlab.diagnose.hidden_effect_recording`.
+    :func:`contactlab.synthetic.diagnosis.hidden_effect_recording`.
     """
     sizes = effect_sizes(effects, magnitude, NORMAL_EFFECTS)
     if {"stiffness_nonlinearity", "asymmetric_branches"} & set(sizes) and (

@@ -10,6 +10,7 @@ from __future__ import annotations
 from .._moved import forward
 from .analysis import analyze_tangential
 from .frame import FrameForce, frame_friction_force, read_frame
+from .options import Options
 from .preprocess import AveragedLoop, CycleScatter, Reversals, average_loop, find_reversals
 from .result import UNITS, TangentialAnalysis
 
@@ -18,6 +19,7 @@ __all__ = [
     "AveragedLoop",
     "CycleScatter",
     "FrameForce",
+    "Options",
     "Reversals",
     "TangentialAnalysis",
     "analyze_tangential",

@@ -44,13 +44,13 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
-from .. import _core
 from .._arrays import as_1d
+from .._moved import forward
+from .._options import takes_options
 from .._physical import check_channel
 from ..errors import ContactLabWarning, InputError
 from ..fitting import FitResult
@@ -58,11 +58,11 @@ from ..io import Recording
 from ..masing import loop_area
 from . import lag, steps
 from .orientation import Orientation, orient
-from .preprocess import AveragedLoop, average_loop, find_reversals, negated_loop
+from .preprocess import AveragedLoop
 from .regime import GROSS_SLIDING_Z as REGIME_GROSS_Z
 from .regime import PRE_SLIDING_Z, Regime, classify, z_from_area_ratio
 from .result import TangentialAnalysis
-from .uncertainty import correl, numeric_energy, reparametrize, trend
+from .uncertainty import correl, numeric_energy, reparametrize
 
 #: ``ac·A`` above which the loop is taken to have reached gross sliding (branch slope at the
 #: turn below e^-3 = 5 % of the initial stiffness: the force has plateaued near ±h0)
@@ -425,6 +425,7 @@ def misfit_ratio(raw: FitResult, data: steps.FitData, weights: np.ndarray | None
     return math.sqrt(raw.redchi / noise)
 
 
+@takes_options
 def analyze_tangential(
     recording: Recording | None = None,
     *,
@@ -550,48 +551,8 @@ def analyze_tangential(
     lag.record(res, delay, dropped)
     if warn:
         for wtxt in res.warnings:
-            warnings.warn(wtxt, ContactLabWarning, stacklevel=2)
+            warnings.warn(wtxt, ContactLabWarning, stacklevel=3)
     return res
-
-
-def _fast_orientation(
-    x: np.ndarray, F: np.ndarray, loop: AveragedLoop, force_sign: Any
-) -> Orientation | None:
-    """The force sign from the averaged loop's per-cycle areas (the signed loop area of the
-    complete cycles, its noise error from the bins' cycle-to-cycle spread); None when the
-    area does not decide it (then the full :func:`orient` does)."""
-    from .orientation import SIGNIFICANCE, parse_force_sign
-
-    e = loop.scatter.energy
-    ok = np.isfinite(e)
-    area = float(np.sum(e[ok])) if ok.any() else 0.0
-    n = loop.n_cycles
-    err = math.nan
-    if loop.cycle_bounds is not None and n > 1:
-        per_cycle = loop.count / n
-        vF, vx = loop.F_std**2 * per_cycle, loop.x_std**2 * per_cycle
-        if np.any(np.isfinite(vF)) and np.any(np.isfinite(vx)):
-            g_F, g_x = (
-                loop.sensitivity  # of x, F: the loop was folded from them
-                if loop.sensitivity is not None
-                else _core.loop_area_sensitivity(x, F, [int(b) for b in loop.cycle_bounds[: n + 1]])
-            )
-            err = math.sqrt(
-                float(np.sum(g_F)) * float(np.nanmean(vF))
-                + float(np.sum(g_x)) * float(np.nanmean(vx))
-            )
-    fixed = parse_force_sign(force_sign)
-    if fixed is not None:
-        return Orientation(fixed, f"force sign {fixed:+d} given by the user", area, err, "user")
-    if not (math.isfinite(err) and area != 0 and abs(area) > SIGNIFICANCE * err):
-        return None
-    sign = 1 if area > 0 else -1
-    what = "as recorded" if sign > 0 else "after inverting F (the load cell counts the other way)"
-    reason = (
-        f"a passive joint dissipates (∮F dx > 0): the signed loop area is {area:.4g} J "
-        f"± {err:.2g} J, so the force is analysed {what}"
-    )
-    return Orientation(sign, reason, area, err, "loop area")
 
 
 def _fast_regime(z_fit: float | None, ratio: float) -> Regime | None:
@@ -610,137 +571,6 @@ def _fast_regime(z_fit: float | None, ratio: float) -> Regime | None:
     return Regime("transition", f"transition towards gross sliding: {zt}", z, src, ratio)
 
 
-def analyze_window(
-    recording: Recording,
-    *,
-    force_sign: int | str = "auto",
-    n_points: int | None = None,
-    rel_threshold: float = 0.5,
-    min_cycles: int = 2,
-    max_rel_stderr: float = 0.2,
-    fit_offset: bool = True,
-    fit_x0: bool | None = None,
-    fit_amplitude: bool = True,
-    detrend: bool = True,
-    initial: dict[str, float] | None = None,
-    delay: float | None = None,
-) -> TangentialAnalysis:
-    """:func:`analyze_tangential` of one window of a streamed recording (``on="averaged"``,
-    steady history), with the per-sample work in one pass of Rust kernels.
-
-    The samples are folded once: the drifts come from the period means between the raw
-    displacement's peaks (what :func:`steps.detrend`'s first fold gives them from), the
-    detrended samples are folded in one Rust pass (:func:`contactlab._core.fold_window`:
-    phase bins, cycle bounds, per-cycle areas and their sensitivities, period means), and
-    that loop is reused: the force sign follows from its per-cycle areas (an inverted force
-    negates the fold), the drift covariance from its bins' mean time, the numeric energy's
-    error from the cycles' area sensitivities. The velocity and stick search over the
-    samples (which only decide between gross sliding and stick-slip) runs only when the loop
-    reaches gross sliding, and then the window is analysed exactly as
-    :func:`analyze_tangential` does; below it, ``stick_slip`` gives the window's reversals
-    and null for what only the search measures. The results are those of
-    :func:`analyze_tangential` (warnings are kept in ``.warnings``, not issued; the recorded
-    loop area of the orientation is that of the detrended samples).
-    """
-    xa, Fa, ta, source = _inputs(recording, None, None, None)
-    _check_options("averaged", "steady", n_points)
-    finite_x = check_channel("x", xa, "m", "displacement")
-    finite_f = check_channel("F", Fa, "N", "force")
-    dropped = 0
-    if delay is not None:  # ``delay`` as in analyze_tangential
-        ta, xa, Fa, dropped = lag.shift_force(ta, xa, Fa, delay)
-    opts: dict[str, Any] = {
-        "n_points": n_points,
-        "rel_threshold": rel_threshold,
-        "min_cycles": min_cycles,
-        "max_rel_stderr": max_rel_stderr,
-        "fit_offset": fit_offset,
-        "fit_x0": fit_x0,
-        "fit_amplitude": fit_amplitude,
-        "detrend": detrend,
-        "initial": initial,
-    }
-    # (a recording's channels are contiguous float64 arrays unless replaced since)
-    plain = all(a.dtype == np.float64 and a.ndim == 1 and a.flags.c_contiguous for a in (xa, Fa))
-    pre = _window_detrended(xa, Fa, ta, opts, checked=finite_x and finite_f and plain)
-    ori = _fast_orientation(pre.x, pre.F, pre.loop, force_sign)
-    res = None
-    if ori is not None:
-        if ori.sign < 0:
-            pre = _negated(pre)
-        res = _analyze(xa, Fa, ta, source, ori, pre, on="averaged", history="steady",
-                       streamed=True, delay=delay, **opts)  # fmt: skip
-    if res is None:  # the sign undecided by the area, or gross sliding: the full analysis
-        return analyze_tangential(recording, force_sign=force_sign, warn=False, delay=delay,
-                                  **opts)  # fmt: skip
-    lag.record(res, delay, dropped)
-    return res
-
-
-def _window_detrended(
-    xa: np.ndarray,
-    Fa: np.ndarray,
-    ta: np.ndarray | None,
-    opts: dict[str, Any],
-    checked: bool = False,
-) -> steps.Detrended:
-    """:func:`steps.detrend` of the window with one fold instead of two: the linear drifts
-    come from the period means between the raw displacement's peaks (what the first fold's
-    per-cycle means are: the same Rust kernel on the same edges), so the samples are
-    detrended before the only fold. The same numbers as :func:`steps.detrend`. ``checked``:
-    x and F (a recording's float64 channels) were scanned finite by :func:`check_channel`,
-    so only t is checked here (else x, t and F are, naming a non-finite sample)."""
-    n_points, rel = opts["n_points"], opts["rel_threshold"]
-    min_cycles = opts["min_cycles"]
-    if checked:
-        tc = None if ta is None else as_1d(ta, "t")
-        rev = find_reversals(xa, tc, rel_threshold=rel, checked=True)
-    else:
-        rev = find_reversals(xa, ta, rel_threshold=rel)  # checks x and t
-        Fa = as_1d(Fa, "F")
-    if not (opts["detrend"] and rev.peaks.size - 1 >= 3):
-        loop = average_loop(xa, Fa, ta, n_points=n_points, rel_threshold=rel,
-                            min_cycles=min_cycles, checked=True)  # fmt: skip
-        return steps.Detrended(xa, Fa, loop, None)
-    tt = ta if ta is not None else np.arange(xa.size, dtype=float)
-    pt = rev.peak_times
-    time = 0.5 * (pt[:-1] + pt[1:])
-    tm = float(np.mean(time))
-    # period_means of F and of x in one pass over t (bit for bit the two calls)
-    f_means, x_means = _core.period_means_pair(tt, Fa, xa, np.ascontiguousarray(pt, dtype=float))
-    f_drift = trend(time, f_means)
-    x_drift = trend(time, x_means)
-    # Fa - s·(tt - tm) for both channels in one Rust pass without the interpreter lock (bit
-    # for bit numpy's a + (tt - tm)·(-s), which is a - s·τ): 16 bytes a sample at the peak
-    # instead of 32 (τ, a product and the two results), one pass instead of six
-    # (into numpy.empty arrays: numpy's allocator asks for huge pages, where the core's own
-    # buffers faulted in every 4 KiB page, 5 ms of system time a window of 2^19 samples)
-    F, x = np.empty_like(Fa), np.empty_like(xa)
-    _core.detrend_pair_into(tt, tm, Fa, f_drift[0], xa, x_drift[0], F, x)
-    # x, F and t were checked above (the detrended samples are finite: the fold checks them
-    # again in its pass), so the fold's reversal search does not scan them a second time
-    loop = average_loop(x, F, ta, n_points=n_points, rel_threshold=rel, min_cycles=min_cycles,
-                        checked=True)  # fmt: skip
-    return steps.Detrended(x, F, loop, steps.Drift(f_drift, x_drift, tt, tm))
-
-
-def _detrended(v: np.ndarray, tt: np.ndarray, tm: float, slope: float) -> np.ndarray:
-    """``v - slope * (tt - tm)`` in numpy (the reference of ``_core.detrend_pair``, tests)."""
-    out = np.subtract(tt, tm)
-    np.multiply(out, -slope, out=out)
-    np.add(v, out, out=out)
-    return out
-
-
-def _negated(d: steps.Detrended) -> steps.Detrended:
-    """The detrended window of ``-F`` (bit for bit: negation commutes with every step)."""
-    dr = d.drift
-    if dr is not None:
-        dr = replace(dr, force=(-dr.force[0], dr.force[1]))
-    loop = negated_loop(d.loop) if d.loop is not None else None
-    return steps.Detrended(d.x, -d.F, loop, dr)
-
-
 def _unsearched_sticks(rev: Any, n_samples: int) -> dict[str, Any]:
     """``stick_slip`` of a streamed window below gross sliding, where the stick search over
     the samples does not run (it is a gross-sliding verdict, and its velocity estimate costs
@@ -750,7 +580,8 @@ def _unsearched_sticks(rev: Any, n_samples: int) -> dict[str, Any]:
     if n_turns < 2 or n_samples < 20:  # where the search would give none either
         return {}
     unknown = ("reversals_with_stick", "stick_duration", "breakaway_force",
-               "breakaway_force_stderr", "velocity_threshold", "smooth_turn_dwell")  # fmt: skip
+               "breakaway_force_stderr", "velocity_threshold", "smooth_turn_dwell",
+               "reversals_with_dwell")  # fmt: skip
     return {"stick_slip": {"n_reversals": n_turns, **dict.fromkeys(unknown, math.nan)}}
 
 
@@ -899,5 +730,15 @@ def _analyze(
             "orientation_reason": ori.reason,
             "orientation_by": ori.by,
             "loop_area_recorded": (ori.loop_area, ori.loop_area_stderr),
+            # the plateau levels' mid-point and branch length, for the loop plot's levels
+            **(
+                {"plateau_offset": regime.plateau.offset, "plateau_dx95": regime.plateau.dx95}
+                if regime.plateau is not None
+                else {}
+            ),
         },
     )
+
+
+# analyze_window moved to contactlab.tangential.window (issue 32): the old name forwards
+__getattr__ = forward(__name__, {"analyze_window": "contactlab.tangential.window"})

@@ -170,6 +170,24 @@ class TangentialAnalysis:
                 out["units"][f"{k}_stderr"] = UNITS[k]
         return out
 
+    def _error_text(self, key: str, value: float, stderr: float) -> str:
+        """``+/- e unit`` of a derived quantity, or why it has no meaningful error: a bound
+        has none, a NaN error is no error, and a channel delay whose error exceeds half the
+        loop's period is not identifiable (a delay is only defined within a period)."""
+        unit = UNITS.get(key, "")
+        if key.endswith(("_lower_bound", "_upper_bound")):
+            return f"{unit} (a one-sided bound: no standard error)"
+        if not np.isfinite(stderr):
+            return f"{unit} (not identifiable: no finite standard error)"
+        if key == "channel_delay" and self.scatter is not None:
+            period = float(np.median(self.scatter.period))
+            if np.isfinite(period) and stderr > 0.5 * period:
+                return (
+                    f"s (not identifiable: its standard error, {stderr:.3g} s, exceeds half "
+                    f"the period, {0.5 * period:.3g} s)"
+                )
+        return f"+/- {stderr:.3g} {unit}"
+
     def report(self) -> str:
         """Human-readable summary: fit report, identifiability and derived quantities."""
         lines = [f"Tangential analysis of {self.source} (fit on {self.on}, {self.history})"]
@@ -180,9 +198,12 @@ class TangentialAnalysis:
             lines.append("[[Regime]]")
             lines.append(f"    {self.regime.get('regime_reason', '')}")
         lines.append("[[Derived quantities]]")
-        lines.append(f"    amplitude = {self.amplitude:.6g} +/- {self.amplitude_stderr:.3g} m")
+        lines.append(
+            f"    amplitude = {self.amplitude:.6g} "
+            f"{self._error_text('amplitude', self.amplitude, self.amplitude_stderr)}"
+        )
         for k, (v, e) in self.derived.items():
-            lines.append(f"    {k} = {v:.6g} +/- {e:.3g} {UNITS.get(k, '')}")
+            lines.append(f"    {k} = {v:.6g} {self._error_text(k, v, e)}".rstrip())
         if self.warnings:
             lines.append("[[Warnings]]")
             lines += [f"    {w}" for w in self.warnings]

@@ -7,8 +7,19 @@
 /// `(all finite, min, max)` of `v`, the extremes over its finite values (`(+inf, -inf)`
 /// when it has none). The extremes are values of `v` (exact): the smallest and largest by
 /// `<` (of `0.0` and `-0.0`, whichever comes first in its lane).
+/// Vectorised and dispatched at run time ([`crate::simd`]): the same numbers on every level.
 #[must_use]
 pub fn finite_min_max(v: &[f64]) -> (bool, f64, f64) {
+    finite_min_max_at(crate::simd::level(), v)
+}
+
+crate::simd::dispatch! {
+    /// [`finite_min_max`] with its kernel at `level`.
+    pub fn finite_min_max_at(v: &[f64]) -> (bool, f64, f64) = finite_min_max_generic;
+}
+
+#[inline(always)]
+fn finite_min_max_generic(v: &[f64]) -> (bool, f64, f64) {
     const L: usize = 8;
     let mut lo = [f64::INFINITY; L];
     let mut hi = [f64::NEG_INFINITY; L];
@@ -55,6 +66,31 @@ pub fn finite_min_max(v: &[f64]) -> (bool, f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_simd_level_equals_the_generic_one() {
+        for n in [0_usize, 1, 7, 8, 9, 63, 64, 65, 1001] {
+            let mut v: Vec<f64> = (0..n).map(|i| ((i * 7919) % 1013) as f64 - 500.0).collect();
+            let want = finite_min_max_at(crate::simd::Level::Generic, &v);
+            for lv in crate::simd::Level::ALL
+                .into_iter()
+                .filter(|l| l.supported())
+            {
+                assert_eq!(finite_min_max_at(lv, &v), want, "{lv:?} {n}");
+            }
+            if n > 3 {
+                v[n / 2] = f64::NAN;
+                let want = finite_min_max_at(crate::simd::Level::Generic, &v);
+                assert!(!want.0);
+                for lv in crate::simd::Level::ALL
+                    .into_iter()
+                    .filter(|l| l.supported())
+                {
+                    assert_eq!(finite_min_max_at(lv, &v), want, "{lv:?} {n}");
+                }
+            }
+        }
+    }
     use proptest::prelude::*;
 
     fn reference(v: &[f64]) -> (bool, f64, f64) {

@@ -13,6 +13,7 @@
 //! - [`fold`]: phase-bin folding of a periodic recording and its cycle-to-cycle spread.
 //! - [`cycles`]: blocks of whole cycles cut at the drive's crossings; period means.
 //! - [`loop_area`]: loop areas of cycles and their noise sensitivity.
+//! - [`simd`]: runtime dispatch of the vectorised kernels (baseline, AVX2, AVX-512).
 //! - [`stream`]: the reading side of a streamed analysis (chunk checks, time axis).
 //! - [`window`]: the per-sample work of one analysis window (fold, cycle areas, detrending).
 //!
@@ -44,6 +45,7 @@ pub mod parallel;
 pub mod reversal;
 pub mod scan;
 pub mod select;
+pub mod simd;
 pub mod stream;
 pub mod structure;
 pub mod window;

@@ -491,118 +491,6 @@ impl WindowFold {
     }
 }
 
-/// A cycle's range of cell means before its first cell: [max x, min x, max F, min F].
-const NO_RANGE: [f64; 4] = [
-    f64::NEG_INFINITY,
-    f64::INFINITY,
-    f64::NEG_INFINITY,
-    f64::INFINITY,
-];
-
-/// One knot segment of the phase: `φ(t) = slope (t - k_lo) + p_lo` on `[k_lo, k_hi)`.
-struct Segment {
-    k_lo: f64,
-    k_hi: f64,
-    p_lo: f64,
-    slope: f64,
-}
-
-impl Segment {
-    /// The segment from knot `j` (`j + 1` a knot).
-    // Index arithmetic: j + 1 < the knots' length (the caller's).
-    #[allow(clippy::arithmetic_side_effects)]
-    #[inline(always)]
-    fn of(kt: &[f64], kp: &[f64], j: usize) -> Self {
-        Segment {
-            k_lo: kt[j],
-            k_hi: kt[j + 1],
-            p_lo: kp[j],
-            slope: (kp[j + 1] - kp[j]) / (kt[j + 1] - kt[j]),
-        }
-    }
-}
-
-/// The open cell's running sums: its bin's sample sums (x, F, φ, φ², x², t) carried from
-/// the bin, and the cell's own sums of x, F, φ (kept in registers while the cell's run of
-/// samples lasts: the same additions in the same order as adding into the bin sample by
-/// sample).
-#[derive(Default, Clone, Copy)]
-struct Cell {
-    cur: [f64; 6],
-    cx: f64,
-    cf: f64,
-    cp: f64,
-}
-
-impl Cell {
-    /// The complete cell into its bin and its cycle's ranges `r`; `n` its samples.
-    #[inline(always)]
-    fn flush(&self, bin: &mut Bin, r: &mut [f64; 4], n: f64) {
-        flush_cell(bin, r, n, (self.cx, self.cf, self.cp), &self.cur);
-    }
-
-    #[inline(always)]
-    fn add(&mut self, xi: f64, fi: f64, frac: f64, ti: f64) {
-        self.cur[0] += xi;
-        self.cur[1] += fi;
-        self.cur[2] += frac;
-        self.cur[3] += frac * frac;
-        self.cur[4] += xi * xi;
-        self.cur[5] += ti;
-        self.cx += xi;
-        self.cf += fi;
-        self.cp += frac;
-    }
-
-    /// The samples from `i` that follow in the same knot segment `seg`, cycle (from `c_lo`)
-    /// and bin (`g < g_hi`, `g = frac · n_bins`): added; returns the first sample not taken,
-    /// its phase when computed here (else -1) and the last phase taken.
-    // Index arithmetic: i < end <= the slices' length.
-    #[allow(clippy::arithmetic_side_effects)]
-    #[inline(always)]
-    fn run(
-        &mut self,
-        (t, x, f): (&[f64], &[f64], &[f64]),
-        mut i: usize,
-        end: usize,
-        seg: &Segment,
-        (c_lo, nbf, g_hi): (f64, f64, f64),
-        mut last_ph: f64,
-    ) -> (usize, f64, f64) {
-        while i < end {
-            let ti = t[i];
-            if ti >= seg.k_hi {
-                break;
-            }
-            let ph = seg.slope * (ti - seg.k_lo) + seg.p_lo;
-            let frac = ph - c_lo;
-            if frac * nbf >= g_hi {
-                return (i, ph, last_ph);
-            }
-            last_ph = ph;
-            self.add(x[i], f[i], frac, ti);
-            i += 1;
-        }
-        (i, -1.0, last_ph)
-    }
-}
-
-/// The bin of `g = frac · n_bins` when the open bin `[b_hi - 1, b_hi)` (number `cb`) does
-/// not hold it: `(b, b_lo, b_hi)`, the last bin open above.
-// Index arithmetic: cb + 2 < nb checked; nb >= 1.
-#[allow(clippy::arithmetic_side_effects)]
-#[inline(always)]
-fn next_bin(g: f64, b_hi: f64, cb: usize, nb: usize) -> (usize, f64, f64) {
-    if g >= b_hi && g < b_hi + 1.0 && cb + 2 < nb {
-        // the next bin (not the last): b_hi = cb + 1 exactly, so floor(g) = cb + 1
-        return (cb + 1, b_hi, b_hi + 1.0);
-    }
-    let b = (g as usize).min(nb - 1);
-    let lo = b as f64;
-    let hi = if b + 1 == nb { f64::INFINITY } else { lo + 1.0 };
-    (b, lo, hi)
-}
-
 /// Fold `(t, x, F)` (one window, `t` strictly increasing) by the phase knots `(kt, kp)` into
 /// `n_bins` bins per cycle over `n_cycles` cycles, with the phases and bins of
 /// [`crate::fold::fold_phase`], and derive the per-cycle quantities and period means (see
@@ -823,6 +711,9 @@ fn finish(
     w.bounds = bounds;
     Ok(())
 }
+
+mod cell;
+use cell::{next_bin, Cell, Segment, NO_RANGE};
 
 #[cfg(test)]
 mod tests;

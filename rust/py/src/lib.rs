@@ -11,6 +11,7 @@ use pyo3::sync::PyOnceLock;
 
 mod cycles;
 mod error;
+mod extrema;
 mod fold;
 mod isotonic;
 mod joints;
@@ -21,6 +22,7 @@ mod normal;
 mod reversal;
 mod scan;
 mod select;
+mod simd;
 mod stream;
 mod structure;
 mod window;
@@ -76,7 +78,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     select::register(m)?;
     window::register(m)?;
     isotonic::register(m)?;
+    extrema::register(m)?;
     scan::register(m)?;
+    simd::register(m)?;
     stream::register(m)?;
     loop_fit::register(m)?;
     joints::register(m)?;

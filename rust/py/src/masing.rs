@@ -99,7 +99,8 @@ impl MasingCore {
 
     /// Forces for the chunk `x`, continuing the carried history; into `out` when given
     /// (same length, contiguous float64), else into a new array.
-    /// With `threads > 1` a long chunk runs in pieces of `piece` samples on that many threads
+    /// With `threads > 1` a long chunk runs in pieces of `piece` samples on up to that many
+    /// threads, no more than CPUs are idle now (`contactlab_core::parallel::threads_that_pay`)
     /// (`contactlab_core::masing::split`), bit for bit the same.
     #[pyo3(signature = (x, out=None, threads=1, piece=masing::split::PIECE))]
     fn push<'py>(
@@ -129,6 +130,8 @@ impl MasingCore {
                 .map_err(|_| input(py, "out must be contiguous"))?;
             let me = &*self;
             st = detach_guarded(py, || {
+                // split only onto CPUs that are idle now (a split onto a busy CPU loses)
+                let threads = contactlab_core::parallel::threads_that_pay(threads);
                 if threads > 1 {
                     let mut sts = [st];
                     masing::channels::force_channels(

@@ -630,43 +630,7 @@ pub fn cycle_energies<C: Backbone>(
     Ok(cycles)
 }
 
-/// `∮ F dx` of the closed polygon through `(x_i, F_i)` (last point joined to the first):
-/// positive for a clockwise (dissipative) loop. Uses the trapezoid form with the mean force
-/// removed and compensated summation, so large offsets in `x` or `F` cost no accuracy.
-pub fn loop_area(x: &[f64], f: &[f64]) -> Result<f64, CoreError> {
-    crate::error::check_same_len("x", x.len(), "F", f.len())?;
-    if x.is_empty() {
-        return Err(CoreError::Empty { name: "x" });
-    }
-    crate::error::check_finite("x", x)?;
-    crate::error::check_finite("F", f)?;
-    let n = x.len();
-    // Work in units of the largest |x| and |F| so that sums and products of 1e±300 data
-    // neither overflow nor underflow (found by fuzzing); the scales multiply the result.
-    let sx = x.iter().fold(0.0_f64, |a, &v| a.max(v.abs()));
-    let sf = f.iter().fold(0.0_f64, |a, &v| a.max(v.abs()));
-    if sx == 0.0 || sf == 0.0 {
-        return Ok(0.0);
-    }
-    let fm = f.iter().map(|&v| v / sf).sum::<f64>() / n as f64;
-    let (mut sum, mut comp) = (0.0_f64, 0.0_f64);
-    // Point i joined to the next, the last to the first.
-    for (i, j) in (0..n).zip((1..n).chain(std::iter::once(0))) {
-        let (fi, fj) = (f[i] / sf - fm, f[j] / sf - fm);
-        let term = 0.5 * (fi + fj) * (x[j] / sx - x[i] / sx);
-        // Neumaier summation.
-        let t = sum + term;
-        if sum.abs() >= term.abs() {
-            comp += (sum - t) + term;
-        } else {
-            comp += (term - t) + sum;
-        }
-        sum = t;
-    }
-    let area = (sum + comp) * sx * sf;
-    crate::error::check_output("loop area", &[area])?;
-    Ok(area)
-}
+pub use crate::loop_area::loop_area;
 
 #[cfg(test)]
 mod range_tests {

@@ -5,8 +5,21 @@ from __future__ import annotations
 import numpy as np
 
 from ..._family import ParamSpec
-from .._base import EffectModel, register
+from .._base import EffectModel, Plausibility, register
 from ._common import peak_speed
+
+
+def presliding_force(d, p) -> np.ndarray:
+    """``σ1 ẋ k(x)/k0`` along the record for the exponential element of ``h0``, ``ac``
+    (the term this effect adds), from the record's reversals."""
+    from ....masing import Masing
+    from .stick_slip import reversal_anchors
+
+    h = Masing(p["h0"], p["ac"]).force(d.u)
+    has, r = reversal_anchors(d.cycles.reversals, h.size)
+    hr = np.where(has, h[r], 0.0)
+    share = np.clip(1.0 - np.abs(h - hr) / (2.0 * p["h0"]), 0.0, 1.0)
+    return p["sigma1"] * d.ud * share
 
 
 @register
@@ -52,10 +65,30 @@ class RateDependentPresliding(EffectModel):
         share = np.clip(1.0 - np.abs(he - hr) / (2.0 * p["h0"]), 0.0, 1.0)
         return h + p["sigma1"] * ctx.pick(d.ud) * share
 
+    #: the pre-sliding damping force may reach this share of the friction force at most:
+    #: beyond, the "bristles" would carry more than the contact transmits when it slides
+    MAX_FORCE_SHARE = 0.5
+
+    def plausible(self, d, p):
+        base = super().plausible(d, p)
+        if not base.ok or not (p.get("h0", 0) > 0 and p.get("ac", 0) > 0):
+            return base
+        peak = float(np.max(np.abs(presliding_force(d, p))))
+        if peak > self.MAX_FORCE_SHARE * p["h0"]:
+            return Plausibility(
+                False,
+                f"a pre-sliding damping force of up to {peak:.3g} N is "
+                f"{100 * peak / p['h0']:.0f} % of the friction force h0 = {p['h0']:.4g} N "
+                f"(plausible: up to {100 * self.MAX_FORCE_SHARE:g} %): the asperities cannot "
+                "carry more than the sliding contact; a misfit after the turns is read as one",
+            )
+        return base
+
     def argument(self, d, p):
+        peak = float(np.max(np.abs(presliding_force(d, p))))
         v = peak_speed(d)
         return (
-            f"σ1 = {p['sigma1']:.3g} N s/m: up to {p['sigma1'] * v:.3g} N at the peak speed "
-            f"{v:.3g} m/s right after each turning point ({100 * p['sigma1'] * v / p['h0']:.0f} "
-            "% of h0), gone once the contact slides: damped pre-sliding deflection"
+            f"σ1 = {p['sigma1']:.3g} N s/m: up to {peak:.3g} N ({100 * peak / p['h0']:.0f} % "
+            f"of h0) right after each turning point (peak speed {v:.3g} m/s), gone once the "
+            "contact slides: damped pre-sliding deflection (LuGre's σ1 ż)"
         )

@@ -1,0 +1,309 @@
+"""The speed table of issue 33 in one run: contactlab, the other tools, the limits, ratios.
+
+Every row times contactlab and its reference in the same process, interleaved round by round
+(A B A B …), and quotes medians over ``--rounds``; the machine is shared, so single times are
+noise and the ratio of medians is the figure. Rows:
+
+- ``loop_area`` of 1e6 / 1e7 samples against numpy's closed trapezoid (``0.5 Σ (F_i +
+  F_{i+1}) (x_{i+1} - x_i)`` plus the closing edge), ``np.trapezoid`` (open) and
+  ``np.copyto`` of the same array (a memory-bandwidth limit).
+- per-cycle energies with the cycle bounds given (``contactlab.loop_areas``) against numpy
+  (terms, then ``np.add.reduceat``, plus each cycle's closing edge).
+- ``Masing(h0=1, ac=3).force(x, out=buf)`` on the anchor's signals (sine, band-limited,
+  random walk) against ``../shared/bench/masing_anchor.rs`` (its ``masing_idx`` row), built
+  here for generic x86-64 (``rustc -O``) and run as a subprocess between our rounds.
+- ``Masing.force(threads=2)`` with a competing busy process against one thread.
+- ``contactlab --help`` and ``python -c 'import contactlab'`` wall time (a new process each).
+- the normal-contact ODE against scipy ``odeint`` (LSODA) on the problem of
+  ``benches/bench_normal.py`` when ``--ode`` is given (slow).
+
+numba and OpenSees rows appear only when those are installed (they are not dependencies).
+Run: ``.venv/bin/python benches/speed_table.py [--rounds 5] [--quick]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+import contactlab
+
+ROOT = Path(__file__).resolve().parents[1]
+ANCHOR = ROOT.parent / "shared" / "bench" / "masing_anchor.rs"
+
+
+def med(v: list[float]) -> float:
+    return float(np.median(v))
+
+
+def timed(f) -> float:
+    t0 = time.perf_counter()
+    f()
+    return time.perf_counter() - t0
+
+
+def interleave(fns: dict[str, object], rounds: int) -> dict[str, float]:
+    """Median seconds of each callable, run in turn round by round (order rotating)."""
+    times: dict[str, list[float]] = {k: [] for k in fns}
+    keys = list(fns)
+    for f in fns.values():
+        f()  # warm-up: page faults, caches, lazy imports
+    for r in range(rounds):
+        for k in keys[r % len(keys) :] + keys[: r % len(keys)]:
+            times[k].append(timed(fns[k]))
+    return {k: med(v) for k, v in times.items()}
+
+
+def closed_trapezoid(x: np.ndarray, f: np.ndarray) -> float:
+    inner = 0.5 * np.dot(f[:-1] + f[1:], np.diff(x))
+    return float(inner + 0.5 * (f[-1] + f[0]) * (x[0] - x[-1]))
+
+
+def row(task: str, ours: str, other: str, ratio: float, note: str = "") -> None:
+    print(f"| {task} | {ours} | {other} | {ratio:.2f} {note}|")
+
+
+def loop_rows(rounds: int, sizes: list[int]) -> None:
+    rng = np.random.default_rng(1)
+    for n in sizes:
+        t = np.arange(n) * (2 * np.pi / 1000)
+        x = np.sin(t) + 1e-3 * rng.standard_normal(n)
+        f = np.sin(t + 0.4) + 1e-3 * rng.standard_normal(n)
+        buf = np.empty_like(x)
+        r = interleave(
+            {
+                "cl": lambda x=x, f=f: contactlab.loop_area(x, f),
+                "np": lambda x=x, f=f: closed_trapezoid(x, f),
+                "trapz": lambda x=x, f=f: np.trapezoid(f, x),
+                "copy": lambda x=x, buf=buf: np.copyto(buf, x),
+            },
+            rounds,
+        )
+        row(
+            f"`loop_area`, {n:.0e}",
+            f"{r['cl'] * 1e3:.1f} ms",
+            f"numpy closed trapezoid {r['np'] * 1e3:.1f} ms; `np.trapezoid` "
+            f"{r['trapz'] * 1e3:.1f} ms; `np.copyto` {r['copy'] * 1e3:.1f} ms",
+            r["np"] / r["cl"],
+            f"of numpy; {r['trapz'] / r['cl']:.2f} of np.trapezoid; "
+            f"{r['cl'] / r['copy']:.1f}x the copy ",
+        )
+    n = sizes[0]
+    t = np.arange(n) * (2 * np.pi / 1000)
+    x = np.sin(t)
+    f = np.sin(t + 0.4)
+    bounds = np.arange(0, n + 1, 1000, dtype=np.int64)
+    per_cycle = getattr(contactlab, "loop_areas", None)
+
+    def numpy_cycles() -> np.ndarray:
+        terms = 0.5 * (f[:-1] + f[1:]) * np.diff(x)
+        a, b = bounds[:-1], bounds[1:]
+        inner = np.add.reduceat(terms, a)
+        # reduceat over [a, next a) includes the edge b-1 -> b; remove it, add the closing edge
+        inner[:-1] -= terms[b[:-1] - 1]
+        return inner + 0.5 * (f[b - 1] + f[a]) * (x[a] - x[b - 1])
+
+    if per_cycle is None:
+        from contactlab import _core
+
+        def ours() -> np.ndarray:
+            return _core.loop_areas(x, f, bounds)
+
+        label = "`_core.loop_areas`"
+    else:
+
+        def ours() -> np.ndarray:
+            return per_cycle(x, f, bounds)
+
+        label = "`contactlab.loop_areas`"
+    r = interleave({"cl": ours, "np": numpy_cycles}, rounds)
+    err = np.max(np.abs(ours() - numpy_cycles()))
+    row(
+        f"per-cycle energies, bounds given, {n:.0e} ({label})",
+        f"{r['cl'] * 1e3:.1f} ms",
+        f"numpy {r['np'] * 1e3:.1f} ms (max diff {err:.1e})",
+        r["np"] / r["cl"],
+    )
+
+
+def splitmix_uniform(seed: int, n: int) -> np.ndarray:
+    with np.errstate(over="ignore"):
+        i = np.arange(1, n + 1, dtype=np.uint64)
+        z = np.uint64(seed) + i * np.uint64(0x9E3779B97F4A7C15)
+        z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+        z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+        z ^= z >> np.uint64(31)
+    u = (z >> np.uint64(11)).astype(np.float64) * (1.0 / 9007199254740992.0)
+    return 2.0 * u - 1.0
+
+
+def anchor_signal(kind: str, n: int) -> np.ndarray:
+    from scipy.signal import lfilter
+
+    if kind == "sine":
+        return np.sin((2.0 * np.pi * (np.arange(n) % 1000)) / 1000.0)
+    if kind == "bandlim":
+        e = splitmix_uniform(1, n)
+        r = 0.95
+        a1, a2 = 2.0 * r * np.cos(2.0 * np.pi / 40.0), -(r * r)
+        x = lfilter([0.06], [1.0, -a1, -a2], e)
+        x[:2] = 0.0
+        return x
+    e = splitmix_uniform(2, n)
+    e[0] = 0.0
+    return lfilter([0.05], [1.0, -0.999], e)
+
+
+def build_anchor() -> Path | None:
+    if not ANCHOR.exists() or shutil.which("rustc") is None:
+        return None
+    out = Path(tempfile.gettempdir()) / f"masing_anchor_{os.getpid()}"
+    subprocess.run(["rustc", "-O", "-o", str(out), str(ANCHOR)], check=True)
+    return out
+
+
+def anchor_time(exe: Path, n: int, kind: str) -> float:
+    p = subprocess.run([str(exe), "bench", str(n), "1", kind], capture_output=True, text=True)
+    for line in p.stdout.splitlines():
+        d = json.loads(line)
+        if d["kernel"] == "masing_idx":
+            return float(d["median_s"])
+    raise RuntimeError(p.stderr)
+
+
+def masing_rows(rounds: int, n: int) -> None:
+    exe = build_anchor()
+    m = contactlab.Masing(h0=1.0, ac=3.0)
+    for kind in ("sine", "bandlim", "randwalk"):
+        x = anchor_signal(kind, n)
+        buf = np.empty(n)
+        ours, theirs = [], []
+        m.force(x, out=buf)
+        for _ in range(rounds):
+            ours.append(timed(lambda x=x, buf=buf: m.force(x, out=buf)))
+            if exe is not None:
+                theirs.append(anchor_time(exe, n, kind))
+        o = n / med(ours) / 1e6
+        if exe is None:
+            row(
+                f"`Masing.force(x, out=buf)`, {n:.0e}, {kind}", f"{o:.0f} M/s", "anchor absent", 0.0
+            )
+            continue
+        a = n / med(theirs) / 1e6
+        row(
+            f"`Masing.force(x, out=buf)`, {n:.0e}, {kind}",
+            f"{o:.0f} M/s",
+            f"anchor {a:.0f} M/s",
+            o / a,
+        )
+    if exe is not None:
+        exe.unlink(missing_ok=True)
+
+
+def threads_row(rounds: int, n: int) -> None:
+    x = anchor_signal("randwalk", n)
+    m = contactlab.Masing(h0=1.0, ac=3.0)
+    buf = np.empty(n)
+    busy = subprocess.Popen([sys.executable, "-c", "while True: pass"])
+    try:
+        time.sleep(0.3)
+        r = interleave(
+            {
+                "one": lambda: m.force(x, out=buf, threads=1),
+                "two": lambda: m.force(x, out=buf, threads=2),
+            },
+            rounds,
+        )
+    finally:
+        busy.kill()
+        busy.wait()
+    load = os.getloadavg()[0]
+    row(
+        f"`Masing.force(threads=2)`, {n:.0e} random walk, one busy competitor (load {load:.1f})",
+        f"{r['two'] * 1e3:.0f} ms",
+        f"one thread {r['one'] * 1e3:.0f} ms",
+        r["one"] / r["two"],
+        "of one thread ",
+    )
+
+
+def startup_rows(rounds: int) -> None:
+    exe = Path(sys.executable).with_name("contactlab")
+    env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
+    cmds = {
+        "help": [str(exe), "--help"],
+        "import": [sys.executable, "-c", "import contactlab"],
+        "python": [sys.executable, "-c", "pass"],
+    }
+    r = interleave(
+        {k: (lambda c=c: subprocess.run(c, capture_output=True, env=env)) for k, c in cmds.items()},
+        rounds,
+    )
+    row(
+        "`contactlab --help` (new process)",
+        f"{r['help'] * 1e3:.0f} ms",
+        f"bar 150 ms; bare `python -c pass` {r['python'] * 1e3:.0f} ms; "
+        f"`import contactlab` {r['import'] * 1e3:.0f} ms",
+        0.150 / r["help"],
+        "of the bar ",
+    )
+
+
+def ode_row(rounds: int) -> None:
+    sys.path.insert(0, str(ROOT / "benches"))
+    import bench_normal
+
+    sys.argv = [sys.argv[0]]
+    bench_normal.main([])
+
+
+def optional_tools() -> str:
+    found = []
+    for mod in ("numba", "openseespy"):
+        try:
+            __import__(mod)
+            found.append(mod)
+        except ImportError:
+            pass
+    return ", ".join(found) or "none"
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--quick", action="store_true", help="1e6-sample rows only")
+    ap.add_argument("--ode", action="store_true", help="also the normal ODE against odeint")
+    args = ap.parse_args()
+    big = 1_000_000 if args.quick else 10_000_000
+    try:
+        from contactlab import _core
+
+        simd = _core.simd_level()
+    except (ImportError, AttributeError):  # a build before the dispatch
+        simd = "n/a (before runtime dispatch)"
+    print(
+        f"contactlab {contactlab.__version__}; SIMD level {simd}; load "
+        f"{', '.join(f'{a:.2f}' for a in os.getloadavg())}; {os.cpu_count()} CPUs; medians of "
+        f"{args.rounds} interleaved rounds; optional tools installed: {optional_tools()}"
+    )
+    print("| task | contactlab | the other tool / the limit | ratio |")
+    print("|---|---|---|---|")
+    loop_rows(args.rounds, sorted({1_000_000, big}))
+    masing_rows(args.rounds, big)
+    threads_row(args.rounds, big)
+    startup_rows(args.rounds)
+    if args.ode:
+        ode_row(args.rounds)
+
+
+if __name__ == "__main__":
+    main()
