@@ -38,6 +38,7 @@ output's units and as a percentage of the output's range.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
@@ -342,17 +343,22 @@ def unexplained_structure(
     full &= wbar >= min_weight
     mb = means[:, full]
     n_b = np.sum(np.isfinite(mb), axis=0)
-    mean_b = np.nanmean(mb, axis=0)
-    sd_b = np.nanstd(mb, axis=0, ddof=1)
+    with warnings.catch_warnings():  # a bin no cycle reached: NaN, left out below, no warning
+        warnings.simplefilter("ignore", RuntimeWarning)
+        mean_b = np.nanmean(mb, axis=0)
+        sd_b = np.nanstd(mb, axis=0, ddof=1)
     m_null = m
     if m < POOL_BELOW:
         # few cycles: a bin's own scatter has m - 1 degrees of freedom only (t with 4 of
         # them needs T three times a χ²'s); the scatter is pooled over the bins instead, as
         # one factor κ on each bin's white-noise variance (κ absorbs the noise's
         # correlation), with (m - 1) per bin degrees of freedom
-        v_b = np.nanmean(white[:, full], axis=0)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            kappa = float(np.nanmedian(sd_b**2 / v_b))
+        with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore"):
+            warnings.simplefilter("ignore", RuntimeWarning)
+            v_b = np.nanmean(white[:, full], axis=0)
+            ratio = sd_b**2 / v_b
+        ratio = ratio[np.isfinite(ratio)]
+        kappa = float(np.median(ratio)) if ratio.size else math.nan
         if np.isfinite(kappa) and kappa > 0:
             sd_b = np.sqrt(np.maximum(kappa * v_b, 0.0))
             m_null = min((m - 1) * int(np.sum(full)) + 1, 200)
