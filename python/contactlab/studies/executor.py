@@ -144,9 +144,28 @@ def ordered_map(
 
 def kill_worker_processes() -> None:
     """Kill every child process this process started through multiprocessing (the pools'
-    workers); they hold no outputs (every output is written by the parent, all or nothing)."""
-    import multiprocessing
+    workers); they hold no outputs (every output is written by the parent, all or nothing).
 
+    For a process that is ending (an interrupted or failed command-line run): the pools'
+    own threads, finding their workers gone, would print a traceback ("Exception in thread
+    ..."); from here on such an error in a thread (a closed pipe, a cancelled future) is not
+    printed (any other thread exception still goes to the hook that was there)."""
+    import multiprocessing
+    import threading
+    from concurrent.futures import InvalidStateError
+
+    previous = threading.excepthook
+    # what a pool's manager thread raises when its workers vanish: a closed pipe, and (Python
+    # 3.11's terminate_broken) setting an exception on a future already cancelled
+    expected = (OSError, EOFError, InvalidStateError)
+
+    def quiet(args: Any) -> None:
+        if args.exc_type is not None and issubclass(args.exc_type, expected):
+            return
+        previous(args)
+
+    if getattr(previous, "__name__", "") != "quiet":
+        threading.excepthook = quiet
     for child in multiprocessing.active_children():
         with contextlib.suppress(Exception):
             child.kill()
