@@ -157,6 +157,7 @@ def friction(max_samples: int, jobs: int = 1, laws: list[str] | None = None) -> 
     print(f"{'pooled':<8} {a['snr_db']:24.2f} {b['snr_db']:10.2f} {a['nrmse']:24.4f} "
           f"{b['nrmse']:12.4f}")  # fmt: skip
     print(f"held-out gain over LuGre: {a['snr_db'] - b['snr_db']:+.2f} dB")
+    _per_test_all(complete, lugre, recs)
     name, _, extra = best.partition("+")
     final = fit(recs, law=name, offset=True, asymmetry=True, damping="c" in extra,
                 mass="m" in extra, max_samples=max_samples)  # fmt: skip
@@ -166,6 +167,20 @@ def friction(max_samples: int, jobs: int = 1, laws: list[str] | None = None) -> 
     if not quakes:
         print("earthquake histories: none in ../shared/data/friction_damper (only the harmonic "
               "tests are here); not scored")  # fmt: skip
+
+
+def _per_test_all(complete: dict, lugre: dict, recs: list[JointRecord]) -> None:
+    """Held-out SNR [dB] and NRMSE of every law on every test, LuGre's beside them."""
+    models = {**complete, "LuGre": lugre}
+    table = compare(models, recs)
+    names = list(models)
+    for metric, fmt in (("snr_db", "7.2f"), ("nrmse", "7.4f")):
+        print(f"\nheld-out {metric} of every law (rows: tests; columns: laws)")
+        print(f"{'test':<8} " + " ".join(f"{n[:12]:>12}" for n in names))
+        for r in [*recs, None]:
+            rows = [table.pooled(n) if r is None else table.row(n, r.name) for n in names]
+            label = "pooled" if r is None else r.name
+            print(f"{label:<8} " + " ".join(f"{format(x[metric], fmt):>12}" for x in rows))
 
 
 def _brb_sweeps(path: Path) -> tuple[list[Sweep], list[Sweep]]:
