@@ -94,7 +94,7 @@ def test_law_joint_needs_a_law() -> None:
     s = Structure(1.0, 0.0, 1e3)
     with pytest.raises(contactlab.InputError, match="law="):
         s.add_joint("law", 0)
-    with pytest.raises(contactlab.InputError, match="contactlab.joints law"):
+    with pytest.raises(contactlab.InputError, match=r"contactlab\.joints law"):
         s.add_joint("law", 0, law="lugre")
 
 
