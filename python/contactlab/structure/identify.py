@@ -519,6 +519,30 @@ def _starts(joint: str) -> list[dict[str, float]]:
 
 
 @with_single_blas_thread
+def _start_plan(
+    joint: str,
+    lin: Any,
+    lins: list[dict[str, Any]],
+    y: np.ndarray,
+    mass: float | None,
+    t: np.ndarray,
+    short_residual: Callable[[], Any],
+) -> list[tuple[dict[str, Any], dict[str, Any], dict[str, Any]]]:
+    """The starts of a single-DOF identification: ``(start, linear model, joint start)``
+    for every joint start on every linear model of the grid of frequencies
+    (``short_residual()`` makes the residual on the first samples, used only there)."""
+    starts = _starts(joint)
+    plan = [(st0 if len(lins) == 1 else {**st0, "grid_f": li["grid_f"]}, li, st0)
+            for li in lins for st0 in starts]  # fmt: skip
+    if len(lins) > 1 and joint in ("masing", "jenkins", "iwan"):
+        # the linear grid cannot hold the mass against a joint to the fixed ground (what a
+        # frame rubbing on a wall does on a short record): explore the joint's stiffness
+        # share and slip force on the grid of frequencies, one simulation each (first), as
+        # well as the usual starts on the linear grid's models
+        plan = _joint_grid_plan(joint, lin, y, mass, t, short_residual()) + plan
+    return plan
+
+
 def identify(
     t: Any,
     u: Any,
@@ -609,17 +633,9 @@ def identify(
 
     residual_on = _SdofResidual(joint, excitation, t, u, y, interpolation, substeps, progress)
 
-    starts = _starts(joint)
     records: list[dict[str, Any]] = []
     n_s = min(int(start_samples), t.size)
-    plan = [(st0 if len(lins) == 1 else {**st0, "grid_f": li["grid_f"]}, li, st0)
-            for li in lins for st0 in starts]  # fmt: skip
-    if len(lins) > 1 and joint in ("masing", "jenkins", "iwan"):
-        # the linear grid cannot hold the mass against a joint to the fixed ground (what a
-        # frame rubbing on a wall does on a short record): explore the joint's stiffness
-        # share and slip force on the grid of frequencies, one simulation each (first), as
-        # well as the usual starts on the linear grid's models
-        plan = _joint_grid_plan(joint, lin, y, mass, t, residual_on(n_s, 2)) + plan
+    plan = _start_plan(joint, lin, lins, y, mass, t, lambda: residual_on(n_s, 2))
     est = estimate_initial_state
     best_ps = hold_state(_params(joint, plan[0][1], y, mass, plan[0][2]), est)
     if multistart and len(plan) > 1:
