@@ -21,8 +21,15 @@ from ..errors import InputError
 from .units import SI_UNITS, UnknownUnitError, split_name, to_si
 
 #: canonical channel -> physical dimension (``y``: a frame's base displacement)
-DIMENSIONS = {"t": "time", "x": "length", "F": "force", "p": "pressure", "delta": "length",
-              "y": "length", "N": "force"}  # fmt: skip
+DIMENSIONS = {
+    "t": "time",
+    "x": "length",
+    "F": "force",
+    "p": "pressure",
+    "delta": "length",
+    "y": "length",
+    "N": "force",
+}
 #: the channels each kind of recording needs
 KIND_CHANNELS = {"tangential": ("x", "F"), "normal": ("p", "delta")}
 #: channels read along when a column is named like one (never needed): a tangential test's
@@ -218,12 +225,14 @@ def _not_real(unusable: dict[str, str], *wanted: str) -> str:
     hits = [
         f"{n!r} is {what}"
         for n, what in unusable.items()
-        if n.strip().lower() in low or split_name(n)[0].strip().lower() in low
+        if n.strip().lower() in low
+        or split_name(n)[0].strip().lower() in low
         or n.rsplit("/", 1)[-1].strip().lower() in low
         or n.rsplit(".", 1)[-1].strip().lower() in low  # a MATLAB struct's field
-    ]  # fmt: skip
-    return (f"; {', '.join(hits[:5])}: a channel must hold real numbers" if hits else "") \
-        + _structs(unusable)  # fmt: skip
+    ]
+    return (
+        f"; {', '.join(hits[:5])}: a channel must hold real numbers" if hits else ""
+    ) + _structs(unusable)
 
 
 def _structs(unusable: dict[str, str]) -> str:
@@ -237,9 +246,11 @@ def _structs(unusable: dict[str, str]) -> str:
         if "." in names[0]
         else f"save(file, '-struct', {names[0]!r})"
     )
-    return (f"; {', '.join(repr(n) for n in names[:3])} "
-            f"{'is a MATLAB struct' if len(names) == 1 else 'are MATLAB structs'}, whose "
-            f"fields are not read: save them as variables (in MATLAB: {how})")  # fmt: skip
+    return (
+        f"; {', '.join(repr(n) for n in names[:3])} "
+        f"{'is a MATLAB struct' if len(names) == 1 else 'are MATLAB structs'}, whose "
+        f"fields are not read: save them as variables (in MATLAB: {how})"
+    )
 
 
 def resolve_columns(
