@@ -99,3 +99,23 @@ def test_fit_with_sensitivities_equals_the_finite_difference_fit(law, monkeypatc
         if p.vary and q.stderr:
             assert abs(p.value - q.value) <= 0.05 * q.stderr, n
             assert p.stderr == pytest.approx(q.stderr, rel=1e-3), n
+
+
+def test_lugre_on_a_one_speed_quantised_record_converges_with_stribeck_held():
+    """A stage that strokes at one speed in 100 nm steps, holding still every other sample
+    (the micro-tribometer's record): Fs and vs cannot be separated from Fc, σ1 runs to 0;
+    the fit holds them (with notes) and converges."""
+    n = 6000
+    t = np.arange(n) * 5e-3
+    steps = np.tile(np.r_[np.ones(600), -np.ones(600)], n // 1200 + 1)[:n] * (np.arange(n) % 2)
+    x = 1e-7 * np.cumsum(steps)
+    true = LuGre(sigma0=4e4, sigma1=0.0, sigma2=20.0, Fc=2.5, Fs=3.0, vs=1e-6)
+    F = true.force(t, x) + np.random.default_rng(5).normal(0, 0.02, n)
+    res = fit(t, x, F, law="lugre", offset=True)
+    assert res.success, res.result.message
+    assert not res.params["Fs"].vary and not res.params["vs"].vary
+    assert any("one speed" in n for n in res.notes)
+    assert res.params["Fc"].stderr is not None
+    for name, v in (("Fc", 2.5), ("sigma0", 4e4)):
+        p = res.params[name]
+        assert abs(p.value - v) < 5 * p.stderr, name

@@ -76,7 +76,10 @@ class LoopFeatures:
     ``force_level`` [N]: half the robust range of F (1-99 %); ``force_mid`` [N]: its middle;
     ``swing_length`` [m]: median travel after a reversal for the force to swing through 80 %
     of ``2·force_level``; ``stiffness`` [N/m] = ``1.6 force_level / swing_length``;
-    ``speed`` [m/s]: median |ẋ|; ``stroke`` [m]: half the displacement range.
+    ``speed`` [m/s]: median |Δx/Δt| over the steps where x moves (a quantised stage that
+    holds still every other sample moves at this speed, not at half of it); ``stroke`` [m]:
+    half the displacement range; ``speed_spread``: the 95th over the 5th percentile of those
+    speeds (near 1: the record slides at one speed).
     """
 
     force_level: float
@@ -85,6 +88,7 @@ class LoopFeatures:
     stiffness: float
     speed: float
     stroke: float
+    speed_spread: float = math.inf
 
 
 def loop_features(records: Sequence[JointRecord]) -> LoopFeatures:
@@ -100,7 +104,8 @@ def loop_features(records: Sequence[JointRecord]) -> LoopFeatures:
         x, F = r.x, r.require_force()
         lo, hi = float(np.min(x)), float(np.max(x))
         strokes.append(0.5 * (hi - lo))
-        speeds.append(float(np.median(np.abs(np.gradient(x, r.t)))))
+        v = np.abs(np.diff(x) / np.diff(r.t))
+        speeds.append(v[v > 0])
         if not hi > lo:
             continue
         ex = excursions(x, 0.5 * (lo + hi), 0.25 * (hi - lo))
@@ -115,10 +120,13 @@ def loop_features(records: Sequence[JointRecord]) -> LoopFeatures:
     stroke = max(float(np.median(strokes)), 1e-300)
     swing = float(np.median(swings)) if swings else 0.5 * stroke
     swing = min(max(swing, 1e-6 * stroke), 2.0 * stroke)
-    speed = float(np.median(speeds))
-    if not speed > 0:
-        speed = stroke
-    return LoopFeatures(level, mid, swing, 1.6 * level / swing, speed, stroke)
+    moving = np.concatenate(speeds)
+    speed, spread = stroke, math.inf
+    if moving.size:
+        speed = float(np.median(moving))
+        p5, p95 = np.percentile(moving, [5.0, 95.0])
+        spread = float(p95 / p5) if p5 > 0 else math.inf
+    return LoopFeatures(level, mid, swing, 1.6 * level / swing, speed, stroke, spread)
 
 
 def _leaf_start(name: str, f: LoopFeatures, stiff: float, n_elements: int) -> Any:
@@ -525,15 +533,32 @@ def _resolve_law(law: Any, recs: list[JointRecord], stiffness_factor: float,
                      f"instance, got {type(law).__name__}")  # fmt: skip
 
 
-def _fixed_names(law: Any, fixed: Any) -> set[str]:
+#: the spread of sliding speeds (95th / 5th percentile) below which a record is taken to
+#: slide at one speed: the Stribeck curve's Fs and vs are then held (see :func:`fit`)
+ONE_SPEED_SPREAD = 3.0
+
+#: the Stribeck parameters of the rate-dependent laws
+_STRIBECK = {"lugre": ("Fs", "vs"), "gms": ("Fs", "vs")}
+
+
+def _fixed_names(law: Any, fixed: Any, features: LoopFeatures | None = None,
+                 notes: list[str] | None = None) -> set[str]:  # fmt: skip
     names = law.param_names
     if fixed is None:
-        base = law.name
-        defaults = DEFAULT_FIXED.get(base, ())
+        base, pre = law.name, ""
         if base == "backlash":
-            inner = law.laws[0]
-            pre = inner.name
-            defaults = tuple(f"{pre}.{n}" for n in DEFAULT_FIXED.get(inner.name, ()))
+            base, pre = law.laws[0].name, law.laws[0].name + "."
+        defaults = [pre + n for n in DEFAULT_FIXED.get(base, ())]
+        if features is not None and features.speed_spread < ONE_SPEED_SPREAD and base in _STRIBECK:
+            held = [pre + n for n in _STRIBECK[base]]
+            defaults += held
+            if notes is not None:
+                notes.append(
+                    f"{' and '.join(held)} held at their start values: the records slide at "
+                    f"one speed (95th / 5th percentile of the moving |dx/dt|: "
+                    f"{features.speed_spread:.2g}), which does not separate a Stribeck curve "
+                    "from the Coulomb force (give fixed= to fit them anyway)"
+                )
         return {n for n in defaults if n in names}
     out = set(fixed.keys() if isinstance(fixed, Mapping) else fixed)
     unknown = out - set(names)
@@ -541,6 +566,25 @@ def _fixed_names(law: Any, fixed: Any) -> set[str]:
         raise InputError(f"fixed: unknown parameter(s) {', '.join(sorted(unknown))} of "
                          f"{law.name} ({', '.join(names)})")  # fmt: skip
     return out
+
+
+def _zero_at_bound(fitted: Any, start: Any, fixed: set[str], notes: list[str]) -> Any:
+    """Parameters whose closed lower bound is 0 (a damping, a viscous coefficient) that the
+    search drove to it (below 1e-6 of their start value) are set to 0 and held there
+    (added to ``fixed``), with a note: a boundary optimum, which the covariance fit and its
+    trust check would otherwise take for an unconverged direction."""
+    zero = {}
+    starts = start.params
+    for spec, (n, v) in zip(fitted._specs(), fitted.params.items(), strict=True):
+        if n in fixed or spec.lo != 0.0 or spec.open_lo:
+            continue
+        if starts.get(n, 0.0) > 0 and v <= 1e-6 * starts[n]:
+            zero[n] = 0.0
+    if not zero:
+        return fitted
+    fixed.update(zero)
+    notes.append(f"{', '.join(zero)} = 0 at the lower bound (held there for the covariance)")
+    return fitted.with_params(zero)
 
 
 def _parameters(law: Any, fixed: set[str], bounds: Mapping[str, tuple[float, float]] | None
@@ -678,7 +722,8 @@ def fit(
     Fm = np.concatenate([p.F for p in prep])
     phi = np.concatenate([p.phi for p in prep], axis=0)
     first = _resolve_law(law, recs, 1.0, n_elements)
-    fixed_names = _fixed_names(first, fixed)
+    held: list[str] = []
+    fixed_names = _fixed_names(first, fixed, loop_features(recs), held)
     fixed_values = dict(fixed) if isinstance(fixed, Mapping) else {}
     if fixed_values:
         first = first.with_params(fixed_values)
@@ -742,6 +787,7 @@ def fit(
         raise InputError(f"the law {first.name} could not be evaluated from any start: "
                          f"{errors[0] if errors else 'no start'}")  # fmt: skip
     res_law, fitted = best
+    fitted = _zero_at_bound(fitted, first, fixed_names, held)
     # the final joint fit of the law's parameters and the linear terms: the covariance of all
     P = _law_forces(fitted, prep)
     beta = _linear_solve(np.column_stack([phi, np.abs(P)]) if asym else phi, Fm - P)
@@ -810,6 +856,6 @@ def fit(
         thinned_every=every,
         starts_tried=tried,
         name=name,
-        notes=errors[:3],
+        notes=held + errors[:3],
     )
     return out
