@@ -216,17 +216,22 @@ def beam() -> None:
     A, c, f, names = _table(fc + rc)
     order = np.argsort(A)
     print("\n=== Brake-Reuss beam: phase-resonance table (12 sweeps)")
-    for law in ("segalman", "iwan"):
+    free = {"chi": (-0.99, 1.0)}  # Segalman's χ beyond its physical range (-1, 0]
+    for law, bounds in (("segalman", None), ("segalman", free), ("iwan", None)):
         t0 = time.perf_counter()
-        fa = fit_amplitude(A, damping=c, frequency=f, law=law, viscous=True)
+        fa = fit_amplitude(A, damping=c, frequency=f, law=law, viscous=True, bounds=bounds)
+        law = law + (" (chi free)" if bounds else "")
+        out = [n for n in fa.result.notes if "outside the physical range" in n]
         print(f"amplitude-table fit, {law} + viscous c0: damping RMS error "
               f"{100 * fa.rms_relative_error('c_eq'):.2f} % ({time.perf_counter() - t0:.2f} s, "
               f"{'converged' if fa.success else 'NOT converged'}); {fa.law!r}, "
               f"c0 = {fa.result.params['c0'].value:.3f} ± {fa.result.params['c0'].stderr:.2g} "
-              "N s/m")  # fmt: skip
-    for law in ("segalman", "iwan"):
+              "N s/m" + "".join(f"; {n}" for n in out))  # fmt: skip
+    for law, bounds in (("segalman", None), ("segalman", free), ("iwan", None)):
         t0 = time.perf_counter()
-        ss = fit_stepped_sine(fc + rc, law=law)
+        ss = fit_stepped_sine(fc + rc, law=law, bounds=bounds)
+        if bounds:
+            law = law + " (chi free)"
         bb = ss.backbone(A)
         rel = bb["c_eq"] / c - 1.0
         print(f"stepped-sine fit of all 984 points, {law}: damping at phase resonance RMS "
@@ -234,7 +239,8 @@ def beam() -> None:
               f"{100 * float(np.max(np.abs(rel))):.1f} %; frequency RMS error "
               f"{math.sqrt(float(np.mean((bb['f_n'] - f) ** 2))):.3f} Hz "
               f"({time.perf_counter() - t0:.2f} s, "
-              f"{'converged' if ss.success else 'NOT converged'})")  # fmt: skip
+              f"{'converged' if ss.success else 'NOT converged'}); {ss.law!r}"
+              + "".join(f"; {n}" for n in ss.result.notes if "physical range" in n))  # fmt: skip
         if law == "segalman":
             best, best_bb = ss, bb
     print(best_bb and f"segalman stepped-sine fit: {best.law!r}, modal "

@@ -241,11 +241,49 @@ def secant_stiffness(law: Any, amplitude: Any, frequency: float | None = None) -
 # fits
 
 
+#: parameter ranges the fits keep to by default, narrower than the laws' own where a
+#: value the law can evaluate has no physical meaning: Segalman's power-law exponent
+#: −1 < χ < 0 (a slip-force density that diverges at 0 slip and a dissipation growing as
+#: A^(3+χ), between A² and A³; Segalman 2005; kept 0.01 off −1, where the density's
+#: normalisation diverges). ``bounds`` widens them.
+PHYSICAL_BOUNDS: dict[str, dict[str, tuple[float, float]]] = {"segalman": {"chi": (-0.99, 0.0)}}
+
+
+def physical_bounds(law: Any, bounds: Mapping[str, tuple[float, float]] | None
+                    ) -> dict[str, tuple[float, float]]:  # fmt: skip
+    """``bounds`` over the physical ranges of :data:`PHYSICAL_BOUNDS` for ``law`` (a
+    composite's children's names prefixed)."""
+    out: dict[str, tuple[float, float]] = {}
+    for name in law.param_names:
+        *owners, own = name.split(".")
+        # the law owning the parameter: the composite's child prefix ("segalman",
+        # "segalman1" when two children share a name) or the law itself
+        owner = owners[-1].rstrip("0123456789") if owners else law.name
+        b = PHYSICAL_BOUNDS.get(owner, {}).get(own)
+        if b is not None:
+            out[name] = b
+    out.update(bounds or {})
+    return out
+
+
+def out_of_range_notes(law: Any) -> list[str]:
+    """A note per parameter outside its physical range (a fit given wider ``bounds``)."""
+    notes = []
+    for n, (lo, hi) in physical_bounds(law, None).items():
+        v = law.params[n]
+        if not lo <= v <= hi:
+            notes.append(f"{n} = {v:.3g} is outside the physical range ({lo:g}, {hi:g}] of "
+                         f"{law.name} (the fit was given wider bounds)")  # fmt: skip
+    return notes
+
+
 def _law_params(law: Any, fixed: set[str], bounds: Mapping[str, tuple[float, float]] | None,
                 ) -> dict[str, Parameter]:  # fmt: skip
     out = {}
+    bounds = physical_bounds(law, bounds)
     for n, v in law.params.items():
-        lo, hi = (bounds or {}).get(n, law.bounds[n])
+        lo, hi = bounds.get(n, law.bounds[n])
+        v = min(max(v, lo), hi) if n in bounds else v
         if lo == 0.0 and v > 0 and n not in (bounds or {}):
             lo = 1e-9 * v
         out[n] = Parameter(n, float(v), vary=n not in fixed, min=lo, max=hi,
@@ -473,6 +511,7 @@ def fit_amplitude(
     _mark_identifiability(res)
     pred, fails = predict(res.values)
     fitted = start.with_params([res.params[n].value for n in names])
+    res.notes.extend(out_of_range_notes(fitted))
     return AmplitudeFit(fitted, res, A, cols, {k: pred[k] for k in cols}, f_single, fails)
 
 
@@ -646,7 +685,9 @@ def _default_fixed(law: Any, fixed: Sequence[str] | None, stiffness_given: bool
 
 def fit_stepped_sine(sweeps: Sequence[Sweep], *, law: Any = "segalman",
                      fixed: Sequence[str] | None = None, sweep_stiffness: bool = True,
-                     weighting: str = "relative") -> SteppedSineFit:  # fmt: skip
+                     weighting: str = "relative",
+                     bounds: Mapping[str, tuple[float, float]] | None = None
+                     ) -> SteppedSineFit:  # fmt: skip
     """Fit a mode with a joint to first-harmonic stepped-sine points (all sweeps at once).
 
     At each point the measured dynamic stiffness ``K = F / X`` (``X = |X| e^{iφ}``, the
@@ -683,6 +724,9 @@ def fit_stepped_sine(sweeps: Sequence[Sweep], *, law: Any = "segalman",
     weighting : {"relative", "resonance"}
         "relative": the damping residual of each point relative to its own ``Im K``;
         "resonance": relative to ``|K|`` (the points near resonance weigh most).
+    bounds : mapping, optional
+        ``name -> (lo, hi)`` of law parameters, over the defaults (the law's own range, and
+        Segalman's physical −1 < χ <= 0, :data:`PHYSICAL_BOUNDS`).
     """
     if not sweeps:
         raise InputError("give at least one sweep")
@@ -765,11 +809,11 @@ def fit_stepped_sine(sweeps: Sequence[Sweep], *, law: Any = "segalman",
         beta = np.linalg.lstsq(Lr, -b, rcond=None)[0]
         return b + Lr @ beta
 
-    params = _law_params(start, fixed_set, None)
+    params = _law_params(start, fixed_set, bounds)
     res1 = least_squares_fit(residual_nl, params)
     v1 = res1.values
     beta = np.linalg.lstsq(Lr, -base(v1), rcond=None)[0]
-    params = _law_params(start.with_params([v1[n] for n in names]), fixed_set, None)
+    params = _law_params(start.with_params([v1[n] for n in names]), fixed_set, bounds)
     for n, b, u in zip(lin_names, beta, lin_units, strict=True):
         params[n] = Parameter(n, float(b), unit=u, scale=abs(float(b)) or 1.0)
 
@@ -785,5 +829,6 @@ def fit_stepped_sine(sweeps: Sequence[Sweep], *, law: Any = "segalman",
     _mark_identifiability(res)
     joint(res.values)  # the end point's failures
     law_fit = start.with_params([res.params[n].value for n in names])
+    res.notes.extend(out_of_range_notes(law_fit))
     modal = {n: res.params[n].value for n in ("k", "m", "c0")}
     return SteppedSineFit(law_fit, modal, res, [s.name for s in sw], fmid, dict(failures))

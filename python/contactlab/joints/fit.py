@@ -589,13 +589,17 @@ def _zero_at_bound(fitted: Any, start: Any, fixed: set[str], notes: list[str]) -
 
 def _parameters(law: Any, fixed: set[str], bounds: Mapping[str, tuple[float, float]] | None
                 ) -> dict[str, Parameter]:  # fmt: skip
+    from .amplitude import physical_bounds
+
     units = law.units
     lb = law.bounds
+    bounds = physical_bounds(law, bounds)
     out = {}
     for n, v in law.params.items():
         lo, hi = lb[n]
         if bounds and n in bounds:
             lo, hi = bounds[n]
+            v = min(max(v, lo), hi)
         scale = None
         if v == 0:
             scale = 1.0
