@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -526,27 +526,11 @@ def analyze_tangential(
     if delay is not None:
         ta, xa, Fa, dropped = lag.shift_force(ta, xa, Fa, delay)
     ori = orient(xa, Fa, ta, force_sign=force_sign)
-    res = _analyze(
-        xa,
-        Fa,
-        ta,
-        source,
-        ori,
-        None,
-        on=on,
-        history=history,
-        fit_offset=fit_offset,
-        fit_x0=fit_x0,
-        n_points=n_points,
-        rel_threshold=rel_threshold,
-        min_cycles=min_cycles,
-        max_rel_stderr=max_rel_stderr,
-        fit_amplitude=fit_amplitude,
-        detrend=detrend,
-        initial=initial,
-        streamed=False,
-        delay=delay,
-    )
+    res = _analyze(xa, Fa, ta, source, ori, None, on=on, history=history, fit_offset=fit_offset,
+                   fit_x0=fit_x0, n_points=n_points, rel_threshold=rel_threshold,
+                   min_cycles=min_cycles, max_rel_stderr=max_rel_stderr,
+                   fit_amplitude=fit_amplitude, detrend=detrend, initial=initial,
+                   streamed=False, delay=delay)  # fmt: skip
     assert res is not None  # only a streamed window hands its case back
     lag.record(res, delay, dropped)
     if warn:
@@ -630,40 +614,14 @@ def _analyze(
     if ori.sign < 0 and pre is None:  # (a detrended window is negated already: no copy)
         Fa = -Fa
     fit_x0 = True if fit_x0 is None else fit_x0
-    det = (
-        pre
-        if pre is not None
-        else steps.detrend(
-            xa,
-            Fa,
-            ta,
-            on=on,
-            enabled=detrend,
-            n_points=n_points,
-            rel_threshold=rel_threshold,
-            min_cycles=min_cycles,
-        )
-    )
-    data = steps.fit_data(det, ta, on=on, steady=steady, rel_threshold=rel_threshold)
-    sv = steps.start_values(
-        data,
-        rel_threshold=rel_threshold,
-        fit_offset=fit_offset,
-        fit_x0=fit_x0,
-        fit_amplitude=fit_amplitude,
-        initial=initial,
-    )
-    raw, res, x_noise = steps.fit(
-        steps.Residuals(data, data.w), sv, fit_x0=fit_x0, fit_amplitude=fit_amplitude
-    )
-    raw = steps.drift_covariance(
-        raw, res, det.drift, rel_threshold=rel_threshold, min_cycles=min_cycles
-    )
-    raw, c_theta_amp = steps.turn_covariance(raw, res)
-    raw, g_amp = steps.fixed_amplitude_covariance(raw, res, sv.prior, fit_amplitude)
-    amp = steps.amplitude_estimate(
-        raw, data, sv.prior, fit_amplitude=fit_amplitude, g_amp=g_amp, c_theta_amp=c_theta_amp
-    )
+    det = pre
+    if det is None:
+        det = steps.detrend(xa, Fa, ta, on=on, enabled=detrend, n_points=n_points,
+                            rel_threshold=rel_threshold, min_cycles=min_cycles)  # fmt: skip
+    f = _fitted(det, ta, on=on, steady=steady, rel_threshold=rel_threshold, min_cycles=min_cycles,
+                fit_offset=fit_offset, fit_x0=fit_x0, fit_amplitude=fit_amplitude,
+                initial=initial)  # fmt: skip
+    raw, amp, data = f.raw, f.amp, f.data
     fit = reparametrize(raw)
     identifiable, evidence = identifiability(fit, raw, amp.value, max_rel_stderr)
     h0_lo = evidence.pop("h0_lower_bound")
@@ -676,35 +634,26 @@ def _analyze(
     ratio = loop_area_ratio(data, amp.value, derived["energy_per_cycle_numeric"][0])
     z_fit = evidence["ac_times_amplitude"] if identifiable else None
     if streamed:
-        fast = _fast_regime(z_fit, ratio)
-        if fast is None:
+        regime = _fast_regime(z_fit, ratio)
+        if regime is None:
             return None
-        regime = fast
     else:
-        regime = classify(
-            z_fit=z_fit,
-            ratio=ratio,
-            loop=det.loop,
-            x=det.x,
-            F=det.F,
-            t=ta,
-            rev=data.rev,
-            x_raw=xa,
-        )
+        regime = classify(z_fit=z_fit, ratio=ratio, loop=det.loop, x=det.x, F=det.F, t=ta,
+                          rev=data.rev, x_raw=xa)  # fmt: skip
     apply_regime(regime, amp, fit, identifiable, evidence, derived, max_rel_stderr)
-    warns = collect_warnings(pre_warns, raw, data, amp.value, identifiable, evidence, regime, res.w)
+    warns = collect_warnings(pre_warns, raw, data, amp.value, identifiable, evidence, regime,
+                             f.res.w)  # fmt: skip
     if steady and det.loop is not None:
         warns += _transient_warning(det.loop, amp.value, amp.stderr)
     if on == "averaged":  # the delay between the channels the loop shows (:mod:`.lag`)
-        warns += lag.annotate(derived, fit, raw, res, data, sliding=regime.sliding,
-                              misfit=misfit_ratio(raw, data, res.w), applied=delay)  # fmt: skip
-    vals = raw.values
+        warns += lag.annotate(derived, fit, raw, f.res, data, sliding=regime.sliding,
+                              misfit=misfit_ratio(raw, data, f.res.w), applied=delay)  # fmt: skip
     regime_d = regime.to_dict()
     if streamed:
         regime_d.update(_unsearched_sticks(data.rev, xa.size))
     return TangentialAnalysis(
         fit=fit,
-        model=steps.model_of(vals),
+        model=steps.model_of(raw.values),
         amplitude=float(amp.value),
         amplitude_stderr=amp.stderr,
         loop=det.loop,
@@ -718,26 +667,76 @@ def _analyze(
         history=history,
         x=np.asarray(data.xd),
         F=np.asarray(data.Fd),
-        F_model=res.predict(vals),
-        weights=res.w,
+        F_model=f.res.predict(raw.values),
+        weights=f.res.w,
         t=data.td,
         source=source,
-        meta={
-            "fit_start": data.start,
-            "invert_force": ori.sign < 0,
-            "x_noise": x_noise,
-            "force_sign": ori.sign,
-            "orientation_reason": ori.reason,
-            "orientation_by": ori.by,
-            "loop_area_recorded": (ori.loop_area, ori.loop_area_stderr),
-            # the plateau levels' mid-point and branch length, for the loop plot's levels
-            **(
-                {"plateau_offset": regime.plateau.offset, "plateau_dx95": regime.plateau.dx95}
-                if regime.plateau is not None
-                else {}
-            ),
-        },
+        meta=_meta(data, f.x_noise, ori, regime),
     )
+
+
+class _Fitted(NamedTuple):
+    """What :func:`_fitted` gives: the fit data, the raw fit and its residuals, the
+    displacement noise and the amplitude estimate."""
+
+    data: steps.FitData
+    raw: FitResult
+    res: steps.Residuals
+    x_noise: float
+    amp: steps.Amplitude
+
+
+def _fitted(
+    det: steps.Detrended,
+    ta: np.ndarray | None,
+    *,
+    on: str,
+    steady: bool,
+    rel_threshold: float,
+    min_cycles: int,
+    fit_offset: bool,
+    fit_x0: bool,
+    fit_amplitude: bool,
+    initial: dict[str, float] | None,
+) -> _Fitted:
+    """The Masing fit of the detrended samples ``det`` with the covariance of what it takes
+    as exact (drifts, turning points, a fixed amplitude) and the amplitude estimate."""
+    data = steps.fit_data(det, ta, on=on, steady=steady, rel_threshold=rel_threshold)
+    sv = steps.start_values(data, rel_threshold=rel_threshold, fit_offset=fit_offset,
+                            fit_x0=fit_x0, fit_amplitude=fit_amplitude,
+                            initial=initial)  # fmt: skip
+    raw, res, x_noise = steps.fit(
+        steps.Residuals(data, data.w), sv, fit_x0=fit_x0, fit_amplitude=fit_amplitude
+    )
+    raw = steps.drift_covariance(
+        raw, res, det.drift, rel_threshold=rel_threshold, min_cycles=min_cycles
+    )
+    raw, c_theta_amp = steps.turn_covariance(raw, res)
+    raw, g_amp = steps.fixed_amplitude_covariance(raw, res, sv.prior, fit_amplitude)
+    amp = steps.amplitude_estimate(
+        raw, data, sv.prior, fit_amplitude=fit_amplitude, g_amp=g_amp, c_theta_amp=c_theta_amp
+    )
+    return _Fitted(data, raw, res, x_noise, amp)
+
+
+def _meta(data: steps.FitData, x_noise: float, ori: Orientation, regime: Regime) -> dict[str, Any]:
+    """The result's ``meta``: where the fit starts, the displacement noise, the orientation
+    and, in a sliding regime, the plateau levels' mid-point and branch length (the loop
+    plot's levels)."""
+    return {
+        "fit_start": data.start,
+        "invert_force": ori.sign < 0,
+        "x_noise": x_noise,
+        "force_sign": ori.sign,
+        "orientation_reason": ori.reason,
+        "orientation_by": ori.by,
+        "loop_area_recorded": (ori.loop_area, ori.loop_area_stderr),
+        **(
+            {"plateau_offset": regime.plateau.offset, "plateau_dx95": regime.plateau.dx95}
+            if regime.plateau is not None
+            else {}
+        ),
+    }
 
 
 # analyze_window moved to contactlab.tangential.window (issue 32): the old name forwards
