@@ -516,6 +516,50 @@ def analyze_tangential(
     >>> res.identifiable, abs(res.fit.params["h0"].value - 20) < 3 * res.fit.params["h0"].stderr
     (True, True)
     """
+    xa, Fa, ta, source, ori, dropped = _prepared(
+        recording, t, x, F, on, history, n_points, invert_force, force_sign, delay
+    )
+    res = _analyze(
+        xa,
+        Fa,
+        ta,
+        source,
+        ori,
+        None,
+        on=on,
+        history=history,
+        fit_offset=fit_offset,
+        fit_x0=fit_x0,
+        n_points=n_points,
+        rel_threshold=rel_threshold,
+        min_cycles=min_cycles,
+        max_rel_stderr=max_rel_stderr,
+        fit_amplitude=fit_amplitude,
+        detrend=detrend,
+        initial=initial,
+        streamed=False,
+        delay=delay,
+    )
+    assert res is not None  # only a streamed window hands its case back
+    lag.record(res, delay, dropped)
+    _issue(res.warnings, warn)
+    return res
+
+
+def _prepared(
+    recording: Recording | None,
+    t: Any,
+    x: Any,
+    F: Any,
+    on: str,
+    history: str,
+    n_points: int | None,
+    invert_force: bool | None,
+    force_sign: int | str,
+    delay: float | None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, str, Orientation, int]:
+    """:func:`analyze_tangential`'s inputs checked, the known delay corrected and the force
+    oriented: ``(x, F, t, source, orientation, samples dropped by the delay)``."""
     xa, Fa, ta, source = _inputs(recording, t, x, F)
     _check_options(on, history, n_points)
     check_channel("x", xa, "m", "displacement")
@@ -525,18 +569,15 @@ def analyze_tangential(
     dropped = 0
     if delay is not None:
         ta, xa, Fa, dropped = lag.shift_force(ta, xa, Fa, delay)
-    ori = orient(xa, Fa, ta, force_sign=force_sign)
-    res = _analyze(xa, Fa, ta, source, ori, None, on=on, history=history, fit_offset=fit_offset,
-                   fit_x0=fit_x0, n_points=n_points, rel_threshold=rel_threshold,
-                   min_cycles=min_cycles, max_rel_stderr=max_rel_stderr,
-                   fit_amplitude=fit_amplitude, detrend=detrend, initial=initial,
-                   streamed=False, delay=delay)  # fmt: skip
-    assert res is not None  # only a streamed window hands its case back
-    lag.record(res, delay, dropped)
+    return xa, Fa, ta, source, orient(xa, Fa, ta, force_sign=force_sign), dropped
+
+
+def _issue(texts: list[str], warn: bool) -> None:
+    """Each warning of the result as a :class:`ContactLabWarning` when ``warn``, attributed
+    to the caller of :func:`analyze_tangential` (through its options wrapper)."""
     if warn:
-        for wtxt in res.warnings:
-            warnings.warn(wtxt, ContactLabWarning, stacklevel=3)
-    return res
+        for wtxt in texts:
+            warnings.warn(wtxt, ContactLabWarning, stacklevel=4)
 
 
 def _fast_regime(z_fit: float | None, ratio: float) -> Regime | None:
@@ -563,9 +604,15 @@ def _unsearched_sticks(rev: Any, n_samples: int) -> dict[str, Any]:
     n_turns = int(rev.peaks.size + rev.valleys.size)
     if n_turns < 2 or n_samples < 20:  # where the search would give none either
         return {}
-    unknown = ("reversals_with_stick", "stick_duration", "breakaway_force",
-               "breakaway_force_stderr", "velocity_threshold", "smooth_turn_dwell",
-               "reversals_with_dwell")  # fmt: skip
+    unknown = (
+        "reversals_with_stick",
+        "stick_duration",
+        "breakaway_force",
+        "breakaway_force_stderr",
+        "velocity_threshold",
+        "smooth_turn_dwell",
+        "reversals_with_dwell",
+    )
     return {"stick_slip": {"n_reversals": n_turns, **dict.fromkeys(unknown, math.nan)}}
 
 
@@ -616,11 +663,28 @@ def _analyze(
     fit_x0 = True if fit_x0 is None else fit_x0
     det = pre
     if det is None:
-        det = steps.detrend(xa, Fa, ta, on=on, enabled=detrend, n_points=n_points,
-                            rel_threshold=rel_threshold, min_cycles=min_cycles)  # fmt: skip
-    f = _fitted(det, ta, on=on, steady=steady, rel_threshold=rel_threshold, min_cycles=min_cycles,
-                fit_offset=fit_offset, fit_x0=fit_x0, fit_amplitude=fit_amplitude,
-                initial=initial)  # fmt: skip
+        det = steps.detrend(
+            xa,
+            Fa,
+            ta,
+            on=on,
+            enabled=detrend,
+            n_points=n_points,
+            rel_threshold=rel_threshold,
+            min_cycles=min_cycles,
+        )
+    f = _fitted(
+        det,
+        ta,
+        on=on,
+        steady=steady,
+        rel_threshold=rel_threshold,
+        min_cycles=min_cycles,
+        fit_offset=fit_offset,
+        fit_x0=fit_x0,
+        fit_amplitude=fit_amplitude,
+        initial=initial,
+    )
     raw, amp, data = f.raw, f.amp, f.data
     fit = reparametrize(raw)
     identifiable, evidence = identifiability(fit, raw, amp.value, max_rel_stderr)
@@ -638,16 +702,26 @@ def _analyze(
         if regime is None:
             return None
     else:
-        regime = classify(z_fit=z_fit, ratio=ratio, loop=det.loop, x=det.x, F=det.F, t=ta,
-                          rev=data.rev, x_raw=xa)  # fmt: skip
+        regime = classify(
+            z_fit=z_fit, ratio=ratio, loop=det.loop, x=det.x, F=det.F, t=ta, rev=data.rev, x_raw=xa
+        )
     apply_regime(regime, amp, fit, identifiable, evidence, derived, max_rel_stderr)
-    warns = collect_warnings(pre_warns, raw, data, amp.value, identifiable, evidence, regime,
-                             f.res.w)  # fmt: skip
+    warns = collect_warnings(
+        pre_warns, raw, data, amp.value, identifiable, evidence, regime, f.res.w
+    )
     if steady and det.loop is not None:
         warns += _transient_warning(det.loop, amp.value, amp.stderr)
     if on == "averaged":  # the delay between the channels the loop shows (:mod:`.lag`)
-        warns += lag.annotate(derived, fit, raw, f.res, data, sliding=regime.sliding,
-                              misfit=misfit_ratio(raw, data, f.res.w), applied=delay)  # fmt: skip
+        warns += lag.annotate(
+            derived,
+            fit,
+            raw,
+            f.res,
+            data,
+            sliding=regime.sliding,
+            misfit=misfit_ratio(raw, data, f.res.w),
+            applied=delay,
+        )
     regime_d = regime.to_dict()
     if streamed:
         regime_d.update(_unsearched_sticks(data.rev, xa.size))
@@ -702,9 +776,14 @@ def _fitted(
     """The Masing fit of the detrended samples ``det`` with the covariance of what it takes
     as exact (drifts, turning points, a fixed amplitude) and the amplitude estimate."""
     data = steps.fit_data(det, ta, on=on, steady=steady, rel_threshold=rel_threshold)
-    sv = steps.start_values(data, rel_threshold=rel_threshold, fit_offset=fit_offset,
-                            fit_x0=fit_x0, fit_amplitude=fit_amplitude,
-                            initial=initial)  # fmt: skip
+    sv = steps.start_values(
+        data,
+        rel_threshold=rel_threshold,
+        fit_offset=fit_offset,
+        fit_x0=fit_x0,
+        fit_amplitude=fit_amplitude,
+        initial=initial,
+    )
     raw, res, x_noise = steps.fit(
         steps.Residuals(data, data.w), sv, fit_x0=fit_x0, fit_amplitude=fit_amplitude
     )

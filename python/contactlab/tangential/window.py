@@ -131,11 +131,21 @@ def analyze_window(
     if ori is not None:
         if ori.sign < 0:
             pre = _negated(pre)
-        res = _analyze(xa, Fa, ta, source, ori, pre, on="averaged", history="steady",
-                       streamed=True, delay=delay, **opts)  # fmt: skip
+        res = _analyze(
+            xa,
+            Fa,
+            ta,
+            source,
+            ori,
+            pre,
+            on="averaged",
+            history="steady",
+            streamed=True,
+            delay=delay,
+            **opts,
+        )
     if res is None:  # the sign undecided by the area, or gross sliding: the full analysis
-        return analyze_tangential(recording, force_sign=force_sign, warn=False, delay=delay,
-                                  **opts)  # fmt: skip
+        return analyze_tangential(recording, force_sign=force_sign, warn=False, delay=delay, **opts)
     lag.record(res, delay, dropped)
     return res
 
@@ -162,8 +172,9 @@ def _window_detrended(
         rev = find_reversals(xa, ta, rel_threshold=rel)  # checks x and t
         Fa = as_1d(Fa, "F")
     if not (opts["detrend"] and rev.peaks.size - 1 >= 3):
-        loop = average_loop(xa, Fa, ta, n_points=n_points, rel_threshold=rel,
-                            min_cycles=min_cycles, checked=True)  # fmt: skip
+        loop = average_loop(
+            xa, Fa, ta, n_points=n_points, rel_threshold=rel, min_cycles=min_cycles, checked=True
+        )
         return steps.Detrended(xa, Fa, loop, None)
     tt = ta if ta is not None else np.arange(xa.size, dtype=float)
     pt = rev.peak_times
@@ -183,12 +194,13 @@ def _window_detrended(
     # for: the tails of x for its robust amplitude (the reversal search's band) and the
     # fold's checks and scales (issue 33: a pass a window less each; the same numbers)
     sel = _tail_ranks(x.size)
-    scan = _core.detrend_pair_scan_into(tt, tm, Fa, f_drift[0], xa, x_drift[0], F, x,
-                                        sel[0] if sel is not None else [])  # fmt: skip
+    ranks = sel[0] if sel is not None else []
+    scan = _core.detrend_pair_scan_into(tt, tm, Fa, f_drift[0], xa, x_drift[0], F, x, ranks)
     drift = steps.Drift(f_drift, x_drift, tt, tm)
     if not scan.clean:  # the fold names what is wrong (as before the scan)
-        loop = average_loop(x, F, ta, n_points=n_points, rel_threshold=rel,
-                            min_cycles=min_cycles, checked=True)  # fmt: skip
+        loop = average_loop(
+            x, F, ta, n_points=n_points, rel_threshold=rel, min_cycles=min_cycles, checked=True
+        )
         return steps.Detrended(x, F, loop, drift)
     pct = _lerp_tails(scan.order_stats, sel[1]) if sel is not None else tail_percentiles(x)
     rev = _reversals(x, tt, pct, rel, None)
