@@ -88,16 +88,28 @@ def tail_percentiles(x: np.ndarray, q: float = 0.5) -> tuple[float, float]:
     them from the samples beyond a subsample's thresholds (one pass in Rust, where numpy's
     selection took a partition of a subsample and two boolean masks of ``x``). numpy's
     interpolation of them is kept as it is; ``np.percentile`` itself for short ``x``."""
-    n = x.size
+    sel = _tail_ranks(x.size, q)
+    if sel is None:
+        lo, hi = np.percentile(x, [q, 100.0 - q])
+        return float(lo), float(hi)
+    ranks, g = sel
+    return _lerp_tails(_core.order_stats(np.ascontiguousarray(x, dtype=float), ranks), g)
+
+
+def _tail_ranks(n: int, q: float = 0.5) -> tuple[list[int], np.ndarray] | None:
+    """The order statistics :func:`tail_percentiles` interpolates for ``n`` samples (their
+    ranks and numpy's fractions between them), None where it takes ``np.percentile``."""
     qq = np.array([q, 100.0 - q]) / 100.0
     vi = (n - 1) * qq  # numpy's virtual index of the linear method
     i0 = np.floor(vi).astype(np.int64)
     g = vi - i0
     if n <= _TAIL_SELECT_ABOVE or not (0 <= i0[0] and i0[1] + 1 < n):
-        lo, hi = np.percentile(x, [q, 100.0 - q])
-        return float(lo), float(hi)
-    ranks = [int(i0[0]), int(i0[0]) + 1, int(i0[1]), int(i0[1]) + 1]
-    v = _core.order_stats(np.ascontiguousarray(x, dtype=float), ranks)
+        return None
+    return [int(i0[0]), int(i0[0]) + 1, int(i0[1]), int(i0[1]) + 1], g
+
+
+def _lerp_tails(v: np.ndarray, g: np.ndarray) -> tuple[float, float]:
+    """The two percentiles from the order statistics ``v`` of :func:`_tail_ranks`."""
     out = []
     for a, b, t in ((v[0], v[1], g[0]), (v[2], v[3], g[1])):
         d = b - a
@@ -147,6 +159,19 @@ def find_reversals(
     if ta.size != xa.size:
         raise InputError(f"t has {ta.size} samples but x has {xa.size}")
     lo_p, hi_p = tail_percentiles(xa)
+    return _reversals(xa, ta, (lo_p, hi_p), rel_threshold, threshold)
+
+
+def _reversals(
+    xa: np.ndarray,
+    ta: np.ndarray,
+    percentiles: tuple[float, float],
+    rel_threshold: float,
+    threshold: float | None,
+) -> Reversals:
+    """:func:`find_reversals` of checked float64 ``xa``, ``ta`` whose 0.5 and 99.5
+    percentiles (:func:`tail_percentiles`) are ``percentiles``."""
+    lo_p, hi_p = percentiles
     centre = 0.5 * (lo_p + hi_p)
     amp = 0.5 * (hi_p - lo_p)
     if threshold is None:
@@ -414,6 +439,22 @@ def average_loop(
     if ta.size != xa.size:
         raise InputError(f"t has {ta.size} samples but x has {xa.size}")
     rev = find_reversals(xa, ta, rel_threshold=rel_threshold, threshold=threshold, checked=True)
+    return _fold_loop(xa, Fa, ta, rev, n_points=n_points, min_cycles=min_cycles)
+
+
+def _fold_loop(
+    xa: np.ndarray,
+    Fa: np.ndarray,
+    ta: np.ndarray,
+    rev: Reversals,
+    *,
+    n_points: int | None,
+    min_cycles: int,
+    scan: _core.WindowScan | None = None,
+) -> AveragedLoop:
+    """:func:`average_loop` of checked ``xa``, ``Fa``, ``ta`` whose reversals are ``rev``;
+    ``scan``: :func:`contactlab._core.detrend_pair_scan_into`'s clean scan of them, which
+    stands for the fold's check pass."""
     n_cyc = max(int(rev.peaks.size) - 1, 0)
     if n_cyc < min_cycles:
         raise InputError(
@@ -438,7 +479,7 @@ def average_loop(
     # One call in Rust: phase by interpolating the knots, bin sums overall and per cycle (no
     # per-sample temporaries; the bins are numpy.interp's), the cycles' bounds, loop areas and
     # their noise sensitivities, the period means between the peaks.
-    wf = _core.fold_window(ta, xa, Fa, kt, kp, int(n_points), n_cyc, rev.peak_times)
+    wf = _core.fold_window(ta, xa, Fa, kt, kp, int(n_points), n_cyc, rev.peak_times, scan)
     return _loop_of_fold(wf, rev, int(n_points), start, end)
 
 
