@@ -311,6 +311,21 @@ def _strip_rust(line: str) -> str:
     return line.split("//", 1)[0]
 
 
+def _reason(lines: list[str], at: int) -> str:
+    """The ``//`` comment (not doc comment) just above line ``at`` (0-based), skipping the
+    attributes and doc comments between: the justification an allowance carries."""
+    said: list[str] = []
+    k = at - 1
+    while k >= 0:
+        text = lines[k].strip()
+        if text.startswith("//") and not text.startswith(("///", "//!")):
+            said.insert(0, text.lstrip("/ "))
+        elif said or not (text.startswith(("#[", "///")) or text == ""):
+            break
+        k -= 1
+    return " ".join(said) or "(no comment)"
+
+
 def measure(files: dict[str, str]) -> Metrics:
     """Every measurement of one tree."""
     m = Metrics()
@@ -331,9 +346,11 @@ def measure(files: dict[str, str]) -> Metrics:
             for name, _, length in rust_functions(text):
                 if length > RS_FUNC_LIMIT:
                     m.rs_long_functions.append((f"{path}:{name}", length))
-            for k, line in enumerate(text.split("\n"), 1):
+            rs_lines = text.split("\n")
+            for k, line in enumerate(rs_lines, 1):
                 if re.search(r"allow\(\s*clippy::", line) and not line.lstrip().startswith("//"):
-                    m.clippy_allows.append(f"{path}:{k} {line.strip()}")
+                    lint = ", ".join(re.findall(r"clippy::(\w+)", line))
+                    m.clippy_allows.append(f"{path}:{k} `{lint}`: {_reason(rs_lines, k - 1)}")
     graph = import_graph(files)
     m.module_cycles = strongly_connected(graph)
     m.package_cycles = sibling_cycles(graph)
@@ -397,8 +414,8 @@ def details(m: Metrics) -> str:
     parts += [f"- `{p}`" for p in m.test_files_private] or ["none"]
     parts += ["", "### Private names crossing a package", ""]
     parts += [f"- `{p}`" for p in m.private_crossings] or ["none"]
-    parts += ["", "### `allow(clippy::…)` attributes", ""]
-    parts += [f"- `{p}`" for p in m.clippy_allows] or ["none"]
+    parts += ["", "### `allow(clippy::…)` attributes and the comment that justifies each", ""]
+    parts += [f"- {p}" for p in m.clippy_allows] or ["none"]
     return "\n".join(parts)
 
 

@@ -15,7 +15,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from ..errors import InputError
-from ._common import DefaultsShown, describe, quantity
+from .common import DefaultsShown, describe, quantity
 
 if TYPE_CHECKING:
     from ..io import Recording

@@ -16,7 +16,7 @@ import math
 import sys
 
 from ..errors import InputError
-from ._common import (
+from .common import (
     add_frame_flags,
     add_pressure_flags,
     add_progress_flags,

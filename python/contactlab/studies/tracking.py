@@ -15,7 +15,7 @@ keeps only the results:
 - normal windows: :func:`contactlab.normal.analyze_loop` — E_d (with its standard error from
   the cycle-to-cycle scatter), ψ (eq. 7), ψ_KV (eq. 3), k_tan (eq. 4), k_sec (eq. 5) and the
   loading, unloading and centre polynomials of eq. 1;
-- every cycle of the record (:mod:`._cycles`): loop energy ∮F dx, amplitude, offset.
+- every cycle of the record (:mod:`.cycles`): loop energy ∮F dx, amplitude, offset.
 
 Memory holds one chunk and one window, whatever the length of the record.
 :meth:`TrackResult.combined` pools the windows (weights by window size, the error widened by
@@ -42,8 +42,8 @@ from .._options import as_dict
 from .._physical import MAX_MAGNITUDE
 from ..errors import ContactLabError, ContactLabWarning, InputError
 from ..io import Recording, read_chunks
-from ._cycles import CycleState, block_cycles, trigger_levels
 from .columns import CYCLE_UNITS
+from .cycles import CycleState, block_cycles, trigger_levels
 from .study import coefficient_unit
 from .track_cuts import WindowCuts
 from .track_result import (  # noqa: F401  (the constants and TrackResult, re-exported)

@@ -36,8 +36,6 @@ fn select_into(v: &mut [f64], ranks: &[usize], offset: usize, out: &mut [f64]) {
 /// # Errors
 /// [`CoreError::Empty`] for an empty `x`, [`CoreError::InvalidParameter`] for a rank not
 /// below `x.len()`.
-// Index arithmetic: ranks < n (checked), sub ranks < sub.len(), counts <= n.
-#[allow(clippy::arithmetic_side_effects)]
 pub fn order_stats(x: &[f64], ranks: &[usize]) -> Result<Vec<f64>, CoreError> {
     let n = x.len();
     if n == 0 {
@@ -74,6 +72,8 @@ pub fn order_stats(x: &[f64], ranks: &[usize]) -> Result<Vec<f64>, CoreError> {
 
 /// [`order_stats`] of the ranks `low` (below `n/2`) and `high` (the rest), both ascending,
 /// from the tails of `x`, into `vals` (low's then high's); false when a tail is too short.
+// Count arithmetic: ranks < n = x.len() >= 1 (checked by the caller), m = the subsample's
+// length >= 1, the tail counts nl, nh <= n, so no sum or difference leaves 0..=2n.
 #[allow(clippy::arithmetic_side_effects)]
 fn tails(x: &[f64], low: &[usize], high: &[usize], vals: &mut [f64]) -> bool {
     let n = x.len();
