@@ -14,7 +14,6 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from .._options import as_dict
 from ..errors import InputError
 from .common import (
     FORCE_SIGN_CHOICES,
@@ -313,6 +312,7 @@ def _handler(args: argparse.Namespace) -> int:
     if args.delay is not None and args.model != "tangential":
         raise InputError("--delay is for tangential recordings (force against displacement)")
     # the flags parsed into the typed options (issue 32); the library takes them as dicts too
+    from .._options import as_dict
     from ..normal.options import Options as NormalOptions
     from ..tangential.options import Options as TangentialOptions
 

@@ -117,8 +117,7 @@ def _check(doc: dict, kind: str, args: argparse.Namespace) -> None:
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    from ..fem.units import SYSTEMS
-    from ..fem.writers import FORMATS
+    from ..fem.units import FORMATS, SYSTEMS
 
     p = sub.add_parser(
         "export",

@@ -73,6 +73,10 @@ class UnitSystem:
         return f"{self.name}: mm, N, s, t (pressure MPa = N/mm^2)"
 
 
+#: the export's file formats (:func:`contactlab.fem.writers.render`); here, beside the unit
+#: systems, so that the command line's parser offers both without importing the writers
+FORMATS = ("calculix", "abaqus", "ansys", "csv", "json")
+
 SYSTEMS = {
     "SI": UnitSystem("SI", 1.0),
     "mm-N-s": UnitSystem("mm-N-s", 1e-3),

@@ -28,9 +28,7 @@ from pathlib import Path
 from .._io_atomic import write_text
 from ..errors import InputError
 from .characteristics import JointCharacteristics, NotIdentifiableError, Value
-from .units import UnitSystem
-
-FORMATS = ("calculix", "abaqus", "ansys", "csv", "json")
+from .units import FORMATS, UnitSystem
 
 
 def _g(x: float) -> str:
