@@ -163,6 +163,9 @@ def analyses() -> dict[str, str]:
         t, p, d = normal_recording(model="table2", n_cycles=5, noise=0.01, seed=seed)
         res = analyze_loop(t, p, d, **kw)
         out[f"analyze_loop seed={seed} {kw}"] = digest(res.to_dict(arrays=True))
+    t, p, d = normal_recording(model="table2", n_cycles=5, noise=0.01, seed=24)
+    res = analyze_loop(t, p, d, options={"degree": 3, "pa": 0.4e6})
+    out["analyze_loop seed=24 options={degree: 3, pa: 4e5}"] = digest(res.to_dict(arrays=True))
     layouts = [
         (["t [ms]", "x [um]", "F [N]"], {}, None, {}),
         (["time", "disp", "force", "other"], {}, None, {}),

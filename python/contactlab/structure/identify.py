@@ -530,7 +530,6 @@ def _starts(joint: str) -> list[dict[str, float]]:
     return [{}]
 
 
-@with_single_blas_thread
 def _start_plan(
     joint: str,
     lin: Any,
@@ -558,6 +557,7 @@ def _start_plan(
     return plan
 
 
+@with_single_blas_thread
 def identify(
     t: Any,
     u: Any,
