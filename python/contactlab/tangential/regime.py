@@ -220,7 +220,7 @@ def plateau(
 @dataclass(frozen=True)
 class StickSlip:
     """Sticking segments found at the reversals: ``durations`` (s) and ``breakaway`` force
-    (the largest |F - offset| while stuck: the static friction the drive had to overcome,
+    (the largest ``|F - offset|`` while stuck: the static friction the drive had to overcome,
     N), over ``n_turns`` reversals; the velocity
     threshold used and how long a smooth turn stays below it."""
 
