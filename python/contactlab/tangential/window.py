@@ -125,7 +125,7 @@ def analyze_window(
     }
     # (a recording's channels are contiguous float64 arrays unless replaced since)
     plain = all(a.dtype == np.float64 and a.ndim == 1 and a.flags.c_contiguous for a in (xa, Fa))
-    pre = _window_detrended(xa, Fa, ta, opts, checked=finite_x and finite_f and plain)
+    pre = window_detrended(xa, Fa, ta, opts, checked=finite_x and finite_f and plain)
     ori = _fast_orientation(pre.x, pre.F, pre.loop, force_sign)
     res = None
     if ori is not None:
@@ -150,7 +150,7 @@ def analyze_window(
     return res
 
 
-def _window_detrended(
+def window_detrended(
     xa: np.ndarray,
     Fa: np.ndarray,
     ta: np.ndarray | None,
@@ -206,14 +206,6 @@ def _window_detrended(
     rev = _reversals(x, tt, pct, rel, None)
     loop = _fold_loop(x, F, tt, rev, n_points=n_points, min_cycles=min_cycles, scan=scan)
     return steps.Detrended(x, F, loop, drift)
-
-
-def _detrended(v: np.ndarray, tt: np.ndarray, tm: float, slope: float) -> np.ndarray:
-    """``v - slope * (tt - tm)`` in numpy (the reference of ``_core.detrend_pair``, tests)."""
-    out = np.subtract(tt, tm)
-    np.multiply(out, -slope, out=out)
-    np.add(v, out, out=out)
-    return out
 
 
 def _negated(d: steps.Detrended) -> steps.Detrended:
