@@ -226,8 +226,15 @@ def estimate(raw: Any, res: Any, data: Any) -> DelayEstimate | None:
         return _solve(system, v, names, idx, nb, period, model_of)
 
 
-def _solve(system: Any, v: dict[str, float], names: list[str], idx: dict[str, int], nb: int,
-           period: float, model_of: Any) -> DelayEstimate | None:  # fmt: skip
+def _solve(
+    system: Any,
+    v: dict[str, float],
+    names: list[str],
+    idx: dict[str, int],
+    nb: int,
+    period: float,
+    model_of: Any,
+) -> DelayEstimate | None:
     """The Gauss-Newton steps of :func:`estimate`."""
     th0 = np.array([v[n] for n in names])
     th, tau = th0.copy(), 0.0
@@ -463,8 +470,9 @@ def annotate(
     if displacement_noise_share(raw, data) > MAX_X_SHARE:
         return []  # the stated error is too small there (module docstring): not warned
     e_se = derived.get("energy_per_cycle", (math.nan, math.nan))[1]
-    txt = warning(est, fit.params["h0"].stderr, e_se, misfit=misfit, sliding=sliding,
-                  applied=applied)  # fmt: skip
+    txt = warning(
+        est, fit.params["h0"].stderr, e_se, misfit=misfit, sliding=sliding, applied=applied
+    )
     return [txt] if txt else []
 
 
@@ -507,8 +515,10 @@ def shifted_recording(rec: Any, delay: float) -> tuple[Any, int]:
 
     t, x, F, dropped = shift_force(rec.t, rec["x"], rec["F"], delay)
     lo = int(np.searchsorted(rec.t, t[0])) if t is not None and t.size else 0
-    data = {k: (x if k == "x" else F if k == "F" else np.asarray(a)[lo : lo + x.size])
-            for k, a in rec.data.items()}  # fmt: skip
+    data = {
+        k: (x if k == "x" else F if k == "F" else np.asarray(a)[lo : lo + x.size])
+        for k, a in rec.data.items()
+    }
     meta = dict(rec.meta or {}, delay=float(delay), delay_dropped_samples=dropped)
     return replace(rec, t=t, data=data, meta=meta), dropped
 
@@ -548,11 +558,17 @@ def delayed_recording(recording: Any, delay: float) -> Any:
         if t is None or "x" not in recording or "F" not in recording:
             raise InputError("delay= needs the channels 't', 'x' and 'F' of a tangential recording")
         ta = np.asarray(t, dtype=float)
-        ts, x, F, _ = shift_force(ta, np.asarray(recording["x"], dtype=float),
-                                  np.asarray(recording["F"], dtype=float), delay)  # fmt: skip
+        ts, x, F, _ = shift_force(
+            ta,
+            np.asarray(recording["x"], dtype=float),
+            np.asarray(recording["F"], dtype=float),
+            delay,
+        )
         lo = int(np.searchsorted(ta, ts[0])) if ts is not None and ts.size else 0
-        out = {k: (np.asarray(v)[lo : lo + x.size] if np.ndim(v) == 1 and len(v) == ta.size
-                   else v) for k, v in recording.items()}  # fmt: skip
+        out = {
+            k: (np.asarray(v)[lo : lo + x.size] if np.ndim(v) == 1 and len(v) == ta.size else v)
+            for k, v in recording.items()
+        }
         out.update(t=ts, x=x, F=F)
         return out
     if isinstance(recording, (tuple, list)) and len(recording) == 3:
