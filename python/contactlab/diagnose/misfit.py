@@ -29,6 +29,12 @@ noise dominates the effective variance are not tested (:data:`MIN_WEIGHT`), and 
 mean counts only by what exceeds the reach of the input noise through the model's slope
 (:func:`eiv_tolerance`, an interval null). Both were tuned on tuning seeds only.
 
+A second test (:func:`backbone_misfit`, tangential records) fits the residual on alternate
+cycles by a free-form virgin curve — Masing's rules are linear in the virgin curve — and
+asks whether it predicts the held-out cycles: a virgin curve of another shape that a named
+effect (series compliance) absorbed in part leaves a residual too spread over the phase bins
+for ``T`` but shaped like a branch.
+
 When ``T`` exceeds the threshold, :func:`unexplained_structure` reports where the structure
 sits (the branch and the phase range of the bins with ``|t_b|`` above a Bonferroni level,
 merged into runs) and how large it is: the RMS and the peak of the binned means, in the
