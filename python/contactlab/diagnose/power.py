@@ -497,10 +497,44 @@ def detectable_above(
             ),
         )  # fmt: skip
     worst = max(mags, key=lambda s: rel[s.name] or 0.0)
+    why = _implausible_at(family, p0, name, worst, per[worst.name], d)
+    if why:
+        v, u = _display(float(per[worst.name]), worst.unit)
+        return Detectable(
+            name, worst.name, None, worst.unit, worst.null, None, shape, per,
+            reason=(
+                f"not detectable within its physically plausible range: it would be seen "
+                f"above {v:.2g} {u}, where the diagnosis refuses it ({why})"
+            ),
+        )  # fmt: skip
     return Detectable(
         name, worst.name, per[worst.name], worst.unit, worst.null, rel[worst.name], shape, per,
         gain_at_bound=gain[worst.name],
     )  # fmt: skip
+
+
+def _implausible_at(
+    family: Family, p0: dict[str, float], name: str, s: ParamSpec, b: float, d: Prepared
+) -> str | None:
+    """Why the diagnosis would refuse the effect at the bound as implausible (either sign
+    away from "absent" where the range allows), or None (plausible at one of them, or the
+    family has no plausibility rule)."""
+    check = getattr(family, "implausible", None)
+    if check is None:
+        return None
+    why = None
+    for v in (s.null + b, s.null - b):
+        if not (s.lower <= v <= s.upper):
+            continue
+        p = dict(p0)
+        p[s.name] = v
+        try:
+            why = check(name, p, d)
+        except (ValueError, KeyError, FloatingPointError):
+            return None
+        if why is None:
+            return None
+    return why
 
 
 def _refusal(
