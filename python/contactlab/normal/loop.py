@@ -630,7 +630,6 @@ def _stiffness(
 # --- main entry point ----------------------------------------------------------------------
 
 
-@takes_options
 def _folded(v: np.ndarray, cyc: _Cycles) -> np.ndarray:
     """Step 4: the whole cycles of one channel folded onto the phase grid, ``(cycles, bins)``,
     each starting at the fundamental's upward crossing (as the averaged cycle reports), with
@@ -671,6 +670,7 @@ def _averaged_cycle(
     return ps, ds, dstd, e_std
 
 
+@takes_options
 def analyze_loop(
     t: Any,
     p: Any,
