@@ -5,6 +5,7 @@ the sensor's wiggles at rest, and the fit starts at the λ the data show."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from contactlab.diagnose._family import Prepared
 from contactlab.diagnose.candidates_tangential import TangentialFamily
@@ -58,3 +59,43 @@ def test_branch_scale_starts_where_the_data_put_it():
     got = registry("tangential")["non_masing_scaling"].start(base, d, resid)
     assert abs(got["lam"] - lam) <= 0.16
     assert abs(got["h0"] / h0 - 1) < 0.15 and abs(got["ac"] / ac - 1) < 0.15
+
+
+def _doc_breakaway(x, rev, b, dc, h0):
+    """docs/effects.md, plain Python: b h0 sgn(ẋ) (s/d_c) e^(1 - s/d_c), s the travel since
+    the last turning point, nothing before the first."""
+    out = []
+    last = None
+    for i, xi in enumerate(x):
+        if last is None or (rev.size and i >= rev[0] and last != rev[rev <= i][-1]):
+            last = rev[rev <= i][-1] if rev.size and i >= rev[0] else None
+        if last is None:
+            out.append(0.0)
+            continue
+        s = abs(xi - x[last])
+        sgn = 1.0 if xi >= x[last] else -1.0
+        out.append(b * h0 * sgn * (s / dc) * np.exp(1 - s / dc))
+    return np.array(out)
+
+
+def test_stick_slip_is_the_documents_breakaway():
+    """The candidate adds docs/effects.md's breakaway to the branches (against a plain
+    loop); its peak b h0 sits a travel d_c after each reversal; the full-branch breakaway
+    force is h0 (1 + b) once the branch has saturated before d_c."""
+    from contactlab.diagnose.effects.tangential.stick_slip import (
+        breakaway_force,
+        breakaway_term,
+    )
+
+    t = np.linspace(0.0, 3.0, 3001)
+    x = 1e-4 * np.sin(2 * np.pi * t)
+    rev = turning_points(x, 1e-9)
+    h = Masing(40.0, 4e4).force(x)
+    b, dc = 0.2, 2.5e-5
+    got = breakaway_term(h, x, rev, b, dc, 40.0) - h
+    np.testing.assert_allclose(got, _doc_breakaway(x, rev, b, dc, 40.0), atol=1e-12)
+    after = slice(rev[0], rev[1])
+    k = int(np.argmax(np.abs(got[after])))
+    assert abs(got[after][k]) == pytest.approx(b * 40.0, rel=1e-3)
+    assert abs(x[after][k] - x[rev[0]]) == pytest.approx(dc, rel=0.02)
+    assert breakaway_force(40.0, 1e7, b, dc) == pytest.approx(40.0 * (1 + b), rel=1e-3)
