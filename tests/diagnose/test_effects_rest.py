@@ -99,3 +99,20 @@ def test_stick_slip_is_the_documents_breakaway():
     assert abs(got[after][k]) == pytest.approx(b * 40.0, rel=1e-3)
     assert abs(x[after][k] - x[rev[0]]) == pytest.approx(dc, rel=0.02)
     assert breakaway_force(40.0, 1e7, b, dc) == pytest.approx(40.0 * (1 + b), rel=1e-3)
+
+
+def test_a_base_biased_by_the_missing_effect_may_move_as_far_as_the_effect_explains():
+    """The base parameters may move by 30 % when an effect is added; by 50 % when the
+    effect leaves at most a fifth of the current model's excess held-out error, and by 100 %
+    when it leaves at most a tenth (a breakaway at ac·A = 0.8 biases the base's h0 by -40 %);
+    a model that takes h0 from 29 N to 6330 N is refused whatever it explains."""
+    from contactlab.diagnose.search import _takes_over
+
+    fam = TangentialFamily()
+    base = {"h0": 24.3, "ac": 4e4}
+    for h0, share, refused in [
+        (33.0, 1.0, True), (30.0, 1.0, False), (33.0, 0.15, False), (40.5, 0.15, True),
+        (40.5, 0.05, False), (6330.0, 0.0, True), (8.9, 0.05, False), (8.9, 0.5, True),
+    ]:  # fmt: skip
+        why = _takes_over(fam, base, {"h0": h0, "ac": 4e4}, (), share)
+        assert (why is not None) == refused, (h0, share, why)
