@@ -27,7 +27,7 @@ name                           measured force ``F`` (or measured ``x``)         
 ``parameter_drift``            ``F = h (1 + β (t - t_m)/T)``, ``t_m`` mid-record           beta [-]
 ``stribeck``                   ``F = h (1 + s exp(-|ẋ|/v_s))``                             s, v_s
 ``position_friction``          ``F = h (1 + Σ a_k cos kπξ + b_k sin kπξ)``                 a_k, b_k
-``stick_slip``                 breakaway ``s_b`` after each reversal over ``ell``          s_b, ell
+``stick_slip``                 ``F = h + s_b h0 sgn(ẋ) (s/ell) e^(1 - s/ell)``, s: travel  s_b, ell
 ``normal_load``                ``F = h (1 + ε_c cos 2π f_n t + ε_s sin 2π f_n t)``         eps, f_n
 ``power_law_microslip``        Segalman's Iwan element (F_S = h0, K_T = h0 ac)             chi, beta
 ``backlash``                   ``F = M(u)``, ``u`` the play operator of ``x`` (width 2b)   b [m]
