@@ -138,3 +138,17 @@ def test_position_friction_follows_a_wave_of_any_length_along_the_stroke(waves, 
     left = F - fam.predict(out.params, ("position_friction",), d)
     assert np.sqrt(np.mean(left**2)) < 0.15 * np.sqrt(np.mean((F - h) ** 2))
     assert out.params["h0"] == pytest.approx(40.0, rel=0.02)
+
+
+def test_breakaway_read_off_the_model_covers_a_series_springs_stretch():
+    """A friction damper's model (h0 17 kN behind a series spring of 2 MN/m, 4 cm stroke):
+    its breakaway force is read where the branch has crossed the spring's stretch, not
+    within the slip distance of the reversal (there it read 1.0 kN)."""
+    fam = TangentialFamily()
+    t = np.arange(0.0, 6.0, 1.0 / 1024.0)
+    x = 0.04 * np.sin(2 * np.pi * t)
+    d = Prepared.build(t, x, np.zeros_like(x))
+    fam.prepare(d)
+    p = {"h0": 1.7e4, "ac": 5e6, "C_s": 5e-7, "s_b": 0.3, "ell": 2.4e-3}
+    fb = fam.model_breakaway(p, ("series_compliance", "stick_slip"), d)
+    assert 1.7e4 < fb < 1.7e4 * 1.3
