@@ -121,6 +121,48 @@ macro_rules! dispatch {
 }
 pub(crate) use dispatch;
 
+/// A kernel whose body [`run`] compiles for each level: `run_at` must be `#[inline(always)]`
+/// (so that it is compiled inside the `#[target_feature]` functions of [`run`]), and is
+/// written in plain Rust over slices, in the same order of operations whatever the level.
+pub trait Kernel {
+    type Output;
+    /// The kernel's body.
+    fn run_at(self) -> Self::Output;
+}
+
+/// Run `kernel` compiled for `level` when the CPU has it, else for the baseline: the generic
+/// counterpart of [`dispatch!`] for kernels generic over a curve or a closure.
+#[allow(unsafe_code)]
+pub fn run<K: Kernel>(level: Level, kernel: K) -> K::Output {
+    #[cfg(target_arch = "x86_64")]
+    {
+        #[target_feature(enable = "avx2,fma")]
+        fn avx2<K: Kernel>(kernel: K) -> K::Output {
+            kernel.run_at()
+        }
+        #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2,fma")]
+        fn avx512<K: Kernel>(kernel: K) -> K::Output {
+            kernel.run_at()
+        }
+        match level {
+            // SAFETY: `avx512` is compiled for AVX-512 F/VL/DQ, AVX2 and FMA; `supported`
+            // has just checked (by `is_x86_feature_detected!`) that this CPU has each of them.
+            Level::Avx512 if Level::Avx512.supported() => {
+                return unsafe { avx512(kernel) };
+            }
+            // SAFETY: `avx2` is compiled for AVX2 and FMA; `supported` has just checked
+            // (by `is_x86_feature_detected!`) that this CPU has both.
+            Level::Avx2 | Level::Avx512 if Level::Avx2.supported() => {
+                return unsafe { avx2(kernel) };
+            }
+            _ => {}
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = level;
+    kernel.run_at()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -28,6 +28,7 @@
 
 use super::{MasingState, Reversal};
 use crate::curve::Backbone;
+use crate::simd::{self, Kernel, Level};
 
 /// No pending sample: the value is known.
 pub(super) const KNOWN: u32 = u32::MAX;
@@ -54,14 +55,15 @@ pub(super) struct Run {
 /// exponential curve); then each run's base is resolved in order (a deferred base is the
 /// output of an earlier sample, itself `base + mul · f(u)` of an earlier run); then
 /// `out[i] = base + mul · out[i]` with the run of sample `i` looked up in `rid`.
-#[inline(never)]
-pub(super) fn eval_block<C: Backbone>(
+#[inline(always)]
+fn eval_block_body<C: Backbone>(
     curve: &C,
     runs: &mut [Run],
     u: &[f64],
     rid: &[u16],
     out: &mut [f64],
-) {
+    tab: &mut RunTab,
+) -> bool {
     for (o, &v) in out.iter_mut().zip(u) {
         *o = curve.eval(v);
     }
@@ -103,9 +105,236 @@ pub(super) fn eval_block<C: Backbone>(
         runs[k].src = KNOWN;
         prev_ha = ha;
     }
+    // The bases and multipliers in two arrays indexed by a masked run number (`rid` < BLOCK
+    // + 2 <= 1024: the mask changes nothing and spares the bounds check), so that the loop
+    // over the samples vectorises with gathers; one run (a smooth block) needs no gather.
+    // Whether every force is finite is found on the way (no pass of its own).
+    let mut finite = true;
+    if let [r] = runs {
+        for o in out.iter_mut() {
+            *o = r.ha + r.mul * *o;
+            finite &= o.is_finite();
+        }
+        return finite;
+    }
+    let (ha, mul) = (&mut tab.ha, &mut tab.mul);
+    for ((h, m), r) in ha.iter_mut().zip(mul.iter_mut()).zip(runs.iter()) {
+        (*h, *m) = (r.ha, r.mul);
+    }
     for (o, &k) in out.iter_mut().zip(rid) {
-        let r = &runs[k as usize];
-        *o = r.ha + r.mul * *o;
+        let k = usize::from(k) & (RUNS - 1);
+        *o = ha[k] + mul[k] * *o;
+        finite &= o.is_finite();
+    }
+    finite
+}
+
+/// The runs' bases and multipliers for the gathers of [`eval_block_body`] (allocated once
+/// per call of the kernel, not per block).
+pub(super) struct RunTab {
+    ha: [f64; RUNS],
+    mul: [f64; RUNS],
+}
+
+impl RunTab {
+    pub(super) fn new() -> Box<Self> {
+        Box::new(Self {
+            ha: [0.0; RUNS],
+            mul: [0.0; RUNS],
+        })
+    }
+}
+
+/// Size of the gather tables of [`eval_block_body`]: a power of two above `BLOCK + 2`.
+const RUNS: usize = 1024;
+
+/// [`eval_block_body`] as a [`Kernel`] for [`simd::run`].
+struct EvalBlock<'a, C> {
+    curve: &'a C,
+    runs: &'a mut [Run],
+    u: &'a [f64],
+    rid: &'a [u16],
+    out: &'a mut [f64],
+    tab: &'a mut RunTab,
+}
+
+impl<C: Backbone> Kernel for EvalBlock<'_, C> {
+    type Output = bool;
+    #[inline(always)]
+    fn run_at(self) -> bool {
+        eval_block_body(self.curve, self.runs, self.u, self.rid, self.out, self.tab)
+    }
+}
+
+/// Curve pass of one block (see [`eval_block_body`]) compiled for SIMD level `level`: every
+/// level runs the same IEEE operations in the same order, so the forces are the same bit for
+/// bit (the curve's evaluation is the part that vectorises; no fused multiply-add is formed).
+/// Returns whether every force of the block is finite.
+#[inline(never)]
+pub(super) fn eval_block<C: Backbone>(
+    level: Level,
+    curve: &C,
+    runs: &mut [Run],
+    u: &[f64],
+    rid: &[u16],
+    out: &mut [f64],
+    tab: &mut RunTab,
+) -> bool {
+    simd::run(
+        level,
+        EvalBlock {
+            curve,
+            runs,
+            u,
+            rid,
+            out,
+            tab,
+        },
+    )
+}
+
+/// [`eval_dense_body`] as a [`Kernel`] for [`simd::run`].
+struct EvalDense<'a, C> {
+    curve: &'a C,
+    d: &'a mut Dense,
+    start: u64,
+    out: &'a mut [f64],
+}
+
+impl<C: Backbone> Kernel for EvalDense<'_, C> {
+    type Output = bool;
+    #[inline(always)]
+    fn run_at(self) -> bool {
+        eval_dense_body(self.curve, self.d, self.start, self.out)
+    }
+}
+
+/// Curve pass of a dense block (see [`eval_dense_body`]) compiled for SIMD level `level`
+/// (bit for bit the same at every level). Returns whether every force is finite.
+#[inline(never)]
+fn eval_dense<C: Backbone>(
+    level: Level,
+    curve: &C,
+    d: &mut Dense,
+    start: u64,
+    out: &mut [f64],
+) -> bool {
+    simd::run(
+        level,
+        EvalDense {
+            curve,
+            d,
+            start,
+            out,
+        },
+    )
+}
+
+/// Continuation bits of a block of input.
+type Cont = [u64; BLOCK / 64];
+
+/// Bit `p` (word `p / 64`) set when step `p` of `x` moves strictly in the direction of step
+/// `p - 1`: `x[p] - x[p-1]` and `x[p-1] - x[p-2]` both positive or both negative. Bits 0 and
+/// 1 (no earlier step in the block) and bits past `x.len()` are clear.
+#[inline(always)]
+fn continuation_bits(x: &[f64]) -> Cont {
+    let mut flags = [0_u8; BLOCK];
+    let m = x.len().min(BLOCK);
+    if m >= 3 {
+        let (a, b, c) = (&x[..m.wrapping_sub(2)], &x[1..m.wrapping_sub(1)], &x[2..m]);
+        for (((f, &x0), &x1), &x2) in flags[2..m].iter_mut().zip(a).zip(b).zip(c) {
+            let (d0, d1) = (x1 - x0, x2 - x1);
+            *f = u8::from((d0 > 0.0 && d1 > 0.0) || (d0 < 0.0 && d1 < 0.0));
+        }
+    }
+    let mut bits = [0_u64; BLOCK / 64];
+    for (w, fl) in bits.iter_mut().zip(flags.chunks_exact(64)) {
+        *w = fl
+            .iter()
+            .enumerate()
+            .fold(0_u64, |acc, (j, &f)| acc | (u64::from(f) << j));
+    }
+    bits
+}
+
+/// The first position `>= p` whose bit in `bits` is clear (`BLOCK` if none).
+#[inline(always)]
+fn next_clear(bits: &Cont, p: usize) -> usize {
+    let mut w = p / 64;
+    if w >= bits.len() {
+        return BLOCK;
+    }
+    let mut v = !bits[w] >> (p % 64);
+    if v != 0 {
+        return p.wrapping_add(v.trailing_zeros() as usize);
+    }
+    loop {
+        w = w.wrapping_add(1);
+        if w >= bits.len() {
+            return BLOCK;
+        }
+        v = !bits[w];
+        if v != 0 {
+            return (w << 6).wrapping_add(v.trailing_zeros() as usize);
+        }
+    }
+}
+
+/// First pass over one block ([`Pass::block_body`]) compiled for SIMD level `level`.
+#[inline(never)]
+fn block_pass(
+    level: Level,
+    pass: &mut Pass,
+    stk: &mut [Reversal],
+    xc: &[f64],
+    u: &mut [f64],
+    rid: &mut [u16],
+    runs: &mut [Run; BLOCK + 2],
+    cont: &Cont,
+) -> usize {
+    simd::run(
+        level,
+        BlockPass {
+            pass,
+            stk,
+            xc,
+            u,
+            rid,
+            runs,
+            cont,
+        },
+    )
+}
+
+/// [`Pass::block_body`] as a [`Kernel`] for [`simd::run`].
+struct BlockPass<'a> {
+    pass: &'a mut Pass,
+    stk: &'a mut [Reversal],
+    xc: &'a [f64],
+    u: &'a mut [f64],
+    rid: &'a mut [u16],
+    runs: &'a mut [Run; BLOCK + 2],
+    cont: &'a Cont,
+}
+
+impl Kernel for BlockPass<'_> {
+    type Output = usize;
+    #[inline(always)]
+    fn run_at(self) -> usize {
+        self.pass
+            .block_body(self.stk, self.xc, self.u, self.rid, self.runs, self.cont)
+    }
+}
+
+/// The input scan of a block, as a [`Kernel`]: whether every value is finite and, when so,
+/// the continuation bits (the first pass's turning points).
+struct Scan<'a>(&'a [f64]);
+
+impl Kernel for Scan<'_> {
+    type Output = Option<Cont>;
+    #[inline(always)]
+    fn run_at(self) -> Option<Cont> {
+        all_finite(self.0).then(|| continuation_bits(self.0))
     }
 }
 
@@ -146,8 +375,8 @@ impl Dense {
 /// order `out[p] = base + mm[p] · out[p]` with `base` the output of the in-block anchor
 /// sample (`idx[p] - start < BLOCK`) or the known `kh[p]`, picked by an index into one
 /// buffer (no data-dependent branch).
-#[inline(never)]
-pub(super) fn eval_dense<C: Backbone>(curve: &C, d: &mut Dense, start: u64, out: &mut [f64]) {
+#[inline(always)]
+fn eval_dense_body<C: Backbone>(curve: &C, d: &mut Dense, start: u64, out: &mut [f64]) -> bool {
     let m = out.len().min(BLOCK);
     let out = &mut out[..m];
     for (o, &v) in out.iter_mut().zip(&d.u[..m]) {
@@ -165,6 +394,7 @@ pub(super) fn eval_dense<C: Backbone>(curve: &C, d: &mut Dense, start: u64, out:
         d.kh[BLOCK.wrapping_add(p) & (2 * BLOCK - 1)] = v;
         *o = v;
     }
+    out.iter().fold(true, |ok, o| ok & o.is_finite())
 }
 
 /// Written above the stack top (never read as a reversal).
@@ -325,22 +555,39 @@ impl Pass {
 
     /// First pass over one block (`xc`, global start `self.start`): curve arguments into `u`,
     /// the runs into `runs` and each sample's run into `rid`. Returns the number of runs.
-    #[inline(never)]
-    fn block(
+    ///
+    /// The input's turning points are found first, for the whole block in one vectorised
+    /// loop: bit `p` of `cont` says that step `p` moves strictly in the direction of step
+    /// `p - 1` (`x[p] - x[p-1]` and `x[p-1] - x[p-2]` both positive or both negative). The
+    /// memory rules then run once per sample where the bit is clear (a reversal, a
+    /// zero-length step, the block's first sample) and the samples of the monotone stretch
+    /// that follows are filled in bulk — `u = (x - x_a) · inv` on the current branch — when
+    /// the stretch's last sample does not reach the branch's closure point (being monotone,
+    /// none of it does; `(x - target) · dir` is monotone in `x` after rounding too). A
+    /// stretch that does reach it goes sample by sample through the rules, as every sample
+    /// did before; the arguments and runs are the same bit for bit.
+    #[inline(always)]
+    fn block_body(
         &mut self,
         stk: &mut [Reversal],
         xc: &[f64],
         u: &mut [f64],
         rid: &mut [u16],
         runs: &mut [Run; BLOCK + 2],
+        cont: &Cont,
     ) -> usize {
+        const W: usize = 8;
         // Work on a copy in registers (the struct behind `self` would live in memory).
         let mut st = *self;
         st.load_branch(stk); // the top's force may have been resolved since
         runs[0] = st.record();
         let mut nr = 1_usize;
-        let samples = xc.iter().zip(u.iter_mut()).zip(rid.iter_mut());
-        for (p, ((&xi, ui), ri)) in samples.enumerate() {
+        let m = xc.len().min(BLOCK).min(u.len()).min(rid.len());
+        let (xc, u, rid) = (&xc[..m], &mut u[..m], &mut rid[..m]);
+        let mut p = 0_usize;
+        while p < m {
+            // One sample through the rules (or the fast path).
+            let xi = xc[p];
             let dx = xi - st.xp;
             // Moving on along the branch without reaching its closure point.
             if dx * st.dir > 0.0 && (xi - st.target) * st.dir < 0.0 {
@@ -349,8 +596,47 @@ impl Pass {
                 runs[nr] = st.record();
                 nr = nr.wrapping_add(1); // <= BLOCK + 1
             }
-            *ui = (st.xp - st.xa) * st.inv;
-            *ri = nr.wrapping_sub(1) as u16; // nr in 1..=BLOCK + 1
+            u[p] = (st.xp - st.xa) * st.inv;
+            let r = nr.wrapping_sub(1) as u16; // nr in 1..=BLOCK + 1
+            rid[p] = r;
+            p = p.wrapping_add(1);
+            // The monotone stretch p..q that continues the direction of the last step.
+            let q = next_clear(cont, p).min(m);
+            if q > p {
+                // The samples of p..q short of the closure point: a prefix p..c, the stretch
+                // being monotone (`(x - target) · dir` is non-decreasing along it after
+                // rounding too); sample c, if any, closes a loop through the rules.
+                let (t, d) = (st.target, st.dir);
+                let c = if (xc[q.wrapping_sub(1)] - t) * d < 0.0 {
+                    q
+                } else {
+                    let short = xc[p..q].iter().map(|&x| usize::from((x - t) * d < 0.0));
+                    p.wrapping_add(short.sum::<usize>())
+                };
+                if c > p {
+                    // All on the branch. Whole groups of W (the lanes past c are rewritten
+                    // by the samples after).
+                    let (xa, inv) = (st.xa, st.inv);
+                    let mut i = p;
+                    while i < c {
+                        let e = i.wrapping_add(W);
+                        if e <= m {
+                            for j in i..e {
+                                u[j] = (xc[j] - xa) * inv;
+                                rid[j] = r;
+                            }
+                        } else {
+                            for j in i..m {
+                                u[j] = (xc[j] - xa) * inv;
+                                rid[j] = r;
+                            }
+                        }
+                        i = i.wrapping_add(W);
+                    }
+                    st.xp = xc[c.wrapping_sub(1)];
+                    p = c;
+                }
+            }
         }
         *self = st;
         nr
@@ -370,7 +656,7 @@ impl Pass {
     }
 
     /// First pass for a block where the input reverses often (a random walk reverses every
-    /// ~2 samples; there the predicted test of [`Pass::block`] is a coin toss). It writes, per
+    /// ~2 samples; there the predicted test of [`Pass::block_body`] is a coin toss). It writes, per
     /// sample, the curve argument `u`, the anchor's sample index `idx`, its force `kh` where
     /// known (before the block) and the branch multiplier `mm`; [`eval_dense`] resolves the
     /// rest. No run table: a branch change costs nothing more than a step on. Returns the
@@ -386,7 +672,7 @@ impl Pass {
     /// virgin curve, or the first reversal's branch whose target is a mirror point) and a
     /// closure down to it, both through [`Pass::rules`]; a step that closes two or more
     /// loops at once; a zero-length step. Needs `dir != 0` (the first move goes through
-    /// [`Pass::block`]).
+    /// [`Pass::block_body`]).
     #[inline(never)]
     // `&` on booleans on purpose: no branch per condition.
     #[allow(clippy::needless_bitwise_bool)]
@@ -522,6 +808,7 @@ impl Pass {
 /// Whether every value is finite: one vectorised pass without an early exit (the
 /// `position`-based checks of `crate::error` run a compare and branch per value; they are
 /// called only to name the first bad value once this says there is one).
+#[inline(always)]
 pub(super) fn all_finite(v: &[f64]) -> bool {
     v.chunks(256)
         .all(|c| c.iter().fold(true, |ok, a| ok & a.is_finite()))
@@ -534,17 +821,32 @@ pub(super) fn takes(state: &MasingState) -> bool {
     (state.count > 0 || state.dir == 0) && state.stack.iter().all(|r| r.index < state.count)
 }
 
+/// What [`scaled_force`] found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Forces {
+    /// Every input and every force is finite.
+    Finite,
+    /// Every input is finite, some force is not.
+    NotFinite,
+    /// Some input is not finite: the run stopped at its block (`state` and `out` are then
+    /// partly advanced; the caller restores or discards them).
+    BadInput,
+}
+
 /// Masing forces of `x` under the scaled branch rule `h = h_r + lam f((x - x_r) / lam)` into
-/// `out` (same length), continuing from `state` and updating it. The caller has validated the
-/// input, checked that `state.count + x.len()` fits in 63 bits, and that [`takes`] `state`.
-/// Returns whether every force is finite (checked block by block while it is in cache).
+/// `out` (same length), continuing from `state` and updating it, with the vectorised parts
+/// compiled for SIMD level `level` (every level gives the same forces bit for bit). The caller
+/// has checked that `state.count + x.len()` fits in 63 bits and that [`takes`] `state`. The
+/// input's and the forces' finiteness are checked block by block while the block is in cache
+/// (the input before its block is run: no separate pass over `x`).
 pub(super) fn scaled_force<C: Backbone>(
+    level: Level,
     curve: &C,
     lam: f64,
     x: &[f64],
     out: &mut [f64],
     state: &mut MasingState,
-) -> bool {
+) -> Forces {
     let stack = &mut state.stack;
     let mut pass = Pass {
         n: stack.len(),
@@ -571,8 +873,13 @@ pub(super) fn scaled_force<C: Backbone>(
     // The dense path's records, allocated at its first block.
     let mut dense_rec: Option<Box<Dense>> = None;
     let mut dense = false;
+    let mut tab = RunTab::new();
     let mut finite = true;
     for (xc, oc) in x.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
+        // The input's check while the block is read for its turning points.
+        let Some(cont) = simd::run(level, Scan(xc)) else {
+            return Forces::BadInput;
+        };
         let m = xc.len();
         // Room for one candidate above the top per sample.
         let need = pass.n.saturating_add(m).saturating_add(1);
@@ -584,15 +891,14 @@ pub(super) fn scaled_force<C: Backbone>(
         let changes = if dense && pass.dir != 0.0 {
             let d = dense_rec.get_or_insert_with(Dense::new);
             let c = pass.dense_block(stk, xc, d);
-            eval_dense(curve, d, pass.start, oc);
+            finite &= eval_dense(level, curve, d, pass.start, oc);
             c
         } else {
             let (u, r) = (&mut ub[..m], &mut rid[..m]);
-            let nr = pass.block(stk, xc, u, r, &mut runs);
-            eval_block(curve, &mut runs[..nr], u, r, oc);
+            let nr = block_pass(level, &mut pass, stk, xc, u, r, &mut runs, &cont);
+            finite &= eval_block(level, curve, &mut runs[..nr], u, r, oc, &mut tab);
             nr.saturating_sub(1)
         };
-        finite &= all_finite(oc);
         pass.end_block(stk, oc);
         dense = changes.saturating_mul(DENSE) > m;
         pass.start = pass.start.saturating_add(m as u64);
@@ -603,5 +909,9 @@ pub(super) fn scaled_force<C: Backbone>(
     state.h = h;
     state.dir = dir as i8;
     state.count = end;
-    finite
+    if finite {
+        Forces::Finite
+    } else {
+        Forces::NotFinite
+    }
 }
