@@ -18,6 +18,17 @@
 //! written above the stack top, the top raised by 0 or 1, the branch registers selected by
 //! integer selects); only a closure takes a branch and reloads the branch from the stack.
 //!
+//! The first pass does not visit every sample: one vectorised scan of the block's input
+//! ([`continuation_bits`], with the finiteness check folded in) marks the turning points, and
+//! the monotone stretches between them are filled in bulk up to where they reach the
+//! branch's closure point ([`Pass::block_body`]).
+//!
+//! Every vectorised part (the input scan, the first pass, both curve passes with the
+//! output's finiteness check) is compiled for the baseline, AVX2 and AVX-512 and chosen at
+//! run time ([`simd::run`]); the same IEEE operations in the same order at every level, so
+//! the forces are the same bit for bit (tests: `level_tests` below, `simd` tests for the
+//! exponential against libm).
+//!
 //! A block after one that changed branch more than once every [`DENSE`] samples (a random
 //! walk) takes the dense path instead: [`Pass::dense_block`] applies the rules with no
 //! data-dependent branch and writes per sample only the curve argument, the anchor's sample
@@ -553,6 +564,47 @@ impl Pass {
         rev | closes | first
     }
 
+    /// [`Pass::rules`] with the common cases free of data-dependent branches: a step that
+    /// moves, off the first reversal's branch (a stack of two or more), with a reversal or
+    /// not, closing one loop or none, raises the top by 0 or 1 and lowers it by 0 or 2 by
+    /// arithmetic on the comparisons and reloads the branch from the stack (the same values
+    /// [`Pass::rules`] selects); a closure that leaves fewer than two reversals, a zero-length
+    /// step and the first move go through [`Pass::rules`], further closures in one step
+    /// through [`Pass::more_closures`]. Returns whether the branch changed.
+    #[inline(always)]
+    // `&` on booleans on purpose: no branch per condition.
+    #[allow(clippy::needless_bitwise_bool)]
+    fn step_rules(&mut self, stk: &mut [Reversal], xi: f64, p: usize) -> bool {
+        let dx = xi - self.xp;
+        if (dx == 0.0) | (self.dir == 0.0) | (self.n < 2) {
+            return self.rules(stk, xi, p);
+        }
+        let s = 1.0_f64.copysign(dx);
+        let rev = s != self.dir;
+        // Candidate reversal: the previous sample (see `rules`).
+        stk[self.n] = Reversal {
+            x: self.xp,
+            h: self.h_before,
+            index: self.start.wrapping_add(p as u64).wrapping_sub(1),
+        };
+        let n1 = self.n.wrapping_add(usize::from(rev)); // in 2..stk.len()
+                                                        // The branch from the top of n1 reversals heads for the one below it.
+        let closes = (xi - stk[n1.wrapping_sub(2)].x) * s >= 0.0;
+        if closes & (n1 < 4) {
+            // Down to the first reversal's branch or the virgin curve.
+            return self.rules(stk, xi, p);
+        }
+        self.n = n1.wrapping_sub(usize::from(closes) << 1); // >= 2
+        self.dir = s;
+        self.xp = xi;
+        if closes & ((xi - stk[self.n.wrapping_sub(2)].x) * s >= 0.0) {
+            self.more_closures(stk, xi, s); // reloads the branch
+        } else {
+            self.load_branch(stk);
+        }
+        rev | closes
+    }
+
     /// First pass over one block (`xc`, global start `self.start`): curve arguments into `u`,
     /// the runs into `runs` and each sample's run into `rid`. Returns the number of runs.
     ///
@@ -562,11 +614,14 @@ impl Pass {
     /// memory rules then run once per sample where the bit is clear (a reversal, a
     /// zero-length step, the block's first sample) and the samples of the monotone stretch
     /// that follows are filled in bulk — `u = (x - x_a) · inv` on the current branch — when
-    /// the stretch's last sample does not reach the branch's closure point (being monotone,
-    /// none of it does; `(x - target) · dir` is monotone in `x` after rounding too). A
-    /// stretch that does reach it goes sample by sample through the rules, as every sample
-    /// did before; the arguments and runs are the same bit for bit.
+    /// up to the first sample that reaches the branch's closure point (the stretch being
+    /// monotone, the samples short of it are a prefix, counted without a branch for a short
+    /// stretch; `(x - target) · dir` is monotone in `x` after rounding too); that sample goes
+    /// through the rules ([`Pass::step_rules`]). The arguments and runs are the same bit for
+    /// bit as the sample-by-sample pass's.
     #[inline(always)]
+    // `&` on booleans on purpose: no branch per condition.
+    #[allow(clippy::needless_bitwise_bool)]
     fn block_body(
         &mut self,
         stk: &mut [Reversal],
@@ -592,7 +647,7 @@ impl Pass {
             // Moving on along the branch without reaching its closure point.
             if dx * st.dir > 0.0 && (xi - st.target) * st.dir < 0.0 {
                 st.xp = xi;
-            } else if st.rules(stk, xi, p) {
+            } else if st.step_rules(stk, xi, p) {
                 runs[nr] = st.record();
                 nr = nr.wrapping_add(1); // <= BLOCK + 1
             }
@@ -602,11 +657,28 @@ impl Pass {
             p = p.wrapping_add(1);
             // The monotone stretch p..q that continues the direction of the last step.
             let q = next_clear(cont, p).min(m);
-            if q > p {
-                // The samples of p..q short of the closure point: a prefix p..c, the stretch
-                // being monotone (`(x - target) · dir` is non-decreasing along it after
-                // rounding too); sample c, if any, closes a loop through the rules.
-                let (t, d) = (st.target, st.dir);
+            let (t, d) = (st.target, st.dir);
+            let (xa, inv) = (st.xa, st.inv);
+            let len = q.wrapping_sub(p); // q >= p
+            let e = p.wrapping_add(W);
+            if (len <= W) & (e <= m) {
+                // A short stretch, without a data-dependent branch: the samples short of the
+                // closure point are a prefix p..c of it (the stretch being monotone, and
+                // `(x - target) · dir` non-decreasing along it after rounding too); W lanes
+                // are written from p, those from c on are rewritten by the samples after.
+                let mut k = 0_usize;
+                for j in 0..W {
+                    let x = xc[p.wrapping_add(j)];
+                    k = k.wrapping_add(usize::from(((x - t) * d < 0.0) & (j < len)));
+                }
+                for j in p..e {
+                    u[j] = (xc[j] - xa) * inv;
+                    rid[j] = r;
+                }
+                p = p.wrapping_add(k);
+                st.xp = xc[p.wrapping_sub(1)]; // the last input so far (p >= 1)
+            } else if q > p {
+                // The same for a long stretch (or one at the block's end).
                 let c = if (xc[q.wrapping_sub(1)] - t) * d < 0.0 {
                     q
                 } else {
@@ -614,9 +686,6 @@ impl Pass {
                     p.wrapping_add(short.sum::<usize>())
                 };
                 if c > p {
-                    // All on the branch. Whole groups of W (the lanes past c are rewritten
-                    // by the samples after).
-                    let (xa, inv) = (st.xa, st.inv);
                     let mut i = p;
                     while i < c {
                         let e = i.wrapping_add(W);
@@ -913,5 +982,146 @@ pub(super) fn scaled_force<C: Backbone>(
         Forces::Finite
     } else {
         Forces::NotFinite
+    }
+}
+
+#[cfg(test)]
+mod level_tests {
+    //! Every SIMD level the CPU has gives the generic path's forces bit for bit, and all of
+    //! them the plain loop's (the anchor's rules with libm `exp`) to 1e-12 of h0.
+    use super::*;
+    use crate::curve::Exponential;
+
+    fn uniform(seed: u64, n: usize) -> Vec<f64> {
+        let mut s = seed;
+        (0..n)
+            .map(|_| {
+                s = s
+                    .wrapping_mul(6_364_136_223_846_793_005)
+                    .wrapping_add(1_442_695_040_888_963_407);
+                2.0 * ((s >> 11) as f64 / 9_007_199_254_740_992.0) - 1.0
+            })
+            .collect()
+    }
+
+    /// Sine (long runs), band-limited noise (runs of ~6), random walk (runs of ~2), and a
+    /// mix with zero-length steps, held values, jumps that close several loops, and a drift.
+    fn signals(n: usize) -> Vec<Vec<f64>> {
+        let sine: Vec<f64> = (0..n)
+            .map(|i| 0.8 * (std::f64::consts::TAU * (i % 700) as f64 / 700.0).sin())
+            .collect();
+        let e = uniform(1, n);
+        let mut band = vec![0.0; n];
+        let a1 = 2.0 * 0.95 * (std::f64::consts::TAU / 40.0).cos();
+        for i in 2..n {
+            band[i] = a1 * band[i - 1] - 0.9025 * band[i - 2] + 0.06 * e[i];
+        }
+        let e = uniform(2, n);
+        let mut walk = vec![0.0; n];
+        for i in 1..n {
+            walk[i] = 0.999 * walk[i - 1] + 0.05 * e[i];
+        }
+        let e = uniform(3, n);
+        let mixed: Vec<f64> = (0..n)
+            .map(|i| {
+                let held = (i / 3) as f64; // every value thrice: zero-length steps
+                let jump = if i % 997 == 0 { 3.0 * e[i] } else { 0.0 };
+                0.4 * (held * 0.05).sin() + 0.1 * e[i].round() + jump + 1e-5 * i as f64
+            })
+            .collect();
+        vec![sine, band, walk, mixed]
+    }
+
+    /// The anchor's scalar loop (`masing_anchor.rs`, `masing`) for branch scale `lam`.
+    fn plain(h0: f64, ac: f64, lam: f64, x: &[f64]) -> Vec<f64> {
+        let (mut xr, mut hr): (Vec<f64>, Vec<f64>) = (Vec::new(), Vec::new());
+        let (mut xp, mut hp, mut d) = (0.0_f64, 0.0_f64, 0.0_f64);
+        let f = |u: f64| (h0 * -(-ac * u.abs()).exp_m1()).copysign(u);
+        x.iter()
+            .map(|&xi| {
+                if xi != xp {
+                    let s = if xi > xp { 1.0 } else { -1.0 };
+                    if s != d {
+                        if d != 0.0 {
+                            xr.push(xp);
+                            hr.push(hp);
+                        }
+                        d = s;
+                    }
+                    while let Some(&top) = xr.last() {
+                        let k = xr.len();
+                        let t = if k >= 2 { xr[k - 2] } else { -top };
+                        if s * (xi - t) < 0.0 {
+                            break;
+                        }
+                        let nk = k.saturating_sub(2);
+                        xr.truncate(nk);
+                        hr.truncate(nk);
+                    }
+                    hp = match (xr.last(), hr.last()) {
+                        (Some(&a), Some(&b)) => b + lam * f((xi - a) / lam),
+                        _ => f(xi),
+                    };
+                    xp = xi;
+                }
+                hp
+            })
+            .collect()
+    }
+
+    #[test]
+    fn every_level_gives_the_generic_forces_bit_for_bit() {
+        let (h0, ac) = (1.0, 3.0);
+        let c = Exponential::new(h0, ac).unwrap_or_else(|_| unreachable!());
+        for (k, x) in signals(20_000).iter().enumerate() {
+            for lam in [2.0, 1.7] {
+                let run_at = |level: Level, cut: usize| {
+                    let mut out = vec![0.0; x.len()];
+                    let mut st = MasingState::default();
+                    let (a, b) = x.split_at(cut);
+                    let (oa, ob) = out.split_at_mut(cut);
+                    assert_eq!(scaled_force(level, &c, lam, a, oa, &mut st), Forces::Finite);
+                    assert_eq!(scaled_force(level, &c, lam, b, ob, &mut st), Forces::Finite);
+                    (out, st)
+                };
+                let (want, want_st) = run_at(Level::Generic, x.len());
+                let reference = plain(h0, ac, lam, x);
+                let worst = want
+                    .iter()
+                    .zip(&reference)
+                    .map(|(a, b)| (a - b).abs())
+                    .fold(0.0, f64::max);
+                assert!(
+                    worst <= 1e-12 * h0,
+                    "signal {k}, lam {lam}: {worst:e} from the loop"
+                );
+                for level in Level::ALL.into_iter().filter(|l| l.supported()) {
+                    for cut in [x.len(), 777, 5_000] {
+                        let (got, st) = run_at(level, cut);
+                        let same = got
+                            .iter()
+                            .zip(&want)
+                            .all(|(a, b)| a.to_bits() == b.to_bits());
+                        assert!(same, "signal {k}, level {}, cut {cut}", level.name());
+                        assert_eq!(st, want_st);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_non_finite_input_stops_the_kernel_at_every_level() {
+        let c = Exponential::new(1.0, 3.0).unwrap_or_else(|_| unreachable!());
+        for level in Level::ALL.into_iter().filter(|l| l.supported()) {
+            for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                let mut x: Vec<f64> = (0..3000).map(|i| (i as f64 * 0.01).sin()).collect();
+                x[2100] = bad;
+                let mut out = vec![0.0; x.len()];
+                let mut st = MasingState::default();
+                let r = scaled_force(level, &c, 2.0, &x, &mut out, &mut st);
+                assert_eq!(r, Forces::BadInput, "level {}", level.name());
+            }
+        }
     }
 }
