@@ -13,7 +13,9 @@ noise and the ratio of medians is the figure. Rows:
   random walk) against ``../shared/bench/masing_anchor.rs`` (its ``masing_idx`` row), built
   here for generic x86-64 (``rustc -O``) and run as a subprocess between our rounds.
 - ``Masing.force(threads=2)`` with a competing busy process against one thread.
-- ``contactlab --help`` and ``python -c 'import contactlab'`` wall time (a new process each).
+- ``contactlab --help``, ``python -c 'import contactlab'`` and ``contactlab analyze`` to its
+  first sample read and to its end, against ``python -c pass`` (wall and CPU time, a new
+  process each: ``benches/bench_startup.py``).
 - the normal-contact ODE against scipy ``odeint`` (LSODA) on the problem of
   ``benches/bench_normal.py`` when ``--ode`` is given (slow).
 
@@ -237,25 +239,13 @@ def threads_row(rounds: int, n: int) -> None:
 
 
 def startup_rows(rounds: int) -> None:
-    exe = Path(sys.executable).with_name("contactlab")
-    env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
-    cmds = {
-        "help": [str(exe), "--help"],
-        "import": [sys.executable, "-c", "import contactlab"],
-        "python": [sys.executable, "-c", "pass"],
-    }
-    r = interleave(
-        {k: (lambda c=c: subprocess.run(c, capture_output=True, env=env)) for k, c in cmds.items()},
-        rounds,
-    )
-    row(
-        "`contactlab --help` (new process)",
-        f"{r['help'] * 1e3:.0f} ms",
-        f"bar 150 ms; bare `python -c pass` {r['python'] * 1e3:.0f} ms; "
-        f"`import contactlab` {r['import'] * 1e3:.0f} ms",
-        0.150 / r["help"],
-        "of the bar ",
-    )
+    """``contactlab --help``, ``import contactlab`` and ``analyze`` up to its first sample
+    read and to its end, each a new process, against ``python -c pass`` (bench_startup.py)."""
+    sys.path.insert(0, str(ROOT / "benches"))
+    import bench_startup
+
+    for task, ours, other, ratio, note in bench_startup.table(max(rounds, 5)):
+        row(f"{task} (new process)", ours, other, ratio, note + " ")
 
 
 def ode_row(rounds: int) -> None:

@@ -189,8 +189,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--out", default="demo-output", help="output folder (default: demo-output)")
     p.add_argument("--quick", action="store_true", help="a reduced set (one file per material)")
-    p.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="analyse the recordings and draw the figures in N processes (default: "
-                   "one per core, at most 8; 0: serially in this process)")  # fmt: skip
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        metavar="N",
+        help="analyse the recordings and draw the figures in N processes (default: "
+        "one per core, at most 8; 0: serially in this process)",
+    )
     add_progress_flags(p)
     p.set_defaults(handler=_handler)

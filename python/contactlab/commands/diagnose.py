@@ -56,10 +56,12 @@ def add_parser(subparsers: Any) -> None:
         help="diagnose a structure: this identified model (contactlab identify --json) is "
         "the base; FILE is a CSV with the input and response columns",
     )
-    p.add_argument("--u", metavar="COLUMN",
-                   help="with --structure: input column (force, or base displacement)")  # fmt: skip
-    p.add_argument("--y", metavar="COLUMN",
-                   help="with --structure: response column (displacement of the mass)")  # fmt: skip
+    p.add_argument(
+        "--u", metavar="COLUMN", help="with --structure: input column (force, or base displacement)"
+    )
+    p.add_argument(
+        "--y", metavar="COLUMN", help="with --structure: response column (displacement of the mass)"
+    )
     from ..commands._common import quantity
 
     p.add_argument(

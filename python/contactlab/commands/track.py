@@ -182,8 +182,9 @@ def _options(args: argparse.Namespace) -> dict | None:
         if args.p0 is not None or args.pa is not None:
             raise InputError(f"{args.file}: --p0/--pa are for normal-contact recordings")
         return None
-    kind = args.model or read_chunks(args.file, columns=parse_columns(args.columns),
-                                     fs=args.fs).kind  # fmt: skip
+    kind = (
+        args.model or read_chunks(args.file, columns=parse_columns(args.columns), fs=args.fs).kind
+    )
     if kind != "normal":
         if args.p0 is not None or args.pa is not None:
             raise InputError(f"{args.file}: --p0/--pa are for normal-contact recordings")

@@ -312,6 +312,60 @@ def unexplained_structure(
     e = np.asarray(residual, float)
     w = d.extra.get("weight")
     w = np.ones(e.size) if w is None else np.asarray(w, float)
+    cb = _cycle_bins(d, e, w, bins)
+    if cb is None:
+        return None
+    full, mean_b, t_b, m_null = _bin_t(cb, bins, min_weight, tolerance)
+    nb = int(np.sum(full))
+    if nb == 0:
+        return None
+    T = float(np.sum(t_b * t_b))
+    factor = POOLED_CALIBRATION if m_null != cb.m else CALIBRATION
+    thr = factor * null_quantile(m_null, nb, alpha)
+    sums = _null_sums(m_null, nb)
+    p_val = float(1.0 - np.searchsorted(sums, T, side="left") / sums.size)
+    flagged = T > thr
+    full_idx = np.flatnonzero(full)
+    prof_mean = np.full(2 * bins, np.nan)
+    prof_t = np.full(2 * bins, np.nan)
+    prof_mean[full_idx] = mean_b
+    prof_t[full_idx] = t_b
+    # where: bins beyond a Bonferroni level of the two-sided t over the bins
+    t_crit = t_quantile(1.0 - 0.5 * alpha / nb, cb.m - 1)
+    where = _runs(prof_t, prof_mean, T, t_crit, bins) if flagged else []
+    rng_y = float(np.ptp(d.y[np.isfinite(d.y)])) or 1.0
+    rms = float(np.sqrt(np.mean(mean_b * mean_b)))
+    peak = float(np.max(np.abs(mean_b)))
+    return Unexplained(
+        flagged=bool(flagged), statistic=T, threshold=thr, p_value=p_val, cycles=int(cb.m),
+        bins_tested=nb, where=where, rms=rms, peak=peak,
+        rms_percent_of_range=100.0 * rms / rng_y, peak_percent_of_range=100.0 * peak / rng_y,
+        rms_over_noise=rms / sigma if sigma > 0 else float("inf"), unit=unit,
+        profile={
+            "bins": bins,
+            "rising_mean": [_f(v) for v in prof_mean[:bins]],
+            "falling_mean": [_f(v) for v in prof_mean[bins:]],
+            "rising_t": [_f(v) for v in prof_t[:bins]],
+            "falling_t": [_f(v) for v in prof_t[bins:]],
+        },
+    )  # fmt: skip
+
+
+@dataclass
+class _CycleBins:
+    """Per cycle and phase bin: the weighted mean residual and its white-noise variance."""
+
+    ok: np.ndarray  # the samples used
+    b: np.ndarray  # bin of each sample (branch * bins + phase bin)
+    w: np.ndarray
+    m: int  # complete cycles
+    means: np.ndarray  # (m, 2 bins), NaN where a cycle leaves a bin empty
+    white: np.ndarray  # (m, 2 bins): each mean's variance as white noise would give it
+    have: np.ndarray  # (m, 2 bins): bins with samples
+
+
+def _cycle_bins(d: Prepared, e: np.ndarray, w: np.ndarray, bins: int) -> _CycleBins | None:
+    """The residual's weighted means per cycle and bin (None: fewer than MIN_CYCLES)."""
     cyc = d.cycles.cycle
     br = _branch_of(d)
     ok = (cyc >= 0) & (br >= 0) & (w > 0) & np.isfinite(e)
@@ -321,27 +375,39 @@ def unexplained_structure(
         return None
     ph = np.clip(d.cycles.phase_in_branch, 0.0, 1.0 - 1e-12)
     b = br * bins + np.minimum((ph * bins).astype(int), bins - 1)
-    ci = np.searchsorted(ids, cyc[ok])
-    key = ci * (2 * bins) + b[ok]
-    sw = np.bincount(key, w[ok], m * 2 * bins).reshape(m, 2 * bins)
-    se = np.bincount(key, (w * e)[ok], m * 2 * bins).reshape(m, 2 * bins)
+    key = np.searchsorted(ids, cyc[ok]) * (2 * bins) + b[ok]
+    n = m * 2 * bins
+
+    def per_bin(v: np.ndarray) -> np.ndarray:
+        return np.bincount(key, v, n).reshape(m, 2 * bins)
+
+    sw = per_bin(w[ok])
     have = sw > 0
-    means = np.where(have, se / np.where(have, sw, 1.0), np.nan)
+    means = np.where(have, per_bin((w * e)[ok]) / np.where(have, sw, 1.0), np.nan)
     # each cycle-bin mean's variance as white noise would give it (its samples' scatter about
     # the mean over their effective count), for the pooled scale of few-cycle records
-    sw2 = np.bincount(key, (w * w)[ok], m * 2 * bins).reshape(m, 2 * bins)
     dev = e[ok] - means.reshape(-1)[key]
-    ss = np.bincount(key, w[ok] * dev * dev, m * 2 * bins).reshape(m, 2 * bins)
     with np.errstate(invalid="ignore", divide="ignore"):
-        white = np.where(have, ss / sw * sw2 / (sw * sw), np.nan)
+        white = np.where(
+            have, per_bin(w[ok] * dev * dev) / sw * per_bin((w * w)[ok]) / (sw * sw), np.nan
+        )
+    return _CycleBins(ok, b, w, m, means, white, have)
+
+
+def _bin_t(
+    cb: _CycleBins, bins: int, min_weight: float, tolerance: np.ndarray | None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """``(full, mean_b, t_b, m_null)``: the bins tested, their mean over the cycles, its t,
+    and the cycles of the null (pooled scatter: more degrees of freedom)."""
+    ok, b, w, m = cb.ok, cb.b, cb.w, cb.m
     # bins every cycle fills (a cycle with too few samples per bin leaves some empty)
-    full = np.sum(have, axis=0) >= max(MIN_CYCLES, m - 1)
+    full = np.sum(cb.have, axis=0) >= max(MIN_CYCLES, m - 1)
     # bins where the input's noise dominates the effective variance (steep branches right
     # after a reversal) are left out: the noise biases the model there (turning points
     # pushed outward), which is structure but no misfit
     wbar = np.bincount(b[ok], w[ok], 2 * bins) / np.maximum(np.bincount(b[ok], None, 2 * bins), 1)
     full &= wbar >= min_weight
-    mb = means[:, full]
+    mb = cb.means[:, full]
     n_b = np.sum(np.isfinite(mb), axis=0)
     with warnings.catch_warnings():  # a bin no cycle reached: NaN, left out below, no warning
         warnings.simplefilter("ignore", RuntimeWarning)
@@ -355,7 +421,7 @@ def unexplained_structure(
         # correlation), with (m - 1) per bin degrees of freedom
         with warnings.catch_warnings(), np.errstate(invalid="ignore", divide="ignore"):
             warnings.simplefilter("ignore", RuntimeWarning)
-            v_b = np.nanmean(white[:, full], axis=0)
+            v_b = np.nanmean(cb.white[:, full], axis=0)
             ratio = sd_b**2 / v_b
         ratio = ratio[np.isfinite(ratio)]
         kappa = float(np.median(ratio)) if ratio.size else math.nan
@@ -371,78 +437,41 @@ def unexplained_structure(
         excess = np.sign(mean_b) * np.maximum(np.abs(mean_b) - tb[full], 0.0)
     with np.errstate(divide="ignore", invalid="ignore"):
         t_b = np.where(sd_b > 0, excess / (sd_b / np.sqrt(n_b)), 0.0)
-    nb = int(np.sum(full))
-    if nb == 0:
-        return None
-    T = float(np.sum(t_b * t_b))
-    factor = POOLED_CALIBRATION if m_null != m else CALIBRATION
-    thr = factor * null_quantile(m_null, nb, alpha)
-    sums = _null_sums(m_null, nb)
-    p_val = float(1.0 - np.searchsorted(sums, T, side="left") / sums.size)
-    flagged = T > thr
-    # where: bins beyond a Bonferroni level of the two-sided t over the bins
-    t_crit = t_quantile(1.0 - 0.5 * alpha / nb, m - 1)
-    full_idx = np.flatnonzero(full)
-    prof_mean = np.full(2 * bins, np.nan)
-    prof_t = np.full(2 * bins, np.nan)
-    prof_mean[full_idx] = mean_b
-    prof_t[full_idx] = t_b
+    return full, mean_b, t_b, m_null
+
+
+def _runs(
+    prof_t: np.ndarray, prof_mean: np.ndarray, T: float, t_crit: float, bins: int
+) -> list[dict[str, Any]]:
+    """Runs of bins with ``|t| > t_crit`` per branch (none: the bins with the largest
+    ``|t|`` that make up half of ``T``), with the largest binned mean of each run."""
+    sig = np.abs(prof_t) > t_crit
+    if not sig.any():  # spread thinly: the bins with the largest |t| that make up half T
+        order = np.argsort(-np.nan_to_num(prof_t**2))
+        cum = np.cumsum(np.nan_to_num(prof_t[order] ** 2))
+        top = order[: int(np.searchsorted(cum, 0.5 * T)) + 1]
+        sig = np.zeros(2 * bins, bool)
+        sig[top] = True
     where: list[dict[str, Any]] = []
-    if flagged:
-        sig = np.abs(prof_t) > t_crit
-        if not sig.any():  # spread thinly: the bins with the largest |t| that make up half T
-            order = np.argsort(-np.nan_to_num(prof_t**2))
-            cum = np.cumsum(np.nan_to_num(prof_t[order] ** 2))
-            top = order[: int(np.searchsorted(cum, 0.5 * T)) + 1]
-            sig = np.zeros(2 * bins, bool)
-            sig[top] = True
-        for branch, name in ((0, "rising"), (1, "falling")):
-            s = sig[branch * bins : (branch + 1) * bins]
-            vals = prof_mean[branch * bins : (branch + 1) * bins]
-            k = 0
-            while k < bins:
-                if not s[k]:
-                    k += 1
-                    continue
-                j = k
-                while j + 1 < bins and s[j + 1]:
-                    j += 1
-                seg = vals[k : j + 1]
-                big = seg[int(np.nanargmax(np.abs(seg)))]
-                where.append(
-                    {
-                        "branch": name,
-                        "phase_from": k / bins,
-                        "phase_to": (j + 1) / bins,
-                        "mean": float(big),
-                    }
-                )
-                k = j + 1
-    rng_y = float(np.ptp(d.y[np.isfinite(d.y)])) or 1.0
-    rms = float(np.sqrt(np.mean(mean_b * mean_b)))
-    peak = float(np.max(np.abs(mean_b)))
-    return Unexplained(
-        flagged=bool(flagged),
-        statistic=T,
-        threshold=thr,
-        p_value=p_val,
-        cycles=int(m),
-        bins_tested=nb,
-        where=where,
-        rms=rms,
-        peak=peak,
-        rms_percent_of_range=100.0 * rms / rng_y,
-        peak_percent_of_range=100.0 * peak / rng_y,
-        rms_over_noise=rms / sigma if sigma > 0 else float("inf"),
-        unit=unit,
-        profile={
-            "bins": bins,
-            "rising_mean": [_f(v) for v in prof_mean[:bins]],
-            "falling_mean": [_f(v) for v in prof_mean[bins:]],
-            "rising_t": [_f(v) for v in prof_t[:bins]],
-            "falling_t": [_f(v) for v in prof_t[bins:]],
-        },
-    )
+    for branch, name in ((0, "rising"), (1, "falling")):
+        s = sig[branch * bins : (branch + 1) * bins]
+        vals = prof_mean[branch * bins : (branch + 1) * bins]
+        k = 0
+        while k < bins:
+            if not s[k]:
+                k += 1
+                continue
+            j = k
+            while j + 1 < bins and s[j + 1]:
+                j += 1
+            seg = vals[k : j + 1]
+            big = seg[int(np.nanargmax(np.abs(seg)))]
+            where.append(
+                {"branch": name, "phase_from": k / bins, "phase_to": (j + 1) / bins,
+                 "mean": float(big)}
+            )  # fmt: skip
+            k = j + 1
+    return where
 
 
 def _f(v: float) -> float | None:

@@ -290,8 +290,9 @@ def _normal(
         ("E_d", _pm(_num(d, "E_d", where), _se(d, "E_d"), "J/m^2")),
         ("cycle scatter", f"{100 * float(d.get('cycle_scatter_rel', math.nan)):.3g}% of Δδ"),
     ]
-    return JointCharacteristics("normal", str(d.get("file", where)), values, prov, table, lo,
-                                notes, ks)  # fmt: skip
+    return JointCharacteristics(
+        "normal", str(d.get("file", where)), values, prov, table, lo, notes, ks
+    )
 
 
 def _ks_table(d: dict[str, Any], where: str, dmin: float, dmax: float, n: int) -> np.ndarray:
@@ -483,8 +484,14 @@ def joint_characteristics(
             raise InputError("frequency must be > 0")
         return _normal(result, where, frequency=frequency, points=check_points(points))
     if kind == "tangential":
-        return _tangential(result, where, area=area, normal_load=normal_load,
-                           amplitude=amplitude, frequency=frequency)  # fmt: skip
+        return _tangential(
+            result,
+            where,
+            area=area,
+            normal_load=normal_load,
+            amplitude=amplitude,
+            frequency=frequency,
+        )
     if kind is None:
         raise InputError(
             f"{where}: no 'model' key: not one recording's result of `contactlab analyze "
@@ -493,5 +500,11 @@ def joint_characteristics(
     raise InputError(f"{where}: 'model' is {kind!r}; expected 'normal' or 'tangential'")
 
 
-__all__ = ["JointCharacteristics", "NotIdentifiableError", "Value", "joint_characteristics",
-           "load_result", "unit_system"]  # fmt: skip
+__all__ = [
+    "JointCharacteristics",
+    "NotIdentifiableError",
+    "Value",
+    "joint_characteristics",
+    "load_result",
+    "unit_system",
+]

@@ -49,6 +49,7 @@ import numpy as np
 from ..errors import ContactLabError, InputError
 from ..fitting import FitResult, Parameter, json_number, least_squares_fit
 from ..reversals import excursions
+from ._solve import lm_solver
 from .records import JointRecord, as_records
 
 #: linear terms in parallel with the law: name -> unit of the coefficient
@@ -318,6 +319,44 @@ def _law_forces(law: Any, prep: list[_Prepared]) -> np.ndarray:
         f = np.asarray(law.force(p.t, p.x, float(p.x[0])), dtype=float)
         parts.append(f if p.cmp is None else f[p.cmp])
     return parts[0] if len(parts) == 1 else np.concatenate(parts)
+
+
+def _has_sensitivities(law: Any) -> bool:
+    """True when the Rust core carries the law's forward sensitivities (its Jacobian in one
+    pass); the other laws are differentiated by finite differences."""
+    from .. import _core
+
+    try:
+        return bool(_core.joint_has_sens(law.spec()))
+    except (ContactLabError, ValueError, TypeError):
+        return False
+
+
+def _law_forces_jac(law: Any, prep: list[_Prepared]) -> tuple[np.ndarray, np.ndarray]:
+    """The law's forces at the compared samples and their derivatives in every parameter
+    (columns in the order of ``law.param_names``), from the forward sensitivities."""
+    from .. import _core
+
+    Ps, Js = [], []
+    spec = law.spec()
+    for p in prep:
+        f, J = _core.joint_force_sens(spec, p.t, p.x, float(p.x[0]))
+        Ps.append(f if p.cmp is None else f[p.cmp])
+        Js.append(J if p.cmp is None else J[p.cmp])
+    if len(Ps) == 1:
+        return Ps[0], Js[0]
+    return np.concatenate(Ps), np.concatenate(Js, axis=0)
+
+
+def _project_out(cols: np.ndarray, J: np.ndarray) -> np.ndarray:
+    """``(I - Π) J``, ``Π`` the orthogonal projection onto the span of ``cols`` (the
+    variable-projection Jacobian, Kaufman's form when the columns depend on the law)."""
+    if cols.shape[1] == 0:
+        return J
+    sc = np.sqrt(np.sum(cols**2, axis=0))
+    sc[sc == 0] = 1.0
+    Q = np.linalg.qr(cols / sc)[0]
+    return J - Q @ (Q.T @ J)
 
 
 def _guarded(residual: Any, Fm: np.ndarray) -> Any:
@@ -659,7 +698,21 @@ def fit(
             beta = _linear_solve(cols, Fm - P)
             return P + cols @ beta - Fm
 
-        res = least_squares_fit(_guarded(residual, Fm), params, max_nfev=max_nfev)
+        def jacobian(v: Mapping[str, float]) -> dict[str, np.ndarray]:
+            P, J = _law_forces_jac(law_of(v), prep)
+            if asym:
+                cols = np.column_stack([phi, np.abs(P)])
+                a = _linear_solve(cols, Fm - P)[-1]
+                J = J * (1.0 + a * np.sign(P))[:, None]
+            else:
+                cols = phi
+            J = _project_out(cols, J)
+            return {n: J[:, j] for j, n in enumerate(names)}
+
+        fn = _guarded(residual, Fm)
+        jac = jacobian if _has_sensitivities(start_law_) else None
+        res = least_squares_fit(fn, params, max_nfev=max_nfev, jac=jac,
+                                solver=None if jac is None else lm_solver(fn, jac))  # fmt: skip
         return res, law_of(res.values)
 
     candidates = [first]
@@ -709,8 +762,27 @@ def fit(
             out += v["asymmetry"] * np.abs(P)
         return out
 
+    def full_jacobian(v: Mapping[str, float]) -> dict[str, np.ndarray]:
+        P, J = _law_forces_jac(fitted.with_params([v[n] for n in names]), prep)
+        if asym:
+            J = J * (1.0 + v["asymmetry"] * np.sign(P))[:, None]
+        out = {n: J[:, j] for j, n in enumerate(names)}
+        static = [n for n in terms if n in _STATIC]
+        out.update({n: phi[:, i] for i, n in enumerate(static)})
+        if asym:
+            out["asymmetry"] = np.abs(P)
+        return out
+
+    fn_full = _guarded(full_residual, Fm)
+    jac_full = full_jacobian if _has_sensitivities(fitted) else None
     try:
-        res = least_squares_fit(_guarded(full_residual, Fm), params, max_nfev=max_nfev)
+        res = least_squares_fit(
+            fn_full,
+            params,
+            max_nfev=max_nfev,
+            jac=jac_full,
+            solver=None if jac_full is None else lm_solver(fn_full, jac_full),
+        )
         final_law = fitted.with_params([res.params[n].value for n in names])
     except ContactLabError as exc:
         res, final_law = res_law, fitted

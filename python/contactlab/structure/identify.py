@@ -48,8 +48,14 @@ from .fitkit import (
 from .model import SimulationResult, Structure
 
 JOINTS = ("masing", "jenkins", "iwan", "bouc_wen", "kelvin_voigt", "normal", "linear")
-__all__ = ["IWAN_ELEMENTS", "JOINTS", "IdentifiedModel", "equation_error", "identify",
-           "linear_grid_start"]  # fmt: skip
+__all__ = [
+    "IWAN_ELEMENTS",
+    "JOINTS",
+    "IdentifiedModel",
+    "equation_error",
+    "identify",
+    "linear_grid_start",
+]
 
 
 @dataclass
@@ -192,18 +198,22 @@ class IdentifiedModel:
         try:
             s = Structure.from_dict(d["structure"])
             fd = d["fit"]
-            params = {
-                p["name"]: Parameter(
-                    name=p["name"],
-                    value=float(p["value"]),
-                    stderr=p.get("stderr"),
-                    vary=bool(p.get("vary", True)),
-                    identifiable=p.get("identifiable"),
-                    note=p.get("note", ""),
-                    unit=p.get("unit", ""),
-                )
-                for p in fd["params"].values()
-            } if isinstance(fd.get("params"), dict) else {}  # fmt: skip
+            params = (
+                {
+                    p["name"]: Parameter(
+                        name=p["name"],
+                        value=float(p["value"]),
+                        stderr=p.get("stderr"),
+                        vary=bool(p.get("vary", True)),
+                        identifiable=p.get("identifiable"),
+                        note=p.get("note", ""),
+                        unit=p.get("unit", ""),
+                    )
+                    for p in fd["params"].values()
+                }
+                if isinstance(fd.get("params"), dict)
+                else {}
+            )
             fit = FitResult(
                 params=params,
                 var_names=list(fd.get("var_names", [])),
@@ -431,8 +441,10 @@ def _joint_grid_plan(
                 if math.isfinite(rms):
                     scored.append((rms, float(f), kf, ff, li, st0))
     scored.sort(key=lambda a: a[0])
-    return [({"f_frac": ff, "k_frac": kf, "grid_f": f, "grid_rms": rms}, li, st0)
-            for rms, f, kf, ff, li, st0 in scored[:keep]]  # fmt: skip
+    return [
+        ({"f_frac": ff, "k_frac": kf, "grid_f": f, "grid_rms": rms}, li, st0)
+        for rms, f, kf, ff, li, st0 in scored[:keep]
+    ]
 
 
 def _params(
@@ -519,6 +531,33 @@ def _starts(joint: str) -> list[dict[str, float]]:
 
 
 @with_single_blas_thread
+def _start_plan(
+    joint: str,
+    lin: Any,
+    lins: list[dict[str, Any]],
+    y: np.ndarray,
+    mass: float | None,
+    t: np.ndarray,
+    short_residual: Callable[[], Any],
+) -> list[tuple[dict[str, Any], dict[str, Any], dict[str, Any]]]:
+    """The starts of a single-DOF identification: ``(start, linear model, joint start)``
+    for every joint start on every linear model of the grid of frequencies
+    (``short_residual()`` makes the residual on the first samples, used only there)."""
+    starts = _starts(joint)
+    plan = [
+        (st0 if len(lins) == 1 else {**st0, "grid_f": li["grid_f"]}, li, st0)
+        for li in lins
+        for st0 in starts
+    ]
+    if len(lins) > 1 and joint in ("masing", "jenkins", "iwan"):
+        # the linear grid cannot hold the mass against a joint to the fixed ground (what a
+        # frame rubbing on a wall does on a short record): explore the joint's stiffness
+        # share and slip force on the grid of frequencies, one simulation each (first), as
+        # well as the usual starts on the linear grid's models
+        plan = _joint_grid_plan(joint, lin, y, mass, t, short_residual()) + plan
+    return plan
+
+
 def identify(
     t: Any,
     u: Any,
@@ -609,17 +648,9 @@ def identify(
 
     residual_on = _SdofResidual(joint, excitation, t, u, y, interpolation, substeps, progress)
 
-    starts = _starts(joint)
     records: list[dict[str, Any]] = []
     n_s = min(int(start_samples), t.size)
-    plan = [(st0 if len(lins) == 1 else {**st0, "grid_f": li["grid_f"]}, li, st0)
-            for li in lins for st0 in starts]  # fmt: skip
-    if len(lins) > 1 and joint in ("masing", "jenkins", "iwan"):
-        # the linear grid cannot hold the mass against a joint to the fixed ground (what a
-        # frame rubbing on a wall does on a short record): explore the joint's stiffness
-        # share and slip force on the grid of frequencies, one simulation each (first), as
-        # well as the usual starts on the linear grid's models
-        plan = _joint_grid_plan(joint, lin, y, mass, t, residual_on(n_s, 2)) + plan
+    plan = _start_plan(joint, lin, lins, y, mass, t, lambda: residual_on(n_s, 2))
     est = estimate_initial_state
     best_ps = hold_state(_params(joint, plan[0][1], y, mass, plan[0][2]), est)
     if multistart and len(plan) > 1:
@@ -675,9 +706,13 @@ def _checked_sdof_record(
 
 
 def _linear_starts(
-    t: np.ndarray, u: np.ndarray, y: np.ndarray, excitation: str, mass: float | None,
+    t: np.ndarray,
+    u: np.ndarray,
+    y: np.ndarray,
+    excitation: str,
+    mass: float | None,
     periodic: bool,
-) -> tuple[dict[str, Any], list[dict[str, Any]]]:  # fmt: skip
+) -> tuple[dict[str, Any], list[dict[str, Any]]]:
     """The equation-error linear model and the linear models that seed the joint's starts."""
     lin = equation_error(t, u, y, excitation, mass, periodic=periodic)
     lins = [lin]
@@ -707,9 +742,16 @@ class _SdofResidual:
     fitted values. ``progress`` (optional) is called with the stage after each simulation."""
 
     def __init__(
-        self, joint: str, excitation: str, t: np.ndarray, u: np.ndarray, y: np.ndarray,
-        interpolation: str, substeps: int, progress: Callable[[str], None] | None = None,
-    ) -> None:  # fmt: skip
+        self,
+        joint: str,
+        excitation: str,
+        t: np.ndarray,
+        u: np.ndarray,
+        y: np.ndarray,
+        interpolation: str,
+        substeps: int,
+        progress: Callable[[str], None] | None = None,
+    ) -> None:
         self.joint, self.excitation, self.t, self.u, self.y = joint, excitation, t, u, y
         self.interpolation, self.substeps = interpolation, substeps
         self.progress = progress
@@ -729,8 +771,9 @@ class _SdofResidual:
             try:
                 s = build_structure(joint, v, excitation)
                 kw = {"force": uu} if excitation == "force" else {"base": uu}
-                r = s.simulate(tt, x0=[v["x0"]], v0=[v["v0"]], substeps=sub,
-                               interpolation=interp, **kw)  # fmt: skip
+                r = s.simulate(
+                    tt, x0=[v["x0"]], v0=[v["v0"]], substeps=sub, interpolation=interp, **kw
+                )
             except ContactLabError:
                 return np.full(n, 1e3 * float(np.max(np.abs(yy))) + 1.0)
             x = r.x

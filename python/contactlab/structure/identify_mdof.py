@@ -234,8 +234,10 @@ def _joint_params(
     joint: str, kj: float, fs: float, st: dict[str, float], dr: float, cj: float = 0.0
 ) -> list:
     if joint == "kelvin_voigt":
-        return [Parameter("kj", kj, min=0.0, unit="N/m"), Parameter("cj", cj, min=0.0,
-                                                                   unit="N s/m")]  # fmt: skip
+        return [
+            Parameter("kj", kj, min=0.0, unit="N/m"),
+            Parameter("cj", cj, min=0.0, unit="N s/m"),
+        ]
     if joint == "bouc_wen":
         return [
             Parameter("alpha", kj, min=1e-9 * kj, unit="N/m"),
@@ -244,8 +246,10 @@ def _joint_params(
             Parameter("nu", 1.0, min=0.25, max=4.0, vary=st.get("fit_nu", True), unit=""),
         ]
     if joint == "masing":
-        return [Parameter("h0", fs, min=0.0, unit="N"), Parameter("ac", kj / fs, min=0.0,
-                                                                   unit="1/m")]  # fmt: skip
+        return [
+            Parameter("h0", fs, min=0.0, unit="N"),
+            Parameter("ac", kj / fs, min=0.0, unit="1/m"),
+        ]
     if joint in ("jenkins", "iwan"):
         return [Parameter("kj", kj, min=0.0, unit="N/m"), Parameter("fs", fs, min=0.0, unit="N")]
     return []
@@ -255,8 +259,10 @@ def _mdof_starts(joint: str) -> list[dict[str, float]]:
     if joint == "kelvin_voigt":
         return [{"k_frac": 0.5}]
     if joint == "bouc_wen":
-        return [{"gamma": g, "delta": d, "k_frac": 0.5}
-                for (g, d) in ((0.5, -0.5), (0.5, 0.5), (-0.25, 0.5))]  # fmt: skip
+        return [
+            {"gamma": g, "delta": d, "k_frac": 0.5}
+            for (g, d) in ((0.5, -0.5), (0.5, 0.5), (-0.25, 0.5))
+        ]
     if joint in ("masing", "jenkins", "iwan"):
         return [{"f_frac": f, "k_frac": kf} for f in (0.1, 0.5) for kf in (0.5,)] + [
             {"coulomb": 1.0, "f_frac": f, "kj_frac": kf} for f in (0.7, 1.4) for kf in (3.0, 30.0)
@@ -303,10 +309,15 @@ def _start_params(
             lo = 0.0 if positive else -math.inf
             ps.append(Parameter(name, vals[name], min=lo, unit=unit, scale=sc))
     cb = float(b @ pattern.matrix("C", vals) @ b)  # damping seen across the joint
-    cj = 0.5 * cb if cb > 0 else 1e-3 * math.sqrt(max(kj, 1e-300) * max(
-        float(np.trace(mass)) if mass is not None else 1.0, 1e-300))  # fmt: skip
-    ps += _joint_params(joint, max(kj, 1e-300), max(fs, 1e-300), st, max(d_rms, 1e-300),
-                        cj)  # fmt: skip
+    cj = (
+        0.5 * cb
+        if cb > 0
+        else 1e-3
+        * math.sqrt(
+            max(kj, 1e-300) * max(float(np.trace(mass)) if mass is not None else 1.0, 1e-300)
+        )
+    )
+    ps += _joint_params(joint, max(kj, 1e-300), max(fs, 1e-300), st, max(d_rms, 1e-300), cj)
     for i in range(pattern.n):
         ps.append(Parameter(f"x0_{i}", float(x0[i]), unit="m", scale=y_rms))
         ps.append(Parameter(f"v0_{i}", float(v0[i]), unit="m/s", scale=y_rms * 2 * np.pi * 10))
@@ -453,8 +464,9 @@ def _checked_mdof_record(t: Any, u: Any, y: Any) -> tuple[np.ndarray, np.ndarray
         raise InputError(f"{nt} samples are too few to identify a structure")
     big = float(np.max(np.abs(u)))
     if big > MAX_MAGNITUDE:
-        raise InputError(f"u reaches {big:.3g}: beyond any physical input; a unit mix-up or a "
-                         "corrupt file?")  # fmt: skip
+        raise InputError(
+            f"u reaches {big:.3g}: beyond any physical input; a unit mix-up or a corrupt file?"
+        )
     for j in range(n):  # each DOF's displacement: in range, not zero, not constant
         check_channel(f"y[:, {j}]", y[:, j], "m", f"displacement (DOF {j})")
     if np.any(np.diff(t) <= 0):

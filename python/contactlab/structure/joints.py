@@ -115,8 +115,14 @@ class Joint:
         j = -1 if self.dof2 is None else self.dof2
         if self.kind == "masing":
             if "x_points" in a:
-                return ("masing_tabulated", self.dof, j, np.array([p["scale"]]), a["x_points"],
-                        a["f_points"])  # fmt: skip
+                return (
+                    "masing_tabulated",
+                    self.dof,
+                    j,
+                    np.array([p["scale"]]),
+                    a["x_points"],
+                    a["f_points"],
+                )
             return ("masing", self.dof, j, np.array([p["h0"], p["ac"], p["scale"]]), empty, empty)
         if self.kind == "iwan":
             return ("iwan", self.dof, j, empty, a["k"], a["fs"])
@@ -238,8 +244,13 @@ def make_joint(kind: str, dof: int, dof2: int | None = None, **kw: Any) -> Joint
         )
     if kw:
         raise InputError(f"joint {kind!r} does not take parameter(s) {', '.join(sorted(kw))}")
-    return Joint(kind=kind, dof=int(dof), dof2=None if dof2 is None else int(dof2),
-                 params=params, arrays=arrays)  # fmt: skip
+    return Joint(
+        kind=kind,
+        dof=int(dof),
+        dof2=None if dof2 is None else int(dof2),
+        params=params,
+        arrays=arrays,
+    )
 
 
 def iwan_uniform(k_total: float, f_total: float, n: int = 20) -> dict[str, np.ndarray]:
@@ -271,9 +282,20 @@ def iwan_uniform(k_total: float, f_total: float, n: int = 20) -> dict[str, np.nd
 #: Kind codes of the flat encoding of a joint-law spec (the Rust core's
 #: ``contactlab_core::joints::AnyLaw::from_flat`` reads the same table).
 LAW_CODES: tuple[str, ...] = (
-    "jenkins", "iwan", "segalman", "masing", "maxwell_slip", "gms", "dahl", "lugre",
-    "bouc_wen", "kelvin_voigt", "parallel", "series", "backlash",
-)  # fmt: skip
+    "jenkins",
+    "iwan",
+    "segalman",
+    "masing",
+    "maxwell_slip",
+    "gms",
+    "dahl",
+    "lugre",
+    "bouc_wen",
+    "kelvin_voigt",
+    "parallel",
+    "series",
+    "backlash",
+)
 
 
 def encode_law(law: Any) -> np.ndarray:

@@ -159,11 +159,14 @@ def analyze_entry(
         from ..tangential import read_frame
 
         if entry.kind != "tangential":
-            raise InputError(f"{entry.path}: a friction frame gives a tangential recording "
-                             f"(x, F), not a {entry.kind} one")  # fmt: skip
+            raise InputError(
+                f"{entry.path}: a friction frame gives a tangential recording "
+                f"(x, F), not a {entry.kind} one"
+            )
         f = entry.frame
-        frame = read_frame(entry.path, f["M"], f["C"], f["K"], x=f.get("x"), y=f.get("y"),
-                           fs=entry.fs)  # fmt: skip
+        frame = read_frame(
+            entry.path, f["M"], f["C"], f["K"], x=f.get("x"), y=f.get("y"), fs=entry.fs
+        )
         rec = frame.recording(str(entry.path))
         rec.meta.update(columns=frame.columns, file_units=frame.file_units)
         cols, funits = frame.columns or {}, frame.file_units or {}
@@ -171,8 +174,9 @@ def analyze_entry(
         if assumed_frame:
             rec.meta["units_assumed_si"] = assumed_frame
     else:
-        rec = read_recording(entry.path, columns=entry.columns, kind=entry.kind, fs=entry.fs,
-                             resample=entry.resample)  # fmt: skip
+        rec = read_recording(
+            entry.path, columns=entry.columns, kind=entry.kind, fs=entry.fs, resample=entry.resample
+        )
     from ..io.checks import check_recording_glitches
 
     check_recording_glitches(rec)  # a sensor glitch is refused, as diagnose refuses it
@@ -322,8 +326,10 @@ class StudyResult:
 
     def __repr__(self) -> str:
         n = {k: len(self.table(k)) for k in KINDS}
-        return (f"StudyResult({n['tangential']} tangential, {n['normal']} normal, "
-                f"{len(self.failures)} failed)")  # fmt: skip
+        return (
+            f"StudyResult({n['tangential']} tangential, {n['normal']} normal, "
+            f"{len(self.failures)} failed)"
+        )
 
     def table_files(self, stem: str = "study") -> dict[str, bytes]:
         """``<stem>_<kind>.csv`` and ``.parquet`` for each kind present."""
@@ -488,5 +494,11 @@ def run_study(
     return StudyResult(results)
 
 
-__all__ = ["KINDS", "RecordingResult", "StudyResult", "analyze_entry", "collect_entries",
-           "run_study"]  # fmt: skip
+__all__ = [
+    "KINDS",
+    "RecordingResult",
+    "StudyResult",
+    "analyze_entry",
+    "collect_entries",
+    "run_study",
+]

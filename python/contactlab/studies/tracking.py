@@ -66,9 +66,20 @@ from .track_result import (  # noqa: F401  (the constants and TrackResult, re-ex
 #: (:func:`contactlab.tangential.window.analyze_window`) takes; others (``on="signal"``,
 #: ``history``) take the whole-window analysis
 _WINDOW_OPTIONS = frozenset(
-    ("force_sign", "n_points", "rel_threshold", "min_cycles", "max_rel_stderr", "fit_offset",
-     "fit_x0", "fit_amplitude", "detrend", "initial", "delay")
-)  # fmt: skip
+    (
+        "force_sign",
+        "n_points",
+        "rel_threshold",
+        "min_cycles",
+        "max_rel_stderr",
+        "fit_offset",
+        "fit_x0",
+        "fit_amplitude",
+        "detrend",
+        "initial",
+        "delay",
+    )
+)
 
 
 class _WindowSamples:
@@ -393,8 +404,9 @@ def _segments(
                 piece, part = c, got
             else:
                 meta = dict(c.meta, offset=off + a)
-                piece = Recording(c.t[a:b], {k: v[a:b] for k, v in c.data.items()},
-                                  c.units, c.source, meta)  # fmt: skip
+                piece = Recording(
+                    c.t[a:b], {k: v[a:b] for k, v in c.data.items()}, c.units, c.source, meta
+                )
                 part = {k: _core.finite_min_max(v)[1:] for k, v in piece.data.items()}
             ranges = {
                 k: (min(ranges[k][0], lo), max(ranges[k][1], hi)) if k in ranges else (lo, hi)
@@ -562,8 +574,9 @@ def _track(
     every_text = every if isinstance(every, str) else f"{every}cycles"
     if not (isinstance(max_window, int) and max_window >= 16):
         raise InputError(f"max_window must be an integer >= 16, got {max_window!r}")
-    cr = read_chunks(source, chunk_size=chunk_size, columns=columns, kind=kind, fs=fs,
-                     resample=resample)  # fmt: skip
+    cr = read_chunks(
+        source, chunk_size=chunk_size, columns=columns, kind=kind, fs=fs, resample=resample
+    )
     noted: dict[str, Any] = {}
     kind_ = cr.kind
     if kind_ not in ("tangential", "normal"):
@@ -594,9 +607,15 @@ def _track(
             n_total = off + len(block)
             levels = trigger_levels(*ranges[drive]) if ranges and len(block) else None
             got = block_cycles(
-                block.t, block[loop_x], block[loop_F], block[drive], off, state, levels,
+                block.t,
+                block[loop_x],
+                block[loop_F],
+                block[drive],
+                off,
+                state,
+                levels,
                 cr.time_step,
-            )  # fmt: skip
+            )
             for k in cyc:
                 cyc[k].append(np.asarray(getattr(got, k), dtype=float))
             cuts.block(float(block.t[0]), got.crossings)

@@ -421,8 +421,13 @@ def average_loop(
             f"±{rev.threshold:.3g} m around x = {rev.centre:.3g} m; "
             f"at least {min_cycles} are needed"
         )
-    kt, kp = _phase_knots(replace(rev, peak_times=smooth_turn_times(rev.peak_times),
-                                  valley_times=smooth_turn_times(rev.valley_times)))  # fmt: skip
+    kt, kp = _phase_knots(
+        replace(
+            rev,
+            peak_times=smooth_turn_times(rev.peak_times),
+            valley_times=smooth_turn_times(rev.valley_times),
+        )
+    )
     start = int(np.searchsorted(ta, kt[0], side="left"))
     end = int(np.searchsorted(ta, kt[-1], side="left"))
     if n_points is None:

@@ -107,8 +107,9 @@ def velocity(t: np.ndarray | None, x: np.ndarray) -> tuple[np.ndarray, float, in
     return v, thr, window
 
 
-def _first_crossing(u: np.ndarray, phase: np.ndarray, F: np.ndarray, level: float,
-                    rising: bool) -> float | None:  # fmt: skip
+def _first_crossing(
+    u: np.ndarray, phase: np.ndarray, F: np.ndarray, level: float, rising: bool
+) -> float | None:
     """Distance from the reversal at which the branch (bins in phase order) first passes
     ``level``."""
     o = np.argsort(phase)
@@ -140,10 +141,12 @@ def _reach(
     swing = hi - lo
     if not swing > 0:
         return None
-    d1 = _first_crossing(u_d, loop.phase[desc], loop.F[desc], hi - PLATEAU_FRACTION * swing,
-                         rising=False)  # fmt: skip
-    d2 = _first_crossing(u_a, loop.phase[~desc], loop.F[~desc], lo + PLATEAU_FRACTION * swing,
-                         rising=True)  # fmt: skip
+    d1 = _first_crossing(
+        u_d, loop.phase[desc], loop.F[desc], hi - PLATEAU_FRACTION * swing, rising=False
+    )
+    d2 = _first_crossing(
+        u_a, loop.phase[~desc], loop.F[~desc], lo + PLATEAU_FRACTION * swing, rising=True
+    )
     if d1 is None or d2 is None:
         return None
     dx95 = max(d1, d2)
@@ -444,8 +447,15 @@ def stick_slip(
         durations.append(n_stuck * dt)
         breakaway.append(_breakaway(f, x, v, (a, b), window, max(sliding, thr), sx, reach))
     hit = spans
-    return StickSlip(int(turns.size), np.asarray(durations), np.asarray(breakaway), float(thr),
-                     float(smooth), len(hit), dwells)  # fmt: skip
+    return StickSlip(
+        int(turns.size),
+        np.asarray(durations),
+        np.asarray(breakaway),
+        float(thr),
+        float(smooth),
+        len(hit),
+        dwells,
+    )
 
 
 def _drop_dwells(spans: dict[int, list[int]], F: np.ndarray, turns: np.ndarray) -> int:
@@ -457,8 +467,9 @@ def _drop_dwells(spans: dict[int, list[int]], F: np.ndarray, turns: np.ndarray) 
         return 0
     lo, hi = np.percentile(F[turns[0] : turns[-1] + 1], [1.0, 99.0])
     half = 0.5 * float(hi - lo)
-    dwell = [k for k, (a, b, _n) in spans.items()
-             if not float(np.ptp(F[a:b])) > STICK_FORCE_SHARE * half]  # fmt: skip
+    dwell = [
+        k for k, (a, b, _n) in spans.items() if not float(np.ptp(F[a:b])) > STICK_FORCE_SHARE * half
+    ]
     for k in dwell:
         del spans[k]
     return len(dwell)
@@ -521,14 +532,17 @@ def classify(
     st = stick_slip(t, x, F, rev, v, thr, window, pl.offset if pl is not None else 0.0)
     zt = f"ac·A = {z:.3g} (from the {src}; loop area {100 * ratio:.0f}% of the rectangle 4·A·h_m)"
     if not math.isfinite(z):  # an area no friction loop of this size encloses
-        zt = (f"ac·A undetermined (the loop area is {100 * ratio:.0f}% of the rectangle "
-              "4·A·h_m, which bounds any friction loop)")  # fmt: skip
+        zt = (
+            f"ac·A undetermined (the loop area is {100 * ratio:.0f}% of the rectangle "
+            "4·A·h_m, which bounds any friction loop)"
+        )
     if z < PRE_SLIDING_Z:
         return Regime("pre-sliding", f"pre-sliding (microslip): {zt}", z, src, ratio, None, st)
     if (z < GROSS_SLIDING_Z and pl is None) or (pl is None and src != "fit"):
         why = "" if z < GROSS_SLIDING_Z else "; no plateau over the middle of the stroke"
-        return Regime("transition", f"transition towards gross sliding: {zt}{why}", z, src,
-                      ratio, pl, st)  # fmt: skip
+        return Regime(
+            "transition", f"transition towards gross sliding: {zt}{why}", z, src, ratio, pl, st
+        )
     if pl is None:
         text = (
             f"gross sliding: {zt}; the branches flatten to under 5% of the initial stiffness "

@@ -121,11 +121,21 @@ def analyze_window(
     if ori is not None:
         if ori.sign < 0:
             pre = _negated(pre)
-        res = _analyze(xa, Fa, ta, source, ori, pre, on="averaged", history="steady",
-                       streamed=True, delay=delay, **opts)  # fmt: skip
+        res = _analyze(
+            xa,
+            Fa,
+            ta,
+            source,
+            ori,
+            pre,
+            on="averaged",
+            history="steady",
+            streamed=True,
+            delay=delay,
+            **opts,
+        )
     if res is None:  # the sign undecided by the area, or gross sliding: the full analysis
-        return analyze_tangential(recording, force_sign=force_sign, warn=False, delay=delay,
-                                  **opts)  # fmt: skip
+        return analyze_tangential(recording, force_sign=force_sign, warn=False, delay=delay, **opts)
     lag.record(res, delay, dropped)
     return res
 
@@ -152,8 +162,9 @@ def _window_detrended(
         rev = find_reversals(xa, ta, rel_threshold=rel)  # checks x and t
         Fa = as_1d(Fa, "F")
     if not (opts["detrend"] and rev.peaks.size - 1 >= 3):
-        loop = average_loop(xa, Fa, ta, n_points=n_points, rel_threshold=rel,
-                            min_cycles=min_cycles, checked=True)  # fmt: skip
+        loop = average_loop(
+            xa, Fa, ta, n_points=n_points, rel_threshold=rel, min_cycles=min_cycles, checked=True
+        )
         return steps.Detrended(xa, Fa, loop, None)
     tt = ta if ta is not None else np.arange(xa.size, dtype=float)
     pt = rev.peak_times
@@ -172,8 +183,9 @@ def _window_detrended(
     _core.detrend_pair_into(tt, tm, Fa, f_drift[0], xa, x_drift[0], F, x)
     # x, F and t were checked above (the detrended samples are finite: the fold checks them
     # again in its pass), so the fold's reversal search does not scan them a second time
-    loop = average_loop(x, F, ta, n_points=n_points, rel_threshold=rel, min_cycles=min_cycles,
-                        checked=True)  # fmt: skip
+    loop = average_loop(
+        x, F, ta, n_points=n_points, rel_threshold=rel, min_cycles=min_cycles, checked=True
+    )
     return steps.Detrended(x, F, loop, steps.Drift(f_drift, x_drift, tt, tm))
 
 
