@@ -128,6 +128,20 @@ fn eval_block_body<C: Backbone>(
         }
         return finite;
     }
+    if runs.len() <= SEGMENTS {
+        // Few runs (a smooth block): `rid` is non-decreasing (runs are numbered in order), so
+        // each run is a contiguous stretch, found by bisection, and done by a vectorised loop.
+        let mut from = 0_usize;
+        for (k, r) in runs.iter().enumerate() {
+            let to = from.wrapping_add(rid[from..].partition_point(|&q| usize::from(q) <= k));
+            for o in &mut out[from..to] {
+                *o = r.ha + r.mul * *o;
+                finite &= o.is_finite();
+            }
+            from = to;
+        }
+        return finite;
+    }
     let (ha, mul) = (&mut tab.ha, &mut tab.mul);
     for ((h, m), r) in ha.iter_mut().zip(mul.iter_mut()).zip(runs.iter()) {
         (*h, *m) = (r.ha, r.mul);
@@ -155,6 +169,9 @@ impl RunTab {
         })
     }
 }
+
+/// Up to this many runs in a block, [`eval_block_body`] applies the bases run by run.
+const SEGMENTS: usize = 16;
 
 /// Size of the gather tables of [`eval_block_body`]: a power of two above `BLOCK + 2`.
 const RUNS: usize = 1024;
@@ -339,13 +356,21 @@ impl Kernel for BlockPass<'_> {
 
 /// The input scan of a block, as a [`Kernel`]: whether every value is finite and, when so,
 /// the continuation bits (the first pass's turning points).
-struct Scan<'a>(&'a [f64]);
+/// (The bits only when the second field says so; else all clear.)
+struct Scan<'a>(&'a [f64], bool);
 
 impl Kernel for Scan<'_> {
     type Output = Option<Cont>;
     #[inline(always)]
     fn run_at(self) -> Option<Cont> {
-        all_finite(self.0).then(|| continuation_bits(self.0))
+        let (x, bits) = (self.0, self.1);
+        all_finite(x).then(|| {
+            if bits {
+                continuation_bits(x)
+            } else {
+                [0; BLOCK / 64]
+            }
+        })
     }
 }
 
@@ -945,8 +970,10 @@ pub(super) fn scaled_force<C: Backbone>(
     let mut tab = RunTab::new();
     let mut finite = true;
     for (xc, oc) in x.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
-        // The input's check while the block is read for its turning points.
-        let Some(cont) = simd::run(level, Scan(xc)) else {
+        // The input's check, while the block is read for its turning points when the
+        // block path will need them.
+        let dense_path = dense && pass.dir != 0.0;
+        let Some(cont) = simd::run(level, Scan(xc, !dense_path)) else {
             return Forces::BadInput;
         };
         let m = xc.len();
@@ -957,7 +984,7 @@ pub(super) fn scaled_force<C: Backbone>(
         }
         let stk = stack.as_mut_slice();
         // The path for this block from the branch changes of the last one.
-        let changes = if dense && pass.dir != 0.0 {
+        let changes = if dense_path {
             let d = dense_rec.get_or_insert_with(Dense::new);
             let c = pass.dense_block(stk, xc, d);
             finite &= eval_dense(level, curve, d, pass.start, oc);
