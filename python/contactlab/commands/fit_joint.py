@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import InputError
-from ._common import (
+from .common import (
     FORCE_SIGN_CHOICES,
     add_reader_flags,
     check_output_targets,
