@@ -14,6 +14,8 @@ noise and the ratio of medians is the figure. Rows:
   built here for generic x86-64 (``rustc -O``) into a driver kept running between our rounds
   (``benches/bench_masing.py``); ratio of thread-CPU medians, wall-clock figures beside it.
 - ``Masing.force(threads=2)`` with a competing busy process against one thread.
+- ``contactlab analyze --json`` of a 1e7 / 3e7-sample HDF5 recording on the command line
+  against the Masing kernel on the same samples (``benches/bench_analyze.py``).
 - ``contactlab --help``, ``python -c 'import contactlab'`` and ``contactlab analyze`` to its
   first sample read and to its end, against ``python -c pass`` (wall and CPU time, a new
   process each: ``benches/bench_startup.py``).
@@ -225,6 +227,16 @@ def startup_rows(rounds: int) -> None:
         row(f"{task} (new process)", ours, other, ratio, note + " ")
 
 
+def analyze_rows(rounds: int, sizes: list[int]) -> None:
+    """``contactlab analyze --json`` of long HDF5 recordings (command line) against the
+    Masing kernel on the same samples (bench_analyze.py; the bar is 0.3 of the kernel)."""
+    sys.path.insert(0, str(ROOT / "benches"))
+    import bench_analyze
+
+    for task, ours, other, ratio, note in bench_analyze.rows(sizes, max(3, rounds // 2)):
+        row(task, ours, other, ratio, note + " ")
+
+
 def ode_row(rounds: int) -> None:
     sys.path.insert(0, str(ROOT / "benches"))
     import bench_normal
@@ -267,6 +279,7 @@ def main() -> None:
     loop_rows(args.rounds, sorted({1_000_000, big}))
     masing_rows(args.rounds, big)
     threads_row(args.rounds, big)
+    analyze_rows(args.rounds, [1_000_000] if args.quick else [10_000_000, 30_000_000])
     startup_rows(args.rounds)
     if args.ode:
         ode_row(args.rounds)
