@@ -19,7 +19,7 @@ import numpy as np
 
 from contactlab.joints import BoucWen, Dahl, Jenkins, LuGre, MaxwellSlip, fit
 
-fit_module = importlib.import_module("contactlab.joints.fit")
+fit_module = importlib.import_module("contactlab.joints.fit_problem")
 
 
 def history(n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -43,15 +43,15 @@ def one(law: str, n: int, analytic: bool) -> tuple[float, object]:
     true = TRUTH[law]
     F = true.force(t, x)
     F = F + np.random.default_rng(1).normal(0, 0.01 * np.std(F), n)
-    saved = fit_module._has_sensitivities
+    saved = fit_module.has_sensitivities
     if not analytic:
-        fit_module._has_sensitivities = lambda _law: False
+        fit_module.has_sensitivities = lambda _law: False
     try:
         c0 = time.process_time()
         res = fit(t, x, F, law=law)
         cpu = time.process_time() - c0
     finally:
-        fit_module._has_sensitivities = saved
+        fit_module.has_sensitivities = saved
     return cpu, (res, true, F)
 
 
@@ -77,7 +77,7 @@ def main() -> None:
     print(f"{'law':<13} {'sens s':>7} {'FD s':>7} {'FD/sens':>8} {'rms/noise sens':>15} "
           f"{'FD':>6} {'max param err sens':>19} {'FD':>8}  converged")  # fmt: skip
     for law in a.laws.split(","):
-        has = fit_module._has_sensitivities(TRUTH[law])
+        has = fit_module.has_sensitivities(TRUTH[law])
         cs, os_ = one(law, a.n, True)
         cf, of = one(law, a.n, False) if has else (cs, os_)
         qs, qf = quality(os_), quality(of)

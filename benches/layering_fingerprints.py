@@ -163,6 +163,9 @@ def analyses() -> dict[str, str]:
         t, p, d = normal_recording(model="table2", n_cycles=5, noise=0.01, seed=seed)
         res = analyze_loop(t, p, d, **kw)
         out[f"analyze_loop seed={seed} {kw}"] = digest(res.to_dict(arrays=True))
+    t, p, d = normal_recording(model="table2", n_cycles=5, noise=0.01, seed=24)
+    res = analyze_loop(t, p, d, options={"degree": 3, "pa": 0.4e6})
+    out["analyze_loop seed=24 options={degree: 3, pa: 4e5}"] = digest(res.to_dict(arrays=True))
     layouts = [
         (["t [ms]", "x [um]", "F [N]"], {}, None, {}),
         (["time", "disp", "force", "other"], {}, None, {}),
@@ -210,6 +213,25 @@ def analyses() -> dict[str, str]:
     d = m.to_dict()
     d.pop("elapsed", None)
     out[f"identify short frame seed={seed} (grid starts)"] = digest(d)
+    # two DOFs, a Jenkins joint between them, force on the second (identify_mdof)
+    rng = np.random.default_rng(40417)
+    n = 600
+    t = np.arange(n) / 500.0
+    u = sum(np.sin(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi)) for f in np.arange(3, 60, 0.5))
+    u = u * 6.0 / np.std(u)
+    K = np.array([[6e3, -2e3], [-2e3, 2e3]])
+    C = np.array([[3.0, -1.0], [-1.0, 1.0]])
+    s2 = Structure(np.diag([1.0, 0.5]), C, K)
+    s2.add_joint("jenkins", 0, 1, k=1.5e3, fs=1.5)
+    f2 = np.zeros((n, 2))
+    f2[:, 1] = u
+    y2 = s2.simulate(t, force=f2, substeps=4).x
+    um = u + 0.01 * np.std(u) * rng.standard_normal(n)
+    ym = y2 + 0.01 * np.std(y2, axis=0) * rng.standard_normal(y2.shape)
+    m = identify(t, um, ym, joint="jenkins", joint_dofs=(0, 1), input_dof=1, substeps=1)
+    d = m.to_dict()
+    d.pop("elapsed", None)
+    out["identify_mdof jenkins between DOFs"] = digest(d)
     return out
 
 

@@ -311,6 +311,21 @@ def _strip_rust(line: str) -> str:
     return line.split("//", 1)[0]
 
 
+def _reason(lines: list[str], at: int) -> str:
+    """The ``//`` comment (not doc comment) just above line ``at`` (0-based), skipping the
+    attributes and doc comments between: the justification an allowance carries."""
+    said: list[str] = []
+    k = at - 1
+    while k >= 0:
+        text = lines[k].strip()
+        if text.startswith("//") and not text.startswith(("///", "//!")):
+            said.insert(0, text.lstrip("/ "))
+        elif said or not (text.startswith(("#[", "///")) or text == ""):
+            break
+        k -= 1
+    return " ".join(said) or "(no comment)"
+
+
 def measure(files: dict[str, str]) -> Metrics:
     """Every measurement of one tree."""
     m = Metrics()
@@ -331,9 +346,11 @@ def measure(files: dict[str, str]) -> Metrics:
             for name, _, length in rust_functions(text):
                 if length > RS_FUNC_LIMIT:
                     m.rs_long_functions.append((f"{path}:{name}", length))
-            for k, line in enumerate(text.split("\n"), 1):
+            rs_lines = text.split("\n")
+            for k, line in enumerate(rs_lines, 1):
                 if re.search(r"allow\(\s*clippy::", line) and not line.lstrip().startswith("//"):
-                    m.clippy_allows.append(f"{path}:{k} {line.strip()}")
+                    lint = ", ".join(re.findall(r"clippy::(\w+)", line))
+                    m.clippy_allows.append(f"{path}:{k} `{lint}`: {_reason(rs_lines, k - 1)}")
     graph = import_graph(files)
     m.module_cycles = strongly_connected(graph)
     m.package_cycles = sibling_cycles(graph)
@@ -397,9 +414,62 @@ def details(m: Metrics) -> str:
     parts += [f"- `{p}`" for p in m.test_files_private] or ["none"]
     parts += ["", "### Private names crossing a package", ""]
     parts += [f"- `{p}`" for p in m.private_crossings] or ["none"]
-    parts += ["", "### `allow(clippy::…)` attributes", ""]
-    parts += [f"- `{p}`" for p in m.clippy_allows] or ["none"]
+    parts += ["", "### `allow(clippy::…)` attributes and the comment that justifies each", ""]
+    parts += [f"- {p}" for p in m.clippy_allows] or ["none"]
     return "\n".join(parts)
+
+
+HEADER = """# Layering (issue 32): the measurements before and after
+
+Written by `{argv}`; re-run it to refresh. Columns: {columns}. A function's length runs from
+its `def`/`fn` line to its last line; imports are counted module level and inside functions
+(only `if TYPE_CHECKING:` blocks left out), a name imported from a package that is a module of
+it counting as that module.
+
+"""
+
+#: what the revisions this report is usually run with stand for
+KNOWN = {
+    "8660a71^": "the tree before the layering began (the issue's figures)",
+    "6b32b6d": "the tree when the last round of the layering started (the big moves done)",
+    "main": "the integration branch (other helpers' work, without this branch's)",
+    "working tree": "this branch, main merged",
+}
+
+
+def fingerprints(before: Path) -> str:
+    """The fingerprints of the working tree against those recorded in ``before``."""
+    run = subprocess.run(
+        [sys.executable, str(ROOT / "benches" / "layering_fingerprints.py")],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    old = dict(_split(line) for line in before.read_text().splitlines() if line.strip())
+    new = dict(_split(line) for line in run.stdout.splitlines() if line.strip())
+    same = [k for k in new if old.get(k) == new[k]]
+    changed = [k for k in new if k in old and old[k] != new[k]]
+    out = [
+        "## Results unchanged (benches/layering_fingerprints.py)",
+        "",
+        f"SHA-256 of `contactlab analyze --json` (and its printout) of the bundled data and of "
+        f"fixed-seed outputs of every function the layering split, against "
+        f"`{before.as_posix()}`: **{len(same)} of {len(new)} identical**"
+        + (f", changed: {', '.join(changed)}" if changed else "")
+        + (
+            f", new: {len(new) - len(same) - len(changed)}"
+            if len(new) > len(same) + len(changed)
+            else ""
+        )
+        + ".",
+    ]
+    return "\n".join(out)
+
+
+def _split(line: str) -> tuple[str, str]:
+    digest, _, name = line.partition("  ")
+    return name, digest
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -409,13 +479,30 @@ def main(argv: list[str] | None = None) -> int:
         "--before", action="append", default=[], help="revision(s) to show before it"
     )
     parser.add_argument("--out", help="write the Markdown here")
+    parser.add_argument(
+        "--fingerprints",
+        metavar="BEFORE",
+        help="run benches/layering_fingerprints.py on the working tree and compare its lines "
+        "with this file (recorded on the old tree)",
+    )
+    parser.add_argument("--notes", help="a Markdown file appended after the table")
     args = parser.parse_args(argv)
     after = measure(_read_tree(args.rev))
     after_label = args.rev or "working tree"
     columns = [(rev, measure(_read_tree(rev))) for rev in args.before]
     columns.append((after_label, after))
-    text = table(columns)
-    text += "\n\n## Details (" + after_label + ")\n\n" + details(after) + "\n"
+    text = HEADER.format(
+        columns="; ".join(
+            f"`{label}`" + (f" {KNOWN[label]}" if label in KNOWN else "") for label, _ in columns
+        ),
+        argv=" ".join(["python benches/layering_metrics.py", *(argv or sys.argv[1:])]),
+    )
+    text += table(columns) + "\n"
+    if args.fingerprints:
+        text += "\n" + fingerprints(Path(args.fingerprints)) + "\n"
+    if args.notes:
+        text += "\n" + Path(args.notes).read_text(encoding="utf-8").strip() + "\n"
+    text += "\n## Details (" + after_label + ")\n\n" + details(after) + "\n"
     if args.out:
         Path(args.out).write_text(text, encoding="utf-8")
     else:

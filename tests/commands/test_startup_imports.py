@@ -98,3 +98,21 @@ def test_fem_package_loads_its_workers_on_first_use():
     assert set(dir(contactlab.fem)) >= set(contactlab.fem.__all__)
     with pytest.raises(AttributeError, match="no_such_name"):
         contactlab.fem.no_such_name  # noqa: B018
+
+
+def test_studies_package_loads_its_workflows_on_first_use():
+    loaded = _modules_after("from contactlab.studies import entry_from_file")
+    assert "contactlab.studies.manifest" in loaded
+    assert not {"contactlab.studies.study", "contactlab.studies.tracking"} & loaded
+    assert "concurrent.futures" not in loaded
+    import importlib
+
+    import contactlab.studies as studies
+
+    for name, home in studies._LAZY.items():
+        module = importlib.import_module(f"contactlab.studies.{home}")
+        assert getattr(studies, name) is getattr(module, name), name
+    assert set(dir(studies)) >= set(studies.__all__)
+    assert set(studies._LAZY) == set(studies.__all__)
+    with pytest.raises(AttributeError, match="no_such_name"):
+        studies.no_such_name  # noqa: B018

@@ -22,7 +22,7 @@ from contactlab.joints import (
 )
 from contactlab.joints import _reference as ref
 
-fit_module = importlib.import_module("contactlab.joints.fit")
+fit_module = importlib.import_module("contactlab.joints.fit_problem")
 
 
 def _signal(n=400):
@@ -70,8 +70,8 @@ def test_sensitivities_equal_differences_of_the_python_reference(law):
 def test_laws_without_sensitivities_fall_back_and_bad_input_is_typed():
     t, x = _signal(50)
     bw = BoucWen(alpha=1e4, beta=1e3, gamma=0.5, delta=0.5, nu=1.0)
-    assert not fit_module._has_sensitivities(bw)
-    assert fit_module._has_sensitivities(LuGre(1e5, 30.0, 2.0, 4.0, 5.0, 2e-3))
+    assert not fit_module.has_sensitivities(bw)
+    assert fit_module.has_sensitivities(LuGre(1e5, 30.0, 2.0, 4.0, 5.0, 2e-3))
     lg = LuGre(1e5, 30.0, 2.0, 4.0, 5.0, 2e-3)
     with pytest.raises(ContactLabError):
         _core.joint_force_sens(bw.spec(), t, x, 0.0)
@@ -90,7 +90,7 @@ def test_fit_with_sensitivities_equals_the_finite_difference_fit(law, monkeypatc
     true = {"dahl": Dahl(3e4, 10.0, 1.0), "lugre": LuGre(2e5, 30.0, 5.0, 10.0, 12.0, 2e-3)}[law]
     F = true.force(t, x) + np.random.default_rng(3).normal(0, 0.05, t.size)
     a = fit(t, x, F, law=law, offset=True, asymmetry=True)
-    monkeypatch.setattr(fit_module, "_has_sensitivities", lambda _law: False)
+    monkeypatch.setattr(fit_module, "has_sensitivities", lambda _law: False)
     b = fit(t, x, F, law=law, offset=True, asymmetry=True)
     assert a.success and b.success
     assert a.result.chisqr <= b.result.chisqr * (1 + 1e-6)
@@ -99,3 +99,23 @@ def test_fit_with_sensitivities_equals_the_finite_difference_fit(law, monkeypatc
         if p.vary and q.stderr:
             assert abs(p.value - q.value) <= 0.05 * q.stderr, n
             assert p.stderr == pytest.approx(q.stderr, rel=1e-3), n
+
+
+def test_lugre_on_a_one_speed_quantised_record_converges_with_stribeck_held():
+    """A stage that strokes at one speed in 100 nm steps, holding still every other sample
+    (the micro-tribometer's record): Fs and vs cannot be separated from Fc, σ1 runs to 0;
+    the fit holds them (with notes) and converges."""
+    n = 6000
+    t = np.arange(n) * 5e-3
+    steps = np.tile(np.r_[np.ones(600), -np.ones(600)], n // 1200 + 1)[:n] * (np.arange(n) % 2)
+    x = 1e-7 * np.cumsum(steps)
+    true = LuGre(sigma0=4e4, sigma1=0.0, sigma2=20.0, Fc=2.5, Fs=3.0, vs=1e-6)
+    F = true.force(t, x) + np.random.default_rng(5).normal(0, 0.02, n)
+    res = fit(t, x, F, law="lugre", offset=True)
+    assert res.success, res.result.message
+    assert not res.params["Fs"].vary and not res.params["vs"].vary
+    assert any("one speed" in n for n in res.notes)
+    assert res.params["Fc"].stderr is not None
+    for name, v in (("Fc", 2.5), ("sigma0", 4e4)):
+        p = res.params[name]
+        assert abs(p.value - v) < 5 * p.stderr, name

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import InputError
-from ._common import (
+from .common import (
     FORCE_SIGN_CHOICES,
     add_frame_flags,
     add_pressure_flags,
@@ -36,12 +36,12 @@ from ._common import (
     quantity,
     recording_json,
     refuse_if_none_analysed,
+    window_threads,
     wrap_warning,
     wrapped,
     write_json,
     write_report,
 )
-from ._common import window_threads as _window_threads
 
 _SUMMARY = {
     "tangential": [
@@ -245,7 +245,7 @@ def _auto_streamed(
         resample=getattr(args, "resample", False),
         options=opts,
         keep_documents=True,
-        threads=_window_threads(),
+        threads=window_threads(),
     )
     if not res.window_docs:
         errors = "; ".join(str(r.get("error")) for r in res.rows if r.get("error"))

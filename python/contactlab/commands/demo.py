@@ -134,7 +134,7 @@ def run_demo(
     from ..report import commit_outputs
     from ..report.study_report import build_report
     from ..studies import run_study
-    from ._common import process_pool
+    from .common import process_pool
 
     files = masing_outputs()
     intro = (f"Made by: {command}. " if command else "") + (
@@ -156,7 +156,7 @@ def run_demo(
 
 def _handler(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
-    from ._common import made_by, resolve_workers
+    from .common import made_by, resolve_workers
 
     workers = resolve_workers(args.workers)
     paths = run_demo(
@@ -177,7 +177,7 @@ def _handler(args: argparse.Namespace) -> int:
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    from ._common import add_progress_flags
+    from .common import add_progress_flags
 
     p = sub.add_parser(
         "demo",

@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 
 from ..errors import InputError
-from ._common import command_line, describe
+from .common import command_line, describe
 from .simulate import finite_quantity
 
 #: exit code when a requested value is not identifiable (bad input in general exits 1)

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import InputError
-from ._common import (
+from .common import (
     FORCE_SIGN_CHOICES,
     add_reader_flags,
     check_output_targets,
@@ -57,15 +57,25 @@ def _read(
     files: list[str], columns: dict | None, fs: float | None, role: str, resample: bool = False
 ) -> list[Any]:
     from ..io import read_recording
-    from ..joints.records import as_record
+    from ..joints.records import as_record, npy_single_quantity, read_npy_pair
 
-    out = []
+    out, seen = [], set()
     for f in files:
         p = Path(f)
         if p.is_dir():
             raise InputError(f"--{role} {f}: is a folder, not a recording file")
         if not p.is_file():
             raise InputError(f"--{role} {f}: no such file")
+        if columns is None and npy_single_quantity(p):
+            # one quantity per file (<stem>_x.npy, <stem>_F.npy): the pair is one recording
+            try:
+                rec = read_npy_pair(p, fs)
+            except InputError as exc:
+                raise InputError(f"--{role} {exc}") from None
+            if rec.name not in seen:
+                seen.add(rec.name)
+                out.append(rec)
+            continue
         rec = read_recording(p, columns=columns, kind="tangential", fs=fs, resample=resample)
         out.append(as_record(rec, name=p.name))
     return out
@@ -218,7 +228,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         nargs="+",
         required=True,
         metavar="FILE",
-        help="recordings (x, F; .csv .tdms .h5 .mat) the laws are fitted to, together",
+        help="recordings (x, F; .csv .tdms .h5 .mat .npy) the laws are fitted to, together; "
+        "a test stored as <stem>_x.npy and <stem>_F.npy with no time column is one "
+        "recording (either file names it; give --fs)",
     )
     p.add_argument(
         "--predict",

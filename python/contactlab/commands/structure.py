@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InputError
-from ._common import (
+from .common import (
     add_progress_flags,
     check_output_targets,
     describe,
@@ -81,7 +81,7 @@ def read_table(path: str) -> dict[str, np.ndarray]:
     return out
 
 
-def _pick(
+def pick_column(
     cols: dict[str, np.ndarray], want: str | None, guesses: tuple[str, ...], what: str, path: str
 ) -> str:
     if want:
@@ -121,7 +121,7 @@ def _identify(args: argparse.Namespace) -> int:
     check_output_targets(json_out=args.json, report=args.report, inputs=[args.file])
     cols = read_table(args.file)
     exc = args.excitation
-    ucol = _pick(
+    ucol = pick_column(
         cols,
         args.u,
         ("u", "f", "y_base", "base") if exc == "force" else ("y_base", "base", "y"),
@@ -131,13 +131,13 @@ def _identify(args: argparse.Namespace) -> int:
     ynames = [c.strip() for c in args.y.split(",")] if args.y and "," in args.y else None
     if ynames:
         # several response channels: one displacement per DOF (a multi-DOF structure)
-        ycols = [_pick(cols, c, (), "y", args.file) for c in ynames]
+        ycols = [pick_column(cols, c, (), "y", args.file) for c in ynames]
         if ucol in ycols or len(set(ycols)) < len(ycols):
             raise InputError(f"{args.file}: --y names the input or a column twice")
         y = np.stack([cols[c] for c in ycols], axis=1)
         ycol: str | list[str] = ycols
     else:
-        ycol = _pick(
+        ycol = pick_column(
             cols,
             args.y,
             ("y_disp", "y", "x") if exc == "force" else ("x", "y_disp"),
@@ -344,7 +344,7 @@ def simulate_structure(args: argparse.Namespace) -> int:
         model = None  # perhaps a Structure.save file (read below)
     cols = read_table(args.input)
     exc = model.excitation if model else ("base" if args.base else "force")
-    ucol = _pick(
+    ucol = pick_column(
         cols, args.u, ("u", "f") if exc == "force" else ("y_base", "base", "y"), "u", args.input
     )
     u = cols[ucol]
@@ -392,10 +392,10 @@ def diagnose_structure_cli(args: argparse.Namespace) -> int:
     model = IdentifiedModel.load(args.structure)
     cols = read_table(args.file)
     exc = model.excitation
-    ucol = _pick(
+    ucol = pick_column(
         cols, args.u, ("u", "f") if exc == "force" else ("y_base", "base", "y"), "u", args.file
     )
-    ycol = _pick(
+    ycol = pick_column(
         cols, args.y, ("y_disp", "y", "x") if exc == "force" else ("x", "y_disp"), "y", args.file
     )
     if ucol == ycol:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ._common import (
+from .common import (
     add_progress_flags,
     add_workers_flag,
     check_output_targets,

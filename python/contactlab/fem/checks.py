@@ -38,7 +38,7 @@ from .writers import render
 _MM = unit_system("mm-N-s")
 
 
-def _interaction_lines(text: str) -> list[str]:
+def interaction_lines(text: str) -> list[str]:
     """The exported keyword lines that belong inside ``*SURFACE INTERACTION`` (no header)."""
     lines = [ln for ln in text.splitlines() if ln.strip() and not ln.startswith("**")]
     if lines and lines[0].upper().startswith("*SURFACE INTERACTION"):
@@ -107,7 +107,7 @@ def check_normal(
     if jc.table is None:
         raise InputError("check_normal needs a normal-contact result")
     text = render(jc, "calculix", _MM)
-    inter = _interaction_lines(text)
+    inter = interaction_lines(text)
     inter = [ln for ln in inter if not ln.upper().startswith("*CONTACT DAMPING")]
     inter = inter[: 1 + len(jc.table)]  # static check: the table alone (damping needs velocity)
     tab = np.array([[float(v) for v in ln.split(",")] for ln in inter[1:]])
@@ -197,7 +197,7 @@ class TangentialCheck:
         }
 
 
-def _loop_energy(x: np.ndarray, f: np.ndarray) -> float:
+def loop_energy(x: np.ndarray, f: np.ndarray) -> float:
     """Area of the closed polygon (x, f) (shoelace), the energy of one cycle."""
     return 0.5 * abs(float(np.dot(x, np.roll(f, -1)) - np.dot(f, np.roll(x, -1))))
 
@@ -218,7 +218,7 @@ def check_tangential(
     """
     jc = joint_characteristics(result, area=area, normal_load=normal_load)
     text = render(jc, "calculix", _MM)
-    friction = _interaction_lines(text)
+    friction = interaction_lines(text)
     mu, lam = (float(v) for v in friction[-1].split(","))  # as written: μ, λ in N/mm³
     side = math.sqrt(area) * 1e3  # mm
     b = Block(size=side, height=side / 2, n=2, m=1, nu=0.0)
@@ -248,7 +248,7 @@ def check_tangential(
         if x.size < 20:
             raise InputError(f"CalculiX printed only {x.size} points of the cycle at A = {a} mm")
         loops.append((x * 1e-3, f))
-        e_fe.append(_loop_energy(x, f) * 1e-3)  # N·mm → J
+        e_fe.append(loop_energy(x, f) * 1e-3)  # N·mm → J
         e_j.append(4 * fs * (a - fs / k) * 1e-3)
         e_m.append(float(model.loop_energy(a * 1e-3)))
     if not np.allclose(t_u, t_rf):

@@ -369,9 +369,19 @@ def identify_mdof(
         _check_kv_joint(pattern, b, i_j, j_j)
 
     def ee(kj: float, coulomb: bool) -> dict[str, Any]:
-        return equation_error_mdof(t, u, y, pattern, excitation, input_dof or 0, jdofs, mass_m,
-                                   periodic=bool(periodic), joint_stiffness=kj,
-                                   coulomb=coulomb)  # fmt: skip
+        return equation_error_mdof(
+            t,
+            u,
+            y,
+            pattern,
+            excitation,
+            input_dof or 0,
+            jdofs,
+            mass_m,
+            periodic=bool(periodic),
+            joint_stiffness=kj,
+            coulomb=coulomb,
+        )
 
     xd, _ = column_derivatives(t, y, bool(periodic))
     d_rms = max(float(np.std(y @ b)), 1e-300)
@@ -379,31 +389,9 @@ def identify_mdof(
     # from the measured start when the state is estimated, else the record starts from rest
     x0s, v0s = (y[0], xd[0]) if estimate_initial_state else (np.zeros(n), np.zeros(n))
 
-    def residual_on(nn: int, sub: int, u_in: np.ndarray | None = None) -> Any:
-        tt, uu, yy = t[:nn], (u[:nn] if u_in is None else u_in), y[:nn]
-        interp = interpolation if nn == nt else "linear"
-        fail = 10 * float(np.max(np.abs(yy))) + 1.0
-        if excitation == "force":
-            f = np.zeros((nn, n))
-            f[:, input_dof] = uu
-            kw: dict[str, Any] = {"force": f}
-        else:
-            kw = {"base": uu}
-
-        def res(v: dict[str, float]) -> np.ndarray:
-            try:
-                s = build_mdof(pattern, joint, v, jdofs, mass_m)
-                r = s.simulate(tt, x0=[v[f"x0_{i}"] for i in range(n)],
-                               v0=[v[f"v0_{i}"] for i in range(n)], substeps=sub,
-                               interpolation=interp, **kw)  # fmt: skip
-            except ContactLabError:
-                return np.full(nn * n, 100 * fail)
-            x = np.asarray(r.x).reshape(-1, n)
-            if x.shape[0] < nn:
-                x = np.concatenate([x, np.full((nn - x.shape[0], n), fail)])
-            return (x - yy).reshape(-1)
-
-        return res
+    residual_on = _MdofResidual(
+        t, u, y, interpolation, excitation, input_dof, pattern, joint, jdofs, mass_m
+    )
 
     starts = _mdof_starts(joint)
     records: list[dict[str, Any]] = []
@@ -417,8 +405,9 @@ def identify_mdof(
         n_s = min(int(start_samples), nt)
         tried = [(st, params(st)) for st in starts]
         best_ps = best_start(tried, residual_on(n_s, 2), records) or best_ps
-    fit = least_squares_fit(residual_on(nt, substeps), best_ps, max_nfev=max_nfev, ftol=1e-7,
-                            xtol=1e-7, gtol=1e-10)  # fmt: skip
+    fit = least_squares_fit(
+        residual_on(nt, substeps), best_ps, max_nfev=max_nfev, ftol=1e-7, xtol=1e-7, gtol=1e-10
+    )
     # residuals correlated in time and across DOFs (input noise reaches every DOF)
     v = fit.values
     r_fit = residual_on(nt, substeps)(v)
@@ -441,6 +430,64 @@ def identify_mdof(
         "pattern": pattern,
         "noise": noise,
     }
+
+
+class _MdofResidual:
+    """The output-error residual of a multi-DOF model on the first ``nn`` samples: every
+    DOF's simulated minus measured displacement, flattened (a large constant where the
+    simulation fails or stops early); ``u_in`` replaces the input (the noise model)."""
+
+    def __init__(
+        self,
+        t: np.ndarray,
+        u: np.ndarray,
+        y: np.ndarray,
+        interpolation: str,
+        excitation: str,
+        input_dof: int | None,
+        pattern: Any,
+        joint: str,
+        jdofs: tuple[int, int | None],
+        mass_m: np.ndarray | None,
+    ) -> None:
+        self.t, self.u, self.y = t, u, y
+        self.interpolation, self.excitation, self.input_dof = interpolation, excitation, input_dof
+        self.pattern, self.joint, self.jdofs, self.mass_m = pattern, joint, jdofs, mass_m
+
+    def __call__(self, nn: int, sub: int, u_in: np.ndarray | None = None) -> Any:
+        t, u, y = self.t, self.u, self.y
+        nt, n = y.shape
+        interpolation, excitation, input_dof = self.interpolation, self.excitation, self.input_dof
+        pattern, joint, jdofs, mass_m = self.pattern, self.joint, self.jdofs, self.mass_m
+        tt, uu, yy = t[:nn], (u[:nn] if u_in is None else u_in), y[:nn]
+        interp = interpolation if nn == nt else "linear"
+        fail = 10 * float(np.max(np.abs(yy))) + 1.0
+        if excitation == "force":
+            f = np.zeros((nn, n))
+            f[:, input_dof] = uu
+            kw: dict[str, Any] = {"force": f}
+        else:
+            kw = {"base": uu}
+
+        def res(v: dict[str, float]) -> np.ndarray:
+            try:
+                s = build_mdof(pattern, joint, v, jdofs, mass_m)
+                r = s.simulate(
+                    tt,
+                    x0=[v[f"x0_{i}"] for i in range(n)],
+                    v0=[v[f"v0_{i}"] for i in range(n)],
+                    substeps=sub,
+                    interpolation=interp,
+                    **kw,
+                )
+            except ContactLabError:
+                return np.full(nn * n, 100 * fail)
+            x = np.asarray(r.x).reshape(-1, n)
+            if x.shape[0] < nn:
+                x = np.concatenate([x, np.full((nn - x.shape[0], n), fail)])
+            return (x - yy).reshape(-1)
+
+        return res
 
 
 def _checked_mdof_record(t: Any, u: Any, y: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

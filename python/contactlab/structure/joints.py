@@ -14,8 +14,10 @@ ground, which stays fixed under base excitation) and adds its force ``F(d)`` to 
 - ``kelvin_voigt``: ``F = k d + c ḋ``.
 - ``normal``: nonlinear contact stiffness ``F = k_s(d) d``, ``k_s(d) = a1 + a2 d + a3 d² + …``
   (Konowalski's eq. 6, the same polynomial law as :class:`contactlab.normal.NonlinearContact`).
-- ``law``: any rate-independent law of :mod:`contactlab.joints` (Segalman, Dahl, Maxwell-slip,
+- ``law``: any law of :mod:`contactlab.joints` (Segalman, Dahl, LuGre, Maxwell-slip, GMS,
   a backlash, laws in series or parallel, …), ``add_joint("law", dof, law=Segalman(...))``;
+  a rate-dependent law sees the velocity at the end of each integrator step as its velocity
+  over the step;
   stored as the flat float encoding :func:`encode_law` of its spec (array ``spec``).
 """
 
@@ -356,9 +358,4 @@ def _law_array(kw: dict[str, Any]) -> np.ndarray:
         law = decode_law(_array("spec", kw.pop("spec")))
     else:
         raise InputError("joint 'law' needs law=<a contactlab.joints law>")
-    if law.rate_dependent:
-        raise InputError(
-            f"joint 'law': {law.name} is rate-dependent; structure joints take rate-independent "
-            "laws (Kelvin-Voigt for viscous terms)"
-        )
     return encode_law(law)

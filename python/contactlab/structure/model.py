@@ -84,6 +84,12 @@ class SimulationResult:
     n_iter: int = 0
     extra: dict[str, Any] = field(default_factory=dict)
 
+    @property
+    def response(self) -> np.ndarray:
+        """``x``: the main output, as :class:`contactlab.simulation.SimulatedResponse` names
+        it."""
+        return self.x
+
     def kinetic_energy(self, M: np.ndarray) -> np.ndarray:
         v = self.v.reshape(len(self.t), -1)
         return 0.5 * np.einsum("ti,ij,tj->t", v, M, v)

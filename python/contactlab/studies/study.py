@@ -70,7 +70,7 @@ def coefficient_unit(unit: str, i: int) -> str:
     return m.group(1) if n == 0 else f"{m.group(1)}/{var}" if n == 1 else f"{m.group(1)}/{var}^{n}"
 
 
-def _flatten(d: Mapping[str, Any], units: Mapping[str, str]) -> tuple[dict, dict]:
+def flatten(d: Mapping[str, Any], units: Mapping[str, str]) -> tuple[dict, dict]:
     """Scalars as they are, short vectors as ``key_0, key_1, ...``; nested dicts dotted."""
     row: dict[str, Any] = {}
     out_units: dict[str, str] = {}
@@ -79,7 +79,7 @@ def _flatten(d: Mapping[str, Any], units: Mapping[str, str]) -> tuple[dict, dict
             continue
         unit = units.get(key, "")
         if isinstance(value, Mapping):
-            sub, sub_units = _flatten(value, value.get("units", {}) or {})
+            sub, sub_units = flatten(value, value.get("units", {}) or {})
             for k, v in sub.items():
                 row[f"{key}.{k}"] = v
                 if sub_units.get(k):
@@ -196,7 +196,7 @@ def analyze_entry(
         opts = {"warn": False, **dict(tangential_options or {})}  # warnings go in the table
         analysis = analyze_tangential(rec, **opts)
         d = tangential_row(analysis.to_dict())
-        row, u = _flatten(d, d.get("units", {}) or {})
+        row, u = flatten(d, d.get("units", {}) or {})
         extra: dict[str, Any] = {}
         if "N" in rec.data:  # a recorded normal force: μ = F/N on the sliding plateau
             from ..tangential.friction import sliding_friction
@@ -215,7 +215,7 @@ def analyze_entry(
         from .normal import analyze_normal_recording
 
         analysis, d, extra = analyze_normal_recording(rec, entry, **dict(normal_options or {}))
-        row, u = _flatten(d, d.get("units", {}) or {})
+        row, u = flatten(d, d.get("units", {}) or {})
     units.update(u)
     base.update(row)
     resampled = (rec.meta or {}).get("resampled")

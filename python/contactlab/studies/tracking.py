@@ -15,7 +15,7 @@ keeps only the results:
 - normal windows: :func:`contactlab.normal.analyze_loop` — E_d (with its standard error from
   the cycle-to-cycle scatter), ψ (eq. 7), ψ_KV (eq. 3), k_tan (eq. 4), k_sec (eq. 5) and the
   loading, unloading and centre polynomials of eq. 1;
-- every cycle of the record (:mod:`._cycles`): loop energy ∮F dx, amplitude, offset.
+- every cycle of the record (:mod:`.cycles`): loop energy ∮F dx, amplitude, offset.
 
 Memory holds one chunk and one window, whatever the length of the record.
 :meth:`TrackResult.combined` pools the windows (weights by window size, the error widened by
@@ -37,13 +37,12 @@ from typing import Any
 
 import numpy as np
 
-from .._json import dumps, jsonable
 from .._options import as_dict
 from .._physical import MAX_MAGNITUDE
 from ..errors import ContactLabError, ContactLabWarning, InputError
 from ..io import Recording, read_chunks
-from ._cycles import CycleState, block_cycles, trigger_levels
 from .columns import CYCLE_UNITS
+from .cycles import CycleState, block_cycles, trigger_levels
 from .study import coefficient_unit
 from .track_cuts import WindowCuts
 from .track_result import (  # noqa: F401  (the constants and TrackResult, re-exported)
@@ -60,6 +59,7 @@ from .track_result import (  # noqa: F401  (the constants and TrackResult, re-ex
     _as_float,
     _finite,
     parse_every,
+    track_json,
 )
 
 #: options of ``analyze_tangential`` the one-pass window analysis
@@ -522,6 +522,18 @@ def track(
     True
     """
     options = as_dict(options)  # a contactlab.tangential/normal.Options or a dict
+    settings: dict[str, Any] = {
+        "kind": kind,
+        "columns": columns,
+        "fs": fs,
+        "chunk_size": chunk_size,
+        "max_window": max_window,
+        "options": options,
+        "keep_going": keep_going,
+        "callback": callback,
+        "keep_documents": keep_documents,
+        "resample": resample,
+    }
     if executor is None and threads != 0:
         from concurrent.futures import ThreadPoolExecutor
 
@@ -538,17 +550,9 @@ def track(
             # on 2 threads, interleaved runs 4.43-5.15 s against 4.45-5.96 s, peak 245-263
             # against 240-255 MB); one thread is three times slower than the reader and
             # always has a window waiting. An executor given by the caller gets two per worker
-            return _track(
-                source, every, kind=kind, columns=columns, fs=fs, chunk_size=chunk_size,
-                max_window=max_window, options=options, keep_going=keep_going,
-                callback=callback, executor=pool, keep_documents=keep_documents,
-                slots=n_threads + (2 if n_threads >= 2 else 1), resample=resample,
-            )  # fmt: skip
-    return _track(
-        source, every, kind=kind, columns=columns, fs=fs, chunk_size=chunk_size,
-        max_window=max_window, options=options, keep_going=keep_going, callback=callback,
-        executor=executor, keep_documents=keep_documents, slots=None, resample=resample,
-    )  # fmt: skip
+            slots = n_threads + (2 if n_threads >= 2 else 1)
+            return _track(source, every, **settings, executor=pool, slots=slots)
+    return _track(source, every, **settings, executor=executor, slots=None)
 
 
 def _track(
@@ -773,14 +777,6 @@ def track_many(
     parse_every(every)  # a bad window length fails before anything is submitted
     task = functools.partial(track, every=every, **options)
     yield from ordered_map(task, list(sources), executor)
-
-
-def track_json(result: TrackResult, *, cycles: bool = True) -> str:
-    """The result as JSON text (NaN → null; each per-cycle array on one line)."""
-    doc = result.to_dict(cycles=False)
-    if cycles:  # the arrays as they are: jsonable converts numbers at numpy's speed
-        doc["cycles"] = dict(result.cycles)
-    return dumps(jsonable(doc), indent=1) + "\n"
 
 
 __all__ = [

@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -516,16 +516,9 @@ def analyze_tangential(
     >>> res.identifiable, abs(res.fit.params["h0"].value - 20) < 3 * res.fit.params["h0"].stderr
     (True, True)
     """
-    xa, Fa, ta, source = _inputs(recording, t, x, F)
-    _check_options(on, history, n_points)
-    check_channel("x", xa, "m", "displacement")
-    check_channel("F", Fa, "N", "force")
-    if invert_force is not None:
-        force_sign = -1 if invert_force else 1
-    dropped = 0
-    if delay is not None:
-        ta, xa, Fa, dropped = lag.shift_force(ta, xa, Fa, delay)
-    ori = orient(xa, Fa, ta, force_sign=force_sign)
+    xa, Fa, ta, source, ori, dropped = _prepared(
+        recording, t, x, F, on, history, n_points, invert_force, force_sign, delay
+    )
     res = _analyze(
         xa,
         Fa,
@@ -549,10 +542,42 @@ def analyze_tangential(
     )
     assert res is not None  # only a streamed window hands its case back
     lag.record(res, delay, dropped)
-    if warn:
-        for wtxt in res.warnings:
-            warnings.warn(wtxt, ContactLabWarning, stacklevel=3)
+    _issue(res.warnings, warn)
     return res
+
+
+def _prepared(
+    recording: Recording | None,
+    t: Any,
+    x: Any,
+    F: Any,
+    on: str,
+    history: str,
+    n_points: int | None,
+    invert_force: bool | None,
+    force_sign: int | str,
+    delay: float | None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, str, Orientation, int]:
+    """:func:`analyze_tangential`'s inputs checked, the known delay corrected and the force
+    oriented: ``(x, F, t, source, orientation, samples dropped by the delay)``."""
+    xa, Fa, ta, source = _inputs(recording, t, x, F)
+    _check_options(on, history, n_points)
+    check_channel("x", xa, "m", "displacement")
+    check_channel("F", Fa, "N", "force")
+    if invert_force is not None:
+        force_sign = -1 if invert_force else 1
+    dropped = 0
+    if delay is not None:
+        ta, xa, Fa, dropped = lag.shift_force(ta, xa, Fa, delay)
+    return xa, Fa, ta, source, orient(xa, Fa, ta, force_sign=force_sign), dropped
+
+
+def _issue(texts: list[str], warn: bool) -> None:
+    """Each warning of the result as a :class:`ContactLabWarning` when ``warn``, attributed
+    to the caller of :func:`analyze_tangential` (through its options wrapper)."""
+    if warn:
+        for wtxt in texts:
+            warnings.warn(wtxt, ContactLabWarning, stacklevel=4)
 
 
 def _fast_regime(z_fit: float | None, ratio: float) -> Regime | None:
@@ -579,9 +604,15 @@ def _unsearched_sticks(rev: Any, n_samples: int) -> dict[str, Any]:
     n_turns = int(rev.peaks.size + rev.valleys.size)
     if n_turns < 2 or n_samples < 20:  # where the search would give none either
         return {}
-    unknown = ("reversals_with_stick", "stick_duration", "breakaway_force",
-               "breakaway_force_stderr", "velocity_threshold", "smooth_turn_dwell",
-               "reversals_with_dwell")  # fmt: skip
+    unknown = (
+        "reversals_with_stick",
+        "stick_duration",
+        "breakaway_force",
+        "breakaway_force_stderr",
+        "velocity_threshold",
+        "smooth_turn_dwell",
+        "reversals_with_dwell",
+    )
     return {"stick_slip": {"n_reversals": n_turns, **dict.fromkeys(unknown, math.nan)}}
 
 
@@ -630,10 +661,9 @@ def _analyze(
     if ori.sign < 0 and pre is None:  # (a detrended window is negated already: no copy)
         Fa = -Fa
     fit_x0 = True if fit_x0 is None else fit_x0
-    det = (
-        pre
-        if pre is not None
-        else steps.detrend(
+    det = pre
+    if det is None:
+        det = steps.detrend(
             xa,
             Fa,
             ta,
@@ -643,7 +673,108 @@ def _analyze(
             rel_threshold=rel_threshold,
             min_cycles=min_cycles,
         )
+    f = _fitted(
+        det,
+        ta,
+        on=on,
+        steady=steady,
+        rel_threshold=rel_threshold,
+        min_cycles=min_cycles,
+        fit_offset=fit_offset,
+        fit_x0=fit_x0,
+        fit_amplitude=fit_amplitude,
+        initial=initial,
     )
+    raw, amp, data = f.raw, f.amp, f.data
+    fit = reparametrize(raw)
+    identifiable, evidence = identifiability(fit, raw, amp.value, max_rel_stderr)
+    h0_lo = evidence.pop("h0_lower_bound")
+    ac_up = evidence.pop("ac_upper_bound")
+    derived = derived_quantities(raw, amp, det, data.start)
+    _refuse_no_loop(evidence, derived["energy_per_cycle_numeric"])
+    if not identifiable:
+        derived["h0_lower_bound"] = (h0_lo, math.nan)
+        derived["ac_upper_bound"] = (ac_up, math.nan)
+    ratio = loop_area_ratio(data, amp.value, derived["energy_per_cycle_numeric"][0])
+    z_fit = evidence["ac_times_amplitude"] if identifiable else None
+    if streamed:
+        regime = _fast_regime(z_fit, ratio)
+        if regime is None:
+            return None
+    else:
+        regime = classify(
+            z_fit=z_fit, ratio=ratio, loop=det.loop, x=det.x, F=det.F, t=ta, rev=data.rev, x_raw=xa
+        )
+    apply_regime(regime, amp, fit, identifiable, evidence, derived, max_rel_stderr)
+    warns = collect_warnings(
+        pre_warns, raw, data, amp.value, identifiable, evidence, regime, f.res.w
+    )
+    if steady and det.loop is not None:
+        warns += _transient_warning(det.loop, amp.value, amp.stderr)
+    if on == "averaged":  # the delay between the channels the loop shows (:mod:`.lag`)
+        warns += lag.annotate(
+            derived,
+            fit,
+            raw,
+            f.res,
+            data,
+            sliding=regime.sliding,
+            misfit=misfit_ratio(raw, data, f.res.w),
+            applied=delay,
+        )
+    regime_d = regime.to_dict()
+    if streamed:
+        regime_d.update(_unsearched_sticks(data.rev, xa.size))
+    return TangentialAnalysis(
+        fit=fit,
+        model=steps.model_of(raw.values),
+        amplitude=float(amp.value),
+        amplitude_stderr=amp.stderr,
+        loop=det.loop,
+        scatter=det.loop.scatter if det.loop is not None else None,
+        identifiable=identifiable,
+        identifiability=evidence,
+        derived=derived,
+        regime=regime_d,
+        warnings=warns,
+        on=on,
+        history=history,
+        x=np.asarray(data.xd),
+        F=np.asarray(data.Fd),
+        F_model=f.res.predict(raw.values),
+        weights=f.res.w,
+        t=data.td,
+        source=source,
+        meta=_meta(data, f.x_noise, ori, regime),
+    )
+
+
+class _Fitted(NamedTuple):
+    """What :func:`_fitted` gives: the fit data, the raw fit and its residuals, the
+    displacement noise and the amplitude estimate."""
+
+    data: steps.FitData
+    raw: FitResult
+    res: steps.Residuals
+    x_noise: float
+    amp: steps.Amplitude
+
+
+def _fitted(
+    det: steps.Detrended,
+    ta: np.ndarray | None,
+    *,
+    on: str,
+    steady: bool,
+    rel_threshold: float,
+    min_cycles: int,
+    fit_offset: bool,
+    fit_x0: bool,
+    fit_amplitude: bool,
+    initial: dict[str, float] | None,
+) -> _Fitted:
+    """The Masing fit of the detrended samples ``det`` with the covariance of what it takes
+    as exact (drifts, turning points, a fixed amplitude) and the amplitude estimate."""
     data = steps.fit_data(det, ta, on=on, steady=steady, rel_threshold=rel_threshold)
     sv = steps.start_values(
         data,
@@ -664,80 +795,27 @@ def _analyze(
     amp = steps.amplitude_estimate(
         raw, data, sv.prior, fit_amplitude=fit_amplitude, g_amp=g_amp, c_theta_amp=c_theta_amp
     )
-    fit = reparametrize(raw)
-    identifiable, evidence = identifiability(fit, raw, amp.value, max_rel_stderr)
-    h0_lo = evidence.pop("h0_lower_bound")
-    ac_up = evidence.pop("ac_upper_bound")
-    derived = derived_quantities(raw, amp, det, data.start)
-    _refuse_no_loop(evidence, derived["energy_per_cycle_numeric"])
-    if not identifiable:
-        derived["h0_lower_bound"] = (h0_lo, math.nan)
-        derived["ac_upper_bound"] = (ac_up, math.nan)
-    ratio = loop_area_ratio(data, amp.value, derived["energy_per_cycle_numeric"][0])
-    z_fit = evidence["ac_times_amplitude"] if identifiable else None
-    if streamed:
-        fast = _fast_regime(z_fit, ratio)
-        if fast is None:
-            return None
-        regime = fast
-    else:
-        regime = classify(
-            z_fit=z_fit,
-            ratio=ratio,
-            loop=det.loop,
-            x=det.x,
-            F=det.F,
-            t=ta,
-            rev=data.rev,
-            x_raw=xa,
-        )
-    apply_regime(regime, amp, fit, identifiable, evidence, derived, max_rel_stderr)
-    warns = collect_warnings(pre_warns, raw, data, amp.value, identifiable, evidence, regime, res.w)
-    if steady and det.loop is not None:
-        warns += _transient_warning(det.loop, amp.value, amp.stderr)
-    if on == "averaged":  # the delay between the channels the loop shows (:mod:`.lag`)
-        warns += lag.annotate(derived, fit, raw, res, data, sliding=regime.sliding,
-                              misfit=misfit_ratio(raw, data, res.w), applied=delay)  # fmt: skip
-    vals = raw.values
-    regime_d = regime.to_dict()
-    if streamed:
-        regime_d.update(_unsearched_sticks(data.rev, xa.size))
-    return TangentialAnalysis(
-        fit=fit,
-        model=steps.model_of(vals),
-        amplitude=float(amp.value),
-        amplitude_stderr=amp.stderr,
-        loop=det.loop,
-        scatter=det.loop.scatter if det.loop is not None else None,
-        identifiable=identifiable,
-        identifiability=evidence,
-        derived=derived,
-        regime=regime_d,
-        warnings=warns,
-        on=on,
-        history=history,
-        x=np.asarray(data.xd),
-        F=np.asarray(data.Fd),
-        F_model=res.predict(vals),
-        weights=res.w,
-        t=data.td,
-        source=source,
-        meta={
-            "fit_start": data.start,
-            "invert_force": ori.sign < 0,
-            "x_noise": x_noise,
-            "force_sign": ori.sign,
-            "orientation_reason": ori.reason,
-            "orientation_by": ori.by,
-            "loop_area_recorded": (ori.loop_area, ori.loop_area_stderr),
-            # the plateau levels' mid-point and branch length, for the loop plot's levels
-            **(
-                {"plateau_offset": regime.plateau.offset, "plateau_dx95": regime.plateau.dx95}
-                if regime.plateau is not None
-                else {}
-            ),
-        },
-    )
+    return _Fitted(data, raw, res, x_noise, amp)
+
+
+def _meta(data: steps.FitData, x_noise: float, ori: Orientation, regime: Regime) -> dict[str, Any]:
+    """The result's ``meta``: where the fit starts, the displacement noise, the orientation
+    and, in a sliding regime, the plateau levels' mid-point and branch length (the loop
+    plot's levels)."""
+    return {
+        "fit_start": data.start,
+        "invert_force": ori.sign < 0,
+        "x_noise": x_noise,
+        "force_sign": ori.sign,
+        "orientation_reason": ori.reason,
+        "orientation_by": ori.by,
+        "loop_area_recorded": (ori.loop_area, ori.loop_area_stderr),
+        **(
+            {"plateau_offset": regime.plateau.offset, "plateau_dx95": regime.plateau.dx95}
+            if regime.plateau is not None
+            else {}
+        ),
+    }
 
 
 # analyze_window moved to contactlab.tangential.window (issue 32): the old name forwards

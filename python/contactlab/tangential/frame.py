@@ -209,7 +209,7 @@ def lepski_window(
 
     Candidate windows grow geometrically from 7 samples to a fifth of the record (at most
     401); with no measurable noise the smallest is used. The comparisons run over the record
-    in blocks (:func:`_lepski_square_sums`): O(n) time, memory independent of its length.
+    in blocks (:func:`lepski_square_sums`): O(n) time, memory independent of its length.
     ``coefficients(window, deriv, dt)``: the filter weights (dot orientation) when not
     :func:`savgol_coefficients` (a numpy implementation spares importing scipy.signal).
     """
@@ -219,7 +219,7 @@ def lepski_window(
     cands = sorted({w | 1 for w in np.geomspace(7, top, 16).astype(int) if w >= 7})
     if sigma <= 0 or len(cands) < 2:
         return cands[0]
-    sq = _lepski_square_sums(np.asarray(x, dtype=float), cands, dt, coefficients=coefficients)
+    sq = lepski_square_sums(np.asarray(x, dtype=float), cands, dt, coefficients=coefficients)
     chosen = cands[0]
     for i, w in enumerate(cands[1:], start=1):
         ok = True
@@ -238,11 +238,11 @@ def lepski_window(
     return chosen
 
 
-#: samples per block of :func:`_lepski_square_sums`
+#: samples per block of :func:`lepski_square_sums`
 LEPSKI_BLOCK = 1 << 16
 
 
-def _lepski_square_sums(
+def lepski_square_sums(
     x: np.ndarray,
     cands: list[int],
     dt: float,

@@ -220,7 +220,7 @@ def plateau(
 @dataclass(frozen=True)
 class StickSlip:
     """Sticking segments found at the reversals: ``durations`` (s) and ``breakaway`` force
-    (the largest |F - offset| while stuck: the static friction the drive had to overcome,
+    (the largest ``|F - offset|`` while stuck: the static friction the drive had to overcome,
     N), over ``n_turns`` reversals; the velocity
     threshold used and how long a smooth turn stays below it."""
 
@@ -279,7 +279,7 @@ def _break_time(x: np.ndarray, a: int, b: int, end: int, window: int, sigma: flo
     since the break), fitted by least squares with the break on a grid of tenths of a sample
     between a window before the stick's end and the onset of sliding. Without a drop the
     acceleration grows from zero (``c2 = 0``); the jump is taken as shown only when freeing
-    ``c2`` lowers the squared error by more than :func:`_break_threshold` ``· σ²`` (``σ``: the
+    ``c2`` lowers the squared error by more than :func:`break_threshold` ``· σ²`` (``σ``: the
     displacement noise).
     """
     hi = min(end + window, x.size)
@@ -316,7 +316,7 @@ def _break_time(x: np.ndarray, a: int, b: int, end: int, window: int, sigma: flo
     # quantile at a 1 % false-alarm rate shared among the whole samples searched (Bonferroni;
     # a fixed 9 σ² read a drop into 1 in 5 sticks without one and put breakaway 8-10 % high)
     positions = max(int(min(end + 2, hi - 1) - lo), 1)
-    if True not in best or best[False][0] - best[True][0] <= _break_threshold(positions) * sigma**2:
+    if True not in best or best[False][0] - best[True][0] <= break_threshold(positions) * sigma**2:
         return None
     return best[True][1]
 
@@ -325,14 +325,14 @@ def _break_time(x: np.ndarray, a: int, b: int, end: int, window: int, sigma: flo
 _FINE_SEARCH = 200
 
 
-def _break_threshold(positions: int) -> float:
+def break_threshold(positions: int) -> float:
     """χ²(1) quantile for a 1 % false-alarm rate over ``positions`` break positions."""
     from scipy.special import chdtri  # chi2.isf(q, df) is chdtri(df, q); scipy.stats costs 0.5 s
 
     return float(chdtri(1, 0.01 / positions))
 
 
-def _smooth_peak(g: np.ndarray, window: int) -> float:
+def smooth_peak(g: np.ndarray, window: int) -> float:
     """Largest value of ``g`` read off a quadratic fitted over half a window either side of
     its largest sample: the largest of noisy samples overshoots the force by about twice its
     noise (static equal to kinetic friction: the plateau's noise after the stick), the
@@ -377,7 +377,7 @@ def _breakaway(
     smooth ramp (the drive's sinusoid), so a quadratic is fitted on the stuck samples clear
     of that half window and read at the instant the displacement starts to move with a jump
     of its acceleration (:func:`_break_time`; without a jump there is no drop to recover).
-    The larger of that and the maximum (:func:`_smooth_peak`: not the largest noisy sample)
+    The larger of that and the maximum (:func:`smooth_peak`: not the largest noisy sample)
     is the breakaway force.
     """
     a, b = span
@@ -388,7 +388,7 @@ def _breakaway(
     stop = n if reach is None else min(n, b + reach)
     while end < stop and abs(v[end]) < sliding:
         end += 1
-    peak = _smooth_peak(np.abs(f[a : min(end + 1, n)]), window)
+    peak = smooth_peak(np.abs(f[a : min(end + 1, n)]), window)
     if reach is not None and end >= stop:
         return peak  # no sliding within reach of the stick: no break to look for
     tb = _break_time(x, a, b, end, window, sigma)

@@ -266,7 +266,7 @@ def masing_force(
 
 
 def play_operator(x: np.ndarray, b: float, u0: float = 0.0) -> np.ndarray:
-    """Backlash (lost motion): u stands still until |x − u| = b, then follows at distance b.
+    """Backlash (lost motion): u stands still until ``|x − u| = b``, then follows at distance b.
 
     Parameters
     ----------

@@ -202,10 +202,11 @@ def rig_recording(
     frequencies : sequence of float
         Normal: frequencies of successive tone blocks relative to ``f``.
     x_noise : float
-        Displacement-sensor noise RMS as a fraction of the displacement amplitude (max |x| or
-        max |δ|), after the anti-alias filter.
+        Displacement-sensor noise RMS as a fraction of the displacement amplitude (``max |x|`` or
+        ``max |δ|``), after the anti-alias filter.
     F_noise : float
-        Force (pressure) channel noise RMS as a fraction of the force amplitude (max |F|, or pa).
+        Force (pressure) channel noise RMS as a fraction of the force amplitude (``max |F|``,
+        or pa).
     x_drift : float
         Drift of the displacement sensor over the record, fraction of the amplitude.
     ramp_cycles : float
