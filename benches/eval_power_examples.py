@@ -60,14 +60,16 @@ def table(label: str, rep: object, seconds: float) -> list[str]:
         f"{cn.input_unit}, output {cn.output:.3g} {cn.output_unit}; {seconds:.1f} s CPU"
     )
     lines.append("")
-    lines.append("| candidate | parameter | would be seen above | % of output RMS | note |")
+    lines.append(
+        "| candidate | size (distance from absent) | would be seen above | % of output RMS | note |"
+    )
     lines.append("|---|---|---|---|---|")
     for b in rep.not_detected:
         if b.detectable_above is None:
             lines.append(f"| {b.effect} | {b.parameter} | – | – | {b.reason[:90]} |")
             continue
         v, u = _display(b.detectable_above, b.unit)
-        dev = f"|{b.parameter} - {b.null:g}|" if b.null else f"|{b.parameter}|"
+        dev = f"{b.parameter} − {b.null:g}" if b.null else b.parameter
         lines.append(f"| {b.effect} | {dev} | {v:.3g} {u} | {100 * (b.relative_size or 0):.2g} | |")
     lines.append("")
     return lines

@@ -86,3 +86,19 @@ def test_spring_the_base_absorbs_is_not_claimed_at_its_linear_size(
     assert nonlinear["force_offset"].detectable_above == pytest.approx(
         linear["force_offset"].detectable_above, rel=1e-9
     )
+
+
+def test_samples_left_out_of_the_fits_do_not_set_the_bound() -> None:
+    """Where the weight is 0 the projected direction is unconstrained (a frame record's
+    projection was 60x the direction there): the bound ignores those samples (before, no
+    bound at all was stated on the measured frame record)."""
+    jp = _direction()
+    st = _setting(1.0)
+    b = _bound(jp, st, 2.0)
+    st.w = st.w.copy()
+    st.w[::10] = 0.0
+    wild = jp.copy()
+    wild[::10] = 1e4
+    b_kept = _bound(jp, st, 2.0)
+    assert b is not None and b_kept is not None
+    assert _bound(wild, st, 2.0) == pytest.approx(b_kept, rel=1e-12)

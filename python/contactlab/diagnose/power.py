@@ -387,7 +387,9 @@ def _fit_error(jp: np.ndarray, st: _Setting) -> tuple[float, float]:
 def _bound(jp: np.ndarray, st: _Setting, ident: float = 0.0) -> float | None:
     """Smallest ``a`` with detection probability at least :data:`POWER`, or None (``ident``:
     the standard errors a named size must lie from "absent", 0: no such rule)."""
-    size = float(np.sqrt(np.mean(jp * jp)))
+    # RMS over the weighted samples: where the weight is 0 (left out of the fits) the
+    # projection is unconstrained and may be anything (a frame record: 60x the direction)
+    size = float(np.sqrt(np.sum(st.w * jp * jp) / max(float(np.sum(st.w)), 1e-300)))
     if not size > 0:
         return None
     power = _power_curve(jp, st, ident)

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ConvergenceError
+from ..errors import ConvergenceError, InputError
 from ._family import Family, Prepared
 from ._parallel import pmap
 from .select import MIN_RELATIVE_GAIN, FitOut, Trial, Verdict, evaluate, fit, judge
@@ -119,7 +119,9 @@ def _try_candidate(
     if full is None:
         try:
             full = fit(family, trial_effects, d, all_samples, start_c, scales)
-        except ConvergenceError as exc:  # e.g. a trial stiffness with no equilibrium
+        # e.g. a trial stiffness with no equilibrium; a trial fit stepping out of the model's
+        # domain (ac to 0: "ac must be finite and > 0", a rig record with a channel delay)
+        except (ConvergenceError, InputError) as exc:
             return _not_fitted(name, exc), None
     in_gain = (current.full.mse - full.mse) / sigma**2
     if in_gain < min_gain:
@@ -127,7 +129,7 @@ def _try_candidate(
         return Verdict(name, np.nan, float(in_gain), np.nan, np.nan, False, reason), None
     try:
         cand = evaluate(family, trial_effects, d, start_c, scales, folds, full)
-    except ConvergenceError as exc:
+    except (ConvergenceError, InputError) as exc:
         return _not_fitted(name, exc), None
     p = cand.full.params
     # errors in variables: every candidate must beat what the input's noise alone does to
