@@ -429,6 +429,7 @@ def run_case(case):
                 )
             else:
                 eff = rig_normal_effect(effect, fac, rng)
+                x_drift = 0.0  # (the normal rig records have no drift; rec_args names it)
                 rec = rig_recording(
                     eff,
                     "normal",

@@ -6,9 +6,10 @@
 - :class:`NonlinearContact`: eq. 17, ``p = k_s δ + (ψ k_s / (2π ω)) δ'`` with ``k_s`` a
   polynomial of δ (eq. 6) or of the dynamic pressure p (eq. 16).
 
-Both are solved as ``δ' = (2π ω / ψ)(p / k_s − δ)`` by the Rust core (RODAS4, an L-stable
-Rosenbrock method with error control, stepping sample to sample over a cubic-Hermite or linear
-continuation of p between samples). ω is the angular frequency at which ψ holds; for a
+Both are solved as ``δ' = (2π ω / ψ)(p / k_s − δ)`` by the Rust core, stepping sample to
+sample over a cubic-Hermite or linear continuation of p between samples: Taylor series of
+adaptive order in each interval (error-controlled), RODAS4 (an L-stable Rosenbrock method)
+where an interval is stiff. ω is the angular frequency at which ψ holds; for a
 pressure that is not a single sine it must still be given.
 
 :meth:`~_ContactModel.simulate_grid` is the fast route for a well-sampled record: a
@@ -117,6 +118,7 @@ class _ContactModel:
         interp: str = "cubic",
         first_step: float | None = None,
         max_steps: int | None = None,
+        method: str = "auto",
     ) -> OdeResult:
         """Displacement response δ(t) to the sampled pressure ``p(t)``.
 
@@ -143,6 +145,12 @@ class _ContactModel:
             ``AUTO_STEPS_PER_SAMPLE`` per sample plus ``AUTO_STEPS_BASE``, so that a stiff
             or absurd model ends with ``success=False`` and a message instead of running
             for minutes: an ordinary record takes a few steps per sample).
+        method : {"auto", "rodas4"}
+            ``"auto"``: each sample interval by Taylor-series steps of adaptive order (the
+            interval's forcing is one cubic, so the series is exact up to its truncation,
+            which is kept below the tolerance), RODAS4 where the interval is stiff
+            (``2π ω Δt / ψ`` above 256) or the series does not converge; ``"rodas4"``:
+            RODAS4 throughout.
 
         Returns
         -------
@@ -185,6 +193,8 @@ class _ContactModel:
             max_steps = AUTO_STEPS_PER_SAMPLE * tv.size + AUTO_STEPS_BASE
         if max_steps < 0:
             raise InputError(f"max_steps must be >= 0, got {max_steps}")
+        if method not in ("auto", "rodas4"):
+            raise InputError(f"method must be 'auto' or 'rodas4', got {method!r}")
         r = _core.normal_simulate(
             tv,
             np.ascontiguousarray(pd),
@@ -199,6 +209,7 @@ class _ContactModel:
             dv,
             first_step,
             int(max_steps),
+            method,
         )
         n_out = int(r["n_out"])
         res = OdeResult(

@@ -146,11 +146,10 @@ pub fn one_minus_exp_neg(z: f64) -> f64 {
             - z * (1.0 / 6.0
                 - z * (1.0 / 24.0 - z * (1.0 / 120.0 - z * (1.0 / 720.0 - z * (1.0 / 5040.0))))));
     let direct = z - z * w;
-    if z < Z_SMALL {
-        direct
-    } else {
-        reduced
-    }
+    // A bit mask, not `if`: LLVM turns a float select into a branch that keeps the AVX2
+    // build of the loops over this function from vectorising.
+    let small = 0_u64.wrapping_sub(u64::from(z < Z_SMALL));
+    f64::from_bits((direct.to_bits() & small) | (reduced.to_bits() & !small))
 }
 
 /// The paper's exponential virgin curve `f(u) = h0 (1 - exp(-ac u))`, odd-extended.

@@ -39,7 +39,7 @@ fn build_model(law: &str, coeffs: &[f64], psi: f64, omega: f64) -> Result<Contac
 
 /// Integrate the contact ODE over sampled `(t, p)`; returns a dict of arrays and counters.
 #[pyfunction]
-#[pyo3(signature = (t, p, law, coeffs, psi, omega, delta0, rtol, atol, interp="cubic", dpdt=None, first_step=None, max_steps=0))]
+#[pyo3(signature = (t, p, law, coeffs, psi, omega, delta0, rtol, atol, interp="cubic", dpdt=None, first_step=None, max_steps=0, method="auto"))]
 fn normal_simulate<'py>(
     py: Python<'py>,
     t: PyReadonlyArray1<'py, f64>,
@@ -55,6 +55,7 @@ fn normal_simulate<'py>(
     dpdt: Option<PyReadonlyArray1<'py, f64>>,
     first_step: Option<f64>,
     max_steps: u64,
+    method: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let ts = slice(&t, "t")?;
     let ps = slice(&p, "p")?;
@@ -69,6 +70,11 @@ fn normal_simulate<'py>(
         "linear" => Interp::Linear,
         _ => return Err(to_pyerr(py, &bad("interp", "must be 'cubic' or 'linear'"))),
     };
+    let method = match method {
+        "auto" => ode::Method::Auto,
+        "rodas4" => ode::Method::Rodas4,
+        _ => return Err(to_pyerr(py, &bad("method", "must be 'auto' or 'rodas4'"))),
+    };
     let opts = ode::Options {
         rtol,
         atol,
@@ -81,7 +87,9 @@ fn normal_simulate<'py>(
         let n = forcing.len();
         let mut delta = vec![0.0; n];
         let mut vel = vec![0.0; n];
-        let out = ode::simulate(&model, &forcing, delta0, &opts, &mut delta, &mut vel)?;
+        let out = ode::simulate_with(
+            &model, &forcing, delta0, &opts, method, &mut delta, &mut vel,
+        )?;
         Ok((delta, vel, out))
     })?;
     delta.truncate(out.n_out);

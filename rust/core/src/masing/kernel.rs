@@ -780,6 +780,17 @@ impl Pass {
         // Record of the last sample (a zero-length step repeats it).
         let mut ul = (xp - self.xa) * self.inv;
         let (mut li, mut lk, mut lm) = self.anchor(stk);
+        // The inputs of the top reversal and the one below it, kept in registers while the
+        // stack holds two or more (reloaded after the rare paths): the closure test of the
+        // common step then needs no load that waits for the previous step's depth.
+        let reload = |n: usize, stk: &[Reversal]| {
+            if n >= 2 {
+                (stk[n.wrapping_sub(1)].x, stk[n.wrapping_sub(2)].x)
+            } else {
+                (0.0, 0.0)
+            }
+        };
+        let (mut ta, mut tb) = reload(self.n, stk);
         let m = xc.len().min(BLOCK);
         let (u, idx, kh, mm) = (
             &mut d.u[..m],
@@ -809,6 +820,7 @@ impl Pass {
                 (n, xp, up) = (q.n, q.xp, q.dir > 0.0);
                 ul = (q.xp - q.xa) * q.inv;
                 (li, lk, lm) = q.anchor(stk);
+                (ta, tb) = reload(n, stk);
                 (u[p], idx[p], kh[p], mm[p]) = (ul, li, lk, lm);
                 continue;
             }
@@ -819,50 +831,70 @@ impl Pass {
                 h: h_before,
                 index: before.wrapping_add(p as u64),
             };
-            let n1 = n.wrapping_add(usize::from(rev)); // in 2..stk.len()
-            let t = stk[n1.wrapping_sub(2)].x;
+            // in 2..stk.len()
+            let n1 = n.wrapping_add(usize::from(rev));
+            // The target stk[n1 - 2].x: the top's input after a reversal, else the one below.
+            let t = pickf(rev, ta, tb);
             // (x - target) · s >= 0 with s the direction of the step
             let closes = (rising & (xi >= t)) | (!rising & (xi <= t));
-            if closes & (n1 < 4) {
-                // A closure down to the first reversal's branch or onto the virgin curve:
-                // the general rules.
-                let mut q = Pass {
-                    n,
-                    xp,
-                    dir: if up { 1.0 } else { -1.0 },
-                    ..*self
-                };
-                q.load_branch(stk);
-                changes = changes.wrapping_add(usize::from(q.rules(stk, xi, p)));
-                (n, xp, up) = (q.n, q.xp, q.dir > 0.0);
-                ul = (q.xp - q.xa) * q.inv;
-                (li, lk, lm) = q.anchor(stk);
+            if closes {
+                if n1 < 4 {
+                    // A closure down to the first reversal's branch or onto the virgin
+                    // curve: the general rules.
+                    let mut q = Pass {
+                        n,
+                        xp,
+                        dir: if up { 1.0 } else { -1.0 },
+                        ..*self
+                    };
+                    q.load_branch(stk);
+                    changes = changes.wrapping_add(usize::from(q.rules(stk, xi, p)));
+                    (n, xp, up) = (q.n, q.xp, q.dir > 0.0);
+                    ul = (q.xp - q.xa) * q.inv;
+                    (li, lk, lm) = q.anchor(stk);
+                    (ta, tb) = reload(n, stk);
+                    (u[p], idx[p], kh[p], mm[p]) = (ul, li, lk, lm);
+                    continue;
+                }
+                n = n1.wrapping_sub(2); // >= 2
+                up = rising;
+                xp = xi;
+                changes = changes.wrapping_add(1); // <= BLOCK
+                let below = stk[n.wrapping_sub(2)].x;
+                if (rising & (xi >= below)) | (!rising & (xi <= below)) {
+                    // The step closes further loops (a large jump).
+                    let mut q = Pass {
+                        n,
+                        xp,
+                        dir: if up { 1.0 } else { -1.0 },
+                        ..*self
+                    };
+                    q.more_closures(stk, xi, q.dir);
+                    n = q.n;
+                    ul = (xp - q.xa) * q.inv;
+                    (li, lk, lm) = q.anchor(stk);
+                    (ta, tb) = reload(n, stk);
+                    (u[p], idx[p], kh[p], mm[p]) = (ul, li, lk, lm);
+                    continue;
+                }
+                let top = stk[n.wrapping_sub(1)];
+                (ta, tb) = (top.x, below);
+                ul = (xp - top.x) * inv_lam;
+                (li, lk, lm) = (top.index, top.h, lam);
                 (u[p], idx[p], kh[p], mm[p]) = (ul, li, lk, lm);
                 continue;
             }
-            n = n1.wrapping_sub(usize::from(closes) << 1); // >= 2
+            // No closure: after a reversal the candidate (the previous sample) is the top.
+            n = n1;
+            changes = changes.wrapping_add(usize::from(rev)); // <= BLOCK
+            tb = pickf(rev, ta, tb);
+            ta = pickf(rev, xp, ta);
+            li = pick(rev, before.wrapping_add(p as u64), li);
+            lk = pickf(rev, h_before, lk);
+            lm = lam;
             up = rising;
             xp = xi;
-            changes = changes.wrapping_add(usize::from(rev | closes)); // <= BLOCK
-            let below = stk[n.wrapping_sub(2)].x;
-            if closes & ((rising & (xi >= below)) | (!rising & (xi <= below))) {
-                // The step closes further loops (a large jump).
-                let mut q = Pass {
-                    n,
-                    xp,
-                    dir: if up { 1.0 } else { -1.0 },
-                    ..*self
-                };
-                q.more_closures(stk, xi, q.dir);
-                n = q.n;
-                ul = (xp - q.xa) * q.inv;
-                (li, lk, lm) = q.anchor(stk);
-                (u[p], idx[p], kh[p], mm[p]) = (ul, li, lk, lm);
-                continue;
-            }
-            let top = stk[n.wrapping_sub(1)];
-            ul = (xp - top.x) * inv_lam;
-            (li, lk, lm) = (top.index, top.h, lam);
+            ul = (xp - ta) * inv_lam;
             (u[p], idx[p], kh[p], mm[p]) = (ul, li, lk, lm);
         }
         (self.n, self.xp, self.dir) = (n, xp, if up { 1.0 } else { -1.0 });

@@ -7,7 +7,8 @@
 //! - [`forcing`]: the sampled pressure continued between samples (linear or cubic Hermite).
 //! - [`grid`]: the fixed-grid exponential integrator on the record's own samples (the
 //!   diagnosis' fits; [`ode`] is its accurate reference).
-//! - [`ode`]: RODAS4 with error control, stepping sample to sample, for recordings of any length.
+//! - [`ode`]: the error-controlled solve, stepping sample to sample, for recordings of any
+//!   length: Taylor series per interval ([`taylor`]), RODAS4 where the interval is stiff.
 //! - [`cycles`]: folding a recording into whole cycles on a common phase grid.
 
 pub mod cycles;
@@ -17,8 +18,9 @@ pub mod kelvin_voigt;
 pub mod model;
 pub mod ode;
 pub mod poly;
+pub mod taylor;
 
 pub use forcing::{Forcing, Interp};
 pub use kelvin_voigt::KelvinVoigt;
 pub use model::{ContactModel, Stiffness};
-pub use ode::{simulate, Options, Outcome, Stats, Status};
+pub use ode::{simulate, simulate_with, Method, Options, Outcome, Stats, Status};

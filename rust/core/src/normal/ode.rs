@@ -15,6 +15,7 @@
 
 use super::forcing::Forcing;
 use super::model::ContactModel;
+use super::taylor::Taylor;
 use crate::error::{check_positive, CoreError};
 
 /// RODAS4 coefficients in the `(A, C, γ_i, α_i)` form used by KPP / Hairer's `RODAS`
@@ -274,6 +275,81 @@ pub fn simulate(
     delta: &mut [f64],
     velocity: &mut [f64],
 ) -> Result<Outcome, CoreError> {
+    simulate_with(model, forcing, delta0, opts, Method::Auto, delta, velocity)
+}
+
+/// Which step the solve takes inside a sample interval.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Method {
+    /// Taylor series (see [`super::taylor`]) where the interval's rate `r·Δt` allows a few
+    /// sub-steps at most ([`TAYLOR_MAX_SUBSTEPS`] of `r·h ≤` [`TAYLOR_RATE`]); RODAS4 for a
+    /// stiffer interval, or where the series does not converge (e.g. near `k_s = 0`).
+    #[default]
+    Auto,
+    /// RODAS4 throughout (the method before issue 33).
+    Rodas4,
+}
+
+/// Largest `r·h` of one Taylor sub-step when an interval is first split.
+pub const TAYLOR_RATE: f64 = 4.0;
+/// Most Taylor sub-steps per sample interval before the interval is left to RODAS4.
+pub const TAYLOR_MAX_SUBSTEPS: usize = 64;
+
+/// The forcing cubic `c` (in `s ∈ [0, 1]` of its interval) re-expanded on the sub-step
+/// `s = s0 + σ v`, `v ∈ [0, 1]`.
+#[inline]
+fn shift_cubic(c: &[f64; 4], s0: f64, sigma: f64) -> [f64; 4] {
+    let [c0, c1, c2, c3] = *c;
+    let s2 = sigma * sigma;
+    [
+        c0 + s0 * (c1 + s0 * (c2 + s0 * c3)),
+        sigma * (c1 + s0 * (2.0 * c2 + 3.0 * c3 * s0)),
+        s2 * (c2 + 3.0 * c3 * s0),
+        s2 * sigma * c3,
+    ]
+}
+
+/// One sample interval by `m` equal Taylor steps from `y`: `δ` at its end and the highest
+/// order used, or `None` if a step failed.
+#[inline]
+fn taylor_interval(
+    tay: &mut Taylor,
+    c: &[f64; 4],
+    rate_h: f64,
+    m: usize,
+    mut y: f64,
+    opts: &Options,
+    stats: &mut Stats,
+) -> Option<(f64, usize)> {
+    let sigma = 1.0 / m as f64;
+    let rs = rate_h * sigma;
+    let mut max_order = 0;
+    for j in 0..m {
+        let e = if m == 1 {
+            *c
+        } else {
+            shift_cubic(c, j as f64 * sigma, sigma)
+        };
+        let tol = opts.atol + opts.rtol * y.abs();
+        let (y1, order) = tay.step(&e, rs, y, tol)?;
+        stats.nfev = stats.nfev.saturating_add(order as u64);
+        max_order = max_order.max(order);
+        y = y1;
+    }
+    Some((y, max_order))
+}
+
+/// [`simulate`] with the interval method chosen (`Method::Rodas4`: the pre-issue-33 solver,
+/// kept as the independent reference of the tests).
+pub fn simulate_with(
+    model: &ContactModel,
+    forcing: &Forcing<'_>,
+    delta0: f64,
+    opts: &Options,
+    method: Method,
+    delta: &mut [f64],
+    velocity: &mut [f64],
+) -> Result<Outcome, CoreError> {
     opts.validate()?;
     let n = forcing.len();
     crate::error::check_same_len("t", n, "delta (output)", delta.len())?;
@@ -291,6 +367,12 @@ pub fn simulate(
     let mut h_prop = opts.first_step.unwrap_or(t[1] - t[0]);
     let mut attempts: u64 = 0;
     let mut last_rejected = false;
+    let mut taylor = match method {
+        Method::Auto => Taylor::new(model.stiffness()),
+        Method::Rodas4 => None,
+    };
+    // Taylor sub-steps per interval proposed for the next one.
+    let mut m_prop: usize = 1;
 
     // Interval i runs from t[i] to t_end = t[i + 1].
     for (i, &t_end) in t[1..].iter().enumerate() {
@@ -308,6 +390,41 @@ pub fn simulate(
         velocity[i] = e.f;
         let (mut f0, mut jac, mut dfdt) = (e.f, e.jac, e.dfdt);
         let mut first = true;
+        if let Some(tay) = taylor.as_mut() {
+            let rate_h = model.rate() * (t_end - tc);
+            let need = (rate_h / TAYLOR_RATE).ceil();
+            if need <= TAYLOR_MAX_SUBSTEPS as f64 {
+                let mut m = m_prop.max(need as usize).max(1);
+                while m <= TAYLOR_MAX_SUBSTEPS {
+                    attempts = attempts.saturating_add(m as u64);
+                    if opts.max_steps > 0 && attempts > opts.max_steps {
+                        return Ok(Outcome {
+                            status: Status::MaxSteps { time: tc },
+                            n_out: i.saturating_add(1),
+                            stats,
+                        });
+                    }
+                    if let Some((y1, order)) =
+                        taylor_interval(tay, &seg.c, rate_h, m, y, opts, &mut stats)
+                    {
+                        y = y1;
+                        tc = t_end;
+                        stats.n_accepted = stats.n_accepted.saturating_add(m as u64);
+                        // Keep the orders moderate: the work grows as the order squared.
+                        m_prop = if order > 18 {
+                            m.saturating_mul(2).min(TAYLOR_MAX_SUBSTEPS)
+                        } else if order < 10 {
+                            (m / 2).max(1)
+                        } else {
+                            m
+                        };
+                        break;
+                    }
+                    stats.n_rejected = stats.n_rejected.saturating_add(1);
+                    m = m.saturating_mul(2);
+                }
+            }
+        }
         while tc < t_end {
             if !first {
                 let (p, dp) = seg.value_deriv(tc);
@@ -489,6 +606,50 @@ mod tests {
             );
             assert!(out.stats.n_accepted >= (t.len() - 1) as u64);
         }
+    }
+
+    #[test]
+    fn taylor_matches_rodas4_on_noisy_input_and_a_far_start() {
+        // Table 2 centre curve (SI), 1 % noise on p, started 0.3 µm off equilibrium: the
+        // Taylor route (split where the start-up needs it) against RODAS4, both at rtol 1e-11.
+        let m = ContactModel::new(
+            Stiffness::Delta(vec![1.32596e12, 1.59811e18, 2.92127e24, 2.87416e30]),
+            0.0887,
+            1.0,
+        )
+        .unwrap();
+        let (t, mut p, _) = sine(256 * 3 + 1, 256, 1.0);
+        let mut state: u64 = 7;
+        for v in &mut p {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1);
+            let u = (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            *v = *v * 1e6 + 0.4e6 * 0.01 * 3.46 * u;
+        }
+        let fo = Forcing::new(&t, &p, None, Interp::Cubic).unwrap();
+        let scale = 0.4e6 / 1.32596e12;
+        let o = Options {
+            rtol: 1e-11,
+            atol: 1e-11 * scale,
+            ..Options::default()
+        };
+        let run = |method| {
+            let (mut y, mut v) = (vec![0.0; t.len()], vec![0.0; t.len()]);
+            let out = simulate_with(&m, &fo, 0.3e-6, &o, method, &mut y, &mut v).unwrap();
+            assert_eq!(out.status, Status::Success);
+            (y, v, out)
+        };
+        let (ya, va, oa) = run(Method::Auto);
+        let (yr, vr, _) = run(Method::Rodas4);
+        let dmax = yr.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+        let vmax = vr.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+        for i in 0..t.len() {
+            assert!((ya[i] - yr[i]).abs() < 1e-9 * dmax, "δ at {i}");
+            assert!((va[i] - vr[i]).abs() < 1e-8 * vmax, "δ' at {i}");
+        }
+        assert_eq!(oa.stats.njev, 0, "every interval by Taylor steps");
+        assert!(oa.stats.n_rejected > 0, "the far start was split");
     }
 
     #[test]
