@@ -20,6 +20,8 @@ Closed forms where they exist, numerical cycles elsewhere:
   ``E = 4 R A^(χ+3) / ((χ+2)(χ+3))`` in micro-slip), the first-harmonic stiffness from the
   Masing branch ``F(θ) = f(A) − 2 f(A (1 − cos θ) / 2)`` of the closed-form virgin curve
   ``f`` by Gauss-Legendre quadrature.
+- **Masing laws in parallel** with a spring (no viscous term): the virgin curves and the
+  energies add up.
 - **Others** (LuGre, Dahl, Maxwell-slip, Bouc-Wen, compositions): the law driven over
   ``cycles`` periods of ``A sin(ω t)`` from the relaxed state; the last period gives k_eq and
   E (trapezoid rule).
@@ -83,7 +85,27 @@ def _virgin(law: Any) -> Any:
     if name == "masing" and getattr(law, "scale", 2.0) == 2.0:
         model = law.masing()
         return lambda u: np.asarray(model.virgin(np.asarray(u, dtype=float)), dtype=float)
+    if name == "parallel" and law.c == 0.0:
+        # Masing laws in parallel with a spring: the virgin curves add up (and so do the
+        # loops, each child following Masing's rules on its own virgin curve)
+        fs = [_virgin(child) for child in law.laws]
+        if any(f is None for f in fs):
+            return None
+        k = law.k
+        return lambda u: k * np.asarray(u, dtype=float) + sum(f(u) for f in fs)
     return None
+
+
+def _closed_energy(law: Any, A: np.ndarray) -> np.ndarray:
+    """Energy per cycle of a law :func:`_virgin` knows (closed forms)."""
+    name = getattr(law, "name", "")
+    if name == "jenkins":
+        return _jenkins(law, A)[1]
+    if name == "parallel":
+        return sum((_closed_energy(child, A) for child in law.laws), np.zeros(A.size))
+    if hasattr(law, "loop_energy"):
+        return np.asarray(law.loop_energy(A), dtype=float)
+    return np.asarray(law.masing().loop_energy(A), dtype=float)
 
 
 def closed_form_available(law: Any) -> bool:
@@ -208,8 +230,7 @@ def equivalent_properties(
         method = "closed form"
     elif (f := _virgin(law)) is not None:
         keq = _masing_first_harmonic(f, A)
-        E = (np.asarray(law.loop_energy(A), dtype=float) if hasattr(law, "loop_energy")
-             else np.asarray(law.masing().loop_energy(A), dtype=float))  # fmt: skip
+        E = _closed_energy(law, A)
         ksec = np.abs(np.asarray(f(A), dtype=float)) / A
         method = "closed form"
     else:
