@@ -563,3 +563,48 @@ def _default_fixed(law: Any, fixed: Sequence[str] | None, stiffness_given: bool
     if law.name == "iwan" and stiffness_given:
         return set(), None
     return set(held), why
+
+
+def macroslip_start(amplitude: Any, damping: Any, frequency: Any, c0: float | None = None,
+                    phi_max: float | None = None) -> tuple[Any, float]:  # fmt: skip
+    """Start values of a Segalman law with a Dirac share (``β > 0``) and of the viscous floor
+    ``c0`` from a table of equivalent damping [N s/m] against amplitude [m].
+
+    Below ``φmax`` a Segalman joint dissipates ``4 R A^(χ+3) / ((χ+2)(χ+3))``, so
+    ``c − c0`` grows at most as ``A`` (``χ <= 0``); the onset of macro-slip at ``φmax``
+    steepens it. ``φmax`` is started at the amplitude where the log-log slope of ``c − c0``
+    steepens most, ``χ`` at −0.05, ``R`` from the damping below ``φmax``, ``β = 1``.
+
+    ``phi_max`` [m] replaces that guess (a multi-start over the measured amplitudes).
+
+    Returns
+    -------
+    (Segalman, float)
+        The law and ``c0`` (default ``0.7 min(c)``).
+    """
+    from .laws import LAWS
+
+    A, _ = _amplitudes(amplitude)
+    c = as_1d(damping, "damping")
+    f = np.broadcast_to(np.asarray(frequency, dtype=float), A.shape)
+    if c.size != A.size or A.size < 4:
+        raise InputError("macroslip_start: give 4 or more amplitudes with one damping each")
+    o = np.argsort(A)
+    A, c, f = A[o], c[o], f[o]
+    c0 = 0.7 * float(np.min(c)) if c0 is None else float(c0)
+    cj = np.clip(c - c0, 1e-3 * c, None)
+    slope = np.diff(np.log(cj)) / np.diff(np.log(A))
+    # the point after which the slope grows most (the interior points only)
+    jump = np.diff(slope)
+    i = int(np.argmax(jump)) + 1 if jump.size else A.size // 2
+    pm = float(A[min(max(i, 1), A.size - 2)]) if phi_max is None else float(phi_max)
+    if not pm >= A[0]:
+        raise InputError(f"phi_max = {pm} m is below the smallest amplitude {A[0]} m")
+    chi = -0.05
+    E = cj * math.pi * 2.0 * math.pi * f * A**2
+    below = A <= pm
+    R = float(np.median(E[below] * (chi + 2) * (chi + 3) / (4.0 * A[below] ** (chi + 3))))
+    KR = R * pm ** (chi + 1) / (chi + 1)  # stiffness of the power-law part
+    S = KR  # β = S / KR = 1
+    FS = R * pm ** (chi + 2) / (chi + 2) + S * pm
+    return LAWS["segalman"](F_S=FS, K_T=KR + S, chi=chi, beta=S / KR), c0

@@ -112,7 +112,7 @@ class SteppedSineFit:
         amplitudes ``amplitude``, with their standard errors (first-order propagation of the
         fit's covariance; NaN where it is not determined) and ``failures``."""
         A, _ = _amplitudes(amplitude)
-        names = list(self.law.param_names)
+        names = [_law_key(n) for n in self.law.param_names]
 
         def props(v: Mapping[str, float]) -> np.ndarray:
             lw = self.law.with_params([v[n] for n in names])
@@ -215,7 +215,7 @@ def fit_stepped_sine(sweeps: Sequence[Sweep], *, law: Any = "segalman",
     w = 2.0 * math.pi * f
     start = _resonance_start(sw, law)
     fixed_set, why = _default_fixed(start, fixed, False)
-    names = list(start.param_names)
+    names = [_law_key(n) for n in start.param_names]
     # a law without closed forms is simulated on a log-spaced amplitude grid, interpolated
     grid = np.geomspace(float(A.min()) * 0.98, float(A.max()) * 1.02, 48)
     fmid = float(np.median(f))
@@ -255,11 +255,11 @@ def fit_stepped_sine(sweeps: Sequence[Sweep], *, law: Any = "segalman",
         beta = np.linalg.lstsq(Lr, -b, rcond=None)[0]
         return b + Lr @ beta
 
-    params = _law_params(start, fixed_set, bounds)
+    params = _keyed(_law_params(start, fixed_set, bounds))
     res1 = least_squares_fit(residual_nl, params)
     v1 = res1.values
     beta = np.linalg.lstsq(Lr, -base(v1), rcond=None)[0]
-    params = _law_params(start.with_params([v1[n] for n in names]), fixed_set, bounds)
+    params = _keyed(_law_params(start.with_params([v1[n] for n in names]), fixed_set, bounds))
     for n, b, u in zip(lin_names, beta, lin_units, strict=True):
         params[n] = Parameter(n, float(b), unit=u, scale=abs(float(b)) or 1.0)
 
@@ -278,6 +278,24 @@ def fit_stepped_sine(sweeps: Sequence[Sweep], *, law: Any = "segalman",
     res.notes.extend(out_of_range_notes(law_fit))
     modal = {n: res.params[n].value for n in ("k", "m", "c0")}
     return SteppedSineFit(law_fit, modal, res, [s.name for s in sw], fmid, dict(failures))
+
+
+#: the mode's own parameter names, which a law parameter is renamed away from
+_MODAL = ("k", "m", "c0")
+
+
+def _law_key(name: str) -> str:
+    """A law parameter's name in the stepped-sine fit: ``joint.<name>`` where it would clash
+    with the mode's ``k``, ``m``, ``c0`` (the own stiffness of a :class:`Parallel`)."""
+    return f"joint.{name}" if name in _MODAL or name.startswith("dk_") else name
+
+
+def _keyed(params: dict[str, Parameter]) -> dict[str, Parameter]:
+    out = {}
+    for n, p in params.items():
+        p.name = _law_key(n)
+        out[p.name] = p
+    return out
 
 
 def _points(sw: list[Sweep]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
