@@ -208,26 +208,11 @@ def _table(sweeps: list[Sweep]) -> tuple[np.ndarray, np.ndarray, np.ndarray, lis
 
 
 def _physical_table_fits(A: np.ndarray, c: np.ndarray, f: np.ndarray) -> tuple[Any, Any]:
-    """Segalman (F_S, K_T, χ in (−1, 0], β >= 0 all free) + viscous c0 fitted to the table,
-    multi-started over φmax at every interior amplitude; then Segalman + a parallel Jenkins
-    started from it. Returns both fits."""
-    from contactlab.joints import Jenkins, Parallel
-    from contactlab.joints.amplitude import macroslip_start
+    """Segalman (F_S, K_T, χ in (−1, 0], β >= 0 all free) + viscous c0, and Segalman + a
+    parallel Jenkins, fitted to the table (:func:`contactlab.joints.fit_macroslip`)."""
+    from contactlab.joints import fit_macroslip
 
-    best = None
-    for pm in A[np.argsort(A)][1:-1]:
-        s0, _ = macroslip_start(A, c, f, phi_max=float(pm))
-        fa = fit_amplitude(A, damping=c, frequency=f, law=s0, viscous=True, fixed=[])
-        if best is None or fa.rms_relative_error("c_eq") < best.rms_relative_error("c_eq"):
-            best = fa
-    s = best.law
-    comp = None
-    for u in A[np.argsort(A)][1:-1]:
-        l0 = Parallel(s, Jenkins(k=0.1 * s.F_S / float(u), fs=0.1 * s.F_S))
-        fb = fit_amplitude(A, damping=c, frequency=f, law=l0, viscous=True, fixed=["k", "c"])
-        if comp is None or fb.rms_relative_error("c_eq") < comp.rms_relative_error("c_eq"):
-            comp = fb
-    return best, comp
+    return fit_macroslip(A, c, f), fit_macroslip(A, c, f, parallel_jenkins=True)
 
 
 def _param_lines(res: Any) -> list[str]:

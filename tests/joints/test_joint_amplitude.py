@@ -17,7 +17,9 @@ from contactlab.joints import (
     Sweep,
     equivalent_properties,
     fit_amplitude,
+    fit_macroslip,
     fit_stepped_sine,
+    macroslip_start,
 )
 from contactlab.joints.amplitude import simulated_cycle
 
@@ -27,8 +29,7 @@ def test_jenkins_closed_forms_against_a_simulated_cycle():
     A = np.array([5e-4, 1.5e-3, 4e-3, 2e-2])
     cf = equivalent_properties(law, A)
     assert cf.method == "closed form"
-    # a parallel wrapper with nothing added takes the simulated-cycle route
-    num = equivalent_properties(Parallel(law), A, cycles=2, n_per_cycle=20000)
+    num = equivalent_properties(law, A, cycles=2, n_per_cycle=20000, simulate=True)
     assert num.method == "simulated cycles"
     np.testing.assert_allclose(cf.energy, np.where(A > 1e-3, 4 * 10 * (A - 1e-3), 0.0))
     np.testing.assert_allclose(num.energy, cf.energy, rtol=1e-6, atol=1e-9)
@@ -43,7 +44,7 @@ def test_jenkins_closed_forms_against_a_simulated_cycle():
 def test_masing_quadrature_against_a_simulated_cycle(law):
     A = np.array([5e-5, 2e-4, 4e-4, 1e-3])
     cf = equivalent_properties(law, A)
-    num = equivalent_properties(Parallel(law), A, cycles=2, n_per_cycle=20000)
+    num = equivalent_properties(law, A, cycles=2, n_per_cycle=20000, simulate=True)
     np.testing.assert_allclose(cf.energy, num.energy, rtol=1e-5)
     np.testing.assert_allclose(cf.k_eq, num.k_eq, rtol=1e-5)
 
@@ -145,6 +146,59 @@ def test_stepped_sine_fit_recovers_damping_and_backbone():
         pa = equivalent_properties(true, [a])
         wr = 2 * np.pi * pr["frequency"]
         assert pr["c_eq"] == pytest.approx(c0 + pa.energy[0] / (np.pi * wr * a**2), rel=2e-3)
+
+
+def test_parallel_closed_form_against_a_simulated_cycle():
+    law = Parallel(Segalman(F_S=3.0, K_T=2e4, chi=-0.2, beta=0.7), Jenkins(k=4e3, fs=0.6), k=100.0)
+    A = np.array([2e-5, 2e-4, 4e-4])  # micro-slip, past the Jenkins' slip, past φmax
+    p = equivalent_properties(law, A, 80.0)
+    assert p.method == "closed form"
+    # the virgin curves and the energies add up: each part alone, plus the spring
+    s, j = (equivalent_properties(c, A, 80.0) for c in law.laws)
+    np.testing.assert_allclose(p.energy, s.energy + j.energy, rtol=1e-12)
+    # (Caughey's closed form for the Jenkins; the quadrature across its kink: 1e-6)
+    np.testing.assert_allclose(p.k_eq, s.k_eq + j.k_eq + 100.0, rtol=1e-6)
+    for i, a in enumerate(A):
+        th, x, F = simulated_cycle(law, float(a), 80.0, n_per_cycle=8192)
+        assert float(np.trapezoid(F, x)) == pytest.approx(p.energy[i], rel=1e-5)
+        keq = float(np.trapezoid(F * np.sin(th), th)) / (math.pi * a)
+        assert keq == pytest.approx(p.k_eq[i], rel=1e-5)
+    # a viscous term makes it rate-dependent: simulated
+    assert equivalent_properties(Parallel(law.laws[1], c=1.0), A, 80.0).method != "closed form"
+
+
+def test_fit_macroslip_recovers_segalman_with_a_dirac_share():
+    # an independent table: Segalman's energy written out here (power law below φmax, the
+    # Dirac share slipping beyond it), not the law's own loop_energy
+    chi, beta, FS, KT = -0.3, 0.8, 4.0, 3e4
+    true = Segalman(F_S=FS, K_T=KT, chi=chi, beta=beta)
+    pm, R, S = true.phi_max, true.R, true.S
+    A = np.geomspace(2e-5, 2.2 * pm, 14)
+    E = np.where(A <= pm, 4 * R * A ** (chi + 3) / ((chi + 2) * (chi + 3)),
+                 4 * R * (A * pm ** (chi + 2) / (chi + 2) - pm ** (chi + 3) / (chi + 3))
+                 + 4 * S * pm * (A - pm))  # fmt: skip
+    f, c0 = 80.0, 1.2
+    c = c0 + E / (math.pi * 2 * math.pi * f * A**2)
+    start, c0_start = macroslip_start(A, c, f)
+    assert start.beta == pytest.approx(1.0) and -1 < start.chi <= 0 and c0_start > 0
+    res = fit_macroslip(A, c, f)
+    assert res.success
+    assert res.rms_relative_error("c_eq") < 1e-6
+    for n, v in (("F_S", FS), ("K_T", KT), ("chi", chi), ("beta", beta), ("c0", c0)):
+        assert res.result.params[n].value == pytest.approx(v, rel=1e-3, abs=1e-4), n
+        assert res.result.params[n].identifiable, n  # exact data: no residual, no stderr
+
+
+def test_stepped_sine_law_stiffness_renamed_from_the_modes():
+    law = Parallel(Segalman(F_S=10.0, K_T=6e4, chi=-0.3, beta=0.0), k=1e4)
+    m, k, c0 = 2.0, 4.4e5, 2.0
+    sweeps = _sdof_sweeps(law, m, k, c0, np.array([2e-5, 1.2e-4]), np.linspace(70.0, 80.0, 21))
+    res = fit_stepped_sine(sweeps, law=law, fixed=["k", "c", "segalman.K_T", "segalman.beta"])
+    assert "joint.k" in res.result.params and not res.result.params["joint.k"].vary
+    assert res.law.k == 1e4
+    assert res.modal["k"] == pytest.approx(k, rel=1e-4)
+    assert res.law.laws[0].chi == pytest.approx(-0.3, abs=1e-4)
+    assert np.all(np.isfinite(res.backbone([5e-5])["f_n"]))
 
 
 def test_bad_input_is_named():

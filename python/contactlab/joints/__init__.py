@@ -14,6 +14,8 @@ from .amplitude import (
     energy_per_cycle,
     equivalent_properties,
     fit_amplitude,
+    fit_macroslip,
+    macroslip_start,
     secant_stiffness,
 )
 from .compare import Comparison, compare
@@ -71,8 +73,10 @@ __all__ = [
     "equivalent_properties",
     "fit",
     "fit_amplitude",
+    "fit_macroslip",
     "fit_stepped_sine",
     "from_spec",
+    "macroslip_start",
     "secant_stiffness",
     "start_law",
 ]

@@ -209,10 +209,12 @@ def equivalent_properties(
     *,
     cycles: int = 3,
     n_per_cycle: int = 1024,
+    simulate: bool = False,
 ) -> EquivalentProperties:
     """Equivalent stiffness, energy per cycle and equivalent damping of ``law`` at the given
     amplitudes (closed forms where the module docstring lists them, else simulated cycles
-    at ``frequency`` [Hz], needed for a rate-dependent law).
+    at ``frequency`` [Hz], needed for a rate-dependent law; ``simulate=True`` takes the
+    simulated cycles also where closed forms exist, to check them).
 
     Examples
     --------
@@ -225,10 +227,10 @@ def equivalent_properties(
     if frequency is not None and not (math.isfinite(frequency) and frequency > 0):
         raise InputError(f"frequency must be a finite number > 0 Hz, got {frequency}")
     failures: dict[int, str] = {}
-    if getattr(law, "name", "") == "jenkins":
+    if getattr(law, "name", "") == "jenkins" and not simulate:
         keq, E, ksec = _jenkins(law, A)
         method = "closed form"
-    elif (f := _virgin(law)) is not None:
+    elif not simulate and (f := _virgin(law)) is not None:
         keq = _masing_first_harmonic(f, A)
         E = _closed_energy(law, A)
         ksec = np.abs(np.asarray(f(A), dtype=float)) / A
@@ -608,3 +610,56 @@ def macroslip_start(amplitude: Any, damping: Any, frequency: Any, c0: float | No
     S = KR  # β = S / KR = 1
     FS = R * pm ** (chi + 2) / (chi + 2) + S * pm
     return LAWS["segalman"](F_S=FS, K_T=KR + S, chi=chi, beta=S / KR), c0
+
+
+def fit_macroslip(amplitude: Any, damping: Any, frequency: Any, *,
+                  parallel_jenkins: bool = False) -> AmplitudeFit:  # fmt: skip
+    """Segalman's four-parameter law (``F_S``, ``K_T``, ``β >= 0`` free, ``χ`` in its
+    physical range (−1, 0]) plus a viscous floor ``c0`` fitted to a table of equivalent
+    damping against amplitude, the approach to macro-slip carried by ``β`` and ``φmax``.
+
+    Multi-started (:func:`macroslip_start`) with ``φmax`` at every interior amplitude; the
+    best fit (RMS relative error of ``c_eq``) is returned. With ``parallel_jenkins`` a
+    :class:`~contactlab.joints.Jenkins` element is added in parallel (a second slip
+    displacement; the parallel spring and viscous term held at 0), started from the
+    Segalman fit with its slip displacement at every interior amplitude.
+
+    Parameters
+    ----------
+    amplitude, damping : array
+        Displacement amplitudes [m] and equivalent damping [N s/m] (4 or more).
+    frequency : float or array
+        Frequency of the cycles, Hz.
+    parallel_jenkins : bool, default False
+        Fit Segalman + a parallel Jenkins.
+
+    Returns
+    -------
+    AmplitudeFit
+        The best of the multi-start.
+    """
+    from .laws import LAWS
+
+    A, _ = _amplitudes(amplitude)
+    c = as_1d(damping, "damping")
+    f = np.broadcast_to(np.asarray(frequency, dtype=float), A.shape)
+    inner = np.sort(A)[1:-1]
+    best: AmplitudeFit | None = None
+    for pm in inner:
+        s0, _ = macroslip_start(A, c, f, phi_max=float(pm))
+        fa = fit_amplitude(A, damping=c, frequency=f, law=s0, viscous=True, fixed=[])
+        if best is None or fa.rms_relative_error("c_eq") < best.rms_relative_error("c_eq"):
+            best = fa
+    assert best is not None
+    if not parallel_jenkins:
+        return best
+    s = best.law
+    comp: AmplitudeFit | None = None
+    for u in inner:
+        jen = LAWS["jenkins"](k=0.1 * s.F_S / float(u), fs=0.1 * s.F_S)
+        l0 = LAWS["parallel"](s, jen)
+        fb = fit_amplitude(A, damping=c, frequency=f, law=l0, viscous=True, fixed=["k", "c"])
+        if comp is None or fb.rms_relative_error("c_eq") < comp.rms_relative_error("c_eq"):
+            comp = fb
+    assert comp is not None
+    return comp
