@@ -250,6 +250,7 @@ def beam() -> None:
               f"({'converged' if fa.success else 'NOT converged'}); {fa.law!r}, phi_max = "
               f"{_seg(fa.law).phi_max * 1e6:.1f} um")  # fmt: skip
         print("\n".join(_param_lines(fa.result)))
+        print(f"    frequency: {_table_frequency(fa.law, A, f)}")
     print(f"(both table fits with their multi-starts: {dt:.1f} s)")
     fixed = {"segalman": [], "segalman+jenkins": ["k", "c"]}
     ss_fits = {}
@@ -303,6 +304,26 @@ def beam() -> None:
     for i, a in enumerate(grid):
         print(f"{a * 1e6:8.1f} {bb['f_n'][i]:10.4f} ± {bb['f_n_stderr'][i]:.4f} "
               f"{bb['zeta'][i]:10.6f} ± {bb['zeta_stderr'][i]:.6f}")  # fmt: skip
+
+
+def _table_frequency(law: Any, A: np.ndarray, f: np.ndarray) -> str:
+    """The table's frequencies from the law's softening: ``(2π f)² = (k + k_eq(A)) / m``
+    with ``k / m`` and ``1 / m >= 0`` fitted by linear least squares."""
+    from contactlab.joints import equivalent_properties
+
+    keq = equivalent_properties(law, A, float(np.median(f))).k_eq
+    w2 = (2 * math.pi * f) ** 2
+    M = np.column_stack([np.ones_like(A), keq])
+    a, b = np.linalg.lstsq(M, w2, rcond=None)[0]
+    if b < 0:  # the frequencies rise with amplitude: no softening law follows that
+        a, b = float(np.mean(w2)), 0.0
+    fp = np.sqrt(a + b * keq) / (2 * math.pi)
+    rms = math.sqrt(float(np.mean((fp - f) ** 2)))
+    m = f"m = {1 / b:.4g} kg" if b > 0 else "1/m at its bound 0: the law's softening unused"
+    return (
+        f"RMS error {rms:.3f} Hz with (k, m) fitted to the table's frequencies ({m}; a "
+        f"constant frequency: {math.sqrt(float(np.mean((f - f.mean()) ** 2))):.3f} Hz)"
+    )
 
 
 def _seg(law: Any) -> Any:
