@@ -12,8 +12,10 @@ from contactlab.errors import InputError
 from contactlab.joints import (
     Iwan,
     Jenkins,
+    KelvinVoigt,
     Parallel,
     Segalman,
+    Series,
     Sweep,
     equivalent_properties,
     fit_amplitude,
@@ -165,6 +167,25 @@ def test_parallel_closed_form_against_a_simulated_cycle():
         assert keq == pytest.approx(p.k_eq[i], rel=1e-5)
     # a viscous term makes it rate-dependent: simulated
     assert equivalent_properties(Parallel(law.laws[1], c=1.0), A, 80.0).method != "closed form"
+
+
+def test_series_spring_closed_form_against_a_simulated_cycle():
+    joint = Segalman(F_S=3.0, K_T=3e4, chi=-0.2, beta=0.3)
+    law = Series(joint, KelvinVoigt(k=4e4))
+    A = np.array([2e-5, 2e-4, 5e-4])  # micro-slip, near and past macro-slip
+    p = equivalent_properties(law, A, 80.0)
+    assert p.method == "closed form"
+    # the split: the spring carries the joint's force, the joint dissipates at its share
+    u = A - p.k_secant * A / 4e4
+    np.testing.assert_allclose(joint.virgin(u), p.k_secant * A, rtol=1e-12)
+    np.testing.assert_allclose(p.energy, joint.loop_energy(u), rtol=1e-12)
+    q = equivalent_properties(law, A, 80.0, simulate=True, n_per_cycle=8192)
+    np.testing.assert_allclose(p.energy, q.energy, rtol=1e-6)
+    np.testing.assert_allclose(p.k_eq, q.k_eq, rtol=1e-6)
+    # a viscous spring is rate-dependent: simulated
+    assert equivalent_properties(Series(joint, KelvinVoigt(k=4e4, c=1.0)), A, 80.0).method != (
+        "closed form"
+    )
 
 
 def test_fit_macroslip_recovers_segalman_with_a_dirac_share():

@@ -21,7 +21,9 @@ Closed forms where they exist, numerical cycles elsewhere:
   Masing branch ``F(θ) = f(A) − 2 f(A (1 − cos θ) / 2)`` of the closed-form virgin curve
   ``f`` by Gauss-Legendre quadrature.
 - **Masing laws in parallel** with a spring (no viscous term): the virgin curves and the
-  energies add up.
+  energies add up. **A Masing law in series with a spring** (``KelvinVoigt`` with
+  ``c = 0``): the joint's share ``u`` of a displacement ``x`` solves ``u + f(u)/k_s = x``
+  (bisection); the loop is Masing on that virgin curve, the energy the joint's at ``u(A)``.
 - **Others** (LuGre, Dahl, Maxwell-slip, Bouc-Wen, compositions): the law driven over
   ``cycles`` periods of ``A sin(ω t)`` from the relaxed state; the last period gives k_eq and
   E (trapezoid rule).
@@ -93,7 +95,41 @@ def _virgin(law: Any) -> Any:
             return None
         k = law.k
         return lambda u: k * np.asarray(u, dtype=float) + sum(f(u) for f in fs)
+    if (sp := _series_spring(law)) is not None:
+        f, ks, _ = sp
+
+        def series_virgin(x: Any) -> np.ndarray:
+            xa = np.asarray(x, dtype=float)
+            return np.sign(xa) * f(_series_split(f, ks, np.abs(xa)))
+
+        return series_virgin
     return None
+
+
+def _series_spring(law: Any) -> tuple[Any, float, Any] | None:
+    """``(f, k_s, joint)`` of a :class:`Series` of a Masing law with a closed-form virgin
+    curve ``f`` and a linear spring ``k_s`` (a :class:`KelvinVoigt` with ``c = 0``)."""
+    if getattr(law, "name", "") != "series" or len(law.laws) != 2:
+        return None
+    springs = [c for c in law.laws if c.name == "kelvin_voigt" and c.c == 0.0 and c.k > 0]
+    joints = [c for c in law.laws if c.name != "kelvin_voigt"]
+    if len(springs) != 1 or len(joints) != 1:
+        return None
+    f = _virgin(joints[0])
+    return None if f is None else (f, float(springs[0].k), joints[0])
+
+
+def _series_split(f: Any, ks: float, x: np.ndarray) -> np.ndarray:
+    """The joint's displacement ``u`` of a joint + spring in series displaced by ``x >= 0``:
+    the root of ``u + f(u) / k_s = x`` (strictly increasing in ``u``, so bisection on
+    ``[0, x]`` to machine precision)."""
+    lo, hi = np.zeros_like(x), x.copy()
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        over = mid + f(mid) / ks > x
+        hi = np.where(over, mid, hi)
+        lo = np.where(over, lo, mid)
+    return 0.5 * (lo + hi)
 
 
 def _closed_energy(law: Any, A: np.ndarray) -> np.ndarray:
@@ -103,6 +139,10 @@ def _closed_energy(law: Any, A: np.ndarray) -> np.ndarray:
         return _jenkins(law, A)[1]
     if name == "parallel":
         return sum((_closed_energy(child, A) for child in law.laws), np.zeros(A.size))
+    if (sp := _series_spring(law)) is not None:
+        # the spring stores and returns: the joint dissipates at its own amplitude
+        f, ks, joint = sp
+        return _closed_energy(joint, _series_split(f, ks, np.abs(A)))
     if hasattr(law, "loop_energy"):
         return np.asarray(law.loop_energy(A), dtype=float)
     return np.asarray(law.masing().loop_energy(A), dtype=float)
@@ -613,7 +653,8 @@ def macroslip_start(amplitude: Any, damping: Any, frequency: Any, c0: float | No
 
 
 def fit_macroslip(amplitude: Any, damping: Any, frequency: Any, *,
-                  parallel_jenkins: bool = False) -> AmplitudeFit:  # fmt: skip
+                  parallel_jenkins: bool = False, series_spring: bool = False
+                  ) -> AmplitudeFit:  # fmt: skip
     """Segalman's four-parameter law (``F_S``, ``K_T``, ``β >= 0`` free, ``χ`` in its
     physical range (−1, 0]) plus a viscous floor ``c0`` fitted to a table of equivalent
     damping against amplitude, the approach to macro-slip carried by ``β`` and ``φmax``.
@@ -632,6 +673,11 @@ def fit_macroslip(amplitude: Any, damping: Any, frequency: Any, *,
         Frequency of the cycles, Hz.
     parallel_jenkins : bool, default False
         Fit Segalman + a parallel Jenkins.
+    series_spring : bool, default False
+        Fit Segalman in series with a linear spring ``k_s`` (a :class:`KelvinVoigt` with
+        ``c = 0``; the compliance of the parts around the joint), started from the
+        Segalman fit with ``k_s`` at 0.5, 1, 2 and 5 times its ``K_T``. Not with
+        ``parallel_jenkins``.
 
     Returns
     -------
@@ -651,9 +697,21 @@ def fit_macroslip(amplitude: Any, damping: Any, frequency: Any, *,
         if best is None or fa.rms_relative_error("c_eq") < best.rms_relative_error("c_eq"):
             best = fa
     assert best is not None
+    if parallel_jenkins and series_spring:
+        raise InputError("fit_macroslip: give parallel_jenkins or series_spring, not both")
+    s = best.law
+    if series_spring:
+        ser: AmplitudeFit | None = None
+        for r in (0.5, 1.0, 2.0, 5.0):
+            l0 = LAWS["series"](s, LAWS["kelvin_voigt"](k=r * s.K_T))
+            fb = fit_amplitude(A, damping=c, frequency=f, law=l0, viscous=True,
+                               fixed=["kelvin_voigt.c"])  # fmt: skip
+            if ser is None or fb.rms_relative_error("c_eq") < ser.rms_relative_error("c_eq"):
+                ser = fb
+        assert ser is not None
+        return ser
     if not parallel_jenkins:
         return best
-    s = best.law
     comp: AmplitudeFit | None = None
     for u in inner:
         jen = LAWS["jenkins"](k=0.1 * s.F_S / float(u), fs=0.1 * s.F_S)
