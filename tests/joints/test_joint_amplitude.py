@@ -224,6 +224,13 @@ def test_stepped_sine_law_stiffness_renamed_from_the_modes():
 
 def test_bad_input_is_named():
     law = Jenkins(k=1e4, fs=10.0)
+    with pytest.raises(InputError, match="4 or more amplitudes"):
+        fit_macroslip([1e-4, 2e-4, 3e-4], [1.0, 2.0, 3.0], 80.0)
+    with pytest.raises(InputError, match="4 or more amplitudes"):
+        macroslip_start([1e-4, 2e-4, 3e-4, 4e-4], [1.0, 2.0], 80.0)
+    with pytest.raises(InputError, match="both"):
+        fit_macroslip(np.geomspace(1e-5, 1e-4, 5), np.linspace(1, 2, 5), 80.0,
+                      parallel_jenkins=True, series_spring=True)  # fmt: skip
     with pytest.raises(InputError, match=r"amplitude\[1\]"):
         equivalent_properties(law, [1e-3, -1e-3])
     with pytest.raises(InputError, match="needs the frequency"):

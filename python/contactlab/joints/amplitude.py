@@ -688,6 +688,11 @@ def fit_macroslip(amplitude: Any, damping: Any, frequency: Any, *,
 
     A, _ = _amplitudes(amplitude)
     c = as_1d(damping, "damping")
+    if c.size != A.size or A.size < 4:
+        raise InputError(f"fit_macroslip: give 4 or more amplitudes with one damping each "
+                         f"(got {A.size} amplitudes, {c.size} damping values)")  # fmt: skip
+    if parallel_jenkins and series_spring:
+        raise InputError("fit_macroslip: give parallel_jenkins or series_spring, not both")
     f = np.broadcast_to(np.asarray(frequency, dtype=float), A.shape)
     inner = np.sort(A)[1:-1]
     best: AmplitudeFit | None = None
@@ -697,8 +702,6 @@ def fit_macroslip(amplitude: Any, damping: Any, frequency: Any, *,
         if best is None or fa.rms_relative_error("c_eq") < best.rms_relative_error("c_eq"):
             best = fa
     assert best is not None
-    if parallel_jenkins and series_spring:
-        raise InputError("fit_macroslip: give parallel_jenkins or series_spring, not both")
     s = best.law
     if series_spring:
         ser: AmplitudeFit | None = None
