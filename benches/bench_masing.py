@@ -1,66 +1,219 @@
-"""Python-level throughput of the Masing operator on 1e7 samples.
+"""``Masing.force(x, out=buf)`` against the anchor kernel, compiled and run in this run.
 
-For a sine, band-limited noise and a random walk that reverses every ~2 samples it reports the
-throughput of ``Masing.force`` called from Python and of ``MasingOperator.push(x, out=buf)``
-(no allocation), timed here in Python, interleaved, best of ``--repeat``; and a numpy ``exp``
-pass over the same array as a same-run reference. The kernel's own speed against a plain
-std-Rust loop of the same rules is ``cargo bench -p contactlab-core --bench masing``; the
-parallel speed-up over channels is ``benches/bench_parallel.py``.
-Run: ``.venv/bin/python benches/bench_masing.py [--n 10000000] [--repeat 15]``.
+The anchor is ``../shared/bench/masing_anchor.rs`` (its ``masing_idx`` kernel: the plain
+std-Rust loop of the same rules with libm ``exp``), included verbatim into a small driver and
+built here the way a wheel is built, for generic x86-64 (``rustc -O``). The driver stays up
+for the whole run and times one call per request, so that the rounds interleave: per round
+and signal, contactlab then the anchor, the order swapped every round. Each call is timed by
+wall clock and by the CPU time of the thread that ran it (``time.thread_time`` here,
+``/proc/thread-self/schedstat`` in the driver): on a shared, loaded machine the wall time
+holds the time spent waiting for a core and the CPU time does not. Figures are medians over
+``--rounds``; the ratios are contactlab's throughput over the anchor's.
+
+The signals are the anchor's own (``sine``, ``bandlim``, ``randwalk``, h0 = 1, ac = 3), written
+by the driver with the anchor's generators; the checksums (sequential sums of the forces) of both
+kernels are compared.
+Run: ``.venv/bin/python benches/bench_masing.py [--n 10000000] [--rounds 7]``.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import shutil
+import subprocess
+import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
-from scipy import signal
 
 import contactlab
 
+ROOT = Path(__file__).resolve().parents[1]
+ANCHOR = ROOT.parent / "shared" / "bench" / "masing_anchor.rs"
+SIGNALS = ("sine", "bandlim", "randwalk")
 
-def signals(n: int) -> dict[str, np.ndarray]:
-    rng = np.random.default_rng(7)
-    sos = signal.butter(4, 1 / 25, output="sos")  # cut-off at fs/50
-    noise = signal.sosfilt(sos, rng.uniform(-0.5, 0.5, n))
-    noise *= 20e-6 / np.sqrt(np.mean(noise**2))
-    walk = np.cumsum(np.where(rng.integers(0, 2, n) == 0, 0.5e-6, -0.5e-6))
-    return {
-        "sine": 40e-6 * np.sin(np.arange(n) * (2 * np.pi / 1000)),
-        "band_limited_noise": np.ascontiguousarray(noise),
-        "random_walk": walk,
+# The driver: the anchor file verbatim in a module (so its private kernel is reachable from
+# a function added to the module), one timed `masing_idx` call per stdin line.
+DRIVER = r"""
+mod anchor {
+    include!(env!("ANCHOR_RS"));
+    pub fn signal(kind: &str, n: usize) -> Vec<f64> { gen(kind, n) }
+    pub const IDX: Kern = masing_idx;
+    #[allow(dead_code)]
+    pub fn unused() { main() }
+}
+use std::io::{BufRead, Write};
+fn cpu_ns() -> u64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat").ok()
+        .and_then(|s| s.split_whitespace().next().and_then(|v| v.parse().ok())).unwrap_or(0)
+}
+fn main() {
+    let mut cache: Option<(String, usize, Vec<f64>, Vec<f64>)> = None;
+    let (mut xr, mut hr) = (Vec::new(), Vec::new());
+    let stdout = std::io::stdout();
+    for line in std::io::stdin().lock().lines() {
+        let line = line.unwrap();
+        let mut it = line.split_whitespace();
+        let kind = it.next().unwrap().to_string();
+        let n: usize = it.next().unwrap().parse().unwrap();
+        if let Some(path) = it.next() {
+            // "<signal> <n> <path>": write the signal (little-endian f64) to path
+            let x = anchor::signal(&kind, n);
+            let bytes: Vec<u8> = x.iter().flat_map(|v| v.to_le_bytes()).collect();
+            std::fs::write(path, bytes).unwrap();
+            writeln!(stdout.lock(), "ok").unwrap();
+            continue;
+        }
+        if cache.as_ref().map_or(true, |c| c.0 != kind || c.1 != n) {
+            let x = anchor::signal(&kind, n);
+            let mut out = vec![0.0; n];
+            (anchor::IDX)(&x, &mut out, &mut xr, &mut hr); // warm-up: page faults
+            cache = Some((kind, n, x, out));
+        }
+        let c = cache.as_mut().unwrap();
+        let k = std::hint::black_box(anchor::IDX);
+        let (c0, t0) = (cpu_ns(), std::time::Instant::now());
+        k(std::hint::black_box(&c.2), &mut c.3, &mut xr, &mut hr);
+        std::hint::black_box(&c.3);
+        let (wall, cpu) = (t0.elapsed().as_secs_f64(), (cpu_ns() - c0) as f64 * 1e-9);
+        let chk: f64 = c.3.iter().sum();
+        let mut o = stdout.lock();
+        writeln!(o, "{wall:.9} {cpu:.9} {chk:.17e}").unwrap();
+        o.flush().unwrap();
     }
+}
+"""
 
 
-def timed(f) -> float:
-    t0 = time.perf_counter()
-    result = f()
-    dt = time.perf_counter() - t0
-    del result  # freeing the output is not part of the call
-    return dt
+class Anchor:
+    """The anchor driver, built for generic x86-64 and kept running."""
+
+    def __init__(self, workdir: Path) -> None:
+        src = workdir / "anchor_driver.rs"
+        src.write_text(DRIVER)
+        self.exe = workdir / "anchor_driver"
+        env = dict(os.environ, ANCHOR_RS=str(ANCHOR.resolve()))
+        env.pop("RUSTFLAGS", None)
+        subprocess.run(
+            ["rustc", "-O", "--edition", "2021", "-o", str(self.exe), str(src)],
+            check=True,
+            env=env,
+            capture_output=True,
+        )
+        self.proc = subprocess.Popen(
+            [str(self.exe)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
+        )
+
+    def time(self, kind: str, n: int) -> tuple[float, float, float]:
+        """Wall seconds, CPU seconds and checksum of one call on signal ``kind``."""
+        assert self.proc.stdin is not None and self.proc.stdout is not None
+        self.proc.stdin.write(f"{kind} {n}\n")
+        self.proc.stdin.flush()
+        wall, cpu, chk = self.proc.stdout.readline().split()
+        return float(wall), float(cpu), float(chk)
+
+    def signal(self, kind: str, n: int, workdir: Path) -> np.ndarray:
+        """The anchor's own signal ``kind`` of ``n`` samples (generated by the driver)."""
+        assert self.proc.stdin is not None and self.proc.stdout is not None
+        path = workdir / f"{kind}.f64"
+        self.proc.stdin.write(f"{kind} {n} {path}\n")
+        self.proc.stdin.flush()
+        if self.proc.stdout.readline().strip() != "ok":
+            raise RuntimeError("the anchor driver did not write the signal")
+        x = np.fromfile(path, dtype="<f8")
+        path.unlink()
+        return x
+
+    def close(self) -> None:
+        if self.proc.stdin is not None:
+            self.proc.stdin.close()
+        self.proc.wait()
+
+
+def ours_time(m: contactlab.Masing, x: np.ndarray, buf: np.ndarray) -> tuple[float, float]:
+    """Wall and thread-CPU seconds of one ``m.force(x, out=buf)``."""
+    c0, t0 = time.thread_time(), time.perf_counter()
+    m.force(x, out=buf)
+    return time.perf_counter() - t0, time.thread_time() - c0
+
+
+def measure(n: int, rounds: int) -> list[dict[str, float | str]] | None:
+    """Per signal: medians of wall/CPU seconds of both kernels over interleaved rounds.
+
+    None when the anchor or ``rustc`` is absent.
+    """
+    if not ANCHOR.exists() or shutil.which("rustc") is None:
+        return None
+    m = contactlab.Masing(h0=1.0, ac=3.0)
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        anchor = Anchor(Path(tmp))
+        try:
+            for kind in SIGNALS:
+                x = anchor.signal(kind, n, Path(tmp))
+                buf = np.empty(n)
+                m.force(x, out=buf)  # warm-up: page faults
+                anchor.time(kind, n)
+                ow, oc, aw, ac = [], [], [], []
+                chk = np.nan
+                for r in range(rounds):
+                    first_ours = r % 2 == 0
+                    if first_ours:
+                        w, c = ours_time(m, x, buf)
+                    wa, ca, chk = anchor.time(kind, n)
+                    if not first_ours:
+                        w, c = ours_time(m, x, buf)
+                    ow.append(w)
+                    oc.append(c)
+                    aw.append(wa)
+                    ac.append(ca)
+                ours_chk = float(np.cumsum(buf)[-1])  # the anchor's sequential sum
+                rows.append(
+                    {
+                        "signal": kind,
+                        "ours_wall": float(np.median(ow)),
+                        "ours_cpu": float(np.median(oc)),
+                        "anchor_wall": float(np.median(aw)),
+                        "anchor_cpu": float(np.median(ac)),
+                        "checksum_rel_diff": abs(ours_chk - chk) / abs(chk),
+                    }
+                )
+        finally:
+            anchor.close()
+    return rows
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--n", type=int, default=10_000_000)
-    ap.add_argument("--repeat", type=int, default=15)
+    ap.add_argument("--rounds", type=int, default=7)
     args = ap.parse_args()
     n = args.n
-    m = contactlab.Masing(40.0, 4.0e4)
-    sig = signals(n)
-    buf = np.empty(n)
+    from contactlab import _core
+
     load = ", ".join(f"{a:.2f}" for a in os.getloadavg())
-    print(f"n = {n:.0e} samples, best of {args.repeat} interleaved repeats; load {load}")
-    print(f"{'signal':<20}{'force Ms/s':>12}{'push(out=) Ms/s':>17}{'numpy exp Ms/s':>16}")
-    for name, x in sig.items():
-        t_f = t_o = t_e = np.inf
-        for _ in range(args.repeat):
-            t_f = min(t_f, timed(lambda x=x: m.force(x)))
-            t_o = min(t_o, timed(lambda x=x: m.operator().push(x, out=buf)))
-            t_e = min(t_e, timed(lambda x=x: np.exp(-4.0e4 * x)))
-        print(f"{name:<20}{n / t_f / 1e6:12.1f}{n / t_o / 1e6:17.1f}{n / t_e / 1e6:16.1f}")
+    print(
+        f"n = {n:.0e} samples, medians of {args.rounds} interleaved rounds; SIMD level "
+        f"{_core.simd_level()}; load {load}; {os.cpu_count()} CPUs"
+    )
+    rows = measure(n, args.rounds)
+    if rows is None:
+        print("anchor absent (../shared/bench/masing_anchor.rs or rustc missing)")
+        return
+    print(
+        f"{'signal':<10}{'ours M/s':>10}{'anchor M/s':>12}{'ratio':>7}"
+        f"{'ours ns/sample CPU':>20}{'anchor ns/sample CPU':>22}{'CPU ratio':>11}"
+        f"{'checksum rel diff':>19}"
+    )
+    for r in rows:
+        ow, aw, oc, ac = r["ours_wall"], r["anchor_wall"], r["ours_cpu"], r["anchor_cpu"]
+        print(
+            f"{r['signal']:<10}{n / ow / 1e6:10.1f}{n / aw / 1e6:12.1f}{aw / ow:7.2f}"
+            f"{oc / n * 1e9:20.2f}{ac / n * 1e9:22.2f}{ac / oc:11.2f}"
+            f"{r['checksum_rel_diff']:19.1e}"
+        )
 
 
 if __name__ == "__main__":

@@ -124,7 +124,7 @@ def stage(name: str, path: str, workers: int) -> dict:
         n = sum(len(c) for c in read_chunks(path, chunk_size=CHUNK))
         out["n"] = n
     elif name == "cycles":
-        from contactlab.studies._cycles import CycleState, block_cycles
+        from contactlab.studies.cycles import CycleState, block_cycles
 
         s, n_cyc = CycleState(), 0
         for c in read_chunks(path, chunk_size=CHUNK):

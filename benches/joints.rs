@@ -61,6 +61,24 @@ impl Rng {
     }
 }
 
+/// The signal of `--signal <path>`: `2 n` little-endian f64, the times then the
+/// displacements (written by `benches/speed_joints.py`, which times the Python path on the
+/// same arrays).
+fn signal_file() -> Option<(Vec<f64>, Vec<f64>)> {
+    let args: Vec<String> = std::env::args().collect();
+    let path = args
+        .iter()
+        .position(|a| a == "--signal")
+        .and_then(|i| args.get(i + 1))?;
+    let bytes = std::fs::read(path).expect("--signal: cannot read the file");
+    let v: Vec<f64> = bytes
+        .chunks_exact(8)
+        .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    let (t, x) = v.split_at(v.len() / 2);
+    Some((t.to_vec(), x.to_vec()))
+}
+
 fn signal(n: usize) -> (Vec<f64>, Vec<f64>) {
     let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
     let mut walk = 0.0;
@@ -194,9 +212,9 @@ fn plain_segalman(f_s: f64, k_t: f64, chi: f64, beta: f64, x: &[f64], out: &mut 
 type Plain<'a> = Box<dyn Fn(&[f64], &mut [f64]) + 'a>;
 
 fn main() {
-    let n = arg("--n", 2_000_000);
     let repeat = arg("--repeat", 9).max(1);
-    let (t, x) = signal(n);
+    let (t, x) = signal_file().unwrap_or_else(|| signal(arg("--n", 2_000_000)));
+    let n = x.len();
     let k10: Vec<f64> = (0..10).map(|i| 1e4 * (1.0 + 0.1 * i as f64)).collect();
     let fs10: Vec<f64> = (0..10).map(|i| 0.5 * (1.0 + i as f64)).collect();
     let mut p10 = k10.clone();

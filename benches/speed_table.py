@@ -10,10 +10,15 @@ noise and the ratio of medians is the figure. Rows:
 - per-cycle energies with the cycle bounds given (``contactlab.loop_areas``) against numpy
   (terms, then ``np.add.reduceat``, plus each cycle's closing edge).
 - ``Masing(h0=1, ac=3).force(x, out=buf)`` on the anchor's signals (sine, band-limited,
-  random walk) against ``../shared/bench/masing_anchor.rs`` (its ``masing_idx`` row), built
-  here for generic x86-64 (``rustc -O``) and run as a subprocess between our rounds.
+  random walk) against ``../shared/bench/masing_anchor.rs`` (its ``masing_idx`` kernel),
+  built here for generic x86-64 (``rustc -O``) into a driver kept running between our rounds
+  (``benches/bench_masing.py``); ratio of thread-CPU medians, wall-clock figures beside it.
 - ``Masing.force(threads=2)`` with a competing busy process against one thread.
-- ``contactlab --help`` and ``python -c 'import contactlab'`` wall time (a new process each).
+- ``contactlab analyze --json`` of a 1e7 / 3e7-sample HDF5 recording on the command line
+  against the Masing kernel on the same samples (``benches/bench_analyze.py``).
+- ``contactlab --help``, ``python -c 'import contactlab'`` and ``contactlab analyze`` to its
+  first sample read and to its end, against ``python -c pass`` (wall and CPU time, a new
+  process each: ``benches/bench_startup.py``).
 - the normal-contact ODE against scipy ``odeint`` (LSODA) on the problem of
   ``benches/bench_normal.py`` when ``--ode`` is given (slow).
 
@@ -24,12 +29,9 @@ Run: ``.venv/bin/python benches/speed_table.py [--rounds 5] [--quick]``.
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import shutil
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -38,7 +40,6 @@ import numpy as np
 import contactlab
 
 ROOT = Path(__file__).resolve().parents[1]
-ANCHOR = ROOT.parent / "shared" / "bench" / "masing_anchor.rs"
 
 
 def med(v: list[float]) -> float:
@@ -163,50 +164,30 @@ def anchor_signal(kind: str, n: int) -> np.ndarray:
     return lfilter([0.05], [1.0, -0.999], e)
 
 
-def build_anchor() -> Path | None:
-    if not ANCHOR.exists() or shutil.which("rustc") is None:
-        return None
-    out = Path(tempfile.gettempdir()) / f"masing_anchor_{os.getpid()}"
-    subprocess.run(["rustc", "-O", "-o", str(out), str(ANCHOR)], check=True)
-    return out
-
-
-def anchor_time(exe: Path, n: int, kind: str) -> float:
-    p = subprocess.run([str(exe), "bench", str(n), "1", kind], capture_output=True, text=True)
-    for line in p.stdout.splitlines():
-        d = json.loads(line)
-        if d["kernel"] == "masing_idx":
-            return float(d["median_s"])
-    raise RuntimeError(p.stderr)
-
-
 def masing_rows(rounds: int, n: int) -> None:
-    exe = build_anchor()
-    m = contactlab.Masing(h0=1.0, ac=3.0)
-    for kind in ("sine", "bandlim", "randwalk"):
-        x = anchor_signal(kind, n)
-        buf = np.empty(n)
-        ours, theirs = [], []
-        m.force(x, out=buf)
-        for _ in range(rounds):
-            ours.append(timed(lambda x=x, buf=buf: m.force(x, out=buf)))
-            if exe is not None:
-                theirs.append(anchor_time(exe, n, kind))
-        o = n / med(ours) / 1e6
-        if exe is None:
-            row(
-                f"`Masing.force(x, out=buf)`, {n:.0e}, {kind}", f"{o:.0f} M/s", "anchor absent", 0.0
-            )
-            continue
-        a = n / med(theirs) / 1e6
+    """``Masing(h0=1, ac=3).force(x, out=buf)`` against the anchor (``bench_masing.py``).
+
+    The anchor's ``masing_idx`` built here for generic x86-64, kept running and called
+    between our rounds on its own signals; the ratio is of the medians of thread-CPU time
+    (the wall-clock ratio, which holds waiting for a core on a loaded machine, beside it).
+    """
+    sys.path.insert(0, str(ROOT / "benches"))
+    import bench_masing
+
+    rows = bench_masing.measure(n, max(rounds, 5))
+    if rows is None:
+        row(f"`Masing.force(x, out=buf)`, {n:.0e}", "n/a", "anchor absent", 0.0)
+        return
+    for r in rows:
+        oc, ac, ow, aw = r["ours_cpu"], r["anchor_cpu"], r["ours_wall"], r["anchor_wall"]
         row(
-            f"`Masing.force(x, out=buf)`, {n:.0e}, {kind}",
-            f"{o:.0f} M/s",
-            f"anchor {a:.0f} M/s",
-            o / a,
+            f"`Masing.force(x, out=buf)`, {n:.0e}, {r['signal']}",
+            f"{n / oc / 1e6:.0f} M/s CPU ({oc / n * 1e9:.2f} ns/sample), "
+            f"{n / ow / 1e6:.0f} M/s wall",
+            f"anchor {n / ac / 1e6:.0f} M/s CPU ({ac / n * 1e9:.2f} ns/sample), "
+            f"{n / aw / 1e6:.0f} M/s wall; wall ratio {aw / ow:.2f}",
+            ac / oc,
         )
-    if exe is not None:
-        exe.unlink(missing_ok=True)
 
 
 def threads_row(rounds: int, n: int) -> None:
@@ -237,25 +218,23 @@ def threads_row(rounds: int, n: int) -> None:
 
 
 def startup_rows(rounds: int) -> None:
-    exe = Path(sys.executable).with_name("contactlab")
-    env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
-    cmds = {
-        "help": [str(exe), "--help"],
-        "import": [sys.executable, "-c", "import contactlab"],
-        "python": [sys.executable, "-c", "pass"],
-    }
-    r = interleave(
-        {k: (lambda c=c: subprocess.run(c, capture_output=True, env=env)) for k, c in cmds.items()},
-        rounds,
-    )
-    row(
-        "`contactlab --help` (new process)",
-        f"{r['help'] * 1e3:.0f} ms",
-        f"bar 150 ms; bare `python -c pass` {r['python'] * 1e3:.0f} ms; "
-        f"`import contactlab` {r['import'] * 1e3:.0f} ms",
-        0.150 / r["help"],
-        "of the bar ",
-    )
+    """``contactlab --help``, ``import contactlab`` and ``analyze`` up to its first sample
+    read and to its end, each a new process, against ``python -c pass`` (bench_startup.py)."""
+    sys.path.insert(0, str(ROOT / "benches"))
+    import bench_startup
+
+    for task, ours, other, ratio, note in bench_startup.table(max(rounds, 5)):
+        row(f"{task} (new process)", ours, other, ratio, note + " ")
+
+
+def analyze_rows(rounds: int, sizes: list[int]) -> None:
+    """``contactlab analyze --json`` of long HDF5 recordings (command line) against the
+    Masing kernel on the same samples (bench_analyze.py; the bar is 0.3 of the kernel)."""
+    sys.path.insert(0, str(ROOT / "benches"))
+    import bench_analyze
+
+    for task, ours, other, ratio, note in bench_analyze.rows(sizes, max(3, rounds // 2)):
+        row(task, ours, other, ratio, note + " ")
 
 
 def ode_row(rounds: int) -> None:
@@ -300,6 +279,7 @@ def main() -> None:
     loop_rows(args.rounds, sorted({1_000_000, big}))
     masing_rows(args.rounds, big)
     threads_row(args.rounds, big)
+    analyze_rows(args.rounds, [1_000_000] if args.quick else [10_000_000, 30_000_000])
     startup_rows(args.rounds)
     if args.ode:
         ode_row(args.rounds)

@@ -60,7 +60,27 @@ def fold_window(
     n_bins: int,
     n_cycles: int,
     edges: _F,
+    scan: WindowScan | None = None,
 ) -> WindowFold: ...
+
+@final
+class WindowScan:
+    @property
+    def clean(self) -> bool: ...
+    @property
+    def order_stats(self) -> _F: ...
+
+def detrend_pair_scan_into(
+    t: _F,
+    tm: float,
+    f: _F,
+    slope_f: float,
+    x: _F,
+    slope_x: float,
+    out_f: _F,
+    out_x: _F,
+    ranks: list[int],
+) -> WindowScan: ...
 def loop_areas(x: _F, f: _F, bounds: list[int]) -> _F: ...
 def fit_steady_loop(
     x: _F,
@@ -196,3 +216,6 @@ class JointOperatorCore:
     @property
     def rate_dependent(self) -> bool: ...
     def copy(self) -> JointOperatorCore: ...
+
+def joint_force_sens(spec: _LawSpec, t: _F | None, x: _F, x0: float) -> tuple[_F, _F]: ...
+def joint_has_sens(spec: _LawSpec) -> bool: ...

@@ -75,9 +75,14 @@ def savgol_filter(
     if half:
         y[:half] = _fit_edge(x, 0, window_length, np.arange(half), polyorder, deriv, delta)
         y[n - half :] = _fit_edge(
-            x, n - window_length, n, np.arange(window_length - half, window_length),
-            polyorder, deriv, delta,
-        )  # fmt: skip
+            x,
+            n - window_length,
+            n,
+            np.arange(window_length - half, window_length),
+            polyorder,
+            deriv,
+            delta,
+        )
     return y
 
 

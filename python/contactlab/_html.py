@@ -23,7 +23,8 @@ from ._outputs import commit_outputs
 from ._version import __version__
 from .errors import InputError
 
-_CSS = """
+#: The stylesheet of every HTML report (tables, figures, warnings).
+CSS = """
 body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;margin:2em auto;
 max-width:1100px;padding:0 1em;color:#222;line-height:1.45}
 h1{border-bottom:2px solid #345;padding-bottom:.2em}h2{border-bottom:1px solid #bbb;margin-top:2em}
@@ -326,7 +327,7 @@ class Report:
         parts = [
             "<!DOCTYPE html>",
             '<html lang="en"><head><meta charset="utf-8">',
-            f"<title>{esc(self.title)}</title><style>{_CSS}</style></head><body>",
+            f"<title>{esc(self.title)}</title><style>{CSS}</style></head><body>",
             f"<h1>{esc(self.title)}</h1>",
             f"<p><small>contactlab {esc(__version__)} · generated {stamp}</small></p>",
         ]

@@ -226,10 +226,16 @@ def polish(
             # Gauss-Newton steps of a few hundredths of a standard error that no solver
             # removes; a quarter of a standard error changes no reported digit that matters.
             if ratio[worst] > TRUST_STEP:
-                return (z, r, J, False, -2,
-                        f"not converged: a further Gauss-Newton step would move {names[worst]} "
-                        f"by {ratio[worst]:.2g} standard errors (the minimum is not reached; "
-                        "try other starting values or bounds)")  # fmt: skip
+                return (
+                    z,
+                    r,
+                    J,
+                    False,
+                    -2,
+                    f"not converged: a further Gauss-Newton step would move {names[worst]} "
+                    f"by {ratio[worst]:.2g} standard errors (the minimum is not reached; "
+                    "try other starting values or bounds)",
+                )
     return z, r, J, True, 1, f"converged (Gauss-Newton step below {TRUST_STEP:g} standard errors)"
 
 
@@ -362,14 +368,27 @@ class Scaled:
         """``(z, scaled residuals, status, scipy's result or None)`` of the given solver, else
         of SciPy's bounded trust-region solver, from ``z0``."""
         if solver is not None:
-            z, rs, nfev_s, status = run_solver(solver, self.fun, z0, self.names, self.scale,
-                                               self.lo, self.hi, self.fixed, self.rscale, ftol,
-                                               xtol, gtol, max_nfev)  # fmt: skip
+            z, rs, nfev_s, status = run_solver(
+                solver,
+                self.fun,
+                z0,
+                self.names,
+                self.scale,
+                self.lo,
+                self.hi,
+                self.fixed,
+                self.rscale,
+                ftol,
+                xtol,
+                gtol,
+                max_nfev,
+            )
             self.nfev += nfev_s
             return z, rs, status, None
         analytic = self.analytic if self.jac is not None else None
-        return scipy_solve(self.fun, z0, self.lo, self.hi, analytic, loss, ftol, xtol, gtol,
-                           max_nfev, self.workers)  # fmt: skip
+        return scipy_solve(
+            self.fun, z0, self.lo, self.hi, analytic, loss, ftol, xtol, gtol, max_nfev, self.workers
+        )
 
     def values_of(self, z: np.ndarray) -> dict[str, float]:
         v = dict(self.fixed)
@@ -389,10 +408,15 @@ class Scaled:
         assert self.jac is not None
         with np.errstate(all="ignore"):  # a non-finite column is reported below
             cols = self.jac(self.values_of(z))
-            return np.column_stack(
-                [np.asarray(cols[n], dtype=np.float64).reshape(-1) * s
-                 for n, s in zip(self.names, self.scale, strict=True)]
-            ) / self.rscale  # fmt: skip
+            return (
+                np.column_stack(
+                    [
+                        np.asarray(cols[n], dtype=np.float64).reshape(-1) * s
+                        for n, s in zip(self.names, self.scale, strict=True)
+                    ]
+                )
+                / self.rscale
+            )
 
     def jacobian(self, z: np.ndarray) -> np.ndarray:
         if self.jac is not None:

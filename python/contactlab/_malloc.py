@@ -17,7 +17,6 @@ library itself never changes the allocator); a no-op where there is no glibc ``m
 from __future__ import annotations
 
 import ctypes
-import ctypes.util
 import sys
 
 # mallopt parameters (malloc.h)
@@ -32,13 +31,24 @@ TOP_PAD = 64 << 20
 _done = False
 
 
+def _libc() -> ctypes.CDLL:
+    """glibc by its soname; ``ctypes.util.find_library`` only where that fails (it runs
+    ``ldconfig -p`` in a subprocess: 5-20 ms of every command's start-up)."""
+    try:
+        return ctypes.CDLL("libc.so.6")
+    except OSError:
+        from ctypes.util import find_library
+
+        return ctypes.CDLL(find_library("c") or "libc.so.6")
+
+
 def keep_freed_memory() -> bool:
     """Set the thresholds once per process; True when glibc accepted them."""
     global _done
     if _done or not sys.platform.startswith("linux"):
         return _done
     try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
+        libc = _libc()
         mallopt = libc.mallopt
     except (OSError, AttributeError):
         return False
@@ -65,7 +75,7 @@ def release_freed_memory() -> bool:
     if not sys.platform.startswith("linux"):
         return False
     try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
+        libc = _libc()
         trim = libc.malloc_trim
     except (OSError, AttributeError):
         return False

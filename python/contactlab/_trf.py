@@ -442,8 +442,9 @@ def solve(
     J0 = jacobian(x0)
     if not np.all(np.isfinite(f0)):
         raise ValueError("Residuals are not finite in the initial point.")
-    x, f, status, nfev, njev = _trf_bounds(vf.at, jacobian, x0, f0, J0, lb, ub, ftol, xtol,
-                                           gtol, max_nfev)  # fmt: skip
+    x, f, status, nfev, njev = _trf_bounds(
+        vf.at, jacobian, x0, f0, J0, lb, ub, ftol, xtol, gtol, max_nfev
+    )
     return Solution(x, f, status, nfev, njev)
 
 
@@ -511,8 +512,9 @@ def _trf_bounds(
         theta = max(0.995, 1 - g_norm)
         actual_reduction = -1
         while actual_reduction <= 0 and nfev < max_nfev:
-            p_h, alpha, _n_iter = _solve_lsq_trust_region(n, m, uf, s, V, Delta,
-                                                          initial_alpha=alpha)  # fmt: skip
+            p_h, alpha, _n_iter = _solve_lsq_trust_region(
+                n, m, uf, s, V, Delta, initial_alpha=alpha
+            )
             p = d * p_h
             step, step_h, predicted_reduction = _select_step(
                 x, J_h, diag_h, g_h, p, p_h, d, Delta, lb, ub, theta
@@ -527,9 +529,12 @@ def _trf_bounds(
             cost_new = 0.5 * np.dot(f_new, f_new)
             actual_reduction = cost - cost_new
             Delta_new, ratio = _update_tr_radius(
-                Delta, actual_reduction, predicted_reduction, step_h_norm,
+                Delta,
+                actual_reduction,
+                predicted_reduction,
+                step_h_norm,
                 step_h_norm > 0.95 * Delta,
-            )  # fmt: skip
+            )
             step_norm = norm(step)
             termination_status = _check_termination(
                 actual_reduction, cost, step_norm, norm(x), ratio, ftol, xtol

@@ -46,7 +46,7 @@ _VERB_ALIASES = {
 _TEMP = re.compile(r"(^|[/\\])\.([^/\\]+)\.[A-Za-z0-9_]+\.part$")
 
 
-def _os_error_text(exc: OSError) -> str:
+def os_error_text(exc: OSError) -> str:
     """``strerror: path``, naming the output the user asked for rather than its temporary."""
     name = exc.filename2 or exc.filename  # os.replace(tmp, final): final is filename2
     if name is None:
@@ -135,7 +135,7 @@ def _exit_interrupted() -> None:
 _READING_VERBS = {"analyze", "track", "diagnose"}
 
 
-def _prefetch(argv: list[str]) -> None:
+def prefetch_checks(argv: list[str]) -> None:
     """Start the structure check of each long HDF5 file named on the command line of a verb
     that reads recordings (:func:`contactlab.io.hdf5.prefetch_structure_check`: a scan of the
     whole file) before the verb's modules are imported, which then runs alongside."""
@@ -210,7 +210,7 @@ def join_negative_values(argv: list[str]) -> list[str]:
 def _main(argv: list[str]) -> int:
     given = list(argv)  # as typed, for the reports' "Made by" line
     argv = join_negative_values(argv)
-    _prefetch(argv)
+    prefetch_checks(argv)
     parser = build_parser(_verb_module(argv))
     args = parser.parse_args(argv)
     args.argv = given
@@ -223,7 +223,7 @@ def _main(argv: list[str]) -> int:
         print(f"contactlab {args.verb}: error: {cli_wording(str(exc))}", file=sys.stderr)
         return 1
     except OSError as exc:  # the file system said no (permissions, full disk, a file in the way)
-        print(f"contactlab {args.verb}: error: {_os_error_text(exc)}", file=sys.stderr)
+        print(f"contactlab {args.verb}: error: {os_error_text(exc)}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print(f"contactlab {args.verb}: interrupted; no partial outputs written", file=sys.stderr)

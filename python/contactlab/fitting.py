@@ -204,8 +204,10 @@ class FitResult:
             if p.stderr is None or not math.isfinite(p.stderr):
                 err = "(not identifiable: no finite standard error)"
             elif rel is not None and not rel < UNDETERMINED_REL_STDERR:
-                err = (f"(not identifiable: standard error {p.stderr:.2g}, over "
-                       f"{100 * UNDETERMINED_REL_STDERR:.0f} % of the value)")  # fmt: skip
+                err = (
+                    f"(not identifiable: standard error {p.stderr:.2g}, over "
+                    f"{100 * UNDETERMINED_REL_STDERR:.0f} % of the value)"
+                )
             else:
                 err = f"+/- {p.stderr:.4g}" + (f" ({100 * rel:.2f}%)" if rel is not None else "")
             flag = "" if p.identifiable is not False else "  [NOT IDENTIFIABLE]"
@@ -445,8 +447,11 @@ def _finish(
             for idx in np.flatnonzero(~keep):
                 v = Vt[idx]
                 involved = [names[i] for i in np.flatnonzero(np.abs(v) > 0.1)]
-                what = (f"the combination of {', '.join(involved)}" if len(involved) > 1
-                        else ", ".join(involved))  # fmt: skip
+                what = (
+                    f"the combination of {', '.join(involved)}"
+                    if len(involved) > 1
+                    else ", ".join(involved)
+                )
                 rel = s[idx] / s[0] if s[0] > 0 else 0.0
                 notes.append(
                     f"the data do not determine {what}: the fit is {rel:.1e} times as sensitive "

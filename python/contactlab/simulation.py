@@ -10,6 +10,13 @@ them, then keyword options of its own. :class:`Simulator` names that shape, so a
 can take "any model" (``isinstance(model, Simulator)`` at run time, or a type hint), and
 :func:`simulate` calls it with the input given by name or position.
 
+The results are typed objects with one shape, :class:`SimulatedResponse`: the sample times
+``t``, the main ``response`` (δ of a normal model, ``x`` of a structure, the measured output
+of a diagnosis model), and the solver's ``success``, ``status`` and ``message``. The normal
+models' :class:`~contactlab.normal.OdeResult` and the structures'
+:class:`~contactlab.structure.SimulationResult` have it themselves; :func:`simulate_response`
+returns it for every model (a model that returns a bare array gets a :class:`Response`).
+
 >>> from contactlab.normal import KelvinVoigt
 >>> isinstance(KelvinVoigt(k=1e12, psi=0.2, omega=1.0), Simulator)
 True
@@ -19,11 +26,15 @@ False
 
 from __future__ import annotations
 
-from typing import Any, Protocol, runtime_checkable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 from .errors import InputError
 
-__all__ = ["Simulator", "simulate"]
+if TYPE_CHECKING:
+    import numpy as np
+
+__all__ = ["Response", "SimulatedResponse", "Simulator", "simulate", "simulate_response"]
 
 
 @runtime_checkable
@@ -63,3 +74,75 @@ def simulate(model: Any, t: Any, *inputs: Any, **options: Any) -> Any:
     if not isinstance(model, Simulator):
         raise InputError(f"{type(model).__name__} is not a simulator: it has no simulate(t, ...)")
     return model.simulate(t, *inputs, **options)
+
+
+@runtime_checkable
+class SimulatedResponse(Protocol):
+    """The typed result of a simulation: times, the main response and the solver's verdict.
+
+    ``t`` holds the samples reached (shorter than asked when ``success`` is False),
+    ``response`` the model's main output at them (an array of ``len(t)`` rows), ``status`` 0
+    on success.
+    """
+
+    t: np.ndarray
+    success: bool
+    status: int
+    message: str
+
+    @property
+    def response(self) -> np.ndarray:
+        """The main output at ``t``."""
+        ...
+
+
+@dataclass(frozen=True)
+class Response:
+    """A :class:`SimulatedResponse` for a model whose ``simulate`` returns a bare array.
+
+    Attributes
+    ----------
+    t : ndarray
+        Sample times (s).
+    response : ndarray
+        The model's output at ``t``.
+    success, status, message
+        Always ``True``, ``0`` and ``""``: such a model either returns every sample or raises.
+    """
+
+    t: np.ndarray
+    response: np.ndarray
+    success: bool = True
+    status: int = 0
+    message: str = ""
+
+
+def simulate_response(model: Any, t: Any, *inputs: Any, **options: Any) -> SimulatedResponse:
+    """Run :func:`simulate` and return its result as a :class:`SimulatedResponse`.
+
+    Parameters
+    ----------
+    model : Simulator
+        Any of the package's simulating models.
+    t : array_like
+        Sample times (s).
+    *inputs, **options
+        The input(s) sampled at ``t`` and the model's own keyword options.
+
+    Returns
+    -------
+    SimulatedResponse
+        The model's own result object where it has that shape (``OdeResult``,
+        ``SimulationResult``), else a :class:`Response` around the returned array.
+
+    Raises
+    ------
+    InputError
+        When ``model`` has no ``simulate`` method.
+    """
+    import numpy as np  # the protocol itself loads no numpy
+
+    out = simulate(model, t, *inputs, **options)
+    if isinstance(out, SimulatedResponse):
+        return out
+    return Response(np.asarray(t, dtype=float), np.asarray(out))

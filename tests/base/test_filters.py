@@ -12,15 +12,15 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from contactlab.commands._common import output_filter_taps
+from contactlab.commands.common import output_filter_taps
 from contactlab.data import data_dir
 from contactlab.tangential.frame import (
     POLYORDER,
-    _lepski_square_sums,
+    lepski_square_sums,
     savgol_coefficients,
     savgol_derivative,
 )
-from contactlab.tangential.regime import _break_threshold
+from contactlab.tangential.regime import break_threshold
 
 signal = pytest.importorskip("scipy.signal")
 stats = pytest.importorskip("scipy.stats")
@@ -56,14 +56,14 @@ def test_lepski_sums_match_scipy_weights():
     def scipy_dot(w, deriv, dt):
         return signal.savgol_coeffs(w, POLYORDER, deriv=deriv, delta=dt, use="dot")
 
-    want = _lepski_square_sums(x, cands, 1e-3, coefficients=scipy_dot)
-    got = _lepski_square_sums(x, cands, 1e-3)
+    want = lepski_square_sums(x, cands, 1e-3, coefficients=scipy_dot)
+    got = lepski_square_sums(x, cands, 1e-3)
     np.testing.assert_allclose(got, want, rtol=1e-9)
 
 
 @pytest.mark.parametrize("positions", [1, 2, 17, 1000, 10**6])
 def test_break_threshold_is_the_chi2_quantile(positions):
-    assert _break_threshold(positions) == float(stats.chi2.isf(0.01 / positions, 1))
+    assert break_threshold(positions) == float(stats.chi2.isf(0.01 / positions, 1))
 
 
 @pytest.mark.parametrize(("window", "order"), [(5, 2), (11, 2), (11, 3), (31, 4)])

@@ -14,7 +14,7 @@ import pytest
 
 import contactlab
 from contactlab import cli
-from contactlab._io_atomic import write_text
+from contactlab.commands.common import write_json
 from contactlab.data import data_dir
 from contactlab.io import Recording, RecordingError, read_recording, write_recording
 from contactlab.report import Column, table_html
@@ -43,7 +43,7 @@ def _short_csv(path: Path, rows: list[str], header: str = "t [ms],x [um],F [N]")
 def test_atomic_outputs_get_ordinary_permissions(tmp_path):
     """JSON and recordings written by contactlab were 0600 (mkstemp's mode), unreadable for
     anyone else sharing the results folder."""
-    p = write_text(tmp_path / "a.json", "{}\n")
+    p = write_json(str(tmp_path / "a.json"), "{}\n")
     assert _mode(p) == default_mode()
     rec = Recording(np.arange(4) * 1e-3, {"x": np.zeros(4), "F": np.ones(4)}, {"x": "m", "F": "N"})
     q = write_recording(tmp_path / "r.csv", rec)
@@ -54,7 +54,7 @@ def test_atomic_outputs_keep_the_mode_of_the_file_they_replace(tmp_path):
     p = tmp_path / "a.json"
     p.write_text("old")
     os.chmod(p, 0o640)
-    write_text(p, "new")
+    write_json(str(p), "new")
     assert p.read_text() == "new" and _mode(p) == 0o640
 
 
@@ -241,7 +241,7 @@ def test_normal_json_gives_units_of_the_paper_b_coefficients(tmp_path, capsys):
 def test_cli_quantities_check_sign_and_dimension(capsys):
     """``--fs -5`` was accepted silently, ``--amplitude 5N`` became 5 m, ``--fs 10kHz`` was an
     unknown unit, and argparse replaced every reason with 'invalid quantity in Hz value'."""
-    from contactlab.commands._common import quantity
+    from contactlab.commands.common import quantity
 
     assert quantity("m")("20um") == 2e-05  # exact, not 1.9999999999999998e-05
     assert quantity("Hz", positive=True)("10kHz") == 1e4
@@ -286,12 +286,12 @@ def test_report_shows_the_uncertainty_of_the_numeric_loop_energy():
 
 def test_os_error_names_the_output_not_its_temporary():
     """'Is a directory: /tmp/.fit.json.h3a5bx85.part' named a file the user never asked for."""
-    from contactlab.cli import _os_error_text
+    from contactlab.cli import os_error_text
 
     e = IsADirectoryError(21, "Is a directory", "/d/.fit.json.h3a5bx85.part", "/d/fit.json")
-    assert _os_error_text(e) == "Is a directory: /d/fit.json"
+    assert os_error_text(e) == "Is a directory: /d/fit.json"
     e = NotADirectoryError(20, "Not a directory", "/d/afile/.report.html.k2_j4x9.part")
-    assert _os_error_text(e) == "Not a directory: /d/afile/report.html"
+    assert os_error_text(e) == "Not a directory: /d/afile/report.html"
 
 
 def test_polynomial_coefficients_get_their_own_units_in_the_table():

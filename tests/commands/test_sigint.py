@@ -56,6 +56,14 @@ def test_sigint_to_parent_only_exits_130_without_partial_output(tmp_path: Path) 
                     proc.communicate()
                     pytest.fail(f"run {i}: no exit {DEADLINE} s after SIGINT at {delays[i]:.2f} s")
                 waited = time.monotonic() - sent
+                if proc.returncode == -signal.SIGINT:
+                    # on a loaded machine the signal can arrive while the interpreter still
+                    # starts, before Python installs its SIGINT handler: the default action
+                    # ends it (a shell reports 130), with nothing said and nothing written
+                    assert err == b"", (i, err.decode()[-2000:])
+                    assert not out.exists(), f"run {i}: partial output {sorted(out.rglob('*'))}"
+                    outcomes.append(("before start-up", waited))
+                    continue
                 assert proc.returncode == 130, (i, proc.returncode, err.decode()[-2000:])
                 assert "interrupted" in err.decode(), err.decode()[-2000:]
                 assert not out.exists(), f"run {i}: partial output {sorted(out.rglob('*'))}"

@@ -124,7 +124,7 @@ def test_auto_streamed_analyze_ctrl_c_writes_nothing(rec_file, tmp_path, monkeyp
 
     monkeypatch.setattr(pooled, "STREAM_ABOVE", 4000)
     monkeypatch.setattr(track_mod, "_tangential_window", interrupted)
-    assert analyze_cmd._window_threads() >= 1
+    assert analyze_cmd.window_threads() >= 1
     out, rep = tmp_path / "o.json", tmp_path / "rep"
     code = main(["analyze", str(rec_file), "--model", "tangential", "--json", str(out),
                  "--report", str(rep), "--no-progress"])  # fmt: skip
@@ -301,16 +301,16 @@ def test_pool_weights_and_birge():
 
 def test_analyze_window_threads_from_the_environment(monkeypatch):
     from contactlab import InputError
-    from contactlab.commands.analyze import _window_threads
+    from contactlab.commands.common import window_threads
 
     monkeypatch.delenv("CONTACTLAB_ANALYZE_THREADS", raising=False)
-    assert 1 <= _window_threads() <= 2
+    assert 1 <= window_threads() <= 2
     monkeypatch.setenv("CONTACTLAB_ANALYZE_THREADS", "0")
-    assert _window_threads() == 0
+    assert window_threads() == 0
     for bad in ("-1", "two"):
         monkeypatch.setenv("CONTACTLAB_ANALYZE_THREADS", bad)
         with pytest.raises(InputError, match="CONTACTLAB_ANALYZE_THREADS"):
-            _window_threads()
+            window_threads()
 
 
 @pytest.mark.parametrize("how", ["flags", "tags"])

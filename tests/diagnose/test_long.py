@@ -174,20 +174,9 @@ _VALUES = {
 }  # fmt: skip
 
 
-#: known defect (issue 29 work, left open): the element scaled from rest at the actual
-#: turning points takes them from the kept record's reversals on a long record and from the
-#: noisy full-rate input on a whole one; its branch levels accumulate over the turns, so the
-#: two models part by 0.65 sigma^2 over 2000 cycles (bias^2/sigma^2 <= 1e-3 wanted)
-_KEPT_DEFECT = pytest.mark.xfail(
-    strict=True, reason="non_masing_scaling: kept-record turning points differ from the "
-    "full-rate ones (a long record's diagnosis of this effect is not the full-rate model's)",
-)  # fmt: skip
-
-
 @pytest.mark.parametrize(
     "effects",
-    [(), *((name,) if name != "non_masing_scaling" else pytest.param((name,), marks=_KEPT_DEFECT)
-           for name in CANDIDATES),
+    [(), *((name,) for name in CANDIDATES),
      ("displacement_offset", "asymmetry", "stick_slip", "parameter_drift", "channel_delay")],
 )  # fmt: skip
 def test_kept_record_model_is_the_full_rate_model(kept_and_full, effects):

@@ -122,10 +122,13 @@ def test_swap_step_label_and_json():
 
 def test_swap_move_reaches_an_effect_never_tried_because_the_set_filled():
     """Behind anti-alias filters at 0.3 / 0.6 of Nyquist, Stribeck friction first looks like
-    parallel stiffness + stick-slip + a branch scale; with max_effects = 3 reached, stribeck
-    is never tried as an addition. The swap move replaces an effect by stribeck; each swap is a
-    step. With the channel delay among the candidates the truth (stribeck and the filters'
-    skew) is named, by whichever route the search takes."""
+    parallel stiffness + a breakaway after each reversal. With the channel delay among the
+    candidates the truth (stribeck and the filters' skew) is named, by whichever route the
+    search takes. Without it and with max_effects = 2 reached, the swap move replaces each
+    named effect by each candidate not in the model, stribeck included, and every swap is
+    judged and listed ("out ⇄ in"); with docs/effects.md's breakaway the stand-ins predict
+    this record better than stribeck in place of either (in-sample gains -3.9 and -4.8 σ²),
+    so none is taken: a swap is made only where it predicts the held-out cycles better."""
     rec = hidden_effect_recording(
         ["stribeck"], magnitude=0.05, noise=0.005, input_noise=0.002,
         samples_per_cycle=200, anti_alias=(0.3, 0.6), bits=16, seed=92010,
@@ -136,21 +139,17 @@ def test_swap_move_reaches_an_effect_never_tried_because_the_set_filled():
                     "channel_delay"],
     )  # fmt: skip
     assert sorted(rep.effect_names) == ["channel_delay", "stribeck"]
-    # without the delay candidate the set fills with stand-ins before stribeck is tried
-    rep = contactlab.diagnose(
-        rec, candidates=["parallel_stiffness", "stick_slip", "non_masing_scaling", "stribeck"]
-    )
-    assert "stribeck" in rep.effect_names
-    swaps = [s for s in rep.steps if s.removed is not None and s.added is not None]
-    assert swaps and swaps[0].added == "stribeck"
-    assert all(s.removal is not None and s.removal.accepted for s in swaps)
-    assert all(s.heldout_rms < rep.steps[0].heldout_rms for s in swaps)
-    assert any(w.startswith(f"swap: {swaps[0].removed} replaced by stribeck") for w in rep.where)
-    js = rep.to_dict()["steps"]
-    assert any(s["removed"] == swaps[0].removed and s["added"] == "stribeck" for s in js)
-    assert f"{swaps[0].removed} ⇄ stribeck" in rep.table()
-    # the verdicts on the swaps tried are kept with the step they were tried after
-    assert any("⇄" in v.name for s in rep.steps for v in s.candidates)
+    full = contactlab.diagnose(
+        rec, candidates=["parallel_stiffness", "stick_slip", "non_masing_scaling", "stribeck"],
+        max_effects=2,
+    )  # fmt: skip
+    assert len(full.effect_names) == 2 and "stribeck" not in full.effect_names
+    tried = [v for v in full.steps[-1].candidates if "⇄" in v.name]
+    named = set(full.effect_names)
+    assert {v.name for v in tried} >= {f"{e} ⇄ stribeck" for e in named}
+    for v in tried:
+        assert not v.accepted and np.isfinite(v.gain) and v.gain < 0
+    assert not any(s.removed is not None and s.added is not None for s in full.steps)
 
 
 def test_pair_move_names_an_offset_and_a_drift_that_each_look_like_a_displacement_offset():

@@ -21,7 +21,7 @@ from contactlab.fem import (
     unit_system,
 )
 from contactlab.fem.ccx import parse_dat
-from contactlab.fem.checks import _interaction_lines, _loop_energy, pinned_spring_beam_frequency
+from contactlab.fem.checks import interaction_lines, loop_energy, pinned_spring_beam_frequency
 from contactlab.fem.models import Beam, Block, beam_deck, two_block_deck
 from contactlab.synthetic.normal import synthetic_recording as normal_recording
 from contactlab.synthetic.tangential import synthetic_recording
@@ -91,7 +91,7 @@ def test_calculix_and_abaqus_text(tangential: dict, normal: dict) -> None:
     txt = render(jn, "abaqus", mm)
     assert "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=TABULAR" in txt
     assert "*CONTACT DAMPING, DEFINITION=DAMPING COEFFICIENT" in txt
-    rows = _interaction_lines(render(jn, "calculix", mm))[1 : 1 + len(jn.table)]
+    rows = interaction_lines(render(jn, "calculix", mm))[1 : 1 + len(jn.table)]
     tab = np.array([[float(v) for v in r.split(",")] for r in rows])
     assert np.allclose(tab, jn.table * [1e-6, 1e3], rtol=1e-8)
 
@@ -309,7 +309,7 @@ def test_loop_energy_of_a_bilinear_loop() -> None:
     fs, k, A = 2.0, 10.0, 1.0
     x = np.array([A, A - 2 * fs / k, -A, -A + 2 * fs / k])
     f = np.array([fs, -fs, -fs, fs])
-    assert _loop_energy(x, f) == pytest.approx(4 * fs * (A - fs / k))
+    assert loop_energy(x, f) == pytest.approx(4 * fs * (A - fs / k))
 
 
 def test_check_without_ccx_names_the_package(tmp_path, capsys, monkeypatch, normal) -> None:

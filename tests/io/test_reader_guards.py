@@ -369,7 +369,7 @@ def test_structure_check_started_ahead_is_waited_for_and_damage_still_named(tmp_
     """The command line starts the scan of a long HDF5 file before importing the analysis
     (``prefetch_structure_check``); the call that opens the file waits for it instead of
     scanning again, and a damaged file is refused by that call with its own message."""
-    from contactlab.cli import _prefetch
+    from contactlab.cli import prefetch_checks
     from contactlab.io import hdf5
 
     scans = []
@@ -378,7 +378,7 @@ def test_structure_check_started_ahead_is_waited_for_and_damage_still_named(tmp_
     monkeypatch.setattr(hdf5, "_CACHE_ABOVE", 1 << 10)
     monkeypatch.setattr(hdf5, "_CHECKED", set())
     path, _ = _gcol_file(tmp_path)
-    _prefetch(["analyze", str(path), "--model", "tangential"])
+    prefetch_checks(["analyze", str(path), "--model", "tangential"])
     hdf5.check_structure(path, file=str(path))
     assert read_recording(path).t.size == 64
     assert len(scans) == 1  # the scan started ahead, waited for; not run again

@@ -88,3 +88,55 @@ def test_help_lists_the_verb(capsys):
     with pytest.raises(SystemExit):
         main(["fit-joint", "--help"])
     assert "--predict" in capsys.readouterr().out
+
+
+def _npy_test(folder, stem, law, fs=200.0, n=1200, amp=2e-3, freq=1.0):
+    """A test stored as the friction damper's: <stem>_x.npy and <stem>_F.npy, shape (1, N),
+    no time column."""
+    t = np.arange(n) / fs
+    x = amp * np.sin(2 * np.pi * freq * t)
+    np.save(folder / f"{stem}_x.npy", x[None, :])
+    np.save(folder / f"{stem}_F.npy", law.force(t, x)[None, :])
+    return folder / f"{stem}_x.npy", folder / f"{stem}_F.npy"
+
+
+def test_npy_pairs_without_time_read_with_fs(tmp_path, capsys):
+    law = Jenkins(5e3, 4.0)
+    a_x, a_F = _npy_test(tmp_path, "test0", law)
+    _, b_F = _npy_test(tmp_path, "test1", law, amp=3e-3)
+    out = tmp_path / "out.json"
+    code = main(["fit-joint", "--law", "jenkins", "--fit", str(a_x), str(a_F), "--predict",
+                 str(b_F), "--fs", "200", "--json", str(out)])  # fmt: skip
+    assert code == 0, capsys.readouterr().err
+    res = json.loads(out.read_text())
+    text = json.dumps(res)
+    assert "test0" in text and "test1" in text
+    fitted = res["fits"][0] if "fits" in res else res
+    assert "jenkins" in json.dumps(fitted)
+
+
+@pytest.mark.parametrize(
+    ("setup", "message"),
+    [
+        ("no_fs", "give the sampling rate with --fs"),
+        ("no_partner", "test0_F.npy, is not next to it"),
+        ("bad_name", "name the test's files"),
+        ("lengths", "has 1200 samples"),
+    ],
+)
+def test_npy_pairs_missing_parts_are_named(tmp_path, capsys, setup, message):
+    a_x, a_F = _npy_test(tmp_path, "test0", Jenkins(5e3, 4.0))
+    argv = ["fit-joint", "--law", "jenkins", "--fit", str(a_x), "--fs", "200"]
+    if setup == "no_fs":
+        argv = argv[:-2]
+    elif setup == "no_partner":
+        a_F.unlink()
+    elif setup == "bad_name":
+        np.save(tmp_path / "alone.npy", np.zeros((1, 50)))
+        argv[argv.index(str(a_x))] = str(tmp_path / "alone.npy")
+    elif setup == "lengths":
+        np.save(a_F, np.zeros((1, 900)))
+    assert main(argv) == 1
+    err = capsys.readouterr().err
+    assert message in err
+    assert "Traceback" not in err

@@ -65,15 +65,28 @@ def _beam_table():
     return A, c, f
 
 
-def test_beam_damping_table_and_segalman_fit_within_the_bar():
+def test_beam_damping_table_segalman_physical_and_free_chi():
     A, c, f = _beam_table()
     # the README: damping rises about 4x over 20-315 um
     assert A.min() == pytest.approx(19.6e-6, rel=0.02)
     assert A.max() == pytest.approx(315e-6, rel=0.02)
     assert c[np.argmax(A)] / c[np.argmin(A)] > 4.0
+    # by default χ is kept in Segalman's physical range −1 < χ <= 0: the table's damping
+    # grows faster than A^1 above its viscous floor, which micro-slip with χ <= 0 cannot
+    # follow (measured: χ -> 0, RMS error 11.7 %)
     res = fit_amplitude(A, damping=c, frequency=f, law="segalman", viscous=True)
     assert res.success
-    assert res.rms_relative_error("c_eq") < 0.05  # the bar (measured: 2.4 %)
+    assert -0.99 <= res.law.chi <= 0.0
+    assert 0.05 < res.rms_relative_error("c_eq") < 0.13
+    assert not any("outside the physical range" in n for n in res.result.notes)
+    # with χ free the table is fitted within the bar (measured: 3.1 %) at χ ≈ 0.79,
+    # which the result reports as out of range
+    free = fit_amplitude(A, damping=c, frequency=f, law="segalman", viscous=True,
+                         bounds={"chi": (-0.99, 1.0)})  # fmt: skip
+    assert free.success
+    assert free.rms_relative_error("c_eq") < 0.05
+    assert free.law.chi > 0
+    assert any("chi = " in n and "outside the physical range" in n for n in free.result.notes)
 
 
 def test_tribometer_law_from_early_cycles_predicts_later_ones():

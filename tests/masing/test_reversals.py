@@ -179,7 +179,7 @@ def test_force_many_into_given_outputs_with_per_thread_stats():
 
 def test_phase_fold_equals_numpy_bincount_and_streams():
     from contactlab import _core
-    from contactlab.tangential.preprocess import _phase_knots, find_reversals, phase_of
+    from contactlab.tangential.preprocess import find_reversals, phase_knots, phase_of
 
     rng = np.random.default_rng(8)
     n = 20_000
@@ -192,7 +192,7 @@ def test_phase_fold_equals_numpy_bincount_and_streams():
     cyc = np.floor(ph).astype(np.int64)
     frac = ph - cyc
     b = np.minimum((frac * nb).astype(np.int64), nb - 1)
-    kt, kp = _phase_knots(rev)
+    kt, kp = phase_knots(rev)
     fold = _core.PhaseFold(nb, n_cyc)
     for a in range(0, n, 3001):  # chunk by chunk
         fold.push(t[a : a + 3001], x[a : a + 3001], F[a : a + 3001], a, kt, kp)

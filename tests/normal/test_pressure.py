@@ -10,7 +10,7 @@ import pytest
 
 from contactlab import ContactLabWarning, InputError
 from contactlab.cli import main
-from contactlab.commands._common import with_static_pressure
+from contactlab.commands.common import with_static_pressure
 from contactlab.io import read_recording
 from contactlab.normal import analyze_loop
 from contactlab.synthetic.normal import synthetic_recording

@@ -14,15 +14,15 @@ import pytest
 from matplotlib.backends.backend_agg import RendererAgg
 from matplotlib.font_manager import FontProperties
 
-from contactlab._html import _CSS, NBSP, Report, table_html
+from contactlab.report import CSS, NBSP, Report, table_html
 from contactlab.studies.columns import NORMAL_COLUMNS, TANGENTIAL_COLUMNS
 
 #: body{max-width:1100px}: the content width of the page at a 1400 px window
 PAGE = 1100.0
-FONT_PX = 16 * float(re.search(r"table\{[^}]*font-size:([.\d]+)em", _CSS).group(1))
+FONT_PX = 16 * float(re.search(r"table\{[^}]*font-size:([.\d]+)em", CSS).group(1))
 #: th,td{padding:V Hem}: twice H, and a 1 px border
 PAD_PX = (
-    2 * float(re.search(r"th,td\{[^}]*padding:[.\d]+em ([.\d]+)em", _CSS).group(1)) * FONT_PX + 1
+    2 * float(re.search(r"th,td\{[^}]*padding:[.\d]+em ([.\d]+)em", CSS).group(1)) * FONT_PX + 1
 )
 
 # the demo's rows (contactlab demo --quick; SI as in study_*.csv)
@@ -63,7 +63,7 @@ def _width(text: str, bold: bool) -> float:
 def _rule(selector: str) -> str:
     """The declarations of every CSS rule whose selector list names ``selector``."""
     out = []
-    for sel, body in re.findall(r"([^{}]+)\{([^}]*)\}", _CSS):
+    for sel, body in re.findall(r"([^{}]+)\{([^}]*)\}", CSS):
         if selector in [s.strip() for s in sel.split(",")]:
             out.append(body)
     return ";".join(out)

@@ -172,17 +172,17 @@ def test_cli_columns_by_bare_name():
     """``--u u --y x0,x1`` pick the columns ``u [N]``, ``x0 [m]``, ``x1 [m]`` that contactlab's
     own writers (``simulate structure``, ``write_recording``) head them with."""
     from contactlab import InputError
-    from contactlab.commands.structure import _pick
+    from contactlab.commands.structure import pick_column
 
     cols = {"t [s]": np.zeros(2), "u [N]": np.zeros(2), "x0 [m]": np.zeros(2), "x1_m": np.zeros(2)}
-    assert _pick(cols, "u", (), "u", "f.csv") == "u [N]"
-    assert _pick(cols, "x1", (), "y", "f.csv") == "x1_m"
-    assert _pick(cols, "x0 [m]", (), "y", "f.csv") == "x0 [m]"
+    assert pick_column(cols, "u", (), "u", "f.csv") == "u [N]"
+    assert pick_column(cols, "x1", (), "y", "f.csv") == "x1_m"
+    assert pick_column(cols, "x0 [m]", (), "y", "f.csv") == "x0 [m]"
     with pytest.raises(InputError, match="no column 'x2'"):
-        _pick(cols, "x2", (), "y", "f.csv")
+        pick_column(cols, "x2", (), "y", "f.csv")
     both = {"u [N]": np.zeros(2), "u_N": np.zeros(2)}  # ambiguous: refused, not guessed
     with pytest.raises(InputError, match="no column 'u'"):
-        _pick(both, "u", (), "u", "f.csv")
+        pick_column(both, "u", (), "u", "f.csv")
 
 
 def test_cli_identify_masks_inline_and_file(tmp_path, capsys):

@@ -16,7 +16,7 @@ import pytest
 
 from contactlab import InputError
 from contactlab.cli import main
-from contactlab.commands._common import default_workers, resolve_workers
+from contactlab.commands.common import default_workers, resolve_workers
 from contactlab.data import data_dir
 from contactlab.report.study_report import build_report
 from contactlab.studies import run_study

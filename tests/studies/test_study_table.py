@@ -24,7 +24,7 @@ from contactlab.report.study_plots import (
     trends,
 )
 from contactlab.studies.manifest import StudyEntry
-from contactlab.studies.study import RecordingResult, StudyResult, _flatten
+from contactlab.studies.study import RecordingResult, StudyResult, flatten
 
 
 def _tangential_rows():
@@ -115,7 +115,7 @@ def test_failures_are_kept_out_of_the_table():
 
 
 def test_flatten_vectors_nested_and_numpy():
-    row, units = _flatten(
+    row, units = flatten(
         {
             "poly_load": np.array([1.0, 2.0, 3.0]),
             "k": np.float64(2.5),

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 import contactlab
 from contactlab import InputError
 from contactlab.io import Recording, write_recording
-from contactlab.studies._cycles import CycleState, block_cycles
+from contactlab.studies.cycles import CycleState, block_cycles
 from contactlab.studies.tracking import parse_every, track
 from contactlab.synthetic.normal import synthetic_recording as normal_recording
 from contactlab.synthetic.tangential import synthetic_recording
@@ -285,13 +285,14 @@ def test_window_analysis_equals_the_whole_analysis(case, invert):
     ties=st.booleans(),
 )
 def test_phase_knots_vectorised_equals_the_loop(pt, vt, ties):
-    from contactlab.tangential.preprocess import Reversals, _phase_knots, _phase_knots_loop
+    from contactlab.tangential.preprocess import Reversals, phase_knots
+    from fold_reference import phase_knots_loop
 
     p = np.sort(np.asarray(pt, dtype=float))
     v = np.sort(np.r_[vt, p[:2]] if ties else np.asarray(vt, dtype=float))
     e = np.empty(0, dtype=np.int64)
     rev = Reversals(e, e, p, v, 1.0, 0.0)
-    for a, b in zip(_phase_knots(rev), _phase_knots_loop(rev), strict=True):
+    for a, b in zip(phase_knots(rev), phase_knots_loop(rev), strict=True):
         np.testing.assert_array_equal(a, b)
 
 
@@ -446,7 +447,7 @@ def test_threads_read_on_when_a_younger_window_finishes_first(long_rec, monkeypa
 def test_fold_spread_is_the_numpy_spread(seed, n_bins, n_cyc):
     """PhaseFold.spread (Rust) against preprocess' numpy formulas, cells left empty included."""
     from contactlab import _core
-    from contactlab.tangential.preprocess import _dphase, _spread
+    from fold_reference import dphase, spread
 
     rng = np.random.default_rng(seed)
     n = n_cyc * n_bins * 3
@@ -461,8 +462,8 @@ def test_fold_spread_is_the_numpy_spread(seed, n_bins, n_cyc):
         cx, cF = s["cycle_x"] / s["cycle_count"], s["cycle_F"] / s["cycle_count"]
         dphi = s["cycle_phase"] / s["cycle_count"] - s["sum_phase"] / s["count"]
         xm, Fm = s["sum_x"] / s["count"], s["sum_F"] / s["count"]
-        ref_x = _spread(cx - _dphase(xm, n_bins) * dphi)
-        ref_F = _spread(cF - _dphase(Fm, n_bins) * dphi)
+        ref_x = spread(cx - dphase(xm, n_bins) * dphi)
+        ref_F = spread(cF - dphase(Fm, n_bins) * dphi)
     np.testing.assert_allclose(got["x_std"], ref_x, rtol=1e-12, atol=0)
     np.testing.assert_allclose(got["F_std"], ref_F, rtol=1e-12, atol=0)
     with np.errstate(invalid="ignore"):
@@ -531,7 +532,7 @@ def test_window_fold_spread_is_exact_on_the_cells(seed, offset, spread):
 def test_detrend_pair_is_numpys_expression_bit_for_bit(seed, n, exp, slopes):
     """The window's drift removal in one Rust pass equals numpy's ``v - s·(t - tm)``."""
     from contactlab import _core
-    from contactlab.tangential.window import _detrended
+    from fold_reference import detrended
 
     rng = np.random.default_rng(seed)
     t = np.cumsum(rng.uniform(1e-4, 1.0, n))
@@ -539,8 +540,8 @@ def test_detrend_pair_is_numpys_expression_bit_for_bit(seed, n, exp, slopes):
     F = rng.standard_normal(n) * 10.0**exp
     x = rng.standard_normal(n) * 1e-5
     a, b = _core.detrend_pair(t, tm, F, slopes[0], x, slopes[1])
-    np.testing.assert_array_equal(a, _detrended(F, t, tm, slopes[0]))
-    np.testing.assert_array_equal(b, _detrended(x, t, tm, slopes[1]))
+    np.testing.assert_array_equal(a, detrended(F, t, tm, slopes[0]))
+    np.testing.assert_array_equal(b, detrended(x, t, tm, slopes[1]))
     np.testing.assert_array_equal(a, F - slopes[0] * (t - tm))
     with pytest.raises(InputError):
         _core.detrend_pair(t, tm, F[: n - 1], 1.0, x, 1.0)

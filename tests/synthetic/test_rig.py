@@ -14,13 +14,13 @@ from contactlab.synthetic.rig import (
     Virgin,
     butterworth,
     discretise,
+    group_delay,
     load_cell,
     masing_force,
     play_operator,
     rig_recording,
     segalman_parameters,
 )
-from contactlab.synthetic.rig import _group_delay as group_delay
 
 H0, AC = 40.0, 4.0e4
 

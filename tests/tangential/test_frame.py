@@ -221,16 +221,16 @@ def test_measured_friction_rises_with_the_normal_load(measured):
 def test_smooth_peak_reads_a_peak_without_the_noise_maximum():
     """Exact on a noiseless parabola; on a noisy plateau (static equal to kinetic friction)
     it overshoots less than the largest sample does."""
-    from contactlab.tangential.regime import _smooth_peak
+    from contactlab.tangential.regime import smooth_peak
 
     i = np.arange(60.0)
-    assert _smooth_peak(1.0 - 1e-3 * (i - 31.3) ** 2, 11) == pytest.approx(1.0, abs=1e-9)
+    assert smooth_peak(1.0 - 1e-3 * (i - 31.3) ** 2, 11) == pytest.approx(1.0, abs=1e-9)
     rng = np.random.default_rng(77)
     over_max, over_smooth = [], []
     for _ in range(200):
         g = 0.8 + rng.normal(0.0, 0.01, 80)
         over_max.append(np.max(g) - 0.8)
-        over_smooth.append(_smooth_peak(g, 11) - 0.8)
+        over_smooth.append(smooth_peak(g, 11) - 0.8)
     assert np.mean(over_smooth) < 0.6 * np.mean(over_max)
 
 

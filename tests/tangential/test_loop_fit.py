@@ -14,13 +14,13 @@ from contactlab import InputError, _core
 from contactlab.fitting import least_squares_fit
 from contactlab.synthetic.tangential import synthetic_recording
 from contactlab.tangential import steps
-from contactlab.tangential.window import _window_detrended
+from contactlab.tangential.window import window_detrended
 
 _OPTS = {"n_points": None, "rel_threshold": 0.5, "min_cycles": 2, "detrend": True}
 
 
 def _problem(rec, prior: bool):
-    det = _window_detrended(rec["x"], rec["F"], rec.t, _OPTS)
+    det = window_detrended(rec["x"], rec["F"], rec.t, _OPTS)
     data = steps.fit_data(det, rec.t, on="averaged", steady=True, rel_threshold=0.5)
     sv = steps.start_values(data, rel_threshold=0.5, fit_offset=True, fit_x0=True,
                             fit_amplitude=True, initial=None)  # fmt: skip

@@ -50,7 +50,7 @@ def _lepski_statistics(x: np.ndarray, dt: float) -> None:
     cands = sorted({w | 1 for w in np.geomspace(7, top, 16).astype(int) if w >= 7})
     if len(cands) < 2:
         return
-    sq = frame._lepski_square_sums(x, cands, dt, block=997)  # many blocks, odd size
+    sq = frame.lepski_square_sums(x, cands, dt, block=997)  # many blocks, odd size
     ests = {w: frame.savgol_derivative(x, w, 2, dt) for w in cands}
     for i, w in enumerate(cands[1:], start=1):
         inner = slice(w // 2, n - w // 2)

@@ -163,12 +163,12 @@ def test_analytic_jacobian_equals_finite_differences(ac, amp_factor, prior):
     above the bins' range put some bins beyond a turn (on their branch's tangent there);
     ac = 3 1/m is a nearly linear loop (ac·A ~ 5e-5), where the ac column's two terms
     cancel."""
-    from contactlab.tangential.window import _window_detrended
+    from contactlab.tangential.window import window_detrended
 
     rec = synthetic_recording(h0=2e6 / ac, ac=ac, amplitude=15e-6, n_cycles=8, fs=1500.0,
                               frequency=2.0, noise=0.02, x_noise=0.01, seed=6911)  # fmt: skip
     opts = {"n_points": None, "rel_threshold": 0.5, "min_cycles": 2, "detrend": True}
-    det = _window_detrended(rec["x"], rec["F"], rec.t, opts)
+    det = window_detrended(rec["x"], rec["F"], rec.t, opts)
     data = steps.fit_data(det, rec.t, on="averaged", steady=True, rel_threshold=0.5)
     assert data.bin_var is not None
     pr = steps.PriorRows(("x0", "amplitude"), 1e-8, 15e-6, 2e-8, 0.3) if prior else None

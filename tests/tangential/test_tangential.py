@@ -106,7 +106,7 @@ def test_monotone_path_is_monotone_between_turns(seed, n):
 def test_monotone_path_is_scipys_isotonic_regression(seed, n, k, ties):
     """The Rust projection gives SciPy's numbers (ties pooled, both directions, turns at the
     ends and repeated)."""
-    from contactlab.tangential.preprocess import _monotone_path_scipy
+    from fold_reference import monotone_path_scipy
 
     rng = np.random.default_rng(seed)
     x = np.cumsum(rng.standard_normal(n))
@@ -114,7 +114,7 @@ def test_monotone_path_is_scipys_isotonic_regression(seed, n, k, ties):
         x = np.round(x)
     turns = np.sort(rng.integers(0, n + 1, size=k))
     np.testing.assert_allclose(
-        monotone_path(x, turns), _monotone_path_scipy(x, turns), rtol=1e-14, atol=1e-14
+        monotone_path(x, turns), monotone_path_scipy(x, turns), rtol=1e-14, atol=1e-14
     )
 
 
@@ -559,7 +559,7 @@ def test_brentq_refuses_an_unbracketed_root():
     ).filter(lambda v: not all(math.isnan(a) for a in v))
 )
 def test_tip_nanmean_is_numpys_bit_for_bit(v):
-    from contactlab.tangential.turns import _nanmean
+    from contactlab.tangential.turns import nanmean
 
     a = np.asarray(v)
-    assert _nanmean(a) == float(np.nanmean(a))
+    assert nanmean(a) == float(np.nanmean(a))

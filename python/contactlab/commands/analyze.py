@@ -14,9 +14,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from .._options import as_dict
 from ..errors import InputError
-from ._common import (
+from .common import (
     FORCE_SIGN_CHOICES,
     add_frame_flags,
     add_pressure_flags,
@@ -37,22 +36,34 @@ from ._common import (
     quantity,
     recording_json,
     refuse_if_none_analysed,
+    window_threads,
     wrap_warning,
     wrapped,
     write_json,
     write_report,
 )
-from ._common import window_threads as _window_threads
 
 _SUMMARY = {
-    "tangential": [("h0", "N", 1.0), ("ac", "1/m", 1.0), ("h0_ac", "N/m", 1.0),
-                   ("amplitude", "um", 1e6),
-                   ("energy_per_cycle", "J", 1.0), ("equivalent_damping", "N/m", 1.0),
-                   ("k_local0", "N/m", 1.0), ("k_global", "N/m", 1.0), ("mu", "", 1.0),
-                   ("normal_load", "N", 1.0)],
-    "normal": [("E_d", "J/m^2", 1.0), ("psi", "", 1.0), ("psi_kv", "", 1.0),
-               ("k_tan", "Pa/m", 1.0), ("k_sec", "Pa/m", 1.0)],
-}  # fmt: skip
+    "tangential": [
+        ("h0", "N", 1.0),
+        ("ac", "1/m", 1.0),
+        ("h0_ac", "N/m", 1.0),
+        ("amplitude", "um", 1e6),
+        ("energy_per_cycle", "J", 1.0),
+        ("equivalent_damping", "N/m", 1.0),
+        ("k_local0", "N/m", 1.0),
+        ("k_global", "N/m", 1.0),
+        ("mu", "", 1.0),
+        ("normal_load", "N", 1.0),
+    ],
+    "normal": [
+        ("E_d", "J/m^2", 1.0),
+        ("psi", "", 1.0),
+        ("psi_kv", "", 1.0),
+        ("k_tan", "Pa/m", 1.0),
+        ("k_sec", "Pa/m", 1.0),
+    ],
+}
 
 
 #: width the console's summary lines and warnings are wrapped to
@@ -224,13 +235,23 @@ def _auto_streamed(
 
     path = entry.path  # type: ignore[attr-defined]
     kind = entry.kind  # type: ignore[attr-defined]
-    res = track(path, "auto", kind=kind, columns=columns, fs=args.fs, executor=ex,
-                resample=getattr(args, "resample", False),
-                options=opts, keep_documents=True, threads=_window_threads())  # fmt: skip
+    res = track(
+        path,
+        "auto",
+        kind=kind,
+        columns=columns,
+        fs=args.fs,
+        executor=ex,
+        resample=getattr(args, "resample", False),
+        options=opts,
+        keep_documents=True,
+        threads=window_threads(),
+    )
     if not res.window_docs:
         errors = "; ".join(str(r.get("error")) for r in res.rows if r.get("error"))
-        raise RecordingError(f"no window of the streamed analysis could be fitted: {errors}",
-                             file=str(path))  # fmt: skip
+        raise RecordingError(
+            f"no window of the streamed analysis could be fitted: {errors}", file=str(path)
+        )
     n = res.meta["n_samples"]
     reason = (
         f"{n} samples > {STREAM_ABOVE}: analysed in {len(res.rows)} windows of whole cycles "
@@ -291,6 +312,7 @@ def _handler(args: argparse.Namespace) -> int:
     if args.delay is not None and args.model != "tangential":
         raise InputError("--delay is for tangential recordings (force against displacement)")
     # the flags parsed into the typed options (issue 32); the library takes them as dicts too
+    from .._options import as_dict
     from ..normal.options import Options as NormalOptions
     from ..tangential.options import Options as TangentialOptions
 
@@ -340,9 +362,15 @@ def _in_memory(
     """``analyze`` of recordings read whole: on ``ex`` (a process pool) or serially."""
     from ..studies.study import run_study
 
-    result = run_study(entries, progress=args.progress, keep_going=args.keep_going,
-                       tangential_options=topts, normal_options=nopts, executor=ex,
-                       keep_recordings=True)  # fmt: skip
+    result = run_study(
+        entries,
+        progress=args.progress,
+        keep_going=args.keep_going,
+        tangential_options=topts,
+        normal_options=nopts,
+        executor=ex,
+        keep_recordings=True,
+    )
     # With --json -, stdout carries the JSON alone; everything else goes to stderr.
     say = sys.stderr if args.json == "-" else sys.stdout
     for r in result.results:
@@ -351,8 +379,9 @@ def _in_memory(
             if rebuilt:
                 from ..tangential.frame import describe_reconstruction
 
-                print(f"{r.entry.path}: friction frame: {describe_reconstruction(rebuilt)}",
-                      file=say)  # fmt: skip
+                print(
+                    f"{r.entry.path}: friction frame: {describe_reconstruction(rebuilt)}", file=say
+                )
             print(summary_lines(str(r.entry.path), r.row, r.entry.kind), file=say)
             if r.row.get("warnings"):
                 for w in str(r.row["warnings"]).split(" | "):
@@ -361,8 +390,9 @@ def _in_memory(
                 print(r.analysis.report(), file=say)
         else:
             print(f"{r.entry.path}: FAILED: {r.error}", file=sys.stderr)
-    refuse_if_none_analysed(sum(r.ok for r in result.results),
-                            [str(r.error) for r in result.failures])  # fmt: skip
+    refuse_if_none_analysed(
+        sum(r.ok for r in result.results), [str(r.error) for r in result.failures]
+    )
     doc = json_text(json_document(result)) if args.json else None
     if args.report:
         title = f"contactlab analyze ({args.model}, {len(entries)} recording(s))"
@@ -513,8 +543,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--delay", type=quantity("s"), default=None, help=DELAY_HELP)
     add_pressure_flags(p)
     add_frame_flags(p)
-    p.add_argument("--keep-going", action="store_true",
-                   help="skip recordings that fail (exit code 1) instead of stopping")  # fmt: skip
+    p.add_argument(
+        "--keep-going",
+        action="store_true",
+        help="skip recordings that fail (exit code 1) instead of stopping",
+    )
     p.add_argument("-v", "--verbose", action="store_true", help="print each fit report")
     p.add_argument(
         "--stream",
@@ -532,9 +565,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--every", default="auto", help="window of --stream: 'auto' (default), '200cycles' or '10s'"
     )
-    p.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="analyse the recordings (four or more files: one process per core by "
-                   "default) or the windows of --stream in N processes (0: in this "
-                   "process)")  # fmt: skip
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        metavar="N",
+        help="analyse the recordings (four or more files: one process per core by "
+        "default) or the windows of --stream in N processes (0: in this "
+        "process)",
+    )
     add_progress_flags(p)
     p.set_defaults(handler=_handler)

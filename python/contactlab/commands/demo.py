@@ -134,7 +134,7 @@ def run_demo(
     from ..report import commit_outputs
     from ..report.study_report import build_report
     from ..studies import run_study
-    from ._common import process_pool
+    from .common import process_pool
 
     files = masing_outputs()
     intro = (f"Made by: {command}. " if command else "") + (
@@ -156,7 +156,7 @@ def run_demo(
 
 def _handler(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
-    from ._common import made_by, resolve_workers
+    from .common import made_by, resolve_workers
 
     workers = resolve_workers(args.workers)
     paths = run_demo(
@@ -177,7 +177,7 @@ def _handler(args: argparse.Namespace) -> int:
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    from ._common import add_progress_flags
+    from .common import add_progress_flags
 
     p = sub.add_parser(
         "demo",
@@ -189,8 +189,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--out", default="demo-output", help="output folder (default: demo-output)")
     p.add_argument("--quick", action="store_true", help="a reduced set (one file per material)")
-    p.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="analyse the recordings and draw the figures in N processes (default: "
-                   "one per core, at most 8; 0: serially in this process)")  # fmt: skip
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        metavar="N",
+        help="analyse the recordings and draw the figures in N processes (default: "
+        "one per core, at most 8; 0: serially in this process)",
+    )
     add_progress_flags(p)
     p.set_defaults(handler=_handler)

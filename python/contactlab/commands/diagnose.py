@@ -47,7 +47,7 @@ def add_parser(subparsers: Any) -> None:
         ),
     )
     p.add_argument("file", metavar="FILE", help="recording (CSV, TDMS, HDF5, MAT)")
-    from ..commands._common import add_reader_flags
+    from ..commands.common import add_reader_flags
 
     add_reader_flags(p)
     p.add_argument(
@@ -56,11 +56,13 @@ def add_parser(subparsers: Any) -> None:
         help="diagnose a structure: this identified model (contactlab identify --json) is "
         "the base; FILE is a CSV with the input and response columns",
     )
-    p.add_argument("--u", metavar="COLUMN",
-                   help="with --structure: input column (force, or base displacement)")  # fmt: skip
-    p.add_argument("--y", metavar="COLUMN",
-                   help="with --structure: response column (displacement of the mass)")  # fmt: skip
-    from ..commands._common import quantity
+    p.add_argument(
+        "--u", metavar="COLUMN", help="with --structure: input column (force, or base displacement)"
+    )
+    p.add_argument(
+        "--y", metavar="COLUMN", help="with --structure: response column (displacement of the mass)"
+    )
+    from ..commands.common import quantity
 
     p.add_argument(
         "--holdout",
@@ -74,7 +76,7 @@ def add_parser(subparsers: Any) -> None:
         "--report", metavar="DIR", help="write DIR/diagnose.html (+ figures/, diagnose.json)"
     )
     p.add_argument("--max-effects", type=int, default=3, help="stop after this many additions")
-    from ..commands._common import add_frame_flags, add_pressure_flags, positive_number
+    from ..commands.common import add_frame_flags, add_pressure_flags, positive_number
 
     add_pressure_flags(p)
     add_frame_flags(p)
@@ -100,7 +102,7 @@ def add_parser(subparsers: Any) -> None:
         help="tangential: a known delay of the force behind the displacement (e.g. 1.1ms), "
         "corrected before the diagnosis (the force read that much later)",
     )
-    from ..commands._common import FORCE_SIGN_CHOICES, force_sign
+    from ..commands.common import FORCE_SIGN_CHOICES, force_sign
 
     p.add_argument(
         "--force-sign",
@@ -208,7 +210,7 @@ def run(args: argparse.Namespace) -> int:
     import json
 
     from .._io_atomic import atomic_path
-    from ..commands._common import check_output_targets
+    from ..commands.common import check_output_targets
     from ..diagnose import diagnose
     from ..errors import ConvergenceError, InputError
     from ..io import read_recording
@@ -223,14 +225,14 @@ def run(args: argparse.Namespace) -> int:
         if getattr(args, dest, None) is not None:
             raise InputError(f"{flag} is for a structure: give it with --structure MODEL.json")
     check_output_targets(json_out=args.json, report=args.report, inputs=[args.file])
-    from ..commands._common import frame_option, output_filter_taps, parse_columns
+    from ..commands.common import frame_option, output_filter_taps, parse_columns
 
     frame = frame_option(args)
     if args.model is None and frame is not None:
         args.model = "tangential"
     columns = parse_columns(args.columns)
     if args.model is None:
-        from ..commands._common import infer_model, wrapped
+        from ..commands.common import infer_model, wrapped
 
         try:
             args.model, note = infer_model(args.file, None, columns, args.fs)
@@ -267,7 +269,7 @@ def run(args: argparse.Namespace) -> int:
     if sign is not None and args.model != "tangential":
         raise InputError("--force-sign is for tangential recordings (the force's sign)")
     if args.model == "normal":
-        from ..commands._common import with_static_pressure
+        from ..commands.common import with_static_pressure
 
         rec = with_static_pressure(rec, args.file, getattr(args, "p0", None),
                                    getattr(args, "pa", None))  # fmt: skip
@@ -306,7 +308,7 @@ def run(args: argparse.Namespace) -> int:
         import matplotlib
 
         matplotlib.use("Agg")
-        from ..commands._common import made_by
+        from ..commands.common import made_by
         from ..report.diagnosis import report_files
 
         files = report_files(report, intro=f"Made by: {made_by(args, 'diagnose', args.file)}")

@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 
 from ..errors import InputError
-from ._common import command_line, describe
+from .common import command_line, describe
 from .simulate import finite_quantity
 
 #: exit code when a requested value is not identifiable (bad input in general exits 1)
@@ -77,8 +77,9 @@ def _handler(args: argparse.Namespace) -> int:
     except NotIdentifiableError as exc:
         print(f"contactlab export: refused: {exc}; nothing written", file=sys.stderr)
         return EXIT_NOT_IDENTIFIABLE
-    cmd = command_line("export", args.result, "--format", args.format, "--units", args.units,
-                       "-o", args.output)  # fmt: skip
+    cmd = command_line(
+        "export", args.result, "--format", args.format, "--units", args.units, "-o", args.output
+    )
     try:
         text = render(jc, args.format, units, command=cmd)  # refuses what a format cannot hold
     except NotIdentifiableError as exc:
@@ -104,13 +105,19 @@ def _check(doc: dict, kind: str, args: argparse.Namespace) -> None:
     area_ = args.area if args.area is not None else doc.get("contact_area", doc.get("area"))
     print(check_tangential(doc, area=area_, normal_load=load).report())
     if args.amplitude is not None and args.frequency is not None:
-        print(check_dynamics(doc, area=area_, normal_load=load, amplitude=args.amplitude,
-                             frequency=args.frequency).report())  # fmt: skip
+        print(
+            check_dynamics(
+                doc,
+                area=area_,
+                normal_load=load,
+                amplitude=args.amplitude,
+                frequency=args.frequency,
+            ).report()
+        )
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    from ..fem.units import SYSTEMS
-    from ..fem.writers import FORMATS
+    from ..fem.units import FORMATS, SYSTEMS
 
     p = sub.add_parser(
         "export",
@@ -120,19 +127,39 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("result", metavar="RESULT.json", help="what `contactlab analyze --json` wrote")
     p.add_argument("--format", required=True, choices=FORMATS)
     p.add_argument("-o", "--output", required=True, metavar="FILE", help="output file")
-    p.add_argument("--units", default="SI", choices=tuple(SYSTEMS),
-                   help="unit system of the exported numbers (default SI)")  # fmt: skip
+    p.add_argument(
+        "--units",
+        default="SI",
+        choices=tuple(SYSTEMS),
+        help="unit system of the exported numbers (default SI)",
+    )
     p.add_argument("--recording", help="which recording of a multi-recording JSON (index/name)")
     p.add_argument("--area", type=area, help="nominal contact area (tangential; e.g. 50cm2)")
-    p.add_argument("--normal-load", type=finite_quantity("N", positive=True),
-                   help="normal load W (tangential; default from the tags, e.g. W50N)")  # fmt: skip
-    p.add_argument("--amplitude", type=finite_quantity("m", positive=True),
-                   help="amplitude of the joint spring/dashpot (tangential; 20um)")  # fmt: skip
-    p.add_argument("--frequency", type=finite_quantity("Hz", positive=True),
-                   help="frequency of the viscous values (normal: default the test's)")  # fmt: skip
-    p.add_argument("--points", type=points, default=25,
-                   help="rows of the pressure–overclosure table over the measured range, "
-                   "3..10000 (default 25; solvers interpolate linearly between rows)")  # fmt: skip
-    p.add_argument("--check", action="store_true",
-                   help="first run the CalculiX checks on these values (needs ccx)")  # fmt: skip
+    p.add_argument(
+        "--normal-load",
+        type=finite_quantity("N", positive=True),
+        help="normal load W (tangential; default from the tags, e.g. W50N)",
+    )
+    p.add_argument(
+        "--amplitude",
+        type=finite_quantity("m", positive=True),
+        help="amplitude of the joint spring/dashpot (tangential; 20um)",
+    )
+    p.add_argument(
+        "--frequency",
+        type=finite_quantity("Hz", positive=True),
+        help="frequency of the viscous values (normal: default the test's)",
+    )
+    p.add_argument(
+        "--points",
+        type=points,
+        default=25,
+        help="rows of the pressure–overclosure table over the measured range, "
+        "3..10000 (default 25; solvers interpolate linearly between rows)",
+    )
+    p.add_argument(
+        "--check",
+        action="store_true",
+        help="first run the CalculiX checks on these values (needs ccx)",
+    )
     p.set_defaults(handler=_handler)

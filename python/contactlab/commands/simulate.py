@@ -15,7 +15,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from ..errors import InputError
-from ._common import DefaultsShown, describe, quantity
+from .common import DefaultsShown, describe, quantity
 
 if TYPE_CHECKING:
     from ..io import Recording
@@ -204,15 +204,58 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("model", choices=("tangential", "normal", "structure"))
     p.add_argument("out", metavar="OUT", help="output file (.csv .tdms .h5 .mat)")
-    g = p.add_argument_group("tangential")
-    g.add_argument("--h0", type=finite_quantity("N", positive=True, bounds="h0"), default=40.0,
-                   help="saturation force (N, > 0)")  # fmt: skip
-    g.add_argument("--ac", type=finite_quantity("1/m", positive=True, bounds="ac"), default=4e4,
-                   help="curvature (1/m, > 0)")  # fmt: skip
-    g.add_argument("--amplitude", type=finite_quantity("m", positive=True, bounds="amplitude"),
-                   default=20e-6, help="displacement amplitude (m, 1nm..1m: 20um)")  # fmt: skip
-    g.add_argument("--frequency", type=finite_quantity("Hz", positive=True, bounds="frequency"),
-                   default=1.0, help="Hz, 1e-6..1e6")  # fmt: skip
+    _tangential_flags(p.add_argument_group("tangential"))
+    _normal_flags(p.add_argument_group("normal"))
+    p.add_argument(
+        "--cycles",
+        type=integer(1),
+        default=5,
+        help=f"number of cycles (an integer >= 1; at most {MAX_SAMPLES:,} samples in all)",
+    )
+    p.add_argument(
+        "--noise",
+        type=real(minimum=0.0, maximum=10.0),
+        default=None,
+        help="tangential: force noise as a fraction of the peak force (default "
+        "0.01); normal: relative to each channel's peak-to-peak value (default: "
+        "realistic sensor noise and 16-bit quantisation); 0 = exact, 0..10",
+    )
+    p.add_argument(
+        "--seed",
+        type=integer(0),
+        default=0,
+        help="noise generator seed (a non-negative integer; default 0)",
+    )
+    _structure_flags(p.add_argument_group("structure (a model from `contactlab identify --json`)"))
+    p.set_defaults(handler=_handler)
+
+
+def _tangential_flags(g: argparse._ArgumentGroup) -> None:
+    """The flags of a tangential recording."""
+    g.add_argument(
+        "--h0",
+        type=finite_quantity("N", positive=True, bounds="h0"),
+        default=40.0,
+        help="saturation force (N, > 0)",
+    )
+    g.add_argument(
+        "--ac",
+        type=finite_quantity("1/m", positive=True, bounds="ac"),
+        default=4e4,
+        help="curvature (1/m, > 0)",
+    )
+    g.add_argument(
+        "--amplitude",
+        type=finite_quantity("m", positive=True, bounds="amplitude"),
+        default=20e-6,
+        help="displacement amplitude (m, 1nm..1m: 20um)",
+    )
+    g.add_argument(
+        "--frequency",
+        type=finite_quantity("Hz", positive=True, bounds="frequency"),
+        default=1.0,
+        help="Hz, 1e-6..1e6",
+    )
     g.add_argument(
         "--fs",
         type=finite_quantity("Hz", positive=True, bounds="fs"),
@@ -220,39 +263,71 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         metavar="RATE",
         help="sampling rate (Hz, > 0)",
     )
-    g.add_argument("--offset", type=finite_quantity("N", bounds="offset"), default=0.0,
-                   help="load-cell zero offset (N)")  # fmt: skip
-    g.add_argument("--x-offset", type=finite_quantity("m", bounds="x_offset"), default=0.0,
-                   help="displacement-sensor zero offset (m)")  # fmt: skip
-    g.add_argument("--drift", type=real(), default=0.0,
-                   help="force drift (N/s, a finite number of either sign)")  # fmt: skip
-    g.add_argument("--adc-bits", type=integer(4, 32), default=None,
-                   help="quantise to this many bits (4..32)")  # fmt: skip
-    n = p.add_argument_group("normal")
-    n.add_argument("--p0", type=finite_quantity("Pa", positive=True, bounds="p0"), default=0.5e6,
-                   help="static pressure (Pa, > 0)")  # fmt: skip
-    n.add_argument("--pa", type=finite_quantity("Pa", positive=True, bounds="pa"), default=0.4e6,
-                   help="pressure amplitude (Pa, > 0 and <= p0)")  # fmt: skip
-    n.add_argument("--omega", type=finite_quantity("1/s", positive=True, bounds="omega"),
-                   default=1.0, help="angular frequency (1/s, 1e-6..1e7)")  # fmt: skip
-    n.add_argument("--samples-per-cycle", type=integer(8), default=400,
-                   help="samples per cycle (an integer >= 8; default 400)")  # fmt: skip
-    n.add_argument("--normal-model", default=None, choices=("nonlinear", "linear", "table2"),
-                   help="eq. 17 (default), Kelvin-Voigt, or the Table 2 loop itself")  # fmt: skip
-    p.add_argument("--cycles", type=integer(1), default=5,
-                   help=f"number of cycles (an integer >= 1; at most {MAX_SAMPLES:,} samples "
-                   "in all)")  # fmt: skip
-    p.add_argument("--noise", type=real(minimum=0.0, maximum=10.0), default=None,
-                   help="tangential: force noise as a fraction of the peak force (default "
-                   "0.01); normal: relative to each channel's peak-to-peak value (default: "
-                   "realistic sensor noise and 16-bit quantisation); 0 = exact, 0..10")  # fmt: skip
-    p.add_argument("--seed", type=integer(0), default=0,
-                   help="noise generator seed (a non-negative integer; default 0)")  # fmt: skip
-    s = p.add_argument_group("structure (a model from `contactlab identify --json`)")
-    s.add_argument("--structure", metavar="MODEL.json",
-                   help="model JSON (identified model or Structure.save)")  # fmt: skip
-    s.add_argument("--input", metavar="FILE",
-                   help="CSV with the input column and a time column (else --fs)")  # fmt: skip
+    g.add_argument(
+        "--offset",
+        type=finite_quantity("N", bounds="offset"),
+        default=0.0,
+        help="load-cell zero offset (N)",
+    )
+    g.add_argument(
+        "--x-offset",
+        type=finite_quantity("m", bounds="x_offset"),
+        default=0.0,
+        help="displacement-sensor zero offset (m)",
+    )
+    g.add_argument(
+        "--drift",
+        type=real(),
+        default=0.0,
+        help="force drift (N/s, a finite number of either sign)",
+    )
+    g.add_argument(
+        "--adc-bits", type=integer(4, 32), default=None, help="quantise to this many bits (4..32)"
+    )
+
+
+def _normal_flags(n: argparse._ArgumentGroup) -> None:
+    """The flags of a normal-contact recording."""
+    n.add_argument(
+        "--p0",
+        type=finite_quantity("Pa", positive=True, bounds="p0"),
+        default=0.5e6,
+        help="static pressure (Pa, > 0)",
+    )
+    n.add_argument(
+        "--pa",
+        type=finite_quantity("Pa", positive=True, bounds="pa"),
+        default=0.4e6,
+        help="pressure amplitude (Pa, > 0 and <= p0)",
+    )
+    n.add_argument(
+        "--omega",
+        type=finite_quantity("1/s", positive=True, bounds="omega"),
+        default=1.0,
+        help="angular frequency (1/s, 1e-6..1e7)",
+    )
+    n.add_argument(
+        "--samples-per-cycle",
+        type=integer(8),
+        default=400,
+        help="samples per cycle (an integer >= 8; default 400)",
+    )
+    n.add_argument(
+        "--normal-model",
+        default=None,
+        choices=("nonlinear", "linear", "table2"),
+        help="eq. 17 (default), Kelvin-Voigt, or the Table 2 loop itself",
+    )
+
+
+def _structure_flags(s: argparse._ArgumentGroup) -> None:
+    """The flags of a structure's response."""
+    s.add_argument(
+        "--structure", metavar="MODEL.json", help="model JSON (identified model or Structure.save)"
+    )
+    s.add_argument(
+        "--input", metavar="FILE", help="CSV with the input column and a time column (else --fs)"
+    )
     s.add_argument("--u", metavar="COLUMN", help="input column name")
     s.add_argument("--base", action="store_true", help="the input is base displacement")
     s.add_argument(
@@ -266,4 +341,3 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="if the integration stops early, write the samples it reached (exit 1 all the "
         "same); without it a failed run writes nothing",
     )
-    p.set_defaults(handler=_handler)

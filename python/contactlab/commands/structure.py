@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InputError
-from ._common import (
+from .common import (
     add_progress_flags,
     check_output_targets,
     describe,
@@ -54,8 +54,9 @@ def read_table(path: str) -> dict[str, np.ndarray]:
         with warnings.catch_warnings():
             # numpy warns "input contained no data" for a header alone: refused just below
             warnings.simplefilter("ignore", UserWarning)
-            data = np.loadtxt(p, delimiter=delim, skiprows=header_line + 1, ndmin=2,
-                              comments="#", encoding=enc)  # fmt: skip
+            data = np.loadtxt(
+                p, delimiter=delim, skiprows=header_line + 1, ndmin=2, comments="#", encoding=enc
+            )
     except ValueError as exc:
         raise InputError(f"{path}: not a numeric table: {exc}") from None
     if data.size == 0:
@@ -80,8 +81,9 @@ def read_table(path: str) -> dict[str, np.ndarray]:
     return out
 
 
-def _pick(cols: dict[str, np.ndarray], want: str | None, guesses: tuple[str, ...], what: str,
-          path: str) -> str:  # fmt: skip
+def pick_column(
+    cols: dict[str, np.ndarray], want: str | None, guesses: tuple[str, ...], what: str, path: str
+) -> str:
     if want:
         if want in cols:
             return want
@@ -119,19 +121,29 @@ def _identify(args: argparse.Namespace) -> int:
     check_output_targets(json_out=args.json, report=args.report, inputs=[args.file])
     cols = read_table(args.file)
     exc = args.excitation
-    ucol = _pick(cols, args.u, ("u", "f", "y_base", "base") if exc == "force" else
-                 ("y_base", "base", "y"), "u", args.file)  # fmt: skip
+    ucol = pick_column(
+        cols,
+        args.u,
+        ("u", "f", "y_base", "base") if exc == "force" else ("y_base", "base", "y"),
+        "u",
+        args.file,
+    )
     ynames = [c.strip() for c in args.y.split(",")] if args.y and "," in args.y else None
     if ynames:
         # several response channels: one displacement per DOF (a multi-DOF structure)
-        ycols = [_pick(cols, c, (), "y", args.file) for c in ynames]
+        ycols = [pick_column(cols, c, (), "y", args.file) for c in ynames]
         if ucol in ycols or len(set(ycols)) < len(ycols):
             raise InputError(f"{args.file}: --y names the input or a column twice")
         y = np.stack([cols[c] for c in ycols], axis=1)
         ycol: str | list[str] = ycols
     else:
-        ycol = _pick(cols, args.y, ("y_disp", "y", "x") if exc == "force" else
-                     ("x", "y_disp"), "y", args.file)  # fmt: skip
+        ycol = pick_column(
+            cols,
+            args.y,
+            ("y_disp", "y", "x") if exc == "force" else ("x", "y_disp"),
+            "y",
+            args.file,
+        )
         if ucol == ycol:
             raise InputError(f"{args.file}: input and response are the same column {ucol!r}")
         y = cols[ycol]
@@ -149,16 +161,33 @@ def _identify(args: argparse.Namespace) -> int:
             mdof["masks"] = _masks(args.masks)
     elif args.masks is not None:
         raise InputError("--masks needs several response channels (--y x0,x1,...)")
-    cmd = made_by(args, "identify", args.file, "--joint", args.joint, "--excitation", exc,
-                  *(["--fs", args.fs] if args.fs else []))  # fmt: skip
+    cmd = made_by(
+        args,
+        "identify",
+        args.file,
+        "--joint",
+        args.joint,
+        "--excitation",
+        exc,
+        *(["--fs", args.fs] if args.fs else []),
+    )
     bar = _progress_bar(args.progress) if y.ndim == 1 else None
     try:
         model, rep, summary = identify_record(
-            t, u, y, joint=args.joint, excitation=exc, mass=mass, holdout=args.holdout,
-            substeps=args.substeps, periodic=args.periodic, title=f"{Path(args.file).name}: "
-            f"{args.joint} joint", intro=f"Made by: {cmd}",
-            progress=bar.step if bar is not None else None, **mdof,
-        )  # fmt: skip
+            t,
+            u,
+            y,
+            joint=args.joint,
+            excitation=exc,
+            mass=mass,
+            holdout=args.holdout,
+            substeps=args.substeps,
+            periodic=args.periodic,
+            title=f"{Path(args.file).name}: {args.joint} joint",
+            intro=f"Made by: {cmd}",
+            progress=bar.step if bar is not None else None,
+            **mdof,
+        )
     finally:
         if bar is not None:
             bar.close()
@@ -175,10 +204,12 @@ def _identify(args: argparse.Namespace) -> int:
         write_json(args.json, text)
     if args.json != "-":
         hold, train = summary.get("rms_holdout"), summary["rms_train"]
-        print(f"{args.joint}: RMS output error "
-              + (f"{train:.4g} m (training)" if train is not None else "n/a (training)")
-              + (f", {hold:.4g} m (hold-out)" if hold is not None else "")
-              + f"; identified in {model.elapsed:.1f} s")  # fmt: skip
+        print(
+            f"{args.joint}: RMS output error "
+            + (f"{train:.4g} m (training)" if train is not None else "n/a (training)")
+            + (f", {hold:.4g} m (hold-out)" if hold is not None else "")
+            + f"; identified in {model.elapsed:.1f} s"
+        )
         print(parameter_lines(model.fit))
     return 0
 
@@ -201,9 +232,11 @@ def parameter_lines(fit: Any) -> str:
             why = why.removeprefix("not identifiable: ")
             lines.append(f"{head}{p.value:.6g}{unit} (not identifiable: {why})")
         elif p.rel_stderr is not None and not p.rel_stderr < UNDETERMINED_REL_STDERR:
-            lines.append(f"{head}{p.value:.6g}{unit} (not identifiable: standard error "
-                         f"{p.stderr:.2g}, over {100 * UNDETERMINED_REL_STDERR:.0f} % of the "
-                         "value)")  # fmt: skip
+            lines.append(
+                f"{head}{p.value:.6g}{unit} (not identifiable: standard error "
+                f"{p.stderr:.2g}, over {100 * UNDETERMINED_REL_STDERR:.0f} % of the "
+                "value)"
+            )
         else:
             lines.append(f"{head}{format_measurement(p.value, p.stderr)}{unit}")
     return "\n".join(lines)
@@ -220,8 +253,9 @@ class _Bar:
     def __init__(self) -> None:
         from tqdm.auto import tqdm
 
-        self._bar = tqdm(desc="identify: starts", unit="sim", file=sys.stderr,
-                         delay=PROGRESS_DELAY, leave=False)  # fmt: skip
+        self._bar = tqdm(
+            desc="identify: starts", unit="sim", file=sys.stderr, delay=PROGRESS_DELAY, leave=False
+        )
         self._stage = "starts"
 
     def step(self, stage: str) -> None:
@@ -310,8 +344,9 @@ def simulate_structure(args: argparse.Namespace) -> int:
         model = None  # perhaps a Structure.save file (read below)
     cols = read_table(args.input)
     exc = model.excitation if model else ("base" if args.base else "force")
-    ucol = _pick(cols, args.u, ("u", "f") if exc == "force" else ("y_base", "base", "y"), "u",
-                 args.input)  # fmt: skip
+    ucol = pick_column(
+        cols, args.u, ("u", "f") if exc == "force" else ("y_base", "base", "y"), "u", args.input
+    )
     u = cols[ucol]
     t = _time(cols, args, u.size, args.input)
     kw = {"force": u} if exc == "force" else {"base": u}
@@ -357,17 +392,20 @@ def diagnose_structure_cli(args: argparse.Namespace) -> int:
     model = IdentifiedModel.load(args.structure)
     cols = read_table(args.file)
     exc = model.excitation
-    ucol = _pick(cols, args.u, ("u", "f") if exc == "force" else ("y_base", "base", "y"),
-                 "u", args.file)  # fmt: skip
-    ycol = _pick(cols, args.y, ("y_disp", "y", "x") if exc == "force" else ("x", "y_disp"),
-                 "y", args.file)  # fmt: skip
+    ucol = pick_column(
+        cols, args.u, ("u", "f") if exc == "force" else ("y_base", "base", "y"), "u", args.file
+    )
+    ycol = pick_column(
+        cols, args.y, ("y_disp", "y", "x") if exc == "force" else ("x", "y_disp"), "y", args.file
+    )
     if ucol == ycol:
         raise InputError(f"{args.file}: input and response are the same column {ucol!r}")
     u, y = cols[ucol], cols[ycol]
     t = _time(cols, args, u.size, args.file)
     try:
-        rep = diagnose_structure((t, u, y), model, holdout=args.holdout,
-                                 max_effects=args.max_effects)  # fmt: skip
+        rep = diagnose_structure(
+            (t, u, y), model, holdout=args.holdout, max_effects=args.max_effects
+        )
     except InputError as exc_:
         raise InputError(f"{args.file}: {exc_}") from exc_
     print(rep.summary())
@@ -382,8 +420,9 @@ def diagnose_structure_cli(args: argparse.Namespace) -> int:
         matplotlib.use("Agg")
         from ..report.structure import write_diagnosis_html
 
-        cmd = made_by(args, "diagnose", args.file, "--structure", args.structure,
-                      "--report", args.report)  # fmt: skip
+        cmd = made_by(
+            args, "diagnose", args.file, "--structure", args.structure, "--report", args.report
+        )
         print(f"report: {write_diagnosis_html(rep, args.report, intro=f'Made by: {cmd}')}")
     if text is not None:
         write_text(args.json, text)
@@ -397,38 +436,66 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         description=describe(__doc__),
     )
     p.add_argument("file", metavar="FILE", help="CSV record (input and response columns)")
-    p.add_argument("--joint", default="bouc_wen",
-                   choices=("masing", "jenkins", "iwan", "bouc_wen", "kelvin_voigt", "normal",
-                            "linear"))  # fmt: skip
+    p.add_argument(
+        "--joint",
+        default="bouc_wen",
+        choices=("masing", "jenkins", "iwan", "bouc_wen", "kelvin_voigt", "normal", "linear"),
+    )
     p.add_argument("--excitation", default="force", choices=("force", "base"))
     p.add_argument("--u", metavar="COLUMN", help="input column (force, or base displacement)")
-    p.add_argument("--y", metavar="COLUMN",
-                   help="response column (displacement of the mass); several "
-                   "comma-separated columns (one per DOF, in DOF order) identify a chain of "
-                   "masses")  # fmt: skip
-    p.add_argument("--fs", type=quantity("Hz", positive=True), metavar="RATE",
-                   help="sampling rate when there is no time column, e.g. 1kHz")  # fmt: skip
-    p.add_argument("--mass", help="known mass (kg), held fixed; needed for base; one per DOF "
-                   "(comma-separated) with several --y channels")  # fmt: skip
-    p.add_argument("--joint-dofs", default="0,ground",
-                   help="several DOFs: the DOFs the joint joins, I,J or I,ground "
-                   "(default 0,ground)")  # fmt: skip
-    p.add_argument("--input-dof", type=int, default=None,
-                   help="several DOFs, force excitation: the DOF the input force acts on "
-                   "(default the last)")  # fmt: skip
-    p.add_argument("--masks", default=None,
-                   help='several DOFs: free entries of M, C, K instead of a chain, as inline '
-                   'JSON or a JSON file, e.g. \'{"K": [[1, 1], [1, 1]]}\' (missing M: the '
-                   "diagonal; missing C: as K)")  # fmt: skip
-    p.add_argument("--holdout", type=float, default=0.0,
-                   help="fraction of the record (at its end) kept out of the fit and "
-                   "reported as hold-out error")  # fmt: skip
+    p.add_argument(
+        "--y",
+        metavar="COLUMN",
+        help="response column (displacement of the mass); several "
+        "comma-separated columns (one per DOF, in DOF order) identify a chain of "
+        "masses",
+    )
+    p.add_argument(
+        "--fs",
+        type=quantity("Hz", positive=True),
+        metavar="RATE",
+        help="sampling rate when there is no time column, e.g. 1kHz",
+    )
+    p.add_argument(
+        "--mass",
+        help="known mass (kg), held fixed; needed for base; one per DOF "
+        "(comma-separated) with several --y channels",
+    )
+    p.add_argument(
+        "--joint-dofs",
+        default="0,ground",
+        help="several DOFs: the DOFs the joint joins, I,J or I,ground (default 0,ground)",
+    )
+    p.add_argument(
+        "--input-dof",
+        type=int,
+        default=None,
+        help="several DOFs, force excitation: the DOF the input force acts on (default the last)",
+    )
+    p.add_argument(
+        "--masks",
+        default=None,
+        help="several DOFs: free entries of M, C, K instead of a chain, as inline "
+        "JSON or a JSON file, e.g. '{\"K\": [[1, 1], [1, 1]]}' (missing M: the "
+        "diagonal; missing C: as K)",
+    )
+    p.add_argument(
+        "--holdout",
+        type=float,
+        default=0.0,
+        help="fraction of the record (at its end) kept out of the fit and "
+        "reported as hold-out error",
+    )
     p.add_argument("--substeps", type=int, default=4, help="integration steps per sample")
-    p.add_argument("--periodic", action="store_true",
-                   help="the record holds whole periods of a periodic input (band-limited "
-                   "interpolation between samples)")  # fmt: skip
-    p.add_argument("--json", metavar="OUT",
-                   help="write the model (and summary) as JSON ('-': stdout)")  # fmt: skip
+    p.add_argument(
+        "--periodic",
+        action="store_true",
+        help="the record holds whole periods of a periodic input (band-limited "
+        "interpolation between samples)",
+    )
+    p.add_argument(
+        "--json", metavar="OUT", help="write the model (and summary) as JSON ('-': stdout)"
+    )
     p.add_argument("--report", metavar="DIR", help="write report.html and figures/ here")
     add_progress_flags(p)
     p.set_defaults(handler=_identify)

@@ -37,11 +37,18 @@ def identify_record(
     if n_train < 20:
         raise InputError("too few training samples after the hold-out")
     model = identify(
-        t[:n_train], u[:n_train], y[:n_train], joint=joint, excitation=excitation,
-        mass=mass, substeps=substeps, interpolation="fourier" if periodic and holdout == 0
-        else "linear", periodic=periodic, **mdof,
+        t[:n_train],
+        u[:n_train],
+        y[:n_train],
+        joint=joint,
+        excitation=excitation,
+        mass=mass,
+        substeps=substeps,
+        interpolation="fourier" if periodic and holdout == 0 else "linear",
+        periodic=periodic,
+        **mdof,
         **({"progress": progress} if progress is not None and not mdof else {}),
-    )  # fmt: skip
+    )
     if progress is not None:
         progress("done")  # the simulations are over: a bar closes before the report is drawn
     if periodic:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ._common import (
+from .common import (
     add_progress_flags,
     add_workers_flag,
     check_output_targets,
@@ -46,8 +46,10 @@ def _handler(args: argparse.Namespace) -> int:
         print(f"analysed {n_ok} of {len(result.results)} recordings", flush=True)
         warned = [r.entry.name for r in result.results if r.ok and r.row.get("warnings")]
         if warned:
-            print(f"{len(warned)} with warnings (listed in the report): {', '.join(warned)}",
-                  file=sys.stderr)  # fmt: skip
+            print(
+                f"{len(warned)} with warnings (listed in the report): {', '.join(warned)}",
+                file=sys.stderr,
+            )
         doc = json_text(json_document(result)) if args.json else None
         cmd = made_by(args, "study", args.manifest, "--report", args.report)
         paths = write_report(
@@ -77,8 +79,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--report", metavar="DIR", required=True, help="output folder")
     p.add_argument("--json", metavar="OUT", help="also write every result as JSON (SI)")
     p.add_argument("--title", default="contactlab study", help="report title")
-    p.add_argument("--keep-going", action="store_true",
-                   help="skip recordings that fail (exit code 1) instead of stopping")  # fmt: skip
+    p.add_argument(
+        "--keep-going",
+        action="store_true",
+        help="skip recordings that fail (exit code 1) instead of stopping",
+    )
     add_workers_flag(p, "recordings", per_core=True)
     add_progress_flags(p)
     p.set_defaults(handler=_handler)

@@ -14,9 +14,10 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+from typing import Any
 
 from ..errors import InputError
-from ._common import (
+from .common import (
     add_frame_flags,
     add_pressure_flags,
     add_progress_flags,
@@ -58,8 +59,7 @@ def _handler(args: argparse.Namespace) -> int:
     frame = frame_option(args)  # before the file is read: it has no force column
     note = None
     if frame is None:
-        args.model, note = infer_model(args.file, args.model, parse_columns(args.columns),
-                                       args.fs)  # fmt: skip
+        args.model, note = infer_model(args.file, args.model, parse_columns(args.columns), args.fs)
     options = _options(args)
     if args.delay is not None:
         if options is not None:  # a normal recording's options
@@ -79,13 +79,17 @@ def _handler(args: argparse.Namespace) -> int:
         from ..tangential import read_frame
         from ..tangential.frame import describe_reconstruction
 
-        fr = read_frame(args.file, frame["M"], frame["C"], frame["K"], x=frame["x"],
-                        y=frame["y"], fs=args.fs)  # fmt: skip
+        fr = read_frame(
+            args.file, frame["M"], frame["C"], frame["K"], x=frame["x"], y=frame["y"], fs=args.fs
+        )
         source = fr.recording(args.file)
         rebuilt = fr.to_dict()
         print(f"{args.file}: friction frame: {describe_reconstruction(rebuilt)}", file=say)
-    print(wrapped(f"tracking {args.file} every {args.every}" + (f"; {note}" if note else "")),
-          file=say, flush=True)  # fmt: skip
+    print(
+        wrapped(f"tracking {args.file} every {args.every}" + (f"; {note}" if note else "")),
+        file=say,
+        flush=True,
+    )
     bar = None
     if args.progress or (args.progress is None and sys.stderr.isatty()):
         from tqdm.auto import tqdm
@@ -122,6 +126,20 @@ def _handler(args: argparse.Namespace) -> int:
             f"{res.source}: none of the {len(res.rows)} windows could be analysed{why}; "
             "nothing written"
         )
+    _print_summary(res, comb, say)
+    doc = track_json(res) if args.json else None  # rendered before anything is written
+    if args.report:
+        _write_report(args, res, frame, say)
+    if args.json:
+        p = write_json(args.json, doc)
+        if str(p) != "-":
+            print(f"wrote {p}", file=say)
+    return 0
+
+
+def _print_summary(res: Any, comb: dict, say: Any) -> None:
+    """The tracked record's windows, cycles and samples, each combined quantity with its
+    error and how it was combined, the resampling and the notes."""
     print(
         f"{res.source}: {len(res.rows)} window{'s' if len(res.rows) != 1 else ''}, "
         f"{comb.get('n_cycles', 0)} cycles, {res.meta['n_samples']} samples",
@@ -144,31 +162,34 @@ def _handler(args: argparse.Namespace) -> int:
         print(wrapped(f"  {describe_resampling(res.meta['resampled'])}"), file=say)
     for note in res.notes(comb):
         print(wrap_warning(str(note)), file=sys.stderr)
-    doc = track_json(res) if args.json else None  # rendered before anything is written
-    if args.report:
-        import matplotlib
 
-        matplotlib.use("Agg")
-        from ..report import commit_outputs
-        from ..report.track_report import build_track_report, track_files
 
-        cmd = made_by(args,
-            "track", args.file, "--every", args.every, "--report", args.report,
-            *(["--frame", args.frame] if frame else []),
-            *(["--frame-x", args.frame_x] if args.frame_x else []),
-            *(["--frame-y", args.frame_y] if args.frame_y else []),
-        )  # fmt: skip
-        rep = build_track_report(
-            res, f"contactlab track: {args.file}", against=args.against, intro=f"Made by: {cmd}"
-        )
-        for p in commit_outputs(args.report, track_files(res, rep)):
-            if p.suffix == ".html":
-                print(f"wrote {p}", file=say)
-    if args.json:
-        p = write_json(args.json, doc)
-        if str(p) != "-":
+def _write_report(args: argparse.Namespace, res: Any, frame: Any, say: Any) -> None:
+    """The HTML report of a tracked record, written all or nothing into ``--report``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from ..report import commit_outputs
+    from ..report.track_report import build_track_report, track_files
+
+    cmd = made_by(
+        args,
+        "track",
+        args.file,
+        "--every",
+        args.every,
+        "--report",
+        args.report,
+        *(["--frame", args.frame] if frame else []),
+        *(["--frame-x", args.frame_x] if args.frame_x else []),
+        *(["--frame-y", args.frame_y] if args.frame_y else []),
+    )
+    rep = build_track_report(
+        res, f"contactlab track: {args.file}", against=args.against, intro=f"Made by: {cmd}"
+    )
+    for p in commit_outputs(args.report, track_files(res, rep)):
+        if p.suffix == ".html":
             print(f"wrote {p}", file=say)
-    return 0
 
 
 def _options(args: argparse.Namespace) -> dict | None:
@@ -182,8 +203,9 @@ def _options(args: argparse.Namespace) -> dict | None:
         if args.p0 is not None or args.pa is not None:
             raise InputError(f"{args.file}: --p0/--pa are for normal-contact recordings")
         return None
-    kind = args.model or read_chunks(args.file, columns=parse_columns(args.columns),
-                                     fs=args.fs).kind  # fmt: skip
+    kind = (
+        args.model or read_chunks(args.file, columns=parse_columns(args.columns), fs=args.fs).kind
+    )
     if kind != "normal":
         if args.p0 is not None or args.pa is not None:
             raise InputError(f"{args.file}: --p0/--pa are for normal-contact recordings")

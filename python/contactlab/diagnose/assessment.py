@@ -5,11 +5,12 @@ the structure the final residual still holds (:mod:`.misfit`), in one call for t
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 from ._family import Prepared
 from .detection import channel_noise, model_slope
-from .misfit import eiv_tolerance, unexplained_structure
+from .misfit import backbone_misfit, eiv_tolerance, unexplained_structure
 from .power import POWER, _setting, bounds_for
 
 __all__ = ["assess"]
@@ -49,6 +50,12 @@ def assess(
         d, residual, sigma, unit=family.output_unit,
         tolerance=eiv_tolerance(slope, noise.input_seen),
     )  # fmt: skip
+    if misfit is not None and getattr(family, "kind", "") == "tangential" and "ac" in params:
+        # a virgin curve of another shape, partly absorbed by a named effect
+        bb = backbone_misfit(d, residual, float(params["ac"]), sigma)
+        if bb is not None:
+            flagged = misfit.flagged or bb["flagged"]
+            misfit = dataclasses.replace(misfit, backbone=bb, flagged=flagged)
     return {
         "noise": noise,
         "not_detected": bounds,

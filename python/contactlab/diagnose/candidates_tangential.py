@@ -27,7 +27,7 @@ name                           measured force ``F`` (or measured ``x``)         
 ``parameter_drift``            ``F = h (1 + β (t - t_m)/T)``, ``t_m`` mid-record           beta [-]
 ``stribeck``                   ``F = h (1 + s exp(-|ẋ|/v_s))``                             s, v_s
 ``position_friction``          ``F = h (1 + Σ a_k cos kπξ + b_k sin kπξ)``                 a_k, b_k
-``stick_slip``                 breakaway ``s_b`` after each reversal over ``ell``          s_b, ell
+``stick_slip``                 ``F = h + s_b h0 sgn(ẋ) (s/ell) e^(1 - s/ell)``, s: travel  s_b, ell
 ``normal_load``                ``F = h (1 + ε_c cos 2π f_n t + ε_s sin 2π f_n t)``         eps, f_n
 ``power_law_microslip``        Segalman's Iwan element (F_S = h0, K_T = h0 ac)             chi, beta
 ``backlash``                   ``F = M(u)``, ``u`` the play operator of ``x`` (width 2b)   b [m]
@@ -613,7 +613,9 @@ class TangentialFamily:
     def model_breakaway(self, p: dict[str, float], effects: tuple[str, ...], d: Prepared) -> float:
         """The breakaway force of the fitted model as the sticks of the data measure it: the
         mean over the strokes between reversals of the largest force within ``20/ac + 3 ell``
-        of the reversal, about the model's own zero (the force offset and drift taken off).
+        of the reversal (plus ``2 h0 C_s (1 + s_b)`` with a series spring, whose stretch the
+        swing needs too: without it a friction damper's breakaway read 1.0 kN for h0 = 17
+        kN), about the model's own zero (the force offset and drift taken off).
 
         This is the quantity :func:`contactlab.tangential.regime.stick_slip` reads off the
         measured sticks (the largest ``|F - offset|`` while stuck and up to the onset of
@@ -632,6 +634,8 @@ class TangentialFamily:
         # the peak lies within a few slip distances (ell) of the reversal, once the branch
         # has covered its swing (20/ac: to within 2e^-10): beyond, the term has decayed
         reach = 20.0 / p["ac"] + (3.0 * p["ell"] if "stick_slip" in effects else 0.0)
+        if "series_compliance" in effects:  # a series spring stretches the swing by 2 h0 C_s
+            reach += 2.0 * p["h0"] * p["C_s"] * (1.0 + p.get("s_b", 0.0))
         peaks = []
         for a, b in itertools.pairwise(rev):
             s = 1.0 if d.u[b] > d.u[a] else -1.0

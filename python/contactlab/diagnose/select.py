@@ -151,14 +151,7 @@ def fit(
     specs = specs_for(family, effects)
     names = [s.name for s in specs]
     sc = {s.name: scales[s.name] if s.name in scales else scales[s.scale] for s in specs}
-    x0: dict[str, float] = {}
-    for s in specs:
-        v = float(start.get(s.name, s.null))
-        if not np.isfinite(v):  # no "absent" value (e.g. a time constant): a typical one
-            v = 0.3 * sc[s.name]
-        span = s.upper - s.lower if np.isfinite(s.upper - s.lower) else sc[s.name]
-        # strictly inside the bounds, so a start at "absent" (often a bound) can move
-        x0[s.name] = float(np.clip(v, s.lower + 1e-6 * span, s.upper - 1e-6 * span))
+    x0 = _inside({s.name: float(start.get(s.name, s.null)) for s in specs}, specs, sc, True)
     # long records: the fit sees every stride-th sample of the mask (the solver's work grows
     # with the number of residuals); held-out errors are still taken on every sample, and
     # the standard errors are those of the strided fit: its estimate uses those samples only
@@ -183,9 +176,7 @@ def fit(
         x0, searched = search(effects, d, idx, y, sw, x0)
         if spent is not None and not in_column():
             spent.tick(searched)
-        for s in specs:  # (strictly inside the bounds, as above)
-            span = s.upper - s.lower if np.isfinite(s.upper - s.lower) else sc[s.name]
-            x0[s.name] = float(np.clip(x0[s.name], s.lower + 1e-6 * span, s.upper - 1e-6 * span))
+        x0 = _inside(x0, specs, sc, False)
     params = [
         Parameter(
             s.name,
@@ -196,7 +187,6 @@ def fit(
         )
         for s in specs
     ]
-
     lo = {s.name: s.lower for s in specs}
     hi = {s.name: s.upper for s in specs}
 
@@ -211,28 +201,7 @@ def fit(
     # at half the starting stiffness or more), so no candidate wins by filtering the input
     c_top = 4.0 * noise_bound(family, x0, d)
     n_fit = float(np.sum(sample_weight(d)[idx]))
-
-    if getattr(family, "predicts_at", False):  # the model at the fit's samples only
-
-        def plain(w: dict[str, float]) -> np.ndarray:
-            if spent is not None and not in_column():
-                spent.tick()
-            return (family.predict(value(w), effects, d, at=idx) - y) * sw  # type: ignore[call-arg]
-
-    else:
-
-        def plain(w: dict[str, float]) -> np.ndarray:
-            if spent is not None and not in_column():
-                spent.tick()
-            return (family.predict(value(w), effects, d)[idx] - y) * sw
-
-    resid = plain
-    if c_top > 0:
-
-        def resid(w: dict[str, float]) -> np.ndarray:
-            extra = n_fit * max(c_top - noise_term(family, value(w), effects, d), 0.0)
-            return np.append(plain(w), np.sqrt(extra) / ys)
-
+    resid = _residual(family, effects, d, idx, y, sw, value, spent, c_top, n_fit, ys)
     # the corrected fits (normal contact) converge within 12–30 solver evaluations; one that
     # has not within 100 is not going to, and its finite-difference Jacobians at 400 cost
     # seconds on a long record (2813 model evaluations measured on one run-away fit)
@@ -264,11 +233,31 @@ def fit(
         jac = None if jac is None else jac[:-1]
     # the errors scale with the corrected residual, not with the constant C the solver saw
     shrink = float(np.sqrt(rss / chisqr)) if chisqr > 0 else 1.0
+    lag = int(d.cycles.period_samples // stride) if n_all == d.y.size else None
+    se = _stderr(res, names, sc, shrink, lag, resid_vec, jac)
+    wsum = float(np.sum(sw * sw)) * ys * ys
+    return FitOut(
+        value(w), se, rss, rss / wsum, res.ndata, res.nvarys, res.success, res.message,
+        res.nfev + searched,
+    )  # fmt: skip
+
+
+def _stderr(
+    res: Any,
+    names: list[str],
+    sc: dict[str, float],
+    shrink: float,
+    lag: int | None,
+    resid_vec: np.ndarray,
+    jac: np.ndarray | None,
+) -> dict[str, float]:
+    """Standard errors of a fit in the parameters' units (``inf``: not identifiable),
+    scaled by ``shrink`` and, for the fit to all data (``lag``: the period in fitted
+    samples; None otherwise), inflated for the residual's correlation over ``lag``."""
     infl = dict.fromkeys(names, 1.0)
-    if n_all == d.y.size and jac is not None:  # the fit to all data: its errors are reported
-        lag = int(d.cycles.period_samples // stride)
+    if lag is not None and jac is not None:  # the fit to all data: its errors are reported
         infl.update(zip(res.var_names, stderr_inflation(jac, resid_vec, lag), strict=True))
-    se = {
+    return {
         n: (
             res.params[n].stderr * sc[n] * shrink * infl[n]
             if res.params[n].stderr is not None
@@ -276,18 +265,58 @@ def fit(
         )
         for n in names
     }
-    wsum = float(np.sum(sw * sw)) * ys * ys
-    return FitOut(
-        value(w),
-        se,
-        rss,
-        rss / wsum,
-        res.ndata,
-        res.nvarys,
-        res.success,
-        res.message,
-        res.nfev + searched,
-    )
+
+
+def _inside(
+    x0: dict[str, float], specs: list[ParamSpec], sc: dict[str, float], typical: bool
+) -> dict[str, float]:
+    """Starting values strictly inside the bounds, so a start at "absent" (often a bound)
+    can move; ``typical``: a value with no "absent" (a time constant, NaN) starts at a
+    typical one, 0.3 of its scale."""
+    out = dict(x0)
+    for s in specs:
+        v = float(out[s.name])
+        if typical and not np.isfinite(v):
+            v = 0.3 * sc[s.name]
+        span = s.upper - s.lower if np.isfinite(s.upper - s.lower) else sc[s.name]
+        out[s.name] = float(np.clip(v, s.lower + 1e-6 * span, s.upper - 1e-6 * span))
+    return out
+
+
+def _residual(
+    family: Family,
+    effects: tuple[str, ...],
+    d: Prepared,
+    idx: np.ndarray,
+    y: np.ndarray,
+    sw: np.ndarray,
+    value: Any,
+    spent: Any,
+    c_top: float,
+    n_fit: float,
+    ys: float,
+) -> Any:
+    """The solver's residual of :func:`fit`: weighted model minus data at the samples
+    ``idx`` (the model at those samples only for a family that ``predicts_at``), and, for
+    the errors-in-variables correction (``c_top`` > 0), the one more residual
+    ``√(n (C - T(θ)))``; each call counted against the budget."""
+    at = getattr(family, "predicts_at", False)
+
+    def plain(w: dict[str, float]) -> np.ndarray:
+        if spent is not None and not in_column():
+            spent.tick()
+        if at:
+            return (family.predict(value(w), effects, d, at=idx) - y) * sw  # type: ignore[call-arg]
+        return (family.predict(value(w), effects, d)[idx] - y) * sw
+
+    if c_top <= 0:
+        return plain
+
+    def resid(w: dict[str, float]) -> np.ndarray:
+        extra = n_fit * max(c_top - noise_term(family, value(w), effects, d), 0.0)
+        return np.append(plain(w), np.sqrt(extra) / ys)
+
+    return resid
 
 
 def correlation_time(r: np.ndarray, lag: int) -> float:

@@ -546,30 +546,67 @@ def diagnose(
     taps, declared_noise = _declared(recording, family, output_filter, output_noise, t.size, y)
     notes = [n for n in (sign_note, _same_clock(recording, names, candidates)) if n]
     d, reduced = path.prepare(t, u, y, taps)
-    d.extra.update(context)
-    d.extra["meta"] = _meta(recording)
-    prior, prior_notes = _prior_weight(family, d, taps)
-    d.extra["evaluations"] = EvaluationCounter()  # counted by select.fit
-    family.prepare(d)
+    prior, prior_notes = _ready(family, d, recording, context, taps)
     effects: tuple[str, ...] = tuple(model.effects) if isinstance(model, ExtendedModel) else ()
     regime = path.regime(t, u, y)  # the one decision analyze, track and diagnose share
-    d.extra["regime_info"] = {
-        "name": regime.name, "plateau_h0": regime.h0, "plateau_stderr": regime.h0_stderr,
-        "breakaway_force": regime.breakaway_force, **regime.extra,
-    }  # fmt: skip
+    d.extra["regime_info"] = _regime_info(regime)
     b = _fit_base(family, effects, d, start, folds, declared_noise)
     where, location = _describe_base(b, d, regime, notes, reduced, prior, prior_notes)
     location["samples"] = {"recording": int(t.size), "diagnosed": int(d.t.size)}
     location["noise_declared"] = declared_noise is not None
+    st = _search(b, names, d, folds, z, min_gain, max_effects, where)
+    checks = _assess(b, d, st, names, z, min_gain, folds, declared_noise, location)
+    report = _report(b.family, path, recording, regime, d, st, b.sigma, location)
+    report.model_inferred = inferred
+    report.channel_noise = checks["noise"]
+    report.not_detected = checks["not_detected"]
+    report.unexplained = checks["unexplained"]
+    return report
+
+
+def _search(
+    b: _Base,
+    names: list[str],
+    d: Prepared,
+    folds: int,
+    z: float,
+    min_gain: float,
+    max_effects: int,
+    where: list[str],
+) -> SearchState:
+    """The stepwise candidate search (:class:`.search.StepwiseSearch`) from the base."""
     steps = [Step(None, *StepwiseSearch._errors(b.current))]
     search = StepwiseSearch(
         b.family, names, d, b.scales, folds, b.sigma, z, min_gain, b.budget,
         dict(b.current.full.params), max_effects, Step,
     )  # fmt: skip
     spent = d.extra["evaluations"].total  # by the base; then as a serial run counts them
-    st = search.run(SearchState(b.current, steps, where, [b.current], used=spent))
-    # issue 29 items 1-3: both channels' noise, what each candidate not named would have
-    # needed to be seen, and structure the final model leaves (detection.py)
+    return search.run(SearchState(b.current, steps, where, [b.current], used=spent))
+
+
+def _regime_info(regime: RegimeDecision) -> dict[str, Any]:
+    """The regime decision as the candidates read it (``d.extra["regime_info"]``)."""
+    return {
+        "name": regime.name, "plateau_h0": regime.h0, "plateau_stderr": regime.h0_stderr,
+        "breakaway_force": regime.breakaway_force, **regime.extra,
+    }  # fmt: skip
+
+
+def _assess(
+    b: _Base,
+    d: Prepared,
+    st: SearchState,
+    names: list[str],
+    z: float,
+    min_gain: float,
+    folds: int,
+    declared_noise: float | None,
+    location: dict[str, Any],
+) -> dict[str, Any]:
+    """Issue 29 items 1-3 on the finished search: both channels' noise, what each candidate
+    not named would have needed to be seen, and structure the final model leaves
+    (:mod:`.assessment`); the detection settings go into ``location``, a flagged misfit's
+    sentence into the search's ``where``."""
     from .assessment import assess
 
     checks = assess(
@@ -579,12 +616,21 @@ def diagnose(
     location["detection"] = {k: checks[k] for k in ("z", "gain_floor", "folds", "candidates")}
     if checks["unexplained"] is not None and checks["unexplained"].flagged:
         st.where.append(checks["unexplained"].sentence())
-    report = _report(b.family, path, recording, regime, d, st, b.sigma, location)
-    report.model_inferred = inferred
-    report.channel_noise = checks["noise"]
-    report.not_detected = checks["not_detected"]
-    report.unexplained = checks["unexplained"]
-    return report
+    return checks
+
+
+def _ready(
+    family: Family, d: Prepared, recording: Any, context: dict[str, float], taps: Any
+) -> tuple[dict[str, Any] | None, list[str]]:
+    """The prepared record made ready for the search: the model's context and the
+    recording's meta in ``d.extra``, the prior weight of the data (returned, with its
+    sentences), the evaluation counter, and the family's own preparation."""
+    d.extra.update(context)
+    d.extra["meta"] = _meta(recording)
+    prior, prior_notes = _prior_weight(family, d, taps)
+    d.extra["evaluations"] = EvaluationCounter()  # counted by select.fit
+    family.prepare(d)
+    return prior, prior_notes
 
 
 def _checked_arrays(

@@ -56,8 +56,11 @@ class DatFile:
 
     def series(self, what: str, set_: str | None = None) -> tuple[np.ndarray, list[np.ndarray]]:
         """Times and data of every block whose ``what`` starts with ``what`` (and ``set``)."""
-        sel = [b for b in self.blocks if b.what.startswith(what) and (set_ is None or
-               (b.set or "").upper() == set_.upper())]  # fmt: skip
+        sel = [
+            b
+            for b in self.blocks
+            if b.what.startswith(what) and (set_ is None or (b.set or "").upper() == set_.upper())
+        ]
         return np.array([b.time for b in sel]), [b.data for b in sel]
 
 
@@ -102,8 +105,15 @@ def parse_dat(text: str) -> DatFile:
                 i += 1
             width = max((len(r) for r in rows), default=0)
             data = np.array([r + [np.nan] * (width - len(r)) for r in rows], float)
-            out.blocks.append(DatBlock(m.group("what"), m.group("cols") or "", m.group("set"),
-                                       float(m.group("time")), data))  # fmt: skip
+            out.blocks.append(
+                DatBlock(
+                    m.group("what"),
+                    m.group("cols") or "",
+                    m.group("set"),
+                    float(m.group("time")),
+                    data,
+                )
+            )
             continue
         i += 1
     return out
@@ -145,12 +155,20 @@ def run_ccx(deck: str, *, timeout: float = 120.0, keep: str | Path | None = None
         raise SolverError(f"ccx not found: install the {CCX_PACKAGE} package")
     with tempfile.TemporaryDirectory(prefix="contactlab-ccx-") as tmp:
         Path(tmp, "job.inp").write_text(deck, encoding="utf-8")
-        env = dict(os.environ, OMP_NUM_THREADS="1", CCX_NPROC_STIFFNESS="1",
-                   CCX_NPROC_EQUATION_SOLVER="1")  # fmt: skip
+        env = dict(
+            os.environ, OMP_NUM_THREADS="1", CCX_NPROC_STIFFNESS="1", CCX_NPROC_EQUATION_SOLVER="1"
+        )
         t0 = time.perf_counter()
         try:
-            r = subprocess.run([exe, "-i", "job"], cwd=tmp, capture_output=True, text=True,
-                               timeout=timeout, env=env, check=False)  # fmt: skip
+            r = subprocess.run(
+                [exe, "-i", "job"],
+                cwd=tmp,
+                capture_output=True,
+                text=True,
+                timeout=timeout,
+                env=env,
+                check=False,
+            )
         except subprocess.TimeoutExpired as exc:
             raise SolverError(f"ccx did not finish within {timeout:g} s") from exc
         seconds = time.perf_counter() - t0

@@ -290,8 +290,9 @@ def _normal(
         ("E_d", _pm(_num(d, "E_d", where), _se(d, "E_d"), "J/m^2")),
         ("cycle scatter", f"{100 * float(d.get('cycle_scatter_rel', math.nan)):.3g}% of Δδ"),
     ]
-    return JointCharacteristics("normal", str(d.get("file", where)), values, prov, table, lo,
-                                notes, ks)  # fmt: skip
+    return JointCharacteristics(
+        "normal", str(d.get("file", where)), values, prov, table, lo, notes, ks
+    )
 
 
 def _ks_table(d: dict[str, Any], where: str, dmin: float, dmax: float, n: int) -> np.ndarray:
@@ -329,6 +330,68 @@ def _tag(d: dict[str, Any], keys: tuple[str, ...], where: str) -> float | None:
     return None
 
 
+def _amplitude_values(
+    d: dict[str, Any],
+    where: str,
+    fitted_values: tuple[float, float, float, float],
+    ac_ok: bool,
+    reason: str,
+    amplitude: float,
+    frequency: float | None,
+    values: list[Value],
+    notes: list[str],
+) -> None:
+    """The amplitude-dependent characteristics of a Masing fit at ``amplitude`` (k_global,
+    c_e, the energy per cycle), appended to ``values``; a note when the amplitude is far from
+    the tested one."""
+    h0, h0_se, ac, ac_se = fitted_values
+    ident = d.get("identifiable") if isinstance(d.get("identifiable"), dict) else {}
+    if frequency is None:
+        raise InputError(f"{where}: --amplitude needs --frequency (for the dashpot c_e)")
+    if not ac_ok:
+        raise NotIdentifiableError(
+            f"{where}: k_global(A) and c_e(A) need h0 and ac; ac is not identified: {reason}"
+        )
+    m = Masing(h0, ac)
+    omega = 2 * math.pi * frequency
+    rho = float(ident.get("correlation_h0_ac", 0.0) or 0.0)
+    cov = np.array([[h0_se**2, rho * h0_se * ac_se], [rho * h0_se * ac_se, ac_se**2]])
+
+    def kg(a: float, b: float) -> float:
+        return float(Masing(a, b).global_stiffness(amplitude))
+
+    def ce(a: float, b: float) -> float:
+        return float(Masing(a, b).loop_energy(amplitude)) / (math.pi * amplitude**2 * omega)
+
+    for name, fn, dim, src in (
+        ("k_global", kg, "stiffness", f"eq. 19: f(A)/A at A = {amplitude:.4g} m"),
+        (
+            "c_e",
+            ce,
+            "damping",
+            f"eq. 17: E(A)/(π A² ω) at A = {amplitude:.4g} m, f = {frequency:.6g} Hz",
+        ),
+    ):
+        v, g = _dyn_grad(h0, ac, fn)
+        se = math.sqrt(max(float(g @ cov @ g), 0.0)) if np.all(np.isfinite(cov)) else math.nan
+        values.append(Value(name, v, se, dim, src))
+    fitted = d.get("amplitude")
+    if isinstance(fitted, float) and not 0.25 * fitted <= amplitude <= 4 * fitted:
+        notes.append(
+            f"amplitude {amplitude:.3g} m is far from the tested {fitted:.3g} m: k_global and "
+            "c_e extrapolate the exponential virgin curve"
+        )
+    values.append(
+        Value(
+            "energy_per_cycle",
+            float(m.loop_energy(amplitude)),
+            math.nan,
+            "energy",
+            f"Masing E(A) at A = {amplitude:.4g} m",
+        )
+    )
+
+
 def _tangential(
     d: dict[str, Any],
     where: str,
@@ -357,61 +420,40 @@ def _tangential(
         )
     notes: list[str] = []
     h0, h0_se = _num(d, "h0", where, positive=True), _se(d, "h0")
-    values = [Value("mu", h0 / normal_load, h0_se / normal_load, "1", "h0 / W"),
-              Value("slip_force", h0, h0_se, "force", "μ·W = h0 (Jenkins F_s)")]  # fmt: skip
+    values = [
+        Value("mu", h0 / normal_load, h0_se / normal_load, "1", "h0 / W"),
+        Value("slip_force", h0, h0_se, "force", "μ·W = h0 (Jenkins F_s)"),
+    ]
     if ident.get("h0_ac", False) and d.get("h0_ac") is not None:
         k0, k0_se = _num(d, "h0_ac", where, positive=True), _se(d, "h0_ac")
         values += [
-            Value("stick_slope", k0 / area, k0_se / area, "stiffness_per_area",
-                  "h0·ac / A_c (eq. 18)"),
-            Value("elastic_slip", h0 / k0, h0 / k0 * math.hypot(h0_se / h0, k0_se / k0),
-                  "length", "μp/λ = h0/(h0·ac) = 1/ac"),
+            Value(
+                "stick_slope", k0 / area, k0_se / area, "stiffness_per_area", "h0·ac / A_c (eq. 18)"
+            ),
+            Value(
+                "elastic_slip",
+                h0 / k0,
+                h0 / k0 * math.hypot(h0_se / h0, k0_se / k0),
+                "length",
+                "μp/λ = h0/(h0·ac) = 1/ac",
+            ),
             Value("k_stick", k0, k0_se, "stiffness", "h0·ac (Jenkins k)"),
-        ]  # fmt: skip
+        ]
     else:
         k0, k0_se = math.nan, math.nan
         lb = d.get("ac_lower_bound")
-        bound = (f"; the data only bound it: ac ≥ {lb:.3g} 1/m, i.e. an elastic slip ≤ "
-                 f"{1 / lb:.3g} m" if isinstance(lb, (int, float)) and lb > 0 else "")  # fmt: skip
+        bound = (
+            f"; the data only bound it: ac ≥ {lb:.3g} 1/m, i.e. an elastic slip ≤ {1 / lb:.3g} m"
+            if isinstance(lb, (int, float)) and lb > 0
+            else ""
+        )
         notes.append(f"no stick slope: h0·ac is not identified{bound} ({reason})")
     ac_ok = bool(ident.get("ac", False)) and d.get("ac") is not None
     ac, ac_se = (_num(d, "ac", where, positive=True), _se(d, "ac")) if ac_ok else (math.nan,) * 2
     if amplitude is not None:
-        if frequency is None:
-            raise InputError(f"{where}: --amplitude needs --frequency (for the dashpot c_e)")
-        if not ac_ok:
-            raise NotIdentifiableError(
-                f"{where}: k_global(A) and c_e(A) need h0 and ac; ac is not identified: {reason}"
-            )
-        m = Masing(h0, ac)
-        omega = 2 * math.pi * frequency
-        rho = float(ident.get("correlation_h0_ac", 0.0) or 0.0)
-        cov = np.array([[h0_se**2, rho * h0_se * ac_se], [rho * h0_se * ac_se, ac_se**2]])
-
-        def kg(a: float, b: float) -> float:
-            return float(Masing(a, b).global_stiffness(amplitude))
-
-        def ce(a: float, b: float) -> float:
-            return float(Masing(a, b).loop_energy(amplitude)) / (math.pi * amplitude**2 * omega)
-
-        for name, fn, dim, src in (
-            ("k_global", kg, "stiffness", f"eq. 19: f(A)/A at A = {amplitude:.4g} m"),
-            ("c_e", ce, "damping", f"eq. 17: E(A)/(π A² ω) at A = {amplitude:.4g} m, "
-             f"f = {frequency:.6g} Hz"),
-        ):  # fmt: skip
-            v, g = _dyn_grad(h0, ac, fn)
-            se = math.sqrt(max(float(g @ cov @ g), 0.0)) if np.all(np.isfinite(cov)) else math.nan
-            values.append(Value(name, v, se, dim, src))
-        fitted = d.get("amplitude")
-        if isinstance(fitted, float) and not 0.25 * fitted <= amplitude <= 4 * fitted:
-            notes.append(
-                f"amplitude {amplitude:.3g} m is far from the tested {fitted:.3g} m: k_global and "
-                "c_e extrapolate the exponential virgin curve"
-            )
-        values.append(
-            Value("energy_per_cycle", float(m.loop_energy(amplitude)), math.nan, "energy",
-                  f"Masing E(A) at A = {amplitude:.4g} m")
-        )  # fmt: skip
+        _amplitude_values(
+            d, where, (h0, h0_se, ac, ac_se), ac_ok, reason, amplitude, frequency, values, notes
+        )
     prov = [
         ("source", str(d.get("file", where))),
         (
@@ -430,8 +472,9 @@ def _tangential(
         "the elastic-Coulomb law is bilinear (Jenkins): its loop energy 4·F_s·(A - F_s/k) "
         "differs from the fitted Masing energy; compare both at your amplitude"
     )
-    return JointCharacteristics("tangential", str(d.get("file", where)), values, prov, None, 0.0,
-                                notes)  # fmt: skip
+    return JointCharacteristics(
+        "tangential", str(d.get("file", where)), values, prov, None, 0.0, notes
+    )
 
 
 def joint_characteristics(
@@ -483,8 +526,14 @@ def joint_characteristics(
             raise InputError("frequency must be > 0")
         return _normal(result, where, frequency=frequency, points=check_points(points))
     if kind == "tangential":
-        return _tangential(result, where, area=area, normal_load=normal_load,
-                           amplitude=amplitude, frequency=frequency)  # fmt: skip
+        return _tangential(
+            result,
+            where,
+            area=area,
+            normal_load=normal_load,
+            amplitude=amplitude,
+            frequency=frequency,
+        )
     if kind is None:
         raise InputError(
             f"{where}: no 'model' key: not one recording's result of `contactlab analyze "
@@ -493,5 +542,11 @@ def joint_characteristics(
     raise InputError(f"{where}: 'model' is {kind!r}; expected 'normal' or 'tangential'")
 
 
-__all__ = ["JointCharacteristics", "NotIdentifiableError", "Value", "joint_characteristics",
-           "load_result", "unit_system"]  # fmt: skip
+__all__ = [
+    "JointCharacteristics",
+    "NotIdentifiableError",
+    "Value",
+    "joint_characteristics",
+    "load_result",
+    "unit_system",
+]

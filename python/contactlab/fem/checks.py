@@ -38,7 +38,7 @@ from .writers import render
 _MM = unit_system("mm-N-s")
 
 
-def _interaction_lines(text: str) -> list[str]:
+def interaction_lines(text: str) -> list[str]:
     """The exported keyword lines that belong inside ``*SURFACE INTERACTION`` (no header)."""
     lines = [ln for ln in text.splitlines() if ln.strip() and not ln.startswith("**")]
     if lines and lines[0].upper().startswith("*SURFACE INTERACTION"):
@@ -85,10 +85,14 @@ class NormalCheck:
         )
 
     def to_dict(self) -> dict[str, Any]:
-        return {"table_pressure_error": self.table_pressure_error, "poly_error": self.poly_error,
-                "compliance_error": self.compliance_error, "block_share": self.block_share,
-                "seconds": self.seconds,
-                "increments": int(self.pressure.size)}  # fmt: skip
+        return {
+            "table_pressure_error": self.table_pressure_error,
+            "poly_error": self.poly_error,
+            "compliance_error": self.compliance_error,
+            "block_share": self.block_share,
+            "seconds": self.seconds,
+            "increments": int(self.pressure.size),
+        }
 
 
 def check_normal(
@@ -103,7 +107,7 @@ def check_normal(
     if jc.table is None:
         raise InputError("check_normal needs a normal-contact result")
     text = render(jc, "calculix", _MM)
-    inter = _interaction_lines(text)
+    inter = interaction_lines(text)
     inter = [ln for ln in inter if not ln.upper().startswith("*CONTACT DAMPING")]
     inter = inter[: 1 + len(jc.table)]  # static check: the table alone (damping needs velocity)
     tab = np.array([[float(v) for v in ln.split(",")] for ln in inter[1:]])
@@ -136,8 +140,9 @@ def check_normal(
     analytic = 2 * p_applied * b.height / b.E + np.interp(p_applied, tab[:, 0], tab[:, 1])
     comp = float(np.max(np.abs(top - analytic) / analytic))
     share = float(2 * p_top * b.height / b.E / analytic[-1])
-    return NormalCheck(p_fe, u_fe, err_tab, err_poly, top, analytic, comp, share, run.seconds,
-                       jc.notes)  # fmt: skip
+    return NormalCheck(
+        p_fe, u_fe, err_tab, err_poly, top, analytic, comp, share, run.seconds, jc.notes
+    )
 
 
 @dataclass
@@ -158,25 +163,41 @@ class TangentialCheck:
         return [abs(f - j) / j for f, j in zip(self.energy_fe, self.energy_jenkins, strict=True)]
 
     def report(self) -> str:
-        lines = [f"tangential check (CalculiX elastic Coulomb, {self.seconds:.2f} s): "
-                 f"F_s = μW = {self.slip_force:.5g} N, k = λ·A_c = {self.stiffness:.5g} N/m",
-                 f"{'A [um]':>8} {'E_FE [J]':>12} {'E_Jenkins [J]':>14} {'error':>8} "
-                 f"{'E_Masing [J]':>13} {'Masing/FE':>10}"]  # fmt: skip
-        for a, f, j, m, e in zip(self.amplitudes, self.energy_fe, self.energy_jenkins,
-                                 self.energy_masing, self.errors, strict=True):  # fmt: skip
-            lines.append(f"{a * 1e6:8.4g} {f:12.5g} {j:14.5g} {100 * e:7.3g}% {m:13.5g} "
-                         f"{m / f:10.3g}")  # fmt: skip
-        lines.append("the FE law (bilinear, Jenkins) and the fitted Masing contact dissipate "
-                     "different energies: Masing/FE is the factor the FE model misses")  # fmt: skip
+        lines = [
+            f"tangential check (CalculiX elastic Coulomb, {self.seconds:.2f} s): "
+            f"F_s = μW = {self.slip_force:.5g} N, k = λ·A_c = {self.stiffness:.5g} N/m",
+            f"{'A [um]':>8} {'E_FE [J]':>12} {'E_Jenkins [J]':>14} {'error':>8} "
+            f"{'E_Masing [J]':>13} {'Masing/FE':>10}",
+        ]
+        for a, f, j, m, e in zip(
+            self.amplitudes,
+            self.energy_fe,
+            self.energy_jenkins,
+            self.energy_masing,
+            self.errors,
+            strict=True,
+        ):
+            lines.append(
+                f"{a * 1e6:8.4g} {f:12.5g} {j:14.5g} {100 * e:7.3g}% {m:13.5g} {m / f:10.3g}"
+            )
+        lines.append(
+            "the FE law (bilinear, Jenkins) and the fitted Masing contact dissipate "
+            "different energies: Masing/FE is the factor the FE model misses"
+        )
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, Any]:
-        return {"amplitudes": self.amplitudes, "energy_fe": self.energy_fe,
-                "energy_jenkins": self.energy_jenkins, "energy_masing": self.energy_masing,
-                "errors": self.errors, "seconds": self.seconds}  # fmt: skip
+        return {
+            "amplitudes": self.amplitudes,
+            "energy_fe": self.energy_fe,
+            "energy_jenkins": self.energy_jenkins,
+            "energy_masing": self.energy_masing,
+            "errors": self.errors,
+            "seconds": self.seconds,
+        }
 
 
-def _loop_energy(x: np.ndarray, f: np.ndarray) -> float:
+def loop_energy(x: np.ndarray, f: np.ndarray) -> float:
     """Area of the closed polygon (x, f) (shoelace), the energy of one cycle."""
     return 0.5 * abs(float(np.dot(x, np.roll(f, -1)) - np.dot(f, np.roll(x, -1))))
 
@@ -197,15 +218,22 @@ def check_tangential(
     """
     jc = joint_characteristics(result, area=area, normal_load=normal_load)
     text = render(jc, "calculix", _MM)
-    friction = _interaction_lines(text)
+    friction = interaction_lines(text)
     mu, lam = (float(v) for v in friction[-1].split(","))  # as written: μ, λ in N/mm³
     side = math.sqrt(area) * 1e3  # mm
     b = Block(size=side, height=side / 2, n=2, m=1, nu=0.0)
     fs, k = mu * normal_load, lam * b.area  # N, N/mm
     amps_mm = [a * 1e3 for a in amplitudes] if amplitudes else [2 * fs / k, 4 * fs / k]
     inter = ["*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR", f"{100 * lam:.9g}", *friction]
-    deck = two_block_deck(b, inter, mode="shear", pressure=normal_load / b.area,
-                          amplitudes=amps_mm, cycles=1, increment=increment)  # fmt: skip
+    deck = two_block_deck(
+        b,
+        inter,
+        mode="shear",
+        pressure=normal_load / b.area,
+        amplitudes=amps_mm,
+        cycles=1,
+        increment=increment,
+    )
     run = run_ccx(deck)
     t_rf, rf = run.dat.series("total force", "NB")
     t_u, u = run.dat.series("displacements", "NTOP")
@@ -220,13 +248,14 @@ def check_tangential(
         if x.size < 20:
             raise InputError(f"CalculiX printed only {x.size} points of the cycle at A = {a} mm")
         loops.append((x * 1e-3, f))
-        e_fe.append(_loop_energy(x, f) * 1e-3)  # N·mm → J
+        e_fe.append(loop_energy(x, f) * 1e-3)  # N·mm → J
         e_j.append(4 * fs * (a - fs / k) * 1e-3)
         e_m.append(float(model.loop_energy(a * 1e-3)))
     if not np.allclose(t_u, t_rf):
         raise InputError("CalculiX printed forces and displacements at different times")
-    return TangentialCheck([a * 1e-3 for a in amps_mm], e_fe, e_j, e_m, fs, k * 1e3,
-                           run.seconds, loops)  # fmt: skip
+    return TangentialCheck(
+        [a * 1e-3 for a in amps_mm], e_fe, e_j, e_m, fs, k * 1e3, run.seconds, loops
+    )
 
 
 @dataclass
@@ -250,19 +279,26 @@ class DynamicsCheck:
     def report(self) -> str:
         b = self.beam
         ratio = self.spring * 1e-3 * b.length**3 / b.EI
-        return (f"dynamics check (CalculiX *FREQUENCY, {self.seconds:.2f} s): beam "
-                f"{b.length:.4g} mm × {b.side:.3g} mm square, joint spring {self.spring:.5g} N/m "
-                f"(kL³/EI = {ratio:.3g}): f1 = {self.frequency_fe:.6g} Hz vs {self.reference} "
-                f"{self.frequency_reference:.6g} Hz, error {100 * self.error:.3g}% (closed form "
-                f"{self.frequency_closed_form:.6g} Hz; modal damping ratio with the joint "
-                f"dashpot {self.damping_ratio:.3g})")  # fmt: skip
+        return (
+            f"dynamics check (CalculiX *FREQUENCY, {self.seconds:.2f} s): beam "
+            f"{b.length:.4g} mm × {b.side:.3g} mm square, joint spring {self.spring:.5g} N/m "
+            f"(kL³/EI = {ratio:.3g}): f1 = {self.frequency_fe:.6g} Hz vs {self.reference} "
+            f"{self.frequency_reference:.6g} Hz, error {100 * self.error:.3g}% (closed form "
+            f"{self.frequency_closed_form:.6g} Hz; modal damping ratio with the joint "
+            f"dashpot {self.damping_ratio:.3g})"
+        )
 
     def to_dict(self) -> dict[str, Any]:
-        return {"frequency_fe": self.frequency_fe, "frequency_reference":
-                self.frequency_reference, "reference": self.reference, "error": self.error,
-                "frequency_closed_form": self.frequency_closed_form,
-                "damping_ratio": self.damping_ratio, "spring": self.spring,
-                "seconds": self.seconds}  # fmt: skip
+        return {
+            "frequency_fe": self.frequency_fe,
+            "frequency_reference": self.frequency_reference,
+            "reference": self.reference,
+            "error": self.error,
+            "frequency_closed_form": self.frequency_closed_form,
+            "damping_ratio": self.damping_ratio,
+            "spring": self.spring,
+            "seconds": self.seconds,
+        }
 
 
 def structure_beam_modes(beam: Beam, k: float, c: float, n: int = 40) -> Any:
@@ -290,9 +326,19 @@ def structure_beam_modes(beam: Beam, k: float, c: float, n: int = 40) -> Any:
         )
     )
     q = h * h
-    me = m * h / 420 * np.array([[156, 22 * h, 54, -13 * h], [22 * h, 4 * q, 13 * h, -3 * q],
-                                 [54, 13 * h, 156, -22 * h],
-                                 [-13 * h, -3 * q, -22 * h, 4 * q]])  # fmt: skip
+    me = (
+        m
+        * h
+        / 420
+        * np.array(
+            [
+                [156, 22 * h, 54, -13 * h],
+                [22 * h, 4 * q, 13 * h, -3 * q],
+                [54, 13 * h, 156, -22 * h],
+                [-13 * h, -3 * q, -22 * h, 4 * q],
+            ]
+        )
+    )
     size = 2 * (n + 1)
     K, M = np.zeros((size, size)), np.zeros((size, size))
     for e in range(n):
@@ -323,9 +369,14 @@ def pinned_spring_beam_frequency(beam: Beam, k: float) -> float:
 
 
 def check_dynamics(
-    result: dict[str, Any], *, area: float, normal_load: float, amplitude: float,
-    frequency: float, n: int = 40,
-) -> DynamicsCheck:  # fmt: skip
+    result: dict[str, Any],
+    *,
+    area: float,
+    normal_load: float,
+    amplitude: float,
+    frequency: float,
+    n: int = 40,
+) -> DynamicsCheck:
     """Beam on the exported joint spring k_global(A): CalculiX vs the closed form.
 
     The beam is sized so that the spring matters (kL³/EI = 40, slenderness L/side = 40).
@@ -348,8 +399,16 @@ def check_dynamics(
     try:
         md = structure_beam_modes(beam, k * 1e3, c * 1e3, n=n)
     except ImportError:
-        return DynamicsCheck(f_fe, f_closed, "Euler–Bernoulli closed form", k * 1e3, beam,
-                             run.seconds, f_closed)  # fmt: skip
-    return DynamicsCheck(f_fe, float(md.frequency_hz[0]), "contactlab.structure modes()",
-                         k * 1e3, beam, run.seconds, f_closed,
-                         float(md.damping_ratio[0]))  # fmt: skip
+        return DynamicsCheck(
+            f_fe, f_closed, "Euler–Bernoulli closed form", k * 1e3, beam, run.seconds, f_closed
+        )
+    return DynamicsCheck(
+        f_fe,
+        float(md.frequency_hz[0]),
+        "contactlab.structure modes()",
+        k * 1e3,
+        beam,
+        run.seconds,
+        f_closed,
+        float(md.damping_ratio[0]),
+    )

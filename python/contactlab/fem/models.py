@@ -71,9 +71,16 @@ def _mesh(b: Block) -> tuple[list[str], dict[str, np.ndarray], dict[str, list[in
             for j in range(b.n):
                 for i in range(b.n):
                     eid += 1
-                    c = [ids[i, j, k], ids[i + 1, j, k], ids[i + 1, j + 1, k], ids[i, j + 1, k],
-                         ids[i, j, k + 1], ids[i + 1, j, k + 1], ids[i + 1, j + 1, k + 1],
-                         ids[i, j + 1, k + 1]]  # fmt: skip
+                    c = [
+                        ids[i, j, k],
+                        ids[i + 1, j, k],
+                        ids[i + 1, j + 1, k],
+                        ids[i, j + 1, k],
+                        ids[i, j, k + 1],
+                        ids[i + 1, j, k + 1],
+                        ids[i + 1, j + 1, k + 1],
+                        ids[i, j + 1, k + 1],
+                    ]
                     lines.append(f"{eid}, " + ", ".join(map(str, c)))
                     sets[f"E{name}"].append(eid)
                     if name == "A" and k == b.m - 1:
@@ -130,42 +137,78 @@ def two_block_deck(
     for s in ("EA", "EB", "EATOP", "EBBOT", "EBTOP"):
         if s not in ("EA", "EB"):
             elset(s)
-    lines += ["*SURFACE, NAME=SMASTER, TYPE=ELEMENT", "EATOP, S2",
-              "*SURFACE, NAME=SSLAVE, TYPE=ELEMENT", "EBBOT, S1",
-              "*MATERIAL, NAME=BLOCK", "*ELASTIC", f"{block.E:.9g}, {block.nu:.9g}",
-              "*SOLID SECTION, ELSET=EA, MATERIAL=BLOCK",
-              "*SOLID SECTION, ELSET=EB, MATERIAL=BLOCK",
-              "*SURFACE INTERACTION, NAME=JOINT", *interaction]  # fmt: skip
+    lines += [
+        "*SURFACE, NAME=SMASTER, TYPE=ELEMENT",
+        "EATOP, S2",
+        "*SURFACE, NAME=SSLAVE, TYPE=ELEMENT",
+        "EBBOT, S1",
+        "*MATERIAL, NAME=BLOCK",
+        "*ELASTIC",
+        f"{block.E:.9g}, {block.nu:.9g}",
+        "*SOLID SECTION, ELSET=EA, MATERIAL=BLOCK",
+        "*SOLID SECTION, ELSET=EB, MATERIAL=BLOCK",
+        "*SURFACE INTERACTION, NAME=JOINT",
+        *interaction,
+    ]
     kind = "NODE TO SURFACE" if mode == "normal" else "SURFACE TO SURFACE"
     lines += [f"*CONTACT PAIR, INTERACTION=JOINT, TYPE={kind}", "SSLAVE, SMASTER"]
     if mode == "normal":
         if increments < 2:
             raise InputError("increments must be ≥ 2")
-        lines += ["*BOUNDARY", "NX0, 1", "NY0, 2", "NBASE, 3",
-                  "*STEP, INC=1000", "*STATIC, DIRECT", f"{1 / increments:.9g}, 1.0",
-                  "*DLOAD", f"EBTOP, P2, {pressure:.9g}",
-                  "*NODE PRINT, NSET=NTOP", "U", "*CONTACT PRINT", "CDIS, CSTR",
-                  "*END STEP"]  # fmt: skip
+        lines += [
+            "*BOUNDARY",
+            "NX0, 1",
+            "NY0, 2",
+            "NBASE, 3",
+            "*STEP, INC=1000",
+            "*STATIC, DIRECT",
+            f"{1 / increments:.9g}, 1.0",
+            "*DLOAD",
+            f"EBTOP, P2, {pressure:.9g}",
+            "*NODE PRINT, NSET=NTOP",
+            "U",
+            "*CONTACT PRINT",
+            "CDIS, CSTR",
+            "*END STEP",
+        ]
         return "\n".join(lines) + "\n"
     if not amplitudes or any(not a > 0 for a in amplitudes) or cycles < 1:
         raise InputError("shear: give positive amplitudes and cycles ≥ 1")
     t = [0.0, 1.0] + [v for c in range(cycles) for v in (3.0 + 4 * c, 5.0 + 4 * c)]
     a = [0.0, 1.0] + [v for _ in range(cycles) for v in (-1.0, 1.0)]
     lines.append("*AMPLITUDE, NAME=CYCLE")
-    lines += [", ".join(f"{ti:g}, {ai:g}" for ti, ai in zip(t[i : i + 4], a[i : i + 4],
-                                                            strict=True))
-              for i in range(0, len(t), 4)]  # fmt: skip
-    lines += ["*BOUNDARY", "NBASE, 3", "NA, 1", "NALL, 2",
-              "*STEP, INC=10000", "*STATIC, DIRECT", "0.25, 1.0",
-              "*BOUNDARY", "NB, 1, 1, 0.", "*DLOAD", f"EBTOP, P2, {pressure:.9g}",
-              "*END STEP"]  # fmt: skip
+    lines += [
+        ", ".join(f"{ti:g}, {ai:g}" for ti, ai in zip(t[i : i + 4], a[i : i + 4], strict=True))
+        for i in range(0, len(t), 4)
+    ]
+    lines += [
+        "*BOUNDARY",
+        "NBASE, 3",
+        "NA, 1",
+        "NALL, 2",
+        "*STEP, INC=10000",
+        "*STATIC, DIRECT",
+        "0.25, 1.0",
+        "*BOUNDARY",
+        "NB, 1, 1, 0.",
+        "*DLOAD",
+        f"EBTOP, P2, {pressure:.9g}",
+        "*END STEP",
+    ]
     period = t[-1]
     for amp in amplitudes:
-        lines += ["*STEP, INC=100000", "*STATIC",
-                  f"{increment:.9g}, {period:g}, 1e-7, {increment:.9g}",
-                  "*BOUNDARY, AMPLITUDE=CYCLE", f"NB, 1, 1, {amp:.9g}",
-                  "*NODE PRINT, NSET=NB, TOTALS=ONLY", "RF",
-                  "*NODE PRINT, NSET=NTOP", "U", "*END STEP"]  # fmt: skip
+        lines += [
+            "*STEP, INC=100000",
+            "*STATIC",
+            f"{increment:.9g}, {period:g}, 1e-7, {increment:.9g}",
+            "*BOUNDARY, AMPLITUDE=CYCLE",
+            f"NB, 1, 1, {amp:.9g}",
+            "*NODE PRINT, NSET=NB, TOTALS=ONLY",
+            "RF",
+            "*NODE PRINT, NSET=NTOP",
+            "U",
+            "*END STEP",
+        ]
     return "\n".join(lines) + "\n"
 
 
@@ -204,13 +247,30 @@ def beam_deck(beam: Beam, joint: Sequence[str], *, modes: int = 3) -> str:
     lines.append(f"{ground}, {beam.length:.9g}, {-beam.length / 10:.9g}, 0")
     lines.append("*ELEMENT, TYPE=B31, ELSET=EBEAM")
     lines += [f"{i + 1}, {i + 1}, {i + 2}" for i in range(n)]
-    lines += ["*ELEMENT, TYPE=SPRINGA, ELSET=JOINT_SPRING", f"{n + 1}, {tip}, {ground}",
-              "*ELEMENT, TYPE=DASHPOTA, ELSET=JOINT_DASHPOT", f"{n + 2}, {tip}, {ground}",
-              "*NSET, NSET=NBEAM", *_ids_lines(list(range(1, n + 2))),
-              "*MATERIAL, NAME=BEAM", "*ELASTIC", f"{beam.E:.9g}, {beam.nu:.9g}",
-              "*DENSITY", f"{beam.density:.9g}",
-              "*BEAM SECTION, ELSET=EBEAM, MATERIAL=BEAM, SECTION=RECT",
-              f"{beam.side:.9g}, {beam.side:.9g}", "0, 0, 1", *joint,
-              "*BOUNDARY", "1, 1, 3", "1, 4, 4", f"{ground}, 1, 3", "NBEAM, 3, 3",
-              "*STEP", "*FREQUENCY", f"{modes}", "*END STEP"]  # fmt: skip
+    lines += [
+        "*ELEMENT, TYPE=SPRINGA, ELSET=JOINT_SPRING",
+        f"{n + 1}, {tip}, {ground}",
+        "*ELEMENT, TYPE=DASHPOTA, ELSET=JOINT_DASHPOT",
+        f"{n + 2}, {tip}, {ground}",
+        "*NSET, NSET=NBEAM",
+        *_ids_lines(list(range(1, n + 2))),
+        "*MATERIAL, NAME=BEAM",
+        "*ELASTIC",
+        f"{beam.E:.9g}, {beam.nu:.9g}",
+        "*DENSITY",
+        f"{beam.density:.9g}",
+        "*BEAM SECTION, ELSET=EBEAM, MATERIAL=BEAM, SECTION=RECT",
+        f"{beam.side:.9g}, {beam.side:.9g}",
+        "0, 0, 1",
+        *joint,
+        "*BOUNDARY",
+        "1, 1, 3",
+        "1, 4, 4",
+        f"{ground}, 1, 3",
+        "NBEAM, 3, 3",
+        "*STEP",
+        "*FREQUENCY",
+        f"{modes}",
+        "*END STEP",
+    ]
     return "\n".join(lines) + "\n"

@@ -25,13 +25,31 @@ DIMENSIONS: dict[str, tuple[int, int, int]] = {
 }
 
 _LABELS = {
-    "SI": {"1": "1", "length": "m", "force": "N", "energy": "J", "pressure": "Pa",
-           "stiffness": "N/m", "damping": "N·s/m", "stiffness_per_area": "Pa/m",
-           "damping_per_area": "Pa·s/m", "area": "m^2"},
-    "mm": {"1": "1", "length": "mm", "force": "N", "energy": "N·mm", "pressure": "MPa",
-           "stiffness": "N/mm", "damping": "N·s/mm", "stiffness_per_area": "MPa/mm",
-           "damping_per_area": "MPa·s/mm", "area": "mm^2"},
-}  # fmt: skip
+    "SI": {
+        "1": "1",
+        "length": "m",
+        "force": "N",
+        "energy": "J",
+        "pressure": "Pa",
+        "stiffness": "N/m",
+        "damping": "N·s/m",
+        "stiffness_per_area": "Pa/m",
+        "damping_per_area": "Pa·s/m",
+        "area": "m^2",
+    },
+    "mm": {
+        "1": "1",
+        "length": "mm",
+        "force": "N",
+        "energy": "N·mm",
+        "pressure": "MPa",
+        "stiffness": "N/mm",
+        "damping": "N·s/mm",
+        "stiffness_per_area": "MPa/mm",
+        "damping_per_area": "MPa·s/mm",
+        "area": "mm^2",
+    },
+}
 
 
 @dataclass(frozen=True)
@@ -54,6 +72,10 @@ class UnitSystem:
             return "SI: m, N, s, kg (pressure Pa)"
         return f"{self.name}: mm, N, s, t (pressure MPa = N/mm^2)"
 
+
+#: the export's file formats (:func:`contactlab.fem.writers.render`); here, beside the unit
+#: systems, so that the command line's parser offers both without importing the writers
+FORMATS = ("calculix", "abaqus", "ansys", "csv", "json")
 
 SYSTEMS = {
     "SI": UnitSystem("SI", 1.0),

@@ -28,9 +28,7 @@ from pathlib import Path
 from .._io_atomic import write_text
 from ..errors import InputError
 from .characteristics import JointCharacteristics, NotIdentifiableError, Value
-from .units import UnitSystem
-
-FORMATS = ("calculix", "abaqus", "ansys", "csv", "json")
+from .units import FORMATS, UnitSystem
 
 
 def _g(x: float) -> str:
@@ -55,8 +53,10 @@ def _header(jc: JointCharacteristics, u: UnitSystem, fmt: str, c: str, command: 
     lines += [f"  {_value_line(v, u)}" for v in jc.values]
     lines += [f"note: {n}" for n in jc.notes]
     if fmt == "calculix" and jc.kind == "normal":
-        lines.append("note: CalculiX 2.20 converges with this table in TYPE=NODE TO SURFACE "
-                     "contact pairs (checked); with SURFACE TO SURFACE it did not")  # fmt: skip
+        lines.append(
+            "note: CalculiX 2.20 converges with this table in TYPE=NODE TO SURFACE "
+            "contact pairs (checked); with SURFACE TO SURFACE it did not"
+        )
     return [f"{c} {line}".rstrip() for line in lines]
 
 
@@ -70,8 +70,10 @@ def _ks_comment(jc: JointCharacteristics, u: UnitSystem, c: str) -> list[str]:
     if jc.ks_table is None:
         return []
     fp, fk = u.factor("pressure"), u.factor("stiffness_per_area")
-    out = [f"{c} contact stiffness k_s(p) (eq. 6, secant along the centre curve): "
-           f"pressure [{u.label('pressure')}], k_s [{u.label('stiffness_per_area')}]"]  # fmt: skip
+    out = [
+        f"{c} contact stiffness k_s(p) (eq. 6, secant along the centre curve): "
+        f"pressure [{u.label('pressure')}], k_s [{u.label('stiffness_per_area')}]"
+    ]
     out += [f"{c}   {_g(p * fp)}, {_g(k * fk)}" for p, k in jc.ks_table]
     return out
 
@@ -79,18 +81,20 @@ def _ks_comment(jc: JointCharacteristics, u: UnitSystem, c: str) -> list[str]:
 def _keywords(jc: JointCharacteristics, u: UnitSystem, abaqus: bool) -> list[str]:
     out: list[str] = []
     if jc.kind == "normal":
-        out += ["*SURFACE INTERACTION, NAME=JOINT",
-                "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=TABULAR",
-                f"** pressure [{u.label('pressure')}], "
-                f"overclosure [{u.label('length')}]"]  # fmt: skip
+        out += [
+            "*SURFACE INTERACTION, NAME=JOINT",
+            "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=TABULAR",
+            f"** pressure [{u.label('pressure')}], overclosure [{u.label('length')}]",
+        ]
         out += [f"{_g(p)}, {_g(d)}" for p, d in _table(jc, u)]
         out += _ks_comment(jc, u, "**")
         c = jc.get("c_contact")
         if c is not None:
             val, _, lab = c.converted(u)
             out.append(f"** contact damping per unit area [{lab}]: {c.source}")
-            out.append("*CONTACT DAMPING, DEFINITION=DAMPING COEFFICIENT" if abaqus
-                       else "*CONTACT DAMPING")  # fmt: skip
+            out.append(
+                "*CONTACT DAMPING, DEFINITION=DAMPING COEFFICIENT" if abaqus else "*CONTACT DAMPING"
+            )
             out.append(_g(val))
     else:
         mu, lam = jc.get("mu"), jc.get("stick_slope")
@@ -103,27 +107,43 @@ def _keywords(jc: JointCharacteristics, u: UnitSystem, abaqus: bool) -> list[str
                 f"alone (μ = {mu.value:.4g}) goes out with --format abaqus, ansys, csv or json"
             )
         if abaqus and lam is None:
-            out += ["** friction coefficient [1]; stick slope not identified: Abaqus' default "
-                    "penalty (SLIP TOLERANCE) applies", "*FRICTION", _g(mu.value)]  # fmt: skip
+            out += [
+                "** friction coefficient [1]; stick slope not identified: Abaqus' default "
+                "penalty (SLIP TOLERANCE) applies",
+                "*FRICTION",
+                _g(mu.value),
+            ]
         elif abaqus:
             slip = jc.get("elastic_slip")
             assert slip is not None
             s, _, lab = slip.converted(u)
-            out += [f"** elastic slip [{lab}] = μp/λ = 1/ac", f"*FRICTION, ELASTIC SLIP={_g(s)}",
-                    _g(mu.value)]  # fmt: skip
+            out += [
+                f"** elastic slip [{lab}] = μp/λ = 1/ac",
+                f"*FRICTION, ELASTIC SLIP={_g(s)}",
+                _g(mu.value),
+            ]
         else:
             assert lam is not None
             lv, _, lab = lam.converted(u)
-            out += [f"** friction coefficient [1], stick slope [{lab}]", "*FRICTION",
-                    f"{_g(mu.value)}, {_g(lv)}"]  # fmt: skip
+            out += [
+                f"** friction coefficient [1], stick slope [{lab}]",
+                "*FRICTION",
+                f"{_g(mu.value)}, {_g(lv)}",
+            ]
     k, c = jc.get("k_global"), jc.get("c_e")
     if k is not None and c is not None:
         kv, _, kl = k.converted(u)
         cv, _, cl = c.converted(u)
-        out += [f"** joint spring [{kl}] ({k.source}) for SPRINGA elements in ELSET JOINT_SPRING",
-                "*SPRING, ELSET=JOINT_SPRING", "", _g(kv),
-                f"** joint dashpot [{cl}] ({c.source}) for DASHPOTA elements in ELSET "
-                "JOINT_DASHPOT", "*DASHPOT, ELSET=JOINT_DASHPOT", "", _g(cv)]  # fmt: skip
+        out += [
+            f"** joint spring [{kl}] ({k.source}) for SPRINGA elements in ELSET JOINT_SPRING",
+            "*SPRING, ELSET=JOINT_SPRING",
+            "",
+            _g(kv),
+            f"** joint dashpot [{cl}] ({c.source}) for DASHPOTA elements in ELSET JOINT_DASHPOT",
+            "*DASHPOT, ELSET=JOINT_DASHPOT",
+            "",
+            _g(cv),
+        ]
     return out
 
 
@@ -134,11 +154,14 @@ def _ansys(jc: JointCharacteristics, u: UnitSystem) -> list[str]:
         assert ks is not None
         kv, _, kl = ks.converted(u)
         rows = _table(jc, u)
-        out += [f"! FKN < 0: absolute normal contact stiffness [{kl}], linearised at p0",
-                "R,1", f"RMODIF,1,3,{_g(-kv)}",
-                f"! pressure [{u.label('pressure')}] vs overclosure [{u.label('length')}] "
-                "(the exported loading curve)",
-                f"*DIM,JOINT_PU,ARRAY,{len(rows)},2"]  # fmt: skip
+        out += [
+            f"! FKN < 0: absolute normal contact stiffness [{kl}], linearised at p0",
+            "R,1",
+            f"RMODIF,1,3,{_g(-kv)}",
+            f"! pressure [{u.label('pressure')}] vs overclosure [{u.label('length')}] "
+            "(the exported loading curve)",
+            f"*DIM,JOINT_PU,ARRAY,{len(rows)},2",
+        ]
         for i, (p, d) in enumerate(rows, 1):
             out.append(f"JOINT_PU({i},1)={_g(p)}")
             out.append(f"JOINT_PU({i},2)={_g(d)}")
@@ -146,8 +169,7 @@ def _ansys(jc: JointCharacteristics, u: UnitSystem) -> list[str]:
         c = jc.get("c_contact")
         if c is not None:
             cv, _, cl = c.converted(u)
-            out += [f"! viscous coefficient per unit area [{cl}] ({c.source})",
-                    f"JOINT_C={_g(cv)}"]  # fmt: skip
+            out += [f"! viscous coefficient per unit area [{cl}] ({c.source})", f"JOINT_C={_g(cv)}"]
     else:
         mu, lam = jc.get("mu"), jc.get("stick_slope")
         assert mu is not None
@@ -156,14 +178,20 @@ def _ansys(jc: JointCharacteristics, u: UnitSystem) -> list[str]:
             out.append("! stick slope not identified: FKT left at the program default")
         else:
             lv, _, ll = lam.converted(u)
-            out += [f"! FKT < 0: absolute tangential (stick) stiffness [{ll}] (h0·ac / A_c)",
-                    "R,1", f"RMODIF,1,12,{_g(-lv)}"]  # fmt: skip
+            out += [
+                f"! FKT < 0: absolute tangential (stick) stiffness [{ll}] (h0·ac / A_c)",
+                "R,1",
+                f"RMODIF,1,12,{_g(-lv)}",
+            ]
     k, c = jc.get("k_global"), jc.get("c_e")
     if k is not None and c is not None:
         kv, _, kl = k.converted(u)
         cv, _, cl = c.converted(u)
-        out += [f"! COMBIN14 joint spring/dashpot: K [{kl}], CV1 [{cl}]", "ET,2,COMBIN14",
-                f"R,2,{_g(kv)},{_g(cv)}"]  # fmt: skip
+        out += [
+            f"! COMBIN14 joint spring/dashpot: K [{kl}], CV1 [{cl}]",
+            "ET,2,COMBIN14",
+            f"R,2,{_g(kv)},{_g(cv)}",
+        ]
     return out
 
 
@@ -171,26 +199,69 @@ def _rows(jc: JointCharacteristics, u: UnitSystem) -> list[dict[str, object]]:
     rows: list[dict[str, object]] = []
     for v in jc.values:
         val, se, lab = v.converted(u)
-        rows.append({"quantity": v.name, "index": "", "value": val,
-                     "stderr": se if math.isfinite(se) else None, "unit": lab,
-                     "source": v.source})  # fmt: skip
+        rows.append(
+            {
+                "quantity": v.name,
+                "index": "",
+                "value": val,
+                "stderr": se if math.isfinite(se) else None,
+                "unit": lab,
+                "source": v.source,
+            }
+        )
     if jc.table is not None:
         for i, (p, d) in enumerate(_table(jc, u)):
             p_si = float(jc.table[i, 0])
-            src = ("loading branch" if p_si >= jc.extrapolated_below and p_si > 0
-                   else "zero pressure" if i == 0 else "extrapolated (tangent)")  # fmt: skip
-            rows.append({"quantity": "table_pressure", "index": i, "value": p, "stderr": None,
-                         "unit": u.label("pressure"), "source": src})  # fmt: skip
-            rows.append({"quantity": "table_overclosure", "index": i, "value": d,
-                         "stderr": None, "unit": u.label("length"), "source": src})  # fmt: skip
+            src = (
+                "loading branch"
+                if p_si >= jc.extrapolated_below and p_si > 0
+                else "zero pressure"
+                if i == 0
+                else "extrapolated (tangent)"
+            )
+            rows.append(
+                {
+                    "quantity": "table_pressure",
+                    "index": i,
+                    "value": p,
+                    "stderr": None,
+                    "unit": u.label("pressure"),
+                    "source": src,
+                }
+            )
+            rows.append(
+                {
+                    "quantity": "table_overclosure",
+                    "index": i,
+                    "value": d,
+                    "stderr": None,
+                    "unit": u.label("length"),
+                    "source": src,
+                }
+            )
     if jc.ks_table is not None:
         src = "eq. 6: p_centre(δ)/δ along the centre curve"
         for i, (p, k) in enumerate(jc.ks_table):
-            rows.append({"quantity": "ks_pressure", "index": i, "value": p * u.factor("pressure"),
-                         "stderr": None, "unit": u.label("pressure"), "source": src})  # fmt: skip
-            rows.append({"quantity": "ks", "index": i,
-                         "value": k * u.factor("stiffness_per_area"), "stderr": None,
-                         "unit": u.label("stiffness_per_area"), "source": src})  # fmt: skip
+            rows.append(
+                {
+                    "quantity": "ks_pressure",
+                    "index": i,
+                    "value": p * u.factor("pressure"),
+                    "stderr": None,
+                    "unit": u.label("pressure"),
+                    "source": src,
+                }
+            )
+            rows.append(
+                {
+                    "quantity": "ks",
+                    "index": i,
+                    "value": k * u.factor("stiffness_per_area"),
+                    "stderr": None,
+                    "unit": u.label("stiffness_per_area"),
+                    "source": src,
+                }
+            )
     return rows
 
 
@@ -203,8 +274,9 @@ def render(jc: JointCharacteristics, fmt: str, units: UnitSystem, command: str =
     elif fmt == "csv":
         buf = io.StringIO()
         buf.write("\n".join(_header(jc, units, fmt, "#", command)) + "\n")
-        w = csv.DictWriter(buf, ["quantity", "index", "value", "stderr", "unit", "source"],
-                           lineterminator="\n")  # fmt: skip
+        w = csv.DictWriter(
+            buf, ["quantity", "index", "value", "stderr", "unit", "source"], lineterminator="\n"
+        )
         w.writeheader()
         for r in _rows(jc, units):
             w.writerow({k: ("" if v is None else v) for k, v in r.items()})

@@ -194,8 +194,15 @@ class _Finisher:
         if self.prev_t is None:
             if t.size >= 2:
                 self.step = float(np.median(np.diff(t)))
-            check_time(t, file=self.file, column=col, row_of=self.row_of, step=self.step,
-                       offset=offset, max_gap=gap)  # fmt: skip
+            check_time(
+                t,
+                file=self.file,
+                column=col,
+                row_of=self.row_of,
+                step=self.step,
+                offset=offset,
+                max_gap=gap,
+            )
             return
         if t.size:  # the boundary: the previous chunk's last stamp, then this one's first
             check_time(
@@ -208,8 +215,15 @@ class _Finisher:
                 max_gap=gap,
             )
         if t.size >= 2:
-            check_time(t, file=self.file, column=col, row_of=self.row_of, step=self.step,
-                       offset=offset, max_gap=gap)  # fmt: skip
+            check_time(
+                t,
+                file=self.file,
+                column=col,
+                row_of=self.row_of,
+                step=self.step,
+                offset=offset,
+                max_gap=gap,
+            )
 
     def _resample(
         self, t: np.ndarray, data: dict[str, np.ndarray]
@@ -317,8 +331,9 @@ class _Finisher:
                 k: (float(v.min()), float(v.max())) for k, v in data.items() if v.size
             }
             # what was bridged so far (the last chunk's: the whole record's)
-            meta["resampled"] = dict(self.bridged, step=self.step, resampled=True,
-                                     n_samples=self.grid_next)  # fmt: skip
+            meta["resampled"] = dict(
+                self.bridged, step=self.step, resampled=True, n_samples=self.grid_next
+            )
         return Recording(t, data, dict(self.units), self.file, meta)
 
 
@@ -405,8 +420,16 @@ def _h5_chunks(
     names = ["t", *(c for c in mapping if c != "t")]
 
     def gen(alloc: Alloc | None) -> Iterator[Recording]:
-        fin = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, meta={"format": fmt},
-                        resample=resample)  # fmt: skip
+        fin = _Finisher(
+            mapping,
+            units,
+            kind=kind_,
+            file=file,
+            fs=fs,
+            dt=dt,
+            meta={"format": fmt},
+            resample=resample,
+        )
         if resample:
             alloc = None  # a resampled chunk's length is not the samples read
         with h5_guard(file), h5py.File(path, "r") as f:
@@ -445,9 +468,17 @@ def _h5_chunks(
                 if fd is not None:
                     os.close(fd)
 
-    return ChunkedRecording(file, kind_, fin0.units, mapping, None if resample else n,
-                            fin0.meta, lambda: gen(None), None if resample else gen,
-                            fin0.time_step)  # fmt: skip
+    return ChunkedRecording(
+        file,
+        kind_,
+        fin0.units,
+        mapping,
+        None if resample else n,
+        fin0.meta,
+        lambda: gen(None),
+        None if resample else gen,
+        fin0.time_step,
+    )
 
 
 def _tdms_chunks(
@@ -500,8 +531,17 @@ def _tdms_chunks(
     )
 
     def gen() -> Iterator[Recording]:
-        fin = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, t0=t0,
-                        meta={"format": "tdms"}, resample=resample)  # fmt: skip
+        fin = _Finisher(
+            mapping,
+            units,
+            kind=kind_,
+            file=file,
+            fs=fs,
+            dt=dt,
+            t0=t0,
+            meta={"format": "tdms"},
+            resample=resample,
+        )
         with quiet_nptdms():
             fh, tf, chans = open_tdms()
         with tf, fh:
@@ -514,8 +554,16 @@ def _tdms_chunks(
                     }
                 yield fin(raw, a)
 
-    return ChunkedRecording(file, kind_, fin0.units, mapping, None if resample else n,
-                            fin0.meta, gen, time_step=fin0.time_step)  # fmt: skip
+    return ChunkedRecording(
+        file,
+        kind_,
+        fin0.units,
+        mapping,
+        None if resample else n,
+        fin0.meta,
+        gen,
+        time_step=fin0.time_step,
+    )
 
 
 def _csv_chunks(
@@ -550,8 +598,16 @@ def _csv_chunks(
     fin0 = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, row_of=row_of, meta=meta)
 
     def gen() -> Iterator[Recording]:
-        fin = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, row_of=row_of, meta=meta,
-                        resample=resample)  # fmt: skip
+        fin = _Finisher(
+            mapping,
+            units,
+            kind=kind_,
+            file=file,
+            fs=fs,
+            row_of=row_of,
+            meta=meta,
+            resample=resample,
+        )
         offset = 0
         with open(path, encoding=enc, errors="strict", newline="") as fh:
             try:
@@ -577,8 +633,9 @@ def _csv_chunks(
                                 else None,
                             )
                     except ValueError:
-                        raise locate_bad_cell(path, delim, first_data, idx, names, comma,
-                                               enc) from None  # fmt: skip
+                        raise locate_bad_cell(
+                            path, delim, first_data, idx, names, comma, enc
+                        ) from None
                     if block.shape[0] == 0:
                         continue
                     raw = {c: np.ascontiguousarray(block[:, j]) for j, c in enumerate(canon)}
@@ -615,13 +672,22 @@ def _npy_chunks(
     fin0 = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, meta=meta)
 
     def gen() -> Iterator[Recording]:
-        fin = _Finisher(mapping, units, kind=kind_, file=file, fs=fs, dt=dt, meta=meta,
-                        resample=resample)  # fmt: skip
+        fin = _Finisher(
+            mapping, units, kind=kind_, file=file, fs=fs, dt=dt, meta=meta, resample=resample
+        )
         for a, raw in slices(chunk):
             yield fin(raw, a)
 
-    return ChunkedRecording(file, kind_, fin0.units, mapping, None if resample else n,
-                            fin0.meta, gen, time_step=fin0.time_step)  # fmt: skip
+    return ChunkedRecording(
+        file,
+        kind_,
+        fin0.units,
+        mapping,
+        None if resample else n,
+        fin0.meta,
+        gen,
+        time_step=fin0.time_step,
+    )
 
 
 def _whole_chunks(rec: Recording, chunk: int) -> ChunkedRecording:

@@ -190,8 +190,15 @@ def layout(
     kind: str | None,
     fs: float | None,
     mmap: bool,
-) -> tuple[str | None, dict[str, str], dict[str, Any], dict[str, str | None], float | None,
-           dict[str, Any], Any]:  # fmt: skip
+) -> tuple[
+    str | None,
+    dict[str, str],
+    dict[str, Any],
+    dict[str, str | None],
+    float | None,
+    dict[str, Any],
+    Any,
+]:
     """What both readers need: ``(kind, mapping, arrays, file_units, dt, meta, handle)``."""
     file = str(path)
     chans, scalars, positional, fmt, handle = _table(path, mmap=mmap)
@@ -245,8 +252,9 @@ def read_npy(
         path, columns=columns, kind=kind, fs=fs, mmap=False
     )
     try:
-        raw = {c: real_values(a, file=file, column=mapping[c]).reshape(-1)
-               for c, a in arrays.items()}  # fmt: skip
+        raw = {
+            c: real_values(a, file=file, column=mapping[c]).reshape(-1) for c, a in arrays.items()
+        }
     finally:
         if handle is not None:
             handle.close()
@@ -254,14 +262,30 @@ def read_npy(
     t_fallback = None
     if "t" not in raw and fs is None and dt is not None:
         t_fallback = time_from_interval(dt, next(iter(raw.values())).size, file=file)
-    return finish(raw, mapping, units, kind=kind, file=file, fs=fs, t_fallback=t_fallback,
-                  meta=meta, resample=resample)  # fmt: skip
+    return finish(
+        raw,
+        mapping,
+        units,
+        kind=kind,
+        file=file,
+        fs=fs,
+        t_fallback=t_fallback,
+        meta=meta,
+        resample=resample,
+    )
 
 
 def npy_chunk_source(
     path: Path, *, columns: dict[str, str] | None, kind: str | None, fs: float | None
-) -> tuple[str | None, dict[str, str], dict[str, str | None], float | None, int, dict[str, Any],
-           Callable[[int], Iterator[tuple[int, dict[str, np.ndarray]]]]]:  # fmt: skip
+) -> tuple[
+    str | None,
+    dict[str, str],
+    dict[str, str | None],
+    float | None,
+    int,
+    dict[str, Any],
+    Callable[[int], Iterator[tuple[int, dict[str, np.ndarray]]]],
+]:
     """An ``.npy`` opened memory-mapped for :func:`contactlab.io.read_chunks`: ``(kind,
     mapping, file_units, dt, n, meta, slices)``, where ``slices(chunk)`` yields ``(offset,
     {canonical: values})`` chunk by chunk (only those pages of the file are read)."""
@@ -277,14 +301,18 @@ def npy_chunk_source(
     n = next(iter(sizes.values()))
 
     def slices(chunk: int) -> Iterator[tuple[int, dict[str, np.ndarray]]]:
-        _k, _m, arrs, _u, _dt, _meta, h = layout(path, columns=columns, kind=kind, fs=fs,
-                                                 mmap=True)  # fmt: skip
+        _k, _m, arrs, _u, _dt, _meta, h = layout(path, columns=columns, kind=kind, fs=fs, mmap=True)
         if h is not None:
             h.close()
         for a in range(0, max(n, 1), chunk):
             b = min(a + chunk, n)
-            yield a, {c: real_values(np.array(v[a:b]), file=file, column=mapping[c])
-                      for c, v in arrs.items()}  # fmt: skip
+            yield (
+                a,
+                {
+                    c: real_values(np.array(v[a:b]), file=file, column=mapping[c])
+                    for c, v in arrs.items()
+                },
+            )
 
     return kind, mapping, units, dt, n, meta, slices
 

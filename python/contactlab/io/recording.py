@@ -21,8 +21,15 @@ from ..errors import InputError
 from .units import SI_UNITS, UnknownUnitError, split_name, to_si
 
 #: canonical channel -> physical dimension (``y``: a frame's base displacement)
-DIMENSIONS = {"t": "time", "x": "length", "F": "force", "p": "pressure", "delta": "length",
-              "y": "length", "N": "force"}  # fmt: skip
+DIMENSIONS = {
+    "t": "time",
+    "x": "length",
+    "F": "force",
+    "p": "pressure",
+    "delta": "length",
+    "y": "length",
+    "N": "force",
+}
 #: the channels each kind of recording needs
 KIND_CHANNELS = {"tangential": ("x", "F"), "normal": ("p", "delta")}
 #: channels read along when a column is named like one (never needed): a tangential test's
@@ -212,6 +219,40 @@ class Recording:
         return None
 
 
+def _not_real(unusable: dict[str, str], *wanted: str) -> str:
+    """``; 'F' is complex: ...`` for the unusable objects named like one of ``wanted``."""
+    low = {w.strip().lower() for w in wanted}
+    hits = [
+        f"{n!r} is {what}"
+        for n, what in unusable.items()
+        if n.strip().lower() in low
+        or split_name(n)[0].strip().lower() in low
+        or n.rsplit("/", 1)[-1].strip().lower() in low
+        or n.rsplit(".", 1)[-1].strip().lower() in low  # a MATLAB struct's field
+    ]
+    return (
+        f"; {', '.join(hits[:5])}: a channel must hold real numbers" if hits else ""
+    ) + _structs(unusable)
+
+
+def _structs(unusable: dict[str, str]) -> str:
+    """``; 'data' is a MATLAB struct: ...`` (channels inside a struct are not read)."""
+    names = [n for n, what in unusable.items() if what == "a MATLAB struct" and n != "units"]
+    if not names:
+        return ""
+    # a struct's vector fields are read (data.x); a struct inside one is not
+    how = (
+        f"s = {names[0]}; save(file, '-struct', 's')"
+        if "." in names[0]
+        else f"save(file, '-struct', {names[0]!r})"
+    )
+    return (
+        f"; {', '.join(repr(n) for n in names[:3])} "
+        f"{'is a MATLAB struct' if len(names) == 1 else 'are MATLAB structs'}, whose "
+        f"fields are not read: save them as variables (in MATLAB: {how})"
+    )
+
+
 def resolve_columns(
     available: list[str],
     *,
@@ -231,32 +272,7 @@ def resolve_columns(
     unusable = dict(unusable or {})
 
     def not_real(*wanted: str) -> str:
-        """``; 'F' is complex: ...`` for the unusable objects named like one of ``wanted``."""
-        low = {w.strip().lower() for w in wanted}
-        hits = [
-            f"{n!r} is {what}"
-            for n, what in unusable.items()
-            if n.strip().lower() in low or split_name(n)[0].strip().lower() in low
-            or n.rsplit("/", 1)[-1].strip().lower() in low
-            or n.rsplit(".", 1)[-1].strip().lower() in low  # a MATLAB struct's field
-        ]  # fmt: skip
-        return (f"; {', '.join(hits[:5])}: a channel must hold real numbers" if hits else "") \
-            + structs()  # fmt: skip
-
-    def structs() -> str:
-        """``; 'data' is a MATLAB struct: ...`` (channels inside a struct are not read)."""
-        names = [n for n, what in unusable.items() if what == "a MATLAB struct" and n != "units"]
-        if not names:
-            return ""
-        # a struct's vector fields are read (data.x); a struct inside one is not
-        how = (
-            f"s = {names[0]}; save(file, '-struct', 's')"
-            if "." in names[0]
-            else f"save(file, '-struct', {names[0]!r})"
-        )
-        return (f"; {', '.join(repr(n) for n in names[:3])} "
-                f"{'is a MATLAB struct' if len(names) == 1 else 'are MATLAB structs'}, whose "
-                f"fields are not read: save them as variables (in MATLAB: {how})")  # fmt: skip
+        return _not_real(unusable, *wanted)
 
     if kind not in (None, "tangential", "normal", "frame"):
         raise InputError(f"kind must be 'tangential', 'normal', 'frame' or None, got {kind!r}")

@@ -21,8 +21,14 @@ EXTENSIONS = {
     ".npy": "npy",
     ".npz": "npy",
 }
-NAMES = {"csv": "a text (CSV)", "tdms": "a TDMS", "hdf5": "an HDF5", "mat": "a MATLAB .mat",
-         "npy": "a NumPy .npy", "npz": "a NumPy .npz (zip)"}  # fmt: skip
+NAMES = {
+    "csv": "a text (CSV)",
+    "tdms": "a TDMS",
+    "hdf5": "an HDF5",
+    "mat": "a MATLAB .mat",
+    "npy": "a NumPy .npy",
+    "npz": "a NumPy .npz (zip)",
+}
 
 
 def content_format(path: Path) -> str:

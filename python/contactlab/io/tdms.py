@@ -182,8 +182,9 @@ def read_tdms(
     file = str(path)
     # Our own handle: npTDMS leaks the one it opens when parsing fails (ResourceWarning).
     with quiet_nptdms() as quiet:
-        return _read_tdms(nptdms, path, file, quiet, columns=columns, kind=kind, fs=fs,
-                          resample=resample)  # fmt: skip
+        return _read_tdms(
+            nptdms, path, file, quiet, columns=columns, kind=kind, fs=fs, resample=resample
+        )
 
 
 def _read_tdms(

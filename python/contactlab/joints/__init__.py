@@ -11,12 +11,9 @@ from __future__ import annotations
 from .amplitude import (
     AmplitudeFit,
     EquivalentProperties,
-    SteppedSineFit,
-    Sweep,
     energy_per_cycle,
     equivalent_properties,
     fit_amplitude,
-    fit_stepped_sine,
     secant_stiffness,
 )
 from .compare import Comparison, compare
@@ -42,6 +39,7 @@ from .laws import (
     from_spec,
 )
 from .records import JointRecord
+from .stepped_sine import SteppedSineFit, Sweep, fit_stepped_sine
 
 __all__ = [
     "LAWS",

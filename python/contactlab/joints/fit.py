@@ -47,15 +47,31 @@ from typing import Any
 import numpy as np
 
 from ..errors import ContactLabError, InputError
-from ..fitting import FitResult, Parameter, json_number, least_squares_fit
+from ..fitting import FitResult, Parameter, json_number
 from ..reversals import excursions
+from .fit_problem import (
+    _STATIC,
+    TERMS,
+    Problem,
+    _term_columns,
+    thin_indices,
+    turning_points,
+)
 from .records import JointRecord, as_records
 
-#: linear terms in parallel with the law: name -> unit of the coefficient
-TERMS = {"offset": "N", "k_parallel": "N/m", "c_parallel": "N s/m", "mass": "kg",
-         "asymmetry": ""}  # fmt: skip
-#: terms whose column is computed from the displacement (the others from the law's force)
-_STATIC = ("offset", "k_parallel", "c_parallel", "mass")
+__all__ = [
+    "DEFAULT_FIXED",
+    "ONE_SPEED_SPREAD",
+    "TERMS",
+    "JointFit",
+    "LoopFeatures",
+    "fit",
+    "loop_features",
+    "start_law",
+    "thin_indices",
+    "turning_points",
+]
+
 
 #: parameters held at their start value unless ``fixed`` says otherwise (weakly determined
 #: shape exponents and redundant scales)
@@ -75,7 +91,10 @@ class LoopFeatures:
     ``force_level`` [N]: half the robust range of F (1-99 %); ``force_mid`` [N]: its middle;
     ``swing_length`` [m]: median travel after a reversal for the force to swing through 80 %
     of ``2·force_level``; ``stiffness`` [N/m] = ``1.6 force_level / swing_length``;
-    ``speed`` [m/s]: median |ẋ|; ``stroke`` [m]: half the displacement range.
+    ``speed`` [m/s]: median |Δx/Δt| over the steps where x moves (a quantised stage that
+    holds still every other sample moves at this speed, not at half of it); ``stroke`` [m]:
+    half the displacement range; ``speed_spread``: the 95th over the 5th percentile of those
+    speeds (near 1: the record slides at one speed).
     """
 
     force_level: float
@@ -84,6 +103,7 @@ class LoopFeatures:
     stiffness: float
     speed: float
     stroke: float
+    speed_spread: float = math.inf
 
 
 def loop_features(records: Sequence[JointRecord]) -> LoopFeatures:
@@ -99,7 +119,8 @@ def loop_features(records: Sequence[JointRecord]) -> LoopFeatures:
         x, F = r.x, r.require_force()
         lo, hi = float(np.min(x)), float(np.max(x))
         strokes.append(0.5 * (hi - lo))
-        speeds.append(float(np.median(np.abs(np.gradient(x, r.t)))))
+        v = np.abs(np.diff(x) / np.diff(r.t))
+        speeds.append(v[v > 0])
         if not hi > lo:
             continue
         ex = excursions(x, 0.5 * (lo + hi), 0.25 * (hi - lo))
@@ -114,10 +135,13 @@ def loop_features(records: Sequence[JointRecord]) -> LoopFeatures:
     stroke = max(float(np.median(strokes)), 1e-300)
     swing = float(np.median(swings)) if swings else 0.5 * stroke
     swing = min(max(swing, 1e-6 * stroke), 2.0 * stroke)
-    speed = float(np.median(speeds))
-    if not speed > 0:
-        speed = stroke
-    return LoopFeatures(level, mid, swing, 1.6 * level / swing, speed, stroke)
+    moving = np.concatenate(speeds)
+    speed, spread = stroke, math.inf
+    if moving.size:
+        speed = float(np.median(moving))
+        p5, p95 = np.percentile(moving, [5.0, 95.0])
+        spread = float(p95 / p5) if p5 > 0 else math.inf
+    return LoopFeatures(level, mid, swing, 1.6 * level / swing, speed, stroke, spread)
 
 
 def _leaf_start(name: str, f: LoopFeatures, stiff: float, n_elements: int) -> Any:
@@ -186,169 +210,6 @@ def start_law(law: str, records: Any, *, stiffness_factor: float = 1.0,
     if len(parts) != 1:
         raise InputError(f"law {law!r}: only 'backlash:<law>' chains are known")
     return _leaf_start(parts[0], f, stiffness_factor, n_elements)
-
-
-def _derivatives(t: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    v = np.gradient(x, t, edge_order=2) if t.size > 2 else np.gradient(x, t)
-    a = np.gradient(v, t, edge_order=2) if t.size > 2 else np.gradient(v, t)
-    return v, a
-
-
-def _term_columns(terms: Sequence[str], t: np.ndarray, x: np.ndarray) -> np.ndarray:
-    terms = [n for n in terms if n in _STATIC]
-    cols = []
-    v = a = None
-    if "c_parallel" in terms or "mass" in terms:
-        v, a = _derivatives(t, x)
-    for n in terms:
-        if n == "offset":
-            cols.append(np.ones_like(x))
-        elif n == "k_parallel":
-            cols.append(x - x[0])
-        elif n == "c_parallel":
-            cols.append(v)
-        elif n == "mass":
-            cols.append(a)
-    return np.column_stack(cols) if cols else np.zeros((x.size, 0))
-
-
-def turning_points(x: np.ndarray, gate: float) -> np.ndarray:
-    """Indices of the turning points of ``x``: the extremes between which it moves by more
-    than ``gate`` (a hysteresis threshold, as the gate of ASTM E1049-85 peak counting; 0
-    keeps every local extremum)."""
-    d = np.diff(x)
-    nz = np.flatnonzero(d != 0)
-    if nz.size == 0:
-        return np.zeros(0, dtype=np.int64)
-    s = np.sign(d[nz])
-    # candidates: the last sample of each monotone run (a change of sign of the steps)
-    cand = nz[np.flatnonzero(s[1:] != s[:-1])] + 1
-    if gate <= 0 or cand.size == 0:
-        return cand.astype(np.int64)
-    # hysteresis over the candidates (the first sample included: the first run's start)
-    pts = np.concatenate([[0], cand]).astype(np.int64)
-    v = x[pts]
-    out: list[int] = []
-    hi = lo = 0  # positions in pts while no direction is set
-    direction, ext = 0, 0
-    for j in range(1, pts.size):
-        if direction == 0:
-            if v[j] > v[hi]:
-                hi = j
-            if v[j] < v[lo]:
-                lo = j
-            if v[hi] - v[lo] > gate:
-                first, ext, direction = (lo, hi, 1) if hi > lo else (hi, lo, -1)
-                out.append(int(pts[first]))
-            continue
-        if direction > 0:
-            if v[j] >= v[ext]:
-                ext = j
-            elif v[ext] - v[j] > gate:
-                out.append(int(pts[ext]))
-                direction, ext = -1, j
-        else:
-            if v[j] <= v[ext]:
-                ext = j
-            elif v[j] - v[ext] > gate:
-                out.append(int(pts[ext]))
-                direction, ext = 1, j
-    if direction != 0:
-        out.append(int(pts[ext]))
-    return np.asarray(out, dtype=np.int64)
-
-
-def thin_indices(rec: JointRecord, keep_every: int, gate: float = 1e-3) -> np.ndarray:
-    """Every ``keep_every``-th sample plus each turning point of ``x``, first and last.
-
-    Turning points: :func:`turning_points` with a gate of ``gate`` times the range of ``x``.
-    A rate-independent law gives the same force at the kept samples as on the whole record
-    (its force depends only on the sequence of turning points and the current displacement),
-    up to the effect of reversals smaller than the gate (exact with ``gate=0``).
-    """
-    n = rec.n
-    if keep_every <= 1:
-        return np.arange(n)
-    x = rec.x
-    rng = float(np.max(x) - np.min(x))
-    keep = np.zeros(n, bool)
-    keep[::keep_every] = True
-    keep[-1] = True
-    keep[turning_points(x, gate * rng)] = True
-    return np.flatnonzero(keep)
-
-
-@dataclass
-class _Prepared:
-    """A record as a fit evaluates it: the samples the law runs on, the compared ones."""
-
-    rec: JointRecord
-    run: np.ndarray  # indices of the samples the law is driven with
-    cmp: np.ndarray | None  # positions within ``run`` compared (None: all of them)
-    F: np.ndarray  # measured force at the compared samples
-    phi: np.ndarray  # linear terms' columns at the compared samples
-    t: np.ndarray  # time and displacement at ``run`` (taken once, not at every evaluation)
-    x: np.ndarray
-
-
-def _prepare(recs: list[JointRecord], terms: Sequence[str],
-             max_samples: int | None) -> list[_Prepared]:  # fmt: skip
-    total = sum(r.n for r in recs)
-    every = 1 if max_samples is None or total <= max_samples else math.ceil(total / max_samples)
-    out = []
-    for r in recs:
-        F = r.require_force()
-        run = thin_indices(r, every)
-        sel = np.ones(r.n, bool) if r.mask is None else r.mask
-        cmp = np.flatnonzero(sel[run])
-        if cmp.size == 0:
-            cmp = np.arange(run.size)
-        phi = _term_columns(terms, r.t, r.x)[run[cmp]]
-        every_one = cmp.size == run.size
-        t_run = r.t if run.size == r.n else np.ascontiguousarray(r.t[run])
-        x_run = r.x if run.size == r.n else np.ascontiguousarray(r.x[run])
-        out.append(_Prepared(r, run, None if every_one else cmp, F[run[cmp]], phi, t_run,
-                             x_run))  # fmt: skip
-    return out
-
-
-def _law_forces(law: Any, prep: list[_Prepared]) -> np.ndarray:
-    parts = []
-    for p in prep:
-        f = np.asarray(law.force(p.t, p.x, float(p.x[0])), dtype=float)
-        parts.append(f if p.cmp is None else f[p.cmp])
-    return parts[0] if len(parts) == 1 else np.concatenate(parts)
-
-
-def _guarded(residual: Any, Fm: np.ndarray) -> Any:
-    """``residual`` that, once it has been evaluated, answers a trial point the law refuses
-    (a Bouc-Wen whose β(γ+δ) turns negative, a force out of range) with a residual 10× the
-    measured force's size, so that the solver steps back instead of the fit failing; at the
-    start point the law's error is raised (bad input)."""
-    started = False
-    big = 10.0 * (float(np.sqrt(np.mean(Fm**2))) or 1.0)
-
-    def wrapped(v: Mapping[str, float]) -> np.ndarray:
-        nonlocal started
-        try:
-            out = residual(v)
-        except InputError:
-            if not started:
-                raise
-            return np.full(Fm.size, big)
-        started = True
-        return out
-
-    return wrapped
-
-
-def _linear_solve(phi: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    if phi.shape[1] == 0:
-        return np.zeros(0)
-    sc = np.sqrt(np.sum(phi**2, axis=0))
-    sc[sc == 0] = 1.0
-    beta = np.linalg.lstsq(phi / sc, rhs, rcond=None)[0]
-    return beta / sc
 
 
 @dataclass
@@ -486,15 +347,32 @@ def _resolve_law(law: Any, recs: list[JointRecord], stiffness_factor: float,
                      f"instance, got {type(law).__name__}")  # fmt: skip
 
 
-def _fixed_names(law: Any, fixed: Any) -> set[str]:
+#: the spread of sliding speeds (95th / 5th percentile) below which a record is taken to
+#: slide at one speed: the Stribeck curve's Fs and vs are then held (see :func:`fit`)
+ONE_SPEED_SPREAD = 3.0
+
+#: the Stribeck parameters of the rate-dependent laws
+_STRIBECK = {"lugre": ("Fs", "vs"), "gms": ("Fs", "vs")}
+
+
+def _fixed_names(law: Any, fixed: Any, features: LoopFeatures | None = None,
+                 notes: list[str] | None = None) -> set[str]:  # fmt: skip
     names = law.param_names
     if fixed is None:
-        base = law.name
-        defaults = DEFAULT_FIXED.get(base, ())
+        base, pre = law.name, ""
         if base == "backlash":
-            inner = law.laws[0]
-            pre = inner.name
-            defaults = tuple(f"{pre}.{n}" for n in DEFAULT_FIXED.get(inner.name, ()))
+            base, pre = law.laws[0].name, law.laws[0].name + "."
+        defaults = [pre + n for n in DEFAULT_FIXED.get(base, ())]
+        if features is not None and features.speed_spread < ONE_SPEED_SPREAD and base in _STRIBECK:
+            held = [pre + n for n in _STRIBECK[base]]
+            defaults += held
+            if notes is not None:
+                notes.append(
+                    f"{' and '.join(held)} held at their start values: the records slide at "
+                    f"one speed (95th / 5th percentile of the moving |dx/dt|: "
+                    f"{features.speed_spread:.2g}), which does not separate a Stribeck curve "
+                    "from the Coulomb force (give fixed= to fit them anyway)"
+                )
         return {n for n in defaults if n in names}
     out = set(fixed.keys() if isinstance(fixed, Mapping) else fixed)
     unknown = out - set(names)
@@ -504,36 +382,23 @@ def _fixed_names(law: Any, fixed: Any) -> set[str]:
     return out
 
 
-def _parameters(law: Any, fixed: set[str], bounds: Mapping[str, tuple[float, float]] | None
-                ) -> dict[str, Parameter]:  # fmt: skip
-    units = law.units
-    lb = law.bounds
-    out = {}
-    for n, v in law.params.items():
-        lo, hi = lb[n]
-        if bounds and n in bounds:
-            lo, hi = bounds[n]
-        scale = None
-        if v == 0:
-            scale = 1.0
-        # a parameter whose lower bound is excluded (stiffness, forces) is kept off it
-        if lo == 0.0 and v > 0 and n not in fixed:
-            lo = 1e-9 * v if not (bounds and n in bounds) else lo
-        out[n] = Parameter(n, float(v), vary=n not in fixed, min=lo, max=hi, unit=units[n],
-                           scale=scale)  # fmt: skip
-    return out
-
-
-def _identifiability_notes(res: FitResult) -> None:
-    """``not identifiable: <why>`` on every parameter the fit flagged."""
-    for n, p in res.params.items():
-        if p.identifiable is False:
-            why = next((s for s in res.notes if n in s), None)
-            if p.note and p.note.startswith("not identifiable"):
-                continue
-            text = why or p.note or "the data do not constrain it"
-            p.note = f"not identifiable: {text}"
-            p.stderr = None
+def _zero_at_bound(fitted: Any, start: Any, fixed: set[str], notes: list[str]) -> Any:
+    """Parameters whose closed lower bound is 0 (a damping, a viscous coefficient) that the
+    search drove to it (below 1e-6 of their start value) are set to 0 and held there
+    (added to ``fixed``), with a note: a boundary optimum, which the covariance fit and its
+    trust check would otherwise take for an unconverged direction."""
+    zero = {}
+    starts = start.params
+    for spec, (n, v) in zip(fitted._specs(), fitted.params.items(), strict=True):
+        if n in fixed or spec.lo != 0.0 or spec.open_lo:
+            continue
+        if starts.get(n, 0.0) > 0 and v <= 1e-6 * starts[n]:
+            zero[n] = 0.0
+    if not zero:
+        return fitted
+    fixed.update(zero)
+    notes.append(f"{', '.join(zero)} = 0 at the lower bound (held there for the covariance)")
+    return fitted.with_params(zero)
 
 
 def fit(
@@ -616,6 +481,44 @@ def fit(
     (5000, 4.0, True)
     """
     t0 = time.perf_counter()
+    recs = _records(records, x, F, fs, max_samples, n_elements)
+    terms = [n for n, on in (("offset", offset), ("k_parallel", stiffness),
+                             ("c_parallel", damping), ("mass", mass),
+                             ("asymmetry", asymmetry)) if on]  # fmt: skip
+    first = _resolve_law(law, recs, 1.0, n_elements)
+    held: list[str] = []
+    fixed_names = _fixed_names(first, fixed, loop_features(recs), held)
+    fixed_values = dict(fixed) if isinstance(fixed, Mapping) else {}
+    if fixed_values:
+        first = first.with_params(fixed_values)
+    prob = Problem.build(recs, terms, max_samples, fixed_names, bounds, max_nfev)
+    errors: list[str] = []
+    restart = isinstance(law, str) and restarts
+
+    def other_starts() -> list[Any]:
+        out = []
+        for factor in (4.0, 0.25):
+            try:
+                c = _resolve_law(law, recs, factor, n_elements)
+                out.append(c.with_params(fixed_values) if fixed_values else c)
+            except ContactLabError as exc:
+                errors.append(str(exc))
+        return out
+
+    (res_law, fitted), tried = _best_start(prob, first, other_starts if restart else None, errors)
+    fitted = _zero_at_bound(fitted, first, fixed_names, held)
+    res, final_law = prob.joint_fit(fitted, res_law, errors)
+    _explained(res, final_law, prob.var, errors)
+    every = max(1, math.ceil(sum(r.n for r in recs) / max_samples)) if max_samples else 1
+    return JointFit(law=final_law, terms={n: res.params[n].value for n in terms}, result=res,
+                    records=[r.name for r in recs], n_samples=int(prob.Fm.size),
+                    seconds=time.perf_counter() - t0, thinned_every=every, starts_tried=tried,
+                    name=name, notes=held + errors[:3])  # fmt: skip
+
+
+def _records(records: Any, x: Any, F: Any, fs: float | None, max_samples: Any,
+             n_elements: Any) -> list[JointRecord]:  # fmt: skip
+    """The records of :func:`fit`'s arguments, with its options checked."""
     if x is not None or F is not None:
         if x is None or F is None:
             raise InputError("give t, x and F of one record, or a list of records")
@@ -630,114 +533,44 @@ def fit(
         )
     if not (isinstance(n_elements, int) and n_elements >= 1):
         raise InputError(f"n_elements must be an integer >= 1, got {n_elements!r}")
-    terms = [n for n, on in (("offset", offset), ("k_parallel", stiffness),
-                             ("c_parallel", damping), ("mass", mass),
-                             ("asymmetry", asymmetry)) if on]  # fmt: skip
-    asym = "asymmetry" in terms
-    prep = _prepare(recs, terms, max_samples)
-    every = max(1, math.ceil(sum(r.n for r in recs) / max_samples)) if max_samples else 1
-    Fm = np.concatenate([p.F for p in prep])
-    phi = np.concatenate([p.phi for p in prep], axis=0)
-    first = _resolve_law(law, recs, 1.0, n_elements)
-    fixed_names = _fixed_names(first, fixed)
-    fixed_values = dict(fixed) if isinstance(fixed, Mapping) else {}
-    if fixed_values:
-        first = first.with_params(fixed_values)
+    return recs
 
-    def run_from(start_law_: Any) -> tuple[FitResult, Any]:
-        params = _parameters(start_law_, fixed_names, bounds)
-        names = list(start_law_.param_names)
 
-        def law_of(v: Mapping[str, float]) -> Any:
-            return start_law_.with_params([v[n] for n in names])
-
-        def residual(v: Mapping[str, float]) -> np.ndarray:
-            P = _law_forces(law_of(v), prep)
-            if not terms:
-                return P - Fm
-            cols = np.column_stack([phi, np.abs(P)]) if asym else phi
-            beta = _linear_solve(cols, Fm - P)
-            return P + cols @ beta - Fm
-
-        res = least_squares_fit(_guarded(residual, Fm), params, max_nfev=max_nfev)
-        return res, law_of(res.values)
-
-    candidates = [first]
-    tried = 0
+def _best_start(prob: Problem, first: Any, others: Any,
+                errors: list[str]) -> tuple[tuple[FitResult, Any], int]:  # fmt: skip
+    """The best search from ``first`` and, when it fails or explains less than 90 % of the
+    force's variance, from ``others()`` (stiffer and softer starts)."""
+    candidates, tried = [first], 0
     best: tuple[FitResult, Any] | None = None
-    errors: list[str] = []
-    var = float(np.sum((Fm - Fm.mean()) ** 2))
     while candidates:
         cand = candidates.pop(0)
         tried += 1
         try:
-            res, fitted = run_from(cand)
+            res, fitted = prob.search(cand)
         except ContactLabError as exc:
             errors.append(str(exc))
             res = None
         if res is not None and (best is None or res.chisqr < best[0].chisqr):
             best = (res, fitted)
-        good = best is not None and best[0].success and best[0].chisqr < 0.1 * var
-        if restarts and tried == 1 and not good and isinstance(law, str):
-            for factor in (4.0, 0.25):
-                try:
-                    c = _resolve_law(law, recs, factor, n_elements)
-                    candidates.append(c.with_params(fixed_values) if fixed_values else c)
-                except ContactLabError as exc:
-                    errors.append(str(exc))
+        good = best is not None and best[0].success and best[0].chisqr < 0.1 * prob.var
+        if others is not None and tried == 1 and not good:
+            candidates.extend(others())
     if best is None:
         raise InputError(f"the law {first.name} could not be evaluated from any start: "
                          f"{errors[0] if errors else 'no start'}")  # fmt: skip
-    res_law, fitted = best
-    # the final joint fit of the law's parameters and the linear terms: the covariance of all
-    P = _law_forces(fitted, prep)
-    beta = _linear_solve(np.column_stack([phi, np.abs(P)]) if asym else phi, Fm - P)
-    params = _parameters(fitted, fixed_names, bounds)
-    for p in params.values():  # the nonlinear fit's end point: keep its bounds' sense
-        p.min = min(p.min, p.value)
-    for i, n in enumerate(terms):
-        params[n] = Parameter(n, float(beta[i]), unit=TERMS[n],
-                              scale=None if beta[i] != 0 else 1.0)  # fmt: skip
-    names = list(fitted.param_names)
+    return best, tried
 
-    def full_residual(v: Mapping[str, float]) -> np.ndarray:
-        lw = fitted.with_params([v[n] for n in names])
-        b = np.array([v[n] for n in terms if n in _STATIC])
-        P = _law_forces(lw, prep)
-        out = P + phi @ b - Fm
-        if asym:
-            out += v["asymmetry"] * np.abs(P)
-        return out
 
-    try:
-        res = least_squares_fit(_guarded(full_residual, Fm), params, max_nfev=max_nfev)
-        final_law = fitted.with_params([res.params[n].value for n in names])
-    except ContactLabError as exc:
-        res, final_law = res_law, fitted
-        errors.append(f"the joint covariance fit failed ({exc}); the law's fit is reported")
-    if not res_law.success and res.success:
-        res.notes.append(f"the search over the law's parameters ended: {res_law.message}")
-    _identifiability_notes(res)
+def _explained(res: FitResult, law: Any, var: float, errors: list[str]) -> None:
+    """A law that explains under 10 % of the force's variance: said first in the notes, and
+    the fit failed when no parameter is determined."""
     explained = 1.0 - res.chisqr / var if var > 0 else math.nan
     if explained < 0.1:
         errors.insert(0, (
-            f"the fitted {final_law.name} law explains {100 * max(explained, 0.0):.0f} % of "
+            f"the fitted {law.name} law explains {100 * max(explained, 0.0):.0f} % of "
             "the force's variance: it cannot produce these loops (a force of the opposite "
             "sign, whose loops run the active way? a record with no joint motion?)"
         ))  # fmt: skip
         if all(p.identifiable is False for p in res.params.values() if p.vary):
             res.success = False
             res.message = "no parameter is determined by the data: " + errors[0]
-    out = JointFit(
-        law=final_law,
-        terms={n: res.params[n].value for n in terms},
-        result=res,
-        records=[r.name for r in recs],
-        n_samples=int(Fm.size),
-        seconds=time.perf_counter() - t0,
-        thinned_every=every,
-        starts_tried=tried,
-        name=name,
-        notes=errors[:3],
-    )
-    return out

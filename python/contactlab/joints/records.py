@@ -180,3 +180,72 @@ def as_records(
             rec.name = label
         out.append(rec)
     return out
+
+
+#: the suffixes of one-quantity array files: displacement, force (and velocity, not read)
+_NPY_ROLES = {"x": "x", "F": "F", "f": "F", "v": "v"}
+
+
+def npy_single_quantity(path: Any) -> bool:
+    """True when ``path`` is a ``.npy`` file holding one quantity: a 1-D array, or 2-D with
+    one row or one column (as ``(1, N)``), which a joint record pairs with its sibling files
+    (:func:`read_npy_pair`)."""
+    from pathlib import Path
+
+    p = Path(path)
+    if p.suffix.lower() != ".npy" or not p.is_file():
+        return False
+    try:
+        arr = np.load(p, mmap_mode="r", allow_pickle=False)
+    except (OSError, ValueError):
+        return False
+    return arr.ndim == 1 or (arr.ndim == 2 and min(arr.shape) == 1)
+
+
+def read_npy_pair(path: Any, fs: float | None) -> JointRecord:
+    """The record of a test stored as one ``.npy`` file per quantity with no time column
+    (``<stem>_x.npy`` displacement [m], ``<stem>_F.npy`` force [N], each of shape ``(N,)``,
+    ``(1, N)`` or ``(N, 1)``), sampled at ``fs`` [Hz]: ``t = arange(N) / fs``.
+
+    ``path`` is either file of the pair. Raises :class:`InputError` naming what is missing:
+    the sampling rate, the partner file, a file name without the ``_x`` / ``_F`` suffix, or
+    arrays of different lengths.
+    """
+    import re
+    from pathlib import Path
+
+    p = Path(path)
+    m = re.fullmatch(r"(.+)_([xFfv])", p.stem)
+    if m is None:
+        raise InputError(
+            f"{p}: a .npy file of one quantity with no time column; name the test's files "
+            "<stem>_x.npy (displacement) and <stem>_F.npy (force) so that they are read as "
+            "one recording, or store t, x, F as the columns of one array"
+        )
+    stem = m.group(1)
+    files = {"x": p.with_name(f"{stem}_x.npy"), "F": p.with_name(f"{stem}_F.npy")}
+    if not files["F"].is_file() and p.with_name(f"{stem}_f.npy").is_file():
+        files["F"] = p.with_name(f"{stem}_f.npy")
+    for role, f in files.items():
+        if not f.is_file():
+            what = "displacement" if role == "x" else "force"
+            raise InputError(f"{p}: the {what} of this test, {f.name}, is not next to it")
+    if fs is None:
+        raise InputError(
+            f"{p}: the arrays have no time column; give the sampling rate with --fs (Hz; a "
+            "data folder's README states it)"
+        )
+    fs = float(fs)
+    if not (np.isfinite(fs) and fs > 0):
+        raise InputError(f"--fs must be a positive sampling rate in Hz, got {fs}")
+    data = {}
+    for role, f in files.items():
+        arr = np.load(f, allow_pickle=False)
+        if not (arr.ndim == 1 or (arr.ndim == 2 and min(arr.shape) == 1)):
+            raise InputError(f"{f}: shape {arr.shape} is not one quantity ((N,), (1, N), (N, 1))")
+        data[role] = np.asarray(arr, dtype=float).reshape(-1)
+    if data["x"].size != data["F"].size:
+        raise InputError(f"{stem}: {files['x'].name} has {data['x'].size} samples, "
+                         f"{files['F'].name} has {data['F'].size}")  # fmt: skip
+    t = np.arange(data["x"].size) / fs
+    return JointRecord(t, data["x"], data["F"], stem)

@@ -69,6 +69,12 @@ class OdeResult:
         """``delta`` as a (1, n) array, like ``solve_ivp``."""
         return self.delta[np.newaxis, :]
 
+    @property
+    def response(self) -> np.ndarray:
+        """``delta``: the main output, as :class:`contactlab.simulation.SimulatedResponse`
+        names it."""
+        return self.delta
+
     def __repr__(self) -> str:
         return (
             f"OdeResult(success={self.success}, status={self.status}, n={self.t.size}, "

@@ -62,8 +62,10 @@ def with_static_pressure(
     if pa is not None:
         measured = big * 0.5 * float(np.ptp(unit)) if big > 0 else 0.0
         if abs(measured - pa) > 0.1 * pa:
-            notes.append(f"{source}: the pressure's half range {measured:.4g} Pa differs "
-                         f"from the nominal pa = {pa:.4g} Pa")  # fmt: skip
+            notes.append(
+                f"{source}: the pressure's half range {measured:.4g} Pa differs "
+                f"from the nominal pa = {pa:.4g} Pa"
+            )
     if not dynamic_only(p):
         return rec, notes
     if p0 is None:

@@ -7,6 +7,8 @@ set of files all or nothing, so a failed or interrupted run leaves the output fo
 from __future__ import annotations
 
 from .._html import (
+    CSS,
+    NBSP,
     Column,
     Report,
     figure_png,
@@ -18,6 +20,8 @@ from .._html import (
 from .._outputs import commit_outputs
 
 __all__ = [
+    "CSS",
+    "NBSP",
     "Column",
     "Report",
     "commit_outputs",

@@ -27,8 +27,9 @@ def build(report: Any, intro: str | None = None) -> Report:
         "Where the base model and the measurement disagree, which candidate effects explain "
         "it (chosen by their error on held-out cycles) and how much the gap shrinks."
     )
-    r = Report(f"Model discrepancy: {report.model} contact",
-               f"{intro}\n\n{lead}" if intro else lead)  # fmt: skip
+    r = Report(
+        f"Model discrepancy: {report.model} contact", f"{intro}\n\n{lead}" if intro else lead
+    )
     r.section("Where the base model disagrees")
     for w in report.where:
         r.text(w, note=w.startswith("after "))

@@ -52,8 +52,7 @@ def _loop_figure(rec: Any, predictions: Mapping[str, np.ndarray]) -> Any:
         off = ~rec.mask
         if off.any():
             lo, hi = np.min(rec.F), np.max(rec.F)
-            ax2.fill_between(rec.t, lo, hi, where=off, color="0.9", step="mid",
-                             label="not scored")  # fmt: skip
+            ax2.fill_between(rec.t, lo, hi, where=off, color="0.9", step="mid", label="not scored")
     ax1.legend(fontsize=7, loc="best")
     fig.tight_layout()
     return fig
@@ -80,19 +79,31 @@ def build_joint_report(
     rows = []
     for r in table.to_dict()["rows"]:
         rows.append(dict(r, role=roles.get(r["record"], "all")))
-    rep.table(rows, _SCORE_COLUMNS,
-              "SNR = 10 log10(ΣF²/Σ(F−F̂)²); NRMSE = RMSE/(max F − min F); RRSE = "
-              "√(Σ(F−F̂)²/Σ(F−F̄)²); TRAC = (ΣFF̂)²/(ΣF²ΣF̂²); energy/cycle error = "
-              "(ΣÊ−ΣE)/ΣE over whole cycles")  # fmt: skip
+    rep.table(
+        rows,
+        _SCORE_COLUMNS,
+        "SNR = 10 log10(ΣF²/Σ(F−F̂)²); NRMSE = RMSE/(max F − min F); RRSE = "
+        "√(Σ(F−F̂)²/Σ(F−F̄)²); TRAC = (ΣFF̂)²/(ΣF²ΣF̂²); energy/cycle error = "
+        "(ΣÊ−ΣE)/ΣE over whole cycles",
+    )
     for f in fits:
         rep.section(f"Law {f.name}")
-        rep.text(f"{f.law!r} fitted to {', '.join(f.records)} ({f.n_samples} samples, "
-                 f"{f.seconds:.2f} s); {'converged' if f.success else 'NOT converged'}: "
-                 f"{f.message}")  # fmt: skip
+        rep.text(
+            f"{f.law!r} fitted to {', '.join(f.records)} ({f.n_samples} samples, "
+            f"{f.seconds:.2f} s); {'converged' if f.success else 'NOT converged'}: "
+            f"{f.message}"
+        )
         prow = []
         for n, p in f.params.items():
-            prow.append({"name": n, "value": p.value, "stderr": p.stderr, "unit": p.unit,
-                         "note": p.note if p.vary else "fixed"})  # fmt: skip
+            prow.append(
+                {
+                    "name": n,
+                    "value": p.value,
+                    "stderr": p.stderr,
+                    "unit": p.unit,
+                    "note": p.note if p.vary else "fixed",
+                }
+            )
         rep.table(prow, _PARAM_COLUMNS, "parameters ± standard error")
         notes = list(f.result.notes) + list(f.notes)
         for n in notes:
@@ -106,8 +117,13 @@ def build_joint_report(
             except Exception as exc:
                 rep.text(f"{f.name} on {rec.name}: {exc}", note=True)
         step = max(1, rec.n // max_points)
-        sub = type(rec)(rec.t[::step], rec.x[::step], rec.F[::step], rec.name,
-                        None if rec.mask is None else rec.mask[::step])  # fmt: skip
+        sub = type(rec)(
+            rec.t[::step],
+            rec.x[::step],
+            rec.F[::step],
+            rec.name,
+            None if rec.mask is None else rec.mask[::step],
+        )
         fig = _loop_figure(sub, {k: v[::step] for k, v in preds.items()})
         rep.figure(fig, f"loop-{rec.name}", f"{rec.name} ({roles.get(rec.name, '')})")
     return rep

@@ -51,9 +51,11 @@ def build_structure_report(
     rep = Report(title, intro=intro)
     rep.section("Summary")
     rows = [{"quantity": k, "value": v} for k, v in summary.items()]
-    rows += [{"quantity": "joint", "value": model.joint},
-             {"quantity": "excitation", "value": model.excitation},
-             {"quantity": "identification time [s]", "value": model.elapsed}]  # fmt: skip
+    rows += [
+        {"quantity": "joint", "value": model.joint},
+        {"quantity": "excitation", "value": model.excitation},
+        {"quantity": "identification time [s]", "value": model.elapsed},
+    ]
     rep.table(rows, [Column("quantity"), Column("value")])
     rep.table(
         [
@@ -84,8 +86,11 @@ def build_structure_report(
     ax[1].plot(t, res, lw=0.6, color="C3")
     ax[1].set_ylabel("residual [m]")
     ax[1].set_xlabel("t [s]")
-    rep.figure(fig, "response", "Measured and simulated displacement; residual (dashed: end "
-               "of the training part).")  # fmt: skip
+    rep.figure(
+        fig,
+        "response",
+        "Measured and simulated displacement; residual (dashed: end of the training part).",
+    )
     rep.section("Joint loop")
     fig, ax = plt.subplots(figsize=(6, 4.5))
     if multi:
@@ -129,8 +134,10 @@ def _mdof_amplitude(rep: Any, model: IdentifiedModel, y: np.ndarray, summary: di
     amp = float(np.nanmax(np.abs(y)))
     amps = np.geomspace(amp / 100, amp, 12)
     try:
-        ads = [modal_amplitude_dependence(model.structure, amps, mode=i)
-               for i in range(model.structure.n)]  # fmt: skip
+        ads = [
+            modal_amplitude_dependence(model.structure, amps, mode=i)
+            for i in range(model.structure.n)
+        ]
     except ContactLabError as exc:
         summary["amplitude_dependence"] = {"error": str(exc)}
         return
@@ -138,9 +145,13 @@ def _mdof_amplitude(rep: Any, model: IdentifiedModel, y: np.ndarray, summary: di
     rep.section("Amplitude-dependent frequency and damping of each mode")
     fig, ax = plt.subplots(1, 2, figsize=(9, 3.5), layout="constrained")
     plot_modal_amplitude_dependence(ads, ax)
-    rep.figure(fig, "amplitude", "Equivalent-linear natural frequency and damping ratio of "
-               "each mode against the amplitude of its reference DOF (mode shape and joint "
-               "stiffness iterated together).")  # fmt: skip
+    rep.figure(
+        fig,
+        "amplitude",
+        "Equivalent-linear natural frequency and damping ratio of "
+        "each mode against the amplitude of its reference DOF (mode shape and joint "
+        "stiffness iterated together).",
+    )
 
 
 def _sdof_reconstructed(
@@ -154,8 +165,11 @@ def _sdof_reconstructed(
 ) -> None:
     try:
         ee = equation_error(t, u, y, model.excitation, mass if mass is not None else None)
-        m_, c_, k_ = (float(model.structure.M[0, 0]), float(model.structure.C[0, 0]),
-                      float(model.structure.K[0, 0]))  # fmt: skip
+        m_, c_, k_ = (
+            float(model.structure.M[0, 0]),
+            float(model.structure.C[0, 0]),
+            float(model.structure.K[0, 0]),
+        )
         xd = np.gradient(y, t, edge_order=2)
         xdd = np.gradient(xd, t, edge_order=2)
         if model.excitation == "force":
@@ -165,15 +179,29 @@ def _sdof_reconstructed(
             ud = np.gradient(u, t, edge_order=2)
             recon = -m_ * xdd - c_ * (xd - ud) - k_ * (y - u)
             d_meas = y
-        ax.plot(d_meas, recon, ".", ms=1.5, alpha=0.4, color="0.5",
-                label="reconstructed from the equation of motion")  # fmt: skip
+        ax.plot(
+            d_meas,
+            recon,
+            ".",
+            ms=1.5,
+            alpha=0.4,
+            color="0.5",
+            label="reconstructed from the equation of motion",
+        )
         summary["equation_error_linear"] = {k: ee[k] for k in ("m", "c", "k")}
     except Exception:
         pass
 
 
-def _mdof_loop(ax: Any, model: IdentifiedModel, sim: Any, t: np.ndarray, u: np.ndarray,
-               y: np.ndarray, summary: dict[str, Any]) -> None:  # fmt: skip
+def _mdof_loop(
+    ax: Any,
+    model: IdentifiedModel,
+    sim: Any,
+    t: np.ndarray,
+    u: np.ndarray,
+    y: np.ndarray,
+    summary: dict[str, Any],
+) -> None:
     """Several DOFs: the joint force against the joint's relative displacement, identified
     and reconstructed from the equations of motion with the identified ``M``, ``C``, ``K``
     (the force ``b F`` left over, projected on the joint's direction ``b``)."""
@@ -193,12 +221,20 @@ def _mdof_loop(ax: Any, model: IdentifiedModel, sim: Any, t: np.ndarray, u: np.n
     else:
         ud = column_derivatives(t, u[:, None], False)[0]
         left = -(xdd @ s.M.T) - (xd - ud) @ s.C.T - (y - u[:, None]) @ s.K.T
-    ax.plot(y @ b, left @ b / float(b @ b), ".", ms=1.5, alpha=0.4, color="0.5",
-            label="reconstructed from the equations of motion")  # fmt: skip
+    ax.plot(
+        y @ b,
+        left @ b / float(b @ b),
+        ".",
+        ms=1.5,
+        alpha=0.4,
+        color="0.5",
+        label="reconstructed from the equations of motion",
+    )
     if sim.joint_force.shape[1]:
         xs = np.asarray(sim.x).reshape(-1, s.n)
-        ax.plot(xs @ b, sim.joint_force.sum(axis=1)[: xs.shape[0]], lw=0.6,
-                label="identified joint")  # fmt: skip
+        ax.plot(
+            xs @ b, sim.joint_force.sum(axis=1)[: xs.shape[0]], lw=0.6, label="identified joint"
+        )
     summary["joint_dofs"] = [i, j]
 
 
@@ -217,8 +253,10 @@ def build_diagnosis_report(diag: Any, intro: str | None = None) -> Report:
     if not rec or diag.base_prediction is None or diag.residual is None:
         from ..errors import InputError
 
-        raise InputError("this diagnosis carries no record (loaded from JSON?): re-run "
-                         "diagnose_structure to write its report")  # fmt: skip
+        raise InputError(
+            "this diagnosis carries no record (loaded from JSON?): re-run "
+            "diagnose_structure to write its report"
+        )
     y = rec["y"]
     base, final = diag.base_prediction, y + diag.residual
     sigma = diag.noise_rms
@@ -247,19 +285,25 @@ def _diag_findings(r: Report, diag: Any, fmt: Any) -> None:
     if diag.effects:
         for name in diag.effects:
             keys = [k for k in diag.parameters if k in _EXTRA_KEYS.get(name, ())]
-            r.text(f"Named: {name} — " + ", ".join(
-                f"{k} = {_pm(diag.parameters[k], diag.stderr.get(k), fmt)}"
-                for k in keys))  # fmt: skip
+            r.text(
+                f"Named: {name} — "
+                + ", ".join(
+                    f"{k} = {_pm(diag.parameters[k], diag.stderr.get(k), fmt)}" for k in keys
+                )
+            )
     else:
         r.text("No candidate improves the held-out error significantly.")
     r.subheading("Where the model disagrees")
     for w in diag.where:
         r.text(w, note=w.startswith("after "))
     r.text(
-        ("Unexplained: the final model's held-out error is above 1.5 × the noise level."
-         if diag.unexplained else "Explained: the final model's held-out error is within "
-         "1.5 × the noise level."), note=diag.unexplained,
-    )  # fmt: skip
+        (
+            "Unexplained: the final model's held-out error is above 1.5 × the noise level."
+            if diag.unexplained
+            else "Explained: the final model's held-out error is within 1.5 × the noise level."
+        ),
+        note=diag.unexplained,
+    )
 
 
 def _diag_tables(r: Report, diag: Any, sigma: float) -> None:
@@ -313,8 +357,9 @@ def _diag_response(r: Report, diag: Any, base: np.ndarray, final: np.ndarray, si
     ax[1].plot(t, y, lw=0.7, color="k", label="measured")
     ax[1].plot(t, base, lw=0.7, label="base model")
     if diag.effects:
-        ax[1].plot(t, final, lw=0.7, ls="--", label="final model (+ " +
-                   ", ".join(diag.effects) + ")")  # fmt: skip
+        ax[1].plot(
+            t, final, lw=0.7, ls="--", label="final model (+ " + ", ".join(diag.effects) + ")"
+        )
     ax[1].set_ylabel("displacement [m]")
     ax[1].legend(loc="upper right", fontsize=8)
     ax[2].plot(t, base - y, lw=0.6, label="base model")
@@ -327,8 +372,13 @@ def _diag_response(r: Report, diag: Any, base: np.ndarray, final: np.ndarray, si
     ax[2].legend(loc="upper right", fontsize=8)
     for a in ax:
         a.axvline(t[ntr], color="k", ls="--", lw=0.8)
-    r.figure(fig, "response", "Input; measured and simulated displacement (base and final "
-             "model); residual before and after (dotted: ± 2 × noise RMS).", dpi=110)  # fmt: skip
+    r.figure(
+        fig,
+        "response",
+        "Input; measured and simulated displacement (base and final "
+        "model); residual before and after (dotted: ± 2 × noise RMS).",
+        dpi=110,
+    )
 
 
 def _diag_joint_loop(r: Report, diag: Any, base: np.ndarray, final: np.ndarray) -> None:
@@ -339,22 +389,39 @@ def _diag_joint_loop(r: Report, diag: Any, base: np.ndarray, final: np.ndarray) 
     r.section("Joint loop")
     fig = Figure(figsize=(6.5, 4.6), layout="constrained")
     ax1 = fig.add_subplot()
-    for lab, x, jf in (("base model", base, diag.base_joint_force),
-                       ("final model", final, diag.joint_force)):  # fmt: skip
+    for lab, x, jf in (
+        ("base model", base, diag.base_joint_force),
+        ("final model", final, diag.joint_force),
+    ):
         if jf is not None and jf.ndim == 2 and jf.shape[1] and jf.shape[0] == x.size:
             ax1.plot(x[ntr:], jf[ntr:, 0], lw=0.7, label=f"{lab}: {diag.joint} joint")
             if jf.shape[1] > 1 and lab == "final model":
-                ax1.plot(x[ntr:], jf[ntr:].sum(axis=1), lw=0.7, ls="--",
-                         label="final model: all joint elements")  # fmt: skip
+                ax1.plot(
+                    x[ntr:],
+                    jf[ntr:].sum(axis=1),
+                    lw=0.7,
+                    ls="--",
+                    label="final model: all joint elements",
+                )
     ax1.set_xlabel("displacement of the mass [m]")
     ax1.set_ylabel("joint force [N]")
     if ax1.get_lines():
         ax1.legend(loc="upper left", fontsize=8)
     else:  # a linear model has no joint (matplotlib warned of a legend with no entries)
-        ax1.text(0.5, 0.5, f"no joint force: the {diag.joint} model has no joint",
-                 ha="center", va="center", transform=ax1.transAxes)  # fmt: skip
-    r.figure(fig, "joint-loop", "The joint's force against the displacement on the held-out "
-             "part (simulated).", dpi=110)  # fmt: skip
+        ax1.text(
+            0.5,
+            0.5,
+            f"no joint force: the {diag.joint} model has no joint",
+            ha="center",
+            va="center",
+            transform=ax1.transAxes,
+        )
+    r.figure(
+        fig,
+        "joint-loop",
+        "The joint's force against the displacement on the held-out part (simulated).",
+        dpi=110,
+    )
 
 
 def _diag_residual(r: Report, diag: Any, base: np.ndarray, final: np.ndarray, sigma: float) -> None:
@@ -381,8 +448,13 @@ def _diag_residual(r: Report, diag: Any, base: np.ndarray, final: np.ndarray, si
     axs[1].axhline(2 * sigma, color="0.5", ls=":", lw=0.8)
     for a in axs:
         a.legend(fontsize=8)
-    r.figure(fig, "residual-where", "Held-out residual: its spectrum, and its size against the "
-             "speed of the mass (near reversals on the left).", dpi=110)  # fmt: skip
+    r.figure(
+        fig,
+        "residual-where",
+        "Held-out residual: its spectrum, and its size against the "
+        "speed of the mass (near reversals on the left).",
+        dpi=110,
+    )
 
 
 def _diag_candidates(r: Report, diag: Any, fmt: Any) -> None:
@@ -398,8 +470,18 @@ def _diag_candidates(r: Report, diag: Any, fmt: Any) -> None:
                     f"{k} = {_pm(val, c.stderr.get(k), fmt)}" for k, val in c.parameters.items()
                 )
                 rows.append(d)
-            r.table(rows, ["name", "accepted", Column("heldout_rms", "held-out RMS", unit="m"),
-                           Column("gain", "gain / σ²"), "t", "parameters", "reason"])  # fmt: skip
+            r.table(
+                rows,
+                [
+                    "name",
+                    "accepted",
+                    Column("heldout_rms", "held-out RMS", unit="m"),
+                    Column("gain", "gain / σ²"),
+                    "t",
+                    "parameters",
+                    "reason",
+                ],
+            )
 
 
 #: the parameters each structure candidate adds (as diagnose.structure names them)

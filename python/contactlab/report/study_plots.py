@@ -121,8 +121,11 @@ def plot_study(
     pts = [r for r in rows if math.isfinite(_num(r, quantity)) and math.isfinite(_num(r, against))]
     yunit, yf = display_unit(unit, [_num(r, quantity) for r in pts])
     xunit, xf = display_unit(units.get(against, ""), [_num(r, against) for r in pts])
-    gunit, gf = display_unit(units.get(group_by or "", ""), [_num(r, group_by) for r in pts]) \
-        if group_by else ("", 1.0)  # fmt: skip
+    gunit, gf = (
+        display_unit(units.get(group_by or "", ""), [_num(r, group_by) for r in pts])
+        if group_by
+        else ("", 1.0)
+    )
     groups: dict[float, list[Mapping[str, Any]]] = {}
     for r in pts:
         groups.setdefault(_group_key(r, group_by) if group_by else 0.0, []).append(r)
@@ -136,8 +139,17 @@ def plot_study(
         color = f"C{i % 10}"
         name = f"{group_by} = {g * gf:.3g} {gunit}".replace("_", " ") if group_by else quantity
         if np.isfinite(s).any():
-            ax.errorbar(x, y, yerr=np.where(np.isfinite(s), s, 0.0), color=color, marker="o",
-                        ms=4, lw=1.2, capsize=2, label=name)  # fmt: skip
+            ax.errorbar(
+                x,
+                y,
+                yerr=np.where(np.isfinite(s), s, 0.0),
+                color=color,
+                marker="o",
+                ms=4,
+                lw=1.2,
+                capsize=2,
+                label=name,
+            )
         else:
             ax.plot(x, y, color=color, marker="o", ms=4, lw=1.2, label=name)
         if secondary:
@@ -187,10 +199,28 @@ def tangential_study_figures(
             if index % n_parts != k_part:
                 continue
             fig, (a1, a2) = plt.subplots(1, 2, figsize=(9.0, 3.6), constrained_layout=True)
-            plot_study(mrows, key, "normal_load", amp_group, unit=unit, label=label,
-                       secondary=secondary, units=units, ax=a1)  # fmt: skip
-            plot_study(mrows, key, amp_x, "normal_load", unit=unit, label=label,
-                       secondary=secondary, units=units, ax=a2)  # fmt: skip
+            plot_study(
+                mrows,
+                key,
+                "normal_load",
+                amp_group,
+                unit=unit,
+                label=label,
+                secondary=secondary,
+                units=units,
+                ax=a1,
+            )
+            plot_study(
+                mrows,
+                key,
+                amp_x,
+                "normal_load",
+                unit=unit,
+                label=label,
+                secondary=secondary,
+                units=units,
+                ax=a2,
+            )
             fig.suptitle(f"{mat}: {label}", fontsize=10)
             cap = f"{mat}: {label} against normal load and amplitude (± 1 standard error)"
             if secondary:
@@ -261,36 +291,59 @@ def normal_study_figures(
     import matplotlib.pyplot as plt
 
     units = {"p0": "Pa", "pa": "Pa", **(units or {})}
-    quantities = [(k, lab, u) for k, lab, u in NORMAL_QUANTITIES
-                  if any(math.isfinite(_num(r, k)) for r in rows)]  # fmt: skip
-    bs = [f"b{i}_paper" for i in range(1, 5)
-          if any(math.isfinite(_num(r, f"b{i}_paper")) for r in rows)]  # fmt: skip
+    quantities = [
+        (k, lab, u)
+        for k, lab, u in NORMAL_QUANTITIES
+        if any(math.isfinite(_num(r, k)) for r in rows)
+    ]
+    bs = [
+        f"b{i}_paper"
+        for i in range(1, 5)
+        if any(math.isfinite(_num(r, f"b{i}_paper")) for r in rows)
+    ]
     out = []
     if quantities:
         n = len(quantities)
         ncol = min(3, n)
         nrow = math.ceil(n / ncol)
-        fig, axs = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 3.3 * nrow),
-                                constrained_layout=True, squeeze=False)  # fmt: skip
+        fig, axs = plt.subplots(
+            nrow, ncol, figsize=(4.2 * ncol, 3.3 * nrow), constrained_layout=True, squeeze=False
+        )
         for ax, (key, label, unit) in zip(axs.flat, quantities, strict=False):
             plot_study(rows, key, "p0", "pa", unit=unit, label=label, units=units, ax=ax)
         for ax in list(axs.flat)[n:]:
             ax.set_visible(False)
         fig.suptitle("Normal contact against static pressure p0", fontsize=10)
-        out.append(("study-normal-loop-quantities", fig,
-                    "ψ, stiffness and dissipated energy against p0 (one line per pa)"))  # fmt: skip
+        out.append(
+            (
+                "study-normal-loop-quantities",
+                fig,
+                "ψ, stiffness and dissipated energy against p0 (one line per pa)",
+            )
+        )
     if bs:
-        fig, axs = plt.subplots(1, len(bs), figsize=(3.4 * len(bs), 3.2),
-                                constrained_layout=True, squeeze=False)  # fmt: skip
+        fig, axs = plt.subplots(
+            1, len(bs), figsize=(3.4 * len(bs), 3.2), constrained_layout=True, squeeze=False
+        )
         for ax, key in zip(axs.flat, bs, strict=False):
             name = key.split("_")[0]
-            plot_study(rows, key, "p0", "pa", label=f"{name} [{B_PAPER_UNITS[name]}]",
-                       units=units, ax=ax)  # fmt: skip
-        fig.suptitle("k_s(p) = b1 p³ + b2 p² + b3 p + b4 (eq. 16; k_s in MPa/µm, p in MPa) "
-                     "against p0", fontsize=10)  # fmt: skip
+            plot_study(
+                rows, key, "p0", "pa", label=f"{name} [{B_PAPER_UNITS[name]}]", units=units, ax=ax
+            )
+        fig.suptitle(
+            "k_s(p) = b1 p³ + b2 p² + b3 p + b4 (eq. 16; k_s in MPa/µm, p in MPa) against p0",
+            fontsize=10,
+        )
         out.append(("study-normal-b-coefficients", fig, "b1..b4 of eq. 16 against p0"))
     return out
 
 
-__all__ = ["NORMAL_QUANTITIES", "TANGENTIAL_QUANTITIES", "display_unit", "normal_study_figures",
-           "plot_study", "tangential_study_figures", "trends"]  # fmt: skip
+__all__ = [
+    "NORMAL_QUANTITIES",
+    "TANGENTIAL_QUANTITIES",
+    "display_unit",
+    "normal_study_figures",
+    "plot_study",
+    "tangential_study_figures",
+    "trends",
+]

@@ -78,16 +78,27 @@ def plot_normal_loop(r: RecordingResult, ax: Any = None) -> Any:
         d = np.asarray(rec["delta"], dtype=float)
         ax.plot((d - shift) * 1e6, (p - p0) * 1e-6, color="0.75", lw=0.5, label="recorded")
     if res is not None and hasattr(res, "cycle_delta"):
-        ax.plot(np.asarray(res.cycle_delta) * 1e6, np.asarray(res.cycle_p) * 1e-6, ".",
-                color="0.2", ms=2, label="averaged cycle")  # fmt: skip
+        ax.plot(
+            np.asarray(res.cycle_delta) * 1e6,
+            np.asarray(res.cycle_p) * 1e-6,
+            ".",
+            color="0.2",
+            ms=2,
+            label="averaged cycle",
+        )
     lo, hi = row.get("delta_min"), row.get("delta_max")
     if isinstance(lo, float) and isinstance(hi, float) and math.isfinite(lo + hi):
         dm = np.linspace(lo, hi, 200)  # SI: the polynomials take δ in m and give p in Pa
         for name, style in (("poly_load", "C3-"), ("poly_centre", "k--"), ("poly_unload", "C0-")):
             coeffs = [row.get(f"{name}_{i}") for i in range(5)]
             if all(isinstance(c, float) for c in coeffs):
-                ax.plot(dm * 1e6, poly_eval(coeffs, dm) * 1e-6, style, lw=1.2,
-                        label=name.replace("poly_", ""))  # fmt: skip
+                ax.plot(
+                    dm * 1e6,
+                    poly_eval(coeffs, dm) * 1e-6,
+                    style,
+                    lw=1.2,
+                    label=name.replace("poly_", ""),
+                )
     ax.set_xlabel("normal contact displacement δ [µm]")
     ax.set_ylabel("dynamic pressure p − p0 [MPa]")
     ax.grid(alpha=0.3)
@@ -128,8 +139,10 @@ def _provenance(rep: Report, result: StudyResult) -> None:
     rep.table(rows, cols)
     assumed = [r["file"] for r in rows if r.get("units_assumed_si")]
     if assumed:
-        rep.text(f"{len(assumed)} file(s) have columns without units, read as SI: "
-                 + ", ".join(assumed), note=True)  # fmt: skip
+        rep.text(
+            f"{len(assumed)} file(s) have columns without units, read as SI: " + ", ".join(assumed),
+            note=True,
+        )
 
 
 def _render_part(job: tuple) -> list[tuple[str, Any]]:
@@ -221,12 +234,19 @@ def build_report(
         for kind, rows in plan:
             cols = _present(TANGENTIAL_COLUMNS if kind == "tangential" else NORMAL_COLUMNS, rows)
             rep.section(f"{kind.capitalize()} recordings: summary")
-            rep.table(rows, cols, caption="Fitted parameters (± 1 standard error); full table "
-                      f"with every column in SI: study_{kind}.csv / .parquet")  # fmt: skip
+            rep.table(
+                rows,
+                cols,
+                caption="Fitted parameters (± 1 standard error); full table "
+                f"with every column in SI: study_{kind}.csv / .parquet",
+            )
             warned = [r.entry.name for r in result.of_kind(kind) if r.ok and r.row.get("warnings")]
             if warned:
-                rep.text(f"{len(warned)} recording(s) with warnings (see their sections below): "
-                         + ", ".join(warned), note=True)  # fmt: skip
+                rep.text(
+                    f"{len(warned)} recording(s) with warnings (see their sections below): "
+                    + ", ".join(warned),
+                    note=True,
+                )
             if study_plots and len(rows) > 1:
                 figs: list[tuple[int, tuple[str, Any]]] = []
                 for _ in range(nparts):
@@ -247,8 +267,12 @@ def build_report(
             if details:
                 rep.section(f"{kind.capitalize()} recordings: loops, fits and residuals")
                 n = sum(r.ok for r in result.of_kind(kind))
-                bar = tqdm(range(n), desc=f"report ({kind})", unit="fig",
-                           disable=None if progress is None else not progress)  # fmt: skip
+                bar = tqdm(
+                    range(n),
+                    desc=f"report ({kind})",
+                    unit="fig",
+                    disable=None if progress is None else not progress,
+                )
                 for _ in bar:
                     rep.extend(next(parts))
     finally:
@@ -261,5 +285,11 @@ def build_report(
     return rep
 
 
-__all__ = ["NORMAL_COLUMNS", "TANGENTIAL_COLUMNS", "build_report", "display_unit",
-           "plot_normal_loop", "poly_eval"]  # fmt: skip
+__all__ = [
+    "NORMAL_COLUMNS",
+    "TANGENTIAL_COLUMNS",
+    "build_report",
+    "display_unit",
+    "plot_normal_loop",
+    "poly_eval",
+]

@@ -86,9 +86,15 @@ def plot_loop(analysis: TangentialAnalysis, ax: Any = None, *, show_scatter: boo
             h0 = a.derived["h0_plateau"][0]
             off = float(a.meta["plateau_offset"])
             lo, hi = float(loop.x.min()) * um, float(loop.x.max()) * um
-            ax.hlines([off + h0, off - h0], lo, hi, colors="C2" if not plateau else "C3",
-                      linestyles="--", lw=1.5,
-                      label=f"plateau levels offset ± h0 (h0 = {h0:.4g} N)")  # fmt: skip
+            ax.hlines(
+                [off + h0, off - h0],
+                lo,
+                hi,
+                colors="C2" if not plateau else "C3",
+                linestyles="--",
+                lw=1.5,
+                label=f"plateau levels offset ± h0 (h0 = {h0:.4g} N)",
+            )
     else:
         s = a.meta.get("fit_start", 0)
         ax.plot(a.x * um, a.F, ",", color="C0", alpha=0.5, label="signal")
@@ -153,8 +159,9 @@ def plot_residuals(analysis: TangentialAnalysis, ax: Any = None) -> Any:
         if a.loop.n_cycles > 1:
             sem = a.loop.F_std / np.sqrt(a.loop.n_cycles)
             o = np.argsort(ph)
-            ax.fill_between(ph[o], -2 * sem[o], 2 * sem[o], color="0.85",
-                            label="±2 s.e.m. (scatter)")  # fmt: skip
+            ax.fill_between(
+                ph[o], -2 * sem[o], 2 * sem[o], color="0.85", label="±2 s.e.m. (scatter)"
+            )
             ax.legend(fontsize=8)
         ax.axvline(0.5, color="0.5", lw=0.8, ls=":")
         ax.set_xlabel("phase (0 = peak, 0.5 = valley)")

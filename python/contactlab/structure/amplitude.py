@@ -78,8 +78,10 @@ def loop_keq_energy(t: np.ndarray, d: np.ndarray, F: np.ndarray) -> tuple[float,
 def checked_amplitudes(structure: Structure, amplitudes: Any, who: str) -> np.ndarray:
     """The amplitudes as a positive 1-D array; a rate-dependent (Kelvin-Voigt) joint refused."""
     if any(j.kind == "kelvin_voigt" for j in structure.joints):
-        raise InputError(f"{who}: a Kelvin-Voigt joint is rate-dependent; add its k and c to "
-                         "the structure instead")  # fmt: skip
+        raise InputError(
+            f"{who}: a Kelvin-Voigt joint is rate-dependent; add its k and c to "
+            "the structure instead"
+        )
     a = as_1d(amplitudes, "amplitudes")
     if np.any(a <= 0):
         raise InputError("amplitudes must be > 0")

@@ -167,8 +167,9 @@ def modal_amplitude_dependence(
     joints = structure.joints
     B = [_direction(j, n) for j in joints]
     tables = [_JointTable(j) for j in joints]
-    k_lin = K + sum((t.k0 * np.outer(b, b) for t, b in zip(tables, B, strict=True)),
-                    np.zeros((n, n)))  # fmt: skip
+    k_lin = K + sum(
+        (t.k0 * np.outer(b, b) for t, b in zip(tables, B, strict=True)), np.zeros((n, n))
+    )
     phi0 = _mode(M, k_lin, mode, None)[1]
     if ref_dof is None:
         ref_dof = int(np.argmax(np.abs(phi0)))
@@ -187,8 +188,9 @@ def modal_amplitude_dependence(
         for it in range(1, max_iter + 1):
             A = np.array([ai * abs(float(b @ phi)) for b in B])
             ke = np.array([tb(float(x))[0] for tb, x in zip(tables, A, strict=True)])
-            Keq = K + sum((k * np.outer(b, b) for k, b in zip(ke, B, strict=True)),
-                          np.zeros((n, n)))  # fmt: skip
+            Keq = K + sum(
+                (k * np.outer(b, b) for k, b in zip(ke, B, strict=True)), np.zeros((n, n))
+            )
             w2_new, phi_new = _mode(M, Keq, mode, phi)
             phi_new = phi_new / phi_new[ref]
             change = float(np.max(np.abs(phi_new - phi))) + abs(w2_new - w2) / w2_new
@@ -206,8 +208,7 @@ def modal_amplitude_dependence(
         vals = [tb(float(x)) for tb, x in zip(tables, A, strict=True)]
         ke = np.array([v[0] for v in vals])
         E = np.array([v[1] for v in vals])
-        Keq = K + sum((k * np.outer(b, b) for k, b in zip(ke, B, strict=True)),
-                      np.zeros((n, n)))  # fmt: skip
+        Keq = K + sum((k * np.outer(b, b) for k, b in zip(ke, B, strict=True)), np.zeros((n, n)))
         w = float(np.sqrt(w2))
         x = ai * phi
         e_visc = float(np.pi * w * (x @ C @ x))
@@ -216,10 +217,18 @@ def modal_amplitude_dependence(
         shapes[i], iters[i] = phi, it
         out["A"][i], out["keq"][i], out["E"][i] = A, ke, E
     return ModalAmplitudeDependence(
-        mode=mode, ref_dof=ref, amplitude=a.copy(), frequency_hz=freq, damping_ratio=zeta,
-        shapes=shapes, joint_amplitude=out["A"], k_eq=out["keq"], energy=out["E"],
-        viscous_energy=ev, iterations=iters,
-    )  # fmt: skip
+        mode=mode,
+        ref_dof=ref,
+        amplitude=a.copy(),
+        frequency_hz=freq,
+        damping_ratio=zeta,
+        shapes=shapes,
+        joint_amplitude=out["A"],
+        k_eq=out["keq"],
+        energy=out["E"],
+        viscous_energy=ev,
+        iterations=iters,
+    )
 
 
 def _mode(M: np.ndarray, K: np.ndarray, mode: int, prev: np.ndarray | None) -> tuple[float, Any]:
@@ -293,8 +302,13 @@ def phase_resonance(
         nonlocal runs
         runs += 1
         t = np.arange(npp) / (npp * f)
-        r = structure.simulate(t, force=np.outer(np.sin(2 * np.pi * f * t), p), periodic=True,
-                               periodic_tol=1e-7, max_periods=1024)  # fmt: skip
+        r = structure.simulate(
+            t,
+            force=np.outer(np.sin(2 * np.pi * f * t), p),
+            periodic=True,
+            periodic_tol=1e-7,
+            max_periods=1024,
+        )
         if not r.success:
             raise ConvergenceError(f"phase_resonance at {f:.6g} Hz: {r.message}")
         x = np.asarray(r.x).reshape(npp, -1)
@@ -306,10 +320,14 @@ def phase_resonance(
     # bracket between the neighbouring modes (of the equivalent-linear structure): the phase
     # of x_ref turns through every resonance on the way
     keq = structure.K + sum(
-        (k * np.outer(bj, bj) for k, bj in zip(ad.k_eq[0], [_direction(j, structure.n)
-                                                        for j in structure.joints], strict=True)),
+        (
+            k * np.outer(bj, bj)
+            for k, bj in zip(
+                ad.k_eq[0], [_direction(j, structure.n) for j in structure.joints], strict=True
+            )
+        ),
         np.zeros_like(structure.K),
-    )  # fmt: skip
+    )
     fr = np.sqrt(np.abs(scipy.linalg.eigh(keq, structure.M, eigvals_only=True))) / (2 * np.pi)
     i0 = int(np.argmin(np.abs(fr - f0)))
     lo = max(0.5 * f0, float(np.sqrt(fr[i0 - 1] * f0)) if i0 > 0 else 0.0)

@@ -24,8 +24,16 @@ def add_fitted_joint(
 ) -> None:
     """Add the joint of fitted values ``v`` (names as in :mod:`.identify`) to ``s``."""
     if joint == "bouc_wen":
-        s.add_joint("bouc_wen", dof, dof2, alpha=v["alpha"], beta=1.0, gamma=v["gamma"],
-                    delta=v["delta"], nu=v["nu"])  # fmt: skip
+        s.add_joint(
+            "bouc_wen",
+            dof,
+            dof2,
+            alpha=v["alpha"],
+            beta=1.0,
+            gamma=v["gamma"],
+            delta=v["delta"],
+            nu=v["nu"],
+        )
     elif joint == "masing":
         s.add_joint("masing", dof, dof2, h0=v["h0"], ac=v["ac"], scale=v.get("scale", 2.0))
     elif joint == "jenkins":
@@ -95,8 +103,7 @@ def best_start(
     best: list[Parameter] | None = None
     for st, ps in plan:
         try:
-            fr = least_squares_fit(residual, ps, max_nfev=max_nfev, ftol=1e-5, xtol=1e-5,
-                                   gtol=1e-8)  # fmt: skip
+            fr = least_squares_fit(residual, ps, max_nfev=max_nfev, ftol=1e-5, xtol=1e-5, gtol=1e-8)
         except ContactLabError as exc:
             records.append({"start": st, "cost": None, "error": str(exc)})
             continue
@@ -104,8 +111,18 @@ def best_start(
         records.append({"start": st, "rms_short": cost})
         if cost < best_cost:
             best_cost = cost
-            best = [Parameter(p.name, fr.params[p.name].value, vary=p.vary, min=p.min,
-                              max=p.max, unit=p.unit, scale=p.scale) for p in ps]  # fmt: skip
+            best = [
+                Parameter(
+                    p.name,
+                    fr.params[p.name].value,
+                    vary=p.vary,
+                    min=p.min,
+                    max=p.max,
+                    unit=p.unit,
+                    scale=p.scale,
+                )
+                for p in ps
+            ]
     return best
 
 
@@ -118,8 +135,10 @@ def _band_mean(p: np.ndarray, width: int) -> np.ndarray:
 def _white_only(fit: FitResult) -> FitResult:
     if fit.covar is None:
         return fit
-    note = ("the noise model could not be evaluated: the standard errors assume white "
-            "residuals and are likely too small")  # fmt: skip
+    note = (
+        "the noise model could not be evaluated: the standard errors assume white "
+        "residuals and are likely too small"
+    )
     return replace(fit, notes=[*fit.notes, note])
 
 
@@ -178,8 +197,11 @@ def noise_model_covariance(
     if not (np.all(np.isfinite(covar)) and math.isfinite(su2) and np.all(np.isfinite(sy2))):
         return _white_only(fit), info
     ratio = stderr_ratio(fit, covar)
-    info = {"input_noise": math.sqrt(su2), "output_noise": [math.sqrt(float(v)) for v in sy2],
-            "probes": probes}  # fmt: skip
+    info = {
+        "input_noise": math.sqrt(su2),
+        "output_noise": [math.sqrt(float(v)) for v in sy2],
+        "probes": probes,
+    }
     note = (
         f"standard errors allow for input noise (σ_u ≈ {info['input_noise']:.3g}) as well as "
         "output noise (σ_y ≈ " + ", ".join(f"{v:.3g}" for v in info["output_noise"]) + "), "

@@ -41,15 +41,21 @@ from .fitkit import (
     IWAN_ELEMENTS,
     add_fitted_joint,
     best_start,
-    derivatives,
     hold_state,
     noise_model_covariance,
 )
 from .model import SimulationResult, Structure
+from .starts import _linear_starts, _params, _start_plan, equation_error, linear_grid_start
 
 JOINTS = ("masing", "jenkins", "iwan", "bouc_wen", "kelvin_voigt", "normal", "linear")
-__all__ = ["IWAN_ELEMENTS", "JOINTS", "IdentifiedModel", "equation_error", "identify",
-           "linear_grid_start"]  # fmt: skip
+__all__ = [
+    "IWAN_ELEMENTS",
+    "JOINTS",
+    "IdentifiedModel",
+    "equation_error",
+    "identify",
+    "linear_grid_start",
+]
 
 
 @dataclass
@@ -192,18 +198,22 @@ class IdentifiedModel:
         try:
             s = Structure.from_dict(d["structure"])
             fd = d["fit"]
-            params = {
-                p["name"]: Parameter(
-                    name=p["name"],
-                    value=float(p["value"]),
-                    stderr=p.get("stderr"),
-                    vary=bool(p.get("vary", True)),
-                    identifiable=p.get("identifiable"),
-                    note=p.get("note", ""),
-                    unit=p.get("unit", ""),
-                )
-                for p in fd["params"].values()
-            } if isinstance(fd.get("params"), dict) else {}  # fmt: skip
+            params = (
+                {
+                    p["name"]: Parameter(
+                        name=p["name"],
+                        value=float(p["value"]),
+                        stderr=p.get("stderr"),
+                        vary=bool(p.get("vary", True)),
+                        identifiable=p.get("identifiable"),
+                        note=p.get("note", ""),
+                        unit=p.get("unit", ""),
+                    )
+                    for p in fd["params"].values()
+                }
+                if isinstance(fd.get("params"), dict)
+                else {}
+            )
             fit = FitResult(
                 params=params,
                 var_names=list(fd.get("var_names", [])),
@@ -273,249 +283,6 @@ def build_structure(joint: str, v: dict[str, float], excitation: str) -> Structu
     s = Structure(v["m"], v["c"], v["k"])
     add_fitted_joint(s, joint, v, 0, None)
     return s
-
-
-def equation_error(
-    t: np.ndarray,
-    u: np.ndarray,
-    y: np.ndarray,
-    excitation: str = "force",
-    mass: float | None = None,
-    *,
-    periodic: bool = False,
-) -> dict[str, Any]:
-    """Linear equation-error fit and the reconstructed joint force.
-
-    ``force``: ``u ≈ m x'' + c x' + k x``; ``base`` (``u`` = base displacement, ``y`` = mass
-    displacement): ``−m x'' ≈ c (x' − u') + k (x − u)``, ``m`` required. Returns ``m``, ``c``,
-    ``k`` and ``joint_force = rhs − m x'' − c x' − k x`` (what the joint must supply if the
-    linear part were exactly this).
-    """
-    xd, xdd = derivatives(t, y, periodic)
-    if excitation == "force":
-        cols = [xdd, xd, y]
-        rhs = u.copy()
-        if mass is not None:
-            rhs = rhs - mass * xdd
-            cols = [xd, y]
-        A = np.stack(cols, axis=1)
-        coef, *_ = np.linalg.lstsq(A, rhs, rcond=None)
-        m, c, k = coef if mass is None else (mass, coef[0], coef[1])
-        jf = u - m * xdd - c * xd - k * y
-    else:
-        if mass is None:
-            raise InputError("base excitation needs the mass (mass=...) for the equation error")
-        ud, _ = derivatives(t, u, periodic)
-        A = np.stack([xd - ud, y - u], axis=1)
-        coef, *_ = np.linalg.lstsq(A, -mass * xdd, rcond=None)
-        m, (c, k) = mass, coef
-        jf = -m * xdd - c * (xd - ud) - k * (y - u)
-    # The same with a Coulomb term fs·sign(x') (joint to ground): starting values for the
-    # friction joints (a linear fit lets the stiffness absorb the friction force).
-    sgn = np.sign(xd)
-    if excitation == "force":
-        rhs_c, cols_c = u - m * xdd, [xd, y, sgn]
-    else:
-        ud, _ = derivatives(t, u, periodic)
-        rhs_c, cols_c = -m * xdd, [xd - ud, y - u, sgn]
-    cc, *_ = np.linalg.lstsq(np.stack(cols_c, axis=1), rhs_c, rcond=None)
-    return {
-        "m": float(m),
-        "c": float(c),
-        "k": float(k),
-        "joint_force": jf,
-        "coulomb": {"c": float(cc[0]), "k": float(cc[1]), "fs": float(cc[2])},
-    }
-
-
-def linear_grid_start(
-    t: np.ndarray,
-    u: np.ndarray,
-    y: np.ndarray,
-    excitation: str,
-    mass: float | None,
-    *,
-    n_freq: int = 24,
-    zetas: tuple[float, ...] = (0.01, 0.05, 0.2, 0.7),
-    keep: int = 3,
-) -> list[dict[str, Any]]:
-    """The linear SDOF model (``m``, ``c``, ``k``) of least output error over a grid of
-    natural frequencies (geometric, from one cycle per record to a sixth of the sampling
-    rate) and damping ratios: starting values when the equation error fails.
-
-    Base excitation: the response depends on ``k/m`` and ``c/m`` only (``m`` given).
-    Force excitation: the response of the unit-stiffness model is scaled by its least-squares
-    factor ``1/k`` (``m = k/ω²``; with a given mass, ``k = m ω²``). Returns the best ``keep``
-    models at distinct frequencies (at least a factor 1.5 apart), best first, each with
-    ``grid_f`` [Hz] and ``grid_rms`` (its output error) [m]; empty when none has a positive
-    scale.
-    """
-    dt = float(np.median(np.diff(t)))
-    f_lo = 1.0 / max(float(t[-1] - t[0]), dt)
-    f_hi = 1.0 / (6.0 * dt)
-    if not f_hi > f_lo:
-        return []
-    found: list[tuple[float, float, float, float, float]] = []  # rms, f, m, c, k
-    x0 = [float(y[0])] if excitation == "base" else None
-    for f in np.geomspace(f_lo, f_hi, n_freq):
-        w = 2 * np.pi * f
-        for z in zetas:
-            if excitation == "base":
-                m = float(mass)  # type: ignore[arg-type]
-                k, c = m * w * w, 2 * z * m * w
-                try:
-                    r = Structure(m, c, k).simulate(t, base=u, x0=x0)
-                except ContactLabError:
-                    continue
-                if r.x.size < t.size:
-                    continue
-                e = r.x - y
-            else:
-                # unit stiffness (or the given mass), then the best scale
-                m1 = 1.0 / (w * w) if mass is None else float(mass)
-                k1 = 1.0 if mass is None else m1 * w * w
-                try:
-                    r = Structure(m1, 2 * z * m1 * w, k1).simulate(t, force=u)
-                except ContactLabError:
-                    continue
-                g = r.x
-                if g.size < t.size or not np.all(np.isfinite(g)):
-                    continue
-                gg = float(g @ g)
-                scale = float(g @ y) / gg if gg > 0 else 0.0
-                if not scale > 0:
-                    continue
-                if mass is None:
-                    k = 1.0 / scale
-                    m, c = k / (w * w), 2 * z * k / w
-                else:
-                    scale = 1.0  # the mass fixes the scale
-                    m, c, k = m1, 2 * z * m1 * w, k1
-                e = scale * g - y
-            rms = float(np.sqrt(np.mean(e * e)))
-            if math.isfinite(rms):
-                found.append((rms, float(f), m, c, k))
-    out: list[dict[str, Any]] = []
-    for rms, f, m, c, k in sorted(found):
-        if all(max(f / o["grid_f"], o["grid_f"] / f) >= 1.5 for o in out):
-            out.append({"m": m, "c": c, "k": k, "grid_f": f, "grid_rms": rms})
-        if len(out) == keep:
-            break
-    return out
-
-
-def _joint_grid_plan(
-    joint: str,
-    lin: dict[str, Any],
-    y: np.ndarray,
-    mass: float | None,
-    t: np.ndarray,
-    res: Any,
-    keep: int = 10,
-) -> list[tuple[dict[str, Any], dict[str, Any], dict[str, float]]]:
-    """The ``keep`` best starts of a friction joint on a grid of total stiffness (natural
-    frequency), joint share and slip force, each judged by one simulation (``res``)."""
-    dt = float(np.median(np.diff(t)))
-    m = float(mass) if mass is not None else float(lin["m"])
-    scored = []
-    for f in np.geomspace(1.0 / max(float(t[-1] - t[0]), dt), 1.0 / (6.0 * dt), 12):
-        k = m * (2 * np.pi * f) ** 2
-        li = {**lin, "m": m, "k": k, "c": 0.02 * math.sqrt(k * m)}
-        for kf in (0.5, 0.85):
-            for ff in (0.01, 0.03, 0.1, 0.3, 1.0, 3.0):
-                st0 = {"f_frac": ff, "k_frac": kf}
-                v = {p.name: p.value for p in _params(joint, li, y, mass, st0)}
-                v["x0"] = float(y[0])
-                e = res(v)
-                rms = float(np.sqrt(np.mean(e * e)))
-                if math.isfinite(rms):
-                    scored.append((rms, float(f), kf, ff, li, st0))
-    scored.sort(key=lambda a: a[0])
-    return [({"f_frac": ff, "k_frac": kf, "grid_f": f, "grid_rms": rms}, li, st0)
-            for rms, f, kf, ff, li, st0 in scored[:keep]]  # fmt: skip
-
-
-def _params(
-    joint: str, lin: dict[str, Any], y: np.ndarray, mass: float | None, start: dict[str, float]
-) -> list[Parameter]:
-    m, c, k = lin["m"], max(lin["c"], 1e-9 * abs(lin["k"]) + 1e-12), abs(lin["k"])
-    yr = max(float(np.std(y)), 1e-300)
-    ftyp = max(k * yr, 1e-300)
-    frac = start.get("k_frac", 0.5)
-    ps = [
-        Parameter("m", m if mass is None else mass, vary=mass is None, min=0.0, unit="kg"),
-        Parameter("c", c, min=0.0, unit="N s/m", scale=max(c, 1e-3 * k * yr)),
-    ]
-    kl = Parameter("k", k * (1 - frac), min=0.0, unit="N/m", scale=k)
-    if joint in ("linear",):
-        kl.value = k
-        ps.append(kl)
-    elif joint == "kelvin_voigt":
-        # the joint is the linear spring-damper: the structure's own k, c would duplicate it
-        ps[1] = Parameter("c", 0.0, vary=False, unit="N s/m")
-        ps += [
-            Parameter("k", 0.0, vary=False, unit="N/m"),
-            Parameter("kj", k, min=0.0, unit="N/m"),
-            Parameter("cj", c, min=0.0, unit="N s/m"),
-        ]
-    elif joint == "normal":
-        ps.append(Parameter("k", 0.0, vary=False, unit="N/m"))
-        ps += [
-            Parameter("a1", k, min=0.0, unit="N/m"),
-            Parameter("a2", start.get("a2", 0.0), unit="N/m^2", scale=k / yr),
-            Parameter("a3", start.get("a3", 0.0), unit="N/m^3", scale=k / yr**2),
-        ]
-    else:
-        ps.append(kl)
-        kj = k * frac
-        if joint == "bouc_wen":
-            ps += [
-                Parameter("alpha", kj, min=1e-9 * kj, unit="N/m"),
-                Parameter("gamma", start["gamma"] / yr, unit="1/m", scale=1 / yr),
-                Parameter("delta", start["delta"] / yr, unit="1/m", scale=1 / yr),
-                Parameter("nu", 1.0, min=0.25, max=4.0, vary=start.get("fit_nu", True), unit=""),
-            ]
-        elif joint in ("masing", "jenkins", "iwan"):
-            cf = lin["coulomb"]
-            fsc = start["f_frac"] * ftyp
-            if start.get("coulomb") and cf["fs"] > 0 and cf["k"] > 0:
-                # k and c from the Coulomb-augmented regression, joint stiffer than k
-                kl.value = cf["k"]
-                ps[1].value = max(cf["c"], ps[1].value * 1e-3)
-                kj, fsc = start["kj_frac"] * cf["k"], start["f_frac"] * cf["fs"]
-            if joint == "masing":
-                ps += [
-                    Parameter("h0", fsc, min=0.0, unit="N"),
-                    Parameter("ac", kj / fsc, min=0.0, unit="1/m"),
-                ]
-            else:
-                ps += [
-                    Parameter("kj", kj, min=0.0, unit="N/m"),
-                    Parameter("fs", fsc, min=0.0, unit="N"),
-                ]
-    ps += [
-        Parameter("x0", 0.0, unit="m", scale=yr),
-        Parameter("v0", 0.0, unit="m/s", scale=yr * 2 * np.pi * 10),
-    ]
-    return ps
-
-
-def _starts(joint: str) -> list[dict[str, float]]:
-    if joint == "bouc_wen":
-        return [
-            {"gamma": g, "delta": d, "k_frac": f}
-            for (g, d) in ((0.5, -0.5), (0.5, 0.5), (-0.25, 0.5))
-            for f in (0.5,)
-        ]
-    if joint in ("masing", "jenkins", "iwan"):
-        return [{"f_frac": f, "k_frac": kf} for f in (0.1, 0.3, 1.0) for kf in (0.3, 0.7)] + [
-            {"coulomb": 1.0, "f_frac": f, "kj_frac": kf, "k_frac": 0.5}
-            for f in (0.7, 1.4)
-            for kf in (3.0, 30.0)
-        ]
-    if joint == "normal":
-        return [{"a2": 0.0, "a3": 0.0}]
-    return [{}]
 
 
 @with_single_blas_thread
@@ -591,15 +358,64 @@ def identify(
         from .identify_mdof import identify_mdof
 
         fields = identify_mdof(
-            t, u, y, joint, excitation, structure=structure, masks=masks,
-            joint_dofs=joint_dofs, input_dof=input_dof, mass=mass, substeps=substeps,
-            interpolation=interpolation, periodic=periodic, multistart=multistart,
-            start_samples=start_samples, max_nfev=max_nfev,
+            t,
+            u,
+            y,
+            joint,
+            excitation,
+            structure=structure,
+            masks=masks,
+            joint_dofs=joint_dofs,
+            input_dof=input_dof,
+            mass=mass,
+            substeps=substeps,
+            interpolation=interpolation,
+            periodic=periodic,
+            multistart=multistart,
+            start_samples=start_samples,
+            max_nfev=max_nfev,
             estimate_initial_state=estimate_initial_state,
-        )  # fmt: skip
+        )
         model = IdentifiedModel(**fields)
-        model.elapsed = time.perf_counter() - t0
-        return model
+    else:
+        model = _identify_sdof(
+            t,
+            u,
+            y,
+            joint,
+            excitation,
+            mass=mass,
+            substeps=substeps,
+            interpolation=interpolation,
+            periodic=periodic,
+            multistart=multistart,
+            start_samples=start_samples,
+            max_nfev=max_nfev,
+            estimate_initial_state=estimate_initial_state,
+            progress=progress,
+        )
+    model.elapsed = time.perf_counter() - t0
+    return model
+
+
+def _identify_sdof(
+    t: Any,
+    u: Any,
+    y: Any,
+    joint: str,
+    excitation: str,
+    *,
+    mass: float | None,
+    substeps: int,
+    interpolation: str,
+    periodic: bool | None,
+    multistart: bool,
+    start_samples: int,
+    max_nfev: int,
+    estimate_initial_state: bool,
+    progress: Callable[[str], None] | None,
+) -> IdentifiedModel:
+    """:func:`identify` of a single-DOF record: starts, fit, and the noise-model errors."""
     t, u, y = _checked_sdof_record(t, u, y, excitation, mass)
     if interpolation == "auto":
         interpolation = "fourier" if periodic else "linear"
@@ -609,24 +425,17 @@ def identify(
 
     residual_on = _SdofResidual(joint, excitation, t, u, y, interpolation, substeps, progress)
 
-    starts = _starts(joint)
     records: list[dict[str, Any]] = []
     n_s = min(int(start_samples), t.size)
-    plan = [(st0 if len(lins) == 1 else {**st0, "grid_f": li["grid_f"]}, li, st0)
-            for li in lins for st0 in starts]  # fmt: skip
-    if len(lins) > 1 and joint in ("masing", "jenkins", "iwan"):
-        # the linear grid cannot hold the mass against a joint to the fixed ground (what a
-        # frame rubbing on a wall does on a short record): explore the joint's stiffness
-        # share and slip force on the grid of frequencies, one simulation each (first), as
-        # well as the usual starts on the linear grid's models
-        plan = _joint_grid_plan(joint, lin, y, mass, t, residual_on(n_s, 2)) + plan
+    plan = _start_plan(joint, lin, lins, y, mass, t, lambda: residual_on(n_s, 2))
     est = estimate_initial_state
     best_ps = hold_state(_params(joint, plan[0][1], y, mass, plan[0][2]), est)
     if multistart and len(plan) > 1:
         tried = [(st, hold_state(_params(joint, li, y, mass, st0), est)) for st, li, st0 in plan]
         best_ps = best_start(tried, residual_on(n_s, 2), records) or best_ps
-    fit = least_squares_fit(residual_on(t.size), best_ps, max_nfev=max_nfev, ftol=1e-7,
-                            xtol=1e-7, gtol=1e-10)  # fmt: skip
+    fit = least_squares_fit(
+        residual_on(t.size), best_ps, max_nfev=max_nfev, ftol=1e-7, xtol=1e-7, gtol=1e-10
+    )
     # the residuals of an output-error fit are correlated in time (input noise filtered by
     # the structure): the white-noise covariance understated the errors several-fold
     v = fit.values
@@ -634,14 +443,19 @@ def identify(
     fit, noise = noise_model_covariance(
         fit, lambda du: residual_on(t.size, substeps, u + du)(v) - r_fit, u
     )
-    model = IdentifiedModel(
-        structure=build_structure(joint, v, excitation), joint=joint, excitation=excitation,
-        fit=fit, x0=float(v["x0"]), v0=float(v["v0"]), substeps=int(substeps),
-        interpolation=interpolation, rms=float(np.sqrt(fit.chisqr / max(fit.ndata, 1))),
-        starts=records, noise=noise,
-    )  # fmt: skip
-    model.elapsed = time.perf_counter() - t0
-    return model
+    return IdentifiedModel(
+        structure=build_structure(joint, v, excitation),
+        joint=joint,
+        excitation=excitation,
+        fit=fit,
+        x0=float(v["x0"]),
+        v0=float(v["v0"]),
+        substeps=int(substeps),
+        interpolation=interpolation,
+        rms=float(np.sqrt(fit.chisqr / max(fit.ndata, 1))),
+        starts=records,
+        noise=noise,
+    )
 
 
 def _checked_sdof_record(
@@ -674,42 +488,22 @@ def _checked_sdof_record(
     return t, u, y
 
 
-def _linear_starts(
-    t: np.ndarray, u: np.ndarray, y: np.ndarray, excitation: str, mass: float | None,
-    periodic: bool,
-) -> tuple[dict[str, Any], list[dict[str, Any]]]:  # fmt: skip
-    """The equation-error linear model and the linear models that seed the joint's starts."""
-    lin = equation_error(t, u, y, excitation, mass, periodic=periodic)
-    lins = [lin]
-    if not (lin["k"] > 0 and lin["m"] > 0):
-        # a short or slow record (a few hundred samples, the mass following the base) can
-        # leave the regression's stiffness at or below zero: start from the linear model of
-        # a grid of natural frequencies and damping ratios that best matches the output
-        grid = linear_grid_start(t, u, y, excitation, mass)
-        if not grid:
-            raise InputError(
-                "the equation-error fit gives a non-positive mass or stiffness "
-                f"(m = {lin['m']:.4g}, k = {lin['k']:.4g}), and no linear model on a grid of "
-                "natural frequencies follows the response; is the response in metres and "
-                "the input the right channel?"
-            )
-        # the best few grid models (distinct frequencies) each seed the joint's starts
-        # with light viscous damping: the grid's damping ratio stands in for the joint's
-        # dissipation, which the joint's parameters are to take over
-        lins = [{**lin, **g, "c": 0.02 * math.sqrt(g["k"] * g["m"])} for g in grid]
-        lin = lins[0]
-    return lin, lins
-
-
 class _SdofResidual:
     """``residual_on(n, sub, u_in)``: the output-error residual of the first ``n`` samples
     (simulated with ``sub`` substeps, the input ``u_in`` if given) as a function of the
     fitted values. ``progress`` (optional) is called with the stage after each simulation."""
 
     def __init__(
-        self, joint: str, excitation: str, t: np.ndarray, u: np.ndarray, y: np.ndarray,
-        interpolation: str, substeps: int, progress: Callable[[str], None] | None = None,
-    ) -> None:  # fmt: skip
+        self,
+        joint: str,
+        excitation: str,
+        t: np.ndarray,
+        u: np.ndarray,
+        y: np.ndarray,
+        interpolation: str,
+        substeps: int,
+        progress: Callable[[str], None] | None = None,
+    ) -> None:
         self.joint, self.excitation, self.t, self.u, self.y = joint, excitation, t, u, y
         self.interpolation, self.substeps = interpolation, substeps
         self.progress = progress
@@ -729,8 +523,9 @@ class _SdofResidual:
             try:
                 s = build_structure(joint, v, excitation)
                 kw = {"force": uu} if excitation == "force" else {"base": uu}
-                r = s.simulate(tt, x0=[v["x0"]], v0=[v["v0"]], substeps=sub,
-                               interpolation=interp, **kw)  # fmt: skip
+                r = s.simulate(
+                    tt, x0=[v["x0"]], v0=[v["v0"]], substeps=sub, interpolation=interp, **kw
+                )
             except ContactLabError:
                 return np.full(n, 1e3 * float(np.max(np.abs(yy))) + 1.0)
             x = r.x

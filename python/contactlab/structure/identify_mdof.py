@@ -234,8 +234,10 @@ def _joint_params(
     joint: str, kj: float, fs: float, st: dict[str, float], dr: float, cj: float = 0.0
 ) -> list:
     if joint == "kelvin_voigt":
-        return [Parameter("kj", kj, min=0.0, unit="N/m"), Parameter("cj", cj, min=0.0,
-                                                                   unit="N s/m")]  # fmt: skip
+        return [
+            Parameter("kj", kj, min=0.0, unit="N/m"),
+            Parameter("cj", cj, min=0.0, unit="N s/m"),
+        ]
     if joint == "bouc_wen":
         return [
             Parameter("alpha", kj, min=1e-9 * kj, unit="N/m"),
@@ -244,8 +246,10 @@ def _joint_params(
             Parameter("nu", 1.0, min=0.25, max=4.0, vary=st.get("fit_nu", True), unit=""),
         ]
     if joint == "masing":
-        return [Parameter("h0", fs, min=0.0, unit="N"), Parameter("ac", kj / fs, min=0.0,
-                                                                   unit="1/m")]  # fmt: skip
+        return [
+            Parameter("h0", fs, min=0.0, unit="N"),
+            Parameter("ac", kj / fs, min=0.0, unit="1/m"),
+        ]
     if joint in ("jenkins", "iwan"):
         return [Parameter("kj", kj, min=0.0, unit="N/m"), Parameter("fs", fs, min=0.0, unit="N")]
     return []
@@ -255,8 +259,10 @@ def _mdof_starts(joint: str) -> list[dict[str, float]]:
     if joint == "kelvin_voigt":
         return [{"k_frac": 0.5}]
     if joint == "bouc_wen":
-        return [{"gamma": g, "delta": d, "k_frac": 0.5}
-                for (g, d) in ((0.5, -0.5), (0.5, 0.5), (-0.25, 0.5))]  # fmt: skip
+        return [
+            {"gamma": g, "delta": d, "k_frac": 0.5}
+            for (g, d) in ((0.5, -0.5), (0.5, 0.5), (-0.25, 0.5))
+        ]
     if joint in ("masing", "jenkins", "iwan"):
         return [{"f_frac": f, "k_frac": kf} for f in (0.1, 0.5) for kf in (0.5,)] + [
             {"coulomb": 1.0, "f_frac": f, "kj_frac": kf} for f in (0.7, 1.4) for kf in (3.0, 30.0)
@@ -303,10 +309,15 @@ def _start_params(
             lo = 0.0 if positive else -math.inf
             ps.append(Parameter(name, vals[name], min=lo, unit=unit, scale=sc))
     cb = float(b @ pattern.matrix("C", vals) @ b)  # damping seen across the joint
-    cj = 0.5 * cb if cb > 0 else 1e-3 * math.sqrt(max(kj, 1e-300) * max(
-        float(np.trace(mass)) if mass is not None else 1.0, 1e-300))  # fmt: skip
-    ps += _joint_params(joint, max(kj, 1e-300), max(fs, 1e-300), st, max(d_rms, 1e-300),
-                        cj)  # fmt: skip
+    cj = (
+        0.5 * cb
+        if cb > 0
+        else 1e-3
+        * math.sqrt(
+            max(kj, 1e-300) * max(float(np.trace(mass)) if mass is not None else 1.0, 1e-300)
+        )
+    )
+    ps += _joint_params(joint, max(kj, 1e-300), max(fs, 1e-300), st, max(d_rms, 1e-300), cj)
     for i in range(pattern.n):
         ps.append(Parameter(f"x0_{i}", float(x0[i]), unit="m", scale=y_rms))
         ps.append(Parameter(f"v0_{i}", float(v0[i]), unit="m/s", scale=y_rms * 2 * np.pi * 10))
@@ -358,9 +369,19 @@ def identify_mdof(
         _check_kv_joint(pattern, b, i_j, j_j)
 
     def ee(kj: float, coulomb: bool) -> dict[str, Any]:
-        return equation_error_mdof(t, u, y, pattern, excitation, input_dof or 0, jdofs, mass_m,
-                                   periodic=bool(periodic), joint_stiffness=kj,
-                                   coulomb=coulomb)  # fmt: skip
+        return equation_error_mdof(
+            t,
+            u,
+            y,
+            pattern,
+            excitation,
+            input_dof or 0,
+            jdofs,
+            mass_m,
+            periodic=bool(periodic),
+            joint_stiffness=kj,
+            coulomb=coulomb,
+        )
 
     xd, _ = column_derivatives(t, y, bool(periodic))
     d_rms = max(float(np.std(y @ b)), 1e-300)
@@ -368,31 +389,9 @@ def identify_mdof(
     # from the measured start when the state is estimated, else the record starts from rest
     x0s, v0s = (y[0], xd[0]) if estimate_initial_state else (np.zeros(n), np.zeros(n))
 
-    def residual_on(nn: int, sub: int, u_in: np.ndarray | None = None) -> Any:
-        tt, uu, yy = t[:nn], (u[:nn] if u_in is None else u_in), y[:nn]
-        interp = interpolation if nn == nt else "linear"
-        fail = 10 * float(np.max(np.abs(yy))) + 1.0
-        if excitation == "force":
-            f = np.zeros((nn, n))
-            f[:, input_dof] = uu
-            kw: dict[str, Any] = {"force": f}
-        else:
-            kw = {"base": uu}
-
-        def res(v: dict[str, float]) -> np.ndarray:
-            try:
-                s = build_mdof(pattern, joint, v, jdofs, mass_m)
-                r = s.simulate(tt, x0=[v[f"x0_{i}"] for i in range(n)],
-                               v0=[v[f"v0_{i}"] for i in range(n)], substeps=sub,
-                               interpolation=interp, **kw)  # fmt: skip
-            except ContactLabError:
-                return np.full(nn * n, 100 * fail)
-            x = np.asarray(r.x).reshape(-1, n)
-            if x.shape[0] < nn:
-                x = np.concatenate([x, np.full((nn - x.shape[0], n), fail)])
-            return (x - yy).reshape(-1)
-
-        return res
+    residual_on = _MdofResidual(
+        t, u, y, interpolation, excitation, input_dof, pattern, joint, jdofs, mass_m
+    )
 
     starts = _mdof_starts(joint)
     records: list[dict[str, Any]] = []
@@ -406,8 +405,9 @@ def identify_mdof(
         n_s = min(int(start_samples), nt)
         tried = [(st, params(st)) for st in starts]
         best_ps = best_start(tried, residual_on(n_s, 2), records) or best_ps
-    fit = least_squares_fit(residual_on(nt, substeps), best_ps, max_nfev=max_nfev, ftol=1e-7,
-                            xtol=1e-7, gtol=1e-10)  # fmt: skip
+    fit = least_squares_fit(
+        residual_on(nt, substeps), best_ps, max_nfev=max_nfev, ftol=1e-7, xtol=1e-7, gtol=1e-10
+    )
     # residuals correlated in time and across DOFs (input noise reaches every DOF)
     v = fit.values
     r_fit = residual_on(nt, substeps)(v)
@@ -432,6 +432,64 @@ def identify_mdof(
     }
 
 
+class _MdofResidual:
+    """The output-error residual of a multi-DOF model on the first ``nn`` samples: every
+    DOF's simulated minus measured displacement, flattened (a large constant where the
+    simulation fails or stops early); ``u_in`` replaces the input (the noise model)."""
+
+    def __init__(
+        self,
+        t: np.ndarray,
+        u: np.ndarray,
+        y: np.ndarray,
+        interpolation: str,
+        excitation: str,
+        input_dof: int | None,
+        pattern: Any,
+        joint: str,
+        jdofs: tuple[int, int | None],
+        mass_m: np.ndarray | None,
+    ) -> None:
+        self.t, self.u, self.y = t, u, y
+        self.interpolation, self.excitation, self.input_dof = interpolation, excitation, input_dof
+        self.pattern, self.joint, self.jdofs, self.mass_m = pattern, joint, jdofs, mass_m
+
+    def __call__(self, nn: int, sub: int, u_in: np.ndarray | None = None) -> Any:
+        t, u, y = self.t, self.u, self.y
+        nt, n = y.shape
+        interpolation, excitation, input_dof = self.interpolation, self.excitation, self.input_dof
+        pattern, joint, jdofs, mass_m = self.pattern, self.joint, self.jdofs, self.mass_m
+        tt, uu, yy = t[:nn], (u[:nn] if u_in is None else u_in), y[:nn]
+        interp = interpolation if nn == nt else "linear"
+        fail = 10 * float(np.max(np.abs(yy))) + 1.0
+        if excitation == "force":
+            f = np.zeros((nn, n))
+            f[:, input_dof] = uu
+            kw: dict[str, Any] = {"force": f}
+        else:
+            kw = {"base": uu}
+
+        def res(v: dict[str, float]) -> np.ndarray:
+            try:
+                s = build_mdof(pattern, joint, v, jdofs, mass_m)
+                r = s.simulate(
+                    tt,
+                    x0=[v[f"x0_{i}"] for i in range(n)],
+                    v0=[v[f"v0_{i}"] for i in range(n)],
+                    substeps=sub,
+                    interpolation=interp,
+                    **kw,
+                )
+            except ContactLabError:
+                return np.full(nn * n, 100 * fail)
+            x = np.asarray(r.x).reshape(-1, n)
+            if x.shape[0] < nn:
+                x = np.concatenate([x, np.full((nn - x.shape[0], n), fail)])
+            return (x - yy).reshape(-1)
+
+        return res
+
+
 def _checked_mdof_record(t: Any, u: Any, y: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Several DOFs' record as checked arrays: ``y`` (samples × DOFs) finite, same lengths,
     enough samples, physical magnitudes, increasing time."""
@@ -453,8 +511,9 @@ def _checked_mdof_record(t: Any, u: Any, y: Any) -> tuple[np.ndarray, np.ndarray
         raise InputError(f"{nt} samples are too few to identify a structure")
     big = float(np.max(np.abs(u)))
     if big > MAX_MAGNITUDE:
-        raise InputError(f"u reaches {big:.3g}: beyond any physical input; a unit mix-up or a "
-                         "corrupt file?")  # fmt: skip
+        raise InputError(
+            f"u reaches {big:.3g}: beyond any physical input; a unit mix-up or a corrupt file?"
+        )
     for j in range(n):  # each DOF's displacement: in range, not zero, not constant
         check_channel(f"y[:, {j}]", y[:, j], "m", f"displacement (DOF {j})")
     if np.any(np.diff(t) <= 0):

@@ -14,8 +14,10 @@ ground, which stays fixed under base excitation) and adds its force ``F(d)`` to 
 - ``kelvin_voigt``: ``F = k d + c ḋ``.
 - ``normal``: nonlinear contact stiffness ``F = k_s(d) d``, ``k_s(d) = a1 + a2 d + a3 d² + …``
   (Konowalski's eq. 6, the same polynomial law as :class:`contactlab.normal.NonlinearContact`).
-- ``law``: any rate-independent law of :mod:`contactlab.joints` (Segalman, Dahl, Maxwell-slip,
+- ``law``: any law of :mod:`contactlab.joints` (Segalman, Dahl, LuGre, Maxwell-slip, GMS,
   a backlash, laws in series or parallel, …), ``add_joint("law", dof, law=Segalman(...))``;
+  a rate-dependent law sees the velocity at the end of each integrator step as its velocity
+  over the step;
   stored as the flat float encoding :func:`encode_law` of its spec (array ``spec``).
 """
 
@@ -115,8 +117,14 @@ class Joint:
         j = -1 if self.dof2 is None else self.dof2
         if self.kind == "masing":
             if "x_points" in a:
-                return ("masing_tabulated", self.dof, j, np.array([p["scale"]]), a["x_points"],
-                        a["f_points"])  # fmt: skip
+                return (
+                    "masing_tabulated",
+                    self.dof,
+                    j,
+                    np.array([p["scale"]]),
+                    a["x_points"],
+                    a["f_points"],
+                )
             return ("masing", self.dof, j, np.array([p["h0"], p["ac"], p["scale"]]), empty, empty)
         if self.kind == "iwan":
             return ("iwan", self.dof, j, empty, a["k"], a["fs"])
@@ -238,8 +246,13 @@ def make_joint(kind: str, dof: int, dof2: int | None = None, **kw: Any) -> Joint
         )
     if kw:
         raise InputError(f"joint {kind!r} does not take parameter(s) {', '.join(sorted(kw))}")
-    return Joint(kind=kind, dof=int(dof), dof2=None if dof2 is None else int(dof2),
-                 params=params, arrays=arrays)  # fmt: skip
+    return Joint(
+        kind=kind,
+        dof=int(dof),
+        dof2=None if dof2 is None else int(dof2),
+        params=params,
+        arrays=arrays,
+    )
 
 
 def iwan_uniform(k_total: float, f_total: float, n: int = 20) -> dict[str, np.ndarray]:
@@ -271,9 +284,20 @@ def iwan_uniform(k_total: float, f_total: float, n: int = 20) -> dict[str, np.nd
 #: Kind codes of the flat encoding of a joint-law spec (the Rust core's
 #: ``contactlab_core::joints::AnyLaw::from_flat`` reads the same table).
 LAW_CODES: tuple[str, ...] = (
-    "jenkins", "iwan", "segalman", "masing", "maxwell_slip", "gms", "dahl", "lugre",
-    "bouc_wen", "kelvin_voigt", "parallel", "series", "backlash",
-)  # fmt: skip
+    "jenkins",
+    "iwan",
+    "segalman",
+    "masing",
+    "maxwell_slip",
+    "gms",
+    "dahl",
+    "lugre",
+    "bouc_wen",
+    "kelvin_voigt",
+    "parallel",
+    "series",
+    "backlash",
+)
 
 
 def encode_law(law: Any) -> np.ndarray:
@@ -334,9 +358,4 @@ def _law_array(kw: dict[str, Any]) -> np.ndarray:
         law = decode_law(_array("spec", kw.pop("spec")))
     else:
         raise InputError("joint 'law' needs law=<a contactlab.joints law>")
-    if law.rate_dependent:
-        raise InputError(
-            f"joint 'law': {law.name} is rate-dependent; structure joints take rate-independent "
-            "laws (Kelvin-Voigt for viscous terms)"
-        )
     return encode_law(law)

@@ -84,6 +84,12 @@ class SimulationResult:
     n_iter: int = 0
     extra: dict[str, Any] = field(default_factory=dict)
 
+    @property
+    def response(self) -> np.ndarray:
+        """``x``: the main output, as :class:`contactlab.simulation.SimulatedResponse` names
+        it."""
+        return self.x
+
     def kinetic_energy(self, M: np.ndarray) -> np.ndarray:
         v = self.v.reshape(len(self.t), -1)
         return 0.5 * np.einsum("ti,ij,tj->t", v, M, v)
@@ -300,10 +306,19 @@ class Structure:
                 t, substeps, interpolation, force, base, base_velocity
             )
             r = self.simulate(
-                tf, force, base, x0a, v0a, periodic=periodic, base_velocity=base_velocity,
-                influence=influence, max_periods=max_periods, periodic_tol=periodic_tol,
-                rtol=rtol, outputs=outputs,
-            )  # fmt: skip
+                tf,
+                force,
+                base,
+                x0a,
+                v0a,
+                periodic=periodic,
+                base_velocity=base_velocity,
+                influence=influence,
+                max_periods=max_periods,
+                periodic_tol=periodic_tol,
+                rtol=rtol,
+                outputs=outputs,
+            )
             return _slice(r, slice(None, None, substeps), t[: (r.t.size - 1) // substeps + 1])
         kw = self._inputs(t, force, base, base_velocity, influence)
         if not periodic:
@@ -383,8 +398,10 @@ class Structure:
         last: SimulationResult | None = None
         while True:
             tt = t[0] + dt * np.arange(nt * periods)
-            kk = {k: (np.tile(v, periods) if k in ("force", "base", "base_velocity") else v)
-                  for k, v in kw.items()}  # fmt: skip
+            kk = {
+                k: (np.tile(v, periods) if k in ("force", "base", "base_velocity") else v)
+                for k, v in kw.items()
+            }
             r = self._run(tt, kk, x0, v0, rtol, outputs)
             if not r.success or r.t.size < nt * periods:
                 return r
@@ -472,8 +489,9 @@ def load_json(path: str | Path, what: str) -> Any:
     try:
         return json.loads(text)
     except ValueError as exc:
-        raise InputError(f"{path}: not JSON (line {getattr(exc, 'lineno', '?')}): expected a "
-                         f"{what}") from None  # fmt: skip
+        raise InputError(
+            f"{path}: not JSON (line {getattr(exc, 'lineno', '?')}): expected a {what}"
+        ) from None
 
 
 _OUTPUTS = {

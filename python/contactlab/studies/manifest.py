@@ -329,5 +329,12 @@ def _recording_path(mpath: Path, fname: str, where: str) -> Path:
     return fpath
 
 
-__all__ = ["TAG_UNITS", "StudyEntry", "entry_from_file", "read_manifest", "si_unit",
-           "tags_from_filename", "unit_factor"]  # fmt: skip
+__all__ = [
+    "TAG_UNITS",
+    "StudyEntry",
+    "entry_from_file",
+    "read_manifest",
+    "si_unit",
+    "tags_from_filename",
+    "unit_factor",
+]

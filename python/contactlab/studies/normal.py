@@ -84,8 +84,18 @@ def analyze_normal_recording(
         if not issubclass(w.category, ContactLabWarning):
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     d["warnings"] = " | ".join(msgs)
-    added = ("b1", "b2", "b3", "b4", "b1_paper", "b2_paper", "b3_paper", "b4_paper",
-             "k_s_p_rms", "E_d_stderr")  # fmt: skip
+    added = (
+        "b1",
+        "b2",
+        "b3",
+        "b4",
+        "b1_paper",
+        "b2_paper",
+        "b3_paper",
+        "b4_paper",
+        "k_s_p_rms",
+        "E_d_stderr",
+    )
     extra = {k: d[k] for k in added if k in d}
     extra["warnings"] = msgs
     return result, d, extra

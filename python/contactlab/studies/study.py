@@ -70,7 +70,7 @@ def coefficient_unit(unit: str, i: int) -> str:
     return m.group(1) if n == 0 else f"{m.group(1)}/{var}" if n == 1 else f"{m.group(1)}/{var}^{n}"
 
 
-def _flatten(d: Mapping[str, Any], units: Mapping[str, str]) -> tuple[dict, dict]:
+def flatten(d: Mapping[str, Any], units: Mapping[str, str]) -> tuple[dict, dict]:
     """Scalars as they are, short vectors as ``key_0, key_1, ...``; nested dicts dotted."""
     row: dict[str, Any] = {}
     out_units: dict[str, str] = {}
@@ -79,7 +79,7 @@ def _flatten(d: Mapping[str, Any], units: Mapping[str, str]) -> tuple[dict, dict
             continue
         unit = units.get(key, "")
         if isinstance(value, Mapping):
-            sub, sub_units = _flatten(value, value.get("units", {}) or {})
+            sub, sub_units = flatten(value, value.get("units", {}) or {})
             for k, v in sub.items():
                 row[f"{key}.{k}"] = v
                 if sub_units.get(k):
@@ -159,11 +159,14 @@ def analyze_entry(
         from ..tangential import read_frame
 
         if entry.kind != "tangential":
-            raise InputError(f"{entry.path}: a friction frame gives a tangential recording "
-                             f"(x, F), not a {entry.kind} one")  # fmt: skip
+            raise InputError(
+                f"{entry.path}: a friction frame gives a tangential recording "
+                f"(x, F), not a {entry.kind} one"
+            )
         f = entry.frame
-        frame = read_frame(entry.path, f["M"], f["C"], f["K"], x=f.get("x"), y=f.get("y"),
-                           fs=entry.fs)  # fmt: skip
+        frame = read_frame(
+            entry.path, f["M"], f["C"], f["K"], x=f.get("x"), y=f.get("y"), fs=entry.fs
+        )
         rec = frame.recording(str(entry.path))
         rec.meta.update(columns=frame.columns, file_units=frame.file_units)
         cols, funits = frame.columns or {}, frame.file_units or {}
@@ -171,8 +174,9 @@ def analyze_entry(
         if assumed_frame:
             rec.meta["units_assumed_si"] = assumed_frame
     else:
-        rec = read_recording(entry.path, columns=entry.columns, kind=entry.kind, fs=entry.fs,
-                             resample=entry.resample)  # fmt: skip
+        rec = read_recording(
+            entry.path, columns=entry.columns, kind=entry.kind, fs=entry.fs, resample=entry.resample
+        )
     from ..io.checks import check_recording_glitches
 
     check_recording_glitches(rec)  # a sensor glitch is refused, as diagnose refuses it
@@ -192,7 +196,7 @@ def analyze_entry(
         opts = {"warn": False, **dict(tangential_options or {})}  # warnings go in the table
         analysis = analyze_tangential(rec, **opts)
         d = tangential_row(analysis.to_dict())
-        row, u = _flatten(d, d.get("units", {}) or {})
+        row, u = flatten(d, d.get("units", {}) or {})
         extra: dict[str, Any] = {}
         if "N" in rec.data:  # a recorded normal force: μ = F/N on the sliding plateau
             from ..tangential.friction import sliding_friction
@@ -211,7 +215,7 @@ def analyze_entry(
         from .normal import analyze_normal_recording
 
         analysis, d, extra = analyze_normal_recording(rec, entry, **dict(normal_options or {}))
-        row, u = _flatten(d, d.get("units", {}) or {})
+        row, u = flatten(d, d.get("units", {}) or {})
     units.update(u)
     base.update(row)
     resampled = (rec.meta or {}).get("resampled")
@@ -322,8 +326,10 @@ class StudyResult:
 
     def __repr__(self) -> str:
         n = {k: len(self.table(k)) for k in KINDS}
-        return (f"StudyResult({n['tangential']} tangential, {n['normal']} normal, "
-                f"{len(self.failures)} failed)")  # fmt: skip
+        return (
+            f"StudyResult({n['tangential']} tangential, {n['normal']} normal, "
+            f"{len(self.failures)} failed)"
+        )
 
     def table_files(self, stem: str = "study") -> dict[str, bytes]:
         """``<stem>_<kind>.csv`` and ``.parquet`` for each kind present."""
@@ -488,5 +494,11 @@ def run_study(
     return StudyResult(results)
 
 
-__all__ = ["KINDS", "RecordingResult", "StudyResult", "analyze_entry", "collect_entries",
-           "run_study"]  # fmt: skip
+__all__ = [
+    "KINDS",
+    "RecordingResult",
+    "StudyResult",
+    "analyze_entry",
+    "collect_entries",
+    "run_study",
+]

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from .._json import dumps, jsonable
 from ..errors import InputError
 from ..io.units import UnknownUnitError, to_si
 from .columns import CYCLE_UNITS
@@ -328,3 +329,11 @@ class TrackResult:
             f"TrackResult({self.source!r}, {self.kind}, every={self.every!r}, "
             f"{len(self.rows)} windows, {self.cycles['energy'].size} cycles)"
         )
+
+
+def track_json(result: TrackResult, *, cycles: bool = True) -> str:
+    """The result as JSON text (NaN → null; each per-cycle array on one line)."""
+    doc = result.to_dict(cycles=False)
+    if cycles:  # the arrays as they are: jsonable converts numbers at numpy's speed
+        doc["cycles"] = dict(result.cycles)
+    return dumps(jsonable(doc), indent=1) + "\n"

@@ -15,7 +15,7 @@ keeps only the results:
 - normal windows: :func:`contactlab.normal.analyze_loop` — E_d (with its standard error from
   the cycle-to-cycle scatter), ψ (eq. 7), ψ_KV (eq. 3), k_tan (eq. 4), k_sec (eq. 5) and the
   loading, unloading and centre polynomials of eq. 1;
-- every cycle of the record (:mod:`._cycles`): loop energy ∮F dx, amplitude, offset.
+- every cycle of the record (:mod:`.cycles`): loop energy ∮F dx, amplitude, offset.
 
 Memory holds one chunk and one window, whatever the length of the record.
 :meth:`TrackResult.combined` pools the windows (weights by window size, the error widened by
@@ -37,13 +37,12 @@ from typing import Any
 
 import numpy as np
 
-from .._json import dumps, jsonable
 from .._options import as_dict
 from .._physical import MAX_MAGNITUDE
 from ..errors import ContactLabError, ContactLabWarning, InputError
 from ..io import Recording, read_chunks
-from ._cycles import CycleState, block_cycles, trigger_levels
 from .columns import CYCLE_UNITS
+from .cycles import CycleState, block_cycles, trigger_levels
 from .study import coefficient_unit
 from .track_cuts import WindowCuts
 from .track_result import (  # noqa: F401  (the constants and TrackResult, re-exported)
@@ -60,15 +59,27 @@ from .track_result import (  # noqa: F401  (the constants and TrackResult, re-ex
     _as_float,
     _finite,
     parse_every,
+    track_json,
 )
 
 #: options of ``analyze_tangential`` the one-pass window analysis
 #: (:func:`contactlab.tangential.window.analyze_window`) takes; others (``on="signal"``,
 #: ``history``) take the whole-window analysis
 _WINDOW_OPTIONS = frozenset(
-    ("force_sign", "n_points", "rel_threshold", "min_cycles", "max_rel_stderr", "fit_offset",
-     "fit_x0", "fit_amplitude", "detrend", "initial", "delay")
-)  # fmt: skip
+    (
+        "force_sign",
+        "n_points",
+        "rel_threshold",
+        "min_cycles",
+        "max_rel_stderr",
+        "fit_offset",
+        "fit_x0",
+        "fit_amplitude",
+        "detrend",
+        "initial",
+        "delay",
+    )
+)
 
 
 class _WindowSamples:
@@ -393,8 +404,9 @@ def _segments(
                 piece, part = c, got
             else:
                 meta = dict(c.meta, offset=off + a)
-                piece = Recording(c.t[a:b], {k: v[a:b] for k, v in c.data.items()},
-                                  c.units, c.source, meta)  # fmt: skip
+                piece = Recording(
+                    c.t[a:b], {k: v[a:b] for k, v in c.data.items()}, c.units, c.source, meta
+                )
                 part = {k: _core.finite_min_max(v)[1:] for k, v in piece.data.items()}
             ranges = {
                 k: (min(ranges[k][0], lo), max(ranges[k][1], hi)) if k in ranges else (lo, hi)
@@ -510,6 +522,18 @@ def track(
     True
     """
     options = as_dict(options)  # a contactlab.tangential/normal.Options or a dict
+    settings: dict[str, Any] = {
+        "kind": kind,
+        "columns": columns,
+        "fs": fs,
+        "chunk_size": chunk_size,
+        "max_window": max_window,
+        "options": options,
+        "keep_going": keep_going,
+        "callback": callback,
+        "keep_documents": keep_documents,
+        "resample": resample,
+    }
     if executor is None and threads != 0:
         from concurrent.futures import ThreadPoolExecutor
 
@@ -526,17 +550,9 @@ def track(
             # on 2 threads, interleaved runs 4.43-5.15 s against 4.45-5.96 s, peak 245-263
             # against 240-255 MB); one thread is three times slower than the reader and
             # always has a window waiting. An executor given by the caller gets two per worker
-            return _track(
-                source, every, kind=kind, columns=columns, fs=fs, chunk_size=chunk_size,
-                max_window=max_window, options=options, keep_going=keep_going,
-                callback=callback, executor=pool, keep_documents=keep_documents,
-                slots=n_threads + (2 if n_threads >= 2 else 1), resample=resample,
-            )  # fmt: skip
-    return _track(
-        source, every, kind=kind, columns=columns, fs=fs, chunk_size=chunk_size,
-        max_window=max_window, options=options, keep_going=keep_going, callback=callback,
-        executor=executor, keep_documents=keep_documents, slots=None, resample=resample,
-    )  # fmt: skip
+            slots = n_threads + (2 if n_threads >= 2 else 1)
+            return _track(source, every, **settings, executor=pool, slots=slots)
+    return _track(source, every, **settings, executor=executor, slots=None)
 
 
 def _track(
@@ -562,8 +578,9 @@ def _track(
     every_text = every if isinstance(every, str) else f"{every}cycles"
     if not (isinstance(max_window, int) and max_window >= 16):
         raise InputError(f"max_window must be an integer >= 16, got {max_window!r}")
-    cr = read_chunks(source, chunk_size=chunk_size, columns=columns, kind=kind, fs=fs,
-                     resample=resample)  # fmt: skip
+    cr = read_chunks(
+        source, chunk_size=chunk_size, columns=columns, kind=kind, fs=fs, resample=resample
+    )
     noted: dict[str, Any] = {}
     kind_ = cr.kind
     if kind_ not in ("tangential", "normal"):
@@ -594,9 +611,15 @@ def _track(
             n_total = off + len(block)
             levels = trigger_levels(*ranges[drive]) if ranges and len(block) else None
             got = block_cycles(
-                block.t, block[loop_x], block[loop_F], block[drive], off, state, levels,
+                block.t,
+                block[loop_x],
+                block[loop_F],
+                block[drive],
+                off,
+                state,
+                levels,
                 cr.time_step,
-            )  # fmt: skip
+            )
             for k in cyc:
                 cyc[k].append(np.asarray(getattr(got, k), dtype=float))
             cuts.block(float(block.t[0]), got.crossings)
@@ -754,14 +777,6 @@ def track_many(
     parse_every(every)  # a bad window length fails before anything is submitted
     task = functools.partial(track, every=every, **options)
     yield from ordered_map(task, list(sources), executor)
-
-
-def track_json(result: TrackResult, *, cycles: bool = True) -> str:
-    """The result as JSON text (NaN → null; each per-cycle array on one line)."""
-    doc = result.to_dict(cycles=False)
-    if cycles:  # the arrays as they are: jsonable converts numbers at numpy's speed
-        doc["cycles"] = dict(result.cycles)
-    return dumps(jsonable(doc), indent=1) + "\n"
 
 
 __all__ = [

@@ -71,13 +71,46 @@ class MaterialPair:
 
 
 MATERIALS = (
-    MaterialPair("Al-Al", "Al/Al", 0.42, 6.0e4, 100.0, (50.0, 109.0, 150.0),
-                 (5e-6, 10e-6, 20e-6), ("csv",), 10e-9, 0.05, 200.0),
-    MaterialPair("PVC-steel", "PVC/steel", 0.30, 2.5e4, 60.0, (30.0, 60.0, 90.0),
-                 (10e-6, 20e-6, 40e-6), ("tdms",), 10e-9, 0.03, 100.0),
-    MaterialPair("steel-steel", "steel/steel", 0.18, 5.0e4, 75.0, (75.0, 150.0, 225.0),
-                 (0.25e-6, 0.5e-6, 1.0e-6), ("h5", "mat"), 5e-9, 0.02, 50.0),
-)  # fmt: skip
+    MaterialPair(
+        "Al-Al",
+        "Al/Al",
+        0.42,
+        6.0e4,
+        100.0,
+        (50.0, 109.0, 150.0),
+        (5e-6, 10e-6, 20e-6),
+        ("csv",),
+        10e-9,
+        0.05,
+        200.0,
+    ),
+    MaterialPair(
+        "PVC-steel",
+        "PVC/steel",
+        0.30,
+        2.5e4,
+        60.0,
+        (30.0, 60.0, 90.0),
+        (10e-6, 20e-6, 40e-6),
+        ("tdms",),
+        10e-9,
+        0.03,
+        100.0,
+    ),
+    MaterialPair(
+        "steel-steel",
+        "steel/steel",
+        0.18,
+        5.0e4,
+        75.0,
+        (75.0, 150.0, 225.0),
+        (0.25e-6, 0.5e-6, 1.0e-6),
+        ("h5", "mat"),
+        5e-9,
+        0.02,
+        50.0,
+    ),
+)
 
 NORMAL_P0 = (0.5e6, 1.0e6, 1.5e6, 2.0e6, 2.5e6)  # Pa
 NORMAL_PA = 0.4e6  # Pa
@@ -158,9 +191,11 @@ def write_normal(path: Path, t: np.ndarray, p: np.ndarray, delta: np.ndarray) ->
     from ..io import Recording, write_recording
 
     rec = Recording(
-        t, {"p": p * 1e-6, "delta": delta * 1e6}, {"p": "MPa", "delta": "um"},
+        t,
+        {"p": p * 1e-6, "delta": delta * 1e6},
+        {"p": "MPa", "delta": "um"},
         source="contactlab.data.generate",
-    )  # fmt: skip
+    )
     return write_recording(path, rec)
 
 
@@ -184,9 +219,17 @@ def normal_signal(p0: float, rng: np.random.Generator) -> tuple[np.ndarray, ...]
 
 
 MANIFEST_HEADER = [
-    "file", "kind", "material", "normal_load [N]", "amplitude [um]", "frequency [Hz]",
-    "p0 [MPa]", "pa [MPa]", "true_h0 [N]", "true_ac [1/m]",
-]  # fmt: skip
+    "file",
+    "kind",
+    "material",
+    "normal_load [N]",
+    "amplitude [um]",
+    "frequency [Hz]",
+    "p0 [MPa]",
+    "pa [MPa]",
+    "true_h0 [N]",
+    "true_ac [1/m]",
+]
 
 
 def generate(out: Path, *, normal: bool = True) -> list[Path]:
@@ -203,8 +246,20 @@ def generate(out: Path, *, normal: bool = True) -> list[Path]:
                 name = f"tangential/{pair.key}_W{load:g}N_A{amp * 1e6:g}um.{ext}"
                 t, x, f = tangential_signal(h0, ac, amp, rng, pair)
                 written.append(write_tangential(out / name, t, x, f))
-                rows.append([name, "tangential", pair.material, f"{load:g}", f"{amp * 1e6:g}",
-                             f"{FREQUENCY:g}", "", "", f"{h0:.6g}", f"{ac:.6g}"])  # fmt: skip
+                rows.append(
+                    [
+                        name,
+                        "tangential",
+                        pair.material,
+                        f"{load:g}",
+                        f"{amp * 1e6:g}",
+                        f"{FREQUENCY:g}",
+                        "",
+                        "",
+                        f"{h0:.6g}",
+                        f"{ac:.6g}",
+                    ]
+                )
     if normal:
         for i, p0 in enumerate(NORMAL_P0):
             rng = np.random.default_rng(root.spawn(1)[0])
@@ -213,8 +268,20 @@ def generate(out: Path, *, normal: bool = True) -> list[Path]:
             t, p, delta = normal_signal(p0, rng)
             written.append(write_normal(out / name, t, p, delta))
             freq = NORMAL_OMEGA / (2.0 * np.pi)
-            rows.append([name, "normal", "C45/C45", "", "", f"{freq:.12g}",
-                         f"{p0 * 1e-6:g}", f"{NORMAL_PA * 1e-6:g}", "", ""])  # fmt: skip
+            rows.append(
+                [
+                    name,
+                    "normal",
+                    "C45/C45",
+                    "",
+                    "",
+                    f"{freq:.12g}",
+                    f"{p0 * 1e-6:g}",
+                    f"{NORMAL_PA * 1e-6:g}",
+                    "",
+                    "",
+                ]
+            )
     buf = io.StringIO()
     buf.write("# Example study made by contactlab.data.generate (seeded; see its docstring).\n")
     buf.write("# true_h0, true_ac: the parameters the tangential recordings were made with.\n")
@@ -229,8 +296,9 @@ def generate(out: Path, *, normal: bool = True) -> list[Path]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m contactlab.data.generate", description=__doc__)
-    ap.add_argument("--out", default=str(DATA_DIR),
-                    help="output folder (default: the package's data folder)")  # fmt: skip
+    ap.add_argument(
+        "--out", default=str(DATA_DIR), help="output folder (default: the package's data folder)"
+    )
     ap.add_argument("--no-normal", action="store_true", help="tangential recordings only")
     args = ap.parse_args(argv)
     paths = generate(Path(args.out), normal=not args.no_normal)

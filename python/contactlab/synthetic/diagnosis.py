@@ -237,23 +237,41 @@ def hidden_effect_recording(
     >>> sorted(rec.data), rec.truth["effects"]["channel_delay"]["tau"] > 0
     (['F', 'x'], True)
     """
-    if model == "normal":
-        return hidden_effect_recording_normal(
-            effects,
-            magnitude=magnitude,
-            noise=noise,
-            seed=seed,
-            cycles_per_block=cycles_per_block,
-            samples_per_cycle=samples_per_cycle,
-            input_noise=input_noise,
-            anti_alias=anti_alias,
-            bits=bits,
-            start=start,
-            frequencies=frequencies,
-            **base,
-        )
-    if model != "tangential":
+    if model not in ("tangential", "normal"):
         raise InputError(f"model must be 'tangential' or 'normal', got {model!r}")
+    generate = hidden_effect_recording_normal if model == "normal" else _tangential_recording
+    return generate(
+        effects,
+        magnitude=magnitude,
+        noise=noise,
+        seed=seed,
+        cycles_per_block=cycles_per_block,
+        samples_per_cycle=samples_per_cycle,
+        input_noise=input_noise,
+        anti_alias=anti_alias,
+        bits=bits,
+        start=start,
+        frequencies=frequencies,
+        **base,
+    )
+
+
+def _tangential_recording(
+    effects: Iterable[str] | Mapping[str, float],
+    *,
+    magnitude: float,
+    noise: float,
+    seed: int,
+    cycles_per_block: int,
+    samples_per_cycle: int,
+    input_noise: float | None,
+    anti_alias: tuple[float, float] | None,
+    bits: int | None,
+    start: str,
+    frequencies: Sequence[float] | None,
+    **base: float,
+) -> HiddenEffectRecording:
+    """:func:`hidden_effect_recording` of a tangential joint (``model="tangential"``)."""
     sizes = effect_sizes(effects, magnitude, TANGENTIAL_EFFECTS)
     h0 = float(base.pop("h0", 50.0))
     ac = float(base.pop("ac", 5e4))
@@ -268,30 +286,7 @@ def hidden_effect_recording(
     t = np.arange(round(T * fs) + 1) / fs
     period = 1.0 / fmax
     keep = start_index(start, t, f0, 0.6 * f0)
-    _x0, F0 = _tangential_force({}, t, xfun, h0, ac, period)
-    Fr = rms(F0)
-
-    def size(name: str, value: float) -> float:
-        x1, F1 = _tangential_force({name: value}, t, xfun, h0, ac, period, float(t[keep]))
-        # measured output change, on the measured displacement (what a base fit would see)
-        F_on_x1 = Masing(h0, ac).force(x1)
-        return rms(F1 - F_on_x1) / Fr
-
-    params: dict[str, float] = {}
-    for name, target in sizes.items():
-        sign = 1.0
-        if name in (
-            "force_offset",
-            "force_drift",
-            "displacement_offset",
-            "asymmetry",
-            "parameter_drift",
-            "non_masing_scaling",
-            "position_friction",
-            "normal_load",
-        ):
-            sign = 1.0 if rng.random() < 0.5 else -1.0
-        params[name] = _solve_size(name, target, sign, size, h0, ac, Fr, period)
+    params = _effect_parameters(sizes, rng, t, xfun, h0, ac, period, keep)
     x, F = _tangential_force(params, t, xfun, h0, ac, period, float(t[keep]))
     t, x, F = t[keep:] - t[keep], x[keep:], F[keep:]
     x_noise = (
@@ -326,6 +321,49 @@ def hidden_effect_recording(
         truth=truth,
         model="tangential",
     )
+
+
+#: Effects that may have either sign: the sign is drawn (one draw each, in this order).
+_EITHER_SIGN = (
+    "force_offset",
+    "force_drift",
+    "displacement_offset",
+    "asymmetry",
+    "parameter_drift",
+    "non_masing_scaling",
+    "position_friction",
+    "normal_load",
+)
+
+
+def _effect_parameters(
+    sizes: Mapping[str, float],
+    rng: np.random.Generator,
+    t: np.ndarray,
+    xfun: Callable[[np.ndarray], np.ndarray],
+    h0: float,
+    ac: float,
+    period: float,
+    keep: int,
+) -> dict[str, float]:
+    """The physical parameter of each effect whose output change has its requested relative
+    RMS (signs drawn from ``rng`` where the effect may have either)."""
+    _x0, F0 = _tangential_force({}, t, xfun, h0, ac, period)
+    Fr = rms(F0)
+
+    def size(name: str, value: float) -> float:
+        x1, F1 = _tangential_force({name: value}, t, xfun, h0, ac, period, float(t[keep]))
+        # measured output change, on the measured displacement (what a base fit would see)
+        F_on_x1 = Masing(h0, ac).force(x1)
+        return rms(F1 - F_on_x1) / Fr
+
+    params: dict[str, float] = {}
+    for name, target in sizes.items():
+        sign = 1.0
+        if name in _EITHER_SIGN:
+            sign = 1.0 if rng.random() < 0.5 else -1.0
+        params[name] = _solve_size(name, target, sign, size, h0, ac, Fr, period)
+    return params
 
 
 def _fixed(name: str, ac: float, period: float) -> dict[str, float]:

@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -55,14 +55,20 @@ from .._physical import check_channel
 from ..errors import ContactLabWarning, InputError
 from ..fitting import FitResult
 from ..io import Recording
-from ..masing import loop_area
 from . import lag, steps
 from .orientation import Orientation, orient
 from .preprocess import AveragedLoop
+from .quantities import (
+    _refuse_no_loop,
+    derived_quantities,
+    identifiability,
+    loop_area_ratio,
+    misfit_ratio,
+)
 from .regime import GROSS_SLIDING_Z as REGIME_GROSS_Z
 from .regime import PRE_SLIDING_Z, Regime, classify, z_from_area_ratio
 from .result import TangentialAnalysis
-from .uncertainty import correl, numeric_energy, reparametrize
+from .uncertainty import reparametrize
 
 #: ``ac·A`` above which the loop is taken to have reached gross sliding (branch slope at the
 #: turn below e^-3 = 5 % of the initial stiffness: the force has plateaued near ±h0)
@@ -116,153 +122,6 @@ def _check_options(on: str, history: str, n_points: int | None) -> None:
         raise InputError("history='virgin' applies to on='signal'; an averaged loop is steady")
     if n_points is not None and (n_points < 8 or n_points % 2):
         raise InputError(f"n_points must be even and >= 8, got {n_points}")
-
-
-def _percent(rel: float) -> str:
-    """A relative standard error as a percentage for a message: beyond 1000 % the figure
-    says nothing more than that the parameter is not determined ("1175301844650%" read as
-    noise), so it is given as such."""
-    if not math.isfinite(rel) or rel >= 10.0:
-        return "over 1000% (undetermined)"
-    return f"{100 * rel:.0f}%"
-
-
-def identifiability(
-    fit: FitResult, raw: FitResult, amplitude: float, max_rel_stderr: float
-) -> tuple[bool, dict[str, Any]]:
-    """Are ``h0`` and ``ac`` separately determined? Marks the parameters of ``fit`` that are
-    not and returns ``(identifiable, evidence)``."""
-    ph0, pac = fit.params["h0"], fit.params["ac"]
-    rel_h0 = ph0.rel_stderr if ph0.stderr is not None else math.inf
-    rel_ac = pac.rel_stderr if pac.stderr is not None else math.inf
-    k0 = raw.params["k0"]
-    rel_k0 = k0.rel_stderr if k0.stderr is not None else math.inf
-    corr = correl(fit, "h0", "ac")
-    z = pac.value * amplitude
-    at_bound = pac.value <= raw.params["ac"].min * 1.0001
-    identifiable = bool(rel_h0 < max_rel_stderr and rel_ac < max_rel_stderr and not at_bound)
-    ac_up = pac.value + 2 * pac.stderr if pac.stderr is not None else math.inf
-    h0_lo = k0.value / ac_up if math.isfinite(ac_up) and ac_up > 0 else 0.0
-    if identifiable:
-        msg = (
-            f"h0 and ac are identified (relative errors {100 * rel_h0:.1f}% and "
-            f"{100 * rel_ac:.1f}%, correlation {corr:+.3f}, ac·A = {z:.3g})"
-        )
-    else:
-        msg = (
-            f"h0 and ac are NOT separately identifiable from this loop: ac·A = {z:.3g} "
-            f"(the loop is {'nearly linear, a pure stiffness' if z < 0.5 else 'too noisy'}); "
-            f"relative errors h0 {_percent(rel_h0)}, ac {_percent(rel_ac)}, correlation "
-            f"{corr:+.3f}. Identified: h0·ac = {k0.value:.6g} ± {k0.stderr or math.nan:.3g} N/m"
-            f" ({100 * rel_k0:.2f}%); ac < {ac_up:.3g} 1/m and h0 > {h0_lo:.3g} N (2σ)."
-        )
-        if not rel_k0 < max_rel_stderr:
-            msg += (
-                " Not even h0·ac is determined: the force hardly follows the displacement "
-                "(a noise-only or disconnected force channel?)."
-            )
-        for p in (ph0, pac):
-            p.identifiable = False
-            p.note = "not separately identifiable: only h0·ac is (see identifiability)"
-    evidence = {
-        "h0": identifiable,
-        "ac": identifiable,
-        "h0_ac": bool(rel_k0 < max_rel_stderr),
-        "rel_stderr_h0": float(rel_h0),
-        "rel_stderr_ac": float(rel_ac),
-        "rel_stderr_h0_ac": float(rel_k0),
-        "correlation_h0_ac": float(corr),
-        "ac_times_amplitude": float(z),
-        "condition": float(raw.condition),
-        "max_rel_stderr": float(max_rel_stderr),
-        "message": msg,
-        "h0_lower_bound": float(h0_lo),
-        "ac_upper_bound": float(ac_up),
-    }
-    return identifiable, evidence
-
-
-def _refuse_no_loop(evidence: dict[str, Any], energy: tuple[float, float]) -> None:
-    """Refuse a recording without a loop: neither the loop's initial stiffness h0·ac is
-    determined nor its area (the energy per cycle from the samples) distinguishable from
-    zero at 3 standard errors. Pure noise, a disconnected force channel or unrelated
-    channels would otherwise give a result of undetermined numbers ("± nan", "ac < inf")."""
-    if evidence["h0_ac"]:
-        return
-    e, e_err = energy
-    if math.isfinite(e_err) and e_err > 0 and abs(e) > 3 * e_err:
-        return
-    area = f"{e:.3g} ± {e_err:.2g} J" if math.isfinite(e_err) else f"{e:.3g} J"
-    raise InputError(
-        "no friction loop in this recording: the force does not follow the displacement "
-        f"(the loop's initial stiffness h0·ac is undetermined, relative error "
-        f"{_percent(evidence['rel_stderr_h0_ac'])}, and the loop area {area} per cycle is "
-        "not distinguishable from zero): a noise-only or disconnected force channel, or "
-        "unrelated channels?"
-    )
-
-
-#: the model's quantities at the amplitude (:func:`_model_quantities`), in its order
-_MODEL_QUANTITIES = (
-    "energy_per_cycle",
-    "equivalent_damping",
-    "k_local_amplitude",
-    "k_global",
-    "peak_force",
-)
-
-
-def _model_quantities(v: dict[str, float], A: float) -> np.ndarray:
-    """Energy per cycle, c_e·ω = E / (π A²) (eq. 17), local stiffness at the amplitude
-    (eq. 18), global stiffness (eq. 19) and peak force of the model ``v`` at amplitude ``A``:
-    one model for the five (their errors from one set of perturbed parameter values)."""
-    m = steps.model_of(v)
-    e = float(m.loop_energy(A))
-    return np.array(
-        [
-            e,
-            e / (math.pi * A * A),
-            float(m.local_stiffness(A)),
-            float(m.global_stiffness(A)),
-            float(m.virgin(A)),
-        ]
-    )
-
-
-def derived_quantities(
-    raw: FitResult, amp: steps.Amplitude, det: steps.Detrended, start: int
-) -> dict[str, tuple[float, float]]:
-    """Energy per cycle (analytic and loop area), c_e·ω (eq. 17), stiffness (eqs. 18-19),
-    peak force and drifts, each ``(value, stderr)``."""
-
-    k0 = raw.params["k0"]
-    derived: dict[str, tuple[float, float]] = {}
-    derived["h0_ac"] = (float(k0.value), float(k0.stderr) if k0.stderr is not None else math.nan)
-    derived.update(steps.propagate_many(raw, amp, _MODEL_QUANTITIES, _model_quantities))
-    derived["k_local0"] = derived["h0_ac"]
-    loop, xa, Fa = det.loop, det.x, det.F
-    drift = det.force_drift
-    if loop is not None:
-        e_num, e_sem = numeric_energy(loop, xa, Fa)
-        if drift[1] > 0:
-            # a drift error δs opens every cycle's polygon by δs·T·A
-            period = float(np.mean(loop.scatter.period))
-            e_sem = math.hypot(e_sem, drift[1] * period * amp.value)
-    else:
-        e_num = loop_area(xa[start:], Fa[start:])
-        e_sem = math.nan
-    derived["energy_per_cycle_numeric"] = (float(e_num), e_sem)
-    a2 = math.pi * amp.value**2
-    derived["equivalent_damping_numeric"] = (float(e_num / a2), e_sem / a2)
-    derived["force_drift"] = drift
-    derived["displacement_drift"] = det.displacement_drift
-    return derived
-
-
-def loop_area_ratio(data: steps.FitData, amplitude: float, e_num: float) -> float:
-    """``E / (4 A h_m)``: 0 for a line, 1 for the Coulomb rectangle (h_m from the data)."""
-    hm = 0.5 * float(np.ptp(data.loop.F if data.loop is not None else data.F))
-    return e_num / (4 * amplitude * hm) if hm > 0 and amplitude > 0 else 0.0
 
 
 #: the fit's h0 gives way to the plateau's where they differ by more than this share (and 3
@@ -398,33 +257,6 @@ def collect_warnings(
     return warns
 
 
-def misfit_ratio(raw: FitResult, data: steps.FitData, weights: np.ndarray | None) -> float:
-    """RMS of an averaged fit's residuals over what the cycle-to-cycle noise explains (1 for
-    a model that fits to the noise; NaN when there is no spread to compare with).
-
-    A bin's mean force errs by its force noise and its mean displacement by the displacement
-    noise, which the model turns into a force error ``k σx`` (``k``: the branch's local
-    stiffness, ``h0·ac`` at the turns, :func:`steps.branch_slope`): the expected squared
-    residual of bin ``i`` is ``(σF,i² + k_i² σx,i²) / count_i`` (per-sample variances from
-    the cycle-to-cycle spread), weighted as the fit weights it. Force noise alone is not
-    enough: with a noisy displacement channel and a clean force the residuals were 2.0-3.0×
-    the force's spread, a warning about a model that fits."""
-    loop = data.loop
-    if loop is None or loop.n_cycles < 2:
-        return math.nan
-    vF, vx = steps.loop_noise(loop)
-    k = steps.branch_slope(raw.values, data.xpath)
-    expected = vF + k * k * np.nan_to_num(vx, nan=0.0)
-    ok = np.isfinite(expected)
-    if not ok.any():  # no bin with a spread (numpy would warn on an empty mean)
-        return math.nan
-    w2 = (weights[: loop.count.size] ** 2 if weights is not None else loop.count) / loop.count
-    noise = float(np.mean((w2 * expected)[ok]))
-    if not noise > 0:
-        return math.nan
-    return math.sqrt(raw.redchi / noise)
-
-
 @takes_options
 def analyze_tangential(
     recording: Recording | None = None,
@@ -516,16 +348,9 @@ def analyze_tangential(
     >>> res.identifiable, abs(res.fit.params["h0"].value - 20) < 3 * res.fit.params["h0"].stderr
     (True, True)
     """
-    xa, Fa, ta, source = _inputs(recording, t, x, F)
-    _check_options(on, history, n_points)
-    check_channel("x", xa, "m", "displacement")
-    check_channel("F", Fa, "N", "force")
-    if invert_force is not None:
-        force_sign = -1 if invert_force else 1
-    dropped = 0
-    if delay is not None:
-        ta, xa, Fa, dropped = lag.shift_force(ta, xa, Fa, delay)
-    ori = orient(xa, Fa, ta, force_sign=force_sign)
+    xa, Fa, ta, source, ori, dropped = _prepared(
+        recording, t, x, F, on, history, n_points, invert_force, force_sign, delay
+    )
     res = _analyze(
         xa,
         Fa,
@@ -549,10 +374,42 @@ def analyze_tangential(
     )
     assert res is not None  # only a streamed window hands its case back
     lag.record(res, delay, dropped)
-    if warn:
-        for wtxt in res.warnings:
-            warnings.warn(wtxt, ContactLabWarning, stacklevel=3)
+    _issue(res.warnings, warn)
     return res
+
+
+def _prepared(
+    recording: Recording | None,
+    t: Any,
+    x: Any,
+    F: Any,
+    on: str,
+    history: str,
+    n_points: int | None,
+    invert_force: bool | None,
+    force_sign: int | str,
+    delay: float | None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, str, Orientation, int]:
+    """:func:`analyze_tangential`'s inputs checked, the known delay corrected and the force
+    oriented: ``(x, F, t, source, orientation, samples dropped by the delay)``."""
+    xa, Fa, ta, source = _inputs(recording, t, x, F)
+    _check_options(on, history, n_points)
+    check_channel("x", xa, "m", "displacement")
+    check_channel("F", Fa, "N", "force")
+    if invert_force is not None:
+        force_sign = -1 if invert_force else 1
+    dropped = 0
+    if delay is not None:
+        ta, xa, Fa, dropped = lag.shift_force(ta, xa, Fa, delay)
+    return xa, Fa, ta, source, orient(xa, Fa, ta, force_sign=force_sign), dropped
+
+
+def _issue(texts: list[str], warn: bool) -> None:
+    """Each warning of the result as a :class:`ContactLabWarning` when ``warn``, attributed
+    to the caller of :func:`analyze_tangential` (through its options wrapper)."""
+    if warn:
+        for wtxt in texts:
+            warnings.warn(wtxt, ContactLabWarning, stacklevel=4)
 
 
 def _fast_regime(z_fit: float | None, ratio: float) -> Regime | None:
@@ -579,9 +436,15 @@ def _unsearched_sticks(rev: Any, n_samples: int) -> dict[str, Any]:
     n_turns = int(rev.peaks.size + rev.valleys.size)
     if n_turns < 2 or n_samples < 20:  # where the search would give none either
         return {}
-    unknown = ("reversals_with_stick", "stick_duration", "breakaway_force",
-               "breakaway_force_stderr", "velocity_threshold", "smooth_turn_dwell",
-               "reversals_with_dwell")  # fmt: skip
+    unknown = (
+        "reversals_with_stick",
+        "stick_duration",
+        "breakaway_force",
+        "breakaway_force_stderr",
+        "velocity_threshold",
+        "smooth_turn_dwell",
+        "reversals_with_dwell",
+    )
     return {"stick_slip": {"n_reversals": n_turns, **dict.fromkeys(unknown, math.nan)}}
 
 
@@ -630,10 +493,9 @@ def _analyze(
     if ori.sign < 0 and pre is None:  # (a detrended window is negated already: no copy)
         Fa = -Fa
     fit_x0 = True if fit_x0 is None else fit_x0
-    det = (
-        pre
-        if pre is not None
-        else steps.detrend(
+    det = pre
+    if det is None:
+        det = steps.detrend(
             xa,
             Fa,
             ta,
@@ -643,7 +505,108 @@ def _analyze(
             rel_threshold=rel_threshold,
             min_cycles=min_cycles,
         )
+    f = _fitted(
+        det,
+        ta,
+        on=on,
+        steady=steady,
+        rel_threshold=rel_threshold,
+        min_cycles=min_cycles,
+        fit_offset=fit_offset,
+        fit_x0=fit_x0,
+        fit_amplitude=fit_amplitude,
+        initial=initial,
     )
+    raw, amp, data = f.raw, f.amp, f.data
+    fit = reparametrize(raw)
+    identifiable, evidence = identifiability(fit, raw, amp.value, max_rel_stderr)
+    h0_lo = evidence.pop("h0_lower_bound")
+    ac_up = evidence.pop("ac_upper_bound")
+    derived = derived_quantities(raw, amp, det, data.start)
+    _refuse_no_loop(evidence, derived["energy_per_cycle_numeric"])
+    if not identifiable:
+        derived["h0_lower_bound"] = (h0_lo, math.nan)
+        derived["ac_upper_bound"] = (ac_up, math.nan)
+    ratio = loop_area_ratio(data, amp.value, derived["energy_per_cycle_numeric"][0])
+    z_fit = evidence["ac_times_amplitude"] if identifiable else None
+    if streamed:
+        regime = _fast_regime(z_fit, ratio)
+        if regime is None:
+            return None
+    else:
+        regime = classify(
+            z_fit=z_fit, ratio=ratio, loop=det.loop, x=det.x, F=det.F, t=ta, rev=data.rev, x_raw=xa
+        )
+    apply_regime(regime, amp, fit, identifiable, evidence, derived, max_rel_stderr)
+    warns = collect_warnings(
+        pre_warns, raw, data, amp.value, identifiable, evidence, regime, f.res.w
+    )
+    if steady and det.loop is not None:
+        warns += _transient_warning(det.loop, amp.value, amp.stderr)
+    if on == "averaged":  # the delay between the channels the loop shows (:mod:`.lag`)
+        warns += lag.annotate(
+            derived,
+            fit,
+            raw,
+            f.res,
+            data,
+            sliding=regime.sliding,
+            misfit=misfit_ratio(raw, data, f.res.w),
+            applied=delay,
+        )
+    regime_d = regime.to_dict()
+    if streamed:
+        regime_d.update(_unsearched_sticks(data.rev, xa.size))
+    return TangentialAnalysis(
+        fit=fit,
+        model=steps.model_of(raw.values),
+        amplitude=float(amp.value),
+        amplitude_stderr=amp.stderr,
+        loop=det.loop,
+        scatter=det.loop.scatter if det.loop is not None else None,
+        identifiable=identifiable,
+        identifiability=evidence,
+        derived=derived,
+        regime=regime_d,
+        warnings=warns,
+        on=on,
+        history=history,
+        x=np.asarray(data.xd),
+        F=np.asarray(data.Fd),
+        F_model=f.res.predict(raw.values),
+        weights=f.res.w,
+        t=data.td,
+        source=source,
+        meta=_meta(data, f.x_noise, ori, regime),
+    )
+
+
+class _Fitted(NamedTuple):
+    """What :func:`_fitted` gives: the fit data, the raw fit and its residuals, the
+    displacement noise and the amplitude estimate."""
+
+    data: steps.FitData
+    raw: FitResult
+    res: steps.Residuals
+    x_noise: float
+    amp: steps.Amplitude
+
+
+def _fitted(
+    det: steps.Detrended,
+    ta: np.ndarray | None,
+    *,
+    on: str,
+    steady: bool,
+    rel_threshold: float,
+    min_cycles: int,
+    fit_offset: bool,
+    fit_x0: bool,
+    fit_amplitude: bool,
+    initial: dict[str, float] | None,
+) -> _Fitted:
+    """The Masing fit of the detrended samples ``det`` with the covariance of what it takes
+    as exact (drifts, turning points, a fixed amplitude) and the amplitude estimate."""
     data = steps.fit_data(det, ta, on=on, steady=steady, rel_threshold=rel_threshold)
     sv = steps.start_values(
         data,
@@ -664,80 +627,27 @@ def _analyze(
     amp = steps.amplitude_estimate(
         raw, data, sv.prior, fit_amplitude=fit_amplitude, g_amp=g_amp, c_theta_amp=c_theta_amp
     )
-    fit = reparametrize(raw)
-    identifiable, evidence = identifiability(fit, raw, amp.value, max_rel_stderr)
-    h0_lo = evidence.pop("h0_lower_bound")
-    ac_up = evidence.pop("ac_upper_bound")
-    derived = derived_quantities(raw, amp, det, data.start)
-    _refuse_no_loop(evidence, derived["energy_per_cycle_numeric"])
-    if not identifiable:
-        derived["h0_lower_bound"] = (h0_lo, math.nan)
-        derived["ac_upper_bound"] = (ac_up, math.nan)
-    ratio = loop_area_ratio(data, amp.value, derived["energy_per_cycle_numeric"][0])
-    z_fit = evidence["ac_times_amplitude"] if identifiable else None
-    if streamed:
-        fast = _fast_regime(z_fit, ratio)
-        if fast is None:
-            return None
-        regime = fast
-    else:
-        regime = classify(
-            z_fit=z_fit,
-            ratio=ratio,
-            loop=det.loop,
-            x=det.x,
-            F=det.F,
-            t=ta,
-            rev=data.rev,
-            x_raw=xa,
-        )
-    apply_regime(regime, amp, fit, identifiable, evidence, derived, max_rel_stderr)
-    warns = collect_warnings(pre_warns, raw, data, amp.value, identifiable, evidence, regime, res.w)
-    if steady and det.loop is not None:
-        warns += _transient_warning(det.loop, amp.value, amp.stderr)
-    if on == "averaged":  # the delay between the channels the loop shows (:mod:`.lag`)
-        warns += lag.annotate(derived, fit, raw, res, data, sliding=regime.sliding,
-                              misfit=misfit_ratio(raw, data, res.w), applied=delay)  # fmt: skip
-    vals = raw.values
-    regime_d = regime.to_dict()
-    if streamed:
-        regime_d.update(_unsearched_sticks(data.rev, xa.size))
-    return TangentialAnalysis(
-        fit=fit,
-        model=steps.model_of(vals),
-        amplitude=float(amp.value),
-        amplitude_stderr=amp.stderr,
-        loop=det.loop,
-        scatter=det.loop.scatter if det.loop is not None else None,
-        identifiable=identifiable,
-        identifiability=evidence,
-        derived=derived,
-        regime=regime_d,
-        warnings=warns,
-        on=on,
-        history=history,
-        x=np.asarray(data.xd),
-        F=np.asarray(data.Fd),
-        F_model=res.predict(vals),
-        weights=res.w,
-        t=data.td,
-        source=source,
-        meta={
-            "fit_start": data.start,
-            "invert_force": ori.sign < 0,
-            "x_noise": x_noise,
-            "force_sign": ori.sign,
-            "orientation_reason": ori.reason,
-            "orientation_by": ori.by,
-            "loop_area_recorded": (ori.loop_area, ori.loop_area_stderr),
-            # the plateau levels' mid-point and branch length, for the loop plot's levels
-            **(
-                {"plateau_offset": regime.plateau.offset, "plateau_dx95": regime.plateau.dx95}
-                if regime.plateau is not None
-                else {}
-            ),
-        },
-    )
+    return _Fitted(data, raw, res, x_noise, amp)
+
+
+def _meta(data: steps.FitData, x_noise: float, ori: Orientation, regime: Regime) -> dict[str, Any]:
+    """The result's ``meta``: where the fit starts, the displacement noise, the orientation
+    and, in a sliding regime, the plateau levels' mid-point and branch length (the loop
+    plot's levels)."""
+    return {
+        "fit_start": data.start,
+        "invert_force": ori.sign < 0,
+        "x_noise": x_noise,
+        "force_sign": ori.sign,
+        "orientation_reason": ori.reason,
+        "orientation_by": ori.by,
+        "loop_area_recorded": (ori.loop_area, ori.loop_area_stderr),
+        **(
+            {"plateau_offset": regime.plateau.offset, "plateau_dx95": regime.plateau.dx95}
+            if regime.plateau is not None
+            else {}
+        ),
+    }
 
 
 # analyze_window moved to contactlab.tangential.window (issue 32): the old name forwards

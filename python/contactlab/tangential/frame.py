@@ -118,8 +118,9 @@ def spectral_noise(v: np.ndarray, *, quantile: float = 0.25, bands: int = 24) ->
         last += 1
     passband = float(np.median(level[first : last + 3]))
     total = lo[first] * passband  # under the signal: flat at the pass-band level
-    total += float(np.sum((np.array(hi[first:]) - np.array(lo[first:])) * np.minimum(
-        level[first:], passband)))  # fmt: skip
+    total += float(
+        np.sum((np.array(hi[first:]) - np.array(lo[first:])) * np.minimum(level[first:], passband))
+    )
     total += max(P.size - hi[-1], 0) * min(float(level[-1]), passband)
     return math.sqrt(total / P.size)
 
@@ -208,7 +209,7 @@ def lepski_window(
 
     Candidate windows grow geometrically from 7 samples to a fifth of the record (at most
     401); with no measurable noise the smallest is used. The comparisons run over the record
-    in blocks (:func:`_lepski_square_sums`): O(n) time, memory independent of its length.
+    in blocks (:func:`lepski_square_sums`): O(n) time, memory independent of its length.
     ``coefficients(window, deriv, dt)``: the filter weights (dot orientation) when not
     :func:`savgol_coefficients` (a numpy implementation spares importing scipy.signal).
     """
@@ -218,7 +219,7 @@ def lepski_window(
     cands = sorted({w | 1 for w in np.geomspace(7, top, 16).astype(int) if w >= 7})
     if sigma <= 0 or len(cands) < 2:
         return cands[0]
-    sq = _lepski_square_sums(np.asarray(x, dtype=float), cands, dt, coefficients=coefficients)
+    sq = lepski_square_sums(np.asarray(x, dtype=float), cands, dt, coefficients=coefficients)
     chosen = cands[0]
     for i, w in enumerate(cands[1:], start=1):
         ok = True
@@ -237,11 +238,11 @@ def lepski_window(
     return chosen
 
 
-#: samples per block of :func:`_lepski_square_sums`
+#: samples per block of :func:`lepski_square_sums`
 LEPSKI_BLOCK = 1 << 16
 
 
-def _lepski_square_sums(
+def lepski_square_sums(
     x: np.ndarray,
     cands: list[int],
     dt: float,
@@ -377,9 +378,19 @@ class FrameForce:
             out["columns"] = dict(self.columns)
         if self.file_units is not None:
             out["file_units"] = dict(self.file_units)
-        out["units"] = {"window": "samples", "window_s": "s", "noise_x": "m", "noise_y": "m",
-                        "force_noise": "N", "force_error": "N", "force_error_near_jumps": "N",
-                        "jump_share": "", "M": "kg", "C": "N s/m", "K": "N/m"}  # fmt: skip
+        out["units"] = {
+            "window": "samples",
+            "window_s": "s",
+            "noise_x": "m",
+            "noise_y": "m",
+            "force_noise": "N",
+            "force_error": "N",
+            "force_error_near_jumps": "N",
+            "jump_share": "",
+            "M": "kg",
+            "C": "N s/m",
+            "K": "N/m",
+        }
         return out
 
     def describe(self) -> str:
@@ -403,8 +414,9 @@ class FrameForce:
             meta["output_filter"] = self.force_filter
         if source == "<frame>":
             source = self.source
-        return Recording(self.t, {"x": self.x, "F": self.F}, {"x": "m", "F": "N"},
-                         source=source, meta=meta)  # fmt: skip
+        return Recording(
+            self.t, {"x": self.x, "F": self.F}, {"x": "m", "F": "N"}, source=source, meta=meta
+        )
 
 
 def frame_friction_force(
@@ -510,9 +522,23 @@ def frame_friction_force(
     jump_rms = math.sqrt(float(np.mean(np.square(sizes)))) if sizes else 0.0
     near_err = math.hypot(f_noise, jump_rms * step_error(window))
     total = math.sqrt((1.0 - share) * f_noise**2 + share * near_err**2)
-    return FrameForce(ta, xa, F, xd, xdd, int(window), window * dt, sx, sy, f_noise, share,
-                      near_err, total, force_kernel(window),
-                      {"M": float(M), "C": float(C), "K": float(K)})  # fmt: skip
+    return FrameForce(
+        ta,
+        xa,
+        F,
+        xd,
+        xdd,
+        int(window),
+        window * dt,
+        sx,
+        sy,
+        f_noise,
+        share,
+        near_err,
+        total,
+        force_kernel(window),
+        {"M": float(M), "C": float(C), "K": float(K)},
+    )
 
 
 def describe_reconstruction(d: dict[str, object]) -> str:

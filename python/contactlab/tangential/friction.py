@@ -83,9 +83,14 @@ class SlidingFriction:
 
 
 def sliding_friction(
-    t: np.ndarray, x: np.ndarray, F: np.ndarray, N: np.ndarray, *, tail: float = TAIL,
+    t: np.ndarray,
+    x: np.ndarray,
+    F: np.ndarray,
+    N: np.ndarray,
+    *,
+    tail: float = TAIL,
     flat: float = FLAT,
-) -> SlidingFriction:  # fmt: skip
+) -> SlidingFriction:
     """Friction coefficient μ = |F|/N on the sliding plateau of each stroke.
 
     Parameters
@@ -161,7 +166,12 @@ def sliding_friction(
     m = np.asarray(mus)
     se = 1.2533 * float(np.std(m, ddof=1)) / np.sqrt(m.size) if m.size > 1 else None
     return SlidingFriction(
-        float(np.median(m)), se, normal_load, int(m.size), branches,
-        float(np.median(up)) if up else None, float(np.median(down)) if down else None,
+        float(np.median(m)),
+        se,
+        normal_load,
+        int(m.size),
+        branches,
+        float(np.median(up)) if up else None,
+        float(np.median(down)) if down else None,
         reason="" if se is not None else "one stroke: no scatter",
-    )  # fmt: skip
+    )

@@ -109,8 +109,9 @@ def orient(
                 f"; with this sign the loop area is {fixed * area:.3g} J < 0, which a passive "
                 "joint cannot produce"
             )
-        return Orientation(fixed, f"force sign {fixed:+d} given by the user{note}", area, err,
-                           "user")  # fmt: skip
+        return Orientation(
+            fixed, f"force sign {fixed:+d} given by the user{note}", area, err, "user"
+        )
     if area != 0 and abs(area) > SIGNIFICANCE * err:
         sign = 1 if area > 0 else -1
         what = (

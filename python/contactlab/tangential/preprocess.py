@@ -18,7 +18,6 @@ The paper (*Experimental investigation of tangential contact stiffness and equiv
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -88,16 +87,28 @@ def tail_percentiles(x: np.ndarray, q: float = 0.5) -> tuple[float, float]:
     them from the samples beyond a subsample's thresholds (one pass in Rust, where numpy's
     selection took a partition of a subsample and two boolean masks of ``x``). numpy's
     interpolation of them is kept as it is; ``np.percentile`` itself for short ``x``."""
-    n = x.size
+    sel = _tail_ranks(x.size, q)
+    if sel is None:
+        lo, hi = np.percentile(x, [q, 100.0 - q])
+        return float(lo), float(hi)
+    ranks, g = sel
+    return _lerp_tails(_core.order_stats(np.ascontiguousarray(x, dtype=float), ranks), g)
+
+
+def _tail_ranks(n: int, q: float = 0.5) -> tuple[list[int], np.ndarray] | None:
+    """The order statistics :func:`tail_percentiles` interpolates for ``n`` samples (their
+    ranks and numpy's fractions between them), None where it takes ``np.percentile``."""
     qq = np.array([q, 100.0 - q]) / 100.0
     vi = (n - 1) * qq  # numpy's virtual index of the linear method
     i0 = np.floor(vi).astype(np.int64)
     g = vi - i0
     if n <= _TAIL_SELECT_ABOVE or not (0 <= i0[0] and i0[1] + 1 < n):
-        lo, hi = np.percentile(x, [q, 100.0 - q])
-        return float(lo), float(hi)
-    ranks = [int(i0[0]), int(i0[0]) + 1, int(i0[1]), int(i0[1]) + 1]
-    v = _core.order_stats(np.ascontiguousarray(x, dtype=float), ranks)
+        return None
+    return [int(i0[0]), int(i0[0]) + 1, int(i0[1]), int(i0[1]) + 1], g
+
+
+def _lerp_tails(v: np.ndarray, g: np.ndarray) -> tuple[float, float]:
+    """The two percentiles from the order statistics ``v`` of :func:`_tail_ranks`."""
     out = []
     for a, b, t in ((v[0], v[1], g[0]), (v[2], v[3], g[1])):
         d = b - a
@@ -147,6 +158,19 @@ def find_reversals(
     if ta.size != xa.size:
         raise InputError(f"t has {ta.size} samples but x has {xa.size}")
     lo_p, hi_p = tail_percentiles(xa)
+    return _reversals(xa, ta, (lo_p, hi_p), rel_threshold, threshold)
+
+
+def _reversals(
+    xa: np.ndarray,
+    ta: np.ndarray,
+    percentiles: tuple[float, float],
+    rel_threshold: float,
+    threshold: float | None,
+) -> Reversals:
+    """:func:`find_reversals` of checked float64 ``xa``, ``ta`` whose 0.5 and 99.5
+    percentiles (:func:`tail_percentiles`) are ``percentiles``."""
+    lo_p, hi_p = percentiles
     centre = 0.5 * (lo_p + hi_p)
     amp = 0.5 * (hi_p - lo_p)
     if threshold is None:
@@ -251,7 +275,7 @@ class AveragedLoop:
         return self.phase < 0.5
 
 
-def _phase_knots(rev: Reversals) -> tuple[np.ndarray, np.ndarray]:
+def phase_knots(rev: Reversals) -> tuple[np.ndarray, np.ndarray]:
     """Knots ``(time, phase)``: peak k at phase k, the valley after it at k + 1/2 (the first
     valley after the peak, when it comes before the next peak)."""
     pt, vt = np.asarray(rev.peak_times, dtype=float), np.asarray(rev.valley_times, dtype=float)
@@ -269,20 +293,6 @@ def _phase_knots(rev: Reversals) -> tuple[np.ndarray, np.ndarray]:
         kt[pos[ok] + 1] = vt[j[ok]]
         kp[pos[ok] + 1] = np.flatnonzero(ok) + 0.5
     return kt, kp
-
-
-def _phase_knots_loop(rev: Reversals) -> tuple[np.ndarray, np.ndarray]:
-    """The plain-loop reference of :func:`_phase_knots` (tests)."""
-    pt, vt = rev.peak_times, rev.valley_times
-    knots_t, knots_p = [], []
-    for k, tp in enumerate(pt):
-        knots_t.append(tp)
-        knots_p.append(float(k))
-        later = vt[vt > tp]
-        if k + 1 < pt.size and later.size and later[0] < pt[k + 1]:
-            knots_t.append(later[0])
-            knots_p.append(k + 0.5)
-    return np.asarray(knots_t), np.asarray(knots_p)
 
 
 #: turns either side whose instants are averaged into a turn's phase knot
@@ -330,7 +340,7 @@ def smooth_turn_times(times: np.ndarray, k: int = SMOOTH_TURNS) -> np.ndarray:
 def phase_of(t: np.ndarray, rev: Reversals) -> tuple[np.ndarray, int, int]:
     """Phase of each sample of the complete cycles; returns ``(phase, start, end)`` where
     samples ``start:end`` are covered (phase ``k + φ`` for cycle ``k``, φ in [0, 1))."""
-    kt, kp = _phase_knots(rev)
+    kt, kp = phase_knots(rev)
     start = int(np.searchsorted(t, kt[0], side="left"))
     end = int(np.searchsorted(t, kt[-1], side="left"))
     ph = np.interp(t[start:end], kt, kp)
@@ -344,24 +354,6 @@ def period_means(t: np.ndarray, v: np.ndarray, edges: np.ndarray) -> np.ndarray:
     One pass in Rust with numpy's arithmetic (``cumsum`` of the trapezoids, ``interp`` at the
     edges)."""
     return _core.period_means(t, v, np.ascontiguousarray(edges, dtype=float))
-
-
-def _dphase(v: np.ndarray, n: int) -> np.ndarray:
-    """Derivative of bin values along phase (periodic central difference); the numpy
-    reference of the gradient ``PhaseFold.spread`` applies (tests)."""
-    return (np.roll(v, -1) - np.roll(v, 1)) * (n / 2.0)
-
-
-def _spread(a: np.ndarray) -> np.ndarray:
-    """Standard deviation over axis 0 ignoring NaN; NaN where fewer than 2 values (the numpy
-    reference of ``PhaseFold.spread``, tests)."""
-    ok = np.isfinite(a)
-    k = ok.sum(axis=0)
-    z = np.where(ok, a, 0.0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        mean = z.sum(axis=0) / k
-        var = (np.where(ok, a - mean, 0.0) ** 2).sum(axis=0) / (k - 1)
-    return np.where(k >= 2, np.sqrt(var), np.nan)
 
 
 def average_loop(
@@ -414,6 +406,22 @@ def average_loop(
     if ta.size != xa.size:
         raise InputError(f"t has {ta.size} samples but x has {xa.size}")
     rev = find_reversals(xa, ta, rel_threshold=rel_threshold, threshold=threshold, checked=True)
+    return _fold_loop(xa, Fa, ta, rev, n_points=n_points, min_cycles=min_cycles)
+
+
+def _fold_loop(
+    xa: np.ndarray,
+    Fa: np.ndarray,
+    ta: np.ndarray,
+    rev: Reversals,
+    *,
+    n_points: int | None,
+    min_cycles: int,
+    scan: _core.WindowScan | None = None,
+) -> AveragedLoop:
+    """:func:`average_loop` of checked ``xa``, ``Fa``, ``ta`` whose reversals are ``rev``;
+    ``scan``: :func:`contactlab._core.detrend_pair_scan_into`'s clean scan of them, which
+    stands for the fold's check pass."""
     n_cyc = max(int(rev.peaks.size) - 1, 0)
     if n_cyc < min_cycles:
         raise InputError(
@@ -421,8 +429,13 @@ def average_loop(
             f"±{rev.threshold:.3g} m around x = {rev.centre:.3g} m; "
             f"at least {min_cycles} are needed"
         )
-    kt, kp = _phase_knots(replace(rev, peak_times=smooth_turn_times(rev.peak_times),
-                                  valley_times=smooth_turn_times(rev.valley_times)))  # fmt: skip
+    kt, kp = phase_knots(
+        replace(
+            rev,
+            peak_times=smooth_turn_times(rev.peak_times),
+            valley_times=smooth_turn_times(rev.valley_times),
+        )
+    )
     start = int(np.searchsorted(ta, kt[0], side="left"))
     end = int(np.searchsorted(ta, kt[-1], side="left"))
     if n_points is None:
@@ -433,7 +446,7 @@ def average_loop(
     # One call in Rust: phase by interpolating the knots, bin sums overall and per cycle (no
     # per-sample temporaries; the bins are numpy.interp's), the cycles' bounds, loop areas and
     # their noise sensitivities, the period means between the peaks.
-    wf = _core.fold_window(ta, xa, Fa, kt, kp, int(n_points), n_cyc, rev.peak_times)
+    wf = _core.fold_window(ta, xa, Fa, kt, kp, int(n_points), n_cyc, rev.peak_times, scan)
     return _loop_of_fold(wf, rev, int(n_points), start, end)
 
 
@@ -454,7 +467,7 @@ def _loop_of_fold(
     # cycle sit inside a bin differs from cycle to cycle; on a steep branch that alone spreads
     # the per-cycle means: it is removed to first order (gradient along phase, periodic), so
     # the spread measures noise and real cycle-to-cycle change. In Rust over the fold's cells
-    # with the arithmetic of ``_spread`` and ``_dphase`` (numpy reference in the tests).
+    # with the arithmetic of ``spread`` and ``dphase`` of tests/fold_reference.py (numpy).
     spread = wf.spread()
     cyc = wf.cycles()
     # sample index where each cycle starts (a cycle without samples starts where the next
@@ -514,7 +527,8 @@ def monotone_path(x: np.ndarray, turns: np.ndarray) -> np.ndarray:
     One Rust call (:func:`contactlab._core.monotone_path`: the pool-adjacent-violators
     algorithm in the arithmetic of ``scipy.optimize.isotonic_regression``, whose numbers it
     gives, without importing SciPy: half a second, under the interpreter lock, in the first
-    window of a streamed analysis; :func:`_monotone_path_scipy` is the reference).
+    window of a streamed analysis; ``monotone_path_scipy`` of tests/fold_reference.py is
+    the reference).
 
     Examples
     --------
@@ -532,20 +546,3 @@ def _path_edges(turns: np.ndarray, n: int) -> np.ndarray:
     # lock in the first window of a streamed analysis)
     e = np.sort(np.r_[0, t[(t > 0) & (t < n)], n].astype(np.int64))
     return e[np.r_[True, e[1:] != e[:-1]]]
-
-
-def _monotone_path_scipy(x: np.ndarray, turns: np.ndarray) -> np.ndarray:
-    """The SciPy reference of :func:`monotone_path` (tests)."""
-    from scipy.optimize import isotonic_regression
-
-    xa = np.asarray(x, dtype=float)
-    out = xa.copy()
-    edges = np.unique(np.r_[0, np.asarray(turns, dtype=np.int64), xa.size])
-    for a, b in itertools.pairwise(edges):
-        seg = xa[a:b]
-        if seg.size < 2:
-            continue
-        # Direction from the stretch's ends; the turn at a belongs to the stretch after it.
-        rising = seg[-1] >= seg[0] if b == xa.size else xa[min(b, xa.size - 1)] >= seg[0]
-        out[a:b] = isotonic_regression(seg, increasing=bool(rising)).x
-    return out

@@ -107,8 +107,9 @@ def velocity(t: np.ndarray | None, x: np.ndarray) -> tuple[np.ndarray, float, in
     return v, thr, window
 
 
-def _first_crossing(u: np.ndarray, phase: np.ndarray, F: np.ndarray, level: float,
-                    rising: bool) -> float | None:  # fmt: skip
+def _first_crossing(
+    u: np.ndarray, phase: np.ndarray, F: np.ndarray, level: float, rising: bool
+) -> float | None:
     """Distance from the reversal at which the branch (bins in phase order) first passes
     ``level``."""
     o = np.argsort(phase)
@@ -140,10 +141,12 @@ def _reach(
     swing = hi - lo
     if not swing > 0:
         return None
-    d1 = _first_crossing(u_d, loop.phase[desc], loop.F[desc], hi - PLATEAU_FRACTION * swing,
-                         rising=False)  # fmt: skip
-    d2 = _first_crossing(u_a, loop.phase[~desc], loop.F[~desc], lo + PLATEAU_FRACTION * swing,
-                         rising=True)  # fmt: skip
+    d1 = _first_crossing(
+        u_d, loop.phase[desc], loop.F[desc], hi - PLATEAU_FRACTION * swing, rising=False
+    )
+    d2 = _first_crossing(
+        u_a, loop.phase[~desc], loop.F[~desc], lo + PLATEAU_FRACTION * swing, rising=True
+    )
     if d1 is None or d2 is None:
         return None
     dx95 = max(d1, d2)
@@ -217,7 +220,7 @@ def plateau(
 @dataclass(frozen=True)
 class StickSlip:
     """Sticking segments found at the reversals: ``durations`` (s) and ``breakaway`` force
-    (the largest |F - offset| while stuck: the static friction the drive had to overcome,
+    (the largest ``|F - offset|`` while stuck: the static friction the drive had to overcome,
     N), over ``n_turns`` reversals; the velocity
     threshold used and how long a smooth turn stays below it."""
 
@@ -276,7 +279,7 @@ def _break_time(x: np.ndarray, a: int, b: int, end: int, window: int, sigma: flo
     since the break), fitted by least squares with the break on a grid of tenths of a sample
     between a window before the stick's end and the onset of sliding. Without a drop the
     acceleration grows from zero (``c2 = 0``); the jump is taken as shown only when freeing
-    ``c2`` lowers the squared error by more than :func:`_break_threshold` ``· σ²`` (``σ``: the
+    ``c2`` lowers the squared error by more than :func:`break_threshold` ``· σ²`` (``σ``: the
     displacement noise).
     """
     hi = min(end + window, x.size)
@@ -313,7 +316,7 @@ def _break_time(x: np.ndarray, a: int, b: int, end: int, window: int, sigma: flo
     # quantile at a 1 % false-alarm rate shared among the whole samples searched (Bonferroni;
     # a fixed 9 σ² read a drop into 1 in 5 sticks without one and put breakaway 8-10 % high)
     positions = max(int(min(end + 2, hi - 1) - lo), 1)
-    if True not in best or best[False][0] - best[True][0] <= _break_threshold(positions) * sigma**2:
+    if True not in best or best[False][0] - best[True][0] <= break_threshold(positions) * sigma**2:
         return None
     return best[True][1]
 
@@ -322,14 +325,14 @@ def _break_time(x: np.ndarray, a: int, b: int, end: int, window: int, sigma: flo
 _FINE_SEARCH = 200
 
 
-def _break_threshold(positions: int) -> float:
+def break_threshold(positions: int) -> float:
     """χ²(1) quantile for a 1 % false-alarm rate over ``positions`` break positions."""
     from scipy.special import chdtri  # chi2.isf(q, df) is chdtri(df, q); scipy.stats costs 0.5 s
 
     return float(chdtri(1, 0.01 / positions))
 
 
-def _smooth_peak(g: np.ndarray, window: int) -> float:
+def smooth_peak(g: np.ndarray, window: int) -> float:
     """Largest value of ``g`` read off a quadratic fitted over half a window either side of
     its largest sample: the largest of noisy samples overshoots the force by about twice its
     noise (static equal to kinetic friction: the plateau's noise after the stick), the
@@ -374,7 +377,7 @@ def _breakaway(
     smooth ramp (the drive's sinusoid), so a quadratic is fitted on the stuck samples clear
     of that half window and read at the instant the displacement starts to move with a jump
     of its acceleration (:func:`_break_time`; without a jump there is no drop to recover).
-    The larger of that and the maximum (:func:`_smooth_peak`: not the largest noisy sample)
+    The larger of that and the maximum (:func:`smooth_peak`: not the largest noisy sample)
     is the breakaway force.
     """
     a, b = span
@@ -385,7 +388,7 @@ def _breakaway(
     stop = n if reach is None else min(n, b + reach)
     while end < stop and abs(v[end]) < sliding:
         end += 1
-    peak = _smooth_peak(np.abs(f[a : min(end + 1, n)]), window)
+    peak = smooth_peak(np.abs(f[a : min(end + 1, n)]), window)
     if reach is not None and end >= stop:
         return peak  # no sliding within reach of the stick: no break to look for
     tb = _break_time(x, a, b, end, window, sigma)
@@ -444,8 +447,15 @@ def stick_slip(
         durations.append(n_stuck * dt)
         breakaway.append(_breakaway(f, x, v, (a, b), window, max(sliding, thr), sx, reach))
     hit = spans
-    return StickSlip(int(turns.size), np.asarray(durations), np.asarray(breakaway), float(thr),
-                     float(smooth), len(hit), dwells)  # fmt: skip
+    return StickSlip(
+        int(turns.size),
+        np.asarray(durations),
+        np.asarray(breakaway),
+        float(thr),
+        float(smooth),
+        len(hit),
+        dwells,
+    )
 
 
 def _drop_dwells(spans: dict[int, list[int]], F: np.ndarray, turns: np.ndarray) -> int:
@@ -457,8 +467,9 @@ def _drop_dwells(spans: dict[int, list[int]], F: np.ndarray, turns: np.ndarray) 
         return 0
     lo, hi = np.percentile(F[turns[0] : turns[-1] + 1], [1.0, 99.0])
     half = 0.5 * float(hi - lo)
-    dwell = [k for k, (a, b, _n) in spans.items()
-             if not float(np.ptp(F[a:b])) > STICK_FORCE_SHARE * half]  # fmt: skip
+    dwell = [
+        k for k, (a, b, _n) in spans.items() if not float(np.ptp(F[a:b])) > STICK_FORCE_SHARE * half
+    ]
     for k in dwell:
         del spans[k]
     return len(dwell)
@@ -521,14 +532,17 @@ def classify(
     st = stick_slip(t, x, F, rev, v, thr, window, pl.offset if pl is not None else 0.0)
     zt = f"ac·A = {z:.3g} (from the {src}; loop area {100 * ratio:.0f}% of the rectangle 4·A·h_m)"
     if not math.isfinite(z):  # an area no friction loop of this size encloses
-        zt = (f"ac·A undetermined (the loop area is {100 * ratio:.0f}% of the rectangle "
-              "4·A·h_m, which bounds any friction loop)")  # fmt: skip
+        zt = (
+            f"ac·A undetermined (the loop area is {100 * ratio:.0f}% of the rectangle "
+            "4·A·h_m, which bounds any friction loop)"
+        )
     if z < PRE_SLIDING_Z:
         return Regime("pre-sliding", f"pre-sliding (microslip): {zt}", z, src, ratio, None, st)
     if (z < GROSS_SLIDING_Z and pl is None) or (pl is None and src != "fit"):
         why = "" if z < GROSS_SLIDING_Z else "; no plateau over the middle of the stroke"
-        return Regime("transition", f"transition towards gross sliding: {zt}{why}", z, src,
-                      ratio, pl, st)  # fmt: skip
+        return Regime(
+            "transition", f"transition towards gross sliding: {zt}{why}", z, src, ratio, pl, st
+        )
     if pl is None:
         text = (
             f"gross sliding: {zt}; the branches flatten to under 5% of the initial stiffness "

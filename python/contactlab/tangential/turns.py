@@ -47,7 +47,7 @@ def _truncation_var(
     return d2 / (1.0 - ratio**4) ** 2
 
 
-def _nanmean(v: np.ndarray) -> float:
+def nanmean(v: np.ndarray) -> float:
     """``np.nanmean`` of a short array with its arithmetic (NaN as 0 in the sum, divided by
     the count of the others), without its dispatch (a tenth of the call)."""
     nan = np.isnan(v)
@@ -71,7 +71,7 @@ def _tip_fit(loop: AveragedLoop, first: int, k: int) -> tuple[float, float] | No
     dof = 2 * k - 3
     s2_fit = float(resid @ resid) / dof if dof > 0 else 0.0
     sb = loop.x_std[idx] / math.sqrt(loop.n_cycles)
-    s2_bins = _nanmean(sb**2) if np.any(np.isfinite(sb)) else 0.0
+    s2_bins = nanmean(sb**2) if np.any(np.isfinite(sb)) else 0.0
     s2 = max(s2_fit, s2_bins)
     var0 = s2 * float(np.linalg.inv(X.T @ X)[0, 0])
     if not np.isfinite(var0):

@@ -18,7 +18,17 @@ from ..io import Recording
 from . import lag, steps
 from .analysis import _analyze, _check_options, _inputs, analyze_tangential
 from .orientation import Orientation
-from .preprocess import AveragedLoop, average_loop, find_reversals, negated_loop
+from .preprocess import (
+    AveragedLoop,
+    _fold_loop,
+    _lerp_tails,
+    _reversals,
+    _tail_ranks,
+    average_loop,
+    find_reversals,
+    negated_loop,
+    tail_percentiles,
+)
 from .result import TangentialAnalysis
 from .uncertainty import trend
 
@@ -115,22 +125,32 @@ def analyze_window(
     }
     # (a recording's channels are contiguous float64 arrays unless replaced since)
     plain = all(a.dtype == np.float64 and a.ndim == 1 and a.flags.c_contiguous for a in (xa, Fa))
-    pre = _window_detrended(xa, Fa, ta, opts, checked=finite_x and finite_f and plain)
+    pre = window_detrended(xa, Fa, ta, opts, checked=finite_x and finite_f and plain)
     ori = _fast_orientation(pre.x, pre.F, pre.loop, force_sign)
     res = None
     if ori is not None:
         if ori.sign < 0:
             pre = _negated(pre)
-        res = _analyze(xa, Fa, ta, source, ori, pre, on="averaged", history="steady",
-                       streamed=True, delay=delay, **opts)  # fmt: skip
+        res = _analyze(
+            xa,
+            Fa,
+            ta,
+            source,
+            ori,
+            pre,
+            on="averaged",
+            history="steady",
+            streamed=True,
+            delay=delay,
+            **opts,
+        )
     if res is None:  # the sign undecided by the area, or gross sliding: the full analysis
-        return analyze_tangential(recording, force_sign=force_sign, warn=False, delay=delay,
-                                  **opts)  # fmt: skip
+        return analyze_tangential(recording, force_sign=force_sign, warn=False, delay=delay, **opts)
     lag.record(res, delay, dropped)
     return res
 
 
-def _window_detrended(
+def window_detrended(
     xa: np.ndarray,
     Fa: np.ndarray,
     ta: np.ndarray | None,
@@ -152,8 +172,9 @@ def _window_detrended(
         rev = find_reversals(xa, ta, rel_threshold=rel)  # checks x and t
         Fa = as_1d(Fa, "F")
     if not (opts["detrend"] and rev.peaks.size - 1 >= 3):
-        loop = average_loop(xa, Fa, ta, n_points=n_points, rel_threshold=rel,
-                            min_cycles=min_cycles, checked=True)  # fmt: skip
+        loop = average_loop(
+            xa, Fa, ta, n_points=n_points, rel_threshold=rel, min_cycles=min_cycles, checked=True
+        )
         return steps.Detrended(xa, Fa, loop, None)
     tt = ta if ta is not None else np.arange(xa.size, dtype=float)
     pt = rev.peak_times
@@ -169,20 +190,22 @@ def _window_detrended(
     # (into numpy.empty arrays: numpy's allocator asks for huge pages, where the core's own
     # buffers faulted in every 4 KiB page, 5 ms of system time a window of 2^19 samples)
     F, x = np.empty_like(Fa), np.empty_like(xa)
-    _core.detrend_pair_into(tt, tm, Fa, f_drift[0], xa, x_drift[0], F, x)
-    # x, F and t were checked above (the detrended samples are finite: the fold checks them
-    # again in its pass), so the fold's reversal search does not scan them a second time
-    loop = average_loop(x, F, ta, n_points=n_points, rel_threshold=rel, min_cycles=min_cycles,
-                        checked=True)  # fmt: skip
-    return steps.Detrended(x, F, loop, steps.Drift(f_drift, x_drift, tt, tm))
-
-
-def _detrended(v: np.ndarray, tt: np.ndarray, tm: float, slope: float) -> np.ndarray:
-    """``v - slope * (tt - tm)`` in numpy (the reference of ``_core.detrend_pair``, tests)."""
-    out = np.subtract(tt, tm)
-    np.multiply(out, -slope, out=out)
-    np.add(v, out, out=out)
-    return out
+    # the same pass gathers what the next two passes over the detrended samples read them
+    # for: the tails of x for its robust amplitude (the reversal search's band) and the
+    # fold's checks and scales (issue 33: a pass a window less each; the same numbers)
+    sel = _tail_ranks(x.size)
+    ranks = sel[0] if sel is not None else []
+    scan = _core.detrend_pair_scan_into(tt, tm, Fa, f_drift[0], xa, x_drift[0], F, x, ranks)
+    drift = steps.Drift(f_drift, x_drift, tt, tm)
+    if not scan.clean:  # the fold names what is wrong (as before the scan)
+        loop = average_loop(
+            x, F, ta, n_points=n_points, rel_threshold=rel, min_cycles=min_cycles, checked=True
+        )
+        return steps.Detrended(x, F, loop, drift)
+    pct = _lerp_tails(scan.order_stats, sel[1]) if sel is not None else tail_percentiles(x)
+    rev = _reversals(x, tt, pct, rel, None)
+    loop = _fold_loop(x, F, tt, rev, n_points=n_points, min_cycles=min_cycles, scan=scan)
+    return steps.Detrended(x, F, loop, drift)
 
 
 def _negated(d: steps.Detrended) -> steps.Detrended:

@@ -295,7 +295,6 @@ mod tests {
 
     /// The one-sample-at-a-time loop `cycle_block` replaced (its next crossing is now found
     /// first and the samples before it summed in one tight pass): the reference.
-    #[allow(clippy::arithmetic_side_effects)]
     fn cycle_block_reference(
         t: &[f64],
         x: &[f64],

@@ -265,7 +265,6 @@ pub fn loop_area_sensitivity(
 mod tests {
     use super::*;
 
-    #[allow(clippy::arithmetic_side_effects)]
     /// The implementation before the dispatched one (divisions per sample, one Neumaier
     /// chain): the accuracy reference.
     /// `∮ F dx` of the closed polygon through `(x_i, F_i)` (last point joined to the first):

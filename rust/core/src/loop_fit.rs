@@ -255,8 +255,6 @@ struct Scaled<'a> {
 }
 
 impl Scaled<'_> {
-    // idx holds indices < 5; j < idx.len()
-    #[allow(clippy::arithmetic_side_effects)]
     fn params(&self, z: &Vector5<f64>) -> [f64; N_PARAMS] {
         let mut p = self.setup.values;
         for (j, &k) in self.idx.iter().enumerate() {
@@ -267,6 +265,7 @@ impl Scaled<'_> {
 
     /// Cost `½ Σ (r/rscale)²` at `z` (infinite when not finite); with `jac`, `JᵀJ` and `Jᵀr`
     /// of the scaled problem as well.
+    // Index arithmetic: the Jacobian holds N_PARAMS columns of `rows` values, ka, kb < 5.
     #[allow(clippy::arithmetic_side_effects)]
     fn eval(&mut self, z: &Vector5<f64>, with_jac: bool) -> (f64, Option<Normal>) {
         self.nfev = self.nfev.saturating_add(1);

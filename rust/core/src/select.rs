@@ -14,7 +14,7 @@ use crate::error::CoreError;
 /// Below this many samples the whole sample is selected from (no subsample).
 const SUBSAMPLE_ABOVE: usize = 1 << 15;
 /// Every this many samples one goes into the subsample.
-const STRIDE: usize = 32;
+pub const STRIDE: usize = 32;
 /// Samples a block of the tails' gathering.
 const GATHER: usize = 2048;
 
@@ -36,93 +36,196 @@ fn select_into(v: &mut [f64], ranks: &[usize], offset: usize, out: &mut [f64]) {
 /// # Errors
 /// [`CoreError::Empty`] for an empty `x`, [`CoreError::InvalidParameter`] for a rank not
 /// below `x.len()`.
-// Index arithmetic: ranks < n (checked), sub ranks < sub.len(), counts <= n.
-#[allow(clippy::arithmetic_side_effects)]
 pub fn order_stats(x: &[f64], ranks: &[usize]) -> Result<Vec<f64>, CoreError> {
-    let n = x.len();
-    if n == 0 {
-        return Err(CoreError::Empty { name: "x" });
+    let mut g = TailGather::new(x.len(), ranks, STRIDE, |i| x[i])?;
+    if g.gathering() {
+        for block in x.chunks(GATHER) {
+            g.block(block);
+        }
     }
-    if let Some(&r) = ranks.iter().find(|&&r| r >= n) {
-        return Err(CoreError::InvalidParameter {
-            name: "rank",
-            value: r as f64,
-            reason: "must be below the number of samples",
-        });
-    }
-    let mut order: Vec<usize> = (0..ranks.len()).collect();
-    order.sort_by_key(|&i| ranks[i]);
-    let sorted: Vec<usize> = order.iter().map(|&i| ranks[i]).collect();
-    let mut vals = vec![0.0_f64; ranks.len()];
-    let half = n / 2;
-    let n_low = sorted.iter().filter(|&&r| r < half).count();
-    let (low_r, high_r) = sorted.split_at(n_low);
-    let mut done = false;
-    if n > SUBSAMPLE_ABOVE {
-        done = tails(x, low_r, high_r, &mut vals);
-    }
-    if !done {
-        let mut all = x.to_vec();
-        select_into(&mut all, &sorted, 0, &mut vals);
-    }
-    let mut out = vec![0.0_f64; ranks.len()];
-    for (&i, &v) in order.iter().zip(&vals) {
-        out[i] = v;
-    }
-    Ok(out)
+    Ok(g.finish(x))
 }
 
-/// [`order_stats`] of the ranks `low` (below `n/2`) and `high` (the rest), both ascending,
-/// from the tails of `x`, into `vals` (low's then high's); false when a tail is too short.
-#[allow(clippy::arithmetic_side_effects)]
-fn tails(x: &[f64], low: &[usize], high: &[usize], vals: &mut [f64]) -> bool {
-    let n = x.len();
-    let mut sub: Vec<f64> = x.iter().step_by(STRIDE).copied().collect();
-    let m = sub.len();
-    // a subsample rank whose value has about twice the samples the rank needs below it
-    // (and 16 subsample values more): a tail short of the rank is rare, and then only slower
-    let sub_rank = |r: usize| (2 * (r + 2) * m / n + 16).min(m - 1);
-    let t_lo = low.last().map(|&r| {
-        let k = sub_rank(r);
-        *sub.select_nth_unstable_by(k, f64::total_cmp).1
-    });
-    let t_hi = high.first().map(|&r| {
-        let k = m - 1 - sub_rank(n - 1 - r);
-        *sub.select_nth_unstable_by(k, f64::total_cmp).1
-    });
-    drop(sub);
-    // the tails by value (every sample at or below t_lo: the smallest samples of x, ±0
-    // together, so a rank of x is the same rank of the low tail; the high tail's ranks are
-    // x's less the samples below it)
-    let lo = t_lo.unwrap_or(f64::NEG_INFINITY);
-    let hi = t_hi.unwrap_or(f64::INFINITY);
-    // branch-free: each sample is written at the tail's end, which moves on only when the
-    // sample belongs to the tail (the buffers grow a block ahead)
-    let (mut lv, mut hv) = (Vec::new(), Vec::new());
-    let (mut nl, mut nh) = (0_usize, 0_usize);
-    for block in x.chunks(GATHER) {
-        lv.resize(nl + GATHER, 0.0);
-        hv.resize(nh + GATHER, 0.0);
-        let (lb, hb) = (&mut lv[nl..nl + GATHER], &mut hv[nh..nh + GATHER]);
+/// [`order_stats`] split into its steps, so that another kernel's pass over the samples can
+/// gather the tails as it makes them (the detrended displacement of an analysis window:
+/// [`crate::window::detrend_pair_scan_into`]): [`TailGather::new`] takes the subsample's
+/// thresholds, [`TailGather::block`] gathers the tails of consecutive blocks of at most
+/// [`GATHER`] samples, [`TailGather::finish`] selects the ranks (from the whole sample where
+/// a tail is too short or the sample too short for a subsample). The values are those of
+/// [`order_stats`]: exact order statistics, whichever way they are found.
+pub struct TailGather {
+    n: usize,
+    /// positions of the ranks in ascending order, and the ranks so sorted
+    order: Vec<usize>,
+    sorted: Vec<usize>,
+    /// the sorted ranks below `n / 2`
+    n_low: usize,
+    /// None: no subsample (select from the whole sample)
+    thresholds: Option<(f64, f64)>,
+    lv: Vec<f64>,
+    hv: Vec<f64>,
+    nl: usize,
+    nh: usize,
+}
+
+/// Samples a block of [`TailGather::block`] at most.
+pub const GATHER_BLOCK: usize = GATHER;
+
+impl TailGather {
+    /// The gathering of `ranks` of `n` samples, `sample(i)` the `i`-th (read at the
+    /// subsample's positions only: every `stride`-th sample, [`STRIDE`] in [`order_stats`]).
+    /// The stride sets only how well the thresholds are guessed, not the values: a tail
+    /// found too short is selected from the whole sample.
+    ///
+    /// # Errors
+    /// As [`order_stats`].
+    // Index arithmetic: ranks < n (checked), sub ranks < sub.len(), counts <= n.
+    #[allow(clippy::arithmetic_side_effects)]
+    pub fn new(
+        n: usize,
+        ranks: &[usize],
+        stride: usize,
+        sample: impl Fn(usize) -> f64,
+    ) -> Result<Self, CoreError> {
+        if n == 0 {
+            return Err(CoreError::Empty { name: "x" });
+        }
+        if let Some(&r) = ranks.iter().find(|&&r| r >= n) {
+            return Err(CoreError::InvalidParameter {
+                name: "rank",
+                value: r as f64,
+                reason: "must be below the number of samples",
+            });
+        }
+        let mut order: Vec<usize> = (0..ranks.len()).collect();
+        order.sort_by_key(|&i| ranks[i]);
+        let sorted: Vec<usize> = order.iter().map(|&i| ranks[i]).collect();
+        let half = n / 2;
+        let n_low = sorted.iter().filter(|&&r| r < half).count();
+        let thresholds = if n > SUBSAMPLE_ABOVE {
+            let (low, high) = sorted.split_at(n_low);
+            let mut sub: Vec<f64> = (0..n).step_by(stride.max(1)).map(sample).collect();
+            let m = sub.len();
+            // a subsample rank whose value has about twice the samples the rank needs below
+            // it (and 16 subsample values more): a tail short of the rank is rare, and then
+            // only slower
+            let sub_rank = |r: usize| (2 * (r + 2) * m / n + 16).min(m - 1);
+            let t_lo = low.last().map(|&r| {
+                let k = sub_rank(r);
+                *sub.select_nth_unstable_by(k, f64::total_cmp).1
+            });
+            let t_hi = high.first().map(|&r| {
+                let k = m - 1 - sub_rank(n - 1 - r);
+                *sub.select_nth_unstable_by(k, f64::total_cmp).1
+            });
+            Some((
+                t_lo.unwrap_or(f64::NEG_INFINITY),
+                t_hi.unwrap_or(f64::INFINITY),
+            ))
+        } else {
+            None
+        };
+        Ok(TailGather {
+            n,
+            order,
+            sorted,
+            n_low,
+            thresholds,
+            lv: Vec::new(),
+            hv: Vec::new(),
+            nl: 0,
+            nh: 0,
+        })
+    }
+
+    /// Whether the samples' blocks are to be gathered (false: the whole sample is selected
+    /// from at [`TailGather::finish`]).
+    pub fn gathering(&self) -> bool {
+        self.thresholds.is_some()
+    }
+
+    /// The next block of at most [`GATHER_BLOCK`] samples (in order).
+    // Index arithmetic: the buffers grow a block ahead; il, ih < GATHER after the mask.
+    #[allow(clippy::arithmetic_side_effects)]
+    #[inline]
+    pub fn block(&mut self, block: &[f64]) {
+        let Some((lo, hi)) = self.thresholds else {
+            return;
+        };
+        // the tails by value (every sample at or below lo: the smallest samples of x, ±0
+        // together, so a rank of x is the same rank of the low tail; the high tail's ranks
+        // are x's less the samples below it). Branch-free: each sample is written at the
+        // tail's end, which moves on only when the sample belongs to the tail
+        let (nl, nh) = (self.nl, self.nh);
+        self.lv.resize(nl + GATHER, 0.0);
+        self.hv.resize(nh + GATHER, 0.0);
+        let (lb, hb) = (&mut self.lv[nl..nl + GATHER], &mut self.hv[nh..nh + GATHER]);
         let (mut il, mut ih) = (0_usize, 0_usize);
-        for &v in block {
+        for &v in &block[..block.len().min(GATHER)] {
             lb[il & (GATHER - 1)] = v;
             hb[ih & (GATHER - 1)] = v;
             il += usize::from(v <= lo);
             ih += usize::from(v >= hi);
         }
-        nl += il;
-        nh += ih;
+        self.nl += il;
+        self.nh += ih;
     }
-    lv.truncate(nl);
-    hv.truncate(nh);
-    let below_hi = n - hv.len();
-    if low.last().is_some_and(|&r| r >= lv.len()) || high.first().is_some_and(|&r| r < below_hi) {
+
+    /// The values of the ranks, in the order given; `x` the whole sample (selected from when
+    /// there were no tails, or a tail too short for a rank).
+    // Index arithmetic: counts <= n.
+    #[allow(clippy::arithmetic_side_effects)]
+    pub fn finish(mut self, x: &[f64]) -> Vec<f64> {
+        let mut vals = vec![0.0_f64; self.sorted.len()];
+        let (low, high) = self.sorted.split_at(self.n_low);
+        let mut done = false;
+        if self.thresholds.is_some() {
+            self.lv.truncate(self.nl);
+            self.hv.truncate(self.nh);
+            let below_hi = self.n - self.hv.len();
+            let short = low.last().is_some_and(|&r| r >= self.lv.len())
+                || high.first().is_some_and(|&r| r < below_hi);
+            if !short {
+                let (v_lo, v_hi) = vals.split_at_mut(low.len());
+                select_into(&mut self.lv, low, 0, v_lo);
+                select_into(&mut self.hv, high, below_hi, v_hi);
+                done = true;
+            }
+        }
+        if !done {
+            let mut all = x.to_vec();
+            select_into(&mut all, &self.sorted, 0, &mut vals);
+        }
+        let mut out = vec![0.0_f64; vals.len()];
+        for (&i, &v) in self.order.iter().zip(&vals) {
+            out[i] = v;
+        }
+        out
+    }
+}
+
+/// [`order_stats`] of the ranks `low` (below `n/2`) and `high` (the rest), both ascending,
+/// from the tails of `x`, into `vals` (low's then high's); false when a tail is too short.
+#[cfg(test)]
+fn tails(x: &[f64], low: &[usize], high: &[usize], vals: &mut [f64]) -> bool {
+    let ranks: Vec<usize> = low.iter().chain(high).copied().collect();
+    let Ok(mut g) = TailGather::new(x.len(), &ranks, STRIDE, |i| x[i]) else {
+        return false;
+    };
+    if g.n_low != low.len() || !g.gathering() {
         return false;
     }
-    let (v_lo, v_hi) = vals.split_at_mut(low.len());
-    select_into(&mut lv, low, 0, v_lo);
-    select_into(&mut hv, high, below_hi, v_hi);
+    for block in x.chunks(GATHER) {
+        g.block(block);
+    }
+    g.lv.truncate(g.nl);
+    g.hv.truncate(g.nh);
+    let below_hi = x.len() - g.hv.len();
+    if low.last().is_some_and(|&r| r >= g.lv.len()) || high.first().is_some_and(|&r| r < below_hi) {
+        return false;
+    }
+    let v = g.finish(x);
+    vals.copy_from_slice(&v);
     true
 }
 

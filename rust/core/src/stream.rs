@@ -9,7 +9,6 @@ const LANES: usize = 8;
 /// sampled every `dt` from `t0`, in one pass; bit for bit numpy's
 /// `t0 + dt * np.arange(offset, offset + n, dtype=float64)` (the indices are exact in double
 /// precision below 2^53, and each value is one product and one sum, rounded as IEEE says).
-#[allow(clippy::needless_range_loop)]
 pub fn fill_time(out: &mut [f64], t0: f64, dt: f64, offset: u64) -> Result<(), CoreError> {
     let n = u64::try_from(out.len()).map_err(|_| CoreError::TooLong { len: out.len() })?;
     match offset.checked_add(n) {
@@ -26,9 +25,9 @@ pub fn fill_time(out: &mut [f64], t0: f64, dt: f64, offset: u64) -> Result<(), C
     }
     let mut it = out.chunks_exact_mut(LANES);
     for o in &mut it {
-        for j in 0..LANES {
-            o[j] = t0 + dt * k[j];
-            k[j] += LANES as f64;
+        for (oj, kj) in o.iter_mut().zip(k.iter_mut()) {
+            *oj = t0 + dt * *kj;
+            *kj += LANES as f64;
         }
     }
     for (j, o) in it.into_remainder().iter_mut().enumerate() {

@@ -1,8 +1,9 @@
 //! Binding of `contactlab_core::joints`: a joint law's operator built from a nested
 //! description, pushing chunks with the GIL released. Conversion only.
 
+use contactlab_core::joints::sens::force_sens;
 use contactlab_core::joints::{AnyLaw, Operator};
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyList, PyTuple};
 
@@ -107,7 +108,40 @@ impl JointOperatorCore {
     }
 }
 
+/// Forces of a whole history from the relaxed state at `x0` and their forward sensitivities
+/// to the law's parameters: `(F, J)`, `J` of shape `(len(x), n_params)`.
+#[pyfunction]
+#[pyo3(signature = (spec, t, x, x0))]
+#[allow(clippy::type_complexity)]
+fn joint_force_sens<'py>(
+    py: Python<'py>,
+    spec: &Bound<'py, PyAny>,
+    t: Option<PyReadonlyArray1<'py, f64>>,
+    x: PyReadonlyArray1<'py, f64>,
+    x0: f64,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>)> {
+    let law = build(py, spec, 0)?;
+    let xs = slice(&x, "x")?;
+    let ts = match &t {
+        Some(t) => Some(slice(t, "t")?),
+        None => None,
+    };
+    let np = law.n_params();
+    let (f, jac) = detach_guarded(py, || force_sens(&law, ts, xs, x0))?;
+    let n = f.len();
+    let jac = jac.into_pyarray(py).reshape([n, np])?;
+    Ok((f.into_pyarray(py), jac))
+}
+
+/// True when [`joint_force_sens`] differentiates the law (else: finite differences).
+#[pyfunction]
+fn joint_has_sens(py: Python<'_>, spec: &Bound<'_, PyAny>) -> PyResult<bool> {
+    Ok(build(py, spec, 0)?.sens_len().is_some())
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<JointOperatorCore>()?;
+    m.add_function(wrap_pyfunction!(joint_force_sens, m)?)?;
+    m.add_function(wrap_pyfunction!(joint_has_sens, m)?)?;
     Ok(())
 }

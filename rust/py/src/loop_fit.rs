@@ -8,6 +8,10 @@ use crate::detach_guarded;
 use crate::error::slice;
 
 type Five = [f64; N_PARAMS];
+/// `(x0 or None, amplitude or None, sigma, scale)` of the turning-point prior.
+type PriorArgs = (Option<f64>, Option<f64>, f64, f64);
+/// `(values, vary, scale, lower, upper)` of the parameters.
+type SetupArgs = (Five, [bool; N_PARAMS], Five, Five, Five);
 
 /// Fit the steady Masing loop to averaged bins (GIL released). `prior`: `(x0 or None,
 /// amplitude or None, sigma, scale)`; `setup`: `(values, vary, scale, lower, upper)`
@@ -15,15 +19,14 @@ type Five = [f64; N_PARAMS];
 /// nfev, status)` (status as SciPy's `least_squares`: 0 = evaluation budget exhausted).
 #[pyfunction]
 #[pyo3(name = "fit_steady_loop")]
-#[allow(clippy::type_complexity)]
 fn fit_steady_loop_py(
     py: Python<'_>,
     x: PyReadonlyArray1<'_, f64>,
     f: PyReadonlyArray1<'_, f64>,
     w: PyReadonlyArray1<'_, f64>,
     bin_var: Option<PyReadonlyArray1<'_, f64>>,
-    prior: Option<(Option<f64>, Option<f64>, f64, f64)>,
-    setup: (Five, [bool; N_PARAMS], Five, Five, Five),
+    prior: Option<PriorArgs>,
+    setup: SetupArgs,
     tol: (f64, f64, f64, f64),
     max_nfev: usize,
 ) -> PyResult<(Five, usize, i32)> {

@@ -197,9 +197,11 @@ fn kv_analytic(
     ))
 }
 
+/// Two arrays handed to Python.
+type ArrayPair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
+
 /// Kelvin-Voigt steady state `(δ, δ')` at times `t` under `pa sin ω t`.
 #[pyfunction]
-#[allow(clippy::type_complexity)]
 fn kv_steady_state<'py>(
     py: Python<'py>,
     k: f64,
@@ -207,7 +209,7 @@ fn kv_steady_state<'py>(
     omega: f64,
     pa: f64,
     t: PyReadonlyArray1<'py, f64>,
-) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+) -> PyResult<ArrayPair<'py>> {
     let kv = KelvinVoigt::new(k, psi, omega).map_err(|e| to_pyerr(py, &e))?;
     let ts = slice(&t, "t")?;
     let (d, v) = detach_guarded(py, || {

@@ -2,7 +2,8 @@
 //! cycle areas, detrending).
 
 use contactlab_core::window::{
-    detrend_pair, detrend_pair_into, fold_window, WindowFold as CoreWindowFold,
+    detrend_pair, detrend_pair_into, detrend_pair_scan_into, fold_window, fold_window_scanned,
+    WindowFold as CoreWindowFold, WindowScan as CoreWindowScan,
 };
 use numpy::{IntoPyArray, PyReadonlyArray1, PyReadwriteArray1};
 use pyo3::prelude::*;
@@ -88,7 +89,7 @@ impl WindowFold {
 
 /// Fold one window (see `contactlab_core::window::fold_window`).
 #[pyfunction]
-#[pyo3(name = "fold_window")]
+#[pyo3(name = "fold_window", signature = (t, x, f, knot_t, knot_phase, n_bins, n_cycles, edges, scan=None))]
 fn fold_window_py(
     py: Python<'_>,
     t: PyReadonlyArray1<'_, f64>,
@@ -99,12 +100,69 @@ fn fold_window_py(
     n_bins: usize,
     n_cycles: usize,
     edges: PyReadonlyArray1<'_, f64>,
+    scan: Option<PyRef<'_, WindowScan>>,
 ) -> PyResult<WindowFold> {
     let (ts, xs, fs) = (slice(&t, "t")?, slice(&x, "x")?, slice(&f, "F")?);
     let (kt, kp) = (slice(&knot_t, "knot_t")?, slice(&knot_phase, "knot_phase")?);
     let es = slice(&edges, "edges")?;
-    let inner = detach_guarded(py, || fold_window(ts, xs, fs, kt, kp, n_bins, n_cycles, es))?;
+    let sc = scan.map(|s| s.inner.clone());
+    let inner = detach_guarded(py, || match &sc {
+        Some(s) => fold_window_scanned(ts, xs, fs, (kt, kp), (n_bins, n_cycles), es, s),
+        None => fold_window(ts, xs, fs, kt, kp, n_bins, n_cycles, es),
+    })?;
     Ok(WindowFold { inner })
+}
+
+/// What `detrend_pair_scan_into` found of the detrended samples (see
+/// `contactlab_core::window::WindowScan`): `clean`, the order statistics asked for; handed
+/// to `fold_window(..., scan=)` it stands for the fold's own check pass.
+#[pyclass(module = "contactlab._core", frozen)]
+struct WindowScan {
+    inner: CoreWindowScan,
+}
+
+#[pymethods]
+impl WindowScan {
+    /// Whether t is finite and increasing and the detrended x and F finite.
+    #[getter]
+    fn clean(&self) -> bool {
+        self.inner.clean
+    }
+
+    /// The order statistics of the detrended x at the ranks asked for (in their order).
+    #[getter]
+    fn order_stats<'py>(&self, py: Python<'py>) -> Arr<'py> {
+        self.inner.order_stats.clone().into_pyarray(py)
+    }
+}
+
+/// `detrend_pair_into` and, in the same pass, the order statistics of the detrended x at
+/// `ranks` and the fold's checks (`contactlab_core::window::detrend_pair_scan_into`).
+#[pyfunction]
+#[pyo3(name = "detrend_pair_scan_into")]
+fn detrend_pair_scan_into_py<'py>(
+    py: Python<'py>,
+    t: PyReadonlyArray1<'py, f64>,
+    tm: f64,
+    f: PyReadonlyArray1<'py, f64>,
+    slope_f: f64,
+    x: PyReadonlyArray1<'py, f64>,
+    slope_x: f64,
+    mut out_f: PyReadwriteArray1<'py, f64>,
+    mut out_x: PyReadwriteArray1<'py, f64>,
+    ranks: Vec<usize>,
+) -> PyResult<WindowScan> {
+    let (ts, fs, xs) = (slice(&t, "t")?, slice(&f, "F")?, slice(&x, "x")?);
+    let of = out_f
+        .as_slice_mut()
+        .map_err(|_| input(py, "out_F must be a contiguous array"))?;
+    let ox = out_x
+        .as_slice_mut()
+        .map_err(|_| input(py, "out_x must be a contiguous array"))?;
+    let inner = detach_guarded(py, || {
+        detrend_pair_scan_into(ts, tm, (fs, slope_f), (xs, slope_x), (of, ox), &ranks)
+    })?;
+    Ok(WindowScan { inner })
 }
 
 /// Remove the linear drifts of F and x in one pass (see
@@ -155,6 +213,8 @@ fn detrend_pair_into_py<'py>(
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<WindowFold>()?;
+    m.add_class::<WindowScan>()?;
+    m.add_function(wrap_pyfunction!(detrend_pair_scan_into_py, m)?)?;
     m.add_function(wrap_pyfunction!(fold_window_py, m)?)?;
     m.add_function(wrap_pyfunction!(detrend_pair_py, m)?)?;
     m.add_function(wrap_pyfunction!(detrend_pair_into_py, m)?)?;

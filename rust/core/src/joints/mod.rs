@@ -26,6 +26,7 @@ pub mod iwan;
 pub mod jenkins;
 pub mod lugre;
 pub mod maxwell;
+pub mod sens;
 
 use crate::error::{check_finite, check_same_len, CoreError};
 

@@ -430,25 +430,29 @@ pub fn run_rule<C: Backbone, O: Observer>(
     if let Some(o) = out.as_deref() {
         crate::error::check_same_len("x", x.len(), "out", o.len())?;
     }
-    if !kernel::all_finite(x) {
+    // Masing's scaled rule with nobody watching closures: the kernel that defers reversal
+    // forces to the curve pass, and checks the input block by block as it goes.
+    let fast = out.is_some() && matches!(rule, BranchRule::Scaled(_)) && O::IGNORES;
+    let fast = fast && kernel::takes(state);
+    if !fast && !kernel::all_finite(x) {
         crate::error::check_finite("x", x)?;
     }
     let end = checked_end(state, x.len())?;
     let saved = state.clone(); // restored when the forces overflow
     let range = match (out, rule) {
-        // Masing's scaled rule with nobody watching closures: the kernel that defers
-        // reversal forces to the curve pass.
-        (Some(out), BranchRule::Scaled(lam)) if O::IGNORES && kernel::takes(state) => {
-            if kernel::scaled_force(curve, lam, x, out, state) {
-                Ok(())
-            } else {
-                crate::error::check_output("force", out)
+        (Some(out), BranchRule::Scaled(lam)) if fast => {
+            match kernel::scaled_force(crate::simd::level(), curve, lam, x, out, state) {
+                kernel::Forces::Finite => Ok(()),
+                kernel::Forces::NotFinite => crate::error::check_output("force", out),
+                kernel::Forces::BadInput => crate::error::check_finite("x", x),
             }
         }
         (out, _) => {
             let mut index = state.count;
             let mut st = Stepper::new(curve, rule, out.is_some(), state);
             let range = if let Some(out) = out {
+                let level = crate::simd::level();
+                let mut tab = kernel::RunTab::new();
                 let mut ub = [0.0_f64; BLOCK];
                 let mut rid = [0_u16; BLOCK];
                 for (xc, oc) in x.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
@@ -460,7 +464,16 @@ pub fn run_rule<C: Backbone, O: Observer>(
                         index = index.saturating_add(1); // <= end, checked above
                     }
                     let m = xc.len();
-                    eval_block(curve, &mut st.runs, &ub[..m], &rid[..m], oc);
+                    // the forces' finiteness is checked over `out` below
+                    let _ = eval_block(
+                        level,
+                        curve,
+                        &mut st.runs,
+                        &ub[..m],
+                        &rid[..m],
+                        oc,
+                        &mut tab,
+                    );
                 }
                 crate::error::check_output("force", out)
             } else {

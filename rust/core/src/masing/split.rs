@@ -416,5 +416,12 @@ pub fn force_piece<C: Backbone>(
             reason: "a piece must start from a state the split produced",
         });
     }
-    Ok(kernel::scaled_force(curve, scale, x, out, state))
+    match kernel::scaled_force(crate::simd::level(), curve, scale, x, out, state) {
+        kernel::Forces::Finite => Ok(true),
+        kernel::Forces::NotFinite => Ok(false),
+        kernel::Forces::BadInput => {
+            crate::error::check_finite("x", x)?;
+            Ok(false) // not reached: the input has a non-finite value
+        }
+    }
 }

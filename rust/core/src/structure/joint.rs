@@ -85,9 +85,15 @@ pub enum JointLaw {
         slope: Vec<f64>,
         energy: Vec<f64>,
     },
-    /// A rate-independent law of [`crate::joints`] (exact along each monotone step; tangent
-    /// by a one-sided difference in the direction of motion), with its initial stiffness.
-    Law { law: Box<AnyLaw>, k0: f64 },
+    /// A law of [`crate::joints`] (exact along each monotone step; tangent by a one-sided
+    /// difference in the direction of motion), with its initial stiffness. A rate-dependent
+    /// law (`rate`) sees the step's end velocity `v` as its constant velocity over the step
+    /// (its time step taken as `Δd / v`), and adds `∂F/∂v` to Newton's damping tangent.
+    Law {
+        law: Box<AnyLaw>,
+        k0: f64,
+        rate: bool,
+    },
 }
 
 impl JointLaw {
@@ -185,22 +191,16 @@ impl JointLaw {
         }
     }
 
-    /// A joint of a rate-independent [`crate::joints`] law (a rate-dependent one is refused:
-    /// the integrator's step has no time for it).
+    /// A joint of a [`crate::joints`] law (rate-dependent ones included: see
+    /// [`JointLaw::Law`]).
     pub fn law(law: AnyLaw) -> Result<Self, CoreError> {
-        if law.rate_dependent() {
-            return Err(CoreError::InvalidLaw {
-                kind: "structure joint".to_string(),
-                reason: "a rate-dependent law (LuGre, generalised Maxwell-slip, a viscous term) \
-                         is not a structure joint; use kelvin_voigt for viscous terms"
-                    .to_string(),
-            });
-        }
         let st = law.start(0.0);
-        let k0 = law_tangent(&law, &st, 0.0, 0.0, 1.0).1;
+        let rate = law.rate_dependent();
+        let k0 = law_tangent(&law, &st, 0.0, 0.0, 1.0, None).1;
         Ok(Self::Law {
             law: Box::new(law),
             k0,
+            rate,
         })
     }
 
@@ -229,15 +229,48 @@ pub enum JointState {
     Law(Box<AnyState>),
 }
 
+/// The time step a rate-dependent law is given for the step `d_old -> d` at the end velocity
+/// `v`: `Δd / v` (the law then sees the velocity `v`), `None` (a quasi-static step, velocity
+/// 0) when `v` is 0 or against the step, or for a rate-independent law (`v = None`).
+#[inline]
+fn law_dt(d_old: f64, d: f64, v: Option<f64>) -> Option<f64> {
+    let v = v?;
+    let dt = (d - d_old) / v;
+    (dt > 0.0 && dt.is_finite()).then_some(dt)
+}
+
 /// Force of `law` at `d` from `st` (unchanged) and its tangent by a one-sided difference in
-/// the direction `dir` of the motion (`h`: 1e-7 of the step, at least 1e-9 of |d| and 1e-15).
-fn law_tangent(law: &AnyLaw, st: &AnyState, d_old: f64, d: f64, dir: f64) -> (f64, f64) {
+/// the direction `dir` of the motion (`h`: 1e-7 of the step, at least 1e-9 of |d| and 1e-15),
+/// at the velocity `v` held (a rate-dependent law; `None` otherwise).
+fn law_tangent(
+    law: &AnyLaw,
+    st: &AnyState,
+    d_old: f64,
+    d: f64,
+    dir: f64,
+    v: Option<f64>,
+) -> (f64, f64) {
     let mut s = st.clone();
-    let f = law.step(&mut s, None, d);
+    let f = law.step(&mut s, law_dt(d_old, d, v), d);
     let h = (1e-7 * (d - d_old).abs()).max(1e-9 * d.abs()).max(1e-15) * dir;
     let mut s2 = st.clone();
-    let f2 = law.step(&mut s2, None, d + h);
+    let f2 = law.step(&mut s2, law_dt(d_old, d + h, v), d + h);
     (f, ((f2 - f) / h).max(0.0))
+}
+
+/// `∂F/∂v` of a rate-dependent law at the step `d_old -> d` (one-sided difference of 1e-7 of
+/// `|v|`; 0 for a quasi-static step).
+fn law_damping(law: &AnyLaw, st: &AnyState, d_old: f64, d: f64, v: f64, f: f64) -> f64 {
+    if law_dt(d_old, d, Some(v)).is_none() {
+        return 0.0;
+    }
+    let hv = 1e-7 * v;
+    let Some(dt) = law_dt(d_old, d, Some(v + hv)) else {
+        return 0.0;
+    };
+    let mut s = st.clone();
+    let f2 = law.step(&mut s, Some(dt), d);
+    ((f2 - f) / hv).max(0.0)
 }
 
 /// Force and tangents at a trial displacement.
@@ -251,6 +284,8 @@ pub struct Trial {
     /// Masing: `2 × (reversals kept) + (1 if the trial point pushed a reversal)`, so that
     /// committing applies the same memory update without walking the branches again.
     pub aux: usize,
+    /// The velocity the trial was made at (a rate-dependent law's commit repeats it).
+    pub v: f64,
 }
 
 /// Masing force and tangent at `x` from `state`, without changing the state (the branch logic
@@ -381,6 +416,7 @@ impl JointLaw {
                     kt,
                     ct: 0.0,
                     aux,
+                    v: 0.0,
                 }
             }
             (Self::Jenkins { k, fs }, JointState::Slider(f0)) => {
@@ -436,18 +472,27 @@ impl JointLaw {
                 kt: *k,
                 ct: *c,
                 aux: 0,
+                v: 0.0,
             },
             (Self::Normal { force, slope, .. }, _) => Trial {
                 f: poly::eval(force, d_new),
                 kt: poly::eval(slope, d_new),
                 ..Trial::default()
             },
-            (Self::Law { law, .. }, JointState::Law(st)) => {
+            (Self::Law { law, rate, .. }, JointState::Law(st)) => {
                 let dir = if dd < 0.0 { -1.0 } else { 1.0 };
-                let (f, kt) = law_tangent(law, st, d_old, d_new, dir);
+                let v = rate.then_some(v_new);
+                let (f, kt) = law_tangent(law, st, d_old, d_new, dir, v);
+                let ct = if *rate {
+                    law_damping(law, st, d_old, d_new, v_new, f)
+                } else {
+                    0.0
+                };
                 Trial {
                     f,
                     kt,
+                    ct,
+                    v: v_new,
                     ..Trial::default()
                 }
             }
@@ -482,8 +527,8 @@ impl JointLaw {
                 }
                 Ok(())
             }
-            (Self::Law { law, .. }, JointState::Law(st)) => {
-                let _ = law.step(st, None, d_new);
+            (Self::Law { law, rate, .. }, JointState::Law(st)) => {
+                let _ = law.step(st, law_dt(d_old, d_new, rate.then_some(trial.v)), d_new);
                 Ok(())
             }
             _ => Ok(()),
@@ -517,7 +562,7 @@ impl JointLaw {
             (Self::KelvinVoigt { k, .. }, _) => 0.5 * k * d * d,
             (Self::Normal { energy, .. }, _) => poly::eval(energy, d),
             // F² / (2 k0) as for Masing (exact for every closed cycle)
-            (Self::Law { law, k0 }, JointState::Law(st)) if *k0 > 0.0 => {
+            (Self::Law { law, k0, .. }, JointState::Law(st)) if *k0 > 0.0 => {
                 let f = law.step(&mut (**st).clone(), None, d);
                 0.5 * f * f / k0
             }

@@ -270,3 +270,97 @@ fn bad_input_is_an_error() {
         Err(CoreError::OutOfRange { .. })
     ));
 }
+
+/// The order statistics ranks of `tail_percentiles` for `n` samples (0.5 and 99.5 %).
+fn tail_ranks(n: usize) -> Vec<usize> {
+    let (a, b) = ((n - 1) / 200, (n - 1) * 199 / 200);
+    vec![a, a + 1, b, b + 1]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    /// The fused pass equals the passes it stands for: `detrend_pair_into`'s samples bit for
+    /// bit, `order_stats` of the detrended x exactly (long windows: from the tails; short
+    /// ones: the whole sample), the fold's check numbers exactly, so that a fold of the scan
+    /// is bit for bit the fold that checks its samples itself.
+    #[test]
+    fn the_scanned_pass_equals_the_separate_passes(
+        seed in 0u64..1000, n in prop::sample::select(vec![40usize, 5000, 40_000, 70_001]),
+        s_f in -1e3f64..1e3, s_x in -1e-3f64..1e-3, n_cyc in 1usize..4,
+        scale in prop::sample::select(vec![1.0, 1e-6, 1e150]),
+    ) {
+        let (t, x, f) = signal(n, seed, scale);
+        let tm = t[n / 2];
+        let (mut ef, mut ex) = (vec![0.0; n], vec![0.0; n]);
+        detrend_pair_into(&t, tm, (&f, s_f), (&x, s_x), (&mut ef, &mut ex)).unwrap();
+        let ranks = tail_ranks(n);
+        let (mut of, mut ox) = (vec![0.0; n], vec![0.0; n]);
+        let scan = detrend_pair_scan_into(&t, tm, (&f, s_f), (&x, s_x), (&mut of, &mut ox), &ranks)
+            .unwrap();
+        prop_assert!(of.iter().zip(&ef).all(|(a, b)| a.to_bits() == b.to_bits()));
+        prop_assert!(ox.iter().zip(&ex).all(|(a, b)| a.to_bits() == b.to_bits()));
+        prop_assert_eq!(&scan.order_stats, &crate::select::order_stats(&ex, &ranks).unwrap());
+        prop_assert!(scan.clean);
+        let [sx, sf, fm] = check_samples(&t, &ex, &ef, &[]).unwrap();
+        prop_assert_eq!(
+            [scan.max_abs_x, scan.max_abs_f, scan.force_centre].map(f64::to_bits),
+            [sx, sf, fm].map(f64::to_bits)
+        );
+        let period = 2.0 * std::f64::consts::PI / 6.0;
+        if n >= 5000 {
+            let (kt, kp) = knots(&t, period, n_cyc);
+            let edges: Vec<f64> = kt.iter().step_by(2).copied().collect();
+            let a = fold_window(&t, &ox, &of, &kt, &kp, 16, n_cyc, &edges).unwrap();
+            let b = fold_window_scanned(&t, &ox, &of, (&kt, &kp), (16, n_cyc), &edges, &scan)
+                .unwrap();
+            // bit for bit (NaN == NaN by bits)
+            prop_assert_eq!(format!("{a:?}"), format!("{b:?}"));
+        }
+    }
+}
+
+#[test]
+fn the_scan_finds_what_the_fold_check_refuses() {
+    let (t, x, f) = signal(3000, 7, 1.0);
+    let tm = t[0];
+    let run = |t: &[f64], x: &[f64], f: &[f64]| {
+        let n = t.len();
+        let (mut of, mut ox) = (vec![0.0; n], vec![0.0; n]);
+        detrend_pair_scan_into(t, tm, (f, 0.5), (x, 1e-3), (&mut of, &mut ox), &[]).unwrap()
+    };
+    assert!(run(&t, &x, &f).clean);
+    assert!(run(&t, &x, &f).order_stats.is_empty());
+    for (k, bad) in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY]
+        .into_iter()
+        .enumerate()
+    {
+        let mut xb = x.clone();
+        xb[1234 + k] = bad;
+        assert!(!run(&t, &xb, &f).clean);
+        let mut fb = f.clone();
+        fb[2999] = bad;
+        assert!(!run(&t, &x, &fb).clean);
+        let mut tb = t.clone();
+        tb[0] = bad;
+        assert!(!run(&tb, &x, &f).clean);
+    }
+    // t not strictly increasing: a repeat, a step back, at a block's edge
+    for i in [1, 2048, 2999] {
+        let mut tb = t.clone();
+        tb[i] = tb[i - 1];
+        assert!(!run(&tb, &x, &f).clean);
+        tb[i] = tb[i - 1] - 1e-3;
+        assert!(!run(&tb, &x, &f).clean);
+    }
+    assert!(!run(&t[..1], &x[..1], &f[..1]).clean);
+    // a scan that is not clean, or of other samples, is no stand-in for the fold's check
+    let mut xb = x.clone();
+    xb[5] = f64::NAN;
+    let bad = run(&t, &xb, &f);
+    let (kt, kp) = knots(&t, 1.0, 1);
+    assert!(fold_window_scanned(&t, &x, &f, (&kt, &kp), (8, 1), &[], &bad).is_err());
+    let other = run(&t[..2000], &x[..2000], &f[..2000]);
+    assert!(fold_window_scanned(&t, &x, &f, (&kt, &kp), (8, 1), &[], &other).is_err());
+    let ok = run(&t, &x, &f);
+    assert!(fold_window_scanned(&t, &x, &f, (&kt, &kp), (8, 1), &[], &ok).is_ok());
+}

@@ -82,15 +82,66 @@ def turning_points(x: np.ndarray, band: float) -> np.ndarray:
 TURN_SIGMAS, TURN_SHARE = 6.0, 1e-3
 
 
+#: samples at the start whose median is the rest position
+REST_SAMPLES = 9
+
+
+def from_rest(
+    x: np.ndarray, turns: np.ndarray, band: float, start: np.ndarray | None = None
+) -> np.ndarray:
+    """``turns`` without the leading ones that lie within ``band`` (the turning points'
+    hysteresis, several input-noise RMS) of the rest position (the median of the first
+    :data:`REST_SAMPLES` samples of ``start``, default ``x``), when the record starts near
+    the middle of its stroke (within a quarter of the range: a record cut from a steady run
+    near one end keeps a first turn close to its start).
+
+    A record that starts from rest loads the contact along its virgin curve up to the first
+    real turning point; a wiggle of the displacement *sensor* at rest (its noise, a filter's
+    start-up transient: a first sample 8 σ off) found as a turning point would start a
+    branch there instead. For a Masing element that is wiped out at once, but a λ-scaled
+    element has no wiping-out: a branch from a turn at rest is a Masing branch whatever λ,
+    and the first loading — the one thing that tells λ from a force offset
+    (docs/effects.md) — is lost."""
+    if turns.size == 0 or x.size == 0:
+        return turns
+    head = x if start is None else start
+    rest = float(np.median(head[: min(REST_SAMPLES, head.size)]))
+    span = float(np.ptp(x))
+    if abs(rest - 0.5 * (float(np.max(x)) + float(np.min(x)))) > 0.25 * span:
+        return turns
+    far = np.abs(x[turns] - rest) > band
+    first = int(np.argmax(far)) if far.any() else turns.size
+    return turns[first:]
+
+
+def record_turns(
+    u: np.ndarray, u_noise: float, start: np.ndarray | None = None, span: float | None = None
+) -> np.ndarray:
+    """The actual turning points of the filtered input ``u`` (noise RMS ``u_noise``):
+    :func:`turning_points` with the hysteresis band of :data:`TURN_SIGMAS`,
+    :data:`TURN_SHARE` (of ``span``, default the range of ``u``), from rest
+    (:func:`from_rest`; ``start``: the record's first samples when ``u`` is a sequence
+    merged from a kept record's samples and turning points)."""
+    span = float(np.ptp(u)) if span is None else span
+    band = max(TURN_SIGMAS * float(u_noise), TURN_SHARE * span)
+    return from_rest(u, turning_points(u, band), band, start)
+
+
 def actual_turns(ctx) -> np.ndarray:
     """The actual turning points of the history an element runs over (``ctx.xm``): on a
-    whole record, :func:`turning_points` of the filtered input (kept per record); on a kept
-    record, its reversals (the knots keep the turns between the samples)."""
+    whole record, :func:`record_turns` of the filtered input (kept per record); on a kept
+    record, the same of the merged sequence (the knots hold every turning point between the
+    kept samples, so the turns found there are those of the raw-rate input), kept per span."""
     d = ctx.d
     if ctx.sp is not None:
-        return ctx.sp.reversals
-    band = max(TURN_SIGMAS * float(d.extra.get("u_noise", 0.0)), TURN_SHARE * float(np.ptp(d.u)))
-    return ctx.fixed("turning_points", lambda: turning_points(d.u, band))
+        turns = getattr(ctx.sp, "turns_from_rest", None)
+        if turns is None:
+            noise = d.extra.get("u_noise", 0.0)
+            start = d.u + (float(ctx.xm[0]) - float(d.u[0]))  # (an offset moves both)
+            turns = record_turns(ctx.xm, noise, start, float(np.ptp(d.u)))
+            ctx.sp.turns_from_rest = turns
+        return turns
+    return ctx.fixed("turning_points", lambda: record_turns(d.u, d.extra.get("u_noise", 0.0)))
 
 
 def fixed(d: Prepared, key: str, make: Callable[[], Any]) -> Any:

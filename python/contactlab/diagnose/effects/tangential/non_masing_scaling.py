@@ -7,7 +7,10 @@ import numpy as np
 
 from ..._family import ParamSpec
 from .._base import EffectModel, Plausibility, register
-from ._common import actual_turns, turning_points  # noqa: F401  (re-exported)
+from ._common import actual_turns, record_turns, turning_points  # noqa: F401  (re-exported)
+
+#: the branch scales :meth:`NonMasingScaling.start` tries (λ = 2 is Masing)
+START_GRID = (0.6, 0.8, 1.0, 1.2, 1.35, 1.5, 1.65, 1.8, 2.0, 2.3, 2.7, 3.2, 4.0, 5.0, 6.5)
 
 
 def turning_point_force(virgin, lam: float, x: np.ndarray, rev: np.ndarray) -> np.ndarray:
@@ -48,6 +51,37 @@ class NonMasingScaling(EffectModel):
     stage = "element"
     order = 9
     size_param = "lam"
+
+    def start(self, p, d, residual, family=None):
+        """λ and the base parameters that keep the steady loop the current one.
+
+        A λ-scaled element of ``(2 h0 / λ, λ ac / 2)`` runs, after the first half cycle, the
+        same loop as the Masing element of ``(h0, ac)``, shifted by the constant ``F_c(λ)``
+        (docs/effects.md): what tells λ is that shift together with the first loading from
+        rest. Started at λ = 2 the solver sees the offset and the first loading pull λ in
+        opposite directions and can run to the edge of its range (λ = 0.2 on a record of
+        λ = 1.47 whose force offset then took the gain); each λ of :data:`START_GRID` is
+        scored against the data with the rest of the current model kept, and the fit starts
+        at the best."""
+        from ....masing import Masing
+
+        h0, ac = float(p.get("h0", np.nan)), float(p.get("ac", np.nan))
+        if not (np.isfinite(h0) and np.isfinite(ac) and h0 > 0 and ac > 0) or d.u.size < 3:
+            return {}
+        x = d.u
+        turns = record_turns(x, d.extra.get("u_noise", 0.0))
+        masing = Masing(h0, ac).force(x)
+        rest = (d.y - residual) - masing  # the current model's terms beside its element
+        best, best_sse = None, np.inf
+        for lam in START_GRID:
+            h_l, a_l = 2.0 * h0 / lam, lam * ac / 2.0
+            pred = rest + turning_point_force(Masing(h_l, a_l).virgin, lam, x, turns)
+            sse = float(np.sum((pred - d.y) ** 2))
+            if np.isfinite(sse) and sse < best_sse:
+                best, best_sse = lam, sse
+        if best is None or best == 2.0:
+            return {}
+        return {"lam": best, "h0": 2.0 * h0 / best, "ac": best * ac / 2.0}
 
     def apply(self, core, p, ctx):
         from ....masing import Masing

@@ -6,6 +6,7 @@ import numpy as np
 
 from ..._family import ParamSpec
 from .._base import EffectModel, register
+from ._common import amplitude
 
 
 def reversal_anchors(reversals: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -17,6 +18,33 @@ def reversal_anchors(reversals: np.ndarray, n: int) -> tuple[np.ndarray, np.ndar
     return has, r
 
 
+def breakaway_term(
+    h: np.ndarray,
+    x: np.ndarray,
+    reversals: np.ndarray,
+    s_b: float,
+    ell: float,
+    h0: float,
+    anchors: tuple[np.ndarray, np.ndarray] | None = None,
+    at: np.ndarray | None = None,
+) -> np.ndarray:
+    """The branches with the breakaway of docs/effects.md added: after each reversal
+    ``r``, ``h + s_b h0 sgn(ẋ) (s/ell) e^(1 - s/ell)`` with ``s = |x - x_r|`` the travel
+    since it (``sgn(ẋ) s = x - x_r``): zero at the reversal (no jump), peak ``s_b h0`` at
+    ``s = ell``, gone far from it; none before the first reversal (the first loading from
+    rest). ``anchors``: :func:`reversal_anchors` of ``reversals``, when computed already;
+    ``at``: sample indices, the result at those samples only."""
+    if s_b == 0.0:
+        return h if at is None else h[at]
+    has, r = anchors if anchors is not None else reversal_anchors(reversals, h.size)
+    xx = x
+    if at is not None:  # the anchors (reversals) from the whole history, the rest at ``at``
+        has, r, h, xx = has[at], r[at], h[at], x[at]
+    e = max(ell, 1e-300)
+    dx = np.where(has, xx - x[r], 0.0)
+    return h + s_b * h0 * (dx / e) * np.exp(1.0 - np.abs(dx) / e)
+
+
 def breakaway(
     h: np.ndarray,
     x: np.ndarray,
@@ -26,10 +54,12 @@ def breakaway(
     anchors: tuple[np.ndarray, np.ndarray] | None = None,
     at: np.ndarray | None = None,
 ) -> np.ndarray:
-    """Branches with a breakaway peak: after each reversal ``r`` the rise ``h - h_r`` is
-    scaled by ``1 + s_b exp(-|x - x_r| / ell)`` — equal to Masing's at the reversal (no
-    jump) and far from it, above it in between (static friction above kinetic). Before the
-    first reversal the virgin curve from the origin is treated the same way. ``anchors``:
+    """Branches with a breakaway peak of the package's generator
+    (:func:`contactlab.synthetic.diagnosis.hidden_effect_recording` makes its stick-slip
+    with it; the candidate follows docs/effects.md, :func:`breakaway_term`): after each
+    reversal ``r`` the rise ``h - h_r`` is scaled by ``1 + s_b exp(-|x - x_r| / ell)`` —
+    equal to Masing's at the reversal (no jump) and far from it, above it in between. Before
+    the first reversal the virgin curve from the origin is treated the same way. ``anchors``:
     :func:`reversal_anchors` of ``reversals``, when computed already; ``at``: sample indices,
     the result at those samples only."""
     if s_b == 0.0:
@@ -45,11 +75,16 @@ def breakaway(
 
 
 def breakaway_force(h0: float, ac: float, s_b: float, ell: float) -> float:
-    """Peak force of a full branch from ``-h0`` with the breakaway of :func:`breakaway`
+    """Peak force of a full branch from ``-h0`` with the breakaway of :func:`breakaway_term`
     (the static friction force; ``h0`` without breakaway)."""
     u = np.linspace(0.0, 20.0 / ac + 20.0 * ell, 4001)
     rise = 2.0 * h0 * -np.expm1(-ac * u / 2.0)
-    return float(np.max(-h0 + rise * (1.0 + s_b * np.exp(-u / max(ell, 1e-300)))))
+    e = max(ell, 1e-300)
+    return float(np.max(-h0 + rise + s_b * h0 * (u / e) * np.exp(1.0 - u / e)))
+
+
+#: slip distances :meth:`StickSlip.start` tries, as shares of the displacement amplitude
+START_SHARES = (0.03, 0.06, 0.1, 0.15, 0.25, 0.4, 0.6)
 
 
 @register
@@ -57,24 +92,44 @@ class StickSlip(EffectModel):
     name = "stick_slip"
     kind = "tangential"
     params = (
-        ParamSpec("s_b", "-", 0.0, 0.0, 0.5, "one"),
+        ParamSpec("s_b", "-", 0.0, 0.0, 1.0, "one"),
         ParamSpec("ell", "m", np.nan, 0.0, np.inf, "x"),
     )
     description = (
-        "breakaway after each reversal: the branch rises s_b above Masing's and falls back "
-        "over a slip distance ell (static friction above kinetic)"
+        "breakaway after each reversal: s_b h0 sgn(v) (s/ell) e^(1 - s/ell) added, s the "
+        "travel since the reversal (static friction above kinetic)"
     )
     physics = (
-        "Static friction above kinetic: after each reversal the branch overshoots the "
-        "plateau by up to s_b h0 and falls back to it over a slip distance ell (a function "
-        "of the distance slid, not of the speed — Stribeck's is of the speed)."
+        "Static friction above kinetic: after each reversal the force rises above Masing's "
+        "branch by up to s_b h0 at a travel ell and falls back to it (a function of the "
+        "distance slid since the reversal, not of the speed — Stribeck's is of the speed): "
+        "F = M[x] + s_b h0 sgn(ẋ) (s/ell) e^(1 - s/ell) (docs/effects.md)."
     )
     stage = "branch"
     order = 13
     size_param = "s_b"
 
     def start(self, p, d, residual, family=None):
-        return {"ell": 1.0 / p["ac"]}
+        """The slip distance (of :data:`START_SHARES` of the amplitude) and size whose term
+        lowers the current residual most (the term is linear in ``s_b`` at a given
+        ``ell``); ``ell = 1/ac`` when none does."""
+        h0 = float(p.get("h0", np.nan))
+        A = amplitude(d)
+        rev = d.cycles.reversals
+        best: dict[str, float] = {"ell": 1.0 / p["ac"]}
+        if not (np.isfinite(h0) and h0 > 0 and A > 0 and rev.size):
+            return best
+        has, r = reversal_anchors(rev, d.u.size)
+        dx = np.where(has, d.u - d.u[r], 0.0)
+        top = 0.0
+        for share in START_SHARES:
+            e = share * A
+            term = h0 * (dx / e) * np.exp(1.0 - np.abs(dx) / e)
+            tt, rt = float(term @ term), float(residual @ term)
+            if tt > 0 and rt > 0 and rt * rt / tt > top:
+                top = rt * rt / tt
+                best = {"ell": e, "s_b": min(rt / tt, 0.9)}
+        return best
 
     def apply(self, h, p, ctx):
         d = ctx.d
@@ -82,11 +137,13 @@ class StickSlip(EffectModel):
             rev = d.cycles.reversals
             n = ctx.x.size
             anchors = ctx.fixed("anchors", lambda: reversal_anchors(rev, n))
-            return breakaway(h, ctx.x, rev, p["s_b"], p["ell"], anchors, ctx.rows)
+            return breakaway_term(h, ctx.x, rev, p["s_b"], p["ell"], p["h0"], anchors, ctx.rows)
         sp = ctx.sp
         if sp.anchors is None:
             sp.anchors = reversal_anchors(sp.reversals, sp.size)
-        return breakaway(h, ctx.xm, sp.reversals, p["s_b"], p["ell"], sp.anchors, sp.rows)
+        return breakaway_term(
+            h, ctx.xm, sp.reversals, p["s_b"], p["ell"], p["h0"], sp.anchors, sp.rows
+        )
 
     def derived(self, p, se, *, effects=None, d=None, family=None, **more):
         """``breakaway_force``: with the model's ``effects``, the data ``d`` and the
@@ -116,7 +173,7 @@ class StickSlip(EffectModel):
 
     def argument(self, d, p):
         return (
-            f"the force overshoots the plateau by up to {100 * p['s_b']:.0f} % after each "
-            f"reversal and falls back within ell = {p['ell']:.3g} m of sliding: static "
-            "friction above kinetic"
+            f"the force rises {100 * p['s_b']:.0f} % of h0 above the branch at a travel "
+            f"ell = {p['ell']:.3g} m after each reversal and falls back: static friction "
+            "above kinetic"
         )

@@ -316,8 +316,13 @@ def add_workers_flag(p: Any, what: str, *, per_core: bool = False) -> None:
         )
         p.add_argument("--workers", type=int, default=None, metavar="N", help=help_)
         return
-    p.add_argument("--workers", type=int, default=None, metavar="N",
-                   help=f"analyse {what} in N processes (default: serially)")  # fmt: skip
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        metavar="N",
+        help=f"analyse {what} in N processes (default: serially)",
+    )
 
 
 def default_workers() -> int | None:
@@ -395,8 +400,10 @@ def process_pool(workers: int | None, *, auto: bool = False) -> Any:
                 f"--workers {workers}: cannot start worker processes here ({exc}); "
                 "--workers 0 runs in this process"
             ) from None
-        print(f"note: cannot start worker processes here ({exc}); running in this process",
-              file=sys.stderr)  # fmt: skip
+        print(
+            f"note: cannot start worker processes here ({exc}); running in this process",
+            file=sys.stderr,
+        )
         return contextlib.nullcontext(None)
 
 
@@ -427,10 +434,16 @@ class _InterruptiblePool:
 
 def add_progress_flags(p: Any) -> None:
     g = p.add_mutually_exclusive_group()
-    g.add_argument("--progress", dest="progress", action="store_true", default=None,
-                   help="always show a progress bar (default: only on a terminal)")  # fmt: skip
-    g.add_argument("--no-progress", dest="progress", action="store_false",
-                   help="never show a progress bar")  # fmt: skip
+    g.add_argument(
+        "--progress",
+        dest="progress",
+        action="store_true",
+        default=None,
+        help="always show a progress bar (default: only on a terminal)",
+    )
+    g.add_argument(
+        "--no-progress", dest="progress", action="store_false", help="never show a progress bar"
+    )
 
 
 def normal_options(entry: object, nopts: dict) -> dict:
@@ -489,8 +502,9 @@ def frame_option(args: Any) -> dict[str, Any] | None:
     if getattr(args, "model", None) == "normal":
         raise InputError("--frame gives a tangential recording (x, F): use --model tangential")
     if getattr(args, "columns", None):
-        raise InputError("--frame reads the displacements: name them with --frame-x/--frame-y, "
-                         "not --columns")  # fmt: skip
+        raise InputError(
+            "--frame reads the displacements: name them with --frame-x/--frame-y, not --columns"
+        )
     from ..tangential.frame import parse_frame
 
     M, C, K = parse_frame(text)
@@ -509,8 +523,10 @@ def output_filter_taps(text: str | None) -> Any:
     kind, _, rest = text.strip().partition(":")
     kind = kind.strip().lower()
     fields = [f.strip() for f in rest.split(":")] if rest else []
-    usage = ("--output-filter: give savgol:WINDOW[:ORDER], mean:WINDOW or frame:WINDOW "
-             "(WINDOW an odd number of samples), e.g. savgol:11")  # fmt: skip
+    usage = (
+        "--output-filter: give savgol:WINDOW[:ORDER], mean:WINDOW or frame:WINDOW "
+        "(WINDOW an odd number of samples), e.g. savgol:11"
+    )
     if kind not in ("savgol", "mean", "frame") or not fields or len(fields) > 2:
         raise InputError(f"{usage}; got {text!r}")
     if len(fields) == 2 and kind != "savgol":
@@ -572,8 +588,12 @@ def add_reader_flags(p: Any, *, model: bool = True) -> None:
     """The flags every verb that reads a recording shares, worded alike: ``--model``,
     ``--columns``, ``--fs`` and ``--resample``."""
     if model:
-        p.add_argument("--model", choices=("tangential", "normal"), metavar="{tangential,normal}",
-                       help=MODEL_HELP)  # fmt: skip
+        p.add_argument(
+            "--model",
+            choices=("tangential", "normal"),
+            metavar="{tangential,normal}",
+            help=MODEL_HELP,
+        )
     p.add_argument(
         "--columns",
         metavar="MAP",
@@ -623,8 +643,9 @@ def wrapped(text: str, width: int = 100) -> str:
     """``text`` wrapped to ``width`` characters, continuation lines indented."""
     import textwrap
 
-    return textwrap.fill(text, width=width, subsequent_indent="   ", break_long_words=False,
-                         break_on_hyphens=False)  # fmt: skip
+    return textwrap.fill(
+        text, width=width, subsequent_indent="   ", break_long_words=False, break_on_hyphens=False
+    )
 
 
 def wrap_warning(text: str, *, prefix: str = "  warning: ", width: int = 100) -> str:
@@ -632,9 +653,13 @@ def wrap_warning(text: str, *, prefix: str = "  warning: ", width: int = 100) ->
     import textwrap
 
     return textwrap.fill(
-        text, width=width, initial_indent=prefix, subsequent_indent=" " * len(prefix),
-        break_long_words=False, break_on_hyphens=False,
-    )  # fmt: skip
+        text,
+        width=width,
+        initial_indent=prefix,
+        subsequent_indent=" " * len(prefix),
+        break_long_words=False,
+        break_on_hyphens=False,
+    )
 
 
 #: ``--force-sign``'s values as ``--help`` shows them (``1`` is read as ``+1``)

@@ -1,0 +1,140 @@
+"""Streamed ``contactlab analyze`` of a long HDF5 recording against the Masing kernel on the
+same samples, in the same run (issue 33 item 4: the bar is 0.3 of the kernel's throughput).
+
+Writes tangential HDF5 recordings of ``--samples`` samples (x and F float64, a sampling
+interval attribute: :func:`bench_track.write_file`, a 10 Hz Masing loop at 10 kHz with sensor
+noise) into a temporary folder and deletes them afterwards. Per size, interleaved round by
+round:
+
+- ``kernel``: ``Masing(h0, ac).force(x, out=buf)`` over the whole displacement in memory
+  (this process; the row of ``speed_table.py``);
+- ``analyze``: ``contactlab analyze FILE --json OUT`` as a user runs it (a new process:
+  start-up, reading, the windows on the default helper threads, pooling, the JSON), wall time
+  and CPU time (user + system of the process and its threads, ``os.wait4``);
+- ``read``: :func:`contactlab.io.read_chunks` over the file alone (a new process), the floor
+  the reading sets.
+
+Throughput = samples / median wall time; the ratio analyze / kernel is the figure. The JSON of
+every analyze round is compared byte for byte with the first (the windows are deterministic).
+
+Run: ``nice .venv/bin/python benches/bench_analyze.py [--samples 1e7 3e7] [--rounds 5]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benches"))
+
+import bench_track  # noqa: E402
+
+READ = (
+    "import sys\nfrom contactlab.io import read_chunks\n"
+    "n = sum(len(c) for c in read_chunks(sys.argv[1], chunk_size=1 << 20))\nprint(n)"
+)
+
+
+def child(cmd: list[str]) -> tuple[float, float]:
+    """Wall and CPU seconds of a child process (which must succeed)."""
+    t0 = time.perf_counter()
+    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    err = p.stderr.read() if p.stderr is not None else b""
+    _, status, usage = os.wait4(p.pid, 0)
+    wall = time.perf_counter() - t0
+    if os.waitstatus_to_exitcode(status) != 0:
+        raise SystemExit(f"{cmd} failed: {err.decode()[-2000:]}")
+    return wall, usage.ru_utime + usage.ru_stime
+
+
+def measure(path: Path, n: int, rounds: int, tmp: Path) -> dict[str, float]:
+    import h5py
+
+    import contactlab
+
+    with h5py.File(path, "r") as f:
+        x = f["x"][:]
+    m = contactlab.Masing(h0=bench_track.H0, ac=bench_track.AC)
+    buf = np.empty_like(x)
+    exe = str(Path(sys.executable).with_name("contactlab"))
+    times: dict[str, list[float]] = {"kernel": [], "analyze": [], "analyze_cpu": [], "read": []}
+    outputs: list[bytes] = []
+
+    def kernel() -> None:
+        t0 = time.perf_counter()
+        m.force(x, out=buf)
+        times["kernel"].append(time.perf_counter() - t0)
+
+    def analyze() -> None:
+        out = tmp / f"a{len(outputs)}.json"
+        w, c = child([exe, "analyze", str(path), "--json", str(out)])
+        times["analyze"].append(w)
+        times["analyze_cpu"].append(c)
+        outputs.append(out.read_bytes())
+        out.unlink()
+
+    def read() -> None:
+        times["read"].append(child([sys.executable, "-c", READ, str(path)])[0])
+
+    m.force(x, out=buf)  # warm-up
+    steps = [kernel, analyze, read]
+    for r in range(rounds):
+        for f in steps[r % 3 :] + steps[: r % 3]:
+            f()
+    same = all(o == outputs[0] for o in outputs)
+    med = {k: float(np.median(v)) for k, v in times.items()}
+    med["same_json"] = float(same)
+    return med
+
+
+def rows(sizes: list[int], rounds: int) -> list[tuple[str, str, str, float, str]]:
+    """Rows (task, ours, reference, ratio, note) for ``speed_table.py``."""
+    out = []
+    with tempfile.TemporaryDirectory(prefix="contactlab-bench-analyze-") as d:
+        tmp = Path(d)
+        for n in sizes:
+            path = tmp / f"t{n:.0e}.h5"
+            bench_track.write_file(path, n)
+            r = measure(path, n, rounds, tmp)
+            path.unlink()
+            ka, an, rd = n / r["kernel"] / 1e6, n / r["analyze"] / 1e6, n / r["read"] / 1e6
+            out.append(
+                (
+                    f"`contactlab analyze --json`, {n:.0e}-sample HDF5, command line",
+                    f"{r['analyze']:.2f} s wall ({an:.1f} M samples/s), "
+                    f"{r['analyze_cpu']:.2f} s CPU ({n / r['analyze_cpu'] / 1e6:.1f} M/CPU-s)",
+                    f"Masing kernel {ka:.0f} M/s; read_chunks alone (new process) "
+                    f"{r['read']:.2f} s ({rd:.0f} M/s)",
+                    an / ka,
+                    "of the kernel; JSON "
+                    + ("identical in every round" if r["same_json"] else "DIFFERS between rounds"),
+                )
+            )
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--samples", type=float, nargs="+", default=[1e7, 3e7])
+    ap.add_argument("--rounds", type=int, default=5)
+    args = ap.parse_args()
+    print(
+        f"load {', '.join(f'{a:.2f}' for a in os.getloadavg())}; {os.cpu_count()} CPUs; "
+        f"medians of {args.rounds} interleaved rounds"
+    )
+    print("| task | contactlab | reference | ratio | note |")
+    print("|---|---|---|---|---|")
+    for task, ours, ref, ratio, note in rows([int(s) for s in args.samples], args.rounds):
+        print(f"| {task} | {ours} | {ref} | {ratio:.2f} | {note} |")
+
+
+if __name__ == "__main__":
+    main()

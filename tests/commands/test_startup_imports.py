@@ -1,0 +1,118 @@
+"""Command-line start-up (issue 33): what ``contactlab --help`` and ``analyze`` import before
+they have work for it. A behaviour test on ``sys.modules`` in a new process (no timings)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import contactlab.fem
+
+RECORDING = (
+    Path(__file__).resolve().parents[2]
+    / "python"
+    / "contactlab"
+    / "data"
+    / "tangential"
+    / "Al-Al_W50N_A5um.csv"
+)
+HEAVY = ("scipy", "matplotlib")
+
+
+def _modules_after(code: str, *args: str) -> set[str]:
+    out = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            f"{code}\nimport sys\nprint('\\n'.join(sys.modules))",
+            *args,
+        ],
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout
+    return set(out.split())
+
+
+def _heavy(loaded: set[str]) -> list[str]:
+    return sorted(m for m in loaded if m.split(".")[0] in HEAVY)
+
+
+def test_help_imports_neither_numpy_nor_scipy_nor_matplotlib():
+    loaded = _modules_after(
+        "import contextlib, io\nfrom contactlab.cli import main\n"
+        "with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit):\n"
+        "    main(['--help'])"
+    )
+    assert "contactlab.commands.export" in loaded  # every verb's parser was built
+    assert not _heavy(loaded), _heavy(loaded)
+    assert "numpy" not in loaded
+    assert "contactlab.fem.ccx" not in loaded
+
+
+def test_every_verbs_parser_imports_no_scipy_or_matplotlib():
+    loaded = _modules_after(
+        "import contactlab.commands\nfrom contactlab.cli import _VERB_MODULES, build_parser\n"
+        "for m in _VERB_MODULES:\n    build_parser(m)"
+    )
+    assert not _heavy(loaded), _heavy(loaded)
+
+
+def test_analyze_reads_its_first_sample_before_importing_scipy_or_matplotlib():
+    # an audit hook ends the run when the reader opens the recording; what was imported then
+    code = (
+        "import os, sys\n"
+        "target = os.path.abspath(sys.argv[1])\n"
+        "def hook(event, args):\n"
+        "    path = args[0] if event == 'open' else None\n"
+        "    if isinstance(path, str) and os.path.abspath(path) == target:\n"
+        "        print('OPENED'); print('\\n'.join(sys.modules)); sys.stdout.flush(); os._exit(0)\n"
+        "sys.addaudithook(hook)\n"
+        "from contactlab.cli import main\n"
+        "main(['analyze', target])\n"
+        "print('NOT OPENED')"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code, str(RECORDING)], capture_output=True, text=True, check=True
+    ).stdout.split()
+    assert out[0] == "OPENED", out[:3]
+    loaded = set(out[1:])
+    assert "contactlab.commands.analyze" in loaded
+    assert not _heavy(loaded), _heavy(loaded)
+    assert "contactlab.diagnose" not in loaded
+
+
+def test_fem_package_loads_its_workers_on_first_use():
+    loaded = _modules_after("import contactlab.fem\ncontactlab.fem.unit_system('SI')")
+    assert "numpy" not in loaded
+    assert not {"contactlab.fem.ccx", "contactlab.fem.characteristics"} & loaded
+    from contactlab.fem import ccx, characteristics, writers
+
+    assert contactlab.fem.render is writers.render
+    assert contactlab.fem.SolverError is ccx.SolverError
+    assert contactlab.fem.joint_characteristics is characteristics.joint_characteristics
+    assert contactlab.fem.FORMATS is writers.FORMATS
+    assert set(dir(contactlab.fem)) >= set(contactlab.fem.__all__)
+    with pytest.raises(AttributeError, match="no_such_name"):
+        contactlab.fem.no_such_name  # noqa: B018
+
+
+def test_studies_package_loads_its_workflows_on_first_use():
+    loaded = _modules_after("from contactlab.studies import entry_from_file")
+    assert "contactlab.studies.manifest" in loaded
+    assert not {"contactlab.studies.study", "contactlab.studies.tracking"} & loaded
+    assert "concurrent.futures" not in loaded
+    import importlib
+
+    import contactlab.studies as studies
+
+    for name, home in studies._LAZY.items():
+        module = importlib.import_module(f"contactlab.studies.{home}")
+        assert getattr(studies, name) is getattr(module, name), name
+    assert set(dir(studies)) >= set(studies.__all__)
+    assert set(studies._LAZY) == set(studies.__all__)
+    with pytest.raises(AttributeError, match="no_such_name"):
+        studies.no_such_name  # noqa: B018

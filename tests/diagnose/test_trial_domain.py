@@ -1,0 +1,31 @@
+"""A candidate's trial fit that steps out of the model's domain is a failed candidate, not
+the end of the diagnosis (issue 29: "ac must be finite and > 0, got 0.0" from diagnose)."""
+
+from __future__ import annotations
+
+import tempfile
+import warnings
+from pathlib import Path
+
+import contactlab
+from contactlab.synthetic.rig import rig_recording
+
+
+def test_trial_fit_reaching_ac_zero_is_a_candidate_not_fitted() -> None:
+    # a rig record in deep pre-sliding with a channel delay, fresh seed 931864028 of
+    # benches/eval_diagnose_rig.py: a trial fit drove ac to its bound 0 and the InputError
+    # of the Masing element ended the diagnosis
+    rec = rig_recording(
+        {"channel_delay": {"tau": 0.0010838150289017342}}, "tangential", seed=931864028,
+        fs=1156.8, f=13.84, cycles=16, acA=0.332, x_noise=0.0032, F_noise=0.0076,
+        x_drift=-0.0007894239635301654, bits=13,
+    )  # fmt: skip
+    with tempfile.TemporaryDirectory() as tmp:
+        r = contactlab.read_recording(str(rec.to_csv(Path(tmp) / "rec.csv")))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rep = contactlab.diagnose(r, model="tangential", max_effects=1)
+    tried = [v for st in rep.steps for v in st.candidates]
+    failed = [v for v in tried if v.reason.startswith("could not be fitted")]
+    assert any("ac must be" in v.reason for v in failed)
+    assert not any(v.accepted for v in failed)
