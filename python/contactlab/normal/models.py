@@ -175,26 +175,9 @@ class _ContactModel:
         dv = None if dpdt is None else as_1d(dpdt, "dpdt")
         if dv is not None and dv.size != tv.size:
             raise InputError(f"t has {tv.size} samples but dpdt has {dv.size}")
-        rtol = positive(rtol, "rtol")
-        if atol is None:
-            atol = rtol * self._delta_scale(float(np.max(np.abs(pd))))
-        atol = positive(atol, "atol")
-        if isinstance(delta0, str):
-            if delta0 != "equilibrium":
-                raise InputError(f"delta0 must be a number or 'equilibrium', got {delta0!r}")
-            d0 = self.equilibrium(float(pd[0]))
-        else:
-            d0 = float(delta0)
-            if not math.isfinite(d0):
-                raise InputError(f"delta0 must be finite, got {delta0}")
-        if interp not in ("cubic", "linear"):
-            raise InputError(f"interp must be 'cubic' or 'linear', got {interp!r}")
-        if max_steps is None:
-            max_steps = AUTO_STEPS_PER_SAMPLE * tv.size + AUTO_STEPS_BASE
-        if max_steps < 0:
-            raise InputError(f"max_steps must be >= 0, got {max_steps}")
-        if method not in ("auto", "rodas4"):
-            raise InputError(f"method must be 'auto' or 'rodas4', got {method!r}")
+        rtol, atol, d0, max_steps = self._solver_settings(
+            pd, tv.size, rtol, atol, delta0, interp, max_steps, method
+        )
         r = _core.normal_simulate(
             tv,
             np.ascontiguousarray(pd),
@@ -229,6 +212,41 @@ class _ContactModel:
             res.message += self._failure_hint(res.delta)
         self._check_solution(res.delta)
         return res
+
+    def _solver_settings(
+        self,
+        pd: np.ndarray,
+        n: int,
+        rtol: float,
+        atol: float | None,
+        delta0: float | str,
+        interp: str,
+        max_steps: int | None,
+        method: str,
+    ) -> tuple[float, float, float, int]:
+        """:meth:`simulate`'s tolerances, start and options checked: ``(rtol, atol, δ0,
+        max_steps)`` for ``n`` samples of the dynamic pressure ``pd``."""
+        rtol = positive(rtol, "rtol")
+        if atol is None:
+            atol = rtol * self._delta_scale(float(np.max(np.abs(pd))))
+        atol = positive(atol, "atol")
+        if isinstance(delta0, str):
+            if delta0 != "equilibrium":
+                raise InputError(f"delta0 must be a number or 'equilibrium', got {delta0!r}")
+            d0 = self.equilibrium(float(pd[0]))
+        else:
+            d0 = float(delta0)
+            if not math.isfinite(d0):
+                raise InputError(f"delta0 must be finite, got {delta0}")
+        if interp not in ("cubic", "linear"):
+            raise InputError(f"interp must be 'cubic' or 'linear', got {interp!r}")
+        if max_steps is None:
+            max_steps = AUTO_STEPS_PER_SAMPLE * n + AUTO_STEPS_BASE
+        if max_steps < 0:
+            raise InputError(f"max_steps must be >= 0, got {max_steps}")
+        if method not in ("auto", "rodas4"):
+            raise InputError(f"method must be 'auto' or 'rodas4', got {method!r}")
+        return rtol, atol, d0, int(max_steps)
 
     def _failure_hint(self, delta: np.ndarray) -> str:
         """Extra explanation appended to a failed solve's message (override)."""
