@@ -123,7 +123,7 @@ def _call(b: Bytes) -> tuple[object, tuple]:
             out = _core.normal_simulate(
                 t, p, law, coeffs, psi, omega, d0, rtol, atol, interp, dpdt, first, steps
             )
-            return out if out["status"] == 0 else None
+            return out if out.status == 0 else None
 
         return run, (t, p, coeffs, psi, omega, d0, rtol, atol, dpdt, first)
     if op == 8:

@@ -181,9 +181,9 @@ def _unit_response(
     r = _core.normal_simulate_grid(
         tc, uc, "constant", np.ones(1), psi, omega, float(u[0]), 1, 1.0, dudt
     )
-    if int(r["status"]) != 0:
-        raise ConvergenceError(f"Kelvin-Voigt response: {r['message']}")
-    return np.asarray(r["delta"])
+    if int(r.status) != 0:
+        raise ConvergenceError(f"Kelvin-Voigt response: {r.message}")
+    return np.asarray(r.delta)
 
 
 def _creep_shape(d: Prepared, tc: float) -> np.ndarray:

@@ -194,19 +194,19 @@ class _ContactModel:
             int(max_steps),
             method,
         )
-        n_out = int(r["n_out"])
+        n_out = int(r.n_out)
         res = OdeResult(
             t=tv[:n_out],
-            delta=r["delta"],
-            velocity=r["velocity"],
-            success=r["status"] == 0,
-            status=int(r["status"]),
-            message=str(r["message"]),
-            nfev=int(r["nfev"]),
-            njev=int(r["njev"]),
-            nlu=int(r["nlu"]),
-            n_steps=int(r["n_accepted"]),
-            n_rejected=int(r["n_rejected"]),
+            delta=r.delta,
+            velocity=r.velocity,
+            success=r.status == 0,
+            status=int(r.status),
+            message=str(r.message),
+            nfev=int(r.nfev),
+            njev=int(r.njev),
+            nlu=int(r.nlu),
+            n_steps=int(r.n_accepted),
+            n_rejected=int(r.n_rejected),
         )
         if not res.success:
             res.message += self._failure_hint(res.delta)
@@ -341,18 +341,18 @@ class _ContactModel:
             tol,
             None if dpdt is None else np.ascontiguousarray(as_1d(dpdt, "dpdt")),
         )
-        n_out = int(r["n_out"])
+        n_out = int(r.n_out)
         res = OdeResult(
             t=tv[:n_out],
-            delta=r["delta"],
-            velocity=r["velocity"],
-            success=r["status"] == 0,
-            status=int(r["status"]),
-            message=str(r["message"]),
-            nfev=int(r["nfev"]),
+            delta=r.delta,
+            velocity=r.velocity,
+            success=r.status == 0,
+            status=int(r.status),
+            message=str(r.message),
+            nfev=int(r.nfev),
             njev=0,
             nlu=0,
-            n_steps=int(r["n_accepted"]),
+            n_steps=int(r.n_accepted),
             n_rejected=0,
         )
         if not res.success:

@@ -6,7 +6,6 @@ use contactlab_core::normal::{
 use contactlab_core::CoreError;
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 
 use crate::detach_guarded;
 use crate::error::{slice, to_pyerr};
@@ -37,7 +36,43 @@ fn build_model(law: &str, coeffs: &[f64], psi: f64, omega: f64) -> Result<Contac
     ContactModel::new(st, psi, omega)
 }
 
-/// Integrate the contact ODE over sampled `(t, p)`; returns a dict of arrays and counters.
+/// The result of `normal_simulate` / `normal_simulate_grid`: the displacement and velocity
+/// at the first `n_out` samples, the solver status (0 = success) with its message, and the
+/// solver's counters.
+#[pyclass(module = "contactlab._core", frozen, get_all)]
+struct NormalRun {
+    delta: Py<PyArray1<f64>>,
+    velocity: Py<PyArray1<f64>>,
+    n_out: usize,
+    status: i32,
+    message: String,
+    nfev: u64,
+    njev: u64,
+    nlu: u64,
+    n_accepted: u64,
+    n_rejected: u64,
+}
+
+impl NormalRun {
+    fn new(py: Python<'_>, mut delta: Vec<f64>, mut vel: Vec<f64>, out: &ode::Outcome) -> Self {
+        delta.truncate(out.n_out);
+        vel.truncate(out.n_out);
+        Self {
+            delta: delta.into_pyarray(py).unbind(),
+            velocity: vel.into_pyarray(py).unbind(),
+            n_out: out.n_out,
+            status: out.status.code(),
+            message: out.status.message(),
+            nfev: out.stats.nfev,
+            njev: out.stats.njev,
+            nlu: out.stats.nlu,
+            n_accepted: out.stats.n_accepted,
+            n_rejected: out.stats.n_rejected,
+        }
+    }
+}
+
+/// Integrate the contact ODE over sampled `(t, p)`; returns a `NormalRun`.
 #[pyfunction]
 #[pyo3(signature = (t, p, law, coeffs, psi, omega, delta0, rtol, atol, interp="cubic", dpdt=None, first_step=None, max_steps=0, method="auto"))]
 fn normal_simulate<'py>(
@@ -56,7 +91,7 @@ fn normal_simulate<'py>(
     first_step: Option<f64>,
     max_steps: u64,
     method: &str,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<NormalRun> {
     let ts = slice(&t, "t")?;
     let ps = slice(&p, "p")?;
     let cs = slice(&coeffs, "coeffs")?;
@@ -81,7 +116,7 @@ fn normal_simulate<'py>(
         first_step,
         max_steps,
     };
-    let (mut delta, mut vel, out) = detach_guarded(py, move || {
+    let (delta, vel, out) = detach_guarded(py, move || {
         let model = build_model(&law, cs, psi, omega)?;
         let forcing = Forcing::new(ts, ps, ds, interp)?;
         let n = forcing.len();
@@ -92,24 +127,11 @@ fn normal_simulate<'py>(
         )?;
         Ok((delta, vel, out))
     })?;
-    delta.truncate(out.n_out);
-    vel.truncate(out.n_out);
-    let d = PyDict::new(py);
-    d.set_item("delta", delta.into_pyarray(py))?;
-    d.set_item("velocity", vel.into_pyarray(py))?;
-    d.set_item("n_out", out.n_out)?;
-    d.set_item("status", out.status.code())?;
-    d.set_item("message", out.status.message())?;
-    d.set_item("nfev", out.stats.nfev)?;
-    d.set_item("njev", out.stats.njev)?;
-    d.set_item("nlu", out.stats.nlu)?;
-    d.set_item("n_accepted", out.stats.n_accepted)?;
-    d.set_item("n_rejected", out.stats.n_rejected)?;
-    Ok(d)
+    Ok(NormalRun::new(py, delta, vel, &out))
 }
 
-/// Eq. 17 on the samples' own grid (`grid::simulate_grid`); returns a dict like
-/// `normal_simulate`'s. `dpdt`: the pressure's exact slopes at the samples (else finite
+/// Eq. 17 on the samples' own grid (`grid::simulate_grid`); returns a `NormalRun`
+/// (`njev`, `nlu` as the grid counts them). `dpdt`: the pressure's exact slopes at the samples (else finite
 /// differences).
 #[pyfunction]
 #[pyo3(signature = (t, p, law, coeffs, psi, omega, delta0, substeps, tol, dpdt=None))]
@@ -125,7 +147,7 @@ fn normal_simulate_grid<'py>(
     substeps: usize,
     tol: f64,
     dpdt: Option<PyReadonlyArray1<'py, f64>>,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<NormalRun> {
     let ts = slice(&t, "t")?;
     let ps = slice(&p, "p")?;
     let cs = slice(&coeffs, "coeffs")?;
@@ -134,7 +156,7 @@ fn normal_simulate_grid<'py>(
         None => None,
     };
     let law = law.to_owned();
-    let (mut delta, mut vel, out) = detach_guarded(py, move || {
+    let (delta, vel, out) = detach_guarded(py, move || {
         let model = build_model(&law, cs, psi, omega)?;
         let forcing = Forcing::new(ts, ps, ds, Interp::Cubic)?;
         let n = forcing.len();
@@ -145,17 +167,7 @@ fn normal_simulate_grid<'py>(
         )?;
         Ok((delta, vel, out))
     })?;
-    delta.truncate(out.n_out);
-    vel.truncate(out.n_out);
-    let d = PyDict::new(py);
-    d.set_item("delta", delta.into_pyarray(py))?;
-    d.set_item("velocity", vel.into_pyarray(py))?;
-    d.set_item("n_out", out.n_out)?;
-    d.set_item("status", out.status.code())?;
-    d.set_item("message", out.status.message())?;
-    d.set_item("nfev", out.stats.nfev)?;
-    d.set_item("n_accepted", out.stats.n_accepted)?;
-    Ok(d)
+    Ok(NormalRun::new(py, delta, vel, &out))
 }
 
 /// Equilibrium displacement `k_s δ = p` of a model under constant pressure `p`.
@@ -293,6 +305,7 @@ fn fold_cycles<'py>(
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<NormalRun>()?;
     m.add_function(wrap_pyfunction!(normal_simulate, m)?)?;
     m.add_function(wrap_pyfunction!(normal_simulate_grid, m)?)?;
     m.add_function(wrap_pyfunction!(normal_equilibrium, m)?)?;
