@@ -453,54 +453,51 @@ def _fold_loop(
 def _loop_of_fold(
     wf: _core.WindowFold, rev: Reversals, n_points: int, start: int, end: int
 ) -> AveragedLoop:
-    sums = wf.sums()
-    count = sums["count"]
+    count = wf.count
     if np.any(count == 0):
         raise InputError(
             f"{int(np.sum(count == 0))} of {n_points} phase bins are empty: the recording has "
             f"too few samples per cycle for n_points={n_points}; lower n_points"
         )
-    xm = sums["sum_x"] / count
-    Fm = sums["sum_F"] / count
-    phim = sums["sum_phase"] / count
+    xm = wf.sum_x / count
+    Fm = wf.sum_F / count
+    phim = wf.sum_phase / count
     # Per-cycle bin means (cycles x bins) spread from cycle to cycle. Where the samples of a
     # cycle sit inside a bin differs from cycle to cycle; on a steep branch that alone spreads
     # the per-cycle means: it is removed to first order (gradient along phase, periodic), so
     # the spread measures noise and real cycle-to-cycle change. In Rust over the fold's cells
     # with the arithmetic of ``spread`` and ``dphase`` of tests/fold_reference.py (numpy).
-    spread = wf.spread()
-    cyc = wf.cycles()
     # sample index where each cycle starts (a cycle without samples starts where the next
     # does), and where the last one ends; the area of the cycle's own samples (bin means
     # would cut the corners at the turns)
     scatter = CycleScatter(
-        amplitude=spread["amplitude"],
-        force_range=spread["force_range"],
-        energy=cyc["energy"],
+        amplitude=wf.amplitude,
+        force_range=wf.force_range,
+        energy=wf.energy,
         period=np.diff(rev.peak_times),
-        mean_force=cyc["mean_F"],
-        mean_x=cyc["mean_x"],
+        mean_force=wf.mean_F,
+        mean_x=wf.mean_x,
         time=0.5 * (rev.peak_times[:-1] + rev.peak_times[1:]),
     )
     phase = (np.arange(n_points) + 0.5) / n_points
-    x_var = np.clip(sums["sum_xx"] / count - xm * xm, 0.0, None)
+    x_var = np.clip(wf.sum_xx / count - xm * xm, 0.0, None)
     return AveragedLoop(
         phase,
         xm,
         Fm,
         count,
-        spread["x_std"],
-        spread["F_std"],
+        wf.x_std,
+        wf.F_std,
         scatter,
         rev,
         start,
         end,
         phim,
-        sums["sum_phase2"] / count,
-        cyc["bounds"],
+        wf.sum_phase2 / count,
+        wf.bounds,
         x_var,
-        sums["sum_t"] / count,
-        sensitivity=(cyc["sens_F"], cyc["sens_x"]),
+        wf.sum_t / count,
+        sensitivity=(wf.sens_F, wf.sens_x),
     )
 
 

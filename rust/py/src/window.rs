@@ -5,85 +5,133 @@ use contactlab_core::window::{
     detrend_pair, detrend_pair_into, detrend_pair_scan_into, fold_window, fold_window_scanned,
     WindowFold as CoreWindowFold, WindowScan as CoreWindowScan,
 };
-use numpy::{IntoPyArray, PyReadonlyArray1, PyReadwriteArray1};
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadwriteArray1};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 
 use crate::error::{input, slice};
 use crate::{detach_guarded, Arr};
 
 /// One analysis window folded (`contactlab_core::window`): fold sums, cycle bounds, loop
-/// areas and their sensitivities, period means.
-#[pyclass(module = "contactlab._core")]
+/// areas and their sensitivities, period means (read-only array attributes, each a copy).
+#[pyclass(module = "contactlab._core", frozen)]
 struct WindowFold {
     inner: CoreWindowFold,
 }
 
-fn f64_dict<'py>(py: Python<'py>, items: &[(&str, &Vec<f64>)]) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    for &(k, v) in items {
-        d.set_item(k, v.clone().into_pyarray(py))?;
-    }
-    Ok(d)
-}
-
 #[pymethods]
 impl WindowFold {
-    /// Per bin sums (`count, sum_x, sum_F, sum_phase, sum_phase2, sum_xx, sum_t`) and
-    /// `first` (each cycle's first sample, -1 for none).
-    fn sums<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let w = &self.inner;
-        let d = f64_dict(
-            py,
-            &[
-                ("count", &w.count),
-                ("sum_x", &w.sum_x),
-                ("sum_F", &w.sum_f),
-                ("sum_phase", &w.sum_phase),
-                ("sum_phase2", &w.sum_phase2),
-                ("sum_xx", &w.sum_xx),
-                ("sum_t", &w.sum_t),
-            ],
-        )?;
-        d.set_item("first", w.first.clone().into_pyarray(py))?;
-        Ok(d)
+    /// Per phase bin: the number of samples.
+    #[getter]
+    fn count<'py>(&self, py: Python<'py>) -> Arr<'py> {
+        self.inner.count.clone().into_pyarray(py)
     }
 
-    /// As `PhaseFold.spread`: `x_std`, `F_std` per bin, `amplitude`, `force_range` per cycle.
-    fn spread<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let w = &self.inner;
-        f64_dict(
-            py,
-            &[
-                ("x_std", &w.x_std),
-                ("F_std", &w.f_std),
-                ("amplitude", &w.amplitude),
-                ("force_range", &w.force_range),
-            ],
-        )
+    /// Per phase bin: the sum of x.
+    #[getter]
+    fn sum_x<'py>(&self, py: Python<'py>) -> Arr<'py> {
+        self.inner.sum_x.clone().into_pyarray(py)
     }
 
-    /// Per cycle: `bounds` (n + 1 sample indices), `energy` (loop area), `sens_F`, `sens_x`
-    /// (the area's noise sensitivities), `mean_F`, `mean_x` (period means between the edges).
-    fn cycles<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let w = &self.inner;
-        let d = f64_dict(
-            py,
-            &[
-                ("energy", &w.energy),
-                ("sens_F", &w.sens_f),
-                ("sens_x", &w.sens_x),
-                ("mean_F", &w.mean_f),
-                ("mean_x", &w.mean_x),
-            ],
-        )?;
-        let b: Vec<i64> = w
+    /// Per phase bin: the sum of F.
+    #[getter(sum_F)]
+    fn get_sum_f<'py>(&self, py: Python<'py>) -> Arr<'py> {
+        self.inner.sum_f.clone().into_pyarray(py)
+    }
+
+    /// Per phase bin: the sum of the phase.
+    #[getter]
+    fn sum_phase<'py>(&self, py: Python<'py>) -> Arr<'py> {
+        self.inner.sum_phase.clone().into_pyarray(py)
+    }
+
+    /// Per phase bin: the sum of the squared phase.
+    #[getter]
+    fn sum_phase2<'py>(&self, py: Python<'py>) -> Arr<'py> {
+        self.inner.sum_phase2.clone().into_pyarray(py)
+    }
+
+    /// Per phase bin: the sum of x squared.
+    #[getter]
+    fn sum_xx<'py>(&self, py: Python<'py>) -> Arr<'py> {
+        self.inner.sum_xx.clone().into_pyarray(py)
+    }
+
+    /// Per phase bin: the sum of t.
+    #[getter]
+    fn sum_t<'py>(&self, py: Python<'py>) -> Arr<'py> {
+        self.inner.sum_t.clone().into_pyarray(py)
+    }
+
+    /// As `PhaseFold.spread`: the cycle-to-cycle spread of x per bin.
+    #[getter]
+    fn x_std<'py>(&self, py: Python<'py>) -> Arr<'py> {
+        self.inner.x_std.clone().into_pyarray(py)
+    }
+
+    /// As `PhaseFold.spread`: the cycle-to-cycle spread of F per bin.
+    #[getter(F_std)]
+    fn get_f_std<'py>(&self, py: Python<'py>) -> Arr<'py> {
+        self.inner.f_std.clone().into_pyarray(py)
+    }
+
+    /// Per cycle: the displacement amplitude.
+    #[getter]
+    fn amplitude<'py>(&self, py: Python<'py>) -> Arr<'py> {
+        self.inner.amplitude.clone().into_pyarray(py)
+    }
+
+    /// Per cycle: the force range.
+    #[getter]
+    fn force_range<'py>(&self, py: Python<'py>) -> Arr<'py> {
+        self.inner.force_range.clone().into_pyarray(py)
+    }
+
+    /// Per cycle: the loop area.
+    #[getter]
+    fn energy<'py>(&self, py: Python<'py>) -> Arr<'py> {
+        self.inner.energy.clone().into_pyarray(py)
+    }
+
+    /// Per cycle: the loop area's noise sensitivity to F.
+    #[getter(sens_F)]
+    fn get_sens_f<'py>(&self, py: Python<'py>) -> Arr<'py> {
+        self.inner.sens_f.clone().into_pyarray(py)
+    }
+
+    /// Per cycle: the loop area's noise sensitivity to x.
+    #[getter]
+    fn sens_x<'py>(&self, py: Python<'py>) -> Arr<'py> {
+        self.inner.sens_x.clone().into_pyarray(py)
+    }
+
+    /// Per cycle: the period mean of F between the edges.
+    #[getter(mean_F)]
+    fn get_mean_f<'py>(&self, py: Python<'py>) -> Arr<'py> {
+        self.inner.mean_f.clone().into_pyarray(py)
+    }
+
+    /// Per cycle: the period mean of x between the edges.
+    #[getter]
+    fn mean_x<'py>(&self, py: Python<'py>) -> Arr<'py> {
+        self.inner.mean_x.clone().into_pyarray(py)
+    }
+
+    /// Each cycle's first sample (-1 for none).
+    #[getter]
+    fn first<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
+        self.inner.first.clone().into_pyarray(py)
+    }
+
+    /// Per cycle: the bounds (n + 1 sample indices).
+    #[getter]
+    fn bounds<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
+        let b: Vec<i64> = self
+            .inner
             .bounds
             .iter()
             .map(|&v| i64::try_from(v).unwrap_or(i64::MAX))
             .collect();
-        d.set_item("bounds", b.into_pyarray(py))?;
-        Ok(d)
+        b.into_pyarray(py)
     }
 }
 
