@@ -52,6 +52,18 @@ class Excursions:
         return cls(**{k: np.concatenate([getattr(p, k) for p in parts]) for k in names})
 
 
+def _excursions(t: _core.ExcursionTable) -> Excursions:
+    """The binding's columns as :class:`Excursions`."""
+    return Excursions(
+        sign=t.sign,
+        start=t.start,
+        extreme=t.extreme,
+        extreme_value=t.extreme_value,
+        last_beyond=t.last_beyond,
+        returned=t.returned,
+    )
+
+
 class ReversalDetector:
     """Streaming hysteresis-threshold detector.
 
@@ -78,11 +90,11 @@ class ReversalDetector:
         default ``x``; same length)."""
         xa = as_1d(x, "x", allow_empty=True, finite=False)
         va = None if value is None else as_1d(value, "value", allow_empty=True, finite=False)
-        return Excursions(**self._core.push(xa, va))
+        return _excursions(self._core.push(xa, va))
 
     def open(self) -> Excursions:
         """The excursion in progress (0 or 1 rows)."""
-        return Excursions(**self._core.open())
+        return _excursions(self._core.open())
 
     @property
     def count(self) -> int:

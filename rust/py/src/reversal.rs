@@ -2,9 +2,8 @@
 //! detector.
 
 use contactlab_core::reversal::{Excursion, Schmitt};
-use numpy::{IntoPyArray, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 
 use crate::detach_guarded;
 use crate::error::{slice, to_pyerr};
@@ -15,38 +14,49 @@ struct ReversalDetector {
     inner: Schmitt,
 }
 
-fn table<'py>(py: Python<'py>, ex: &[Excursion]) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    let idx = |f: &dyn Fn(&Excursion) -> u64| -> Vec<i64> {
+/// Excursions as columns, one row each (`push`, `open`): `sign`, `start`, `extreme`,
+/// `last_beyond`, `extreme_value`, `returned`.
+#[pyclass(module = "contactlab._core", frozen, get_all)]
+struct ExcursionTable {
+    sign: Py<PyArray1<i64>>,
+    start: Py<PyArray1<i64>>,
+    extreme: Py<PyArray1<i64>>,
+    last_beyond: Py<PyArray1<i64>>,
+    extreme_value: Py<PyArray1<f64>>,
+    returned: Py<PyArray1<bool>>,
+}
+
+fn table(py: Python<'_>, ex: &[Excursion]) -> ExcursionTable {
+    let idx = |f: &dyn Fn(&Excursion) -> u64| {
         ex.iter()
             .map(|e| i64::try_from(f(e)).unwrap_or(i64::MAX))
-            .collect()
+            .collect::<Vec<i64>>()
+            .into_pyarray(py)
+            .unbind()
     };
-    d.set_item(
-        "sign",
-        ex.iter()
+    ExcursionTable {
+        sign: ex
+            .iter()
             .map(|e| i64::from(e.sign))
             .collect::<Vec<_>>()
-            .into_pyarray(py),
-    )?;
-    d.set_item("start", idx(&|e| e.start).into_pyarray(py))?;
-    d.set_item("extreme", idx(&|e| e.extreme).into_pyarray(py))?;
-    d.set_item("last_beyond", idx(&|e| e.last_beyond).into_pyarray(py))?;
-    d.set_item(
-        "extreme_value",
-        ex.iter()
+            .into_pyarray(py)
+            .unbind(),
+        start: idx(&|e| e.start),
+        extreme: idx(&|e| e.extreme),
+        last_beyond: idx(&|e| e.last_beyond),
+        extreme_value: ex
+            .iter()
             .map(|e| e.extreme_value)
             .collect::<Vec<_>>()
-            .into_pyarray(py),
-    )?;
-    d.set_item(
-        "returned",
-        ex.iter()
+            .into_pyarray(py)
+            .unbind(),
+        returned: ex
+            .iter()
             .map(|e| e.returned)
             .collect::<Vec<_>>()
-            .into_pyarray(py),
-    )?;
-    Ok(d)
+            .into_pyarray(py)
+            .unbind(),
+    }
 }
 
 #[pymethods]
@@ -57,8 +67,7 @@ impl ReversalDetector {
         Ok(Self { inner })
     }
 
-    /// Excursions completed in this chunk: dict of arrays `sign, start, extreme,
-    /// last_beyond, extreme_value, returned`. `value` (default `x`) is where extremes are
+    /// Excursions completed in this chunk (an `ExcursionTable`). `value` (default `x`) is where extremes are
     /// located.
     #[pyo3(signature = (x, value=None))]
     fn push<'py>(
@@ -66,7 +75,7 @@ impl ReversalDetector {
         py: Python<'py>,
         x: PyReadonlyArray1<'py, f64>,
         value: Option<PyReadonlyArray1<'py, f64>>,
-    ) -> PyResult<Bound<'py, PyDict>> {
+    ) -> PyResult<ExcursionTable> {
         let xs = slice(&x, "x")?;
         let vs = value.as_ref().map(|v| slice(v, "value")).transpose()?;
         let mut st = self.inner.clone();
@@ -76,11 +85,11 @@ impl ReversalDetector {
             Ok((done, st))
         })?;
         self.inner = st;
-        table(py, &done)
+        Ok(table(py, &done))
     }
 
     /// The excursion in progress (0 or 1 rows, same columns as `push`).
-    fn open<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+    fn open(&self, py: Python<'_>) -> ExcursionTable {
         let open: Vec<Excursion> = self.inner.open.iter().copied().collect();
         table(py, &open)
     }
@@ -93,5 +102,6 @@ impl ReversalDetector {
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ReversalDetector>()?;
+    m.add_class::<ExcursionTable>()?;
     Ok(())
 }
