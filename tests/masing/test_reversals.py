@@ -197,14 +197,14 @@ def test_phase_fold_equals_numpy_bincount_and_streams():
     for a in range(0, n, 3001):  # chunk by chunk
         fold.push(t[a : a + 3001], x[a : a + 3001], F[a : a + 3001], a, kt, kp)
     s = fold.sums()
-    assert np.array_equal(s["count"], np.bincount(b, minlength=nb))
-    assert np.array_equal(s["sum_x"], np.bincount(b, x[start:end], nb))
-    assert np.array_equal(s["sum_phase2"], np.bincount(b, frac * frac, nb))
+    assert np.array_equal(s.count, np.bincount(b, minlength=nb))
+    assert np.array_equal(s.sum_x, np.bincount(b, x[start:end], nb))
+    assert np.array_equal(s.sum_phase2, np.bincount(b, frac * frac, nb))
     flat = cyc * nb + b
     cf = np.bincount(flat, F[start:end], n_cyc * nb).reshape(n_cyc, nb)
-    assert np.array_equal(s["cycle_F"], cf)
-    assert s["first"][0] == start
-    assert np.array_equal(s["first"], start + np.searchsorted(cyc, np.arange(n_cyc)))
+    assert np.array_equal(s.cycle_F, cf)
+    assert s.first[0] == start
+    assert np.array_equal(s.first, start + np.searchsorted(cyc, np.arange(n_cyc)))
     with pytest.raises(InputError, match="knot_t"):
         fold.push(t, x, F, 0, kt[::-1].copy(), kp)
 

@@ -1,9 +1,8 @@
 //! Binding of `contactlab_core::fold`: the phase-bin fold, its spread, and period means.
 
 use contactlab_core::fold::{fold_phase, fold_spread, period_means, period_means_pair, FoldSums};
-use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 
 use crate::error::{slice, to_pyerr};
 use crate::{detach_guarded, Arr};
@@ -43,51 +42,76 @@ impl PhaseFold {
 
     /// Cycle-to-cycle spread per bin (`x_std`, `F_std`) and per-cycle half ranges of the
     /// bin means (`amplitude`, `force_range`); see `contactlab_core::fold::fold_spread`.
-    fn spread<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+    fn spread(&self, py: Python<'_>) -> PyResult<FoldSpread> {
         let sums = &self.sums;
         let sp = detach_guarded(py, || fold_spread(sums))?;
-        let d = PyDict::new(py);
-        d.set_item("x_std", sp.x_std.into_pyarray(py))?;
-        d.set_item("F_std", sp.f_std.into_pyarray(py))?;
-        d.set_item("amplitude", sp.amplitude.into_pyarray(py))?;
-        d.set_item("force_range", sp.force_range.into_pyarray(py))?;
-        Ok(d)
+        Ok(FoldSpread {
+            x_std: sp.x_std.into_pyarray(py).unbind(),
+            f_std: sp.f_std.into_pyarray(py).unbind(),
+            amplitude: sp.amplitude.into_pyarray(py).unbind(),
+            force_range: sp.force_range.into_pyarray(py).unbind(),
+        })
     }
 
-    /// The sums so far: dict of arrays (per bin, and with `cells` per cycle × bin as 2-D
-    /// arrays).
+    /// The sums so far (a `FoldTable`: per bin, and with `cells` per cycle × bin as 2-D
+    /// arrays, else those are `None`).
     #[pyo3(signature = (cells=true))]
-    fn sums<'py>(&self, py: Python<'py>, cells: bool) -> PyResult<Bound<'py, PyDict>> {
+    fn sums(&self, py: Python<'_>, cells: bool) -> PyResult<FoldTable> {
         let s = &self.sums;
-        let d = PyDict::new(py);
-        for (k, v) in [
-            ("count", &s.count),
-            ("sum_x", &s.sum_x),
-            ("sum_F", &s.sum_f),
-            ("sum_phase", &s.sum_phase),
-            ("sum_phase2", &s.sum_phase2),
-            ("sum_xx", &s.sum_xx),
-            ("sum_t", &s.sum_t),
-        ] {
-            d.set_item(k, v.clone().into_pyarray(py))?;
-        }
-        let per_cell: &[(&str, &Vec<f64>)] = if cells {
-            &[
-                ("cycle_count", &s.cycle_count),
-                ("cycle_x", &s.cycle_x),
-                ("cycle_F", &s.cycle_f),
-                ("cycle_phase", &s.cycle_phase),
-            ]
-        } else {
-            &[]
-        };
-        for &(k, v) in per_cell {
+        let arr = |v: &Vec<f64>| v.clone().into_pyarray(py).unbind();
+        let cell = |v: &Vec<f64>| -> PyResult<Option<Py<PyArray2<f64>>>> {
+            if !cells {
+                return Ok(None);
+            }
             let a = v.clone().into_pyarray(py);
-            d.set_item(k, a.reshape([s.n_cycles, s.n_bins])?)?;
-        }
-        d.set_item("first", s.first.clone().into_pyarray(py))?;
-        Ok(d)
+            Ok(Some(a.reshape([s.n_cycles, s.n_bins])?.unbind()))
+        };
+        Ok(FoldTable {
+            count: arr(&s.count),
+            sum_x: arr(&s.sum_x),
+            sum_f: arr(&s.sum_f),
+            sum_phase: arr(&s.sum_phase),
+            sum_phase2: arr(&s.sum_phase2),
+            sum_xx: arr(&s.sum_xx),
+            sum_t: arr(&s.sum_t),
+            first: s.first.clone().into_pyarray(py).unbind(),
+            cycle_count: cell(&s.cycle_count)?,
+            cycle_x: cell(&s.cycle_x)?,
+            cycle_f: cell(&s.cycle_f)?,
+            cycle_phase: cell(&s.cycle_phase)?,
+        })
     }
+}
+
+/// `PhaseFold.spread`: `x_std`, `F_std` per bin, `amplitude`, `force_range` per cycle.
+#[pyclass(module = "contactlab._core", frozen, get_all)]
+struct FoldSpread {
+    x_std: Py<PyArray1<f64>>,
+    #[pyo3(name = "F_std")]
+    f_std: Py<PyArray1<f64>>,
+    amplitude: Py<PyArray1<f64>>,
+    force_range: Py<PyArray1<f64>>,
+}
+
+/// `PhaseFold.sums`: per bin `count, sum_x, sum_F, sum_phase, sum_phase2, sum_xx, sum_t`,
+/// `first` (each cycle's first sample, -1 for none), and per cycle × bin `cycle_count,
+/// cycle_x, cycle_F, cycle_phase` (`None` unless asked for).
+#[pyclass(module = "contactlab._core", frozen, get_all)]
+struct FoldTable {
+    count: Py<PyArray1<f64>>,
+    sum_x: Py<PyArray1<f64>>,
+    #[pyo3(name = "sum_F")]
+    sum_f: Py<PyArray1<f64>>,
+    sum_phase: Py<PyArray1<f64>>,
+    sum_phase2: Py<PyArray1<f64>>,
+    sum_xx: Py<PyArray1<f64>>,
+    sum_t: Py<PyArray1<f64>>,
+    first: Py<PyArray1<i64>>,
+    cycle_count: Option<Py<PyArray2<f64>>>,
+    cycle_x: Option<Py<PyArray2<f64>>>,
+    #[pyo3(name = "cycle_F")]
+    cycle_f: Option<Py<PyArray2<f64>>>,
+    cycle_phase: Option<Py<PyArray2<f64>>>,
 }
 
 /// Time averages of `v` between consecutive `edges` (see
@@ -124,6 +148,8 @@ fn period_means_pair_py<'py>(
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PhaseFold>()?;
+    m.add_class::<FoldSpread>()?;
+    m.add_class::<FoldTable>()?;
     m.add_function(wrap_pyfunction!(period_means_py, m)?)?;
     m.add_function(wrap_pyfunction!(period_means_pair_py, m)?)?;
     Ok(())
