@@ -89,12 +89,12 @@ def block_cycles(
         t0, dt = time_step
         d = s.tracker.push_sampled(float(t0), float(dt), x, F, drive, int(offset), low, high)
     return Cycles(
-        crossings=d["crossings"],
-        start=d["start"],
-        end=d["end"],
-        energy=d["energy"],
-        amplitude=d["amplitude"],
-        offset=d["offset"],
+        crossings=d.crossings,
+        start=d.start,
+        end=d.end,
+        energy=d.energy,
+        amplitude=d.amplitude,
+        offset=d.offset,
     )
 
 

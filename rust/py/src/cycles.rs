@@ -2,9 +2,8 @@
 //! and without a time axis.
 
 use contactlab_core::cycles::{cycle_block, cycle_block_sampled, BlockCycles, CycleState};
-use numpy::{IntoPyArray, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 
 use crate::detach_guarded;
 use crate::error::slice;
@@ -25,8 +24,8 @@ impl CycleTracker {
         }
     }
 
-    /// One block: dict of arrays `crossings` (global indices), `start`, `end`, `energy`,
-    /// `amplitude`, `offset` (one per complete cycle).
+    /// One block: a `CycleBlock` (`crossings`, and per complete cycle `start`, `end`,
+    /// `energy`, `amplitude`, `offset`).
     fn push<'py>(
         &mut self,
         py: Python<'py>,
@@ -37,28 +36,12 @@ impl CycleTracker {
         offset: u64,
         low: f64,
         high: f64,
-    ) -> PyResult<Bound<'py, PyDict>> {
+    ) -> PyResult<CycleBlock> {
         let (ts, xs, fs) = (slice(&t, "t")?, slice(&x, "x")?, slice(&f, "F")?);
         let ds = slice(&drive, "drive")?;
         let state = &mut self.state;
         let c = detach_guarded(py, || cycle_block(ts, xs, fs, ds, offset, low, high, state))?;
-        let d = PyDict::new(py);
-        let idx: Vec<i64> = c
-            .crossings
-            .iter()
-            .map(|&i| i64::try_from(i).unwrap_or(i64::MAX))
-            .collect();
-        d.set_item("crossings", idx.into_pyarray(py))?;
-        for (k, v) in [
-            ("start", c.start),
-            ("end", c.end),
-            ("energy", c.energy),
-            ("amplitude", c.amplitude),
-            ("offset", c.offset),
-        ] {
-            d.set_item(k, v.into_pyarray(py))?;
-        }
-        Ok(d)
+        Ok(cycles_table(py, c))
     }
 }
 
@@ -70,24 +53,33 @@ struct CycleStream {
     state: CycleState,
 }
 
-fn cycles_dict(py: Python<'_>, c: BlockCycles) -> PyResult<Bound<'_, PyDict>> {
-    let d = PyDict::new(py);
+/// The cycles a block completed (`CycleTracker.push`, `CycleStream.push`/`push_sampled`):
+/// `crossings` (global sample indices of the block's upward crossings) and, one per complete
+/// cycle, `start`, `end`, `energy`, `amplitude`, `offset`.
+#[pyclass(module = "contactlab._core", frozen, get_all)]
+struct CycleBlock {
+    crossings: Py<PyArray1<i64>>,
+    start: Py<PyArray1<f64>>,
+    end: Py<PyArray1<f64>>,
+    energy: Py<PyArray1<f64>>,
+    amplitude: Py<PyArray1<f64>>,
+    offset: Py<PyArray1<f64>>,
+}
+
+fn cycles_table(py: Python<'_>, c: BlockCycles) -> CycleBlock {
     let idx: Vec<i64> = c
         .crossings
         .iter()
         .map(|&i| i64::try_from(i).unwrap_or(i64::MAX))
         .collect();
-    d.set_item("crossings", idx.into_pyarray(py))?;
-    for (k, v) in [
-        ("start", c.start),
-        ("end", c.end),
-        ("energy", c.energy),
-        ("amplitude", c.amplitude),
-        ("offset", c.offset),
-    ] {
-        d.set_item(k, v.into_pyarray(py))?;
+    CycleBlock {
+        crossings: idx.into_pyarray(py).unbind(),
+        start: c.start.into_pyarray(py).unbind(),
+        end: c.end.into_pyarray(py).unbind(),
+        energy: c.energy.into_pyarray(py).unbind(),
+        amplitude: c.amplitude.into_pyarray(py).unbind(),
+        offset: c.offset.into_pyarray(py).unbind(),
     }
-    Ok(d)
 }
 
 #[pymethods]
@@ -99,8 +91,7 @@ impl CycleStream {
         }
     }
 
-    /// One block with its time stamps: dict of arrays `crossings` (global indices), `start`,
-    /// `end`, `energy`, `amplitude`, `offset` (one per complete cycle).
+    /// One block with its time stamps: a `CycleBlock`.
     fn push<'py>(
         &mut self,
         py: Python<'py>,
@@ -111,12 +102,12 @@ impl CycleStream {
         offset: u64,
         low: f64,
         high: f64,
-    ) -> PyResult<Bound<'py, PyDict>> {
+    ) -> PyResult<CycleBlock> {
         let (ts, xs, fs) = (slice(&t, "t")?, slice(&x, "x")?, slice(&f, "F")?);
         let ds = slice(&drive, "drive")?;
         let state = &mut self.state;
         let c = detach_guarded(py, || cycle_block(ts, xs, fs, ds, offset, low, high, state))?;
-        cycles_dict(py, c)
+        Ok(cycles_table(py, c))
     }
 
     /// One block of a recording sampled every `dt` from `t0` (no time array; see
@@ -132,18 +123,19 @@ impl CycleStream {
         offset: u64,
         low: f64,
         high: f64,
-    ) -> PyResult<Bound<'py, PyDict>> {
+    ) -> PyResult<CycleBlock> {
         let (xs, fs, ds) = (slice(&x, "x")?, slice(&f, "F")?, slice(&drive, "drive")?);
         let state = &mut self.state;
         let c = detach_guarded(py, || {
             cycle_block_sampled(t0, dt, xs, fs, ds, offset, low, high, state)
         })?;
-        cycles_dict(py, c)
+        Ok(cycles_table(py, c))
     }
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<CycleTracker>()?;
     m.add_class::<CycleStream>()?;
+    m.add_class::<CycleBlock>()?;
     Ok(())
 }
