@@ -350,15 +350,15 @@ class Structure:
             outputs=outputs,
             **kw,
         )
-        m = int(out["n_out"])  # type: ignore[call-overload]
+        m = int(out.n_out)
 
         def arr(key: str, width: int) -> np.ndarray:
             # an output not asked for is empty: no rows
             rows = len(t) if outputs is None or key in outputs else 0
-            a = np.asarray(out[key]).reshape(rows, width)[:m]
+            a = np.asarray(getattr(out, key)).reshape(rows, width)[:m]
             return a[:, 0] if width == 1 and key in ("x", "v", "a") else a
 
-        status = int(out["status"])  # type: ignore[call-overload]
+        status = int(out.status)
         return SimulationResult(
             t=t[:m],
             x=arr("x", n),
@@ -367,13 +367,13 @@ class Structure:
             joint_force=arr("joint_force", nj),
             joint_energy=arr("joint_dissipated", nj),
             joint_work=arr("joint_work", nj),
-            input_work=np.asarray(out["input_work"])[:m],
-            damping_work=np.asarray(out["damping_work"])[:m],
+            input_work=np.asarray(out.input_work)[:m],
+            damping_work=np.asarray(out.damping_work)[:m],
             success=status == 0,
             status=status,
-            message=str(out["message"]),
-            n_steps=int(out["n_steps"]),  # type: ignore[call-overload]
-            n_iter=int(out["n_iter"]),  # type: ignore[call-overload]
+            message=str(out.message),
+            n_steps=int(out.n_steps),
+            n_iter=int(out.n_iter),
         )
 
     def _periodic(

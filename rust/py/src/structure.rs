@@ -7,7 +7,6 @@ use contactlab_core::structure::{
 use contactlab_core::CoreError;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadwriteArray1};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 
 use crate::detach_guarded;
 use crate::error::slice as sl;
@@ -65,7 +64,28 @@ fn build_joint(spec: &JointSpec) -> Result<Joint, CoreError> {
     })
 }
 
-/// Newmark simulation of a structure with joints; returns a dict of flat arrays and status.
+/// The result of `structure_simulate`: the flat output arrays (`x`, `v`, `a` of `n_t × n`
+/// values, the joints' `joint_force`, `joint_work`, `joint_dissipated` of `n_t × n_joints`,
+/// `input_work`, `damping_work` of `n_t`; empty when not asked for), valid for the first
+/// `n_out` steps, the status (0 = success) with its message, and the step and iteration counts.
+#[pyclass(module = "contactlab._core", frozen, get_all)]
+struct StructureRun {
+    x: Py<PyArray1<f64>>,
+    v: Py<PyArray1<f64>>,
+    a: Py<PyArray1<f64>>,
+    joint_force: Py<PyArray1<f64>>,
+    joint_work: Py<PyArray1<f64>>,
+    joint_dissipated: Py<PyArray1<f64>>,
+    input_work: Py<PyArray1<f64>>,
+    damping_work: Py<PyArray1<f64>>,
+    n_out: usize,
+    status: i32,
+    message: String,
+    n_steps: u64,
+    n_iter: u64,
+}
+
+/// Newmark simulation of a structure with joints; returns a `StructureRun`.
 #[pyfunction]
 #[pyo3(signature = (n, m, c, k, joints, t, x0, v0, force=None, base=None, base_velocity=None, kr=None, cr=None, rtol=1e-10, max_iter=30, outputs=None))]
 fn structure_simulate<'py>(
@@ -86,7 +106,7 @@ fn structure_simulate<'py>(
     rtol: f64,
     max_iter: usize,
     outputs: Option<Vec<String>>,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<StructureRun> {
     let (ms, cs, ks) = (sl(&m, "M")?, sl(&c, "C")?, sl(&k, "K")?);
     let (ts, x0s, v0s) = (sl(&t, "t")?, sl(&x0, "x0")?, sl(&v0, "v0")?);
     let fs = match &force {
@@ -186,19 +206,28 @@ fn structure_simulate<'py>(
         simulate_into(&s, &inp, x0s, v0s, &opts, &mut bufs)
     })?;
     drop(rws);
-    let d = PyDict::new(py);
-    for (name, arr) in names.iter().zip(&arrays) {
-        d.set_item(name, arr)?;
-    }
-    d.set_item("n_out", r.n_out)?;
-    d.set_item("status", r.status.code())?;
-    d.set_item("message", r.status.message())?;
-    d.set_item("n_steps", r.n_steps)?;
-    d.set_item("n_iter", r.n_iter)?;
-    Ok(d)
+    let [x, v, a, joint_force, joint_work, joint_dissipated, input_work, damping_work] =
+        <[Bound<'py, PyArray1<f64>>; 8]>::try_from(arrays)
+            .map_err(|_| crate::error::internal(py, "output arrays"))?;
+    Ok(StructureRun {
+        x: x.unbind(),
+        v: v.unbind(),
+        a: a.unbind(),
+        joint_force: joint_force.unbind(),
+        joint_work: joint_work.unbind(),
+        joint_dissipated: joint_dissipated.unbind(),
+        input_work: input_work.unbind(),
+        damping_work: damping_work.unbind(),
+        n_out: r.n_out,
+        status: r.status.code(),
+        message: r.status.message(),
+        n_steps: r.n_steps,
+        n_iter: r.n_iter,
+    })
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<StructureRun>()?;
     m.add_function(wrap_pyfunction!(structure_simulate, m)?)?;
     Ok(())
 }
