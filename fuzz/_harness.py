@@ -77,6 +77,14 @@ def no_nan(value: Any, where: str = "result") -> None:
     if isinstance(value, (list, tuple)):
         for i, v in enumerate(value):
             no_nan(v, f"{where}[{i}]")
+        return
+    if type(value).__module__ == "contactlab._core":
+        # a typed result of the binding (frozen #[pyclass]): its public data attributes
+        for k in dir(value):
+            if not k.startswith("_"):
+                v = getattr(value, k)
+                if not callable(v):
+                    no_nan(v, f"{where}.{k}")
 
 
 def files_under(folder: Path) -> list[Path]:
