@@ -219,7 +219,8 @@ class MasingOperator:
         """Closed cycles in the next chunk (advances the state like ``push``)."""
         x = as_1d(chunk, "x", allow_empty=True, finite=False)
         with _one_thread():
-            return CycleTable(**self._core.cycles(x))
+            c = self._core.cycles(x)
+        return CycleTable(c.range, c.mean, c.start, c.end, c.count, c.energy)
 
     def reset(self) -> None:
         """Forget the history: back to the origin on the virgin curve."""

@@ -154,13 +154,13 @@ impl MasingCore {
         Ok(arr)
     }
 
-    /// Closed cycles of `x` (continuing the carried history, which is advanced):
-    /// dict of arrays `range, mean, start, end, count, energy`.
+    /// Closed cycles of `x` (continuing the carried history, which is advanced): a
+    /// `MasingCycles`.
     fn cycles<'py>(
         &mut self,
         py: Python<'py>,
         x: PyReadonlyArray1<'py, f64>,
-    ) -> PyResult<Bound<'py, PyDict>> {
+    ) -> PyResult<MasingCycles> {
         let xs = slice(&x, "x")?;
         if self.anchored {
             return Err(input(
@@ -175,19 +175,30 @@ impl MasingCore {
             Ok((c, st))
         })?;
         self.state = st;
-        let d = PyDict::new(py);
-        let col =
-            |f: &dyn Fn(&masing::Cycle) -> f64| -> Vec<f64> { cycles.iter().map(f).collect() };
-        d.set_item("range", col(&|c| c.range).into_pyarray(py))?;
-        d.set_item("mean", col(&|c| c.mean).into_pyarray(py))?;
-        let idx = |f: &dyn Fn(&masing::Cycle) -> u64| -> Vec<i64> {
-            cycles.iter().map(|c| f(c) as i64).collect()
+        let col = |f: &dyn Fn(&masing::Cycle) -> f64| {
+            cycles
+                .iter()
+                .map(f)
+                .collect::<Vec<f64>>()
+                .into_pyarray(py)
+                .unbind()
         };
-        d.set_item("start", idx(&|c| c.start).into_pyarray(py))?;
-        d.set_item("end", idx(&|c| c.end).into_pyarray(py))?;
-        d.set_item("count", col(&|c| c.count).into_pyarray(py))?;
-        d.set_item("energy", col(&|c| c.energy).into_pyarray(py))?;
-        Ok(d)
+        let idx = |f: &dyn Fn(&masing::Cycle) -> u64| {
+            cycles
+                .iter()
+                .map(|c| i64::try_from(f(c)).unwrap_or(i64::MAX))
+                .collect::<Vec<i64>>()
+                .into_pyarray(py)
+                .unbind()
+        };
+        Ok(MasingCycles {
+            range: col(&|c| c.range),
+            mean: col(&|c| c.mean),
+            start: idx(&|c| c.start),
+            end: idx(&|c| c.end),
+            count: col(&|c| c.count),
+            energy: col(&|c| c.energy),
+        })
     }
 
     fn reset(&mut self) {
@@ -450,8 +461,21 @@ fn force_repeat<'py>(
     Ok(dicts)
 }
 
+/// `MasingCore.cycles`: one row per closed cycle, `range`, `mean`, `start`, `end` (sample
+/// indices), `count` (1 or 0.5), `energy` (count included).
+#[pyclass(module = "contactlab._core", frozen, get_all)]
+struct MasingCycles {
+    range: Py<PyArray1<f64>>,
+    mean: Py<PyArray1<f64>>,
+    start: Py<PyArray1<i64>>,
+    end: Py<PyArray1<i64>>,
+    count: Py<PyArray1<f64>>,
+    energy: Py<PyArray1<f64>>,
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<MasingCore>()?;
+    m.add_class::<MasingCycles>()?;
     m.add_function(wrap_pyfunction!(branch_memory_py, m)?)?;
     m.add_function(wrap_pyfunction!(force_many, m)?)?;
     m.add_function(wrap_pyfunction!(force_repeat, m)?)?;
