@@ -137,7 +137,9 @@ def main() -> None:
         res, st = _core.force_many(
             [MODEL._core] * len(xs), xs, cores, wbufs, True, max(x.size for x in xs) + 1
         )
-        stats.setdefault("rust threads, whole channels", []).append(st)
+        keys = ("jobs", "samples", "start", "end", "cpu", "wait", "prepass", "prepass_cpu")
+        rows = [{k: getattr(s, k) for k in keys} for s in st]
+        stats.setdefault("rust threads, whole channels", []).append(rows)
         return res
 
     small = channels(1, 16384)[0]
@@ -146,7 +148,8 @@ def main() -> None:
 
     def ceiling(threads: int, name: str) -> None:
         st = _core.force_repeat(MODEL._core, small, ceil_jobs, ceil_reps, threads)
-        stats.setdefault(name, []).append(st)
+        keys = ("jobs", "start", "end", "cpu", "wait")
+        stats.setdefault(name, []).append([{k: getattr(s, k) for k in keys} for s in st])
 
     long_x = channels(1, int(args.long)) if args.long >= 1 else []
     long_ref = [_force(x) for x in long_x]

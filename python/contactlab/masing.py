@@ -273,6 +273,10 @@ def _out_buffer(out: Any, n: int) -> np.ndarray | None:
     return out
 
 
+#: the keys of each dict ``force_many(..., stats=)`` receives (the core's ``WorkerStats``)
+_WORKER_STATS = ("jobs", "samples", "start", "end", "cpu", "wait", "prepass", "prepass_cpu")
+
+
 def force_many(
     models: Any,
     signals: Any,
@@ -335,7 +339,7 @@ def force_many(
         [m._core for m in ms], sigs, int(threads), outs, stats is not None
     )
     if stats is not None:
-        stats.extend(per_thread)
+        stats.extend({k: getattr(s, k) for k in _WORKER_STATS} for s in per_thread)
     return res
 
 

@@ -128,8 +128,8 @@ def test_force_repeat_the_benchmarks_ceiling_runs_every_job_and_checks_its_input
     for threads in (1, 2, 3):
         st = _core.force_repeat(m._core, x, 7, 3, threads)
         assert len(st) == min(threads, 7)
-        assert sum(s["jobs"] for s in st) == 7
-        assert all(0.0 <= s["start"] <= s["end"] for s in st)
+        assert sum(s.jobs for s in st) == 7
+        assert all(0.0 <= s.start <= s.end for s in st)
     bad = x.copy()
     bad[17] = np.nan
     with pytest.raises(contactlab.InputError, match="17"):

@@ -40,8 +40,6 @@ pub(crate) type IndexPair<'py> = (
     Bound<'py, numpy::PyArray1<i64>>,
     Bound<'py, numpy::PyArray1<i64>>,
 );
-/// Outputs of `force_many` and one statistics dict per worker thread.
-pub(crate) type ManyForces<'py> = (Vec<Arr<'py>>, Vec<Bound<'py, pyo3::types::PyDict>>);
 
 /// Run `f` without the GIL, turning a panic (a bug, never expected) into `ContactLabError`.
 pub(crate) fn detach_guarded<T: Send, F: FnOnce() -> Result<T, CoreError> + Send>(

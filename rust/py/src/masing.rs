@@ -5,14 +5,47 @@ use contactlab_core::curve::{Backbone, Exponential, Tabulated};
 use contactlab_core::masing::channels::{force_channels, Channel};
 use contactlab_core::masing::split::PIECE;
 use contactlab_core::masing::{branch_memory, MasingState};
-use contactlab_core::parallel::run_jobs;
+use contactlab_core::parallel::{run_jobs, ThreadStats};
 use contactlab_core::{masing, BranchRule, CoreError};
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadwriteArray1};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 
 use crate::error::{input, slice, to_pyerr};
-use crate::{detach_guarded, IndexPair, ManyForces};
+use crate::{detach_guarded, Arr, IndexPair};
+
+/// One worker thread's statistics (`force_many`, `force_repeat`; see
+/// `contactlab_core::parallel::ThreadStats`): `jobs`, `samples`, `start` and `end` (seconds
+/// since the call began), `cpu` and `wait` (CPU seconds, seconds runnable but waiting; `None`
+/// where the system does not tell), `prepass` and `prepass_cpu` (the pre-pass's share).
+#[pyclass(module = "contactlab._core", frozen, get_all)]
+struct WorkerStats {
+    jobs: usize,
+    samples: usize,
+    start: f64,
+    end: f64,
+    cpu: Option<f64>,
+    wait: Option<f64>,
+    prepass: f64,
+    prepass_cpu: Option<f64>,
+}
+
+impl From<ThreadStats> for WorkerStats {
+    fn from(s: ThreadStats) -> Self {
+        Self {
+            jobs: s.jobs,
+            samples: s.samples,
+            start: s.start,
+            end: s.end,
+            cpu: s.cpu,
+            wait: s.wait,
+            prepass: s.prepass,
+            prepass_cpu: s.prepass_cpu,
+        }
+    }
+}
+
+/// Outputs of `force_many` and one `WorkerStats` per worker thread.
+type ManyForces<'py> = (Vec<Arr<'py>>, Vec<WorkerStats>);
 
 /// A virgin curve: the exponential curve or a tabulated backbone.
 #[derive(Clone)]
@@ -326,9 +359,8 @@ fn branch_memory_py<'py>(
 /// comparisons-only pre-pass, then pieces and short channels go longest first from one shared
 /// queue; bit for bit the serial kernel). Into `outs` when given (one
 /// contiguous float64 array per channel, reused between calls: no fresh pages to fault in),
-/// else into new arrays. Returns the outputs and one dict per worker thread (`jobs`,
-/// `samples`, `start`, `end`, `cpu`, `wait`, `prepass`, `prepass_cpu`; seconds; the CPU
-/// times only with `cpu_times` and where the system tells, else None).
+/// else into new arrays. Returns the outputs and one `WorkerStats` per worker thread (the
+/// CPU times only with `cpu_times` and where the system tells, else None).
 #[pyfunction]
 #[pyo3(signature = (models, xs, threads, outs=None, cpu_times=false, piece=PIECE))]
 fn force_many<'py>(
@@ -396,27 +428,14 @@ fn force_many<'py>(
         force_channels(&cores, &xs, os, &mut states, threads, piece, cpu_times)
     })?;
     drop(rws);
-    let mut dicts = Vec::with_capacity(stats.len());
-    for s in stats {
-        let d = PyDict::new(py);
-        d.set_item("jobs", s.jobs)?;
-        d.set_item("samples", s.samples)?;
-        d.set_item("start", s.start)?;
-        d.set_item("end", s.end)?;
-        d.set_item("cpu", s.cpu)?;
-        d.set_item("wait", s.wait)?;
-        d.set_item("prepass", s.prepass)?;
-        d.set_item("prepass_cpu", s.prepass_cpu)?;
-        dicts.push(d);
-    }
-    Ok((outs, dicts))
+    Ok((outs, stats.into_iter().map(WorkerStats::from).collect()))
 }
 
 /// The machine's own scaling, for the benchmarks: `jobs` independent jobs, each the force of
 /// the same short signal `x` from the origin `repeats` times into the job's own buffer
 /// (`x` and the buffer stay in cache: no memory traffic, no shared data written, no split),
 /// on up to `threads` threads (`contactlab_core::parallel::run_jobs`). What `force_many`'s
-/// speed-up is compared with in the same run. Returns one statistics dict per thread.
+/// speed-up is compared with in the same run. Returns one `WorkerStats` per thread.
 #[pyfunction]
 #[pyo3(signature = (model, x, jobs, repeats, threads))]
 fn force_repeat<'py>(
@@ -426,7 +445,7 @@ fn force_repeat<'py>(
     jobs: usize,
     repeats: usize,
     threads: usize,
-) -> PyResult<Vec<Bound<'py, PyDict>>> {
+) -> PyResult<Vec<WorkerStats>> {
     if threads == 0 {
         return Err(input(py, "threads must be >= 1"));
     }
@@ -448,17 +467,7 @@ fn force_repeat<'py>(
             },
         )
     })?;
-    let mut dicts = Vec::with_capacity(stats.len());
-    for s in stats {
-        let d = PyDict::new(py);
-        d.set_item("jobs", s.jobs)?;
-        d.set_item("start", s.start)?;
-        d.set_item("end", s.end)?;
-        d.set_item("cpu", s.cpu)?;
-        d.set_item("wait", s.wait)?;
-        dicts.push(d);
-    }
-    Ok(dicts)
+    Ok(stats.into_iter().map(WorkerStats::from).collect())
 }
 
 /// `MasingCore.cycles`: one row per closed cycle, `range`, `mean`, `start`, `end` (sample
@@ -476,6 +485,7 @@ struct MasingCycles {
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<MasingCore>()?;
     m.add_class::<MasingCycles>()?;
+    m.add_class::<WorkerStats>()?;
     m.add_function(wrap_pyfunction!(branch_memory_py, m)?)?;
     m.add_function(wrap_pyfunction!(force_many, m)?)?;
     m.add_function(wrap_pyfunction!(force_repeat, m)?)?;
