@@ -13,7 +13,7 @@
 //! `|err| ≤ atol + rtol·|δ|` (err = the embedded estimate), with equal sub-steps.
 //! Memory: the two output arrays only.
 
-use super::forcing::Forcing;
+use super::forcing::{Forcing, Segment};
 use super::model::ContactModel;
 use super::taylor::Taylor;
 use crate::error::{check_positive, CoreError};
@@ -344,17 +344,68 @@ fn taylor_interval(
     Some((y, max_order, v0))
 }
 
-/// [`simulate`] with the interval method chosen (`Method::Rodas4`: the pre-issue-33 solver,
-/// kept as the independent reference of the tests).
-pub fn simulate_with(
+/// What [`taylor_try`] made of an interval.
+enum TaylorTry {
+    /// Done: `δ` at the interval's end `y1` and `δ'` at its start `v0`.
+    Done { y1: f64, v0: f64 },
+    /// Left to the RODAS4 steps (too stiff for the sub-step limit, or every try failed).
+    Fallback,
+    /// The step budget `opts.max_steps` ran out.
+    MaxSteps,
+}
+
+/// The interval from `tc` to `t_end` on `seg` by Taylor sub-steps from `y`: the proposed
+/// count `m_prop` (at least what the rate needs), doubled after each failure up to
+/// [`TAYLOR_MAX_SUBSTEPS`]; updates the proposal for the next interval, the attempts and the
+/// statistics.
+fn taylor_try(
+    tay: &mut Taylor,
     model: &ContactModel,
+    seg: &Segment,
+    (tc, t_end): (f64, f64),
+    y: f64,
+    opts: &Options,
+    (m_prop, attempts): (&mut usize, &mut u64),
+    stats: &mut Stats,
+) -> TaylorTry {
+    let rate_h = model.rate() * (t_end - tc);
+    let need = (rate_h / TAYLOR_RATE).ceil();
+    if need <= TAYLOR_MAX_SUBSTEPS as f64 {
+        let mut m = (*m_prop).max(need as usize).max(1);
+        while m <= TAYLOR_MAX_SUBSTEPS {
+            *attempts = attempts.saturating_add(m as u64);
+            if opts.max_steps > 0 && *attempts > opts.max_steps {
+                return TaylorTry::MaxSteps;
+            }
+            if let Some((y1, order, v0)) =
+                taylor_interval(tay, &seg.c, seg.h, rate_h, m, y, opts, stats)
+            {
+                stats.n_accepted = stats.n_accepted.saturating_add(m as u64);
+                // Keep the orders moderate: the work grows as the order squared.
+                *m_prop = if order > 18 {
+                    m.saturating_mul(2).min(TAYLOR_MAX_SUBSTEPS)
+                } else if order < 10 {
+                    (m / 2).max(1)
+                } else {
+                    m
+                };
+                return TaylorTry::Done { y1, v0 };
+            }
+            stats.n_rejected = stats.n_rejected.saturating_add(1);
+            m = m.saturating_mul(2);
+        }
+    }
+    TaylorTry::Fallback
+}
+
+/// [`simulate_with`]'s argument checks: the options, the output lengths, a finite `delta0`.
+fn check_inputs(
     forcing: &Forcing<'_>,
     delta0: f64,
     opts: &Options,
-    method: Method,
-    delta: &mut [f64],
-    velocity: &mut [f64],
-) -> Result<Outcome, CoreError> {
+    delta: &[f64],
+    velocity: &[f64],
+) -> Result<(), CoreError> {
     opts.validate()?;
     let n = forcing.len();
     crate::error::check_same_len("t", n, "delta (output)", delta.len())?;
@@ -366,6 +417,21 @@ pub fn simulate_with(
             reason: "must be finite",
         });
     }
+    Ok(())
+}
+
+/// [`simulate`] with the interval method chosen (`Method::Rodas4`: the pre-issue-33 solver,
+/// kept as the independent reference of the tests).
+pub fn simulate_with(
+    model: &ContactModel,
+    forcing: &Forcing<'_>,
+    delta0: f64,
+    opts: &Options,
+    method: Method,
+    delta: &mut [f64],
+    velocity: &mut [f64],
+) -> Result<Outcome, CoreError> {
+    check_inputs(forcing, delta0, opts, delta, velocity)?;
     let t = forcing.times();
     let mut stats = Stats::default();
     let mut y = delta0;
@@ -384,39 +450,31 @@ pub fn simulate_with(
         let seg = forcing.segment(i);
         let mut tc = t[i];
         if let Some(tay) = taylor.as_mut() {
-            let rate_h = model.rate() * (t_end - tc);
-            let need = (rate_h / TAYLOR_RATE).ceil();
-            if need <= TAYLOR_MAX_SUBSTEPS as f64 {
-                let mut m = m_prop.max(need as usize).max(1);
-                while m <= TAYLOR_MAX_SUBSTEPS {
-                    attempts = attempts.saturating_add(m as u64);
-                    if opts.max_steps > 0 && attempts > opts.max_steps {
-                        return Ok(Outcome {
-                            status: Status::MaxSteps { time: tc },
-                            n_out: i.saturating_add(1),
-                            stats,
-                        });
-                    }
-                    if let Some((y1, order, v0)) =
-                        taylor_interval(tay, &seg.c, seg.h, rate_h, m, y, opts, &mut stats)
-                    {
-                        delta[i] = y;
-                        velocity[i] = v0;
-                        y = y1;
-                        stats.n_accepted = stats.n_accepted.saturating_add(m as u64);
-                        // Keep the orders moderate: the work grows as the order squared.
-                        m_prop = if order > 18 {
-                            m.saturating_mul(2).min(TAYLOR_MAX_SUBSTEPS)
-                        } else if order < 10 {
-                            (m / 2).max(1)
-                        } else {
-                            m
-                        };
-                        continue 'intervals;
-                    }
-                    stats.n_rejected = stats.n_rejected.saturating_add(1);
-                    m = m.saturating_mul(2);
+            let tried = taylor_try(
+                tay,
+                model,
+                &seg,
+                (tc, t_end),
+                y,
+                opts,
+                (&mut m_prop, &mut attempts),
+                &mut stats,
+            );
+            match tried {
+                TaylorTry::Done { y1, v0 } => {
+                    delta[i] = y;
+                    velocity[i] = v0;
+                    y = y1;
+                    continue 'intervals;
                 }
+                TaylorTry::MaxSteps => {
+                    return Ok(Outcome {
+                        status: Status::MaxSteps { time: tc },
+                        n_out: i.saturating_add(1),
+                        stats,
+                    });
+                }
+                TaylorTry::Fallback => {}
             }
         }
         // Output at the start of the interval: δ and δ' = f(t_i, δ_i).
@@ -494,6 +552,21 @@ pub fn simulate_with(
             }
         }
     }
+    finish(model, forcing, y, delta, velocity, stats)
+}
+
+/// The last sample of a solve that reached it: `δ` and `δ' = f(t, δ)` written there, the
+/// outcome a success (or a stop if `δ` is outside the model's domain).
+fn finish(
+    model: &ContactModel,
+    forcing: &Forcing<'_>,
+    y: f64,
+    delta: &mut [f64],
+    velocity: &mut [f64],
+    mut stats: Stats,
+) -> Result<Outcome, CoreError> {
+    let n = forcing.len();
+    let t = forcing.times();
     let last = n.saturating_sub(1); // n >= 2 (Forcing::new)
     let p = forcing.values()[last];
     let e = match model.eval(p, forcing.sample_deriv(last), y) {
