@@ -487,7 +487,8 @@ def main() -> None:
         print(calibration_table(results), flush=True)
     if a.tanh:
         jobs = [("tangential", a.seed0 + 500 + i, "tanh", "pkg") for i in range(a.tanh)]
-        jobs += [("tangential", a.seed0 + 800 + i, "tanh", "rig") for i in range(min(a.rig, a.tanh))]
+        n_rig = min(a.rig, a.tanh)
+        jobs += [("tangential", a.seed0 + 800 + i, "tanh", "rig") for i in range(n_rig)]
         with ProcessPoolExecutor(a.jobs) as ex:
             res = list(ex.map(run_one, jobs))
         everything += res
