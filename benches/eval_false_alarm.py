@@ -138,6 +138,7 @@ def run_one(job: tuple[str, int, str] | tuple[str, int, str, str]) -> dict[str, 
     from contactlab.errors import ContactLabError
 
     warnings.simplefilter("ignore")
+    sweep = _sweep_tolerance()
     model, seed, virgin = job[:3]
     gen = job[3] if len(job) > 3 else "pkg"
     if gen == "rig":
@@ -165,11 +166,40 @@ def run_one(job: tuple[str, int, str] | tuple[str, int, str, str]) -> dict[str, 
             # and the free-form virgin curve (held-out t and gain), for a joint calibration
             bins_flag=bool(u is not None and u.statistic > u.threshold),
             bb_t=None if u is None or u.backbone is None else u.backbone["t"],
+            bb_half=None if u is None or u.backbone is None else u.backbone["t_half"],
+            bb_nhalf=None if u is None or u.backbone is None else u.backbone["half_cycles"],
             bb_gain=None if u is None or u.backbone is None else u.backbone["gain_over_noise_var"],
             bb_flag=bool(u is not None and u.backbone is not None and u.backbone["flagged"]),
+            tol_sweep=dict(sweep),
         )
     out["cpu"] = time.process_time() - t0
     return out
+
+
+#: multiples of the errors-in-variables tolerance at which each record's phase-bin
+#: statistic is also computed (same residual: one diagnosis per record)
+TOL_MULTIPLES = (0.5, 1.0, 1.5, 2.0, 3.0, 4.0)
+
+
+def _sweep_tolerance() -> dict[float, float]:
+    """Wrap the workflow's structure test so that every call also records ``T`` over its
+    threshold at :data:`TOL_MULTIPLES` of the tolerance (filled when the diagnosis runs)."""
+    from contactlab.diagnose import assessment, misfit
+
+    found: dict[float, float] = {}
+    orig = misfit.unexplained_structure
+
+    def wrapped(d: Any, residual: Any, sigma: float, **kw: Any) -> Any:
+        tol = kw.get("tolerance")
+        for k in TOL_MULTIPLES:
+            kw2 = dict(kw, tolerance=None if tol is None else k * tol)
+            u = orig(d, residual, sigma, **kw2)
+            if u is not None:
+                found[k] = u.statistic / u.threshold
+        return orig(d, residual, sigma, **kw)
+
+    assessment.unexplained_structure = wrapped  # type: ignore[attr-defined]
+    return found
 
 
 def _calibration(u: Any) -> float:
