@@ -29,7 +29,9 @@ def _record(virgin: str, acA: float, cycles: int, x_noise: float, seed: int):
     return t, xm, Fm
 
 
-@pytest.mark.parametrize(("acA", "x_noise", "seed"), [(2.0, 0.015, 3), (1.0, 0.02, 4), (5.0, 0.005, 6)])
+@pytest.mark.parametrize(
+    ("acA", "x_noise", "seed"), [(2.0, 0.015, 3), (1.0, 0.02, 4), (5.0, 0.005, 6)]
+)
 def test_clean_record_with_input_noise_is_not_flagged(acA: float, x_noise: float, seed: int):
     rep = diagnose(_record("exp", acA, 15, x_noise, seed), model="tangential")
     u = rep.unexplained
