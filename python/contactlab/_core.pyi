@@ -162,6 +162,7 @@ def normal_simulate(
     dpdt: _F | None = None,
     first_step: float | None = None,
     max_steps: int = 0,
+    method: str = "auto",
 ) -> dict[str, object]: ...
 def normal_simulate_grid(
     t: _F,

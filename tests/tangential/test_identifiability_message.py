@@ -11,7 +11,7 @@ import pytest
 
 from contactlab.data import data_dir
 from contactlab.studies import run_study
-from contactlab.tangential.analysis import _percent
+from contactlab.tangential.quantities import _percent
 
 
 @pytest.mark.parametrize(

@@ -61,7 +61,7 @@ SIGNIFICANCE = 4.0
 #: 0.050 / 0.036; none on F (1.0): 0.055 / 0.014, and 9 of 20 records were warned
 MAX_X_SHARE = 0.9
 #: the averaged fit's residuals over the noise above which the estimate is not warned about
-#: (the model misses the loop; :func:`~contactlab.tangential.analysis.misfit_ratio`)
+#: (the model misses the loop; :func:`~contactlab.tangential.quantities.misfit_ratio`)
 MAX_MISFIT = 2.0
 
 

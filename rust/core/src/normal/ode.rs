@@ -309,21 +309,23 @@ fn shift_cubic(c: &[f64; 4], s0: f64, sigma: f64) -> [f64; 4] {
     ]
 }
 
-/// One sample interval by `m` equal Taylor steps from `y`: `δ` at its end and the highest
-/// order used, or `None` if a step failed.
+/// One sample interval (length `h`) by `m` equal Taylor steps from `y`: `δ` at its end, the
+/// highest order used and `δ'` at its start, or `None` if a step failed.
 #[inline]
 fn taylor_interval(
     tay: &mut Taylor,
     c: &[f64; 4],
+    h: f64,
     rate_h: f64,
     m: usize,
     mut y: f64,
     opts: &Options,
     stats: &mut Stats,
-) -> Option<(f64, usize)> {
+) -> Option<(f64, usize, f64)> {
     let sigma = 1.0 / m as f64;
     let rs = rate_h * sigma;
     let mut max_order = 0;
+    let mut v0 = 0.0;
     for j in 0..m {
         let e = if m == 1 {
             *c
@@ -332,11 +334,14 @@ fn taylor_interval(
         };
         let tol = opts.atol + opts.rtol * y.abs();
         let (y1, order) = tay.step(&e, rs, y, tol)?;
+        if j == 0 {
+            v0 = tay.first_term() / (h * sigma); // dδ/dv at v = 0, v = (t − t_i)/(σ h)
+        }
         stats.nfev = stats.nfev.saturating_add(order as u64);
         max_order = max_order.max(order);
         y = y1;
     }
-    Some((y, max_order))
+    Some((y, max_order, v0))
 }
 
 /// [`simulate`] with the interval method chosen (`Method::Rodas4`: the pre-issue-33 solver,
@@ -375,21 +380,9 @@ pub fn simulate_with(
     let mut m_prop: usize = 1;
 
     // Interval i runs from t[i] to t_end = t[i + 1].
-    for (i, &t_end) in t[1..].iter().enumerate() {
+    'intervals: for (i, &t_end) in t[1..].iter().enumerate() {
         let seg = forcing.segment(i);
         let mut tc = t[i];
-        // Output at the start of the interval: δ and δ' = f(t_i, δ_i).
-        let (p_i, dp_i) = seg.value_deriv(tc);
-        let e = match model.eval(p_i, dp_i, y) {
-            Ok(e) => e,
-            Err(e) if i > 0 => return stopped(e, tc, i, stats),
-            Err(e) => return Err(e), // delta0 itself is outside the model's domain
-        };
-        stats.nfev = stats.nfev.saturating_add(1);
-        delta[i] = y;
-        velocity[i] = e.f;
-        let (mut f0, mut jac, mut dfdt) = (e.f, e.jac, e.dfdt);
-        let mut first = true;
         if let Some(tay) = taylor.as_mut() {
             let rate_h = model.rate() * (t_end - tc);
             let need = (rate_h / TAYLOR_RATE).ceil();
@@ -404,11 +397,12 @@ pub fn simulate_with(
                             stats,
                         });
                     }
-                    if let Some((y1, order)) =
-                        taylor_interval(tay, &seg.c, rate_h, m, y, opts, &mut stats)
+                    if let Some((y1, order, v0)) =
+                        taylor_interval(tay, &seg.c, seg.h, rate_h, m, y, opts, &mut stats)
                     {
+                        delta[i] = y;
+                        velocity[i] = v0;
                         y = y1;
-                        tc = t_end;
                         stats.n_accepted = stats.n_accepted.saturating_add(m as u64);
                         // Keep the orders moderate: the work grows as the order squared.
                         m_prop = if order > 18 {
@@ -418,13 +412,25 @@ pub fn simulate_with(
                         } else {
                             m
                         };
-                        break;
+                        continue 'intervals;
                     }
                     stats.n_rejected = stats.n_rejected.saturating_add(1);
                     m = m.saturating_mul(2);
                 }
             }
         }
+        // Output at the start of the interval: δ and δ' = f(t_i, δ_i).
+        let (p_i, dp_i) = seg.value_deriv(tc);
+        let e = match model.eval(p_i, dp_i, y) {
+            Ok(e) => e,
+            Err(e) if i > 0 => return stopped(e, tc, i, stats),
+            Err(e) => return Err(e), // delta0 itself is outside the model's domain
+        };
+        stats.nfev = stats.nfev.saturating_add(1);
+        delta[i] = y;
+        velocity[i] = e.f;
+        let (mut f0, mut jac, mut dfdt) = (e.f, e.jac, e.dfdt);
+        let mut first = true;
         while tc < t_end {
             if !first {
                 let (p, dp) = seg.value_deriv(tc);

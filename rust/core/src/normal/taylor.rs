@@ -76,15 +76,45 @@ impl Taylor {
         })
     }
 
+    /// `δ_1` of the last step's series (`dδ/dv` at its start).
+    #[inline]
+    pub(crate) fn first_term(&self) -> f64 {
+        self.d[1]
+    }
+
     /// One step: `e` the forcing cubic in the step's normalised time `v ∈ [0, 1]`
     /// (`p = e0 + e1 v + e2 v² + e3 v³`), `rs` the rate `r` times the step length, `y0` the
     /// state at `v = 0`, `tol` the absolute tolerance. Returns `δ(1)` and the order used, or
     /// `None` if the series did not converge, `k_s(δ_0) ≤ 0` or a value is not finite.
     // Index arithmetic on fixed-size buffers: every index is < NP or < LMAX by the loop
     // bounds (n + 1 < NP is checked before it is used; len ≤ LMAX by `new`).
-    #[allow(clippy::arithmetic_side_effects)]
     #[inline]
     pub(crate) fn step(
+        &mut self,
+        e: &[f64; 4],
+        rs: f64,
+        y0: f64,
+        tol: f64,
+    ) -> Option<(f64, usize)> {
+        // The number of Horner levels as a constant, so that their loop unrolls.
+        match (self.kind, self.len) {
+            (Kind::Delta, 2) => self.step_impl::<2>(e, rs, y0, tol),
+            (Kind::Delta, 3) => self.step_impl::<3>(e, rs, y0, tol),
+            (Kind::Delta, 4) => self.step_impl::<4>(e, rs, y0, tol),
+            (Kind::Delta, 5) => self.step_impl::<5>(e, rs, y0, tol),
+            (Kind::Delta, 6) => self.step_impl::<6>(e, rs, y0, tol),
+            (Kind::Delta, 7) => self.step_impl::<7>(e, rs, y0, tol),
+            (Kind::Delta, 8) => self.step_impl::<8>(e, rs, y0, tol),
+            _ => self.step_impl::<1>(e, rs, y0, tol),
+        }
+    }
+
+    /// [`Self::step`] for `L` stiffness coefficients (δ law; any `L` for the others).
+    // Index arithmetic on fixed-size buffers: every index is < NP or < LMAX by the loop
+    // bounds (n + 1 < NP is checked before it is used; L ≤ LMAX by `step`).
+    #[allow(clippy::arithmetic_side_effects)]
+    #[inline(always)]
+    fn step_impl<const L: usize>(
         &mut self,
         e: &[f64; 4],
         rs: f64,
@@ -109,12 +139,12 @@ impl Taylor {
         };
         for n in 0..NP - 1 {
             if self.kind == Kind::Delta {
-                // Horner levels h[m] = a[m] + δ·h[m+1], top level the constant a[len-1].
-                if len == 1 {
+                // Horner levels h[m] = a[m] + δ·h[m+1], top level the constant a[L-1].
+                if L == 1 {
                     k[n] = if n == 0 { a[0] } else { 0.0 };
                 } else {
-                    let top = len - 2;
-                    h[top][n] = a[len - 1] * d[n] + if n == 0 { a[top] } else { 0.0 };
+                    let top = L - 2;
+                    h[top][n] = a[L - 1] * d[n] + if n == 0 { a[top] } else { 0.0 };
                     for m in (0..top).rev() {
                         let (lo, hi) = h.split_at_mut(m + 1);
                         let (cur, up) = (&mut lo[m], &hi[0]);
