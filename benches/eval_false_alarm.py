@@ -26,6 +26,14 @@ on a few records of the package's generator it states the bound of ``channel_del
 (expected near 95 %). ``--tanh`` diagnoses records whose virgin curve is ``h0 tanh(ac x)``
 (no candidate can draw it) and reports how often the misfit is flagged.
 
+``--rig N`` adds N clean records per model of the independent rig generator
+(:mod:`contactlab.synthetic.rig`, factors as ``benches/eval_diagnose_rig.py`` draws them;
+seeds ``seed0 + 700 ...``) and, with ``--tanh``, N of its ``tanh_virgin`` records (``seed0 +
+800 ...``); the tanh rate is given for ``ac·A >= 1`` apart. Each record also carries each
+misfit test's own verdict and, in ``--dump`` (JSON lines), the phase-bin statistic at
+multiples of the errors-in-variables tolerance (:data:`TOL_MULTIPLES`), for calibrating the
+two tests jointly from one diagnosis per record.
+
 Run: ``nice .venv/bin/python benches/eval_false_alarm.py --n 60 --jobs 2`` (about 10
 CPU-minutes). Not part of the test suite.
 """
