@@ -26,6 +26,14 @@ on a few records of the package's generator it states the bound of ``channel_del
 (expected near 95 %). ``--tanh`` diagnoses records whose virgin curve is ``h0 tanh(ac x)``
 (no candidate can draw it) and reports how often the misfit is flagged.
 
+``--rig N`` adds N clean records per model of the independent rig generator
+(:mod:`contactlab.synthetic.rig`, factors as ``benches/eval_diagnose_rig.py`` draws them;
+seeds ``seed0 + 700 ...``) and, with ``--tanh``, N of its ``tanh_virgin`` records (``seed0 +
+800 ...``); the tanh rate is given for ``ac·A >= 1`` apart. Each record also carries each
+misfit test's own verdict and, in ``--dump`` (JSON lines), the phase-bin statistic at
+multiples of the errors-in-variables tolerance (:data:`TOL_MULTIPLES`), for calibrating the
+two tests jointly from one diagnosis per record.
+
 Run: ``nice .venv/bin/python benches/eval_false_alarm.py --n 60 --jobs 2`` (about 10
 CPU-minutes). Not part of the test suite.
 """
@@ -106,12 +114,46 @@ def clean_record(model: str, seed: int, virgin: str = "exp") -> tuple[Any, dict[
     return (t, _noisy(rng, p, lv["x_noise"]), _noisy(rng, delta, lv["y_noise"])), lv
 
 
-def run_one(job: tuple[str, int, str]) -> dict[str, Any]:
+def rig_record(model: str, seed: int, virgin: str = "exp") -> tuple[Any, dict[str, Any]]:
+    """A clean record of the independent rig generator (``virgin="tanh"``: its
+    ``tanh_virgin`` effect), factors drawn as in ``benches/eval_diagnose_rig.py``, as the
+    CSV round trip a user would read."""
+    import sys
+    import tempfile
+    from pathlib import Path
+
+    import contactlab
+    from contactlab.synthetic.rig import rig_recording
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from eval_diagnose_rig import draw_factors
+
+    f = draw_factors(np.random.default_rng(seed), model)
+    fac = {k: f[k] for k in ("fs", "f", "cycles", "acA", "x_noise", "F_noise")}
+    eff = {"tanh_virgin": {}} if virgin == "tanh" else {}
+    rec = rig_recording(eff, model, seed=seed, **fac)
+    with tempfile.TemporaryDirectory() as tmp:
+        out = contactlab.read_recording(str(rec.to_csv(Path(tmp) / "rec.csv")))
+    lv = {"fs": fac["fs"], "cycles": fac["cycles"], "x_noise": fac["x_noise"],
+          "amp": fac["acA"], "y_noise": fac["F_noise"], "f0": fac["f"]}  # fmt: skip
+    return out, lv
+
+
+def run_one(job: tuple[str, int, str] | tuple[str, int, str, str]) -> dict[str, Any]:
+    import warnings
+
     from contactlab.diagnose.workflow import diagnose
     from contactlab.errors import ContactLabError
 
-    model, seed, virgin = job
-    rec, lv = clean_record(model, seed, virgin)
+    warnings.simplefilter("ignore")
+    sweep = _sweep_tolerance()
+    model, seed, virgin = job[:3]
+    gen = job[3] if len(job) > 3 else "pkg"
+    if gen == "rig":
+        rec, lv = rig_record(model, seed, virgin)
+    else:
+        rec, lv = clean_record(model, seed, virgin)
+    lv["gen"] = gen
     t0 = time.process_time()
     out: dict[str, Any] = {"model": model, "seed": seed, "virgin": virgin, **lv}
     try:
@@ -128,9 +170,44 @@ def run_one(job: tuple[str, int, str]) -> dict[str, Any]:
             # T over its threshold (before the calibration factor): the null's quantiles
             misfit_ratio=None if u is None else u.statistic / u.threshold * _calibration(u),
             misfit_cycles=None if u is None else u.cycles,
+            # each test's own verdict: the phase bins (T over the calibrated threshold)
+            # and the free-form virgin curve (held-out t and gain), for a joint calibration
+            bins_flag=bool(u is not None and u.statistic > u.threshold),
+            bb_t=None if u is None or u.backbone is None else u.backbone["t"],
+            bb_half=None if u is None or u.backbone is None else u.backbone["t_half"],
+            bb_nhalf=None if u is None or u.backbone is None else u.backbone["half_cycles"],
+            bb_gain=None if u is None or u.backbone is None else u.backbone["gain_over_noise_var"],
+            bb_flag=bool(u is not None and u.backbone is not None and u.backbone["flagged"]),
+            tol_sweep=dict(sweep),
         )
     out["cpu"] = time.process_time() - t0
     return out
+
+
+#: multiples of the errors-in-variables tolerance at which each record's phase-bin
+#: statistic is also computed (same residual: one diagnosis per record)
+TOL_MULTIPLES = (0.5, 1.0, 1.5, 2.0, 3.0, 4.0)
+
+
+def _sweep_tolerance() -> dict[float, float]:
+    """Wrap the workflow's structure test so that every call also records ``T`` over its
+    threshold at :data:`TOL_MULTIPLES` of the tolerance (filled when the diagnosis runs)."""
+    from contactlab.diagnose import assessment, misfit
+
+    found: dict[float, float] = {}
+    orig = misfit.unexplained_structure
+
+    def wrapped(d: Any, residual: Any, sigma: float, **kw: Any) -> Any:
+        tol = kw.get("tolerance")
+        for k in TOL_MULTIPLES:
+            kw2 = dict(kw, tolerance=None if tol is None else k * tol)
+            u = orig(d, residual, sigma, **kw2)
+            if u is not None:
+                found[k] = u.statistic / u.threshold
+        return orig(d, residual, sigma, **kw)
+
+    assessment.unexplained_structure = wrapped  # type: ignore[attr-defined]
+    return found
 
 
 def _calibration(u: Any) -> float:
@@ -184,10 +261,13 @@ def _fmt(v: Any) -> str:
     return str(v)
 
 
-def table(results: list[dict[str, Any]], model: str) -> str:
+def table(results: list[dict[str, Any]], model: str, gen: str = "pkg") -> str:
+    results = [r for r in results if r.get("gen", "pkg") == gen]
     rs = [r for r in results if r["model"] == model and r["refused"] is None]
     refused = sum(1 for r in results if r["model"] == model and r["refused"] is not None)
-    lines = [f"\n{model}: {len(rs)} clean records diagnosed ({refused} refused)"]
+    if not rs and not refused:
+        return ""
+    lines = [f"\n{model} ({gen} generator): {len(rs)} clean records diagnosed ({refused} refused)"]
     factors = [("fs", "fs (Hz)"), ("cycles", "cycles"), ("x_noise", "x noise (% range)")]
     factors.append(("amp", "ac·A" if model == "tangential" else "pa/p0"))
     head = f"{'factor':<20}{'level':>10}{'n':>5}{'named':>7}{'rate':>7}{'95% up':>8}"
@@ -196,12 +276,14 @@ def table(results: list[dict[str, Any]], model: str) -> str:
     for key, label in factors:
         groups: dict[Any, list[dict[str, Any]]] = defaultdict(list)
         for r in rs:
-            groups[r[key]].append(r)
+            groups[_level(r[key], key) if gen == "rig" else r[key]].append(r)
         for lvl in sorted(groups):
             g = groups[lvl]
             k = sum(1 for r in g if r["named"])
             f = sum(1 for r in g if r["flagged"])
             lv = f"{100 * lvl:g}" if key == "x_noise" else f"{lvl:g}"
+            if gen == "rig":  # continuous factors: the record's level rounded
+                lv = f"{100 * lvl:.2g}" if key == "x_noise" else f"{lvl:.3g}"
             lines.append(
                 f"{label:<20}{lv:>10}{len(g):>5}{k:>7}{100 * k / len(g):>6.1f}%"
                 f"{100 * _upper(k, len(g)):>7.0f}%{f:>8}{100 * f / len(g):>6.1f}%"
@@ -214,16 +296,63 @@ def table(results: list[dict[str, Any]], model: str) -> str:
         f"{100 * _upper(k, len(rs)):>7.0f}%"
         f"{f:>8}{100 * f / n:>6.1f}%"
     )
+    nb = sum(1 for r in rs if r.get("bins_flag"))
+    nbb = sum(1 for r in rs if r.get("bb_flag"))
+    lines.append(f"  flagged by the phase bins {nb}, by the free-form virgin curve {nbb}")
     for r in rs:
         if r["named"] or r["flagged"]:
             lines.append(
                 f"  seed {r['seed']}: named {r['named']} flagged {r['flagged']} "
+                f"(bins {r.get('bins_flag')}, virgin curve {r.get('bb_flag')}) "
                 f"(fs {r['fs']:g}, cycles {r['cycles']}, x noise {100 * r['x_noise']:g} %, "
                 f"amp {r['amp']:g}, F noise {100 * r['y_noise']:.2g} %, f0 {r['f0']:.3g} Hz)"
             )
     cpu = [r["cpu"] for r in results if r["model"] == model]
     lines.append(f"CPU per record: median {np.median(cpu):.1f} s, max {np.max(cpu):.1f} s")
     return "\n".join(lines)
+
+
+def _level(v: float, key: str) -> float:
+    """The rig's continuous factor, as the lower edge of the package's level it falls in."""
+    edges = {"fs": FS, "cycles": CYCLES, "x_noise": X_NOISE, "amp": AC_A}.get(key, PA_P0)
+    below = [e for e in edges if e <= v * (1 + 1e-9)]
+    return float(below[-1]) if below else float(edges[0])
+
+
+def tanh_table(res: list[dict[str, Any]]) -> str:
+    """The tanh virgin curve's flag rate per generator, visible (ac·A >= 1) apart."""
+    lines = []
+    for gen in ("pkg", "rig"):
+        ok = [r for r in res if r["refused"] is None and r.get("gen", "pkg") == gen]
+        if not ok:
+            continue
+        refused = sum(1 for r in res if r["refused"] is not None and r.get("gen", "pkg") == gen)
+        f = sum(r["flagged"] for r in ok)
+        lines.append(f"\ntanh virgin curve ({gen}): flagged {f}/{len(ok)} ({refused} refused)")
+        for name, sel in (("ac·A >= 1 (visible)", lambda a: a >= 1.0),
+                          ("ac·A < 1", lambda a: a < 1.0)):  # fmt: skip
+            g = [r for r in ok if sel(r["amp"])]
+            k = sum(r["flagged"] for r in g)
+            kb = sum(bool(r.get("bins_flag")) for r in g)
+            kv = sum(bool(r.get("bb_flag")) for r in g)
+            if g:
+                lines.append(
+                    f"  {name:<22} flagged {k}/{len(g)} ({100 * k / len(g):.0f} %): by the "
+                    f"phase bins {kb}, by the free-form virgin curve {kv}"
+                )
+        for r in ok:
+            bt = r.get("bb_t")
+            lines.append(
+                f"  seed {r['seed']}: named {r['named']}, flagged {r['flagged']} "
+                f"(bins {r.get('bins_flag')}, T/q {_g(r.get('misfit_ratio'))}, virgin t "
+                f"{_g(bt)}, gain {_g(r.get('bb_gain'))}) (x noise {100 * r['x_noise']:.2g} %, "
+                f"ac·A {r['amp']:.3g}, cycles {r['cycles']}, fs {r['fs']:g})"
+            )
+    return "\n".join(lines)
+
+
+def _g(v: Any) -> str:
+    return "-" if v is None else f"{v:.3g}"
 
 
 def power_check(seeds: list[int], jobs: int) -> str:
@@ -374,29 +503,40 @@ def main() -> None:
     ap.add_argument("--power-seeds", type=int, default=6, help="seeds per generator")
     ap.add_argument("--tanh", type=int, default=0, help="tanh-virgin records to diagnose")
     ap.add_argument("--skip-null", action="store_true")
+    ap.add_argument("--rig", type=int, default=0,
+                    help="clean records of the rig generator per model (and as many tanh "
+                    "records with --tanh)")  # fmt: skip
+    ap.add_argument("--dump", default=None, help="write every record's result (JSON lines)")
     a = ap.parse_args()
     models = ("tangential", "normal") if a.model == "both" else (a.model,)
     t0 = time.time()
+    everything: list[dict[str, Any]] = []
     if not a.skip_null:
-        jobs = [(m, a.seed0 + i, "exp") for m in models for i in range(a.n)]
+        jobs: list[tuple[str, int, str, str]] = [
+            (m, a.seed0 + i, "exp", "pkg") for m in models for i in range(a.n)
+        ]
+        jobs += [(m, a.seed0 + 700 + i, "exp", "rig") for m in models for i in range(a.rig)]
         with ProcessPoolExecutor(a.jobs) as ex:
             results = list(ex.map(run_one, jobs))
-        for m in models:
-            print(table(results, m), flush=True)
+        everything += results
+        for gen in ("pkg", "rig"):
+            for m in models:
+                print(table(results, m, gen), flush=True)
         print(calibration_table(results), flush=True)
     if a.tanh:
-        jobs = [("tangential", a.seed0 + 500 + i, "tanh") for i in range(a.tanh)]
+        jobs = [("tangential", a.seed0 + 500 + i, "tanh", "pkg") for i in range(a.tanh)]
+        n_rig = min(a.rig, a.tanh)
+        jobs += [("tangential", a.seed0 + 800 + i, "tanh", "rig") for i in range(n_rig)]
         with ProcessPoolExecutor(a.jobs) as ex:
             res = list(ex.map(run_one, jobs))
-        ok = [r for r in res if r["refused"] is None]
-        f = sum(r["flagged"] for r in ok)
-        print(f"\ntanh virgin curve: flagged {f}/{len(ok)} ({len(res) - len(ok)} refused)")
-        for r in ok:
-            print(
-                f"  seed {r['seed']}: named {r['named']}, flagged {r['flagged']} "
-                f"(x noise {100 * r['x_noise']:g} %, ac·A {r['amp']:g}, cycles {r['cycles']}, "
-                f"fs {r['fs']:g})"
-            )
+        everything += res
+        print(tanh_table(res), flush=True)
+    if a.dump:
+        import json
+
+        with open(a.dump, "w") as fh:
+            for r in everything:
+                fh.write(json.dumps(r, default=str) + "\n")
     if a.power:
         print(power_check([a.seed0 + 900 + i for i in range(a.power_seeds)], a.jobs))
     print(f"\nwall {time.time() - t0:.0f} s", flush=True)

@@ -17,13 +17,13 @@
 //! [`loop_area_sensitivity`](crate::loop_area::loop_area_sensitivity),
 //! [`period_means`](crate::fold::period_means)) to rounding: the per-bin sums and the
 //! period means bit for bit, the rest to ~1e-12 relative (another summation order).
+//!
+//! The detrending pass that precedes the fold ([`detrend_pair_scan_into`], [`WindowScan`]) is in
+//! `window/detrend.rs`, a fold's cell and segment records in `window/cell.rs`, the tests in
+//! `window/tests.rs`.
 
 use crate::error::{check_finite, check_same_len, CoreError};
 use crate::fold::period_means_pair_checked;
-use crate::select::{TailGather, GATHER_BLOCK, STRIDE};
-
-/// Samples a block of [`detrend_pair_scan_into`]'s pass (a multiple of [`GATHER_BLOCK`]).
-const SCAN_BLOCK: usize = 16 * GATHER_BLOCK;
 
 /// One window folded (see the module docs). Per bin: samples, `Σx`, `ΣF`, `Σφ`, `Σφ²`,
 /// `Σx²`, `Σt` (φ the phase within the cycle), and the cycle-to-cycle spread of the per-cycle
@@ -393,177 +393,6 @@ fn clean_samples(t: &[f64], x: &[f64], f: &[f64]) -> Option<[f64; 3]> {
     Some([sx, sf, force_centre(f, sum_f, sf)])
 }
 
-/// `F - s_F·(t - tm)` and `x - s_x·(t - tm)` (the window's linear drifts removed), one
-/// vectorised pass a channel, with numpy's operations in numpy's order (`v + (t - tm)·(-s)`,
-/// bit for bit that of the expression `v - s·(t - tm)`).
-pub fn detrend_pair(
-    t: &[f64],
-    tm: f64,
-    (f, s_f): (&[f64], f64),
-    (x, s_x): (&[f64], f64),
-) -> Result<(Vec<f64>, Vec<f64>), CoreError> {
-    let mut out_f = vec![0.0; f.len()];
-    let mut out_x = vec![0.0; x.len()];
-    detrend_pair_into(t, tm, (f, s_f), (x, s_x), (&mut out_f, &mut out_x))?;
-    Ok((out_f, out_x))
-}
-
-/// [`detrend_pair`] into the caller's buffers (the Python binding's numpy arrays: a fresh
-/// `Vec` of a window's length cost a page fault every 4 KiB, 5 ms of system time a window,
-/// where numpy's allocator asks for huge pages).
-pub fn detrend_pair_into(
-    t: &[f64],
-    tm: f64,
-    (f, s_f): (&[f64], f64),
-    (x, s_x): (&[f64], f64),
-    (out_f, out_x): (&mut [f64], &mut [f64]),
-) -> Result<(), CoreError> {
-    check_same_len("t", t.len(), "F", f.len())?;
-    check_same_len("t", t.len(), "x", x.len())?;
-    check_same_len("t", t.len(), "out_F", out_f.len())?;
-    check_same_len("t", t.len(), "out_x", out_x.len())?;
-    for (out, v, neg) in [(out_f, f, -s_f), (out_x, x, -s_x)] {
-        for ((o, &ti), &vi) in out.iter_mut().zip(t).zip(v) {
-            *o = vi + (ti - tm) * neg;
-        }
-    }
-    Ok(())
-}
-
-/// What [`detrend_pair_scan_into`] found of the samples it made: whether `t` is finite and
-/// strictly increasing and the detrended `x` and `F` finite (`clean`), the largest `|x|` and
-/// `|F|`, the centre of the scaled force (the numbers [`fold_window`]'s check pass finds:
-/// the same lanes and order of additions), and the order statistics of the detrended `x` at
-/// the ranks asked for.
-#[derive(Debug, Clone, PartialEq)]
-pub struct WindowScan {
-    pub n: usize,
-    pub clean: bool,
-    pub max_abs_x: f64,
-    pub max_abs_f: f64,
-    pub force_centre: f64,
-    pub order_stats: Vec<f64>,
-}
-
-/// [`detrend_pair_into`] and, in the same pass over the samples, what the window's next two
-/// passes over the detrended samples would read them for: the order statistics of `x` at
-/// `ranks` ([`crate::select::order_stats`]'s: the subsample's detrended values computed
-/// first, the tails gathered from each block as it is written; the robust amplitude of the
-/// reversal search) and the fold's checks and scales ([`WindowScan`], for
-/// [`fold_window_scanned`]). The detrended samples are bit for bit [`detrend_pair_into`]'s,
-/// the order statistics those of [`crate::select::order_stats`] of them (exact), the scan's
-/// numbers those of [`fold_window`]'s check. An empty `ranks` gathers nothing.
-///
-/// # Errors
-/// As [`detrend_pair_into`]; a rank not below the samples' number as
-/// [`crate::select::order_stats`].
-// Index arithmetic: a + k < b <= n inside the blocks; k < 4.
-#[allow(clippy::arithmetic_side_effects, clippy::needless_bitwise_bool)]
-pub fn detrend_pair_scan_into(
-    t: &[f64],
-    tm: f64,
-    (f, s_f): (&[f64], f64),
-    (x, s_x): (&[f64], f64),
-    (out_f, out_x): (&mut [f64], &mut [f64]),
-    ranks: &[usize],
-) -> Result<WindowScan, CoreError> {
-    check_same_len("t", t.len(), "F", f.len())?;
-    check_same_len("t", t.len(), "x", x.len())?;
-    check_same_len("t", t.len(), "out_F", out_f.len())?;
-    check_same_len("t", t.len(), "out_x", out_x.len())?;
-    let n = t.len();
-    let (nf, nx) = (-s_f, -s_x);
-    let mut gather = if ranks.is_empty() || n == 0 {
-        None
-    } else {
-        // a sparser subsample than order_stats' (its samples are cache misses here, where
-        // order_stats' were just written): thresholds a little less sharp, values the same
-        Some(TailGather::new(n, ranks, 4 * STRIDE, |i| {
-            x[i] + (t[i] - tm) * nx
-        })?)
-    };
-    let (mut mx, mut mf, mut sum_f) = ([0.0_f64; 4], [0.0_f64; 4], [0.0_f64; 4]);
-    // Σ v·0 of x, F and t: ±0 while every value is finite, NaN from an inf or a NaN on (a
-    // vectorised finiteness check, where a lane of booleans was not); the smallest step of t
-    let (mut z, mut zt, mut dmin) = ([0.0_f64; 4], [0.0_f64; 4], [f64::INFINITY; 4]);
-    let mut a = 0_usize;
-    while a < n {
-        // blocks that stay in L2 for the passes over what was just written, long enough for
-        // the prefetchers' streams (blocks of GATHER_BLOCK were 2.5x slower)
-        let b = (a + SCAN_BLOCK).min(n);
-        let (tb, fb, xb) = (&t[a..b], &f[a..b], &x[a..b]);
-        let (ofb, oxb) = (&mut out_f[a..b], &mut out_x[a..b]);
-        for ((o, &ti), &vi) in ofb.iter_mut().zip(tb).zip(fb) {
-            *o = vi + (ti - tm) * nf;
-        }
-        for ((o, &ti), &vi) in oxb.iter_mut().zip(tb).zip(xb) {
-            *o = vi + (ti - tm) * nx;
-        }
-        // the steps of t from the sample before the block (none before the first)
-        let tp = &t[a.saturating_sub(1)..b];
-        let (t0, t1) = (&tp[..tp.len() - 1], &tp[1..]);
-        let mut c0 = t0.chunks_exact(4);
-        let mut c1 = t1.chunks_exact(4);
-        for (p, q) in (&mut c0).zip(&mut c1) {
-            for l in 0..4 {
-                let d = q[l] - p[l];
-                dmin[l] = if d < dmin[l] { d } else { dmin[l] };
-                zt[l] += q[l] * 0.0;
-            }
-        }
-        for (l, (&p, &q)) in c0.remainder().iter().zip(c1.remainder()).enumerate() {
-            let d = q - p;
-            dmin[l] = if d < dmin[l] { d } else { dmin[l] };
-            zt[l] += q * 0.0;
-        }
-        // finite_max_abs's lanes (sample i in lane i mod 4; blocks start at multiples of 4)
-        let mut cx = oxb.chunks_exact(4);
-        let mut cf = ofb.chunks_exact(4);
-        for (qx, qf) in (&mut cx).zip(&mut cf) {
-            for l in 0..4 {
-                let (ax, af) = (qx[l].abs(), qf[l].abs());
-                mx[l] = if ax > mx[l] { ax } else { mx[l] };
-                mf[l] = if af > mf[l] { af } else { mf[l] };
-                sum_f[l] += qf[l];
-                z[l] += qx[l] * 0.0 + qf[l] * 0.0;
-            }
-        }
-        for (l, (&vx, &vf)) in cx.remainder().iter().zip(cf.remainder()).enumerate() {
-            let (ax, af) = (vx.abs(), vf.abs());
-            mx[l] = if ax > mx[l] { ax } else { mx[l] };
-            mf[l] = if af > mf[l] { af } else { mf[l] };
-            sum_f[l] += vf;
-            z[l] += vx * 0.0 + vf * 0.0;
-        }
-        if let Some(g) = gather.as_mut() {
-            for blk in oxb.chunks(GATHER_BLOCK) {
-                g.block(blk);
-            }
-        }
-        a = b;
-    }
-    // t: finite (its first sample too) and strictly increasing (a NaN step fails `> 0`)
-    let t_ok =
-        n >= 2 && t[0].is_finite() && zt.iter().all(|&v| v == 0.0) && dmin.iter().all(|&d| d > 0.0);
-    let ok = [z.iter().all(|&v| v == 0.0); 1];
-    let big = |m: [f64; 4]| m.iter().fold(0.0_f64, |a, &b| if b > a { b } else { a });
-    let (sx, sf) = (big(mx), big(mf));
-    let sum = (sum_f[0] + sum_f[1]) + (sum_f[2] + sum_f[3]);
-    let clean = t_ok && ok[0];
-    let order_stats = match gather {
-        Some(g) => g.finish(out_x),
-        None => Vec::new(),
-    };
-    Ok(WindowScan {
-        n,
-        clean,
-        max_abs_x: sx,
-        max_abs_f: sf,
-        force_centre: force_centre(out_f, sum, sf),
-        order_stats,
-    })
-}
-
 /// A complete cell (`n` samples, sums `cx`, `cf`, `cp` of x, F, φ) of a bin whose sample
 /// sums are now `cur`: into the bin and the cycle's ranges `r` of cell means.
 #[inline(always)]
@@ -911,7 +740,9 @@ fn finish(
 }
 
 mod cell;
+mod detrend;
 use cell::{next_bin, Cell, Segment, NO_RANGE};
+pub use detrend::{detrend_pair, detrend_pair_into, detrend_pair_scan_into, WindowScan};
 
 #[cfg(test)]
 mod tests;

@@ -12,8 +12,10 @@
 //! dense-output interpolation error). Within a sample interval the step adapts to
 //! `|err| ≤ atol + rtol·|δ|` (err = the embedded estimate), with equal sub-steps.
 //! Memory: the two output arrays only.
+//!
+//! The tests are in `ode/tests.rs`.
 
-use super::forcing::Forcing;
+use super::forcing::{Forcing, Segment};
 use super::model::ContactModel;
 use super::taylor::Taylor;
 use crate::error::{check_positive, CoreError};
@@ -344,17 +346,68 @@ fn taylor_interval(
     Some((y, max_order, v0))
 }
 
-/// [`simulate`] with the interval method chosen (`Method::Rodas4`: the pre-issue-33 solver,
-/// kept as the independent reference of the tests).
-pub fn simulate_with(
+/// What [`taylor_try`] made of an interval.
+enum TaylorTry {
+    /// Done: `δ` at the interval's end `y1` and `δ'` at its start `v0`.
+    Done { y1: f64, v0: f64 },
+    /// Left to the RODAS4 steps (too stiff for the sub-step limit, or every try failed).
+    Fallback,
+    /// The step budget `opts.max_steps` ran out.
+    MaxSteps,
+}
+
+/// The interval from `tc` to `t_end` on `seg` by Taylor sub-steps from `y`: the proposed
+/// count `m_prop` (at least what the rate needs), doubled after each failure up to
+/// [`TAYLOR_MAX_SUBSTEPS`]; updates the proposal for the next interval, the attempts and the
+/// statistics.
+fn taylor_try(
+    tay: &mut Taylor,
     model: &ContactModel,
+    seg: &Segment,
+    (tc, t_end): (f64, f64),
+    y: f64,
+    opts: &Options,
+    (m_prop, attempts): (&mut usize, &mut u64),
+    stats: &mut Stats,
+) -> TaylorTry {
+    let rate_h = model.rate() * (t_end - tc);
+    let need = (rate_h / TAYLOR_RATE).ceil();
+    if need <= TAYLOR_MAX_SUBSTEPS as f64 {
+        let mut m = (*m_prop).max(need as usize).max(1);
+        while m <= TAYLOR_MAX_SUBSTEPS {
+            *attempts = attempts.saturating_add(m as u64);
+            if opts.max_steps > 0 && *attempts > opts.max_steps {
+                return TaylorTry::MaxSteps;
+            }
+            if let Some((y1, order, v0)) =
+                taylor_interval(tay, &seg.c, seg.h, rate_h, m, y, opts, stats)
+            {
+                stats.n_accepted = stats.n_accepted.saturating_add(m as u64);
+                // Keep the orders moderate: the work grows as the order squared.
+                *m_prop = if order > 18 {
+                    m.saturating_mul(2).min(TAYLOR_MAX_SUBSTEPS)
+                } else if order < 10 {
+                    (m / 2).max(1)
+                } else {
+                    m
+                };
+                return TaylorTry::Done { y1, v0 };
+            }
+            stats.n_rejected = stats.n_rejected.saturating_add(1);
+            m = m.saturating_mul(2);
+        }
+    }
+    TaylorTry::Fallback
+}
+
+/// [`simulate_with`]'s argument checks: the options, the output lengths, a finite `delta0`.
+fn check_inputs(
     forcing: &Forcing<'_>,
     delta0: f64,
     opts: &Options,
-    method: Method,
-    delta: &mut [f64],
-    velocity: &mut [f64],
-) -> Result<Outcome, CoreError> {
+    delta: &[f64],
+    velocity: &[f64],
+) -> Result<(), CoreError> {
     opts.validate()?;
     let n = forcing.len();
     crate::error::check_same_len("t", n, "delta (output)", delta.len())?;
@@ -366,6 +419,21 @@ pub fn simulate_with(
             reason: "must be finite",
         });
     }
+    Ok(())
+}
+
+/// [`simulate`] with the interval method chosen (`Method::Rodas4`: the pre-issue-33 solver,
+/// kept as the independent reference of the tests).
+pub fn simulate_with(
+    model: &ContactModel,
+    forcing: &Forcing<'_>,
+    delta0: f64,
+    opts: &Options,
+    method: Method,
+    delta: &mut [f64],
+    velocity: &mut [f64],
+) -> Result<Outcome, CoreError> {
+    check_inputs(forcing, delta0, opts, delta, velocity)?;
     let t = forcing.times();
     let mut stats = Stats::default();
     let mut y = delta0;
@@ -384,39 +452,31 @@ pub fn simulate_with(
         let seg = forcing.segment(i);
         let mut tc = t[i];
         if let Some(tay) = taylor.as_mut() {
-            let rate_h = model.rate() * (t_end - tc);
-            let need = (rate_h / TAYLOR_RATE).ceil();
-            if need <= TAYLOR_MAX_SUBSTEPS as f64 {
-                let mut m = m_prop.max(need as usize).max(1);
-                while m <= TAYLOR_MAX_SUBSTEPS {
-                    attempts = attempts.saturating_add(m as u64);
-                    if opts.max_steps > 0 && attempts > opts.max_steps {
-                        return Ok(Outcome {
-                            status: Status::MaxSteps { time: tc },
-                            n_out: i.saturating_add(1),
-                            stats,
-                        });
-                    }
-                    if let Some((y1, order, v0)) =
-                        taylor_interval(tay, &seg.c, seg.h, rate_h, m, y, opts, &mut stats)
-                    {
-                        delta[i] = y;
-                        velocity[i] = v0;
-                        y = y1;
-                        stats.n_accepted = stats.n_accepted.saturating_add(m as u64);
-                        // Keep the orders moderate: the work grows as the order squared.
-                        m_prop = if order > 18 {
-                            m.saturating_mul(2).min(TAYLOR_MAX_SUBSTEPS)
-                        } else if order < 10 {
-                            (m / 2).max(1)
-                        } else {
-                            m
-                        };
-                        continue 'intervals;
-                    }
-                    stats.n_rejected = stats.n_rejected.saturating_add(1);
-                    m = m.saturating_mul(2);
+            let tried = taylor_try(
+                tay,
+                model,
+                &seg,
+                (tc, t_end),
+                y,
+                opts,
+                (&mut m_prop, &mut attempts),
+                &mut stats,
+            );
+            match tried {
+                TaylorTry::Done { y1, v0 } => {
+                    delta[i] = y;
+                    velocity[i] = v0;
+                    y = y1;
+                    continue 'intervals;
                 }
+                TaylorTry::MaxSteps => {
+                    return Ok(Outcome {
+                        status: Status::MaxSteps { time: tc },
+                        n_out: i.saturating_add(1),
+                        stats,
+                    });
+                }
+                TaylorTry::Fallback => {}
             }
         }
         // Output at the start of the interval: δ and δ' = f(t_i, δ_i).
@@ -494,6 +554,21 @@ pub fn simulate_with(
             }
         }
     }
+    finish(model, forcing, y, delta, velocity, stats)
+}
+
+/// The last sample of a solve that reached it: `δ` and `δ' = f(t, δ)` written there, the
+/// outcome a success (or a stop if `δ` is outside the model's domain).
+fn finish(
+    model: &ContactModel,
+    forcing: &Forcing<'_>,
+    y: f64,
+    delta: &mut [f64],
+    velocity: &mut [f64],
+    mut stats: Stats,
+) -> Result<Outcome, CoreError> {
+    let n = forcing.len();
+    let t = forcing.times();
     let last = n.saturating_sub(1); // n >= 2 (Forcing::new)
     let p = forcing.values()[last];
     let e = match model.eval(p, forcing.sample_deriv(last), y) {
@@ -529,210 +604,4 @@ fn stopped(e: CoreError, time: f64, n_out: usize, stats: Stats) -> Result<Outcom
 }
 
 #[cfg(test)]
-mod tests {
-    use super::super::forcing::Interp;
-    use super::super::model::Stiffness;
-    use super::*;
-    use std::f64::consts::PI;
-
-    fn sine(n: usize, per: usize, w: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-        let dt = 2.0 * PI / w / per as f64;
-        let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
-        let p = t.iter().map(|&v| 0.4 * (w * v).sin()).collect();
-        let d = t.iter().map(|&v| 0.4 * w * (w * v).cos()).collect();
-        (t, p, d)
-    }
-
-    #[test]
-    fn kelvin_voigt_reaches_analytic_steady_state() {
-        let (k, psi, w) = (1.206, 0.0887, 1.0);
-        let m = ContactModel::new(Stiffness::Constant(k), psi, w).unwrap();
-        // 512 samples per period: the cubic interpolant's own error (~(ωΔt)⁴/384) is then
-        // small enough that δ' = (2πω/ψ)(p/k − δ), which amplifies δ errors by 2π/ψ, is
-        // within 1e-8 too.
-        let (t, p, d) = sine(512 * 6 + 1, 512, w);
-        let fo = Forcing::new(&t, &p, Some(&d), Interp::Cubic).unwrap();
-        let mut y = vec![0.0; t.len()];
-        let mut v = vec![0.0; t.len()];
-        let opts = Options {
-            rtol: 1e-10,
-            atol: 1e-16,
-            ..Options::default()
-        };
-        let out = simulate(&m, &fo, 0.0, &opts, &mut y, &mut v).unwrap();
-        assert_eq!(out.status, Status::Success);
-        let g = psi / (2.0 * PI);
-        let amp = 0.4 / k / (1.0 + g * g).sqrt();
-        let phi = g.atan();
-        let (mut ed, mut ev) = (0.0_f64, 0.0_f64);
-        for i in 512 * 2..t.len() {
-            let exact = amp * (w * t[i] - phi).sin();
-            ed = ed.max((y[i] - exact).abs() / amp);
-            let vexact = amp * w * (w * t[i] - phi).cos();
-            ev = ev.max((v[i] - vexact).abs() / (amp * w));
-        }
-        assert!(ed < 1e-8 && ev < 1e-8, "relative error {ed} {ev}");
-    }
-
-    #[test]
-    fn order_four_convergence() {
-        // Fixed large sample interval, tight tolerance off: compare two coarse tolerances.
-        let m = ContactModel::new(
-            Stiffness::Delta(vec![1.32596, 1.59811, 2.92127, 2.87416]),
-            0.0887,
-            1.0,
-        )
-        .unwrap();
-        let (t, p, d) = sine(256 * 3 + 1, 256, 1.0);
-        let fo = Forcing::new(&t, &p, Some(&d), Interp::Cubic).unwrap();
-        let run = |rtol: f64| {
-            let mut y = vec![0.0; t.len()];
-            let mut v = vec![0.0; t.len()];
-            let o = Options {
-                rtol,
-                atol: rtol * 1e-3,
-                ..Options::default()
-            };
-            let out = simulate(&m, &fo, 0.0, &o, &mut y, &mut v).unwrap();
-            (y, out)
-        };
-        let (yref, _) = run(1e-13);
-        for rtol in [1e-6, 1e-8, 1e-10] {
-            let (y, out) = run(rtol);
-            let err = y
-                .iter()
-                .zip(&yref)
-                .map(|(a, b)| (a - b).abs())
-                .fold(0.0, f64::max);
-            let scale = yref.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
-            assert!(
-                err / scale < 50.0 * rtol,
-                "rtol {rtol}: err {}",
-                err / scale
-            );
-            assert!(out.stats.n_accepted >= (t.len() - 1) as u64);
-        }
-    }
-
-    #[test]
-    fn taylor_matches_rodas4_on_noisy_input_and_a_far_start() {
-        // Table 2 centre curve (SI), 1 % noise on p, started 0.3 µm off equilibrium: the
-        // Taylor route (split where the start-up needs it) against RODAS4, both at rtol 1e-11.
-        let m = ContactModel::new(
-            Stiffness::Delta(vec![1.32596e12, 1.59811e18, 2.92127e24, 2.87416e30]),
-            0.0887,
-            1.0,
-        )
-        .unwrap();
-        let (t, mut p, _) = sine(256 * 3 + 1, 256, 1.0);
-        let mut state: u64 = 7;
-        for v in &mut p {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1);
-            let u = (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
-            *v = *v * 1e6 + 0.4e6 * 0.01 * 3.46 * u;
-        }
-        let fo = Forcing::new(&t, &p, None, Interp::Cubic).unwrap();
-        let scale = 0.4e6 / 1.32596e12;
-        let o = Options {
-            rtol: 1e-11,
-            atol: 1e-11 * scale,
-            ..Options::default()
-        };
-        let run = |method| {
-            let (mut y, mut v) = (vec![0.0; t.len()], vec![0.0; t.len()]);
-            let out = simulate_with(&m, &fo, 0.3e-6, &o, method, &mut y, &mut v).unwrap();
-            assert_eq!(out.status, Status::Success);
-            (y, v, out)
-        };
-        let (ya, va, oa) = run(Method::Auto);
-        let (yr, vr, _) = run(Method::Rodas4);
-        let dmax = yr.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
-        let vmax = vr.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
-        for i in 0..t.len() {
-            assert!((ya[i] - yr[i]).abs() < 1e-9 * dmax, "δ at {i}");
-            assert!((va[i] - vr[i]).abs() < 1e-8 * vmax, "δ' at {i}");
-        }
-        assert_eq!(oa.stats.njev, 0, "every interval by Taylor steps");
-        assert!(oa.stats.n_rejected > 0, "the far start was split");
-    }
-
-    #[test]
-    fn stiff_limit_is_stable_on_the_sample_grid() {
-        // ψ tiny: time constant 1e-6 of the sample interval; the L-stable method must not blow up.
-        let m = ContactModel::new(Stiffness::Constant(2.0), 1e-7, 1.0).unwrap();
-        let (t, p, d) = sine(513, 64, 1.0);
-        let fo = Forcing::new(&t, &p, Some(&d), Interp::Cubic).unwrap();
-        let mut y = vec![0.0; t.len()];
-        let mut v = vec![0.0; t.len()];
-        let out = simulate(&m, &fo, 1.0, &Options::default(), &mut y, &mut v).unwrap();
-        assert_eq!(out.status, Status::Success);
-        for i in 64..t.len() {
-            assert!((y[i] - p[i] / 2.0).abs() < 1e-6);
-        }
-    }
-
-    #[test]
-    fn leaving_the_domain_returns_the_partial_solution() {
-        // k_s(δ) = 1 + 5e6 δ vanishes at δ = -0.2e-6 inside the response; a loose tolerance
-        // lets an accepted step land beyond it.
-        let m = ContactModel::new(Stiffness::Delta(vec![1e12, 5e18]), 0.1, 1.0).unwrap();
-        let w = 1.0;
-        let per = 16;
-        let n = 2 * per + 1;
-        let dt = 2.0 * PI / w / per as f64;
-        let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
-        let p: Vec<f64> = t.iter().map(|&v| 0.4e6 * (w * v).sin()).collect();
-        let fo = Forcing::new(&t, &p, None, Interp::Linear).unwrap();
-        let mut y = vec![f64::NAN; n];
-        let mut v = vec![f64::NAN; n];
-        let o = Options {
-            rtol: 0.1,
-            atol: 1e-8,
-            ..Options::default()
-        };
-        let out = simulate(&m, &fo, 0.0, &o, &mut y, &mut v).unwrap();
-        let Status::NonPositiveStiffness {
-            name, at, value, ..
-        } = out.status
-        else {
-            panic!("expected NonPositiveStiffness, got {:?}", out.status);
-        };
-        assert_eq!(name, "delta");
-        assert!(at < -0.2e-6 && value <= 0.0);
-        assert_eq!(out.status.code(), -1);
-        assert!(out.status.message().contains("not positive"));
-        assert!(out.n_out > 1 && out.n_out < n);
-        // Everything reported lies inside the domain and was computed.
-        for &d in &y[..out.n_out] {
-            assert!(d.is_finite() && 1e12 + 5e18 * d > 0.0);
-        }
-    }
-
-    #[test]
-    fn starting_outside_the_domain_is_an_error() {
-        let m = ContactModel::new(Stiffness::Delta(vec![1e12, 5e18]), 0.1, 1.0).unwrap();
-        let (t, p, _) = sine(33, 16, 1.0);
-        let fo = Forcing::new(&t, &p, None, Interp::Linear).unwrap();
-        let (mut y, mut v) = (vec![0.0; t.len()], vec![0.0; t.len()]);
-        let r = simulate(&m, &fo, -1e-6, &Options::default(), &mut y, &mut v);
-        assert!(matches!(r, Err(CoreError::NonPositiveStiffness { .. })));
-    }
-
-    #[test]
-    fn max_steps_reports_failure() {
-        let m = ContactModel::new(Stiffness::Constant(2.0), 0.1, 1.0).unwrap();
-        let (t, p, _) = sine(100, 64, 1.0);
-        let fo = Forcing::new(&t, &p, None, Interp::Linear).unwrap();
-        let mut y = vec![0.0; t.len()];
-        let mut v = vec![0.0; t.len()];
-        let o = Options {
-            max_steps: 10,
-            ..Options::default()
-        };
-        let out = simulate(&m, &fo, 0.0, &o, &mut y, &mut v).unwrap();
-        assert!(matches!(out.status, Status::MaxSteps { .. }));
-        assert!(out.n_out < t.len());
-    }
-}
+mod tests;
