@@ -223,39 +223,12 @@ def estimate(raw: Any, res: Any, data: Any) -> DelayEstimate | None:
         return np.concatenate([r, rows]), J
 
     with np.errstate(all="ignore"):  # a wild step: not finite, no estimate
-        return _solve(
-            system, v, names, idx, nb, period, model_of, _row_variance(loop, res, raw, data)
-        )
+        return _solve(system, v, names, idx, nb, period, model_of)
 
 
-def _row_variance(loop: Any, res: Any, raw: Any, data: Any) -> np.ndarray | None:
-    """Variance of each averaged bin's residual row from both channels' cycle-to-cycle
-    scatter: ``w² (σF² + (k σx)²) / n_cycles`` (``σF``, ``σx`` the spread of the per-cycle
-    bin means, ``k`` the branch's local stiffness, ``w`` the fit's row weight); None without
-    a spread. The delay's error is taken from these as well as from the residual (the larger
-    one): the bins' residual alone, correlated between neighbouring bins, understated it
-    (delay-free simulated windows scattered 1.3x their stated error)."""
-    from .steps import branch_slope
-
-    if loop.n_cycles < 3 or loop.F_std is None:
-        return None
-    k = branch_slope(raw.values, data.xpath)
-    with np.errstate(over="ignore", invalid="ignore"):
-        v = (loop.F_std**2 + (k * loop.x_std) ** 2) / loop.n_cycles * res.w**2
-    return v if v.shape == (loop.x.size,) and np.all(np.isfinite(v)) else None
-
-
-def _solve(
-    system: Any,
-    v: dict[str, float],
-    names: list[str],
-    idx: dict[str, int],
-    nb: int,
-    period: float,
-    model_of: Any,
-    row_var: np.ndarray | None = None,
-) -> DelayEstimate | None:
-    """The Gauss-Newton steps of :func:`estimate` (``row_var``: :func:`_row_variance`)."""
+def _solve(system: Any, v: dict[str, float], names: list[str], idx: dict[str, int], nb: int,
+           period: float, model_of: Any) -> DelayEstimate | None:  # fmt: skip
+    """The Gauss-Newton steps of :func:`estimate`."""
     th0 = np.array([v[n] for n in names])
     th, tau = th0.copy(), 0.0
     e, J = system(th, tau)
@@ -284,16 +257,10 @@ def _solve(
     if not (abs(tau) < 0.1 * period and dof > 0 and np.all(np.isfinite(J))):
         return None
     try:
-        inv = np.linalg.inv(J.T @ J)
+        cov = np.linalg.inv(J.T @ J) * (float(e @ e) / dof)
     except np.linalg.LinAlgError:
         return None
-    cov = inv * (float(e @ e) / dof)
     se = math.sqrt(cov[-1, -1]) if cov[-1, -1] > 0 else math.nan
-    if row_var is not None:  # both channels' scatter per bin (the prior rows: unit variance)
-        rv = np.concatenate([row_var, np.ones(J.shape[0] - nb)])
-        c2 = inv @ (J.T * rv) @ J @ inv
-        if c2[-1, -1] > 0 and math.isfinite(se):
-            se = max(se, math.sqrt(c2[-1, -1]))
     vc = dict(v)
     for n, i in idx.items():
         vc[n] = v[n] + float(th[i] - th_nd[i])
@@ -496,9 +463,8 @@ def annotate(
     if displacement_noise_share(raw, data) > MAX_X_SHARE:
         return []  # the stated error is too small there (module docstring): not warned
     e_se = derived.get("energy_per_cycle", (math.nan, math.nan))[1]
-    txt = warning(
-        est, fit.params["h0"].stderr, e_se, misfit=misfit, sliding=sliding, applied=applied
-    )
+    txt = warning(est, fit.params["h0"].stderr, e_se, misfit=misfit, sliding=sliding,
+                  applied=applied)  # fmt: skip
     return [txt] if txt else []
 
 
@@ -541,10 +507,8 @@ def shifted_recording(rec: Any, delay: float) -> tuple[Any, int]:
 
     t, x, F, dropped = shift_force(rec.t, rec["x"], rec["F"], delay)
     lo = int(np.searchsorted(rec.t, t[0])) if t is not None and t.size else 0
-    data = {
-        k: (x if k == "x" else F if k == "F" else np.asarray(a)[lo : lo + x.size])
-        for k, a in rec.data.items()
-    }
+    data = {k: (x if k == "x" else F if k == "F" else np.asarray(a)[lo : lo + x.size])
+            for k, a in rec.data.items()}  # fmt: skip
     meta = dict(rec.meta or {}, delay=float(delay), delay_dropped_samples=dropped)
     return replace(rec, t=t, data=data, meta=meta), dropped
 
@@ -584,17 +548,11 @@ def delayed_recording(recording: Any, delay: float) -> Any:
         if t is None or "x" not in recording or "F" not in recording:
             raise InputError("delay= needs the channels 't', 'x' and 'F' of a tangential recording")
         ta = np.asarray(t, dtype=float)
-        ts, x, F, _ = shift_force(
-            ta,
-            np.asarray(recording["x"], dtype=float),
-            np.asarray(recording["F"], dtype=float),
-            delay,
-        )
+        ts, x, F, _ = shift_force(ta, np.asarray(recording["x"], dtype=float),
+                                  np.asarray(recording["F"], dtype=float), delay)  # fmt: skip
         lo = int(np.searchsorted(ta, ts[0])) if ts is not None and ts.size else 0
-        out = {
-            k: (np.asarray(v)[lo : lo + x.size] if np.ndim(v) == 1 and len(v) == ta.size else v)
-            for k, v in recording.items()
-        }
+        out = {k: (np.asarray(v)[lo : lo + x.size] if np.ndim(v) == 1 and len(v) == ta.size
+                   else v) for k, v in recording.items()}  # fmt: skip
         out.update(t=ts, x=x, F=F)
         return out
     if isinstance(recording, (tuple, list)) and len(recording) == 3:
