@@ -24,8 +24,9 @@ TANGENTIAL_STAGES = (
     "additive", "output",
 )  # fmt: skip
 #: the normal-contact stages: the stiffness law's coefficients, an element replacing the
-#: Kelvin-Voigt solve, terms added to the displacement, the measurement
-NORMAL_STAGES = ("law", "element", "additive", "output")
+#: Kelvin-Voigt solve, a loss that depends on the joint's own rate (solved again with it),
+#: terms added to the displacement, the measurement
+NORMAL_STAGES = ("law", "element", "loss", "additive", "output")
 
 
 @dataclass
