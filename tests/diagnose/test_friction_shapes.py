@@ -72,3 +72,49 @@ def test_rig_friction_shapes_named_alone(tmp_path, effect, params):
     assert rep.effect_names == [effect]
     if effect == "position_friction":
         assert rep.effects[0].parameters["L"] == pytest.approx(params["L"], rel=0.1)
+
+
+def _search(rec, effects):
+    """A stepwise search holding ``effects`` fitted to ``rec`` (as tests/diagnose/
+    test_search.py builds it)."""
+    from contactlab.diagnose._parallel import EvaluationCounter
+    from contactlab.diagnose._signal import noise_rms
+    from contactlab.diagnose.search import SearchState, StepwiseSearch
+    from contactlab.diagnose.select import evaluate, fit, fold_masks
+    from contactlab.diagnose.workflow import Step
+
+    fam = TangentialFamily()
+    d = Prepared.build(*rec.arrays())
+    d.extra["evaluations"] = EvaluationCounter()
+    fam.prepare(d)
+    scales = fam.scales(d)
+    fold_masks(d, 2)
+    base = fit(fam, (), d, np.ones(d.y.size, bool), fam.initial_base(d), scales)
+    sigma = noise_rms(fam.predict(base.params, (), d) - d.y)
+    start = dict(base.params)
+    for e in effects:
+        start.update(fam.start_effect(e, start, d, d.y - fam.predict(base.params, (), d)))
+    current = evaluate(fam, tuple(effects), d, start, scales, 2)
+    search = StepwiseSearch(fam, list(fam.candidates), d, scales, 2, sigma, 3.0, 0.05, 0.0,
+                            dict(base.params), 3, Step)  # fmt: skip
+    st = SearchState(current, [Step(None, 1.0, 1.0, 0.0)], [], [current], added=list(effects))
+    return search, st
+
+
+def test_parsimony_between_friction_shapes():
+    """Stribeck and position friction both reshape the friction between reversals (item 5):
+    on a Stribeck record they are not named together; with both in the record, each stands
+    on its own after the other and both stay."""
+    from contactlab.synthetic.diagnosis import hidden_effect_recording
+
+    kw = {"noise": 0.01, "seed": 7, "samples_per_cycle": 80}
+    search, st = _search(hidden_effect_recording(["stribeck"], magnitude=0.05, **kw),
+                         ["stribeck", "position_friction"])  # fmt: skip
+    search.parsimony(st)
+    assert st.added == ["stribeck"]
+    assert any(w.startswith("parsimony: position_friction dropped") for w in st.where)
+    both = hidden_effect_recording({"stribeck": 0.05, "position_friction": 0.05}, **kw)
+    search, st = _search(both, ["stribeck", "position_friction"])
+    search.parsimony(st)
+    assert st.added == ["stribeck", "position_friction"]
+    assert any("friction along the branch" in w and "named together" in w for w in st.where)

@@ -106,8 +106,10 @@ class EffectModel:
     physics: ClassVar[str] = ""
     #: effects that act through the same signal are told apart only when each is needed
     #: beside the other: "velocity" (delay, viscous damping, Stribeck, inertia: a term in
-    #: ẋ or ẍ, or a shift of the force along the velocity) — see the workflow's parsimony
-    acts_through: ClassVar[str | None] = None
+    #: ẋ or ẍ, or a shift of the force along the velocity), "friction along the branch"
+    #: (Stribeck, position friction, stick-slip: a reshaping of the friction force between
+    #: reversals); a tuple for an effect in several — see the search's parsimony rule
+    acts_through: ClassVar[str | tuple[str, ...] | None] = None
     stage: ClassVar[str]
     rank: ClassVar[float] = 0.0
     #: position in the library (the order verdicts are listed and ties are broken in)

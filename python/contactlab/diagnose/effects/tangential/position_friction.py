@@ -53,6 +53,7 @@ class PositionFriction(EffectModel):
         "A normal load fluctuating at the drive's harmonics depends on time (the same along "
         "up and down strokes only for even harmonics in phase)."
     )
+    acts_through = "friction along the branch"
     stage = "factor"
     rank = 1
     order = 12

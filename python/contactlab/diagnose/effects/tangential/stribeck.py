@@ -29,7 +29,7 @@ class Stribeck(EffectModel):
         "(speed near zero) is s h0 above the plateau — a breakaway the sticks measure. Acts "
         "through the velocity, like a delay, a viscous term and inertia."
     )
-    acts_through = "velocity"
+    acts_through = ("velocity", "friction along the branch")
     stage = "factor"
     rank = 0
     order = 11
