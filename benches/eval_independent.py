@@ -184,25 +184,31 @@ def _truth_factors(T: dict, kind: str) -> dict:
 
 # --------------------------------------------------------------------------- plan
 def plan(n: int, n_misfit: int, seed_base: int, effects_t, effects_n) -> list[dict]:
+    """Records to run; each seed depends on (kind, label, size class, repeat) only, so a run
+    with a smaller ``n`` on the same seed base replays a subset of a larger one."""
     specs = []
-    i = 0
-    for kind, effects in (("tangential", effects_t), ("normal", effects_n)):
+    for kind, effects, all_effects in (
+        ("tangential", effects_t, TANGENTIAL_EFFECTS),
+        ("normal", effects_n, NORMAL_EFFECTS),
+    ):
+        off = 0 if kind == "tangential" else 2000
         for e in effects:
-            for size_class in ("visible", "near"):
-                for _ in range(n):
+            j = all_effects.index(e)
+            for c, size_class in enumerate(("visible", "near")):
+                for rep in range(n):
+                    idx = off + j * 100 + c * 50 + rep
                     specs.append(
                         {
                             "kind": kind,
                             "label": e,
-                            "seed": seed_base * 10000 + i,
+                            "seed": seed_base * 10000 + idx,
                             "size_class": size_class,
                         }
                     )
-                    i += 1
-    for m in MISFITS:
-        for _ in range(n_misfit):
-            specs.append({"kind": "tangential", "label": m, "seed": seed_base * 10000 + i})
-            i += 1
+    for j, m in enumerate(MISFITS):
+        for rep in range(n_misfit):
+            idx = 4000 + j * 100 + rep
+            specs.append({"kind": "tangential", "label": m, "seed": seed_base * 10000 + idx})
     return specs
 
 
@@ -316,9 +322,9 @@ def tables(results: list[dict], header: str) -> str:
         L.append(
             "| effect | n | all: exact/extra/missed/wrong | visible (own): n, exact, extra, "
             "missed, wrong | visible (bound): n, exact, extra, missed, wrong | invisible by "
-            "both: n, named wrong |"
+            "both: n, named wrong | named/true (median, range) |"
         )
-        L.append("|---|---|---|---|---|---|")
+        L.append("|---|---|---|---|---|---|---|")
         tot = defaultdict(Counter)
         for e in sorted({r["label"] for r in rs}):
             g = [r for r in rs if r["label"] == e]
@@ -338,12 +344,28 @@ def tables(results: list[dict], header: str) -> str:
                     cells.append(
                         f"{len(sub)}: {c['exact']}, {c['extra']}, {c['missed']}, {c['wrong']}"
                     )
+            ratios = []
+            if e in SAME_UNITS:
+                pname, true_of = SAME_UNITS[e]
+                for r in g:
+                    named_p = r["rec"].get("params", {}).get(e, {})
+                    if pname in named_p:
+                        v = named_p[pname] - (2.0 if e == "non_masing_scaling" else 0.0)
+                        tv = true_of(r["params"], None)
+                        if tv:
+                            ratios.append(v / tv)
+            rcell = (
+                f"{np.median(ratios):.2f} ({min(ratios):.2f}-{max(ratios):.2f}, n {len(ratios)})"
+                if ratios
+                else "–"
+            )
             inv = [r for r in g if not r["info"].get("visible_own") and not r.get("visible_bound")]
             wrong = sum(outcome(r["rec"]["named"], e) == "wrong" for r in inv)
             tot["inv"]["n"] += len(inv)
             tot["inv"]["wrong"] += wrong
             L.append(
-                f"| {e} | {len(g)} | {cells[0]} | {cells[1]} | {cells[2]} | {len(inv)}, {wrong} |"
+                f"| {e} | {len(g)} | {cells[0]} | {cells[1]} | {cells[2]} | {len(inv)}, {wrong} "
+                f"| {rcell} |"
             )
         c = tot["all"]
         cells = [f"{c['exact']}/{c['extra']}/{c['missed']}/{c['wrong']}"]
@@ -355,7 +377,7 @@ def tables(results: list[dict], header: str) -> str:
             )
         L.append(
             f"| **total** | {len(rs)} | {cells[0]} | {cells[1]} | {cells[2]} | "
-            f"{tot['inv']['n']}, {tot['inv']['wrong']} |"
+            f"{tot['inv']['n']}, {tot['inv']['wrong']} | |"
         )
         L.append("")
         # agreement of the two visibility judgements
@@ -467,7 +489,17 @@ def main(argv=None) -> int:
     ap.add_argument("--jobs", type=int, default=2, help="parallel records (at most 2)")
     ap.add_argument("--label", default=None, help="results file suffix")
     ap.add_argument("--effects", default=None, help="comma-separated subset of effects")
+    ap.add_argument("--tables-from", default=None, help="re-render the tables of a results JSON")
     args = ap.parse_args(argv)
+    if args.tables_from:
+        path = Path(args.tables_from)
+        results = json.loads(path.read_text())
+        md_path = path.with_suffix(".md")
+        first = md_path.read_text().split("\n\n")[:2] if md_path.exists() else [path.stem, ""]
+        md = tables(results, "\n\n".join(first))
+        md_path.write_text(md + "\n")
+        print(md)
+        return 0
     seed_base = args.seed_base if args.seed_base is not None else int(time.time()) % 100000
     jobs = max(1, min(args.jobs, 2))
     et, en = TANGENTIAL_EFFECTS, NORMAL_EFFECTS
