@@ -170,6 +170,32 @@ def kelvin_voigt_asymmetric(
     ``passes`` times, each from the mean of the last two solutions (each pass changes only
     the steps at the turning points; the fits take 4, the generator up to 50, until a pass
     changes ``δ`` by less than ``tol`` of its largest value).
+
+    Parameters
+    ----------
+    t, pd : numpy.ndarray
+        Sample times (s) and dynamic pressure ``p - p0`` (Pa).
+    k, psi, omega : float
+        Contact stiffness (Pa/m), energy dissipation coefficient (-) and the angular
+        frequency (rad/s) at which ``ψ`` holds: ``h = ψ k / (2π ω)``.
+    a : float
+        Loss asymmetry, ``|a| < 1``; ``a > 0`` damps loading more.
+    dpdt : numpy.ndarray, optional
+        Pressure slopes at the samples (a kept long record's, from the raw rate).
+    start : numpy.ndarray, optional
+        A displacement near the solution to take the signs of ``R`` from.
+    passes, tol : int, float
+        Sign updates at most, and the relative change that ends them early.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``δ`` at the samples (m).
+
+    Raises
+    ------
+    InputError
+        ``k`` or ``h`` not positive, or ``|a| >= 1``.
     """
     from .._filters import first_order_response
 
@@ -341,6 +367,25 @@ def nonlinear_viscous(
     ``|k_s/a1 - 1|`` of the damping pressure (a few per cent of 1.4 % of ``p`` at ψ = 0.09),
     and each pass leaves that fraction of the previous error: one pass is within 1e-5 of
     ``δ`` at a 15 % stiffness change (tested against the adaptive solve of the same equation).
+
+    Parameters
+    ----------
+    t, pd : numpy.ndarray
+        Sample times (s) and dynamic pressure ``p - p0`` (Pa).
+    coeffs : tuple of float
+        ``k_s(δ) = Σ coeffs[i] δ^i`` (Pa/m, Pa/m², Pa/m³), ``coeffs[0]`` the linear stiffness.
+    psi, omega : float
+        Energy dissipation coefficient (-) and the angular frequency (rad/s) it holds at.
+    dpdt : numpy.ndarray, optional
+        Pressure slopes at the samples, if known.
+    passes : int
+        Damping corrections (:data:`VISCOUS_PASSES` in a fit).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``δ`` at the samples (m); a solve that stops early holds its last value
+        (:func:`_delta`).
     """
     from ..normal import NonlinearContact
 
