@@ -160,7 +160,7 @@ def kelvin_voigt_asymmetric(
 
     The sign of ``δ'`` is that of ``R = pd - k δ``, the pressure the damping carries. On a
     step where ``R`` keeps its sign the equation is linear, ``δ' = k/(h (1 + a s)) (pd/k -
-    δ)``, and :func:`contactlab._filters.first_order_response` solves it exactly under the
+    δ)``, and :func:`contactlab.diagnose._filters.first_order_response` solves it exactly under the
     cubic Hermite pressure (slopes ``dpdt`` at the samples, else differences); a step where
     ``R`` changes sign (a turning point) is split where it does (``R`` linear between the
     samples, the pressure the same cubic on both parts), so the solution is a smooth
@@ -197,7 +197,6 @@ def kelvin_voigt_asymmetric(
     InputError
         ``k`` or ``h`` not positive, or ``|a| >= 1``.
     """
-    from .._filters import first_order_response
 
     h = psi * k / (2.0 * np.pi * omega)
     if not (k > 0.0 and h > 0.0 and abs(a) < 1.0):
