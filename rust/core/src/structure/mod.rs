@@ -91,6 +91,14 @@ pub struct Options {
     pub max_halvings: usize,
     /// Event sub-steps allowed per sample interval.
     pub max_events: usize,
+    /// Error control: `Some(tol)` steps each sample interval in pieces whose step-doubling
+    /// error estimate (a Newmark step against two half steps, per piece, relative to the
+    /// largest displacement and velocity so far) is at most `tol`, and keeps the Richardson
+    /// extrapolation of the pair (fourth order); `None`: fixed steps (`substeps` equal
+    /// Newmark steps per sample interval, the second-order scheme of old).
+    pub tol: Option<f64>,
+    /// Equal Newmark steps per sample interval when `tol` is `None` (at least 1).
+    pub substeps: usize,
 }
 
 impl Default for Options {
@@ -100,6 +108,8 @@ impl Default for Options {
             max_iter: 30,
             max_halvings: 12,
             max_events: 16,
+            tol: None,
+            substeps: 1,
         }
     }
 }
@@ -341,6 +351,22 @@ pub fn simulate_into(
             name: "rtol",
             value: opts.rtol,
             reason: "rtol must be > 0 and max_iter >= 1",
+        });
+    }
+    if let Some(tol) = opts.tol {
+        if !(tol.is_finite() && tol > 0.0) {
+            return Err(CoreError::InvalidParameter {
+                name: "tol",
+                value: tol,
+                reason: "the error tolerance must be finite and > 0",
+            });
+        }
+    }
+    if opts.substeps == 0 {
+        return Err(CoreError::InvalidParameter {
+            name: "substeps",
+            value: 0.0,
+            reason: "substeps must be >= 1",
         });
     }
     if n == 1 {

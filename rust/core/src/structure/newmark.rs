@@ -17,6 +17,8 @@ use super::joint::{Joint, JointState, Trial};
 use super::{Buffers, Inputs, Options, Status, Structure, Summary};
 use crate::error::CoreError;
 
+mod adaptive;
+
 /// The integrator's per-step state.
 struct Work {
     x: Vec<f64>,
@@ -262,12 +264,18 @@ pub(super) fn simulate_dense(
     let mut sum = Summary::new();
     record(s, &w, out, 0);
     sum.n_out = 1;
+    if let Some(tol) = opts.tol {
+        return adaptive::run(s, inp, tol, opts, w, sc, sum, out);
+    }
+    // fixed steps: `substeps` equal pieces per interval (events and halvings split them)
+    let piece = 1.0 / opts.substeps as f64;
+    let max_events = opts.max_events.saturating_mul(opts.substeps);
     for (i, pair) in inp.t.windows(2).enumerate() {
         let big_h = pair[1] - pair[0];
         let mut tau = 0.0_f64;
         let mut halvings = 0usize;
         let mut events = 0usize;
-        let mut frac = 1.0_f64; // fraction of the interval to try next
+        let mut frac = piece; // fraction of the interval to try next
         while tau < 1.0 {
             let step = frac.min(1.0 - tau);
             let h = step * big_h;
@@ -276,7 +284,7 @@ pub(super) fn simulate_dense(
             match newton_step(s, &w, h, &mut sc, opts) {
                 None => {
                     halvings = halvings.saturating_add(1);
-                    if halvings > opts.max_halvings {
+                    if halvings > opts.max_halvings.saturating_mul(opts.substeps) {
                         sum.status = Status::NoConvergence {
                             time: inp.t[i] + tau * big_h,
                             step: h,
@@ -289,7 +297,7 @@ pub(super) fn simulate_dense(
                 Some(it) => sum.n_iter = sum.n_iter.saturating_add(it),
             }
             // Split the step at the earliest joint event strictly inside it.
-            if events < opts.max_events {
+            if events < max_events {
                 let mut theta = 1.0_f64;
                 for (jn, j) in s.joints.iter().enumerate() {
                     let d1 = rel(j, &sc.x1);
@@ -308,7 +316,7 @@ pub(super) fn simulate_dense(
             accept(s, &mut w, &mut sc)?;
             sum.n_steps = sum.n_steps.saturating_add(1);
             tau = tau1;
-            frac = (1.0 - tau).max(0.0);
+            frac = piece.min(1.0 - tau).max(0.0);
             if w.x.iter().chain(&w.v).any(|v| !v.is_finite()) {
                 sum.status = Status::NonFinite {
                     time: inp.t[i] + tau * big_h,
