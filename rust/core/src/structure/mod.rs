@@ -263,6 +263,17 @@ impl Response {
     }
 }
 
+/// The factor on the piece length after an estimate `err` (`0.9 (tol / err)^(1/3)` within
+/// `[0.2, 4]`; the cube root only where it matters).
+#[inline]
+pub(crate) fn grow(tol: f64, err: f64) -> f64 {
+    if err * 88.0 <= tol {
+        4.0
+    } else {
+        (0.9 * (tol / err).cbrt()).clamp(0.2, 4.0)
+    }
+}
+
 /// `(len(t)·n, len(t)·n_joints)`, the output sizes, or an error if they overflow.
 fn sizes(s: &Structure, nt: usize) -> Result<(usize, usize), CoreError> {
     let too_many = CoreError::InvalidParameter {

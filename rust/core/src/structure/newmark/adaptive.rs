@@ -270,11 +270,7 @@ pub(super) fn run(
                     continue;
                 }
             }
-            let factor = if err > 0.0 {
-                (0.9 * (tol / err).cbrt()).clamp(0.2, 4.0)
-            } else {
-                4.0
-            };
+            let factor = crate::structure::grow(tol, err);
             if err > tol && step > min_frac {
                 frac = step * factor.min(0.9);
                 continue;

@@ -19,6 +19,11 @@ use super::{load, newton, record, Joints, Point, State, Step};
 use crate::error::CoreError;
 use crate::structure::{Buffers, Inputs, Options, Status, Summary};
 
+/// A Newton solve of the pair ends, without a last trial, once its residual is below this
+/// fraction of the forces (see `newton`): the error left is of the order of its square, and
+/// such a solve's joint trials are never committed (the extrapolated point is tried anew).
+const QUICK: f64 = 1e-3;
+
 /// A step-doubling piece, extrapolated (not yet committed): the step to keep, the coarse and
 /// fine ends, the midpoint, the error estimate, the event inside (1: none) and iterations.
 struct Piece {
@@ -51,7 +56,7 @@ fn piece<J: Joints>(
     let (m, c, k) = mck;
     let f1 = load(inp, i, tau1);
     let fm = load(inp, i, 0.5 * (tau + tau1));
-    let quick = 0.1 * opts.rtol.sqrt();
+    let quick = QUICK;
     let (coarse, i1) = newton(jt, mck, w, (w.x, quick), h, f1, opts)?;
     jt.keep(0, coarse.moved);
     let (half, i2) = newton(jt, mck, w, (w.x, quick), 0.5 * h, fm, opts)?;
@@ -206,11 +211,7 @@ pub(super) fn run<J: Joints>(
                     continue;
                 }
             }
-            let factor = if p.err > 0.0 {
-                (0.9 * (tol / p.err).cbrt()).clamp(0.2, 4.0)
-            } else {
-                4.0
-            };
+            let factor = crate::structure::grow(tol, p.err);
             if p.err > tol && step > min_frac {
                 frac = step * factor.min(0.9);
                 continue;
