@@ -268,7 +268,8 @@ pub(super) fn simulate_dense(
         return adaptive::run(s, inp, tol, opts, w, sc, sum, out);
     }
     // fixed steps: `substeps` equal pieces per interval (events and halvings split them)
-    let piece = 1.0 / opts.substeps as f64;
+    let k_sub = opts.substeps as f64;
+    let piece = 1.0 / k_sub;
     let max_events = opts.max_events.saturating_mul(opts.substeps);
     for (i, pair) in inp.t.windows(2).enumerate() {
         let big_h = pair[1] - pair[0];
@@ -306,7 +307,7 @@ pub(super) fn simulate_dense(
                         theta = theta.min(th);
                     }
                 }
-                let min_piece = 1e-3 / step;
+                let min_piece = 1e-3 * piece / step;
                 if theta > min_piece && theta < 1.0 - min_piece {
                     events = events.saturating_add(1);
                     frac = step * theta;
@@ -316,7 +317,9 @@ pub(super) fn simulate_dense(
             accept(s, &mut w, &mut sc)?;
             sum.n_steps = sum.n_steps.saturating_add(1);
             tau = tau1;
-            frac = piece.min(1.0 - tau).max(0.0);
+            // on to the next point of the fixed grid (events split between them)
+            frac = ((tau * k_sub + 1e-9).floor() + 1.0) / k_sub - tau;
+            frac = frac.min(1.0 - tau).max(0.0);
             if w.x.iter().chain(&w.v).any(|v| !v.is_finite()) {
                 sum.status = Status::NonFinite {
                     time: inp.t[i] + tau * big_h,

@@ -637,7 +637,8 @@ fn run<J: Joints>(
         return adaptive::run(inp, (m, c, k), tol, opts, jt, w, sum, out);
     }
     // fixed steps: `substeps` equal pieces per interval (events and halvings split them)
-    let piece = 1.0 / opts.substeps as f64;
+    let k_sub = opts.substeps as f64;
+    let piece = 1.0 / k_sub;
     let max_events = opts.max_events.saturating_mul(opts.substeps);
     for (i, pair) in inp.t.windows(2).enumerate() {
         let big_h = pair[1] - pair[0];
@@ -666,7 +667,7 @@ fn run<J: Joints>(
             if events < max_events {
                 let theta = jt.event(w.x, st.x1, w.v, st.v1);
                 if theta < 1.0 {
-                    let min_piece = 1e-3 / step;
+                    let min_piece = 1e-3 * piece / step;
                     if theta > min_piece && theta < 1.0 - min_piece {
                         events = events.saturating_add(1);
                         frac = step * theta;
@@ -677,7 +678,9 @@ fn run<J: Joints>(
             accept(jt, c, &mut w, &st)?;
             sum.n_steps = sum.n_steps.saturating_add(1);
             tau = tau1;
-            frac = piece.min(1.0 - tau).max(0.0);
+            // on to the next point of the fixed grid (events split between them)
+            frac = ((tau * k_sub + 1e-9).floor() + 1.0) / k_sub - tau;
+            frac = frac.min(1.0 - tau).max(0.0);
             if !(w.x.is_finite() && w.v.is_finite()) {
                 sum.status = Status::NonFinite {
                     time: inp.t[i] + tau * big_h,
