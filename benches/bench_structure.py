@@ -31,6 +31,7 @@ import math
 import os
 import statistics
 import time
+from functools import partial
 
 import numpy as np
 
@@ -379,8 +380,8 @@ def stepping_table(n_time: int, repeat: int) -> None:
         tt = t[:n_time]
         c_old, c_new = [], []
         for _ in range(repeat):
-            c_old.append(_cpu(lambda: s.simulate(tt, force=ft, substeps=1))[0])
-            c_new.append(_cpu(lambda: s.simulate(tt, force=ft))[0])
+            c_old.append(_cpu(partial(s.simulate, tt, force=ft, substeps=1))[0])
+            c_new.append(_cpu(partial(s.simulate, tt, force=ft))[0])
         mo, mn = statistics.median(c_old), statistics.median(c_new)
         ratio = statistics.median(b / a for a, b in zip(c_old, c_new, strict=True))
         print(f"| {name} | {1e3 * mo:.0f} ms | {1e3 * mn:.0f} ms | {ratio:.2f} | {old:.1e} | "

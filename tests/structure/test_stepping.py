@@ -22,7 +22,9 @@ BW = {"alpha": 5e4, "beta": 1e3, "gamma": 0.8, "delta": -1.1}
 def _force(n: int, fs: float, seed: int, amp: float = 20.0) -> np.ndarray:
     rng = np.random.default_rng(seed)
     t = np.arange(n) / fs
-    return amp * sum(np.sin(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi)) for f in (7, 19, 53, 131))
+    return amp * sum(
+        np.sin(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi)) for f in (7, 19, 53, 131)
+    )
 
 
 def _rrms(x: np.ndarray, ref: np.ndarray) -> float:

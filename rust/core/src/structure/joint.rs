@@ -391,7 +391,7 @@ fn bw_exact(alpha: f64, beta: f64, gamma: f64, delta: f64, z0: f64, dd: f64) -> 
         // z + (α − b z) (1 − e^(−b x)) / b, with expm1 for small b x
         z + (alpha - b * z) * (-(-b * x).exp_m1() / b)
     };
-    let sigma0 = if z0 != 0.0 { z0.signum() } else { s };
+    let sigma0 = if z0 == 0.0 { s } else { z0.signum() };
     let z1 = along(z0, sigma0, dd);
     if z1 * sigma0 >= 0.0 || z0 == 0.0 {
         return z1;
@@ -733,14 +733,23 @@ mod tests {
     fn bouc_wen_closed_form_matches_fine_rk4_across_zero() {
         // ν = 1 in closed form against RK4 with ν = 1 + 1e-12 (the RK4 path), many sub-steps
         let (alpha, beta, gamma, delta) = (5e4, 1e3, 0.8, -1.1);
-        for &(z0, dd) in &[(-20.0, 1e-3), (20.0, -1e-3), (5.0, 2e-4), (-30.0, -1e-4), (0.0, 3e-4)] {
+        for &(z0, dd) in &[
+            (-20.0, 1e-3),
+            (20.0, -1e-3),
+            (5.0, 2e-4),
+            (-30.0, -1e-4),
+            (0.0, 3e-4),
+        ] {
             let z = bw_advance((alpha, beta, gamma, delta, 1.0), z0, dd);
             let mut zr = z0;
             let k = 20000;
             for _ in 0..k {
                 zr = bw_advance((alpha, beta, gamma, delta, 1.0 + 1e-12), zr, dd / k as f64);
             }
-            assert!((z - zr).abs() < 1e-8 * (1.0 + zr.abs()), "{z0} {dd}: {z} vs {zr}");
+            assert!(
+                (z - zr).abs() < 1e-8 * (1.0 + zr.abs()),
+                "{z0} {dd}: {z} vs {zr}"
+            );
         }
     }
 

@@ -118,7 +118,10 @@ fn piece(
     let mut theta = 1.0_f64;
     for (jn, j) in s.joints.iter().enumerate() {
         let (vm, vf) = (rel(j, &p.vm), rel(j, &p.vf));
-        if let Some(th) = j.law.event(&w.states[jn], w.jd[jn], rel(j, &p.xf), w.jv[jn], vf) {
+        if let Some(th) = j
+            .law
+            .event(&w.states[jn], w.jd[jn], rel(j, &p.xf), w.jv[jn], vf)
+        {
             theta = theta.min(th);
         }
         let v0 = w.jv[jn];
@@ -167,6 +170,8 @@ fn piece(
 
 /// Commit the extrapolated piece: state, joints (work extrapolated), energies (Romberg on the
 /// pair's trapezoidal sums).
+// Row-major index arithmetic: rows d < n of the n × n C checked in `Structure::new`.
+#[allow(clippy::arithmetic_side_effects)]
 fn accept(s: &Structure, w: &mut Work, sc: &Scratch, p: &Pair) -> Result<(), CoreError> {
     let n = s.n;
     let rich = |coarse: f64, fine: f64| (4.0 * fine - coarse) / 3.0;
@@ -247,7 +252,8 @@ pub(super) fn run(
             let h = step * big_h;
             let tau1 = if step >= 1.0 - tau { 1.0 } else { tau + step };
             let span = (tau, tau1, h);
-            let Some((err, theta, it)) = piece(s, &mut w, &mut sc, &mut p, inp, i, span, scale, opts)
+            let Some((err, theta, it)) =
+                piece(s, &mut w, &mut sc, &mut p, inp, i, span, scale, opts)
             else {
                 halvings = halvings.saturating_add(1);
                 if halvings > opts.max_halvings.saturating_mul(4) {

@@ -91,7 +91,8 @@ fn piece<J: Joints>(
         scale.1.max(fine.v1.abs()).max(coarse.v1.abs()),
     );
     let rel = |e: f64, s: f64| if e == 0.0 { 0.0 } else { e / s };
-    let err = rel((fine.x1 - coarse.x1).abs() / 3.0, sx).max(rel((fine.v1 - coarse.v1).abs() / 3.0, sv));
+    let err =
+        rel((fine.x1 - coarse.x1).abs() / 3.0, sx).max(rel((fine.v1 - coarse.v1).abs() / 3.0, sv));
     // the joints at the extrapolated point, tried from their committed state
     let pt = Point {
         x1: xr,

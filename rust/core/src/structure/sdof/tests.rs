@@ -153,7 +153,10 @@ fn error_controlled_run_matches_fine_fixed_steps() -> Result<(), CoreError> {
         };
         let s = Structure::new(1, &[0.8], &[1.5], &[900.0], vec![j])?;
         let t: Vec<f64> = (0..801).map(|i| i as f64 * 2e-3).collect();
-        let u: Vec<f64> = t.iter().map(|ti| 2.0 * (2.0 * std::f64::consts::PI * 5.0 * ti).sin()).collect();
+        let u: Vec<f64> = t
+            .iter()
+            .map(|ti| 2.0 * (2.0 * std::f64::consts::PI * 5.0 * ti).sin())
+            .collect();
         let inp = Inputs {
             t: &t,
             force: Some(&u),
@@ -176,7 +179,10 @@ fn error_controlled_run_matches_fine_fixed_steps() -> Result<(), CoreError> {
             (e / n).sqrt()
         };
         let (e_ctl, e_one) = (rms(&a.x), rms(&one.x));
-        assert!(e_ctl < 1e-4 && e_ctl < 0.1 * e_one, "{e_ctl:e} vs one step {e_one:e}");
+        assert!(
+            e_ctl < 1e-4 && e_ctl < 0.1 * e_one,
+            "{e_ctl:e} vs one step {e_one:e}"
+        );
     }
     Ok(())
 }
