@@ -59,16 +59,23 @@ trait Joints {
     /// Accept the last trial (at `xr`, from `x0`) of a step-doubling piece whose coarse end,
     /// midpoint and fine end were at `(xc, xm, xf)`: each joint's work is the Richardson
     /// extrapolation of the pair's trapezoidal sums.
-    fn commit_doubled(&mut self, x0: f64, ends: (f64, f64, f64), xr: f64) -> Result<(), CoreError>;
+    /// `ext`: the extrapolation weight (1/3, or 0 when the plain half steps are kept).
+    fn commit_doubled(
+        &mut self,
+        x0: f64,
+        ends: (f64, f64, f64),
+        ext: f64,
+        xr: f64,
+    ) -> Result<(), CoreError>;
 }
 
 /// The Richardson extrapolation of a joint's work over a step-doubling piece: forces `f0` at
 /// the start `x0` and `kept` (coarse end, midpoint, fine end) at `(xc, xm, xf)`.
 #[inline(always)]
-fn doubled_work(f0: f64, kept: [f64; 3], x0: f64, (xc, xm, xf): (f64, f64, f64)) -> f64 {
+fn doubled_work(f0: f64, kept: [f64; 3], x0: f64, (xc, xm, xf): (f64, f64, f64), ext: f64) -> f64 {
     let coarse = 0.5 * (f0 + kept[0]) * (xc - x0);
     let fine = 0.5 * (f0 + kept[1]) * (xm - x0) + 0.5 * (kept[1] + kept[2]) * (xf - xm);
-    (4.0 * fine - coarse) / 3.0
+    fine + (fine - coarse) * ext
 }
 
 /// Any set of joints, through [`JointLaw`]'s dispatch.
@@ -130,11 +137,17 @@ impl Joints for Dyn<'_> {
     }
 
     #[inline]
-    fn commit_doubled(&mut self, x0: f64, ends: (f64, f64, f64), xr: f64) -> Result<(), CoreError> {
+    fn commit_doubled(
+        &mut self,
+        x0: f64,
+        ends: (f64, f64, f64),
+        ext: f64,
+        xr: f64,
+    ) -> Result<(), CoreError> {
         let parts = self.joints.iter().zip(&self.trials).zip(&mut self.states);
         let books = self.jwork.iter_mut().zip(&mut self.jf).zip(&self.kept);
         for (((j, tr), st), ((work, f), kept)) in parts.zip(books) {
-            *work += doubled_work(*f, *kept, x0, ends);
+            *work += doubled_work(*f, *kept, x0, ends, ext);
             j.law.commit(st, x0, xr, tr)?;
             *f = tr.f;
         }
@@ -331,8 +344,14 @@ impl Joints for MasingExp {
     }
 
     #[inline(always)]
-    fn commit_doubled(&mut self, x0: f64, ends: (f64, f64, f64), xr: f64) -> Result<(), CoreError> {
-        self.jwork += doubled_work(self.jf, self.kept, x0, ends);
+    fn commit_doubled(
+        &mut self,
+        x0: f64,
+        ends: (f64, f64, f64),
+        ext: f64,
+        xr: f64,
+    ) -> Result<(), CoreError> {
+        self.jwork += doubled_work(self.jf, self.kept, x0, ends, ext);
         masing_commit(&mut self.st, xr, self.f, self.aux);
         self.refresh();
         self.argl = f64::NAN;

@@ -29,6 +29,8 @@ struct Pair {
     a0: Vec<f64>,
     kept: Vec<[f64; 3]>,
     m_lu: Lu,
+    /// The extrapolation weight of the last piece (1/3; 0: the plain half steps kept).
+    ext: f64,
 }
 
 impl Pair {
@@ -57,6 +59,7 @@ impl Pair {
             a0: z(),
             kept: vec![[0.0; 3]; s.joints.len()],
             m_lu,
+            ext: 1.0 / 3.0,
         })
     }
 
@@ -81,9 +84,10 @@ fn piece(
     inp: &Inputs<'_>,
     i: usize,
     (tau, tau1, h): (f64, f64, f64),
-    scale: (f64, f64),
+    (scale, ext): ((f64, f64), f64),
     opts: &Options,
 ) -> Option<(f64, f64, u64)> {
+    p.ext = ext;
     load(s, inp, i, tau1, &mut p.f1);
     load(s, inp, i, 0.5 * (tau + tau1), &mut p.fm);
     sc.f1.copy_from_slice(&p.f1);
@@ -139,8 +143,8 @@ fn piece(
         ev = ev.max((vf - vc).abs() / 3.0);
         sx = sx.max(xf.abs()).max(xc.abs());
         sv = sv.max(vf.abs()).max(vc.abs());
-        sc.x1[d] = xf + (xf - xc) / 3.0;
-        sc.v1[d] = vf + (vf - vc) / 3.0;
+        sc.x1[d] = xf + (xf - xc) * ext;
+        sc.v1[d] = vf + (vf - vc) * ext;
         sc.dx[d] = sc.x1[d] - w.x[d];
     }
     let rel_err = |e: f64, sz: f64| if e == 0.0 { 0.0 } else { e / sz };
@@ -174,7 +178,7 @@ fn piece(
 #[allow(clippy::arithmetic_side_effects)]
 fn accept(s: &Structure, w: &mut Work, sc: &Scratch, p: &Pair) -> Result<(), CoreError> {
     let n = s.n;
-    let rich = |coarse: f64, fine: f64| (4.0 * fine - coarse) / 3.0;
+    let rich = |coarse: f64, fine: f64| fine + (fine - coarse) * p.ext;
     let (mut in_c, mut in_f, mut d_c, mut d_f) = (0.0, 0.0, 0.0, 0.0);
     for d in 0..n {
         let x0 = w.x[d];
@@ -241,7 +245,8 @@ pub(super) fn run(
     let amax = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
     let mut scale = (amax(&w.x), amax(&w.v));
     let mut want = f64::INFINITY;
-    let min_frac = 0.5_f64.powi(i32::try_from(opts.max_halvings).unwrap_or(30));
+    let min_frac = 1.0 / 64.0; // as the one-DOF path's `MIN_FRAC`
+    let mut rejected = f64::NAN; // as there
     for (i, pair) in inp.t.windows(2).enumerate() {
         let big_h = pair[1] - pair[0];
         let (mut tau, mut halvings, mut events) = (0.0_f64, 0usize, 0usize);
@@ -252,8 +257,9 @@ pub(super) fn run(
             let h = step * big_h;
             let tau1 = if step >= 1.0 - tau { 1.0 } else { tau + step };
             let span = (tau, tau1, h);
-            let Some((err, theta, it)) =
-                piece(s, &mut w, &mut sc, &mut p, inp, i, span, scale, opts)
+            let ext = (scale, 1.0 / 3.0);
+            let Some((mut err, theta, it)) =
+                piece(s, &mut w, &mut sc, &mut p, inp, i, span, ext, opts)
             else {
                 halvings = halvings.saturating_add(1);
                 if halvings > opts.max_halvings.saturating_mul(4) {
@@ -276,10 +282,26 @@ pub(super) fn run(
                     continue;
                 }
             }
-            let factor = crate::structure::grow(tol, err);
-            if err > tol && step > min_frac {
-                frac = step * factor.min(0.9);
-                continue;
+            let mut factor = crate::structure::grow(tol, err);
+            if err > tol {
+                // not cut as h³ would, or at the shortest piece: kept plain (see sdof)
+                if !(err > 0.5 * rejected || step <= min_frac) {
+                    rejected = err;
+                    frac = step * factor.min(0.8);
+                    continue;
+                }
+                let plain = (scale, 0.0);
+                let Some((e, _, it)) = piece(s, &mut w, &mut sc, &mut p, inp, i, span, plain, opts)
+                else {
+                    frac = 0.5 * step;
+                    continue;
+                };
+                sum.n_iter = sum.n_iter.saturating_add(it);
+                err = e;
+            }
+            rejected = f64::NAN;
+            if p.ext == 0.0 {
+                (factor, rejected) = (2.0, err);
             }
             accept(s, &mut w, &sc, &p)?;
             sum.n_steps = sum.n_steps.saturating_add(1);

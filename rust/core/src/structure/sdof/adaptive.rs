@@ -24,9 +24,14 @@ use crate::structure::{Buffers, Inputs, Options, Status, Summary};
 /// such a solve's joint trials are never committed (the extrapolated point is tried anew).
 const QUICK: f64 = 1e-3;
 
+/// The shortest piece (a fraction of the sample interval) error control cuts to.
+const MIN_FRAC: f64 = 1.0 / 64.0;
+
 /// A step-doubling piece, extrapolated (not yet committed): the step to keep, the coarse and
 /// fine ends, the midpoint, the error estimate, the event inside (1: none) and iterations.
 struct Piece {
+    /// The extrapolation weight used (1/3; 0: the plain half steps kept).
+    ext: f64,
     st: Step,
     xc: f64,
     vc: f64,
@@ -50,7 +55,7 @@ fn piece<J: Joints>(
     inp: &Inputs<'_>,
     i: usize,
     (tau, tau1, h): (f64, f64, f64),
-    scale: (f64, f64),
+    (scale, ext): ((f64, f64), f64),
     opts: &Options,
 ) -> Option<Piece> {
     let (m, c, k) = mck;
@@ -83,8 +88,8 @@ fn piece<J: Joints>(
         theta = theta.min(0.5 + 0.5 * mid.v / (mid.v - fine.v1));
     }
     let (xr, vr) = (
-        fine.x1 + (fine.x1 - coarse.x1) / 3.0,
-        fine.v1 + (fine.v1 - coarse.v1) / 3.0,
+        fine.x1 + (fine.x1 - coarse.x1) * ext,
+        fine.v1 + (fine.v1 - coarse.v1) * ext,
     );
     let (sx, sv) = (
         scale.0.max(fine.x1.abs()).max(coarse.x1.abs()),
@@ -113,6 +118,7 @@ fn piece<J: Joints>(
         moved: (0.0, 0.0),
     };
     Some(Piece {
+        ext,
         st,
         xc: coarse.x1,
         vc: coarse.v1,
@@ -131,7 +137,7 @@ fn piece<J: Joints>(
 /// (input and damping work: Romberg on the trapezoidal sums of the pair).
 fn accept<J: Joints>(jt: &mut J, c: f64, w: &mut State, p: &Piece) -> Result<(), CoreError> {
     let (x0, v0, f0, f1) = (w.x, w.v, w.f, p.st.f1);
-    let rich = |coarse: f64, fine: f64| (4.0 * fine - coarse) / 3.0;
+    let rich = |coarse: f64, fine: f64| fine + (fine - coarse) * p.ext;
     let e_in = rich(
         (p.xc - x0) * 0.5 * (f0 + f1),
         (p.xm - x0) * 0.5 * (f0 + p.fm) + (p.xf - p.xm) * 0.5 * (p.fm + f1),
@@ -142,7 +148,7 @@ fn accept<J: Joints>(jt: &mut J, c: f64, w: &mut State, p: &Piece) -> Result<(),
     );
     w.e_in += e_in;
     w.e_damp += e_damp;
-    jt.commit_doubled(x0, (p.xc, p.xm, p.xf), p.st.x1)?;
+    jt.commit_doubled(x0, (p.xc, p.xm, p.xf), p.ext, p.st.x1)?;
     w.x = p.st.x1;
     w.v = p.st.v1;
     (w.g, w.kt, w.ct) = (p.st.joints.f, p.st.joints.kt, p.st.joints.ct);
@@ -178,7 +184,9 @@ pub(super) fn run<J: Joints>(
     // the wanted piece length in seconds (carried from interval to interval)
     let mut want = f64::INFINITY;
     // a piece this short is kept whatever its estimate (a kink the pair cannot resolve)
-    let min_frac = 0.5_f64.powi(i32::try_from(opts.max_halvings).unwrap_or(30));
+    let min_frac = MIN_FRAC;
+    // the estimate of the last rejected try, or of the last piece kept plain (NaN: none)
+    let mut rejected = f64::NAN;
     for (i, pair) in inp.t.windows(2).enumerate() {
         let big_h = pair[1] - pair[0];
         let mut tau = 0.0_f64;
@@ -190,7 +198,8 @@ pub(super) fn run<J: Joints>(
             let step = frac.min(1.0 - tau);
             let h = step * big_h;
             let tau1 = if step >= 1.0 - tau { 1.0 } else { tau + step };
-            let Some(p) = piece(jt, mck, &w, inp, i, (tau, tau1, h), scale, opts) else {
+            let span = (tau, tau1, h);
+            let Some(mut p) = piece(jt, mck, &w, inp, i, span, (scale, 1.0 / 3.0), opts) else {
                 halvings = halvings.saturating_add(1);
                 if halvings > opts.max_halvings.saturating_mul(4) {
                     sum.status = Status::NoConvergence {
@@ -213,10 +222,30 @@ pub(super) fn run<J: Joints>(
                 }
             }
             let factor = crate::structure::grow(tol, p.err);
-            if p.err > tol && step > min_frac {
-                frac = step * factor.min(0.9);
-                continue;
+            if p.err > tol {
+                // A shorter piece that did not cut the estimate as h³ would (by 2 for a
+                // piece at most 0.8 as long): a stiff or non-smooth part the pair cannot
+                // resolve; so is a piece at the shortest length. Keep the plain half steps
+                // there (the trapezoidal rule is A-stable, its extrapolation is not).
+                let stuck = p.err > 0.5 * rejected || step <= min_frac;
+                if !stuck {
+                    rejected = p.err;
+                    frac = step * factor.min(0.8);
+                    continue;
+                }
+                if let Some(q) = piece(jt, mck, &w, inp, i, span, (scale, 0.0), opts) {
+                    sum.n_iter = sum.n_iter.saturating_add(q.iters);
+                    p = q;
+                }
             }
+            // A piece kept plain: refining did not pay; the next piece tries a longer one and
+            // is kept plain too unless its estimate halves (`rejected` carried on).
+            let (factor, carried) = if p.ext == 0.0 {
+                (2.0, p.err)
+            } else {
+                (factor, f64::NAN)
+            };
+            rejected = carried;
             accept(jt, mck.1, &mut w, &p)?;
             sum.n_steps = sum.n_steps.saturating_add(1);
             scale = (scale.0.max(w.x.abs()), scale.1.max(w.v.abs()));
