@@ -265,7 +265,8 @@ pub(super) fn simulate_dense(
     record(s, &w, out, 0);
     sum.n_out = 1;
     if let Some(tol) = opts.tol {
-        return adaptive::run(s, inp, tol, opts, w, sc, sum, out);
+        let rate = super::stiff_rate(s);
+        return adaptive::run(s, inp, (tol, rate), opts, w, sc, sum, out);
     }
     // fixed steps: `substeps` equal pieces per interval (events and halvings split them)
     let k_sub = opts.substeps as f64;

@@ -53,6 +53,12 @@ trait Joints {
     fn commit(&mut self, x0: f64, x1: f64) -> Result<(), CoreError>;
     /// Write each joint's force, work and dissipated energy at `x` as sample `i`.
     fn record(&self, x: f64, i: usize, out: &mut Buffers<'_>);
+    /// How close Newton's residual must come (relative) before a step-doubling pair's inner
+    /// solve ends without a last trial: `QUICK` where every tangent is exact (convergence is
+    /// quadratic), 0 (never) where a law's tangent is a difference quotient.
+    fn quick(&self) -> f64 {
+        adaptive::QUICK
+    }
     /// Keep each joint's force at the last trial, moved by `(dx, dv)` along its tangents, in
     /// `slot` (0: the coarse end of a step-doubling pair, 1: its midpoint, 2: its fine end).
     fn keep(&mut self, slot: usize, moved: (f64, f64));
@@ -127,6 +133,18 @@ impl<'a> Dyn<'a> {
 }
 
 impl Joints for Dyn<'_> {
+    fn quick(&self) -> f64 {
+        let exact = !self
+            .joints
+            .iter()
+            .any(|j| matches!(j.law, JointLaw::Law { .. }));
+        if exact {
+            adaptive::QUICK
+        } else {
+            0.0
+        }
+    }
+
     #[inline]
     fn keep(&mut self, slot: usize, (dx, dv): (f64, f64)) {
         for (k, tr) in self.kept.iter_mut().zip(&self.trials) {
@@ -653,7 +671,8 @@ fn run<J: Joints>(
     record(jt, &w, out, 0);
     sum.n_out = 1;
     if let Some(tol) = opts.tol {
-        return adaptive::run(inp, (m, c, k), tol, opts, jt, w, sum, out);
+        let rate = super::stiff_rate(s);
+        return adaptive::run(inp, (m, c, k), (tol, rate), opts, jt, w, sum, out);
     }
     // fixed steps: `substeps` equal pieces per interval (events and halvings split them)
     let k_sub = opts.substeps as f64;

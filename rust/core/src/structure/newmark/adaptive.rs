@@ -234,7 +234,7 @@ fn next_frac(tau: f64, want: f64) -> f64 {
 pub(super) fn run(
     s: &Structure,
     inp: &Inputs<'_>,
-    tol: f64,
+    (tol, rate): (f64, f64),
     opts: &Options,
     mut w: Work,
     mut sc: Scratch,
@@ -257,7 +257,7 @@ pub(super) fn run(
             let h = step * big_h;
             let tau1 = if step >= 1.0 - tau { 1.0 } else { tau + step };
             let span = (tau, tau1, h);
-            let ext = (scale, 1.0 / 3.0);
+            let ext = (scale, if h * rate > 2.0 { 0.0 } else { 1.0 / 3.0 });
             let Some((mut err, theta, it)) =
                 piece(s, &mut w, &mut sc, &mut p, inp, i, span, ext, opts)
             else {

@@ -22,7 +22,7 @@ use crate::structure::{Buffers, Inputs, Options, Status, Summary};
 /// A Newton solve of the pair ends, without a last trial, once its residual is below this
 /// fraction of the forces (see `newton`): the error left is of the order of its square, and
 /// such a solve's joint trials are never committed (the extrapolated point is tried anew).
-const QUICK: f64 = 1e-3;
+pub(super) const QUICK: f64 = 1e-3;
 
 /// The shortest piece (a fraction of the sample interval) error control cuts to.
 const MIN_FRAC: f64 = 1.0 / 64.0;
@@ -61,7 +61,7 @@ fn piece<J: Joints>(
     let (m, c, k) = mck;
     let f1 = load(inp, i, tau1);
     let fm = load(inp, i, 0.5 * (tau + tau1));
-    let quick = QUICK;
+    let quick = jt.quick();
     let (coarse, i1) = newton(jt, mck, w, (w.x, quick), h, f1, opts)?;
     jt.keep(0, coarse.moved);
     let (half, i2) = newton(jt, mck, w, (w.x, quick), 0.5 * h, fm, opts)?;
@@ -173,7 +173,7 @@ fn next_frac(tau: f64, want: f64) -> f64 {
 pub(super) fn run<J: Joints>(
     inp: &Inputs<'_>,
     mck: (f64, f64, f64),
-    tol: f64,
+    (tol, rate): (f64, f64),
     opts: &Options,
     jt: &mut J,
     mut w: State,
@@ -199,7 +199,8 @@ pub(super) fn run<J: Joints>(
             let h = step * big_h;
             let tau1 = if step >= 1.0 - tau { 1.0 } else { tau + step };
             let span = (tau, tau1, h);
-            let Some(mut p) = piece(jt, mck, &w, inp, i, span, (scale, 1.0 / 3.0), opts) else {
+            let ext = if h * rate > 2.0 { 0.0 } else { 1.0 / 3.0 };
+            let Some(mut p) = piece(jt, mck, &w, inp, i, span, (scale, ext), opts) else {
                 halvings = halvings.saturating_add(1);
                 if halvings > opts.max_halvings.saturating_mul(4) {
                     sum.status = Status::NoConvergence {
