@@ -500,6 +500,7 @@ fn load(inp: &Inputs<'_>, i: usize, tau: f64) -> f64 {
 /// tried from their committed position `xc` (`w.x`, or the start of a step-doubling piece when
 /// `w` is its midpoint: a monotone path, so the same end state). Returns the step and the
 /// Newton iterations used, or `None` if Newton failed.
+// The step's context (joints, M C K, state, start, length, load, options) as it is.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn newton<J: Joints>(

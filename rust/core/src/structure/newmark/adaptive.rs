@@ -75,6 +75,7 @@ impl Pair {
 /// Step doubling over `[tau, tau1]` (length `h`) of interval `i`: on success the extrapolated
 /// state is in `sc.x1/v1/a1/f1/trials` and `(error estimate, event fraction (1: none),
 /// Newton iterations)` is returned; `None` if Newton failed.
+// The piece's context (structure, state, input, span, scales, options) as it is.
 #[allow(clippy::too_many_arguments)]
 fn piece(
     s: &Structure,
@@ -230,6 +231,7 @@ fn next_frac(tau: f64, want: f64) -> f64 {
 }
 
 /// The error-controlled loop of the n-DOF path (state `w` at `t[0]`, already recorded).
+// The run's context, handed on from the fixed-step front as it is.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn run(
     s: &Structure,

@@ -47,6 +47,7 @@ struct Piece {
 
 /// Step doubling over `[tau, tau1]` of interval `i` (length `h`) from `w`; `None` if Newton
 /// failed on any of the three steps. `scale`: the displacement and velocity sizes.
+// The piece's context (structure, state, input, span, scales, options) as it is.
 #[allow(clippy::too_many_arguments)]
 fn piece<J: Joints>(
     jt: &mut J,
@@ -169,6 +170,7 @@ fn next_frac(tau: f64, want: f64) -> f64 {
 }
 
 /// The error-controlled integration loop (state `w` at `t[0]`, already recorded).
+// The run's context, handed on from the fixed-step front as it is.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn run<J: Joints>(
     inp: &Inputs<'_>,
