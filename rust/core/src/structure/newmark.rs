@@ -98,7 +98,17 @@ struct Scratch {
 // Row-major index arithmetic: indices < n (dofs), nj (joints) or the sample count, into
 // buffers whose sizes n*n, nt*n and nt*nj were checked in `Structure::new` and `simulate`.
 #[allow(clippy::arithmetic_side_effects)]
-fn newton_step(s: &Structure, w: &Work, h: f64, sc: &mut Scratch, opts: &Options) -> Option<u64> {
+///
+/// `quick` (0: never): a residual below this fraction of the forces ends the solve after its
+/// update without another trial, the joints' forces carried along their tangents (a
+/// step-doubling pair's inner solves, whose trials are never committed; see `sdof::newton`).
+fn newton_step(
+    s: &Structure,
+    w: &Work,
+    (h, quick): (f64, f64),
+    sc: &mut Scratch,
+    opts: &Options,
+) -> Option<u64> {
     let n = s.n;
     let (b, g) = (0.25 * h * h, 0.5 * h);
     // The unknown is the new acceleration: x1 and v1 follow from it without the cancellation
@@ -161,6 +171,20 @@ fn newton_step(s: &Structure, w: &Work, h: f64, sc: &mut Scratch, opts: &Options
         sc.lu.solve(&mut sc.tmp);
         for d in 0..n {
             sc.a1[d] -= sc.tmp[d];
+        }
+        if rn <= quick * scale {
+            for d in 0..n {
+                let asum = w.a[d] + sc.a1[d];
+                sc.dx[d] = h * w.v[d] + b * asum;
+                sc.x1[d] = w.x[d] + sc.dx[d];
+                sc.v1[d] = w.v[d] + g * asum;
+            }
+            for (j, t) in s.joints.iter().zip(sc.trials.iter_mut()) {
+                // the end moved by −b δa in x and −g δa in v since the trial
+                let (dd, dv) = (-b * rel(j, &sc.tmp), -g * rel(j, &sc.tmp));
+                t.f += t.kt * dd + t.ct * dv;
+            }
+            return Some(it);
         }
     }
     None
@@ -283,7 +307,7 @@ pub(super) fn simulate_dense(
             let h = step * big_h;
             let tau1 = if step >= 1.0 - tau { 1.0 } else { tau + step };
             load(s, inp, i, tau1, &mut sc.f1);
-            match newton_step(s, &w, h, &mut sc, opts) {
+            match newton_step(s, &w, (h, 0.0), &mut sc, opts) {
                 None => {
                     halvings = halvings.saturating_add(1);
                     if halvings > opts.max_halvings.saturating_mul(opts.substeps) {
