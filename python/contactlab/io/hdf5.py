@@ -186,6 +186,34 @@ def _read_into(fd: int, buf: memoryview, at: int) -> int:
     return len(data)
 
 
+def _mapped_hits(
+    fd: int, at: int, want: int, needles: tuple[bytes, ...], block: int
+) -> list[list[int]] | None:
+    """Each needle's positions starting in the ``block`` bytes from ``at`` (``want`` bytes
+    searched: the block and what a match starting in it may reach), searched in a read-only
+    memory map of just those bytes (the file's cached pages, no copy; unmapped before the
+    next block, so the scan's resident memory stays one block): a third of the CPU time of
+    reading them into a buffer (3e7-sample file, 480 MB: 0.06 against 0.09-0.19 s). None
+    where the block cannot be mapped (then it is read)."""
+    import mmap
+
+    from .._core import signature_positions
+
+    if at % mmap.ALLOCATIONGRANULARITY:
+        return None
+    try:
+        m = mmap.mmap(fd, want, offset=at, access=mmap.ACCESS_READ)
+    except (OSError, ValueError, OverflowError):
+        return None
+    try:
+        view = np.frombuffer(m, dtype=np.uint8)
+        hits = signature_positions(view, list(needles), block, at)
+        del view  # no export left when the map closes
+        return [h.tolist() for h in hits]
+    finally:
+        m.close()
+
+
 #: threads of the structure scan of a long file (:meth:`_FileView.index`)
 _SCAN_THREADS = 2
 
@@ -262,6 +290,10 @@ class _FileView:
             if _STOP.is_set():  # the process is ending (stop_prefetched_checks)
                 raise InputError("the structure check was stopped: the process is ending")
             want = min(self.BLOCK + longest - 1, self.size - at)
+            mapped = _mapped_hits(self.fd, at, want, needles, self.BLOCK)
+            if mapped is not None:
+                out[at] = mapped
+                continue
             if len(buf) < want:
                 buf = bytearray(want)
                 if owner is not None:
