@@ -214,6 +214,14 @@ def _mapped_hits(
         m.close()
 
 
+def _usable_cpus() -> int:
+    """CPUs this process may run on (its affinity mask; the CPU count without one)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
 #: threads of the structure scan of a long file (:meth:`_FileView.index`)
 _SCAN_THREADS = 2
 
@@ -250,7 +258,7 @@ class _FileView:
         scan that precedes every read of a long recording (1.6 GB: 0.7 s on one core)."""
         longest = max(len(nd) for nd in needles)
         starts = list(range(0, self.size, self.BLOCK))
-        n_threads = min(_SCAN_THREADS, len(starts), os.cpu_count() or 1)
+        n_threads = min(_SCAN_THREADS, len(starts), _usable_cpus())
         if n_threads > 1:
             from concurrent.futures import ThreadPoolExecutor
 

@@ -6,6 +6,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from .._arrays import median
 from .track_result import AUTO_WINDOW, MIN_CYCLES
 
 __all__ = ["WindowCuts"]
@@ -33,7 +34,7 @@ class WindowCuts:
         if self.mode == "auto":
             self.first_crossings.extend(crossings[:64].tolist())
             if len(self.first_crossings) >= 3:
-                per_cycle = float(np.median(np.diff(self.first_crossings)))
+                per_cycle = float(median(np.diff(self.first_crossings)))
                 self.size = float(max(MIN_CYCLES + 1, round(self.auto_window / per_cycle)))
                 self.mode, self.next_cross_target = "cycles", int(self.size)
 
