@@ -12,18 +12,20 @@ round:
   start-up, reading, the windows on the default helper threads, pooling, the JSON), wall time
   and CPU time (user + system of the process and its threads, ``os.wait4``);
 - ``read``: :func:`contactlab.io.read_chunks` over the file alone (a new process), the floor
-  the reading sets.
-
+  the reading sets;
 - ``analyze, one core``: the same command pinned to one CPU (``sched_setaffinity``: the
   reader, the structure scan and the window threads share it), the single-core figure;
   the ``analyze`` row uses every core the machine gives it (default helper threads).
 
 Throughput = samples / median wall time; the ratio analyze / kernel is the figure (the kernel
-is single-threaded in both). The JSON of every analyze round is compared byte for byte with
-the first (the windows are deterministic). ``--baseline DIR`` also runs another tree's
-package (``PYTHONPATH=DIR``, e.g. an ``git archive`` of an older commit's ``python/`` with its
-built ``_core`` copied in) in the same interleaved rounds: before/after rows from one run, and
-whether its JSON is byte for byte ours.
+is single-threaded in both). The note also gives the ratio of samples per CPU-second (the
+kernel's thread time against the command's user + system time): on a loaded machine the
+wall times of both stretch with the load, the CPU times much less. The JSON of every
+analyze round is compared byte for byte with the first (the windows are deterministic).
+``--baseline DIR`` also runs another tree's package (``PYTHONPATH=DIR``, e.g. a ``git
+archive`` of an older commit's ``python/`` with its built ``_core`` copied in) in the same
+interleaved rounds: before/after rows from one run, and whether its JSON is byte for byte
+ours.
 
 Run: ``nice .venv/bin/python benches/bench_analyze.py [--samples 1e7 3e7] [--rounds 5]
 [--baseline DIR]``.
@@ -94,13 +96,14 @@ def measure(
     buf = np.empty_like(x)
     exe = str(Path(sys.executable).with_name("contactlab"))
     cpu = _one_cpu()
-    times: dict[str, list[float]] = {"kernel": [], "read": []}
+    times: dict[str, list[float]] = {"kernel": [], "kernel_cpu": [], "read": []}
     outputs: dict[str, list[bytes]] = {}
 
     def kernel() -> None:
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.thread_time()
         m.force(x, out=buf)
         times["kernel"].append(time.perf_counter() - t0)
+        times["kernel_cpu"].append(time.thread_time() - c0)
 
     def analyze(label: str, env: dict[str, str] | None, pin: int | None) -> None:
         got = outputs.setdefault(label, [])
@@ -150,6 +153,7 @@ def rows(
             r = measure(path, n, rounds, tmp, baseline)
             path.unlink()
             ka, rd = n / r["kernel"] / 1e6, n / r["read"] / 1e6
+            kc = n / r["kernel_cpu"] / 1e6
             same = "identical in every round" if r["same_json"] else "DIFFERS between rounds"
             if baseline is not None:
                 same += " and builds"
@@ -164,10 +168,10 @@ def rows(
                         f"`contactlab analyze --json`, {n:.0e}-sample HDF5, command line, {what}",
                         f"{r[key]:.2f} s wall ({an:.1f} M samples/s), "
                         f"{cpu:.2f} s CPU ({n / cpu / 1e6:.1f} M/CPU-s)",
-                        f"Masing kernel {ka:.0f} M/s (one thread); read_chunks alone (new "
-                        f"process) {r['read']:.2f} s ({rd:.0f} M/s)",
+                        f"Masing kernel {ka:.0f} M/s, {kc:.0f} M/CPU-s (one thread); "
+                        f"read_chunks alone (new process) {r['read']:.2f} s ({rd:.0f} M/s)",
                         an / ka,
-                        f"of the kernel; JSON {same}",
+                        f"of the kernel (by CPU time: {n / cpu / 1e6 / kc:.2f}); JSON {same}",
                     )
                 )
     return out
