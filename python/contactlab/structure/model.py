@@ -548,11 +548,15 @@ def _stepping(substeps: Any, tol: Any) -> _Stepping:
     if substeps is not None and tol is not None:
         raise InputError("give either substeps (fixed steps) or tol (error control), not both")
     if substeps is not None:
-        if isinstance(substeps, bool) or not isinstance(substeps, int | np.integer):
+        try:
+            k = int(substeps)
+        except (TypeError, ValueError, OverflowError):
+            raise InputError(f"substeps must be an integer, got {substeps!r}") from None
+        if isinstance(substeps, bool) or k != substeps:
             raise InputError(f"substeps must be an integer, got {substeps!r}")
-        if substeps < 1:
+        if k < 1:
             raise InputError(f"substeps must be >= 1, got {substeps}")
-        return _Stepping(None, int(substeps))
+        return _Stepping(None, k)
     if tol is None:
         return _Stepping(DEFAULT_TOL, 1)
     try:
