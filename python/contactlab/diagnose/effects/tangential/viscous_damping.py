@@ -25,6 +25,9 @@ class ViscousDamping(EffectModel):
     rank = 2
     order = 0
     size_param = "c"
+    #: the effect reads ẋ of the measured input (the stated bound takes its direction with
+    #: the differentiated noise smoothed away: :func:`contactlab.diagnose.power.signal_input`)
+    reads_input_derivatives = True
 
     def apply(self, F, p, ctx):
         return F + p["c"] * ctx.pick(ctx.d.ud)
