@@ -63,6 +63,7 @@ from typing import Any
 import numpy as np
 
 from ._family import Family, ParamSpec, Prepared
+from ._signal import smooth_window
 from .detection import ChannelNoise, effective_variance, model_slope
 from .select import (
     FIT_SAMPLES,
@@ -636,14 +637,20 @@ def _per_parameter(
     # ẋ) has its direction taken with the derivatives' noise smoothed away: the data hold
     # the true ẍ, not the input noise differentiated twice, so only the signal's part of
     # the direction can show in them (:func:`signal_input`)
-    ds = signal_input(d) if reads_input_derivatives(family, name) else d
+    derived = reads_input_derivatives(family, name)
+    ds = _effect_signal(family, name, signal_input(d)) if derived else d
+    steady = steady_samples(d) if derived else None
     rivals = _rival_directions(family, p0, trial, name, ds, scales)
     for s in mags:
         j = _derivative(family, p0, trial, ds, s, _step(s, s.null, scales))
         if not np.all(np.isfinite(j)):
             per[s.name] = rel[s.name] = gain[s.name] = None
             continue
+        if steady is not None:
+            j = np.where(steady, j, 0.0)
         jp = _project(j, np.column_stack([jb, *rivals]) if rivals else jb, st.w)
+        if steady is not None:
+            jp = np.where(steady, jp, 0.0)
         ident = identified_sigmas(family, name)
         b = _bound(jp, st, ident)
         # the current model's parameters absorb a large effect beyond what the linear
@@ -653,7 +660,7 @@ def _per_parameter(
         for _ in range(NONLINEAR_STEPS if keep < NONLINEAR_BELOW else 0):
             if b is None:
                 break
-            left = _left_by_refit(family, p0, effects, name, s, b, ds, st.w, jp)
+            left = _left_by_refit(family, p0, effects, name, s, b, ds, st.w, jp, steady)
             if left >= 0.9:
                 break
             jp = jp * np.sqrt(max(left, 1e-6))
@@ -668,10 +675,12 @@ def _per_parameter(
 
 
 #: the window of the smoothing that takes the input noise out of the derivatives an
-#: effect's direction is read through (:func:`signal_input`), as a fraction of a period: a
-#: local cubic over a quarter period passes the drive and its first harmonics and a
-#: start-up over a cycle, and cuts the twice-differentiated noise by about 20x in power
-SIGNAL_FRACTION = 0.25
+#: effect's direction is read through (:func:`signal_input`), as a fraction of a period, and
+#: its polynomial degree: a local quintic over half a period passes the drive (1 - 4e-4),
+#: a block at 1.7 times its frequency (1 - 0.009) and a start-up over a cycle, and leaves
+#: of the twice-differentiated noise only what lies below a few times the drive frequency
+SIGNAL_FRACTION = 0.5
+SIGNAL_DEGREE = 5
 
 
 def reads_input_derivatives(family: Family, name: str) -> bool:
@@ -684,8 +693,9 @@ def reads_input_derivatives(family: Family, name: str) -> bool:
 
 
 def signal_input(d: Prepared) -> Prepared:
-    """``d`` with the input's derivatives ``ud``, ``udd`` smoothed by a local cubic over
-    :data:`SIGNAL_FRACTION` of a period (the samples are uniform), when the input carries
+    """``d`` with the input's derivatives ``ud``, ``udd`` smoothed by a local polynomial
+    (:data:`SIGNAL_DEGREE`) over :data:`SIGNAL_FRACTION` of a period (the samples are
+    uniform), when the input carries
     noise (``d.extra["u_noise"] > 0``); ``d`` itself otherwise.
 
     The derivatives every candidate reads are those of the measured input: twice
@@ -700,16 +710,42 @@ def signal_input(d: Prepared) -> Prepared:
         return d
     from scipy.signal import savgol_filter
 
-    from ._signal import smooth_window
-
-    w = smooth_window(d.cycles.period_samples, SIGNAL_FRACTION, 7)
+    w = smooth_window(d.cycles.period_samples, SIGNAL_FRACTION, 9)
     w = min(w, d.t.size - (1 - d.t.size % 2))
-    if w < 5:
+    if w <= SIGNAL_DEGREE + 2:
         return d
-    ud = savgol_filter(d.ud, w, 3, mode="interp")
-    udd = savgol_filter(d.udd, w, 3, mode="interp")
+    ud = savgol_filter(d.ud, w, SIGNAL_DEGREE, mode="interp")
+    udd = savgol_filter(d.udd, w, SIGNAL_DEGREE, mode="interp")
     extra = {k: v for k, v in d.extra.items() if k not in ("fixed", "evaluations")}
     return dataclasses.replace(d, ud=ud, udd=udd, extra=extra)
+
+
+def _effect_signal(family: Family, name: str, d: Prepared) -> Prepared:
+    """``d`` as the effect's own ``signal_input`` hook reads its signature in the data
+    (a mass on a single-frequency drive: ``ẍ = -ω² x`` exactly), else ``d``."""
+    from .effects import registry
+
+    eff = registry(getattr(family, "kind", "")).get(name)
+    hook = getattr(eff, "signal_input", None)
+    return d if hook is None else hook(d)
+
+
+def steady_samples(d: Prepared) -> np.ndarray:
+    """The samples whose input derivatives the data can pin down: from the second cycle on
+    (``d.cycles.cycle >= 1``) and short of the last half window of :func:`signal_input`.
+
+    The start from rest carries the actuator's own transient, whose ẍ (at the servo's
+    frequency, many times the drive's) no derivative of the noisy input resolves: on the rig
+    the model's ẍ there was off by the true ẍ's own size, and a bound counting the start-up
+    promised 6x the gain a mass gave (tuning seed 1407). The smoothing's last half window
+    is an extrapolation."""
+    keep = d.cycles.cycle >= 1
+    w = smooth_window(d.cycles.period_samples, SIGNAL_FRACTION, 9)
+    tail = min(w // 2, keep.size)
+    if tail:
+        keep = keep.copy()
+        keep[keep.size - tail :] = False
+    return keep
 
 
 def _rival_directions(
@@ -765,10 +801,13 @@ def _left_by_refit(
     d: Prepared,
     w: np.ndarray,
     jp: np.ndarray,
+    rows: np.ndarray | None = None,
 ) -> float:
     """The share of the linearised effect ``b · jp`` (weighted squares) that the current
     model, refitted to its own prediction with the effect at size ``b`` (noise-free), still
-    leaves; 1 when the refit fails."""
+    leaves; 1 when the refit fails. ``rows``: the samples the refit and the share are taken
+    on (default all; :func:`steady_samples` for an effect read through the input's
+    derivatives, whose start-up the bound leaves out)."""
     from ..errors import ContactLabError
     from .select import fit
 
@@ -778,13 +817,14 @@ def _left_by_refit(
     extra = {k: v for k, v in d.extra.items() if k != "evaluations"}
     dd = dataclasses.replace(d, y=target, extra=extra)
     start = {q.name: p0[q.name] for q in specs_for(family, effects) if q.name in p0}
+    mask = np.ones(d.y.size, bool) if rows is None else np.asarray(rows, bool)
     try:
-        out = fit(family, effects, dd, np.ones(d.y.size, bool), start, family.scales(d))
+        out = fit(family, effects, dd, mask, start, family.scales(d))
         r = target - family.predict(out.params, effects, dd)
     except (ContactLabError, ValueError, FloatingPointError, np.linalg.LinAlgError):
         return 1.0
-    lin = b * b * float(np.sum(w * jp * jp))
-    ok = np.isfinite(r)
+    lin = b * b * float(np.sum((w * jp * jp)[mask]))
+    ok = np.isfinite(r) & mask
     return float(np.sum((w * r * r)[ok]) / lin) if lin > 0 and ok.any() else 1.0
 
 
