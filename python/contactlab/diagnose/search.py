@@ -41,12 +41,18 @@ def _takes_over(
     p: dict[str, float],
     effects: tuple[str, ...] = (),
     explains: float = 1.0,
+    regime: str | None = None,
 ) -> str | None:
     """Why the model moves a base parameter that carries the joint's physics by more than
     :data:`MAX_BASE_SHIFT` (more when the model leaves only the share ``explains`` of the
     current misfit: :data:`MAX_BASE_SHIFT_EXPLAINED`, :data:`MAX_BASE_SHIFT_MOSTLY`), or
     None. An effect that rescales the base (a branch scale makes
-    the loop's height ``λ h0 / 2``) is compared by its equivalent of the base parameter."""
+    the loop's height ``λ h0 / 2``) is compared by its equivalent of the base parameter.
+
+    In pre-sliding (``regime``, as analyze decides it) a tangential loop never reaches its
+    plateau and shows its initial stiffness ``h0·ac`` and curvature, not ``h0``: the anchor
+    is then ``h0·ac`` (a dashpot's loop area, read by the base as curvature, moved h0 from
+    27.6 to 40 N, its true value, at an unchanged stiffness: rig tuning seeds 1402-1408)."""
     from .effects import registry
 
     reg = registry(family.kind)
@@ -57,7 +63,12 @@ def _takes_over(
     limit = MAX_BASE_SHIFT
     if explains <= EXPLAINED_SHARE:
         limit = MAX_BASE_SHIFT_MOSTLY if explains <= MOSTLY_SHARE else MAX_BASE_SHIFT_EXPLAINED
-    for name in _ANCHORS.get(family.kind, ()):
+    anchors = _ANCHORS.get(family.kind, ())
+    if regime == "pre-sliding" and family.kind == "tangential" and "ac" in base:
+        anchors = ("h0·ac",)
+        base = {**base, "h0·ac": base["h0"] * base["ac"]}
+        equivalent["h0·ac"] = equivalent["h0"] * equivalent["ac"]
+    for name in anchors:
         b, v = base[name], equivalent[name]
         if b > 0 and abs(v / b - 1.0) > limit:
             return (
@@ -143,7 +154,10 @@ def _try_candidate(
     # effect added before to the edge of its physical range
     why = next(
         (w for e in trial_effects if (w := family.implausible(e, p, d))), None
-    ) or _takes_over(family, base_fit, p, trial_effects, _explains(current, cand, sigma))
+    ) or _takes_over(
+        family, base_fit, p, trial_effects, _explains(current, cand, sigma),
+        regime=(d.extra.get("regime_info") or {}).get("name"),
+    )  # fmt: skip
     if v.accepted and why:
         v = dataclasses.replace(v, accepted=False, reason=f"implausible: {why}")
     if v.accepted and hasattr(family, "identified"):

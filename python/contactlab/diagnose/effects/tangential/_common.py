@@ -224,6 +224,24 @@ def single_frequency(d: Prepared) -> tuple[float, float] | None:
     return -c, share
 
 
+def smoothed_velocity(d: Prepared) -> np.ndarray:
+    """``ẋ`` of the input smoothed as :func:`smoothed_acceleration` smooths ``ẍ`` (``d.ud``
+    itself when the input carries no noise), kept per record."""
+
+    def make() -> np.ndarray:
+        if not float(d.extra.get("u_noise", 0.0) or 0.0) > 0.0:
+            return d.ud
+        from scipy.signal import savgol_filter
+
+        from ..._signal import smooth_window
+
+        w = smooth_window(d.cycles.period_samples, SIGNAL_FRACTION, 7)
+        w = min(w, d.t.size - (1 - d.t.size % 2))
+        return savgol_filter(d.ud, w, 3, mode="interp") if w >= 5 else d.ud
+
+    return fixed(d, "smoothed_velocity", make)
+
+
 def smoothed_acceleration(d: Prepared) -> np.ndarray:
     """``ẍ`` of the input smoothed by a local cubic over :data:`SIGNAL_FRACTION` of a
     period (the twice differentiated input noise taken out) when the input carries noise
