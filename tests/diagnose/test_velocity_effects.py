@@ -96,7 +96,7 @@ def presliding_mass():
     """A rig record in pre-sliding (ac·A 0.38, 46 Hz) with a mass making 10 % of the force:
     on this single-frequency drive ``m ẍ = -mω² x`` is absorbed by the contact's own
     stiffness; the record cannot show it."""
-    fac = {"fs": 3158.8, "f": 45.856, "cycles": 14, "acA": 0.381}
+    fac = {"fs": 3158.8, "f": 45.856, "cycles": 8, "acA": 0.381}
     A = fac["acA"] / 4e4
     hm = 40.0 * (1 - np.exp(-fac["acA"]))
     m = 0.1 * hm / (A * (2 * np.pi * fac["f"]) ** 2)
