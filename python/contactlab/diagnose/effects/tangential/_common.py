@@ -194,9 +194,9 @@ def delay_support(d: Prepared, at: np.ndarray, tau: float) -> np.ndarray:
 #: servo-driven sine leaves 0.2-1.3 %, the package's three-block drive half
 SINGLE_FREQUENCY_SHARE = 0.05
 #: window of the smoothing of ``ẍ`` (:func:`smoothed_acceleration`), as a fraction of the
-#: dominant period: a local cubic over 15 % of a period passes the drive (1 - 2e-4) and a
-#: block at 1.7 times its frequency (1 - 1.5e-3), and cuts the twice-differentiated noise of
-#: the 8 % window ``udd`` is taken over by about 6x in power
+#: fastest cycles' period (:func:`fastest_period`): a local cubic over 15 % of a period
+#: passes them to 2e-4 and cuts the twice-differentiated noise of the 8 % window ``udd``
+#: is taken over by about 6x in power
 SIGNAL_FRACTION = 0.15
 
 
@@ -224,6 +224,17 @@ def single_frequency(d: Prepared) -> tuple[float, float] | None:
     return -c, share
 
 
+def fastest_period(d: Prepared) -> float:
+    """The period (samples) of the record's fastest cycles: twice the 10th percentile of the
+    half-cycles between reversals, at most the dominant period (a drive in blocks of
+    several frequencies: its dominant period may be the slowest block's)."""
+    per = float(d.cycles.period_samples)
+    half = np.diff(np.asarray(d.cycles.reversals))
+    if half.size >= 4:
+        per = min(per, 2.0 * float(np.percentile(half, 10)))
+    return max(per, 1.0)
+
+
 def smoothed_velocity(d: Prepared) -> np.ndarray:
     """``ẋ`` of the input smoothed as :func:`smoothed_acceleration` smooths ``ẍ`` (``d.ud``
     itself when the input carries no noise), kept per record."""
@@ -235,7 +246,7 @@ def smoothed_velocity(d: Prepared) -> np.ndarray:
 
         from ..._signal import smooth_window
 
-        w = smooth_window(d.cycles.period_samples, SIGNAL_FRACTION, 7)
+        w = smooth_window(fastest_period(d), SIGNAL_FRACTION, 7)
         w = min(w, d.t.size - (1 - d.t.size % 2))
         return savgol_filter(d.ud, w, 3, mode="interp") if w >= 5 else d.ud
 
@@ -254,7 +265,7 @@ def smoothed_acceleration(d: Prepared) -> np.ndarray:
 
         from ..._signal import smooth_window
 
-        w = smooth_window(d.cycles.period_samples, SIGNAL_FRACTION, 7)
+        w = smooth_window(fastest_period(d), SIGNAL_FRACTION, 7)
         w = min(w, d.t.size - (1 - d.t.size % 2))
         return savgol_filter(d.udd, w, 3, mode="interp") if w >= 5 else d.udd
 
