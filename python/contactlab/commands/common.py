@@ -359,9 +359,7 @@ def window_threads() -> int:
     """Helper threads of an auto-streamed analysis and of ``track`` (``track(threads=...)``):
     one per CPU this process may run on (its affinity mask), at most 2, none on a single
     CPU, or ``CONTACTLAB_ANALYZE_THREADS`` (0: analyse each window before reading on). They
-    analyse windows (the Rust kernels release the GIL) while the main thread reads on (two
-    threads on tangential windows: one runs each window's per-sample part, the other fits
-    the windows in window order, :func:`contactlab.studies.tracking.track`); at
+    analyse windows (the Rust kernels release the GIL) while the main thread reads on; at
     most threads + 2 windows (2^20 samples each) are unanalysed at a time, those waiting for
     a thread without their time axis (peak 240-241 MB on 1e7 samples, 245-263 MB on 1e8,
     with 2). The pooled document is the serial one.
