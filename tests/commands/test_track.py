@@ -95,7 +95,6 @@ def test_track_ctrl_c_writes_nothing(rec_file, tmp_path, monkeypatch, capsys):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(track_mod, "_tangential_window", interrupted)
-    monkeypatch.setattr(track_mod, "_tangential_prepare", interrupted)  # (on helper threads)
     out, rep = tmp_path / "o.json", tmp_path / "rep"
     code = main(
         [
@@ -125,7 +124,6 @@ def test_auto_streamed_analyze_ctrl_c_writes_nothing(rec_file, tmp_path, monkeyp
 
     monkeypatch.setattr(pooled, "STREAM_ABOVE", 4000)
     monkeypatch.setattr(track_mod, "_tangential_window", interrupted)
-    monkeypatch.setattr(track_mod, "_tangential_prepare", interrupted)  # (on helper threads)
     monkeypatch.setattr(os, "sched_getaffinity", lambda _pid: {0, 1}, raising=False)
     assert analyze_cmd.window_threads() >= 1
     out, rep = tmp_path / "o.json", tmp_path / "rep"

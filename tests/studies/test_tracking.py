@@ -397,35 +397,6 @@ def test_threads_give_the_serial_rows(long_rec):
         track(long_rec, every="6cycles", threads=-1)
 
 
-def test_staged_threads_give_the_serial_rows_documents_and_errors(long_rec, monkeypatch):
-    """Tangential windows on two threads or more: the per-sample part on the window
-    threads, the fits on one more thread in window order. Rows, window documents and a
-    window whose per-sample part fails (kept going, or raised) are those of the serial run."""
-    from contactlab.studies import tracking
-
-    real = tracking._tangential_prepare
-
-    def failing(rec, opts):
-        if int(tracking._window_recording(rec).meta["offset"]) > 0 and not failing.done:
-            failing.done = True  # the second window fails, once a run
-            raise InputError("window prepared badly")
-        return real(rec, opts)
-
-    monkeypatch.setattr(tracking, "_tangential_prepare", failing)
-    runs = {}
-    for n in (0, 1, 2, 3):
-        failing.done = False
-        runs[n] = track(long_rec, every="4cycles", threads=n, keep_going=True, keep_documents=True)
-    ref = runs[0]
-    assert len(ref.rows) >= 4 and "window prepared badly" in ref.rows[1]["error"]
-    for n in (1, 2, 3):
-        assert runs[n].rows == ref.rows
-        assert runs[n].window_docs == ref.window_docs
-    failing.done = False
-    with pytest.raises(InputError, match="prepared badly"):
-        track(long_rec, every="4cycles", threads=2, keep_going=False)
-
-
 def test_threads_read_on_when_a_younger_window_finishes_first(long_rec, monkeypatch):
     """On helper threads the reader waits for any window to finish, not the oldest: windows
     whose analysis times vary (a younger one done first) give the serial rows, the callbacks
@@ -435,7 +406,7 @@ def test_threads_read_on_when_a_younger_window_finishes_first(long_rec, monkeypa
 
     from contactlab.studies import tracking
 
-    real = tracking._tangential_prepare  # (the per-sample part: on the window threads)
+    real = tracking._tangential_window
     lock = threading.Lock()
     state = {"open": 0, "most": 0, "calls": 0}
 
@@ -455,13 +426,12 @@ def test_threads_read_on_when_a_younger_window_finishes_first(long_rec, monkeypa
     submit = ThreadPoolExecutor.submit
 
     def counted(self, fn, *a, **k):
-        if fn is slow:  # (not the fits, submitted alongside)
-            with lock:
-                state["open"] += 1
-                state["most"] = max(state["most"], state["open"])
+        with lock:
+            state["open"] += 1
+            state["most"] = max(state["most"], state["open"])
         return submit(self, fn, *a, **k)
 
-    monkeypatch.setattr(tracking, "_tangential_prepare", slow)
+    monkeypatch.setattr(tracking, "_tangential_window", slow)
     monkeypatch.setattr(ThreadPoolExecutor, "submit", counted)
     order = []
     b = track(long_rec, every="3cycles", threads=2, callback=lambda r: order.append(r["window"]))

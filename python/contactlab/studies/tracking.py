@@ -176,14 +176,12 @@ def _with_glitch_check(
     return run
 
 
-def _tangential_prepare(
-    rec: Recording | _WindowSamples, options: Mapping[str, Any]
-) -> tuple[Recording, Any]:
-    """The per-sample part of a tangential window's analysis (mostly Rust, without the
-    interpreter lock): its recording and :func:`~contactlab.tangential.window.prepare_window`
-    (options outside ``_WINDOW_OPTIONS``: the whole :func:`analyze_tangential`)."""
+@_glitch_checked(always=False)
+def _tangential_window(
+    rec: Recording | _WindowSamples, options: Mapping[str, Any], keep_doc: bool = False
+) -> tuple[dict, dict]:
     from ..tangential import analyze_tangential
-    from ..tangential.window import prepare_window
+    from ..tangential.window import analyze_window
 
     rec = _window_recording(rec)
 
@@ -196,15 +194,9 @@ def _tangential_prepare(
         if inv is not None:
             opts["force_sign"] = -1 if inv else 1
     if set(opts) <= _WINDOW_OPTIONS:
-        return rec, prepare_window(rec, **opts)
-    return rec, analyze_tangential(rec, **{"warn": False, **dict(options)})
-
-
-def _tangential_row(got: Any, keep_doc: bool) -> tuple[dict, dict]:
-    """The fits of a :func:`_tangential_prepare` (mostly Python) and the window's row."""
-    from ..tangential.window import PreparedWindow, finish_window
-
-    res = finish_window(got) if isinstance(got, PreparedWindow) else got
+        res = analyze_window(rec, **opts)
+    else:
+        res = analyze_tangential(rec, **{"warn": False, **dict(options)})
     d = res.to_dict()
     row: dict[str, Any] = {}
     for q in TANGENTIAL_QUANTITIES:
@@ -217,22 +209,6 @@ def _tangential_row(got: Any, keep_doc: bool) -> tuple[dict, dict]:
     if keep_doc:
         row["_doc"] = d
     return row, units
-
-
-@_glitch_checked(always=False)
-def _tangential_window(
-    rec: Recording | _WindowSamples, options: Mapping[str, Any], keep_doc: bool = False
-) -> tuple[dict, dict]:
-    return _tangential_row(_tangential_prepare(rec, options)[1], keep_doc)
-
-
-@_glitch_checked(always=False)
-def _tangential_fits(
-    rec: Recording | _WindowSamples, prepared: Any, keep_doc: bool = False
-) -> tuple[dict, dict]:
-    """:func:`_tangential_window` whose per-sample part another thread runs: ``prepared``,
-    the future of its :func:`_tangential_prepare` (its error re-raised here)."""
-    return _tangential_row(prepared.result()[1], keep_doc)
 
 
 @_glitch_checked(always=True)
@@ -528,10 +504,8 @@ def track(
         chunks are read and their cycles found (the Rust kernels release the GIL); default 1
         (``threads + 1`` windows in flight, ``threads + 2`` from two threads on, those
         waiting for a thread without their time axis: 2 threads peaked at 245-263 MB on 1e8
-        samples with ``"auto"`` windows), 0 analyses each window before reading on. A
-        tangential window's per-sample part runs on these threads and its fits on one more
-        thread, in window order, so that one window is fitted while the next are prepared.
-        The rows are the same.
+        samples with ``"auto"`` windows), 0 analyses each window before reading on. The rows
+        are the same.
     keep_documents : bool
         Keep each window's whole analysis document (``TrackResult.window_docs``; what
         :func:`contactlab.studies.pooled.pooled_document` and
@@ -566,38 +540,24 @@ def track(
         "resample": resample,
     }
     if executor is None and threads != 0:
+        from concurrent.futures import ThreadPoolExecutor
+
         n_threads = 1 if threads is None else int(threads)
         if n_threads < 0:
             raise InputError(f"threads must be >= 0, got {threads!r}")
-        with _one_blas_thread():
-            return _track(source, every, **settings, executor=None, slots=None, threads=n_threads)
+        with (
+            ThreadPoolExecutor(n_threads, thread_name_prefix="contactlab-track") as pool,
+            _one_blas_thread(),
+        ):
+            # each helper thread analyses one window while the next is read: n + 1 windows
+            # in memory, those waiting without their time axis; n + 2 for two threads or more,
+            # which together outpace the reader (with n + 1 they waited for it: 1e8 samples
+            # on 2 threads, interleaved runs 4.43-5.15 s against 4.45-5.96 s, peak 245-263
+            # against 240-255 MB); one thread is three times slower than the reader and
+            # always has a window waiting. An executor given by the caller gets two per worker
+            slots = n_threads + (2 if n_threads >= 2 else 1)
+            return _track(source, every, **settings, executor=pool, slots=slots)
     return _track(source, every, **settings, executor=executor, slots=None)
-
-
-def _own_threads(stack: contextlib.ExitStack, n_threads: int, kind: str) -> tuple[Any, int, Any]:
-    """The helper threads of :func:`track` (``threads=n_threads``) for windows of ``kind``:
-    (window executor, windows in flight at most, fits executor or None).
-
-    Each helper thread analyses one window while the next is read: n + 1 windows in memory,
-    those waiting without their time axis; n + 2 for two threads or more, which together
-    outpace the reader (with n + 1 they waited for it: 1e8 samples on 2 threads, interleaved
-    runs 4.43-5.15 s against 4.45-5.96 s, peak 245-263 against 240-255 MB); one thread is
-    three times slower than the reader and always has a window waiting.
-
-    Tangential windows from two threads on: one thread fits the windows (mostly Python) in
-    window order, the others run their per-sample part (Rust, without the interpreter lock),
-    so that one window is fitted while the next ones are prepared. Whole windows on every
-    thread left threads waiting for the interpreter lock whenever two were fitting."""
-    from concurrent.futures import ThreadPoolExecutor
-
-    staged = kind == "tangential" and n_threads >= 2
-    pool = stack.enter_context(
-        ThreadPoolExecutor(n_threads - staged, thread_name_prefix="contactlab-track")
-    )
-    fits = None
-    if staged:
-        fits = stack.enter_context(ThreadPoolExecutor(1, thread_name_prefix="contactlab-fits"))
-    return pool, n_threads + (2 if n_threads >= 2 else 1), fits
 
 
 def _track(
@@ -616,40 +576,9 @@ def _track(
     keep_documents: bool,
     slots: int | None,
     resample: bool = False,
-    threads: int | None = None,
 ) -> TrackResult:
     """:func:`track` on ``executor`` (None: serial); ``slots``: windows in flight at most
-    (default two per worker); ``threads``: on this many helper threads of its own instead
-    (:func:`_own_threads`)."""
-    with contextlib.ExitStack() as stack:
-        return _track_on(
-            source, every, kind=kind, columns=columns, fs=fs, chunk_size=chunk_size,
-            max_window=max_window, options=options, keep_going=keep_going,
-            callback=callback, executor=executor, keep_documents=keep_documents,
-            slots=slots, resample=resample, threads=threads, stack=stack,
-        )  # fmt: skip
-
-
-def _track_on(
-    source: str | Path | Recording,
-    every: str | float,
-    *,
-    kind: str | None,
-    columns: dict[str, str] | None,
-    fs: float | None,
-    chunk_size: int,
-    max_window: int,
-    options: Mapping[str, Any] | None,
-    keep_going: bool,
-    callback: Callable[[dict[str, Any]], None] | None,
-    executor: Any,
-    keep_documents: bool,
-    slots: int | None,
-    resample: bool,
-    threads: int | None,
-    stack: contextlib.ExitStack,
-) -> TrackResult:
-    """:func:`_track` (the helper threads, if any, entered on ``stack``)."""
+    (default two per worker)."""
     mode, size = parse_every(every)
     every_text = every if isinstance(every, str) else f"{every}cycles"
     if not (isinstance(max_window, int) and max_window >= 16):
@@ -678,12 +607,7 @@ def _track_on(
         first if cr.n_samples is None else max(min(first, cr.n_samples), 1), cr.time_step
     )
     cuts = WindowCuts(mode, size, AUTO_WINDOW)  # (a module global: tests shrink it)
-    fits = None
-    if threads:
-        executor, slots, fits = _own_threads(stack, threads, kind_)
     out = _Dispatch(analyse, dict(options or {}), executor, slots, keep_going, callback, buf)
-    if fits is not None:
-        out.staged = (fits, functools.partial(_tangential_fits, keep_doc=keep_documents))
     n_total = 0
     try:
         for block, ranges in _segments(_noting(cr.chunks_into(buf.alloc), noted), CYCLE_SEGMENT):
@@ -760,15 +684,11 @@ class _Dispatch:
         self.rows: list[dict[str, Any]] = []
         self.units: dict[str, str] = {"t_start": "s", "t_end": "s", "t_mid": "s"}
         self.docs: list[dict[str, Any]] = []
-        # (row, its job, the job's per-sample part when staged)
-        self.in_flight: deque[tuple[dict[str, Any], Any, Any]] = deque()
+        self.in_flight: deque[tuple[dict[str, Any], Any]] = deque()
         self.cycles_at_start = 0  # complete cycles before the current window
         self.limit = slots if slots is not None else 2 * n_workers(executor)
         module = type(executor).__module__.split(".")[0]
         self.dask = executor is not None and module == "distributed"
-        # (fits executor, fits job): each window's per-sample part on ``executor``, its fits
-        # on the one fits thread (a thread pool of this process; set by _track)
-        self.staged: tuple[Any, Callable[..., tuple[dict, dict]]] | None = None
 
     def collect(self, row: dict[str, Any], job: Any) -> None:
         try:
@@ -803,40 +723,34 @@ class _Dispatch:
         if ex is None:
             self.collect(row, functools.partial(self.analyse, rec, self.opts))
             return
-        prepared = None
-        if self.staged is not None:
-            fits, fit = self.staged
-            prepared = ex.submit(_tangential_prepare, rec, self.opts)
-            fut = fits.submit(fit, rec, prepared)
-        elif self.dask:
-            fut = ex.submit(self.analyse, rec, self.opts, pure=False)
-        else:
-            fut = ex.submit(self.analyse, rec, self.opts)
-        in_flight.append((row, fut, prepared))
+        fut = (
+            ex.submit(self.analyse, rec, self.opts, pure=False)
+            if self.dask
+            else ex.submit(self.analyse, rec, self.opts)
+        )
+        in_flight.append((row, fut))
         if self.slots is not None:
             # our helper threads: a window holds its samples until its analysis is done, so
             # the limit counts the windows not done yet, and the reader goes on as soon as any
             # is (waiting for the oldest left a helper thread idle whenever a younger window
             # finished first: the two threads were busy 65 % of a run); finished windows are
             # collected in order
-            busy = [f for _, f, _p in in_flight if not f.done()]
+            busy = [f for _, f in in_flight if not f.done()]
             if len(busy) >= self.limit:
                 futures_wait(busy, return_when=FIRST_COMPLETED)
             while in_flight and in_flight[0][1].done():
-                self.collect(*in_flight.popleft()[:2])
+                self.collect(*in_flight.popleft())
             return
         while len(in_flight) >= self.limit:
-            self.collect(*in_flight.popleft()[:2])
+            self.collect(*in_flight.popleft())
 
     def drain(self) -> None:
         while self.in_flight:
-            self.collect(*self.in_flight.popleft()[:2])
+            self.collect(*self.in_flight.popleft())
 
     def cancel(self) -> None:
-        for _row, fut, prepared in self.in_flight:
+        for _row, fut in self.in_flight:
             fut.cancel()
-            if prepared is not None:
-                prepared.cancel()
 
 
 def track_many(

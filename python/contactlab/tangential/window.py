@@ -6,7 +6,7 @@ detrending decided on that one fold (:func:`analyze_window`, used by
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -105,65 +105,6 @@ def analyze_window(
     :func:`analyze_tangential` (warnings are kept in ``.warnings``, not issued; the recorded
     loop area of the orientation is that of the detrended samples).
     """
-    return finish_window(
-        prepare_window(
-            recording,
-            force_sign=force_sign,
-            n_points=n_points,
-            rel_threshold=rel_threshold,
-            min_cycles=min_cycles,
-            max_rel_stderr=max_rel_stderr,
-            fit_offset=fit_offset,
-            fit_x0=fit_x0,
-            fit_amplitude=fit_amplitude,
-            detrend=detrend,
-            initial=initial,
-            delay=delay,
-        )
-    )
-
-
-@dataclass(frozen=True)
-class PreparedWindow:
-    """A window after the per-sample work of :func:`analyze_window` (:func:`prepare_window`:
-    the checks, the drifts, the detrended samples folded, the force sign), before its fits
-    (:func:`finish_window`)."""
-
-    recording: Recording
-    xa: np.ndarray
-    Fa: np.ndarray
-    ta: np.ndarray | None
-    source: str
-    ori: Orientation | None
-    pre: steps.Detrended
-    opts: dict[str, Any]
-    force_sign: int | str
-    delay: float | None
-    dropped: int
-
-
-def prepare_window(
-    recording: Recording,
-    *,
-    force_sign: int | str = "auto",
-    n_points: int | None = None,
-    rel_threshold: float = 0.5,
-    min_cycles: int = 2,
-    max_rel_stderr: float = 0.2,
-    fit_offset: bool = True,
-    fit_x0: bool | None = None,
-    fit_amplitude: bool = True,
-    detrend: bool = True,
-    initial: dict[str, float] | None = None,
-    delay: float | None = None,
-) -> PreparedWindow:
-    """The first part of :func:`analyze_window`: the per-sample work (mostly Rust, without
-    the interpreter lock), ready for :func:`finish_window` (the fits, mostly Python).
-
-    ``finish_window(prepare_window(rec, **opts))`` is ``analyze_window(rec, **opts)``, number
-    for number; the two parts let a window's fits run while another thread prepares the
-    next window (:func:`contactlab.studies.tracking.track`).
-    """
     xa, Fa, ta, source = _inputs(recording, None, None, None)
     _check_options("averaged", "steady", n_points)
     finite_x = check_channel("x", xa, "m", "displacement")
@@ -186,35 +127,26 @@ def prepare_window(
     plain = all(a.dtype == np.float64 and a.ndim == 1 and a.flags.c_contiguous for a in (xa, Fa))
     pre = window_detrended(xa, Fa, ta, opts, checked=finite_x and finite_f and plain)
     ori = _fast_orientation(pre.x, pre.F, pre.loop, force_sign)
-    if ori is not None and ori.sign < 0:
-        pre = _negated(pre)
-    return PreparedWindow(recording, xa, Fa, ta, source, ori, pre, opts, force_sign, delay, dropped)
-
-
-def finish_window(prep: PreparedWindow) -> TangentialAnalysis:
-    """The second part of :func:`analyze_window`: the fits of a :func:`prepare_window`
-    (or, where the loop area does not decide the force sign or the loop reaches gross
-    sliding, the whole :func:`analyze_tangential` of the window)."""
     res = None
-    if prep.ori is not None:
+    if ori is not None:
+        if ori.sign < 0:
+            pre = _negated(pre)
         res = _analyze(
-            prep.xa,
-            prep.Fa,
-            prep.ta,
-            prep.source,
-            prep.ori,
-            prep.pre,
+            xa,
+            Fa,
+            ta,
+            source,
+            ori,
+            pre,
             on="averaged",
             history="steady",
             streamed=True,
-            delay=prep.delay,
-            **prep.opts,
+            delay=delay,
+            **opts,
         )
     if res is None:  # the sign undecided by the area, or gross sliding: the full analysis
-        return analyze_tangential(
-            prep.recording, force_sign=prep.force_sign, warn=False, delay=prep.delay, **prep.opts
-        )
-    lag.record(res, prep.delay, prep.dropped)
+        return analyze_tangential(recording, force_sign=force_sign, warn=False, delay=delay, **opts)
+    lag.record(res, delay, dropped)
     return res
 
 
