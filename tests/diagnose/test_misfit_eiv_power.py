@@ -100,3 +100,24 @@ def test_detectable_rms_grows_with_the_tolerance():
     assert a0 is not None and a1 is not None
     assert abs(a1 - a0 - 0.2) < 0.02  # the interval null adds its width
     assert detectable_rms(np.full(3, np.nan), np.zeros(3), 30, 40.0) is None
+
+
+def test_series_compliance_absorbing_a_tanh_virgin_curve_is_not_named():
+    """A tanh virgin curve (no candidate draws it) at ac·A 2, 20 cycles, input noise 0.5 %:
+    series compliance takes up most of it, the structure left is flagged, so series
+    compliance is withdrawn (its own signature test failed) and the report says why."""
+    from contactlab.diagnose.scaled_masing import memory, scaled_force
+
+    fs, f0, cycles = 2000.0, 5.0, 20
+    t = np.arange(round((cycles + 1.5) * fs / f0)) / fs
+    x = A * np.sin(2 * np.pi * f0 * t) * np.minimum(t * f0, 1.0)
+    F = scaled_force(lambda s: 50.0 * np.tanh(2.0 / A * s), 2.0, memory(x))
+    rng = np.random.default_rng(2)
+    xm = x + rng.normal(0.0, 0.005 * np.ptp(x), x.size)
+    Fm = F + rng.normal(0.0, 0.01 * np.ptp(F), F.size)
+    rep = diagnose((t, xm, Fm), model="tangential")
+    u = rep.unexplained
+    assert u is not None and u.flagged
+    assert "series_compliance" in u.absorbing and "series_compliance" not in rep.effect_names
+    assert rep.location["withdrawn"] == list(u.absorbing)
+    assert "is not named" in u.sentence() and u.to_dict()["absorbing"] == list(u.absorbing)
