@@ -441,9 +441,10 @@ def power_table(results: list[dict[str, Any]]) -> str:
             rates = [sum(bool(r["power_flags"][i]) for r in g) for i in range(len(POWER_CHECK))]
             cells = ", ".join(f"{k:g}x {n}/{len(g)} ({100 * n / len(g):.0f} %)"
                               for k, n in zip(POWER_CHECK, rates, strict=True))  # fmt: skip
-            b = np.array([r["detectable_rms"] / (r["y_noise"] or 1.0) for r in g])
+            b = np.array([r["detectable_rms"] for r in g])
+            q = np.quantile(b, [0.1, 0.5, 0.9])
             lines.append(f"  {gen} {model:<11} {cells}")
-            lines.append(f"    bound / output noise share: median {np.median(b):.3g}")
+            lines.append(f"    bound (output units), 10/50/90 %: {q[0]:.3g} {q[1]:.3g} {q[2]:.3g}")
     return "\n".join(lines)
 
 
