@@ -642,12 +642,11 @@ BACKBONE_SHAPES = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0)
 #: the held-out t (over cycles) above which the free-form virgin curve's gain counts as
 #: structure
 BACKBONE_Z = 4.5
-#: the same where the residual has the input noise's simulated bias taken out
-#: (:func:`eiv_bias`) or the input carries no measurable noise: tuning seeds (package
-#: 410-438 and rig 1107-1197 clean, input noise 1-2 %, ac·A 1.5-5; 18 records simulated):
-#: the held-out t of clean records at most 1.05 corrected (2.6 uncorrected); visible tanh
-#: virgin curves (package 901-917, rig 1203-1221) reach 2.4-11.6, one without input noise
-#: 4.25
+#: the same where the input carries no measurable noise (no errors-in-variables bias to
+#: guard against). Tried and not kept: this z on the residual with the simulated bias taken
+#: out (:func:`eiv_bias`): on tuning seeds it held clean records' t at most 1.05 (2.6 as
+#: measured), but it also lowered tanh virgin curves' t (3 of 10), and on fresh seeds
+#: (60500-60529) it flagged 8 of 27 visible tanh records against 11 of 27
 BACKBONE_Z_CORRECTED = 3.5
 #: one-sided level of the held-out t over half-cycles (Student's t with half-cycles - 1
 #: degrees of freedom), reported as ``t_half``/``z_half`` but not tested: on tuning seeds
@@ -675,7 +674,7 @@ def backbone_misfit(
     curvatures of :data:`BACKBONE_SHAPES` and ``f(s) = s``, the residual of the final model
     is fitted on half the cycles (alternate cycles) and predicted on the other half; the
     per-cycle held-out gains give a t across cycles, flagged above ``z`` (:data:`BACKBONE_Z`;
-    :data:`BACKBONE_Z_CORRECTED` where the input noise's bias was taken out or there is none)
+    :data:`BACKBONE_Z_CORRECTED` where the input carries no measurable noise)
     (the same over half-cycles is reported as ``t_half``). A virgin curve of another shape (a
     tanh) that a named effect only partly absorbed (series compliance) shows up here even
     where its phase-binned means stay within the noise. Samples where the input's noise
