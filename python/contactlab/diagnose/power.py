@@ -708,7 +708,7 @@ def signal_input(d: Prepared) -> Prepared:
     per-record evaluation caches)."""
     if not float(d.extra.get("u_noise", 0.0) or 0.0) > 0.0 or d.t.size < 9:
         return d
-    from scipy.signal import savgol_filter
+    from .._filters import savgol_filter
 
     w = smooth_window(_fastest_period(d), SIGNAL_FRACTION, 9)
     w = min(w, d.t.size - (1 - d.t.size % 2))

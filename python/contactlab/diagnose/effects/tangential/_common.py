@@ -242,8 +242,7 @@ def smoothed_velocity(d: Prepared) -> np.ndarray:
     def make() -> np.ndarray:
         if not float(d.extra.get("u_noise", 0.0) or 0.0) > 0.0:
             return d.ud
-        from scipy.signal import savgol_filter
-
+        from ...._filters import savgol_filter
         from ..._signal import smooth_window
 
         w = smooth_window(fastest_period(d), SIGNAL_FRACTION, 7)
@@ -261,8 +260,7 @@ def smoothed_acceleration(d: Prepared) -> np.ndarray:
     def make() -> np.ndarray:
         if not float(d.extra.get("u_noise", 0.0) or 0.0) > 0.0:
             return d.udd
-        from scipy.signal import savgol_filter
-
+        from ...._filters import savgol_filter
         from ..._signal import smooth_window
 
         w = smooth_window(fastest_period(d), SIGNAL_FRACTION, 7)
