@@ -1034,6 +1034,13 @@ def main(argv=None):
     ap.add_argument("--no-measured", action="store_true")
     ap.add_argument("--measured-only", action="store_true")
     ap.add_argument("--kinds", default="tangential,normal", help="which kinds of records")
+    ap.add_argument(
+        "--effects",
+        default=None,
+        help="comma-separated effects to run (from the plan, seeds unchanged; 'clean' for "
+        "the records without an effect)",
+    )
+    ap.add_argument("--gens", default="rig,pkg", help="generators to run (rig, pkg)")
     ap.add_argument("--label", default="")
     ap.add_argument("--out", type=Path, default=None, help="also write the tables here")
     ap.add_argument("--raw", type=Path, default=None, help="write per-record results (JSON)")
@@ -1078,6 +1085,11 @@ def main(argv=None):
         return
     kinds = set(args.kinds.split(","))
     cases = [c for c in plan(mode, base, args.scale) if c["kind"] in kinds]
+    if args.effects:
+        wanted = set(args.effects.split(","))
+        cases = [c for c in cases if (c["effect"] or "clean") in wanted]
+    gens = set(args.gens.split(","))
+    cases = [c for c in cases if c["gen"] in gens]
     print(
         f"seeds: {args.seeds} base {base} ({len(cases)} records, mode {mode}, jobs {jobs})",
         flush=True,

@@ -139,6 +139,77 @@ def rig_record(model: str, seed: int, virgin: str = "exp") -> tuple[Any, dict[st
     return out, lv
 
 
+def visibility(x: np.ndarray, F: np.ndarray, x_noise: float, F_noise: float) -> dict[str, float]:
+    """How visible a tanh virgin curve is, independently of the flag: the noncentrality
+    ``λ = Σ d² / (σF² + (dF/dx)² σx²)`` of ``d``, the noise-free force minus the best
+    exponential Masing element (``lam_base``) and minus the best one in series with a
+    compliance (``lam_series``: the candidate that absorbs it), both fitted by least squares
+    to the noise-free record; ``σx``, ``σF`` the record's noise (share of each channel's
+    range), ``dF/dx`` along the noise-free path. Also the RMS of each ``d`` in N."""
+    from scipy.optimize import least_squares
+
+    from contactlab.diagnose.effects.tangential.series_compliance import series_backbone
+    from contactlab.masing import Masing
+
+    sx, sF = x_noise * float(np.ptp(x)), F_noise * float(np.ptp(F))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope = np.abs(np.gradient(F) / np.gradient(x))
+    kmax = float(np.nanpercentile(slope[np.isfinite(slope)], 99))
+    slope = np.clip(np.where(np.isfinite(slope), slope, kmax), 0, kmax)
+    V = sF**2 + (slope * sx) ** 2
+    h0g, xm = float(np.max(np.abs(F))), float(np.max(np.abs(x)))
+
+    def base(p: np.ndarray) -> np.ndarray:
+        return (Masing(p[0] * h0g, p[1] / xm).force(x) - F) / np.sqrt(V)
+
+    rb = least_squares(base, [1.0, 3.0], bounds=([1e-3, 1e-3], [10.0, 1e3]))
+
+    def series(p: np.ndarray) -> np.ndarray:
+        bx, bf = series_backbone(p[0] * h0g, p[1] / xm, p[2] * xm / h0g, xm)
+        return (Masing.from_backbone(bx, bf).force(x) - F) / np.sqrt(V)
+
+    best = None
+    for c in (0.05, 0.2, 1.0):
+        lo, hi = [1e-3, 1e-3, 0.0], [10.0, 1e4, 1e2]
+        r = least_squares(series, [rb.x[0], 2.0 * rb.x[1], c], bounds=(lo, hi))
+        if best is None or r.cost < best.cost:
+            best = r
+    return {
+        "lam_base": float(2 * rb.cost),
+        "lam_series": float(2 * best.cost),
+        "d_base_rms": float(np.sqrt(np.mean((rb.fun * np.sqrt(V)) ** 2))),
+        "d_series_rms": float(np.sqrt(np.mean((best.fun * np.sqrt(V)) ** 2))),
+    }
+
+
+def _visibility_of(gen: str, seed: int, lv: dict[str, Any]) -> dict[str, float]:
+    """:func:`visibility` of a tanh record of either generator (its noise-free channels)."""
+    if gen == "rig":
+        import sys
+        from pathlib import Path
+
+        from contactlab.synthetic.rig import rig_recording
+
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
+        from eval_diagnose_rig import draw_factors
+
+        f = draw_factors(np.random.default_rng(seed), "tangential")
+        fac = {k: f[k] for k in ("fs", "f", "cycles", "acA")}
+        rec = rig_recording({"tanh_virgin": {}}, "tangential", seed=seed, x_noise=0.0,
+                            F_noise=0.0, bits=None, **fac)  # fmt: skip
+        x, F = rec.channels["x"], rec.channels["F"]
+    else:
+        from contactlab.diagnose.scaled_masing import memory, scaled_force
+
+        rng = np.random.default_rng(seed)
+        lv0 = _levels("tangential", rng)
+        A = 1e-5
+        ac = lv0["amp"] / A
+        _, x = _excitation(A, lv0["f0"], lv0["cycles"], lv0["fs"])
+        F = scaled_force(lambda s: 50.0 * np.tanh(ac * s), 2.0, memory(x))
+    return visibility(np.asarray(x, float), np.asarray(F, float), lv["x_noise"], lv["y_noise"])
+
+
 def run_one(job: tuple[str, int, str] | tuple[str, int, str, str]) -> dict[str, Any]:
     import warnings
 
@@ -178,15 +249,26 @@ def run_one(job: tuple[str, int, str] | tuple[str, int, str, str]) -> dict[str, 
             bb_nhalf=None if u is None or u.backbone is None else u.backbone["half_cycles"],
             bb_gain=None if u is None or u.backbone is None else u.backbone["gain_over_noise_var"],
             bb_flag=bool(u is not None and u.backbone is not None and u.backbone["flagged"]),
-            tol_sweep=dict(sweep),
+            tol_sweep={k: v for k, v in sweep.items() if isinstance(k, float)},
+            detectable_rms=sweep.get("detectable_rms"),
+            power_flags=[sweep.get(f"power_{k}") for k in POWER_CHECK],
+            where=None if u is None else u.where,
+            misfit_rms=None if u is None else u.rms,
         )
     out["cpu"] = time.process_time() - t0
+    if virgin == "tanh":
+        try:
+            out.update(_visibility_of(gen, seed, lv))
+        except Exception as exc:  # a failure is a figure
+            out["visibility_error"] = str(exc)[:120]
     return out
 
 
 #: multiples of the errors-in-variables tolerance at which each record's phase-bin
 #: statistic is also computed (same residual: one diagnosis per record)
 TOL_MULTIPLES = (0.5, 1.0, 1.5, 2.0, 3.0, 4.0)
+#: multiples of the stated misfit power (``detectable_rms``) injected into each residual
+POWER_CHECK = (0.5, 1.0, 1.5)
 
 
 def _sweep_tolerance() -> dict[float, float]:
@@ -204,7 +286,19 @@ def _sweep_tolerance() -> dict[float, float]:
             u = orig(d, residual, sigma, **kw2)
             if u is not None:
                 found[k] = u.statistic / u.threshold
-        return orig(d, residual, sigma, **kw)
+        u = orig(d, residual, sigma, **kw)
+        if u is not None and u.detectable_rms:
+            # the stated power checked: a misfit locked to the phase (one sine period per
+            # branch, opposite on the two branches) of the stated RMS, added to this
+            # residual, at 0.5, 1 and 1.5 times the bound
+            br = misfit._branch_of(d)
+            shape = np.sqrt(2.0) * np.sin(2.0 * np.pi * d.cycles.phase_in_branch)
+            shape = np.where(br == 1, -shape, shape)
+            for k in POWER_CHECK:
+                v = orig(d, residual + k * u.detectable_rms * shape, sigma, **kw)
+                found[f"power_{k}"] = bool(v is not None and v.statistic > v.threshold)
+            found["detectable_rms"] = u.detectable_rms
+        return u
 
     assessment.unexplained_structure = wrapped  # type: ignore[attr-defined]
     return found
@@ -319,6 +413,41 @@ def _level(v: float, key: str) -> float:
     return float(below[-1]) if below else float(edges[0])
 
 
+#: the tanh records' groups: by ac·A (as before) and by the noncentrality of what the best
+#: exponential element (alone, or in series with a compliance) leaves (:func:`visibility`)
+VISIBLE = (
+    ("ac·A >= 1", lambda r: r["amp"] >= 1.0),
+    ("ac·A < 1", lambda r: r["amp"] < 1.0),
+    ("lam_base >= 30", lambda r: r.get("lam_base", 0.0) >= 30.0),
+    ("lam_base < 30", lambda r: r.get("lam_base", 0.0) < 30.0),
+    ("lam_series >= 30", lambda r: r.get("lam_series", 0.0) >= 30.0),
+    ("lam_series >= 100", lambda r: r.get("lam_series", 0.0) >= 100.0),
+    ("lam_series < 30", lambda r: r.get("lam_series", 0.0) < 30.0),
+)
+
+
+def power_table(results: list[dict[str, Any]]) -> str:
+    """The stated misfit power checked: share of clean records flagged once a phase-locked
+    misfit of 0.5, 1 and 1.5 times the stated ``detectable_rms`` is added to the residual."""
+    rs = [r for r in results if r.get("power_flags") and r["power_flags"][0] is not None]
+    if not rs:
+        return ""
+    lines = ["\nstated misfit power (95 %) against simulation: flagged with the misfit added"]
+    for gen in ("pkg", "rig"):
+        for model in ("tangential", "normal"):
+            g = [r for r in rs if r.get("gen", "pkg") == gen and r["model"] == model]
+            if not g:
+                continue
+            rates = [sum(bool(r["power_flags"][i]) for r in g) for i in range(len(POWER_CHECK))]
+            cells = ", ".join(f"{k:g}x {n}/{len(g)} ({100 * n / len(g):.0f} %)"
+                              for k, n in zip(POWER_CHECK, rates, strict=True))  # fmt: skip
+            b = np.array([r["detectable_rms"] for r in g])
+            q = np.quantile(b, [0.1, 0.5, 0.9])
+            lines.append(f"  {gen} {model:<11} {cells}")
+            lines.append(f"    bound (output units), 10/50/90 %: {q[0]:.3g} {q[1]:.3g} {q[2]:.3g}")
+    return "\n".join(lines)
+
+
 def tanh_table(res: list[dict[str, Any]]) -> str:
     """The tanh virgin curve's flag rate per generator, visible (ac·A >= 1) apart."""
     lines = []
@@ -329,9 +458,8 @@ def tanh_table(res: list[dict[str, Any]]) -> str:
         refused = sum(1 for r in res if r["refused"] is not None and r.get("gen", "pkg") == gen)
         f = sum(r["flagged"] for r in ok)
         lines.append(f"\ntanh virgin curve ({gen}): flagged {f}/{len(ok)} ({refused} refused)")
-        for name, sel in (("ac·A >= 1 (visible)", lambda a: a >= 1.0),
-                          ("ac·A < 1", lambda a: a < 1.0)):  # fmt: skip
-            g = [r for r in ok if sel(r["amp"])]
+        for name, sel in VISIBLE:
+            g = [r for r in ok if sel(r)]
             k = sum(r["flagged"] for r in g)
             kb = sum(bool(r.get("bins_flag")) for r in g)
             kv = sum(bool(r.get("bb_flag")) for r in g)
@@ -345,7 +473,9 @@ def tanh_table(res: list[dict[str, Any]]) -> str:
             lines.append(
                 f"  seed {r['seed']}: named {r['named']}, flagged {r['flagged']} "
                 f"(bins {r.get('bins_flag')}, T/q {_g(r.get('misfit_ratio'))}, virgin t "
-                f"{_g(bt)}, gain {_g(r.get('bb_gain'))}) (x noise {100 * r['x_noise']:.2g} %, "
+                f"{_g(bt)}, gain {_g(r.get('bb_gain'))}) lam {_g(r.get('lam_base'))}/"
+                f"{_g(r.get('lam_series'))} where {r.get('where')} "
+                f"(x noise {100 * r['x_noise']:.2g} %, "
                 f"ac·A {r['amp']:.3g}, cycles {r['cycles']}, fs {r['fs']:g})"
             )
     return "\n".join(lines)
@@ -355,7 +485,10 @@ def _g(v: Any) -> str:
     return "-" if v is None else f"{v:.3g}"
 
 
-def power_check(seeds: list[int], jobs: int) -> str:
+def power_check(
+    seeds: list[int], jobs: int, effects: tuple[str, ...] | None = None,
+    gens: tuple[str, ...] = ("pkg", "rig"),
+) -> str:  # fmt: skip
     """Calibration of the stated power (issue 29, item 2) on both generators.
 
     Per seed and generator: a clean record is diagnosed and the bound stated for each of
@@ -363,15 +496,15 @@ def power_check(seeds: list[int], jobs: int) -> str:
     record with the same factors and fresh noise, and diagnosed. Named at 1.0x should be
     near 95 % (far below: the bound is optimistic; near 100 % at both: conservative)."""
     with ProcessPoolExecutor(jobs) as ex:
-        rows = [r for rs in ex.map(_power_one, [(g, s) for g in ("pkg", "rig") for s in seeds])
-                for r in rs]  # fmt: skip
+        jobs_ = [(g, s, effects or POWER_EFFECTS) for g in gens for s in seeds]
+        rows = [r for rs in ex.map(_power_one, jobs_) for r in rs]
     lines = ["\nstated power against simulation: the effect hidden at 1.0x and 1.5x the bound"]
     lines.append(
         f"{'generator':<10}{'effect':<20}{'n':>4}{'named 1.0x':>12}{'rate':>7}"
         f"{'named 1.5x':>12}{'rate':>7}{'exact 1.0x':>12}{'no bound':>10}"
     )
-    for gen in ("pkg", "rig", "all"):
-        for eff in (*POWER_EFFECTS, "all"):
+    for gen in (*gens, "all"):
+        for eff in (*(effects or POWER_EFFECTS), "all"):
             g = [r for r in rows if gen in ("all", r["gen"]) and eff in ("all", r["effect"])]
             ok = [r for r in g if r["bound"] is not None]
             n1 = sum(r["named"][0] for r in ok)
@@ -440,7 +573,7 @@ def _power_record(gen: str, seed: int, fac: dict[str, Any], effect: str | None, 
         return contactlab.read_recording(str(rec.to_csv(Path(tmp) / "rec.csv")))
 
 
-def _power_one(job: tuple[str, int]) -> list[dict[str, Any]]:
+def _power_one(job: tuple[str, int, tuple[str, ...]]) -> list[dict[str, Any]]:
     import os
     import sys
     import warnings
@@ -449,7 +582,7 @@ def _power_one(job: tuple[str, int]) -> list[dict[str, Any]]:
     from contactlab.diagnose.workflow import diagnose
 
     warnings.simplefilter("ignore")
-    gen, seed = job
+    gen, seed, wanted = job
     if gen == "rig":
         sys.path.insert(0, str(Path(__file__).resolve().parent))
         from eval_diagnose_rig import draw_factors
@@ -464,6 +597,8 @@ def _power_one(job: tuple[str, int]) -> list[dict[str, Any]]:
     bounds = {x.effect: x for x in rep.not_detected}
     out = []
     for k, effect in enumerate(POWER_EFFECTS):
+        if effect not in wanted:
+            continue
         b = bounds.get(effect)
         r: dict[str, Any] = {"gen": gen, "seed": seed, "effect": effect, "factors": fac}
         r.update(bound=None, unit="", named=[], exact=[], names=[], gain=[], why=[])
@@ -506,6 +641,10 @@ def main() -> None:
     ap.add_argument("--rig", type=int, default=0,
                     help="clean records of the rig generator per model (and as many tanh "
                     "records with --tanh)")  # fmt: skip
+    ap.add_argument(
+        "--power-effects", default=None, help="comma-separated subset of the power check's effects"
+    )
+    ap.add_argument("--power-gens", default="pkg,rig", help="generators of the power check")
     ap.add_argument("--dump", default=None, help="write every record's result (JSON lines)")
     a = ap.parse_args()
     models = ("tangential", "normal") if a.model == "both" else (a.model,)
@@ -523,6 +662,7 @@ def main() -> None:
             for m in models:
                 print(table(results, m, gen), flush=True)
         print(calibration_table(results), flush=True)
+        print(power_table(results), flush=True)
     if a.tanh:
         jobs = [("tangential", a.seed0 + 500 + i, "tanh", "pkg") for i in range(a.tanh)]
         n_rig = min(a.rig, a.tanh)
@@ -538,7 +678,9 @@ def main() -> None:
             for r in everything:
                 fh.write(json.dumps(r, default=str) + "\n")
     if a.power:
-        print(power_check([a.seed0 + 900 + i for i in range(a.power_seeds)], a.jobs))
+        wanted = tuple(a.power_effects.split(",")) if a.power_effects else None
+        gens = tuple(a.power_gens.split(","))
+        print(power_check([a.seed0 + 900 + i for i in range(a.power_seeds)], a.jobs, wanted, gens))
     print(f"\nwall {time.time() - t0:.0f} s", flush=True)
     _ = math
 

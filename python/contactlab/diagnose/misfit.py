@@ -53,10 +53,14 @@ import numpy as np
 
 from ._family import Prepared
 from .detection import MISFIT_FALSE_ALARM
+from .eiv import eiv_bias
 
 __all__ = [
     "BINS",
     "Unexplained",
+    "backbone_misfit",
+    "detectable_rms",
+    "eiv_bias",
     "null_quantile",
     "unexplained_structure",
 ]
@@ -158,6 +162,18 @@ class Unexplained:
     profile: dict[str, Any]
     #: the flexible-backbone test (:func:`backbone_misfit`), None where it did not run
     backbone: dict[str, Any] | None = None
+    #: the stated power: the smallest RMS (over the tested bins, output units) of a misfit
+    #: locked to the phase that this record flags with probability :attr:`power`
+    #: (:func:`detectable_rms`); None where it cannot be stated
+    detectable_rms: float | None = None
+    power: float = 0.95
+    #: errors in variables: the RMS of the residual structure the input's noise alone
+    #: leaves (:func:`.eiv.eiv_bias`), subtracted before both tests; None where not simulated
+    eiv_bias_rms: float | None = None
+    #: named effects that reshape the virgin curve (:data:`SHAPE_ABSORBERS`) and still
+    #: leave this structure: each absorbed part of a misfit it does not model, and is not
+    #: named (its signature test failed)
+    absorbing: tuple[str, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         """JSON layout of ``"unexplained"`` (a contract; see the README's JSON section)."""
@@ -178,10 +194,34 @@ class Unexplained:
             "unit": self.unit,
             "profile": self.profile,
             "backbone": None if self.backbone is None else dict(self.backbone),
+            "detectable_rms": self.detectable_rms,
+            "power": self.power,
+            "eiv_bias_rms": self.eiv_bias_rms,
+            "absorbing": list(self.absorbing),
         }
 
     def sentence(self) -> str:
-        """One sentence for the report."""
+        """One sentence for the report (with the stated power, :attr:`detectable_rms`)."""
+        return self._verdict() + self._absorbed_clause() + self._power_clause()
+
+    def _absorbed_clause(self) -> str:
+        if not (self.flagged and self.absorbing):
+            return ""
+        names = ", ".join(self.absorbing)
+        return (
+            f"; {names} reshaped the virgin curve and took up part of it but leaves this "
+            "structure: it does not model it and is not named"
+        )
+
+    def _power_clause(self) -> str:
+        if self.detectable_rms is None:
+            return ""
+        return (
+            f"; a misfit locked to the phase would be flagged ({100 * self.power:.0f} % power) "
+            f"above {self.detectable_rms:.3g} {self.unit} RMS over the phase bins"
+        )
+
+    def _verdict(self) -> str:
         bb = self.backbone or {}
         if self.flagged and bb.get("flagged") and self.statistic <= self.threshold:
             return (
@@ -217,6 +257,69 @@ class Unexplained:
         )
 
 
+#: effects that reshape a Masing element's virgin curve and so absorb part of a virgin curve
+#: of another shape (a tanh): named only when no structure is left after them
+SHAPE_ABSORBERS = ("series_compliance", "position_friction")
+#: probability of flagging at which the structure test's power is stated
+MISFIT_POWER = 0.95
+#: draws of the simulated alternative in :func:`detectable_rms` (fixed seed)
+POWER_DRAWS = 4000
+
+
+def detectable_rms(
+    se: np.ndarray,
+    tol: np.ndarray,
+    m_null: int,
+    threshold: float,
+    power: float = MISFIT_POWER,
+    spread: float = 1.0,
+    pooled_cycles: int = 0,
+) -> float | None:
+    """The smallest phase-locked misfit the structure test flags with probability ``power``.
+
+    A misfit locked to the phase moves every tested bin's mean by ``a`` (either sign: the
+    RMS over the bins is ``a``); in units of the bin's standard error ``se_b`` its mean is
+    ``a/se_b + z`` (``z`` normal, variance ``spread``), its t ``(|a/se_b + z| - tol_b/se_b)₊``
+    over the scatter's own estimate ``√(χ²_ν/ν)``, ``ν = m_null - 1`` (a noncentral t with
+    the interval null; with ``pooled_cycles``, a record whose bins share one scale factor
+    estimated from few cycles, one such estimate for every bin with ``pooled_cycles - 1``
+    degrees of freedom: conservative, the factor is a median over the bins), and
+    ``T = Σ t_b²``. ``a`` is
+    found by bisection so that the ``1 - power`` quantile of ``T`` over :data:`POWER_DRAWS`
+    simulated draws (fixed seed) reaches ``threshold``. Returned in output units; None when
+    no bin has a finite standard error.
+    """
+    se = np.asarray(se, float)
+    tol = np.asarray(tol, float)
+    ok = np.isfinite(se) & (se > 0) & np.isfinite(tol)
+    if not ok.any():
+        return None
+    se, tol = se[ok], tol[ok]
+    rng = np.random.default_rng(2029 + se.size)
+    z = rng.standard_normal((POWER_DRAWS, se.size)) * math.sqrt(spread)
+    if pooled_cycles:  # one scale factor for every bin, from the pooled few-cycle scatter
+        nu = max(pooled_cycles - 1, 1)
+        s_hat = np.sqrt(rng.chisquare(nu, (POWER_DRAWS, 1)) / nu)
+    else:
+        nu = max(m_null - 1, 1)
+        s_hat = np.sqrt(rng.chisquare(nu, (POWER_DRAWS, se.size)) / nu)
+
+    def low_T(a: float) -> float:
+        mean = a / se + z  # the bin's mean in units of its standard error
+        t = np.maximum(np.abs(mean) - tol / se, 0.0) / s_hat
+        return float(np.quantile(np.sum(t * t, axis=1), 1.0 - power))
+
+    lo, hi = 0.0, float(np.max(tol)) + float(np.max(se))
+    while low_T(hi) < threshold:
+        lo, hi = hi, 2.0 * hi
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if low_T(mid) < threshold else (lo, mid)
+        if hi - lo < 1e-4 * hi:
+            break
+    return hi
+
+
 #: the input noise's reach, in units of ``σu' · |dy/du|`` per sample (:func:`eiv_tolerance`).
 #: Tuned on clean and tanh-virgin records of ``benches/eval_false_alarm.py`` (tuning seeds):
 #: without it 4 of 40 clean tangential records were flagged, all at input noise 1-2 % of the
@@ -230,10 +333,22 @@ class Unexplained:
 EIV_TOLERANCE = 0.4
 
 
-def eiv_tolerance(slope: np.ndarray | None, input_seen: float) -> np.ndarray | None:
+#: the same after the input noise's simulated bias is taken out of the residual
+#: (:func:`eiv_bias`): tuning seeds (rig generator 1107-1197 with input noise 1-1.8 % and
+#: ac·A 1.5-4.6, 12 clean records): T over the threshold at most 0.79 with the
+#: uncorrected residual and EIV_TOLERANCE, 1.23 corrected without a tolerance, 0.65
+#: corrected with 0.2; visible tanh virgin curves (rig 1203-1221) flagged 6 of 10 both ways
+EIV_TOLERANCE_CORRECTED = 0.2
+
+
+def eiv_tolerance(
+    slope: np.ndarray | None, input_seen: float, *, corrected: bool = False
+) -> np.ndarray | None:
     """How far the input's noise can move a nonlinear model's prediction, per sample:
     :data:`EIV_TOLERANCE` ``· σu' · |dy/du|`` (``σu'``: the input noise the model sees, after
-    the candidates' filter; ``|dy/du|`` the model's local slope).
+    the candidates' filter; ``|dy/du|`` the model's local slope); with ``corrected`` (the
+    residual already has the simulated bias of :func:`eiv_bias` taken out)
+    :data:`EIV_TOLERANCE_CORRECTED` instead.
 
     A model driven by a noisy input is biased where it bends: a Masing element's turning
     points are pushed outward by the noise at every reversal (by a fraction of ``σu'``),
@@ -244,7 +359,8 @@ def eiv_tolerance(slope: np.ndarray | None, input_seen: float) -> np.ndarray | N
     """
     if slope is None or not input_seen > 0:
         return None
-    return EIV_TOLERANCE * input_seen * np.abs(np.asarray(slope, float))
+    k = EIV_TOLERANCE_CORRECTED if corrected else EIV_TOLERANCE
+    return k * input_seen * np.abs(np.asarray(slope, float))
 
 
 def _branch_of(d: Prepared) -> np.ndarray:
@@ -297,6 +413,7 @@ def unexplained_structure(
     alpha: float = MISFIT_FALSE_ALARM,
     min_weight: float = MIN_WEIGHT,
     tolerance: np.ndarray | None = None,
+    power: float = MISFIT_POWER,
 ) -> Unexplained | None:
     """Test a final residual for structure over phase and branch.
 
@@ -321,6 +438,9 @@ def unexplained_structure(
         Per sample, how far the input's noise alone can move the model (errors in
         variables: :func:`eiv_tolerance`): a bin's mean counts only by what exceeds the
         bin's mean tolerance (an interval null).
+    power : float
+        Probability of flagging at which :attr:`Unexplained.detectable_rms` is stated
+        (:func:`detectable_rms`).
 
     Returns
     -------
@@ -345,7 +465,7 @@ def unexplained_structure(
     cb = _cycle_bins(d, e, w, bins)
     if cb is None:
         return None
-    full, mean_b, t_b, m_null = _bin_t(cb, bins, min_weight, tolerance)
+    full, mean_b, t_b, m_null, se_b, tol_b = _bin_t(cb, bins, min_weight, tolerance)
     nb = int(np.sum(full))
     if nb == 0:
         return None
@@ -364,6 +484,9 @@ def unexplained_structure(
     t_crit = t_quantile(1.0 - 0.5 * alpha / nb, cb.m - 1)
     where = _runs(prof_t, prof_mean, T, t_crit, bins) if flagged else []
     rng_y = float(np.ptp(d.y[np.isfinite(d.y)])) or 1.0
+    detect = detectable_rms(
+        se_b, tol_b, m_null, thr, power, pooled_cycles=cb.m if m_null != cb.m else 0
+    )
     rms = float(np.sqrt(np.mean(mean_b * mean_b)))
     peak = float(np.max(np.abs(mean_b)))
     return Unexplained(
@@ -371,6 +494,7 @@ def unexplained_structure(
         bins_tested=nb, where=where, rms=rms, peak=peak,
         rms_percent_of_range=100.0 * rms / rng_y, peak_percent_of_range=100.0 * peak / rng_y,
         rms_over_noise=rms / sigma if sigma > 0 else float("inf"), unit=unit,
+        detectable_rms=detect, power=power,
         profile={
             "bins": bins,
             "rising_mean": [_f(v) for v in prof_mean[:bins]],
@@ -426,9 +550,10 @@ def _cycle_bins(d: Prepared, e: np.ndarray, w: np.ndarray, bins: int) -> _CycleB
 
 def _bin_t(
     cb: _CycleBins, bins: int, min_weight: float, tolerance: np.ndarray | None
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
-    """``(full, mean_b, t_b, m_null)``: the bins tested, their mean over the cycles, its t,
-    and the cycles of the null (pooled scatter: more degrees of freedom)."""
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, int, np.ndarray, np.ndarray]:
+    """``(full, mean_b, t_b, m_null, se_b, tol_b)``: the bins tested, their mean over the
+    cycles, its t, the cycles of the null (pooled scatter: more degrees of freedom), the
+    standard error of each mean and the tolerance each mean must exceed (0 without one)."""
     ok, b, w, m = cb.ok, cb.b, cb.w, cb.m
     # bins every cycle fills (a cycle with too few samples per bin leaves some empty)
     full = np.sum(cb.have, axis=0) >= max(MIN_CYCLES, m - 1)
@@ -459,15 +584,18 @@ def _bin_t(
             sd_b = np.sqrt(np.maximum(kappa * v_b, 0.0))
             m_null = min((m - 1) * int(np.sum(full)) + 1, 200)
     excess = mean_b
+    tol_b = np.zeros(mean_b.size)
     if tolerance is not None:  # interval null: within the tolerance is no evidence
         tol = np.asarray(tolerance, float)[ok]
         tb = np.bincount(b[ok], w[ok] * tol, 2 * bins) / np.maximum(
             np.bincount(b[ok], w[ok], 2 * bins), 1e-300
         )
-        excess = np.sign(mean_b) * np.maximum(np.abs(mean_b) - tb[full], 0.0)
+        tol_b = tb[full]
+        excess = np.sign(mean_b) * np.maximum(np.abs(mean_b) - tol_b, 0.0)
+    se_b = sd_b / np.sqrt(np.maximum(n_b, 1))
     with np.errstate(divide="ignore", invalid="ignore"):
-        t_b = np.where(sd_b > 0, excess / (sd_b / np.sqrt(n_b)), 0.0)
-    return full, mean_b, t_b, m_null
+        t_b = np.where(sd_b > 0, excess / se_b, 0.0)
+    return full, mean_b, t_b, m_null, se_b, tol_b
 
 
 def _runs(
@@ -514,6 +642,12 @@ BACKBONE_SHAPES = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0)
 #: the held-out t (over cycles) above which the free-form virgin curve's gain counts as
 #: structure
 BACKBONE_Z = 4.5
+#: the same where the input carries no measurable noise (no errors-in-variables bias to
+#: guard against). Tried and not kept: this z on the residual with the simulated bias taken
+#: out (:func:`eiv_bias`): on tuning seeds it held clean records' t at most 1.05 (2.6 as
+#: measured), but it also lowered tanh virgin curves' t (3 of 10), and on fresh seeds
+#: (60500-60529) it flagged 8 of 27 visible tanh records against 11 of 27
+BACKBONE_Z_CORRECTED = 3.5
 #: one-sided level of the held-out t over half-cycles (Student's t with half-cycles - 1
 #: degrees of freedom), reported as ``t_half``/``z_half`` but not tested: on tuning seeds
 #: (400-449, rig 1100-1124) it flagged no clean record (0/75) and visible tanh virgin curves
@@ -531,6 +665,7 @@ def backbone_misfit(
     sigma: float,
     *,
     min_weight: float = MIN_WEIGHT,
+    z: float = BACKBONE_Z,
 ) -> dict[str, Any] | None:
     """Test a tangential residual against a free-form virgin curve (issue 29 item 3).
 
@@ -538,7 +673,8 @@ def backbone_misfit(
     ``Σ c_k`` times the force of each ``f_k``. With ``f_k(s) = 1 - exp(-k·ac·s)`` for the
     curvatures of :data:`BACKBONE_SHAPES` and ``f(s) = s``, the residual of the final model
     is fitted on half the cycles (alternate cycles) and predicted on the other half; the
-    per-cycle held-out gains give a t across cycles, flagged above :data:`BACKBONE_Z`
+    per-cycle held-out gains give a t across cycles, flagged above ``z`` (:data:`BACKBONE_Z`;
+    :data:`BACKBONE_Z_CORRECTED` where the input carries no measurable noise)
     (the same over half-cycles is reported as ``t_half``). A virgin curve of another shape (a
     tanh) that a named effect only partly absorbed (series compliance) shows up here even
     where its phase-binned means stay within the noise. Samples where the input's noise
@@ -607,9 +743,9 @@ def backbone_misfit(
         "gain_over_noise_var": gain,
         "rms": float(np.sqrt(np.mean(pred * pred))),
         "cycles": int(ids.size),
-        "z": BACKBONE_Z,
+        "z": z,
         "z_half": z_half,
         "alpha_half": BACKBONE_ALPHA,
         "min_gain": BACKBONE_MIN_GAIN,
-        "flagged": bool(t > BACKBONE_Z and gain >= BACKBONE_MIN_GAIN),
+        "flagged": bool(t > z and gain >= BACKBONE_MIN_GAIN),
     }

@@ -56,12 +56,14 @@ simulation (the effect hidden at the bound is named in about 95 % of records).
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from ._family import Family, ParamSpec, Prepared
+from ._signal import smooth_window
 from .detection import ChannelNoise, effective_variance, model_slope
 from .select import (
     FIT_SAMPLES,
@@ -120,6 +122,10 @@ class Detectable:
     gain_at_bound : float or None
         The mean held-out gain (in σ²) the linearised model expects from the effect at the
         bound (for calibration against the naming decision's actual gain).
+    note : str
+        What the record's drive means for the effect beyond the bound (the effect's
+        ``power_note``: a mass and a parallel spring are not separable on a
+        single-frequency drive); empty when nothing.
     """
 
     effect: str
@@ -132,6 +138,7 @@ class Detectable:
     per_parameter: dict[str, float | None] = field(default_factory=dict)
     reason: str = ""
     gain_at_bound: float | None = None
+    note: str = ""
 
     def to_dict(self) -> dict[str, Any]:
         """JSON layout (a contract): ``effect``, ``parameter``, ``detectable_above`` (SI,
@@ -149,12 +156,14 @@ class Detectable:
             "per_parameter": dict(self.per_parameter),
             "reason": self.reason,
             "gain_at_bound": self.gain_at_bound,
+            "note": self.note,
         }
 
     def sentence(self) -> str:
         """``"channel_delay: not detected; would be seen above 0.6 ms (tau)"``."""
+        tail = f"; {self.note}" if self.note else ""
         if self.detectable_above is None:
-            return f"{self.effect}: not detected; {self.reason}"
+            return f"{self.effect}: not detected; {self.reason}{tail}"
         v, u = _display(self.detectable_above, self.unit)
         dev = f"|{self.parameter} - {self.null:g}|" if self.null != 0.0 else f"|{self.parameter}|"
         rel = (
@@ -164,7 +173,7 @@ class Detectable:
         )
         return (
             f"{self.effect}: not detected; would be seen above {v:.2g} {u} "
-            f"({dev}{rel}; {100 * POWER:.0f} % power)"
+            f"({dev}{rel}; {100 * POWER:.0f} % power){tail}"
         )
 
 
@@ -476,6 +485,44 @@ def detectable_above(
     >>> b.unit, 0 < b.detectable_above < 1e-3
     ('s', True)
     """
+    out = _detectable(
+        family, params, effects, name, d, noise, sigma, z, gain_floor, current, folds, seed,
+        _setting_cache,
+    )  # fmt: skip
+    note = _note(family, name, d, params)
+    return dataclasses.replace(out, note=note) if note else out
+
+
+def _note(family: Family, name: str, d: Prepared, params: dict[str, float]) -> str:
+    """The effect's ``power_note`` on this record (empty when it has none)."""
+    from .effects import registry
+
+    eff = registry(getattr(family, "kind", "")).get(name)
+    how = getattr(eff, "power_note", None)
+    if how is None:
+        return ""
+    try:
+        return str(how(d, params) or "")
+    except (ValueError, KeyError, FloatingPointError):
+        return ""
+
+
+def _detectable(
+    family: Family,
+    params: dict[str, float],
+    effects: tuple[str, ...],
+    name: str,
+    d: Prepared,
+    noise: ChannelNoise,
+    sigma: float,
+    z: float,
+    gain_floor: float,
+    current: Any,
+    folds: int,
+    seed: int,
+    _setting_cache: _Setting | None,
+) -> Detectable:
+    """:func:`detectable_above` without the effect's note."""
     cand = family.candidates[name]
     shape = shape_values(family, name, params, d)
     mags = [s for s in cand.params if np.isfinite(s.null)]
@@ -586,12 +633,24 @@ def _per_parameter(
     per: dict[str, float | None] = {}
     rel: dict[str, float | None] = {}
     gain: dict[str, float | None] = {}
+    # an effect read through the input's derivatives (a mass through ẍ, a dashpot through
+    # ẋ) has its direction taken with the derivatives' noise smoothed away: the data hold
+    # the true ẍ, not the input noise differentiated twice, so only the signal's part of
+    # the direction can show in them (:func:`signal_input`)
+    derived = reads_input_derivatives(family, name)
+    ds = _effect_signal(family, name, signal_input(d)) if derived else d
+    steady = steady_samples(d) if derived else None
+    rivals = _rival_directions(family, p0, trial, name, ds, scales)
     for s in mags:
-        j = _derivative(family, p0, trial, d, s, _step(s, s.null, scales))
+        j = _derivative(family, p0, trial, ds, s, _step(s, s.null, scales))
         if not np.all(np.isfinite(j)):
             per[s.name] = rel[s.name] = gain[s.name] = None
             continue
-        jp = _project(j, jb, st.w)
+        if steady is not None:
+            j = np.where(steady, j, 0.0)
+        jp = _project(j, np.column_stack([jb, *rivals]) if rivals else jb, st.w)
+        if steady is not None:
+            jp = np.where(steady, jp, 0.0)
         ident = identified_sigmas(family, name)
         b = _bound(jp, st, ident)
         # the current model's parameters absorb a large effect beyond what the linear
@@ -601,7 +660,7 @@ def _per_parameter(
         for _ in range(NONLINEAR_STEPS if keep < NONLINEAR_BELOW else 0):
             if b is None:
                 break
-            left = _left_by_refit(family, p0, effects, name, s, b, d, st.w, jp)
+            left = _left_by_refit(family, p0, effects, name, s, b, ds, st.w, jp, steady)
             if left >= 0.9:
                 break
             jp = jp * np.sqrt(max(left, 1e-6))
@@ -613,6 +672,128 @@ def _per_parameter(
         q = float(np.sum(st.w * jp * jp) / np.sum(st.w)) / st.sigma**2
         gain[s.name] = None if b is None else b * b * q
     return per, rel, gain
+
+
+#: the window of the smoothing that takes the input noise out of the derivatives an
+#: effect's direction is read through (:func:`signal_input`), as a fraction of a period, and
+#: its polynomial degree: a local quintic over half a period passes the drive (1 - 4e-4),
+#: a block at 1.7 times its frequency (1 - 0.009) and a start-up over a cycle, and leaves
+#: of the twice-differentiated noise only what lies below a few times the drive frequency
+SIGNAL_FRACTION = 0.5
+SIGNAL_DEGREE = 5
+
+
+def reads_input_derivatives(family: Family, name: str) -> bool:
+    """Whether candidate ``name`` reads the input's derivatives (the effect's
+    ``reads_input_derivatives``: a mass through ẍ, a dashpot through ẋ)."""
+    from .effects import registry
+
+    eff = registry(getattr(family, "kind", "")).get(name)
+    return bool(getattr(eff, "reads_input_derivatives", False))
+
+
+def signal_input(d: Prepared) -> Prepared:
+    """``d`` with the input's derivatives ``ud``, ``udd`` smoothed by a local polynomial
+    (:data:`SIGNAL_DEGREE`) over :data:`SIGNAL_FRACTION` of a period (the samples are
+    uniform), when the input carries
+    noise (``d.extra["u_noise"] > 0``); ``d`` itself otherwise.
+
+    The derivatives every candidate reads are those of the measured input: twice
+    differentiated over a few samples, the input noise in ``udd`` can be a fifth of the
+    drive's own acceleration. An effect in the data acts through the true derivative, so a
+    direction taken with the noisy one credits the effect with a part (the differentiated
+    noise, which no base parameter absorbs) that the data never hold: a bound stated from
+    it is optimistic (the rig's inertia: 0 of 5 named at the bound). The smoothed copy
+    shares nothing cached with ``d`` (its ``extra`` is a shallow copy without the
+    per-record evaluation caches)."""
+    if not float(d.extra.get("u_noise", 0.0) or 0.0) > 0.0 or d.t.size < 9:
+        return d
+    from scipy.signal import savgol_filter
+
+    w = smooth_window(_fastest_period(d), SIGNAL_FRACTION, 9)
+    w = min(w, d.t.size - (1 - d.t.size % 2))
+    if w <= SIGNAL_DEGREE + 2:
+        return d
+    ud = savgol_filter(d.ud, w, SIGNAL_DEGREE, mode="interp")
+    udd = savgol_filter(d.udd, w, SIGNAL_DEGREE, mode="interp")
+    extra = {k: v for k, v in d.extra.items() if k not in ("fixed", "evaluations")}
+    return dataclasses.replace(d, ud=ud, udd=udd, extra=extra)
+
+
+def _effect_signal(family: Family, name: str, d: Prepared) -> Prepared:
+    """``d`` as the effect's own ``signal_input`` hook reads its signature in the data
+    (a mass on a single-frequency drive: ``ẍ = -ω² x`` exactly), else ``d``."""
+    from .effects import registry
+
+    eff = registry(getattr(family, "kind", "")).get(name)
+    hook = getattr(eff, "signal_input", None)
+    return d if hook is None else hook(d)
+
+
+def _fastest_period(d: Prepared) -> float:
+    """The period (samples) of the record's fastest cycles (twice the 10th percentile of
+    the half-cycles, at most the dominant period): the smoothing windows are set by it,
+    not by the dominant period, which for a drive in blocks may be the slowest block's (a
+    window of half the 0.6 f block's period took 78 % of ẋ out of the 1.7 f block)."""
+    per = float(d.cycles.period_samples)
+    half = np.diff(np.asarray(d.cycles.reversals))
+    if half.size >= 4:
+        per = min(per, 2.0 * float(np.percentile(half, 10)))
+    return max(per, 1.0)
+
+
+def steady_samples(d: Prepared) -> np.ndarray:
+    """The samples whose input derivatives the data can pin down: from the second cycle on
+    (``d.cycles.cycle >= 1``) and short of the last half window of :func:`signal_input`.
+
+    The start from rest carries the actuator's own transient, whose ẍ (at the servo's
+    frequency, many times the drive's) no derivative of the noisy input resolves: on the rig
+    the model's ẍ there was off by the true ẍ's own size, and a bound counting the start-up
+    promised 6x the gain a mass gave (tuning seed 1407). The smoothing's last half window
+    is an extrapolation."""
+    keep = d.cycles.cycle >= 1
+    w = smooth_window(_fastest_period(d), SIGNAL_FRACTION, 9)
+    tail = min(w // 2, keep.size)
+    if tail:
+        keep = keep.copy()
+        keep[keep.size - tail :] = False
+    return keep
+
+
+def _rival_directions(
+    family: Family,
+    p0: dict[str, float],
+    trial: tuple[str, ...],
+    name: str,
+    d: Prepared,
+    scales: dict[str, float],
+) -> list[np.ndarray]:
+    """The directions of the candidates that compete with ``name`` for the same signature
+    (the effect's ``rivals``: series compliance softens the turns as a mass does on a
+    single-frequency drive), each magnitude parameter's derivative at its "absent" value
+    (one-sided where the range is): to be named, the effect must show beyond what a rival
+    would take of it."""
+    from ..errors import ContactLabError
+    from .effects import registry
+
+    eff = registry(getattr(family, "kind", "")).get(name)
+    out = []
+    for rival in getattr(eff, "rivals", ()):
+        if rival in trial or rival not in family.candidates:
+            continue
+        with_rival = (*trial, rival)
+        if not family.check(with_rival):
+            continue
+        specs = [q for q in family.candidates[rival].params if np.isfinite(q.null)]
+        p = {**shape_values(family, rival, p0, d), **p0, **{q.name: q.null for q in specs}}
+        for q in specs:
+            try:
+                j = _derivative(family, p, with_rival, d, q, _step(q, q.null, scales))
+            except (ContactLabError, ValueError, FloatingPointError, KeyError):
+                continue
+            if np.all(np.isfinite(j)) and np.any(j != 0):
+                out.append(j)
+    return out
 
 
 #: the nonlinear check of :func:`_left_by_refit` runs where the linear projection keeps less
@@ -632,12 +813,13 @@ def _left_by_refit(
     d: Prepared,
     w: np.ndarray,
     jp: np.ndarray,
+    rows: np.ndarray | None = None,
 ) -> float:
     """The share of the linearised effect ``b · jp`` (weighted squares) that the current
     model, refitted to its own prediction with the effect at size ``b`` (noise-free), still
-    leaves; 1 when the refit fails."""
-    import dataclasses
-
+    leaves; 1 when the refit fails. ``rows``: the samples the refit and the share are taken
+    on (default all; :func:`steady_samples` for an effect read through the input's
+    derivatives, whose start-up the bound leaves out)."""
     from ..errors import ContactLabError
     from .select import fit
 
@@ -647,13 +829,14 @@ def _left_by_refit(
     extra = {k: v for k, v in d.extra.items() if k != "evaluations"}
     dd = dataclasses.replace(d, y=target, extra=extra)
     start = {q.name: p0[q.name] for q in specs_for(family, effects) if q.name in p0}
+    mask = np.ones(d.y.size, bool) if rows is None else np.asarray(rows, bool)
     try:
-        out = fit(family, effects, dd, np.ones(d.y.size, bool), start, family.scales(d))
+        out = fit(family, effects, dd, mask, start, family.scales(d))
         r = target - family.predict(out.params, effects, dd)
     except (ContactLabError, ValueError, FloatingPointError, np.linalg.LinAlgError):
         return 1.0
-    lin = b * b * float(np.sum(w * jp * jp))
-    ok = np.isfinite(r)
+    lin = b * b * float(np.sum((w * jp * jp)[mask]))
+    ok = np.isfinite(r) & mask
     return float(np.sum((w * r * r)[ok]) / lin) if lin > 0 and ok.any() else 1.0
 
 

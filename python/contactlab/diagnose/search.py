@@ -41,12 +41,18 @@ def _takes_over(
     p: dict[str, float],
     effects: tuple[str, ...] = (),
     explains: float = 1.0,
+    regime: str | None = None,
 ) -> str | None:
     """Why the model moves a base parameter that carries the joint's physics by more than
     :data:`MAX_BASE_SHIFT` (more when the model leaves only the share ``explains`` of the
     current misfit: :data:`MAX_BASE_SHIFT_EXPLAINED`, :data:`MAX_BASE_SHIFT_MOSTLY`), or
     None. An effect that rescales the base (a branch scale makes
-    the loop's height ``λ h0 / 2``) is compared by its equivalent of the base parameter."""
+    the loop's height ``λ h0 / 2``) is compared by its equivalent of the base parameter.
+
+    In pre-sliding (``regime``, as analyze decides it) a tangential loop never reaches its
+    plateau and shows its initial stiffness ``h0·ac`` and curvature, not ``h0``: the anchor
+    is then ``h0·ac`` (a dashpot's loop area, read by the base as curvature, moved h0 from
+    27.6 to 40 N, its true value, at an unchanged stiffness: rig tuning seeds 1402-1408)."""
     from .effects import registry
 
     reg = registry(family.kind)
@@ -57,7 +63,12 @@ def _takes_over(
     limit = MAX_BASE_SHIFT
     if explains <= EXPLAINED_SHARE:
         limit = MAX_BASE_SHIFT_MOSTLY if explains <= MOSTLY_SHARE else MAX_BASE_SHIFT_EXPLAINED
-    for name in _ANCHORS.get(family.kind, ()):
+    anchors = _ANCHORS.get(family.kind, ())
+    if regime == "pre-sliding" and family.kind == "tangential" and "ac" in base:
+        anchors = ("h0·ac",)
+        base = {**base, "h0·ac": base["h0"] * base["ac"]}
+        equivalent["h0·ac"] = equivalent["h0"] * equivalent["ac"]
+    for name in anchors:
         b, v = base[name], equivalent[name]
         if b > 0 and abs(v / b - 1.0) > limit:
             return (
@@ -159,7 +170,10 @@ def _try_candidate(
     # effect added before to the edge of its physical range
     why = next(
         (w for e in trial_effects if (w := family.implausible(e, p, d))), None
-    ) or _takes_over(family, base_fit, p, trial_effects, _explains(current, cand, sigma))
+    ) or _takes_over(
+        family, base_fit, p, trial_effects, _explains(current, cand, sigma),
+        regime=(d.extra.get("regime_info") or {}).get("name"),
+    )  # fmt: skip
     if v.accepted and why:
         v = dataclasses.replace(v, accepted=False, reason=f"implausible: {why}")
     if v.accepted and hasattr(family, "identified"):
@@ -504,6 +518,7 @@ class StepwiseSearch:
         # the budget spent for is run here after all if the serial count says it would be
         verdicts: list[Verdict] = []
         best = None
+        accepted: list[tuple[Verdict, Trial]] = []
         outs = pmap(unless_spent, tried, cost=partial(_fit_cost, self.family))
         for name, out in zip(tried, outs, strict=True):
             if st.used >= limit:
@@ -516,6 +531,9 @@ class StepwiseSearch:
             verdicts.append(v)
             if cand is not None and v.accepted and (best is None or v.gain > best[0].gain):
                 best = (v, cand)
+            if cand is not None and v.accepted:
+                accepted.append((v, cand))
+        best = _parsimonious(best, accepted)
         if verdicts:
             st.steps[-1] = dataclasses.replace(
                 st.steps[-1], candidates=tuple(sorted(verdicts, key=lambda v: v.heldout_rms))
@@ -623,8 +641,9 @@ class StepwiseSearch:
         st.where.append(f"{what}: {v.name} dropped ({why})")
 
     def parsimony(self, st: SearchState) -> None:
-        """Effects that act through the same signal (``acts_through``: the velocity for a
-        delay, viscous damping, Stribeck friction, inertia, pre-sliding damping) are named
+        """Effects that act through the same signal (``acts_through``, one name or several: the
+        velocity for a delay, viscous damping, Stribeck friction, inertia, pre-sliding damping;
+        the friction along the branch for Stribeck, position friction and stick-slip) are named
         together only when each is separately significant after the others at
         :data:`PARSIMONY_Z` times the search's threshold (each one's gain, refitted without
         it, must stand on its own, not on a misfit the others share). The weakest is
@@ -632,13 +651,16 @@ class StepwiseSearch:
         from .effects import registry
 
         reg = registry(self.family.kind)
+        settled: set[tuple[str, ...]] = set()  # groups whose members all stood on their own
         while st.used < _max_evaluations():
             groups: dict[str, list[str]] = {}
             for e in st.added:
                 g = reg[e].acts_through if e in reg else None
-                if g:
-                    groups.setdefault(g, []).append(e)
-            shared = [(g, es) for g, es in groups.items() if len(es) >= 2]
+                for one in (g,) if isinstance(g, str) else g or ():
+                    groups.setdefault(one, []).append(e)
+            shared = [
+                (g, es) for g, es in groups.items() if len(es) >= 2 and (g, *es) not in settled
+            ]
             if not shared:
                 return
             group, members = shared[0]
@@ -657,11 +679,38 @@ class StepwiseSearch:
                     f"(t = {', '.join(f'{v.t_stat:.1f}' for v, _ in checks)}, threshold "
                     f"{PARSIMONY_Z * self.z:g}): named together"
                 )
-                return
+                settled.add((group, *members))
+                continue
             v, st.current = min(weak, key=lambda vr: vr[0].gain)
             others = ", ".join(m for m in members if m != v.name)
             self._drop(st, v, "parsimony", f"it acts through the {group} as {others} does, and "
                        f"is not separately significant after it: {v.reason}")  # fmt: skip
+
+
+#: accepted candidates whose held-out gains lie within this share of the best one's are a
+#: tie the held-out error cannot break: the one with the lowest BIC (fewest parameters for
+#: the same fit) is added (:func:`_parsimonious`)
+TIE_SHARE = 0.02
+
+
+def _parsimonious(
+    best: tuple[Verdict, Trial] | None, accepted: list[tuple[Verdict, Trial]]
+) -> tuple[Verdict, Trial] | None:
+    """Of the accepted candidates whose held-out gain is within :data:`TIE_SHARE` of the
+    best's, the one with the lowest ``delta_bic`` (``best`` when alone).
+
+    A viscous term and a normal-load fluctuation at twice the drive frequency draw nearly
+    the same force in gross sliding (both the friction's sign times a bump at mid-stroke,
+    docs/effects.md): the held-out gains tie to 0.2 % (rig, tuning seed 1044) and the
+    three-parameter fluctuation won by chance; with equal fits the one-parameter effect is
+    the simpler reading."""
+    if best is None or len(accepted) < 2:
+        return best
+    floor = best[0].gain * (1.0 - TIE_SHARE)
+    tied = [vc for vc in accepted if vc[0].gain >= floor and np.isfinite(vc[0].delta_bic)]
+    if len(tied) < 2:
+        return best
+    return min(tied, key=lambda vc: vc[0].delta_bic)
 
 
 #: the parsimony rule's threshold on the t statistic, in units of the search's ``z``

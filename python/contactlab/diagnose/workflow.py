@@ -281,6 +281,10 @@ def diagnose(
     report.channel_noise = checks["noise"]
     report.not_detected = checks["not_detected"]
     report.unexplained = checks["unexplained"]
+    absorbing = getattr(report.unexplained, "absorbing", ())
+    if absorbing:  # issue 29: an effect whose own signature test failed is not named
+        report.effects = [e for e in report.effects if e.name not in absorbing]
+        report.location["withdrawn"] = list(absorbing)
     return report
 
 

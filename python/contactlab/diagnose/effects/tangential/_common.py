@@ -187,3 +187,86 @@ def delay_support(d: Prepared, at: np.ndarray, tau: float) -> np.ndarray:
     rows = np.flatnonzero(need)
     rows_memo[key] = (at, rows)
     return rows
+
+
+#: the share of the input's (smoothed) acceleration outside the start-up that ``-ω² x`` may
+#: leave for the drive to count as a single frequency (:func:`single_frequency`): the rig's
+#: servo-driven sine leaves 0.2-1.3 %, the package's three-block drive half
+SINGLE_FREQUENCY_SHARE = 0.05
+#: window of the smoothing of ``ẍ`` (:func:`smoothed_acceleration`), as a fraction of the
+#: fastest cycles' period (:func:`fastest_period`): a local cubic over 15 % of a period
+#: passes them to 2e-4 and cuts the twice-differentiated noise of the 8 % window ``udd``
+#: is taken over by about 6x in power
+SIGNAL_FRACTION = 0.15
+
+
+def single_frequency(d: Prepared) -> tuple[float, float] | None:
+    """``(ω², share)`` when the drive is one sine (outside the start-up, the first cycle
+    and what precedes it: ``ẍ = -ω² x`` but for a ``share`` below
+    :data:`SINGLE_FREQUENCY_SHARE` of ``ẍ``'s power, ``ẍ`` from
+    :func:`smoothed_acceleration`), else None.
+
+    On such a drive a force in ``ẍ`` (a mass) and one in ``x`` (a spring) are the same
+    signature, ``m ẍ = -mω² x``: the record sets ``k_p - mω²`` only, and the contact's
+    own stiffness absorbs either in pre-sliding (docs/effects.md, inertia)."""
+    keep = d.cycles.cycle >= 1
+    if np.count_nonzero(keep) < 16 or d.t.size < 9:
+        return None
+    acc = smoothed_acceleration(d)[keep]
+    x = d.u[keep] - float(np.mean(d.u[keep]))
+    xx, aa = float(np.dot(x, x)), float(np.dot(acc, acc))
+    if not (xx > 0 and aa > 0):
+        return None
+    c = float(np.dot(acc, x)) / xx
+    share = float(np.dot(acc - c * x, acc - c * x)) / aa
+    if c >= 0 or share > SINGLE_FREQUENCY_SHARE:
+        return None
+    return -c, share
+
+
+def fastest_period(d: Prepared) -> float:
+    """The period (samples) of the record's fastest cycles: twice the 10th percentile of the
+    half-cycles between reversals, at most the dominant period (a drive in blocks of
+    several frequencies: its dominant period may be the slowest block's)."""
+    per = float(d.cycles.period_samples)
+    half = np.diff(np.asarray(d.cycles.reversals))
+    if half.size >= 4:
+        per = min(per, 2.0 * float(np.percentile(half, 10)))
+    return max(per, 1.0)
+
+
+def smoothed_velocity(d: Prepared) -> np.ndarray:
+    """``ẋ`` of the input smoothed as :func:`smoothed_acceleration` smooths ``ẍ`` (``d.ud``
+    itself when the input carries no noise), kept per record."""
+
+    def make() -> np.ndarray:
+        if not float(d.extra.get("u_noise", 0.0) or 0.0) > 0.0:
+            return d.ud
+        from scipy.signal import savgol_filter
+
+        from ..._signal import smooth_window
+
+        w = smooth_window(fastest_period(d), SIGNAL_FRACTION, 7)
+        w = min(w, d.t.size - (1 - d.t.size % 2))
+        return savgol_filter(d.ud, w, 3, mode="interp") if w >= 5 else d.ud
+
+    return fixed(d, "smoothed_velocity", make)
+
+
+def smoothed_acceleration(d: Prepared) -> np.ndarray:
+    """``ẍ`` of the input smoothed by a local cubic over :data:`SIGNAL_FRACTION` of a
+    period (the twice differentiated input noise taken out) when the input carries noise
+    (``d.extra["u_noise"] > 0``; ``d.udd`` itself otherwise), kept per record."""
+
+    def make() -> np.ndarray:
+        if not float(d.extra.get("u_noise", 0.0) or 0.0) > 0.0:
+            return d.udd
+        from scipy.signal import savgol_filter
+
+        from ..._signal import smooth_window
+
+        w = smooth_window(fastest_period(d), SIGNAL_FRACTION, 7)
+        w = min(w, d.t.size - (1 - d.t.size % 2))
+        return savgol_filter(d.udd, w, 3, mode="interp") if w >= 5 else d.udd
+
+    return fixed(d, "smoothed_acceleration", make)

@@ -6,7 +6,7 @@ import numpy as np
 
 from ..._family import ParamSpec
 from .._base import EffectModel, register
-from ._common import amplitude
+from ._common import amplitude, single_frequency
 
 
 @register
@@ -30,8 +30,27 @@ class ParallelStiffness(EffectModel):
     def argument(self, d, p):
         a = amplitude(d)
         h0 = p.get("h0", np.nan)
-        return (
+        text = (
             f"k_p = {p['k_p']:.4g} N/m tilts the plateaus by {p['k_p'] * a:.3g} N at the "
             f"stroke's end ({100 * p['k_p'] * a / h0:.0f} % of h0 = {h0:.4g} N): a spring "
             "beside the contact"
+        )
+        one = single_frequency(d)
+        if one is not None:
+            w2 = one[0]
+            text += (
+                f"; on this single-frequency drive (ω = {np.sqrt(w2):.4g} rad/s) a mass m "
+                "would act as the stiffness -mω² and the two are not separable: the record "
+                f"sets k_p - mω² = {p['k_p']:.4g} N/m; a positive value cannot be a mass"
+            )
+        return text
+
+    def power_note(self, d, p):
+        """What a single-frequency drive means for the stated bound (empty otherwise)."""
+        one = single_frequency(d)
+        if one is None:
+            return ""
+        return (
+            "parallel stiffness and inertia are not separable on this single-frequency drive "
+            f"(ω = {np.sqrt(one[0]):.4g} rad/s): the record sets k_p - mω² only"
         )

@@ -407,6 +407,8 @@ impl Pass {
             }
         };
         let (mut ta, mut tb) = reload(self.n, stk);
+        // The force of the first sample's candidate (the sample before the block).
+        stk[self.n].h = h_before;
         let m = xc.len().min(BLOCK);
         let (u, idx, kh, mm) = (
             &mut d.u[..m],
@@ -441,12 +443,12 @@ impl Pass {
                 continue;
             }
             let rev = rising != up;
-            // Candidate reversal: the previous sample (its force deferred for p > 0).
-            stk[n] = Reversal {
-                x: xp,
-                h: h_before,
-                index: before.wrapping_add(p as u64),
-            };
+            // Candidate reversal: the previous sample. Its force is deferred for p > 0 (the
+            // placeholder is never read: the index names the in-block sample, and
+            // `end_block` writes the force), so only the input and the index are written;
+            // for p = 0 the force `h_before` was written at the block's start.
+            let cand = &mut stk[n];
+            (cand.x, cand.index) = (xp, before.wrapping_add(p as u64));
             // in 2..stk.len()
             let n1 = n.wrapping_add(usize::from(rev));
             // The target stk[n1 - 2].x: the top's input after a reversal, else the one below.
