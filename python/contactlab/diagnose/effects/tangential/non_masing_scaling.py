@@ -8,6 +8,7 @@ import numpy as np
 from ..._family import ParamSpec
 from .._base import EffectModel, Plausibility, register
 from ._common import actual_turns, record_turns, turning_points  # noqa: F401  (re-exported)
+from ._first_loading import start_tells, unexplained_start
 
 #: the branch scales :meth:`NonMasingScaling.start` tries (λ = 2 is Masing)
 START_GRID = (0.6, 0.8, 1.0, 1.2, 1.35, 1.5, 1.65, 1.8, 2.0, 2.3, 2.7, 3.2, 4.0, 5.0, 6.5)
@@ -34,6 +35,23 @@ def turning_point_force(virgin, lam: float, x: np.ndarray, rev: np.ndarray) -> n
     on = k >= 0
     kk = np.where(on, k, 0)
     return np.where(on, hr[kk] + lam * virgin((x - xr[kk]) / lam), virgin(x))
+
+
+def loop_shift(p: dict[str, float], d) -> float:
+    """The constant force by which the fitted λ-scaled element's closed loops sit off the
+    Masing loops of ``(λ h0 / 2, 2 ac / λ)`` after the first turning point (the median over
+    the record; one amplitude: exactly ``f(A) - λ f(2A/λ)/2``, docs/effects.md), N."""
+    from ....masing import Masing
+
+    x = d.u - p.get("x0", 0.0)
+    turns = record_turns(d.u, d.extra.get("u_noise", 0.0))
+    if turns.size == 0:
+        return float("nan")
+    lam, h0, ac = p["lam"], p["h0"], p["ac"]
+    g = turning_point_force(Masing(h0, ac).virgin, lam, x, turns)
+    gm = Masing(h0 * lam / 2.0, 2.0 * ac / lam).force(x)
+    k = int(turns[0])
+    return float(np.median(g[k:] - gm[k:]))
 
 
 @register
@@ -94,11 +112,26 @@ class NonMasingScaling(EffectModel):
         return {"h0": p["h0"] * p["lam"] / 2.0, "ac": 2.0 * p["ac"] / p["lam"]}
 
     def plausible(self, d, p):
+        """The shared rules, λ within 0.5..8, and the first loading from rest explained
+        (:func:`~._first_loading.unexplained_start`): the loop shift a branch scale draws
+        appears with the motion, so a record whose force is already off by it at rest (a
+        force offset) or whose contact rests off the sensor's zero (a displacement offset:
+        the model's virgin curve then starts with a jump) is refused with that reason; and
+        told from a force offset by that start (:func:`~._first_loading.start_tells`: a
+        start too noisy to tell leaves the simpler reading, a sensor's zero). Beside a
+        force offset (``F0`` in the model) the start is the offset's to explain."""
         base = super().plausible(d, p)
         if base.ok and not 0.5 <= p["lam"] <= 8.0:
             return Plausibility(
                 False, f"branch scale lam = {p['lam']:.3g} is outside 0.5..8 (no known joint)"
             )
+        if base.ok and "F0" not in p:
+            shift, what = loop_shift(p, d), f"λ = {p['lam']:.3g}"
+            why = unexplained_start(p, d, shift, what) or start_tells(
+                p, d, shift, what, "a force offset", self.IDENTIFIED_SIGMAS
+            )
+            if why:
+                return Plausibility(False, why)
         return base
 
     def argument(self, d, p):

@@ -27,6 +27,11 @@ class ParameterDrift(EffectModel):
     rank = 1
     order = 10
     size_param = "beta"
+    #: a slow factor in time on the element's force: no noise of the input feeds its fit
+    #: (the noise is white in time, the factor a straight line over the record), so it
+    #: need not beat the input-noise budget of the search (search._noise_floor); the
+    #: held-out rules across cycles (t > z, BIC, the gain floor) still apply
+    input_noise_gain = False
 
     def apply(self, h, p, ctx):
         return h * (1.0 + p["beta"] * (ctx.t_rel / ctx.d.duration - 0.5))
