@@ -128,7 +128,16 @@ def job(spec: dict) -> dict:
         tmp = Path(tmp)
         if label in MISFITS:
             rec = tangential_record(seed, label)
-            twin, info = None, {}
+            twin = None
+            from visibility import THRESHOLD, tangential_visibility
+
+            lam_d, lam_i, near, _ = tangential_visibility(rec.ideal, rec.truth, label)
+            info = {
+                "lam_detect": lam_d,
+                "lam_identify": lam_i,
+                "nearest": near,
+                "visible_own": bool(lam_i >= THRESHOLD),
+            }
         else:
             twin, rec, info = make_pair(kind, label, seed, spec["size_class"], rng)
         gen_cpu = time.process_time() - t0
@@ -506,8 +515,11 @@ def tables(results: list[dict], header: str) -> str:
     if mis:
         L.append("### Unnameable misfits (tangential)")
         L.append("")
-        L.append("| misfit | n | flagged 'systematic misfit' | nothing named | named (counts) |")
-        L.append("|---|---|---|---|---|")
+        L.append(
+            "| misfit | n | flagged 'systematic misfit' | visible vs base: n, flagged | "
+            "visible (own): n, flagged | nothing named | named (counts) |"
+        )
+        L.append("|---|---|---|---|---|---|---|")
         for m in MISFITS:
             g = [r for r in mis if r["label"] == m]
             if not g:
@@ -515,12 +527,31 @@ def tables(results: list[dict], header: str) -> str:
             fl = sum(r["rec"]["flagged"] for r in g)
             nothing = sum(not r["rec"]["named"] for r in g)
             names = Counter(n for r in g for n in r["rec"]["named"])
+            vis = [r for r in g if r["info"].get("visible_own")]
+            vfl = sum(r["rec"]["flagged"] for r in vis)
+            vb = [r for r in g if r["info"].get("lam_detect", 0) >= 44.8]
+            vbf = sum(r["rec"]["flagged"] for r in vb)
             L.append(
-                f"| {m} | {len(g)} | {_pct(fl, len(g))} | {nothing} | "
+                f"| {m} | {len(g)} | {_pct(fl, len(g))} | {len(vb)}, {vbf} | {len(vis)}, {vfl} "
+                f"| {nothing} | "
                 f"{', '.join(f'{k} {v}' for k, v in names.most_common()) or '–'} |"
             )
         fl = sum(r["rec"]["flagged"] for r in mis)
-        L.append(f"| **total** | {len(mis)} | {_pct(fl, len(mis))} | | |")
+        vis = [r for r in mis if r["info"].get("visible_own")]
+        vfl = sum(r["rec"]["flagged"] for r in vis)
+        vb = [r for r in mis if r["info"].get("lam_detect", 0) >= 44.8]
+        vbf = sum(r["rec"]["flagged"] for r in vb)
+        L.append(
+            f"| **total** | {len(mis)} | {_pct(fl, len(mis))} | {len(vb)}, {_pct(vbf, len(vb))} | "
+            f"{len(vis)}, {_pct(vfl, len(vis))} | | |"
+        )
+        L.append("")
+        L.append(
+            "Visible vs base: the weighted residual of the noise-free misfit after refitting the "
+            "base (h0, ac) is >= 44.8 noise variances; visible (own): also after projecting off "
+            "the nearest candidate's linearised direction (a misfit one candidate absorbs to "
+            "within the noise cannot be told from that candidate)."
+        )
         L.append("")
     return "\n".join(L)
 
