@@ -212,6 +212,22 @@ def visible_by_bound(r: dict) -> bool:
     return False
 
 
+def _bound_over_own(r: dict) -> float | None:
+    """Diagnose's bound / the size at which lam_identify reaches the threshold (linear)."""
+    b, info = r.get("bound"), r.get("info", {})
+    lam = info.get("lam_identify")
+    if not b or b.get("detectable_above") is None or not lam or lam <= 0:
+        return None
+    k = math.sqrt(44.8 / lam)
+    label = r["label"]
+    if label in SAME_UNITS:
+        m = abs(SAME_UNITS[label][1](r["params"], r["truth"]))
+        return b["detectable_above"] / (m * k) if m else None
+    if b.get("relative_size") and b.get("true_relative_change"):
+        return b["relative_size"] / (b["true_relative_change"] * k)
+    return None
+
+
 def _truth_factors(T: dict, kind: str) -> dict:
     keys = ["fs", "f", "cycles", "noise_x", "noise_y"]
     f = {k: T[k] for k in keys}
@@ -436,6 +452,18 @@ def tables(results: list[dict], header: str) -> str:
             f"{tot['inv']['n']}, {tot['inv']['wrong']} | |"
         )
         L.append("")
+        # diagnose's stated bound against the size the independent criterion calls visible
+        ratio_rows = []
+        for e in sorted({r["label"] for r in rs}):
+            q = [x for x in (_bound_over_own(r) for r in rs if r["label"] == e) if x is not None]
+            if q:
+                ratio_rows.append(f"{e} {np.median(q):.2g} ({min(q):.2g}-{max(q):.2g})")
+        if ratio_rows:
+            L.append(
+                "Bound stated on the clean twin over the size the independent criterion needs "
+                "(lam_identify = 44.8), median (range): " + "; ".join(ratio_rows) + "."
+            )
+            L.append("")
         # agreement of the two visibility judgements
         agree = Counter(
             (bool(r["info"].get("visible_own")), bool(r.get("visible_bound"))) for r in rs
