@@ -12,12 +12,23 @@ round:
   start-up, reading, the windows on the default helper threads, pooling, the JSON), wall time
   and CPU time (user + system of the process and its threads, ``os.wait4``);
 - ``read``: :func:`contactlab.io.read_chunks` over the file alone (a new process), the floor
-  the reading sets.
+  the reading sets;
+- ``analyze, one core``: the same command pinned to one CPU (``sched_setaffinity``: the
+  reader, the structure scan and the window threads share it), the single-core figure;
+  the ``analyze`` row uses every core the machine gives it (default helper threads).
 
-Throughput = samples / median wall time; the ratio analyze / kernel is the figure. The JSON of
-every analyze round is compared byte for byte with the first (the windows are deterministic).
+Throughput = samples / median wall time; the ratio analyze / kernel is the figure (the kernel
+is single-threaded in both). The note also gives the ratio of samples per CPU-second (the
+kernel's thread time against the command's user + system time): on a loaded machine the
+wall times of both stretch with the load, the CPU times much less. The JSON of every
+analyze round is compared byte for byte with the first (the windows are deterministic).
+``--baseline DIR`` also runs another tree's package (``PYTHONPATH=DIR``, e.g. a ``git
+archive`` of an older commit's ``python/`` with its built ``_core`` copied in) in the same
+interleaved rounds: before/after rows from one run, and whether its JSON is byte for byte
+ours.
 
-Run: ``nice .venv/bin/python benches/bench_analyze.py [--samples 1e7 3e7] [--rounds 5]``.
+Run: ``nice .venv/bin/python benches/bench_analyze.py [--samples 1e7 3e7] [--rounds 5]
+[--baseline DIR]``.
 """
 
 from __future__ import annotations
@@ -43,10 +54,19 @@ READ = (
 )
 
 
-def child(cmd: list[str]) -> tuple[float, float]:
-    """Wall and CPU seconds of a child process (which must succeed)."""
+def child(
+    cmd: list[str], env: dict[str, str] | None = None, cpu: int | None = None
+) -> tuple[float, float]:
+    """Wall and CPU seconds of a child process (which must succeed); ``cpu``: pinned to it."""
+
+    def pin() -> None:
+        if cpu is not None:
+            os.sched_setaffinity(0, {cpu})
+
     t0 = time.perf_counter()
-    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    p = subprocess.Popen(
+        cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env, preexec_fn=pin
+    )
     err = p.stderr.read() if p.stderr is not None else b""
     _, status, usage = os.wait4(p.pid, 0)
     wall = time.perf_counter() - t0
@@ -55,7 +75,17 @@ def child(cmd: list[str]) -> tuple[float, float]:
     return wall, usage.ru_utime + usage.ru_stime
 
 
-def measure(path: Path, n: int, rounds: int, tmp: Path) -> dict[str, float]:
+def _one_cpu() -> int | None:
+    """A CPU this process may run on (for the one-core rows), None without affinity."""
+    try:
+        return min(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        return None
+
+
+def measure(
+    path: Path, n: int, rounds: int, tmp: Path, baseline: Path | None = None
+) -> dict[str, float]:
     import h5py
 
     import contactlab
@@ -65,37 +95,54 @@ def measure(path: Path, n: int, rounds: int, tmp: Path) -> dict[str, float]:
     m = contactlab.Masing(h0=bench_track.H0, ac=bench_track.AC)
     buf = np.empty_like(x)
     exe = str(Path(sys.executable).with_name("contactlab"))
-    times: dict[str, list[float]] = {"kernel": [], "analyze": [], "analyze_cpu": [], "read": []}
-    outputs: list[bytes] = []
+    cpu = _one_cpu()
+    times: dict[str, list[float]] = {"kernel": [], "kernel_cpu": [], "read": []}
+    outputs: dict[str, list[bytes]] = {}
 
     def kernel() -> None:
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.thread_time()
         m.force(x, out=buf)
         times["kernel"].append(time.perf_counter() - t0)
+        times["kernel_cpu"].append(time.thread_time() - c0)
 
-    def analyze() -> None:
-        out = tmp / f"a{len(outputs)}.json"
-        w, c = child([exe, "analyze", str(path), "--json", str(out)])
-        times["analyze"].append(w)
-        times["analyze_cpu"].append(c)
-        outputs.append(out.read_bytes())
+    def analyze(label: str, env: dict[str, str] | None, pin: int | None) -> None:
+        got = outputs.setdefault(label, [])
+        out = tmp / f"{label}{len(got)}.json"
+        w, c = child([exe, "analyze", str(path), "--json", str(out)], env, pin)
+        times.setdefault(label, []).append(w)
+        times.setdefault(f"{label}_cpu", []).append(c)
+        got.append(out.read_bytes())
         out.unlink()
 
     def read() -> None:
         times["read"].append(child([sys.executable, "-c", READ, str(path)])[0])
 
+    steps = [
+        kernel,
+        lambda: analyze("analyze", None, None),
+        lambda: analyze("analyze_1", None, cpu),
+        read,
+    ]
+    if baseline is not None:
+        env = {**os.environ, "PYTHONPATH": str(baseline)}
+        steps += [
+            lambda: analyze("before", env, None),
+            lambda: analyze("before_1", env, cpu),
+        ]
     m.force(x, out=buf)  # warm-up
-    steps = [kernel, analyze, read]
+    k = len(steps)
     for r in range(rounds):
-        for f in steps[r % 3 :] + steps[: r % 3]:
+        for f in steps[r % k :] + steps[: r % k]:
             f()
-    same = all(o == outputs[0] for o in outputs)
-    med = {k: float(np.median(v)) for k, v in times.items()}
-    med["same_json"] = float(same)
+    first = outputs["analyze"][0]
+    med = {key: float(np.median(v)) for key, v in times.items()}
+    med["same_json"] = float(all(o == first for v in outputs.values() for o in v))
     return med
 
 
-def rows(sizes: list[int], rounds: int) -> list[tuple[str, str, str, float, str]]:
+def rows(
+    sizes: list[int], rounds: int, baseline: Path | None = None
+) -> list[tuple[str, str, str, float, str]]:
     """Rows (task, ours, reference, ratio, note) for ``speed_table.py``."""
     out = []
     with tempfile.TemporaryDirectory(prefix="contactlab-bench-analyze-") as d:
@@ -103,21 +150,30 @@ def rows(sizes: list[int], rounds: int) -> list[tuple[str, str, str, float, str]
         for n in sizes:
             path = tmp / f"t{n:.0e}.h5"
             bench_track.write_file(path, n)
-            r = measure(path, n, rounds, tmp)
+            r = measure(path, n, rounds, tmp, baseline)
             path.unlink()
-            ka, an, rd = n / r["kernel"] / 1e6, n / r["analyze"] / 1e6, n / r["read"] / 1e6
-            out.append(
-                (
-                    f"`contactlab analyze --json`, {n:.0e}-sample HDF5, command line",
-                    f"{r['analyze']:.2f} s wall ({an:.1f} M samples/s), "
-                    f"{r['analyze_cpu']:.2f} s CPU ({n / r['analyze_cpu'] / 1e6:.1f} M/CPU-s)",
-                    f"Masing kernel {ka:.0f} M/s; read_chunks alone (new process) "
-                    f"{r['read']:.2f} s ({rd:.0f} M/s)",
-                    an / ka,
-                    "of the kernel; JSON "
-                    + ("identical in every round" if r["same_json"] else "DIFFERS between rounds"),
+            ka, rd = n / r["kernel"] / 1e6, n / r["read"] / 1e6
+            kc = n / r["kernel_cpu"] / 1e6
+            same = "identical in every round" if r["same_json"] else "DIFFERS between rounds"
+            if baseline is not None:
+                same += " and builds"
+            labels = [("analyze", "all cores"), ("analyze_1", "one core")]
+            if baseline is not None:
+                labels += [("before", "all cores, BEFORE"), ("before_1", "one core, BEFORE")]
+            for key, what in labels:
+                an = n / r[key] / 1e6
+                cpu = r[f"{key}_cpu"]
+                out.append(
+                    (
+                        f"`contactlab analyze --json`, {n:.0e}-sample HDF5, command line, {what}",
+                        f"{r[key]:.2f} s wall ({an:.1f} M samples/s), "
+                        f"{cpu:.2f} s CPU ({n / cpu / 1e6:.1f} M/CPU-s)",
+                        f"Masing kernel {ka:.0f} M/s, {kc:.0f} M/CPU-s (one thread); "
+                        f"read_chunks alone (new process) {r['read']:.2f} s ({rd:.0f} M/s)",
+                        an / ka,
+                        f"of the kernel (by CPU time: {n / cpu / 1e6 / kc:.2f}); JSON {same}",
+                    )
                 )
-            )
     return out
 
 
@@ -125,6 +181,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--samples", type=float, nargs="+", default=[1e7, 3e7])
     ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--baseline", type=Path, help="another tree's python/ folder, run alike")
     args = ap.parse_args()
     print(
         f"load {', '.join(f'{a:.2f}' for a in os.getloadavg())}; {os.cpu_count()} CPUs; "
@@ -132,7 +189,9 @@ def main() -> None:
     )
     print("| task | contactlab | reference | ratio | note |")
     print("|---|---|---|---|---|")
-    for task, ours, ref, ratio, note in rows([int(s) for s in args.samples], args.rounds):
+    for task, ours, ref, ratio, note in rows(
+        [int(s) for s in args.samples], args.rounds, args.baseline
+    ):
         print(f"| {task} | {ours} | {ref} | {ratio:.2f} | {note} |")
 
 

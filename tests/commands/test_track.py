@@ -124,6 +124,7 @@ def test_auto_streamed_analyze_ctrl_c_writes_nothing(rec_file, tmp_path, monkeyp
 
     monkeypatch.setattr(pooled, "STREAM_ABOVE", 4000)
     monkeypatch.setattr(track_mod, "_tangential_window", interrupted)
+    monkeypatch.setattr(os, "sched_getaffinity", lambda _pid: {0, 1}, raising=False)
     assert analyze_cmd.window_threads() >= 1
     out, rep = tmp_path / "o.json", tmp_path / "rep"
     code = main(["analyze", str(rec_file), "--model", "tangential", "--json", str(out),
@@ -304,7 +305,11 @@ def test_analyze_window_threads_from_the_environment(monkeypatch):
     from contactlab.commands.common import window_threads
 
     monkeypatch.delenv("CONTACTLAB_ANALYZE_THREADS", raising=False)
-    assert 1 <= window_threads() <= 2
+    monkeypatch.setattr(os, "sched_getaffinity", lambda _pid: {0, 1, 2}, raising=False)
+    assert window_threads() == 2
+    # one CPU to run on: helper threads would only take turns with the reader
+    monkeypatch.setattr(os, "sched_getaffinity", lambda _pid: {3}, raising=False)
+    assert window_threads() == 0
     monkeypatch.setenv("CONTACTLAB_ANALYZE_THREADS", "0")
     assert window_threads() == 0
     for bad in ("-1", "two"):

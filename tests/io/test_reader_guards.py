@@ -340,6 +340,41 @@ def test_file_view_index_answers_as_find_does(tmp_path, monkeypatch, block, thre
                 assert v.find(needle, start) == data.find(needle, start), (needle, start)
 
 
+@pytest.mark.parametrize("mapped", [True, False])
+def test_file_view_index_mapped_blocks_as_read_ones(tmp_path, monkeypatch, mapped):
+    """Blocks of a whole page-granule are searched in a memory map (no copy), others read:
+    both give every occurrence, those straddling a block's edge included."""
+    import mmap
+
+    from contactlab.io import hdf5
+
+    g = mmap.ALLOCATIONGRANULARITY
+    monkeypatch.setattr(hdf5._FileView, "BLOCK", g)
+    calls = []
+    real = hdf5._mapped_hits
+
+    def spy(*a):
+        calls.append(a[1])
+        return real(*a) if mapped else None
+
+    monkeypatch.setattr(hdf5, "_mapped_hits", spy)
+    rng = np.random.default_rng(3)
+    data = bytearray(rng.integers(0, 256, 3 * g + 77, dtype=np.uint8).tobytes())
+    for at in (0, g - 2, g + 5, 2 * g - 3, 3 * g + 70):  # across the edges too
+        data[at : at + 4] = b"TREE"
+    data[2 * g - 1 : 2 * g + 3] = b"HEAP"
+    data = bytes(data)
+    path = tmp_path / "b.bin"
+    path.write_bytes(data)
+    with open(path, "rb") as fh:
+        v = hdf5._FileView(fh.fileno(), len(data))
+        v.index((b"TREE", b"HEAP"))
+    assert calls  # the mapped path was asked for every block
+    for nd in (b"TREE", b"HEAP"):
+        ref = [i for i in range(len(data)) if data.startswith(nd, i)]
+        assert v._index[nd] == ref, nd
+
+
 @settings(max_examples=60, deadline=None)
 @given(
     data=st.binary(max_size=120).map(lambda b: bytes(b"TREAHP"[c % 6] for c in b)),

@@ -186,6 +186,42 @@ def _read_into(fd: int, buf: memoryview, at: int) -> int:
     return len(data)
 
 
+def _mapped_hits(
+    fd: int, at: int, want: int, needles: tuple[bytes, ...], block: int
+) -> list[list[int]] | None:
+    """Each needle's positions starting in the ``block`` bytes from ``at`` (``want`` bytes
+    searched: the block and what a match starting in it may reach), searched in a read-only
+    memory map of just those bytes (the file's cached pages, no copy; unmapped before the
+    next block, so the scan's resident memory stays one block): a third of the CPU time of
+    reading them into a buffer (3e7-sample file, 480 MB: 0.06 against 0.09-0.19 s). None
+    where the block cannot be mapped (then it is read)."""
+    import mmap
+
+    from .._core import signature_positions
+
+    if at % mmap.ALLOCATIONGRANULARITY:
+        return None
+    try:
+        m = mmap.mmap(fd, want, offset=at, access=mmap.ACCESS_READ)
+    except (OSError, ValueError, OverflowError):
+        return None
+    try:
+        view = np.frombuffer(m, dtype=np.uint8)
+        hits = signature_positions(view, list(needles), block, at)
+        del view  # no export left when the map closes
+        return [h.tolist() for h in hits]
+    finally:
+        m.close()
+
+
+def _usable_cpus() -> int:
+    """CPUs this process may run on (its affinity mask; the CPU count without one)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
 #: threads of the structure scan of a long file (:meth:`_FileView.index`)
 _SCAN_THREADS = 2
 
@@ -222,7 +258,7 @@ class _FileView:
         scan that precedes every read of a long recording (1.6 GB: 0.7 s on one core)."""
         longest = max(len(nd) for nd in needles)
         starts = list(range(0, self.size, self.BLOCK))
-        n_threads = min(_SCAN_THREADS, len(starts), os.cpu_count() or 1)
+        n_threads = min(_SCAN_THREADS, len(starts), _usable_cpus())
         if n_threads > 1:
             from concurrent.futures import ThreadPoolExecutor
 
@@ -262,6 +298,10 @@ class _FileView:
             if _STOP.is_set():  # the process is ending (stop_prefetched_checks)
                 raise InputError("the structure check was stopped: the process is ending")
             want = min(self.BLOCK + longest - 1, self.size - at)
+            mapped = _mapped_hits(self.fd, at, want, needles, self.BLOCK)
+            if mapped is not None:
+                out[at] = mapped
+                continue
             if len(buf) < want:
                 buf = bytearray(want)
                 if owner is not None:

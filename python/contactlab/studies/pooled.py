@@ -34,6 +34,8 @@ from typing import Any
 
 import numpy as np
 
+from .._arrays import median
+
 #: samples above which ``contactlab analyze`` streams a tangential recording (a whole-file
 #: analysis peaked at 317 MB on 1e6 samples, 1.9 GB on 1e7; streamed: about 200 MB at any length)
 STREAM_ABOVE = 1 << 19
@@ -95,7 +97,7 @@ def pool(
     rel = sk / smin
     if sizes is not None and ok.sum() >= 3:
         n = np.array([_num(a) for a in sizes])[ok]
-        c = float(np.median(rel * np.sqrt(n))) if np.all(np.isfinite(n) & (n > 0)) else math.nan
+        c = float(median(rel * np.sqrt(n))) if np.all(np.isfinite(n) & (n > 0)) else math.nan
         if math.isfinite(c):
             typical = c / np.sqrt(n)
             rel = np.where(rel > OWN_ERROR_ABOVE * typical, rel, typical)

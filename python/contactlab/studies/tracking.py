@@ -355,6 +355,11 @@ class _Windows:
         return rec
 
 
+def _time_at(t: np.ndarray, off: int, g: int) -> float:
+    """The time of global sample ``g`` in a block starting at global sample ``off``."""
+    return float(t[g - off])
+
+
 def _noting(chunks: Iterator[Recording], noted: dict[str, Any]) -> Iterator[Recording]:
     """The chunks as they come, keeping the last one's ``meta["resampled"]`` in ``noted``."""
     for c in chunks:
@@ -623,10 +628,10 @@ def _track(
             for k in cyc:
                 cyc[k].append(np.asarray(getattr(got, k), dtype=float))
             cuts.block(float(block.t[0]), got.crossings)
-            for g in got.crossings.tolist():
-                if cuts.crossing(float(block.t[g - off])):
-                    # complete cycles before crossing g: crossings so far minus the first one
-                    out.emit(g, cuts.n_cross - 1)
+            # (g, complete cycles before crossing g: crossings so far minus the first one)
+            at = functools.partial(_time_at, block.t, off)
+            for g, n_before in cuts.cuts(got.crossings.tolist(), at):
+                out.emit(g, n_before)
             if buf.n > max_window:  # the open window (cut windows have left the buffer)
                 raise InputError(
                     f"{cr.source}: a window of every={every_text!r} holds more than "

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .. import _core
-from .._arrays import as_1d
+from .._arrays import as_1d, median
 from ..errors import InputError
 from ..reversals import excursions
 
@@ -333,7 +333,7 @@ def smooth_turn_times(times: np.ndarray, k: int = SMOOTH_TURNS) -> np.ndarray:
     for sl, idx in ((slice(0, w), np.arange(k)), (slice(n - w, n), np.arange(w - k, w))):
         b, a = np.polyfit(j, v[sl], 1)
         out[sl][idx] = a + b * j[idx]
-    tol = SMOOTH_TOLERANCE * float(np.median(np.diff(v)))
+    tol = SMOOTH_TOLERANCE * float(median(np.diff(v)))
     return np.where(np.abs(out - v) <= tol, out, v)
 
 
@@ -440,7 +440,7 @@ def _fold_loop(
     end = int(np.searchsorted(ta, kt[-1], side="left"))
     if n_points is None:
         # about two samples of every cycle per bin, so no bin is left empty by jitter
-        n_points = 2 * int(np.clip(np.median(np.diff(rev.peaks)) / 2, 16, 400) // 2)
+        n_points = 2 * int(np.clip(median(np.diff(rev.peaks)) / 2, 16, 400) // 2)
     if n_points < 8:
         raise InputError(f"n_points must be >= 8, got {n_points}")
     # One call in Rust: phase by interpolating the knots, bin sums overall and per cycle (no

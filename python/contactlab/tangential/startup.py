@@ -18,6 +18,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .._arrays import median
+
 #: a cycle whose amplitude is this many robust standard deviations from the median is not
 #: steady (a steady record of 300 cycles has a chance of 2e-2 of one cycle beyond 4 sd at
 #: either end, 1e-5 at 5)
@@ -134,8 +136,8 @@ def transient_cycles(
             return None
         if a.size < MIN_CYCLES:
             return _short_record(a, tt, pp, ee)
-    med = float(np.median(a))
-    scale = 1.4826 * float(np.median(np.abs(a - med)))
+    med = float(median(a))
+    scale = 1.4826 * float(median(np.abs(a - med)))
     # a noise-free record: the cycles' amplitudes (half the range of each cycle's binned
     # loop) differ by the binning, up to ~1e-4 relative; a transient is more than that
     scale = max(scale, SCALE_FLOOR * abs(med))
@@ -156,7 +158,7 @@ def _short_record(
     """:func:`transient_cycles` of a record of too few cycles for their scatter: end cycles
     more than :data:`SHORT_SHARE` off the median amplitude, with at least two cycles left
     that agree to half of that."""
-    med = float(np.median(a))
+    med = float(median(a))
     if not med > 0:
         return None
     off = np.abs(a - med) > SHORT_SHARE * med
@@ -166,9 +168,9 @@ def _short_record(
     if lead + trail == 0 or n - lead - trail < 2:
         return None
     rest = a[lead : n - trail]
-    if float(np.ptp(rest)) > 0.5 * SHORT_SHARE * float(np.median(rest)):
+    if float(np.ptp(rest)) > 0.5 * SHORT_SHARE * float(median(rest)):
         return None  # no steady state among the others either: nothing to compare with
-    tr = _transient(a, tt, pp, ee, lead, trail, float(np.median(rest)), SHORT_SHARE * med)
+    tr = _transient(a, tt, pp, ee, lead, trail, float(median(rest)), SHORT_SHARE * med)
     return replace(tr, short=True)
 
 

@@ -462,7 +462,7 @@ pub(crate) fn period_means_pair_checked(
 // Index arithmetic: j + 1 < n, the shortest slice's length.
 #[allow(clippy::arithmetic_side_effects)]
 #[inline(never)]
-fn trapezoids_until(
+pub(crate) fn trapezoids_until(
     t: &[f64],
     (f, x): (&[f64], &[f64]),
     mut j: usize,

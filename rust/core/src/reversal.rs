@@ -206,28 +206,35 @@ fn side_block<const UP: bool>(
     for &b in &best[1..] {
         top = if better(b, top) { b } else { top };
     }
-    // one bit a sample: the block's extreme value, beyond the centre, beyond the band
-    let (mut at, mut back, mut beyond) = (0_u64, 0_u64, 0_u64);
-    for k in 0..BLOCK {
-        let x = u[k];
-        at |= u64::from(v[k] == top) << k;
-        back |= u64::from(if UP { x < centre } else { x > centre }) << k;
-        beyond |= u64::from(if UP { x > hi } else { x < lo }) << k;
-    }
+    let back_of = |x: f64| if UP { x < centre } else { x > centre };
+    let beyond_of = |x: f64| if UP { x > hi } else { x < lo };
     if better(top, e.extreme_value) {
-        // the first sample of the block's extreme value (numerically equal: ±0 are one)
-        let m = at.trailing_zeros() as usize % BLOCK;
+        // the first sample of the block's extreme value (numerically equal: ±0 are one; top
+        // is one of the block's values, as it beats the excursion's)
+        let m = v.iter().position(|&x| x == top).unwrap_or(0);
         e.extreme = base + m as u64;
         e.extreme_value = v[m];
         // beyond the centre after it
-        e.returned = (back >> m) >> 1 != 0;
+        e.returned = any_of(&u[m + 1..], back_of);
     } else {
-        e.returned |= back != 0;
+        e.returned |= any_of(u, back_of);
     }
-    if beyond != 0 {
-        e.last_beyond = base + u64::from(beyond.ilog2());
+    // the block's last sample beyond the band (a vectorised test first: most blocks of an
+    // excursion have none, or all)
+    if any_of(u, beyond_of) {
+        if let Some(k) = u.iter().rposition(|&x| beyond_of(x)) {
+            e.last_beyond = base + k as u64;
+        }
     }
     true
+}
+
+/// Whether `f` holds for any of `xs`: bitwise ors, no early exit, so the test vectorises
+/// (a block's "any" was a bit a sample shifted into a mask, then tested).
+#[inline(always)]
+#[allow(clippy::needless_bitwise_bool)]
+fn any_of(xs: &[f64], f: impl Fn(f64) -> bool) -> bool {
+    xs.iter().fold(false, |a, &x| a | f(x))
 }
 
 #[cfg(test)]

@@ -9,8 +9,10 @@
 //! straight into its bin's moments (sums shifted by the bin's first cell mean, with the
 //! co-moment with the phase that the spread's phase correction needs; see `Bin`). Memory: a
 //! few values per bin and per cycle. The
-//! period means of `F` and `x` between the peaks take a pass of their own in the same call
-//! ([`crate::fold::period_means_pair`]'s, whose two running sums stay in registers there).
+//! period means of `F` and `x` between the peaks ([`crate::fold::period_means_pair`]'s
+//! numbers, whose two running integrals stay in registers in a loop of their own) are
+//! carried over each cycle's samples as the cycle completes, after its loop area, while the
+//! samples are in cache (`window/period.rs`), instead of a pass over the window afterwards.
 //!
 //! The numbers are those of the separate kernels ([`fold_phase`](crate::fold::fold_phase),
 //! [`fold_spread`](crate::fold::fold_spread), [`loop_areas`](crate::loop_area::loop_areas),
@@ -19,11 +21,10 @@
 //! period means bit for bit, the rest to ~1e-12 relative (another summation order).
 //!
 //! The detrending pass that precedes the fold ([`detrend_pair_scan_into`], [`WindowScan`]) is in
-//! `window/detrend.rs`, a fold's cell and segment records in `window/cell.rs`, the tests in
-//! `window/tests.rs`.
+//! `window/detrend.rs`, a fold's cell and segment records in `window/cell.rs`, the period
+//! means' running state in `window/period.rs`, the tests in `window/tests.rs`.
 
 use crate::error::{check_finite, check_same_len, CoreError};
-use crate::fold::period_means_pair_checked;
 
 /// One window folded (see the module docs). Per bin: samples, `Σx`, `ΣF`, `Σφ`, `Σφ²`,
 /// `Σx²`, `Σt` (φ the phase within the cycle), and the cycle-to-cycle spread of the per-cycle
@@ -583,6 +584,7 @@ fn fold_window_with(
     let mut a0 = start;
     let mut a1 = end;
     let mut area_cycle: Option<usize> = None;
+    let mut pm = PeriodMeans::new(edges.len());
     // the phase of sample i where the inner loop below computed it (in the same knot
     // segment, so as this path would), else -1 (phases are >= kp[0] >= 0)
     let mut carried = -1.0_f64;
@@ -630,6 +632,8 @@ fn fold_window_with(
             if let Some(ac) = area_cycle {
                 (w.energy[ac], w.sens_f[ac], w.sens_x[ac]) =
                     cycle_area(&x[a0..i], &f[a0..i], ux, uf, fm, area_scale);
+                // the period means' integrals over the same samples, still in cache
+                pm.advance((t_all, f_all, x_all), edges, Some(i - 1));
             }
             area_cycle = Some(c);
             a0 = i;
@@ -674,7 +678,14 @@ fn fold_window_with(
         (w.energy[ac], w.sens_f[ac], w.sens_x[ac]) =
             cycle_area(&x[a0..a1], &f[a0..a1], ux, uf, fm, area_scale);
     }
-    finish(&mut w, &bins, &ranges, (t_all, f_all, x_all, edges), end)?;
+    finish(
+        &mut w,
+        &bins,
+        &ranges,
+        (t_all, f_all, x_all, edges),
+        end,
+        pm,
+    )?;
     Ok(w)
 }
 
@@ -688,6 +699,7 @@ fn finish(
     ranges: &[[f64; 4]],
     (t_all, f_all, x_all, edges): (&[f64], &[f64], &[f64], &[f64]),
     end: usize,
+    pm: PeriodMeans,
 ) -> Result<(), CoreError> {
     let (nb, nc) = (w.n_bins, w.n_cycles);
     for (b, s) in bins.iter().enumerate() {
@@ -708,9 +720,9 @@ fn finish(
             });
         }
     }
-    // the period means between the edges in a pass of their own (period_means_pair's: the
-    // same numbers; in this loop its two running sums were kept on the stack)
-    (w.mean_f, w.mean_x) = period_means_pair_checked(t_all, f_all, x_all, edges);
+    // the period means between the edges (period_means_pair's numbers), their integrals
+    // carried over each cycle as it completed (window/period.rs) and taken to the end here
+    (w.mean_f, w.mean_x) = pm.finish((t_all, f_all, x_all), edges);
     // the spread, phase-corrected by each bin's slope along phase (fold_spread)
     let half_n = nb as f64 / 2.0;
     let mean_of = |s: &[f64], b: usize| s[b] / w.count[b];
@@ -741,8 +753,10 @@ fn finish(
 
 mod cell;
 mod detrend;
+mod period;
 use cell::{next_bin, Cell, Segment, NO_RANGE};
 pub use detrend::{detrend_pair, detrend_pair_into, detrend_pair_scan_into, WindowScan};
+use period::PeriodMeans;
 
 #[cfg(test)]
 mod tests;

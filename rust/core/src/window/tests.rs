@@ -228,6 +228,37 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+    /// The period means carried over each cycle as it completes (window/period.rs) equal
+    /// `period_means` bit for bit whatever the edges: before the samples, on sample times,
+    /// repeated, inside cycles, past the end.
+    #[test]
+    fn period_means_carried_by_cycle_equal_one_pass(
+        seed in 0u64..1000, n_cyc in 1usize..6, start in 0usize..300,
+        picks in prop::collection::vec((0usize..4100, 0usize..4), 0..24),
+    ) {
+        let (t, x, f) = signal(4000, seed, 1.0);
+        let period = 2.0 * std::f64::consts::PI / 6.0;
+        let (kt, kp) = knots(&t[start..], period, n_cyc);
+        let mut edges: Vec<f64> = picks
+            .iter()
+            .map(|&(i, how)| match how {
+                0 => t[i.min(t.len() - 1)],                           // on a sample
+                1 => t[i.min(t.len() - 1)] + 0.37e-3,                 // between samples
+                2 => t[0] - 1.0 + i as f64 * 1e-4,                    // before the samples
+                _ => kt[i % kt.len()],                                // on a knot
+            })
+            .collect();
+        edges.sort_by(f64::total_cmp);
+        let w = fold_window(&t, &x, &f, &kt, &kp, 8, n_cyc, &edges).unwrap();
+        // bit for bit (a repeated edge gives NaN, 0/0, in both)
+        let bits = |v: &[f64]| v.iter().map(|a| a.to_bits()).collect::<Vec<_>>();
+        prop_assert_eq!(bits(&w.mean_f), bits(&period_means(&t, &f, &edges).unwrap()));
+        prop_assert_eq!(bits(&w.mean_x), bits(&period_means(&t, &x, &edges).unwrap()));
+    }
+}
+
 #[test]
 fn short_cycles_and_edges_outside_the_samples() {
     // 6 samples, two cycles of 1 and 3 samples: NaN area below 3 samples
