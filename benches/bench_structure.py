@@ -12,7 +12,16 @@ the ratio is the median of the pairs' ratios (on a loaded machine the CPU ratio 
 steadier one). The Rust run returns what the reference returns, the displacement
 (``outputs=("x",)``); the run with all eight outputs is timed and reported too. Target: the
 Rust core ≥ 100× the reference.
-Run: ``.venv/bin/python benches/bench_structure.py``.
+
+``--stepping`` prints instead the error-controlled stepping table (issue 33 item 6): for SDOF
+and MDOF structures with Bouc-Wen, Masing and Jenkins joints, the default run
+(error-controlled, ``tol = DEFAULT_TOL``) against the old default (``substeps=1``: one Newmark
+step per sample, the same code path as before) — their CPU-time ratio (medians of
+``--repeat`` interleaved pairs) and each one's relative RMS error of ``x`` against tight
+references: scipy ``solve_ivp`` LSODA and Radau at ``rtol = 1e-11`` where the joint law is an
+ODE (Bouc-Wen), fixed Newmark with 64 steps per sample (second order, an independent route)
+and the error-controlled run at ``tol / 100``. OpenSeesPy is compared when installed.
+Run: ``.venv/bin/python benches/bench_structure.py [--stepping]``.
 """
 
 from __future__ import annotations
@@ -22,6 +31,7 @@ import math
 import os
 import statistics
 import time
+from functools import partial
 
 import numpy as np
 
@@ -179,7 +189,11 @@ def main() -> None:
     ap.add_argument("--n", type=int, default=1_000_000)
     ap.add_argument("--n-python", type=int, default=20_000)
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--stepping", action="store_true", help="the error-control table")
     a = ap.parse_args()
+    if a.stepping:
+        stepping_table(a.n, a.repeat)
+        return
     t, f = excitation(a.n)
     s = Structure(M, C, K)
     s.add_joint("masing", 0, h0=H0, ac=AC, scale=LAM)
@@ -239,6 +253,139 @@ def main() -> None:
           f"wall, {ratio_c:.0f}x CPU (per pair, CPU: "
           f"{', '.join(f'{p / q:.0f}' for p, q in zip(py_c, rust_c, strict=True))}; target "
           f">= 100x); load average {load0:.1f} -> {os.getloadavg()[0]:.1f}")  # fmt: skip
+
+
+# ----------------------------------------------------------------- error-controlled stepping
+BW = {"alpha": 5e4, "beta": 1e3, "gamma": 0.8, "delta": -1.1}  # the hysteretic benchmark's
+
+
+def multisine(n: int, fs: float, cols: int = 1, seed: int = 1) -> np.ndarray:
+    """Random-phase multisine, 5-150 Hz, 50 N RMS, period 8192 samples, ``(n, cols)``."""
+    rng = np.random.default_rng(seed)
+    freq = np.fft.rfftfreq(8192, 1 / fs)
+    band = (freq >= 5) & (freq <= 150)
+    out = np.empty((n, cols))
+    for c in range(cols):
+        spec = np.zeros(freq.size, complex)
+        spec[band] = np.exp(2j * np.pi * rng.uniform(size=band.sum()))
+        u = np.fft.irfft(spec, 8192)
+        out[:, c] = np.resize(u * 50.0 / np.sqrt(np.mean(u**2)), n)
+    return out
+
+
+def bouc_wen_ode(s: Structure, t: np.ndarray, f: np.ndarray, method: str) -> np.ndarray:
+    """``x`` of a structure whose joints are all Bouc-Wen (ν = 1) by scipy ``solve_ivp`` at
+    rtol 1e-11 (the joint law as the ODE ``ż = α ḋ − β (γ |ḋ| z + δ ḋ |z|)``; the force linear
+    between samples, as the core takes it)."""
+    from scipy.integrate import solve_ivp
+
+    n, js = s.n, s.joints
+    minv = np.linalg.inv(s.M)
+
+    def rhs(tt: float, y: np.ndarray) -> np.ndarray:
+        x, v, z = y[:n], y[n : 2 * n], y[2 * n :]
+        i = min(int(np.searchsorted(t, tt, side="right")) - 1, t.size - 2)
+        w = (tt - t[i]) / (t[i + 1] - t[i])
+        g = np.zeros(n)
+        dz = np.empty(len(js))
+        for k, j in enumerate(js):
+            p = j.params
+            dv = v[j.dof] - (v[j.dof2] if j.dof2 is not None else 0.0)
+            g[j.dof] += z[k]
+            if j.dof2 is not None:
+                g[j.dof2] -= z[k]
+            dz[k] = p["alpha"] * dv - p["beta"] * (
+                p["gamma"] * abs(dv) * z[k] + p["delta"] * dv * abs(z[k])
+            )
+        a = minv @ ((1 - w) * f[i] + w * f[i + 1] - s.C @ v - s.K @ x - g)
+        return np.concatenate([v, a, dz])
+
+    y0 = np.zeros(2 * n + len(js))
+    sol = solve_ivp(rhs, (t[0], t[-1]), y0, method=method, t_eval=t, rtol=1e-11, atol=1e-15,
+                    max_step=float(t[1] - t[0]))  # fmt: skip
+    return sol.y[:n].T
+
+
+def stepping_cases() -> list[tuple[str, Structure, float, int, bool]]:
+    """(name, structure, sample rate, samples for the accuracy check, Bouc-Wen only)."""
+    out = []
+    for fs in (3000.0, 750.0):
+        s = Structure(2.0, 10.0, 5e4)
+        s.add_joint("bouc_wen", 0, **BW)
+        out.append((f"SDOF Bouc-Wen, {fs:g} Hz", s, fs, int(fs), True))
+    s = Structure(2.0, 10.0, 5e4)
+    s.add_joint("masing", 0, h0=40.0, ac=2e4, scale=2.0)
+    out.append(("SDOF Masing, 3000 Hz", s, 3000.0, 9000, False))
+    s = Structure(2.0, 10.0, 5e4)
+    s.add_joint("jenkins", 0, k=5e4, fs=30.0)
+    out.append(("SDOF Jenkins, 3000 Hz", s, 3000.0, 9000, False))
+    m, k = np.diag([2.0, 1.0, 1.5]), 5e4 * np.array([[2, -1, 0], [-1, 2, -1], [0, -1, 1.0]])
+    c = 1e-4 * k + 2.0 * m
+    s = Structure(m, c, k)
+    s.add_joint("bouc_wen", 0, **BW)
+    s.add_joint("bouc_wen", 2, 1, **BW)
+    out.append(("3-DOF Bouc-Wen x2, 3000 Hz", s, 3000.0, 1500, True))
+    s = Structure(m, c, k)
+    s.add_joint("masing", 0, h0=40.0, ac=2e4, scale=2.0)
+    s.add_joint("jenkins", 2, 1, k=3e4, fs=20.0)
+    out.append(("3-DOF Masing + Jenkins, 3000 Hz", s, 3000.0, 6000, False))
+    return out
+
+
+def _cpu(fn):  # type: ignore[no-untyped-def]
+    c0 = time.process_time()
+    out = fn()
+    return time.process_time() - c0, out
+
+
+def stepping_table(n_time: int, repeat: int) -> None:
+    """The error-control table: cost ratio and relative RMS errors, per case (see the
+    module's docstring)."""
+    from contactlab.structure.model import DEFAULT_TOL
+
+    def rrms(x: np.ndarray, ref: np.ndarray) -> float:
+        return float(np.sqrt(np.mean((x - ref) ** 2) / np.mean(ref**2)))
+
+    try:
+        import openseespy  # noqa: F401
+
+        print("OpenSeesPy is installed but not wired into this table")
+    except ImportError:
+        print("OpenSeesPy: not installed (no comparison row)")
+    print(f"default tol = {DEFAULT_TOL:g}; CPU-time medians of {repeat} interleaved pairs on "
+          f"{n_time} samples; errors: relative RMS of x on the accuracy record")  # fmt: skip
+    print("| case | old default (substeps=1) | new default | cost new/old | "
+          "old err vs ref | new err vs ref | references (max pairwise diff) |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|")
+    for name, s, fs, n_acc, bw_only in stepping_cases():
+        f = multisine(max(n_acc, n_time), fs, s.n)
+        t = np.arange(f.shape[0]) / fs
+        ta, fa = t[:n_acc], f[:n_acc]
+        fa1 = fa[:, 0] if s.n == 1 else fa
+        refs = {
+            "fixed x64": s.simulate(ta, force=fa1, substeps=64).x,
+            "tol/100": s.simulate(ta, force=fa1, tol=DEFAULT_TOL / 100).x,
+        }
+        if bw_only:
+            for meth in ("LSODA", "Radau"):
+                x = bouc_wen_ode(s, ta, fa, meth)
+                refs[meth] = x[:, 0] if s.n == 1 else x
+        ref = refs["LSODA"] if bw_only else refs["tol/100"]
+        spread = max(rrms(a, ref) for a in refs.values())
+        old = rrms(s.simulate(ta, force=fa1, substeps=1).x, ref)
+        new_r = s.simulate(ta, force=fa1)
+        new = rrms(new_r.x, ref)
+        others = ", ".join(f"{k} {rrms(new_r.x, v):.1e}" for k, v in refs.items())
+        ft = f[:n_time, 0] if s.n == 1 else f[:n_time]
+        tt = t[:n_time]
+        c_old, c_new = [], []
+        for _ in range(repeat):
+            c_old.append(_cpu(partial(s.simulate, tt, force=ft, substeps=1))[0])
+            c_new.append(_cpu(partial(s.simulate, tt, force=ft))[0])
+        mo, mn = statistics.median(c_old), statistics.median(c_new)
+        ratio = statistics.median(b / a for a, b in zip(c_old, c_new, strict=True))
+        print(f"| {name} | {1e3 * mo:.0f} ms | {1e3 * mn:.0f} ms | {ratio:.2f} | {old:.1e} | "
+              f"{new:.1e} (vs {others}) | {spread:.1e} |", flush=True)  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -392,6 +392,8 @@ def structure_simulate(
     rtol: float = 1e-10,
     max_iter: int = 30,
     outputs: list[str] | None = None,
+    tol: float | None = None,
+    substeps: int = 1,
 ) -> StructureRun: ...
 
 # --- joint laws driven by displacement (contactlab.joints) ---

@@ -38,7 +38,16 @@ def test_registry_lists_every_effect_once_with_its_parameters():
         assert eff.candidate.params == eff.params
         for s in eff.params:
             assert s.lower <= s.upper and s.unit
-    assert {n for n, e in tang.items() if e.acts_through == "velocity"} == VELOCITY
+
+    def groups(e):
+        return (e.acts_through,) if isinstance(e.acts_through, str) else e.acts_through or ()
+
+    assert {n for n, e in tang.items() if "velocity" in groups(e)} == VELOCITY
+    assert {n for n, e in tang.items() if "friction along the branch" in groups(e)} == {
+        "stribeck",
+        "position_friction",
+        "stick_slip",
+    }
     # composition order: input, element, terms on the force, then the measurement
     chain = [
         e.name

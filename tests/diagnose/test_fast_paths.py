@@ -132,7 +132,7 @@ def test_reused_masing_force_is_the_fresh_one():
         idx = np.arange(3, d.u.size, 7)
         for eff in [(), ("stick_slip", "stribeck"), ("position_friction", "force_drift")]:
             q = {**p, "s_b": 0.2, "ell": 3e-6, "s": 0.1, "v_s": 1e-3, "a1": 0.05, "b1": 0.0}
-            q.update(a2=-0.02, b2=0.01, F1=0.3)
+            q.update(L=2.5e-5, F1=0.3)
             assert np.array_equal(fam.predict(q, eff, d, at=idx), fam.predict(q, eff, d)[idx])
     with pytest.raises(contactlab.InputError, match="h0 must be finite"):
         fam.predict({"h0": 0.0, "ac": 4.6e4}, (), d)
@@ -300,8 +300,8 @@ def test_prediction_at_samples_is_the_full_one(effects, tau_samples, stride, sta
     d = _small_tangential()
     fam = TangentialFamily()
     p = {"h0": 48.0, "ac": 4.6e4, "x0": 1e-7, "c": 3.0, "m": 0.01, "k_p": 1e4, "F0": 0.5}
-    p.update(F1=0.3, alpha=0.1, beta=0.05, s=0.1, v_s=1e-3, a1=0.05, b1=0.0, a2=-0.02)
-    p.update(b2=0.01, s_b=0.2, ell=3e-6, eps_c=0.03, eps_s=-0.02, f_n=f_n)
+    p.update(F1=0.3, alpha=0.1, beta=0.05, s=0.1, v_s=1e-3, a1=0.05, b1=0.02, L=2.5e-5)
+    p.update(s_b=0.2, ell=3e-6, eps_c=0.03, eps_s=-0.02, f_n=f_n)
     p["tau"] = tau_samples * d.dt
     eff = (*effects, "channel_delay")
     idx = np.arange(start, d.u.size, stride)

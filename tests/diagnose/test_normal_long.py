@@ -58,7 +58,8 @@ def _truth(rec, effect):
 def test_kept_model_is_the_full_rate_model(monkeypatch, effect):
     """Noise-free record of 26 000 samples kept one in 27 (15 samples per fastest cycle):
     the model at the kept samples against the full-rate model there, bias²/σ² for an output
-    noise of 1 % of the RMS. Measured 1.8e-8 for every effect but hysteretic damping: its
+    noise of 1 % of the RMS. Measured 1.8e-8 for every effect but the loss asymmetry (2.1e-5,
+    its kink at the turning points between kept samples) and hysteretic damping: its
     ideal loss is non-causal and sees the periodic continuation after the record, whose
     length in time differs with the rate (FFT lengths): 1.5e-2 here, of which the last 5 %
     of the record 0.19 and the rest 6.7e-3; 1.8e-3 at 325 491 samples kept one in 14."""
@@ -79,7 +80,10 @@ def test_kept_model_is_the_full_rate_model(monkeypatch, effect):
     ref = fam.predict(p, effects, full)[::q][: d.t.size]
     sig = 0.01 * float(np.sqrt(np.mean(y * y)))
     bias2 = float(np.mean((kept - ref)[2:] ** 2)) / sig**2
-    assert bias2 < (3e-2 if effect == "hysteretic_damping" else 1e-5)
+    # the loss asymmetry switches its damping at each turning point, located between the
+    # kept samples by a linear zero of the damping's pressure: 2.1e-5 measured
+    limit = {"hysteretic_damping": 3e-2, "asymmetric_branches": 5e-5}.get(effect, 1e-5)
+    assert bias2 < limit
 
 
 def test_kept_slopes_matter():

@@ -26,8 +26,10 @@ def _truth_params(rec, d=None):
             p["s"] = vals["s"]
             p["v_s"] = vals["v_s_over_rms_speed"] * float(np.sqrt(np.mean(d.ud**2)))
         elif name == "position_friction":
-            eps, ph = vals["eps"], vals["phase"]
-            p.update(a1=0.0, b1=0.0, a2=eps * np.sin(ph), b2=eps * np.cos(ph))
+            # sin(2π x/L + ph), L the stroke's half-width, written about the stroke's middle
+            eps, L = vals["eps"], d.extra["x_half"] / vals["waves_over_stroke"]
+            ph = vals["phase"] + 2 * np.pi * d.extra["x_mid"] / L
+            p.update(a1=eps * np.sin(ph), b1=eps * np.cos(ph), L=L)
         elif name == "normal_load":
             eps, ph = vals["eps"], vals["phase"]
             p.update(eps_c=eps * np.sin(ph), eps_s=eps * np.cos(ph), f_n=vals["f_n"])

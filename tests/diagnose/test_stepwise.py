@@ -124,11 +124,13 @@ def test_swap_move_reaches_an_effect_never_tried_because_the_set_filled():
     """Behind anti-alias filters at 0.3 / 0.6 of Nyquist, Stribeck friction first looks like
     parallel stiffness + a breakaway after each reversal. With the channel delay among the
     candidates the truth (stribeck and the filters' skew) is named, by whichever route the
-    search takes. Without it and with max_effects = 2 reached, the swap move replaces each
-    named effect by each candidate not in the model, stribeck included, and every swap is
-    judged and listed ("out ⇄ in"); with docs/effects.md's breakaway the stand-ins predict
-    this record better than stribeck in place of either (in-sample gains -3.9 and -4.8 σ²),
-    so none is taken: a swap is made only where it predicts the held-out cycles better."""
+    search takes. Without it and with max_effects = 2 reached, the swap move replaces a
+    named effect by a candidate not in the model: the parallel stiffness by stribeck (the
+    Gaussian Stribeck of docs/effects.md predicts the held-out cycles better in its place),
+    listed as "out ⇄ in". Stribeck and the breakaway then both reshape the friction between
+    reversals, and the parsimony rule keeps them together only if each is significant after
+    the other (the breakaway here also stands for the filters' skew, which no candidate of
+    this list can name): a sentence says which one stays."""
     rec = hidden_effect_recording(
         ["stribeck"], magnitude=0.05, noise=0.005, input_noise=0.002,
         samples_per_cycle=200, anti_alias=(0.3, 0.6), bits=16, seed=92010,
@@ -143,13 +145,15 @@ def test_swap_move_reaches_an_effect_never_tried_because_the_set_filled():
         rec, candidates=["parallel_stiffness", "stick_slip", "non_masing_scaling", "stribeck"],
         max_effects=2,
     )  # fmt: skip
-    assert len(full.effect_names) == 2 and "stribeck" not in full.effect_names
-    tried = [v for v in full.steps[-1].candidates if "⇄" in v.name]
-    named = set(full.effect_names)
-    assert {v.name for v in tried} >= {f"{e} ⇄ stribeck" for e in named}
-    for v in tried:
-        assert not v.accepted and np.isfinite(v.gain) and v.gain < 0
-    assert not any(s.removed is not None and s.added is not None for s in full.steps)
+    swaps = [s for s in full.steps if s.removed is not None and s.added is not None]
+    assert [(s.removed, s.added) for s in swaps] == [("parallel_stiffness", "stribeck")]
+    assert any(w.startswith("swap: parallel_stiffness replaced by stribeck") for w in full.where)
+    tried = [v for v in full.steps[-1].candidates if "⇄" in v.name] or [
+        v for s in full.steps for v in s.candidates if "⇄" in v.name
+    ]
+    assert any(v.name == "parallel_stiffness ⇄ stribeck" for v in tried)
+    assert "parallel_stiffness" not in full.effect_names
+    assert any("friction along the branch" in w for w in full.where)
 
 
 def test_pair_move_names_an_offset_and_a_drift_that_each_look_like_a_displacement_offset():

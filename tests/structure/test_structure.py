@@ -19,7 +19,11 @@ def _quasi_static(joint: str, amp: float, **params: float) -> tuple[Structure, o
     s.add_joint(joint, 0, **params)
     t = np.linspace(0.0, 3.0, 6001)
     y = amp * np.sin(2 * np.pi * t)
-    return s, s.simulate(t, base=y, base_velocity=amp * 2 * np.pi * np.cos(2 * np.pi * t))
+    # fixed steps: the tie's mode (~1e5 rad/s) is far beyond the sample rate; the A-stable
+    # trapezoidal rule steps over it smoothly, while error control leaves sub-sample jitter of
+    # ~3e-4 relative at the turning points, enough to move a Masing loop's closure there
+    yd = amp * 2 * np.pi * np.cos(2 * np.pi * t)
+    return s, s.simulate(t, base=y, base_velocity=yd, substeps=1)
 
 
 def test_linear_sdof_free_response_matches_closed_form():
@@ -168,7 +172,8 @@ def test_failed_integration_returns_partial_result():
     s = Structure(1.0, 0.1, 100.0)
     s.add_joint("bouc_wen", 0, alpha=100.0, beta=1.0, gamma=50.0, delta=10.0, nu=1.5)
     t = np.linspace(0, 1, 101)
-    r = s.simulate(t, force=np.sin(10 * t), rtol=1e-30)
+    # (fixed steps: error control's inner solves may end on a quadratic-convergence bound)
+    r = s.simulate(t, force=np.sin(10 * t), rtol=1e-30, substeps=1)
     assert not r.success and r.status == -1 and "t =" in r.message
     assert 1 <= r.t.size < t.size and r.x.shape == r.t.shape
     assert np.all(np.isfinite(r.x))

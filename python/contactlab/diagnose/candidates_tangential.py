@@ -25,8 +25,8 @@ name                           measured force ``F`` (or measured ``x``)         
 ``asymmetry``                  ``F = h + α |h|``: saturation ``h0(1 ± α)`` per direction   alpha [-]
 ``non_masing_scaling``         branches ``h_r + λ f((x - x_r)/λ)`` from rest at the turns  lam [-]
 ``parameter_drift``            ``F = h (1 + β (t - t_m)/T)``, ``t_m`` mid-record           beta [-]
-``stribeck``                   ``F = h (1 + s exp(-|ẋ|/v_s))``                             s, v_s
-``position_friction``          ``F = h (1 + Σ a_k cos kπξ + b_k sin kπξ)``                 a_k, b_k
+``stribeck``                   ``F = h (1 + s exp(-(ẋ/v_s)²))``                            s, v_s
+``position_friction``          ``F = h (1 + a1 cos φ + b1 sin φ)``, ``φ = 2π(x-x_mid)/L``  a1, b1, L
 ``stick_slip``                 ``F = h + s_b h0 sgn(ẋ) (s/ell) e^(1 - s/ell)``, s: travel  s_b, ell
 ``normal_load``                ``F = h (1 + ε_c cos 2π f_n t + ε_s sin 2π f_n t)``         eps, f_n
 ``power_law_microslip``        Segalman's Iwan element (F_S = h0, K_T = h0 ac)             chi, beta

@@ -87,7 +87,7 @@ class ExtendedModel:
     def coefficients(self) -> dict[str, float] | None:
         """Normal contact: the stiffness law's coefficients of the paper's eq. 6 (``a1`` Pa/m,
         ``a2`` Pa/m², ``a3`` Pa/m³), independent of the record's displacement scale ``δ_r``
-        that ``kappa`` and ``a`` are relative to; None for the tangential model."""
+        that ``kappa1`` and ``kappa`` are relative to; None for the tangential model."""
         f = getattr(self.family, "coefficients", None)
         return None if f is None else f(self.params, self.effects, self.context)
 

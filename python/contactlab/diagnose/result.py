@@ -229,14 +229,14 @@ class DiagnosisReport:
             if e.plausibility:
                 out.append(wrap(f"why plausible: {e.plausibility}", "  ", "    "))
         coeffs = self.final_model.coefficients()
-        if coeffs is not None and ({"a", "kappa"} & set(self.final_model.params)):
+        if coeffs is not None and ({"kappa1", "kappa"} & set(self.final_model.params)):
             law = (
                 "Stiffness law (eq. 6): "
                 + ", ".join(
                     f"{k} = {v:.4g} {u}"
                     for (k, v), u in zip(coeffs.items(), ("Pa/m", "Pa/m²", "Pa/m³"), strict=True)
                 )
-                + f" (κ and a are relative to δ_r = {self.final_model.context['delta_r']:.4g} m)"
+                + f" (κ1 and κ are relative to δ_r = {self.final_model.context['delta_r']:.4g} m)"
             )
             out.append(wrap(law, "", "    "))
         unit = getattr(self.final_model.family, "output_unit", "")

@@ -607,8 +607,9 @@ class StepwiseSearch:
         st.where.append(f"{what}: {v.name} dropped ({why})")
 
     def parsimony(self, st: SearchState) -> None:
-        """Effects that act through the same signal (``acts_through``: the velocity for a
-        delay, viscous damping, Stribeck friction, inertia, pre-sliding damping) are named
+        """Effects that act through the same signal (``acts_through``, one name or several: the
+        velocity for a delay, viscous damping, Stribeck friction, inertia, pre-sliding damping;
+        the friction along the branch for Stribeck, position friction and stick-slip) are named
         together only when each is separately significant after the others at
         :data:`PARSIMONY_Z` times the search's threshold (each one's gain, refitted without
         it, must stand on its own, not on a misfit the others share). The weakest is
@@ -616,13 +617,16 @@ class StepwiseSearch:
         from .effects import registry
 
         reg = registry(self.family.kind)
+        settled: set[tuple[str, ...]] = set()  # groups whose members all stood on their own
         while st.used < _max_evaluations():
             groups: dict[str, list[str]] = {}
             for e in st.added:
                 g = reg[e].acts_through if e in reg else None
-                if g:
-                    groups.setdefault(g, []).append(e)
-            shared = [(g, es) for g, es in groups.items() if len(es) >= 2]
+                for one in (g,) if isinstance(g, str) else g or ():
+                    groups.setdefault(one, []).append(e)
+            shared = [
+                (g, es) for g, es in groups.items() if len(es) >= 2 and (g, *es) not in settled
+            ]
             if not shared:
                 return
             group, members = shared[0]
@@ -641,7 +645,8 @@ class StepwiseSearch:
                     f"(t = {', '.join(f'{v.t_stat:.1f}' for v, _ in checks)}, threshold "
                     f"{PARSIMONY_Z * self.z:g}): named together"
                 )
-                return
+                settled.add((group, *members))
+                continue
             v, st.current = min(weak, key=lambda vr: vr[0].gain)
             others = ", ".join(m for m in members if m != v.name)
             self._drop(st, v, "parsimony", f"it acts through the {group} as {others} does, and "

@@ -308,6 +308,7 @@ def phase_resonance(
             periodic=True,
             periodic_tol=1e-7,
             max_periods=1024,
+            substeps=1,  # fixed steps, as the resonance search was calibrated with
         )
         if not r.success:
             raise ConvergenceError(f"phase_resonance at {f:.6g} Hz: {r.message}")

@@ -6,7 +6,8 @@ prescribed base (ground) displacement ``y`` whose velocity ``ẏ`` is taken from
 structure stands on one moving base). Joints attach to the fixed ground, not to the base
 (a frame rubbing on a wall). Integration: implicit Newmark average acceleration with Newton
 iterations on the joint forces, steps split at reversals and stick-slip transitions, outputs
-exactly at the samples.
+exactly at the samples; by default error-controlled (step doubling with Richardson
+extrapolation, fourth order, in the Rust core), or ``substeps`` fixed steps per sample.
 """
 
 from __future__ import annotations
@@ -245,9 +246,10 @@ class Structure:
         max_periods: int = 50,
         periodic_tol: float = 1e-6,
         rtol: float = 1e-10,
-        substeps: int = 1,
+        substeps: int | None = None,
         interpolation: str = "linear",
         outputs: Any = None,
+        tol: float | None = None,
     ) -> SimulationResult:
         """Response to a force input and/or base motion sampled at ``t``.
 
@@ -269,17 +271,27 @@ class Structure:
             ``max_periods`` periods) and return the last period.
         influence : array_like (n,), optional
             Influence vector ``r`` of the base motion (default ones).
-        substeps : int
-            Integration steps per sample interval (the response is returned at ``t`` only).
+        substeps : int, optional
+            Fixed stepping: this many equal Newmark steps per sample interval (split further
+            at reversals and stick-slip transitions; second order), instead of the default
+            error-controlled stepping. The response is returned at ``t`` only.
         interpolation : {"linear", "fourier"}
             How inputs are continued between samples when ``substeps > 1``: linear, or
             band-limited (FFT zero padding, for a uniformly sampled periodic input such as a
-            multisine record of whole periods).
+            multisine record of whole periods). Error-controlled stepping takes the inputs
+            linear between samples.
         outputs : iterable of str, optional
             The arrays to compute, among ``x``, ``v``, ``a``, ``joint_force``,
             ``joint_energy``, ``joint_work``, ``input_work``, ``damping_work`` (default all).
             The others come back empty (no rows) and cost nothing. A periodic run also
             computes ``x``, ``v``, ``joint_energy`` and ``input_work`` (its convergence check).
+        tol : float, optional
+            Error-controlled stepping (the default, ``tol`` = :data:`DEFAULT_TOL`): each
+            piece of a sample interval is a Newmark step checked against two half steps, the
+            pair's Richardson extrapolation is kept (fourth order) and pieces are shortened
+            until the pair's difference / 3 is at most ``tol`` relative to the largest
+            displacement and velocity so far. Pieces end on the samples, at velocity
+            reversals and at stick-slip transitions. Not together with ``substeps``.
 
         Returns
         -------
@@ -298,10 +310,12 @@ class Structure:
             if a.size != n:
                 raise InputError(f"{name} has {a.size} entries, expected {n}")
         want = _core_outputs(outputs)
-        substeps = int(substeps)
-        if substeps < 1:
-            raise InputError(f"substeps must be >= 1, got {substeps}")
-        if substeps > 1:
+        step = _stepping(substeps, tol)
+        if interpolation not in ("linear", "fourier"):
+            raise InputError(f"interpolation must be 'linear' or 'fourier', got {interpolation!r}")
+        if interpolation == "fourier" and step.substeps > 1:
+            # band-limited inputs between samples: prepared here, stepped on the fine grid
+            substeps = step.substeps
             tf, force, base, base_velocity = _refine(
                 t, substeps, interpolation, force, base, base_velocity
             )
@@ -318,9 +332,11 @@ class Structure:
                 periodic_tol=periodic_tol,
                 rtol=rtol,
                 outputs=outputs,
+                substeps=1,
             )
             return _slice(r, slice(None, None, substeps), t[: (r.t.size - 1) // substeps + 1])
         kw = self._inputs(t, force, base, base_velocity, influence)
+        kw.update(tol=step.tol, substeps=step.substeps)
         if not periodic:
             return self._run(t, kw, x0a, v0a, rtol, want)
         if want is not None:
@@ -517,6 +533,41 @@ def _core_outputs(outputs: Any) -> list[str] | None:
     return [_OUTPUTS[name] for name in names]
 
 
+#: Default error tolerance of :meth:`Structure.simulate` (see its ``tol``).
+DEFAULT_TOL = 1e-4
+
+
+@dataclass(frozen=True)
+class _Stepping:
+    tol: float | None
+    substeps: int
+
+
+def _stepping(substeps: Any, tol: Any) -> _Stepping:
+    """The stepping asked for: error-controlled (``tol``, the default) or fixed."""
+    if substeps is not None and tol is not None:
+        raise InputError("give either substeps (fixed steps) or tol (error control), not both")
+    if substeps is not None:
+        try:
+            k = int(substeps)
+        except (TypeError, ValueError, OverflowError):
+            raise InputError(f"substeps must be an integer, got {substeps!r}") from None
+        if isinstance(substeps, bool) or k != substeps:
+            raise InputError(f"substeps must be an integer, got {substeps!r}")
+        if k < 1:
+            raise InputError(f"substeps must be >= 1, got {substeps}")
+        return _Stepping(None, k)
+    if tol is None:
+        return _Stepping(DEFAULT_TOL, 1)
+    try:
+        value = float(tol)
+    except (TypeError, ValueError):
+        raise InputError(f"tol must be a number, got {tol!r}") from None
+    if not (np.isfinite(value) and value > 0):
+        raise InputError(f"tol must be finite and > 0, got {tol!r}")
+    return _Stepping(value, 1)
+
+
 def _slice(r: SimulationResult, s: slice, t: np.ndarray) -> SimulationResult:
     return SimulationResult(
         t=t.copy(),
@@ -540,16 +591,16 @@ def _slice(r: SimulationResult, s: slice, t: np.ndarray) -> SimulationResult:
 def _refine(
     t: np.ndarray, k: int, how: str, force: Any, base: Any, base_velocity: Any
 ) -> tuple[np.ndarray, Any, Any, Any]:
-    """``k`` sub-samples per interval: the fine time grid and the inputs on it."""
+    """``k`` sub-samples per interval: the fine time grid and the band-limited inputs on it
+    (``how="fourier"``; linear inputs are sub-stepped by the core itself)."""
     nt = t.size
     frac = np.arange(k) / k
     tf = np.concatenate([(t[:-1, None] + np.diff(t)[:, None] * frac).reshape(-1), t[-1:]])
-    if how not in ("linear", "fourier"):
-        raise InputError(f"interpolation must be 'linear' or 'fourier', got {how!r}")
-    if how == "fourier":
-        dt = np.diff(t)
-        if np.ptp(dt) > 1e-9 * dt.mean():
-            raise InputError("interpolation='fourier' needs uniformly sampled t")
+    if how != "fourier":
+        raise InputError(f"only interpolation='fourier' is refined here, got {how!r}")
+    dt = np.diff(t)
+    if np.ptp(dt) > 1e-9 * dt.mean():
+        raise InputError("interpolation='fourier' needs uniformly sampled t")
 
     def fine(a: Any, name: str) -> Any:
         if a is None:
@@ -557,19 +608,10 @@ def _refine(
         arr = np.asarray(a, dtype=float)
         if arr.shape[0] != nt:
             raise InputError(f"{name} has {arr.shape[0]} samples but t has {nt}")
-        if how == "linear":
-            cols = arr.reshape(nt, -1)
-            out = np.stack([np.interp(tf, t, c) for c in cols.T], axis=1)
-        else:
-            # Periodic band-limited interpolation of the whole record (nt samples = one
-            # period), evaluated on the k-times finer grid; the last point wraps around.
-            spec = np.fft.rfft(arr.reshape(nt, -1), axis=0)
-            fine_n = nt * k
-            out = np.fft.irfft(spec, n=fine_n, axis=0) * k
-            out = np.concatenate([out[: (nt - 1) * k + 1]], axis=0)
-        return out.reshape((tf.size, *arr.shape[1:]))
+        # Periodic band-limited interpolation of the whole record (nt samples = one period),
+        # evaluated on the k-times finer grid; the last point wraps around.
+        spec = np.fft.rfft(arr.reshape(nt, -1), axis=0)
+        out = np.fft.irfft(spec, n=nt * k, axis=0) * k
+        return out[: (nt - 1) * k + 1].reshape((tf.size, *arr.shape[1:]))
 
-    fv = fine(force, "force")
-    yv = fine(base, "base")
-    ydv = fine(base_velocity, "base_velocity")
-    return tf, fv, yv, ydv
+    return tf, fine(force, "force"), fine(base, "base"), fine(base_velocity, "base_velocity")

@@ -112,7 +112,7 @@ def linear_grid_start(
                 m = float(mass)  # type: ignore[arg-type]
                 k, c = m * w * w, 2 * z * m * w
                 try:
-                    r = Structure(m, c, k).simulate(t, base=u, x0=x0)
+                    r = Structure(m, c, k).simulate(t, base=u, x0=x0, substeps=1)
                 except ContactLabError:
                     continue
                 if r.x.size < t.size:
@@ -123,7 +123,7 @@ def linear_grid_start(
                 m1 = 1.0 / (w * w) if mass is None else float(mass)
                 k1 = 1.0 if mass is None else m1 * w * w
                 try:
-                    r = Structure(m1, 2 * z * m1 * w, k1).simulate(t, force=u)
+                    r = Structure(m1, 2 * z * m1 * w, k1).simulate(t, force=u, substeps=1)
                 except ContactLabError:
                     continue
                 g = r.x

@@ -119,7 +119,7 @@ def _tangential_force(
         h = breakaway(h, xc, rev, effects["stick_slip"], BREAKAWAY_DISTANCE / ac)
     if "stribeck" in effects:
         vs = STRIBECK_SPEED * rms(v)
-        h = h * (1.0 + effects["stribeck"] * np.exp(-np.abs(v) / vs))
+        h = h * (1.0 + effects["stribeck"] * np.exp(-((v / vs) ** 2)))  # docs/effects.md
     if "position_friction" in effects:
         xi = xc / np.max(np.abs(xc))
         h = h * (

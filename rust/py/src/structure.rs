@@ -87,7 +87,7 @@ struct StructureRun {
 
 /// Newmark simulation of a structure with joints; returns a `StructureRun`.
 #[pyfunction]
-#[pyo3(signature = (n, m, c, k, joints, t, x0, v0, force=None, base=None, base_velocity=None, kr=None, cr=None, rtol=1e-10, max_iter=30, outputs=None))]
+#[pyo3(signature = (n, m, c, k, joints, t, x0, v0, force=None, base=None, base_velocity=None, kr=None, cr=None, rtol=1e-10, max_iter=30, outputs=None, tol=None, substeps=1))]
 fn structure_simulate<'py>(
     py: Python<'py>,
     n: usize,
@@ -106,6 +106,8 @@ fn structure_simulate<'py>(
     rtol: f64,
     max_iter: usize,
     outputs: Option<Vec<String>>,
+    tol: Option<f64>,
+    substeps: usize,
 ) -> PyResult<StructureRun> {
     let (ms, cs, ks) = (sl(&m, "M")?, sl(&c, "C")?, sl(&k, "K")?);
     let (ts, x0s, v0s) = (sl(&t, "t")?, sl(&x0, "x0")?, sl(&v0, "v0")?);
@@ -131,6 +133,8 @@ fn structure_simulate<'py>(
     let opts = Options {
         rtol,
         max_iter,
+        tol,
+        substeps,
         ..Options::default()
     };
     // The outputs are numpy arrays the kernel writes into (no Vec and copy; numpy's large

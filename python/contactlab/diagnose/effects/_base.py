@@ -24,8 +24,9 @@ TANGENTIAL_STAGES = (
     "additive", "output",
 )  # fmt: skip
 #: the normal-contact stages: the stiffness law's coefficients, an element replacing the
-#: Kelvin-Voigt solve, terms added to the displacement, the measurement
-NORMAL_STAGES = ("law", "element", "additive", "output")
+#: Kelvin-Voigt solve, a loss that depends on the joint's own rate (solved again with it),
+#: terms added to the displacement, the measurement
+NORMAL_STAGES = ("law", "element", "loss", "additive", "output")
 
 
 @dataclass
@@ -105,8 +106,10 @@ class EffectModel:
     physics: ClassVar[str] = ""
     #: effects that act through the same signal are told apart only when each is needed
     #: beside the other: "velocity" (delay, viscous damping, Stribeck, inertia: a term in
-    #: ẋ or ẍ, or a shift of the force along the velocity) — see the workflow's parsimony
-    acts_through: ClassVar[str | None] = None
+    #: ẋ or ẍ, or a shift of the force along the velocity), "friction along the branch"
+    #: (Stribeck, position friction, stick-slip: a reshaping of the friction force between
+    #: reversals); a tuple for an effect in several — see the search's parsimony rule
+    acts_through: ClassVar[str | tuple[str, ...] | None] = None
     stage: ClassVar[str]
     rank: ClassVar[float] = 0.0
     #: position in the library (the order verdicts are listed and ties are broken in)

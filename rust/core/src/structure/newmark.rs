@@ -17,6 +17,8 @@ use super::joint::{Joint, JointState, Trial};
 use super::{Buffers, Inputs, Options, Status, Structure, Summary};
 use crate::error::CoreError;
 
+mod adaptive;
+
 /// The integrator's per-step state.
 struct Work {
     x: Vec<f64>,
@@ -96,7 +98,17 @@ struct Scratch {
 // Row-major index arithmetic: indices < n (dofs), nj (joints) or the sample count, into
 // buffers whose sizes n*n, nt*n and nt*nj were checked in `Structure::new` and `simulate`.
 #[allow(clippy::arithmetic_side_effects)]
-fn newton_step(s: &Structure, w: &Work, h: f64, sc: &mut Scratch, opts: &Options) -> Option<u64> {
+///
+/// `quick` (0: never): a residual below this fraction of the forces ends the solve after its
+/// update without another trial, the joints' forces carried along their tangents (a
+/// step-doubling pair's inner solves, whose trials are never committed; see `sdof::newton`).
+fn newton_step(
+    s: &Structure,
+    w: &Work,
+    (h, quick): (f64, f64),
+    sc: &mut Scratch,
+    opts: &Options,
+) -> Option<u64> {
     let n = s.n;
     let (b, g) = (0.25 * h * h, 0.5 * h);
     // The unknown is the new acceleration: x1 and v1 follow from it without the cancellation
@@ -159,6 +171,20 @@ fn newton_step(s: &Structure, w: &Work, h: f64, sc: &mut Scratch, opts: &Options
         sc.lu.solve(&mut sc.tmp);
         for d in 0..n {
             sc.a1[d] -= sc.tmp[d];
+        }
+        if rn <= quick * scale {
+            for d in 0..n {
+                let asum = w.a[d] + sc.a1[d];
+                sc.dx[d] = h * w.v[d] + b * asum;
+                sc.x1[d] = w.x[d] + sc.dx[d];
+                sc.v1[d] = w.v[d] + g * asum;
+            }
+            for (j, t) in s.joints.iter().zip(sc.trials.iter_mut()) {
+                // the end moved by −b δa in x and −g δa in v since the trial
+                let (dd, dv) = (-b * rel(j, &sc.tmp), -g * rel(j, &sc.tmp));
+                t.f += t.kt * dd + t.ct * dv;
+            }
+            return Some(it);
         }
     }
     None
@@ -262,21 +288,29 @@ pub(super) fn simulate_dense(
     let mut sum = Summary::new();
     record(s, &w, out, 0);
     sum.n_out = 1;
+    if let Some(tol) = opts.tol {
+        let rate = super::stiff_rate(s);
+        return adaptive::run(s, inp, (tol, rate), opts, w, sc, sum, out);
+    }
+    // fixed steps: `substeps` equal pieces per interval (events and halvings split them)
+    let k_sub = opts.substeps as f64;
+    let piece = 1.0 / k_sub;
+    let max_events = opts.max_events.saturating_mul(opts.substeps);
     for (i, pair) in inp.t.windows(2).enumerate() {
         let big_h = pair[1] - pair[0];
         let mut tau = 0.0_f64;
         let mut halvings = 0usize;
         let mut events = 0usize;
-        let mut frac = 1.0_f64; // fraction of the interval to try next
+        let mut frac = piece; // fraction of the interval to try next
         while tau < 1.0 {
             let step = frac.min(1.0 - tau);
             let h = step * big_h;
             let tau1 = if step >= 1.0 - tau { 1.0 } else { tau + step };
             load(s, inp, i, tau1, &mut sc.f1);
-            match newton_step(s, &w, h, &mut sc, opts) {
+            match newton_step(s, &w, (h, 0.0), &mut sc, opts) {
                 None => {
                     halvings = halvings.saturating_add(1);
-                    if halvings > opts.max_halvings {
+                    if halvings > opts.max_halvings.saturating_mul(opts.substeps) {
                         sum.status = Status::NoConvergence {
                             time: inp.t[i] + tau * big_h,
                             step: h,
@@ -289,7 +323,7 @@ pub(super) fn simulate_dense(
                 Some(it) => sum.n_iter = sum.n_iter.saturating_add(it),
             }
             // Split the step at the earliest joint event strictly inside it.
-            if events < opts.max_events {
+            if events < max_events {
                 let mut theta = 1.0_f64;
                 for (jn, j) in s.joints.iter().enumerate() {
                     let d1 = rel(j, &sc.x1);
@@ -298,7 +332,7 @@ pub(super) fn simulate_dense(
                         theta = theta.min(th);
                     }
                 }
-                let min_piece = 1e-3 / step;
+                let min_piece = 1e-3 * piece / step;
                 if theta > min_piece && theta < 1.0 - min_piece {
                     events = events.saturating_add(1);
                     frac = step * theta;
@@ -308,7 +342,9 @@ pub(super) fn simulate_dense(
             accept(s, &mut w, &mut sc)?;
             sum.n_steps = sum.n_steps.saturating_add(1);
             tau = tau1;
-            frac = (1.0 - tau).max(0.0);
+            // on to the next point of the fixed grid (events split between them)
+            frac = ((tau * k_sub + 1e-9).floor() + 1.0) / k_sub - tau;
+            frac = frac.min(1.0 - tau).max(0.0);
             if w.x.iter().chain(&w.v).any(|v| !v.is_finite()) {
                 sum.status = Status::NonFinite {
                     time: inp.t[i] + tau * big_h,

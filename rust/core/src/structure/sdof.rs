@@ -53,6 +53,35 @@ trait Joints {
     fn commit(&mut self, x0: f64, x1: f64) -> Result<(), CoreError>;
     /// Write each joint's force, work and dissipated energy at `x` as sample `i`.
     fn record(&self, x: f64, i: usize, out: &mut Buffers<'_>);
+    /// How close Newton's residual must come (relative) before a step-doubling pair's inner
+    /// solve ends without a last trial: `QUICK` where every tangent is exact (convergence is
+    /// quadratic), 0 (never) where a law's tangent is a difference quotient.
+    fn quick(&self) -> f64 {
+        adaptive::QUICK
+    }
+    /// Keep each joint's force at the last trial, moved by `(dx, dv)` along its tangents, in
+    /// `slot` (0: the coarse end of a step-doubling pair, 1: its midpoint, 2: its fine end).
+    fn keep(&mut self, slot: usize, moved: (f64, f64));
+    /// Accept the last trial (at `xr`, from `x0`) of a step-doubling piece whose coarse end,
+    /// midpoint and fine end were at `(xc, xm, xf)`: each joint's work is the Richardson
+    /// extrapolation of the pair's trapezoidal sums.
+    /// `ext`: the extrapolation weight (1/3, or 0 when the plain half steps are kept).
+    fn commit_doubled(
+        &mut self,
+        x0: f64,
+        ends: (f64, f64, f64),
+        ext: f64,
+        xr: f64,
+    ) -> Result<(), CoreError>;
+}
+
+/// The Richardson extrapolation of a joint's work over a step-doubling piece: forces `f0` at
+/// the start `x0` and `kept` (coarse end, midpoint, fine end) at `(xc, xm, xf)`.
+#[inline(always)]
+fn doubled_work(f0: f64, kept: [f64; 3], x0: f64, (xc, xm, xf): (f64, f64, f64), ext: f64) -> f64 {
+    let coarse = 0.5 * (f0 + kept[0]) * (xc - x0);
+    let fine = 0.5 * (f0 + kept[1]) * (xm - x0) + 0.5 * (kept[1] + kept[2]) * (xf - xm);
+    fine + (fine - coarse) * ext
 }
 
 /// Any set of joints, through [`JointLaw`]'s dispatch.
@@ -64,6 +93,8 @@ struct Dyn<'a> {
     jf: Vec<f64>,
     jwork: Vec<f64>,
     stored0: Vec<f64>,
+    /// Each joint's forces kept by [`Joints::keep`].
+    kept: Vec<[f64; 3]>,
 }
 
 impl<'a> Dyn<'a> {
@@ -94,6 +125,7 @@ impl<'a> Dyn<'a> {
                 jf,
                 jwork: vec![0.0; nj],
                 stored0,
+                kept: vec![[0.0; 3]; nj],
             },
             sum,
         ))
@@ -101,6 +133,45 @@ impl<'a> Dyn<'a> {
 }
 
 impl Joints for Dyn<'_> {
+    fn quick(&self) -> f64 {
+        let exact = !self
+            .joints
+            .iter()
+            .any(|j| matches!(j.law, JointLaw::Law { .. }));
+        if exact {
+            adaptive::QUICK
+        } else {
+            0.0
+        }
+    }
+
+    #[inline]
+    fn keep(&mut self, slot: usize, (dx, dv): (f64, f64)) {
+        for (k, tr) in self.kept.iter_mut().zip(&self.trials) {
+            if let Some(v) = k.get_mut(slot) {
+                *v = tr.f + tr.kt * dx + tr.ct * dv;
+            }
+        }
+    }
+
+    #[inline]
+    fn commit_doubled(
+        &mut self,
+        x0: f64,
+        ends: (f64, f64, f64),
+        ext: f64,
+        xr: f64,
+    ) -> Result<(), CoreError> {
+        let parts = self.joints.iter().zip(&self.trials).zip(&mut self.states);
+        let books = self.jwork.iter_mut().zip(&mut self.jf).zip(&self.kept);
+        for (((j, tr), st), ((work, f), kept)) in parts.zip(books) {
+            *work += doubled_work(*f, *kept, x0, ends, ext);
+            j.law.commit(st, x0, xr, tr)?;
+            *f = tr.f;
+        }
+        Ok(())
+    }
+
     #[inline(always)]
     fn trial(&mut self, x0: f64, pt: &Point) -> Sum {
         let (x1, v1) = (pt.x1, pt.v1);
@@ -189,6 +260,7 @@ struct MasingExp {
     jf: f64,
     jwork: f64,
     stored0: f64,
+    kept: [f64; 3],
 }
 
 impl MasingExp {
@@ -228,6 +300,7 @@ impl MasingExp {
             jf: 0.0,
             jwork: 0.0,
             stored0: 0.0,
+            kept: [0.0; 3],
         };
         // (the virgin state has no cached branch: this is the memory walk)
         let pt = Point {
@@ -281,6 +354,29 @@ impl MasingExp {
 }
 
 impl Joints for MasingExp {
+    #[inline(always)]
+    fn keep(&mut self, slot: usize, (dx, _): (f64, f64)) {
+        if let Some(v) = self.kept.get_mut(slot) {
+            *v = self.f + self.kt * dx;
+        }
+    }
+
+    #[inline(always)]
+    fn commit_doubled(
+        &mut self,
+        x0: f64,
+        ends: (f64, f64, f64),
+        ext: f64,
+        xr: f64,
+    ) -> Result<(), CoreError> {
+        self.jwork += doubled_work(self.jf, self.kept, x0, ends, ext);
+        masing_commit(&mut self.st, xr, self.f, self.aux);
+        self.refresh();
+        self.argl = f64::NAN;
+        self.jf = self.f;
+        Ok(())
+    }
+
     // `2 · (reversals kept)`: at most twice the stack length, a Vec's length.
     #[inline(always)]
     #[allow(clippy::arithmetic_side_effects)]
@@ -368,6 +464,9 @@ struct State {
 
 /// A converged step (not yet committed) and the joints' sum at its end.
 struct Step {
+    /// (How far the end moved after the joints' last trial, in `x` and `v`: nonzero only for
+    /// a step ended without a final trial.)
+    moved: (f64, f64),
     dx: f64,
     x1: f64,
     v1: f64,
@@ -397,13 +496,18 @@ fn load(inp: &Inputs<'_>, i: usize, tau: f64) -> f64 {
     out
 }
 
-/// One Newmark step of length `h` to load `f1` (`mck`: the scalar M, C, K). Returns the step
-/// and the Newton iterations used, or `None` if Newton failed.
+/// One Newmark step of length `h` from `w` to load `f1` (`mck`: the scalar M, C, K), the joints
+/// tried from their committed position `xc` (`w.x`, or the start of a step-doubling piece when
+/// `w` is its midpoint: a monotone path, so the same end state). Returns the step and the
+/// Newton iterations used, or `None` if Newton failed.
+// The step's context (joints, M C K, state, start, length, load, options) as it is.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn newton<J: Joints>(
     jt: &mut J,
     (m, c, k): (f64, f64, f64),
     w: &State,
+    (xc, quick): (f64, f64),
     h: f64,
     f1: f64,
     opts: &Options,
@@ -433,7 +537,7 @@ fn newton<J: Joints>(
         let x1 = xp + b * a1;
         let v1 = vp + g * a1;
         let pt = Point { x1, v1, xp, b, a1 };
-        let js = jt.trial(w.x, &pt);
+        let js = jt.trial(xc, &pt);
         let (ma, cv, kx) = (m * a1, c * v1, k * x1);
         let r = ((ma + cv) + (kx - f1)) + js.f;
         let scale = (f1.abs() + ((ma.abs() + cv.abs()) + kx.abs())).max(js.fmax);
@@ -442,12 +546,13 @@ fn newton<J: Joints>(
         }
         if r.abs() <= opts.rtol * scale.max(f64::MIN_POSITIVE) {
             let st = Step {
-                dx: x1 - w.x,
+                dx: x1 - xc,
                 x1,
                 v1,
                 a1,
                 f1,
                 joints: js,
+                moved: (0.0, 0.0),
             };
             return Some((st, it));
         }
@@ -455,7 +560,28 @@ fn newton<J: Joints>(
         if !(jac != 0.0 && jac.is_finite()) {
             return None;
         }
-        a1 -= r / jac;
+        let da = r / jac;
+        a1 -= da;
+        if r.abs() <= quick * scale {
+            // Newton converges quadratically: the next residual would be of the order of the
+            // square of this one, so the update is kept without another trial, the joints'
+            // forces carried along their tangents (a step-doubling pair's inner steps only:
+            // their joint trials are never committed)
+            let (mx, mv) = (-b * da, -g * da);
+            let mut joints = js;
+            joints.f += js.kt * mx + js.ct * mv;
+            let (x1, v1) = (xp + b * a1, vp + g * a1);
+            let st = Step {
+                dx: x1 - xc,
+                x1,
+                v1,
+                a1,
+                f1,
+                joints,
+                moved: (mx, mv),
+            };
+            return Some((st, it));
+        }
     }
     None
 }
@@ -545,20 +671,28 @@ fn run<J: Joints>(
     let mut sum = Summary::new();
     record(jt, &w, out, 0);
     sum.n_out = 1;
+    if let Some(tol) = opts.tol {
+        let rate = super::stiff_rate(s);
+        return adaptive::run(inp, (m, c, k), (tol, rate), opts, jt, w, sum, out);
+    }
+    // fixed steps: `substeps` equal pieces per interval (events and halvings split them)
+    let k_sub = opts.substeps as f64;
+    let piece = 1.0 / k_sub;
+    let max_events = opts.max_events.saturating_mul(opts.substeps);
     for (i, pair) in inp.t.windows(2).enumerate() {
         let big_h = pair[1] - pair[0];
         let mut tau = 0.0_f64;
         let mut halvings = 0usize;
         let mut events = 0usize;
-        let mut frac = 1.0_f64;
+        let mut frac = piece;
         while tau < 1.0 {
             let step = frac.min(1.0 - tau);
             let h = step * big_h;
             let tau1 = if step >= 1.0 - tau { 1.0 } else { tau + step };
             let f1 = load(inp, i, tau1);
-            let Some((st, it)) = newton(jt, (m, c, k), &w, h, f1, opts) else {
+            let Some((st, it)) = newton(jt, (m, c, k), &w, (w.x, 0.0), h, f1, opts) else {
                 halvings = halvings.saturating_add(1);
-                if halvings > opts.max_halvings {
+                if halvings > opts.max_halvings.saturating_mul(opts.substeps) {
                     sum.status = Status::NoConvergence {
                         time: inp.t[i] + tau * big_h,
                         step: h,
@@ -569,10 +703,10 @@ fn run<J: Joints>(
                 continue;
             };
             sum.n_iter = sum.n_iter.saturating_add(it);
-            if events < opts.max_events {
+            if events < max_events {
                 let theta = jt.event(w.x, st.x1, w.v, st.v1);
                 if theta < 1.0 {
-                    let min_piece = 1e-3 / step;
+                    let min_piece = 1e-3 * piece / step;
                     if theta > min_piece && theta < 1.0 - min_piece {
                         events = events.saturating_add(1);
                         frac = step * theta;
@@ -583,7 +717,9 @@ fn run<J: Joints>(
             accept(jt, c, &mut w, &st)?;
             sum.n_steps = sum.n_steps.saturating_add(1);
             tau = tau1;
-            frac = (1.0 - tau).max(0.0);
+            // on to the next point of the fixed grid (events split between them)
+            frac = ((tau * k_sub + 1e-9).floor() + 1.0) / k_sub - tau;
+            frac = frac.min(1.0 - tau).max(0.0);
             if !(w.x.is_finite() && w.v.is_finite()) {
                 sum.status = Status::NonFinite {
                     time: inp.t[i] + tau * big_h,
@@ -598,5 +734,6 @@ fn run<J: Joints>(
     Ok(sum)
 }
 
+mod adaptive;
 #[cfg(test)]
 mod tests;

@@ -1,4 +1,4 @@
-"""``asymmetric_branches``: a different stiffness on the compression and relief sides."""
+"""``asymmetric_branches``: loading and unloading dissipate differently."""
 
 from __future__ import annotations
 
@@ -8,25 +8,40 @@ from .._base import EffectModel, register
 
 @register
 class AsymmetricBranches(EffectModel):
+    """Loading and unloading dissipate differently: ``p - p0 = k_s δ + h (1 + a sgn δ') δ'``.
+
+    docs/effects.md §2: plastic flattening of the asperities on loading, elastic recovery on
+    unloading. Beyond the symmetric Kelvin-Voigt loss the loading branch (``δ' > 0``) carries
+    ``a h |δ'|`` more pressure: an even distortion of the loop's centre curve locked to the
+    rate (largest at mid-stroke, nothing at the turning points) that grows with the
+    excitation frequency, while the energy per cycle stays that of ``h`` to first order.
+    Solved exactly on the linear Kelvin-Voigt joint
+    (:func:`contactlab.diagnose.candidates_normal.kelvin_voigt_asymmetric`); not combined
+    with a stiffness law or a hysteretic element (each is another account of the loop's
+    shape beyond the ellipse).
+    """
+
     name = "asymmetric_branches"
     kind = "normal"
-    params = (ParamSpec("a", "-", 0.0, -0.4, 0.4, "one"),)
-    description = "different stiffness on the compression and relief sides, k (1 + a δ/δ_r)"
+    params = (ParamSpec("a", "-", 0.0, -0.95, 0.95, "one"),)
+    description = "loading and unloading branches damped differently, h (1 + a sgn δ') δ'"
     physics = (
-        "Compression closes the gap between asperities, relief opens it: the stiffness "
-        "depends on the sign of the displacement, k_s(δ) = k (1 + a δ/δ_r)."
+        "Asperities flatten plastically on loading and recover elastically on unloading: "
+        "the damping differs between the branches, p - p0 = k_s δ + h (1 + a sgn δ') δ' "
+        "(a > 0: the loading branch lies farther from the centre curve)."
     )
-    stage = "law"
+    stage = "loss"
     rank = 0
     order = 4
     size_param = "a"
 
-    def apply(self, coeffs, p, ctx):
-        k, a2, a3 = coeffs
-        return (k, a2 + p["k"] * p["a"] / ctx.d.extra["delta_r"], a3)
+    def apply(self, delta, p, ctx):
+        return ctx.family.asymmetric(delta, p, ctx.d)
 
     def argument(self, d, p):
         return (
-            f"the stiffness is {100 * abs(p['a']):.1f} % {'higher' if p['a'] > 0 else 'lower'} "
-            "in compression than in relief at the displacement's RMS"
+            f"the loading branch is damped {100 * abs(p['a']):.0f} % "
+            f"{'more' if p['a'] > 0 else 'less'} and unloading {100 * abs(p['a']):.0f} % "
+            f"{'less' if p['a'] > 0 else 'more'} than the Kelvin-Voigt mean (a function of "
+            "|δ'|, growing with the frequency, not of δ)"
         )

@@ -1,32 +1,66 @@
-"""``stiffness_nonlinearity``: symmetric hardening of the contact stiffness (eq. 17)."""
+"""``stiffness_nonlinearity``: the contact stiffness changes with the displacement (eq. 6)."""
 
 from __future__ import annotations
+
+import numpy as np
 
 from ..._family import ParamSpec
 from .._base import EffectModel, register
 
+#: the terms of the stiffness law relative to ``k``: linear and quadratic in ``δ/δ_r``
+LAW_TERMS = ("kappa1", "kappa")
+
 
 @register
 class StiffnessNonlinearity(EffectModel):
+    """Rough-surface hardening: ``k_s(δ) = k (1 + κ1 δ/δ_r + κ (δ/δ_r)²)`` (docs/effects.md §2).
+
+    The paper's eq. 6 law ``k_s = a1 + a2 δ + a3 δ²`` on the record's displacement scale
+    ``δ_r``: ``κ1`` (``a2 = k κ1 / δ_r``) hardens the compression side (δ > 0) and softens
+    relief, a banana loop with unequal displacement extremes; ``κ`` (``a3 = k κ / δ_r²``)
+    hardens both sides alike. Either way a function of δ: both branches of the loop bend
+    together around one centre curve, at every frequency the same (its look-alike
+    ``asymmetric_branches`` is a function of ``|δ'|``, growing with the frequency).
+    """
+
     name = "stiffness_nonlinearity"
     kind = "normal"
-    params = (ParamSpec("kappa", "-", 0.0, -0.15, 10.0, "one"),)
-    description = "stiffness growing with displacement, k_s(δ) = k (1 + κ (δ/δ_r)²) (eq. 17)"
+    params = (
+        ParamSpec("kappa", "-", 0.0, -0.15, 10.0, "one"),
+        ParamSpec("kappa1", "-", 0.0, -0.4, 0.4, "one"),
+    )
+    description = (
+        "stiffness changing with displacement, k_s(δ) = k (1 + κ1 δ/δ_r + κ (δ/δ_r)²) (eq. 6)"
+    )
     physics = (
         "The real contact area of rough surfaces grows with the load: the stiffness "
-        "hardens symmetrically, k_s(δ) = k (1 + κ (δ/δ_r)²) (the paper's eq. 17)."
+        "changes with the displacement, k_s(δ) = a1 + a2 δ + a3 δ² (the paper's eq. 6), "
+        "here k (1 + κ1 δ/δ_r + κ (δ/δ_r)²); both branches bend together."
     )
     stage = "law"
     rank = 1
     order = 0
     size_param = "kappa"
 
+    def size(self, p, se):
+        """The change of the stiffness at ``±δ_r`` over (κ1, κ) in quadrature, with its
+        delta-method error."""
+        v = float(np.hypot(p.get("kappa", 0.0), p.get("kappa1", 0.0)))
+        if v == 0:
+            return 0.0, float(np.inf)
+        e2 = sum((p.get(n, 0.0) / v * se.get(n, np.inf)) ** 2 for n in LAW_TERMS)
+        return v, float(np.sqrt(e2))
+
     def apply(self, coeffs, p, ctx):
         k, a2, a3 = coeffs
-        return (k, a2, a3 + p["k"] * p["kappa"] / ctx.d.extra["delta_r"] ** 2)
+        dr = ctx.d.extra["delta_r"]
+        return (k, a2 + p["k"] * p.get("kappa1", 0.0) / dr, a3 + p["k"] * p["kappa"] / dr**2)
 
     def argument(self, d, p):
+        k1, k2 = p.get("kappa1", 0.0), p["kappa"]
+        dr = d.extra.get("delta_r", float("nan"))
         return (
-            f"the stiffness changes by {100 * p['kappa']:.1f} % at the displacement's RMS "
-            f"δ_r = {d.extra.get('delta_r', float('nan')):.3g} m, alike in compression and relief"
+            f"at the displacement's RMS δ_r = {dr:.3g} m the stiffness changes by "
+            f"{100 * (k2 + k1):+.1f} % in compression and {100 * (k2 - k1):+.1f} % in relief "
+            "(a function of δ: both branches bend together, at every frequency alike)"
         )

@@ -5,64 +5,111 @@ from __future__ import annotations
 import numpy as np
 
 from ..._family import ParamSpec
-from .._base import EffectModel, register
+from .._base import EffectModel, Plausibility, register
+
+#: wavelengths :meth:`PositionFriction.start` tries, as multiples of the stroke's half-width
+START_WAVELENGTHS = np.geomspace(0.6, 8.0, 28)
+#: a wave longer than this many half-widths of the stroke is a level or a gradient of the
+#: friction over the stroke (h0, parameter drift, asymmetry), not a feature of the track
+LONGEST_WAVE = 12.0
 
 
-def track_harmonics(x: np.ndarray, d) -> tuple[np.ndarray, ...]:
-    """``cos ξ, sin ξ, cos 2ξ, sin 2ξ`` and ``ξ/π``, ``ξ = π (x - x_mid)/x_half``."""
-    r = (x - d.extra["x_mid"]) / d.extra["x_half"]
-    xi = np.pi * r
-    return np.cos(xi), np.sin(xi), np.cos(2 * xi), np.sin(2 * xi), r
+def track_phase(x: np.ndarray, d, wavelength: float) -> np.ndarray:
+    """``2π (x - x_mid) / L``: the phase of the track's wave at the positions ``x``."""
+    return (2.0 * np.pi / max(wavelength, 1e-300)) * (x - d.extra["x_mid"])
 
 
-#: the terms of the friction along the track: two harmonics of the stroke and a gradient
-TRACK_TERMS = ("a1", "b1", "a2", "b2", "g1")
+#: the amplitudes of the friction's wave along the track (in phase and in quadrature with
+#: the stroke's middle)
+TRACK_TERMS = ("a1", "b1")
 
 
 @register
 class PositionFriction(EffectModel):
+    """Friction varying along the track: ``h0(x) = h0 (1 + a1 cos φ + b1 sin φ)``, ``φ = 2π
+    (x - x_mid)/L`` (docs/effects.md §1: one wave of free length ``L``; ``x_mid`` the middle
+    of the stroke).
+
+    The same bumps at the same ``x`` on both branches, every cycle; locked to position (not
+    to time or to the cycle's phase). The wavelength is fitted: a track feature is a wave of
+    its own length, not a harmonic of the stroke.
+    """
+
     name = "position_friction"
     kind = "tangential"
-    params = tuple(ParamSpec(n, "-", 0.0, -0.3, 0.3, "one") for n in TRACK_TERMS)
+    params = (
+        ParamSpec("a1", "-", 0.0, -0.3, 0.3, "one"),
+        ParamSpec("b1", "-", 0.0, -0.3, 0.3, "one"),
+        ParamSpec("L", "m", np.nan, 0.0, np.inf, "x"),
+    )
     description = (
-        "friction varying along the track (wavy plateaus): F = h (1 + Σ a_k cos(kπ ξ) + "
-        "b_k sin(kπ ξ) + g1 ξ), ξ the position scaled to -1..1 over the stroke, k = 1, 2"
+        "friction varying along the track (wavy plateaus): F = h (1 + a1 cos φ + b1 sin φ), "
+        "φ = 2π (x - x_mid)/L, a wave of length L along the track"
     )
     physics = (
         "The friction coefficient varies along the track (waviness, wear scar, debris): the "
         "plateaus bend with position, the same on every stroke, up and down alike as a "
-        "function of x. A normal load fluctuating at the drive's harmonics depends on time "
-        "(the same along up and down strokes only for even harmonics in phase)."
+        "function of x: h0(x) = h0 (1 + a1 cos 2π(x - x_mid)/L + b1 sin 2π(x - x_mid)/L). "
+        "A normal load fluctuating at the drive's harmonics depends on time (the same along "
+        "up and down strokes only for even harmonics in phase)."
     )
+    acts_through = "friction along the branch"
     stage = "factor"
     rank = 1
     order = 12
     size_param = "a1"
 
     def size(self, p, se):
-        """The amplitude over (a1, b1, a2, b2, g1), with its delta-method error."""
-        names = TRACK_TERMS
-        v = float(np.sqrt(sum(p.get(n, 0.0) ** 2 for n in names)))
+        """The wave's amplitude ``√(a1² + b1²)``, with its delta-method error."""
+        v = float(np.hypot(p.get("a1", 0.0), p.get("b1", 0.0)))
         if v == 0:
             return 0.0, float(np.inf)
-        e2 = sum((p.get(n, 0.0) / v * se.get(n, np.inf)) ** 2 for n in names)
+        e2 = sum((p.get(n, 0.0) / v * se.get(n, np.inf)) ** 2 for n in TRACK_TERMS)
         return v, float(np.sqrt(e2))
+
+    def start(self, p, d, residual, family=None):
+        """The wavelength (of :data:`START_WAVELENGTHS` half-widths of the stroke) whose wave,
+        on the current model's force (``d.y - residual``), explains most of the residual,
+        with its least-squares amplitudes (the term is linear in them at a given ``L``)."""
+        half = float(d.extra.get("x_half", 0.5 * float(np.ptp(d.u))))
+        best: dict[str, float] = {"L": 2.0 * half if half > 0 else 1.0}
+        model = d.y - residual
+        if not (half > 0 and np.all(np.isfinite(model))):
+            return best
+        top = 0.0
+        for m in START_WAVELENGTHS:
+            ph = track_phase(d.u, d, m * half)
+            cols = np.column_stack((model * np.cos(ph), model * np.sin(ph)))
+            coef, *_ = np.linalg.lstsq(cols, residual, rcond=None)
+            gain = float(residual @ (cols @ coef))
+            if gain > top:
+                top = gain
+                best = {"L": float(m * half), "a1": float(np.clip(coef[0], -0.25, 0.25)),
+                        "b1": float(np.clip(coef[1], -0.25, 0.25))}  # fmt: skip
+        return best
 
     def apply(self, h, p, ctx):
         d = ctx.d
-        if "displacement_offset" in ctx.effects:
-            c1, s1, c2, s2, r = track_harmonics(ctx.pick(ctx.x), d)
-        else:
-            x = ctx.x
-            c1, s1, c2, s2, r = map(ctx.pick, ctx.fixed("track", lambda: track_harmonics(x, d)))
-        g = (
-            p["a1"] * c1 + p["b1"] * s1 + p["a2"] * c2 + p["b2"] * s2 + p.get("g1", 0.0) * r
-        )  # (a model saved before g1: none)
-        return h * (1.0 + g)
+        x = ctx.pick(ctx.x)
+        ph = track_phase(x, d, p["L"])
+        return h * (1.0 + p["a1"] * np.cos(ph) + p["b1"] * np.sin(ph))
+
+    def plausible(self, d, p):
+        base = super().plausible(d, p)
+        if not base.ok:
+            return base
+        half = float(d.extra.get("x_half", np.nan))
+        if np.isfinite(half) and half > 0 and p["L"] > LONGEST_WAVE * half:
+            return Plausibility(
+                False,
+                f"a wave of {p['L']:.3g} m is {p['L'] / (2 * half):.1f} strokes long: a level "
+                "or gradient of the friction over the stroke, not a feature of the track",
+            )
+        return base
 
     def argument(self, d, p):
-        amp = float(np.sqrt(sum(p.get(n, 0.0) ** 2 for n in TRACK_TERMS)))
+        amp = float(np.hypot(p.get("a1", 0.0), p.get("b1", 0.0)))
         return (
-            f"the friction varies by {100 * amp:.0f} % along the track, the same on every "
-            "stroke (a function of position, not of time)"
+            f"the friction varies by ±{100 * amp:.0f} % along the track in a wave of "
+            f"{p['L']:.3g} m, the same on every stroke (a function of position, not of time)"
         )

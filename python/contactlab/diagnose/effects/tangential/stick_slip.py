@@ -105,6 +105,7 @@ class StickSlip(EffectModel):
         "distance slid since the reversal, not of the speed — Stribeck's is of the speed): "
         "F = M[x] + s_b h0 sgn(ẋ) (s/ell) e^(1 - s/ell) (docs/effects.md)."
     )
+    acts_through = "friction along the branch"
     stage = "branch"
     order = 13
     size_param = "s_b"

@@ -20,16 +20,16 @@ class Stribeck(EffectModel):
         ParamSpec("v_s", "m/s", np.nan, 0.0, np.inf, "v"),
     )
     description = (
-        "velocity-dependent friction: F = h (1 + s exp(-|ẋ|/v_s)) (Stribeck, s > 0: "
+        "velocity-dependent friction: F = h (1 + s exp(-(ẋ/v_s)²)) (Stribeck, s > 0: "
         "friction weakening with sliding speed)"
     )
     physics = (
         "The friction coefficient falls from its static value as the sliding speed rises "
-        "(Stribeck): F = h (1 + s exp(-|ẋ|/v_s)). s > 0: the force right after a reversal "
+        "(Stribeck): F = h (1 + s exp(-(ẋ/v_s)²)). s > 0: the force right after a reversal "
         "(speed near zero) is s h0 above the plateau — a breakaway the sticks measure. Acts "
         "through the velocity, like a delay, a viscous term and inertia."
     )
-    acts_through = "velocity"
+    acts_through = ("velocity", "friction along the branch")
     stage = "factor"
     rank = 0
     order = 11
@@ -40,7 +40,7 @@ class Stribeck(EffectModel):
 
     def apply(self, h, p, ctx):
         speed = ctx.pick(ctx.fixed("speed", lambda: np.abs(ctx.d.ud)))
-        return h * (1.0 + p["s"] * np.exp(-speed / max(p["v_s"], 1e-300)))
+        return h * (1.0 + p["s"] * np.exp(-((speed / max(p["v_s"], 1e-300)) ** 2)))
 
     def plausible(self, d, p):
         base = super().plausible(d, p)

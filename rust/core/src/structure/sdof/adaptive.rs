@@ -1,0 +1,274 @@
+//! Error-controlled stepping for one DOF: step doubling with Richardson extrapolation.
+//!
+//! Each piece of a sample interval is taken twice, as one Newmark step of length `h` and as two
+//! of `h/2` (the second from the midpoint, its joint trials from the piece's committed start:
+//! pieces never contain a reversal or a stick-slip transition, so the path is monotone and
+//! the hysteretic state at the end is the same). Average-acceleration Newmark is the
+//! trapezoidal rule, whose error has an expansion in even powers of `h`; the difference of the
+//! pair, divided by 3, estimates the local error of the half steps, and their Richardson
+//! extrapolation `(4 y_{h/2} − y_h) / 3` cancels the leading term: the kept state is fourth
+//! order. Its acceleration is the one in equilibrium there, the joints are tried at the
+//! extrapolated displacement from their committed state (their history carried exactly), and
+//! the energy increments are extrapolated the same way (Romberg on the trapezoidal sums).
+//!
+//! A piece is accepted when the estimate is at most `tol` relative to the largest displacement
+//! and velocity so far; the next piece length follows the usual `(tol / err)^(1/3)` rule, and
+//! pieces always end on the samples (the inputs have a kink there).
+
+use super::{load, newton, record, Joints, Point, State, Step};
+use crate::error::CoreError;
+use crate::structure::{Buffers, Inputs, Options, Status, Summary};
+
+/// A Newton solve of the pair ends, without a last trial, once its residual is below this
+/// fraction of the forces (see `newton`): the error left is of the order of its square, and
+/// such a solve's joint trials are never committed (the extrapolated point is tried anew).
+pub(super) const QUICK: f64 = 1e-3;
+
+/// The shortest piece (a fraction of the sample interval) error control cuts to.
+const MIN_FRAC: f64 = 1.0 / 64.0;
+
+/// A step-doubling piece, extrapolated (not yet committed): the step to keep, the coarse and
+/// fine ends, the midpoint, the error estimate, the event inside (1: none) and iterations.
+struct Piece {
+    /// The extrapolation weight used (1/3; 0: the plain half steps kept).
+    ext: f64,
+    st: Step,
+    xc: f64,
+    vc: f64,
+    xm: f64,
+    vm: f64,
+    fm: f64,
+    xf: f64,
+    vf: f64,
+    err: f64,
+    theta: f64,
+    iters: u64,
+}
+
+/// Step doubling over `[tau, tau1]` of interval `i` (length `h`) from `w`; `None` if Newton
+/// failed on any of the three steps. `scale`: the displacement and velocity sizes.
+// The piece's context (structure, state, input, span, scales, options) as it is.
+#[allow(clippy::too_many_arguments)]
+fn piece<J: Joints>(
+    jt: &mut J,
+    mck: (f64, f64, f64),
+    w: &State,
+    inp: &Inputs<'_>,
+    i: usize,
+    (tau, tau1, h): (f64, f64, f64),
+    (scale, ext): ((f64, f64), f64),
+    opts: &Options,
+) -> Option<Piece> {
+    let (m, c, k) = mck;
+    let f1 = load(inp, i, tau1);
+    let fm = load(inp, i, 0.5 * (tau + tau1));
+    let quick = jt.quick();
+    let (coarse, i1) = newton(jt, mck, w, (w.x, quick), h, f1, opts)?;
+    jt.keep(0, coarse.moved);
+    let (half, i2) = newton(jt, mck, w, (w.x, quick), 0.5 * h, fm, opts)?;
+    jt.keep(1, half.moved);
+    let mid = State {
+        x: half.x1,
+        v: half.v1,
+        a: half.a1,
+        f: fm,
+        e_in: 0.0,
+        e_damp: 0.0,
+        g: half.joints.f,
+        kt: half.joints.kt,
+        ct: half.joints.ct,
+    };
+    let (fine, i3) = newton(jt, mck, &mid, (w.x, quick), 0.5 * h, f1, opts)?;
+    jt.keep(2, fine.moved);
+    // events: the joints' own (from the committed start to the fine end), and a velocity
+    // reversal of the fine path in either half
+    let mut theta = jt.event(w.x, fine.x1, w.v, fine.v1);
+    if w.v * mid.v < 0.0 {
+        theta = theta.min(0.5 * w.v / (w.v - mid.v));
+    } else if mid.v * fine.v1 < 0.0 {
+        theta = theta.min(0.5 + 0.5 * mid.v / (mid.v - fine.v1));
+    }
+    let (xr, vr) = (
+        fine.x1 + (fine.x1 - coarse.x1) * ext,
+        fine.v1 + (fine.v1 - coarse.v1) * ext,
+    );
+    let (sx, sv) = (
+        scale.0.max(fine.x1.abs()).max(coarse.x1.abs()),
+        scale.1.max(fine.v1.abs()).max(coarse.v1.abs()),
+    );
+    let rel = |e: f64, s: f64| if e == 0.0 { 0.0 } else { e / s };
+    let err =
+        rel((fine.x1 - coarse.x1).abs() / 3.0, sx).max(rel((fine.v1 - coarse.v1).abs() / 3.0, sv));
+    // the joints at the extrapolated point, tried from their committed state
+    let pt = Point {
+        x1: xr,
+        v1: vr,
+        xp: xr,
+        b: 0.0,
+        a1: 0.0,
+    };
+    let js = jt.trial(w.x, &pt);
+    let ar = (f1 - c * vr - k * xr - js.f) / m;
+    let st = Step {
+        dx: xr - w.x,
+        x1: xr,
+        v1: vr,
+        a1: ar,
+        f1,
+        joints: js,
+        moved: (0.0, 0.0),
+    };
+    Some(Piece {
+        ext,
+        st,
+        xc: coarse.x1,
+        vc: coarse.v1,
+        xm: mid.x,
+        vm: mid.v,
+        fm,
+        xf: fine.x1,
+        vf: fine.v1,
+        err: if err.is_nan() { f64::INFINITY } else { err },
+        theta,
+        iters: i1.saturating_add(i2).saturating_add(i3),
+    })
+}
+
+/// Commit an accepted piece: the state, the joints (their work extrapolated) and the energies
+/// (input and damping work: Romberg on the trapezoidal sums of the pair).
+fn accept<J: Joints>(jt: &mut J, c: f64, w: &mut State, p: &Piece) -> Result<(), CoreError> {
+    let (x0, v0, f0, f1) = (w.x, w.v, w.f, p.st.f1);
+    let rich = |coarse: f64, fine: f64| fine + (fine - coarse) * p.ext;
+    let e_in = rich(
+        (p.xc - x0) * 0.5 * (f0 + f1),
+        (p.xm - x0) * 0.5 * (f0 + p.fm) + (p.xf - p.xm) * 0.5 * (p.fm + f1),
+    );
+    let e_damp = c * rich(
+        (p.xc - x0) * 0.5 * (v0 + p.vc),
+        (p.xm - x0) * 0.5 * (v0 + p.vm) + (p.xf - p.xm) * 0.5 * (p.vm + p.vf),
+    );
+    w.e_in += e_in;
+    w.e_damp += e_damp;
+    jt.commit_doubled(x0, (p.xc, p.xm, p.xf), p.ext, p.st.x1)?;
+    w.x = p.st.x1;
+    w.v = p.st.v1;
+    (w.g, w.kt, w.ct) = (p.st.joints.f, p.st.joints.kt, p.st.joints.ct);
+    w.a = p.st.a1;
+    w.f = f1;
+    Ok(())
+}
+
+/// The piece length (a fraction of the interval) to try from `tau`: the wanted length `want`,
+/// or the rest of the interval cut into equal pieces no longer than it.
+fn next_frac(tau: f64, want: f64) -> f64 {
+    let rest = (1.0 - tau).max(0.0);
+    if want >= rest {
+        return rest;
+    }
+    let pieces = (rest / want).ceil().max(1.0);
+    rest / pieces
+}
+
+/// The error-controlled integration loop (state `w` at `t[0]`, already recorded).
+// The run's context, handed on from the fixed-step front as it is.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn run<J: Joints>(
+    inp: &Inputs<'_>,
+    mck: (f64, f64, f64),
+    (tol, rate): (f64, f64),
+    opts: &Options,
+    jt: &mut J,
+    mut w: State,
+    mut sum: Summary,
+    out: &mut Buffers<'_>,
+) -> Result<Summary, CoreError> {
+    let mut scale = (w.x.abs(), w.v.abs());
+    // the wanted piece length in seconds (carried from interval to interval)
+    let mut want = f64::INFINITY;
+    // a piece this short is kept whatever its estimate (a kink the pair cannot resolve)
+    let min_frac = MIN_FRAC;
+    // the estimate of the last rejected try, or of the last piece kept plain (NaN: none)
+    let mut rejected = f64::NAN;
+    for (i, pair) in inp.t.windows(2).enumerate() {
+        let big_h = pair[1] - pair[0];
+        let mut tau = 0.0_f64;
+        let mut halvings = 0usize;
+        let mut events = 0usize;
+        let mut frac = next_frac(tau, want / big_h);
+        let mut shortened = false;
+        while tau < 1.0 {
+            let step = frac.min(1.0 - tau);
+            let h = step * big_h;
+            let tau1 = if step >= 1.0 - tau { 1.0 } else { tau + step };
+            let span = (tau, tau1, h);
+            let ext = if h * rate > 2.0 { 0.0 } else { 1.0 / 3.0 };
+            let Some(mut p) = piece(jt, mck, &w, inp, i, span, (scale, ext), opts) else {
+                halvings = halvings.saturating_add(1);
+                if halvings > opts.max_halvings.saturating_mul(4) {
+                    sum.status = Status::NoConvergence {
+                        time: inp.t[i] + tau * big_h,
+                        step: h,
+                    };
+                    return Ok(sum);
+                }
+                frac = 0.5 * step;
+                continue;
+            };
+            sum.n_iter = sum.n_iter.saturating_add(p.iters);
+            if events < opts.max_events && p.theta < 1.0 {
+                let min_piece = 1e-3 / step;
+                if p.theta > min_piece && p.theta < 1.0 - min_piece {
+                    events = events.saturating_add(1);
+                    frac = step * p.theta;
+                    shortened = true;
+                    continue;
+                }
+            }
+            let factor = crate::structure::grow(tol, p.err);
+            if p.err > tol {
+                // A shorter piece that did not cut the estimate as h³ would (by 2 for a
+                // piece at most 0.8 as long): a stiff or non-smooth part the pair cannot
+                // resolve; so is a piece at the shortest length. Keep the plain half steps
+                // there (the trapezoidal rule is A-stable, its extrapolation is not).
+                let stuck = p.err > 0.5 * rejected || step <= min_frac;
+                if !stuck {
+                    rejected = p.err;
+                    frac = step * factor.min(0.8);
+                    continue;
+                }
+                if let Some(q) = piece(jt, mck, &w, inp, i, span, (scale, 0.0), opts) {
+                    sum.n_iter = sum.n_iter.saturating_add(q.iters);
+                    p = q;
+                }
+            }
+            // A piece kept plain: refining did not pay; the next piece tries a longer one and
+            // is kept plain too unless its estimate halves (`rejected` carried on).
+            let (factor, carried) = if p.ext == 0.0 {
+                (2.0, p.err)
+            } else {
+                (factor, f64::NAN)
+            };
+            rejected = carried;
+            accept(jt, mck.1, &mut w, &p)?;
+            sum.n_steps = sum.n_steps.saturating_add(1);
+            scale = (scale.0.max(w.x.abs()), scale.1.max(w.v.abs()));
+            if !(w.x.is_finite() && w.v.is_finite()) {
+                sum.status = Status::NonFinite {
+                    time: inp.t[i] + tau1 * big_h,
+                };
+                return Ok(sum);
+            }
+            // an event-shortened piece says nothing of the length the error wants
+            if !shortened {
+                want = (h * factor).max(f64::MIN_POSITIVE);
+            }
+            shortened = false;
+            tau = tau1;
+            frac = next_frac(tau, want / big_h);
+        }
+        let next = i.saturating_add(1); // < nt
+        record(jt, &w, out, next);
+        sum.n_out = next.saturating_add(1);
+    }
+    Ok(sum)
+}
