@@ -632,8 +632,13 @@ def main(argv=None) -> int:
     t0 = time.time()
     results = []
     with ProcessPoolExecutor(max_workers=jobs) as ex:
+        res_dir = HERE / "results"
+        res_dir.mkdir(exist_ok=True)
+        partial = res_dir / f"eval_independent_{label}.json"
         for k, r in enumerate(ex.map(job, specs), 1):
             results.append(r)
+            # written as it goes: an interrupted run can be tabled with --tables-from
+            partial.write_text(json.dumps(results, indent=1, default=float))
             o = (
                 outcome(r["rec"]["named"], r["label"])
                 if r["label"] not in MISFITS
