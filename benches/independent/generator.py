@@ -25,8 +25,10 @@ rig simulator where the physics allows:
 
 The effects are those of ``docs/effects.md``, implemented from their definitions, with their
 parameters in the document's units. Misfits that no candidate models: a tanh virgin curve, a
-rational virgin curve ``h0 ac u / (1 + ac u)`` and a Jenkins (elastic-perfectly-plastic)
-virgin curve, each under Masing's rules.
+rational virgin curve ``h0 ac u / (1 + ac u)`` and a "gamma" virgin curve
+``h0 (1 - (1 + ac u) exp(-ac u))`` (zero initial slope), each under Masing's rules. (A Jenkins
+virgin curve was dropped: it is exactly a rigid-plastic Masing element, ac -> inf, in series
+with a spring, i.e. nameable as ``series_compliance``.)
 """
 
 from __future__ import annotations
@@ -57,7 +59,7 @@ TANGENTIAL_EFFECTS = (
     "normal_load",
 )
 NORMAL_EFFECTS = ("stiffness_nonlinearity", "creep_drift", "channel_delay", "asymmetric_branches")
-MISFITS = ("tanh_virgin", "rational_virgin", "jenkins_virgin")
+MISFITS = ("tanh_virgin", "rational_virgin", "gamma_virgin")
 OVERSAMPLE = 8
 
 
@@ -70,8 +72,9 @@ def virgin_function(kind: str, h0: float, ac: float):
         return lambda u: h0 * math.tanh(ac * u)
     if kind == "rational_virgin":
         return lambda u: h0 * ac * u / (1.0 + ac * abs(u))
-    if kind == "jenkins_virgin":
-        return lambda u: math.copysign(min(h0 * ac * abs(u), h0), u)
+    if kind == "gamma_virgin":
+        # zero initial slope (a contact that stiffens as it closes), then saturation
+        return lambda u: math.copysign(h0 * (1.0 - math.exp(-ac * abs(u)) * (1.0 + ac * abs(u))), u)
     raise ValueError(f"unknown virgin curve {kind!r}")
 
 
@@ -461,7 +464,8 @@ def tangential_record(
     r_draw, r_nx, r_ny, r_hum, r_jit = (np.random.default_rng(s) for s in ss.spawn(5))
     ch = chain if chain is not None else draw_chain(r_draw)
     if base is None:
-        acA = float(acA if acA is not None else np.exp(r_draw.uniform(np.log(0.3), np.log(5.0))))
+        lo = 1.5 if label in MISFITS else 0.3  # a virgin curve's shape shows past the knee
+        acA = float(acA if acA is not None else np.exp(r_draw.uniform(np.log(lo), np.log(5.0))))
         A = float(np.exp(r_draw.uniform(np.log(5e-6), np.log(200e-6))))
         h0 = float(np.exp(r_draw.uniform(np.log(1.0), np.log(500.0))))
         base = {"h0": h0, "ac": acA / A, "A": A}
