@@ -497,6 +497,7 @@ class NormalFamily:
         ``delta_r`` belong to the model's parameters.
         """
         d.extra.setdefault("omega", 2.0 * np.pi / (d.cycles.period_samples * d.dt))
+        d.extra.setdefault("gain_scale", gain_scale(d.y.size))
         smooth_input(d)
         if "delta_r" not in d.extra:
             if not np.isfinite(d.y).all():
@@ -732,6 +733,29 @@ class NormalFamily:
         return _core.loop_areas(y, u, bounds)
 
 
+#: samples over which the per-sample gain floors (``min_gain`` σ² and
+#: :data:`~contactlab.diagnose.select.MIN_RELATIVE_GAIN`) hold as given (:func:`gain_scale`)
+GAIN_REFERENCE_SAMPLES = 1000
+
+
+def gain_scale(n: int) -> float:
+    """Factor on the per-sample gain floors of a normal record of ``n`` samples diagnosed:
+    ``min(1, GAIN_REFERENCE_SAMPLES / n)``.
+
+    The floors ``min_gain`` σ² and 1 % of the current error are per sample: on ``n``
+    independent samples they ask a noncentrality ``n`` times the floor, i.e. an effect's
+    size grows ``√n`` times above what its significance (``t > z`` over the cycles, the
+    identification rule) needs. Measured on the chain of ``benches/chain_normal.py`` (one
+    tone, 21 000 samples kept): the stated bounds were 10-17 times the size a
+    noncentrality of 44.8 needs, the floors setting them all. On a normal joint driven
+    by its measured pressure, a linear chain (filters, load cell, sensor lags) is absorbed
+    by ``k`` and ``ψ`` at one tone; the floors stay what they were at
+    :data:`GAIN_REFERENCE_SAMPLES` and keep their total (a noncentrality of 50 and 10
+    σ² · samples) beyond.
+    """
+    return float(min(1.0, GAIN_REFERENCE_SAMPLES / max(int(n), 1)))
+
+
 #: τ_c tried (log-spaced over the plausible range) for the creep's starting values
 CREEP_START_GRID = 24
 
@@ -748,12 +772,15 @@ INPUT_FILTER_ORDERS = (3, 5, 7, 9)
 INPUT_MAX_WINDOW = 0.6
 
 
-def input_filter_choice(fastest_samples: float, current: int) -> tuple[int, int]:
+def input_filter_choice(
+    fastest_samples: float, current: int, longest: int | None = None
+) -> tuple[int, int]:
     """The Savitzky-Golay filter ``(window, order)`` of least white-noise gain ``Σ c²`` whose
     gain stays within :data:`INPUT_PASS_ERROR` of 1 up to :data:`INPUT_PASS_HARMONICS` times
     the fastest excitation frequency (``1 / fastest_samples`` cycles per sample), windows up
     to :data:`INPUT_MAX_WINDOW` of the fastest period; ``(current, 3)`` (the cubic every
-    family sees, :func:`contactlab.diagnose._signal.filter_input`) when none smooths more."""
+    family sees, :func:`contactlab.diagnose._signal.filter_input`) when none smooths more.
+    ``longest``: the longest window allowed (samples), if shorter."""
     best = (current, 3)
     best_gain = float(np.sum(savgol_coeffs(current, 3) ** 2)) if current >= 5 else 1.0
     f = np.linspace(0.0, INPUT_PASS_HARMONICS / fastest_samples, 48)
@@ -764,6 +791,8 @@ def input_filter_choice(fastest_samples: float, current: int) -> tuple[int, int]
         return float(np.max(np.abs(1.0 - h))) <= INPUT_PASS_ERROR
 
     top = (int(INPUT_MAX_WINDOW * fastest_samples) - 1) // 2  # half windows
+    if longest is not None:
+        top = min(top, (int(longest) - 1) // 2)
     for order in INPUT_FILTER_ORDERS:
         lo = order // 2 + 1  # the shortest window that smooths at all: order + 2 or + 3
         if lo > top or not flat(lo, order):

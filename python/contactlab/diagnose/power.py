@@ -46,8 +46,9 @@ the base model" in deep pre-sliding), and effects whose generator's signature di
 the library's model (the rig's inertia on a single sine is a negative parallel stiffness,
 told apart only by the start from rest): there the bound is optimistic.
 The BIC rule (``k ln n`` over a fit of at most 5000 samples) is far weaker than the gain
-rule and is not modelled; neither is a family's alternative proportional t (normal
-contact), which can only make detection easier: there the bound is conservative.
+rule and is not modelled. A family's alternative proportional t (normal contact,
+:func:`~contactlab.diagnose.select.proportional_t`) is, linearised (:func:`_proportional_t`):
+without it a creep, whose gain sits in the first cycles, was stated 4 times too large.
 
 :func:`detectable_above` gives one candidate's bound; :func:`stated_power` every candidate a
 report did not name. ``benches/eval_false_alarm.py --power`` checks the bound against
@@ -273,6 +274,9 @@ class _Setting:
     se_inflation: float = 1.0
     rng_fit: np.ndarray = field(default_factory=lambda: np.zeros(DRAWS))  # (DRAWS,)
     size_factor: np.ndarray = field(default_factory=lambda: np.ones(DRAWS))  # (DRAWS,)
+    #: the family's rule 2 may pass by :func:`~contactlab.diagnose.select.proportional_t`
+    #: (``Family.proportional_gain``: normal contact)
+    proportional: bool = False
 
 
 def _setting(
@@ -285,6 +289,7 @@ def _setting(
     gain_floor: float,
     folds: int,
     seed: int,
+    proportional: bool = False,
 ) -> _Setting:
     w = sample_weight(d)
     cyc = d.cycles.cycle
@@ -296,6 +301,7 @@ def _setting(
     if mse.size != ids.size:
         mse = np.full(ids.size, sigma**2)
     rel = MIN_RELATIVE_GAIN * float(getattr(current, "heldout_mse", sigma**2)) / sigma**2
+    rel *= float(d.extra.get("gain_scale", 1.0))  # (select.judge's floor of the family)
     rng = np.random.default_rng(seed)
     normals = rng.standard_normal((DRAWS, ids.size))
     rows = np.flatnonzero(w > 0)
@@ -322,6 +328,7 @@ def _setting(
         se_inflation=infl,
         rng_fit=rng.standard_normal(DRAWS),
         size_factor=np.exp(0.5 * GAIN_SCATTER * rng.standard_normal(DRAWS)),
+        proportional=proportional,
     )
 
 
@@ -368,11 +375,35 @@ def _power_curve(jp: np.ndarray, st: _Setting, ident: float = 0.0) -> Any:
         sd = np.std(ratio, axis=1, ddof=1)
         with np.errstate(divide="ignore", invalid="ignore"):  # (sd = 0: t = inf below)
             t = np.where(sd > 0, np.mean(ratio, axis=1) / (sd / np.sqrt(n)), np.inf)
+        if st.proportional:  # rule 2's proportional form (select.proportional_t)
+            t = np.maximum(t, _proportional_t(a, delta, A, B, W, ok))
         gain = ((cur - cand) @ W) / Wtot / sig2
         named = np.abs(a[:, 0] + eps) >= ident * fit_se
         return float(np.mean((t > st.z) & (gain >= st.gain_floor) & named))
 
     return power
+
+
+def _proportional_t(
+    a: np.ndarray, delta: np.ndarray, A: np.ndarray, B: np.ndarray, W: np.ndarray, ok: np.ndarray
+) -> np.ndarray:
+    """:func:`contactlab.diagnose.select.proportional_t` of each draw, linearised: the
+    candidate fitted on the other fold moves a held-out cycle's prediction by ``â j⊥``
+    (``â = a + δ``), the current residual is ``a j⊥ + e``, so ``N_c = â W_c (a A_c + B_c)``
+    and ``D_c = â² W_c A_c``; ``t = (ΣN/ΣD - 1/2) / se`` with the cluster sandwich ``se``
+    over the cycles."""
+    ah = a + delta
+    n_c = (ah * W * (a * A + B))[:, ok]
+    d_c = (ah * ah * W * A)[:, ok]
+    m = n_c.shape[1]
+    if m < 3:
+        return np.full(a.shape[0], -np.inf)
+    tot = np.sum(d_c, axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        g = np.sum(n_c, axis=1) / tot
+        se = np.sqrt(m / (m - 1) * np.sum((n_c - g[:, None] * d_c) ** 2, axis=1)) / tot
+        t = (g - 0.5) / se
+    return np.where((tot > 0) & (se > 0), t, -np.inf)
 
 
 def _fit_error(jp: np.ndarray, st: _Setting) -> tuple[float, float]:
@@ -532,7 +563,8 @@ def _detectable(
     st = _setting_cache
     if st is None:
         slope = model_slope(family, params, d)
-        st = _setting(d, current, noise, slope, sigma, z, gain_floor, folds, seed)
+        st = _setting(d, current, noise, slope, sigma, z, gain_floor, folds, seed,
+                      getattr(family, "proportional_gain", False))  # fmt: skip
     p0 = {**params, **shape, **{s.name: s.null for s in mags}}
     per, rel, gain = _per_parameter(family, p0, effects, name, mags, d, st)
     if any(v is None for v in per.values()):
@@ -887,6 +919,7 @@ def stated_power(report: Any, *, seed: int = 0) -> list[Detectable]:
     st = _setting(
         d, current, noise, slope, sigma, float(settings.get("z", 3.0)),
         float(settings.get("gain_floor", 0.05)), int(settings.get("folds", 2)), seed,
+        getattr(fam, "proportional_gain", False),
     )  # fmt: skip
     names = settings.get("candidates") or list(fam.candidates)
     return bounds_for(fam, params, effects, names, d, noise, sigma, current, st)

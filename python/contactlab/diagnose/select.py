@@ -644,12 +644,13 @@ def judge(
         t = max(t, proportional_t(current, cand, d))
     dbic = cand.full.bic - current.full.bic
     rel = float(current.heldout_mse - cand_mse) / current.heldout_mse
+    rel_floor = MIN_RELATIVE_GAIN * (1.0 if d is None else float(d.extra.get("gain_scale", 1.0)))
     if gain < min_gain:
         reason = f"held-out gain {gain:.3g} σ² below {min_gain:g} σ²"
-    elif rel < MIN_RELATIVE_GAIN:
+    elif rel < rel_floor:
         reason = (
             f"held-out gain {100 * rel:.2g} % of the remaining error (below "
-            f"{100 * MIN_RELATIVE_GAIN:g} %): a sliver of a larger misfit"
+            f"{100 * rel_floor:.2g} %): a sliver of a larger misfit"
         )
     elif not t > z:
         reason = f"gain not significant across held-out cycles (t = {t:.2f} <= {z:g})"

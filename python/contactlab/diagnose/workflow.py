@@ -267,6 +267,8 @@ def diagnose(
     notes = [n for n in (sign_note, _same_clock(recording, names, candidates)) if n]
     d, reduced = path.prepare(t, u, y, taps)
     prior, prior_notes = _ready(family, d, recording, context, taps)
+    # a family whose floors are totals over the record (normal contact: gain_scale)
+    min_gain = min_gain * float(d.extra.get("gain_scale", 1.0))
     effects: tuple[str, ...] = tuple(model.effects) if isinstance(model, ExtendedModel) else ()
     regime = path.regime(t, u, y)  # the one decision analyze, track and diagnose share
     d.extra["regime_info"] = _regime_info(regime)
