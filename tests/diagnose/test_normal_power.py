@@ -1,0 +1,101 @@
+"""The normal diagnosis keeps the power its data hold (issue 29 items 1-2): a long record's
+kept samples carry the mean of the raw ones about them, the per-sample gain floors are
+totals over the record, and the stated power models the family's proportional t."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from contactlab.diagnose._prepare import average_kept
+from contactlab.diagnose.candidates_normal import GAIN_REFERENCE_SAMPLES, gain_scale
+from contactlab.diagnose.power import DRAWS, _bound, _proportional_t, _Setting
+
+
+def test_kept_samples_average_the_noise_and_pass_the_signal() -> None:
+    q, per = 9, 4000.0
+    n = 40 * int(per)
+    i = np.arange(n)
+    clean = np.sin(2 * np.pi * i / per) + 0.3 * np.sin(4 * np.pi * i / per + 0.4)
+    noise = np.random.default_rng(1).normal(0.0, 0.1, n)
+    g = slice(0, n, q)
+    yk, filt = average_kept(clean + noise, per, q, g)
+    assert filt is not None and filt[0] <= q
+    ck, _ = average_kept(clean, per, q, g)
+    # the excitation and its second harmonic pass as measured
+    assert np.max(np.abs(ck - clean[g])[5:-5]) < 2e-4
+    e = (yk - ck)[5:-5]
+    # the mean of q samples: the noise's variance q times smaller, the kept samples'
+    # noise independent of each other (their windows do not overlap)
+    assert np.var(e) == pytest.approx(0.01 / q, rel=0.1)
+    assert abs(np.corrcoef(e[:-1], e[1:])[0, 1]) < 0.05
+    # one sample in q as measured would keep the raw variance
+    assert np.var(noise[g]) > 5 * np.var(e)
+
+
+def test_short_windows_are_left_alone() -> None:
+    y = np.random.default_rng(2).normal(size=1000)
+    yk, filt = average_kept(y, 100.0, 1, slice(0, 1000, 1))
+    assert filt is None and np.array_equal(yk, y)
+
+
+@pytest.mark.parametrize("n", [10, 500, GAIN_REFERENCE_SAMPLES, 4 * GAIN_REFERENCE_SAMPLES])
+def test_gain_floors_are_totals_beyond_the_reference_length(n: int) -> None:
+    s = gain_scale(n)
+    assert s == pytest.approx(min(1.0, GAIN_REFERENCE_SAMPLES / n))
+    assert s * n >= min(n, GAIN_REFERENCE_SAMPLES) - 1e-9
+
+
+def _setting(proportional: bool, m: int = 20, n_c: int = 200) -> _Setting:
+    n = m * n_c
+    rng = np.random.default_rng(5)
+    return _Setting(
+        w=np.ones(n), var=1.0, cycle_of=np.arange(n) // n_c, fold_of_cycle=np.arange(m) % 2,
+        cycle_mse=np.ones(m), sigma=1.0, z=3.0, gain_floor=0.002, y_rms=10.0,
+        rng_normals=rng.standard_normal((DRAWS, m)), fit_rows=np.arange(n),
+        rng_fit=rng.standard_normal(DRAWS), proportional=proportional,
+    )  # fmt: skip
+
+
+def test_proportional_t_lowers_the_bound_of_an_effect_in_the_first_cycles() -> None:
+    """A creep settles in the first cycles: the per-cycle log ratios' t is bounded by the
+    few cycles that carry it, the proportional t grows with the effect's size."""
+    n = 20 * 200
+    t = np.arange(n) / n
+    creep = -np.expm1(-t / 0.05)
+    jp = creep - np.mean(creep)
+    plain = _bound(jp, _setting(False))
+    prop = _bound(jp, _setting(True))
+    assert prop is not None
+    assert plain is None or prop < 0.7 * plain
+
+
+def test_proportional_t_against_the_rule_it_models() -> None:
+    """The linearised t of one draw equals select.proportional_t on the records it stands
+    for: residual ``a j + e`` of the current model, a candidate moving each held-out cycle's
+    prediction by ``(a + δ_fold) j``."""
+    from types import SimpleNamespace
+
+    from contactlab.diagnose.select import proportional_t
+
+    rng = np.random.default_rng(9)
+    m, n_c = 8, 50
+    n = m * n_c
+    cyc = np.arange(n) // n_c
+    j = np.sin(np.arange(n) / 7.0) + 0.3
+    e = rng.normal(0.0, 0.4, n)
+    a, fold = 0.7, cyc % 2
+    est = {k: a + rng.normal(0.0, 0.05) for k in (0, 1)}
+    ah = np.array([est[k] for k in fold])
+    y = a * j + e
+    d = SimpleNamespace(y=y, extra={}, cycles=SimpleNamespace(cycle=cyc))
+    held = np.ones(n, bool)
+    current = SimpleNamespace(prediction=np.zeros(n), heldout=held)
+    cand = SimpleNamespace(prediction=ah * j, heldout=held)
+    want = proportional_t(current, cand, d)
+    W = np.bincount(cyc, minlength=m).astype(float)
+    A = np.bincount(cyc, j * j, m) / W
+    B = np.bincount(cyc, j * e, m) / W
+    delta = (np.array([est[k] for k in np.arange(m) % 2]) - a)[None]
+    got = _proportional_t(np.array([[a]]), delta, A[None], B[None], W[None], np.ones(m, bool))
+    assert got[0] == pytest.approx(want, rel=1e-9)
