@@ -27,7 +27,7 @@ def draw_factors(rng: np.random.Generator) -> dict:
     """Random chain settings of one record."""
     return {
         "fs": float(rng.choice([1000.0, 2000.0, 5000.0, 10000.0])),
-        "f": float(rng.uniform(1.0, 20.0)),
+        "f": float(np.exp(rng.uniform(np.log(0.5), np.log(20.0)))),
         "cycles": int(rng.integers(5, 51)),
         "ratio": float(rng.uniform(0.2, 0.8)),
         "noise_p": float(rng.uniform(0.005, 0.02)),
@@ -76,9 +76,10 @@ def chain_record(effect: str | None, size: float, fac: dict, seed: int, k: float
     p0 = 5e5
     pa = fac["ratio"] * p0
     psi = fac["psi"]
-    over = 8
+    over = 4
     fsi = fs * over
-    T = fac["cycles"] / f
+    # (at most 150 000 samples: the chain's joint is integrated in Python)
+    T = min(fac["cycles"], max(5, int(150_000 * f / fs))) / f
     ti = np.arange(int(T * fsi) + 1) / fsi
     # actuator from rest: a second-order servo (fn 12 f, ζ 0.7) following a sine command
     fn, z = 12.0 * f, 0.7

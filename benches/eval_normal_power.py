@@ -40,6 +40,8 @@ PARAM = {"stiffness_nonlinearity": "kappa", "creep_drift": "D", "asymmetric_bran
          "channel_delay": "tau"}  # fmt: skip
 
 
+#: hide the effects at ``--factor`` times the stated bound instead of the needed size
+AT_BOUND = False
 #: keyword arguments passed to diagnose (``--min-gain``)
 KW: dict = {}
 
@@ -88,7 +90,13 @@ def run(seed, factor, effects):
         need = REF[e] * math.sqrt(LAMBDA_VISIBLE / lam) if lam > 0 else math.inf
         b = bounds.get(e, {})
         bc = bound_in_chain_units(e, b, clean) if b else math.nan
-        size = factor * need
+        # --at-bound: the effect hidden at `factor` times the bound stated on the clean twin
+        size = factor * (bc if AT_BOUND else need)
+        if not np.isfinite(size):
+            out["effects"][e] = {"lam_ref": lam, "lam_base": lam_base, "nearest": nearest,
+                                 "need": need, "bound": bc, "ratio": bc / need, "size": size,
+                                 "named": ["(no bound)"]}  # fmt: skip
+            continue
         if size > CAP[e](fac):  # not reachable: the joint or the chain would not hold it
             nm = ["(beyond reach)"]
         else:
@@ -108,7 +116,10 @@ def main():
     ap.add_argument("--effects", default=",".join(EFFECTS))
     ap.add_argument("--out", default=None)
     ap.add_argument("--min-gain", type=float, default=None)
+    ap.add_argument("--at-bound", action="store_true")
     a = ap.parse_args()
+    global AT_BOUND
+    AT_BOUND = a.at_bound
     if a.min_gain is not None:
         KW["min_gain"] = a.min_gain
     lo, hi = (int(s) for s in a.seeds.split("-"))
