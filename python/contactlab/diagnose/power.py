@@ -573,8 +573,9 @@ def _detectable(
             name, worst.name, None, worst.unit, worst.null, None, shape, per,
             reason=(
                 f"not detectable on this record below an effect of {LARGEST_RELATIVE:g}× "
-                "the output's RMS (the current model's parameters absorb it, or the record "
-                "is too short or noisy)"
+                "the output's RMS or within the parameter's range (the current model's "
+                "parameters or a rival candidate absorb it, or the record is too short or "
+                "noisy)"
             ),
         )  # fmt: skip
     worst = max(mags, key=lambda s: rel[s.name] or 0.0)
@@ -690,13 +691,15 @@ def _per_parameter(
         # direction is shrunk by the share a nonlinear refit leaves, twice
         keep = float(np.sum(st.w * jp * jp) / max(np.sum(st.w * j * j), 1e-300))
         for _ in range(NONLINEAR_STEPS if keep < NONLINEAR_BELOW else 0):
-            if b is None:
+            if b is None or b >= max(s.upper - s.null, s.null - s.lower):
                 break
             left = _left_by_refit(family, p0, effects, name, s, b, ds, st.w, jp, steady)
             if left >= 0.9:
                 break
             jp = jp * np.sqrt(max(left, 1e-6))
             b = _bound(jp, st, ident)
+        if b is not None and b >= max(s.upper - s.null, s.null - s.lower):
+            b = None  # beyond the parameter's range (a loss asymmetry |a| < 1): no bound
         r = None if b is None else b * float(np.sqrt(np.mean(j * j))) / st.y_rms
         if r is not None and r > LARGEST_RELATIVE:
             b = r = None
@@ -814,8 +817,11 @@ def _rival_directions(
         if rival in trial or rival not in family.candidates:
             continue
         with_rival = (*trial, rival)
-        if not family.check(with_rival):
-            continue
+        if not family.check(with_rival):  # one at a time (normal contact's shapes): the
+            # rival's direction in place of the candidate, which the diagnosis fits instead
+            with_rival = (*(e for e in trial if e != name), rival)
+            if not family.check(with_rival):
+                continue
         specs = [q for q in family.candidates[rival].params if np.isfinite(q.null)]
         p = {**shape_values(family, rival, p0, d), **p0, **{q.name: q.null for q in specs}}
         for q in specs:

@@ -34,6 +34,9 @@ class AsymmetricBranches(EffectModel):
     rank = 0
     order = 4
     size_param = "a"
+    #: the stiffness law's κ1 δ² takes the same 2ω signature (docs/effects.md §2): the
+    #: stated bound is what shows beyond it
+    rivals = ("stiffness_nonlinearity",)
 
     def apply(self, delta, p, ctx):
         return ctx.family.asymmetric(delta, p, ctx.d)
