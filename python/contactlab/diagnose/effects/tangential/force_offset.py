@@ -4,8 +4,66 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._family import ParamSpec
-from .._base import EffectModel, register
+from ..._family import ParamSpec, Prepared
+from .._base import EffectModel, Plausibility, register
+from ._common import REST_SAMPLES, TURN_SHARE, TURN_SIGMAS
+
+#: a record "starts at rest" when the displacement stands still (within the turning points'
+#: hysteresis band, :data:`~._common.TURN_SIGMAS` input-noise RMS or
+#: :data:`~._common.TURN_SHARE` of its range) for at least this many samples
+REST_MIN_SAMPLES = 10
+#: the force at rest and a fitted sensor zero ``F0`` disagree when they differ by more than
+#: this share of ``|F0|`` and more than :data:`REST_SIGMAS` times the force's spread at rest
+REST_SHARE = 0.3
+REST_SIGMAS = 4.0
+
+
+def rest_start(d: Prepared) -> tuple[int, float, float, float] | None:
+    """The record's rest at its start: ``(samples, duration s, mean force, force spread)``
+    while the displacement has not yet left its first position (by more than the turning
+    points' band), or None when it moves from its first samples (a record cut from a
+    running test, a frame's record starting mid-stroke).
+
+    A contact at rest before the first motion carries no friction load from the test: the
+    force read there is the load cell's zero (plus any residual force the contact holds),
+    which is what a sensor's offset ``F0`` must equal."""
+    u, y = d.u, d.y
+    if y is None or u.size < 2 * REST_MIN_SAMPLES:
+        return None
+    noise = float(d.extra.get("u_noise", 0.0) or 0.0)
+    band = max(TURN_SIGMAS * noise, TURN_SHARE * float(np.ptp(u)))
+    x0 = float(np.median(u[:REST_SAMPLES]))
+    moved = np.flatnonzero(np.abs(u - x0) > band)
+    n = int(moved[0]) if moved.size else int(u.size)
+    if n < REST_MIN_SAMPLES or n >= u.size // 2:
+        return None
+    yr = np.asarray(y[:n], float)
+    return n, float(d.t[n - 1] - d.t[0]), float(np.mean(yr)), float(np.std(yr))
+
+
+def rest_verdict(d: Prepared, F0: float) -> tuple[bool | None, str]:
+    """Whether the force at rest at the record's start agrees with a sensor zero ``F0``
+    (None: the record does not start at rest, so the rest force cannot check it) and the
+    sentence saying so in numbers."""
+    rest = rest_start(d)
+    if rest is None:
+        return None, (
+            "the record does not start at rest (the displacement moves from its first "
+            "samples), so the force at rest cannot check F0"
+        )
+    n, dur, fr, spread = rest
+    tol = max(REST_SHARE * abs(F0), REST_SIGMAS * spread)
+    if abs(fr - F0) > tol:
+        return False, (
+            f"the record starts at rest ({n} samples, {dur:.3g} s, the displacement still) "
+            f"with the force at {fr:.4g} ± {spread:.2g} N, not at F0 = {F0:.4g} N: a sensor's "
+            "zero would read there; the shift of the plateaus is the contact's, not the "
+            "load cell's"
+        )
+    return True, (
+        f"the record starts at rest with the force at {fr:.4g} ± {spread:.2g} N "
+        f"({n} samples), as a sensor's zero F0 = {F0:.4g} N reads"
+    )
 
 
 @register
@@ -14,7 +72,10 @@ class ForceOffset(EffectModel):
     kind = "tangential"
     params = (ParamSpec("F0", "N", 0.0, -np.inf, np.inf, "F"),)
     description = "constant force-sensor bias F0"
-    physics = "The load cell's zero is off: F = h + F0. Both plateaus move by F0."
+    physics = (
+        "The load cell's zero is off: F = h + F0. Both plateaus move by F0, and a record "
+        "that starts at rest reads F0 before the first motion."
+    )
     stage = "additive"
     rank = 4
     order = 4
@@ -22,6 +83,15 @@ class ForceOffset(EffectModel):
 
     def apply(self, F, p, ctx):
         return F + p["F0"]
+
+    def plausible(self, d, p):
+        base = super().plausible(d, p)
+        if not base.ok:
+            return base
+        ok, why = rest_verdict(d, float(p["F0"]))
+        if ok is False:
+            return Plausibility(False, why)
+        return Plausibility(True, f"{base.reason}; {why}")
 
     def argument(self, d, p):
         h0 = p.get("h0", np.nan)
