@@ -159,3 +159,38 @@ def test_damper_turns_hold_a_dead_band_and_its_rest_force_is_no_large_sensor_zer
     assert shape["level"] < 0.1 * 17e3
     ok, why = rest_verdict(d, -2241.0)
     assert ok is False, why
+
+
+def test_stroke_levels_and_the_h0_check_say_why_with_figures():
+    from contactlab.diagnose.paths import RegimeDecision, TangentialPath, stroke_levels
+
+    t, x, F = _branches()
+    d = _prepared(t, x, F + 3.0)  # both plateaus shifted by +3
+    up, down = stroke_levels(d.u, d.y, d.cycles.reversals)
+    assert abs(up - (H0 + 3.0)) < 0.02 * H0 and abs(down - (-H0 + 3.0)) < 0.02 * H0
+    regime = RegimeDecision("gross sliding", "", "analyze", 1.1 * H0, 0.01, None,
+                            {"h0_source": "analyze fit"})  # fmt: skip
+    path = TangentialPath.__new__(TangentialPath)
+    doc, text = path.check_final(
+        regime, {"h0": H0}, ("asymmetry",), None, ((up, down), (0.9 * up, 0.9 * down))
+    )
+    assert doc is not None and not doc["within_tolerance"]
+    assert abs(doc["stroke_half"]["ratio"] - 0.9) < 1e-12
+    assert "no plateau" in text and "second half of each stroke" in text
+    assert "does not redefine h0" in text
+    doc, text = path.check_final(regime, {"h0": 1.08 * H0}, (), None, None)
+    assert doc["within_tolerance"] and text is None and "stroke_half" not in doc
+
+
+def test_unfounded_withdraws_an_effect_at_its_null_or_without_an_error():
+    from contactlab.diagnose.candidates_tangential import TangentialFamily
+    from contactlab.diagnose.workflow import _unfounded
+
+    d = _prepared(*_branches())
+    full = SimpleNamespace(
+        params={"h0": H0, "ac": AC, "s_b": 2e-8, "ell": 1e-4},
+        stderr={"h0": 0.1, "ac": 10.0, "s_b": np.inf, "ell": np.inf},
+    )
+    state = SimpleNamespace(current=SimpleNamespace(full=full), added=["stick_slip"])
+    name, why = _unfounded(TangentialFamily(), state, d)
+    assert name == "stick_slip" and "cannot be computed" in why

@@ -352,7 +352,8 @@ ABSORBED = (
 def _unfounded(family: Family, st: SearchState, d: Prepared) -> tuple[str, str] | None:
     """The first effect named by this diagnosis that its final fit does not support, and
     why: its size within :attr:`~contactlab.diagnose.effects.EffectModel.IDENTIFIED_SIGMAS`
-    standard errors of "absent" (the least significant first), else implausible on the
+    standard errors of "absent", at "absent" itself, or with no computable error (the least
+    significant first), else implausible on the
     record with the final parameters (a refit after later additions can move an effect
     accepted early into a value the record contradicts). None when every one stands."""
     p, se = st.current.full.params, st.current.full.stderr
@@ -362,10 +363,19 @@ def _unfounded(family: Family, st: SearchState, d: Prepared) -> tuple[str, str] 
 
         reg = registry(family.kind)
         for e in st.added:
+            if e not in reg:
+                continue
             why = family.identified(e, p, se)
-            if why and e in reg:
-                v, s = reg[e].size(p, se)
-                ratio = v / s if s > 0 else 0.0
+            v, s = reg[e].size(p, se)
+            if not why and (v == 0 or (not np.isfinite(s) and _at_null(reg[e], p))):
+                # at its null value (its error not computable there): nothing says it is there
+                err = "cannot be computed" if not np.isfinite(s) else f"is {s:.2g}"
+                why = (
+                    f"not identifiable: its size is {v:.3g}, at the value meaning no effect, "
+                    f"and its standard error {err}"
+                )
+            if why:
+                ratio = v / s if np.isfinite(s) and s > 0 else 0.0
                 if weakest is None or ratio < weakest[0]:
                     weakest = (ratio, e, why)
     if weakest is not None:
@@ -376,6 +386,16 @@ def _unfounded(family: Family, st: SearchState, d: Prepared) -> tuple[str, str] 
             if why:
                 return e, f"implausible: {why}"
     return None
+
+
+def _at_null(effect: Any, p: dict[str, float]) -> bool:
+    """Whether the effect's size parameter lies within 1e-3 of its bounds' span from the
+    value meaning "absent" (as :meth:`~contactlab.diagnose.effects.EffectModel.plausible`
+    judges a value at a limit; False for a parameter without finite bounds)."""
+    spec = next((q for q in effect.params if q.name == effect.size_param), effect.params[0])
+    span = spec.upper - spec.lower
+    null = spec.null if np.isfinite(spec.null) else 0.0
+    return bool(np.isfinite(span) and abs(p[spec.name] - null) <= 1e-3 * span)
 
 
 def _withdraw(
