@@ -176,6 +176,7 @@ def test_stroke_levels_and_the_h0_check_say_why_with_figures():
     )
     assert doc is not None and not doc["within_tolerance"]
     assert abs(doc["stroke_half"]["ratio"] - 0.9) < 1e-12
+    assert not doc["stroke_half"]["within_tolerance"]
     assert "no plateau" in text and "second half of each stroke" in text
     assert "does not redefine h0" in text
     doc, text = path.check_final(regime, {"h0": 1.08 * H0}, (), None, None)

@@ -230,6 +230,7 @@ class TangentialPath(KindPath):
             doc["stroke_half"] = {
                 "data_up": du, "data_down": dd, "model_up": mu, "model_down": md,
                 "ratio": half_m / half_d if half_d > 0 else None,
+                "within_tolerance": bool(half_d > 0 and abs(half_m / half_d - 1) <= H0_TOLERANCE),
             }  # fmt: skip
         if doc["within_tolerance"]:
             return doc, None

@@ -636,6 +636,18 @@ def _regime_sentence(
     return f"{regime.reason}; base model: {tail}" if tail else regime.reason
 
 
+def _refused(st: SearchState, effects: tuple[str, ...]) -> dict[str, str]:
+    """The candidates that passed the held-out rules at some step but were refused as
+    physically implausible on the record (the last reason given for each), not in the final
+    model: the report says why each is not named (issue 29 item 5)."""
+    out: dict[str, str] = {}
+    for step in st.steps:
+        for v in step.candidates:
+            if v.reason.startswith("implausible: ") and " ⇄ " not in v.name and "+" not in v.name:
+                out[v.name] = v.reason.removeprefix("implausible: ")
+    return {k: v for k, v in out.items() if k not in effects}
+
+
 def _report(
     family: Family,
     path: KindPath,
@@ -673,6 +685,14 @@ def _report(
         location["h0_check"] = check
     if moved:
         where.append(moved)
+    refused = _refused(st, effects)
+    if refused:
+        location["refused"] = refused
+        where.extend(
+            f"not named: {name} would have lowered the held-out error significantly, but is "
+            f"refused as {why}"
+            for name, why in refused.items()
+        )
     gap = current.heldout_rms / sigma
     if gap > 1.5:
         where.append(
