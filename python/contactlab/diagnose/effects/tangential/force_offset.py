@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 from ..._family import ParamSpec, Prepared
@@ -63,6 +65,62 @@ def rest_verdict(d: Prepared, F0: float) -> tuple[bool | None, str]:
     return True, (
         f"the record starts at rest with the force at {fr:.4g} ± {spread:.2g} N "
         f"({n} samples), as a sensor's zero F0 = {F0:.4g} N reads"
+    )
+
+
+#: the plateaus' common trend and a fitted drift ``F1`` disagree when they differ by more
+#: than this share of ``|F1|`` and more than DRIFT_SIGMAS standard errors of the trend
+DRIFT_SHARE, DRIFT_SIGMAS = 0.5, 3.0
+
+
+def plateau_trend(d: Prepared) -> tuple[float, float, int] | None:
+    """How the two directions' force levels move together over the record: each stroke's
+    mean force over the second half of its travel (``level_k`` at the stroke's start
+    ``t_k``, direction ``s_k = ±1``) regressed on ``1, s_k, t_k, s_k t_k``; returns the
+    common change over the record (the ``t_k`` coefficient times the duration: what a
+    drifting sensor zero moves both plateaus by), its standard error and the strokes read,
+    or None with fewer than six strokes. A change of one direction's friction alone (wear,
+    heating on one side) moves the levels apart instead (the ``s_k t_k`` term)."""
+    rev = np.asarray(d.cycles.reversals, int)
+    rows = []
+    for a, b in itertools.pairwise(rev):
+        if b - a < 4:
+            continue
+        s = d.u[a : b + 1] - d.u[a]
+        sign = 1.0 if s[-1] > 0 else -1.0
+        sel = sign * s > 0.5 * abs(float(s[-1]))
+        if np.count_nonzero(sel):
+            rows.append((float(np.mean(d.y[a : b + 1][sel])), sign, float(d.t[a] - d.t[0])))
+    if len(rows) < 6:
+        return None
+    lv, sg, tt = (np.asarray(c) for c in zip(*rows, strict=True))
+    X = np.column_stack([np.ones_like(tt), sg, tt, sg * tt])
+    coef, *_ = np.linalg.lstsq(X, lv, rcond=None)
+    r = lv - X @ coef
+    dof = max(len(rows) - 4, 1)
+    cov = float(r @ r) / dof * np.linalg.pinv(X.T @ X)
+    T = float(d.t[-1] - d.t[0])
+    return float(coef[2]) * T, float(np.sqrt(max(cov[2, 2], 0.0))) * T, len(rows)
+
+
+def drift_verdict(d: Prepared, p: dict[str, float]) -> tuple[bool | None, str]:
+    """Whether a fitted drift of the force sensor's zero by ``p["F1"]`` over the record
+    agrees with how the data's two plateaus move together (:func:`plateau_trend`; None:
+    too few strokes to tell), and the sentence saying so."""
+    got = plateau_trend(d)
+    if got is None:
+        return None, "too few strokes to follow the plateaus over the record"
+    common, se, n = got
+    F1 = float(p["F1"])
+    if abs(common - F1) > max(DRIFT_SHARE * abs(F1), DRIFT_SIGMAS * se):
+        return False, (
+            f"over {n} strokes the two directions' force levels move together by "
+            f"{common:.4g} ± {se:.2g} N over the record, not by F1 = {F1:.4g} N: a drifting "
+            "sensor zero would move both by F1"
+        )
+    return True, (
+        f"over {n} strokes the two directions' force levels move together by {common:.4g} ± "
+        f"{se:.2g} N over the record, as a sensor zero drifting by F1 = {F1:.4g} N does"
     )
 
 
