@@ -32,6 +32,23 @@ class DisplacementOffset(EffectModel):
             return Plausibility(
                 False, f"a displacement offset of {p['x0']:.3g} m is over half the amplitude"
             )
+        if base.ok:  # a record from rest: the contact rests where the record starts
+            from .force_offset import rest_start
+
+            rest = rest_start(d)
+            if rest is not None and p.get("h0", 0) > 0 and p.get("ac", 0) > 0:
+                n, _, fr, spread = rest
+                u = float(np.median(d.u[:n])) - p["x0"]
+                f = float(np.sign(u) * p["h0"] * -np.expm1(-p["ac"] * abs(u)))
+                f += p.get("alpha", 0.0) * abs(f) + p.get("F0", 0.0)
+                if abs(f - fr) > max(0.5 * abs(f - p.get("F0", 0.0)), 4.0 * spread):
+                    return Plausibility(
+                        False,
+                        f"the record starts at rest with the force at {fr:.4g} N; an offset "
+                        f"x0 = {p['x0']:.3g} m would have the contact loaded to {f:.4g} N "
+                        "there (its virgin curve at x - x0): the contact rests where the "
+                        "record starts",
+                    )
         return base
 
     def argument(self, d, p):
