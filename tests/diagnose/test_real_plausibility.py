@@ -195,3 +195,30 @@ def test_unfounded_withdraws_an_effect_at_its_null_or_without_an_error():
     state = SimpleNamespace(current=SimpleNamespace(full=full), added=["stick_slip"])
     name, why = _unfounded(TangentialFamily(), state, d)
     assert name == "stick_slip" and "cannot be computed" in why
+
+
+def test_plateau_trend_tells_a_drifting_zero_from_one_direction_changing():
+    from contactlab.diagnose.effects.tangential.force_offset import drift_verdict, plateau_trend
+
+    t, x, F = _branches()
+    T = t[-1] - t[0]
+    drift = _prepared(t, x, F + 2.0 * (t - t[0]) / T)  # the zero drifts by 2 N
+    common, se, n = plateau_trend(drift)
+    assert n >= 6 and abs(common - 2.0) < 0.3 and se < 0.3
+    assert drift_verdict(drift, {"F1": 2.0})[0] is True
+    assert drift_verdict(drift, {"F1": -2.0})[0] is False
+    # the falling stroke's friction shrinks by 2 N (wear on one side): common change +1 N
+    one_sided = _prepared(t, x, F + np.where(F < 0, 2.0 * (t - t[0]) / T, 0.0))
+    common, _, _ = plateau_trend(one_sided)
+    assert abs(common - 1.0) < 0.3
+    ok, why = drift_verdict(one_sided, {"F1": -3.0})
+    assert ok is False and "move together by" in why
+
+
+def test_displacement_offset_is_refused_where_the_contact_would_be_loaded_at_rest():
+    eff = registry("tangential")["displacement_offset"]
+    d = _prepared(*_branches(rest=100))  # at rest at x = 0 with F = 0
+    p = {"h0": H0, "ac": AC, "x0": 0.2 * A}  # M(-x0) = -H0 (1 - e^-4): -9.8 N at rest
+    ok, why = eff.plausible(d, p)
+    assert not ok and "starts at rest" in why
+    assert eff.plausible(d, {**p, "x0": 1e-3 * A}).ok  # M(-x0) = -0.2 N: within the rule
