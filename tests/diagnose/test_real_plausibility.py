@@ -222,3 +222,13 @@ def test_displacement_offset_is_refused_where_the_contact_would_be_loaded_at_res
     ok, why = eff.plausible(d, p)
     assert not ok and "starts at rest" in why
     assert eff.plausible(d, {**p, "x0": 1e-3 * A}).ok  # M(-x0) = -0.2 N: within the rule
+
+
+def test_asymmetry_in_gross_sliding_is_told_from_an_offset_by_the_rest_force():
+    eff = registry("tangential")["asymmetry"]
+    p = {"h0": H0, "ac": AC, "alpha": -0.2}  # ac·A = 20: both plateaus shift by -2 N
+    ok, why = eff.plausible(_prepared(*_branches(rest=100)), p)  # at rest F = 0
+    assert ok and "is not the sensor's" in why
+    t, x, F = _branches(rest=100)
+    ok, why = eff.plausible(_prepared(t, x, F - 2.0), p)  # at rest F = -2 = α h0
+    assert not ok and "force_offset stands for both" in why
