@@ -152,8 +152,19 @@ class ForceOffset(EffectModel):
         return Plausibility(True, f"{base.reason}; {why}")
 
     def argument(self, d, p):
+        from ._common import meta
+
         h0 = p.get("h0", np.nan)
+        frame = meta(d).get("frame")
+        K = frame.get("K") if isinstance(frame, dict) else None
+        zero = (
+            f"; the force is reconstructed as K (y - x) + ...: F0 is a zero of the two "
+            f"displacement sensors off by F0/K = {p['F0'] / K:.3g} m"
+            if isinstance(K, (int, float)) and K > 0
+            else ""
+        )
         return (
             f"F0 = {p['F0']:.4g} N ({100 * p['F0'] / h0:.1f} % of h0 = {h0:.4g} N): both "
-            "plateaus shifted alike, a sensor's zero (the virgin curve starts from F0, not 0)"
+            "plateaus shifted alike, a sensor's zero (the virgin curve starts from F0, not "
+            f"0){zero}"
         )
