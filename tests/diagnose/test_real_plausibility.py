@@ -232,3 +232,13 @@ def test_asymmetry_in_gross_sliding_is_told_from_an_offset_by_the_rest_force():
     t, x, F = _branches(rest=100)
     ok, why = eff.plausible(_prepared(t, x, F - 2.0), p)  # at rest F = -2 = α h0
     assert not ok and "force_offset stands for both" in why
+
+
+def test_report_json_carries_withdrawn_and_refused_with_reasons():
+    from contactlab.diagnose.result import DiagnosisReport
+
+    rep = DiagnosisReport("tangential", [], [], [], 1.0, None, {})  # type: ignore[arg-type]
+    rep.location = {"withdrawn_why": {"backlash": "not identifiable"}, "refused": {"a": "b"}}
+    rep.final_model = SimpleNamespace(to_dict=lambda: {})
+    doc = rep.to_dict()
+    assert doc["withdrawn"] == {"backlash": "not identifiable"} and doc["refused"] == {"a": "b"}
