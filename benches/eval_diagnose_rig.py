@@ -110,7 +110,7 @@ def chain_kwargs(seed, fac):
     if os.environ.get(CHAIN_ENV, "plain") != "sensors":
         return {}
     rng = np.random.default_rng(int(seed) + 424_242)
-    f, fs = fac["f"], fac["fs"]
+    fs = fac["fs"]
     return {
         # an LVDT conditioner's demodulator low-pass (2nd order) at 0.3-2 kHz
         "x_lowpass": round(min(_loguniform(rng, 300.0, 2000.0), 0.45 * fs), 3),

@@ -21,7 +21,6 @@ import math
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
-
 #: the largest ``(window // 2) ** polyorder`` whose Savitzky-Golay design keeps the plain
 #: integer abscissa (as scipy does); longer windows are designed on one scaled to [-1, 1]
 _UNSCALED_SPAN = 1e8
