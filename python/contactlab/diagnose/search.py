@@ -57,8 +57,9 @@ def _takes_over(
 
     In pre-sliding and transition (``regime``, as analyze decides it:
     :data:`ANCHOR_STIFFNESS_REGIMES`) a tangential loop never reaches its plateau and shows
-    its initial stiffness ``h0·ac`` and curvature, not ``h0``: the anchor is then ``h0·ac`` (a dashpot's loop area, read by the base as curvature, moved h0 from
-    27.6 to 40 N, its true value, at an unchanged stiffness: rig tuning seeds 1402-1408)."""
+    its initial stiffness ``h0·ac`` and curvature, not ``h0``: the anchor is then
+    ``h0·ac`` (a dashpot's loop area, read by the base as curvature, moved h0 from 27.6 to
+    40 N, its true value, at an unchanged stiffness: rig tuning seeds 1402-1408)."""
     from .effects import registry
 
     reg = registry(family.kind)
