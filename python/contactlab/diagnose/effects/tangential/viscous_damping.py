@@ -61,10 +61,9 @@ class ViscousDamping(EffectModel):
     rivals = ("channel_delay",)
 
     def apply(self, F, p, ctx):
-        # ẋ smoothed over 15 % of a period: differentiated over 8 %, the input noise left
-        # 16 % of the drive's ẋ in d.ud (rig, x noise 1.7 % at 86 samples a period), and a
-        # delay, which shifts the model's force of the filtered input, fitted the dashpot
-        # better than the dashpot did (held-out gain 2.2 against 1.35 σ², tune seed 1407)
+        # ẋ smoothed by a quintic over half a period (dashpot_velocity): differentiated over
+        # 8 %, the input noise left 16 % of the drive's ẋ in d.ud (rig, x noise 1.7 % at 86
+        # samples a period), and a regressor carrying noise shrinks c (errors in variables)
         return F + p["c"] * ctx.pick(dashpot_velocity(ctx.d))
 
     def argument(self, d, p):
