@@ -50,6 +50,34 @@ def _fit_line(t: np.ndarray, s: np.ndarray, f: float, w: np.ndarray) -> tuple[fl
     return float(beta[2]), float(beta[3]), float(0.5 * (cov[2, 2] + cov[3, 3]))
 
 
+#: a hum holds through the record: its amplitude in each third within this factor of the
+#: whole record's, its phase within STEADY_PHASE rad (a drive in blocks of other frequencies
+#: has content near 50 Hz in one block only: the package's generator at 7.3 Hz, 60.34 Hz)
+STEADY_FACTOR, STEADY_PHASE = 1.5, 0.5
+
+
+def _steady(t: np.ndarray, s: np.ndarray, f: float, a: float, b: float) -> bool:
+    """Whether the line ``(a, b)`` at ``f`` found on the whole record is there, alike, in
+    each third of it."""
+    amp, ph = float(np.hypot(a, b)), float(np.arctan2(b, a))
+    n = t.size // 3
+    for k in range(3):
+        sl = slice(k * n, (k + 1) * n if k < 2 else t.size)
+        tk = t[sl]
+        ak, bk, _ = _fit_line(tk, s[sl], f, np.hanning(tk.size))
+        # (the phase is referred to the record's start, as (a, b) are)
+        rot = 2.0 * np.pi * f * (tk[0] - t[0])
+        c, sn = np.cos(rot), np.sin(rot)
+        ak, bk = ak * c - bk * sn, ak * sn + bk * c
+        amp_k = float(np.hypot(ak, bk))
+        if not (amp / STEADY_FACTOR <= amp_k <= amp * STEADY_FACTOR):
+            return False
+        dph = float(np.angle(np.exp(1j * (np.arctan2(bk, ak) - ph))))
+        if abs(dph) > STEADY_PHASE:
+            return False
+    return True
+
+
 def _clear(f_line: float, f_drive: float, duration: float, harmonics: int | None) -> bool:
     """Whether no drive harmonic lies within :data:`GUARD_BINS` bins of ``f_line``."""
     if not (f_drive > 0 and duration > 0):
@@ -92,7 +120,7 @@ def _one_channel(
         amp = float(np.hypot(a, b))
         if not (sigma > 0 and np.isfinite(v)) or amp < LINE_SIGMAS * sigma * np.sqrt(v):
             continue
-        if not _clear(f, f_drive, duration, harmonics):
+        if not _clear(f, f_drive, duration, harmonics) or not _steady(t, out, f, a, b):
             continue
         ph = 2.0 * np.pi * f * (t - t[0])
         out = out - (a * np.cos(ph) + b * np.sin(ph))
