@@ -295,9 +295,8 @@ class Structure:
             :mod:`contactlab.joints` law and stiff structures: each piece is a Newmark step
             checked against two half steps, the pair's Richardson extrapolation is kept
             (fourth order) and the pair's difference / 3 is held to ``tol``. Pieces end on
-            the samples, at velocity reversals and at stick-slip transitions (Hermite pieces
-            also where a Bouc-Wen ``z`` crosses 0 or a Masing loop closes). Not together with
-            ``substeps``.
+            the samples, at velocity reversals and at stick-slip transitions. Not together
+            with ``substeps``.
 
         Returns
         -------

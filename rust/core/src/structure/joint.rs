@@ -237,35 +237,6 @@ impl JointLaw {
         }
     }
 
-    /// Fraction `θ ∈ (0, 1)` of the trial `tr` from `state` (`d_old → d_new`) at which the law
-    /// has a kink that is not an [`JointLaw::event`]: a Bouc-Wen `z` crossing 0 (its rate
-    /// `dz/dd` has a kink there), a Masing branch closing (rejoining the branch below, whose
-    /// curvature differs); `None` otherwise.
-    pub fn kink(&self, state: &JointState, (d_old, d_new): (f64, f64), tr: &Trial) -> Option<f64> {
-        match (self, state) {
-            (Self::BoucWen { .. }, JointState::Slider(z0)) if *z0 * tr.f < 0.0 => {
-                Some(*z0 / (*z0 - tr.f))
-            }
-            (Self::Masing { .. }, JointState::Masing(st)) => {
-                // a closure on the branch the state is on (not after a reversal in the trial)
-                let n = st.stack.len();
-                let dir = f64::from(st.dir);
-                if tr.aux & 1 == 1 || tr.aux / 2 >= n || dir == 0.0 || (d_new - d_old) * dir <= 0.0
-                {
-                    return None;
-                }
-                let target = match n {
-                    0 => return None,
-                    1 => -st.stack[0].x,
-                    _ => st.stack[n.saturating_sub(2)].x,
-                };
-                let th = (target - d_old) / (d_new - d_old);
-                (th > 0.0 && th < 1.0).then_some(th)
-            }
-            _ => None,
-        }
-    }
-
     /// The virgin state (d = 0, F = 0).
     pub fn fresh_state(&self) -> JointState {
         match self {

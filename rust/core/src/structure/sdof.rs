@@ -77,10 +77,6 @@ trait Joints {
     /// right limit; see [`JointLaw::start_tangent`]), where they may differ from those the
     /// state holds. `None`: the state's.
     fn start_tangent(&self, x0: f64, x1: f64) -> Option<(f64, f64)>;
-    /// Earliest fraction `θ` of the step last tried (from the committed `x0` to `x1`) at
-    /// which a joint's law has a kink that is not an event (a Bouc-Wen `z` crossing 0, a
-    /// Masing loop closing); 1: none.
-    fn kink(&self, x0: f64, x1: f64) -> f64;
     /// Whether error control takes Hermite pieces (see `adaptive`) for this joint set: not
     /// where a law's tangent is a difference quotient (a [`JointLaw::Law`]) nor for Masing
     /// joints, whose branches right after a reversal (the tangent falling from its initial
@@ -247,17 +243,6 @@ impl Joints for Dyn<'_> {
             out = (out.0 + kt, out.1 + ct);
         }
         Some(out)
-    }
-
-    #[inline]
-    fn kink(&self, x0: f64, x1: f64) -> f64 {
-        let mut theta = 1.0_f64;
-        for ((j, st), tr) in self.joints.iter().zip(&self.states).zip(&self.trials) {
-            if let Some(th) = j.law.kink(st, (x0, x1), tr) {
-                theta = theta.min(th);
-            }
-        }
-        theta
     }
 
     #[inline]
@@ -483,18 +468,6 @@ impl Joints for MasingExp {
 
     fn hermite(&self) -> bool {
         false
-    }
-
-    #[inline(always)]
-    fn kink(&self, _x0: f64, x1: f64) -> f64 {
-        // the cached branch closing inside the trial (rejoining the branch below)
-        let dir = f64::from(self.st.dir);
-        let (a, b) = (self.st.x * dir, x1 * dir);
-        if dir != 0.0 && self.lim.is_finite() && a < self.lim && b > self.lim {
-            (self.lim - a) / (b - a)
-        } else {
-            1.0
-        }
     }
 
     #[inline(always)]
