@@ -161,3 +161,24 @@ def test_fixed_substeps_still_work_and_converge_at_second_order():
     # band-limited inputs between samples (prepared in Python) keep working
     r = s.simulate(t, force=u, substeps=2, interpolation="fourier")
     assert r.success and r.x.shape == (n,)
+
+
+@pytest.mark.parametrize("kind", ["masing", "bouc_wen"])
+def test_rtol_bounds_the_inner_newton_under_error_control(kind):
+    # step doubling (Masing) ends its inner Newton solves early once the residual is small;
+    # that end must follow rtol (at most sqrt(rtol)), so that a tighter rtol costs iterations
+    # and moves the result towards the tightest one; Hermite pieces (Bouc-Wen) end on rtol
+    m = np.diag([2.0, 1.0, 1.5])
+    k = 5e4 * np.array([[2, -1, 0], [-1, 2, -1], [0, -1, 1.0]])
+    s = Structure(m, 1e-4 * k + 2.0 * m, k)
+    if kind == "masing":
+        s.add_joint("masing", 0, h0=40.0, ac=2e4, scale=2.0)
+    else:
+        s.add_joint("bouc_wen", 0, **BW)
+    s.add_joint("jenkins", 2, 1, k=3e4, fs=20.0)
+    fs, n = 3000.0, 600
+    t = np.arange(n) / fs
+    f = np.stack([_force(n, fs, 21), np.zeros(n), _force(n, fs, 22, 10.0)], axis=1)
+    runs = {rtol: s.simulate(t, force=f, tol=1e-6, rtol=rtol) for rtol in (1e-6, 1e-9, 1e-13)}
+    assert runs[1e-13].n_iter > runs[1e-9].n_iter > runs[1e-6].n_iter
+    assert _rrms(runs[1e-9].x, runs[1e-13].x) <= 1e-7

@@ -96,7 +96,9 @@ fn piece<J: Joints>(
     let (m, c, k) = mck;
     let f1 = load(inp, i, tau1);
     let fm = load(inp, i, 0.5 * (tau + tau1));
-    let quick = jt.quick();
+    // Quadratic convergence leaves a residual of the order of the square of the last one (in
+    // units of the forces): ending at `√rtol` keeps the solve's error within `rtol`.
+    let quick = jt.quick().min(opts.rtol.sqrt());
     let (coarse, i1) = newton(jt, mck, w, (w.x, quick), h, f1, opts)?;
     jt.keep(0, coarse.moved);
     let (half, i2) = newton(jt, mck, w, (w.x, quick), 0.5 * h, fm, opts)?;
