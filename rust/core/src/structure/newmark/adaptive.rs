@@ -114,7 +114,11 @@ fn piece(
         .iter()
         .any(|j| matches!(j.law, JointLaw::Law { .. }));
     // (at most √rtol: the residual left is then of the order of rtol, as the one-DOF path)
-    let quick = if exact { opts.rtol.sqrt().min(1e-3) } else { 0.0 };
+    let quick = if exact {
+        opts.rtol.sqrt().min(1e-3)
+    } else {
+        0.0
+    };
     let i1 = newton_step(s, w, (h, quick, false), sc, opts)?;
     p.xc.copy_from_slice(&sc.x1);
     p.vc.copy_from_slice(&sc.v1);
