@@ -1,0 +1,136 @@
+"""The slow effects' detection (issue 29 items 1-2): a drift's held-out gain tested by the
+proportional t across cycles, the per-effect gain floor, and a force drift told from a
+displacement-sensor drift."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from contactlab.diagnose.candidates_tangential import TangentialFamily
+from contactlab.diagnose.effects.tangential.force_drift import (
+    X_DRIFT_SHARE,
+    displacement_alike,
+)
+from contactlab.diagnose.power import DRAWS, _bound, _power_curve, _Setting
+from contactlab.diagnose.search import own_gain_floor
+from contactlab.diagnose.select import proportional_t
+
+M, PER = 8, 60  # cycles, samples per cycle
+
+
+def _drift_direction() -> np.ndarray:
+    """A drift of the loop's height: nothing in the record's middle, most at its ends."""
+    n = M * PER
+    t = np.arange(n) / n
+    return (t - 0.5) * np.sin(2 * np.pi * M * t)
+
+
+def _setting(seed: int = 0) -> _Setting:
+    rng = np.random.default_rng(seed)
+    cyc = np.repeat(np.arange(M), PER)
+    return _Setting(
+        w=np.ones(M * PER), var=1.0, cycle_of=cyc, fold_of_cycle=np.arange(M) % 2,
+        cycle_mse=np.ones(M), sigma=1.0, z=3.0, gain_floor=0.0, y_rms=1.0,
+        rng_normals=rng.standard_normal((DRAWS, M)), rng_fit=np.zeros(DRAWS),
+        size_factor=np.ones(DRAWS),
+    )  # fmt: skip
+
+
+def test_the_proportional_t_lowers_a_drifts_bound() -> None:
+    """The per-cycle log ratios of a drift scatter by the drift's own shape (gain ∝ (t -
+    t_m)²), so their t stays low however large the drift; the proportional t does not."""
+    j, st = _drift_direction(), _setting()
+    plain = _bound(j, st)
+    prop = _bound(j, st, proportional=True)
+    assert prop is not None
+    assert plain is None or plain > 1.5 * prop
+
+
+def test_the_linearised_proportional_t_matches_the_statistic_itself() -> None:
+    """Independent route: the rate at which :func:`select.proportional_t` itself, on
+    simulated held-out predictions (two folds of interleaved cycles, each fitted on the
+    other by least squares), exceeds z agrees with the bound's linearised draws."""
+    j, st = _drift_direction(), _setting(1)
+    z = 3.0
+    cyc = np.repeat(np.arange(M), PER)
+    fold = cyc % 2
+    d = SimpleNamespace(y=None, cycles=SimpleNamespace(cycle=cyc), extra={})
+    rng = np.random.default_rng(2)
+    a = None
+    for a_try in np.geomspace(0.05, 5, 40):  # a size where the power is in between
+        if 0.3 < _power_curve(j, st, proportional=True)(a_try) < 0.7:
+            a = float(a_try)
+            break
+    assert a is not None
+    hits = 0
+    runs = 400
+    for _ in range(runs):
+        y = a * j + rng.standard_normal(j.size)
+        pred = np.zeros(j.size)
+        for k in (0, 1):
+            train = fold != k
+            c = float(np.sum(j[train] * y[train]) / np.sum(j[train] ** 2))
+            pred[fold == k] = c * j[fold == k]
+        d.y = y
+        cur = SimpleNamespace(prediction=np.zeros(j.size), heldout=np.ones(j.size, bool))
+        cand = SimpleNamespace(prediction=pred, heldout=np.ones(j.size, bool))
+        hits += proportional_t(cur, cand, d) > z
+    simulated = hits / runs
+    # the linearised power with the log-ratio t switched off (z beyond its reach)
+    lin = _power_curve(j, st, proportional=True)(a)
+    plain = _power_curve(j, st)(a)
+    assert plain < 0.2  # the log-ratio t alone rarely passes at this size
+    assert abs(simulated - lin) < 0.12
+
+
+def test_own_gain_floor_per_effect() -> None:
+    fam = TangentialFamily()
+    assert own_gain_floor(fam, ("force_drift",), 0.05) == pytest.approx(0.01)
+    assert own_gain_floor(fam, ("parameter_drift",), 0.05) == pytest.approx(0.01)
+    assert own_gain_floor(fam, ("stribeck",), 0.05) == pytest.approx(0.05)
+    # a pair is held to the stricter of its two floors
+    assert own_gain_floor(fam, ("force_drift", "stribeck"), 0.05) == pytest.approx(0.05)
+
+
+def _record(acA: float, cycles: int = 10, n: int = 2000) -> SimpleNamespace:
+    ac = 4.0e4
+    t = np.linspace(0.0, 1.0, n)
+    u = (acA / ac) * np.sin(2 * np.pi * cycles * t)
+    return SimpleNamespace(u=u, t=t, duration=1.0, extra={})
+
+
+@pytest.mark.parametrize("acA", [0.3, 1.0])
+def test_a_small_force_ramp_in_pre_sliding_is_a_displacement_drift(acA: float) -> None:
+    d = _record(acA)
+    A = acA / 4.0e4
+    k = 40.0 * 4.0e4  # the contact's stiffness at small slip
+    F1 = 0.005 * A * k  # what a drift of 0.5 % of the amplitude draws
+    alike = displacement_alike(d, {"h0": 40.0, "ac": 4.0e4, "F1": F1})
+    assert alike is not None
+    D, share = alike
+    assert share > 0.5 and 0 < abs(D) <= X_DRIFT_SHARE * A
+    assert D < 0  # the force rose by F1 = -k D: the sensor reads the contact D too low
+    # a force ramp of 15 % of the loop's height is no sensor drift of the displacement
+    assert displacement_alike(d, {"h0": 40.0, "ac": 4.0e4, "F1": 30 * F1}) is None
+
+
+def test_in_gross_sliding_a_force_ramp_is_no_displacement_drift() -> None:
+    d = _record(5.0)
+    A = 5.0 / 4.0e4
+    F1 = 0.005 * A * 40.0 * 4.0e4
+    assert displacement_alike(d, {"h0": 40.0, "ac": 4.0e4, "F1": F1}) is None
+
+
+def test_the_bound_starts_where_a_displacement_drift_no_longer_draws_the_ramp() -> None:
+    from contactlab.diagnose.effects import registry
+
+    eff = registry("tangential")["force_drift"]
+    p = {"h0": 40.0, "ac": 4.0e4, "F1": 0.0}
+    low = eff.smallest_plausible(_record(0.3), p)
+    assert low is not None and low > 0
+    assert displacement_alike(_record(0.3), {**p, "F1": 0.99 * low}) is not None
+    assert displacement_alike(_record(0.3), {**p, "F1": 1.01 * low}) is None
+    assert eff.smallest_plausible(_record(5.0), p) is None
