@@ -138,6 +138,8 @@ def candidate_directions(rep, t_raw: np.ndarray, skip: str) -> dict[str, np.ndar
         if not mags:
             continue
         pc = {**p, **shape_values(fam, c, p, d), **{q.name: q.null for q in mags}}
+        if c == "position_friction":  # a wave of 1.5 half-widths (the same in every version)
+            pc["L"] = 1.5 * float(d.extra.get("x_half", 0.5 * float(np.ptp(d.u))))
         cols = []
         for q in mags:
             try:

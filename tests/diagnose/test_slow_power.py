@@ -134,3 +134,13 @@ def test_the_bound_starts_where_a_displacement_drift_no_longer_draws_the_ramp() 
     assert displacement_alike(_record(0.3), {**p, "F1": 0.99 * low}) is not None
     assert displacement_alike(_record(0.3), {**p, "F1": 1.01 * low}) is None
     assert eff.smallest_plausible(_record(5.0), p) is None
+
+
+def test_position_frictions_bound_is_stated_for_a_wave_of_the_strokes_length() -> None:
+    from contactlab.diagnose.effects import registry
+    from contactlab.diagnose.effects.tangential.position_friction import POWER_WAVELENGTH
+
+    eff = registry("tangential")["position_friction"]
+    d = SimpleNamespace(extra={"x_half": 2.0e-5}, u=np.array([-2.0e-5, 2.0e-5]))
+    assert eff.power_shape(d, {})["L"] == pytest.approx(POWER_WAVELENGTH * 2.0e-5)
+    assert 1.0 <= POWER_WAVELENGTH <= 2.0

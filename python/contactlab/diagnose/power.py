@@ -211,7 +211,20 @@ def shape_values(family: Family, name: str, p: dict[str, float], d: Prepared) ->
         else:
             v = 0.3 * float(scales.get(s.name, scales.get(s.scale, 1.0)))
         out[s.name] = float(v)
-    return out
+    return {**out, **_own_shape(family, name, p, d)}
+
+
+def _own_shape(family: Family, name: str, p: dict[str, float], d: Prepared) -> dict[str, float]:
+    """The shape values the effect itself states its bound at (its ``power_shape(d, p)``:
+    a track's wave as long as the stroke, not a tenth of a micrometre), else none."""
+    from .effects import registry
+
+    try:
+        eff = registry(getattr(family, "kind", "")).get(name)
+    except KeyError:
+        return {}
+    hook = getattr(eff, "power_shape", None)
+    return {} if hook is None else {k: float(v) for k, v in hook(d, p).items()}
 
 
 def _step(s: ParamSpec, value: float, scales: dict[str, float]) -> float:

@@ -100,7 +100,20 @@ def _noise_floor(family: Family, names: tuple[str, ...], budget: float) -> float
     except KeyError:
         return budget
     blind = all(not getattr(reg.get(n), "input_noise_gain", True) for n in names)
-    return 0.0 if names and blind else budget
+    if names and blind:
+        return 0.0
+    # an effect that can take only part of what the input's noise leaves (its
+    # ``input_noise_share``, measured on clean records) beats that part of the budget
+    return budget * max((_noise_share(reg.get(n)) for n in names), default=1.0)
+
+
+def _noise_share(eff: object) -> float:
+    """The share of the input-noise budget an effect's fit can take from the noise alone: 0
+    when it is blind to the input (``input_noise_gain`` False), else its
+    ``input_noise_share`` (default 1: all of it)."""
+    if not getattr(eff, "input_noise_gain", True):
+        return 0.0
+    return float(getattr(eff, "input_noise_share", 1.0))
 
 
 def own_gain_floor(family: Family, names: tuple[str, ...], min_gain: float) -> float:

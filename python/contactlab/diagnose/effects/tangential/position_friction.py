@@ -9,6 +9,9 @@ from .._base import EffectModel, Plausibility, register
 
 #: wavelengths :meth:`PositionFriction.start` tries, as multiples of the stroke's half-width
 START_WAVELENGTHS = np.geomspace(0.6, 8.0, 28)
+#: the wavelength the stated power is given at, in half-widths of the stroke (a wave between
+#: one and two of them: the track's features that a stroke shows as a wave)
+POWER_WAVELENGTH = 1.5
 #: a wave longer than this many half-widths of the stroke is a level or a gradient of the
 #: friction over the stroke (h0, parameter drift, asymmetry), not a feature of the track
 LONGEST_WAVE = 12.0
@@ -66,6 +69,14 @@ class PositionFriction(EffectModel):
             return 0.0, float(np.inf)
         e2 = sum((p.get(n, 0.0) / v * se.get(n, np.inf)) ** 2 for n in TRACK_TERMS)
         return v, float(np.sqrt(e2))
+
+    def power_shape(self, d, p):
+        """The wavelength the stated power is given at: :data:`POWER_WAVELENGTH` half-widths
+        of the stroke (a wave of the track's own length, between one and two strokes' worth
+        of the half-widths :meth:`start` searches), not the parameter's generic starting
+        value (a hundredth of the stroke)."""
+        half = float(d.extra.get("x_half", 0.5 * float(np.ptp(d.u))))
+        return {"L": POWER_WAVELENGTH * half} if half > 0 else {}
 
     def start(self, p, d, residual, family=None):
         """The wavelength (of :data:`START_WAVELENGTHS` half-widths of the stroke) whose wave,
