@@ -15,7 +15,7 @@ from contactlab.diagnose.effects.tangential.force_drift import (
     displacement_alike,
 )
 from contactlab.diagnose.power import DRAWS, _bound, _power_curve, _Setting
-from contactlab.diagnose.search import own_gain_floor
+from contactlab.diagnose.search import _noise_floor, own_gain_floor
 from contactlab.diagnose.select import proportional_t
 
 M, PER = 8, 60  # cycles, samples per cycle
@@ -90,9 +90,19 @@ def test_own_gain_floor_per_effect() -> None:
     fam = TangentialFamily()
     assert own_gain_floor(fam, ("force_drift",), 0.05) == pytest.approx(0.01)
     assert own_gain_floor(fam, ("parameter_drift",), 0.05) == pytest.approx(0.01)
-    assert own_gain_floor(fam, ("stribeck",), 0.05) == pytest.approx(0.05)
+    assert own_gain_floor(fam, ("viscous_damping",), 0.05) == pytest.approx(0.05)
     # a pair is held to the stricter of its two floors
-    assert own_gain_floor(fam, ("force_drift", "stribeck"), 0.05) == pytest.approx(0.05)
+    assert own_gain_floor(fam, ("force_drift", "viscous_damping"), 0.05) == pytest.approx(0.05)
+
+
+def test_the_input_noise_budget_by_share() -> None:
+    fam = TangentialFamily()
+    assert _noise_floor(fam, ("force_drift",), 0.4) == 0.0  # blind to the input's noise
+    assert _noise_floor(fam, ("viscous_damping",), 0.4) == pytest.approx(0.4)
+    share = _noise_floor(fam, ("position_friction",), 0.4) / 0.4
+    assert 0.0 < share < 1.0
+    # a pair beats the larger of its shares
+    assert _noise_floor(fam, ("position_friction", "viscous_damping"), 0.4) == pytest.approx(0.4)
 
 
 def _record(acA: float, cycles: int = 10, n: int = 2000) -> SimpleNamespace:

@@ -27,6 +27,15 @@ def track_phase(x: np.ndarray, d, wavelength: float) -> np.ndarray:
 TRACK_TERMS = ("a1", "b1")
 
 
+#: the share of the search's ``min_gain`` its held-out gain must reach, and the share of the
+#: input-noise budget it must beat (:func:`contactlab.diagnose.search.own_gain_floor`,
+#: ``search._noise_floor``): on 36 clean records of both generators (tuning seeds 1000-1035
+#: of ``benches/eval_clean_gains.py --open``, every floor off) its largest held-out gain was
+#: 0.050 σ² at t <= 2.05 (at most 0.10 of the budget on records with a budget above 0.1 σ²)
+GAIN_FLOOR_SCALE = 0.2
+INPUT_NOISE_SHARE = 0.25
+
+
 @register
 class PositionFriction(EffectModel):
     """Friction varying along the track: ``h0(x) = h0 (1 + a1 cos φ + b1 sin φ)``, ``φ = 2π
@@ -61,6 +70,9 @@ class PositionFriction(EffectModel):
     rank = 1
     order = 12
     size_param = "a1"
+    #: per-effect floors (see GAIN_FLOOR_SCALE, INPUT_NOISE_SHARE above)
+    gain_floor_scale = GAIN_FLOOR_SCALE
+    input_noise_share = INPUT_NOISE_SHARE
 
     def size(self, p, se):
         """The wave's amplitude ``√(a1² + b1²)``, with its delta-method error."""
