@@ -10,10 +10,6 @@ import numpy as np
 import pytest
 
 from contactlab.diagnose.candidates_tangential import TangentialFamily
-from contactlab.diagnose.effects.tangential.force_drift import (
-    X_DRIFT_SHARE,
-    displacement_alike,
-)
 from contactlab.diagnose.power import DRAWS, _bound, _power_curve, _Setting
 from contactlab.diagnose.search import _noise_floor, own_gain_floor
 from contactlab.diagnose.select import proportional_t
@@ -105,47 +101,6 @@ def test_the_input_noise_budget_by_share() -> None:
     assert _noise_floor(fam, ("position_friction", "viscous_damping"), 0.4) == pytest.approx(0.4)
 
 
-def _record(acA: float, cycles: int = 10, n: int = 2000) -> SimpleNamespace:
-    ac = 4.0e4
-    t = np.linspace(0.0, 1.0, n)
-    u = (acA / ac) * np.sin(2 * np.pi * cycles * t)
-    return SimpleNamespace(u=u, t=t, duration=1.0, extra={})
-
-
-@pytest.mark.parametrize("acA", [0.3, 1.0])
-def test_a_small_force_ramp_in_pre_sliding_is_a_displacement_drift(acA: float) -> None:
-    d = _record(acA)
-    A = acA / 4.0e4
-    k = 40.0 * 4.0e4  # the contact's stiffness at small slip
-    F1 = 0.005 * A * k  # what a drift of 0.5 % of the amplitude draws
-    alike = displacement_alike(d, {"h0": 40.0, "ac": 4.0e4, "F1": F1})
-    assert alike is not None
-    D, share = alike
-    assert share > 0.5 and 0 < abs(D) <= X_DRIFT_SHARE * A
-    assert D < 0  # the force rose by F1 = -k D: the sensor reads the contact D too low
-    # a force ramp of 15 % of the loop's height is no sensor drift of the displacement
-    assert displacement_alike(d, {"h0": 40.0, "ac": 4.0e4, "F1": 30 * F1}) is None
-
-
-def test_in_gross_sliding_a_force_ramp_is_no_displacement_drift() -> None:
-    d = _record(5.0)
-    A = 5.0 / 4.0e4
-    F1 = 0.005 * A * 40.0 * 4.0e4
-    assert displacement_alike(d, {"h0": 40.0, "ac": 4.0e4, "F1": F1}) is None
-
-
-def test_the_bound_starts_where_a_displacement_drift_no_longer_draws_the_ramp() -> None:
-    from contactlab.diagnose.effects import registry
-
-    eff = registry("tangential")["force_drift"]
-    p = {"h0": 40.0, "ac": 4.0e4, "F1": 0.0}
-    low = eff.smallest_plausible(_record(0.3), p)
-    assert low is not None and low > 0
-    assert displacement_alike(_record(0.3), {**p, "F1": 0.99 * low}) is not None
-    assert displacement_alike(_record(0.3), {**p, "F1": 1.01 * low}) is None
-    assert eff.smallest_plausible(_record(5.0), p) is None
-
-
 def test_position_frictions_bound_is_stated_for_a_wave_of_the_strokes_length() -> None:
     from contactlab.diagnose.effects import registry
     from contactlab.diagnose.effects.tangential.position_friction import POWER_WAVELENGTH
@@ -154,3 +109,40 @@ def test_position_frictions_bound_is_stated_for_a_wave_of_the_strokes_length() -
     d = SimpleNamespace(extra={"x_half": 2.0e-5}, u=np.array([-2.0e-5, 2.0e-5]))
     assert eff.power_shape(d, {})["L"] == pytest.approx(POWER_WAVELENGTH * 2.0e-5)
     assert 1.0 <= POWER_WAVELENGTH <= 2.0
+
+
+@pytest.mark.parametrize("acA", [0.3, 1.0, 4.0])
+def test_a_displacement_drift_draws_a_force_ramp_in_pre_sliding(acA: float) -> None:
+    """Independent of the diagnosis (the Masing element itself): a sensor drift D of x
+    makes the force climb by the branch's end slope h0·ac·exp(-ac·A) times D over the
+    record, which is what ``displacement_ramp`` states."""
+    from contactlab.diagnose.effects.tangential.force_drift import (
+        X_DRIFT_SHARE,
+        displacement_ramp,
+    )
+    from contactlab.masing import Masing
+
+    h0, ac, cycles = 40.0, 4.0e4, 20
+    t = np.linspace(0.0, 1.0, 20 * 400)
+    A = acA / ac
+    x = A * np.sin(2 * np.pi * cycles * t)
+    D = X_DRIFT_SHARE * A
+    dF = Masing(h0, ac).force(x + D * t) - Masing(h0, ac).force(x)
+    late = t > 1.0 / cycles
+    slope = np.polyfit(t[late], dF[late], 1)[0]
+    d = SimpleNamespace(u=x)
+    assert slope == pytest.approx(displacement_ramp(d, {"h0": h0, "ac": ac}), rel=0.05)
+
+
+def test_a_force_drift_within_that_ramp_is_refused_and_the_bound_starts_above_it() -> None:
+    from contactlab.diagnose.effects import registry
+    from contactlab.diagnose.effects.tangential.force_drift import displacement_ramp
+
+    eff = registry("tangential")["force_drift"]
+    x = 1e-5 * np.sin(np.linspace(0, 20 * np.pi, 2000))  # ac·A = 0.4
+    d = SimpleNamespace(u=x, t=np.linspace(0, 1, 2000), duration=1.0, extra={})
+    p = {"h0": 40.0, "ac": 4.0e4}
+    ramp = displacement_ramp(d, p)
+    assert not eff.plausible(d, {**p, "F1": 0.9 * ramp}).ok
+    assert eff.plausible(d, {**p, "F1": -1.1 * ramp}).ok
+    assert eff.smallest_plausible(d, p) > ramp
