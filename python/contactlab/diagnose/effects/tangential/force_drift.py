@@ -52,9 +52,13 @@ class ForceDrift(EffectModel):
         return F + p["F1"] * ctx.pick(ctx.fixed("t_rel", lambda: d.t - d.t[0])) / d.duration
 
     def plausible(self, d, p):
-        """The shared rules, and a ramp larger than what a plausible displacement-sensor
-        drift draws (:func:`displacement_ramp`): below it the record cannot tell which
-        sensor drifted, and a displacement drift is not an effect (docs/effects.md §3)."""
+        """The shared rules; a ramp larger than what a plausible displacement-sensor drift
+        draws (:func:`displacement_ramp`): below it the record cannot tell which sensor
+        drifted, and a displacement drift is not an effect (docs/effects.md §3); then the
+        data's plateaus must move together by about ``F1`` over the record
+        (:func:`.force_offset.drift_verdict`)."""
+        from .force_offset import drift_verdict
+
         base = super().plausible(d, p)
         if not base.ok:
             return base
@@ -67,11 +71,15 @@ class ForceDrift(EffectModel):
                 "contact is stiff at the turns (h0·ac·exp(-ac·A) per metre): the record "
                 "cannot tell which sensor drifted",
             )
-        return base
+        ok, why = drift_verdict(d, p)
+        if ok is False:
+            return Plausibility(False, why)
+        return Plausibility(True, f"{base.reason}; {why}") if ok else base
 
     def smallest_plausible(self, d, p):
-        """The smallest ``|F1|`` the diagnosis does not refuse (:meth:`plausible`), with
-        :data:`PLAUSIBLE_MARGIN`, for the stated power; None when it refuses none."""
+        """The smallest ``|F1|`` the diagnosis does not refuse as a displacement drift
+        (:meth:`plausible`), with :data:`PLAUSIBLE_MARGIN`, for the stated power; None when
+        it refuses none."""
         ramp = displacement_ramp(d, p)
         return None if ramp is None else PLAUSIBLE_MARGIN * ramp
 
