@@ -33,6 +33,12 @@ MAX_BASE_SHIFT_EXPLAINED = 0.5
 MOSTLY_SHARE = 0.1
 MAX_BASE_SHIFT_MOSTLY = 1.0
 _ANCHORS = {"tangential": ("h0",), "normal": ("k",)}
+#: the regimes (analyze's decision) whose loops never reach a plateau, so the base reads
+#: h0 by extrapolation and the anchor is the initial stiffness h0·ac: pre-sliding, and the
+#: transition (a dashpot's loop area, read by the base as the way to gross sliding, moved
+#: h0 from 24 to 40 N, the truth, at ac·A 0.53 behind an LVDT's low-pass; the base fit
+#: called it transition at ac·A 1.2: rig seed 1000, --chain sensors)
+ANCHOR_STIFFNESS_REGIMES = ("pre-sliding", "transition")
 
 
 def _takes_over(
@@ -49,10 +55,11 @@ def _takes_over(
     None. An effect that rescales the base (a branch scale makes
     the loop's height ``λ h0 / 2``) is compared by its equivalent of the base parameter.
 
-    In pre-sliding (``regime``, as analyze decides it) a tangential loop never reaches its
-    plateau and shows its initial stiffness ``h0·ac`` and curvature, not ``h0``: the anchor
-    is then ``h0·ac`` (a dashpot's loop area, read by the base as curvature, moved h0 from
-    27.6 to 40 N, its true value, at an unchanged stiffness: rig tuning seeds 1402-1408)."""
+    In pre-sliding and transition (``regime``, as analyze decides it:
+    :data:`ANCHOR_STIFFNESS_REGIMES`) a tangential loop never reaches its plateau and shows
+    its initial stiffness ``h0·ac`` and curvature, not ``h0``: the anchor is then
+    ``h0·ac`` (a dashpot's loop area, read by the base as curvature, moved h0 from 27.6 to
+    40 N, its true value, at an unchanged stiffness: rig tuning seeds 1402-1408)."""
     from .effects import registry
 
     reg = registry(family.kind)
@@ -64,7 +71,7 @@ def _takes_over(
     if explains <= EXPLAINED_SHARE:
         limit = MAX_BASE_SHIFT_MOSTLY if explains <= MOSTLY_SHARE else MAX_BASE_SHIFT_EXPLAINED
     anchors = _ANCHORS.get(family.kind, ())
-    if regime == "pre-sliding" and family.kind == "tangential" and "ac" in base:
+    if regime in ANCHOR_STIFFNESS_REGIMES and family.kind == "tangential" and "ac" in base:
         anchors = ("h0·ac",)
         base = {**base, "h0·ac": base["h0"] * base["ac"]}
         equivalent["h0·ac"] = equivalent["h0"] * equivalent["ac"]
