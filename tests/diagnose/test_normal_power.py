@@ -53,7 +53,7 @@ def _setting(proportional: bool, m: int = 20, n_c: int = 200) -> _Setting:
         w=np.ones(n), var=1.0, cycle_of=np.arange(n) // n_c, fold_of_cycle=np.arange(m) % 2,
         cycle_mse=np.ones(m), sigma=1.0, z=3.0, gain_floor=0.002, y_rms=10.0,
         rng_normals=rng.standard_normal((DRAWS, m)), fit_rows=np.arange(n),
-        rng_fit=rng.standard_normal(DRAWS), proportional=proportional,
+        rng_fit=rng.standard_normal(DRAWS),
     )  # fmt: skip
 
 
@@ -64,8 +64,8 @@ def test_proportional_t_lowers_the_bound_of_an_effect_in_the_first_cycles() -> N
     t = np.arange(n) / n
     creep = -np.expm1(-t / 0.05)
     jp = creep - np.mean(creep)
-    plain = _bound(jp, _setting(False))
-    prop = _bound(jp, _setting(True))
+    plain = _bound(jp, _setting(False), 0.0, False)
+    prop = _bound(jp, _setting(True), 0.0, True)
     assert prop is not None
     assert plain is None or prop < 0.7 * plain
 

@@ -54,8 +54,7 @@ def assess(
         d, residual, declared_output=declared_output, slope=slope,
         input_unit=family.input_unit, output_unit=family.output_unit,
     )  # fmt: skip
-    st = _setting(d, current, noise, slope, sigma, z, gain_floor, folds, seed,
-                  getattr(family, "proportional_gain", False))  # fmt: skip
+    st = _setting(d, current, noise, slope, sigma, z, gain_floor, folds, seed)
     bounds = bounds_for(family, params, effects, candidates, d, noise, sigma, current, st)
     # errors in variables: the structure the input's noise alone leaves, simulated and
     # taken out of the residual before the phase-bin test (the interval null then only
