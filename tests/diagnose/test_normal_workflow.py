@@ -400,7 +400,9 @@ def test_normal_input_filter_keeps_the_excitation_and_cuts_the_noise():
     # smooth_input: the strongest Savitzky-Golay filter flat to 1e-4 over the excitation's
     # band and its second harmonic; on the clean three-tone pressure it changes nothing
     # that matters, and it passes less white noise than the every-family cubic
-    from contactlab.diagnose._filters import savgol_coeffs
+    # (the package's filter, which the diagnosis applies: scipy's designs a long window's
+    # high order on the plain abscissa, singular to rounding — contactlab._filters)
+    from contactlab.diagnose._filters import savgol_coeffs, savgol_filter
 
     for spc in (50, 200, 1000):
         t, p, y, p_clean, _ = _noisy_kv(31, 0.01, spc=spc)
