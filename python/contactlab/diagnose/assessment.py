@@ -12,6 +12,7 @@ import numpy as np
 
 from ._family import Prepared
 from .detection import channel_noise, model_slope
+from .eiv import input_noise_spectrum
 from .misfit import (
     BACKBONE_Z,
     BACKBONE_Z_CORRECTED,
@@ -61,9 +62,13 @@ def assess(
     # covers what the simulation misses)
     bias = eiv_bias(family, params, effects, d, seed=seed)
     tested = residual if bias is None else residual - bias
+    # the input noise the model sees, from its spectrum where it is coloured (a white-noise
+    # estimate from neighbouring samples misses a low-passed sensor's noise)
+    spec = input_noise_spectrum(d)
+    seen = noise.input_seen if spec is None else max(noise.input_seen, spec.seen)
     misfit = unexplained_structure(
         d, tested, sigma, unit=family.output_unit,
-        tolerance=eiv_tolerance(slope, noise.input_seen, corrected=bias is not None),
+        tolerance=eiv_tolerance(slope, seen, corrected=bias is not None),
     )  # fmt: skip
     if misfit is not None and bias is not None:
         misfit = dataclasses.replace(misfit, eiv_bias_rms=float(np.sqrt(np.mean(bias * bias))))
