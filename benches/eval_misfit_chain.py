@@ -146,16 +146,18 @@ def main() -> None:
     ap.add_argument("--seed0", type=int, default=5000)
     ap.add_argument("--corner", action="store_true")
     ap.add_argument("--jobs", type=int, default=2)
-    ap.add_argument("--dump", default=None)
+    ap.add_argument("--dump", default=None, help="append every record's result (JSON lines)")
+    ap.add_argument("--first", type=int, default=0, help="skip the first clean seeds")
     a = ap.parse_args()
-    jobs = [(a.seed0 + k, "exp", a.corner) for k in range(a.n)]
+    jobs = [(a.seed0 + k, "exp", a.corner) for k in range(a.first, a.n)]
     jobs += [(a.seed0 + 500 + k, UNNAMEABLE[k % 3], a.corner) for k in range(a.misfits)]
+    res = []
     with ProcessPoolExecutor(a.jobs) as ex:
-        res = list(ex.map(run_one, jobs))
-    if a.dump:
-        with open(a.dump, "w") as fh:
-            for r in res:
-                fh.write(json.dumps(r, default=str) + "\n")
+        for r in ex.map(run_one, jobs):  # each row written as it comes (a long run's part)
+            res.append(r)
+            if a.dump:
+                with open(a.dump, "a") as fh:
+                    fh.write(json.dumps(r, default=str) + "\n")
     print(table([r for r in res if r["virgin"] == "exp"], "clean (exponential virgin curve)"))
     print(table([r for r in res if r["virgin"] != "exp"], "unnameable virgin curves"))
 

@@ -12,7 +12,7 @@ import numpy as np
 
 from ._family import Prepared
 from .detection import channel_noise, model_slope
-from .eiv import input_noise_spectrum
+from .eiv import input_noise_spectrum, is_coloured
 from .misfit import (
     BACKBONE_Z,
     BACKBONE_Z_CORRECTED,
@@ -65,11 +65,17 @@ def assess(
     # the input noise the model sees, from its spectrum where it is coloured (a white-noise
     # estimate from neighbouring samples misses a low-passed sensor's noise)
     spec = input_noise_spectrum(d)
-    seen = noise.input_seen if spec is None else max(noise.input_seen, spec.seen)
+    seen = noise.input_seen
+    if spec is not None and is_coloured(d, spec):
+        seen = max(seen, spec.seen)
     misfit = unexplained_structure(
         d, tested, sigma, unit=family.output_unit,
         tolerance=eiv_tolerance(slope, seen, corrected=bias is not None),
     )  # fmt: skip
+    if misfit is not None and spec is not None:
+        misfit = dataclasses.replace(
+            misfit, input_noise={"rms": spec.rms, "seen": seen, "white": noise.input}
+        )
     if misfit is not None and bias is not None:
         misfit = dataclasses.replace(misfit, eiv_bias_rms=float(np.sqrt(np.mean(bias * bias))))
     if misfit is not None and getattr(family, "kind", "") == "tangential" and "ac" in params:

@@ -124,6 +124,21 @@ def input_noise_spectrum(d: Prepared) -> InputNoise | None:
     return out
 
 
+#: the input noise counts as coloured when what the candidates' filter passes of it, read
+#: from its spectrum, exceeds this many times what white noise at the white estimate's level
+#: would pass (white noise reads 0.9-1.1; behind an LVDT demodulator 3-20)
+COLOURED_RATIO = 1.5
+
+
+def is_coloured(d: Prepared, spec: InputNoise) -> bool:
+    """True when the input noise's spectrum passes clearly more through the candidates'
+    filter than white noise at the white estimate's level would (:data:`COLOURED_RATIO`)."""
+    su = float(d.extra.get("u_noise", 0.0) or 0.0)
+    wlen = int(d.extra.get("u_filter", 0))
+    gain = float(np.sum(savgol_coeffs(wlen, 3) ** 2)) if wlen else 1.0
+    return spec.seen > COLOURED_RATIO * su * math.sqrt(gain)
+
+
 def _coloured(rng: np.random.Generator, n: int, spec: InputNoise | None) -> np.ndarray:
     """``n`` samples of unit-variance noise with the spectrum's shape (white without one)."""
     w = rng.standard_normal(n)
@@ -175,6 +190,7 @@ def eiv_bias(
     *,
     reps: int | None = None,
     seed: int = 0,
+    coloured: bool = True,
 ) -> np.ndarray | None:
     """The residual structure the input's noise alone leaves in a fitted model's residual
     (errors in variables), by simulation-extrapolation; measured minus model, per sample.
@@ -198,6 +214,8 @@ def eiv_bias(
     points between them in the Masing memory) gets the noise at its raw rate and its
     turning points rebuilt per draw. None when the input carries no measurable noise, the
     model cannot be driven, or a draw changes which turning points a kept record keeps.
+    ``coloured=False`` draws white noise at the white estimate's level and skips kept
+    records (the null before the spectrum was read; kept for comparison in benches).
     """
     from .select import sample_weight, specs_for
 
@@ -206,7 +224,9 @@ def eiv_bias(
     kept = "raw_input" in d.extra
     if not (su > 0 and wlen) or (kept and "knots" not in d.extra):
         return None
-    spec = input_noise_spectrum(d)
+    spec = input_noise_spectrum(d) if coloured else None
+    if spec is not None and not is_coloured(d, spec):
+        spec = None  # white: drawn as before (the spectrum's own scatter adds nothing)
     if kept and spec is None:
         return None
     if spec is not None:  # coloured noise: its level and shape from the spectrum

@@ -174,6 +174,11 @@ class Unexplained:
     #: leave this structure: each absorbed part of a misfit it does not model, and is not
     #: named (its signature test failed)
     absorbing: tuple[str, ...] = ()
+    #: the input channel's noise the errors-in-variables null was built with: ``rms`` (from
+    #: its spectrum, :func:`.eiv.input_noise_spectrum`), ``seen`` (after the candidates'
+    #: filter) and ``white`` (the estimate from neighbouring samples); None where the input
+    #: carries no measurable noise
+    input_noise: dict[str, float] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON layout of ``"unexplained"`` (a contract; see the README's JSON section)."""
@@ -198,6 +203,7 @@ class Unexplained:
             "power": self.power,
             "eiv_bias_rms": self.eiv_bias_rms,
             "absorbing": list(self.absorbing),
+            "input_noise": None if self.input_noise is None else dict(self.input_noise),
         }
 
     def sentence(self) -> str:
