@@ -23,7 +23,9 @@ noise and the ratio of medians is the figure. Rows:
   ``benches/bench_normal.py`` when ``--ode`` is given (slow).
 
 numba and OpenSees rows appear only when those are installed (they are not dependencies).
-Run: ``.venv/bin/python benches/speed_table.py [--rounds 5] [--quick]``.
+Run: ``.venv/bin/python benches/speed_table.py [--rounds 5] [--quick] [--only analyze ...]``
+(``--only``: just those groups of rows, e.g. ``--only analyze`` for the streamed-analyze
+rows; the groups are loop, masing, threads, analyze, startup and ode).
 """
 
 from __future__ import annotations
@@ -258,12 +260,23 @@ def optional_tools() -> str:
     return ", ".join(found) or "none"
 
 
+#: the groups of rows ``--only`` selects, in the table's order (ode last: only on request)
+GROUPS = ("loop", "masing", "threads", "analyze", "startup", "ode")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--quick", action="store_true", help="1e6-sample rows only")
     ap.add_argument("--ode", action="store_true", help="also the normal ODE against odeint")
+    ap.add_argument(
+        "--only",
+        nargs="+",
+        choices=GROUPS,
+        help="only these groups of rows (e.g. --only analyze)",
+    )
     args = ap.parse_args()
+    only = set(args.only or GROUPS[:-1] + (("ode",) if args.ode else ()))
     big = 1_000_000 if args.quick else 10_000_000
     try:
         from contactlab import _core
@@ -278,12 +291,17 @@ def main() -> None:
     )
     print("| task | contactlab | the other tool / the limit | ratio |")
     print("|---|---|---|---|")
-    loop_rows(args.rounds, sorted({1_000_000, big}))
-    masing_rows(args.rounds, big)
-    threads_row(args.rounds, big)
-    analyze_rows(args.rounds, [1_000_000] if args.quick else [10_000_000, 30_000_000])
-    startup_rows(args.rounds)
-    if args.ode:
+    if "loop" in only:
+        loop_rows(args.rounds, sorted({1_000_000, big}))
+    if "masing" in only:
+        masing_rows(args.rounds, big)
+    if "threads" in only:
+        threads_row(args.rounds, big)
+    if "analyze" in only:
+        analyze_rows(args.rounds, [1_000_000] if args.quick else [10_000_000, 30_000_000])
+    if "startup" in only:
+        startup_rows(args.rounds)
+    if "ode" in only:
         ode_row(args.rounds)
 
 
