@@ -12,7 +12,7 @@ import numpy as np
 
 from ._family import Prepared
 from .detection import channel_noise, model_slope
-from .eiv import input_noise_spectrum, is_coloured
+from .eiv import input_noise_spectrum, is_coloured, reweighted
 from .misfit import (
     BACKBONE_Z,
     BACKBONE_Z_CORRECTED,
@@ -66,10 +66,13 @@ def assess(
     # estimate from neighbouring samples misses a low-passed sensor's noise)
     spec = input_noise_spectrum(d)
     seen = noise.input_seen
+    dm = d
     if spec is not None and is_coloured(d, spec):
         seen = max(seen, spec.seen)
+        # the samples where that noise dominates the output's error are left out
+        dm = reweighted(d, slope, sigma, noise.input_seen, seen)
     misfit = unexplained_structure(
-        d, tested, sigma, unit=family.output_unit,
+        dm, tested, sigma, unit=family.output_unit,
         tolerance=eiv_tolerance(slope, seen, corrected=bias is not None),
     )  # fmt: skip
     if misfit is not None and spec is not None:
@@ -85,7 +88,7 @@ def assess(
         # flagged 11 -> 8 of 27), so this test keeps its interval of z instead; only a
         # noise-free input, where there is no such bias, gets the lower z
         z_bb = BACKBONE_Z_CORRECTED if not noise.input > 0 else BACKBONE_Z
-        bb = backbone_misfit(d, residual, float(params["ac"]), sigma, z=z_bb)
+        bb = backbone_misfit(dm, residual, float(params["ac"]), sigma, z=z_bb)
         if bb is not None:
             flagged = misfit.flagged or bb["flagged"]
             misfit = dataclasses.replace(misfit, backbone=bb, flagged=flagged)

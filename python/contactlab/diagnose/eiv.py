@@ -15,7 +15,15 @@ from ..errors import ContactLabError
 from ._family import Prepared
 from ._filters import savgol_coeffs, savgol_filter, welch
 
-__all__ = ["EIV_LEVELS", "EIV_REPS", "InputNoise", "eiv_bias", "input_noise_spectrum"]
+__all__ = [
+    "EIV_LEVELS",
+    "EIV_REPS",
+    "InputNoise",
+    "eiv_bias",
+    "input_noise_spectrum",
+    "is_coloured",
+    "reweighted",
+]
 
 #: fresh input-noise draws averaged by :func:`eiv_bias` at each added level
 EIV_REPS = 6
@@ -137,6 +145,25 @@ def is_coloured(d: Prepared, spec: InputNoise) -> bool:
     wlen = int(d.extra.get("u_filter", 0))
     gain = float(np.sum(savgol_coeffs(wlen, 3) ** 2)) if wlen else 1.0
     return spec.seen > COLOURED_RATIO * su * math.sqrt(gain)
+
+
+def reweighted(
+    d: Prepared, slope: np.ndarray | None, sigma: float, white_seen: float, seen: float
+) -> Prepared:
+    """``d`` with its errors-in-variables sample weights (``d.extra["weight"]``,
+    ``σy² / (σy² + (s σu')²)`` times any prior weight) recomputed for the input noise the
+    candidates see read from its spectrum (``seen``) instead of the white estimate
+    (``white_seen``): where a coloured input noise dominates the output's error (steep
+    branches after a reversal), the misfit tests leave the samples out (:data:`.misfit.
+    MIN_WEIGHT`). ``d`` itself when nothing changes."""
+    w = d.extra.get("weight")
+    if slope is None or w is None or not (seen > white_seen and sigma > 0):
+        return d
+    s2 = np.asarray(slope, float) ** 2
+    ratio = (sigma**2 + s2 * white_seen**2) / (sigma**2 + s2 * seen**2)
+    extra = dict(d.extra)
+    extra["weight"] = np.asarray(w, float) * ratio
+    return dataclasses.replace(d, extra=extra)
 
 
 def _coloured(rng: np.random.Generator, n: int, spec: InputNoise | None) -> np.ndarray:
