@@ -88,3 +88,42 @@ def test_kept_record_driven_by_no_noise_is_unchanged():
     np.testing.assert_allclose(fam.predict(p, (), same), base, rtol=0, atol=1e-9)
     other = _kept_driven(d, 1e-7 * rng.standard_normal(raw.u.size))
     assert other is None or not np.allclose(fam.predict(p, (), other), base)
+
+
+def test_effect_floor_keeps_a_tiny_phase_locked_difference_unflagged():
+    """200 cycles of a sine: a phase-locked difference of 0.03 of the noise RMS has a t of
+    about 2-3 per bin (flagged without the floor), but stays within the effect-size floor
+    (0.05); 0.5 of the noise is flagged; the stated power includes the floor."""
+    from contactlab.diagnose import misfit
+
+    t = np.arange(200 * 400) / 400.0
+    d = Prepared.build(t, np.sin(2 * np.pi * t), np.zeros(t.size), errors_in_input=False)
+    e = np.random.default_rng(6).normal(0.0, 0.01, t.size)
+    shape = np.sqrt(2.0) * np.cos(2 * np.pi * t)
+    small = misfit.unexplained_structure(d, e + 0.0003 * shape, 0.01)
+    big = misfit.unexplained_structure(d, e + 0.005 * shape, 0.01)
+    assert small is not None and big is not None
+    assert not small.flagged and big.flagged
+    assert small.detectable_rms is not None and small.detectable_rms > misfit.EFFECT_FLOOR * 0.01
+    old = misfit.EFFECT_FLOOR
+    try:
+        misfit.EFFECT_FLOOR = 0.0
+        assert misfit.unexplained_structure(d, e + 0.0003 * shape, 0.01).flagged
+    finally:
+        misfit.EFFECT_FLOOR = old
+
+
+def test_reweighted_leaves_out_steep_samples_under_coloured_noise():
+    """The weights recomputed for a larger seen input noise fall where the slope is steep
+    and stay where it is flat; with no larger noise, ``d`` itself comes back."""
+    from contactlab.diagnose.eiv import reweighted
+
+    t = np.arange(2000) / 400.0
+    d = Prepared.build(t, np.sin(2 * np.pi * t), np.zeros(t.size), errors_in_input=False)
+    d.extra["weight"] = np.ones(t.size)
+    slope = np.where(np.arange(t.size) % 2 == 0, 100.0, 0.0)
+    out = reweighted(d, slope, 0.01, 1e-5, 1e-3)
+    w = out.extra["weight"]
+    assert np.all(w[1::2] == 1.0) and np.all(w[::2] < 0.5)
+    assert np.all(d.extra["weight"] == 1.0)  # the original untouched
+    assert reweighted(d, slope, 0.01, 1e-3, 1e-3) is d
