@@ -88,7 +88,12 @@ def assess(
         # flagged 11 -> 8 of 27), so this test keeps its interval of z instead; only a
         # noise-free input, where there is no such bias, gets the lower z
         z_bb = BACKBONE_Z_CORRECTED if not noise.input > 0 else BACKBONE_Z
-        bb = backbone_misfit(dm, residual, float(params["ac"]), sigma, z=z_bb)
+        # a coloured input noise's bias is itself shaped like a virgin curve (and several
+        # times what white noise leaves): there the test reads the corrected residual
+        # (fresh chain seed 6000, x noise 2 % behind an LVDT: held-out t 5.27 > 4.5 as
+        # measured)
+        bb_res = tested if dm is not d else residual
+        bb = backbone_misfit(dm, bb_res, float(params["ac"]), sigma, z=z_bb)
         if bb is not None:
             flagged = misfit.flagged or bb["flagged"]
             misfit = dataclasses.replace(misfit, backbone=bb, flagged=flagged)
