@@ -44,6 +44,8 @@ NOISE_SEGMENT_PERIODS = 8.0
 #: a bin of the noise band above this many times the band's median is a line (mains hum,
 #: a drive harmonic) and is left out of the band's level
 NOISE_LINE_FACTOR = 4.0
+#: bins of the running median that a line is compared with
+NOISE_LINE_BINS = 33
 
 
 @dataclasses.dataclass(frozen=True)
@@ -118,6 +120,15 @@ def input_noise_spectrum(d: Prepared) -> InputNoise | None:
             if np.count_nonzero(band) >= 4:
                 sb = s[band]
                 level = float(np.mean(sb[sb <= NOISE_LINE_FACTOR * np.median(sb)]))
+                # lines above the band (the drive's harmonics: a displacement that sticks
+                # at its turns is no sine; mains hum) are no broadband noise: each bin is
+                # held to NOISE_LINE_FACTOR times the running median around it
+                k = NOISE_LINE_BINS // 2
+                med = np.median(
+                    np.lib.stride_tricks.sliding_window_view(np.pad(s, k, mode="edge"), 2 * k + 1),
+                    axis=1,
+                )
+                s = np.minimum(s, NOISE_LINE_FACTOR * med)
                 power = np.where(f < lo, level, s) * df
                 wlen = int(d.extra.get("u_filter", 0))
                 seen = power
