@@ -8,12 +8,14 @@ and signal, contactlab then the anchor, the order swapped every round. Each call
 wall clock and by the CPU time of the thread that ran it (``time.thread_time`` here,
 ``/proc/thread-self/schedstat`` in the driver): on a shared, loaded machine the wall time
 holds the time spent waiting for a core and the CPU time does not. Figures are medians over
-``--rounds``; the ratios are contactlab's throughput over the anchor's.
+``--rounds``; the ratios are contactlab's throughput over the anchor's. Beside the ratio of the
+medians, the median of the per-round CPU ratios (each round's two calls run back to back, so
+they share the load of the moment: steadier when the load changes during the run).
 
 The signals are the anchor's own (``sine``, ``bandlim``, ``randwalk``, h0 = 1, ac = 3), written
 by the driver with the anchor's generators; the checksums (sequential sums of the forces) of both
 kernels are compared.
-Run: ``.venv/bin/python benches/bench_masing.py [--n 10000000] [--rounds 7]``.
+Run: ``.venv/bin/python benches/bench_masing.py [--n 10000000] [--rounds 7] [--signals bandlim]``.
 """
 
 from __future__ import annotations
@@ -139,10 +141,13 @@ def ours_time(m: contactlab.Masing, x: np.ndarray, buf: np.ndarray) -> tuple[flo
     return time.perf_counter() - t0, time.thread_time() - c0
 
 
-def measure(n: int, rounds: int) -> list[dict[str, float | str]] | None:
+def measure(
+    n: int, rounds: int, signals: tuple[str, ...] = SIGNALS
+) -> list[dict[str, float | str]] | None:
     """Per signal: medians of wall/CPU seconds of both kernels over interleaved rounds.
 
-    None when the anchor or ``rustc`` is absent.
+    Also ``cpu_ratio_paired``, the median over the rounds of the anchor's CPU time over
+    contactlab's in the same round. None when the anchor or ``rustc`` is absent.
     """
     if not ANCHOR.exists() or shutil.which("rustc") is None:
         return None
@@ -151,7 +156,7 @@ def measure(n: int, rounds: int) -> list[dict[str, float | str]] | None:
     with tempfile.TemporaryDirectory() as tmp:
         anchor = Anchor(Path(tmp))
         try:
-            for kind in SIGNALS:
+            for kind in signals:
                 x = anchor.signal(kind, n, Path(tmp))
                 buf = np.empty(n)
                 m.force(x, out=buf)  # warm-up: page faults
@@ -177,6 +182,7 @@ def measure(n: int, rounds: int) -> list[dict[str, float | str]] | None:
                         "ours_cpu": float(np.median(oc)),
                         "anchor_wall": float(np.median(aw)),
                         "anchor_cpu": float(np.median(ac)),
+                        "cpu_ratio_paired": float(np.median(np.array(ac) / np.array(oc))),
                         "checksum_rel_diff": abs(ours_chk - chk) / abs(chk),
                     }
                 )
@@ -189,6 +195,13 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--n", type=int, default=10_000_000)
     ap.add_argument("--rounds", type=int, default=7)
+    ap.add_argument(
+        "--signals",
+        nargs="+",
+        choices=SIGNALS,
+        default=list(SIGNALS),
+        help="the anchor's signals to run (default: all three)",
+    )
     args = ap.parse_args()
     n = args.n
     from contactlab import _core
@@ -198,21 +211,21 @@ def main() -> None:
         f"n = {n:.0e} samples, medians of {args.rounds} interleaved rounds; SIMD level "
         f"{_core.simd_level()}; load {load}; {os.cpu_count()} CPUs"
     )
-    rows = measure(n, args.rounds)
+    rows = measure(n, args.rounds, tuple(args.signals))
     if rows is None:
         print("anchor absent (../shared/bench/masing_anchor.rs or rustc missing)")
         return
     print(
         f"{'signal':<10}{'ours M/s':>10}{'anchor M/s':>12}{'ratio':>7}"
         f"{'ours ns/sample CPU':>20}{'anchor ns/sample CPU':>22}{'CPU ratio':>11}"
-        f"{'checksum rel diff':>19}"
+        f"{'paired CPU ratio':>18}{'checksum rel diff':>19}"
     )
     for r in rows:
         ow, aw, oc, ac = r["ours_wall"], r["anchor_wall"], r["ours_cpu"], r["anchor_cpu"]
         print(
             f"{r['signal']:<10}{n / ow / 1e6:10.1f}{n / aw / 1e6:12.1f}{aw / ow:7.2f}"
             f"{oc / n * 1e9:20.2f}{ac / n * 1e9:22.2f}{ac / oc:11.2f}"
-            f"{r['checksum_rel_diff']:19.1e}"
+            f"{r['cpu_ratio_paired']:18.2f}{r['checksum_rel_diff']:19.1e}"
         )
 
 

@@ -228,8 +228,8 @@ class Unexplained:
         names = ", ".join(self.absorbing)
         return (
             f"; {names} reshaped the virgin curve and took up part of it but leaves this "
-            "structure: it does not model it and is not named (the final model, fitted "
-            "with it, still carries its term: refit without it before using h0)"
+            "structure: it does not model it and is not named (withdrawn: the final model "
+            "is refitted without it)"
         )
 
     def _power_clause(self) -> str:

@@ -18,6 +18,7 @@ differs between a tangential joint (force against displacement) and a normal one
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -194,9 +195,15 @@ class TangentialPath(KindPath):
         p: dict[str, float],
         effects: tuple[str, ...],
         model_force: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+        strokes: tuple[tuple[float, float], tuple[float, float]] | None = None,
     ) -> tuple[dict[str, Any] | None, str | None]:
         """The friction force of the final model against the one ``analyze`` reads in gross
         sliding and stick-slip (its plateau, or its fit where the stroke has no plateau).
+
+        ``strokes``: ``((up, down) of the data, (up, down) of the final model)``, the mean
+        force over the second half of the strokes with the displacement rising and falling
+        (:func:`stroke_levels`, the same samples for both): the like-with-like reading of
+        the friction force in each direction, which the report quotes when the two differ.
 
         ``model_force``: ``(t, x, F_model)``, the final model's force on the record; it is
         read by ``analyze`` exactly as the data were (``h0_model_reading``), which is what a
@@ -217,15 +224,41 @@ class TangentialPath(KindPath):
             "ratio": ratio,
             "within_tolerance": bool(abs(ratio - 1.0) <= H0_TOLERANCE),
         }
+        if strokes is not None:
+            (du, dd), (mu, md) = strokes
+            half_d, half_m = 0.5 * (du - dd), 0.5 * (mu - md)
+            doc["stroke_half"] = {
+                "data_up": du, "data_down": dd, "model_up": mu, "model_down": md,
+                "ratio": half_m / half_d if half_d > 0 else None,
+                "within_tolerance": bool(half_d > 0 and abs(half_m / half_d - 1) <= H0_TOLERANCE),
+            }  # fmt: skip
         if doc["within_tolerance"]:
             return doc, None
         why = {
             "parameter_drift": "h0 is the friction force at the record's start (it drifts)",
-            "asymmetry": "h0 is the mean of the two directions' forces",
+            "asymmetry": (
+                "h0 is half the difference of the two directions' forces h0(1 ± α), as "
+                "analyze's plateau is: it does not redefine h0"
+            ),
             "position_friction": "h0 is the mean along the track, the plateau a median",
             "normal_load": "h0 is the force at the mean normal load",
         }
         reasons = [f"{e}: {why[e]}" for e in effects if e in why]
+        if regime.extra.get("h0_source") != "plateau":
+            reasons.append(
+                "analyze finds no plateau on the data: its h0 is the asymptote of its "
+                "exponential fit, which the force need not reach"
+            )
+        sh = doc.get("stroke_half")
+        if sh is not None and sh["ratio"] is not None:
+            reasons.append(
+                f"over the second half of each stroke the data's force averages "
+                f"{sh['data_up']:.4g} N rising and {sh['data_down']:.4g} N falling (half the "
+                f"difference {0.5 * (sh['data_up'] - sh['data_down']):.4g} N), the final "
+                f"model's {sh['model_up']:.4g} N and {sh['model_down']:.4g} N "
+                f"({0.5 * (sh['model_up'] - sh['model_down']):.4g} N, ratio "
+                f"{sh['ratio']:.3f})"
+            )
         doc["why"] = reasons
         what = "plateau" if regime.extra.get("h0_source") == "plateau" else "friction force"
         text = (
@@ -239,6 +272,29 @@ class TangentialPath(KindPath):
             else " with no effect that redefines it: the base model trades h0 against a misfit"
         )
         return doc, text
+
+
+def stroke_levels(
+    x: np.ndarray, F: np.ndarray, reversals: np.ndarray
+) -> tuple[float, float] | None:
+    """The mean force over the second half of the travel of each stroke between two
+    reversals, over the strokes with ``x`` rising and those with it falling (a plateau's
+    level where the stroke reaches one, the same statistic of any loop otherwise); None
+    without a stroke each way."""
+    ups: list[float] = []
+    downs: list[float] = []
+    rev = np.asarray(reversals, int)
+    for a, b in itertools.pairwise(rev):
+        if b - a < 4:
+            continue
+        s = x[a : b + 1] - x[a]
+        sign = 1.0 if s[-1] > 0 else -1.0
+        sel = sign * s > 0.5 * abs(float(s[-1]))
+        if np.count_nonzero(sel):
+            (ups if sign > 0 else downs).append(float(np.mean(F[a : b + 1][sel])))
+    if not (ups and downs):
+        return None
+    return float(np.mean(ups)), float(np.mean(downs))
 
 
 def _model_reading(

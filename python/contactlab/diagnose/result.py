@@ -162,6 +162,15 @@ class DiagnosisReport:
                 else {}
             ),
             **({"unexplained": self.unexplained.to_dict()} if self.unexplained else {}),
+            # issue 29 item 5: effects the final model was refitted without, and candidates
+            # that passed the held-out rules but are physically implausible on the record,
+            # each with its reason
+            **(
+                {"withdrawn": dict(self.location["withdrawn_why"])}
+                if "withdrawn_why" in self.location
+                else {}
+            ),
+            **({"refused": dict(self.location["refused"])} if "refused" in self.location else {}),
             # a frame's reconstructed force: its mass read from an inertia term
             **(
                 {"frame_constants": dict(self.location["frame_constants"])}

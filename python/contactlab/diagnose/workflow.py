@@ -21,6 +21,7 @@ other; (5) report held-out RMS, peak error and loop-energy error after each step
 from __future__ import annotations
 
 import copy
+import dataclasses
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -29,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from .._options import takes_options
-from ..errors import InputError
+from ..errors import ConvergenceError, InputError
 from ._family import Family, Prepared
 from ._inputs import arrays as _arrays
 from ._inputs import check_channels, check_glitches
@@ -48,7 +49,7 @@ from ._prepare import (  # (the names tests and benches import from here, re-exp
 from ._signal import noise_rms
 from .locate import locate
 from .model import ExtendedModel
-from .paths import KindPath, RegimeDecision, kind_path
+from .paths import KindPath, RegimeDecision, kind_path, stroke_levels
 from .result import DiagnosisReport, Effect, Step, _finite_or_none
 from .search import MAX_EVALUATIONS, SearchState, StepwiseSearch, _pair_search  # noqa: F401
 from .select import Trial, evaluate, fit, fold_masks
@@ -276,15 +277,14 @@ def diagnose(
     location["noise_declared"] = declared_noise is not None
     st = _search(b, names, d, folds, z, min_gain, max_effects, where)
     checks = _assess(b, d, st, names, z, min_gain, folds, declared_noise, location)
+    checks = _withdraw(b, d, st, names, z, min_gain, folds, declared_noise, location, checks)
+    if checks["unexplained"] is not None and checks["unexplained"].flagged:
+        st.where.append(checks["unexplained"].sentence())
     report = _report(b.family, path, recording, regime, d, st, b.sigma, location)
     report.model_inferred = inferred
     report.channel_noise = checks["noise"]
     report.not_detected = checks["not_detected"]
     report.unexplained = checks["unexplained"]
-    absorbing = getattr(report.unexplained, "absorbing", ())
-    if absorbing:  # issue 29: an effect whose own signature test failed is not named
-        report.effects = [e for e in report.effects if e.name not in absorbing]
-        report.location["withdrawn"] = list(absorbing)
     return report
 
 
@@ -338,9 +338,145 @@ def _assess(
         candidates=names, declared_output=declared_noise,
     )  # fmt: skip
     location["detection"] = {k: checks[k] for k in ("z", "gain_floor", "folds", "candidates")}
-    if checks["unexplained"] is not None and checks["unexplained"].flagged:
-        st.where.append(checks["unexplained"].sentence())
     return checks
+
+
+#: what the report says of an effect withdrawn because the misfit test found it absorbing
+#: structure it does not model (:data:`contactlab.diagnose.misfit.SHAPE_ABSORBERS`)
+ABSORBED = (
+    "it reshaped the virgin curve and took up part of a systematic misfit it does not "
+    "model (its own signature test failed)"
+)
+
+
+def _unfounded(family: Family, st: SearchState, d: Prepared) -> tuple[str, str] | None:
+    """The first effect named by this diagnosis that its final fit does not support, and
+    why: its size within :attr:`~contactlab.diagnose.effects.EffectModel.IDENTIFIED_SIGMAS`
+    standard errors of "absent", at "absent" itself, or with no computable error (the least
+    significant first), else implausible on the
+    record with the final parameters (a refit after later additions can move an effect
+    accepted early into a value the record contradicts). None when every one stands."""
+    p, se = st.current.full.params, st.current.full.stderr
+    weakest: tuple[float, str, str] | None = None
+    if hasattr(family, "identified"):
+        from .effects import registry
+
+        reg = registry(family.kind)
+        for e in st.added:
+            if e not in reg:
+                continue
+            why = family.identified(e, p, se)
+            v, s = reg[e].size(p, se)
+            if not why and (v == 0 or (not np.isfinite(s) and _at_null(reg[e], p))):
+                # at its null value (its error not computable there): nothing says it is there
+                err = "cannot be computed" if not np.isfinite(s) else f"is {s:.2g}"
+                why = (
+                    f"not identifiable: its size is {v:.3g}, at the value meaning no effect, "
+                    f"and its standard error {err}"
+                )
+            if why:
+                ratio = v / s if np.isfinite(s) and s > 0 else 0.0
+                if weakest is None or ratio < weakest[0]:
+                    weakest = (ratio, e, why)
+    if weakest is not None:
+        return weakest[1], weakest[2]
+    if hasattr(family, "implausible"):
+        for e in st.added:
+            why = family.implausible(e, p, d)
+            if why:
+                return e, f"implausible: {why}"
+    return None
+
+
+def _at_null(effect: Any, p: dict[str, float]) -> bool:
+    """Whether the effect's size parameter lies within 1e-3 of its bounds' span from the
+    value meaning "absent" (as :meth:`~contactlab.diagnose.effects.EffectModel.plausible`
+    judges a value at a limit; False for a parameter without finite bounds)."""
+    spec = next((q for q in effect.params if q.name == effect.size_param), effect.params[0])
+    span = spec.upper - spec.lower
+    null = spec.null if np.isfinite(spec.null) else 0.0
+    return bool(np.isfinite(span) and abs(p[spec.name] - null) <= 1e-3 * span)
+
+
+def _withdraw(
+    b: _Base,
+    d: Prepared,
+    st: SearchState,
+    names: list[str],
+    z: float,
+    min_gain: float,
+    folds: int,
+    declared_noise: float | None,
+    location: dict[str, Any],
+    checks: dict[str, Any],
+) -> dict[str, Any]:
+    """The final model without the effects it cannot name (issue 29 item 5), refitted.
+
+    An effect named by the search is withdrawn when the closing checks find it absorbing a
+    misfit it does not model (the misfit test's ``absorbing``; kept, with a sentence, when
+    the data show its own signature independently of the fit: :func:`_signature`), when
+    its final size is not significantly different from "absent" (within two standard
+    errors, after the other effects: the search judged it against the model of its step),
+    or when its final
+    parameters are implausible on the record. One at a time: the model is refitted and
+    cross-validated without it (a step ``- name`` in the gap-shrink table, so that the
+    parameters, the held-out gap and the h0 check are the reported model's) and checked
+    again. ``location["withdrawn"]`` lists them, ``location["withdrawn_why"]`` says why.
+    Returns the closing checks of the final model."""
+    withdrawn: dict[str, str] = {}
+    absorbed: list[str] = []
+    kept: set[str] = set()
+    for _ in range(len(st.added)):
+        absorbing = getattr(checks["unexplained"], "absorbing", ())
+        for e in absorbing:
+            shown = _signature(b.family, e, d) if e in st.added and e not in kept else None
+            if shown:
+                kept.add(e)
+                st.where.append(
+                    f"{e} leaves a systematic misfit but is kept: {shown} (the misfit left is "
+                    "reported as unexplained)"
+                )
+        gone = next(((e, ABSORBED) for e in absorbing if e in st.added and e not in kept), None)
+        gone = gone or _unfounded(b.family, st, d)
+        if gone is None:
+            break
+        name, why = gone
+        rest = tuple(e for e in st.current.effects if e != name)
+        try:
+            refit = evaluate(b.family, rest, d, st.current.full.params, b.scales, folds)
+        except (ConvergenceError, InputError) as exc:
+            st.where.append(f"{name} could not be withdrawn ({why}): the refit failed: {exc}")
+            break
+        st.current = refit
+        st.added.remove(name)
+        st.trials.append(refit)
+        st.steps.append(Step(None, *StepwiseSearch._errors(refit), removed=name))
+        st.where.append(
+            f"withdrawn: {name} ({why}); the final model is refitted without it, and its "
+            "parameters, held-out error and h0 are those of the refit"
+        )
+        withdrawn[name] = why
+        if why is ABSORBED:
+            absorbed.append(name)
+        checks = _assess(b, d, st, names, z, min_gain, folds, declared_noise, location)
+    if withdrawn:
+        location["withdrawn"] = list(withdrawn)
+        location["withdrawn_why"] = dict(withdrawn)
+    if checks["unexplained"] is not None:  # the absorbers withdrawn (not those kept)
+        checks["unexplained"] = dataclasses.replace(
+            checks["unexplained"], absorbing=tuple(absorbed)
+        )
+    return checks
+
+
+def _signature(family: Family, name: str, d: Prepared) -> str | None:
+    """The data's own evidence for the effect ``name``, independent of any fit (the
+    effect's ``signature(d)``: series compliance's straight turns), or None."""
+    from .effects import registry
+
+    eff = registry(family.kind).get(name) if family.kind in ("tangential", "normal") else None
+    sig = getattr(eff, "signature", None)
+    return sig(d) if sig is not None else None
 
 
 def _ready(
@@ -500,6 +636,18 @@ def _regime_sentence(
     return f"{regime.reason}; base model: {tail}" if tail else regime.reason
 
 
+def _refused(st: SearchState, effects: tuple[str, ...]) -> dict[str, str]:
+    """The candidates that passed the held-out rules at some step but were refused as
+    physically implausible on the record (the last reason given for each), not in the final
+    model: the report says why each is not named (issue 29 item 5)."""
+    out: dict[str, str] = {}
+    for step in st.steps:
+        for v in step.candidates:
+            if v.reason.startswith("implausible: ") and " ⇄ " not in v.name and "+" not in v.name:
+                out[v.name] = v.reason.removeprefix("implausible: ")
+    return {k: v for k, v in out.items() if k not in effects}
+
+
 def _report(
     family: Family,
     path: KindPath,
@@ -526,14 +674,25 @@ def _report(
         out_effects.append(Effect(name, {**ps, **dp}, {**ss, **ds}, why))
     final = ExtendedModel(family, effects, p, se, family.context(d))
     out_effects = _frame_constants(recording, out_effects, where, location)
-    model_force = None
+    model_force = strokes = None
     if regime.h0 is not None:  # the final model's force, read as analyze read the data
-        model_force = (d.t, d.extra.get("u_raw", d.u), family.predict(p, effects, d))
-    check, moved = path.check_final(regime, p, effects, model_force)
+        fitted = family.predict(p, effects, d)
+        model_force = (d.t, d.extra.get("u_raw", d.u), fitted)
+        levels = [stroke_levels(d.u, f, d.cycles.reversals) for f in (d.y, fitted)]
+        strokes = (levels[0], levels[1]) if None not in levels else None
+    check, moved = path.check_final(regime, p, effects, model_force, strokes)
     if check is not None:
         location["h0_check"] = check
     if moved:
         where.append(moved)
+    refused = _refused(st, effects)
+    if refused:
+        location["refused"] = refused
+        where.extend(
+            f"not named: {name} would have lowered the held-out error significantly, but is "
+            f"refused as {why}"
+            for name, why in refused.items()
+        )
     gap = current.heldout_rms / sigma
     if gap > 1.5:
         where.append(

@@ -42,8 +42,20 @@ class Asymmetry(EffectModel):
         }
 
     def plausible(self, d, p):
+        from .force_offset import rest_verdict
+
         base = super().plausible(d, p)
-        if base.ok and p["ac"] * amplitude(d) >= GROSS_SLIDING_ZA:
+        if not base.ok:
+            return base
+        # a record from rest tells the two apart: a sensor's zero reads its offset at rest,
+        # a friction differing between the directions reads nothing before the motion
+        ok, rest = rest_verdict(d, p["alpha"] * p["h0"])
+        if ok is False:
+            return Plausibility(
+                True, f"{base.reason}; an offset of the plateaus' midline α h0 = "
+                f"{p['alpha'] * p['h0']:.4g} N is not the sensor's: {rest}",
+            )  # fmt: skip
+        if p["ac"] * amplitude(d) >= GROSS_SLIDING_ZA:
             # on a near-rectangular loop h + α|h| moves both plateaus by α h0, as an offset
             # does: only the short turns differ, so the two cannot be told apart
             return Plausibility(

@@ -32,6 +32,29 @@ class DisplacementOffset(EffectModel):
             return Plausibility(
                 False, f"a displacement offset of {p['x0']:.3g} m is over half the amplitude"
             )
+        if base.ok:  # a record from rest: the contact rests where the record starts
+            from .force_offset import rest_start
+
+            rest = rest_start(d)
+            if rest is not None and p.get("h0", 0) > 0 and p.get("ac", 0) > 0:
+                n, _, fr, spread = rest
+
+                def at_rest(x0: float) -> float:  # the model's force at rest
+                    u = float(np.median(d.u[:n])) - x0
+                    f = float(np.sign(u) * p["h0"] * -np.expm1(-p["ac"] * abs(u)))
+                    return f + p.get("alpha", 0.0) * abs(f) + p.get("F0", 0.0)
+
+                # wrong by more than the rest's noise and 5 % of h0, and twice as wrong as
+                # the same model without the offset
+                f, off = at_rest(p["x0"]), abs(at_rest(0.0) - fr)
+                if abs(f - fr) > max(4.0 * spread, 0.05 * p["h0"], 2.0 * off):
+                    return Plausibility(
+                        False,
+                        f"the record starts at rest with the force at {fr:.4g} N; an offset "
+                        f"x0 = {p['x0']:.3g} m would have the contact loaded to {f:.4g} N "
+                        "there (its virgin curve at x - x0): the contact rests where the "
+                        "record starts",
+                    )
         return base
 
     def argument(self, d, p):

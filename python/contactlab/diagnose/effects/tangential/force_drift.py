@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..._family import ParamSpec
-from .._base import EffectModel, register
+from .._base import EffectModel, Plausibility, register
 
 
 @register
@@ -23,6 +23,19 @@ class ForceDrift(EffectModel):
     def apply(self, F, p, ctx):
         d = ctx.d
         return F + p["F1"] * ctx.pick(ctx.fixed("t_rel", lambda: d.t - d.t[0])) / d.duration
+
+    def plausible(self, d, p):
+        """The shared rules, then the data's plateaus must move together by about ``F1``
+        over the record (:func:`.force_offset.drift_verdict`)."""
+        from .force_offset import drift_verdict
+
+        base = super().plausible(d, p)
+        if not base.ok:
+            return base
+        ok, why = drift_verdict(d, p)
+        if ok is False:
+            return Plausibility(False, why)
+        return Plausibility(True, f"{base.reason}; {why}") if ok else base
 
     def argument(self, d, p):
         return (

@@ -70,9 +70,24 @@ class RateDependentPresliding(EffectModel):
     MAX_FORCE_SHARE = 0.5
 
     def plausible(self, d, p):
+        """The shared rules; then the turns must be the contact's own pre-sliding: where
+        the data's turns hold a dead band (:func:`.stick_slip.dead_band`: the displacement
+        crossing a gap with no force change), what follows a turning point is the gap and
+        the impact that closes it, not damped asperities; and the damping force must stay
+        below :attr:`MAX_FORCE_SHARE` of ``h0``."""
+        from .stick_slip import dead_band
+
         base = super().plausible(d, p)
         if not base.ok or not (p.get("h0", 0) > 0 and p.get("ac", 0) > 0):
             return base
+        gap = dead_band(d)
+        if gap is not None:
+            return Plausibility(
+                False,
+                f"{gap}; right after the turns the force is set by crossing that gap and the "
+                "impact closing it (its overshoot grows with the speed), not by damped "
+                "asperities deflecting (LuGre's σ1 ż)",
+            )
         peak = float(np.max(np.abs(presliding_force(d, p))))
         if peak > self.MAX_FORCE_SHARE * p["h0"]:
             return Plausibility(

@@ -10,6 +10,28 @@ from .._base import EffectModel, register
 
 _SERIES_POINTS = 400
 
+#: the straightness of the turns (:func:`straightness`): the travel to half the force's rise
+#: over the travel to 90 % of it. An exponential branch gives ln 2 / ln 10 = 0.30, a tanh
+#: one 0.37, a straight ramp to a plateau (a compliance far softer than the contact) 0.56;
+#: (the package's clean records at ac·A 1-5: 0.36-0.39; a tanh virgin curve at ac·A 2 with
+#: noise: 0.41; the micro-tribometer in ../shared/data, whose README puts its turns on the
+#: load cell's and flexure's compliance: 0.59): from STRAIGHT on the turns are the
+#: compliance's, unless they hold a dead band (a gap crossed mid-turn also delays the half
+#: rise)
+STRAIGHT = 0.5
+
+
+def straightness(d) -> tuple[float, int] | None:
+    """The median over the record's branches of the travel to half the force's rise over
+    the travel to 90 % of it (see :data:`STRAIGHT`), and the branches read; None when too
+    few branches reach 90 % of their rise."""
+    from .stick_slip import crossing_travels
+
+    rows = crossing_travels(d, (0.5, 0.9))
+    if rows is None:
+        return None
+    return float(np.median(rows[:, 0] / rows[:, 1])), int(rows.shape[0])
+
 
 def series_backbone(h0: float, ac: float, C_s: float, x_max: float) -> tuple[np.ndarray, ...]:
     """Virgin curve of a Masing element in series with compliance ``C_s``, as points.
@@ -47,6 +69,23 @@ class SeriesCompliance(EffectModel):
         if p["C_s"] > 0:
             return {"k_s": 1.0 / p["C_s"]}, {"k_s": se["C_s"] / p["C_s"] ** 2}
         return {}, {}
+
+    def signature(self, d) -> str | None:
+        """The data's own evidence for a compliance in series, independent of the fit: the
+        turns are straight ramps to the plateau (:func:`straightness` at least
+        :data:`STRAIGHT`, and no dead band), which an exponential (0.30) or tanh (0.37)
+        element is not. A sentence saying so, or None."""
+        from .stick_slip import dead_band
+
+        got = straightness(d)
+        if got is None or got[0] < STRAIGHT or dead_band(d) is not None:
+            return None
+        return (
+            f"the turns are straight ramps (over {got[1]} branches the travel to half the "
+            f"force's rise is {got[0]:.2f} of the travel to 90 % of it: a straight ramp's "
+            "0.56, an exponential branch's 0.30, a tanh one's 0.37): a compliance in series "
+            "draws them"
+        )
 
     def argument(self, d, p):
         k0 = p.get("h0", np.nan) * p.get("ac", np.nan)

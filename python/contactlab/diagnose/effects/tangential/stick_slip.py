@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 from ..._family import ParamSpec
-from .._base import EffectModel, register
+from .._base import EffectModel, Plausibility, register
 from ._common import amplitude
 
 
@@ -81,6 +83,120 @@ def breakaway_force(h0: float, ac: float, s_b: float, ell: float) -> float:
     rise = 2.0 * h0 * -np.expm1(-ac * u / 2.0)
     e = max(ell, 1e-300)
     return float(np.max(-h0 + rise + s_b * h0 * (u / e) * np.exp(1.0 - u / e)))
+
+
+#: the dead-band test (:func:`turn_shape`): the force window, as a share of a branch's rise
+#: (half-width), the window centres it tries (shares of the rise), the share of the rise the
+#: travel is measured to, and the share of that travel a dead band spends in one window
+#: (an exponential Masing branch spends at most 12.5 % of its travel to 90 % of the rise in
+#: a window of 10 % of the rise centred within 35-65 %, a straight one 11 %, about 15 %
+#: sampled at 45 samples per turn; a breakaway or a stick does not flatten it (17 % for a
+#: breakaway of 0.4 h0 in the test); a dead band, where the displacement moves with no force
+#: change, spends the gap there)
+WINDOW_HALF, WINDOW_CENTRES, TRAVEL_TO = 0.05, tuple(np.linspace(0.35, 0.65, 7)), 0.9
+DEAD_BAND_SHARE = 0.25
+#: branches the test needs, and samples each must hold
+MIN_BRANCHES, MIN_BRANCH_SAMPLES = 3, 40
+
+
+def _first_crossing(s: np.ndarray, q: np.ndarray, level: float) -> float:
+    above = np.flatnonzero(q >= level)
+    return float(s[above[0]]) if above.size else np.nan
+
+
+def turn_branches(d) -> list[tuple[np.ndarray, np.ndarray, float, float]]:
+    """The record's branches from one reversal to the next as the turn-shape tests read
+    them: ``(s, q, start force, rise)`` with ``s`` the travel since the reversal and ``q``
+    the force's rise from it (oriented with the motion, smoothed over 1 % of the branch's
+    samples) over the whole rise to the branch's end (the median over its last 5 % of
+    travel). Branches with fewer than :data:`MIN_BRANCH_SAMPLES` samples or no rise are
+    left out."""
+    rev = np.asarray(d.cycles.reversals, int)
+    u, y = d.u, d.y
+    out: list[tuple[np.ndarray, np.ndarray, float, float]] = []
+    if y is None or rev.size < 2:
+        return out
+    for a, b in itertools.pairwise(rev):
+        if b - a < MIN_BRANCH_SAMPLES:
+            continue
+        uu, yy = u[a : b + 1], y[a : b + 1]
+        sign = 1.0 if uu[-1] >= uu[0] else -1.0
+        s = sign * (uu - uu[0])
+        g = sign * (yy - yy[0])
+        k = max(1, (b - a) // 100)
+        if k > 1:
+            g = np.convolve(g, np.ones(k) / k, mode="same")
+        rise = float(np.median(g[s >= 0.95 * float(np.max(s))]))
+        if rise > 0:
+            out.append((s, g / rise, float(yy[0]), sign * rise))
+    return out
+
+
+def crossing_travels(d, levels: tuple[float, ...]) -> np.ndarray | None:
+    """Per branch (:func:`turn_branches`), the travel since the reversal at which the force
+    first covers each share ``levels`` of its rise (rows: branches), or None when fewer than
+    :data:`MIN_BRANCHES` branches reach every level."""
+    rows = []
+    for s, q, _, _ in turn_branches(d):
+        row = [_first_crossing(s, q, lv) for lv in levels]
+        if all(np.isfinite(row)) and row[-1] > 0:
+            rows.append(row)
+    return np.asarray(rows) if len(rows) >= MIN_BRANCHES else None
+
+
+def turn_shape(d) -> dict | None:
+    """How the force turns over at the reversals of the record ``d`` (the data, not a
+    model): per branch (:func:`turn_branches`), ``share``: the largest travel spent with the
+    rise ``q`` in a window of ±:data:`WINDOW_HALF` centred at :data:`WINDOW_CENTRES`, over
+    the travel to :data:`TRAVEL_TO` of the rise (the median over the branches); ``level``:
+    the force at the centre of that window (the median of its magnitude over the
+    branches), ``travel``: that travel (m).
+
+    A stick holds the displacement while the force turns (``share`` near 0), a breakaway
+    leaves the middle of the turn about as steep as an exponential branch's (0.125), a dead
+    band (backlash: the displacement crosses a gap with no force change) makes it flat
+    there (above :data:`DEAD_BAND_SHARE`). None when fewer than :data:`MIN_BRANCHES`
+    branches can be read."""
+    shares, levels, travels = [], [], []
+    for s, q, f0, rise in turn_branches(d):
+        s90 = _first_crossing(s, q, TRAVEL_TO)
+        if not (np.isfinite(s90) and s90 > 0):
+            continue
+        best, at = -1.0, np.nan
+        for c in WINDOW_CENTRES:
+            w = _first_crossing(s, q, c + WINDOW_HALF) - _first_crossing(s, q, c - WINDOW_HALF)
+            if np.isfinite(w) and w > best:
+                best, at = w, float(c)
+        if best < 0:
+            continue
+        shares.append(best / s90)
+        travels.append(best)
+        levels.append(f0 + at * rise)
+    if len(shares) < MIN_BRANCHES:
+        return None
+    return {
+        "share": float(np.median(shares)),
+        "level": float(np.median(np.abs(levels))),
+        "travel": float(np.median(travels)),
+        "branches": len(shares),
+    }
+
+
+def dead_band(d) -> str | None:
+    """The sentence saying the record's turns hold a dead band (:func:`turn_shape`'s
+    ``share`` at least :data:`DEAD_BAND_SHARE`), or None."""
+    shape = turn_shape(d)
+    if shape is None or shape["share"] < DEAD_BAND_SHARE:
+        return None
+    return (
+        f"the data show a dead band at the turns, not a breakaway: over {shape['branches']} "
+        f"branches the displacement travels {shape['travel']:.3g} m "
+        f"({100 * shape['share']:.0f} % of the travel to {100 * TRAVEL_TO:.0f} % of the "
+        f"force's rise) while the force changes by only {200 * WINDOW_HALF:.0f} % of its rise "
+        f"(near |F| = {shape['level']:.3g} N), where an exponential branch spends at most "
+        "12.5 %, a breakaway or a stick no more (backlash: the displacement crosses a gap with "
+        "no force change)"
+    )
 
 
 #: slip distances :meth:`StickSlip.start` tries, as shares of the displacement amplitude
@@ -172,9 +288,30 @@ class StickSlip(EffectModel):
             var += ((breakaway_force(*q) - val) / step * se.get(k, np.inf)) ** 2
         return {"breakaway_force": val}, {"breakaway_force": float(np.sqrt(var))}
 
+    def plausible(self, d, p):
+        """The shared rules, then the data's own turns: a dead band (the displacement
+        moving with no force change in the middle of the turn, :func:`dead_band`) is the
+        opposite of a breakaway, and the breakaway term fitted there only bends the branch
+        towards it."""
+        base = super().plausible(d, p)
+        if not base.ok:
+            return base
+        why = dead_band(d)
+        if why is not None:
+            return Plausibility(False, why)
+        return base
+
     def argument(self, d, p):
+        shape = turn_shape(d)
+        seen = (
+            f"; in the middle of the turns the displacement travels {100 * shape['share']:.0f} "
+            f"% of the way to {100 * TRAVEL_TO:.0f} % of the rise per {200 * WINDOW_HALF:.0f} % "
+            "of force change (no dead band: an exponential branch's is at most 12.5 %)"
+            if shape is not None
+            else ""
+        )
         return (
             f"the force rises {100 * p['s_b']:.0f} % of h0 above the branch at a travel "
             f"ell = {p['ell']:.3g} m after each reversal and falls back: static friction "
-            "above kinetic"
+            f"above kinetic{seen}"
         )
