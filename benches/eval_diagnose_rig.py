@@ -96,6 +96,36 @@ def draw_factors(rng, kind):
     }
 
 
+#: ``--chain sensors`` (or CONTACTLAB_RIG_CHAIN=sensors in the environment, which the worker
+#: processes and benches/eval_false_alarm.py inherit): every rig record also passes an LVDT
+#: demodulator's low-pass on x, a piezo (high-pass) or strain-gauge load cell, Bessel
+#: anti-alias filters, mains hum, clock jitter, drive harmonics and an abrupt start from rest
+CHAIN_ENV = "CONTACTLAB_RIG_CHAIN"
+
+
+def chain_kwargs(seed, fac):
+    """The sensor figures of a rig record under ``--chain sensors`` (``{}`` otherwise), drawn
+    from their own stream so that the record's factors and noise are those of the plain
+    chain."""
+    if os.environ.get(CHAIN_ENV, "plain") != "sensors":
+        return {}
+    rng = np.random.default_rng(int(seed) + 424_242)
+    fs = fac["fs"]
+    return {
+        # an LVDT conditioner's demodulator low-pass (2nd order) at 0.3-2 kHz
+        "x_lowpass": round(min(_loguniform(rng, 300.0, 2000.0), 0.45 * fs), 3),
+        # a piezo cell: its charge amplifier's time constant 1.6-30 s; else a strain gauge
+        "F_highpass": (round(_loguniform(rng, 0.005, 0.1), 5) if rng.random() < 0.5
+                       else None),
+        "aa_kind": "bessel",
+        "hum": round(float(rng.uniform(0.0, 0.005)), 5),
+        "jitter": float(rng.uniform(0.0, 0.02)) / fs,
+        "drive_harmonics": (round(float(rng.uniform(0, 0.01)), 4),
+                            round(float(rng.uniform(0, 0.01)), 4)),
+        "ramp_cycles": round(float(rng.uniform(0.0, 1.0)), 3),
+    }  # fmt: skip
+
+
 def plan(mode, base_seed, scale=1.0):
     """Cases: (generator, kind, effect or None, variant, seed, factors).
 
@@ -414,6 +444,8 @@ def run_case(case):
             if kind == "tangential":
                 eff = rig_effect(effect, case["variant"], fac, rng)
                 x_drift = float(rng.uniform(-0.003, 0.003))
+                sensors = chain_kwargs(case["seed"], fac)
+                out["sensors"] = sensors
                 rec = rig_recording(
                     eff,
                     "tangential",
@@ -426,6 +458,7 @@ def run_case(case):
                     F_noise=fac["F_noise"],
                     x_drift=x_drift,
                     bits=int(rng.integers(12, 17)),
+                    **sensors,
                 )
             else:
                 eff = rig_normal_effect(effect, fac, rng)
@@ -447,7 +480,8 @@ def run_case(case):
             rec_args = (eff, {"seed": case["seed"], "fs": fac["fs"], "f": fac["f"],
                               "cycles": fac["cycles"], "acA": fac["acA"],
                               "x_noise": fac["x_noise"], "F_noise": fac["F_noise"],
-                              "x_drift": x_drift, "bits": rec.truth.get("chain", {}).get("bits")},
+                              "x_drift": x_drift, "bits": rec.truth.get("chain", {}).get("bits"),
+                              **(chain_kwargs(case["seed"], fac) if kind == "tangential" else {})},
                         rec.truth["chain"]["noise_rms"])  # fmt: skip
 
             with tempfile.TemporaryDirectory() as tmp:
@@ -1041,6 +1075,9 @@ def main(argv=None):
         "the records without an effect)",
     )
     ap.add_argument("--gens", default="rig,pkg", help="generators to run (rig, pkg)")
+    ap.add_argument("--chain", choices=("plain", "sensors"), default=None,
+                    help="rig chain: plain, or sensors (LVDT low-pass, piezo/strain-gauge cell, "
+                    "Bessel, hum, jitter, drive harmonics; see chain_kwargs)")  # fmt: skip
     ap.add_argument("--label", default="")
     ap.add_argument("--out", type=Path, default=None, help="also write the tables here")
     ap.add_argument("--raw", type=Path, default=None, help="write per-record results (JSON)")
@@ -1052,6 +1089,8 @@ def main(argv=None):
         help="print the tables of saved --raw results (merged) and stop",
     )
     args = ap.parse_args(argv)
+    if args.chain:
+        os.environ[CHAIN_ENV] = args.chain
     jobs = max(1, min(2, args.jobs))
     if args.tables_from:
         results = [r for p in args.tables_from for r in json.loads(p.read_text())]

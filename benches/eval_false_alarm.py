@@ -130,8 +130,11 @@ def rig_record(model: str, seed: int, virgin: str = "exp") -> tuple[Any, dict[st
 
     f = draw_factors(np.random.default_rng(seed), model)
     fac = {k: f[k] for k in ("fs", "f", "cycles", "acA", "x_noise", "F_noise")}
+    from eval_diagnose_rig import chain_kwargs
+
     eff = {"tanh_virgin": {}} if virgin == "tanh" else {}
-    rec = rig_recording(eff, model, seed=seed, **fac)
+    sensors = chain_kwargs(seed, fac) if model == "tangential" else {}
+    rec = rig_recording(eff, model, seed=seed, **fac, **sensors)
     with tempfile.TemporaryDirectory() as tmp:
         out = contactlab.read_recording(str(rec.to_csv(Path(tmp) / "rec.csv")))
     lv = {"fs": fac["fs"], "cycles": fac["cycles"], "x_noise": fac["x_noise"],
@@ -567,8 +570,13 @@ def _power_record(gen: str, seed: int, fac: dict[str, Any], effect: str | None, 
 
     param = {"channel_delay": "tau", "parallel_stiffness": "k_p", "force_offset": "F0",
              "viscous_damping": "c", "inertia": "m"}  # fmt: skip
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from eval_diagnose_rig import chain_kwargs
+
     eff = {effect: {param[effect]: size}} if effect else {}
-    rec = rig_recording(eff, "tangential", seed=seed, **fac)
+    rec = rig_recording(eff, "tangential", seed=seed, **fac, **chain_kwargs(seed, fac))
     with tempfile.TemporaryDirectory() as tmp:
         return contactlab.read_recording(str(rec.to_csv(Path(tmp) / "rec.csv")))
 
@@ -646,7 +654,13 @@ def main() -> None:
     )
     ap.add_argument("--power-gens", default="pkg,rig", help="generators of the power check")
     ap.add_argument("--dump", default=None, help="write every record's result (JSON lines)")
+    ap.add_argument("--chain", choices=("plain", "sensors"), default=None,
+                    help="rig chain (benches/eval_diagnose_rig.py chain_kwargs)")  # fmt: skip
     a = ap.parse_args()
+    if a.chain:
+        import os
+
+        os.environ["CONTACTLAB_RIG_CHAIN"] = a.chain
     models = ("tangential", "normal") if a.model == "both" else (a.model,)
     t0 = time.time()
     everything: list[dict[str, Any]] = []

@@ -21,6 +21,10 @@ import math
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
+#: the largest ``(window // 2) ** polyorder`` whose Savitzky-Golay design keeps the plain
+#: integer abscissa (as scipy does); longer windows are designed on one scaled to [-1, 1]
+_UNSCALED_SPAN = 1e8
+
 
 def savgol_coeffs(
     window_length: int, polyorder: int, deriv: int = 0, delta: float = 1.0
@@ -33,11 +37,16 @@ def savgol_coeffs(
             f"savgol window {window_length} must be odd and above polyorder {polyorder}"
         )
     pos = window_length // 2
-    x = np.arange(-pos, window_length - pos, dtype=float)[::-1]  # reversed: a convolution
+    # the abscissa scaled to [-1, 1]: the plain powers of up to ±pos make the normal matrix
+    # singular to rounding for long windows (a quintic over 907 samples kept 0.27 of a sine
+    # it should pass whole); a derivative in the scaled abscissa is divided by ``pos``
+    # (short windows keep scipy's unscaled abscissa: its coefficients to the last bit)
+    scale = float(pos) if float(pos) ** polyorder > _UNSCALED_SPAN else 1.0
+    x = np.arange(-pos, window_length - pos, dtype=float)[::-1] / scale  # reversed: a convolution
     A = x ** np.arange(polyorder + 1, dtype=float).reshape(-1, 1)
     y = np.zeros(polyorder + 1)
     if deriv <= polyorder:
-        y[deriv] = math.factorial(deriv) / delta**deriv
+        y[deriv] = math.factorial(deriv) / (delta * scale) ** deriv
     return np.linalg.lstsq(A, y, rcond=None)[0]
 
 

@@ -124,10 +124,13 @@ def test_energy_balance_of_the_error_controlled_run(kind, amp, seed, two):
     ke = 0.5 * np.einsum("ti,ij,tj->t", v, m, v)
     se = 0.5 * np.einsum("ti,ij,tj->t", x, k, x)
     bal = r.input_work - ke - se - r.damping_work - r.joint_work.sum(axis=1)
-    # the extrapolated pair balances to its own accuracy (fixed steps: to rounding)
-    assert np.max(np.abs(bal)) <= 1e-5 * np.max(np.abs(r.input_work))
+    # the error-controlled pieces balance to their own accuracy (fixed steps: to rounding);
+    # Hermite pieces of Jenkins/Iwan joints up to 1e-5 of the input work (measured over 15
+    # seeds x 4 amplitudes x 1/2 DOFs: 6.8e-6 Jenkins, 1.0e-5 Iwan, 1.9e-6 Bouc-Wen; the
+    # stick-slip transitions), step doubling (Masing) 1e-6
+    assert np.max(np.abs(bal)) <= 3e-5 * np.max(np.abs(r.input_work))
     # dissipation never negative beyond that accuracy
-    assert r.joint_energy[-1].min() >= -1e-5 * np.max(np.abs(r.input_work))
+    assert r.joint_energy[-1].min() >= -3e-5 * np.max(np.abs(r.input_work))
 
 
 @pytest.mark.parametrize("tol", [0.0, -1e-4, float("nan"), float("inf"), "tight"])
@@ -161,3 +164,24 @@ def test_fixed_substeps_still_work_and_converge_at_second_order():
     # band-limited inputs between samples (prepared in Python) keep working
     r = s.simulate(t, force=u, substeps=2, interpolation="fourier")
     assert r.success and r.x.shape == (n,)
+
+
+@pytest.mark.parametrize("kind", ["masing", "bouc_wen"])
+def test_rtol_bounds_the_inner_newton_under_error_control(kind):
+    # step doubling (Masing) ends its inner Newton solves early once the residual is small;
+    # that end must follow rtol (at most sqrt(rtol)), so that a tighter rtol costs iterations
+    # and moves the result towards the tightest one; Hermite pieces (Bouc-Wen) end on rtol
+    m = np.diag([2.0, 1.0, 1.5])
+    k = 5e4 * np.array([[2, -1, 0], [-1, 2, -1], [0, -1, 1.0]])
+    s = Structure(m, 1e-4 * k + 2.0 * m, k)
+    if kind == "masing":
+        s.add_joint("masing", 0, h0=40.0, ac=2e4, scale=2.0)
+    else:
+        s.add_joint("bouc_wen", 0, **BW)
+    s.add_joint("jenkins", 2, 1, k=3e4, fs=20.0)
+    fs, n = 3000.0, 600
+    t = np.arange(n) / fs
+    f = np.stack([_force(n, fs, 21), np.zeros(n), _force(n, fs, 22, 10.0)], axis=1)
+    runs = {rtol: s.simulate(t, force=f, tol=1e-6, rtol=rtol) for rtol in (1e-6, 1e-9, 1e-13)}
+    assert runs[1e-13].n_iter > runs[1e-9].n_iter > runs[1e-6].n_iter
+    assert _rrms(runs[1e-9].x, runs[1e-13].x) <= 1e-7

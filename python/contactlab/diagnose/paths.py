@@ -116,10 +116,12 @@ class KindPath:
         p: dict[str, float],
         effects: tuple[str, ...],
         model_force: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+        strokes: tuple[tuple[float, float], tuple[float, float]] | None = None,
     ) -> tuple[dict[str, Any] | None, str | None]:
         """The final model's physical parameters against ``analyze``'s (None: nothing to
-        check), and a sentence when they moved (``model_force``: the final model's output,
-        as the tangential path takes it; unused here)."""
+        check), and a sentence when they moved (``model_force``, ``strokes``: the final
+        model's output and the stroke levels, as the tangential path takes them; unused
+        here)."""
         return None, None
 
 

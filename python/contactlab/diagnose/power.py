@@ -211,7 +211,20 @@ def shape_values(family: Family, name: str, p: dict[str, float], d: Prepared) ->
         else:
             v = 0.3 * float(scales.get(s.name, scales.get(s.scale, 1.0)))
         out[s.name] = float(v)
-    return out
+    return {**out, **_own_shape(family, name, p, d)}
+
+
+def _own_shape(family: Family, name: str, p: dict[str, float], d: Prepared) -> dict[str, float]:
+    """The shape values the effect itself states its bound at (its ``power_shape(d, p)``:
+    a track's wave as long as the stroke, not a tenth of a micrometre), else none."""
+    from .effects import registry
+
+    try:
+        eff = registry(getattr(family, "kind", "")).get(name)
+    except KeyError:
+        return {}
+    hook = getattr(eff, "power_shape", None)
+    return {} if hook is None else {k: float(v) for k, v in hook(d, p).items()}
 
 
 def _step(s: ParamSpec, value: float, scales: dict[str, float]) -> float:
@@ -273,6 +286,8 @@ class _Setting:
     se_inflation: float = 1.0
     rng_fit: np.ndarray = field(default_factory=lambda: np.zeros(DRAWS))  # (DRAWS,)
     size_factor: np.ndarray = field(default_factory=lambda: np.ones(DRAWS))  # (DRAWS,)
+    #: rule 4's floor (σ²): MIN_RELATIVE_GAIN of the current held-out error
+    rel_floor: float = 0.0
 
 
 def _setting(
@@ -322,11 +337,17 @@ def _setting(
         se_inflation=infl,
         rng_fit=rng.standard_normal(DRAWS),
         size_factor=np.exp(0.5 * GAIN_SCATTER * rng.standard_normal(DRAWS)),
+        rel_floor=rel,
     )
 
 
-def _power_curve(jp: np.ndarray, st: _Setting, ident: float = 0.0) -> Any:
-    """The detection probability as a function of the magnitude ``a`` (linearised)."""
+def _power_curve(
+    jp: np.ndarray, st: _Setting, ident: float = 0.0, proportional: bool = False
+) -> Any:
+    """The detection probability as a function of the magnitude ``a`` (linearised);
+    ``proportional``: rule 2 may also pass by the proportional t of
+    :func:`contactlab.diagnose.select.proportional_t` (an effect whose gain is by its nature
+    uneven across cycles, a drift: the effect's ``proportional_gain``)."""
     held = st.cycle_of >= 0
     m = st.fold_of_cycle.size
     idx = st.cycle_of[held]
@@ -368,11 +389,35 @@ def _power_curve(jp: np.ndarray, st: _Setting, ident: float = 0.0) -> Any:
         sd = np.std(ratio, axis=1, ddof=1)
         with np.errstate(divide="ignore", invalid="ignore"):  # (sd = 0: t = inf below)
             t = np.where(sd > 0, np.mean(ratio, axis=1) / (sd / np.sqrt(n)), np.inf)
+        if proportional:
+            t = np.maximum(t, _proportional_t(a, delta, A, B, W, ok))
         gain = ((cur - cand) @ W) / Wtot / sig2
         named = np.abs(a[:, 0] + eps) >= ident * fit_se
         return float(np.mean((t > st.z) & (gain >= st.gain_floor) & named))
 
     return power
+
+
+def _proportional_t(
+    a: np.ndarray, delta: np.ndarray, A: np.ndarray, B: np.ndarray, W: np.ndarray, ok: np.ndarray
+) -> np.ndarray:
+    """The proportional t (:func:`contactlab.diagnose.select.proportional_t`) of the draws,
+    linearised: on held-out cycle ``c`` the current residual is ``a j + e`` and the
+    candidate's move ``ĉ j`` (``ĉ = a + δ``, the fold fit's size), so ``N_c = W_c ĉ (a A_c +
+    B_c)``, ``D_c = W_c ĉ² A_c``; ``(ĝ - 1/2) / se`` with ``ĝ = ΣN/ΣD`` and the cluster
+    sandwich ``se`` over the cycles."""
+    c = a + delta  # (draws, m)
+    n_c = (W * c * (a * A + B))[:, ok]
+    d_c = (W * c * c * A)[:, ok]
+    m = n_c.shape[1]
+    if m < 3:
+        return np.full(a.shape[0], -np.inf)
+    tot = np.sum(d_c, axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        g = np.sum(n_c, axis=1) / tot
+        se = np.sqrt(m / (m - 1) * np.sum((n_c - g[:, None] * d_c) ** 2, axis=1)) / tot
+        t = (g - 0.5) / se
+    return np.where(np.isfinite(t), t, -np.inf)
 
 
 def _fit_error(jp: np.ndarray, st: _Setting) -> tuple[float, float]:
@@ -393,15 +438,18 @@ def _fit_error(jp: np.ndarray, st: _Setting) -> tuple[float, float]:
     return sd, se
 
 
-def _bound(jp: np.ndarray, st: _Setting, ident: float = 0.0) -> float | None:
+def _bound(
+    jp: np.ndarray, st: _Setting, ident: float = 0.0, proportional: bool = False
+) -> float | None:
     """Smallest ``a`` with detection probability at least :data:`POWER`, or None (``ident``:
-    the standard errors a named size must lie from "absent", 0: no such rule)."""
+    the standard errors a named size must lie from "absent", 0: no such rule;
+    ``proportional``: see :func:`_power_curve`)."""
     # RMS over the weighted samples: where the weight is 0 (left out of the fits) the
     # projection is unconstrained and may be anything (a frame record: 60x the direction)
     size = float(np.sqrt(np.sum(st.w * jp * jp) / max(float(np.sum(st.w)), 1e-300)))
     if not size > 0:
         return None
-    power = _power_curve(jp, st, ident)
+    power = _power_curve(jp, st, ident, proportional)
     top = LARGEST_RELATIVE * st.y_rms / size
     q = float(np.sum(st.w * jp * jp) / np.sum(st.w)) / st.sigma**2
     lo = min(top, np.sqrt(max(st.gain_floor, 1e-6) / max(q, 1e-300)))
@@ -546,6 +594,7 @@ def _detectable(
             ),
         )  # fmt: skip
     worst = max(mags, key=lambda s: rel[s.name] or 0.0)
+    per, rel = _plausible_from(family, name, p0, d, worst, per, rel)
     why = _implausible_at(family, p0, name, worst, per[worst.name], d)
     if why:
         v, u = _display(float(per[worst.name]), worst.unit)
@@ -560,6 +609,39 @@ def _detectable(
         name, worst.name, per[worst.name], worst.unit, worst.null, rel[worst.name], shape, per,
         gain_at_bound=gain[worst.name],
     )  # fmt: skip
+
+
+def _plausible_from(
+    family: Family,
+    name: str,
+    p0: dict[str, float],
+    d: Prepared,
+    s: ParamSpec,
+    per: dict[str, float | None],
+    rel: dict[str, float | None],
+) -> tuple[dict[str, float | None], dict[str, float | None]]:
+    """``per`` and ``rel`` with the bound of ``s`` raised to the smallest size the
+    diagnosis does not refuse (the effect's ``smallest_plausible(d, p)``: a force ramp
+    below what a plausible displacement-sensor drift draws in pre-sliding), where the
+    effect states one and it is larger."""
+    from .effects import registry
+
+    eff = registry(getattr(family, "kind", "")).get(name)
+    hook = getattr(eff, "smallest_plausible", None)
+    b = per.get(s.name)
+    if hook is None or b is None:
+        return per, rel
+    try:
+        low = hook(d, p0)
+    except (ValueError, KeyError, FloatingPointError):
+        return per, rel
+    if low is None or not np.isfinite(low) or low <= b:
+        return per, rel
+    per, rel = dict(per), dict(rel)
+    if rel.get(s.name) is not None:
+        rel[s.name] = float(rel[s.name]) * low / b
+    per[s.name] = float(low)
+    return per, rel
 
 
 def _implausible_at(
@@ -641,6 +723,8 @@ def _per_parameter(
     ds = _effect_signal(family, name, signal_input(d)) if derived else d
     steady = steady_samples(d) if derived else None
     rivals = _rival_directions(family, p0, trial, name, ds, scales)
+    prop = proportional_gain(family, name)
+    st = _own_floor(family, name, d, st)
     for s in mags:
         j = _derivative(family, p0, trial, ds, s, _step(s, s.null, scales))
         if not np.all(np.isfinite(j)):
@@ -652,7 +736,7 @@ def _per_parameter(
         if steady is not None:
             jp = np.where(steady, jp, 0.0)
         ident = identified_sigmas(family, name)
-        b = _bound(jp, st, ident)
+        b = _bound(jp, st, ident, prop)
         # the current model's parameters absorb a large effect beyond what the linear
         # projection says (a parallel spring as stiff as the contact, in pre-sliding): the
         # direction is shrunk by the share a nonlinear refit leaves, twice
@@ -664,7 +748,7 @@ def _per_parameter(
             if left >= 0.9:
                 break
             jp = jp * np.sqrt(max(left, 1e-6))
-            b = _bound(jp, st, ident)
+            b = _bound(jp, st, ident, prop)
         r = None if b is None else b * float(np.sqrt(np.mean(j * j))) / st.y_rms
         if r is not None and r > LARGEST_RELATIVE:
             b = r = None
@@ -838,6 +922,35 @@ def _left_by_refit(
     lin = b * b * float(np.sum((w * jp * jp)[mask]))
     ok = np.isfinite(r) & mask
     return float(np.sum((w * r * r)[ok]) / lin) if lin > 0 and ok.any() else 1.0
+
+
+def _own_floor(family: Family, name: str, d: Prepared, st: _Setting) -> _Setting:
+    """``st`` with the gain floor the search holds candidate ``name`` to: its own share of
+    ``min_gain`` (:func:`contactlab.diagnose.search.own_gain_floor`) plus the input-noise
+    budget unless the effect is blind to the input's noise, as the search kept them in
+    ``d.extra["gain_rules"]``; ``st`` itself when they are not there."""
+    rules = d.extra.get("gain_rules")
+    if not isinstance(rules, dict):
+        return st
+    from .search import _noise_floor, own_gain_floor
+
+    mg, budget = float(rules["min_gain"]), float(rules["budget"])
+    floor = own_gain_floor(family, (name,), mg) + _noise_floor(family, (name,), budget)
+    return dataclasses.replace(st, gain_floor=max(floor, st.rel_floor))
+
+
+def proportional_gain(family: Family, name: str) -> bool:
+    """Whether candidate ``name``'s held-out gain may pass rule 2 by the proportional t in
+    the bound: the effect's own ``proportional_gain`` (a drift, whose gain is by its nature
+    uneven across cycles). A family's ``proportional_gain`` (normal contact) is not modelled
+    (see the module docstring: the bound is conservative there)."""
+    from .effects import registry
+
+    try:
+        eff = registry(getattr(family, "kind", "")).get(name)
+    except KeyError:
+        return False
+    return bool(getattr(eff, "proportional_gain", False))
 
 
 def identified_sigmas(family: Family, name: str) -> float:

@@ -33,6 +33,12 @@ MAX_BASE_SHIFT_EXPLAINED = 0.5
 MOSTLY_SHARE = 0.1
 MAX_BASE_SHIFT_MOSTLY = 1.0
 _ANCHORS = {"tangential": ("h0",), "normal": ("k",)}
+#: the regimes (analyze's decision) whose loops never reach a plateau, so the base reads
+#: h0 by extrapolation and the anchor is the initial stiffness h0·ac: pre-sliding, and the
+#: transition (a dashpot's loop area, read by the base as the way to gross sliding, moved
+#: h0 from 24 to 40 N, the truth, at ac·A 0.53 behind an LVDT's low-pass; the base fit
+#: called it transition at ac·A 1.2: rig seed 1000, --chain sensors)
+ANCHOR_STIFFNESS_REGIMES = ("pre-sliding", "transition")
 
 
 def _takes_over(
@@ -49,10 +55,11 @@ def _takes_over(
     None. An effect that rescales the base (a branch scale makes
     the loop's height ``λ h0 / 2``) is compared by its equivalent of the base parameter.
 
-    In pre-sliding (``regime``, as analyze decides it) a tangential loop never reaches its
-    plateau and shows its initial stiffness ``h0·ac`` and curvature, not ``h0``: the anchor
-    is then ``h0·ac`` (a dashpot's loop area, read by the base as curvature, moved h0 from
-    27.6 to 40 N, its true value, at an unchanged stiffness: rig tuning seeds 1402-1408)."""
+    In pre-sliding and transition (``regime``, as analyze decides it:
+    :data:`ANCHOR_STIFFNESS_REGIMES`) a tangential loop never reaches its plateau and shows
+    its initial stiffness ``h0·ac`` and curvature, not ``h0``: the anchor is then
+    ``h0·ac`` (a dashpot's loop area, read by the base as curvature, moved h0 from 27.6 to
+    40 N, its true value, at an unchanged stiffness: rig tuning seeds 1402-1408)."""
     from .effects import registry
 
     reg = registry(family.kind)
@@ -64,7 +71,7 @@ def _takes_over(
     if explains <= EXPLAINED_SHARE:
         limit = MAX_BASE_SHIFT_MOSTLY if explains <= MOSTLY_SHARE else MAX_BASE_SHIFT_EXPLAINED
     anchors = _ANCHORS.get(family.kind, ())
-    if regime == "pre-sliding" and family.kind == "tangential" and "ac" in base:
+    if regime in ANCHOR_STIFFNESS_REGIMES and family.kind == "tangential" and "ac" in base:
         anchors = ("h0·ac",)
         base = {**base, "h0·ac": base["h0"] * base["ac"]}
         equivalent["h0·ac"] = equivalent["h0"] * equivalent["ac"]
@@ -100,7 +107,59 @@ def _noise_floor(family: Family, names: tuple[str, ...], budget: float) -> float
     except KeyError:
         return budget
     blind = all(not getattr(reg.get(n), "input_noise_gain", True) for n in names)
-    return 0.0 if names and blind else budget
+    if names and blind:
+        return 0.0
+    # an effect that can take only part of what the input's noise leaves (its
+    # ``input_noise_share``, measured on clean records) beats that part of the budget
+    return budget * max((_noise_share(reg.get(n)) for n in names), default=1.0)
+
+
+def _noise_share(eff: object) -> float:
+    """The share of the input-noise budget an effect's fit can take from the noise alone: 0
+    when it is blind to the input (``input_noise_gain`` False), else its
+    ``input_noise_share`` (default 1: all of it)."""
+    if not getattr(eff, "input_noise_gain", True):
+        return 0.0
+    return float(getattr(eff, "input_noise_share", 1.0))
+
+
+def own_gain_floor(family: Family, names: tuple[str, ...], min_gain: float) -> float:
+    """The held-out (and in-sample) gain, σ², a candidate adding ``names`` must reach beside
+    the input-noise budget: ``min_gain`` times the largest of their ``gain_floor_scale``
+    (an effect's own, default 1).
+
+    ``min_gain`` is a floor on the effect's size per sample, whatever the record's length:
+    on a long record it asks far more than significance does (an effect of 0.05 σ² per sample
+    over 20 000 samples has a noncentrality of 1 000). An effect with a structure no noise
+    and no misfit of the base model along the phase of the cycle takes — a straight line in
+    time — has its floor scaled down (``gain_floor_scale``, measured on clean records), the
+    significance rules across cycles, the BIC and the share of the remaining error
+    (:data:`~contactlab.diagnose.select.MIN_RELATIVE_GAIN`) still apply in full."""
+    from .effects import registry
+
+    try:
+        reg = registry(family.kind)
+    except KeyError:
+        return min_gain
+    scale = max((float(getattr(reg.get(n), "gain_floor_scale", 1.0)) for n in names), default=1.0)
+    return min_gain * scale
+
+
+def _proportional(family: Family, names: tuple[str, ...]) -> bool:
+    """Whether rule 2 may pass by :func:`~contactlab.diagnose.select.proportional_t` for a
+    candidate adding ``names``: the family's ``proportional_gain``, or every one of them an
+    effect whose held-out gain is by its nature uneven across cycles (its own
+    ``proportional_gain``: a drift gains nothing in the record's middle and most at its
+    ends, so the per-cycle log ratios scatter by the drift's own shape, not by the noise)."""
+    if getattr(family, "proportional_gain", False):
+        return True
+    from .effects import registry
+
+    try:
+        reg = registry(family.kind)
+    except KeyError:
+        return False
+    return bool(names) and all(getattr(reg.get(n), "proportional_gain", False) for n in names)
 
 
 def _not_fitted(name: str, exc: Exception) -> Verdict:
@@ -151,8 +210,9 @@ def _try_candidate(
         except (ConvergenceError, InputError) as exc:
             return _not_fitted(name, exc), None
     in_gain = (current.full.mse - full.mse) / sigma**2
-    if in_gain < min_gain:
-        reason = f"in-sample gain {in_gain:.3g} σ² below {min_gain:g} σ²"
+    floor = own_gain_floor(family, (*also, name), min_gain)
+    if in_gain < floor:
+        reason = f"in-sample gain {in_gain:.3g} σ² below {floor:g} σ²"
         return Verdict(name, np.nan, float(in_gain), np.nan, np.nan, False, reason), None
     try:
         cand = evaluate(family, trial_effects, d, start_c, scales, folds, full)
@@ -164,8 +224,8 @@ def _try_candidate(
     # track-dependent friction by the turning points noisy x pushes outward (at 1 % x noise
     # position_friction gained 0.08 σ² on clean records against a budget of 0.70 σ²)
     extra = _noise_floor(family, (*also, name), budget)
-    prop = d if getattr(family, "proportional_gain", False) else None
-    v = judge(name, current, cand, sigma, z, min_gain + extra, prop)
+    prop = d if _proportional(family, (*also, name)) else None
+    v = judge(name, current, cand, sigma, z, floor + extra, prop)
     # every effect of the candidate model, not only the new one: a refit can push an
     # effect added before to the edge of its physical range
     why = next(
@@ -225,8 +285,9 @@ def _drop_check(
     except ConvergenceError as exc:
         return _not_fitted(name, exc), None
     extra = _noise_floor(family, (name,), budget)  # the forward rule's (_try_candidate)
-    prop = d if getattr(family, "proportional_gain", False) else None
-    return judge(name, reduced, current, sigma, z, min_gain + extra, prop), reduced
+    prop = d if _proportional(family, (name,)) else None
+    floor = own_gain_floor(family, (name,), min_gain)
+    return judge(name, reduced, current, sigma, z, floor + extra, prop), reduced
 
 
 #: the swap move's threshold on the t statistic of the per-cycle gain (see _swap_search)
@@ -450,6 +511,8 @@ class StepwiseSearch:
     def __post_init__(self) -> None:
         self.all_samples = np.ones(self.d.y.size, bool)
         self.spent = self.d.extra["evaluations"]
+        # the search's two floors, for the stated power's per-effect floor (own_gain_floor)
+        self.d.extra["gain_rules"] = {"min_gain": self.min_gain, "budget": self.budget}
 
     def _rules(self) -> dict[str, Any]:
         return {

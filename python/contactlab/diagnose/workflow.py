@@ -263,9 +263,14 @@ def diagnose(
     path = kind_path(family)
     t, u, y = _checked_arrays(recording, family, folds, max_effects, z, min_gain)
     y, sign_note = path.orient(t, u, y, force_sign)
+    hum_note = None
+    if family.kind == "tangential":  # (diagvel: mains hum on both channels feeds a delay)
+        from ._mains import remove_mains
+
+        u, y, hum_note = remove_mains(t, u, y)
     names = _candidate_names(family, candidates)
     taps, declared_noise = _declared(recording, family, output_filter, output_noise, t.size, y)
-    notes = [n for n in (sign_note, _same_clock(recording, names, candidates)) if n]
+    notes = [n for n in (sign_note, hum_note, _same_clock(recording, names, candidates)) if n]
     d, reduced = path.prepare(t, u, y, taps)
     prior, prior_notes = _ready(family, d, recording, context, taps)
     effects: tuple[str, ...] = tuple(model.effects) if isinstance(model, ExtendedModel) else ()

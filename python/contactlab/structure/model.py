@@ -286,12 +286,17 @@ class Structure:
             The others come back empty (no rows) and cost nothing. A periodic run also
             computes ``x``, ``v``, ``joint_energy`` and ``input_work`` (its convergence check).
         tol : float, optional
-            Error-controlled stepping (the default, ``tol`` = :data:`DEFAULT_TOL`): each
-            piece of a sample interval is a Newmark step checked against two half steps, the
-            pair's Richardson extrapolation is kept (fourth order) and pieces are shortened
-            until the pair's difference / 3 is at most ``tol`` relative to the largest
-            displacement and velocity so far. Pieces end on the samples, at velocity
-            reversals and at stick-slip transitions. Not together with ``substeps``.
+            Error-controlled stepping (the default, ``tol`` = :data:`DEFAULT_TOL`). Bouc-Wen,
+            Jenkins, Iwan, Kelvin-Voigt and normal-contact joints: each piece of a sample
+            interval is one Newmark step corrected twice by the two-point Hermite rule
+            (fourth order; the jerk from the equation of motion), and pieces are shortened
+            until the change of the second correction is at most ``tol`` relative to the
+            largest displacement and velocity so far. Masing joints, joints of any
+            :mod:`contactlab.joints` law and stiff structures: each piece is a Newmark step
+            checked against two half steps, the pair's Richardson extrapolation is kept
+            (fourth order) and the pair's difference / 3 is held to ``tol``. Pieces end on
+            the samples, at velocity reversals and at stick-slip transitions. Not together
+            with ``substeps``.
 
         Returns
         -------

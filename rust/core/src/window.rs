@@ -605,7 +605,7 @@ fn fold_window_with(
             let raw = if ti == seg.k_lo {
                 seg.p_lo
             } else {
-                seg.slope * (ti - seg.k_lo) + seg.p_lo
+                seg.phase(ti)
             };
             // never back (rounding at a knot): each cell stays one run of samples
             let clamped = raw < last_ph;
@@ -667,8 +667,40 @@ fn fold_window_with(
         // and g < g_hi places a sample in the cell: g >= b_lo (monotone) and frac < 1
         // (frac >= 1 gives g >= n_bins); the last bin's edge n_bins is its cycle's end but
         // for rounding, which the path above decides.
-        let g_hi = if b_hi > nbf { nbf } else { b_hi };
-        (i, carried, last_ph) = cell.run((t, x, f), i, end, &seg, (c_lo, nbf, g_hi), last_ph);
+        let taken = i;
+        loop {
+            let g_hi = if b_hi > nbf { nbf } else { b_hi };
+            let ph;
+            (i, ph) = cell.run((t, x, f), i, end, &seg, (c_lo, nbf, g_hi));
+            if ph < 0.0 {
+                break;
+            }
+            // sample i is past the cell: where it starts the next bin of the same cycle (not
+            // the last bin), the cell changes here as the path above would change it (there
+            // ph = carried, not clamped; frac < 1 as g < b_hi + 1 <= n_bins - 1, so the same
+            // cycle; next_bin's first case), else that path takes it
+            let frac = ph - c_lo;
+            let g = frac * nbf;
+            if !(g < b_hi + 1.0 && cb + 2 < nb) {
+                carried = ph;
+                break;
+            }
+            let n = (i - cell_start) as i64 as f64;
+            cell.flush(&mut bins[cb], &mut ranges[cc], n);
+            cb += 1;
+            (b_lo, b_hi) = (b_hi, b_hi + 1.0);
+            cell = Cell {
+                cur: bins[cb].sums,
+                ..Cell::default()
+            };
+            cell_start = i;
+            cell.add(x[i], f[i], frac, t[i]);
+            i += 1;
+        }
+        if i > taken {
+            // the phase of the last sample taken (run's expression, so its number)
+            last_ph = seg.phase(t[i - 1]);
+        }
     }
     if cb != usize::MAX {
         let n = (a1 - cell_start) as i64 as f64;

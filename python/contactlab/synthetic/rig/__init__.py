@@ -9,7 +9,9 @@ tangential
     effects of ``docs/effects.md`` → load cell (second-order dynamics) → anti-alias filters on
     both channels (4th-order Butterworth, corner tolerances → a small channel skew) →
     sampling → quantisation; displacement-sensor noise and drift, force noise, each from its
-    own random stream.
+    own random stream. Optionally (``rig_recording`` arguments): the displacement sensor's
+    own low-pass (an LVDT demodulator), a piezoelectric (high-pass) force cell, Bessel
+    anti-alias filters, mains hum, clock jitter and the actuator's drive harmonics.
 normal
     pressure actuator (ramped tone blocks from the static preload) → the joint (Kelvin-Voigt
     with the normal effects, solved for δ by an implicit integrator) → pressure cell
@@ -19,7 +21,7 @@ Everything analogue runs on an internal grid ``oversample`` times finer than the
 rate; the filters are discretised exactly for piecewise-linear input (first-order hold).
 """
 
-from .chain import butterworth, discretise, group_delay, load_cell
+from .chain import bessel, butterworth, discretise, group_delay, highpass, load_cell
 from .contact import Virgin, masing_force, play_operator, segalman_parameters
 from .recording import NEW_EFFECTS, NORMAL_EFFECTS, TANGENTIAL_EFFECTS, RigRecording, rig_recording
 
@@ -29,9 +31,11 @@ __all__ = [
     "TANGENTIAL_EFFECTS",
     "RigRecording",
     "Virgin",
+    "bessel",
     "butterworth",
     "discretise",
     "group_delay",
+    "highpass",
     "load_cell",
     "masing_force",
     "play_operator",

@@ -13,12 +13,24 @@ from typing import Any
 import numpy as np
 from scipy import interpolate, signal
 
-__all__ = ["butterworth", "discretise", "group_delay", "load_cell"]
+__all__ = ["bessel", "butterworth", "discretise", "group_delay", "highpass", "load_cell"]
 
 
 def butterworth(fc: float, order: int = 4) -> tuple[np.ndarray, np.ndarray]:
     """Analogue Butterworth low-pass (b, a) in s, corner fc (Hz)."""
     return signal.butter(order, 2 * math.pi * fc, analog=True)
+
+
+def bessel(fc: float, order: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """Analogue Bessel low-pass (b, a) in s, −3 dB at fc (Hz): the flat group delay of an
+    anti-alias filter that keeps the waveform."""
+    return signal.bessel(order, 2 * math.pi * fc, analog=True, norm="mag")
+
+
+def highpass(fc: float) -> tuple[np.ndarray, np.ndarray]:
+    """First-order high-pass s / (s + ωc), corner fc (Hz): a piezoelectric load cell's charge
+    leaking through its amplifier's time constant 1/ωc."""
+    return np.array([1.0, 0.0]), np.array([1.0, 2 * math.pi * fc])
 
 
 def load_cell(fn: float, zeta: float) -> tuple[np.ndarray, np.ndarray]:
@@ -122,6 +134,15 @@ class _Chain:
     bits: int | None
     rng_x: np.random.Generator
     rng_F: np.random.Generator
+    #: the displacement sensor's own low-pass (an LVDT demodulator), None: none
+    x_sensor: tuple[np.ndarray, np.ndarray] | None = None
+    #: the force sensor's high-pass (a piezoelectric cell's charge amplifier), None: none
+    F_highpass: tuple[np.ndarray, np.ndarray] | None = None
+    #: mains hum on both channels (fraction of each channel's amplitude), its frequency (Hz)
+    hum: float = 0.0
+    hum_f: float = 50.0
+    #: RMS jitter of the sampling clock (s)
+    jitter: float = 0.0
 
 
 def _design_chain(
@@ -136,15 +157,22 @@ def _design_chain(
     aa_ratio: float,
     aa_tolerance: float,
     bits: int | None,
+    sensors: dict[str, Any] | None = None,
 ) -> tuple[_Chain, dict[str, Any]]:
     """The chain with its anti-alias corners drawn (tolerances), and the truth it starts."""
     rng_x, rng_F, rng_tol, _spare = rngs
     fc_x = aa_ratio * fs * (1 + aa_tolerance * rng_tol.standard_normal())
     fc_F = aa_ratio * fs * (1 + aa_tolerance * rng_tol.standard_normal())
-    aa_x, aa_F = butterworth(fc_x), butterworth(fc_F)
+    sensors = dict(sensors or {})
+    aa = bessel if sensors.get("aa_kind", "butterworth") == "bessel" else butterworth
+    aa_x, aa_F = aa(fc_x), aa(fc_F)
     cell = load_cell(cell_fn, cell_zeta)
+    x_lp = sensors.get("x_lowpass")
+    x_sensor = butterworth(float(x_lp), int(sensors.get("x_lowpass_order", 2))) if x_lp else None
+    f_hp = sensors.get("F_highpass")
+    F_highpass = highpass(float(f_hp)) if f_hp else None
     # low-frequency group delays (s): Butterworth 4: Σ 1/(ωc·sin θk); cell: 2ζ/ωn
-    gd_x = group_delay(aa_x)
+    gd_x = group_delay(aa_x) + (group_delay(x_sensor) if x_sensor is not None else 0.0)
     gd_F = group_delay(aa_F) + group_delay(cell)
     truth: dict[str, Any] = {
         "kind": kind,
@@ -156,11 +184,20 @@ def _design_chain(
             "cell_fn": cell_fn,
             "cell_zeta": cell_zeta,
             "bits": bits,
+            "aa_kind": sensors.get("aa_kind", "butterworth"),
+            "x_lowpass": x_lp,
+            "F_highpass": f_hp,
+            "hum": float(sensors.get("hum", 0.0)),
+            "jitter": float(sensors.get("jitter", 0.0)),
             # the output channel behind the input at low frequency (s)
             "channel_skew": (gd_F - gd_x) if kind == "tangential" else (gd_x - gd_F),
         },
     }
-    chain = _Chain(kind, oversample, dt, aa_x, aa_F, cell, bits, rng_x, rng_F)
+    chain = _Chain(
+        kind, oversample, dt, aa_x, aa_F, cell, bits, rng_x, rng_F, x_sensor, F_highpass,
+        float(sensors.get("hum", 0.0)), float(sensors.get("hum_f", 50.0)),
+        float(sensors.get("jitter", 0.0)),
+    )  # fmt: skip
     return chain, truth
 
 
@@ -186,7 +223,16 @@ def _measure(
     force, disp = out_ch, in_ch
     disp_amp = meta["displacement_amplitude"]
     force_amp = meta["force_amplitude"]
+    if chain.x_sensor is not None:  # the displacement sensor's own low-pass (from rest)
+        disp = _filter(chain.x_sensor, dt, disp)
+    if chain.F_highpass is not None and kind == "tangential":  # a piezo cell: from zero charge
+        b, a = discretise(chain.F_highpass, dt)
+        force = signal.lfilter(b, a, force)
     disp = disp + x_drift * disp_amp * ti / ti[-1]
+    if chain.hum > 0.0:  # mains hum, its own phase on each channel
+        ph_x, ph_F = chain.rng_x.uniform(0, 2 * math.pi), chain.rng_F.uniform(0, 2 * math.pi)
+        disp = disp + chain.hum * disp_amp * np.sin(2 * math.pi * chain.hum_f * ti + ph_x)
+        force = force + chain.hum * force_amp * np.sin(2 * math.pi * chain.hum_f * ti + ph_F)
     g_x = _noise_gain(aa_x, dt)
     g_F = _noise_gain(aa_F, dt)
     disp = disp + chain.rng_x.standard_normal(ti.size) * (x_noise * disp_amp / g_x)
@@ -200,6 +246,11 @@ def _measure(
     # the delayed channel (F tangential, δ normal: the output) is sampled at t − τ
     disp_s = disp_f[::oversample]
     force_s = force_f[::oversample]
+    if chain.jitter > 0.0:  # one clock samples both channels, each instant off by its jitter
+        tj = t + chain.jitter * chain.rng_x.standard_normal(t.size)
+        disp_s = _sample_at(ti, disp_f, tj)
+        force_s = _sample_at(ti, force_f, tj)
+        t = tj
     if tau != 0.0:
         if kind == "tangential":
             force_s = _sample_at(ti, force_f, t - tau)

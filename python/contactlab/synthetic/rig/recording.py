@@ -173,6 +173,12 @@ def rig_recording(
     aa_tolerance: float = 0.01,
     bits: int | None = 16,
     oversample: int | None = None,
+    x_lowpass: float | None = None,
+    F_highpass: float | None = None,
+    aa_kind: str = "butterworth",
+    hum: float = 0.0,
+    jitter: float = 0.0,
+    drive_harmonics: Sequence[float] = (),
 ) -> RigRecording:
     """Simulate a recording of the whole measurement chain with the given effects.
 
@@ -222,6 +228,22 @@ def rig_recording(
         ADC resolution (None: no quantisation).
     oversample : int, optional
         Internal grid rate / fs (default: enough for the load cell, ≥ 8).
+    x_lowpass : float, optional
+        Corner (Hz) of the displacement sensor's own second-order Butterworth low-pass (an
+        LVDT's demodulator), before its noise and the anti-alias filter; None: none.
+    F_highpass : float, optional
+        Tangential: corner (Hz) of a first-order high-pass on the force (a piezoelectric load
+        cell's charge leaking away, from zero charge at rest); None: a strain-gauge cell.
+    aa_kind : {"butterworth", "bessel"}
+        The anti-alias filters' type (4th order, −3 dB at the corner).
+    hum : float
+        Mains hum (50 Hz) on both channels, amplitude as a fraction of each channel's
+        amplitude, each with its own phase.
+    jitter : float
+        RMS jitter (s) of the sampling clock, common to both channels.
+    drive_harmonics : sequence of float
+        Tangential: the command's 2nd, 3rd, ... harmonics as fractions of its fundamental
+        (an actuator's distortion), in phase with it.
 
     Returns
     -------
@@ -231,6 +253,7 @@ def rig_recording(
     _check_arguments(
         kind, cycles, f, fs, x_noise, F_noise, h0=h0, ac=ac, acA=acA, k=k, psi=psi, pa=pa
     )
+    sensors = _check_sensors(x_lowpass, F_highpass, aa_kind, hum, jitter, drive_harmonics)
     allowed = TANGENTIAL_EFFECTS + NEW_EFFECTS if kind == "tangential" else NORMAL_EFFECTS
     eff = _effect_params(effects, allowed)
 
@@ -243,15 +266,17 @@ def rig_recording(
     dt = 1.0 / fsi
     ti, t = _grids(kind, fs, f, cycles, frequencies, oversample, dt)
     chain, truth = _design_chain(
-        kind, eff, rngs, fs, oversample, dt, cell_fn, cell_zeta, aa_ratio, aa_tolerance, bits
-    )
+        kind, eff, rngs, fs, oversample, dt, cell_fn, cell_zeta, aa_ratio, aa_tolerance, bits,
+        sensors,
+    )  # fmt: skip
     truth["chain"]["ramp_cycles"] = ramp_cycles
 
     if kind == "tangential":
         actuator = (actuator_f or 15 * f, actuator_zeta)
         out_ch, in_ch, meta = _tangential(
-            ti, eff, f, h0, ac, acA, ramp_cycles, *actuator, chain.cell, dt
-        )
+            ti, eff, f, h0, ac, acA, ramp_cycles, *actuator, chain.cell, dt,
+            tuple(sensors["drive_harmonics"]),
+        )  # fmt: skip
     else:
         out_ch, in_ch, meta = _normal(
             ti, eff, f, k, psi, p0, pa, frequencies, cycles, ramp_cycles, chain.cell, dt
@@ -259,6 +284,32 @@ def rig_recording(
     truth["base"] = meta
     channels = _measure(chain, eff, ti, t, out_ch, in_ch, meta, truth, x_noise, F_noise, x_drift)
     return RigRecording(kind, t, channels, truth)
+
+
+def _check_sensors(
+    x_lowpass: float | None,
+    F_highpass: float | None,
+    aa_kind: str,
+    hum: float,
+    jitter: float,
+    drive_harmonics: Sequence[float],
+) -> dict[str, Any]:
+    """The optional sensor figures of :func:`rig_recording`, checked."""
+    for name, v in (("x_lowpass", x_lowpass), ("F_highpass", F_highpass)):
+        if v is not None and not (np.isfinite(v) and v > 0):
+            raise InputError(f"rig_recording: {name} must be None or a finite number > 0, got {v}")
+    if aa_kind not in ("butterworth", "bessel"):
+        raise InputError(
+            f"rig_recording: aa_kind must be 'butterworth' or 'bessel', got {aa_kind!r}"
+        )
+    for name, v in (("hum", hum), ("jitter", jitter)):
+        if not (np.isfinite(v) and v >= 0):
+            raise InputError(f"rig_recording: {name} must be >= 0, got {v}")
+    harm = [float(h) for h in drive_harmonics]
+    if any(not np.isfinite(h) for h in harm):
+        raise InputError(f"rig_recording: drive_harmonics must be finite, got {harm}")
+    return {"x_lowpass": x_lowpass, "F_highpass": F_highpass, "aa_kind": aa_kind, "hum": hum,
+            "jitter": jitter, "drive_harmonics": harm}  # fmt: skip
 
 
 def _check_arguments(

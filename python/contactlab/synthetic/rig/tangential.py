@@ -17,7 +17,9 @@ from .chain import _filter, _ramp, discretise
 from .contact import Virgin, _breakaway, _lugre, masing_force, play_operator
 
 
-def _tangential(ti, eff, f, h0, ac, acA, ramp_cycles, actuator_f, actuator_zeta, cell, dt):
+def _tangential(
+    ti, eff, f, h0, ac, acA, ramp_cycles, actuator_f, actuator_zeta, cell, dt, harmonics=()
+):
     """The tangential joint on the internal grid: ``(cell force, measured x, base truth)``."""
     w = 2 * math.pi * f
     A = acA / ac
@@ -26,7 +28,10 @@ def _tangential(ti, eff, f, h0, ac, acA, ramp_cycles, actuator_f, actuator_zeta,
     wa = 2 * math.pi * actuator_f
     act = (np.array([wa**2]), np.array([1.0, 2 * actuator_zeta * wa, wa**2]))
     _, H = signal.freqs(*act, worN=[w])
-    cmd = (A / abs(H[0])) * _ramp(ti, f, ramp_cycles) * np.sin(w * ti)
+    wave = np.sin(w * ti)
+    for k, share in enumerate(harmonics, start=2):  # the actuator's distortion
+        wave = wave + share * np.sin(k * w * ti)
+    cmd = (A / abs(H[0])) * _ramp(ti, f, ramp_cycles) * wave
     bd, ad = discretise(act, dt)
     x = signal.lfilter(bd, ad, cmd)  # from rest: zero state, cmd[0] = 0
     v = np.gradient(x, dt, edge_order=2)

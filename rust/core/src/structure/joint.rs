@@ -204,6 +204,39 @@ impl JointLaw {
         })
     }
 
+    /// The tangents `(∂F/∂d, ∂F/∂ḋ)` at the start `d_old` of the trial `tr` (to `d_new`) along
+    /// its direction (the right limit), where they may differ from the left limit the last
+    /// step ended with: a Masing branch that the trial starts (its slope at 0), a Bouc-Wen
+    /// rate in the trial's direction, a Jenkins/Iwan element that began to slip or stick (its
+    /// tangent is constant between events: the trial's own). `None`: the left limit holds.
+    pub fn start_tangent(
+        &self,
+        state: &JointState,
+        d_old: f64,
+        d_new: f64,
+        tr: &Trial,
+    ) -> Option<(f64, f64)> {
+        match (self, state) {
+            (Self::Masing { curve, .. }, _) if tr.aux & 1 == 1 => Some((curve.slope(0.0), 0.0)),
+            (Self::Jenkins { .. } | Self::Iwan { .. }, _) => Some((tr.kt, tr.ct)),
+            (
+                Self::BoucWen {
+                    alpha,
+                    beta,
+                    gamma,
+                    delta,
+                    nu,
+                },
+                JointState::Slider(z0),
+            ) => {
+                let s = if d_new < d_old { -1.0 } else { 1.0 };
+                let kt = bw_rate(*alpha, *beta, *gamma, *delta, *nu, *z0, s);
+                Some((kt.max(0.0), 0.0))
+            }
+            _ => None,
+        }
+    }
+
     /// The virgin state (d = 0, F = 0).
     pub fn fresh_state(&self) -> JointState {
         match self {

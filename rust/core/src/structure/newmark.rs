@@ -105,7 +105,7 @@ struct Scratch {
 fn newton_step(
     s: &Structure,
     w: &Work,
-    (h, quick): (f64, f64),
+    (h, quick, guessed): (f64, f64, bool),
     sc: &mut Scratch,
     opts: &Options,
 ) -> Option<u64> {
@@ -113,7 +113,10 @@ fn newton_step(
     let (b, g) = (0.25 * h * h, 0.5 * h);
     // The unknown is the new acceleration: x1 and v1 follow from it without the cancellation
     // of the displacement form (4/h² Δx − 4/h v), which loses all accuracy on short sub-steps.
-    sc.a1.copy_from_slice(&w.a);
+    // (`guessed`: the caller put a better start in `sc.a1`)
+    if !guessed {
+        sc.a1.copy_from_slice(&w.a);
+    }
     for it in 1..=opts.max_iter as u64 {
         for d in 0..n {
             let asum = w.a[d] + sc.a1[d];
@@ -307,7 +310,7 @@ pub(super) fn simulate_dense(
             let h = step * big_h;
             let tau1 = if step >= 1.0 - tau { 1.0 } else { tau + step };
             load(s, inp, i, tau1, &mut sc.f1);
-            match newton_step(s, &w, (h, 0.0), &mut sc, opts) {
+            match newton_step(s, &w, (h, 0.0, false), &mut sc, opts) {
                 None => {
                     halvings = halvings.saturating_add(1);
                     if halvings > opts.max_halvings.saturating_mul(opts.substeps) {

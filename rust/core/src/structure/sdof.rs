@@ -73,6 +73,44 @@ trait Joints {
         ext: f64,
         xr: f64,
     ) -> Result<(), CoreError>;
+    /// The summed tangents at the start `x0` of the step last tried (to `x1`), along it (the
+    /// right limit; see [`JointLaw::start_tangent`]), where they may differ from those the
+    /// state holds. `None`: the state's.
+    fn start_tangent(&self, x0: f64, x1: f64) -> Option<(f64, f64)>;
+    /// Whether error control takes Hermite pieces (see `adaptive`) for this joint set: not
+    /// where a law's tangent is a difference quotient (a [`JointLaw::Law`]) nor for Masing
+    /// joints, whose branches right after a reversal (the tangent falling from its initial
+    /// value at the rate `ac / λ` of the travel) the pieces' estimate does not see: there
+    /// step doubling.
+    fn hermite(&self) -> bool;
+    /// Move each joint's force at the last trial along its tangents by `(dx, dv)`.
+    fn shift(&mut self, moved: (f64, f64));
+    /// Accept the last trial (shifted to `x1`, from `x0`) of a Hermite piece with the ends
+    /// `e`: each joint's work by [`hermite_work`].
+    fn commit_hermite(&mut self, x0: f64, x1: f64, e: &Ends) -> Result<(), CoreError>;
+}
+
+/// The ends of a Hermite piece (see `adaptive`): its length, the velocity and acceleration at
+/// the start and end, and the summed joint stiffness at the start (for a joint set that does
+/// not keep its own).
+#[derive(Debug, Clone, Copy)]
+struct Ends {
+    h: f64,
+    v0: f64,
+    a0: f64,
+    v1: f64,
+    a1: f64,
+    kt0: f64,
+}
+
+/// `∫ F ḋ dt` over a Hermite piece by the two-point Hermite rule (fourth order): `F ḋ` and its
+/// rate `(kt ḋ + ct d̈) ḋ + F d̈` at both ends, `(f, kt, ct)` the force and tangents there.
+#[inline(always)]
+fn hermite_work(e: &Ends, (f0, kt0, ct0): (f64, f64, f64), (f1, kt1, ct1): (f64, f64, f64)) -> f64 {
+    let (g0, g1) = (f0 * e.v0, f1 * e.v1);
+    let dg0 = (kt0 * e.v0 + ct0 * e.a0) * e.v0 + f0 * e.a0;
+    let dg1 = (kt1 * e.v1 + ct1 * e.a1) * e.v1 + f1 * e.a1;
+    0.5 * e.h * (g0 + g1) + e.h * e.h / 12.0 * (dg0 - dg1)
 }
 
 /// The Richardson extrapolation of a joint's work over a step-doubling piece: forces `f0` at
@@ -95,6 +133,17 @@ struct Dyn<'a> {
     stored0: Vec<f64>,
     /// Each joint's forces kept by [`Joints::keep`].
     kept: Vec<[f64; 3]>,
+    /// Each joint's tangents `(∂/∂d, ∂/∂ḋ)` at the committed point.
+    tang: Vec<(f64, f64)>,
+}
+
+impl Dyn<'_> {
+    /// Joint `jn`'s tangents at the start `x0` of its last trial (to `x1`), along it.
+    #[inline]
+    fn start_of(&self, jn: usize, x0: f64, x1: f64) -> (f64, f64) {
+        let (j, st, tr) = (&self.joints[jn], &self.states[jn], &self.trials[jn]);
+        j.law.start_tangent(st, x0, x1, tr).unwrap_or(self.tang[jn])
+    }
 }
 
 impl<'a> Dyn<'a> {
@@ -103,11 +152,14 @@ impl<'a> Dyn<'a> {
         let nj = joints.len();
         let mut states: Vec<JointState> = joints.iter().map(|j| j.law.fresh_state()).collect();
         let mut jf = vec![0.0; nj];
+        let mut tang = vec![(0.0, 0.0); nj];
         let mut sum = Sum::default();
-        for ((j, st), f) in joints.iter().zip(states.iter_mut()).zip(jf.iter_mut()) {
+        let parts = joints.iter().zip(states.iter_mut());
+        for ((j, st), (f, tg)) in parts.zip(jf.iter_mut().zip(tang.iter_mut())) {
             let tr = j.law.trial(st, 0.0, x0, v0);
             j.law.commit(st, 0.0, x0, &tr)?;
             *f = tr.f;
+            *tg = (tr.kt, tr.ct);
             sum.f += tr.f;
             sum.kt += tr.kt;
             sum.ct += tr.ct;
@@ -126,6 +178,7 @@ impl<'a> Dyn<'a> {
                 jwork: vec![0.0; nj],
                 stored0,
                 kept: vec![[0.0; 3]; nj],
+                tang,
             },
             sum,
         ))
@@ -169,6 +222,50 @@ impl Joints for Dyn<'_> {
             j.law.commit(st, x0, xr, tr)?;
             *f = tr.f;
         }
+        for (tg, tr) in self.tang.iter_mut().zip(&self.trials) {
+            *tg = (tr.kt, tr.ct);
+        }
+        Ok(())
+    }
+
+    fn hermite(&self) -> bool {
+        !self
+            .joints
+            .iter()
+            .any(|j| matches!(j.law, JointLaw::Law { .. } | JointLaw::Masing { .. }))
+    }
+
+    #[inline]
+    fn start_tangent(&self, x0: f64, x1: f64) -> Option<(f64, f64)> {
+        let mut out = (0.0, 0.0);
+        for jn in 0..self.joints.len() {
+            let (kt, ct) = self.start_of(jn, x0, x1);
+            out = (out.0 + kt, out.1 + ct);
+        }
+        Some(out)
+    }
+
+    #[inline]
+    fn shift(&mut self, (dx, dv): (f64, f64)) {
+        for tr in &mut self.trials {
+            tr.f += tr.kt * dx + tr.ct * dv;
+        }
+    }
+
+    #[inline]
+    fn commit_hermite(&mut self, x0: f64, x1: f64, e: &Ends) -> Result<(), CoreError> {
+        for jn in 0..self.joints.len() {
+            let (kt, ct) = self.start_of(jn, x0, x1);
+            let tr = &self.trials[jn];
+            self.jwork[jn] += hermite_work(e, (self.jf[jn], kt, ct), (tr.f, tr.kt, tr.ct));
+        }
+        let parts = self.joints.iter().zip(&self.trials).zip(&mut self.states);
+        let books = self.jf.iter_mut().zip(&mut self.tang);
+        for (((j, tr), st), (f, tg)) in parts.zip(books) {
+            j.law.commit(st, x0, x1, tr)?;
+            *f = tr.f;
+            *tg = (tr.kt, tr.ct);
+        }
         Ok(())
     }
 
@@ -205,6 +302,9 @@ impl Joints for Dyn<'_> {
             *work += 0.5 * (*f + tr.f) * (x1 - x0);
             j.law.commit(st, x0, x1, tr)?;
             *f = tr.f;
+        }
+        for (tg, tr) in self.tang.iter_mut().zip(&self.trials) {
+            *tg = (tr.kt, tr.ct);
         }
         Ok(())
     }
@@ -359,6 +459,31 @@ impl Joints for MasingExp {
         if let Some(v) = self.kept.get_mut(slot) {
             *v = self.f + self.kt * dx;
         }
+    }
+
+    #[inline(always)]
+    fn shift(&mut self, (dx, _): (f64, f64)) {
+        self.f += self.kt * dx;
+    }
+
+    fn hermite(&self) -> bool {
+        false
+    }
+
+    #[inline(always)]
+    fn start_tangent(&self, _x0: f64, _x1: f64) -> Option<(f64, f64)> {
+        // a trial that reversed starts a branch, whose slope at its anchor is f'(0)
+        (self.aux & 1 == 1).then_some((self.k0, 0.0))
+    }
+
+    #[inline(always)]
+    fn commit_hermite(&mut self, _x0: f64, x1: f64, e: &Ends) -> Result<(), CoreError> {
+        self.jwork += hermite_work(e, (self.jf, e.kt0, 0.0), (self.f, self.kt, 0.0));
+        masing_commit(&mut self.st, x1, self.f, self.aux);
+        self.refresh();
+        self.argl = f64::NAN;
+        self.jf = self.f;
+        Ok(())
     }
 
     #[inline(always)]

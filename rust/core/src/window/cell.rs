@@ -32,6 +32,13 @@ impl Segment {
             slope: (kp[j + 1] - kp[j]) / (kt[j + 1] - kt[j]),
         }
     }
+
+    /// The phase at `ti` inside the segment (off its first knot: [`super::fold_window`]
+    /// takes `p_lo` there).
+    #[inline(always)]
+    pub(super) fn phase(&self, ti: f64) -> f64 {
+        self.slope * (ti - self.k_lo) + self.p_lo
+    }
 }
 
 /// The open cell's running sums: its bin's sample sums (x, F, φ, φ², x², t) carried from
@@ -66,36 +73,37 @@ impl Cell {
         self.cp += frac;
     }
 
-    /// The samples from `i` that follow in the same knot segment `seg`, cycle (from `c_lo`)
-    /// and bin (`g < g_hi`, `g = frac · n_bins`): added; returns the first sample not taken,
-    /// its phase when computed here (else -1) and the last phase taken.
-    // Index arithmetic: i < end <= the slices' length.
+    /// The samples from `i` (below `stop`) that follow in the same knot segment `seg`, cycle
+    /// (from `c_lo`) and bin (`g < g_hi`, `g = frac · n_bins`): added; returns the first
+    /// sample not taken and its phase when computed here (else -1: `stop` or the segment's
+    /// end reached). The phase of the last sample taken is [`Segment::phase`] of it (the same
+    /// expression, so the same number).
+    // Index arithmetic: i < stop <= the slices' length.
     #[allow(clippy::arithmetic_side_effects)]
     #[inline(always)]
     pub(super) fn run(
         &mut self,
         (t, x, f): (&[f64], &[f64], &[f64]),
         mut i: usize,
-        end: usize,
+        stop: usize,
         seg: &Segment,
         (c_lo, nbf, g_hi): (f64, f64, f64),
-        mut last_ph: f64,
-    ) -> (usize, f64, f64) {
-        while i < end {
+    ) -> (usize, f64) {
+        let (t, x, f) = (&t[..stop], &x[..stop], &f[..stop]);
+        while i < stop {
             let ti = t[i];
             if ti >= seg.k_hi {
                 break;
             }
-            let ph = seg.slope * (ti - seg.k_lo) + seg.p_lo;
+            let ph = seg.phase(ti);
             let frac = ph - c_lo;
             if frac * nbf >= g_hi {
-                return (i, ph, last_ph);
+                return (i, ph);
             }
-            last_ph = ph;
             self.add(x[i], f[i], frac, ti);
             i += 1;
         }
-        (i, -1.0, last_ph)
+        (i, -1.0)
     }
 }
 

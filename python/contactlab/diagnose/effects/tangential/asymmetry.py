@@ -12,6 +12,15 @@ from ._common import amplitude
 GROSS_SLIDING_ZA = 10.0
 
 
+#: the share of the search's ``min_gain`` its held-out gain must reach, and the share of the
+#: input-noise budget it must beat (:func:`contactlab.diagnose.search.own_gain_floor`,
+#: ``search._noise_floor``): on 36 clean records of both generators (tuning seeds 1000-1035
+#: of ``benches/eval_clean_gains.py --open``, every floor off) its largest held-out gain was
+#: 0.018 σ² at t <= 2.10 (at most 0.07 of the budget on records with a budget above 0.1 σ²)
+GAIN_FLOOR_SCALE = 0.2
+INPUT_NOISE_SHARE = 0.25
+
+
 @register
 class Asymmetry(EffectModel):
     name = "asymmetry"
@@ -28,6 +37,9 @@ class Asymmetry(EffectModel):
     rank = 0
     order = 8
     size_param = "alpha"
+    #: per-effect floors (see GAIN_FLOOR_SCALE, INPUT_NOISE_SHARE above)
+    gain_floor_scale = GAIN_FLOOR_SCALE
+    input_noise_share = INPUT_NOISE_SHARE
 
     def apply(self, h, p, ctx):
         return h + p["alpha"] * np.abs(h)

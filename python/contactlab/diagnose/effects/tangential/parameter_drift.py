@@ -6,6 +6,7 @@ import numpy as np
 
 from ..._family import ParamSpec
 from .._base import EffectModel, register
+from .force_drift import GAIN_FLOOR_SCALE
 
 
 @register
@@ -32,6 +33,11 @@ class ParameterDrift(EffectModel):
     #: need not beat the input-noise budget of the search (search._noise_floor); the
     #: held-out rules across cycles (t > z, BIC, the gain floor) still apply
     input_noise_gain = False
+    #: its held-out gain is nothing in the record's middle and largest at both ends: rule 2
+    #: may pass by the proportional t across cycles (search._proportional)
+    proportional_gain = True
+    #: the share of ``min_gain`` its held-out gain must reach (search.own_gain_floor)
+    gain_floor_scale = GAIN_FLOOR_SCALE
 
     def apply(self, h, p, ctx):
         return h * (1.0 + p["beta"] * (ctx.t_rel / ctx.d.duration - 0.5))

@@ -9,6 +9,9 @@ from .._base import EffectModel, Plausibility, register
 
 #: wavelengths :meth:`PositionFriction.start` tries, as multiples of the stroke's half-width
 START_WAVELENGTHS = np.geomspace(0.6, 8.0, 28)
+#: the wavelength the stated power is given at, in half-widths of the stroke (a wave between
+#: one and two of them: the track's features that a stroke shows as a wave)
+POWER_WAVELENGTH = 1.5
 #: a wave longer than this many half-widths of the stroke is a level or a gradient of the
 #: friction over the stroke (h0, parameter drift, asymmetry), not a feature of the track
 LONGEST_WAVE = 12.0
@@ -22,6 +25,15 @@ def track_phase(x: np.ndarray, d, wavelength: float) -> np.ndarray:
 #: the amplitudes of the friction's wave along the track (in phase and in quadrature with
 #: the stroke's middle)
 TRACK_TERMS = ("a1", "b1")
+
+
+#: the share of the search's ``min_gain`` its held-out gain must reach, and the share of the
+#: input-noise budget it must beat (:func:`contactlab.diagnose.search.own_gain_floor`,
+#: ``search._noise_floor``): on 36 clean records of both generators (tuning seeds 1000-1035
+#: of ``benches/eval_clean_gains.py --open``, every floor off) its largest held-out gain was
+#: 0.050 σ² at t <= 2.05 (at most 0.10 of the budget on records with a budget above 0.1 σ²)
+GAIN_FLOOR_SCALE = 0.2
+INPUT_NOISE_SHARE = 0.25
 
 
 @register
@@ -58,6 +70,9 @@ class PositionFriction(EffectModel):
     rank = 1
     order = 12
     size_param = "a1"
+    #: per-effect floors (see GAIN_FLOOR_SCALE, INPUT_NOISE_SHARE above)
+    gain_floor_scale = GAIN_FLOOR_SCALE
+    input_noise_share = INPUT_NOISE_SHARE
 
     def size(self, p, se):
         """The wave's amplitude ``√(a1² + b1²)``, with its delta-method error."""
@@ -66,6 +81,14 @@ class PositionFriction(EffectModel):
             return 0.0, float(np.inf)
         e2 = sum((p.get(n, 0.0) / v * se.get(n, np.inf)) ** 2 for n in TRACK_TERMS)
         return v, float(np.sqrt(e2))
+
+    def power_shape(self, d, p):
+        """The wavelength the stated power is given at: :data:`POWER_WAVELENGTH` half-widths
+        of the stroke (a wave of the track's own length, between one and two strokes' worth
+        of the half-widths :meth:`start` searches), not the parameter's generic starting
+        value (a hundredth of the stroke)."""
+        half = float(d.extra.get("x_half", 0.5 * float(np.ptp(d.u))))
+        return {"L": POWER_WAVELENGTH * half} if half > 0 else {}
 
     def start(self, p, d, residual, family=None):
         """The wavelength (of :data:`START_WAVELENGTHS` half-widths of the stroke) whose wave,

@@ -12,6 +12,21 @@ use super::super::{Buffers, Inputs, Options, Status, Structure, Summary};
 use super::{load, matvec, newton_step, record, rel, Scratch, Work};
 use crate::error::CoreError;
 
+mod hermite;
+
+/// Hermite pieces while `h ×` the fastest rate is at most this (as the one-DOF path).
+const HERMITE_RATE: f64 = 1.0;
+
+/// The factor on the piece length after a Hermite piece's estimate (as the one-DOF path's).
+#[inline]
+fn grow4(tol: f64, err: f64) -> f64 {
+    if err * 391.0 <= tol {
+        4.0
+    } else {
+        (0.9 * (tol / err).sqrt().sqrt()).clamp(0.2, 4.0)
+    }
+}
+
 /// The pair's states (coarse end, midpoint, fine end), the extrapolated acceleration's
 /// factors of `M`, and each joint's forces at the three points.
 struct Pair {
@@ -98,13 +113,18 @@ fn piece(
         .joints
         .iter()
         .any(|j| matches!(j.law, JointLaw::Law { .. }));
-    let quick = if exact { 1e-3 } else { 0.0 };
-    let i1 = newton_step(s, w, (h, quick), sc, opts)?;
+    // (at most √rtol: the residual left is then of the order of rtol, as the one-DOF path)
+    let quick = if exact {
+        opts.rtol.sqrt().min(1e-3)
+    } else {
+        0.0
+    };
+    let i1 = newton_step(s, w, (h, quick, false), sc, opts)?;
     p.xc.copy_from_slice(&sc.x1);
     p.vc.copy_from_slice(&sc.v1);
     p.keep(sc, 0);
     sc.f1.copy_from_slice(&p.fm);
-    let i2 = newton_step(s, w, (0.5 * h, quick), sc, opts)?;
+    let i2 = newton_step(s, w, (0.5 * h, quick, false), sc, opts)?;
     p.xm.copy_from_slice(&sc.x1);
     p.vm.copy_from_slice(&sc.v1);
     p.am.copy_from_slice(&sc.a1);
@@ -117,7 +137,7 @@ fn piece(
     w.v.copy_from_slice(&p.vm);
     w.a.copy_from_slice(&p.am);
     sc.f1.copy_from_slice(&p.f1);
-    let i3 = newton_step(s, w, (0.5 * h, quick), sc, opts);
+    let i3 = newton_step(s, w, (0.5 * h, quick, false), sc, opts);
     w.x.copy_from_slice(&p.x0);
     w.v.copy_from_slice(&p.v0);
     w.a.copy_from_slice(&p.a0);
@@ -251,6 +271,8 @@ pub(super) fn run(
     out: &mut Buffers<'_>,
 ) -> Result<Summary, CoreError> {
     let mut p = Pair::new(s)?;
+    let mut hm = hermite::Herm::new(s, &w)?;
+    let herm_ok = hermite::allowed(s);
     let amax = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
     let mut scale = (amax(&w.x), amax(&w.v));
     let mut want = f64::INFINITY;
@@ -261,11 +283,62 @@ pub(super) fn run(
         let (mut tau, mut halvings, mut events) = (0.0_f64, 0usize, 0usize);
         let mut frac = next_frac(tau, want / big_h);
         let mut shortened = false;
+        if herm_ok {
+            hm.interval(s, inp, i, big_h);
+        }
         while tau < 1.0 {
             let step = frac.min(1.0 - tau);
             let h = step * big_h;
             let tau1 = if step >= 1.0 - tau { 1.0 } else { tau + step };
             let span = (tau, tau1, h);
+            if herm_ok && h * rate <= HERMITE_RATE {
+                let got = hermite::piece(s, &w, &mut sc, &mut hm, inp, i, (tau1, h), scale, opts);
+                let Some((err, theta, it)) = got else {
+                    halvings = halvings.saturating_add(1);
+                    if halvings > opts.max_halvings.saturating_mul(4) {
+                        sum.status = Status::NoConvergence {
+                            time: inp.t[i] + tau * big_h,
+                            step: h,
+                        };
+                        return Ok(sum);
+                    }
+                    frac = 0.5 * step;
+                    continue;
+                };
+                sum.n_iter = sum.n_iter.saturating_add(it);
+                if events < opts.max_events && theta < 1.0 {
+                    let min_piece = 1e-3 / step;
+                    if theta > min_piece && theta < 1.0 - min_piece {
+                        events = events.saturating_add(1);
+                        frac = step * theta;
+                        shortened = true;
+                        continue;
+                    }
+                }
+                let factor = grow4(tol, err);
+                if err > tol && !(err > 0.5 * rejected || step <= min_frac) {
+                    rejected = err;
+                    frac = step * factor.min(0.8);
+                    continue;
+                }
+                rejected = f64::NAN;
+                hermite::accept(s, &mut w, &sc, &mut hm, h)?;
+                sum.n_steps = sum.n_steps.saturating_add(1);
+                scale = (scale.0.max(amax(&w.x)), scale.1.max(amax(&w.v)));
+                if w.x.iter().chain(&w.v).any(|v| !v.is_finite()) {
+                    sum.status = Status::NonFinite {
+                        time: inp.t[i] + tau1 * big_h,
+                    };
+                    return Ok(sum);
+                }
+                if !shortened {
+                    want = (h * factor).max(f64::MIN_POSITIVE);
+                }
+                shortened = false;
+                tau = tau1;
+                frac = next_frac(tau, want / big_h);
+                continue;
+            }
             let ext = (scale, if h * rate > 2.0 { 0.0 } else { 1.0 / 3.0 });
             let Some((mut err, theta, it)) =
                 piece(s, &mut w, &mut sc, &mut p, inp, i, span, ext, opts)
@@ -313,6 +386,7 @@ pub(super) fn run(
                 (factor, rejected) = (2.0, err);
             }
             accept(s, &mut w, &sc, &p)?;
+            hm.committed(&sc);
             sum.n_steps = sum.n_steps.saturating_add(1);
             scale = (scale.0.max(amax(&w.x)), scale.1.max(amax(&w.v)));
             if w.x.iter().chain(&w.v).any(|v| !v.is_finite()) {
