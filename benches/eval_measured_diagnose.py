@@ -105,7 +105,60 @@ def run(name: str, rec: object, sign: int) -> dict:
         "where": rep.where,
         "h0_check": doc.get("h0_check"),
     }
+    u = rep.unexplained  # the misfit flag (issue 29, item 3)
+    out["misfit"] = None if u is None else {
+        "flagged": u.flagged,
+        "T_over_threshold": u.statistic / u.threshold,
+        "backbone_t": None if u.backbone is None else u.backbone["t"],
+        "eiv_bias_rms": u.eiv_bias_rms,
+        "input_noise": u.input_noise if hasattr(u, "input_noise") else None,
+        "detectable_rms": u.detectable_rms,
+        "sentence": u.sentence(),
+        "flagged_white_null": _white_null_flag(rep),
+    }  # fmt: skip
     return out
+
+
+def _white_null_flag(rep: object) -> bool | None:
+    """The misfit flag as the null before the input noise's spectrum was read would give it
+    on the same final model: white input noise at the white estimate's level, no simulation
+    on kept records, the tolerance from the white noise after the candidates' filter."""
+    from contactlab.diagnose.detection import channel_noise, model_slope
+    from contactlab.diagnose.eiv import eiv_bias
+    from contactlab.diagnose.misfit import (
+        BACKBONE_Z,
+        BACKBONE_Z_CORRECTED,
+        backbone_misfit,
+        eiv_tolerance,
+        unexplained_structure,
+    )
+
+    m, d = rep.final_model, rep.prepared
+    if m is None or d is None:
+        return None
+    fam, p, eff = m.family, dict(m.params), tuple(m.effects)
+    residual = d.y - np.asarray(fam.predict(p, eff, d), float)
+    slope = model_slope(fam, p, d)
+    noise = channel_noise(d, residual, slope=slope)
+    bias = eiv_bias(fam, p, eff, d, coloured=False)
+    tested = residual if bias is None else residual - bias
+    tol = eiv_tolerance(slope, noise.input_seen, corrected=bias is not None)
+    u = unexplained_structure(d, tested, rep.noise_rms, tolerance=tol)
+    if u is None:
+        return None
+    flagged = u.flagged
+    if getattr(fam, "kind", "") == "tangential" and "ac" in p:
+        z = BACKBONE_Z_CORRECTED if not noise.input > 0 else BACKBONE_Z
+        bb = backbone_misfit(d, residual, float(p["ac"]), rep.noise_rms, z=z)
+        flagged = flagged or bool(bb and bb["flagged"])
+    return bool(flagged)
+
+
+def _flag(m: dict | None) -> str:
+    """The misfit flag's verdict and T over its threshold."""
+    if m is None:
+        return "-"
+    return f"{'FLAG' if m['flagged'] else 'no'} {m['T_over_threshold']:.2f}"
 
 
 def main(argv: list[str]) -> None:
@@ -128,7 +181,7 @@ def main(argv: list[str]) -> None:
         rows.append(row)
         print(json.dumps(row, default=str), flush=True)
     print()
-    print(f"{'record':<16}{'regime a/d':<30}{'h0 a':>9}{'h0 d':>9}{'ratio':>7}  named")
+    print(f"{'record':<16}{'regime a/d':<30}{'h0 a':>9}{'h0 d':>9}{'ratio':>7}  misfit  named")
     for r in rows:
         if "error" in r:
             print(f"{r['record']:<16}ERROR {r['error'][:100]}")
@@ -138,7 +191,7 @@ def main(argv: list[str]) -> None:
         print(
             f"{r['record']:<16}{reg:<30}{r['h0_analyze'] or float('nan'):>9.4g}"
             f"{r['h0_final']:>9.4g}{ratio if ratio else float('nan'):>7.3f}  "
-            f"{', '.join(r['named']) or '-'}"
+            f"{_flag(r.get('misfit')):<7} {', '.join(r['named']) or '-'}"
         )
 
 

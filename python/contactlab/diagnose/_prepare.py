@@ -119,6 +119,9 @@ def subsample_long(t: np.ndarray, u: np.ndarray, y: np.ndarray) -> tuple[Prepare
     )
     extra: dict[str, Any] = {
         "u_raw": u[g], "u_noise": sig, "u_filter": wf, "knots": knots, "raw_input": raw,
+        # the measured input at the raw rate and which turning points were kept, for the
+        # errors-in-variables simulation (:func:`.eiv.eiv_bias`, its noise spectrum)
+        "u_measured": u, "raw_exact": exact,
     }  # fmt: skip
     d = Prepared(t[g], uf[g], y[g], dt * q, smooth_window(per / q), ud[g], udd[g], cycles, extra)
     how = []
