@@ -66,17 +66,3 @@ def test_grid_evaluation_work_is_bounded_and_a_failed_solve_holds_its_last_value
     assert out.shape == t.shape and np.all(np.isfinite(out))
     np.testing.assert_array_equal(out[: res.delta.size], res.delta)
     assert np.all(out[res.delta.size :] == res.delta[-1])
-
-
-def test_base_lower_bounds_keep_the_masing_element_defined():
-    # a virgin curve with zero initial slope (1 - (1 + u) e^-u) drove a one-sided difference
-    # step of the base fit to ac = 0 exactly, and the diagnosis stopped with the element's
-    # "ac must be finite and > 0" (independent generator, seeds 528174202 and 614094203)
-    from contactlab.diagnose.candidates_tangential import BASE_PARAMS, TangentialFamily
-    from contactlab.masing import Masing
-
-    lower = {p.name: p.lower for p in BASE_PARAMS}
-    assert lower["h0"] > 0 and lower["ac"] > 0
-    assert TangentialFamily.ac_floor > 0
-    f = Masing(lower["h0"], lower["ac"]).force(np.linspace(0.0, 1e-3, 50))
-    assert np.all(np.isfinite(f))

@@ -29,3 +29,22 @@ def test_trial_fit_reaching_ac_zero_is_a_candidate_not_fitted() -> None:
     failed = [v for v in tried if v.reason.startswith("could not be fitted")]
     assert any("ac must be" in v.reason for v in failed)
     assert not any(v.accepted for v in failed)
+
+
+def test_drop_check_whose_refit_leaves_the_domain_keeps_the_effect(monkeypatch) -> None:
+    # the backward step's refit without an effect (search._drop_check) reached ac = 0 in a
+    # difference step on a zero-initial-slope virgin curve (independent generator, seeds
+    # 528174202 and 614094203) and the InputError ended the diagnosis: it is a verdict now
+    from contactlab.diagnose import search
+    from contactlab.errors import InputError
+
+    def out_of_domain(*args, **kwargs):
+        raise InputError("ac must be finite and > 0, got 0.0")
+
+    monkeypatch.setattr(search, "evaluate", out_of_domain)
+    current = type("T", (), {"effects": ("backlash",), "full": type("F", (), {"params": {}})})
+    verdict, reduced = search._drop_check(
+        "backlash", None, current, None, {}, 2, 1.0, 3.0, 0.05, 0.0
+    )  # fmt: skip
+    assert reduced is None and not verdict.accepted
+    assert verdict.reason.startswith("could not be fitted: ac must be")

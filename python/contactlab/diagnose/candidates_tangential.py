@@ -85,14 +85,9 @@ _INF = np.inf
 EFFECTS = registry("tangential")
 CANDIDATES: dict[str, Candidate] = {name: e.candidate for name, e in EFFECTS.items()}
 
-#: the base's lower bounds: strictly positive, as the Masing element needs (a zero-slope
-#: virgin curve drove the fit's one-sided difference step to ac = 0 exactly, and the
-#: diagnosis stopped with "ac must be finite and > 0")
-_POSITIVE = float(np.finfo(np.float64).tiny)
-
 BASE_PARAMS = (
-    ParamSpec("h0", "N", _INF, _POSITIVE, _INF, "F"),
-    ParamSpec("ac", "1/m", _INF, _POSITIVE, _INF, "ac"),
+    ParamSpec("h0", "N", _INF, 0.0, _INF, "F"),
+    ParamSpec("ac", "1/m", _INF, 0.0, _INF, "ac"),
 )
 
 #: a normal-load fluctuation must make this many periods in the record; slower, it is a drift
@@ -180,7 +175,7 @@ class TangentialFamily:
     quick_polish = True
     #: the base's h0 held to this band and ac to at least ``ac_floor`` (:meth:`anchor`)
     h0_band: tuple[float, float] | None = None
-    ac_floor: float = _POSITIVE
+    ac_floor: float = 0.0
 
     @property
     def base_params(self) -> tuple[ParamSpec, ...]:
@@ -233,7 +228,7 @@ class TangentialFamily:
         band = max(ANCHOR_BAND * se_pl, H0_HOLD * h0_pl)
         self.h0_band = (h0_pl - band, h0_pl + band)
         if ac_lb is not None and np.isfinite(ac_lb):
-            self.ac_floor = max(min(float(ac_lb), p["ac"]), _POSITIVE)
+            self.ac_floor = min(float(ac_lb), p["ac"])
         err = float(np.hypot(se["h0"] if np.isfinite(se["h0"]) else 0.0, se_pl))
         off = abs(p["h0"] - h0_pl) / err
         if off <= ANCHOR_SIGMAS and abs(p["h0"] - h0_pl) <= band:

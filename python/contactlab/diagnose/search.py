@@ -282,7 +282,10 @@ def _drop_check(
     rest = tuple(e for e in current.effects if e != name)
     try:
         reduced = evaluate(family, rest, d, current.full.params, scales, folds)
-    except ConvergenceError as exc:
+    except (ConvergenceError, InputError) as exc:
+        # as in a forward trial (_try_candidate): a refit that steps out of the model's
+        # domain (a zero-slope virgin curve drove ac to its bound 0 in a difference step:
+        # "ac must be finite and > 0") cannot judge the effect, which is then kept
         return _not_fitted(name, exc), None
     extra = _noise_floor(family, (name,), budget)  # the forward rule's (_try_candidate)
     prop = d if _proportional(family, (name,)) else None
