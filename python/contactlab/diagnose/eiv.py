@@ -161,12 +161,14 @@ def is_coloured(d: Prepared, spec: InputNoise) -> bool:
 def reweighted(
     d: Prepared, slope: np.ndarray | None, sigma: float, white_seen: float, seen: float
 ) -> Prepared:
-    """``d`` with its errors-in-variables sample weights (``d.extra["weight"]``,
-    ``σy² / (σy² + (s σu')²)`` times any prior weight) recomputed for the input noise the
-    candidates see read from its spectrum (``seen``) instead of the white estimate
-    (``white_seen``): where a coloured input noise dominates the output's error (steep
-    branches after a reversal), the misfit tests leave the samples out (:data:`.misfit.
-    MIN_WEIGHT`). ``d`` itself when nothing changes."""
+    """Recompute the errors-in-variables sample weights for the input noise read from its spectrum.
+
+    The weights (``d.extra["weight"]``, ``σy² / (σy² + (s σu')²)`` times any prior weight)
+    are recomputed for the input noise the candidates see read from its spectrum (``seen``)
+    instead of the white estimate (``white_seen``): where a coloured input noise dominates
+    the output's error (steep branches after a reversal), the misfit tests leave the
+    samples out (:data:`contactlab.diagnose.misfit.MIN_WEIGHT`). Returns ``d`` itself when
+    nothing changes."""
     w = d.extra.get("weight")
     if slope is None or w is None or not (seen > white_seen and sigma > 0):
         return d
