@@ -11,7 +11,7 @@ $(STAMP): pyproject.toml
 	python3 -m venv $(VENV)
 	$(PIP) install -q --upgrade pip
 	$(PIP) install -q "maturin>=1.9,<2" "numpy>=1.24" "scipy>=1.10" "matplotlib>=3.7" \
-		"pytest>=8" "hypothesis>=6.100" "ruff>=0.6" "mypy>=1.10" "npTDMS>=1.9" "h5py>=3.9" "pyarrow>=14" "tqdm>=4.60" \
+		"pytest>=8" "pytest-timeout>=2.2" "hypothesis>=6.100" "ruff>=0.6" "mypy>=1.10" "npTDMS>=1.9" "h5py>=3.9" "pyarrow>=14" "tqdm>=4.60" \
 		"dask[distributed]>=2024.1" "threadpoolctl>=3.1" "import-linter>=2.1"
 	touch $(STAMP)
 
@@ -47,6 +47,8 @@ py-lint: develop
 	$(VENV)/bin/ruff format --check $(PYSRC)
 	$(VENV)/bin/lint-imports
 
+# Every test has a deadline (pytest-timeout, pyproject.toml): a test that hangs fails alone
+# with the stacks of its threads, instead of holding the suite until CI's own limit.
 pytest: develop
 	$(PY) -m pytest -q -p no:cacheprovider
 
