@@ -65,6 +65,17 @@ class SeriesCompliance(EffectModel):
         bx, bf = series_backbone(p["h0"], p["ac"], max(p["C_s"], 0.0), xmax)
         return Masing.from_backbone(bx, bf)
 
+    def base_equivalent(self, p):
+        """The loop's initial stiffness is the contact's and the compliance's in series,
+        ``1/(1/(h0·ac) + C_s)`` (docs/effects.md): the base alone reads that as its ``h0·ac``
+        (the plateau ``h0`` stays). Compared raw, the contact's own ``h0·ac`` behind a
+        compliance of a third of its stiffness looked like a base taken over (rig tuning
+        seeds 73002, 73005: h0·ac from 1.15e6 to 1.61e6 N/m, the truth 1.6e6, and the
+        compliance refused at 2x its stated bound)."""
+        k0 = p["h0"] * p["ac"]
+        c = max(float(p.get("C_s", 0.0)), 0.0)
+        return {"ac": p["ac"] / (1.0 + c * k0)} if k0 > 0 else {}
+
     def derived(self, p, se, **more):
         if p["C_s"] > 0:
             return {"k_s": 1.0 / p["C_s"]}, {"k_s": se["C_s"] / p["C_s"] ** 2}
