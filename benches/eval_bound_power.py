@@ -184,7 +184,8 @@ def tables(res: list[dict]) -> str:
             continue
         b = r["bound"]
         lines.append(
-            head + f"clean {r['clean_named']}, bound {b if b is None else f'{b:.3g}'}"
+            head
+            + f"clean {r['clean_named']}, bound {b if b is None else f'{b:.3g}'}"
             + (f" ({r['reason'][:90]})" if b is None else "")
         )
         for run in r["runs"]:

@@ -3,7 +3,6 @@ compares these with the base fit), against the sheared backbone's own initial sl
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
