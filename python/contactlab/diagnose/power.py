@@ -579,6 +579,11 @@ def _detectable(
     refused = _refusal(family, name, effects, mags, shape)
     if refused is not None:
         return refused
+    apart = _not_separable(family, name, d, params)
+    if apart:
+        first = mags[0]
+        return Detectable(name, first.name, None, first.unit, first.null, None, shape,
+                          reason=apart)  # fmt: skip
     st = _setting_cache
     if st is None:
         slope = model_slope(family, params, d)
@@ -612,6 +617,22 @@ def _detectable(
         name, worst.name, per[worst.name], worst.unit, worst.null, rel[worst.name], shape, per,
         gain_at_bound=gain[worst.name],
     )  # fmt: skip
+
+
+def _not_separable(family: Family, name: str, d: Prepared, params: dict[str, float]) -> str:
+    """Why no size of the effect can be promised on this record (the effect's
+    ``not_separable(d, p)``: a mass on a single-frequency drive is a negative parallel
+    stiffness), or empty."""
+    from .effects import registry
+
+    eff = registry(getattr(family, "kind", "")).get(name)
+    how = getattr(eff, "not_separable", None)
+    if how is None:
+        return ""
+    try:
+        return str(how(d, params) or "")
+    except (ValueError, KeyError, FloatingPointError):
+        return ""
 
 
 def _plausible_from(
