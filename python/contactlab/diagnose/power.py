@@ -748,6 +748,7 @@ def _per_parameter(
     steady = steady_samples(d) if derived else None
     rivals = _rival_directions(family, p0, trial, name, ds, scales)
     prop = proportional_gain(family, name)
+    margin = power_margin(family, name)
     st = _own_floor(family, name, d, st)
     for s in mags:
         j = _derivative(family, p0, trial, ds, s, _step(s, s.null, scales))
@@ -773,6 +774,8 @@ def _per_parameter(
                 break
             jp = jp * np.sqrt(max(left, 1e-6))
             b = _bound(jp, st, ident, prop)
+        if b is not None:
+            b *= margin  # the effect's calibration against its own simulations
         if b is not None and b >= max(s.upper - s.null, s.null - s.lower):
             b = None  # beyond the parameter's range (a loss asymmetry |a| < 1): no bound
         r = None if b is None else b * float(np.sqrt(np.mean(j * j))) / st.y_rms
@@ -966,6 +969,20 @@ def _own_floor(family: Family, name: str, d: Prepared, st: _Setting) -> _Setting
     mg, budget = float(rules["min_gain"]), float(rules["budget"])
     floor = own_gain_floor(family, (name,), mg) + _noise_floor(family, (name,), budget)
     return dataclasses.replace(st, gain_floor=max(floor, st.rel_floor))
+
+
+def power_margin(family: Family, name: str) -> float:
+    """The factor candidate ``name``'s linearised bound is widened by (the effect's
+    ``power_margin``, default 1): what the simulations of the effect hidden at its stated
+    bound measured beyond the linearised power (the plausibility refusals, the fits'
+    scatter), so that the bound keeps its 95 % promise."""
+    from .effects import registry
+
+    try:
+        eff = registry(getattr(family, "kind", "")).get(name)
+    except KeyError:
+        return 1.0
+    return float(getattr(eff, "power_margin", 1.0))
 
 
 def proportional_gain(family: Family, name: str) -> bool:

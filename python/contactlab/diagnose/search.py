@@ -599,6 +599,8 @@ class StepwiseSearch:
                 best = (v, cand)
             if cand is not None and v.accepted:
                 accepted.append((v, cand))
+        accepted, verdicts = _yield_to_lookalikes(self.family, accepted, verdicts)
+        best = max(accepted, key=lambda vc: vc[0].gain) if accepted else None
         best = _parsimonious(best, accepted)
         if verdicts:
             st.steps[-1] = dataclasses.replace(
@@ -751,6 +753,34 @@ class StepwiseSearch:
             others = ", ".join(m for m in members if m != v.name)
             self._drop(st, v, "parsimony", f"it acts through the {group} as {others} does, and "
                        f"is not separately significant after it: {v.reason}")  # fmt: skip
+
+
+def _yield_to_lookalikes(
+    family: Family, accepted: list[tuple[Verdict, Trial]], verdicts: list[Verdict]
+) -> tuple[list[tuple[Verdict, Trial]], list[Verdict]]:
+    """``accepted`` and ``verdicts`` with the candidates that yield to a look-alike accepted
+    at the same step refused: an effect's ``yields_to(p, gains, own)`` (the fitted
+    parameters, the accepted candidates' held-out gains, its own) says why its fit is
+    another effect's signature (a speed-strengthening Stribeck term beside a mass or a
+    series compliance), or None."""
+    from .effects import registry
+
+    try:
+        reg = registry(family.kind)
+    except KeyError:
+        return accepted, verdicts
+    gains = {v.name: v.gain for v, _ in accepted}
+    keep, refused = [], {}
+    for v, cand in accepted:
+        hook = getattr(reg.get(v.name), "yields_to", None)
+        why = None if hook is None else hook(cand.full.params, gains, v.gain)
+        if why:
+            refused[v.name] = dataclasses.replace(v, accepted=False, reason=f"look-alike: {why}")
+        else:
+            keep.append((v, cand))
+    if not refused:
+        return accepted, verdicts
+    return keep, [refused.get(v.name, v) if v.accepted else v for v in verdicts]
 
 
 #: accepted candidates whose held-out gains lie within this share of the best one's are a

@@ -46,6 +46,12 @@ class ForceDrift(EffectModel):
     #: the share of ``min_gain`` its held-out gain must reach (search.own_gain_floor); the
     #: relative rule (1 % of the remaining error) and the significance rules still apply
     gain_floor_scale = GAIN_FLOOR_SCALE
+    #: the stated bound's widening (:func:`contactlab.diagnose.power.power_margin`): hidden
+    #: at the linearised bound, a drift was named 6 times in 8 last stop
+    #: (``benches/eval_slow_power.py``, seeds 20777000-7) and 3 in 4 on rig tuning seeds
+    #: 73001-73005 of ``benches/eval_bound_power.py`` (the miss: t = 2.1 < 3), 4 in 4 at
+    #: twice it; the per-cycle t of a ramp scatters more than the linearised draws say
+    power_margin = 1.3
 
     def apply(self, F, p, ctx):
         d = ctx.d
