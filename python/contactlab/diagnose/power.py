@@ -43,8 +43,10 @@ the bound stated on a clean record of either generator (the package's and the ri
 simulator), fresh noise; see ``benches/results/eval_power_calibration.txt``. Not modelled:
 the parsimony rule between velocity-like effects, the plausibility refusals ("takes over
 the base model" in deep pre-sliding), and effects whose generator's signature differs from
-the library's model (the rig's inertia on a single sine is a negative parallel stiffness,
-told apart only by the start from rest): there the bound is optimistic.
+the library's model. A mass on a single-frequency drive is a negative parallel stiffness,
+told apart only by the start from rest: no bound is stated there (the effect's
+``not_separable``). Where the simulations of an effect hidden at its bound measured less
+than the linearised power, the bound is widened by the effect's ``power_margin``.
 The BIC rule (``k ln n`` over a fit of at most 5000 samples) is far weaker than the gain
 rule and is not modelled. The proportional t of rule 2 is, linearised (:func:`_proportional_t`),
 for an effect's own ``proportional_gain`` and for a family's (normal contact): without it
