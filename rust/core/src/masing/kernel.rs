@@ -139,7 +139,8 @@ pub(super) enum Forces {
 /// compiled for SIMD level `level` (every level gives the same forces bit for bit). The caller
 /// has checked that `state.count + x.len()` fits in 63 bits and that [`takes`] `state`. The
 /// input's and the forces' finiteness are checked block by block while the block is in cache
-/// (the input before its block is run: no separate pass over `x`).
+/// (no separate pass over `x`): the input before its block is run on the block path (the same
+/// scan finds its turning points), after its first pass on the dense path (from L1).
 pub(super) fn scaled_force<C: Backbone>(
     level: Level,
     curve: &C,
