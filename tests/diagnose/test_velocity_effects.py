@@ -191,3 +191,21 @@ def test_a_drive_with_a_third_harmonic_is_not_one_frequency():
     d = Prepared.build(t, x, 40.0 * np.tanh(4e4 * x))
     FAM.prepare(d)
     assert single_frequency(d) is None
+
+
+def test_no_spring_is_promised_where_the_loops_never_reach_a_plateau(presliding_mass):
+    """ac·A 0.38: the base absorbs a parallel spring as a stronger, stiffer contact (the rig
+    named one at its former bound and at twice it 0 times in 10 at ac·A 0.66-1.17)."""
+    _, rep = presliding_mass
+    b = {x.effect: x for x in rep.not_detected}["parallel_stiffness"]
+    assert b.detectable_above is None
+    assert b.reason.startswith("not separable from the contact's own stiffness")
+
+
+def test_a_spring_is_promised_in_gross_sliding():
+    reg = registry("tangential")
+    d, _, _ = _noisy_sine()
+    A = 0.5 * float(np.ptp(d.u))
+    assert reg["parallel_stiffness"].not_separable(d, {"h0": 40.0, "ac": 3.0 / A}) is None
+    why = reg["parallel_stiffness"].not_separable(d, {"h0": 40.0, "ac": 1.0 / A})
+    assert "ac·A = 1 < 1.5" in why

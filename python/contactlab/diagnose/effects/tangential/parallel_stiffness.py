@@ -8,6 +8,11 @@ from ..._family import ParamSpec
 from .._base import EffectModel, register
 from ._common import amplitude, single_frequency
 
+#: below this ``ac·A`` the loops never reach their plateau and no parallel spring is
+#: promised (:meth:`ParallelStiffness.not_separable`): a branch of ``2A`` ends at
+#: ``exp(-ac·A)`` of its initial slope, 22 % at 1.5
+PLATEAU_ACA = 1.5
+
 
 @register
 class ParallelStiffness(EffectModel):
@@ -44,6 +49,29 @@ class ParallelStiffness(EffectModel):
                 f"sets k_p - mω² = {p['k_p']:.4g} N/m; a positive value cannot be a mass"
             )
         return text
+
+    def not_separable(self, d, p):
+        """Why no spring can be promised where the loops never reach their plateau
+        (``ac·A`` below :data:`PLATEAU_ACA`), or None: there the base absorbs ``k_p x`` as
+        a stronger, stiffer contact (docs/effects.md: only a flat plateau tells a spring
+        beside the contact from it). On the rig a spring at its stated bound and at twice
+        it was named 0 times in 10 at ac·A 0.66-1.17, and the base took it as h0 = 118 N
+        for 40 (in-sample gain 0.025 σ² at the bound, 0.012 σ² at twice it; tuning seed
+        73003 of ``benches/eval_bound_power.py``); at ac·A 1.98-4.8 it was named 10 times
+        in 12."""
+        h0, ac = float(p.get("h0", np.nan)), float(p.get("ac", np.nan))
+        a = amplitude(d)
+        if not (np.isfinite(ac) and ac > 0 and a > 0 and np.isfinite(h0)):
+            return None
+        aca = ac * a
+        if aca >= PLATEAU_ACA:
+            return None
+        return (
+            "not separable from the contact's own stiffness on this record: its loops never "
+            f"reach a plateau (ac·A = {aca:.2g} < {PLATEAU_ACA:g}), and only a flat plateau "
+            "tells a spring beside the contact from a stronger, stiffer contact (the base "
+            "absorbs k_p x as a larger h0)"
+        )
 
     def power_note(self, d, p):
         """What a single-frequency drive means for the stated bound (empty otherwise)."""
