@@ -133,6 +133,16 @@ fn hermite_work(e: &Ends, (f0, kt0, ct0): (f64, f64, f64), (f1, kt1, ct1): (f64,
     0.5 * e.h * (g0 + g1) + e.h * e.h / 12.0 * (dg0 - dg1)
 }
 
+/// `∫ F dd` of a rate-independent joint over a monotone move by `dd` on one branch, by the
+/// two-point Hermite rule in `d` (exact for a cubic `F(d)`): the force and the tangent along
+/// the move at both ends. (The same rule in time, `∫ F ḋ dt`, also depends on the ends'
+/// velocities and accelerations: for Masing joints 1e-4 of the input work off at small
+/// amplitudes, against 1e-5 with this.)
+#[inline(always)]
+fn masing_work(dd: f64, (f0, k0): (f64, f64), (f1, k1): (f64, f64)) -> f64 {
+    0.5 * dd * (f0 + f1) + dd * dd / 12.0 * (k0 - k1)
+}
+
 /// The Richardson extrapolation of a joint's work over a step-doubling piece: forces `f0` at
 /// the start `x0` and `kept` (coarse end, midpoint, fine end) at `(xc, xm, xf)`.
 #[inline(always)]
@@ -332,7 +342,11 @@ impl Joints for Dyn<'_> {
                 (0.0, 0.0)
             };
             let (f0, f1) = (self.jf[jn], tr.f);
-            self.jwork[jn] += hermite_work(e, (f0, kt + d0, ct), (f1, tr.kt + d1, tr.ct));
+            self.jwork[jn] += if matches!(j.law, JointLaw::Masing { .. }) {
+                masing_work(x1 - x0, (f0, kt + d0), (f1, tr.kt + d1))
+            } else {
+                hermite_work(e, (f0, kt + d0, ct), (f1, tr.kt + d1, tr.ct))
+            };
         }
         let parts = self.joints.iter().zip(&self.trials).zip(&mut self.states);
         let books = self.jf.iter_mut().zip(&mut self.tang);
@@ -561,9 +575,9 @@ impl Joints for MasingExp {
     }
 
     #[inline(always)]
-    fn commit_hermite(&mut self, _x0: f64, x1: f64, e: &Ends) -> Result<(), CoreError> {
+    fn commit_hermite(&mut self, x0: f64, x1: f64, e: &Ends) -> Result<(), CoreError> {
         let k1 = self.kt + e.dk.1;
-        self.jwork += hermite_work(e, (self.jf, e.kt0, 0.0), (self.f, k1, 0.0));
+        self.jwork += masing_work(x1 - x0, (self.jf, e.kt0), (self.f, k1));
         masing_commit(&mut self.st, x1, self.f, self.aux);
         self.refresh();
         self.argl = f64::NAN;

@@ -259,6 +259,7 @@ pub(super) fn piece(
             if j.law.kink(st, d1).is_some() != hm.crossed[jn] {
                 let tr = j.law.trial(st, w.jd[jn], d1, rel(j, &sc.v1));
                 hm.end[jn] = (tr.kt, tr.ct);
+                hm.end_j[jn] = hm.end[jn];
                 sc.trials[jn] = tr;
                 again = true;
             }
@@ -342,10 +343,17 @@ pub(super) fn accept(
         let (v0, a0, v1, a1) = (w.jv[jn], rel(j, &w.a), rel(j, &sc.v1), rel(j, &sc.a1));
         let ((kt0, ct0), (kt1, ct1)) = (hm.start[jn], hm.end[jn]);
         let f0 = w.jf[jn];
-        let g0 = (f0 * v0, (kt0 * v0 + ct0 * a0) * v0 + f0 * a0);
-        let g1 = (tr.f * v1, (kt1 * v1 + ct1 * a1) * v1 + tr.f * a1);
-        w.jwork[jn] += rule(h, g0, g1);
         let d1 = rel(j, &sc.x1);
+        if matches!(j.law, JointLaw::Masing { .. }) {
+            // the Hermite rule in d (rate-independent; as the one-DOF path's `masing_work`),
+            // with the tangents of the branch the piece is on at both ends
+            let (dd, k1) = (d1 - w.jd[jn], hm.end_j[jn].0);
+            w.jwork[jn] += 0.5 * dd * (f0 + tr.f) + dd * dd / 12.0 * (kt0 - k1);
+        } else {
+            let g0 = (f0 * v0, (kt0 * v0 + ct0 * a0) * v0 + f0 * a0);
+            let g1 = (tr.f * v1, (kt1 * v1 + ct1 * a1) * v1 + tr.f * a1);
+            w.jwork[jn] += rule(h, g0, g1);
+        }
         j.law.commit(&mut w.states[jn], w.jd[jn], d1, tr)?;
         w.jf[jn] = tr.f;
         w.jd[jn] = d1;
