@@ -250,6 +250,57 @@ impl JointLaw {
         }
     }
 
+    /// The first stick-slip transition of a Jenkins/Iwan element on the monotone move
+    /// `d_old → d_new` from `state` beyond the fraction `floor` of the move (an element's force
+    /// is linear in `d` while it sticks), as a fraction of the move; `None`: none, or another
+    /// law. (Transitions at most `floor` in are left to the piece that contains them, so that
+    /// they do not hide a later event.)
+    #[inline]
+    pub fn slip_after(
+        &self,
+        state: &JointState,
+        d_old: f64,
+        d_new: f64,
+        floor: f64,
+    ) -> Option<f64> {
+        let dd = d_new - d_old;
+        if dd == 0.0 {
+            return None;
+        }
+        let mut theta: Option<f64> = None;
+        let mut stick_slip = |k: f64, fs: f64, f0: f64| {
+            let ft = f0 + k * dd;
+            if f0.abs() < fs && ft.abs() > fs {
+                let t = (fs.copysign(ft) - f0) / (k * dd);
+                if t > floor && t < 1.0 {
+                    theta = Some(theta.map_or(t, |a: f64| a.min(t)));
+                }
+            }
+        };
+        match (self, state) {
+            (Self::Jenkins { k, fs }, JointState::Slider(f0)) => stick_slip(*k, *fs, *f0),
+            (Self::Iwan { k, fs }, JointState::Sliders(f0)) => {
+                for ((&ki, &fi), &f0i) in k.iter().zip(fs).zip(f0) {
+                    stick_slip(ki, fi, f0i);
+                }
+            }
+            _ => {}
+        }
+        theta
+    }
+
+    /// Whether the trial `tr` from `state` crossed a Masing branch's closure (its memory walk
+    /// dropped a branch: fewer branches kept than it started with). `false` for other laws.
+    #[inline]
+    pub fn closed(&self, state: &JointState, tr: &Trial) -> bool {
+        match (self, state) {
+            (Self::Masing { .. }, JointState::Masing(st)) => {
+                tr.aux / 2 < st.stack.len().saturating_add(tr.aux & 1)
+            }
+            _ => false,
+        }
+    }
+
     /// A Bouc-Wen joint with `ν = 1` whose `z` changes sign over the trial `tr` from `state`:
     /// `(z0, z1, Δ)` with `Δ` the jump of `∂(dz/dd)/∂z` there (`−βδ (sgn z1 − sgn z0)`; the
     /// rate `dz/dd` itself is continuous, `α`, so the force's second time derivative jumps by

@@ -85,6 +85,11 @@ trait Joints {
     fn kink(&self, x1: f64) -> Option<(f64, f64)>;
     /// Whether [`Joints::kink`] can name one (a Masing joint in the set).
     fn kinks(&self) -> bool;
+    /// The first stick-slip transition beyond the fraction `floor` of the monotone move
+    /// `x0 → x1`, as a fraction of the move ([`JointLaw::slip_after`]); 1 when none.
+    fn slip(&self, _x0: f64, _x1: f64, _floor: f64) -> f64 {
+        1.0
+    }
     /// Where a Bouc-Wen joint's `z` crosses 0 on the step last tried from `x0` (to `x1`, over
     /// `h`, velocities `v0 → v1`), as a fraction of the step (the root of the cubic through
     /// `z` and `ż = k_t ḋ` at the ends), and `Δ α` ([`JointLaw::zero_crossing`]): the jump of
@@ -270,6 +275,17 @@ impl Joints for Dyn<'_> {
         self.joints
             .iter()
             .any(|j| matches!(j.law, JointLaw::Masing { .. }))
+    }
+
+    #[inline]
+    fn slip(&self, x0: f64, x1: f64, floor: f64) -> f64 {
+        let mut theta = 1.0_f64;
+        for (j, st) in self.joints.iter().zip(&self.states) {
+            if let Some(th) = j.law.slip_after(st, x0, x1, floor) {
+                theta = theta.min(th);
+            }
+        }
+        theta
     }
 
     fn zero_crossings(&self) -> bool {

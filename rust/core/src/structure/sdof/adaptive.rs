@@ -220,7 +220,19 @@ fn hermite<J: Joints>(
     // tangents by its last update, as the corrections below carry them
     let quick = jt.quick().min(opts.rtol.sqrt());
     let (st, iters) = newton(jt, (m, c, k), w, (w.x, quick), h, f1, opts)?;
-    let mut theta = jt.event(w.x, st.x1, w.v, st.v1);
+    // A stick-slip transition (linear in the displacement while stuck): where the cubic
+    // through the ends' displacements and velocities reaches it (the fraction of the move is
+    // not that of the time: a piece ended there would land short, again and again). Events at
+    // most `min_piece` in are left to this piece (they would hide a later one, e.g. a
+    // reversal).
+    let mut theta = jt.slip(w.x, st.x1, min_piece);
+    if theta < 1.0 && w.v * st.v1 >= 0.0 {
+        let xk = w.x + theta * (st.x1 - w.x);
+        theta = cubic_root(theta, (w.x - xk, h * w.v), (st.x1 - xk, h * st.v1));
+    }
+    if theta <= min_piece {
+        theta = 1.0;
+    }
     if w.v * st.v1 < 0.0 {
         // a velocity reversal: where the cubic through the ends' velocities and accelerations
         // has its root (the linear guess is off by O(h²), and the monotone path a trial

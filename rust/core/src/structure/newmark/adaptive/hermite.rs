@@ -184,13 +184,9 @@ pub(super) fn piece(
     for ((a1, a0), j0) in sc.a1.iter_mut().zip(&w.a).zip(&hm.j0) {
         *a1 = a0 + h * j0;
     }
-    // Newton ends without a last trial once converged quadratically (as the one-DOF path),
-    // except with Masing joints (whose crossing of a closure is read from the trial point)
-    let quick = if hm.kinks {
-        0.0
-    } else {
-        opts.rtol.sqrt().min(1e-3)
-    };
+    // Newton ends without a last trial once converged quadratically (as the one-DOF path; a
+    // Masing joint's crossing of a closure is then read from its trial's memory walk)
+    let quick = opts.rtol.sqrt().min(1e-3);
     let it = newton_step(s, w, (h, quick, true), sc, opts)?;
     let mut theta = 1.0_f64;
     let min_piece = 1e-3 / step;
@@ -198,7 +194,17 @@ pub(super) fn piece(
         let (d1, v1) = (rel(j, &sc.x1), rel(j, &sc.v1));
         let (d0, v0) = (w.jd[jn], w.jv[jn]);
         let (st, tr) = (&w.states[jn], &sc.trials[jn]);
-        let mut th = j.law.event(st, d0, d1, v0, v1).unwrap_or(1.0);
+        // (a stick-slip transition placed on the cubic through the ends' relative
+        // displacements and velocities, as the one-DOF path; events at most `min_piece` in
+        // left to this piece, so that they do not hide a later one)
+        let mut th = j.law.slip_after(st, d0, d1, min_piece).unwrap_or(1.0);
+        if th < 1.0 && v0 * v1 >= 0.0 {
+            let dk = d0 + th * (d1 - d0);
+            th = reversal(th, (d0 - dk, h * v0), (d1 - dk, h * v1));
+        }
+        if th <= min_piece {
+            th = 1.0;
+        }
         if v0 * v1 < 0.0 {
             let lin = v0 / (v0 - v1);
             if th >= lin {
@@ -210,11 +216,10 @@ pub(super) fn piece(
         hm.end_j[jn] = hm.end[jn];
         hm.dt[jn] = (d1, v1);
         hm.ft[jn] = tr.f;
-        hm.crossed[jn] = false;
+        hm.crossed[jn] = hm.kinks && j.law.closed(st, tr);
         if hm.kinks {
             if let Some((xk, dk)) = j.law.kink(st, d1) {
                 // a Masing branch closing (its tangent jumps by dk): as the one-DOF path
-                hm.crossed[jn] = true;
                 let lin = (xk - d0) / (d1 - d0);
                 let tk = reversal(lin, (d0 - xk, h * v0), (d1 - xk, h * v1));
                 if tk <= min_piece {
@@ -226,7 +231,9 @@ pub(super) fn piece(
                 }
             }
         }
-        theta = theta.min(th);
+        if th > min_piece {
+            theta = theta.min(th);
+        }
     }
     jerk(s, hm, (&w.v, &w.a), true);
     let (h2, h3) = (h * h, h * h * h);
