@@ -107,7 +107,10 @@ def _band(name: str, r: dict[str, Any]) -> str:
 def table(rs: list[dict[str, Any]], title: str) -> str:
     ok = [r for r in rs if r["refused"] is None]
     lines = [f"\n{title}: {len(ok)} diagnosed ({len(rs) - len(ok)} refused)"]
-    lines.append(f"{'factor':<12}{'level':>10}{'n':>5}{'named':>7}{'flagged':>9}{'rate':>7}")
+    lines.append(
+        f"{'factor':<12}{'level':>10}{'n':>5}{'named':>7}{'flagged':>9}{'rate':>7}"
+        f"{'w/o rivals':>12}"
+    )
     for name in ("kind", "x colour", "x noise %", "ac·A", "cycles", "fs"):
         g: dict[str, list] = defaultdict(list)
         for r in ok:
@@ -115,23 +118,36 @@ def table(rs: list[dict[str, Any]], title: str) -> str:
         for lvl in sorted(g):
             k = sum(bool(r["named"]) for r in g[lvl])
             f = sum(r["flagged"] for r in g[lvl])
+            f0 = sum(_without_rivals(r) for r in g[lvl])
             lines.append(
                 f"{name:<12}{lvl:>10}{len(g[lvl]):>5}{k:>7}{f:>9}{100 * f / len(g[lvl]):>6.0f}%"
+                f"{f0:>12}"
             )
     f = sum(r["flagged"] for r in ok)
-    lines.append(f"all: flagged {f}/{len(ok)}")
+    f0 = sum(_without_rivals(r) for r in ok)
+    lines.append(f"all: flagged {f}/{len(ok)}; without the rival check {f0}/{len(ok)}")
     for r in ok:
         u = r.get("unexplained") or {}
         bb = u.get("backbone") or {}
-        sh = u.get("shape") or {}
+        rv = ",".join(f"{x['effect']} {x['share']:.2f}" for x in u.get("rivals") or [])
         lines.append(
             f"  {r['seed']} {r['kind']}: named {r['named']} flag {int(r['flagged'])} "
-            f"T/thr {_g(r.get('ratio'))} bb t {_g(bb.get('t'))} shape "
-            f"{_g(sh.get('z'))}/{_g(sh.get('z_crit'))} (fs {r['fs']:g} f {r['f']:.3g} cyc "
+            f"T/thr {_g(r.get('ratio'))} bb t {_g(bb.get('t'))} rivals [{rv}] "
+            f"(fs {r['fs']:g} f {r['f']:.3g} cyc "
             f"{r['cycles']} xn {100 * r['x_noise']:.2g}% {r.get('x_colour')} Fn "
             f"{100 * r['F_noise']:.2g}% acA {r['acA']:.3g} cpu {r['cpu']:.0f})"
         )
     return "\n".join(lines)
+
+
+def _without_rivals(r: dict[str, Any]) -> bool:
+    """The flag as the tree before the rival check raised it: the rival check runs last and
+    only adds ``rivals`` and sets ``flagged``, so the earlier flag is the phase bins' or the
+    free-form virgin curve test's (the same run, the same record)."""
+    u = r.get("unexplained") or {}
+    if not u.get("rivals"):
+        return bool(r["flagged"])
+    return bool(r.get("bins_flag") or (u.get("backbone") or {}).get("flagged"))
 
 
 def _g(v: Any) -> str:
