@@ -35,6 +35,12 @@ asks whether it predicts the held-out cycles: a virgin curve of another shape th
 effect (series compliance) absorbed in part leaves a residual too spread over the phase bins
 for ``T`` but shaped like a branch.
 
+A third check runs in the workflow once the model is final
+(:func:`contactlab.diagnose.shape.rival_share`): a named effect that a free-form virgin
+curve explains as well (a tanh virgin curve taken up by a normal-load fluctuation or a
+Stribeck term, after which the residual looks white) flags the misfit
+(:attr:`Unexplained.rivals`).
+
 When ``T`` exceeds the threshold, :func:`unexplained_structure` reports where the structure
 sits (the branch and the phase range of the bins with ``|t_b|`` above a Bonferroni level,
 merged into runs) and how large it is: the RMS and the peak of the binned means, in the
