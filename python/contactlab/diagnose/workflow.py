@@ -285,6 +285,7 @@ def diagnose(
     st = _search(b, names, d, folds, z, min_gain, max_effects, where)
     checks = _assess(b, d, st, names, z, min_gain, folds, declared_noise, location)
     checks = _withdraw(b, d, st, names, z, min_gain, folds, declared_noise, location, checks)
+    checks = _rivals(b, d, st, checks)
     if checks["unexplained"] is not None and checks["unexplained"].flagged:
         st.where.append(checks["unexplained"].sentence())
     report = _report(b.family, path, recording, regime, d, st, b.sigma, location)
@@ -473,6 +474,47 @@ def _withdraw(
         checks["unexplained"] = dataclasses.replace(
             checks["unexplained"], absorbing=tuple(absorbed)
         )
+    return checks
+
+
+def _rivals(b: _Base, d: Prepared, st: SearchState, checks: dict[str, Any]) -> dict[str, Any]:
+    """A named effect that a free-form virgin curve explains as well (issue 29 item 3).
+
+    A virgin curve of another shape is taken up by named effects that are no shape of the
+    branches (a tanh virgin curve named normal_load or stribeck): after them the residual
+    looks white and the misfit tests stay silent. For each named effect of
+    :data:`.shape.SHAPE_RIVALS` the final model is refitted without it, and a Masing
+    element with a free-form virgin curve is fitted to that refit's residual
+    (:func:`.shape.rival_share`): where it reaches :data:`.shape.RIVAL_SHARE` of the
+    effect's gain, the effect's evidence is equally a misfit of the branch shape, and the
+    misfit is flagged (``unexplained.rivals``; the effect stays named, with that caveat).
+    Returns the closing checks, updated."""
+    from .select import specs_for
+    from .shape import RIVAL_SHARE, RIVAL_SHARE_OWN, SHAPE_RIVALS, rival_share
+
+    u = checks["unexplained"]
+    p = dict(st.current.full.params)
+    effects = tuple(st.current.effects)
+    if u is None or b.family.kind != "tangential" or "ac" not in p:
+        return checks
+    r1 = -st.current.full_residual(d)
+    found: list[dict[str, Any]] = []
+    for e in effects:
+        if e not in SHAPE_RIVALS:
+            continue
+        rest = tuple(x for x in effects if x != e)
+        try:
+            f = fit(b.family, rest, d, np.ones(d.y.size, bool), p, b.scales)
+            r0 = d.y - b.family.predict(f.params, rest, d)
+        except (ConvergenceError, InputError):
+            continue
+        n_par = len(specs_for(b.family, effects)) - len(specs_for(b.family, rest))
+        got = rival_share(d, r1, r0, float(p["ac"]), b.sigma, n_par)
+        if got is not None and got["share"] >= RIVAL_SHARE_OWN.get(e, RIVAL_SHARE):
+            found.append({"effect": e, **got})
+    if not found:
+        return checks
+    checks["unexplained"] = dataclasses.replace(u, flagged=True, rivals=found)
     return checks
 
 
