@@ -253,19 +253,52 @@ def subsample_normal(t: np.ndarray, u: np.ndarray, y: np.ndarray) -> tuple[Prepa
     return d, f"the record of {n} samples was " + " and ".join(how)
 
 
+#: the input noise read from its spectrum sets the weights when it passes at least this many
+#: times what the white estimate says through the candidates' filter (the misfit test's
+#: :data:`contactlab.diagnose.eiv.COLOURED_RATIO`: white noise reads 0.9-1.1)
+SPECTRAL_WEIGHT_RATIO = 1.5
+
+
+def input_seen(d: Prepared) -> float:
+    """The input noise RMS per sample that the candidates see (after their zero-phase input
+    filter), and the one the detection's weights use (kept in ``d.extra["u_seen"]``).
+
+    The white estimate (:func:`~contactlab.diagnose._signal.input_noise`, from neighbouring
+    samples) times the filter's noise gain, unless the noise's spectrum
+    (:func:`contactlab.diagnose.eiv.input_noise_spectrum`) shows it coloured: an LVDT's
+    demodulator and a Bessel anti-alias filter low-pass the sensor's noise, the white
+    estimate then sees a fifth of it or less, and the filter, which passes the drive's
+    band, removes little of it. Then what the spectrum passes through the filter is used
+    (when it exceeds :data:`SPECTRAL_WEIGHT_RATIO` times the white figure)."""
+    if "u_seen" in d.extra:
+        return float(d.extra["u_seen"])
+    from .eiv import input_noise_spectrum
+
+    su = float(d.extra.get("u_noise", 0.0) or 0.0)
+    wlen = int(d.extra.get("u_filter", 0))
+    gain = float(np.sum(savgol_coeffs(wlen, 3) ** 2)) if wlen else 1.0
+    seen = su * float(np.sqrt(gain))
+    spec = input_noise_spectrum(d) if su > 0 else None
+    if spec is not None and spec.seen > SPECTRAL_WEIGHT_RATIO * seen:
+        seen = float(spec.seen)
+    d.extra["u_seen"] = seen
+    return seen
+
+
 def eiv_weight(
     family: Family, params: dict[str, float], d: Prepared, sigma: float
 ) -> tuple[np.ndarray, float] | None:
     """Errors-in-variables weights of the samples and the candidates' gain budget.
 
     ``w = σy² / (σy² + (s σu')²)`` with ``s`` the base model's local slope ``|dy/du|``
-    (:meth:`Family.slope`) and ``σu'`` the noise left in the input the candidates see (the
-    estimated input noise times the filter's noise gain). The budget, in units of ``σy²``, is
-    the mean of ``(s σu')² w``: what the input's noise contributes to the weighted error,
-    the most that smoothing the input (a delay shorter than a sample) or absorbing the
-    noise's bias (turning points pushed outward) could lower it; every candidate's held-out
-    gain must beat it. None when the family has no slope or the input carries no measurable
-    noise.
+    (:meth:`Family.slope`) and ``σu'`` the noise left in the input the candidates see
+    (:func:`input_seen`: the white estimate times the filter's noise gain, or what the
+    noise's spectrum passes through the filter when it is coloured). The budget, in units
+    of ``σy²``, is the mean of ``(s σu')² w``: what the input's noise contributes to the
+    weighted error, the most that smoothing the input (a delay shorter than a sample) or
+    absorbing the noise's bias (turning points pushed outward) could lower it; every
+    candidate's held-out gain must beat it. None when the family has no slope or the input
+    carries no measurable noise.
     """
     su = float(d.extra.get("u_noise", 0.0))
     if not su > 0.0:
@@ -273,9 +306,8 @@ def eiv_weight(
     s = family.slope(params, d)
     if s is None:
         return None
-    wlen = int(d.extra.get("u_filter", 0))
-    gain = float(np.sum(savgol_coeffs(wlen, 3) ** 2)) if wlen else 1.0
-    var = (s * su) ** 2 * gain
+    seen = input_seen(d)
+    var = (s * seen) ** 2
     w = sigma**2 / (sigma**2 + var)
     prior = d.extra.get("weight")  # samples weighted out before (sticks, a filter's ends)
     if prior is None:

@@ -70,7 +70,8 @@ def assess(
     if spec is not None and is_coloured(d, spec):
         seen = max(seen, spec.seen)
         # the samples where that noise dominates the output's error are left out
-        dm = reweighted(d, slope, sigma, noise.input_seen, seen)
+        # (from the input noise the detection's weights already carry: d.extra["u_seen"])
+        dm = reweighted(d, slope, sigma, float(d.extra.get("u_seen", noise.input_seen)), seen)
     misfit = unexplained_structure(
         dm, tested, sigma, unit=family.output_unit,
         tolerance=eiv_tolerance(slope, seen, corrected=bias is not None),

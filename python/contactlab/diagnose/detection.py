@@ -52,10 +52,12 @@ from ._signal import noise_rms
 __all__ = [
     "FALSE_ALARM_RATE",
     "MISFIT_FALSE_ALARM",
+    "OUTPUT_COLOURED_RATIO",
     "ChannelNoise",
     "channel_noise",
     "effective_variance",
     "model_slope",
+    "output_noise_rms",
 ]
 
 #: the per-record false-alarm rate the naming rules are calibrated to stay below, and the
@@ -155,6 +157,8 @@ def channel_noise(
     gain = filter_noise_gain(d)
     if declared_output is not None:
         sy = float(declared_output)
+    elif "y_noise_spectral" in d.extra:  # coloured: the level the detection used
+        sy = float(d.extra["y_noise_spectral"])
     else:
         sy = noise_rms(residual)
         wlen = int(d.extra.get("u_filter", 0))
@@ -214,3 +218,83 @@ def model_slope(family: Any, params: dict[str, float], d: Prepared) -> np.ndarra
     if s is None and params.get("k", 0.0) > 0:
         s = np.full(d.y.size, 1.0 / float(params["k"]))
     return s
+
+
+#: the output noise read from the residual's spectrum replaces the white estimate (third
+#: differences, :func:`contactlab.diagnose._signal.noise_rms`) when it is this many times
+#: larger: white noise reads 0.9-1.2 (plus what the input's noise leaves through the slope,
+#: which is taken out), noise behind a Bessel anti-alias filter at 0.2-0.4 fs several times
+OUTPUT_COLOURED_RATIO = 1.5
+#: bins of Welch's periodogram either side of each drive harmonic that
+#: :func:`output_noise_rms` leaves out (the model's misfit and the effects are periodic:
+#: their residual sits on the harmonics; a Hann window's main lobe spans two bins)
+HARMONIC_GUARD_BINS = 2.5
+
+
+def output_noise_rms(
+    d: Prepared, residual: np.ndarray, slope: np.ndarray | None, white: float
+) -> float | None:
+    """The output channel's noise RMS read from the residual's spectrum, or None when it is
+    white (not :data:`OUTPUT_COLOURED_RATIO` times ``white``) or cannot be read.
+
+    An anti-alias filter (a Bessel at 0.2-0.4 fs) or a load cell's conditioning low-passes
+    the force channel's noise, so neighbouring samples are correlated and an estimate from
+    their differences (third differences of the residual, ``white``) sees only its fast
+    part: on such a chain it read 0.09 N where the force noise was 0.58 N, every held-out
+    gain in units of it was 40 times too large and a clean record named inertia at 2 σ²
+    (benches/eval_detect.py, misfit chain). Welch's periodogram of the base model's
+    residual (segments of eight drive periods) is read between the drive's harmonics
+    (:data:`HARMONIC_GUARD_BINS` either side of each left out: the model's misfit and any
+    effect are periodic and sit on them) from 1.5 drive frequencies up, lines above four
+    times the running median clipped; the harmonics' bins and those below read as their
+    noise neighbours, and the whole is summed. The share the input's noise passes through
+    the model's local slope ``s`` (its spectrum through the candidates' filter times the
+    mean ``s²``: :func:`.eiv.input_noise_spectrum`) is taken out first, never more than
+    three quarters of any bin."""
+    from ._filters import welch
+    from .eiv import NOISE_LINE_BINS, NOISE_LINE_FACTOR, input_noise_spectrum
+
+    r = np.asarray(residual, float)
+    r = r[np.isfinite(r)]
+    n = r.size
+    per = float(d.cycles.period_samples)
+    if not (n >= 256 and per > 0 and white > 0):
+        return None
+    nper = int(min(n, 2 ** int(np.ceil(np.log2(max(8.0 * per, 64.0))))))
+    if nper < 64:
+        return None
+    f, psd = welch(r - float(np.mean(r)), 1.0 / d.dt, nper)
+    df = float(f[1] - f[0])
+    nyq = 0.5 / d.dt
+    f0 = 1.0 / (per * d.dt)
+    # the bins between the drive's harmonics, from 1.5 f up: noise only
+    k = np.maximum(np.rint(f / f0), 1.0)
+    noise = (np.abs(f - k * f0) > HARMONIC_GUARD_BINS * df) & (f >= 1.5 * f0)
+    if np.count_nonzero(noise) < 8:
+        return None
+    fn, pn = f[noise], psd[noise]
+    kk = NOISE_LINE_BINS // 2
+    med = np.median(
+        np.lib.stride_tricks.sliding_window_view(np.pad(pn, kk, mode="edge"), 2 * kk + 1), axis=1
+    )
+    pn = np.minimum(pn, NOISE_LINE_FACTOR * med)  # lines (hum, another block's harmonics)
+    # the harmonics' bins and those below 1.5 f read as their noise neighbours
+    psd = np.interp(f, fn, pn)
+    spec = input_noise_spectrum(d) if slope is not None else None
+    if spec is not None:
+        s2 = float(np.mean(np.asarray(slope, float) ** 2))
+        wlen = int(d.extra.get("u_filter", 0))
+        du = float(spec.f[1] - spec.f[0]) if spec.f.size > 1 else 1.0
+        seen = spec.power / du  # density of the raw input noise
+        if wlen:
+            c = savgol_coeffs(wlen, 3)
+            j = np.arange(wlen) - wlen // 2
+            seen = seen * np.abs(np.exp(-2j * np.pi * np.outer(spec.f * spec.dt, j)) @ c) ** 2
+        if spec.dt < 0.99 * d.dt:  # a kept record: the raw noise folds flat into its band
+            through = np.full_like(f, s2 * float(np.sum(seen) * du) / nyq)
+        else:
+            through = s2 * np.interp(f, spec.f, seen, right=0.0)
+        psd = np.maximum(psd - through, 0.25 * psd)
+    power = psd * df
+    total = float(np.sqrt(np.sum(power)))
+    return total if total > OUTPUT_COLOURED_RATIO * white else None
