@@ -109,7 +109,8 @@ def make(set_: str, seed: int) -> tuple[Any, dict[str, Any]]:
         eff = rig_effect(e, variant, fac, rng)
         info["effect"] = e
         info["truth"] = eff[e]
-        rec, _ = _rig(eff, seed, fac, True)
+        rec, kw = _rig(eff, seed, fac, True)
+        info["channel_skew"] = kw["channel_skew"]
         return rec, info
     if set_ == "delay":
         per = 1.0 / fac["f"]
@@ -122,7 +123,10 @@ def make(set_: str, seed: int) -> tuple[Any, dict[str, Any]]:
             eff = {"backlash": {"b": float(rng.uniform(0.05, 0.15)) * A}}
             info["effect"] = "backlash"
         info["truth"] = eff[info["effect"]]
-        rec, _ = _rig(eff, seed, fac, True)
+        rec, kw = _rig(eff, seed, fac, True)
+        # the chain's own skew (the LVDT's lag, the anti-alias corners): the delay the
+        # record holds is tau plus it
+        info["channel_skew"] = kw["channel_skew"]
         return rec, info
     if set_ == "hum":
         k = int(rng.integers(2, 5))
@@ -236,6 +240,7 @@ def tables(rs: list[dict[str, Any]]) -> str:
                 for r in rows:
                     if r.get("named") != [e]:
                         lines.append(f"  - seed {r['seed']} xn {r.get('x_noise')}: {r.get('named')}"
+                                     f" truth {r.get('truth')} skew {r.get('channel_skew')}"
                                      f" bound {r.get('bound')} err {r.get('error')}")  # fmt: skip
             g2 = defaultdict(list)
             for r in rr:

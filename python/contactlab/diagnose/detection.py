@@ -229,6 +229,12 @@ OUTPUT_COLOURED_RATIO = 1.5
 #: :func:`output_noise_rms` leaves out (the model's misfit and the effects are periodic:
 #: their residual sits on the harmonics; a Hann window's main lobe spans two bins)
 HARMONIC_GUARD_BINS = 2.5
+#: what is left of the residual's noise after the input's share is taken out, at least
+#: (as :func:`channel_noise` keeps of its estimate): returning None where the input's share
+#: dominates left the friction frame at 450 g with nothing named and a held-out error 26
+#: times the white estimate (its rectangular loops pass a sensor's noise through a
+#: near-vertical slope)
+INPUT_SHARE_FLOOR = 0.25
 
 
 def output_noise_rms(
@@ -247,25 +253,31 @@ def output_noise_rms(
     (:data:`HARMONIC_GUARD_BINS` either side of each left out: the model's misfit and any
     effect are periodic and sit on them) from 1.5 drive frequencies up, lines above four
     times the running median clipped; the harmonics' bins and those below read as their
-    noise neighbours, and the whole is summed. The share the input's noise passes through
-    the model's local slope ``s`` (its spectrum through the candidates' filter times the
-    mean ``s²``: :func:`.eiv.input_noise_spectrum`) is taken out first, never more than
-    three quarters of any bin."""
+    noise neighbours, and the whole is summed; samples weighted out (sticking phases, where
+    the force is what holds the body) are left out. The share the input's noise passes through
+    the model's local slope ``s`` (the mean ``s²`` times the input noise the candidates see,
+    :func:`contactlab.diagnose._prepare.input_seen`) is taken out of the total, leaving at
+    least :data:`INPUT_SHARE_FLOOR` of it."""
     from ._filters import welch
     from .eiv import NOISE_LINE_BINS, NOISE_LINE_FACTOR, input_noise_spectrum
 
     r = np.asarray(residual, float)
-    r = r[np.isfinite(r)]
+    # samples no candidate is judged on (sticking phases, a declared filter's ends: weight
+    # 0) hold what holds the body, not noise: zeroed, and the sum scaled back up
+    prior = d.extra.get("weight")
+    keep = np.isfinite(r) & (np.ones(r.size, bool) if prior is None else np.asarray(prior) > 0)
+    share = float(np.mean(keep))
+    r = np.where(keep, r, 0.0)
     n = r.size
     per = float(d.cycles.period_samples)
-    if not (n >= 256 and per > 0 and white > 0):
+    if not (n >= 256 and per > 0 and white > 0 and share > 0.25):
         return None
     nper = int(min(n, 2 ** int(np.ceil(np.log2(max(8.0 * per, 64.0))))))
     if nper < 64:
         return None
-    f, psd = welch(r - float(np.mean(r)), 1.0 / d.dt, nper)
+    f, psd = welch(np.where(keep, r - float(np.mean(r[keep])), 0.0), 1.0 / d.dt, nper)
+    psd = psd / share
     df = float(f[1] - f[0])
-    nyq = 0.5 / d.dt
     f0 = 1.0 / (per * d.dt)
     # the bins between the drive's harmonics, from 1.5 f up: noise only
     k = np.maximum(np.rint(f / f0), 1.0)
@@ -280,21 +292,14 @@ def output_noise_rms(
     pn = np.minimum(pn, NOISE_LINE_FACTOR * med)  # lines (hum, another block's harmonics)
     # the harmonics' bins and those below 1.5 f read as their noise neighbours
     psd = np.interp(f, fn, pn)
+    total2 = float(np.sum(psd) * df)
     spec = input_noise_spectrum(d) if slope is not None else None
     if spec is not None:
-        s2 = float(np.mean(np.asarray(slope, float) ** 2))
-        wlen = int(d.extra.get("u_filter", 0))
-        du = float(spec.f[1] - spec.f[0]) if spec.f.size > 1 else 1.0
-        seen = spec.power / du  # density of the raw input noise
-        if wlen:
-            c = savgol_coeffs(wlen, 3)
-            j = np.arange(wlen) - wlen // 2
-            seen = seen * np.abs(np.exp(-2j * np.pi * np.outer(spec.f * spec.dt, j)) @ c) ** 2
-        if spec.dt < 0.99 * d.dt:  # a kept record: the raw noise folds flat into its band
-            through = np.full_like(f, s2 * float(np.sum(seen) * du) / nyq)
-        else:
-            through = s2 * np.interp(f, spec.f, seen, right=0.0)
-        psd = np.maximum(psd - through, 0.25 * psd)
-    power = psd * df
-    total = float(np.sqrt(np.sum(power)))
+        # the input noise the candidates see (:func:`._prepare.input_seen`), through the
+        # slope: spread over the band by the slope's modulation, so taken out in total
+        from ._prepare import input_seen
+
+        s2 = float(np.mean(np.asarray(slope, float)[keep] ** 2))
+        total2 = max(total2 - s2 * input_seen(d) ** 2, INPUT_SHARE_FLOOR * total2)
+    total = float(np.sqrt(total2))
     return total if total > OUTPUT_COLOURED_RATIO * white else None
