@@ -429,4 +429,5 @@ def _prior_weight(
     if not loc:
         return None, []
     d.extra["weight"] = w
+    d.extra["location_prior"] = dict(loc)  # (read by .detection.output_noise_rms)
     return loc, notes

@@ -229,6 +229,10 @@ OUTPUT_COLOURED_RATIO = 1.5
 #: :func:`output_noise_rms` leaves out (the model's misfit and the effects are periodic:
 #: their residual sits on the harmonics; a Hann window's main lobe spans two bins)
 HARMONIC_GUARD_BINS = 2.5
+#: the residual's spectrum is read from this many times the fastest drive frequency up
+#: (from 1.5 times it, another block's harmonics and an unmodelled effect's content, a
+#: delay's on the package generator's three blocks, were read as noise: 0.52 N of 0.30 N)
+OUTPUT_BAND_HARMONICS = 6.0
 #: what is left of the residual's noise after the input's share is taken out, at least
 #: (as :func:`channel_noise` keeps of its estimate): returning None where the input's share
 #: dominates left the friction frame at 450 g with nothing named and a held-out error 26
@@ -251,9 +255,10 @@ def output_noise_rms(
     (benches/eval_detect.py, misfit chain). Welch's periodogram of the base model's
     residual (segments of eight drive periods) is read between the drive's harmonics
     (:data:`HARMONIC_GUARD_BINS` either side of each left out: the model's misfit and any
-    effect are periodic and sit on them) from 1.5 drive frequencies up, lines above four
-    times the running median clipped; the harmonics' bins and those below read as their
-    noise neighbours, and the whole is summed; samples weighted out (sticking phases, where
+    effect are periodic and sit on them) from :data:`OUTPUT_BAND_HARMONICS` times the
+    fastest drive frequency up, lines above four times the running median clipped; the
+    harmonics' bins read as their noise neighbours, those below as the octave above, and
+    the whole is summed; samples weighted out (sticking phases, where
     the force is what holds the body) are left out. The share the input's noise passes through
     the model's local slope ``s`` (the mean ``s²`` times the input noise the candidates see,
     :func:`contactlab.diagnose._prepare.input_seen`) is taken out of the total, leaving at
@@ -262,8 +267,13 @@ def output_noise_rms(
     from .eiv import NOISE_LINE_BINS, NOISE_LINE_FACTOR, input_noise_spectrum
 
     r = np.asarray(residual, float)
-    # samples no candidate is judged on (sticking phases, a declared filter's ends: weight
-    # 0) hold what holds the body, not noise: zeroed, and the sum scaled back up
+    # a record that sticks (samples weighted out as sticking) leaves a misfit the model
+    # cannot draw, spread between the harmonics (the friction frame at 250 g: 0.06 N of it
+    # read as noise, the held-out error then 1.0 of it): its white estimate is kept
+    if float((d.extra.get("location_prior") or {}).get("sticking_fraction", 0.0)) > 0.0:
+        return None
+    # samples no candidate is judged on (a declared filter's ends: weight 0): zeroed, and
+    # the sum scaled back up
     prior = d.extra.get("weight")
     keep = np.isfinite(r) & (np.ones(r.size, bool) if prior is None else np.asarray(prior) > 0)
     share = float(np.mean(keep))
@@ -279,10 +289,14 @@ def output_noise_rms(
     psd = psd / share
     df = float(f[1] - f[0])
     f0 = 1.0 / (per * d.dt)
-    # the bins between the drive's harmonics, from 1.5 f up: noise only
+    half = np.diff(d.cycles.reversals)
+    fastest = min(per, 2.0 * float(np.percentile(half, 10))) if half.size >= 4 else per
+    lo = max(1.5 * f0, OUTPUT_BAND_HARMONICS / (fastest * d.dt))
+    # the bins between the drive's harmonics, from lo up: noise only
     k = np.maximum(np.rint(f / f0), 1.0)
-    noise = (np.abs(f - k * f0) > HARMONIC_GUARD_BINS * df) & (f >= 1.5 * f0)
-    if np.count_nonzero(noise) < 8:
+    noise = (np.abs(f - k * f0) > HARMONIC_GUARD_BINS * df) & (f >= lo)
+    band = noise & (f <= 2.0 * lo)
+    if np.count_nonzero(noise) < 8 or np.count_nonzero(band) < 4:
         return None
     fn, pn = f[noise], psd[noise]
     kk = NOISE_LINE_BINS // 2
@@ -290,8 +304,9 @@ def output_noise_rms(
         np.lib.stride_tricks.sliding_window_view(np.pad(pn, kk, mode="edge"), 2 * kk + 1), axis=1
     )
     pn = np.minimum(pn, NOISE_LINE_FACTOR * med)  # lines (hum, another block's harmonics)
-    # the harmonics' bins and those below 1.5 f read as their noise neighbours
-    psd = np.interp(f, fn, pn)
+    # the harmonics' bins read as their noise neighbours; below lo, flat at the octave's level
+    level = float(np.mean(pn[fn <= 2.0 * lo]))
+    psd = np.where(f < lo, level, np.interp(f, fn, pn))
     total2 = float(np.sum(psd) * df)
     spec = input_noise_spectrum(d) if slope is not None else None
     if spec is not None:
