@@ -269,7 +269,9 @@ def input_seen(d: Prepared) -> float:
     demodulator and a Bessel anti-alias filter low-pass the sensor's noise, the white
     estimate then sees a fifth of it or less, and the filter, which passes the drive's
     band, removes little of it. Then what the spectrum passes through the filter is used
-    (when it exceeds :data:`SPECTRAL_WEIGHT_RATIO` times the white figure)."""
+    (when it exceeds :data:`SPECTRAL_WEIGHT_RATIO` times the white figure), unless the
+    record sticks (``d.extra["location_prior"]``): its jerks above the drive's band are
+    motion, not noise."""
     if "u_seen" in d.extra:
         return float(d.extra["u_seen"])
     from .eiv import input_noise_spectrum
@@ -278,7 +280,10 @@ def input_seen(d: Prepared) -> float:
     wlen = int(d.extra.get("u_filter", 0))
     gain = float(np.sum(savgol_coeffs(wlen, 3) ** 2)) if wlen else 1.0
     seen = su * float(np.sqrt(gain))
-    spec = input_noise_spectrum(d) if su > 0 else None
+    # a record that sticks moves in jerks above the drive's band, which the spectrum would
+    # read as noise (the friction frame at 450 g then named nothing, h0 off its plateau)
+    sticks = float((d.extra.get("location_prior") or {}).get("sticking_fraction", 0.0)) > 0.0
+    spec = input_noise_spectrum(d) if su > 0 and not sticks else None
     if spec is not None and spec.seen > SPECTRAL_WEIGHT_RATIO * seen:
         seen = float(spec.seen)
     d.extra["u_seen"] = seen
