@@ -21,7 +21,13 @@ local, over a few samples, and a median over the record):
   (:func:`contactlab.diagnose._signal.noise_rms`). The candidates see a smoothed input, so
   the input noise reaches the residual smoothed too and its third differences are small;
   what is left of it is removed by subtracting the filtered input noise's share
-  (:func:`channel_noise`).
+  (:func:`channel_noise`). Where an anti-alias filter colours the output's noise, third
+  differences see only its fast part; a tangential record's ``σy`` is then read from the
+  residual's spectrum between the drive's harmonics (:func:`output_noise_rms`);
+- the input noise the candidates see per sample, ``σu'``, likewise from the input's spectrum
+  where it is coloured (:func:`contactlab.diagnose._prepare.input_seen`: an LVDT's
+  demodulator low-passes it); the errors-in-variables weights and the input-noise budget
+  use it.
 
 What ``V`` means for a smooth effect: the candidates see the input after a zero-phase
 filter of unit DC gain, which lowers the *per-sample* input noise to ``σu'`` (``eiv_weight``
