@@ -195,8 +195,9 @@ mod tests {
 
     /// Arguments over the range the kernel uses (`z = ac |u| >= 0`): a geometric sweep from
     /// the smallest subnormal to past the clamp at 708, a dense sweep over [0, 20] (every
-    /// table index and power of two, the cancellation-prone `k = -1` range), pseudo-random
-    /// arguments, and the edge cases.
+    /// power of two, the `k = -1` range), pseudo-random arguments, the neighbourhoods of the
+    /// reduction's switch points `(k + 1/2) ln 2` (where `|r|` is largest), and the edge
+    /// cases.
     fn arguments() -> Vec<f64> {
         let mut z = vec![
             0.0,
@@ -238,6 +239,11 @@ mod tests {
                 .wrapping_add(1_442_695_040_888_963_407);
             let e = (state >> 11) as f64 * (1.0 / 9_007_199_254_740_992.0);
             z.push(40.0 * e * e); // denser near 0
+        }
+        // around the switch points of the reduction, where |r| = ln2/2
+        for k in 0..40 {
+            let c = (f64::from(k) + 0.5) * std::f64::consts::LN_2;
+            z.extend((0..2_000).map(|i| c * (1.0 + f64::from(i - 1_000) * 1e-9)));
         }
         // the neighbours of every edge case
         let edges: Vec<f64> = z[..23].to_vec();

@@ -23,8 +23,8 @@ fn one_minus_exp_neg_is_accurate_everywhere() {
         worst = worst.max((one_minus_exp_neg(z) / want - 1.0).abs());
         z *= 1.001_3;
     }
-    // Densely where the table index and the power of two change (|r| at its largest, and
-    // the cancellation-prone k = -1 range just above ln2/128).
+    // Densely where the power of two changes (|r| at its largest at (k + 1/2) ln2) and
+    // over the k = 0 and k = -1 ranges.
     for i in 1..200_000 {
         let z = f64::from(i) * 1e-4;
         let want = if z < 0.5 {

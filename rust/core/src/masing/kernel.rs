@@ -46,7 +46,7 @@ use crate::curve::Backbone;
 use crate::simd::{self, Level};
 use eval::eval_dense;
 pub(super) use eval::{eval_block, RunTab};
-use pass::{block_pass, Pass, SPARE};
+use pass::{block_pass, dense_pass, Pass, SPARE};
 use scan::Scan;
 
 /// No pending sample: the value is known.
@@ -139,7 +139,8 @@ pub(super) enum Forces {
 /// compiled for SIMD level `level` (every level gives the same forces bit for bit). The caller
 /// has checked that `state.count + x.len()` fits in 63 bits and that [`takes`] `state`. The
 /// input's and the forces' finiteness are checked block by block while the block is in cache
-/// (the input before its block is run: no separate pass over `x`).
+/// (no separate pass over `x`): the input before its block is run on the block path (the same
+/// scan finds its turning points), after its first pass on the dense path (from L1).
 pub(super) fn scaled_force<C: Backbone>(
     level: Level,
     curve: &C,
@@ -178,10 +179,20 @@ pub(super) fn scaled_force<C: Backbone>(
     let mut finite = true;
     for (xc, oc) in x.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
         // The input's check, while the block is read for its turning points when the
-        // block path will need them.
+        // block path will need them. The dense path needs no turning points: its block is
+        // checked after its first pass, from L1 (the pass's own loads then meet the block's
+        // cache misses, overlapped with its work, instead of a streaming pass of its own).
+        // A non-finite input there makes only meaningless values within the block (every
+        // stack index stays within the room made below, every loop ends), and the call is
+        // then an error whose partial results the caller discards.
         let dense_path = dense && pass.dir != 0.0;
-        let Some(cont) = simd::run(level, Scan(xc, !dense_path)) else {
-            return Forces::BadInput;
+        let cont = if dense_path {
+            [0; BLOCK / 64]
+        } else {
+            let Some(cont) = simd::run(level, Scan(xc, true)) else {
+                return Forces::BadInput;
+            };
+            cont
         };
         let m = xc.len();
         // Room for one candidate above the top per sample.
@@ -193,7 +204,10 @@ pub(super) fn scaled_force<C: Backbone>(
         // The path for this block from the branch changes of the last one.
         let changes = if dense_path {
             let d = dense_rec.get_or_insert_with(Dense::new);
-            let c = pass.dense_block(stk, xc, d);
+            let c = dense_pass(level, &mut pass, stk, xc, d);
+            if simd::run(level, Scan(xc, false)).is_none() {
+                return Forces::BadInput;
+            }
             finite &= eval_dense(level, curve, d, pass.start, oc);
             c
         } else {

@@ -135,3 +135,38 @@ fn a_non_finite_input_stops_the_kernel_at_every_level() {
         }
     }
 }
+
+/// The dense path checks its block after its first pass: a non-finite input anywhere in a
+/// dense block (a random walk's, or band-limited noise's) still stops the kernel, at every
+/// level, and the blocks before it are the forces of the input without it.
+#[test]
+fn a_non_finite_input_in_a_dense_block_stops_the_kernel_at_every_level() {
+    let c = Exponential::new(1.0, 3.0).unwrap_or_else(|_| unreachable!());
+    let sig = signals(4 * BLOCK);
+    for level in Level::ALL.into_iter().filter(|l| l.supported()) {
+        for x0 in &sig[1..3] {
+            let mut good = vec![0.0; x0.len()];
+            let mut st = MasingState::default();
+            let r = scaled_force(level, &c, 2.0, x0, &mut good, &mut st);
+            assert_eq!(r, Forces::Finite);
+            // in the first dense block (the second), at its first, a middle and its last
+            // sample, and in a later one
+            for at in [BLOCK, BLOCK + 1, BLOCK + 300, 2 * BLOCK - 1, 3 * BLOCK + 7] {
+                for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                    let mut x = x0.clone();
+                    x[at] = bad;
+                    let mut out = vec![0.0; x.len()];
+                    let mut st = MasingState::default();
+                    let r = scaled_force(level, &c, 2.0, &x, &mut out, &mut st);
+                    assert_eq!(r, Forces::BadInput, "level {}, at {at}", level.name());
+                    let done = at / BLOCK * BLOCK;
+                    let same = out[..done]
+                        .iter()
+                        .zip(&good)
+                        .all(|(a, b)| a.to_bits() == b.to_bits());
+                    assert!(same, "level {}, at {at}", level.name());
+                }
+            }
+        }
+    }
+}

@@ -53,6 +53,36 @@ impl Kernel for BlockPass<'_> {
     }
 }
 
+/// First pass over one dense block ([`Pass::dense_block`]) compiled for SIMD level `level`
+/// (scalar code; the wider levels bring three-operand instructions and twice the registers,
+/// the same IEEE operations in the same order).
+#[inline(never)]
+pub(super) fn dense_pass(
+    level: Level,
+    pass: &mut Pass,
+    stk: &mut [Reversal],
+    xc: &[f64],
+    d: &mut Dense,
+) -> usize {
+    simd::run(level, DensePass { pass, stk, xc, d })
+}
+
+/// [`Pass::dense_block`] as a [`Kernel`] for [`simd::run`].
+struct DensePass<'a> {
+    pass: &'a mut Pass,
+    stk: &'a mut [Reversal],
+    xc: &'a [f64],
+    d: &'a mut Dense,
+}
+
+impl Kernel for DensePass<'_> {
+    type Output = usize;
+    #[inline(always)]
+    fn run_at(self) -> usize {
+        self.pass.dense_block(self.stk, self.xc, self.d)
+    }
+}
+
 /// Anchor index of a sample on the virgin curve (its base is 0, its multiplier 1).
 const VIRGIN: u64 = u64::MAX;
 
@@ -383,7 +413,7 @@ impl Pass {
     /// closure down to it, both through [`Pass::rules`]; a step that closes two or more
     /// loops at once; a zero-length step. Needs `dir != 0` (the first move goes through
     /// [`Pass::block_body`]).
-    #[inline(never)]
+    #[inline(always)]
     // `&` on booleans on purpose: no branch per condition.
     #[allow(clippy::needless_bitwise_bool)]
     pub(super) fn dense_block(&mut self, stk: &mut [Reversal], xc: &[f64], d: &mut Dense) -> usize {
