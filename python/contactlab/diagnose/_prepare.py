@@ -12,7 +12,7 @@ import numpy as np
 from ..errors import InputError
 from ._family import Family, Prepared
 from ._filters import decimate, savgol_coeffs, savgol_filter
-from ._kept import RawInput, knots_at
+from ._kept import MAX_SAMPLES, RawInput, knots_at
 from ._signal import (
     Cycles,
     check_uniform,
@@ -25,12 +25,14 @@ from ._signal import (
     smooth_window,
 )
 
-#: longest record diagnosed sample by sample. Longer tangential ones keep every q-th sample
-#: over their whole length with the turning points between them (:func:`subsample_long`);
-#: longer normal ones likewise (:func:`subsample_normal`). :func:`reduce_long` (decimated,
-#: anti-aliased, zero phase, to no fewer than MIN_SAMPLES_PER_CYCLE per period of the fastest
-#: cycles and cut to the first MAX_SAMPLES samples) is the route before
-MAX_SAMPLES = 24_000
+# longest record diagnosed sample by sample. Longer tangential ones keep every q-th sample
+# over their whole length with the turning points between them (:func:`subsample_long`);
+# longer normal ones likewise (:func:`subsample_normal`). :func:`reduce_long` (decimated,
+# anti-aliased, zero phase, to no fewer than MIN_SAMPLES_PER_CYCLE per period of the fastest
+# cycles and cut to the first MAX_SAMPLES samples) is the route before. MAX_SAMPLES itself is
+# defined in :mod:`._kept` (imported above), which :mod:`.eiv` reads it from without
+# importing this module
+#: fewest samples per cycle of the fastest cycles :func:`reduce_long` decimates to
 MIN_SAMPLES_PER_CYCLE = 64
 
 
