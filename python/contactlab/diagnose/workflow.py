@@ -264,14 +264,20 @@ def diagnose(
     t, u, y = _checked_arrays(recording, family, folds, max_effects, z, min_gain)
     y, sign_note = path.orient(t, u, y, force_sign)
     hum_note = None
+    hum_kept: list[dict[str, float]] = []
     if family.kind == "tangential":  # (diagvel: mains hum on both channels feeds a delay)
-        from ._mains import remove_mains
+        from ._mains import kept_hum, remove_mains
 
+        hum_kept, hum_kept_note = kept_hum(t, u, y)
         u, y, hum_note = remove_mains(t, u, y)
+        if hum_kept_note:
+            hum_note = f"{hum_note}; {hum_kept_note}" if hum_note else hum_kept_note
     names = _candidate_names(family, candidates)
     taps, declared_noise = _declared(recording, family, output_filter, output_noise, t.size, y)
     notes = [n for n in (sign_note, hum_note, _same_clock(recording, names, candidates)) if n]
     d, reduced = path.prepare(t, u, y, taps)
+    if family.kind == "tangential" and hum_kept:
+        d.extra["hum_kept"] = hum_kept
     prior, prior_notes = _ready(family, d, recording, context, taps)
     # a family whose floors are totals over the record (normal contact: gain_scale)
     min_gain = min_gain * float(d.extra.get("gain_scale", 1.0))
@@ -584,6 +590,28 @@ def _meta(recording: Any) -> dict[str, Any]:
     return dict(meta) if isinstance(meta, dict) else {}
 
 
+def _output_noise(
+    family: Family, params: dict[str, float], d: Prepared, residual: np.ndarray
+) -> float:
+    """The output noise RMS the detection judges gains in: the white estimate from the
+    residual's third differences, or, for a tangential record whose residual's spectrum
+    shows the noise coloured (an anti-alias filter on the force), the spectral one
+    (:func:`.detection.output_noise_rms`, kept in ``d.extra["y_noise_spectral"]`` for the
+    closing checks)."""
+    white = noise_rms(residual)
+    d.extra.pop("y_noise_spectral", None)
+    if family.kind != "tangential":
+        return white
+    from .detection import model_slope, output_noise_rms
+
+    slope = model_slope(family, params, d) if float(d.extra.get("u_noise", 0.0) or 0.0) else None
+    coloured = output_noise_rms(d, residual, slope, white)
+    if coloured is None:
+        return white
+    d.extra["y_noise_spectral"] = coloured
+    return coloured
+
+
 @dataclass
 class _Base:
     """The base model as the search starts from it."""
@@ -614,7 +642,9 @@ def _fit_base(
         start = family.initial_base(d)
     fold_masks(d, folds)  # too few cycles to hold any out: said before fitting
     base_all = fit(family, effects, d, np.ones(d.y.size, bool), start, scales)
-    sigma = declared_noise or noise_rms(family.predict(base_all.params, effects, d) - d.y)
+    sigma = declared_noise or _output_noise(
+        family, base_all.params, d, family.predict(base_all.params, effects, d) - d.y
+    )
     if sigma <= 0:
         raise InputError("the output channel has no noise at all; cannot judge significance")
     budget = 0.0
@@ -622,7 +652,9 @@ def _fit_base(
     if w is not None:  # errors in variables: refit the base with the likelihood's weights
         d.extra["weight"], budget = w
         current = evaluate(family, effects, d, base_all.params, scales, folds, parallel=True)
-        sigma = declared_noise or noise_rms(current.full_residual(d))
+        sigma = declared_noise or _output_noise(
+            family, current.full.params, d, current.full_residual(d)
+        )
     else:
         current = evaluate(family, effects, d, start, scales, folds, base_all, parallel=True)
     anchored, unanchored = None, {}
