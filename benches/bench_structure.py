@@ -19,8 +19,11 @@ and MDOF structures with Bouc-Wen, Masing and Jenkins joints, the default run
 step per sample, the same code path as before) — their CPU-time ratio (medians of
 ``--repeat`` interleaved pairs) and each one's relative RMS error of ``x`` against tight
 references: scipy ``solve_ivp`` LSODA and Radau at ``rtol = 1e-11`` where the joint law is an
-ODE (Bouc-Wen), fixed Newmark with 64 steps per sample (second order, an independent route)
-and the error-controlled run at ``tol / 100``. OpenSeesPy is compared when installed.
+ODE (Bouc-Wen), ``solve_ivp`` DOP853 at ``rtol = 1e-10`` with the Masing memory and Jenkins
+stick-slip handled by terminal events (``structure_reference.py``, written apart from the
+core; the reference of the Masing and Jenkins cases), fixed Newmark with 64 steps per sample
+(second order, an independent route) and the error-controlled run at ``tol / 100``.
+OpenSeesPy is compared when installed. ``--only TEXT`` runs the cases whose name has TEXT.
 Run: ``.venv/bin/python benches/bench_structure.py [--stepping]``.
 """
 
@@ -190,9 +193,10 @@ def main() -> None:
     ap.add_argument("--n-python", type=int, default=20_000)
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--stepping", action="store_true", help="the error-control table")
+    ap.add_argument("--only", default="", help="--stepping: the cases whose name has this")
     a = ap.parse_args()
     if a.stepping:
-        stepping_table(a.n, a.repeat)
+        stepping_table(a.n, a.repeat, a.only)
         return
     t, f = excitation(a.n)
     s = Structure(M, C, K)
@@ -338,10 +342,11 @@ def _cpu(fn):  # type: ignore[no-untyped-def]
     return time.process_time() - c0, out
 
 
-def stepping_table(n_time: int, repeat: int) -> None:
+def stepping_table(n_time: int, repeat: int, only: str = "") -> None:
     """The error-control table: cost ratio and relative RMS errors, per case (see the
     module's docstring)."""
     from contactlab.structure.model import DEFAULT_TOL
+    from structure_reference import hysteretic_ode
 
     def rrms(x: np.ndarray, ref: np.ndarray) -> float:
         return float(np.sqrt(np.mean((x - ref) ** 2) / np.mean(ref**2)))
@@ -353,11 +358,14 @@ def stepping_table(n_time: int, repeat: int) -> None:
     except ImportError:
         print("OpenSeesPy: not installed (no comparison row)")
     print(f"default tol = {DEFAULT_TOL:g}; CPU-time medians of {repeat} interleaved pairs on "
-          f"{n_time} samples; errors: relative RMS of x on the accuracy record")  # fmt: skip
+          f"{n_time} samples; errors: relative RMS of x on the accuracy record; load average "
+          f"{os.getloadavg()[0]:.1f}")  # fmt: skip
     print("| case | old default (substeps=1) | new default | cost new/old | "
           "old err vs ref | new err vs ref | references (max pairwise diff) |")  # fmt: skip
     print("|---|---|---|---|---|---|---|")
     for name, s, fs, n_acc, bw_only in stepping_cases():
+        if only not in name:
+            continue
         f = multisine(max(n_acc, n_time), fs, s.n)
         t = np.arange(f.shape[0]) / fs
         ta, fa = t[:n_acc], f[:n_acc]
@@ -370,7 +378,10 @@ def stepping_table(n_time: int, repeat: int) -> None:
             for meth in ("LSODA", "Radau"):
                 x = bouc_wen_ode(s, ta, fa, meth)
                 refs[meth] = x[:, 0] if s.n == 1 else x
-        ref = refs["LSODA"] if bw_only else refs["tol/100"]
+        else:
+            x = hysteretic_ode(s, ta, fa)
+            refs["DOP853 events"] = x[:, 0] if s.n == 1 else x
+        ref = refs["LSODA"] if bw_only else refs["DOP853 events"]
         spread = max(rrms(a, ref) for a in refs.values())
         old = rrms(s.simulate(ta, force=fa1, substeps=1).x, ref)
         new_r = s.simulate(ta, force=fa1)
@@ -386,6 +397,7 @@ def stepping_table(n_time: int, repeat: int) -> None:
         ratio = statistics.median(b / a for a, b in zip(c_old, c_new, strict=True))
         print(f"| {name} | {1e3 * mo:.0f} ms | {1e3 * mn:.0f} ms | {ratio:.2f} | {old:.1e} | "
               f"{new:.1e} (vs {others}) | {spread:.1e} |", flush=True)  # fmt: skip
+    print(f"load average at the end {os.getloadavg()[0]:.1f}")
 
 
 if __name__ == "__main__":

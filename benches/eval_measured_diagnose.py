@@ -113,6 +113,7 @@ def run(name: str, rec: object, sign: int) -> dict:
         "eiv_bias_rms": u.eiv_bias_rms,
         "input_noise": u.input_noise if hasattr(u, "input_noise") else None,
         "detectable_rms": u.detectable_rms,
+        "rivals": [dict(r) for r in getattr(u, "rivals", ())],
         "sentence": u.sentence(),
         "flagged_white_null": _white_null_flag(rep),
     }  # fmt: skip

@@ -84,9 +84,19 @@ def chain_record(
     hum: bool = True,
     jitter: bool = True,
     lvdt: bool = True,
+    x_colour: str = "lvdt",
+    scale: float = 2.0,
     **over: Any,
 ) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], dict[str, Any]]:
-    """``((t, x, F), factors)`` of one record (see the module docstring)."""
+    """``((t, x, F), factors)`` of one record (see the module docstring).
+
+    ``x_colour`` shapes the x sensor's noise before the anti-alias filter: ``"lvdt"`` (a
+    2nd-order demodulator low-pass plus a white share, ``lvdt=False``: white only),
+    ``"lp1"`` (a first-order low-pass at 0.02-0.2 fs, at least 10 drive frequencies, plus
+    the white share) or ``"white"``. ``scale`` is the branch scale of the Masing rules (2:
+    Masing; 1.3-1.6: non-Masing scaling applied from rest, the virgin curve exponential).
+    The draws of the default settings are those of earlier versions (same seeds, same
+    records)."""
     fac = draw(seed, **over)
     rng = np.random.default_rng([seed, 7])
     fs, f, cycles = fac["fs"], fac["f"], fac["cycles"]
@@ -112,15 +122,18 @@ def chain_record(
     x *= A / max(float(np.max(np.abs(x))), 1e-300)
     from contactlab.diagnose.scaled_masing import memory, scaled_force
 
-    F = scaled_force(virgin_curve(virgin, h0, ac), 2.0, memory(x))
+    F = scaled_force(virgin_curve(virgin, h0, ac), scale, memory(x))
     xr, Fr = float(np.ptp(x)), float(np.ptp(F))
     aa = _bessel(rng.uniform(0.2, 0.4) * fs, ffine)
     # x: LVDT demodulator low-pass on the sensor noise, then a small white share, then AA
     fl = max(rng.uniform(0.03, 0.25) * fs, 10.0 * f)
     lv = signal.butter(2, fl, fs=ffine, output="sos")
+    if x_colour == "lp1":  # a first-order low-pass (an RC stage) in place of the demodulator
+        fl = max(np.random.default_rng([seed, 11]).uniform(0.02, 0.2) * fs, 10.0 * f)
+        lv = signal.butter(1, fl, fs=ffine, output="sos")
     n1 = signal.sosfilt(lv, rng.standard_normal(n_fine))
     n2 = rng.standard_normal(n_fine)
-    share = 0.8 if lvdt else 0.0
+    share = 0.8 if lvdt and x_colour != "white" else 0.0
     nx = signal.sosfilt(aa, math.sqrt(share) * n1 / np.std(n1) + math.sqrt(1 - share) * n2)
     nx *= fac["x_noise"] * xr / max(float(np.std(nx[n_fine // 10 :])), 1e-300)
     # F: white noise, piezo high-pass or strain-gauge resonance, AA
@@ -152,5 +165,5 @@ def chain_record(
         fsr = 1.25 * float(np.max(np.abs(s)))
         q = 2 * fsr / 2 ** fac["bits"]
         out.append(np.round(s / q) * q)
-    fac.update(h0=h0, virgin=virgin, lvdt_corner=fl)
+    fac.update(h0=h0, virgin=virgin, lvdt_corner=fl, x_colour=x_colour, scale=scale)
     return (t, out[0], out[1]), fac

@@ -85,12 +85,14 @@ class ReversalDetector:
             raise InputError(f"threshold must be finite and > 0, got {threshold}")
         self._core = _core.ReversalDetector(c, t)
 
-    def push(self, x: Any, value: Any = None) -> Excursions:
+    def push(self, x: Any, value: Any = None, *, finite: bool = False) -> Excursions:
         """Excursions completed in the chunk ``x`` (``value``: where extremes are located,
-        default ``x``; same length)."""
+        default ``x``; same length). ``finite``: the caller has checked ``x`` and ``value``
+        finite, so they are not scanned again (a NaN or inf then only makes the excursions
+        meaningless)."""
         xa = as_1d(x, "x", allow_empty=True, finite=False)
         va = None if value is None else as_1d(value, "value", allow_empty=True, finite=False)
-        return _excursions(self._core.push(xa, va))
+        return _excursions(self._core.push(xa, va, finite))
 
     def open(self) -> Excursions:
         """The excursion in progress (0 or 1 rows)."""
@@ -102,10 +104,13 @@ class ReversalDetector:
         return int(self._core.count)
 
 
-def excursions(x: Any, centre: float, threshold: float, value: Any = None) -> Excursions:
-    """All excursions of ``x``, the last (open) one included: one-shot :class:`ReversalDetector`."""
+def excursions(
+    x: Any, centre: float, threshold: float, value: Any = None, *, finite: bool = False
+) -> Excursions:
+    """All excursions of ``x``, the last (open) one included: one-shot :class:`ReversalDetector`
+    (``finite``: as :meth:`ReversalDetector.push`)."""
     det = ReversalDetector(centre, threshold)
-    return Excursions.concat([det.push(x, value), det.open()])
+    return Excursions.concat([det.push(x, value, finite=finite), det.open()])
 
 
 def branch_memory(x: Any) -> tuple[np.ndarray, np.ndarray]:

@@ -22,6 +22,7 @@ from scipy.signal import savgol_filter
 import contactlab
 from contactlab.diagnose._family import MAX_DELAY_FRACTION
 from contactlab.diagnose.candidates_tangential import CANDIDATES
+from contactlab.diagnose.effects.tangential.channel_delay import MAX_SKEW_SECONDS
 
 DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "friction_frame"
 M, C, K = 3.0799, 0.6690, 1191.0  # kg, N s/m, N/m (README of the data set)
@@ -80,7 +81,7 @@ def test_measured_loop_names_nothing_unphysical(load):
             if np.isfinite(span):
                 assert min(v - spec.lower, spec.upper - v) > 1e-3 * span or v == spec.null
         if e.name == "channel_delay":
-            assert abs(e.parameters["tau"]) <= MAX_DELAY_FRACTION * period
+            assert abs(e.parameters["tau"]) <= max(MAX_DELAY_FRACTION * period, MAX_SKEW_SECONDS)
     names = rep.effect_names
     assert "inertia" not in names or rep.final_model.params["m"] >= 0
     assert "viscous_damping" not in names or rep.final_model.params["c"] >= 0

@@ -22,6 +22,11 @@ import numpy as np
 from ._family import Prepared
 from ._signal import Knots, local_extrema
 
+#: longest record diagnosed sample by sample (:data:`contactlab.diagnose._prepare.MAX_SAMPLES`,
+#: where it is described; defined here so that the errors-in-variables simulation reads it
+#: without importing the preparation)
+MAX_SAMPLES = 24_000
+
 #: shifted recordings kept per delay (a fit steps the other parameters at one delay)
 _DELAYED_KEEP = 4
 #: sample sets (fits, folds) whose spans are kept

@@ -87,6 +87,18 @@ def _clear(f_line: float, f_drive: float, duration: float, harmonics: int | None
     return bool(np.min(np.abs(f_line - k * f_drive)) * duration >= GUARD_BINS)
 
 
+#: a line left in place (a drive harmonic within GUARD_BINS) counts as hum, not as the
+#: drive's own harmonic, when it is at least this many bins from every harmonic
+HUM_APART_BINS = 1.0
+
+
+def _apart(f_line: float, f_drive: float, duration: float) -> bool:
+    """Whether ``f_line`` is at least :data:`HUM_APART_BINS` bins from every drive harmonic."""
+    k = max(round(f_line / f_drive), 1)
+    near = min(abs(f_line - j * f_drive) for j in (k - 1, k, k + 1) if j >= 1)
+    return bool(near * duration >= HUM_APART_BINS)
+
+
 def _one_channel(
     t: np.ndarray, s: np.ndarray, f_drive: float, harmonics: int | None
 ) -> tuple[np.ndarray, list[tuple[float, float]]]:
@@ -144,6 +156,99 @@ def drive_frequency(t: np.ndarray, u: np.ndarray) -> float:
     tt = t - t[0]
     amps = [abs(np.dot(s, np.exp(-2j * np.pi * f * tt))) for f in grid]
     return float(grid[int(np.argmax(amps))]) if grid.size else f0
+
+
+def _beside_harmonics(t: np.ndarray, s: np.ndarray, f_drive: float) -> list[tuple[float, float]]:
+    """Significant mains lines of ``s`` within :data:`GUARD_BINS` of a drive harmonic (those
+    :func:`remove_mains` leaves) and at least :data:`HUM_APART_BINS` from every one:
+    ``(f, amplitude)``. Each line is fitted beside the three drive harmonics nearest it
+    (Hann-weighted least squares): a Hann window's main lobe spans two bins either side,
+    so the line alone would carry a near harmonic's leakage."""
+    duration = float(t[-1] - t[0])
+    dt = duration / max(t.size - 1, 1)
+    w = np.hanning(t.size)
+    try:
+        sigma = noise_rms(s)
+    except Exception:  # (a too-short channel)
+        return []
+    tt = t - t[0]
+    out = []
+    for f0 in MAINS:
+        if f0 >= 0.45 / dt or duration * f0 < MIN_PERIODS:
+            continue
+        k = max(round(f0 / f_drive), 1)
+        ks = [j for j in (k - 1, k, k + 1) if j >= 1]
+        cols = [np.ones_like(tt), tt / max(duration, 1e-300)]
+        for j in ks:
+            ph = 2.0 * np.pi * j * f_drive * tt
+            cols += [np.cos(ph), np.sin(ph)]
+        base = np.column_stack(cols)
+        best = None
+        for f in np.arange(f0 - MAINS_DRIFT, f0 + MAINS_DRIFT + 1e-9, 0.1 / duration):
+            if _clear(f, f_drive, duration, None) or not _apart(f, f_drive, duration):
+                continue
+            ph = 2.0 * np.pi * f * tt
+            X = np.column_stack([base, np.cos(ph), np.sin(ph)])
+            Xw = X * w[:, None]
+            try:
+                Gi = np.linalg.inv(X.T @ Xw)
+            except np.linalg.LinAlgError:
+                continue
+            beta = Gi @ (Xw.T @ s)
+            amp = float(np.hypot(beta[-2], beta[-1]))
+            if best is None or amp > best[1]:
+                cov = Gi @ (Xw.T @ Xw) @ Gi
+                best = (float(f), amp, float(0.5 * (cov[-2, -2] + cov[-1, -1])))
+        if best is None:
+            continue
+        f, amp, v = best
+        if sigma > 0 and np.isfinite(v) and amp >= LINE_SIGMAS * sigma * np.sqrt(v):
+            out.append((f, amp))
+    return out
+
+
+def kept_hum(
+    t: np.ndarray, u: np.ndarray, y: np.ndarray, units: tuple[str, str] = ("m", "N")
+) -> tuple[list[dict[str, float]], str | None]:
+    """Mains lines on both channels that :func:`remove_mains` leaves in place because a
+    drive harmonic lies within :data:`GUARD_BINS` bins, and a sentence saying so (None:
+    there are none).
+
+    A line significant (:data:`LINE_SIGMAS`) at the same frequency (within a bin) on the
+    displacement and on the force, at least :data:`HUM_APART_BINS` bins from every drive
+    harmonic, is hum picked up by both channels: no effect of the joint moves the
+    displacement sensor at the mains frequency. It stays in the residual, unexplained; an
+    effect whose fit draws a line there (a normal-load fluctuation whose sideband falls on
+    it: :class:`~contactlab.diagnose.effects.tangential.normal_load.NormalLoad`) is refused.
+    Returns ``[{"f": Hz, "x": amplitude, "F": amplitude, "harmonic": k}]``.
+    """
+    if t.size < 64:
+        return [], None
+    f_drive = drive_frequency(t, u)
+    duration = float(t[-1] - t[0])
+    if duration * f_drive < 2:
+        return [], None
+    on_x = _beside_harmonics(t, u, f_drive)
+    on_y = _beside_harmonics(t, y, f_drive)
+    out = []
+    for fx, ax in on_x:
+        for fy, ay in on_y:
+            if abs(fx - fy) * duration <= 1.0:
+                f = 0.5 * (fx + fy)
+                out.append({"f": f, "x": ax, "F": ay, "harmonic": round(f / f_drive)})
+    if not out:
+        return [], None
+    parts = [
+        f"{h['x']:.3g} {units[0]} and {h['F']:.3g} {units[1]} at {h['f']:.2f} Hz, "
+        f"{abs(h['f'] - h['harmonic'] * f_drive) * duration:.1f} bins from drive harmonic "
+        f"{h['harmonic']}"
+        for h in out
+    ]
+    return out, (
+        "mains hum on both channels left in place (a drive harmonic too near to tell them "
+        "apart): " + "; ".join(parts) + "; it stays in the residual unexplained, and no "
+        "normal-load fluctuation is named for it"
+    )
 
 
 def remove_mains(

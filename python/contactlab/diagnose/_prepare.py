@@ -12,7 +12,7 @@ import numpy as np
 from ..errors import InputError
 from ._family import Family, Prepared
 from ._filters import decimate, savgol_coeffs, savgol_filter
-from ._kept import RawInput, knots_at
+from ._kept import MAX_SAMPLES, RawInput, knots_at
 from ._signal import (
     Cycles,
     check_uniform,
@@ -25,12 +25,14 @@ from ._signal import (
     smooth_window,
 )
 
-#: longest record diagnosed sample by sample. Longer tangential ones keep every q-th sample
-#: over their whole length with the turning points between them (:func:`subsample_long`);
-#: longer normal ones likewise (:func:`subsample_normal`). :func:`reduce_long` (decimated,
-#: anti-aliased, zero phase, to no fewer than MIN_SAMPLES_PER_CYCLE per period of the fastest
-#: cycles and cut to the first MAX_SAMPLES samples) is the route before
-MAX_SAMPLES = 24_000
+# longest record diagnosed sample by sample. Longer tangential ones keep every q-th sample
+# over their whole length with the turning points between them (:func:`subsample_long`);
+# longer normal ones likewise (:func:`subsample_normal`). :func:`reduce_long` (decimated,
+# anti-aliased, zero phase, to no fewer than MIN_SAMPLES_PER_CYCLE per period of the fastest
+# cycles and cut to the first MAX_SAMPLES samples) is the route before. MAX_SAMPLES itself is
+# defined in :mod:`._kept` (imported above), which :mod:`.eiv` reads it from without
+# importing this module
+#: fewest samples per cycle of the fastest cycles :func:`reduce_long` decimates to
 MIN_SAMPLES_PER_CYCLE = 64
 
 
@@ -253,19 +255,57 @@ def subsample_normal(t: np.ndarray, u: np.ndarray, y: np.ndarray) -> tuple[Prepa
     return d, f"the record of {n} samples was " + " and ".join(how)
 
 
+#: the input noise read from its spectrum sets the weights when it passes at least this many
+#: times what the white estimate says through the candidates' filter (the misfit test's
+#: :data:`contactlab.diagnose.eiv.COLOURED_RATIO`: white noise reads 0.9-1.1)
+SPECTRAL_WEIGHT_RATIO = 1.5
+
+
+def input_seen(d: Prepared) -> float:
+    """The input noise RMS per sample that the candidates see (after their zero-phase input
+    filter), and the one the detection's weights use (kept in ``d.extra["u_seen"]``).
+
+    The white estimate (:func:`~contactlab.diagnose._signal.input_noise`, from neighbouring
+    samples) times the filter's noise gain, unless the noise's spectrum
+    (:func:`contactlab.diagnose.eiv.input_noise_spectrum`) shows it coloured: an LVDT's
+    demodulator and a Bessel anti-alias filter low-pass the sensor's noise, the white
+    estimate then sees a fifth of it or less, and the filter, which passes the drive's
+    band, removes little of it. Then what the spectrum passes through the filter is used
+    (when it exceeds :data:`SPECTRAL_WEIGHT_RATIO` times the white figure), unless the
+    record sticks (``d.extra["location_prior"]``): its jerks above the drive's band are
+    motion, not noise."""
+    if "u_seen" in d.extra:
+        return float(d.extra["u_seen"])
+    from .eiv import input_noise_spectrum
+
+    su = float(d.extra.get("u_noise", 0.0) or 0.0)
+    wlen = int(d.extra.get("u_filter", 0))
+    gain = float(np.sum(savgol_coeffs(wlen, 3) ** 2)) if wlen else 1.0
+    seen = su * float(np.sqrt(gain))
+    # a record that sticks moves in jerks above the drive's band, which the spectrum would
+    # read as noise (the friction frame at 450 g then named nothing, h0 off its plateau)
+    sticks = float((d.extra.get("location_prior") or {}).get("sticking_fraction", 0.0)) > 0.0
+    spec = input_noise_spectrum(d) if su > 0 and not sticks else None
+    if spec is not None and spec.seen > SPECTRAL_WEIGHT_RATIO * seen:
+        seen = float(spec.seen)
+    d.extra["u_seen"] = seen
+    return seen
+
+
 def eiv_weight(
     family: Family, params: dict[str, float], d: Prepared, sigma: float
 ) -> tuple[np.ndarray, float] | None:
     """Errors-in-variables weights of the samples and the candidates' gain budget.
 
     ``w = σy² / (σy² + (s σu')²)`` with ``s`` the base model's local slope ``|dy/du|``
-    (:meth:`Family.slope`) and ``σu'`` the noise left in the input the candidates see (the
-    estimated input noise times the filter's noise gain). The budget, in units of ``σy²``, is
-    the mean of ``(s σu')² w``: what the input's noise contributes to the weighted error,
-    the most that smoothing the input (a delay shorter than a sample) or absorbing the
-    noise's bias (turning points pushed outward) could lower it; every candidate's held-out
-    gain must beat it. None when the family has no slope or the input carries no measurable
-    noise.
+    (:meth:`Family.slope`) and ``σu'`` the noise left in the input the candidates see
+    (:func:`input_seen`: the white estimate times the filter's noise gain, or what the
+    noise's spectrum passes through the filter when it is coloured). The budget, in units
+    of ``σy²``, is the mean of ``(s σu')² w``: what the input's noise contributes to the
+    weighted error, the most that smoothing the input (a delay shorter than a sample) or
+    absorbing the noise's bias (turning points pushed outward) could lower it; every
+    candidate's held-out gain must beat it. None when the family has no slope or the input
+    carries no measurable noise.
     """
     su = float(d.extra.get("u_noise", 0.0))
     if not su > 0.0:
@@ -273,9 +313,8 @@ def eiv_weight(
     s = family.slope(params, d)
     if s is None:
         return None
-    wlen = int(d.extra.get("u_filter", 0))
-    gain = float(np.sum(savgol_coeffs(wlen, 3) ** 2)) if wlen else 1.0
-    var = (s * su) ** 2 * gain
+    seen = input_seen(d)
+    var = (s * seen) ** 2
     w = sigma**2 / (sigma**2 + var)
     prior = d.extra.get("weight")  # samples weighted out before (sticks, a filter's ends)
     if prior is None:
@@ -397,4 +436,5 @@ def _prior_weight(
     if not loc:
         return None, []
     d.extra["weight"] = w
+    d.extra["location_prior"] = dict(loc)  # (read by .detection.output_noise_rms)
     return loc, notes

@@ -67,15 +67,17 @@ def assess(
     spec = input_noise_spectrum(d)
     seen = noise.input_seen
     dm = d
-    if spec is not None and is_coloured(d, spec):
+    coloured = spec is not None and is_coloured(d, spec)
+    if coloured:
         seen = max(seen, spec.seen)
         # the samples where that noise dominates the output's error are left out
-        dm = reweighted(d, slope, sigma, noise.input_seen, seen)
+        # (from the input noise the detection's weights already carry: d.extra["u_seen"])
+        dm = reweighted(d, slope, sigma, float(d.extra.get("u_seen", noise.input_seen)), seen)
     misfit = unexplained_structure(
         dm, tested, sigma, unit=family.output_unit,
         tolerance=eiv_tolerance(slope, seen, corrected=bias is not None),
     )  # fmt: skip
-    if misfit is None and dm is not d:
+    if misfit is None and coloured:
         # the coloured noise dominates every bin: rather than no verdict, the bins at the
         # white weights, with the spectral tolerance (fresh chain seeds 7004, 7502)
         dm = d
@@ -100,7 +102,8 @@ def assess(
         # times what white noise leaves): there the test reads the corrected residual
         # (fresh chain seed 6000, x noise 2 % behind an LVDT: held-out t 5.27 > 4.5 as
         # measured)
-        bb_res = tested if dm is not d else residual
+        # (coloured: whether or not the detection's weights already carried it, dm is d)
+        bb_res = tested if coloured else residual
         bb = backbone_misfit(dm, bb_res, float(params["ac"]), sigma, z=z_bb)
         if bb is not None:
             flagged = misfit.flagged or bb["flagged"]

@@ -205,8 +205,7 @@ def _kept_driven(d: Prepared, nu_raw: np.ndarray) -> Prepared | None:
     kept samples and the turning points between them (:func:`._kept.knots_at`) rebuilt
     as :func:`._prepare.subsample_long` builds them; None when the added noise changes
     which turning points are kept (all local extrema, or the reversals only)."""
-    from ._kept import RawInput, knots_at
-    from ._prepare import MAX_SAMPLES
+    from ._kept import MAX_SAMPLES, RawInput, knots_at
 
     raw = d.extra["raw_input"]
     u = raw.u + nu_raw

@@ -35,6 +35,12 @@ asks whether it predicts the held-out cycles: a virgin curve of another shape th
 effect (series compliance) absorbed in part leaves a residual too spread over the phase bins
 for ``T`` but shaped like a branch.
 
+A third check runs in the workflow once the model is final
+(:func:`contactlab.diagnose.shape.rival_share`): a named effect that a free-form virgin
+curve explains as well (a tanh virgin curve taken up by a normal-load fluctuation or a
+Stribeck term, after which the residual looks white) flags the misfit
+(:attr:`Unexplained.rivals`).
+
 When ``T`` exceeds the threshold, :func:`unexplained_structure` reports where the structure
 sits (the branch and the phase range of the bins with ``|t_b|`` above a Bonferroni level,
 merged into runs) and how large it is: the RMS and the peak of the binned means, in the
@@ -191,6 +197,12 @@ class Unexplained:
     #: filter) and ``white`` (the estimate from neighbouring samples); None where the input
     #: carries no measurable noise
     input_noise: dict[str, float] | None = None
+    #: named effects that a Masing element with a free-form virgin curve explains as well
+    #: (:func:`contactlab.diagnose.shape.rival_share`): each a dict with ``effect``,
+    #: ``share`` (of its gain the free-form curve reaches), ``gain_effect`` and
+    #: ``gain_virgin`` (σ²) and ``rms`` (of the free-form fit, output units); a non-empty
+    #: list flags the misfit
+    rivals: tuple[dict[str, Any], ...] | list[dict[str, Any]] = ()
 
     def to_dict(self) -> dict[str, Any]:
         """JSON layout of ``"unexplained"`` (a contract; see the README's JSON section)."""
@@ -216,6 +228,7 @@ class Unexplained:
             "eiv_bias_rms": self.eiv_bias_rms,
             "absorbing": list(self.absorbing),
             "input_noise": None if self.input_noise is None else dict(self.input_noise),
+            "rivals": [dict(r) for r in self.rivals],
         }
 
     def sentence(self) -> str:
@@ -242,6 +255,24 @@ class Unexplained:
 
     def _verdict(self) -> str:
         bb = self.backbone or {}
+        if (
+            self.flagged
+            and self.rivals
+            and self.statistic <= self.threshold
+            and not bb.get("flagged")
+        ):
+            names = "; ".join(
+                f"{r['effect']} (a free-form virgin curve reaches {100 * r['share']:.0f} % of "
+                f"its gain, RMS {r['rms']:.3g} {self.unit})"
+                for r in self.rivals
+            )
+            return (
+                "systematic misfit that no candidate explains: the shape of the virgin curve "
+                f"(branches), taken up by named effects that a Masing element with a "
+                f"free-form virgin curve explains as well: {names}; after them the phase "
+                f"bins see T = {self.statistic:.3g} <= {self.threshold:.3g} over "
+                f"{self.cycles} cycles"
+            )
         if self.flagged and bb.get("flagged") and self.statistic <= self.threshold:
             return (
                 "systematic misfit that no candidate explains: the shape of the virgin curve "

@@ -264,14 +264,20 @@ def diagnose(
     t, u, y = _checked_arrays(recording, family, folds, max_effects, z, min_gain)
     y, sign_note = path.orient(t, u, y, force_sign)
     hum_note = None
+    hum_kept: list[dict[str, float]] = []
     if family.kind == "tangential":  # (diagvel: mains hum on both channels feeds a delay)
-        from ._mains import remove_mains
+        from ._mains import kept_hum, remove_mains
 
+        hum_kept, hum_kept_note = kept_hum(t, u, y)
         u, y, hum_note = remove_mains(t, u, y)
+        if hum_kept_note:
+            hum_note = f"{hum_note}; {hum_kept_note}" if hum_note else hum_kept_note
     names = _candidate_names(family, candidates)
     taps, declared_noise = _declared(recording, family, output_filter, output_noise, t.size, y)
     notes = [n for n in (sign_note, hum_note, _same_clock(recording, names, candidates)) if n]
     d, reduced = path.prepare(t, u, y, taps)
+    if family.kind == "tangential" and hum_kept:
+        d.extra["hum_kept"] = hum_kept
     prior, prior_notes = _ready(family, d, recording, context, taps)
     # a family whose floors are totals over the record (normal contact: gain_scale)
     min_gain = min_gain * float(d.extra.get("gain_scale", 1.0))
@@ -285,6 +291,7 @@ def diagnose(
     st = _search(b, names, d, folds, z, min_gain, max_effects, where)
     checks = _assess(b, d, st, names, z, min_gain, folds, declared_noise, location)
     checks = _withdraw(b, d, st, names, z, min_gain, folds, declared_noise, location, checks)
+    checks = _rivals(b, d, st, checks)
     if checks["unexplained"] is not None and checks["unexplained"].flagged:
         st.where.append(checks["unexplained"].sentence())
     report = _report(b.family, path, recording, regime, d, st, b.sigma, location)
@@ -476,6 +483,47 @@ def _withdraw(
     return checks
 
 
+def _rivals(b: _Base, d: Prepared, st: SearchState, checks: dict[str, Any]) -> dict[str, Any]:
+    """A named effect that a free-form virgin curve explains as well (issue 29 item 3).
+
+    A virgin curve of another shape is taken up by named effects that are no shape of the
+    branches (a tanh virgin curve named normal_load or stribeck): after them the residual
+    looks white and the misfit tests stay silent. For each named effect of
+    :data:`.shape.SHAPE_RIVALS` the final model is refitted without it, and a Masing
+    element with a free-form virgin curve is fitted to that refit's residual
+    (:func:`.shape.rival_share`): where it reaches :data:`.shape.RIVAL_SHARE` of the
+    effect's gain, the effect's evidence is equally a misfit of the branch shape, and the
+    misfit is flagged (``unexplained.rivals``; the effect stays named, with that caveat).
+    Returns the closing checks, updated."""
+    from .select import specs_for
+    from .shape import RIVAL_SHARE, RIVAL_SHARE_OWN, SHAPE_RIVALS, rival_share
+
+    u = checks["unexplained"]
+    p = dict(st.current.full.params)
+    effects = tuple(st.current.effects)
+    if u is None or b.family.kind != "tangential" or "ac" not in p:
+        return checks
+    r1 = -st.current.full_residual(d)
+    found: list[dict[str, Any]] = []
+    for e in effects:
+        if e not in SHAPE_RIVALS:
+            continue
+        rest = tuple(x for x in effects if x != e)
+        try:
+            f = fit(b.family, rest, d, np.ones(d.y.size, bool), p, b.scales)
+            r0 = d.y - b.family.predict(f.params, rest, d)
+        except (ConvergenceError, InputError):
+            continue
+        n_par = len(specs_for(b.family, effects)) - len(specs_for(b.family, rest))
+        got = rival_share(d, r1, r0, float(p["ac"]), b.sigma, n_par)
+        if got is not None and got["share"] >= RIVAL_SHARE_OWN.get(e, RIVAL_SHARE):
+            found.append({"effect": e, **got})
+    if not found:
+        return checks
+    checks["unexplained"] = dataclasses.replace(u, flagged=True, rivals=found)
+    return checks
+
+
 def _signature(family: Family, name: str, d: Prepared) -> str | None:
     """The data's own evidence for the effect ``name``, independent of any fit (the
     effect's ``signature(d)``: series compliance's straight turns), or None."""
@@ -542,6 +590,28 @@ def _meta(recording: Any) -> dict[str, Any]:
     return dict(meta) if isinstance(meta, dict) else {}
 
 
+def _output_noise(
+    family: Family, params: dict[str, float], d: Prepared, residual: np.ndarray
+) -> float:
+    """The output noise RMS the detection judges gains in: the white estimate from the
+    residual's third differences, or, for a tangential record whose residual's spectrum
+    shows the noise coloured (an anti-alias filter on the force), the spectral one
+    (:func:`.detection.output_noise_rms`, kept in ``d.extra["y_noise_spectral"]`` for the
+    closing checks)."""
+    white = noise_rms(residual)
+    d.extra.pop("y_noise_spectral", None)
+    if family.kind != "tangential":
+        return white
+    from .detection import model_slope, output_noise_rms
+
+    slope = model_slope(family, params, d) if float(d.extra.get("u_noise", 0.0) or 0.0) else None
+    coloured = output_noise_rms(d, residual, slope, white)
+    if coloured is None:
+        return white
+    d.extra["y_noise_spectral"] = coloured
+    return coloured
+
+
 @dataclass
 class _Base:
     """The base model as the search starts from it."""
@@ -572,7 +642,9 @@ def _fit_base(
         start = family.initial_base(d)
     fold_masks(d, folds)  # too few cycles to hold any out: said before fitting
     base_all = fit(family, effects, d, np.ones(d.y.size, bool), start, scales)
-    sigma = declared_noise or noise_rms(family.predict(base_all.params, effects, d) - d.y)
+    sigma = declared_noise or _output_noise(
+        family, base_all.params, d, family.predict(base_all.params, effects, d) - d.y
+    )
     if sigma <= 0:
         raise InputError("the output channel has no noise at all; cannot judge significance")
     budget = 0.0
@@ -580,7 +652,9 @@ def _fit_base(
     if w is not None:  # errors in variables: refit the base with the likelihood's weights
         d.extra["weight"], budget = w
         current = evaluate(family, effects, d, base_all.params, scales, folds, parallel=True)
-        sigma = declared_noise or noise_rms(current.full_residual(d))
+        sigma = declared_noise or _output_noise(
+            family, current.full.params, d, current.full_residual(d)
+        )
     else:
         current = evaluate(family, effects, d, start, scales, folds, base_all, parallel=True)
     anchored, unanchored = None, {}

@@ -287,11 +287,12 @@ class Structure:
             computes ``x``, ``v``, ``joint_energy`` and ``input_work`` (its convergence check).
         tol : float, optional
             Error-controlled stepping (the default, ``tol`` = :data:`DEFAULT_TOL`). Bouc-Wen,
-            Jenkins, Iwan, Kelvin-Voigt and normal-contact joints: each piece of a sample
-            interval is one Newmark step corrected twice by the two-point Hermite rule
+            Masing, Jenkins, Iwan, Kelvin-Voigt and normal-contact joints: each piece of a
+            sample interval is one Newmark step corrected twice by the two-point Hermite rule
             (fourth order; the jerk from the equation of motion), and pieces are shortened
             until the change of the second correction is at most ``tol`` relative to the
-            largest displacement and velocity so far. Masing joints, joints of any
+            largest displacement and velocity so far (pieces also end where a Masing branch
+            closes). Joints of any
             :mod:`contactlab.joints` law and stiff structures: each piece is a Newmark step
             checked against two half steps, the pair's Richardson extrapolation is kept
             (fourth order) and the pair's difference / 3 is held to ``tol``. Pieces end on

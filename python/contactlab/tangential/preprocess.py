@@ -158,7 +158,8 @@ def find_reversals(
     if ta.size != xa.size:
         raise InputError(f"t has {ta.size} samples but x has {xa.size}")
     lo_p, hi_p = tail_percentiles(xa)
-    return _reversals(xa, ta, (lo_p, hi_p), rel_threshold, threshold)
+    # (x scanned finite by as_1d unless the caller checked it)
+    return _reversals(xa, ta, (lo_p, hi_p), rel_threshold, threshold, finite=not checked)
 
 
 def _reversals(
@@ -167,9 +168,12 @@ def _reversals(
     percentiles: tuple[float, float],
     rel_threshold: float,
     threshold: float | None,
+    *,
+    finite: bool = False,
 ) -> Reversals:
     """:func:`find_reversals` of checked float64 ``xa``, ``ta`` whose 0.5 and 99.5
-    percentiles (:func:`tail_percentiles`) are ``percentiles``."""
+    percentiles (:func:`tail_percentiles`) are ``percentiles``; ``finite``: ``xa`` was
+    scanned finite already (the reversal detector does not scan it again)."""
     lo_p, hi_p = percentiles
     centre = 0.5 * (lo_p + hi_p)
     amp = 0.5 * (hi_p - lo_p)
@@ -180,7 +184,7 @@ def _reversals(
     if not threshold > 0:
         raise InputError(f"the displacement does not move (amplitude {amp:g}); no reversals")
     # Excursions beyond the band (Rust detector): +1 = above it since the last time below.
-    ex = excursions(xa, centre, float(threshold))
+    ex = excursions(xa, centre, float(threshold), finite=finite)
     empty = np.empty(0, dtype=np.int64)
     if len(ex) == 0:
         return Reversals(empty, empty, np.empty(0), np.empty(0), float(threshold), centre)

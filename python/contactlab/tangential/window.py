@@ -14,6 +14,7 @@ import numpy as np
 from .. import _core
 from .._arrays import as_1d
 from .._physical import check_channel
+from ..errors import InputError
 from ..io import Recording
 from . import lag, steps
 from .analysis import _analyze, _check_options, _inputs, analyze_tangential
@@ -166,8 +167,12 @@ def window_detrended(
     n_points, rel = opts["n_points"], opts["rel_threshold"]
     min_cycles = opts["min_cycles"]
     if checked:
-        tc = None if ta is None else as_1d(ta, "t")
-        rev = find_reversals(xa, tc, rel_threshold=rel, checked=True)
+        # find_reversals(checked=True) of an x known finite: the reversal detector does not
+        # scan it again
+        tc = np.arange(xa.size, dtype=float) if ta is None else as_1d(ta, "t")
+        if tc.size != xa.size:
+            raise InputError(f"t has {tc.size} samples but x has {xa.size}")
+        rev = _reversals(xa, tc, tail_percentiles(xa), rel, None, finite=True)
     else:
         rev = find_reversals(xa, ta, rel_threshold=rel)  # checks x and t
         Fa = as_1d(Fa, "F")
@@ -203,7 +208,7 @@ def window_detrended(
         )
         return steps.Detrended(x, F, loop, drift)
     pct = _lerp_tails(scan.order_stats, sel[1]) if sel is not None else tail_percentiles(x)
-    rev = _reversals(x, tt, pct, rel, None)
+    rev = _reversals(x, tt, pct, rel, None, finite=True)  # (the scan found x finite)
     loop = _fold_loop(x, F, tt, rev, n_points=n_points, min_cycles=min_cycles, scan=scan)
     return steps.Detrended(x, F, loop, drift)
 

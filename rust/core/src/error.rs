@@ -73,12 +73,9 @@ pub enum CoreError {
 
 /// Return `Err(NonFinite)` naming the first non-finite sample of `data`.
 pub fn check_finite(name: &'static str, data: &[f64]) -> Result<(), CoreError> {
-    // blocks of 64 tested without an early exit (the compiler vectorises that), the first
-    // offending index searched only in a block that has one
-    if data
-        .chunks(64)
-        .all(|c| c.iter().fold(true, |ok, v| ok & v.is_finite()))
-    {
+    // blocks of 64 tested without an early exit (the compiler vectorises that, for the
+    // CPU's SIMD level), the first offending index searched only in a block that has one
+    if all_finite_at(crate::simd::level(), data) {
         return Ok(());
     }
     match data.iter().position(|v| !v.is_finite()) {
@@ -89,6 +86,17 @@ pub fn check_finite(name: &'static str, data: &[f64]) -> Result<(), CoreError> {
         }),
         None => Ok(()),
     }
+}
+
+crate::simd::dispatch! {
+    /// Whether every value of `data` is finite, the scan compiled for `level`.
+    fn all_finite_at(data: &[f64]) -> bool = all_finite_generic;
+}
+
+#[inline(always)]
+fn all_finite_generic(data: &[f64]) -> bool {
+    data.chunks(64)
+        .all(|c| c.iter().fold(true, |ok, v| ok & v.is_finite()))
 }
 
 /// Return `Err(OutOfRange)` naming the first non-finite value of a kernel's result (inputs
@@ -133,5 +141,38 @@ pub fn check_same_len(
             name_b,
             len_b,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_finiteness_scan_is_the_same_on_every_simd_level() {
+        for n in [0_usize, 1, 63, 64, 65, 1000] {
+            let v: Vec<f64> = (0..n).map(|i| i as f64 - 3.5).collect();
+            for bad in [
+                None,
+                Some(f64::NAN),
+                Some(f64::INFINITY),
+                Some(f64::NEG_INFINITY),
+            ] {
+                for at in [0, n / 2, n.saturating_sub(1)] {
+                    let mut w = v.clone();
+                    if let (Some(b), true) = (bad, n > 0) {
+                        w[at] = b;
+                    }
+                    let want = w.iter().all(|x| x.is_finite());
+                    for level in crate::simd::Level::ALL
+                        .into_iter()
+                        .filter(|l| l.supported())
+                    {
+                        assert_eq!(all_finite_at(level, &w), want, "{level:?} n={n} at={at}");
+                    }
+                    assert_eq!(check_finite("v", &w).is_ok(), want);
+                }
+            }
+        }
     }
 }

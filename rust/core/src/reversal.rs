@@ -73,19 +73,89 @@ impl Schmitt {
             check_same_len("x", trigger.len(), "value", v.len())?;
             check_finite("value", v)?;
         }
+        self.push_finite(trigger, value, done)
+    }
+
+    /// [`Schmitt::push`] of samples the caller has checked finite (an analysis window's,
+    /// scanned already): the same excursions without the finiteness pass over them (a NaN
+    /// or an infinity only makes the excursions meaningless). `value`, when given, must be
+    /// as long as `trigger`.
+    ///
+    /// # Errors
+    /// [`CoreError::LengthMismatch`] for a `value` of another length,
+    /// [`CoreError::TooLong`] when the sample count would overflow.
+    pub fn push_finite(
+        &mut self,
+        trigger: &[f64],
+        value: Option<&[f64]>,
+        done: &mut Vec<Excursion>,
+    ) -> Result<(), CoreError> {
+        if let Some(v) = value {
+            check_same_len("x", trigger.len(), "value", v.len())?;
+        }
         let value = value.unwrap_or(trigger);
         let end = u64::try_from(trigger.len())
             .ok()
             .and_then(|n| self.count.checked_add(n))
             .ok_or(CoreError::TooLong { len: trigger.len() })?;
-        let hi = self.centre + self.threshold;
-        let lo = self.centre - self.threshold;
-        let centre = self.centre;
+        self.push_loop(crate::simd::level(), trigger, value, done, end);
+        Ok(())
+    }
+
+    /// The loop of [`Schmitt::push_finite`] compiled for `level` (AVX2 / AVX-512 when the
+    /// CPU has them: comparisons and selects only, so every level makes the same decisions)
+    /// over `trigger` and `value` of one length; `end` the sample count after them.
+    fn push_loop(
+        &mut self,
+        level: crate::simd::Level,
+        trigger: &[f64],
+        value: &[f64],
+        done: &mut Vec<Excursion>,
+        end: u64,
+    ) {
+        self.open = crate::simd::run(
+            level,
+            PushLoop {
+                st: self,
+                trigger,
+                value,
+                done,
+            },
+        );
+        self.count = end;
+    }
+}
+
+/// [`Schmitt::push`]'s loop over checked samples as a [`crate::simd::Kernel`]: the open
+/// excursion after the samples.
+struct PushLoop<'a> {
+    st: &'a Schmitt,
+    trigger: &'a [f64],
+    value: &'a [f64],
+    done: &'a mut Vec<Excursion>,
+}
+
+impl crate::simd::Kernel for PushLoop<'_> {
+    type Output = Option<Excursion>;
+
+    // Index arithmetic: i < n, stop <= n; the sample index is saturating.
+    #[allow(clippy::arithmetic_side_effects)]
+    #[inline(always)]
+    fn run_at(self) -> Option<Excursion> {
+        let PushLoop {
+            st,
+            trigger,
+            value,
+            done,
+        } = self;
+        let hi = st.centre + st.threshold;
+        let lo = st.centre - st.threshold;
+        let centre = st.centre;
         // the open excursion in locals (an `Option<Excursion>` matched every sample kept it
         // in memory: 7 ns a sample, against about 2 now); the same decisions as
         // `push_reference` in the tests, sample for sample
-        let mut has = self.open.is_some();
-        let mut e = self.open.unwrap_or(Excursion {
+        let mut has = st.open.is_some();
+        let mut e = st.open.unwrap_or(Excursion {
             sign: 1,
             start: 0,
             extreme: 0,
@@ -96,7 +166,7 @@ impl Schmitt {
         let mut sign_f = f64::from(e.sign);
         let n = trigger.len().min(value.len());
         let mut i = 0_usize;
-        let mut index = self.count;
+        let mut index = st.count;
         while i < n {
             let stop = i.saturating_add(BLOCK).min(n);
             let (ub, vb) = (&trigger[i..stop], &value[i..stop]);
@@ -155,15 +225,18 @@ impl Schmitt {
             }
             i = stop;
         }
-        let open = if has { Some(e) } else { None };
-        self.open = open;
-        self.count = end;
-        Ok(())
+        if has {
+            Some(e)
+        } else {
+            None
+        }
     }
 }
 
-/// Samples a block of [`Schmitt::push`]'s fast path holds.
+/// Samples a block of [`Schmitt::push`]'s fast path holds (at most 64: one bit a sample in
+/// [`mask_of`]'s masks).
 const BLOCK: usize = 32;
+const _: () = assert!(BLOCK <= 64);
 
 /// One block of samples `(u, v)` (trigger, value; finite, [`BLOCK`] long) of the open
 /// excursion `e` (above the band when `UP`, else below), its first sample's index `base`:
@@ -208,33 +281,43 @@ fn side_block<const UP: bool>(
     }
     let back_of = |x: f64| if UP { x < centre } else { x > centre };
     let beyond_of = |x: f64| if UP { x > hi } else { x < lo };
+    // the block's samples back beyond the centre and beyond the band as bit masks (bit k:
+    // sample k; branch-free, so they vectorise): the first sample after the new extreme
+    // back beyond the centre, and the last beyond the band, without a scalar search
+    let back = mask_of(u, back_of);
     if better(top, e.extreme_value) {
         // the first sample of the block's extreme value (numerically equal: ±0 are one; top
         // is one of the block's values, as it beats the excursion's)
-        let m = v.iter().position(|&x| x == top).unwrap_or(0);
+        let at = mask_of(v, |x| x == top);
+        let m = if at == 0 {
+            0
+        } else {
+            at.trailing_zeros() as usize
+        };
         e.extreme = base + m as u64;
         e.extreme_value = v[m];
-        // beyond the centre after it
-        e.returned = any_of(&u[m + 1..], back_of);
+        // beyond the centre after it (m < BLOCK <= 64: both shifts are defined)
+        e.returned = (back >> m) >> 1 != 0;
     } else {
-        e.returned |= any_of(u, back_of);
+        e.returned |= back != 0;
     }
-    // the block's last sample beyond the band (a vectorised test first: most blocks of an
-    // excursion have none, or all)
-    if any_of(u, beyond_of) {
-        if let Some(k) = u.iter().rposition(|&x| beyond_of(x)) {
-            e.last_beyond = base + k as u64;
-        }
+    // the block's last sample beyond the band
+    let beyond = mask_of(u, beyond_of);
+    if beyond != 0 {
+        e.last_beyond = base + u64::from(beyond.ilog2()); // the highest bit set (beyond != 0)
     }
     true
 }
 
-/// Whether `f` holds for any of `xs`: bitwise ors, no early exit, so the test vectorises
-/// (a block's "any" was a bit a sample shifted into a mask, then tested).
+/// Bit `k` set where `f(xs[k])` holds (`xs` at most 64 long): branch-free, so it vectorises
+/// (a compare and a move-mask a few samples).
 #[inline(always)]
-#[allow(clippy::needless_bitwise_bool)]
-fn any_of(xs: &[f64], f: impl Fn(f64) -> bool) -> bool {
-    xs.iter().fold(false, |a, &x| a | f(x))
+fn mask_of(xs: &[f64; BLOCK], f: impl Fn(f64) -> bool) -> u64 {
+    let mut m = 0_u64;
+    for (k, &x) in xs.iter().enumerate() {
+        m |= u64::from(f(x)) << k;
+    }
+    m
 }
 
 #[cfg(test)]
@@ -337,6 +420,12 @@ mod tests {
             let mut a = Schmitt::new(centre, thr).unwrap();
             let mut b = a.clone();
             let (mut da, mut db) = (Vec::new(), Vec::new());
+            // the loop compiled for every SIMD level this CPU has (the same decisions)
+            let mut at: Vec<_> = crate::simd::Level::ALL
+                .into_iter()
+                .filter(|l| l.supported())
+                .map(|l| (l, a.clone(), Vec::new()))
+                .collect();
             // two chunks, the second in pieces of `piece` samples: the open excursion (its
             // return flag above all) compared after every push
             let mut ends = vec![cut];
@@ -348,10 +437,35 @@ mod tests {
                 a.push(&u[s0..s1], Some(&v[s0..s1]), &mut da).unwrap();
                 push_reference(&mut b, &u[s0..s1], &v[s0..s1], &mut db);
                 proptest::prop_assert_eq!(&a, &b);
+                for (level, st, d) in &mut at {
+                    let end = st.count + (s1 - s0) as u64;
+                    st.push_loop(*level, &u[s0..s1], &v[s0..s1], d, end);
+                    proptest::prop_assert_eq!(&*st, &b, "level {:?}", level);
+                }
                 s0 = s1;
             }
             proptest::prop_assert_eq!(&da, &db);
+            for (level, _, d) in &at {
+                proptest::prop_assert_eq!(d, &db, "level {:?}", level);
+            }
         }
+    }
+
+    #[test]
+    fn push_finite_is_push_without_the_check() {
+        let x: Vec<f64> = (0..5000).map(|i| (f64::from(i) * 0.01).sin()).collect();
+        let (mut a, mut da) = (Schmitt::new(0.0, 0.5).unwrap(), Vec::new());
+        let (mut b, mut db) = (a.clone(), Vec::new());
+        a.push(&x, None, &mut da).unwrap();
+        b.push_finite(&x, None, &mut db).unwrap();
+        assert_eq!((a, da), (b, db));
+        // the check is push's: a NaN is refused by push, not by push_finite
+        let mut y = x.clone();
+        y[77] = f64::NAN;
+        let mut c = Schmitt::new(0.0, 0.5).unwrap();
+        assert!(c.push(&y, None, &mut Vec::new()).is_err());
+        assert!(c.push_finite(&y, None, &mut Vec::new()).is_ok());
+        assert!(c.push_finite(&y, Some(&y[1..]), &mut Vec::new()).is_err());
     }
 
     #[test]

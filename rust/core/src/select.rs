@@ -41,11 +41,28 @@ fn select_into(v: &mut [f64], ranks: &[usize], offset: usize, out: &mut [f64]) {
 pub fn order_stats(x: &[f64], ranks: &[usize]) -> Result<Vec<f64>, CoreError> {
     let mut g = TailGather::new(x.len(), ranks, STRIDE, |i| x[i])?;
     if g.gathering() {
-        for block in x.chunks(GATHER) {
-            g.block(block);
-        }
+        // the gathering pass compiled for the CPU's SIMD level (the same tails on every one)
+        crate::simd::run(crate::simd::level(), GatherPass { x, gather: &mut g });
     }
     Ok(g.finish(x))
+}
+
+/// The gathering pass of [`order_stats`] as a [`crate::simd::Kernel`] (compiled for the
+/// CPU's SIMD level: the same tails on every one).
+struct GatherPass<'a> {
+    x: &'a [f64],
+    gather: &'a mut TailGather,
+}
+
+impl crate::simd::Kernel for GatherPass<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run_at(self) {
+        for block in self.x.chunks(GATHER) {
+            self.gather.block(block);
+        }
+    }
 }
 
 /// [`order_stats`] split into its steps, so that another kernel's pass over the samples can
@@ -149,8 +166,9 @@ impl TailGather {
     /// The next block of at most [`GATHER_BLOCK`] samples (in order).
     // Index arithmetic: the buffers grow a block ahead; il, ih < GATHER after the mask.
     // Bitwise ors: no early exit, so the prefilter's test vectorises.
+    // Inlined whole into its callers' passes, which are compiled for the CPU's SIMD level.
     #[allow(clippy::arithmetic_side_effects, clippy::needless_bitwise_bool)]
-    #[inline]
+    #[inline(always)]
     pub fn block(&mut self, block: &[f64]) {
         let Some((lo, hi)) = self.thresholds else {
             return;

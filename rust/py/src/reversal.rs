@@ -68,20 +68,25 @@ impl ReversalDetector {
     }
 
     /// Excursions completed in this chunk (an `ExcursionTable`). `value` (default `x`) is where extremes are
-    /// located.
-    #[pyo3(signature = (x, value=None))]
+    /// located. `finite`: the caller has checked the samples finite (no pass to check them).
+    #[pyo3(signature = (x, value=None, finite=false))]
     fn push<'py>(
         &mut self,
         py: Python<'py>,
         x: PyReadonlyArray1<'py, f64>,
         value: Option<PyReadonlyArray1<'py, f64>>,
+        finite: bool,
     ) -> PyResult<ExcursionTable> {
         let xs = slice(&x, "x")?;
         let vs = value.as_ref().map(|v| slice(v, "value")).transpose()?;
         let mut st = self.inner.clone();
         let (done, st) = detach_guarded(py, || {
             let mut done = Vec::new();
-            st.push(xs, vs, &mut done)?;
+            if finite {
+                st.push_finite(xs, vs, &mut done)?;
+            } else {
+                st.push(xs, vs, &mut done)?;
+            }
             Ok((done, st))
         })?;
         self.inner = st;

@@ -237,6 +237,90 @@ impl JointLaw {
         }
     }
 
+    /// The relative displacement inside the monotone move from `state` to `d_new` at which
+    /// the law's tangent jumps without an [`JointLaw::event`], and the jump: a Masing branch
+    /// closing ([`masing_kink`]). `None` for every other law, or no such point.
+    #[inline]
+    pub fn kink(&self, state: &JointState, d_new: f64) -> Option<(f64, f64)> {
+        match (self, state) {
+            (Self::Masing { curve, scale }, JointState::Masing(st)) => {
+                masing_kink(curve, *scale, st, d_new)
+            }
+            _ => None,
+        }
+    }
+
+    /// The first stick-slip transition of a Jenkins/Iwan element on the monotone move
+    /// `d_old → d_new` from `state` beyond the fraction `floor` of the move (an element's force
+    /// is linear in `d` while it sticks), as a fraction of the move; `None`: none, or another
+    /// law. (Transitions at most `floor` in are left to the piece that contains them, so that
+    /// they do not hide a later event.)
+    #[inline]
+    pub fn slip_after(
+        &self,
+        state: &JointState,
+        d_old: f64,
+        d_new: f64,
+        floor: f64,
+    ) -> Option<f64> {
+        let dd = d_new - d_old;
+        if dd == 0.0 {
+            return None;
+        }
+        let mut theta: Option<f64> = None;
+        let mut stick_slip = |k: f64, fs: f64, f0: f64| {
+            let ft = f0 + k * dd;
+            if f0.abs() < fs && ft.abs() > fs {
+                let t = (fs.copysign(ft) - f0) / (k * dd);
+                if t > floor && t < 1.0 {
+                    theta = Some(theta.map_or(t, |a: f64| a.min(t)));
+                }
+            }
+        };
+        match (self, state) {
+            (Self::Jenkins { k, fs }, JointState::Slider(f0)) => stick_slip(*k, *fs, *f0),
+            (Self::Iwan { k, fs }, JointState::Sliders(f0)) => {
+                for ((&ki, &fi), &f0i) in k.iter().zip(fs).zip(f0) {
+                    stick_slip(ki, fi, f0i);
+                }
+            }
+            _ => {}
+        }
+        theta
+    }
+
+    /// Whether the trial `tr` from `state` crossed a Masing branch's closure (its memory walk
+    /// dropped a branch: fewer branches kept than it started with). `false` for other laws.
+    #[inline]
+    pub fn closed(&self, state: &JointState, tr: &Trial) -> bool {
+        match (self, state) {
+            (Self::Masing { .. }, JointState::Masing(st)) => {
+                tr.aux / 2 < st.stack.len().saturating_add(tr.aux & 1)
+            }
+            _ => false,
+        }
+    }
+
+    /// A Bouc-Wen joint with `ν = 1` whose `z` changes sign over the trial `tr` from `state`:
+    /// `(z0, z1, Δ)` with `Δ` the jump of `∂(dz/dd)/∂z` there (`−βδ (sgn z1 − sgn z0)`; the
+    /// rate `dz/dd` itself is continuous, `α`, so the force's second time derivative jumps by
+    /// `Δ α ḋ²`). `None` for every other law, `ν ≠ 1`, or no sign change.
+    #[inline]
+    pub fn zero_crossing(&self, state: &JointState, tr: &Trial) -> Option<(f64, f64, f64)> {
+        match (self, state) {
+            (
+                Self::BoucWen {
+                    beta, delta, nu, ..
+                },
+                JointState::Slider(z0),
+            ) if *nu == 1.0 && *z0 * tr.f < 0.0 => {
+                let jump = -beta * delta * (tr.f.signum() - z0.signum());
+                Some((*z0, tr.f, jump))
+            }
+            _ => None,
+        }
+    }
+
     /// The virgin state (d = 0, F = 0).
     pub fn fresh_state(&self) -> JointState {
         match self {
@@ -375,6 +459,47 @@ pub(super) fn masing_trial(
         let (f, k) = curve.eval_slope((x - xa) / scale);
         return (ha + scale * f, k, 2 * len + usize::from(pushed));
     }
+}
+
+/// The closure a Masing joint in `st` (at `st.x`) crosses on a monotone move to `x1`, as
+/// `(x_k, Δk)`: the displacement `x_k` where its branch rejoins the one below (the reversal
+/// before the anchor, or the mirror point `−x_a` of a lone reversal) and the jump `Δk` of the
+/// tangent there (the outer branch's slope minus the closing one's; the force is continuous).
+/// The branch is the trial's own ([`masing_trial`]): after a reversal at `st.x` (a move
+/// against `st.dir`), the new branch anchored there. `None`: the move stays on its branch (or
+/// on the virgin curve, which never closes). Only the first closure is named: a piece that
+/// ends there finds the next one from its end.
+#[inline]
+pub(super) fn masing_kink(
+    curve: &MasingCurve,
+    scale: f64,
+    st: &MasingState,
+    x1: f64,
+) -> Option<(f64, f64)> {
+    let dx = x1 - st.x;
+    if dx == 0.0 {
+        return None;
+    }
+    let s = if dx > 0.0 { 1.0 } else { -1.0 };
+    let n = st.stack.len();
+    let reversed = st.dir != 0 && s != f64::from(st.dir);
+    let (anchor, target) = match (reversed, n) {
+        (true, 0) => (st.x, -st.x),
+        (true, _) => (st.x, st.stack[n.saturating_sub(1)].x),
+        (false, 0) => return None,
+        (false, 1) => (st.stack[0].x, -st.stack[0].x),
+        (false, _) => (
+            st.stack[n.saturating_sub(1)].x,
+            st.stack[n.saturating_sub(2)].x,
+        ),
+    };
+    if !((x1 - target) * s > 0.0 && (target - st.x) * s > 0.0) {
+        return None;
+    }
+    // the closing branch's slope there, and the outer one's (a trial at the target pops it)
+    let left = curve.slope((target - anchor) / scale);
+    let right = masing_trial(curve, scale, st, target).1;
+    Some((target, right - left))
 }
 
 /// Accept the Masing trial at `x` (force `f`, memory update `aux` from [`masing_trial`]): the

@@ -21,6 +21,32 @@ MIN_DIRECTION_SHARE = 0.25
 MAX_FLUCTUATION = 0.3
 #: position bins of that test
 _BINS = 32
+#: a fluctuation whose sideband ``f_n ± j f`` (j up to SIDEBANDS) falls within this many
+#: bins of a mains line left on both channels (:func:`contactlab.diagnose._mains.kept_hum`)
+#: draws that hum, not a load: refused
+HUM_SIDEBAND_BINS = 0.5
+SIDEBANDS = 3
+
+
+def hum_sideband(d, f_n: float) -> str | None:
+    """Why a fluctuation at ``f_n`` is the mains hum left on both channels (one of its
+    sidebands on the line), or None."""
+    lines = d.extra.get("hum_kept") or ()
+    if not lines or not d.duration > 0:
+        return None
+    f_exc = 1.0 / (d.cycles.period_samples * d.dt)
+    for h in lines:
+        for j in range(0, SIDEBANDS + 1):
+            for sb in {f_n + j * f_exc, abs(f_n - j * f_exc)}:
+                if abs(sb - h["f"]) * d.duration <= HUM_SIDEBAND_BINS:
+                    return (
+                        f"a load fluctuation at {f_n:.4g} Hz puts its sideband "
+                        f"{'f_n' if j == 0 else f'f_n ± {j}f'} = {sb:.4g} Hz on the mains line "
+                        f"at {h['f']:.4g} Hz that both channels carry (hum, {h['F']:.3g} on the "
+                        f"force): a load does not move the displacement sensor; the line is "
+                        f"left unexplained (drive harmonic {h['harmonic']} too near to remove it)"
+                    )
+    return None
 
 
 def load_terms(d, f_n: float, rows: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
@@ -134,6 +160,9 @@ class NormalLoad(EffectModel):
                 f"±{100 * MAX_FLUCTUATION:g} %) is not a fluctuation of the loaded joint: the "
                 "base model's misfit is read as one",
             )
+        hum = hum_sideband(d, p["f_n"])
+        if hum:
+            return Plausibility(False, hum)
         k = self.harmonic(d, p)
         if k == 1:
             return Plausibility(

@@ -292,7 +292,17 @@ pub(super) fn run(
             let tau1 = if step >= 1.0 - tau { 1.0 } else { tau + step };
             let span = (tau, tau1, h);
             if herm_ok && h * rate <= HERMITE_RATE {
-                let got = hermite::piece(s, &w, &mut sc, &mut hm, inp, i, (tau1, h), scale, opts);
+                let got = hermite::piece(
+                    s,
+                    &w,
+                    &mut sc,
+                    &mut hm,
+                    inp,
+                    i,
+                    (tau1, h, step),
+                    scale,
+                    opts,
+                );
                 let Some((err, theta, it)) = got else {
                     halvings = halvings.saturating_add(1);
                     if halvings > opts.max_halvings.saturating_mul(4) {

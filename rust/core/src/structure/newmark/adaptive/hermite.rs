@@ -11,12 +11,12 @@ use super::super::super::{Inputs, Options, Structure};
 use super::super::{load, matvec, newton_step, rel, Scratch, Work};
 use crate::error::CoreError;
 
-/// Whether the n-DOF error control takes Hermite pieces for these joints (not for Masing
-/// joints nor [`crate::joints`] laws, as the one-DOF path).
+/// Whether the n-DOF error control takes Hermite pieces for these joints (not for
+/// [`crate::joints`] laws, as the one-DOF path).
 pub(super) fn allowed(s: &Structure) -> bool {
     !s.joints
         .iter()
-        .any(|j| matches!(j.law, JointLaw::Law { .. } | JointLaw::Masing { .. }))
+        .any(|j| matches!(j.law, JointLaw::Law { .. }))
 }
 
 /// The buffers of the Hermite pieces.
@@ -37,6 +37,12 @@ pub(super) struct Herm {
     end: Vec<(f64, f64)>,
     dt: Vec<(f64, f64)>,
     ft: Vec<f64>,
+    /// The end tangents the jerk is taken with (`end`, less the jump of a Masing closure
+    /// just before the end), whether a joint can have such a jump, and whether the joint's
+    /// Newmark end crossed one.
+    end_j: Vec<(f64, f64)>,
+    kinks: bool,
+    crossed: Vec<bool>,
     m_lu: Lu,
 }
 
@@ -75,6 +81,12 @@ impl Herm {
             end: vec![(0.0, 0.0); nj],
             dt: vec![(0.0, 0.0); nj],
             ft: vec![0.0; nj],
+            end_j: vec![(0.0, 0.0); nj],
+            kinks: s
+                .joints
+                .iter()
+                .any(|j| matches!(j.law, JointLaw::Masing { .. })),
+            crossed: vec![false; nj],
             m_lu,
         })
     }
@@ -108,7 +120,7 @@ fn jerk(s: &Structure, hm: &mut Herm, (v, a): (&[f64], &[f64]), at_start: bool) 
             *r -= t;
         }
     }
-    let tang = if at_start { &hm.start } else { &hm.end };
+    let tang = if at_start { &hm.start } else { &hm.end_j };
     for (j, &(kt, ct)) in s.joints.iter().zip(tang) {
         let g = kt * rel(j, v) + ct * rel(j, a);
         hm.r[j.dof] -= g;
@@ -160,7 +172,7 @@ pub(super) fn piece(
     hm: &mut Herm,
     inp: &Inputs<'_>,
     i: usize,
-    (tau1, h): (f64, f64),
+    (tau1, h, step): (f64, f64, f64),
     scale: (f64, f64),
     opts: &Options,
 ) -> Option<(f64, f64, u64)> {
@@ -172,24 +184,56 @@ pub(super) fn piece(
     for ((a1, a0), j0) in sc.a1.iter_mut().zip(&w.a).zip(&hm.j0) {
         *a1 = a0 + h * j0;
     }
-    let it = newton_step(s, w, (h, 0.0, true), sc, opts)?;
+    // Newton ends without a last trial once converged quadratically (as the one-DOF path; a
+    // Masing joint's crossing of a closure is then read from its trial's memory walk)
+    let quick = opts.rtol.sqrt().min(1e-3);
+    let it = newton_step(s, w, (h, quick, true), sc, opts)?;
     let mut theta = 1.0_f64;
+    let min_piece = 1e-3 / step;
     for (jn, j) in s.joints.iter().enumerate() {
         let (d1, v1) = (rel(j, &sc.x1), rel(j, &sc.v1));
         let (d0, v0) = (w.jd[jn], w.jv[jn]);
         let (st, tr) = (&w.states[jn], &sc.trials[jn]);
-        let mut th = j.law.event(st, d0, d1, v0, v1).unwrap_or(1.0);
+        // (a stick-slip transition placed on the cubic through the ends' relative
+        // displacements and velocities, as the one-DOF path; events at most `min_piece` in
+        // left to this piece, so that they do not hide a later one)
+        let mut th = j.law.slip_after(st, d0, d1, min_piece).unwrap_or(1.0);
+        if th < 1.0 && v0 * v1 >= 0.0 {
+            let dk = d0 + th * (d1 - d0);
+            th = reversal(th, (d0 - dk, h * v0), (d1 - dk, h * v1));
+        }
+        if th <= min_piece {
+            th = 1.0;
+        }
         if v0 * v1 < 0.0 {
             let lin = v0 / (v0 - v1);
             if th >= lin {
                 th = reversal(lin, (v0, h * rel(j, &w.a)), (v1, h * rel(j, &sc.a1)));
             }
         }
-        theta = theta.min(th);
         hm.start[jn] = j.law.start_tangent(st, d0, d1, tr).unwrap_or(hm.tang[jn]);
         hm.end[jn] = (tr.kt, tr.ct);
+        hm.end_j[jn] = hm.end[jn];
         hm.dt[jn] = (d1, v1);
         hm.ft[jn] = tr.f;
+        hm.crossed[jn] = hm.kinks && j.law.closed(st, tr);
+        if hm.kinks {
+            if let Some((xk, dk)) = j.law.kink(st, d1) {
+                // a Masing branch closing (its tangent jumps by dk): as the one-DOF path
+                let lin = (xk - d0) / (d1 - d0);
+                let tk = reversal(lin, (d0 - xk, h * v0), (d1 - xk, h * v1));
+                if tk <= min_piece {
+                    hm.start[jn].0 += dk;
+                } else if tk >= 1.0 - min_piece {
+                    hm.end_j[jn].0 -= dk;
+                } else {
+                    th = th.min(tk);
+                }
+            }
+        }
+        if th > min_piece {
+            theta = theta.min(th);
+        }
     }
     jerk(s, hm, (&w.v, &w.a), true);
     let (h2, h3) = (h * h, h * h * h);
@@ -205,25 +249,31 @@ pub(super) fn piece(
                 + h2 / 20.0 * (7.0 * a0 + 3.0 * a1)
                 + h3 / 60.0 * (3.0 * j0 - 2.0 * j1);
         }
-        // a = M⁻¹ (f − C v − K x − G), the joints carried along their tangents
-        sc.r.copy_from_slice(&sc.f1);
-        for (mat, vec) in [(&s.c, &sc.v1), (&s.k, &sc.x1)] {
-            matvec(mat, vec, n, &mut sc.tmp);
-            for (r, t) in sc.r.iter_mut().zip(&sc.tmp) {
-                *r -= t;
-            }
-        }
+        // the joints carried along their tangents
         for (jn, j) in s.joints.iter().enumerate() {
             let ((kt, ct), (d, v)) = (hm.end[jn], hm.dt[jn]);
-            let g = hm.ft[jn] + kt * (rel(j, &sc.x1) - d) + ct * (rel(j, &sc.v1) - v);
-            sc.trials[jn].f = g;
-            sc.r[j.dof] -= g;
-            if let Some(q) = j.dof2 {
-                sc.r[q] += g;
+            sc.trials[jn].f = hm.ft[jn] + kt * (rel(j, &sc.x1) - d) + ct * (rel(j, &sc.v1) - v);
+        }
+        equilibrium(s, sc, hm);
+    }
+    if hm.kinks {
+        // a corrected end across a closure the Newmark end had not crossed (or back): the
+        // joint tried anew there, so that its memory is the end's
+        let mut again = false;
+        for (jn, j) in s.joints.iter().enumerate() {
+            let st = &w.states[jn];
+            let d1 = rel(j, &sc.x1);
+            if j.law.kink(st, d1).is_some() != hm.crossed[jn] {
+                let tr = j.law.trial(st, w.jd[jn], d1, rel(j, &sc.v1));
+                hm.end[jn] = (tr.kt, tr.ct);
+                hm.end_j[jn] = hm.end[jn];
+                sc.trials[jn] = tr;
+                again = true;
             }
         }
-        hm.m_lu.solve(&mut sc.r);
-        sc.a1.copy_from_slice(&sc.r);
+        if again {
+            equilibrium(s, sc, hm);
+        }
     }
     let (mut ex, mut ev, mut sx, mut sv) = (0.0_f64, 0.0_f64, scale.0, scale.1);
     for d in 0..n {
@@ -235,6 +285,28 @@ pub(super) fn piece(
     let rel_err = |e: f64, sz: f64| if e == 0.0 { 0.0 } else { e / sz };
     let err = rel_err(ex, sx).max(rel_err(ev, sv));
     Some((if err.is_nan() { f64::INFINITY } else { err }, theta, it))
+}
+
+/// `sc.a1 = M⁻¹ (f − C v − K x − G)` at the end in `sc`, the joints' forces `sc.trials[].f`.
+// Joint DOFs < n (checked in `Structure::new`); the buffers are n long.
+#[allow(clippy::arithmetic_side_effects)]
+fn equilibrium(s: &Structure, sc: &mut Scratch, hm: &mut Herm) {
+    let n = s.n;
+    sc.r.copy_from_slice(&sc.f1);
+    for (mat, vec) in [(&s.c, &sc.v1), (&s.k, &sc.x1)] {
+        matvec(mat, vec, n, &mut sc.tmp);
+        for (r, t) in sc.r.iter_mut().zip(&sc.tmp) {
+            *r -= t;
+        }
+    }
+    for (j, tr) in s.joints.iter().zip(&sc.trials) {
+        sc.r[j.dof] -= tr.f;
+        if let Some(q) = j.dof2 {
+            sc.r[q] += tr.f;
+        }
+    }
+    hm.m_lu.solve(&mut sc.r);
+    sc.a1.copy_from_slice(&sc.r);
 }
 
 /// `∫ g dt` over a piece of length `h` by the two-point Hermite rule: `g` and `ġ` at both ends.
@@ -278,10 +350,17 @@ pub(super) fn accept(
         let (v0, a0, v1, a1) = (w.jv[jn], rel(j, &w.a), rel(j, &sc.v1), rel(j, &sc.a1));
         let ((kt0, ct0), (kt1, ct1)) = (hm.start[jn], hm.end[jn]);
         let f0 = w.jf[jn];
-        let g0 = (f0 * v0, (kt0 * v0 + ct0 * a0) * v0 + f0 * a0);
-        let g1 = (tr.f * v1, (kt1 * v1 + ct1 * a1) * v1 + tr.f * a1);
-        w.jwork[jn] += rule(h, g0, g1);
         let d1 = rel(j, &sc.x1);
+        if matches!(j.law, JointLaw::Masing { .. }) {
+            // the Hermite rule in d (rate-independent; as the one-DOF path's `masing_work`),
+            // with the tangents of the branch the piece is on at both ends
+            let (dd, k1) = (d1 - w.jd[jn], hm.end_j[jn].0);
+            w.jwork[jn] += 0.5 * dd * (f0 + tr.f) + dd * dd / 12.0 * (kt0 - k1);
+        } else {
+            let g0 = (f0 * v0, (kt0 * v0 + ct0 * a0) * v0 + f0 * a0);
+            let g1 = (tr.f * v1, (kt1 * v1 + ct1 * a1) * v1 + tr.f * a1);
+            w.jwork[jn] += rule(h, g0, g1);
+        }
         j.law.commit(&mut w.states[jn], w.jd[jn], d1, tr)?;
         w.jf[jn] = tr.f;
         w.jd[jn] = d1;
