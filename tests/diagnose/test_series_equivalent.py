@@ -3,6 +3,7 @@ compares these with the base fit), against the sheared backbone's own initial sl
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -50,3 +51,14 @@ def test_a_compliance_at_twice_its_bound_is_named():
     assert rep.effect_names == ["series_compliance"]
     k_s = 1.0 / rep.final_model.params["C_s"]
     assert 0.5 < k_s * 2.92e-7 < 2.0
+
+
+def test_no_compliance_is_promised_where_the_loops_never_reach_a_plateau():
+    from types import SimpleNamespace
+
+    eff = registry("tangential")["series_compliance"]
+    d = SimpleNamespace(u=np.array([-1e-4, 1e-4]))  # A = 1e-4 m
+    assert eff.not_separable(d, {"h0": 40.0, "ac": 2.0e4}) is None  # ac·A 2
+    why = eff.not_separable(d, {"h0": 40.0, "ac": 1.2e4})  # ac·A 1.2
+    assert why.startswith("not separable from a softer contact")
+    assert "ac·A = 1.2 < 1.5" in why

@@ -21,6 +21,11 @@ _SERIES_POINTS = 400
 STRAIGHT = 0.5
 
 
+#: below this ``ac·A`` the loops never reach their plateau and no compliance is promised
+#: (:meth:`SeriesCompliance.not_separable`; as for a parallel spring)
+PLATEAU_ACA = 1.5
+
+
 def straightness(d) -> tuple[float, int] | None:
     """The median over the record's branches of the travel to half the force's rise over
     the travel to 90 % of it (see :data:`STRAIGHT`), and the branches read; None when too
@@ -96,6 +101,27 @@ class SeriesCompliance(EffectModel):
             f"force's rise is {got[0]:.2f} of the travel to 90 % of it: a straight ramp's "
             "0.56, an exponential branch's 0.30, a tanh one's 0.37): a compliance in series "
             "draws them"
+        )
+
+    def not_separable(self, d, p):
+        """Why no compliance can be promised where the loops never reach their plateau
+        (``ac·A`` below :data:`PLATEAU_ACA`), or None: there a compliance in series is a
+        softer contact (a smaller ``ac``, docs/effects.md), which the base absorbs. On the
+        rig a compliance at its stated bound and at twice it was named 0 times in 4 at
+        ac·A 1.14 and 1.35 (its in-sample gain 0.05 σ² at the bound, 0.009 σ² at twice it;
+        position_friction named twice instead: fresh seeds 75220003-4 of
+        ``benches/eval_bound_power.py``), and 7 times in 7 at the bound at ac·A 1.98-4.8."""
+        ac = float(p.get("ac", np.nan))
+        a = 0.5 * float(np.ptp(d.u))
+        if not (np.isfinite(ac) and ac > 0 and a > 0):
+            return None
+        aca = ac * a
+        if aca >= PLATEAU_ACA:
+            return None
+        return (
+            "not separable from a softer contact on this record: its loops never reach a "
+            f"plateau (ac·A = {aca:.2g} < {PLATEAU_ACA:g}), where a compliance in series is "
+            "a smaller ac to the base"
         )
 
     def argument(self, d, p):
