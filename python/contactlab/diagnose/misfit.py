@@ -267,11 +267,12 @@ class Unexplained:
                 for r in self.rivals
             )
             return (
-                "systematic misfit that no candidate explains: the shape of the virgin curve "
-                f"(branches), taken up by named effects that a Masing element with a "
-                f"free-form virgin curve explains as well: {names}; after them the phase "
-                f"bins see T = {self.statistic:.3g} <= {self.threshold:.3g} over "
-                f"{self.cycles} cycles"
+                "systematic misfit that no candidate explains, or a named effect this record "
+                "cannot tell from it: the shape of the virgin curve (branches) and the named "
+                f"effects that a Masing element with a free-form virgin curve explains as "
+                f"well: {names}; either may be the physics (records at other amplitudes or "
+                f"rates tell them apart); after them the phase bins see "
+                f"T = {self.statistic:.3g} <= {self.threshold:.3g} over {self.cycles} cycles"
             )
         if self.flagged and bb.get("flagged") and self.statistic <= self.threshold:
             return (
