@@ -174,8 +174,9 @@ class Inertia(EffectModel):
             return None
         return (
             "not separable from parallel stiffness on this single-frequency record: no "
-            "size of a mass can be promised (a start from rest too short to resolve, no "
-            "harmonics, one frequency)"
+            "size of a mass can be promised (one frequency, no harmonics: only the start-up "
+            "from rest or a change of amplitude tells a mass from a stiffness, by an amount "
+            "no linearised bound foresees)"
         )
 
     def power_note(self, d, p):
