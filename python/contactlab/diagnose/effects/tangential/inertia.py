@@ -137,9 +137,11 @@ class Inertia(EffectModel):
             text += (
                 f"; on this single-frequency drive (ẍ = -ω² x but for {100 * share:.1g} % "
                 f"outside the start-up, ω = {np.sqrt(w2):.4g} rad/s) a mass is the "
-                f"stiffness -mω² and inertia and parallel stiffness are not separable: the "
-                f"record sets k_p - mω² = {-p['m'] * w2:.4g} N/m; a parallel spring "
-                "cannot be negative, so a mass is its physical reading"
+                f"stiffness -mω², and the steady cycles set k_p - mω² = "
+                f"{-p['m'] * w2:.4g} N/m only; a parallel spring cannot be negative, so a "
+                "mass is its physical reading (the start-up from rest or a change of "
+                "amplitude tells it from the contact's own stiffness, which takes part of "
+                "-mω² where the loops do not reach a plateau: m may read low)"
             )
         return text
 
