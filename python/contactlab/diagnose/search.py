@@ -236,6 +236,13 @@ def _try_candidate(
     )  # fmt: skip
     if v.accepted and why:
         v = dataclasses.replace(v, accepted=False, reason=f"implausible: {why}")
+    if v.accepted:
+        # an effect whose held-out gain counts as its evidence only where it lies (a mass on
+        # a single-frequency drive with no plateau: in the start-up, not the steady cycles)
+        unsep = next((w for e in (*also, name) if (w := _gain_not_its_own(family, e, d,
+                      current, cand))), None)  # fmt: skip
+        if unsep:
+            v = dataclasses.replace(v, accepted=False, reason=unsep)
     if v.accepted and hasattr(family, "identified"):
         # each new effect's size must stand out of its own error (issue 29: a held-out gain
         # the effect shares with a base parameter it trades off with is not its own)
@@ -244,6 +251,44 @@ def _try_candidate(
         if unid:
             v = dataclasses.replace(v, accepted=False, reason=unid)
     return v, cand
+
+
+def _gain_not_its_own(
+    family: Family, name: str, d: Prepared, current: Trial, cand: Trial
+) -> str | None:
+    """Why the held-out gain of the candidate model (``name`` added to ``current``) is not
+    the effect's own evidence on this record, or None: the effect's
+    ``gain_not_its_own(d, p, cycle_gain)`` given the fitted parameters and the held-out
+    gain of each cycle (weighted as the held-out error is, :func:`gain_by_cycle`)."""
+    from .effects import registry
+
+    try:
+        eff = registry(family.kind).get(name)
+    except KeyError:
+        return None
+    hook = getattr(eff, "gain_not_its_own", None)
+    if hook is None:
+        return None
+    return hook(d, cand.full.params, gain_by_cycle(d, current, cand))
+
+
+def gain_by_cycle(d: Prepared, current: Trial, cand: Trial) -> dict[int, float]:
+    """The held-out gain of ``cand`` over ``current`` on each cycle of ``d`` (index as
+    ``d.cycles.cycle``; -1 before the first): ``Σ w (r² - (r - Δ)²)`` over its held-out
+    samples, ``r`` the current model's held-out residual, ``Δ`` the candidate's held-out
+    prediction minus the current one, ``w`` the likelihood weights
+    (:func:`~contactlab.diagnose.select.sample_weight`)."""
+    from .select import sample_weight
+
+    r = d.y - current.prediction
+    delta = cand.prediction - current.prediction
+    held = current.heldout & cand.heldout
+    g = sample_weight(d) * (2.0 * r * delta - delta * delta)
+    cyc = np.asarray(d.cycles.cycle)
+    out: dict[int, float] = {}
+    for c in np.unique(cyc[held]):
+        out[int(c)] = float(np.sum(g[held & (cyc == c)]))
+    return out
 
 
 def _fit_cost(family: Family, name: str) -> int:

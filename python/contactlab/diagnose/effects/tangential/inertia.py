@@ -12,6 +12,11 @@ from ._common import peak_acceleration, single_frequency, smoothed_acceleration
 #: and of the search's ``min_gain`` its gain must reach (:attr:`Inertia.gain_floor_scale`)
 INPUT_NOISE_SHARE = 0.25
 GAIN_FLOOR_SCALE = 0.6
+#: below this ``ac·A`` a single-frequency record's steady cycles cannot tell a mass from the
+#: contact's stiffness (:meth:`Inertia.gain_not_its_own`; as for a parallel spring), and
+#: the start-up must hold at least STARTUP_SHARE of the mass's held-out gain
+STEADY_SEPARABLE_ACA = 1.5
+STARTUP_SHARE = 0.3
 
 
 @register
@@ -144,6 +149,41 @@ class Inertia(EffectModel):
                 "-mω² where the loops do not reach a plateau: m may read low)"
             )
         return text
+
+    def gain_not_its_own(self, d, p, cycle_gain):
+        """Why a mass's held-out gain is not a mass's evidence on this record, or None.
+
+        On a single-frequency drive (:func:`single_frequency`) whose loops never reach a
+        plateau (``ac·A`` below :data:`STEADY_SEPARABLE_ACA`) the steady cycles see a mass
+        as the stiffness ``-mω²``, which the contact's own stiffness ``h0·ac`` takes as
+        well: only the start-up from rest (the cycles before the first steady one) tells the
+        two apart. A gain that lies in the steady cycles (at most
+        :data:`STARTUP_SHARE` of it in the start-up) is the base model's trade-off between
+        its stiffness and its curvature, not a mass: on the rig a spring beside the contact
+        (k_p = 1.4e5 N/m, ac·A 0.32, 47 cycles, x noise 1.6 %) was named a mass of 1.9 kg
+        with its gain spread evenly over the cycles (t = 8.3, -0.06 of it in the start-up;
+        fresh seed 8800015 of ``benches/eval_diagnose_rig.py``, found after tuning); masses
+        named on the rig at ac·A 0.8 and 1.2 put 0.98-1.0 of their gain there (tuning seeds
+        108 and 110 of ``benches/eval_inertia_single.py``)."""
+        one = single_frequency(d)
+        ac = float(p.get("ac", np.nan))
+        a = 0.5 * float(np.ptp(d.u))
+        if one is None or not (np.isfinite(ac) and ac > 0 and a > 0) or not cycle_gain:
+            return None
+        aca = ac * a
+        if aca >= STEADY_SEPARABLE_ACA:
+            return None
+        total = sum(cycle_gain.values())
+        start = sum(g for c, g in cycle_gain.items() if c < 1)
+        if not total > 0 or start >= STARTUP_SHARE * total:
+            return None
+        return (
+            f"not separable from the contact's own stiffness: on this single-frequency drive "
+            f"with no plateau (ac·A = {aca:.2g} < {STEADY_SEPARABLE_ACA:g}) a mass is the "
+            f"stiffness -mω² in every steady cycle, and {100 * (1 - start / total):.0f} % of "
+            "its held-out gain lies there; only the start-up from rest tells a mass from a "
+            "stiffer or softer contact"
+        )
 
     def signal_input(self, d):
         """The record with ``ẍ`` as the data hold it, for the stated bound: on a
