@@ -73,3 +73,29 @@ def test_a_mass_on_the_package_generator_at_one_frequency_is_named():
     assert rep.effect_names == ["inertia"]
     clean = contactlab.diagnose(hidden_effect_recording({}, **kw), model="tangential")
     assert clean.effect_names == []
+
+
+def test_a_mass_gain_in_the_steady_cycles_of_a_record_with_no_plateau_is_not_its_own():
+    """Fresh rig seed 8800015: a spring beside the contact at ac·A 0.32 was named a 1.9 kg
+    mass whose gain lay evenly over the steady cycles; a mass's own evidence on one
+    frequency with no plateau is the start-up (cycles before the first steady one)."""
+    from contactlab.diagnose._family import Prepared
+    from contactlab.diagnose.candidates_tangential import TangentialFamily
+    from contactlab.diagnose.effects import registry
+    from contactlab.diagnose.effects.tangential.inertia import STEADY_SEPARABLE_ACA
+
+    t = np.arange(12 * 86) / 860.0  # a 10 Hz sine from rest (a one-cycle ramp), 12 cycles
+    ramp = 0.5 - 0.5 * np.cos(np.pi * np.clip(t * 10.0, 0, 1))
+    x = 1e-5 * ramp * np.sin(2 * np.pi * 10.0 * t)
+    d = Prepared.build(t, x, 40.0 * np.tanh(4e4 * x))
+    TangentialFamily().prepare(d)
+    eff = registry("tangential")["inertia"]
+    a = 0.5 * float(np.ptp(d.u))
+    low = {"m": 1.0, "h0": 40.0, "ac": 0.3 / a}
+    steady = {-1: 0.01, 0: 0.02, **{c: 1.0 for c in range(1, 12)}}
+    why = eff.gain_not_its_own(d, low, steady)
+    assert why is not None and why.startswith("not separable from the contact's own stiffness")
+    startup = {-1: 2.0, 0: 8.0, **{c: 0.05 for c in range(1, 12)}}
+    assert eff.gain_not_its_own(d, low, startup) is None
+    plateau = {**low, "ac": 1.01 * STEADY_SEPARABLE_ACA / a}
+    assert eff.gain_not_its_own(d, plateau, steady) is None
