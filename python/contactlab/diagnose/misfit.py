@@ -203,6 +203,16 @@ class Unexplained:
     #: ``gain_virgin`` (σ²) and ``rms`` (of the free-form fit, output units); a non-empty
     #: list flags the misfit
     rivals: tuple[dict[str, Any], ...] | list[dict[str, Any]] = ()
+    #: the decision against the record's own simulated null
+    #: (:func:`contactlab.diagnose.misfit_null.calibrated_flag`): where present it replaces
+    #: the hand thresholds of the phase bins and the free-form virgin curve test in
+    #: :attr:`flagged`; None where the null could not be simulated
+    calibrated: dict[str, Any] | None = None
+    #: named sets that a Masing element with a free-form virgin curve and fewer
+    #: parameters explains as well (:func:`contactlab.diagnose.shape.patch_check`): each a
+    #: dict with ``effects``, ``params_effects``, ``params_virgin``, ``gain_effects``,
+    #: ``gain_virgin`` (σ²); a non-empty list flags the misfit
+    patches: tuple[dict[str, Any], ...] | list[dict[str, Any]] = ()
 
     def to_dict(self) -> dict[str, Any]:
         """JSON layout of ``"unexplained"`` (a contract; see the README's JSON section)."""
@@ -229,6 +239,8 @@ class Unexplained:
             "absorbing": list(self.absorbing),
             "input_noise": None if self.input_noise is None else dict(self.input_noise),
             "rivals": [dict(r) for r in self.rivals],
+            "calibrated": None if self.calibrated is None else dict(self.calibrated),
+            "patches": [dict(r) for r in self.patches],
         }
 
     def sentence(self) -> str:

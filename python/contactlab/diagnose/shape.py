@@ -34,7 +34,15 @@ import numpy as np
 
 from ._family import Prepared
 
-__all__ = ["RIVAL_SHARE", "SHAPES", "SHAPE_RIVALS", "rival_share"]
+__all__ = [
+    "PATCHABLE",
+    "PATCH_SHARE",
+    "RIVAL_SHARE",
+    "SHAPES",
+    "SHAPE_RIVALS",
+    "patch_check",
+    "rival_share",
+]
 
 #: curvatures of the free-form virgin curve's basis relative to the fitted ``ac``: for each
 #: ``k`` the shapes ``1 - exp(-k ac s)`` and ``1 - (1 + k ac s) exp(-k ac s)`` (zero initial
@@ -133,3 +141,103 @@ def rival_share(
         "gain_virgin": g_bb,
         "rms": float(np.sqrt(np.mean((fit / sw) ** 2))),
     }
+
+
+#: named effects a free-form virgin curve may stand in for, together (:func:`patch_check`):
+#: the rivals and the effects that reshape the branches themselves
+PATCHABLE = (
+    *SHAPE_RIVALS,
+    "series_compliance",
+    "parallel_stiffness",
+    "backlash",
+    "power_law_microslip",
+)
+#: share of the named set's gain that the free-form virgin curve with fewer parameters must
+#: reach for the set to count as a patch over a shape misfit (:func:`patch_check`)
+PATCH_SHARE = 1.0
+
+
+def _forward_fit(A: np.ndarray, r: np.ndarray, q: int) -> np.ndarray:
+    """The least-squares fit of ``r`` by the best ``q`` columns of ``A`` chosen greedily
+    (each step adds the column that lowers the sum of squares most)."""
+    chosen: list[int] = []
+    fit = np.zeros(r.size)
+    for _ in range(min(q, A.shape[1])):
+        best, best_fit, best_ss = -1, fit, float(r @ r)
+        for j in range(A.shape[1]):
+            if j in chosen:
+                continue
+            M = A[:, [*chosen, j]]
+            c, *_ = np.linalg.lstsq(M, r, rcond=1e-10)
+            f = M @ c
+            ss = float((r - f) @ (r - f))
+            if ss < best_ss:
+                best, best_fit, best_ss = j, f, ss
+        if best < 0:
+            break
+        chosen.append(best)
+        fit = best_fit
+    return fit
+
+
+def patch_check(
+    family: Any,
+    effects: tuple[str, ...],
+    d: Prepared,
+    params: dict[str, float],
+    scales: dict[str, float],
+    residual: np.ndarray,
+    sigma: float,
+) -> list[dict[str, Any]]:
+    """Named effects that together patch a virgin curve of another shape (issue 29, item 3).
+
+    A virgin curve no candidate draws is taken up by several named effects together (a
+    gamma-like curve by backlash, a parallel stiffness and a series compliance; a rational
+    one by a normal-load fluctuation and a position-dependent friction). The named effects
+    of :data:`PATCHABLE` are dropped together and the rest refitted; a Masing element
+    with a free-form virgin curve (the columns of :func:`_basis`, the straight line
+    included) with fewer parameters than the dropped set has (the best ``q`` columns,
+    chosen greedily, ``q`` = the set's parameters − 1) is fitted to that refit's
+    residual. Where it reaches :data:`PATCH_SHARE` of the set's gain (σ², weighted
+    residual sums of squares), the set is a patch over a shape misfit: returned as
+    ``[{"effects", "params_effects", "params_virgin", "gain_effects", "gain_virgin",
+    "share"}]`` (empty when not; also for a set of one parameter, which no free-form curve
+    with fewer can replace).
+    """
+    from ..errors import ConvergenceError, InputError
+    from .select import fit, sample_weight, specs_for
+
+    ac = float(params.get("ac", np.nan))
+    drop = tuple(e for e in effects if e in PATCHABLE)
+    rest = tuple(e for e in effects if e not in drop)
+    n_set = len(specs_for(family, effects)) - len(specs_for(family, rest))
+    q = n_set - 1
+    if not drop or q < 1 or not (np.isfinite(ac) and ac > 0 and sigma > 0):
+        return []
+    try:
+        f = fit(family, rest, d, np.ones(d.y.size, bool), params, scales)
+        r0 = d.y - np.asarray(family.predict(f.params, rest, d), float)
+    except (ConvergenceError, InputError):
+        return []
+    w = sample_weight(d)
+    r1 = np.asarray(residual, float)
+    use = np.isfinite(r0) & np.isfinite(r1) & (w > 0)
+    if np.count_nonzero(use) <= 100:
+        return []
+    ww = w[use]
+    g_set = (float(np.sum(ww * r0[use] ** 2)) - float(np.sum(ww * r1[use] ** 2))) / sigma**2
+    if not g_set > 0:
+        return []
+    sw = np.sqrt(ww)
+    A = _basis(d, ac)[use] * sw[:, None]
+    nrm = np.linalg.norm(A, axis=0)
+    nrm[nrm == 0] = 1.0
+    fitv = _forward_fit(A / nrm, r0[use] * sw, q)
+    g_ff = float(fitv @ fitv) / sigma**2
+    share = g_ff / g_set
+    if share < PATCH_SHARE:
+        return []
+    return [
+        {"effects": list(drop), "params_effects": int(n_set), "params_virgin": int(q),
+         "gain_effects": g_set, "gain_virgin": g_ff, "share": share}
+    ]  # fmt: skip
