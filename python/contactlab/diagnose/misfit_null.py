@@ -54,7 +54,7 @@ from ._family import Prepared
 from ._filters import savgol_filter
 from .detection import MISFIT_FALSE_ALARM
 from .eiv import InputNoise, _coloured, _driven, input_noise_spectrum, is_coloured
-from .misfit import backbone_misfit, t_quantile, unexplained_structure
+from .misfit import BACKBONE_MIN_GAIN, backbone_misfit, t_quantile, unexplained_structure
 
 __all__ = [
     "KEEP_HARMONICS",
@@ -69,6 +69,11 @@ __all__ = [
 NULL_DRAWS = 24
 #: harmonics of the fastest drive frequency the denoised input keeps
 KEEP_HARMONICS = 12.0
+#: the free-form virgin curve's held-out gain (``σ²`` per sample) below which its test does
+#: not fire however significant (an effect-size floor, as :data:`.misfit.BACKBONE_MIN_GAIN`:
+#: a long record resolves a chain's own imprint, a load cell's ringing after each reversal
+#: or a skew between anti-alias filters, far below any misfit of consequence)
+MIN_GAIN = BACKBONE_MIN_GAIN
 
 
 def denoised_input(d: Prepared) -> tuple[np.ndarray, int]:
@@ -131,6 +136,8 @@ class NullDraws:
     t, T : float
         The free-form virgin curve's held-out ``t`` and the phase bins' ``T`` on the
         measured residual (no bias taken out, no interval null); NaN where not computable.
+    gain : float
+        The free-form virgin curve's held-out gain on the measured residual (``σ²``).
     t_null, T_null : ndarray
         The same on each copy drawn under the null.
     input_rms, output_rms : float
@@ -139,6 +146,7 @@ class NullDraws:
 
     t: float
     T: float
+    gain: float
     t_null: np.ndarray
     T_null: np.ndarray
     input_rms: float
@@ -148,12 +156,14 @@ class NullDraws:
 def _statistics(d: Prepared, r: np.ndarray, ac: float, sigma: float) -> tuple[float, float]:
     """``(t, T)`` of a residual (measured minus model): held-out ``t`` of the free-form
     virgin curve and the phase bins' ``T`` (no tolerance, every bin and sample: the null
-    carries the input noise's share, so no guard leaves any out)."""
+    carries the input noise's share, so no guard leaves any out), and the free-form curve's
+    held-out gain in units of ``sigma²``."""
     bb = backbone_misfit(d, r, ac, sigma, min_weight=0.0)
     u = unexplained_structure(d, r, sigma, min_weight=0.0)
     return (
         math.nan if bb is None else float(bb["t"]),
         math.nan if u is None else float(u.statistic),
+        math.nan if bb is None else float(bb["gain_over_noise_var"]),
     )
 
 
@@ -270,7 +280,7 @@ def simulated_null(
     if not (np.isfinite(ac) and ac > 0 and sigma > 0) or (kept and "knots" not in d.extra):
         return None
     r = np.asarray(residual, float)
-    t_obs, T_obs = _statistics(d, r, ac, sigma)
+    t_obs, T_obs, g_obs = _statistics(d, r, ac, sigma)
     su = float(d.extra.get("u_noise", 0.0) or 0.0)
     wlen = int(d.extra.get("u_filter", 0))
     spec = input_noise_spectrum(d) if su > 0 and wlen else None
@@ -315,7 +325,7 @@ def simulated_null(
                 ru = rk[use] * sw
                 rk = rk.copy()
                 rk[use] = (ru - Q @ (Q.T @ ru)) / sw
-            tk, Tk = _statistics(dk, rk, ac, sigma)
+            tk, Tk, _ = _statistics(dk, rk, ac, sigma)
             t_null.append(tk)
             T_null.append(Tk)
     except (ContactLabError, ValueError, ArithmeticError, np.linalg.LinAlgError):
@@ -323,7 +333,7 @@ def simulated_null(
     if len(t_null) < max(8, draws // 2):
         return None
     return NullDraws(
-        t=t_obs, T=T_obs, t_null=np.asarray(t_null), T_null=np.asarray(T_null),
+        t=t_obs, T=T_obs, gain=g_obs, t_null=np.asarray(t_null), T_null=np.asarray(T_null),
         input_rms=su, output_rms=float(sigma_out),
     )  # fmt: skip
 
@@ -340,25 +350,31 @@ def _upper(v: np.ndarray, alpha: float) -> float:
     return float(np.mean(v)) + t_quantile(1.0 - alpha, k - 1) * sd * math.sqrt(1.0 + 1.0 / k)
 
 
-def calibrated_flag(nd: NullDraws, alpha: float = MISFIT_FALSE_ALARM) -> dict[str, Any]:
+def calibrated_flag(
+    nd: NullDraws, alpha: float = MISFIT_FALSE_ALARM, *, hand_bins: bool = True
+) -> dict[str, Any]:
     """The misfit decision against the simulated null (JSON ``unexplained.calibrated``).
 
     The held-out ``t`` is compared with the upper prediction bound of its draws at
     ``alpha/2``, ``√T`` with that of the draws' ``√T`` at ``alpha/2`` (Bonferroni: the
-    record's false-alarm rate is at most ``alpha``). Returns ``t``, ``t_threshold``,
-    ``T``, ``T_threshold``, ``draws``, ``alpha``, ``input_noise``, ``output_noise``,
-    ``by`` (the tests that fire: ``"backbone"``, ``"phase_bins"``) and ``flagged``."""
+    record's false-alarm rate is at most ``alpha``), the first only with a held-out gain of
+    at least :data:`MIN_GAIN`; the phase bins fire only where
+    ``hand_bins`` (their own threshold, :func:`.misfit.unexplained_structure`) agrees.
+    Returns ``t``, ``t_threshold``, ``T``, ``T_threshold``, ``draws``, ``alpha``,
+    ``input_noise``, ``output_noise``, ``by`` (the tests that fire: ``"backbone"``,
+    ``"phase_bins"``) and ``flagged``."""
     a = 0.5 * alpha
     t_thr = _upper(nd.t_null, a)
     sT = _upper(np.sqrt(np.maximum(nd.T_null, 0.0)), a)
     T_thr = sT * sT if np.isfinite(sT) else math.nan
     by = []
-    if np.isfinite(nd.t) and np.isfinite(t_thr) and nd.t > t_thr:
+    if np.isfinite(nd.t) and np.isfinite(t_thr) and nd.t > t_thr and nd.gain >= MIN_GAIN:
         by.append("backbone")
-    if np.isfinite(nd.T) and np.isfinite(T_thr) and nd.T > T_thr:
+    if hand_bins and np.isfinite(nd.T) and np.isfinite(T_thr) and nd.T > T_thr:
         by.append("phase_bins")
     return {
-        "t": _num(nd.t), "t_threshold": _num(t_thr), "T": _num(nd.T),
+        "t": _num(nd.t), "t_threshold": _num(t_thr), "gain": _num(nd.gain),
+        "min_gain": MIN_GAIN, "T": _num(nd.T),
         "T_threshold": _num(T_thr), "draws": int(nd.t_null.size), "alpha": alpha,
         "input_noise": nd.input_rms, "output_noise": nd.output_rms,
         "by": by, "flagged": bool(by),

@@ -41,6 +41,7 @@ __all__ = [
     "SHAPES",
     "SHAPE_RIVALS",
     "patch_check",
+    "patch_share",
     "rival_share",
 ]
 
@@ -157,17 +158,24 @@ PATCHABLE = (
 PATCH_SHARE = 1.0
 
 
-def _forward_fit(A: np.ndarray, r: np.ndarray, q: int) -> np.ndarray:
-    """The least-squares fit of ``r`` by the best ``q`` columns of ``A`` chosen greedily
-    (each step adds the column that lowers the sum of squares most)."""
+def _forward_fit(
+    A: np.ndarray, r: np.ndarray, q: int, base: np.ndarray | None = None
+) -> np.ndarray:
+    """The least-squares fit of ``r`` by the columns of ``base`` (always in) and the best
+    ``q`` columns of ``A`` chosen greedily (each step adds the column that lowers the sum
+    of squares most)."""
     chosen: list[int] = []
+    B = np.zeros((r.size, 0)) if base is None else base
     fit = np.zeros(r.size)
+    if B.shape[1]:
+        c, *_ = np.linalg.lstsq(B, r, rcond=1e-10)
+        fit = B @ c
     for _ in range(min(q, A.shape[1])):
         best, best_fit, best_ss = -1, fit, float(r @ r)
         for j in range(A.shape[1]):
             if j in chosen:
                 continue
-            M = A[:, [*chosen, j]]
+            M = np.column_stack([B, A[:, [*chosen, j]]])
             c, *_ = np.linalg.lstsq(M, r, rcond=1e-10)
             f = M @ c
             ss = float((r - f) @ (r - f))
@@ -205,7 +213,7 @@ def patch_check(
     with fewer can replace).
     """
     from ..errors import ConvergenceError, InputError
-    from .select import fit, sample_weight, specs_for
+    from .select import fit, specs_for
 
     ac = float(params.get("ac", np.nan))
     drop = tuple(e for e in effects if e in PATCHABLE)
@@ -219,25 +227,67 @@ def patch_check(
         r0 = d.y - np.asarray(family.predict(f.params, rest, d), float)
     except (ConvergenceError, InputError):
         return []
-    w = sample_weight(d)
-    r1 = np.asarray(residual, float)
-    use = np.isfinite(r0) & np.isfinite(r1) & (w > 0)
-    if np.count_nonzero(use) <= 100:
+    got = patch_share(d, residual, r0, ac, sigma, q)
+    if got is None or got["share"] < PATCH_SHARE:
         return []
+    return [{"effects": list(drop), "params_effects": int(n_set), **got}]
+
+
+def patch_share(
+    d: Prepared,
+    with_set: np.ndarray,
+    without_set: np.ndarray,
+    ac: float,
+    sigma: float,
+    q: int,
+) -> dict[str, Any] | None:
+    """How much of a named set's gain a free-form virgin curve of ``q`` columns reaches.
+
+    ``with_set`` and ``without_set`` are the residuals (measured minus model) of the final
+    model and of its refit without the set. The set's gain is the drop in the weighted
+    residual sum of squares it brings (σ²); the free-form curve's, the drop the best ``q``
+    columns of :func:`_basis` (chosen greedily, the straight line among them), refitted
+    with the base's own virgin curve's two directions (its ``h0`` and ``ac``: the free-form
+    curve replaces the exponential one, whose parameters both models have), bring to the
+    residual without the set. Returns ``share`` (the second over the first), both gains
+    (``gain_effects``, ``gain_virgin``) and ``params_virgin`` (``q``); None without a
+    positive gain of the set or with too few samples.
+    """
+    from .select import sample_weight
+
+    w = sample_weight(d)
+    r1 = np.asarray(with_set, float)
+    r0 = np.asarray(without_set, float)
+    use = np.isfinite(r0) & np.isfinite(r1) & (w > 0)
+    if np.count_nonzero(use) <= 100 or not (sigma > 0 and np.isfinite(ac) and ac > 0):
+        return None
     ww = w[use]
     g_set = (float(np.sum(ww * r0[use] ** 2)) - float(np.sum(ww * r1[use] ** 2))) / sigma**2
     if not g_set > 0:
-        return []
+        return None
+    from ..masing import Masing
+
     sw = np.sqrt(ww)
     A = _basis(d, ac)[use] * sw[:, None]
     nrm = np.linalg.norm(A, axis=0)
     nrm[nrm == 0] = 1.0
-    fitv = _forward_fit(A / nrm, r0[use] * sw, q)
+    # the base's own virgin curve is refitted with the free-form columns (its h0 and ac
+    # directions, counted on both sides): the free-form curve replaces it, not adds to it
+    h = 1.05
+    own = (
+        np.column_stack(
+            [
+                Masing(1.0, ac).force(d.u),
+                Masing(1.0, h * ac).force(d.u) - Masing(1.0, ac / h).force(d.u),
+            ]
+        )[use]
+        * sw[:, None]
+    )
+    on = np.linalg.norm(own, axis=0)
+    on[on == 0] = 1.0
+    fitv = _forward_fit(A / nrm, r0[use] * sw, q, own / on)
     g_ff = float(fitv @ fitv) / sigma**2
-    share = g_ff / g_set
-    if share < PATCH_SHARE:
-        return []
-    return [
-        {"effects": list(drop), "params_effects": int(n_set), "params_virgin": int(q),
-         "gain_effects": g_set, "gain_virgin": g_ff, "share": share}
-    ]  # fmt: skip
+    return {
+        "params_virgin": int(q), "gain_effects": g_set, "gain_virgin": g_ff,
+        "share": g_ff / g_set,
+    }  # fmt: skip

@@ -558,7 +558,11 @@ def _calibrated(b: _Base, d: Prepared, st: SearchState, checks: dict[str, Any]) 
         if patches:
             checks["unexplained"] = dataclasses.replace(u, flagged=True, patches=patches)
         return checks
-    cal = calibrated_flag(nd)
+    # the phase bins flag where both their hand threshold (with the interval null of the
+    # input noise's reach) and the simulated null say so: the chain's own imprint (a load
+    # cell's ringing after each reversal, a skew between the anti-alias filters) is
+    # structure at a few per cent of the noise that the simulation does not carry
+    cal = calibrated_flag(nd, hand_bins=bool(u.statistic > u.threshold))
     flagged = cal["flagged"] or bool(u.rivals) or bool(patches)
     checks["unexplained"] = dataclasses.replace(u, flagged=flagged, calibrated=cal, patches=patches)
     return checks
