@@ -63,6 +63,11 @@ EFFECTS = (
 )
 
 
+#: ``--hard``: the corner where the independent generator's clean records were flagged
+#: (x noise 1.5-2 % of the range, ac·A 1-5)
+HARD = {"x_min": 0.0, "acA_min": 0.3}
+
+
 def factors(seed: int) -> dict[str, Any]:
     """The factors of one record, drawn from its seed."""
     rng = np.random.default_rng([seed, 3131])
@@ -71,8 +76,8 @@ def factors(seed: int) -> dict[str, Any]:
         "fs": fs,
         "f": min(float(np.exp(rng.uniform(0.0, np.log(50.0)))), fs / 20.0),
         "cycles": int(rng.integers(5, 51)),
-        "acA": float(np.exp(rng.uniform(np.log(0.3), np.log(5.0)))),
-        "x_noise": float(rng.uniform(0.0, 0.02)),
+        "acA": float(np.exp(rng.uniform(np.log(HARD["acA_min"]), np.log(5.0)))),
+        "x_noise": float(rng.uniform(HARD["x_min"], 0.02)),
         "F_noise": float(rng.uniform(0.005, 0.02)),
         "x_colour": str(rng.choice(("lvdt", "lp1", "white"))),
         "hum": bool(rng.random() < 0.5),
@@ -230,7 +235,10 @@ def main() -> None:
     ap.add_argument("--dump", default=None, help="append each record's result (JSON lines)")
     ap.add_argument("--table", nargs="*", default=None, help="print the tables of dumps")
     ap.add_argument("--detail", action="store_true")
+    ap.add_argument("--hard", action="store_true", help="x noise 1.5-2 %%, ac·A 1-5 only")
     a = ap.parse_args()
+    if a.hard:
+        HARD.update(x_min=0.015, acA_min=1.0)
     if a.table:
         rs = [json.loads(line) for path in a.table for line in open(path)]
         cl = [r for r in rs if r["kind"] in ("exp", "rigclean")]
