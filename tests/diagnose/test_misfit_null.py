@@ -63,11 +63,11 @@ def test_prediction_bound_holds_its_rate() -> None:
     # a new draw from the same normal exceeds the bound at the stated rate
     rng = np.random.default_rng(7)
     over = 0
-    trials = 4000
+    trials = 2000
     for _ in range(trials):
         v = rng.normal(0.0, 1.0, 24)
         over += rng.normal() > _upper(v, 0.03)
-    assert abs(over / trials - 0.03) < 0.009, over / trials
+    assert abs(over / trials - 0.03) < 0.012, over / trials
 
 
 def _draws(t: float, T: float, gain: float = 0.1) -> NullDraws:
@@ -150,7 +150,7 @@ def test_json_adds_the_calibrated_decision_and_keeps_the_contract() -> None:
 
 
 def _record(virgin: str, x_noise: float, seed: int):
-    fs, f0, cycles, A, acA = 2000.0, 5.0, 14, 1e-5, 2.0
+    fs, f0, cycles, A, acA = 1000.0, 5.0, 10, 1e-5, 2.0
     t = np.arange(round((cycles + 1.5) * fs / f0)) / fs
     x = A * np.sin(2 * np.pi * f0 * t) * np.minimum(t * f0, 1.0)
     ac = acA / A
