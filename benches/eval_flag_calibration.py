@@ -236,7 +236,17 @@ def main() -> None:
     ap.add_argument("--table", nargs="*", default=None, help="print the tables of dumps")
     ap.add_argument("--detail", action="store_true")
     ap.add_argument("--hard", action="store_true", help="x noise 1.5-2 %%, ac·A 1-5 only")
+    ap.add_argument("--keep", type=float, default=None, help="misfit_null.KEEP_HARMONICS")
+    ap.add_argument("--no-project", action="store_true", help="PROJECT_OBSERVED = False")
     a = ap.parse_args()
+    if a.keep is not None:
+        import contactlab.diagnose.misfit_null as mn
+
+        mn.KEEP_HARMONICS = a.keep
+    if a.no_project:
+        import contactlab.diagnose.misfit_null as mn
+
+        mn.PROJECT_OBSERVED = False
     if a.hard:
         HARD.update(x_min=0.015, acA_min=1.0)
     if a.table:
