@@ -41,6 +41,13 @@ curve explains as well (a tanh virgin curve taken up by a normal-load fluctuatio
 Stribeck term, after which the residual looks white) flags the misfit
 (:attr:`Unexplained.rivals`).
 
+A fourth step replaces the hand thresholds of the first two tests on tangential records
+(:mod:`contactlab.diagnose.misfit_null`, ``unexplained.calibrated``): both statistics are
+compared with their distribution over copies of the record simulated under the null with its
+own noise on both channels; and a named set that a free-form virgin curve with fewer
+parameters explains as well flags the misfit (:func:`contactlab.diagnose.shape.patch_check`,
+``unexplained.patches``).
+
 When ``T`` exceeds the threshold, :func:`unexplained_structure` reports where the structure
 sits (the branch and the phase range of the bins with ``|t_b|`` above a Bonferroni level,
 merged into runs) and how large it is: the RMS and the peak of the binned means, in the

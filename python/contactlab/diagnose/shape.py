@@ -13,7 +13,12 @@ that free-form curve reaches on the residual of the final model refitted without
 effect; the workflow flags the misfit where it reaches :data:`RIVAL_SHARE`
 (``unexplained.rivals``), and the effect stays named with that caveat.
 
-Tried and not kept (diagflag, stop 38): a test of the final residual against the same
+:func:`patch_check` asks the same of the named effects together: dropped as a set, with a
+free-form virgin curve of fewer parameters than the set fitted instead (``unexplained.patches``:
+a gamma-like curve patched by backlash, a parallel stiffness and a series compliance).
+
+Tried and not kept (diagflag, stop 38; the reason, and its fix, in
+:mod:`.misfit_null`: the simulation's true input must be the denoised one): a test of the final residual against the same
 free-form curve with its null simulated from the final model with the record's own noise
 on both channels (the input noise drawn from its spectrum, :func:`.eiv.input_noise_spectrum`,
 the output noise from the residual's spectrum above the drive's harmonics). On a clean
