@@ -17,18 +17,18 @@ effect; the workflow flags the misfit where it reaches :data:`RIVAL_SHARE`
 free-form virgin curve of fewer parameters than the set fitted instead (``unexplained.patches``:
 a gamma-like curve patched by backlash, a parallel stiffness and a series compliance).
 
-Tried and not kept (diagflag, stop 38; the reason, and its fix, in
-:mod:`.misfit_null`: the simulation's true input must be the denoised one): a test of the final residual against the same
-free-form curve with its null simulated from the final model with the record's own noise
-on both channels (the input noise drawn from its spectrum, :func:`.eiv.input_noise_spectrum`,
-the output noise from the residual's spectrum above the drive's harmonics). On a clean
-record of ``benches/eval_misfit_flag.py`` (tuning seed 1000: white x noise 1.9 % behind
-a Bessel filter, ac·A 0.74) the statistic was 3400 against a simulated null of 370 ± 150:
-the measured input noise left far more branch-shaped structure than fresh draws of the
-same spectrum did, whether added to the measured input (370) or to the noise-free one
-(500-900, the same record rebuilt without x noise); shifting the measured noise by a few
-periods brought it to 560-1000. The null of such a test is not the record's own noise
-spectrum, and the test was not used.
+Tried and not kept (diagflag, stop 38; :mod:`.misfit_null` now simulates from the denoised
+input and computes the same statistics on the record and its copies): a test of the final
+residual against the same free-form curve with its null simulated from the final model with
+the record's own noise on both channels (the input noise drawn from its spectrum,
+:func:`.eiv.input_noise_spectrum`, the output noise from the residual's spectrum above the
+drive's harmonics). On a clean record of ``benches/eval_misfit_flag.py`` (tuning seed 1000:
+white x noise 1.9 % behind a Bessel filter, ac·A 0.74) the statistic was 3400 against a
+simulated null of 370 ± 150: the measured input noise left far more branch-shaped structure
+than fresh draws of the same spectrum did, whether added to the measured input (370) or to
+the noise-free one (500-900, the same record rebuilt without x noise); shifting the measured
+noise by a few periods brought it to 560-1000. The null of such a test is not the record's
+own noise spectrum, and the test was not used.
 """
 
 from __future__ import annotations
