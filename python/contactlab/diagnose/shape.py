@@ -217,7 +217,7 @@ def patch_check(
     "share"}]`` (empty when not; also for a set of one parameter, which no free-form curve
     with fewer can replace).
     """
-    from ..errors import ConvergenceError, InputError
+    from ..errors import ContactLabError
     from .select import fit, specs_for
 
     ac = float(params.get("ac", np.nan))
@@ -230,8 +230,8 @@ def patch_check(
     try:
         f = fit(family, rest, d, np.ones(d.y.size, bool), params, scales)
         r0 = d.y - np.asarray(family.predict(f.params, rest, d), float)
-    except (ConvergenceError, InputError):
-        return []
+    except (ContactLabError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+        return []  # no refit without the set: no verdict on it
     got = patch_share(d, residual, r0, ac, sigma, q)
     if got is None or got["share"] < PATCH_SHARE:
         return []
