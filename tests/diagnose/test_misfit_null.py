@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy import stats
 
 from contactlab.diagnose._family import Prepared
@@ -173,3 +175,20 @@ def test_through_the_diagnosis_clean_quiet_and_tanh_flagged() -> None:
     tanh = diagnose(_record("tanh", 0.0, 5), model="tangential").unexplained
     assert tanh is not None and tanh.flagged and tanh.calibrated is not None
     assert tanh.calibrated["flagged"], tanh.calibrated
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    t=st.floats(-10, 30), dt=st.floats(0, 20), T=st.floats(0, 500), dT=st.floats(0, 500),
+    seed=st.integers(0, 1000),
+)  # fmt: skip
+def test_a_larger_statistic_never_unflags(t: float, dt: float, T: float, dT: float, seed: int):
+    rng = np.random.default_rng(seed)
+    null = (rng.normal(0.0, 1.5, 24), rng.chisquare(20, 24))
+
+    def flag(tv: float, Tv: float) -> set[str]:
+        nd = NullDraws(t=tv, T=Tv, gain=1.0, t_null=null[0], T_null=null[1],
+                       input_rms=0.0, output_rms=1.0)  # fmt: skip
+        return set(calibrated_flag(nd)["by"])
+
+    assert flag(t, T) <= flag(t + dt, T + dT)
