@@ -168,9 +168,11 @@ def test_fixed_substeps_still_work_and_converge_at_second_order():
 
 @pytest.mark.parametrize("kind", ["masing", "bouc_wen"])
 def test_rtol_bounds_the_inner_newton_under_error_control(kind):
-    # step doubling (Masing) ends its inner Newton solves early once the residual is small;
-    # that end must follow rtol (at most sqrt(rtol)), so that a tighter rtol costs iterations
-    # and moves the result towards the tightest one; Hermite pieces (Bouc-Wen) end on rtol
+    # Hermite pieces end their Newton solve after the update once the residual is below
+    # min(1e-2, 1e3 sqrt(rtol)) of the forces (the corrections remove what is left); that end
+    # must follow rtol where it is tighter than the default, so that a tighter rtol costs
+    # iterations and moves the result towards the tightest one (1e-9 and 1e-6 both end at
+    # 1e-2: equal counts where no residual is below 1e-6 before an update)
     m = np.diag([2.0, 1.0, 1.5])
     k = 5e4 * np.array([[2, -1, 0], [-1, 2, -1], [0, -1, 1.0]])
     s = Structure(m, 1e-4 * k + 2.0 * m, k)
@@ -183,5 +185,5 @@ def test_rtol_bounds_the_inner_newton_under_error_control(kind):
     t = np.arange(n) / fs
     f = np.stack([_force(n, fs, 21), np.zeros(n), _force(n, fs, 22, 10.0)], axis=1)
     runs = {rtol: s.simulate(t, force=f, tol=1e-6, rtol=rtol) for rtol in (1e-6, 1e-9, 1e-13)}
-    assert runs[1e-13].n_iter > runs[1e-9].n_iter > runs[1e-6].n_iter
+    assert runs[1e-13].n_iter > runs[1e-9].n_iter >= runs[1e-6].n_iter
     assert _rrms(runs[1e-9].x, runs[1e-13].x) <= 1e-7

@@ -321,6 +321,40 @@ impl JointLaw {
         }
     }
 
+    /// Whether a trial made at `d_trial` (from `state`, committed at `d_old`) still describes
+    /// the nearby `d_new` when carried along its tangents: the move keeps its direction (a
+    /// Masing branch, a Bouc-Wen rate and a rate-dependent law depend on it), no Masing branch
+    /// closes between the two and no Jenkins/Iwan element sticks at one point and slips at the
+    /// other. A Newton solve that ends without a
+    /// last trial (see `newmark::newton_step`) tries the joint anew at `d_new` otherwise: an end
+    /// that a small update moved back across the start, or across a slip point, would be
+    /// carried along the tangents of the wrong branch or regime for the whole piece.
+    #[inline]
+    pub fn holds(&self, state: &JointState, d_old: f64, d_trial: f64, d_new: f64) -> bool {
+        let slips = |k: f64, fs: f64, f0: f64, d: f64| {
+            let ft = f0 + k * (d - d_old);
+            (ft.abs() > fs, ft > 0.0)
+        };
+        match (self, state) {
+            (Self::KelvinVoigt { .. } | Self::Normal { .. }, _) => true,
+            (Self::Jenkins { k, fs }, JointState::Slider(f0)) => {
+                slips(*k, *fs, *f0, d_trial) == slips(*k, *fs, *f0, d_new)
+            }
+            (Self::Iwan { k, fs }, JointState::Sliders(f0)) => {
+                k.iter().zip(fs).zip(f0).all(|((&ki, &fi), &f0i)| {
+                    slips(ki, fi, f0i, d_trial) == slips(ki, fi, f0i, d_new)
+                })
+            }
+            (Self::Masing { .. }, JointState::Masing(st)) => {
+                d_trial == d_new
+                    || ((d_trial - d_old) * (d_new - d_old) > 0.0
+                        && masing_closure(st, d_trial).is_some()
+                            == masing_closure(st, d_new).is_some())
+            }
+            _ => (d_trial - d_old) * (d_new - d_old) > 0.0 || d_trial == d_new,
+        }
+    }
+
     /// The virgin state (d = 0, F = 0).
     pub fn fresh_state(&self) -> JointState {
         match self {
@@ -476,6 +510,18 @@ pub(super) fn masing_kink(
     st: &MasingState,
     x1: f64,
 ) -> Option<(f64, f64)> {
+    let (anchor, target) = masing_closure(st, x1)?;
+    // the closing branch's slope there, and the outer one's (a trial at the target pops it)
+    let left = curve.slope((target - anchor) / scale);
+    let right = masing_trial(curve, scale, st, target).1;
+    Some((target, right - left))
+}
+
+/// The anchor and the closure point of the branch a Masing joint in `st` moves on toward
+/// `x1` (see [`masing_kink`]), when the monotone move to `x1` crosses that closure; `None`
+/// otherwise.
+#[inline]
+pub(super) fn masing_closure(st: &MasingState, x1: f64) -> Option<(f64, f64)> {
     let dx = x1 - st.x;
     if dx == 0.0 {
         return None;
@@ -493,13 +539,7 @@ pub(super) fn masing_kink(
             st.stack[n.saturating_sub(2)].x,
         ),
     };
-    if !((x1 - target) * s > 0.0 && (target - st.x) * s > 0.0) {
-        return None;
-    }
-    // the closing branch's slope there, and the outer one's (a trial at the target pops it)
-    let left = curve.slope((target - anchor) / scale);
-    let right = masing_trial(curve, scale, st, target).1;
-    Some((target, right - left))
+    ((x1 - target) * s > 0.0 && (target - st.x) * s > 0.0).then_some((anchor, target))
 }
 
 /// Accept the Masing trial at `x` (force `f`, memory update `aux` from [`masing_trial`]): the

@@ -11,9 +11,11 @@
 //! second order; each correction gains an order (the first is limited by the Newmark end's
 //! acceleration, `h/2 δa`), the second is fourth order, and the change it made is the error
 //! estimate (held to `tol` relative to the displacement and velocity sizes, the length
-//! following `(tol / err)^(1/4)`). One Newton solve per piece (ended without its last trial
-//! once converged quadratically, the joints carried along their tangents by its last update)
-//! and no further joint evaluations: the cost of a fixed step plus a few flops. Energies are
+//! following `(tol / err)^(1/4)`). One Newton solve per piece (ended after its update once
+//! the residual is below `HERMITE_QUICK` of the forces, without a last trial: the joints
+//! carried along their tangents by that update, or tried anew where it moved the end across
+//! the start, a Masing closure or a slip point) and no further joint evaluations: about the
+//! cost of a fixed step. Energies are
 //! the Hermite rule's integrals of the powers. Velocity reversals are placed at the root of
 //! the cubic through the ends' velocities and accelerations.
 //!
@@ -215,10 +217,15 @@ fn hermite<J: Joints>(
     (opts, min_piece, (kinks, kinks_z)): (&Options, f64, (bool, bool)),
 ) -> Option<Herm> {
     let f1 = load(inp, i, tau1);
-    // Newton ends without a last trial once converged quadratically (as a step-doubling pair's
-    // inner solves; not for difference-quotient tangents): the joints are carried along their
-    // tangents by its last update, as the corrections below carry them
-    let quick = jt.quick().min(opts.rtol.sqrt());
+    // Newton ends without a last trial once its residual is below `HERMITE_QUICK` of the
+    // forces (not for difference-quotient tangents): the joints are carried along their
+    // tangents by its last update, as the corrections below carry them, and the corrections
+    // remove the residual left with the Newmark end's own error
+    let quick = if jt.quick() > 0.0 {
+        crate::structure::hermite_quick(opts.rtol)
+    } else {
+        0.0
+    };
     let (st, iters) = newton(jt, (m, c, k), w, (w.x, quick), h, f1, opts)?;
     // A stick-slip transition (linear in the displacement while stuck): where the cubic
     // through the ends' displacements and velocities reaches it (the fraction of the move is
