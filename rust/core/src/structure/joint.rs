@@ -952,6 +952,39 @@ mod tests {
     }
 
     #[test]
+    fn a_quick_trial_holds_on_its_branch_and_regime_only() -> Result<(), CoreError> {
+        // Jenkins: both points stuck (or both slipping the same way), not one of each
+        let jk = JointLaw::Jenkins { k: 100.0, fs: 1.0 };
+        let st = JointState::Slider(0.5);
+        assert!(jk.holds(&st, 0.0, 0.004, 0.0045));
+        assert!(jk.holds(&st, 0.0, 0.006, 0.007));
+        assert!(!jk.holds(&st, 0.0, 0.004, 0.006));
+        assert!(!jk.holds(&st, 0.0, 0.006, 0.004));
+        // Masing: up to 1e-4, back to -5e-5; moving up again, the branch closes at 1e-4
+        let law = JointLaw::masing(exp_curve(), 1.0)?;
+        let mut st = law.fresh_state();
+        let mut d = 0.0;
+        for x in [1e-4, -5e-5] {
+            let tr = law.trial(&st, d, x, 0.0);
+            law.commit(&mut st, d, x, &tr)?;
+            d = x;
+        }
+        assert!(law.holds(&st, d, 5e-5, 6e-5));
+        assert!(!law.holds(&st, d, 1.01e-4, 0.99e-4));
+        assert!(!law.holds(&st, d, 0.99e-4, 1.01e-4));
+        assert!(law.holds(&st, d, 1.01e-4, 1.02e-4));
+        assert!(!law.holds(&st, d, -6e-5, -4e-5));
+        // Bouc-Wen: the direction of the move; Kelvin-Voigt: always
+        let bw = JointLaw::bouc_wen(5e4, 1e3, 0.8, -1.1, 1.0)?;
+        let st = bw.fresh_state();
+        assert!(bw.holds(&st, 0.0, 1e-6, 2e-6));
+        assert!(!bw.holds(&st, 0.0, 1e-6, -1e-6));
+        let kv = JointLaw::kelvin_voigt(1e3, 1.0)?;
+        assert!(kv.holds(&JointState::Elastic, 0.0, 1e-6, -1e-6));
+        Ok(())
+    }
+
+    #[test]
     fn jenkins_event_is_at_the_slip_force() {
         let law = JointLaw::Jenkins { k: 100.0, fs: 1.0 };
         let st = JointState::Slider(0.5);
