@@ -194,9 +194,10 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--stepping", action="store_true", help="the error-control table")
     ap.add_argument("--only", default="", help="--stepping: the cases whose name has this")
+    ap.add_argument("--seed", type=int, default=1, help="--stepping: the multisine's seed")
     a = ap.parse_args()
     if a.stepping:
-        stepping_table(a.n, a.repeat, a.only)
+        stepping_table(a.n, a.repeat, a.only, a.seed)
         return
     t, f = excitation(a.n)
     s = Structure(M, C, K)
@@ -342,9 +343,10 @@ def _cpu(fn):  # type: ignore[no-untyped-def]
     return time.process_time() - c0, out
 
 
-def stepping_table(n_time: int, repeat: int, only: str = "") -> None:
+def stepping_table(n_time: int, repeat: int, only: str = "", seed: int = 1) -> None:
     """The error-control table: cost ratio and relative RMS errors, per case (see the
-    module's docstring)."""
+    module's docstring); ``seed``: the multisine's (1: the bench's own; others: fresh
+    forcing for the accuracy check)."""
     from contactlab.structure.model import DEFAULT_TOL
     from structure_reference import hysteretic_ode
 
@@ -358,15 +360,16 @@ def stepping_table(n_time: int, repeat: int, only: str = "") -> None:
     except ImportError:
         print("OpenSeesPy: not installed (no comparison row)")
     print(f"default tol = {DEFAULT_TOL:g}; CPU-time medians of {repeat} interleaved pairs on "
-          f"{n_time} samples; errors: relative RMS of x on the accuracy record; load average "
-          f"{os.getloadavg()[0]:.1f}")  # fmt: skip
-    print("| case | old default (substeps=1) | new default | cost new/old | "
-          "old err vs ref | new err vs ref | references (max pairwise diff) |")  # fmt: skip
-    print("|---|---|---|---|---|---|---|")
+          f"{n_time} samples; errors: relative RMS of x on the accuracy record; multisine seed "
+          f"{seed}; load average {os.getloadavg()[0]:.1f}")  # fmt: skip
+    print("| case | old default (substeps=1) | new default | cost new/old | pieces/sample "
+          "(Newton it./piece) | old err vs ref | new err vs ref | references (max pairwise "
+          "diff) |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|---|")
     for name, s, fs, n_acc, bw_only in stepping_cases():
         if only not in name:
             continue
-        f = multisine(max(n_acc, n_time), fs, s.n)
+        f = multisine(max(n_acc, n_time), fs, s.n, seed)
         t = np.arange(f.shape[0]) / fs
         ta, fa = t[:n_acc], f[:n_acc]
         fa1 = fa[:, 0] if s.n == 1 else fa
@@ -390,12 +393,16 @@ def stepping_table(n_time: int, repeat: int, only: str = "") -> None:
         ft = f[:n_time, 0] if s.n == 1 else f[:n_time]
         tt = t[:n_time]
         c_old, c_new = [], []
+        run = new_r
         for _ in range(repeat):
             c_old.append(_cpu(partial(s.simulate, tt, force=ft, substeps=1))[0])
-            c_new.append(_cpu(partial(s.simulate, tt, force=ft))[0])
+            c, run = _cpu(partial(s.simulate, tt, force=ft))
+            c_new.append(c)
+        pieces = f"{run.n_steps / (run.t.size - 1):.3f} ({run.n_iter / run.n_steps:.2f})"
         mo, mn = statistics.median(c_old), statistics.median(c_new)
         ratio = statistics.median(b / a for a, b in zip(c_old, c_new, strict=True))
-        print(f"| {name} | {1e3 * mo:.0f} ms | {1e3 * mn:.0f} ms | {ratio:.2f} | {old:.1e} | "
+        print(f"| {name} | {1e3 * mo:.0f} ms | {1e3 * mn:.0f} ms | {ratio:.2f} | {pieces} | "
+              f"{old:.1e} | "
               f"{new:.1e} (vs {others}) | {spread:.1e} |", flush=True)  # fmt: skip
     print(f"load average at the end {os.getloadavg()[0]:.1f}")
 

@@ -92,6 +92,26 @@ def test_default_mdof_matches_fine_fixed_steps():
     assert _rrms(s.simulate(t, force=f, substeps=1).x, ref) > 10 * _rrms(r.x, ref)
 
 
+@pytest.mark.parametrize("seed", [2, 3])
+def test_masing_and_jenkins_mdof_within_1e5_of_fine_fixed_steps(seed):
+    # Hermite pieces end their Newton solve after one update; where that update moves an end
+    # back across a Masing closure (or the start, or a slip point) the joint is tried anew
+    # there. Without that the end was carried along the wrong branch's tangent: 3e-5 to 7e-5
+    # on these records (seeds 2 to 5), against 2e-6 to 3e-6 with it.
+    m = np.diag([2.0, 1.0, 1.5])
+    k = 5e4 * np.array([[2, -1, 0], [-1, 2, -1], [0, -1, 1.0]])
+    s = Structure(m, 1e-4 * k + 2.0 * m, k)
+    s.add_joint("masing", 0, h0=40.0, ac=2e4, scale=2.0)
+    s.add_joint("jenkins", 2, 1, k=3e4, fs=20.0)
+    fs, n = 3000.0, 3000
+    t = np.arange(n) / fs
+    f = np.stack([_force(n, fs, seed, 30.0), np.zeros(n), _force(n, fs, seed + 10, 15.0)], 1)
+    ref = s.simulate(t, force=f, substeps=64).x  # second order: ~4000x below one step
+    r = s.simulate(t, force=f)
+    assert r.success
+    assert _rrms(r.x, ref) <= 1e-5
+
+
 @settings(max_examples=12, deadline=None)
 @given(
     kind=st.sampled_from(["bouc_wen", "masing", "jenkins", "iwan"]),
@@ -168,9 +188,11 @@ def test_fixed_substeps_still_work_and_converge_at_second_order():
 
 @pytest.mark.parametrize("kind", ["masing", "bouc_wen"])
 def test_rtol_bounds_the_inner_newton_under_error_control(kind):
-    # step doubling (Masing) ends its inner Newton solves early once the residual is small;
-    # that end must follow rtol (at most sqrt(rtol)), so that a tighter rtol costs iterations
-    # and moves the result towards the tightest one; Hermite pieces (Bouc-Wen) end on rtol
+    # Hermite pieces end their Newton solve after the update once the residual is below
+    # min(1e-2, 1e3 sqrt(rtol)) of the forces (the corrections remove what is left); that end
+    # must follow rtol where it is tighter than the default, so that a tighter rtol costs
+    # iterations and moves the result towards the tightest one (1e-9 and 1e-6 both end at
+    # 1e-2: equal counts where no residual is below 1e-6 before an update)
     m = np.diag([2.0, 1.0, 1.5])
     k = 5e4 * np.array([[2, -1, 0], [-1, 2, -1], [0, -1, 1.0]])
     s = Structure(m, 1e-4 * k + 2.0 * m, k)
@@ -183,5 +205,5 @@ def test_rtol_bounds_the_inner_newton_under_error_control(kind):
     t = np.arange(n) / fs
     f = np.stack([_force(n, fs, 21), np.zeros(n), _force(n, fs, 22, 10.0)], axis=1)
     runs = {rtol: s.simulate(t, force=f, tol=1e-6, rtol=rtol) for rtol in (1e-6, 1e-9, 1e-13)}
-    assert runs[1e-13].n_iter > runs[1e-9].n_iter > runs[1e-6].n_iter
+    assert runs[1e-13].n_iter > runs[1e-9].n_iter >= runs[1e-6].n_iter
     assert _rrms(runs[1e-9].x, runs[1e-13].x) <= 1e-7

@@ -321,6 +321,40 @@ impl JointLaw {
         }
     }
 
+    /// Whether a trial made at `d_trial` (from `state`, committed at `d_old`) still describes
+    /// the nearby `d_new` when carried along its tangents: the move keeps its direction (a
+    /// Masing branch, a Bouc-Wen rate and a rate-dependent law depend on it), no Masing branch
+    /// closes between the two and no Jenkins/Iwan element sticks at one point and slips at the
+    /// other. A Newton solve that ends without a
+    /// last trial (see `newmark::newton_step`) tries the joint anew at `d_new` otherwise: an end
+    /// that a small update moved back across the start, or across a slip point, would be
+    /// carried along the tangents of the wrong branch or regime for the whole piece.
+    #[inline]
+    pub fn holds(&self, state: &JointState, d_old: f64, d_trial: f64, d_new: f64) -> bool {
+        let slips = |k: f64, fs: f64, f0: f64, d: f64| {
+            let ft = f0 + k * (d - d_old);
+            (ft.abs() > fs, ft > 0.0)
+        };
+        match (self, state) {
+            (Self::KelvinVoigt { .. } | Self::Normal { .. }, _) => true,
+            (Self::Jenkins { k, fs }, JointState::Slider(f0)) => {
+                slips(*k, *fs, *f0, d_trial) == slips(*k, *fs, *f0, d_new)
+            }
+            (Self::Iwan { k, fs }, JointState::Sliders(f0)) => {
+                k.iter().zip(fs).zip(f0).all(|((&ki, &fi), &f0i)| {
+                    slips(ki, fi, f0i, d_trial) == slips(ki, fi, f0i, d_new)
+                })
+            }
+            (Self::Masing { .. }, JointState::Masing(st)) => {
+                d_trial == d_new
+                    || ((d_trial - d_old) * (d_new - d_old) > 0.0
+                        && masing_closure(st, d_trial).is_some()
+                            == masing_closure(st, d_new).is_some())
+            }
+            _ => (d_trial - d_old) * (d_new - d_old) > 0.0 || d_trial == d_new,
+        }
+    }
+
     /// The virgin state (d = 0, F = 0).
     pub fn fresh_state(&self) -> JointState {
         match self {
@@ -476,6 +510,18 @@ pub(super) fn masing_kink(
     st: &MasingState,
     x1: f64,
 ) -> Option<(f64, f64)> {
+    let (anchor, target) = masing_closure(st, x1)?;
+    // the closing branch's slope there, and the outer one's (a trial at the target pops it)
+    let left = curve.slope((target - anchor) / scale);
+    let right = masing_trial(curve, scale, st, target).1;
+    Some((target, right - left))
+}
+
+/// The anchor and the closure point of the branch a Masing joint in `st` moves on toward
+/// `x1` (see [`masing_kink`]), when the monotone move to `x1` crosses that closure; `None`
+/// otherwise.
+#[inline]
+pub(super) fn masing_closure(st: &MasingState, x1: f64) -> Option<(f64, f64)> {
     let dx = x1 - st.x;
     if dx == 0.0 {
         return None;
@@ -493,13 +539,7 @@ pub(super) fn masing_kink(
             st.stack[n.saturating_sub(2)].x,
         ),
     };
-    if !((x1 - target) * s > 0.0 && (target - st.x) * s > 0.0) {
-        return None;
-    }
-    // the closing branch's slope there, and the outer one's (a trial at the target pops it)
-    let left = curve.slope((target - anchor) / scale);
-    let right = masing_trial(curve, scale, st, target).1;
-    Some((target, right - left))
+    ((x1 - target) * s > 0.0 && (target - st.x) * s > 0.0).then_some((anchor, target))
 }
 
 /// Accept the Masing trial at `x` (force `f`, memory update `aux` from [`masing_trial`]): the
@@ -909,6 +949,39 @@ mod tests {
                 "{z0} {dd}: {z} vs {zr}"
             );
         }
+    }
+
+    #[test]
+    fn a_quick_trial_holds_on_its_branch_and_regime_only() -> Result<(), CoreError> {
+        // Jenkins: both points stuck (or both slipping the same way), not one of each
+        let jk = JointLaw::Jenkins { k: 100.0, fs: 1.0 };
+        let st = JointState::Slider(0.5);
+        assert!(jk.holds(&st, 0.0, 0.004, 0.0045));
+        assert!(jk.holds(&st, 0.0, 0.006, 0.007));
+        assert!(!jk.holds(&st, 0.0, 0.004, 0.006));
+        assert!(!jk.holds(&st, 0.0, 0.006, 0.004));
+        // Masing: up to 1e-4, back to -5e-5; moving up again, the branch closes at 1e-4
+        let law = JointLaw::masing(exp_curve(), 1.0)?;
+        let mut st = law.fresh_state();
+        let mut d = 0.0;
+        for x in [1e-4, -5e-5] {
+            let tr = law.trial(&st, d, x, 0.0);
+            law.commit(&mut st, d, x, &tr)?;
+            d = x;
+        }
+        assert!(law.holds(&st, d, 5e-5, 6e-5));
+        assert!(!law.holds(&st, d, 1.01e-4, 0.99e-4));
+        assert!(!law.holds(&st, d, 0.99e-4, 1.01e-4));
+        assert!(law.holds(&st, d, 1.01e-4, 1.02e-4));
+        assert!(!law.holds(&st, d, -6e-5, -4e-5));
+        // Bouc-Wen: the direction of the move; Kelvin-Voigt: always
+        let bw = JointLaw::bouc_wen(5e4, 1e3, 0.8, -1.1, 1.0)?;
+        let st = bw.fresh_state();
+        assert!(bw.holds(&st, 0.0, 1e-6, 2e-6));
+        assert!(!bw.holds(&st, 0.0, 1e-6, -1e-6));
+        let kv = JointLaw::kelvin_voigt(1e3, 1.0)?;
+        assert!(kv.holds(&JointState::Elastic, 0.0, 1e-6, -1e-6));
+        Ok(())
     }
 
     #[test]

@@ -263,6 +263,27 @@ impl Response {
     }
 }
 
+/// A Hermite piece's Newton solve (see `sdof::adaptive`) ends after its update once the
+/// residual is below this fraction of the forces ([`hermite_quick`]: less with an `rtol` tighter
+/// than the default), without another joint evaluation (the joints
+/// carried along their tangents, or tried anew where the update moved an end across a
+/// reversal, a Masing closure or a slip point: [`JointLaw::holds`]). The residual left is of
+/// the order of its square, 1e-4 of the forces, which the piece's two Hermite corrections then
+/// remove with the Newmark end's own error (each re-solves the equilibrium; their fixed point
+/// does not depend on where they start). Ending at `min(1e-3, √rtol)`, as the step-doubling
+/// pairs do, took 1.8–2.2 Newton iterations per piece where this takes 1.0–1.3, at the same
+/// error against the references of `benches/bench_structure.py --stepping` (stop 39).
+pub(crate) const HERMITE_QUICK: f64 = 1e-2;
+
+/// The residual (relative to the forces) below which a Hermite piece's Newton solve ends after
+/// its update: [`HERMITE_QUICK`], or `1e3 √rtol` where that is less (the default `rtol =
+/// 1e-10` gives `HERMITE_QUICK`; a tighter `rtol` still costs iterations and moves the result
+/// toward the tightest solve's).
+#[inline]
+pub(crate) fn hermite_quick(rtol: f64) -> f64 {
+    HERMITE_QUICK.min(1e3 * rtol.sqrt())
+}
+
 /// The factor on the piece length after an estimate `err` (`0.9 (tol / err)^(1/3)` within
 /// `[0.2, 4]`; the cube root only where it matters).
 #[inline]

@@ -182,10 +182,16 @@ fn newton_step(
                 sc.x1[d] = w.x[d] + sc.dx[d];
                 sc.v1[d] = w.v[d] + g * asum;
             }
-            for (j, t) in s.joints.iter().zip(sc.trials.iter_mut()) {
-                // the end moved by −b δa in x and −g δa in v since the trial
+            for (jn, (j, t)) in s.joints.iter().zip(sc.trials.iter_mut()).enumerate() {
+                // the end moved by −b δa in x and −g δa in v since the trial (a joint whose
+                // trial does not hold there, see `JointLaw::holds`, is tried anew)
                 let (dd, dv) = (-b * rel(j, &sc.tmp), -g * rel(j, &sc.tmp));
-                t.f += t.kt * dd + t.ct * dv;
+                let (st, d0, d1) = (&w.states[jn], w.jd[jn], rel(j, &sc.x1));
+                if j.law.holds(st, d0, d1 - dd, d1) {
+                    t.f += t.kt * dd + t.ct * dv;
+                } else {
+                    *t = j.law.trial(st, d0, d1, rel(j, &sc.v1));
+                }
             }
             return Some(it);
         }

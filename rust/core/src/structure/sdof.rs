@@ -16,7 +16,8 @@
 //! buffer is empty are not computed.
 
 use super::joint::{
-    masing_commit, masing_kink, masing_trial, Joint, JointLaw, JointState, MasingCurve, Trial,
+    masing_closure, masing_commit, masing_kink, masing_trial, Joint, JointLaw, JointState,
+    MasingCurve, Trial,
 };
 use super::{Buffers, Inputs, Options, Status, Structure, Summary};
 use crate::error::CoreError;
@@ -107,6 +108,9 @@ trait Joints {
     fn hermite(&self) -> bool;
     /// Move each joint's force at the last trial along its tangents by `(dx, dv)`.
     fn shift(&mut self, moved: (f64, f64));
+    /// Whether the last trial, made at `x_trial` from the committed `x0`, still describes the
+    /// nearby `x1` for every joint ([`JointLaw::holds`]).
+    fn holds(&self, x0: f64, x_trial: f64, x1: f64) -> bool;
     /// Accept the last trial (shifted to `x1`, from `x0`) of a Hermite piece with the ends
     /// `e`: each joint's work by [`hermite_work`].
     fn commit_hermite(&mut self, x0: f64, x1: f64, e: &Ends) -> Result<(), CoreError>;
@@ -346,6 +350,14 @@ impl Joints for Dyn<'_> {
     }
 
     #[inline]
+    fn holds(&self, x0: f64, x_trial: f64, x1: f64) -> bool {
+        self.joints
+            .iter()
+            .zip(&self.states)
+            .all(|(j, st)| j.law.holds(st, x0, x_trial, x1))
+    }
+
+    #[inline]
     fn commit_hermite(&mut self, x0: f64, x1: f64, e: &Ends) -> Result<(), CoreError> {
         // (the closure's jumps go to the joint that crosses it)
         let mut dk = e.dk;
@@ -569,6 +581,14 @@ impl Joints for MasingExp {
     #[inline(always)]
     fn shift(&mut self, (dx, _): (f64, f64)) {
         self.f += self.kt * dx;
+    }
+
+    #[inline(always)]
+    fn holds(&self, x0: f64, x_trial: f64, x1: f64) -> bool {
+        x_trial == x1
+            || ((x_trial - x0) * (x1 - x0) > 0.0
+                && masing_closure(&self.st, x_trial).is_some()
+                    == masing_closure(&self.st, x1).is_some())
     }
 
     fn hermite(&self) -> bool {
@@ -807,10 +827,15 @@ fn newton<J: Joints>(
             // square of this one, so the update is kept without another trial, the joints'
             // forces carried along their tangents (a step-doubling pair's inner steps only:
             // their joint trials are never committed)
-            let (mx, mv) = (-b * da, -g * da);
+            let (mut mx, mut mv) = (-b * da, -g * da);
             let mut joints = js;
             joints.f += js.kt * mx + js.ct * mv;
             let (x1, v1) = (xp + b * a1, vp + g * a1);
+            if !jt.holds(xc, x1 - mx, x1) {
+                // the update moved the end across the start or a slip point: tried anew
+                joints = jt.trial(xc, &Point { x1, v1, xp, b, a1 });
+                (mx, mv) = (0.0, 0.0);
+            }
             let st = Step {
                 dx: x1 - xc,
                 x1,

@@ -247,14 +247,15 @@ fn accept(s: &Structure, w: &mut Work, sc: &Scratch, p: &Pair) -> Result<(), Cor
     Ok(())
 }
 
-/// The piece length (a fraction of the interval) to try from `tau`: `want`, or the rest of
-/// the interval cut into equal pieces no longer than it.
-fn next_frac(tau: f64, want: f64) -> f64 {
+/// The piece length (a fraction of the interval, whose length is `big_h`) to try from `tau`:
+/// `want` (in seconds), or the rest of the interval cut into equal pieces no longer than it.
+fn next_frac(tau: f64, want: f64, big_h: f64) -> f64 {
+    // (compared in seconds: no division where the rest is taken whole, the common case)
     let rest = (1.0 - tau).max(0.0);
-    if want >= rest {
+    if want >= rest * big_h {
         return rest;
     }
-    rest / (rest / want).ceil().max(1.0)
+    rest / (rest * big_h / want).ceil().max(1.0)
 }
 
 /// The error-controlled loop of the n-DOF path (state `w` at `t[0]`, already recorded).
@@ -281,7 +282,7 @@ pub(super) fn run(
     for (i, pair) in inp.t.windows(2).enumerate() {
         let big_h = pair[1] - pair[0];
         let (mut tau, mut halvings, mut events) = (0.0_f64, 0usize, 0usize);
-        let mut frac = next_frac(tau, want / big_h);
+        let mut frac = next_frac(tau, want, big_h);
         let mut shortened = false;
         if herm_ok {
             hm.interval(s, inp, i, big_h);
@@ -346,7 +347,7 @@ pub(super) fn run(
                 }
                 shortened = false;
                 tau = tau1;
-                frac = next_frac(tau, want / big_h);
+                frac = next_frac(tau, want, big_h);
                 continue;
             }
             let ext = (scale, if h * rate > 2.0 { 0.0 } else { 1.0 / 3.0 });
@@ -410,7 +411,7 @@ pub(super) fn run(
             }
             shortened = false;
             tau = tau1;
-            frac = next_frac(tau, want / big_h);
+            frac = next_frac(tau, want, big_h);
         }
         let next = i.saturating_add(1); // < nt
         record(s, &w, out, next);

@@ -11,9 +11,11 @@
 //! second order; each correction gains an order (the first is limited by the Newmark end's
 //! acceleration, `h/2 δa`), the second is fourth order, and the change it made is the error
 //! estimate (held to `tol` relative to the displacement and velocity sizes, the length
-//! following `(tol / err)^(1/4)`). One Newton solve per piece (ended without its last trial
-//! once converged quadratically, the joints carried along their tangents by its last update)
-//! and no further joint evaluations: the cost of a fixed step plus a few flops. Energies are
+//! following `(tol / err)^(1/4)`). One Newton solve per piece (ended after its update once
+//! the residual is below `HERMITE_QUICK` of the forces, without a last trial: the joints
+//! carried along their tangents by that update, or tried anew where it moved the end across
+//! the start, a Masing closure or a slip point) and no further joint evaluations: about the
+//! cost of a fixed step. Energies are
 //! the Hermite rule's integrals of the powers. Velocity reversals are placed at the root of
 //! the cubic through the ends' velocities and accelerations.
 //!
@@ -215,10 +217,17 @@ fn hermite<J: Joints>(
     (opts, min_piece, (kinks, kinks_z)): (&Options, f64, (bool, bool)),
 ) -> Option<Herm> {
     let f1 = load(inp, i, tau1);
-    // Newton ends without a last trial once converged quadratically (as a step-doubling pair's
-    // inner solves; not for difference-quotient tangents): the joints are carried along their
-    // tangents by its last update, as the corrections below carry them
-    let quick = jt.quick().min(opts.rtol.sqrt());
+    // (the corrections' chain multiplies by it: a division there is 3-4 times the latency)
+    let im = 1.0 / m;
+    // Newton ends without a last trial once its residual is below `HERMITE_QUICK` of the
+    // forces (not for difference-quotient tangents): the joints are carried along their
+    // tangents by its last update, as the corrections below carry them, and the corrections
+    // remove the residual left with the Newmark end's own error
+    let quick = if jt.quick() > 0.0 {
+        crate::structure::hermite_quick(opts.rtol)
+    } else {
+        0.0
+    };
     let (st, iters) = newton(jt, (m, c, k), w, (w.x, quick), h, f1, opts)?;
     // A stick-slip transition (linear in the displacement while stuck): where the cubic
     // through the ends' displacements and velocities reaches it (the fraction of the move is
@@ -280,7 +289,7 @@ fn hermite<J: Joints>(
     let (ex, ev) = match zero {
         Some((th, q)) if th > 0.0 && th < 1.0 => {
             let vk = cubic_value(th, (w.v, h * w.a), (st.v1, h * st.a1));
-            let d = -q * vk * vk / m;
+            let d = -q * vk * vk * im;
             let u = (1.0 - th) * h;
             let (u2, h2) = (u * u, h * h);
             (
@@ -290,13 +299,13 @@ fn hermite<J: Joints>(
         }
         _ => (0.0, 0.0),
     };
-    let j0 = (fd - (c + ct0) * w.a - (k + kt0) * w.v) / m;
+    let j0 = (fd - (c + ct0) * w.a - (k + kt0) * w.v) * im;
     let (xt, vt, gt) = (st.x1, st.v1, st.joints.f);
     let (mut x1, mut v1, mut a1, mut g1) = (xt, vt, st.a1, gt);
     let (mut xp, mut vp) = (x1, v1);
     let (h2, h3) = (h * h, h * h * h);
     for _ in 0..2 {
-        let j1 = (fd - (c + ct1) * a1 - (k + kt1) * v1) / m;
+        let j1 = (fd - (c + ct1) * a1 - (k + kt1) * v1) * im;
         (xp, vp) = (x1, v1);
         v1 = w.v + 0.5 * h * (w.a + a1) + h2 / 12.0 * (j0 - j1) + ev;
         x1 = w.x
@@ -307,7 +316,7 @@ fn hermite<J: Joints>(
         // the joints carried along their tangents from the Newmark end (the move is of the
         // order of the step's local error: the linearisation's error is of its square)
         g1 = gt + st.joints.kt * (x1 - xt) + ct1 * (v1 - vt);
-        a1 = (f1 - c * v1 - k * x1 - g1) / m;
+        a1 = (f1 - c * v1 - k * x1 - g1) * im;
     }
     let mut joints = st.joints;
     let mut moved = (st.moved.0 + (x1 - xt), st.moved.1 + (v1 - vt));
@@ -323,7 +332,7 @@ fn hermite<J: Joints>(
         };
         joints = jt.trial(w.x, &pt);
         g1 = joints.f;
-        a1 = (f1 - c * v1 - k * x1 - g1) / m;
+        a1 = (f1 - c * v1 - k * x1 - g1) * im;
         moved = (0.0, 0.0);
         dks.1 = 0.0;
     }
@@ -453,15 +462,16 @@ fn accept<J: Joints>(jt: &mut J, c: f64, w: &mut State, p: &Piece) -> Result<(),
     Ok(())
 }
 
-/// The piece length (a fraction of the interval) to try from `tau`: the wanted length `want`,
-/// or the rest of the interval cut into equal pieces no longer than it.
-fn next_frac(tau: f64, want: f64) -> f64 {
+/// The piece length (a fraction of the interval, whose length is `big_h`) to try from `tau`:
+/// the wanted length `want` (in seconds), or the rest of the interval cut into equal pieces
+/// no longer than it.
+fn next_frac(tau: f64, want: f64, big_h: f64) -> f64 {
+    // (compared in seconds: no division where the rest is taken whole, the common case)
     let rest = (1.0 - tau).max(0.0);
-    if want >= rest {
+    if want >= rest * big_h {
         return rest;
     }
-    let pieces = (rest / want).ceil().max(1.0);
-    rest / pieces
+    rest / (rest * big_h / want).ceil().max(1.0)
 }
 
 /// The error-controlled integration loop (state `w` at `t[0]`, already recorded).
@@ -494,7 +504,7 @@ pub(super) fn run<J: Joints>(
         let mut tau = 0.0_f64;
         let mut halvings = 0usize;
         let mut events = 0usize;
-        let mut frac = next_frac(tau, want / big_h);
+        let mut frac = next_frac(tau, want, big_h);
         let mut shortened = false;
         // the load's rate over the interval (linear between samples)
         let fd = (load(inp, i, 1.0) - load(inp, i, 0.0)) / big_h;
@@ -550,7 +560,7 @@ pub(super) fn run<J: Joints>(
                 }
                 shortened = false;
                 tau = tau1;
-                frac = next_frac(tau, want / big_h);
+                frac = next_frac(tau, want, big_h);
                 continue;
             }
             let ext = if h * rate > 2.0 { 0.0 } else { 1.0 / 3.0 };
@@ -616,7 +626,7 @@ pub(super) fn run<J: Joints>(
             }
             shortened = false;
             tau = tau1;
-            frac = next_frac(tau, want / big_h);
+            frac = next_frac(tau, want, big_h);
         }
         let next = i.saturating_add(1); // < nt
         record(jt, &w, out, next);

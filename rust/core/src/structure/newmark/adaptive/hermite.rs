@@ -3,7 +3,9 @@
 //! `M j = ḟ − C a − K v − Σ (k_t ḋ + c_t d̈)` (joint terms scattered to their DOFs; at the
 //! start the joints' right-limit tangents), the joints carried along their tangents from the
 //! Newmark end and the acceleration put back in equilibrium (`M⁻¹` of the residual forces)
-//! after each correction. The change of the second correction is the error estimate.
+//! after each correction. The change of the second correction is the error estimate. `M⁻¹`,
+//! `M⁻¹ C`, `M⁻¹ K` and `M⁻¹` of each joint's direction are formed once, so the jerks and the
+//! equilibria are products, without a solve (a third of the cost of a 3-DOF piece, stop 38).
 
 use super::super::super::dense::Lu;
 use super::super::super::joint::JointLaw;
@@ -27,7 +29,6 @@ pub(super) struct Herm {
     j1: Vec<f64>,
     xp: Vec<f64>,
     vp: Vec<f64>,
-    r: Vec<f64>,
     tmp: Vec<f64>,
     /// Each joint's tangents at the committed point (left limit), at the piece's start along
     /// it (right limit) and at the Newmark end; its relative displacement and velocity and its
@@ -43,10 +44,27 @@ pub(super) struct Herm {
     end_j: Vec<(f64, f64)>,
     kinks: bool,
     crossed: Vec<bool>,
-    m_lu: Lu,
+    /// `M⁻¹`, `M⁻¹ C` and `M⁻¹ K` (row-major), and each joint's column `M⁻¹ (e_dof −
+    /// e_dof2)`: the jerk and the equilibrium acceleration as products, without a solve.
+    mi: Vec<f64>,
+    mic: Vec<f64>,
+    mik: Vec<f64>,
+    mcol: Vec<Vec<f64>>,
+    /// `M⁻¹` of the load at the interval's start and of its rate, and the interval's length.
+    mf0: Vec<f64>,
+    mfd: Vec<f64>,
+    mf1: Vec<f64>,
+    big_h: f64,
+    /// `C v` and `C a` at the committed point (the start's damping power in [`accept`]), when
+    /// `cv_ok`: kept from the last Hermite piece's end.
+    cv: Vec<f64>,
+    ca: Vec<f64>,
+    cv_ok: bool,
 }
 
 impl Herm {
+    // Row-major n × n index arithmetic, n * n checked in `Structure::new`.
+    #[allow(clippy::arithmetic_side_effects)]
     pub(super) fn new(s: &Structure, w: &Work) -> Result<Self, CoreError> {
         let n = s.n;
         let z = || vec![0.0; n];
@@ -57,6 +75,36 @@ impl Herm {
                 value: 0.0,
                 reason: "mass matrix is singular",
             })?;
+        // M⁻¹ column by column, then M⁻¹ C and M⁻¹ K (row-major)
+        let mut mi = vec![0.0; n * n];
+        let mut col = vec![0.0; n];
+        for c in 0..n {
+            col.fill(0.0);
+            col[c] = 1.0;
+            m_lu.solve(&mut col);
+            for r in 0..n {
+                mi[r * n + c] = col[r];
+            }
+        }
+        let prod = |a: &[f64]| -> Vec<f64> {
+            let mut out = vec![0.0; n * n];
+            for r in 0..n {
+                for c in 0..n {
+                    out[r * n + c] = (0..n).map(|q| mi[r * n + q] * a[q * n + c]).sum();
+                }
+            }
+            out
+        };
+        let (mic, mik) = (prod(&s.c), prod(&s.k));
+        let mcol = s
+            .joints
+            .iter()
+            .map(|j| {
+                (0..n)
+                    .map(|r| mi[r * n + j.dof] - j.dof2.map_or(0.0, |q| mi[r * n + q]))
+                    .collect()
+            })
+            .collect();
         let tang = s
             .joints
             .iter()
@@ -74,7 +122,6 @@ impl Herm {
             j1: z(),
             xp: z(),
             vp: z(),
-            r: z(),
             tmp: z(),
             tang,
             start: vec![(0.0, 0.0); nj],
@@ -87,52 +134,73 @@ impl Herm {
                 .iter()
                 .any(|j| matches!(j.law, JointLaw::Masing { .. })),
             crossed: vec![false; nj],
-            m_lu,
+            mi,
+            mic,
+            mik,
+            mcol,
+            mf0: z(),
+            mfd: z(),
+            mf1: z(),
+            big_h: 0.0,
+            cv: z(),
+            ca: z(),
+            cv_ok: false,
         })
     }
 
-    /// The committed point's tangents from the trials just committed.
+    /// The committed point's tangents from the trials just committed (and `C v`, `C a` there
+    /// no longer known).
     pub(super) fn committed(&mut self, sc: &Scratch) {
         for (tg, tr) in self.tang.iter_mut().zip(&sc.trials) {
             *tg = (tr.kt, tr.ct);
         }
+        self.cv_ok = false;
     }
 
-    /// The load's rate over interval `i` (length `big_h`).
+    /// The load's rate over interval `i` (length `big_h`), and `M⁻¹` of it and of the load at
+    /// the interval's start (the load is linear over the interval).
     pub(super) fn interval(&mut self, s: &Structure, inp: &Inputs<'_>, i: usize, big_h: f64) {
         load(s, inp, i, 1.0, &mut self.fd);
         load(s, inp, i, 0.0, &mut self.tmp);
         for (f, f0) in self.fd.iter_mut().zip(&self.tmp) {
             *f = (*f - f0) / big_h;
         }
+        matvec(&self.mi, &self.tmp, s.n, &mut self.mf0);
+        matvec(&self.mi, &self.fd, s.n, &mut self.mfd);
+        self.big_h = big_h;
     }
 }
 
-/// `out = M⁻¹ (ḟ − C a − K v − Σ (k_t ḋ + c_t d̈))` with the joints' tangents `tang`.
-// Joint DOFs < n (checked in `Structure::new`); the buffers are n long.
+/// `out = p − A u − B w` (`A`, `B` row-major `n × n`).
+// Row-major index arithmetic below n (the buffers are n and n × n long).
 #[allow(clippy::arithmetic_side_effects)]
+#[inline(always)]
+fn affine(p: &[f64], (a, u): (&[f64], &[f64]), (b, w): (&[f64], &[f64]), out: &mut [f64]) {
+    let n = out.len();
+    for (r, o) in out.iter_mut().enumerate() {
+        let (ra, rb) = (&a[r * n..(r + 1) * n], &b[r * n..(r + 1) * n]);
+        let mut acc = p[r];
+        for c in 0..n {
+            acc -= ra[c] * u[c] + rb[c] * w[c];
+        }
+        *o = acc;
+    }
+}
+
+/// `M⁻¹ (ḟ − C a − K v − Σ (k_t ḋ + c_t d̈))` with the joints' tangents (`hm.start` into
+/// `hm.j0`, or `hm.end_j` into `hm.j1`), as products with the `M⁻¹` matrices.
 fn jerk(s: &Structure, hm: &mut Herm, (v, a): (&[f64], &[f64]), at_start: bool) {
-    let n = s.n;
-    hm.r.copy_from_slice(&hm.fd);
-    for (mat, vec) in [(&s.c, a), (&s.k, v)] {
-        matvec(mat, vec, n, &mut hm.tmp);
-        for (r, t) in hm.r.iter_mut().zip(&hm.tmp) {
-            *r -= t;
-        }
-    }
-    let tang = if at_start { &hm.start } else { &hm.end_j };
-    for (j, &(kt, ct)) in s.joints.iter().zip(tang) {
-        let g = kt * rel(j, v) + ct * rel(j, a);
-        hm.r[j.dof] -= g;
-        if let Some(q) = j.dof2 {
-            hm.r[q] += g;
-        }
-    }
-    hm.m_lu.solve(&mut hm.r);
-    if at_start {
-        hm.j0.copy_from_slice(&hm.r);
+    let (tang, out) = if at_start {
+        (&hm.start, &mut hm.j0)
     } else {
-        hm.j1.copy_from_slice(&hm.r);
+        (&hm.end_j, &mut hm.j1)
+    };
+    affine(&hm.mfd, (&hm.mic, a), (&hm.mik, v), out);
+    for ((j, &(kt, ct)), col) in s.joints.iter().zip(tang).zip(&hm.mcol) {
+        let g = kt * rel(j, v) + ct * rel(j, a);
+        for (o, m) in out.iter_mut().zip(col) {
+            *o -= g * m;
+        }
     }
 }
 
@@ -178,15 +246,20 @@ pub(super) fn piece(
 ) -> Option<(f64, f64, u64)> {
     let n = s.n;
     load(s, inp, i, tau1, &mut sc.f1);
+    let t1 = tau1 * hm.big_h;
+    for ((o, f0), fd) in hm.mf1.iter_mut().zip(&hm.mf0).zip(&hm.mfd) {
+        *o = f0 + t1 * fd;
+    }
     // Newton starts from a + h j (the jerk with the committed tangents): closer than a by h
     hm.start.copy_from_slice(&hm.tang);
     jerk(s, hm, (&w.v, &w.a), true);
     for ((a1, a0), j0) in sc.a1.iter_mut().zip(&w.a).zip(&hm.j0) {
         *a1 = a0 + h * j0;
     }
-    // Newton ends without a last trial once converged quadratically (as the one-DOF path; a
-    // Masing joint's crossing of a closure is then read from its trial's memory walk)
-    let quick = opts.rtol.sqrt().min(1e-3);
+    // Newton ends without a last trial once its residual is below `HERMITE_QUICK` (as the
+    // one-DOF path; a Masing joint's crossing of a closure is then read from its trial's
+    // memory walk)
+    let quick = crate::structure::hermite_quick(opts.rtol);
     let it = newton_step(s, w, (h, quick, true), sc, opts)?;
     let mut theta = 1.0_f64;
     let min_piece = 1e-3 / step;
@@ -235,7 +308,9 @@ pub(super) fn piece(
             theta = theta.min(th);
         }
     }
-    jerk(s, hm, (&w.v, &w.a), true);
+    if hm.start != hm.tang {
+        jerk(s, hm, (&w.v, &w.a), true);
+    }
     let (h2, h3) = (h * h, h * h * h);
     for _ in 0..2 {
         jerk(s, hm, (&sc.v1, &sc.a1), false);
@@ -254,7 +329,7 @@ pub(super) fn piece(
             let ((kt, ct), (d, v)) = (hm.end[jn], hm.dt[jn]);
             sc.trials[jn].f = hm.ft[jn] + kt * (rel(j, &sc.x1) - d) + ct * (rel(j, &sc.v1) - v);
         }
-        equilibrium(s, sc, hm);
+        equilibrium(sc, hm);
     }
     if hm.kinks {
         // a corrected end across a closure the Newmark end had not crossed (or back): the
@@ -272,7 +347,7 @@ pub(super) fn piece(
             }
         }
         if again {
-            equilibrium(s, sc, hm);
+            equilibrium(sc, hm);
         }
     }
     let (mut ex, mut ev, mut sx, mut sv) = (0.0_f64, 0.0_f64, scale.0, scale.1);
@@ -287,26 +362,15 @@ pub(super) fn piece(
     Some((if err.is_nan() { f64::INFINITY } else { err }, theta, it))
 }
 
-/// `sc.a1 = M⁻¹ (f − C v − K x − G)` at the end in `sc`, the joints' forces `sc.trials[].f`.
-// Joint DOFs < n (checked in `Structure::new`); the buffers are n long.
-#[allow(clippy::arithmetic_side_effects)]
-fn equilibrium(s: &Structure, sc: &mut Scratch, hm: &mut Herm) {
-    let n = s.n;
-    sc.r.copy_from_slice(&sc.f1);
-    for (mat, vec) in [(&s.c, &sc.v1), (&s.k, &sc.x1)] {
-        matvec(mat, vec, n, &mut sc.tmp);
-        for (r, t) in sc.r.iter_mut().zip(&sc.tmp) {
-            *r -= t;
+/// `sc.a1 = M⁻¹ (f − C v − K x − G)` at the end in `sc` (`hm.mf1`: `M⁻¹ f` there), the joints'
+/// forces `sc.trials[].f`, as products with the `M⁻¹` matrices.
+fn equilibrium(sc: &mut Scratch, hm: &Herm) {
+    affine(&hm.mf1, (&hm.mic, &sc.v1), (&hm.mik, &sc.x1), &mut sc.a1);
+    for (tr, col) in sc.trials.iter().zip(&hm.mcol) {
+        for (o, m) in sc.a1.iter_mut().zip(col) {
+            *o -= tr.f * m;
         }
     }
-    for (j, tr) in s.joints.iter().zip(&sc.trials) {
-        sc.r[j.dof] -= tr.f;
-        if let Some(q) = j.dof2 {
-            sc.r[q] += tr.f;
-        }
-    }
-    hm.m_lu.solve(&mut sc.r);
-    sc.a1.copy_from_slice(&sc.r);
 }
 
 /// `∫ g dt` over a piece of length `h` by the two-point Hermite rule: `g` and `ġ` at both ends.
@@ -329,6 +393,7 @@ pub(super) fn accept(
     let n = s.n;
     let (mut p0, mut dp0, mut p1, mut dp1) = (0.0, 0.0, 0.0, 0.0);
     let (mut q0, mut dq0, mut q1, mut dq1) = (0.0, 0.0, 0.0, 0.0);
+    let known = hm.cv_ok;
     for d in 0..n {
         let fd = hm.fd[d];
         p0 += w.f[d] * w.v[d];
@@ -337,7 +402,13 @@ pub(super) fn accept(
         dp1 += fd * sc.v1[d] + sc.f1[d] * sc.a1[d];
         let row = &s.c[d * n..(d + 1) * n];
         let dot = |u: &[f64]| -> f64 { row.iter().zip(u).map(|(c, x)| c * x).sum() };
-        let (cv0, ca0, cv1, ca1) = (dot(&w.v), dot(&w.a), dot(&sc.v1), dot(&sc.a1));
+        let (cv0, ca0) = if known {
+            (hm.cv[d], hm.ca[d])
+        } else {
+            (dot(&w.v), dot(&w.a))
+        };
+        let (cv1, ca1) = (dot(&sc.v1), dot(&sc.a1));
+        (hm.cv[d], hm.ca[d]) = (cv1, ca1);
         q0 += w.v[d] * cv0;
         dq0 += w.a[d] * cv0 + w.v[d] * ca0;
         q1 += sc.v1[d] * cv1;
@@ -367,6 +438,7 @@ pub(super) fn accept(
         w.jv[jn] = v1;
     }
     hm.committed(sc);
+    hm.cv_ok = true;
     w.x.copy_from_slice(&sc.x1);
     w.v.copy_from_slice(&sc.v1);
     w.a.copy_from_slice(&sc.a1);
