@@ -21,6 +21,12 @@ MIN_LOAD_PERIODS = 2.0
 #: within 30° of φ = 0 or π (a third of phases; helper loadslip's chain: φ = 0, ±10 %, named
 #: series_compliance; φ = 0.52, nothing)
 MIN_DIRECTION_SHARE = 0.25
+#: the effects (with a parameter only they carry) that make the friction a function of the
+#: speed or of the position: beside one of them, a harmonic fluctuation mostly the same on
+#: both strokes (direction share below MIN_DIRECTION_SHARE) is refused — at one amplitude it
+#: only reshapes their function (a Stribeck term of the rig, s 0.31, was named with a 2f
+#: load beside it: rivals tuning seed 940024)
+BESIDE = {"stribeck": "v_s", "position_friction": "L"}
 #: largest plausible fluctuation of the normal load, relative: a joint whose normal load
 #: swings by more than this within the record is not "loaded with fluctuations" but a
 #: different test; a fit beyond it absorbs a misfit of the base model
@@ -178,6 +184,18 @@ class NormalLoad(EffectModel):
                 "friction's own sign) a friction growing with the sliding speed: the velocity "
                 "effects and position_friction stand for it",
             )
+        beside = [n for n, key in BESIDE.items() if key in p]
+        if k and beside:
+            cos, sin = load_terms(d, p["f_n"], None)
+            share = direction_share(d, p["eps_c"] * cos + p["eps_s"] * sin)
+            if share < MIN_DIRECTION_SHARE:
+                return Plausibility(
+                    False,
+                    f"a load fluctuation at {p['f_n']:.4g} Hz, harmonic {k} of the drive, is "
+                    f"{100 * (1 - share):.0f} % the same on both strokes: at one amplitude a "
+                    "friction that is a function of the speed and of the position, so beside "
+                    f"{' and '.join(beside)} it reshapes that function, not a load of its own",
+                )
         return base
 
     def argument(self, d, p):

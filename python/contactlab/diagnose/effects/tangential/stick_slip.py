@@ -225,6 +225,19 @@ def drawn_by_breakaway(d, p) -> bool:
     return shape is not None and shape["share"] >= DEAD_BAND_SHARE
 
 
+#: the share of the search's ``min_gain`` its held-out gain must reach, and the share of the
+#: input-noise budget it must beat (:func:`contactlab.diagnose.search.own_gain_floor`,
+#: ``search._noise_floor``), as for ``stribeck`` and ``position_friction``: on 24 clean
+#: records (tuning seeds 950000-950029 of ``benches/eval_loadslip_gains.py``, 12 of
+#: ``benches/chain_loadslip.py`` and 12 of the rig, x noise 0-1.9 %, its own floors off) its
+#: largest held-out gain was 0.0008 σ² at t <= 1.22, at most 0.001 of the budget (a
+#: breakaway is one-signed, s_b >= 0, and anchored at the reversals: the input's noise
+#: cannot feed it). The whole budget had hidden a breakaway of 8 % of h0 at ac·A 3.2 and
+#: 1.6 % x noise (held-out gain 0.118 σ², t = 6.8, against a floor of 0.276 σ²)
+GAIN_FLOOR_SCALE = 0.2
+INPUT_NOISE_SHARE = 0.25
+
+
 #: slip distances :meth:`StickSlip.start` tries, as shares of the displacement amplitude
 START_SHARES = (0.03, 0.06, 0.1, 0.15, 0.25, 0.4, 0.6)
 
@@ -251,6 +264,9 @@ class StickSlip(EffectModel):
     stage = "branch"
     order = 13
     size_param = "s_b"
+    #: per-effect floors (see GAIN_FLOOR_SCALE, INPUT_NOISE_SHARE above)
+    gain_floor_scale = GAIN_FLOOR_SCALE
+    input_noise_share = INPUT_NOISE_SHARE
 
     def start(self, p, d, residual, family=None):
         """The slip distance (of :data:`START_SHARES` of the amplitude) and size whose term
