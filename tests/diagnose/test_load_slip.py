@@ -90,3 +90,46 @@ def test_a_2f_load_is_plausible_at_any_phase(phi, eps):
     assert "harmonic 2" in text
     if np.sin(phi) ** 2 < 0.2:
         assert "cannot tell" in text
+
+
+def _in_phase(d, eps=0.1, phi=0.0):
+    f2 = 2.0 / (400 * d.dt)
+    return {"h0": H0, "ac": AC, "eps_c": eps * np.cos(phi), "eps_s": -eps * np.sin(phi), "f_n": f2}
+
+
+def test_an_in_phase_load_yields_to_an_accepted_stribeck_term_only():
+    d = _record(3.0)
+    eff = registry("tangential")["normal_load"]
+    p = _in_phase(d)
+    assert eff.yields_to(p, {"stribeck": 0.9}, 1.0, d)  # a parabola in the speed: Stribeck
+    assert eff.yields_to(p, {"stribeck": 0.5}, 1.0, d) is None  # far below the load's gain
+    assert eff.yields_to(p, {"position_friction": 0.99}, 1.0, d) is None
+    assert eff.yields_to(_in_phase(d, phi=np.pi / 2), {"stribeck": 0.95}, 1.0, d) is None
+    assert eff.yields_to(p, {"stribeck": 0.9}, 1.0) is None  # no record: nothing to read
+
+
+def test_a_load_yields_only_to_a_rival_that_stands():
+    """A 2f load yields to a Stribeck term, which itself yields to a series compliance (a
+    speed-strengthening term): the load stands."""
+    from types import SimpleNamespace
+
+    from contactlab.diagnose.search import _yield_to_lookalikes
+    from contactlab.diagnose.select import Verdict
+
+    d = _record(3.0)
+    fam = SimpleNamespace(kind="tangential")
+    load = _in_phase(d)
+    strib = {"h0": H0, "ac": AC, "s": -0.14, "v_s": 1e-3}
+
+    def acc(name, gain, p):
+        return Verdict(name, 1.0, gain, 10.0, -50.0, True, "accepted"), SimpleNamespace(
+            full=SimpleNamespace(params=p)
+        )
+
+    both = [acc("normal_load", 1.0, load), acc("stribeck", 0.93, strib)]
+    keep, _ = _yield_to_lookalikes(fam, both, [v for v, _ in both], d)
+    assert [v.name for v, _ in keep] == ["stribeck"]
+    three = [*both, acc("series_compliance", 0.8, {"h0": H0, "ac": AC, "C_s": 1e-6})]
+    keep, verdicts = _yield_to_lookalikes(fam, three, [v for v, _ in three], d)
+    assert [v.name for v, _ in keep] == ["normal_load", "series_compliance"]
+    assert [v.accepted for v in verdicts] == [True, False, True]
