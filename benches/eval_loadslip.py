@@ -166,7 +166,11 @@ def main(argv=None):
     ap.add_argument("--gens", default="chain,rig")
     ap.add_argument("--effects", default=",".join(EFFECTS))
     ap.add_argument("--out", type=Path, default=None)
+    ap.add_argument(
+        "--only", default=None, help="run only these effects (clean: 'clean'), same seeds"
+    )
     a = ap.parse_args(argv)
+    only = None if a.only is None else set(a.only.split(","))
     jobs = []
     for g in a.gens.split(","):
         for e in [None] * a.clean + [e for e in a.effects.split(",") if e for _ in range(a.n)]:
@@ -174,6 +178,8 @@ def main(argv=None):
                 jobs.append((g, e))
     results = []
     for i, (g, e) in enumerate(jobs):
+        if only is not None and (e or "clean") not in only:
+            continue
         r = run(g, e, a.seed_base + i)
         results.append(r)
         fac = r["truth"]["factors"]
