@@ -114,6 +114,13 @@ def run(name: str, rec: object, sign: int) -> dict:
         "input_noise": u.input_noise if hasattr(u, "input_noise") else None,
         "detectable_rms": u.detectable_rms,
         "rivals": [dict(r) for r in getattr(u, "rivals", ())],
+        "calibrated": getattr(u, "calibrated", None),
+        "patches": [dict(r) for r in getattr(u, "patches", ())],
+        "flagged_before_calibration": bool(
+            u.statistic > u.threshold
+            or (u.backbone or {}).get("flagged")
+            or getattr(u, "rivals", ())
+        ),
         "sentence": u.sentence(),
         "flagged_white_null": _white_null_flag(rep),
     }  # fmt: skip
@@ -159,7 +166,13 @@ def _flag(m: dict | None) -> str:
     """The misfit flag's verdict and T over its threshold."""
     if m is None:
         return "-"
-    return f"{'FLAG' if m['flagged'] else 'no'} {m['T_over_threshold']:.2f}"
+    c = m.get("calibrated") or {}
+    by = "+".join(c.get("by") or []) + ("+patch" if m.get("patches") else "")
+    if m.get("rivals"):
+        by += "+rival"
+    before = "FLAG" if m.get("flagged_before_calibration") else "no"
+    now = "FLAG" if m["flagged"] else "no"
+    return f"{now} ({by or '-'}; before {before}) {m['T_over_threshold']:.2f}"
 
 
 def main(argv: list[str]) -> None:

@@ -5,7 +5,10 @@ rest with drive harmonics, mains hum, clock jitter and an ADC.
 The contact is a Masing element whose virgin curve is the exponential one (``virgin="exp"``:
 a clean record, nothing to flag) or one no candidate draws: ``"tanh"`` (``h0 tanh(ac s)``),
 ``"rational"`` (``h0 ac s / (1 + ac s)``) or ``"gamma"`` (``h0 (1 - (1 + ac s) e^(-ac s))``:
-zero initial slope), all with Masing's branch scale 2 (:func:`scaled_force`).
+zero initial slope), all with Masing's branch scale 2 (:func:`scaled_force`); for evaluation
+only (:data:`EVAL_VIRGINS`) ``"arctan"``, ``"bilinear"`` (two slopes to a plateau),
+``"weibull"`` (``1 - exp(-(ac s)^0.7)``) and ``"cubic"`` (``1 - (1 - ac s/3)³`` to full slip
+at ``3/ac``).
 
 The chain, on a grid ``OVERSAMPLE`` times finer than the ADC's:
 
@@ -34,7 +37,10 @@ import numpy as np
 from scipy import interpolate, signal
 
 OVERSAMPLE = 4
-VIRGINS = ("exp", "tanh", "rational", "gamma")
+VIRGINS = ("exp", "tanh", "rational", "gamma", "arctan", "bilinear", "weibull", "cubic")
+#: virgin curves written for evaluating the misfit flag only (flagcal, stop 39): none was used
+#: for tuning (the flag was tuned on tanh, rational and gamma)
+EVAL_VIRGINS = ("arctan", "bilinear", "weibull", "cubic")
 
 
 def virgin_curve(kind: str, h0: float, ac: float):
@@ -52,6 +58,20 @@ def virgin_curve(kind: str, h0: float, ac: float):
             return h0 * np.sign(s) * (1.0 - (1.0 + a) * np.exp(-a))
 
         return g
+    if kind == "arctan":  # initial slope h0 ac, slow approach to the plateau (1/s)
+        return lambda s: h0 * (2.0 / np.pi) * np.arctan(0.5 * np.pi * ac * s)
+    if kind == "bilinear":  # two slopes, then a plateau at h0 (an Iwan model of 3 elements)
+        return lambda s: (
+            h0
+            * np.sign(s)
+            * np.minimum(np.minimum(ac * np.abs(s), 0.4 + 0.3 * (ac * np.abs(s) - 0.4)), 1.0)
+        )
+    if kind == "weibull":  # a stretched exponential: infinite initial slope
+        return lambda s: h0 * np.sign(s) * (1.0 - np.exp(-((ac * np.abs(s)) ** 0.7)))
+    if kind == "cubic":  # polynomial to full slip at a finite slip (3/ac), smooth there
+        return lambda s: (
+            h0 * np.sign(s) * (1.0 - (1.0 - np.minimum(ac * np.abs(s) / 3.0, 1.0)) ** 3)
+        )
     raise ValueError(kind)
 
 

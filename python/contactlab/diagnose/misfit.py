@@ -41,6 +41,13 @@ curve explains as well (a tanh virgin curve taken up by a normal-load fluctuatio
 Stribeck term, after which the residual looks white) flags the misfit
 (:attr:`Unexplained.rivals`).
 
+A fourth step replaces the hand thresholds of the first two tests on tangential records
+(:mod:`contactlab.diagnose.misfit_null`, ``unexplained.calibrated``): both statistics are
+compared with their distribution over copies of the record simulated under the null with its
+own noise on both channels; and a named set that a free-form virgin curve with fewer
+parameters explains as well flags the misfit (:func:`contactlab.diagnose.shape.patch_check`,
+``unexplained.patches``).
+
 When ``T`` exceeds the threshold, :func:`unexplained_structure` reports where the structure
 sits (the branch and the phase range of the bins with ``|t_b|`` above a Bonferroni level,
 merged into runs) and how large it is: the RMS and the peak of the binned means, in the
@@ -203,6 +210,16 @@ class Unexplained:
     #: ``gain_virgin`` (σ²) and ``rms`` (of the free-form fit, output units); a non-empty
     #: list flags the misfit
     rivals: tuple[dict[str, Any], ...] | list[dict[str, Any]] = ()
+    #: the decision against the record's own simulated null
+    #: (:func:`contactlab.diagnose.misfit_null.calibrated_flag`): where present it replaces
+    #: the hand thresholds of the phase bins and the free-form virgin curve test in
+    #: :attr:`flagged`; None where the null could not be simulated
+    calibrated: dict[str, Any] | None = None
+    #: named sets that a Masing element with a free-form virgin curve and fewer
+    #: parameters explains as well (:func:`contactlab.diagnose.shape.patch_check`): each a
+    #: dict with ``effects``, ``params_effects``, ``params_virgin``, ``gain_effects``,
+    #: ``gain_virgin`` (σ²); a non-empty list flags the misfit
+    patches: tuple[dict[str, Any], ...] | list[dict[str, Any]] = ()
 
     def to_dict(self) -> dict[str, Any]:
         """JSON layout of ``"unexplained"`` (a contract; see the README's JSON section)."""
@@ -229,6 +246,8 @@ class Unexplained:
             "absorbing": list(self.absorbing),
             "input_noise": None if self.input_noise is None else dict(self.input_noise),
             "rivals": [dict(r) for r in self.rivals],
+            "calibrated": None if self.calibrated is None else dict(self.calibrated),
+            "patches": [dict(r) for r in self.patches],
         }
 
     def sentence(self) -> str:
@@ -254,6 +273,77 @@ class Unexplained:
         )
 
     def _verdict(self) -> str:
+        cal = self.calibrated
+        if cal is not None:
+            return self._calibrated_verdict(cal)
+        return self._hand_verdict()
+
+    def _calibrated_verdict(self, cal: dict[str, Any]) -> str:
+        """The verdict where the record's own simulated null decided
+        (:mod:`contactlab.diagnose.misfit_null`)."""
+        null = (
+            f"the upper {100 * (1 - cal['alpha'] / 2):.1f} % bound of {cal['draws']} copies of "
+            "this record simulated under the null with its own noise on both channels"
+        )
+        by = list(cal.get("by") or [])
+        parts = []
+        if "backbone" in by:
+            parts.append(
+                "the shape of the virgin curve (branches): a Masing element with a free-form "
+                f"virgin curve predicts the held-out cycles better by {cal['gain']:.2g} σ² "
+                f"(t = {cal['t']:.3g} > {cal['t_threshold']:.3g}, {null})"
+            )
+        if "phase_bins" in by:
+            runs = (
+                "; ".join(
+                    f"{w['branch']} branch, phase {w['phase_from']:.2f}-{w['phase_to']:.2f} "
+                    f"(up to {w['mean']:+.3g} {self.unit})"
+                    for w in self.where
+                )
+                or "spread over the loop"
+            )
+            parts.append(
+                f"over phase and branch: {runs}; RMS {self.rms:.3g} {self.unit} "
+                f"({self.rms_percent_of_range:.2g} % of the output's range, "
+                f"{self.rms_over_noise:.2g}× the noise) (T = {cal['T']:.3g} > "
+                f"{cal['T_threshold']:.3g}, {null}, and > {self.threshold:.3g}, the phase "
+                "bins' own threshold)"
+            )
+        for p in self.patches:
+            parts.append(
+                f"the named set {' + '.join(p['effects'])} ({p['params_effects']} parameters) "
+                f"is a patch over the shape of the virgin curve: a Masing element with a "
+                f"free-form virgin curve of {p['params_virgin']} parameters explains "
+                f"{100 * p['share']:.0f} % of its gain"
+            )
+        if self.rivals:
+            names = "; ".join(
+                f"{r['effect']} (a free-form virgin curve reaches {100 * r['share']:.0f} % of "
+                f"its gain, RMS {r['rms']:.3g} {self.unit})"
+                for r in self.rivals
+            )
+            parts.append(
+                "named effects that a Masing element with a free-form virgin curve explains "
+                f"as well: {names}; either may be the physics (records at other amplitudes "
+                "or rates tell them apart)"
+            )
+        if self.flagged and parts:
+            head = (
+                "systematic misfit that no candidate explains, or a named effect this record "
+                "cannot tell from it: "
+                if self.rivals and not by and not self.patches
+                else "systematic misfit that no candidate explains: "
+            )
+            return head + "; ".join(parts)
+        return (
+            "no systematic misfit left over phase or branch beyond what the record's own "
+            f"noise leaves: free-form virgin curve t = {_fmt(cal['t'])} <= "
+            f"{_fmt(cal['t_threshold'])}, phase bins T = {_fmt(cal['T'])} <= "
+            f"{_fmt(cal['T_threshold'])} or <= {self.threshold:.3g} (their own threshold), "
+            f"{null}; {self.cycles} cycles"
+        )
+
+    def _hand_verdict(self) -> str:
         bb = self.backbone or {}
         if (
             self.flagged
@@ -719,6 +809,10 @@ def _runs(
             )  # fmt: skip
             k = j + 1
     return where
+
+
+def _fmt(v: float | None) -> str:
+    return "n/a" if v is None else f"{v:.3g}"
 
 
 def _f(v: float) -> float | None:

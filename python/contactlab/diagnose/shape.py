@@ -13,17 +13,22 @@ that free-form curve reaches on the residual of the final model refitted without
 effect; the workflow flags the misfit where it reaches :data:`RIVAL_SHARE`
 (``unexplained.rivals``), and the effect stays named with that caveat.
 
-Tried and not kept (diagflag, stop 38): a test of the final residual against the same
-free-form curve with its null simulated from the final model with the record's own noise
-on both channels (the input noise drawn from its spectrum, :func:`.eiv.input_noise_spectrum`,
-the output noise from the residual's spectrum above the drive's harmonics). On a clean
-record of ``benches/eval_misfit_flag.py`` (tuning seed 1000: white x noise 1.9 % behind
-a Bessel filter, ac·A 0.74) the statistic was 3400 against a simulated null of 370 ± 150:
-the measured input noise left far more branch-shaped structure than fresh draws of the
-same spectrum did, whether added to the measured input (370) or to the noise-free one
-(500-900, the same record rebuilt without x noise); shifting the measured noise by a few
-periods brought it to 560-1000. The null of such a test is not the record's own noise
-spectrum, and the test was not used.
+:func:`patch_check` asks the same of the named effects together: dropped as a set, with a
+free-form virgin curve of fewer parameters than the set fitted instead (``unexplained.patches``:
+a gamma-like curve patched by backlash, a parallel stiffness and a series compliance).
+
+Tried and not kept (diagflag, stop 38; :mod:`.misfit_null` now simulates from the denoised
+input and computes the same statistics on the record and its copies): a test of the final
+residual against the same free-form curve with its null simulated from the final model with
+the record's own noise on both channels (the input noise drawn from its spectrum,
+:func:`.eiv.input_noise_spectrum`, the output noise from the residual's spectrum above the
+drive's harmonics). On a clean record of ``benches/eval_misfit_flag.py`` (tuning seed 1000:
+white x noise 1.9 % behind a Bessel filter, ac·A 0.74) the statistic was 3400 against a
+simulated null of 370 ± 150: the measured input noise left far more branch-shaped structure
+than fresh draws of the same spectrum did, whether added to the measured input (370) or to
+the noise-free one (500-900, the same record rebuilt without x noise); shifting the measured
+noise by a few periods brought it to 560-1000. The null of such a test is not the record's
+own noise spectrum, and the test was not used.
 """
 
 from __future__ import annotations
@@ -34,7 +39,16 @@ import numpy as np
 
 from ._family import Prepared
 
-__all__ = ["RIVAL_SHARE", "SHAPES", "SHAPE_RIVALS", "rival_share"]
+__all__ = [
+    "PATCHABLE",
+    "PATCH_SHARE",
+    "RIVAL_SHARE",
+    "SHAPES",
+    "SHAPE_RIVALS",
+    "patch_check",
+    "patch_share",
+    "rival_share",
+]
 
 #: curvatures of the free-form virgin curve's basis relative to the fitted ``ac``: for each
 #: ``k`` the shapes ``1 - exp(-k ac s)`` and ``1 - (1 + k ac s) exp(-k ac s)`` (zero initial
@@ -133,3 +147,152 @@ def rival_share(
         "gain_virgin": g_bb,
         "rms": float(np.sqrt(np.mean((fit / sw) ** 2))),
     }
+
+
+#: named effects a free-form virgin curve may stand in for, together (:func:`patch_check`):
+#: the rivals and the effects that reshape the branches themselves
+PATCHABLE = (
+    *SHAPE_RIVALS,
+    "series_compliance",
+    "parallel_stiffness",
+    "backlash",
+    "power_law_microslip",
+)
+#: share of the named set's gain that the free-form virgin curve with fewer parameters must
+#: reach for the set to count as a patch over a shape misfit (:func:`patch_check`)
+PATCH_SHARE = 1.0
+
+
+def _forward_fit(
+    A: np.ndarray, r: np.ndarray, q: int, base: np.ndarray | None = None
+) -> np.ndarray:
+    """The least-squares fit of ``r`` by the columns of ``base`` (always in) and the best
+    ``q`` columns of ``A`` chosen greedily (each step adds the column that lowers the sum
+    of squares most)."""
+    chosen: list[int] = []
+    B = np.zeros((r.size, 0)) if base is None else base
+    fit = np.zeros(r.size)
+    if B.shape[1]:
+        c, *_ = np.linalg.lstsq(B, r, rcond=1e-10)
+        fit = B @ c
+    for _ in range(min(q, A.shape[1])):
+        best, best_fit, best_ss = -1, fit, float(r @ r)
+        for j in range(A.shape[1]):
+            if j in chosen:
+                continue
+            M = np.column_stack([B, A[:, [*chosen, j]]])
+            c, *_ = np.linalg.lstsq(M, r, rcond=1e-10)
+            f = M @ c
+            ss = float((r - f) @ (r - f))
+            if ss < best_ss:
+                best, best_fit, best_ss = j, f, ss
+        if best < 0:
+            break
+        chosen.append(best)
+        fit = best_fit
+    return fit
+
+
+def patch_check(
+    family: Any,
+    effects: tuple[str, ...],
+    d: Prepared,
+    params: dict[str, float],
+    scales: dict[str, float],
+    residual: np.ndarray,
+    sigma: float,
+) -> list[dict[str, Any]]:
+    """Named effects that together patch a virgin curve of another shape (issue 29, item 3).
+
+    A virgin curve no candidate draws is taken up by several named effects together (a
+    gamma-like curve by backlash, a parallel stiffness and a series compliance; a rational
+    one by a normal-load fluctuation and a position-dependent friction). The named effects
+    of :data:`PATCHABLE` are dropped together and the rest refitted; a Masing element
+    with a free-form virgin curve (the columns of :func:`_basis`, the straight line
+    included) with fewer parameters than the dropped set has (the best ``q`` columns,
+    chosen greedily, ``q`` = the set's parameters − 1) is fitted to that refit's
+    residual. Where it reaches :data:`PATCH_SHARE` of the set's gain (σ², weighted
+    residual sums of squares), the set is a patch over a shape misfit: returned as
+    ``[{"effects", "params_effects", "params_virgin", "gain_effects", "gain_virgin",
+    "share"}]`` (empty when not; also for a set of one parameter, which no free-form curve
+    with fewer can replace).
+    """
+    from ..errors import ContactLabError
+    from .select import fit, specs_for
+
+    ac = float(params.get("ac", np.nan))
+    drop = tuple(e for e in effects if e in PATCHABLE)
+    rest = tuple(e for e in effects if e not in drop)
+    n_set = len(specs_for(family, effects)) - len(specs_for(family, rest))
+    q = n_set - 1
+    if not drop or q < 1 or not (np.isfinite(ac) and ac > 0 and sigma > 0):
+        return []
+    try:
+        f = fit(family, rest, d, np.ones(d.y.size, bool), params, scales)
+        r0 = d.y - np.asarray(family.predict(f.params, rest, d), float)
+    except (ContactLabError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+        return []  # no refit without the set: no verdict on it
+    got = patch_share(d, residual, r0, ac, sigma, q)
+    if got is None or got["share"] < PATCH_SHARE:
+        return []
+    return [{"effects": list(drop), "params_effects": int(n_set), **got}]
+
+
+def patch_share(
+    d: Prepared,
+    with_set: np.ndarray,
+    without_set: np.ndarray,
+    ac: float,
+    sigma: float,
+    q: int,
+) -> dict[str, Any] | None:
+    """How much of a named set's gain a free-form virgin curve of ``q`` columns reaches.
+
+    ``with_set`` and ``without_set`` are the residuals (measured minus model) of the final
+    model and of its refit without the set. The set's gain is the drop in the weighted
+    residual sum of squares it brings (σ²); the free-form curve's, the drop the best ``q``
+    columns of :func:`_basis` (chosen greedily, the straight line among them), refitted
+    with the base's own virgin curve's two directions (its ``h0`` and ``ac``: the free-form
+    curve replaces the exponential one, whose parameters both models have), bring to the
+    residual without the set. Returns ``share`` (the second over the first), both gains
+    (``gain_effects``, ``gain_virgin``) and ``params_virgin`` (``q``); None without a
+    positive gain of the set or with too few samples.
+    """
+    from .select import sample_weight
+
+    w = sample_weight(d)
+    r1 = np.asarray(with_set, float)
+    r0 = np.asarray(without_set, float)
+    use = np.isfinite(r0) & np.isfinite(r1) & (w > 0)
+    if np.count_nonzero(use) <= 100 or not (sigma > 0 and np.isfinite(ac) and ac > 0):
+        return None
+    ww = w[use]
+    g_set = (float(np.sum(ww * r0[use] ** 2)) - float(np.sum(ww * r1[use] ** 2))) / sigma**2
+    if not g_set > 0:
+        return None
+    from ..masing import Masing
+
+    sw = np.sqrt(ww)
+    A = _basis(d, ac)[use] * sw[:, None]
+    nrm = np.linalg.norm(A, axis=0)
+    nrm[nrm == 0] = 1.0
+    # the base's own virgin curve is refitted with the free-form columns (its h0 and ac
+    # directions, counted on both sides): the free-form curve replaces it, not adds to it
+    h = 1.05
+    own = (
+        np.column_stack(
+            [
+                Masing(1.0, ac).force(d.u),
+                Masing(1.0, h * ac).force(d.u) - Masing(1.0, ac / h).force(d.u),
+            ]
+        )[use]
+        * sw[:, None]
+    )
+    on = np.linalg.norm(own, axis=0)
+    on[on == 0] = 1.0
+    fitv = _forward_fit(A / nrm, r0[use] * sw, q, own / on)
+    g_ff = float(fitv @ fitv) / sigma**2
+    return {
+        "params_virgin": int(q), "gain_effects": g_set, "gain_virgin": g_ff,
+        "share": g_ff / g_set,
+    }  # fmt: skip

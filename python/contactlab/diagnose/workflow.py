@@ -292,6 +292,7 @@ def diagnose(
     checks = _assess(b, d, st, names, z, min_gain, folds, declared_noise, location)
     checks = _withdraw(b, d, st, names, z, min_gain, folds, declared_noise, location, checks)
     checks = _rivals(b, d, st, checks)
+    checks = _calibrated(b, d, st, checks)
     if checks["unexplained"] is not None and checks["unexplained"].flagged:
         st.where.append(checks["unexplained"].sentence())
     report = _report(b.family, path, recording, regime, d, st, b.sigma, location)
@@ -521,6 +522,49 @@ def _rivals(b: _Base, d: Prepared, st: SearchState, checks: dict[str, Any]) -> d
     if not found:
         return checks
     checks["unexplained"] = dataclasses.replace(u, flagged=True, rivals=found)
+    return checks
+
+
+def _calibrated(b: _Base, d: Prepared, st: SearchState, checks: dict[str, Any]) -> dict[str, Any]:
+    """The misfit flag against the record's own simulated null (issue 29 items 1 and 3).
+
+    The phase bins' ``T`` and the free-form virgin curve's held-out ``t`` on the final
+    residual are compared with their distribution over copies of the record simulated
+    under the null with its own noise on both channels
+    (:func:`.misfit_null.simulated_null`, :func:`.misfit_null.calibrated_flag`), not with
+    hand thresholds; and a named set that a free-form virgin curve with fewer parameters
+    explains as well is a patch over a shape misfit (:func:`.shape.patch_check`). Either
+    flags the misfit, as do the rivals (:func:`_rivals`). Tangential records only; where
+    the null cannot be simulated (a record kept at a lower rate) the earlier flag stands.
+    Returns the closing checks, updated."""
+    from .misfit import unexplained_structure
+    from .misfit_null import calibrated_flag, simulated_null
+    from .shape import patch_check
+
+    u = checks["unexplained"]
+    p = dict(st.current.full.params)
+    if b.family.kind != "tangential" or "ac" not in p:
+        return checks
+    effects = tuple(st.current.effects)
+    r1 = -st.current.full_residual(d)
+    if u is None:  # every bin left out for its input noise: the calibrated null needs none
+        u = unexplained_structure(d, r1, b.sigma, unit=b.family.output_unit, min_weight=0.0)
+        if u is None:
+            return checks
+        u = dataclasses.replace(u, flagged=False)
+    nd = simulated_null(b.family, p, effects, d, r1, float(checks["noise"].output), b.sigma)
+    patches = patch_check(b.family, effects, d, p, b.scales, r1, b.sigma)
+    if nd is None:
+        if patches:
+            checks["unexplained"] = dataclasses.replace(u, flagged=True, patches=patches)
+        return checks
+    # the phase bins flag where both their hand threshold (with the interval null of the
+    # input noise's reach) and the simulated null say so: the chain's own imprint (a load
+    # cell's ringing after each reversal, a skew between the anti-alias filters) is
+    # structure at a few per cent of the noise that the simulation does not carry
+    cal = calibrated_flag(nd, hand_bins=bool(u.statistic > u.threshold))
+    flagged = cal["flagged"] or bool(u.rivals) or bool(patches)
+    checks["unexplained"] = dataclasses.replace(u, flagged=flagged, calibrated=cal, patches=patches)
     return checks
 
 

@@ -1,0 +1,403 @@
+"""The misfit flag's threshold from a simulation of the record's own null (issue 29, item 3).
+
+The structure tests of :mod:`.misfit` (phase bins ``T``, the free-form virgin curve's
+held-out ``t``) compare their statistic with a threshold set by hand on tuning seeds, with
+guards for the input channel's noise (an interval null, bins left out, a simulated bias
+taken out). Errors in the input channel leave structure in a fitted Masing element that is
+no misfit (turning points pushed outward by the noise at every reversal, a curved branch's
+mean moved by its curvature times the noise's variance), and its size depends on the
+record: the noise's level and spectrum seen through the loop's slope, the number of
+cycles, the samples per period. A hand threshold is either too low for some records or too
+high for others.
+
+Here the threshold is the record's own: :func:`simulated_null` draws :data:`NULL_DRAWS`
+copies of the record under the null (the final model is the truth), with the record's own
+estimated noise on both channels, and computes the same statistics on each:
+
+- the true input is the measured one with its noise filtered away (:func:`denoised_input`:
+  zero-phase, keeping :data:`KEEP_HARMONICS` harmonics of the fastest drive frequency);
+  adding fresh noise to the measured input instead (which already carries one draw of it)
+  under-states the bias: a turning point pushed out by a noise of level ``s`` moves by
+  about ``s`` times a constant, so noise added on top of the measured one moves it by
+  ``(√2 - 1)`` times what the measured noise did;
+- the output is the final model driven by that input plus noise at the output channel's
+  estimated level (``noise.output``: the input's share through the slope taken out; the
+  simulated input noise puts that share back) with the spectrum the final residual shows
+  between the drive's harmonics (:func:`output_noise_shape`: a Bessel anti-alias filter
+  or a load cell colours it);
+- the model sees the true input plus fresh input noise of the record's own spectrum
+  (:func:`.eiv.input_noise_spectrum`, the white estimate where it is not coloured), through
+  the candidates' input filter, as the measured input passed it;
+- the fit is linearised: the residual is projected off the final model's Jacobian (weighted
+  as the fit weights the samples); the record's own residual is the nonlinear fit's
+  (:data:`PROJECT_OBSERVED`);
+- the statistics are computed on the residual as measured (no simulated bias taken out, no
+  interval null, no bin or sample left out for its input noise), in the measurement and in
+  every draw alike.
+
+The decision (:func:`calibrated_flag`): each statistic is compared with the upper
+prediction bound of its null at ``α/2`` (:data:`~.detection.MISFIT_FALSE_ALARM` split
+between the two tests): for the held-out ``t``, the draws' mean plus Student's quantile
+times their scatter (a new draw from a normal null: ``sd·√(1 + 1/K)``); for ``T`` (a sum
+of squares, skewed), the same on ``√T``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any
+
+import numpy as np
+
+from ..errors import ContactLabError
+from ._family import Prepared
+from ._filters import savgol_filter
+from .detection import MISFIT_FALSE_ALARM
+from .eiv import InputNoise, _coloured, _driven, input_noise_spectrum, is_coloured
+from .misfit import backbone_misfit, t_quantile, unexplained_structure
+
+__all__ = [
+    "KEEP_HARMONICS",
+    "NULL_DRAWS",
+    "NullDraws",
+    "calibrated_flag",
+    "denoised_input",
+    "simulated_null",
+]
+
+#: copies of the record drawn under the null
+NULL_DRAWS = 24
+#: harmonics of the fastest drive frequency the denoised input keeps
+KEEP_HARMONICS = 12.0
+#: project the record's own residual off the final model's Jacobian as every copy's is.
+#: Tried and not kept as the default (the evaluated flag does not): on tuning seeds
+#: 3000-3011 (x noise 1.5-2 %, ac·A 1-5) it moved the statistics by at most 0.2 in t and
+#: 13 % in T and flagged the same 2 of 12 clean records
+PROJECT_OBSERVED = False
+#: the free-form virgin curve's held-out gain (``σ²`` per sample) below which its test does
+#: not fire however significant (an effect-size floor, as :data:`.misfit.BACKBONE_MIN_GAIN`
+#: is for the hand-set test:
+#: a long record resolves a chain's own imprint, a load cell's ringing after each reversal
+#: or a skew between anti-alias filters, far below any misfit of consequence). Tuning seeds
+#: 200-209 and 1200-1209 of ``benches/eval_flag_calibration.py``: clean records' gains at
+#: most 0.041 (one, 0.006, over its simulated t bound: a rig record's chain), the virgin
+#: curves flagged 0.083-0.345
+MIN_GAIN = 0.05
+
+
+def denoised_input(d: Prepared) -> tuple[np.ndarray, int]:
+    """The measured input with its noise filtered away (the null's true input), at the raw
+    rate, and the raw samples per kept one (1 unless the record was kept at a lower rate).
+
+    Zero-phase: the raw input (``d.extra["u_measured"]`` for a kept record, else
+    ``d.extra["u_raw"]``, both before the candidates' filter) is mirrored (no jump at the
+    ends), transformed, and every frequency above :data:`KEEP_HARMONICS` times the fastest
+    drive frequency (its shortest half-cycles' 10th percentile) is removed, with a
+    raised-cosine edge over the next half of that band. Where that band reaches the
+    Nyquist frequency the raw input is returned as measured."""
+    raw = d.extra.get("raw_input")
+    q = int(raw.q) if raw is not None else 1
+    key = "u_measured" if raw is not None else "u_raw"
+    u = np.asarray(d.extra.get(key, d.u), float)
+    half = np.diff(d.cycles.reversals) * q
+    per = float(d.cycles.period_samples) * q
+    fastest = min(per, 2.0 * float(np.percentile(half, 10))) if half.size >= 4 else per
+    if not (fastest > 0 and u.size >= 16):
+        return u, q
+    fc = KEEP_HARMONICS / fastest  # cycles per sample
+    if fc >= 0.5:
+        return u, q
+    ext = np.concatenate([u, u[::-1]])
+    f = np.fft.rfftfreq(ext.size)
+    x = np.clip((f - fc) / (0.5 * fc), 0.0, 1.0)
+    g = 0.5 + 0.5 * np.cos(np.pi * x)
+    return np.fft.irfft(np.fft.rfft(ext) * g, ext.size)[: u.size], q
+
+
+def _drive(d: Prepared, u_raw: np.ndarray) -> Prepared | None:
+    """A copy of ``d`` whose model input is ``u_raw`` (raw rate, after the candidates'
+    filter): for a kept record its kept samples and the turning points between them
+    rebuilt (:func:`._kept.knots_at`); None when that changes which turning points a kept
+    record keeps."""
+    raw = d.extra.get("raw_input")
+    if raw is None:
+        return _driven(d, u_raw)
+    from ._kept import MAX_SAMPLES, RawInput, knots_at
+
+    new, exact = RawInput.build(
+        raw.t0, raw.dt, u_raw, raw.ud, raw.udd, raw.reversals, raw.q, limit=4 * MAX_SAMPLES
+    )
+    if exact != d.extra.get("raw_exact", exact):
+        return None
+    pos = np.arange(d.u.size) * raw.q
+    out = _driven(d, u_raw[pos])
+    out.extra["raw_input"] = new
+    out.extra["knots"] = knots_at(new, pos)
+    return out
+
+
+@dataclasses.dataclass(frozen=True)
+class NullDraws:
+    """The misfit statistics of the measured record and of its simulated null copies.
+
+    Attributes
+    ----------
+    t, T : float
+        The free-form virgin curve's held-out ``t`` and the phase bins' ``T`` on the
+        measured residual (no bias taken out, no interval null); NaN where not computable.
+    gain : float
+        The free-form virgin curve's held-out gain on the measured residual (``σ²``).
+    t_null, T_null : ndarray
+        The same on each copy drawn under the null.
+    input_rms, output_rms : float
+        The noise drawn on the input (before the candidates' filter) and the output.
+    """
+
+    t: float
+    T: float
+    gain: float
+    t_null: np.ndarray
+    T_null: np.ndarray
+    input_rms: float
+    output_rms: float
+
+
+def _statistics(d: Prepared, r: np.ndarray, ac: float, sigma: float) -> tuple[float, float]:
+    """``(t, T)`` of a residual (measured minus model): held-out ``t`` of the free-form
+    virgin curve and the phase bins' ``T`` (no tolerance, every bin and sample: the null
+    carries the input noise's share, so no guard leaves any out), and the free-form curve's
+    held-out gain in units of ``sigma²``."""
+    bb = backbone_misfit(d, r, ac, sigma, min_weight=0.0)
+    u = unexplained_structure(d, r, sigma, min_weight=0.0)
+    return (
+        math.nan if bb is None else float(bb["t"]),
+        math.nan if u is None else float(u.statistic),
+        math.nan if bb is None else float(bb["gain_over_noise_var"]),
+    )
+
+
+def output_noise_shape(d: Prepared, residual: np.ndarray) -> InputNoise | None:
+    """The shape of the output channel's noise spectrum, read from the final residual.
+
+    Welch's periodogram of the residual (segments of eight drive periods) between the
+    drive's harmonics (:data:`~.detection.HARMONIC_GUARD_BINS` either side left out: a misfit
+    is periodic and sits on them), from :data:`~.detection.OUTPUT_BAND_HARMONICS` times the
+    fastest drive frequency up, lines clipped at :data:`~.eiv.NOISE_LINE_FACTOR` times the
+    running median; the harmonics' bins read as their neighbours, below the band flat at
+    the octave's level (as :func:`~.detection.output_noise_rms` reads its level). Only the
+    shape is used (:func:`.eiv._coloured` draws unit variance); None where it cannot be
+    read (then the output noise is drawn white)."""
+    from ._filters import welch
+    from .detection import HARMONIC_GUARD_BINS, OUTPUT_BAND_HARMONICS
+    from .eiv import NOISE_LINE_BINS, NOISE_LINE_FACTOR
+
+    r = np.asarray(residual, float)
+    keep = np.isfinite(r)
+    r = np.where(keep, r - float(np.mean(r[keep])) if keep.any() else 0.0, 0.0)
+    per = float(d.cycles.period_samples)
+    if not (r.size >= 256 and per > 0):
+        return None
+    nper = int(min(r.size, 2 ** int(np.ceil(np.log2(max(8.0 * per, 64.0))))))
+    f, psd = welch(r, 1.0 / d.dt, nper)
+    df = float(f[1] - f[0])
+    f0 = 1.0 / (per * d.dt)
+    half = np.diff(d.cycles.reversals)
+    fastest = min(per, 2.0 * float(np.percentile(half, 10))) if half.size >= 4 else per
+    lo = max(1.5 * f0, OUTPUT_BAND_HARMONICS / (fastest * d.dt))
+    k = np.maximum(np.rint(f / f0), 1.0)
+    noise = (np.abs(f - k * f0) > HARMONIC_GUARD_BINS * df) & (f >= lo)
+    band = noise & (f <= 2.0 * lo)
+    if np.count_nonzero(noise) < 8 or np.count_nonzero(band) < 4:
+        return None
+    fn, pn = f[noise], psd[noise]
+    kk = NOISE_LINE_BINS // 2
+    med = np.median(
+        np.lib.stride_tricks.sliding_window_view(np.pad(pn, kk, mode="edge"), 2 * kk + 1), axis=1
+    )
+    pn = np.minimum(pn, NOISE_LINE_FACTOR * med)
+    level = float(np.mean(pn[fn <= 2.0 * lo]))
+    power = np.where(f < lo, level, np.interp(f, fn, pn)) * df
+    tot = float(np.sum(power))
+    if not tot > 0:
+        return None
+    return InputNoise(f, power, float(d.dt), math.sqrt(tot), math.sqrt(tot))
+
+
+def _jacobian(
+    family: Any, params: dict[str, float], effects: tuple[str, ...], d: Prepared
+) -> np.ndarray | None:
+    """The final model's Jacobian on ``d`` (central differences; columns per parameter)."""
+    from .select import specs_for
+
+    cols = []
+    scales = family.scales(d)
+    for spec in specs_for(family, effects):
+        v = params.get(spec.name)
+        if v is None or not np.isfinite(v):
+            continue
+        h = 1e-4 * max(abs(v), float(scales.get(spec.scale, 1.0)) * 1e-2)
+        up, dn = dict(params), dict(params)
+        up[spec.name], dn[spec.name] = v + h, v - h
+        diff = np.asarray(family.predict(up, effects, d), float) - np.asarray(
+            family.predict(dn, effects, d), float
+        )
+        cols.append(diff / (2 * h))
+    return np.column_stack(cols) if cols else None
+
+
+def simulated_null(
+    family: Any,
+    params: dict[str, float],
+    effects: tuple[str, ...],
+    d: Prepared,
+    residual: np.ndarray,
+    sigma_out: float,
+    sigma: float,
+    *,
+    draws: int = NULL_DRAWS,
+    seed: int = 0,
+) -> NullDraws | None:
+    """The misfit statistics of the record and of ``draws`` copies simulated under the null.
+
+    Parameters
+    ----------
+    family, params, effects
+        The final model.
+    d : Prepared
+        The record as the diagnosis saw it.
+    residual : ndarray
+        Measured minus the final model, per sample of ``d``.
+    sigma_out : float
+        The output channel's noise RMS (the input's share through the slope taken out),
+        drawn white on each copy.
+    sigma : float
+        The noise RMS the tests scale by (the diagnosis's).
+    draws : int
+        Copies simulated.
+    seed : int
+        Seed of the draws (reproducible).
+
+    Returns
+    -------
+    NullDraws or None
+        None for a model without ``ac``, one that cannot be driven by the simulated input,
+        or a kept record whose draws change which turning points it keeps (fewer than half
+        the draws usable).
+    """
+    ac = float(params.get("ac", math.nan))
+    kept = "raw_input" in d.extra
+    if not (np.isfinite(ac) and ac > 0 and sigma > 0) or (kept and "knots" not in d.extra):
+        return None
+    r = np.asarray(residual, float)
+    su = float(d.extra.get("u_noise", 0.0) or 0.0)
+    wlen = int(d.extra.get("u_filter", 0))
+    spec = input_noise_spectrum(d) if su > 0 and wlen else None
+    if spec is not None and not is_coloured(d, spec):
+        spec = None
+    if spec is not None:
+        su = max(su, spec.rms)
+    if not wlen:
+        su = 0.0
+    w = d.extra.get("weight")
+    w = np.ones(d.y.size) if w is None else np.asarray(w, float)
+    rng = np.random.default_rng(seed)
+    t_null: list[float] = []
+    T_null: list[float] = []
+    try:
+        x_true, _ = denoised_input(d)
+        x_in = savgol_filter(x_true, wlen, 3, mode="interp") if wlen else x_true
+        d_true = _drive(d, x_in)
+        if d_true is None:
+            return None
+        truth = np.asarray(family.predict(params, effects, d_true), float)
+        J = _jacobian(family, params, effects, d)
+        use = np.isfinite(d.y) & (w > 0)
+        sw = np.sqrt(w[use])
+        Q = None
+        if J is not None:
+            A = J[use] * sw[:, None]
+            nrm = np.linalg.norm(A, axis=0)
+            nrm[nrm == 0] = 1.0
+            Q, _ = np.linalg.qr(A / nrm)
+        r_obs = r
+        if Q is not None and PROJECT_OBSERVED:
+            # the record's residual off the same directions as every copy's: what the
+            # final model's parameters can draw (moved by the fit's noise-corrected
+            # objective, :func:`.select.noise_term`) is no misfit, in either
+            ru = r[use] * sw
+            r_obs = r.copy()
+            r_obs[use] = (ru - Q @ (Q.T @ ru)) / sw
+        t_obs, T_obs, g_obs = _statistics(d, r_obs, ac, sigma)
+        out_shape = output_noise_shape(d, r)
+        for _ in range(draws):
+            u = x_true
+            if su > 0:
+                u = x_true + _coloured(rng, x_true.size, spec) * su
+            dk = _drive(d, savgol_filter(u, wlen, 3, mode="interp") if wlen else u)
+            if dk is None:
+                continue
+            yk = truth + _coloured(rng, truth.size, out_shape) * sigma_out
+            rk = yk - np.asarray(family.predict(params, effects, dk), float)
+            if Q is not None:  # the fit takes up what its parameters can draw
+                ru = rk[use] * sw
+                rk = rk.copy()
+                rk[use] = (ru - Q @ (Q.T @ ru)) / sw
+            tk, Tk, _ = _statistics(dk, rk, ac, sigma)
+            t_null.append(tk)
+            T_null.append(Tk)
+    except (ContactLabError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+        return None
+    if len(t_null) < max(8, draws // 2):
+        return None
+    return NullDraws(
+        t=t_obs, T=T_obs, gain=g_obs, t_null=np.asarray(t_null), T_null=np.asarray(T_null),
+        input_rms=su, output_rms=float(sigma_out),
+    )  # fmt: skip
+
+
+def _upper(v: np.ndarray, alpha: float) -> float:
+    """Upper ``1 - alpha`` prediction bound of a new draw from the normal the finite ``v``
+    come from (mean plus Student's quantile times ``sd·√(1 + 1/K)``); NaN with fewer
+    than 4."""
+    v = v[np.isfinite(v)]
+    if v.size < 4:
+        return math.nan
+    k = v.size
+    sd = float(np.std(v, ddof=1))
+    return float(np.mean(v)) + t_quantile(1.0 - alpha, k - 1) * sd * math.sqrt(1.0 + 1.0 / k)
+
+
+def calibrated_flag(
+    nd: NullDraws, alpha: float = MISFIT_FALSE_ALARM, *, hand_bins: bool = True
+) -> dict[str, Any]:
+    """The misfit decision against the simulated null (JSON ``unexplained.calibrated``).
+
+    The held-out ``t`` is compared with the upper prediction bound of its draws at
+    ``alpha/2``, ``√T`` with that of the draws' ``√T`` at ``alpha/2`` (Bonferroni: the
+    record's false-alarm rate is at most ``alpha``), the first only with a held-out gain of
+    at least :data:`MIN_GAIN`; the phase bins fire only where
+    ``hand_bins`` (their own threshold, :func:`.misfit.unexplained_structure`) agrees.
+    Returns ``t``, ``t_threshold``, ``T``, ``T_threshold``, ``draws``, ``alpha``,
+    ``input_noise``, ``output_noise``, ``by`` (the tests that fire: ``"backbone"``,
+    ``"phase_bins"``) and ``flagged``."""
+    a = 0.5 * alpha
+    t_thr = _upper(nd.t_null, a)
+    sT = _upper(np.sqrt(np.maximum(nd.T_null, 0.0)), a)
+    T_thr = sT * sT if np.isfinite(sT) else math.nan
+    by = []
+    if np.isfinite(nd.t) and np.isfinite(t_thr) and nd.t > t_thr and nd.gain >= MIN_GAIN:
+        by.append("backbone")
+    if hand_bins and np.isfinite(nd.T) and np.isfinite(T_thr) and nd.T > T_thr:
+        by.append("phase_bins")
+    return {
+        "t": _num(nd.t), "t_threshold": _num(t_thr), "gain": _num(nd.gain),
+        "min_gain": MIN_GAIN, "T": _num(nd.T),
+        "T_threshold": _num(T_thr), "draws": int(nd.t_null.size), "alpha": alpha,
+        "input_noise": nd.input_rms, "output_noise": nd.output_rms,
+        "by": by, "flagged": bool(by),
+    }  # fmt: skip
+
+
+def _num(v: float) -> float | None:
+    return float(v) if np.isfinite(v) else None
