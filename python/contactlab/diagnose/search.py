@@ -644,7 +644,7 @@ class StepwiseSearch:
                 best = (v, cand)
             if cand is not None and v.accepted:
                 accepted.append((v, cand))
-        accepted, verdicts = _yield_to_lookalikes(self.family, accepted, verdicts)
+        accepted, verdicts = _yield_to_lookalikes(self.family, accepted, verdicts, self.d)
         best = max(accepted, key=lambda vc: vc[0].gain) if accepted else None
         best = _parsimonious(best, accepted)
         if verdicts:
@@ -801,26 +801,43 @@ class StepwiseSearch:
 
 
 def _yield_to_lookalikes(
-    family: Family, accepted: list[tuple[Verdict, Trial]], verdicts: list[Verdict]
+    family: Family,
+    accepted: list[tuple[Verdict, Trial]],
+    verdicts: list[Verdict],
+    d: Prepared | None = None,
 ) -> tuple[list[tuple[Verdict, Trial]], list[Verdict]]:
     """``accepted`` and ``verdicts`` with the candidates that yield to a look-alike accepted
-    at the same step refused: an effect's ``yields_to(p, gains, own)`` (the fitted
-    parameters, the accepted candidates' held-out gains, its own) says why its fit is
-    another effect's signature (a speed-strengthening Stribeck term beside a mass or a
-    series compliance), or None."""
+    at the same step refused: an effect's ``yields_to(p, gains, own, d)`` (the fitted
+    parameters, the accepted candidates' held-out gains, its own, the record) says why its
+    fit is another effect's signature (a speed-strengthening Stribeck term beside a mass or
+    a series compliance; a 2f load in phase with the stroke beside a Stribeck term), or
+    None."""
     from .effects import registry
 
     try:
         reg = registry(family.kind)
     except KeyError:
         return accepted, verdicts
-    gains = {v.name: v.gain for v, _ in accepted}
+
+    def yielding(gains: dict[str, float]) -> dict[str, str]:
+        out = {}
+        for v, cand in accepted:
+            hook = getattr(reg.get(v.name), "yields_to", None)
+            why = None if hook is None else hook(cand.full.params, gains, v.gain, d)
+            if why:
+                out[v.name] = why
+        return out
+
+    # an effect yields only to a rival that stands: those that yield are judged again
+    # against the others (a 2f load yields to a Stribeck term, which may itself yield to a
+    # series compliance: the load then stands)
+    first = yielding({v.name: v.gain for v, _ in accepted})
+    why_of = yielding({v.name: v.gain for v, _ in accepted if v.name not in first}) if first else {}
     keep, refused = [], {}
     for v, cand in accepted:
-        hook = getattr(reg.get(v.name), "yields_to", None)
-        why = None if hook is None else hook(cand.full.params, gains, v.gain)
-        if why:
-            refused[v.name] = dataclasses.replace(v, accepted=False, reason=f"look-alike: {why}")
+        if v.name in first and v.name in why_of:
+            reason = f"look-alike: {why_of[v.name]}"
+            refused[v.name] = dataclasses.replace(v, accepted=False, reason=reason)
         else:
             keep.append((v, cand))
     if not refused:

@@ -88,7 +88,7 @@ class Stribeck(EffectModel):
                 )
         return base
 
-    def yields_to(self, p, gains, own):
+    def yields_to(self, p, gains, own, d=None):
         """Why a speed-*strengthening* term (``s < 0``: the force lowest where the speed is,
         at the stroke's ends and right after each turn) is not named beside a look-alike
         accepted at the same step (:data:`LOOKALIKES`: a mass lowers the force at the
