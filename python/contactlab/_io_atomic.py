@@ -8,6 +8,8 @@ import stat
 from collections.abc import Iterator
 from pathlib import Path
 
+from . import _interrupt
+
 
 def default_mode() -> int:
     """Permissions a plain ``open(..., "w")`` would give: ``0o666`` less the umask.
@@ -44,6 +46,7 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     tmp_path = Path(tmp)
     try:
         yield tmp_path
+        _interrupt.check()  # a Ctrl-C swallowed where it landed (a finaliser, a fork hook)
         os.chmod(tmp_path, _final_mode(final))
         os.replace(tmp_path, final)
     except BaseException:

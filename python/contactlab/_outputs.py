@@ -14,6 +14,7 @@ import tempfile
 from collections.abc import Mapping
 from pathlib import Path, PurePosixPath
 
+from . import _interrupt
 from .errors import InputError
 
 
@@ -73,7 +74,9 @@ def commit_outputs(directory: str | os.PathLike[str], files: Mapping[str, bytes]
             with os.fdopen(fd, "wb") as fh:
                 fh.write(data)
             os.chmod(staged[-1][0], mode)
-        # Every temporary is complete: move them into place (fast, no more I/O of content).
+        # Every temporary is complete: move them into place (fast, no more I/O of content),
+        # unless a Ctrl-C came and was swallowed where it landed (a finaliser, a fork hook)
+        _interrupt.check()
         for tmp, final in staged:
             os.replace(tmp, final)
     except BaseException:

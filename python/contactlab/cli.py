@@ -87,6 +87,9 @@ def build_parser(verb_module: str | None = None) -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     if argv is None:  # the process's own command line: it ends when this returns
+        from . import _interrupt
+
+        _interrupt.install()
         try:
             code = _main(sys.argv[1:])
             if code == _INTERRUPTED:
@@ -97,6 +100,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             _exit_interrupted()
             raise  # not reached
         finally:
+            _interrupt.uninstall()
             # a structure scan started ahead for a file the run never opened (a usage error,
             # Ctrl-C) stops at its next block instead of holding the exit for the whole file
             hdf5 = sys.modules.get("contactlab.io.hdf5")

@@ -405,8 +405,15 @@ def process_pool(workers: int | None, *, auto: bool = False) -> Any:
         raise InputError(f"--workers must be >= 1, got {workers}")
     from concurrent.futures import ProcessPoolExecutor
 
+    from .. import _interrupt
+
     try:
-        return _InterruptiblePool(ProcessPoolExecutor(workers, initializer=_ignore_sigint))
+        executor = ProcessPoolExecutor(workers, initializer=_ignore_sigint)
+        # the workers start now, with Ctrl-C held back: forked at a first submit, a SIGINT
+        # landing in the fork's hooks would be printed as "Exception ignored" and lost
+        with _interrupt.deferred():
+            executor.submit(int)
+        return _InterruptiblePool(executor)
     except (OSError, ImportError, NotImplementedError) as exc:
         if not auto:
             raise InputError(
@@ -436,9 +443,19 @@ class _InterruptiblePool:
         return self.executor
 
     def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
+        from .. import _interrupt
+
         if exc_type is None:
+            try:
+                _interrupt.check()  # a Ctrl-C swallowed where it landed ends the run here
+            except KeyboardInterrupt:
+                self._kill()
+                raise
             self.executor.shutdown(wait=True)
             return
+        self._kill()
+
+    def _kill(self) -> None:
         from ..studies.executor import kill_worker_processes
 
         kill_worker_processes()
