@@ -106,6 +106,7 @@ def chain_record(
     lvdt: bool = True,
     x_colour: str = "lvdt",
     scale: float = 2.0,
+    noise_seed: int | None = None,
     **over: Any,
 ) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], dict[str, Any]]:
     """``((t, x, F), factors)`` of one record (see the module docstring).
@@ -116,7 +117,8 @@ def chain_record(
     the white share) or ``"white"``. ``scale`` is the branch scale of the Masing rules (2:
     Masing; 1.3-1.6: non-Masing scaling applied from rest, the virgin curve exponential).
     The draws of the default settings are those of earlier versions (same seeds, same
-    records)."""
+    records). ``noise_seed`` draws the sensor noises of both channels (not the hum, the
+    jitter or anything else) from a stream of its own: the same record under other noise."""
     fac = draw(seed, **over)
     rng = np.random.default_rng([seed, 7])
     fs, f, cycles = fac["fs"], fac["f"], fac["cycles"]
@@ -151,8 +153,12 @@ def chain_record(
     if x_colour == "lp1":  # a first-order low-pass (an RC stage) in place of the demodulator
         fl = max(np.random.default_rng([seed, 11]).uniform(0.02, 0.2) * fs, 10.0 * f)
         lv = signal.butter(1, fl, fs=ffine, output="sos")
+    nrng = rng if noise_seed is None else np.random.default_rng([seed, 13, noise_seed])
     n1 = signal.sosfilt(lv, rng.standard_normal(n_fine))
     n2 = rng.standard_normal(n_fine)
+    if noise_seed is not None:  # the main stream drawn as before, the noise from its own
+        n1 = signal.sosfilt(lv, nrng.standard_normal(n_fine))
+        n2 = nrng.standard_normal(n_fine)
     share = 0.8 if lvdt and x_colour != "white" else 0.0
     nx = signal.sosfilt(aa, math.sqrt(share) * n1 / np.std(n1) + math.sqrt(1 - share) * n2)
     nx *= fac["x_noise"] * xr / max(float(np.std(nx[n_fine // 10 :])), 1e-300)
@@ -166,6 +172,8 @@ def chain_record(
         bd, ad, _ = signal.cont2discrete(([wc * wc], [1.0, 2 * zc * wc, wc * wc]), 1 / ffine, "foh")
         Fc = signal.lfilter(np.squeeze(bd), np.squeeze(ad), F)
     nF = signal.sosfilt(aa, rng.standard_normal(n_fine))
+    if noise_seed is not None:
+        nF = signal.sosfilt(aa, nrng.standard_normal(n_fine))
     nF *= fac["F_noise"] * Fr / max(float(np.std(nF[n_fine // 10 :])), 1e-300)
     xm = signal.sosfilt(aa, x) + nx
     Fm = signal.sosfilt(aa, Fc) + nF
