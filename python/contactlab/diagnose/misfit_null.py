@@ -14,17 +14,19 @@ Here the threshold is the record's own: :func:`simulated_null` draws :data:`NULL
 copies of the record under the null (the final model is the truth), with the record's own
 estimated noise on both channels, and computes the same statistics on each:
 
-- the true input is the measured one with its noise filtered away (:func:`denoised_input`:
-  zero-phase, keeping :data:`KEEP_HARMONICS` harmonics of the fastest drive frequency);
-  adding fresh noise to the measured input instead (which already carries one draw of it)
-  under-states the bias: a turning point pushed out by a noise of level ``s`` moves by
-  about ``s`` times a constant, so noise added on top of the measured one moves it by
-  ``(√2 - 1)`` times what the measured noise did;
-- the output is the final model driven by that input plus noise at the output channel's
-  estimated level (``noise.output``: the input's share through the slope taken out; the
-  simulated input noise puts that share back) with the spectrum the final residual shows
-  between the drive's harmonics (:func:`output_noise_shape`: a Bessel anti-alias filter
-  or a load cell colours it);
+- the true input is the measured one with its noise taken away (:func:`denoised_input`:
+  zero-phase, the drive's spectral lines kept and every coefficient at the noise's level
+  removed); adding fresh noise to the measured input instead (which already carries one
+  draw of it) under-states the bias: a turning point pushed out by a noise of level ``s``
+  moves by about ``s`` times a constant, so noise added on top of the measured one moves it
+  by ``(√2 - 1)`` times what the measured noise did. A low-pass at a dozen harmonics
+  (stop 39) under-stated it too: the noise it keeps makes the true input's turning points
+  sharper than the drive's, and the push of a noise at a sharp turn is smaller;
+- the output is the final model driven by that input plus noise at the level the record's
+  residual holds between the drive's harmonics beyond what the simulated input noise
+  leaves there (:func:`_output_beyond_input`; the simulated input noise puts its share
+  back), with the spectrum the final residual shows there (:func:`output_noise_shape`: a
+  Bessel anti-alias filter or a load cell colours it);
 - the model sees the true input plus fresh input noise of the record's own spectrum
   (:func:`.eiv.input_noise_spectrum`, the white estimate where it is not coloured), through
   the candidates' input filter, as the measured input passed it;
@@ -76,9 +78,6 @@ KEEP_HARMONICS = 12.0
 #: 3000-3011 (x noise 1.5-2 %, ac·A 1-5) it moved the statistics by at most 0.2 in t and
 #: 13 % in T and flagged the same 2 of 12 clean records
 PROJECT_OBSERVED = False
-#: take the structure the input's noise leaves under the null (the copies' mean residual)
-#: out of the record's residual and, leaving each out, out of the copies' before the tests
-BIAS_TAKEN_OUT = False
 #: the free-form virgin curve's held-out gain (``σ²`` per sample) below which its test does
 #: not fire however significant (an effect-size floor, as :data:`.misfit.BACKBONE_MIN_GAIN`
 #: is for the hand-set test:
@@ -231,14 +230,12 @@ class NullDraws:
     output_rms: float
 
 
-def _statistics(
-    d: Prepared, r: np.ndarray, ac: float, sigma: float, r_bb: np.ndarray | None = None
-) -> tuple[float, float, float]:
+def _statistics(d: Prepared, r: np.ndarray, ac: float, sigma: float) -> tuple[float, float, float]:
     """``(t, T)`` of a residual (measured minus model): held-out ``t`` of the free-form
     virgin curve and the phase bins' ``T`` (no tolerance, every bin and sample: the null
     carries the input noise's share, so no guard leaves any out), and the free-form curve's
     held-out gain in units of ``sigma²``."""
-    bb = backbone_misfit(d, r if r_bb is None else r_bb, ac, sigma, min_weight=0.0)
+    bb = backbone_misfit(d, r, ac, sigma, min_weight=0.0)
     u = unexplained_structure(d, r, sigma, min_weight=0.0)
     return (
         math.nan if bb is None else float(bb["t"]),
@@ -380,8 +377,9 @@ def simulated_null(
     residual : ndarray
         Measured minus the final model, per sample of ``d``.
     sigma_out : float
-        The output channel's noise RMS (the input's share through the slope taken out),
-        drawn white on each copy.
+        The diagnosis's output-noise RMS (the input's share through the slope taken out):
+        drawn on each copy only where the residual's own level beyond the input's share
+        cannot be read (:data:`OUTPUT_NOISE` ``"estimate"``: always).
     sigma : float
         The noise RMS the tests scale by (the diagnosis's).
     draws : int
@@ -459,19 +457,9 @@ def simulated_null(
                 rk = rk.copy()
                 rk[use] = (ru - Q @ (Q.T @ ru)) / sw
             copies.append((dk, rk))
-        bias = None
-        if BIAS_TAKEN_OUT and len(copies) >= 2:
-            # the structure the input's noise leaves under the null, the copies' mean
-            # residual: taken out of the record's residual, and out of each copy's as the
-            # mean of the others (as independent of it as the copies' mean is of the record)
-            total = np.sum([rk for _, rk in copies], axis=0)
-            bias = total / len(copies)
-        t_obs, T_obs, g_obs = _statistics(
-            d, r_obs, ac, sigma, None if bias is None else r_obs - bias
-        )
+        t_obs, T_obs, g_obs = _statistics(d, r_obs, ac, sigma)
         for dk, rk in copies:
-            rb = None if bias is None else rk - (total - rk) / (len(copies) - 1)
-            tk, Tk, _ = _statistics(dk, rk, ac, sigma, rb)
+            tk, Tk, _ = _statistics(dk, rk, ac, sigma)
             t_null.append(tk)
             T_null.append(Tk)
     except (ContactLabError, ValueError, ArithmeticError, np.linalg.LinAlgError):
