@@ -79,6 +79,10 @@ def draw(seed: int, effect: str = "clean", **over: Any) -> dict[str, Any]:
         "h0": float(rng.uniform(20.0, 100.0)),
     }
     fac["cell_fn"] = max(fac["cell_fn"], 30.0 * fac["f"])
+    for key in [k for k in over if k.endswith("_range")]:  # a factor drawn from a sub-range
+        lo, hi = over.pop(key)
+        name = key[: -len("_range")]
+        fac[name] = round(lo + (hi - lo) * float(np.random.default_rng([seed, 77]).random()), 4)
     fac.update(over)
     return fac
 
