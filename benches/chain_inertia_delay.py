@@ -18,6 +18,8 @@ chain on a grid ``OVERSAMPLE`` times finer than the ADC's:
   damping 0.02-0.2;
 - anti-alias: Butterworth of order 2-4 at 0.2-0.4 fs on both channels, the corners drawn
   independently within ±2 % (so the channels skew by a few microseconds);
+- ``backlash``: lost motion of half-width ``b`` (2-10 % of the amplitude) between the
+  displacement sensor and the contact (a play operator on x before the contact);
 - ``channel_delay``: the force channel sampled ``tau`` later than the displacement channel
   (0.3 or 1.5 ms, or drawn 0.2-2 ms with ``delay="uniform"``);
 - noise: white on each channel before the anti-alias filter, from independent streams,
@@ -39,7 +41,7 @@ import numpy as np
 from scipy import signal
 
 OVERSAMPLE = 8
-EFFECTS = ("inertia", "channel_delay", "clean")
+EFFECTS = ("inertia", "channel_delay", "clean", "backlash")
 MAX_SAMPLES = 24_000
 
 
@@ -77,6 +79,7 @@ def draw(seed: int, effect: str = "clean", **over: Any) -> dict[str, Any]:
         "tau": float(rng.choice((0.3e-3, 1.5e-3))),
         "tau_u": float(rng.uniform(0.2e-3, 2.0e-3)),
         "h0": float(rng.uniform(20.0, 100.0)),
+        "gap": float(rng.uniform(0.02, 0.10)),
     }
     fac["cell_fn"] = max(fac["cell_fn"], 30.0 * fac["f"])
     for key in [k for k in over if k.endswith("_range")]:  # a factor drawn from a sub-range
@@ -114,6 +117,16 @@ def _truth_motion(fac: dict[str, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarr
     return tf, x, acc, A
 
 
+def _play(x: np.ndarray, b: float) -> np.ndarray:
+    """The play operator of half-width ``b`` sample by sample (from rest at 0)."""
+    u = np.empty_like(x)
+    v = 0.0
+    for i, xi in enumerate(x.tolist()):
+        v = min(max(v, xi - b), xi + b)
+        u[i] = v
+    return u
+
+
 def _lowpass(order: int, fc: float, ffine: float):
     return signal.butter(order, fc, fs=ffine, output="sos")
 
@@ -128,7 +141,8 @@ def _chain(fac: dict[str, Any], effect: str, noise: bool = True):
     tf, x, acc, A = _truth_motion(fac)
     h0 = fac["h0"]
     ac = fac["acA"] / A
-    F = scaled_force(lambda s: h0 * np.sign(s) * (1.0 - np.exp(-ac * np.abs(s))), 2.0, memory(x))
+    u = _play(x, fac["gap"] * A) if effect == "backlash" else x
+    F = scaled_force(lambda s: h0 * np.sign(s) * (1.0 - np.exp(-ac * np.abs(s))), 2.0, memory(u))
     Famp = h0 * (1.0 - math.exp(-fac["acA"]))
     m = 0.0
     if effect == "inertia":
@@ -172,7 +186,8 @@ def _chain(fac: dict[str, Any], effect: str, noise: bool = True):
             out.append(np.round(v / q) * q)
         xo, Fo = out
     del rng
-    info = {"m": m, "tau": tau, "A": A, "ac": ac, "h0": h0, "Famp": Famp,
+    b = fac["gap"] * A if effect == "backlash" else 0.0
+    info = {"m": m, "tau": tau, "b": b, "A": A, "ac": ac, "h0": h0, "Famp": Famp,
             "sigma_F": fac["F_noise"] * Fr, "sigma_x": fac["x_noise"] * xr}  # fmt: skip
     return t, xo, Fo, info
 

@@ -27,11 +27,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-EFFECTS = ("inertia", "channel_delay", "clean")
+EFFECTS = ("inertia", "channel_delay", "clean", "backlash")
 
 
 def _size_of(effect: str, info: dict[str, Any]) -> float:
-    return {"inertia": info["m"], "channel_delay": info["tau"]}.get(effect, 0.0)
+    return {"inertia": info["m"], "channel_delay": info["tau"],
+            "backlash": info.get("b", 0.0)}.get(effect, 0.0)  # fmt: skip
 
 
 def run_job(job: tuple[int, str, dict[str, Any]]) -> dict[str, Any]:
@@ -61,7 +62,7 @@ def run_job(job: tuple[int, str, dict[str, Any]]) -> dict[str, Any]:
     out["params"] = {e.name: dict(e.parameters) for e in rep.effects}
     un = rep.unexplained
     out["flagged"] = bool(un is not None and un.flagged)
-    for name in ("inertia", "channel_delay"):
+    for name in ("inertia", "channel_delay", "backlash"):
         vs = [v for st in rep.steps for v in st.candidates if v.name == name]
         out[f"{name}_verdicts"] = [
             {"gain": v.gain, "t": v.t_stat, "accepted": v.accepted,
@@ -111,7 +112,7 @@ def tables(res: list[dict[str, Any]]) -> str:
     lines += ["", f"clean: nothing named and nothing flagged {n_ok}/{len(clean)}; "
               f"inertia or delay named {n_id}/{len(clean)}", ""]  # fmt: skip
     lines += ["| effect | outcome against the stated bound | n |", "|---|---|---|"]
-    for e in EFFECTS[:2]:
+    for e in ("inertia", "channel_delay", "backlash"):
         bb: dict[str, int] = defaultdict(int)
         for r in by.get(e, []):
             v = _visible(r)
