@@ -62,7 +62,6 @@ IMPORTS = """
 import numpy, h5py
 import contactlab.cli, contactlab.commands.analyze, contactlab.io.hdf5
 import contactlab.studies.tracking, contactlab.studies.pooled, contactlab.tangential.window
-import contactlab.normal.options
 """
 
 #: the second track of the file in one process: CPU seconds on stdout
