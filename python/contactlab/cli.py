@@ -149,8 +149,7 @@ _BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_T
 
 
 def one_blas_thread(argv: Sequence[str]) -> bool:
-    """Set ``OPENBLAS_NUM_THREADS=1`` for a verb of :data:`_SMALL_BLAS_VERBS` before numpy
-    is imported (the process's own command line only; True when set).
+    """Set ``OPENBLAS_NUM_THREADS=1`` for ``analyze`` and ``track`` before numpy is imported.
 
     OpenBLAS starts a thread per CPU when numpy is imported, and the new threads spin before
     they sleep: ``import numpy`` took 25 ms more CPU on this project's 2-CPU VM than with one
@@ -158,9 +157,20 @@ def one_blas_thread(argv: Sequence[str]) -> bool:
     run their least-squares problems on one BLAS thread
     (:func:`contactlab.studies.tracking.track`), so nothing they compute changes, and the
     results of ``analyze``/``track`` no longer depend on the machine's number of CPUs through
-    BLAS's splitting of long dot products. Left alone when numpy is already imported or
-    when the user set any of :data:`_BLAS_THREAD_VARIABLES`; the verb's worker processes
-    inherit it.
+    BLAS's splitting of long dot products. Called for the process's own command line only
+    (``main()`` without arguments); the verb's worker processes inherit the setting.
+
+    Parameters
+    ----------
+    argv : sequence of str
+        The command line's words after the program name.
+
+    Returns
+    -------
+    bool
+        True when the variable was set; False for another verb, when numpy is already
+        imported, or when the user set any of ``OPENBLAS_NUM_THREADS``, ``GOTO_NUM_THREADS``
+        or ``OMP_NUM_THREADS`` (kept as they are).
     """
     import os
 
