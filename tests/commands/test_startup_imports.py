@@ -33,6 +33,7 @@ def _modules_after(code: str, *args: str) -> set[str]:
         check=True,
         capture_output=True,
         text=True,
+        timeout=300,
     ).stdout
     return set(out.split())
 
