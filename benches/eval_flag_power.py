@@ -43,7 +43,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 BEFORE = {"DENOISE": "harmonics", "OUTPUT_NOISE": "estimate", "MIN_GAIN": 0.05}
-AFTER = {"DENOISE": "lines", "OUTPUT_NOISE": "residual", "MIN_GAIN": 0.02}
+AFTER = {"DENOISE": "lines", "OUTPUT_NOISE": "residual", "MIN_GAIN": 0.05}
 
 
 def corner_record(seed: int, kind: str) -> tuple[Any, dict[str, Any]]:
