@@ -102,7 +102,8 @@ def main():
         f = r["fac"]
         print(f"seed {s}: fs {f['fs']:.0f} f {f['f']:.2f} cyc {f['cycles']} noise p/d "
               f"{100 * f['noise_p']:.2f}/{100 * f['noise_d']:.2f} % ψ {f['psi']:.2f} drift "
-              f"{100 * f.get('sensor_drift', 0):.2f} % cpu {r['cpu']:.0f}s", flush=True)  # fmt: skip
+              f"{100 * f.get('sensor_drift', 0):.2f} % cpu {r['cpu']:.0f}s",
+              flush=True)  # fmt: skip
         for e, v in r["rows"].items():
             extra = f" law {v['law']}" if v.get("law") else ""
             extra += f" τ/T {v['tau_frac']:.2f}" if v.get("tau_frac") else ""
