@@ -36,6 +36,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 EFFECTS = ("displacement_offset", "normal_load", "position_friction", "parallel_stiffness")
+#: effects that may be asked for besides (``--effects``): the offsets' look-alike
+OTHER_EFFECTS = ("force_offset", "non_masing_scaling")
 UNNAMEABLE = ("rational", "gamma")
 #: the rig's parameter that the diagnosis's own parameter compares with
 BOUND_PARAM = {
@@ -43,6 +45,7 @@ BOUND_PARAM = {
     "parallel_stiffness": "k_p",
     "position_friction": "eps",
     "normal_load": "eps",
+    "force_offset": "F0",
 }
 
 
@@ -101,6 +104,10 @@ def effect_params(effect: str, seed: int, fac: dict, h0=40.0, ac=4.0e4) -> dict:
                 "phi": float(rng.uniform(0, 2 * math.pi))}  # fmt: skip
     if effect == "parallel_stiffness":
         return {"k_p": 0.1 * k * hm / A}
+    if effect == "force_offset":  # the look-alikes of a displacement offset (--effects)
+        return {"F0": sgn * 0.1 * k * hm}
+    if effect == "non_masing_scaling":
+        return {"lam": float(rng.uniform(1.3, 1.6))}
     return {}
 
 
@@ -111,7 +118,7 @@ def record(gen: str, effect: str | None, seed: int, xn: tuple[float, float]):
         import misfit_chain
 
         over = {k: fac[k] for k in ("fs", "f", "cycles", "acA", "x_noise", "F_noise")}
-        (t, x, F), cf = misfit_chain.chain_record(seed, effect or "exp", x_colour="lp1", **over)
+        (t, x, F), _cf = misfit_chain.chain_record(seed, effect or "exp", x_colour="lp1", **over)
         return (t, x, F), {"factors": fac, "effect": effect, "params": {}, "gen": gen}
     from contactlab.synthetic.rig import rig_recording
 
@@ -153,7 +160,8 @@ def run(gen, effect, seed, xn):
         out["params"] = {e["name"]: e.get("parameters", {}) for e in d.get("effects", [])}
         un = d.get("unexplained") or {}
         out["flagged"] = bool(un.get("flagged")) if isinstance(un, dict) else bool(un)
-        if effect in EFFECTS and effect not in out["named"]:
+        out["withdrawn"] = d.get("withdrawn")
+        if effect in BOUND_PARAM and effect not in out["named"]:
             nd = [b for b in d.get("not_detected", []) or [] if b.get("effect") == effect]
             if nd:
                 out["bound"] = {k: nd[0].get(k) for k in ("parameter", "detectable_above",
@@ -218,9 +226,7 @@ def table(results) -> str:
                 f"silent {c['silent']} | normal_load {nl} | | {named} |"
             )
             continue
-        ab = sum(
-            1 for r in rs if outcome(r) in ("missed", "wrong") and above_bound(r) is not False
-        )
+        ab = sum(1 for r in rs if outcome(r) in ("missed", "wrong") and above_bound(r) is not False)
         lines.append(
             f"| {e} | {len(rs)} | {c['exact']} | {c['extra']} | {c['missed']} | {c['wrong']} "
             f"| {ab} | {named} |"
@@ -249,15 +255,29 @@ def main(argv=None):
     ap.add_argument("--xn", default="0.01,0.02", help="x noise range (fraction)")
     ap.add_argument("--aca", default="0.5,5", help="ac·A range")
     ap.add_argument("--only", default=None, help="comma list of effects ('clean', shapes)")
+    ap.add_argument(
+        "--max-per-group",
+        type=int,
+        default=None,
+        help="run at most this many records of each group (the seeds stay those of the plan)",
+    )
+    ap.add_argument("--resume", type=Path, default=None, help="skip the seeds of this JSON")
     ap.add_argument("--out", type=Path, default=None)
     a = ap.parse_args(argv)
     xn = tuple(float(v) for v in a.xn.split(","))
     global ACA
     ACA = tuple(float(v) for v in a.aca.split(","))
     only = None if a.only is None else set(a.only.split(","))
-    results = []
+    results = json.loads(a.resume.read_text()) if a.resume else []
+    done = {r["seed"] for r in results}
+    count: Counter = Counter()
     for i, (g, e) in enumerate(jobs_of(a.n, a.clean, a.unnameable, a.effects.split(","))):
         if only is not None and (e or "clean") not in only:
+            continue
+        count[e] += 1
+        if a.max_per_group is not None and count[e] > a.max_per_group:
+            continue
+        if a.seed_base + i in done:
             continue
         r = run(g, e, a.seed_base + i, xn)
         results.append(r)

@@ -98,3 +98,33 @@ def test_a_load_yields_to_a_stribeck_term_only_when_that_term_is_named():
     keep, _ = _yield_to_lookalikes(fam, [load, strib, spring], [load[0], strib[0], spring[0]], d)
     assert max(keep, key=lambda vc: vc[0].gain)[0].name == "parallel_stiffness"
     assert "normal_load" not in [v.name for v, _ in keep]
+
+
+def _fitted_offset(t, x, F):
+    """The sensor zero ``F0`` a force offset fits on the steady loop (the second half of the
+    record) of a Masing element of the record's own ``(H0, AC)`` on the measured ``x``."""
+    half = t.size // 2
+    return float(np.mean(F[half:] - Masing(H0, AC).force(x)[half:]))
+
+
+def test_a_force_offset_must_explain_the_first_loading_from_rest():
+    """No still stretch at the start (the ramp moves x from the first sample), but a first
+    loading from rest: a sensor's zero is there before the motion, the shift a displacement
+    offset draws is not."""
+    eff = __import__("contactlab.diagnose.effects", fromlist=["registry"]).registry("tangential")[
+        "force_offset"
+    ]
+    for acA in (1.0, 2.5):
+        t, x, F = _offset_record(0.25, acA=acA)
+        d = Prepared.build(t, x, F)
+        p = {"h0": H0, "ac": AC, "F0": _fitted_offset(t, x, F)}
+        ok, why = eff.plausible(d, p)
+        assert not ok and "first loading from rest" in why, (acA, p, why)
+        # a true sensor zero off by the same amount stands
+        t, u, _ = _offset_record(0.0, acA=acA)
+        F0 = p["F0"]
+        G = Masing(H0, AC).force(u - float(u[0])) + F0
+        G = G + 0.01 * float(np.ptp(G)) * np.random.default_rng(5).standard_normal(u.size)
+        d = Prepared.build(t, u, G)
+        ok, why = eff.plausible(d, {"h0": H0, "ac": AC, "F0": F0})
+        assert ok, (acA, why)

@@ -149,6 +149,17 @@ class ForceOffset(EffectModel):
         ok, why = rest_verdict(d, float(p["F0"]))
         if ok is False:
             return Plausibility(False, why)
+        if "lam" not in p:
+            # the first loading from rest before the first turning point (read as the
+            # intercept at rest of the residual against the travel: sharper than the still
+            # stretch's mean, and there when the motion starts at once): a sensor's zero is
+            # there before the motion, a displacement offset's (or a branch scale's) shift
+            # of the loop is not (:func:`~._first_loading.unexplained_start`)
+            from ._first_loading import unexplained_start
+
+            start = unexplained_start(p, d, float(p["F0"]), f"a force offset F0 = {p['F0']:.3g} N")
+            if start:
+                return Plausibility(False, start)
         return Plausibility(True, f"{base.reason}; {why}")
 
     def argument(self, d, p):
