@@ -128,3 +128,16 @@ def test_a_force_offset_must_explain_the_first_loading_from_rest():
         d = Prepared.build(t, u, G)
         ok, why = eff.plausible(d, {"h0": H0, "ac": AC, "F0": F0})
         assert ok, (acA, why)
+
+
+def test_only_a_record_from_rest_is_checked_at_its_first_loading():
+    """A record cut from a running test (full speed at its first sample) has no first
+    loading from rest: a sensor's zero is not checked there."""
+    from contactlab.diagnose.effects.tangential.force_offset import starts_slowly
+
+    t, x, F = _offset_record(0.0)
+    assert starts_slowly(Prepared.build(t, x, F))
+    n = 8 * 250
+    tc = np.arange(n) / 2500.0
+    xc = 4.0 / AC * np.sin(2 * np.pi * np.arange(n) / 250.0)  # mid-stroke at full speed
+    assert not starts_slowly(Prepared.build(tc, xc, Masing(H0, AC).force(xc)))

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..._family import ParamSpec, Prepared
 from .._base import EffectModel, Plausibility, register
-from ._common import REST_SAMPLES, TURN_SHARE, TURN_SIGMAS
+from ._common import REST_SAMPLES, TURN_SHARE, TURN_SIGMAS, reconstructed
 
 #: a record "starts at rest" when the displacement stands still (within the turning points'
 #: hysteresis band, :data:`~._common.TURN_SIGMAS` input-noise RMS or
@@ -124,6 +124,29 @@ def drift_verdict(d: Prepared, p: dict[str, float]) -> tuple[bool | None, str]:
     )
 
 
+#: a record "starts from rest" (its first loading is the virgin curve from the contact's
+#: rest) when the input's speed over its first samples is below this share of the speed it
+#: reaches: a drive from rest (a servo, a ramp) starts at zero speed, a record cut from a
+#: running test at any speed up to the full one. A force reconstructed from a frame's
+#: displacements is never checked there (the frame's records are cut from a running test:
+#: frame_450g starts at a low speed, and its first stretch lay 3.1 N, four times h0, from
+#: any virgin curve from rest)
+START_SPEED_SHARE = 0.25
+
+
+def starts_slowly(d: Prepared) -> bool:
+    """Whether the input's mean speed over its first :data:`~._common.REST_SAMPLES` samples
+    (the smoothed ``ẋ``) lies below :data:`START_SPEED_SHARE` of its 99th-percentile speed:
+    a start from rest, which a record cut mid-stroke is not."""
+    from ._common import smoothed_velocity
+
+    v = np.abs(np.asarray(smoothed_velocity(d), float))
+    if v.size < 4 * REST_SAMPLES:
+        return False
+    top = float(np.percentile(v, 99.0))
+    return bool(top > 0 and float(np.mean(v[:REST_SAMPLES])) < START_SPEED_SHARE * top)
+
+
 @register
 class ForceOffset(EffectModel):
     name = "force_offset"
@@ -149,7 +172,7 @@ class ForceOffset(EffectModel):
         ok, why = rest_verdict(d, float(p["F0"]))
         if ok is False:
             return Plausibility(False, why)
-        if "lam" not in p:
+        if "lam" not in p and starts_slowly(d) and not reconstructed(d):
             # the first loading from rest before the first turning point (read as the
             # intercept at rest of the residual against the travel: sharper than the still
             # stretch's mean, and there when the motion starts at once): a sensor's zero is
