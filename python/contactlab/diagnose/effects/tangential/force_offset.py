@@ -172,7 +172,7 @@ class ForceOffset(EffectModel):
         ok, why = rest_verdict(d, float(p["F0"]))
         if ok is False:
             return Plausibility(False, why)
-        if "lam" not in p and starts_slowly(d) and not reconstructed(d):
+        if {"h0", "ac"} <= set(p) and "lam" not in p and starts_slowly(d) and not reconstructed(d):
             # the first loading from rest before the first turning point (read as the
             # intercept at rest of the residual against the travel: sharper than the still
             # stretch's mean, and there when the motion starts at once): a sensor's zero is
