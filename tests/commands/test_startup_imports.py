@@ -33,6 +33,7 @@ def _modules_after(code: str, *args: str) -> set[str]:
         check=True,
         capture_output=True,
         text=True,
+        timeout=300,
     ).stdout
     return set(out.split())
 
@@ -116,3 +117,44 @@ def test_studies_package_loads_its_workflows_on_first_use():
     assert set(studies._LAZY) == set(studies.__all__)
     with pytest.raises(AttributeError, match="no_such_name"):
         studies.no_such_name  # noqa: B018
+
+
+def test_a_streamed_tangential_analyze_imports_no_normal_study_or_html_module(tmp_path):
+    # a recording above STREAM_ABOVE samples is analysed in windows (issue 33: the modules a
+    # tangential run never uses cost 30-50 ms of its start-up); its whole run, then sys.modules
+    import h5py
+    import numpy as np
+
+    import contactlab
+    from contactlab.studies.pooled import STREAM_ABOVE
+
+    n = STREAM_ABOVE + 60_000
+    t = np.arange(n) / 5000.0
+    x = 20e-6 * np.sin(2 * np.pi * 25.0 * t)
+    rng = np.random.default_rng(1)
+    F = contactlab.Masing(h0=40.0, ac=4e4).force(x) + 0.4 * rng.standard_normal(n)
+    x = x + 2e-8 * rng.standard_normal(n)  # (the recording of benches/bench_track.py)
+    with h5py.File(path := tmp_path / "long.h5", "w") as f:
+        for name, v, unit in (("x", x, "m"), ("F", F, "N")):
+            f[name] = v
+            f[name].attrs["unit"] = unit
+            f[name].attrs["dt"] = 1 / 5000.0
+    code = (
+        "import contextlib, io, sys\nfrom contactlab.cli import main\n"
+        "with contextlib.redirect_stdout(io.StringIO()):\n"
+        "    code = main(['analyze', sys.argv[1], '--json', sys.argv[2]])\n"
+        "assert code == 0, code"
+    )
+    out = tmp_path / "out.json"
+    loaded = _modules_after(code, str(path), str(out))
+    assert "contactlab.studies.tracking" in loaded  # it was streamed
+    assert '"n_windows"' in out.read_text()
+    lazy = (
+        "contactlab.normal",
+        "contactlab.studies.study",
+        "contactlab._html",
+        "contactlab.io.checks",
+    )
+    assert not [m for m in loaded if m.startswith(lazy)], sorted(
+        m for m in loaded if m.startswith(lazy)
+    )

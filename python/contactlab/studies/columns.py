@@ -7,12 +7,7 @@ itself in a notebook without importing the report builder (which imports the stu
 from __future__ import annotations
 
 from .._html import Column
-
-#: SI units of the per-cycle quantities of :func:`contactlab.studies.tracking.track`
-CYCLE_UNITS = {
-    "tangential": {"start": "s", "end": "s", "energy": "J", "amplitude": "m", "offset": "N"},
-    "normal": {"start": "s", "end": "s", "energy": "J/m^2", "amplitude": "m", "offset": "Pa"},
-}
+from .cycles import CYCLE_UNITS  # noqa: F401  (defined with the cycles; kept importable here)
 
 TANGENTIAL_COLUMNS = [
     Column("file"),

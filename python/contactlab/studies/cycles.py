@@ -25,6 +25,12 @@ import numpy as np
 
 from .. import _core
 
+#: SI units of the per-cycle quantities of :func:`contactlab.studies.tracking.track`
+CYCLE_UNITS = {
+    "tangential": {"start": "s", "end": "s", "energy": "J", "amplitude": "m", "offset": "N"},
+    "normal": {"start": "s", "end": "s", "energy": "J/m^2", "amplitude": "m", "offset": "Pa"},
+}
+
 #: smallest block the thresholds were judged on before fixed segments (samples; kept for
 #: callers of :func:`block_cycles`)
 MIN_BLOCK = 1 << 16

@@ -17,7 +17,7 @@ import numpy as np
 from .._json import dumps, jsonable
 from ..errors import InputError
 from ..io.units import UnknownUnitError, to_si
-from .columns import CYCLE_UNITS
+from .cycles import CYCLE_UNITS
 from .pooled import pool
 
 #: tangential quantities tracked per window (each with ``*_stderr``)

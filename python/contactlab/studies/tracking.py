@@ -41,9 +41,7 @@ from .._options import as_dict
 from .._physical import MAX_MAGNITUDE
 from ..errors import ContactLabError, ContactLabWarning, InputError
 from ..io import Recording, read_chunks
-from .columns import CYCLE_UNITS
-from .cycles import CycleState, block_cycles, trigger_levels
-from .study import coefficient_unit
+from .cycles import CYCLE_UNITS, CycleState, block_cycles, trigger_levels
 from .track_cuts import WindowCuts
 from .track_result import (  # noqa: F401  (the constants and TrackResult, re-exported)
     _EVERY,
@@ -157,11 +155,12 @@ def _with_glitch_check(
 ) -> Callable[..., tuple[dict, dict]]:
     @functools.wraps(fn)
     def run(rec: Recording | _WindowSamples, *args: Any, **kwargs: Any) -> tuple[dict, dict]:
-        from ..io.checks import check_recording_glitches
-
+        # (imported where a check runs: a clean tangential window never needs it)
         try:
             row, units = fn(rec, *args, **kwargs)
         except ContactLabError as exc:
+            from ..io.checks import check_recording_glitches
+
             w = _window_recording(rec)
             try:
                 check_recording_glitches(w, offset=int((w.meta or {}).get("offset", 0)))
@@ -169,6 +168,8 @@ def _with_glitch_check(
                 raise glitch from exc
             raise
         if always or row.get("warnings"):
+            from ..io.checks import check_recording_glitches
+
             w = _window_recording(rec)
             check_recording_glitches(w, offset=int((w.meta or {}).get("offset", 0)))
         return row, units
@@ -252,6 +253,9 @@ def _normal_window(
 
 
 def _normal_row(d: dict[str, Any]) -> tuple[dict, dict]:
+    # (imported here: a tangential run does not need the study module, 5-7 ms of start-up)
+    from .study import coefficient_unit
+
     du = d.get("units", {})
     row: dict[str, Any] = {}
     units: dict[str, str] = {}
