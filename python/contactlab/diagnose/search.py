@@ -70,6 +70,10 @@ def _takes_over(
     limit = MAX_BASE_SHIFT
     if explains <= EXPLAINED_SHARE:
         limit = MAX_BASE_SHIFT_MOSTLY if explains <= MOSTLY_SHARE else MAX_BASE_SHIFT_EXPLAINED
+    # an effect that changes what the base was read from (a channel delay thins the loop whose
+    # area decided the regime) may move it by its own ``max_base_shift``
+    limit = max([limit] + [float(getattr(reg[e], "max_base_shift", 0.0)) for e in effects
+                           if e in reg])  # fmt: skip
     anchors = _ANCHORS.get(family.kind, ())
     if regime in ANCHOR_STIFFNESS_REGIMES and family.kind == "tangential" and "ac" in base:
         anchors = ("h0·ac",)

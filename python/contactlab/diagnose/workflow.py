@@ -695,6 +695,7 @@ def _fit_base(
     w = eiv_weight(family, base_all.params, d, sigma)
     if w is not None:  # errors in variables: refit the base with the likelihood's weights
         d.extra["weight"], budget = w
+        d.extra["input_noise_budget"] = budget  # (for an effect's yields_to)
         current = evaluate(family, effects, d, base_all.params, scales, folds, parallel=True)
         sigma = declared_noise or _output_noise(
             family, current.full.params, d, current.full_residual(d)
