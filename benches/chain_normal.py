@@ -90,7 +90,12 @@ def chain_record(effect: str | None, size: float, fac: dict, seed: int, k: float
     damp = pa / k
     eff = {}
     if effect == "stiffness_nonlinearity":
-        eff = {"a2": size * k / damp}
+        # law "a2" (default): κ1-type, a2 = size·k/D; "a3": both sides harden alike,
+        # a3 = size·k/D²; "a23": both, each of the size
+        law = fac.get("law", "a2")
+        eff = {"a2": size * k / damp} if law in ("a2", "a23") else {}
+        if law in ("a3", "a23"):
+            eff["a3"] = size * k / damp**2
     elif effect == "asymmetric_branches":
         eff = {"a": size}
     delta = _joint(ti, pdyn, k, psi, omega, eff)
@@ -120,6 +125,12 @@ def chain_record(effect: str | None, size: float, fac: dict, seed: int, k: float
     hum = np.sin(2 * math.pi * 50.0 * ts + rng.uniform(0, 2 * math.pi))
     clean = {"p": pc.copy(), "delta": dc.copy(), "fac": fac, "k": k, "psi": psi, "p0": p0,
              "pa": pa, "D": damp}  # fmt: skip
+    # a slow drift of the displacement sensor (fraction of its range over the record,
+    # straight or bowed), when the factors ask for one
+    sd = fac.get("sensor_drift", 0.0)
+    if sd:
+        u = ts / ts[-1]
+        dc = dc + sd * rd * (u + fac.get("sensor_bow", 0.0) * (u * u - u))
     pn = pc + 0.001 * rp * hum + rng.normal(0, fac["noise_p"] * rp, n)
     dn = dc + 0.001 * rd * hum + rng.normal(0, fac["noise_d"] * rd, n)
     q = 2.0 ** fac["bits"]

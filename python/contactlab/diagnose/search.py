@@ -846,6 +846,21 @@ def _yield_to_lookalikes(
             keep.append((v, cand))
     if not refused:
         return accepted, verdicts
+    # ... and only to a rival that is named at this step: when a third candidate outgains
+    # every rival, the look-alike's reading ("the speed function is named") does not hold,
+    # and the yielding effect is judged against that candidate alone (rig, tuning seed
+    # 610017 of benches/eval_offsets.py: a 2f load in phase with the stroke, ±15 % at ac·A
+    # 4, gained 87.8 σ²; it yielded to a Stribeck term of 73.3 σ², and a parallel spring of
+    # 85.8 σ², which draws the rise of each branch's second half, was named)
+    top = max(keep, key=lambda vc: vc[0].gain) if keep else None
+    if top is not None:
+        for v, cand in accepted:
+            if v.name not in refused or not v.gain > top[0].gain:
+                continue
+            hook = getattr(reg.get(v.name), "yields_to", None)
+            if hook is None or not hook(cand.full.params, {top[0].name: top[0].gain}, v.gain, d):
+                del refused[v.name]
+                keep.append((v, cand))
     return keep, [refused.get(v.name, v) if v.accepted else v for v in verdicts]
 
 

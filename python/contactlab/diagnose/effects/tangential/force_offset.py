@@ -8,7 +8,7 @@ import numpy as np
 
 from ..._family import ParamSpec, Prepared
 from .._base import EffectModel, Plausibility, register
-from ._common import REST_SAMPLES, TURN_SHARE, TURN_SIGMAS
+from ._common import REST_SAMPLES, TURN_SHARE, TURN_SIGMAS, reconstructed
 
 #: a record "starts at rest" when the displacement stands still (within the turning points'
 #: hysteresis band, :data:`~._common.TURN_SIGMAS` input-noise RMS or
@@ -124,6 +124,39 @@ def drift_verdict(d: Prepared, p: dict[str, float]) -> tuple[bool | None, str]:
     )
 
 
+#: a record "starts from rest" (its first loading is the virgin curve from the contact's
+#: rest) when the input's speed over its first samples is below this share of the speed it
+#: reaches: a drive from rest (a servo, a ramp) starts at zero speed, a record cut from a
+#: running test at any speed up to the full one. A force reconstructed from a frame's
+#: displacements is never checked there (the frame's records are cut from a running test:
+#: frame_450g starts at a low speed, and its first stretch lay 3.1 N, four times h0, from
+#: any virgin curve from rest)
+START_SPEED_SHARE = 0.25
+
+
+def starts_slowly(d: Prepared) -> bool:
+    """Whether the record starts from rest in the middle of its stroke: the input's first
+    :data:`~._common.REST_SAMPLES` samples within a quarter of its range from the stroke's
+    middle, their mean speed (the smoothed ``ẋ``) below :data:`START_SPEED_SHARE` of its
+    99th-percentile speed. A record cut from a running test is not (at full speed
+    mid-stroke, or slowly near a turning point)."""
+    from ._common import smoothed_velocity
+
+    v = np.abs(np.asarray(smoothed_velocity(d), float))
+    if v.size < 4 * REST_SAMPLES:
+        return False
+    # a contact at rest sits in the middle of the stroke it is then driven over (within a
+    # quarter of the range, as _common.from_rest reads it); a record cut near a turning
+    # point starts slowly too, at an end (the friction frame at 450 g: 0.47 of the range
+    # from the middle, at 0.17 of the peak speed)
+    span = float(np.ptp(d.u))
+    mid = 0.5 * (float(np.max(d.u)) + float(np.min(d.u)))
+    if not abs(float(np.median(d.u[:REST_SAMPLES])) - mid) <= 0.25 * span:
+        return False
+    top = float(np.percentile(v, 99.0))
+    return bool(top > 0 and float(np.mean(v[:REST_SAMPLES])) < START_SPEED_SHARE * top)
+
+
 @register
 class ForceOffset(EffectModel):
     name = "force_offset"
@@ -149,6 +182,17 @@ class ForceOffset(EffectModel):
         ok, why = rest_verdict(d, float(p["F0"]))
         if ok is False:
             return Plausibility(False, why)
+        if {"h0", "ac"} <= set(p) and "lam" not in p and starts_slowly(d) and not reconstructed(d):
+            # the first loading from rest before the first turning point (read as the
+            # intercept at rest of the residual against the travel: sharper than the still
+            # stretch's mean, and there when the motion starts at once): a sensor's zero is
+            # there before the motion, a displacement offset's (or a branch scale's) shift
+            # of the loop is not (:func:`~._first_loading.unexplained_start`)
+            from ._first_loading import unexplained_start
+
+            start = unexplained_start(p, d, float(p["F0"]), f"a force offset F0 = {p['F0']:.3g} N")
+            if start:
+                return Plausibility(False, start)
         return Plausibility(True, f"{base.reason}; {why}")
 
     def argument(self, d, p):
