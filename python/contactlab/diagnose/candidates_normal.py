@@ -84,7 +84,6 @@ BASE_PARAMS = (
     ParamSpec("k", "Pa/m", _INF, 0.0, _INF, "k"),
     ParamSpec("psi", "-", _INF, 1e-6, 10.0, "psi"),
     ParamSpec("p0", "Pa", _INF, -_INF, _INF, "p"),
-    ParamSpec("drift", "m", _INF, -_INF, _INF, "delta"),
 )
 
 
@@ -527,7 +526,7 @@ class NormalFamily:
         p0 = float(np.mean(d.u))
         pd = d.u - p0
         k = float(pd @ pd) / float(pd @ d.y) if float(pd @ d.y) > 0 else self.scales(d)["k"]
-        return {"k": abs(k), "psi": 0.1, "p0": p0, "drift": 0.0}
+        return {"k": abs(k), "psi": 0.1, "p0": p0}
 
     def start_effect(
         self, name: str, p: dict[str, float], d: Prepared, residual: np.ndarray
@@ -612,7 +611,7 @@ class NormalFamily:
             delta = _kelvin_voigt_fit(d, k, psi, p["p0"], om)
         for e in staged("loss") + staged("additive") + staged("output"):
             delta = e.apply(delta, p, ctx)
-        return sensor_drift(delta, p, d)
+        return delta
 
     @staticmethod
     def asymmetric(delta: np.ndarray, p: dict[str, float], d: Prepared) -> np.ndarray:
@@ -945,18 +944,6 @@ def delay_identifiability(p: dict[str, float], d: Prepared) -> str | None:
         "no channel_delay is named on this record; excite at several frequencies (a factor "
         "≥ 2 apart) to tell them apart"
     )
-
-
-def sensor_drift(delta: np.ndarray, p: dict[str, float], d: Prepared) -> np.ndarray:
-    """``delta`` plus the displacement sensor's straight drift: ``drift`` (m) over the
-    record, ``drift · (t - t_mid) / duration`` (docs/effects.md §3: a slow drift of the
-    sensor is part of the measurement chain, not an effect of the joint; carried by the
-    base so that no candidate takes it and ``creep_drift`` must show its settling)."""
-    v = float(p.get("drift", 0.0))
-    if v == 0.0 or d.duration <= 0:
-        return delta
-    t = d.t
-    return delta + v * (t - 0.5 * (t[0] + t[-1])) / d.duration
 
 
 def start_from_model(model: Any) -> dict[str, float] | None:
