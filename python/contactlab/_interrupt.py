@@ -52,6 +52,11 @@ def check() -> None:
         raise KeyboardInterrupt
 
 
+def pending() -> bool:
+    """Whether a SIGINT arrived (raised or swallowed) since :func:`install` or :func:`reset`."""
+    return _pending
+
+
 def reset() -> None:
     """Forget a noted interrupt (after it was handled, and in tests)."""
     global _pending

@@ -95,6 +95,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             code = _main(sys.argv[1:])
             if code == _INTERRUPTED:
                 _exit_interrupted()
+            if _interrupt.pending():
+                # swallowed where it landed after the last output was committed: the run had
+                # done its work and its outputs are whole; say so rather than nothing
+                print("contactlab: interrupt arrived after the outputs were complete; "
+                      "they are whole", file=sys.stderr)  # fmt: skip
             return code
         except KeyboardInterrupt:  # before the verb's handler started, or after it ended
             print("contactlab: interrupted; no partial outputs written", file=sys.stderr)

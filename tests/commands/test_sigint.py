@@ -71,6 +71,12 @@ def test_sigint_to_parent_only_exits_130_without_partial_output(tmp_path: Path) 
     assert len(interrupted) >= RUNS // 2, outcomes  # the test interrupts, mostly
 
 
+def _assert_whole(i: int, out: Path) -> None:
+    """An output folder that exists must be whole: the report (written last) and no part."""
+    whole = (out / "report.html").is_file() and not list(out.rglob("*.part"))
+    assert whole, f"run {i}: partial output {sorted(out.rglob('*'))}"
+
+
 def _run_batch(runs: list, outcomes: list) -> None:
     """SIGINT each run of a batch at its moment; record how each ended."""
     for i, out, proc, at in sorted(runs, key=lambda r: r[3]):
@@ -93,15 +99,22 @@ def _run_batch(runs: list, outcomes: list) -> None:
                     # or it arrived after the run had committed its output, while the
                     # interpreter shut down (its handlers already restored to the
                     # default): then the output must be whole, the report last
-                    whole = (out / "report.html").is_file() and not list(out.rglob("*.part"))
-                    assert whole, f"run {i}: partial output {sorted(out.rglob('*'))}"
+                    _assert_whole(i, out)
                     outcomes.append(("finished", 0.0))
                     continue
                 outcomes.append(("before start-up", waited))
                 continue
+            if proc.returncode == 0:
+                # it arrived after the run had committed its last output (the report), in
+                # the moments before it returned: the run had done its work, and says so
+                # with status 0; its output must then be whole
+                _assert_whole(i, out)
+                outcomes.append(("finished", 0.0))
+                continue
             assert proc.returncode == 130, (i, proc.returncode, err.decode()[-2000:])
             assert "interrupted" in err.decode(), err.decode()[-2000:]
-            assert not out.exists(), f"run {i}: partial output {sorted(out.rglob('*'))}"
+            if out.exists():  # interrupted after its last commit: nothing partial
+                _assert_whole(i, out)
             outcomes.append(("interrupted", waited))
         else:  # it finished first: then it wrote everything
             proc.communicate()
