@@ -195,7 +195,8 @@ def _tangential_window(
         if inv is not None:
             opts["force_sign"] = -1 if inv else 1
     if set(opts) <= _WINDOW_OPTIONS:
-        res = analyze_window(rec, **opts)
+        # (the rows keep no per-cycle mean of the detrended window: not computed)
+        res = analyze_window(rec, period_means=False, **opts)
     else:
         res = analyze_tangential(rec, **{"warn": False, **dict(options)})
     d = res.to_dict()
