@@ -4,7 +4,8 @@ The anchor is ``../shared/bench/masing_anchor.rs`` (its ``masing_idx`` kernel: t
 std-Rust loop of the same rules with libm ``exp``), included verbatim into a small driver and
 built here the way a wheel is built, for generic x86-64 (``rustc -O``). The driver stays up
 for the whole run and times one call per request, so that the rounds interleave: per round
-and signal, contactlab then the anchor, the order swapped every round. Each call is timed by
+and signal, contactlab then the anchor, the order swapped every round, and every round visits
+every signal (a burst of load hits all three rows alike). Each call is timed by
 wall clock and by the CPU time of the thread that ran it (``time.thread_time`` here,
 ``clock_gettime(CLOCK_THREAD_CPUTIME_ID)`` in the driver): on a shared, loaded machine the wall time
 holds the time spent waiting for a core and the CPU time does not. Figures are medians over
@@ -61,7 +62,9 @@ fn cpu_ns() -> u64 {
     ts.sec as u64 * 1_000_000_000 + ts.nsec as u64
 }
 fn main() {
-    let mut cache: Option<(String, usize, Vec<f64>, Vec<f64>)> = None;
+    // every signal asked for so far, with its output buffer (the rounds visit them in turn)
+    let mut cache: std::collections::HashMap<(String, usize), (Vec<f64>, Vec<f64>)> =
+        std::collections::HashMap::new();
     let (mut xr, mut hr) = (Vec::new(), Vec::new());
     let stdout = std::io::stdout();
     for line in std::io::stdin().lock().lines() {
@@ -77,19 +80,18 @@ fn main() {
             writeln!(stdout.lock(), "ok").unwrap();
             continue;
         }
-        if cache.as_ref().map_or(true, |c| c.0 != kind || c.1 != n) {
+        let c = cache.entry((kind.clone(), n)).or_insert_with(|| {
             let x = anchor::signal(&kind, n);
             let mut out = vec![0.0; n];
             (anchor::IDX)(&x, &mut out, &mut xr, &mut hr); // warm-up: page faults
-            cache = Some((kind, n, x, out));
-        }
-        let c = cache.as_mut().unwrap();
+            (x, out)
+        });
         let k = std::hint::black_box(anchor::IDX);
         let (c0, t0) = (cpu_ns(), std::time::Instant::now());
-        k(std::hint::black_box(&c.2), &mut c.3, &mut xr, &mut hr);
-        std::hint::black_box(&c.3);
+        k(std::hint::black_box(&c.0), &mut c.1, &mut xr, &mut hr);
+        std::hint::black_box(&c.1);
         let (wall, cpu) = (t0.elapsed().as_secs_f64(), (cpu_ns() - c0) as f64 * 1e-9);
-        let chk: f64 = c.3.iter().sum();
+        let chk: f64 = c.1.iter().sum();
         let mut o = stdout.lock();
         writeln!(o, "{wall:.9} {cpu:.9} {chk:.17e}").unwrap();
         o.flush().unwrap();
@@ -176,51 +178,59 @@ def _spread(v: np.ndarray) -> tuple[float, float, float, float]:
 
 
 def measure(
-    n: int, rounds: int, signals: tuple[str, ...] = SIGNALS
+    n: int, rounds: int, signals: tuple[str, ...] = SIGNALS, pin: bool = True
 ) -> list[dict[str, float | str]] | None:
     """Per signal: medians of wall/CPU seconds of both kernels over interleaved rounds.
 
-    Each round runs contactlab and the anchor back to back (the order swapped every round)
-    with both pinned to the same CPU, the CPU taking turns round by round: a round's two calls
+    Each round visits every signal (the first one rotating) and runs contactlab and the
+    anchor back to back on it (the order swapped every round), with both pinned to the same
+    CPU, the CPU taking turns every two rounds (one of each order): a round's two calls
     then share one core's state and the load of the moment, and neither side keeps the
     faster or the busier core for the whole run (on this shared VM the two CPUs' speeds
     differ by up to a third from minute to minute). Besides the medians: ``cpu_ratio_paired``,
     the median over the rounds of the anchor's CPU time over contactlab's in the same round;
     ``cpu_ratio_spread``, the minimum, quartiles and maximum of those per-round ratios; and
     ``cpu_ratio_min``, the ratio of the two sides' fastest calls (the least disturbed).
-    None when the anchor or ``rustc`` is absent.
+    ``pin=False`` leaves the placement to the scheduler (for comparison). None when the
+    anchor or ``rustc`` is absent.
     """
     if not ANCHOR.exists() or shutil.which("rustc") is None:
         return None
     m = contactlab.Masing(h0=1.0, ac=3.0)
-    allowed = _cpus()
+    allowed = _cpus() if pin else []
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         anchor = Anchor(Path(tmp))
         try:
+            xs, bufs = {}, {}
             for kind in signals:
-                x = anchor.signal(kind, n, Path(tmp))
-                buf = np.empty(n)
-                m.force(x, out=buf)  # warm-up: page faults
+                xs[kind] = anchor.signal(kind, n, Path(tmp))
+                bufs[kind] = np.empty(n)
+                m.force(xs[kind], out=bufs[kind])  # warm-up: page faults
                 anchor.time(kind, n)
-                ow, oc, aw, ac = [], [], [], []
-                chk = np.nan
-                for r in range(rounds):
-                    cpu = allowed[(r // 2) % len(allowed)] if allowed else None
-                    _pin(cpu, (anchor.proc.pid,), allowed)
-                    first_ours = r % 2 == 0
+            t: dict[str, dict[str, list[float]]] = {
+                kind: {"ow": [], "oc": [], "aw": [], "ac": []} for kind in signals
+            }
+            chk = dict.fromkeys(signals, np.nan)
+            for r in range(rounds):
+                cpu = allowed[(r // 2) % len(allowed)] if allowed else None
+                _pin(cpu, (anchor.proc.pid,), allowed)
+                first_ours = r % 2 == 0
+                # the signals in turn, the first one rotating from round to round
+                for j in range(len(signals)):
+                    kind = signals[(j + r) % len(signals)]
                     if first_ours:
-                        w, c = ours_time(m, x, buf)
-                    wa, ca, chk = anchor.time(kind, n)
+                        w, c = ours_time(m, xs[kind], bufs[kind])
+                    wa, ca, chk[kind] = anchor.time(kind, n)
                     if not first_ours:
-                        w, c = ours_time(m, x, buf)
-                    ow.append(w)
-                    oc.append(c)
-                    aw.append(wa)
-                    ac.append(ca)
-                _pin(None, (anchor.proc.pid,), allowed)
-                ours_chk = float(np.cumsum(buf)[-1])  # the anchor's sequential sum
-                paired = np.array(ac) / np.array(oc)
+                        w, c = ours_time(m, xs[kind], bufs[kind])
+                    for key, v in (("ow", w), ("oc", c), ("aw", wa), ("ac", ca)):
+                        t[kind][key].append(v)
+            _pin(None, (anchor.proc.pid,), allowed)
+            for kind in signals:
+                ow, oc, aw, ac = (np.array(t[kind][k]) for k in ("ow", "oc", "aw", "ac"))
+                ours_chk = float(np.cumsum(bufs[kind])[-1])  # the anchor's sequential sum
+                paired = ac / oc
                 rows.append(
                     {
                         "signal": kind,
@@ -230,8 +240,8 @@ def measure(
                         "anchor_cpu": float(np.median(ac)),
                         "cpu_ratio_paired": float(np.median(paired)),
                         "cpu_ratio_spread": _spread(paired),
-                        "cpu_ratio_min": min(ac) / min(oc),
-                        "checksum_rel_diff": abs(ours_chk - chk) / abs(chk),
+                        "cpu_ratio_min": float(ac.min() / oc.min()),
+                        "checksum_rel_diff": abs(ours_chk - chk[kind]) / abs(chk[kind]),
                     }
                 )
         finally:
@@ -251,16 +261,22 @@ def main() -> None:
         default=list(SIGNALS),
         help="the anchor's signals to run (default: all three)",
     )
+    ap.add_argument(
+        "--no-pin",
+        action="store_true",
+        help="leave both sides' CPU to the scheduler (default: each round on one CPU)",
+    )
     args = ap.parse_args()
     n = args.n
     from contactlab import _core
 
     load = ", ".join(f"{a:.2f}" for a in os.getloadavg())
     print(
-        f"n = {n:.0e} samples, medians of {args.rounds} interleaved rounds; SIMD level "
+        f"n = {n:.0e} samples, medians of {args.rounds} interleaved rounds"
+        f"{' (not pinned)' if args.no_pin else ', each round on one CPU'}; SIMD level "
         f"{_core.simd_level()}; load {load}; {os.cpu_count()} CPUs"
     )
-    rows = measure(n, args.rounds, tuple(args.signals))
+    rows = measure(n, args.rounds, tuple(args.signals), pin=not args.no_pin)
     if rows is None:
         print("anchor absent (../shared/bench/masing_anchor.rs or rustc missing)")
         return
