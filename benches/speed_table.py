@@ -181,7 +181,8 @@ def masing_rows(rounds: int, n: int) -> None:
     sys.path.insert(0, str(ROOT / "benches"))
     import bench_masing
 
-    rows = bench_masing.measure(n, max(rounds, 12))
+    k = max(rounds, 12)
+    rows = bench_masing.measure(n, k)
     if rows is None:
         row(f"`Masing.force(x, out=buf)`, {n:.0e}", "n/a", "anchor absent", 0.0)
         return
@@ -193,9 +194,9 @@ def masing_rows(rounds: int, n: int) -> None:
             f"{n / oc / 1e6:.0f} M/s CPU ({oc / n * 1e9:.2f} ns/sample), "
             f"{n / ow / 1e6:.0f} M/s wall",
             f"anchor {n / ac / 1e6:.0f} M/s CPU ({ac / n * 1e9:.2f} ns/sample), "
-            f"{n / aw / 1e6:.0f} M/s wall; per-round ratios {lo:.2f} / {q1:.2f}-{q3:.2f} / "
-            f"{hi:.2f} (min / quartiles / max); ratio of medians {ac / oc:.2f}, of the fastest "
-            f"calls {r['cpu_ratio_min']:.2f}, wall {aw / ow:.2f}",
+            f"{n / aw / 1e6:.0f} M/s wall; {k} rounds, per-round ratios {lo:.2f} / "
+            f"{q1:.2f}-{q3:.2f} / {hi:.2f} (min / quartiles / max); ratio of medians "
+            f"{ac / oc:.2f}, of the fastest calls {r['cpu_ratio_min']:.2f}, wall {aw / ow:.2f}",
             r["cpu_ratio_paired"],
         )
 
