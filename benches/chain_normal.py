@@ -38,19 +38,30 @@ def draw_factors(rng: np.random.Generator) -> dict:
 
 
 def _joint(t, pdyn, k, psi, omega, eff):
-    """δ of the joint (docs/effects.md §2) under the dynamic pressure on grid t."""
+    """δ of the joint (docs/effects.md §2) under the dynamic pressure on grid t.
+
+    ``eff``: ``a2``, ``a3`` (the stiffness law k + a2 δ + a3 δ²), ``a`` (loss asymmetry),
+    ``follow`` (the damping follows the stiffness, ψ k_s / (2π ω): the paper's eq. 17,
+    instead of the constant c of docs/effects.md), ``bp`` (a stiffness that depends on the
+    pressure instead, k_s = k (1 + bp p/pa): the paper's eq. 16, ``pa`` the amplitude)."""
     c = psi * k / (2 * math.pi * omega)
     a2 = eff.get("a2", 0.0)
     a3 = eff.get("a3", 0.0)
     asym = eff.get("a", 0.0)
+    follow = bool(eff.get("follow", False))
+    bp = eff.get("bp", 0.0)
+    pa = float(np.max(np.abs(pdyn))) or 1.0
     pf = lambda tt: np.interp(tt, t, pdyn)  # noqa: E731
 
     def rhs(tt, y):
         d = y[0]
-        r = pf(tt) - (k + a2 * d + a3 * d * d) * d
-        return [r / (c * (1 + asym * math.copysign(1.0, r)))]
+        p = pf(tt)
+        ks = k + a2 * d + a3 * d * d + k * bp * p / pa
+        r = p - ks * d
+        ce = c * ks / k if follow else c
+        return [r / (ce * (1 + asym * math.copysign(1.0, r)))]
 
-    if a2 == 0.0 and a3 == 0.0 and asym == 0.0:  # exact for piecewise-linear p
+    if a2 == 0.0 and a3 == 0.0 and asym == 0.0 and bp == 0.0:  # exact for piecewise-linear p
         h = float(t[1] - t[0])
         tau = c / k
         E = math.exp(-h / tau)
@@ -82,20 +93,36 @@ def chain_record(effect: str | None, size: float, fac: dict, seed: int, k: float
     T = min(fac["cycles"], max(5, int(150_000 * f / fs))) / f
     ti = np.arange(int(T * fsi) + 1) / fsi
     # actuator from rest: a second-order servo (fn 12 f, ζ 0.7) following a sine command
+    # (``ramp``: the command's amplitude rises over that many cycles, a raised cosine;
+    # ``tones``: blocks of the frequencies f·r, as many cycles each, phase continuous)
     fn, z = 12.0 * f, 0.7
     wn = 2 * math.pi * fn
     act = signal.lti([wn * wn], [1, 2 * z * wn, wn * wn])
-    _, pdyn, _ = signal.lsim(act, pa * np.sin(2 * math.pi * f * ti), ti)
+    tones = fac.get("tones") or (1.0,)
+    rate = np.full(ti.size, f)
+    edge = T / len(tones)
+    for j, r in enumerate(tones):
+        rate[ti >= j * edge] = f * r
+    phase = 2 * math.pi * np.concatenate([[0.0], np.cumsum(rate[:-1]) / fsi])
+    ramp = float(fac.get("ramp", 0.0))
+    env = 0.5 - 0.5 * np.cos(math.pi * np.clip(ti * f / ramp, 0, 1)) if ramp > 0 else 1.0
+    _, pdyn, _ = signal.lsim(act, pa * env * np.sin(phase), ti)
     omega = 2 * math.pi * f
     damp = pa / k
     eff = {}
     if effect == "stiffness_nonlinearity":
         # law "a2" (default): κ1-type, a2 = size·k/D; "a3": both sides harden alike,
         # a3 = size·k/D²; "a23": both, each of the size
+        # "eq17": "a2" with the damping following the stiffness; "p": k_s depends on the
+        # pressure, k (1 + size p/pa)
         law = fac.get("law", "a2")
-        eff = {"a2": size * k / damp} if law in ("a2", "a23") else {}
+        eff = {"a2": size * k / damp} if law in ("a2", "a23", "eq17") else {}
         if law in ("a3", "a23"):
             eff["a3"] = size * k / damp**2
+        if law == "eq17":
+            eff["follow"] = True
+        if law == "p":
+            eff["bp"] = size
     elif effect == "asymmetric_branches":
         eff = {"a": size}
     delta = _joint(ti, pdyn, k, psi, omega, eff)
