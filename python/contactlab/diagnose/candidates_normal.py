@@ -704,7 +704,8 @@ class NormalFamily:
         """Why a fitted effect cannot be physical on this rig, or None (the effect's own
         :meth:`~contactlab.diagnose.effects.EffectModel.plausible`: a channel delay on a
         single-tone record is not identifiable, :func:`delay_identifiability`; a creep that
-        settles within one excitation period is the record's start-up, not the joint)."""
+        settles within a quarter of an excitation period is the record's start-up, not the
+        joint)."""
         ok, why = EFFECTS[name].plausible(d, p)
         return None if ok else why
 

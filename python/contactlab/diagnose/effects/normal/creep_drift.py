@@ -33,7 +33,8 @@ class CreepDrift(EffectModel):
     description = "displacement creeping over the cycles, D (1 - exp(-t/τ_c))"
     physics = (
         "The joint settles under its mean load (asperities creeping): δ += D (1 - "
-        "exp(-t/τ_c)), slower than an excitation period, settling within the record."
+        "exp(-t/τ_c)), slower than a quarter of an excitation period, settling within "
+        "the record."
     )
     stage = "additive"
     order = 2
