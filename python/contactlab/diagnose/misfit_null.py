@@ -56,9 +56,10 @@ import numpy as np
 from ..errors import ContactLabError
 from ._family import Prepared
 from ._filters import savgol_filter
+from ._parallel import one_blas_thread
 from .detection import MISFIT_FALSE_ALARM
-from .eiv import InputNoise, _coloured, _driven, input_noise_spectrum, is_coloured
-from .misfit import backbone_misfit, t_quantile, unexplained_structure
+from .eiv import InputNoise, _driven, input_noise_spectrum, is_coloured
+from .misfit import backbone_misfit, phase_statistic, t_quantile
 
 __all__ = [
     "KEEP_HARMONICS",
@@ -243,12 +244,51 @@ def _statistics(d: Prepared, r: np.ndarray, ac: float, sigma: float) -> tuple[fl
     carries the input noise's share, so no guard leaves any out), and the free-form curve's
     held-out gain in units of ``sigma²``."""
     bb = backbone_misfit(d, r, ac, sigma, min_weight=0.0)
-    u = unexplained_structure(d, r, sigma, min_weight=0.0)
     return (
         math.nan if bb is None else float(bb["t"]),
-        math.nan if u is None else float(u.statistic),
+        phase_statistic(d, r, sigma),
         math.nan if bb is None else float(bb["gain_over_noise_var"]),
     )
+
+
+def _fast_length(n: int) -> int:
+    """The smallest ``2^a 3^b 5^c`` not below ``n`` (a transform of that length is fast;
+    one of a length with a large prime factor is many times slower)."""
+    best = 1 << max(int(n - 1).bit_length(), 0)
+    p5 = 1
+    while p5 < best:
+        p35 = p5
+        while p35 < best:
+            m = p35
+            while m < n:
+                m *= 2
+            best = min(best, m)
+            p35 *= 3
+        p5 *= 5
+    return best
+
+
+class _NoiseDraws:
+    """Unit-variance noise of one spectrum's shape (:func:`.eiv._coloured`'s), ``n`` samples
+    at a time: drawn at a fast transform length (:func:`_fast_length`) and cut to ``n`` (a
+    stationary noise's stretch), the spectral gain computed once."""
+
+    def __init__(self, n: int, spec: InputNoise | None) -> None:
+        self.n = n
+        self.m = _fast_length(n)
+        self.g: np.ndarray | None = None
+        if spec is not None:
+            fn = np.fft.rfftfreq(self.m, spec.dt)
+            g = np.sqrt(np.maximum(np.interp(fn, spec.f, spec.power), 0.0))
+            scale = math.sqrt(float(np.mean(g * g)))
+            if scale > 0:
+                self.g = g / scale
+
+    def __call__(self, rng: np.random.Generator) -> np.ndarray:
+        if self.g is None:
+            return rng.standard_normal(self.n)
+        w = rng.standard_normal(self.m)
+        return np.fft.irfft(np.fft.rfft(w) * self.g, self.m)[: self.n]
 
 
 def output_noise_shape(d: Prepared, residual: np.ndarray) -> InputNoise | None:
@@ -367,6 +407,7 @@ def _jacobian(
     return np.column_stack(cols) if cols else None
 
 
+@one_blas_thread
 def simulated_null(
     family: Any,
     params: dict[str, float],
@@ -452,10 +493,11 @@ def simulated_null(
             r_obs[use] = (ru - Q @ (Q.T @ ru)) / sw
         out_shape = output_noise_shape(d, r)
         driven = []
+        in_noise = _NoiseDraws(x_true.size, spec)
         for _ in range(draws):
             u = x_true
             if su > 0:
-                u = x_true + _coloured(rng, x_true.size, spec) * su
+                u = x_true + in_noise(rng) * su
             dk = _drive(d, savgol_filter(u, wlen, 3, mode="interp") if wlen else u)
             if dk is not None:
                 driven.append((dk, np.asarray(family.predict(params, effects, dk), float)))
@@ -463,8 +505,9 @@ def simulated_null(
         if OUTPUT_NOISE == "residual" and out_shape is not None and driven:
             out_shape, sig_out = _output_beyond_input(d, out_shape, truth, driven, sigma_out)
         copies = []
+        out_noise = _NoiseDraws(truth.size, out_shape)
         for dk, mk in driven:
-            rk = truth + _coloured(rng, truth.size, out_shape) * sig_out - mk
+            rk = truth + out_noise(rng) * sig_out - mk
             if Q is not None:  # the fit takes up what its parameters can draw
                 ru = rk[use] * sw
                 rk = rk.copy()
