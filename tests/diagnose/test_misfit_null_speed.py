@@ -77,3 +77,18 @@ def test_noise_draws_have_unit_variance_and_the_shape() -> None:
     assert lag1 > 0.5
     white = _NoiseDraws(n, None)(rng)
     assert white.size == n and abs(float(np.var(white)) - 1.0) < 0.05
+
+
+def test_noise_draws_through_a_flat_spectrum_are_white() -> None:
+    """The white noise's transform drawn directly: through a flat gain it is white noise of
+    unit variance (no correlation between neighbours, a normal distribution)."""
+    n, dt = 4999, 1e-3  # odd: the last coefficient is complex
+    f = np.fft.rfftfreq(1024, dt)
+    draw = _NoiseDraws(n, InputNoise(f, np.ones(f.size), dt, 1.0, 1.0))
+    assert draw.m == 5000
+    rng = np.random.default_rng(5)
+    v = np.stack([draw(rng) for _ in range(40)])
+    assert abs(float(np.var(v)) - 1.0) < 0.03
+    assert abs(float(np.mean(v[:, 1:] * v[:, :-1]))) < 0.02
+    kurt = float(np.mean(v**4)) / float(np.var(v)) ** 2
+    assert abs(kurt - 3.0) < 0.1

@@ -287,7 +287,8 @@ def _fast_length(n: int) -> int:
 class _NoiseDraws:
     """Unit-variance noise of one spectrum's shape (:func:`.eiv._coloured`'s), ``n`` samples
     at a time: drawn at a fast transform length (:func:`_fast_length`) and cut to ``n`` (a
-    stationary noise's stretch), the spectral gain computed once."""
+    stationary noise's stretch), the spectral gain computed once and the white noise's
+    transform drawn directly."""
 
     def __init__(self, n: int, spec: InputNoise | None) -> None:
         self.n = n
@@ -303,8 +304,15 @@ class _NoiseDraws:
     def __call__(self, rng: np.random.Generator) -> np.ndarray:
         if self.g is None:
             return rng.standard_normal(self.n)
-        w = rng.standard_normal(self.m)
-        return np.fft.irfft(np.fft.rfft(w) * self.g, self.m)[: self.n]
+        # the transform of white noise drawn directly (one transform less): independent
+        # complex normal coefficients of variance m, the first (and the last, m even) real
+        k = self.m // 2 + 1
+        z = rng.standard_normal((2, k))
+        X = (z[0] + 1j * z[1]) * math.sqrt(0.5 * self.m)
+        X[0] = z[0, 0] * math.sqrt(self.m)
+        if self.m % 2 == 0:
+            X[-1] = z[0, -1] * math.sqrt(self.m)
+        return np.fft.irfft(X * self.g, self.m)[: self.n]
 
 
 def output_noise_shape(d: Prepared, residual: np.ndarray) -> InputNoise | None:
