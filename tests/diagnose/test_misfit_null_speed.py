@@ -92,3 +92,25 @@ def test_noise_draws_through_a_flat_spectrum_are_white() -> None:
     assert abs(float(np.mean(v[:, 1:] * v[:, :-1]))) < 0.02
     kurt = float(np.mean(v**4)) / float(np.var(v)) ** 2
     assert abs(kurt - 3.0) < 0.1
+
+
+@settings(max_examples=6, deadline=None)
+@given(seed=st.integers(0, 10_000), wlen=st.sampled_from([5, 11, 31]), coloured=st.booleans())
+def test_noise_filtered_in_the_transform_is_the_savgol_filter(
+    seed: int, wlen: int, coloured: bool
+) -> None:
+    """The candidates' input filter applied in the noise's own transform gives, half a
+    window or more from the ends, exactly what the Savitzky-Golay filter gives of the
+    unfiltered draw."""
+    from contactlab.diagnose._filters import savgol_filter
+
+    n, dt = 3001, 1e-3
+    f = np.fft.rfftfreq(512, dt)
+    power = 1.0 / (1.0 + (f / 80.0) ** 2) if coloured else np.ones(f.size)
+    spec = InputNoise(f, power, dt, 1.0, 1.0)
+    plain = _NoiseDraws(n, spec)(np.random.default_rng(seed))
+    filtered = _NoiseDraws(n, spec, savgol=wlen)(np.random.default_rng(seed))
+    ref = savgol_filter(plain, wlen, 3, mode="interp")
+    h = wlen // 2
+    assert np.allclose(filtered[h : n - h], ref[h : n - h], atol=1e-12, rtol=0)
+    assert np.std(filtered) < np.std(plain)

@@ -55,7 +55,7 @@ import numpy as np
 
 from ..errors import ContactLabError
 from ._family import Prepared
-from ._filters import savgol_filter
+from ._filters import savgol_coeffs, savgol_filter
 from ._parallel import one_blas_thread
 from .detection import MISFIT_FALSE_ALARM
 from .eiv import InputNoise, _driven, input_noise_spectrum, is_coloured
@@ -290,7 +290,7 @@ class _NoiseDraws:
     stationary noise's stretch), the spectral gain computed once and the white noise's
     transform drawn directly."""
 
-    def __init__(self, n: int, spec: InputNoise | None) -> None:
+    def __init__(self, n: int, spec: InputNoise | None, savgol: int = 0) -> None:
         self.n = n
         self.m = _fast_length(n)
         self.g: np.ndarray | None = None
@@ -300,6 +300,20 @@ class _NoiseDraws:
             scale = math.sqrt(float(np.mean(g * g)))
             if scale > 0:
                 self.g = g / scale
+        if savgol and savgol <= n:
+            # the candidates' input filter (a cubic Savitzky-Golay window of ``savgol``
+            # samples) applied in the same transform: its kernel placed circularly, so each
+            # sample half a window or more from either end is exactly what
+            # :func:`.savgol_filter` gives of the unfiltered draw (its end fits, over half
+            # a window at each end of a stretch of stationary noise, are not reproduced)
+            c = savgol_coeffs(savgol, 3)
+            h = np.zeros(self.m)
+            half = savgol // 2
+            h[: half + 1] = c[half:]
+            if half:
+                h[-half:] = c[:half]
+            H = np.fft.rfft(h)
+            self.g = H if self.g is None else self.g * H
 
     def __call__(self, rng: np.random.Generator) -> np.ndarray:
         if self.g is None:
@@ -517,12 +531,11 @@ def simulated_null(
             r_obs[use] = (ru - Q @ (Q.T @ ru)) / sw
         out_shape = output_noise_shape(d, r)
         driven = []
-        in_noise = _NoiseDraws(x_true.size, spec)
+        in_noise = _NoiseDraws(x_true.size, spec, savgol=wlen)
         for _ in range(draws):
-            u = x_true
-            if su > 0:
-                u = x_true + in_noise(rng) * su
-            dk = _drive(d, savgol_filter(u, wlen, 3, mode="interp") if wlen else u)
+            # the filter is linear: the filtered true input plus the filtered noise
+            u = x_in + in_noise(rng) * su if su > 0 else x_in
+            dk = _drive(d, u)
             if dk is not None:
                 driven.append((dk, np.asarray(family.predict(params, effects, dk), float)))
         sig_out = sigma_out
