@@ -634,6 +634,7 @@ class StepwiseSearch:
         verdicts: list[Verdict] = []
         best = None
         accepted: list[tuple[Verdict, Trial]] = []
+        seen_trials: dict[str, tuple[Verdict, Trial]] = {}
         outs = pmap(unless_spent, tried, cost=partial(_fit_cost, self.family))
         for name, out in zip(tried, outs, strict=True):
             if st.used >= limit:
@@ -648,7 +649,12 @@ class StepwiseSearch:
                 best = (v, cand)
             if cand is not None and v.accepted:
                 accepted.append((v, cand))
+            if cand is not None and np.isfinite(v.gain):
+                seen_trials[name] = (v, cand)
         accepted, verdicts = _yield_to_lookalikes(self.family, accepted, verdicts, self.d)
+        accepted, verdicts = _yield_to_tried(
+            self.family, accepted, verdicts, seen_trials, st.current, self.d
+        )
         best = max(accepted, key=lambda vc: vc[0].gain) if accepted else None
         best = _parsimonious(best, accepted)
         if verdicts:
@@ -862,6 +868,61 @@ def _yield_to_lookalikes(
                 del refused[v.name]
                 keep.append((v, cand))
     return keep, [refused.get(v.name, v) if v.accepted else v for v in verdicts]
+
+
+def _yield_to_tried(
+    family: Family,
+    accepted: list[tuple[Verdict, Trial]],
+    verdicts: list[Verdict],
+    tried: dict[str, tuple[Verdict, Trial]],
+    current: Trial,
+    d: Prepared,
+) -> tuple[list[tuple[Verdict, Trial]], list[Verdict]]:
+    """``accepted`` and ``verdicts`` with the candidates refused whose lead over a look-alike
+    *tried* at the same step (cross-validated, accepted or not: ``tried``) is not their own
+    physics: an effect's ``yields_to_tried(p, v, cand, tried, current, d)`` says why, or
+    None.
+
+    :func:`_yield_to_lookalikes` judges an effect against rivals accepted at the same step.
+    A look-alike whose fit feeds on the input's noise (a play passes over the noise's
+    wiggles at each turning point) can pass the input-noise budget where the effect it
+    mimics, which no such noise feeds, falls just short of it: then the rival is not
+    accepted, and the comparison must read where the two differ physically (a play against
+    a delay: away from the turns, a fixed shift against one proportional to the speed)."""
+    from .effects import registry
+
+    try:
+        reg = registry(family.kind)
+    except KeyError:
+        return accepted, verdicts
+    keep, refused = [], {}
+    for v, cand in accepted:
+        hook = getattr(reg.get(v.name), "yields_to_tried", None)
+        why = None if hook is None else hook(cand.full.params, v, cand, tried, current, d)
+        if why:
+            refused[v.name] = dataclasses.replace(v, accepted=False, reason=f"look-alike: {why}")
+        else:
+            keep.append((v, cand))
+    if not refused:
+        return accepted, verdicts
+    return keep, [refused.get(v.name, v) if v.accepted else v for v in verdicts]
+
+
+def gain_where(d: Prepared, current: Trial, cand: Trial, where: np.ndarray) -> float:
+    """The held-out gain of ``cand`` over ``current`` on the samples ``where`` only, per
+    held-out sample of the whole record (output units squared: compare two candidates'
+    on one record): ``Σ w (r² - (r - Δ)²)`` over the samples held out by both and in
+    ``where``, ``r`` the current model's held-out residual, ``Δ`` the candidate's held-out
+    prediction minus the current one, ``w`` the likelihood weights
+    (:func:`~contactlab.diagnose.select.sample_weight`)."""
+    from .select import sample_weight
+
+    r = d.y - current.prediction
+    delta = cand.prediction - current.prediction
+    held = current.heldout & cand.heldout
+    n = max(int(np.count_nonzero(held)), 1)
+    g = sample_weight(d) * (2.0 * r * delta - delta * delta)
+    return float(np.sum(g[held & where])) / n
 
 
 #: accepted candidates whose held-out gains lie within this share of the best one's are a
