@@ -14,7 +14,8 @@ Pairs (true effect → the look-alike named instead):
 - ``displacement_offset`` → ``asymmetry``: x0 2-6 % of A, ac·A 1.5-4;
 - ``clean``: nothing to name (for the false-alarm rate);
 - ``backlash`` → ``channel_delay`` (the reverse of the first pair: a play of half-width b 1-5 %
-  of A, 5-50 Hz, ac·A 1.5-4), so that a rule for the first pair is checked against it.
+  of A, 5-50 Hz, ac·A 1.5-4), so that a rule for the first pair is checked against it;
+- ``asymmetry`` → ``displacement_offset`` (the reverse of the fifth: a 2-8 %, ac·A 1.5-4).
 
 The effects follow docs/effects.md (the rig implements its equations). Seeds: the record's
 factors and noise come from ``seed`` alone; tune on one base, report on another.
@@ -31,7 +32,7 @@ from typing import Any
 import numpy as np
 
 EFFECTS = ("channel_delay", "stribeck", "stick_slip", "normal_load", "displacement_offset",
-           "clean", "backlash")  # fmt: skip
+           "clean", "backlash", "asymmetry")  # fmt: skip
 #: the look-alikes the diagnosis named for each (blind judge, stop 40)
 RIVALS = {
     "channel_delay": ("backlash",),
@@ -41,6 +42,7 @@ RIVALS = {
     "displacement_offset": ("asymmetry",),
     "clean": (),
     "backlash": ("channel_delay",),
+    "asymmetry": ("displacement_offset",),
 }
 MAX_SAMPLES = 24_000
 H0, AC = 40.0, 4.0e4
@@ -61,6 +63,7 @@ def draw(effect: str, seed: int) -> dict[str, Any]:
         "displacement_offset": (2.0, 30.0, 1.5, 4.0),
         "clean": (1.0, 50.0, 0.5, 5.0),
         "backlash": (5.0, 50.0, 1.5, 4.0),
+        "asymmetry": (2.0, 30.0, 1.5, 4.0),
     }[effect]
     fs = float(rng.choice((1000.0, 2000.0, 5000.0, 10000.0)))
     f = min(_logu(rng, f_lo, f_hi), fs / 20.0)
@@ -103,6 +106,8 @@ def draw(effect: str, seed: int) -> dict[str, Any]:
         p = {"displacement_offset": {"x0": sgn * float(rng.uniform(0.02, 0.06)) * A}}
     elif effect == "backlash":
         p = {"backlash": {"b": float(rng.uniform(0.01, 0.05)) * A}}
+    elif effect == "asymmetry":
+        p = {"asymmetry": {"a": sgn * float(rng.uniform(0.02, 0.08))}}
     return {"factors": fac, "effects": p, "A": A}
 
 

@@ -29,12 +29,12 @@ from chain_lookalike import EFFECTS, RIVALS
 SIZE = {"channel_delay": ("channel_delay", "tau"), "stribeck": ("stribeck", "s"),
         "stick_slip": ("stick_slip", "b"), "normal_load": ("normal_load", "eps"),
         "displacement_offset": ("displacement_offset", "x0"),
-        "backlash": ("backlash", "b")}  # fmt: skip
+        "backlash": ("backlash", "b"), "asymmetry": ("asymmetry", "a")}  # fmt: skip
 
 
 #: the discriminators of this helper, by effect: ``--without`` takes them off (the "before" of
 #: a before/after comparison on one tree)
-HOOKS = {"backlash": "yields_to_tried"}
+HOOKS = {"backlash": "yields_to_tried", "asymmetry": "yields_to_tried"}
 
 
 def _without(names: tuple[str, ...]) -> None:
