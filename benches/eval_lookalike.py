@@ -34,7 +34,8 @@ SIZE = {"channel_delay": ("channel_delay", "tau"), "stribeck": ("stribeck", "s")
 
 #: the discriminators of this helper, by effect: ``--without`` takes them off (the "before" of
 #: a before/after comparison on one tree)
-HOOKS = {"backlash": "yields_to_tried", "asymmetry": "yields_to_tried"}
+HOOKS = {"backlash": ("yields_to_tried", None), "asymmetry": ("yields_to_tried", None),
+         "displacement_offset": ("input_noise_share", 1.0)}  # fmt: skip
 
 
 def _without(names: tuple[str, ...]) -> None:
@@ -43,8 +44,11 @@ def _without(names: tuple[str, ...]) -> None:
     reg = registry("tangential")
     for n in names:
         cls = type(reg[n])
-        if HOOKS[n] in cls.__dict__:
-            delattr(cls, HOOKS[n])
+        attr, before = HOOKS[n]
+        if before is not None:
+            setattr(cls, attr, before)
+        elif attr in cls.__dict__:
+            delattr(cls, attr)
 
 
 def run_job(job: tuple[str, int, str, tuple[str, ...]]) -> dict[str, Any]:
