@@ -9,8 +9,12 @@ Two measurements, both in this process:
   analyze`` runs it (``"auto"`` windows, window documents kept, the allocator settings of the
   command line), with every per-sample kernel of the chain wrapped: its CPU time (the calling
   thread's), ns a sample of the recording, its share of the process's CPU and the minor page
-  faults it took. What is left is the interpreter's part (the fits, the bookkeeping) and the
-  start of the reader. Run serially (``threads=0``) and with two helper threads (the
+  faults it took (a part's figures exclude the wrapped parts it calls). The window's analysis
+  after the fold (``tangential.window._analyze``: the fits, covariances, lag, in Python) is a
+  part of its own; what is left is the interpreter's other work (reversals' and knots'
+  bookkeeping, windows, the reader). The track runs as ``analyze --json`` runs it, without
+  the per-cycle table (``track(cycles=False)``) where the tree under test has that.
+  Run serially (``threads=0``) and with two helper threads (the
   command line's default on two CPUs): the difference of the process's CPU is what the
   threads cost.
 - ``--scaling``: two threads of the same kernel at once against one after the other, for a
@@ -26,7 +30,8 @@ Two measurements, both in this process:
   busy (``/proc/sys/kernel/sched_autogroup_enabled``).
 
 Run: ``nice .venv/bin/python benches/bench_analyze_parts.py [--parts] [--scaling]
-[--samples 3e7] [--rounds 3]``.
+[--samples 3e7] [--rounds 3] [--threads 0 2]`` (``--threads 0``: the serial run only; another
+tree's package with ``PYTHONPATH=<its python/ folder, built>``).
 """
 
 from __future__ import annotations
@@ -59,20 +64,32 @@ KERNELS = (
 )
 
 
+#: per thread, the CPU seconds and faults of the wrapped calls nested in the open ones
+_NESTED = threading.local()
+
+
 def _wrapped(f: Any, name: str, stats: dict[str, list[float]]) -> Any:
-    """``f`` counting its calls, the calling thread's CPU seconds and minor faults."""
+    """``f`` counting its calls, the calling thread's CPU seconds and minor faults, less
+    those of wrapped calls made inside it (each part counted once)."""
 
     def run(*a: Any, **k: Any) -> Any:
+        stack = _NESTED.__dict__.setdefault("stack", [])
+        stack.append([0.0, 0])
         r0 = resource.getrusage(resource.RUSAGE_THREAD)
         c0 = time.thread_time()
-        out = f(*a, **k)
-        c1 = time.thread_time()
-        r1 = resource.getrusage(resource.RUSAGE_THREAD)
-        s = stats.setdefault(name, [0, 0.0, 0])
-        s[0] += 1
-        s[1] += c1 - c0
-        s[2] += r1.ru_minflt - r0.ru_minflt
-        return out
+        try:
+            return f(*a, **k)
+        finally:
+            c = time.thread_time() - c0
+            fl = resource.getrusage(resource.RUSAGE_THREAD).ru_minflt - r0.ru_minflt
+            inner_c, inner_f = stack.pop()
+            if stack:
+                stack[-1][0] += c
+                stack[-1][1] += fl
+            s = stats.setdefault(name, [0, 0.0, 0])
+            s[0] += 1
+            s[1] += c - inner_c
+            s[2] += fl - inner_f
 
     return run
 
@@ -80,9 +97,12 @@ def _wrapped(f: Any, name: str, stats: dict[str, list[float]]) -> Any:
 def parts(path: Path, threads: int) -> tuple[dict[str, list[float]], float, float, int]:
     """Per-kernel [calls, CPU s, minor faults], the process's CPU and wall seconds and its
     minor faults over one ``track`` of ``path``."""
+    import inspect
+
     from contactlab import _core
     from contactlab.reversals import ReversalDetector
     from contactlab.studies import tracking
+    from contactlab.tangential import window
 
     stats: dict[str, list[float]] = {}
     # (a kernel the tree under test does not have is left out: A/B runs of an older build)
@@ -94,14 +114,26 @@ def parts(path: Path, threads: int) -> tuple[dict[str, list[float]], float, floa
     saved += [
         (ReversalDetector, "push", ReversalDetector.push),
         (tracking, "block_cycles", tracking.block_cycles),
+        # the window's analysis after the fold, in Python (fits, covariances, lag, derived
+        # quantities; the Rust calls it makes are counted inside it)
+        (window, "_analyze", window._analyze),
     ]
     for obj, k, f in saved:
-        label = {"push": "ReversalDetector.push", "block_cycles": "CycleStream (block_cycles)"}
+        label = {
+            "push": "ReversalDetector.push",
+            "block_cycles": "CycleStream (block_cycles)",
+            "_analyze": "window analysis in Python (_analyze)",
+        }
         setattr(obj, k, _wrapped(f, label.get(k, k), stats))
+    # as ``analyze --json`` runs it: without the per-cycle table where the tree can (the
+    # crossings that cut the windows only; older trees compute the table)
+    extra = {"cycles": False} if "cycles" in inspect.signature(tracking.track).parameters else {}
     try:
         r0 = resource.getrusage(resource.RUSAGE_SELF)
         t0, c0 = time.perf_counter(), time.process_time()
-        tracking.track(path, "auto", kind="tangential", keep_documents=True, threads=threads)
+        tracking.track(
+            path, "auto", kind="tangential", keep_documents=True, threads=threads, **extra
+        )
         wall, cpu = time.perf_counter() - t0, time.process_time() - c0
         r1 = resource.getrusage(resource.RUSAGE_SELF)
     finally:
@@ -110,7 +142,7 @@ def parts(path: Path, threads: int) -> tuple[dict[str, list[float]], float, floa
     return stats, cpu, wall, r1.ru_minflt - r0.ru_minflt
 
 
-def print_parts(n: int, rounds: int) -> None:
+def print_parts(n: int, rounds: int, threads_list: tuple[int, ...] = (0, 2)) -> None:
     from contactlab._malloc import keep_freed_memory
 
     keep_freed_memory()  # as the command line
@@ -118,7 +150,7 @@ def print_parts(n: int, rounds: int) -> None:
         path = Path(d) / "rec.h5"
         bench_track.write_file(path, n)
         parts(path, 0)  # warm: imports, the file in the page cache
-        for threads in (0, 2):
+        for threads in threads_list:
             runs = [parts(path, threads) for _ in range(rounds)]
             k = int(np.argsort([r[1] for r in runs])[len(runs) // 2])  # the median run by CPU
             stats, cpu, wall, faults = runs[k]
@@ -138,8 +170,8 @@ def print_parts(n: int, rounds: int) -> None:
                 )
             rest = cpu - total
             print(
-                f"| the rest (interpreter: fits, bookkeeping; the reader's preadv and cycle "
-                f"tracker; the structure scan) | | {rest:.3f} | {rest / n * 1e9:.2f} | "
+                f"| the rest (interpreter: reversals, knots, windows, bookkeeping; the "
+                f"reader's preadv) | | {rest:.3f} | {rest / n * 1e9:.2f} | "
                 f"{100 * rest / cpu:.1f} % | |"
             )
 
@@ -206,11 +238,12 @@ def main() -> None:
     ap.add_argument("--scaling", action="store_true", help="two threads against one")
     ap.add_argument("--samples", type=float, default=3e7)
     ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--threads", type=int, nargs="+", default=[0, 2], help="runs of --parts")
     args = ap.parse_args()
     if args.scaling:
         print_scaling(args.rounds)
     if args.parts or not args.scaling:
-        print_parts(int(args.samples), args.rounds)
+        print_parts(int(args.samples), args.rounds, tuple(args.threads))
 
 
 if __name__ == "__main__":

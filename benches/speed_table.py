@@ -12,7 +12,9 @@ noise and the ratio of medians is the figure. Rows:
 - ``Masing(h0=1, ac=3).force(x, out=buf)`` on the anchor's signals (sine, band-limited,
   random walk) against ``../shared/bench/masing_anchor.rs`` (its ``masing_idx`` kernel),
   built here for generic x86-64 (``rustc -O``) into a driver kept running between our rounds
-  (``benches/bench_masing.py``); ratio of thread-CPU medians, wall-clock figures beside it.
+  (``benches/bench_masing.py``), each round's two calls on one CPU (taking turns), at least
+  12 rounds; ratio: median of the per-round thread-CPU ratios, their spread and the ratio of
+  the medians, of the fastest calls and of wall-clock time beside it.
 - ``Masing.force(threads=2)`` with a competing busy process against one thread.
 - ``contactlab analyze --json`` of a 1e7 / 3e7-sample HDF5 recording on the command line
   against the Masing kernel on the same samples (``benches/bench_analyze.py``).
@@ -170,25 +172,32 @@ def masing_rows(rounds: int, n: int) -> None:
     """``Masing(h0=1, ac=3).force(x, out=buf)`` against the anchor (``bench_masing.py``).
 
     The anchor's ``masing_idx`` built here for generic x86-64, kept running and called
-    between our rounds on its own signals; the ratio is of the medians of thread-CPU time
-    (the wall-clock ratio, which holds waiting for a core on a loaded machine, beside it).
+    between our rounds on its own signals, each round's two calls pinned to the same CPU
+    (taking turns); at least 12 rounds. The ratio is the median of the per-round thread-CPU
+    ratios, with their spread (minimum, quartiles, maximum), the ratio of the CPU medians and
+    that of the fastest calls beside it (the wall-clock ratio, which holds waiting for a core
+    on a loaded machine, too).
     """
     sys.path.insert(0, str(ROOT / "benches"))
     import bench_masing
 
-    rows = bench_masing.measure(n, max(rounds, 5))
+    k = max(rounds, 12)
+    rows = bench_masing.measure(n, k)
     if rows is None:
         row(f"`Masing.force(x, out=buf)`, {n:.0e}", "n/a", "anchor absent", 0.0)
         return
     for r in rows:
         oc, ac, ow, aw = r["ours_cpu"], r["anchor_cpu"], r["ours_wall"], r["anchor_wall"]
+        lo, q1, q3, hi = r["cpu_ratio_spread"]
         row(
             f"`Masing.force(x, out=buf)`, {n:.0e}, {r['signal']}",
             f"{n / oc / 1e6:.0f} M/s CPU ({oc / n * 1e9:.2f} ns/sample), "
             f"{n / ow / 1e6:.0f} M/s wall",
             f"anchor {n / ac / 1e6:.0f} M/s CPU ({ac / n * 1e9:.2f} ns/sample), "
-            f"{n / aw / 1e6:.0f} M/s wall; wall ratio {aw / ow:.2f}",
-            ac / oc,
+            f"{n / aw / 1e6:.0f} M/s wall; {k} rounds, per-round ratios {lo:.2f} / "
+            f"{q1:.2f}-{q3:.2f} / {hi:.2f} (min / quartiles / max); ratio of medians "
+            f"{ac / oc:.2f}, of the fastest calls {r['cpu_ratio_min']:.2f}, wall {aw / ow:.2f}",
+            r["cpu_ratio_paired"],
         )
 
 

@@ -230,6 +230,9 @@ class CycleTracker:
 @final
 class CycleStream:
     def __new__(cls) -> CycleStream: ...
+    def push_crossings(
+        self, x: _F, f: _F, drive: _F, offset: int, low: float, high: float
+    ) -> npt.NDArray[np.int64]: ...
     def push(
         self, t: _F, x: _F, f: _F, drive: _F, offset: int, low: float, high: float
     ) -> CycleBlock: ...

@@ -246,6 +246,9 @@ def _auto_streamed(
         options=opts,
         keep_documents=True,
         threads=window_threads(),
+        # the document pools the windows' documents; the per-cycle table is drawn only in
+        # a report (the crossings that cut the windows are found either way)
+        cycles=bool(args.report),
     )
     if not res.window_docs:
         errors = "; ".join(str(r.get("error")) for r in res.rows if r.get("error"))

@@ -94,13 +94,18 @@ BASE_PARAMS = (
 MIN_LOAD_PERIODS = _normal_load.MIN_LOAD_PERIODS
 
 
-def _grid(x: np.ndarray, F: np.ndarray) -> tuple[float, float, float]:
-    """Best ``(rss, h0, ac)`` over ``ac·max|x|`` from pre-sliding to gross sliding."""
+def _grid(x: np.ndarray, F: np.ndarray, offset: bool = False) -> tuple[float, float, float]:
+    """Best ``(rss, h0, ac)`` over ``ac·max|x|`` from pre-sliding to gross sliding; with
+    ``offset``, each curve is fitted with a constant force beside it (its rss then)."""
     xmax = float(np.max(np.abs(x)))
     best = (np.inf, 1.0, 1.0)
+    if offset:
+        F = F - np.mean(F)
     for q in np.geomspace(0.2, 5000.0, 23):
         ac = q / xmax
         g = Masing(1.0, ac).force(x)
+        if offset:
+            g = g - np.mean(g)
         gg = float(g @ g)
         if gg == 0.0:
             continue
@@ -477,6 +482,13 @@ class TangentialFamily:
         rss, h0, ac = _grid(d.u, d.y)
         var = float(np.sum((d.y - d.y.mean()) ** 2))
         if not rss < 0.9 * var:
+            # a constant force beside the loop (a sensor's zero, force_offset) larger than the
+            # loop itself: the curve through the origin cannot follow it, one beside a constant
+            # can (a pre-sliding loop of +-1.6 N offset by -1.5 N was refused as "no friction
+            # loop"); the base starts from that curve and the candidates take the constant
+            rss_c, h0_c, ac_c = _grid(d.u, d.y, offset=True)
+            if rss_c < 0.5 * var:
+                return {"h0": h0_c, "ac": ac_c}
             if _grid(d.u, -d.y)[0] < 0.5 * var:
                 raise InputError(
                     f"the loop runs the wrong way: ∮F dx = {loop_area(d.u, d.y):.3g} J over the "

@@ -74,6 +74,7 @@ def block_cycles(
     s: CycleState,
     levels: tuple[float, float] | None = None,
     time_step: tuple[float, float] | None = None,
+    quantities: bool = True,
 ) -> Cycles:
     """Crossings of ``drive`` and the cycles they complete in one block; updates ``s``.
 
@@ -82,13 +83,17 @@ def block_cycles(
     sample. ``levels = (low, high)`` fixes the trigger band (default: :func:`trigger_levels`
     of the drive's range in the block). ``time_step = (t0, dt)``: the recording is sampled
     every ``dt`` from ``t0`` (sample ``i`` at ``t0 + dt * i``, bit for bit
-    ``contactlab._core.fill_time``) and ``t`` is not read.
+    ``contactlab._core.fill_time``) and ``t`` is not read. ``quantities=False``: the
+    crossings alone (the same ones; the per-cycle arrays empty), without the chain of
+    additions of ∮ F dx a sample; a state ``s`` is then cut so to the end.
     """
     if levels is None:
         lo_d, hi_d = (float(drive.min()), float(drive.max())) if drive.size else (0.0, 0.0)
         low, high = trigger_levels(lo_d, hi_d)
     else:
         low, high = float(levels[0]), float(levels[1])
+    if not quantities:
+        return Cycles(crossings=s.tracker.push_crossings(x, F, drive, int(offset), low, high))
     if time_step is None:
         d = s.tracker.push(t, x, F, drive, int(offset), low, high)
     else:

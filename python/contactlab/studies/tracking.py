@@ -195,7 +195,8 @@ def _tangential_window(
         if inv is not None:
             opts["force_sign"] = -1 if inv else 1
     if set(opts) <= _WINDOW_OPTIONS:
-        res = analyze_window(rec, **opts)
+        # (the rows keep no per-cycle mean of the detrended window: not computed)
+        res = analyze_window(rec, period_means=False, **opts)
     else:
         res = analyze_tangential(rec, **{"warn": False, **dict(options)})
     d = res.to_dict()
@@ -469,6 +470,7 @@ def track(
     keep_documents: bool = False,
     threads: int | None = None,
     resample: bool = False,
+    cycles: bool = True,
 ) -> TrackResult:
     """Fitted quantities of a long recording window by window, in bounded memory.
 
@@ -514,6 +516,12 @@ def track(
         Keep each window's whole analysis document (``TrackResult.window_docs``; what
         :func:`contactlab.studies.pooled.pooled_document` and
         :func:`~contactlab.studies.pooled.pooled_normal_document` pool).
+    cycles : bool
+        Compute the per-cycle table (``TrackResult.cycles``: energy, amplitude, offset of
+        every cycle; default). False finds only the crossings the windows are cut at (the
+        same windows and rows): ``cycles`` then holds empty arrays, and ``combined()`` has
+        no ``cycle_energy_*`` (``analyze --json`` of a long file, which pools the window
+        documents, skips the ∮ F dx of every sample so).
 
     Returns
     -------
@@ -542,6 +550,7 @@ def track(
         "callback": callback,
         "keep_documents": keep_documents,
         "resample": resample,
+        "cycles": cycles,
     }
     if executor is None and threads != 0:
         from concurrent.futures import ThreadPoolExecutor
@@ -580,6 +589,7 @@ def _track(
     keep_documents: bool,
     slots: int | None,
     resample: bool = False,
+    cycles: bool = True,
 ) -> TrackResult:
     """:func:`track` on ``executor`` (None: serial); ``slots``: windows in flight at most
     (default two per worker)."""
@@ -628,6 +638,7 @@ def _track(
                 state,
                 levels,
                 cr.time_step,
+                quantities=cycles,
             )
             for k in cyc:
                 cyc[k].append(np.asarray(getattr(got, k), dtype=float))

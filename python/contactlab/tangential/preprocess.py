@@ -422,10 +422,14 @@ def _fold_loop(
     n_points: int | None,
     min_cycles: int,
     scan: _core.WindowScan | None = None,
+    period_means: bool = True,
 ) -> AveragedLoop:
     """:func:`average_loop` of checked ``xa``, ``Fa``, ``ta`` whose reversals are ``rev``;
     ``scan``: :func:`contactlab._core.detrend_pair_scan_into`'s clean scan of them, which
-    stands for the fold's check pass."""
+    stands for the fold's check pass. ``period_means=False``: the per-cycle means of F and x
+    (``scatter.mean_force``, ``scatter.mean_x``) are not computed and are NaN (the fold runs
+    no trapezoid chain: 1.9 ns a sample, 6 % of a streamed window); every other number is
+    the same."""
     n_cyc = max(int(rev.peaks.size) - 1, 0)
     if n_cyc < min_cycles:
         raise InputError(
@@ -450,8 +454,13 @@ def _fold_loop(
     # One call in Rust: phase by interpolating the knots, bin sums overall and per cycle (no
     # per-sample temporaries; the bins are numpy.interp's), the cycles' bounds, loop areas and
     # their noise sensitivities, the period means between the peaks.
-    wf = _core.fold_window(ta, xa, Fa, kt, kp, int(n_points), n_cyc, rev.peak_times, scan)
+    edges = rev.peak_times if period_means else _NO_EDGES
+    wf = _core.fold_window(ta, xa, Fa, kt, kp, int(n_points), n_cyc, edges, scan)
     return _loop_of_fold(wf, rev, int(n_points), start, end)
+
+
+#: no period edges: a fold that computes no period means
+_NO_EDGES = np.empty(0)
 
 
 def _loop_of_fold(
@@ -479,8 +488,8 @@ def _loop_of_fold(
         force_range=wf.force_range,
         energy=wf.energy,
         period=np.diff(rev.peak_times),
-        mean_force=wf.mean_F,
-        mean_x=wf.mean_x,
+        mean_force=_per_cycle(wf.mean_F, rev),
+        mean_x=_per_cycle(wf.mean_x, rev),
         time=0.5 * (rev.peak_times[:-1] + rev.peak_times[1:]),
     )
     phase = (np.arange(n_points) + 0.5) / n_points
@@ -503,6 +512,13 @@ def _loop_of_fold(
         wf.sum_t / count,
         sensitivity=(wf.sens_F, wf.sens_x),
     )
+
+
+def _per_cycle(means: np.ndarray, rev: Reversals) -> np.ndarray:
+    """A fold's period means, or NaN for each cycle where it computed none (no edges)."""
+    if means.size == 0 and rev.peak_times.size > 1:
+        return np.full(rev.peak_times.size - 1, np.nan)
+    return means
 
 
 def negated_loop(loop: AveragedLoop) -> AveragedLoop:

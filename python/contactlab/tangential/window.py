@@ -88,6 +88,7 @@ def analyze_window(
     detrend: bool = True,
     initial: dict[str, float] | None = None,
     delay: float | None = None,
+    period_means: bool = True,
 ) -> TangentialAnalysis:
     """:func:`analyze_tangential` of one window of a streamed recording (``on="averaged"``,
     steady history), with the per-sample work in one pass of Rust kernels.
@@ -105,6 +106,11 @@ def analyze_window(
     and null for what only the search measures. The results are those of
     :func:`analyze_tangential` (warnings are kept in ``.warnings``, not issued; the recorded
     loop area of the orientation is that of the detrended samples).
+
+    ``period_means=False`` leaves the per-cycle mean force and displacement of the detrended
+    window (``scatter.mean_force``, ``scatter.mean_x``) NaN instead of computing them; no
+    other number depends on them (:func:`contactlab.studies.tracking.track`, which keeps only
+    the quantities, saves the fold's trapezoid chain: about 6 % of a window's CPU).
     """
     xa, Fa, ta, source = _inputs(recording, None, None, None)
     _check_options("averaged", "steady", n_points)
@@ -126,7 +132,9 @@ def analyze_window(
     }
     # (a recording's channels are contiguous float64 arrays unless replaced since)
     plain = all(a.dtype == np.float64 and a.ndim == 1 and a.flags.c_contiguous for a in (xa, Fa))
-    pre = window_detrended(xa, Fa, ta, opts, checked=finite_x and finite_f and plain)
+    pre = window_detrended(
+        xa, Fa, ta, opts, checked=finite_x and finite_f and plain, period_means=period_means
+    )
     ori = _fast_orientation(pre.x, pre.F, pre.loop, force_sign)
     res = None
     if ori is not None:
@@ -157,13 +165,16 @@ def window_detrended(
     ta: np.ndarray | None,
     opts: dict[str, Any],
     checked: bool = False,
+    period_means: bool = True,
 ) -> steps.Detrended:
     """:func:`steps.detrend` of the window with one fold instead of two: the linear drifts
     come from the period means between the raw displacement's peaks (what the first fold's
     per-cycle means are: the same Rust kernel on the same edges), so the samples are
     detrended before the only fold. The same numbers as :func:`steps.detrend`. ``checked``:
     x and F (a recording's float64 channels) were scanned finite by :func:`check_channel`,
-    so only t is checked here (else x, t and F are, naming a non-finite sample)."""
+    so only t is checked here (else x, t and F are, naming a non-finite sample).
+    ``period_means=False``: the final loop's per-cycle means of F and x are NaN (not
+    computed; see :func:`analyze_window`)."""
     n_points, rel = opts["n_points"], opts["rel_threshold"]
     min_cycles = opts["min_cycles"]
     if checked:
@@ -209,7 +220,16 @@ def window_detrended(
         return steps.Detrended(x, F, loop, drift)
     pct = _lerp_tails(scan.order_stats, sel[1]) if sel is not None else tail_percentiles(x)
     rev = _reversals(x, tt, pct, rel, None, finite=True)  # (the scan found x finite)
-    loop = _fold_loop(x, F, tt, rev, n_points=n_points, min_cycles=min_cycles, scan=scan)
+    loop = _fold_loop(
+        x,
+        F,
+        tt,
+        rev,
+        n_points=n_points,
+        min_cycles=min_cycles,
+        scan=scan,
+        period_means=period_means,
+    )
     return steps.Detrended(x, F, loop, drift)
 
 

@@ -1,12 +1,14 @@
 //! Binding of `contactlab_core::cycles`: the streaming cycle finder (`cycle_block`), with
 //! and without a time axis.
 
-use contactlab_core::cycles::{cycle_block, cycle_block_sampled, BlockCycles, CycleState};
+use contactlab_core::cycles::{
+    crossings_block, cycle_block, cycle_block_sampled, BlockCycles, CycleState,
+};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 
 use crate::detach_guarded;
-use crate::error::slice;
+use crate::error::{input, slice};
 
 /// Streaming cycle finder: upward crossings of a drive channel and per-cycle loop energy,
 /// amplitude and offset (see `contactlab_core::cycles::cycle_block`).
@@ -51,6 +53,21 @@ impl CycleTracker {
 #[pyclass(module = "contactlab._core")]
 struct CycleStream {
     state: CycleState,
+    /// `push_crossings` has cut this stream: its per-cycle state is stale, so `push` and
+    /// `push_sampled` refuse it
+    crossings_only: bool,
+}
+
+impl CycleStream {
+    fn check_cycles(&self, py: Python<'_>) -> PyResult<()> {
+        if self.crossings_only {
+            return Err(input(
+                py,
+                "this CycleStream was cut by push_crossings (no per-cycle state): start a new one",
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// The cycles a block completed (`CycleTracker.push`, `CycleStream.push`/`push_sampled`):
@@ -88,7 +105,34 @@ impl CycleStream {
     fn new() -> Self {
         Self {
             state: CycleState::default(),
+            crossings_only: false,
         }
+    }
+
+    /// The upward crossings alone of one block (global sample indices; see
+    /// `contactlab_core::cycles::crossings_block`): those `push` finds, without the
+    /// per-cycle quantities. A stream cut by this is cut by it to the end.
+    fn push_crossings<'py>(
+        &mut self,
+        py: Python<'py>,
+        x: PyReadonlyArray1<'py, f64>,
+        f: PyReadonlyArray1<'py, f64>,
+        drive: PyReadonlyArray1<'py, f64>,
+        offset: u64,
+        low: f64,
+        high: f64,
+    ) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let (xs, fs, ds) = (slice(&x, "x")?, slice(&f, "F")?, slice(&drive, "drive")?);
+        self.crossings_only = true;
+        let state = &mut self.state;
+        let c = detach_guarded(py, || {
+            crossings_block(xs, fs, ds, offset, (low, high), state)
+        })?;
+        let idx: Vec<i64> = c
+            .iter()
+            .map(|&i| i64::try_from(i).unwrap_or(i64::MAX))
+            .collect();
+        Ok(idx.into_pyarray(py))
     }
 
     /// One block with its time stamps: a `CycleBlock`.
@@ -105,6 +149,7 @@ impl CycleStream {
     ) -> PyResult<CycleBlock> {
         let (ts, xs, fs) = (slice(&t, "t")?, slice(&x, "x")?, slice(&f, "F")?);
         let ds = slice(&drive, "drive")?;
+        self.check_cycles(py)?;
         let state = &mut self.state;
         let c = detach_guarded(py, || cycle_block(ts, xs, fs, ds, offset, low, high, state))?;
         Ok(cycles_table(py, c))
@@ -125,6 +170,7 @@ impl CycleStream {
         high: f64,
     ) -> PyResult<CycleBlock> {
         let (xs, fs, ds) = (slice(&x, "x")?, slice(&f, "F")?, slice(&drive, "drive")?);
+        self.check_cycles(py)?;
         let state = &mut self.state;
         let c = detach_guarded(py, || {
             cycle_block_sampled(t0, dt, xs, fs, ds, offset, low, high, state)

@@ -46,6 +46,11 @@ impl PeriodMeans {
         let Some(&t0) = t.first() else {
             return;
         };
+        if self.k >= edges.len() {
+            // every edge recorded: the integrals are read nowhere after (no chain to carry;
+            // a fold without edges runs none)
+            return;
+        }
         let below = limit.map_or(f64::INFINITY, |l| t[l]);
         while self.k < edges.len() && edges[self.k] < below {
             let e = edges[self.k];

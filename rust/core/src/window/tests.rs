@@ -395,3 +395,49 @@ fn the_scan_finds_what_the_fold_check_refuses() {
     let ok = run(&t, &x, &f);
     assert!(fold_window_scanned(&t, &x, &f, (&kt, &kp), (8, 1), &[], &ok).is_ok());
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    /// A fold without period edges (what `track`'s windows ask for: they keep no period
+    /// means) gives every other number of the fold with edges bit for bit, and no means;
+    /// the edges' means do not depend on where the integrals stop after the last edge.
+    #[test]
+    fn a_fold_without_edges_is_the_fold_less_its_period_means(
+        seed in 0u64..1000, n_bins in 4usize..40, n_cyc in 1usize..5, start in 0usize..300,
+    ) {
+        let (t, x, f) = signal(4000, seed, 1.0);
+        let period = 2.0 * std::f64::consts::PI / 6.0;
+        let (kt, kp) = knots(&t[start..], period, n_cyc);
+        let edges: Vec<f64> = kt.iter().step_by(2).copied().collect();
+        let with = fold_window(&t, &x, &f, &kt, &kp, n_bins, n_cyc, &edges).unwrap();
+        let without = fold_window(&t, &x, &f, &kt, &kp, n_bins, n_cyc, &[]).unwrap();
+        prop_assert!(without.mean_f.is_empty() && without.mean_x.is_empty());
+        prop_assert_eq!(with.mean_f.len(), n_cyc);
+        let bits = |v: &[f64]| v.iter().map(|a| a.to_bits()).collect::<Vec<_>>();
+        for (a, b) in [
+            (&with.count, &without.count),
+            (&with.sum_x, &without.sum_x),
+            (&with.sum_f, &without.sum_f),
+            (&with.sum_phase, &without.sum_phase),
+            (&with.sum_phase2, &without.sum_phase2),
+            (&with.sum_xx, &without.sum_xx),
+            (&with.sum_t, &without.sum_t),
+            (&with.x_std, &without.x_std),
+            (&with.f_std, &without.f_std),
+            (&with.energy, &without.energy),
+            (&with.sens_f, &without.sens_f),
+            (&with.sens_x, &without.sens_x),
+            (&with.amplitude, &without.amplitude),
+            (&with.force_range, &without.force_range),
+        ] {
+            prop_assert_eq!(bits(a), bits(b));
+        }
+        prop_assert_eq!(&with.first, &without.first);
+        prop_assert_eq!(&with.bounds, &without.bounds);
+        // the period means with edges are those of the separate kernel, bit for bit
+        let pf = period_means(&t, &f, &edges).unwrap();
+        let px = period_means(&t, &x, &edges).unwrap();
+        prop_assert_eq!(bits(&with.mean_f), bits(&pf));
+        prop_assert_eq!(bits(&with.mean_x), bits(&px));
+    }
+}

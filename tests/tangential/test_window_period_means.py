@@ -1,0 +1,39 @@
+"""``analyze_window(period_means=False)`` (what ``track``'s windows run): the per-cycle means
+of the detrended window are left out of the fold, and nothing else changes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from contactlab.io import Recording
+from contactlab.synthetic.tangential import synthetic_recording
+from contactlab.tangential.window import analyze_window
+
+# fresh seeds: drifts on both channels, pre-sliding, an inverted load cell (the negated fold)
+_CASES = {
+    "drifts": dict(h0=25.0, ac=8e4, amplitude=10e-6, n_cycles=9.4, fs=800.0, noise=0.02,
+                   x_noise=0.01, drift=0.3, x_drift=1.5e-7, seed=7311),
+    "pre-sliding": dict(h0=30.0, ac=5e4, amplitude=12e-6, n_cycles=11, fs=1200.0, noise=0.02,
+                        seed=7312),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("case", sorted(_CASES))
+@pytest.mark.parametrize("invert", [False, True])
+def test_a_window_without_period_means_has_every_other_number(case, invert):
+    rec = synthetic_recording(**_CASES[case])
+    if invert:
+        rec = Recording(rec.t, {"x": rec["x"], "F": -rec["F"]}, rec.units, rec.source, {})
+    a = analyze_window(rec)
+    b = analyze_window(rec, period_means=False)
+    assert a.to_dict() == b.to_dict()
+    sa, sb = a.scatter, b.scatter
+    assert sa is not None and sb is not None
+    for k in ("amplitude", "force_range", "energy", "period", "time"):
+        np.testing.assert_array_equal(getattr(sa, k), getattr(sb, k), err_msg=k)
+    # the means were computed with them, and are NaN (one a cycle) without
+    assert np.all(np.isfinite(sa.mean_force)) and np.all(np.isfinite(sa.mean_x))
+    for k in ("mean_force", "mean_x"):
+        v = getattr(sb, k)
+        assert v.shape == (sb.n_cycles,) and np.all(np.isnan(v)), k
