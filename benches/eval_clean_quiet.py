@@ -74,6 +74,6 @@ for case in cases:
     print(json.dumps(r), flush=True)
     out.append(r)
 q = sum(1 for r in out if not r["named"] and not r["flagged"])
-print(
-    f"quiet {q}/{len(out)} named {sum(1 for r in out if r['named'])} flagged {sum(1 for r in out if r['flagged'])}"
-)
+n_named = sum(1 for r in out if r["named"])
+n_flagged = sum(1 for r in out if r["flagged"])
+print(f"quiet {q}/{len(out)} named {n_named} flagged {n_flagged}")
