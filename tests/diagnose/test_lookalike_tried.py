@@ -19,8 +19,8 @@ import numpy as np
 from contactlab.diagnose._family import Prepared
 from contactlab.diagnose._signal import shift
 from contactlab.diagnose.effects.tangential.backlash import play
-from contactlab.diagnose.search import _yield_to_tried, gain_where
-from contactlab.diagnose.select import Verdict
+from contactlab.diagnose.search import _yield_to_tried
+from contactlab.diagnose.select import Verdict, gain_where
 from contactlab.masing import Masing
 
 H0, AC, N_C, CYCLES = 10.0, 1e4, 400, 8

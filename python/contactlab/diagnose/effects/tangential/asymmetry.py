@@ -71,7 +71,7 @@ class Asymmetry(EffectModel):
             return None
         if (rv.reason or "").startswith("implausible"):
             return None
-        from ...search import gain_where
+        from ...select import gain_where
 
         h = np.abs(current.fitted)
         near = h <= NEAR_ZERO * float(np.percentile(h, 99.0))

@@ -123,7 +123,7 @@ class Backlash(EffectModel):
             return None
         if (rv.reason or "").startswith("implausible") or not v.gain - rv.gain < budget:
             return None
-        from ...search import gain_where
+        from ...select import gain_where
 
         speed = np.abs(smoothed_velocity(d))
         fast = speed >= FAST_SHARE * float(np.percentile(speed, 99.0))
