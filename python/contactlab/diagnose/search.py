@@ -634,6 +634,7 @@ class StepwiseSearch:
         verdicts: list[Verdict] = []
         best = None
         accepted: list[tuple[Verdict, Trial]] = []
+        seen_trials: dict[str, tuple[Verdict, Trial]] = {}
         outs = pmap(unless_spent, tried, cost=partial(_fit_cost, self.family))
         for name, out in zip(tried, outs, strict=True):
             if st.used >= limit:
@@ -648,7 +649,12 @@ class StepwiseSearch:
                 best = (v, cand)
             if cand is not None and v.accepted:
                 accepted.append((v, cand))
+            if cand is not None and np.isfinite(v.gain):
+                seen_trials[name] = (v, cand)
         accepted, verdicts = _yield_to_lookalikes(self.family, accepted, verdicts, self.d)
+        accepted, verdicts = _yield_to_tried(
+            self.family, accepted, verdicts, seen_trials, st.current, self.d
+        )
         best = max(accepted, key=lambda vc: vc[0].gain) if accepted else None
         best = _parsimonious(best, accepted)
         if verdicts:
@@ -861,6 +867,44 @@ def _yield_to_lookalikes(
             if hook is None or not hook(cand.full.params, {top[0].name: top[0].gain}, v.gain, d):
                 del refused[v.name]
                 keep.append((v, cand))
+    return keep, [refused.get(v.name, v) if v.accepted else v for v in verdicts]
+
+
+def _yield_to_tried(
+    family: Family,
+    accepted: list[tuple[Verdict, Trial]],
+    verdicts: list[Verdict],
+    tried: dict[str, tuple[Verdict, Trial]],
+    current: Trial,
+    d: Prepared,
+) -> tuple[list[tuple[Verdict, Trial]], list[Verdict]]:
+    """``accepted`` and ``verdicts`` with the candidates refused whose lead over a look-alike
+    *tried* at the same step (cross-validated, accepted or not: ``tried``) is not their own
+    physics: an effect's ``yields_to_tried(p, v, cand, tried, current, d)`` says why, or
+    None.
+
+    :func:`_yield_to_lookalikes` judges an effect against rivals accepted at the same step.
+    A look-alike whose fit feeds on the input's noise (a play passes over the noise's
+    wiggles at each turning point) can pass the input-noise budget where the effect it
+    mimics, which no such noise feeds, falls just short of it: then the rival is not
+    accepted, and the comparison must read where the two differ physically (a play against
+    a delay: away from the turns, a fixed shift against one proportional to the speed)."""
+    from .effects import registry
+
+    try:
+        reg = registry(family.kind)
+    except KeyError:
+        return accepted, verdicts
+    keep, refused = [], {}
+    for v, cand in accepted:
+        hook = getattr(reg.get(v.name), "yields_to_tried", None)
+        why = None if hook is None else hook(cand.full.params, v, cand, tried, current, d)
+        if why:
+            refused[v.name] = dataclasses.replace(v, accepted=False, reason=f"look-alike: {why}")
+        else:
+            keep.append((v, cand))
+    if not refused:
+        return accepted, verdicts
     return keep, [refused.get(v.name, v) if v.accepted else v for v in verdicts]
 
 

@@ -659,3 +659,18 @@ def judge(
     else:
         reason = "accepted"
     return Verdict(name, cand.heldout_rms, gain, t, dbic, reason == "accepted", reason)
+
+
+def gain_where(d: Prepared, current: Trial, cand: Trial, where: np.ndarray) -> float:
+    """The held-out gain of ``cand`` over ``current`` on the samples ``where`` only, per
+    held-out sample of the whole record (output units squared: compare two candidates'
+    on one record): ``Σ w (r² - (r - Δ)²)`` over the samples held out by both and in
+    ``where``, ``r`` the current model's held-out residual, ``Δ`` the candidate's held-out
+    prediction minus the current one, ``w`` the likelihood weights
+    (:func:`sample_weight`)."""
+    r = d.y - current.prediction
+    delta = cand.prediction - current.prediction
+    held = current.heldout & cand.heldout
+    n = max(int(np.count_nonzero(held)), 1)
+    g = sample_weight(d) * (2.0 * r * delta - delta * delta)
+    return float(np.sum(g[held & where])) / n

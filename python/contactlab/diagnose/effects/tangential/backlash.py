@@ -8,7 +8,13 @@ import numpy as np
 
 from ..._family import ParamSpec
 from .._base import EffectModel, Plausibility, register
-from ._common import actual_turns, amplitude
+from ._common import actual_turns, amplitude, smoothed_velocity
+
+#: the samples away from the turns (:meth:`Backlash.yields_to_tried`): the speed at least
+#: this share of the record's peak speed (the middle two thirds of each stroke in time on a
+#: sine, |x| within 0.87 A), where a play's dead band has closed and the noise's wiggles at
+#: the turning points are not
+FAST_SHARE = 0.5
 
 
 def play(x: np.ndarray, b: float, rev: np.ndarray) -> np.ndarray:
@@ -87,6 +93,50 @@ class Backlash(EffectModel):
             f"{own - gains[rival]:.3g} σ² of held-out gain, less than the {budget:.3g} σ² the "
             "input's noise alone can give a play that passes over its wiggles at the turns: "
             f"{rival} draws the same dead band"
+        )
+
+    def yields_to_tried(self, p, v, cand, tried, current, d):
+        """Why a play is not named when a channel delay tried at the same step (accepted or
+        not) falls short of its held-out gain by less than the input-noise budget
+        (``d.extra["input_noise_budget"]``) and, away from the turns (speed at least
+        :data:`FAST_SHARE` of the peak), predicts the held-out cycles at least as well as
+        the play; or None.
+
+        The two differ in where they act (docs/effects.md): a play is a dead band of fixed
+        width at each reversal, after which the branch runs shifted by the constant ``b``;
+        a delay shifts both branches in time by ``τ``, in ``x`` by ``ẋτ``, largest where
+        the speed is. At the turns both thin the loop alike, and there a play also passes
+        over the input noise's wiggles, which gives it up to the budget on a noisy ``x``:
+        so the delay, which the noise does not feed, may miss the budget where the play
+        passes it (rig through the whole sensor chain, x noise 1.6-2 % of the range,
+        τ 0.57-0.73 ms at 22-39 Hz: play 0.64-0.74 σ², delay 0.18-0.56 σ², floors
+        0.55-0.62 σ²; ``benches/eval_lookalike.py`` tuning seeds 41000-42005). Away from
+        the turns the noise gives neither anything; where the delay's speed-proportional
+        shift fits there as well as the play's constant one, the play's lead is the
+        noise's."""
+        rival = tried.get("channel_delay")
+        if rival is None:
+            return None
+        rv, rc = rival
+        budget = float(d.extra.get("input_noise_budget", 0.0) or 0.0)
+        if not (budget > 0 and np.isfinite(rv.gain) and rv.gain > 0):
+            return None
+        if (rv.reason or "").startswith("implausible") or not v.gain - rv.gain < budget:
+            return None
+        from ...select import gain_where
+
+        speed = np.abs(smoothed_velocity(d))
+        fast = speed >= FAST_SHARE * float(np.percentile(speed, 99.0))
+        own, other = gain_where(d, current, cand, fast), gain_where(d, current, rc, fast)
+        if not (other > 0 and other >= own):
+            return None
+        return (
+            f"b = {p['b']:.3g} m beats channel_delay by {v.gain - rv.gain:.3g} σ² of held-out "
+            f"gain, less than the {budget:.3g} σ² the input's noise can give a play at the "
+            "turns; away from them (speed above half its peak), where a play is a fixed "
+            "shift and a delay one proportional to the speed, the delay predicts the held-out "
+            f"cycles at least as well ({other / own if own > 0 else np.inf:.2f}× the play's "
+            "gain there): the dead band is not the data's"
         )
 
     def apply(self, xm, p, ctx):
