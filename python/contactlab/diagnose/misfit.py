@@ -75,7 +75,6 @@ __all__ = [
     "detectable_rms",
     "eiv_bias",
     "null_quantile",
-    "phase_statistic",
     "unexplained_structure",
 ]
 
@@ -677,26 +676,6 @@ def unexplained_structure(
             "falling_t": [_f(v) for v in prof_t[bins:]],
         },
     )  # fmt: skip
-
-
-def phase_statistic(
-    d: Prepared, residual: np.ndarray, sigma: float, *, bins: int = BINS, min_weight: float = 0.0
-) -> float:
-    """The phase bins' ``T`` of :func:`unexplained_structure` alone (same bins, same
-    effect-size floor, no tolerance), without its threshold and stated power: what the
-    simulated null (:mod:`contactlab.diagnose.misfit_null`) computes on every copy. NaN
-    where :func:`unexplained_structure` returns None."""
-    e = np.asarray(residual, float)
-    w = d.extra.get("weight")
-    w = np.ones(e.size) if w is None else np.asarray(w, float)
-    cb = _cycle_bins(d, e, w, bins)
-    if cb is None:
-        return math.nan
-    floor = EFFECT_FLOOR * sigma if np.isfinite(sigma) and sigma > 0 else 0.0
-    full, _, t_b, _, _, _ = _bin_t(cb, bins, min_weight, None, floor)
-    if not np.any(full):
-        return math.nan
-    return float(np.sum(t_b * t_b))
 
 
 @dataclass
