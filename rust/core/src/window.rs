@@ -81,9 +81,8 @@ impl Bin {
     /// the bin's moments; returns the means of x and F (the cycle's ranges).
     #[inline(always)]
     fn add_cell(&mut self, n: f64, cx: f64, cf: f64, cp: f64) -> (f64, f64) {
-        // the divisions of fold_spread's cell means (the same numbers), as one vector of
-        // four (correctly rounded either way: one packed division instead of three)
-        let [mx, mf, mp, _] = [cx, cf, cp, n].map(|v| v / n);
+        // the divisions of fold_spread's cell means (the same numbers)
+        let (mx, mf, mp) = (cx / n, cf / n, cp / n);
         if self.k == 0.0 {
             self.shift = [mx, mf, mp];
         }
@@ -133,7 +132,6 @@ struct Neumaier {
 }
 
 impl Neumaier {
-    #[inline(always)]
     fn add(&mut self, term: f64) {
         let t = self.sum + term;
         // (sum - t) + term when |sum| >= |term|, else (term - t) + sum: as selects, not a
@@ -163,7 +161,6 @@ const LANES: usize = 4;
 /// sequential sum was one chain of dependent additions a sample).
 // Index arithmetic: m >= 3, so m - 1 and m - 2 are samples of the cycle.
 #[allow(clippy::arithmetic_side_effects)]
-#[inline(always)]
 fn cycle_area(x: &[f64], f: &[f64], ux: f64, uf: f64, fm: f64, scale: f64) -> (f64, f64, f64) {
     let m = x.len().min(f.len());
     if m < 3 {
@@ -523,6 +520,9 @@ pub fn fold_window_scanned(
 
 /// [`fold_window`], its check pass over the samples left out where `scanned` gives what it
 /// finds (`[largest |x|, largest |F|, centre of F]`).
+// Index arithmetic: as fold_window's.
+#[allow(clippy::arithmetic_side_effects)]
+#[inline(never)]
 fn fold_window_with(
     t: &[f64],
     x: &[f64],
@@ -532,30 +532,9 @@ fn fold_window_with(
     edges: &[f64],
     scanned: Option<[f64; 3]>,
 ) -> Result<WindowFold, CoreError> {
-    fold_window_at(
-        crate::simd::level(),
-        (t, x, f),
-        (kt, kp),
-        (n_bins, n_cycles),
-        edges,
-        scanned,
-    )
-}
-
-/// [`fold_window_with`] with its pass compiled for `level` (the same numbers at every
-/// level: the pass is plain Rust in one order of operations; the tests compare the levels).
-#[doc(hidden)]
-pub fn fold_window_at(
-    level: crate::simd::Level,
-    (t, x, f): (&[f64], &[f64], &[f64]),
-    (kt, kp): (&[f64], &[f64]),
-    (n_bins, n_cycles): (usize, usize),
-    edges: &[f64],
-    scanned: Option<[f64; 3]>,
-) -> Result<WindowFold, CoreError> {
     check_sizes(n_bins, n_cycles)?;
     check_knots(kt, kp, n_cycles)?;
-    let scales = match scanned {
+    let [sx, sf, fm] = match scanned {
         Some(v) => {
             check_same_len("t", t.len(), "x", x.len())?;
             check_same_len("t", t.len(), "F", f.len())?;
@@ -565,224 +544,6 @@ pub fn fold_window_at(
         }
         None => check_samples(t, x, f, edges)?,
     };
-    crate::simd::run(
-        level,
-        FoldPass {
-            txf: (t, x, f),
-            knots: (kt, kp),
-            sizes: (n_bins, n_cycles),
-            edges,
-            scales,
-        },
-    )
-}
-
-/// [`fold_window_at`]'s pass over checked samples as a [`crate::simd::Kernel`].
-struct FoldPass<'a> {
-    txf: (&'a [f64], &'a [f64], &'a [f64]),
-    knots: (&'a [f64], &'a [f64]),
-    sizes: (usize, usize),
-    edges: &'a [f64],
-    scales: [f64; 3],
-}
-
-impl crate::simd::Kernel for FoldPass<'_> {
-    type Output = Result<WindowFold, CoreError>;
-
-    #[inline(always)]
-    fn run_at(self) -> Self::Output {
-        fold_pass(self)
-    }
-}
-
-/// Samples a block of [`fold_pass`] (its phases, cells and fractions on the stack).
-const FOLD_BLOCK: usize = 256;
-
-/// The fold's pass over checked samples (see [`fold_window`]), by blocks of
-/// [`FOLD_BLOCK`] samples in two steps, with the numbers of the sample-by-sample pass
-/// (`fold_pass_reference` in the tests) bit for bit:
-///
-/// 1. each sample's phase, cell (cycle · n_bins + bin) and phase within its cycle, in a
-///    loop without branches a knot segment at a time: the phase is the running maximum of
-///    the segment's line (`slope (t - k_lo) + p_lo`, monotone inside a segment, so the
-///    running maximum is the maximum with the phase before the segment), the cycle its
-///    floor, the bin `min(floor(frac · n_bins), n_bins - 1)` (what `fold_phase` and the
-///    sample-by-sample pass's interval tests give);
-/// 2. the cells' starts (where the cell changes), then each cell's run of samples added
-///    to its bin's and its own sums four samples at a time, the samples past the run as
-///    `-0.0` (`v + -0.0 = v` exactly: the same sums in the same order), so a cell's end is
-///    no mispredicted branch (a cell was 2-3 samples: a branch on its end every few
-///    samples, its outcome the noise's).
-// Index arithmetic: q < FOLD_BLOCK within a block, abs = i + q < end; b < n_bins and
-// c < n_cycles (checked against the allocations); j + 1 < the knots' length (t < kt[last]).
-#[allow(clippy::arithmetic_side_effects)]
-#[inline(always)]
-fn fold_pass(p: FoldPass<'_>) -> Result<WindowFold, CoreError> {
-    let FoldPass {
-        txf: (t, x, f),
-        knots: (kt, kp),
-        sizes: (n_bins, n_cycles),
-        edges,
-        scales: [sx, sf, fm],
-    } = p;
-    let (nb, nc) = (n_bins, n_cycles);
-    let mut w = WindowFold::empty(nb, nc);
-    let mut bins = vec![Bin::default(); nb];
-    let mut ranges = vec![NO_RANGE; nc];
-    let (ux, uf) = (
-        if sx > 0.0 { 1.0 / sx } else { 0.0 },
-        if sf > 0.0 { 1.0 / sf } else { 0.0 },
-    );
-    let area_scale = sx * sf;
-    let (t0, t1) = (kt[0], kt[kt.len() - 1]);
-    let start = t.partition_point(|&v| v < t0);
-    let end = t.partition_point(|&v| v < t1);
-    let (t_all, x_all, f_all) = (t, x, f);
-    let (t, x, f) = (&t[..end], &x[..end], &f[..end]);
-    let mut j = 0_usize;
-    let mut seg = Segment::of(kt, kp, 0);
-    let mut last_ph = f64::NEG_INFINITY;
-    let nbf = nb as f64;
-    let (nb64, top) = (nb as i64, (nb - 1) as i64);
-    // the open cell: its key (NONE: none yet), first sample, running sums
-    const NONE: i64 = -1;
-    let mut open_key = NONE;
-    let (mut cc, mut cb) = (0_usize, 0_usize);
-    let mut cell_start = start;
-    let mut cell = Cell::default();
-    let mut cyc = usize::MAX;
-    let mut a0 = start;
-    let mut a1 = end;
-    let mut area_cycle: Option<usize> = None;
-    let mut pm = PeriodMeans::new(edges.len());
-    let mut key = [0_i64; FOLD_BLOCK];
-    let mut cyc_of = [0_i64; FOLD_BLOCK];
-    let mut bin_of = [0_i64; FOLD_BLOCK];
-    let mut fr = [0.0_f64; FOLD_BLOCK];
-    let mut starts = [0_usize; FOLD_BLOCK + 1];
-    let mut i = start;
-    'blocks: while i < end {
-        let stop = (i + FOLD_BLOCK).min(end);
-        let len = stop - i;
-        // 1. phases, cells and fractions, a knot segment at a time
-        let mut k = i;
-        while k < stop {
-            if t[k] >= seg.k_hi {
-                while kt[j + 1] <= t[k] {
-                    j += 1;
-                }
-                seg = Segment::of(kt, kp, j);
-            }
-            let e = k + t[k..stop].partition_point(|&v| v < seg.k_hi);
-            let lo = last_ph;
-            let mut ph = lo;
-            for (q, &ti) in (k - i..e - i).zip(&t[k..e]) {
-                let raw = seg.phase(ti);
-                // never back (rounding at a knot): the running maximum
-                ph = if raw < lo { lo } else { raw };
-                // ph >= kp[0] >= 0 and below 2^33: the conversions are floors
-                let c = ph as i64;
-                let frac = ph - c as f64;
-                let b = ((frac * nbf) as i64).min(top);
-                key[q] = c * nb64 + b;
-                cyc_of[q] = c;
-                bin_of[q] = b;
-                fr[q] = frac;
-            }
-            last_ph = ph;
-            k = e;
-        }
-        // 2. the cells' starts in the block (no branch a sample)
-        let mut n_starts = 0_usize;
-        let mut prev = open_key;
-        for (q, &kq) in key[..len].iter().enumerate() {
-            starts[n_starts] = q;
-            n_starts += usize::from(kq != prev);
-            prev = kq;
-        }
-        starts[n_starts] = len;
-        // the runs: [0, starts[0]) continues the open cell, each start opens one
-        let blk = (&t[i..stop], &x[i..stop], &f[i..stop], &fr[..len]);
-        let mut q = 0_usize;
-        for s in 0..=n_starts {
-            let run_end = starts[s];
-            if q < run_end {
-                cell.add_run(blk, q, run_end);
-            }
-            if s == n_starts {
-                break;
-            }
-            let abs = i + run_end;
-            if open_key != NONE {
-                let n = (abs - cell_start) as i64 as f64;
-                cell.flush(&mut bins[cb], &mut ranges[cc], n);
-            }
-            let kq = key[run_end];
-            let (c, b) = (cyc_of[run_end] as usize, bin_of[run_end] as usize);
-            if c != cyc {
-                if c >= nc {
-                    // past the last cycle, as every later sample
-                    open_key = NONE;
-                    a1 = abs;
-                    break 'blocks;
-                }
-                if w.first[c] < 0 {
-                    w.first[c] = i64::try_from(abs).unwrap_or(i64::MAX);
-                }
-                if let Some(ac) = area_cycle {
-                    (w.energy[ac], w.sens_f[ac], w.sens_x[ac]) =
-                        cycle_area(&x[a0..abs], &f[a0..abs], ux, uf, fm, area_scale);
-                    // the period means' integrals over the same samples, still in cache
-                    pm.advance((t_all, f_all, x_all), edges, Some(abs - 1));
-                }
-                area_cycle = Some(c);
-                a0 = abs;
-                cyc = c;
-            }
-            open_key = kq;
-            (cc, cb) = (c, b);
-            cell = Cell {
-                cur: bins[b].sums,
-                ..Cell::default()
-            };
-            cell_start = abs;
-            q = run_end;
-        }
-        i = stop;
-    }
-    if open_key != NONE {
-        let n = (a1 - cell_start) as i64 as f64;
-        cell.flush(&mut bins[cb], &mut ranges[cc], n);
-    }
-    if let Some(ac) = area_cycle {
-        (w.energy[ac], w.sens_f[ac], w.sens_x[ac]) =
-            cycle_area(&x[a0..a1], &f[a0..a1], ux, uf, fm, area_scale);
-    }
-    finish(
-        &mut w,
-        &bins,
-        &ranges,
-        (t_all, f_all, x_all, edges),
-        end,
-        pm,
-    )?;
-    Ok(w)
-}
-
-/// The fold's pass as it was before the blocked pass ([`fold_pass`]): one sample at a
-/// time, each cell's run of samples ended by a branch. The tests' reference: the blocked
-/// pass gives its numbers bit for bit.
-#[cfg(test)]
-// Index arithmetic: as fold_window's.
-#[allow(clippy::arithmetic_side_effects)]
-fn fold_pass_reference(p: FoldPass<'_>) -> Result<WindowFold, CoreError> {
-    let FoldPass {
-        txf: (t, x, f),
-        knots: (kt, kp),
-        sizes: (n_bins, n_cycles),
-        edges,
-        scales: [sx, sf, fm],
-    } = p;
     let (nb, nc) = (n_bins, n_cycles);
     let mut w = WindowFold::empty(nb, nc);
     let mut bins = vec![Bin::default(); nb];
@@ -960,26 +721,6 @@ fn fold_pass_reference(p: FoldPass<'_>) -> Result<WindowFold, CoreError> {
     Ok(w)
 }
 
-/// [`fold_window`] with the sample-by-sample pass (the tests' reference).
-#[cfg(test)]
-fn fold_window_reference(
-    (t, x, f): (&[f64], &[f64], &[f64]),
-    (kt, kp): (&[f64], &[f64]),
-    (n_bins, n_cycles): (usize, usize),
-    edges: &[f64],
-) -> Result<WindowFold, CoreError> {
-    check_sizes(n_bins, n_cycles)?;
-    check_knots(kt, kp, n_cycles)?;
-    let scales = check_samples(t, x, f, edges)?;
-    fold_pass_reference(FoldPass {
-        txf: (t, x, f),
-        knots: (kt, kp),
-        sizes: (n_bins, n_cycles),
-        edges,
-        scales,
-    })
-}
-
 /// [`fold_window`]'s last steps after the pass over the samples: the bin sums into `w`, the
 /// loop-area check, the period means, the spread, the per-cycle ranges and the bounds.
 // Index arithmetic: b < n_bins, the bins' and sums' length.
@@ -1045,9 +786,7 @@ fn finish(
 mod cell;
 mod detrend;
 mod period;
-#[cfg(test)]
-use cell::next_bin;
-use cell::{Cell, Segment, NO_RANGE};
+use cell::{next_bin, Cell, Segment, NO_RANGE};
 pub use detrend::{detrend_pair, detrend_pair_into, detrend_pair_scan_into, WindowScan};
 use period::PeriodMeans;
 

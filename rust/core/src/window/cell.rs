@@ -73,52 +73,12 @@ impl Cell {
         self.cp += frac;
     }
 
-    /// Samples `a..b` of a block (`t`, `x`, `F`, phase within the cycle) into the cell, in
-    /// order: four at a time, the samples past `b` as `-0.0` (the identity of addition, bit
-    /// for bit: `v + -0.0 = v` for every `v`, `-0.0` included), so the run's length makes
-    /// no branch below four samples. The sums and their order are [`Cell::add`]'s, sample
-    /// after sample.
-    // Index arithmetic: a < b <= the block's length; indices clamped below it.
-    #[allow(clippy::arithmetic_side_effects)]
-    #[inline(always)]
-    pub(super) fn add_run(
-        &mut self,
-        (t, x, f, fr): (&[f64], &[f64], &[f64], &[f64]),
-        mut a: usize,
-        b: usize,
-    ) {
-        while b - a > 4 {
-            for q in a..a + 4 {
-                self.add(x[q], f[q], fr[q], t[q]);
-            }
-            a += 4;
-        }
-        let last = b - 1;
-        for k in 0..4 {
-            let q = (a + k).min(last);
-            let on = a + k < b;
-            let z = -0.0_f64;
-            let (xi, fi, pi, ti) = (x[q], f[q], fr[q], t[q]);
-            let sel = |v: f64| if on { v } else { z };
-            self.cur[0] += sel(xi);
-            self.cur[1] += sel(fi);
-            self.cur[2] += sel(pi);
-            self.cur[3] += sel(pi * pi);
-            self.cur[4] += sel(xi * xi);
-            self.cur[5] += sel(ti);
-            self.cx += sel(xi);
-            self.cf += sel(fi);
-            self.cp += sel(pi);
-        }
-    }
-
     /// The samples from `i` (below `stop`) that follow in the same knot segment `seg`, cycle
     /// (from `c_lo`) and bin (`g < g_hi`, `g = frac · n_bins`): added; returns the first
     /// sample not taken and its phase when computed here (else -1: `stop` or the segment's
     /// end reached). The phase of the last sample taken is [`Segment::phase`] of it (the same
     /// expression, so the same number).
     // Index arithmetic: i < stop <= the slices' length.
-    #[cfg(test)]
     #[allow(clippy::arithmetic_side_effects)]
     #[inline(always)]
     pub(super) fn run(
@@ -150,7 +110,6 @@ impl Cell {
 /// The bin of `g = frac · n_bins` when the open bin `[b_hi - 1, b_hi)` (number `cb`) does
 /// not hold it: `(b, b_lo, b_hi)`, the last bin open above.
 // Index arithmetic: cb + 2 < nb checked; nb >= 1.
-#[cfg(test)]
 #[allow(clippy::arithmetic_side_effects)]
 #[inline(always)]
 pub(super) fn next_bin(g: f64, b_hi: f64, cb: usize, nb: usize) -> (usize, f64, f64) {
