@@ -893,7 +893,9 @@ mod cell;
 mod detrend;
 mod period;
 use cell::{next_bin, Cell, Segment, NO_RANGE};
-pub use detrend::{detrend_pair, detrend_pair_into, detrend_pair_scan_into, WindowScan};
+pub use detrend::{
+    detrend_pair, detrend_pair_into, detrend_pair_scan_at, detrend_pair_scan_into, WindowScan,
+};
 use period::PeriodMeans;
 
 #[cfg(test)]

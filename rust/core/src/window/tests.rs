@@ -646,3 +646,37 @@ proptest! {
         prop_assert_eq!(a.2.to_bits(), b.2.to_bits());
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    /// The detrending scan compiled for each SIMD level this CPU has gives the generic
+    /// build's samples, order statistics and scan numbers bit for bit, a non-finite or
+    /// non-increasing sample included (then `clean` is false at every level).
+    #[test]
+    fn every_simd_level_scans_as_the_generic_build(
+        seed in 0u64..1000, n in prop::sample::select(vec![2usize, 7, 40, 5000, 70_001]),
+        s_f in -1e3f64..1e3, s_x in -1e-3f64..1e-3, bad in 0u8..4,
+    ) {
+        let (mut t, mut x, f) = signal(n, seed, 1e-3);
+        let k = (seed as usize) % n;
+        match bad {
+            1 => x[k] = f64::NAN,
+            2 => t[k] = f64::INFINITY,
+            3 if k > 0 => t[k] = t[k - 1],
+            _ => {}
+        }
+        let tm = t[n / 2];
+        let ranks = if n > 1000 { tail_ranks(n) } else { Vec::new() };
+        let (mut gf, mut gx) = (vec![0.0; n], vec![0.0; n]);
+        let g = detrend_pair_scan_at(
+            crate::simd::Level::Generic, &t, tm, (&f, s_f), (&x, s_x), (&mut gf, &mut gx), &ranks,
+        );
+        for l in crate::simd::Level::ALL.into_iter().filter(|l| l.supported()) {
+            let (mut of, mut ox) = (vec![0.0; n], vec![0.0; n]);
+            let s = detrend_pair_scan_at(l, &t, tm, (&f, s_f), (&x, s_x), (&mut of, &mut ox), &ranks);
+            prop_assert_eq!(format!("{s:?}"), format!("{g:?}"), "level {}", l.name());
+            prop_assert!(of.iter().zip(&gf).all(|(a, b)| a.to_bits() == b.to_bits()));
+            prop_assert!(ox.iter().zip(&gx).all(|(a, b)| a.to_bits() == b.to_bits()));
+        }
+    }
+}
