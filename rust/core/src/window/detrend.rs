@@ -136,7 +136,7 @@ pub fn detrend_pair_scan_at(
     let t_ok =
         n >= 2 && t[0].is_finite() && zt.iter().all(|&v| v == 0.0) && dmin.iter().all(|&d| d > 0.0);
     let ok = [z.iter().all(|&v| v == 0.0); 1];
-    let big = |m: [f64; 4]| m.iter().fold(0.0_f64, |a, &b| if b > a { b } else { a });
+    let big = |m: [f64; W]| m.iter().fold(0.0_f64, |a, &b| if b > a { b } else { a });
     let (sx, sf) = (big(mx), big(mf));
     let sum = (sum_f[0] + sum_f[1]) + (sum_f[2] + sum_f[3]);
     let clean = t_ok && ok[0];
@@ -156,7 +156,10 @@ pub fn detrend_pair_scan_at(
 
 /// The lanes [`ScanPass`] hands back: the largest `|x|`, `|F|`, the sum of F, `Σ (x, F)·0`,
 /// `Σ t·0`, the smallest step of t.
-type ScanLanes = ([f64; 4], [f64; 4], [f64; 4], [f64; 4], [f64; 4], [f64; 4]);
+type ScanLanes = ([f64; W], [f64; W], [f64; 4], [f64; W], [f64; W], [f64; W]);
+
+/// Lanes of [`ScanPass`]'s order-free scans (maxima, minimum, zero tests).
+const W: usize = 8;
 
 /// [`detrend_pair_scan_at`]'s pass over the samples as a [`crate::simd::Kernel`] (compiled
 /// for each level: in the baseline build the detrending and the scans ran two lanes wide,
@@ -172,7 +175,7 @@ struct ScanPass<'a> {
 impl crate::simd::Kernel for ScanPass<'_> {
     type Output = ScanLanes;
 
-    // Index arithmetic: a + k < b <= n inside the blocks; k < 4.
+    // Index arithmetic: a + k < b <= n inside the blocks; l < 8.
     #[allow(clippy::arithmetic_side_effects)]
     #[inline(always)]
     fn run_at(self) -> ScanLanes {
@@ -184,10 +187,10 @@ impl crate::simd::Kernel for ScanPass<'_> {
             mut gather,
         } = self;
         let n = t.len();
-        let (mut mx, mut mf, mut sum_f) = ([0.0_f64; 4], [0.0_f64; 4], [0.0_f64; 4]);
+        let (mut mx, mut mf, mut sum_f) = ([0.0_f64; W], [0.0_f64; W], [0.0_f64; 4]);
         // Σ v·0 of x, F and t: ±0 while every value is finite, NaN from an inf or a NaN on (a
         // vectorised finiteness check, where a lane of booleans was not); the smallest step of t
-        let (mut z, mut zt, mut dmin) = ([0.0_f64; 4], [0.0_f64; 4], [f64::INFINITY; 4]);
+        let (mut z, mut zt, mut dmin) = ([0.0_f64; W], [0.0_f64; W], [f64::INFINITY; W]);
         let mut a = 0_usize;
         while a < n {
             // blocks that stay in L2 for the passes over what was just written, long enough for
@@ -201,13 +204,14 @@ impl crate::simd::Kernel for ScanPass<'_> {
             for ((o, &ti), &vi) in oxb.iter_mut().zip(tb).zip(xb) {
                 *o = vi + (ti - tm) * nx;
             }
-            // the steps of t from the sample before the block (none before the first)
+            // the steps of t from the sample before the block (none before the first); eight
+            // lanes: a minimum and a zero test do not depend on the order
             let tp = &t[a.saturating_sub(1)..b];
             let (t0, t1) = (&tp[..tp.len() - 1], &tp[1..]);
-            let mut c0 = t0.chunks_exact(4);
-            let mut c1 = t1.chunks_exact(4);
+            let mut c0 = t0.chunks_exact(W);
+            let mut c1 = t1.chunks_exact(W);
             for (p, q) in (&mut c0).zip(&mut c1) {
-                for l in 0..4 {
+                for l in 0..W {
                     let d = q[l] - p[l];
                     dmin[l] = if d < dmin[l] { d } else { dmin[l] };
                     zt[l] += q[l] * 0.0;
@@ -218,23 +222,30 @@ impl crate::simd::Kernel for ScanPass<'_> {
                 dmin[l] = if d < dmin[l] { d } else { dmin[l] };
                 zt[l] += q * 0.0;
             }
-            // finite_max_abs's lanes (sample i in lane i mod 4; blocks start at multiples of 4)
-            let mut cx = oxb.chunks_exact(4);
-            let mut cf = ofb.chunks_exact(4);
+            // finite_max_abs's numbers: the maxima and the zero test in eight lanes (order
+            // free), the sum of F in its four lanes (sample i in lane i mod 4, in order:
+            // blocks start at multiples of 8)
+            let mut cx = oxb.chunks_exact(W);
+            let mut cf = ofb.chunks_exact(W);
             for (qx, qf) in (&mut cx).zip(&mut cf) {
-                for l in 0..4 {
+                for l in 0..W {
                     let (ax, af) = (qx[l].abs(), qf[l].abs());
                     mx[l] = if ax > mx[l] { ax } else { mx[l] };
                     mf[l] = if af > mf[l] { af } else { mf[l] };
-                    sum_f[l] += qf[l];
                     z[l] += qx[l] * 0.0 + qf[l] * 0.0;
+                }
+                for l in 0..4 {
+                    sum_f[l] += qf[l];
+                }
+                for l in 0..4 {
+                    sum_f[l] += qf[l + 4];
                 }
             }
             for (l, (&vx, &vf)) in cx.remainder().iter().zip(cf.remainder()).enumerate() {
                 let (ax, af) = (vx.abs(), vf.abs());
                 mx[l] = if ax > mx[l] { ax } else { mx[l] };
                 mf[l] = if af > mf[l] { af } else { mf[l] };
-                sum_f[l] += vf;
+                sum_f[l % 4] += vf;
                 z[l] += vx * 0.0 + vf * 0.0;
             }
             if let Some(g) = gather.as_mut() {
