@@ -21,6 +21,7 @@ Perturbations of the inputs (for the covariance terms) are explicit keyword argu
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -53,6 +54,16 @@ from .model import (
 from .preprocess import AveragedLoop, Reversals, average_loop, find_reversals, monotone_path
 from .turns import VirginTurns, turning_point_prior, virgin_nodes
 from .uncertainty import path_slope, trend, x_noise_var
+
+
+@functools.lru_cache(maxsize=16)
+def _branch_signs(n: int) -> np.ndarray:
+    """``+1`` on the descending bins ``0:n/2`` of an averaged loop, ``-1`` on the ascending
+    ones (read-only; one array per bin count: the fit's model and derivatives are evaluated
+    a few dozen times a window on the same bins)."""
+    sg = np.where(np.arange(n) < n // 2, 1.0, -1.0)
+    sg.flags.writeable = False
+    return sg
 
 
 def model_of(v: dict[str, float]) -> Masing:
@@ -423,13 +434,13 @@ class Residuals:
             raise InputError("analytic derivatives are those of an averaged fit")
         k0, ac, x0, A = v["k0"], v["ac"], v["x0"], v["amplitude"]
         xp = d.xpath
-        n, h = xp.size, xp.size // 2
+        n = xp.size
         raw = xp - x0
         u = np.clip(raw, -A, A)
         inside = (raw > -A) & (raw < A)
         du_dx0 = np.where(inside, -1.0, 0.0)
         du_dA = np.where(raw >= A, 1.0, np.where(raw <= -A, -1.0, 0.0))
-        sg = np.where(np.arange(n) < h, 1.0, -1.0)  # descending, then ascending bins
+        sg = _branch_signs(n)  # descending, then ascending bins
         s = 0.5 * (A - sg * u)
         ds_dA = 0.5 * (1.0 - sg * du_dA)
         ds_dx0 = -0.5 * sg * du_dx0
@@ -539,7 +550,7 @@ def _beyond_turns(
     """
     k0, ac, x0, A = v["k0"], v["ac"], v["x0"], v["amplitude"]
     n = xp.size
-    sg = np.where(np.arange(n) < n // 2, 1.0, -1.0)
+    sg = _branch_signs(n)
     s = 0.5 * (A - sg * (xp - x0))
     far = s > A  # beyond the turn that ends the branch
     sc = np.clip(s, 0.0, A)
