@@ -92,6 +92,10 @@ def as_1d(x: Any, name: str, *, allow_empty: bool = False, finite: bool = True) 
 
 def scalar_or_array(x: Any, name: str) -> tuple[np.ndarray, bool]:
     """Flatten a scalar or array for a vectorised kernel; tell whether it was a scalar."""
+    if type(x) is float:  # (what the conversion below makes of it: one sample, and False)
+        if not math.isfinite(x):
+            raise InputError(f"{name}[0] is not finite ({x})")
+        return np.array([x]), False
     a = _float_array(x, name)
     flat = np.ascontiguousarray(a.reshape(-1))
     bad = ~np.isfinite(flat)

@@ -552,6 +552,9 @@ def _beyond_turns(
     n = xp.size
     sg = _branch_signs(n)
     s = 0.5 * (A - sg * (xp - x0))
+    if s.min() >= 0.0 and s.max() <= A:  # no bin beyond a turn (the usual case: two
+        # reductions instead of the clip, difference and test below; NaN goes on there)
+        return None if derivatives else np.zeros(n)
     far = s > A  # beyond the turn that ends the branch
     sc = np.clip(s, 0.0, A)
     dd = s - sc
