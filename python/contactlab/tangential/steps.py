@@ -24,7 +24,7 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -362,6 +362,10 @@ class PriorRows:
     scale: float
 
 
+#: evaluations of an averaged model :meth:`Residuals.predict` keeps
+_KEPT_MODELS = 4
+
+
 @dataclass(frozen=True)
 class Residuals:
     """Weighted residuals ``(model - data) · w`` of a parameter set, plus the prior rows.
@@ -374,6 +378,12 @@ class Residuals:
     data: FitData
     w: np.ndarray
     prior: PriorRows | None = None
+    #: the averaged model's last few evaluations at unperturbed inputs, by parameter values
+    #: (:meth:`predict`); shared by the copies ``dataclasses.replace`` makes (other weights
+    #: or prior rows: the model does not depend on them)
+    models: dict[Any, tuple[FitData, np.ndarray]] = field(
+        default_factory=dict, repr=False, compare=False
+    )
 
     def predict(
         self,
@@ -381,6 +391,33 @@ class Residuals:
         *,
         xp: np.ndarray | None = None,
         vn: tuple[np.ndarray, np.ndarray] | None = None,
+    ) -> np.ndarray:
+        """The model force at the bins (``on="averaged"``) or samples for the parameter
+        values ``v``; ``xp`` and ``vn`` perturb the path and the fixed turn values.
+
+        An averaged model at the data's own path is kept for the last few parameter sets:
+        the analysis evaluates it again at the fits' end points (the second fit's start, the
+        drift covariance's base, the reported model), 5 of a window's 11 evaluations. A copy
+        is returned, the same numbers."""
+        d = self.data
+        if xp is None and vn is None and d.on == "averaged":
+            # (floats by their bits: -0.0 is not 0.0 here)
+            key = (id(d), tuple((k, x.hex() if type(x) is float else x) for k, x in v.items()))
+            hit = self.models.get(key)
+            if hit is not None and hit[0] is d:
+                return hit[1].copy()
+            F = self._predict(v, None, None)
+            if len(self.models) >= _KEPT_MODELS:
+                del self.models[next(iter(self.models))]
+            self.models[key] = (d, F)
+            return F.copy()
+        return self._predict(v, xp, vn)
+
+    def _predict(
+        self,
+        v: dict[str, float],
+        xp: np.ndarray | None,
+        vn: tuple[np.ndarray, np.ndarray] | None,
     ) -> np.ndarray:
         d = self.data
         m = model_of(v)
