@@ -38,10 +38,49 @@ ROWS = ("clean", "stiffness_nonlinearity", "asymmetric_branches", "creep_drift")
 LAWS = ("a2", "a2", "a3", "a23", "eq17", "p")
 
 
-def diagnose(t, p, d):
+#: the stop-42 rule (the stiffening law against the loss asymmetry by their likelihood):
+#: its hooks, which ``--compare`` takes away for the "before" run
+HOOKED = ("asymmetric_branches", "stiffness_nonlinearity")
+
+
+def _without_hooks():
+    """A context in which the two effects' ``yields_to_tried`` hooks are gone (main before
+    stop 42)."""
+    import contextlib
+
+    from contactlab.diagnose.effects import registry
+
+    @contextlib.contextmanager
+    def ctx():
+        reg = registry("normal")
+        saved = {n: type(reg[n]).__dict__.get("yields_to_tried") for n in HOOKED}
+        for n in HOOKED:
+            if saved[n] is not None:
+                delattr(type(reg[n]), "yields_to_tried")
+        try:
+            yield
+        finally:
+            for n, f in saved.items():
+                if f is not None:
+                    type(reg[n]).yields_to_tried = f
+
+    return ctx()
+
+
+def _hook_fired(r) -> bool:
+    return any(
+        (v.reason or "").startswith("look-alike:") and v.name in HOOKED
+        for st in r.steps
+        for v in st.candidates
+    )
+
+
+def diagnose(t, p, d, before=False):
+    import contextlib
+
     import contactlab
 
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), _without_hooks() if before else contextlib.nullcontext():
         warnings.simplefilter("ignore")
         r = contactlab.diagnose({"t": t, "p": p, "delta": d}, "normal")
     rd = r.to_dict()
@@ -51,6 +90,7 @@ def diagnose(t, p, d):
     gains = {v.name: float(v.gain) for v in r.steps[0].candidates}
     for v in r.steps[0].candidates:
         gains[v.name + ":why"] = v.reason
+    gains["fired"] = _hook_fired(r)
     return list(r.effect_names), flagged, bounds, params, gains, rd.get("refused", {})
 
 
@@ -134,7 +174,10 @@ def rig_record(effect: str | None, size: float, fac: dict, seed: int):
     return r.t, r.channels["p"], r.channels["delta"], None
 
 
-def run(seed: int, rows: tuple[str, ...], gen: str = "chain") -> dict:
+from contactlab.errors import ContactLabError  # noqa: E402
+
+
+def run(seed: int, rows: tuple[str, ...], gen: str = "chain", compare: bool = False) -> dict:
     rng = np.random.default_rng((420_000 if gen == "chain" else 520_000) + seed)
     base = factors(rng)
     out = {"seed": seed, "fac": dict(base), "rows": {}}
@@ -146,19 +189,31 @@ def run(seed: int, rows: tuple[str, ...], gen: str = "chain") -> dict:
         t0 = time.process_time()
         make = chain_record if gen == "chain" else rig_record
         t, p, d, _ = make(effect, size, fac, seed * 11 + ROWS.index(row))
-        nm, fl, bd, par, gains, refused = diagnose(t, p, d)
+        try:
+            nm, fl, bd, par, gains, refused = diagnose(t, p, d)
+        except ContactLabError as exc:  # a record diagnose refuses (too few cycles)
+            out["rows"][row] = {"size": size, "own": 0.0, "law": fac.get("law"),
+                                "named": [], "flagged": False, "bound": None, "params": {},
+                                "gains": {}, "refused": {"record": str(exc)}, "cpu": 0.0,
+                                "before": None, "error": str(exc)}  # fmt: skip
+            continue
+        before = None
+        if compare:  # the rule changed nothing unless one of its hooks refused a candidate
+            before = (nm, fl) if not gains["fired"] else diagnose(t, p, d, before=True)[:2]
         per = 1.0 / fac["f"]
         out["rows"][row] = {
             "size": size, "own": own_size(row, size, fac, d), "law": fac.get("law"),
             "tau_c_periods": fac["tau_c"] / per if "tau_c" in fac else None,
             "tau_c_durations": fac["tau_c"] / float(t[-1]) if "tau_c" in fac else None,
             "named": nm, "flagged": fl, "bound": bd.get(row), "params": par, "gains": gains,
-            "refused": refused, "cpu": time.process_time() - t0,
+            "refused": refused, "cpu": time.process_time() - t0, "before": before,
         }  # fmt: skip
     return out
 
 
 def verdict(row: str, v: dict) -> str:
+    if v.get("error"):
+        return "refused record"
     if row == "clean":
         return "named" if v["named"] else ("flagged" if v["flagged"] else "ok")
     return "exact" if v["named"] == [row] else "+".join(v["named"]) or "nothing"
@@ -171,6 +226,7 @@ def main():
     ap.add_argument("--out", default=None)
     ap.add_argument("--gen", default="chain", choices=("chain", "rig"))
     ap.add_argument("--creep", default=None, help="lo_periods,hi_durations,d_lo,d_hi")
+    ap.add_argument("--compare", action="store_true", help="also the verdict without the rule")
     a = ap.parse_args()
     if a.creep:
         CREEP.update(zip(("lo_periods", "hi_durations", "d_lo", "d_hi"),
@@ -180,7 +236,7 @@ def main():
     res = []
     tally = defaultdict(Counter)
     for s in range(lo, hi + 1):
-        r = run(s, rows, a.gen)
+        r = run(s, rows, a.gen, a.compare)
         res.append(r)
         f = r["fac"]
         print(f"seed {s}: fs {f['fs']:.0f} f {f['f']:.2f} cyc {f['cycles']} ramp {f['ramp']:.1f} "
@@ -192,11 +248,17 @@ def main():
                 extra += f" τc {v['tau_c_periods']:.2f} per {v['tau_c_durations']:.2f} dur"
             b = v.get("bound")
             extra += f" own {v['own']:.3g} bound {b:.3g}" if isinstance(b, float) else ""
-            g = {k: round(x, 2) for k, x in v["gains"].items() if not k.endswith(":why")}
+            g = {k: round(x, 2) for k, x in v["gains"].items()
+                 if not k.endswith(":why") and k != "fired"}  # fmt: skip
+            if v.get("before") is not None:
+                extra += f" BEFORE {v['before'][0]} flagged {v['before'][1]}"
             print(f"   {e:24s} size {v['size']:+.3f}{extra} named {v['named']} "
                   f"flagged {v['flagged']} cpu {v['cpu']:.0f}s gains {g} "
                   f"refused {v['refused']}", flush=True)  # fmt: skip
             tally[e][verdict(e, v)] += 1
+            if v.get("before") is not None:
+                was = {"named": v["before"][0], "flagged": v["before"][1]}
+                tally[e + " (before)"][verdict(e, was)] += 1
     print()
     for e, c in tally.items():
         print(f"{e:24s} " + ", ".join(f"{k} {n}" for k, n in c.most_common()))
