@@ -123,12 +123,13 @@ def test_choice_between_the_two_follows_the_evidence():
     cur = trial(d.y * 0.0, 1.2)
     better = trial(d.y * 0.0, 1.0)
     worse = trial(d.y * 0.0, 1.1)
-    v = SimpleNamespace(gain=0.2, accepted=True)
-    refused = SimpleNamespace(gain=0.2, accepted=False)
+    v = SimpleNamespace(gain=0.2, accepted=True, reason="accepted")
+    weak = SimpleNamespace(gain=0.2, accepted=False, reason="gain not significant (t = 2.6)")
+    odd = SimpleNamespace(gain=0.2, accepted=False, reason="implausible: at its limit")
     pa, ps = {"a": 0.3}, {"kappa": 0.0, "kappa1": 0.03}
     # the law fits better: the asymmetry yields, the law stays
     why = asym.yields_to_tried(pa, v, worse, {"stiffness_nonlinearity": (v, better)}, cur, d)
-    assert why and "stiffening law" in why
+    assert why and "stiffening law" in why and "neither" not in why
     assert stiff.yields_to_tried(ps, v, better, {"asymmetric_branches": (v, worse)}, cur, d) is None
     # the asymmetry fits better: the law yields, the asymmetry stays
     assert (
@@ -136,9 +137,19 @@ def test_choice_between_the_two_follows_the_evidence():
     )
     why = stiff.yields_to_tried(ps, v, worse, {"asymmetric_branches": (v, better)}, cur, d)
     assert why and "loss asymmetry" in why
-    # a rival not accepted takes nothing
-    assert asym.yields_to_tried(pa, v, worse, {"stiffness_nonlinearity": (refused, better)},
-                                cur, d) is None  # fmt: skip
+    # a law that fits better but did not pass on its own: the asymmetry yields all the
+    # same (neither is named); an implausible law takes nothing
+    why = asym.yields_to_tried(pa, v, worse, {"stiffness_nonlinearity": (weak, better)}, cur, d)
+    assert why and "neither is named" in why
+    assert (
+        asym.yields_to_tried(pa, v, worse, {"stiffness_nonlinearity": (odd, better)}, cur, d)
+        is None
+    )
+    # and the other way round
+    why = stiff.yields_to_tried(ps, v, worse, {"asymmetric_branches": (weak, better)}, cur, d)
+    assert why and "neither is named" in why
+    why = stiff.yields_to_tried(ps, v, worse, {"asymmetric_branches": (odd, better)}, cur, d)
+    assert why is None
 
 
 def _rig(effect: dict, seed: int):
