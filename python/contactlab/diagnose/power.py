@@ -581,7 +581,7 @@ def _detectable(
     refused = _refusal(family, name, effects, mags, shape)
     if refused is not None:
         return refused
-    apart = _not_separable(family, name, d, params)
+    apart = _not_separable(family, name, d, params) or _not_told_apart(name, d, effects)
     if apart:
         first = mags[0]
         return Detectable(name, first.name, None, first.unit, first.null, None, shape,
@@ -619,6 +619,25 @@ def _detectable(
         name, worst.name, per[worst.name], worst.unit, worst.null, rel[worst.name], shape, per,
         gain_at_bound=gain[worst.name],
     )  # fmt: skip
+
+
+def _not_told_apart(name: str, d: Prepared, effects: tuple[str, ...]) -> str:
+    """Why no size of candidate ``name`` can be promised because an effect named in the
+    final model (``effects``) fitted the held-out cycles as well as it when it was added
+    (the search's note in ``d.extra``: :func:`contactlab.diagnose.search._mark_not_told_apart`),
+    or empty: a look-alike took its signature, and the bound would promise what the data
+    cannot show."""
+    from .search import NOT_TOLD_APART
+
+    tie = (d.extra.get(NOT_TOLD_APART) or {}).get(name)
+    if not tie or tie["named"] not in effects:
+        return ""
+    return (
+        f"not told apart from {tie['named']}, named: when it was added, {name} fitted the "
+        f"held-out cycles as well (held-out gains {tie['gain']:.3g} against "
+        f"{tie['gain_named']:.3g} σ², paired t of the named effect's lead {tie['t']:.2f}); "
+        "on this record the data do not say which of the two they hold"
+    )
 
 
 def _not_separable(family: Family, name: str, d: Prepared, params: dict[str, float]) -> str:
