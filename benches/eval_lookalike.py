@@ -126,7 +126,13 @@ def bound_before(rep: Any, name: str) -> float | None:
                     delattr(c, k)
         vd.rivals = ("channel_delay",)
         rep.not_detected = []
-        nd = {x.effect: x for x in stated_power(rep)}.get(name)
+        det = rep.location.setdefault("detection", {})
+        had = det.get("candidates")
+        det["candidates"] = [name]  # the true effect's bound only
+        try:
+            nd = {x.effect: x for x in stated_power(rep)}.get(name)
+        finally:
+            det["candidates"] = had
         return None if nd is None else nd.detectable_above
     finally:
         for c, attrs in saved.items():

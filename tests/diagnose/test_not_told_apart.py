@@ -110,3 +110,17 @@ def test_normal_load_bound_is_stated_at_twice_the_drive_beside_its_look_alikes()
     assert "normal_load" in reg["parallel_stiffness"].rivals
     assert "normal_load" in reg["viscous_damping"].rivals
     assert "2f" in reg["normal_load"].power_note(d, {})
+
+
+@pytest.mark.parametrize(("budget", "tied"), [(0.0, False), (0.9, True)])
+def test_a_plays_lead_owed_to_the_input_noise_is_no_evidence(budget: float, tied: bool):
+    d, base, bump = _record(2)
+    d.extra["input_noise_budget"] = budget
+    current = _trial(base)
+    st = SimpleNamespace(effects=(), current=current, where=[])
+    best = (_v("backlash", 2.27), _trial(base + bump, "backlash"))
+    other = (_v("channel_delay", 1.46), _trial(base + 0.6 * bump))
+    assert paired_lead(d, current, best[1], other[1]) > 10.0  # every cycle: the play leads
+    _mark_not_told_apart(best, {"backlash": best, "channel_delay": other}, st, d, 3.0)
+    # a lead of 0.81 σ² within a budget of 0.9 σ² is what the noise gives a play at the turns
+    assert ("channel_delay" in d.extra[NOT_TOLD_APART]) is tied
