@@ -99,6 +99,10 @@ def test_bound_withheld_only_while_the_look_alike_stays_named():
     assert "not told apart from viscous_damping" in why and "2.43" in why
     assert _not_told_apart("normal_load", d, ("stribeck",)) == ""  # dropped later: a bound
     assert _not_told_apart("parallel_stiffness", d, ("viscous_damping",)) == ""
+    # a rival that fitted better but was refused by a look-alike rule says why
+    d.extra[NOT_TOLD_APART]["normal_load"].update(t=-2.9, refused="look-alike: a parabola")
+    why = _not_told_apart("normal_load", d, ("viscous_damping",))
+    assert "as well or better" in why and "not named (look-alike: a parabola)" in why
 
 
 def test_normal_load_bound_is_stated_at_twice_the_drive_beside_its_look_alikes():

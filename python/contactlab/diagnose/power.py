@@ -632,11 +632,14 @@ def _not_told_apart(name: str, d: Prepared, effects: tuple[str, ...]) -> str:
     tie = (d.extra.get(NOT_TOLD_APART) or {}).get(name)
     if not tie or tie["named"] not in effects:
         return ""
+    better = "as well or better" if tie["t"] < 0 else "as well"
+    why = tie.get("refused") or ""
     return (
         f"not told apart from {tie['named']}, named: when it was added, {name} fitted the "
-        f"held-out cycles as well (held-out gains {tie['gain']:.3g} against "
-        f"{tie['gain_named']:.3g} σ², paired t of the named effect's lead {tie['t']:.2f}); "
-        "on this record the data do not say which of the two they hold"
+        f"held-out cycles {better} (held-out gains {tie['gain']:.3g} against "
+        f"{tie['gain_named']:.3g} σ², paired t of the named effect's lead {tie['t']:.2f})"
+        + (f" and was not named ({why[:200]})" if why else "")
+        + "; on this record the data do not say which of the two they hold"
     )
 
 

@@ -884,7 +884,8 @@ def _mark_not_told_apart(
             t *= 1.0 - owed / lead
         if np.isfinite(t) and t <= z:
             store[name] = {"named": v.name, "gain_named": float(v.gain),
-                           "gain": float(w.gain), "t": float(t)}  # fmt: skip
+                           "gain": float(w.gain), "t": float(t),
+                           "refused": "" if w.accepted else why}  # fmt: skip
             ties.append(f"{name} ({w.gain:.3g} σ², t = {t:.2f})")
     if ties:
         st.where.append(
