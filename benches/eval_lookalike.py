@@ -104,7 +104,8 @@ def run_job(job: tuple[str, int, str, tuple[str, ...]]) -> dict[str, Any]:
 
 def bound_before(rep: Any, name: str) -> float | None:
     """The bound stated for ``name`` without stop 42's honest-bound rules (the look-alikes not
-    told apart, a normal load's bound at 2f beside a dashpot and a spring, their rivals):
+    told apart, an effect seen and withdrawn, a normal load's bound at 2f beside a dashpot
+    and a spring, their rivals):
     the report's bounds recomputed with them taken off (the named set does not depend on
     them). None when ``name`` is named or has no bound."""
     from contactlab.diagnose import search
@@ -118,6 +119,7 @@ def bound_before(rep: Any, name: str) -> float | None:
     saved = {c: {k: c.__dict__[k] for k in ("rivals", "power_shape", "power_note")
                  if k in c.__dict__} for c in (nl, ps, vd)}  # fmt: skip
     ties = rep.prepared.extra.pop(search.NOT_TOLD_APART, None)
+    gone = rep.prepared.extra.pop("withdrawn", None)
     kept = rep.not_detected
     try:
         for c in (nl, ps):
@@ -141,6 +143,8 @@ def bound_before(rep: Any, name: str) -> float | None:
         rep.not_detected = kept
         if ties is not None:
             rep.prepared.extra[search.NOT_TOLD_APART] = ties
+        if gone is not None:
+            rep.prepared.extra["withdrawn"] = gone
 
 
 def verdict(r: dict[str, Any]) -> str:

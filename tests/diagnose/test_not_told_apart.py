@@ -128,3 +128,17 @@ def test_a_plays_lead_owed_to_the_input_noise_is_no_evidence(budget: float, tied
     _mark_not_told_apart(best, {"backlash": best, "channel_delay": other}, st, d, 3.0)
     # a lead of 0.81 σ² within a budget of 0.9 σ² is what the noise gives a play at the turns
     assert ("channel_delay" in d.extra[NOT_TOLD_APART]) is tied
+
+
+def test_no_size_promised_for_an_effect_seen_and_withdrawn():
+    from contactlab.diagnose.power import _withdrawn
+    from contactlab.diagnose.workflow import WITHDRAWN
+
+    d, _, _ = _record()
+    assert _withdrawn("position_friction", d, ()) == ""
+    d.extra[WITHDRAWN] = {"position_friction": "it took up part of a misfit"}
+    why = _withdrawn("position_friction", d, ())
+    assert why.startswith("seen and withdrawn") and "took up part of a misfit" in why
+    # named again after all (not withdrawn in the final model): its bound is not asked for
+    assert _withdrawn("position_friction", d, ("position_friction",)) == ""
+    assert _withdrawn("stribeck", d, ()) == ""

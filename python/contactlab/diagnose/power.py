@@ -581,7 +581,11 @@ def _detectable(
     refused = _refusal(family, name, effects, mags, shape)
     if refused is not None:
         return refused
-    apart = _not_separable(family, name, d, params) or _not_told_apart(name, d, effects)
+    apart = (
+        _not_separable(family, name, d, params)
+        or _not_told_apart(name, d, effects)
+        or _withdrawn(name, d, effects)
+    )
     if apart:
         first = mags[0]
         return Detectable(name, first.name, None, first.unit, first.null, None, shape,
@@ -619,6 +623,23 @@ def _detectable(
         name, worst.name, per[worst.name], worst.unit, worst.null, rel[worst.name], shape, per,
         gain_at_bound=gain[worst.name],
     )  # fmt: skip
+
+
+def _withdrawn(name: str, d: Prepared, effects: tuple[str, ...]) -> str:
+    """Why no size of candidate ``name`` can be promised because the search named it and the
+    closing checks withdrew it (``d.extra["withdrawn"]``, kept by
+    :func:`contactlab.diagnose.workflow._withdraw`), or empty: the record showed it, and a
+    bound saying it "would be seen above" a size promises a name the diagnosis withholds on
+    this record whatever the size (a track's wave of 5-8 % of h0 through the rig's sensor
+    chain, at 3-4 times its stated bound, was withdrawn as taking up a misfit of the branch
+    shape: ``benches/eval_lookalike.py`` fresh seeds 56000-56004)."""
+    why = (d.extra.get("withdrawn") or {}).get(name)
+    if not why or name in effects:
+        return ""
+    return (
+        f"seen and withdrawn on this record ({why}): the data hold a signature the diagnosis "
+        "does not name here, so no size is promised"
+    )
 
 
 def _not_told_apart(name: str, d: Prepared, effects: tuple[str, ...]) -> str:
