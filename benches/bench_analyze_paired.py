@@ -3,7 +3,8 @@ package (``--baseline``: a ``python/`` folder with its built ``_core``, e.g. a `
 of an older commit's ``python/`` with its ``_core`` copied in), alternating which runs first,
 CPU time (user + system, ``os.wait4``) of each run pinned to one CPU (serial windows).
 
-Prints the medians, the median paired difference of CPU and in how many rounds this tree
+Both trees' modules are compiled first (``bench_analyze.compile_tree``). Prints the
+medians, the median paired difference of CPU and in how many rounds this tree
 was lower: a difference of a few percent that the medians of separate rounds do not show
 on a loaded machine (issue 33 item 4). Writes nothing but a temporary JSON.
 
@@ -47,6 +48,16 @@ def main() -> None:
     args = ap.parse_args()
     exe = str(Path(sys.executable).with_name("contactlab"))
     cpu = min(os.sched_getaffinity(0))
+    # both trees compiled first (``bench_analyze.compile_tree``): with
+    # PYTHONDONTWRITEBYTECODE=1 a tree without its __pycache__ (a ``git archive`` copy) or
+    # with modules edited since it was compiled compiles them in every run, ~0.07 s of CPU
+    # at 1e7 samples that the other tree does not pay
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from bench_analyze import compile_tree
+
+    for tree in (args.baseline, Path(__file__).resolve().parents[1] / "python"):
+        if compile_tree(tree):
+            raise SystemExit(f"{tree}: a module does not compile")
     base = {**os.environ, "PYTHONPATH": str(args.baseline)}
     new = dict(os.environ)
     rows: dict[str, list[tuple[float, float]]] = {"b": [], "n": []}

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -58,6 +59,8 @@ def scan(a: np.ndarray, extremes: bool = True) -> tuple[bool, float, float]:
 def _float_array(x: Any, name: str) -> np.ndarray:
     """``x`` as a float64 array; complex input is an error (numpy would drop the imaginary
     part with only a warning)."""
+    if type(x) is np.ndarray and x.dtype == np.float64 and x.ndim and x.flags.c_contiguous:
+        return x  # (what the conversion below gives such an array: itself)
     try:
         a = np.asarray(x)
         complex_ = np.iscomplexobj(a)
@@ -89,6 +92,10 @@ def as_1d(x: Any, name: str, *, allow_empty: bool = False, finite: bool = True) 
 
 def scalar_or_array(x: Any, name: str) -> tuple[np.ndarray, bool]:
     """Flatten a scalar or array for a vectorised kernel; tell whether it was a scalar."""
+    if type(x) is float:  # (what the conversion below makes of it: one sample, and False)
+        if not math.isfinite(x):
+            raise InputError(f"{name}[0] is not finite ({x})")
+        return np.array([x]), False
     a = _float_array(x, name)
     flat = np.ascontiguousarray(a.reshape(-1))
     bad = ~np.isfinite(flat)
@@ -109,7 +116,7 @@ def positive(value: Any, name: str) -> float:
         v = float(value)
     except (TypeError, ValueError):
         raise InputError(f"{name} must be a number, got {value!r}") from None
-    if not np.isfinite(v) or v <= 0:
+    if not math.isfinite(v) or v <= 0:
         raise InputError(f"{name} must be finite and > 0, got {v}")
     return v
 

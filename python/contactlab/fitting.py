@@ -268,7 +268,7 @@ def _as_params(params: Any) -> dict[str, Parameter]:
             if isinstance(v, Parameter):
                 if v.name != k:
                     raise InputError(f"parameter stored under {k!r} is named {v.name!r}")
-                out[k] = replace(v)
+                out[k] = _copied(v)
             else:
                 out[k] = Parameter(k, float(v))
         return out
@@ -277,7 +277,7 @@ def _as_params(params: Any) -> dict[str, Parameter]:
         for p in params:
             if not isinstance(p, Parameter):
                 raise InputError(f"expected Parameter objects, got {type(p).__name__}")
-            out[p.name] = replace(p)
+            out[p.name] = _copied(p)
         return out
     raise InputError(f"params must be a dict or a list of Parameter, got {type(params).__name__}")
 
@@ -358,7 +358,7 @@ def least_squares_fit(
     (2.0, True)
     """
     ps = _as_params(params)
-    start = [replace(p) for p in ps.values()] if solver is not None else []
+    start = [_copied(p) for p in ps.values()] if solver is not None else []
     check_params(ps)
     pb = Scaled(ps, residual_fn, jac, jac_rel_step, workers)
     names, lo, hi = pb.names, pb.lo, pb.hi
@@ -551,11 +551,21 @@ def stderr_and_correl(covar: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return d, correl
 
 
+def _copied(p: Parameter) -> Parameter:
+    """``dataclasses.replace(p)`` (a shallow copy), without its field-by-field constructor
+    call for a plain :class:`Parameter` (a fit copies its parameters a few dozen times)."""
+    if type(p) is not Parameter:
+        return replace(p)
+    q = object.__new__(Parameter)
+    q.__dict__.update(p.__dict__)
+    return q
+
+
 def with_covariance(fit: FitResult, covar: np.ndarray, *, note: str | None = None) -> FitResult:
     """``fit`` with the parameter covariance ``covar``: standard errors and correlations
     follow from it, and ``note`` (if any) is added to the fit's notes."""
     d, correl = stderr_and_correl(covar)
-    params = {n: replace(p) for n, p in fit.params.items()}
+    params = {n: _copied(p) for n, p in fit.params.items()}
     for i, n in enumerate(fit.var_names):
         if params[n].stderr is not None:
             params[n].stderr = float(d[i])

@@ -115,10 +115,15 @@ class Masing:
         the forces are those of one thread bit for bit.
         """
         xa = as_1d(x, "x", finite=False)  # the core names a non-finite sample's index
-        op = self.operator()
         if state is not None:
+            op = self.operator()
             op.state = state
-        return op.push(xa, out=out, threads=_threads_for(threads))
+            return op.push(xa, out=out, threads=_threads_for(threads))
+        # a fresh core of its own (no other thread holds it: no borrow guard), pushed once:
+        # what ``operator().push`` runs, without its wrappers (a fit evaluates the model on a
+        # few hundred bins a dozen times a window, where they were half of each call)
+        n_threads = _threads_for(threads)
+        return self._core.fresh().push(xa, _out_buffer(out, xa.size), n_threads)
 
     def operator(self) -> MasingOperator:
         """A stateful operator for streaming a recording chunk by chunk."""

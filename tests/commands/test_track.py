@@ -125,6 +125,7 @@ def test_auto_streamed_analyze_ctrl_c_writes_nothing(rec_file, tmp_path, monkeyp
     monkeypatch.setattr(pooled, "STREAM_ABOVE", 4000)
     monkeypatch.setattr(track_mod, "_tangential_window", interrupted)
     monkeypatch.setattr(os, "sched_getaffinity", lambda _pid: {0, 1}, raising=False)
+    _idle_machine(monkeypatch)
     assert analyze_cmd.window_threads() >= 1
     out, rep = tmp_path / "o.json", tmp_path / "rep"
     code = main(["analyze", str(rec_file), "--model", "tangential", "--json", str(out),
@@ -300,22 +301,61 @@ def test_pool_weights_and_birge():
     assert m == 3.0 and e == pytest.approx(1.0) and b != b
 
 
+def _idle_machine(monkeypatch, load=0.0, running=0.0):
+    """The machine's load as :func:`contactlab.commands.common.window_threads` reads it."""
+    from contactlab.commands import common
+
+    monkeypatch.setattr(os, "getloadavg", lambda: (load, load, load))
+    monkeypatch.setattr(common, "_runnable_elsewhere", lambda: running)
+
+
 def test_analyze_window_threads_from_the_environment(monkeypatch):
     from contactlab import InputError
     from contactlab.commands.common import window_threads
 
     monkeypatch.delenv("CONTACTLAB_ANALYZE_THREADS", raising=False)
     monkeypatch.setattr(os, "sched_getaffinity", lambda _pid: {0, 1, 2}, raising=False)
+    _idle_machine(monkeypatch)
     assert window_threads() == 2
     # one CPU to run on: helper threads would only take turns with the reader
     monkeypatch.setattr(os, "sched_getaffinity", lambda _pid: {3}, raising=False)
     assert window_threads() == 0
     monkeypatch.setenv("CONTACTLAB_ANALYZE_THREADS", "0")
     assert window_threads() == 0
+    monkeypatch.setenv("CONTACTLAB_ANALYZE_THREADS", "2")
+    _idle_machine(monkeypatch, load=9.0, running=9.0)
+    assert window_threads() == 2  # asked for: whatever the load
     for bad in ("-1", "two"):
         monkeypatch.setenv("CONTACTLAB_ANALYZE_THREADS", bad)
         with pytest.raises(InputError, match="CONTACTLAB_ANALYZE_THREADS"):
             window_threads()
+
+
+def test_analyze_window_threads_only_where_a_cpu_is_free(monkeypatch):
+    """Helper threads where a CPU besides this process's is free of other work, by the
+    smaller of the load average and the tasks runnable now; serially where every CPU is
+    busy (a second thread only adds GIL hand-overs there: issue 33 item 5)."""
+    from contactlab.commands import common
+
+    monkeypatch.delenv("CONTACTLAB_ANALYZE_THREADS", raising=False)
+    monkeypatch.setattr(os, "sched_getaffinity", lambda _pid: {0, 1}, raising=False)
+    cases = [
+        (0.0, 0.0, 2),  # idle
+        (0.9, 0.0, 2),  # the average still counts work that has ended
+        (5.0, 0.5, 2),
+        (1.5, 1.5, 0),  # one CPU taken, the other shared
+        (8.0, 6.0, 0),  # every CPU busy
+        (0.5, 7.0, 2),  # a burst of runnable tasks right now, an idle minute
+    ]
+    for load, running, want in cases:
+        _idle_machine(monkeypatch, load, running)
+        assert common.window_threads() == want, (load, running)
+    _idle_machine(monkeypatch, 3.0, None)  # no /proc/stat: the load average decides
+    assert common.window_threads() == 0
+    monkeypatch.setattr(os, "sched_getaffinity", lambda _pid: {0, 1, 2, 3}, raising=False)
+    _idle_machine(monkeypatch, 2.0, 2.0)  # four CPUs, two busy
+    assert common.window_threads() == 2
+    assert isinstance(common._busy_cpus(), float)
 
 
 @pytest.mark.parametrize("how", ["flags", "tags"])

@@ -355,24 +355,54 @@ def _ignore_sigint() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
+def _runnable_elsewhere() -> float | None:
+    """Tasks runnable on the machine right now besides this process (``procs_running`` of
+    ``/proc/stat`` less one), or None where the system does not tell."""
+    try:
+        with open("/proc/stat", "rb") as f:
+            for line in f:
+                if line.startswith(b"procs_running"):
+                    return max(float(line.split()[1]) - 1.0, 0.0)
+    except (OSError, ValueError, IndexError):
+        return None
+    return None
+
+
+def _busy_cpus() -> float:
+    """CPUs other work keeps busy: the smaller of the 1-minute load average and the tasks
+    runnable right now (:func:`_runnable_elsewhere`; the average lags, so a run started just
+    after other work ended would otherwise see the machine busy for up to a minute)."""
+    try:
+        busy = os.getloadavg()[0]
+    except (AttributeError, OSError):  # no load average on this system
+        busy = 0.0
+    now = _runnable_elsewhere()
+    return busy if now is None else min(busy, now)
+
+
 def window_threads() -> int:
     """Helper threads of an auto-streamed analysis and of ``track`` (``track(threads=...)``):
-    one per CPU this process may run on (its affinity mask), at most 2, none on a single
-    CPU, or ``CONTACTLAB_ANALYZE_THREADS`` (0: analyse each window before reading on). They
-    analyse windows (the Rust kernels release the GIL) while the main thread reads on; at
-    most threads + 2 windows (2^20 samples each) are unanalysed at a time, those waiting for
-    a thread without their time axis (peak 240-241 MB on 1e7 samples, 245-263 MB on 1e8,
-    with 2). The pooled document is the serial one.
+    2 where this process may run on two CPUs or more (its affinity mask) and at least one of
+    them is free of other work, else none; ``CONTACTLAB_ANALYZE_THREADS`` sets it (0:
+    analyse each window before reading on). They analyse windows (the Rust kernels release
+    the GIL) while the main thread reads on; at most threads + 2 windows (2^20 samples each)
+    are unanalysed at a time, those waiting for a thread without their time axis (peak
+    240-241 MB on 1e7 samples, 245-263 MB on 1e8, with 2). The pooled document is the serial
+    one.
 
-    On one CPU (``taskset -c 0``, a one-CPU container) helper threads only take turns with
-    the reader: a 3e7-sample ``analyze`` pinned to one CPU took 4.67-4.68 s serially against
-    4.98-5.05 s with one helper thread and 5.42-5.49 s with two (peak 146 against 172 and
-    238 MB). The machine's load is not asked (unlike ``Masing.force(threads=...)``'s split,
-    whose call waits for its slowest piece): windows flow through a pipeline, and with every
-    CPU busy the threads still won (the scheduler shares a CPU by thread: 3e7 samples at a
-    load of 10 on 2 CPUs, 4.51-5.37 s with two threads against 4.22-5.57 s serially)."""
-    import os
+    Threads must never lose against the serial run (issue 33 item 5):
 
+    - On one CPU (``taskset -c 0``, a one-CPU container) helper threads only take turns with
+      the reader: a 3e7-sample ``analyze`` pinned to one CPU took 4.67-4.68 s serially
+      against 4.98-5.05 s with one helper thread and 5.42-5.49 s with two (peak 146 against
+      172 and 238 MB).
+    - With every CPU busy, a second thread gets no CPU the first would not have had, and the
+      GIL hand-overs and more windows in flight cost CPU: 3e7 samples in process at a load
+      of 7.7 on 2 CPUs, 2.11-2.61 s wall and 0.82-1.06 s CPU with two helper threads against
+      2.00-2.07 s and 0.80-0.83 s serially (5 paired rounds, the threads slower in each).
+      Busy is counted as :mod:`contactlab.diagnose` counts it for its fits: the smaller of
+      the 1-minute load average and the tasks runnable right now (:func:`_busy_cpus`); the
+      threads run when ``int(cpus - busy) + 1 >= 2``."""
     env = os.environ.get("CONTACTLAB_ANALYZE_THREADS", "").strip()
     if env:
         try:
@@ -388,7 +418,10 @@ def window_threads() -> int:
         cpus = len(os.sched_getaffinity(0))
     except (AttributeError, OSError):  # no affinity mask on this system
         cpus = os.cpu_count() or 1
-    return 0 if cpus <= 1 else 2
+    if cpus <= 1:
+        return 0
+    usable = int(cpus - _busy_cpus()) + 1  # this process's CPU and the free ones
+    return 2 if usable >= 2 else 0
 
 
 def process_pool(workers: int | None, *, auto: bool = False) -> Any:

@@ -259,7 +259,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         default=None,
         metavar="N",
         help="without --workers: analyse windows on N helper threads while reading on "
-        "(default: one per core, at most 2, as analyze; 0: each window before reading on)",
+        "(default: one per core, at most 2, none while every core is busy, as analyze; 0: "
+        "each window before reading on)",
     )
     add_progress_flags(p)
     p.set_defaults(handler=_handler)

@@ -214,9 +214,11 @@ def collect_warnings(
     evidence: dict[str, Any],
     regime: Regime,
     weights: np.ndarray | None = None,
+    misfit: float | None = None,
 ) -> list[str]:
     """Everything the user should know about the fit: regime, identifiability, convergence,
-    and a misfit beyond the cycle-to-cycle noise."""
+    and a misfit beyond the cycle-to-cycle noise (``misfit``: :func:`misfit_ratio` of
+    ``raw, data, weights`` when the caller has it already)."""
     # on a plateau the Masing fit is superseded: its numerical notes would only confuse
     plateau = evidence.get("h0_source") == "plateau"
     warns: list[str] = pre + ([] if plateau else list(raw.notes))
@@ -246,7 +248,7 @@ def collect_warnings(
     elif not raw.success:
         warns.append(f"the Masing fit did not converge ({raw.message})")
     if loop is not None and data.on == "averaged" and loop.n_cycles > 2:
-        ratio_noise = misfit_ratio(raw, data, weights)
+        ratio_noise = misfit_ratio(raw, data, weights) if misfit is None else misfit
         if ratio_noise > 2.0:
             warns.append(
                 f"the residuals are {ratio_noise:.1f}× the cycle-to-cycle noise of force and "
@@ -538,8 +540,10 @@ def _analyze(
             z_fit=z_fit, ratio=ratio, loop=det.loop, x=det.x, F=det.F, t=ta, rev=data.rev, x_raw=xa
         )
     apply_regime(regime, amp, fit, identifiable, evidence, derived, max_rel_stderr)
+    # (the warnings and the delay's both read the misfit of an averaged fit: computed once)
+    misfit = misfit_ratio(raw, data, f.res.w) if on == "averaged" else None
     warns = collect_warnings(
-        pre_warns, raw, data, amp.value, identifiable, evidence, regime, f.res.w
+        pre_warns, raw, data, amp.value, identifiable, evidence, regime, f.res.w, misfit
     )
     if steady and det.loop is not None:
         warns += _transient_warning(det.loop, amp.value, amp.stderr)
@@ -551,7 +555,7 @@ def _analyze(
             f.res,
             data,
             sliding=regime.sliding,
-            misfit=misfit_ratio(raw, data, f.res.w),
+            misfit=misfit,
             applied=delay,
         )
     regime_d = regime.to_dict()

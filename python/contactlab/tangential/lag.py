@@ -384,7 +384,14 @@ class _DelayedLoop:
         out[4] = -stiff
         out[5] = sg * (k0 * eA - 2.0 * k0 * e * ds_dA)
         out[6] = stiff * dx * (-1.0 / self.period)
-        m = out.reshape(7, -1, self.SUB).mean(axis=2) * self.w
+        if self.SUB == 2:
+            # the mean over each bin's two points as ``mean(axis=2)`` sums them (from +0.0,
+            # the sum's identity), bit for bit, without its strided reduction (95 of a
+            # call's ~370 µs)
+            o3 = out.reshape(7, -1, 2)
+            m = (0.0 + o3[:, :, 0] + o3[:, :, 1]) / 2 * self.w
+        else:
+            m = out.reshape(7, -1, self.SUB).mean(axis=2) * self.w
         m[0] -= self.F * self.w
         return m[0], dict(zip(("k0", "ac", "offset", "x0", "amplitude", "tau"), m[1:], strict=True))
 

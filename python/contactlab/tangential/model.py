@@ -55,9 +55,18 @@ def steady_loop_force(
     h = n // 2
     top, bot = amplitude, -amplitude
     u = np.clip(x - x0, bot, top)
-    one = np.concatenate([[top], u[:h], [bot], u[h:]])
-    out = model.force(np.concatenate([[0.0, top], one, one]))
-    second = out[2 + one.size :]
+    # the path (0, top), then the cycle (top, descending bins, bot, ascending bins) twice,
+    # filled into one array
+    m = n + 2
+    path = np.empty(2 + 2 * m)
+    path[0], path[1] = 0.0, top
+    for a in (2, 2 + m):
+        path[a] = top
+        path[a + 1 : a + 1 + h] = u[:h]
+        path[a + 1 + h] = bot
+        path[a + 2 + h : a + m] = u[h:]
+    out = model.force(path)
+    second = out[2 + m :]
     F = np.concatenate([second[1 : h + 1], second[h + 2 :]])
     if x_var is not None and model.is_exponential:
         # from the turn that starts each branch (np.concatenate: np.r_ costs ~20 µs a call)

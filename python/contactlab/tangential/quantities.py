@@ -117,16 +117,12 @@ def _model_quantities(v: dict[str, float], A: float) -> np.ndarray:
     (eq. 18), global stiffness (eq. 19) and peak force of the model ``v`` at amplitude ``A``:
     one model for the five (their errors from one set of perturbed parameter values)."""
     m = steps.model_of(v)
-    e = float(m.loop_energy(A))
-    return np.array(
-        [
-            e,
-            e / (math.pi * A * A),
-            float(m.local_stiffness(A)),
-            float(m.global_stiffness(A)),
-            float(m.virgin(A)),
-        ]
-    )
+    e = float(m.loop_energy(A))  # (refuses a non-finite A first, as before)
+    f = float(m.virgin(A))
+    # f(A) / A is what global_stiffness divides (its backbone value, the same call) away
+    # from A = 0, where it takes the slope instead
+    kg = f / A if A != 0.0 else float(m.global_stiffness(A))
+    return np.array([e, e / (math.pi * A * A), float(m.local_stiffness(A)), kg, f])
 
 
 def derived_quantities(

@@ -21,9 +21,10 @@ Perturbations of the inputs (for the covariance terms) are explicit keyword argu
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -53,6 +54,16 @@ from .model import (
 from .preprocess import AveragedLoop, Reversals, average_loop, find_reversals, monotone_path
 from .turns import VirginTurns, turning_point_prior, virgin_nodes
 from .uncertainty import path_slope, trend, x_noise_var
+
+
+@functools.lru_cache(maxsize=16)
+def _branch_signs(n: int) -> np.ndarray:
+    """``+1`` on the descending bins ``0:n/2`` of an averaged loop, ``-1`` on the ascending
+    ones (read-only; one array per bin count: the fit's model and derivatives are evaluated
+    a few dozen times a window on the same bins)."""
+    sg = np.where(np.arange(n) < n // 2, 1.0, -1.0)
+    sg.flags.writeable = False
+    return sg
 
 
 def model_of(v: dict[str, float]) -> Masing:
@@ -351,6 +362,10 @@ class PriorRows:
     scale: float
 
 
+#: evaluations of an averaged model :meth:`Residuals.predict` keeps
+_KEPT_MODELS = 4
+
+
 @dataclass(frozen=True)
 class Residuals:
     """Weighted residuals ``(model - data) · w`` of a parameter set, plus the prior rows.
@@ -363,6 +378,12 @@ class Residuals:
     data: FitData
     w: np.ndarray
     prior: PriorRows | None = None
+    #: the averaged model's last few evaluations at unperturbed inputs, by parameter values
+    #: (:meth:`predict`); shared by the copies ``dataclasses.replace`` makes (other weights
+    #: or prior rows: the model does not depend on them)
+    models: dict[Any, tuple[FitData, np.ndarray]] = field(
+        default_factory=dict, repr=False, compare=False
+    )
 
     def predict(
         self,
@@ -370,6 +391,33 @@ class Residuals:
         *,
         xp: np.ndarray | None = None,
         vn: tuple[np.ndarray, np.ndarray] | None = None,
+    ) -> np.ndarray:
+        """The model force at the bins (``on="averaged"``) or samples for the parameter
+        values ``v``; ``xp`` and ``vn`` perturb the path and the fixed turn values.
+
+        An averaged model at the data's own path is kept for the last few parameter sets:
+        the analysis evaluates it again at the fits' end points (the second fit's start, the
+        drift covariance's base, the reported model), 5 of a window's 11 evaluations. A copy
+        is returned, the same numbers."""
+        d = self.data
+        if xp is None and vn is None and d.on == "averaged":
+            # (floats by their bits: -0.0 is not 0.0 here)
+            key = (id(d), tuple((k, x.hex() if type(x) is float else x) for k, x in v.items()))
+            hit = self.models.get(key)
+            if hit is not None and hit[0] is d:
+                return hit[1].copy()
+            F = self._predict(v, None, None)
+            if len(self.models) >= _KEPT_MODELS:
+                del self.models[next(iter(self.models))]
+            self.models[key] = (d, F)
+            return F.copy()
+        return self._predict(v, xp, vn)
+
+    def _predict(
+        self,
+        v: dict[str, float],
+        xp: np.ndarray | None,
+        vn: tuple[np.ndarray, np.ndarray] | None,
     ) -> np.ndarray:
         d = self.data
         m = model_of(v)
@@ -423,13 +471,13 @@ class Residuals:
             raise InputError("analytic derivatives are those of an averaged fit")
         k0, ac, x0, A = v["k0"], v["ac"], v["x0"], v["amplitude"]
         xp = d.xpath
-        n, h = xp.size, xp.size // 2
+        n = xp.size
         raw = xp - x0
         u = np.clip(raw, -A, A)
         inside = (raw > -A) & (raw < A)
         du_dx0 = np.where(inside, -1.0, 0.0)
         du_dA = np.where(raw >= A, 1.0, np.where(raw <= -A, -1.0, 0.0))
-        sg = np.where(np.arange(n) < h, 1.0, -1.0)  # descending, then ascending bins
+        sg = _branch_signs(n)  # descending, then ascending bins
         s = 0.5 * (A - sg * u)
         ds_dA = 0.5 * (1.0 - sg * du_dA)
         ds_dx0 = -0.5 * sg * du_dx0
@@ -539,8 +587,11 @@ def _beyond_turns(
     """
     k0, ac, x0, A = v["k0"], v["ac"], v["x0"], v["amplitude"]
     n = xp.size
-    sg = np.where(np.arange(n) < n // 2, 1.0, -1.0)
+    sg = _branch_signs(n)
     s = 0.5 * (A - sg * (xp - x0))
+    if s.min() >= 0.0 and s.max() <= A:  # no bin beyond a turn (the usual case: two
+        # reductions instead of the clip, difference and test below; NaN goes on there)
+        return None if derivatives else np.zeros(n)
     far = s > A  # beyond the turn that ends the branch
     sc = np.clip(s, 0.0, A)
     dd = s - sc

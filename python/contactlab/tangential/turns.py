@@ -23,8 +23,10 @@ is of fourth order, Richardson) plus noise of known variance ``var(narrow) - var
 
 from __future__ import annotations
 
+import contextlib
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -54,26 +56,54 @@ def nanmean(v: np.ndarray) -> float:
     return float(np.where(nan, 0.0, v).sum() / (v.size - int(nan.sum())))
 
 
-def _tip_fit(loop: AveragedLoop, first: int, k: int) -> tuple[float, float] | None:
+#: the designs of :func:`_tip_fit` last made, by the arrays they were made from (those are
+#: kept with them, so that an ``id`` is not reused while its entry lives)
+_DESIGNS: dict[tuple[int, ...], tuple[Any, ...]] = {}
+_KEPT_DESIGNS = 16
+
+
+def _tip_design(
+    loop: AveragedLoop, first: int, k: int
+) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """What :func:`_tip_fit` needs besides the bins' displacement: the bins' indices, the
+    regressors, the bins' noise variance and ``inv(XᵀX)[0, 0]``. They depend on the phases
+    and the spread only: a loop whose displacement alone differs (the drift covariance's
+    shifted loop) reuses them."""
     n = loop.x.size
+    assert loop.phase_mean is not None and loop.phase_sq is not None
+    key = (id(loop.phase_mean), id(loop.phase_sq), id(loop.x_std), loop.n_cycles, n, first, k)
+    got = _DESIGNS.get(key)
+    if got is not None and got[0] is loop.phase_mean and got[1] is loop.phase_sq:
+        if got[2] is loop.x_std:
+            return got[3]
     idx = np.arange(first - k, first + k) % n  # k bins either side of the turn
     turn = first / n  # phase of the turn: 0 (peak) or 1/2 (valley)
-    assert loop.phase_mean is not None and loop.phase_sq is not None
     pm, p2 = loop.phase_mean[idx], loop.phase_sq[idx]
     before = np.arange(2 * k) < k
     ref = np.where(before & (turn == 0.0), 1.0, turn)  # bins before the peak sit just below 1
     m1 = np.abs(pm - ref)
     m2 = p2 - 2.0 * ref * pm + ref * ref
     X = np.column_stack([np.ones(2 * k), m1, m2])
+    sb = loop.x_std[idx] / math.sqrt(loop.n_cycles)
+    s2_bins = nanmean(sb**2) if np.any(np.isfinite(sb)) else 0.0
+    inv00 = float(np.linalg.inv(X.T @ X)[0, 0])
+    design = (idx, X, s2_bins, inv00)
+    if len(_DESIGNS) >= _KEPT_DESIGNS:
+        with contextlib.suppress(KeyError, StopIteration, RuntimeError):  # (another thread)
+            del _DESIGNS[next(iter(_DESIGNS))]
+    _DESIGNS[key] = (loop.phase_mean, loop.phase_sq, loop.x_std, design)
+    return design
+
+
+def _tip_fit(loop: AveragedLoop, first: int, k: int) -> tuple[float, float] | None:
+    idx, X, s2_bins, inv00 = _tip_design(loop, first, k)
     y = loop.x[idx]
     coef, *_ = np.linalg.lstsq(X, y, rcond=None)
     resid = y - X @ coef
     dof = 2 * k - 3
     s2_fit = float(resid @ resid) / dof if dof > 0 else 0.0
-    sb = loop.x_std[idx] / math.sqrt(loop.n_cycles)
-    s2_bins = nanmean(sb**2) if np.any(np.isfinite(sb)) else 0.0
     s2 = max(s2_fit, s2_bins)
-    var0 = s2 * float(np.linalg.inv(X.T @ X)[0, 0])
+    var0 = s2 * inv00
     if not np.isfinite(var0):
         return None
     return float(coef[0]), var0

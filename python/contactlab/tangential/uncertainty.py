@@ -125,14 +125,13 @@ def numeric_energy(loop: AveragedLoop, x: np.ndarray, F: np.ndarray) -> tuple[fl
     # per cycle Σ (∂A/∂F_i)² and Σ (∂A/∂x_i)² (∂A/∂F_i = (x_{i-1} - x_{i+1}) / 2,
     # ∂A/∂x_i = (F_{i+1} - F_{i-1}) / 2, cyclic in the cycle): one pass in Rust
     # (the loop's own, from the fold of these samples, when it carries them)
-    bounds = [int(b) for b in loop.cycle_bounds[: n + 1]]
-    g_F, g_x = (
-        loop.sensitivity
-        if loop.sensitivity is not None and loop.sensitivity[0].size == n
-        else _core.loop_area_sensitivity(
+    if loop.sensitivity is not None and loop.sensitivity[0].size == n:
+        g_F, g_x = loop.sensitivity
+    else:
+        bounds = [int(b) for b in loop.cycle_bounds[: n + 1]]
+        g_F, g_x = _core.loop_area_sensitivity(
             np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(F, dtype=float), bounds
         )
-    )
     with np.errstate(over="ignore", invalid="ignore"):  # 1e300-scale loops: err is NaN below
         var = float(np.sum(g_F) * s2F + np.sum(g_x) * s2x)
     err = math.sqrt(var) / n
