@@ -76,7 +76,7 @@ def run_job(job: tuple[str, int, str, tuple[str, ...]]) -> dict[str, Any]:
     if effect in SIZE:
         e, k = SIZE[effect]
         out["size"] = abs(float(case["effects"][e][k]))
-    out["size"] = effective_size(effect, chain, case["factors"], out.get("size"))
+        out["size"] = effective_size(effect, chain, case["factors"], out["size"])
     t0 = time.process_time()
     try:
         rep = diagnose(data, model="tangential")
