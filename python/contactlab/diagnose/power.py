@@ -581,10 +581,9 @@ def _detectable(
     refused = _refusal(family, name, effects, mags, shape)
     if refused is not None:
         return refused
-    apart = (
-        _not_separable(family, name, d, params)
-        or _not_told_apart(name, d, effects)
-        or _withdrawn(name, d, effects)
+    tangential = getattr(family, "kind", "") == "tangential"
+    apart = _not_separable(family, name, d, params) or (
+        tangential and (_not_told_apart(name, d, effects) or _withdrawn(name, d, effects))
     )
     if apart:
         first = mags[0]

@@ -657,7 +657,8 @@ class StepwiseSearch:
         )
         best = max(accepted, key=lambda vc: vc[0].gain) if accepted else None
         best = _parsimonious(best, accepted)
-        if best is not None:
+        # tangential only: the normal family's look-alikes are judged by their own rules
+        if best is not None and getattr(self.family, "kind", "") == "tangential":
             _mark_not_told_apart(best, seen_trials, st, self.d, self.z, self.family.kind)
         if verdicts:
             st.steps[-1] = dataclasses.replace(
