@@ -81,6 +81,10 @@ def test_spring_the_base_absorbs_is_not_claimed_at_its_linear_size(
     assert stated["parallel_stiffness"].detectable_above is None
     assert "not separable" in stated["parallel_stiffness"].reason
     monkeypatch.setattr(ps, "PLATEAU_ACA", 0.0)
+    # ... and without its rival, a 2f normal load (stop 42): in pre-sliding h·(1 + ε cos 2ωt)
+    # holds (1 + ε) k x, the spring's own direction, so beside it no spring is promised
+    # either; the refit's share is what this test checks
+    monkeypatch.setattr(ps.ParallelStiffness, "rivals", ())
     nonlinear = {b.effect: b for b in power.stated_power(presliding_report, seed=1)}
     monkeypatch.setattr(power, "NONLINEAR_STEPS", 0)
     linear = {b.effect: b for b in power.stated_power(presliding_report, seed=1)}

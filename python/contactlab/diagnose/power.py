@@ -581,7 +581,10 @@ def _detectable(
     refused = _refusal(family, name, effects, mags, shape)
     if refused is not None:
         return refused
-    apart = _not_separable(family, name, d, params)
+    tangential = getattr(family, "kind", "") == "tangential"
+    apart = _not_separable(family, name, d, params) or (
+        tangential and (_not_told_apart(name, d, effects) or _withdrawn(name, d, effects))
+    )
     if apart:
         first = mags[0]
         return Detectable(name, first.name, None, first.unit, first.null, None, shape,
@@ -619,6 +622,45 @@ def _detectable(
         name, worst.name, per[worst.name], worst.unit, worst.null, rel[worst.name], shape, per,
         gain_at_bound=gain[worst.name],
     )  # fmt: skip
+
+
+def _withdrawn(name: str, d: Prepared, effects: tuple[str, ...]) -> str:
+    """Why no size of candidate ``name`` can be promised because the search named it and the
+    closing checks withdrew it (``d.extra["withdrawn"]``, kept by
+    :func:`contactlab.diagnose.workflow._withdraw`), or empty: the record showed it, and a
+    bound saying it "would be seen above" a size promises a name the diagnosis withholds on
+    this record whatever the size (a track's wave of 5-8 % of h0 through the rig's sensor
+    chain, at 3-4 times its stated bound, was withdrawn as taking up a misfit of the branch
+    shape: ``benches/eval_lookalike.py`` fresh seeds 56000-56004)."""
+    why = (d.extra.get("withdrawn") or {}).get(name)
+    if not why or name in effects:
+        return ""
+    return (
+        f"seen and withdrawn on this record ({why}): the data hold a signature the diagnosis "
+        "does not name here, so no size is promised"
+    )
+
+
+def _not_told_apart(name: str, d: Prepared, effects: tuple[str, ...]) -> str:
+    """Why no size of candidate ``name`` can be promised because an effect named in the
+    final model (``effects``) fitted the held-out cycles as well as it when it was added
+    (the search's note in ``d.extra``: :func:`contactlab.diagnose.search._mark_not_told_apart`),
+    or empty: a look-alike took its signature, and the bound would promise what the data
+    cannot show."""
+    from .search import NOT_TOLD_APART
+
+    tie = (d.extra.get(NOT_TOLD_APART) or {}).get(name)
+    if not tie or tie["named"] not in effects:
+        return ""
+    better = "as well or better" if tie["t"] < 0 else "as well"
+    why = tie.get("refused") or ""
+    return (
+        f"not told apart from {tie['named']}, named: when it was added, {name} fitted the "
+        f"held-out cycles {better} (held-out gains {tie['gain']:.3g} against "
+        f"{tie['gain_named']:.3g} σ², paired t of the named effect's lead {tie['t']:.2f})"
+        + (f" and was not named ({why[:200]})" if why else "")
+        + "; on this record the data do not say which of the two they hold"
+    )
 
 
 def _not_separable(family: Family, name: str, d: Prepared, params: dict[str, float]) -> str:

@@ -657,6 +657,9 @@ class StepwiseSearch:
         )
         best = max(accepted, key=lambda vc: vc[0].gain) if accepted else None
         best = _parsimonious(best, accepted)
+        # tangential only: the normal family's look-alikes are judged by their own rules
+        if best is not None and getattr(self.family, "kind", "") == "tangential":
+            _mark_not_told_apart(best, seen_trials, st, self.d, self.z, self.family.kind)
         if verdicts:
             st.steps[-1] = dataclasses.replace(
                 st.steps[-1], candidates=tuple(sorted(verdicts, key=lambda v: v.heldout_rms))
@@ -808,6 +811,89 @@ class StepwiseSearch:
             others = ", ".join(m for m in members if m != v.name)
             self._drop(st, v, "parsimony", f"it acts through the {group} as {others} does, and "
                        f"is not separately significant after it: {v.reason}")  # fmt: skip
+
+
+#: the key of ``d.extra`` under which the search keeps, per candidate not named, the named
+#: effect it was not told apart from (:func:`_mark_not_told_apart`; read by the stated
+#: power: :func:`contactlab.diagnose.power.detectable_above`)
+NOT_TOLD_APART = "not_told_apart"
+
+
+def paired_lead(d: Prepared, current: Trial, best: Trial, other: Trial) -> float:
+    """The t statistic of ``best``'s lead over ``other`` across held-out cycles: the mean of
+    the per-cycle differences of their held-out gains over ``current``
+    (:func:`gain_by_cycle`) over its standard error (``±inf`` when every cycle gives the
+    same lead, ``nan`` with fewer than two cycles in common)."""
+    a, b = gain_by_cycle(d, current, best), gain_by_cycle(d, current, other)
+    diff = np.array([a[c] - b[c] for c in a if c in b])
+    if diff.size < 2:
+        return float("nan")
+    sd = float(np.std(diff, ddof=1))
+    m = float(np.mean(diff))
+    if not sd > 0:
+        return float("inf") if m > 0 else float("-inf") if m < 0 else 0.0
+    return m / (sd / np.sqrt(diff.size))
+
+
+def _mark_not_told_apart(
+    best: tuple[Verdict, Trial],
+    tried: dict[str, tuple[Verdict, Trial]],
+    st: SearchState,
+    d: Prepared,
+    z: float,
+    kind: str = "tangential",
+) -> None:
+    """Note in ``d.extra[NOT_TOLD_APART]`` every candidate tried at this step (accepted or
+    not, neither implausible nor unfitted, a positive held-out gain) whose held-out gain
+    the effect added (``best``) does not beat significantly cycle by cycle (the paired t
+    of :func:`paired_lead` at most the search's ``z``), and say so in ``st.where``. The
+    lead counted is beyond what the input's noise alone gives the effect over that rival
+    (its ``noise_fed_lead[rival]`` times the input-noise budget
+    ``d.extra["input_noise_budget"]``, σ²: a play passes over the noise's wiggles at each
+    turn, which a delay cannot): the t is scaled by the share of the held-out lead left
+    beyond it, the per-cycle scatter unchanged.
+
+    Look-alikes draw nearly the same force on one amplitude (docs/effects.md: a 2f load, a
+    dashpot, a Stribeck term and a delay in gross sliding; a spring and a 2f load's
+    quadrature part): where the held-out error ranks them by chance, naming one is a
+    choice the data do not make. The effect stays named (it passed every rule); the
+    rival's stated bound says it was not told apart from it instead of promising a size
+    (rig through the whole sensor chain, 2f loads of 3-6 % of h0: named viscous_damping at
+    2.452 σ² against the load's 2.429, stribeck at 3.175 against 3.228, channel_delay at
+    1.188 against 1.139; ``benches/eval_lookalike.py`` tuning seeds 52001, 52005,
+    52006)."""
+    from .effects import registry
+
+    v, cand = best
+    store = d.extra.setdefault(NOT_TOLD_APART, {})
+    try:
+        fed = dict(getattr(registry(kind).get(v.name), "noise_fed_lead", {}) or {})
+    except KeyError:
+        fed = {}
+    budget = float(d.extra.get("input_noise_budget", 0.0) or 0.0)
+    ties = []
+    for name, (w, other) in tried.items():
+        if name == v.name or name in st.effects or not (np.isfinite(w.gain) and w.gain > 0):
+            continue
+        why = w.reason or ""
+        if why.startswith(("implausible", "could not be fitted")):
+            continue
+        t = paired_lead(d, st.current, cand, other)
+        lead, owed = v.gain - w.gain, fed.get(name, 0.0) * budget
+        if owed > 0 and lead > 0 and np.isfinite(t):
+            # the lead beyond what the noise gives, at the same scatter across cycles
+            t *= 1.0 - owed / lead
+        if np.isfinite(t) and t <= z:
+            store[name] = {"named": v.name, "gain_named": float(v.gain),
+                           "gain": float(w.gain), "t": float(t),
+                           "refused": "" if w.accepted else why}  # fmt: skip
+            ties.append(f"{name} ({w.gain:.3g} σ², t = {t:.2f})")
+    if ties:
+        st.where.append(
+            f"{v.name} (held-out gain {v.gain:.3g} σ²) is not told apart from "
+            f"{', '.join(ties)}: its lead over each across held-out cycles is not significant "
+            f"(paired t at most {z:g}); on this record the data do not say which of them it is"
+        )
 
 
 def _yield_to_lookalikes(

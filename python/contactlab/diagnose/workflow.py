@@ -356,6 +356,9 @@ def _assess(
     return checks
 
 
+#: the key of ``d.extra`` under which the closing checks keep the effects they withdrew,
+#: with why (read by the stated power: :func:`contactlab.diagnose.power.detectable_above`)
+WITHDRAWN = "withdrawn"
 #: what the report says of an effect withdrawn because the misfit test found it absorbing
 #: structure it does not model (:data:`contactlab.diagnose.misfit.SHAPE_ABSORBERS`)
 ABSORBED = (
@@ -471,6 +474,8 @@ def _withdraw(
             "parameters, held-out error and h0 are those of the refit"
         )
         withdrawn[name] = why
+        # the stated power promises no size of an effect seen and withdrawn (power.py)
+        d.extra.setdefault(WITHDRAWN, {})[name] = why
         if why is ABSORBED:
             absorbed.append(name)
         checks = _assess(b, d, st, names, z, min_gain, folds, declared_noise, location)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+from typing import ClassVar
 
 import numpy as np
 
@@ -64,6 +65,15 @@ class Backlash(EffectModel):
 
     #: the look-alike a play yields to (:meth:`yields_to`)
     LOOKALIKES = ("channel_delay",)
+    #: the share of the input-noise budget a play's lead over a rival may owe to the noise
+    #: alone (:func:`contactlab.diagnose.search._mark_not_told_apart`): at each turn a play
+    #: passes over the noise's wiggles, which a delay cannot, and so leads it cycle after
+    #: cycle, a lead a paired t reads as significant. On the rig through the whole sensor
+    #: chain at 1.5-2 % x noise, delays of 0.46 and 0.96 ms were named backlash with leads
+    #: of 0.81 and 0.57 σ² against budgets of 0.65 and 0.60 σ², nearly all of it within a
+    #: fifth of the stroke's speed of the turns (``benches/eval_lookalike.py`` tuning seeds
+    #: 52001, 52005, plain chain): the delay's bound said it would have been seen
+    noise_fed_lead: ClassVar[dict[str, float]] = {"channel_delay": 1.0}
 
     def yields_to(self, p, gains, own, d=None):
         """Why a play is not named beside a channel delay accepted at the same step whose

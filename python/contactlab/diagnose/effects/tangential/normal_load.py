@@ -120,6 +120,30 @@ class NormalLoad(EffectModel):
     rank = 2
     order = 14
     size_param = "eps_c"
+    #: the candidates whose directions the stated bound projects out (power's
+    #: ``_rival_directions``): locked to the drive at 2f (:meth:`power_shape`), the load's
+    #: in-phase part is in gross sliding the friction's sign times a bump at mid-stroke, as
+    #: a dashpot's c ẋ, and its quadrature part a function of x alone on both strokes, as a
+    #: spring's k_p x (docs/effects.md). Stated at 0.23 f with no rival, the bound promised
+    #: 2f loads of 3-6 % of h0 that were named viscous_damping, stribeck or channel_delay
+    #: at 1.4-2.9 times it (rig, ``benches/eval_lookalike.py`` tuning seeds 52001-52006)
+    rivals = ("viscous_damping", "parallel_stiffness")
+
+    def power_shape(self, d, p):
+        """The frequency the stated bound is given at: twice the drive's (a normal load
+        coupled to the motion; the drive frequency itself is refused), where a dashpot and
+        a spring take most of the load's signature, so the bound holds for a load at any
+        frequency, not only for one that no harmonic comes near."""
+        period = d.cycles.period_samples * d.dt
+        return {"f_n": 2.0 / period} if period > 0 else {}
+
+    def power_note(self, d, p):
+        """What the bound is stated for."""
+        return (
+            "stated for a load locked to the drive at 2f, beyond what a dashpot (its in-phase "
+            "part) and a parallel spring (its quadrature part) take of it; a load at a "
+            "frequency no harmonic of the drive comes near shows at a smaller size"
+        )
 
     def size(self, p, se):
         """The amplitude over (eps_c, eps_s), with its delta-method error."""

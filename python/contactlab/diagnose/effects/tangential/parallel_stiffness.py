@@ -28,6 +28,12 @@ class ParallelStiffness(EffectModel):
     rank = 1
     order = 2
     size_param = "k_p"
+    #: the candidate whose direction the stated bound projects out: a normal load locked to
+    #: the drive at 2f adds, in gross sliding, ``h0 ε sin φ · 2(x/A)√(1 - (x/A)²)`` to both
+    #: strokes alike, a function of x that k_p x takes most of (docs/effects.md; a spring of
+    #: k_p A = 0.28 h_m was named normal_load: rig, ``benches/eval_lookalike.py`` tuning
+    #: seed 52000)
+    rivals = ("normal_load",)
 
     def apply(self, F, p, ctx):
         return F + p["k_p"] * ctx.pick(ctx.x)

@@ -58,7 +58,9 @@ class ViscousDamping(EffectModel):
     reads_input_derivatives = True
     #: candidates that take the same signature: in pre-sliding a delay shifts the force by
     #: ``-τ k ẋ`` (``k`` the local stiffness), a dashpot's ``c ẋ`` for ``τ = -c/k``
-    rivals = ("channel_delay",)
+    #: ... and a normal load locked to the drive at 2f, whose in-phase part is in gross
+    #: sliding the friction's sign times a bump at mid-stroke, as c ẋ (docs/effects.md)
+    rivals = ("channel_delay", "normal_load")
 
     def apply(self, F, p, ctx):
         # ẋ smoothed by a quintic over half a period (dashpot_velocity): differentiated over
