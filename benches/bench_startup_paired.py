@@ -7,6 +7,9 @@ Commands, each a new process (``python -m contactlab ...``, the same interpreter
 trees, ``PYTHONPATH`` naming the tree), stdout and stderr to /dev/null as in a script:
 
 - ``help``: ``contactlab --help``;
+- ``first read``: the same run ended (``os._exit``) by an audit hook when the reader opens
+  the recording: start-up, imports and the checks before the read, nothing of the analysis
+  (as ``bench_startup.py``'s, but the command line's own path: ``main()`` of ``sys.argv``);
 - ``csv``: ``contactlab analyze`` of the bundled 4 000-sample recording with ``--json``;
 - ``h5 FILE``: ``contactlab analyze FILE --json`` of each ``--h5`` file (e.g.
   ``bench_track.write_file``'s 1e7 and 3e7-sample recordings).
@@ -40,11 +43,33 @@ ROOT = Path(__file__).resolve().parents[1]
 CSV = ROOT / "python" / "contactlab" / "data" / "tangential" / "Al-Al_W50N_A5um.csv"
 
 
+#: ``python -c _PROBE FILE OUT``: ``contactlab analyze FILE --json OUT`` ended when the reader
+#: opens FILE
+_PROBE = r"""
+import os, sys
+target = os.path.abspath(sys.argv[1])
+def _hook(event, args):
+    if event == "open" and args and isinstance(args[0], (str, bytes, os.PathLike)):
+        try:
+            p = os.path.abspath(os.fsdecode(args[0]))
+        except (TypeError, ValueError):
+            return
+        if p == target:
+            os._exit(0)
+sys.addaudithook(_hook)
+sys.argv = ["contactlab", "analyze", target, "--json", sys.argv[2]]
+from contactlab.cli import main
+main()
+os._exit(3)  # the recording was never opened
+"""
+
+
 def run(argv: list[str], env: dict[str, str], pin: int | None) -> tuple[float, float]:
-    """Wall and CPU seconds of one ``python -m contactlab argv`` (which must succeed)."""
+    """Wall and CPU seconds of one ``python -m contactlab argv`` (which must succeed);
+    ``argv`` starting with ``-c``: ``python -c ...`` instead."""
     t0 = time.perf_counter()
     p = subprocess.Popen(
-        [sys.executable, "-m", "contactlab", *argv],
+        [sys.executable, *(argv if argv[0] == "-c" else ["-m", "contactlab", *argv])],
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
         env=env,
@@ -62,7 +87,7 @@ def main() -> None:
     ap.add_argument("--h5", type=Path, nargs="*", default=[], help="HDF5 recordings")
     ap.add_argument("--rounds", type=int, default=9)
     ap.add_argument("--pin", action="store_true", help="run every child on one CPU")
-    ap.add_argument("--skip", nargs="*", default=[], help="commands to leave out (help, csv)")
+    ap.add_argument("--skip", nargs="*", default=[], help="leave out: help, first, csv")
     args = ap.parse_args()
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     from bench_analyze import compile_tree
@@ -80,6 +105,13 @@ def main() -> None:
         cmds: dict[str, list[str]] = {}
         if "help" not in args.skip:
             cmds["contactlab --help"] = ["--help"]
+        if "first" not in args.skip:
+            cmds["analyze bundled CSV, to the first sample read"] = [
+                "-c",
+                _PROBE,
+                str(CSV),
+                str(Path(d) / "probe.json"),
+            ]
         if "csv" not in args.skip:
             cmds["analyze bundled CSV --json"] = ["analyze", str(CSV), "--json", "{out}"]
         for f in args.h5:
