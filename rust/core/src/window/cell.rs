@@ -90,6 +90,12 @@ impl Cell {
         (c_lo, nbf, g_hi): (f64, f64, f64),
     ) -> (usize, f64) {
         let (t, x, f) = (&t[..stop], &x[..stop], &f[..stop]);
+        // the nine running sums in locals for the loop (as fields of `self` behind the
+        // reference they stayed in memory: a store and a load in each sum's chain every
+        // sample); the same additions in the same order
+        let [mut s0, mut s1, mut s2, mut s3, mut s4, mut s5] = self.cur;
+        let (mut cx, mut cf, mut cp) = (self.cx, self.cf, self.cp);
+        let mut next = -1.0;
         while i < stop {
             let ti = t[i];
             if ti >= seg.k_hi {
@@ -98,12 +104,24 @@ impl Cell {
             let ph = seg.phase(ti);
             let frac = ph - c_lo;
             if frac * nbf >= g_hi {
-                return (i, ph);
+                next = ph;
+                break;
             }
-            self.add(x[i], f[i], frac, ti);
+            let (xi, fi) = (x[i], f[i]);
+            s0 += xi;
+            s1 += fi;
+            s2 += frac;
+            s3 += frac * frac;
+            s4 += xi * xi;
+            s5 += ti;
+            cx += xi;
+            cf += fi;
+            cp += frac;
             i += 1;
         }
-        (i, -1.0)
+        self.cur = [s0, s1, s2, s3, s4, s5];
+        (self.cx, self.cf, self.cp) = (cx, cf, cp);
+        (i, next)
     }
 }
 

@@ -83,6 +83,30 @@ pub fn detrend_pair_scan_into(
     (out_f, out_x): (&mut [f64], &mut [f64]),
     ranks: &[usize],
 ) -> Result<WindowScan, CoreError> {
+    detrend_pair_scan_at(
+        crate::simd::level(),
+        t,
+        tm,
+        (f, s_f),
+        (x, s_x),
+        (out_f, out_x),
+        ranks,
+    )
+}
+
+/// [`detrend_pair_scan_into`] with its pass compiled for `level` ([`crate::simd`]): the
+/// same numbers at every level (the tests compare them).
+#[doc(hidden)]
+#[allow(clippy::arithmetic_side_effects)]
+pub fn detrend_pair_scan_at(
+    level: crate::simd::Level,
+    t: &[f64],
+    tm: f64,
+    (f, s_f): (&[f64], f64),
+    (x, s_x): (&[f64], f64),
+    (out_f, out_x): (&mut [f64], &mut [f64]),
+    ranks: &[usize],
+) -> Result<WindowScan, CoreError> {
     check_same_len("t", t.len(), "F", f.len())?;
     check_same_len("t", t.len(), "x", x.len())?;
     check_same_len("t", t.len(), "out_F", out_f.len())?;
@@ -98,71 +122,21 @@ pub fn detrend_pair_scan_into(
             x[i] + (t[i] - tm) * nx
         })?)
     };
-    let (mut mx, mut mf, mut sum_f) = ([0.0_f64; 4], [0.0_f64; 4], [0.0_f64; 4]);
-    // Σ v·0 of x, F and t: ±0 while every value is finite, NaN from an inf or a NaN on (a
-    // vectorised finiteness check, where a lane of booleans was not); the smallest step of t
-    let (mut z, mut zt, mut dmin) = ([0.0_f64; 4], [0.0_f64; 4], [f64::INFINITY; 4]);
-    let mut a = 0_usize;
-    while a < n {
-        // blocks that stay in L2 for the passes over what was just written, long enough for
-        // the prefetchers' streams (blocks of GATHER_BLOCK were 2.5x slower)
-        let b = (a + SCAN_BLOCK).min(n);
-        let (tb, fb, xb) = (&t[a..b], &f[a..b], &x[a..b]);
-        let (ofb, oxb) = (&mut out_f[a..b], &mut out_x[a..b]);
-        for ((o, &ti), &vi) in ofb.iter_mut().zip(tb).zip(fb) {
-            *o = vi + (ti - tm) * nf;
-        }
-        for ((o, &ti), &vi) in oxb.iter_mut().zip(tb).zip(xb) {
-            *o = vi + (ti - tm) * nx;
-        }
-        // the steps of t from the sample before the block (none before the first)
-        let tp = &t[a.saturating_sub(1)..b];
-        let (t0, t1) = (&tp[..tp.len() - 1], &tp[1..]);
-        let mut c0 = t0.chunks_exact(4);
-        let mut c1 = t1.chunks_exact(4);
-        for (p, q) in (&mut c0).zip(&mut c1) {
-            for l in 0..4 {
-                let d = q[l] - p[l];
-                dmin[l] = if d < dmin[l] { d } else { dmin[l] };
-                zt[l] += q[l] * 0.0;
-            }
-        }
-        for (l, (&p, &q)) in c0.remainder().iter().zip(c1.remainder()).enumerate() {
-            let d = q - p;
-            dmin[l] = if d < dmin[l] { d } else { dmin[l] };
-            zt[l] += q * 0.0;
-        }
-        // finite_max_abs's lanes (sample i in lane i mod 4; blocks start at multiples of 4)
-        let mut cx = oxb.chunks_exact(4);
-        let mut cf = ofb.chunks_exact(4);
-        for (qx, qf) in (&mut cx).zip(&mut cf) {
-            for l in 0..4 {
-                let (ax, af) = (qx[l].abs(), qf[l].abs());
-                mx[l] = if ax > mx[l] { ax } else { mx[l] };
-                mf[l] = if af > mf[l] { af } else { mf[l] };
-                sum_f[l] += qf[l];
-                z[l] += qx[l] * 0.0 + qf[l] * 0.0;
-            }
-        }
-        for (l, (&vx, &vf)) in cx.remainder().iter().zip(cf.remainder()).enumerate() {
-            let (ax, af) = (vx.abs(), vf.abs());
-            mx[l] = if ax > mx[l] { ax } else { mx[l] };
-            mf[l] = if af > mf[l] { af } else { mf[l] };
-            sum_f[l] += vf;
-            z[l] += vx * 0.0 + vf * 0.0;
-        }
-        if let Some(g) = gather.as_mut() {
-            for blk in oxb.chunks(GATHER_BLOCK) {
-                g.block(blk);
-            }
-        }
-        a = b;
-    }
+    let (mx, mf, sum_f, z, zt, dmin) = crate::simd::run(
+        level,
+        ScanPass {
+            t,
+            tm,
+            inputs: (f, nf, x, nx),
+            outputs: (out_f, out_x),
+            gather: gather.as_mut(),
+        },
+    );
     // t: finite (its first sample too) and strictly increasing (a NaN step fails `> 0`)
     let t_ok =
         n >= 2 && t[0].is_finite() && zt.iter().all(|&v| v == 0.0) && dmin.iter().all(|&d| d > 0.0);
     let ok = [z.iter().all(|&v| v == 0.0); 1];
-    let big = |m: [f64; 4]| m.iter().fold(0.0_f64, |a, &b| if b > a { b } else { a });
+    let big = |m: [f64; W]| m.iter().fold(0.0_f64, |a, &b| if b > a { b } else { a });
     let (sx, sf) = (big(mx), big(mf));
     let sum = (sum_f[0] + sum_f[1]) + (sum_f[2] + sum_f[3]);
     let clean = t_ok && ok[0];
@@ -178,4 +152,109 @@ pub fn detrend_pair_scan_into(
         force_centre: force_centre(out_f, sum, sf),
         order_stats,
     })
+}
+
+/// The lanes [`ScanPass`] hands back: the largest `|x|`, `|F|`, the sum of F, `Σ (x, F)·0`,
+/// `Σ t·0`, the smallest step of t.
+type ScanLanes = ([f64; W], [f64; W], [f64; 4], [f64; W], [f64; W], [f64; W]);
+
+/// Lanes of [`ScanPass`]'s order-free scans (maxima, minimum, zero tests).
+const W: usize = 8;
+
+/// [`detrend_pair_scan_at`]'s pass over the samples as a [`crate::simd::Kernel`] (compiled
+/// for each level: in the baseline build the detrending and the scans ran two lanes wide,
+/// 1.6 ns a sample in cache).
+struct ScanPass<'a> {
+    t: &'a [f64],
+    tm: f64,
+    inputs: (&'a [f64], f64, &'a [f64], f64),
+    outputs: (&'a mut [f64], &'a mut [f64]),
+    gather: Option<&'a mut TailGather>,
+}
+
+impl crate::simd::Kernel for ScanPass<'_> {
+    type Output = ScanLanes;
+
+    // Index arithmetic: a + k < b <= n inside the blocks; l < 8.
+    #[allow(clippy::arithmetic_side_effects)]
+    #[inline(always)]
+    fn run_at(self) -> ScanLanes {
+        let ScanPass {
+            t,
+            tm,
+            inputs: (f, nf, x, nx),
+            outputs: (out_f, out_x),
+            mut gather,
+        } = self;
+        let n = t.len();
+        let (mut mx, mut mf, mut sum_f) = ([0.0_f64; W], [0.0_f64; W], [0.0_f64; 4]);
+        // Σ v·0 of x, F and t: ±0 while every value is finite, NaN from an inf or a NaN on (a
+        // vectorised finiteness check, where a lane of booleans was not); the smallest step of t
+        let (mut z, mut zt, mut dmin) = ([0.0_f64; W], [0.0_f64; W], [f64::INFINITY; W]);
+        let mut a = 0_usize;
+        while a < n {
+            // blocks that stay in L2 for the passes over what was just written, long enough for
+            // the prefetchers' streams (blocks of GATHER_BLOCK were 2.5x slower)
+            let b = (a + SCAN_BLOCK).min(n);
+            let (tb, fb, xb) = (&t[a..b], &f[a..b], &x[a..b]);
+            let (ofb, oxb) = (&mut out_f[a..b], &mut out_x[a..b]);
+            for ((o, &ti), &vi) in ofb.iter_mut().zip(tb).zip(fb) {
+                *o = vi + (ti - tm) * nf;
+            }
+            for ((o, &ti), &vi) in oxb.iter_mut().zip(tb).zip(xb) {
+                *o = vi + (ti - tm) * nx;
+            }
+            // the steps of t from the sample before the block (none before the first); eight
+            // lanes: a minimum and a zero test do not depend on the order
+            let tp = &t[a.saturating_sub(1)..b];
+            let (t0, t1) = (&tp[..tp.len() - 1], &tp[1..]);
+            let mut c0 = t0.chunks_exact(W);
+            let mut c1 = t1.chunks_exact(W);
+            for (p, q) in (&mut c0).zip(&mut c1) {
+                for l in 0..W {
+                    let d = q[l] - p[l];
+                    dmin[l] = if d < dmin[l] { d } else { dmin[l] };
+                    zt[l] += q[l] * 0.0;
+                }
+            }
+            for (l, (&p, &q)) in c0.remainder().iter().zip(c1.remainder()).enumerate() {
+                let d = q - p;
+                dmin[l] = if d < dmin[l] { d } else { dmin[l] };
+                zt[l] += q * 0.0;
+            }
+            // finite_max_abs's numbers: the maxima and the zero test in eight lanes (order
+            // free), the sum of F in its four lanes (sample i in lane i mod 4, in order:
+            // blocks start at multiples of 8)
+            let mut cx = oxb.chunks_exact(W);
+            let mut cf = ofb.chunks_exact(W);
+            for (qx, qf) in (&mut cx).zip(&mut cf) {
+                for l in 0..W {
+                    let (ax, af) = (qx[l].abs(), qf[l].abs());
+                    mx[l] = if ax > mx[l] { ax } else { mx[l] };
+                    mf[l] = if af > mf[l] { af } else { mf[l] };
+                    z[l] += qx[l] * 0.0 + qf[l] * 0.0;
+                }
+                for l in 0..4 {
+                    sum_f[l] += qf[l];
+                }
+                for l in 0..4 {
+                    sum_f[l] += qf[l + 4];
+                }
+            }
+            for (l, (&vx, &vf)) in cx.remainder().iter().zip(cf.remainder()).enumerate() {
+                let (ax, af) = (vx.abs(), vf.abs());
+                mx[l] = if ax > mx[l] { ax } else { mx[l] };
+                mf[l] = if af > mf[l] { af } else { mf[l] };
+                sum_f[l % 4] += vf;
+                z[l] += vx * 0.0 + vf * 0.0;
+            }
+            if let Some(g) = gather.as_mut() {
+                for blk in oxb.chunks(GATHER_BLOCK) {
+                    g.block(blk);
+                }
+            }
+            a = b;
+        }
+        (mx, mf, sum_f, z, zt, dmin)
+    }
 }

@@ -441,3 +441,242 @@ proptest! {
         prop_assert_eq!(bits(&with.mean_x), bits(&px));
     }
 }
+
+/// Every number of two folds equal bit for bit (NaN's bits too).
+fn bits_equal(a: &WindowFold, b: &WindowFold) -> Result<(), String> {
+    let pairs: [(&str, &[f64], &[f64]); 16] = [
+        ("count", &a.count, &b.count),
+        ("sum_x", &a.sum_x, &b.sum_x),
+        ("sum_f", &a.sum_f, &b.sum_f),
+        ("sum_phase", &a.sum_phase, &b.sum_phase),
+        ("sum_phase2", &a.sum_phase2, &b.sum_phase2),
+        ("sum_xx", &a.sum_xx, &b.sum_xx),
+        ("sum_t", &a.sum_t, &b.sum_t),
+        ("x_std", &a.x_std, &b.x_std),
+        ("f_std", &a.f_std, &b.f_std),
+        ("energy", &a.energy, &b.energy),
+        ("sens_f", &a.sens_f, &b.sens_f),
+        ("sens_x", &a.sens_x, &b.sens_x),
+        ("amplitude", &a.amplitude, &b.amplitude),
+        ("force_range", &a.force_range, &b.force_range),
+        ("mean_f", &a.mean_f, &b.mean_f),
+        ("mean_x", &a.mean_x, &b.mean_x),
+    ];
+    for (name, u, v) in pairs {
+        let same = u.len() == v.len() && u.iter().zip(v).all(|(p, q)| p.to_bits() == q.to_bits());
+        if !same {
+            return Err(format!("{name}: {u:?} != {v:?}"));
+        }
+    }
+    if a.first != b.first || a.bounds != b.bounds {
+        return Err(format!(
+            "first/bounds {:?} {:?} != {:?} {:?}",
+            a.first, a.bounds, b.first, b.bounds
+        ));
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+    /// The fold's pass compiled for each SIMD level this CPU has gives the generic build's
+    /// numbers bit for bit: irregular sampling and knots (phases held at a knot, empty
+    /// bins), cycles of a few to a thousand samples (the loop areas' blocks of terms and
+    /// their remainders), with and without period edges.
+    #[test]
+    fn every_simd_level_folds_as_the_generic_build(
+        seed in 0u64..1_000_000, n_bins in 1usize..40, n_cyc in 1usize..8,
+        n in 3usize..4000, n_knots in 2usize..30, with_edges in any::<bool>(),
+    ) {
+        let mut s = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(11);
+        let mut u = move || {
+            s = s
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut t = Vec::with_capacity(n);
+        let mut v = 0.0;
+        for _ in 0..n {
+            v += 0.05 + u();
+            t.push(v);
+        }
+        let x: Vec<f64> = t.iter().map(|&ti| (0.01 * ti).sin() + 0.1 * u()).collect();
+        let f: Vec<f64> = t.iter().map(|&ti| (0.01 * ti + 0.5).cos() + 0.1 * u()).collect();
+        let span = t[n - 1] - t[0];
+        let mut kt: Vec<f64> = (0..n_knots)
+            .map(|_| {
+                if u() < 0.3 {
+                    t[(u() * n as f64) as usize % n]
+                } else {
+                    t[0] - 0.1 * span + 1.2 * span * u()
+                }
+            })
+            .collect();
+        kt.sort_by(f64::total_cmp);
+        kt.dedup();
+        prop_assume!(kt.len() >= 2);
+        let mut kp: Vec<f64> = (0..kt.len())
+            .map(|_| if u() < 0.2 { 0.0 } else { u() * n_cyc as f64 })
+            .collect();
+        kp.sort_by(f64::total_cmp);
+        kp[0] = if u() < 0.5 { 0.0 } else { kp[0] };
+        let edges: Vec<f64> = if with_edges {
+            kt.iter().step_by(2).copied().collect()
+        } else {
+            Vec::new()
+        };
+        let args = ((&t[..], &x[..], &f[..]), (&kt[..], &kp[..]), (n_bins, n_cyc));
+        let want = fold_window_at(crate::simd::Level::Generic, args.0, args.1, args.2, &edges, None);
+        for l in crate::simd::Level::ALL.into_iter().filter(|l| l.supported()) {
+            let got = fold_window_at(l, args.0, args.1, args.2, &edges, None);
+            match (&want, &got) {
+                (Ok(a), Ok(b)) => {
+                    let r = bits_equal(a, b);
+                    prop_assert!(r.is_ok(), "level {}: {}", l.name(), r.unwrap_err());
+                }
+                (Err(a), Err(b)) => prop_assert_eq!(a.to_string(), b.to_string()),
+                _ => prop_assert!(false, "level {}: {:?} / {:?}", l.name(), got.is_ok(), want.is_ok()),
+            }
+        }
+    }
+}
+
+/// [`cycle_area`] as it was before its terms were computed by blocks (one loop over four
+/// shifted slices in lanes): the reference the blocked sums must equal bit for bit.
+#[allow(clippy::arithmetic_side_effects)]
+fn cycle_area_reference(
+    x: &[f64],
+    f: &[f64],
+    ux: f64,
+    uf: f64,
+    fm: f64,
+    scale: f64,
+) -> (f64, f64, f64) {
+    let m = x.len().min(f.len());
+    if m < 3 {
+        return (f64::NAN, 0.0, 0.0);
+    }
+    let (x, f) = (&x[..m], &f[..m]);
+    // the shoelace terms 0.5·(F[i-1] + F[i])·(x[i] - x[i-1]) of the scaled samples, i >= 1
+    let term = |xp: f64, xs: f64, fp: f64, fs: f64| {
+        let (xp, xs, fp, fs) = (xp * ux, xs * ux, fp * uf - fm, fs * uf - fm);
+        0.5 * (fp + fs) * (xs - xp)
+    };
+    let (mut s, mut c) = ([0.0_f64; LANES], [0.0_f64; LANES]);
+    let (xa, xb, fa, fb) = (&x[..m - 1], &x[1..], &f[..m - 1], &f[1..]);
+    let mut it = xa
+        .chunks_exact(LANES)
+        .zip(xb.chunks_exact(LANES))
+        .zip(fa.chunks_exact(LANES))
+        .zip(fb.chunks_exact(LANES));
+    for (((xa, xb), fa), fb) in &mut it {
+        for k in 0..LANES {
+            let v = term(xa[k], xb[k], fa[k], fb[k]);
+            // two-sum: t + e = s + v exactly
+            let t = s[k] + v;
+            let bb = t - s[k];
+            c[k] += (s[k] - (t - bb)) + (v - bb);
+            s[k] = t;
+        }
+    }
+    let mut a = Neumaier::default();
+    for &v in &s {
+        a.add(v);
+    }
+    a.comp += c.iter().sum::<f64>();
+    let done = (m - 1) / LANES * LANES;
+    for i in done..m - 1 {
+        a.add(term(xa[i], xb[i], fa[i], fb[i]));
+    }
+    // the closing term, last sample to first
+    a.add(term(x[m - 1], x[0], f[m - 1], f[0]));
+    // each sample's neighbours i - 1 and i + 1 as four slices of one length
+    let (xa, xb, fa, fb) = (&x[..m - 2], &x[2..], &f[..m - 2], &f[2..]);
+    let (mut sf, mut sx) = ([0.0_f64; LANES], [0.0_f64; LANES]);
+    let mut it = xa
+        .chunks_exact(LANES)
+        .zip(xb.chunks_exact(LANES))
+        .zip(fa.chunks_exact(LANES))
+        .zip(fb.chunks_exact(LANES));
+    for (((xa, xb), fa), fb) in &mut it {
+        for k in 0..LANES {
+            let cf = 0.5 * (xa[k] - xb[k]);
+            let cx = 0.5 * (fb[k] - fa[k]);
+            sf[k] += cf * cf;
+            sx[k] += cx * cx;
+        }
+    }
+    let (mut sf, mut sx) = (
+        (sf[0] + sf[1]) + (sf[2] + sf[3]),
+        (sx[0] + sx[1]) + (sx[2] + sx[3]),
+    );
+    for i in (m - 2) / LANES * LANES..m - 2 {
+        let cf = 0.5 * (xa[i] - xb[i]);
+        let cx = 0.5 * (fb[i] - fa[i]);
+        sf += cf * cf;
+        sx += cx * cx;
+    }
+    // the first sample (neighbours: the last and the second), then the last (the one before
+    // it and the first)
+    let (c0f, c0x) = (0.5 * (x[m - 1] - x[1]), 0.5 * (f[1] - f[m - 1]));
+    let (c1f, c1x) = (0.5 * (x[m - 2] - x[0]), 0.5 * (f[0] - f[m - 2]));
+    (
+        (a.sum + a.comp) * scale,
+        sf + c0f * c0f + c1f * c1f,
+        sx + c0x * c0x + c1x * c1x,
+    )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+    /// The loop area and its sensitivities of one cycle by blocks of terms are the
+    /// sample-by-lane sums' bit for bit (lengths around the block and lane bounds).
+    #[test]
+    fn cycle_area_by_blocks_is_the_lane_sum(
+        seed in 0u64..1_000_000, m in 0usize..300, fm in -2.0f64..2.0,
+    ) {
+        let (_, x, f) = signal(m.max(1), seed, 1e-3);
+        let (x, f) = (&x[..m], &f[..m]);
+        let (ux, uf) = (1.0 / 1e-3, 1.0 / 1.5);
+        let a = cycle_area(x, f, ux, uf, fm, 1.5e-3);
+        let b = cycle_area_reference(x, f, ux, uf, fm, 1.5e-3);
+        prop_assert_eq!(a.0.to_bits(), b.0.to_bits());
+        prop_assert_eq!(a.1.to_bits(), b.1.to_bits());
+        prop_assert_eq!(a.2.to_bits(), b.2.to_bits());
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    /// The detrending scan compiled for each SIMD level this CPU has gives the generic
+    /// build's samples, order statistics and scan numbers bit for bit, a non-finite or
+    /// non-increasing sample included (then `clean` is false at every level).
+    #[test]
+    fn every_simd_level_scans_as_the_generic_build(
+        seed in 0u64..1000, n in prop::sample::select(vec![2usize, 7, 40, 5000, 70_001]),
+        s_f in -1e3f64..1e3, s_x in -1e-3f64..1e-3, bad in 0u8..4,
+    ) {
+        let (mut t, mut x, f) = signal(n, seed, 1e-3);
+        let k = (seed as usize) % n;
+        match bad {
+            1 => x[k] = f64::NAN,
+            2 => t[k] = f64::INFINITY,
+            3 if k > 0 => t[k] = t[k - 1],
+            _ => {}
+        }
+        let tm = t[n / 2];
+        let ranks = if n > 1000 { tail_ranks(n) } else { Vec::new() };
+        let (mut gf, mut gx) = (vec![0.0; n], vec![0.0; n]);
+        let g = detrend_pair_scan_at(
+            crate::simd::Level::Generic, &t, tm, (&f, s_f), (&x, s_x), (&mut gf, &mut gx), &ranks,
+        );
+        for l in crate::simd::Level::ALL.into_iter().filter(|l| l.supported()) {
+            let (mut of, mut ox) = (vec![0.0; n], vec![0.0; n]);
+            let s = detrend_pair_scan_at(l, &t, tm, (&f, s_f), (&x, s_x), (&mut of, &mut ox), &ranks);
+            prop_assert_eq!(format!("{s:?}"), format!("{g:?}"), "level {}", l.name());
+            prop_assert!(of.iter().zip(&gf).all(|(a, b)| a.to_bits() == b.to_bits()));
+            prop_assert!(ox.iter().zip(&gx).all(|(a, b)| a.to_bits() == b.to_bits()));
+        }
+    }
+}
