@@ -84,6 +84,13 @@ def run(argv: list[str], env: dict[str, str], pin: int | None) -> tuple[float, f
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--baseline", type=Path, required=True, help="the other tree's python/")
+    ap.add_argument(
+        "--tree",
+        type=Path,
+        default=ROOT / "python",
+        help="the tree measured against the baseline (default: this one; a copy beside the "
+        "baseline, on the same file system, keeps the comparison even)",
+    )
     ap.add_argument("--h5", type=Path, nargs="*", default=[], help="HDF5 recordings")
     ap.add_argument("--rounds", type=int, default=9)
     ap.add_argument("--pin", action="store_true", help="run every child on one CPU")
@@ -92,7 +99,7 @@ def main() -> None:
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     from bench_analyze import compile_tree
 
-    here = ROOT / "python"
+    here = args.tree.resolve()
     for tree in (args.baseline, here):
         if compile_tree(tree):
             raise SystemExit(f"{tree}: a module does not compile")
