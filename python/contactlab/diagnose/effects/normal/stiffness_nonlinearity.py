@@ -47,6 +47,39 @@ class StiffnessNonlinearity(EffectModel):
     #: hidden at the bound stated without it was named asymmetric_branches)
     rivals = ("asymmetric_branches",)
 
+    def yields_to_tried(self, p, v, cand, tried, current, d):
+        """Why the stiffening law is not named when the loss asymmetry tried at the same
+        step (accepted or not, not implausible) fits the record better counting its start
+        from rest (:func:`~.asymmetric_branches.shape_evidence` < 0), or None; neither is
+        named when the asymmetry did not pass on its own (rig, fresh seed 309: an
+        asymmetry a = 0.31, 0.377 σ² at t = 2.84, was named ``stiffness_nonlinearity`` at
+        0.323 σ²). The converse of
+        :meth:`AsymmetricBranches.yields_to_tried
+        <contactlab.diagnose.effects.normal.asymmetric_branches.AsymmetricBranches.yields_to_tried>`)."""
+        from .asymmetric_branches import shape_evidence
+
+        rival = tried.get("asymmetric_branches")
+        if rival is None:
+            return None
+        rv, rc = rival
+        if (rv.reason or "").startswith("implausible"):
+            return None
+        total, held, start = shape_evidence(d, current, cand, rc)
+        if not total < 0.0:
+            return None
+        tail = (
+            ""
+            if rv.accepted
+            else f"; the asymmetry itself did not pass ({rv.reason}), so neither is named: "
+            "the record shows a shape beyond the ellipse that it cannot attribute"
+        )
+        return (
+            f"the loss asymmetry a = {rc.full.params.get('a', np.nan):.3g} ({rv.gain:.3g} σ² "
+            f"held out) fits the record better than the law ({v.gain:.3g} σ²) by "
+            f"{-total:.3g} χ² units ({-held:.3g} on the held-out cycles, {-start:.3g} on the "
+            f"start-up, where the mean displacement builds as |δ'|, not as δ²){tail}"
+        )
+
     def size(self, p, se):
         """The change of the stiffness at ``±δ_r`` over (κ1, κ) in quadrature, with its
         delta-method error."""
