@@ -158,3 +158,42 @@ def test_a_streamed_tangential_analyze_imports_no_normal_study_or_html_module(tm
     assert not [m for m in loaded if m.startswith(lazy)], sorted(
         m for m in loaded if m.startswith(lazy)
     )
+
+
+def test_analyze_without_a_terminal_imports_no_progress_bar(tmp_path):
+    # stderr is a pipe here: tqdm's own rule (disable=None) would show no bar, so the run
+    # does not import tqdm (tqdm.auto pulls in asyncio and ssl)
+    out = tmp_path / "r.json"
+    loaded = _modules_after(
+        "import sys\nfrom contactlab.cli import main\n"
+        "assert main(['analyze', sys.argv[1], '--json', sys.argv[2]]) == 0",
+        str(RECORDING),
+        str(out),
+    )
+    assert "contactlab.studies.study" in loaded and out.is_file()
+    assert not {"tqdm", "asyncio", "ssl"} & loaded, sorted({"tqdm", "asyncio", "ssl"} & loaded)
+    assert "concurrent.futures" not in loaded
+    assert "contactlab.diagnose" not in loaded
+
+
+def test_study_progress_bar_only_where_tqdm_would_show_one(monkeypatch):
+    import io
+
+    from contactlab.studies import study
+
+    items = [1, 2, 3]
+    assert study._progress(items, False, "x") is items
+    monkeypatch.setattr(sys, "stderr", io.StringIO())  # not a terminal
+    assert study._progress(items, None, "x") is items
+    bar = study._progress(items, True, "x")
+    assert list(bar) == items and bar is not items
+    bar.close()
+
+    class Tty(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    monkeypatch.setattr(sys, "stderr", Tty())
+    bar = study._progress(items, None, "x")
+    assert bar is not items and not bar.disable and list(bar) == items
+    bar.close()

@@ -30,8 +30,6 @@ import functools
 import math
 from collections import deque
 from collections.abc import Callable, Iterator, Mapping, Sequence
-from concurrent.futures import FIRST_COMPLETED
-from concurrent.futures import wait as futures_wait
 from pathlib import Path
 from typing import Any
 
@@ -752,6 +750,11 @@ class _Dispatch:
             # collected in order
             busy = [f for _, f in in_flight if not f.done()]
             if len(busy) >= self.limit:
+                # (imported here: a serial run needs no concurrent.futures, whose import
+                # pulls in logging, ~5 % of a short streamed run's start-up)
+                from concurrent.futures import FIRST_COMPLETED
+                from concurrent.futures import wait as futures_wait
+
                 futures_wait(busy, return_when=FIRST_COMPLETED)
             while in_flight and in_flight[0][1].done():
                 self.collect(*in_flight.popleft())

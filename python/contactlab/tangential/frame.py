@@ -268,8 +268,9 @@ def lepski_square_sums(
         coeffs = [savgol_coeffs(w, POLYORDER, deriv=2, delta=dt) for w in cands]
     else:  # convolution orientation: the dot weights reversed
         coeffs = [coefficients(w, 2, dt)[::-1] for w in cands]
-    est = np.empty((k, block))
-    diff = np.empty((k, block))
+    width = max(min(block, n), 1)  # a short record's buffers no wider than it (2 x 8 MB)
+    est = np.empty((k, width))
+    diff = np.empty((k, width))
     out = np.zeros((k, k))
     for s in range(0, n, block):
         e = min(s + block, n)
