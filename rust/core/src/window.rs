@@ -269,6 +269,15 @@ fn cycle_area(x: &[f64], f: &[f64], ux: f64, uf: f64, fm: f64, scale: f64) -> (f
     )
 }
 
+crate::simd::dispatch! {
+    /// [`cycle_area`] compiled for `level`, out of line: run once a cycle completes, it
+    /// keeps its own registers. Inlined into the fold's pass, its blocks of terms added to
+    /// the pass's register pressure, and the run loop kept one pair of the cell's running
+    /// sums on the stack (a store and a load in those sums' chains every sample).
+    #[inline(never)]
+    fn cycle_area_at(x: &[f64], f: &[f64], ux: f64, uf: f64, fm: f64, scale: f64) -> (f64, f64, f64) = cycle_area;
+}
+
 fn bad(name: &'static str, value: f64, reason: &'static str) -> CoreError {
     CoreError::InvalidParameter {
         name,
@@ -604,6 +613,7 @@ pub fn fold_window_at(
             sizes: (n_bins, n_cycles),
             edges,
             scales,
+            level,
         },
     )
 }
@@ -616,6 +626,7 @@ struct FoldPass<'a> {
     sizes: (usize, usize),
     edges: &'a [f64],
     scales: [f64; 3],
+    level: crate::simd::Level,
 }
 
 impl crate::simd::Kernel for FoldPass<'_> {
@@ -638,6 +649,7 @@ fn fold_pass(p: FoldPass<'_>) -> Result<WindowFold, CoreError> {
         sizes: (n_bins, n_cycles),
         edges,
         scales: [sx, sf, fm],
+        level,
     } = p;
     let (nb, nc) = (n_bins, n_cycles);
     let mut w = WindowFold::empty(nb, nc);
@@ -728,7 +740,7 @@ fn fold_pass(p: FoldPass<'_>) -> Result<WindowFold, CoreError> {
             }
             if let Some(ac) = area_cycle {
                 (w.energy[ac], w.sens_f[ac], w.sens_x[ac]) =
-                    cycle_area(&x[a0..i], &f[a0..i], ux, uf, fm, area_scale);
+                    cycle_area_at(level, &x[a0..i], &f[a0..i], ux, uf, fm, area_scale);
                 // the period means' integrals over the same samples, still in cache
                 pm.advance((t_all, f_all, x_all), edges, Some(i - 1));
             }
@@ -814,7 +826,7 @@ fn fold_pass(p: FoldPass<'_>) -> Result<WindowFold, CoreError> {
     }
     if let Some(ac) = area_cycle {
         (w.energy[ac], w.sens_f[ac], w.sens_x[ac]) =
-            cycle_area(&x[a0..a1], &f[a0..a1], ux, uf, fm, area_scale);
+            cycle_area_at(level, &x[a0..a1], &f[a0..a1], ux, uf, fm, area_scale);
     }
     finish(
         &mut w,
