@@ -71,9 +71,12 @@ struct Bin {
     sums: [f64; 6],
     samples: f64,
     k: f64,
-    shift: [f64; 3],
-    /// Σdx, Σdf, Σdp, Σdx², Σdf², Σdp², Σdx·dp, Σdf·dp
-    d: [f64; 8],
+    /// the shift of x, F, φ (φ's twice: the lanes of `d`)
+    shift: [f64; 4],
+    /// `[Σdx, Σdf, Σdp, -]`, `[Σdx², Σdf², Σdp², -]`, `[Σdx·dp, Σdf·dp, -, -]` (each cell
+    /// adds the four lanes `[dx, df, dp, dp]`, their squares and their products with dp: three
+    /// vector additions; the lanes marked `-` are not read)
+    d: [[f64; 4]; 3],
 }
 
 impl Bin {
@@ -82,22 +85,25 @@ impl Bin {
     #[inline(always)]
     fn add_cell(&mut self, n: f64, cx: f64, cf: f64, cp: f64) -> (f64, f64) {
         // the divisions of fold_spread's cell means (the same numbers)
-        let (mx, mf, mp) = (cx / n, cf / n, cp / n);
+        let m = [cx / n, cf / n, cp / n, cp / n];
         if self.k == 0.0 {
-            self.shift = [mx, mf, mp];
+            self.shift = m;
         }
-        let (dx, df, dp) = (mx - self.shift[0], mf - self.shift[1], mp - self.shift[2]);
+        let v = [
+            m[0] - self.shift[0],
+            m[1] - self.shift[1],
+            m[2] - self.shift[2],
+            m[3] - self.shift[3],
+        ];
+        let dp = v[2];
         self.k += 1.0;
-        let d = &mut self.d;
-        d[0] += dx;
-        d[1] += df;
-        d[2] += dp;
-        d[3] += dx * dx;
-        d[4] += df * df;
-        d[5] += dp * dp;
-        d[6] += dx * dp;
-        d[7] += df * dp;
-        (mx, mf)
+        let [d0, d1, d2] = &mut self.d;
+        for l in 0..4 {
+            d0[l] += v[l];
+            d1[l] += v[l] * v[l];
+            d2[l] += v[l] * dp;
+        }
+        (m[0], m[1])
     }
 
     /// Sample standard deviations of `mx - gx·φ` and `mf - gf·φ` over the cycles (NaN below
@@ -107,7 +113,8 @@ impl Bin {
         if k < 2.0 {
             return (f64::NAN, f64::NAN);
         }
-        let d = &self.d;
+        let [[d0, d1, d2, _], [d3, d4, d5, _], [d6, d7, _, _]] = self.d;
+        let d = [d0, d1, d2, d3, d4, d5, d6, d7];
         // centred moments of the shifted means: the squares, the co-moments with φ
         let m2p = d[5] - d[2] * d[2] / k;
         let one = |sd: f64, sdd: f64, sdp: f64, g: f64| {
