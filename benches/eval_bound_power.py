@@ -40,6 +40,7 @@ EFFECTS = (
     "series_compliance",
     "force_drift",
     "position_friction",
+    "backlash",
 )
 TUNE_BASE = 73_000
 H0, AC = 40.0, 4.0e4
@@ -69,6 +70,8 @@ def rig_params(effect: str, size: float, fac: dict) -> dict:
         return {"k_p": size}
     if effect == "series_compliance":
         return {"k_s": 1.0 / size}
+    if effect == "backlash":
+        return {"b": size}
     return slow(effect, size, fac)
 
 
@@ -84,6 +87,7 @@ def visible_size(effect: str, fac: dict, rng) -> float:
         "series_compliance": 1.0 / (H0 * AC * float(rng.uniform(0.7, 1.5))),
         "force_drift": 1.5 * 0.1 * hm / T_rec * T_rec,
         "position_friction": 0.1,
+        "backlash": 0.05 * A,
     }[effect]
 
 
