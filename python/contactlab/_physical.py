@@ -19,12 +19,16 @@ MAX_MAGNITUDE = 1e100
 MIN_MAGNITUDE = 1e-100
 
 
-def check_channel(name: str, v: np.ndarray, unit: str, what: str) -> bool:
+def check_channel(
+    name: str, v: np.ndarray, unit: str, what: str, extremes: tuple[float, float] | None = None
+) -> bool:
     """Refuse a channel that is out of any physical scale, zero throughout, or constant.
 
     ``what`` names the sensor in the sentence (e.g. "force"). Returns whether every sample
     is finite (the scan the checks made; a NaN or inf is not refused here, the caller's
-    conversion names it), so a caller need not scan the channel again.
+    conversion names it), so a caller need not scan the channel again. ``extremes``: the
+    channel's ``(min, max)``, every sample known finite (a streamed reader's scan of the
+    same samples): the checks use them instead of reading ``v`` (the same outcome).
 
     Examples
     --------
@@ -34,7 +38,10 @@ def check_channel(name: str, v: np.ndarray, unit: str, what: str) -> bool:
     contactlab.errors.InputError: F is constant (3 N in all 5 samples): ...
     """
     v = np.asarray(v, dtype=np.float64)
-    finite, lo, hi = scan(v)  # the largest magnitude is max(-min, max)
+    if extremes is None:
+        finite, lo, hi = scan(v)  # the largest magnitude is max(-min, max)
+    else:
+        finite, lo, hi = True, float(extremes[0]), float(extremes[1])
     big = max(-lo, hi) if v.size else 0.0
     if big > MAX_MAGNITUDE:
         i = int(np.argmax(np.abs(v)))

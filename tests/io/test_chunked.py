@@ -224,3 +224,32 @@ def test_hdf5_datasets_libhdf5_must_decode_read_alike(tmp_path) -> None:
     j = _joined(list(read_chunks(q, chunk_size=64)))
     np.testing.assert_array_equal(j["x"], np.arange(500))
     np.testing.assert_array_equal(j["F"], np.arange(500))
+
+
+def test_chunks_into_without_the_time_axis(tmp_path):
+    """``chunks_into(time_axis=False)`` of a sampled HDF5 file: the channels and checks of
+    the written axis, the axis itself not written (the caller makes it)."""
+    import h5py
+
+    fs = 1000.0
+    rec = _rec(1000, seed=31)
+    with h5py.File(p := tmp_path / "sampled.h5", "w") as f:
+        f.create_dataset("x", data=rec["x"], chunks=(128,)).attrs["unit"] = "m"
+        f.create_dataset("F", data=rec["F"]).attrs["unit"] = "N"
+    cr = read_chunks(p, chunk_size=300, fs=fs)
+    assert cr.checked and cr.time_step == (0.0, 1 / fs)
+
+    def alloc(m, names):
+        return {k: np.full(m, np.nan) for k in names}
+
+    made = list(cr.chunks_into(alloc))
+    bare = list(cr.chunks_into(alloc, time_axis=False))
+    offsets = [c.meta["offset"] for c in bare]
+    assert offsets == [c.meta["offset"] for c in made] == [0, 300, 600, 900]
+    for a, b in zip(made, bare, strict=True):
+        assert np.isnan(b.t).all() and not np.isnan(a.t).any()
+        assert a.meta["ranges"] == b.meta["ranges"]
+        for k in ("x", "F"):
+            assert a[k].tobytes() == b[k].tobytes()
+    assert _joined(made)["t"].tobytes() == ((1 / fs) * np.arange(1000.0)).tobytes()
+    assert _joined(bare)["x"].tobytes() == rec["x"].tobytes()

@@ -602,6 +602,41 @@ def test_windows_read_in_place_hold_their_samples(long_rec, tmp_path, monkeypatc
         assert r.cycles[k].tobytes() == m.cycles[k].tobytes()
 
 
+@pytest.mark.parametrize("segment", [300, 1 << 18])
+def test_sampled_windows_carry_their_channels_ranges(long_rec, tmp_path, monkeypatch, segment):
+    """A window of a checked, sampled file carries its channels' exact (min, max), made from
+    the reader's blocks inside it and a scan of the blocks it cuts: the window analysis then
+    does not scan x, F and t again; the rows are those of the same samples in memory."""
+    import h5py
+
+    from contactlab.studies import tracking
+
+    monkeypatch.setattr(tracking, "CYCLE_SEGMENT", segment)
+    with h5py.File(p := tmp_path / "sampled.h5", "w") as f:
+        f.create_dataset("x", data=long_rec["x"], chunks=(1000,))
+        f["F"] = long_rec["F"]
+        f.attrs["dt"] = 1 / 1500.0
+    seen = []
+    analyse = tracking._tangential_window
+
+    def spy(rec, options, keep_doc=False):
+        seen.append((rec.scanned, rec.data["x"].copy(), rec.data["F"].copy()))
+        return analyse(rec, options, keep_doc)
+
+    monkeypatch.setattr(tracking, "_tangential_window", spy)
+    r = track(p, every="3cycles", chunk_size=700, threads=0)
+    monkeypatch.setattr(tracking, "_tangential_window", analyse)
+    assert len(seen) == len(r.rows) >= 4
+    for scanned, x, F in seen:
+        assert scanned == {"x": (x.min(), x.max()), "F": (F.min(), F.max())}
+    same = Recording(
+        (1 / 1500.0) * np.arange(len(long_rec), dtype=np.float64),
+        {"x": long_rec["x"], "F": long_rec["F"]},
+        {"x": "m", "F": "N"},
+    )
+    assert track(same, every="3cycles", chunk_size=700, threads=0).rows == r.rows
+
+
 def test_sampled_window_makes_its_time_axis_when_analysed():
     """A window of a sampled recording waits for its helper thread without a time axis: the
     axis it then makes is fill_time's, bit for bit, as are the row's start and end times,

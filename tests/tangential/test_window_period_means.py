@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from contactlab.errors import InputError
 from contactlab.io import Recording
 from contactlab.synthetic.tangential import synthetic_recording
 from contactlab.tangential.window import analyze_window
@@ -37,3 +38,19 @@ def test_a_window_without_period_means_has_every_other_number(case, invert):
     for k in ("mean_force", "mean_x"):
         v = getattr(sb, k)
         assert v.shape == (sb.n_cycles,) and np.all(np.isnan(v)), k
+
+
+@pytest.mark.parametrize("case", sorted(_CASES))
+def test_a_window_scanned_by_its_reader_is_not_scanned_again(case):
+    """``analyze_window(scanned=...)`` (a streamed reader's extremes of x and F, t known
+    finite): the channel checks take those extremes instead of reading the samples, and every
+    number is that of the window checked by its own scans."""
+    rec = synthetic_recording(**_CASES[case])
+    x, F = rec["x"], rec["F"]
+    exact = {"x": (float(x.min()), float(x.max())), "F": (float(F.min()), float(F.max()))}
+    a = analyze_window(rec, period_means=False)
+    b = analyze_window(rec, period_means=False, scanned=exact)
+    assert a.to_dict() == b.to_dict() and a.warnings == b.warnings
+    # the extremes given are the ones checked: a channel said constant is refused as one
+    with pytest.raises(InputError, match="F is constant"):
+        analyze_window(rec, scanned={**exact, "F": (1.0, 1.0)})

@@ -84,24 +84,35 @@ class ChunkedRecording:
     n_samples: int | None
     meta: dict[str, Any]
     _open: Callable[[], Iterator[Recording]] = field(repr=False)
-    _open_into: Callable[[Alloc], Iterator[Recording]] | None = field(default=None, repr=False)
+    _open_into: Callable[[Alloc, bool], Iterator[Recording]] | None = field(
+        default=None, repr=False
+    )
     #: ``(t0, dt)`` when the time axis is made from a sampling interval: sample ``i`` is at
     #: ``t0 + dt * i`` (``contactlab._core.fill_time``), else None (a time column)
     time_step: tuple[float, float] | None = None
+    #: the reader checks every chunk as the whole-file reader checks a recording: channels
+    #: finite (``meta["ranges"]`` their exact extremes), time axis finite and increasing
+    checked: bool = False
 
     def __iter__(self) -> Iterator[Recording]:
         return self._open()
 
-    def chunks_into(self, alloc: Alloc) -> Iterator[Recording]:
+    def chunks_into(self, alloc: Alloc, *, time_axis: bool = True) -> Iterator[Recording]:
         """The chunks, with the time axis and each channel (SI) written into the arrays that
         ``alloc(n, names)`` returns for a chunk of ``n`` samples: a dict of each of ``names``
         (``"t"`` and the channels) to a writable contiguous float64 array of ``n`` samples,
         which become the chunk's arrays. HDF5 datasets stored as plain float64 are read
         straight into them (no array allocated per chunk, no copy); other data is copied.
         ``alloc`` is called for a chunk only once the previous chunk has been taken from the
-        iterator."""
+        iterator.
+
+        ``time_axis=False``, for a caller that makes the axis from :attr:`time_step` itself:
+        where the reader would make it from the sampling interval (:attr:`time_step` not
+        None), it is checked (its last stamps finite and increasing) but not written, and
+        the chunks' ``t`` holds whatever ``alloc`` left in its array (do not read it). A
+        time column is written as always."""
         if self._open_into is not None:
-            yield from self._open_into(alloc)
+            yield from self._open_into(alloc, time_axis)
             return
         for c in self._open():
             out = alloc(len(c), ["t", *c.data])
@@ -131,8 +142,12 @@ class _Finisher:
         row_of: Callable[[int], int] | None = None,
         meta: dict[str, Any] | None = None,
         resample: bool = False,
+        time_axis: bool = True,
     ) -> None:
         self.mapping, self.kind, self.file = mapping, kind, file
+        # a time axis made from the sampling interval written into ``out["t"]`` (False: only
+        # checked; see ChunkedRecording.chunks_into)
+        self.time_axis = time_axis
         # resampling onto the grid t0 + step·k: the grid's next index, the previous chunk's
         # last sample (interpolation across the boundary), what was bridged so far
         self.resample = resample and "t" in mapping
@@ -310,11 +325,16 @@ class _Finisher:
             # t0 + dt * np.arange(offset, offset + n)
             assert self.dt is not None
             t = np.empty(n, dtype=np.float64) if out is None else out["t"]
-            _core.fill_time(t, self.t0, self.dt, offset)
+            if out is None or self.time_axis:
+                _core.fill_time(t, self.t0, self.dt, offset)
+                last = t[-2:]
+            else:  # the caller makes the axis: its last two stamps (fill_time is elementwise)
+                last = np.empty(min(n, 2))
+                _core.fill_time(last, self.t0, self.dt, offset + n - last.size)
             # found by audit (--fs 1e-308): a step so large that the axis overflows, or so
             # small against the start time that it stops increasing; the axis is monotonic,
             # so its last stamps tell
-            if n and (not math.isfinite(t[-1]) or (n >= 2 and t[-1] <= t[-2])):
+            if n and (not math.isfinite(last[-1]) or (n >= 2 and last[-1] <= last[-2])):
                 raise RecordingError(
                     f"{self.dt_source} gives no increasing, finite time axis for "
                     f"{offset + n} samples",
@@ -419,7 +439,7 @@ def _h5_chunks(
 
     names = ["t", *(c for c in mapping if c != "t")]
 
-    def gen(alloc: Alloc | None) -> Iterator[Recording]:
+    def gen(alloc: Alloc | None, time_axis: bool = True) -> Iterator[Recording]:
         fin = _Finisher(
             mapping,
             units,
@@ -429,6 +449,7 @@ def _h5_chunks(
             dt=dt,
             meta={"format": fmt},
             resample=resample,
+            time_axis=time_axis,
         )
         if resample:
             alloc = None  # a resampled chunk's length is not the samples read
@@ -478,6 +499,7 @@ def _h5_chunks(
         lambda: gen(None),
         None if resample else gen,
         fin0.time_step,
+        checked=True,
     )
 
 
@@ -563,6 +585,7 @@ def _tdms_chunks(
         fin0.meta,
         gen,
         time_step=fin0.time_step,
+        checked=True,
     )
 
 
@@ -651,7 +674,15 @@ def _csv_chunks(
             raise RecordingError("header but no data rows", file=file)
 
     return ChunkedRecording(
-        file, kind_, fin0.units, mapping, None, fin0.meta, gen, time_step=fin0.time_step
+        file,
+        kind_,
+        fin0.units,
+        mapping,
+        None,
+        fin0.meta,
+        gen,
+        time_step=fin0.time_step,
+        checked=True,
     )
 
 
@@ -687,6 +718,7 @@ def _npy_chunks(
         fin0.meta,
         gen,
         time_step=fin0.time_step,
+        checked=True,
     )
 
 

@@ -83,9 +83,11 @@ class _WindowSamples:
     its analysis starts (:meth:`recording`, on the helper thread or worker): a window waiting
     for a helper holds its channels only, 8 bytes a sample less, and the reader does not fill
     the axis. The axis is :func:`contactlab._core.fill_time`'s, bit for bit the one
-    :meth:`_Windows.take` made before."""
+    :meth:`_Windows.take` made before. ``scanned``: each channel's ``(min, max)`` when the
+    reader checked every sample finite and the axis finite (``ChunkedRecording.checked``),
+    else None (:func:`contactlab.tangential.window.analyze_window`'s ``scanned``)."""
 
-    __slots__ = ("data", "meta", "source", "start", "time_step", "units")
+    __slots__ = ("data", "meta", "scanned", "source", "start", "time_step", "units")
 
     def __init__(
         self,
@@ -95,9 +97,10 @@ class _WindowSamples:
         meta: dict[str, Any],
         time_step: tuple[float, float],
         start: int,
+        scanned: dict[str, tuple[float, float]] | None = None,
     ) -> None:
         self.data, self.units, self.source, self.meta = data, units, source, meta
-        self.time_step, self.start = time_step, start
+        self.time_step, self.start, self.scanned = time_step, start, scanned
 
     def __getstate__(self) -> tuple[Any, ...]:
         return tuple(getattr(self, k) for k in self.__slots__)
@@ -111,11 +114,7 @@ class _WindowSamples:
 
     def time(self, i: int) -> float:
         """The time of sample ``i`` of the window (that of :meth:`recording`'s axis)."""
-        from .. import _core
-
-        one = np.empty(1)
-        _core.fill_time(one, self.time_step[0], self.time_step[1], self.start + i)
-        return float(one[0])
+        return _step_time(self.time_step, self.start + i)
 
     def recording(self) -> Recording:
         from .. import _core
@@ -123,6 +122,16 @@ class _WindowSamples:
         t = np.empty(len(self))
         _core.fill_time(t, self.time_step[0], self.time_step[1], self.start)
         return Recording(t, self.data, self.units, self.source, self.meta)
+
+
+def _step_time(time_step: tuple[float, float], g: int) -> float:
+    """The time of global sample ``g`` of an axis sampled every ``dt`` from ``t0``
+    (``time_step``): :func:`contactlab._core.fill_time`'s, bit for bit."""
+    from .. import _core
+
+    one = np.empty(1)
+    _core.fill_time(one, time_step[0], time_step[1], g)
+    return float(one[0])
 
 
 def _window_recording(rec: Recording | _WindowSamples) -> Recording:
@@ -182,6 +191,7 @@ def _tangential_window(
     from ..tangential import analyze_tangential
     from ..tangential.window import analyze_window
 
+    scanned = rec.scanned if isinstance(rec, _WindowSamples) else None
     rec = _window_recording(rec)
 
     opts = {k: v for k, v in options.items() if k != "warn"}
@@ -194,7 +204,7 @@ def _tangential_window(
             opts["force_sign"] = -1 if inv else 1
     if set(opts) <= _WINDOW_OPTIONS:
         # (the rows keep no per-cycle mean of the detrended window: not computed)
-        res = analyze_window(rec, period_means=False, **opts)
+        res = analyze_window(rec, period_means=False, scanned=scanned, **opts)
     else:
         res = analyze_tangential(rec, **{"warn": False, **dict(options)})
     d = res.to_dict()
@@ -284,10 +294,18 @@ class _Windows:
     chunk, and the samples already read past the cut (less than a chunk) are copied over. A
     window that outgrows its array moves to one twice as long (rare: the first window, or one
     much longer than the last). A time axis made from the sampling interval (``time_step``)
-    is made for each window instead (bit for bit the chunks'), and each chunk's on its own.
+    is made for each window instead (bit for bit the chunks'); the chunks' own axis is then
+    not made (``chunks_into(time_axis=False)``: their ``t`` is one scratch array, unread).
+
+    ``checked`` (the reader's ``ChunkedRecording.checked``): the blocks' ranges
+    (:meth:`add`) are the exact extremes of samples found finite; a sampled window then
+    carries its channels' ranges (``_WindowSamples.scanned``), from the blocks inside it
+    and a scan of the parts of the blocks it cuts.
     """
 
-    def __init__(self, first_window: int, time_step: tuple[float, float] | None) -> None:
+    def __init__(
+        self, first_window: int, time_step: tuple[float, float] | None, checked: bool = False
+    ) -> None:
         self.arrays: dict[str, np.ndarray] = {}
         self.cap = 0
         self.head = 0  # index in the arrays of global sample self.start
@@ -298,6 +316,10 @@ class _Windows:
         self.chunk = 0  # longest chunk read
         self.time_step = time_step
         self.proto: tuple[dict[str, str], str, dict[str, Any]] | None = None
+        self.scratch_t = np.empty(0)  # the chunks' unread time axis (a sampled recording)
+        # (global first sample, end, ranges or None) of the blocks added, not yet all in windows
+        self.checked = checked and time_step is not None
+        self.blocks: deque[tuple[int, int, dict[str, tuple[float, float]] | None]] = deque()
 
     def _move(self, cap: int, names: list[str]) -> None:
         rest = self.used - self.head
@@ -319,15 +341,52 @@ class _Windows:
         self.used += m
         out = {k: v[a : self.used] for k, v in self.arrays.items()}
         if "t" not in out:
-            out["t"] = np.empty(m)
+            if self.scratch_t.size < m:
+                self.scratch_t = np.empty(m)
+            out["t"] = self.scratch_t[:m]
         return out
 
-    def add(self, rec: Recording) -> None:
-        """The next ``len(rec)`` samples (written where :meth:`alloc` said) are read."""
+    def add(self, rec: Recording, ranges: dict[str, tuple[float, float]] | None = None) -> None:
+        """The next ``len(rec)`` samples (written where :meth:`alloc` said) are read;
+        ``ranges``: their channels' ``(min, max)``."""
         if self.proto is None:  # what the windows inherit (not the arrays: they would
             # keep the first window's array alive to the end)
             self.proto = (rec.units, rec.source, rec.meta)
+        if self.checked:
+            a = self.start + self.n
+            self.blocks.append((a, a + len(rec), ranges))
         self.n += len(rec)
+
+    def _ranges(self, stop: int, data: dict[str, np.ndarray]) -> dict | None:
+        """The channels' ``(min, max)`` over the window ``[start, stop)`` (``data``: its
+        arrays): the blocks' ranges, and the parts of blocks the window cuts scanned (min and
+        max are exact: the same numbers as a scan of the window); None when a block's are
+        not known."""
+        from .. import _core
+
+        lo = dict.fromkeys(data, math.inf)
+        hi = dict.fromkeys(data, -math.inf)
+        known = True
+        blocks = self.blocks
+        while blocks and blocks[0][0] < stop:
+            a, b, r = blocks[0]
+            if r is None or any(c not in r for c in data):
+                known = False
+            elif a >= self.start and b <= stop:
+                for c in data:
+                    lo[c], hi[c] = min(lo[c], r[c][0]), max(hi[c], r[c][1])
+            else:
+                i, j = max(a, self.start) - self.start, min(b, stop) - self.start
+                for c, v in data.items():
+                    if j > i:
+                        _f, p, q = _core.finite_min_max(v[i:j])
+                        lo[c], hi[c] = min(lo[c], p), max(hi[c], q)
+            if b > stop:
+                break
+            blocks.popleft()
+        if not known or not all(math.isfinite(lo[c]) and math.isfinite(hi[c]) for c in data):
+            return None
+        return {c: (lo[c], hi[c]) for c in data}
 
     def take(self, stop: int) -> Recording | _WindowSamples:
         """Samples ``[start, stop)`` as one recording (views); they leave the buffer. With a
@@ -343,8 +402,15 @@ class _Windows:
             t = self.arrays["t"][a:b]
             rec = Recording(t, data, dict(units), source, dict(meta, offset=self.start))
         else:
+            scanned = self._ranges(stop, data) if self.checked else None
             rec = _WindowSamples(
-                data, dict(units), source, dict(meta, offset=self.start), self.time_step, self.start
+                data,
+                dict(units),
+                source,
+                dict(meta, offset=self.start),
+                self.time_step,
+                self.start,
+                scanned,
             )
         self.head, self.start, self.n = b, stop, self.n - k
         self.expect = k + k // 256  # the next window's length, and some
@@ -358,8 +424,13 @@ class _Windows:
         return rec
 
 
-def _time_at(t: np.ndarray, off: int, g: int) -> float:
-    """The time of global sample ``g`` in a block starting at global sample ``off``."""
+def _time_at(
+    t: np.ndarray, off: int, g: int, time_step: tuple[float, float] | None = None
+) -> float:
+    """The time of global sample ``g`` in a block starting at global sample ``off`` (with
+    ``time_step``, from the sampling interval: the block's ``t`` is not read)."""
+    if time_step is not None:
+        return _step_time(time_step, g)
     return float(t[g - off])
 
 
@@ -616,15 +687,19 @@ def _track(
     # the recording
     first = AUTO_WINDOW if mode == "auto" else chunk_size
     buf = _Windows(
-        first if cr.n_samples is None else max(min(first, cr.n_samples), 1), cr.time_step
+        first if cr.n_samples is None else max(min(first, cr.n_samples), 1),
+        cr.time_step,
+        cr.checked,
     )
     cuts = WindowCuts(mode, size, AUTO_WINDOW)  # (a module global: tests shrink it)
     out = _Dispatch(analyse, dict(options or {}), executor, slots, keep_going, callback, buf)
     n_total = 0
     try:
-        for block, ranges in _segments(_noting(cr.chunks_into(buf.alloc), noted), CYCLE_SEGMENT):
+        # (a sampled recording's axis is made for each window: the reader does not make it)
+        chunks = cr.chunks_into(buf.alloc, time_axis=False)
+        for block, ranges in _segments(_noting(chunks, noted), CYCLE_SEGMENT):
             off = int(block.meta.get("offset", n_total))
-            buf.add(block)
+            buf.add(block, ranges)
             n_total = off + len(block)
             levels = trigger_levels(*ranges[drive]) if ranges and len(block) else None
             got = block_cycles(
@@ -640,9 +715,9 @@ def _track(
             )
             for k in cyc:
                 cyc[k].append(np.asarray(getattr(got, k), dtype=float))
-            cuts.block(float(block.t[0]), got.crossings)
+            cuts.block(_time_at(block.t, off, off, cr.time_step), got.crossings)
             # (g, complete cycles before crossing g: crossings so far minus the first one)
-            at = functools.partial(_time_at, block.t, off)
+            at = functools.partial(_time_at, block.t, off, time_step=cr.time_step)
             for g, n_before in cuts.cuts(got.crossings.tolist(), at):
                 out.emit(g, n_before)
             if buf.n > max_window:  # the open window (cut windows have left the buffer)
