@@ -381,12 +381,11 @@ pub fn period_means_pair(
         check_finite("edges", edges)?;
         return Err(CoreError::Empty { name: "t" });
     }
-    // finite and strictly increasing in one pass (NaN fails the comparison); the separate
-    // checks name the first failure
-    let mut ok = t[0].is_finite();
-    for w in t.windows(2) {
-        ok &= w[1] > w[0] && w[1].is_finite();
-    }
+    // t finite and strictly increasing, checked as the walk reads it (NaN fails the
+    // comparison): one read of t, not a pass of its own (the walk's chain of additions
+    // leaves room for the compares; the pass read t at memory speed); the separate checks
+    // name the first failure, before any of the edges (as they did)
+    let (ok, means) = period_means_pair_walk(t, f, x, edges);
     if !ok {
         check_finite("t", t)?;
         for i in 1..t.len() {
@@ -411,30 +410,34 @@ pub fn period_means_pair(
             });
         }
     }
-    Ok(period_means_pair_checked(t, f, x, edges))
+    Ok(means)
 }
 
-/// [`period_means_pair`] of checked samples: `t` finite, strictly increasing and at least
-/// two samples, `f` and `x` as long, `edges` finite and non-decreasing (the callers' checks).
-// Index arithmetic: j + 1 < n where j + 1 is taken (trapezoids_until stops there).
+/// [`period_means_pair`]'s walk over at least two samples (`f` and `x` as long as `t`):
+/// whether `t` is finite and strictly increasing (every sample read once: the pairs the
+/// trapezoids step over, then the rest), and the means, which are those of checked samples
+/// when it is. Edges need not be checked (NaN or decreasing edges give NaN or wrong means,
+/// never a panic).
+// Index arithmetic: j + 1 < n where j + 1 is taken (trapezoids_checked_until stops there).
 #[allow(clippy::arithmetic_side_effects)]
-pub(crate) fn period_means_pair_checked(
+fn period_means_pair_walk(
     t: &[f64],
     f: &[f64],
     x: &[f64],
     edges: &[f64],
-) -> (Vec<f64>, Vec<f64>) {
+) -> (bool, (Vec<f64>, Vec<f64>)) {
     let n = t.len();
     let mut ce_f = Vec::with_capacity(edges.len());
     let mut ce_x = Vec::with_capacity(edges.len());
     let (mut j, mut cf, mut cx) = (0_usize, 0.0_f64, 0.0_f64);
+    let mut ok = t[0].is_finite();
     for &e in edges {
         if e <= t[0] {
             ce_f.push(0.0);
             ce_x.push(0.0);
             continue;
         }
-        (j, cf, cx) = trapezoids_until(t, (f, x), j, e, (cf, cx));
+        (j, cf, cx, ok) = trapezoids_checked_until(t, (f, x), j, e, (cf, cx), ok);
         if j + 1 >= n || e == t[j] {
             ce_f.push(cf);
             ce_x.push(cx);
@@ -446,13 +449,41 @@ pub(crate) fn period_means_pair_checked(
             ce_x.push((c1x - cx) / dt * (e - t[j]) + cx);
         }
     }
+    // the samples after the last step taken (pair j, j + 1 on)
+    for w in t[j..].windows(2) {
+        ok &= (w[1] > w[0]) & w[1].is_finite();
+    }
     let means = |ce: &[f64]| -> Vec<f64> {
         ce.windows(2)
             .zip(edges.windows(2))
             .map(|(c, e)| (c[1] - c[0]) / (e[1] - e[0]))
             .collect()
     };
-    (means(&ce_f), means(&ce_x))
+    (ok, (means(&ce_f), means(&ce_x)))
+}
+
+/// [`trapezoids_until`] checking each pair of samples it steps over (`t[j + 1]` finite and
+/// above `t[j]`, into `ok`): the same sums, bit for bit.
+// Index arithmetic: j + 1 < n, the shortest slice's length.
+#[allow(clippy::arithmetic_side_effects)]
+#[inline(never)]
+fn trapezoids_checked_until(
+    t: &[f64],
+    (f, x): (&[f64], &[f64]),
+    mut j: usize,
+    e: f64,
+    (mut cf, mut cx): (f64, f64),
+    mut ok: bool,
+) -> (usize, f64, f64, bool) {
+    let n = t.len().min(f.len()).min(x.len());
+    while j + 1 < n && t[j + 1] <= e {
+        ok &= (t[j + 1] > t[j]) & t[j + 1].is_finite();
+        let dt = t[j + 1] - t[j];
+        cf += 0.5 * (f[j + 1] + f[j]) * dt;
+        cx += 0.5 * (x[j + 1] + x[j]) * dt;
+        j += 1;
+    }
+    (j, cf, cx, ok)
 }
 
 /// [`period_means_pair`]'s cumulative trapezoid integrals `(cf, cx)` of `F` and `x` carried
@@ -505,5 +536,37 @@ mod tests {
         assert!(period_means_pair(&[0.0, 1.0], &v[..2], &v[..2], &[0.5, 0.2]).is_err());
         assert!(period_means_pair(&[0.0], &v[..1], &v[..1], &[]).is_err());
         assert!(period_means_pair(&[0.0, 1.0], &v[..2], &v[..1], &[]).is_err());
+    }
+
+    #[test]
+    fn period_means_pair_finds_a_bad_time_wherever_its_walk_reads_it() {
+        // t checked as the trapezoids are walked: a NaN, an infinity, a repeated or a falling
+        // stamp at any sample (before the first edge, between edges, after the last, the
+        // first sample) is refused as period_means refuses it, naming the same sample
+        let n = 40;
+        let t0: Vec<f64> = (0..n).map(|i| i as f64 * 0.25).collect();
+        let f: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).sin()).collect();
+        let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.3).cos()).collect();
+        let edges = [1.1, 2.0, 4.6, 7.3];
+        let (mf, mx) = period_means_pair(&t0, &f, &x, &edges).unwrap();
+        assert_eq!(mf, period_means(&t0, &f, &edges).unwrap());
+        assert_eq!(mx, period_means(&t0, &x, &edges).unwrap());
+        for i in 0..n {
+            let prev = if i > 0 { t0[i - 1] } else { -1.0 };
+            for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, prev, prev - 0.1] {
+                let mut t = t0.clone();
+                t[i] = bad;
+                let want = period_means(&t, &f, &edges);
+                let got = period_means_pair(&t, &f, &x, &edges);
+                if i == 0 && bad.is_finite() {
+                    assert!(want.is_ok() && got.is_ok(), "{i} {bad}");
+                    continue;
+                }
+                assert!(want.is_err(), "{i} {bad}");
+                // (by their text: an error holding a NaN is not equal to itself)
+                let (got, want) = (got.unwrap_err(), want.unwrap_err());
+                assert_eq!(format!("{got:?}"), format!("{want:?}"), "{i} {bad}");
+            }
+        }
     }
 }

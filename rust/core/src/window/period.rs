@@ -1,5 +1,5 @@
 //! The period means of [`super::fold_window`] (those of
-//! [`crate::fold::period_means_pair_checked`], bit for bit) advanced as the fold's cycles
+//! [`crate::fold::period_means_pair`], bit for bit) advanced as the fold's cycles
 //! complete: the cumulative trapezoid integrals of F and x run over each completed cycle's
 //! samples while they are still in cache (after the cycle's loop area), instead of a pass
 //! of their own over the whole window afterwards. The integrals are one sequential chain of
@@ -33,7 +33,7 @@ impl PeriodMeans {
 
     /// Record the edges below `t[limit]` (their interpolation reads at most sample `limit`)
     /// and carry the integrals to sample `limit` (`None`: every edge, to the end, as
-    /// `period_means_pair_checked` does).
+    /// `period_means_pair` does).
     // Index arithmetic: j + 1 < n where read; limit < n (the caller's).
     #[allow(clippy::arithmetic_side_effects)]
     pub(super) fn advance(
