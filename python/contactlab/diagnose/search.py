@@ -276,17 +276,21 @@ def _gain_not_its_own(
     return hook(d, cand.full.params, gain_by_cycle(d, current, cand))
 
 
-def gain_by_cycle(d: Prepared, current: Trial, cand: Trial) -> dict[int, float]:
+def gain_by_cycle(
+    d: Prepared, current: Trial, cand: Trial, where: np.ndarray | None = None
+) -> dict[int, float]:
     """The held-out gain of ``cand`` over ``current`` on each cycle of ``d`` (index as
     ``d.cycles.cycle``; -1 before the first): ``Σ w (r² - (r - Δ)²)`` over its held-out
-    samples, ``r`` the current model's held-out residual, ``Δ`` the candidate's held-out
-    prediction minus the current one, ``w`` the likelihood weights
-    (:func:`~contactlab.diagnose.select.sample_weight`)."""
+    samples (and, given ``where``, those of them in it), ``r`` the current model's held-out
+    residual, ``Δ`` the candidate's held-out prediction minus the current one, ``w`` the
+    likelihood weights (:func:`~contactlab.diagnose.select.sample_weight`)."""
     from .select import sample_weight
 
     r = d.y - current.prediction
     delta = cand.prediction - current.prediction
     held = current.heldout & cand.heldout
+    if where is not None:
+        held = held & where
     g = sample_weight(d) * (2.0 * r * delta - delta * delta)
     cyc = np.asarray(d.cycles.cycle)
     out: dict[int, float] = {}
@@ -819,12 +823,15 @@ class StepwiseSearch:
 NOT_TOLD_APART = "not_told_apart"
 
 
-def paired_lead(d: Prepared, current: Trial, best: Trial, other: Trial) -> float:
+def paired_lead(
+    d: Prepared, current: Trial, best: Trial, other: Trial, where: np.ndarray | None = None
+) -> float:
     """The t statistic of ``best``'s lead over ``other`` across held-out cycles: the mean of
     the per-cycle differences of their held-out gains over ``current``
-    (:func:`gain_by_cycle`) over its standard error (``±inf`` when every cycle gives the
-    same lead, ``nan`` with fewer than two cycles in common)."""
-    a, b = gain_by_cycle(d, current, best), gain_by_cycle(d, current, other)
+    (:func:`gain_by_cycle`, on the samples ``where`` only when given) over its standard
+    error (``±inf`` when every cycle gives the same lead, ``nan`` with fewer than two
+    cycles in common)."""
+    a, b = gain_by_cycle(d, current, best, where), gain_by_cycle(d, current, other, where)
     diff = np.array([a[c] - b[c] for c in a if c in b])
     if diff.size < 2:
         return float("nan")
@@ -851,7 +858,12 @@ def _mark_not_told_apart(
     (its ``noise_fed_lead[rival]`` times the input-noise budget
     ``d.extra["input_noise_budget"]``, σ²: a play passes over the noise's wiggles at each
     turn, which a delay cannot): the t is scaled by the share of the held-out lead left
-    beyond it, the per-cycle scatter unchanged.
+    beyond it, the per-cycle scatter unchanged; and where the effect says on which samples
+    the noise does not feed it (its ``unfed_samples(d)``: a play away from the turns), the
+    paired t there counts too, the smaller of the two deciding (delays of 0.25-1.8 ms at
+    x noise 1.6 % of the range and ac·A 2.5-2.7 were named backlash with a paired t of
+    4.1-4.5 over the delay, 3.5-4.4 after the discount, and 1.8-2.6 at speeds above half
+    the peak; ``benches/eval_confusions.py --cases delay``, tuning seeds 90000-90001).
 
     Look-alikes draw nearly the same force on one amplitude (docs/effects.md: a 2f load, a
     dashpot, a Stribeck term and a delay in gross sliding; a spring and a 2f load's
@@ -871,6 +883,8 @@ def _mark_not_told_apart(
     except KeyError:
         fed = {}
     budget = float(d.extra.get("input_noise_budget", 0.0) or 0.0)
+    where_unfed = getattr(registry(kind).get(v.name), "unfed_samples", None) if fed else None
+    unfed = where_unfed(d) if where_unfed is not None and budget > 0 else None
     ties = []
     for name, (w, other) in tried.items():
         if name == v.name or name in st.effects or not (np.isfinite(w.gain) and w.gain > 0):
@@ -883,6 +897,11 @@ def _mark_not_told_apart(
         if owed > 0 and lead > 0 and np.isfinite(t):
             # the lead beyond what the noise gives, at the same scatter across cycles
             t *= 1.0 - owed / lead
+        if name in fed and unfed is not None:
+            # and where the noise does not feed it: the lead there must be significant too
+            t_unfed = paired_lead(d, st.current, cand, other, unfed)
+            if np.isfinite(t_unfed):
+                t = min(t, t_unfed) if np.isfinite(t) else t_unfed
         if np.isfinite(t) and t <= z:
             store[name] = {"named": v.name, "gain_named": float(v.gain),
                            "gain": float(w.gain), "t": float(t),

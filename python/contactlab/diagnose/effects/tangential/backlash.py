@@ -75,6 +75,14 @@ class Backlash(EffectModel):
     #: 52001, 52005, plain chain): the delay's bound said it would have been seen
     noise_fed_lead: ClassVar[dict[str, float]] = {"channel_delay": 1.0}
 
+    def unfed_samples(self, d):
+        """The samples where the input's noise does not feed a play's lead over a delay
+        (:func:`contactlab.diagnose.search._mark_not_told_apart`): away from the turns, the
+        speed at least :data:`FAST_SHARE` of its peak, where a play is a fixed shift of the
+        branch and a delay one proportional to the speed."""
+        speed = np.abs(smoothed_velocity(d))
+        return speed >= FAST_SHARE * float(np.percentile(speed, 99.0))
+
     def yields_to(self, p, gains, own, d=None):
         """Why a play is not named beside a channel delay accepted at the same step whose
         held-out gain falls short of its own by less than the input-noise budget
