@@ -101,3 +101,21 @@ def test_only_a_play_is_judged_away_from_the_turns():
     _mark_not_told_apart(best, {"channel_delay": best, "backlash": other}, SimpleNamespace(
         effects=(), current=current, where=[]), d, 3.0)  # fmt: skip
     assert "backlash" not in d.extra.get(NOT_TOLD_APART, {})
+
+
+@pytest.mark.parametrize(("b_over_noise", "tied"), [(1.2, True), (4.0, False)])
+def test_a_play_within_the_input_noise_is_not_told_from_a_delay(b_over_noise, tied):
+    d, base, sig, _ = _play_record(6)
+    d.extra["input_noise_budget"] = 1e-3
+    d.extra["u_noise"] = 0.02 * A
+    current = _trial(base)
+    play = _trial(base + sig, "backlash")
+    play.full = SimpleNamespace(params={"h0": H0, "ac": AC, "b": b_over_noise * 0.02 * A})
+    best = (_v("backlash", 2.0), play)
+    other = (_v("channel_delay", 1.0), _trial(base + 0.2 * sig))  # poorer everywhere
+    _mark_not_told_apart(best, {"backlash": best, "channel_delay": other}, SimpleNamespace(
+        effects=(), current=current, where=[]), d, 3.0)  # fmt: skip
+    tie = d.extra.get(NOT_TOLD_APART, {}).get("channel_delay")
+    assert (tie is not None) is tied
+    if tied:
+        assert "times the input noise" in tie["noise_sized"]

@@ -863,7 +863,9 @@ def _mark_not_told_apart(
     paired t there counts too, the smaller of the two deciding (delays of 0.25-1.8 ms at
     x noise 1.6 % of the range and ac·A 2.5-2.7 were named backlash with a paired t of
     4.1-4.5 over the delay, 3.5-4.4 after the discount, and 1.8-2.6 at speeds above half
-    the peak; ``benches/eval_confusions.py --cases delay``, tuning seeds 90000-90001).
+    the peak; ``benches/eval_confusions.py --cases delay``, tuning seeds 90000-90001); and
+    where its fitted size is within what the noise itself draws (its ``within_noise(d,
+    p)``: a play no wider than twice the input noise), it is not told apart at all.
 
     Look-alikes draw nearly the same force on one amplitude (docs/effects.md: a 2f load, a
     dashpot, a Stribeck term and a delay in gross sliding; a spring and a 2f load's
@@ -885,6 +887,7 @@ def _mark_not_told_apart(
     budget = float(d.extra.get("input_noise_budget", 0.0) or 0.0)
     where_unfed = getattr(registry(kind).get(v.name), "unfed_samples", None) if fed else None
     unfed = where_unfed(d) if where_unfed is not None and budget > 0 else None
+    within = getattr(registry(kind).get(v.name), "within_noise", None) if fed else None
     ties = []
     for name, (w, other) in tried.items():
         if name == v.name or name in st.effects or not (np.isfinite(w.gain) and w.gain > 0):
@@ -897,16 +900,23 @@ def _mark_not_told_apart(
         if owed > 0 and lead > 0 and np.isfinite(t):
             # the lead beyond what the noise gives, at the same scatter across cycles
             t *= 1.0 - owed / lead
+        noise_sized = ""
+        params = getattr(getattr(cand, "full", None), "params", None)
+        if name in fed and within is not None and params is not None:
+            noise_sized = within(d, params) or ""
         if name in fed and unfed is not None:
             # and where the noise does not feed it: the lead there must be significant too
             t_unfed = paired_lead(d, st.current, cand, other, unfed)
             if np.isfinite(t_unfed):
                 t = min(t, t_unfed) if np.isfinite(t) else t_unfed
-        if np.isfinite(t) and t <= z:
+        if (np.isfinite(t) and t <= z) or noise_sized:
             store[name] = {"named": v.name, "gain_named": float(v.gain),
                            "gain": float(w.gain), "t": float(t),
                            "refused": "" if w.accepted else why}  # fmt: skip
-            ties.append(f"{name} ({w.gain:.3g} σ², t = {t:.2f})")
+            if noise_sized:
+                store[name]["noise_sized"] = noise_sized
+            ties.append(f"{name} ({w.gain:.3g} σ², t = {t:.2f}"
+                        + (f"; {noise_sized}" if noise_sized else "") + ")")  # fmt: skip
     if ties:
         st.where.append(
             f"{v.name} (held-out gain {v.gain:.3g} σ²) is not told apart from "
