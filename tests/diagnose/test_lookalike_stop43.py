@@ -119,3 +119,21 @@ def test_a_play_within_the_input_noise_is_not_told_from_a_delay(b_over_noise, ti
     assert (tie is not None) is tied
     if tied:
         assert "times the input noise" in tie["noise_sized"]
+
+
+@pytest.mark.parametrize(("b_over_noise", "lead", "tied"), [(4.0, 0.99, True),
+                                                           (1.2, 0.2, True),
+                                                           (4.0, 0.2, False)])  # fmt: skip
+def test_a_swap_without_telling_the_two_apart_withholds_the_bound(b_over_noise, lead, tied):
+    from contactlab.diagnose.search import _mark_swapped_out
+
+    d, base, sig, _ = _play_record(7)
+    d.extra["u_noise"] = 0.02 * A
+    old = _trial(base + lead * sig, "channel_delay")  # the model the play replaces
+    new = _trial(base + sig, "backlash")
+    new.full = SimpleNamespace(params={"h0": H0, "ac": AC, "b": b_over_noise * 0.02 * A})
+    st = SimpleNamespace(effects=("backlash",), where=[])
+    _mark_swapped_out("channel_delay", _v("backlash", 0.5), old, new, st, d, 3.0)
+    tie = d.extra.get(NOT_TOLD_APART, {}).get("channel_delay")
+    assert (tie is not None) is tied
+    assert bool(st.where) is tied

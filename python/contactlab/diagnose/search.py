@@ -692,7 +692,10 @@ class StepwiseSearch:
             )
         if swap is None:
             return False
-        out, v, st.current = swap
+        out, v, new = swap
+        if getattr(self.family, "kind", "") == "tangential":
+            _mark_swapped_out(out, v, st.current, new, st, self.d, self.z, self.family.kind)
+        st.current = new
         st.added[st.added.index(out)] = v.name
         st.trials.append(st.current)
         st.visited.add(frozenset(st.effects))
@@ -923,6 +926,49 @@ def _mark_not_told_apart(
             f"{', '.join(ties)}: its lead over each across held-out cycles is not significant "
             f"(paired t at most {z:g}); on this record the data do not say which of them it is"
         )
+
+
+def _mark_swapped_out(
+    out: str,
+    v: Verdict,
+    old: Trial,
+    new: Trial,
+    st: SearchState,
+    d: Prepared,
+    z: float,
+    kind: str = "tangential",
+) -> None:
+    """Note in ``d.extra[NOT_TOLD_APART]`` an effect ``out`` a swap replaced by ``v.name``
+    when the data do not tell the two apart: the swapped model's lead over the old one is
+    not significant cycle by cycle (:func:`paired_lead` at most ``z``), or the incoming
+    effect says its fitted size is what the input's noise draws for that rival (its
+    ``within_noise(d, p)``, where ``noise_fed_lead`` names the rival). As
+    :func:`_mark_not_told_apart` does for a step's rivals; a swap is a step too (a delay of
+    1.9 ms at 4x its stated bound, named first, was swapped for a play, and its bound of
+    0.41 ms stood: ``benches/eval_confusions.py --cases delay``, fresh seed 95002)."""
+    from .effects import registry
+
+    try:
+        eff = registry(kind).get(v.name)
+    except KeyError:
+        eff = None
+    t = paired_lead(d, old, new, old)
+    noise_sized = ""
+    within = getattr(eff, "within_noise", None)
+    if out in dict(getattr(eff, "noise_fed_lead", {}) or {}) and within is not None:
+        noise_sized = within(d, new.full.params) or ""
+    if not ((np.isfinite(t) and t <= z) or noise_sized):
+        return
+    entry = {"named": v.name, "gain_named": float(v.gain), "gain": 0.0, "t": float(t),
+             "refused": f"swapped out: the model with {v.name} instead gained {v.gain:.3g} "
+                        "σ² held-out over it"}  # fmt: skip
+    if noise_sized:
+        entry["noise_sized"] = noise_sized
+    d.extra.setdefault(NOT_TOLD_APART, {})[out] = entry
+    st.where.append(
+        f"{v.name} replaced {out} without telling them apart (paired t of its lead "
+        f"{t:.2f}" + (f"; {noise_sized}" if noise_sized else "") + ")"
+    )
 
 
 def _yield_to_lookalikes(
