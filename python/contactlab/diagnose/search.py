@@ -945,7 +945,7 @@ def _mark_swapped_out(
     ``within_noise(d, p)``, where ``noise_fed_lead`` names the rival). As
     :func:`_mark_not_told_apart` does for a step's rivals; a swap is a step too (a delay of
     1.9 ms at 4x its stated bound, named first, was swapped for a play, and its bound of
-    0.41 ms stood: ``benches/eval_confusions.py --cases delay``, fresh seed 95002)."""
+    0.41 ms stood: ``benches/eval_confusions.py --cases delay``, fresh seed 95001)."""
     from .effects import registry
 
     try:
