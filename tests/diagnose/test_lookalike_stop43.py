@@ -137,3 +137,19 @@ def test_a_swap_without_telling_the_two_apart_withholds_the_bound(b_over_noise, 
     tie = d.extra.get(NOT_TOLD_APART, {}).get("channel_delay")
     assert (tie is not None) is tied
     assert bool(st.where) is tied
+
+
+@pytest.mark.parametrize("kind", ["tangential", "normal"])
+def test_an_effect_named_and_then_displaced_gets_no_stated_bound(kind):
+    from contactlab.diagnose.power import _withdrawn
+    from contactlab.diagnose.search import StepwiseSearch
+
+    d, _, _, _ = _play_record(8)
+    me = SimpleNamespace(family=SimpleNamespace(kind=kind), d=d)
+    StepwiseSearch._seen_and_dropped(me, "channel_delay", "named, then swapped out for backlash")
+    why = _withdrawn("channel_delay", d, ("backlash",))
+    assert bool(why) is (kind == "tangential")
+    if why:
+        assert "swapped out for backlash" in why
+        # in the final model after all: its size is not asked for
+        assert _withdrawn("channel_delay", d, ("channel_delay",)) == ""
