@@ -38,7 +38,7 @@ class ParallelStiffness(EffectModel):
     #: the spring's k_p x on the input smoothed over a share of the period
     #: (:func:`~._common.smoothed_displacement`), not on the sample itself: the spring
     #: pulls with the true position, and k_p times the sensor's white noise is noise the
-    #: data do not hold. On the raw samples a spring of k_p A = 0.3-0.55 h0 at x noise
+    #: data do not hold. On the raw samples a spring of k_p A = 0.2-0.9 h0 at x noise
     #: 1.5 % of the range added k_p σ_x, about the force's own noise, to every predicted
     #: sample, and a 2f normal load (a function of time, no noise) fitted the tilt better
     #: cycle by cycle and was named instead (``benches/eval_confusions.py --cases spring``,
