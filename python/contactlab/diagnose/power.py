@@ -659,6 +659,7 @@ def _not_told_apart(name: str, d: Prepared, effects: tuple[str, ...]) -> str:
         f"held-out cycles {better} (held-out gains {tie['gain']:.3g} against "
         f"{tie['gain_named']:.3g} σ², paired t of the named effect's lead {tie['t']:.2f})"
         + (f" and was not named ({why[:200]})" if why else "")
+        + (f"; {tie['noise_sized']}" if tie.get("noise_sized") else "")
         + "; on this record the data do not say which of the two they hold"
     )
 

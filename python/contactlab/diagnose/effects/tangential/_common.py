@@ -283,6 +283,25 @@ def smoothed_velocity(d: Prepared) -> np.ndarray:
     return fixed(d, "smoothed_velocity", make)
 
 
+def smoothed_displacement(d: Prepared) -> np.ndarray:
+    """The input ``x`` smoothed as :func:`smoothed_velocity` smooths ``ẋ`` (``d.u`` itself
+    when the input carries no noise), kept per record: what a term proportional to the
+    position (a parallel spring's ``k_p x``) is evaluated on, so that the term does not
+    carry the sensor's white noise into the predicted force."""
+
+    def make() -> np.ndarray:
+        if not float(d.extra.get("u_noise", 0.0) or 0.0) > 0.0:
+            return d.u
+        from ...._filters import savgol_filter
+        from ..._signal import smooth_window
+
+        w = smooth_window(fastest_period(d), SIGNAL_FRACTION, 7)
+        w = min(w, d.t.size - (1 - d.t.size % 2))
+        return savgol_filter(d.u, w, 3, mode="interp") if w >= 5 else d.u
+
+    return fixed(d, "smoothed_displacement", make)
+
+
 def smoothed_acceleration(d: Prepared) -> np.ndarray:
     """``ẍ`` of the input smoothed by a local cubic over :data:`SIGNAL_FRACTION` of a
     period (the twice differentiated input noise taken out) when the input carries noise

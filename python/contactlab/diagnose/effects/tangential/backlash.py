@@ -16,6 +16,13 @@ from ._common import actual_turns, amplitude, smoothed_velocity
 #: sine, |x| within 0.87 A), where a play's dead band has closed and the noise's wiggles at
 #: the turning points are not
 FAST_SHARE = 0.5
+#: a play no wider than this many input-noise RMS (``d.extra["u_noise"]``, the raw input's)
+#: is within the outward push the noise gives the turning points (:meth:`Backlash.
+#: within_noise`): a delay of 0.90 ms (1.5x its stated bound, ac·A 2.5, x noise 1.6 % of
+#: the range) was named a play of b = 1.15 σ_u at a paired t of 6.1 over the delay (3.3 at
+#: speeds above half the peak), its own fit stuck at τ = 0.40 ms (``benches/
+#: eval_confusions.py --cases delay``, fresh seed 95000)
+NOISE_WIDTH = 2.0
 
 
 def play(x: np.ndarray, b: float, rev: np.ndarray) -> np.ndarray:
@@ -74,6 +81,31 @@ class Backlash(EffectModel):
     #: fifth of the stroke's speed of the turns (``benches/eval_lookalike.py`` tuning seeds
     #: 52001, 52005, plain chain): the delay's bound said it would have been seen
     noise_fed_lead: ClassVar[dict[str, float]] = {"channel_delay": 1.0}
+
+    def within_noise(self, d, p):
+        """Why the play cannot be told from the turning points the input's noise pushes
+        outward (its half-width at most :data:`NOISE_WIDTH` times the input noise's RMS),
+        or None (:func:`contactlab.diagnose.search._mark_not_told_apart`). A noisy ``x``
+        peaks beyond its true turning point, so the base turns late by about the noise's
+        RMS and its next branch runs shifted as a play of that width shifts it; a delay
+        takes that shift in part. The play stays named; a delay's bound is not promised."""
+        noise = float(d.extra.get("u_noise", 0.0) or 0.0)
+        b = float(p.get("b", 0.0))
+        if not (noise > 0 and 0 < b <= NOISE_WIDTH * noise):
+            return None
+        return (
+            f"the play's half-width b = {b:.3g} m is {b / noise:.2f} times the input noise's "
+            f"RMS ({noise:.3g} m), within the {NOISE_WIDTH:g} the noise pushes the turning "
+            "points outward by"
+        )
+
+    def unfed_samples(self, d):
+        """The samples where the input's noise does not feed a play's lead over a delay
+        (:func:`contactlab.diagnose.search._mark_not_told_apart`): away from the turns, the
+        speed at least :data:`FAST_SHARE` of its peak, where a play is a fixed shift of the
+        branch and a delay one proportional to the speed."""
+        speed = np.abs(smoothed_velocity(d))
+        return speed >= FAST_SHARE * float(np.percentile(speed, 99.0))
 
     def yields_to(self, p, gains, own, d=None):
         """Why a play is not named beside a channel delay accepted at the same step whose
