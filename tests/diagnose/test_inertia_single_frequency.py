@@ -102,3 +102,87 @@ def test_a_mass_gain_in_the_steady_cycles_of_a_record_with_no_plateau_is_not_its
     why = eff.gain_not_its_own(d, plateau, steady)
     assert why is not None and "that the input's noise tilts as a mass would" in why
     assert eff.gain_not_its_own(d, plateau, startup) is None
+
+
+#: a rig record whose loops reach a plateau (ac·A 3.5, 20 Hz, 12 cycles from rest, one
+#: amplitude, x and F noise 1 %)
+PLATEAU = {"fs": 3000.0, "f": 20.0, "cycles": 12, "acA": 3.5}
+
+
+def _plateau_mass(share: float) -> float:
+    A = PLATEAU["acA"] / AC
+    hm = H0 * (1 - np.exp(-PLATEAU["acA"]))
+    return share * hm / (A * (2 * np.pi * PLATEAU["f"]) ** 2)
+
+
+def _plateau_prepared(effects: dict, seed: int = 0):
+    from contactlab.diagnose._family import Prepared
+    from contactlab.diagnose.candidates_tangential import TangentialFamily
+
+    rec = rig_recording(effects, "tangential", seed=seed, x_noise=0.01, F_noise=0.01, **PLATEAU)
+    d = Prepared.build(rec.t, rec.channels["x"], rec.channels["F"])
+    TangentialFamily().prepare(d)
+    return d
+
+
+@pytest.fixture(scope="module")
+def plateau_pair():
+    m = _plateau_mass(0.05)
+    return m, _plateau_prepared({"inertia": {"m": m}}), _plateau_prepared({})
+
+
+def test_the_plateau_tilt_reads_a_mass_and_not_a_clean_record(plateau_pair):
+    """A mass tilts every plateau by -mω² (F = h + m ẍ); away from the turns the clean
+    record's plateaus are flat within their scatter."""
+    from contactlab.diagnose.effects.tangential.inertia import TILT_T, plateau_tilt
+
+    m, dm, dc = plateau_pair
+    w2 = (2 * np.pi * PLATEAU["f"]) ** 2
+    k, se, n = plateau_tilt(dm, AC)
+    assert n >= 15 and k < -TILT_T * se
+    assert k == pytest.approx(-m * w2, rel=0.35)
+    k, se, n = plateau_tilt(dc, AC)
+    assert n >= 15 and abs(k) < 3 * se
+
+
+def test_a_mass_gain_in_the_steady_cycles_is_its_own_where_the_plateaus_slope(plateau_pair):
+    """Issue 29: on one amplitude with a plateau (ac·A ≥ 2.5) the start-up rule refused every
+    small mass (its gain lies in the steady cycles); the plateaus' slope is its own signature.
+    The clean twin with the same mass fitted is still refused, its reason giving the slope."""
+    m, dm, dc = plateau_pair
+    eff = registry_inertia()
+    steady = {-1: 0.01, 0: 0.02, **{c: 1.0 for c in range(1, 12)}}
+    p = {"m": m, "h0": H0, "ac": AC}
+    assert eff.gain_not_its_own(dm, p, steady) is None
+    why = eff.gain_not_its_own(dc, p, steady)
+    assert why is not None and "the plateaus slope by" in why
+    # a mass the tilt does not bear out (twice the truth: the slope below half of -mω²) is not
+    assert eff.gain_not_its_own(dm, {**p, "m": 2.5 * m}, steady) is not None
+
+
+def test_a_bound_is_stated_where_the_plateaus_show_a_mass_and_not_below(plateau_pair):
+    """With a plateau the bound is at least what the tilt shows at 95 %; below ac·A 2.5 the
+    reason says why a mass is not identifiable."""
+    from contactlab.diagnose.effects.tangential._common import single_frequency
+    from contactlab.diagnose.effects.tangential.inertia import plateau_tilt
+
+    m, _, dc = plateau_pair
+    eff = registry_inertia()
+    p = {"m": 0.0, "h0": H0, "ac": AC}
+    assert eff.not_separable(dc, p) is None
+    low = eff.smallest_plausible(dc, p)
+    k, se, _ = plateau_tilt(dc, AC)
+    w2 = single_frequency(dc)[0]
+    assert w2 == pytest.approx((2 * np.pi * PLATEAU["f"]) ** 2, rel=0.02)
+    assert low == pytest.approx((max(k, 0) + 5.645 * se) / w2, rel=1e-6)
+    assert 0 < low < m
+    flat = {**p, "ac": 2.0 / (0.5 * float(np.ptp(dc.u)))}
+    why = eff.not_separable(dc, flat)
+    assert why.startswith("not identifiable: ") and "no flat plateau" in why
+    assert eff.smallest_plausible(dc, flat) is None
+
+
+def registry_inertia():
+    from contactlab.diagnose.effects import registry
+
+    return registry("tangential")["inertia"]
