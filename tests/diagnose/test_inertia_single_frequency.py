@@ -186,3 +186,32 @@ def registry_inertia():
     from contactlab.diagnose.effects import registry
 
     return registry("tangential")["inertia"]
+
+
+def test_a_small_mass_on_a_plateau_record_of_one_amplitude_is_named():
+    """Issue 29: a mass whose force at the peak acceleration is 5 % of the force amplitude, on
+    one amplitude with a plateau (ac·A 3.5), was refused before (its gain in the steady
+    cycles, "a plateau that the input's noise tilts as a mass would"); its argument gives
+    the mass the plateaus' tilt reads."""
+    m = _plateau_mass(0.05)
+    rec = rig_recording({"inertia": {"m": m}}, "tangential", seed=0, x_noise=0.01,
+                        F_noise=0.01, **PLATEAU)  # fmt: skip
+    rep = contactlab.diagnose((rec.t, rec.channels["x"], rec.channels["F"]), model="tangential")
+    assert rep.effect_names == ["inertia"]
+    text = rep.effects[0].plausibility
+    tilt = float(re.search(r"a mass of (\S+) ± (\S+) kg", text).group(1))
+    assert 0.6 * m < tilt < 1.4 * m
+
+
+def test_the_plateau_tilt_identifies_a_mass_the_fit_trades_with_ac(plateau_pair):
+    """Where the fit's error puts m within 2 standard errors of 0 (its ac trades with m over
+    the steep parts), the tilt of the record's plateaus identifies it; a clean record's
+    plateaus do not."""
+    from contactlab.diagnose.candidates_tangential import TangentialFamily
+
+    m, dm, dc = plateau_pair
+    fam = TangentialFamily()
+    p, se = {"m": 0.3 * m, "h0": H0, "ac": AC}, {"m": 0.3 * m}
+    assert fam.identified("inertia", p, se).startswith("not identifiable")
+    assert fam.identified("inertia", p, se, d=dm) is None
+    assert fam.identified("inertia", p, se, d=dc).startswith("not identifiable")

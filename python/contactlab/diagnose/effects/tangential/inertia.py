@@ -259,6 +259,14 @@ class Inertia(EffectModel):
                 "amplitude tells it from the contact's own stiffness, which takes part of "
                 "-mω² where the loops do not reach a plateau: m may read low)"
             )
+            ac = float(p.get("ac", np.nan))
+            if np.isfinite(ac) and ac * amplitude(d) >= STEADY_SEPARABLE_ACA:
+                k, se, n = plateau_tilt(d, ac)
+                if n >= 2 and np.isfinite(k) and np.isfinite(se):
+                    text += (
+                        f"; away from the turns the plateaus slope by {k:.3g} ± {se:.2g} N/m "
+                        f"over {n} steady branches, a mass of {-k / w2:.3g} ± {se / w2:.2g} kg"
+                    )
         return text
 
     def gain_not_its_own(self, d, p, cycle_gain):
