@@ -160,26 +160,18 @@ def test_a_mass_gain_in_the_steady_cycles_is_its_own_where_the_plateaus_slope(pl
     assert eff.gain_not_its_own(dm, {**p, "m": 2.5 * m}, steady) is not None
 
 
-def test_a_bound_is_stated_where_the_plateaus_show_a_mass_and_not_below(plateau_pair):
-    """With a plateau the bound is at least what the tilt shows at 95 %; below ac·A 2.5 the
-    reason says why a mass is not identifiable."""
-    from contactlab.diagnose.effects.tangential._common import single_frequency
-    from contactlab.diagnose.effects.tangential.inertia import plateau_tilt
-
-    m, _, dc = plateau_pair
+def test_no_mass_size_is_promised_on_one_frequency_and_the_reason_says_why(plateau_pair):
+    """With a plateau a mass is named by its tilt, but the bound was not calibrated (a mass
+    hidden at it was named 0/4 times on the rig, 2f load and position friction taking the
+    tilt): "not calibrated"; below ac·A 2.5 "not identifiable" with the reason."""
+    _, _, dc = plateau_pair
     eff = registry_inertia()
     p = {"m": 0.0, "h0": H0, "ac": AC}
-    assert eff.not_separable(dc, p) is None
-    low = eff.smallest_plausible(dc, p)
-    k, se, _ = plateau_tilt(dc, AC)
-    w2 = single_frequency(dc)[0]
-    assert w2 == pytest.approx((2 * np.pi * PLATEAU["f"]) ** 2, rel=0.02)
-    assert low == pytest.approx((max(k, 0) + 5.645 * se) / w2, rel=1e-6)
-    assert 0 < low < m
+    why = eff.not_separable(dc, p)
+    assert why.startswith("not calibrated: ") and "slope away from the turns" in why
     flat = {**p, "ac": 2.0 / (0.5 * float(np.ptp(dc.u)))}
     why = eff.not_separable(dc, flat)
     assert why.startswith("not identifiable: ") and "no flat plateau" in why
-    assert eff.smallest_plausible(dc, flat) is None
 
 
 def registry_inertia():
