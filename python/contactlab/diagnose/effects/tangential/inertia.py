@@ -60,7 +60,9 @@ def plateau_tilt(d, ac: float) -> tuple[float, float, int]:
     noise moves the turning points, which the part read here leaves out. On the rig's
     single-amplitude records at ac·A 2.5-5 (tuning seeds 610000-610007 of
     ``benches/eval_inertia_single.py --gen rig``, mass share 1-6 %, x noise 0.1-2 %) the
-    clean records' t lay in -0.95..1.81, the masses' in -78..-5 at 0.78-1.39 of -mω²."""
+    clean records' t lay in -0.95..1.81, the masses' in -78..-5 at 0.78-1.39 of -mω² (read
+    with the true ac); on 36 clean chain records of ``benches/misfit_chain.py`` (2 % white x
+    noise, ac·A drawn apart in 2.6-5, seeds 500000-500035) in -2.25..1.52."""
     u, y = np.asarray(d.u, float), np.asarray(d.y, float)
     if not (np.isfinite(ac) and ac > 0):
         return np.nan, np.nan, 0
@@ -282,7 +284,9 @@ class Inertia(EffectModel):
         (fitted per branch on the smoothed drive) read -1.2e5 to -1.0e6 N/m where 0.05 %
         x noise gave +1.1e5. So on one amplitude the start-up rule holds at every ac·A (a
         record of several amplitudes, :func:`amplitudes_vary`, shows a mass on its plateaus
-        alike while the noise tilts each by its own share). A gain that lies in
+        alike while the noise tilts each by its own share), and neither where the plateaus
+        slope down away from the turns (:func:`plateau_tilt`, :func:`tilt_shows_mass`),
+        which the input's noise does not reach. A gain that lies in
         the steady cycles (at most
         :data:`STARTUP_SHARE` of it in the start-up) is the base model's trade-off between
         its stiffness and its curvature, not a mass: on the rig a spring beside the contact
