@@ -46,12 +46,16 @@ TUNE_BASE = 73_000
 H0, AC = 40.0, 4.0e4
 
 
-def factors(seed: int, effect: str, any_f: bool) -> dict:
+def factors(seed: int, effect: str, any_f: bool, aca=None) -> dict:
+    """The record's factors; ``aca``: (lo, hi) to draw ac·A from instead (log-uniform, its
+    own stream: ``--aca``, e.g. records whose loops reach a plateau)."""
     from eval_diagnose_rig import MAX_SAMPLES as RIG_MAX
     from eval_diagnose_rig import _loguniform
     from eval_slow_power import MAX_SAMPLES, factors
 
     fac = factors(seed, 0.0)
+    if aca is not None:
+        fac["acA"] = round(_loguniform(np.random.default_rng(seed + 2_000_003), *aca), 3)
     if effect == "inertia" and not any_f:
         rng = np.random.default_rng(seed + 1_000_003)
         fac["f"] = round(_loguniform(rng, 20.0, 50.0), 3)
@@ -98,8 +102,8 @@ def run_job(job):
     from eval_slow_power import read, record
 
     warnings.simplefilter("ignore")
-    seed, effect, mults, visible, any_f = job
-    fac = factors(seed, effect, any_f)
+    seed, effect, mults, visible, any_f, *rest = job
+    fac = factors(seed, effect, any_f, rest[0] if rest else None)
     t0 = time.process_time()
     out = {"seed": seed, "effect": effect, "factors": fac, "runs": []}
     try:
@@ -212,6 +216,7 @@ def main(argv=None):
     ap.add_argument("--mults", default="1,2", help="multiples of the stated bound")
     ap.add_argument("--visible", action="store_true")
     ap.add_argument("--inertia-any-f", action="store_true")
+    ap.add_argument("--aca", default=None, help="lo,hi: draw ac·A log-uniform from this range")
     ap.add_argument("--raw", type=Path, default=None)
     ap.add_argument("--tables-from", type=Path, nargs="+", default=None)
     ap.add_argument("--out", type=Path, default=None)
@@ -227,13 +232,14 @@ def main(argv=None):
     else:
         base = 30_000_000 + (int(time.time()) % 1_000_000) * 100
     mults = tuple(float(m) for m in a.mults.split(",") if m)
+    aca = None if a.aca is None else tuple(float(v) for v in a.aca.split(","))
     effects = tuple(a.effects.split(","))
     print(f"seeds {a.seeds} base {base}, {a.n} seeds, effects {effects}", flush=True)
     t0 = time.time()
     res = []
     for i in range(a.n):
         for e in effects:
-            res.append(run_job((base + i, e, mults, a.visible, a.inertia_any_f)))
+            res.append(run_job((base + i, e, mults, a.visible, a.inertia_any_f, aca)))
             if a.raw:
                 a.raw.write_text(json.dumps(res, indent=1, default=float))
     cpu = sum(r.get("cpu", 0) for r in res)

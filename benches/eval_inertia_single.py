@@ -47,8 +47,20 @@ def _logu(rng, lo, hi):
     return float(math.exp(rng.uniform(math.log(lo), math.log(hi))))
 
 
-def factors(seed: int, effect: str = "clean") -> dict:
-    """The record's factors: drawn from ``seed`` and the effect (each effect its own draws)."""
+#: the range of the mass's share of the force (``--share``) and the generator forced
+#: (``--gen``; None: 60 % rig); set by :func:`main`, read by :func:`factors`
+SHARE = (0.03, 0.10)
+GEN: str | None = None
+#: the range ac·A is drawn from (log-uniform; ``--aca``)
+ACA = (0.3, 5.0)
+
+
+def factors(seed: int, effect: str = "clean", share=None, gen=None, aca=None) -> dict:
+    """The record's factors: drawn from ``seed`` and the effect (each effect its own draws);
+    ``share``: the mass's share range (default :data:`SHARE`), ``gen``: force a generator."""
+    share = SHARE if share is None else share
+    gen = GEN if gen is None else gen
+    aca = ACA if aca is None else aca
     rng = np.random.default_rng([seed, EFFECTS.index(effect)])
     fs = _logu(rng, 1000.0, 10000.0)
     f = _logu(rng, 1.0, 50.0)
@@ -59,15 +71,15 @@ def factors(seed: int, effect: str = "clean") -> dict:
         "fs": round(fs, 1),
         "f": round(f, 3),
         "cycles": cycles,
-        "acA": round(_logu(rng, 0.3, 5.0), 3),
+        "acA": round(_logu(rng, *aca), 3),
         "x_noise": round(float(rng.uniform(0.0, 0.02)), 4),
         "F_noise": round(float(rng.uniform(0.005, 0.02)), 4),
         "x_drift": float(rng.uniform(-0.003, 0.003)),
         "bits": int(rng.integers(12, 17)),
-        "share": float(rng.uniform(0.03, 0.10)),
+        "share": float(rng.uniform(*share)),
         "kshare": float(rng.uniform(0.05, 0.15)),
         "ks": float(rng.uniform(0.7, 1.5)),
-        "gen": "rig" if rng.random() < 0.6 else "pkg",
+        "gen": ("rig" if rng.random() < 0.6 else "pkg") if gen is None else gen,
         "spc": int(rng.integers(60, 400)),
     }
 
@@ -115,8 +127,8 @@ def run_job(job):
     import contactlab
 
     warnings.simplefilter("ignore")
-    seed, effect = job
-    fac = factors(seed, effect)
+    seed, effect, share, gen, aca = job
+    fac = factors(seed, effect, share, gen, aca)
     out = {"seed": seed, "effect": effect, "factors": fac}
     t0 = time.process_time()
     try:
@@ -234,12 +246,20 @@ def main(argv=None):
     ap.add_argument("--effects", default=",".join(EFFECTS))
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--out", default=None)
+    ap.add_argument("--share", default="0.03,0.10",
+                    help="lo,hi of the mass's share of the force (rig: m ω² A over the force "
+                    "amplitude; pkg: the RMS share)")  # fmt: skip
+    ap.add_argument("--gen", choices=("rig", "pkg"), default=None,
+                    help="force one generator (default: 60 %% rig)")  # fmt: skip
+    ap.add_argument("--aca", default="0.3,5.0", help="lo,hi of ac·A (log-uniform)")
     a = ap.parse_args(argv)
+    share = tuple(float(v) for v in a.share.split(","))
+    aca = tuple(float(v) for v in a.aca.split(","))
     effects = a.effects.split(",")
     jobs = []
     for e in effects:
         n = a.n_clean if (e == "clean" and a.n_clean) else a.n
-        jobs += [(a.base + i, e) for i in range(n)]
+        jobs += [(a.base + i, e, share, a.gen, aca) for i in range(n)]
     t0 = time.time()
     if a.jobs > 1:
         with ProcessPoolExecutor(a.jobs) as ex:
@@ -251,7 +271,10 @@ def main(argv=None):
             r = res[-1]
             print(j, r["named"], "F" if r["flagged"] else "", f"{r.get('cpu', 0):.0f}s",
                   file=sys.stderr, flush=True)  # fmt: skip
-    text = f"base {a.base}, n {a.n}, {time.time() - t0:.0f} s\n\n" + tables(res)
+    text = (
+        f"base {a.base}, n {a.n}, share {a.share}, ac·A {a.aca}, gen {a.gen or 'mixed'}, "
+        f"{time.time() - t0:.0f} s\n\n" + tables(res)
+    )
     print(text)
     if a.out:
         Path(a.out).write_text(text + "\n")

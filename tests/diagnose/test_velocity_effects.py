@@ -153,11 +153,12 @@ def test_a_tie_in_held_out_gain_goes_to_the_lower_bic():
 def test_no_mass_is_promised_on_a_single_frequency_drive(presliding_mass):
     """A bound from the steady cycles promised 95 % power; the rig named the mass at it 1
     time in 4 and at twice it 1 in 4 (benches/eval_bound_power.py, tuning seeds 73001-73005):
-    on one sine the record cannot promise any mass."""
+    on one sine whose loops reach no plateau the record cannot promise any mass."""
     _, rep = presliding_mass
     b = {x.effect: x for x in rep.not_detected}["inertia"]
     assert b.detectable_above is None
-    assert b.reason.startswith("not separable from parallel stiffness")
+    assert b.reason.startswith("not identifiable: not separable from parallel stiffness")
+    assert "no flat plateau" in b.reason  # the reason: ac·A 0.38
 
 
 def test_a_drive_of_several_frequencies_gets_a_mass_bound():

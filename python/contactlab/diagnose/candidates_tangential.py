@@ -705,9 +705,18 @@ class TangentialFamily:
         ok, why = EFFECTS[name].plausible(d, p)
         return None if ok else why
 
-    def identified(self, name: str, p: dict[str, float], se: dict[str, float]) -> str | None:
-        """Why a fitted effect's size is not identified (within its error of "absent")."""
-        return EFFECTS[name].identified(p, se)
+    def identified(
+        self, name: str, p: dict[str, float], se: dict[str, float], d: Prepared | None = None
+    ) -> str | None:
+        """Why a fitted effect's size is not identified (within its error of "absent"), or
+        None; with the record ``d``, an effect whose own signature in the data stands out
+        of the noise apart from the fit's error (its ``identified_apart(d, p)``: a mass's
+        plateau tilt on one drive frequency) is identified."""
+        why = EFFECTS[name].identified(p, se)
+        apart = getattr(EFFECTS[name], "identified_apart", None)
+        if why and d is not None and apart is not None and apart(d, p):
+            return None
+        return why
 
     def plausibility(self, name: str, p: dict[str, float], d: Prepared) -> tuple[bool, str]:
         """The effect's plausibility verdict and its argument in numbers."""

@@ -250,7 +250,8 @@ def _try_candidate(
     if v.accepted and hasattr(family, "identified"):
         # each new effect's size must stand out of its own error (issue 29: a held-out gain
         # the effect shares with a base parameter it trades off with is not its own)
-        unid = next((w for e in (*also, name) if (w := family.identified(e, p, cand.full.stderr))),
+        se = cand.full.stderr
+        unid = next((w for e in (*also, name) if (w := family.identified(e, p, se, d=d))),
                     None)  # fmt: skip
         if unid:
             v = dataclasses.replace(v, accepted=False, reason=unid)

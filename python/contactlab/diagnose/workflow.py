@@ -383,7 +383,7 @@ def _unfounded(family: Family, st: SearchState, d: Prepared) -> tuple[str, str] 
         for e in st.added:
             if e not in reg:
                 continue
-            why = family.identified(e, p, se)
+            why = family.identified(e, p, se, d=d)
             v, s = reg[e].size(p, se)
             if not why and (v == 0 or (not np.isfinite(s) and _at_null(reg[e], p))):
                 # at its null value (its error not computable there): nothing says it is there

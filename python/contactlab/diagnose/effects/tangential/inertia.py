@@ -2,11 +2,19 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 from ..._family import ParamSpec
 from .._base import EffectModel, Plausibility, register
-from ._common import peak_acceleration, single_frequency, smoothed_acceleration
+from ._common import (
+    amplitude,
+    peak_acceleration,
+    record_turns,
+    single_frequency,
+    smoothed_acceleration,
+)
 
 #: the share of the input-noise budget a mass must beat (:attr:`Inertia.input_noise_share`)
 #: and of the search's ``min_gain`` its gain must reach (:attr:`Inertia.gain_floor_scale`)
@@ -27,6 +35,84 @@ STARTUP_SHARE = 0.3
 #: steady cycles whose strokes differ by more than this ratio (90th over 10th percentile)
 #: make a record of several amplitudes (:func:`amplitudes_vary`)
 AMPLITUDE_RATIO = 1.2
+
+
+#: the plateau's tilt (:func:`plateau_tilt`): each steady branch read from where it is
+#: TILT_FAR/ac past its turning point (its Masing stiffness below exp(-TILT_FAR/2), the tail
+#: regressed out) to TILT_EDGE of its stroke before the next turn; a mass's tilt must stand
+#: TILT_T standard errors (of the branches' scatter) below zero over at least TILT_BRANCHES
+#: branches and reach TILT_AGREE of the fitted mass's -mω² (:meth:`Inertia.gain_not_its_own`)
+TILT_FAR, TILT_EDGE = 2.5, 0.05
+TILT_T, TILT_BRANCHES, TILT_AGREE = 4.0, 6, 0.5
+
+
+def plateau_tilt(d, ac: float) -> tuple[float, float, int]:
+    """The slope ``dF/dx`` (N/m) of the steady branches' plateaus and its standard error, and
+    how many branches gave one: per branch between two turning points of the filtered input
+    (cycles ≥ 1), the force over the part ``ac·|x - x_turn| ≥`` :data:`TILT_FAR` up to
+    :data:`TILT_EDGE` of the stroke before the next turn is regressed on ``1``, ``x`` and
+    ``exp(-ac |x - x_turn| / 2)`` (the Masing branch's tail at the contact's ``ac``); the
+    slopes' mean over the branches and its error from their scatter (so a coloured noise or
+    a drift is judged by what it does to each branch, not sample by sample).
+
+    A mass tilts every plateau by ``-mω²`` (F = h + m ẍ, ẍ = -ω² x); a Masing element, a
+    spring beside it (positive) and a compliance in series cannot slope down; the input's
+    noise moves the turning points, which the part read here leaves out. On the rig's
+    single-amplitude records at ac·A 2.5-5 (tuning seeds 610000-610007 of
+    ``benches/eval_inertia_single.py --gen rig``, mass share 1-6 %, x noise 0.1-2 %) the
+    clean records' t lay in -0.95..1.81, the masses' in -78..-5 at 0.78-1.39 of -mω² (read
+    with the true ac); on 36 clean chain records of ``benches/misfit_chain.py`` (2 % white x
+    noise, ac·A drawn apart in 2.6-5, seeds 500000-500035) in -2.25..1.52."""
+    u, y = np.asarray(d.u, float), np.asarray(d.y, float)
+    if not (np.isfinite(ac) and ac > 0):
+        return np.nan, np.nan, 0
+    turns = record_turns(u, float(d.extra.get("u_noise", 0.0) or 0.0))
+    cyc = np.asarray(d.cycles.cycle)
+    slopes = []
+    for a, b in itertools.pairwise(turns):
+        if cyc[a] < 1:
+            continue
+        uu, yy = u[a:b], y[a:b]
+        dist = np.abs(uu - u[a])
+        stroke = abs(float(u[b] - u[a]))
+        keep = (ac * dist >= TILT_FAR) & (dist <= (1 - TILT_EDGE) * stroke) & np.isfinite(yy)
+        if np.count_nonzero(keep) < 6 or np.ptp(uu[keep]) < 0.2 * stroke:
+            continue
+        X = np.column_stack([np.ones(np.count_nonzero(keep)), uu[keep],
+                             np.exp(-0.5 * ac * dist[keep])])  # fmt: skip
+        coef, *_ = np.linalg.lstsq(X, yy[keep], rcond=None)
+        slopes.append(float(coef[1]))
+    if len(slopes) < 2:
+        return np.nan, np.nan, len(slopes)
+    k = np.asarray(slopes)
+    return float(k.mean()), float(k.std(ddof=1) / np.sqrt(k.size)), int(k.size)
+
+
+def tilt_shows_mass(tilt: tuple[float, float, int], mw2: float) -> bool:
+    """Whether a plateau tilt ``(slope, se, branches)`` of :func:`plateau_tilt` is a mass's
+    own: at least :data:`TILT_BRANCHES` branches, the slope :data:`TILT_T` standard errors
+    below zero and at least :data:`TILT_AGREE` of the fitted mass's ``-mω²`` (``mw2``)."""
+    k, se, n = tilt
+    return bool(
+        n >= TILT_BRANCHES
+        and np.isfinite(k)
+        and np.isfinite(se)
+        and se > 0
+        and mw2 > 0
+        and k <= -TILT_T * se
+        and k <= -TILT_AGREE * mw2
+    )
+
+
+def _tilt_text(tilt: tuple[float, float, int], mw2: float) -> str:
+    k, se, n = tilt
+    if n < 2 or not np.isfinite(k):
+        return " (too few steady branches reach their plateau to read its slope)"
+    return (
+        f" (away from the turns the plateaus slope by {k:.3g} ± {se:.2g} N/m over {n} "
+        f"branches, against -mω² = {-mw2:.3g} N/m: not {TILT_T:g} standard errors below "
+        f"zero and {100 * TILT_AGREE:g} % of -mω²)"
+    )
 
 
 def amplitudes_vary(d) -> bool:
@@ -173,6 +259,14 @@ class Inertia(EffectModel):
                 "amplitude tells it from the contact's own stiffness, which takes part of "
                 "-mω² where the loops do not reach a plateau: m may read low)"
             )
+            ac = float(p.get("ac", np.nan))
+            if np.isfinite(ac) and ac * amplitude(d) >= STEADY_SEPARABLE_ACA:
+                k, se, n = plateau_tilt(d, ac)
+                if n >= 2 and np.isfinite(k) and np.isfinite(se):
+                    text += (
+                        f"; away from the turns the plateaus slope by {k:.3g} ± {se:.2g} N/m "
+                        f"over {n} steady branches, a mass of {-k / w2:.3g} ± {se / w2:.2g} kg"
+                    )
         return text
 
     def gain_not_its_own(self, d, p, cycle_gain):
@@ -190,7 +284,9 @@ class Inertia(EffectModel):
         (fitted per branch on the smoothed drive) read -1.2e5 to -1.0e6 N/m where 0.05 %
         x noise gave +1.1e5. So on one amplitude the start-up rule holds at every ac·A (a
         record of several amplitudes, :func:`amplitudes_vary`, shows a mass on its plateaus
-        alike while the noise tilts each by its own share). A gain that lies in
+        alike while the noise tilts each by its own share), and neither where the plateaus
+        slope down away from the turns (:func:`plateau_tilt`, :func:`tilt_shows_mass`),
+        which the input's noise does not reach. A gain that lies in
         the steady cycles (at most
         :data:`STARTUP_SHARE` of it in the start-up) is the base model's trade-off between
         its stiffness and its curvature, not a mass: on the rig a spring beside the contact
@@ -207,6 +303,9 @@ class Inertia(EffectModel):
         aca = ac * a
         if aca >= STEADY_SEPARABLE_ACA and amplitudes_vary(d):
             return None  # the plateau's tilt at several amplitudes tells -mω² from x noise
+        tilt = plateau_tilt(d, ac) if aca >= STEADY_SEPARABLE_ACA else (np.nan, np.nan, 0)
+        if tilt_shows_mass(tilt, p["m"] * one[0]):
+            return None  # the plateaus slope down, away from the turns: -mω² itself
         total = sum(cycle_gain.values())
         start = sum(g for c, g in cycle_gain.items() if c < 1)
         if not total > 0 or start >= STARTUP_SHARE * total:
@@ -215,6 +314,7 @@ class Inertia(EffectModel):
             f"no flat plateau (ac·A = {aca:.2g} < {STEADY_SEPARABLE_ACA:g})"
             if aca < STEADY_SEPARABLE_ACA
             else f"a plateau (ac·A = {aca:.2g}) that the input's noise tilts as a mass would"
+            + _tilt_text(tilt, p["m"] * one[0])
         )
         return (
             f"not separable from the contact's own stiffness: on this single-frequency drive "
@@ -222,6 +322,24 @@ class Inertia(EffectModel):
             f"{100 * (1 - start / total):.0f} % of its held-out gain lies there; only the "
             "start-up from rest tells a mass from a stiffer or softer contact"
         )
+
+    def identified_apart(self, d, p) -> bool:
+        """Whether the plateaus' tilt identifies the mass where the fit's own error does
+        not (``TangentialFamily.identified``): on a single-frequency record whose loops
+        reach a plateau the base model's ``ac`` trades with ``m`` over the steep parts,
+        whose input noise dominates the error, while the plateaus away from the turns
+        read the tilt ``-mω²`` by themselves (:func:`tilt_shows_mass`). Rig, tuning seed
+        610000 of ``benches/eval_inertia_single.py --gen rig --share 0.01,0.06 --aca 2.5,5``
+        (36 Hz, ac·A 2.9, x noise 0.6 %, a 5.7 % mass): m fitted 0.167 ± 0.11 kg, the tilt
+        -3.0e4 ± 1.8e3 N/m (0.57 kg at its ω²; true 0.57 kg)."""
+        one = single_frequency(d)
+        ac = float(p.get("ac", np.nan))
+        m = float(p.get("m", 0.0))
+        if one is None or not (m > 0 and np.isfinite(ac)):
+            return False
+        if ac * amplitude(d) < STEADY_SEPARABLE_ACA:
+            return False
+        return tilt_shows_mass(plateau_tilt(d, ac), m * one[0])
 
     def signal_input(self, d):
         """The record with ``ẍ`` as the data hold it, for the stated bound: on a
@@ -248,15 +366,47 @@ class Inertia(EffectModel):
         bound stated from the steady cycles (the start-up left out) promised 95 %; the rig
         named the mass at it 1 time in 4, and at twice it 1 in 4 (tuning seeds 73001-73005
         of ``benches/eval_bound_power.py``: normal_load, stribeck with s < 0, series
-        compliance with a delay named instead, or the base fit collapsing)."""
+        compliance with a delay named instead, or the base fit collapsing).
+
+        Where the loops reach a flat plateau (``ac·A`` at least :data:`STEADY_SEPARABLE_ACA`)
+        and at least :data:`TILT_BRANCHES` steady branches reach it, the plateaus' slope
+        away from the turns (:func:`plateau_tilt`) is a mass's own signature and a mass is
+        named by it; but no size is promised there either: the linearised bound its clean
+        twin stated (1.05-1.32 kg) hidden on the rig's plateau records was named 0/4 times,
+        at twice it 2/4, a 2f ``normal_load`` or ``position_friction`` taking the tilt with
+        a larger held-out gain (``benches/eval_bound_power.py --effects inertia --aca
+        2.5,5``, fresh seeds 660000-660003; in 5 of the 6 misses the mass passed its own rules and
+        lost the step to the look-alike)."""
         one = single_frequency(d)
         if one is None:
             return None
+        ac = float(p.get("ac", np.nan))
+        aca = ac * amplitude(d)
+        if np.isfinite(aca) and aca >= STEADY_SEPARABLE_ACA:
+            _, se, n = plateau_tilt(d, ac)
+            if n >= TILT_BRANCHES and np.isfinite(se) and se > 0:
+                return (
+                    f"not calibrated: its loops reach a plateau (ac·A = {aca:.2g}) whose "
+                    f"slope away from the turns, over {n} steady branches, shows a mass "
+                    "(-mω²), but a 2f load fluctuation and a position-dependent friction tilt "
+                    "it too and took it with a larger held-out gain: on the rig a mass hidden "
+                    "at the linearised bound was named 0 times in 4, at twice it 2 in 4, so "
+                    "no size of a mass is promised on this single-frequency record"
+                )
+            where = (
+                f"its loops reach a plateau (ac·A = {aca:.2g}) but {n} steady branches read "
+                f"its slope (at least {TILT_BRANCHES} needed)"
+            )
+        elif np.isfinite(aca):
+            where = f"its loops reach no flat plateau (ac·A = {aca:.2g} < {STEADY_SEPARABLE_ACA:g})"
+        else:
+            where = "the contact's ac is unknown"
         return (
-            "not separable from parallel stiffness on this single-frequency record: no "
-            "size of a mass can be promised (one frequency, no harmonics: only the start-up "
-            "from rest or a change of amplitude tells a mass from a stiffness, by an amount "
-            "no linearised bound foresees)"
+            "not identifiable: not separable from parallel stiffness on this "
+            f"single-frequency record, {where}: no size of a mass can be promised (one "
+            "frequency, no harmonics: only the start-up from rest, a change of amplitude or "
+            "a plateau's downward slope tells a mass from a stiffness, and here only the "
+            "first two could, by an amount no linearised bound foresees)"
         )
 
     def power_note(self, d, p):
