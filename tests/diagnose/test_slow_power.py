@@ -201,3 +201,25 @@ def test_a_drift_is_orthogonal_to_a_residual_repeating_every_cycle() -> None:
         c = abs(float(np.sum(drift[steady] * r1[steady])))
         scale = float(np.sqrt(np.sum(drift[steady] ** 2) * np.sum(r1[steady] ** 2)))
         assert c < 0.1 * scale
+
+
+def test_the_bound_holds_each_effect_to_its_own_floors() -> None:
+    """The stated bound's floor (power._own_floor) is the search's for that effect: a
+    parameter drift's share of ``min_gain`` and of rule 4, a load's share of the budget."""
+    import dataclasses
+
+    from contactlab.diagnose.power import _own_floor
+
+    fam = TangentialFamily()
+    d = SimpleNamespace(extra={"gain_rules": {"min_gain": 0.05, "budget": 0.4}})
+    st = dataclasses.replace(_setting(), rel_floor=0.02)
+    drift = _own_floor(fam, "parameter_drift", d, st)
+    assert drift.rel_floor == pytest.approx(0.02 * relative_gain_scale(fam, ("parameter_drift",)))
+    assert drift.gain_floor == pytest.approx(
+        max(own_gain_floor(fam, ("parameter_drift",), 0.05), drift.rel_floor)
+    )
+    assert drift.gain_floor < 0.01
+    force = _own_floor(fam, "force_drift", d, st)
+    assert force.gain_floor == pytest.approx(0.02)  # rule 4 in full, above its 0.01 σ²
+    load = _own_floor(fam, "normal_load", d, st)
+    assert load.gain_floor == pytest.approx(0.05 + 0.1)
