@@ -48,7 +48,12 @@ EFFECTS = (
     "asymmetry",
     "displacement_offset",
     "non_masing_scaling",
+    "normal_load",
+    "normal_load_beat",
 )
+#: the rig's (and the diagnosis's) name of a bench effect: ``normal_load_beat`` is a normal
+#: load off the drive's harmonics (2f plus three beats over the record)
+RIG_NAME = {"normal_load_beat": "normal_load"}
 #: the λ a criterion like the blind judge's needs (3 % false alarm, 95 % power, one fold
 #: of two held out)
 LAMBDA = 44.8
@@ -86,6 +91,8 @@ def rig_params(effect: str, size: float, fac: dict) -> dict:
         "asymmetry": {"a": s * size},
         "displacement_offset": {"x0": s * size},
         "non_masing_scaling": {"lam": 2.0 - size},
+        "normal_load": {"eps": size, "f_n": 2.0 * fac["f"], "phi": fac["phi"]},
+        "normal_load_beat": {"eps": size, "f_n": 2.0 * fac["f"] + 3.0 / T_rec, "phi": fac["phi"]},
     }[effect]
 
 
@@ -101,12 +108,15 @@ def ref_size(effect: str, fac: dict) -> float:
         "asymmetry": 0.03,
         "displacement_offset": 0.05 * A,
         "non_masing_scaling": 0.1,
+        "normal_load": 0.03,
+        "normal_load_beat": 0.03,
     }[effect]
 
 
 def record(effects: dict, fac: dict, seed: int, quiet: bool = False):
     from contactlab.synthetic.rig import rig_recording
 
+    effects = {RIG_NAME.get(k, k): v for k, v in effects.items()}
     kw = {k: fac[k] for k in ("fs", "f", "cycles", "acA", "x_noise", "F_noise", "x_drift")}
     kw["bits"] = fac["bits"]
     if quiet:
@@ -207,14 +217,15 @@ def run_seed(job):
         out["error"] = f"directions: {type(exc).__name__}: {exc}"[:200]
         return out
     for e in effects:
+        name = RIG_NAME.get(e, e)
         s_ref = ref_size(e, fac)
         q1 = record({e: rig_params(e, s_ref, fac)}, fac, seed, quiet=True)
         x1, F1 = q1.channels["x"], q1.channels["F"]
         delta = (F1 - F0) - (Masing(H0, AC).force(x1) - m0)
-        others = {c: v for c, v in others_all.items() if c != e}
+        others = {c: v for c, v in others_all.items() if c != name}
         lam_b, lam, nearest = lam_of(delta, base, others, V)
         need = s_ref * math.sqrt(LAMBDA / lam) if lam > 0 else math.inf
-        b = bounds.get(e)
+        b = bounds.get(name)
         bound = None if b is None else b.detectable_above
         case = {"effect": e, "lambda_ref": lam, "lambda_base_only": lam_b, "nearest": nearest,
                 "s_ref": s_ref, "need": need, "bound": bound,
@@ -233,7 +244,7 @@ def run_seed(job):
                     read(record({e: rig_params(e, size, fac)}, fac, s2)), model="tangential"
                 )
                 names = r.effect_names
-                vs = [v for st in r.steps for v in st.candidates if v.name == e]
+                vs = [v for st in r.steps for v in st.candidates if v.name == name]
                 v = vs[0] if vs else None
                 why = None if v is None else {
                     "gain": v.gain, "t": v.t_stat, "dbic": v.delta_bic, "reason": v.reason[:120]
@@ -283,8 +294,8 @@ def tables(results: list[dict]) -> str:
         labels = sorted({run["label"] for _, c in rows for run in c["runs"]})
         for i, lab in enumerate(labels):
             runs = [run for _, c in rows for run in c["runs"] if run["label"] == lab]
-            ex = sum(run["named"] == [e] for run in runs)
-            nm = sum(e in run["named"] for run in runs)
+            ex = sum(run["named"] == [RIG_NAME.get(e, e)] for run in runs)
+            nm = sum(RIG_NAME.get(e, e) in run["named"] for run in runs)
             lines.append(
                 f"| {e if i == 0 else ''} | {rs if i == 0 else ''} | {nr if i == 0 else ''} | "
                 f"{lab} | {len(runs)} | {ex} | {nm} | {len(runs) - nm} |"
@@ -294,7 +305,7 @@ def tables(results: list[dict]) -> str:
     for e in EFFECTS:
         for r, c in by.get(e, []):
             for run in c["runs"]:
-                if e in run["named"]:
+                if RIG_NAME.get(e, e) in run["named"]:
                     continue
                 f = r["factors"]
                 lines.append(

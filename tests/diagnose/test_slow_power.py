@@ -11,8 +11,8 @@ import pytest
 
 from contactlab.diagnose.candidates_tangential import TangentialFamily
 from contactlab.diagnose.power import DRAWS, _bound, _power_curve, _Setting
-from contactlab.diagnose.search import _noise_floor, own_gain_floor
-from contactlab.diagnose.select import proportional_t
+from contactlab.diagnose.search import _noise_floor, own_gain_floor, relative_gain_scale
+from contactlab.diagnose.select import MIN_RELATIVE_GAIN, judge, proportional_t
 
 M, PER = 8, 60  # cycles, samples per cycle
 
@@ -85,7 +85,9 @@ def test_the_linearised_proportional_t_matches_the_statistic_itself() -> None:
 def test_own_gain_floor_per_effect() -> None:
     fam = TangentialFamily()
     assert own_gain_floor(fam, ("force_drift",), 0.05) == pytest.approx(0.01)
-    assert own_gain_floor(fam, ("parameter_drift",), 0.05) == pytest.approx(0.01)
+    # a parameter drift's floor is of the order of the BIC's own (ln n / n at 5000 samples)
+    assert own_gain_floor(fam, ("parameter_drift",), 0.05) <= 0.3 * 0.01
+    assert own_gain_floor(fam, ("parameter_drift",), 0.05) > 0.0
     assert own_gain_floor(fam, ("viscous_damping",), 0.05) == pytest.approx(0.05)
     # a pair is held to the stricter of its two floors
     assert own_gain_floor(fam, ("force_drift", "viscous_damping"), 0.05) == pytest.approx(0.05)
@@ -97,6 +99,10 @@ def test_the_input_noise_budget_by_share() -> None:
     assert _noise_floor(fam, ("viscous_damping",), 0.4) == pytest.approx(0.4)
     share = _noise_floor(fam, ("position_friction",), 0.4) / 0.4
     assert 0.0 < share < 1.0
+    # a load is a factor in time: it beats a quarter of the budget, its own floor stays
+    # min_gain (its largest clean held-out gain, 0.024 σ², is below it)
+    assert _noise_floor(fam, ("normal_load",), 0.4) == pytest.approx(0.1)
+    assert own_gain_floor(fam, ("normal_load",), 0.05) == pytest.approx(0.05)
     # a pair beats the larger of its shares
     assert _noise_floor(fam, ("position_friction", "viscous_damping"), 0.4) == pytest.approx(0.4)
 
@@ -146,3 +152,74 @@ def test_a_force_drift_within_that_ramp_is_refused_and_the_bound_starts_above_it
     verdict = eff.plausible(d, {**p, "F1": -0.9 * ramp})
     assert not verdict.ok and "displacement-sensor drift" in verdict.reason
     assert eff.smallest_plausible(d, p) > ramp
+
+
+def _trial(cycle_mse: np.ndarray, bic: float) -> SimpleNamespace:
+    return SimpleNamespace(
+        cycle_mse=cycle_mse, heldout_mse=float(np.mean(cycle_mse)),
+        heldout_rms=float(np.sqrt(np.mean(cycle_mse))), full=SimpleNamespace(bic=bic),
+    )  # fmt: skip
+
+
+def test_the_relative_rule_by_the_effects_share() -> None:
+    """Rule 4 (a gain of MIN_RELATIVE_GAIN of the remaining error) at the candidate's
+    ``relative_gain_scale``: a parameter drift is held to a quarter of it or less, other
+    effects to all of it; a pair to the larger share."""
+    fam = TangentialFamily()
+    share = relative_gain_scale(fam, ("parameter_drift",))
+    assert 0.0 < share <= 0.25
+    assert relative_gain_scale(fam, ("force_drift",)) == 1.0
+    assert relative_gain_scale(fam, ("parameter_drift", "viscous_damping")) == 1.0
+    # a consistent gain of half the relative floor over 20 cycles of error 2 σ²
+    cur = _trial(np.full(20, 2.0), 0.0)
+    drop = 0.5 * MIN_RELATIVE_GAIN * 2.0
+    rng = np.random.default_rng(0)
+    cand = _trial(2.0 - drop * (1 + 0.1 * rng.standard_normal(20)), -50.0)
+    plain = judge("parameter_drift", cur, cand, 1.0, 3.0, 0.0)
+    assert not plain.accepted and "remaining error" in plain.reason
+    scaled = judge("parameter_drift", cur, cand, 1.0, 3.0, 0.0, rel_scale=share)
+    assert scaled.accepted, scaled.reason
+
+
+def test_a_drift_is_orthogonal_to_a_residual_repeating_every_cycle() -> None:
+    """The reason for the drift's share of rule 4: a factor linear in time centred on the
+    record's middle, applied to a periodic force, has no component along any residual that
+    repeats cycle after cycle (the base's misfit of a virgin curve of another shape)."""
+    from contactlab.masing import Masing
+
+    n = M * PER
+    t = np.arange(n) / n
+    x = 1e-4 * np.sin(2 * np.pi * M * t)
+    F = Masing(40.0, 4.0e4).force(x)
+    drift = (t - 0.5) * F
+    steady = np.arange(n) >= PER  # after the first loading
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        r = np.tile(rng.standard_normal(PER), M)  # any residual repeating every cycle
+        r1 = r * steady
+        # the same residual, steady cycles only: the drift's weight there sums to ~0
+        c = abs(float(np.sum(drift[steady] * r1[steady])))
+        scale = float(np.sqrt(np.sum(drift[steady] ** 2) * np.sum(r1[steady] ** 2)))
+        assert c < 0.1 * scale
+
+
+def test_the_bound_holds_each_effect_to_its_own_floors() -> None:
+    """The stated bound's floor (power._own_floor) is the search's for that effect: a
+    parameter drift's share of ``min_gain`` and of rule 4, a load's share of the budget."""
+    import dataclasses
+
+    from contactlab.diagnose.power import _own_floor
+
+    fam = TangentialFamily()
+    d = SimpleNamespace(extra={"gain_rules": {"min_gain": 0.05, "budget": 0.4}})
+    st = dataclasses.replace(_setting(), rel_floor=0.02)
+    drift = _own_floor(fam, "parameter_drift", d, st)
+    assert drift.rel_floor == pytest.approx(0.02 * relative_gain_scale(fam, ("parameter_drift",)))
+    assert drift.gain_floor == pytest.approx(
+        max(own_gain_floor(fam, ("parameter_drift",), 0.05), drift.rel_floor)
+    )
+    assert drift.gain_floor < 0.01
+    force = _own_floor(fam, "force_drift", d, st)
+    assert force.gain_floor == pytest.approx(0.02)  # rule 4 in full, above its 0.01 σ²
+    load = _own_floor(fam, "normal_load", d, st)
+    assert load.gain_floor == pytest.approx(0.05 + 0.1)

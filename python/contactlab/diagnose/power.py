@@ -1009,11 +1009,12 @@ def _own_floor(family: Family, name: str, d: Prepared, st: _Setting) -> _Setting
     rules = d.extra.get("gain_rules")
     if not isinstance(rules, dict):
         return st
-    from .search import _noise_floor, own_gain_floor
+    from .search import _noise_floor, own_gain_floor, relative_gain_scale
 
     mg, budget = float(rules["min_gain"]), float(rules["budget"])
     floor = own_gain_floor(family, (name,), mg) + _noise_floor(family, (name,), budget)
-    return dataclasses.replace(st, gain_floor=max(floor, st.rel_floor))
+    rel = st.rel_floor * relative_gain_scale(family, (name,))
+    return dataclasses.replace(st, gain_floor=max(floor, rel), rel_floor=rel)
 
 
 def power_margin(family: Family, name: str) -> float:

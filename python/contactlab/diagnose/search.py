@@ -149,6 +149,25 @@ def own_gain_floor(family: Family, names: tuple[str, ...], min_gain: float) -> f
     return min_gain * scale
 
 
+def relative_gain_scale(family: Family, names: tuple[str, ...]) -> float:
+    """The share of rule 4's :data:`~contactlab.diagnose.select.MIN_RELATIVE_GAIN` a
+    candidate adding ``names`` must reach: the largest of their ``relative_gain_scale`` (an
+    effect's own, default 1).
+
+    Rule 4 keeps a misspecified base's systematic residual from being shaved by any
+    candidate. A residual that repeats cycle after cycle (a virgin curve of another shape,
+    a sensor chain's filters) is orthogonal to a factor that is a straight line in time
+    centred on the record's middle (a parameter drift: Σ (t - t_m) g(phase) r(phase) = 0
+    over whole cycles), so such an effect can be held to a smaller share of it."""
+    from .effects import registry
+
+    try:
+        reg = registry(family.kind)
+    except KeyError:
+        return 1.0
+    return max((float(getattr(reg.get(n), "relative_gain_scale", 1.0)) for n in names), default=1.0)
+
+
 def _proportional(family: Family, names: tuple[str, ...]) -> bool:
     """Whether rule 2 may pass by :func:`~contactlab.diagnose.select.proportional_t` for a
     candidate adding ``names``: the family's ``proportional_gain``, or every one of them an
@@ -229,7 +248,8 @@ def _try_candidate(
     # position_friction gained 0.08 σ² on clean records against a budget of 0.70 σ²)
     extra = _noise_floor(family, (*also, name), budget)
     prop = d if _proportional(family, (*also, name)) else None
-    v = judge(name, current, cand, sigma, z, floor + extra, prop)
+    rs = relative_gain_scale(family, (*also, name))
+    v = judge(name, current, cand, sigma, z, floor + extra, prop, rel_scale=rs)
     # every effect of the candidate model, not only the new one: a refit can push an
     # effect added before to the edge of its physical range
     why = next(
@@ -344,7 +364,8 @@ def _drop_check(
     extra = _noise_floor(family, (name,), budget)  # the forward rule's (_try_candidate)
     prop = d if _proportional(family, (name,)) else None
     floor = own_gain_floor(family, (name,), min_gain)
-    return judge(name, reduced, current, sigma, z, floor + extra, prop), reduced
+    rs = relative_gain_scale(family, (name,))
+    return judge(name, reduced, current, sigma, z, floor + extra, prop, rel_scale=rs), reduced
 
 
 #: the swap move's threshold on the t statistic of the per-cycle gain (see _swap_search)

@@ -626,9 +626,12 @@ def judge(
     z: float,
     min_gain: float,
     d: Prepared | None = None,
+    rel_scale: float = 1.0,
 ) -> Verdict:
     """Apply the three acceptance rules of the module docstring (rule 2's proportional
-    form when ``d`` is given: the family's ``proportional_gain``)."""
+    form when ``d`` is given: the family's ``proportional_gain``; ``rel_scale``: the share
+    of rule 4's :data:`MIN_RELATIVE_GAIN` the candidate must reach, its effects'
+    ``relative_gain_scale``, :func:`contactlab.diagnose.search.relative_gain_scale`)."""
     # errors in variables: the candidate's held-out errors are compared as if it passed the
     # input noise as the current model does (corrected least squares, :func:`noise_term`)
     # (each held-out error with the noise term of the fold fit that made it)
@@ -645,6 +648,7 @@ def judge(
     dbic = cand.full.bic - current.full.bic
     rel = float(current.heldout_mse - cand_mse) / current.heldout_mse
     rel_floor = MIN_RELATIVE_GAIN * (1.0 if d is None else float(d.extra.get("gain_scale", 1.0)))
+    rel_floor *= float(rel_scale)
     if gain < min_gain:
         reason = f"held-out gain {gain:.3g} σ² below {min_gain:g} σ²"
     elif rel < rel_floor:
