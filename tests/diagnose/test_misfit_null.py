@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -166,6 +167,10 @@ def test_json_adds_the_calibrated_decision_and_keeps_the_contract() -> None:
     said = u.sentence()
     assert said.startswith("systematic misfit that no candidate explains"), said
     assert "backlash + parallel_stiffness (2 parameters) is a patch" in said, said
+    swap = {"effects": ["series_compliance"], "share": 1.2, "params_effects": 1,
+            "params_virgin": 1, "swap": True}  # fmt: skip
+    said = dataclasses.replace(u, patches=[swap]).sentence()
+    assert "the named series_compliance is a patch" in said and "120 %" in said, said
 
 
 def _record(virgin: str, x_noise: float, seed: int):
