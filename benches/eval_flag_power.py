@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import argparse
 import glob
+import math
 import os
 import pickle
 import sys
@@ -78,6 +79,30 @@ def misfit_record(seed: int, kind: str) -> tuple[Any, dict[str, Any]]:
     return rec, {**fac, "x_colour": col}
 
 
+def hidden_record(seed: int, kind: str) -> tuple[Any, dict[str, Any]]:
+    """A visible effect (``kind``) of the package's generator (``hidden_effect_recording``,
+    start from rest): magnitude 4-10 % of the output's RMS, output noise 0.5-2 %, input noise
+    0-2 % of max|x|, 1-50 Hz, 20-1500 samples per cycle, 2-8 cycles per block (three
+    blocks); ``kind`` ``"exp"`` for a clean record."""
+    from contactlab.synthetic.diagnosis import hidden_effect_recording
+
+    rng = np.random.default_rng([seed, 6161, sum(map(ord, kind))])
+    f0 = float(np.exp(rng.uniform(0.0, np.log(50.0))))
+    fs = float(np.exp(rng.uniform(np.log(1000.0), np.log(10000.0))))
+    fac = {
+        "samples_per_cycle": int(max(20, min(fs / f0, 1500))),
+        "cycles_per_block": int(rng.integers(2, 9)),
+        "noise": float(rng.uniform(0.005, 0.02)),
+        "input_noise": float(rng.uniform(0.0, 0.02)),
+    }  # fmt: skip
+    mag = float(rng.uniform(0.04, 0.10))
+    eff = {} if kind == "exp" else {kind: mag}
+    rec = hidden_effect_recording(eff, seed=seed, start="rest", f0=f0, **fac)
+    out = {**fac, "magnitude": mag, "x_noise": fac["input_noise"], "acA": math.nan,
+           "cycles": 3 * fac["cycles_per_block"]}  # fmt: skip
+    return rec, out
+
+
 def get(seed: int, kind: str, gen: str, cache: str) -> dict[str, Any]:
     """One record's diagnosis (this tree), cached with what its flag step saw."""
     path = f"{cache}/{gen}_{kind}_{seed}.pkl"
@@ -91,6 +116,8 @@ def get(seed: int, kind: str, gen: str, cache: str) -> dict[str, Any]:
         rec, fac = corner_record(seed, kind)
     elif gen == "misfit":
         rec, fac = misfit_record(seed, kind)
+    elif gen == "hidden":
+        rec, fac = hidden_record(seed, kind)
     else:
         from eval_flag_calibration import record
 
@@ -119,7 +146,9 @@ def get(seed: int, kind: str, gen: str, cache: str) -> dict[str, Any]:
         "seed": seed, "kind": kind, "gen": gen, "cpu": cpu, "named": list(rep.effect_names),
         "fac": {k: v for k, v in fac.items() if isinstance(v, (int, float, str, bool))},
         "flagged": bool(u is not None and u.flagged), "rivals": bool(ud.get("rivals")),
-        "patches": bool(ud.get("patches")), "cal": ud.get("calibrated"),
+        "patches": any(not q.get("swap") for q in ud.get("patches") or []),
+        "swaps": [q["effects"][0] for q in ud.get("patches") or [] if q.get("swap")],
+        "cal": ud.get("calibrated"),
     }  # fmt: skip
     if "args" in cap:
         cap["args"][3].extra.pop("evaluations", None)

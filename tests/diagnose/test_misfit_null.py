@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -25,7 +26,13 @@ from contactlab.diagnose.misfit_null import (
     simulated_null,
 )
 from contactlab.diagnose.scaled_masing import memory, scaled_force
-from contactlab.diagnose.shape import PATCH_SHARE, patch_share
+from contactlab.diagnose.shape import (
+    PATCH_SHARE,
+    SWAP_SHARE,
+    patch_check,
+    patch_share,
+    swap_check,
+)
 from contactlab.diagnose.workflow import diagnose
 from contactlab.masing import Masing
 
@@ -160,6 +167,10 @@ def test_json_adds_the_calibrated_decision_and_keeps_the_contract() -> None:
     said = u.sentence()
     assert said.startswith("systematic misfit that no candidate explains"), said
     assert "backlash + parallel_stiffness (2 parameters) is a patch" in said, said
+    swap = {"effects": ["series_compliance"], "share": 1.2, "params_effects": 1,
+            "params_virgin": 1, "swap": True}  # fmt: skip
+    said = dataclasses.replace(u, patches=[swap]).sentence()
+    assert "the named series_compliance is a patch" in said and "120 %" in said, said
 
 
 def _record(virgin: str, x_noise: float, seed: int):
@@ -230,3 +241,48 @@ def test_the_copies_output_noise_is_what_the_input_noise_does_not_explain(
     nd = simulated_null(fam, p, (), d, r, white, white, draws=8)
     assert nd is not None
     assert low * so < nd.output_rms < high * so, (nd.output_rms / so, white / so)
+
+
+def _shaped(virgin: str, seed: int):
+    """A record (no input noise, ac·A 4) of a Masing element with a rational virgin curve,
+    or an exponential one with a stiffness in parallel (the family's own model), 1 % output
+    noise; the family fitted with a parallel stiffness named alone."""
+    from contactlab.diagnose.select import fit
+
+    t, u, _ = _sine(cycles=12)
+    ac = 2.0 * AC
+    d = Prepared.build(t, u, np.zeros(t.size), errors_in_input=False)
+    fam = TangentialFamily()
+    fam.prepare(d)
+    eff = ("parallel_stiffness",)
+    if virgin == "rational":
+        y = scaled_force(lambda s: 40.0 * ac * s / (1.0 + ac * np.abs(s)), 2.0, memory(u))
+    else:  # a parallel stiffness of a tenth of the contact's initial one
+        y = np.asarray(fam.predict({"h0": 40.0, "ac": ac, "k_p": 4.0 * ac}, eff, d))
+    sigma = 0.01 * float(np.ptp(y))
+    d = Prepared.build(t, u, y + np.random.default_rng(seed).normal(0.0, sigma, y.size),
+                       errors_in_input=False)  # fmt: skip
+    fam.prepare(d)
+    scales = fam.scales(d)
+    f = fit(fam, eff, d, np.ones(d.y.size, bool), {"h0": 40.0, "ac": ac}, scales)
+    r = d.y - np.asarray(fam.predict(f.params, eff, d), float)
+    return fam, eff, d, dict(f.params), scales, r, sigma
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_a_shape_effect_named_alone_over_a_rational_curve_is_a_swap_a_genuine_one_not(
+    seed: int,
+) -> None:
+    # a rational virgin curve taken up by a parallel stiffness alone: one free-form column
+    # explains more than the stiffness (a set of one parameter: no patch_check verdict)
+    fam, eff, d, p, scales, r, sigma = _shaped("rational", seed)
+    assert p["k_p"] > 0
+    got = swap_check(fam, eff, d, p, scales, r, sigma)
+    assert got and got[0]["swap"] and got[0]["effects"] == ["parallel_stiffness"], got
+    assert got[0]["share"] >= SWAP_SHARE
+    assert patch_check(fam, eff, d, p, scales, r, sigma) == got
+    # the family's own parallel stiffness: the free-form column at best matches it
+    fam, eff, d, p, scales, r, sigma = _shaped("stiffness", seed)
+    assert p["k_p"] > 0
+    assert swap_check(fam, eff, d, p, scales, r, sigma) == []
+    assert patch_check(fam, eff, d, p, scales, r, sigma) == []

@@ -310,6 +310,14 @@ class Unexplained:
                 "bins' own threshold)"
             )
         for p in self.patches:
+            if p.get("swap"):  # one shape effect that a curve as large explains better
+                parts.append(
+                    f"the named {p['effects'][0]} is a patch over the shape of the virgin "
+                    "curve: a Masing element with a free-form virgin curve of as many "
+                    f"parameters ({p['params_virgin']}) explains {100 * p['share']:.0f} % of "
+                    "its gain (it stays named: either may be the physics)"
+                )
+                continue
             parts.append(
                 f"the named set {' + '.join(p['effects'])} ({p['params_effects']} parameters) "
                 f"is a patch over the shape of the virgin curve: a Masing element with a "

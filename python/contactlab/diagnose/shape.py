@@ -45,9 +45,13 @@ __all__ = [
     "RIVAL_SHARE",
     "SHAPES",
     "SHAPE_RIVALS",
+    "SWAP_EFFECTS",
+    "SWAP_MIN_EXTRA",
+    "SWAP_SHARE",
     "patch_check",
     "patch_share",
     "rival_share",
+    "swap_check",
 ]
 
 #: curvatures of the free-form virgin curve's basis relative to the fitted ``ac``: for each
@@ -214,8 +218,9 @@ def patch_check(
     residual. Where it reaches :data:`PATCH_SHARE` of the set's gain (σ², weighted
     residual sums of squares), the set is a patch over a shape misfit: returned as
     ``[{"effects", "params_effects", "params_virgin", "gain_effects", "gain_virgin",
-    "share"}]`` (empty when not; also for a set of one parameter, which no free-form curve
-    with fewer can replace).
+    "share"}]``; where the set is no such patch (or has one parameter, which no free-form
+    curve with fewer can replace), each named one-parameter shape effect alone is checked
+    against a free-form curve with as many (:func:`swap_check`), else empty.
     """
     from ..errors import ContactLabError
     from .select import fit, specs_for
@@ -226,16 +231,81 @@ def patch_check(
     n_set = len(specs_for(family, effects)) - len(specs_for(family, rest))
     q = n_set - 1
     if not drop or q < 1 or not (np.isfinite(ac) and ac > 0 and sigma > 0):
-        return []
+        return swap_check(family, effects, d, params, scales, residual, sigma)
     try:
         f = fit(family, rest, d, np.ones(d.y.size, bool), params, scales)
         r0 = d.y - np.asarray(family.predict(f.params, rest, d), float)
     except (ContactLabError, ValueError, ArithmeticError, np.linalg.LinAlgError):
-        return []  # no refit without the set: no verdict on it
+        # no refit without the set: no verdict on it (each shape effect alone may have one)
+        return swap_check(family, effects, d, params, scales, residual, sigma)
     got = patch_share(d, residual, r0, ac, sigma, q)
     if got is None or got["share"] < PATCH_SHARE:
-        return []
+        return swap_check(family, effects, d, params, scales, residual, sigma)
     return [{"effects": list(drop), "params_effects": int(n_set), **got}]
+
+
+#: named effects that are a reshaped virgin curve of one parameter (a compliance in series, a
+#: stiffness in parallel), each checked alone by :func:`swap_check`
+SWAP_EFFECTS = ("series_compliance", "parallel_stiffness")
+#: share of the effect's gain that a free-form virgin curve with as many parameters must
+#: exceed for the effect to count as a patch over a shape misfit (:func:`swap_check`)
+SWAP_SHARE = 1.10
+#: and the least it must explain beyond the effect (σ²): a column chosen from the basis's 13
+#: on noise alone gains the largest of 13 χ² of one degree of freedom
+SWAP_MIN_EXTRA = 12.0
+
+
+def swap_check(
+    family: Any,
+    effects: tuple[str, ...],
+    d: Prepared,
+    params: dict[str, float],
+    scales: dict[str, float],
+    residual: np.ndarray,
+    sigma: float,
+) -> list[dict[str, Any]]:
+    """A named one-parameter shape effect that a free-form virgin curve with as many
+    parameters explains better (issue 29, item 3).
+
+    A series compliance or a parallel stiffness (:data:`SWAP_EFFECTS`) is itself a virgin
+    curve of another shape: a free-form virgin curve explains a genuine one as well, and
+    :func:`patch_check` (fewer parameters) cannot judge a set of one parameter. A tanh
+    virgin curve named series compliance alone, a rational one parallel stiffness alone, is
+    explained *better* by one free-form column than by the effect: the effect took up
+    most of a shape it does not model. For each named effect of :data:`SWAP_EFFECTS` the
+    final model is refitted without it and the best single column of :func:`_basis` (with
+    the base's own two directions) is fitted to that refit's residual
+    (:func:`patch_share`, ``q`` = the effect's parameters); where it reaches
+    :data:`SWAP_SHARE` of the effect's gain and exceeds it by :data:`SWAP_MIN_EXTRA` σ²,
+    the effect is returned as a patch (the layout of :func:`patch_check`, ``"swap"``
+    true). A genuine one (the package's generator) stays below: the free-form column at
+    best matches it."""
+    from ..errors import ContactLabError
+    from .select import fit, specs_for
+
+    ac = float(params.get("ac", np.nan))
+    if not (np.isfinite(ac) and ac > 0 and sigma > 0):
+        return []
+    out = []
+    for e in effects:
+        if e not in SWAP_EFFECTS:
+            continue
+        rest = tuple(x for x in effects if x != e)
+        q = len(specs_for(family, effects)) - len(specs_for(family, rest))
+        try:
+            f = fit(family, rest, d, np.ones(d.y.size, bool), params, scales)
+            r0 = d.y - np.asarray(family.predict(f.params, rest, d), float)
+        except (ContactLabError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+            continue  # no refit without it: no verdict on it
+        got = patch_share(d, residual, r0, ac, sigma, q)
+        if (
+            got is not None
+            and got["gain_effects"] >= SWAP_MIN_EXTRA  # an effect at noise level: no verdict
+            and got["share"] >= SWAP_SHARE
+            and got["gain_virgin"] - got["gain_effects"] >= SWAP_MIN_EXTRA
+        ):
+            out.append({"effects": [e], "params_effects": int(q), **got, "swap": True})
+    return out
 
 
 def patch_share(
