@@ -99,9 +99,9 @@ def test_the_input_noise_budget_by_share() -> None:
     assert _noise_floor(fam, ("viscous_damping",), 0.4) == pytest.approx(0.4)
     share = _noise_floor(fam, ("position_friction",), 0.4) / 0.4
     assert 0.0 < share < 1.0
-    # a load is a factor in time: it beats a quarter of the budget, its own floor stays
-    # min_gain (its largest clean held-out gain, 0.024 σ², is below it)
-    assert _noise_floor(fam, ("normal_load",), 0.4) == pytest.approx(0.1)
+    # a load beats the whole budget (a quarter of it named a load on a tanh virgin curve),
+    # its own floor stays min_gain
+    assert _noise_floor(fam, ("normal_load",), 0.4) == pytest.approx(0.4)
     assert own_gain_floor(fam, ("normal_load",), 0.05) == pytest.approx(0.05)
     # a pair beats the larger of its shares
     assert _noise_floor(fam, ("position_friction", "viscous_damping"), 0.4) == pytest.approx(0.4)
@@ -205,7 +205,7 @@ def test_a_drift_is_orthogonal_to_a_residual_repeating_every_cycle() -> None:
 
 def test_the_bound_holds_each_effect_to_its_own_floors() -> None:
     """The stated bound's floor (power._own_floor) is the search's for that effect: a
-    parameter drift's share of ``min_gain`` and of rule 4, a load's share of the budget."""
+    parameter drift's share of ``min_gain`` and of rule 4, a load's whole budget."""
     import dataclasses
 
     from contactlab.diagnose.power import _own_floor
@@ -222,4 +222,4 @@ def test_the_bound_holds_each_effect_to_its_own_floors() -> None:
     force = _own_floor(fam, "force_drift", d, st)
     assert force.gain_floor == pytest.approx(0.02)  # rule 4 in full, above its 0.01 σ²
     load = _own_floor(fam, "normal_load", d, st)
-    assert load.gain_floor == pytest.approx(0.05 + 0.1)
+    assert load.gain_floor == pytest.approx(0.05 + 0.4)
