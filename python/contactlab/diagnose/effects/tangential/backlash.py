@@ -17,11 +17,11 @@ from ._common import actual_turns, amplitude, smoothed_velocity
 #: the turning points are not
 FAST_SHARE = 0.5
 #: a play no wider than this many input-noise RMS (``d.extra["u_noise"]``, the raw input's)
-#: is within the outward push the noise gives the turning points (:meth:`Backlash.
-#: within_noise`): a delay of 0.90 ms (1.5x its stated bound, ac·A 2.5, x noise 1.6 % of
-#: the range) was named a play of b = 1.15 σ_u at a paired t of 6.1 over the delay (3.3 at
-#: speeds above half the peak), its own fit stuck at τ = 0.40 ms (``benches/
-#: eval_confusions.py --cases delay``, fresh seed 95000)
+#: is within the outward push the noise gives the turning points
+#: (:meth:`Backlash.within_noise`): a delay of 0.90 ms (1.5x its stated bound, ac·A 2.5,
+#: x noise 1.6 % of the range) was named a play of b = 1.15 σ_u at a paired t of 6.1 over
+#: the delay (3.3 at speeds above half the peak), its own fit stuck at τ = 0.40 ms
+#: (``benches/eval_confusions.py --cases delay``, fresh seed 95000)
 NOISE_WIDTH = 2.0
 
 
