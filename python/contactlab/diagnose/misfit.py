@@ -310,6 +310,16 @@ class Unexplained:
                 "bins' own threshold)"
             )
         for p in self.patches:
+            if p.get("slope"):  # a spring whose slope falls along the branches
+                parts.append(
+                    "the named parallel_stiffness is a patch over the shape of the virgin "
+                    f"curve: a spring adds one slope along every branch, but the plateaus' "
+                    f"slope falls from {p['k_near']:.3g} N/m to {p['k_far']:.3g} N/m away "
+                    f"from the turn (t = {p['t']:.2g} over {p['branches']} branches): a "
+                    "virgin curve that saturates more slowly than the exponential one (it "
+                    "stays named: either may be the physics)"
+                )
+                continue
             if p.get("swap"):  # one shape effect that a curve as large explains better
                 parts.append(
                     f"the named {p['effects'][0]} is a patch over the shape of the virgin "

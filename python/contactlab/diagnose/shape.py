@@ -51,6 +51,7 @@ __all__ = [
     "patch_check",
     "patch_share",
     "rival_share",
+    "slope_check",
     "swap_check",
 ]
 
@@ -306,6 +307,51 @@ def swap_check(
         ):
             out.append({"effects": [e], "params_effects": int(q), **got, "swap": True})
     return out
+
+
+def slope_check(
+    effects: tuple[str, ...], d: Prepared, params: dict[str, float]
+) -> tuple[list[dict[str, Any]], str | None]:
+    """A named parallel stiffness whose slope is not the same along the branches
+    (issue 29, item 3; spring_shape).
+
+    A spring beside the contact adds one slope k_p everywhere along every branch; a virgin
+    curve that saturates more slowly than the exponential one (a rational one) is taken up
+    by a parallel stiffness alone, and a free-form virgin curve explains that as well as
+    it explains a genuine spring (:func:`swap_check`'s shares 0.99-1.04 against
+    0.99-1.01). The plateau's slope is read in two parts of each steady branch away from
+    the turn, the Masing tail regressed out
+    (:func:`~.effects.tangential.parallel_stiffness.plateau_slopes`); where the far part's
+    slope falls significantly below the near part's
+    (:func:`~.effects.tangential.parallel_stiffness.spring_slope_fails`), the spring is a
+    patch over the shape of the virgin curve: returned as a patch entry (the layout of
+    :func:`patch_check` without the free-form gains: ``effects``, ``params_effects``,
+    ``slope`` true, ``k_near``, ``k_far``, ``t``, ``branches``). The second value is a
+    sentence where the check has no verdict (too few branches reach far enough from
+    their turn), else None."""
+    from .effects.tangential.parallel_stiffness import (
+        SLOPE_FAR,
+        plateau_slopes,
+        spring_slope_fails,
+    )
+
+    ac = float(params.get("ac", np.nan))
+    if "parallel_stiffness" not in effects or not (np.isfinite(ac) and ac > 0):
+        return [], None
+    s = plateau_slopes(d, ac)
+    fails = spring_slope_fails(s)
+    if fails is None:
+        return [], (
+            "the parallel stiffness's constant slope along the branches was not checked: "
+            f"{s['branches']} steady branches reach ac·|x - x_turn| = {SLOPE_FAR:g} with room "
+            f"to read a slope (the farthest reaches {s['reach']:.2g}), so a virgin curve that "
+            "saturates more slowly than the exponential one is not told from a spring here"
+        )
+    if not fails:
+        return [], None
+    keep = ("k_near", "k_far", "t", "branches")
+    return [{"effects": ["parallel_stiffness"], "params_effects": 1, "slope": True,
+             **{k: s[k] for k in keep}}], None  # fmt: skip
 
 
 def patch_share(

@@ -2,16 +2,34 @@
 
 from __future__ import annotations
 
+import itertools
+from typing import Any
+
 import numpy as np
 
 from ..._family import ParamSpec
 from .._base import EffectModel, register
-from ._common import amplitude, single_frequency, smoothed_displacement
+from ._common import amplitude, record_turns, single_frequency, smoothed_displacement
 
 #: below this ``ac·A`` the loops never reach their plateau and no parallel spring is
 #: promised (:meth:`ParallelStiffness.not_separable`): a branch of ``2A`` ends at
 #: ``exp(-ac·A)`` of its initial slope, 22 % at 1.5
 PLATEAU_ACA = 1.5
+
+#: the plateau's slope along each branch (:func:`plateau_slopes`): each steady branch read
+#: from SLOPE_FAR/ac past its turning point to SLOPE_EDGE of its stroke before the next
+#: turn, in two halves of that part (near and far), the Masing tail at the fitted ``ac``
+#: regressed out; at least SLOPE_BRANCHES branches must reach that far
+SLOPE_FAR, SLOPE_EDGE, SLOPE_BRANCHES = 1.5, 0.05, 4
+#: a named spring fails the check (:func:`spring_slope_fails`) where the far half's slope
+#: stands SLOPE_T standard errors (of the branches' scatter) below the near half's and
+#: below SLOPE_RATIO of it: a spring adds the same slope k_p everywhere along a branch, a
+#: slowly saturating virgin curve an extra slope that decays with the distance from the
+#: turn. Tuned on quick fits of the base with a spring (``benches/eval_spring_shape.py``,
+#: seeds 100-115, ac·A 1.6-4.4, x noise 0.8-1.9 %, 5-12 cycles): rational virgin curves of
+#: the misfit chain had t -11.2..1.3 (8 of 16 at or below -2, ratios 0.58-0.91 there),
+#: genuine springs of the rig (k_p A 0.1-0.35 of the plateau) -1.26..2.65
+SLOPE_T, SLOPE_RATIO = 2.0, 0.9
 
 
 @register
@@ -104,3 +122,71 @@ class ParallelStiffness(EffectModel):
             "parallel stiffness and inertia are not separable on this single-frequency drive "
             f"(ω = {np.sqrt(one[0]):.4g} rad/s): the record sets k_p - mω² only"
         )
+
+
+def plateau_slopes(d: Any, ac: float) -> dict[str, Any]:
+    """The slope ``dF/dx`` (N/m) of the steady branches in two parts away from the turn.
+
+    Per branch between two turning points of the filtered input (cycles ≥ 1), the force
+    over the part ``ac·|x - x_turn| ≥`` :data:`SLOPE_FAR` up to :data:`SLOPE_EDGE` of the
+    stroke before the next turn is regressed on ``1``, ``exp(-ac |x - x_turn| / 2)`` (the
+    Masing branch's tail at the contact's ``ac``), ``x`` and a hinge at the middle of that
+    part (the slope's change from its near half to its far half). Returns ``k_near`` and
+    ``k_far`` (the means over the branches), ``t`` (the mean change over its standard error
+    from the branches' scatter, NaN with fewer than two), ``branches`` and ``reach`` (the
+    steady branches, and the largest ``ac`` times the distance from the turn any reaches).
+
+    A spring beside the contact adds the same slope k_p everywhere (``t`` about 0); a
+    virgin curve that saturates more slowly than the exponential one (a rational
+    ``ac s/(1 + ac s)``, whose extra slope decays like ``1/(1 + ac s)²``) a slope that
+    falls with the distance (``t`` negative)."""
+    u, y = np.asarray(d.u, float), np.asarray(d.y, float)
+    out: dict[str, Any] = {
+        "k_near": float("nan"), "k_far": float("nan"), "t": float("nan"), "branches": 0,
+        "reach": 0.0,
+    }  # fmt: skip
+    if not (np.isfinite(ac) and ac > 0):
+        return out
+    turns = record_turns(u, float(d.extra.get("u_noise", 0.0) or 0.0))
+    cyc = np.asarray(d.cycles.cycle)
+    near, far, reach = [], [], 0.0
+    for a, b in itertools.pairwise(turns):
+        if cyc[a] < 1:
+            continue
+        dist = np.abs(u[a:b] - u[a])
+        stroke = abs(float(u[b] - u[a]))
+        reach = max(reach, float(ac * (1 - SLOPE_EDGE) * stroke))
+        keep = (ac * dist >= SLOPE_FAR) & (dist <= (1 - SLOPE_EDGE) * stroke)
+        keep &= np.isfinite(y[a:b])
+        if np.count_nonzero(keep) < 12:
+            continue
+        dk = dist[keep]
+        mid = 0.5 * (float(dk.min()) + float(dk.max()))
+        sgn = float(np.sign(u[b] - u[a]))
+        X = np.column_stack([np.ones(dk.size), np.exp(-0.5 * ac * dk), u[a:b][keep],
+                             sgn * np.maximum(dk - mid, 0.0)])  # fmt: skip
+        c, *_ = np.linalg.lstsq(X, y[a:b][keep], rcond=None)
+        near.append(float(c[2]))
+        far.append(float(c[2] + c[3]))
+    out["branches"], out["reach"] = len(near), reach
+    if len(near) < 2:
+        return out
+    kn, kf = np.asarray(near), np.asarray(far)
+    dif = kf - kn
+    se = float(dif.std(ddof=1) / np.sqrt(dif.size))
+    out.update(
+        k_near=float(kn.mean()), k_far=float(kf.mean()),
+        t=float(dif.mean() / se) if se > 0 else float("nan"),
+    )  # fmt: skip
+    return out
+
+
+def spring_slope_fails(s: dict[str, Any]) -> bool | None:
+    """Whether plateau slopes ``s`` (:func:`plateau_slopes`) contradict a spring: the far
+    half's slope :data:`SLOPE_T` standard errors below the near half's and below
+    :data:`SLOPE_RATIO` of it; None where fewer than :data:`SLOPE_BRANCHES` branches reach
+    the part read (no verdict)."""
+    if s["branches"] < SLOPE_BRANCHES or not np.isfinite(s["t"]):
+        return None
+    kn, kf = s["k_near"], s["k_far"]
+    return bool(s["t"] <= -SLOPE_T and kn > 0 and kf < SLOPE_RATIO * kn)
