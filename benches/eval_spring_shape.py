@@ -19,6 +19,7 @@ report on fresh seeds. One process, ``nice``::
 
     nice .venv/bin/python benches/eval_spring_shape.py run rational,spring 300 6 --cache DIR
     .venv/bin/python benches/eval_spring_shape.py table 'rational_3*,spring_3*' --cache DIR
+    nice .venv/bin/python benches/eval_spring_shape.py quick rational,spring 100 16
 """
 
 from __future__ import annotations
@@ -177,17 +178,60 @@ def table(pattern: str, cache: str) -> None:
         )
 
 
+def quick(kinds: list[str], seed0: int, n: int) -> None:
+    """The check's figures on a least-squares fit of the base with a spring (a grid of
+    ``ac``; ``h0``, ``k_p`` and an offset linear): the tuning view, no diagnosis."""
+    from contactlab.diagnose._family import Prepared
+    from contactlab.diagnose.effects.tangential.parallel_stiffness import (
+        plateau_slopes,
+        spring_slope_fails,
+    )
+    from contactlab.masing import Masing
+
+    for kind in kinds:
+        for s in range(seed0, seed0 + n):
+            (t, x, F), fac = record(s, kind)
+            d = Prepared.build(t, x, F)
+            half = float(np.ptp(d.u)) / 2
+            best = None
+            for aca in np.exp(np.linspace(np.log(0.3), np.log(12), 60)):
+                ac = aca / half
+                X = np.column_stack([Masing(1.0, ac).force(d.u), d.u, np.ones(d.u.size)])
+                c, *_ = np.linalg.lstsq(X, d.y, rcond=None)
+                ss = float(np.sum((d.y - X @ c) ** 2))
+                if best is None or ss < best[0]:
+                    best = (ss, ac, c)
+            _, ac, c = best
+            q = plateau_slopes(d, ac)
+            print(
+                f"{kind} {s} acA {fac['acA']:.2f} xn {100 * fac['x_noise']:.2g} cyc "
+                f"{fac['cycles']} fs {fac['fs']:g} | fit acA {ac * half:.2f} k_p A/h0 "
+                f"{c[1] * half / c[0]:.3f} | t {q['t']:.2f} far/near "
+                f"{q['k_far'] / q['k_near']:.2f} branches {q['branches']} fails "
+                f"{spring_slope_fails(q)}",
+                flush=True,
+            )
+
+
 def main() -> None:
     warnings.simplefilter("ignore")
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("what", choices=("run", "table"))
+    ap.add_argument("what", choices=("run", "table", "quick"))
     ap.add_argument("args", nargs="+")
     ap.add_argument("--cache", default="spring_shape_cache")
+    ap.add_argument("--smooth", action="store_true", help="ParallelStiffness.smooth_input = True")
     a = ap.parse_args()
+    if a.smooth:
+        from contactlab.diagnose.effects.tangential.parallel_stiffness import ParallelStiffness
+
+        ParallelStiffness.smooth_input = True
     if a.what == "table":
         table(a.args[0], a.cache)
         return
     kinds, seed0, n = a.args[0].split(","), int(a.args[1]), int(a.args[2])
+    if a.what == "quick":
+        quick(kinds, seed0, n)
+        return
     for s in range(seed0, seed0 + n):
         for kind in kinds:
             o = get(s, kind, a.cache)
