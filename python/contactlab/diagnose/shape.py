@@ -330,6 +330,7 @@ def slope_check(
     sentence where the check has no verdict (too few branches reach far enough from
     their turn), else None."""
     from .effects.tangential.parallel_stiffness import (
+        SLOPE_BRANCHES,
         SLOPE_FAR,
         plateau_slopes,
         spring_slope_fails,
@@ -343,9 +344,10 @@ def slope_check(
     if fails is None:
         return [], (
             "the parallel stiffness's constant slope along the branches was not checked: "
-            f"{s['branches']} steady branches reach ac·|x - x_turn| = {SLOPE_FAR:g} with room "
-            f"to read a slope (the farthest reaches {s['reach']:.2g}), so a virgin curve that "
-            "saturates more slowly than the exponential one is not told from a spring here"
+            f"{s['branches']} steady branches hold enough samples beyond ac·|x - x_turn| = "
+            f"{SLOPE_FAR:g} to read a slope in two parts (the farthest reaches "
+            f"{s['reach']:.2g}; {SLOPE_BRANCHES} needed), so a virgin curve that saturates "
+            "more slowly than the exponential one is not told from a spring here"
         )
     if not fails:
         return [], None

@@ -19,7 +19,9 @@ PLATEAU_ACA = 1.5
 #: the plateau's slope along each branch (:func:`plateau_slopes`): each steady branch read
 #: from SLOPE_FAR/ac past its turning point to SLOPE_EDGE of its stroke before the next
 #: turn, in two halves of that part (near and far), the Masing tail at the fitted ``ac``
-#: regressed out; at least SLOPE_BRANCHES branches must reach that far
+#: regressed out; at least SLOPE_BRANCHES branches must reach that far with 12 samples or
+#: more there (43 samples per cycle left 2 such branches: spring seed 405 of
+#: ``benches/eval_spring_shape.py``, 1 kHz at 23 Hz, ac·A 2.9)
 SLOPE_FAR, SLOPE_EDGE, SLOPE_BRANCHES = 1.5, 0.05, 4
 #: a named spring fails the check (:func:`spring_slope_fails`) where the far half's slope
 #: stands SLOPE_T standard errors (of the branches' scatter) below the near half's and
