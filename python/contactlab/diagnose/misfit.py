@@ -218,7 +218,12 @@ class Unexplained:
     #: named sets that a Masing element with a free-form virgin curve and fewer
     #: parameters explains as well (:func:`contactlab.diagnose.shape.patch_check`): each a
     #: dict with ``effects``, ``params_effects``, ``params_virgin``, ``gain_effects``,
-    #: ``gain_virgin`` (σ²); a non-empty list flags the misfit
+    #: ``gain_virgin`` (σ²); a non-empty list flags the misfit. An entry with ``"swap"``
+    #: true is one shape effect a free-form curve as large explains better
+    #: (:func:`contactlab.diagnose.shape.swap_check`); one with ``"slope"`` true a named
+    #: parallel stiffness whose slope falls along the branches
+    #: (:func:`contactlab.diagnose.shape.slope_check`: ``k_near``, ``k_far``, ``t``,
+    #: ``branches`` in place of the gains)
     patches: tuple[dict[str, Any], ...] | list[dict[str, Any]] = ()
 
     def to_dict(self) -> dict[str, Any]:
