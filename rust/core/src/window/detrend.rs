@@ -309,11 +309,62 @@ impl crate::simd::Kernel for ScanPass<'_> {
             let tb = &tp[a - lo..];
             let (fb, xb) = (&f[a..b], &x[a..b]);
             let (ofb, oxb) = (&mut out_f[a..b], &mut out_x[a..b]);
-            for ((o, &ti), &vi) in ofb.iter_mut().zip(tb).zip(fb) {
-                *o = vi + (ti - tm) * nf;
-            }
-            for ((o, &ti), &vi) in oxb.iter_mut().zip(tb).zip(xb) {
-                *o = vi + (ti - tm) * nx;
+            // the detrended samples and, as they are made (in registers, not read back),
+            // finite_max_abs's numbers: the maxima and the zero test in eight lanes (order
+            // free), the sum of F in its four lanes (sample i in lane i mod 4, in order:
+            // blocks start at multiples of 8). Each sample is `v + (t - tm)·(-s)`, as
+            // detrend_pair_into makes it.
+            {
+                let mut qf_it = ofb.chunks_exact_mut(W);
+                let mut qx_it = oxb.chunks_exact_mut(W);
+                let mut tt_it = tb.chunks_exact(W);
+                let mut ff_it = fb.chunks_exact(W);
+                let mut xx_it = xb.chunks_exact(W);
+                for ((((qf, qx), tt), ff), xx) in (&mut qf_it)
+                    .zip(&mut qx_it)
+                    .zip(&mut tt_it)
+                    .zip(&mut ff_it)
+                    .zip(&mut xx_it)
+                {
+                    let (mut vf, mut vx) = ([0.0_f64; W], [0.0_f64; W]);
+                    for l in 0..W {
+                        let d = tt[l] - tm;
+                        vf[l] = ff[l] + d * nf;
+                        vx[l] = xx[l] + d * nx;
+                    }
+                    qf.copy_from_slice(&vf);
+                    qx.copy_from_slice(&vx);
+                    for l in 0..W {
+                        let (ax, af) = (vx[l].abs(), vf[l].abs());
+                        mx[l] = if ax > mx[l] { ax } else { mx[l] };
+                        mf[l] = if af > mf[l] { af } else { mf[l] };
+                        z[l] += vx[l] * 0.0 + vf[l] * 0.0;
+                    }
+                    for l in 0..4 {
+                        sum_f[l] += vf[l];
+                    }
+                    for l in 0..4 {
+                        sum_f[l] += vf[l + 4];
+                    }
+                }
+                let rest = qf_it
+                    .into_remainder()
+                    .iter_mut()
+                    .zip(qx_it.into_remainder())
+                    .zip(tt_it.remainder())
+                    .zip(ff_it.remainder())
+                    .zip(xx_it.remainder());
+                for (l, ((((of, ox), &ti), &fi), &xi)) in rest.enumerate() {
+                    let d = ti - tm;
+                    let (vf, vx) = (fi + d * nf, xi + d * nx);
+                    *of = vf;
+                    *ox = vx;
+                    let (ax, af) = (vx.abs(), vf.abs());
+                    mx[l] = if ax > mx[l] { ax } else { mx[l] };
+                    mf[l] = if af > mf[l] { af } else { mf[l] };
+                    sum_f[l % 4] += vf;
+                    z[l] += vx * 0.0 + vf * 0.0;
+                }
             }
             // the steps of t from the sample before the block (none before the first); eight
             // lanes: a minimum and a zero test do not depend on the order
@@ -331,32 +382,6 @@ impl crate::simd::Kernel for ScanPass<'_> {
                 let d = q - p;
                 dmin[l] = if d < dmin[l] { d } else { dmin[l] };
                 zt[l] += q * 0.0;
-            }
-            // finite_max_abs's numbers: the maxima and the zero test in eight lanes (order
-            // free), the sum of F in its four lanes (sample i in lane i mod 4, in order:
-            // blocks start at multiples of 8)
-            let mut cx = oxb.chunks_exact(W);
-            let mut cf = ofb.chunks_exact(W);
-            for (qx, qf) in (&mut cx).zip(&mut cf) {
-                for l in 0..W {
-                    let (ax, af) = (qx[l].abs(), qf[l].abs());
-                    mx[l] = if ax > mx[l] { ax } else { mx[l] };
-                    mf[l] = if af > mf[l] { af } else { mf[l] };
-                    z[l] += qx[l] * 0.0 + qf[l] * 0.0;
-                }
-                for l in 0..4 {
-                    sum_f[l] += qf[l];
-                }
-                for l in 0..4 {
-                    sum_f[l] += qf[l + 4];
-                }
-            }
-            for (l, (&vx, &vf)) in cx.remainder().iter().zip(cf.remainder()).enumerate() {
-                let (ax, af) = (vx.abs(), vf.abs());
-                mx[l] = if ax > mx[l] { ax } else { mx[l] };
-                mf[l] = if af > mf[l] { af } else { mf[l] };
-                sum_f[l % 4] += vf;
-                z[l] += vx * 0.0 + vf * 0.0;
             }
             if let Some(g) = gather.as_mut() {
                 for blk in oxb.chunks(GATHER_BLOCK) {
