@@ -182,6 +182,19 @@ def detrend_pair_scan_into(
     out_x: _F,
     ranks: list[int],
 ) -> WindowScan: ...
+def detrend_pair_scan_uniform_into(
+    t0: float,
+    dt: float,
+    offset: int,
+    tm: float,
+    f: _F,
+    slope_f: float,
+    x: _F,
+    slope_x: float,
+    out_f: _F,
+    out_x: _F,
+    ranks: list[int],
+) -> WindowScan: ...
 def loop_areas(x: _F, f: _F, bounds: list[int]) -> _F: ...
 def fit_steady_loop(
     x: _F,

@@ -54,3 +54,24 @@ def test_a_window_scanned_by_its_reader_is_not_scanned_again(case):
     # the extremes given are the ones checked: a channel said constant is refused as one
     with pytest.raises(InputError, match="F is constant"):
         analyze_window(rec, scanned={**exact, "F": (1.0, 1.0)})
+
+
+@pytest.mark.parametrize("case", sorted(_CASES))
+def test_a_sampled_window_is_detrended_on_its_axis_made_as_it_goes(case):
+    """``analyze_window(time_step=(t0, dt, offset))`` (a streamed window of a sampled
+    recording): the detrending pass makes ``fill_time``'s axis instead of reading it, and
+    every number is that of the window read with its axis. An axis said to start a sample
+    later is used (the numbers move), so the axis made is the one given."""
+    from contactlab import _core
+
+    src = synthetic_recording(**_CASES[case])
+    n = len(src.t)
+    t0, dt, offset = 0.125, 1.0 / _CASES[case]["fs"], 2_000_003
+    t = np.empty(n)
+    _core.fill_time(t, t0, dt, offset)
+    rec = Recording(t, {"x": src["x"], "F": src["F"]}, src.units, src.source, {})
+    a = analyze_window(rec, period_means=False)
+    b = analyze_window(rec, period_means=False, time_step=(t0, dt, offset))
+    assert a.to_dict() == b.to_dict() and a.warnings == b.warnings
+    c = analyze_window(rec, period_means=False, time_step=(t0, dt, offset + 1))
+    assert c.to_dict() != a.to_dict()

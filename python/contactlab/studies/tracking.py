@@ -191,7 +191,11 @@ def _tangential_window(
     from ..tangential import analyze_tangential
     from ..tangential.window import analyze_window
 
-    scanned = rec.scanned if isinstance(rec, _WindowSamples) else None
+    scanned: dict[str, tuple[float, float]] | None = None
+    time_step: tuple[float, float, int] | None = None
+    if isinstance(rec, _WindowSamples):
+        # (the axis recording() makes: fill_time's from the window's first global sample)
+        scanned, time_step = rec.scanned, (*rec.time_step, rec.start)
     rec = _window_recording(rec)
 
     opts = {k: v for k, v in options.items() if k != "warn"}
@@ -204,7 +208,7 @@ def _tangential_window(
             opts["force_sign"] = -1 if inv else 1
     if set(opts) <= _WINDOW_OPTIONS:
         # (the rows keep no per-cycle mean of the detrended window: not computed)
-        res = analyze_window(rec, period_means=False, scanned=scanned, **opts)
+        res = analyze_window(rec, period_means=False, scanned=scanned, time_step=time_step, **opts)
     else:
         res = analyze_tangential(rec, **{"warn": False, **dict(options)})
     d = res.to_dict()

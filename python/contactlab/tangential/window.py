@@ -90,6 +90,7 @@ def analyze_window(
     delay: float | None = None,
     period_means: bool = True,
     scanned: dict[str, tuple[float, float]] | None = None,
+    time_step: tuple[float, float, int] | None = None,
 ) -> TangentialAnalysis:
     """:func:`analyze_tangential` of one window of a streamed recording (``on="averaged"``,
     steady history), with the per-sample work in one pass of Rust kernels.
@@ -118,6 +119,11 @@ def analyze_window(
     of channels it found finite, with a time axis it found finite. The channel checks then
     use these extremes, and the time axis is not scanned again (three reads of the window
     fewer; the same results).
+
+    ``time_step``: ``(t0, dt, offset)`` when the recording's time axis is
+    :func:`contactlab._core.fill_time`'s ``t0 + dt·(offset + i)`` (a streamed window of a
+    sampled recording, :func:`contactlab.studies.tracking.track`'s): the detrending pass then
+    makes the axis as it goes instead of reading it (the same numbers).
     """
     xa, Fa, ta, source = _inputs(recording, None, None, None)
     _check_options("averaged", "steady", n_points)
@@ -148,6 +154,7 @@ def analyze_window(
         checked=finite_x and finite_f and plain,
         period_means=period_means,
         time_checked=scanned is not None and delay is None,
+        time_step=time_step if delay is None else None,
     )
     ori = _fast_orientation(pre.x, pre.F, pre.loop, force_sign)
     res = None
@@ -181,6 +188,7 @@ def window_detrended(
     checked: bool = False,
     period_means: bool = True,
     time_checked: bool = False,
+    time_step: tuple[float, float, int] | None = None,
 ) -> steps.Detrended:
     """:func:`steps.detrend` of the window with one fold instead of two: the linear drifts
     come from the period means between the raw displacement's peaks (what the first fold's
@@ -190,7 +198,9 @@ def window_detrended(
     so only t is checked here (else x, t and F are, naming a non-finite sample).
     ``period_means=False``: the final loop's per-cycle means of F and x are NaN (not
     computed; see :func:`analyze_window`). ``time_checked`` (with ``checked``): t too is
-    known finite (a streamed reader's axis), so it is not scanned either."""
+    known finite (a streamed reader's axis), so it is not scanned either. ``time_step``:
+    ``(t0, dt, offset)`` of ``ta`` when it is :func:`contactlab._core.fill_time`'s axis (see
+    :func:`analyze_window`)."""
     n_points, rel = opts["n_points"], opts["rel_threshold"]
     min_cycles = opts["min_cycles"]
     if checked:
@@ -230,7 +240,14 @@ def window_detrended(
     # fold's checks and scales (issue 33: a pass a window less each; the same numbers)
     sel = _tail_ranks(x.size)
     ranks = sel[0] if sel is not None else []
-    scan = _core.detrend_pair_scan_into(tt, tm, Fa, f_drift[0], xa, x_drift[0], F, x, ranks)
+    if time_step is not None and ta is not None:
+        # the axis made as the pass goes (fill_time's numbers): 8 of its 40 bytes a sample
+        t0, dt, offset = time_step
+        scan = _core.detrend_pair_scan_uniform_into(
+            t0, dt, offset, tm, Fa, f_drift[0], xa, x_drift[0], F, x, ranks
+        )
+    else:
+        scan = _core.detrend_pair_scan_into(tt, tm, Fa, f_drift[0], xa, x_drift[0], F, x, ranks)
     drift = steps.Drift(f_drift, x_drift, tt, tm)
     if not scan.clean:  # the fold names what is wrong (as before the scan)
         loop = average_loop(

@@ -15,6 +15,23 @@ pub fn fill_time(out: &mut [f64], t0: f64, dt: f64, offset: u64) -> Result<(), C
         Some(end) if end <= 1 << 53 => {}
         _ => return Err(CoreError::TooLong { len: out.len() }),
     }
+    fill_time_in(out, t0, dt, offset);
+    Ok(())
+}
+
+/// Whether the axis of `n` samples from `offset` has exact indices (`offset + n <= 2^53`,
+/// [`fill_time`]'s condition).
+pub(crate) fn indices_exact(offset: u64, n: usize) -> bool {
+    u64::try_from(n)
+        .ok()
+        .and_then(|n| offset.checked_add(n))
+        .is_some_and(|end| end <= 1 << 53)
+}
+
+/// [`fill_time`] of an axis whose indices are exact ([`indices_exact`]), inlined into the
+/// caller (a kernel compiled for each SIMD level: the same numbers at each).
+#[inline(always)]
+pub(crate) fn fill_time_in(out: &mut [f64], t0: f64, dt: f64, offset: u64) {
     // the indices as doubles, counted up in lanes (exact: whole numbers below 2^53; a
     // 64-bit integer to double conversion per sample has no SSE2 instruction)
     let k0 = offset as f64;
@@ -33,7 +50,15 @@ pub fn fill_time(out: &mut [f64], t0: f64, dt: f64, offset: u64) -> Result<(), C
     for (j, o) in it.into_remainder().iter_mut().enumerate() {
         *o = t0 + dt * k[j];
     }
-    Ok(())
+}
+
+/// Sample `i` of [`fill_time`]'s axis (bit for bit: the index is exact below 2^53).
+#[inline(always)]
+pub(crate) fn time_at(t0: f64, dt: f64, offset: u64, i: usize) -> f64 {
+    // (callers keep offset + i below 2^53: indices_exact)
+    #[allow(clippy::arithmetic_side_effects)]
+    let k = (offset + i as u64) as f64;
+    t0 + dt * k
 }
 
 #[cfg(test)]

@@ -913,7 +913,8 @@ mod detrend;
 mod period;
 use cell::{next_bin, Cell, Segment, NO_RANGE};
 pub use detrend::{
-    detrend_pair, detrend_pair_into, detrend_pair_scan_at, detrend_pair_scan_into, WindowScan,
+    detrend_pair, detrend_pair_into, detrend_pair_scan_at, detrend_pair_scan_into,
+    detrend_pair_scan_uniform_at, detrend_pair_scan_uniform_into, WindowScan,
 };
 use period::PeriodMeans;
 

@@ -2,8 +2,8 @@
 //! cycle areas, detrending).
 
 use contactlab_core::window::{
-    detrend_pair, detrend_pair_into, detrend_pair_scan_into, fold_window, fold_window_scanned,
-    WindowFold as CoreWindowFold, WindowScan as CoreWindowScan,
+    detrend_pair, detrend_pair_into, detrend_pair_scan_into, detrend_pair_scan_uniform_into,
+    fold_window, fold_window_scanned, WindowFold as CoreWindowFold, WindowScan as CoreWindowScan,
 };
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadwriteArray1};
 use pyo3::prelude::*;
@@ -213,6 +213,46 @@ fn detrend_pair_scan_into_py<'py>(
     Ok(WindowScan { inner })
 }
 
+/// `detrend_pair_scan_into` of a window whose time axis is `t0 + dt * (offset + i)`
+/// (`fill_time`'s, bit for bit), made as the pass goes instead of read
+/// (`contactlab_core::window::detrend_pair_scan_uniform_into`).
+#[pyfunction]
+#[pyo3(name = "detrend_pair_scan_uniform_into")]
+#[allow(clippy::too_many_arguments)]
+fn detrend_pair_scan_uniform_into_py<'py>(
+    py: Python<'py>,
+    t0: f64,
+    dt: f64,
+    offset: u64,
+    tm: f64,
+    f: PyReadonlyArray1<'py, f64>,
+    slope_f: f64,
+    x: PyReadonlyArray1<'py, f64>,
+    slope_x: f64,
+    mut out_f: PyReadwriteArray1<'py, f64>,
+    mut out_x: PyReadwriteArray1<'py, f64>,
+    ranks: Vec<usize>,
+) -> PyResult<WindowScan> {
+    let (fs, xs) = (slice(&f, "F")?, slice(&x, "x")?);
+    let of = out_f
+        .as_slice_mut()
+        .map_err(|_| input(py, "out_F must be a contiguous array"))?;
+    let ox = out_x
+        .as_slice_mut()
+        .map_err(|_| input(py, "out_x must be a contiguous array"))?;
+    let inner = detach_guarded(py, || {
+        detrend_pair_scan_uniform_into(
+            (t0, dt, offset),
+            tm,
+            (fs, slope_f),
+            (xs, slope_x),
+            (of, ox),
+            &ranks,
+        )
+    })?;
+    Ok(WindowScan { inner })
+}
+
 /// Remove the linear drifts of F and x in one pass (see
 /// `contactlab_core::window::detrend_pair`).
 #[pyfunction]
@@ -263,6 +303,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<WindowFold>()?;
     m.add_class::<WindowScan>()?;
     m.add_function(wrap_pyfunction!(detrend_pair_scan_into_py, m)?)?;
+    m.add_function(wrap_pyfunction!(detrend_pair_scan_uniform_into_py, m)?)?;
     m.add_function(wrap_pyfunction!(fold_window_py, m)?)?;
     m.add_function(wrap_pyfunction!(detrend_pair_py, m)?)?;
     m.add_function(wrap_pyfunction!(detrend_pair_into_py, m)?)?;

@@ -108,10 +108,103 @@ pub fn detrend_pair_scan_at(
     ranks: &[usize],
 ) -> Result<WindowScan, CoreError> {
     check_same_len("t", t.len(), "F", f.len())?;
-    check_same_len("t", t.len(), "x", x.len())?;
-    check_same_len("t", t.len(), "out_F", out_f.len())?;
-    check_same_len("t", t.len(), "out_x", out_x.len())?;
-    let n = t.len();
+    scan_with(
+        level,
+        Axis::Samples(t),
+        tm,
+        (f, s_f),
+        (x, s_x),
+        (out_f, out_x),
+        ranks,
+    )
+}
+
+/// [`detrend_pair_scan_into`] of a window whose time axis is sampled every `dt` from `t0`:
+/// sample `i` at `t0 + dt · (offset + i)`, [`crate::stream::fill_time`]'s axis bit for bit,
+/// made as the pass goes instead of read (a streamed recording's windows: 8 of the 40 bytes a
+/// sample the pass moves). The same numbers as [`detrend_pair_scan_into`] of that axis, and
+/// the same checks of it (an axis that overflows or stops increasing is not clean).
+///
+/// # Errors
+/// As [`detrend_pair_scan_into`]; [`CoreError::TooLong`] when `offset` plus the samples
+/// pass 2^53 (as [`crate::stream::fill_time`]).
+pub fn detrend_pair_scan_uniform_into(
+    (t0, dt, offset): (f64, f64, u64),
+    tm: f64,
+    (f, s_f): (&[f64], f64),
+    (x, s_x): (&[f64], f64),
+    (out_f, out_x): (&mut [f64], &mut [f64]),
+    ranks: &[usize],
+) -> Result<WindowScan, CoreError> {
+    detrend_pair_scan_uniform_at(
+        crate::simd::level(),
+        (t0, dt, offset),
+        tm,
+        (f, s_f),
+        (x, s_x),
+        (out_f, out_x),
+        ranks,
+    )
+}
+
+/// [`detrend_pair_scan_uniform_into`] with its pass compiled for `level`.
+#[doc(hidden)]
+pub fn detrend_pair_scan_uniform_at(
+    level: crate::simd::Level,
+    (t0, dt, offset): (f64, f64, u64),
+    tm: f64,
+    (f, s_f): (&[f64], f64),
+    (x, s_x): (&[f64], f64),
+    (out_f, out_x): (&mut [f64], &mut [f64]),
+    ranks: &[usize],
+) -> Result<WindowScan, CoreError> {
+    if !crate::stream::indices_exact(offset, f.len()) {
+        return Err(CoreError::TooLong { len: f.len() });
+    }
+    scan_with(
+        level,
+        Axis::Uniform(t0, dt, offset),
+        tm,
+        (f, s_f),
+        (x, s_x),
+        (out_f, out_x),
+        ranks,
+    )
+}
+
+/// The time axis of [`ScanPass`]: the samples, or `t0 + dt · (offset + i)` (indices exact,
+/// checked by the caller), made block by block as [`crate::stream::fill_time`] makes it.
+#[derive(Clone, Copy)]
+enum Axis<'a> {
+    Samples(&'a [f64]),
+    Uniform(f64, f64, u64),
+}
+
+impl Axis<'_> {
+    #[inline(always)]
+    fn at(&self, i: usize) -> f64 {
+        match *self {
+            Axis::Samples(t) => t[i],
+            Axis::Uniform(t0, dt, offset) => crate::stream::time_at(t0, dt, offset, i),
+        }
+    }
+}
+
+/// [`detrend_pair_scan_at`] on either axis (`f`'s length is the samples').
+#[allow(clippy::arithmetic_side_effects)]
+fn scan_with(
+    level: crate::simd::Level,
+    t: Axis<'_>,
+    tm: f64,
+    (f, s_f): (&[f64], f64),
+    (x, s_x): (&[f64], f64),
+    (out_f, out_x): (&mut [f64], &mut [f64]),
+    ranks: &[usize],
+) -> Result<WindowScan, CoreError> {
+    check_same_len("t", f.len(), "x", x.len())?;
+    check_same_len("t", f.len(), "out_F", out_f.len())?;
+    check_same_len("t", f.len(), "out_x", out_x.len())?;
+    let n = f.len();
     let (nf, nx) = (-s_f, -s_x);
     let mut gather = if ranks.is_empty() || n == 0 {
         None
@@ -119,7 +212,7 @@ pub fn detrend_pair_scan_at(
         // a sparser subsample than order_stats' (its samples are cache misses here, where
         // order_stats' were just written): thresholds a little less sharp, values the same
         Some(TailGather::new(n, ranks, 4 * STRIDE, |i| {
-            x[i] + (t[i] - tm) * nx
+            x[i] + (t.at(i) - tm) * nx
         })?)
     };
     let (mx, mf, sum_f, z, zt, dmin) = crate::simd::run(
@@ -133,8 +226,10 @@ pub fn detrend_pair_scan_at(
         },
     );
     // t: finite (its first sample too) and strictly increasing (a NaN step fails `> 0`)
-    let t_ok =
-        n >= 2 && t[0].is_finite() && zt.iter().all(|&v| v == 0.0) && dmin.iter().all(|&d| d > 0.0);
+    let t_ok = n >= 2
+        && t.at(0).is_finite()
+        && zt.iter().all(|&v| v == 0.0)
+        && dmin.iter().all(|&d| d > 0.0);
     let ok = [z.iter().all(|&v| v == 0.0); 1];
     let big = |m: [f64; W]| m.iter().fold(0.0_f64, |a, &b| if b > a { b } else { a });
     let (sx, sf) = (big(mx), big(mf));
@@ -165,7 +260,7 @@ const W: usize = 8;
 /// for each level: in the baseline build the detrending and the scans ran two lanes wide,
 /// 1.6 ns a sample in cache).
 struct ScanPass<'a> {
-    t: &'a [f64],
+    t: Axis<'a>,
     tm: f64,
     inputs: (&'a [f64], f64, &'a [f64], f64),
     outputs: (&'a mut [f64], &'a mut [f64]),
@@ -186,7 +281,12 @@ impl crate::simd::Kernel for ScanPass<'_> {
             outputs: (out_f, out_x),
             mut gather,
         } = self;
-        let n = t.len();
+        let n = f.len();
+        // a sampled axis's block (and the sample before it), made here: in L2, not read
+        let mut made = match t {
+            Axis::Samples(_) => Vec::new(),
+            Axis::Uniform(..) => vec![0.0_f64; SCAN_BLOCK.min(n) + 1],
+        };
         let (mut mx, mut mf, mut sum_f) = ([0.0_f64; W], [0.0_f64; W], [0.0_f64; 4]);
         // Σ v·0 of x, F and t: ±0 while every value is finite, NaN from an inf or a NaN on (a
         // vectorised finiteness check, where a lane of booleans was not); the smallest step of t
@@ -196,17 +296,78 @@ impl crate::simd::Kernel for ScanPass<'_> {
             // blocks that stay in L2 for the passes over what was just written, long enough for
             // the prefetchers' streams (blocks of GATHER_BLOCK were 2.5x slower)
             let b = (a + SCAN_BLOCK).min(n);
-            let (tb, fb, xb) = (&t[a..b], &f[a..b], &x[a..b]);
+            // t from the sample before the block (none before the first) to its end
+            let lo = a.saturating_sub(1);
+            let tp: &[f64] = match t {
+                Axis::Samples(t) => &t[lo..b],
+                Axis::Uniform(t0, dt, offset) => {
+                    let buf = &mut made[..b - lo];
+                    crate::stream::fill_time_in(buf, t0, dt, offset + lo as u64);
+                    buf
+                }
+            };
+            let tb = &tp[a - lo..];
+            let (fb, xb) = (&f[a..b], &x[a..b]);
             let (ofb, oxb) = (&mut out_f[a..b], &mut out_x[a..b]);
-            for ((o, &ti), &vi) in ofb.iter_mut().zip(tb).zip(fb) {
-                *o = vi + (ti - tm) * nf;
-            }
-            for ((o, &ti), &vi) in oxb.iter_mut().zip(tb).zip(xb) {
-                *o = vi + (ti - tm) * nx;
+            // the detrended samples and, as they are made (in registers, not read back),
+            // finite_max_abs's numbers: the maxima and the zero test in eight lanes (order
+            // free), the sum of F in its four lanes (sample i in lane i mod 4, in order:
+            // blocks start at multiples of 8). Each sample is `v + (t - tm)·(-s)`, as
+            // detrend_pair_into makes it.
+            {
+                let mut qf_it = ofb.chunks_exact_mut(W);
+                let mut qx_it = oxb.chunks_exact_mut(W);
+                let mut tt_it = tb.chunks_exact(W);
+                let mut ff_it = fb.chunks_exact(W);
+                let mut xx_it = xb.chunks_exact(W);
+                for ((((qf, qx), tt), ff), xx) in (&mut qf_it)
+                    .zip(&mut qx_it)
+                    .zip(&mut tt_it)
+                    .zip(&mut ff_it)
+                    .zip(&mut xx_it)
+                {
+                    let (mut vf, mut vx) = ([0.0_f64; W], [0.0_f64; W]);
+                    for l in 0..W {
+                        let d = tt[l] - tm;
+                        vf[l] = ff[l] + d * nf;
+                        vx[l] = xx[l] + d * nx;
+                    }
+                    qf.copy_from_slice(&vf);
+                    qx.copy_from_slice(&vx);
+                    for l in 0..W {
+                        let (ax, af) = (vx[l].abs(), vf[l].abs());
+                        mx[l] = if ax > mx[l] { ax } else { mx[l] };
+                        mf[l] = if af > mf[l] { af } else { mf[l] };
+                        z[l] += vx[l] * 0.0 + vf[l] * 0.0;
+                    }
+                    for l in 0..4 {
+                        sum_f[l] += vf[l];
+                    }
+                    for l in 0..4 {
+                        sum_f[l] += vf[l + 4];
+                    }
+                }
+                let rest = qf_it
+                    .into_remainder()
+                    .iter_mut()
+                    .zip(qx_it.into_remainder())
+                    .zip(tt_it.remainder())
+                    .zip(ff_it.remainder())
+                    .zip(xx_it.remainder());
+                for (l, ((((of, ox), &ti), &fi), &xi)) in rest.enumerate() {
+                    let d = ti - tm;
+                    let (vf, vx) = (fi + d * nf, xi + d * nx);
+                    *of = vf;
+                    *ox = vx;
+                    let (ax, af) = (vx.abs(), vf.abs());
+                    mx[l] = if ax > mx[l] { ax } else { mx[l] };
+                    mf[l] = if af > mf[l] { af } else { mf[l] };
+                    sum_f[l % 4] += vf;
+                    z[l] += vx * 0.0 + vf * 0.0;
+                }
             }
             // the steps of t from the sample before the block (none before the first); eight
             // lanes: a minimum and a zero test do not depend on the order
-            let tp = &t[a.saturating_sub(1)..b];
             let (t0, t1) = (&tp[..tp.len() - 1], &tp[1..]);
             let mut c0 = t0.chunks_exact(W);
             let mut c1 = t1.chunks_exact(W);
@@ -221,32 +382,6 @@ impl crate::simd::Kernel for ScanPass<'_> {
                 let d = q - p;
                 dmin[l] = if d < dmin[l] { d } else { dmin[l] };
                 zt[l] += q * 0.0;
-            }
-            // finite_max_abs's numbers: the maxima and the zero test in eight lanes (order
-            // free), the sum of F in its four lanes (sample i in lane i mod 4, in order:
-            // blocks start at multiples of 8)
-            let mut cx = oxb.chunks_exact(W);
-            let mut cf = ofb.chunks_exact(W);
-            for (qx, qf) in (&mut cx).zip(&mut cf) {
-                for l in 0..W {
-                    let (ax, af) = (qx[l].abs(), qf[l].abs());
-                    mx[l] = if ax > mx[l] { ax } else { mx[l] };
-                    mf[l] = if af > mf[l] { af } else { mf[l] };
-                    z[l] += qx[l] * 0.0 + qf[l] * 0.0;
-                }
-                for l in 0..4 {
-                    sum_f[l] += qf[l];
-                }
-                for l in 0..4 {
-                    sum_f[l] += qf[l + 4];
-                }
-            }
-            for (l, (&vx, &vf)) in cx.remainder().iter().zip(cf.remainder()).enumerate() {
-                let (ax, af) = (vx.abs(), vf.abs());
-                mx[l] = if ax > mx[l] { ax } else { mx[l] };
-                mf[l] = if af > mf[l] { af } else { mf[l] };
-                sum_f[l % 4] += vf;
-                z[l] += vx * 0.0 + vf * 0.0;
             }
             if let Some(g) = gather.as_mut() {
                 for blk in oxb.chunks(GATHER_BLOCK) {

@@ -680,3 +680,58 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    /// The scan of a sampled axis made as the pass goes equals, at every SIMD level, the scan
+    /// of `fill_time`'s axis read from memory: the detrended samples bit for bit, the order
+    /// statistics and scan numbers; an axis that stops increasing (a step lost against the
+    /// start time) or overflows is not clean in either.
+    #[test]
+    fn a_sampled_axis_scans_as_its_filled_axis(
+        seed in 0u64..1000, n in prop::sample::select(vec![2usize, 7, 40, 5000, 70_001]),
+        offset in prop::sample::select(vec![0u64, 1, 32_767, 2_000_003, 1 << 40]),
+        axis in 0u8..4, s_f in -1e3f64..1e3, s_x in -1e-3f64..1e-3,
+    ) {
+        let (_t, x, f) = signal(n, seed, 1e-3);
+        let (t0, dt) = match axis {
+            0 => (0.0, 1e-4),
+            1 => (-3.25, 1.0 / 3.0),
+            2 => (1e9, 1e-9), // stops increasing
+            _ => (1.0, 1e300), // overflows
+        };
+        let mut t = vec![0.0; n];
+        crate::stream::fill_time(&mut t, t0, dt, offset).unwrap();
+        let tm = t[n / 2];
+        let ranks = if n > 1000 { tail_ranks(n) } else { Vec::new() };
+        for l in crate::simd::Level::ALL.into_iter().filter(|l| l.supported()) {
+            let (mut gf, mut gx) = (vec![0.0; n], vec![0.0; n]);
+            let g = detrend_pair_scan_at(l, &t, tm, (&f, s_f), (&x, s_x), (&mut gf, &mut gx), &ranks);
+            let (mut of, mut ox) = (vec![0.0; n], vec![0.0; n]);
+            let s = detrend_pair_scan_uniform_at(
+                l, (t0, dt, offset), tm, (&f, s_f), (&x, s_x), (&mut of, &mut ox), &ranks,
+            );
+            prop_assert_eq!(format!("{s:?}"), format!("{g:?}"), "level {}", l.name());
+            prop_assert!(of.iter().zip(&gf).all(|(a, b)| a.to_bits() == b.to_bits()));
+            prop_assert!(ox.iter().zip(&gx).all(|(a, b)| a.to_bits() == b.to_bits()));
+            if axis == 2 {
+                prop_assert!(!s.as_ref().is_ok_and(|s| s.clean));
+            }
+        }
+    }
+}
+
+#[test]
+fn a_sampled_axis_past_exact_indices_is_refused() {
+    let (x, f) = (vec![1.0; 4], vec![2.0; 4]);
+    let (mut of, mut ox) = (vec![0.0; 4], vec![0.0; 4]);
+    let r = detrend_pair_scan_uniform_into(
+        (0.0, 1.0, (1 << 53) - 2),
+        0.0,
+        (&f, 0.0),
+        (&x, 0.0),
+        (&mut of, &mut ox),
+        &[],
+    );
+    assert!(matches!(r, Err(CoreError::TooLong { .. })));
+}
