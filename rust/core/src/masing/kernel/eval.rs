@@ -208,9 +208,13 @@ fn eval_dense_body<C: Backbone>(curve: &C, d: &mut Dense, lam: f64, out: &mut [f
     }
     let slot = &d.slot[..m];
     let virgin = VIRGIN_SLOT as usize;
-    // Whether a sample is on the virgin curve (only before the first reversal): one
-    // vectorised test, which spares the common loop the select of the multiplier.
-    if slot.iter().fold(false, |any, &j| any | (j == VIRGIN_SLOT)) {
+    // Whether a sample is on the virgin curve (rare: before the first reversal or after a
+    // rejoin): one vectorised test, which spares the common loop the select of the multiplier.
+    if slot
+        .iter()
+        .fold(0_u32, |any, &j| any | u32::from(j == VIRGIN_SLOT))
+        != 0
+    {
         for (p, (o, &j)) in out.iter_mut().zip(slot).enumerate() {
             let j = j as usize;
             let mul = f64::from_bits(pick(j == virgin, 1.0_f64.to_bits(), lam.to_bits()));
