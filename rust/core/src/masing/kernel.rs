@@ -31,11 +31,11 @@
 //!
 //! A block after one that changed branch more than once every [`DENSE`] samples (a random
 //! walk) takes the dense path instead: [`Pass::dense_block`] applies the rules with no
-//! data-dependent branch and writes per sample only the curve argument, the anchor's sample
-//! index and its force where known (no run table, whose bookkeeping cost as much as the rules
-//! there); [`eval_dense`] evaluates the curve over the block, then each force as the anchor's
-//! output (an earlier sample of the block, through one indexed buffer) or the known base, plus
-//! `lam · f(u)`. Both paths give the stepper's forces bit for bit.
+//! data-dependent branch but the closure's and writes per sample only the curve argument and
+//! the slot of its base in one buffer (no run table, whose bookkeeping cost as much as the
+//! rules there); [`eval_dense`] evaluates the curve over the block, then each force as the
+//! base in its slot (the anchor's output, an earlier sample of the block, or a base known
+//! before the block) plus `lam · f(u)`. Both paths give the stepper's forces bit for bit.
 //!
 //! Files: `kernel/scan.rs` the input scan, `kernel/pass.rs` the first pass (memory rules),
 //! `kernel/eval.rs` the curve passes, `kernel/level_tests.rs` the SIMD level tests; this file the
@@ -82,26 +82,31 @@ pub(super) struct Dense {
     /// Padding: arrays 4 KiB apart alias in the store-to-load check (the stores of one
     /// sample would all share their low 12 address bits).
     _pad0: [f64; 40],
-    idx: [u64; BLOCK],
+    /// `slot[p]`: where in `kh` the base of sample `p` is.
+    slot: [u32; BLOCK],
     _pad1: [f64; 40],
-    /// `kh[p]`: the known base of sample `p` (an anchor before the block, or 0 on the virgin
-    /// curve); `kh[BLOCK + p]`: the output of sample `p` once computed, the base of the
-    /// samples anchored at it.
-    kh: [f64; 2 * BLOCK],
-    _pad2: [f64; 40],
-    mm: [f64; BLOCK],
+    /// The bases, by slot: `kh[p]` for `p < BLOCK` a known base written at sample `p` (an
+    /// anchor before the block); `kh[BLOCK]` the output of the sample before the block;
+    /// `kh[BLOCK + 1 + q]` the output of in-block sample `q` once computed; `kh[VIRGIN_SLOT]`
+    /// 0, the base of the virgin curve (whose multiplier is 1, not `lam`).
+    kh: [f64; KH],
 }
+
+/// The slot of the virgin curve's base in [`Dense::kh`].
+pub(super) const VIRGIN_SLOT: u32 = 2 * BLOCK as u32 + 1;
+
+/// Length of [`Dense::kh`]: a power of two above [`VIRGIN_SLOT`] (a masked index needs no
+/// bounds check).
+pub(super) const KH: usize = 4 * BLOCK;
 
 impl Dense {
     pub(super) fn new() -> Box<Self> {
         Box::new(Self {
             u: [0.0; BLOCK],
             _pad0: [0.0; 40],
-            idx: [0; BLOCK],
+            slot: [0; BLOCK],
             _pad1: [0.0; 40],
-            kh: [0.0; 2 * BLOCK],
-            _pad2: [0.0; 40],
-            mm: [0.0; BLOCK],
+            kh: [0.0; KH],
         })
     }
 }
@@ -208,7 +213,7 @@ pub(super) fn scaled_force<C: Backbone>(
             if simd::run(level, Scan(xc, false)).is_none() {
                 return Forces::BadInput;
             }
-            finite &= eval_dense(level, curve, d, pass.start, oc);
+            finite &= eval_dense(level, curve, d, lam, oc);
             c
         } else {
             let (u, r) = (&mut ub[..m], &mut rid[..m]);

@@ -1,7 +1,7 @@
 //! The curve passes of the kernel: [`eval_block`] (a block of runs) and [`eval_dense`] (a
 //! dense block), each compiled for every SIMD level, and the gather tables they use.
 
-use super::{pick, Dense, Run, BLOCK, KNOWN};
+use super::{pick, Dense, Run, BLOCK, KH, KNOWN, VIRGIN_SLOT};
 use crate::curve::Backbone;
 use crate::simd::{self, Kernel, Level};
 
@@ -169,7 +169,7 @@ pub(in crate::masing) fn eval_block<C: Backbone>(
 struct EvalDense<'a, C> {
     curve: &'a C,
     d: &'a mut Dense,
-    start: u64,
+    lam: f64,
     out: &'a mut [f64],
 }
 
@@ -177,7 +177,7 @@ impl<C: Backbone> Kernel for EvalDense<'_, C> {
     type Output = bool;
     #[inline(always)]
     fn run_at(self) -> bool {
-        eval_dense_body(self.curve, self.d, self.start, self.out)
+        eval_dense_body(self.curve, self.d, self.lam, self.out)
     }
 }
 
@@ -188,42 +188,46 @@ pub(super) fn eval_dense<C: Backbone>(
     level: Level,
     curve: &C,
     d: &mut Dense,
-    start: u64,
+    lam: f64,
     out: &mut [f64],
 ) -> bool {
-    simd::run(
-        level,
-        EvalDense {
-            curve,
-            d,
-            start,
-            out,
-        },
-    )
+    simd::run(level, EvalDense { curve, d, lam, out })
 }
 
 /// Curve pass of a dense block: `out[p] = f(u[p])` over the block (vectorised), then in
-/// order `out[p] = base + mm[p] · out[p]` with `base` the output of the in-block anchor
-/// sample (`idx[p] - start < BLOCK`) or the known `kh[p]`, picked by an index into one
-/// buffer (no data-dependent branch).
+/// order `out[p] = kh[slot[p]] + mul · out[p]`, writing the result to `kh[BLOCK + 1 + p]`
+/// (the base of the samples anchored at sample `p`), with `mul` 1 on the virgin curve and
+/// `lam` elsewhere (no data-dependent branch; a block with no sample on the virgin curve
+/// takes a loop with `mul = lam`).
 #[inline(always)]
-fn eval_dense_body<C: Backbone>(curve: &C, d: &mut Dense, start: u64, out: &mut [f64]) -> bool {
+fn eval_dense_body<C: Backbone>(curve: &C, d: &mut Dense, lam: f64, out: &mut [f64]) -> bool {
     let m = out.len().min(BLOCK);
     let out = &mut out[..m];
     for (o, &v) in out.iter_mut().zip(&d.u[..m]) {
         *o = curve.eval(v);
     }
-    for (p, o) in out.iter_mut().enumerate() {
-        let rel = d.idx[p].wrapping_sub(start);
-        // the anchor's output (BLOCK + rel) when it is in this block, else the known base
-        let j = pick(
-            rel < BLOCK as u64,
-            (BLOCK as u64).wrapping_add(rel),
-            p as u64,
-        ) as usize;
-        let v = d.kh[j & (2 * BLOCK - 1)] + d.mm[p] * *o;
-        d.kh[BLOCK.wrapping_add(p) & (2 * BLOCK - 1)] = v;
-        *o = v;
+    let slot = &d.slot[..m];
+    let virgin = VIRGIN_SLOT as usize;
+    // Whether a sample is on the virgin curve (rare: before the first reversal or after a
+    // rejoin): one vectorised test, which spares the common loop the select of the multiplier.
+    if slot
+        .iter()
+        .fold(0_u32, |any, &j| any | u32::from(j == VIRGIN_SLOT))
+        != 0
+    {
+        for (p, (o, &j)) in out.iter_mut().zip(slot).enumerate() {
+            let j = j as usize;
+            let mul = f64::from_bits(pick(j == virgin, 1.0_f64.to_bits(), lam.to_bits()));
+            let v = d.kh[j & (KH - 1)] + mul * *o;
+            d.kh[BLOCK.wrapping_add(1).wrapping_add(p) & (KH - 1)] = v;
+            *o = v;
+        }
+    } else {
+        for (p, (o, &j)) in out.iter_mut().zip(slot).enumerate() {
+            let v = d.kh[j as usize & (KH - 1)] + lam * *o;
+            d.kh[BLOCK.wrapping_add(1).wrapping_add(p) & (KH - 1)] = v;
+            *o = v;
+        }
     }
     out.iter().fold(true, |ok, o| ok & o.is_finite())
 }

@@ -3,7 +3,7 @@
 //! dense block ([`Pass::dense_block`]), and the branch-free selects they use.
 
 use super::scan::{next_clear, Cont};
-use super::{pick, Dense, Run, BLOCK, KNOWN};
+use super::{pick, Dense, Run, BLOCK, KH, KNOWN, VIRGIN_SLOT};
 use crate::masing::Reversal;
 use crate::simd::{self, Kernel, Level};
 
@@ -55,7 +55,11 @@ impl Kernel for BlockPass<'_> {
 
 /// First pass over one dense block ([`Pass::dense_block`]) compiled for SIMD level `level`
 /// (scalar code; the wider levels bring three-operand instructions and twice the registers,
-/// the same IEEE operations in the same order).
+/// the same IEEE operations in the same order). The branch target is selected in registers
+/// at AVX-512 (a masked move) and loaded from the stack below it: there the compiler turns
+/// the select into a branch, a coin toss on a random walk (measured on the anchor's random
+/// walk with `CONTACTLAB_SIMD=avx2`: 1.3x the anchor with the select, 1.8x with the load; at
+/// AVX-512 the select is 5 to 10 % faster than the load).
 #[inline(never)]
 pub(super) fn dense_pass(
     level: Level,
@@ -64,27 +68,56 @@ pub(super) fn dense_pass(
     xc: &[f64],
     d: &mut Dense,
 ) -> usize {
-    simd::run(level, DensePass { pass, stk, xc, d })
+    if level == Level::Avx512 {
+        simd::run(level, DensePass::<true> { pass, stk, xc, d })
+    } else {
+        simd::run(level, DensePass::<false> { pass, stk, xc, d })
+    }
 }
 
-/// [`Pass::dense_block`] as a [`Kernel`] for [`simd::run`].
-struct DensePass<'a> {
+/// [`Pass::dense_block`] as a [`Kernel`] for [`simd::run`] (`SELECT`: see [`dense_pass`]).
+struct DensePass<'a, const SELECT: bool> {
     pass: &'a mut Pass,
     stk: &'a mut [Reversal],
     xc: &'a [f64],
     d: &'a mut Dense,
 }
 
-impl Kernel for DensePass<'_> {
+impl<const SELECT: bool> Kernel for DensePass<'_, SELECT> {
     type Output = usize;
     #[inline(always)]
     fn run_at(self) -> usize {
-        self.pass.dense_block(self.stk, self.xc, self.d)
+        self.pass.dense_block::<SELECT>(self.stk, self.xc, self.d)
     }
 }
 
-/// Anchor index of a sample on the virgin curve (its base is 0, its multiplier 1).
-const VIRGIN: u64 = u64::MAX;
+/// The inputs of the top two reversals of a stack of `n` (0 for fewer than two).
+#[inline(always)]
+fn top_two(n: usize, stk: &[Reversal]) -> (f64, f64) {
+    if n >= 2 {
+        (stk[n.wrapping_sub(1)].x, stk[n.wrapping_sub(2)].x)
+    } else {
+        (0.0, 0.0)
+    }
+}
+
+/// The base slot ([`Dense::kh`]) of block position `p` whose branch starts at reversal
+/// `top` (off the virgin curve), the sample before the block being `before`: that of the
+/// output of an in-block sample or of the sample before the block, else slot `p`, where the
+/// known force is written (always written, harmless when unused: slot `p` is read only by
+/// samples whose slot this call made `p`). Integer selects only (in-block and older anchors
+/// alternate at random after closures).
+#[inline(always)]
+fn known_slot(top: Reversal, before: u64, p: usize, kh: &mut [f64; KH]) -> u32 {
+    // 0 for the sample before the block, q + 1 for in-block sample q
+    let rel = top.index.wrapping_sub(before);
+    kh[p & (BLOCK - 1)] = top.h;
+    pick(
+        rel <= BLOCK as u64,
+        (BLOCK as u64).wrapping_add(rel),
+        p as u64,
+    ) as u32
+}
 
 /// Written above the stack top (never read as a reversal).
 pub(super) const SPARE: Reversal = Reversal {
@@ -382,81 +415,138 @@ impl Pass {
         nr
     }
 
-    /// The record of the current sample for [`eval_dense`]: the anchor's global sample
-    /// index ([`VIRGIN`] on the virgin curve), its force as far as it is known (a deferred
-    /// one is resolved by the index), and the branch's multiplier.
+    /// The base slot ([`Dense::kh`]) of block position `p` for [`eval_dense`] on the current
+    /// branch: [`VIRGIN_SLOT`] on the virgin curve, else that of the anchor, the stack top
+    /// (see [`known_slot`]).
     #[inline(always)]
-    fn anchor(&self, stk: &[Reversal]) -> (u64, f64, f64) {
+    fn slot(&self, stk: &[Reversal], p: usize, kh: &mut [f64; KH]) -> u32 {
         if self.n == 0 {
-            (VIRGIN, 0.0, 1.0)
+            VIRGIN_SLOT
         } else {
             let top = stk[self.n.saturating_sub(1)];
-            (top.index, top.h, self.lam)
+            known_slot(top, self.start.wrapping_sub(1), p, kh)
         }
     }
 
     /// First pass for a block where the input reverses often (a random walk reverses every
     /// ~2 samples; there the predicted test of [`Pass::block_body`] is a coin toss). It writes, per
-    /// sample, the curve argument `u`, the anchor's sample index `idx`, its force `kh` where
-    /// known (before the block) and the branch multiplier `mm`; [`eval_dense`] resolves the
-    /// rest. No run table: a branch change costs nothing more than a step on. Returns the
-    /// number of branch changes.
+    /// sample, the curve argument `u` and the slot of its base in [`Dense::kh`] (writing there
+    /// the bases known before the block); [`eval_dense`] resolves the rest. No run table: a
+    /// branch change costs nothing more than a step on. Returns the number of branch changes.
     ///
-    /// Only the stack depth `n`, the last input and the direction live in registers: the
-    /// current branch's target is always `stk[n - 2].x` and its anchor `stk[n - 1]` (the
-    /// candidate reversal, always written above the top, is the anchor once the top is raised
-    /// over it), so a reversal raises `n` by one and a closure lowers it by two, by
-    /// arithmetic on the comparison results, without a data-dependent branch.
+    /// Only the stack depth `n`, the last input and the direction live in registers (and the
+    /// inputs of the top two reversals, so that the closure test of a step needs no load that
+    /// waits for the previous step's depth): the current branch's target is always
+    /// `stk[n - 2].x` and its anchor `stk[n - 1]` (the candidate reversal, always written above
+    /// the top, is the anchor once the top is raised over it), so a reversal raises `n` by one
+    /// and a closure lowers it by two, by arithmetic on the comparison results, without a
+    /// data-dependent branch. Per common step four stores: the candidate's input and index,
+    /// the argument and the slot (after a reversal the anchor's slot is that of the previous
+    /// sample's output, `BLOCK + p`).
     ///
-    /// Left to branches (rare on such a signal): a stack of fewer than two reversals (the
-    /// virgin curve, or the first reversal's branch whose target is a mirror point) and a
-    /// closure down to it, both through [`Pass::rules`]; a step that closes two or more
-    /// loops at once; a zero-length step. Needs `dir != 0` (the first move goes through
-    /// [`Pass::block_body`]).
+    /// The common steps (a move on a stack of two or more, with a reversal or not, closing
+    /// one loop or none; the closure a predicted branch, taken on about a tenth of the
+    /// samples of a band-limited signal and a fifth of a random walk's) run in an inner loop
+    /// of their own; it leaves, to apply [`Pass::rules`], for the rare others: a zero-length
+    /// step, a stack of fewer than two reversals (the virgin curve, or the first reversal's
+    /// branch whose target is a mirror point), a closure down to it, and a step that closes
+    /// two loops or more. With those in the same loop body, the compiler kept a branch
+    /// register on the stack, stored and reloaded at every step. Needs `dir != 0` (the first
+    /// move goes through [`Pass::block_body`]).
     #[inline(always)]
     // `&` on booleans on purpose: no branch per condition.
     #[allow(clippy::needless_bitwise_bool)]
-    pub(super) fn dense_block(&mut self, stk: &mut [Reversal], xc: &[f64], d: &mut Dense) -> usize {
+    pub(super) fn dense_block<const SELECT: bool>(
+        &mut self,
+        stk: &mut [Reversal],
+        xc: &[f64],
+        d: &mut Dense,
+    ) -> usize {
         self.load_branch(stk); // the top's force may have been resolved since
-        let (start, lam, inv_lam, h_before) = (self.start, self.lam, self.inv_lam, self.h_before);
+        let (start, inv_lam, h_before) = (self.start, self.inv_lam, self.h_before);
         // Global index of the sample before block position 0.
         let before = start.wrapping_sub(1);
+        let kh = &mut d.kh;
+        kh[BLOCK] = h_before;
+        kh[VIRGIN_SLOT as usize] = 0.0;
         let (mut n, mut xp, mut up) = (self.n, self.xp, self.dir > 0.0);
-        let mut changes = 0_usize;
-        // Record of the last sample (a zero-length step repeats it).
-        let mut ul = (xp - self.xa) * self.inv;
-        let (mut li, mut lk, mut lm) = self.anchor(stk);
-        // The inputs of the top reversal and the one below it, kept in registers while the
-        // stack holds two or more (reloaded after the rare paths): the closure test of the
-        // common step then needs no load that waits for the previous step's depth.
-        let reload = |n: usize, stk: &[Reversal]| {
-            if n >= 2 {
-                (stk[n.wrapping_sub(1)].x, stk[n.wrapping_sub(2)].x)
-            } else {
-                (0.0, 0.0)
-            }
-        };
-        let (mut ta, mut tb) = reload(self.n, stk);
+        let (mut ta, mut tb) = top_two(n, stk);
+        // The last sample's record (a zero-length step repeats it).
+        let mut ul = (self.xp - self.xa) * self.inv;
+        let mut j = self.slot(stk, 0, kh);
         // The force of the first sample's candidate (the sample before the block).
         stk[self.n].h = h_before;
         let m = xc.len().min(BLOCK);
-        let (u, idx, kh, mm) = (
-            &mut d.u[..m],
-            &mut d.idx[..m],
-            &mut d.kh[..m],
-            &mut d.mm[..m],
-        );
-        for (p, &xi) in xc[..m].iter().enumerate() {
-            if xi == xp {
-                // A zero-length step changes nothing (a predicted branch: rare where the
-                // input reverses often).
-                (u[p], idx[p], kh[p], mm[p]) = (ul, li, lk, lm);
-                continue;
+        let (xc, u, sl) = (&xc[..m], &mut d.u[..m], &mut d.slot[..m]);
+        let mut p = 0_usize;
+        // The common steps run in an inner loop that leaves for any other: its registers are
+        // then not shared with the general rules'.
+        while p < m {
+            while p < m {
+                let xi = xc[p];
+                let dx = xi - xp;
+                if (dx == 0.0) | (n < 2) {
+                    break;
+                }
+                let rising = dx > 0.0;
+                let rev = rising != up;
+                // Candidate reversal: the previous sample. Its force is deferred for p > 0
+                // (the placeholder is never read: the index names the in-block sample, and
+                // `end_block` writes the force), so only the input and the index are
+                // written; for p = 0 the force `h_before` was written at the block's start.
+                let cand = &mut stk[n];
+                (cand.x, cand.index) = (xp, before.wrapping_add(p as u64));
+                // in 2..stk.len()
+                let n1 = n.wrapping_add(usize::from(rev));
+                // The target stk[n1 - 2].x: the top's input after a reversal, else the one
+                // below (selected from the registers, or loaded: see `dense_pass`).
+                let t = if SELECT {
+                    pickf(rev, ta, tb)
+                } else {
+                    stk[n1.wrapping_sub(2)].x
+                };
+                // (x - target) · s >= 0 with s the direction of the step (exact: s = ±1)
+                let s = 1.0_f64.copysign(dx);
+                if (xi - t) * s >= 0.0 {
+                    if n1 < 4 {
+                        break;
+                    }
+                    let n2 = n1.wrapping_sub(2); // >= 2
+                    let below = stk[n2.wrapping_sub(2)].x;
+                    if (xi - below) * s >= 0.0 {
+                        break;
+                    }
+                    let top = stk[n2.wrapping_sub(1)];
+                    (n, up, xp) = (n2, rising, xi);
+                    (ta, tb) = (top.x, below);
+                    ul = (xi - top.x) * inv_lam;
+                    j = known_slot(top, before, p, kh);
+                    (u[p], sl[p]) = (ul, j);
+                    p = p.wrapping_add(1);
+                    continue;
+                }
+                // No closure: after a reversal the candidate (the previous sample, whose
+                // output is slot BLOCK + p) is the top, and the old top's input the target.
+                n = n1;
+                tb = t;
+                ta = pickf(rev, xp, ta);
+                j = pick(rev, BLOCK.wrapping_add(p) as u64, u64::from(j)) as u32;
+                up = rising;
+                xp = xi;
+                ul = (xi - ta) * inv_lam;
+                (u[p], sl[p]) = (ul, j);
+                p = p.wrapping_add(1);
             }
-            let rising = xi > xp;
-            if n < 2 {
-                // The virgin curve or the first reversal's branch (whose target is a mirror
-                // point): the general rules.
+            if p >= m {
+                break;
+            }
+            // A step the inner loop left: a zero-length step (changes nothing), a stack of
+            // fewer than two reversals (the virgin curve, or the first reversal's branch whose
+            // target is a mirror point) or a closure down to it (the general rules), or a
+            // step that closes two loops or more (a large jump). All rare where the input
+            // reverses often.
+            let xi = xc[p];
+            if xi != xp {
                 let mut q = Pass {
                     n,
                     xp,
@@ -464,90 +554,21 @@ impl Pass {
                     ..*self
                 };
                 q.load_branch(stk);
-                changes = changes.wrapping_add(usize::from(q.rules(stk, xi, p)));
+                q.rules(stk, xi, p);
                 (n, xp, up) = (q.n, q.xp, q.dir > 0.0);
                 ul = (q.xp - q.xa) * q.inv;
-                (li, lk, lm) = q.anchor(stk);
-                (ta, tb) = reload(n, stk);
-                (u[p], idx[p], kh[p], mm[p]) = (ul, li, lk, lm);
-                continue;
+                j = q.slot(stk, p, kh);
+                (ta, tb) = top_two(n, stk);
             }
-            let rev = rising != up;
-            // Candidate reversal: the previous sample. Its force is deferred for p > 0 (the
-            // placeholder is never read: the index names the in-block sample, and
-            // `end_block` writes the force), so only the input and the index are written;
-            // for p = 0 the force `h_before` was written at the block's start.
-            let cand = &mut stk[n];
-            (cand.x, cand.index) = (xp, before.wrapping_add(p as u64));
-            // in 2..stk.len()
-            let n1 = n.wrapping_add(usize::from(rev));
-            // The target stk[n1 - 2].x: the top's input after a reversal, else the one below.
-            let t = pickf(rev, ta, tb);
-            // (x - target) · s >= 0 with s the direction of the step
-            let closes = (rising & (xi >= t)) | (!rising & (xi <= t));
-            if closes {
-                if n1 < 4 {
-                    // A closure down to the first reversal's branch or onto the virgin
-                    // curve: the general rules.
-                    let mut q = Pass {
-                        n,
-                        xp,
-                        dir: if up { 1.0 } else { -1.0 },
-                        ..*self
-                    };
-                    q.load_branch(stk);
-                    changes = changes.wrapping_add(usize::from(q.rules(stk, xi, p)));
-                    (n, xp, up) = (q.n, q.xp, q.dir > 0.0);
-                    ul = (q.xp - q.xa) * q.inv;
-                    (li, lk, lm) = q.anchor(stk);
-                    (ta, tb) = reload(n, stk);
-                    (u[p], idx[p], kh[p], mm[p]) = (ul, li, lk, lm);
-                    continue;
-                }
-                n = n1.wrapping_sub(2); // >= 2
-                up = rising;
-                xp = xi;
-                changes = changes.wrapping_add(1); // <= BLOCK
-                let below = stk[n.wrapping_sub(2)].x;
-                if (rising & (xi >= below)) | (!rising & (xi <= below)) {
-                    // The step closes further loops (a large jump).
-                    let mut q = Pass {
-                        n,
-                        xp,
-                        dir: if up { 1.0 } else { -1.0 },
-                        ..*self
-                    };
-                    q.more_closures(stk, xi, q.dir);
-                    n = q.n;
-                    ul = (xp - q.xa) * q.inv;
-                    (li, lk, lm) = q.anchor(stk);
-                    (ta, tb) = reload(n, stk);
-                    (u[p], idx[p], kh[p], mm[p]) = (ul, li, lk, lm);
-                    continue;
-                }
-                let top = stk[n.wrapping_sub(1)];
-                (ta, tb) = (top.x, below);
-                ul = (xp - top.x) * inv_lam;
-                (li, lk, lm) = (top.index, top.h, lam);
-                (u[p], idx[p], kh[p], mm[p]) = (ul, li, lk, lm);
-                continue;
-            }
-            // No closure: after a reversal the candidate (the previous sample) is the top.
-            n = n1;
-            changes = changes.wrapping_add(usize::from(rev)); // <= BLOCK
-            tb = pickf(rev, ta, tb);
-            ta = pickf(rev, xp, ta);
-            li = pick(rev, before.wrapping_add(p as u64), li);
-            lk = pickf(rev, h_before, lk);
-            lm = lam;
-            up = rising;
-            xp = xi;
-            ul = (xp - ta) * inv_lam;
-            (u[p], idx[p], kh[p], mm[p]) = (ul, li, lk, lm);
+            (u[p], sl[p]) = (ul, j);
+            p = p.wrapping_add(1);
         }
         (self.n, self.xp, self.dir) = (n, xp, if up { 1.0 } else { -1.0 });
         self.load_branch(stk);
-        changes
+        // The branch changes: where the slot changes (a reversal or a closure always gives a
+        // new one), counted after the loop (a counter in it is one register too many).
+        sl.windows(2)
+            .fold(0_usize, |c, w| c.wrapping_add(usize::from(w[0] != w[1])))
     }
 
     /// After a first closure by input `xi` (direction `s`, already the state's direction and
