@@ -44,7 +44,8 @@ def _noisy_sine(x_noise=0.02, n_per=500, cycles=12, seed=3):
     return d, x
 
 
-def test_the_element_turns_where_the_input_turned_not_where_its_noise_peaked():
+def test_the_element_turns_where_the_input_turned_not_where_its_noise_peaked(monkeypatch):
+    monkeypatch.setattr(_common, "CLIP_TURNS", True)  # (tried, off by default)
     d, x = _noisy_sine()
     sigma = float(d.extra["u_noise"])
     assert sigma > 0
@@ -82,6 +83,7 @@ def _unit(x):
 
 
 def test_a_noise_free_input_or_the_switch_off_leaves_the_input(monkeypatch):
+    monkeypatch.setattr(_common, "CLIP_TURNS", True)
     d, _ = _noisy_sine(x_noise=0.0)
     assert turn_clipped_input(d) is d.u
     monkeypatch.setattr(_common, "CLIP_TURNS", False)

@@ -320,8 +320,15 @@ def smoothed_acceleration(d: Prepared) -> np.ndarray:
     return fixed(d, "smoothed_acceleration", make)
 
 
-#: the element's turning points are taken from the smoothed input (:func:`turn_clipped_input`)
-CLIP_TURNS = True
+#: whether the element's turning points are taken from the smoothed input
+#: (:func:`turn_clipped_input`). Tried and not kept (off): on the rig's plain chain (tuning
+#: seeds 7100000-7100007 of ``benches/eval_velocity_noise.py``) it took the play's lead
+#: over a delay down (delays named ``backlash`` 4/8 -> 1/8) but named none more delays
+#: exactly (2/8 -> 2/8: the delay lost its share of the noise's push as well, and two
+#: delays at 1.02 and 1.1 times their stated bound went unnamed), and a clean record at
+#: ac·A 0.34 and x noise 0.6 % of the range was flagged (a misfit over the rising branch's
+#: middle, T = 100 against a null's 27) that the element on ``d.u`` leaves quiet
+CLIP_TURNS = False
 #: ... cut back by at most this many input-noise RMS (``d.extra["u_noise"]``, the raw
 #: input's): the noise's push (the filtered input peaks 0.3 of it beyond a sine's turn at
 #: 2 % x noise), not a sharp turn of the drive itself, which the smoothing rounds off
