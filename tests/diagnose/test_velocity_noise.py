@@ -53,8 +53,6 @@ def test_the_element_turns_where_the_input_turned_not_where_its_noise_peaked(mon
     assert rev.size >= 10
     clipped = turn_clipped_input(d)
     # the noisy (filtered) input peaks beyond the true turning points, its clipped copy not
-    push = [abs(d.u[r]) - abs(x[r]) for r in rev]
-    half = len(rev)
     mids = np.r_[0, (d.cycles.reversals[:-1] + d.cycles.reversals[1:]) // 2, d.u.size]
     k_of = {int(r): k for k, r in enumerate(d.cycles.reversals)}
     out_raw, out_clip = [], []
@@ -65,7 +63,6 @@ def test_the_element_turns_where_the_input_turned_not_where_its_noise_peaked(mon
         true_ext = float(np.max(s * x[a:b]))
         out_raw.append(float(np.max(s * d.u[a:b])) - true_ext)
         out_clip.append(float(np.max(s * clipped[a:b])) - true_ext)
-    assert half and np.mean(push) > -np.inf  # (every reversal has its stretch)
     assert np.mean(out_raw) > 0.2 * sigma
     assert abs(np.mean(out_clip)) < 0.25 * np.mean(out_raw)
     # only the excursions beyond the turn are cut: elsewhere the element sees the input
