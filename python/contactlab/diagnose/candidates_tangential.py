@@ -63,7 +63,7 @@ from ._filters import savgol_coeffs, savgol_filter
 from ._kept import delayed, span
 from ._signal import Knots, minimize_bounded
 from .effects import ForceContext, ordered, registry
-from .effects.tangential import memo
+from .effects.tangential import memo, turn_clipped_input
 from .effects.tangential import normal_load as _normal_load
 from .effects.tangential.series_compliance import series_backbone
 from .effects.tangential.stick_slip import breakaway, breakaway_force, reversal_anchors
@@ -552,6 +552,10 @@ class TangentialFamily:
         x = ctx.x
         ctx.x0 = p["x0"] if x is not d.u else None
         self._merge(ctx)
+        if ctx.sp is None:  # the element turns where the denoised input turns
+            clipped = turn_clipped_input(d)
+            if clipped is not d.u:
+                ctx.xm = clipped if ctx.xm is d.u else ctx.xm + (clipped - d.u)
         reshaped = staged("element_input")
         for e in reshaped:
             ctx.xm = e.apply(ctx.xm, p, ctx)

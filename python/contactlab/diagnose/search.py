@@ -74,6 +74,11 @@ def _takes_over(
     # area decided the regime) may move it by its own ``max_base_shift``
     limit = max([limit] + [float(getattr(reg[e], "max_base_shift", 0.0)) for e in effects
                            if e in reg])  # fmt: skip
+    # ... and an effect that only ever adds to what the base was read from (a dashpot adds
+    # loop area, which the base fitted without it reads as a stiffer, more curved contact)
+    # may lower it by its own ``max_base_lowering``
+    lower = max([limit] + [float(getattr(reg[e], "max_base_lowering", 0.0)) for e in effects
+                           if e in reg])  # fmt: skip
     anchors = _ANCHORS.get(family.kind, ())
     if regime in ANCHOR_STIFFNESS_REGIMES and family.kind == "tangential" and "ac" in base:
         anchors = ("h0·ac",)
@@ -81,7 +86,7 @@ def _takes_over(
         equivalent["h0·ac"] = equivalent["h0"] * equivalent["ac"]
     for name in anchors:
         b, v = base[name], equivalent[name]
-        if b > 0 and abs(v / b - 1.0) > limit:
+        if b > 0 and (v / b - 1.0 > limit or v / b - 1.0 < -lower):
             return (
                 f"it takes over the base model ({name} from {b:.4g} to {v:.4g}): the base "
                 "is in the wrong regime or the effect is not what the data show"

@@ -318,3 +318,70 @@ def smoothed_acceleration(d: Prepared) -> np.ndarray:
         return savgol_filter(d.udd, w, 3, mode="interp") if w >= 5 else d.udd
 
     return fixed(d, "smoothed_acceleration", make)
+
+
+#: whether the element's turning points are taken from the smoothed input
+#: (:func:`turn_clipped_input`). Tried and not kept (off): on the rig's plain chain (tuning
+#: seeds 7100000-7100007 of ``benches/eval_velocity_noise.py``) it took the play's lead
+#: over a delay down (delays named ``backlash`` 4/8 -> 1/8) but named none more delays
+#: exactly (2/8 -> 2/8: the delay lost its share of the noise's push as well, and two
+#: delays at 1.02 and 1.1 times their stated bound went unnamed), and a clean record at
+#: ac·A 0.34 and x noise 0.6 % of the range was flagged (a misfit over the rising branch's
+#: middle, T = 100 against a null's 27) that the element on ``d.u`` leaves quiet
+CLIP_TURNS = False
+#: ... cut back by at most this many input-noise RMS (``d.extra["u_noise"]``, the raw
+#: input's): the noise's push (the filtered input peaks 0.3 of it beyond a sine's turn at
+#: 2 % x noise), not a sharp turn of the drive itself, which the smoothing rounds off
+CLIP_SIGMAS = 2.0
+
+
+def turn_clipped_input(d: Prepared) -> np.ndarray:
+    """The filtered input ``d.u`` with each excursion beyond the smoothed input's extreme
+    of its turn cut back to that extreme, by at most :data:`CLIP_SIGMAS` input-noise RMS
+    (``d.u`` itself when the input carries no noise or
+    the record was kept at a lower rate), kept per record: what the Masing element runs
+    over, so that its memory turns where the displacement turned, not where its noise
+    peaked.
+
+    A noisy ``x`` peaks beyond its true turning point by about its noise's RMS (the largest
+    of the samples around the turn), so the element fitted to it turns late and runs its
+    next branch shifted, most where the contact is stiffest; a play of that half-width
+    (which stands still over the noise's wiggles at each turn) and a delay both take up
+    that shift, the play more of it. The input smoothed by a local quintic over half of the
+    fastest cycles' period (as :func:`drive_acceleration` smooths ``ẍ``: the drive passes
+    to 4e-4) has no such push. Each turn's stretch runs from halfway (in samples) from the
+    previous reversal to halfway to the next one."""
+
+    def make() -> np.ndarray:
+        u = d.u
+        if not CLIP_TURNS or not float(d.extra.get("u_noise", 0.0) or 0.0) > 0.0:
+            return u
+        if d.extra.get("knots") is not None:
+            return u
+        from ...._filters import savgol_filter
+        from ..._signal import smooth_window
+
+        w = smooth_window(fastest_period(d), DRIVE_FRACTION, 9)
+        w = min(w, u.size - (1 - u.size % 2))
+        if w <= DRIVE_DEGREE + 2:
+            return u
+        xd = savgol_filter(u, w, DRIVE_DEGREE, mode="interp")
+        rev = np.asarray(d.cycles.reversals, int)
+        if rev.size < 2:
+            return u
+        cut = CLIP_SIGMAS * float(d.extra["u_noise"])  # the most a turn is cut back by
+        out = u.copy()
+        mids = np.r_[0, (rev[:-1] + rev[1:]) // 2, u.size]
+        for k in range(rev.size):
+            a, b = int(mids[k]), int(mids[k + 1])
+            if b <= a:
+                continue
+            if bool(d.cycles.is_max[k]):
+                top = max(float(np.max(xd[a:b])), float(np.max(u[a:b])) - cut)
+                np.minimum(out[a:b], top, out=out[a:b])
+            else:
+                bottom = min(float(np.min(xd[a:b])), float(np.min(u[a:b])) + cut)
+                np.maximum(out[a:b], bottom, out=out[a:b])
+        return out
+
+    return fixed(d, "turn_clipped_input", make)
