@@ -323,6 +323,24 @@ class Inertia(EffectModel):
             "start-up from rest tells a mass from a stiffer or softer contact"
         )
 
+    #: whether a mass refused by :meth:`gain_not_its_own` below a plateau is tested against
+    #: the record's own simulated null (:meth:`steady_null`); False restores the start-up
+    #: rule alone (kept for comparison in benches)
+    null_test = True
+
+    def steady_null(self, d, p) -> bool:
+        """Whether a fitted mass (``m > 0``) is judged against the record's
+        own simulated null (``contactlab.diagnose.search._beyond_null``,
+        :func:`contactlab.diagnose.mass_null.linear_term_null`): on a single-frequency
+        drive whose loops reach no flat plateau (``ac·A`` below
+        :data:`STEADY_SEPARABLE_ACA`), where the steady cycles see a mass as the stiffness
+        ``-mω²`` and the base model takes most of it; what it cannot take, and what the
+        input's noise does to the base model alone, the simulated copies show."""
+        if not self.null_test or single_frequency(d) is None or not p.get("m", 0.0) > 0:
+            return False
+        ac = float(p.get("ac", np.nan))
+        return bool(np.isfinite(ac) and ac > 0 and ac * amplitude(d) < STEADY_SEPARABLE_ACA)
+
     def identified_apart(self, d, p) -> bool:
         """Whether the plateaus' tilt identifies the mass where the fit's own error does
         not (``TangentialFamily.identified``): on a single-frequency record whose loops
