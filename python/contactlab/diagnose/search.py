@@ -325,7 +325,9 @@ def _beyond_null(
     stands beyond them, it takes the place of the candidate's gain floors, the
     significance of its held-out gain, its ``gain_not_its_own`` and ``identified`` rules
     (the base model's trade-off with a linear term, and the input noise's bias, are what
-    the copies simulate); the plausibility stays, and the held-out gain must be positive."""
+    the copies simulate); the plausibility stays, and the held-out gain must be positive.
+    The names that stood beyond are kept in ``d.extra["beyond_null"]`` (the effect's
+    ``identified_apart`` reads it in the closing checks)."""
     from .effects import registry
 
     try:
@@ -336,10 +338,17 @@ def _beyond_null(
     size_param = getattr(eff, "size_param", None)
     if hook is None or not size_param or not hook(d, p):
         return None
-    from .mass_null import linear_term_null
+    from .mass_null import MASS_NULL_ALPHA, linear_term_null
 
-    res = linear_term_null(family, current.full.params, current.effects, name, size_param, d, sigma)
-    return res if res is not None and res.beyond else None
+    alpha = float(getattr(eff, "null_alpha", MASS_NULL_ALPHA))
+    res = linear_term_null(
+        family, current.full.params, current.effects, name, size_param, d, sigma, alpha=alpha
+    )
+    if res is None or not res.beyond:
+        return None
+    # the closing checks ask the effect's ``identified_apart`` again (workflow._unfounded)
+    d.extra.setdefault("beyond_null", set()).add(name)
+    return res
 
 
 def gain_by_cycle(
