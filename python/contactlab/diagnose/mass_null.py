@@ -11,10 +11,14 @@ what the record's own null gives (:func:`linear_term_null`): copies of the recor
 from the base model fitted without the candidate, driven by the record's input with its
 noise taken away (:func:`.misfit_null.denoised_input`) plus fresh input noise of the
 record's own spectrum, with output noise at the residual's own level
-(:func:`.misfit_null.output_noise_shape`). On each copy, and on the record, the candidate's
-size is read as the fit would take it, linearised: the residual of the base model projected
-off the base model's Jacobian (weighted as the fit weights the samples) and regressed on the
-candidate's direction (its effect per unit of its size, off the same Jacobian). The record's
+(:func:`.misfit_null.output_noise_shape`). On each copy (its base refitted, ``refit``), and
+on the record, the candidate's size is read as the fit would take it, linearised: the
+residual of the base model projected off the base model's Jacobian (weighted as the fit
+weights the samples) and regressed on the candidate's direction (its effect per unit of its
+size, off the same Jacobian), each copy's direction from its own noisy input (a mass reads
+ẍ of the measured x, whose noise correlates with the force error it makes through the base:
+a clean rig record's size is positive by itself, tuning seed 920000 of
+``benches/eval_inertia_null.py``: 1.7 % of the force amplitude at x noise 1.3 %). The record's
 size must stand beyond the upper prediction bound of the copies' sizes at
 :data:`MASS_NULL_ALPHA` (Student's, as :func:`.misfit_null.calibrated_flag`).
 """
