@@ -207,3 +207,53 @@ def test_the_plateau_tilt_identifies_a_mass_the_fit_trades_with_ac(plateau_pair)
     assert fam.identified("inertia", p, se).startswith("not identifiable")
     assert fam.identified("inertia", p, se, d=dm) is None
     assert fam.identified("inertia", p, se, d=dc).startswith("not identifiable")
+
+
+#: a rig record with no plateau (ac·A 1.15, 2.9 Hz, 19 cycles from rest, x noise 1.2 %): a
+#: mass whose force m ω² A is 7.6 % of the force amplitude (tuning seed 921010 of
+#: ``benches/eval_inertia_null.py``); the start-up rule alone named nothing on it
+LOW = {"fs": 3459.3, "f": 2.869, "cycles": 19, "acA": 1.149, "x_noise": 0.0119,
+       "F_noise": 0.0193, "x_drift": -0.00055, "bits": 15}  # fmt: skip
+#: its clean counterpart with the input-noise bias the null must carry: 20 Hz, ac·A 0.8, x
+#: noise 1.3 % (tuning seed 920000): read against a null whose mass direction ignored the
+#: copies' own input noise, its size stood 6.6 standard deviations out (1.7 % of the force)
+NOISY = {"fs": 2137.5, "f": 20.466, "cycles": 26, "acA": 0.797, "x_noise": 0.0132,
+         "F_noise": 0.0123, "x_drift": -0.0024, "bits": 12}  # fmt: skip
+
+
+def _low_record(fac: dict, effects: dict, seed: int):
+    rec = rig_recording(effects, "tangential", seed=seed, **fac)
+    return contactlab.diagnose((rec.t, rec.channels["x"], rec.channels["F"]), model="tangential")
+
+
+def _null_of(rep):
+    from contactlab.diagnose.candidates_tangential import TangentialFamily
+    from contactlab.diagnose.mass_null import linear_term_null
+
+    base = rep.trials[-1]
+    return linear_term_null(TangentialFamily(), base.full.params, base.effects, "inertia", "m",
+                            rep.prepared, rep.noise_rms)  # fmt: skip
+
+
+def test_a_mass_below_a_plateau_is_named_beyond_its_simulated_null():
+    """No plateau, so the start-up rule alone refused it (and its held-out gain lay below the
+    floors); against copies of the record simulated from its base model with its own noise
+    on both channels its size stands far out."""
+    A = LOW["acA"] / AC
+    m = 0.076 * H0 * (1 - np.exp(-LOW["acA"])) / (A * (2 * np.pi * LOW["f"]) ** 2)
+    rep = _low_record(LOW, {"inertia": {"m": m}}, 921027)
+    assert rep.effect_names == ["inertia"]
+    assert 0.2 * m < rep.effects[0].parameters["m"] < 1.5 * m
+
+
+def test_the_mass_null_carries_the_input_noise_bias_of_a_clean_record():
+    """ẍ of a noisy x correlates with the force error the same noise makes through the base
+    model: a clean record's mass size is positive, and the null's copies (each its own ẍ)
+    carry that bias, so it does not stand beyond them."""
+    rep = _low_record(NOISY, {}, 920017)
+    assert rep.effect_names == []
+    res = _null_of(rep)
+    assert res is not None and not res.beyond
+    sd = float(np.std(res.null, ddof=1))
+    assert res.size > 2 * sd  # the bias itself, far from 0 ...
+    assert abs(res.size - float(np.mean(res.null))) < 2.5 * sd  # ... and in the null

@@ -239,7 +239,14 @@ def _try_candidate(
             return _not_fitted(name, exc), None
     in_gain = (current.full.mse - full.mse) / sigma**2
     floor = own_gain_floor(family, (*also, name), min_gain)
-    if in_gain < floor:
+    # a mass on one drive frequency with no plateau: its size against the record's own
+    # simulated null stands in for the floors, the significance and the start-up rule
+    beyond = (
+        _beyond_null(family, name, d, current, full.params, sigma)
+        if not also and in_gain > 0
+        else None
+    )
+    if in_gain < floor and beyond is None:
         reason = f"in-sample gain {in_gain:.3g} σ² below {floor:g} σ²"
         return Verdict(name, np.nan, float(in_gain), np.nan, np.nan, False, reason), None
     try:
@@ -255,6 +262,8 @@ def _try_candidate(
     prop = d if _proportional(family, (*also, name)) else None
     rs = relative_gain_scale(family, (*also, name))
     v = judge(name, current, cand, sigma, z, floor + extra, prop, rel_scale=rs)
+    if beyond is not None and not v.accepted and v.gain > 0:
+        v = dataclasses.replace(v, accepted=True, reason="accepted")
     # every effect of the candidate model, not only the new one: a refit can push an
     # effect added before to the edge of its physical range
     why = next(
@@ -268,16 +277,22 @@ def _try_candidate(
     if v.accepted:
         # an effect whose held-out gain counts as its evidence only where it lies (a mass on
         # a single-frequency drive with no plateau: in the start-up, not the steady cycles)
-        unsep = next((w for e in (*also, name) if (w := _gain_not_its_own(family, e, d,
-                      current, cand))), None)  # fmt: skip
+        unsep = None
+        if beyond is None:
+            unsep = next((w for e in (*also, name) if (w := _gain_not_its_own(family, e, d,
+                          current, cand))), None)  # fmt: skip
         if unsep:
             v = dataclasses.replace(v, accepted=False, reason=unsep)
     if v.accepted and hasattr(family, "identified"):
         # each new effect's size must stand out of its own error (issue 29: a held-out gain
-        # the effect shares with a base parameter it trades off with is not its own)
+        # the effect shares with a base parameter it trades off with is not its own); one
+        # whose size stood beyond its simulated null (:func:`_beyond_null`) has been judged
+        # against the trade-off itself
         se = cand.full.stderr
-        unid = next((w for e in (*also, name) if (w := family.identified(e, p, se, d=d))),
-                    None)  # fmt: skip
+        unid = None
+        if beyond is None:
+            unid = next((w for e in (*also, name) if (w := family.identified(e, p, se, d=d))),
+                        None)  # fmt: skip
         if unid:
             v = dataclasses.replace(v, accepted=False, reason=unid)
     return v, cand
@@ -300,6 +315,45 @@ def _gain_not_its_own(
     if hook is None:
         return None
     return hook(d, cand.full.params, gain_by_cycle(d, current, cand))
+
+
+def _beyond_null(
+    family: Family, name: str, d: Prepared, current: Trial, p: dict[str, float], sigma: float
+) -> Any:
+    """The effect ``name``'s test against the record's own simulated null where it applies
+    and its size stands beyond it (a :class:`~contactlab.diagnose.mass_null.LinearNull`),
+    else None. It applies where the effect's ``steady_null(d, p)`` says so (``p``: the
+    candidate model fitted to all data; a mass on one drive frequency with no plateau):
+    its size, linearised on the base model ``current``, is compared with its sizes on
+    copies of the record simulated from that base model with the record's own noise on
+    both channels (:func:`~contactlab.diagnose.mass_null.linear_term_null`). Where it
+    stands beyond them, it takes the place of the candidate's gain floors, the
+    significance of its held-out gain, its ``gain_not_its_own`` and ``identified`` rules
+    (the base model's trade-off with a linear term, and the input noise's bias, are what
+    the copies simulate); the plausibility stays, and the held-out gain must be positive.
+    The names that stood beyond are kept in ``d.extra["beyond_null"]`` (the effect's
+    ``identified_apart`` reads it in the closing checks)."""
+    from .effects import registry
+
+    try:
+        eff = registry(family.kind).get(name)
+    except KeyError:
+        return None
+    hook = getattr(eff, "steady_null", None)
+    size_param = getattr(eff, "size_param", None)
+    if hook is None or not size_param or not hook(d, p):
+        return None
+    from .mass_null import MASS_NULL_ALPHA, linear_term_null
+
+    alpha = float(getattr(eff, "null_alpha", MASS_NULL_ALPHA))
+    res = linear_term_null(
+        family, current.full.params, current.effects, name, size_param, d, sigma, alpha=alpha
+    )
+    if res is None or not res.beyond:
+        return None
+    # the closing checks ask the effect's ``identified_apart`` again (workflow._unfounded)
+    d.extra.setdefault("beyond_null", set()).add(name)
+    return res
 
 
 def gain_by_cycle(

@@ -323,6 +323,26 @@ class Inertia(EffectModel):
             "start-up from rest tells a mass from a stiffer or softer contact"
         )
 
+    #: whether a mass refused by :meth:`gain_not_its_own` below a plateau is tested against
+    #: the record's own simulated null (:meth:`steady_null`); False restores the start-up
+    #: rule alone (kept for comparison in benches)
+    null_test = True
+    #: the one-sided false-alarm rate of that test against the record's copies
+    null_alpha = 0.01
+
+    def steady_null(self, d, p) -> bool:
+        """Whether a fitted mass (``m > 0``) is judged against the record's
+        own simulated null (``contactlab.diagnose.search._beyond_null``,
+        :func:`contactlab.diagnose.mass_null.linear_term_null`): on a single-frequency
+        drive whose loops reach no flat plateau (``ac·A`` below
+        :data:`STEADY_SEPARABLE_ACA`), where the steady cycles see a mass as the stiffness
+        ``-mω²`` and the base model takes most of it; what it cannot take, and what the
+        input's noise does to the base model alone, the simulated copies show."""
+        if not self.null_test or single_frequency(d) is None or not p.get("m", 0.0) > 0:
+            return False
+        ac = float(p.get("ac", np.nan))
+        return bool(np.isfinite(ac) and ac > 0 and ac * amplitude(d) < STEADY_SEPARABLE_ACA)
+
     def identified_apart(self, d, p) -> bool:
         """Whether the plateaus' tilt identifies the mass where the fit's own error does
         not (``TangentialFamily.identified``): on a single-frequency record whose loops
@@ -338,7 +358,9 @@ class Inertia(EffectModel):
         if one is None or not (m > 0 and np.isfinite(ac)):
             return False
         if ac * amplitude(d) < STEADY_SEPARABLE_ACA:
-            return False
+            # below a plateau: where its size stood beyond the record's own simulated null
+            # (:meth:`steady_null`), which judged it against the base's trade-off itself
+            return bool(self.null_test and self.name in d.extra.get("beyond_null", ()))
         return tilt_shows_mass(plateau_tilt(d, ac), m * one[0])
 
     def signal_input(self, d):
@@ -401,13 +423,23 @@ class Inertia(EffectModel):
             where = f"its loops reach no flat plateau (ac·A = {aca:.2g} < {STEADY_SEPARABLE_ACA:g})"
         else:
             where = "the contact's ac is unknown"
-        return (
+        text = (
             "not identifiable: not separable from parallel stiffness on this "
             f"single-frequency record, {where}: no size of a mass can be promised (one "
             "frequency, no harmonics: only the start-up from rest, a change of amplitude or "
             "a plateau's downward slope tells a mass from a stiffness, and here only the "
             "first two could, by an amount no linearised bound foresees)"
         )
+        if self.null_test and np.isfinite(aca) and aca < STEADY_SEPARABLE_ACA:
+            text += (
+                "; a mass is named here only where its size, with the base model's own "
+                "stiffness and curvature free, stands beyond what copies of this record "
+                "simulated from the base model with its own noise on both channels give "
+                f"(one-sided, {100 * self.null_alpha:g} % per record against those copies); "
+                "the part of a mass the base cannot take is a few per cent of it, so no "
+                "size is promised"
+            )
+        return text
 
     def power_note(self, d, p):
         """What a single-frequency drive means for the stated bound (empty otherwise)."""
