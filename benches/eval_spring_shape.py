@@ -9,10 +9,14 @@ Hz (at most fs/20), 5-12 cycles, ac·A 1.6-4.5, x noise 0.8-1.9 % of the range, 
 - ``rational``, ``tanh``, ``exp``: the misfit chain (``benches/misfit_chain.py``), virgin
   curve ``h0 ac s/(1 + ac s)``, ``h0 tanh(ac s)`` or the exponential one (clean);
 - ``spring``: the package's rig (``synthetic.rig``) with a parallel stiffness of
-  ``k_p A`` = 0.10-0.35 of the plateau force; ``rigclean``: the same without it.
+  ``k_p A`` = 0.10-0.35 of the plateau force; ``rigclean``: the same without it;
+- ``series``: the rig with a compliance in series of 0.3-1.0 of the contact's initial
+  one ``1/(h0 ac)`` (the tail check of a named series compliance,
+  :func:`contactlab.diagnose.shape.tail_check`: ``tanh`` records against these).
 
 Each record is diagnosed once by this tree and cached with what its flag step saw; "before"
-is the flag without the slope check's entries (``patches`` with ``"slope"``), "after" the
+is the flag without the slope and tail checks' entries (``patches`` with ``"slope"`` or
+``"tail"``), "after" the
 flag as diagnosed. ``quick`` prints the check's figures on a least-squares fit of the base
 with a spring (no diagnosis): the tuning view. Seeds 100-115 tuned the check (quick);
 report on fresh seeds. One process, ``nice``::
@@ -64,6 +68,9 @@ def record(seed: int, kind: str) -> tuple[Any, dict[str, Any]]:
     a = fac["acA"] / ac
     hm = h0 * (1 - np.exp(-fac["acA"]))
     eff = {} if kind == "rigclean" else {"parallel_stiffness": {"k_p": m * hm / a}}
+    if kind == "series":  # a compliance of 0.3-1.0 of the contact's initial one, 1/(h0 ac)
+        m = float(rng.uniform(0.3, 1.0))
+        eff = {"series_compliance": {"k_s": h0 * ac / m}}
     fac["m"] = m if eff else 0.0
     r = rig_recording(
         eff, "tangential", seed=seed, fs=fac["fs"], f=fac["f"], cycles=fac["cycles"],
@@ -100,8 +107,8 @@ def get(seed: int, kind: str, cache: str) -> dict[str, Any]:
     u = rep.unexplained
     ud = {} if u is None else u.to_dict()
     pats = ud.get("patches") or []
-    slope = [q for q in pats if q.get("slope")]
-    others = bool(ud.get("rivals")) or any(not q.get("slope") for q in pats)
+    slope = [q for q in pats if q.get("slope") or q.get("tail")]
+    others = bool(ud.get("rivals")) or any(not (q.get("slope") or q.get("tail")) for q in pats)
     cal = ud.get("calibrated") or {}
     before = bool(
         u is not None and (others or (cal.get("flagged") if cal else u.statistic > u.threshold))
@@ -109,7 +116,7 @@ def get(seed: int, kind: str, cache: str) -> dict[str, Any]:
     out = {
         "seed": seed, "kind": kind, "cpu": cpu, "named": list(rep.effect_names), "fac": fac,
         "flagged": bool(u is not None and u.flagged), "before": before, "slope": slope,
-        "where": [w for w in rep.where if "slope" in w],
+        "where": [w for w in rep.where if "slope" in w or "tail" in w],
     }  # fmt: skip
     if "args" in cap:
         cap["args"][3].extra.pop("evaluations", None)
@@ -131,6 +138,14 @@ def recompute(o: dict[str, Any]) -> dict[str, Any] | None:
     if "args" not in o:
         return None
     _fam, p, eff, d = o["args"]
+    if "series_compliance" in eff:
+        from contactlab.diagnose.effects.tangential.series_compliance import (
+            plateau_tail,
+            tail_fails,
+        )
+
+        s = plateau_tail(d, float(p["ac"]), float(p["C_s"]), float(p["h0"]))
+        return {**s, "fails": tail_fails(s)}
     if "parallel_stiffness" not in eff:
         return None
     s = plateau_slopes(d, float(p["ac"]))
@@ -151,7 +166,12 @@ def table(pattern: str, cache: str) -> None:
             f = o["fac"]
             s = recompute(o)
             fig = ""
-            if s is not None:
+            if s is not None and "g" in s:
+                fig = (
+                    f" tail g {s['g']:.3g} t {s['t']:.2f} branches {s['branches']} "
+                    f"fails {s['fails']}"
+                )
+            elif s is not None:
                 fig = (
                     f" slopes near {s['k_near']:.3g} far {s['k_far']:.3g} t {s['t']:.2f} "
                     f"branches {s['branches']} fails {s['fails']}"
@@ -165,7 +185,8 @@ def table(pattern: str, cache: str) -> None:
             g[o["kind"]].append(o)
     print(
         "\n| kind | n | named parallel_stiffness | named it alone | flagged before | after "
-        "| nothing named or flagged before | after |\n|---|---|---|---|---|---|---|---|"
+        "| nothing named or flagged before | after | named series_compliance | alone |"
+        "\n|---|---|---|---|---|---|---|---|---|---|"
     )
     for k in sorted(g):
         rr = g[k]
@@ -174,7 +195,9 @@ def table(pattern: str, cache: str) -> None:
             f"{sum(r['named'] == ['parallel_stiffness'] for r in rr)} | "
             f"{sum(r['before'] for r in rr)} | {sum(r['after'] for r in rr)} | "
             f"{sum(not r['named'] and not r['before'] for r in rr)} | "
-            f"{sum(not r['named'] and not r['after'] for r in rr)} |"
+            f"{sum(not r['named'] and not r['after'] for r in rr)} | "
+            f"{sum('series_compliance' in r['named'] for r in rr)} | "
+            f"{sum(r['named'] == ['series_compliance'] for r in rr)} |"
         )
 
 

@@ -223,7 +223,9 @@ class Unexplained:
     #: (:func:`contactlab.diagnose.shape.swap_check`); one with ``"slope"`` true a named
     #: parallel stiffness whose slope falls along the branches
     #: (:func:`contactlab.diagnose.shape.slope_check`: ``k_near``, ``k_far``, ``t``,
-    #: ``branches`` in place of the gains)
+    #: ``branches`` in place of the gains); one with ``"tail"`` true a named series
+    #: compliance whose branches approach their plateau faster than the exponential curve
+    #: (:func:`contactlab.diagnose.shape.tail_check`: ``g``, ``t``, ``branches``)
     patches: tuple[dict[str, Any], ...] | list[dict[str, Any]] = ()
 
     def to_dict(self) -> dict[str, Any]:
@@ -315,6 +317,17 @@ class Unexplained:
                 "bins' own threshold)"
             )
         for p in self.patches:
+            if p.get("tail"):  # a compliance whose branches approach the plateau too fast
+                parts.append(
+                    "the named series_compliance is a patch over the shape of the virgin "
+                    "curve: re-expressed against the contact's own displacement x - C_s·F, "
+                    "the branches approach their plateau faster than the exponential curve's "
+                    f"tail (the faster tail's share {p['g']:.3g} of 2·h0, t = {p['t']:.2g} "
+                    f"over {p['branches']} branches): a virgin curve that saturates faster "
+                    "than the exponential one, e.g. tanh (it stays named: either may be the "
+                    "physics)"
+                )
+                continue
             if p.get("slope"):  # a spring whose slope falls along the branches
                 parts.append(
                     "the named parallel_stiffness is a patch over the shape of the virgin "

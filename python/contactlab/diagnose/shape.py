@@ -356,6 +356,49 @@ def slope_check(
              **{k: s[k] for k in keep}}], None  # fmt: skip
 
 
+def tail_check(
+    effects: tuple[str, ...], d: Prepared, params: dict[str, float]
+) -> tuple[list[dict[str, Any]], str | None]:
+    """A named series compliance whose branches do not approach their plateau as the
+    exponential virgin curve's do (issue 29; tanh_shape).
+
+    A compliance in series keeps the Masing shape in the contact's own displacement
+    ``x - C_s F``; a virgin curve that saturates faster than the exponential one (a
+    ``tanh``, whose approach goes as ``exp(-2 ac s)`` against ``exp(-ac s)``) is taken up by
+    a compliance alone. Re-expressed against ``x - C_s F`` with the named ``C_s``, each
+    steady branch's approach is regressed on the exponential curve's tail and the faster
+    one (:func:`~.effects.tangential.series_compliance.plateau_tail`); where the faster
+    one's share stands significantly above zero across the branches
+    (:func:`~.effects.tangential.series_compliance.tail_fails`), the compliance is a patch
+    over the shape of the virgin curve: returned as a patch entry (``effects``,
+    ``params_effects``, ``tail`` true, ``g``, ``t``, ``branches``). The second value is a
+    sentence where the check has no verdict, else None."""
+    from .effects.tangential.series_compliance import (
+        TAIL_BRANCHES,
+        TAIL_NEAR,
+        plateau_tail,
+        tail_fails,
+    )
+
+    ac = float(params.get("ac", np.nan))
+    if "series_compliance" not in effects or not (np.isfinite(ac) and ac > 0):
+        return [], None
+    s = plateau_tail(d, ac, float(params.get("C_s", 0.0)), float(params.get("h0", np.nan)))
+    fails = tail_fails(s)
+    if fails is None:
+        return [], (
+            "the series compliance's exponential approach to the plateau was not checked: "
+            f"{s['branches']} steady branches hold enough samples beyond ac·|v - v_turn| = "
+            f"{TAIL_NEAR:g} in the contact's own displacement v = x - C_s·F (the farthest "
+            f"reaches {s['reach']:.2g}; {TAIL_BRANCHES} needed), so a virgin curve that "
+            "saturates faster than the exponential one is not told from a compliance here"
+        )
+    if not fails:
+        return [], None
+    return [{"effects": ["series_compliance"], "params_effects": 1, "tail": True,
+             **{k: s[k] for k in ("g", "t", "branches")}}], None  # fmt: skip
+
+
 def patch_share(
     d: Prepared,
     with_set: np.ndarray,

@@ -544,7 +544,7 @@ def _calibrated(b: _Base, d: Prepared, st: SearchState, checks: dict[str, Any]) 
     Returns the closing checks, updated."""
     from .misfit import unexplained_structure
     from .misfit_null import calibrated_flag, simulated_null
-    from .shape import patch_check, slope_check
+    from .shape import patch_check, slope_check, tail_check
 
     u = checks["unexplained"]
     p = dict(st.current.full.params)
@@ -560,9 +560,11 @@ def _calibrated(b: _Base, d: Prepared, st: SearchState, checks: dict[str, Any]) 
     nd = simulated_null(b.family, p, effects, d, r1, float(checks["noise"].output), b.sigma)
     patches = patch_check(b.family, effects, d, p, b.scales, r1, b.sigma)
     slope, unchecked = slope_check(effects, d, p)
-    patches = [*patches, *slope]
-    if unchecked:
-        st.where.append(unchecked)
+    tail, untailed = tail_check(effects, d, p)
+    patches = [*patches, *slope, *tail]
+    for note in (unchecked, untailed):
+        if note:
+            st.where.append(note)
     if nd is None:
         if patches:
             checks["unexplained"] = dataclasses.replace(u, flagged=True, patches=patches)

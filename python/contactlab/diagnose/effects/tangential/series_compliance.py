@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
+import itertools
+from typing import Any
+
 import numpy as np
 
 from ....masing import Masing
 from ..._family import ParamSpec
 from .._base import EffectModel, register
+from ._common import record_turns
 
 _SERIES_POINTS = 400
 
@@ -36,6 +40,80 @@ def straightness(d) -> tuple[float, int] | None:
     if rows is None:
         return None
     return float(np.median(rows[:, 0] / rows[:, 1])), int(rows.shape[0])
+
+
+#: the branches' approach to the plateau (:func:`plateau_tail`): each steady branch read in
+#: the contact's own displacement from TAIL_NEAR/ac past its turning point to TAIL_EDGE of
+#: its stroke before the next turn; at least TAIL_BRANCHES branches must reach that far
+#: with 12 samples or more for a verdict
+TAIL_NEAR, TAIL_EDGE, TAIL_BRANCHES = 0.5, 0.05, 4
+
+#: a named compliance fails the check (:func:`tail_fails`) where the faster tail's share
+#: ``g`` (of ``2 h0``) stands TAIL_T standard errors (of the branches' scatter) above zero
+#: and above TAIL_G. Tuned on diagnoses of ``benches/eval_spring_shape.py`` seeds 300-307
+#: (tanh: misfit chain; series: the rig with a compliance of 0.3-1.0 of the contact's):
+#: the 7 tanh records named series_compliance had g 0.067-0.32, t 5.4-10.1; the 7 genuine
+#: compliances named g 0.002-0.023, t 0.47-2.63 (a first setting, t ≥ 2 alone, flagged
+#: two of them)
+TAIL_T, TAIL_G = 3.0, 0.035
+
+
+def plateau_tail(
+    d: Any, ac: float, C_s: float, h0: float, near: float = TAIL_NEAR
+) -> dict[str, Any]:
+    """The branches' approach to their plateau in the contact's own displacement
+    ``v = x - C_s F``.
+
+    A compliance in series keeps the Masing shape in ``v``: along a steady branch from its
+    turn the force approaches the plateau as ``exp(-ac |v - v_turn| / 2)``. Per branch
+    between two turning points of the filtered input (cycles ≥ 1), the force over the part
+    ``ac·|v - v_turn| ≥ near`` up to :data:`TAIL_EDGE` of the stroke before the next turn is
+    regressed on ``1``, that tail and the faster ``exp(-ac |v - v_turn|)`` (a tanh virgin
+    curve's approach, ``exp(-2 ac_t s)`` against ``exp(-ac_t s)``); ``g`` is the faster
+    tail's coefficient in units of ``2 h0`` towards the plateau. Returns ``g`` (the mean
+    over the branches), ``t`` (its mean over its standard error from the branches' scatter,
+    NaN with fewer than two), ``branches`` and ``reach`` (the steady branches read, the
+    largest ``ac`` times the contact's travel from a turn)."""
+    x, y = np.asarray(d.u, float), np.asarray(d.y, float)
+    out: dict[str, Any] = {"g": float("nan"), "t": float("nan"), "branches": 0, "reach": 0.0}
+    if not (np.isfinite(ac) and ac > 0 and np.isfinite(C_s) and np.isfinite(h0) and h0 > 0):
+        return out
+    v = x - max(C_s, 0.0) * y
+    turns = record_turns(x, float(d.extra.get("u_noise", 0.0) or 0.0))
+    cyc = np.asarray(d.cycles.cycle)
+    gs, reach = [], 0.0
+    for a, b in itertools.pairwise(turns):
+        if cyc[a] < 1:
+            continue
+        dist = np.abs(v[a:b] - v[a])
+        stroke = abs(float(v[b] - v[a]))
+        reach = max(reach, float(ac * (1 - TAIL_EDGE) * stroke))
+        keep = (ac * dist >= near) & (dist <= (1 - TAIL_EDGE) * stroke)
+        keep &= np.isfinite(y[a:b])
+        if np.count_nonzero(keep) < 12:
+            continue
+        dk = dist[keep]
+        sgn = float(np.sign(x[b] - x[a]))
+        X = np.column_stack([np.ones(dk.size), np.exp(-0.5 * ac * dk), np.exp(-ac * dk)])
+        c, *_ = np.linalg.lstsq(X, y[a:b][keep], rcond=None)
+        gs.append(float(-sgn * c[2] / (2 * h0)))
+    out["branches"], out["reach"] = len(gs), reach
+    if len(gs) < 2:
+        return out
+    g = np.asarray(gs)
+    se = float(g.std(ddof=1) / np.sqrt(g.size))
+    out.update(g=float(g.mean()), t=float(g.mean() / se) if se > 0 else float("nan"))
+    return out
+
+
+def tail_fails(s: dict[str, Any]) -> bool | None:
+    """Whether a plateau tail ``s`` (:func:`plateau_tail`) contradicts the compliance: the
+    faster tail's share :data:`TAIL_T` standard errors above zero and above :data:`TAIL_G`;
+    None where fewer than :data:`TAIL_BRANCHES` branches reach the part read (no
+    verdict)."""
+    if s["branches"] < TAIL_BRANCHES or not np.isfinite(s["t"]):
+        return None
+    return bool(s["t"] >= TAIL_T and s["g"] >= TAIL_G)
 
 
 def series_backbone(h0: float, ac: float, C_s: float, x_max: float) -> tuple[np.ndarray, ...]:
