@@ -244,7 +244,14 @@ class CycleTracker:
 class CycleStream:
     def __new__(cls) -> CycleStream: ...
     def push_crossings(
-        self, x: _F, f: _F, drive: _F, offset: int, low: float, high: float
+        self,
+        x: _F,
+        f: _F,
+        drive: _F,
+        offset: int,
+        low: float,
+        high: float,
+        finite: bool = False,
     ) -> npt.NDArray[np.int64]: ...
     def push(
         self, t: _F, x: _F, f: _F, drive: _F, offset: int, low: float, high: float

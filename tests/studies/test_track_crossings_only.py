@@ -39,17 +39,23 @@ def test_crossings_alone_are_the_per_cycle_passes_crossings(seed, cuts, drive_is
     d = x if drive_is_x else np.sin(ph - 0.3)
     t = np.arange(n) * 1e-3
     levels = (-0.3, -0.3 + band)  # band <= 0: no crossing can count
-    full, alone = CycleState(), CycleState()
-    got_full, got_alone = [], []
+    full, alone, known = CycleState(), CycleState(), CycleState()
+    got_full, got_alone, got_known = [], [], []
     edges = [0, *sorted(cuts), n]
     for a, b in itertools.pairwise(edges):
         dd = x[a:b] if drive_is_x else d[a:b]
         c1 = block_cycles(t[a:b], x[a:b], F[a:b], dd, a, full, levels)
         c2 = block_cycles(t[a:b], x[a:b], F[a:b], dd, a, alone, levels, quantities=False)
+        # samples known finite (a checked reader's): the same crossings without the scans
+        c3 = block_cycles(
+            t[a:b], x[a:b], F[a:b], dd, a, known, levels, quantities=False, finite=True
+        )
         got_full.append(c1.crossings)
         got_alone.append(c2.crossings)
+        got_known.append(c3.crossings)
         assert c2.energy.size == c2.start.size == c2.amplitude.size == 0
     np.testing.assert_array_equal(np.concatenate(got_alone), np.concatenate(got_full))
+    np.testing.assert_array_equal(np.concatenate(got_known), np.concatenate(got_full))
 
 
 def test_a_stream_cut_by_its_crossings_gives_no_per_cycle_quantities_later():

@@ -75,6 +75,7 @@ def block_cycles(
     levels: tuple[float, float] | None = None,
     time_step: tuple[float, float] | None = None,
     quantities: bool = True,
+    finite: bool = False,
 ) -> Cycles:
     """Crossings of ``drive`` and the cycles they complete in one block; updates ``s``.
 
@@ -85,7 +86,10 @@ def block_cycles(
     every ``dt`` from ``t0`` (sample ``i`` at ``t0 + dt * i``, bit for bit
     ``contactlab._core.fill_time``) and ``t`` is not read. ``quantities=False``: the
     crossings alone (the same ones; the per-cycle arrays empty), without the chain of
-    additions of ∮ F dx a sample; a state ``s`` is then cut so to the end.
+    additions of ∮ F dx a sample; a state ``s`` is then cut so to the end. ``finite`` (with
+    ``quantities=False``): the caller checked ``x``, ``F`` and ``drive`` finite (a checked
+    reader's block, ``ChunkedRecording.checked``), so the crossings' pass does not scan them
+    again (the same crossings).
     """
     if levels is None:
         lo_d, hi_d = (float(drive.min()), float(drive.max())) if drive.size else (0.0, 0.0)
@@ -93,7 +97,9 @@ def block_cycles(
     else:
         low, high = float(levels[0]), float(levels[1])
     if not quantities:
-        return Cycles(crossings=s.tracker.push_crossings(x, F, drive, int(offset), low, high))
+        return Cycles(
+            crossings=s.tracker.push_crossings(x, F, drive, int(offset), low, high, bool(finite))
+        )
     if time_step is None:
         d = s.tracker.push(t, x, F, drive, int(offset), low, high)
     else:

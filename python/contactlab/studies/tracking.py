@@ -716,6 +716,8 @@ def _track(
                 levels,
                 cr.time_step,
                 quantities=cycles,
+                # (a checked reader refused any non-finite sample: not scanned again)
+                finite=cr.checked,
             )
             for k in cyc:
                 cyc[k].append(np.asarray(getattr(got, k), dtype=float))

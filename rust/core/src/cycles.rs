@@ -57,31 +57,83 @@ pub struct BlockCycles {
     pub offset: Vec<f64>,
 }
 
+/// Samples a block of [`first_beyond`]'s search (its compares are or-ed over a block without
+/// an exit, which vectorises; the block with a hit is searched again sample by sample).
+const SEARCH_BLOCK: usize = 16;
+
+/// The first index of `v` whose value is `<= level` (`ABOVE = false`) or `>= level`
+/// (`ABOVE = true`), `v.len()` when none: `position`'s answer (a NaN is neither), searched by
+/// blocks whose compares are or-ed without an early exit (a loop that exits at the first hit
+/// is compiled one sample at a time).
+// Index arithmetic: base + p < v.len().
+#[allow(clippy::arithmetic_side_effects)]
+#[inline(always)]
+fn first_beyond_generic<const ABOVE: bool>(v: &[f64], level: f64) -> usize {
+    let hit = |d: f64| if ABOVE { d >= level } else { d <= level };
+    let mut chunks = v.chunks_exact(SEARCH_BLOCK);
+    let mut base = 0_usize;
+    for c in &mut chunks {
+        if c.iter().fold(false, |a, &d| a | hit(d)) {
+            return base + c.iter().position(|&d| hit(d)).unwrap_or(SEARCH_BLOCK);
+        }
+        base += SEARCH_BLOCK;
+    }
+    base + chunks
+        .remainder()
+        .iter()
+        .position(|&d| hit(d))
+        .unwrap_or(chunks.remainder().len())
+}
+
+#[inline(always)]
+fn first_at_or_below(v: &[f64], level: f64) -> usize {
+    first_beyond_generic::<false>(v, level)
+}
+
+#[inline(always)]
+fn first_at_or_above(v: &[f64], level: f64) -> usize {
+    first_beyond_generic::<true>(v, level)
+}
+
+crate::simd::dispatch! {
+    /// [`first_beyond_generic`] (`<= level`) compiled for `level_`.
+    fn first_at_or_below_at(v: &[f64], level: f64) -> usize = first_at_or_below;
+}
+
+crate::simd::dispatch! {
+    /// [`first_beyond_generic`] (`>= level`) compiled for `level_`.
+    fn first_at_or_above_at(v: &[f64], level: f64) -> usize = first_at_or_above;
+}
+
 /// The first upward crossing of `drive[from..]` through `[low, high]` (`low < high`) as a
 /// Schmitt trigger with the carried `level`: the drive must have been `<= low` since the last
 /// `>= high`; `drive.len()` when there is none. `level` follows the drive up to the crossing
-/// (to the end without one), as one sample at a time would leave it.
+/// (to the end without one), as one sample at a time would leave it. The scans for the next
+/// sample beyond a level are vectorised ([`first_beyond_generic`]: the same indices as
+/// `position`).
 // Index arithmetic: from <= k <= drive.len() throughout.
 #[allow(clippy::arithmetic_side_effects)]
 fn next_crossing(drive: &[f64], from: usize, low: f64, high: f64, level: &mut i8) -> usize {
     let n = drive.len();
+    let simd = crate::simd::level();
     let mut k = from;
     if *level != -1 {
-        let Some(p) = drive[k..].iter().position(|&d| d <= low) else {
-            if drive[k..].iter().any(|&d| d >= high) {
+        let p = first_at_or_below_at(simd, &drive[k..], low);
+        if k + p >= n {
+            if first_at_or_above_at(simd, &drive[k..], high) < n - k {
                 *level = 1;
             }
             return n;
-        };
+        }
         *level = -1;
         k += p + 1;
     }
-    match drive[k..].iter().position(|&d| d >= high) {
-        Some(p) => {
-            *level = 1;
-            k + p
-        }
-        None => n,
+    let p = first_at_or_above_at(simd, &drive[k..], high);
+    if k + p < n {
+        *level = 1;
+        k + p
+    } else {
+        n
     }
 }
 
@@ -162,8 +214,42 @@ pub fn crossings_block(
     f: &[f64],
     drive: &[f64],
     offset: u64,
+    levels: (f64, f64),
+    state: &mut CycleState,
+) -> Result<Vec<u64>, CoreError> {
+    crossings_block_with(x, f, drive, offset, levels, state, false)
+}
+
+/// [`crossings_block`] of samples the caller has checked finite (a streamed reader's
+/// chunks, each scanned by its range pass): the same crossings and `state.level`, without
+/// the finiteness scans of `x`, `F` and `drive` (two reads of the block of the three the
+/// pass made). The lengths, the levels and the sample count are checked as there; a
+/// non-finite sample only makes the crossings meaningless.
+///
+/// # Errors
+/// As [`crossings_block`], but for the finiteness of the samples.
+pub fn crossings_block_checked(
+    x: &[f64],
+    f: &[f64],
+    drive: &[f64],
+    offset: u64,
+    levels: (f64, f64),
+    state: &mut CycleState,
+) -> Result<Vec<u64>, CoreError> {
+    crossings_block_with(x, f, drive, offset, levels, state, true)
+}
+
+/// [`crossings_block`] (`finite`: the samples are known finite, not scanned).
+// Index arithmetic: c < n where indexed; offset + n checked.
+#[allow(clippy::arithmetic_side_effects)]
+fn crossings_block_with(
+    x: &[f64],
+    f: &[f64],
+    drive: &[f64],
+    offset: u64,
     (low, high): (f64, f64),
     state: &mut CycleState,
+    finite: bool,
 ) -> Result<Vec<u64>, CoreError> {
     let n = x.len();
     check_same_len("x", n, "F", f.len())?;
@@ -174,8 +260,8 @@ pub fn crossings_block(
         .filter(|&end| end <= 1 << 53)
         .ok_or(CoreError::TooLong { len: n })?;
     // vectorised scans (the drive once when it is x); the separate checks name a failure
-    let finite = |v: &[f64]| crate::extrema::finite_min_max(v).0;
-    if !(finite(x) && finite(f) && (std::ptr::eq(drive, x) || finite(drive))) {
+    let is_finite = |v: &[f64]| crate::extrema::finite_min_max(v).0;
+    if !finite && !(is_finite(x) && is_finite(f) && (std::ptr::eq(drive, x) || is_finite(drive))) {
         check_finite("x", x)?;
         check_finite("F", f)?;
         check_finite("drive", drive)?;
@@ -564,6 +650,133 @@ mod tests {
             }
             proptest::prop_assert_eq!(&got, &a.crossings);
             proptest::prop_assert_eq!(st.level, sa.level);
+        }
+    }
+
+    /// `next_crossing` as it was before its scans were vectorised: `position` one sample at
+    /// a time (the reference of the blocked search).
+    fn next_crossing_reference(
+        drive: &[f64],
+        from: usize,
+        low: f64,
+        high: f64,
+        level: &mut i8,
+    ) -> usize {
+        let n = drive.len();
+        let mut k = from;
+        if *level != -1 {
+            let Some(p) = drive[k..].iter().position(|&d| d <= low) else {
+                if drive[k..].iter().any(|&d| d >= high) {
+                    *level = 1;
+                }
+                return n;
+            };
+            *level = -1;
+            k += p + 1;
+        }
+        match drive[k..].iter().position(|&d| d >= high) {
+            Some(p) => {
+                *level = 1;
+                k + p
+            }
+            None => n,
+        }
+    }
+
+    /// The blocked scans find what `position` finds at every SIMD level this CPU has: hits in
+    /// the first, a middle and the last block, in the remainder, none, NaN (neither side),
+    /// constant and short inputs.
+    #[test]
+    fn blocked_scans_are_positions_at_every_level() {
+        let mut cases: Vec<Vec<f64>> = vec![vec![], vec![0.5], vec![0.0; 37], vec![f64::NAN; 40]];
+        let mut seed = 12345_u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((seed >> 11) as f64) / ((1_u64 << 53) as f64)
+        };
+        for n in [1_usize, 15, 16, 17, 31, 32, 33, 100, 257] {
+            for hit in [0, 1, n / 2, n.saturating_sub(1)] {
+                let mut v: Vec<f64> = (0..n).map(|_| 0.2 + 0.5 * next()).collect();
+                if hit < n {
+                    v[hit] = 0.05;
+                }
+                if n > 3 {
+                    v[n / 3] = f64::NAN;
+                }
+                cases.push(v.clone());
+                for d in &mut v {
+                    *d = 1.0 - *d;
+                }
+                cases.push(v);
+            }
+        }
+        for v in &cases {
+            for level in crate::simd::Level::ALL
+                .into_iter()
+                .filter(|l| l.supported())
+            {
+                for lv in [0.1, 0.2, 0.5, 0.9, 0.95, f64::NAN] {
+                    let below = v.iter().position(|&d| d <= lv).unwrap_or(v.len());
+                    let above = v.iter().position(|&d| d >= lv).unwrap_or(v.len());
+                    assert_eq!(first_at_or_below_at(level, v, lv), below, "{level:?} {v:?}");
+                    assert_eq!(first_at_or_above_at(level, v, lv), above, "{level:?} {v:?}");
+                }
+            }
+            for start in [-1_i8, 0, 1] {
+                for from in [0, v.len() / 2, v.len()] {
+                    let (mut a, mut b) = (start, start);
+                    let got = next_crossing(v, from, 0.1, 0.9, &mut a);
+                    let want = next_crossing_reference(v, from, 0.1, 0.9, &mut b);
+                    assert_eq!((got, a), (want, b));
+                }
+            }
+        }
+    }
+
+    proptest::proptest! {
+        /// The crossings of samples known finite (`crossings_block_checked`, the scans left
+        /// out) are `crossings_block`'s over any chunking and band, and the trigger level
+        /// carried the same; the one-sample `next_crossing_reference` finds them too.
+        #[test]
+        fn checked_crossings_are_the_scanned_ones(
+            xs in proptest::collection::vec(-2.0_f64..2.0, 1..700),
+            fs in proptest::collection::vec(-3.0_f64..3.0, 700),
+            low in -1.0_f64..1.0,
+            width in -0.5_f64..1.0,
+            mut cuts in proptest::collection::vec(0_usize..700, 0..6),
+        ) {
+            let n = xs.len();
+            let f = &fs[..n];
+            cuts.sort_unstable();
+            let high = low + width;
+            let (mut sa, mut sb) = (CycleState::default(), CycleState::default());
+            let (mut a, mut b) = (Vec::new(), Vec::new());
+            let mut k = 0;
+            for &e in cuts.iter().chain(std::iter::once(&n)) {
+                let e = e.clamp(k, n);
+                let (xr, fr) = (&xs[k..e], &f[k..e]);
+                a.extend(crossings_block(xr, fr, xr, k as u64, (low, high), &mut sa).unwrap());
+                b.extend(
+                    crossings_block_checked(xr, fr, xr, k as u64, (low, high), &mut sb).unwrap(),
+                );
+                k = e;
+            }
+            proptest::prop_assert_eq!(&a, &b);
+            proptest::prop_assert_eq!(sa.level, sb.level);
+            if high > low {
+                let (mut want, mut level, mut i) = (Vec::new(), 0_i8, 0_usize);
+                while i < n {
+                    let c = next_crossing_reference(&xs, i, low, high, &mut level);
+                    if c >= n {
+                        break;
+                    }
+                    want.push(c as u64);
+                    i = c + 1;
+                }
+                proptest::prop_assert_eq!(&a, &want);
+            }
         }
     }
 

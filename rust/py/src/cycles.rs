@@ -2,7 +2,8 @@
 //! and without a time axis.
 
 use contactlab_core::cycles::{
-    crossings_block, cycle_block, cycle_block_sampled, BlockCycles, CycleState,
+    crossings_block, crossings_block_checked, cycle_block, cycle_block_sampled, BlockCycles,
+    CycleState,
 };
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -111,7 +112,9 @@ impl CycleStream {
 
     /// The upward crossings alone of one block (global sample indices; see
     /// `contactlab_core::cycles::crossings_block`): those `push` finds, without the
-    /// per-cycle quantities. A stream cut by this is cut by it to the end.
+    /// per-cycle quantities. A stream cut by this is cut by it to the end. ``finite``: the
+    /// caller checked the samples finite (`crossings_block_checked`: not scanned again).
+    #[pyo3(signature = (x, f, drive, offset, low, high, finite = false))]
     fn push_crossings<'py>(
         &mut self,
         py: Python<'py>,
@@ -121,12 +124,17 @@ impl CycleStream {
         offset: u64,
         low: f64,
         high: f64,
+        finite: bool,
     ) -> PyResult<Bound<'py, PyArray1<i64>>> {
         let (xs, fs, ds) = (slice(&x, "x")?, slice(&f, "F")?, slice(&drive, "drive")?);
         self.crossings_only = true;
         let state = &mut self.state;
         let c = detach_guarded(py, || {
-            crossings_block(xs, fs, ds, offset, (low, high), state)
+            if finite {
+                crossings_block_checked(xs, fs, ds, offset, (low, high), state)
+            } else {
+                crossings_block(xs, fs, ds, offset, (low, high), state)
+            }
         })?;
         let idx: Vec<i64> = c
             .iter()
