@@ -23,6 +23,41 @@ FAST_SHARE = 0.5
 #: the delay (3.3 at speeds above half the peak), its own fit stuck at τ = 0.40 ms
 #: (``benches/eval_confusions.py --cases delay``, fresh seed 95000)
 NOISE_WIDTH = 2.0
+#: the paired t (across held-out cycles) a play no wider than :data:`NOISE_WIDTH` input-noise
+#: RMS must reach over a channel delay tried at the same step, after its lead is discounted
+#: by the input-noise budget and read away from the turns too
+#: (:meth:`Backlash.yields_to_tried`; the search's default ``z``)
+NOISE_LEAD_Z = 3.0
+
+
+def _cycle_gains(d, current, cand, where=None) -> dict[int, float]:
+    """The held-out gain of ``cand`` over ``current`` per cycle (weighted as the held-out
+    error is; on the samples ``where`` only when given), as
+    :func:`contactlab.diagnose.search.gain_by_cycle` reads it."""
+    from ...select import sample_weight
+
+    r = d.y - current.prediction
+    delta = cand.prediction - current.prediction
+    held = current.heldout & cand.heldout
+    if where is not None:
+        held = held & where
+    g = sample_weight(d) * (2.0 * r * delta - delta * delta)
+    cyc = np.asarray(d.cycles.cycle)
+    return {int(c): float(np.sum(g[held & (cyc == c)])) for c in np.unique(cyc[held])}
+
+
+def paired_t(d, current, a, b, where=None) -> float:
+    """The t statistic of ``a``'s lead over ``b`` across held-out cycles (the mean of the
+    per-cycle differences of their held-out gains over its standard error; nan with fewer
+    than two cycles, ±inf when every cycle gives the same lead)."""
+    ga, gb = _cycle_gains(d, current, a, where), _cycle_gains(d, current, b, where)
+    diff = np.array([ga[c] - gb[c] for c in ga if c in gb])
+    if diff.size < 2:
+        return float("nan")
+    sd, m = float(np.std(diff, ddof=1)), float(np.mean(diff))
+    if not sd > 0:
+        return float("inf") if m > 0 else float("-inf") if m < 0 else 0.0
+    return m / (sd / np.sqrt(diff.size))
 
 
 def play(x: np.ndarray, b: float, rev: np.ndarray) -> np.ndarray:
@@ -161,9 +196,15 @@ class Backlash(EffectModel):
             return None
         rv, rc = rival
         budget = float(d.extra.get("input_noise_budget", 0.0) or 0.0)
+        if (rv.reason or "").startswith(("implausible", "could not be fitted")):
+            return None
+        if budget > 0 and np.isfinite(rv.gain):
+            noise_sized = self.noise_sized_lead(p, v, cand, rv, rc, current, d)
+            if noise_sized:
+                return noise_sized
         if not (budget > 0 and np.isfinite(rv.gain) and rv.gain > 0):
             return None
-        if (rv.reason or "").startswith("implausible") or not v.gain - rv.gain < budget:
+        if not v.gain - rv.gain < budget:
             return None
         from ...select import gain_where
 
@@ -179,6 +220,41 @@ class Backlash(EffectModel):
             "shift and a delay one proportional to the speed, the delay predicts the held-out "
             f"cycles at least as well ({other / own if own > 0 else np.inf:.2f}× the play's "
             "gain there): the dead band is not the data's"
+        )
+
+    def noise_sized_lead(self, p, v, cand, rv, rc, current, d):
+        """Why a play no wider than the input noise pushes the turning points
+        (:meth:`within_noise`) is not named beside a channel delay tried at the same step
+        (``rv``, ``rc``: its verdict and trial), or None: the play's lead over the delay,
+        beyond the input-noise budget the noise alone gives a play (the paired t across
+        held-out cycles scaled by the share of the lead left beyond it) and away from the
+        turns (the paired t on :meth:`unfed_samples`), the smaller of the two, is not
+        significant (at most :data:`NOISE_LEAD_Z`).
+
+        Such a play is what the input's noise draws at every turn, on a clean record as
+        behind a delay: the search had named it and only withheld the delay's bound
+        (``_mark_not_told_apart``). On the rig's plain chain (tuning seeds 8100000-8100003
+        of ``benches/eval_velocity_conf.py --kinds delay``: τ 0.38-0.74 ms, ac·A 1.5-1.8,
+        x noise 1.5-1.9 % of the range) three delays were named plays of 0.45-0.96 input
+        noise RMS whose lead over the delay read t = -4.6, 2.6 and -2.9 that way."""
+        why = self.within_noise(d, p)
+        budget = float(d.extra.get("input_noise_budget", 0.0) or 0.0)
+        if not why or not budget > 0:
+            return None
+        lead = float(v.gain - rv.gain)
+        t = paired_t(d, current, cand, rc)
+        if lead > 0 and np.isfinite(t):
+            t *= 1.0 - budget / lead
+        t_unfed = paired_t(d, current, cand, rc, self.unfed_samples(d))
+        if np.isfinite(t_unfed):
+            t = min(t, t_unfed) if np.isfinite(t) else t_unfed
+        if not (np.isfinite(t) and t <= NOISE_LEAD_Z):
+            return None
+        return (
+            f"{why}; its lead over channel_delay ({lead:.3g} σ² of held-out gain, beyond the "
+            f"{budget:.3g} σ² the input's noise alone can give a play and away from the "
+            f"turns) is not significant across held-out cycles (t = {t:.2f} <= "
+            f"{NOISE_LEAD_Z:g}): the dead band is the noise's"
         )
 
     def not_separable(self, d, p):
