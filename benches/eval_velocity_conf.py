@@ -9,7 +9,8 @@ Butterworth anti-alias filters, a start from rest), at factors where a delay was
   what the diagnosis calls plausible: 2 % of a period or 2 ms);
 - ``stick``: ac·A 0.6-1.0, 35-50 cycles, fs 1 kHz, 10-16 Hz, b 0.04-0.09, d_c 0.1-0.3 A;
 - ``backlash``: ac·A 1.5-4, a play of half-width 1-5 % of A, fs 5 or 10 kHz;
-- ``clean``: ac·A 1-5, fs 5 or 10 kHz.
+- ``clean``: ac·A 1-5, fs 5 or 10 kHz; ``clean_hi``: ac·A 4-4.6, fs 10 kHz (where a clean
+  record was named a play of 1 µm).
 
 x noise 1.5-2 % of the range, F noise 0.8-1.8 % of the force amplitude. Per record: the
 named set, the misfit flag, the bound stated for the true effect, and the held-out gains
@@ -40,6 +41,8 @@ KINDS = {
                  "f": (10.0, 40.0), "cycles": (8, 40)},
     "clean": {"effect": None, "acA": (1.0, 5.0), "fs": (5000.0, 10000.0), "f": (10.0, 40.0),
               "cycles": (8, 40)},
+    "clean_hi": {"effect": None, "acA": (4.0, 4.6), "fs": (10000.0,), "f": (10.0, 40.0),
+                 "cycles": (8, 40)},
 }  # fmt: skip
 
 

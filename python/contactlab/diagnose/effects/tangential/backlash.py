@@ -23,10 +23,16 @@ FAST_SHARE = 0.5
 #: the delay (3.3 at speeds above half the peak), its own fit stuck at τ = 0.40 ms
 #: (``benches/eval_confusions.py --cases delay``, fresh seed 95000)
 NOISE_WIDTH = 2.0
-#: the paired t (across held-out cycles) a play no wider than :data:`NOISE_WIDTH` input-noise
-#: RMS must reach over a channel delay tried at the same step, after its lead is discounted
-#: by the input-noise budget and read away from the turns too
-#: (:meth:`Backlash.yields_to_tried`; the search's default ``z``)
+#: a play no wider than this many input-noise RMS must lead a channel delay tried at the
+#: same step beyond the noise to be named (:meth:`Backlash.noise_sized_lead`): delays of
+#: 0.32-0.89 ms at x noise 1.5-2 % of the range were fitted plays of 0.40-0.96 noise RMS,
+#: a clean record's play 0.33; a genuine play of 1.58 noise RMS (b = 4 % of A), whose lead
+#: over the delay read t = 0.2, was lost at :data:`NOISE_WIDTH` (rig, tuning seeds
+#: 8100000-8100003 and fresh 8200000-8200005, 8300002 of ``benches/eval_velocity_conf.py``)
+NOISE_LEAD_WIDTH = 1.0
+#: the paired t (across held-out cycles) such a play must reach over the delay, after its
+#: lead is discounted by the input-noise budget and read away from the turns too (the
+#: search's default ``z``)
 NOISE_LEAD_Z = 3.0
 
 
@@ -223,8 +229,8 @@ class Backlash(EffectModel):
         )
 
     def noise_sized_lead(self, p, v, cand, rv, rc, current, d):
-        """Why a play no wider than the input noise pushes the turning points
-        (:meth:`within_noise`) is not named beside a channel delay tried at the same step
+        """Why a play no wider than :data:`NOISE_LEAD_WIDTH` input-noise RMS (what the noise
+        alone draws at the turns) is not named beside a channel delay tried at the same step
         (``rv``, ``rc``: its verdict and trial), or None: the play's lead over the delay,
         beyond the input-noise budget the noise alone gives a play (the paired t across
         held-out cycles scaled by the share of the lead left beyond it) and away from the
@@ -237,10 +243,15 @@ class Backlash(EffectModel):
         of ``benches/eval_velocity_conf.py --kinds delay``: τ 0.38-0.74 ms, ac·A 1.5-1.8,
         x noise 1.5-1.9 % of the range) three delays were named plays of 0.45-0.96 input
         noise RMS whose lead over the delay read t = -4.6, 2.6 and -2.9 that way."""
-        why = self.within_noise(d, p)
+        noise = float(d.extra.get("u_noise", 0.0) or 0.0)
+        b = float(p.get("b", 0.0))
         budget = float(d.extra.get("input_noise_budget", 0.0) or 0.0)
-        if not why or not budget > 0:
+        if not (noise > 0 and 0 < b <= NOISE_LEAD_WIDTH * noise and budget > 0):
             return None
+        why = (
+            f"the play's half-width b = {b:.3g} m is {b / noise:.2f} times the input noise's "
+            f"RMS ({noise:.3g} m), within the {NOISE_LEAD_WIDTH:g} the noise draws at each turn"
+        )
         lead = float(v.gain - rv.gain)
         t = paired_t(d, current, cand, rc)
         if lead > 0 and np.isfinite(t):
