@@ -1187,8 +1187,8 @@ def _parsimonious(
     best: tuple[Verdict, Trial] | None, accepted: list[tuple[Verdict, Trial]]
 ) -> tuple[Verdict, Trial] | None:
     """Of the accepted candidates whose held-out gain is within :data:`TIE_SHARE` of the
-    best's, the one with the lowest ``delta_bic`` (``best`` when alone, or when no tied
-    candidate has fewer parameters than it).
+    best's, the one with the fewest parameters, among as many the lowest ``delta_bic``
+    (``best`` when alone, or when no tied candidate has fewer parameters than it).
 
     A viscous term and a normal-load fluctuation at twice the drive frequency draw nearly
     the same force in gross sliding (both the friction's sign times a bump at mid-stroke,
