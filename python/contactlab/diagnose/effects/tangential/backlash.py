@@ -23,6 +23,47 @@ FAST_SHARE = 0.5
 #: the delay (3.3 at speeds above half the peak), its own fit stuck at τ = 0.40 ms
 #: (``benches/eval_confusions.py --cases delay``, fresh seed 95000)
 NOISE_WIDTH = 2.0
+#: a play no wider than this many input-noise RMS must lead a channel delay tried at the
+#: same step beyond the noise to be named (:meth:`Backlash.noise_sized_lead`): delays of
+#: 0.32-0.89 ms at x noise 1.5-2 % of the range were fitted plays of 0.40-0.96 noise RMS,
+#: a clean record's play 0.33; a genuine play of 1.58 noise RMS (b = 4 % of A), whose lead
+#: over the delay read t = 0.2, was lost at :data:`NOISE_WIDTH` (rig, tuning seeds
+#: 8100000-8100003 and fresh 8200000-8200005, 8300002 of ``benches/eval_velocity_conf.py``)
+NOISE_LEAD_WIDTH = 1.0
+#: the paired t (across held-out cycles) such a play must reach over the delay, after its
+#: lead is discounted by the input-noise budget and read away from the turns too (the
+#: search's default ``z``)
+NOISE_LEAD_Z = 3.0
+
+
+def _cycle_gains(d, current, cand, where=None) -> dict[int, float]:
+    """The held-out gain of ``cand`` over ``current`` per cycle (weighted as the held-out
+    error is; on the samples ``where`` only when given), as
+    :func:`contactlab.diagnose.search.gain_by_cycle` reads it."""
+    from ...select import sample_weight
+
+    r = d.y - current.prediction
+    delta = cand.prediction - current.prediction
+    held = current.heldout & cand.heldout
+    if where is not None:
+        held = held & where
+    g = sample_weight(d) * (2.0 * r * delta - delta * delta)
+    cyc = np.asarray(d.cycles.cycle)
+    return {int(c): float(np.sum(g[held & (cyc == c)])) for c in np.unique(cyc[held])}
+
+
+def paired_t(d, current, a, b, where=None) -> float:
+    """The t statistic of ``a``'s lead over ``b`` across held-out cycles (the mean of the
+    per-cycle differences of their held-out gains over its standard error; nan with fewer
+    than two cycles, ±inf when every cycle gives the same lead)."""
+    ga, gb = _cycle_gains(d, current, a, where), _cycle_gains(d, current, b, where)
+    diff = np.array([ga[c] - gb[c] for c in ga if c in gb])
+    if diff.size < 2:
+        return float("nan")
+    sd, m = float(np.std(diff, ddof=1)), float(np.mean(diff))
+    if not sd > 0:
+        return float("inf") if m > 0 else float("-inf") if m < 0 else 0.0
+    return m / (sd / np.sqrt(diff.size))
 
 
 def play(x: np.ndarray, b: float, rev: np.ndarray) -> np.ndarray:
@@ -161,9 +202,15 @@ class Backlash(EffectModel):
             return None
         rv, rc = rival
         budget = float(d.extra.get("input_noise_budget", 0.0) or 0.0)
+        if (rv.reason or "").startswith(("implausible", "could not be fitted")):
+            return None
+        if budget > 0 and np.isfinite(rv.gain):
+            noise_sized = self.noise_sized_lead(p, v, cand, rv, rc, current, d)
+            if noise_sized:
+                return noise_sized
         if not (budget > 0 and np.isfinite(rv.gain) and rv.gain > 0):
             return None
-        if (rv.reason or "").startswith("implausible") or not v.gain - rv.gain < budget:
+        if not v.gain - rv.gain < budget:
             return None
         from ...select import gain_where
 
@@ -179,6 +226,46 @@ class Backlash(EffectModel):
             "shift and a delay one proportional to the speed, the delay predicts the held-out "
             f"cycles at least as well ({other / own if own > 0 else np.inf:.2f}× the play's "
             "gain there): the dead band is not the data's"
+        )
+
+    def noise_sized_lead(self, p, v, cand, rv, rc, current, d):
+        """Why a play no wider than :data:`NOISE_LEAD_WIDTH` input-noise RMS (what the noise
+        alone draws at the turns) is not named beside a channel delay tried at the same step
+        (``rv``, ``rc``: its verdict and trial), or None: the play's lead over the delay,
+        beyond the input-noise budget the noise alone gives a play (the paired t across
+        held-out cycles scaled by the share of the lead left beyond it) and away from the
+        turns (the paired t on :meth:`unfed_samples`), the smaller of the two, is not
+        significant (at most :data:`NOISE_LEAD_Z`).
+
+        Such a play is what the input's noise draws at every turn, on a clean record as
+        behind a delay: the search had named it and only withheld the delay's bound
+        (``_mark_not_told_apart``). On the rig's plain chain (tuning seeds 8100000-8100003
+        of ``benches/eval_velocity_conf.py --kinds delay``: τ 0.38-0.74 ms, ac·A 1.5-1.8,
+        x noise 1.5-1.9 % of the range) three delays were named plays of 0.45-0.96 input
+        noise RMS whose lead over the delay read t = -4.6, 2.6 and -2.9 that way."""
+        noise = float(d.extra.get("u_noise", 0.0) or 0.0)
+        b = float(p.get("b", 0.0))
+        budget = float(d.extra.get("input_noise_budget", 0.0) or 0.0)
+        if not (noise > 0 and 0 < b <= NOISE_LEAD_WIDTH * noise and budget > 0):
+            return None
+        why = (
+            f"the play's half-width b = {b:.3g} m is {b / noise:.2f} times the input noise's "
+            f"RMS ({noise:.3g} m), within the {NOISE_LEAD_WIDTH:g} the noise draws at each turn"
+        )
+        lead = float(v.gain - rv.gain)
+        t = paired_t(d, current, cand, rc)
+        if lead > 0 and np.isfinite(t):
+            t *= 1.0 - budget / lead
+        t_unfed = paired_t(d, current, cand, rc, self.unfed_samples(d))
+        if np.isfinite(t_unfed):
+            t = min(t, t_unfed) if np.isfinite(t) else t_unfed
+        if not (np.isfinite(t) and t <= NOISE_LEAD_Z):
+            return None
+        return (
+            f"{why}; its lead over channel_delay ({lead:.3g} σ² of held-out gain, beyond the "
+            f"{budget:.3g} σ² the input's noise alone can give a play and away from the "
+            f"turns) is not significant across held-out cycles (t = {t:.2f} <= "
+            f"{NOISE_LEAD_Z:g}): the dead band is the noise's"
         )
 
     def not_separable(self, d, p):
