@@ -541,8 +541,94 @@ def detectable_above(
         family, params, effects, name, d, noise, sigma, z, gain_floor, current, folds, seed,
         _setting_cache,
     )  # fmt: skip
-    note = _note(family, name, d, params)
+    note = "; ".join(x for x in (out.note, _note(family, name, d, params)) if x)
     return dataclasses.replace(out, note=note) if note else out
+
+
+def _from_null(
+    family: Family,
+    name: str,
+    d: Prepared,
+    params: dict[str, float],
+    effects: tuple[str, ...],
+    sigma: float,
+    s: ParamSpec,
+    shape: dict[str, float],
+) -> Detectable | None:
+    """The bound of a candidate the diagnosis names by the record's own simulated null
+    (the effect's ``null_power(d, p)``: a mass on one drive frequency below a plateau,
+    :meth:`~.effects.tangential.inertia.Inertia.steady_null`), from that null
+    (:func:`contactlab.diagnose.mass_null.null_bound`); None where the effect is not named
+    that way on this record. The linearised gain rules of :func:`_bound` do not apply there:
+    the search judges such a size against the copies, not by its held-out gain."""
+    from .effects import registry
+    from .mass_null import MASS_NULL_ALPHA, NULL_POWER, null_bound
+
+    eff = registry(getattr(family, "kind", "")).get(name)
+    hook = getattr(eff, "null_power", None)
+    size_param = getattr(eff, "size_param", None)
+    if hook is None or not size_param or size_param != s.name or not hook(d, params):
+        return None
+    alpha = float(getattr(eff, "null_alpha", MASS_NULL_ALPHA))
+    nb = null_bound(family, params, effects, name, size_param, d, sigma, alpha=alpha)
+    how = (
+        f"stated from the record's own simulated null: copies of the record simulated from "
+        f"the base model with its own noise on both channels, the size standing beyond their "
+        f"one-sided {100 * alpha:g} % bound in {100 * NULL_POWER:.0f} % of records"
+    )
+    if nb.bound is None:
+        return Detectable(
+            name,
+            s.name,
+            None,
+            s.unit,
+            s.null,
+            None,
+            shape,
+            reason=f"not identifiable: {nb.reason} ({how})",
+        )
+    b = float(nb.bound) * power_margin(family, name)
+    why = _implausible_at(family, {**params, **shape, s.name: s.null}, name, s, b, d)
+    if why:
+        v, u = _display(b, s.unit)
+        return Detectable(
+            name,
+            s.name,
+            None,
+            s.unit,
+            s.null,
+            None,
+            shape,
+            {s.name: b},
+            reason=(
+                f"not identifiable within its physically plausible range: "
+                f"it would be seen above {v:.2g} {u} ({how}), where the "
+                f"diagnosis refuses it ({why})"
+            ),
+        )
+    p1 = {**params, **shape, s.name: s.null + b}
+    p0 = {**params, **shape, s.name: s.null}
+    trial = (*effects, name)
+    sig = family.predict(p1, trial, d) - family.predict(p0, trial, d)
+    y_rms = float(np.sqrt(np.mean(d.y * d.y))) or 1.0
+    rel = float(np.sqrt(np.mean(sig * sig))) / y_rms
+    if not rel <= LARGEST_RELATIVE:
+        return Detectable(
+            name,
+            s.name,
+            None,
+            s.unit,
+            s.null,
+            None,
+            shape,
+            {s.name: b},
+            reason=(f"not identifiable: beyond {LARGEST_RELATIVE:g}× the output's RMS ({how})"),
+        )
+    note = (
+        f"{how}; a {name} moves the size it is read by {nb.kept:.2g} per unit (the input's "
+        "differentiated noise dilutes the direction)"
+    )
+    return Detectable(name, s.name, b, s.unit, s.null, rel, shape, {s.name: b}, note=note)
 
 
 def _note(family: Family, name: str, d: Prepared, params: dict[str, float]) -> str:
@@ -581,6 +667,9 @@ def _detectable(
     refused = _refusal(family, name, effects, mags, shape)
     if refused is not None:
         return refused
+    from_null = _from_null(family, name, d, params, effects, sigma, mags[0], shape)
+    if from_null is not None:
+        return from_null
     tangential = getattr(family, "kind", "") == "tangential"
     apart = _not_separable(family, name, d, params) or (
         tangential and (_not_told_apart(name, d, effects) or _withdrawn(name, d, effects))
@@ -1131,4 +1220,10 @@ def bounds_for(
         except (ContactLabError, ValueError, FloatingPointError, np.linalg.LinAlgError) as exc:
             spec = family.candidates[n].params[0]
             out.append(Detectable(n, spec.name, None, spec.unit, reason=f"not computable: {exc}"))
+        last = out[-1]
+        if last.detectable_above is None and not last.reason.strip():
+            # never a silent None (issue 29, item 2)
+            out[-1] = dataclasses.replace(last, reason=(
+                "not identifiable: no bound could be stated on this record (no rule of the "
+                "effect gave one)"))  # fmt: skip
     return out

@@ -343,6 +343,16 @@ class Inertia(EffectModel):
         ac = float(p.get("ac", np.nan))
         return bool(np.isfinite(ac) and ac > 0 and ac * amplitude(d) < STEADY_SEPARABLE_ACA)
 
+    def null_power(self, d, p) -> bool:
+        """Whether the stated bound comes from the record's own simulated null
+        (:func:`contactlab.diagnose.mass_null.null_bound`, via
+        ``contactlab.diagnose.power._from_null``): where a mass is named by it
+        (:meth:`steady_null`, whatever the size), one drive frequency and no plateau."""
+        if not self.null_test or single_frequency(d) is None:
+            return False
+        ac = float(p.get("ac", np.nan))
+        return bool(np.isfinite(ac) and ac > 0 and ac * amplitude(d) < STEADY_SEPARABLE_ACA)
+
     def identified_apart(self, d, p) -> bool:
         """Whether the plateaus' tilt identifies the mass where the fit's own error does
         not (``TangentialFamily.identified``): on a single-frequency record whose loops
