@@ -134,3 +134,16 @@ def test_the_bound_solves_the_power_against_the_copies(monkeypatch):
     k_rec[0] = -0.1  # a mass would lower the size: no bound, a reason
     nb = mass_null.null_bound(None, {}, (), "inertia", "m", None, 1.0)
     assert nb.bound is None and "per unit" in nb.reason
+
+
+@pytest.mark.slow
+def test_a_bound_beyond_the_range_says_where_it_lies():
+    """A loss asymmetry on one tone (the rig's normal contact, 12.3 Hz, 20 cycles): its
+    rival, the stiffening law, takes most of its 2ω signature, and the linearised bound
+    lies beyond |a| < 0.95; the reason gives the number instead of a bare "not detectable"."""
+    rec = rig_recording({}, "normal", seed=6900, fs=10000.0, f=12.3, cycles=20, x_noise=0.015,
+                        F_noise=0.011)  # fmt: skip
+    rep = contactlab.diagnose((rec.t, rec.channels["p"], rec.channels["delta"]), model="normal")
+    nd = {x.effect: x for x in rep.not_detected}["asymmetric_branches"]
+    assert nd.detectable_above is None
+    assert "linearised bound |a - 0| = " in nd.reason and "stiffness_nonlinearity" in nd.reason

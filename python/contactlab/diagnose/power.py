@@ -683,16 +683,18 @@ def _detectable(
         slope = model_slope(family, params, d)
         st = _setting(d, current, noise, slope, sigma, z, gain_floor, folds, seed)
     p0 = {**params, **shape, **{s.name: s.null for s in mags}}
-    per, rel, gain = _per_parameter(family, p0, effects, name, mags, d, st)
+    why_none: dict[str, str] = {}
+    per, rel, gain = _per_parameter(family, p0, effects, name, mags, d, st, why_none)
     if any(v is None for v in per.values()):
         worst = next(s for s in mags if per[s.name] is None)
+        detail = why_none.get(worst.name, "")
         return Detectable(
             name, worst.name, None, worst.unit, worst.null, None, shape, per,
             reason=(
                 f"not detectable on this record below an effect of {LARGEST_RELATIVE:g}× "
                 "the output's RMS or within the parameter's range (the current model's "
                 "parameters or a rival candidate absorb it, or the record is too short or "
-                "noisy)"
+                "noisy)" + (f": {detail}" if detail else "")
             ),
         )  # fmt: skip
     worst = max(mags, key=lambda s: rel[s.name] or 0.0)
@@ -856,10 +858,13 @@ def _per_parameter(
     mags: list[ParamSpec],
     d: Prepared,
     st: _Setting,
+    why_none: dict[str, str] | None = None,
 ) -> tuple[dict[str, float | None], dict[str, float | None], dict[str, float | None]]:
     """Per magnitude parameter: the bound, its relative size and the mean held-out gain
     (σ²) expected at it; the candidate's direction with what the current model's parameters
-    absorb of it projected out."""
+    absorb of it projected out. ``why_none`` (filled when given): per parameter without a
+    bound, why, in numbers (issue 29, item 2: no bare "not detectable")."""
+    why_none = {} if why_none is None else why_none
     scales = family.scales(d)
     trial = (*effects, name)
     jb = np.column_stack(
@@ -888,6 +893,7 @@ def _per_parameter(
         j = _derivative(family, p0, trial, ds, s, _step(s, s.null, scales))
         if not np.all(np.isfinite(j)):
             per[s.name] = rel[s.name] = gain[s.name] = None
+            why_none[s.name] = f"its direction (∂y/∂{s.name}) could not be computed"
             continue
         if steady is not None:
             j = np.where(steady, j, 0.0)
@@ -910,10 +916,29 @@ def _per_parameter(
             b = _bound(jp, st, ident, prop)
         if b is not None:
             b *= margin  # the effect's calibration against its own simulations
-        if b is not None and b >= max(s.upper - s.null, s.null - s.lower):
+        left = float(np.sum(st.w * jp * jp) / max(np.sum(st.w * j * j), 1e-300))
+        by = "the current model's parameters"
+        if rivals:
+            by += " and " + ", ".join(getattr(_effect(family, name), "rivals", ()))
+        absorbed = f"{by} take {100 * (1 - min(left, 1.0)):.0f} % of its direction"
+        span = max(s.upper - s.null, s.null - s.lower)
+        if b is None:
+            why_none[s.name] = (
+                f"no size up to {LARGEST_RELATIVE:g}× the output's RMS reaches "
+                f"{100 * POWER:.0f} % power ({absorbed})"
+            )
+        elif b >= span:
+            why_none[s.name] = (
+                f"its linearised bound |{s.name} - {s.null:g}| = {b:.2g} lies beyond the "
+                f"parameter's range ({span:g}; {absorbed})"
+            )
             b = None  # beyond the parameter's range (a loss asymmetry |a| < 1): no bound
         r = None if b is None else b * float(np.sqrt(np.mean(j * j))) / st.y_rms
         if r is not None and r > LARGEST_RELATIVE:
+            why_none[s.name] = (
+                f"its linearised bound {b:.2g} {s.unit} would change the output by "
+                f"{100 * r:.0f} % of its RMS ({absorbed})"
+            )
             b = r = None
         per[s.name], rel[s.name] = b, r
         q = float(np.sum(st.w * jp * jp) / np.sum(st.w)) / st.sigma**2
@@ -1104,6 +1129,16 @@ def _own_floor(family: Family, name: str, d: Prepared, st: _Setting) -> _Setting
     floor = own_gain_floor(family, (name,), mg) + _noise_floor(family, (name,), budget)
     rel = st.rel_floor * relative_gain_scale(family, (name,))
     return dataclasses.replace(st, gain_floor=max(floor, rel), rel_floor=rel)
+
+
+def _effect(family: Family, name: str) -> Any:
+    """The registered effect ``name`` of the family's kind (None when there is none)."""
+    from .effects import registry
+
+    try:
+        return registry(getattr(family, "kind", "")).get(name)
+    except KeyError:
+        return None
 
 
 def power_margin(family: Family, name: str) -> float:
