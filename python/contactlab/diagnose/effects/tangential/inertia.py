@@ -464,4 +464,10 @@ class Inertia(EffectModel):
             "kg, the record sets k_p - mω² only, and the contact's own stiffness absorbs "
             "it in pre-sliding; only the start-up from rest and a sloping plateau in gross "
             "sliding show a mass"
+            + (
+                ", and below a plateau its size against copies of the record simulated "
+                "without it (the bound above)"
+                if self.null_power(d, p)
+                else ""
+            )
         )
