@@ -360,6 +360,11 @@ def null_bound(
                 f"a {name} in the data moves its size along the direction it is read by "
                 f"{kept:.2g} per unit (the input's differentiated noise in that direction): "
                 "no size of it stands out of the record's null"
+            )
+            if np.isfinite(kept)
+            else (
+                f"how far a {name} in the data moves its size could not be read (the "
+                "denoised input's direction is degenerate on this record)"
             ),
         )
     q = t_quantile(power, e.size - 1) * math.sqrt(1.0 + 1.0 / e.size)
