@@ -52,8 +52,8 @@ def clean():
 @pytest.mark.slow
 def test_the_mass_bound_is_stated_in_kg_from_the_simulated_null(clean):
     """The null's own bound lies above the visible mass (0.85 kg): the record could not
-    reveal it; the stated bound (``null_power_margin`` times it) is a size in kg or, beyond a plausible mass,
-    "not identifiable" with that size and the reason."""
+    reveal it; the stated bound (``null_power_margin`` times it) is a size in kg or,
+    beyond a plausible mass, "not identifiable" with that size and the reason."""
     assert clean.effect_names == []
     nb = _null_bound(clean)
     assert nb.bound is not None and nb.bound > _mass(0.081)
