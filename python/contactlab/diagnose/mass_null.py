@@ -37,7 +37,14 @@ from ._filters import savgol_filter
 from ._parallel import one_blas_thread
 from ._signal import derivatives
 
-__all__ = ["MASS_NULL_ALPHA", "MASS_NULL_DRAWS", "LinearNull", "linear_term_null"]
+__all__ = [
+    "MASS_NULL_ALPHA",
+    "MASS_NULL_DRAWS",
+    "LinearNull",
+    "NullBound",
+    "linear_term_null",
+    "null_bound",
+]
 
 #: copies of the record drawn under the null
 MASS_NULL_DRAWS = 24
@@ -66,6 +73,14 @@ class LinearNull:
     threshold: float
     input_rms: float
     output_rms: float
+    #: the linearised size per unit of a candidate in the data, which acts through the true
+    #: input (:func:`linear_term_null`'s ``kept_at``; NaN when not asked): below 1 where the
+    #: direction the size is read along carries the input's differentiated noise (errors in
+    #: variables dilute the regression)
+    kept: float = math.nan
+    #: the same per copy (each copy's own noisy direction; paired with ``null``), empty when
+    #: not asked
+    kept_draws: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(0))
 
     @property
     def beyond(self) -> bool:
@@ -112,6 +127,8 @@ def linear_term_null(
     alpha: float = MASS_NULL_ALPHA,
     seed: int = 0,
     refit: bool = True,
+    kept_at: float | None = None,
+    signal: Any = None,
 ) -> LinearNull | None:
     """The linearised size of candidate ``name`` (parameter ``size_param``, additive and
     linear in it) on the record and on ``draws`` copies simulated from the base model
@@ -120,7 +137,10 @@ def linear_term_null(
     ``sigma``: the diagnosis's noise RMS, the output noise drawn where the residual's own
     level beyond the input's share cannot be read. None where the record carries no
     measured input noise, the model cannot be driven by the simulated input, or too few
-    copies could be drawn."""
+    copies could be drawn. ``kept_at`` (true): also the linearised size per unit of the
+    candidate acting through the denoised input (``LinearNull.kept``, for the bound of
+    :func:`null_bound`); ``draws`` 0 then skips the copies. ``signal``: a map of a record to
+    the one its candidate's direction is read on (default: itself)."""
     from .eiv import _coloured, input_noise_spectrum, is_coloured
     from .misfit_null import (
         _drive,
@@ -152,8 +172,10 @@ def linear_term_null(
         full = (*effects, name)
         p0 = {**base, size_param: 0.0}
         p1 = {**base, size_param: 1.0}
-        g = np.asarray(family.predict(p1, full, d), float) - np.asarray(
-            family.predict(p0, full, d), float
+        sig = (lambda v: v) if signal is None else signal
+        ds = sig(d)
+        g = np.asarray(family.predict(p1, full, ds), float) - np.asarray(
+            family.predict(p0, full, ds), float
         )
         fitted = np.asarray(family.predict(base, effects, d), float)
         J = _jacobian(family, base, effects, d)
@@ -181,7 +203,7 @@ def linear_term_null(
             # ẍ of the measured x, whose noise correlates with the noise the base model
             # turns into force error (errors in variables in the regressor itself)
             ud, udd = derivatives(u_raw, d.dt, d.window)
-            dg = dataclasses.replace(dk, ud=ud, udd=udd, extra={**dk.extra, "fixed": {}})
+            dg = sig(dataclasses.replace(dk, ud=ud, udd=udd, extra={**dk.extra, "fixed": {}}))
             return np.asarray(family.predict(p1, full, dg), float) - np.asarray(
                 family.predict(p0, full, dg), float
             )
@@ -193,6 +215,12 @@ def linear_term_null(
         if d_true is None:
             return None
         truth = np.asarray(family.predict(base, effects, d_true), float)
+        kept, g_true = math.nan, None
+        if kept_at:  # a candidate in the data acts through the true input's derivatives
+            g_true = direction(d_true, x_true)
+            kept = size(g_true, g)
+        if draws <= 0:  # the share alone
+            return LinearNull(m_obs, np.zeros(0), math.nan, 0.0, float(sigma), kept)
         driven = []
         for _ in range(draws):
             u = x_true + _coloured(rng, x_true.size, spec) * su if su > 0 else x_true
@@ -208,7 +236,8 @@ def linear_term_null(
             out_shape, sig_out = _output_beyond_input(
                 d, out_shape, truth, [(dk, mk) for dk, mk, _ in driven], sigma
             )
-        null = []
+        null: list[float] = []
+        per_unit: list[float] = []
         if refit:
             from .select import fit
 
@@ -221,7 +250,152 @@ def linear_term_null(
                 pk = fit(family, effects, dy, every, dict(base), scales).params
                 mk = np.asarray(family.predict(pk, effects, dk), float)
             null.append(size(yk - mk, gk))
+            if g_true is not None:
+                per_unit.append(size(g_true, gk))
     except (ContactLabError, ValueError, ArithmeticError, np.linalg.LinAlgError):
         return None
     v = np.asarray(null, float)
-    return LinearNull(m_obs, v, _upper(v, alpha), su, float(sig_out))
+    ku = np.asarray(per_unit, float)
+    return LinearNull(m_obs, v, _upper(v, alpha), su, float(sig_out), kept, ku)
+
+
+#: the power the null's bound is stated at (as :data:`contactlab.diagnose.power.POWER`)
+NULL_POWER = 0.95
+
+
+@dataclasses.dataclass(frozen=True)
+class NullBound:
+    """The smallest size of a candidate whose linearised size on the record would stand
+    beyond the record's own simulated null with probability :data:`NULL_POWER`.
+
+    Attributes
+    ----------
+    bound : float or None
+        The size (units of the size parameter); None: see ``reason``.
+    null : LinearNull
+        The null it was read from.
+    kept : float
+        The linearised size per unit of the candidate (``LinearNull.kept``).
+    reason : str
+        Why there is no bound (empty otherwise).
+    """
+
+    bound: float | None
+    null: LinearNull | None
+    kept: float
+    reason: str = ""
+
+
+def null_bound(
+    family: Any,
+    base: dict[str, float],
+    effects: tuple[str, ...],
+    name: str,
+    size_param: str,
+    d: Prepared,
+    sigma: float,
+    *,
+    alpha: float = MASS_NULL_ALPHA,
+    power: float = NULL_POWER,
+    seed: int = 0,
+    signal: Any = None,
+) -> NullBound:
+    """The bound of candidate ``name`` from the record's own simulated null
+    (:func:`linear_term_null`, the test the search names it by): its linearised size on a
+    record holding it at size ``b`` is ``e + κ b``, ``e`` a draw of the null and ``κ`` the
+    size per unit of the candidate acting through the denoised input, read along the
+    record's own noisy direction (the input's differentiated noise dilutes the regression:
+    ``κ`` 0.02-0.6 on the rig's single-frequency records; the base's noise-free refit
+    absorbs a mass as its linearisation does, leaving 1.00-1.01 of it). Both are taken per
+    copy (``LinearNull.null`` and ``kept_draws``, paired; the copies' ``κ`` scaled to the
+    record's own where that is smaller), so that ``κ``'s scatter from record to record
+    counts; the bound is the smallest ``b`` whose sizes ``e_k + κ_k b``
+    have their lower ``power`` prediction bound (Student's, over the ``k`` copies) at the
+    null's upper bound ``T``."""
+    from .misfit import t_quantile
+
+    res = linear_term_null(
+        family,
+        base,
+        effects,
+        name,
+        size_param,
+        d,
+        sigma,
+        alpha=alpha,
+        seed=seed,
+        kept_at=True,
+        signal=signal,
+    )
+    if res is None:
+        return NullBound(
+            None,
+            None,
+            math.nan,
+            "the record's null could not be simulated (no "
+            "measured input noise, or the base model cannot be driven by it)",
+        )
+    v = res.null[np.isfinite(res.null)]
+    if v.size < 4 or not np.isfinite(res.threshold):
+        return NullBound(None, res, math.nan, "too few simulated copies of the record")
+    ku = res.kept_draws
+    ok = np.isfinite(res.null) & np.isfinite(ku) if ku.size == res.null.size else []
+    e, ku = res.null[ok], ku[ok]
+    if e.size < 4:
+        return NullBound(None, res, res.kept, "too few simulated copies of the record")
+    # the copies' directions carry the input noise as the null simulates it, which on the
+    # rig dilutes them less than the record's own (a mass moved the record's size by
+    # 0.021-0.59 per kg where its own κ read 0.028-0.58 and the copies' 0.08-0.64: fresh
+    # seeds 6700-6701 of three factor sets): the copies' κ scaled to the record's own,
+    # keeping their scatter
+    kept = min(float(np.mean(ku)), res.kept) if np.isfinite(res.kept) else math.nan
+    if np.isfinite(kept) and kept > 0:
+        ku = ku * (kept / float(np.mean(ku)))
+    if not (np.isfinite(kept) and kept > 0):
+        return NullBound(
+            None,
+            res,
+            kept,
+            (
+                f"a {name} in the data moves its size along the direction it is read by "
+                f"{kept:.2g} per unit (the input's differentiated noise in that direction): "
+                "no size of it stands out of the record's null"
+            )
+            if np.isfinite(kept)
+            else (
+                f"how far a {name} in the data moves its size could not be read (the "
+                "denoised input's direction is degenerate on this record)"
+            ),
+        )
+    q = t_quantile(power, e.size - 1) * math.sqrt(1.0 + 1.0 / e.size)
+
+    def short(b: float) -> float:
+        """How far the lower ``power`` bound of the sizes at ``b`` falls below ``T``."""
+        z = e + ku * b
+        return res.threshold - (float(np.mean(z)) - q * float(np.std(z, ddof=1)))
+
+    hi = max(res.threshold - float(np.mean(e)), 1e-12 * abs(res.threshold), 1e-300) / kept
+    for _ in range(60):
+        if short(hi) <= 0:
+            break
+        hi *= 2.0
+    else:
+        return NullBound(
+            None,
+            res,
+            kept,
+            (
+                f"the {name}'s effect on its size scatters from copy to copy as much as it grows "
+                "(the input's differentiated noise): no size stands out of the record's null"
+            ),
+        )
+    lo = hi / 2.0 if short(hi / 2.0) > 0 else 0.0
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        if short(mid) > 0:
+            lo = mid
+        else:
+            hi = mid
+        if hi - lo < 1e-3 * hi:
+            break
+    return NullBound(float(hi), res, kept)

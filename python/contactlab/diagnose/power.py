@@ -541,8 +541,98 @@ def detectable_above(
         family, params, effects, name, d, noise, sigma, z, gain_floor, current, folds, seed,
         _setting_cache,
     )  # fmt: skip
-    note = _note(family, name, d, params)
+    note = "; ".join(x for x in (out.note, _note(family, name, d, params)) if x)
     return dataclasses.replace(out, note=note) if note else out
+
+
+def _from_null(
+    family: Family,
+    name: str,
+    d: Prepared,
+    params: dict[str, float],
+    effects: tuple[str, ...],
+    sigma: float,
+    s: ParamSpec,
+    shape: dict[str, float],
+) -> Detectable | None:
+    """The bound of a candidate the diagnosis names by the record's own simulated null
+    (the effect's ``null_power(d, p)``: a mass on one drive frequency below a plateau,
+    :meth:`~.effects.tangential.inertia.Inertia.steady_null`), from that null
+    (:func:`contactlab.diagnose.mass_null.null_bound`); None where the effect is not named
+    that way on this record. The linearised gain rules of :func:`_bound` do not apply there:
+    the search judges such a size against the copies, not by its held-out gain."""
+    from .effects import registry
+    from .mass_null import MASS_NULL_ALPHA, NULL_POWER, null_bound
+
+    eff = registry(getattr(family, "kind", "")).get(name)
+    hook = getattr(eff, "null_power", None)
+    size_param = getattr(eff, "size_param", None)
+    if hook is None or not size_param or size_param != s.name or not hook(d, params):
+        return None
+    alpha = float(getattr(eff, "null_alpha", MASS_NULL_ALPHA))
+    nb = null_bound(family, params, effects, name, size_param, d, sigma, alpha=alpha)
+    how = (
+        f"stated from the record's own simulated null: copies of the record simulated from "
+        f"the base model with its own noise on both channels, the size standing beyond their "
+        f"one-sided {100 * alpha:g} % bound in {100 * NULL_POWER:.0f} % of records"
+    )
+    if nb.bound is None:
+        return Detectable(
+            name,
+            s.name,
+            None,
+            s.unit,
+            s.null,
+            None,
+            shape,
+            reason=f"not identifiable: {nb.reason} ({how})",
+        )
+    b = float(nb.bound) * float(getattr(eff, "null_power_margin", 1.0))
+    why = _implausible_at(family, {**params, **shape, s.name: s.null}, name, s, b, d)
+    if why:
+        v, u = _display(b, s.unit)
+        return Detectable(
+            name,
+            s.name,
+            None,
+            s.unit,
+            s.null,
+            None,
+            shape,
+            {s.name: b},
+            reason=(
+                f"not identifiable within its physically plausible range: "
+                f"it would be seen above {v:.2g} {u} ({how}), where the "
+                f"diagnosis refuses it ({why})"
+            ),
+        )
+    p1 = {**params, **shape, s.name: s.null + b}
+    p0 = {**params, **shape, s.name: s.null}
+    trial = (*effects, name)
+    sig = family.predict(p1, trial, d) - family.predict(p0, trial, d)
+    y_rms = float(np.sqrt(np.mean(d.y * d.y))) or 1.0
+    rel = float(np.sqrt(np.mean(sig * sig))) / y_rms
+    if not rel <= LARGEST_RELATIVE:
+        return Detectable(
+            name,
+            s.name,
+            None,
+            s.unit,
+            s.null,
+            None,
+            shape,
+            {s.name: b},
+            reason=(f"not identifiable: beyond {LARGEST_RELATIVE:g}× the output's RMS ({how})"),
+        )
+    note = (
+        f"{how}; a {name} moves the size it is read by {nb.kept:.2g} per unit (the input's "
+        "differentiated noise dilutes the direction); the search also asks the fitted "
+        f"{name} a positive held-out gain, which the bound does not model (on the rig's "
+        "single-frequency records a mass at the null's own bound was named in 11 of 16, at "
+        f"twice it in 5 of 6: the bound is {getattr(eff, 'null_power_margin', 1.0):g} times "
+        "the null's)"
+    )
+    return Detectable(name, s.name, b, s.unit, s.null, rel, shape, {s.name: b}, note=note)
 
 
 def _note(family: Family, name: str, d: Prepared, params: dict[str, float]) -> str:
@@ -581,6 +671,9 @@ def _detectable(
     refused = _refusal(family, name, effects, mags, shape)
     if refused is not None:
         return refused
+    from_null = _from_null(family, name, d, params, effects, sigma, mags[0], shape)
+    if from_null is not None:
+        return from_null
     tangential = getattr(family, "kind", "") == "tangential"
     apart = _not_separable(family, name, d, params) or (
         tangential and (_not_told_apart(name, d, effects) or _withdrawn(name, d, effects))
@@ -594,16 +687,18 @@ def _detectable(
         slope = model_slope(family, params, d)
         st = _setting(d, current, noise, slope, sigma, z, gain_floor, folds, seed)
     p0 = {**params, **shape, **{s.name: s.null for s in mags}}
-    per, rel, gain = _per_parameter(family, p0, effects, name, mags, d, st)
+    why_none: dict[str, str] = {}
+    per, rel, gain = _per_parameter(family, p0, effects, name, mags, d, st, why_none)
     if any(v is None for v in per.values()):
         worst = next(s for s in mags if per[s.name] is None)
+        detail = why_none.get(worst.name, "")
         return Detectable(
             name, worst.name, None, worst.unit, worst.null, None, shape, per,
             reason=(
                 f"not detectable on this record below an effect of {LARGEST_RELATIVE:g}× "
                 "the output's RMS or within the parameter's range (the current model's "
                 "parameters or a rival candidate absorb it, or the record is too short or "
-                "noisy)"
+                "noisy)" + (f": {detail}" if detail else "")
             ),
         )  # fmt: skip
     worst = max(mags, key=lambda s: rel[s.name] or 0.0)
@@ -767,10 +862,13 @@ def _per_parameter(
     mags: list[ParamSpec],
     d: Prepared,
     st: _Setting,
+    why_none: dict[str, str] | None = None,
 ) -> tuple[dict[str, float | None], dict[str, float | None], dict[str, float | None]]:
     """Per magnitude parameter: the bound, its relative size and the mean held-out gain
     (σ²) expected at it; the candidate's direction with what the current model's parameters
-    absorb of it projected out."""
+    absorb of it projected out. ``why_none`` (filled when given): per parameter without a
+    bound, why, in numbers (issue 29, item 2: no bare "not detectable")."""
+    why_none = {} if why_none is None else why_none
     scales = family.scales(d)
     trial = (*effects, name)
     jb = np.column_stack(
@@ -799,6 +897,7 @@ def _per_parameter(
         j = _derivative(family, p0, trial, ds, s, _step(s, s.null, scales))
         if not np.all(np.isfinite(j)):
             per[s.name] = rel[s.name] = gain[s.name] = None
+            why_none[s.name] = f"its direction (∂y/∂{s.name}) could not be computed"
             continue
         if steady is not None:
             j = np.where(steady, j, 0.0)
@@ -821,10 +920,29 @@ def _per_parameter(
             b = _bound(jp, st, ident, prop)
         if b is not None:
             b *= margin  # the effect's calibration against its own simulations
-        if b is not None and b >= max(s.upper - s.null, s.null - s.lower):
+        left = float(np.sum(st.w * jp * jp) / max(np.sum(st.w * j * j), 1e-300))
+        by = "the current model's parameters"
+        if rivals:
+            by += " and " + ", ".join(getattr(_effect(family, name), "rivals", ()))
+        absorbed = f"{by} take {100 * (1 - min(left, 1.0)):.0f} % of its direction"
+        span = max(s.upper - s.null, s.null - s.lower)
+        if b is None:
+            why_none[s.name] = (
+                f"no size up to {LARGEST_RELATIVE:g}× the output's RMS reaches "
+                f"{100 * POWER:.0f} % power ({absorbed})"
+            )
+        elif b >= span:
+            why_none[s.name] = (
+                f"its linearised bound |{s.name} - {s.null:g}| = {b:.2g} lies beyond the "
+                f"parameter's range ({span:g}; {absorbed})"
+            )
             b = None  # beyond the parameter's range (a loss asymmetry |a| < 1): no bound
         r = None if b is None else b * float(np.sqrt(np.mean(j * j))) / st.y_rms
         if r is not None and r > LARGEST_RELATIVE:
+            why_none[s.name] = (
+                f"its linearised bound {b:.2g} {s.unit} would change the output by "
+                f"{100 * r:.0f} % of its RMS ({absorbed})"
+            )
             b = r = None
         per[s.name], rel[s.name] = b, r
         q = float(np.sum(st.w * jp * jp) / np.sum(st.w)) / st.sigma**2
@@ -1017,6 +1135,16 @@ def _own_floor(family: Family, name: str, d: Prepared, st: _Setting) -> _Setting
     return dataclasses.replace(st, gain_floor=max(floor, rel), rel_floor=rel)
 
 
+def _effect(family: Family, name: str) -> Any:
+    """The registered effect ``name`` of the family's kind (None when there is none)."""
+    from .effects import registry
+
+    try:
+        return registry(getattr(family, "kind", "")).get(name)
+    except KeyError:
+        return None
+
+
 def power_margin(family: Family, name: str) -> float:
     """The factor candidate ``name``'s linearised bound is widened by (the effect's
     ``power_margin``, default 1): what the simulations of the effect hidden at its stated
@@ -1131,4 +1259,10 @@ def bounds_for(
         except (ContactLabError, ValueError, FloatingPointError, np.linalg.LinAlgError) as exc:
             spec = family.candidates[n].params[0]
             out.append(Detectable(n, spec.name, None, spec.unit, reason=f"not computable: {exc}"))
+        last = out[-1]
+        if last.detectable_above is None and not last.reason.strip():
+            # never a silent None (issue 29, item 2)
+            out[-1] = dataclasses.replace(last, reason=(
+                "not identifiable: no bound could be stated on this record (no rule of the "
+                "effect gave one)"))  # fmt: skip
     return out

@@ -89,8 +89,10 @@ def plateau_trend(d: Prepared) -> tuple[float, float, int] | None:
         s = d.u[a : b + 1] - d.u[a]
         sign = 1.0 if s[-1] > 0 else -1.0
         sel = sign * s > 0.5 * abs(float(s[-1]))
-        if np.count_nonzero(sel):
-            rows.append((float(np.mean(d.y[a : b + 1][sel])), sign, float(d.t[a] - d.t[0])))
+        level = d.y[a : b + 1][sel]
+        level = level[np.isfinite(level)]
+        if level.size:  # (a stroke whose force is missing says nothing: no "± nan")
+            rows.append((float(np.mean(level)), sign, float(d.t[a] - d.t[0])))
     if len(rows) < 6:
         return None
     lv, sg, tt = (np.asarray(c) for c in zip(*rows, strict=True))
@@ -111,6 +113,8 @@ def drift_verdict(d: Prepared, p: dict[str, float]) -> tuple[bool | None, str]:
     if got is None:
         return None, "too few strokes to follow the plateaus over the record"
     common, se, n = got
+    if not (np.isfinite(common) and np.isfinite(se)):
+        return None, f"the plateaus' common trend over {n} strokes could not be read"
     F1 = float(p["F1"])
     if abs(common - F1) > max(DRIFT_SHARE * abs(F1), DRIFT_SIGMAS * se):
         return False, (
