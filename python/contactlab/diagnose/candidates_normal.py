@@ -463,7 +463,7 @@ def frequency_domain(
 #: by :func:`gain_scale`) passes at ``t > STRONG_GAIN[1]`` instead of ``z``. Calibrated on
 #: clean single-tone chains from rest (``benches/eval_normal_calibrate.py``, see
 #: docs/effects.md §2)
-STRONG_GAIN = (4.0, 2.0)
+STRONG_GAIN = (2.0, 2.0)
 
 
 @dataclass(frozen=True)
