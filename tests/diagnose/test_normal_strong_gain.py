@@ -33,6 +33,12 @@ def test_strong_rule_is_the_normal_familys_only_and_never_above_z():
     assert (factor, zs) == (STRONG_GAIN[0], min(STRONG_GAIN[1], 3.0))
     assert _strong_rule(NormalFamily(), 1.0)[1] == pytest.approx(min(STRONG_GAIN[1], 1.0))
     assert 1.0 < STRONG_GAIN[1] < 3.0 and STRONG_GAIN[0] > 1.0
+    fam = NormalFamily()
+    for name in ("stiffness_nonlinearity", "creep_drift", "asymmetric_branches"):
+        assert _strong_rule(fam, 3.0, (name,)) is not None
+    for name in ("channel_delay", "hysteretic_damping"):  # opted out
+        assert _strong_rule(fam, 3.0, (name,)) is None
+        assert _strong_rule(fam, 3.0, ("creep_drift", name)) is None
 
 
 def _creep_record(creep: bool):
