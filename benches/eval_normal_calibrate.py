@@ -13,9 +13,13 @@ visible size:
 - ``asymmetric_branches``: ``a`` 0.15-0.35, either sign.
 
 For every record it keeps what ``diagnose`` names, whether the misfit is flagged, and the
-verdict on each candidate at the first step (held-out gain in σ², t, ΔBIC, reason), so
-that the rules can be read off one run. Tuning seeds were 45000-45059; fresh report seeds
-46000 on.
+verdict on each candidate at the first step (held-out gain in σ², t, ΔBIC, reason) and
+every verdict of the search's rules (``judged``: gain, floor, t), so that the rules can be
+read off one run. ``--drift``: a bowed drift of the displacement sensor (0.2-2 % of its
+range) on half the chains; ``--small``: creeps of 0.5-5 % and asymmetries of 0.2-0.6;
+``--no-strong``: rule 2 without the normal family's large-gain route (the "before").
+Stop 45 tuned on seeds 45000-45007 and 45100-45116 and reported on 46000 on
+(``benches/results/normal_strong_gain_stop45.md``).
 
     nice .venv/bin/python benches/eval_normal_calibrate.py --seeds 0-19 --base 45000 \
         --out /tmp/cal.json
