@@ -458,6 +458,14 @@ def frequency_domain(
     return np.fft.irfft(P / (k + 1j * w * h + 1j * eta * k * sgn), m)[:n]
 
 
+#: rule 2's large-gain route of the normal family (:func:`.select._strong_pass`): a
+#: held-out gain of at least ``STRONG_GAIN[0]`` times the gain floor (``min_gain`` σ² scaled
+#: by :func:`gain_scale`) passes at ``t > STRONG_GAIN[1]`` instead of ``z``. Calibrated on
+#: clean single-tone chains from rest (``benches/eval_normal_calibrate.py``, see
+#: docs/effects.md §2)
+STRONG_GAIN = (2.0, 2.0)
+
+
 @dataclass(frozen=True)
 class NormalContext:
     """What a normal-contact effect's ``apply`` sees: the record and the family (its
@@ -479,6 +487,8 @@ class NormalFamily:
     #: the model evaluations release the GIL for milliseconds each (the integrator): a fit's
     #: finite-difference columns run on threads (:func:`._parallel.column_map`)
     parallel_jacobian = True
+    #: rule 2's large-gain route (:func:`.select._strong_pass`, :data:`STRONG_GAIN`)
+    strong_gain = STRONG_GAIN
     #: the polish after each fit stops at steps below :data:`.select.POLISH_STOP` standard
     #: errors (its central-difference Jacobians were half of a diagnosis' evaluations)
     quick_polish = True

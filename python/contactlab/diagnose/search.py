@@ -261,7 +261,8 @@ def _try_candidate(
     extra = _noise_floor(family, (*also, name), budget)
     prop = d if _proportional(family, (*also, name)) else None
     rs = relative_gain_scale(family, (*also, name))
-    v = judge(name, current, cand, sigma, z, floor + extra, prop, rel_scale=rs)
+    v = judge(name, current, cand, sigma, z, floor + extra, prop, rel_scale=rs,
+              strong=_strong_rule(family, z, (*also, name)))  # fmt: skip
     if beyond is not None and not v.accepted and v.gain > 0:
         v = dataclasses.replace(v, accepted=True, reason="accepted")
     # every effect of the candidate model, not only the new one: a refit can push an
@@ -424,7 +425,34 @@ def _drop_check(
     prop = d if _proportional(family, (name,)) else None
     floor = own_gain_floor(family, (name,), min_gain)
     rs = relative_gain_scale(family, (name,))
-    return judge(name, reduced, current, sigma, z, floor + extra, prop, rel_scale=rs), reduced
+    verdict = judge(name, reduced, current, sigma, z, floor + extra, prop, rel_scale=rs,
+                    strong=_strong_rule(family, z, (name,)))  # fmt: skip
+    return verdict, reduced
+
+
+def _strong_rule(
+    family: Family, z: float, names: tuple[str, ...] = ()
+) -> tuple[float, float] | None:
+    """Rule 2's large-gain route of the family (its ``strong_gain``: ``(factor, z_strong)``,
+    :func:`contactlab.diagnose.select._strong_pass`) for a candidate adding ``names``, or
+    None: when the family has none, or one of them opts out (an effect's
+    ``large_gain_route`` False: a normal channel delay or hysteretic loss, which on clean
+    single-tone chains reached 2-14 floors at t 1.9-2.5 by the input noise or a sensor
+    drift, refused there only because one tone cannot identify them). ``z_strong`` never
+    above ``z`` (a search run at a lower threshold keeps its own)."""
+    rule = getattr(family, "strong_gain", None)
+    if rule is None:
+        return None
+    from .effects import registry
+
+    try:
+        reg = registry(family.kind)
+    except KeyError:
+        reg = {}
+    if any(not getattr(reg.get(n), "large_gain_route", True) for n in names):
+        return None
+    factor, z_strong = rule
+    return float(factor), float(min(z_strong, z))
 
 
 #: the swap move's threshold on the t statistic of the per-cycle gain (see _swap_search)

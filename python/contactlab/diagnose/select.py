@@ -627,11 +627,14 @@ def judge(
     min_gain: float,
     d: Prepared | None = None,
     rel_scale: float = 1.0,
+    strong: tuple[float, float] | None = None,
 ) -> Verdict:
     """Apply the three acceptance rules of the module docstring (rule 2's proportional
     form when ``d`` is given: the family's ``proportional_gain``; ``rel_scale``: the share
     of rule 4's :data:`MIN_RELATIVE_GAIN` the candidate must reach, its effects'
-    ``relative_gain_scale``, :func:`contactlab.diagnose.search.relative_gain_scale`)."""
+    ``relative_gain_scale``, :func:`contactlab.diagnose.search.relative_gain_scale`;
+    ``strong``: ``(factor, z_strong)``, the family's ``strong_gain``: a held-out gain of at
+    least ``factor`` times ``min_gain`` passes rule 2 at ``t > z_strong``)."""
     # errors in variables: the candidate's held-out errors are compared as if it passed the
     # input noise as the current model does (corrected least squares, :func:`noise_term`)
     # (each held-out error with the noise term of the fold fit that made it)
@@ -656,13 +659,34 @@ def judge(
             f"held-out gain {100 * rel:.2g} % of the remaining error (below "
             f"{100 * rel_floor:.2g} %): a sliver of a larger misfit"
         )
-    elif not t > z:
+    elif not (t > z or _strong_pass(gain, t, min_gain, strong)):
         reason = f"gain not significant across held-out cycles (t = {t:.2f} <= {z:g})"
+        if strong is not None and gain >= strong[0] * min_gain:
+            reason = (
+                f"gain not significant across held-out cycles (t = {t:.2f} <= {strong[1]:g}, "
+                f"the threshold of a gain {strong[0]:g} times the floor)"
+            )
     elif not dbic < 0:
         reason = f"BIC does not decrease (ΔBIC = {dbic:+.1f})"
     else:
         reason = "accepted"
     return Verdict(name, cand.heldout_rms, gain, t, dbic, reason == "accepted", reason)
+
+
+def _strong_pass(
+    gain: float, t: float, min_gain: float, strong: tuple[float, float] | None
+) -> bool:
+    """Rule 2 for a large held-out gain (a family's ``strong_gain``, ``(factor,
+    z_strong)``): the gain is at least ``factor`` times the floor ``min_gain`` and consistent
+    across the held-out cycles at ``t > z_strong``. The per-cycle t has the cycles as its
+    units: on a record of 5-10 cycles, or for an effect whose gain sits in the first cycles
+    by its physics (a creep settling), it stays below ``z`` for gains far above anything
+    the noise draws (normal contact: calibrated on clean records,
+    :data:`contactlab.diagnose.candidates_normal.STRONG_GAIN`)."""
+    if strong is None or not min_gain > 0.0:
+        return False
+    factor, z_strong = strong
+    return bool(gain >= factor * min_gain and t > z_strong)
 
 
 def gain_where(d: Prepared, current: Trial, cand: Trial, where: np.ndarray) -> float:

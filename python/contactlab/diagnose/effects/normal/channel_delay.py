@@ -43,6 +43,8 @@ class NormalChannelDelay(EffectModel):
     stage = "output"
     order = 3
     size_param = "tau"
+    #: not on rule 2's large-gain route (:func:`contactlab.diagnose.search._strong_rule`)
+    large_gain_route = False
 
     def apply(self, delta, p, ctx):
         from ..._signal import shift_cubic

@@ -20,6 +20,8 @@ class HystereticDamping(EffectModel):
     stage = "element"
     order = 1
     size_param = "eta"
+    #: not on rule 2's large-gain route (:func:`contactlab.diagnose.search._strong_rule`)
+    large_gain_route = False
 
     def apply(self, pd, p, ctx):
         return ctx.family.hysteretic(pd, p, ctx.d)
