@@ -64,33 +64,16 @@ class Reversals:
         return int(min(cand)) if cand else 0
 
 
-def _crossing_times(
-    t: np.ndarray | None,
-    x: np.ndarray,
-    i: np.ndarray,
-    level: np.ndarray,
-    time_step: tuple[float, float, int] | None = None,
-) -> np.ndarray:
+def _crossing_times(t: np.ndarray, x: np.ndarray, i: np.ndarray, level: np.ndarray) -> np.ndarray:
     """Times at which ``x`` crosses ``level`` between samples ``i-1`` and ``i`` (linear; the
-    time of sample ``i`` where the two samples are equal, ``t[0]`` for ``i = 0``).
-    ``time_step``: ``(t0, dt, offset)`` of an axis :func:`contactlab._core.fill_time` makes
-    (``t`` then need not be filled yet): its samples computed where they are read, bit for
-    bit (one product and one sum of an exact index)."""
+    time of sample ``i`` where the two samples are equal, ``t[0]`` for ``i = 0``)."""
     i = np.asarray(i, dtype=np.int64)
     ip = np.maximum(i - 1, 0)
     x0, x1 = x[ip], x[i]
     flat = x1 == x0
     a = (level - x0) / np.where(flat, 1.0, x1 - x0)
-    if time_step is None:
-        assert t is not None
-        t_ip, t_i, t_0 = t[ip], t[i], t[0]
-    else:
-        t0, dt, offset = time_step
-        t_ip = t0 + dt * (ip + offset).astype(np.float64)
-        t_i = t0 + dt * (i + offset).astype(np.float64)
-        t_0 = t0 + dt * float(offset)
-    tc = t_ip + np.clip(a, 0.0, 1.0) * (t_i - t_ip)
-    return np.where(i <= 0, t_0, np.where(flat, t_i, tc))
+    tc = t[ip] + np.clip(a, 0.0, 1.0) * (t[i] - t[ip])
+    return np.where(i <= 0, t[0], np.where(flat, t[i], tc))
 
 
 #: above this many samples :func:`tail_percentiles` selects from the tails only
@@ -187,13 +170,10 @@ def _reversals(
     threshold: float | None,
     *,
     finite: bool = False,
-    time_step: tuple[float, float, int] | None = None,
 ) -> Reversals:
     """:func:`find_reversals` of checked float64 ``xa``, ``ta`` whose 0.5 and 99.5
     percentiles (:func:`tail_percentiles`) are ``percentiles``; ``finite``: ``xa`` was
-    scanned finite already (the reversal detector does not scan it again); ``time_step``:
-    ``ta`` is :func:`contactlab._core.fill_time`'s axis of ``(t0, dt, offset)``, not read
-    (it may not be filled yet; :func:`_crossing_times`)."""
+    scanned finite already (the reversal detector does not scan it again)."""
     lo_p, hi_p = percentiles
     centre = 0.5 * (lo_p + hi_p)
     amp = 0.5 * (hi_p - lo_p)
@@ -216,9 +196,9 @@ def _reversals(
     edge[-1] |= not bool(ex.returned[-1])
     up = ex.sign > 0
     level = np.where(up, centre + threshold, centre - threshold)
-    t_in = _crossing_times(ta, xa, ex.start, level, time_step)
+    t_in = _crossing_times(ta, xa, ex.start, level)
     j = np.minimum(ex.last_beyond + 1, xa.size - 1)  # first sample back inside the band
-    t_mid = 0.5 * (t_in + _crossing_times(ta, xa, j, level, time_step))
+    t_mid = 0.5 * (t_in + _crossing_times(ta, xa, j, level))
     peak, valley = ~edge & up, ~edge & ~up
     return Reversals(
         ex.extreme[peak].astype(np.int64),

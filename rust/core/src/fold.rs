@@ -386,119 +386,6 @@ pub fn period_means_pair(
     // leaves room for the compares; the pass read t at memory speed); the separate checks
     // name the first failure, before any of the edges (as they did)
     let (ok, means) = period_means_pair_walk(t, f, x, edges);
-    pair_checks(t, edges, ok)?;
-    Ok(means)
-}
-
-/// [`period_means_pair`] on the axis `t[i] = t0 + dt * (offset + i)` of a sampled window,
-/// which it writes into `t` ([`crate::stream::fill_time`]'s numbers, bit for bit): the axis
-/// is made block by block just ahead of the walk that reads it (in L1), instead of in a pass
-/// of its own over the window before. The walk, the sums, the checks and the errors are
-/// [`period_means_pair`]'s on that axis; `t` holds the whole axis on return (also on an
-/// error of the checks).
-///
-/// # Errors
-/// [`CoreError::TooLong`] where `offset + len` passes 2^53 ([`crate::stream::fill_time`]'s
-/// condition; `t` is then left as it was), else those of [`period_means_pair`].
-// Index arithmetic: as period_means_pair's.
-#[allow(clippy::arithmetic_side_effects)]
-pub fn period_means_pair_uniform_into(
-    (t0, dt, offset): (f64, f64, u64),
-    t: &mut [f64],
-    f: &[f64],
-    x: &[f64],
-    edges: &[f64],
-) -> Result<(Vec<f64>, Vec<f64>), CoreError> {
-    check_same_len("t", t.len(), "v", f.len())?;
-    check_same_len("t", t.len(), "v", x.len())?;
-    if !crate::stream::indices_exact(offset, t.len()) {
-        return Err(CoreError::TooLong { len: t.len() });
-    }
-    if t.len() < 2 {
-        crate::stream::fill_time_in(t, t0, dt, offset);
-        return period_means_pair(t, f, x, edges);
-    }
-    let (ok, means) = period_means_pair_walk_filling((t0, dt, offset), t, f, x, edges);
-    pair_checks(t, edges, ok)?;
-    Ok(means)
-}
-
-/// Samples of the axis [`period_means_pair_uniform_into`] makes at a time (16 KiB: in L1 when
-/// the walk reads them).
-const FILL_BLOCK: usize = 2048;
-
-/// Fill `t` from `*filled` on, a block at a time, until its last filled value is above `e`
-/// (a NaN `e` or axis: one block at most) or all of it is filled: the walk up to `e` then
-/// reads filled samples only (it stops at the first sample not at or below `e`).
-// Index arithmetic: *filled < t.len() where used; offset + t.len() <= 2^53 (checked).
-#[allow(clippy::arithmetic_side_effects)]
-#[inline(always)]
-fn fill_past(t: &mut [f64], filled: &mut usize, (t0, dt, offset): (f64, f64, u64), e: f64) {
-    while *filled < t.len() && (*filled == 0 || t[*filled - 1] <= e) {
-        let b = (*filled + FILL_BLOCK).min(t.len());
-        crate::stream::fill_time_in(&mut t[*filled..b], t0, dt, offset + *filled as u64);
-        *filled = b;
-    }
-}
-
-/// [`period_means_pair_walk`] writing the axis it walks ([`period_means_pair_uniform_into`]):
-/// before each edge the axis is filled past it ([`fill_past`]), then the same steps.
-// Index arithmetic: as period_means_pair_walk's.
-#[allow(clippy::arithmetic_side_effects)]
-fn period_means_pair_walk_filling(
-    axis: (f64, f64, u64),
-    t: &mut [f64],
-    f: &[f64],
-    x: &[f64],
-    edges: &[f64],
-) -> (bool, (Vec<f64>, Vec<f64>)) {
-    let n = t.len();
-    let mut filled = 0_usize;
-    fill_past(t, &mut filled, axis, f64::NEG_INFINITY);
-    let mut ce_f = Vec::with_capacity(edges.len());
-    let mut ce_x = Vec::with_capacity(edges.len());
-    let (mut j, mut cf, mut cx) = (0_usize, 0.0_f64, 0.0_f64);
-    let mut ok = t[0].is_finite();
-    for &e in edges {
-        if e <= t[0] {
-            ce_f.push(0.0);
-            ce_x.push(0.0);
-            continue;
-        }
-        fill_past(t, &mut filled, axis, e);
-        let tr: &[f64] = t;
-        (j, cf, cx, ok) = trapezoids_checked_until(tr, (f, x), j, e, (cf, cx), ok);
-        if j + 1 >= n || e == tr[j] {
-            ce_f.push(cf);
-            ce_x.push(cx);
-        } else {
-            let dt = tr[j + 1] - tr[j];
-            let c1f = cf + 0.5 * (f[j + 1] + f[j]) * dt;
-            let c1x = cx + 0.5 * (x[j + 1] + x[j]) * dt;
-            ce_f.push((c1f - cf) / dt * (e - tr[j]) + cf);
-            ce_x.push((c1x - cx) / dt * (e - tr[j]) + cx);
-        }
-    }
-    // the rest of the axis, then the samples after the last step taken (pair j, j + 1 on)
-    let (t0, dt, offset) = axis;
-    crate::stream::fill_time_in(&mut t[filled..], t0, dt, offset + filled as u64);
-    for w in t[j..].windows(2) {
-        ok &= (w[1] > w[0]) & w[1].is_finite();
-    }
-    let means = |ce: &[f64]| -> Vec<f64> {
-        ce.windows(2)
-            .zip(edges.windows(2))
-            .map(|(c, e)| (c[1] - c[0]) / (e[1] - e[0]))
-            .collect()
-    };
-    (ok, (means(&ce_f), means(&ce_x)))
-}
-
-/// [`period_means_pair`]'s checks after its walk (`ok`: the walk found `t` finite and
-/// strictly increasing): the first failure of `t`, then of `edges`, named.
-// Index arithmetic: 1 <= i < len.
-#[allow(clippy::arithmetic_side_effects)]
-fn pair_checks(t: &[f64], edges: &[f64], ok: bool) -> Result<(), CoreError> {
     if !ok {
         check_finite("t", t)?;
         for i in 1..t.len() {
@@ -523,7 +410,7 @@ fn pair_checks(t: &[f64], edges: &[f64], ok: bool) -> Result<(), CoreError> {
             });
         }
     }
-    Ok(())
+    Ok(means)
 }
 
 /// [`period_means_pair`]'s walk over at least two samples (`f` and `x` as long as `t`):
@@ -681,72 +568,5 @@ mod tests {
                 assert_eq!(format!("{got:?}"), format!("{want:?}"), "{i} {bad}");
             }
         }
-    }
-    #[test]
-    fn period_means_pair_uniform_is_fill_time_then_period_means_pair() {
-        // the axis written as the walk goes is fill_time's, and the means, the checks and
-        // their errors are period_means_pair's on it, bit for bit: windows longer than a
-        // fill block, edges before the axis, inside a block, on a block's border, past the
-        // end, NaN and falling edges, an axis that rounds to repeated stamps (t0 large
-        // against dt) and one that falls (dt < 0), an offset past 2^53
-        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-        let mut rnd = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1_u64 << 53) as f64
-        };
-        let axes = [
-            (0.25, 1e-4, 1_000_u64),
-            (3.0, 0.37, 123_456_789),
-            (1e12, 1e-5, 7),
-            (5.0, -0.01, 0),
-        ];
-        for &n in &[2_usize, 3, 2047, 2048, 2049, 5000, 9001] {
-            let f: Vec<f64> = (0..n).map(|_| rnd() - 0.5).collect();
-            let x: Vec<f64> = (0..n).map(|_| rnd() * 3.0).collect();
-            for &(t0, dt, offset) in &axes {
-                let mut want_t = vec![0.0; n];
-                crate::stream::fill_time(&mut want_t, t0, dt, offset).unwrap();
-                let (lo, hi) = (want_t[0], want_t[n - 1]);
-                let at = |q: f64| lo + q * (hi - lo);
-                let mut sets: Vec<Vec<f64>> = vec![
-                    vec![],
-                    vec![at(0.5)],
-                    vec![lo - 1.0, at(0.1), at(0.6), hi + 1.0],
-                    vec![want_t[n / 2], want_t[(n - 1).min(2048)], at(0.99)],
-                    vec![at(0.2), f64::NAN, at(0.7)],
-                    vec![at(0.7), at(0.2)],
-                ];
-                let mut e: Vec<f64> = (0..50).map(|_| at(rnd() * 1.2 - 0.1)).collect();
-                e.sort_by(f64::total_cmp);
-                sets.push(e);
-                for edges in &sets {
-                    let want = period_means_pair(&want_t, &f, &x, edges);
-                    let mut t = vec![f64::NAN; n];
-                    let got =
-                        period_means_pair_uniform_into((t0, dt, offset), &mut t, &f, &x, edges);
-                    let same_t = t
-                        .iter()
-                        .zip(&want_t)
-                        .all(|(a, b)| a.to_bits() == b.to_bits());
-                    assert!(same_t, "{n} {t0} {dt} {edges:?}");
-                    match (got, want) {
-                        (Ok(g), Ok(w)) => {
-                            let bits =
-                                |v: &[f64]| v.iter().map(|a| a.to_bits()).collect::<Vec<_>>();
-                            assert_eq!(bits(&g.0), bits(&w.0), "{n} {t0} {dt} {edges:?}");
-                            assert_eq!(bits(&g.1), bits(&w.1), "{n} {t0} {dt} {edges:?}");
-                        }
-                        (Err(g), Err(w)) => assert_eq!(format!("{g:?}"), format!("{w:?}")),
-                        (g, w) => panic!("{n} {t0} {dt} {edges:?}: {g:?} against {w:?}"),
-                    }
-                }
-            }
-        }
-        let mut t = [0.0; 4];
-        let v = [0.0; 4];
-        let r = period_means_pair_uniform_into((0.0, 1.0, (1 << 53) - 2), &mut t, &v, &v, &[]);
-        assert!(matches!(r, Err(CoreError::TooLong { len: 4 })));
     }
 }

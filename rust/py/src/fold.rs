@@ -1,10 +1,7 @@
 //! Binding of `contactlab_core::fold`: the phase-bin fold, its spread, and period means.
 
-use contactlab_core::fold::{
-    fold_phase, fold_spread, period_means, period_means_pair, period_means_pair_uniform_into,
-    FoldSums,
-};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadwriteArray1};
+use contactlab_core::fold::{fold_phase, fold_spread, period_means, period_means_pair, FoldSums};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 
 use crate::error::{slice, to_pyerr};
@@ -149,39 +146,11 @@ fn period_means_pair_py<'py>(
     Ok((a.into_pyarray(py), b.into_pyarray(py)))
 }
 
-/// `period_means_pair` of a window whose axis `t0 + dt * (offset + i)` (`fill_time`'s, bit
-/// for bit) it writes into `t` as its walk goes (see
-/// `contactlab_core::fold::period_means_pair_uniform_into`).
-#[pyfunction]
-#[pyo3(name = "period_means_pair_uniform_into")]
-#[allow(clippy::too_many_arguments)]
-fn period_means_pair_uniform_into_py<'py>(
-    py: Python<'py>,
-    t0: f64,
-    dt: f64,
-    offset: u64,
-    mut t: PyReadwriteArray1<'py, f64>,
-    f: PyReadonlyArray1<'py, f64>,
-    x: PyReadonlyArray1<'py, f64>,
-    edges: PyReadonlyArray1<'py, f64>,
-) -> PyResult<(Arr<'py>, Arr<'py>)> {
-    let (fs, xs) = (slice(&f, "F")?, slice(&x, "x")?);
-    let es = slice(&edges, "edges")?;
-    let ts = t
-        .as_slice_mut()
-        .map_err(|_| crate::error::input(py, "t must be a contiguous array"))?;
-    let (a, b) = detach_guarded(py, || {
-        period_means_pair_uniform_into((t0, dt, offset), ts, fs, xs, es)
-    })?;
-    Ok((a.into_pyarray(py), b.into_pyarray(py)))
-}
-
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PhaseFold>()?;
     m.add_class::<FoldSpread>()?;
     m.add_class::<FoldTable>()?;
     m.add_function(wrap_pyfunction!(period_means_py, m)?)?;
     m.add_function(wrap_pyfunction!(period_means_pair_py, m)?)?;
-    m.add_function(wrap_pyfunction!(period_means_pair_uniform_into_py, m)?)?;
     Ok(())
 }
