@@ -735,3 +735,62 @@ fn a_sampled_axis_past_exact_indices_is_refused() {
     );
     assert!(matches!(r, Err(CoreError::TooLong { .. })));
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    /// The fold and the period means of a sampled axis made where read equal, bit for bit,
+    /// those of `fill_time`'s axis read from memory: every output of the fold (no edges),
+    /// the means of both channels (edges before, inside and past the axis), the errors.
+    #[test]
+    fn a_sampled_axis_folds_as_its_filled_axis(
+        seed in 0u64..1000, n in prop::sample::select(vec![5000usize, 40_000, 70_001]),
+        offset in prop::sample::select(vec![0u64, 1, 32_767, 2_000_003, 1 << 40]),
+        axis in 0u8..2, n_cyc in 1usize..4, n_bins in prop::sample::select(vec![8usize, 16, 64]),
+    ) {
+        let (_t, x, f) = signal(n, seed, 1e-3);
+        let (t0, dt) = if axis == 0 { (0.37, 1e-3) } else { (-3.25, 1.0 / 1024.0 + 1e-9) };
+        let mut t = vec![0.0; n];
+        crate::stream::fill_time(&mut t, t0, dt, offset).unwrap();
+        let tm = t[n / 2];
+        let ranks = tail_ranks(n);
+        let (mut of, mut ox) = (vec![0.0; n], vec![0.0; n]);
+        let scan = detrend_pair_scan_into(&t, tm, (&f, 0.1), (&x, 1e-6), (&mut of, &mut ox), &ranks)
+            .unwrap();
+        prop_assert!(scan.clean);
+        let span = t[n - 1] - t[3];
+        let (kt, kp) = knots(&t, span / (n_cyc as f64 + 0.25), n_cyc);
+        let want = fold_window_scanned(&t, &ox, &of, (&kt, &kp), (n_bins, n_cyc), &[], &scan);
+        let ax = UniformAxis::new(t0, dt, offset, n).unwrap();
+        let got = fold_window_scanned_uniform(ax, &ox, &of, (&kt, &kp), (n_bins, n_cyc), &scan);
+        prop_assert_eq!(format!("{got:?}"), format!("{want:?}"));
+        let mut edges: Vec<f64> = kt.iter().step_by(2).copied().collect();
+        edges.insert(0, t[0] - 1.0);
+        edges.push(t[n - 1] + 1.0);
+        let want = crate::fold::period_means_pair(&t, &of, &ox, &edges);
+        let got = crate::fold::period_means_pair_uniform(ax, &of, &ox, &edges);
+        prop_assert_eq!(format!("{got:?}"), format!("{want:?}"));
+        edges.swap(1, 2); // a falling edge: the same error
+        let want = crate::fold::period_means_pair(&t, &of, &ox, &edges);
+        let got = crate::fold::period_means_pair_uniform(ax, &of, &ox, &edges);
+        prop_assert_eq!(format!("{got:?}"), format!("{want:?}"));
+    }
+}
+
+#[test]
+fn a_sampled_axis_that_stops_increasing_is_refused_by_the_period_means_alike() {
+    let n = 300;
+    let (_t, x, f) = signal(n, 3, 1.0);
+    let (t0, dt, offset) = (1e9, 1e-9, 5);
+    let mut t = vec![0.0; n];
+    crate::stream::fill_time(&mut t, t0, dt, offset).unwrap();
+    let edges = [t[10], t[200]];
+    let want = crate::fold::period_means_pair(&t, &f, &x, &edges);
+    let ax = UniformAxis::new(t0, dt, offset, n).unwrap();
+    let got = crate::fold::period_means_pair_uniform(ax, &f, &x, &edges);
+    assert!(want.is_err());
+    assert_eq!(format!("{got:?}"), format!("{want:?}"));
+    assert!(matches!(
+        UniformAxis::new(0.0, 1.0, (1 << 53) - 2, 4),
+        Err(CoreError::TooLong { len: 4 })
+    ));
+}
