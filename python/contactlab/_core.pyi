@@ -163,18 +163,6 @@ def fold_window(
     edges: _F,
     scan: WindowScan | None = None,
 ) -> WindowFold: ...
-def fold_window_uniform(
-    t0: float,
-    dt: float,
-    offset: int,
-    x: _F,
-    f: _F,
-    knot_t: _F,
-    knot_phase: _F,
-    n_bins: int,
-    n_cycles: int,
-    scan: WindowScan,
-) -> WindowFold: ...
 
 @final
 class WindowScan:
@@ -220,9 +208,6 @@ def fit_steady_loop(
 ) -> tuple[list[float], int, int]: ...
 def period_means(t: _F, v: _F, edges: _F) -> _F: ...
 def period_means_pair(t: _F, f: _F, x: _F, edges: _F) -> tuple[_F, _F]: ...
-def period_means_pair_uniform(
-    t0: float, dt: float, offset: int, f: _F, x: _F, edges: _F
-) -> tuple[_F, _F]: ...
 def order_stats(x: _F, ranks: list[int]) -> _F: ...
 def monotone_path(x: _F, edges: npt.NDArray[np.int64]) -> _F: ...
 def detrend_pair(

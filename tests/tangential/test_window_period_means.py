@@ -75,37 +75,3 @@ def test_a_sampled_window_is_detrended_on_its_axis_made_as_it_goes(case):
     assert a.to_dict() == b.to_dict() and a.warnings == b.warnings
     c = analyze_window(rec, period_means=False, time_step=(t0, dt, offset + 1))
     assert c.to_dict() != a.to_dict()
-
-
-@pytest.mark.parametrize("case", sorted(_CASES))
-@pytest.mark.parametrize("detrend", [True, False])
-def test_a_window_left_without_its_axis_fills_it_with_the_same_numbers(case, detrend):
-    """``analyze_window(time_unfilled=True)``: the window's axis (here NaN where a streamed
-    window's is ``numpy.empty``) is made where it is read (the period means, the crossing
-    times, the fold), or filled before its first read (``detrend=False``); every number is
-    that of the window read with its axis (a NaN read would show)."""
-    from contactlab import _core
-
-    src = synthetic_recording(**{**_CASES[case], "fs": 4 * _CASES[case]["fs"]})
-    n = len(src.t)
-    t0, dt, offset = 0.125, 0.25 / _CASES[case]["fs"], 2_000_003
-    t = np.empty(n)
-    _core.fill_time(t, t0, dt, offset)
-    x, F = src["x"], src["F"]
-    exact = {"x": (float(x.min()), float(x.max())), "F": (float(F.min()), float(F.max()))}
-    kw = dict(period_means=False, scanned=exact, time_step=(t0, dt, offset), detrend=detrend)
-    rec = Recording(t, {"x": x, "F": F}, src.units, src.source, {})
-    a = analyze_window(rec, **kw)
-    empty = Recording(np.full(n, np.nan), {"x": x, "F": F}, src.units, src.source, {})
-    b = analyze_window(empty, time_unfilled=True, **kw)
-    assert a.to_dict() == b.to_dict() and a.warnings == b.warnings
-    if detrend:  # never written: nothing read it
-        assert np.all(np.isnan(empty.t))
-    else:
-        np.testing.assert_array_equal(empty.t, t)
-    # the axis made is the one given: a sample later moves the numbers
-    later = Recording(np.full(n, np.nan), {"x": x, "F": F}, src.units, src.source, {})
-    c = analyze_window(later, time_unfilled=True, **{**kw, "time_step": (t0, dt, offset + 1)})
-    assert c.to_dict() != a.to_dict()
-    with pytest.raises(InputError, match="time_step"):
-        analyze_window(rec, period_means=False, time_unfilled=True)

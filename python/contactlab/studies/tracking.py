@@ -116,15 +116,11 @@ class _WindowSamples:
         """The time of sample ``i`` of the window (that of :meth:`recording`'s axis)."""
         return _step_time(self.time_step, self.start + i)
 
-    def recording(self, fill: bool = True) -> Recording:
-        """The window as a :class:`Recording`; ``fill=False``: its ``t`` is left unfilled
-        (``numpy.empty``) for an analysis that fills it itself
-        (:func:`contactlab.tangential.window.analyze_window`'s ``time_unfilled``)."""
+    def recording(self) -> Recording:
         from .. import _core
 
         t = np.empty(len(self))
-        if fill:
-            _core.fill_time(t, self.time_step[0], self.time_step[1], self.start)
+        _core.fill_time(t, self.time_step[0], self.time_step[1], self.start)
         return Recording(t, self.data, self.units, self.source, self.meta)
 
 
@@ -197,10 +193,10 @@ def _tangential_window(
 
     scanned: dict[str, tuple[float, float]] | None = None
     time_step: tuple[float, float, int] | None = None
-    samples = rec if isinstance(rec, _WindowSamples) else None
-    if samples is not None:
+    if isinstance(rec, _WindowSamples):
         # (the axis recording() makes: fill_time's from the window's first global sample)
-        scanned, time_step = samples.scanned, (*samples.time_step, samples.start)
+        scanned, time_step = rec.scanned, (*rec.time_step, rec.start)
+    rec = _window_recording(rec)
 
     opts = {k: v for k, v in options.items() if k != "warn"}
     if opts.get("on", "averaged") == "averaged" and opts.get("history", "steady") == "steady":
@@ -211,23 +207,10 @@ def _tangential_window(
         if inv is not None:
             opts["force_sign"] = -1 if inv else 1
     if set(opts) <= _WINDOW_OPTIONS:
-        # (the rows keep no per-cycle mean of the detrended window: not computed); a
-        # checked window's axis is left for the analysis to make in its period means' walk
-        # (issue 33: no pass of its own), a window of another reader's gets it here
-        unfilled = samples is not None and scanned is not None
-        win = (
-            samples.recording(fill=not unfilled) if samples is not None else _window_recording(rec)
-        )
-        res = analyze_window(
-            win,
-            period_means=False,
-            scanned=scanned,
-            time_step=time_step,
-            time_unfilled=unfilled,
-            **opts,
-        )
+        # (the rows keep no per-cycle mean of the detrended window: not computed)
+        res = analyze_window(rec, period_means=False, scanned=scanned, time_step=time_step, **opts)
     else:
-        res = analyze_tangential(_window_recording(rec), **{"warn": False, **dict(options)})
+        res = analyze_tangential(rec, **{"warn": False, **dict(options)})
     d = res.to_dict()
     row: dict[str, Any] = {}
     for q in TANGENTIAL_QUANTITIES:

@@ -18,7 +18,6 @@ The paper (*Experimental investigation of tangential contact stiffness and equiv
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -65,33 +64,16 @@ class Reversals:
         return int(min(cand)) if cand else 0
 
 
-def _crossing_times(
-    t: np.ndarray | None,
-    x: np.ndarray,
-    i: np.ndarray,
-    level: np.ndarray,
-    time_step: tuple[float, float, int] | None = None,
-) -> np.ndarray:
+def _crossing_times(t: np.ndarray, x: np.ndarray, i: np.ndarray, level: np.ndarray) -> np.ndarray:
     """Times at which ``x`` crosses ``level`` between samples ``i-1`` and ``i`` (linear; the
-    time of sample ``i`` where the two samples are equal, ``t[0]`` for ``i = 0``).
-    ``time_step``: ``(t0, dt, offset)`` of an axis :func:`contactlab._core.fill_time` makes
-    (``t`` then need not be filled yet): its samples computed where they are read, bit for
-    bit (one product and one sum of an exact index)."""
+    time of sample ``i`` where the two samples are equal, ``t[0]`` for ``i = 0``)."""
     i = np.asarray(i, dtype=np.int64)
     ip = np.maximum(i - 1, 0)
     x0, x1 = x[ip], x[i]
     flat = x1 == x0
     a = (level - x0) / np.where(flat, 1.0, x1 - x0)
-    if time_step is None:
-        assert t is not None
-        t_ip, t_i, t_0 = t[ip], t[i], t[0]
-    else:
-        t0, dt, offset = time_step
-        t_ip = t0 + dt * (ip + offset).astype(np.float64)
-        t_i = t0 + dt * (i + offset).astype(np.float64)
-        t_0 = t0 + dt * float(offset)
-    tc = t_ip + np.clip(a, 0.0, 1.0) * (t_i - t_ip)
-    return np.where(i <= 0, t_0, np.where(flat, t_i, tc))
+    tc = t[ip] + np.clip(a, 0.0, 1.0) * (t[i] - t[ip])
+    return np.where(i <= 0, t[0], np.where(flat, t[i], tc))
 
 
 #: above this many samples :func:`tail_percentiles` selects from the tails only
@@ -188,13 +170,10 @@ def _reversals(
     threshold: float | None,
     *,
     finite: bool = False,
-    time_step: tuple[float, float, int] | None = None,
 ) -> Reversals:
     """:func:`find_reversals` of checked float64 ``xa``, ``ta`` whose 0.5 and 99.5
     percentiles (:func:`tail_percentiles`) are ``percentiles``; ``finite``: ``xa`` was
-    scanned finite already (the reversal detector does not scan it again); ``time_step``:
-    ``ta`` is :func:`contactlab._core.fill_time`'s axis of ``(t0, dt, offset)``, not read
-    (it may not be filled yet; :func:`_crossing_times`)."""
+    scanned finite already (the reversal detector does not scan it again)."""
     lo_p, hi_p = percentiles
     centre = 0.5 * (lo_p + hi_p)
     amp = 0.5 * (hi_p - lo_p)
@@ -217,9 +196,9 @@ def _reversals(
     edge[-1] |= not bool(ex.returned[-1])
     up = ex.sign > 0
     level = np.where(up, centre + threshold, centre - threshold)
-    t_in = _crossing_times(ta, xa, ex.start, level, time_step)
+    t_in = _crossing_times(ta, xa, ex.start, level)
     j = np.minimum(ex.last_beyond + 1, xa.size - 1)  # first sample back inside the band
-    t_mid = 0.5 * (t_in + _crossing_times(ta, xa, j, level, time_step))
+    t_mid = 0.5 * (t_in + _crossing_times(ta, xa, j, level))
     peak, valley = ~edge & up, ~edge & ~up
     return Reversals(
         ex.extreme[peak].astype(np.int64),
@@ -444,17 +423,13 @@ def _fold_loop(
     min_cycles: int,
     scan: _core.WindowScan | None = None,
     period_means: bool = True,
-    time_step: tuple[float, float, int] | None = None,
 ) -> AveragedLoop:
     """:func:`average_loop` of checked ``xa``, ``Fa``, ``ta`` whose reversals are ``rev``;
     ``scan``: :func:`contactlab._core.detrend_pair_scan_into`'s clean scan of them, which
     stands for the fold's check pass. ``period_means=False``: the per-cycle means of F and x
     (``scatter.mean_force``, ``scatter.mean_x``) are not computed and are NaN (the fold runs
     no trapezoid chain: 1.9 ns a sample, 6 % of a streamed window); every other number is
-    the same. ``time_step`` (with ``scan`` and ``period_means=False``): ``ta`` is
-    :func:`contactlab._core.fill_time`'s axis of ``(t0, dt, offset)``, which the fold makes
-    where it reads it (:func:`contactlab._core.fold_window_uniform`); ``ta`` is not read
-    (it need not be filled)."""
+    the same."""
     n_cyc = max(int(rev.peaks.size) - 1, 0)
     if n_cyc < min_cycles:
         raise InputError(
@@ -469,14 +444,8 @@ def _fold_loop(
             valley_times=smooth_turn_times(rev.valley_times),
         )
     )
-    uniform = time_step is not None and scan is not None and not period_means
-    if uniform:
-        assert time_step is not None
-        start = _first_at_or_above(time_step, xa.size, float(kt[0]))
-        end = _first_at_or_above(time_step, xa.size, float(kt[-1]))
-    else:
-        start = int(np.searchsorted(ta, kt[0], side="left"))
-        end = int(np.searchsorted(ta, kt[-1], side="left"))
+    start = int(np.searchsorted(ta, kt[0], side="left"))
+    end = int(np.searchsorted(ta, kt[-1], side="left"))
     if n_points is None:
         # about two samples of every cycle per bin, so no bin is left empty by jitter
         n_points = 2 * int(np.clip(median(np.diff(rev.peaks)) / 2, 16, 400) // 2)
@@ -485,31 +454,9 @@ def _fold_loop(
     # One call in Rust: phase by interpolating the knots, bin sums overall and per cycle (no
     # per-sample temporaries; the bins are numpy.interp's), the cycles' bounds, loop areas and
     # their noise sensitivities, the period means between the peaks.
-    if uniform:
-        assert time_step is not None and scan is not None
-        t0, dt, offset = time_step
-        wf = _core.fold_window_uniform(t0, dt, offset, xa, Fa, kt, kp, int(n_points), n_cyc, scan)
-    else:
-        edges = rev.peak_times if period_means else _NO_EDGES
-        wf = _core.fold_window(ta, xa, Fa, kt, kp, int(n_points), n_cyc, edges, scan)
+    edges = rev.peak_times if period_means else _NO_EDGES
+    wf = _core.fold_window(ta, xa, Fa, kt, kp, int(n_points), n_cyc, edges, scan)
     return _loop_of_fold(wf, rev, int(n_points), start, end)
-
-
-def _first_at_or_above(time_step: tuple[float, float, int], n: int, value: float) -> int:
-    """``numpy.searchsorted(t, value, side="left")`` of the increasing axis ``t`` of ``n``
-    samples that :func:`contactlab._core.fill_time` makes of ``(t0, dt, offset)``, its
-    samples computed as that makes them (one product and one sum of an exact index)."""
-    if math.isnan(value):
-        return n  # (numpy sorts NaN last)
-    t0, dt, offset = time_step
-    lo, hi = 0, n
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if t0 + dt * float(offset + mid) < value:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo
 
 
 #: no period edges: a fold that computes no period means

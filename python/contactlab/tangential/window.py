@@ -91,7 +91,6 @@ def analyze_window(
     period_means: bool = True,
     scanned: dict[str, tuple[float, float]] | None = None,
     time_step: tuple[float, float, int] | None = None,
-    time_unfilled: bool = False,
 ) -> TangentialAnalysis:
     """:func:`analyze_tangential` of one window of a streamed recording (``on="averaged"``,
     steady history), with the per-sample work in one pass of Rust kernels.
@@ -125,28 +124,13 @@ def analyze_window(
     :func:`contactlab._core.fill_time`'s ``t0 + dt·(offset + i)`` (a streamed window of a
     sampled recording, :func:`contactlab.studies.tracking.track`'s): the detrending pass then
     makes the axis as it goes instead of reading it (the same numbers).
-
-    ``time_unfilled`` (with ``time_step``): ``recording.t`` is an array not yet filled
-    (``numpy.empty``). A checked window (``scanned``, no ``delay``) then never reads it: the
-    period means, the reversals' crossing times, the detrending and the fold make
-    ``time_step``'s axis where they read it (:func:`contactlab._core.fill_time`'s numbers,
-    never stored: no pass over the window to fill it, none to read it); any other path fills
-    it (``fill_time``) before its first read. On return ``recording.t`` may still be
-    unfilled (for a caller that drops the window after, as
-    :func:`contactlab.studies.tracking.track` does).
     """
-    if time_unfilled and time_step is None:
-        raise InputError("time_unfilled needs the time_step of the axis to fill")
     xa, Fa, ta, source = _inputs(recording, None, None, None)
     _check_options("averaged", "steady", n_points)
     known = scanned or {}
     finite_x = check_channel("x", xa, "m", "displacement", known.get("x"))
     finite_f = check_channel("F", Fa, "N", "force", known.get("F"))
     dropped = 0
-    if time_unfilled and delay is not None:  # (shift_force reads the axis)
-        assert time_step is not None
-        _fill(recording.t, time_step)
-        time_unfilled = False
     if delay is not None:  # ``delay`` as in analyze_tangential
         ta, xa, Fa, dropped = lag.shift_force(ta, xa, Fa, delay)
     opts: dict[str, Any] = {
@@ -162,22 +146,15 @@ def analyze_window(
     }
     # (a recording's channels are contiguous float64 arrays unless replaced since)
     plain = all(a.dtype == np.float64 and a.ndim == 1 and a.flags.c_contiguous for a in (xa, Fa))
-    checked = finite_x and finite_f and plain
-    time_checked = scanned is not None and delay is None
-    unfilled = time_unfilled and checked and time_checked and time_step is not None
-    if time_unfilled and not unfilled:
-        assert time_step is not None
-        _fill(recording.t, time_step)
     pre = window_detrended(
         xa,
         Fa,
         ta,
         opts,
-        checked=checked,
+        checked=finite_x and finite_f and plain,
         period_means=period_means,
-        time_checked=time_checked,
+        time_checked=scanned is not None and delay is None,
         time_step=time_step if delay is None else None,
-        time_unfilled=unfilled,
     )
     ori = _fast_orientation(pre.x, pre.F, pre.loop, force_sign)
     res = None
@@ -198,17 +175,9 @@ def analyze_window(
             **opts,
         )
     if res is None:  # the sign undecided by the area, or gross sliding: the full analysis
-        if unfilled:
-            assert time_step is not None
-            _fill(recording.t, time_step)
         return analyze_tangential(recording, force_sign=force_sign, warn=False, delay=delay, **opts)
     lag.record(res, delay, dropped)
     return res
-
-
-def _fill(t: np.ndarray, time_step: tuple[float, float, int]) -> None:
-    """``t`` filled with the axis ``(t0, dt, offset)`` (:func:`contactlab._core.fill_time`)."""
-    _core.fill_time(t, time_step[0], time_step[1], time_step[2])
 
 
 def window_detrended(
@@ -220,7 +189,6 @@ def window_detrended(
     period_means: bool = True,
     time_checked: bool = False,
     time_step: tuple[float, float, int] | None = None,
-    time_unfilled: bool = False,
 ) -> steps.Detrended:
     """:func:`steps.detrend` of the window with one fold instead of two: the linear drifts
     come from the period means between the raw displacement's peaks (what the first fold's
@@ -232,19 +200,9 @@ def window_detrended(
     computed; see :func:`analyze_window`). ``time_checked`` (with ``checked``): t too is
     known finite (a streamed reader's axis), so it is not scanned either. ``time_step``:
     ``(t0, dt, offset)`` of ``ta`` when it is :func:`contactlab._core.fill_time`'s axis (see
-    :func:`analyze_window`). ``time_unfilled`` (with ``time_step``): ``ta`` is not filled
-    yet; it is on return (see :func:`analyze_window`)."""
+    :func:`analyze_window`)."""
     n_points, rel = opts["n_points"], opts["rel_threshold"]
     min_cycles = opts["min_cycles"]
-    # the axis not filled yet: made by the period means' walk, where the window gets there
-    pending = None
-    if time_unfilled:
-        if not (checked and time_checked and time_step is not None and ta is not None):
-            raise InputError("time_unfilled needs a checked window with its time_step")
-        pending = time_step
-    # the reversals' crossing times computed from the axis's step where it has one (the
-    # same numbers; no gathers from the window's t, or t not filled yet)
-    axis = time_step if ta is not None else None
     if checked:
         # find_reversals(checked=True) of an x known finite: the reversal detector does not
         # scan it again
@@ -254,14 +212,11 @@ def window_detrended(
             tc = as_1d(ta, "t", finite=not time_checked)
         if tc.size != xa.size:
             raise InputError(f"t has {tc.size} samples but x has {xa.size}")
-        rev = _reversals(xa, tc, tail_percentiles(xa), rel, None, finite=True, time_step=axis)
+        rev = _reversals(xa, tc, tail_percentiles(xa), rel, None, finite=True)
     else:
         rev = find_reversals(xa, ta, rel_threshold=rel)  # checks x and t
         Fa = as_1d(Fa, "F")
     if not (opts["detrend"] and rev.peaks.size - 1 >= 3):
-        if pending is not None:
-            assert ta is not None
-            _fill(ta, pending)
         loop = average_loop(
             xa, Fa, ta, n_points=n_points, rel_threshold=rel, min_cycles=min_cycles, checked=True
         )
@@ -271,14 +226,7 @@ def window_detrended(
     time = 0.5 * (pt[:-1] + pt[1:])
     tm = float(np.mean(time))
     # period_means of F and of x in one pass over t (bit for bit the two calls)
-    edges = np.ascontiguousarray(pt, dtype=float)
-    if pending is not None:
-        # the axis made where the walk reads it (fill_time's numbers), never stored: the
-        # window's t stays unfilled on this path (issue 33: no pass of its own, not read)
-        t0_, dt_, off_ = pending
-        f_means, x_means = _core.period_means_pair_uniform(t0_, dt_, off_, Fa, xa, edges)
-    else:
-        f_means, x_means = _core.period_means_pair(tt, Fa, xa, edges)
+    f_means, x_means = _core.period_means_pair(tt, Fa, xa, np.ascontiguousarray(pt, dtype=float))
     f_drift = trend(time, f_means)
     x_drift = trend(time, x_means)
     # Fa - s·(tt - tm) for both channels in one Rust pass without the interpreter lock (bit
@@ -302,20 +250,12 @@ def window_detrended(
         scan = _core.detrend_pair_scan_into(tt, tm, Fa, f_drift[0], xa, x_drift[0], F, x, ranks)
     drift = steps.Drift(f_drift, x_drift, tt, tm)
     if not scan.clean:  # the fold names what is wrong (as before the scan)
-        if pending is not None:
-            assert ta is not None
-            _fill(ta, pending)
         loop = average_loop(
             x, F, ta, n_points=n_points, rel_threshold=rel, min_cycles=min_cycles, checked=True
         )
         return steps.Detrended(x, F, loop, drift)
     pct = _lerp_tails(scan.order_stats, sel[1]) if sel is not None else tail_percentiles(x)
-    # (the scan found x finite)
-    rev = _reversals(x, tt, pct, rel, None, finite=True, time_step=axis)
-    if pending is not None and period_means:
-        assert ta is not None
-        _fill(ta, pending)  # (the fold's period means walk the stored axis)
-        pending = None
+    rev = _reversals(x, tt, pct, rel, None, finite=True)  # (the scan found x finite)
     loop = _fold_loop(
         x,
         F,
@@ -325,7 +265,6 @@ def window_detrended(
         min_cycles=min_cycles,
         scan=scan,
         period_means=period_means,
-        time_step=pending,
     )
     return steps.Detrended(x, F, loop, drift)
 

@@ -3,7 +3,6 @@
 //! averages between cycle edges (period means).
 
 use crate::error::{check_finite, check_same_len, CoreError};
-use crate::window::Axis;
 
 /// Sums of a phase-bin fold (the cycle averaging of a periodic recording), accumulated over
 /// any number of chunks: per bin (`n_bins`) and per cycle and bin (`n_cycles × n_bins`,
@@ -387,42 +386,6 @@ pub fn period_means_pair(
     // leaves room for the compares; the pass read t at memory speed); the separate checks
     // name the first failure, before any of the edges (as they did)
     let (ok, means) = period_means_pair_walk(t, f, x, edges);
-    pair_checks(t, edges, ok)?;
-    Ok(means)
-}
-
-/// [`period_means_pair`] on a sampled window's axis made where the walk reads it
-/// ([`crate::window::UniformAxis`], never stored): the same walk, sums, checks and errors as
-/// [`period_means_pair`] on [`crate::stream::fill_time`]'s axis, bit for bit.
-///
-/// # Errors
-/// As [`period_means_pair`].
-pub fn period_means_pair_uniform(
-    axis: crate::window::UniformAxis,
-    f: &[f64],
-    x: &[f64],
-    edges: &[f64],
-) -> Result<(Vec<f64>, Vec<f64>), CoreError> {
-    check_same_len("t", axis.len(), "v", f.len())?;
-    check_same_len("t", axis.len(), "v", x.len())?;
-    if axis.len() < 2 {
-        return period_means_pair(&axis.to_vec(), f, x, edges);
-    }
-    let (ok, means) = period_means_pair_walk(axis, f, x, edges);
-    if ok {
-        pair_checks(&[], edges, true)?;
-    } else {
-        // (the checks name the first failure of the axis: made for them, a rare path)
-        pair_checks(&axis.to_vec(), edges, false)?;
-    }
-    Ok(means)
-}
-
-/// [`period_means_pair`]'s checks after its walk (`ok`: the walk found `t` finite and
-/// strictly increasing): the first failure of `t`, then of `edges`, named.
-// Index arithmetic: 1 <= i < len.
-#[allow(clippy::arithmetic_side_effects)]
-fn pair_checks(t: &[f64], edges: &[f64], ok: bool) -> Result<(), CoreError> {
     if !ok {
         check_finite("t", t)?;
         for i in 1..t.len() {
@@ -447,7 +410,7 @@ fn pair_checks(t: &[f64], edges: &[f64], ok: bool) -> Result<(), CoreError> {
             });
         }
     }
-    Ok(())
+    Ok(means)
 }
 
 /// [`period_means_pair`]'s walk over at least two samples (`f` and `x` as long as `t`):
@@ -457,39 +420,38 @@ fn pair_checks(t: &[f64], edges: &[f64], ok: bool) -> Result<(), CoreError> {
 /// never a panic).
 // Index arithmetic: j + 1 < n where j + 1 is taken (trapezoids_checked_until stops there).
 #[allow(clippy::arithmetic_side_effects)]
-fn period_means_pair_walk<A: Axis>(
-    t: A,
+fn period_means_pair_walk(
+    t: &[f64],
     f: &[f64],
     x: &[f64],
     edges: &[f64],
 ) -> (bool, (Vec<f64>, Vec<f64>)) {
-    let n = f.len();
+    let n = t.len();
     let mut ce_f = Vec::with_capacity(edges.len());
     let mut ce_x = Vec::with_capacity(edges.len());
     let (mut j, mut cf, mut cx) = (0_usize, 0.0_f64, 0.0_f64);
-    let mut ok = t.at(0).is_finite();
+    let mut ok = t[0].is_finite();
     for &e in edges {
-        if e <= t.at(0) {
+        if e <= t[0] {
             ce_f.push(0.0);
             ce_x.push(0.0);
             continue;
         }
         (j, cf, cx, ok) = trapezoids_checked_until(t, (f, x), j, e, (cf, cx), ok);
-        if j + 1 >= n || e == t.at(j) {
+        if j + 1 >= n || e == t[j] {
             ce_f.push(cf);
             ce_x.push(cx);
         } else {
-            let dt = t.at(j + 1) - t.at(j);
+            let dt = t[j + 1] - t[j];
             let c1f = cf + 0.5 * (f[j + 1] + f[j]) * dt;
             let c1x = cx + 0.5 * (x[j + 1] + x[j]) * dt;
-            ce_f.push((c1f - cf) / dt * (e - t.at(j)) + cf);
-            ce_x.push((c1x - cx) / dt * (e - t.at(j)) + cx);
+            ce_f.push((c1f - cf) / dt * (e - t[j]) + cf);
+            ce_x.push((c1x - cx) / dt * (e - t[j]) + cx);
         }
     }
     // the samples after the last step taken (pair j, j + 1 on)
-    for k in j + 1..n {
-        let (a, b) = (t.at(k - 1), t.at(k));
-        ok &= (b > a) & b.is_finite();
+    for w in t[j..].windows(2) {
+        ok &= (w[1] > w[0]) & w[1].is_finite();
     }
     let means = |ce: &[f64]| -> Vec<f64> {
         ce.windows(2)
@@ -505,19 +467,18 @@ fn period_means_pair_walk<A: Axis>(
 // Index arithmetic: j + 1 < n, the shortest slice's length.
 #[allow(clippy::arithmetic_side_effects)]
 #[inline(never)]
-fn trapezoids_checked_until<A: Axis>(
-    t: A,
+fn trapezoids_checked_until(
+    t: &[f64],
     (f, x): (&[f64], &[f64]),
     mut j: usize,
     e: f64,
     (mut cf, mut cx): (f64, f64),
     mut ok: bool,
 ) -> (usize, f64, f64, bool) {
-    let n = f.len().min(x.len());
-    while j + 1 < n && t.at(j + 1) <= e {
-        let (tj, tj1) = (t.at(j), t.at(j + 1));
-        ok &= (tj1 > tj) & tj1.is_finite();
-        let dt = tj1 - tj;
+    let n = t.len().min(f.len()).min(x.len());
+    while j + 1 < n && t[j + 1] <= e {
+        ok &= (t[j + 1] > t[j]) & t[j + 1].is_finite();
+        let dt = t[j + 1] - t[j];
         cf += 0.5 * (f[j + 1] + f[j]) * dt;
         cx += 0.5 * (x[j + 1] + x[j]) * dt;
         j += 1;

@@ -627,8 +627,8 @@ pub fn fold_window_at(
 
 /// [`fold_window_at`]'s pass over checked samples as a [`crate::simd::Kernel`].
 #[derive(Clone, Copy)]
-struct FoldPass<'a, A: Axis> {
-    txf: (A, &'a [f64], &'a [f64]),
+struct FoldPass<'a> {
+    txf: (&'a [f64], &'a [f64], &'a [f64]),
     knots: (&'a [f64], &'a [f64]),
     sizes: (usize, usize),
     edges: &'a [f64],
@@ -636,7 +636,7 @@ struct FoldPass<'a, A: Axis> {
     level: crate::simd::Level,
 }
 
-impl<A: Axis> crate::simd::Kernel for FoldPass<'_, A> {
+impl crate::simd::Kernel for FoldPass<'_> {
     type Output = Result<WindowFold, CoreError>;
 
     #[inline(always)]
@@ -649,7 +649,7 @@ impl<A: Axis> crate::simd::Kernel for FoldPass<'_, A> {
 // Index arithmetic: as fold_window's.
 #[allow(clippy::arithmetic_side_effects)]
 #[inline(always)]
-fn fold_pass<A: Axis>(p: FoldPass<'_, A>) -> Result<WindowFold, CoreError> {
+fn fold_pass(p: FoldPass<'_>) -> Result<WindowFold, CoreError> {
     let FoldPass {
         txf: (t, x, f),
         knots: (kt, kp),
@@ -674,10 +674,10 @@ fn fold_pass<A: Axis>(p: FoldPass<'_, A>) -> Result<WindowFold, CoreError> {
     let (t0, t1) = (kt[0], kt[kt.len() - 1]);
     // the samples folded: [start, end) (t increasing), less those past the last cycle (a
     // suffix: the phase never decreases)
-    let start = t.partition_point(|v| v < t0);
-    let end = t.partition_point(|v| v < t1);
+    let start = t.partition_point(|&v| v < t0);
+    let end = t.partition_point(|&v| v < t1);
     let (t_all, x_all, f_all) = (t, x, f);
-    let (t, x, f) = (t.prefix(end), &x[..end], &f[..end]);
+    let (t, x, f) = (&t[..end], &x[..end], &f[..end]);
     let mut j = 0_usize;
     let mut seg = Segment::of(kt, kp, 0);
     let mut last_ph = f64::NEG_INFINITY;
@@ -707,7 +707,7 @@ fn fold_pass<A: Axis>(p: FoldPass<'_, A>) -> Result<WindowFold, CoreError> {
     let mut i = start;
     while i < end {
         // a sample that may start a knot segment, a cycle or a cell
-        let ti = t.at(i);
+        let ti = t[i];
         let (ph, clamped) = if carried >= 0.0 {
             (carried, false)
         } else {
@@ -748,11 +748,8 @@ fn fold_pass<A: Axis>(p: FoldPass<'_, A>) -> Result<WindowFold, CoreError> {
             if let Some(ac) = area_cycle {
                 (w.energy[ac], w.sens_f[ac], w.sens_x[ac]) =
                     cycle_area_at(level, &x[a0..i], &f[a0..i], ux, uf, fm, area_scale);
-                // the period means' integrals over the same samples, still in cache (an
-                // axis made, not read, comes with no edges: nothing to carry)
-                if let Some(ts) = t_all.samples() {
-                    pm.advance((ts, f_all, x_all), edges, Some(i - 1));
-                }
+                // the period means' integrals over the same samples, still in cache
+                pm.advance((t_all, f_all, x_all), edges, Some(i - 1));
             }
             area_cycle = Some(c);
             a0 = i;
@@ -821,12 +818,12 @@ fn fold_pass<A: Axis>(p: FoldPass<'_, A>) -> Result<WindowFold, CoreError> {
                 ..Cell::default()
             };
             cell_start = i;
-            cell.add(x[i], f[i], frac, t.at(i));
+            cell.add(x[i], f[i], frac, t[i]);
             i += 1;
         }
         if i > taken {
             // the phase of the last sample taken (run's expression, so its number)
-            last_ph = seg.phase(t.at(i - 1));
+            last_ph = seg.phase(t[i - 1]);
         }
     }
     if cb != usize::MAX {
@@ -842,7 +839,7 @@ fn fold_pass<A: Axis>(p: FoldPass<'_, A>) -> Result<WindowFold, CoreError> {
         &mut w,
         &bins,
         &ranges,
-        (t_all.samples().unwrap_or(&[]), f_all, x_all, edges),
+        (t_all, f_all, x_all, edges),
         end,
         pm,
     )?;
@@ -909,160 +906,6 @@ fn finish(
     }
     w.bounds = bounds;
     Ok(())
-}
-
-/// A window's time axis as [`fold_window`]'s pass reads it: the samples of `t` (`&[f64]`),
-/// or [`UniformAxis`]'s, made where they are read.
-pub(crate) trait Axis: Copy {
-    /// Sample `i` (`i < len`).
-    fn at(&self, i: usize) -> f64;
-    /// The first `n` samples (`n <= len`).
-    #[must_use]
-    fn prefix(self, n: usize) -> Self;
-    /// The first index whose sample fails `pred` (`pred` true on a prefix of the axis:
-    /// `slice::partition_point`'s answer).
-    fn partition_point(&self, pred: impl Fn(f64) -> bool) -> usize;
-    /// The samples as a slice, where they are stored.
-    fn samples(&self) -> Option<&[f64]>;
-}
-
-impl Axis for &[f64] {
-    #[inline(always)]
-    fn at(&self, i: usize) -> f64 {
-        self[i]
-    }
-    #[inline(always)]
-    fn prefix(self, n: usize) -> Self {
-        &self[..n]
-    }
-    #[inline(always)]
-    fn partition_point(&self, pred: impl Fn(f64) -> bool) -> usize {
-        <[f64]>::partition_point(self, |&v| pred(v))
-    }
-    #[inline(always)]
-    fn samples(&self) -> Option<&[f64]> {
-        Some(self)
-    }
-}
-
-/// The axis `t0 + dt * (offset + i)`, `i < n`, of a sampled window
-/// ([`crate::stream::fill_time`]'s numbers, bit for bit: one product and one sum of an exact
-/// index), made where it is read instead of read from memory.
-#[derive(Clone, Copy, Debug)]
-pub struct UniformAxis {
-    t0: f64,
-    dt: f64,
-    offset: u64,
-    n: usize,
-}
-
-impl UniformAxis {
-    /// The axis of `n` samples from global sample `offset`.
-    ///
-    /// # Errors
-    /// [`CoreError::TooLong`] where `offset + n` passes 2^53 (the indices would not be
-    /// exact; [`crate::stream::fill_time`] refuses it alike).
-    pub fn new(t0: f64, dt: f64, offset: u64, n: usize) -> Result<Self, CoreError> {
-        if !crate::stream::indices_exact(offset, n) {
-            return Err(CoreError::TooLong { len: n });
-        }
-        Ok(Self { t0, dt, offset, n })
-    }
-
-    /// The number of samples.
-    #[must_use]
-    pub fn len(&self) -> usize {
-        self.n
-    }
-
-    /// Whether the axis has no sample.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.n == 0
-    }
-
-    /// The samples, as [`crate::stream::fill_time`] writes them.
-    #[must_use]
-    pub fn to_vec(&self) -> Vec<f64> {
-        (0..self.n).map(|i| self.at(i)).collect()
-    }
-}
-
-impl Axis for UniformAxis {
-    // Index arithmetic: offset + i < 2^53 (UniformAxis::new), so the sum and its conversion
-    // through i64 are exact: the index as fill_time makes it. (Through i64: one instruction
-    // at every SIMD level, where u64 to f64 is a branchy sequence below AVX-512: the axis
-    // made so cost 1.7-2 ns a sample more than read in the period means, 0.8-1.8 in the fold.)
-    #[allow(clippy::arithmetic_side_effects, clippy::cast_possible_wrap)]
-    #[inline(always)]
-    fn at(&self, i: usize) -> f64 {
-        let k = (self.offset + i as u64) as i64 as f64;
-        self.t0 + self.dt * k
-    }
-    #[inline(always)]
-    fn prefix(self, n: usize) -> Self {
-        Self {
-            n: n.min(self.n),
-            ..self
-        }
-    }
-    // Index arithmetic: lo <= mid < hi <= n.
-    #[allow(clippy::arithmetic_side_effects)]
-    fn partition_point(&self, pred: impl Fn(f64) -> bool) -> usize {
-        let (mut lo, mut hi) = (0_usize, self.n);
-        while lo < hi {
-            let mid = lo + (hi - lo) / 2;
-            if pred(self.at(mid)) {
-                lo = mid + 1;
-            } else {
-                hi = mid;
-            }
-        }
-        lo
-    }
-    fn samples(&self) -> Option<&[f64]> {
-        None
-    }
-}
-
-/// [`fold_window_scanned`] of a window whose axis is `axis` ([`UniformAxis`]: made where
-/// read, never stored), without period means (`edges` empty: the means would walk the
-/// stored axis). The same numbers as [`fold_window_scanned`] on
-/// [`crate::stream::fill_time`]'s axis.
-///
-/// # Errors
-/// As [`fold_window_scanned`] (the axis as long as `x`).
-pub fn fold_window_scanned_uniform(
-    axis: UniformAxis,
-    x: &[f64],
-    f: &[f64],
-    (kt, kp): (&[f64], &[f64]),
-    (n_bins, n_cycles): (usize, usize),
-    scan: &WindowScan,
-) -> Result<WindowFold, CoreError> {
-    if !scan.clean || scan.n != axis.n {
-        return Err(bad(
-            "scan",
-            scan.n as f64,
-            "not a clean scan of these samples: fold with fold_window",
-        ));
-    }
-    check_sizes(n_bins, n_cycles)?;
-    check_knots(kt, kp, n_cycles)?;
-    check_same_len("t", axis.n, "x", x.len())?;
-    check_same_len("t", axis.n, "F", f.len())?;
-    let level = crate::simd::level();
-    crate::simd::run(
-        level,
-        FoldPass {
-            txf: (axis, x, f),
-            knots: (kt, kp),
-            sizes: (n_bins, n_cycles),
-            edges: &[],
-            scales: [scan.max_abs_x, scan.max_abs_f, scan.force_centre],
-            level,
-        },
-    )
 }
 
 mod cell;

@@ -1,9 +1,6 @@
 //! Binding of `contactlab_core::fold`: the phase-bin fold, its spread, and period means.
 
-use contactlab_core::fold::{
-    fold_phase, fold_spread, period_means, period_means_pair, period_means_pair_uniform, FoldSums,
-};
-use contactlab_core::window::UniformAxis;
+use contactlab_core::fold::{fold_phase, fold_spread, period_means, period_means_pair, FoldSums};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 
@@ -149,35 +146,11 @@ fn period_means_pair_py<'py>(
     Ok((a.into_pyarray(py), b.into_pyarray(py)))
 }
 
-/// `period_means_pair` of a window whose axis `t0 + dt * (offset + i)` (`fill_time`'s, bit
-/// for bit) is made where its walk reads it, not stored (see
-/// `contactlab_core::fold::period_means_pair_uniform`).
-#[pyfunction]
-#[pyo3(name = "period_means_pair_uniform")]
-fn period_means_pair_uniform_py<'py>(
-    py: Python<'py>,
-    t0: f64,
-    dt: f64,
-    offset: u64,
-    f: PyReadonlyArray1<'py, f64>,
-    x: PyReadonlyArray1<'py, f64>,
-    edges: PyReadonlyArray1<'py, f64>,
-) -> PyResult<(Arr<'py>, Arr<'py>)> {
-    let (fs, xs) = (slice(&f, "F")?, slice(&x, "x")?);
-    let es = slice(&edges, "edges")?;
-    let (a, b) = detach_guarded(py, || {
-        let axis = UniformAxis::new(t0, dt, offset, fs.len())?;
-        period_means_pair_uniform(axis, fs, xs, es)
-    })?;
-    Ok((a.into_pyarray(py), b.into_pyarray(py)))
-}
-
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PhaseFold>()?;
     m.add_class::<FoldSpread>()?;
     m.add_class::<FoldTable>()?;
     m.add_function(wrap_pyfunction!(period_means_py, m)?)?;
     m.add_function(wrap_pyfunction!(period_means_pair_py, m)?)?;
-    m.add_function(wrap_pyfunction!(period_means_pair_uniform_py, m)?)?;
     Ok(())
 }

@@ -3,8 +3,7 @@
 
 use contactlab_core::window::{
     detrend_pair, detrend_pair_into, detrend_pair_scan_into, detrend_pair_scan_uniform_into,
-    fold_window, fold_window_scanned, fold_window_scanned_uniform, UniformAxis,
-    WindowFold as CoreWindowFold, WindowScan as CoreWindowScan,
+    fold_window, fold_window_scanned, WindowFold as CoreWindowFold, WindowScan as CoreWindowScan,
 };
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadwriteArray1};
 use pyo3::prelude::*;
@@ -162,35 +161,6 @@ fn fold_window_py(
     Ok(WindowFold { inner })
 }
 
-/// Fold one window of a sampled recording whose axis `t0 + dt * (offset + i)` (`fill_time`'s,
-/// bit for bit) is made where read, not stored, after a clean scan, without period means
-/// (see `contactlab_core::window::fold_window_scanned_uniform`).
-#[pyfunction]
-#[pyo3(name = "fold_window_uniform")]
-#[allow(clippy::too_many_arguments)]
-fn fold_window_uniform_py(
-    py: Python<'_>,
-    t0: f64,
-    dt: f64,
-    offset: u64,
-    x: PyReadonlyArray1<'_, f64>,
-    f: PyReadonlyArray1<'_, f64>,
-    knot_t: PyReadonlyArray1<'_, f64>,
-    knot_phase: PyReadonlyArray1<'_, f64>,
-    n_bins: usize,
-    n_cycles: usize,
-    scan: PyRef<'_, WindowScan>,
-) -> PyResult<WindowFold> {
-    let (xs, fs) = (slice(&x, "x")?, slice(&f, "F")?);
-    let (kt, kp) = (slice(&knot_t, "knot_t")?, slice(&knot_phase, "knot_phase")?);
-    let sc = scan.inner.clone();
-    let inner = detach_guarded(py, || {
-        let axis = UniformAxis::new(t0, dt, offset, xs.len())?;
-        fold_window_scanned_uniform(axis, xs, fs, (kt, kp), (n_bins, n_cycles), &sc)
-    })?;
-    Ok(WindowFold { inner })
-}
-
 /// What `detrend_pair_scan_into` found of the detrended samples (see
 /// `contactlab_core::window::WindowScan`): `clean`, the order statistics asked for; handed
 /// to `fold_window(..., scan=)` it stands for the fold's own check pass.
@@ -335,7 +305,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(detrend_pair_scan_into_py, m)?)?;
     m.add_function(wrap_pyfunction!(detrend_pair_scan_uniform_into_py, m)?)?;
     m.add_function(wrap_pyfunction!(fold_window_py, m)?)?;
-    m.add_function(wrap_pyfunction!(fold_window_uniform_py, m)?)?;
     m.add_function(wrap_pyfunction!(detrend_pair_py, m)?)?;
     m.add_function(wrap_pyfunction!(detrend_pair_into_py, m)?)?;
     Ok(())

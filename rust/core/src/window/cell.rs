@@ -1,7 +1,7 @@
 //! The pieces of [`super::fold_window`]'s pass over the samples: the knot segment of the
 //! phase, the open cell's running sums, the next bin.
 
-use super::{flush_cell, Axis, Bin};
+use super::{flush_cell, Bin};
 
 /// A cycle's range of cell means before its first cell: [max x, min x, max F, min F].
 pub(super) const NO_RANGE: [f64; 4] = [
@@ -81,15 +81,15 @@ impl Cell {
     // Index arithmetic: i < stop <= the slices' length.
     #[allow(clippy::arithmetic_side_effects)]
     #[inline(always)]
-    pub(super) fn run<A: Axis>(
+    pub(super) fn run(
         &mut self,
-        (t, x, f): (A, &[f64], &[f64]),
+        (t, x, f): (&[f64], &[f64], &[f64]),
         mut i: usize,
         stop: usize,
         seg: &Segment,
         (c_lo, nbf, g_hi): (f64, f64, f64),
     ) -> (usize, f64) {
-        let (t, x, f) = (t.prefix(stop), &x[..stop], &f[..stop]);
+        let (t, x, f) = (&t[..stop], &x[..stop], &f[..stop]);
         // the nine running sums in locals for the loop (as fields of `self` behind the
         // reference they stayed in memory: a store and a load in each sum's chain every
         // sample); the same additions in the same order
@@ -97,7 +97,7 @@ impl Cell {
         let (mut cx, mut cf, mut cp) = (self.cx, self.cf, self.cp);
         let mut next = -1.0;
         while i < stop {
-            let ti = t.at(i);
+            let ti = t[i];
             if ti >= seg.k_hi {
                 break;
             }
