@@ -4,10 +4,9 @@ flagged as a misfit on an independent generator).
 
 A Masing branch of ``h0 (1 - exp(-ac x))`` ends at the rate ``ac/2``; a ``tanh`` backbone's at
 another rate, so with the tail's rate held at ``ac/2`` the plateau keeps a slope of the
-tail's own (on the rig's ``tanh_virgin`` records, tuning seeds 990200-990209: t -11..-45 at
-the ac a Masing fit takes). With the rate free most of that slope is gone, but a mass's
-``-mω² x`` is taken by a slightly faster tail on some records too, so the free rate is a
-rule only with ``FREE_TAIL_CHECK`` (off by default) and otherwise stated in the argument.
+tail's own (rig ``tanh_virgin`` records: t -25..-38 at the ac a Masing fit takes). A tail of
+another rate with no slope fits those plateaus better than the Masing tail with a slope;
+a mass's plateaus the other way round (:func:`tail_shape_ratio`).
 """
 
 from __future__ import annotations
@@ -20,9 +19,10 @@ from contactlab.synthetic.rig import rig_recording
 H0, AC = 40.0, 4.0e4
 #: a rig record whose loops reach a plateau: ac·A 4, 12 Hz, 5 cycles from rest, 1 % noise
 FAC = {"fs": 2000.0, "f": 12.0, "cycles": 5, "acA": 4.0, "x_noise": 0.01, "F_noise": 0.01}
-#: the contact's ac a Masing fit takes on such a tanh record (fitted 49 000-53 000 on the rig
-#: records of the tuning seeds above)
+#: the contact's ac a Masing fit takes on such a tanh record (fitted 49 000-53 000 on rig
+#: tanh records at ac·A 2.6-5, tuning seeds 990200-990209)
 AC_FIT = 1.3 * AC
+STEADY = {-1: 0.01, 0: 0.02, **{c: 1.0 for c in range(1, FAC["cycles"])}}
 
 
 def _prepared(effects: dict, seed: int, **over):
@@ -46,68 +46,57 @@ def tanh_record():
     return _prepared({"tanh_virgin": {}}, seed=31)
 
 
-def test_a_tanh_backbone_tilts_the_plateau_with_the_masing_tail_only(tanh_record):
-    """With the tail's rate free the slope keeps less than half of what it read with the
-    Masing tail (a mass's -mω² keeps all of it, and a mass must reach half of it)."""
+@pytest.fixture(scope="module")
+def mass_record():
+    """The same rig factors with a mass whose force is 6 % of the force amplitude."""
+    A = FAC["acA"] / AC
+    m = 0.06 * H0 * (1 - np.exp(-FAC["acA"])) / (A * (2 * np.pi * FAC["f"]) ** 2)
+    return m, _prepared({"inertia": {"m": m}}, seed=31)
+
+
+def test_a_tanh_tail_tilts_the_plateau_and_another_tail_explains_it(tanh_record):
     from contactlab.diagnose.effects.tangential.inertia import (
-        TILT_AGREE,
+        SHAPE_RATIO,
         TILT_T,
         plateau_tilt,
-        plateau_tilt_free,
+        tail_shape_ratio,
     )
 
     k, se, n = plateau_tilt(tanh_record, AC_FIT)
     assert n >= 6 and k < -TILT_T * se  # the misfit's slope, as a mass's would be
-    kf, _, nf = plateau_tilt_free(tanh_record, AC_FIT)
-    assert nf >= 6 and kf > TILT_AGREE * k
+    ratio, rate = tail_shape_ratio(tanh_record, AC_FIT)
+    assert ratio > SHAPE_RATIO and rate > 0.5
 
 
-def test_with_the_free_tail_check_a_tanh_tilt_is_not_a_mass(tanh_record, monkeypatch):
-    import contactlab.diagnose.effects.tangential.inertia as mod
+def test_a_tanh_tilt_is_not_a_mass_and_the_reason_says_so(tanh_record):
     from contactlab.diagnose.effects.tangential.inertia import plateau_tilt
 
-    monkeypatch.setattr(mod, "FREE_TAIL_CHECK", True)
     eff = _inertia()
     k, _, _ = plateau_tilt(tanh_record, AC_FIT)
-    w2 = (2 * np.pi * FAC["f"]) ** 2
-    p = {"m": -k / w2, "h0": H0, "ac": AC_FIT}
-    steady = {-1: 0.01, 0: 0.02, **{c: 1.0 for c in range(1, FAC["cycles"])}}
-    why = eff.gain_not_its_own(tanh_record, p, steady)
-    assert why is not None and "another backbone's shape" in why
+    p = {"m": -k / (2 * np.pi * FAC["f"]) ** 2, "h0": H0, "ac": AC_FIT}
+    why = eff.gain_not_its_own(tanh_record, p, STEADY)
+    assert why is not None and "a backbone of another shape than the Masing one" in why
     assert not eff.identified_apart(tanh_record, p)
 
 
-def test_a_mass_on_the_plateau_still_shows_with_the_tail_free(monkeypatch):
-    """The same rig factors with a mass whose force is 6 % of the force amplitude instead of
-    the tanh backbone: here the tilt holds with the tail's rate free, and the mass is its own
-    with the check on; its argument gives both slopes."""
+def test_without_the_shape_check_the_tanh_tilt_reads_as_a_mass(tanh_record, monkeypatch):
     import contactlab.diagnose.effects.tangential.inertia as mod
-    from contactlab.diagnose.effects.tangential.inertia import (
-        TILT_AGREE,
-        TILT_T,
-        plateau_tilt_free,
-    )
 
-    A = FAC["acA"] / AC
-    w2 = (2 * np.pi * FAC["f"]) ** 2
-    m = 0.06 * H0 * (1 - np.exp(-FAC["acA"])) / (A * w2)
-    d = _prepared({"inertia": {"m": m}}, seed=31)
-    kf, sef, nf = plateau_tilt_free(d, AC)
-    assert nf >= 6 and kf < -TILT_T * sef and kf < -TILT_AGREE * m * w2
-    eff = _inertia()
-    steady = {-1: 0.01, 0: 0.02, **{c: 1.0 for c in range(1, FAC["cycles"])}}
-    monkeypatch.setattr(mod, "FREE_TAIL_CHECK", True)
-    assert eff.gain_not_its_own(d, {"m": m, "h0": H0, "ac": AC}, steady) is None
-    text = eff.argument(d, {"m": m, "h0": H0, "ac": AC})
-    assert f"{kf:.3g} ± {sef:.2g} N/m" in text and "such as a tanh" in text
-
-
-def test_without_the_free_tail_check_the_tanh_tilt_reads_as_a_mass(tanh_record):
-    """The default: on one amplitude the tilt cannot tell the two apart (the free rate takes
-    a mass's slope as well), so the Masing tail's tilt decides, and a tanh passes it."""
-    from contactlab.diagnose.effects.tangential.inertia import plateau_tilt
-
-    k, _, _ = plateau_tilt(tanh_record, AC_FIT)
-    w2 = (2 * np.pi * FAC["f"]) ** 2
-    p = {"m": -k / w2, "h0": H0, "ac": AC_FIT}
+    monkeypatch.setattr(mod, "SHAPE_CHECK", False)
+    k, _, _ = mod.plateau_tilt(tanh_record, AC_FIT)
+    p = {"m": -k / (2 * np.pi * FAC["f"]) ** 2, "h0": H0, "ac": AC_FIT}
+    assert _inertia().gain_not_its_own(tanh_record, p, STEADY) is None
     assert _inertia().identified_apart(tanh_record, p)
+
+
+def test_a_mass_tilt_is_the_better_explanation_and_stays_its_own(mass_record):
+    from contactlab.diagnose.effects.tangential.inertia import SHAPE_RATIO, tail_shape_ratio
+
+    m, d = mass_record
+    ratio, _ = tail_shape_ratio(d, AC)
+    assert ratio < SHAPE_RATIO
+    eff = _inertia()
+    p = {"m": m, "h0": H0, "ac": AC}
+    assert eff.gain_not_its_own(d, p, STEADY) is None
+    assert eff.identified_apart(d, p)
+    assert f"squared residual ratio {ratio:.3g}" in eff.argument(d, p)
