@@ -29,6 +29,7 @@ def _diagnose(t, p, d):
         return contactlab.diagnose({"t": t, "p": p, "delta": d}, "normal")
 
 
+@pytest.mark.slow
 def test_creep_at_twice_the_stated_bound_is_named():
     """The bound tracks the detector: a creep of twice the stated ``D``, settling at the
     stated ``τc``, added to the clean record, is named (and the clean record names nothing);
