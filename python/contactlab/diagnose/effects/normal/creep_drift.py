@@ -40,7 +40,6 @@ def drift_evidence(d, current, cand, tau_c: float) -> tuple[float, float]:
     (positive: the settling explains it better). Both take two shape parameters beyond
     the constant ``p0`` absorbs (``D``, ``τc`` against the drift's two coefficients)."""
     from ..._signal import noise_rms
-    from ...candidates_normal import _creep_shape
     from ...select import sample_weight
 
     r = np.asarray(d.y - current.fitted, float)
@@ -59,7 +58,7 @@ def drift_evidence(d, current, cand, tau_c: float) -> tuple[float, float]:
         e = b - a @ coef
         return float(e @ e)
 
-    creep = ss([one, np.asarray(_creep_shape(d, float(tau_c)))])
+    creep = ss([one, -np.expm1(-(d.t - d.t[0]) / float(tau_c))])
     drift = ss([one, u, u * u])
     return (drift - creep) / sigma2, sigma2
 
