@@ -82,3 +82,59 @@ def test_creep_must_settle_within_the_record():
     # a quarter of the 0.5 s period is the fastest creep told from a start-up step
     assert fam.implausible("creep_drift", {**base, "tau_c": 0.2}, pr) is None
     assert fam.implausible("creep_drift", {**base, "tau_c": 0.1}, pr) is not None
+
+
+def _bowed(seed: int, drift_frac: float, bow: float, creep: float = 0.0, tau_frac: float = 0.1):
+    """:func:`_record` with a bowed drift of the displacement sensor, ``drift_frac`` of δ's
+    range over the record along ``u + bow (u² - u)`` (u the time over the record), and a
+    creep of ``creep`` times the amplitude settling in ``tau_frac`` of the record."""
+    t, p, d = _record(seed)
+    u = t / t[-1]
+    d = d + drift_frac * np.ptp(d) * (u + bow * (u * u - u))
+    return t, p, d - creep * (PA / K) * np.expm1(-t / (tau_frac * t[-1]))
+
+
+@pytest.mark.slow
+def test_a_bowed_sensor_drift_is_not_named_creep():
+    """A drift of 3 % of δ's range bowed to nearly level off at the end (stop 45: bowed
+    drifts of bow -0.4 to -0.85 were named creep_drift on 4 of 20 drifting chains) is not
+    named creep: the quadratic a drifting sensor draws fits it as well as a settling
+    (:func:`~contactlab.diagnose.effects.normal.creep_drift.drift_evidence`); the verdict
+    says so."""
+    r = _diagnose(*_bowed(3, 0.03, -0.85))
+    assert "creep_drift" not in r.effect_names
+    why = [v.reason for s in r.steps for v in s.candidates if v.name == "creep_drift"]
+    assert any("sensor" in (w or "") for w in why)
+
+
+@pytest.mark.slow
+def test_a_creep_with_a_knee_is_named_beside_a_drift():
+    """A creep of 5 % of the amplitude settling in 0.1 of the record, on a record whose
+    sensor also drifts straight by 1 % of δ's range: its knee is no quadratic's, so it is
+    named."""
+    r = _diagnose(*_bowed(4, 0.01, 0.0, creep=0.05, tau_frac=0.1))
+    assert "creep_drift" in r.effect_names
+
+
+def test_drift_evidence_reads_the_knee():
+    """The χ² of a quadratic drift over a settling: near nil where the residual is a
+    parabola, large where it settles with a knee."""
+    from types import SimpleNamespace
+
+    from contactlab.diagnose.effects.normal.creep_drift import drift_evidence
+
+    t, p, d = _record(0)
+    pr = _prepared(t, p, d)
+    rng = np.random.default_rng(5)
+    noise = rng.normal(0, 1e-9, t.size)
+    u = (pr.t - pr.t[0]) / (pr.t[-1] - pr.t[0])
+    for resid, tau, big in ((2e-8 * (1.85 * u - 0.85 * u * u), 0.4, False),
+                            (2e-8 * -np.expm1(-u / 0.05), 0.05, True)):  # fmt: skip
+        y = pr.y.copy()
+        cur = SimpleNamespace(
+            fitted=y - resid - noise, full_residual=lambda _d, r=resid + noise: -r
+        )
+        tc = tau * (pr.t[-1] - pr.t[0])
+        chi2, s2 = drift_evidence(pr, cur, None, tc)
+        assert s2 > 0
+        assert (chi2 > 100.0) == big, chi2

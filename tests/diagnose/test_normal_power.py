@@ -99,3 +99,30 @@ def test_proportional_t_against_the_rule_it_models() -> None:
     delta = (np.array([est[k] for k in np.arange(m) % 2]) - a)[None]
     got = _proportional_t(np.array([[a]]), delta, A[None], B[None], W[None], np.ones(m, bool))
     assert got[0] == pytest.approx(want, rel=1e-9)
+
+
+@pytest.mark.slow
+def test_a_loss_asymmetry_without_bound_says_how_far_the_record_is():
+    """On three single-tone cycles in steady state the stiffening law takes most of the
+    asymmetry's direction and no |a| < 0.95 reaches 95 % power: the reason then gives the
+    range end's relative size and detection probability, and the note names what the drive
+    leaves to tell the two apart (issue 29: a bare "not identifiable" says nothing)."""
+    import re
+    import warnings
+
+    import contactlab
+    from contactlab.synthetic.diagnosis import hidden_effect_recording
+
+    rec = hidden_effect_recording([], model="normal", noise=0.01, seed=291500,
+                                  cycles_per_block=3, samples_per_cycle=120,
+                                  input_noise=0.007, frequencies=[1.0], start="steady")  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = contactlab.diagnose(rec, "normal")
+    b = next(x.to_dict() for x in r.not_detected if x.to_dict()["effect"] == "asymmetric_branches")
+    assert b["detectable_above"] is None
+    m = re.search(r"change the output by ([0-9.e+-]+) % of its RMS and be found with "
+                  r"probability ([0-9.]+)", b["reason"])  # fmt: skip
+    assert m is not None, b["reason"]
+    assert 0.0 < float(m.group(1)) < 100.0 and 0.0 <= float(m.group(2)) < 0.95
+    assert "one excitation frequency" in b["note"] and "no start from rest" in b["note"]

@@ -932,9 +932,16 @@ def _per_parameter(
                 f"{100 * POWER:.0f} % power ({absorbed})"
             )
         elif b >= span:
+            # what the range's end would show, in numbers (issue 29: a bound of "none" says
+            # how far the record is from one): its relative size and detection probability
+            end = span / margin if margin > 0 else span
+            seen = _power_curve(jp, st, ident, prop)(end)
+            r_end = span * float(np.sqrt(np.mean(j * j))) / st.y_rms
             why_none[s.name] = (
                 f"its linearised bound |{s.name} - {s.null:g}| = {b:.2g} lies beyond the "
-                f"parameter's range ({span:g}; {absorbed})"
+                f"parameter's range ({span:g}; {absorbed}); at the range's end it would "
+                f"change the output by {100 * r_end:.2g} % of its RMS and be found with "
+                f"probability {seen:.2f}"
             )
             b = None  # beyond the parameter's range (a loss asymmetry |a| < 1): no bound
         r = None if b is None else b * float(np.sqrt(np.mean(j * j))) / st.y_rms

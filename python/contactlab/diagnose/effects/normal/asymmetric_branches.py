@@ -124,6 +124,31 @@ class AsymmetricBranches(EffectModel):
             f"mean displacement builds as δ², not as |δ'|){tail}"
         )
 
+    def power_note(self, d, p):
+        """What the record's drive leaves of the asymmetry beyond the stiffening law (its
+        rival in the bound): on one excitation frequency the law's ``κ1 δ²`` takes the
+        asymmetry's 2ω signature, so only the kink of ``|δ'|`` at the turning points and a
+        start from rest tell them apart; several frequencies would (the asymmetry grows
+        with ω, the law does not). Empty on a record at several frequencies."""
+        from .channel_delay import SINGLE_TONE_SPAN, frequency_span
+
+        span = frequency_span(d)
+        if span >= SINGLE_TONE_SPAN:
+            return ""
+        per = float(d.cycles.period_samples)
+        rest = float(np.sum(startup_samples(d))) / per if per > 0 else 0.0
+        start = (
+            f"a start-up of {rest:.2g} periods before the first pressure maximum"
+            if rest >= 0.25
+            else "no start from rest"
+        )
+        return (
+            f"one excitation frequency (cycle periods within a factor {span:.2f}): the "
+            "stiffening law takes the asymmetry's 2ω signature, and the bound is what its "
+            f"kink at the turning points and {start} show beyond it; excitation at "
+            "several frequencies would tell the two apart (the asymmetry grows with ω)"
+        )
+
     def apply(self, delta, p, ctx):
         return ctx.family.asymmetric(delta, p, ctx.d)
 
