@@ -55,6 +55,11 @@ CASES: dict[str, dict[str, Any]] = {
 }  # fmt: skip
 
 
+#: candidates whose held-out gains are printed at every step beside the case's own (the
+#: breakaway's look-alikes on one amplitude)
+SHOWN = ("stick_slip", "channel_delay", "viscous_damping", "parallel_stiffness", "normal_load")
+
+
 def factors(case: str, seed: int) -> dict[str, Any]:
     c = CASES[case]
     rng = np.random.default_rng([seed, list(CASES).index(case), 4343])
@@ -100,7 +105,7 @@ def summary(rep: Any, names: tuple[str, ...]) -> dict[str, Any]:
     steps = []
     for st in rep.steps:
         row = {v.name: [round(float(v.gain), 4), bool(v.accepted), (v.reason or "")[:160]]
-               for v in st.candidates if v.name in names}  # fmt: skip
+               for v in st.candidates if v.name in (*names, *SHOWN)}  # fmt: skip
         if row:
             steps.append(row)
     un = rep.unexplained
@@ -125,6 +130,10 @@ def without(names: tuple[str, ...]) -> None:
         type(reg["parallel_stiffness"]).smooth_input = False
     if "stick" in names:  # stop 46: a breakaway yields to a better dashpot or spring again
         type(reg["stick_slip"]).yield_rivals = ()
+    if "rank" in names:  # stop 46: the accepted candidates ranked by the raw gain again
+        import contactlab.diagnose.search as search
+
+        search.RANK_NET_OF_NOISE = False
     if "backlash" in names and "unfed_samples" in type(reg["backlash"]).__dict__:
         delattr(type(reg["backlash"]), "unfed_samples")
 
@@ -172,7 +181,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--n", type=int, default=4)
     ap.add_argument("--cases", default=",".join(CASES))
     ap.add_argument("--mults", default="1.5,3")
-    ap.add_argument("--without", default="", help="spring,backlash,stick: these rules off")
+    ap.add_argument("--without", default="", help="spring,backlash,stick,rank: these rules off")
     ap.add_argument("--out", type=Path, default=None)
     a = ap.parse_args(argv)
     without(tuple(w for w in a.without.split(",") if w))

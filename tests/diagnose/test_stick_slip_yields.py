@@ -53,3 +53,32 @@ def test_no_budget_no_yield():
     d, v, tried = _case(0.08, "viscous_damping", 0.2, "held-out gain below", budget=0.0)
     assert _why(d, v, tried) is None
     assert np.isfinite(v.gain)
+
+
+def test_accepted_candidates_rank_by_the_gain_beyond_what_the_noise_gives_them(monkeypatch):
+    """Rig, tuning seed 4620000 of benches/eval_confusions.py --cases stick at 1.5x its
+    bound: a breakaway (0.88 σ²) lost to a delay (1.21 σ²) with a budget of 0.55 σ²; a
+    delay takes all of the budget from the input's noise, a breakaway a quarter."""
+    from contactlab.diagnose import search
+    from contactlab.diagnose.search import StepwiseSearch, net_of_noise
+
+    fam = SimpleNamespace(kind="tangential")
+    share = registry("tangential")["stick_slip"].input_noise_share
+    assert share < 1.0
+    assert net_of_noise(fam, "channel_delay", 1.21, 0.55) == pytest.approx(1.21 - 0.55)
+    assert net_of_noise(fam, "stick_slip", 0.88, 0.55) == pytest.approx(0.88 - share * 0.55)
+    assert net_of_noise(fam, "force_drift", 0.3, 0.55) == pytest.approx(0.3)  # noise-blind
+    stick = (Verdict("stick_slip", 1.0, 0.88, 5.0, -50.0, True, "accepted"), object())
+    delay = (Verdict("channel_delay", 1.0, 1.21, 5.0, -60.0, True, "accepted"), object())
+    step = SimpleNamespace(family=fam, budget=0.55)
+    rank = StepwiseSearch._rank
+    assert max([delay, stick], key=lambda vc: rank(step, vc))[0].name == "stick_slip"
+    # a lead beyond the noise's share stands
+    far = (Verdict("channel_delay", 1.0, 0.88 + 0.55 * (1 - share) + 0.05, 5.0, -60.0, True,
+                   "accepted"), object())  # fmt: skip
+    assert max([far, stick], key=lambda vc: rank(step, vc))[0].name == "channel_delay"
+    # the normal family, and the switch off: the raw gain
+    normal = SimpleNamespace(family=SimpleNamespace(kind="normal"), budget=0.55)
+    assert max([delay, stick], key=lambda vc: rank(normal, vc))[0].name == "channel_delay"
+    monkeypatch.setattr(search, "RANK_NET_OF_NOISE", False)
+    assert max([delay, stick], key=lambda vc: rank(step, vc))[0].name == "channel_delay"
