@@ -82,3 +82,13 @@ def test_accepted_candidates_rank_by_the_gain_beyond_what_the_noise_gives_them(m
     assert max([delay, stick], key=lambda vc: rank(normal, vc))[0].name == "channel_delay"
     monkeypatch.setattr(search, "RANK_NET_OF_NOISE", False)
     assert max([delay, stick], key=lambda vc: rank(step, vc))[0].name == "channel_delay"
+
+
+def test_a_higher_raw_gain_ranked_below_beyond_the_noise_is_no_tie():
+    from contactlab.diagnose.search import _parsimonious
+
+    stick = (Verdict("stick_slip", 1.0, 0.88, 5.0, -50.0, True, "accepted"), object())
+    delay = (Verdict("channel_delay", 1.0, 1.21, 5.0, -60.0, True, "accepted"), object())
+    assert _parsimonious(stick, [stick, delay])[0].name == "stick_slip"
+    near = (Verdict("channel_delay", 1.0, 0.885, 5.0, -60.0, True, "accepted"), object())
+    assert _parsimonious(stick, [stick, near])[0].name == "channel_delay"

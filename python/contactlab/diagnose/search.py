@@ -1247,8 +1247,8 @@ def _parsimonious(
     best: tuple[Verdict, Trial] | None, accepted: list[tuple[Verdict, Trial]]
 ) -> tuple[Verdict, Trial] | None:
     """Of the accepted candidates whose held-out gain is within :data:`TIE_SHARE` of the
-    best's, the one with the fewest parameters, among as many the lowest ``delta_bic``
-    (``best`` when alone, or when no tied candidate has fewer parameters than it).
+    best's (either side), the one with the fewest parameters, among as many the lowest
+    ``delta_bic`` (``best`` when alone, or when no tied candidate has fewer parameters than it).
 
     A viscous term and a normal-load fluctuation at twice the drive frequency draw nearly
     the same force in gross sliding (both the friction's sign times a bump at mid-stroke,
@@ -1261,8 +1261,10 @@ def _parsimonious(
     closing checks as absorbing a misfit it does not model, and nothing was named)."""
     if best is None or len(accepted) < 2:
         return best
-    floor = best[0].gain * (1.0 - TIE_SHARE)
-    tied = [vc for vc in accepted if vc[0].gain >= floor and np.isfinite(vc[0].delta_bic)]
+    floor, top = best[0].gain * (1.0 - TIE_SHARE), best[0].gain * (1.0 + TIE_SHARE)
+    # (``top``: a candidate whose raw gain is higher but that ranked below ``best`` beyond
+    # the input noise's share, :func:`net_of_noise`, is not tied with it)
+    tied = [vc for vc in accepted if floor <= vc[0].gain <= top and np.isfinite(vc[0].delta_bic)]
     if len(tied) < 2:
         return best
     n_best = _parameter_count(best[0].name)
