@@ -43,7 +43,21 @@ CASES: dict[str, dict[str, Any]] = {
                "cycles": (5, 5), "xn": (0.005, 0.02), "f": (2.0, 30.0)},
     "scaling": {"effect": "non_masing_scaling", "rival": ("asymmetry", "force_offset"),
                 "acA": (1.5, 1.5), "cycles": (8, 8), "xn": (0.005, 0.02), "f": (2.0, 30.0)},
+    # issue 29, stop 46 (helper delay): the blind records' stick_slip confusions
+    "damping": {"effect": "viscous_damping", "rival": ("stick_slip",), "acA": (0.6, 0.9),
+                "cycles": (20, 20), "xn": (0.008, 0.013), "f": (5.0, 30.0)},
+    "stiff": {"effect": "parallel_stiffness", "rival": ("stick_slip",), "acA": (2.5, 3.0),
+              "cycles": (50, 50), "xn": (0.008, 0.013), "f": (5.0, 30.0)},
+    "stick": {"effect": "stick_slip", "rival": ("channel_delay",), "acA": (1.8, 2.1),
+              "cycles": (50, 50), "xn": (0.015, 0.02), "f": (5.0, 30.0)},
+    "delay_load": {"effect": "channel_delay", "rival": ("normal_load",), "acA": (3.0, 5.0),
+                   "cycles": (8, 8), "xn": (0.008, 0.015), "f": (5.0, 30.0)},
 }  # fmt: skip
+
+
+#: candidates whose held-out gains are printed at every step beside the case's own (the
+#: breakaway's look-alikes on one amplitude)
+SHOWN = ("stick_slip", "channel_delay", "viscous_damping", "parallel_stiffness", "normal_load")
 
 
 def factors(case: str, seed: int) -> dict[str, Any]:
@@ -69,7 +83,8 @@ def params(case: str, size: float, fac: dict[str, Any]) -> dict[str, dict[str, f
     s = fac["sign"]
     return {e: {"channel_delay": {"tau": size}, "parallel_stiffness": {"k_p": size},
                 "displacement_offset": {"x0": s * size},
-                "non_masing_scaling": {"lam": 2.0 - s * size}}[e]}  # fmt: skip
+                "non_masing_scaling": {"lam": 2.0 - s * size},
+                "viscous_damping": {"c": size}, "stick_slip": {"b": size}}[e]}  # fmt: skip
 
 
 def record(effects: dict, fac: dict[str, Any], seed: int):
@@ -90,7 +105,7 @@ def summary(rep: Any, names: tuple[str, ...]) -> dict[str, Any]:
     steps = []
     for st in rep.steps:
         row = {v.name: [round(float(v.gain), 4), bool(v.accepted), (v.reason or "")[:160]]
-               for v in st.candidates if v.name in names}  # fmt: skip
+               for v in st.candidates if v.name in (*names, *SHOWN)}  # fmt: skip
         if row:
             steps.append(row)
     un = rep.unexplained
@@ -113,6 +128,12 @@ def without(names: tuple[str, ...]) -> None:
     reg = registry("tangential")
     if "spring" in names:
         type(reg["parallel_stiffness"]).smooth_input = False
+    if "stick" in names:  # stop 46: a breakaway yields to a better dashpot or spring again
+        type(reg["stick_slip"]).yield_rivals = ()
+    if "rank" in names:  # stop 46: the accepted candidates ranked by the raw gain again
+        import contactlab.diagnose.search as search
+
+        search.RANK_NET_OF_NOISE = False
     if "backlash" in names and "unfed_samples" in type(reg["backlash"]).__dict__:
         delattr(type(reg["backlash"]), "unfed_samples")
 
@@ -160,7 +181,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--n", type=int, default=4)
     ap.add_argument("--cases", default=",".join(CASES))
     ap.add_argument("--mults", default="1.5,3")
-    ap.add_argument("--without", default="", help="spring,backlash: this stop's rules off")
+    ap.add_argument("--without", default="", help="spring,backlash,stick,rank: these rules off")
     ap.add_argument("--out", type=Path, default=None)
     a = ap.parse_args(argv)
     without(tuple(w for w in a.without.split(",") if w))

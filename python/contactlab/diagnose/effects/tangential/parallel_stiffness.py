@@ -78,6 +78,20 @@ class ParallelStiffness(EffectModel):
             x = smoothed_displacement(ctx.d) + (x - ctx.d.u)
         return F + p["k_p"] * ctx.pick(x)
 
+    def base_equivalent(self, p):
+        """The loop's initial stiffness is the contact's and the spring's in parallel,
+        ``h0·ac + k_p``: the base alone reads that as its ``h0·ac`` (the anchor of the
+        search's take-over check in pre-sliding and transition, where analyze puts a loop
+        the spring tilts so far that it shows no plateau). Compared raw, a spring larger
+        than the friction force looked like a base taken over: rig, k_p = 1.2e6 N/m (k_p A
+        = 2 h0) at ac·A 2.68, ``benches/eval_confusions.py --cases stiff`` seed 4610000: the
+        base alone read h0 = 228 N, ac·A 0.67, h0·ac = 2.47e6 N/m; the spring's fit found
+        h0 = 41.3 N, ac = 3.81e4 /m (the truth 40 N, 4e4 /m) and k_p = 1.19e6 N/m, and was
+        refused as moving h0·ac to 1.57e6 N/m (h0·ac + k_p = 2.76e6 N/m, +12 %); a 2f
+        normal_load and a stick_slip fitted on the collapsed base were accepted instead."""
+        h0, k = float(p.get("h0", 0.0)), max(float(p.get("k_p", 0.0)), 0.0)
+        return {"ac": p["ac"] + k / h0} if h0 > 0 and "ac" in p else {}
+
     def argument(self, d, p):
         a = amplitude(d)
         h0 = p.get("h0", np.nan)
