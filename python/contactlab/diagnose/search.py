@@ -103,12 +103,20 @@ def _explains(current: Trial, cand: Trial, sigma: float) -> float:
     return float(max(cand.heldout_mse - sigma**2, 0.0) / excess)
 
 
-def _noise_floor(family: Family, names: tuple[str, ...], budget: float) -> float:
+def _noise_floor(
+    family: Family,
+    names: tuple[str, ...],
+    budget: float,
+    d: Prepared | None = None,
+    p: dict[str, float] | None = None,
+) -> float:
     """The input-noise budget a candidate adding ``names`` must beat, or 0 when every one of
     them is blind to the input's noise (an effect's ``input_noise_gain`` False: a factor
     or term in time only, such as a parameter drift, whose fit no input noise can feed —
     the budget kept a drift of the friction force of 6 % over 20 cycles, gain 0.12-0.15 σ²
-    at t = 3.7-3.9, below a floor of 0.20 σ² at 2 % input noise)."""
+    at t = 3.7-3.9, below a floor of 0.20 σ² at 2 % input noise). With the record ``d`` and
+    the candidate's fitted parameters ``p``, an effect may state its share at those
+    parameters (:func:`_noise_share`)."""
     from .effects import registry
 
     try:
@@ -120,15 +128,24 @@ def _noise_floor(family: Family, names: tuple[str, ...], budget: float) -> float
         return 0.0
     # an effect that can take only part of what the input's noise leaves (its
     # ``input_noise_share``, measured on clean records) beats that part of the budget
-    return budget * max((_noise_share(reg.get(n)) for n in names), default=1.0)
+    return budget * max((_noise_share(reg.get(n), d, p) for n in names), default=1.0)
 
 
-def _noise_share(eff: object) -> float:
+def _noise_share(
+    eff: object, d: Prepared | None = None, p: dict[str, float] | None = None
+) -> float:
     """The share of the input-noise budget an effect's fit can take from the noise alone: 0
     when it is blind to the input (``input_noise_gain`` False), else its
-    ``input_noise_share`` (default 1: all of it)."""
+    ``input_noise_share_at(d, p)`` at the fitted parameters when it has one and they are
+    given (a normal load off the drive's harmonics cannot take what the noise leaves
+    locked to the cycle), else its ``input_noise_share`` (default 1: all of it)."""
     if not getattr(eff, "input_noise_gain", True):
         return 0.0
+    hook = getattr(eff, "input_noise_share_at", None)
+    if hook is not None and d is not None and p is not None:
+        share = hook(d, p)
+        if share is not None:
+            return float(share)
     return float(getattr(eff, "input_noise_share", 1.0))
 
 
@@ -258,7 +275,7 @@ def _try_candidate(
     # the weighted error (the budget). A sub-sample delay wins by smoothing the input; a
     # track-dependent friction by the turning points noisy x pushes outward (at 1 % x noise
     # position_friction gained 0.08 σ² on clean records against a budget of 0.70 σ²)
-    extra = _noise_floor(family, (*also, name), budget)
+    extra = _noise_floor(family, (*also, name), budget, d, p)
     prop = d if _proportional(family, (*also, name)) else None
     rs = relative_gain_scale(family, (*also, name))
     v = judge(name, current, cand, sigma, z, floor + extra, prop, rel_scale=rs,
@@ -421,7 +438,8 @@ def _drop_check(
         # domain (a zero-slope virgin curve drove ac to its bound 0 in a difference step:
         # "ac must be finite and > 0") cannot judge the effect, which is then kept
         return _not_fitted(name, exc), None
-    extra = _noise_floor(family, (name,), budget)  # the forward rule's (_try_candidate)
+    # the forward rule's (_try_candidate), at the kept fit's parameters
+    extra = _noise_floor(family, (name,), budget, d, current.full.params)
     prop = d if _proportional(family, (name,)) else None
     floor = own_gain_floor(family, (name,), min_gain)
     rs = relative_gain_scale(family, (name,))

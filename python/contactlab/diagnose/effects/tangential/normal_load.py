@@ -7,7 +7,7 @@ import numpy as np
 from ..._family import ParamSpec
 from ..._signal import modulation_gains
 from .._base import EffectModel, Plausibility, register
-from ._common import fixed, memo, smoothed_velocity
+from ._common import fixed, memo, single_frequency, smoothed_velocity
 
 #: a normal-load fluctuation must make this many periods in the record; slower, it is a drift
 MIN_LOAD_PERIODS = 2.0
@@ -41,6 +41,10 @@ MAX_FLUCTUATION = 0.3
 #: had left nothing named (``tests/diagnose/test_misfit_eiv_power.py``: held-out gain 0.072
 #: σ² at the second step against 0.116 σ² for the budget; the compliance dropped after it),
 #: so the share was not kept
+#: the largest share of the input-noise budget a load off the drive's harmonics beats
+#: (:meth:`NormalLoad.input_noise_share_at`); below it, ``sinc²`` of its distance from the
+#: nearest harmonic in frequency bins
+OFF_HARMONIC_SHARE = 0.05
 #: position bins of that test
 _BINS = 32
 #: a fluctuation whose sideband ``f_n ± j f`` (j up to SIDEBANDS) falls within this many
@@ -205,6 +209,27 @@ class NormalLoad(EffectModel):
     #: the comparison with a parallel spring away from the turns and locked to the cycle
     #: (:meth:`yields_to_tried`) on; off only to measure what it changes
     spring_check: bool = True
+
+    def input_noise_share_at(self, d, p) -> float | None:
+        """The share of the input-noise budget (``search._noise_floor``) a load at the
+        fitted ``f_n`` must beat: all of it within one frequency bin of a drive harmonic
+        (:meth:`harmonic`: there its ``h cos, h sin`` repeat with the cycle and can take the
+        misfit the noisy input leaves locked to it, the turning points it pushes outward),
+        else the share of a cycle-locked pattern's power a term ``δ`` from the nearest
+        harmonic takes over the record, ``sinc²(δ T)`` (:data:`OFF_HARMONIC_SHARE` at
+        most). The input's white noise fed through the contact's slope is white in time: a
+        factor in time does not take it. Only on a single-frequency drive (None
+        otherwise: a drive in blocks has harmonics of each block's own frequency)."""
+        if single_frequency(d) is None or not d.duration > 0:
+            return None
+        f_exc = 1.0 / (d.cycles.period_samples * d.dt)
+        f_n = float(p.get("f_n", np.nan))
+        if not (np.isfinite(f_n) and f_exc > 0):
+            return None
+        off = abs(f_n - round(f_n / f_exc) * f_exc) * d.duration
+        if off < 1.0:
+            return 1.0
+        return float(min(np.sinc(off) ** 2, OFF_HARMONIC_SHARE))
 
     def power_shape(self, d, p):
         """The frequency the stated bound is given at: twice the drive's (a normal load
