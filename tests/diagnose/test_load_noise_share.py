@@ -5,6 +5,7 @@ input leaves locked to the cycle; at a harmonic it beats all of it, as before.""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from contactlab.diagnose._family import Prepared
@@ -61,3 +62,37 @@ def test_on_a_drive_in_blocks_the_whole_budget() -> None:
     assert eff.input_noise_share_at(d, {"f_n": 1.5 * f}) is None
     fam = TangentialFamily()
     assert _noise_floor(fam, ("normal_load",), 0.4, d, {"f_n": 1.5 * f}) == pytest.approx(0.4)
+
+
+def test_the_drive_frequency_is_read_from_the_reversals() -> None:
+    """One cycle's length in samples is too coarse to call a third harmonic locked (0.75 %
+    off over 50 cycles is a bin or more); the reversals over the record are not."""
+    from contactlab.diagnose.effects.tangential.normal_load import drive_frequency, harmonic_offset
+
+    d = _rig()
+    assert drive_frequency(d) == pytest.approx(10.0, rel=2e-3)
+    for k in (1, 2, 3, 5):
+        assert harmonic_offset(d, 10.0 * k) < 0.3
+
+
+def test_the_start_prefers_a_load_that_clears_its_floors_off_the_harmonics() -> None:
+    """A residual with a larger pair at 2f (which must beat the whole budget) and a smaller
+    one between harmonics (which beats a share of it): with a large budget the start is the
+    latter; with none, the largest gain, as before."""
+    fam = TangentialFamily()
+    eff = registry("tangential")["normal_load"]
+    d = _rig()
+    p = fam.initial_base(d)
+    h = fam.predict(p, (), d)
+    t = d.t - d.t[0]
+    f = 10.0
+    f_off = 2.0 * f + 3.5 / d.duration
+    r = h * (0.05 * np.cos(2 * np.pi * 2 * f * t) + 0.03 * np.cos(2 * np.pi * f_off * t))
+    sigma = float(np.std(r)) * 0.5
+    d.extra["weight"] = None
+    d.extra["gain_rules"] = {"min_gain": 0.05, "budget": 50.0, "sigma": sigma}
+    start = eff.start(p, d, r, family=fam)
+    assert abs(start["f_n"] - f_off) * d.duration < 0.5
+    d.extra["gain_rules"] = {"min_gain": 0.05, "budget": 0.0, "sigma": sigma}
+    start = eff.start(p, d, r, family=fam)
+    assert abs(start["f_n"] - 2 * f) * d.duration < 0.5

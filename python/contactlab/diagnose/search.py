@@ -149,7 +149,13 @@ def _noise_share(
     return float(getattr(eff, "input_noise_share", 1.0))
 
 
-def own_gain_floor(family: Family, names: tuple[str, ...], min_gain: float) -> float:
+def own_gain_floor(
+    family: Family,
+    names: tuple[str, ...],
+    min_gain: float,
+    d: Prepared | None = None,
+    p: dict[str, float] | None = None,
+) -> float:
     """The held-out (and in-sample) gain, σ², a candidate adding ``names`` must reach beside
     the input-noise budget: ``min_gain`` times the largest of their ``gain_floor_scale``
     (an effect's own, default 1).
@@ -160,14 +166,26 @@ def own_gain_floor(family: Family, names: tuple[str, ...], min_gain: float) -> f
     and no misfit of the base model along the phase of the cycle takes — a straight line in
     time — has its floor scaled down (``gain_floor_scale``, measured on clean records), the
     significance rules across cycles, the BIC and the share of the remaining error
-    (:data:`~contactlab.diagnose.select.MIN_RELATIVE_GAIN`) still apply in full."""
+    (:data:`~contactlab.diagnose.select.MIN_RELATIVE_GAIN`) still apply in full. With the
+    record ``d`` and the candidate's parameters ``p`` (its fit to all data), an effect may
+    state its scale at those parameters (``gain_floor_scale_at(d, p)``: a normal load off
+    the drive's harmonics, which no cycle-locked misfit feeds)."""
     from .effects import registry
 
     try:
         reg = registry(family.kind)
     except KeyError:
         return min_gain
-    scale = max((float(getattr(reg.get(n), "gain_floor_scale", 1.0)) for n in names), default=1.0)
+
+    def scale_of(eff: object) -> float:
+        hook = getattr(eff, "gain_floor_scale_at", None)
+        if hook is not None and d is not None and p is not None:
+            at = hook(d, p)
+            if at is not None:
+                return float(at)
+        return float(getattr(eff, "gain_floor_scale", 1.0))
+
+    scale = max((scale_of(reg.get(n)) for n in names), default=1.0)
     return min_gain * scale
 
 
@@ -255,7 +273,7 @@ def _try_candidate(
         except (ConvergenceError, InputError) as exc:
             return _not_fitted(name, exc), None
     in_gain = (current.full.mse - full.mse) / sigma**2
-    floor = own_gain_floor(family, (*also, name), min_gain)
+    floor = own_gain_floor(family, (*also, name), min_gain, d, full.params)
     # a mass on one drive frequency with no plateau: its size against the record's own
     # simulated null stands in for the floors, the significance and the start-up rule
     beyond = (
@@ -441,7 +459,7 @@ def _drop_check(
     # the forward rule's (_try_candidate), at the kept fit's parameters
     extra = _noise_floor(family, (name,), budget, d, current.full.params)
     prop = d if _proportional(family, (name,)) else None
-    floor = own_gain_floor(family, (name,), min_gain)
+    floor = own_gain_floor(family, (name,), min_gain, d, current.full.params)
     rs = relative_gain_scale(family, (name,))
     verdict = judge(name, reduced, current, sigma, z, floor + extra, prop, rel_scale=rs,
                     strong=_strong_rule(family, z, (name,)))  # fmt: skip
@@ -694,8 +712,11 @@ class StepwiseSearch:
     def __post_init__(self) -> None:
         self.all_samples = np.ones(self.d.y.size, bool)
         self.spent = self.d.extra["evaluations"]
-        # the search's two floors, for the stated power's per-effect floor (own_gain_floor)
-        self.d.extra["gain_rules"] = {"min_gain": self.min_gain, "budget": self.budget}
+        # the search's two floors, for the stated power's per-effect floor (own_gain_floor),
+        # and the noise they are in units of (an effect's start weighing its floors)
+        self.d.extra["gain_rules"] = {
+            "min_gain": self.min_gain, "budget": self.budget, "sigma": self.sigma,
+        }  # fmt: skip
 
     def _rules(self) -> dict[str, Any]:
         return {

@@ -45,6 +45,9 @@ MAX_FLUCTUATION = 0.3
 #: (:meth:`NormalLoad.input_noise_share_at`); below it, ``sinc²`` of its distance from the
 #: nearest harmonic in frequency bins
 OFF_HARMONIC_SHARE = 0.05
+#: the share of the search's ``min_gain`` a load off the drive's harmonics must reach
+#: (:meth:`NormalLoad.gain_floor_scale_at`)
+OFF_HARMONIC_FLOOR = 0.4
 #: position bins of that test
 _BINS = 32
 #: a fluctuation whose sideband ``f_n ± j f`` (j up to SIDEBANDS) falls within this many
@@ -87,6 +90,38 @@ def hum_sideband(d, f_n: float) -> str | None:
                         f"left unexplained (drive harmonic {h['harmonic']} too near to remove it)"
                     )
     return None
+
+
+def drive_frequency(d) -> float:
+    """The drive's frequency, Hz, from the times of its reversals after the first cycle
+    (the start from rest left out): over many cycles a far finer figure than one cycle's
+    length in samples (``d.cycles.period_samples``, 0.75 % off on a rig record of 50 cycles
+    of 200 samples: a third harmonic 1.1 frequency bins off its own), which a load's test
+    for being locked to a harmonic needs. ``1 / (period_samples dt)`` with fewer than four
+    reversals."""
+
+    def make() -> float:
+        rev = np.asarray(d.cycles.reversals, int)
+        cyc = np.asarray(d.cycles.cycle)
+        rev = rev[(rev >= 0) & (rev < cyc.size)]
+        rev = rev[cyc[rev] >= 1] if rev.size else rev
+        if rev.size >= 4:
+            span = float(d.t[rev[-1]] - d.t[rev[0]])
+            if span > 0:
+                return 0.5 * (rev.size - 1) / span
+        return 1.0 / (d.cycles.period_samples * d.dt)
+
+    return float(fixed(d, "drive_frequency", make))
+
+
+def harmonic_offset(d, f_n: float) -> float | None:
+    """How far ``f_n`` lies from the nearest multiple of the drive's frequency
+    (:func:`drive_frequency`, the multiple 0 included), in frequency bins of the record
+    (``1/T``); None when it cannot be said."""
+    f_exc = drive_frequency(d)
+    if not (np.isfinite(f_n) and np.isfinite(f_exc) and f_exc > 0 and d.duration > 0):
+        return None
+    return float(abs(f_n - round(f_n / f_exc) * f_exc) * d.duration)
 
 
 def load_terms(d, f_n: float, rows: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
@@ -222,14 +257,23 @@ class NormalLoad(EffectModel):
         otherwise: a drive in blocks has harmonics of each block's own frequency)."""
         if single_frequency(d) is None or not d.duration > 0:
             return None
-        f_exc = 1.0 / (d.cycles.period_samples * d.dt)
         f_n = float(p.get("f_n", np.nan))
-        if not (np.isfinite(f_n) and f_exc > 0):
+        off = harmonic_offset(d, f_n)
+        if off is None:
             return None
-        off = abs(f_n - round(f_n / f_exc) * f_exc) * d.duration
         if off < 1.0:
             return 1.0
         return float(min(np.sinc(off) ** 2, OFF_HARMONIC_SHARE))
+
+    def gain_floor_scale_at(self, d, p) -> float | None:
+        """The share of the search's ``min_gain`` a load at the fitted ``f_n`` must reach
+        (``search.own_gain_floor``): :data:`OFF_HARMONIC_FLOOR` where it beats only a share
+        of the input-noise budget (:meth:`input_noise_share_at` below 1: off the drive's
+        harmonics on a single-frequency drive, where neither the noise's cycle-locked part
+        nor a misfit of the base model that repeats every cycle feeds it), else None (the
+        whole ``min_gain``)."""
+        share = self.input_noise_share_at(d, p)
+        return OFF_HARMONIC_FLOOR if share is not None and share < 1.0 else None
 
     def power_shape(self, d, p):
         """The frequency the stated bound is given at: twice the drive's (a normal load
@@ -270,8 +314,47 @@ class NormalLoad(EffectModel):
         freqs = np.arange(f_lo, 3.0 * f_exc, step)
         if not freqs.size:
             return {"f_n": f_exc}
-        gains = modulation_gains(h, residual, d.duration, f_lo, step, freqs.size)
-        return {"f_n": float(freqs[int(np.argmax(gains[: freqs.size]))])}
+        gains = modulation_gains(h, residual, d.duration, f_lo, step, freqs.size)[: freqs.size]
+        best = int(np.argmax(gains))
+        off = self._off_harmonic_start(d, h, residual, freqs, f_lo, step)
+        return {"f_n": float(freqs[best] if off is None else off)}
+
+    def _off_harmonic_start(self, d, h, residual, freqs, f_lo, step) -> float | None:
+        """The frequency off the drive's harmonics whose pair, weighed as the search weighs
+        it (its in-sample gain per sample in σ² with the likelihood's weights), clears its
+        own floors (:meth:`gain_floor_scale_at`, :meth:`input_noise_share_at`) by more than
+        the best frequency near a harmonic clears the whole of them; None when none does
+        (or the search's rules are not at hand: the start is then the largest gain).
+
+        The largest gain alone may sit at a harmonic (a misfit of the base model that
+        repeats every cycle, or the noisy input's bias at the turns) where the full
+        budget refuses it, while a load between harmonics, which beats only
+        :data:`OFF_HARMONIC_FLOOR` of ``min_gain``, would pass."""
+        rules = d.extra.get("gain_rules") or {}
+        sigma = float(rules.get("sigma", np.nan) or np.nan)
+        if not (np.isfinite(sigma) and sigma > 0) or single_frequency(d) is None:
+            return None
+        w = d.extra.get("weight")
+        sw = np.ones(h.size) if w is None else np.sqrt(np.clip(np.asarray(w, float), 0, None))
+        if sw.size != h.size:
+            return None
+        g = modulation_gains(h * sw, residual * sw, d.duration, f_lo, step, freqs.size)
+        g = g[: freqs.size] / (h.size * sigma**2)
+        f_exc = drive_frequency(d)
+        offs = np.abs(freqs - np.round(freqs / f_exc) * f_exc) * d.duration
+        min_gain = float(rules.get("min_gain", 0.0))
+        budget = float(rules.get("budget", 0.0))
+        far = offs >= 1.0
+        if not np.any(far):
+            return None
+        share = np.minimum(np.sinc(offs) ** 2, OFF_HARMONIC_SHARE)
+        score_far = g - (min_gain * OFF_HARMONIC_FLOOR + budget * share)
+        score_near = g - (min_gain + budget)
+        i = int(np.argmax(np.where(far, score_far, -np.inf)))
+        near = float(np.max(np.where(far, -np.inf, score_near))) if np.any(~far) else -np.inf
+        if score_far[i] > 0 and score_far[i] > near:
+            return float(freqs[i])
+        return None
 
     def apply(self, h, p, ctx):
         cos, sin = load_terms(ctx.d, p["f_n"], ctx.rows)
