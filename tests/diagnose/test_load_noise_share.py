@@ -96,3 +96,20 @@ def test_the_start_prefers_a_load_that_clears_its_floors_off_the_harmonics() -> 
     d.extra["gain_rules"] = {"min_gain": 0.05, "budget": 0.0, "sigma": sigma}
     start = eff.start(p, d, r, family=fam)
     assert abs(start["f_n"] - 2 * f) * d.duration < 0.5
+
+
+def test_a_short_record_keeps_the_whole_budget() -> None:
+    """Below MIN_OFF_CYCLES complete cycles a frequency bin is too wide to tell a load off
+    the harmonics: the whole budget and ``min_gain``, as before."""
+    from contactlab.diagnose.effects.tangential.normal_load import MIN_OFF_CYCLES
+
+    rec = rig_recording(
+        {}, "tangential", seed=4244, fs=2000.0, f=10.0, cycles=MIN_OFF_CYCLES - 3, acA=2.0,
+        x_noise=0.01, F_noise=0.01,
+    )  # fmt: skip
+    d = Prepared.build(rec.t, rec.x, rec.F)
+    TangentialFamily().prepare(d)
+    eff = registry("tangential")["normal_load"]
+    assert eff.input_noise_share_at(d, {"f_n": 15.0}) is None
+    assert eff.gain_floor_scale_at(d, {"f_n": 15.0}) is None
+    assert _noise_floor(TangentialFamily(), ("normal_load",), 0.4, d, {"f_n": 15.0}) == 0.4
