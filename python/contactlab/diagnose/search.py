@@ -103,12 +103,20 @@ def _explains(current: Trial, cand: Trial, sigma: float) -> float:
     return float(max(cand.heldout_mse - sigma**2, 0.0) / excess)
 
 
-def _noise_floor(family: Family, names: tuple[str, ...], budget: float) -> float:
+def _noise_floor(
+    family: Family,
+    names: tuple[str, ...],
+    budget: float,
+    d: Prepared | None = None,
+    p: dict[str, float] | None = None,
+) -> float:
     """The input-noise budget a candidate adding ``names`` must beat, or 0 when every one of
     them is blind to the input's noise (an effect's ``input_noise_gain`` False: a factor
     or term in time only, such as a parameter drift, whose fit no input noise can feed —
     the budget kept a drift of the friction force of 6 % over 20 cycles, gain 0.12-0.15 σ²
-    at t = 3.7-3.9, below a floor of 0.20 σ² at 2 % input noise)."""
+    at t = 3.7-3.9, below a floor of 0.20 σ² at 2 % input noise). With the record ``d`` and
+    the candidate's fitted parameters ``p``, an effect may state its share at those
+    parameters (:func:`_noise_share`)."""
     from .effects import registry
 
     try:
@@ -120,7 +128,7 @@ def _noise_floor(family: Family, names: tuple[str, ...], budget: float) -> float
         return 0.0
     # an effect that can take only part of what the input's noise leaves (its
     # ``input_noise_share``, measured on clean records) beats that part of the budget
-    return budget * max((_noise_share(reg.get(n)) for n in names), default=1.0)
+    return budget * max((_noise_share(reg.get(n), d, p) for n in names), default=1.0)
 
 
 #: a forward step picks among its accepted candidates by the held-out gain beyond the share of
@@ -129,11 +137,19 @@ def _noise_floor(family: Family, names: tuple[str, ...], budget: float) -> float
 RANK_NET_OF_NOISE = True
 
 
-def net_of_noise(family: Family, name: str, gain: float, budget: float) -> float:
+def net_of_noise(
+    family: Family,
+    name: str,
+    gain: float,
+    budget: float,
+    d: Prepared | None = None,
+    p: dict[str, float] | None = None,
+) -> float:
     """A candidate's held-out ``gain`` (σ²) less the part of the input-noise ``budget`` its
     fit can take from the input's noise alone (:func:`_noise_floor`: all of it for most
     effects, a quarter for a breakaway, a Stribeck term or a track's wave, none for a
-    drift in time).
+    drift in time; with the record ``d`` and the fitted parameters ``p``, the share the
+    effect states at those, as its acceptance used: a load off the drive's harmonics).
 
     The budget is what the input's noise alone gives a candidate's held-out gain on this
     record; the shares were measured on clean records. Two candidates accepted at one step
@@ -144,19 +160,34 @@ def net_of_noise(family: Family, name: str, gain: float, budget: float) -> float
     bound their clean twins state, ac·A 1.9-2.1, x noise 1.8-1.9 % of the range,
     ``benches/eval_confusions.py --cases stick``, tuning seeds 4620000 and 4640000): 1.21
     against 0.88 σ² and 0.98 against 0.66 σ² (budgets 0.55 and 0.58 σ²)."""
-    return float(gain) - _noise_floor(family, (name,), budget)
+    return float(gain) - _noise_floor(family, (name,), budget, d, p)
 
 
-def _noise_share(eff: object) -> float:
+def _noise_share(
+    eff: object, d: Prepared | None = None, p: dict[str, float] | None = None
+) -> float:
     """The share of the input-noise budget an effect's fit can take from the noise alone: 0
     when it is blind to the input (``input_noise_gain`` False), else its
-    ``input_noise_share`` (default 1: all of it)."""
+    ``input_noise_share_at(d, p)`` at the fitted parameters when it has one and they are
+    given (a normal load off the drive's harmonics cannot take what the noise leaves
+    locked to the cycle), else its ``input_noise_share`` (default 1: all of it)."""
     if not getattr(eff, "input_noise_gain", True):
         return 0.0
+    hook = getattr(eff, "input_noise_share_at", None)
+    if hook is not None and d is not None and p is not None:
+        share = hook(d, p)
+        if share is not None:
+            return float(share)
     return float(getattr(eff, "input_noise_share", 1.0))
 
 
-def own_gain_floor(family: Family, names: tuple[str, ...], min_gain: float) -> float:
+def own_gain_floor(
+    family: Family,
+    names: tuple[str, ...],
+    min_gain: float,
+    d: Prepared | None = None,
+    p: dict[str, float] | None = None,
+) -> float:
     """The held-out (and in-sample) gain, σ², a candidate adding ``names`` must reach beside
     the input-noise budget: ``min_gain`` times the largest of their ``gain_floor_scale``
     (an effect's own, default 1).
@@ -167,14 +198,26 @@ def own_gain_floor(family: Family, names: tuple[str, ...], min_gain: float) -> f
     and no misfit of the base model along the phase of the cycle takes — a straight line in
     time — has its floor scaled down (``gain_floor_scale``, measured on clean records), the
     significance rules across cycles, the BIC and the share of the remaining error
-    (:data:`~contactlab.diagnose.select.MIN_RELATIVE_GAIN`) still apply in full."""
+    (:data:`~contactlab.diagnose.select.MIN_RELATIVE_GAIN`) still apply in full. With the
+    record ``d`` and the candidate's parameters ``p`` (its fit to all data), an effect may
+    state its scale at those parameters (``gain_floor_scale_at(d, p)``: a normal load off
+    the drive's harmonics, which no cycle-locked misfit feeds)."""
     from .effects import registry
 
     try:
         reg = registry(family.kind)
     except KeyError:
         return min_gain
-    scale = max((float(getattr(reg.get(n), "gain_floor_scale", 1.0)) for n in names), default=1.0)
+
+    def scale_of(eff: object) -> float:
+        hook = getattr(eff, "gain_floor_scale_at", None)
+        if hook is not None and d is not None and p is not None:
+            at = hook(d, p)
+            if at is not None:
+                return float(at)
+        return float(getattr(eff, "gain_floor_scale", 1.0))
+
+    scale = max((scale_of(reg.get(n)) for n in names), default=1.0)
     return min_gain * scale
 
 
@@ -262,7 +305,7 @@ def _try_candidate(
         except (ConvergenceError, InputError) as exc:
             return _not_fitted(name, exc), None
     in_gain = (current.full.mse - full.mse) / sigma**2
-    floor = own_gain_floor(family, (*also, name), min_gain)
+    floor = own_gain_floor(family, (*also, name), min_gain, d, full.params)
     # a mass on one drive frequency with no plateau: its size against the record's own
     # simulated null stands in for the floors, the significance and the start-up rule
     beyond = (
@@ -282,7 +325,7 @@ def _try_candidate(
     # the weighted error (the budget). A sub-sample delay wins by smoothing the input; a
     # track-dependent friction by the turning points noisy x pushes outward (at 1 % x noise
     # position_friction gained 0.08 σ² on clean records against a budget of 0.70 σ²)
-    extra = _noise_floor(family, (*also, name), budget)
+    extra = _noise_floor(family, (*also, name), budget, d, p)
     prop = d if _proportional(family, (*also, name)) else None
     rs = relative_gain_scale(family, (*also, name))
     v = judge(name, current, cand, sigma, z, floor + extra, prop, rel_scale=rs,
@@ -445,9 +488,10 @@ def _drop_check(
         # domain (a zero-slope virgin curve drove ac to its bound 0 in a difference step:
         # "ac must be finite and > 0") cannot judge the effect, which is then kept
         return _not_fitted(name, exc), None
-    extra = _noise_floor(family, (name,), budget)  # the forward rule's (_try_candidate)
+    # the forward rule's (_try_candidate), at the kept fit's parameters
+    extra = _noise_floor(family, (name,), budget, d, current.full.params)
     prop = d if _proportional(family, (name,)) else None
-    floor = own_gain_floor(family, (name,), min_gain)
+    floor = own_gain_floor(family, (name,), min_gain, d, current.full.params)
     rs = relative_gain_scale(family, (name,))
     verdict = judge(name, reduced, current, sigma, z, floor + extra, prop, rel_scale=rs,
                     strong=_strong_rule(family, z, (name,)))  # fmt: skip
@@ -700,8 +744,11 @@ class StepwiseSearch:
     def __post_init__(self) -> None:
         self.all_samples = np.ones(self.d.y.size, bool)
         self.spent = self.d.extra["evaluations"]
-        # the search's two floors, for the stated power's per-effect floor (own_gain_floor)
-        self.d.extra["gain_rules"] = {"min_gain": self.min_gain, "budget": self.budget}
+        # the search's two floors, for the stated power's per-effect floor (own_gain_floor),
+        # and the noise they are in units of (an effect's start weighing its floors)
+        self.d.extra["gain_rules"] = {
+            "min_gain": self.min_gain, "budget": self.budget, "sigma": self.sigma,
+        }  # fmt: skip
 
     def _rules(self) -> dict[str, Any]:
         return {
@@ -740,7 +787,9 @@ class StepwiseSearch:
         candidate's fit can take from the noise alone (:func:`net_of_noise`)."""
         if not (RANK_NET_OF_NOISE and getattr(self.family, "kind", "") == "tangential"):
             return vc[0].gain
-        return net_of_noise(self.family, vc[0].name, vc[0].gain, self.budget)
+        return net_of_noise(
+            self.family, vc[0].name, vc[0].gain, self.budget, self.d, vc[1].full.params
+        )
 
     @staticmethod
     def _errors(tr: Trial) -> tuple[float, float, float]:
