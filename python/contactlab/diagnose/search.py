@@ -787,9 +787,9 @@ class StepwiseSearch:
         candidate's fit can take from the noise alone (:func:`net_of_noise`)."""
         if not (RANK_NET_OF_NOISE and getattr(self.family, "kind", "") == "tangential"):
             return vc[0].gain
-        return net_of_noise(
-            self.family, vc[0].name, vc[0].gain, self.budget, self.d, vc[1].full.params
-        )
+        params = getattr(getattr(vc[1], "full", None), "params", None)
+        d = getattr(self, "d", None)
+        return net_of_noise(self.family, vc[0].name, vc[0].gain, self.budget, d, params)
 
     @staticmethod
     def _errors(tr: Trial) -> tuple[float, float, float]:
