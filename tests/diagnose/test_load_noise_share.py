@@ -17,6 +17,15 @@ from contactlab.synthetic.diagnosis import hidden_effect_recording
 from contactlab.synthetic.rig import rig_recording
 
 
+@pytest.fixture(autouse=True)
+def _off_harmonic_rules_on(monkeypatch):
+    """The rules are off by default since stop 46 (``OFF_HARMONIC_RULES``); these tests
+    measure them switched on."""
+    from contactlab.diagnose.effects.tangential import normal_load
+
+    monkeypatch.setattr(normal_load, "OFF_HARMONIC_RULES", True)
+
+
 def _rig(seed: int = 4242) -> Prepared:
     rec = rig_recording(
         {}, "tangential", seed=seed, fs=2000.0, f=10.0, cycles=20, acA=2.0,
@@ -113,3 +122,14 @@ def test_a_short_record_keeps_the_whole_budget() -> None:
     assert eff.input_noise_share_at(d, {"f_n": 15.0}) is None
     assert eff.gain_floor_scale_at(d, {"f_n": 15.0}) is None
     assert _noise_floor(TangentialFamily(), ("normal_load",), 0.4, d, {"f_n": 15.0}) == 0.4
+
+
+def test_off_by_default_a_load_beats_the_whole_budget(monkeypatch) -> None:
+    from contactlab.diagnose.effects.tangential import normal_load
+
+    monkeypatch.setattr(normal_load, "OFF_HARMONIC_RULES", False)
+    eff = registry("tangential")["normal_load"]
+    d = _rig()
+    f = 1.0 / (d.cycles.period_samples * d.dt)
+    assert eff.input_noise_share_at(d, {"f_n": 2.0 * f + 3.5 / d.duration}) is None
+    assert eff.gain_floor_scale_at(d, {"f_n": 2.0 * f + 3.5 / d.duration}) is None

@@ -62,6 +62,7 @@ def test_accepted_candidates_rank_by_the_gain_beyond_what_the_noise_gives_them(m
     from contactlab.diagnose import search
     from contactlab.diagnose.search import StepwiseSearch, net_of_noise
 
+    monkeypatch.setattr(search, "RANK_NET_OF_NOISE", True)  # off by default since stop 46
     fam = SimpleNamespace(kind="tangential")
     share = registry("tangential")["stick_slip"].input_noise_share
     assert share < 1.0
