@@ -59,9 +59,32 @@ pub(crate) fn detach_guarded<T: Send, F: FnOnce() -> Result<T, CoreError> + Send
 
 static VERSION: PyOnceLock<String> = PyOnceLock::new();
 
+/// Load numpy's C-API table now, at import, with SIGINT deferred.
+///
+/// The `numpy` crate loads the table on the first array it touches, and that load runs Python
+/// code (`numpy.lib.NumpyVersion`); a Ctrl-C landing there turns into a panic inside the crate
+/// (`expect("Failed to access NumPy array API capsule")`), seen as `PanicException` and status 1
+/// instead of an interrupt (a `demo` run given SIGINT while its first Masing loop was drawn).
+/// Here the load runs under `contactlab._interrupt.deferred()`: an interrupt over it is held
+/// back and raised as `KeyboardInterrupt` from the import, which fails cleanly and can be
+/// retried (the table stays unloaded until a load succeeds).
+fn load_numpy_api(py: Python<'_>) -> PyResult<()> {
+    let guard = py
+        .import("contactlab._interrupt")?
+        .getattr("deferred")?
+        .call0()?;
+    guard.call_method0("__enter__")?;
+    // Any array creation loads the table; a zero-length one costs nothing more.
+    let _ = numpy::PyArray1::<f64>::zeros(py, 0, false);
+    let none = py.None();
+    guard.call_method1("__exit__", (none.clone_ref(py), none.clone_ref(py), none))?;
+    Ok(())
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
+    load_numpy_api(py)?;
     m.add(
         "__version__",
         VERSION.get_or_init(py, || env!("CARGO_PKG_VERSION").to_string()),
