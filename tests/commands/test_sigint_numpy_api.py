@@ -1,4 +1,5 @@
-"""A Ctrl-C while numpy's C-API table loads is an interrupt, never a panic.
+"""A Ctrl-C while numpy's C-API table loads, or while the command line is imported, is an
+interrupt: never a panic, never a traceback.
 
 The ``numpy`` crate loads that table on the first array the binding touches, and the load runs
 Python code (``numpy.lib.NumpyVersion``). A ``KeyboardInterrupt`` raised there used to become a
@@ -65,3 +66,30 @@ def test_interrupt_during_numpy_api_load_is_keyboard_interrupt() -> None:
     assert lines[:2] == ["KeyboardInterrupt", "1"], (r.stdout, r.stderr[-2000:])
     assert "panicked" not in r.stderr, r.stderr[-2000:]
     assert abs(abs(float(lines[2])) - 3.142) < 0.01, r.stdout
+
+
+CLI_IMPORT = textwrap.dedent(
+    """
+    import runpy
+    import sys
+
+    class Interrupt:
+        # a SIGINT landing while `python -m contactlab` imports its command line
+        def find_spec(self, name, path=None, target=None):
+            if name == "contactlab.cli":
+                raise KeyboardInterrupt
+            return None
+
+    sys.meta_path.insert(0, Interrupt())
+    runpy.run_module("contactlab", run_name="__main__")
+    """
+)
+
+
+def test_interrupt_while_the_command_line_imports_exits_130_without_traceback() -> None:
+    r = subprocess.run(
+        [sys.executable, "-c", CLI_IMPORT], capture_output=True, text=True, timeout=120
+    )
+    assert r.returncode == 130, (r.returncode, r.stderr[-2000:])
+    assert "Traceback" not in r.stderr, r.stderr[-2000:]
+    assert "interrupted; no partial outputs written" in r.stderr
