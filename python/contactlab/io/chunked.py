@@ -268,11 +268,18 @@ class _Finisher:
         return grid, out, first
 
     def __call__(
-        self, raw: dict[str, np.ndarray], offset: int, out: dict[str, np.ndarray] | None = None
+        self,
+        raw: dict[str, np.ndarray],
+        offset: int,
+        out: dict[str, np.ndarray] | None = None,
+        scans: dict[str, list[Any]] | None = None,
     ) -> Recording:
         """The chunk of samples ``offset..`` from the file's values ``raw`` (by canonical
         name); with ``out`` (``"t"`` and each channel), the SI values are written there (a
-        ``raw`` array that is its ``out`` array itself is converted in place)."""
+        ``raw`` array that is its ``out`` array itself is converted in place). ``scans``:
+        ``[all finite, smallest, largest]`` of a channel's ``raw`` values found as they were
+        read (:meth:`~contactlab.io.hdf5.DirectRead.read`), taken for its check and range
+        where the values are not converted."""
         check_equal_lengths(raw, self.mapping, file=self.file)
         n = next(iter(raw.values())).size
         if self.prev_t is None and n < 2:  # as the whole-file check of the time says
@@ -303,7 +310,15 @@ class _Finisher:
             # use it: meta["ranges"]) is the finiteness check too: numpy's min and max are NaN
             # when a value is, and ±inf when one is (or overflowed in the conversion)
             # (one pass of the core: finiteness, min and max; numpy took two passes)
-            finite, lo, hi = _core.finite_min_max(v) if v.size else (True, math.inf, -math.inf)
+            sc = None if scans is None else scans.get(canon)
+            unconverted = factor == 1.0 and v is raw[canon]
+            if sc is not None and sc[0] and sc[1] != 0.0 and sc[2] != 0.0 and unconverted:
+                # scanned as read, and not converted: the same numbers (the extremes of
+                # pieces are the extremes; a zero extreme, whose sign a pass's order could
+                # pick, and anything not finite are scanned again below)
+                finite, lo, hi = True, sc[1], sc[2]
+            else:
+                finite, lo, hi = _core.finite_min_max(v) if v.size else (True, math.inf, -math.inf)
             if not finite:
                 # the whole-file reader's checks find the value and raise
                 check_finite(values, file=self.file, column=col, row_of=self.row_of, offset=offset)
@@ -476,15 +491,18 @@ def _h5_chunks(
                     b = min(a + chunk, n)
                     out = None if alloc is None else alloc(b - a, names)
                     raw = {}
+                    scans: dict[str, list[Any]] = {}
                     for c, m in mapping.items():
                         d = direct.get(c)
                         if d is not None and fd is not None:
                             buf = np.empty(b - a) if out is None else out[c]
-                            if d.read(fd, a, buf):
+                            sc: list[Any] = [True, math.inf, -math.inf]
+                            if d.read(fd, a, buf, sc):
                                 raw[c] = buf
+                                scans[c] = sc
                                 continue
                         raw[c] = _slice(dsets[m], a, b, file=file, column=m)
-                    yield fin(raw, a, out)
+                    yield fin(raw, a, out, scans)
             finally:
                 if fd is not None:
                     os.close(fd)

@@ -644,6 +644,12 @@ def write_hdf5(path: str | Path, rec: Recording, **_: Any) -> Path:
     return Path(path)
 
 
+#: samples :meth:`DirectRead.read` asks ``preadv`` for at most when it scans what it reads
+#: (256 KB: still in the core's cache when scanned; a streamed analysis's chunk of 2 MB a
+#: channel, scanned after its read, came from memory again)
+SCAN_PIECE = 1 << 15
+
+
 class DirectRead:
     """Where the samples of an uncompressed 1-d little-endian float64 dataset lie in the file,
     read with ``os.preadv`` straight into the caller's array (:func:`direct_read`): the bytes
@@ -658,9 +664,16 @@ class DirectRead:
         self.pieces = pieces
         self.starts = [p[0] for p in pieces]
 
-    def read(self, fd: int, a: int, out: np.ndarray) -> bool:
+    def read(self, fd: int, a: int, out: np.ndarray, scan: list[Any] | None = None) -> bool:
         """Samples ``a : a + out.size`` into ``out`` (contiguous float64); False when the file
-        gave fewer bytes than asked (truncated: the caller lets libhdf5 report it)."""
+        gave fewer bytes than asked (truncated: the caller lets libhdf5 report it).
+
+        ``scan`` (``[True, inf, -inf]`` given): each piece read is scanned as it arrives
+        (``_core.finite_min_max`` of at most :data:`SCAN_PIECE` samples, in the cache the
+        read left them in) and ``scan`` becomes ``[all finite, smallest, largest]`` of
+        ``out`` (after a piece not finite, only its first entry is meaningful: False)."""
+        from .. import _core
+
         b = a + out.size
         k = bisect.bisect_right(self.starts, a) - 1
         mv = memoryview(out).cast("B")
@@ -668,12 +681,25 @@ class DirectRead:
         while a < b:
             start, count, offset = self.pieces[k]
             m = min(b, start + count) - a
+            if scan is not None:
+                m = min(m, SCAN_PIECE)
             want = 8 * m
             if os.preadv(fd, [mv[at : at + want]], offset + 8 * (a - start)) != want:
                 return False
+            if scan is not None and scan[0]:
+                i = at // 8
+                finite, lo, hi = _core.finite_min_max(out[i : i + m])
+                if not finite:
+                    scan[0] = False
+                else:
+                    if lo < scan[1]:
+                        scan[1] = lo
+                    if hi > scan[2]:
+                        scan[2] = hi
             at += want
             a += m
-            k += 1
+            if a >= start + count:
+                k += 1
         return True
 
 

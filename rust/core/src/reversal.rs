@@ -261,30 +261,44 @@ fn side_block<const UP: bool>(
         return false;
     };
     let better = |a: f64, b: f64| if UP { a > b } else { a < b };
-    // four independent running extremes (a chain of selects a sample was the loop's
-    // latency); the block's extreme value is theirs whatever the order
+    // the trigger's running extreme away from the excursion's side (the smallest above,
+    // the largest below): a sample leaves the band on the other side, or comes back beyond
+    // the centre, exactly when that extreme does (it is one of the samples; a NaN is passed
+    // over by both comparisons, as by the per-sample ones)
+    let away = |a: f64, b: f64| if UP { a < b } else { a > b };
+    // four independent running extremes of each (a chain of selects a sample was the
+    // loop's latency); the block's extremes are theirs whatever the order
     let mut best = [e.extreme_value; 4];
-    let mut other = [false; 4];
+    let mut back_most = [if UP { f64::INFINITY } else { f64::NEG_INFINITY }; 4];
     for j in 0..BLOCK / 4 {
         for k in 0..4 {
             let (uk, vk) = (u[4 * j + k], v[4 * j + k]);
             best[k] = if better(vk, best[k]) { vk } else { best[k] };
-            other[k] |= if UP { uk < lo } else { uk > hi };
+            back_most[k] = if away(uk, back_most[k]) {
+                uk
+            } else {
+                back_most[k]
+            };
         }
     }
-    if other.iter().any(|&o| o) {
-        return false;
-    }
     let mut top = best[0];
-    for &b in &best[1..] {
-        top = if better(b, top) { b } else { top };
+    let mut bottom = back_most[0];
+    for k in 1..4 {
+        top = if better(best[k], top) { best[k] } else { top };
+        bottom = if away(back_most[k], bottom) {
+            back_most[k]
+        } else {
+            bottom
+        };
+    }
+    // a sample beyond the band on the other side: a new excursion starts in the block
+    if if UP { bottom < lo } else { bottom > hi } {
+        return false;
     }
     let back_of = |x: f64| if UP { x < centre } else { x > centre };
     let beyond_of = |x: f64| if UP { x > hi } else { x < lo };
-    // the block's samples back beyond the centre and beyond the band as bit masks (bit k:
-    // sample k; branch-free, so they vectorise): the first sample after the new extreme
-    // back beyond the centre, and the last beyond the band, without a scalar search
-    let back = mask_of(u, back_of);
+    // any sample back beyond the centre (most blocks have none: their mask is not made)
+    let any_back = back_of(bottom);
     if better(top, e.extreme_value) {
         // the first sample of the block's extreme value (numerically equal: ±0 are one; top
         // is one of the block's values, as it beats the excursion's)
@@ -296,15 +310,22 @@ fn side_block<const UP: bool>(
         };
         e.extreme = base + m as u64;
         e.extreme_value = v[m];
-        // beyond the centre after it (m < BLOCK <= 64: both shifts are defined)
-        e.returned = (back >> m) >> 1 != 0;
+        // beyond the centre after it (m < BLOCK <= 64: both shifts are defined); the
+        // samples back beyond the centre as a bit mask (bit k: sample k; branch-free, so it
+        // vectorises), made only when there is one
+        e.returned = any_back && (mask_of(u, back_of) >> m) >> 1 != 0;
     } else {
-        e.returned |= back != 0;
+        e.returned |= any_back;
     }
-    // the block's last sample beyond the band
-    let beyond = mask_of(u, beyond_of);
-    if beyond != 0 {
-        e.last_beyond = base + u64::from(beyond.ilog2()); // the highest bit set (beyond != 0)
+    // the block's last sample beyond the band: its last sample when that is (most blocks
+    // deep in an excursion), else the highest bit of the mask
+    if beyond_of(u[BLOCK - 1]) {
+        e.last_beyond = base + (BLOCK - 1) as u64;
+    } else {
+        let beyond = mask_of(u, beyond_of);
+        if beyond != 0 {
+            e.last_beyond = base + u64::from(beyond.ilog2()); // the highest bit set
+        }
     }
     true
 }
