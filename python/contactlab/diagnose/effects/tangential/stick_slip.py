@@ -368,14 +368,18 @@ class StickSlip(EffectModel):
         own form, and a breakaway with the base's curvature moved takes a share of either
         (rig, a dashpot at half its stated bound in pre-sliding: the breakaway, ell 0.1-0.15
         A, gained 0.27 and 0.16 of the dashpot's held-out gain, the dashpot below the full
-        budget; rig, clean, an LVDT low-pass alone, skew -350 µs at ac·A 0.46, seed 63013 of
-        ``benches/sensor_chain_ablation.py``: a breakaway of 0.0425 σ² named where the delay
-        gained 0.0555 σ², paired t 3.74 in its favour). Where the rival, which must beat the
-        whole budget, draws the held-out cycles significantly better, the shape is the
-        rival's held back by the input's noise: the record does not show a peak after the
-        turn falling back to the kinetic branch, and nothing is named in its place. A rival
+        budget). Where the rival, which must beat the whole budget, draws the held-out
+        cycles significantly better beyond what the input's noise gives it over a breakaway
+        (its lead less ``(1 - INPUT_NOISE_SHARE)`` of the budget, the paired t scaled by the
+        share of the lead left, as :func:`~contactlab.diagnose.search._mark_not_told_apart`
+        discounts a play's lead), the shape is the rival's held back by the input's noise:
+        the record does not show a peak after the turn falling back to the kinetic branch,
+        and nothing is named in its place. A rival
         ahead by chance (paired t below :data:`YIELD_Z`) does not make it yield (a blind
-        breakaway of ac·A 1.15 at 1.9 % x noise was lost so, issue 29)."""
+        breakaway of ac·A 1.15 at 1.9 % x noise was lost so, issue 29), nor does a delay's
+        lead that the noise feeds: rig breakaways at their stated bound (tuning seed 5310002
+        of ``benches/eval_confusions.py --cases stick``, ac·A 1.92, x noise 1.84 % of the
+        range) read a delay 0.146 σ² ahead at t = 7.5 against a budget of 0.54 σ²)."""
         budget = float(d.extra.get("input_noise_budget", 0.0) or 0.0)
         # the floors a rival (a gain floor scale and an input-noise share of 1) must reach
         floor = budget + float((d.extra.get("gain_rules") or {}).get("min_gain", 0.0) or 0.0)
@@ -391,7 +395,14 @@ class StickSlip(EffectModel):
                 continue
             if not (np.isfinite(rv.gain) and rv.gain > v.gain):
                 continue
+            # the rival's lead counts beyond what the input's noise alone gives it over a
+            # breakaway (the rest of the budget: the rival takes all of it, a breakaway
+            # INPUT_NOISE_SHARE), at the same scatter across cycles
+            lead, owed = float(rv.gain - v.gain), (1.0 - self.input_noise_share) * budget
+            if not lead > owed:
+                continue
             t = paired_t(d, current, rc, cand)  # search.paired_lead's statistic
+            t *= 1.0 - owed / lead
             if np.isfinite(t) and t >= YIELD_Z and (best is None or rv.gain > best[0].gain):
                 best = (rv, t)
         if best is None:
@@ -402,7 +413,7 @@ class StickSlip(EffectModel):
             f"{v.gain:.3g} σ² held-out, below the {floor:.3g} σ² floors (input-noise budget "
             f"{budget:.3g} σ² and the search's gain floor) it need not reach, and {rv.name} "
             "tried at the same step drew the held-out cycles significantly better "
-            f"({rv.gain:.3g} σ², paired t of its lead {t:.2f} >= "
+            f"({rv.gain:.3g} σ², paired t of its lead beyond the noise's share {t:.2f} >= "
             f"{YIELD_Z:g}): on one amplitude both are the motion's sign times a function of "
             f"the travel since the turn, and the breakaway takes a share of the {rv.name}'s "
             "shape, held back by the input's noise"
