@@ -1127,7 +1127,7 @@ def _mark_not_told_apart(
             entry = f"{name} ({w.gain:.3g} σ², t = {t:.2f}" + (
                 f"; {noise_sized}" if noise_sized else ""
             )
-            if np.isfinite(t) and t <= -z and not noise_sized:
+            if np.isfinite(t) and t <= -z:
                 # told apart, the other way: the rival fitted significantly better and was
                 # kept out by its refusal (or the search's order), not by the data
                 better.append(f"{entry}; {why[:120] if why else 'accepted, ranked below'})")
