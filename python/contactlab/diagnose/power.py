@@ -747,14 +747,47 @@ def _not_told_apart(name: str, d: Prepared, effects: tuple[str, ...]) -> str:
     tie = (d.extra.get(NOT_TOLD_APART) or {}).get(name)
     if not tie or tie["named"] not in effects:
         return ""
-    better = "as well or better" if tie["t"] < 0 else "as well"
+    return tie_text(name, tie)
+
+
+def tie_text(name: str, tie: dict) -> str:
+    """The stated bound's reason for candidate ``name`` from the search's note ``tie``
+    (:func:`contactlab.diagnose.search._mark_not_told_apart`), true for each sign and size
+    of the paired t of the named effect's lead (``tie["t"]``; the search's ``tie["z"]``,
+    3 when not noted): at most ``-z``, the candidate fitted the held-out cycles
+    significantly better and was kept out by its refusal (``tie["refused"]``) or by the
+    search's order, not by the data; between ``-z`` and 0, as well or better, not
+    significantly; from 0 to ``z``, about as well (the named effect ahead, not
+    significantly); a lead within what the input's noise draws (``tie["noise_sized"]``)
+    is said in either case. On a clean rig record (an LVDT low-pass alone, seed 63013 of
+    ``benches/sensor_chain_ablation.py``) a delay, a dashpot and a breakaway refused by
+    their floors read t = -7.6, -7.0 and -8.3 against a mass named: the old text said the
+    data did not tell them apart."""
+    t, z = float(tie["t"]), float(tie.get("z", 3.0))
     why = tie.get("refused") or ""
+    gains = (
+        f"held-out gains {tie['gain']:.3g} against {tie['gain_named']:.3g} σ², paired t of "
+        f"the named effect's lead {t:.2f}"
+    )
+    noise = f"; {tie['noise_sized']}" if tie.get("noise_sized") else ""
+    if t <= -z:
+        kept = (
+            f"was refused ({why[:200]})"
+            if why
+            else f"the search added {tie['named']} first (ranked above it)"
+        )
+        return (
+            f"told apart from {tie['named']}, named, but not named itself: when "
+            f"{tie['named']} was added, {name} fitted the held-out cycles significantly better "
+            f"({gains}, at most -{z:g}) and {kept}{noise}; the refusal, not the fit, keeps it "
+            "out on this record, so no size is promised"
+        )
+    better = "as well or better" if t < 0 else "about as well"
     return (
         f"not told apart from {tie['named']}, named: when it was added, {name} fitted the "
-        f"held-out cycles {better} (held-out gains {tie['gain']:.3g} against "
-        f"{tie['gain_named']:.3g} σ², paired t of the named effect's lead {tie['t']:.2f})"
+        f"held-out cycles {better} ({gains}, not significant at {z:g})"
         + (f" and was not named ({why[:200]})" if why else "")
-        + (f"; {tie['noise_sized']}" if tie.get("noise_sized") else "")
+        + noise
         + "; on this record the data do not say which of the two they hold"
     )
 

@@ -1097,7 +1097,7 @@ def _mark_not_told_apart(
     where_unfed = getattr(registry(kind).get(v.name), "unfed_samples", None) if fed else None
     unfed = where_unfed(d) if where_unfed is not None and budget > 0 else None
     within = getattr(registry(kind).get(v.name), "within_noise", None) if fed else None
-    ties = []
+    ties, better = [], []
     for name, (w, other) in tried.items():
         if name == v.name or name in st.effects or not (np.isfinite(w.gain) and w.gain > 0):
             continue
@@ -1121,16 +1121,31 @@ def _mark_not_told_apart(
         if (np.isfinite(t) and t <= z) or noise_sized:
             store[name] = {"named": v.name, "gain_named": float(v.gain),
                            "gain": float(w.gain), "t": float(t),
-                           "refused": "" if w.accepted else why}  # fmt: skip
+                           "refused": "" if w.accepted else why, "z": float(z)}  # fmt: skip
             if noise_sized:
                 store[name]["noise_sized"] = noise_sized
-            ties.append(f"{name} ({w.gain:.3g} σ², t = {t:.2f}"
-                        + (f"; {noise_sized}" if noise_sized else "") + ")")  # fmt: skip
+            entry = f"{name} ({w.gain:.3g} σ², t = {t:.2f}" + (
+                f"; {noise_sized}" if noise_sized else ""
+            )
+            if np.isfinite(t) and t <= -z:
+                # told apart, the other way: the rival fitted significantly better and was
+                # kept out by its refusal (or the search's order), not by the data
+                better.append(f"{entry}; {why[:120] if why else 'accepted, ranked below'})")
+            else:
+                ties.append(f"{entry})")
     if ties:
         st.where.append(
             f"{v.name} (held-out gain {v.gain:.3g} σ²) is not told apart from "
             f"{', '.join(ties)}: its lead over each across held-out cycles is not significant "
-            f"(paired t at most {z:g}); on this record the data do not say which of them it is"
+            f"(paired t between -{z:g} and {z:g}); on this record the data do not say which of "
+            "them it is"
+        )
+    if better:
+        st.where.append(
+            f"{v.name} (held-out gain {v.gain:.3g} σ²) was added although "
+            f"{', '.join(better)} fitted the held-out cycles significantly better (paired t of "
+            f"its lead at most -{z:g}): each was refused for the reason given, not told apart "
+            "from it by the data"
         )
 
 
