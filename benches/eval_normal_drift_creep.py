@@ -73,6 +73,7 @@ def main() -> None:
     ap.add_argument("--tau-span", default="0.3,3.0", help="τc over the stated, log-uniform")
     ap.add_argument("--rule", choices=("chi2", "z"), default="z")
     ap.add_argument("--z", type=float, default=None, help="DRIFT_Z for --rule z")
+    ap.add_argument("--no-drift", action="store_true", help="creep records only")
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
     from contactlab.diagnose.effects.normal import creep_drift as cd
@@ -115,8 +116,10 @@ def main() -> None:
         rd = np.random.default_rng(seed + 9000)
         sd = float(rd.uniform(0.002, 0.02)) * float(rd.choice([-1, 1]))
         bow = float(rd.uniform(-1, 1))
-        dn, dfl, _, dlog = diagnose(t, p, d + sd * np.ptp(d) * (u + bow * (u * u - u)))
-        tally["drift_n"] += 1
+        dn, dfl, dlog = [], False, []
+        if not a.no_drift:
+            dn, dfl, _, dlog = diagnose(t, p, d + sd * np.ptp(d) * (u + bow * (u * u - u)))
+        tally["drift_n"] += not a.no_drift
         tally["drift_creep"] += "creep_drift" in dn
         tally["drift_alarm"] += bool(dn or dfl)
         row["drift"] = {"frac": sd, "bow": bow, "named": dn, "flagged": dfl, "test": dlog}
