@@ -138,3 +138,51 @@ def test_drift_evidence_reads_the_knee():
         chi2, s2 = drift_evidence(pr, cur, None, tc)
         assert s2 > 0
         assert (chi2 > 100.0) == big, chi2
+
+
+def _hook_verdict(pr, resid, noise, tau_frac):
+    """:meth:`CreepDrift.yields_to_tried` on a current model that leaves ``resid + noise``
+    (the creep's parameters at ``tau_frac`` of the record)."""
+    from types import SimpleNamespace
+
+    from contactlab.diagnose.effects.normal.creep_drift import CreepDrift
+
+    cur = SimpleNamespace(fitted=pr.y - resid - noise, full_residual=lambda _d, r=resid + noise: -r)
+    p = {"D": float(resid[-1]), "tau_c": tau_frac * pr.duration}
+    return CreepDrift().yields_to_tried(p, None, None, {}, cur, pr)
+
+
+def test_a_small_creep_is_not_refused_as_a_drift_on_a_tie(monkeypatch):
+    """A creep of 0.3 of the per-sample noise settling in 0.2 of the record (stop 47): its
+    settling and a quadratic fit its residual alike within the noise, and the former rule
+    (refused wherever the quadratic fits better, χ² < 0) refused it on a quarter of the
+    noise draws; refused only where the drift is significantly better (z < -2) or the
+    settling has no knee, it stands on nearly all."""
+    from contactlab.diagnose.effects.normal import creep_drift as cd
+
+    pr = _prepared(*_record(0))
+    u = (pr.t - pr.t[0]) / (pr.t[-1] - pr.t[0])
+    resid = 3e-10 * -np.expm1(-u / 0.2)
+    noises = [np.random.default_rng(100 + k).normal(0, 1e-9, u.size) for k in range(40)]
+    now = sum(_hook_verdict(pr, resid, n, 0.2) is not None for n in noises)
+    monkeypatch.setattr(cd, "DRIFT_Z", None)
+    before = sum(_hook_verdict(pr, resid, n, 0.2) is not None for n in noises)
+    assert now <= 2, now
+    assert before >= 4, before
+
+
+def test_a_sensor_drift_is_still_refused():
+    """A straight drift of 3 times the per-sample noise over the record, one bowed to
+    speed up (``u + 0.5 (u² - u)``, which no settling draws) and a small straight one
+    (0.5 times the noise, where the settling and the quadratic fit alike) are refused as
+    the sensor drifting: the first two on their significance, the third as a settling
+    without a knee within the record."""
+    pr = _prepared(*_record(0))
+    u = (pr.t - pr.t[0]) / (pr.t[-1] - pr.t[0])
+    noise = np.random.default_rng(7).normal(0, 1e-9, u.size)
+    straight = _hook_verdict(pr, 3e-9 * u, noise, 0.9)
+    assert straight is not None and "sensor" in straight
+    bowed = _hook_verdict(pr, 3e-9 * (u + 0.5 * (u * u - u)), noise, 0.5)
+    assert bowed is not None and "sensor" in bowed and "z = " in bowed
+    small = _hook_verdict(pr, 5e-10 * u, noise, 0.9)
+    assert small is not None and "no knee" in small
