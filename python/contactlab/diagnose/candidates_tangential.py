@@ -540,6 +540,10 @@ class TangentialFamily:
         effects composed in the order of their stage
         (:data:`~contactlab.diagnose.effects.TANGENTIAL_STAGES`), each by its own
         :meth:`~contactlab.diagnose.effects.EffectModel.apply`."""
+        if at is not None and any(getattr(EFFECTS[e], "whole_record", False) for e in effects):
+            # an effect whose value at a sample depends on the whole force before it (a
+            # sensor's high-pass): the whole record, then the samples asked for
+            return self._force(p, effects, d)[at]
         if "channel_delay" in effects and "raw_input" in d.extra and p["tau"] != 0.0:
             # a kept record (workflow.subsample_long): the model at the shifted raw positions
             rest = tuple(e for e in effects if e != "channel_delay")
