@@ -20,6 +20,7 @@ name                           measured force ``F`` (or measured ``x``)         
 ``series_compliance``          ``x = x_c + C_s h`` (rig compliance in series)              C_s [m/N]
 ``force_offset``               ``F = h + F0`` (sensor bias)                                F0 [N]
 ``force_drift``                ``F = h + F1 (t - t0)/T`` (load-cell zero drifting)         F1 [N]
+``force_highpass``             ``F = HP_fc[h]`` (piezo charge amplifier, from rest)        fc [Hz]
 ``displacement_offset``        ``h = M(x - x0)`` (displacement sensor zero off the origin) x0 [m]
 ``channel_delay``              ``F(t) = h(t - τ)`` (force channel lags displacement)       tau [s]
 ``asymmetry``                  ``F = h + α |h|``: saturation ``h0(1 ± α)`` per direction   alpha [-]
