@@ -773,12 +773,12 @@ def _white_variance(
     the bins that have them (over all bins where none has): two or three neighbouring
     samples of a coloured noise scatter far less than the noise, and one not at all.
     Stop 47: with a cycle-bin's own scatter, a record of 30 samples per period (fs 1 kHz,
-    drive 34 Hz, 5 cycles: one or two samples per bin) had bins of zero variance, ``t``
-    of 6e15 and ``T`` of 8e31, on the record and on every copy of its simulated null alike, so the phase bins could flag nothing
-    (tuning seeds 470003 and 470006 of ``benches/eval_misfit_short.py``); with the
-    scatter pooled over the cycles alone, a copy's bin of two neighbouring samples per
-    cycle behind the record's coloured output noise read 6.6e-6 of the others' and
-    ``T`` 4e6."""
+    drive 34 Hz, 5 cycles: one or two samples per bin) had bins of zero variance, ``t`` of
+    6e15 and ``T`` of 8e31, on the record and on every copy of its simulated null alike, so
+    the phase bins could flag nothing (tuning seeds 470003 and 470006 of
+    ``benches/eval_misfit_short.py``); with the scatter pooled over the cycles alone, a
+    copy's bin of two neighbouring samples per cycle behind the record's coloured output
+    noise read 6.6e-6 of the others' and ``T`` 4e6."""
     with np.errstate(invalid="ignore", divide="ignore"):
         n_b = np.sum(count, axis=0)
         dof = n_b - np.sum(have, axis=0)  # samples less the cycle-bin means
