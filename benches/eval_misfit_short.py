@@ -1,5 +1,7 @@
 """The misfit flag on short records (stop 47, issue 29 item 3): virgin curves no candidate
 draws (``rational``, ``gamma``, ``tanh``) and clean ones (``exp``) of ``benches/misfit_chain.py``
+(and ``rigclean`` or ``effect:<name>``: the package's rig generator, clean or with one effect
+of ``benches/eval_diagnose_rig.py``'s sizes)
 at 5, 8 or 12 cycles, fs 1 or 2 kHz, noise 0.5-2 % of the range on both channels, ac·A
 0.5-5 (log-uniform), drive 1-50 Hz (at most fs/20).
 
@@ -51,9 +53,25 @@ def factors(seed: int) -> dict[str, Any]:
 
 
 def record(seed: int, kind: str) -> tuple[Any, dict[str, Any]]:
+    fx = factors(seed)
+    if kind == "rigclean" or kind.startswith("effect:"):
+        from contactlab.synthetic.rig import rig_recording
+        from eval_diagnose_rig import chain_kwargs, rig_effect
+
+        fac = {k: fx[k] for k in ("fs", "f", "cycles", "acA", "x_noise", "F_noise")}
+        rng = np.random.default_rng(seed + 7919)
+        effect = None if kind == "rigclean" else kind.split(":", 1)[1]
+        eff = rig_effect(effect, "2f", fac, rng)
+        rec = rig_recording(
+            eff, "tangential", seed=seed, fs=fac["fs"], f=fac["f"], cycles=fac["cycles"],
+            acA=fac["acA"], x_noise=fac["x_noise"], F_noise=fac["F_noise"],
+            x_drift=float(rng.uniform(-0.003, 0.003)), bits=int(rng.integers(12, 17)),
+            **chain_kwargs(seed, fac),
+        )  # fmt: skip
+        ch = rec.channels
+        return (np.asarray(rec.t), np.asarray(ch["x"]), np.asarray(ch["F"])), fx
     from misfit_chain import chain_record
 
-    fx = factors(seed)
     over = {k: fx[k] for k in ("fs", "f", "cycles", "acA", "x_noise", "F_noise")}
     rec, fac = chain_record(
         seed, kind, x_colour=fx["x_colour"], hum=fx["hum"], jitter=fx["jitter"], **over
