@@ -85,10 +85,10 @@ MIN_CYCLES = 4
 #: records with fewer complete cycles than this pool the bins' scatter (one scale factor on
 #: each bin's white-noise variance) instead of using each bin's own cycle-to-cycle scatter
 POOL_BELOW = 12
-#: a bin's own scatter (pooled over the cycles) sets its white-noise variance where it has at
-#: least this many degrees of freedom per cycle, else the scatter pooled over the bins does
+#: a cycle-bin's own scatter sets its white-noise variance where every cycle holds at least
+#: this many samples in the bin, else the scatter pooled over the cycle-bins that do
 #: (:func:`_white_variance`)
-OWN_SCATTER_SAMPLES = 3
+OWN_SCATTER_SAMPLES = 2
 #: the simulated null quantile is multiplied by this (see the module docstring). Measured on
 #: clean records of ``benches/eval_false_alarm.py`` (tuning seeds 300-359, both models): T
 #: over the simulated threshold had its 97 % quantile at 0.87 (78 records, 2 above 1) with
@@ -763,36 +763,29 @@ def _cycle_bins(d: Prepared, e: np.ndarray, w: np.ndarray, bins: int) -> _CycleB
 def _white_variance(
     dev2: np.ndarray, sw: np.ndarray, sw2: np.ndarray, count: np.ndarray, have: np.ndarray
 ) -> np.ndarray:
-    """Each cycle-bin mean's variance as white noise would give it, ``(m, 2 bins)``.
+    """Each cycle-bin mean's variance as white noise would give it, ``(m, 2 bins)``: the
+    samples' weighted scatter about their cycle-bin mean times the mean's effective count
+    (``Σw² / (Σw)²``).
 
-    The samples' weighted scatter about their cycle-bin mean is pooled over the cycles of
-    each bin, with one degree of freedom taken out per cycle-bin mean (a bin with a
-    single sample in a cycle has no scatter of its own there), and scaled by the mean's
-    effective count (``Σw² / (Σw)²``). A bin with fewer than
-    :data:`OWN_SCATTER_SAMPLES` degrees of freedom per cycle reads the scatter pooled over
-    the bins that have them (over all bins where none has): two or three neighbouring
-    samples of a coloured noise scatter far less than the noise, and one not at all.
-    Stop 47: with a cycle-bin's own scatter, a record of 30 samples per period (fs 1 kHz,
-    drive 34 Hz, 5 cycles: one or two samples per bin) had bins of zero variance, ``t`` of
-    6e15 and ``T`` of 8e31, on the record and on every copy of its simulated null alike, so
-    the phase bins could flag nothing (tuning seeds 470003 and 470006 of
-    ``benches/eval_misfit_short.py``); with the scatter pooled over the cycles alone, a
-    copy's bin of two neighbouring samples per cycle behind the record's coloured output
-    noise read 6.6e-6 of the others' and ``T`` 4e6."""
+    A cycle-bin of a single sample has no scatter of its own: in a bin where some cycle
+    holds fewer than :data:`OWN_SCATTER_SAMPLES` samples, every cycle-bin reads the scatter
+    pooled over the cycle-bins that hold that many (over all bins), times its own effective
+    count. Stop 47: with each cycle-bin's own scatter, a record of 30 samples per period
+    (fs 1 kHz, drive 34 Hz, 5 cycles: one or two samples per bin and cycle) had bins of zero
+    variance, ``t`` of 6e15 and ``T`` of 8e31, on the record and on every copy of its
+    simulated null alike, so the phase bins could flag nothing (tuning seeds 470003 and
+    470006 of ``benches/eval_misfit_short.py``). Where every cycle-bin holds enough samples
+    the variance is each cycle-bin's own, as before (pooling every bin's scatter over the
+    cycles instead raised a clean record's ``T`` from 85 to 145 at 3.9 samples per bin and
+    an input noise of 1.9 %: the bins' noise is not one level times their counts)."""
     with np.errstate(invalid="ignore", divide="ignore"):
-        n_b = np.sum(count, axis=0)
-        dof = n_b - np.sum(have, axis=0)  # samples less the cycle-bin means
-        s2_b = np.where(dof > 0, np.sum(dev2, axis=0) / np.sum(sw, axis=0) * n_b / dof, np.nan)
-        own = dof >= OWN_SCATTER_SAMPLES * np.sum(have, axis=0)
-        pool = own if own.any() else dof > 0
-        if pool.any():
-            s2_all = (
-                float(np.sum(dev2[:, pool]) / np.sum(sw[:, pool]))
-                * float(np.sum(n_b[pool]))
-                / float(np.sum(dof[pool]))
-            )
-            s2_b = np.where(own, s2_b, s2_all)
-        return np.where(have, s2_b[None, :] * sw2 / (sw * sw), np.nan)
+        own_cb = count >= OWN_SCATTER_SAMPLES
+        white = np.where(have, dev2 / sw * sw2 / (sw * sw), np.nan)
+        own = np.all(own_cb | ~have, axis=0)
+        if own.all() or not own_cb.any():
+            return white
+        s2 = float(np.sum(dev2[own_cb]) / np.sum(sw[own_cb]))
+        return np.where(own[None, :], white, np.where(have, s2 * sw2 / (sw * sw), np.nan))
 
 
 def _bin_t(
