@@ -121,6 +121,12 @@ def get(seed: int, kind: str, cache: str) -> dict[str, Any]:
     return out
 
 
+def _period(seed: int) -> float:
+    """Samples per drive period of a seed's record."""
+    f = factors(seed)
+    return f["fs"] / f["f"]
+
+
 def _why(o: dict[str, Any]) -> str:
     ud = o["u"]
     if not ud:
@@ -176,13 +182,20 @@ def main() -> None:
     ap.add_argument("args", nargs="+")
     ap.add_argument("--cache", default="misfit_short_cache")
     ap.add_argument("--jobs", type=int, default=1, help="processes (1: this one)")
+    ap.add_argument(
+        "--few", type=float, default=None,
+        help="only seeds with fewer samples per drive period than this (stop 47: 60)",
+    )  # fmt: skip
     a = ap.parse_args()
     warnings.simplefilter("ignore")
     if a.what == "table":
         table(a.args[0], a.cache)
         return
     kinds, seed0, n = a.args[0].split(","), int(a.args[1]), int(a.args[2])
-    for seed in range(seed0, seed0 + n):
+    seeds = range(seed0, seed0 + n)
+    if a.few is not None:  # the first n seeds from seed0 with few samples per period
+        seeds = [s for s in range(seed0, seed0 + 100 * n) if _period(s) < a.few][:n]
+    for seed in seeds:
         for kind in kinds:
             o = get(seed, kind, a.cache)
             print(f"{kind} {seed} flag {int(o['flagged'])} cpu {o['cpu']:.0f}s "
