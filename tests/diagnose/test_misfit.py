@@ -90,3 +90,22 @@ def test_t_quantile_equals_scipys(nu):
 
     for p in (0.6, 0.975, 0.999, 1 - 0.03 / 80):
         assert t_quantile(p, nu) == pytest.approx(t.ppf(p, nu), rel=1e-10)
+
+
+def test_few_samples_per_bin_give_a_finite_statistic() -> None:
+    """A fast drive (30 samples per period, 7 cycles: one or two samples per phase bin and
+    cycle): white noise must read as noise, a bump locked to the phase as structure (stop
+    47: bins of one sample per cycle read zero variance and T near 1e31)."""
+    t = np.arange(7 * 30) / 30.0
+    d = Prepared.build(t, np.sin(2 * np.pi * t), np.zeros(t.size))
+    rng = np.random.default_rng(4701)
+    stats = []
+    for _ in range(20):
+        u = unexplained_structure(d, rng.normal(0.0, 0.01, t.size), 0.01)
+        assert u is not None and np.isfinite(u.statistic)
+        stats.append(u.statistic)
+    assert max(stats) < 10 * 2 * BINS
+    assert sum(s > 0 for s in stats) >= 15
+    bump = 0.06 * np.exp(-(((t % 1.0) - 0.3) ** 2) / 0.005)
+    u = unexplained_structure(d, rng.normal(0.0, 0.01, t.size) + bump, 0.01)
+    assert u is not None and u.flagged

@@ -85,6 +85,10 @@ MIN_CYCLES = 4
 #: records with fewer complete cycles than this pool the bins' scatter (one scale factor on
 #: each bin's white-noise variance) instead of using each bin's own cycle-to-cycle scatter
 POOL_BELOW = 12
+#: a cycle-bin's own scatter sets its white-noise variance where every cycle holds at least
+#: this many samples in the bin, else the scatter pooled over the cycle-bins that do
+#: (:func:`_white_variance`)
+OWN_SCATTER_SAMPLES = 2
 #: the simulated null quantile is multiplied by this (see the module docstring). Measured on
 #: clean records of ``benches/eval_false_alarm.py`` (tuning seeds 300-359, both models): T
 #: over the simulated threshold had its 97 % quantile at 0.87 (78 records, 2 above 1) with
@@ -747,14 +751,41 @@ def _cycle_bins(d: Prepared, e: np.ndarray, w: np.ndarray, bins: int) -> _CycleB
     sw = per_bin(w[ok])
     have = sw > 0
     means = np.where(have, per_bin((w * e)[ok]) / np.where(have, sw, 1.0), np.nan)
-    # each cycle-bin mean's variance as white noise would give it (its samples' scatter about
-    # the mean over their effective count), for the pooled scale of few-cycle records
+    # each cycle-bin mean's variance as white noise would give it (the samples' scatter about
+    # their cycle-bin mean over the mean's effective count), for the pooled scale of
+    # few-cycle records
     dev = e[ok] - means.reshape(-1)[key]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        white = np.where(
-            have, per_bin(w[ok] * dev * dev) / sw * per_bin((w * w)[ok]) / (sw * sw), np.nan
-        )
+    white = _white_variance(per_bin(w[ok] * dev * dev), sw, per_bin((w * w)[ok]),
+                            per_bin(np.ones(key.size)), have)  # fmt: skip
     return _CycleBins(ok, b, w, m, means, white, have)
+
+
+def _white_variance(
+    dev2: np.ndarray, sw: np.ndarray, sw2: np.ndarray, count: np.ndarray, have: np.ndarray
+) -> np.ndarray:
+    """Each cycle-bin mean's variance as white noise would give it, ``(m, 2 bins)``: the
+    samples' weighted scatter about their cycle-bin mean times the mean's effective count
+    (``Σw² / (Σw)²``).
+
+    A cycle-bin of a single sample has no scatter of its own: in a bin where some cycle
+    holds fewer than :data:`OWN_SCATTER_SAMPLES` samples, every cycle-bin reads the scatter
+    pooled over the cycle-bins that hold that many (over all bins), times its own effective
+    count. Stop 47: with each cycle-bin's own scatter, a record of 30 samples per period
+    (fs 1 kHz, drive 34 Hz, 5 cycles: one or two samples per bin and cycle) had bins of zero
+    variance, ``t`` of 6e15 and ``T`` of 8e31, on the record and on every copy of its
+    simulated null alike, so the phase bins could flag nothing (tuning seeds 470003 and
+    470006 of ``benches/eval_misfit_short.py``). Where every cycle-bin holds enough samples
+    the variance is each cycle-bin's own, as before (pooling every bin's scatter over the
+    cycles instead raised a clean record's ``T`` from 85 to 145 at 3.9 samples per bin and
+    an input noise of 1.9 %: the bins' noise is not one level times their counts)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        own_cb = count >= OWN_SCATTER_SAMPLES
+        white = np.where(have, dev2 / sw * sw2 / (sw * sw), np.nan)
+        own = np.all(own_cb | ~have, axis=0)
+        if own.all() or not own_cb.any():
+            return white
+        s2 = float(np.sum(dev2[own_cb]) / np.sum(sw[own_cb]))
+        return np.where(own[None, :], white, np.where(have, s2 * sw2 / (sw * sw), np.nan))
 
 
 def _bin_t(
