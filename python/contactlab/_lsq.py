@@ -431,8 +431,33 @@ class Scaled:
             up[j] = min(z[j] + h, hi[j])
             dn[j] = max(z[j] - h, lo[j])
             steps += [up, dn]
-        f = list((self.workers or map)(self.fun, steps))
+        f = list((self.workers or map)(self._fun_or_refused, steps))
+        here: np.ndarray | None = None
         for j in range(len(names)):
             up, dn = steps[2 * j], steps[2 * j + 1]
-            J[:, j] = (f[2 * j] - f[2 * j + 1]) / (up[j] - dn[j])
+            fu, fd = f[2 * j], f[2 * j + 1]
+            refused = [v for v in (fu, fd) if isinstance(v, InputError)]
+            if refused:
+                # the model refuses a step's end (a parameter at its closed bound, such as a
+                # Masing ac of 0 once the fit ran towards a straight line): a one-sided
+                # difference from z on the side it accepts
+                if len(refused) == 2:
+                    raise refused[0]
+                if here is None:
+                    here = self.fun(z)
+                if isinstance(fu, InputError):
+                    fu, up = here, z
+                else:
+                    fd, dn = here, z
+                if up[j] == dn[j]:
+                    raise refused[0]
+            assert not isinstance(fu, InputError) and not isinstance(fd, InputError)
+            J[:, j] = (fu - fd) / (up[j] - dn[j])
         return J
+
+    def _fun_or_refused(self, z: np.ndarray) -> np.ndarray | InputError:
+        """:meth:`fun`, or the model's refusal of ``z`` (returned, not raised)."""
+        try:
+            return self.fun(z)
+        except InputError as exc:
+            return exc

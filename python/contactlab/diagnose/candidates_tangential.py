@@ -86,15 +86,9 @@ _INF = np.inf
 EFFECTS = registry("tangential")
 CANDIDATES: dict[str, Candidate] = {name: e.candidate for name, e in EFFECTS.items()}
 
-#: the lowest ``ac`` a fit may try: the Masing element is defined for ``ac > 0`` only, and a
-#: central-difference step of a fit whose ``ac`` ran towards a straight line (a backbone far
-#: from the exponential one on a short record) was clipped to a bound of 0 and refused
-#: ("ac must be finite and > 0, got 0.0", misfit seed 474039 of benches/eval_misfit_short.py)
-AC_MIN = 1e-300
-
 BASE_PARAMS = (
     ParamSpec("h0", "N", _INF, 0.0, _INF, "F"),
-    ParamSpec("ac", "1/m", _INF, AC_MIN, _INF, "ac"),
+    ParamSpec("ac", "1/m", _INF, 0.0, _INF, "ac"),
 )
 
 #: a normal-load fluctuation must make this many periods in the record; slower, it is a drift
@@ -197,7 +191,7 @@ class TangentialFamily:
         lo, hi = self.h0_band
         return (
             ParamSpec("h0", "N", _INF, lo, hi, "F"),
-            ParamSpec("ac", "1/m", _INF, max(self.ac_floor, AC_MIN), _INF, "ac"),
+            ParamSpec("ac", "1/m", _INF, self.ac_floor, _INF, "ac"),
         )
 
     def anchor(self, p: dict[str, float], se: dict[str, float], d: Prepared) -> str | None:
