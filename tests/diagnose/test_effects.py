@@ -25,15 +25,7 @@ from contactlab.diagnose.effects.tangential.power_law_microslip import (
 )
 from contactlab.masing import Masing, loop_area
 
-#: (force_highpass: its steady term -ωc∫F dt is in quadrature with the force, as a dashpot's)
-VELOCITY = {
-    "channel_delay",
-    "viscous_damping",
-    "stribeck",
-    "inertia",
-    "rate_dependent_presliding",
-    "force_highpass",
-}
+VELOCITY = {"channel_delay", "viscous_damping", "stribeck", "inertia", "rate_dependent_presliding"}
 
 
 def test_registry_lists_every_effect_once_with_its_parameters():

@@ -20,7 +20,6 @@ name                           measured force ``F`` (or measured ``x``)         
 ``series_compliance``          ``x = x_c + C_s h`` (rig compliance in series)              C_s [m/N]
 ``force_offset``               ``F = h + F0`` (sensor bias)                                F0 [N]
 ``force_drift``                ``F = h + F1 (t - t0)/T`` (load-cell zero drifting)         F1 [N]
-``force_highpass``             ``F = HP_fc[h]`` (piezo charge amplifier, from rest)        fc [Hz]
 ``displacement_offset``        ``h = M(x - x0)`` (displacement sensor zero off the origin) x0 [m]
 ``channel_delay``              ``F(t) = h(t - τ)`` (force channel lags displacement)       tau [s]
 ``asymmetry``                  ``F = h + α |h|``: saturation ``h0(1 ± α)`` per direction   alpha [-]
@@ -541,10 +540,6 @@ class TangentialFamily:
         effects composed in the order of their stage
         (:data:`~contactlab.diagnose.effects.TANGENTIAL_STAGES`), each by its own
         :meth:`~contactlab.diagnose.effects.EffectModel.apply`."""
-        if at is not None and any(getattr(EFFECTS[e], "whole_record", False) for e in effects):
-            # an effect whose value at a sample depends on the whole force before it (a
-            # sensor's high-pass): the whole record, then the samples asked for
-            return self._force(p, effects, d)[at]
         if "channel_delay" in effects and "raw_input" in d.extra and p["tau"] != 0.0:
             # a kept record (workflow.subsample_long): the model at the shifted raw positions
             rest = tuple(e for e in effects if e != "channel_delay")

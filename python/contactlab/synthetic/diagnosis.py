@@ -61,7 +61,6 @@ TANGENTIAL_EFFECTS = (
     "position_friction",
     "stick_slip",
     "normal_load",
-    "force_highpass",
 )
 
 #: fixed shapes of the real-friction effects (the size parameter is solved for): Stribeck
@@ -141,28 +140,12 @@ def _tangential_force(
         F = F + effects["viscous_damping"] * v
     if "inertia" in effects:
         F = F + effects["inertia"] * a
-    if "force_highpass" in effects:
-        # a piezo cell's charge amplifier, from zero charge at the (uncut) record's start:
-        # scipy's first-order-hold discretisation of s / (s + ωc), through lfilter (the
-        # sensor's zero, offset and drift, is added after it)
-        F = _highpass(F, t, effects["force_highpass"])
     if "force_offset" in effects:
         F = F + effects["force_offset"]
     if "force_drift" in effects:
         ts = t[0] if t_start is None else t_start
         F = F + effects["force_drift"] * (t - ts) / (t[-1] - ts)
     return x_meas, F
-
-
-def _highpass(F: np.ndarray, t: np.ndarray, fc: float) -> np.ndarray:
-    """``F`` through the first-order high-pass ``s / (s + 2π fc)`` from rest (uniform
-    ``t``)."""
-    if not fc > 0.0:
-        return F
-    from scipy.signal import cont2discrete, lfilter
-
-    b, a, _ = cont2discrete(([1.0, 0.0], [1.0, 2 * np.pi * fc]), float(t[1] - t[0]), "foh")
-    return lfilter(np.ravel(b), np.ravel(a), F)
 
 
 _PARAM_NAME = {
@@ -181,7 +164,6 @@ _PARAM_NAME = {
     "position_friction": "eps",
     "stick_slip": "s_b",
     "normal_load": "eps",
-    "force_highpass": "fc",
 }
 
 
@@ -425,7 +407,6 @@ def _solve_size(
         "asymmetry": 0.9,
         "non_masing_scaling": 1.5 if sign > 0 else 0.9,
         "parameter_drift": 0.9,
-        "force_highpass": 2.0 / period,
     }[name]
 
     def g(s: float) -> float:
