@@ -105,6 +105,14 @@ def main(argv: Sequence[str] | None = None) -> int:
             print("contactlab: interrupted; no partial outputs written", file=sys.stderr)
             _exit_interrupted()
             raise  # not reached
+        except Exception as exc:
+            if not (_interrupt.pending() or _by_interrupt(exc)):
+                raise
+            # a Ctrl-C that Python wrapped in another exception where it landed (a class
+            # body's __set_name__ while matplotlib was imported turns it into RuntimeError)
+            print("contactlab: interrupted; no partial outputs written", file=sys.stderr)
+            _exit_interrupted()
+            raise  # not reached
         finally:
             _interrupt.uninstall()
             # a structure scan started ahead for a file the run never opened (a usage error,
@@ -121,6 +129,19 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 #: the exit status of an interrupted run (128 + SIGINT), as a shell reports it
 _INTERRUPTED = 130
+
+
+def _by_interrupt(exc: BaseException) -> bool:
+    """Whether ``exc`` was caused by a ``KeyboardInterrupt`` (its cause or context chain):
+    Python wraps an exception raised in ``__set_name__`` or an import hook in another one."""
+    seen: set[int] = set()
+    e: BaseException | None = exc
+    while e is not None and id(e) not in seen:
+        if isinstance(e, KeyboardInterrupt):
+            return True
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
+    return False
 
 
 def _exit_interrupted() -> None:
@@ -273,6 +294,10 @@ def _main(argv: list[str]) -> int:
     try:
         return int(args.handler(args) or 0)
     except ContactLabError as exc:
+        if _by_interrupt(exc):
+            print(f"contactlab {args.verb}: interrupted; no partial outputs written",
+                  file=sys.stderr)  # fmt: skip
+            return _INTERRUPTED
         print(f"contactlab {args.verb}: error: {cli_wording(str(exc))}", file=sys.stderr)
         return 1
     except OSError as exc:  # the file system said no (permissions, full disk, a file in the way)
@@ -283,6 +308,10 @@ def _main(argv: list[str]) -> int:
         return _INTERRUPTED
     except RuntimeError as exc:  # a worker process was killed (out of memory, a signal)
         futures = sys.modules.get("concurrent.futures")  # imported by whatever started a pool
+        if _by_interrupt(exc):
+            print(f"contactlab {args.verb}: interrupted; no partial outputs written",
+                  file=sys.stderr)  # fmt: skip
+            return _INTERRUPTED
         if futures is None or not isinstance(exc, futures.BrokenExecutor):
             raise
         print(

@@ -96,3 +96,37 @@ def test_interrupt_while_the_command_line_imports_exits_130_without_traceback() 
     assert r.returncode == 130, (r.returncode, r.stderr[-2000:])
     assert "Traceback" not in r.stderr, r.stderr[-2000:]
     assert "interrupted; no partial outputs written" in r.stderr
+
+
+WRAPPED = textwrap.dedent(
+    """
+    import runpy
+    import sys
+
+    class Interrupt:
+        # a SIGINT landing in a class body's __set_name__ while a verb's imports run:
+        # Python hands it on wrapped in RuntimeError (CI: matplotlib's Axis, stop 47)
+        def find_spec(self, name, path=None, target=None):
+            if name == "contactlab.commands.demo":
+                try:
+                    raise KeyboardInterrupt
+                except KeyboardInterrupt as exc:
+                    raise RuntimeError("Error calling __set_name__") from exc
+            return None
+
+    sys.meta_path.insert(0, Interrupt())
+    sys.argv = ["contactlab", "demo", "--quick", "--out", sys.argv[1]]
+    runpy.run_module("contactlab", run_name="__main__")
+    """
+)
+
+
+def test_an_interrupt_wrapped_in_another_exception_exits_130(tmp_path) -> None:
+    out = tmp_path / "out"
+    r = subprocess.run(
+        [sys.executable, "-c", WRAPPED, str(out)], capture_output=True, text=True, timeout=120
+    )
+    assert r.returncode == 130, (r.returncode, r.stderr[-2000:])
+    assert "Traceback" not in r.stderr, r.stderr[-2000:]
+    assert "interrupted; no partial outputs written" in r.stderr
+    assert not out.exists()
