@@ -75,16 +75,6 @@ FAST_SHARE, PLATEAU_SHARE, LOCKED_LEAD = 0.5, 0.95, 0.14
 DELAY_SHARE = 0.7
 
 
-def _debug(share, load, delay, tau) -> None:
-    """Temporary: the delay rule's figures on stderr when CL_DEBUG_DELAY is set."""
-    import os
-    import sys
-
-    if os.environ.get("CL_DEBUG_DELAY"):
-        print(f"DEBUG_DELAY share {share:.3f} load {load:.3f} delay {delay:.3f} tau {tau}",
-              file=sys.stderr, flush=True)  # fmt: skip
-
-
 def hum_sideband(d, f_n: float) -> str | None:
     """Why a fluctuation at ``f_n`` is the mains hum left on both channels (one of its
     sidebands on the line), or None."""
@@ -572,7 +562,7 @@ class NormalLoad(EffectModel):
         at the same step with at least :data:`DELAY_SHARE` of its held-out gain, or None
         (called by :meth:`yields_to_tried` after the harmonic check).
 
-        On a loop that is mostly sliding plateau (ac·A 1.4-4) a delay shifts the force at
+        On a loop that is mostly sliding plateau (ac·A 1.4-5) a delay shifts the force at
         both reversals of every cycle, the same each cycle: a shape locked to the cycle at
         2f, which a load ε cos(2ωt + φ)·M[x] with its phase free draws in good part. The
         held-out gains do not rank them fairly: the delay's fit is shortened or lengthened
@@ -601,7 +591,6 @@ class NormalLoad(EffectModel):
         if not 0.0 < float(rc.full.params.get("tau", 0.0)) <= MAX_SKEW_SECONDS:
             return None
         share = rv.gain / v.gain
-        _debug(share, v.gain, rv.gain, rc.full.params.get("tau"))
         if share < DELAY_SHARE:
             return None
         return (
@@ -610,7 +599,7 @@ class NormalLoad(EffectModel):
             f"{rv.gain:.3g} σ² ({share:.2f} of it) with one parameter against the load's "
             "three: a delay shifts the force at both reversals of every cycle, which a load "
             "locked to the drive at 2f draws at one amplitude, and the input's noise, which "
-            "shortens the delay's fit, does not touch a factor in time"
+            "moves the delay's fit, does not touch a factor in time"
         )
 
     def argument(self, d, p):
