@@ -7,7 +7,9 @@ that the flag can be recomputed on the cached final model (``recompute``).
 
     nice .venv/bin/python benches/eval_clean_chain.py run 480000 40 --cache DIR
     .venv/bin/python benches/eval_clean_chain.py table --cache DIR
-    .venv/bin/python benches/eval_clean_chain.py recompute --cache DIR
+    .venv/bin/python benches/eval_clean_chain.py recompute [PATTERN] --cache DIR
+
+(``recompute`` also reads ``benches/eval_misfit_short.py``'s cache: ``'short_*'``).
 
 Seeds: 480000-480999 tuning (stop 48); report on fresh ones.
 """
@@ -35,7 +37,11 @@ HUM = ("none", "off", "2f")
 
 
 def factors(
-    seed: int, hum: str | None = None, jitter: bool | None = None, xn: float | None = None
+    seed: int,
+    hum: str | None = None,
+    jitter: bool | None = None,
+    xn: float | None = None,
+    white: bool | None = None,
 ) -> dict[str, Any]:
     """The factors of one record, drawn from its seed (``hum``/``jitter`` forced if given,
     ``xn``: the x noise drawn from ``xn``-2 % instead of 0.5-2 %)."""
@@ -60,22 +66,33 @@ def factors(
         "hum_F": float(rng.uniform(0.0, 0.006)) if h != "none" else 0.0,
         "jitter": float(rng.uniform(0.0, 0.02)) / fs if j else 0.0,
         "bits": int(rng.integers(14, 17)),
+        "white": bool(white),
     }
 
 
 def record(seed: int, fx: dict[str, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The rig record of ``fx``: clean, Bessel filters, start from rest; hum added on the
-    sampled channels at its own amplitude per channel (fraction of the channel's amplitude)."""
+    sampled channels at its own amplitude per channel (fraction of the channel's amplitude).
+    With ``fx["white"]`` the noise is white, added to the sampled channels after the chain
+    (at the rig's noise fractions of each channel's amplitude), and the sample times are the
+    nominal ones (the jittered instants unrecorded)."""
     from contactlab.synthetic.rig import rig_recording
 
+    white = bool(fx.get("white"))
     rec = rig_recording(
         {}, "tangential", seed=seed, fs=fx["fs"], f=fx["f"], cycles=fx["cycles"],
-        acA=fx["acA"], x_noise=fx["x_noise"], F_noise=fx["F_noise"], bits=fx["bits"],
+        acA=fx["acA"], x_noise=0.0 if white else fx["x_noise"],
+        F_noise=0.0 if white else fx["F_noise"], bits=fx["bits"],
         aa_kind="bessel", jitter=fx["jitter"], ramp_cycles=0.0,
     )  # fmt: skip
     t = np.asarray(rec.t, float)
     x = np.asarray(rec.channels["x"], float).copy()
     F = np.asarray(rec.channels["F"], float).copy()
+    if white:
+        t = np.arange(t.size) / fx["fs"]
+        rng = np.random.default_rng([seed, 6060])
+        x += rng.standard_normal(x.size) * fx["x_noise"] * 0.5 * float(np.ptp(x))
+        F += rng.standard_normal(F.size) * fx["F_noise"] * 0.5 * float(np.ptp(F))
     if fx["hum"] != "none":
         rng = np.random.default_rng([seed, 5050])
         for s, a in ((x, fx["hum_x"]), (F, fx["hum_F"])):
@@ -173,25 +190,44 @@ def table(cache: str) -> None:
     print(f"quiet {q}/{len(rows)} flagged {nf} named {nn} (inertia {ni})")
 
 
-def recompute(cache: str) -> None:
+def recompute(cache: str, pattern: str = "clean_*") -> None:
     """The calibrated misfit decision recomputed with this tree's null on every cached
-    record's final model (the other flag routes as cached)."""
-    from contactlab.diagnose.misfit_null import calibrated_flag, simulated_null
+    record's final model (the other flag routes as cached), without and with the hum's
+    directions (``misfit_null.HUM``: stop 48's before and after)."""
+    import contactlab.diagnose.misfit_null as mn
 
-    rows = _load(cache)
-    nf = 0
+    rows = []
+    for p in sorted(glob.glob(f"{cache}/{pattern}.pkl")):
+        with open(p, "rb") as fh:
+            rows.append(pickle.load(fh))
+    nf = {False: 0, True: 0}
     for o in rows:
         if "args" not in o:
-            print(_line(o, {}, o["flagged"]) + " (no null)")
-            nf += int(o["flagged"])
+            print(f"{o['seed']} (no null) flag {int(o['flagged'])}")
+            for h in nf:
+                nf[h] += int(o["flagged"])
             continue
-        nd = simulated_null(*o["args"], **o.get("kw", {}))
-        cal = {} if nd is None else calibrated_flag(nd)
         other = bool(o["u"].get("rivals") or o["u"].get("patches"))
-        fl = bool(cal.get("flagged")) or other
-        nf += int(fl)
-        print(_line(o, cal, fl), flush=True)
-    print(f"recomputed: flagged {nf}/{len(rows)}")
+        for hum in (False, True):
+            mn.HUM = hum
+            nd = mn.simulated_null(*o["args"], **o.get("kw", {}))
+            u = o["u"]
+            hand = u.get("statistic") is not None and u["statistic"] > u["threshold"]
+            cal = {} if nd is None else mn.calibrated_flag(nd, hand_bins=bool(hand))
+            fl = bool(cal.get("flagged")) or other
+            nf[hum] += int(fl)
+            if "fac" in o and "hum_x" in o["fac"]:
+                head = _line(o, cal, fl)
+            else:
+                head = (
+                    f"{o.get('kind', '')} {o['seed']} flag {int(fl)} by "
+                    f"{'+'.join(cal.get('by', [])) or '-'} T {_g(cal.get('T'))}/"
+                    f"{_g(cal.get('T_threshold'))} t {_g(cal.get('t'))}/"
+                    f"{_g(cal.get('t_threshold'))}"
+                )
+            print(f"hum {int(hum)} {head}", flush=True)
+    mn.HUM = True
+    print(f"recomputed: flagged {nf[False]}/{len(rows)} before, {nf[True]}/{len(rows)} after")
 
 
 def main() -> None:
@@ -202,16 +238,22 @@ def main() -> None:
     ap.add_argument("--hum", choices=HUM, default=None, help="force the hum case")
     ap.add_argument("--jitter", type=int, choices=(0, 1), default=None, help="force jitter")
     ap.add_argument("--xn", type=float, default=None, help="x noise drawn from XN to 0.02")
+    ap.add_argument("--white", action="store_true", help="white noise after the chain")
     a = ap.parse_args()
     warnings.simplefilter("ignore")
     if a.what == "table":
         table(a.cache)
         return
     if a.what == "recompute":
-        recompute(a.cache)
+        recompute(a.cache, *(a.args[:1]))
         return
     seed0, n = int(a.args[0]), int(a.args[1])
-    force = {"hum": a.hum, "jitter": None if a.jitter is None else bool(a.jitter), "xn": a.xn}
+    force = {
+        "hum": a.hum,
+        "jitter": None if a.jitter is None else bool(a.jitter),
+        "xn": a.xn,
+        "white": True if a.white else None,
+    }
     for seed in range(seed0, seed0 + n):
         o = get(seed, a.cache, **force)
         cal = o["u"].get("calibrated") or {}

@@ -356,11 +356,18 @@ def _output_beyond_input(
 #: bins: 0.64 at half a bin, none at one); a mains frequency (within its drift) this many
 #: bins from a harmonic or nearer gets the hum's directions
 HUM_BINS = 1.5
+#: ... and only up to this drive harmonic: a phase bin spans a twentieth of a cycle
+#: (:data:`.misfit.BINS` per branch), over which the k-th harmonic averages to ``sinc(k/20)``
+#: of itself (0.64 at 10, none at 20). A drive of 1 Hz or slower has a harmonic within a bin
+#: of 50 Hz on every measured record of ``../shared/data`` (the 16 of
+#: ``benches/eval_measured_diagnose.py``: harmonics 25-500); a hum there is no structure the
+#: tests can see
+HUM_MAX_HARMONIC = 10
 
 
 def hum_harmonics(d: Prepared) -> list[float]:
     """The drive harmonics (Hz) with a mains frequency (:data:`._mains.MAINS`, within its
-    drift) at most :data:`HUM_BINS` bins away: there :func:`._mains.remove_mains` cannot
+    drift) at most :data:`HUM_BINS` bins away, up to harmonic :data:`HUM_MAX_HARMONIC`: there :func:`._mains.remove_mains` cannot
     take a hum out (the drive's own line is there), and a hum on the channels stays in the
     record locked to the drive's phase. Empty where none is (the usual case)."""
     from ._mains import MAINS, MAINS_DRIFT, MIN_PERIODS, drive_frequency
@@ -381,7 +388,7 @@ def hum_harmonics(d: Prepared) -> list[float]:
             continue
         k = max(round(f0 / f_drive), 1)
         fh = k * f_drive
-        if (abs(f0 - fh) - MAINS_DRIFT) * duration < HUM_BINS:
+        if k <= HUM_MAX_HARMONIC and (abs(f0 - fh) - MAINS_DRIFT) * duration <= HUM_BINS:
             out.append(float(fh))
     return out
 
