@@ -85,7 +85,13 @@ KEEP_HARMONICS = 12.0
 #: 13 % in T and flagged the same 2 of 12 clean records
 PROJECT_OBSERVED = False
 #: draw the copies' input noise with the record's own spectrum wherever it can be read,
-#: not only where :func:`.eiv.is_coloured` says it is coloured (tried, see below)
+#: not only where :func:`.eiv.is_coloured` says it is coloured. Tried and not kept (stop 48,
+#: ``benches/eval_clean_chain.py``, 70 clean rig records of seeds 480000-480039,
+#: 480100-480105, 481000-481023, Bessel chain): the white estimate reads the rig's noise at
+#: 0.86-0.92 of what the record's input holds beyond its drive lines, and the spectrum's
+#: level lifted the phase bins' null threshold by 10-25 %, but the records whose ``T`` stood
+#: over it went from 6 to 5 of 70 only (their ``T`` 1.2-1.5 times the threshold: the
+#: steep turn after each reversal holds more structure than the copies draw)
 SPECTRUM_ALWAYS = False
 #: take the directions of a hum a drive harmonic hides off the residuals
 #: (:func:`hum_columns`)
