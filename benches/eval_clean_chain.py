@@ -59,7 +59,9 @@ def factors(
         "f": f,
         "cycles": int(rng.choice(CYCLES)),
         "acA": float(np.exp(rng.uniform(np.log(0.3), np.log(4.5)))),
-        "x_noise": float(rng.uniform(0.005 if xn is None else xn, 0.02)),
+        "x_noise": float(
+            rng.uniform(0.005, 0.02) if xn is None else rng.uniform(xn, max(0.02, xn + 0.005))
+        ),
         "F_noise": float(rng.uniform(0.005, 0.02)),
         "hum": h,
         "hum_x": float(rng.uniform(0.0, 0.004)) if h != "none" else 0.0,
@@ -237,7 +239,7 @@ def main() -> None:
     ap.add_argument("--cache", default="clean_chain_cache")
     ap.add_argument("--hum", choices=HUM, default=None, help="force the hum case")
     ap.add_argument("--jitter", type=int, choices=(0, 1), default=None, help="force jitter")
-    ap.add_argument("--xn", type=float, default=None, help="x noise drawn from XN to 0.02")
+    ap.add_argument("--xn", type=float, default=None, help="x noise drawn from XN to max(0.02, XN + 0.005)")
     ap.add_argument("--white", action="store_true", help="white noise after the chain")
     a = ap.parse_args()
     warnings.simplefilter("ignore")
