@@ -239,7 +239,9 @@ def main() -> None:
     ap.add_argument("--cache", default="clean_chain_cache")
     ap.add_argument("--hum", choices=HUM, default=None, help="force the hum case")
     ap.add_argument("--jitter", type=int, choices=(0, 1), default=None, help="force jitter")
-    ap.add_argument("--xn", type=float, default=None, help="x noise drawn from XN to max(0.02, XN + 0.005)")
+    ap.add_argument(
+        "--xn", type=float, default=None, help="x noise drawn from XN to max(0.02, XN + 0.005)"
+    )
     ap.add_argument("--white", action="store_true", help="white noise after the chain")
     a = ap.parse_args()
     warnings.simplefilter("ignore")
