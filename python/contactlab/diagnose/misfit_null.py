@@ -35,7 +35,12 @@ estimated noise on both channels, and computes the same statistics on each:
   (:data:`PROJECT_OBSERVED`);
 - the statistics are computed on the residual as measured (no simulated bias taken out, no
   interval null, no bin or sample left out for its input noise), in the measurement and in
-  every draw alike.
+  every draw alike;
+- where a mains frequency lies on a low drive harmonic (:func:`hum_harmonics`: the mains
+  remover must leave a hum there, and it is locked to the drive's phase), the directions a
+  hum on both channels leaves (:func:`hum_columns`) are taken off the record's residual and
+  every copy's alike: a measurement artefact, not a joint misfit (stop 48: 50 Hz at a 25 Hz
+  drive flagged 6 of 40 clean rig records, ``benches/eval_clean_chain.py``).
 
 The decision (:func:`calibrated_flag`): each statistic is compared with the upper
 prediction bound of its null at ``α/2`` (:data:`~.detection.MISFIT_FALSE_ALARM` split
@@ -79,6 +84,18 @@ KEEP_HARMONICS = 12.0
 #: 3000-3011 (x noise 1.5-2 %, ac·A 1-5) it moved the statistics by at most 0.2 in t and
 #: 13 % in T and flagged the same 2 of 12 clean records
 PROJECT_OBSERVED = False
+#: draw the copies' input noise with the record's own spectrum wherever it can be read,
+#: not only where :func:`.eiv.is_coloured` says it is coloured. Tried and not kept (stop 48,
+#: ``benches/eval_clean_chain.py``, 70 clean rig records of seeds 480000-480039,
+#: 480100-480105, 481000-481023, Bessel chain): the white estimate reads the rig's noise at
+#: 0.86-0.92 of what the record's input holds beyond its drive lines, and the spectrum's
+#: level lifted the phase bins' null threshold by 10-25 %, but the records whose ``T`` stood
+#: over it went from 6 to 5 of 70 only (their ``T`` 1.2-1.5 times the threshold: the
+#: steep turn after each reversal holds more structure than the copies draw)
+SPECTRUM_ALWAYS = False
+#: take the directions of a hum a drive harmonic hides off the residuals
+#: (:func:`hum_columns`)
+HUM = True
 #: the free-form virgin curve's held-out gain (``σ²`` per sample) below which its test does
 #: not fire however significant (an effect-size floor, as :data:`.misfit.BACKBONE_MIN_GAIN`
 #: is for the hand-set test): a long record resolves a chain's own imprint, a load cell's
@@ -346,6 +363,98 @@ def _output_beyond_input(
     return shape, math.sqrt(var)
 
 
+#: the hum a drive harmonic hides (:func:`hum_columns`): :func:`._mains.remove_mains`
+#: leaves mains hum within :data:`~._mains.GUARD_BINS` bins (1 / record length) of a drive
+#: harmonic in both channels, and within about a bin it stays locked to the drive's phase
+#: over the record (the phase bins' means over the cycles keep ``sinc`` of its offset in
+#: bins: 0.64 at half a bin, none at one); a mains frequency (within its drift) this many
+#: bins from a harmonic or nearer gets the hum's directions
+HUM_BINS = 1.5
+#: ... and only up to this drive harmonic: a phase bin spans a twentieth of a cycle
+#: (:data:`.misfit.BINS` per branch), over which the k-th harmonic averages to ``sinc(k/20)``
+#: of itself (0.64 at 10, none at 20). A drive of 1 Hz or slower has a harmonic within a bin
+#: of 50 Hz on every measured record of ``../shared/data`` (the 16 of
+#: ``benches/eval_measured_diagnose.py``: harmonics 25-500); a hum there is no structure the
+#: tests can see
+HUM_MAX_HARMONIC = 10
+
+
+def hum_harmonics(d: Prepared) -> list[float]:
+    """The drive harmonics (Hz) with a mains frequency (:data:`._mains.MAINS`, within its
+    drift) at most :data:`HUM_BINS` bins away, up to harmonic :data:`HUM_MAX_HARMONIC`: there
+    :func:`._mains.remove_mains` cannot take a hum out (the drive's own line is there), and a
+    hum on the channels stays in the record locked to the drive's phase. Empty where none is
+    (the usual case)."""
+    from ._mains import MAINS, MAINS_DRIFT, MIN_PERIODS, drive_frequency
+
+    t = np.asarray(d.t, float)
+    duration = float(t[-1] - t[0]) if t.size > 1 else 0.0
+    if t.size < 64 or not duration > 0:
+        return []
+    try:
+        f_drive = drive_frequency(t, np.asarray(d.u, float))
+    except (ValueError, ArithmeticError, ContactLabError):
+        return []
+    if not (np.isfinite(f_drive) and f_drive > 0) or duration * f_drive < 2:
+        return []
+    out = []
+    for f0 in MAINS:
+        if f0 >= 0.45 / float(d.dt) or duration * f0 < MIN_PERIODS:
+            continue
+        k = max(round(f0 / f_drive), 1)
+        fh = k * f_drive
+        if k <= HUM_MAX_HARMONIC and (abs(f0 - fh) - MAINS_DRIFT) * duration <= HUM_BINS:
+            out.append(float(fh))
+    return out
+
+
+def hum_columns(
+    family: Any,
+    params: dict[str, float],
+    effects: tuple[str, ...],
+    d: Prepared,
+    x_in: np.ndarray,
+    truth: np.ndarray,
+    harmonics: list[float],
+) -> np.ndarray | None:
+    """The residual's directions a hum at each of ``harmonics`` (:func:`hum_harmonics`)
+    leaves, per sample of ``d``: on the force channel ``cos`` and ``sin`` at the harmonic
+    times ``1`` and a slope over the record (a hum up to about a bin off the harmonic), and
+    on the displacement channel the final model's response to the same four added to its
+    input ``x_in`` (raw rate, after the candidates' filter; ``truth`` the model on it). None
+    without harmonics or where the model cannot be driven."""
+    if not harmonics:
+        return None
+    raw = d.extra.get("raw_input")
+    n_raw = x_in.size
+    if raw is not None:
+        t_raw = float(raw.t0) + np.arange(n_raw) * float(raw.dt)
+    else:
+        t_raw = np.asarray(d.t, float)
+    t = np.asarray(d.t, float)
+    span = max(float(t[-1] - t[0]), 1e-300)
+    eps = 1e-3 * max(float(np.std(x_in)), 1e-300)
+    wlen = int(d.extra.get("u_filter", 0))
+    cols = []
+    for fh in harmonics:
+        for tt, out in ((t, cols), (t_raw, None)):
+            ph = 2.0 * np.pi * fh * (tt - t[0])
+            env = 2.0 * (tt - t[0]) / span - 1.0
+            basis = [np.cos(ph), np.sin(ph), env * np.cos(ph), env * np.sin(ph)]
+            if out is not None:
+                out.extend(basis)
+                continue
+            for c in basis:
+                if wlen:
+                    c = savgol_filter(c, wlen, 3, mode="interp")
+                dk = _drive(d, x_in + eps * c)
+                if dk is None:
+                    return None
+                resp = np.asarray(family.predict(params, effects, dk), float) - truth
+                cols.append(resp / eps)
+    return np.column_stack(cols)
+
+
 def _jacobian(
     family: Any, params: dict[str, float], effects: tuple[str, ...], d: Prepared
 ) -> np.ndarray | None:
@@ -417,7 +526,7 @@ def simulated_null(
     su = float(d.extra.get("u_noise", 0.0) or 0.0)
     wlen = int(d.extra.get("u_filter", 0))
     spec = input_noise_spectrum(d) if su > 0 and wlen else None
-    if spec is not None and not is_coloured(d, spec):
+    if spec is not None and not (SPECTRUM_ALWAYS or is_coloured(d, spec)):
         spec = None
     if spec is not None:
         su = max(su, spec.rms)
@@ -436,6 +545,11 @@ def simulated_null(
             return None
         truth = np.asarray(family.predict(params, effects, d_true), float)
         J = _jacobian(family, params, effects, d)
+        # a hum a drive harmonic hides stays in both channels (no joint misfit): its
+        # directions are taken off the record's residual and every copy's alike
+        H = hum_columns(family, params, effects, d, x_in, truth, hum_harmonics(d)) if HUM else None
+        if H is not None:
+            J = H if J is None else np.column_stack([J, H])
         use = np.isfinite(d.y) & (w > 0)
         sw = np.sqrt(w[use])
         Q = None
@@ -445,7 +559,7 @@ def simulated_null(
             nrm[nrm == 0] = 1.0
             Q, _ = np.linalg.qr(A / nrm)
         r_obs = r
-        if Q is not None and PROJECT_OBSERVED:
+        if Q is not None and (PROJECT_OBSERVED or H is not None):
             # the record's residual off the same directions as every copy's: what the
             # final model's parameters can draw (moved by the fit's noise-corrected
             # objective, :func:`.select.noise_term`) is no misfit, in either
