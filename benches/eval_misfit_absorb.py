@@ -43,9 +43,28 @@ def factors(seed: int) -> dict[str, Any]:
     }
 
 
+def _rig(seed: int, kind: str, fac: dict[str, Any]) -> Any:
+    """A record of the package's rig generator, clean (``rigclean``) or with one effect
+    (``effect:<name>``) of ``benches/eval_diagnose_rig.py``'s sizes."""
+    from contactlab.synthetic.rig import rig_recording
+    from eval_diagnose_rig import chain_kwargs, rig_effect
+
+    rng = np.random.default_rng(seed + 7919)
+    effect = None if kind == "rigclean" else kind.split(":", 1)[1]
+    eff = rig_effect(effect, "2f", fac, rng)
+    rec = rig_recording(
+        eff, "tangential", seed=seed, fs=fac["fs"], f=fac["f"], cycles=fac["cycles"],
+        acA=fac["acA"], x_noise=fac["x_noise"], F_noise=fac["F_noise"],
+        x_drift=float(rng.uniform(-0.003, 0.003)), bits=int(rng.integers(12, 17)),
+        **chain_kwargs(seed, fac),
+    )  # fmt: skip
+    ch = rec.channels
+    return np.asarray(rec.t), np.asarray(ch["x"]), np.asarray(ch["F"])
+
+
 def get(seed: int, kind: str, cache: str) -> dict[str, Any]:
     """One record's diagnosis (this tree), cached with what its patch check saw."""
-    path = f"{cache}/a_{kind}_{seed}.pkl"
+    path = f"{cache}/a_{kind.replace(':', '-')}_{seed}.pkl"
     if os.path.exists(path):
         with open(path, "rb") as fh:
             return pickle.load(fh)
@@ -55,9 +74,12 @@ def get(seed: int, kind: str, cache: str) -> dict[str, Any]:
 
     fx = factors(seed)
     over = {k: fx[k] for k in ("fs", "f", "cycles", "acA", "x_noise", "F_noise")}
-    rec, _ = chain_record(
-        seed, kind, x_colour=fx["x_colour"], hum=fx["hum"], jitter=fx["jitter"], **over
-    )
+    if kind == "rigclean" or kind.startswith("effect:"):
+        rec = _rig(seed, kind, over)
+    else:
+        rec, _ = chain_record(
+            seed, kind, x_colour=fx["x_colour"], hum=fx["hum"], jitter=fx["jitter"], **over
+        )
     cap: dict[str, Any] = {}
     orig = sh.patch_check
 
