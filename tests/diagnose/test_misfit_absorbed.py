@@ -58,10 +58,15 @@ def test_a_gamma_curve_absorbed_by_a_named_set_is_flagged(seed: int) -> None:
 
 @pytest.mark.parametrize("seed", [1, 2])
 def test_a_genuine_position_friction_is_not_flagged(seed: int) -> None:
-    fam, eff, d, p, scales, sigma = _record("own", ("position_friction",), seed)
+    # named with a backlash it does not need: the pair predicts better than a free-form
+    # curve; named alone: no verdict (the rivals' check)
+    pair = ("backlash", "position_friction")
+    fam, eff, d, p, scales, sigma = _record("own", pair, seed)
     got = absorbed_backbone(fam, eff, d, p, scales, sigma)
     assert got is not None and got["gain_effects"] > 100, got
     assert not got["flagged"] and got["share"] < 1.0, got
+    fam, eff, d, p, scales, sigma = _record("own", ("position_friction",), seed)
+    assert absorbed_backbone(fam, eff, d, p, scales, sigma) is None
 
 
 def test_a_set_of_reshaped_virgin_curves_alone_gets_no_verdict() -> None:
