@@ -530,6 +530,20 @@ def _rivals(b: _Base, d: Prepared, st: SearchState, checks: dict[str, Any]) -> d
     return checks
 
 
+def _absorbed(b: _Base, d: Prepared, st: SearchState, flagged: bool) -> list[dict[str, Any]]:
+    """The named shape effects that a free-form virgin curve with none of them predicts as
+    well on held-out cycles (:func:`.misfit.absorbed_backbone`): a patch entry where they
+    absorb a backbone misfit, else empty (not run where the misfit is already flagged: it
+    costs four fits)."""
+    from .misfit import absorbed_backbone
+
+    if flagged:
+        return []
+    p = dict(st.current.full.params)
+    got = absorbed_backbone(b.family, tuple(st.current.effects), d, p, b.scales, b.sigma)
+    return [got] if got is not None and got["flagged"] else []
+
+
 def _calibrated(b: _Base, d: Prepared, st: SearchState, checks: dict[str, Any]) -> dict[str, Any]:
     """The misfit flag against the record's own simulated null (issue 29 items 1 and 3).
 
@@ -566,6 +580,7 @@ def _calibrated(b: _Base, d: Prepared, st: SearchState, checks: dict[str, Any]) 
         if note:
             st.where.append(note)
     if nd is None:
+        patches = patches or _absorbed(b, d, st, bool(u.rivals))
         if patches:
             checks["unexplained"] = dataclasses.replace(u, flagged=True, patches=patches)
         return checks
@@ -574,6 +589,8 @@ def _calibrated(b: _Base, d: Prepared, st: SearchState, checks: dict[str, Any]) 
     # cell's ringing after each reversal, a skew between the anti-alias filters) is
     # structure at a few per cent of the noise that the simulation does not carry
     cal = calibrated_flag(nd, hand_bins=bool(u.statistic > u.threshold))
+    if not patches:
+        patches = _absorbed(b, d, st, bool(cal["flagged"] or u.rivals))
     flagged = cal["flagged"] or bool(u.rivals) or bool(patches)
     checks["unexplained"] = dataclasses.replace(u, flagged=flagged, calibrated=cal, patches=patches)
     return checks
