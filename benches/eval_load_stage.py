@@ -46,7 +46,23 @@ MAX_SAMPLES = 16_000
 
 #: ``--clean``: clean twins (no load; ``--law`` a rig base law no candidate draws, e.g.
 #: ``tanh_virgin``) with the noise of both channels drawn from ``--noise lo,hi`` (% of range)
-CLEAN = {"on": False, "law": None, "noise": None}
+CLEAN = {"on": False, "law": None, "noise": None, "other": None}
+#: ``--other``: records with another effect instead of the load (rotating by seed), at a size
+#: the diagnosis sees on most records: are they named normal_load?
+OTHERS = ("position_friction", "stribeck", "parallel_stiffness", "channel_delay", "stick_slip")
+
+
+def other_effect(fac: dict, seed: int) -> dict:
+    A = fac["acA"] / AC
+    name = fac["other"]
+    par = {
+        "position_friction": {"eps": 0.04, "L": 1.5 * A, "phi": fac["phi"]},
+        "stribeck": {"s": 0.08},
+        "parallel_stiffness": {"k_p": 0.1 * H0 / A},
+        "channel_delay": {"tau": 0.004 / fac["f"]},
+        "stick_slip": {"b": 0.12},
+    }[name]
+    return {name: par}
 
 
 def factors(seed: int) -> dict:
@@ -83,6 +99,8 @@ def factors(seed: int) -> dict:
             lo, hi = CLEAN["noise"]
             fac["x_noise"] = round(float(rng.uniform(lo, hi)) / 100, 4)
             fac["F_noise"] = round(float(rng.uniform(lo, hi)) / 100, 4)
+        if CLEAN["other"]:
+            fac["other"] = OTHERS[seed % len(OTHERS)]
     return fac
 
 
@@ -93,6 +111,8 @@ def record(fac: dict, seed: int, eps: float | None = None, quiet: bool = False):
     eff = {"normal_load": {"eps": eps, "f_n": fac["f_n"], "phi": fac["phi"]}} if eps else {}
     if CLEAN["law"]:
         eff[CLEAN["law"]] = {}
+    if CLEAN["other"]:
+        eff.update(other_effect(fac, seed))
     kw = {k: fac[k] for k in ("fs", "f", "cycles", "acA", "x_noise", "F_noise")}
     if quiet:
         kw.update(x_noise=0.0, F_noise=0.0, bits=None)
@@ -219,7 +239,7 @@ def summary(res: list[dict]) -> str:
         sb = None if r["start_bins"] is None else round(r["start_bins"], 2)
         lines.append(
             f"{r['seed']} {f['kind']:4s} eps {f['eps']:.4f} r {f['r']:.3f} λ {r['lambda']:.0f} "
-            f"-> {r['stage']} named {r['named']} bound {bound}"
+            f"{f.get('other', '')} -> {r['stage']} named {r['named']} bound {bound}"
             f" start_bins {sb}"
             f" {r['verdict']} (fs {f['fs']}, f {f['f']}, cyc {f['cycles']}, acA {f['acA']}, "
             f"xn {f['x_noise']}, Fn {f['F_noise']}) cpu {r['cpu']:.0f}s"
@@ -235,10 +255,11 @@ def main(argv=None):
     ap.add_argument("--tables-from", type=Path, default=None)
     ap.add_argument("--clean", action="store_true")
     ap.add_argument("--law", default=None)
+    ap.add_argument("--other", action="store_true", help="another effect, no load")
     ap.add_argument("--noise", default=None, help="lo,hi in % of the range (--clean)")
     a = ap.parse_args(argv)
     noise = tuple(float(v) for v in a.noise.split(",")) if a.noise else None
-    CLEAN.update(on=a.clean, law=a.law, noise=noise)
+    CLEAN.update(on=a.clean or a.other, law=a.law, noise=noise, other=a.other)
     if a.tables_from:
         print(summary(json.loads(a.tables_from.read_text())))
         return
