@@ -135,7 +135,15 @@ OFF_HARMONIC_RULES = True
 EVIDENCE_HARMONICS = 40
 #: the chance, over every frequency the load's search scans off the harmonics, that the
 #: channel's noise alone passes that test
-EVIDENCE_ALPHA = 1e-3
+EVIDENCE_ALPHA = 1e-4
+#: the reduced floors need the load this many frequency bins from every harmonic: the line
+#: and the parabola in time the evidence test takes out with each harmonic absorb about a
+#: bin around it, and what a base law's misfit changes beyond them leaks just outside (a
+#: clean record of a tanh virgin curve at 0.4-0.8 % noise reached S = 21.3 against a
+#: threshold of 22.7 (α 1e-3) one bin from 2f; fresh seed 29960004 of
+#: ``benches/eval_load_stage.py --clean --law tanh_virgin``). A beat load with
+#: |f_n/f - k| >= 0.15 on 10 cycles or more is 1.5 bins or more from k f
+OFF_HARMONIC_MIN_BINS = 1.5
 #: the load's frequency search runs up to this many drive frequencies
 SEARCH_HARMONICS = 4.0
 
@@ -379,9 +387,10 @@ class NormalLoad(EffectModel):
 
     def input_noise_share_at(self, d, p) -> float | None:
         """The share of the input-noise budget (``search._noise_floor``) a load at the
-        fitted ``f_n`` must beat: all of it within one frequency bin of a drive harmonic
-        (:meth:`harmonic`: there its ``h cos, h sin`` repeat with the cycle and can take the
-        misfit the noisy input leaves locked to it, the turning points it pushes outward),
+        fitted ``f_n`` must beat: all of it within :data:`OFF_HARMONIC_MIN_BINS` frequency
+        bins of a drive harmonic (:meth:`harmonic`: there its ``h cos, h sin`` repeat with the
+        cycle and can take the misfit the noisy input leaves locked to it, the turning points
+        it pushes outward),
         else the share of a cycle-locked pattern's power a term ``δ`` from the nearest
         harmonic takes over the record, ``sinc²(δ T)`` (:data:`OFF_HARMONIC_SHARE` at
         most). The input's white noise fed through the contact's slope is white in time: a
@@ -396,7 +405,7 @@ class NormalLoad(EffectModel):
         off = harmonic_offset(d, f_n)
         if off is None:
             return None
-        if off < 1.0 or not shows_off_harmonic(d, f_n):
+        if off < OFF_HARMONIC_MIN_BINS or not shows_off_harmonic(d, f_n):
             return 1.0
         return float(min(np.sinc(off) ** 2, OFF_HARMONIC_SHARE))
 
@@ -485,7 +494,7 @@ class NormalLoad(EffectModel):
         offs = np.abs(freqs - np.round(freqs / f_exc) * f_exc) * d.duration
         min_gain = float(rules.get("min_gain", 0.0))
         budget = float(rules.get("budget", 0.0))
-        far = offs >= 1.0
+        far = offs >= OFF_HARMONIC_MIN_BINS
         if not np.any(far):
             return None
         near = float(np.max(np.where(far, -np.inf, g))) if np.any(~far) else -np.inf
