@@ -144,8 +144,14 @@ EVIDENCE_ALPHA = 1e-4
 #: ``benches/eval_load_stage.py --clean --law tanh_virgin``). A beat load with
 #: |f_n/f - k| >= 0.15 on 10 cycles or more is 1.5 bins or more from k f
 OFF_HARMONIC_MIN_BINS = 1.5
-#: the load's frequency search runs up to this many drive frequencies
+#: the load's frequency search runs up to this many drive frequencies off the harmonics
+#: (:meth:`NormalLoad._off_harmonic_start`, with the force's evidence) ...
 SEARCH_HARMONICS = 4.0
+#: ... and up to this many for the largest gain at a harmonic: a record's 4th harmonic
+#: of the misfit (the noisy input's bias at the turns) outgained a 2f load of 1.4 % there,
+#: started at 4f and lost (fresh seed 29990015 of ``benches/eval_load_stage.py``; found at
+#: 2f with the search to 3f)
+PLAIN_SEARCH_HARMONICS = 3.0
 
 
 def _enough_cycles(d) -> bool:
@@ -450,8 +456,9 @@ class NormalLoad(EffectModel):
     def start(self, p, d, residual, family=None):
         """The frequency whose ``h cos, h sin`` pair explains most of the residual, scanned
         from 0.05 excitation frequencies (at least two periods in the record) to
-        :data:`SEARCH_HARMONICS`, at a
-        quarter of the record's frequency resolution, the drive's harmonics included."""
+        :data:`SEARCH_HARMONICS` (the harmonics up to :data:`PLAIN_SEARCH_HARMONICS` only), at
+        a quarter of the record's frequency resolution, the
+        drive's harmonics included."""
         h = family.predict(p, (), d)
         f_exc = 1.0 / (d.cycles.period_samples * d.dt)
         f_lo = max(0.05 * f_exc, MIN_LOAD_PERIODS / d.duration)
@@ -460,7 +467,10 @@ class NormalLoad(EffectModel):
         if not freqs.size:
             return {"f_n": f_exc}
         gains = modulation_gains(h, residual, d.duration, f_lo, step, freqs.size)[: freqs.size]
-        best = int(np.argmax(gains))
+        f_d = drive_frequency(d)
+        offs = np.abs(freqs - np.round(freqs / f_d) * f_d) * d.duration
+        plain = (freqs < PLAIN_SEARCH_HARMONICS * f_exc) | (offs >= OFF_HARMONIC_MIN_BINS)
+        best = int(np.argmax(np.where(plain, gains, -np.inf)))
         off = self._off_harmonic_start(d, h, residual, freqs, f_lo, step)
         return {"f_n": float(freqs[best] if off is None else off)}
 
@@ -497,12 +507,15 @@ class NormalLoad(EffectModel):
         far = offs >= OFF_HARMONIC_MIN_BINS
         if not np.any(far):
             return None
-        near = float(np.max(np.where(far, -np.inf, g))) if np.any(~far) else -np.inf
-        if np.any(~far):
+        # the harmonics the plain search reaches (a harmonic above it is never a start)
+        plain = freqs < PLAIN_SEARCH_HARMONICS * f_exc
+        near_ok = ~far & plain
+        near = float(np.max(np.where(near_ok, g, -np.inf))) if np.any(near_ok) else -np.inf
+        if np.any(near_ok):
             # the best pair near a harmonic taken out first: what leaks from it into the
             # frequencies a bin or two away is not a load of their own (a 2f load on a
             # 7-cycle rig record was started 1.7 bins off and lost: tuning seed 62102)
-            f_h = float(freqs[int(np.argmax(np.where(far, -np.inf, g)))])
+            f_h = float(freqs[int(np.argmax(np.where(near_ok, g, -np.inf)))])
             ph = 2.0 * np.pi * f_h * (d.t - d.t[0])
             cols = np.column_stack((hw * np.cos(ph), hw * np.sin(ph)))
             coef, *_ = np.linalg.lstsq(cols, rw, rcond=None)
