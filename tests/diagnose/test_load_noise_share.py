@@ -26,11 +26,19 @@ def _off_harmonic_rules_on(monkeypatch):
     monkeypatch.setattr(normal_load, "OFF_HARMONIC_RULES", True)
 
 
-def _rig(seed: int = 4242) -> Prepared:
+def _rig(seed: int = 4242, loads: tuple[float, ...] = ()) -> Prepared:
+    """A rig record at 10 Hz; ``loads``: frequencies of 1.5 % loads it carries (the reduced
+    floors apply only where the force shows the load: ``off_harmonic_evidence``)."""
     rec = rig_recording(
         {}, "tangential", seed=seed, fs=2000.0, f=10.0, cycles=20, acA=2.0,
         x_noise=0.01, F_noise=0.01,
     )  # fmt: skip
+    if loads:
+        t0 = rec.t - rec.t[0]
+        g = 1.0 + sum(0.015 * np.cos(2 * np.pi * f * t0 + 0.3) for f in loads)
+        d = Prepared.build(rec.t, rec.x, rec.F * g)
+        TangentialFamily().prepare(d)
+        return d
     d = Prepared.build(rec.t, rec.x, rec.F)
     TangentialFamily().prepare(d)
     return d
@@ -39,9 +47,9 @@ def _rig(seed: int = 4242) -> Prepared:
 def test_a_load_at_a_harmonic_beats_the_whole_budget_off_it_almost_none() -> None:
     fam = TangentialFamily()
     eff = registry("tangential")["normal_load"]
-    d = _rig()
+    T = _rig().duration
+    d = _rig(loads=(20.0 + 3.0 / T, 15.0, 15.0 + 0.25 / T))
     f = 1.0 / (d.cycles.period_samples * d.dt)
-    T = d.duration
     assert eff.input_noise_share_at(d, {"f_n": 2.0 * f}) == 1.0
     assert eff.input_noise_share_at(d, {"f_n": 2.0 * f + 0.5 / T}) == 1.0  # one bin
     off = eff.input_noise_share_at(d, {"f_n": 2.0 * f + 3.0 / T})
@@ -90,12 +98,12 @@ def test_the_start_prefers_a_load_that_clears_its_floors_off_the_harmonics() -> 
     latter; with none, the largest gain, as before."""
     fam = TangentialFamily()
     eff = registry("tangential")["normal_load"]
-    d = _rig()
+    f = 10.0
+    f_off = 2.0 * f + 3.5 / _rig().duration
+    d = _rig(loads=(f_off,))
     p = fam.initial_base(d)
     h = fam.predict(p, (), d)
     t = d.t - d.t[0]
-    f = 10.0
-    f_off = 2.0 * f + 3.5 / d.duration
     r = h * (0.05 * np.cos(2 * np.pi * 2 * f * t) + 0.03 * np.cos(2 * np.pi * f_off * t))
     sigma = float(np.std(r)) * 0.5
     d.extra["weight"] = None
