@@ -145,7 +145,7 @@ EVIDENCE_ALPHA = 1e-4
 #: clean record of a tanh virgin curve at 0.4-0.8 % noise reached S = 21.3 against a
 #: threshold of 22.7 (α 1e-3) one bin from 2f; fresh seed 29960004 of
 #: ``benches/eval_load_stage.py --clean --law tanh_virgin``). A beat load with
-#: |f_n/f - k| >= 0.15 on 10 cycles or more is 1.5 bins or more from k f
+#: ``|f_n/f - k| >= 0.15`` on 10 cycles or more is 1.5 bins or more from k f
 OFF_HARMONIC_MIN_BINS = 1.5
 #: the load's frequency search runs up to this many drive frequencies off the harmonics
 #: (:meth:`NormalLoad._off_harmonic_start`, with the force's evidence) ...
