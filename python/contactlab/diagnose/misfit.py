@@ -1164,8 +1164,12 @@ def absorbed_backbone(
 #: taken up by a parallel stiffness) and ``gamma`` (``1 - (1 + a) e^-a``: zero initial slope,
 #: taken up by backlash)
 ALT_VIRGINS = ("tanh", "rational", "gamma")
-#: the curvature grid of each alternative, relative to the base's fitted ``ac``
-ALT_AC = tuple(float(2.0 ** (k / 2.0)) for k in range(-6, 7))
+#: the curvature grid of each alternative, ``ac·A`` (``A`` half the input's range over the
+#: complete cycles): not relative to the base's fitted ``ac``, which a named backlash or
+#: series compliance can leave far from the branches' own (a gamma virgin curve named
+#: backlash, tuning seed 480003 of ``benches/eval_misfit_absorb.py``: ``ac·A`` 2e-4, a
+#: straight spring behind the gap)
+ALT_ACA = tuple(float(2.0 ** (k / 2.0)) for k in range(-5, 12))
 
 
 def _alt_curve(kind: str, a: np.ndarray) -> np.ndarray:
@@ -1179,18 +1183,18 @@ def _alt_curve(kind: str, a: np.ndarray) -> np.ndarray:
 
 
 def _alt_fit(
-    kind: str, ac: float, u: np.ndarray, target: np.ndarray, w: np.ndarray, train: np.ndarray
+    kind: str, amp: float, u: np.ndarray, target: np.ndarray, w: np.ndarray, train: np.ndarray
 ) -> tuple[float, np.ndarray | None]:
     """The alternative virgin curve ``kind`` fitted to ``target`` on the ``train`` samples
-    (weights ``w``): its height by least squares, its curvature on the :data:`ALT_AC` grid
-    times ``ac`` and then refined between the grid's neighbours. Returns the training sum
+    (weights ``w``): its height by least squares, its curvature on the :data:`ALT_ACA` grid
+    over ``amp`` and then refined between the grid's neighbours. Returns the training sum
     of squares and the prediction on every sample (None where nothing fits)."""
     from scipy.optimize import minimize_scalar
 
     wt, tt = w[train], target[train]
 
     def one(lk: float) -> tuple[float, np.ndarray | None]:
-        col = _alt_force(kind, ac * math.exp(lk), u)
+        col = _alt_force(kind, math.exp(lk) / amp, u)
         cc = col[train]
         den = float(np.sum(wt * cc * cc))
         if not (den > 0 and np.all(np.isfinite(col))):
@@ -1198,7 +1202,7 @@ def _alt_fit(
         c = float(np.sum(wt * cc * tt)) / den
         return float(np.sum(wt * (tt - c * cc) ** 2)), c * col
 
-    grid = np.log(np.asarray(ALT_AC))
+    grid = np.log(np.asarray(ALT_ACA))
     ss = [one(float(g))[0] for g in grid]
     j = int(np.argmin(ss))
     if not np.isfinite(ss[j]):
@@ -1249,7 +1253,7 @@ def alternative_virgin(
     are split into alternate folds; on each, the final model and the model without the named
     effects of :data:`.shape.PATCHABLE` are fitted on the other fold; in the latter the
     base's Masing element is replaced by one whose virgin curve is each of
-    :data:`ALT_VIRGINS` (its curvature on the :data:`ALT_AC` grid times the base's ``ac``,
+    :data:`ALT_VIRGINS` (its curvature on the :data:`ALT_ACA` grid,
     its height by least squares, the shape and curvature chosen on the training fold), and
     both predict the held-out fold. Flagged where the alternative's held-out gain over the
     final model reaches :data:`ALT_MIN_GAIN` σ² with a t over the held-out cycles of at
@@ -1278,6 +1282,9 @@ def alternative_virgin(
     fold = np.where(ci >= 0, ci % 2, -1)
     w = sample_weight(d)
     u = np.asarray(d.u, float)
+    amp = 0.5 * float(np.ptp(u[cyc >= 0]))
+    if not amp > 0:
+        return None
     per_cycle = np.zeros(ids.size)
     g_set = 0.0
     chosen: list[str] = []
@@ -1300,7 +1307,7 @@ def alternative_virgin(
             return None
         best, best_ss, best_pred = "", math.inf, None
         for kind in ALT_VIRGINS:
-            ss, pred = _alt_fit(kind, ac, u, target, w, train)
+            ss, pred = _alt_fit(kind, amp, u, target, w, train)
             if ss < best_ss:
                 best, best_ss, best_pred = kind, ss, pred
         if best_pred is None:
