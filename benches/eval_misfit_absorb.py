@@ -124,8 +124,9 @@ def _why(o: dict[str, Any]) -> str:
         parts.append("rivals")
     for q in ud.get("patches") or []:
         parts.append(
-            "absorb" if q.get("held_out") else "swap" if q.get("swap") else
-            "slope" if q.get("slope") else "tail" if q.get("tail") else "patch"
+            "alt" if q.get("alternative") else "absorb" if q.get("held_out") else
+            "swap" if q.get("swap") else "slope" if q.get("slope") else
+            "tail" if q.get("tail") else "patch"
         )  # fmt: skip
     return "+".join(dict.fromkeys(parts)) or "-"
 
@@ -137,11 +138,13 @@ def table(pattern: str, cache: str) -> None:
             rows.append(pickle.load(fh))
     tot: dict[str, list[bool]] = {}
     old: dict[str, list[bool]] = {}
+    pre: dict[str, list[bool]] = {}
     for o in sorted(rows, key=lambda o: (o["kind"], o["seed"])):
         f = o["fac"]
         tot.setdefault(o["kind"], []).append(o["flagged"])
         # the held-out check runs only where nothing else flagged: without it, these flags
-        old.setdefault(o["kind"], []).append(o["flagged"] and _why(o) != "absorb")
+        old.setdefault(o["kind"], []).append(o["flagged"] and _why(o) not in ("absorb", "alt"))
+        pre.setdefault(o["kind"], []).append(o["flagged"] and _why(o) != "alt")
         print(
             f"{o['kind']:8s} {o['seed']:7d} cyc {f['cycles']:2d} fs {f['fs']:5.0f} "
             f"f {f['f']:5.1f} acA {f['acA']:4.2f} xn {100 * f['x_noise']:3.1f}% "
@@ -149,7 +152,10 @@ def table(pattern: str, cache: str) -> None:
             f"named {','.join(o['named']) or '-'}"
         )
     for k, v in sorted(tot.items()):
-        print(f"{k:26s}: flagged {sum(v)}/{len(v)} (without the held-out check {sum(old[k])})")
+        print(
+            f"{k:26s}: flagged {sum(v)}/{len(v)} (without misfit.alternative_virgin "
+            f"{sum(pre[k])}, without it and misfit.absorbed_backbone {sum(old[k])})"
+        )
 
 
 def main() -> None:

@@ -5,6 +5,8 @@ in place of the base and the named shape effects and compares them on held-out c
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -90,3 +92,4 @@ def test_the_flag_says_so() -> None:
     s = u.sentence()
     assert "systematic misfit that no candidate explains" in s, s
     assert "tanh" in s and "series_compliance" in s, s
+    assert json.loads(json.dumps(u.to_dict()))["patches"][0]["alternative"] is True
