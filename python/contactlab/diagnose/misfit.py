@@ -1183,24 +1183,36 @@ def _alt_curve(kind: str, a: np.ndarray) -> np.ndarray:
 
 
 def _alt_fit(
-    kind: str, amp: float, u: np.ndarray, target: np.ndarray, w: np.ndarray, train: np.ndarray
+    kind: str,
+    amp: float,
+    u: np.ndarray,
+    target: np.ndarray,
+    w: np.ndarray,
+    train: np.ndarray,
+    straight: np.ndarray | None = None,
 ) -> tuple[float, np.ndarray | None]:
     """The alternative virgin curve ``kind`` fitted to ``target`` on the ``train`` samples
     (weights ``w``): its height by least squares, its curvature on the :data:`ALT_ACA` grid
-    over ``amp`` and then refined between the grid's neighbours. Returns the training sum
-    of squares and the prediction on every sample (None where nothing fits)."""
+    over ``amp`` and then refined between the grid's neighbours; with ``straight`` (a
+    spring's force ``u``) fitted beside it. Returns the training sum of squares and the
+    prediction on every sample (None where nothing fits)."""
     from scipy.optimize import minimize_scalar
 
     wt, tt = w[train], target[train]
+    sw = np.sqrt(wt)
 
     def one(lk: float) -> tuple[float, np.ndarray | None]:
         col = _alt_force(kind, math.exp(lk) / amp, u)
-        cc = col[train]
-        den = float(np.sum(wt * cc * cc))
-        if not (den > 0 and np.all(np.isfinite(col))):
+        if not np.all(np.isfinite(col)):
             return math.inf, None
-        c = float(np.sum(wt * cc * tt)) / den
-        return float(np.sum(wt * (tt - c * cc) ** 2)), c * col
+        C = col[:, None] if straight is None else np.column_stack([col, straight])
+        A = C[train] * sw[:, None]
+        nrm = np.linalg.norm(A, axis=0)
+        if not np.all(nrm > 0):
+            return math.inf, None
+        c, *_ = np.linalg.lstsq(A / nrm, tt * sw, rcond=1e-10)
+        pred = (C / nrm) @ c
+        return float(np.sum(wt * (tt - pred[train]) ** 2)), pred
 
     grid = np.log(np.asarray(ALT_ACA))
     ss = [one(float(g))[0] for g in grid]
@@ -1265,6 +1277,7 @@ def alternative_virgin(
     ``gain_effects``: the named set's over the model without it), or None where the record
     has fewer than :data:`MIN_CYCLES` complete cycles, no curvature, or a fit fails."""
     from ..errors import ContactLabError
+    from .effects.tangential._common import turn_clipped_input
     from .select import fit, sample_weight
     from .shape import PATCHABLE
 
@@ -1281,10 +1294,16 @@ def alternative_virgin(
     ci[cyc >= 0] = np.searchsorted(ids, cyc[cyc >= 0])
     fold = np.where(ci >= 0, ci % 2, -1)
     w = sample_weight(d)
-    u = np.asarray(d.u, float)
+    # the input the base's element runs over (its memory turning where the displacement
+    # turned, not where its noise peaked): on d.u itself the alternatives ran behind
+    u = np.asarray(turn_clipped_input(d), float)
     amp = 0.5 * float(np.ptp(u[cyc >= 0]))
     if not amp > 0:
         return None
+    # a named parallel stiffness keeps its spring beside the alternative (as many parameters
+    # as the base and the spring): a rational virgin curve's slow approach to its plateau is
+    # drawn by the exponential beside a spring better than by the rational curve alone
+    straight = u - float(np.mean(u)) if "parallel_stiffness" in drop else None
     per_cycle = np.zeros(ids.size)
     g_set = 0.0
     chosen: list[str] = []
@@ -1307,7 +1326,7 @@ def alternative_virgin(
             return None
         best, best_ss, best_pred = "", math.inf, None
         for kind in ALT_VIRGINS:
-            ss, pred = _alt_fit(kind, amp, u, target, w, train)
+            ss, pred = _alt_fit(kind, amp, u, target, w, train, straight)
             if ss < best_ss:
                 best, best_ss, best_pred = kind, ss, pred
         if best_pred is None:
