@@ -45,6 +45,23 @@ def factors(seed: int) -> dict[str, Any]:
         "x_colour": str(rng.choice(("lvdt", "lp1", "white"))),
         "hum": bool(rng.random() < 0.5),
         "jitter": bool(rng.random() < 0.5),
+        **(_near(seed) if NEAR else {}),
+    }
+
+
+#: ``--near``: drive 24-36 Hz, ac·A 2.1-3.6, noise 0.9-1.2 % on both channels (the conditions
+#: where tanh virgin curves were named series_compliance alone, issue 29 item 3, stop 49),
+#: drawn from a stream of their own (the other factors as without)
+NEAR = False
+
+
+def _near(seed: int) -> dict[str, Any]:
+    rng = np.random.default_rng([seed, 4949])
+    return {
+        "f": float(rng.uniform(24.0, 36.0)),
+        "acA": float(rng.uniform(2.1, 3.6)),
+        "x_noise": float(rng.uniform(0.009, 0.012)),
+        "F_noise": float(rng.uniform(0.009, 0.012)),
     }
 
 
@@ -164,7 +181,11 @@ def main() -> None:
     ap.add_argument("args", nargs="+")
     ap.add_argument("--cache", default="misfit_absorb_cache")
     ap.add_argument("--cycles", default=None, help="LO,HI: complete cycles drawn (8,35)")
+    ap.add_argument("--near", action="store_true", help="the factors of NEAR (stop 49)")
     a = ap.parse_args()
+    if a.near:
+        global NEAR
+        NEAR = True
     if a.cycles:
         global CYCLES
         lo, hi = (int(v) for v in a.cycles.split(","))
