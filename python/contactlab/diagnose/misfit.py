@@ -1277,7 +1277,7 @@ def alternative_virgin(
     ``gain_effects``: the named set's over the model without it), or None where the record
     has fewer than :data:`MIN_CYCLES` complete cycles, no curvature, or a fit fails."""
     from ..errors import ContactLabError
-    from .effects.tangential._common import turn_clipped_input
+    from .effects.tangential import turn_clipped_input
     from .select import fit, sample_weight
     from .shape import PATCHABLE
 
