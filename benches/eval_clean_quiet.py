@@ -70,10 +70,15 @@ for case in cases:
         "named": list(rep.effect_names),
         "flagged": bool(un is not None and un.flagged),
         "xn": fac["x_noise"],
+        # flagged by the alternative virgin curve alone (misfit.alternative_virgin, stop 49)
+        "by_alternative": bool(
+            un is not None and any(p.get("alternative") for p in (un.patches or ()))
+        ),
     }
     print(json.dumps(r), flush=True)
     out.append(r)
 q = sum(1 for r in out if not r["named"] and not r["flagged"])
 n_named = sum(1 for r in out if r["named"])
 n_flagged = sum(1 for r in out if r["flagged"])
-print(f"quiet {q}/{len(out)} named {n_named} flagged {n_flagged}")
+n_alt = sum(1 for r in out if r["by_alternative"])
+print(f"quiet {q}/{len(out)} named {n_named} flagged {n_flagged} (by the alternative only {n_alt})")

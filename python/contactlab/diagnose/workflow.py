@@ -532,16 +532,21 @@ def _rivals(b: _Base, d: Prepared, st: SearchState, checks: dict[str, Any]) -> d
 
 def _absorbed(b: _Base, d: Prepared, st: SearchState, flagged: bool) -> list[dict[str, Any]]:
     """The named shape effects that a free-form virgin curve with none of them predicts as
-    well on held-out cycles (:func:`.misfit.absorbed_backbone`): a patch entry where they
-    absorb a backbone misfit, else empty (not run where the misfit is already flagged: it
-    costs four fits)."""
-    from .misfit import absorbed_backbone
+    well on held-out cycles (:func:`.misfit.absorbed_backbone`), or a virgin curve of
+    another shape in place of the base and those effects that predicts them better
+    (:func:`.misfit.alternative_virgin`): a patch entry where either flags, else empty (not
+    run where the misfit is already flagged: each costs up to four fits)."""
+    from .misfit import absorbed_backbone, alternative_virgin
 
     if flagged:
         return []
     p = dict(st.current.full.params)
     got = absorbed_backbone(b.family, tuple(st.current.effects), d, p, b.scales, b.sigma)
-    return [got] if got is not None and got["flagged"] else []
+    if got is not None and got["flagged"]:
+        return [got]
+    # a virgin curve of another shape in place of the base and the named shape effects
+    alt = alternative_virgin(b.family, tuple(st.current.effects), d, p, b.scales, b.sigma)
+    return [alt] if alt is not None and alt["flagged"] else []
 
 
 def _calibrated(b: _Base, d: Prepared, st: SearchState, checks: dict[str, Any]) -> dict[str, Any]:
