@@ -50,7 +50,10 @@ than the linearised power, the bound is widened by the effect's ``power_margin``
 The BIC rule (``k ln n`` over a fit of at most 5000 samples) is far weaker than the gain
 rule and is not modelled. The proportional t of rule 2 is, linearised (:func:`_proportional_t`),
 for an effect's own ``proportional_gain`` and for a family's (normal contact): without it
-a creep, whose gain sits in the first cycles, was stated 4 times too large.
+a creep, whose gain sits in the first cycles, was stated 4 times too large. A rival fitted
+one at a time and compared by likelihood (normal contact's loss asymmetry against the
+stiffening law: the effect's ``rival_rows``) is not projected out of the direction the rules
+see; the candidate must also fit better than it (:func:`_rival_wins`).
 
 :func:`detectable_above` gives one candidate's bound; :func:`stated_power` every candidate a
 report did not name. ``benches/eval_false_alarm.py --power`` checks the bound against
