@@ -50,7 +50,10 @@ than the linearised power, the bound is widened by the effect's ``power_margin``
 The BIC rule (``k ln n`` over a fit of at most 5000 samples) is far weaker than the gain
 rule and is not modelled. The proportional t of rule 2 is, linearised (:func:`_proportional_t`),
 for an effect's own ``proportional_gain`` and for a family's (normal contact): without it
-a creep, whose gain sits in the first cycles, was stated 4 times too large.
+a creep, whose gain sits in the first cycles, was stated 4 times too large. A rival fitted
+one at a time and compared by likelihood (normal contact's loss asymmetry against the
+stiffening law: the effect's ``rival_rows``) is not projected out of the direction the rules
+see; the candidate must also fit better than it (:func:`_rival_wins`).
 
 :func:`detectable_above` gives one candidate's bound; :func:`stated_power` every candidate a
 report did not name. ``benches/eval_false_alarm.py --power`` checks the bound against
@@ -291,6 +294,9 @@ class _Setting:
     size_factor: np.ndarray = field(default_factory=lambda: np.ones(DRAWS))  # (DRAWS,)
     #: rule 4's floor (σ²): MIN_RELATIVE_GAIN of the current held-out error
     rel_floor: float = 0.0
+    #: the noise of the likelihood comparison with a rival fitted one at a time
+    #: (:func:`_rival_wins`), a standard normal per draw
+    rng_rival: np.ndarray = field(default_factory=lambda: np.zeros(DRAWS))  # (DRAWS,)
 
 
 def _setting(
@@ -342,16 +348,23 @@ def _setting(
         rng_fit=rng.standard_normal(DRAWS),
         size_factor=np.exp(0.5 * GAIN_SCATTER * rng.standard_normal(DRAWS)),
         rel_floor=rel,
+        rng_rival=np.random.default_rng([seed, 1]).standard_normal(DRAWS),
     )
 
 
 def _power_curve(
-    jp: np.ndarray, st: _Setting, ident: float = 0.0, proportional: bool = False
+    jp: np.ndarray,
+    st: _Setting,
+    ident: float = 0.0,
+    proportional: bool = False,
+    rival: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> Any:
     """The detection probability as a function of the magnitude ``a`` (linearised);
     ``proportional``: rule 2 may also pass by the proportional t of
     :func:`contactlab.diagnose.select.proportional_t` (an effect whose gain is by its nature
-    uneven across cycles, a drift: the effect's ``proportional_gain``)."""
+    uneven across cycles, a drift: the effect's ``proportional_gain``); ``rival``: the
+    direction left beyond a rival fitted one at a time and the samples the two are compared
+    on (:func:`_rival_wins`), which the candidate must also win."""
     held = st.cycle_of >= 0
     m = st.fold_of_cycle.size
     idx = st.cycle_of[held]
@@ -397,9 +410,28 @@ def _power_curve(
             t = np.maximum(t, _proportional_t(a, delta, A, B, W, ok))
         gain = ((cur - cand) @ W) / Wtot / sig2
         named = np.abs(a[:, 0] + eps) >= ident * fit_se
+        if rival is not None:
+            named = named & _rival_wins(a[:, 0], rival[0], rival[1], st)
         return float(np.mean((t > st.z) & (gain >= st.gain_floor) & named))
 
     return power
+
+
+def _rival_wins(a: np.ndarray, jr: np.ndarray, rows: np.ndarray, st: _Setting) -> np.ndarray:
+    """Per draw, whether the candidate fits better than its rival fitted one at a time
+    (normal contact's shapes beyond the ellipse: the diagnosis fits the loss asymmetry and
+    the stiffening law each alone and names the one of the larger likelihood over the
+    held-out cycles and the start-up, :func:`~contactlab.diagnose.effects.normal.
+    asymmetric_branches.shape_evidence`), linearised: with ``jr`` the candidate's direction
+    beyond the base and the rival, the rival's sum of squares over ``rows`` exceeds the
+    candidate's by ``a² Σ w jr² + 2 a Σ w jr e`` (σ² units), the noise term of standard
+    deviation ``2 |a| √(Σ w² jr² V) / σ²`` widened by the residual's correlation."""
+    w, j = st.w[rows], jr[rows]
+    var = st.var[rows] if np.ndim(st.var) else st.var
+    sig2 = st.sigma**2
+    lam = float(np.sum(w * j * j)) / sig2
+    sd = 2.0 * float(np.sqrt(np.sum(w * w * j * j * var))) / sig2 * st.se_inflation
+    return a * a * lam + np.abs(a) * sd * st.rng_rival > 0.0
 
 
 def _proportional_t(
@@ -443,17 +475,21 @@ def _fit_error(jp: np.ndarray, st: _Setting) -> tuple[float, float]:
 
 
 def _bound(
-    jp: np.ndarray, st: _Setting, ident: float = 0.0, proportional: bool = False
+    jp: np.ndarray,
+    st: _Setting,
+    ident: float = 0.0,
+    proportional: bool = False,
+    rival: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> float | None:
     """Smallest ``a`` with detection probability at least :data:`POWER`, or None (``ident``:
     the standard errors a named size must lie from "absent", 0: no such rule;
-    ``proportional``: see :func:`_power_curve`)."""
+    ``proportional``, ``rival``: see :func:`_power_curve`)."""
     # RMS over the weighted samples: where the weight is 0 (left out of the fits) the
     # projection is unconstrained and may be anything (a frame record: 60x the direction)
     size = float(np.sqrt(np.sum(st.w * jp * jp) / max(float(np.sum(st.w)), 1e-300)))
     if not size > 0:
         return None
-    power = _power_curve(jp, st, ident, proportional)
+    power = _power_curve(jp, st, ident, proportional, rival)
     top = LARGEST_RELATIVE * st.y_rms / size
     q = float(np.sum(st.w * jp * jp) / np.sum(st.w)) / st.sigma**2
     lo = min(top, np.sqrt(max(st.gain_floor, 1e-6) / max(q, 1e-300)))
@@ -923,6 +959,12 @@ def _per_parameter(
     ds = _effect_signal(family, name, signal_input(d)) if derived else d
     steady = steady_samples(d) if derived else None
     rivals = _rival_directions(family, p0, trial, name, ds, scales)
+    # a rival fitted one at a time and compared by likelihood (the effect's
+    # ``rival_rows(d)``: normal contact's shapes beyond the ellipse) is not projected out of
+    # the direction the rules see: the candidate passes them on its own and must also fit
+    # better than the rival (:func:`_rival_wins`) over those samples
+    rows_hook = getattr(_effect(family, name), "rival_rows", None)
+    compare = np.asarray(rows_hook(ds), bool) if rivals and rows_hook is not None else None
     prop = proportional_gain(family, name)
     margin = power_margin(family, name)
     st = _own_floor(family, name, d, st)
@@ -937,8 +979,14 @@ def _per_parameter(
         jp = _project(j, np.column_stack([jb, *rivals]) if rivals else jb, st.w)
         if steady is not None:
             jp = np.where(steady, jp, 0.0)
+        rival = None
+        if compare is not None:
+            rival = (jp, compare)
+            jp = _project(j, jb, st.w)
+            if steady is not None:
+                jp = np.where(steady, jp, 0.0)
         ident = identified_sigmas(family, name)
-        b = _bound(jp, st, ident, prop)
+        b = _bound(jp, st, ident, prop, rival)
         # the current model's parameters absorb a large effect beyond what the linear
         # projection says (a parallel spring as stiff as the contact, in pre-sliding): the
         # direction is shrunk by the share a nonlinear refit leaves, twice
@@ -950,10 +998,12 @@ def _per_parameter(
             if left >= 0.9:
                 break
             jp = jp * np.sqrt(max(left, 1e-6))
-            b = _bound(jp, st, ident, prop)
+            b = _bound(jp, st, ident, prop, rival)
         if b is not None:
             b *= margin  # the effect's calibration against its own simulations
         left = float(np.sum(st.w * jp * jp) / max(np.sum(st.w * j * j), 1e-300))
+        if rival is not None:  # (what the rival leaves, which the comparison reads)
+            left = float(np.sum(st.w * rival[0] ** 2) / max(np.sum(st.w * j * j), 1e-300))
         by = "the current model's parameters"
         if rivals:
             by += " and " + ", ".join(getattr(_effect(family, name), "rivals", ()))
@@ -968,7 +1018,7 @@ def _per_parameter(
             # what the range's end would show, in numbers (issue 29: a bound of "none" says
             # how far the record is from one): its relative size and detection probability
             end = span / margin if margin > 0 else span
-            seen = _power_curve(jp, st, ident, prop)(end)
+            seen = _power_curve(jp, st, ident, prop, rival)(end)
             r_end = span * float(np.sqrt(np.mean(j * j))) / st.y_rms
             why_none[s.name] = (
                 f"its linearised bound |{s.name} - {s.null:g}| = {b:.2g} lies beyond the "
