@@ -8,13 +8,49 @@ from ..._family import ParamSpec
 from .._base import EffectModel, Plausibility, register
 
 #: wavelengths :meth:`PositionFriction.start` tries, as multiples of the stroke's half-width
+#: (the long waves; :func:`start_wavelengths` adds the short ones the record resolves)
 START_WAVELENGTHS = np.geomspace(0.6, 8.0, 28)
+#: the short waves' grid (:func:`start_wavelengths`): uniform in the wavenumber, a step that
+#: turns the wave's phase over the whole stroke (two half-widths) by at most π/START_PHASE_STEP
+#: (a geometric grid of 10 % steps turned a wave of 0.17 half-widths by 7 rad over the
+#: stroke between two of its points, and missed it: rig, L = 40 µm at A = 240 µm, tuning seed
+#: 49400000 of ``benches/eval_posfric.py``); down to the shortest wave that keeps
+#: SHORT_WAVE_SAMPLES samples per wave at mid-stroke (where the speed is π/2 of its mean)
+#: and SHORT_WAVE_NOISE input-noise standard deviations per wave, and no shorter than
+#: SHORTEST_WAVE half-widths
+START_PHASE_STEP, SHORT_WAVE_SAMPLES, SHORT_WAVE_NOISE, SHORTEST_WAVE = 4.0, 5.0, 10.0, 0.05
+#: whether :func:`start_wavelengths` adds the short waves (a bench sets it off for a
+#: before/after on one tree)
+SHORT_WAVES = True
 #: the wavelength the stated power is given at, in half-widths of the stroke (a wave between
 #: one and two of them: the track's features that a stroke shows as a wave)
 POWER_WAVELENGTH = 1.5
 #: a wave longer than this many half-widths of the stroke is a level or a gradient of the
 #: friction over the stroke (h0, parameter drift, asymmetry), not a feature of the track
 LONGEST_WAVE = 12.0
+
+
+def start_wavelengths(d, half: float) -> np.ndarray:
+    """The wavelengths (m) :meth:`PositionFriction.start` tries on the record ``d`` whose
+    stroke's half-width is ``half``: :data:`START_WAVELENGTHS` half-widths, and the shorter
+    waves the record resolves on a grid uniform in the wavenumber (see
+    :data:`START_PHASE_STEP`)."""
+    longs = START_WAVELENGTHS * half
+    if not SHORT_WAVES:
+        return longs
+    per = float(getattr(d.cycles, "period_samples", np.nan) or np.nan)
+    sig = float(d.extra.get("u_noise", 0.0) or 0.0)
+    shortest = SHORTEST_WAVE * half
+    if np.isfinite(per) and per > 0:
+        # a branch covers 2 half-widths in per/2 samples, π/2 faster than that at mid-stroke
+        shortest = max(shortest, SHORT_WAVE_SAMPLES * np.pi * half / per)
+    shortest = min(max(shortest, SHORT_WAVE_NOISE * sig), START_WAVELENGTHS[0] * half)
+    # the wavenumber's step that turns the phase over the stroke by π/START_PHASE_STEP, from
+    # the longest wave of the grid to the shortest resolved (beside the geometric grid,
+    # which steps by more than that below 2.5 half-widths)
+    dk = np.pi / START_PHASE_STEP / (2.0 * half)
+    k = np.arange(2.0 * np.pi / longs[-1], 2.0 * np.pi / shortest * (1 + 1e-9), dk)
+    return np.r_[longs, 2.0 * np.pi / k]
 
 
 def track_phase(x: np.ndarray, d, wavelength: float) -> np.ndarray:
@@ -105,14 +141,14 @@ class PositionFriction(EffectModel):
         if not (half > 0 and np.all(np.isfinite(model))):
             return best
         top = 0.0
-        for m in START_WAVELENGTHS:
-            ph = track_phase(d.u, d, m * half)
+        for wl in start_wavelengths(d, half):
+            ph = track_phase(d.u, d, wl)
             cols = np.column_stack((model * np.cos(ph), model * np.sin(ph)))
             coef, *_ = np.linalg.lstsq(cols, residual, rcond=None)
             gain = float(residual @ (cols @ coef))
             if gain > top:
                 top = gain
-                best = {"L": float(m * half), "a1": float(np.clip(coef[0], -0.25, 0.25)),
+                best = {"L": float(wl), "a1": float(np.clip(coef[0], -0.25, 0.25)),
                         "b1": float(np.clip(coef[1], -0.25, 0.25))}  # fmt: skip
         return best
 
