@@ -8,7 +8,9 @@ generator showed them (conditions only):
 - ``spring``: a parallel spring of ``k_p = r h0/A`` (r 1-2.5), fs 1-2 kHz, 2-16 Hz, 5-20
   cycles, ac·A 1.5-4.5; named ``position_friction`` or ``stribeck``;
 - ``stick``: a breakaway b 0.05-0.1 of h0 at d_c 5-15 µm, fs 10 kHz, 30-50 Hz, 35 cycles,
-  ac·A 3-4.2; named ``channel_delay``.
+  ac·A 3-4.2; named ``channel_delay``;
+- ``lead``: the reverse, a force leading the displacement by 0.05-0.3 ms at the factors of
+  ``stick`` (the size at ``--mults`` is the bound's, the sign negative).
 
 Per (case, seed): the clean twin is diagnosed (its names are false alarms; the bound it
 states for the true effect), then the effect is hidden at its drawn size and, with
@@ -40,6 +42,10 @@ CASES: dict[str, dict[str, Any]] = {
                "cycles": (5, 20), "acA": (1.5, 4.5), "xn": (0.005, 0.014)},
     "stick": {"effect": "stick_slip", "fs": (10000.0,), "f": (30.0, 50.0),
               "cycles": (35, 35), "acA": (3.0, 4.2), "xn": (0.005, 0.01)},
+    # the reverse of ``stick``: a force leading the displacement (τ < 0), which a breakaway
+    # mimics, at the same factors
+    "lead": {"effect": "channel_delay", "fs": (10000.0,), "f": (30.0, 50.0),
+             "cycles": (35, 35), "acA": (3.0, 4.2), "xn": (0.005, 0.01)},
 }  # fmt: skip
 MAX_SAMPLES = 24_000
 
@@ -64,6 +70,8 @@ def factors(case: str, seed: int) -> dict[str, Any]:
         "phi": float(rng.uniform(0.0, 2 * math.pi)), "r": float(rng.uniform(1.0, 2.5)),
         "b": float(rng.uniform(0.05, 0.1)), "d_c": float(rng.uniform(5e-6, 15e-6)),
     }  # fmt: skip
+    if case == "lead":
+        fac["tau"] = -float(rng.uniform(0.05e-3, 0.3e-3))
     if case == "wave":  # the contact's curvature too: waves of 0.1-20 half-widths
         fac["ac"] = round(math.exp(rng.uniform(math.log(1.0e4), math.log(8.0e4))), 1)
     return fac
@@ -77,6 +85,8 @@ def params(case: str, fac: dict[str, Any], size: float | None = None) -> dict[st
         return {"position_friction": {"eps": eps, "L": fac["L"], "phi": fac["phi"]}}
     if case == "spring":
         return {"parallel_stiffness": {"k_p": fac["r"] * H0 / A if size is None else size}}
+    if case == "lead":
+        return {"channel_delay": {"tau": fac["tau"] if size is None else -abs(size)}}
     return {"stick_slip": {"b": fac["b"] if size is None else size, "d_c": fac["d_c"]}}
 
 
@@ -112,7 +122,14 @@ def summary(rep: Any, effect: str) -> dict[str, Any]:
 
 def without(names: tuple[str, ...]) -> None:
     """Take off this helper's rules (the "before" of a before/after on one tree): ``short``
-    the position friction's short waves in its start."""
+    the position friction's short waves in its start, ``lead`` a leading force's yielding to
+    a breakaway."""
+    if "lead" in names:
+        from contactlab.diagnose.effects import registry
+
+        cls = type(registry("tangential")["channel_delay"])
+        if "yields_to_tried" in cls.__dict__:
+            delattr(cls, "yields_to_tried")
     if "short" in names:
         import contactlab.diagnose.effects.tangential.position_friction as pf
 
@@ -153,7 +170,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--mults", default="", help="multiples of the clean twin's stated bound")
     ap.add_argument("--no-drawn", action="store_true", help="skip the drawn size")
     ap.add_argument("--jobs", type=int, default=1, help="(one process: kept for the brief)")
-    ap.add_argument("--without", default="", help="short: these rules off")
+    ap.add_argument("--without", default="", help="short,lead: these rules off")
     ap.add_argument("--out", type=Path, default=None)
     a = ap.parse_args(argv)
     without(tuple(w for w in a.without.split(",") if w))
