@@ -48,6 +48,8 @@ CASES: dict[str, dict[str, Any]] = {
              "cycles": (35, 35), "acA": (3.0, 4.2), "xn": (0.005, 0.01)},
 }  # fmt: skip
 MAX_SAMPLES = 24_000
+#: ``--aca lo,hi``: every case's ac·A drawn log-uniform from this range (None: the case's own)
+ACA: tuple[float, float] | None = None
 
 
 def factors(case: str, seed: int) -> dict[str, Any]:
@@ -72,6 +74,9 @@ def factors(case: str, seed: int) -> dict[str, Any]:
     }  # fmt: skip
     if case == "lead":
         fac["tau"] = -float(rng.uniform(0.05e-3, 0.3e-3))
+    if ACA is not None:  # ``--aca``: ac·A from this range instead (its own stream)
+        r2 = np.random.default_rng([seed, list(CASES).index(case), 4950])
+        fac["acA"] = round(math.exp(r2.uniform(math.log(ACA[0]), math.log(ACA[1]))), 3)
     if case == "wave":  # the contact's curvature too: waves of 0.1-20 half-widths
         fac["ac"] = round(math.exp(rng.uniform(math.log(1.0e4), math.log(8.0e4))), 1)
     return fac
@@ -171,8 +176,13 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--no-drawn", action="store_true", help="skip the drawn size")
     ap.add_argument("--jobs", type=int, default=1, help="(one process: kept for the brief)")
     ap.add_argument("--without", default="", help="short,lead: these rules off")
+    ap.add_argument("--aca", default=None, help="lo,hi: ac·A drawn from this range instead")
     ap.add_argument("--out", type=Path, default=None)
     a = ap.parse_args(argv)
+    if a.aca:
+        global ACA
+        lo, hi = (float(v) for v in a.aca.split(","))
+        ACA = (lo, hi)
     without(tuple(w for w in a.without.split(",") if w))
     mults = tuple(float(m) for m in a.mults.split(",") if m)
     rows = []
