@@ -8,7 +8,6 @@ from ..._family import MAX_DELAY_FRACTION, ParamSpec
 from ..._signal import shift
 from .._base import EffectModel, Plausibility, register
 from ._common import delay_support, period, reconstructed
-from .stick_slip import INPUT_NOISE_SHARE as BREAKAWAY_NOISE_SHARE
 
 #: (MAX_DELAY_FRACTION, the largest plausible delay as a fraction of the excitation period,
 #: is shared with the normal family's delay: :data:`contactlab.diagnose._family`)
@@ -27,10 +26,6 @@ MAX_SKEW_SECONDS = 0.002
 #: the start's grid (:meth:`ChannelDelay.start`): this many delays either side of 0 up to the
 #: largest plausible one
 START_GRID = 40
-
-
-#: the breakaway a leading force yields to (:meth:`ChannelDelay.yields_to_tried`)
-BREAKAWAY = "stick_slip"
 
 
 @register
@@ -120,47 +115,6 @@ class ChannelDelay(EffectModel):
             # np.interp brackets each by the same two samples as on the full grid
             return np.interp(d.t[ctx.at] - p["tau"], d.t[ctx.rows], F)
         return F
-
-    def yields_to_tried(self, p, v, cand, tried, current, d):
-        """Why a force *leading* the displacement (``tau < 0``) is not named beside a
-        breakaway (``stick_slip``) accepted at the same step, or None: where the delay's
-        held-out lead over the breakaway is no more than what the input's noise alone gives
-        a delay over a breakaway (the share of the input-noise budget
-        ``d.extra["input_noise_budget"]`` a breakaway is spared, ``1 -
-        StickSlip.input_noise_share``, the mirror of
-        :meth:`~.stick_slip.StickSlip.yields_to_tried`).
-
-        A leading force adds ``|τ| Ḟ``, the branch's stiffness times the speed, in the
-        direction of motion after each turn, as a breakaway adds its peak there; the delay
-        also draws the input's noise at the steep turns (the prediction shifted in time
-        passes over it), the breakaway, anchored at the reversals and one-signed, does not.
-        A lagging force (``tau > 0``) takes force away after the turn, the opposite of a
-        breakaway, and is not judged here. Rig (``benches/eval_posfric.py --cases stick``
-        conditions: a breakaway of 8 % of h0 at d_c 10 µm, 50 Hz, fs 10 kHz, 35 cycles, ac·A
-        3.7, x noise 0.9 % of the range; tuning seed 49400200): the delay (τ = -0.16 ms, the
-        base's ac moved by -10 %) gained 0.717 σ² held-out, the breakaway 0.611 σ² (s_b
-        0.055, ell 11.6 µm; without the x noise s_b 0.079, ell 10.0 µm), and the delay was
-        named."""
-        if not p.get("tau", 0.0) < 0.0:
-            return None
-        rival = tried.get(BREAKAWAY)
-        if rival is None:
-            return None
-        rv, _ = rival
-        if not (rv.accepted and np.isfinite(rv.gain) and rv.gain > 0 and np.isfinite(v.gain)):
-            return None
-        budget = float(d.extra.get("input_noise_budget", 0.0) or 0.0)
-        owed = (1.0 - BREAKAWAY_NOISE_SHARE) * budget
-        lead = float(v.gain - rv.gain)
-        if not (budget > 0 and lead <= owed):
-            return None
-        return (
-            f"a force leading the displacement by {1e3 * abs(p['tau']):.3g} ms gained "
-            f"{v.gain:.3g} σ² held-out, {lead:.3g} σ² more than the breakaway tried at the "
-            f"same step ({rv.gain:.3g} σ², accepted), within the {owed:.3g} σ² the input's "
-            "noise alone gives a delay over a breakaway: both add force in the direction of "
-            "motion after each turn, and only the delay feeds on the input's noise there"
-        )
 
     def plausible(self, d, p):
         base = super().plausible(d, p)
