@@ -27,7 +27,8 @@ def _record(wave_halves: float, cycles: int = 6, n: int = 400, a: float = 0.02):
     L = wave_halves * A
     F = h * (1.0 + a * np.cos(2 * np.pi * x / L + 0.7))
     extra = {"x_mid": 0.0, "x_half": A, "u_noise": 0.0}
-    d = SimpleNamespace(u=x, y=F, extra=extra, cycles=SimpleNamespace(period_samples=float(n)))
+    cycles = SimpleNamespace(period_samples=float(n), cycle=np.floor(t).astype(int))
+    d = SimpleNamespace(u=x, y=F, extra=extra, cycles=cycles)
     return d, F - h, L
 
 
@@ -37,6 +38,16 @@ def test_start_finds_a_wave_shorter_than_the_stroke(halves):
     p = registry("tangential")["position_friction"].start({}, d, residual)
     assert abs(p["L"] / L - 1.0) < 0.03
     assert np.hypot(p["a1"], p["b1"]) == pytest.approx(0.02, rel=0.15)
+
+
+def test_start_takes_the_wave_that_repeats_across_cycles():
+    """A wiggle that changes from cycle to cycle is not a track's wave: with the residual
+    a short wave on the even cycles and its opposite on the odd ones, no short wave gains
+    held out, and the start keeps to the long waves' grid."""
+    d, residual, _ = _record(0.17)
+    flip = np.where(d.cycles.cycle % 2 == 0, 1.0, -1.0)
+    p = registry("tangential")["position_friction"].start({}, d, residual * flip)
+    assert p["L"] >= 0.6 * d.extra["x_half"] * (1 - 1e-9)
 
 
 def test_short_waves_stop_where_the_record_resolves_them():
