@@ -8,13 +8,49 @@ from ..._family import ParamSpec
 from .._base import EffectModel, Plausibility, register
 
 #: wavelengths :meth:`PositionFriction.start` tries, as multiples of the stroke's half-width
+#: (the long waves; :func:`start_wavelengths` adds the short ones the record resolves)
 START_WAVELENGTHS = np.geomspace(0.6, 8.0, 28)
+#: the short waves' grid (:func:`start_wavelengths`): uniform in the wavenumber, a step that
+#: turns the wave's phase over the whole stroke (two half-widths) by at most π/START_PHASE_STEP
+#: (a geometric grid of 10 % steps turned a wave of 0.17 half-widths by 7 rad over the
+#: stroke between two of its points, and missed it: rig, L = 40 µm at A = 240 µm, tuning seed
+#: 49400000 of ``benches/eval_posfric.py``); down to the shortest wave that keeps
+#: SHORT_WAVE_SAMPLES samples per wave at mid-stroke (where the speed is π/2 of its mean)
+#: and SHORT_WAVE_NOISE input-noise standard deviations per wave, and no shorter than
+#: SHORTEST_WAVE half-widths
+START_PHASE_STEP, SHORT_WAVE_SAMPLES, SHORT_WAVE_NOISE, SHORTEST_WAVE = 4.0, 5.0, 10.0, 0.05
+#: whether :func:`start_wavelengths` adds the short waves (a bench sets it off for a
+#: before/after on one tree)
+SHORT_WAVES = True
 #: the wavelength the stated power is given at, in half-widths of the stroke (a wave between
 #: one and two of them: the track's features that a stroke shows as a wave)
 POWER_WAVELENGTH = 1.5
 #: a wave longer than this many half-widths of the stroke is a level or a gradient of the
 #: friction over the stroke (h0, parameter drift, asymmetry), not a feature of the track
 LONGEST_WAVE = 12.0
+
+
+def start_wavelengths(d, half: float) -> np.ndarray:
+    """The wavelengths (m) :meth:`PositionFriction.start` tries on the record ``d`` whose
+    stroke's half-width is ``half``: :data:`START_WAVELENGTHS` half-widths, and the shorter
+    waves the record resolves on a grid uniform in the wavenumber (see
+    :data:`START_PHASE_STEP`)."""
+    longs = START_WAVELENGTHS * half
+    if not SHORT_WAVES:
+        return longs
+    per = float(getattr(d.cycles, "period_samples", np.nan) or np.nan)
+    sig = float(d.extra.get("u_noise", 0.0) or 0.0)
+    shortest = SHORTEST_WAVE * half
+    if np.isfinite(per) and per > 0:
+        # a branch covers 2 half-widths in per/2 samples, π/2 faster than that at mid-stroke
+        shortest = max(shortest, SHORT_WAVE_SAMPLES * np.pi * half / per)
+    shortest = min(max(shortest, SHORT_WAVE_NOISE * sig), START_WAVELENGTHS[0] * half)
+    # the wavenumber's step that turns the phase over the stroke by π/START_PHASE_STEP, from
+    # the longest wave of the grid to the shortest resolved (beside the geometric grid,
+    # which steps by more than that below 2.5 half-widths)
+    dk = np.pi / START_PHASE_STEP / (2.0 * half)
+    k = np.arange(2.0 * np.pi / longs[-1], 2.0 * np.pi / shortest * (1 + 1e-9), dk)
+    return np.r_[longs, 2.0 * np.pi / k]
 
 
 def track_phase(x: np.ndarray, d, wavelength: float) -> np.ndarray:
@@ -96,25 +132,53 @@ class PositionFriction(EffectModel):
         return {"L": POWER_WAVELENGTH * half} if half > 0 else {}
 
     def start(self, p, d, residual, family=None):
-        """The wavelength (of :data:`START_WAVELENGTHS` half-widths of the stroke) whose wave,
-        on the current model's force (``d.y - residual``), explains most of the residual,
-        with its least-squares amplitudes (the term is linear in them at a given ``L``)."""
+        """The wavelength whose wave, on the current model's force (``d.y - residual``),
+        explains most of the residual, with its least-squares amplitudes (the term is linear
+        in them at a given ``L``).
+
+        The wavelengths of :func:`start_wavelengths` are judged across cycles: the wave's
+        amplitudes fitted on the even cycles must lower the residual of the odd ones and
+        the other way round (a track's wave repeats at the same x every cycle); the one
+        whose held-out gain is largest is taken. Where none gains held out, or the record
+        has fewer than two cycles, the wavelength of :data:`START_WAVELENGTHS` half-widths
+        that explains most of the residual in-sample (the start before the short waves).
+        Judged in-sample, the short waves' grid took a measured record's start to a wave
+        that fitted the held-out cycles worse (the friction damper ``damper_12`` of
+        ``benches/eval_measured_diagnose.py``: the wave's held-out gain fell from 0.155 to
+        0.083 σ², and a mass of 271 kg was named in its place)."""
         half = float(d.extra.get("x_half", 0.5 * float(np.ptp(d.u))))
         best: dict[str, float] = {"L": 2.0 * half if half > 0 else 1.0}
         model = d.y - residual
         if not (half > 0 and np.all(np.isfinite(model))):
             return best
-        top = 0.0
-        for m in START_WAVELENGTHS:
-            ph = track_phase(d.u, d, m * half)
+        cyc = getattr(d.cycles, "cycle", None)
+        folds = None
+        if SHORT_WAVES and cyc is not None and np.shape(cyc) == np.shape(residual):
+            cyc = np.asarray(cyc)
+            even, odd = (cyc >= 0) & (cyc % 2 == 0), (cyc >= 0) & (cyc % 2 == 1)
+            if np.count_nonzero(even) >= 8 and np.count_nonzero(odd) >= 8:
+                folds = (even, odd)
+        top, top_cv, pick = 0.0, 0.0, None
+        for wl in start_wavelengths(d, half) if folds is not None else START_WAVELENGTHS * half:
+            ph = track_phase(d.u, d, wl)
             cols = np.column_stack((model * np.cos(ph), model * np.sin(ph)))
             coef, *_ = np.linalg.lstsq(cols, residual, rcond=None)
             gain = float(residual @ (cols @ coef))
-            if gain > top:
-                top = gain
-                best = {"L": float(m * half), "a1": float(np.clip(coef[0], -0.25, 0.25)),
-                        "b1": float(np.clip(coef[1], -0.25, 0.25))}  # fmt: skip
-        return best
+            entry = {"L": float(wl), "a1": float(np.clip(coef[0], -0.25, 0.25)),
+                     "b1": float(np.clip(coef[1], -0.25, 0.25))}  # fmt: skip
+            if gain > top and wl >= START_WAVELENGTHS[0] * half * (1 - 1e-9):
+                top, best = gain, entry
+            if folds is None:
+                continue
+            cv = 0.0
+            for fit, test in (folds, folds[::-1]):
+                c, *_ = np.linalg.lstsq(cols[fit], residual[fit], rcond=None)
+                r = residual[test]
+                e = r - cols[test] @ c
+                cv += float(r @ r - e @ e)
+            if cv > top_cv:
+                top_cv, pick = cv, entry
+        return pick if pick is not None else best
 
     def apply(self, h, p, ctx):
         d = ctx.d
