@@ -131,7 +131,14 @@ def main(argv=None):
     ap.add_argument("--gen", choices=("rig", "plain", "pkg"), default="rig")
     ap.add_argument("--verbose", action="store_true")
     ap.add_argument("--old", action="store_true", help="the mass reads the old ẍ (MASS_GAP off)")
+    ap.add_argument("--only", default="", help="comma-separated seeds to run")
+    ap.add_argument("--set", default="", help="NAME=VALUE,... of contactlab's inertia module")
     a = ap.parse_args(argv)
+    for kv in filter(None, a.set.split(",")):
+        from contactlab.diagnose.effects.tangential import inertia
+
+        k, v = kv.split("=")
+        setattr(inertia, k, type(getattr(inertia, k))(float(v)))
     if a.old:
         from contactlab.diagnose.effects.tangential import inertia
 
@@ -140,8 +147,11 @@ def main(argv=None):
         setattr(a, k, tuple(float(v) for v in getattr(a, k).split(",")))
     a.cycles = tuple(int(v) for v in a.cycles.split(","))
     counts: dict[str, list[int]] = {}
+    only = [int(v) for v in a.only.split(",")] if a.only else None
     for e in a.effects.split(","):
         for i in range(a.n):
+            if only is not None and a.base + i not in only:
+                continue
             r = run(a.base + i, e, a)
             ok = (not r["named"]) if e == "clean" else (r["named"] == [e])
             c = counts.setdefault(e, [0, 0, 0])
