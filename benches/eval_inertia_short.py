@@ -27,14 +27,14 @@ H0, AC = 40.0, 4.0e4
 
 def factors(seed: int, effect: str, a) -> dict:
     rng = np.random.default_rng([seed, 2929, 0 if effect == "clean" else 1])
-    fs = float(rng.uniform(5000.0, 10000.0))
+    fs = float(rng.uniform(*a.fs))
     return {
         "fs": round(fs, 1),
         "f": round(float(rng.uniform(*a.f)), 3),
         "cycles": int(rng.integers(a.cycles[0], a.cycles[1] + 1)),
         "acA": round(float(rng.uniform(*a.aca)), 3),
-        "x_noise": round(float(rng.uniform(0.010, 0.016)), 4),
-        "F_noise": round(float(rng.uniform(0.0086, 0.012)), 4),
+        "x_noise": round(float(rng.uniform(*a.xn)), 4),
+        "F_noise": round(float(rng.uniform(*a.fn)), 4),
         "share": round(float(rng.uniform(*a.share)), 4),
         "bits": int(rng.integers(14, 17)),
     }
@@ -127,6 +127,9 @@ def main(argv=None):
     ap.add_argument("--aca", default="0.42,0.62")
     ap.add_argument("--f", default="11,24")
     ap.add_argument("--cycles", default="5,5")
+    ap.add_argument("--fs", default="5000,10000")
+    ap.add_argument("--xn", default="0.010,0.016", help="x noise, share of the range")
+    ap.add_argument("--fn", default="0.0086,0.012", help="F noise, share of the range")
     ap.add_argument("--share", default="0.03,0.10")
     ap.add_argument("--gen", choices=("rig", "plain", "pkg"), default="rig")
     ap.add_argument("--verbose", action="store_true")
@@ -143,7 +146,7 @@ def main(argv=None):
         from contactlab.diagnose.effects.tangential import inertia
 
         inertia.MASS_GAP = False
-    for k in ("aca", "f", "share"):
+    for k in ("aca", "f", "share", "fs", "xn", "fn"):
         setattr(a, k, tuple(float(v) for v in getattr(a, k).split(",")))
     a.cycles = tuple(int(v) for v in a.cycles.split(","))
     counts: dict[str, list[int]] = {}
