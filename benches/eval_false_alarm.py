@@ -636,12 +636,20 @@ def _power_one(job: tuple[str, int, tuple[str, ...]]) -> list[dict[str, Any]]:
     return out
 
 
+def _old_acc() -> None:
+    """Worker initializer for ``--old-acc``: the mass reads the older ẍ (MASS_GAP off)."""
+    from contactlab.diagnose.effects.tangential import inertia
+
+    inertia.MASS_GAP = False
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--model", choices=("tangential", "normal", "both"), default="both")
     ap.add_argument("--n", type=int, default=60, help="clean records per model")
     ap.add_argument("--seed0", type=int, default=10000)
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--old-acc", action="store_true", help="the mass reads the older ẍ")
     ap.add_argument("--power", action="store_true")
     ap.add_argument("--power-seeds", type=int, default=6, help="seeds per generator")
     ap.add_argument("--tanh", type=int, default=0, help="tanh-virgin records to diagnose")
@@ -669,7 +677,8 @@ def main() -> None:
             (m, a.seed0 + i, "exp", "pkg") for m in models for i in range(a.n)
         ]
         jobs += [(m, a.seed0 + 700 + i, "exp", "rig") for m in models for i in range(a.rig)]
-        with ProcessPoolExecutor(a.jobs) as ex:
+        init = _old_acc if a.old_acc else None
+        with ProcessPoolExecutor(a.jobs, initializer=init) as ex:
             results = list(ex.map(run_one, jobs))
         everything += results
         for gen in ("pkg", "rig"):

@@ -252,7 +252,13 @@ def main(argv=None):
     ap.add_argument("--gen", choices=("rig", "pkg"), default=None,
                     help="force one generator (default: 60 %% rig)")  # fmt: skip
     ap.add_argument("--aca", default="0.3,5.0", help="lo,hi of ac·A (log-uniform)")
+    ap.add_argument("--old-acc", action="store_true",
+                    help="the mass reads the older ẍ (MASS_GAP off), --jobs 1 only")  # fmt: skip
     a = ap.parse_args(argv)
+    if a.old_acc:
+        from contactlab.diagnose.effects.tangential import inertia
+
+        inertia.MASS_GAP = False
     share = tuple(float(v) for v in a.share.split(","))
     aca = tuple(float(v) for v in a.aca.split(","))
     effects = a.effects.split(",")

@@ -205,7 +205,9 @@ def linear_term_null(
             # ẍ of the measured x, whose noise correlates with the noise the base model
             # turns into force error (errors in variables in the regressor itself)
             ud, udd = derivatives(u_raw, d.dt, d.window)
-            dg = sig(dataclasses.replace(dk, ud=ud, udd=udd, extra={**dk.extra, "fixed": {}}))
+            # (``u_raw``: the copy's measured input, which the mass's ẍ is read from)
+            ex = {**dk.extra, "fixed": {}, "u_raw": u_raw}
+            dg = sig(dataclasses.replace(dk, ud=ud, udd=udd, extra=ex))
             return np.asarray(family.predict(p1, full, dg), float) - np.asarray(
                 family.predict(p0, full, dg), float
             )

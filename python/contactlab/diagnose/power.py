@@ -1083,6 +1083,9 @@ def signal_input(d: Prepared) -> Prepared:
     ud = savgol_filter(d.ud, w, SIGNAL_DEGREE, mode="interp")
     udd = savgol_filter(d.udd, w, SIGNAL_DEGREE, mode="interp")
     extra = {k: v for k, v in d.extra.items() if k not in ("fixed", "evaluations")}
+    # the derivatives are the signal part: an effect that reads its own from the raw input
+    # (``inertia``'s mass_acceleration) reads these instead
+    extra["signal_derivatives"] = True
     return dataclasses.replace(d, ud=ud, udd=udd, extra=extra)
 
 
