@@ -146,13 +146,17 @@ def test_the_bound_solves_the_power_against_the_copies(monkeypatch):
 
 
 @pytest.mark.slow
-def test_a_bound_beyond_the_range_says_where_it_lies():
+def test_a_loss_asymmetry_on_one_tone_gets_a_bound_within_its_range():
     """A loss asymmetry on one tone (the rig's normal contact, 12.3 Hz, 20 cycles): its
-    rival, the stiffening law, takes most of its 2ω signature, and the linearised bound
-    lies beyond |a| < 0.95; the reason gives the number instead of a bare "not detectable"."""
+    rival, the stiffening law, takes most of its 2ω signature. Until stop 48 the bound asked
+    the part the law leaves (the 4ω kink) to pass the rules alone and lay beyond |a| < 0.95
+    (no bound, a reason with the number); since stop 49 it models the rule that names the
+    asymmetry (its own direction passes the rules and it fits better than the law fitted in
+    its place, ``power._rival_wins``), which gives a bound within the range here (0.31)."""
     rec = rig_recording({}, "normal", seed=6900, fs=10000.0, f=12.3, cycles=20, x_noise=0.015,
                         F_noise=0.011)  # fmt: skip
     rep = contactlab.diagnose((rec.t, rec.channels["p"], rec.channels["delta"]), model="normal")
     nd = {x.effect: x for x in rep.not_detected}["asymmetric_branches"]
-    assert nd.detectable_above is None
-    assert "linearised bound |a - 0| = " in nd.reason and "stiffness_nonlinearity" in nd.reason
+    assert nd.detectable_above is not None, nd.reason
+    assert 0.05 < nd.detectable_above < 0.95
+    assert "would be seen above" in nd.sentence()

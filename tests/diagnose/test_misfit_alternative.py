@@ -93,3 +93,29 @@ def test_the_flag_says_so() -> None:
     assert "systematic misfit that no candidate explains" in s, s
     assert "tanh" in s and "series_compliance" in s, s
     assert json.loads(json.dumps(u.to_dict()))["patches"][0]["alternative"] is True
+
+
+@pytest.mark.parametrize("case", range(6))
+def test_bounded_min_takes_scipys_steps(case):
+    """The alternative's curvature refinement (misfit._bounded_min) runs Brent's bounded
+    method step for step as SciPy's minimize_scalar(method="bounded") does: the same point
+    and value, bit for bit, on smooth, flat-bottomed, kinked and wiggly functions."""
+    from scipy.optimize import minimize_scalar
+
+    from contactlab.diagnose.misfit import _bounded_min
+
+    rng = np.random.default_rng(4900 + case)
+    c, w = rng.uniform(-1.0, 1.0), rng.uniform(0.5, 20.0)
+    funcs = [
+        lambda v: (v - c) ** 2,
+        lambda v: abs(v - c) + 0.1 * (v - c) ** 2,
+        lambda v: np.cos(w * v) + 0.3 * v,
+        lambda v: (v - c) ** 4,
+        lambda v: np.exp(v) - 2.0 * v,
+        lambda v: float(np.round((v - c) ** 2, 3)),
+    ]
+    f = funcs[case]
+    lo, hi = sorted(rng.uniform(-2.0, 2.0, size=2))
+    r = minimize_scalar(f, bounds=(lo, hi), method="bounded", options={"xatol": 1e-3})
+    x, fx = _bounded_min(f, float(lo), float(hi), 1e-3)
+    assert x == float(r.x) and fx == float(r.fun)

@@ -1196,8 +1196,6 @@ def _alt_fit(
     over ``amp`` and then refined between the grid's neighbours; with ``straight`` (a
     spring's force ``u``) fitted beside it. Returns the training sum of squares and the
     prediction on every sample (None where nothing fits)."""
-    from scipy.optimize import minimize_scalar
-
     wt, tt = w[train], target[train]
     sw = np.sqrt(wt)
 
@@ -1220,11 +1218,82 @@ def _alt_fit(
     if not np.isfinite(ss[j]):
         return math.inf, None
     lo, hi = grid[max(j - 1, 0)], grid[min(j + 1, grid.size - 1)]
-    r = minimize_scalar(
-        lambda v: one(v)[0], bounds=(lo, hi), method="bounded", options={"xatol": 1e-3}
-    )
-    lk = float(r.x) if r.fun < ss[j] else float(grid[j])
+    rx, rfun = _bounded_min(lambda v: one(v)[0], float(lo), float(hi), 1e-3)
+    lk = rx if rfun < ss[j] else float(grid[j])
     return one(lk)
+
+
+def _bounded_min(
+    func: Any, lo: float, hi: float, xatol: float, maxiter: int = 500
+) -> tuple[float, float]:
+    """The minimum of ``func`` on ``[lo, hi]`` by Brent's bounded method (golden sections
+    and parabolic steps): the steps and the stopping rule of SciPy's
+    ``minimize_scalar(method="bounded")``, so the same points are tried and the same minimum
+    returned, without importing SciPy (a diagnosis imports none of it:
+    ``tests/base/test_trf.py``). Returns ``(x, func(x))``."""
+    sqrt_eps = math.sqrt(2.2e-16)
+    golden_mean = 0.5 * (3.0 - math.sqrt(5.0))
+    a, b = lo, hi
+    fulc = a + golden_mean * (b - a)
+    nfc, xf = fulc, fulc
+    rat = e = 0.0
+    fx = func(xf)
+    num = 1
+    ffulc = fnfc = fx
+    xm = 0.5 * (a + b)
+    tol1 = sqrt_eps * abs(xf) + xatol / 3.0
+    tol2 = 2.0 * tol1
+    while abs(xf - xm) > (tol2 - 0.5 * (b - a)):
+        golden = True
+        if abs(e) > tol1:  # a parabola through the three best points
+            golden = False
+            r = (xf - nfc) * (fx - ffulc)
+            q = (xf - fulc) * (fx - fnfc)
+            p = (xf - fulc) * q - (xf - nfc) * r
+            q = 2.0 * (q - r)
+            if q > 0.0:
+                p = -p
+            q = abs(q)
+            r = e
+            e = rat
+            if abs(p) < abs(0.5 * q * r) and p > q * (a - xf) and p < q * (b - xf):
+                rat = (p + 0.0) / q
+                x = xf + rat
+                if (x - a) < tol2 or (b - x) < tol2:
+                    rat = tol1 * (-1.0 if xm - xf < 0 else 1.0)
+            else:
+                golden = True
+        if golden:
+            e = (a - xf) if xf >= xm else (b - xf)
+            rat = golden_mean * e
+        si = -1.0 if rat < 0 else 1.0  # numpy's sign, 1 at 0
+        x = xf + si * max(abs(rat), tol1)
+        fu = func(x)
+        num += 1
+        if fu <= fx:
+            if x >= xf:
+                a = xf
+            else:
+                b = xf
+            fulc, ffulc = nfc, fnfc
+            nfc, fnfc = xf, fx
+            xf, fx = x, fu
+        else:
+            if x < xf:
+                a = x
+            else:
+                b = x
+            if fu <= fnfc or nfc == xf:
+                fulc, ffulc = nfc, fnfc
+                nfc, fnfc = x, fu
+            elif fu <= ffulc or fulc == xf or fulc == nfc:
+                fulc, ffulc = x, fu
+        xm = 0.5 * (a + b)
+        tol1 = sqrt_eps * abs(xf) + xatol / 3.0
+        tol2 = 2.0 * tol1
+        if num >= maxiter:
+            break
+    return float(xf), float(fx)
 
 
 def _alt_force(kind: str, ac: float, u: np.ndarray) -> np.ndarray:
