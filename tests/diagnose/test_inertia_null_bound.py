@@ -160,3 +160,22 @@ def test_a_loss_asymmetry_on_one_tone_gets_a_bound_within_its_range():
     assert nd.detectable_above is not None, nd.reason
     assert 0.05 < nd.detectable_above < 0.95
     assert "would be seen above" in nd.sentence()
+
+
+def test_a_bound_beyond_the_range_says_where_it_lies():
+    """A loss asymmetry on a short one-tone record (the package generator, 15 cycles of 40
+    samples from rest, 1.5 % noise on both channels; seed 49310002 of
+    ``benches/eval_normal_bound_package.py``): the linearised bound lies beyond |a| < 0.95,
+    so no bound is stated and the reason gives the number, what absorbs the direction and
+    the power at the range's end, instead of a bare "not detectable"."""
+    from contactlab.synthetic.diagnosis import hidden_effect_recording
+
+    r = hidden_effect_recording([], model="normal", seed=49310002, noise=0.01505301076446185,
+                                input_noise=0.01505301076446185, cycles_per_block=15,
+                                samples_per_cycle=40, start="rest", frequencies=[1.0])  # fmt: skip
+    ch = r.channels if isinstance(getattr(r, "channels", None), dict) else r.data
+    rep = contactlab.diagnose({"t": r.t, "p": ch["p"], "delta": ch["delta"]}, model="normal")
+    nd = {x.effect: x for x in rep.not_detected}["asymmetric_branches"]
+    assert nd.detectable_above is None
+    assert "linearised bound |a - 0| = " in nd.reason and "stiffness_nonlinearity" in nd.reason
+    assert "lies beyond the parameter's range" in nd.reason and "probability" in nd.reason
