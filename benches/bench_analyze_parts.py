@@ -60,6 +60,7 @@ KERNELS = (
     "finite_min_max",
     "fill_time",
     "order_stats",
+    "order_stats_trapezoids",
     "period_means_pair",
     "detrend_pair_scan_into",
     "detrend_pair_scan_uniform_into",

@@ -203,6 +203,8 @@ def window_detrended(
     :func:`analyze_window`)."""
     n_points, rel = opts["n_points"], opts["rel_threshold"]
     min_cycles = opts["min_cycles"]
+    # the raw samples' scan (x, F and tc, the axis t's values as float64 and checked)
+    raw: _core.RawScan | None = None
     if checked:
         # find_reversals(checked=True) of an x known finite: the reversal detector does not
         # scan it again
@@ -212,7 +214,16 @@ def window_detrended(
             tc = as_1d(ta, "t", finite=not time_checked)
         if tc.size != xa.size:
             raise InputError(f"t has {tc.size} samples but x has {xa.size}")
-        rev = _reversals(xa, tc, tail_percentiles(xa), rel, None, finite=True)
+        sel = _tail_ranks(xa.size)
+        if sel is not None:
+            # tail_percentiles(xa) and, in the same pass, the checkpoints of the period
+            # means' trapezoid integrals below (issue 33: that walk's own pass, 3 ns a
+            # sample, resumed from them instead; the same numbers)
+            raw = _core.order_stats_trapezoids(xa, tc, Fa, sel[0])
+            pct = _lerp_tails(raw.order_stats, sel[1])
+        else:
+            pct = tail_percentiles(xa)
+        rev = _reversals(xa, tc, pct, rel, None, finite=True)
     else:
         rev = find_reversals(xa, ta, rel_threshold=rel)  # checks x and t
         Fa = as_1d(Fa, "F")
@@ -226,7 +237,11 @@ def window_detrended(
     time = 0.5 * (pt[:-1] + pt[1:])
     tm = float(np.mean(time))
     # period_means of F and of x in one pass over t (bit for bit the two calls)
-    f_means, x_means = _core.period_means_pair(tt, Fa, xa, np.ascontiguousarray(pt, dtype=float))
+    edges = np.ascontiguousarray(pt, dtype=float)
+    if raw is not None:  # (tc: tt's values, the axis the scan read)
+        f_means, x_means = _core.period_means_pair(tc, Fa, xa, edges, raw)
+    else:
+        f_means, x_means = _core.period_means_pair(tt, Fa, xa, edges)
     f_drift = trend(time, f_means)
     x_drift = trend(time, x_means)
     # Fa - s·(tt - tm) for both channels in one Rust pass without the interpreter lock (bit

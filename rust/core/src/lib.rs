@@ -42,6 +42,7 @@ pub mod loop_fit;
 pub mod masing;
 pub mod normal;
 pub mod parallel;
+pub mod raw_scan;
 pub mod reversal;
 pub mod scan;
 pub mod select;

@@ -1,6 +1,9 @@
 //! Binding of `contactlab_core::fold`: the phase-bin fold, its spread, and period means.
 
 use contactlab_core::fold::{fold_phase, fold_spread, period_means, period_means_pair, FoldSums};
+use contactlab_core::raw_scan::{
+    order_stats_trapezoids, period_means_pair_resumed, RawScan as CoreRawScan,
+};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 
@@ -130,24 +133,66 @@ fn period_means_py<'py>(
 }
 
 /// Period means of two channels on one time axis in one pass (see
-/// `contactlab_core::fold::period_means_pair`).
+/// `contactlab_core::fold::period_means_pair`); `scan`: `order_stats_trapezoids` of these
+/// very samples, whose checkpoints the walk resumes from (the same numbers:
+/// `contactlab_core::raw_scan::period_means_pair_resumed`).
 #[pyfunction]
-#[pyo3(name = "period_means_pair")]
+#[pyo3(name = "period_means_pair", signature = (t, f, x, edges, scan=None))]
 fn period_means_pair_py<'py>(
     py: Python<'py>,
     t: PyReadonlyArray1<'py, f64>,
     f: PyReadonlyArray1<'py, f64>,
     x: PyReadonlyArray1<'py, f64>,
     edges: PyReadonlyArray1<'py, f64>,
+    scan: Option<PyRef<'py, RawScan>>,
 ) -> PyResult<(Arr<'py>, Arr<'py>)> {
     let (ts, fs, xs) = (slice(&t, "t")?, slice(&f, "F")?, slice(&x, "x")?);
     let es = slice(&edges, "edges")?;
-    let (a, b) = detach_guarded(py, || period_means_pair(ts, fs, xs, es))?;
+    let sc = scan.as_ref().map(|s| &s.inner);
+    let (a, b) = detach_guarded(py, || match sc {
+        Some(s) => period_means_pair_resumed(ts, fs, xs, es, s),
+        None => period_means_pair(ts, fs, xs, es),
+    })?;
     Ok((a.into_pyarray(py), b.into_pyarray(py)))
+}
+
+/// What `order_stats_trapezoids` found of a window's raw samples: the order statistics,
+/// and the period means' checkpoints that `period_means_pair(..., scan=)` resumes from.
+#[pyclass(module = "contactlab._core", frozen)]
+struct RawScan {
+    inner: CoreRawScan,
+}
+
+#[pymethods]
+impl RawScan {
+    /// The order statistics of x at the ranks asked for (in their order).
+    #[getter]
+    fn order_stats<'py>(&self, py: Python<'py>) -> Arr<'py> {
+        self.inner.order_stats.clone().into_pyarray(py)
+    }
+}
+
+/// `order_stats(x, ranks)` and, in the same pass, the checkpoints of the trapezoid
+/// integrals of F and x over t that `period_means_pair(t, F, x, edges, scan=)` resumes
+/// from (`contactlab_core::raw_scan::order_stats_trapezoids`); x finite (the caller's check).
+#[pyfunction]
+#[pyo3(name = "order_stats_trapezoids")]
+fn order_stats_trapezoids_py<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray1<'py, f64>,
+    t: PyReadonlyArray1<'py, f64>,
+    f: PyReadonlyArray1<'py, f64>,
+    ranks: Vec<usize>,
+) -> PyResult<RawScan> {
+    let (xs, ts, fs) = (slice(&x, "x")?, slice(&t, "t")?, slice(&f, "F")?);
+    let inner = detach_guarded(py, || order_stats_trapezoids(xs, ts, fs, &ranks))?;
+    Ok(RawScan { inner })
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PhaseFold>()?;
+    m.add_class::<RawScan>()?;
+    m.add_function(wrap_pyfunction!(order_stats_trapezoids_py, m)?)?;
     m.add_class::<FoldSpread>()?;
     m.add_class::<FoldTable>()?;
     m.add_function(wrap_pyfunction!(period_means_py, m)?)?;
