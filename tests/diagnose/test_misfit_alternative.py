@@ -27,14 +27,15 @@ def _record(
     truth: dict | None = None,
     cycles: int = 10,
     noise: float = 0.01,
+    ramp: float = 1.5,
 ):
     """A record (no input noise, ac·A 3, ``noise`` of the range as output noise, ``cycles``
-    cycles from a ramp of 1.5) of a Masing element with a tanh, rational or gamma virgin
+    cycles from a ramp of ``ramp`` cycles) of a Masing element with a tanh, rational or gamma virgin
     curve, or of the family's own model (``virgin="own"``, parameters ``truth``); the family
     fitted with ``effects`` named."""
     spc = 100
     t = np.arange(cycles * spc) / spc
-    u = 2e-5 * np.sin(2 * np.pi * t) * np.minimum(t / 1.5, 1.0)
+    u = 2e-5 * np.sin(2 * np.pi * t) * np.minimum(t / ramp, 1.0)
     d = Prepared.build(t, u, np.zeros(t.size), errors_in_input=False)
     fam = TangentialFamily()
     fam.prepare(d)
@@ -97,15 +98,15 @@ def test_a_short_gamma_record_is_flagged_when_every_cycle_gains(seed, monkeypatc
     import contactlab.diagnose.misfit as mf
 
     monkeypatch.setattr(mf, "ALT_Z", 1e9)
-    fam, eff, d, p, scales, sigma = _record("gamma", (), seed, cycles=5, noise=0.02)
+    fam, eff, d, p, scales, sigma = _record("gamma", (), seed, cycles=5, noise=0.02, ramp=0.25)
     got = alternative_virgin(fam, eff, d, p, scales, sigma)
     assert got is not None and got["cycles"] < mf.ALT_FEW_CYCLES, got
     assert min(got["per_cycle"]) > 0 and got["flagged"], got
-    fam, eff, d, p, scales, sigma = _record("own", (), seed, cycles=5, noise=0.02)
+    fam, eff, d, p, scales, sigma = _record("own", (), seed, cycles=5, noise=0.02, ramp=0.25)
     got = alternative_virgin(fam, eff, d, p, scales, sigma)
     assert got is not None and not got["flagged"], got
     n = mf.ALT_FEW_CYCLES + 2
-    fam, eff, d, p, scales, sigma = _record("gamma", (), seed, cycles=n, noise=0.02)
+    fam, eff, d, p, scales, sigma = _record("gamma", (), seed, cycles=n, noise=0.02, ramp=0.25)
     got = alternative_virgin(fam, eff, d, p, scales, sigma)
     assert got is not None and got["cycles"] >= mf.ALT_FEW_CYCLES, got
     assert min(got["per_cycle"]) > 0 and not got["flagged"], got
