@@ -52,6 +52,15 @@ CASES: dict[str, dict[str, Any]] = {
               "cycles": (50, 50), "xn": (0.015, 0.02), "f": (5.0, 30.0)},
     "delay_load": {"effect": "channel_delay", "rival": ("normal_load",), "acA": (3.0, 5.0),
                    "cycles": (8, 8), "xn": (0.008, 0.015), "f": (5.0, 30.0)},
+    # issue 29, stop 50 (helper confuse): a dashpot near its bound named stick_slip + stribeck
+    # (5 kHz, 17-20 Hz, 20-50 cycles, ac·A 0.8-1.3, x 0.8-0.9 %, F 1.1-1.2 %), a delay near
+    # its bound named normal_load (10 kHz, 22-27 Hz, 35-50 cycles, ac·A 1.1-1.2, x 1.5-1.9 %)
+    "damp_near": {"effect": "viscous_damping", "rival": ("stick_slip", "stribeck"),
+                  "acA": (0.8, 1.35), "cycles": (20, 50), "xn": (0.008, 0.009),
+                  "f": (17.0, 20.0), "fs": 5000.0, "fn": (0.011, 0.012)},
+    "delay_near": {"effect": "channel_delay", "rival": ("normal_load",), "acA": (1.1, 1.2),
+                   "cycles": (35, 50), "xn": (0.015, 0.019), "f": (22.0, 27.0),
+                   "fs": 10000.0, "fn": (0.016, 0.017)},
 }  # fmt: skip
 
 
@@ -66,14 +75,38 @@ def factors(case: str, seed: int) -> dict[str, Any]:
     f = math.exp(rng.uniform(math.log(c["f"][0]), math.log(c["f"][1])))
     fs = float(rng.choice((2000.0, 5000.0, 10000.0)))
     fs = min(fs, 20000.0 * f / c["cycles"][1])
+    fs = float(c.get("fs", fs))
     return {
         "fs": fs, "f": round(f, 3), "cycles": int(rng.integers(c["cycles"][0], c["cycles"][1] + 1)),
         "acA": round(float(rng.uniform(*c["acA"])), 3),
         "x_noise_range": round(float(rng.uniform(*c["xn"])), 4),
-        "F_noise": round(float(rng.uniform(0.005, 0.015)), 4),
+        "F_noise": round(float(rng.uniform(*c.get("fn", (0.005, 0.015)))), 4),
         "x_drift": float(rng.uniform(-0.003, 0.003)),
         "sign": 1.0 if rng.random() < 0.5 else -1.0,
         "ramp_cycles": round(float(rng.uniform(0.0, 1.0)), 3),
+        # the near-bound cases: a shaker's small 2nd and 3rd harmonics (0-1.5 %, 0-1 %)
+        "harmonics": ((round(float(rng.uniform(0.0, 0.015)), 4),
+                       round(float(rng.uniform(0.0, 0.01)), 4)) if "fs" in c else ()),
+    }  # fmt: skip
+
+
+#: ``--sensors``: the sensor figures of ``eval_diagnose_rig.py --chain sensors`` (an LVDT's
+#: low-pass on x, a piezo or strain-gauge cell, Bessel anti-alias filters, hum, jitter), drawn
+#: from the seed's own stream
+SENSORS = False
+
+
+def sensors(seed: int, fs: float) -> dict[str, Any]:
+    if not SENSORS:
+        return {}
+    rng = np.random.default_rng([seed, 424242])
+    return {
+        "x_lowpass": round(min(math.exp(rng.uniform(math.log(300.0), math.log(2000.0))),
+                               0.45 * fs), 3),
+        "F_highpass": (round(math.exp(rng.uniform(math.log(0.005), math.log(0.1))), 5)
+                       if rng.random() < 0.5 else None),
+        "aa_kind": "bessel", "hum": round(float(rng.uniform(0.0, 0.005)), 5),
+        "jitter": float(rng.uniform(0.0, 0.02)) / fs,
     }  # fmt: skip
 
 
@@ -95,6 +128,7 @@ def record(effects: dict, fac: dict[str, Any], seed: int):
         effects, "tangential", seed=seed, fs=fac["fs"], f=fac["f"], cycles=fac["cycles"],
         acA=fac["acA"], h0=H0, ac=AC, x_noise=2.0 * fac["x_noise_range"],
         F_noise=fac["F_noise"], x_drift=fac["x_drift"], ramp_cycles=fac["ramp_cycles"],
+        drive_harmonics=fac.get("harmonics", ()), **fac.get("sensors", {}),
     )  # fmt: skip
     with tempfile.TemporaryDirectory() as tmp:
         return contactlab.read_recording(str(rec.to_csv(Path(tmp) / "r.csv")))
@@ -148,6 +182,7 @@ def run_job(job: tuple[str, int, tuple[float, ...]]) -> dict[str, Any]:
     c = CASES[case]
     names = (c["effect"], *c["rival"])
     fac = factors(case, seed)
+    fac["sensors"] = sensors(seed, fac["fs"])
     out: dict[str, Any] = {"case": case, "seed": seed, "factors": fac, "runs": []}
     rep = contactlab.diagnose(record({}, fac, seed), model="tangential")
     out["clean"] = summary(rep, names)
@@ -183,7 +218,10 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--mults", default="1.5,3")
     ap.add_argument("--without", default="", help="spring,backlash,stick,rank: these rules off")
     ap.add_argument("--out", type=Path, default=None)
+    ap.add_argument("--sensors", action="store_true", help="the sensors' chain (SENSORS)")
     a = ap.parse_args(argv)
+    global SENSORS
+    SENSORS = a.sensors
     without(tuple(w for w in a.without.split(",") if w))
     mults = tuple(float(m) for m in a.mults.split(","))
     rows = []

@@ -107,6 +107,8 @@ def chain_record(
     x_colour: str = "lvdt",
     scale: float = 2.0,
     noise_seed: int | None = None,
+    c: float = 0.0,
+    tau: float = 0.0,
     **over: Any,
 ) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], dict[str, Any]]:
     """``((t, x, F), factors)`` of one record (see the module docstring).
@@ -117,8 +119,10 @@ def chain_record(
     the white share) or ``"white"``. ``scale`` is the branch scale of the Masing rules (2:
     Masing; 1.3-1.6: non-Masing scaling applied from rest, the virgin curve exponential).
     The draws of the default settings are those of earlier versions (same seeds, same
-    records). ``noise_seed`` draws the sensor noises of both channels (not the hum, the
-    jitter or anything else) from a stream of its own: the same record under other noise."""
+    records). ``c`` adds a dashpot ``c ẋ`` (N s/m) to the contact's force, ``tau`` delays the
+    force by ``tau`` (s) before its cell (the draws unchanged). ``noise_seed`` draws the
+    sensor noises of both channels (not the hum, the jitter or anything else) from a stream
+    of its own: the same record under other noise."""
     fac = draw(seed, **over)
     rng = np.random.default_rng([seed, 7])
     fs, f, cycles = fac["fs"], fac["f"], fac["cycles"]
@@ -145,6 +149,10 @@ def chain_record(
     from contactlab.diagnose.scaled_masing import memory, scaled_force
 
     F = scaled_force(virgin_curve(virgin, h0, ac), scale, memory(x))
+    if c:
+        F = F + c * np.gradient(x, 1.0 / ffine)
+    if tau:
+        F = np.interp(tf - tau, tf, F)
     xr, Fr = float(np.ptp(x)), float(np.ptp(F))
     aa = _bessel(rng.uniform(0.2, 0.4) * fs, ffine)
     # x: LVDT demodulator low-pass on the sensor noise, then a small white share, then AA

@@ -20,13 +20,22 @@ AC = 1.5e5
 H0 = 40.0
 
 
-def _record(virgin: str, effects: tuple[str, ...], seed: int, truth: dict | None = None):
-    """A record (no input noise, ac·A 3, 1 % output noise, 10 cycles) of a Masing element
-    with a tanh or rational virgin curve, or of the family's own model (``virgin="own"``,
-    parameters ``truth``); the family fitted with ``effects`` named."""
-    cycles, spc = 10, 100
+def _record(
+    virgin: str,
+    effects: tuple[str, ...],
+    seed: int,
+    truth: dict | None = None,
+    cycles: int = 10,
+    noise: float = 0.01,
+    ramp: float = 1.5,
+):
+    """A record (no input noise, ac·A 3, ``noise`` of the range as output noise, ``cycles``
+    cycles from a ramp of ``ramp`` cycles) of a Masing element with a tanh, rational or gamma virgin
+    curve, or of the family's own model (``virgin="own"``, parameters ``truth``); the family
+    fitted with ``effects`` named."""
+    spc = 100
     t = np.arange(cycles * spc) / spc
-    u = 2e-5 * np.sin(2 * np.pi * t) * np.minimum(t / 1.5, 1.0)
+    u = 2e-5 * np.sin(2 * np.pi * t) * np.minimum(t / ramp, 1.0)
     d = Prepared.build(t, u, np.zeros(t.size), errors_in_input=False)
     fam = TangentialFamily()
     fam.prepare(d)
@@ -35,11 +44,13 @@ def _record(virgin: str, effects: tuple[str, ...], seed: int, truth: dict | None
         y = scaled_force(lambda s: H0 * np.tanh(AC * s), 2.0, memory(u))
     elif virgin == "rational":
         y = scaled_force(lambda s: H0 * AC * s / (1.0 + AC * np.abs(s)), 2.0, memory(u))
+    elif virgin == "gamma":
+        y = scaled_force(lambda s: H0 * (1.0 - (1.0 + AC * s) * np.exp(-AC * s)), 2.0, memory(u))
     else:
         own = tuple(k for k in effects)
         y = np.asarray(fam.predict({**start, **(truth or {})}, own, d))
         start = {**start, **(truth or {})}
-    sigma = 0.01 * float(np.ptp(y))
+    sigma = noise * float(np.ptp(y))
     y = y + np.random.default_rng(seed).normal(0.0, sigma, y.size)
     d = Prepared.build(t, u, y, errors_in_input=False)
     fam.prepare(d)
@@ -76,6 +87,29 @@ def test_a_clean_record_is_not_flagged(seed: int) -> None:
     fam, eff, d, p, scales, sigma = _record("own", (), seed)
     got = alternative_virgin(fam, eff, d, p, scales, sigma)
     assert got is not None and not got["flagged"] and got["gain"] < 0, got
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_a_short_gamma_record_is_flagged_when_every_cycle_gains(seed, monkeypatch) -> None:
+    """Fewer complete cycles than ALT_FEW_CYCLES: every held-out cycle gaining flags in place
+    of the t (here made unreachable), on a gamma virgin curve (zero initial slope) left
+    unnamed; the same rule does not flag the family's own model, nor a record of as many
+    cycles as ALT_FEW_CYCLES (there the t alone decides)."""
+    import contactlab.diagnose.misfit as mf
+
+    monkeypatch.setattr(mf, "ALT_Z", 1e9)
+    fam, eff, d, p, scales, sigma = _record("gamma", (), seed, cycles=5, noise=0.02, ramp=0.25)
+    got = alternative_virgin(fam, eff, d, p, scales, sigma)
+    assert got is not None and got["cycles"] < mf.ALT_FEW_CYCLES, got
+    assert min(got["per_cycle"]) > 0 and got["flagged"], got
+    fam, eff, d, p, scales, sigma = _record("own", (), seed, cycles=5, noise=0.02, ramp=0.25)
+    got = alternative_virgin(fam, eff, d, p, scales, sigma)
+    assert got is not None and not got["flagged"], got
+    n = mf.ALT_FEW_CYCLES + 2
+    fam, eff, d, p, scales, sigma = _record("gamma", (), seed, cycles=n, noise=0.02, ramp=0.25)
+    got = alternative_virgin(fam, eff, d, p, scales, sigma)
+    assert got is not None and got["cycles"] >= mf.ALT_FEW_CYCLES, got
+    assert min(got["per_cycle"]) > 0 and not got["flagged"], got
 
 
 def test_the_flag_says_so() -> None:

@@ -29,6 +29,15 @@ INPUT_NOISE_SHARE = 0.25
 #: 11.5 σ²); the last stop's blind judge named stribeck on two series-compliance records
 LOOKALIKES = ("inertia", "series_compliance")
 LOOKALIKE_SHARE = 0.5
+#: a speed-strengthening term (s < 0) also yields to a dashpot *tried* at the same step,
+#: accepted or not, that gains at least this share of its held-out gain
+#: (:meth:`Stribeck.yields_to_tried`): the one-parameter dashpot draws the held-out cycles at
+#: least as well. On dashpots of ``benches/eval_chain_near.py --cases damp`` (seeds
+#: 50300000-50300002, 50310000-50310003, 0.35-2 times the bound) the dashpot gained 1.56-36
+#: times a strengthening term's held-out gain at the same step; on rig Stribeck terms of
+#: s = -0.1 and -0.2 (seeds 50700000-50700007, v_s 0.26-1.47 Aω) 0.03-0.63 times. Set
+#: between the two after seeing them (0.5 refused one true term at 0.504)
+DASHPOT_SHARE = 1.0
 
 
 @register
@@ -118,6 +127,43 @@ class Stribeck(EffectModel):
             f"s = {p['s']:.3g} (friction strengthening with speed) lowers the force where "
             f"{rival} does, which takes {gains[rival]:.3g} σ² of its {own:.3g} σ² held-out "
             "gain: not named unless its own signature beats it"
+        )
+
+    #: the dashpot rule of :meth:`yields_to_tried` on; off only to measure what it changes
+    dashpot_check = True
+
+    def yields_to_tried(self, p, v, cand, tried, current, d):
+        """Why a speed-*strengthening* term (``s < 0``) is not named beside a dashpot tried at
+        the same step (accepted or not, fitted and plausible) that gains at least
+        :data:`DASHPOT_SHARE` of its held-out gain, or None.
+
+        ``h (1 + s e^(-(ẋ/v_s)²))`` with ``s < 0`` raises the force where the speed is
+        high relative to where it is low, as ``c ẋ`` does: both are a force along the
+        motion growing with the speed. The term needs only :data:`INPUT_NOISE_SHARE` of the
+        input-noise budget and :data:`GAIN_FLOOR_SCALE` of the search's gain floor (a
+        *weakening* term's breakaway after each turn is what the input's noise cannot
+        feed), the dashpot all of both: below the dashpot's stated bound the strengthening
+        term passed its reduced floors on the dashpot's own signature (issue 29, stop 50:
+        blind dashpots at 0.6-0.8 of their bound named ``stribeck`` with ``stick_slip``).
+        Where a dashpot draws that signature as well, the dashpot is the reading with one
+        parameter, and it stands or falls on its own floors."""
+        if not (self.dashpot_check and p.get("s", 0.0) < 0):
+            return None
+        rival = tried.get("viscous_damping")
+        if rival is None:
+            return None
+        rv, _ = rival
+        if (rv.reason or "").startswith(("implausible", "could not be fitted")):
+            return None
+        if not (np.isfinite(rv.gain) and np.isfinite(v.gain) and v.gain > 0):
+            return None
+        if rv.gain < DASHPOT_SHARE * v.gain:
+            return None
+        return (
+            f"s = {p['s']:.3g} (friction strengthening with speed) raises the force where "
+            f"the speed is high, as a dashpot's c ẋ does; viscous_damping tried at the same "
+            f"step gains {rv.gain:.3g} σ² of its {v.gain:.3g} σ² held-out gain with one "
+            "parameter: not named on the reduced floors a weakening term's breakaway earns"
         )
 
     def argument(self, d, p):
