@@ -115,6 +115,29 @@ def bound_variants(rep, effect: str) -> dict[str, float | None]:
     return out
 
 
+def startup_share(rep, effect: str) -> float:
+    """The share of the effect's information (``Σ w j⊥²``, its direction at the clean twin's
+    base fit with the base's parameters projected out, the diagnosis's weights) on the
+    samples before the first held-out cycle (the start from rest up to the first maximum of
+    x, which no fold holds out: the held-out rules never see it)."""
+    from contactlab.diagnose import power
+    from contactlab.diagnose.select import sample_weight, specs_for
+
+    fam, d = rep.final_model.family, rep.prepared
+    p = dict(rep.trials[-1].full.params)
+    mags = [s for s in fam.candidates[effect].params if np.isfinite(s.null)]
+    p0 = {**p, **power.shape_values(fam, effect, p, d), **{s.name: s.null for s in mags}}
+    sc = fam.scales(d)
+    base = [s for s in specs_for(fam, ()) if np.isfinite(p0.get(s.name, np.nan))]
+    jb = np.column_stack(
+        [power._derivative(fam, p0, (effect,), d, s, power._step(s, p0[s.name], sc)) for s in base]
+    )
+    w = sample_weight(d)
+    j = power._derivative(fam, p0, (effect,), d, mags[0], power._step(mags[0], mags[0].null, sc))
+    e = w * power._project(j, jb, w) ** 2
+    return float(np.sum(e[d.cycles.cycle < 0]) / np.sum(e))
+
+
 def run(cond: str, seed: int, hide: bool) -> dict:
     import warnings
 
@@ -136,7 +159,8 @@ def run(cond: str, seed: int, hide: bool) -> dict:
         "reason": "" if b is None else (b.reason or "")[:160],
         "gain_rules": rules, "sigma": float(rep.noise_rms),
         "n": int(rep.prepared.y.size),
-        "variants": bound_variants(rep, effect), "runs": [],
+        "variants": bound_variants(rep, effect), "startup": startup_share(rep, effect),
+        "runs": [],
     }  # fmt: skip
     if hide:
         for k, m in enumerate((1.0, 2.0)):
@@ -157,7 +181,8 @@ def run(cond: str, seed: int, hide: bool) -> dict:
 
 def table(res: list[dict]) -> str:
     lines = ["| cond | seed | n | ideal | bound/ideal | no margin | no floors | no ident | "
-             "1x | 2x | clean |", "|---|---|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
+             "start-up share | 1x | 2x | clean |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
 
     def ratio(v, ideal):
         return "–" if v is None or not ideal else f"{v / ideal:.2g}"
@@ -173,6 +198,7 @@ def table(res: list[dict]) -> str:
             f"| {r['cond']} | {r['seed']} | {r['n']} | {r['ideal']:.3g} | "
             f"{ratio(r['bound'], r['ideal'])} | {ratio(v['no_margin'], r['ideal'])} | "
             f"{ratio(v['no_floors'], r['ideal'])} | {ratio(v['no_ident'], r['ideal'])} | "
+            f"{'–' if r.get('startup') is None else format(r['startup'], '.2f')} | "
             f"{' | '.join(cells)} | {r['clean_named']} |"
         )
     return "\n".join(lines)
