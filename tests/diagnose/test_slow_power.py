@@ -89,6 +89,12 @@ def test_own_gain_floor_per_effect() -> None:
     assert own_gain_floor(fam, ("parameter_drift",), 0.05) <= 0.3 * 0.01
     assert own_gain_floor(fam, ("parameter_drift",), 0.05) > 0.0
     assert own_gain_floor(fam, ("viscous_damping",), 0.05) == pytest.approx(0.05)
+    # a displacement offset is held to a share of min_gain, as the other shapes of the loop
+    # (issue 29: the whole min_gain, a floor per sample, hid offsets of twice the size an
+    # ideal test needs on long records)
+    off = own_gain_floor(fam, ("displacement_offset",), 0.05)
+    assert 0.0 < off < 0.05
+    assert off <= own_gain_floor(fam, ("asymmetry",), 0.05)
     # a pair is held to the stricter of its two floors
     assert own_gain_floor(fam, ("force_drift", "viscous_damping"), 0.05) == pytest.approx(0.05)
 

@@ -19,6 +19,15 @@ from ._common import amplitude
 #: (``benches/eval_lookalike.py`` tuning seeds 41002, 42001-42002). Its own gain floor
 #: stays the search's ``min_gain``.
 INPUT_NOISE_SHARE = 0.25
+#: the share of the search's ``min_gain`` (0.05 σ² per sample) its held-out and in-sample
+#: gain must reach (``search.own_gain_floor``), as asymmetry's, Stribeck's and position
+#: friction's: the whole ``min_gain`` asked far more than significance on long records
+#: (issue 29: rig at the issue's conditions, ``benches/eval_ideal_bound.py`` seeds
+#: 41000000-2, the stated bound 4.4-5.3 times what an ideal test needs, 1.7-4.3 times with
+#: the floors off; an offset at twice the ideal size missed on the floor, held-out gain
+#: 0.035 σ² against 0.104 σ²). Clean records' largest held-out gain with every floor off
+#: stayed 0.018 σ² at t <= 2.5 (above): the per-cycle t rule, not the floor, keeps them quiet
+GAIN_FLOOR_SCALE = 0.2
 
 
 @register
@@ -45,6 +54,8 @@ class DisplacementOffset(EffectModel):
     #: was not named
     proportional_gain = True
     input_noise_share = INPUT_NOISE_SHARE
+    #: the share of the search's ``min_gain`` its gain must reach (search.own_gain_floor)
+    gain_floor_scale = GAIN_FLOOR_SCALE
 
     def apply(self, x, p, ctx):
         return x - p["x0"]
