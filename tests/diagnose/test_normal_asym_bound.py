@@ -111,3 +111,28 @@ def test_asymmetry_bound_on_a_single_tone_chain() -> None:
     assert m is not None, b.reason
     assert 0.5 < float(m.group(1)) < 0.95
     assert "one excitation frequency" in b.note
+
+
+def test_bound_models_the_large_gain_route() -> None:
+    """Rule 2's large-gain route (normal contact: a held-out gain of twice the floor passes
+    at t > 2) is in the stated bound for the candidates the search gives it to, not for a
+    channel delay or a hysteretic loss (``large_gain_route`` False); with it the bound of a
+    direction whose gain is far above the floor is smaller than at t > 3 alone."""
+    from contactlab.diagnose.candidates_normal import STRONG_GAIN, NormalFamily
+    from contactlab.diagnose.power import _bound, _strong_route
+
+    fam = NormalFamily()
+    for name in ("creep_drift", "stiffness_nonlinearity", "asymmetric_branches"):
+        assert _strong_route(fam, name, 3.0) == (STRONG_GAIN[0], min(STRONG_GAIN[1], 3.0))
+    for name in ("channel_delay", "hysteretic_damping"):
+        assert _strong_route(fam, name, 3.0) is None
+    st = _setting()
+    rng = np.random.default_rng(5)
+    jp = rng.standard_normal(st.w.size)
+    at_z = _bound(jp, st)
+    routed = _bound(jp, st, strong=(2.0, 2.0))
+    assert at_z is not None and routed is not None
+    assert routed < 0.95 * at_z
+    # a floor the gains at the bound do not reach twice: the route changes nothing
+    high = _bound(jp, st, strong=(1e6, 2.0))
+    assert high == pytest.approx(at_z, rel=1e-9)
