@@ -121,8 +121,10 @@ def test_choice_between_the_two_follows_the_evidence():
     asym, stiff = reg["asymmetric_branches"], reg["stiffness_nonlinearity"]
     d, trial, _ = _fake()
     cur = trial(d.y * 0.0, 1.2)
+    # fits 0.3 σ apart: the held-out errors' difference (0.1 σ² over 360 samples) is
+    # 3 deviations of the ratio's noise, beyond SHAPE_Z
     better = trial(d.y * 0.0, 1.0)
-    worse = trial(d.y * 0.0, 1.1)
+    worse = trial(d.y * 0.0 + 0.3, 1.1)
     v = SimpleNamespace(gain=0.2, accepted=True, reason="accepted")
     weak = SimpleNamespace(gain=0.2, accepted=False, reason="gain not significant (t = 2.6)")
     odd = SimpleNamespace(gain=0.2, accepted=False, reason="implausible: at its limit")
@@ -150,6 +152,35 @@ def test_choice_between_the_two_follows_the_evidence():
     assert why and "neither is named" in why
     why = stiff.yields_to_tried(ps, v, worse, {"asymmetric_branches": (odd, better)}, cur, d)
     assert why is None
+
+
+def test_weak_evidence_names_neither():
+    """Where the two fits lie far apart (2 σ a sample) and the likelihood ratio over them
+    is within SHAPE_Z of its noise from a tie, neither shape is named, whichever fits a
+    little better and whether or not the rival passed."""
+    from contactlab.diagnose.effects.normal.asymmetric_branches import SHAPE_Z, shape_test
+
+    reg = registry("normal")
+    asym, stiff = reg["asymmetric_branches"], reg["stiffness_nonlinearity"]
+    d, trial, _ = _fake()
+    cur = trial(d.y * 0.0, 1.2)
+    better = trial(d.y * 0.0, 1.0)
+    alt = np.where(d.cycles.cycle >= 0, 2.0 * np.sign(np.sin(np.arange(d.y.size))), 0.0)
+    worse = trial(alt, 1.05)
+    _, _, _, z = shape_test(d, cur, better, worse)
+    assert 0.0 < z < SHAPE_Z
+    v = SimpleNamespace(gain=0.2, accepted=True, reason="accepted")
+    pa, ps = {"a": 0.3}, {"kappa": 0.0, "kappa1": 0.03}
+    # the law fits a little better: the asymmetry yields, and so does the law
+    why = asym.yields_to_tried(pa, v, worse, {"stiffness_nonlinearity": (v, better)}, cur, d)
+    assert why and "not named either" in why
+    why = stiff.yields_to_tried(ps, v, better, {"asymmetric_branches": (v, worse)}, cur, d)
+    assert why and "does not tell the two apart" in why
+    # the asymmetry fits a little better: both yield the same way round
+    why = asym.yields_to_tried(pa, v, better, {"stiffness_nonlinearity": (v, worse)}, cur, d)
+    assert why and "does not tell the two apart" in why
+    why = stiff.yields_to_tried(ps, v, worse, {"asymmetric_branches": (v, better)}, cur, d)
+    assert why and "not named either" in why
 
 
 def _rig(effect: dict, seed: int):
