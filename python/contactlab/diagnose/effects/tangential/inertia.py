@@ -155,7 +155,8 @@ def _mass_acc(d) -> np.ndarray:
         return smoothed_acceleration(d)
     one = fixed(d, "mass_single_frequency", lambda: single_frequency(d) is not None)
     local = smoothed_acceleration(d) if one else mass_acceleration(d)
-    if not MASS_HARMONIC or d.extra.get("signal_derivatives"):
+    if not MASS_HARMONIC or d.extra.get("signal_derivatives") or d.extra.get("mass_local"):
+        # (``mass_local``: the record's own simulated null, calibrated on the local ẍ)
         return local
     if not float(d.extra.get("u_noise", 0.0) or 0.0) > 0.0:
         return local
@@ -179,6 +180,10 @@ HARMONIC_TRANSIENT = 4.0
 #: above the harmonics, below the anti-alias corners)
 HARMONIC_FIT = 1.5
 HARMONIC_REFERENCE = (0.22, 0.32)
+#: ... and what they leave is at least HARMONIC_QUIET of the input's noise variance
+#: (``u_noise``; the rig's white noise read 1.52 times it on shaker record c5 of
+#: ``benches/eval_inertia_shaker.py``, seed 0): a denoised input is left to the local ẍ
+HARMONIC_QUIET = 0.25
 #: a harmonic enters ``ẍ`` where its amplitude stands HARMONIC_Z standard errors (of a
 #: coefficient under the fit's residual) out: a noise harmonic passes with probability
 #: exp(-HARMONIC_Z²/2) = 3.4e-4 each
@@ -316,6 +321,12 @@ def harmonic_acceleration(d, local: np.ndarray) -> np.ndarray | None:
     if np.count_nonzero(ref) < 16 or not np.any(band):
         return None
     if float(np.mean(R[band])) > HARMONIC_FIT * float(np.mean(R[ref])):
+        return None
+    # ... and as much of it as the input's noise: an input with its noise taken away (the
+    # record's own null's denoised drive, :func:`contactlab.diagnose.mass_null.linear_term_null`)
+    # keeps the local ẍ the null's copies were calibrated with
+    su = float(d.extra.get("u_noise", 0.0) or 0.0)
+    if not float(np.mean(r**2)) > HARMONIC_QUIET * su**2:
         return None
     return np.where(fit_on, acc, local)
 
