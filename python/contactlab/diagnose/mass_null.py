@@ -175,7 +175,10 @@ def linear_term_null(
         p0 = {**base, size_param: 0.0}
         p1 = {**base, size_param: 1.0}
         sig = (lambda v: v) if signal is None else signal
-        ds = sig(d)
+        # the candidate's direction on the record and its copies alike from the local ẍ
+        # (``mass_local``: a mass's ẍ from the drive's harmonics is for the search's fits;
+        # this null and its bound were calibrated on the local one)
+        ds = sig(dataclasses.replace(d, extra={**d.extra, "fixed": {}, "mass_local": True}))
         g = np.asarray(family.predict(p1, full, ds), float) - np.asarray(
             family.predict(p0, full, ds), float
         )
@@ -206,7 +209,7 @@ def linear_term_null(
             # turns into force error (errors in variables in the regressor itself)
             ud, udd = derivatives(u_raw, d.dt, d.window)
             # (``u_raw``: the copy's measured input, which the mass's ẍ is read from)
-            ex = {**dk.extra, "fixed": {}, "u_raw": u_raw}
+            ex = {**dk.extra, "fixed": {}, "u_raw": u_raw, "mass_local": True}
             dg = sig(dataclasses.replace(dk, ud=ud, udd=udd, extra=ex))
             return np.asarray(family.predict(p1, full, dg), float) - np.asarray(
                 family.predict(p0, full, dg), float

@@ -18,6 +18,7 @@ from contactlab.errors import InputError
 
 from .chain import _design_chain, _measure
 from .normal import _normal
+from .shaker import shaker_parameters
 from .tangential import _tangential
 
 __all__ = ["NEW_EFFECTS", "NORMAL_EFFECTS", "TANGENTIAL_EFFECTS", "RigRecording", "rig_recording"]
@@ -179,6 +180,7 @@ def rig_recording(
     hum: float = 0.0,
     jitter: float = 0.0,
     drive_harmonics: Sequence[float] = (),
+    shaker: Mapping[str, float] | None = None,
 ) -> RigRecording:
     """Simulate a recording of the whole measurement chain with the given effects.
 
@@ -244,6 +246,15 @@ def rig_recording(
     drive_harmonics : sequence of float
         Tangential: the command's 2nd, 3rd, ... harmonics as fractions of its fundamental
         (an actuator's distortion), in phase with it.
+    shaker : mapping, optional
+        Tangential: drive ``x`` by an electrodynamic shaker in place of the position servo
+        (:mod:`contactlab.synthetic.rig.shaker`): an armature of ``mass`` (kg, default 0.2)
+        on a suspension of natural frequency ``fn`` (Hz, default 20) and damping ratio
+        ``zeta`` (default 0.05), pushed by the sine force ``F0·sin ωt`` (after the
+        ``ramp_cycles`` start-up; 0 switches it on at t = 0 from rest), the contact's force
+        acting back on it, ``F0`` found so the steady amplitude is ``A``; ``x`` then
+        carries the suspension's start-up transient and odd harmonics of the drive. The
+        truth's ``base["shaker"]`` holds the figures and ``F0``. None: the servo.
 
     Returns
     -------
@@ -256,6 +267,9 @@ def rig_recording(
     sensors = _check_sensors(x_lowpass, F_highpass, aa_kind, hum, jitter, drive_harmonics)
     allowed = TANGENTIAL_EFFECTS + NEW_EFFECTS if kind == "tangential" else NORMAL_EFFECTS
     eff = _effect_params(effects, allowed)
+    shaker_fig = shaker_parameters(shaker)
+    if shaker_fig is not None and kind != "tangential":
+        raise InputError("rig_recording: a shaker drives the tangential rig only")
 
     ss = np.random.SeedSequence(int(seed))
     rngs = [np.random.default_rng(s) for s in ss.spawn(4)]
@@ -275,7 +289,7 @@ def rig_recording(
         actuator = (actuator_f or 15 * f, actuator_zeta)
         out_ch, in_ch, meta = _tangential(
             ti, eff, f, h0, ac, acA, ramp_cycles, *actuator, chain.cell, dt,
-            tuple(sensors["drive_harmonics"]),
+            tuple(sensors["drive_harmonics"]), shaker_fig,
         )  # fmt: skip
     else:
         out_ch, in_ch, meta = _normal(

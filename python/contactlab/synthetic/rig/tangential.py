@@ -15,14 +15,23 @@ from contactlab.errors import InputError
 
 from .chain import _filter, _ramp, discretise
 from .contact import Virgin, _breakaway, _lugre, masing_force, play_operator
+from .shaker import shaker_motion
+
+#: the contact laws the shaker's back-action (an exponential Masing element) does not model
+_NOT_SHAKEN = ("power_law_microslip", "rate_dependent_presliding", "tanh_virgin")
 
 
 def _tangential(
-    ti, eff, f, h0, ac, acA, ramp_cycles, actuator_f, actuator_zeta, cell, dt, harmonics=()
-):
-    """The tangential joint on the internal grid: ``(cell force, measured x, base truth)``."""
+    ti, eff, f, h0, ac, acA, ramp_cycles, actuator_f, actuator_zeta, cell, dt, harmonics=(),
+    shaker=None,
+):  # fmt: skip
+    """The tangential joint on the internal grid: ``(cell force, measured x, base truth)``.
+    ``shaker`` (checked figures of :func:`.shaker.shaker_parameters`): the electrodynamic
+    shaker drives ``x`` in place of the position servo (:func:`.shaker.shaker_motion`)."""
     w = 2 * math.pi * f
     A = acA / ac
+    if shaker is not None:
+        return _shaken(ti, eff, f, h0, ac, A, acA, ramp_cycles, cell, dt, shaker, harmonics)
     # actuator: position servo ωa²/(s² + 2ζωa s + ωa²) from rest; command scaled so the
     # steady amplitude is A
     wa = 2 * math.pi * actuator_f
@@ -34,6 +43,30 @@ def _tangential(
     cmd = (A / abs(H[0])) * _ramp(ti, f, ramp_cycles) * wave
     bd, ad = discretise(act, dt)
     x = signal.lfilter(bd, ad, cmd)  # from rest: zero state, cmd[0] = 0
+    meta = {"actuator_f": actuator_f}
+    return _joint(ti, eff, f, h0, ac, A, acA, x, cell, dt, meta)
+
+
+def _shaken(ti, eff, f, h0, ac, A, acA, ramp_cycles, cell, dt, shaker, harmonics):
+    """:func:`_tangential` with the shaker's armature driving ``x``."""
+    for name in ("series_compliance", "backlash", *_NOT_SHAKEN):
+        if name in eff:
+            raise InputError(f"rig_recording: {name} with a shaker is not modelled")
+    if harmonics:
+        raise InputError("rig_recording: drive_harmonics with a shaker are not modelled")
+    x, F0 = shaker_motion(
+        ti, dt, f, A, _ramp(ti, f, ramp_cycles), h0, ac, shaker,
+        m=eff.get("inertia", {}).get("m", 0.0),
+        k_p=eff.get("parallel_stiffness", {}).get("k_p", 0.0),
+        c_v=eff.get("viscous_damping", {}).get("c", 0.0),
+    )  # fmt: skip
+    meta = {"shaker": {**shaker, "F0": F0}}
+    return _joint(ti, eff, f, h0, ac, A, acA, x, cell, dt, meta)
+
+
+def _joint(ti, eff, f, h0, ac, A, acA, x, cell, dt, extra):
+    """The joint's force through the load cell for the motion ``x`` on the internal grid."""
+    w = 2 * math.pi * f
     v = np.gradient(x, dt, edge_order=2)
     acc = np.gradient(v, dt, edge_order=2)
 
@@ -100,6 +133,6 @@ def _tangential(
         "virgin": virgin.name if "rate_dependent_presliding" not in eff else "lugre",
         "displacement_amplitude": A,
         "force_amplitude": float(np.max(np.abs(Fj))),
-        "actuator_f": actuator_f,
+        **extra,
     }
     return Fc, x_meas, meta

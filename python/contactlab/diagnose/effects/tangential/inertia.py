@@ -154,7 +154,181 @@ def _mass_acc(d) -> np.ndarray:
     if not MASS_GAP:
         return smoothed_acceleration(d)
     one = fixed(d, "mass_single_frequency", lambda: single_frequency(d) is not None)
-    return smoothed_acceleration(d) if one else mass_acceleration(d)
+    local = smoothed_acceleration(d) if one else mass_acceleration(d)
+    if not MASS_HARMONIC or d.extra.get("signal_derivatives") or d.extra.get("mass_local"):
+        # (``mass_local``: the record's own simulated null, calibrated on the local ẍ)
+        return local
+    if not float(d.extra.get("u_noise", 0.0) or 0.0) > 0.0:
+        return local
+    acc = fixed(d, "mass_harmonic_acceleration", lambda: harmonic_acceleration(d, local))
+    return local if acc is None else acc
+
+
+#: whether the mass reads ``ẍ`` of the drive's harmonics (:func:`harmonic_acceleration`)
+#: outside the start-up where they fit the input (True), or the local polynomials alone
+#: (False; kept for comparison in benches)
+MASS_HARMONIC = True
+#: the harmonics of the fundamental fitted (at most; below HARMONIC_BAND of the rate)
+HARMONIC_MAX, HARMONIC_BAND = 30, 0.2
+#: a cycle where the harmonics leave more of the input than their median over the record's
+#: second half (the noise's own level) by HARMONIC_TRANSIENT standard errors (of a white
+#: noise's mean square over a period) is start-up: there the local polynomial's ``ẍ`` is kept
+HARMONIC_TRANSIENT = 4.0
+#: the harmonics stand for the input only where what they leave off it outside the
+#: start-up is noise: its power per frequency bin below the harmonics' band at most
+#: HARMONIC_FIT times its power per bin between HARMONIC_REFERENCE (fractions of the rate,
+#: above the harmonics, below the anti-alias corners)
+HARMONIC_FIT = 1.5
+HARMONIC_REFERENCE = (0.22, 0.32)
+#: ... and what they leave is at least HARMONIC_QUIET of the input's noise variance
+#: (``u_noise``; the rig's white noise read 1.52 times it on shaker record c5 of
+#: ``benches/eval_inertia_shaker.py``, seed 0): a denoised input is left to the local ẍ
+HARMONIC_QUIET = 0.25
+#: a harmonic enters ``ẍ`` where its amplitude stands HARMONIC_Z standard errors (of a
+#: coefficient under the fit's residual) out: a noise harmonic passes with probability
+#: exp(-HARMONIC_Z²/2) = 3.4e-4 each
+HARMONIC_Z = 4.0
+#: the share of the input-noise budget a mass read through the harmonics must beat
+#: (:meth:`Inertia.input_noise_share_at`)
+HARMONIC_NOISE_SHARE = 0.1
+
+
+def _harmonic_basis(t: np.ndarray, w: float, K: int) -> np.ndarray:
+    ph = np.outer(t, w * np.arange(1, K + 1))
+    return np.column_stack([np.ones_like(t), t - t.mean(), np.cos(ph), np.sin(ph)])
+
+
+def _fit_harmonics(t, u, w, K):
+    B = _harmonic_basis(t, w, K)
+    c, *_ = np.linalg.lstsq(B, u, rcond=None)
+    return c, u - B @ c
+
+
+def _refine_frequency(t: np.ndarray, u: np.ndarray, w: float, K: int) -> float:
+    """The fundamental ``w`` refined by the drift of its phase between the two halves of
+    ``(t, u)`` (three steps; each half fitted with all ``K`` harmonics)."""
+    h = t.size // 2
+    for _ in range(3):
+        ph = []
+        for sl in (slice(0, h), slice(h, None)):
+            c, _ = _fit_harmonics(t[sl], u[sl], w, K)
+            ph.append(math.atan2(c[2 + K], c[2]))  # sin and cos of the fundamental
+        dphi = (ph[0] - ph[1] + math.pi) % (2 * math.pi) - math.pi
+        span = float(np.mean(t[h:]) - np.mean(t[:h]))
+        if not span > 0:
+            break
+        step = dphi / span
+        w = w + step
+        if abs(step) < 1e-9 * w:
+            break
+    return w
+
+
+def harmonic_acceleration(d, local: np.ndarray) -> np.ndarray | None:
+    """``ẍ`` of the measured input's fit by the drive's harmonics, differentiated
+    analytically, outside the start-up; ``local`` (the local polynomial's ``ẍ``) within it.
+    None where no harmonic beyond the fundamental stands out of the noise (a pure sine, whose
+    ``ẍ`` is ``-ω² x``: the single-frequency rules and the record's own simulated null were
+    calibrated on the local ``ẍ`` there; with the harmonics' ``ẍ`` a clean rig record's
+    linearised size read -1.21 against a null SD of 0.24, test
+    ``test_the_mass_null_carries_the_input_noise_bias_of_a_clean_record``), or where the
+    harmonics do not stand for the input (several frequencies or amplitudes:
+    what they leave off the input outside the start-up has more than :data:`HARMONIC_FIT`
+    times the power per bin below their band that it has above it) or the record is too
+    short.
+
+    Why (issue 29, a shaker's drive: an armature on a suspension driven by a sine from rest,
+    the contact acting back, so ``x`` carries a start-up transient at the suspension's
+    natural frequency and odd harmonics of the drive): a mass's evidence beyond ``-ω² x`` is
+    in those harmonics, and a local polynomial over a fraction of a period reads ``ẍ`` with
+    so much of the input's differentiated noise that the regression is diluted. The
+    harmonics (a constant and a line for an offset and a drift, whose ``ẍ`` is zero; at
+    most :data:`HARMONIC_MAX`, below :data:`HARMONIC_BAND` of the rate) are fitted over
+    all steady cycles at once, and those that stand out of the noise
+    (:data:`HARMONIC_Z`) enter ``ẍ``, so each sample's noise reaches the regressor by about
+    ``2K/N`` only (K the harmonics kept). The fundamental is the input's periodogram peak
+    refined by the drift of its phase. The start-up (the first cycle, and each following
+    one while the harmonics leave more of the input than in the steady cycles,
+    :data:`HARMONIC_TRANSIENT`) keeps
+    the local polynomial's ``ẍ``, which follows a transient."""
+    u = d.extra.get("u_raw")
+    if u is None or np.shape(u) != np.shape(d.u):
+        u = d.u
+    u = np.asarray(u, float)
+    t = np.asarray(d.t, float)
+    n = u.size
+    per = float(d.cycles.period_samples)
+    cyc = np.asarray(d.cycles.cycle)
+    if n < 64 or not per > 8 or cyc.size != n or local.shape != u.shape:
+        return None
+    # the fundamental: the periodogram's peak (zero-padded 8x, parabolic), refined below
+    tail = cyc >= 1
+    if np.count_nonzero(tail) < 4 * per:
+        return None
+    ut = u[tail] - float(np.mean(u[tail]))
+    nfft = 8 * 2 ** math.ceil(math.log2(ut.size))
+    P = np.abs(np.fft.rfft(ut * np.hanning(ut.size), nfft))
+    f0 = 1.0 / (per * float(d.dt))
+    k0 = round(float(f0 * d.dt * nfft))
+    lo, hi = max(1, int(0.7 * k0)), min(P.size - 2, int(1.3 * k0) + 1)
+    if hi <= lo:
+        return None
+    k = lo + int(np.argmax(P[lo:hi]))
+    a, b, c = np.log(P[k - 1 : k + 2] + 1e-300)
+    off = 0.5 * (a - c) / (a - 2 * b + c) if (a - 2 * b + c) < 0 else 0.0
+    w = 2 * math.pi * (k + off) / (nfft * float(d.dt))
+    K = int(min(HARMONIC_MAX, math.floor(HARMONIC_BAND / (w / (2 * math.pi) * float(d.dt)))))
+    if K < 1:
+        return None
+    w = _refine_frequency(t[tail], u[tail], w, K)
+    cf, r = _fit_harmonics(t[tail], u[tail], w, K)
+    B = _harmonic_basis(t, w, K)
+    # the start-up: cycles from the first on where what the harmonics leave of the input
+    # is beyond its steady level by HARMONIC_TRANSIENT standard errors
+    ncyc = int(cyc.max()) + 1
+    res = (u - B @ cf) ** 2
+    msd = np.array(
+        [float(np.mean(res[cyc == i])) if np.any(cyc == i) else 0.0 for i in range(ncyc)]
+    )
+    steady_level = float(np.median(msd[ncyc // 2 :])) if ncyc >= 2 else math.nan
+    if not np.isfinite(steady_level) or steady_level <= 0:
+        return None
+    limit = steady_level * (1.0 + HARMONIC_TRANSIENT * math.sqrt(2.0 / per))
+    start = 1
+    while start < ncyc // 2 and msd[start] > limit:
+        start += 1
+    fit_on = cyc >= start
+    if start > 1:
+        cf, r = _fit_harmonics(t[fit_on], u[fit_on], w, K)
+    # only the harmonics that stand out of the noise (ẍ weighs the k-th by k²: a noise
+    # harmonic at 30 f would carry 900 times its share)
+    amp = np.hypot(cf[2 : 2 + K], cf[2 + K :])
+    se = float(np.sqrt(np.mean(r**2) * 2.0 / r.size))
+    keep = amp > HARMONIC_Z * se
+    if not keep[1:].any():
+        # a pure sine: its ẍ is -ω² x, which the base's stiffness takes; the local ẍ and the
+        # record's own null (calibrated on it) stand as before
+        return None
+    keep[0] = True
+    kw2 = np.where(keep, (w * np.arange(1, K + 1)) ** 2, 0.0)
+    acc = -(B[:, 2 : 2 + K] @ (kw2 * cf[2 : 2 + K]) + B[:, 2 + K :] @ (kw2 * cf[2 + K :]))
+    # what the harmonics leave must be noise: its power below their band no more than
+    # HARMONIC_FIT times its power per bin between HARMONIC_REFERENCE of the rate
+    R = np.abs(np.fft.rfft(r)) ** 2
+    fr = np.fft.rfftfreq(r.size, float(d.dt)) * float(d.dt)
+    band = (fr > 0) & (fr <= K * w / (2 * math.pi) * float(d.dt))
+    ref = (fr >= HARMONIC_REFERENCE[0]) & (fr <= HARMONIC_REFERENCE[1])
+    if np.count_nonzero(ref) < 16 or not np.any(band):
+        return None
+    if float(np.mean(R[band])) > HARMONIC_FIT * float(np.mean(R[ref])):
+        return None
+    # ... and as much of it as the input's noise: an input with its noise taken away (the
+    # record's own null's denoised drive, :func:`contactlab.diagnose.mass_null.linear_term_null`)
+    # keeps the local ẍ the null's copies were calibrated with
+    su = float(d.extra.get("u_noise", 0.0) or 0.0)
+    if not float(np.mean(r**2)) > HARMONIC_QUIET * su**2:
+        return None
+    return np.where(fit_on, acc, local)
 
 
 #: the share of the input-noise budget a mass must beat (:attr:`Inertia.input_noise_share`)
@@ -384,6 +558,18 @@ class Inertia(EffectModel):
     #: more of it on N cycles; on the clean records above the mass's largest gain was
     #: 0.021 σ², below 0.6 of 0.05 σ²
     gain_floor_scale = GAIN_FLOOR_SCALE
+
+    def input_noise_share_at(self, d, p) -> float | None:
+        """:data:`HARMONIC_NOISE_SHARE` where the mass reads the drive harmonics' ``ẍ``
+        (:func:`harmonic_acceleration`), whose noise is ``(2K + 2)/N`` of the input's:
+        the input's noise cannot feed it as it fed the local polynomials'; None (the
+        effect's :attr:`input_noise_share`) otherwise."""
+        if not MASS_HARMONIC or d.extra.get("signal_derivatives"):
+            return None
+        _mass_acc(d)  # reads (and keeps) the harmonics' ẍ where they stand for the input
+        used = d.extra.get("fixed", {}).get(("mass_harmonic_acceleration", d.t.size))
+        return HARMONIC_NOISE_SHARE if used is not None else None
+
     #: an inertial force beyond this share of the friction force means the sensor weighs the
     #: moving part more than it measures the contact: a misfit of the base model instead
     MAX_FORCE_SHARE = 1.0
