@@ -190,19 +190,27 @@ fn cycle_area(x: &[f64], f: &[f64], ux: f64, uf: f64, fm: f64, scale: f64) -> (f
     // vectorises whole; computed inside the lanes' loop it was built two at a time with
     // shuffles, a fifth of the fold's time), then the lanes' compensated sums over them
     // (the same terms in the same lanes and order)
+    // (each sample scaled once a block, into `sx`, `sf`: the numbers term's products make,
+    // where a term scaled both of its samples)
     let full = (m - 1) / LANES * LANES;
     let mut buf = [0.0_f64; AREA_BLOCK];
+    let (mut sx, mut sf) = ([0.0_f64; AREA_BLOCK + 1], [0.0_f64; AREA_BLOCK + 1]);
     let mut a0 = 0_usize;
     while a0 < full {
         let b0 = (a0 + AREA_BLOCK).min(full);
         let k = b0 - a0;
-        let src = xa[a0..b0]
-            .iter()
-            .zip(&xb[a0..b0])
-            .zip(&fa[a0..b0])
-            .zip(&fb[a0..b0]);
+        // samples a0..=b0 (b0 <= m - 1)
+        for ((ox, of), (&xv, &fv)) in sx[..=k]
+            .iter_mut()
+            .zip(&mut sf[..=k])
+            .zip(x[a0..=b0].iter().zip(&f[a0..=b0]))
+        {
+            *ox = xv * ux;
+            *of = fv * uf - fm;
+        }
+        let src = sx[..k].iter().zip(&sx[1..=k]).zip(&sf[..k]).zip(&sf[1..=k]);
         for (o, (((&xp, &xs), &fp), &fs)) in buf[..k].iter_mut().zip(src) {
-            *o = term(xp, xs, fp, fs);
+            *o = 0.5 * (fp + fs) * (xs - xp);
         }
         for v4 in buf[..k].chunks_exact(LANES) {
             for l in 0..LANES {
@@ -455,11 +463,14 @@ fn flush_cell(
     bin.sums = *cur;
     bin.samples += n;
     let (mx, mf) = bin.add_cell(n, cx, cf, cp);
-    // f64::max and min without their NaN handling (a NaN mean is skipped by both)
-    r[0] = if mx > r[0] { mx } else { r[0] };
-    r[1] = if mx < r[1] { mx } else { r[1] };
-    r[2] = if mf > r[2] { mf } else { r[2] };
-    r[3] = if mf < r[3] { mf } else { r[3] };
+    // the largest of the means and of their negations (the smallest, negated: the same
+    // selections, as `-m > -r` is `m < r`) by one rule in four lanes, f64::max without its
+    // NaN handling (a NaN mean is skipped): one compare-select of four lanes (the two
+    // maxima and two minima were a compare and a mask shuffle each, a cell)
+    let v = [mx, mf, -mx, -mf];
+    for l in 0..4 {
+        r[l] = if v[l] > r[l] { v[l] } else { r[l] };
+    }
 }
 
 /// `n_bins >= 1`, and `n_cycles × n_bins` cells that fit.
@@ -890,9 +901,11 @@ fn finish(
         (w.x_std[b], w.f_std[b]) = m.spread(gx, gf);
     }
     for (c, r) in ranges.iter().enumerate() {
-        if r[0] >= r[1] {
-            w.amplitude[c] = 0.5 * (r[0] - r[1]);
-            w.force_range[c] = 0.5 * (r[2] - r[3]);
+        // [max x, max F, -min x, -min F] (flush_cell); the negations are exact
+        let (x_hi, f_hi, x_lo, f_lo) = (r[0], r[1], -r[2], -r[3]);
+        if x_hi >= x_lo {
+            w.amplitude[c] = 0.5 * (x_hi - x_lo);
+            w.force_range[c] = 0.5 * (f_hi - f_lo);
         }
     }
     // bounds: each cycle's first sample, an empty cycle starting where the next one does

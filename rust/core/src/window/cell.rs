@@ -3,13 +3,9 @@
 
 use super::{flush_cell, Bin};
 
-/// A cycle's range of cell means before its first cell: [max x, min x, max F, min F].
-pub(super) const NO_RANGE: [f64; 4] = [
-    f64::NEG_INFINITY,
-    f64::INFINITY,
-    f64::NEG_INFINITY,
-    f64::INFINITY,
-];
+/// A cycle's range of cell means before its first cell: [max x, max F, max -x, max -F]
+/// (the smallest means negated, so that one rule updates the four).
+pub(super) const NO_RANGE: [f64; 4] = [f64::NEG_INFINITY; 4];
 
 /// One knot segment of the phase: `φ(t) = slope (t - k_lo) + p_lo` on `[k_lo, k_hi)`.
 pub(super) struct Segment {
