@@ -461,6 +461,10 @@ class NormalLoad(EffectModel):
     spring_check: bool = True
     #: the delay rule of :meth:`yields_to_delay` on; off only to measure what it changes
     delay_check: bool = True
+    #: a factor in time, it cannot filter the input: of the input's noise it can take only
+    #: the bias the noise leaves locked to the cycle (at a harmonic of the drive), which the
+    #: record's own simulation measures (``search.locked_noise_budget``)
+    input_noise_locked = True
 
     def input_noise_share_at(self, d, p) -> float | None:
         """The share of the input-noise budget (``search._noise_floor``) a load at the
