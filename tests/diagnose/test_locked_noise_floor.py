@@ -111,3 +111,20 @@ def test_the_stated_bound_models_the_locked_floor() -> None:
     assert with_at.gain_floor == pytest.approx(
         max(0.05 * 0.2 + min(0.25 * budget, locked), with_at.rel_floor), rel=1e-6
     )
+
+
+def test_an_effect_named_only_by_the_lowered_floor_is_marked_for_a_flagged_record() -> None:
+    from types import SimpleNamespace
+
+    from contactlab.diagnose.search import LOCKED_ONLY
+    from contactlab.diagnose.workflow import _locked_on_misfit
+
+    d = SimpleNamespace(extra={LOCKED_ONLY: {"position_friction": 0.05}})
+    st = SimpleNamespace(added=["series_compliance", "position_friction"])
+    flagged = {"unexplained": SimpleNamespace(flagged=True)}
+    quiet = {"unexplained": SimpleNamespace(flagged=False)}
+    got = _locked_on_misfit(st, d, flagged)
+    assert got is not None and got[0] == "position_friction" and "0.05" in got[1]
+    assert _locked_on_misfit(st, d, quiet) is None
+    assert _locked_on_misfit(st, d, {"unexplained": None}) is None
+    assert _locked_on_misfit(SimpleNamespace(added=["series_compliance"]), d, flagged) is None

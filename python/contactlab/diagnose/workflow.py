@@ -293,9 +293,14 @@ def diagnose(
     checks = _withdraw(b, d, st, names, z, min_gain, folds, declared_noise, location, checks)
     checks = _rivals(b, d, st, checks)
     checks = _calibrated(b, d, st, checks)
-    if _locked_on_misfit(st, d, checks):  # flagged by the calibrated null or a patch
+    gone = _locked_on_misfit(st, d, checks)  # flagged by the calibrated null or a patch
+    if gone is not None:
         before = getattr(checks["unexplained"], "absorbing", ())
-        checks = _withdraw(b, d, st, names, z, min_gain, folds, declared_noise, location, checks)
+        args = (names, z, min_gain, folds, declared_noise)
+        if _flagged_without(b, d, st, gone[0], *args, copy.deepcopy(location)):
+            checks = _withdraw(b, d, st, *args, location, checks, [gone])
+        else:  # kept: the closing checks of the model with it again (the trial rewrote them)
+            checks = _assess(b, d, st, *args, location)
         checks = _calibrated(b, d, st, _rivals(b, d, st, checks))
         if before and checks["unexplained"] is not None:
             absorbing = tuple(dict.fromkeys([*before, *checks["unexplained"].absorbing]))
@@ -400,6 +405,39 @@ def _locked_on_misfit(
     )
 
 
+def _flagged_without(
+    b: _Base,
+    d: Prepared,
+    st: SearchState,
+    name: str,
+    names: list[str],
+    z: float,
+    min_gain: float,
+    folds: int,
+    declared_noise: float | None,
+    location: dict[str, Any],
+) -> bool:
+    """Whether the misfit test still flags the final model refitted without ``name`` (the
+    closing checks on a copy of the search's state): a misfit of the base that the effect
+    did not explain (guard of :func:`_locked_on_misfit`); where the flag goes with it, the
+    flag was the effect's own (a named set a free-form virgin curve explains as well) and
+    the effect stays."""
+    rest = tuple(e for e in st.current.effects if e != name)
+    try:
+        refit = evaluate(b.family, rest, d, st.current.full.params, b.scales, folds)
+    except (ConvergenceError, InputError):
+        return True
+    trial = dataclasses.replace(
+        st, current=refit, steps=list(st.steps), where=list(st.where),
+        trials=[*st.trials, refit], added=[e for e in st.added if e != name],
+        visited=set(st.visited), seen=dict(st.seen), untested=list(st.untested),
+    )  # fmt: skip
+    checks = _assess(b, d, trial, names, z, min_gain, folds, declared_noise, location)
+    checks = _calibrated(b, d, trial, _rivals(b, d, trial, checks))
+    u = checks["unexplained"]
+    return bool(u is not None and u.flagged)
+
+
 def _unfounded(family: Family, st: SearchState, d: Prepared) -> tuple[str, str] | None:
     """The first effect named by this diagnosis that its final fit does not support, and
     why: its size within :attr:`~contactlab.diagnose.effects.EffectModel.IDENTIFIED_SIGMAS`
@@ -460,6 +498,7 @@ def _withdraw(
     declared_noise: float | None,
     location: dict[str, Any],
     checks: dict[str, Any],
+    force: list[tuple[str, str]] | None = None,
 ) -> dict[str, Any]:
     """The final model without the effects it cannot name (issue 29 item 5), refitted.
 
@@ -473,7 +512,9 @@ def _withdraw(
     cross-validated without it (a step ``- name`` in the gap-shrink table, so that the
     parameters, the held-out gap and the h0 check are the reported model's) and checked
     again. ``location["withdrawn"]`` lists them, ``location["withdrawn_why"]`` says why.
-    Returns the closing checks of the final model."""
+    ``force``: ``(name, why)`` withdrawn too, when nothing above withdraws one
+    (:func:`_locked_on_misfit`). Returns the closing checks of the final model."""
+    force = list(force or ())
     withdrawn: dict[str, str] = {}
     absorbed: list[str] = []
     kept: set[str] = set()
@@ -488,7 +529,7 @@ def _withdraw(
                     "reported as unexplained)"
                 )
         gone = next(((e, ABSORBED) for e in absorbing if e in st.added and e not in kept), None)
-        gone = gone or _unfounded(b.family, st, d) or _locked_on_misfit(st, d, checks)
+        gone = gone or _unfounded(b.family, st, d) or (force.pop() if force else None)
         if gone is None:
             break
         name, why = gone
