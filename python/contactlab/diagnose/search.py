@@ -219,7 +219,8 @@ def locked_noise_state(
     filters the input (a sub-sample delay, a dashpot reading a smoothed speed) can take a
     fixed share of it on every sample, however long the record: that share stays its
     floor. A candidate that is a function of the measured position or of time (a friction
-    wave along the track, a normal load at a harmonic of the drive) cannot: of the noise's
+    wave along the track; a normal load at a harmonic of the drive too, but it keeps the whole
+    budget, its ``input_noise_locked`` False) cannot: of the noise's
     effect it can take only what repeats cycle after cycle, the bias a nonlinear model
     driven by a noisy input carries (turning points pushed outward at every reversal, a
     curved branch's mean by ``F''σ²/2``), and of that only the part along its own
