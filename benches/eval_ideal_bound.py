@@ -105,7 +105,7 @@ def bound_variants(rep, effect: str) -> dict[str, float | None]:
         power.power_margin = lambda fam, name: 1.0
         one("no_margin")
 
-        def no_floor(fam, name, d, st):
+        def no_floor(fam, name, d, st, *at):
             return dataclasses.replace(st, gain_floor=0.0, rel_floor=0.0)
 
         power._own_floor = no_floor

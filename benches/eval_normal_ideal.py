@@ -206,7 +206,7 @@ def ablated_bounds(rep, what):
             power.GAIN_SCATTER = what["power.GAIN_SCATTER"]
         if "floor" in what:
             saved["_own_floor"] = power._own_floor
-            power._own_floor = lambda fam, n, d, st: power.dataclasses.replace(
+            power._own_floor = lambda fam, n, d, st, *at: power.dataclasses.replace(
                 st, gain_floor=1e-9, rel_floor=0.0
             )
         if "ident" in what:

@@ -25,7 +25,10 @@ statistics are, per held-out cycle ``c`` with weight ``W_c = Σ_c w``:
 
 These are drawn (common random numbers) and pushed through the rules of
 :func:`contactlab.diagnose.select.judge`: the per-cycle log ratios' ``t > z``, the held-out
-gain above ``min_gain`` σ² plus the input-noise budget, and above
+gain above ``min_gain`` σ² plus the input-noise budget (an effect that cannot filter the
+input, its ``input_noise_locked``: at most what the record's simulated noise bias gives its
+direction at the stated shape, :func:`contactlab.diagnose.search.locked_noise_gain`, as the
+search holds it at the fitted one), and above
 :data:`~contactlab.diagnose.select.MIN_RELATIVE_GAIN` of the current error; and through the
 identification rule of the effects (a named size must lie ``IDENTIFIED_SIGMAS`` standard
 errors from "absent"; the full fit's estimate and its reported error on the strided samples
@@ -986,7 +989,7 @@ def _per_parameter(
     prop = proportional_gain(family, name)
     strong = _strong_route(family, name, st.z)
     margin = power_margin(family, name)
-    st = _own_floor(family, name, d, st)
+    st = _own_floor(family, name, d, st, (p0, trial))
     for s in mags:
         j = _derivative(family, p0, trial, ds, s, _step(s, s.null, scales))
         if not np.all(np.isfinite(j)):
@@ -1231,7 +1234,13 @@ def _left_by_refit(
     return float(np.sum((w * r * r)[ok]) / lin) if lin > 0 and ok.any() else 1.0
 
 
-def _own_floor(family: Family, name: str, d: Prepared, st: _Setting) -> _Setting:
+def _own_floor(
+    family: Family,
+    name: str,
+    d: Prepared,
+    st: _Setting,
+    at: tuple[dict[str, float], tuple[str, ...]] | None = None,
+) -> _Setting:
     """``st`` with the gain floor the search holds candidate ``name`` to: its own share of
     ``min_gain`` (:func:`contactlab.diagnose.search.own_gain_floor`) plus the input-noise
     budget unless the effect is blind to the input's noise, as the search kept them in
@@ -1242,7 +1251,13 @@ def _own_floor(family: Family, name: str, d: Prepared, st: _Setting) -> _Setting
     from .search import _noise_floor, own_gain_floor, relative_gain_scale
 
     mg, budget = float(rules["min_gain"]), float(rules["budget"])
-    floor = own_gain_floor(family, (name,), mg) + _noise_floor(family, (name,), budget)
+    # an effect that cannot filter the input beats at most what the record's own simulated
+    # noise bias gives its direction (``search.locked_noise_gain``), as the search held it:
+    # here at the parameters and shape the bound is stated at (``at``: ``(p0, trial)``)
+    p0, trial = at if at is not None else (None, None)
+    floor = own_gain_floor(family, (name,), mg) + _noise_floor(
+        family, (name,), budget, d, p0, trial
+    )
     rel = st.rel_floor * relative_gain_scale(family, (name,))
     return dataclasses.replace(st, gain_floor=max(floor, rel), rel_floor=rel)
 

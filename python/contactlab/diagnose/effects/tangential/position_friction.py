@@ -109,6 +109,10 @@ class PositionFriction(EffectModel):
     #: per-effect floors (see GAIN_FLOOR_SCALE, INPUT_NOISE_SHARE above)
     gain_floor_scale = GAIN_FLOOR_SCALE
     input_noise_share = INPUT_NOISE_SHARE
+    #: a function of the measured position, it cannot filter the input: of the input's
+    #: noise it can take only the bias the noise leaves locked to the cycle, which the
+    #: record's own simulation measures (``search.locked_noise_budget``)
+    input_noise_locked = True
     #: the stated bound's widening (:func:`contactlab.diagnose.power.power_margin`): hidden
     #: at the linearised bound, a wave was named 6 times in 8 last stop
     #: (``benches/eval_slow_power.py``, seeds 20777000-7) and 6 in 6 on rig tuning seeds

@@ -1,0 +1,18 @@
+"""Run a bench with contactlab.diagnose.search.NOISE_LOCKED_RULE from $LOCKED (0: off, the
+floors before stop 51; 1: on), for a before/after on one tree:
+
+    LOCKED=0 nice .venv/bin/python benches/floors_locked_switch.py benches/eval_ideal_bound.py ...
+"""
+
+import os
+import runpy
+import sys
+
+from contactlab.diagnose import search
+
+search.NOISE_LOCKED_RULE = os.environ.get("LOCKED", "1") == "1"
+print("NOISE_LOCKED_RULE", search.NOISE_LOCKED_RULE, file=sys.stderr)
+script = sys.argv[1]
+sys.argv = sys.argv[1:]
+sys.path.insert(0, os.path.dirname(os.path.abspath(script)))
+runpy.run_path(script, run_name="__main__")
