@@ -293,6 +293,7 @@ def diagnose(
     checks = _withdraw(b, d, st, names, z, min_gain, folds, declared_noise, location, checks)
     checks = _rivals(b, d, st, checks)
     checks = _calibrated(b, d, st, checks)
+    checks = _flag_route(b, d, st, names, z, min_gain, folds, declared_noise, location, checks)
     if checks["unexplained"] is not None and checks["unexplained"].flagged:
         st.where.append(checks["unexplained"].sentence())
     report = _report(b.family, path, recording, regime, d, st, b.sigma, location)
@@ -599,6 +600,38 @@ def _calibrated(b: _Base, d: Prepared, st: SearchState, checks: dict[str, Any]) 
     flagged = cal["flagged"] or bool(u.rivals) or bool(patches)
     checks["unexplained"] = dataclasses.replace(u, flagged=flagged, calibrated=cal, patches=patches)
     return checks
+
+
+#: the flag route runs on flagged final models (:mod:`.flag_route`; False: off, to measure)
+FLAG_ROUTE = True
+
+
+def _flag_route(
+    b: _Base,
+    d: Prepared,
+    st: SearchState,
+    names: list[str],
+    z: float,
+    min_gain: float,
+    folds: int,
+    declared_noise: float | None,
+    location: dict[str, Any],
+    checks: dict[str, Any],
+) -> dict[str, Any]:
+    """A flagged final model: the one candidate that explains the flagged structure, named
+    by :func:`.flag_route.flag_route` with the closing checks (:func:`_assess`,
+    :func:`_rivals`, :func:`_calibrated`) re-run on the model with it. Returns the closing
+    checks of the final model."""
+    u = checks["unexplained"]
+    if not FLAG_ROUTE or u is None or not u.flagged:
+        return checks
+    from .flag_route import flag_route
+
+    def recheck(state: SearchState, where: dict[str, Any]) -> dict[str, Any]:
+        ck = _assess(b, d, state, names, z, min_gain, folds, declared_noise, where)
+        return _calibrated(b, d, state, _rivals(b, d, state, ck))
+
+    return flag_route(b, d, st, names, checks, recheck, folds, z, location)
 
 
 def _signature(family: Family, name: str, d: Prepared) -> str | None:

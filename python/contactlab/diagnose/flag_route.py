@@ -1,0 +1,247 @@
+"""The flag route (issue 29): name the one candidate that explains a flagged misfit.
+
+The stepwise search names a candidate only when its held-out gain beats the per-sample
+floors (``min_gain`` and the input-noise budget), is consistent across held-out cycles at
+``t > z``, lowers the BIC and is not a sliver of the remaining error
+(:func:`contactlab.diagnose.select.judge`). Those rules guard a record on which nothing
+says that any structure is left. Once the closing checks flag the final model
+(:mod:`.misfit`, :mod:`.misfit_null`: the residual holds structure locked to the cycle
+beyond the record's own simulated null, at the false-alarm rate
+:data:`~.detection.MISFIT_FALSE_ALARM`), the question is another one: is that structure
+one candidate's, or a misfit no candidate draws (a virgin curve of another shape, a
+non-Masing branch)?
+
+:func:`flag_route` asks it of the final model, flagged by the structure tests alone (the
+phase bins or the free-form virgin curve against the simulated null, not by a named set
+that a free-form curve explains as well, ``rivals``/``patches``, nor where a shape effect
+was withdrawn as absorbing it, ``absorbing``: there the flag already says the structure is
+a shape misfit):
+
+1. every candidate not in the final model (and not withdrawn by the closing checks) is
+   added and cross-validated as the search does (:func:`.search._try_candidate`), with the
+   per-sample floor ``min_gain`` dropped (the flag has established that structure is there)
+   but the input-noise budget kept (the share of it each candidate can take from the
+   input's noise alone: a bias, not a significance floor; a sub-sample delay smoothing the
+   noisy input took a 2f load's flag without it, tuning seed 51300003), the per-cycle
+   ``t`` above :data:`ROUTE_Z` (conditional on the flag: the structure is established, the
+   test only has to say which direction of it the candidate takes), the BIC and rule 4's
+   relative floor as they are, and every plausibility, identification and take-over rule
+   of the search;
+2. the :data:`ROUTE_TRIES` of those with the largest held-out gains beyond their
+   input-noise floor (:func:`.search.net_of_noise`) are added to the final
+   model one at a time and the closing checks re-run on it (the record's null simulated
+   again for that model, the free-form and alternative virgin curves, the patch, slope and
+   tail checks): a candidate *explains* the flagged structure when the flag clears;
+3. the one that explains it is named, with ``location["flag_route"]`` saying so, when no
+   other candidate of step 1 fits the held-out cycles comparably (its lead's paired ``t``
+   across held-out cycles, :func:`.search.paired_lead`, above the search's ``z``, as the
+   search tells look-alikes apart); otherwise
+   none is named and the candidates not told apart are reported (the flag stays).
+
+A misfit no candidate draws (tanh, rational, gamma virgin curves, a non-Masing branch)
+keeps the flag after any single candidate: the closing checks built for shape absorbers
+(:func:`.misfit.absorbed_backbone`, :func:`.misfit.alternative_virgin`,
+:func:`.shape.patch_check`) run on the augmented model too.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from ..errors import ContactLabError
+from ._family import Prepared
+from .shape import RIVAL_SHARE, RIVAL_SHARE_OWN
+
+__all__ = ["ROUTE_TRIES", "ROUTE_Z", "flag_route"]
+
+#: the per-cycle t a candidate's held-out gain must exceed on a flagged record (one-sided
+#: 2.3 % of a normal: the structure is established at the flag's false-alarm rate; the
+#: flag clearing is the candidate's main test)
+ROUTE_Z = 2.0
+#: candidates (largest held-out gain first) for which the closing checks are re-run
+ROUTE_TRIES = 3
+
+
+def _flag_sources(u: Any) -> list[str]:
+    """The tests that flagged the final model (``unexplained``): ``calibrated.by``, else
+    the hand thresholds', and ``rivals``, ``patches`` and ``absorbing`` where non-empty."""
+    cal = getattr(u, "calibrated", None)
+    src = list((cal or {}).get("by") or []) if cal is not None else []
+    if cal is None:
+        if u.statistic > u.threshold:
+            src.append("phase_bins")
+        if (u.backbone or {}).get("flagged"):
+            src.append("backbone")
+    for key in ("rivals", "patches", "absorbing"):
+        if getattr(u, key, ()):
+            src.append(key)
+    return src
+
+
+def flag_route(
+    b: Any,
+    d: Prepared,
+    st: Any,
+    names: list[str],
+    checks: dict[str, Any],
+    recheck: Callable[[Any, dict[str, Any]], dict[str, Any]],
+    folds: int,
+    z: float,
+    location: dict[str, Any],
+) -> dict[str, Any]:
+    """The flag route on the finished diagnosis (module docstring); ``b`` the workflow's
+    base (family, scales, sigma), ``st`` the search's state (updated in place when a
+    candidate is named), ``recheck(state, location)`` the workflow's closing checks on a
+    state. Returns the closing checks of the final model; ``location["flag_route"]`` says
+    what was tried and decided."""
+    from .search import StepwiseSearch, _try_candidate, net_of_noise, paired_lead
+
+    u = checks.get("unexplained")
+    if u is None or not u.flagged:
+        return checks
+    src = _flag_sources(u)
+    info: dict[str, Any] = {
+        "ran": False, "route": "flag", "z": ROUTE_Z,
+        "before": {"named": list(st.added), "flagged_by": src},
+        "tried": [], "named": None, "not_told_apart": [],
+        "input_noise_budget": float(b.budget),
+    }  # fmt: skip
+    location["flag_route"] = info
+    shape = [s for s in src if s in ("rivals", "patches", "absorbing")]
+    if shape or not src:
+        info["why_not"] = (
+            f"flagged by {', '.join(shape)}: a named set patches a shape misfit"
+            if shape
+            else "no structure test flagged"
+        )
+        return checks
+    info["ran"] = True
+    family, current = b.family, st.current
+    effects = tuple(current.effects)
+    withdrawn = set((d.extra.get("withdrawn") or {}).keys())
+    pool = [n for n in names if n not in effects and n not in withdrawn]
+    all_samples = np.ones(d.y.size, bool)
+    base_fit = dict(st.trials[0].full.params) if st.trials else dict(current.full.params)
+    passed: list[tuple[Any, Any]] = []
+    for name in pool:
+        try:
+            v, cand = _try_candidate(
+                name, family, current, effects, d, b.scales, folds, b.sigma, ROUTE_Z, 0.0,
+                0.0, base_fit, all_samples,
+            )  # fmt: skip
+        except ContactLabError:
+            continue
+        if cand is None or not (np.isfinite(v.gain) and v.gain > 0):
+            continue
+        net = net_of_noise(family, name, v.gain, b.budget, d, cand.full.params)
+        entry = {
+            "name": name, "gain": float(v.gain), "gain_net_of_noise": float(net),
+            "t": float(v.t_stat), "accepted": bool(v.accepted), "reason": v.reason,
+        }  # fmt: skip
+        info["tried"].append(entry)
+        if v.accepted:
+            share = _virgin_share(family, name, effects, current, cand, d, b.sigma)
+            if share is not None:
+                entry["virgin_share"] = share
+                if share >= RIVAL_SHARE_OWN.get(name, RIVAL_SHARE):
+                    entry["accepted"] = False
+                    entry["reason"] = (
+                        f"a free-form virgin curve reaches {share:.2f} of its gain: it may "
+                        "be a shape misfit's patch"
+                    )
+                    continue
+            passed.append((v, cand, net))
+    passed.sort(key=lambda vc: -vc[2])
+    explains: list[tuple[Any, Any, dict[str, Any], Any]] = []
+    for v, cand, _ in passed[:ROUTE_TRIES]:
+        trial_st = dataclasses.replace(
+            st, current=cand, added=[*st.added, v.name], where=[], steps=list(st.steps),
+            trials=list(st.trials),
+        )  # fmt: skip
+        scratch: dict[str, Any] = {}
+        try:
+            ck = recheck(trial_st, scratch)
+        except ContactLabError:
+            continue
+        uu = ck.get("unexplained")
+        cleared = uu is None or not uu.flagged
+        for e in info["tried"]:
+            if e["name"] == v.name:
+                e["clears_flag"] = bool(cleared)
+                e["flagged_by_after"] = [] if uu is None else _flag_sources(uu)
+        if cleared:
+            explains.append((v, cand, ck, trial_st))
+    if not explains:
+        info["why_not"] = "no candidate that passed clears the flag"
+        return checks
+    v, cand, ck, trial_st = explains[0]  # (the largest net gain of those that clear it)
+    ties = []
+    for w, other, _ in passed:
+        if w.name == v.name:
+            continue
+        t = paired_lead(d, current, cand, other)
+        info.setdefault("paired", {})[w.name] = float(t)
+        if not (np.isfinite(t) and t > z):
+            ties.append({"name": w.name, "gain": float(w.gain), "t": float(t)})
+    if ties:
+        info["not_told_apart"] = [{"name": v.name, "gain": float(v.gain)}, *ties]
+        info["why_not"] = "not told apart"
+        alts = ", ".join(f"{x['name']} ({x['gain']:.3g} σ², paired t = {x['t']:.2f})" for x in ties)
+        st.where.append(
+            f"flag route: {v.name} (held-out gain {v.gain:.3g} σ², t = {v.t_stat:.2f}) would "
+            f"explain the flagged structure but is not told apart from {alts} (paired t of its "
+            f"lead across held-out cycles at most {z:g}): none is named"
+        )
+        return checks
+    # named: the final model is the candidate's
+    st.current = cand
+    st.added.append(v.name)
+    st.trials.append(cand)
+    st.steps.append(_step_of(st, v, cand, StepwiseSearch))
+    st.where.extend(trial_st.where)
+    st.where.append(
+        f"named by the flag route: {v.name} explains the structure the final model left "
+        f"(held-out gain {v.gain:.3g} σ², t = {v.t_stat:.2f} > {ROUTE_Z:g} across held-out "
+        "cycles, below the search's floors; with it the misfit is no longer flagged, and no "
+        "other candidate fits the held-out cycles comparably)"
+    )
+    info["named"] = v.name
+    info["gain"] = float(v.gain)
+    info["t"] = float(v.t_stat)
+    return ck
+
+
+def _virgin_share(
+    family: Any,
+    name: str,
+    effects: tuple[str, ...],
+    current: Any,
+    cand: Any,
+    d: Prepared,
+    sigma: float,
+) -> float | None:
+    """For a candidate a virgin curve of another shape can stand in for
+    (:data:`.shape.PATCHABLE`), the share of its gain over the final model that a free-form
+    virgin curve reaches on the final model's residual (:func:`.shape.rival_share`, as the
+    closing checks ask of a named rival); None for another candidate or where not
+    computable."""
+    from .select import specs_for
+    from .shape import PATCHABLE, rival_share
+
+    ac = float(current.full.params.get("ac", np.nan))
+    if name not in PATCHABLE or not np.isfinite(ac):
+        return None
+    n_par = len(specs_for(family, (*effects, name))) - len(specs_for(family, effects))
+    got = rival_share(d, -cand.full_residual(d), -current.full_residual(d), ac, sigma, n_par)
+    return None if got is None else float(got["share"])
+
+
+def _step_of(st: Any, v: Any, cand: Any, search: Any) -> Any:
+    """The gap-shrink table's step for an effect the route named (the step class of the
+    search's first step)."""
+    step_cls = type(st.steps[0])
+    return step_cls(v.name, *search._errors(cand), candidates=(v,))
