@@ -18,10 +18,14 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 import time
+from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 H0, AC = 40.0, 4.0e4
 #: label: (effect, fs, f, cycles, x noise, F noise, ac·A, size in the diagnosis's parameter)
@@ -34,6 +38,11 @@ CONDITIONS: dict[str, tuple[str, float, float, int, float, float, float, float]]
     "drift": ("parameter_drift", 10000.0, 25.3, 50, 0.0156, 0.0186, 3.6, 0.0027),
     "fdrift": ("force_drift", 10000.0, 16.8, 12, 0.010, 0.010, 2.0, 0.03),
     "clean": ("", 2000.0, 10.0, 20, 0.012, 0.012, 2.0, 0.0),
+    # normal contact (``benches/chain_normal.py``'s chain: actuator from rest, LVDT, pressure
+    # cell, Bessel anti-alias, hum, jitter, ADC), the size ``mult`` times the ideal test's
+    # (noncentrality 44.8, base and nearest rival projected out); ac·A unused
+    "nstiff": ("stiffness_nonlinearity", 5000.0, 29.4, 35, 0.0106, 0.0165, 0.0, 0.01),
+    "nasym": ("asymmetric_branches", 1000.0, 2.6, 12, 0.0053, 0.0069, 0.0, 0.3),
 }
 
 
@@ -68,6 +77,8 @@ def run_one(label: str, seed: int, mult: float) -> dict[str, Any]:
     from contactlab.synthetic.rig import rig_recording
 
     effect, fs, f, cyc, xn, Fn, aca, size = CONDITIONS[label]
+    if label.startswith("n"):
+        return _run_normal(label, seed, mult)
     fac = {"fs": fs, "f": f, "cycles": cyc, "acA": aca}
     rng = np.random.default_rng([seed, 7])
     eff = {effect: rig_effect(effect, size * mult, fac, rng)} if effect else {}
@@ -85,6 +96,32 @@ def run_one(label: str, seed: int, mult: float) -> dict[str, Any]:
         "label": label, "seed": seed, "mult": mult, "effect": effect,
         "named": list(rep.effect_names), "flagged": bool(u is not None and u.flagged),
         "route": route, "seconds": round(time.time() - t0, 1),
+    }  # fmt: skip
+
+
+def _run_normal(label: str, seed: int, mult: float) -> dict[str, Any]:
+    import warnings
+
+    import contactlab
+    from chain_normal import LAMBDA_VISIBLE, chain_record, noncentrality
+
+    effect, fs, f, cyc, xn, yn, _, ref = CONDITIONS[label]
+    rng = np.random.default_rng([seed, 7])
+    fac = {"fs": fs, "f": f, "cycles": cyc, "ratio": float(rng.uniform(0.3, 0.8)),
+           "noise_p": xn, "noise_d": yn, "bits": 16, "psi": float(rng.uniform(0.08, 0.3)),
+           "law": "a2"}  # fmt: skip
+    lam, _, _ = noncentrality(effect, ref, fac, seed)
+    size = mult * ref * math.sqrt(LAMBDA_VISIBLE / lam) * float(rng.choice([-1, 1]))
+    t, p, d, _ = chain_record(effect, size, fac, seed + 1000)
+    t0 = time.time()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rep = contactlab.diagnose({"t": t, "p": p, "delta": d}, model="normal")
+    u = rep.unexplained
+    return {
+        "label": label, "seed": seed, "mult": mult, "effect": effect, "size": size,
+        "named": list(rep.effect_names), "flagged": bool(u is not None and u.flagged),
+        "route": rep.location.get("flag_route"), "seconds": round(time.time() - t0, 1),
     }  # fmt: skip
 
 
