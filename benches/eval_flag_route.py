@@ -154,6 +154,8 @@ def main() -> None:
     ap.add_argument("--dump", default=None)
     ap.add_argument("--table", nargs="*", default=None)
     a = ap.parse_args()
+    from contactlab.errors import ContactLabError
+
     if a.table is not None:
         rs = [json.loads(x) for p in a.table for x in open(p) if x.strip()]
         print(summary(rs))
@@ -162,7 +164,11 @@ def main() -> None:
     for seed in _seeds(a.seeds):
         for lab in a.labels.split(","):
             for m in (float(v) for v in a.mults.split(",")):
-                r = run_one(lab, seed, m)
+                try:
+                    r = run_one(lab, seed, m)
+                except ContactLabError as exc:  # (the normal chain's NaN beyond its range)
+                    print(f"{lab} {seed} {m:g}: {exc}", flush=True)
+                    continue
                 rs.append(r)
                 print(json.dumps(r, default=str), flush=True)
                 if a.dump:
