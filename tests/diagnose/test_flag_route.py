@@ -84,3 +84,36 @@ def test_a_tanh_virgin_curve_stays_flagged_and_unnamed() -> None:
     assert rep.unexplained is not None and rep.unexplained.flagged, rep.effect_names
     assert rep.location["flag_route"]["named"] is None, rep.location["flag_route"]
     assert rep.effect_names == []
+
+
+def test_signal_share_tells_a_spring_from_a_position_wave() -> None:
+    """A candidate's own signal that a virgin curve of another shape draws (a spring k·x) has
+    a share near 1; a friction that varies along the track (one wavelength over the largest
+    amplitude) on a record of several amplitudes stays below the 0.8 the route asks."""
+    from contactlab.diagnose._family import Prepared
+    from contactlab.diagnose.candidates_tangential import TangentialFamily
+    from contactlab.diagnose.flag_route import _signal_share
+    from contactlab.masing import Masing
+
+    # three amplitudes (on one steady amplitude every branch is some virgin curve's: any
+    # effect odd over the cycle has a share near 1 there, and the route names none of them)
+    t = np.arange(12 * 200) / 200.0
+    A, ac = 5e-5, 4e4
+    x = A * np.sin(2 * np.pi * t) * np.repeat([0.4, 0.7, 1.0], 4 * 200)
+    f0 = Masing(40.0, ac).force(x)
+    d = Prepared.build(t, x, f0, errors_in_input=False)
+    TangentialFamily().prepare(d)
+    full = types.SimpleNamespace(params={"h0": 40.0, "ac": ac})
+    current = types.SimpleNamespace(full=full, fitted=f0)
+
+    def cand(add):
+        return types.SimpleNamespace(full=full, fitted=f0 + add)
+
+    spring = _signal_share("parallel_stiffness", current, cand(2e4 * x), d)
+    # the friction force modulated along the track, one wavelength over the amplitude
+    wave = _signal_share(
+        "position_friction", current, cand(0.02 * f0 * np.cos(2 * np.pi * x / A)), d
+    )
+    assert spring is not None and spring > 0.95, spring
+    assert wave is not None and wave < 0.8, wave
+    assert _signal_share("force_offset", current, cand(np.ones_like(x)), d) is None
