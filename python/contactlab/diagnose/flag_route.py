@@ -115,7 +115,7 @@ def flag_route(
         return checks
     src = _flag_sources(u)
     info: dict[str, Any] = {
-        "ran": False, "route": "flag", "z": ROUTE_Z,
+        "ran": False, "route": "flag", "z": ROUTE_Z, "z_told_apart": float(z),
         "before": {"named": list(st.added), "flagged_by": src},
         "tried": [], "named": None, "not_told_apart": [],
         "input_noise_budget": float(b.budget),
@@ -124,7 +124,7 @@ def flag_route(
     shape = [s for s in src if s in ("rivals", "patches", "absorbing")]
     if shape or not src:
         info["why_not"] = (
-            f"flagged by {', '.join(shape)}: a named set patches a shape misfit"
+            f"flagged by {', '.join(shape)}: the structure reads as a misfit of the branches' shape"
             if shape
             else "no structure test flagged"
         )
