@@ -74,6 +74,10 @@ __all__ = ["ROUTE_TRIES", "ROUTE_Z", "flag_route"]
 ROUTE_Z = 2.0
 #: candidates (largest held-out gain first) for which the closing checks are re-run
 ROUTE_TRIES = 3
+#: the flag sources that read the structure as a misfit of the branches' shape: where any
+#: of them flagged, the route does not run (a bench may empty it to measure the route's own
+#: guards on such records)
+SHAPE_FLAGS = ("rivals", "patches", "absorbing")
 
 
 def _flag_sources(u: Any) -> list[str]:
@@ -121,7 +125,7 @@ def flag_route(
         "input_noise_budget": float(b.budget),
     }  # fmt: skip
     location["flag_route"] = info
-    shape = [s for s in src if s in ("rivals", "patches", "absorbing")]
+    shape = [s for s in src if s in SHAPE_FLAGS]
     if shape or not src:
         info["why_not"] = (
             f"flagged by {', '.join(shape)}: the structure reads as a misfit of the branches' shape"
