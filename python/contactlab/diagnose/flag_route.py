@@ -43,7 +43,8 @@ a shape misfit):
    again for that model, the free-form and alternative virgin curves, the patch, slope and
    tail checks): a candidate *explains* the flagged structure when the flag clears;
 3. the one that explains it is named, with ``location["flag_route"]`` saying so, when no
-   other candidate of step 1 fits the held-out cycles comparably (its lead's paired ``t``
+   other candidate that passed the held-out rules of step 1 (a shape lookalike refused by
+   its signal's share included) fits the held-out cycles comparably (its lead's paired ``t``
    across held-out cycles, :func:`.search.paired_lead`, above the search's ``z``, as the
    search tells look-alikes apart); otherwise
    none is named and the candidates not told apart are reported (the flag stays).
@@ -140,7 +141,8 @@ def flag_route(
     pool = [n for n in names if n not in effects and n not in withdrawn]
     all_samples = np.ones(d.y.size, bool)
     base_fit = dict(st.trials[0].full.params) if st.trials else dict(current.full.params)
-    passed: list[tuple[Any, Any]] = []
+    passed: list[tuple[Any, Any, float]] = []
+    rivals: list[tuple[Any, Any]] = []
     for name in pool:
         try:
             v, cand = _try_candidate(
@@ -158,6 +160,10 @@ def flag_route(
         }  # fmt: skip
         info["tried"].append(entry)
         if v.accepted:
+            # every candidate that passed the held-out rules is a rival of the one named,
+            # a shape lookalike included (a 2f load drawn by a virgin curve still fits the
+            # held-out cycles as a delay does: shaker rig, fresh seeds 51300200-1)
+            rivals.append((v, cand))
             share = _virgin_share(family, name, effects, current, cand, d, b.sigma)
             sig = _signal_share(name, current, cand, d)
             if sig is not None:
@@ -209,7 +215,7 @@ def flag_route(
         return checks
     v, cand, ck, trial_st = explains[0]  # (the largest net gain of those that clear it)
     ties = []
-    for w, other, _ in passed:
+    for w, other in rivals:
         if w.name == v.name:
             continue
         t = paired_lead(d, current, cand, other)
