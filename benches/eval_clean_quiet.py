@@ -74,6 +74,8 @@ for case in cases:
         "by_alternative": bool(
             un is not None and any(p.get("alternative") for p in (un.patches or ()))
         ),
+        # named by the flag route (contactlab.diagnose.flag_route): a flag turned into a name
+        "by_flag_route": (rep.location.get("flag_route") or {}).get("named"),
     }
     print(json.dumps(r), flush=True)
     out.append(r)
@@ -81,4 +83,8 @@ q = sum(1 for r in out if not r["named"] and not r["flagged"])
 n_named = sum(1 for r in out if r["named"])
 n_flagged = sum(1 for r in out if r["flagged"])
 n_alt = sum(1 for r in out if r["by_alternative"])
-print(f"quiet {q}/{len(out)} named {n_named} flagged {n_flagged} (by the alternative only {n_alt})")
+n_route = sum(1 for r in out if r["by_flag_route"])
+print(
+    f"quiet {q}/{len(out)} named {n_named} flagged {n_flagged} (by the alternative only "
+    f"{n_alt}; named by the flag route {n_route})"
+)

@@ -257,6 +257,8 @@ def run_one(job: tuple[str, int, str] | tuple[str, int, str, str]) -> dict[str, 
             power_flags=[sweep.get(f"power_{k}") for k in POWER_CHECK],
             where=None if u is None else u.where,
             misfit_rms=None if u is None else u.rms,
+            # what the flag route (contactlab.diagnose.flag_route) tried and named
+            flag_route=rep.location.get("flag_route"),
         )
     out["cpu"] = time.process_time() - t0
     if virgin == "tanh":

@@ -84,6 +84,7 @@ def run_one(job: tuple[int, str, bool]) -> dict[str, Any]:
             detectable_rms=None if u is None else u.detectable_rms,
             rms=None if u is None else u.rms,
             eiv=None if u is None else u.eiv_bias_rms,
+            flag_route=rep.location.get("flag_route"),
             **seen,
         )
         # the true input noise RMS (the chain scales it to x_noise of the range)

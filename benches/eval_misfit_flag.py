@@ -84,6 +84,7 @@ def run_one(seed: int, kind: str) -> dict[str, Any]:
             bins_flag=bool(u is not None and u.statistic > u.threshold),
             ratio=None if u is None else u.statistic / u.threshold,
             unexplained=ud,
+            flag_route=rep.location.get("flag_route"),
         )
     out["cpu"] = time.process_time() - t0
     return out

@@ -93,7 +93,7 @@ def get(seed: int, kind: str, cache: str) -> dict[str, Any]:
     o1 = mn.simulated_null
 
     def h1(*a: Any, **k: Any) -> Any:
-        cap["args"] = a
+        cap.setdefault("args", a)  # the final model's (not the flag route's rechecks)
         return o1(*a, **k)
 
     mn.simulated_null = h1
@@ -111,6 +111,7 @@ def get(seed: int, kind: str, cache: str) -> dict[str, Any]:
         "fac": {k: v for k, v in fac.items() if isinstance(v, (int, float, str, bool))},
         "flagged": bool(u is not None and u.flagged), "u": ud,
         "withdrawn": list((rep.location or {}).get("withdrawn", [])),
+        "flag_route": (rep.location or {}).get("flag_route"),
     }  # fmt: skip
     if "args" in cap:
         cap["args"][3].extra.pop("evaluations", None)

@@ -171,6 +171,13 @@ class DiagnosisReport:
                 else {}
             ),
             **({"refused": dict(self.location["refused"])} if "refused" in self.location else {}),
+            # issue 29: a flagged final model, and the candidate the flag route named to
+            # explain it (or why none): :mod:`contactlab.diagnose.flag_route`
+            **(
+                {"flag_route": dict(self.location["flag_route"])}
+                if "flag_route" in self.location
+                else {}
+            ),
             # a frame's reconstructed force: its mass read from an inertia term
             **(
                 {"frame_constants": dict(self.location["frame_constants"])}

@@ -165,6 +165,26 @@ def infer_model(recording: Any) -> str:
 
 @one_blas_thread
 @takes_options
+def _withdraw_locked(b, d, st, names, z, min_gain, folds, declared_noise, location, checks):
+    """An effect named only by the input-noise-locked floor is withdrawn where the misfit test
+    flags the final model and still flags it refitted without that effect (a patch over a
+    misfit); kept, with the closing checks of the model with it, where the flag goes away
+    without it (the flag was the effect's own)."""
+    gone = _locked_on_misfit(st, d, checks)  # flagged by the calibrated null or a patch
+    if gone is not None:
+        before = getattr(checks["unexplained"], "absorbing", ())
+        args = (names, z, min_gain, folds, declared_noise)
+        if _flagged_without(b, d, st, gone[0], *args, copy.deepcopy(location)):
+            checks = _withdraw(b, d, st, *args, location, checks, [gone])
+        else:  # kept: the closing checks of the model with it again (the trial rewrote them)
+            checks = _assess(b, d, st, *args, location)
+        checks = _calibrated(b, d, st, _rivals(b, d, st, checks))
+        if before and checks["unexplained"] is not None:
+            absorbing = tuple(dict.fromkeys([*before, *checks["unexplained"].absorbing]))
+            checks["unexplained"] = dataclasses.replace(checks["unexplained"], absorbing=absorbing)
+    return checks
+
+
 def diagnose(
     recording: Any,
     model: Any = None,
@@ -293,18 +313,8 @@ def diagnose(
     checks = _withdraw(b, d, st, names, z, min_gain, folds, declared_noise, location, checks)
     checks = _rivals(b, d, st, checks)
     checks = _calibrated(b, d, st, checks)
-    gone = _locked_on_misfit(st, d, checks)  # flagged by the calibrated null or a patch
-    if gone is not None:
-        before = getattr(checks["unexplained"], "absorbing", ())
-        args = (names, z, min_gain, folds, declared_noise)
-        if _flagged_without(b, d, st, gone[0], *args, copy.deepcopy(location)):
-            checks = _withdraw(b, d, st, *args, location, checks, [gone])
-        else:  # kept: the closing checks of the model with it again (the trial rewrote them)
-            checks = _assess(b, d, st, *args, location)
-        checks = _calibrated(b, d, st, _rivals(b, d, st, checks))
-        if before and checks["unexplained"] is not None:
-            absorbing = tuple(dict.fromkeys([*before, *checks["unexplained"].absorbing]))
-            checks["unexplained"] = dataclasses.replace(checks["unexplained"], absorbing=absorbing)
+    checks = _withdraw_locked(b, d, st, names, z, min_gain, folds, declared_noise, location, checks)
+    checks = _flag_route(b, d, st, names, z, min_gain, folds, declared_noise, location, checks)
     if checks["unexplained"] is not None and checks["unexplained"].flagged:
         st.where.append(checks["unexplained"].sentence())
     report = _report(b.family, path, recording, regime, d, st, b.sigma, location)
@@ -673,6 +683,38 @@ def _calibrated(b: _Base, d: Prepared, st: SearchState, checks: dict[str, Any]) 
     flagged = cal["flagged"] or bool(u.rivals) or bool(patches)
     checks["unexplained"] = dataclasses.replace(u, flagged=flagged, calibrated=cal, patches=patches)
     return checks
+
+
+#: the flag route runs on flagged final models (:mod:`.flag_route`; False: off, to measure)
+FLAG_ROUTE = True
+
+
+def _flag_route(
+    b: _Base,
+    d: Prepared,
+    st: SearchState,
+    names: list[str],
+    z: float,
+    min_gain: float,
+    folds: int,
+    declared_noise: float | None,
+    location: dict[str, Any],
+    checks: dict[str, Any],
+) -> dict[str, Any]:
+    """A flagged final model: the one candidate that explains the flagged structure, named
+    by :func:`.flag_route.flag_route` with the closing checks (:func:`_assess`,
+    :func:`_rivals`, :func:`_calibrated`) re-run on the model with it. Returns the closing
+    checks of the final model."""
+    u = checks["unexplained"]
+    if not FLAG_ROUTE or u is None or not u.flagged:
+        return checks
+    from .flag_route import flag_route
+
+    def recheck(state: SearchState, where: dict[str, Any]) -> dict[str, Any]:
+        ck = _assess(b, d, state, names, z, min_gain, folds, declared_noise, where)
+        return _calibrated(b, d, state, _rivals(b, d, state, ck))
+
+    return flag_route(b, d, st, names, checks, recheck, folds, z, location)
 
 
 def _signature(family: Family, name: str, d: Prepared) -> str | None:
