@@ -976,6 +976,9 @@ def _per_parameter(
     derived = reads_input_derivatives(family, name)
     ds = _effect_signal(family, name, signal_input(d)) if derived else d
     steady = steady_samples(d) if derived else None
+    rows_of = getattr(_effect(family, name), "bound_rows", None) if derived else None
+    if rows_of is not None and rows_of(ds) is not None:
+        steady = rows_of(ds)  # the samples the effect's test reads its signature on
     rivals = _rival_directions(family, p0, trial, name, ds, scales)
     # a rival fitted one at a time and compared by likelihood (the effect's
     # ``rival_rows(d)``: normal contact's shapes beyond the ellipse) is not projected out of
@@ -1242,7 +1245,11 @@ def _own_floor(family: Family, name: str, d: Prepared, st: _Setting) -> _Setting
     from .search import _noise_floor, own_gain_floor, relative_gain_scale
 
     mg, budget = float(rules["min_gain"]), float(rules["budget"])
-    floor = own_gain_floor(family, (name,), mg) + _noise_floor(family, (name,), budget)
+    # (an effect whose share of the input-noise budget depends on the record, such as a
+    # mass read through the drive's harmonics, states it on ``d``: the search's own)
+    at = bool(getattr(_effect(family, name), "bound_noise_share_at", False))
+    noise = _noise_floor(family, (name,), budget, d if at else None, {} if at else None)
+    floor = own_gain_floor(family, (name,), mg) + noise
     rel = st.rel_floor * relative_gain_scale(family, (name,))
     return dataclasses.replace(st, gain_floor=max(floor, rel), rel_floor=rel)
 
