@@ -53,6 +53,8 @@ CONDITIONS = (
 NONCENTRALITY = 44.8
 #: hide the mass at this multiple of the clean twin's stated bound (``--at-bound``; 0: off)
 AT_BOUND = 0.0
+#: diagnose the clean twins only (``--clean-only``: their stated bounds and names)
+CLEAN_ONLY = False
 
 
 def shaker_figures(seed: int, f: float) -> dict:
@@ -179,7 +181,7 @@ def run(job):
             out["lam"] = m * m * out.get("per_kg", math.nan)
         elif AT_BOUND:
             m = 0.0
-        if m > 0:
+        if m > 0 and not CLEAN_ONLY:
             out["mass"] = diag(rig(cond, seed, m))
     except Exception as exc:
         out["error"] = f"{type(exc).__name__}: {exc}"[:200]
@@ -215,9 +217,10 @@ def main(argv=None):
         "--at-bound", type=float, default=0.0,
         help="hide the mass at this multiple of the clean twin's stated bound (0: --lam)",
     )  # fmt: skip
+    ap.add_argument("--clean-only", action="store_true", help="diagnose the clean twins only")
     a = ap.parse_args(argv)
-    global AT_BOUND
-    AT_BOUND = a.at_bound
+    global AT_BOUND, CLEAN_ONLY
+    AT_BOUND, CLEAN_ONLY = a.at_bound, a.clean_only
     if a.bound_before:
         from contactlab.diagnose.effects.tangential.inertia import Inertia
 
