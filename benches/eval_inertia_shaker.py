@@ -217,10 +217,19 @@ def main(argv=None):
         "--at-bound", type=float, default=0.0,
         help="hide the mass at this multiple of the clean twin's stated bound (0: --lam)",
     )  # fmt: skip
+    ap.add_argument(
+        "--startup-local", action="store_true",
+        help="the start-up beside the harmonics' ẍ reads the local ẍ "
+        "(inertia.HARMONIC_STARTUP_SMOOTHED False)",
+    )  # fmt: skip
     ap.add_argument("--clean-only", action="store_true", help="diagnose the clean twins only")
     a = ap.parse_args(argv)
     global AT_BOUND, CLEAN_ONLY
     AT_BOUND, CLEAN_ONLY = a.at_bound, a.clean_only
+    if a.startup_local:
+        from contactlab.diagnose.effects.tangential import inertia as _inertia
+
+        _inertia.HARMONIC_STARTUP_SMOOTHED = False
     if a.bound_before:
         from contactlab.diagnose.effects.tangential.inertia import Inertia
 
