@@ -44,9 +44,17 @@ CONDITIONS = (
     # 5-cycle clean-ish short records at 5-10 kHz (false names are worse than misses)
     ("s1", 5000.0, 12.0, 5, 0.012, 0.010, 0.8, 0.0),
     ("s2", 10000.0, 30.0, 5, 0.015, 0.010, 1.6, 0.0),
+    # issue 29's blind shaker misses of stop 51 (the mass at its share: --lam 0)
+    ("b1", 2000.0, 3.3, 5, 0.0195, 0.0191, 0.95, 0.049),
+    ("b2", 5000.0, 23.9, 8, 0.0143, 0.0099, 0.83, 0.0295),
+    ("b3", 5000.0, 5.5, 20, 0.0154, 0.0057, 0.57, 0.0096),
 )
 
 NONCENTRALITY = 44.8
+#: hide the mass at this multiple of the clean twin's stated bound (``--at-bound``; 0: off)
+AT_BOUND = 0.0
+#: diagnose the clean twins only (``--clean-only``: their stated bounds and names)
+CLEAN_ONLY = False
 
 
 def shaker_figures(seed: int, f: float) -> dict:
@@ -147,7 +155,7 @@ def run(job):
         else:
             xm, Fm = r0.x, r0.F
         m44, per, rival, cos = ideal_test(xm, Fm, dt, b["h0"], b["ac"], sx, sF)
-        out.update(m44=m44, lam=m * m * per, rival=rival, cos=cos)
+        out.update(m44=m44, lam=m * m * per, rival=rival, cos=cos, per_kg=per)
     except Exception as exc:
         out["ideal_error"] = f"{type(exc).__name__}: {exc}"[:200]
 
@@ -167,7 +175,13 @@ def run(job):
 
     try:
         out["clean"] = diag(rig(cond, seed + 1000, 0.0))
-        if m > 0:
+        if AT_BOUND and out["clean"]["bound"] is not None:
+            # the mass hidden at AT_BOUND times the clean twin's stated bound (its promise)
+            m = out["m"] = AT_BOUND * float(out["clean"]["bound"])
+            out["lam"] = m * m * out.get("per_kg", math.nan)
+        elif AT_BOUND:
+            m = 0.0
+        if m > 0 and not CLEAN_ONLY:
             out["mass"] = diag(rig(cond, seed, m))
     except Exception as exc:
         out["error"] = f"{type(exc).__name__}: {exc}"[:200]
@@ -194,7 +208,33 @@ def main(argv=None):
         "--before", action="store_true",
         help="the mass reads the local polynomials' ẍ alone (inertia.MASS_HARMONIC False)",
     )  # fmt: skip
+    ap.add_argument(
+        "--bound-before", action="store_true",
+        help="the stated bound reads the smoothed ẍ over the steady cycles "
+        "(Inertia.bound_harmonic and bound_noise_share_at False)",
+    )  # fmt: skip
+    ap.add_argument(
+        "--at-bound", type=float, default=0.0,
+        help="hide the mass at this multiple of the clean twin's stated bound (0: --lam)",
+    )  # fmt: skip
+    ap.add_argument(
+        "--startup-local", action="store_true",
+        help="the start-up beside the harmonics' ẍ reads the local ẍ "
+        "(inertia.HARMONIC_STARTUP_SMOOTHED False)",
+    )  # fmt: skip
+    ap.add_argument("--clean-only", action="store_true", help="diagnose the clean twins only")
     a = ap.parse_args(argv)
+    global AT_BOUND, CLEAN_ONLY
+    AT_BOUND, CLEAN_ONLY = a.at_bound, a.clean_only
+    if a.startup_local:
+        from contactlab.diagnose.effects.tangential import inertia as _inertia
+
+        _inertia.HARMONIC_STARTUP_SMOOTHED = False
+    if a.bound_before:
+        from contactlab.diagnose.effects.tangential.inertia import Inertia
+
+        Inertia.bound_harmonic = False
+        Inertia.bound_noise_share_at = False
     if a.before:
         from contactlab.diagnose.effects.tangential import inertia
 
@@ -215,7 +255,8 @@ def main(argv=None):
                 f"bound={r.get('clean', {}).get('bound')}",
                 "mass:", mass.get("named"), "F" if mass.get("flagged") else "",
                 (mass.get("params") or {}).get("inertia"),
-                f"own bound={mass.get('bound')}", r.get("error", ""), f"cpu={r['cpu']:.0f}",
+                f"own bound={mass.get('bound')}", mass.get("reason", "")[:120],
+                r.get("error", ""), f"cpu={r['cpu']:.0f}",
                 flush=True,
             )  # fmt: skip
     if a.out:

@@ -979,6 +979,9 @@ def _per_parameter(
     derived = reads_input_derivatives(family, name)
     ds = _effect_signal(family, name, signal_input(d)) if derived else d
     steady = steady_samples(d) if derived else None
+    rows_of = getattr(_effect(family, name), "bound_rows", None) if derived else None
+    if rows_of is not None and rows_of(ds) is not None:
+        steady = rows_of(ds)  # the samples the effect's test reads its signature on
     rivals = _rival_directions(family, p0, trial, name, ds, scales)
     # a rival fitted one at a time and compared by likelihood (the effect's
     # ``rival_rows(d)``: normal contact's shapes beyond the ellipse) is not projected out of
@@ -1253,8 +1256,12 @@ def _own_floor(
     mg, budget = float(rules["min_gain"]), float(rules["budget"])
     # an effect that cannot filter the input beats at most what the record's own simulated
     # noise bias gives its direction (``search.locked_noise_gain``), as the search held it:
-    # here at the parameters and shape the bound is stated at (``at``: ``(p0, trial)``)
+    # here at the parameters and shape the bound is stated at (``at``: ``(p0, trial)``);
+    # an effect whose share of the input-noise budget depends on the record (a mass read
+    # through the drive's harmonics: ``bound_noise_share_at``) states it on ``d``
     p0, trial = at if at is not None else (None, None)
+    if p0 is None and getattr(_effect(family, name), "bound_noise_share_at", False):
+        p0 = {}
     floor = own_gain_floor(family, (name,), mg) + _noise_floor(
         family, (name,), budget, d, p0, trial
     )
