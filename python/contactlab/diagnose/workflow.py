@@ -163,8 +163,6 @@ def infer_model(recording: Any) -> str:
     )
 
 
-@one_blas_thread
-@takes_options
 def _withdraw_locked(b, d, st, names, z, min_gain, folds, declared_noise, location, checks):
     """An effect named only by the input-noise-locked floor is withdrawn where the misfit test
     flags the final model and still flags it refitted without that effect (a patch over a
@@ -185,6 +183,8 @@ def _withdraw_locked(b, d, st, names, z, min_gain, folds, declared_noise, locati
     return checks
 
 
+@one_blas_thread
+@takes_options
 def diagnose(
     recording: Any,
     model: Any = None,
