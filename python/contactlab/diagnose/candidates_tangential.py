@@ -345,7 +345,10 @@ class TangentialFamily:
 
     def prepare(self, d: Prepared) -> None:
         """The stroke (centre and half-range of x) that scales the position of
-        ``position_friction``; kept when given by a fitted model's context."""
+        ``position_friction``; kept when given by a fitted model's context. The start-up
+        (before the input's first maximum) is a held-out unit of the folds
+        (:func:`contactlab.diagnose.select.heldout_unit`, issue 29)."""
+        d.extra.setdefault("heldout_startup", True)
         if "x_mid" not in d.extra:
             lo, hi = float(np.min(d.u)), float(np.max(d.u))
             d.extra["x_mid"], d.extra["x_half"] = 0.5 * (lo + hi), 0.5 * (hi - lo) or 1.0

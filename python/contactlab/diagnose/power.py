@@ -16,7 +16,9 @@ absorb the part of ``j`` they can: ``j⊥ = j - J_b β`` (weighted least squares
 diagnosis's sample weights ``w``). With ``e`` the noise, whose variance per sample is the
 effective variance ``V = σy² + s² σu²`` (:func:`contactlab.diagnose.detection.effective_variance`:
 a smooth direction sees the input noise before the candidates' filter), the diagnosis's
-statistics are, per held-out cycle ``c`` with weight ``W_c = Σ_c w``:
+statistics are, per held-out cycle ``c`` with weight ``W_c = Σ_c w`` (the folds' units,
+:func:`contactlab.diagnose.select.heldout_unit`: on a tangential record the start-up before
+the input's first maximum is one, in the last fold):
 
 - the current model's error grows by ``a² A_c + 2 a B_c`` with ``A_c = Σ_c w j⊥² / W_c`` and
   ``B_c = Σ_c w j⊥ e / W_c`` (Gaussian, variance ``Σ_c w² j⊥² V / W_c²``);
@@ -82,8 +84,10 @@ from .select import (
     FIT_SAMPLES,
     MIN_RELATIVE_GAIN,
     correlation_time,
+    heldout_unit,
     sample_weight,
     specs_for,
+    unit_fold,
 )
 
 __all__ = ["Detectable", "detectable_above", "shape_values", "stated_power"]
@@ -318,7 +322,9 @@ def _setting(
     seed: int,
 ) -> _Setting:
     w = sample_weight(d)
-    cyc = d.cycles.cycle
+    # the held-out units of the diagnosis's folds (select.fold_masks): the cycles and, on a
+    # tangential record, the start-up before the input's first maximum (unit 0)
+    cyc = heldout_unit(d)
     ids = np.unique(cyc[cyc >= 0])
     where = np.full(cyc.size, -1)
     held = cyc >= 0
@@ -343,7 +349,7 @@ def _setting(
         w=w,
         var=effective_variance(slope, noise),
         cycle_of=where,
-        fold_of_cycle=ids % folds,
+        fold_of_cycle=unit_fold(ids, folds),
         cycle_mse=mse,
         sigma=sigma,
         z=z,
