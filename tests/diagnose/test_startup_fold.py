@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import contactlab
+from contactlab.diagnose import select
 from contactlab.diagnose.power import stated_power
 from contactlab.diagnose.select import fold_masks, heldout_unit, startup_mask, unit_fold
 from contactlab.synthetic.diagnosis import hidden_effect_recording
@@ -27,7 +28,10 @@ def test_the_startup_is_held_out_in_the_last_fold(report) -> None:
     d = report.prepared
     start = startup_mask(d)
     first = int(d.cycles.reversals[d.cycles.is_max][0])
-    assert start.sum() == first > 0  # every sample before the first maximum of x
+    edge = int(np.ceil(select.STARTUP_EDGE * float(d.cycles.period_samples)))
+    # every sample before the first maximum of x but the first ones (one-sided derivatives)
+    assert 0 < edge < first and start.sum() == first - edge
+    assert not start[:edge].any() and start[edge:first].all()
     unit = heldout_unit(d)
     assert np.all(unit[start] == 0)
     assert np.array_equal(unit[~start] >= 1, d.cycles.cycle[~start] >= 0)

@@ -440,6 +440,9 @@ STARTUP_MIN_PERIOD = 0.2
 #: (40 records, half with a shaker, fs 1-10 kHz, ac·A 0.3-5, noise 2 %) at most 0.23
 #: (its x sensor's filters settle over the first samples)
 STARTUP_CENTRE = 0.3
+#: ... less its first samples, this share of the period: there a candidate's velocity or
+#: acceleration is read from one side of a window at the record's first sample
+STARTUP_EDGE = 0.05
 
 
 def _from_rest(d: Prepared, first: int, maxima: np.ndarray) -> bool:
@@ -482,7 +485,8 @@ def startup_mask(d: Prepared) -> np.ndarray:
         return out
     if not _from_rest(d, first, maxima):
         return out
-    out[:first] = cyc[:first] < 0
+    edge = min(first, int(np.ceil(STARTUP_EDGE * float(d.cycles.period_samples))))
+    out[edge:first] = cyc[edge:first] < 0
     return out
 
 

@@ -703,10 +703,15 @@ def _flag_route(
 ) -> dict[str, Any]:
     """A flagged final model: the one candidate that explains the flagged structure, named
     by :func:`.flag_route.flag_route` with the closing checks (:func:`_assess`,
-    :func:`_rivals`, :func:`_calibrated`) re-run on the model with it. Returns the closing
-    checks of the final model."""
+    :func:`_rivals`, :func:`_calibrated`) re-run on the model with it; not run once the
+    search has spent its evaluation budget. Returns the closing checks of the final model."""
     u = checks["unexplained"]
     if not FLAG_ROUTE or u is None or not u.flagged:
+        return checks
+    from .search import _max_evaluations
+
+    # the search's evaluation budget binds the route too: once spent, no candidate is fitted
+    if st.untested or st.used >= _max_evaluations():
         return checks
     from .flag_route import flag_route
 

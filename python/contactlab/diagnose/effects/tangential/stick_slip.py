@@ -34,9 +34,10 @@ def breakaway_term(
     """The branches with the breakaway of docs/effects.md added: after each reversal
     ``r``, ``h + s_b h0 sgn(ẋ) (s/ell) e^(1 - s/ell)`` with ``s = |x - x_r|`` the travel
     since it (``sgn(ẋ) s = x - x_r``): zero at the reversal (no jump), peak ``s_b h0`` at
-    ``s = ell``, gone far from it; none before the first reversal (the first loading from
-    rest). ``anchors``: :func:`reversal_anchors` of ``reversals``, when computed already;
-    ``at``: sample indices, the result at those samples only."""
+    ``s = ell``, gone far from it; before the first reversal (the first loading from rest)
+    the travel is counted from the origin, where the virgin curve starts. ``anchors``:
+    :func:`reversal_anchors` of ``reversals``, when computed already; ``at``: sample
+    indices, the result at those samples only."""
     if s_b == 0.0:
         return h if at is None else h[at]
     has, r = anchors if anchors is not None else reversal_anchors(reversals, h.size)
@@ -44,7 +45,9 @@ def breakaway_term(
     if at is not None:  # the anchors (reversals) from the whole history, the rest at ``at``
         has, r, h, xx = has[at], r[at], h[at], x[at]
     e = max(ell, 1e-300)
-    dx = np.where(has, xx - x[r], 0.0)
+    # the first loading from rest breaks away from the origin, where the virgin curve starts
+    # (static friction holds at rest as after a turn; a record cut mid-loop is far from it)
+    dx = np.where(has, xx - x[r], xx)
     return h + s_b * h0 * (dx / e) * np.exp(1.0 - np.abs(dx) / e)
 
 
