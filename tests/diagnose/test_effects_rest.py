@@ -63,17 +63,16 @@ def test_branch_scale_starts_where_the_data_put_it():
 
 def _doc_breakaway(x, rev, b, dc, h0):
     """docs/effects.md, plain Python: b h0 sgn(ẋ) (s/d_c) e^(1 - s/d_c), s the travel since
-    the last turning point, nothing before the first."""
+    the last turning point; before the first, the travel from the origin (the first loading
+    from rest breaks away as after a turn)."""
     out = []
     last = None
     for i, xi in enumerate(x):
         if last is None or (rev.size and i >= rev[0] and last != rev[rev <= i][-1]):
             last = rev[rev <= i][-1] if rev.size and i >= rev[0] else None
-        if last is None:
-            out.append(0.0)
-            continue
-        s = abs(xi - x[last])
-        sgn = 1.0 if xi >= x[last] else -1.0
+        anchor = 0.0 if last is None else x[last]
+        s = abs(xi - anchor)
+        sgn = 1.0 if xi >= anchor else -1.0
         out.append(b * h0 * sgn * (s / dc) * np.exp(1 - s / dc))
     return np.array(out)
 
