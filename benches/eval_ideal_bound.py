@@ -42,6 +42,12 @@ CONDITIONS = {
     "load_a": ("normal_load", 10000.0, 25.0, 50, 0.019, 0.007, 1.66),
     "load_b": ("normal_load", 10000.0, 17.6, 5, 0.010, 0.014, 0.3),
     "posfric": ("position_friction", 2000.0, 7.1, 50, 0.017, 0.015, 1.2),
+    # issue 29's blind misses of stop 51 (the effects acting through the drive's dynamics)
+    "delay_c": ("channel_delay", 5000.0, 24.3, 20, 0.020, 0.015, 1.75),
+    "load_c": ("normal_load", 10000.0, 6.8, 8, 0.010, 0.009, 2.19),
+    "load_d": ("normal_load", 10000.0, 17.5, 5, 0.009, 0.018, 1.75),
+    # the look-alike of load_c's in-phase loads: a Stribeck term of v_s 0.6-1.2 Aω
+    "stribeck_c": ("stribeck_wide", 10000.0, 6.8, 8, 0.010, 0.009, 2.19),
 }
 LAMBDA = 44.8
 H0, AC = 40.0, 4.0e4
@@ -52,6 +58,8 @@ H0, AC = 40.0, 4.0e4
 X_DRIFT = 0.0
 #: ``--at-bound``: also hide the effect at the clean twin's stated bound (is it honest?)
 AT_BOUND = False
+#: ``--mults``: the multiples of the ideal size the effect is hidden at
+MULTS = (1.0, 2.0)
 
 
 def factors(cond: str, seed: int) -> dict:
@@ -69,7 +77,7 @@ def ideal_size(effect: str, fac: dict, seed: int, rep) -> tuple[float, str | Non
     """The size (the diagnosis's parameter) at which the ideal test's noncentrality is
     :data:`LAMBDA`, and the nearest other candidate projected out."""
     from contactlab.masing import Masing
-    from eval_slow_power import candidate_directions, lam_of, record, ref_size, rig_params
+    from eval_slow_power import RIG_NAME, candidate_directions, lam_of, record, ref_size, rig_params
 
     q0 = record({}, fac, seed, quiet=True)
     x0, F0 = q0.channels["x"], q0.channels["F"]
@@ -81,7 +89,7 @@ def ideal_size(effect: str, fac: dict, seed: int, rep) -> tuple[float, str | Non
     k = np.clip(np.nan_to_num(k, nan=H0 * AC), 0, H0 * AC)
     noise = record({}, fac, seed).truth["chain"]["noise_rms"]
     V = noise["F"] ** 2 + (k * noise["x"]) ** 2
-    others = {c: v for c, v in candidate_directions(rep, q0.t, effect).items()}
+    others = dict(candidate_directions(rep, q0.t, RIG_NAME.get(effect, effect)).items())
     s_ref = ref_size(effect, fac)
     q1 = record({effect: rig_params(effect, s_ref, fac)}, fac, seed, quiet=True)
     delta = (q1.channels["F"] - F0) - (Masing(H0, AC).force(q1.channels["x"]) - m0)
@@ -144,15 +152,16 @@ def run(cond: str, seed: int, hide: bool) -> dict:
     import warnings
 
     import contactlab
-    from eval_slow_power import read, record, rig_params
+    from eval_slow_power import RIG_NAME, read, record, rig_params
 
     warnings.simplefilter("ignore")
-    effect = CONDITIONS[cond][0]
+    bench_effect = CONDITIONS[cond][0]
+    effect = RIG_NAME.get(bench_effect, bench_effect)
     fac = factors(cond, seed)
     t0 = time.process_time()
     rep = contactlab.diagnose(read(record({}, fac, seed)), model="tangential")
     b = {x.effect: x for x in rep.not_detected}.get(effect)
-    need, nearest = ideal_size(effect, fac, seed, rep)
+    need, nearest = ideal_size(bench_effect, fac, seed, rep)
     rules = rep.prepared.extra.get("gain_rules")
     out = {
         "cond": cond, "seed": seed, "effect": effect, "clean_named": rep.effect_names,
@@ -165,12 +174,18 @@ def run(cond: str, seed: int, hide: bool) -> dict:
         "runs": [],
     }  # fmt: skip
     if hide:
-        sizes = [(m, m * need) for m in (1.0, 2.0)]
+        sizes = [(m, m * need) for m in MULTS]
         if AT_BOUND and out["bound"] is not None and not rep.effect_names:
             sizes.append(("bound", out["bound"]))
         for k, (m, size) in enumerate(sizes):
             r = contactlab.diagnose(
-                read(record({effect: rig_params(effect, size, fac)}, fac, seed + 7919 * (k + 1))),
+                read(
+                    record(
+                        {bench_effect: rig_params(bench_effect, size, fac)},
+                        fac,
+                        seed + 7919 * (k + 1),
+                    )
+                ),
                 model="tangential",
             )
             vs = [v for st in r.steps for v in st.candidates if v.name == effect]
@@ -195,7 +210,7 @@ def table(res: list[dict]) -> str:
         runs = {x["mult"]: x for x in r["runs"]}
         cells = [
             "named" if r["effect"] in runs[m]["named"] else f"miss {runs[m]['named']}"
-            for m in (1.0, 2.0) if m in runs
+            for m in MULTS if m in runs
         ] or ["", ""]  # fmt: skip
         if "bound" in runs:
             b = runs["bound"]
@@ -218,6 +233,7 @@ def main(argv=None):
     ap.add_argument("--hide", action="store_true")
     ap.add_argument("--at-bound", action="store_true", help="also hide it at the bound")
     ap.add_argument("--x-drift", type=float, default=0.0, help="±share of A (0.003: rig)")
+    ap.add_argument("--mults", default="1,2", help="multiples of the ideal size (--hide)")
     ap.add_argument("--raw", type=Path, default=None)
     ap.add_argument("--tables-from", type=Path, default=None)
     a = ap.parse_args(argv)
@@ -225,8 +241,9 @@ def main(argv=None):
         print(table(json.loads(a.tables_from.read_text())))
         return
     os.environ.setdefault("CONTACTLAB_DIAGNOSE_THREADS", "1")
-    global X_DRIFT, AT_BOUND
+    global X_DRIFT, AT_BOUND, MULTS
     X_DRIFT, AT_BOUND = a.x_drift, a.at_bound
+    MULTS = tuple(float(v) for v in a.mults.split(","))
     res = []
     for i in range(a.n):
         for c in a.conds.split(","):

@@ -55,6 +55,9 @@ NONCENTRALITY = 44.8
 AT_BOUND = 0.0
 #: diagnose the clean twins only (``--clean-only``: their stated bounds and names)
 CLEAN_ONLY = False
+#: the drive (``--drive``): "shaker" (the rig's electrodynamic shaker), or a stiff actuator
+#: whose sine starts from rest abruptly ("ramp0") or over a ramp of one cycle ("ramp1")
+DRIVE = "shaker"
 
 
 def shaker_figures(seed: int, f: float) -> dict:
@@ -71,10 +74,14 @@ def rig(cond, seed, m, noise=True):
 
     _, fs, f, cyc, xn, Fn, aca, _share = cond
     eff = {"inertia": {"m": m}} if m > 0 else {}
+    drive = (
+        {"ramp_cycles": 0.0, "shaker": shaker_figures(seed, f)}
+        if DRIVE == "shaker"
+        else {"ramp_cycles": float(DRIVE.removeprefix("ramp"))}
+    )
     return rig_recording(
         eff, seed=seed, fs=fs, f=f, cycles=cyc, acA=aca, x_noise=xn if noise else 0.0,
-        F_noise=Fn if noise else 0.0, ramp_cycles=0.0, shaker=shaker_figures(seed, f),
-        bits=None if not noise else 16,
+        F_noise=Fn if noise else 0.0, bits=None if not noise else 16, **drive,
     )  # fmt: skip
 
 
@@ -223,9 +230,14 @@ def main(argv=None):
         "(inertia.HARMONIC_STARTUP_SMOOTHED False)",
     )  # fmt: skip
     ap.add_argument("--clean-only", action="store_true", help="diagnose the clean twins only")
+    ap.add_argument(
+        "--drive", default="shaker",
+        help="shaker (default), or a stiff actuator's sine from rest: ramp0 (abrupt), "
+        "ramp1 (a ramp of one cycle)",
+    )  # fmt: skip
     a = ap.parse_args(argv)
-    global AT_BOUND, CLEAN_ONLY
-    AT_BOUND, CLEAN_ONLY = a.at_bound, a.clean_only
+    global AT_BOUND, CLEAN_ONLY, DRIVE
+    AT_BOUND, CLEAN_ONLY, DRIVE = a.at_bound, a.clean_only, a.drive
     if a.startup_local:
         from contactlab.diagnose.effects.tangential import inertia as _inertia
 

@@ -53,7 +53,7 @@ EFFECTS = (
 )
 #: the rig's (and the diagnosis's) name of a bench effect: ``normal_load_beat`` is a normal
 #: load off the drive's harmonics (2f plus three beats over the record)
-RIG_NAME = {"normal_load_beat": "normal_load"}
+RIG_NAME = {"normal_load_beat": "normal_load", "stribeck_wide": "stribeck"}
 #: the λ a criterion like the blind judge's needs (3 % false alarm, 95 % power, one fold
 #: of two held out)
 LAMBDA = 44.8
@@ -93,6 +93,10 @@ def rig_params(effect: str, size: float, fac: dict) -> dict:
         "non_masing_scaling": {"lam": 2.0 - size},
         "normal_load": {"eps": size, "f_n": 2.0 * fac["f"], "phi": fac["phi"]},
         "normal_load_beat": {"eps": size, "f_n": 2.0 * fac["f"] + 3.0 / T_rec, "phi": fac["phi"]},
+        "channel_delay": {"tau": size},
+        # a Stribeck term whose v_s is 0.6-1.2 Aω: at one amplitude nearly a parabola in
+        # the speed, the look-alike of a 2f load in phase with the stroke
+        "stribeck_wide": {"s": size, "v_s": 1.2 * fac["L_frac"] * A * 2 * math.pi * fac["f"]},
     }[effect]
 
 
@@ -110,6 +114,8 @@ def ref_size(effect: str, fac: dict) -> float:
         "non_masing_scaling": 0.1,
         "normal_load": 0.03,
         "normal_load_beat": 0.03,
+        "channel_delay": 0.01 / fac["f"],
+        "stribeck_wide": 0.05,
     }[effect]
 
 

@@ -1420,6 +1420,11 @@ def _yield_to_lookalikes(
                 out[v.name] = why
         return out
 
+    # (the accepted candidates' fitted parameters, for a hook that asks what its rival
+    # shows: a 2f load yields to a Stribeck term only where that term has a low-speed
+    # excess of its own, ``NormalLoad.yields_to``)
+    if d is not None:
+        d.extra["step_accepted_params"] = {v.name: dict(c.full.params) for v, c in accepted}
     # an effect yields only to a rival that stands: those that yield are judged again
     # against the others (a 2f load yields to a Stribeck term, which may itself yield to a
     # series compliance: the load then stands)
