@@ -52,11 +52,6 @@ __all__ = [
 MASS_NULL_DRAWS = 24
 #: the one-sided false-alarm rate of the test (a new draw from the null's normal)
 MASS_NULL_ALPHA = 0.01
-#: whether the size is read over the samples the search judges only (a held-out unit,
-#: :func:`contactlab.diagnose.select.heldout_unit` at least 0: not the start-up's first
-#: samples, where ẍ is read from one side of a window at the record's first sample, nor the
-#: incomplete last cycle). False: every sample (kept for comparison in benches)
-JUDGED_SAMPLES = True
 
 
 @dataclasses.dataclass(frozen=True)
@@ -156,7 +151,7 @@ def linear_term_null(
         denoised_input,
         output_noise_shape,
     )
-    from .select import heldout_unit, sample_weight
+    from .select import sample_weight
 
     su = float(d.extra.get("u_noise", 0.0) or 0.0)
     wlen = int(d.extra.get("u_filter", 0))
@@ -191,10 +186,6 @@ def linear_term_null(
         J = _jacobian(family, base, effects, d)
         w = np.asarray(sample_weight(d), float)
         use = np.isfinite(d.y) & (w > 0) & np.isfinite(g) & np.isfinite(fitted)
-        if JUDGED_SAMPLES:
-            judged = use & (heldout_unit(d) >= 0)
-            if int(judged.sum()) >= max(16, use.sum() // 4):
-                use = judged
         sw = np.sqrt(w[use])
         Q = None
         if J is not None:

@@ -11,7 +11,6 @@ import numpy as np
 from ..._family import ParamSpec
 from .._base import EffectModel, Plausibility, register
 from ._common import (
-    SIGNAL_FRACTION,
     amplitude,
     fastest_period,
     fixed,
@@ -142,68 +141,6 @@ def mass_acceleration(d) -> np.ndarray:
     return fixed(d, "mass_acceleration", make)
 
 
-#: whether on a record from rest the mass's ``ẍ`` on a single-frequency drive is read
-#: with the input held at its rest value before the first sample
-#: (:func:`rest_padded_acceleration`; False: the local cubic's one-sided edge at the first
-#: sample, kept for comparison in benches)
-REST_PADDED = True
-
-
-def rest_padded_acceleration(d) -> np.ndarray | None:
-    """``ẍ`` as :func:`~._common.smoothed_acceleration` reads it, with the measured input
-    (``d.extra["u_raw"]``) held at its rest value before its first sample (a straight line
-    through its first samples, read at the first, as
-    :func:`contactlab.diagnose.select.startup_mask` reads a start from rest), kept per
-    record; None where the record does not start from rest (``startup_mask`` empty), was
-    kept at a lower rate or carries no raw input.
-
-    Why: at the record's first sample the local cubics read ``ẍ`` from one side of their
-    windows, and on a record from rest that edge is far off the drive's: on the rig's sine
-    ramped up over one cycle (5 kHz, 23.9 Hz, 8 cycles, ac·A 0.83, x noise 1.4 %; seed
-    52401002 of ``benches/eval_inertia_shaker.py --drive ramp1``) the mass's direction,
-    off the base's Jacobian, held 5.5 (weighted, per kg²) over the start-up before the
-    first maximum against 0.17 through the noise-free drive, more than all the cycles
-    after it; a mass's fit, which must not predict that force, shrank to nothing (a 4.2
-    kg mass at twice the ideal test's size: in-sample gain -1e-8 σ²). A contact from rest
-    was at rest before the record: held there, the windows read two-sided, and the start's
-    own acceleration (a drive switched on abruptly jumps its speed from 0 within a few
-    samples) is read as what it is."""
-
-    def make() -> np.ndarray | None:
-        from ...select import startup_mask
-
-        u = d.extra.get("u_raw")
-        if "raw_input" in d.extra or u is None or np.shape(u) != np.shape(d.u):
-            return None
-        if not startup_mask(d).any():
-            return None
-        from ...._filters import savgol_filter
-        from ..._signal import derivatives, smooth_window
-
-        u = np.asarray(u, float)
-        per = float(d.cycles.period_samples)
-        k = max(3, min(10, int(0.02 * per)))
-        rest = float(np.polyfit(np.arange(k, dtype=float), u[:k], 1)[1])
-        noisy = float(d.extra.get("u_noise", 0.0) or 0.0) > 0.0
-        w = smooth_window(fastest_period(d), SIGNAL_FRACTION, 7)
-        h = int(w + d.window)
-        up = np.concatenate([np.full(h, rest), u])
-        _, udd = derivatives(up, d.dt, d.window)
-        if noisy and w >= 5:
-            udd = savgol_filter(udd, min(w, up.size - (1 - up.size % 2)), 3, mode="interp")
-        return np.asarray(udd[h:], float)
-
-    return fixed(d, "mass_rest_padded_acceleration", make)
-
-
-def _single_local(d) -> np.ndarray:
-    """The local ``ẍ`` of a single-frequency drive: :func:`rest_padded_acceleration` on a
-    record from rest (:data:`REST_PADDED`), :func:`~._common.smoothed_acceleration`
-    otherwise."""
-    acc = rest_padded_acceleration(d) if REST_PADDED else None
-    return smoothed_acceleration(d) if acc is None else acc
-
-
 def _mass_acc(d) -> np.ndarray:
     """The ``ẍ`` the mass reads: :func:`mass_acceleration` on a drive of more than one
     frequency; on a single-frequency drive (:func:`single_frequency`) the older
@@ -221,7 +158,7 @@ def _mass_acc(d) -> np.ndarray:
     if not MASS_GAP:
         return smoothed_acceleration(d)
     one = fixed(d, "mass_single_frequency", lambda: single_frequency(d) is not None)
-    local = _single_local(d) if one else mass_acceleration(d)
+    local = smoothed_acceleration(d) if one else mass_acceleration(d)
     if not MASS_HARMONIC or d.extra.get("signal_derivatives") or d.extra.get("mass_local"):
         # (``mass_local``: the record's own simulated null, calibrated on the local ẍ)
         return local
@@ -233,7 +170,7 @@ def _mass_acc(d) -> np.ndarray:
     # ``benches/eval_inertia_shaker.py``, seed 21, a 0.761 kg mass: 92 % and 68 % off the
     # noise-free ẍ in cycles 0 and 1, the mass read 0.085 kg at 0.012 σ² of in-sample
     # gain; with the cubic there 0.704 kg at 1.62 σ²)
-    start = _single_local(d) if HARMONIC_STARTUP_SMOOTHED else local
+    start = smoothed_acceleration(d) if HARMONIC_STARTUP_SMOOTHED else local
     acc = fixed(d, "mass_harmonic_acceleration", lambda: harmonic_acceleration(d, start))
     return local if acc is None else acc
 
