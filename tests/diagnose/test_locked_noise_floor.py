@@ -130,23 +130,19 @@ def test_an_effect_named_only_by_the_lowered_floor_is_marked_for_a_flagged_recor
     assert _locked_on_misfit(SimpleNamespace(added=["series_compliance"]), d, flagged) is None
 
 
-#: effects that are functions of the measured position, of the travel since a reversal or
-#: of the smoothed speed: none changes how the element passes the input's noise (stop 52)
-LOCKED_ALSO = (
-    ("parallel_stiffness", {"k_p": 2.0e4}),
-    ("stribeck", {"s": 0.05, "v_s": 0.01}),
-    ("stick_slip", {"s_b": 0.05, "ell": 2.0e-5}),
-    ("displacement_offset", {"x0": 1.0e-6}),
-)
+#: effects that are functions of the measured position: neither changes how the element
+#: passes the input's noise (stop 52; a Stribeck term, a breakaway and an offset were tried
+#: and left at their quarter of the budget: named only by the lower floor, they were
+#: withdrawn on the rig's flagged 50-cycle records and their stated bounds claimed what
+#: the search then did not name)
+LOCKED_ALSO = (("parallel_stiffness", {"k_p": 2.0e4}),)
 
 
 @pytest.mark.parametrize(("name", "extra"), LOCKED_ALSO, ids=[n for n, _ in LOCKED_ALSO])
-def test_position_and_speed_terms_beat_only_the_locked_bias(name, extra) -> None:
-    """A spring, a Stribeck term, a breakaway and an offset of the position are held to the
-    smaller of their share of the budget and the noise bias along their own direction (on
-    50-cycle records a quarter of the budget, or all of it for the spring, hid them at twice
-    the ideal test's size: ``benches/eval_ideal_bound.py --conds spring_long,stribeck_long,
-    stick_long``)."""
+def test_position_terms_beat_only_the_locked_bias(name, extra) -> None:
+    """A spring is held to the smaller of its share of the budget and the noise bias along
+    its own direction (on 50-cycle records the whole budget hid it at twice the ideal test's
+    size: ``benches/eval_ideal_bound.py --conds spring_long``)."""
     from contactlab.diagnose.search import _noise_part
 
     fam, d, _ = _record()
@@ -175,3 +171,18 @@ def test_the_spring_is_held_to_a_fifth_of_min_gain() -> None:
     fam = TangentialFamily()
     assert own_gain_floor(fam, ("parallel_stiffness",), 0.05) == pytest.approx(0.01)
     assert own_gain_floor(fam, ("channel_delay",), 0.05) == pytest.approx(0.05)
+
+
+def test_the_springs_bound_projects_out_a_stribeck_term() -> None:
+    """The spring's stated bound takes out what a Stribeck term would take of its direction
+    (stop 52: on 50-cycle rig records at ac·A 4.15 a Stribeck term out-gained springs of 2-3
+    times the ideal size and was named in their place, under a bound of 1.2 times the ideal
+    size that left it in)."""
+    from contactlab.diagnose import power
+
+    fam, d, _ = _record()
+    p0 = {**fam.initial_base(d), "k_p": 0.0}
+    scales = fam.scales(d)
+    got = power._rival_directions(fam, p0, ("parallel_stiffness",), "parallel_stiffness", d, scales)
+    load = [q for q in fam.candidates["normal_load"].params if np.isfinite(q.null)]
+    assert len(got) == len(load) + 1  # normal_load's magnitudes and stribeck's s

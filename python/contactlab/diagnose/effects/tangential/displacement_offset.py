@@ -54,12 +54,6 @@ class DisplacementOffset(EffectModel):
     #: was not named
     proportional_gain = True
     input_noise_share = INPUT_NOISE_SHARE
-    #: a constant added to the measured position, it cannot filter the input: of the
-    #: input's noise it can take only the bias locked to the cycle, which the record's own
-    #: simulation measures (``search.locked_noise_gain``; stop 52: on 50-cycle records a
-    #: quarter of the budget was 3-4 times the held-out gain of an offset the ideal test
-    #: sees, 0.016-0.022 σ² against floors of 0.063-0.065 σ²)
-    input_noise_locked = True
     #: the share of the search's ``min_gain`` its gain must reach (search.own_gain_floor)
     gain_floor_scale = GAIN_FLOOR_SCALE
 

@@ -287,13 +287,6 @@ class StickSlip(EffectModel):
     #: per-effect floors (see GAIN_FLOOR_SCALE, INPUT_NOISE_SHARE above)
     gain_floor_scale = GAIN_FLOOR_SCALE
     input_noise_share = INPUT_NOISE_SHARE
-    #: a function of the travel since each reversal, it cannot filter the input: of the
-    #: input's noise it can take only the bias locked to the cycle, which the record's own
-    #: simulation measures (``search.locked_noise_gain``; stop 52: a breakaway at twice the
-    #: ideal test's size on a 50-cycle record, ``benches/eval_ideal_bound.py --conds
-    #: stick_long`` tuning seed 52300000, gained 0.067 σ² against a floor of 0.102 σ², a
-    #: quarter of the budget)
-    input_noise_locked = True
 
     def start(self, p, d, residual, family=None):
         """The slip distance (of :data:`START_SHARES` of the amplitude) and size whose term

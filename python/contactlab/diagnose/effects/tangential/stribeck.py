@@ -66,13 +66,6 @@ class Stribeck(EffectModel):
     #: per-effect floors (see GAIN_FLOOR_SCALE, INPUT_NOISE_SHARE above)
     gain_floor_scale = GAIN_FLOOR_SCALE
     input_noise_share = INPUT_NOISE_SHARE
-    #: a term of the smoothed input's speed, it does not change how the element passes the
-    #: input's noise: of that noise it can take only the bias locked to the cycle, which
-    #: the record's own simulation measures (``search.locked_noise_gain``; stop 52: a term
-    #: at twice the ideal test's size on a 50-cycle record, ``benches/eval_ideal_bound.py
-    #: --conds stribeck_long`` tuning seed 52300000, gained 0.047 σ² against a floor of
-    #: 0.081 σ², a quarter of the budget, and a track's wave was named on its lower floor)
-    input_noise_locked = True
 
     def start(self, p, d, residual, family=None):
         return {"v_s": float(np.sqrt(np.mean(d.ud**2)))}
