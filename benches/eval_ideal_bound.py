@@ -45,6 +45,7 @@ CONDITIONS = {
     # stop 52: the blind generator's misses on long records, and the same at 5 cycles
     "spring_long": ("parallel_stiffness", 2000.0, 15.4, 50, 0.019, 0.017, 4.15),
     "spring_short": ("parallel_stiffness", 2000.0, 15.4, 5, 0.019, 0.017, 4.15),
+    "spring_mid": ("parallel_stiffness", 2000.0, 15.4, 50, 0.019, 0.017, 2.0),
     "stribeck_long": ("stribeck", 2000.0, 5.7, 50, 0.013, 0.009, 0.80),
     "stribeck_short": ("stribeck", 2000.0, 5.7, 5, 0.013, 0.009, 0.80),
     "stick_long": ("stick_slip", 2000.0, 19.6, 50, 0.020, 0.019, 1.05),

@@ -130,49 +130,6 @@ def test_an_effect_named_only_by_the_lowered_floor_is_marked_for_a_flagged_recor
     assert _locked_on_misfit(SimpleNamespace(added=["series_compliance"]), d, flagged) is None
 
 
-#: effects that are functions of the measured position: neither changes how the element
-#: passes the input's noise (stop 52; a Stribeck term, a breakaway and an offset were tried
-#: and left at their quarter of the budget: named only by the lower floor, they were
-#: withdrawn on the rig's flagged 50-cycle records and their stated bounds claimed what
-#: the search then did not name)
-LOCKED_ALSO = (("parallel_stiffness", {"k_p": 2.0e4}),)
-
-
-@pytest.mark.parametrize(("name", "extra"), LOCKED_ALSO, ids=[n for n, _ in LOCKED_ALSO])
-def test_position_terms_beat_only_the_locked_bias(name, extra) -> None:
-    """A spring is held to the smaller of its share of the budget and the noise bias along
-    its own direction (on 50-cycle records the whole budget hid it at twice the ideal test's
-    size: ``benches/eval_ideal_bound.py --conds spring_long``)."""
-    from contactlab.diagnose.search import _noise_part
-
-    fam, d, _ = _record()
-    eff = registry("tangential")[name]
-    assert eff.input_noise_locked
-    names = (name,)
-    q = {**fam.initial_base(d), **extra}
-    budget = 0.4
-    share = budget * float(getattr(eff, "input_noise_share", 1.0))
-    # a tiny bias along the direction: the floor falls to it, far below the share
-    d.extra.pop(LOCKED_STATE, None)
-    n = d.y.size
-    _state(d, np.zeros(n), np.zeros(n))
-    got = _noise_floor(fam, names, budget, d, q, names)
-    assert got == pytest.approx(0.0, abs=1e-12)
-    assert _noise_part(eff, budget, None) == pytest.approx(share)
-    assert got < 0.01 * share
-
-
-def test_the_spring_is_held_to_a_fifth_of_min_gain() -> None:
-    """A spring's own gain floor is a fifth of ``min_gain``, as a Stribeck term's (stop 52: the
-    whole 0.05 σ² per sample asked a spring on a 50-cycle record far more than significance;
-    its clean records' largest held-out gain with every floor off was 0.0015 σ²)."""
-    from contactlab.diagnose.search import own_gain_floor
-
-    fam = TangentialFamily()
-    assert own_gain_floor(fam, ("parallel_stiffness",), 0.05) == pytest.approx(0.01)
-    assert own_gain_floor(fam, ("channel_delay",), 0.05) == pytest.approx(0.05)
-
-
 def test_the_springs_bound_projects_out_a_stribeck_term() -> None:
     """The spring's stated bound takes out what a Stribeck term would take of its direction
     (stop 52: on 50-cycle rig records at ac·A 4.15 a Stribeck term out-gained springs of 2-3
