@@ -48,6 +48,16 @@ CONDITIONS = {
     "load_d": ("normal_load", 10000.0, 17.5, 5, 0.009, 0.018, 1.75),
     # the look-alike of load_c's in-phase loads: a Stribeck term of v_s 0.6-1.2 Aω
     "stribeck_c": ("stribeck_wide", 10000.0, 6.8, 8, 0.010, 0.009, 2.19),
+    # stop 52: the blind generator's misses on long records, and the same at 5 cycles
+    "spring_long": ("parallel_stiffness", 2000.0, 15.4, 50, 0.019, 0.017, 4.15),
+    "spring_short": ("parallel_stiffness", 2000.0, 15.4, 5, 0.019, 0.017, 4.15),
+    "spring_mid": ("parallel_stiffness", 2000.0, 15.4, 50, 0.019, 0.017, 2.0),
+    "stribeck_long": ("stribeck", 2000.0, 5.7, 50, 0.013, 0.009, 0.80),
+    "stribeck_short": ("stribeck", 2000.0, 5.7, 5, 0.013, 0.009, 0.80),
+    "stick_long": ("stick_slip", 2000.0, 19.6, 50, 0.020, 0.019, 1.05),
+    "stick_short": ("stick_slip", 2000.0, 19.6, 5, 0.020, 0.019, 1.05),
+    "pdrift_long": ("parameter_drift", 10000.0, 25.3, 50, 0.016, 0.019, 3.60),
+    "pdrift_short": ("parameter_drift", 10000.0, 25.3, 5, 0.016, 0.019, 3.60),
 }
 LAMBDA = 44.8
 H0, AC = 40.0, 4.0e4
@@ -60,6 +70,27 @@ X_DRIFT = 0.0
 AT_BOUND = False
 #: ``--mults``: the multiples of the ideal size the effect is hidden at
 MULTS = (1.0, 2.0)
+
+
+def _rig_params(effect: str, size: float, fac: dict) -> dict:
+    """eval_slow_power's rig parameters, plus the effects it has none for."""
+    from eval_slow_power import rig_params
+
+    if effect == "parallel_stiffness":
+        return {"k_p": size}
+    if effect == "stick_slip":
+        return {"b": size, "d_c": 0.25 * fac["acA"] / AC}
+    return rig_params(effect, size, fac)
+
+
+def _ref_size(effect: str, fac: dict) -> float:
+    from eval_slow_power import ref_size
+
+    if effect == "parallel_stiffness":
+        return 0.05 * H0 / (fac["acA"] / AC)
+    if effect == "stick_slip":
+        return 0.05
+    return ref_size(effect, fac)
 
 
 def factors(cond: str, seed: int) -> dict:
@@ -77,7 +108,7 @@ def ideal_size(effect: str, fac: dict, seed: int, rep) -> tuple[float, str | Non
     """The size (the diagnosis's parameter) at which the ideal test's noncentrality is
     :data:`LAMBDA`, and the nearest other candidate projected out."""
     from contactlab.masing import Masing
-    from eval_slow_power import RIG_NAME, candidate_directions, lam_of, record, ref_size, rig_params
+    from eval_slow_power import RIG_NAME, candidate_directions, lam_of, record
 
     q0 = record({}, fac, seed, quiet=True)
     x0, F0 = q0.channels["x"], q0.channels["F"]
@@ -90,8 +121,8 @@ def ideal_size(effect: str, fac: dict, seed: int, rep) -> tuple[float, str | Non
     noise = record({}, fac, seed).truth["chain"]["noise_rms"]
     V = noise["F"] ** 2 + (k * noise["x"]) ** 2
     others = dict(candidate_directions(rep, q0.t, RIG_NAME.get(effect, effect)).items())
-    s_ref = ref_size(effect, fac)
-    q1 = record({effect: rig_params(effect, s_ref, fac)}, fac, seed, quiet=True)
+    s_ref = _ref_size(effect, fac)
+    q1 = record({effect: _rig_params(effect, s_ref, fac)}, fac, seed, quiet=True)
     delta = (q1.channels["F"] - F0) - (Masing(H0, AC).force(q1.channels["x"]) - m0)
     _, lam, nearest = lam_of(delta, base, others, V)
     return (s_ref * math.sqrt(LAMBDA / lam) if lam > 0 else math.inf), nearest
@@ -152,7 +183,7 @@ def run(cond: str, seed: int, hide: bool) -> dict:
     import warnings
 
     import contactlab
-    from eval_slow_power import RIG_NAME, read, record, rig_params
+    from eval_slow_power import RIG_NAME, read, record
 
     warnings.simplefilter("ignore")
     bench_effect = CONDITIONS[cond][0]
@@ -181,7 +212,7 @@ def run(cond: str, seed: int, hide: bool) -> dict:
             r = contactlab.diagnose(
                 read(
                     record(
-                        {bench_effect: rig_params(bench_effect, size, fac)},
+                        {bench_effect: _rig_params(bench_effect, size, fac)},
                         fac,
                         seed + 7919 * (k + 1),
                     )

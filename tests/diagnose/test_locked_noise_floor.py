@@ -128,3 +128,18 @@ def test_an_effect_named_only_by_the_lowered_floor_is_marked_for_a_flagged_recor
     assert _locked_on_misfit(st, d, quiet) is None
     assert _locked_on_misfit(st, d, {"unexplained": None}) is None
     assert _locked_on_misfit(SimpleNamespace(added=["series_compliance"]), d, flagged) is None
+
+
+def test_the_springs_bound_projects_out_a_stribeck_term() -> None:
+    """The spring's stated bound takes out what a Stribeck term would take of its direction
+    (stop 52: on 50-cycle rig records at ac·A 4.15 a Stribeck term out-gained springs of 2-3
+    times the ideal size and was named in their place, under a bound of 1.2 times the ideal
+    size that left it in)."""
+    from contactlab.diagnose import power
+
+    fam, d, _ = _record()
+    p0 = {**fam.initial_base(d), "k_p": 0.0}
+    scales = fam.scales(d)
+    got = power._rival_directions(fam, p0, ("parallel_stiffness",), "parallel_stiffness", d, scales)
+    load = [q for q in fam.candidates["normal_load"].params if np.isfinite(q.null)]
+    assert len(got) == len(load) + 1  # normal_load's magnitudes and stribeck's s

@@ -57,7 +57,13 @@ class ParallelStiffness(EffectModel):
     #: strokes alike, a function of x that k_p x takes most of (docs/effects.md; a spring of
     #: k_p A = 0.28 h_m was named normal_load: rig, ``benches/eval_lookalike.py`` tuning
     #: seed 52000)
-    rivals = ("normal_load",)
+    #: and a Stribeck term (stop 52): on 50-cycle rig records at ac·A 4.15 (2 kHz, 15.4 Hz,
+    #: x noise 1.9 % of the range; ``benches/eval_ideal_bound.py --conds spring_long``,
+    #: seeds 52300000 and 52350000) a term on the smoothed speed near the turns took 1.3
+    #: times a spring's held-out gain at 2-3 times the ideal size and was named in its place
+    #: (the spring on the raw x pays k_p² σx² of the sensor's noise); with it projected out
+    #: the bound there is 6.4-6.6 times the ideal size (5.4-5.5 without), at 5 cycles 4.3 (3.3)
+    rivals = ("normal_load", "stribeck")
 
     #: the spring's k_p x on the input smoothed over a share of the period
     #: (:func:`~._common.smoothed_displacement`), not on the sample itself: the spring
