@@ -164,14 +164,16 @@ def test_a_loss_asymmetry_on_one_tone_gets_a_bound_within_its_range():
 
 def test_a_bound_beyond_the_range_says_where_it_lies():
     """A loss asymmetry on a short one-tone record (the package generator, 15 cycles of 40
-    samples from rest, 1.5 % noise on both channels; seed 49310002 of
+    samples from rest, 2 % noise on both channels; seed 49310002 of
     ``benches/eval_normal_bound_package.py``): the linearised bound lies beyond |a| < 0.95,
     so no bound is stated and the reason gives the number, what absorbs the direction and
-    the power at the range's end, instead of a bare "not detectable"."""
+    the power at the range's end, instead of a bare "not detectable" (at the seed's own
+    1.5 % the bound has lain just inside the range, 0.92, since stop 52's rival margin on
+    the search's scale)."""
     from contactlab.synthetic.diagnosis import hidden_effect_recording
 
-    r = hidden_effect_recording([], model="normal", seed=49310002, noise=0.01505301076446185,
-                                input_noise=0.01505301076446185, cycles_per_block=15,
+    r = hidden_effect_recording([], model="normal", seed=49310002, noise=0.02,
+                                input_noise=0.02, cycles_per_block=15,
                                 samples_per_cycle=40, start="rest", frequencies=[1.0])  # fmt: skip
     ch = r.channels if isinstance(getattr(r, "channels", None), dict) else r.data
     rep = contactlab.diagnose({"t": r.t, "p": ch["p"], "delta": ch["delta"]}, model="normal")

@@ -91,13 +91,15 @@ def _chain_clean(seed: int):
 def test_asymmetry_bound_on_a_single_tone_chain() -> None:
     """Clean chain (fresh seed 49300001 of ``benches/eval_normal_asym_creep.py``'s recipe):
     the asymmetry must pass the rules on its own direction and fit better than the law by
-    SHAPE_Z deviations of the comparison's noise. The base and the law take 98 % of its
-    direction here, and at the range's end (|a| 0.95) it would be found with a probability
-    between a half and 95 %: no bound within the range, and the reason says so in numbers
-    (stop 49 without the margin: a bound of 0.36-0.91 on such chains, where a = -0.3
-    was named in 1 of 10 and the law in place of the asymmetry as often)."""
-    import re
-
+    SHAPE_Z deviations of the comparison's white-noise scale (as the search's
+    ``shape_test`` asks), its noise widened by the residual's correlation. The base and the
+    law take 98 % of its direction here; the bound lies near the range's end (0.83 since
+    stop 52; until then none within the range, the margin widened by the correlation
+    too). It is in the fitted ``a``, relative to the fitted damping: the chain's sensors
+    lag like a damping (fitted ψ 0.60 for 0.163), so a true a = 0.83 is fitted as 0.24
+    (chain seed 52100301) and was named exactly on 7 of 12 fresh chains (52100300-311;
+    stiffness_nonlinearity on 2, neither on 3, flagged): far below the bound, where no
+    promise is made (stop 49 without any margin: 0.36-0.91)."""
     import contactlab
 
     with warnings.catch_warnings():
@@ -105,11 +107,8 @@ def test_asymmetry_bound_on_a_single_tone_chain() -> None:
         res = contactlab.diagnose(_chain_clean(49300001), "normal")
     assert res.effect_names == []
     b = {x.effect: x for x in res.not_detected}["asymmetric_branches"]
-    assert b.detectable_above is None
-    assert "beyond the parameter's range" in b.reason
-    m = re.search(r"found with probability ([0-9.]+)", b.reason)
-    assert m is not None, b.reason
-    assert 0.5 < float(m.group(1)) < 0.95
+    assert b.detectable_above is not None
+    assert 0.6 < b.detectable_above < 0.95
     assert "one excitation frequency" in b.note
 
 
@@ -136,3 +135,24 @@ def test_bound_models_the_large_gain_route() -> None:
     # a floor the gains at the bound do not reach twice: the route changes nothing
     high = _bound(jp, st, strong=(1e6, 2.0))
     assert high == pytest.approx(at_z, rel=1e-9)
+
+
+@pytest.mark.parametrize("infl", [1.0, 1.7])
+def test_rival_margin_is_on_the_searchs_scale(infl: float) -> None:
+    """The search's shape test divides the likelihood ratio by its white-noise deviation
+    (``shape_test``: ``2 ‖f_s - f_a‖_w / σ``) and asks ``SHAPE_Z`` of it; a residual
+    correlated by the smoothed input's noise (``se_inflation`` c) widens the ratio's noise,
+    not that margin: the candidate wins with probability Φ((|a| √λ / 2 - z) / c) (until
+    stop 52 Φ(|a| √λ / (2c) - z): the shapes' bounds 1.9-2.0 times the ideal size on short
+    one-tone records where the law was named at 1x it on 10 of 10)."""
+    import dataclasses
+
+    st = dataclasses.replace(_setting(), se_inflation=infl)
+    lam = 53.0
+    jr = np.zeros(st.w.size)
+    jr[::2] = np.sqrt(lam / (st.w.size // 2))
+    rows = np.ones(st.w.size, bool)
+    a = np.full(DRAWS, 1.0)
+    won = float(np.mean(_rival_wins(a, jr, rows, st, 2.0)))
+    want = float(norm.cdf((np.sqrt(lam) / 2.0 - 2.0) / infl))
+    assert won == pytest.approx(want, abs=3.0 * np.sqrt(want * (1 - want) / DRAWS) + 0.01)
