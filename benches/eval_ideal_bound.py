@@ -42,6 +42,10 @@ CONDITIONS = {
     "load_a": ("normal_load", 10000.0, 25.0, 50, 0.019, 0.007, 1.66),
     "load_b": ("normal_load", 10000.0, 17.6, 5, 0.010, 0.014, 0.3),
     "posfric": ("position_friction", 2000.0, 7.1, 50, 0.017, 0.015, 1.2),
+    # the blind generator's misses of stop 51 (its noise is SD / range: twice that of the
+    # amplitude, the rig's share, here)
+    "posfric_c": ("position_friction", 5000.0, 19.4, 35, 0.016, 0.022, 1.94),
+    "posfric_d": ("position_friction", 2000.0, 10.7, 35, 0.030, 0.038, 1.57),
 }
 LAMBDA = 44.8
 H0, AC = 40.0, 4.0e4
