@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import os
 import sys
 import tempfile
@@ -63,7 +62,7 @@ def pkg(seed: int, fac: dict, wave: tuple[float, float, float] | None = None):
     rng = np.random.default_rng([seed, 77])
     fs, f, cyc = fac["fs"], fac["f"], fac["cycles"]
     A = fac["acA"] / AC
-    t = np.arange(int(round((cyc + 1.25) * fs / f)) + 1) / fs
+    t = np.arange(round((cyc + 1.25) * fs / f) + 1) / fs
     ramp = np.where(t < 1 / f, 0.5 * (1 - np.cos(np.pi * t * f)), 1.0)
     x = A * ramp * np.sin(2 * np.pi * f * t)
     F = Masing(H0, AC).force(x)
@@ -92,11 +91,15 @@ def one(gen: str, seed: int, fac: dict) -> dict:
     ex = rep.prepared.extra
     b = {x.effect: x for x in rep.not_detected}.get("position_friction")
     return {
-        "gen": gen, "seed": seed, **fac, "named": list(rep.effect_names),
+        "gen": gen,
+        "seed": seed,
+        **fac,
+        "named": list(rep.effect_names),
         "flagged": bool(un is not None and un.flagged),
         "budget": ex.get("input_noise_budget"),
         "locked_only": {k: float(v) for k, v in (ex.get(search.LOCKED_ONLY) or {}).items()},
-        "bound": None if b is None else b.detectable_above, "pf": pf,
+        "bound": None if b is None else b.detectable_above,
+        "pf": pf,
         "cpu": round(time.process_time() - t0, 1),
     }
 

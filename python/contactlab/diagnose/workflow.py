@@ -743,19 +743,47 @@ def _signature(family: Family, name: str, d: Prepared) -> str | None:
 
 def _signature_at(b: _Base, d: Prepared, st: SearchState, name: str) -> str | None:
     """The evidence for the named effect ``name`` that its fitted parameters show beyond
-    the shapes it is withdrawn for (the effect's ``signature_at(d, params, effects,
-    family, sigma, z)``: a track's wave's part that no virgin curve draws), or None."""
-    from .effects import registry
-
-    eff = registry(b.family.kind).get(name) if b.family.kind == "tangential" else None
-    hook = getattr(eff, "signature_at", None)
-    if hook is None:
-        return None
+    any virgin curve (:func:`signature_beyond_virgin` at the final model), or None."""
     try:
-        return hook(d, dict(st.current.full.params), tuple(st.current.effects), b.family,
-                    b.sigma, SIGNATURE_Z)  # fmt: skip
+        return signature_beyond_virgin(
+            b.family, name, d, dict(st.current.full.params), tuple(st.current.effects)
+        )
     except (ConvergenceError, InputError, ValueError, ArithmeticError, np.linalg.LinAlgError):
         return None
+
+
+def signature_beyond_virgin(
+    family: Family,
+    name: str,
+    d: Prepared,
+    params: dict[str, float],
+    effects: tuple[str, ...],
+    z: float | None = None,
+) -> str | None:
+    """Why the effect ``name`` of the model ``(params, effects)`` is no patch over a virgin
+    curve of another shape, or None: the effect's ``signature_parts`` (the residual without
+    it, its direction) tested by :func:`.misfit.beyond_virgin`, its held-out gain beyond a
+    free-form virgin curve across cycles at t > ``z`` (:data:`SIGNATURE_Z`). None for an
+    effect without ``signature_parts`` (issue 29, stop 52: a track's wave)."""
+    from .effects import registry
+    from .misfit import beyond_virgin
+
+    z = SIGNATURE_Z if z is None else z
+    eff = registry(family.kind).get(name) if family.kind == "tangential" else None
+    hook = getattr(eff, "signature_parts", None)
+    if hook is None or "ac" not in params or not np.isfinite(z):
+        return None
+    parts = hook(d, params, effects, family)
+    if parts is None:
+        return None
+    res = beyond_virgin(d, parts[0], parts[1], float(params["ac"]))
+    if res is None or not (res["t"] > z and res["gain"] > 0):
+        return None
+    return (
+        f"a free-form virgin curve does not draw it: its part odd about the stroke's "
+        f"middle gains across held-out cycles beyond one (t = {res['t']:.1f} over "
+        f"{res['cycles']} cycles)"
+    )
 
 
 #: the held-out t across cycles an effect's evidence beyond the shapes it is withdrawn for

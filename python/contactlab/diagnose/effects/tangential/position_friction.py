@@ -184,24 +184,20 @@ class PositionFriction(EffectModel):
                 top_cv, pick = cv, entry
         return pick if pick is not None else best
 
-    def signature_at(self, d, p, effects, family, sigma, z):
-        """The wave's evidence beyond any virgin curve, or None (read by the closing
-        checks before the wave is withdrawn as an absorber of a virgin curve of another
-        shape: ``workflow._signature_at``).
+    def signature_parts(self, d, p, effects, family):
+        """The residual of the model ``(p, effects)`` without the wave (its amplitudes at 0,
+        the rest as fitted) and the wave's direction at the fitted length (columns ``a1``,
+        ``b1``), or None: what the closing checks test for the wave's own signature beyond
+        any virgin curve (``workflow.signature_beyond_virgin``) before withdrawing it as an
+        absorber of a virgin curve of another shape.
 
         At one amplitude a Masing loop is point-symmetric and every point-symmetric change
         of its branches is a change of the virgin curve; a wave's part even about the
         stroke's middle is one (a free-form virgin curve explained 1.2-1.3 times the held-out
         gain of rig waves at twice the ideal size, 2 kHz, 7.1-10.7 Hz, 35-50 cycles: each
         named, then withdrawn, ``benches/eval_ideal_bound.py`` tuning seeds 52200100-1).
-        Its odd part no virgin curve draws: the residual of the model without the wave
-        (its amplitudes at 0, the rest as fitted) is fitted on alternate cycles by a
-        free-form virgin curve (:func:`~contactlab.diagnose.misfit.beyond_virgin`) with and
-        without the wave's direction at the fitted length; where adding it gains across
-        the held-out cycles at t > ``z``, the data hold the wave's own signature. A virgin
-        curve of another shape (a tanh) is point-symmetric and leaves none."""
-        from ...misfit import beyond_virgin
-
+        Its odd part no virgin curve draws; a virgin curve of another shape (a tanh) is
+        point-symmetric and leaves none."""
         if not all(k in p for k in (*TRACK_TERMS, "L", "ac")):
             return None
         p0 = {**p, "a1": 0.0, "b1": 0.0}
@@ -210,14 +206,7 @@ class PositionFriction(EffectModel):
         for k in TRACK_TERMS:
             up = {**p0, k: 1e-3}
             cols.append((np.asarray(family.predict(up, effects, d), float) - base) / 1e-3)
-        res = beyond_virgin(d, d.y - base, np.column_stack(cols), float(p["ac"]))
-        if res is None or not (res["t"] > z and res["gain"] > 0):
-            return None
-        return (
-            f"a free-form virgin curve does not draw it: the wave's part odd about the "
-            f"stroke's middle gains across held-out cycles beyond one (t = {res['t']:.1f} "
-            f"over {res['cycles']} cycles)"
-        )
+        return d.y - base, np.column_stack(cols)
 
     def apply(self, h, p, ctx):
         d = ctx.d
