@@ -75,3 +75,15 @@ def test_beyond_virgin_sees_no_point_symmetric_change() -> None:
     assert quiet is not None and quiet["t"] < 3.0
     loud = beyond_virgin(d, sym + noise + 0.03 * J[:, 1], J, AC)
     assert loud is not None and loud["t"] > 3.0 and loud["gain"] > 0
+
+
+def test_no_signature_where_the_free_form_curve_cannot_bend() -> None:
+    """A base saturated over the stroke (a stick-slip frame's ac·A of 1e10) leaves the
+    free-form virgin curve only plateaus: the test does not answer there."""
+    _, d = _prepared(lambda x: Masing(H0, AC).force(x) * _wave(x, 0.0, 2.0 / AC, 0.0, 0.03))
+    u = d.u
+    J = np.column_stack(
+        [np.cos(u / float(d.extra["x_half"])), np.sin(u / float(d.extra["x_half"]))]
+    )
+    assert beyond_virgin(d, 0.03 * J[:, 1], J, AC) is not None
+    assert beyond_virgin(d, 0.03 * J[:, 1], J, 1e6 * AC) is None

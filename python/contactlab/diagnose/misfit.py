@@ -1037,6 +1037,12 @@ def backbone_misfit(
     }
 
 
+#: :func:`beyond_virgin` answers only where the free-form virgin curve's gentlest column
+#: bends within the stroke: ``BACKBONE_SHAPES[0]·ac·x_half`` at most this (e^-3: 5 % of its
+#: rise left at the stroke's end)
+BEYOND_VIRGIN_SATURATED = 3.0
+
+
 def beyond_virgin(
     d: Prepared,
     residual: np.ndarray,
@@ -1055,10 +1061,18 @@ def beyond_virgin(
     change of them is a change of the virgin curve; what a free-form virgin curve cannot
     draw is the point-asymmetric part of the effect (a friction wave along the track: its
     part odd about the stroke's middle). Returns ``t``, ``gain`` and ``cycles``; None with
-    fewer than :data:`MIN_CYCLES` complete cycles or without a curvature."""
+    fewer than :data:`MIN_CYCLES` complete cycles or without a curvature, and where the
+    free-form curve cannot bend within the stroke (its gentlest column,
+    ``BACKBONE_SHAPES[0]·ac``, saturated over the half-width: ``> BEYOND_VIRGIN_SATURATED``;
+    a stick-slip frame's base at ac·A 1e10 draws only plateaus, and "beyond a virgin curve"
+    would test nothing there: ``benches/eval_measured_diagnose.py``, frame_450g kept a ±29 %
+    wave at t 24.9 otherwise)."""
     from ..masing import Masing
 
     if not (np.isfinite(ac) and ac > 0):
+        return None
+    half = float(d.extra.get("x_half", 0.5 * float(np.ptp(d.u))))
+    if not BACKBONE_SHAPES[0] * ac * half <= BEYOND_VIRGIN_SATURATED:
         return None
     r = np.asarray(residual, float)
     J = np.asarray(direction, float).reshape(r.size, -1)
