@@ -58,6 +58,10 @@ CONDITIONS = {
     "stick_short": ("stick_slip", 2000.0, 19.6, 5, 0.020, 0.019, 1.05),
     "pdrift_long": ("parameter_drift", 10000.0, 25.3, 50, 0.016, 0.019, 3.60),
     "pdrift_short": ("parameter_drift", 10000.0, 25.3, 5, 0.016, 0.019, 3.60),
+    # the blind generator's misses of stop 51 (its noise is SD / range: twice that of the
+    # amplitude, the rig's share, here)
+    "posfric_c": ("position_friction", 5000.0, 19.4, 35, 0.016, 0.022, 1.94),
+    "posfric_d": ("position_friction", 2000.0, 10.7, 35, 0.030, 0.038, 1.57),
 }
 LAMBDA = 44.8
 H0, AC = 40.0, 4.0e4

@@ -12,8 +12,10 @@ from contactlab.diagnose._family import Prepared
 from contactlab.diagnose.candidates_tangential import TangentialFamily
 from contactlab.diagnose.effects import registry
 from contactlab.diagnose.search import (
+    LOCKED_ANCHOR_SHARE,
     LOCKED_STATE,
     _noise_floor,
+    locked_anchor_margin,
     locked_noise_gain,
 )
 from contactlab.synthetic.rig import rig_recording
@@ -79,7 +81,7 @@ def test_the_floor_is_the_smaller_of_the_share_and_the_locked_gain() -> None:
     for scale in (1e-3, 1e3):
         b = scale * j1
         _state(d, b, b)
-        locked = float(b @ b) / d.y.size
+        locked = float(b @ b) / d.y.size + locked_anchor_margin(budget, d)
         got = _noise_floor(fam, EFF, budget, d, p, EFF)
         assert got == pytest.approx(min(share * budget, locked), rel=1e-3)
     # an effect that can filter the input keeps its whole share however small the bias
@@ -108,9 +110,42 @@ def test_the_stated_bound_models_the_locked_floor() -> None:
     locked = locked_noise_gain(fam, EFF, EFF, d, p0)
     assert locked is not None and locked >= 0.0
     assert with_at.gain_floor <= without.gain_floor + 1e-12
+    locked += locked_anchor_margin(budget, d)
     assert with_at.gain_floor == pytest.approx(
         max(0.05 * 0.2 + min(0.25 * budget, locked), with_at.rel_floor), rel=1e-6
     )
+
+
+def test_the_locked_floor_keeps_a_margin_for_the_records_own_noise_falling_with_cycles(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The simulated bias averages fresh draws; the record's own noisy turning points, held
+    in the Masing memory, leave a cycle-locked part of their own (stop 52: a clean 1 kHz
+    record of 20 cycles named a track's wave at 0.065 σ² held out, the simulated bias 0.016
+    σ²). The lowered floor adds LOCKED_ANCHOR_SHARE budgets over the complete cycles."""
+    from types import SimpleNamespace
+
+    from contactlab.diagnose import search
+
+    fam, d, p = _record()
+    j1 = _direction(fam, d, p, "a1")
+    budget = 0.4
+    n = d.cycles.n_cycles
+    assert n >= 10
+    b = 1e-3 * j1  # a bias too small to matter: the margin alone stands above it
+    _state(d, b, b)
+    locked = float(b @ b) / d.y.size
+    got = _noise_floor(fam, EFF, budget, d, p, EFF)
+    assert LOCKED_ANCHOR_SHARE > 0
+    assert got == pytest.approx(locked + LOCKED_ANCHOR_SHARE * budget / n, rel=1e-6)
+    assert got > locked + 0.1 * budget / n
+    # twice the cycles, half the margin
+    short = locked_anchor_margin(budget, d)
+    assert locked_anchor_margin(budget, SimpleNamespace(cycles=SimpleNamespace(
+        n_cycles=2 * n))) == pytest.approx(short / 2)  # fmt: skip
+    # without it, stop 51's floor: the simulated bias alone
+    monkeypatch.setattr(search, "LOCKED_ANCHOR_SHARE", 0.0)
+    assert _noise_floor(fam, EFF, budget, d, p, EFF) == pytest.approx(locked, rel=1e-6)
 
 
 def test_an_effect_named_only_by_the_lowered_floor_is_marked_for_a_flagged_record() -> None:

@@ -1037,6 +1037,80 @@ def backbone_misfit(
     }
 
 
+#: :func:`beyond_virgin` answers only where the free-form virgin curve's gentlest column
+#: bends within the stroke: ``BACKBONE_SHAPES[0]·ac·x_half`` at most this (e^-3: 5 % of its
+#: rise left at the stroke's end)
+BEYOND_VIRGIN_SATURATED = 3.0
+
+
+def beyond_virgin(
+    d: Prepared,
+    residual: np.ndarray,
+    direction: np.ndarray,
+    ac: float,
+    *,
+    min_weight: float = MIN_WEIGHT,
+) -> dict[str, Any] | None:
+    """The held-out evidence for an effect's ``direction`` (columns, one per size parameter)
+    beyond any virgin curve: the residual of the model without the effect fitted on
+    alternate cycles by a free-form virgin curve (the columns of :func:`backbone_misfit`)
+    with and without the direction, and the per-cycle held-out gain of adding it (t across
+    cycles, gain per sample in the residual's units squared times the weights).
+
+    At one amplitude a Masing loop's branches are point-symmetric, and any point-symmetric
+    change of them is a change of the virgin curve; what a free-form virgin curve cannot
+    draw is the point-asymmetric part of the effect (a friction wave along the track: its
+    part odd about the stroke's middle). Returns ``t``, ``gain`` and ``cycles``; None with
+    fewer than :data:`MIN_CYCLES` complete cycles or without a curvature, and where the
+    free-form curve cannot bend within the stroke (its gentlest column,
+    ``BACKBONE_SHAPES[0]·ac``, saturated over the half-width: ``> BEYOND_VIRGIN_SATURATED``;
+    a stick-slip frame's base at ac·A 1e10 draws only plateaus, and "beyond a virgin curve"
+    would test nothing there: ``benches/eval_measured_diagnose.py``, frame_450g kept a ±29 %
+    wave at t 24.9 otherwise)."""
+    from ..masing import Masing
+
+    if not (np.isfinite(ac) and ac > 0):
+        return None
+    half = float(d.extra.get("x_half", 0.5 * float(np.ptp(d.u))))
+    if not BACKBONE_SHAPES[0] * ac * half <= BEYOND_VIRGIN_SATURATED:
+        return None
+    r = np.asarray(residual, float)
+    J = np.asarray(direction, float).reshape(r.size, -1)
+    w = d.extra.get("weight")
+    w = np.ones(r.size) if w is None else np.asarray(w, float)
+    cyc = d.cycles.cycle
+    use = (cyc >= 0) & (w >= min_weight) & np.isfinite(r) & np.all(np.isfinite(J), axis=1)
+    ids = np.unique(cyc[use])
+    if ids.size < MIN_CYCLES:
+        return None
+    u = d.u - float(np.mean(d.u))
+    C = np.column_stack([Masing(1.0, k * ac).force(d.u) for k in BACKBONE_SHAPES] + [u])
+    ci = np.searchsorted(ids, cyc[use])
+    fold = ci % 2
+    ru, wu = r[use], w[use]
+
+    def held(cols: np.ndarray) -> np.ndarray:
+        pred = np.zeros(ru.size)
+        for k in (0, 1):
+            tr = fold != k
+            sw = np.sqrt(wu[tr])
+            A = cols[tr] * sw[:, None]
+            norm = np.linalg.norm(A, axis=0)
+            norm[norm == 0] = 1.0
+            coef, *_ = np.linalg.lstsq(A / norm, ru[tr] * sw, rcond=1e-10)
+            pred[fold == k] = (cols[fold == k] / norm) @ coef
+        return pred
+
+    p_c = held(C[use])
+    p_cj = held(np.column_stack([C[use], J[use]]))
+    gain_u = wu * ((ru - p_c) ** 2 - (ru - p_cj) ** 2)
+    W = np.bincount(ci, wu, ids.size)
+    g = np.bincount(ci, gain_u, ids.size) / np.maximum(W, 1e-300)
+    sd = float(np.std(g, ddof=1))
+    t = float(np.mean(g) / (sd / np.sqrt(g.size))) if sd > 0 else 0.0
+    return {"t": t, "gain": float(np.mean(g)), "cycles": int(ids.size)}
+
+
 #: the free-form virgin curve must predict the held-out cycles better than the named set by at
 #: least this (σ², summed over both folds) for the set to count as absorbing a backbone misfit
 #: (:func:`absorbed_backbone`)

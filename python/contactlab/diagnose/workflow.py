@@ -167,8 +167,15 @@ def _withdraw_locked(b, d, st, names, z, min_gain, folds, declared_noise, locati
     """An effect named only by the input-noise-locked floor is withdrawn where the misfit test
     flags the final model and still flags it refitted without that effect (a patch over a
     misfit); kept, with the closing checks of the model with it, where the flag goes away
-    without it (the flag was the effect's own)."""
+    without it (the flag was the effect's own), or where the data hold its own signature
+    beyond any virgin curve (:func:`_signature_at`, stop 52: a rig wave at twice the ideal
+    size, t 7.1 over 49 cycles, was withdrawn here since the record was flagged without
+    it too: by the wave's own structure)."""
     gone = _locked_on_misfit(st, d, checks)  # flagged by the calibrated null or a patch
+    if gone is not None and (shown := _signature_at(b, d, st, gone[0])):
+        # the data hold the effect's own signature beyond any virgin curve: no patch
+        st.where.append(f"{gone[0]} is kept on a record whose misfit is unexplained: {shown}")
+        gone = None
     if gone is not None:
         before = getattr(checks["unexplained"], "absorbing", ())
         args = (names, z, min_gain, folds, declared_noise)
@@ -532,6 +539,8 @@ def _withdraw(
         absorbing = getattr(checks["unexplained"], "absorbing", ())
         for e in absorbing:
             shown = _signature(b.family, e, d) if e in st.added and e not in kept else None
+            if not shown and e in st.added and e not in kept:
+                shown = _signature_at(b, d, st, e)
             if shown:
                 kept.add(e)
                 st.where.append(
@@ -730,6 +739,57 @@ def _signature(family: Family, name: str, d: Prepared) -> str | None:
     eff = registry(family.kind).get(name) if family.kind in ("tangential", "normal") else None
     sig = getattr(eff, "signature", None)
     return sig(d) if sig is not None else None
+
+
+def _signature_at(b: _Base, d: Prepared, st: SearchState, name: str) -> str | None:
+    """The evidence for the named effect ``name`` that its fitted parameters show beyond
+    any virgin curve (:func:`signature_beyond_virgin` at the final model), or None."""
+    try:
+        return signature_beyond_virgin(
+            b.family, name, d, dict(st.current.full.params), tuple(st.current.effects)
+        )
+    except (ConvergenceError, InputError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+        return None
+
+
+def signature_beyond_virgin(
+    family: Family,
+    name: str,
+    d: Prepared,
+    params: dict[str, float],
+    effects: tuple[str, ...],
+    z: float | None = None,
+) -> str | None:
+    """Why the effect ``name`` of the model ``(params, effects)`` is no patch over a virgin
+    curve of another shape, or None: the effect's ``signature_parts`` (the residual without
+    it, its direction) tested by :func:`.misfit.beyond_virgin`, its held-out gain beyond a
+    free-form virgin curve across cycles at t > ``z`` (:data:`SIGNATURE_Z`). None for an
+    effect without ``signature_parts`` (issue 29, stop 52: a track's wave)."""
+    from .effects import registry
+    from .misfit import beyond_virgin
+
+    z = SIGNATURE_Z if z is None else z
+    eff = registry(family.kind).get(name) if family.kind == "tangential" else None
+    hook = getattr(eff, "signature_parts", None)
+    if hook is None or "ac" not in params or not np.isfinite(z):
+        return None
+    parts = hook(d, params, effects, family)
+    if parts is None:
+        return None
+    res = beyond_virgin(d, parts[0], parts[1], float(params["ac"]))
+    if res is None or not (res["t"] > z and res["gain"] > 0):
+        return None
+    return (
+        f"a free-form virgin curve does not draw it: its part odd about the stroke's "
+        f"middle gains across held-out cycles beyond one (t = {res['t']:.1f} over "
+        f"{res['cycles']} cycles)"
+    )
+
+
+#: the held-out t across cycles an effect's evidence beyond the shapes it is withdrawn for
+#: must reach to keep it (:func:`_signature_at`; the search's own z; inf: never, as before
+#: stop 52)
+SIGNATURE_Z = 3.0
 
 
 def _ready(

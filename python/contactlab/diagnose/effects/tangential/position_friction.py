@@ -184,6 +184,30 @@ class PositionFriction(EffectModel):
                 top_cv, pick = cv, entry
         return pick if pick is not None else best
 
+    def signature_parts(self, d, p, effects, family):
+        """The residual of the model ``(p, effects)`` without the wave (its amplitudes at 0,
+        the rest as fitted) and the wave's direction at the fitted length (columns ``a1``,
+        ``b1``), or None: what the closing checks test for the wave's own signature beyond
+        any virgin curve (``workflow.signature_beyond_virgin``) before withdrawing it as an
+        absorber of a virgin curve of another shape.
+
+        At one amplitude a Masing loop is point-symmetric and every point-symmetric change
+        of its branches is a change of the virgin curve; a wave's part even about the
+        stroke's middle is one (a free-form virgin curve explained 1.2-1.3 times the held-out
+        gain of rig waves at twice the ideal size, 2 kHz, 7.1-10.7 Hz, 35-50 cycles: each
+        named, then withdrawn, ``benches/eval_ideal_bound.py`` tuning seeds 52200100-1).
+        Its odd part no virgin curve draws; a virgin curve of another shape (a tanh) is
+        point-symmetric and leaves none."""
+        if not all(k in p for k in (*TRACK_TERMS, "L", "ac")):
+            return None
+        p0 = {**p, "a1": 0.0, "b1": 0.0}
+        base = np.asarray(family.predict(p0, effects, d), float)
+        cols = []
+        for k in TRACK_TERMS:
+            up = {**p0, k: 1e-3}
+            cols.append((np.asarray(family.predict(up, effects, d), float) - base) / 1e-3)
+        return d.y - base, np.column_stack(cols)
+
     def apply(self, h, p, ctx):
         d = ctx.d
         x = ctx.pick(ctx.x)
