@@ -62,6 +62,12 @@ CONDITIONS = {
     # amplitude, the rig's share, here)
     "posfric_c": ("position_friction", 5000.0, 19.4, 35, 0.016, 0.022, 1.94),
     "posfric_d": ("position_friction", 2000.0, 10.7, 35, 0.030, 0.038, 1.57),
+    # stop 53: the blind generator's misses on short records near gross sliding (its noise
+    # SD / range doubled to the rig's share of the amplitude, as above)
+    "pdrift_e": ("parameter_drift", 5000.0, 32.0, 5, 0.014, 0.018, 4.94),
+    "pdrift_f": ("parameter_drift", 10000.0, 6.3, 5, 0.010, 0.034, 3.94),
+    "load_e": ("normal_load", 2000.0, 2.3, 12, 0.040, 0.036, 0.85),
+    "load_f": ("normal_load", 10000.0, 17.5, 5, 0.018, 0.036, 1.75),
 }
 LAMBDA = 44.8
 H0, AC = 40.0, 4.0e4
