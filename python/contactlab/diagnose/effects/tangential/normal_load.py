@@ -565,9 +565,10 @@ class NormalLoad(EffectModel):
     def power_note(self, d, p):
         """What the bound is stated for."""
         return (
-            "stated for a load locked to the drive at 2f, beyond what a dashpot (its in-phase "
-            "part) and a parallel spring (its quadrature part) take of it; a load at a "
-            "frequency no harmonic of the drive comes near shows at a smaller size"
+            "stated for a load locked to the drive at 2f at its least favourable phase, where "
+            "it must also out-gain a dashpot (its in-phase part's look-alike) and a parallel "
+            "spring (its quadrature part's); a load at a frequency no harmonic of the drive "
+            "comes near shows at a smaller size"
         )
 
     def size(self, p, se):
