@@ -39,9 +39,7 @@ def test_withdraw_locked_keeps_an_effect_that_took_the_flagged_structure(monkeyp
     monkeypatch.setattr(workflow, "LOCKED_OWN_STRUCTURE", rule)
     monkeypatch.setattr(workflow, "_locked_on_misfit", lambda st, d, ck: ("position_friction", "w"))
     monkeypatch.setattr(workflow, "_signature_at", lambda *a: None)
-    monkeypatch.setattr(
-        workflow, "_unexplained_without", lambda *a: (False, _u(by=["phase_bins"]))
-    )
+    monkeypatch.setattr(workflow, "_unexplained_without", lambda *a: (False, _u(by=["phase_bins"])))
 
     def withdraw(*a):
         calls.append(a[-1])
