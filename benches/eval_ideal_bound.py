@@ -68,6 +68,12 @@ CONDITIONS = {
     "pdrift_f": ("parameter_drift", 10000.0, 6.3, 5, 0.010, 0.034, 3.94),
     "load_e": ("normal_load", 2000.0, 2.3, 12, 0.040, 0.036, 0.85),
     "load_f": ("normal_load", 10000.0, 17.5, 5, 0.018, 0.036, 1.75),
+    # stop 53: the blind generator's misses on long records (noise doubled as above)
+    "stribeck_m1": ("stribeck", 10000.0, 25.2, 35, 0.030, 0.022, 2.71),
+    "stribeck_m2": ("stribeck", 10000.0, 31.8, 35, 0.010, 0.024, 0.42),
+    "posfric_m3": ("position_friction", 1000.0, 14.8, 35, 0.022, 0.018, 3.50),
+    "load_m5": ("normal_load", 1000.0, 3.2, 50, 0.028, 0.022, 1.44),
+    "spring_m6": ("parallel_stiffness", 2000.0, 15.4, 50, 0.038, 0.034, 4.15),
 }
 LAMBDA = 44.8
 H0, AC = 40.0, 4.0e4
