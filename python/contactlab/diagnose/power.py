@@ -777,6 +777,14 @@ def _detectable(
             ),
         )  # fmt: skip
     worst = max(mags, key=lambda s: rel[s.name] or 0.0)
+    # a bound stated beyond the parameter's range (the effect's ``bound_beyond_range``)
+    # says so, with what the range's end would show (:func:`_per_parameter`)
+    beyond = "; ".join(
+        f"beyond the range: {why_none[s.name]}: no {name} within its range is promised "
+        "on this record"
+        for s in mags
+        if s.name in why_none
+    )
     per, rel = _plausible_from(family, name, p0, d, worst, per, rel)
     why = _implausible_at(family, p0, name, worst, per[worst.name], d)
     if why:
@@ -790,7 +798,7 @@ def _detectable(
         )  # fmt: skip
     return Detectable(
         name, worst.name, per[worst.name], worst.unit, worst.null, rel[worst.name], shape, per,
-        gain_at_bound=gain[worst.name],
+        gain_at_bound=gain[worst.name], note=beyond,
     )  # fmt: skip
 
 
@@ -1069,7 +1077,8 @@ def _per_parameter(
                 f"change the output by {100 * r_end:.2g} % of its RMS and be found with "
                 f"probability {seen:.2f}"
             )
-            b = None  # beyond the parameter's range (a loss asymmetry |a| < 1): no bound
+            if not getattr(_effect(family, name), "bound_beyond_range", False):
+                b = None  # beyond the parameter's range: no bound
         r = None if b is None else b * float(np.sqrt(np.mean(j * j))) / st.y_rms
         if r is not None and r > LARGEST_RELATIVE:
             why_none[s.name] = (
