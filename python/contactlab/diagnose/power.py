@@ -983,7 +983,9 @@ def _per_parameter(
     """Per magnitude parameter: the bound, its relative size and the mean held-out gain
     (σ²) expected at it; the candidate's direction with what the current model's parameters
     absorb of it projected out. ``why_none`` (filled when given): per parameter without a
-    bound, why, in numbers (issue 29, item 2: no bare "not detectable")."""
+    bound, why, in numbers (issue 29, item 2: no bare "not detectable"); also per parameter
+    whose bound is kept beyond its range (the effect's ``bound_beyond_range``), what the
+    range's end would show."""
     why_none = {} if why_none is None else why_none
     scales = family.scales(d)
     trial = (*effects, name)
