@@ -140,6 +140,15 @@ def chain_record(effect: str | None, size: float, fac: dict, seed: int, k: float
     pm = p0 + signal.lfilter(cell[0].ravel(), cell[1], pdyn)
     # Bessel 4th-order anti-alias at 0.35 fs on both channels
     bb, ab = signal.bessel(4, 0.35 * fs / (fsi / 2), norm="delay")
+    # ``noise_stage`` "analog": the sensors' white noise enters before the anti-alias filter
+    # (at the oversampled rate, scaled so that its SD after the filter is the stated
+    # fraction of the range): the recorded noise is then band-limited, not white
+    analog = fac.get("noise_stage") == "analog"
+    if analog:
+        imp = signal.lfilter(bb, ab, np.r_[1.0, np.zeros(4095)])
+        gain = float(np.sqrt(np.sum(imp**2)))
+        ep = signal.lfilter(bb, ab, rng.normal(0, 1.0 / gain, ti.size))
+        ed = signal.lfilter(bb, ab, rng.normal(0, 1.0 / gain, ti.size))
     pm = signal.lfilter(bb, ab, pm, zi=signal.lfilter_zi(bb, ab) * pm[0])[0]
     dm = signal.lfilter(bb, ab, dm, zi=signal.lfilter_zi(bb, ab) * dm[0])[0]
     # sampling with jitter (0.5 % of a sample), hum at 50 Hz (0.1 % of range)
@@ -158,8 +167,12 @@ def chain_record(effect: str | None, size: float, fac: dict, seed: int, k: float
     if sd:
         u = ts / ts[-1]
         dc = dc + sd * rd * (u + fac.get("sensor_bow", 0.0) * (u * u - u))
-    pn = pc + 0.001 * rp * hum + rng.normal(0, fac["noise_p"] * rp, n)
-    dn = dc + 0.001 * rd * hum + rng.normal(0, fac["noise_d"] * rd, n)
+    if analog:
+        pn = pc + 0.001 * rp * hum + fac["noise_p"] * rp * np.interp(tj, ti, ep)
+        dn = dc + 0.001 * rd * hum + fac["noise_d"] * rd * np.interp(tj, ti, ed)
+    else:
+        pn = pc + 0.001 * rp * hum + rng.normal(0, fac["noise_p"] * rp, n)
+        dn = dc + 0.001 * rd * hum + rng.normal(0, fac["noise_d"] * rd, n)
     q = 2.0 ** fac["bits"]
     lp, ld = 1.25 * rp / q, 1.25 * rd / q
     pn = np.round(pn / lp) * lp

@@ -60,6 +60,17 @@ BLIND52 = {
     "asym_5k_10.5": (5000.0, 10.5, 8, 0.016, 0.017, 0.36),
     "asym_2k_7.9": (2000.0, 7.9, 8, 0.013, 0.011, 0.57),
 }
+#: stop 53: the blind misses as the brief gives them: (fs, f, cycles, p noise, δ noise,
+#: pa/p0 or None when not given)
+BLIND53 = {
+    "asym_2k_3.7": (2000.0, 3.7, 12, 0.007, 0.006, None),
+    "asym_5k_10.5": (5000.0, 10.5, 8, 0.016, 0.017, None),
+    "asym_2k_7.9": (2000.0, 7.9, 8, 0.013, 0.011, None),
+    "stiff_5k_4.2": (5000.0, 4.2, 8, 0.007, 0.008, None),
+    "stiff_1k_1.8": (1000.0, 1.8, 35, 0.009, 0.005, None),
+    "stiff_2k_6.1": (2000.0, 6.1, 50, 0.019, 0.017, None),
+    "creep_1k_1.1": (1000.0, 1.1, 12, 0.020, 0.013, None),
+}
 EFFECTS = ("creep_drift", "stiffness_nonlinearity", "asymmetric_branches")
 
 
@@ -67,6 +78,8 @@ def condition_set(name):
     """``{key: (fs, f, cycles, p noise, δ noise, pa/p0 or None)}`` of ``--set``."""
     if name == "blind52":
         return BLIND52
+    if name == "blind53":
+        return BLIND53
     return {k: (*v, None) for k, v in BLIND.items()}
 
 
@@ -345,11 +358,13 @@ def naming_chain(a) -> None:
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     from chain_normal import chain_record, noncentrality
 
-    facs = [float(x) for x in a.factors.split(",")]
+    facs = [float(x) for x in a.factors.split(",") if x]
     tally: dict = {}
     rows = []
     conds = (
-        condition_set(a.set) if a.set == "blind52" else {k: (*BLIND[k], None) for k in CHAIN_KEYS}
+        condition_set(a.set)
+        if a.set in ("blind52", "blind53")
+        else {k: (*BLIND[k], None) for k in CHAIN_KEYS}
     )
     for i, (key, (fs, f, cyc, xn, yn, ratio)) in enumerate(conds.items()):
         if a.only and a.only not in key:
@@ -360,6 +375,8 @@ def naming_chain(a) -> None:
                "noise_p": xn, "noise_d": yn, "bits": 16,
                "psi": float(rng.uniform(*a.psi_range)), "law": a.law}  # fmt: skip
         fac["ratio"] = fac["ratio"] if ratio is None else ratio
+        if a.noise_stage:
+            fac["noise_stage"] = a.noise_stage
         t, p, d, cl = chain_record(None, 0.0, fac, seed)
         rep = diagnose(t, p, d)
         clean = list(rep.effect_names)
@@ -395,6 +412,12 @@ def naming_chain(a) -> None:
             b = (bnd.get(e, {}).get("per_parameter") or {}).get(par)
             rb = None if b is None else round(b * cf / ideal, 2)
             print(f"   {e[:5]} ideal {ideal:.3g} bound/ideal {rb}", flush=True)
+            if a.ablate:
+                for nm_ab, what in ABLATIONS.items():
+                    bab = (ablated_bounds(rep, what).get(e, {}).get("per_parameter") or {}).get(par)
+                    rab = None if bab is None else round(bab * cf / ideal, 2)
+                    tally.setdefault(f"{e} bound/ideal {nm_ab}", {}).setdefault("values", [])
+                    tally[f"{e} bound/ideal {nm_ab}"]["values"].append(rab)
             tally.setdefault(f"{e} bound/ideal", {}).setdefault("values", [])
             tally[f"{e} bound/ideal"]["values"].append(rb)
             for fc in facs:
@@ -441,6 +464,8 @@ def main() -> None:
     ap.add_argument("--ablate", action="store_true")
     ap.add_argument("--psi", type=float, default=PSI)
     ap.add_argument("--law", default="a2")
+    #: the chain's noise: "analog" (before the anti-alias filter, band-limited) or white
+    ap.add_argument("--noise-stage", default=None)
     ap.add_argument("--psi-range", type=lambda v: tuple(float(x) for x in v.split(",")),
                     default=(0.08, 0.3))  # fmt: skip
     ap.add_argument("--out", default=None)

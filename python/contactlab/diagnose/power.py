@@ -777,6 +777,14 @@ def _detectable(
             ),
         )  # fmt: skip
     worst = max(mags, key=lambda s: rel[s.name] or 0.0)
+    # a bound stated beyond the parameter's range (the effect's ``bound_beyond_range``)
+    # says so, with what the range's end would show (:func:`_per_parameter`)
+    beyond = "; ".join(
+        f"beyond the range: {why_none[s.name]}: no {name} within its range is promised "
+        "on this record"
+        for s in mags
+        if s.name in why_none
+    )
     per, rel = _plausible_from(family, name, p0, d, worst, per, rel)
     why = _implausible_at(family, p0, name, worst, per[worst.name], d)
     if why:
@@ -790,7 +798,7 @@ def _detectable(
         )  # fmt: skip
     return Detectable(
         name, worst.name, per[worst.name], worst.unit, worst.null, rel[worst.name], shape, per,
-        gain_at_bound=gain[worst.name],
+        gain_at_bound=gain[worst.name], note=beyond,
     )  # fmt: skip
 
 
@@ -975,7 +983,9 @@ def _per_parameter(
     """Per magnitude parameter: the bound, its relative size and the mean held-out gain
     (σ²) expected at it; the candidate's direction with what the current model's parameters
     absorb of it projected out. ``why_none`` (filled when given): per parameter without a
-    bound, why, in numbers (issue 29, item 2: no bare "not detectable")."""
+    bound, why, in numbers (issue 29, item 2: no bare "not detectable"); also per parameter
+    whose bound is kept beyond its range (the effect's ``bound_beyond_range``), what the
+    range's end would show."""
     why_none = {} if why_none is None else why_none
     scales = family.scales(d)
     trial = (*effects, name)
@@ -1069,7 +1079,8 @@ def _per_parameter(
                 f"change the output by {100 * r_end:.2g} % of its RMS and be found with "
                 f"probability {seen:.2f}"
             )
-            b = None  # beyond the parameter's range (a loss asymmetry |a| < 1): no bound
+            if not getattr(_effect(family, name), "bound_beyond_range", False):
+                b = None  # beyond the parameter's range: no bound
         r = None if b is None else b * float(np.sqrt(np.mean(j * j))) / st.y_rms
         if r is not None and r > LARGEST_RELATIVE:
             why_none[s.name] = (
