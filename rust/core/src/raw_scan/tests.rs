@@ -112,3 +112,53 @@ fn bad_input_is_an_error() {
     let scan = order_stats_trapezoids(&[1.0], &[1.0], &[1.0], &[0]).unwrap();
     assert!(period_means_pair_resumed(&[1.0], &[1.0], &[1.0], &[1.0], &scan).is_err());
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    /// The uniform axis made in the pass is `fill_time`'s, bit for bit, and the scan is
+    /// `order_stats_trapezoids`' of that axis (the checkpoints, tails and flags), whatever
+    /// the window's length against the axis blocks (one block, a block and a sample, many).
+    #[test]
+    fn the_uniform_pass_equals_fill_time_then_the_scan(
+        seed in 0u64..1000,
+        n in prop::sample::select(vec![2usize, 3, 64, 65, 4095, 4096, 4097, 8193, 40_000, 70_001]),
+        offset in prop::sample::select(vec![0u64, 1, 977, 123_456_789]),
+    ) {
+        let (_t, x, f) = samples(n, seed);
+        let (t0, dt) = (0.125 + seed as f64 * 1e-3, 1e-4);
+        let mut t_ref = vec![0.0; n];
+        crate::stream::fill_time(&mut t_ref, t0, dt, offset).unwrap();
+        let ranks = if n > 8 { vec![1, 2, n - 3, n - 2] } else { vec![0, n - 1] };
+        let want = order_stats_trapezoids(&x, &t_ref, &f, &ranks).unwrap();
+        let mut t_out = vec![f64::NAN; n];
+        let got = order_stats_trapezoids_uniform(&x, &f, (t0, dt, offset), &mut t_out, &ranks)
+            .unwrap();
+        prop_assert_eq!(bits(&t_out), bits(&t_ref));
+        prop_assert_eq!(bits(&got.order_stats), bits(&want.order_stats));
+        prop_assert_eq!(bits(&got.cf), bits(&want.cf));
+        prop_assert_eq!(bits(&got.cx), bits(&want.cx));
+        prop_assert_eq!(bits(&got.ct), bits(&want.ct));
+        prop_assert_eq!(got.t_ok, want.t_ok);
+        prop_assert_eq!(got.n, want.n);
+        prop_assert_eq!(got.t_ends.0.to_bits(), want.t_ends.0.to_bits());
+        prop_assert_eq!(got.t_ends.1.to_bits(), want.t_ends.1.to_bits());
+    }
+}
+
+/// An axis that stops increasing (a step below the precision of t0) is not `t_ok`, as the
+/// scan of the filled axis says; an axis past 2^53 samples and a `t_out` of another length
+/// are refused.
+#[test]
+fn the_uniform_pass_checks_its_axis() {
+    let (_t, x, f) = samples(5000, 3);
+    let n = x.len();
+    let mut t_out = vec![0.0; n];
+    // dt far below t0's spacing: consecutive samples get equal times
+    let got = order_stats_trapezoids_uniform(&x, &f, (1e12, 1e-9, 0), &mut t_out, &[3]).unwrap();
+    let want = order_stats_trapezoids(&x, &t_out, &f, &[3]).unwrap();
+    assert!(!got.t_ok);
+    assert_eq!(got.t_ok, want.t_ok);
+    assert!(order_stats_trapezoids_uniform(&x, &f, (0.0, 1.0, 1 << 53), &mut t_out, &[3]).is_err());
+    let mut short = vec![0.0; n - 1];
+    assert!(order_stats_trapezoids_uniform(&x, &f, (0.0, 1.0, 0), &mut short, &[3]).is_err());
+}
