@@ -61,7 +61,6 @@ KERNELS = (
     "fill_time",
     "order_stats",
     "order_stats_trapezoids",
-    "order_stats_trapezoids_uniform",
     "period_means_pair",
     "detrend_pair_scan_into",
     "detrend_pair_scan_uniform_into",

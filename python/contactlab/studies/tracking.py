@@ -116,15 +116,11 @@ class _WindowSamples:
         """The time of sample ``i`` of the window (that of :meth:`recording`'s axis)."""
         return _step_time(self.time_step, self.start + i)
 
-    def recording(self, fill: bool = True) -> Recording:
-        """The window as a recording. ``fill=False``: its axis is allocated but not made
-        (its values are garbage until :func:`contactlab.tangential.window.analyze_window`,
-        told so by ``axis_filled=False``, makes them in its first pass over the window)."""
+    def recording(self) -> Recording:
         from .. import _core
 
         t = np.empty(len(self))
-        if fill:
-            _core.fill_time(t, self.time_step[0], self.time_step[1], self.start)
+        _core.fill_time(t, self.time_step[0], self.time_step[1], self.start)
         return Recording(t, self.data, self.units, self.source, self.meta)
 
 
@@ -197,10 +193,10 @@ def _tangential_window(
 
     scanned: dict[str, tuple[float, float]] | None = None
     time_step: tuple[float, float, int] | None = None
-    samples = rec if isinstance(rec, _WindowSamples) else None
-    if samples is not None:
+    if isinstance(rec, _WindowSamples):
         # (the axis recording() makes: fill_time's from the window's first global sample)
-        scanned, time_step = samples.scanned, (*samples.time_step, samples.start)
+        scanned, time_step = rec.scanned, (*rec.time_step, rec.start)
+    rec = _window_recording(rec)
 
     opts = {k: v for k, v in options.items() if k != "warn"}
     if opts.get("on", "averaged") == "averaged" and opts.get("history", "steady") == "steady":
@@ -211,20 +207,10 @@ def _tangential_window(
         if inv is not None:
             opts["force_sign"] = -1 if inv else 1
     if set(opts) <= _WINDOW_OPTIONS:
-        # (the rows keep no per-cycle mean of the detrended window: not computed). A sampled
-        # window's axis is made by the window's first pass over its samples (issue 33: the
-        # order statistics' pass, fill_time's numbers), not by a pass of its own
-        w = samples.recording(fill=False) if samples is not None else rec
-        res = analyze_window(
-            w,
-            period_means=False,
-            scanned=scanned,
-            time_step=time_step,
-            axis_filled=samples is None,
-            **opts,
-        )
+        # (the rows keep no per-cycle mean of the detrended window: not computed)
+        res = analyze_window(rec, period_means=False, scanned=scanned, time_step=time_step, **opts)
     else:
-        res = analyze_tangential(_window_recording(rec), **{"warn": False, **dict(options)})
+        res = analyze_tangential(rec, **{"warn": False, **dict(options)})
     d = res.to_dict()
     row: dict[str, Any] = {}
     for q in TANGENTIAL_QUANTITIES:

@@ -91,7 +91,6 @@ def analyze_window(
     period_means: bool = True,
     scanned: dict[str, tuple[float, float]] | None = None,
     time_step: tuple[float, float, int] | None = None,
-    axis_filled: bool = True,
 ) -> TangentialAnalysis:
     """:func:`analyze_tangential` of one window of a streamed recording (``on="averaged"``,
     steady history), with the per-sample work in one pass of Rust kernels.
@@ -125,46 +124,12 @@ def analyze_window(
     :func:`contactlab._core.fill_time`'s ``t0 + dt·(offset + i)`` (a streamed window of a
     sampled recording, :func:`contactlab.studies.tracking.track`'s): the detrending pass then
     makes the axis as it goes instead of reading it (the same numbers).
-
-    ``axis_filled=False`` (with ``time_step``): the recording's time axis is allocated but
-    its values are not made yet (:meth:`contactlab.studies.tracking._WindowSamples.recording`
-    with ``fill=False``); the window's first pass over its samples makes them
-    (:func:`contactlab._core.order_stats_trapezoids_uniform`: ``fill_time``'s numbers,
-    written into the recording's axis), or :func:`contactlab._core.fill_time` does before
-    anything reads them where that pass does not run. The same numbers either way.
     """
     xa, Fa, ta, source = _inputs(recording, None, None, None)
     _check_options("averaged", "steady", n_points)
     known = scanned or {}
-    if not axis_filled and time_step is None:
-        raise InputError("axis_filled=False needs the time_step the axis is made from")
     finite_x = check_channel("x", xa, "m", "displacement", known.get("x"))
     finite_f = check_channel("F", Fa, "N", "force", known.get("F"))
-    # (a recording's channels are contiguous float64 arrays unless replaced since)
-    plain = all(a.dtype == np.float64 and a.ndim == 1 and a.flags.c_contiguous for a in (xa, Fa))
-    axis: tuple[float, float, int] | None = None
-    if not axis_filled:
-        assert time_step is not None
-        # the axis is made by the window's first pass where that pass is the raw samples'
-        # scan below (window_detrended's checked path of a long window), else here, now
-        fused = (
-            scanned is not None
-            and delay is None
-            and finite_x
-            and finite_f
-            and plain
-            and ta is not None
-            and ta.dtype == np.float64
-            and ta.ndim == 1
-            and ta.flags.c_contiguous
-            and ta.size == xa.size
-            and _tail_ranks(xa.size) is not None
-        )
-        if fused:
-            axis = time_step
-        else:
-            assert ta is not None
-            _core.fill_time(ta, time_step[0], time_step[1], time_step[2])
     dropped = 0
     if delay is not None:  # ``delay`` as in analyze_tangential
         ta, xa, Fa, dropped = lag.shift_force(ta, xa, Fa, delay)
@@ -179,6 +144,8 @@ def analyze_window(
         "detrend": detrend,
         "initial": initial,
     }
+    # (a recording's channels are contiguous float64 arrays unless replaced since)
+    plain = all(a.dtype == np.float64 and a.ndim == 1 and a.flags.c_contiguous for a in (xa, Fa))
     pre = window_detrended(
         xa,
         Fa,
@@ -188,7 +155,6 @@ def analyze_window(
         period_means=period_means,
         time_checked=scanned is not None and delay is None,
         time_step=time_step if delay is None else None,
-        fill_axis=axis,
     )
     ori = _fast_orientation(pre.x, pre.F, pre.loop, force_sign)
     res = None
@@ -223,7 +189,6 @@ def window_detrended(
     period_means: bool = True,
     time_checked: bool = False,
     time_step: tuple[float, float, int] | None = None,
-    fill_axis: tuple[float, float, int] | None = None,
 ) -> steps.Detrended:
     """:func:`steps.detrend` of the window with one fold instead of two: the linear drifts
     come from the period means between the raw displacement's peaks (what the first fold's
@@ -235,19 +200,8 @@ def window_detrended(
     computed; see :func:`analyze_window`). ``time_checked`` (with ``checked``): t too is
     known finite (a streamed reader's axis), so it is not scanned either. ``time_step``:
     ``(t0, dt, offset)`` of ``ta`` when it is :func:`contactlab._core.fill_time`'s axis (see
-    :func:`analyze_window`). ``fill_axis``: ``(t0, dt, offset)`` when ``ta``'s values are
-    not made yet (:func:`analyze_window`'s ``axis_filled=False``): the raw samples' scan
-    makes them as it goes (``checked`` and ``time_checked`` windows longer than
-    :data:`~contactlab.tangential.preprocess._TAIL_SELECT_ABOVE`), else
-    :func:`contactlab._core.fill_time` first."""
+    :func:`analyze_window`)."""
     n_points, rel = opts["n_points"], opts["rel_threshold"]
-    sel = _tail_ranks(xa.size)
-    if fill_axis is not None and not (
-        checked and time_checked and ta is not None and sel is not None
-    ):
-        assert ta is not None
-        _core.fill_time(ta, *fill_axis)
-        fill_axis = None
     min_cycles = opts["min_cycles"]
     # the raw samples' scan (x, F and tc, the axis t's values as float64 and checked)
     raw: _core.RawScan | None = None
@@ -260,21 +214,12 @@ def window_detrended(
             tc = as_1d(ta, "t", finite=not time_checked)
         if tc.size != xa.size:
             raise InputError(f"t has {tc.size} samples but x has {xa.size}")
-        if fill_axis is not None and tc is not ta:  # (a copy: ta's own values made first)
-            assert ta is not None
-            _core.fill_time(ta, *fill_axis)
-            tc, fill_axis = as_1d(ta, "t", finite=False), None
+        sel = _tail_ranks(xa.size)
         if sel is not None:
             # tail_percentiles(xa) and, in the same pass, the checkpoints of the period
             # means' trapezoid integrals below (issue 33: that walk's own pass, 3 ns a
-            # sample, resumed from them instead; the same numbers); a sampled window's axis
-            # made in the same pass where it is still to be made (fill_time's numbers, into
-            # ta: the pass reads them back from the cache, not from memory)
-            if fill_axis is not None:
-                t0, dt, offset = fill_axis
-                raw = _core.order_stats_trapezoids_uniform(xa, Fa, t0, dt, offset, tc, sel[0])
-            else:
-                raw = _core.order_stats_trapezoids(xa, tc, Fa, sel[0])
+            # sample, resumed from them instead; the same numbers)
+            raw = _core.order_stats_trapezoids(xa, tc, Fa, sel[0])
             pct = _lerp_tails(raw.order_stats, sel[1])
         else:
             pct = tail_percentiles(xa)
@@ -308,6 +253,7 @@ def window_detrended(
     # the same pass gathers what the next two passes over the detrended samples read them
     # for: the tails of x for its robust amplitude (the reversal search's band) and the
     # fold's checks and scales (issue 33: a pass a window less each; the same numbers)
+    sel = _tail_ranks(x.size)
     ranks = sel[0] if sel is not None else []
     if time_step is not None and ta is not None:
         # the axis made as the pass goes (fill_time's numbers): 8 of its 40 bytes a sample

@@ -67,16 +67,10 @@ pub fn order_stats_trapezoids(
         f: Vec::with_capacity(n_cp),
         x: Vec::with_capacity(n_cp),
     };
-    let state = crate::simd::run(
+    let ok = crate::simd::run(
         crate::simd::level(),
         FusedPass {
             txf: (t, x, f),
-            range: (0, n),
-            state: ChainState {
-                ok: true,
-                cf: 0.0,
-                cx: 0.0,
-            },
             gather: &mut g,
             cps: &mut cps,
         },
@@ -84,98 +78,12 @@ pub fn order_stats_trapezoids(
     Ok(RawScan {
         order_stats: g.finish(x),
         n,
-        t_ok: state.ok,
+        t_ok: ok,
         cf: cps.f,
         cx: cps.x,
         ct: cps.t,
         t_ends: (t[0], t[n - 1]),
     })
-}
-
-/// Samples a block of [`order_stats_trapezoids_uniform`]'s pass (a multiple of
-/// [`CHECKPOINT`]): the axis made for a block is read back from the first-level cache.
-const AXIS_BLOCK: usize = 64 * CHECKPOINT;
-
-/// [`order_stats_trapezoids`] of a window whose time axis is sampled every `dt` from `t0`
-/// (sample `i` at `t0 + dt · (offset + i)`): the axis is made into `t_out` block by block as
-/// the pass goes ([`crate::stream::fill_time`]'s numbers, bit for bit) and read back from
-/// the cache, where the separate `fill_time` wrote it to memory and this pass read it back
-/// (issue 33: a pass over the window's 8 bytes a sample of time less). The same
-/// [`RawScan`] as [`order_stats_trapezoids`] of the filled `t_out`.
-///
-/// # Errors
-/// As [`order_stats_trapezoids`]; [`CoreError::TooLong`] when `offset` plus the samples
-/// pass 2^53 (as [`crate::stream::fill_time`]), [`CoreError::LengthMismatch`] for a
-/// `t_out` of another length.
-// Index arithmetic: a < b <= n; b + 1 <= n where read.
-#[allow(clippy::arithmetic_side_effects)]
-pub fn order_stats_trapezoids_uniform(
-    x: &[f64],
-    f: &[f64],
-    (t0, dt, offset): (f64, f64, u64),
-    t_out: &mut [f64],
-    ranks: &[usize],
-) -> Result<RawScan, CoreError> {
-    check_same_len("t", t_out.len(), "x", x.len())?;
-    check_same_len("t", t_out.len(), "F", f.len())?;
-    if !crate::stream::indices_exact(offset, x.len()) {
-        return Err(CoreError::TooLong { len: x.len() });
-    }
-    let mut g = TailGather::new(x.len(), ranks, STRIDE, |i| x[i])?;
-    let n = x.len();
-    let n_cp = (n - 1) / CHECKPOINT + 1;
-    let mut cps = Checkpoints {
-        t: Vec::with_capacity(n_cp),
-        f: Vec::with_capacity(n_cp),
-        x: Vec::with_capacity(n_cp),
-    };
-    let mut state = ChainState {
-        ok: true,
-        cf: 0.0,
-        cx: 0.0,
-    };
-    let level = crate::simd::level();
-    let mut a = 0_usize;
-    // the first block's axis; each block then makes the next one's before its pass (the
-    // pass reads sample b, the next block's first, for its last pair)
-    let first = AXIS_BLOCK.min(n);
-    crate::stream::fill_time_in(&mut t_out[..first], t0, dt, offset);
-    while a < n {
-        let b = (a + AXIS_BLOCK).min(n);
-        let c = (b + AXIS_BLOCK).min(n);
-        if c > b {
-            crate::stream::fill_time_in(&mut t_out[b..c], t0, dt, offset + b as u64);
-        }
-        let hi = (b + 1).min(n);
-        state = crate::simd::run(
-            level,
-            FusedPass {
-                txf: (&t_out[..hi], &x[..hi], &f[..hi]),
-                range: (a, b),
-                state,
-                gather: &mut g,
-                cps: &mut cps,
-            },
-        );
-        a = b;
-    }
-    Ok(RawScan {
-        order_stats: g.finish(x),
-        n,
-        t_ok: state.ok,
-        cf: cps.f,
-        cx: cps.x,
-        ct: cps.t,
-        t_ends: (t_out[0], t_out[n - 1]),
-    })
-}
-
-/// The chain of [`FusedPass`] between two of its ranges: `t` good so far, the integrals.
-#[derive(Clone, Copy)]
-struct ChainState {
-    ok: bool,
-    cf: f64,
-    cx: f64,
 }
 
 /// The checkpoints as the pass makes them: the sample's time and the two integrals.
@@ -187,44 +95,35 @@ struct Checkpoints {
 
 /// [`order_stats_trapezoids`]' pass as a [`crate::simd::Kernel`] (the gathering's test
 /// vectorised for the CPU's SIMD level; the chain is scalar at every level, the same sums).
-/// `range`: the samples `[a, b)` whose checkpoints and tails this run makes (`a` a multiple
-/// of [`CHECKPOINT`]; the slices reach sample `b` when there is one, for the last pair),
-/// from the chain's `state` after sample `a`; the whole window in one run, or block by block
-/// ([`order_stats_trapezoids_uniform`]): the same numbers.
 struct FusedPass<'a> {
     txf: (&'a [f64], &'a [f64], &'a [f64]),
-    range: (usize, usize),
-    state: ChainState,
     gather: &'a mut TailGather,
     cps: &'a mut Checkpoints,
 }
 
 impl crate::simd::Kernel for FusedPass<'_> {
-    /// `t` finite and strictly increasing so far, and the integrals
-    type Output = ChainState;
+    /// `t` finite and strictly increasing
+    type Output = bool;
 
     // Index arithmetic: s < e <= n; the pairs (j, j + 1) with j < stop <= n - 1; m <= TERMS.
     #[allow(clippy::arithmetic_side_effects, clippy::needless_bitwise_bool)]
     #[inline(always)]
-    fn run_at(self) -> ChainState {
+    fn run_at(self) -> bool {
         let FusedPass {
             txf: (t, x, f),
-            range: (a, b),
-            state,
             gather,
             cps,
         } = self;
         let n = x.len().min(t.len()).min(f.len());
-        let end = b.min(n);
-        let mut ok = state.ok & (a > 0 || t[0].is_finite());
-        let (mut cf, mut cx) = (state.cf, state.cx);
+        let mut ok = t[0].is_finite();
+        let (mut cf, mut cx) = (0.0_f64, 0.0_f64);
         // a piece's trapezoid terms, made in a loop that vectorises (no chain) before the
         // chain adds them: the chain is then two additions a sample, which the processor
         // runs next to the gathering and the next piece's terms
         let (mut tf, mut tx) = ([0.0_f64; TERMS], [0.0_f64; TERMS]);
-        let mut s = a;
-        while s < end {
-            let e = (s + CHECKPOINT).min(end);
+        let mut s = 0_usize;
+        while s < n {
+            let e = (s + CHECKPOINT).min(n);
             gather.block(&x[s..e]);
             cps.t.push(t[s]);
             cps.f.push(cf);
@@ -261,7 +160,7 @@ impl crate::simd::Kernel for FusedPass<'_> {
             }
             s = e;
         }
-        ChainState { ok, cf, cx }
+        ok
     }
 }
 

@@ -2,13 +2,12 @@
 
 use contactlab_core::fold::{fold_phase, fold_spread, period_means, period_means_pair, FoldSums};
 use contactlab_core::raw_scan::{
-    order_stats_trapezoids, order_stats_trapezoids_uniform, period_means_pair_resumed,
-    RawScan as CoreRawScan,
+    order_stats_trapezoids, period_means_pair_resumed, RawScan as CoreRawScan,
 };
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadwriteArray1};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 
-use crate::error::{input, slice, to_pyerr};
+use crate::error::{slice, to_pyerr};
 use crate::{detach_guarded, Arr};
 
 /// Phase-bin fold of a periodic recording, accumulated chunk by chunk (see
@@ -190,38 +189,10 @@ fn order_stats_trapezoids_py<'py>(
     Ok(RawScan { inner })
 }
 
-/// `order_stats_trapezoids(x, t, F, ranks)` of a window sampled every `dt` from `t0`, its
-/// axis `t0 + dt·(offset + i)` (`fill_time`'s, bit for bit) made into `t_out` as the pass
-/// goes (`contactlab_core::raw_scan::order_stats_trapezoids_uniform`): `fill_time` and the
-/// scan in one pass; x finite (the caller's check).
-#[pyfunction]
-#[pyo3(name = "order_stats_trapezoids_uniform")]
-#[allow(clippy::too_many_arguments)]
-fn order_stats_trapezoids_uniform_py<'py>(
-    py: Python<'py>,
-    x: PyReadonlyArray1<'py, f64>,
-    f: PyReadonlyArray1<'py, f64>,
-    t0: f64,
-    dt: f64,
-    offset: u64,
-    mut t_out: PyReadwriteArray1<'py, f64>,
-    ranks: Vec<usize>,
-) -> PyResult<RawScan> {
-    let (xs, fs) = (slice(&x, "x")?, slice(&f, "F")?);
-    let ts = t_out
-        .as_slice_mut()
-        .map_err(|_| input(py, "t_out must be a contiguous array"))?;
-    let inner = detach_guarded(py, || {
-        order_stats_trapezoids_uniform(xs, fs, (t0, dt, offset), ts, &ranks)
-    })?;
-    Ok(RawScan { inner })
-}
-
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PhaseFold>()?;
     m.add_class::<RawScan>()?;
     m.add_function(wrap_pyfunction!(order_stats_trapezoids_py, m)?)?;
-    m.add_function(wrap_pyfunction!(order_stats_trapezoids_uniform_py, m)?)?;
     m.add_class::<FoldSpread>()?;
     m.add_class::<FoldTable>()?;
     m.add_function(wrap_pyfunction!(period_means_py, m)?)?;
