@@ -196,9 +196,12 @@ def _reversals(
     edge[-1] |= not bool(ex.returned[-1])
     up = ex.sign > 0
     level = np.where(up, centre + threshold, centre - threshold)
-    t_in = _crossing_times(ta, xa, ex.start, level)
     j = np.minimum(ex.last_beyond + 1, xa.size - 1)  # first sample back inside the band
-    t_mid = 0.5 * (t_in + _crossing_times(ta, xa, j, level))
+    # the crossings into and out of the band in one call (elementwise: the same numbers as
+    # two calls; 106 -> 94 us for a window's 2100 excursions)
+    m = len(ex)
+    tc = _crossing_times(ta, xa, np.concatenate([ex.start, j]), np.concatenate([level, level]))
+    t_mid = 0.5 * (tc[:m] + tc[m:])
     peak, valley = ~edge & up, ~edge & ~up
     return Reversals(
         ex.extreme[peak].astype(np.int64),
